@@ -1,0 +1,38 @@
+"""frictionlab: rms slope in contact against normal force, over ensembles of
+random rough lines pressed into elastic bodies.
+
+The framework (hooks, registry, presets, engine, fit, result files, CLI) lives
+here; the physics lives in plugins (``frictionlab_spectra``,
+``frictionlab_solvers``, ``frictionlab_slopes``) that register through the same
+hooks as any third-party plugin.
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from .hookspecs import hookimpl
+from .plugin import (
+    ContactCurve,
+    ContactSolver,
+    Plugin,
+    PluginParams,
+    Profile,
+    SlopeEstimator,
+    SpectrumGenerator,
+)
+
+try:
+    __version__ = version("frictionlab")
+except PackageNotFoundError:  # running from a source tree without install
+    __version__ = "0.0.0+unknown"
+
+__all__ = [
+    "ContactCurve",
+    "ContactSolver",
+    "Plugin",
+    "PluginParams",
+    "Profile",
+    "SlopeEstimator",
+    "SpectrumGenerator",
+    "__version__",
+    "hookimpl",
+]

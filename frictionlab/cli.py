@@ -1,0 +1,217 @@
+"""The headless front end: ``frictionlab run | validate | schema | plugins``.
+
+Results go to stdout (a short table, or JSON with ``--json``), progress and
+errors to stderr. Exit codes are ``ExitCode``. A user error never prints a
+traceback (set ``FRICTIONLAB_DEBUG=1`` to see one for an internal error).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from . import __version__
+from .errors import ExitCode, FrictionlabError, PresetError
+
+DEFAULT_RUNS_DIR = Path("runs")
+
+
+def _interval(ci) -> str:
+    low, high = ci
+    return "n/a" if low != low else f"[{low:.4f}, {high:.4f}]"  # NaN check without math
+
+
+def result_table(scene, outcome, out_dir: Path) -> str:
+    preset = scene.preset
+    lines = [
+        f"{preset.name}: {outcome.done}/{outcome.requested} realizations in {outcome.elapsed:.2f} s "
+        f"({outcome.workers} worker{'s' if outcome.workers != 1 else ''}), status {outcome.status}"
+    ]
+    fit = outcome.fit
+    if fit is not None:
+        level = f"{100 * fit.confidence:g}% CI"
+        lines += [
+            f"  xi = a + b ln f      estimate    std.err    {level} (bootstrap {fit.bootstrap})",
+            f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {_interval(fit.a_ci)}",
+            f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {_interval(fit.b_ci)}",
+            f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
+        ]
+        count = outcome.contact_count
+        unit = "F" if scene.control == "force" else "d"
+        lines.append(
+            f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
+            f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
+        )
+    if outcome.failures:
+        index, error = outcome.failures[0]
+        lines.append(f"  {len(outcome.failures)} realization(s) failed; first: #{index}: {error}")
+    lines.append(f"  results in {out_dir}/")
+    return "\n".join(lines)
+
+
+def _default_out(name: str) -> Path:
+    return DEFAULT_RUNS_DIR / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+# ------------------------------------------------------------------ commands
+
+
+def cmd_run(args) -> ExitCode:
+    from . import engine
+    from .preset import load_scene
+    from .reporter import ProgressReporter
+    from .results import summary_dict, write_results
+
+    overrides = list(args.set or [])
+    if args.seed is not None:
+        overrides.append(f"seed={args.seed}")
+    scene = load_scene(args.preset, overrides)
+    if args.workers is not None and args.workers < 1:
+        raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
+    out_dir = Path(args.out) if args.out else _default_out(scene.preset.name)
+    listeners = [] if args.quiet else [ProgressReporter()]
+    outcome = engine.run(scene, workers=args.workers, listeners=listeners)
+    try:
+        files = write_results(out_dir, scene, outcome)
+    except OSError as exc:
+        print(f"error: cannot write results to {out_dir}: {exc}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    if args.json:
+        summary = summary_dict(scene, outcome, {k: str(p) for k, p in files.items()})
+        print(json.dumps(summary, indent=2, allow_nan=False))
+    else:
+        print(result_table(scene, outcome, out_dir))
+    if outcome.status == "interrupted" or outcome.status == "cancelled":
+        return ExitCode.INTERRUPTED
+    if outcome.failures or outcome.status == "failed":
+        if outcome.error:
+            print(f"error: {outcome.error}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    return ExitCode.OK
+
+
+def cmd_validate(args) -> ExitCode:
+    from .preset import load_scene
+
+    worst = ExitCode.OK
+    for path in args.presets:
+        try:
+            scene = load_scene(path, args.set or [])
+        except PresetError as exc:
+            print(str(exc), file=sys.stderr)
+            worst = ExitCode.USAGE
+            continue
+        preset = scene.preset
+        print(
+            f"{path}: ok ({preset.realizations} realizations, {scene.spectrum.name} / {scene.solver.name} / "
+            f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps)"
+        )
+    return worst
+
+
+def cmd_schema(args) -> ExitCode:
+    from .preset import preset_json_schema
+
+    text = json.dumps(preset_json_schema(), indent=2)
+    if args.out:
+        from .results import atomic_write
+
+        atomic_write(Path(args.out), lambda fh: fh.write(text + "\n"))
+    else:
+        print(text)
+    return ExitCode.OK
+
+
+def cmd_plugins(args) -> ExitCode:
+    from .registry import default_registry
+
+    registry = default_registry()
+    infos = registry.infos()
+    if args.json:
+        rows = [
+            {"kind": i.kind, "name": i.name, "summary": i.summary, "provider": i.provider, "version": i.version}
+            for i in infos
+        ]
+        failures = [f.__dict__ for f in registry.failures]
+        print(json.dumps({"plugins": rows, "failed": failures}, indent=2))
+        return ExitCode.OK
+    header = ("KIND", "NAME", "PROVIDER", "VERSION", "SUMMARY")
+    rows = [(i.kind, i.name, i.provider, i.version, i.summary) for i in infos]
+    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(4)]
+    for row in [header, *rows]:
+        print("  ".join(cell.ljust(w) for cell, w in zip(row[:4], widths)) + "  " + row[4])
+    for failure in registry.failures:
+        print(f"failed to load: {failure.entry_point} ({failure.distribution}): {failure.error}", file=sys.stderr)
+    return ExitCode.OK
+
+
+# ------------------------------------------------------------------ parser
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="frictionlab",
+        description="rms slope in contact against normal force, over ensembles of random rough lines.",
+    )
+    parser.add_argument("--version", action="version", version=f"frictionlab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    run = sub.add_parser("run", help="run a preset headless and write its results")
+    run.add_argument("preset", help="preset YAML file")
+    run.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
+    run.add_argument(
+        "--set", action="append", metavar="PATH=VALUE", help="override a preset value, e.g. spectrum.params.hurst=0.8"
+    )
+    run.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in-process)")
+    run.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
+    run.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    run.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    run.set_defaults(handler=cmd_run)
+
+    validate = sub.add_parser("validate", help="check presets and report every problem")
+    validate.add_argument("presets", nargs="+", metavar="PRESET")
+    validate.add_argument("--set", action="append", metavar="PATH=VALUE", help="override before validating")
+    validate.set_defaults(handler=cmd_validate)
+
+    schema = sub.add_parser("schema", help="JSON Schema of presets with the installed plugins")
+    schema.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout")
+    schema.set_defaults(handler=cmd_schema)
+
+    plugins = sub.add_parser("plugins", help="list installed plugins")
+    plugins.add_argument("--json", action="store_true", help="as JSON")
+    plugins.set_defaults(handler=cmd_plugins)
+    return parser
+
+
+def _plain_warning(message, category, filename, lineno, file=None, line=None):
+    return f"warning: {message}\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    warnings.formatwarning = _plain_warning
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.handler(args))
+    except FrictionlabError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return int(exc.exit_code)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return int(ExitCode.INTERRUPTED)
+    except Exception as exc:  # an internal error: say so plainly, traceback on request
+        if os.environ.get("FRICTIONLAB_DEBUG"):
+            raise
+        print(
+            f"internal error: {type(exc).__name__}: {exc}\n(set FRICTIONLAB_DEBUG=1 for the traceback)",
+            file=sys.stderr,
+        )
+        return int(ExitCode.RUNTIME_FAILURE)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

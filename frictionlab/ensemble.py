@@ -1,0 +1,129 @@
+"""Collecting realizations into per-force statistics and the fit.
+
+Rows are stored by realization index, so the statistics do not depend on the
+order in which realizations finish (serial, pool, any worker count).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .fit import LogFit, fit_log_law
+from .preset import Scene
+from .seeds import bootstrap_rng
+
+
+@dataclass
+class RunOutcome:
+    """The statistics of what finished. Per-force arrays have one entry per load
+    step; per-realization arrays one row per finished realization, in index order."""
+
+    status: str  # completed | cancelled | interrupted | failed
+    requested: int
+    indices: np.ndarray  # finished ok, ascending
+    failures: list[tuple[int, str]]
+    loads: np.ndarray
+    force: np.ndarray  # mean total force per step
+    f: np.ndarray  # dimensionless force F / (k h L)
+    xi: np.ndarray  # ensemble mean of slope_rms_contact / slope_rms_line
+    xi_sem: np.ndarray
+    contact_count: np.ndarray  # ensemble mean
+    contact_fraction: np.ndarray
+    indentation: np.ndarray
+    per_realization: dict[str, np.ndarray]
+    fit: LogFit | None
+    rms_height: float
+    length: float
+    stiffness: float
+    elapsed: float
+    workers: int
+    error: str | None = None
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def done(self) -> int:
+        return int(self.indices.size)
+
+
+class Accumulator:
+    """Collects RealizationResults of one scene."""
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+        self.loads = scene.loads
+        self.results = {}
+        self.failures: dict[int, str] = {}
+
+    @property
+    def done(self) -> int:
+        return len(self.results) + len(self.failures)
+
+    def add(self, result) -> None:
+        if result.ok:
+            self.results[result.index] = result
+        else:
+            self.failures[result.index] = result.error
+
+    def stack(self, name: str) -> np.ndarray:
+        rows = [getattr(self.results[i], name) for i in sorted(self.results)]
+        return np.vstack(rows) if rows else np.empty((0, self.loads.size))
+
+    def finish(self, *, status: str, elapsed: float, workers: int, error: str | None = None) -> RunOutcome:
+        scene = self.scene
+        indices = np.array(sorted(self.results), dtype=np.int64)
+        per = {
+            "index": indices,
+            "xi": self.stack("xi"),
+            "contact_count": self.stack("contact_count").astype(np.int64),
+            "indentation": self.stack("indentation"),
+            "slope_rms_line": np.array([self.results[i].slope_rms_line for i in indices]),
+        }
+        if scene.control == "indentation":
+            per["force"] = self.stack("force")
+        n = indices.size
+        first = self.results[indices[0]] if n else None
+        points = first.points if first else 0
+        length = first.length if first else math.nan
+        rms_height = float(scene.spectrum.rms_height()) if n else math.nan
+        stiffness = float(scene.solver.stiffness())
+        force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
+        f = force / (stiffness * rms_height * length) if n else np.full(self.loads.size, math.nan)
+        nan_row = np.full(self.loads.size, math.nan)
+        xi_mean = per["xi"].mean(axis=0) if n else nan_row
+        xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
+        count = per["contact_count"].mean(axis=0) if n else nan_row
+        fit = None
+        if n:
+            settings = scene.preset.fit
+            fit = fit_log_law(
+                f,
+                per["xi"],
+                bootstrap=settings.bootstrap,
+                confidence=settings.confidence,
+                rng=bootstrap_rng(scene.preset.seed),
+            )
+        return RunOutcome(
+            status=status,
+            requested=scene.preset.realizations,
+            indices=indices,
+            failures=sorted(self.failures.items()),
+            loads=self.loads,
+            force=force,
+            f=f,
+            xi=xi_mean,
+            xi_sem=xi_sem,
+            contact_count=count,
+            contact_fraction=count / points if points else nan_row,
+            indentation=per["indentation"].mean(axis=0) if n else nan_row,
+            per_realization=per,
+            fit=fit,
+            rms_height=rms_height,
+            length=length,
+            stiffness=stiffness,
+            elapsed=elapsed,
+            workers=workers,
+            error=error,
+        )

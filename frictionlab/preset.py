@@ -1,0 +1,312 @@
+"""Presets: YAML scenes, validated in two phases into a ``Scene``.
+
+Phase one checks the structure (``Preset``); phase two looks up each named
+plugin and validates its ``params`` with the plugin's own ``Params`` model.
+Every problem is reported, each as ``dotted.path: what is wrong, got VALUE``.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .errors import PluginError, PresetError
+from .plugin import ContactSolver, SlopeEstimator, SpectrumGenerator
+from .registry import Registry, default_registry
+
+PLUGIN_SLOTS = {"spectrum": "spectrum", "solver": "solver", "slope": "slope"}  # preset key -> kind
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class PluginChoice(_Strict):
+    name: str = Field(description="Name of the plugin (see `frictionlab plugins`).")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="The plugin's parameters (see `frictionlab schema`)."
+    )
+
+
+class Loading(_Strict):
+    control: Literal["force", "indentation"] = Field(
+        "force", description="Whether the loads are total normal forces or indentations (rigid-body approach)."
+    )
+    start: float = Field(gt=0, description="First load (force, or indentation), > 0.")
+    stop: float = Field(gt=0, description="Last load, >= start.")
+    steps: int = Field(ge=2, le=1_000_000, description="Number of load steps, start and stop included.")
+    spacing: Literal["linear", "log"] = Field("linear", description="Load steps evenly spaced in value or in log.")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.stop <= self.start:
+            raise ValueError(f"stop must be > start ({self.start}). Got {self.stop} instead.")
+        return self
+
+    def values(self) -> np.ndarray:
+        if self.spacing == "log":
+            return np.geomspace(self.start, self.stop, self.steps)
+        return np.linspace(self.start, self.stop, self.steps)
+
+
+class FitSettings(_Strict):
+    bootstrap: int = Field(
+        1000, ge=0, le=100_000, description="Bootstrap resamples over realizations for the intervals (0: none)."
+    )
+    confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level of the intervals.")
+
+
+class OutputSettings(_Strict):
+    realizations: bool = Field(True, description="Keep per-realization curves in realizations.npz.")
+    plot: bool = Field(True, description="Draw plot.png (xi against f with the fit).")
+
+
+class Preset(_Strict):
+    name: str = Field(min_length=1, description="Short name of the scene; names the default output folder.")
+    description: str = Field("", description="What the scene is and where its numbers come from.")
+    seed: int = Field(0, ge=0, description="Root seed: realization i uses SeedSequence(seed, spawn_key=(0, i)).")
+    realizations: int = Field(ge=1, le=10_000_000, description="Number of independent random lines (M).")
+    spectrum: PluginChoice = Field(description="Spectrum generator: how the rough lines are made.")
+    solver: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(name="mdr"), description="Contact solver."
+    )
+    slope: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(name="forward-difference"), description="Slope estimator."
+    )
+    loading: Loading = Field(description="The load sweep.")
+    fit: FitSettings = Field(default_factory=FitSettings, description="Fit of xi = a + b ln f.")
+    output: OutputSettings = Field(default_factory=OutputSettings, description="What is written.")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated preset with its plugins instantiated: what the engine runs."""
+
+    preset: Preset
+    spectrum: SpectrumGenerator
+    solver: ContactSolver
+    slope: SlopeEstimator
+
+    @property
+    def loads(self) -> np.ndarray:
+        return self.preset.loading.values()
+
+    @property
+    def control(self) -> str:
+        return self.preset.loading.control
+
+    def resolved(self) -> dict:
+        """The preset with every default filled in, plugin params included."""
+        data = self.preset.model_dump(mode="json")
+        for slot in PLUGIN_SLOTS:
+            plugin = getattr(self, slot)
+            data[slot] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
+        return data
+
+
+# ------------------------------------------------------------------ messages
+
+
+def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
+    """Field names of the model reached by walking ``loc`` into ``model``."""
+    for part in loc:
+        if model is None or not isinstance(part, str) or part not in model.model_fields:
+            return []
+        annotation = model.model_fields[part].annotation
+        model = annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+    return sorted(model.model_fields) if model is not None else []
+
+
+def _describe(error: dict, model: type[BaseModel]) -> str:
+    kind, ctx = error["type"], error.get("ctx", {})
+    comparisons = {
+        "less_than_equal": ("<=", "le"),
+        "less_than": ("<", "lt"),
+        "greater_than_equal": (">=", "ge"),
+        "greater_than": (">", "gt"),
+    }
+    if kind in comparisons:
+        symbol, key = comparisons[kind]
+        return f"must be {symbol} {ctx[key]}"
+    if kind == "extra_forbidden":
+        allowed = _allowed_keys(model, tuple(error["loc"][:-1]))
+        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "")
+    if kind == "missing":
+        return "is required"
+    if kind == "literal_error":
+        return f"must be one of {ctx['expected']}"
+    if kind in {"int_parsing", "int_type", "int_from_float"}:
+        return "must be a whole number"
+    if kind in {"float_parsing", "float_type", "finite_number"}:
+        return "must be a finite number" if kind == "finite_number" else "must be a number"
+    if kind in {"bool_parsing", "bool_type"}:
+        return "must be true or false"
+    if kind in {"string_type"}:
+        return "must be text"
+    if kind in {"dict_type", "model_type", "model_attributes_type"}:
+        return "must be a mapping of keys to values"
+    if kind == "string_too_short":
+        return "must not be empty"
+    message = error["msg"]
+    for prefix in ("Value error, ", "Assertion failed, "):
+        message = message.removeprefix(prefix)
+    return message[:1].lower() + message[1:]
+
+
+def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix: str = "") -> list[str]:
+    """One line per pydantic error: ``path: message, got value``."""
+    lines = []
+    for error in exc.errors(include_url=False):
+        path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
+        line = f"{path or '(preset)'}: {_describe(error, model)}"
+        if error["type"] != "missing" and not (error["type"] == "value_error" and not error["loc"]):
+            line += f", got {error['input']!r}"
+        lines.append(line)
+    return lines
+
+
+# ------------------------------------------------------------------ loading
+
+
+def load_preset_file(path: str | Path) -> dict:
+    """Read a preset file with ``yaml.safe_load``; errors become PresetError."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise PresetError([f"(file): no such preset file: {path}"], source=str(path)) from None
+    except OSError as exc:
+        raise PresetError([f"(file): cannot read {path}: {exc.strerror}"], source=str(path)) from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise PresetError([f"(file): not valid YAML{where}: {problem}"], source=str(path)) from None
+    if not isinstance(data, dict):
+        raise PresetError(
+            [f"(file): a preset must be a mapping of keys to values. Got {type(data).__name__} instead."],
+            source=str(path),
+        )
+    return data
+
+
+def apply_overrides(data: dict, assignments: list[str]) -> dict:
+    """Apply ``dotted.path=value`` assignments (values parsed as YAML scalars)."""
+    data = copy.deepcopy(data)
+    problems = []
+    for assignment in assignments:
+        path, sep, raw = assignment.partition("=")
+        keys = [k.strip() for k in path.split(".")]
+        if not sep or not all(keys):
+            problems.append(f"--set {assignment!r}: must look like dotted.path=value, e.g. spectrum.params.hurst=0.8")
+            continue
+        try:
+            value = yaml.safe_load(raw) if raw.strip() else ""
+        except yaml.YAMLError:
+            value = raw
+        node = data
+        for depth, key in enumerate(keys[:-1]):
+            child = node.get(key)
+            if child is None:
+                child = node[key] = {}
+            if not isinstance(child, dict):
+                problems.append(
+                    f"--set {assignment!r}: {'.'.join(keys[: depth + 1])} is a value, not a mapping"
+                )
+                break
+            node = child
+        else:
+            node[keys[-1]] = value
+    if problems:
+        raise PresetError(problems, source="--set")
+    return data
+
+
+def build_scene(data: dict, registry: Registry | None = None, source: str | None = None) -> Scene:
+    """Validate preset data (structure, then each plugin's params) into a Scene."""
+    registry = registry or default_registry()
+    if not isinstance(data, dict):
+        raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
+    try:
+        preset = Preset.model_validate(data)
+    except ValidationError as exc:
+        problems = format_validation_error(exc, Preset)
+        # Check the plugin sections that are well formed too, so every problem shows at once.
+        for slot, kind in PLUGIN_SLOTS.items():
+            try:
+                choice = PluginChoice.model_validate(data.get(slot))
+            except ValidationError:
+                continue
+            problems += _plugin_problems(registry, slot, kind, choice)[1]
+        raise PresetError(problems, source=source) from None
+    plugins, problems = {}, []
+    for slot, kind in PLUGIN_SLOTS.items():
+        instance, slot_problems = _plugin_problems(registry, slot, kind, getattr(preset, slot))
+        plugins[slot] = instance
+        problems += slot_problems
+    if problems:
+        raise PresetError(problems, source=source)
+    # Store normalised plugin names so the resolved preset is canonical.
+    for slot in PLUGIN_SLOTS:
+        getattr(preset, slot).name = plugins[slot].name
+    return Scene(preset=preset, **plugins)
+
+
+def _plugin_problems(registry: Registry, slot: str, kind: str, choice: PluginChoice):
+    try:
+        cls = registry.get(kind, choice.name)
+    except PluginError as exc:
+        return None, [f"{slot}.name: {exc}"]
+    try:
+        params = cls.Params.model_validate(choice.params)
+    except ValidationError as exc:
+        return None, format_validation_error(exc, cls.Params, prefix=f"{slot}.params")
+    return cls(params), []
+
+
+def load_scene(
+    path: str | Path, overrides: list[str] = (), registry: Registry | None = None
+) -> Scene:
+    """File -> overrides -> validated Scene."""
+    data = apply_overrides(load_preset_file(path), list(overrides))
+    return build_scene(data, registry=registry, source=str(path))
+
+
+# ------------------------------------------------------------------ schema
+
+
+def preset_json_schema(registry: Registry | None = None) -> dict:
+    """JSON Schema of a preset, with each installed plugin's params, for editors."""
+    registry = registry or default_registry()
+    schema = Preset.model_json_schema()
+    defs = schema.setdefault("$defs", {})
+    for slot, kind in PLUGIN_SLOTS.items():
+        variants = []
+        for info in registry.infos(kind):
+            params_schema = info.cls.Params.model_json_schema(ref_template="#/$defs/{model}")
+            for def_name, definition in params_schema.pop("$defs", {}).items():
+                defs.setdefault(def_name, definition)
+            variants.append(
+                {
+                    "type": "object",
+                    "title": info.name,
+                    "description": info.summary,
+                    "properties": {"name": {"const": info.name}, "params": params_schema},
+                    "required": ["name"],
+                    "additionalProperties": False,
+                }
+            )
+        description = schema["properties"][slot].get("description", "")
+        schema["properties"][slot] = {"description": description, "oneOf": variants}
+    defs.pop("PluginChoice", None)
+    schema["title"] = "frictionlab preset"
+    return schema
+

@@ -1,0 +1,240 @@
+"""The plugin registry: built-ins, entry-point discovery, environment switches.
+
+Built-in physics registers through the same hooks as any third-party plugin.
+Environment switches (read when a registry is built):
+
+``FRICTIONLAB_DISABLE_DISCOVERY=1``  load built-ins only, no entry points
+``FRICTIONLAB_PLUGINS=a,b``          load only these entry points
+``FRICTIONLAB_BLOCK_PLUGINS=a,b``    never load these entry points
+``FRICTIONLAB_TRACE_HOOKS=1``        trace every hook call on stderr
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+import importlib
+import importlib.metadata as md
+import os
+import sys
+import warnings
+from dataclasses import dataclass
+
+import pluggy
+from pydantic import BaseModel
+
+from .errors import PluginError
+from .hookspecs import PROJECT_NAME, RegistrationSpecs
+from .plugin import KINDS, NAME_PATTERN, Plugin
+
+ENTRY_POINT_GROUP = PROJECT_NAME
+BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
+KIND_HOOKS = {
+    "spectrum": "register_spectra",
+    "solver": "register_solvers",
+    "slope": "register_slope_estimators",
+}
+
+
+def normalize_name(name: str) -> str:
+    """Preset keys are case- and separator-insensitive: ``Power_Law`` -> ``power-law``."""
+    return name.strip().lower().replace("_", "-").replace(" ", "-")
+
+
+def _env_list(env, key: str) -> list[str]:
+    return [item.strip() for item in env.get(key, "").split(",") if item.strip()]
+
+
+def _env_flag(env, key: str) -> bool:
+    return env.get(key, "").strip().lower() in {"1", "true", "yes", "on"}
+
+
+@dataclass(frozen=True)
+class PluginInfo:
+    kind: str
+    name: str
+    cls: type[Plugin]
+    provider: str
+    version: str
+
+    @property
+    def summary(self) -> str:
+        return self.cls.summary
+
+
+@dataclass(frozen=True)
+class LoadFailure:
+    entry_point: str
+    distribution: str
+    error: str
+
+
+@functools.cache
+def _module_distributions() -> dict[str, list[str]]:
+    return md.packages_distributions()
+
+
+def _provider_of(cls: type) -> tuple[str, str]:
+    """The distribution (and version) that ships ``cls``, from its module."""
+    top = cls.__module__.split(".")[0]
+    dists = _module_distributions().get(top)
+    if dists:
+        dist = dists[0]
+        try:
+            return dist, md.version(dist)
+        except md.PackageNotFoundError:  # pragma: no cover - broken metadata
+            return dist, "unknown"
+    return cls.__module__, "unversioned"
+
+
+def validate_plugin_class(kind: str, cls) -> None:
+    """Raise PluginError if ``cls`` does not fulfil the plugin contract of ``kind``."""
+    base = KINDS[kind]
+    label = getattr(cls, "__qualname__", repr(cls))
+    if not (isinstance(cls, type) and issubclass(cls, base)):
+        raise PluginError(f"{label}: a {kind} plugin must subclass frictionlab.{base.__name__}")
+    if not isinstance(cls.name, str) or not NAME_PATTERN.match(cls.name):
+        raise PluginError(
+            f"{label}: name must be kebab-case (lowercase words joined by '-'). "
+            f"Got {cls.name!r} instead."
+        )
+    if not isinstance(cls.summary, str) or not cls.summary.strip() or "\n" in cls.summary.strip():
+        raise PluginError(f"{label}: summary must be one non-empty line. Got {cls.summary!r} instead.")
+    params = cls.Params
+    if not (isinstance(params, type) and issubclass(params, BaseModel)):
+        raise PluginError(f"{label}: Params must be a pydantic model")
+    if params.model_config.get("extra") != "forbid":
+        raise PluginError(f"{label}: Params must forbid unknown keys (model_config extra='forbid')")
+    for field_name, info in params.model_fields.items():
+        if not info.description:
+            raise PluginError(f"{label}: Params.{field_name} has no description")
+
+
+class Registry:
+    """Every installed plugin class, by kind and name."""
+
+    def __init__(self, *, discover: bool = True, builtins: bool = True, env=None):
+        env = os.environ if env is None else env
+        self.pm = pluggy.PluginManager(PROJECT_NAME)
+        self.pm.add_hookspecs(RegistrationSpecs)
+        self.failures: list[LoadFailure] = []
+        self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
+            self.pm.trace.root.setwriter(sys.stderr.write)
+            self.pm.enable_tracing()
+        if builtins:
+            for module_name in BUILTIN_MODULES:
+                self.pm.register(importlib.import_module(module_name), name=module_name)
+        if discover and not _env_flag(env, "FRICTIONLAB_DISABLE_DISCOVERY"):
+            self._load_entry_points(
+                only=_env_list(env, "FRICTIONLAB_PLUGINS"),
+                blocked=_env_list(env, "FRICTIONLAB_BLOCK_PLUGINS"),
+            )
+        self.pm.check_pending()
+        self._collect()
+
+    # ------------------------------------------------------------- loading
+
+    def _load_entry_points(self, only: list[str], blocked: list[str]) -> None:
+        for name in blocked:
+            self.pm.set_blocked(name)
+        for ep in md.entry_points(group=ENTRY_POINT_GROUP):
+            if (only and ep.name not in only) or self.pm.is_blocked(ep.name):
+                continue
+            if self.pm.get_plugin(ep.name) is not None:
+                continue
+            dist = ep.dist.name if ep.dist else "unknown distribution"
+            try:
+                plugin = ep.load()
+                self.pm.register(plugin, name=ep.name)
+            except Exception as exc:  # a broken plugin must not break the tool
+                message = f"{type(exc).__name__}: {exc}"
+                self.failures.append(LoadFailure(ep.name, dist, message))
+                warnings.warn(
+                    f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+
+    def register_plugin(self, plugin, name: str | None = None) -> None:
+        """Register a plugin object (module or class with hookimpls) and re-collect.
+
+        If the plugin is rejected (a misspelled hook: ``pluggy.PluginValidationError``;
+        a class breaking the contract or clashing with another: ``PluginError``),
+        it is unregistered again before the error propagates, so the registry is
+        left as it was.
+        """
+        was_registered = self.pm.is_registered(plugin)
+        try:
+            self.pm.register(plugin, name=name)
+            self.pm.check_pending()
+            self._collect()
+        except BaseException:
+            if not was_registered and self.pm.is_registered(plugin):
+                self.pm.unregister(plugin)
+                self._collect()
+            raise
+
+    def unregister_plugin(self, plugin) -> None:
+        self.pm.unregister(plugin)
+        self._collect()
+
+    def _collect(self) -> None:
+        tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        for kind, hook_name in KIND_HOOKS.items():
+
+            def register(cls, _kind=kind):
+                validate_plugin_class(_kind, cls)
+                provider, version = _provider_of(cls)
+                key = normalize_name(cls.name)
+                previous = tables[_kind].get(key)
+                if previous is not None and previous.cls is not cls:
+                    raise PluginError(
+                        f"two {_kind} plugins are named {key!r}: "
+                        f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
+                        f"and {cls.__module__}.{cls.__qualname__} from {provider}; "
+                        "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
+                    )
+                tables[_kind][key] = PluginInfo(_kind, key, cls, provider, version)
+
+            getattr(self.pm.hook, hook_name)(register=register)
+        self._plugins = tables
+
+    # ------------------------------------------------------------- queries
+
+    def names(self, kind: str) -> list[str]:
+        return sorted(self._plugins[kind])
+
+    def infos(self, kind: str | None = None) -> list[PluginInfo]:
+        kinds = [kind] if kind else list(KINDS)
+        return [self._plugins[k][n] for k in kinds for n in sorted(self._plugins[k])]
+
+    def get(self, kind: str, name: str) -> type[Plugin]:
+        return self.info(kind, name).cls
+
+    def info(self, kind: str, name: str) -> PluginInfo:
+        if kind not in self._plugins:
+            raise PluginError(f"unknown plugin kind {kind!r}; kinds are {', '.join(KINDS)}")
+        key = normalize_name(name)
+        try:
+            return self._plugins[kind][key]
+        except KeyError:
+            raise PluginError(self.not_found_message(kind, name)) from None
+
+    def not_found_message(self, kind: str, name: str) -> str:
+        installed = self.names(kind)
+        close = difflib.get_close_matches(normalize_name(name), installed, n=3, cutoff=0.5)
+        message = f"no {kind} plugin named {name!r}"
+        if close:
+            message += f"; did you mean {' or '.join(repr(c) for c in close)}?"
+        message += f" Installed {kind} plugins: {', '.join(installed) or 'none'}."
+        if self.failures:
+            broken = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error}" for f in self.failures)
+            message += f" Plugins that failed to load: {broken}."
+        return message
+
+
+@functools.cache
+def default_registry() -> Registry:
+    """The process-wide registry, built on first use."""
+    return Registry()

@@ -1,0 +1,126 @@
+"""Result files of a run. Every file is written to a temporary name in the same
+folder and renamed into place, so a reader never sees half a file and an
+interrupted write leaves the previous version intact.
+
+Files in the output folder::
+
+    summary.json       what ran, the fit, where the arrays are
+    curve.csv          one row per load step
+    realizations.npz   per-realization curves (output.realizations)
+    preset.yaml        the resolved preset (every default filled in)
+    plot.png           xi against f with the fit (output.plot)
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import platform
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from . import __version__
+from .ensemble import RunOutcome
+from .fit import json_safe
+from .preset import Scene
+
+SUMMARY_SCHEMA_VERSION = 1
+CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
+
+
+def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
+    """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> dict:
+    fit = outcome.fit.to_dict() if outcome.fit else None
+    counts = outcome.contact_count
+    return {
+        "schema_version": SUMMARY_SCHEMA_VERSION,
+        "frictionlab_version": __version__,
+        "python": platform.python_version(),
+        "preset": scene.resolved(),
+        "seed": scene.preset.seed,
+        "status": outcome.status,
+        "error": outcome.error,
+        "realizations": {
+            "requested": outcome.requested,
+            "done": outcome.done,
+            "failed": len(outcome.failures),
+            "failures": [{"index": i, "error": e} for i, e in outcome.failures[:20]],
+        },
+        "fit": fit,
+        "normalisation": {
+            "rms_height": json_safe(outcome.rms_height),
+            "length": json_safe(outcome.length),
+            "stiffness": outcome.stiffness,
+            "f": "F / (stiffness * rms_height * length)",
+        },
+        "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
+        "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
+        "elapsed_seconds": round(outcome.elapsed, 6),
+        "workers": outcome.workers,
+        "files": files,
+    }
+
+
+def _write_curve(outcome: RunOutcome, fh) -> None:
+    writer = csv.writer(fh, lineterminator="\n")
+    writer.writerow(CURVE_COLUMNS)
+    columns = (
+        outcome.force,
+        outcome.f,
+        outcome.xi,
+        outcome.xi_sem,
+        outcome.contact_count,
+        outcome.contact_fraction,
+        outcome.indentation,
+    )
+    for row in zip(*columns, strict=True):
+        writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
+
+
+def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dict[str, Path]:
+    """Write every output file of ``outcome`` into ``out_dir``; return their paths."""
+    out = Path(out_dir)
+    files: dict[str, Path] = {}
+
+    files["curve"] = out / "curve.csv"
+    atomic_write(files["curve"], lambda fh: _write_curve(outcome, fh))
+
+    files["preset"] = out / "preset.yaml"
+    atomic_write(files["preset"], lambda fh: yaml.safe_dump(scene.resolved(), fh, sort_keys=False))
+
+    if scene.preset.output.realizations:
+        files["realizations"] = out / "realizations.npz"
+        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f}
+        atomic_write(files["realizations"], lambda fh: np.savez_compressed(fh, **arrays), binary=True)
+
+    if scene.preset.output.plot and outcome.done:
+        from .plot import plot_curve  # matplotlib is slow to import: only when drawing
+
+        files["plot"] = out / "plot.png"
+        atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
+
+    files["summary"] = out / "summary.json"  # last: its presence means the rest is complete
+    summary = summary_dict(scene, outcome, {k: p.name for k, p in files.items() if k != "summary"})
+    atomic_write(files["summary"], lambda fh: json.dump(summary, fh, indent=2, allow_nan=False))
+    return files

@@ -1,0 +1,12 @@
+"""Built-in contact solvers of frictionlab (SPEC section 3)."""
+
+from frictionlab import hookimpl
+
+from .springs import BisectionSprings, MDRSprings, WinklerSprings
+
+
+@hookimpl
+def register_solvers(register):
+    register(MDRSprings)
+    register(WinklerSprings)
+    register(BisectionSprings)

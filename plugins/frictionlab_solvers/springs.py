@@ -1,0 +1,340 @@
+"""Rows of independent springs under a rigid rough line (SPEC section 3).
+
+Each grid point is a spring of stiffness ``K = k dx``. Pressed with a total force
+F, the rigid line sinks to the level c with ``F = K * sum_i max(0, z_i - c)``;
+the points in contact are those strictly above the level (``z_i > c``).
+
+Everything is computed in *depths below the top*, ``u_i = max(z) - z_i >= 0``,
+so that the indentation ``d = max(z) - c`` is formed without cancellation
+whatever the offset or scale of the heights. In those variables
+
+    F / K = sum_i max(0, d - u_i),      contact set = {i : u_i < d}.
+
+The contact sets of a sweep are nested (the n shallowest points), so one sort
+of the depths solves every load at once (:class:`SpringRow`); the bisection
+per load (:class:`BisectionSprings`) is kept as the slow baseline and oracle.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from pydantic import Field
+
+from frictionlab import ContactCurve, ContactSolver, PluginParams, Profile
+from frictionlab.plugin import Control
+
+MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
+
+# Relative widening of the candidate bound under force control: a few rounding
+# errors of the bound itself. Extra candidates cost nothing but sorting time.
+_BOUND_SLACK = 16 * np.finfo(float).eps
+
+__all__ = ["BisectionSprings", "MDRSprings", "SpringRow", "WinklerSprings", "effective_modulus"]
+
+
+def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
+    """Plane-strain modulus E* = E / (1 - nu^2); infinite is rejected (nu = +-1)."""
+    denominator = 1.0 - poisson_ratio * poisson_ratio
+    if denominator <= 0.0:
+        raise ValueError(
+            f"poisson_ratio = {poisson_ratio} gives 1 - nu^2 = {denominator}: "
+            "the effective modulus E/(1 - nu^2) is not finite"
+        )
+    return youngs_modulus / denominator
+
+
+# --------------------------------------------------------------- validation
+
+
+def _check_control(control: str) -> None:
+    if control not in ("force", "indentation"):
+        raise ValueError(f"control must be 'force' or 'indentation'. Got {control!r} instead.")
+
+
+def _check_loads(loads, control: str) -> np.ndarray:
+    loads = np.asarray(loads, dtype=float)
+    what = "force" if control == "force" else "indentation"
+    if loads.ndim != 1:
+        raise ValueError(f"loads must be a 1D array of {what}s. Got shape {loads.shape} instead.")
+    if loads.size == 0:
+        raise ValueError(f"loads is empty: give at least one {what}")
+    good = np.isfinite(loads) & (loads > 0.0)
+    if not good.all():
+        j = int(np.argmin(good))
+        value = loads[j]
+        problem = "not finite" if not np.isfinite(value) else "not positive"
+        raise ValueError(
+            f"every load must be a finite positive {what}: load {j} is {value!r} ({problem})"
+        )
+    return loads
+
+
+def _check_line(profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
+    heights = np.asarray(profile.heights, dtype=float)
+    if heights.ndim != 1 or heights.size == 0:
+        raise ValueError(
+            f"spring solvers press a line: heights must have shape (N,) with N >= 1. "
+            f"Got shape {heights.shape} instead."
+        )
+    slopes = np.asarray(slopes, dtype=float)
+    if slopes.shape != heights.shape:
+        raise ValueError(
+            f"slopes must have the shape of the heights {heights.shape}. Got {slopes.shape} instead."
+        )
+    spacing = float(profile.spacing)
+    if not (np.isfinite(spacing) and spacing > 0.0):
+        raise ValueError(f"profile spacing must be finite and positive. Got {spacing!r} instead.")
+    return heights, slopes, spacing
+
+
+def _top(heights: np.ndarray) -> float:
+    zmax = float(heights.max())  # NaN propagates through max
+    if not np.isfinite(zmax):
+        raise ValueError(f"heights must be finite; their maximum is {zmax!r}")
+    return zmax
+
+
+def _line_rms(slopes: np.ndarray) -> float:
+    """The whole-line rms slope, formed exactly as the engine forms it."""
+    return float(np.sqrt(np.mean(np.square(slopes))))
+
+
+# ------------------------------------------------------------ the sorted sweep
+
+
+class SpringRow(ContactSolver):
+    """Independent springs of stiffness ``stiffness() * dx``: exact sweep from one
+    (partial) sort. Not registered itself; subclasses only define ``stiffness``.
+
+    ``extras["candidates"]`` (one entry per load, the same for the whole sweep):
+    how many points were sorted. Only points shallower than the largest load can
+    reach (``u < F_max / (k dx)`` or ``u < d_max``) are candidates: a single
+    point in contact already carries ``k dx * d``, so ``d <= F / (k dx)``.
+    """
+
+    def solve(
+        self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
+    ) -> ContactCurve:
+        _check_control(control)
+        loads = _check_loads(loads, control)
+        heights, slopes, spacing = _check_line(profile, slopes)
+        points = heights.size
+        spring = self.stiffness() * spacing  # K = k dx
+        if not (np.isfinite(spring) and spring > 0.0):
+            raise ValueError(f"spring stiffness k dx must be finite and positive. Got {spring!r} instead.")
+
+        zmax = _top(heights)
+        if control == "force":
+            reach = loads / spring  # F / K: an upper bound of the indentation
+            bound = float(reach.max()) * (1.0 + _BOUND_SLACK)
+        else:
+            reach = loads
+            bound = float(reach.max())
+
+        # Candidates: z >= fl(zmax - bound) keeps every float with u < bound
+        # (round-to-nearest cannot put a float strictly between the two).
+        candidates = np.flatnonzero(heights >= zmax - bound)
+        count = candidates.size
+        if count == points:  # everything may touch: one full sort
+            depth = zmax - heights
+            order = np.argsort(depth, kind="stable")
+            u = depth[order]
+        else:
+            depth = zmax - heights[candidates]
+            perm = np.argsort(depth, kind="stable")
+            order = candidates[perm]
+            u = depth[perm]  # sorted depths, u[0] == 0 (the top)
+        if not np.isfinite(u[-1]):
+            raise ValueError("heights must be finite")
+
+        # G[m] = (force at which point m+1 starts touching) / K
+        #      = sum_{j=1..m} j (u[j] - u[j-1]): a cumsum of non-negative terms.
+        onset = np.empty(count)
+        onset[0] = 0.0
+        if count > 1:
+            np.cumsum(np.arange(1, count) * np.diff(u), out=onset[1:])
+
+        if control == "force":
+            n = np.searchsorted(onset, reach, side="left")  # #{m : G[m] < F/K} >= 1
+            prefix = np.cumsum(u)
+            indentation = (reach + prefix[n - 1]) / n  # d = (F/K + sum of n depths) / n
+            # Keep the exact invariant u[n-1] < d <= u[n] against the last rounding.
+            indentation = np.maximum(indentation, np.nextafter(u[n - 1], np.inf))
+            inside = n < count
+            if inside.any():
+                indentation[inside] = np.minimum(indentation[inside], u[n[inside]])
+            force = loads.copy()
+        else:
+            indentation = loads.copy()
+            n = np.searchsorted(u, indentation, side="left")  # #{i : u_i < d} >= 1
+            # F/K = G[n-1] + n (d - u[n-1]): both terms non-negative, no cancellation.
+            force = spring * (onset[n - 1] + n * (indentation - u[n - 1]))
+
+        squares = np.square(slopes[order])
+        cumulative = np.cumsum(squares)
+        if not np.isfinite(cumulative[-1]):
+            raise ValueError("slopes must be finite (and their squares must not overflow)")
+        slope_rms = np.sqrt(cumulative[n - 1] / n)
+        if count == points:
+            full = n == points
+            if full.any():  # xi = 1 to the last bit at full contact
+                slope_rms[full] = _line_rms(slopes)
+
+        n = n.astype(np.int64, copy=False)
+        return ContactCurve(
+            force=force,
+            indentation=indentation,
+            contact_count=n,
+            contact_fraction=n / points,
+            slope_rms_contact=slope_rms,
+            extras={"candidates": np.full(loads.size, count, dtype=np.int64)},
+        )
+
+
+# -------------------------------------------------------------------- plugins
+
+
+class MDRSprings(SpringRow):
+    name: ClassVar[str] = "mdr"
+    summary: ClassVar[str] = (
+        "MDR springs of stiffness E* dx: exact load sweep from one partial sort of the heights"
+    )
+    references: ClassVar[tuple[str, ...]] = (MDR_BOOK,)
+
+    class Params(PluginParams):
+        youngs_modulus: float = Field(
+            1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body"
+        )
+        poisson_ratio: float = Field(
+            0.0,
+            gt=-1.0,
+            le=0.5,
+            allow_inf_nan=False,
+            description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
+        )
+
+    def stiffness(self) -> float:
+        """E* = E / (1 - nu^2)."""
+        return effective_modulus(self.params.youngs_modulus, self.params.poisson_ratio)
+
+
+class WinklerSprings(SpringRow):
+    name: ClassVar[str] = "winkler"
+    summary: ClassVar[str] = (
+        "Winkler foundation: independent springs of a given modulus per unit length, exact sweep"
+    )
+    references: ClassVar[tuple[str, ...]] = ()
+
+    class Params(PluginParams):
+        modulus: float = Field(
+            1.0,
+            gt=0.0,
+            allow_inf_nan=False,
+            description="foundation modulus: stiffness per unit length of line (e.g. E/t for a thin layer of thickness t)",
+        )
+
+    def stiffness(self) -> float:
+        return float(self.params.modulus)
+
+
+# ------------------------------------------------------------- naive baseline
+
+
+class BisectionSprings(ContactSolver):
+    """The naive method: for each force separately, bisect the indentation over
+    the full array until the force matches to ``tolerance`` (relative).
+
+    Contact counts are exact, not tolerance-limited: at the end the true
+    indentation d* lies in the final bracket (lo, hi]; points with u <= lo are
+    in contact, points with u >= hi are not, and a point whose depth lies inside
+    the bracket (a tie with the level, e.g. a plateau reached exactly at this
+    force) is in contact iff the force at d = u is below the load, i.e. iff
+    u < d*. The reported indentation is the last midpoint (within tolerance).
+
+    ``extras``: ``iterations`` (bisection steps per load, 0 under indentation
+    control) and ``residual`` (|F(d) - F| / F at the reported indentation).
+    """
+
+    name: ClassVar[str] = "mdr-bisection"
+    summary: ClassVar[str] = (
+        "MDR springs solved by bisection per load: the slow baseline for benchmarks and checks"
+    )
+    references: ClassVar[tuple[str, ...]] = (MDR_BOOK,)
+
+    class Params(MDRSprings.Params):
+        tolerance: float = Field(
+            1e-10, gt=0.0, le=0.1, allow_inf_nan=False, description="relative tolerance on the force of each load step"
+        )
+        max_iterations: int = Field(
+            200, ge=1, le=10_000, description="maximum bisection steps per load"
+        )
+
+    def stiffness(self) -> float:
+        """E* = E / (1 - nu^2)."""
+        return effective_modulus(self.params.youngs_modulus, self.params.poisson_ratio)
+
+    def solve(
+        self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
+    ) -> ContactCurve:
+        _check_control(control)
+        loads = _check_loads(loads, control)
+        heights, slopes, spacing = _check_line(profile, slopes)
+        points = heights.size
+        spring = self.stiffness() * spacing
+        depth = _top(heights) - heights  # u_i >= 0
+        if not np.isfinite(depth).all():
+            raise ValueError("heights must be finite")
+
+        def reduced_force(d: float) -> float:  # F(d) / K
+            return float(np.maximum(d - depth, 0.0).sum())
+
+        steps = loads.size
+        indentation = np.empty(steps)
+        force = np.empty(steps)
+        count = np.empty(steps, dtype=np.int64)
+        slope_rms = np.empty(steps)
+        iterations = np.zeros(steps, dtype=np.int64)
+        residual = np.zeros(steps)
+        tolerance = self.params.tolerance
+
+        for j, load in enumerate(loads):
+            if control == "indentation":
+                d = float(load)
+                force[j] = spring * reduced_force(d)
+                contact = depth < d
+            else:
+                target = load / spring
+                lo, hi = 0.0, target  # F(0) = 0 < F; F(F/K) >= F (the top point alone)
+                d, value = hi, reduced_force(hi)
+                for step in range(1, self.params.max_iterations + 1):
+                    mid = 0.5 * (lo + hi)
+                    if mid <= lo or mid >= hi:  # bracket down to one ulp
+                        break
+                    d, value = mid, reduced_force(mid)
+                    iterations[j] = step
+                    if value < target:
+                        lo = mid
+                    else:
+                        hi = mid
+                    if abs(value - target) <= tolerance * target:
+                        break
+                residual[j] = abs(value - target) / target
+                force[j] = load
+                contact = depth <= lo
+                for level in np.unique(depth[(depth > lo) & (depth < hi)]):
+                    if reduced_force(level) < target:  # level < d*: strictly inside
+                        contact |= depth == level
+            indentation[j] = d
+            count[j] = int(contact.sum())
+            slope_rms[j] = _line_rms(slopes[contact])
+
+        return ContactCurve(
+            force=force,
+            indentation=indentation,
+            contact_count=count,
+            contact_fraction=count / points,
+            slope_rms_contact=slope_rms,
+            extras={"iterations": iterations, "residual": residual},
+        )

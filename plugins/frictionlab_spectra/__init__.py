@@ -1,0 +1,13 @@
+"""Built-in spectrum generators of frictionlab (SPEC section 2)."""
+
+from frictionlab import hookimpl
+
+from .power_law import PowerLaw, Rolloff
+from .profile_file import ProfileFile
+
+
+@hookimpl
+def register_spectra(register):
+    register(PowerLaw)
+    register(Rolloff)
+    register(ProfileFile)

@@ -1,0 +1,345 @@
+"""Band-limited self-affine rough lines (SPEC section 2): ``power-law`` and ``rolloff``.
+
+Both are one generator, a PSD that is flat from the long cut-off q_min up to a
+knee q_r and a power law C0 q^(-2H-1) from q_r up to the short cut-off q_max
+(``power-law`` is the case q_r = q_min), synthesised as a sum of cosines with
+random phases by one inverse real FFT.
+
+Conventions
+-----------
+- Grid: N points, spacing dx, length L = N dx, periodic; q_k = 2 pi k / L, dq = 2 pi / L.
+- One-sided 1D PSD with <z^2> = 2 * integral_0^inf psd(q) dq.
+- Mode k (kept when q_min <= q_k <= q_max, both inclusive up to a relative 1e-9)
+  is a_k cos(q_k x + phi_k) with a_k = 2 sqrt(psd(q_k) dq), i.e. variance
+  a_k^2 / 2 = 2 psd(q_k) dq. There is no k = 0 mode, so <z> = 0 exactly.
+- Two rms heights: ``rms_height()`` is the discrete sum sqrt(sum_k a_k^2 / 2),
+  which every fixed-amplitude line has exactly (and the expectation for Rayleigh
+  amplitudes); ``rms_height_continuum()`` is sqrt(2 * integral psd dq). Likewise
+  ``rms_slope_discrete()`` = sqrt(sum_k q_k^2 a_k^2 / 2) and ``rms_slope()``, the
+  continuum integral. They differ by the Riemann-sum error of the band.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from frictionlab import PluginParams, Profile, SpectrumGenerator
+
+TWO_PI = 2.0 * math.pi
+REL_TOL = 1e-9  # band edges and length/spacing consistency are checked to this relative tolerance
+SQRT_HALF = math.sqrt(0.5)
+
+PERSSON_2005 = "10.1088/0953-8984/17/1/R01"
+JACOBS_JUNGE_PASTEWKA_2017 = "10.1088/2051-672X/aa51f8"
+
+
+# ------------------------------------------------------------------ geometry
+
+
+@dataclass(frozen=True)
+class Band:
+    """The resolved grid and cut-offs of a spectrum's parameters (defaults filled in)."""
+
+    points: int
+    spacing: float
+    length: float
+    long_cutoff: float
+    short_cutoff: float
+    knee: float  # wavelength where the power law starts (= long_cutoff for power-law)
+    k_lo: int  # first kept mode
+    k_hi: int  # last kept mode (inclusive)
+
+    @property
+    def dq(self) -> float:
+        return TWO_PI / self.length
+
+    @property
+    def q_min(self) -> float:
+        return TWO_PI / self.long_cutoff
+
+    @property
+    def q_max(self) -> float:
+        return TWO_PI / self.short_cutoff
+
+    @property
+    def q_knee(self) -> float:
+        return TWO_PI / self.knee
+
+
+def resolve_band(p: "PowerLaw.Params") -> Band:
+    """Fill in defaults and check the geometry; ValueError (naming the fields) if inconsistent."""
+    n = p.points
+    if p.spacing is not None and p.length is not None:
+        if not math.isclose(p.length, n * p.spacing, rel_tol=REL_TOL):
+            raise ValueError(
+                f"spacing={p.spacing!r} and length={p.length!r} disagree: length must equal "
+                f"points * spacing = {n * p.spacing!r}; give only one of spacing and length"
+            )
+    if p.spacing is not None:
+        dx = p.spacing
+        length = n * dx
+    elif p.length is not None:
+        length = p.length
+        dx = length / n
+    else:
+        dx = 1.0
+        length = float(n)
+
+    long_cutoff = length if p.long_cutoff is None else p.long_cutoff
+    short_cutoff = 10.0 * dx if p.short_cutoff is None else p.short_cutoff
+    long_txt = "long_cutoff" + (f" (default: length = {length!r})" if p.long_cutoff is None else f"={long_cutoff!r}")
+    short_txt = "short_cutoff" + (
+        f" (default: 10 * spacing = {short_cutoff!r})" if p.short_cutoff is None else f"={short_cutoff!r}"
+    )
+    if long_cutoff > length * (1 + REL_TOL):
+        raise ValueError(f"{long_txt} must not exceed the line length L = points * spacing = {length!r}")
+    if short_cutoff < 2.0 * dx * (1 - REL_TOL):
+        raise ValueError(
+            f"{short_txt} is below the Nyquist wavelength 2 * spacing = {2.0 * dx!r}; "
+            "the grid cannot carry shorter waves"
+        )
+    if short_cutoff >= long_cutoff:
+        raise ValueError(f"{short_txt} must be shorter than {long_txt}")
+
+    knee = long_cutoff
+    rolloff = getattr(p, "rolloff_wavelength", None)
+    if rolloff is not None:
+        if not short_cutoff * (1 - REL_TOL) <= rolloff <= long_cutoff * (1 + REL_TOL):
+            raise ValueError(
+                f"rolloff_wavelength={rolloff!r} must lie between {short_txt} and {long_txt}"
+            )
+        knee = min(max(rolloff, short_cutoff), long_cutoff)
+
+    # mode k has wavelength L / k: keep L / long_cutoff <= k <= L / short_cutoff (inclusive, tolerant)
+    k_lo = max(1, math.ceil(length / long_cutoff * (1 - REL_TOL)))
+    k_hi = min(n // 2, math.floor(length / short_cutoff * (1 + REL_TOL)))
+    if k_lo > k_hi:
+        raise ValueError(
+            f"no mode q_k = 2 pi k / L (wavelength L / k, L = {length!r}) lies between "
+            f"{short_txt} and {long_txt}: widen the band"
+        )
+    return Band(n, dx, length, long_cutoff, short_cutoff, knee, k_lo, k_hi)
+
+
+def _log_integral(p: float, ln_r: float) -> float:
+    """integral_0^ln_r exp(p t) dt = integral_1^R u^(p-1) du, stable through p = 0 (log case)."""
+    x = p * ln_r
+    if abs(x) < 1e-8:  # series: expm1(x)/p loses nothing here, but p may be exactly 0
+        return ln_r * (1.0 + x / 2.0 + x * x / 6.0)
+    return math.expm1(x) / p
+
+
+# ------------------------------------------------------------------ synthesis state
+
+
+@dataclass(frozen=True)
+class _Synthesis:
+    """Everything ``generate`` needs, derived once from the parameters."""
+
+    key: tuple
+    band: Band
+    psd_knee: float  # psd at the knee (flat level below it)
+    rms_height: float  # discrete: sqrt(sum a_k^2 / 2)
+    coeff: np.ndarray  # (N/2) a_k for the regular modes k_lo .. k_hi (Nyquist excluded)
+    nyquist: float  # N a_k / sqrt(2) for the Nyquist mode if it is kept, else 0.0
+    amplitudes: np.ndarray  # a_k, k_lo .. k_hi (Nyquist included)
+
+
+class BandLimitedSpectrum(SpectrumGenerator):
+    """Shared synthesis of ``power-law`` and ``rolloff`` (not registered itself)."""
+
+    references: ClassVar[tuple[str, ...]] = (PERSSON_2005, JACOBS_JUNGE_PASTEWKA_2017)
+
+    class Params(PluginParams):
+        hurst: float = Field(
+            description="Hurst exponent H: psd ~ q^(-2H-1); 0 <= H <= 1.5 (0 < H <= 1 is usual)",
+            ge=0.0,
+            le=1.5,
+        )
+        points: int = Field(description="number of grid points N", ge=8)
+        spacing: float | None = Field(
+            None, description="grid spacing dx (default 1.0, or length / points); give spacing or length", gt=0.0
+        )
+        length: float | None = Field(
+            None, description="line length L = points * spacing; give spacing or length", gt=0.0
+        )
+        long_cutoff: float | None = Field(
+            None, description="long cut-off wavelength lambda_L = 2 pi / q_min (default: length)", gt=0.0
+        )
+        short_cutoff: float | None = Field(
+            None,
+            description="short cut-off wavelength lambda_s = 2 pi / q_max, >= 2 * spacing (default: 10 * spacing)",
+            gt=0.0,
+        )
+        rms_height: float | None = Field(
+            None, description="rms height h of the line (default 1.0); give rms_height or c0", gt=0.0
+        )
+        c0: float | None = Field(
+            None, description="PSD prefactor C0 in psd = C0 q^(-2H-1); give rms_height or c0", gt=0.0
+        )
+        amplitudes: Literal["fixed", "rayleigh"] = Field(
+            "fixed",
+            description="'fixed': amplitudes sqrt(psd), random phases (the study); "
+            "'rayleigh': complex Gaussian modes (random amplitudes too)",
+        )
+
+        @model_validator(mode="after")
+        def _check_geometry(self):
+            if self.rms_height is not None and self.c0 is not None:
+                raise ValueError(
+                    f"rms_height={self.rms_height!r} and c0={self.c0!r} both given: "
+                    "give at most one of rms_height and c0"
+                )
+            resolve_band(self)
+            return self
+
+    # ------------------------------------------------------------ cache
+
+    def _synthesis(self) -> _Synthesis:
+        # keyed on the parameter values: Params may be edited in place (validate_assignment)
+        key = tuple(self.params.__dict__.items())
+        cached = getattr(self, "_cache", None)
+        if cached is not None and cached.key == key:
+            return cached
+        p = self.params
+        band = resolve_band(p)
+        n, a = band.points, 2.0 * p.hurst + 1.0
+        k = np.arange(band.k_lo, band.k_hi + 1, dtype=np.float64)
+        # shape relative to the knee, in (0, 1]: no overflow whatever q_min, H and C0
+        k_knee = band.length / band.knee
+        shape = (np.maximum(k, k_knee) / k_knee) ** (-0.5 * a)  # a_k / a_knee
+        if p.c0 is not None:
+            # psd at the knee = C0 q_knee^(-a), formed in logs (C0 and q_knee may be extreme)
+            log_psd_knee = math.log(p.c0) - a * math.log(band.q_knee)
+            if log_psd_knee > 700.0:
+                raise ValueError(f"c0={p.c0!r} is too large for this band: the amplitudes overflow")
+            psd_knee = math.exp(log_psd_knee)
+            amplitudes = (2.0 * math.sqrt(psd_knee * band.dq)) * shape
+            h = float(math.sqrt(0.5 * np.dot(amplitudes, amplitudes)))
+        else:
+            h = 1.0 if p.rms_height is None else p.rms_height
+            # discrete normalisation: sum a_k^2 / 2 == h^2 exactly
+            scale = h / math.sqrt(0.5 * np.dot(shape, shape))
+            amplitudes = scale * shape
+            psd_knee = (0.5 * scale) ** 2 / band.dq
+        if not (math.isfinite(h) and h > 0 and np.all(np.isfinite(amplitudes))):
+            raise ValueError(f"c0={p.c0!r} gives amplitudes that are not finite positive numbers")
+        nyquist = 0.0
+        coeff = amplitudes
+        if n % 2 == 0 and band.k_hi == n // 2:
+            # the Nyquist coefficient is real: N a/sqrt(2) (-1)^j has variance a^2/2 after irfft
+            nyquist = n * amplitudes[-1] * SQRT_HALF
+            coeff = amplitudes[:-1]
+        coeff = (0.5 * n) * coeff
+        self._cache = _Synthesis(key, band, psd_knee, h, coeff, nyquist, amplitudes)
+        return self._cache
+
+    # ------------------------------------------------------------ geometry
+
+    @property
+    def band(self) -> Band:
+        """Resolved grid and cut-offs (defaults filled in)."""
+        return self._synthesis().band
+
+    def wavevectors(self) -> np.ndarray:
+        """q_k of the modes a generated line carries."""
+        b = self.band
+        return b.dq * np.arange(b.k_lo, b.k_hi + 1, dtype=np.float64)
+
+    def c0(self) -> float:
+        """The PSD prefactor C0 in use (given, or implied by ``rms_height``; may be huge or tiny)."""
+        s = self._synthesis()
+        return math.exp(math.log(s.psd_knee) + (2.0 * self.params.hurst + 1.0) * math.log(s.band.q_knee))
+
+    # ------------------------------------------------------------ contract
+
+    def generate(self, rng: np.random.Generator) -> Profile:
+        """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes)."""
+        s = self._synthesis()
+        n, lo, m = s.band.points, s.band.k_lo, s.coeff.size
+        # only up to the band's top mode: irfft zero-pads the rest, and a short fresh buffer is
+        # markedly cheaper than an N/2 one (large fresh allocations cost page faults)
+        spectrum = np.zeros(s.band.k_hi + 1, dtype=np.complex128)
+        # draw only for the modes in the band: with the default cut-off that is N/10 of them
+        if self.params.amplitudes == "fixed":
+            spectrum[lo : lo + m] = s.coeff * np.exp(1j * (TWO_PI * rng.random(m)))
+            if s.nyquist:
+                spectrum[-1] = s.nyquist if rng.random() < 0.5 else -s.nyquist
+        else:
+            # complex Gaussian, E|g|^2 = 1 after the 1/sqrt(2): uniform phase, Rayleigh modulus
+            g = rng.standard_normal(2 * m).view(np.complex128)
+            spectrum[lo : lo + m] = (SQRT_HALF * s.coeff) * g
+            if s.nyquist:
+                spectrum[-1] = s.nyquist * rng.standard_normal()
+        return Profile(heights=np.fft.irfft(spectrum, n=n), spacing=s.band.spacing)
+
+    def rms_height(self) -> float:
+        """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude line,
+        the expectation (sqrt of the expected mean square) for Rayleigh amplitudes."""
+        return self._synthesis().rms_height
+
+    def rms_slope_discrete(self) -> float:
+        """sqrt(sum_k q_k^2 a_k^2 / 2): the rms of the exact derivative of a fixed-amplitude line
+        (its spectral derivative on the grid, except that a kept Nyquist mode has zero grid slope)."""
+        s = self._synthesis()
+        qa = self.wavevectors() * s.amplitudes
+        return float(math.sqrt(0.5 * np.dot(qa, qa)))
+
+    def psd(self, q) -> np.ndarray:
+        """One-sided PSD: C0 q_r^(-2H-1) for q_min <= q < q_r, C0 q^(-2H-1) for q_r <= q <= q_max,
+        zero elsewhere (edges inclusive to a relative 1e-9, like the mode selection)."""
+        s = self._synthesis()
+        b = s.band
+        q = np.asarray(q, dtype=np.float64)
+        inside = (q >= b.q_min * (1 - REL_TOL)) & (q <= b.q_max * (1 + REL_TOL))
+        ratio = np.maximum(q, b.q_knee) / b.q_knee  # >= 1: no 0 ** negative
+        out = np.where(inside, s.psd_knee * ratio ** (-(2.0 * self.params.hurst + 1.0)), 0.0)
+        return out[()] if out.ndim == 0 else out
+
+    def _moment(self, order: int) -> float:
+        """2 * integral_{q_min}^{q_max} q^order psd(q) dq in closed form (order 0 or 2)."""
+        s = self._synthesis()
+        b, hurst = s.band, self.params.hurst
+        qr, qmin = b.q_knee, b.q_min
+        flat = (qr ** (order + 1) - qmin ** (order + 1)) / (order + 1)
+        # q_r^(order+1) integral_1^R u^(order-2H-1) du, R = q_max / q_r
+        power = qr ** (order + 1) * _log_integral(order - 2.0 * hurst, math.log(b.q_max / qr))
+        return 2.0 * s.psd_knee * (flat + power)
+
+    def rms_height_continuum(self) -> float:
+        """sqrt(2 * integral psd dq) over the band: the continuum limit of ``rms_height()``."""
+        return math.sqrt(self._moment(0))
+
+    def rms_slope(self) -> float:
+        """sqrt(2 * integral q^2 psd dq) over the band, closed form (log case at H = 1);
+        the continuum limit of ``rms_slope_discrete()``."""
+        return math.sqrt(self._moment(2))
+
+
+class PowerLaw(BandLimitedSpectrum):
+    """Self-affine line: psd = C0 q^(-2H-1) between the long and the short cut-off."""
+
+    name: ClassVar[str] = "power-law"
+    summary: ClassVar[str] = "Self-affine line: power-law PSD C0 q^(-2H-1) between two cut-offs, random phases"
+
+    class Params(BandLimitedSpectrum.Params):
+        pass
+
+
+class Rolloff(BandLimitedSpectrum):
+    """Self-affine line with a rolloff: psd flat below q_r = 2 pi / rolloff_wavelength."""
+
+    name: ClassVar[str] = "rolloff"
+    summary: ClassVar[str] = "Self-affine line with a rolloff: flat PSD below q_r, power law C0 q^(-2H-1) above"
+
+    class Params(BandLimitedSpectrum.Params):
+        rolloff_wavelength: float = Field(
+            description="rolloff wavelength lambda_r = 2 pi / q_r, between short_cutoff and long_cutoff; "
+            "psd is flat for longer waves",
+            gt=0.0,
+        )

@@ -1,0 +1,207 @@
+"""A measured line as a spectrum generator: ``profile-file`` (SPEC section 2).
+
+The file holds heights on a uniform grid, optionally with their x positions:
+
+- ``.csv`` / ``.txt``: one column (heights) or two columns (x, z), separated by
+  commas or whitespace; lines starting with ``#`` are comments and one
+  non-numeric header line (e.g. ``x,z``) before the data is skipped.
+- ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z.
+
+Like a synthetic line, a measured line is treated as periodic (the engine wraps
+it): its last point is followed by its first. Removing the tilt
+(``detrend="tilt"``) takes out the least-squares line, which is what makes the
+two ends meet for a scan that was not levelled; any remaining step at the
+wrap is part of the profile the solver sees.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar, Literal
+
+import numpy as np
+from pydantic import Field
+
+from frictionlab import PluginParams, Profile, SpectrumGenerator
+
+MIN_POINTS = 8
+X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
+SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
+
+
+@dataclass(frozen=True)
+class _Line:
+    key: tuple
+    heights: np.ndarray
+    spacing: float
+    rms_height: float
+
+
+class ProfileFile(SpectrumGenerator):
+    """A measured height profile read from a file; every ``generate`` returns the same line."""
+
+    name: ClassVar[str] = "profile-file"
+    summary: ClassVar[str] = "Measured line read from a .csv/.txt/.npy file of heights (or x, z) on a uniform grid"
+    references: ClassVar[tuple[str, ...]] = ()
+
+    class Params(PluginParams):
+        path: str = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z",
+                          min_length=1)
+        spacing: float | None = Field(
+            None,
+            description="grid spacing dx; required if the file has only heights, must agree with x otherwise",
+            gt=0.0,
+        )
+        detrend: Literal["none", "mean", "tilt"] = Field(
+            "mean",
+            description="remove nothing, the mean, or the least-squares line (tilt) before use; "
+            "the line is treated as periodic",
+        )
+
+    # ------------------------------------------------------------ contract
+
+    def generate(self, rng: np.random.Generator) -> Profile:
+        """The measured line (a fresh copy each call); ``rng`` is not used."""
+        line = self._line()
+        return Profile(heights=line.heights.copy(), spacing=line.spacing)
+
+    def rms_height(self) -> float:
+        """rms of the detrended line about its mean (with ``detrend="none"`` a constant offset,
+        which does not change a contact, does not count either)."""
+        return self._line().rms_height
+
+    # ------------------------------------------------------------ reading
+
+    def _line(self) -> _Line:
+        key = tuple(self.params.__dict__.items())
+        cached = getattr(self, "_cache", None)
+        if cached is not None and cached.key == key:
+            return cached
+        p = self.params
+        path = Path(p.path).expanduser()
+        x, z = _read_columns(path)
+        where = f"profile-file {str(path)!r}"
+        if z.size < MIN_POINTS:
+            raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
+        _check_finite(where, "heights", z)
+        if x is None:
+            if p.spacing is None:
+                raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
+            dx = p.spacing
+        else:
+            _check_finite(where, "x", x)
+            dx = _uniform_spacing(where, x)
+            if p.spacing is not None:
+                if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
+                    raise ValueError(
+                        f"{where}: parameter spacing={p.spacing!r} disagrees with the spacing "
+                        f"of the file's x column ({dx!r}); drop the parameter or fix the file"
+                    )
+                dx = p.spacing
+        heights = _detrend(z, p.detrend)
+        rms = float(np.std(heights))
+        scale = float(np.max(np.abs(z)))
+        if not rms > 1e-12 * scale:  # also true for scale == 0
+            raise ValueError(
+                f"{where}: the profile is constant (rms height zero after detrend={p.detrend!r}); "
+                "a flat line has no roughness"
+            )
+        heights.flags.writeable = False
+        self._cache = _Line(key, heights, float(dx), rms)
+        return self._cache
+
+
+def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
+    """(x or None, z) as float64 arrays, from a .npy or a text file."""
+    where = f"profile-file {str(path)!r}"
+    if not path.is_file():
+        raise ValueError(f"{where}: no such file")
+    suffix = path.suffix.lower()
+    if suffix == ".npy":
+        try:
+            data = np.load(path, allow_pickle=False)
+        except Exception as exc:  # corrupt file, pickled objects, ...
+            raise ValueError(f"{where}: not a readable .npy array ({exc})") from None
+        if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
+            raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
+        if data.ndim == 2 and 1 in data.shape:
+            data = data.reshape(-1)
+        if data.ndim == 1:
+            return None, data.astype(np.float64)
+        if data.ndim == 2 and data.shape[1] == 2:
+            return data[:, 0].astype(np.float64), data[:, 1].astype(np.float64)
+        if data.ndim == 2 and data.shape[0] == 2:
+            return data[0].astype(np.float64), data[1].astype(np.float64)
+        raise ValueError(f"{where}: array of shape {data.shape}; expected (N,), (N, 2) or (2, N)")
+    if suffix not in (".csv", ".txt"):
+        raise ValueError(f"{where}: unknown file type {suffix!r}; use .csv, .txt or .npy")
+    data = _read_text(path, where)
+    if data.shape[1] == 1:
+        return None, data[:, 0].copy()
+    if data.shape[1] == 2:
+        return data[:, 0].copy(), data[:, 1].copy()
+    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z) or 2 (x, z)")
+
+
+def _read_text(path: Path, where: str) -> np.ndarray:
+    """Rows x columns of float64; one non-numeric header line is skipped."""
+    skip, delimiter = 0, None
+    try:
+        with path.open() as fh:
+            for lineno, line in enumerate(fh, start=1):
+                text = line.split("#", 1)[0].strip()
+                if not text:
+                    continue
+                delimiter = "," if "," in text else None
+                try:
+                    [float(tok) for tok in text.split(delimiter)]
+                except ValueError:
+                    skip = lineno  # a header such as "x,z"
+                break
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
+            data = np.loadtxt(path, dtype=np.float64, delimiter=delimiter, comments="#", skiprows=skip, ndmin=2)
+    except UnicodeDecodeError:
+        raise ValueError(f"{where}: not a text file") from None
+    except ValueError as exc:
+        raise ValueError(f"{where}: non-numeric content ({exc})") from None
+    if data.size == 0:
+        data = np.zeros((0, 1))
+    return data
+
+
+def _check_finite(where: str, what: str, values: np.ndarray) -> None:
+    bad = ~np.isfinite(values)
+    if bad.any():
+        raise ValueError(
+            f"{where}: {int(bad.sum())} non-finite value(s) (NaN or inf) in {what}, "
+            f"the first at index {int(np.argmax(bad))}"
+        )
+
+
+def _uniform_spacing(where: str, x: np.ndarray) -> float:
+    n = x.size
+    dx = (x[-1] - x[0]) / (n - 1)
+    if not dx > 0:
+        raise ValueError(f"{where}: x must increase (x[0] = {x[0]!r}, x[-1] = {x[-1]!r})")
+    deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
+    if deviation > X_TOLERANCE * dx:
+        raise ValueError(
+            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {dx!r} "
+            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
+        )
+    return float(dx)
+
+
+def _detrend(z: np.ndarray, mode: str) -> np.ndarray:
+    if mode == "none":
+        return z.copy()
+    out = z - z.mean()
+    if mode == "tilt":
+        t = np.arange(z.size, dtype=np.float64)
+        t -= t.mean()
+        out -= (np.dot(t, out) / np.dot(t, t)) * t  # least-squares slope (t and out are centred)
+    return out

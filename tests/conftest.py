@@ -1,0 +1,50 @@
+import copy
+from pathlib import Path
+
+import pytest
+
+from frictionlab.preset import build_scene
+from frictionlab.registry import Registry
+
+ROOT = Path(__file__).resolve().parents[1]
+PRESETS = ROOT / "presets"
+
+SMALL_PRESET = {
+    "name": "small",
+    "seed": 7,
+    "realizations": 8,
+    "spectrum": {"name": "power-law", "params": {"hurst": 0.8, "points": 1024, "rms_height": 1.0}},
+    "solver": {"name": "mdr", "params": {"youngs_modulus": 1.0}},
+    "slope": {"name": "forward-difference"},
+    "loading": {"control": "force", "start": 0.5, "stop": 20.0, "steps": 16, "spacing": "log"},
+    "fit": {"bootstrap": 200},
+}
+
+
+def merge(base: dict, changes: dict) -> dict:
+    """Deep-merge ``changes`` (nested dicts) into a copy of ``base``."""
+    out = copy.deepcopy(base)
+    for key, value in changes.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+@pytest.fixture(scope="session")
+def registry():
+    return Registry(discover=False)
+
+
+@pytest.fixture
+def small_preset():
+    return copy.deepcopy(SMALL_PRESET)
+
+
+@pytest.fixture
+def make_scene(registry):
+    def make(changes: dict | None = None, base: dict = SMALL_PRESET):
+        return build_scene(merge(base, changes or {}), registry=registry)
+
+    return make

@@ -1,0 +1,249 @@
+"""The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.results import atomic_write
+
+from .conftest import PRESETS, SMALL_PRESET, merge
+
+
+def write_preset(tmp_path, data, name="preset.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def run_cli(*args, env=None, **kwargs):
+    return subprocess.run(
+        [sys.executable, "-m", "frictionlab", *map(str, args)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **(env or {})},
+        **kwargs,
+    )
+
+
+def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    out = tmp_path / "out"
+    code = main(["run", str(preset), "--out", str(out), "--workers", "1"])
+    captured = capsys.readouterr()
+    assert code == ExitCode.OK
+    assert {p.name for p in out.iterdir()} == {
+        "summary.json",
+        "curve.csv",
+        "realizations.npz",
+        "preset.yaml",
+        "plot.png",
+    }
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed"
+    assert summary["realizations"] == {"requested": 8, "done": 8, "failed": 0, "failures": []}
+    assert summary["seed"] == 7
+    assert summary["preset"]["spectrum"]["params"]["hurst"] == 0.8
+    assert summary["preset"]["spectrum"]["params"]["amplitudes"] == "fixed"  # defaults resolved
+    fit = summary["fit"]
+    assert fit["a_ci"][0] < fit["a"] < fit["a_ci"][1]
+    assert fit["b_ci"][0] < fit["b"] < fit["b_ci"][1]
+    assert 0 < fit["r2"] <= 1
+    with open(out / "curve.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"]
+    assert len(rows) == 16
+    arrays = np.load(out / "realizations.npz")
+    assert arrays["xi"].shape == (8, 16)
+    # the curve is the mean of the per-realization rows
+    np.testing.assert_allclose([float(r["xi"]) for r in rows], arrays["xi"].mean(axis=0), rtol=1e-15)
+    assert (out / "plot.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the table on stdout carries the same fit; stdout has no progress in it
+    assert f"{fit['a']:10.4f}" in captured.out
+    assert "realizations," not in captured.out
+
+
+def test_resolved_preset_reruns_to_the_same_numbers(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    main(["run", str(preset), "--out", str(tmp_path / "one"), "--workers", "1", "--quiet"])
+    main(["run", str(tmp_path / "one" / "preset.yaml"), "--out", str(tmp_path / "two"), "--workers", "2", "--quiet"])
+    one = json.loads((tmp_path / "one" / "summary.json").read_text())
+    two = json.loads((tmp_path / "two" / "summary.json").read_text())
+    assert one["fit"] == two["fit"]
+    assert (tmp_path / "one" / "curve.csv").read_text() == (tmp_path / "two" / "curve.csv").read_text()
+
+
+def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    result = run_cli(
+        "run", preset, "--out", tmp_path / "o", "--json", "--quiet", "--workers", "1",
+        "--set", "spectrum.params.hurst=0.5", "--set", "realizations=5", "--seed", "99",
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)  # stdout is only the JSON
+    assert summary["preset"]["spectrum"]["params"]["hurst"] == 0.5
+    assert summary["realizations"]["done"] == 5
+    assert summary["seed"] == 99
+    assert result.stderr == ""  # --quiet
+
+
+def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
+    result = run_cli("run", preset, "--out", tmp_path / "o", "--workers", "2")
+    assert result.returncode == 0
+    lines = result.stderr.strip().splitlines()
+    assert lines[0].startswith("small: 40 realizations")
+    progress = [line for line in lines if "/40 realizations" in line]
+    assert 2 <= len(progress) <= 11  # one line per tenth, not one per realization
+    assert progress[-1].startswith("40/40 realizations")
+    assert "\r" not in result.stderr
+
+
+BAD_PRESETS = [
+    ({"spectrum": {"params": {"hurst": 2.0}}}, "spectrum.params.hurst: must be <= 1.5, got 2.0"),
+    ({"spectrum": {"params": {"hurts": 0.5}}}, "spectrum.params.hurts: is not a known field; allowed:"),
+    ({"spectrum": {"name": "power-lw"}}, "spectrum.name: no spectrum plugin named 'power-lw'; did you mean 'power-law'"),
+    ({"solver": {"name": "bem"}}, "solver.name: no solver plugin named 'bem'"),
+    ({"realizations": 0}, "realizations: must be >= 1, got 0"),
+    ({"realizations": "many"}, "realizations: must be a whole number, got 'many'"),
+    ({"loading": {"start": -1.0}}, "loading.start: must be > 0.0, got -1.0"),
+    ({"loading": {"start": 5.0, "stop": 1.0}}, "loading: stop must be > start (5.0). Got 1.0 instead."),
+    ({"loading": {"control": "pressure"}}, "loading.control: must be one of 'force' or 'indentation'"),
+    ({"seeds": 3}, "seeds: is not a known field; allowed: description, fit, loading"),
+    ({"solver": {"params": {"poisson_ratio": 0.7}}}, "solver.params.poisson_ratio: must be <= 0.5, got 0.7"),
+]
+
+
+@pytest.mark.parametrize("changes, message", BAD_PRESETS, ids=[m.split(":")[0] for _, m in BAD_PRESETS])
+def test_bad_presets_give_their_message_and_exit_code(tmp_path, capsys, changes, message):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, changes))
+    for command in (["validate", str(preset)], ["run", str(preset), "--out", str(tmp_path / "o")]):
+        assert main(command) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert message in err
+        assert "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_missing_required_and_file_errors(tmp_path, capsys):
+    data = dict(SMALL_PRESET)
+    del data["loading"]
+    assert main(["validate", str(write_preset(tmp_path, data))]) == ExitCode.USAGE
+    assert "loading: is required" in capsys.readouterr().err
+    assert main(["validate", str(tmp_path / "nope.yaml")]) == ExitCode.USAGE
+    assert "no such preset file" in capsys.readouterr().err
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("name: x\nspectrum: [unclosed\n")
+    assert main(["validate", str(broken)]) == ExitCode.USAGE
+    assert "not valid YAML at line" in capsys.readouterr().err
+    listing = tmp_path / "list.yaml"
+    listing.write_text("- 1\n- 2\n")
+    assert main(["validate", str(listing)]) == ExitCode.USAGE
+    assert "must be a mapping" in capsys.readouterr().err
+
+
+def test_validate_reports_every_problem_at_once(tmp_path, capsys):
+    bad = merge(SMALL_PRESET, {"realizations": -3, "spectrum": {"params": {"hurst": -1}}, "solver": {"name": "nope"}})
+    assert main(["validate", str(write_preset(tmp_path, bad))]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "3 problems in preset" in err
+    for fragment in ("realizations: must be >= 1", "spectrum.params.hurst: must be >= 0", "solver.name: no solver"):
+        assert fragment in err
+
+
+def test_bad_set_override_is_a_usage_error(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    assert main(["validate", str(preset), "--set", "spectrum.params.hurst"]) == ExitCode.USAGE
+    assert "must look like dotted.path=value" in capsys.readouterr().err
+    assert main(["validate", str(preset), "--set", "seed.x=1"]) == ExitCode.USAGE
+    assert "seed is a value, not a mapping" in capsys.readouterr().err
+
+
+def test_bad_command_line_is_a_usage_error_without_traceback():
+    result = run_cli("run")
+    assert result.returncode == ExitCode.USAGE
+    assert "usage:" in result.stderr and "Traceback" not in result.stderr
+    result = run_cli("run", PRESETS / "quickstart.yaml", "--workers", "0")
+    assert result.returncode == ExitCode.USAGE
+    assert "--workers must be >= 1. Got 0 instead." in result.stderr
+
+
+def test_schema_lists_installed_plugins_with_their_params(capsys):
+    assert main(["schema"]) == ExitCode.OK
+    schema = json.loads(capsys.readouterr().out)
+    spectra = {v["properties"]["name"]["const"]: v for v in schema["properties"]["spectrum"]["oneOf"]}
+    assert {"power-law", "rolloff", "profile-file"} <= set(spectra)
+    hurst = spectra["power-law"]["properties"]["params"]["properties"]["hurst"]
+    assert hurst["maximum"] == 1.5 and hurst["description"]
+    assert spectra["power-law"]["properties"]["params"]["additionalProperties"] is False
+
+
+def test_plugins_lists_kind_name_provider_and_version(capsys):
+    assert main(["plugins"]) == ExitCode.OK
+    out = capsys.readouterr().out
+    for kind, name in [("spectrum", "power-law"), ("solver", "mdr"), ("slope", "forward-difference")]:
+        line = next(line for line in out.splitlines() if line.split()[:2] == [kind, name])
+        assert "frictionlab" in line and "0." in line  # provider and its version
+    assert main(["plugins", "--json"]) == ExitCode.OK
+    rows = json.loads(capsys.readouterr().out)["plugins"]
+    assert {r["name"] for r in rows if r["kind"] == "slope"} >= {"forward-difference", "central-difference", "spectral"}
+
+
+def test_headless_run_never_imports_textual(tmp_path):
+    code = (
+        "import sys; from frictionlab.cli import main; "
+        f"rc = main(['run', {str(PRESETS / 'quickstart.yaml')!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet']); "
+        "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'textual', 'rich'}); "
+        "print(rc, bad)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.strip().splitlines()[-1] == "0 []", result.stderr
+
+
+def test_ctrl_c_keeps_finished_realizations_and_exits_130(tmp_path):
+    """A real SIGINT to a running pool run: the finished realizations are written."""
+    data = merge(SMALL_PRESET, {"realizations": 100000, "spectrum": {"params": {"points": 8192}}})
+    preset = write_preset(tmp_path, data)
+    out = tmp_path / "o"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(out), "--workers", "2"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    line = ""
+    deadline = time.monotonic() + 60
+    while "/100000 realizations" not in line and time.monotonic() < deadline:
+        line = proc.stderr.readline()
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == ExitCode.INTERRUPTED, stderr
+    assert "Traceback" not in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted"
+    assert 0 < summary["realizations"]["done"] < 100000
+    arrays = np.load(out / "realizations.npz")
+    assert arrays["xi"].shape[0] == summary["realizations"]["done"]
+
+
+def test_atomic_write_leaves_the_old_file_when_writing_fails(tmp_path):
+    target = tmp_path / "summary.json"
+    target.write_text("old")
+
+    def explode(fh):
+        fh.write("half a fi")
+        raise RuntimeError("disk on fire")
+
+    with pytest.raises(RuntimeError):
+        atomic_write(target, explode)
+    assert target.read_text() == "old"
+    assert list(tmp_path.iterdir()) == [target]  # no temporary left behind

@@ -1,0 +1,207 @@
+"""The ensemble engine: seeding, executors, events, cancellation, scaling laws."""
+
+import threading
+
+import numpy as np
+import pytest
+
+from frictionlab import SpectrumGenerator, engine, hookimpl
+from frictionlab.plugin import PluginParams, Profile
+from frictionlab.preset import Scene
+
+
+def same_outcome(one, two):
+    for key in one.per_realization:
+        np.testing.assert_array_equal(one.per_realization[key], two.per_realization[key])
+    np.testing.assert_array_equal(one.xi, two.xi)
+    np.testing.assert_array_equal(one.f, two.f)
+    assert one.fit == two.fit
+
+
+def test_same_seed_same_numbers_for_one_and_two_workers(make_scene):
+    scene = make_scene({"realizations": 12})
+    serial = engine.run(scene, workers=1)
+    pooled = engine.run(scene, workers=2)
+    assert serial.status == pooled.status == "completed"
+    assert serial.done == 12
+    same_outcome(serial, pooled)
+
+
+def test_other_seed_other_numbers(make_scene):
+    one = engine.run(make_scene({"seed": 1}), workers=1)
+    two = engine.run(make_scene({"seed": 2}), workers=1)
+    assert not np.array_equal(one.per_realization["xi"], two.per_realization["xi"])
+
+
+def test_a_realization_does_not_depend_on_the_others(make_scene):
+    """Realization 5 computed alone equals row 5 of a full run: seeds are addressed,
+    not drawn in sequence."""
+    scene = make_scene({"realizations": 8})
+    full = engine.run(scene, workers=1)
+    alone = engine.compute_realization(scene, 5)
+    np.testing.assert_array_equal(alone.xi, full.per_realization["xi"][5])
+    np.testing.assert_array_equal(alone.contact_count, full.per_realization["contact_count"][5])
+
+
+class Recorder:
+    def __init__(self, cancel_after=None, cancel=None):
+        self.events = []
+        self.cancel_after, self.cancel = cancel_after, cancel
+
+    @hookimpl
+    def run_started(self, run):
+        self.events.append(("started", run.total))
+
+    @hookimpl
+    def realization_done(self, result, done, total):
+        self.events.append(("done", result.index, done, total))
+        if self.cancel_after is not None and done >= self.cancel_after:
+            self.cancel.set()
+
+    @hookimpl
+    def realization_failed(self, result, done):
+        self.events.append(("failed", result.index, done))
+
+    @hookimpl
+    def run_finished(self, outcome):
+        self.events.append(("finished", outcome.status, outcome.done))
+
+
+def test_listeners_see_every_realization_between_start_and_finish(make_scene):
+    recorder = Recorder()
+    outcome = engine.run(make_scene({"realizations": 6}), workers=2, listeners=[recorder])
+    kinds = [e[0] for e in recorder.events]
+    assert kinds[0] == "started" and kinds[-1] == "finished"
+    assert kinds.count("done") == 6
+    assert sorted(e[1] for e in recorder.events if e[0] == "done") == list(range(6))
+    assert [e[2] for e in recorder.events if e[0] == "done"] == list(range(1, 7))
+    assert recorder.events[-1] == ("finished", "completed", outcome.done)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_cancel_keeps_what_finished(make_scene, workers):
+    cancel = threading.Event()
+    recorder = Recorder(cancel_after=3, cancel=cancel)
+    scene = make_scene({"realizations": 400, "spectrum": {"params": {"points": 4096}}})
+    outcome = engine.run(scene, workers=workers, listeners=[recorder], cancel=cancel)
+    assert outcome.status == "cancelled"
+    assert 3 <= outcome.done < 400
+    assert outcome.fit is not None
+    # the kept rows are exactly those realizations, as a full run would give them
+    for row, index in enumerate(outcome.indices[:3]):
+        np.testing.assert_array_equal(outcome.per_realization["xi"][row], engine.compute_realization(scene, index).xi)
+
+
+class Flaky(SpectrumGenerator):
+    """A spectrum that fails for one in three realizations (decided by its rng)."""
+
+    name = "flaky"
+    summary = "test double: fails for some realizations"
+
+    class Params(PluginParams):
+        pass
+
+    def generate(self, rng):
+        if rng.random() < 1 / 3:
+            raise RuntimeError("bad luck")
+        x = np.arange(256)
+        return Profile(np.sin(2 * np.pi * x / 256) + 0.1 * rng.standard_normal(256), 1.0)
+
+    def rms_height(self):
+        return 1.0
+
+
+def test_failures_are_carried_on_results_and_the_run_goes_on(make_scene):
+    base = make_scene({"realizations": 30})
+    scene = Scene(preset=base.preset, spectrum=Flaky(), solver=base.solver, slope=base.slope)
+    recorder = Recorder()
+    outcome = engine.run(scene, workers=2, listeners=[recorder])
+    failed = [e[1] for e in recorder.events if e[0] == "failed"]
+    assert outcome.status == "completed"
+    assert 0 < len(outcome.failures) < 30
+    assert sorted(failed) == [index for index, _ in outcome.failures]
+    assert all("RuntimeError: bad luck" in error for _, error in outcome.failures)
+    assert outcome.done == 30 - len(failed)
+    assert set(outcome.indices) == set(range(30)) - set(failed)
+
+
+def test_a_constant_line_fails_with_a_clear_message(make_scene):
+    base = make_scene()
+
+    class Flat(Flaky):
+        name = "flat"
+
+        def generate(self, rng):
+            return Profile(np.ones(64), 1.0)
+
+    scene = Scene(preset=base.preset, spectrum=Flat(), solver=base.solver, slope=base.slope)
+    result = engine.compute_realization(scene, 0)
+    assert not result.ok
+    assert "rms slope of the whole line is 0.0" in result.error
+
+
+def test_scaling_heights_and_forces_together_leaves_xi_and_f_unchanged(make_scene):
+    """SPEC 5: z -> s z, F -> s F. With s a power of two every operation scales
+    exactly, so the results are bitwise equal."""
+    base = engine.run(make_scene(), workers=1)
+    s = 4.0
+    scaled = engine.run(
+        make_scene({"spectrum": {"params": {"rms_height": s}}, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}),
+        workers=1,
+    )
+    np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
+    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-13)
+    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-13)
+
+
+def test_scaling_modulus_and_forces_together_leaves_xi_and_f_unchanged(make_scene):
+    base = engine.run(make_scene(), workers=1)
+    s = 3.7
+    scaled = engine.run(
+        make_scene({"solver": {"params": {"youngs_modulus": s}}, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}),
+        workers=1,
+    )
+    np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
+    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-12)
+    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-12)
+
+
+def test_result_depends_on_f_not_on_spacing(make_scene):
+    """SPEC 5: at fixed f, H, N and cut-offs in units of dx, changing dx changes nothing.
+    F = f E* h L with L = N dx, so the forces scale with dx."""
+    base = engine.run(make_scene(), workers=1)
+    dx = 0.25
+    scaled = engine.run(
+        make_scene({"spectrum": {"params": {"spacing": dx}}, "loading": {"start": 0.5 * dx, "stop": 20.0 * dx}}),
+        workers=1,
+    )
+    np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
+    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-12)
+    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-12)
+
+
+def test_full_contact_gives_xi_one(make_scene):
+    """Far past full contact every point touches and xi must be exactly 1."""
+    outcome = engine.run(make_scene({"loading": {"start": 1e5, "stop": 1e6, "steps": 4}}), workers=1)
+    assert np.all(outcome.per_realization["contact_count"] == 1024)
+    np.testing.assert_array_equal(outcome.per_realization["xi"], 1.0)
+
+
+def test_only_what_the_scene_needs_is_kept(make_scene):
+    force = engine.run(make_scene({"realizations": 3}), workers=1)
+    assert set(force.per_realization) == {"index", "xi", "contact_count", "indentation", "slope_rms_line"}
+    indentation = engine.run(
+        make_scene({"realizations": 3, "loading": {"control": "indentation", "start": 0.1, "stop": 2.0}}),
+        workers=1,
+    )
+    assert "force" in indentation.per_realization
+    assert indentation.per_realization["force"].shape == (3, 16)
+    # forces grow with indentation in every realization
+    assert np.all(np.diff(indentation.per_realization["force"], axis=1) > 0)
+
+
+def test_chunks_cover_every_index_once():
+    indices = list(range(1000))
+    chunks = engine.chunked(indices, workers=2)
+    assert [i for c in chunks for i in c] == indices
+    assert 16 <= len(chunks) <= 40

@@ -1,0 +1,161 @@
+"""Slope estimators against closed forms on periodic sines (SPEC section 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from frictionlab.registry import validate_plugin_class
+from frictionlab.testing import check_plugin
+from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
+
+ESTIMATORS = (ForwardDifference, CentralDifference, Spectral)
+
+
+def sine(points: int, mode: int, amplitude: float = 0.7, spacing: float = 0.3):
+    """A sin(q x) with ``mode`` whole periods on the periodic grid."""
+    x = np.arange(points) * spacing
+    q = 2.0 * np.pi * mode / (points * spacing)
+    return amplitude * np.sin(q * x), x, q, amplitude, spacing
+
+
+def rms(values):
+    return np.sqrt(np.mean(np.square(values)))
+
+
+# ------------------------------------------------------------------ contract
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_plugin_contract(cls):
+    validate_plugin_class("slope", cls)
+    assert cls.Params.model_fields == {}
+    with pytest.raises(ValueError):
+        cls(unknown=1)
+    assert {c.name for c in ESTIMATORS} == {"forward-difference", "central-difference", "spectral"}
+    check_plugin("slope", cls)
+
+
+# ------------------------------------------------------------- closed forms
+
+
+@pytest.mark.parametrize("points", [256, 255])
+@pytest.mark.parametrize("mode", [1, 3, 40])
+def test_forward_difference_of_a_sine(points, mode):
+    z, x, q, A, dx = sine(points, mode)
+    slopes = ForwardDifference().slopes(z, dx)
+    # sin(q(x+dx)) - sin(qx) = 2 sin(q dx/2) cos(q(x + dx/2)): a shifted cosine
+    gain = 2.0 * np.sin(q * dx / 2.0) / dx
+    scale = A / dx  # rounding of the differences is relative to A, then divided by dx
+    np.testing.assert_allclose(slopes, A * gain * np.cos(q * (x + dx / 2.0)), rtol=0, atol=1e-13 * scale)
+    assert rms(slopes) == pytest.approx(A * gain / np.sqrt(2.0), rel=1e-12)
+
+
+@pytest.mark.parametrize("points", [256, 255])
+@pytest.mark.parametrize("mode", [1, 3, 40])
+def test_central_difference_of_a_sine(points, mode):
+    z, x, q, A, dx = sine(points, mode)
+    slopes = CentralDifference().slopes(z, dx)
+    gain = np.sin(q * dx) / dx
+    np.testing.assert_allclose(slopes, A * gain * np.cos(q * x), rtol=0, atol=1e-13 * A / dx)
+    assert rms(slopes) == pytest.approx(A * gain / np.sqrt(2.0), rel=1e-12)
+
+
+@pytest.mark.parametrize("points", [256, 255])
+@pytest.mark.parametrize("mode", [1, 3, 40, 127])
+def test_spectral_derivative_of_a_sine_is_exact(points, mode):
+    z, x, q, A, dx = sine(points, mode)
+    slopes = Spectral().slopes(z, dx)
+    np.testing.assert_allclose(slopes, A * q * np.cos(q * x), rtol=0, atol=1e-12 * A * q)
+    assert rms(slopes) == pytest.approx(A * q / np.sqrt(2.0), rel=1e-12)
+
+
+def test_spectral_drops_the_nyquist_mode():
+    z = np.cos(np.pi * np.arange(64))  # (-1)^i: the Nyquist mode of an even grid
+    np.testing.assert_allclose(Spectral().slopes(z, 1.0), 0.0, atol=1e-15)
+    assert np.all(np.abs(ForwardDifference().slopes(z, 1.0)) == 2.0)
+    assert np.all(CentralDifference().slopes(z, 1.0) == 0.0)  # z[i+1] == z[i-1]
+
+
+def test_all_three_agree_at_small_q_dx():
+    points, dx = 4096, 1.0
+    x = np.arange(points) * dx
+    rng = np.random.default_rng(5)
+    modes = np.arange(1, 9)
+    q = 2 * np.pi * modes / (points * dx)  # q dx <= 0.0123
+    amplitude = rng.normal(size=modes.size)
+    phase = rng.uniform(0, 2 * np.pi, size=modes.size)
+    z = sum(a * np.sin(qm * x + p) for a, qm, p in zip(amplitude, q, phase))
+    fwd, ctr, spc = (cls().slopes(z, dx) for cls in ESTIMATORS)
+    weight = np.abs(amplitude) * q
+    # per mode: central = spectral * sin(q dx)/(q dx), |1 - sinc| <= (q dx)^2 / 6
+    assert np.max(np.abs(ctr - spc)) <= np.sum(weight * (q * dx) ** 2 / 6)
+    # forward = spectral half a cell later, times sin(q dx/2)/(q dx/2): first order pointwise
+    assert np.max(np.abs(fwd - spc)) <= np.sum(weight * (q * dx / 2 + (q * dx) ** 2 / 24))
+    # rms: distinct modes are orthogonal on the grid, so the gains enter directly (second order)
+    qdx = q.max() * dx
+    assert rms(fwd) == pytest.approx(rms(spc), rel=qdx**2 / 24)
+    assert rms(ctr) == pytest.approx(rms(spc), rel=qdx**2 / 6)
+    assert rms(spc) == pytest.approx(np.sqrt(np.sum((amplitude * q) ** 2) / 2), rel=1e-12)
+
+
+# --------------------------------------------------------- definitions, scaling
+
+
+def test_forward_difference_is_the_periodic_definition():
+    rng = np.random.default_rng(0)
+    z = rng.normal(size=1001)
+    expected = (np.roll(z, -1) - z) / 0.25
+    np.testing.assert_array_equal(ForwardDifference().slopes(z, 0.25), expected)
+    assert ForwardDifference().slopes(z, 0.25)[-1] == (z[0] - z[-1]) / 0.25
+
+
+def test_central_difference_wraps_both_ends():
+    z = np.array([0.0, 1.0, 4.0, 9.0, 16.0])
+    expected = (np.roll(z, -1) - np.roll(z, 1)) / (2 * 0.5)
+    np.testing.assert_array_equal(CentralDifference().slopes(z, 0.5), expected)
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_shape_dtype_and_input_untouched(cls):
+    z = np.random.default_rng(1).normal(size=100)
+    before = z.copy()
+    slopes = cls().slopes(z, 2.0)
+    assert slopes.shape == z.shape and slopes.dtype == np.float64
+    np.testing.assert_array_equal(z, before)
+    # integer input is fine too
+    assert cls().slopes(np.arange(10) % 3, 1.0).shape == (10,)
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_height_scaling_is_exact_for_powers_of_two(cls):
+    z = np.random.default_rng(2).normal(size=128)
+    s = 2.0**-37
+    np.testing.assert_array_equal(cls().slopes(s * z, 1.5), s * cls().slopes(z, 1.5))
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_two_points_is_the_minimum(cls):
+    assert cls().slopes(np.array([0.0, 1.0]), 1.0).shape == (2,)
+    with pytest.raises(ValueError, match="at least 2 points"):
+        cls().slopes(np.array([1.0]), 1.0)
+    with pytest.raises(ValueError, match="at least 2 points"):
+        cls().slopes(np.array([]), 1.0)
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_heights_are_rejected(cls, bad):
+    z = np.zeros(16)
+    z[5] = bad
+    with pytest.raises(ValueError, match="point 5"):
+        cls().slopes(z, 1.0)
+
+
+@pytest.mark.parametrize("cls", ESTIMATORS)
+def test_bad_spacing_and_shape_are_rejected(cls):
+    for spacing in (0.0, -1.0, np.nan, np.inf):
+        with pytest.raises(ValueError, match="spacing"):
+            cls().slopes(np.zeros(8), spacing)
+    with pytest.raises(ValueError, match="shape"):
+        cls().slopes(np.zeros((4, 4)), 1.0)
