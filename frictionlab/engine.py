@@ -100,10 +100,11 @@ def default_workers() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-def chunked(indices: list[int], workers: int, per_worker: int = 16) -> list[list[int]]:
+def chunked(indices: list[int], workers: int, per_worker: int = 16, largest: int = 256) -> list[list[int]]:
     """Split into about ``per_worker`` chunks per worker: small enough to stream
-    progress and balance load, large enough that task overhead stays small."""
-    size = max(1, math.ceil(len(indices) / (workers * per_worker)))
+    progress, balance load and stop soon after a cancel, large enough that task
+    overhead stays small. ``largest`` caps a chunk for very long runs."""
+    size = min(largest, max(1, math.ceil(len(indices) / (workers * per_worker))))
     return [indices[i : i + size] for i in range(0, len(indices), size)]
 
 
@@ -143,8 +144,11 @@ def iter_realizations(
         try:
             while pending:
                 if cancel is not None and cancel.is_set():
-                    break
-                finished, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
+                    # Chunks already running finish and are kept; the rest never start.
+                    running = {future for future in pending if not future.cancel()}
+                    finished, pending = wait(running).done, set()
+                else:
+                    finished, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
                 for future in finished:
                     try:
                         yield from future.result()
@@ -174,6 +178,32 @@ def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
     return pm
 
 
+class _CtrlCToCancel:
+    """The first Ctrl-C sets ``cancel`` (running work finishes and is kept); a
+    second one interrupts at once. Only in the main thread, where signals land."""
+
+    def __init__(self, cancel):
+        self.cancel = cancel
+        self.pressed = False
+        self.previous = None
+
+    def _handle(self, signum, frame):
+        if self.pressed:
+            raise KeyboardInterrupt
+        self.pressed = True
+        self.cancel.set()
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+
 def run(
     scene: Scene,
     *,
@@ -183,28 +213,31 @@ def run(
 ) -> RunOutcome:
     """Run the ensemble of ``scene``, telling ``listeners`` as it goes.
 
-    Ctrl-C (KeyboardInterrupt) or ``cancel`` ends the run early; what finished
-    is kept and summarised (``outcome.status`` says which).
+    ``cancel`` (anything with ``set()``/``is_set()``) or Ctrl-C ends the run
+    early; what finished is kept and summarised, and ``outcome.status`` says
+    ``cancelled`` or ``interrupted``.
     """
     workers = default_workers() if workers is None else max(1, int(workers))
     total = scene.preset.realizations
     info = RunInfo(scene=scene, total=total, workers=workers)
     hooks = _listener_manager(listeners).hook
     accumulator = Accumulator(scene)
+    cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     hooks.run_started(run=info)
     status, error = "completed", None
-    try:
-        for result in iter_realizations(scene, range(total), workers=workers, cancel=cancel):
-            accumulator.add(result)
-            event = hooks.realization_done if result.ok else hooks.realization_failed
-            event(run=info, result=result, done=accumulator.done, total=total)
-        if accumulator.done < total:
-            status = "cancelled"
-    except KeyboardInterrupt:
-        status = "interrupted"
-    except RunError as exc:  # keep what finished before the pool broke
-        status, error = "failed", str(exc)
+    with _CtrlCToCancel(cancel) as ctrl_c:
+        try:
+            for result in iter_realizations(scene, range(total), workers=workers, cancel=cancel):
+                accumulator.add(result)
+                event = hooks.realization_done if result.ok else hooks.realization_failed
+                event(run=info, result=result, done=accumulator.done, total=total)
+        except KeyboardInterrupt:  # the second Ctrl-C
+            pass
+        except RunError as exc:  # keep what finished before the pool broke
+            status, error = "failed", str(exc)
+        if status == "completed" and accumulator.done < total:
+            status = "interrupted" if ctrl_c.pressed else "cancelled"
     outcome = accumulator.finish(
         status=status, elapsed=time.perf_counter() - started, workers=workers, error=error
     )

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, ValidationError
 
 NAME_PATTERN = re.compile(r"^[a-z][a-z0-9]*(-[a-z0-9]+)*$")
 
@@ -29,6 +29,16 @@ class PluginParams(BaseModel):
     validated on assignment too (the TUI edits them in place)."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+
+    def __setattr__(self, name, value):
+        # pydantic keeps a value that fails a model-level check on assignment;
+        # put the old one back so a rejected edit leaves the params valid.
+        previous = dict(self.__dict__)
+        try:
+            super().__setattr__(name, value)
+        except ValidationError:
+            self.__dict__.update(previous)
+            raise
 
 
 class Plugin:

@@ -151,12 +151,9 @@ def register_plugin(frictionlab_registry):
 
     yield register
 
-    pm = frictionlab_registry.pm
     for plugin in reversed(registered):
-        if pm.is_registered(plugin):
-            pm.unregister(plugin)
-    if registered:
-        frictionlab_registry._collect()
+        if frictionlab_registry.pm.is_registered(plugin):
+            frictionlab_registry.unregister_plugin(plugin)
 
 
 def _as_hook_plugin(obj):

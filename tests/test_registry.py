@@ -21,7 +21,6 @@ import pluggy
 import pytest
 from pydantic import BaseModel, ConfigDict, Field
 
-import frictionlab
 from frictionlab import (
     ContactCurve,
     ContactSolver,

@@ -160,11 +160,10 @@ class SpringRow(ContactSolver):
             n = np.searchsorted(onset, reach, side="left")  # #{m : G[m] < F/K} >= 1
             prefix = np.cumsum(u)
             indentation = (reach + prefix[n - 1]) / n  # d = (F/K + sum of n depths) / n
-            # Keep the exact invariant u[n-1] < d <= u[n] against the last rounding.
-            indentation = np.maximum(indentation, np.nextafter(u[n - 1], np.inf))
-            inside = n < count
-            if inside.any():
-                indentation[inside] = np.minimum(indentation[inside], u[n[inside]])
+            # Keep the exact invariant u[n-1] < d <= u[n] against the last rounding
+            # (past the last candidate the next depth is >= the bound >= d: no cap).
+            np.maximum(indentation, np.nextafter(u[n - 1], np.inf), out=indentation)
+            np.minimum(indentation, np.append(u, np.inf)[n], out=indentation)
             force = loads.copy()
         else:
             indentation = loads.copy()
