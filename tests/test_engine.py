@@ -140,44 +140,23 @@ def test_a_constant_line_fails_with_a_clear_message(make_scene):
     assert "rms slope of the whole line is 0.0" in result.error
 
 
-def test_scaling_heights_and_forces_together_leaves_xi_and_f_unchanged(make_scene):
-    """SPEC 5: z -> s z, F -> s F. With s a power of two every operation scales
-    exactly, so the results are bitwise equal."""
+SCALINGS = {
+    # SPEC 5: z -> s z with F -> s F. s a power of two scales every operation exactly.
+    "heights": ({"spectrum": {"params": {"rms_height": 4.0}}}, 4.0, 1e-13),
+    # E -> s E with F -> s F.
+    "modulus": ({"solver": {"params": {"youngs_modulus": 3.7}}}, 3.7, 1e-12),
+    # only f, H, N and the cut-offs in units of dx matter: F = f E* h L with L = N dx.
+    "spacing": ({"spectrum": {"params": {"spacing": 0.25}}}, 0.25, 1e-12),
+}
+
+
+@pytest.mark.parametrize("changes, s, rtol", SCALINGS.values(), ids=SCALINGS)
+def test_scaling_laws_leave_counts_xi_and_f_unchanged(make_scene, changes, s, rtol):
     base = engine.run(make_scene(), workers=1)
-    s = 4.0
-    scaled = engine.run(
-        make_scene({"spectrum": {"params": {"rms_height": s}}, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}),
-        workers=1,
-    )
+    scaled = engine.run(make_scene({**changes, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}), workers=1)
     np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
-    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-13)
-    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-13)
-
-
-def test_scaling_modulus_and_forces_together_leaves_xi_and_f_unchanged(make_scene):
-    base = engine.run(make_scene(), workers=1)
-    s = 3.7
-    scaled = engine.run(
-        make_scene({"solver": {"params": {"youngs_modulus": s}}, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}),
-        workers=1,
-    )
-    np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
-    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-12)
-    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-12)
-
-
-def test_result_depends_on_f_not_on_spacing(make_scene):
-    """SPEC 5: at fixed f, H, N and cut-offs in units of dx, changing dx changes nothing.
-    F = f E* h L with L = N dx, so the forces scale with dx."""
-    base = engine.run(make_scene(), workers=1)
-    dx = 0.25
-    scaled = engine.run(
-        make_scene({"spectrum": {"params": {"spacing": dx}}, "loading": {"start": 0.5 * dx, "stop": 20.0 * dx}}),
-        workers=1,
-    )
-    np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
-    np.testing.assert_allclose(scaled.xi, base.xi, rtol=1e-12)
-    np.testing.assert_allclose(scaled.f, base.f, rtol=1e-12)
+    np.testing.assert_allclose(scaled.xi, base.xi, rtol=rtol)
+    np.testing.assert_allclose(scaled.f, base.f, rtol=rtol)
 
 
 def test_full_contact_gives_xi_one(make_scene):

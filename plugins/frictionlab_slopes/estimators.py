@@ -12,7 +12,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import PluginParams, SlopeEstimator
+from frictionlab import SlopeEstimator
 
 __all__ = ["CentralDifference", "ForwardDifference", "Spectral"]
 
@@ -40,9 +40,6 @@ class ForwardDifference(SlopeEstimator):
     name: ClassVar[str] = "forward-difference"
     summary: ClassVar[str] = "forward difference (z[i+1] - z[i]) / dx, periodic: the study's definition"
 
-    class Params(PluginParams):
-        pass
-
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
         out = np.empty_like(z)
@@ -55,9 +52,6 @@ class ForwardDifference(SlopeEstimator):
 class CentralDifference(SlopeEstimator):
     name: ClassVar[str] = "central-difference"
     summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx), periodic"
-
-    class Params(PluginParams):
-        pass
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
@@ -72,9 +66,6 @@ class CentralDifference(SlopeEstimator):
 class Spectral(SlopeEstimator):
     name: ClassVar[str] = "spectral"
     summary: ClassVar[str] = "spectral derivative by FFT (multiply by i q), Nyquist term dropped for even N"
-
-    class Params(PluginParams):
-        pass
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)

@@ -89,6 +89,17 @@ def _check_line(profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float
     return heights, slopes, spacing
 
 
+def _prepare(solver: ContactSolver, profile: Profile, loads, control: str, slopes):
+    """Checked (loads, heights, slopes, spring stiffness K = k dx) for a sweep."""
+    _check_control(control)
+    loads = _check_loads(loads, control)
+    heights, slopes, spacing = _check_line(profile, slopes)
+    spring = solver.stiffness() * spacing
+    if not (np.isfinite(spring) and spring > 0.0):
+        raise ValueError(f"spring stiffness k dx must be finite and positive. Got {spring!r} instead.")
+    return loads, heights, slopes, spring
+
+
 def _top(heights: np.ndarray) -> float:
     zmax = float(heights.max())  # NaN propagates through max
     if not np.isfinite(zmax):
@@ -117,13 +128,8 @@ class SpringRow(ContactSolver):
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
     ) -> ContactCurve:
-        _check_control(control)
-        loads = _check_loads(loads, control)
-        heights, slopes, spacing = _check_line(profile, slopes)
+        loads, heights, slopes, spring = _prepare(self, profile, loads, control, slopes)
         points = heights.size
-        spring = self.stiffness() * spacing  # K = k dx
-        if not (np.isfinite(spring) and spring > 0.0):
-            raise ValueError(f"spring stiffness k dx must be finite and positive. Got {spring!r} instead.")
 
         zmax = _top(heights)
         if control == "force":
@@ -241,7 +247,7 @@ class WinklerSprings(SpringRow):
 # ------------------------------------------------------------- naive baseline
 
 
-class BisectionSprings(ContactSolver):
+class BisectionSprings(MDRSprings):
     """The naive method: for each force separately, bisect the indentation over
     the full array until the force matches to ``tolerance`` (relative).
 
@@ -270,18 +276,11 @@ class BisectionSprings(ContactSolver):
             200, ge=1, le=10_000, description="maximum bisection steps per load"
         )
 
-    def stiffness(self) -> float:
-        """E* = E / (1 - nu^2)."""
-        return effective_modulus(self.params.youngs_modulus, self.params.poisson_ratio)
-
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
     ) -> ContactCurve:
-        _check_control(control)
-        loads = _check_loads(loads, control)
-        heights, slopes, spacing = _check_line(profile, slopes)
+        loads, heights, slopes, spring = _prepare(self, profile, loads, control, slopes)
         points = heights.size
-        spring = self.stiffness() * spacing
         depth = _top(heights) - heights  # u_i >= 0
         if not np.isfinite(depth).all():
             raise ValueError("heights must be finite")
