@@ -28,7 +28,7 @@ class ProgressReporter:
         self.width = width
         self.started = 0.0
         self.last_draw = 0.0
-        self.next_line_fraction = 0.1
+        self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
         self.failed = 0
 
     def _line(self, done: int, total: int) -> str:
@@ -58,11 +58,11 @@ class ProgressReporter:
                 self.stream.write(f"\r[{bar}] {self._line(done, total)}\x1b[K")
                 self.stream.flush()
                 self.last_draw = now
-        elif done == total or done / total >= self.next_line_fraction:
+        elif done == total or 10 * done >= self.next_tenth * total:
             self.stream.write(self._line(done, total) + "\n")
             self.stream.flush()
-            while self.next_line_fraction <= done / total:
-                self.next_line_fraction += 0.1
+            while self.next_tenth * total <= 10 * done:
+                self.next_tenth += 1
 
     @hookimpl
     def realization_done(self, done, total):

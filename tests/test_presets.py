@@ -49,3 +49,24 @@ def test_fig2_run_in_full_lands_on_the_studys_contact_counts(registry):
     assert np.all(np.diff(counts, axis=1) >= 0)
     # f runs over the study's axis, 1e-9 .. 2e-8
     assert outcome.f[0] == pytest.approx(1e-9) and outcome.f[-1] == pytest.approx(2e-8)
+
+
+@pytest.mark.parametrize(
+    "realizations, steps",
+    [pytest.param(1, 40, id="reduced"), pytest.param(3, 400, id="full", marks=pytest.mark.slow)],
+)
+def test_fig2_lines_solved_exactly_agree_with_the_naive_bisection(registry, realizations, steps):
+    """At full scale (N = 1e5, the study's force grid) the one-sort sweep and the
+    bisection per force give the same contact counts and rms slopes."""
+    overrides = {"loading.steps": steps}
+    exact = load_scene(PRESETS / "benad2012-fig2.yaml", [f"{k}={v}" for k, v in overrides.items()], registry)
+    naive = load_scene(
+        PRESETS / "benad2012-fig2.yaml",
+        [f"{k}={v}" for k, v in overrides.items()] + ["solver.name=mdr-bisection"],
+        registry,
+    )
+    for index in range(realizations):
+        one, two = engine.compute_realization(exact, index), engine.compute_realization(naive, index)
+        np.testing.assert_array_equal(one.contact_count, two.contact_count)
+        np.testing.assert_allclose(one.xi, two.xi, rtol=1e-12)
+        np.testing.assert_allclose(one.indentation, two.indentation, rtol=1e-8)
