@@ -89,11 +89,12 @@ def fit_log_law(
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
-        # Each resample draws M realizations with replacement; counts @ X / M is its mean curve.
-        counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=bootstrap)
-        means = counts @ xi_per_realization / realizations
+        # The fit is linear in the mean curve, so a resample's coefficients are the
+        # resampled mean of each realization's own coefficients: (B, M) @ (M, 2).
         projector = np.linalg.pinv(_design(np.asarray(f, float)))  # (2, n_forces)
-        samples = means @ projector.T  # (bootstrap, 2)
+        per_realization = xi_per_realization @ projector.T  # (M, 2)
+        counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=bootstrap)
+        samples = counts @ per_realization / realizations  # (bootstrap, 2)
         tail = 100 * (1 - confidence) / 2
         low, high = np.percentile(samples, [tail, 100 - tail], axis=0)
         intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]

@@ -74,3 +74,17 @@ def test_no_bootstrap_with_one_realization_or_zero_resamples():
 def test_bad_force_grids_are_refused(f, message):
     with pytest.raises(ValueError, match=message):
         least_squares(f, np.ones_like(f))
+
+
+def test_bootstrap_equals_refitting_every_resampled_mean_curve():
+    """Brute force: draw the same resamples, average the curves, refit each one."""
+    rng = np.random.default_rng(8)
+    f = np.geomspace(0.5, 20, 25)
+    xi = 1.2 + 0.05 * np.log(f) + rng.normal(0, 0.1, (12, f.size))
+    fit = fit_log_law(f, xi, bootstrap=200, confidence=0.8, rng=np.random.default_rng(4))
+    draw = np.random.default_rng(4)
+    counts = draw.multinomial(12, np.full(12, 1 / 12), size=200)
+    refits = np.array([least_squares(f, c @ xi / 12)[0] for c in counts])
+    low, high = np.percentile(refits, [10, 90], axis=0)
+    assert fit.a_ci == pytest.approx((low[0], high[0]), rel=1e-12)
+    assert fit.b_ci == pytest.approx((low[1], high[1]), rel=1e-12)

