@@ -217,8 +217,8 @@ def run(
     early; what finished is kept and summarised, and ``outcome.status`` says
     ``cancelled`` or ``interrupted``.
     """
-    workers = default_workers() if workers is None else max(1, int(workers))
     total = scene.preset.realizations
+    workers = min(total, default_workers() if workers is None else max(1, int(workers)))
     info = RunInfo(scene=scene, total=total, workers=workers)
     hooks = _listener_manager(listeners).hook
     accumulator = Accumulator(scene)

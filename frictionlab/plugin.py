@@ -28,7 +28,7 @@ class PluginParams(BaseModel):
     """Base for every plugin's ``Params``: unknown keys are errors, values are
     validated on assignment too (the TUI edits them in place)."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True, frozen=False)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     def __setattr__(self, name, value):
         # pydantic keeps a value that fails a model-level check on assignment;

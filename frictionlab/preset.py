@@ -8,6 +8,7 @@ Every problem is reported, each as ``dotted.path: what is wrong, got VALUE``.
 from __future__ import annotations
 
 import copy
+import functools
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -93,7 +94,7 @@ class Scene:
     solver: ContactSolver
     slope: SlopeEstimator
 
-    @property
+    @functools.cached_property
     def loads(self) -> np.ndarray:
         return self.preset.loading.values()
 

@@ -249,3 +249,52 @@ def test_atomic_write_leaves_the_old_file_when_writing_fails(tmp_path):
         atomic_write(target, explode)
     assert target.read_text() == "old"
     assert list(tmp_path.iterdir()) == [target]  # no temporary left behind
+
+
+def test_a_measured_profile_runs_end_to_end_with_its_own_rms_height(tmp_path, capsys):
+    x = np.arange(2048)
+    heights = 3.0 * np.cos(2 * np.pi * x / 512) + 0.05 * np.sin(2 * np.pi * x / 16) + 7.0
+    np.savetxt(tmp_path / "scan.csv", heights)
+    preset = write_preset(
+        tmp_path,
+        {
+            "name": "scan",
+            "realizations": 1,
+            "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "scan.csv"), "spacing": 0.5}},
+            "loading": {"start": 0.1, "stop": 50.0, "steps": 12, "spacing": "log"},
+        },
+    )
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == ExitCode.OK
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["workers"] == 1  # one realization runs in-process, and says so
+    assert summary["normalisation"]["rms_height"] == pytest.approx(np.std(heights), rel=1e-12)
+    assert summary["normalisation"]["length"] == 1024.0
+
+
+def test_a_run_whose_every_realization_fails_still_writes_and_exits_1(tmp_path, capsys):
+    np.savetxt(tmp_path / "flat.csv", np.ones(64))
+    data = {**SMALL_PRESET, "realizations": 2}
+    data["spectrum"] = {"name": "profile-file", "params": {"path": str(tmp_path / "flat.csv"), "spacing": 1.0}}
+    preset = write_preset(tmp_path, data)
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    out = capsys.readouterr().out
+    assert "2 realization(s) failed; first: #0: ValueError" in out and "constant" in out
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["realizations"]["done"] == 0 and summary["fit"] is None
+    assert summary["realizations"]["failures"][1]["index"] == 1
+
+
+def test_output_switches_leave_out_the_per_realization_file_and_the_plot(tmp_path, capsys):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"output": {"realizations": False, "plot": False}}))
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == ExitCode.OK
+    assert {p.name for p in (tmp_path / "o").iterdir()} == {"summary.json", "curve.csv", "preset.yaml"}
+    files = json.loads((tmp_path / "o" / "summary.json").read_text())["files"]
+    assert set(files) == {"curve", "preset"}
+
+
+def test_schema_out_writes_the_schema_to_a_file(tmp_path, capsys):
+    assert main(["schema", "--out", str(tmp_path / "schema.json")]) == ExitCode.OK
+    assert capsys.readouterr().out == ""
+    schema = json.loads((tmp_path / "schema.json").read_text())
+    assert schema["title"] == "frictionlab preset"
+    assert set(schema["required"]) == {"name", "realizations", "spectrum", "loading"}
