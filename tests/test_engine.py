@@ -184,3 +184,21 @@ def test_chunks_cover_every_index_once():
     chunks = engine.chunked(indices, workers=2)
     assert [i for c in chunks for i in c] == indices
     assert 16 <= len(chunks) <= 40
+
+
+def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(make_scene):
+    """Forking a threaded process is unsafe (a front end runs the engine in a
+    thread): then the pool starts by forkserver, which pickles the scene."""
+    scene = make_scene({"realizations": 6})
+    serial = engine.run(scene, workers=1)
+    release = threading.Event()
+    bystander = threading.Thread(target=release.wait)
+    bystander.start()
+    try:
+        assert engine._pool_context().get_start_method() == "forkserver"
+        pooled = engine.run(scene, workers=2)
+    finally:
+        release.set()
+        bystander.join()
+    assert engine._pool_context().get_start_method() == "fork"
+    same_outcome(serial, pooled)
