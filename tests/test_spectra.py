@@ -468,43 +468,32 @@ def _bumpy(n=64):
     return 0.3 * np.sin(TWO_PI * 3 * i / n) + 0.1 * np.cos(TWO_PI * 7 * i / n) + 0.05 * (i % 5)
 
 
-@pytest.mark.parametrize("kind", ["csv1", "csv2", "csv-header", "txt1", "txt2", "npy1", "npy2xN", "npyNx2", "npy32"])
+# kind -> (file name, writer(path, x, z), spacing parameter, dtype stored)
+PROFILE_FORMATS = {
+    "csv1": ("a.csv", lambda p, x, z: np.savetxt(p, z), 0.25, np.float64),
+    "csv2": ("a.csv", lambda p, x, z: np.savetxt(p, np.column_stack([x, z]), delimiter=","), None, np.float64),
+    "csv-header": (
+        "a.csv",
+        lambda p, x, z: np.savetxt(p, np.column_stack([x, z]), delimiter=", ", header="x, z", comments=""),
+        None,
+        np.float64,
+    ),
+    "txt1": ("a.txt", lambda p, x, z: np.savetxt(p, z, header="profilometer scan"), 0.25, np.float64),
+    "txt2": ("a.txt", lambda p, x, z: np.savetxt(p, np.column_stack([x, z]), delimiter="\t"), None, np.float64),
+    "npy1": ("a.npy", lambda p, x, z: np.save(p, z), 0.25, np.float64),
+    "npy2xN": ("a.npy", lambda p, x, z: np.save(p, np.vstack([x, z])), None, np.float64),
+    "npyNx2": ("a.npy", lambda p, x, z: np.save(p, np.column_stack([x, z])), None, np.float64),
+    "npy32": ("a.npy", lambda p, x, z: np.save(p, z), 0.25, np.float32),
+}
+
+
+@pytest.mark.parametrize("kind", PROFILE_FORMATS)
 def test_profile_file_formats(tmp_path, kind):
-    z = _bumpy() + 5.0
+    file_name, write, spacing, dtype = PROFILE_FORMATS[kind]
+    z = (_bumpy() + 5.0).astype(dtype)
     x = 0.25 * np.arange(z.size) + 10.0
-    spacing = None
-    if kind == "csv1":
-        path = tmp_path / "a.csv"
-        np.savetxt(path, z)
-        spacing = 0.25
-    elif kind == "csv2":
-        path = tmp_path / "a.csv"
-        np.savetxt(path, np.column_stack([x, z]), delimiter=",")
-    elif kind == "csv-header":
-        path = tmp_path / "a.csv"
-        np.savetxt(path, np.column_stack([x, z]), delimiter=", ", header="x, z", comments="")
-    elif kind == "txt1":
-        path = tmp_path / "a.txt"
-        np.savetxt(path, z, header="profilometer scan")
-        spacing = 0.25
-    elif kind == "txt2":
-        path = tmp_path / "a.txt"
-        np.savetxt(path, np.column_stack([x, z]), delimiter="\t")
-    elif kind == "npy1":
-        path = tmp_path / "a.npy"
-        np.save(path, z)
-        spacing = 0.25
-    elif kind == "npy2xN":
-        path = tmp_path / "a.npy"
-        np.save(path, np.vstack([x, z]))
-    elif kind == "npyNx2":
-        path = tmp_path / "a.npy"
-        np.save(path, np.column_stack([x, z]))
-    else:
-        path = tmp_path / "a.npy"
-        z = z.astype(np.float32)
-        np.save(path, z)
-        spacing = 0.25
+    path = tmp_path / file_name
+    write(path, x, z)
     gen = ProfileFile(path=str(path), spacing=spacing)
     profile = gen.generate(np.random.default_rng(0))
     expected = z.astype(np.float64) - z.astype(np.float64).mean()
