@@ -62,10 +62,10 @@ def _default_out(name: str) -> Path:
 
 
 def cmd_run(args) -> ExitCode:
-    from . import engine
     from .preset import load_scene
     from .reporter import ProgressReporter
-    from .results import summary_dict, write_results
+    from .results import summary_dict
+    from .runner import run_to_folder
 
     overrides = list(args.set or [])
     if args.seed is not None:
@@ -75,9 +75,8 @@ def cmd_run(args) -> ExitCode:
         raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
     out_dir = Path(args.out) if args.out else _default_out(scene.preset.name)
     listeners = [] if args.quiet else [ProgressReporter()]
-    outcome = engine.run(scene, workers=args.workers, listeners=listeners)
     try:
-        files = write_results(out_dir, scene, outcome)
+        outcome, files = run_to_folder(scene, out_dir, workers=args.workers, listeners=listeners)
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE

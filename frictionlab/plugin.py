@@ -76,21 +76,33 @@ class Plugin:
 
 @dataclass(frozen=True)
 class Profile:
-    """One periodic rough line: heights on a uniform grid of ``spacing``.
-
-    ``heights`` has shape (N,). Later kinds (2D surfaces) will use shape (Ny, Nx).
-    """
+    """One periodic rough line, shape (N,), or surface, shape (Ny, Nx), with
+    heights on a uniform grid of ``spacing`` (square pixels on a surface)."""
 
     heights: np.ndarray
     spacing: float
+
+    @property
+    def ndim(self) -> int:
+        return int(np.ndim(self.heights))
 
     @property
     def points(self) -> int:
         return int(self.heights.size)
 
     @property
+    def area(self) -> float:
+        """Apparent (nominal) area of a surface; the length of a line."""
+        return self.points * self.spacing**self.ndim
+
+    @property
     def length(self) -> float:
-        return self.points * self.spacing
+        """The L of f = F / (k h L): the line's length, or for a surface of
+        apparent area A the MDR-equivalent length 2 sqrt(A / pi) (SPEC section 7),
+        so lines and surfaces share one f axis."""
+        if self.ndim == 1:
+            return self.points * self.spacing
+        return 2.0 * float(np.sqrt(self.area / np.pi))
 
 
 @dataclass(frozen=True)
@@ -126,6 +138,7 @@ class SpectrumGenerator(Plugin):
     """
 
     kind: ClassVar[str] = "spectrum"
+    dimension: ClassVar[int] = 1  # 1: makes lines (N,); 2: makes surfaces (Ny, Nx)
 
     def generate(self, rng: np.random.Generator) -> Profile:  # pragma: no cover - interface
         raise NotImplementedError
@@ -150,6 +163,7 @@ class SlopeEstimator(Plugin):
     """
 
     kind: ClassVar[str] = "slope"
+    dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
@@ -165,6 +179,7 @@ class ContactSolver(Plugin):
     """
 
     kind: ClassVar[str] = "solver"
+    dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
