@@ -9,6 +9,8 @@ Files in the output folder::
     realizations.npz   per-realization curves (output.realizations)
     preset.yaml        the resolved preset (every default filled in)
     plot.png           xi against f with the fit (output.plot)
+
+The run directory's own files (run.lock, run.json, chunks/) are ``rundir``'s.
 """
 
 from __future__ import annotations
@@ -34,12 +36,23 @@ SUMMARY_SCHEMA_VERSION = 1
 CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
 
 
+def _read_umask() -> int:
+    mask = os.umask(0)  # the only portable way to read it; done once, at import
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _read_umask()
+
+
 def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
-    """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``."""
+    """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
+    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.fchmod(fd, 0o666 & ~_UMASK)
         with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
             fh.flush()
@@ -78,6 +91,8 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
         "elapsed_seconds": round(outcome.elapsed, 6),
         "workers": outcome.workers,
+        "executor": outcome.extra.get("executor"),
+        "resumed_realizations": outcome.extra.get("resumed", 0),
         "files": files,
     }
 

@@ -35,6 +35,9 @@ def run_cli(*args, env=None, **kwargs):
     )
 
 
+RUN_DIRECTORY = {"run.lock", "run.json", "chunks"}  # the run directory's own files (frictionlab.rundir)
+
+
 def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
     preset = write_preset(tmp_path, SMALL_PRESET)
     out = tmp_path / "out"
@@ -47,6 +50,7 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
         "realizations.npz",
         "preset.yaml",
         "plot.png",
+        *RUN_DIRECTORY,
     }
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "completed"
@@ -237,6 +241,14 @@ def test_ctrl_c_keeps_finished_realizations_and_exits_130(tmp_path):
     assert arrays["xi"].shape[0] == summary["realizations"]["done"]
 
 
+def test_atomic_write_gives_the_usual_permissions_not_mkstemps(tmp_path):
+    target = tmp_path / "out.txt"
+    atomic_write(target, lambda fh: fh.write("x"))
+    mask = os.umask(0)
+    os.umask(mask)
+    assert target.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
 def test_atomic_write_leaves_the_old_file_when_writing_fails(tmp_path):
     target = tmp_path / "summary.json"
     target.write_text("old")
@@ -287,7 +299,7 @@ def test_a_run_whose_every_realization_fails_still_writes_and_exits_1(tmp_path, 
 def test_output_switches_leave_out_the_per_realization_file_and_the_plot(tmp_path, capsys):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"output": {"realizations": False, "plot": False}}))
     assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == ExitCode.OK
-    assert {p.name for p in (tmp_path / "o").iterdir()} == {"summary.json", "curve.csv", "preset.yaml"}
+    assert {p.name for p in (tmp_path / "o").iterdir()} == {"summary.json", "curve.csv", "preset.yaml", *RUN_DIRECTORY}
     files = json.loads((tmp_path / "o" / "summary.json").read_text())["files"]
     assert set(files) == {"curve", "preset"}
 

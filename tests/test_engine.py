@@ -183,7 +183,7 @@ def test_chunks_cover_every_index_once():
     indices = list(range(1000))
     chunks = engine.chunked(indices, workers=2)
     assert [i for c in chunks for i in c] == indices
-    assert 16 <= len(chunks) <= 40
+    assert len(chunks) == 8  # cost unknown: 4 per worker (sizing by cost: test_executors.py)
 
 
 def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(make_scene):
@@ -200,5 +200,6 @@ def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(
     finally:
         release.set()
         bystander.join()
-    assert engine._pool_context().get_start_method() == "fork"
+    # fork again once the bystander is gone (unless a Dask client left its threads in this process)
+    assert engine._pool_context().get_start_method() == ("fork" if threading.active_count() == 1 else "forkserver")
     same_outcome(serial, pooled)

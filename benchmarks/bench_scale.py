@@ -1,0 +1,178 @@
+"""Benchmark: large grids, cost against N and force steps, executors.
+
+Every figure is printed with the baseline it is compared with, measured in the
+same process (or, for peak memory, in a fresh one per size):
+
+* large lines: peak memory (ru_maxrss of a fresh process) and seconds per
+  realization of the Fig. 2 line with N points (1e6, 1e7; 1e8 with --huge);
+* cost per realization against N (1e3..1e7, at 400 steps) and against the
+  number of force steps (10..1e4, at N = 1e5): time / (N log2 N) should stay
+  flat in N, and the time flat in steps;
+* the Fig. 2 scene with each executor (serial; processes 1, 2; Dask
+  LocalCluster of 2, cluster start excluded), efficiency = serial / (workers x time);
+* overhead per task of each executor (tiny realizations, one per task);
+* the Fig. 2 scene end to end (run + chunk files + result files and plot) with
+  the default executor.
+
+    python benchmarks/bench_scale.py [--huge] [--skip-dask] [--repeat 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from frictionlab import engine
+from frictionlab.executors import make_executor
+from frictionlab.preset import load_scene
+from frictionlab.runner import run_to_folder
+
+PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
+
+PEAK_SCRIPT = """
+import sys, time
+from frictionlab.preset import load_scene
+from frictionlab.realization import compute_realization
+n = int(float(sys.argv[2]))
+scene = load_scene(sys.argv[1], [f"spectrum.params.points={n}", f"spectrum.params.length={float(n)}"])
+times = []
+for i in range(int(sys.argv[3])):
+    start = time.perf_counter(); result = compute_realization(scene, i); times.append(time.perf_counter() - start)
+    assert result.ok, result.error
+print(min(times))
+"""
+
+
+def line_scene(points: int, steps: int = 400):
+    return load_scene(
+        PRESET, [f"spectrum.params.points={points}", f"spectrum.params.length={float(points)}", f"loading.steps={steps}"]
+    )
+
+
+def best_of(repeat: int, work) -> float:
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        work()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def per_realization(scene, count: int, repeat: int) -> float:
+    engine.compute_realization(scene, 0)  # warm: synthesis cache, FFT plan
+    return best_of(repeat, lambda: [engine.compute_realization(scene, i) for i in range(count)]) / count
+
+
+def large_lines(sizes: list[float]) -> None:
+    print("Large lines (Fig. 2 line, 400 forces), one fresh process per size, serial:")
+    print(f"  {'N':>8}  {'s/realization':>13}  {'peak RSS':>9}  {'bytes/point':>11}")
+    for n in sizes:
+        count = 1 if n >= 1e8 else 2
+        process = subprocess.Popen(
+            [sys.executable, "-c", PEAK_SCRIPT, str(PRESET), str(n), str(count)], stdout=subprocess.PIPE, text=True
+        )
+        out = process.stdout.read()
+        _, status, usage = os.wait4(process.pid, 0)
+        if status:
+            print(f"  {n:8.0e}  failed (status {status})")
+            continue
+        peak = usage.ru_maxrss * 1024
+        print(f"  {n:8.0e}  {float(out):13.3f}  {peak / 2**20:7.0f} MiB  {peak / n:11.1f}")
+
+
+def cost_against_n_and_steps(repeat: int) -> None:
+    print("Cost per realization against N (400 forces); time / (N log2 N) flat means N log N:")
+    base = None
+    for n in (1_000, 10_000, 100_000, 1_000_000, 10_000_000):
+        count = max(1, int(2e6 // n))
+        seconds = per_realization(line_scene(n), count, repeat if n < 1e7 else 1)
+        norm = seconds / (n * math.log2(n))
+        base = base or norm
+        print(f"  N = {n:>10,}: {seconds * 1e3:9.3f} ms   per N log2 N: {norm * 1e9:6.2f} ns  ({norm / base:5.2f} x N = 1e3)")
+    print("Cost per realization against force steps (N = 1e5):")
+    base = None
+    for steps in (10, 100, 1_000, 10_000):
+        seconds = per_realization(line_scene(100_000, steps), 20, repeat)
+        base = base or seconds
+        print(f"  {steps:>6} steps: {seconds * 1e3:7.3f} ms  ({seconds / base:5.2f} x 10 steps)")
+
+
+def executors(repeat: int, skip_dask: bool) -> None:
+    scene = load_scene(PRESET)
+    m = scene.preset.realizations
+    serial = best_of(repeat, lambda: engine.run(scene, workers=1, executor="serial"))
+    rows = [("serial", 1, serial)]
+    for workers in (1, 2):
+        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, workers=workers, executor="processes"))))
+    tiny = load_scene(PRESET, ["spectrum.params.points=64", "spectrum.params.length=64.0", "loading.steps=2"])
+    tasks = [[i] for i in range(400)]
+    never = threading.Event()
+
+    def overhead(pool) -> float:
+        compute = best_of(repeat, lambda: [engine.compute_realization(tiny, i) for i in range(len(tasks))])
+        wall = best_of(repeat, lambda: list(pool.map_chunks(tiny, tasks, never)))
+        return (wall - compute) / len(tasks)
+
+    overheads = [("serial", overhead(make_executor("serial", 1))), ("processes (2, pool start included)", overhead(make_executor("processes", 2)))]
+    if not skip_dask:
+        import distributed
+
+        with distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
+        ) as cluster:
+            address = cluster.scheduler_address
+            rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, executor="dask", scheduler=address))))
+            overheads.append(("dask (2, connect included)", overhead(make_executor("dask", 2, scheduler=address))))
+    print(f"Fig. 2 scene ({m} realizations), executors (efficiency = serial / (workers x time)):")
+    for name, workers, seconds in rows:
+        print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")
+    print("Overhead per task (400 one-realization tasks of a 64-point line):")
+    for name, seconds in overheads:
+        print(f"  {name:36} {seconds * 1e3:8.3f} ms")
+
+
+def end_to_end(repeat: int) -> None:
+    scene = load_scene(PRESET)
+    with tempfile.TemporaryDirectory() as tmp:
+        counter = iter(range(1000))
+        warm = best_of(repeat, lambda: run_to_folder(scene, Path(tmp) / str(next(counter))))
+        start = time.perf_counter()
+        subprocess.run(
+            [sys.executable, "-m", "frictionlab", "run", str(PRESET), "--out", str(Path(tmp) / "cold"), "--quiet"],
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
+        cold = time.perf_counter() - start
+    print("Fig. 2 scene end to end, default executor:")
+    print(f"  run_to_folder (run, chunk files, results and plot), warm process: {warm:6.3f} s  (target < 1 s)")
+    print(f"  `frictionlab run` in a new process (start-up and imports included): {cold:6.3f} s")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--huge", action="store_true", help="also N = 1e8 (about 3 GiB; run it alone)")
+    parser.add_argument("--skip-dask", action="store_true")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--only", choices=("large", "cost", "executors", "end-to-end"))
+    args = parser.parse_args()
+    sections = {
+        "large": lambda: large_lines([1e6, 1e7] + ([1e8] if args.huge else [])),
+        "cost": lambda: cost_against_n_and_steps(args.repeat),
+        "executors": lambda: executors(args.repeat, args.skip_dask),
+        "end-to-end": lambda: end_to_end(args.repeat),
+    }
+    for name, section in sections.items():
+        if args.only in (None, name):
+            section()
+
+
+if __name__ == "__main__":
+    main()

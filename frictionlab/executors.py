@@ -1,0 +1,305 @@
+"""Where realizations run: in this process, in a local process pool, or on Dask.
+
+An executor takes a list of chunks (lists of realization indices) and yields
+``(chunk, results)`` as each chunk finishes, in completion order. Numbers never
+depend on the executor: every realization draws from its own seed, and the
+statistics are formed by index afterwards.
+
+* ``serial``: in this process, realization by realization.
+* ``processes``: a ``ProcessPoolExecutor`` on this machine. A worker that dies
+  (killed, out of memory) breaks the pool: the pool is rebuilt and only the
+  unfinished chunks are submitted again, a bounded number of times.
+* ``dask``: a ``distributed.Client`` on an existing scheduler, or on a
+  ``LocalCluster`` bound to loopback. The scene is broadcast once; Dask itself
+  reschedules the tasks of a worker that dies.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import math
+import multiprocessing
+import os
+import signal
+import threading
+import time
+import uuid
+from collections.abc import Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+from .errors import FrictionlabError, RunError
+from .preset import Scene
+from .realization import RealizationResult, compute_chunk
+
+EXECUTORS = ("serial", "processes", "dask")
+DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+
+Chunk = list[int]
+
+
+def default_workers() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+# ------------------------------------------------------------------ chunking
+
+TARGET_CHUNK_SECONDS = 0.5  # task overhead is ~1 ms (pool) to ~5 ms (Dask): well under 2% of this
+CHUNKS_PER_WORKER = 4  # at least this many, for load balance and progress
+
+
+def plan_chunks(
+    indices: Sequence[int],
+    workers: int,
+    seconds_each: float,
+    target: float = TARGET_CHUNK_SECONDS,
+    per_worker: int = CHUNKS_PER_WORKER,
+) -> list[Chunk]:
+    """Split ``indices`` into consecutive chunks of about ``target`` seconds each
+    (from the measured ``seconds_each`` of one realization), but into at least
+    ``per_worker`` chunks per worker while there are enough indices."""
+    indices = list(indices)
+    if not indices:
+        return []
+    by_cost = max(1, int(target / max(seconds_each, 1e-9)))
+    by_balance = max(1, math.ceil(len(indices) / (max(1, workers) * per_worker)))
+    size = min(by_cost, by_balance)
+    return [indices[i : i + size] for i in range(0, len(indices), size)]
+
+
+def chunk_label(chunk: Sequence[int]) -> str:
+    return f"{chunk[0]}" if len(chunk) == 1 else f"{chunk[0]}-{chunk[-1]}"
+
+
+# ------------------------------------------------------------------ serial
+
+
+class SerialExecutor:
+    """In this process. ``cancel`` is checked before every realization; a
+    cancelled chunk yields what it finished."""
+
+    name = "serial"
+
+    def __init__(self):
+        self.workers = 1
+
+    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        for chunk in chunks:
+            done = []
+            for index in chunk:
+                if cancel.is_set():
+                    break
+                done.extend(compute_chunk(scene, [index]))
+            if done:
+                yield chunk[: len(done)], done
+            if cancel.is_set():
+                return
+
+
+# ------------------------------------------------------------------ process pool
+
+_worker_scene: Scene | None = None
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """Linux: have the kernel kill this worker when the process that made it
+    dies (the main process, or the forkserver, which ends with the main
+    process), so kill -9 of ``frictionlab run`` leaves no worker computing."""
+    parent = os.getppid()
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    except (OSError, AttributeError):  # not Linux: workers end when their queue closes
+        return
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+
+
+def _init_worker(scene: Scene) -> None:
+    global _worker_scene
+    _worker_scene = scene
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    _die_with_parent()
+
+
+def _run_chunk(indices: Chunk) -> list[RealizationResult]:
+    return compute_chunk(_worker_scene, indices)
+
+
+def pool_context():
+    # fork is the cheapest start on Linux but unsafe with threads (the TUI runs the
+    # engine in one; a Dask client runs an event loop): use forkserver there.
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
+    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+class ProcessExecutor:
+    """A local process pool. ``retries``: how many times a chunk is submitted
+    again after the pool broke while it ran (a worker died)."""
+
+    name = "processes"
+
+    def __init__(self, workers: int, retries: int = 2):
+        self.workers = workers
+        self.retries = retries
+
+    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        todo = dict(enumerate(chunks))
+        attempts = dict.fromkeys(todo, 0)
+        while todo:
+            broken, running = yield from self._one_pool(scene, todo, cancel)
+            if not broken:
+                return
+            # Charge the chunks that were running when a worker died; submit the rest again.
+            for key in (running & todo.keys()) or todo.keys():
+                attempts[key] += 1
+                if attempts[key] > self.retries:
+                    raise RunError(
+                        f"a worker process died {attempts[key]} times while running realizations "
+                        f"{chunk_label(todo[key])} ({broken}); giving up"
+                    )
+
+    def _one_pool(self, scene, todo: dict[int, Chunk], cancel):
+        """Run ``todo`` on a fresh pool, removing each chunk as it finishes.
+        Returns (why the pool broke or None, keys of the chunks seen running)."""
+        running: set[int] = set()
+        pool = ProcessPoolExecutor(
+            max_workers=min(self.workers, len(todo)),
+            mp_context=pool_context(),
+            initializer=_init_worker,
+            initargs=(scene,),
+        )
+        try:
+            futures = {pool.submit(_run_chunk, chunk): key for key, chunk in todo.items()}
+            pending = set(futures)
+            while pending:
+                if cancel.is_set():
+                    # Chunks already running finish and are kept; the rest never start.
+                    pending = {future for future in pending if not future.cancel()}
+                    finished, pending = wait(pending).done, set()
+                else:
+                    running |= {futures[f] for f in pending if f.running()}
+                    finished, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    key = futures[future]
+                    try:
+                        results = future.result()
+                    except BrokenProcessPool as exc:
+                        return str(exc) or "the pool broke", running
+                    chunk = todo.pop(key)
+                    yield chunk, results
+            if cancel.is_set():
+                todo.clear()
+            return None, running
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+# ------------------------------------------------------------------ dask
+
+
+def import_distributed():
+    try:
+        import distributed
+    except ImportError:
+        raise FrictionlabError(DASK_MISSING) from None
+    return distributed
+
+
+class DaskExecutor:
+    """Chunks as Dask tasks. With ``scheduler`` (``tcp://HOST:PORT``) the run uses
+    that cluster's workers; without, a ``LocalCluster`` of ``workers`` single-thread
+    processes on 127.0.0.1, dashboard off, closed at the end. ``retries``: Dask
+    retries of a task that raised (a task whose worker died is rescheduled by Dask
+    up to its ``allowed-failures``)."""
+
+    name = "dask"
+
+    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2):
+        self.workers = workers
+        self.scheduler = scheduler
+        self.retries = retries
+
+    def _connect(self):
+        distributed = import_distributed()
+        if self.scheduler:
+            try:
+                client = distributed.Client(self.scheduler, timeout="10s")
+            except (OSError, TimeoutError) as exc:
+                raise RunError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+            self.workers = max(1, len(client.scheduler_info().get("workers", {})))
+            return client, None
+        cluster = distributed.LocalCluster(
+            n_workers=self.workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # health routes only, loopback, any port
+            silence_logs=logging.ERROR,
+        )
+        return distributed.Client(cluster), cluster
+
+    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        distributed = import_distributed()
+        client, cluster = self._connect()
+        futures = []
+        try:
+            scene_future = client.scatter(scene, broadcast=True, hash=False)
+            run_id = uuid.uuid4().hex[:8]
+            chunk_of = {}
+            for chunk in chunks:
+                future = client.submit(
+                    compute_chunk,
+                    scene_future,
+                    chunk,
+                    key=f"frictionlab-{run_id}-{chunk_label(chunk)}",
+                    retries=self.retries,
+                    pure=False,
+                )
+                futures.append(future)
+                chunk_of[future.key] = chunk
+            stream = distributed.as_completed(futures)
+            while not stream.is_empty():
+                if cancel.is_set():
+                    return
+                batch = stream.next_batch(block=False)
+                if not batch:
+                    time.sleep(0.02)
+                    continue
+                for future in batch:
+                    try:
+                        results = future.result()
+                    except Exception as exc:  # KilledWorker, a plugin missing on a worker, ...
+                        raise RunError(
+                            f"Dask task for realizations {chunk_label(chunk_of[future.key])} failed: "
+                            f"{type(exc).__name__}: {exc}"
+                        ) from None
+                    yield chunk_of[future.key], results
+        finally:
+            if futures:
+                client.cancel([f for f in futures if not f.done()])
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+def make_executor(name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2):
+    """The executor called ``name``; ``None`` is the embedded default: a process
+    pool for more than one worker, in this process for one."""
+    if name is None:
+        name = "dask" if scheduler else "processes" if workers > 1 else "serial"
+    if name not in EXECUTORS:
+        raise FrictionlabError(f"executor must be one of {', '.join(EXECUTORS)}. Got {name!r} instead.")
+    if scheduler and name != "dask":
+        raise FrictionlabError(f"--scheduler {scheduler} needs the dask executor. Got executor {name!r} instead.")
+    if name == "serial":
+        return SerialExecutor()
+    if name == "processes":
+        return ProcessExecutor(workers, retries=retries)
+    import_distributed()  # fail before anything starts
+    return DaskExecutor(workers, scheduler=scheduler, retries=retries)

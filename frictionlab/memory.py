@@ -1,0 +1,152 @@
+"""Peak memory of a run, estimated from the preset before anything starts.
+
+The estimate is an upper bound for the built-in line pipeline (power-law
+synthesis, a slope estimator, the sorted spring sweep), calibrated by measuring
+the growth of ``ru_maxrss`` over one realization (benchmarks/bench_scale.py):
+
+* 32 bytes per grid point in the usual case (few candidate points sorted),
+  97 when the largest load reaches full contact and every point is sorted;
+  ``BYTES_PER_POINT`` takes the worst case with a margin;
+* a process with numpy, scipy and frictionlab imported holds about 70 MiB;
+* the main process keeps every finished realization's per-load arrays.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from .errors import RunError
+from .preset import Scene
+
+MiB = 2**20
+GiB = 2**30
+BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
+BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
+PROCESS_BASE = 160 * MiB  # main process: interpreter, numpy, scipy, pydantic, matplotlib for the plot
+WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process
+KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the file being written
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    points: int  # grid points of one realization
+    workers: int
+    executor: str
+    per_realization: int  # bytes one realization needs while it runs
+    per_worker: int  # a worker process: its base plus one realization
+    main: int  # the main process: base plus the kept rows
+    total: int  # the peak of the whole run on this machine
+
+    def describe(self) -> str:
+        if self.executor == "serial":
+            return (
+                f"{gib(self.total)} (one realization of {self.points:,} points: {gib(self.per_realization)}, "
+                f"in this process, which keeps {gib(self.main)})"
+            )
+        return (
+            f"{gib(self.total)} ({self.workers} worker(s) x {gib(self.per_worker)} for realizations of "
+            f"{self.points:,} points, plus {gib(self.main)} in the main process)"
+        )
+
+
+def gib(n: float) -> str:
+    return f"{n / GiB:.2f} GiB" if n >= 0.1 * GiB else f"{n / MiB:.0f} MiB"
+
+
+def grid_points(scene: Scene) -> int:
+    """Points of one realization: from the spectrum's ``points`` parameter
+    (squared for a surface), else by generating realization 0 once (0 if that fails)."""
+    points = getattr(scene.spectrum.params, "points", None)
+    if isinstance(points, int) and points > 0:
+        return points ** getattr(scene.spectrum, "dimension", 1)
+    from .seeds import realization_rng
+
+    try:
+        return scene.spectrum.generate(realization_rng(scene.preset.seed, 0)).points
+    except Exception:  # the run itself reports a spectrum that fails, per realization
+        return 0
+
+
+def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = None) -> MemoryEstimate:
+    points = grid_points(scene) if points is None else points
+    steps = int(scene.loads.size)
+    arrays = 4 if scene.control == "indentation" else 3
+    kept = scene.preset.realizations * (steps * 8 * arrays * KEPT_COPIES + 512)
+    per_realization = points * BYTES_PER_POINT + steps * BYTES_PER_STEP
+    main = PROCESS_BASE + kept
+    if executor == "serial":
+        per_worker, total, workers = 0, main + per_realization, 1
+    else:
+        per_worker = WORKER_BASE.get(executor, WORKER_BASE["dask"]) + per_realization
+        # the main process measures one realization before the workers start
+        total = main + max(per_realization, workers * per_worker)
+    return MemoryEstimate(points, workers, executor, per_realization, per_worker, main, total)
+
+
+def available_memory() -> tuple[int, str]:
+    """Bytes this process may still use, and where the figure comes from: the
+    smaller of MemAvailable and the room left under a cgroup limit."""
+    found: list[tuple[int, str]] = []
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                found.append((int(line.split()[1]) * 1024, "MemAvailable in /proc/meminfo"))
+    except (OSError, ValueError, IndexError):
+        pass
+    for limit_file, usage_file in (
+        ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),  # cgroup v2
+        ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"),  # v1
+    ):
+        try:
+            limit = Path(limit_file).read_text().strip()
+            usage = int(Path(usage_file).read_text().strip())
+        except (OSError, ValueError):
+            continue
+        if limit.isdigit() and int(limit) < 2**60:
+            found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
+    if not found:
+        return 2**62, "unknown (no /proc/meminfo)"
+    return min(found)
+
+
+def _most_points(scene: Scene, executor: str, available: int) -> int:
+    """The largest ``spectrum.params.points`` whose one-worker estimate fits."""
+    dimension = getattr(scene.spectrum, "dimension", 1)
+    low, high = 1, 2
+    while estimate(scene, workers=1, executor=executor, points=high**dimension).total <= available:
+        low, high = high, 2 * high
+    while high - low > 1:
+        middle = (low + high) // 2
+        fits = estimate(scene, workers=1, executor=executor, points=middle**dimension).total <= available
+        low, high = (middle, high) if fits else (low, middle)
+    return low
+
+
+def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: bool = False) -> MemoryEstimate:
+    """Refuse (RunError) a run whose estimated peak exceeds the available memory,
+    naming the estimate, the limit and a setting that would fit."""
+    if remote_workers:  # workers on other machines: only the main process is here
+        executor, workers = "serial", 1
+    guess = estimate(scene, workers=workers, executor=executor)
+    available, source = available_memory()
+    if guess.total <= available:
+        return guess
+    advice = []
+    for fewer in range(workers - 1, 0, -1):
+        if estimate(scene, workers=fewer, executor=executor, points=guess.points).total <= available:
+            advice.append(f"--workers {fewer}")
+            break
+    if not advice:
+        one = estimate(scene, workers=1, executor=executor, points=guess.points)
+        if one.total - one.per_realization + BYTES_PER_POINT < available and hasattr(scene.spectrum.params, "points"):
+            advice.append(f"--workers 1 and spectrum.params.points <= {_most_points(scene, executor, available):,}")
+        else:
+            rows = scene.loads.size * 8 * (4 if scene.control == "indentation" else 3) * KEPT_COPIES + 512
+            spare = available - PROCESS_BASE - one.per_realization
+            advice.append(f"--workers 1 and realizations <= {max(0, math.floor(spare / rows)):,}")
+    raise RunError(
+        f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
+        f"({source}). It would fit with {advice[0]}. (--no-memory-check skips this estimate, an upper bound.)"
+    )

@@ -1,0 +1,75 @@
+"""One realization of a scene: generate -> slopes -> solve -> xi.
+
+Kept apart from the driver so every executor (in-process, a process pool, Dask
+workers) imports only this and the scene, nothing of the run's bookkeeping.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+import traceback
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .preset import Scene
+from .seeds import realization_rng
+
+
+@dataclass(frozen=True)
+class RealizationResult:
+    """What one realization gives. Arrays have one entry per load step; a failed
+    realization carries ``error`` and no arrays."""
+
+    index: int
+    seconds: float
+    xi: np.ndarray | None = None
+    contact_count: np.ndarray | None = None
+    indentation: np.ndarray | None = None
+    force: np.ndarray | None = None  # kept only under indentation control (forces vary)
+    slope_rms_line: float = math.nan
+    points: int = 0
+    length: float = math.nan
+    error: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None
+
+
+def compute_realization(scene: Scene, index: int) -> RealizationResult:
+    """Realization ``index`` of ``scene``. Never raises: a failure is carried on the result."""
+    start = time.perf_counter()
+    try:
+        rng = realization_rng(scene.preset.seed, index)
+        profile = scene.spectrum.generate(rng)
+        slopes = scene.slope.slopes(profile.heights, profile.spacing)
+        slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
+        if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
+            raise ValueError(
+                f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
+            )
+        curve = scene.solver.solve(profile, scene.loads, scene.control, slopes)
+        return RealizationResult(
+            index=index,
+            seconds=time.perf_counter() - start,
+            xi=curve.slope_rms_contact / slope_rms_line,
+            contact_count=np.asarray(curve.contact_count),
+            indentation=np.asarray(curve.indentation),
+            force=np.asarray(curve.force) if scene.control == "indentation" else None,
+            slope_rms_line=slope_rms_line,
+            points=profile.points,
+            length=profile.length,
+        )
+    except Exception as exc:  # carried, not raised: one bad line must not end the run
+        where = traceback.extract_tb(exc.__traceback__)[-1]
+        error = f"{type(exc).__name__}: {exc} ({os.path.basename(where.filename)}:{where.lineno})"
+        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
+
+
+def compute_chunk(scene: Scene, indices: Iterable[int]) -> list[RealizationResult]:
+    """The task every executor runs: a chunk of realizations, in order."""
+    return [compute_realization(scene, int(i)) for i in indices]

@@ -1,0 +1,177 @@
+"""Run directories: every finished chunk kept, resume computes only what is
+missing and ends bitwise where an uninterrupted run ends; one run at a time per
+directory; a resume with another preset is refused."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab import hookimpl
+from frictionlab.cli import main
+from frictionlab.errors import FrictionlabError, RunError
+from frictionlab.preset import build_scene
+from frictionlab.rundir import RunDirectory
+from frictionlab.runner import run_to_folder
+
+from .conftest import SMALL_PRESET, merge
+
+# ~20 ms per realization: 150 of them last long enough to be killed mid-run
+NO_PLOT = {"output": {"plot": False}}  # matplotlib costs a second per folder and is not under test
+KILL_PRESET = merge(SMALL_PRESET, {"realizations": 80, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
+
+
+def same_files(one: Path, two: Path) -> None:
+    """The numbers two output folders hold are identical, bit for bit."""
+    with np.load(one / "realizations.npz") as a, np.load(two / "realizations.npz") as b:
+        assert a.files == b.files
+        for name in a.files:
+            np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+    assert (one / "curve.csv").read_text() == (two / "curve.csv").read_text()
+    first, second = (json.loads((d / "summary.json").read_text()) for d in (one, two))
+    assert first["fit"] == second["fit"]
+    assert first["status"] == second["status"] == "completed"
+
+
+class CancelAfter:
+    def __init__(self, count: int, cancel: threading.Event):
+        self.count, self.cancel = count, cancel
+
+    @hookimpl
+    def realization_done(self, done):
+        if done >= self.count:
+            self.cancel.set()
+
+
+def test_cancelled_run_resumes_to_the_uninterrupted_numbers(make_scene, tmp_path):
+    scene = make_scene({"realizations": 40, **NO_PLOT})
+    cancel = threading.Event()
+    first, _ = run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(5, cancel)], cancel=cancel)
+    assert first.status == "cancelled" and 5 <= first.done < 40
+    stored = sorted(p.name for p in (tmp_path / "run" / "chunks").glob("*.npz"))
+    assert stored, "no chunk was kept"
+
+    resumed, _ = run_to_folder(scene, tmp_path / "run", workers=2, resume=True)
+    assert resumed.status == "completed"
+    assert resumed.extra["resumed"] == first.done  # only the missing ones were computed
+    run_to_folder(scene, tmp_path / "whole", workers=1)
+    same_files(tmp_path / "run", tmp_path / "whole")
+
+
+def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
+    scene = make_scene({"realizations": 12, **NO_PLOT})
+    run_to_folder(scene, tmp_path / "run", workers=1)
+    before = (tmp_path / "run" / "curve.csv").read_text()
+    again, _ = run_to_folder(scene, tmp_path / "run", workers=1, resume=True)
+    assert again.extra["resumed"] == 12 and again.done == 12
+    assert (tmp_path / "run" / "curve.csv").read_text() == before
+
+
+def test_a_second_run_into_a_locked_directory_is_refused(make_scene, tmp_path):
+    with RunDirectory(tmp_path / "run"):
+        with pytest.raises(RunError, match=rf"{tmp_path / 'run'} is in use by another run \(pid {os.getpid()}, started"):
+            run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)  # released: now it runs
+
+
+def test_a_forked_child_does_not_keep_the_lock(tmp_path):
+    ready_r, ready_w = os.pipe()
+    with RunDirectory(tmp_path / "run"):
+        child = os.fork()
+        if child == 0:  # pragma: no cover - the child says it runs (at-fork handlers done), then sleeps
+            os.write(ready_w, b"x")
+            time.sleep(3)
+            os._exit(0)
+        assert os.read(ready_r, 1) == b"x"
+    os.close(ready_r), os.close(ready_w)
+    try:
+        with RunDirectory(tmp_path / "run"):  # the parent let go; the child's copy was closed at fork
+            pass
+    finally:
+        os.kill(child, signal.SIGKILL)
+        os.waitpid(child, 0)
+
+
+def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, tmp_path):
+    cancel = threading.Event()
+    cancel.set()  # nothing computed, but the directory is started
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1, cancel=cancel)
+    other = make_scene({"realizations": 9, "spectrum": {"params": {"hurst": 0.7}}})
+    with pytest.raises(FrictionlabError) as caught:
+        run_to_folder(other, tmp_path / "run", workers=1, resume=True)
+    message = str(caught.value)
+    assert message.startswith(f"cannot resume {tmp_path / 'run'}: its preset differs from the one given")
+    assert "realizations: 8 in the run directory, 9 given" in message
+    assert "spectrum.params.hurst: 0.8 in the run directory, 0.7 given" in message
+
+
+def test_a_fresh_run_over_an_unfinished_one_is_refused(make_scene, tmp_path):
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    cancel = threading.Event()
+    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(3, cancel)], cancel=cancel)
+    with pytest.raises(FrictionlabError, match="holds an unfinished run .* continue it with --resume"):
+        run_to_folder(scene, tmp_path / "run", workers=1)
+
+
+def test_resume_of_a_folder_without_a_run_says_so(tmp_path, capsys):
+    assert main(["resume", str(tmp_path)]) == 2
+    assert f"{tmp_path} holds no run to resume (no preset.yaml)" in capsys.readouterr().err
+
+
+def _children(pid: int) -> set[int]:
+    found = set()
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        found.update(int(c) for c in (task / "children").read_text().split())
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return False
+    return state != "Z"
+
+
+def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path):
+    preset = tmp_path / "kill.yaml"
+    preset.write_text(yaml.safe_dump(KILL_PRESET))
+    run_dir = tmp_path / "run"
+    command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(run_dir), "--workers", "2", "--quiet"]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while len(list((run_dir / "chunks").glob("*.npz"))) < 2:
+        assert process.poll() is None, process.stderr.read().decode()
+        assert time.monotonic() < deadline, "no chunk written in 60 s"
+        time.sleep(0.01)
+    workers = _children(process.pid)
+    process.send_signal(signal.SIGKILL)
+    assert process.wait() == -signal.SIGKILL
+    assert not (run_dir / "summary.json").exists(), "the run finished before the kill: nothing was tested"
+    kept = len(list((run_dir / "chunks").glob("*.npz")))
+    time.sleep(0.5)
+    assert not [pid for pid in workers if _alive(pid)], "pool workers outlived the killed run"
+
+    resumed = subprocess.run(
+        [sys.executable, "-m", "frictionlab", "resume", str(run_dir), "--workers", "2", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    summary = json.loads(resumed.stdout)
+    assert 0 < summary["resumed_realizations"] < 80
+    assert kept >= 2
+
+    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", workers=2)
+    same_files(run_dir, tmp_path / "whole")
