@@ -67,8 +67,8 @@ classes::
     naming the field. That last part is skipped only when no field is bounded.
 
 ``check_spectrum(cls, *, deterministic=False, **params)``
-    ``cls(**params).generate(rng)`` returns a ``Profile`` with 1-D, finite,
-    floating-point heights and a finite ``spacing > 0``; the same seed gives
+    ``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
+    floating-point heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
     identical heights; a different seed gives different heights (pass
     ``deterministic=True`` for a generator that ignores randomness by design,
     e.g. one that reads a measured profile); ``rms_height()`` is finite and
@@ -79,9 +79,12 @@ classes::
 
 ``check_solver(cls, **params)``
     ``cls(**params).solve(profile, loads, control, slopes)`` on a small smooth
-    random periodic line (64 points) with forward-difference slopes, under force
-    control (forces F = f k h L, f from 0.005 to 1, k = ``stiffness()``) and
-    under indentation control (0.05 h to 2 h): it returns a ``ContactCurve``
+    random periodic line (64 points) with forward-difference slopes (a solver
+    whose ``dimensions`` lack 1 gets a 16 x 16 surface with forward-difference
+    gradient magnitudes instead), under force
+    control (forces F = f k h L, L = ``Profile.length``, f from 0.005 to 1, k = ``stiffness()``) and
+    under indentation control (2.5 % to 95 % of max z - mean z, the approach at
+    which a periodic elastic half-space reaches full contact): it returns a ``ContactCurve``
     whose arrays all have the shape of ``loads`` and are finite; the controlled
     quantity is reported back (``force`` resp. ``indentation`` equal to the
     loads within 1 %); force and indentation do not decrease with load; contact
@@ -97,7 +100,10 @@ classes::
     and is repeatable; a constant line gives zero slopes; on a periodic sine
     (3 periods over 128 points, spacing 0.1) the slopes match the exact
     derivative in order of magnitude and sign (rms within a factor of 2,
-    relative rms error below 0.5).
+    relative rms error below 0.5). An estimator whose ``dimensions`` include 2
+    gets the same checks on a 24 x 40 surface, with a plane wave across both
+    axes whose exact slope is |grad z| (so its slopes must be >= 0); lines are
+    checked only if ``dimensions`` include 1.
 
 ``check_plugin(kind, cls, *, deterministic=False, **params)``
     ``check_plugin_class`` followed by the check of ``kind``
@@ -412,8 +418,9 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
         if not isinstance(profile, Profile):
             _fail(cls, f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead.")
         heights = _check_array(cls, "Profile.heights", profile.heights)
-        if heights.ndim != 1:
-            _fail(cls, f"Profile.heights must be 1-D. Got shape {heights.shape} instead.")
+        dimension = getattr(cls, "dimension", 1)
+        if heights.ndim != dimension:
+            _fail(cls, f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {heights.shape} instead.")
         if heights.size < 2:
             _fail(cls, f"Profile.heights must have at least 2 points. Got {heights.size}.")
         _check_positive_number(cls, "Profile.spacing", profile.spacing)
@@ -473,6 +480,20 @@ def _test_line(points: int = 64, seed: int = 20240613):
     return heights, spacing, slopes
 
 
+def _test_surface(points: int = 16, seed: int = 20240613):
+    """A smooth random periodic surface with rms 1 and its forward-difference gradient magnitude."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    k = np.hypot(*np.meshgrid(np.fft.fftfreq(points, 1 / points), np.arange(points // 2 + 1), indexing="ij"))
+    amplitude = np.where(k > 0, k, np.inf) ** -2.0
+    heights = np.fft.irfft2(amplitude * np.exp(2j * np.pi * rng.random(k.shape)), s=(points, points))
+    heights = (heights - heights.mean()) / heights.std()
+    spacing = 1.0
+    slopes = np.hypot(np.roll(heights, -1, axis=0) - heights, np.roll(heights, -1, axis=1) - heights) / spacing
+    return heights, spacing, slopes
+
+
 def check_solver(cls, **params) -> None:
     """Check a contact solver class (see the module docstring)."""
     import numpy as np
@@ -481,13 +502,17 @@ def check_solver(cls, **params) -> None:
 
     solver = _instantiate(cls, params)
     k = _check_positive_number(cls, "stiffness()", _call(cls, "stiffness()", solver.stiffness))
-    heights, spacing, slopes = _test_line()
+    if 1 in getattr(cls, "dimensions", (1,)):
+        heights, spacing, slopes = _test_line()
+    else:  # a solver of surfaces only
+        heights, spacing, slopes = _test_surface()
     n = heights.size
     h = float(heights.std())
-    length = n * spacing
+    length = Profile(heights, spacing).length
     cases = {
         "force": np.array([0.005, 0.02, 0.1, 0.4, 1.0]) * k * h * length,
-        "indentation": np.array([0.05, 0.2, 0.5, 1.0, 2.0]) * h,
+        # below max z - mean z: past it an elastic half-space would need an infinite force
+        "indentation": np.array([0.025, 0.1, 0.25, 0.5, 0.95]) * float(heights.max() - heights.mean()),
     }
     names = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 
@@ -554,7 +579,8 @@ def check_slope_estimator(cls, **params) -> None:
     import numpy as np
 
     estimator = _instantiate(cls, params)
-    points, spacing = 128, 0.1
+    spacing = 0.1
+    dimensions = getattr(cls, "dimensions", (1,))
 
     def run(what, heights):
         original = heights.copy()
@@ -565,31 +591,39 @@ def check_slope_estimator(cls, **params) -> None:
         return slopes
 
     rng = np.random.default_rng(7)
-    noisy = rng.standard_normal(points)
-    first = run("random line", noisy)
-    if not np.array_equal(run("random line", noisy), first):
-        _fail(cls, "slopes() is not repeatable: two identical calls differ")
+    for shape in [s for d, s in ((1, (128,)), (2, (24, 40))) if d in dimensions]:
+        kind = "line" if len(shape) == 1 else "surface"
+        noisy = rng.standard_normal(shape)
+        first = run(f"random {kind}", noisy)
+        if not np.array_equal(run(f"random {kind}", noisy), first):
+            _fail(cls, "slopes() is not repeatable: two identical calls differ")
 
-    flat = run("constant line", np.full(points, 3.7))
-    if np.max(np.abs(flat)) > 1e-9:
-        _fail(cls, f"a constant line must have zero slopes. Got max |slope| = {np.max(np.abs(flat)):.3g}.")
+        flat = run(f"constant {kind}", np.full(shape, 3.7))
+        if np.max(np.abs(flat)) > 1e-9:
+            _fail(cls, f"a constant {kind} must have zero slopes. Got max |slope| = {np.max(np.abs(flat)):.3g}.")
 
-    x = np.arange(points) * spacing
-    wavenumber = 2 * np.pi * 3 / (points * spacing)
-    amplitude = 0.8
-    sine = amplitude * np.sin(wavenumber * x)
-    exact = amplitude * wavenumber * np.cos(wavenumber * x)
-    estimate = run("sine", sine)
-    rms_exact = float(np.sqrt(np.mean(exact**2)))
-    rms_estimate = float(np.sqrt(np.mean(estimate**2)))
-    error = float(np.sqrt(np.mean((estimate - exact) ** 2))) / rms_exact
-    if not (0.5 <= rms_estimate / rms_exact <= 2.0) or error > 0.5:
-        _fail(
-            cls,
-            f"on A sin(q x) (A = {amplitude}, q = {wavenumber:.4g}, spacing = {spacing}) the slopes have rms "
-            f"{rms_estimate:.4g} and relative rms error {error:.3g} against the exact derivative "
-            f"(rms {rms_exact:.4g}); expected the same order of magnitude and sign (divide by spacing?)",
-        )
+        # a sine along x (a line), a plane wave across both axes (a surface: |grad z|)
+        grids = np.meshgrid(*(np.arange(n) * spacing for n in shape), indexing="ij")
+        q = [2 * np.pi * k / (n * spacing) for k, n in zip((3, 2)[: len(shape)], shape)]
+        amplitude = 0.8
+        phase = sum(qi * xi for qi, xi in zip(q, grids))
+        sine = amplitude * np.sin(phase)
+        exact = amplitude * np.cos(phase) * (q[0] if kind == "line" else np.hypot(*q))
+        estimate = run("sine" if kind == "line" else "plane wave", sine)
+        if kind == "surface":
+            if np.any(estimate < 0):
+                _fail(cls, "on a surface the slopes must be gradient magnitudes |grad z| >= 0")
+            exact = np.abs(exact)
+        rms_exact = float(np.sqrt(np.mean(exact**2)))
+        rms_estimate = float(np.sqrt(np.mean(estimate**2)))
+        error = float(np.sqrt(np.mean((estimate - exact) ** 2))) / rms_exact
+        if not (0.5 <= rms_estimate / rms_exact <= 2.0) or error > 0.5:
+            _fail(
+                cls,
+                f"on A sin(q . x) (A = {amplitude}, q = {np.round(q, 4).tolist()}, spacing = {spacing}, shape {shape}) "
+                f"the slopes have rms {rms_estimate:.4g} and relative rms error {error:.3g} against the exact "
+                f"derivative (rms {rms_exact:.4g}); expected the same order of magnitude and sign (divide by spacing?)",
+            )
 
 
 _KIND_CHECKS = {

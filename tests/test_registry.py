@@ -546,6 +546,8 @@ def _builtin_cases():
         ("spectrum", "power-law"): [{"hurst": 0.8, "points": 256}, {"hurst": 0.3, "points": 255, "amplitudes": "rayleigh"}],
         ("spectrum", "rolloff"): [{"hurst": 1.0, "points": 256, "rolloff_wavelength": 64.0}],
         ("spectrum", "profile-file"): [{"path": "<profile>", "spacing": 0.5}],
+        ("spectrum", "power-law-2d"): [{"hurst": 0.8, "points": 32}, {"hurst": 0.3, "points": 31, "points_y": 40}],
+        ("spectrum", "rolloff-2d"): [{"hurst": 1.0, "points": 48, "rolloff_wavelength": 16.0, "amplitudes": "rayleigh"}],
     }
     for info in Registry(discover=False).infos():
         for i, params in enumerate(extra.get((info.kind, info.name), [{}])):

@@ -158,4 +158,6 @@ def test_bad_spacing_and_shape_are_rejected(cls):
         with pytest.raises(ValueError, match="spacing"):
             cls().slopes(np.zeros(8), spacing)
     with pytest.raises(ValueError, match="shape"):
-        cls().slopes(np.zeros((4, 4)), 1.0)
+        cls().slopes(np.zeros((4, 4, 4)), 1.0)  # lines and surfaces only
+    with pytest.raises(ValueError, match="at least 2 points"):
+        cls().slopes(np.zeros((1, 8)), 1.0)

@@ -1,13 +1,20 @@
-"""Pointwise slopes of a periodic rough line (SPEC section 4).
+"""Pointwise slopes of a periodic rough line or surface (SPEC section 4).
 
 Every estimator maps heights of shape (N,) on a periodic grid of spacing dx to
 an array of the same shape: the slope attributed to each point. The engine
 forms both the whole-line rms slope and the rms over the points in contact from
 it, so the two always use the same estimator.
+
+On a surface, shape (Ny, Nx) with square pixels, the slope of a pixel is the
+gradient magnitude |grad z| = sqrt(dz/dx^2 + dz/dy^2), each component formed
+with the estimator's own scheme along its axis; the rms over all pixels is then
+the rms gradient of the surface. Lines keep their signed slopes (and their
+original, unchanged code path).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -19,29 +26,62 @@ __all__ = ["CentralDifference", "ForwardDifference", "Spectral"]
 
 def _checked(heights, spacing, minimum: int) -> tuple[np.ndarray, float]:
     heights = np.asarray(heights, dtype=float)
-    if heights.ndim != 1:
+    if heights.ndim not in (1, 2):
         raise ValueError(
-            f"slope estimators take a line: heights must have shape (N,). Got shape {heights.shape} instead."
+            "slope estimators take a line or a surface: heights must have shape (N,) or (Ny, Nx). "
+            f"Got shape {heights.shape} instead."
         )
-    if heights.size < minimum:
+    if min(heights.shape) < minimum:
+        what = "line" if heights.ndim == 1 else "surface (along each axis)"
         raise ValueError(
-            f"a periodic line needs at least {minimum} points for a slope. Got {heights.size} instead."
+            f"a periodic {what} needs at least {minimum} points for a slope. Got shape {heights.shape} instead."
         )
     spacing = float(spacing)
     if not (np.isfinite(spacing) and spacing > 0.0):
         raise ValueError(f"spacing must be finite and positive. Got {spacing!r} instead.")
     if not np.isfinite(heights).all():
-        bad = int(np.flatnonzero(~np.isfinite(heights))[0])
-        raise ValueError(f"heights must be finite: point {bad} is {heights[bad]!r}")
+        bad = np.unravel_index(int(np.flatnonzero(~np.isfinite(heights))[0]), heights.shape)
+        where = bad[0] if heights.ndim == 1 else tuple(int(i) for i in bad)
+        raise ValueError(f"heights must be finite: point {where} is {heights[bad]!r}")
     return heights, spacing
+
+
+def _gradient_magnitude(z: np.ndarray, dx: float, derivative: Callable[[np.ndarray, float, int], np.ndarray]):
+    """|grad z| of a surface from a periodic derivative along one axis."""
+    along_x = derivative(z, dx, 1)
+    along_y = derivative(z, dx, 0)
+    return np.hypot(along_x, along_y, out=along_x)
+
+
+def _forward(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
+    return (np.roll(z, -1, axis=axis) - z) / dx
+
+
+def _central(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
+    return (np.roll(z, -1, axis=axis) - np.roll(z, 1, axis=axis)) / (2.0 * dx)
+
+
+def _spectral(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
+    points = z.shape[axis]
+    spectrum = np.fft.rfft(z, axis=axis)
+    q = (2.0 * np.pi / (points * dx)) * np.arange(spectrum.shape[axis])
+    if points % 2 == 0:
+        q[-1] = 0.0  # the Nyquist mode's derivative is not real
+    spectrum *= 1j * np.expand_dims(q, 1 - axis)
+    return np.fft.irfft(spectrum, n=points, axis=axis)
 
 
 class ForwardDifference(SlopeEstimator):
     name: ClassVar[str] = "forward-difference"
-    summary: ClassVar[str] = "forward difference (z[i+1] - z[i]) / dx, periodic: the study's definition"
+    summary: ClassVar[str] = (
+        "forward difference (z[i+1] - z[i]) / dx, periodic: the study's definition; |grad z| on a surface"
+    )
+    dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
+        if z.ndim == 2:
+            return _gradient_magnitude(z, dx, _forward)
         out = np.empty_like(z)
         np.subtract(z[1:], z[:-1], out=out[:-1])
         out[-1] = z[0] - z[-1]  # periodic wrap: z[N] = z[0]
@@ -51,10 +91,13 @@ class ForwardDifference(SlopeEstimator):
 
 class CentralDifference(SlopeEstimator):
     name: ClassVar[str] = "central-difference"
-    summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx), periodic"
+    summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx), periodic; |grad z| on a surface"
+    dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
+        if z.ndim == 2:
+            return _gradient_magnitude(z, dx, _central)
         out = np.empty_like(z)
         np.subtract(z[2:], z[:-2], out=out[1:-1])
         out[0] = z[1] - z[-1]
@@ -65,10 +108,15 @@ class CentralDifference(SlopeEstimator):
 
 class Spectral(SlopeEstimator):
     name: ClassVar[str] = "spectral"
-    summary: ClassVar[str] = "spectral derivative by FFT (multiply by i q), Nyquist term dropped for even N"
+    summary: ClassVar[str] = (
+        "spectral derivative by FFT (multiply by i q), Nyquist term dropped for even N; |grad z| on a surface"
+    )
+    dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
     def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
+        if z.ndim == 2:
+            return _gradient_magnitude(z, dx, _spectral)
         points = z.size
         spectrum = np.fft.rfft(z)
         q = (2.0 * np.pi / (points * dx)) * np.arange(spectrum.size)

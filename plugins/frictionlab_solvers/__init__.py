@@ -2,6 +2,7 @@
 
 from frictionlab import hookimpl
 
+from .bem import BEMHalfPlane, BEMHalfSpace
 from .springs import BisectionSprings, MDRSprings, WinklerSprings
 
 
@@ -10,3 +11,5 @@ def register_solvers(register):
     register(MDRSprings)
     register(WinklerSprings)
     register(BisectionSprings)
+    register(BEMHalfPlane)
+    register(BEMHalfSpace)

@@ -1,6 +1,8 @@
 """Rows of independent springs under a rigid rough line (SPEC section 3).
 
-Each grid point is a spring of stiffness ``K = k dx``. Pressed with a total force
+Each grid point is a spring of stiffness ``K = k dx`` (on a surface, each pixel
+a spring of stiffness ``k dx^2``: the springs are independent, so a surface is
+solved as its flattened pixels). Pressed with a total force
 F, the rigid line sinks to the level c with ``F = K * sum_i max(0, z_i - c)``;
 the points in contact are those strictly above the level (``z_i > c``).
 
@@ -71,12 +73,14 @@ def _check_loads(loads, control: str) -> np.ndarray:
     return loads
 
 
-def _check_line(profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
+def _check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
+    """Heights and slopes flattened (views when contiguous), and the spacing."""
     heights = np.asarray(profile.heights, dtype=float)
-    if heights.ndim != 1 or heights.size == 0:
+    if heights.ndim not in solver.dimensions or heights.size == 0:
+        shapes = " or ".join({1: "(N,)", 2: "(Ny, Nx)"}[d] for d in solver.dimensions)
         raise ValueError(
-            f"spring solvers press a line: heights must have shape (N,) with N >= 1. "
-            f"Got shape {heights.shape} instead."
+            f"{solver.name} presses {'a line' if solver.dimensions == (1,) else 'a line or a surface'}: "
+            f"heights must have shape {shapes} with at least one point. Got shape {heights.shape} instead."
         )
     slopes = np.asarray(slopes, dtype=float)
     if slopes.shape != heights.shape:
@@ -86,17 +90,18 @@ def _check_line(profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float
     spacing = float(profile.spacing)
     if not (np.isfinite(spacing) and spacing > 0.0):
         raise ValueError(f"profile spacing must be finite and positive. Got {spacing!r} instead.")
-    return heights, slopes, spacing
+    return heights.ravel(), slopes.ravel(), spacing
 
 
 def _prepare(solver: ContactSolver, profile: Profile, loads, control: str, slopes):
-    """Checked (loads, heights, slopes, spring stiffness K = k dx) for a sweep."""
+    """Checked (loads, flat heights, flat slopes, spring stiffness K = k dx^ndim) for a sweep."""
     _check_control(control)
     loads = _check_loads(loads, control)
-    heights, slopes, spacing = _check_line(profile, slopes)
-    spring = solver.stiffness() * spacing
+    ndim = np.ndim(profile.heights)
+    heights, slopes, spacing = _check_profile(solver, profile, slopes)
+    spring = solver.stiffness() * spacing**ndim
     if not (np.isfinite(spring) and spring > 0.0):
-        raise ValueError(f"spring stiffness k dx must be finite and positive. Got {spring!r} instead.")
+        raise ValueError(f"spring stiffness k dx^{ndim} must be finite and positive. Got {spring!r} instead.")
     return loads, heights, slopes, spring
 
 
@@ -207,6 +212,8 @@ class MDRSprings(SpringRow):
         "MDR springs of stiffness E* dx: exact load sweep from one partial sort of the heights"
     )
     references: ClassVar[tuple[str, ...]] = (MDR_BOOK,)
+    # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene)
+    dimensions: ClassVar[tuple[int, ...]] = (1,)
 
     class Params(PluginParams):
         youngs_modulus: float = Field(
@@ -228,16 +235,18 @@ class MDRSprings(SpringRow):
 class WinklerSprings(SpringRow):
     name: ClassVar[str] = "winkler"
     summary: ClassVar[str] = (
-        "Winkler foundation: independent springs of a given modulus per unit length, exact sweep"
+        "Winkler foundation: independent springs of a given modulus per unit length (area), exact sweep"
     )
     references: ClassVar[tuple[str, ...]] = ()
+    dimensions: ClassVar[tuple[int, ...]] = (1, 2)  # one spring per point, or per pixel of a surface
 
     class Params(PluginParams):
         modulus: float = Field(
             1.0,
             gt=0.0,
             allow_inf_nan=False,
-            description="foundation modulus: stiffness per unit length of line (e.g. E/t for a thin layer of thickness t)",
+            description="foundation modulus: stiffness per unit length of line, or per unit area of a surface "
+            "(e.g. E/t for a thin layer of thickness t)",
         )
 
     def stiffness(self) -> float:

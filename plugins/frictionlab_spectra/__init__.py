@@ -4,6 +4,7 @@ from frictionlab import hookimpl
 
 from .power_law import PowerLaw, Rolloff
 from .profile_file import ProfileFile
+from .surface import PowerLawSurface, RolloffSurface
 
 
 @hookimpl
@@ -11,3 +12,5 @@ def register_spectra(register):
     register(PowerLaw)
     register(Rolloff)
     register(ProfileFile)
+    register(PowerLawSurface)
+    register(RolloffSurface)

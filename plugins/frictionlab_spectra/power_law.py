@@ -72,9 +72,10 @@ class Band:
         return TWO_PI / self.knee
 
 
-def resolve_band(p: "PowerLaw.Params") -> Band:
-    """Fill in defaults and check the geometry; ValueError (naming the fields) if inconsistent."""
-    n = p.points
+def resolve_spacing(p, points: int | None = None) -> tuple[float, float]:
+    """(spacing dx, length N dx) from ``spacing`` or ``length`` (default dx = 1); ValueError if both
+    are given and disagree. ``points`` defaults to ``p.points`` (the side along which ``length`` is given)."""
+    n = p.points if points is None else points
     if p.spacing is not None and p.length is not None:
         if not math.isclose(p.length, n * p.spacing, rel_tol=REL_TOL):
             raise ValueError(
@@ -82,14 +83,24 @@ def resolve_band(p: "PowerLaw.Params") -> Band:
                 f"points * spacing = {n * p.spacing!r}; give only one of spacing and length"
             )
     if p.spacing is not None:
-        dx = p.spacing
-        length = n * dx
-    elif p.length is not None:
-        length = p.length
-        dx = length / n
+        return p.spacing, n * p.spacing
+    if p.length is not None:
+        return p.length / n, p.length
+    return 1.0, float(n)
+
+
+def resolve_band(p: "PowerLaw.Params", *, spacing: float | None = None, points: int | None = None,
+                 extent: str = "line length L = points * spacing") -> Band:
+    """Fill in defaults and check the geometry; ValueError (naming the fields) if inconsistent.
+
+    A surface passes its resolved ``spacing`` and the ``points`` of its shorter side (the band's
+    longest wave must fit every direction); ``extent`` names that length in messages."""
+    if spacing is None:
+        dx, length = resolve_spacing(p)
+        n = p.points
     else:
-        dx = 1.0
-        length = float(n)
+        n = points
+        dx, length = spacing, n * spacing
 
     long_cutoff = length if p.long_cutoff is None else p.long_cutoff
     short_cutoff = 10.0 * dx if p.short_cutoff is None else p.short_cutoff
@@ -98,7 +109,7 @@ def resolve_band(p: "PowerLaw.Params") -> Band:
         f" (default: 10 * spacing = {short_cutoff!r})" if p.short_cutoff is None else f"={short_cutoff!r}"
     )
     if long_cutoff > length * (1 + REL_TOL):
-        raise ValueError(f"{long_txt} must not exceed the line length L = points * spacing = {length!r}")
+        raise ValueError(f"{long_txt} must not exceed the {extent} = {length!r}")
     if short_cutoff < 2.0 * dx * (1 - REL_TOL):
         raise ValueError(
             f"{short_txt} is below the Nyquist wavelength 2 * spacing = {2.0 * dx!r}; "
@@ -135,6 +146,24 @@ def _log_integral(p: float, ln_r: float) -> float:
     return math.expm1(x) / p
 
 
+def relative_psd(ratio, above: float, below: float):
+    """psd / psd(knee) at ratio = q / q_r: ratio^(-above) from the knee up, ratio^below under it
+    (below = 0: flat). Values stay in (0, 1] whatever the exponents: no overflow."""
+    ratio = np.asarray(ratio, dtype=np.float64)
+    if below == 0.0:  # the flat case as one power of a clipped ratio
+        return np.maximum(ratio, 1.0) ** (-above)
+    return np.where(ratio >= 1.0, ratio ** (-above), np.minimum(ratio, 1.0) ** below)
+
+
+def band_integral(band: Band, power: float, above: float, below: float) -> float:
+    """integral_{q_min}^{q_max} q^power relative_psd(q / q_r) dq in closed form, stable through the
+    log cases (power + 1 = above): the moments of every band-limited spectrum, lines and surfaces."""
+    qr = band.q_knee
+    under = power + below + 1.0  # > 0: the part below the knee is a plain power
+    flat = -math.expm1(under * math.log(band.q_min / qr)) / under if band.q_min < qr else 0.0
+    return qr ** (power + 1.0) * (flat + _log_integral(power + 1.0 - above, math.log(band.q_max / qr)))
+
+
 # ------------------------------------------------------------------ synthesis state
 
 
@@ -155,6 +184,9 @@ class BandLimitedSpectrum(SpectrumGenerator):
     """Shared synthesis of ``power-law`` and ``rolloff`` (not registered itself)."""
 
     references: ClassVar[tuple[str, ...]] = (PERSSON_2005, JACOBS_JUNGE_PASTEWKA_2017)
+    # psd ~ q^below_knee under the knee: 0 (flat) for rolloff; 1 for the MDR-equivalent line of a
+    # rolloff surface, whose C1D = pi q C2D grows with q where C2D is flat
+    below_knee_exponent: ClassVar[float] = 0.0
 
     class Params(PluginParams):
         hurst: float = Field(
@@ -213,7 +245,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
         k = np.arange(band.k_lo, band.k_hi + 1, dtype=np.float64)
         # shape relative to the knee, in (0, 1]: no overflow whatever q_min, H and C0
         k_knee = band.length / band.knee
-        shape = (np.maximum(k, k_knee) / k_knee) ** (-0.5 * a)  # a_k / a_knee
+        shape = relative_psd(k / k_knee, 0.5 * a, 0.5 * self.below_knee_exponent)  # a_k / a_knee = sqrt(psd ratio)
         if p.c0 is not None:
             # psd at the knee = C0 q_knee^(-a), formed in logs (C0 and q_knee may be extreme)
             log_psd_knee = math.log(p.c0) - a * math.log(band.q_knee)
@@ -298,19 +330,15 @@ class BandLimitedSpectrum(SpectrumGenerator):
         b = s.band
         q = np.asarray(q, dtype=np.float64)
         inside = (q >= b.q_min * (1 - REL_TOL)) & (q <= b.q_max * (1 + REL_TOL))
-        ratio = np.maximum(q, b.q_knee) / b.q_knee  # >= 1: no 0 ** negative
-        out = np.where(inside, s.psd_knee * ratio ** (-(2.0 * self.params.hurst + 1.0)), 0.0)
+        shape = relative_psd(q / b.q_knee, 2.0 * self.params.hurst + 1.0, self.below_knee_exponent)
+        out = np.where(inside, s.psd_knee * shape, 0.0)
         return out[()] if out.ndim == 0 else out
 
     def _moment(self, order: int) -> float:
         """2 * integral_{q_min}^{q_max} q^order psd(q) dq in closed form (order 0 or 2)."""
         s = self._synthesis()
-        b, hurst = s.band, self.params.hurst
-        qr, qmin = b.q_knee, b.q_min
-        flat = (qr ** (order + 1) - qmin ** (order + 1)) / (order + 1)
-        # q_r^(order+1) integral_1^R u^(order-2H-1) du, R = q_max / q_r
-        power = qr ** (order + 1) * _log_integral(order - 2.0 * hurst, math.log(b.q_max / qr))
-        return 2.0 * s.psd_knee * (flat + power)
+        above = 2.0 * self.params.hurst + 1.0
+        return 2.0 * s.psd_knee * band_integral(s.band, order, above, self.below_knee_exponent)
 
     def rms_height_continuum(self) -> float:
         """sqrt(2 * integral psd dq) over the band: the continuum limit of ``rms_height()``."""

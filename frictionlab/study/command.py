@@ -1,0 +1,164 @@
+"""``frictionlab study``: options, validation and the run. Heavy modules are
+imported inside ``run_command`` so building the CLI parser stays cheap."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+import time
+from pathlib import Path
+
+from ..errors import ExitCode, FrictionlabError
+
+DEFAULTS = {
+    "reference": "bem-halfplane",
+    "axes": "grid,realizations,steps,solver,tolerance",
+    "target": 0.02,
+    "points": None,
+    "compare_realizations": 10,
+    "compare_steps": 40,
+    "grid_realizations": 50,
+    "grid_factors": "0.25,0.5,1,2,4",
+    "tolerances": "1e-2,1e-4,1e-6,1e-8",
+    "reference_grid": "",
+    "repeats": 1,
+}
+
+
+def add_arguments(parser) -> None:
+    d = DEFAULTS
+    parser.add_argument("preset", help="preset YAML file")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-study-<timestamp>)")
+    parser.add_argument("--set", action="append", metavar="PATH=VALUE", help="override a preset value first")
+    parser.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
+    parser.add_argument(
+        "--reference", default=d["reference"], metavar="SOLVER",
+        help=f"contact solver the others are compared with (default {d['reference']})",
+    )
+    parser.add_argument("--axes", default=d["axes"], metavar="LIST", help=f"axes to run (default {d['axes']})")
+    parser.add_argument("--target", type=float, default=d["target"], help="relative error in b to recommend for (default 0.02)")
+    parser.add_argument(
+        "--points", type=int, default=d["points"], metavar="N",
+        help="grid of the solver and tolerance axes, where the reference runs (default: the preset's N up to "
+        "131072 points on a line, 128 per side on a surface)",
+    )
+    parser.add_argument("--compare-realizations", type=int, default=d["compare_realizations"], metavar="M",
+                        help=f"realizations on the solver and tolerance axes (default {d['compare_realizations']})")
+    parser.add_argument("--compare-steps", type=int, default=d["compare_steps"], metavar="K",
+                        help=f"load steps on the solver and tolerance axes (default {d['compare_steps']})")
+    parser.add_argument("--grid-realizations", type=int, default=d["grid_realizations"], metavar="M",
+                        help=f"realizations on the grid and steps axes (default {d['grid_realizations']})")
+    parser.add_argument("--grid-factors", default=d["grid_factors"], metavar="LIST",
+                        help=f"grid sizes as multiples of the preset's N; the largest is the reference (default {d['grid_factors']})")
+    parser.add_argument("--tolerances", default=d["tolerances"], metavar="LIST",
+                        help=f"tolerances of the reference solver; the tightest is the reference (default {d['tolerances']})")
+    parser.add_argument("--reference-grid", default=d["reference_grid"], metavar="LIST",
+                        help="also refine the reference solver's grid by these factors of --points (e.g. 0.5,1,2)")
+    parser.add_argument("--repeats", type=int, default=d["repeats"], metavar="R", help="time each setting R times, keep the best")
+    parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
+
+
+def _numbers(option: str, text: str, kind=float, low: float = 0.0) -> tuple:
+    try:
+        values = tuple(kind(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise FrictionlabError(f"{option} must be a comma-separated list of numbers. Got {text!r} instead.") from None
+    bad = [v for v in values if not v > low]
+    if bad:
+        raise FrictionlabError(f"{option} values must be > {low:g}. Got {bad[0]!r} instead.")
+    return values
+
+
+def _at_least(option: str, value: int, low: int) -> int:
+    if value < low:
+        raise FrictionlabError(f"{option} must be >= {low}. Got {value} instead.")
+    return value
+
+
+def options_from_args(args):
+    from .axes import AXES, StudyOptions
+
+    axes = tuple(a.strip() for a in args.axes.split(",") if a.strip())
+    unknown = [a for a in axes if a not in AXES]
+    if unknown or not axes:
+        raise FrictionlabError(
+            f"--axes must name some of {', '.join(AXES)}. Got {args.axes!r} instead."
+        )
+    if not 0 < args.target < 1:
+        raise FrictionlabError(f"--target must be > 0 and < 1 (a relative error). Got {args.target} instead.")
+    return StudyOptions(
+        reference=args.reference,
+        axes=axes,
+        target=args.target,
+        **({} if args.points is None else {
+            "compare_points": _at_least("--points", args.points, 8),
+            "compare_points_surface": _at_least("--points", args.points, 8),
+        }),
+        compare_realizations=_at_least("--compare-realizations", args.compare_realizations, 2),
+        compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
+        grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
+        grid_factors=_numbers("--grid-factors", args.grid_factors),
+        tolerances=_numbers("--tolerances", args.tolerances) or (1e-8,),
+        reference_grid=_numbers("--reference-grid", args.reference_grid),
+        repeats=_at_least("--repeats", args.repeats, 1),
+    )
+
+
+def command_line(args) -> str:
+    """The command as a user would type it: the preset and every option that differs from its default."""
+    words = ["frictionlab", "study", args.preset]
+    for assignment in args.set or []:
+        words += ["--set", assignment]
+    if args.seed is not None:
+        words += ["--seed", str(args.seed)]
+    for dest, default in DEFAULTS.items():
+        value = getattr(args, dest)
+        if value != default:
+            words += [f"--{dest.replace('_', '-')}", str(value)]
+    if args.out:
+        words += ["--out", args.out]
+    return shlex.join(words)
+
+
+def run_command(args) -> ExitCode:
+    from ..preset import apply_overrides, load_preset_file
+    from ..registry import default_registry
+    from .axes import Study
+    from .report import recommendation, write_outputs
+    from .scenes import SceneFactory
+
+    options = options_from_args(args)
+    overrides = list(args.set or [])
+    if args.seed is not None:
+        overrides.append(f"seed={args.seed}")
+    data = apply_overrides(load_preset_file(args.preset), overrides)
+    factory = SceneFactory(data, default_registry(), source=str(args.preset))
+    out_dir = Path(args.out) if args.out else Path("runs") / f"{factory.base.preset.name}-study-{time.strftime('%Y%m%d-%H%M%S')}"
+
+    def progress(message: str) -> None:
+        if not args.quiet:
+            print(f"study: {message}", file=sys.stderr, flush=True)
+
+    study = Study(factory, options, progress)
+    progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {study.reference_choice['name']}")
+    interrupted = False
+    try:
+        study.run()
+    except KeyboardInterrupt:
+        interrupted = True
+    text = recommendation(study)
+    try:
+        files = write_outputs(study, out_dir, text, command_line(args))
+    except OSError as exc:
+        print(f"error: cannot write the study to {out_dir}: {exc}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    print(text)
+    print(f"  {', '.join(p.name for p in files.values())} in {out_dir}/")
+    if interrupted:
+        print("interrupted: the files hold the axes finished before the interrupt", file=sys.stderr)
+        return ExitCode.INTERRUPTED
+    failed = [r for r in study.rows if r.outcome is not None and r.outcome.failures]
+    if failed:
+        print(f"error: realizations failed in {len(failed)} setting(s); see the notes in study.md", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    return ExitCode.OK

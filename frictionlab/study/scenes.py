@@ -1,0 +1,127 @@
+"""Variant scenes of one preset for the trade-off study, and their measurement.
+
+A variant is the preset's data with a few dotted-path changes, validated by
+``preset.build_scene`` like any preset, so every variant is a scene a user
+could run. Nothing here knows physics: solvers are swapped by copying the
+parameters their ``Params`` share, and the f range is kept through the
+contract's own normalisation f = F / (k h L) (``stiffness()``, ``rms_height()``,
+``Profile.length``).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+import tracemalloc
+from dataclasses import dataclass
+from typing import Any
+
+from .. import engine
+from ..ensemble import RunOutcome
+from ..errors import FrictionlabError
+from ..preset import Scene, build_scene
+from ..registry import Registry
+from ..seeds import realization_rng
+
+# Parameters that tune a solver's iteration, not the body: never carried from one solver to another.
+ITERATION_PARAMS = ("tolerance", "max_iterations")
+
+
+def assign(data: dict, path: str, value: Any) -> None:
+    """Set ``data[a][b][c] = value`` for ``path = "a.b.c"`` (typed values: no YAML round trip)."""
+    *parents, last = path.split(".")
+    node = data
+    for key in parents:
+        node = node.setdefault(key, {})
+    node[last] = copy.deepcopy(value)
+
+
+def force_scale(scene: Scene) -> float:
+    """k h L of f = F / (k h L), with L from realization 0's profile (lines and surfaces alike)."""
+    profile = scene.spectrum.generate(realization_rng(scene.preset.seed, 0))
+    return float(scene.solver.stiffness()) * float(scene.spectrum.rms_height()) * float(profile.length)
+
+
+class SceneFactory:
+    """Builds validated variants of one preset's data."""
+
+    def __init__(self, data: dict, registry: Registry, source: str):
+        self.data = copy.deepcopy(data)
+        self.registry = registry
+        self.source = source
+        self.base = build_scene(self.data, registry=registry, source=source)
+        self._base_scale = force_scale(self.base)
+
+    def make(self, changes: dict[str, Any], *, keep_f_range: bool = True) -> Scene:
+        """The preset with ``changes`` (dotted path -> value). With ``keep_f_range``
+        the force grid is rescaled so the variant sweeps the base scene's f range
+        (a shorter line or another stiffness would otherwise shift it)."""
+        data = copy.deepcopy(self.data)
+        for path, value in changes.items():
+            assign(data, path, value)
+        where = f"{self.source} with " + ", ".join(f"{k}={v}" for k, v in changes.items())
+        scene = build_scene(data, registry=self.registry, source=where)
+        if keep_f_range:
+            ratio = force_scale(scene) / self._base_scale
+            if not math.isclose(ratio, 1.0, rel_tol=1e-12):
+                loading = self.base.preset.loading
+                assign(data, "loading.start", loading.start * ratio)
+                assign(data, "loading.stop", loading.stop * ratio)
+                scene = build_scene(data, registry=self.registry, source=where)
+        return scene
+
+    def solver_choice(self, name: str, tolerance: float | None = None) -> dict:
+        """``{"name", "params"}`` for solver ``name`` with the base solver's body:
+        the parameters both ``Params`` declare (E, nu), or, for a solver with a
+        single ``modulus`` (Winkler), the base solver's stiffness. Raises
+        FrictionlabError naming the option when the solver is not installed."""
+        try:
+            cls = self.registry.get("solver", name)
+        except FrictionlabError as exc:
+            raise FrictionlabError(f"--reference: {exc}") from None
+        fields = cls.Params.model_fields
+        base = self.base.solver.params.model_dump()
+        params = {k: v for k, v in base.items() if k in fields and k not in ITERATION_PARAMS}
+        if not params and "modulus" in fields:
+            params["modulus"] = float(self.base.solver.stiffness())
+        if tolerance is not None and "tolerance" in fields:
+            params["tolerance"] = tolerance
+        return {"name": cls.name, "params": params}
+
+
+@dataclass(frozen=True)
+class Measurement:
+    outcome: RunOutcome
+    seconds: float  # wall time, best of the repeats
+    peak_bytes: int  # tracemalloc peak above the level before the run
+
+
+def measure(scene: Scene, repeats: int = 1) -> Measurement:
+    """Run ``scene`` serially in this process (so one clock and one allocator
+    see all the work) and measure wall time and peak traced memory.
+
+    Memory is tracemalloc's peak, which includes numpy's data buffers (numpy
+    reports them to tracemalloc); ru_maxrss would not do: it is the process's
+    high-water mark, so any variant smaller than an earlier one would read as
+    zero. tracemalloc is started here if it is not running.
+    """
+    started_tracing = not tracemalloc.is_tracing()
+    if started_tracing:
+        tracemalloc.start()
+    try:
+        best, peak, outcome = math.inf, 0, None
+        for _ in range(max(1, repeats)):
+            tracemalloc.reset_peak()
+            floor = tracemalloc.get_traced_memory()[0]
+            start = time.perf_counter()
+            outcome = engine.run(scene, workers=1)
+            seconds = time.perf_counter() - start
+            peak = max(peak, tracemalloc.get_traced_memory()[1] - floor)
+            best = min(best, seconds)
+            if outcome.status in ("interrupted", "cancelled"):
+                raise KeyboardInterrupt
+    finally:
+        if started_tracing:
+            tracemalloc.stop()
+    return Measurement(outcome=outcome, seconds=best, peak_bytes=int(peak))
