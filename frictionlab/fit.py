@@ -70,6 +70,21 @@ def least_squares(f: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return coef, se, r2, math.sqrt(ssr / f.size)
 
 
+def bootstrap_coefficients(f, xi_per_realization, bootstrap: int, rng: np.random.Generator) -> np.ndarray:
+    """(bootstrap, 2) resampled (a, b) pairs, resampling whole realizations (rows).
+
+    The fit is linear in the mean curve, so a resample's coefficients are the
+    resampled mean of each realization's own coefficients: (B, M) @ (M, 2).
+    The same ``rng`` state gives the same pairs (``frictionlab predict`` redraws a run's).
+    """
+    xi_per_realization = np.atleast_2d(np.asarray(xi_per_realization, float))
+    realizations = xi_per_realization.shape[0]
+    projector = np.linalg.pinv(_design(np.asarray(f, float)))  # (2, n_forces)
+    per_realization = xi_per_realization @ projector.T  # (M, 2)
+    counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=bootstrap)
+    return counts @ per_realization / realizations
+
+
 def fit_log_law(
     f: np.ndarray,
     xi_per_realization: np.ndarray,
@@ -89,12 +104,7 @@ def fit_log_law(
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
-        # The fit is linear in the mean curve, so a resample's coefficients are the
-        # resampled mean of each realization's own coefficients: (B, M) @ (M, 2).
-        projector = np.linalg.pinv(_design(np.asarray(f, float)))  # (2, n_forces)
-        per_realization = xi_per_realization @ projector.T  # (M, 2)
-        counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=bootstrap)
-        samples = counts @ per_realization / realizations  # (bootstrap, 2)
+        samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng)
         tail = 100 * (1 - confidence) / 2
         low, high = np.percentile(samples, [tail, 100 - tail], axis=0)
         intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]

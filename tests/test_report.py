@@ -1,0 +1,133 @@
+"""The reproduction report: averaging readings against brute force, the h calibration
+against a known h, and the report's content on tiny presets (numbers from summary.json)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab import engine
+from frictionlab.cli import main
+from frictionlab.preset import apply_overrides, build_scene, load_preset_file
+from frictionlab.report import (
+    STUDY, Reading, average_curve, calibrated_rms_height, find_presets, readings_markdown, refit, run_figures,
+    run_readings, write_report,
+)  # fmt: skip
+from frictionlab.runner import run_to_folder
+
+from .conftest import PRESETS, SMALL_PRESET
+
+TINY = ["realizations=6", "spectrum.params.points=1024", "spectrum.params.length=1024.0", "output.plot=false",
+        "spectrum.params.rms_height=300.0", "loading.steps=12", "fit.bootstrap=40"]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def tiny_presets(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("presets")
+    for fig in STUDY:
+        data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
+        if data.get("sweep"):
+            data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
+        (folder / fig.preset).write_text(yaml.safe_dump(data, sort_keys=False))
+    return folder
+
+
+def synthetic_lines(seed=3, m=5, forces=4):
+    """Per-realization arrays made from explicit contact slopes, for brute force."""
+    rng = np.random.default_rng(seed)
+    line = rng.uniform(0.5, 2.0, m)
+    slopes = [[rng.normal(0, line[r], rng.integers(1, 9)) for _ in range(forces)] for r in range(m)]
+    per = {
+        "xi": np.array([[np.sqrt(np.mean(s**2)) / line[r] for s in row] for r, row in enumerate(slopes)]),
+        "contact_count": np.array([[s.size for s in row] for row in slopes]),
+        "slope_rms_line": line,
+    }
+    return per, slopes, line
+
+
+def test_averages_against_brute_force():
+    per, slopes, line = synthetic_lines()
+    for k in range(4):
+        pooled = np.concatenate([row[k] for row in slopes])
+        expected = math.sqrt(np.mean(pooled**2)) / math.sqrt(np.mean(line**2))
+        assert average_curve(per, "pooled")[k] == pytest.approx(expected, rel=1e-12)
+        xi_k = per["xi"][:, k]
+        assert average_curve(per, "rms")[k] == pytest.approx(math.sqrt(np.mean(xi_k**2)), rel=1e-12)
+        assert average_curve(per, "mean")[k] == pytest.approx(np.mean(xi_k), rel=1e-12)
+
+
+@pytest.mark.parametrize("method", ["mean", "pooled", "rms"])
+def test_bootstrap_weights_equal_repeated_realizations(method):
+    per, _, _ = synthetic_lines()
+    counts = np.array([[2, 0, 1, 1, 1], [0, 0, 5, 0, 0]])
+    repeated = [{k: np.repeat(v, c, axis=0) for k, v in per.items()} for c in counts]
+    weighted = average_curve(per, method, counts)
+    for row, data in zip(weighted, repeated, strict=True):
+        assert row == pytest.approx(average_curve(data, method), rel=1e-12)
+
+
+def test_refit_of_the_mean_is_the_runs_own_fit(make_scene):
+    scene = make_scene({"realizations": 12})
+    outcome = engine.run(scene, workers=1)
+    fit = refit(outcome.f, outcome.per_realization, "mean", bootstrap=200, confidence=0.95, seed=scene.preset.seed)
+    assert (fit.a, fit.b) == pytest.approx((outcome.fit.a, outcome.fit.b), rel=1e-12)
+    assert fit.a_ci == pytest.approx(outcome.fit.a_ci, rel=1e-12)
+    assert fit.b_ci == pytest.approx(outcome.fit.b_ci, rel=1e-12)
+
+
+def test_calibration_recovers_a_known_rms_height(registry):
+    # counts measured at h = 37 must calibrate back to h = 37 (3 significant digits, grid interpolation)
+    data = {**SMALL_PRESET, "realizations": 8, "loading": {"start": 0.5, "stop": 20.0, "steps": 2}}
+    data = apply_overrides(data, ["spectrum.params.rms_height=37.0"])
+    outcome = engine.run(build_scene(data, registry=registry), workers=1)
+    targets = dict(zip(outcome.loads.tolist(), outcome.contact_count.tolist(), strict=True))
+    assert calibrated_rms_height(data, targets, workers=1) == pytest.approx(37.0, rel=0.03)
+
+
+def test_report_on_tiny_presets(tmp_path, tiny_presets):
+    md = tmp_path / "REPRODUCTION.md"
+    write_report(presets_dir=tiny_presets, out_dir=tmp_path / "runs", markdown_path=md,
+                 figures_dir=tmp_path / "docs" / "fig", workers=1, quiet=True)  # fmt: skip
+    text = md.read_text()
+    assert "Wall time of the whole report (Figs. 2 to 5):" in text
+    for fig in STUDY:
+        assert f"![{fig.title}](docs/fig/{fig.key}.png)" in text
+        assert (tmp_path / "docs" / "fig" / f"{fig.key}.png").stat().st_size > 1000
+    for key in ("fig2", "fig3", "fig4"):
+        fit = json.loads((tmp_path / "runs" / key / "summary.json").read_text())["fit"]
+        study = next(s for s in STUDY if s.key == key)
+        cell = f"| {study.a} | {fit['a']:.4f} [{fit['a_ci'][0]:.4f}, {fit['a_ci'][1]:.4f}]"
+        assert cell in text
+        assert f"{fit['b']:.4f} [{fit['b_ci'][0]:.4f}, {fit['b_ci'][1]:.4f}]" in text
+    rows = list(json.loads((tmp_path / "runs" / "fig5" / "sweep.json").read_text())["points"])
+    for row in rows:
+        assert f"| {row['spectrum.params.hurst']:g} | {row['a']:.4f} [{row['a_lo']:.4f}, {row['a_hi']:.4f}]" in text
+    assert "| Fig. 5 at H = 0.6 | about 2.9 |" in text  # the point nearest H = 0.7
+
+
+def test_readings_rerun_as_documented(tmp_path, tiny_presets):
+    runs = run_figures(tiny_presets, tmp_path, workers=1)
+    readings = (Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
+                Reading("fig2", "spectral", ("slope.name=spectral",)), Reading("fig2", "pooled", average="pooled"))  # fmt: skip
+    rows = run_readings(runs, tmp_path, workers=1, readings=readings)
+    c0 = runs[0].scene.spectrum.c0()
+    assert rows[0].overrides[-1].startswith("spectrum.params.c0=")
+    assert float(rows[0].overrides[-1].split("=")[1]) == pytest.approx(c0, rel=1e-5)
+    for row in rows[:2]:  # each row reruns from its preset and --set options, as the table says
+        preset = next(s.preset for s in STUDY if s.key == row.reading.figure)
+        data = apply_overrides(load_preset_file(tiny_presets / preset), row.overrides)
+        outcome, _ = run_to_folder(build_scene(data), tmp_path / f"again-{row.reading.name}", workers=1)
+        assert (outcome.fit.a, outcome.fit.b) == pytest.approx((row.a, row.b), rel=1e-12)
+    pooled = average_curve(runs[0].outcome.per_realization, "pooled")
+    assert rows[2].a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
+    text = "\n".join(readings_markdown(rows))
+    assert "`slope.name=spectral`" in text and f"{rows[1].a:.4f}" in text
+
+
+def test_presets_folder_errors(tmp_path, capsys):
+    with pytest.raises(Exception, match="no folder with the study's presets"):
+        find_presets(tmp_path)
+    assert main(["report", "--presets", str(tmp_path), "--quiet"]) == 2
+    assert "--presets: no folder with the study's presets" in capsys.readouterr().err

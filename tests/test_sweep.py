@@ -1,0 +1,180 @@
+"""Sweeps: points equal separate runs, grid/zip expansion, bad specs, CLI exit codes."""
+
+import copy
+import json
+import threading
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import PresetError
+from frictionlab.preset import load_scene
+from frictionlab.runner import run_to_folder
+from frictionlab.sweep import load_sweep, plan_sweep, read_table, run_sweep, yaml_scalar
+
+from .conftest import SMALL_PRESET
+
+
+def sweep_preset(parameters, mode="grid", **changes):
+    data = copy.deepcopy(SMALL_PRESET)
+    data.update(realizations=6, fit={"bootstrap": 50}, output={"plot": False})
+    data.update(changes)
+    data["sweep"] = {"mode": mode, "parameters": parameters}
+    return data
+
+
+def write(tmp_path, data, name="sweep.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_points_equal_separate_runs_with_the_same_seed(tmp_path, registry):
+    data = sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.9]}, "loading.stop": {"values": [5.0, 50.0]}})
+    path = write(tmp_path, data)
+    sweep = load_sweep(path, registry=registry)
+    outcome = run_sweep(sweep, tmp_path / "out", workers=1, plot=False)
+    assert outcome.status == "completed" and len(outcome.results) == 4
+    for result in outcome.results:
+        # the documented way to rerun one point: the preset, sweep off, the point's --set options
+        alone = load_scene(path, ["sweep=null", *result.point.assignments], registry=registry)
+        single, _ = run_to_folder(alone, tmp_path / f"alone-{result.point.number}", workers=2)
+        assert np.array_equal(result.outcome.per_realization["xi"], single.per_realization["xi"])
+        assert (result.outcome.fit.a, result.outcome.fit.b) == (single.fit.a, single.fit.b)
+        assert result.outcome.fit.a_ci == single.fit.a_ci
+        stored = np.load(result.folder / "realizations.npz")
+        assert np.array_equal(stored["xi"], single.per_realization["xi"])
+    # the swept values really reached the scenes
+    assert [r.point.scene.spectrum.params.hurst for r in outcome.results] == [0.5, 0.5, 0.9, 0.9]
+    assert [r.point.scene.loads[-1] for r in outcome.results] == [5.0, 50.0, 5.0, 50.0]
+
+
+def test_table_and_json_hold_each_points_fit(tmp_path, registry):
+    data = sweep_preset({"spectrum.params.hurst": {"values": [0.6, 0.8]}})
+    sweep = plan_sweep(data, registry=registry)
+    out = tmp_path / "out"
+    run_sweep(sweep, out, workers=1)
+    rows = read_table(out / "sweep.csv")
+    summary = json.loads((out / "sweep.json").read_text())
+    assert [r["spectrum.params.hurst"] for r in rows] == ["0.6", "0.8"]
+    for row, point in zip(rows, summary["points"], strict=True):
+        run = json.loads((out / row["folder"] / "summary.json").read_text())
+        assert float(row["a"]) == run["fit"]["a"] and float(row["b_hi"]) == run["fit"]["b_ci"][1]
+        assert float(row["contact_last"]) == run["contact_count_at_last_load"]
+        assert row["status"] == "completed" and point["set"] == [f"spectrum.params.hurst={row['spectrum.params.hurst']}"]
+    assert (out / "sweep.png").stat().st_size > 0
+
+
+def test_grid_is_the_product_and_zip_pairs_the_lists(registry):
+    params = {"spectrum.params.hurst": {"values": [0.4, 0.6, 0.8]}, "loading.stop": {"start": 5, "stop": 50, "num": 3}}
+    grid = plan_sweep(sweep_preset(params), registry=registry)
+    assert len(grid.points) == 9
+    assert {tuple(p.values.values()) for p in grid.points} == {(h, s) for h in (0.4, 0.6, 0.8) for s in (5, 27.5, 50)}
+    zipped = plan_sweep(sweep_preset(params, mode="zip"), registry=registry)
+    assert [tuple(p.values.values()) for p in zipped.points] == [(0.4, 5), (0.6, 27.5), (0.8, 50)]
+    assert [p.folder_name for p in zipped.points] == ["01-hurst-0.4_stop-5", "02-hurst-0.6_stop-27.5", "03-hurst-0.8_stop-50"]
+
+
+def test_ranges_linear_and_log(registry):
+    params = {"loading.stop": {"start": 10, "stop": 1000, "num": 3, "spacing": "log"},
+              "spectrum.params.hurst": {"start": 0.3, "stop": 1.0, "num": 8}}  # fmt: skip
+    sweep = plan_sweep(sweep_preset(params, mode="grid"), registry=registry)
+    stops = sorted({p.values["loading.stop"] for p in sweep.points})
+    hursts = sorted({p.values["spectrum.params.hurst"] for p in sweep.points})
+    assert stops == [10, 100, 1000] and all(isinstance(s, int) for s in stops)
+    assert hursts == [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
+
+
+@pytest.mark.parametrize("value", [0.3, 1e-05, 2.5e-07, 1e20, 10000.0, 3, True, None, "spectral", "0.5", -0.0])
+def test_yaml_scalar_reads_back_as_the_same_value(value):
+    text = yaml_scalar(value)
+    assert yaml.safe_load(text) == value and type(yaml.safe_load(text)) is type(value)
+
+
+BAD_SPECS = [
+    ({"spectrum.params.hurts": {"values": [0.5]}},
+     "sweep.parameters.spectrum.params.hurts: the spectrum plugin has no parameter 'hurts'"),
+    ({"loadin.stop": {"values": [5]}}, "sweep.parameters.loadin.stop: the preset has no field 'loadin'"),
+    ({"loading": {"values": [5]}}, "sweep.parameters.loading: loading is a section"),
+    ({"seed.x": {"values": [5]}}, "sweep.parameters.seed.x: seed is a value, not a section"),
+    ({"sweep.mode": {"values": ["zip"]}}, "sweep.parameters.sweep.mode: a sweep cannot sweep its own sweep section"),
+    ({"seed": {"values": []}}, "sweep.parameters.seed: values must not be empty"),
+    ({"loading.stop": {"start": 1, "stop": 5, "num": 0}}, "sweep.parameters.loading.stop.num: must be >= 1, got 0"),
+    ({"loading.stop": {"start": 0, "stop": 5, "num": 3, "spacing": "log"}},
+     "a log range needs start > 0 and stop > 0. Got start=0.0, stop=5.0 instead"),
+    ({"loading.stop": {"values": [5], "start": 1, "stop": 5, "num": 2}},
+     "give either values or a range (start, stop, num), not both"),
+    ({"loading.stop": {"start": 1, "stop": 5}}, "a range needs start, stop and num; missing: num"),
+    ({"loading.stop": {}}, "give values: [...] or a range start, stop, num"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("parameters", "message"), BAD_SPECS)
+def test_bad_specs_name_the_field(parameters, message, registry):
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(parameters), registry=registry)
+    assert message in str(info.value)
+
+
+def test_zip_lengths_must_match(registry):
+    params = {"seed": {"values": [1, 2]}, "loading.stop": {"values": [5, 6, 7]}}
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(params, mode="zip"), registry=registry)
+    assert "mode zip needs the same number of values for every parameter. Got seed: 2, loading.stop: 3" in str(info.value)
+    assert len(plan_sweep(sweep_preset(params), registry=registry).points) == 6  # fine as a grid
+
+
+def test_a_bad_point_value_names_the_point_and_field(registry):
+    params = {"spectrum.params.hurst": {"values": [0.5, 2.0]}, "slope.name": {"values": ["spectral", "slopy"]}}
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(params, mode="zip"), registry=registry)
+    text = str(info.value)
+    assert "sweep point 2 (spectrum.params.hurst=2.0, slope.name='slopy'): spectrum.params.hurst: must be <= 1.5, got 2.0" in text
+    assert "sweep point 2 (spectrum.params.hurst=2.0, slope.name='slopy'): slope.name: no slope plugin named 'slopy'" in text
+    assert "sweep point 1" not in text
+
+
+def test_cancel_after_the_first_point_keeps_it_and_marks_the_rest(tmp_path, registry):
+    cancel = threading.Event()
+
+    class StopAfterFirst:
+        def point_finished(self, sweep, point, result):
+            cancel.set()
+
+    sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2, 3]}}), registry=registry)
+    outcome = run_sweep(sweep, tmp_path, workers=1, listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    assert outcome.status == "interrupted"
+    assert [r["status"] for r in read_table(tmp_path / "sweep.csv")] == ["completed", "pending", "pending"]
+    assert not (tmp_path / "points" / sweep.points[1].folder_name).exists()
+
+
+def test_cli_runs_a_sweep_and_exit_codes(tmp_path, capsys):
+    good = write(tmp_path, sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.9]}}))
+    assert main(["run", str(good), "--out", str(tmp_path / "out"), "--workers", "1"]) == 0
+    captured = capsys.readouterr()
+    assert "point 2/2: spectrum.params.hurst=0.9" in captured.err
+    assert "2 points" in captured.out and "hurst=0.9: a = " in captured.out
+    assert len(read_table(tmp_path / "out" / "sweep.csv")) == 2
+    assert main(["run", str(good), "--out", str(tmp_path / "j"), "--workers", "1", "--quiet", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["status"] == "completed"
+    # one point alone, with sweep=null: a plain run
+    assert main(["run", str(good), "--set", "sweep=null", "--set", "spectrum.params.hurst=0.9",
+                 "--out", str(tmp_path / "one"), "--quiet", "--json"]) == 0  # fmt: skip
+    alone = json.loads(capsys.readouterr().out)
+    point = json.loads((tmp_path / "out" / "points" / "02-hurst-0.9" / "summary.json").read_text())
+    assert alone["fit"]["a"] == point["fit"]["a"] and "sweep" not in alone["preset"]
+    bad = write(tmp_path, sweep_preset({"spectrum.params.hurst": {"values": [0.5, 2.0]}}), "bad.yaml")
+    assert main(["run", str(bad), "--out", str(tmp_path / "bad")]) == 2
+    assert "sweep point 2 (spectrum.params.hurst=2.0)" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()  # nothing runs unless every point is valid
+
+
+def test_validate_checks_every_point(tmp_path, capsys):
+    good = write(tmp_path, sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.9]}}))
+    assert main(["validate", str(good)]) == 0
+    assert "sweep of 2 points" in capsys.readouterr().out
+    bad = write(tmp_path, sweep_preset({"spectrum.params.hurst": {"values": [0.5, 2.0]}}), "bad.yaml")
+    assert main(["validate", str(bad)]) == 2
+    assert "sweep point 2 (spectrum.params.hurst=2.0): spectrum.params.hurst: must be <= 1.5" in capsys.readouterr().err
