@@ -1,0 +1,41 @@
+"""The terminal UI (``frictionlab tui``): the only package that imports Textual.
+
+Importing this package is cheap; Textual loads when the app is built.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def run_app(
+    preset: str | Path | None = None,
+    *,
+    presets_dir: str | Path | None = None,
+    runs_dir: str | Path | None = None,
+    workers: int | None = None,
+) -> int:
+    from .app import FrictionlabApp
+
+    start_process_helpers()
+    app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, workers=workers)
+    app.run()
+    return app.return_code or 0
+
+
+def start_process_helpers() -> None:
+    """Start multiprocessing's forkserver and resource tracker now.
+
+    While a Textual app runs, ``sys.stderr`` is Textual's capture object, whose
+    ``fileno()`` is -1; the resource tracker hands ``sys.stderr.fileno()`` to
+    the helper process it starts, and that fails (``bad value(s) in
+    fds_to_keep``). Started before the app, with the real stderr, both are
+    found running when a run's process pool needs them.
+    """
+    import multiprocessing
+
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        from multiprocessing import forkserver, resource_tracker
+
+        resource_tracker.ensure_running()
+        forkserver.ensure_running()

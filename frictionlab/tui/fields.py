@@ -1,0 +1,235 @@
+"""Form fields derived from pydantic models, and the preset draft they edit.
+
+Nothing here knows a particular plugin: a field's widget kind, bounds, default
+and tooltip come from its ``Params`` model, so a third-party plugin's
+parameters appear in the form with no code of its own. No Textual here.
+"""
+
+from __future__ import annotations
+
+import copy
+import types
+import typing
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel
+from pydantic_core import PydanticUndefined
+
+from ..errors import PresetError
+from ..preset import PLUGIN_SLOTS, Preset, build_scene
+
+MISSING = object()  # "remove this key": the model's default applies (or 'is required')
+
+_BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
+
+
+@dataclass(frozen=True)
+class FieldSpec:
+    path: tuple[str, ...]  # into the preset data, e.g. ("spectrum", "params", "hurst")
+    kind: str  # int | float | choice | bool | text | section | other
+    description: str
+    required: bool
+    default: Any
+    optional: bool = False  # None is allowed (empty input)
+    choices: tuple = ()
+    bounds: str = ""
+    model: type[BaseModel] | None = None  # for kind == "section"
+
+    @property
+    def name(self) -> str:
+        return self.path[-1]
+
+    @property
+    def dotted(self) -> str:
+        return ".".join(self.path)
+
+    @property
+    def widget_id(self) -> str:
+        return "field--" + "--".join(self.path)
+
+    def tooltip(self) -> str:
+        lines = [self.description or self.name]
+        if self.bounds:
+            lines.append(f"allowed: {self.bounds}")
+        if self.choices:
+            lines.append("one of: " + ", ".join(map(str, self.choices)))
+        lines.append("required" if self.required else f"default: {display(self.default) or 'none'}")
+        return "\n".join(lines)
+
+
+def _unwrap_optional(annotation) -> tuple[Any, bool]:
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        args = typing.get_args(annotation)
+        rest = [a for a in args if a is not type(None)]
+        if len(rest) == 1 and len(args) == 2:
+            return rest[0], True
+    return annotation, False
+
+
+def _bounds(info) -> str:
+    parts = []
+    for item in info.metadata:
+        for attr, symbol in _BOUND_SYMBOLS:
+            value = getattr(item, attr, None)
+            if value is not None:
+                parts.append(f"{symbol} {value}")
+    return ", ".join(parts)
+
+
+def field_specs(model: type[BaseModel], prefix: tuple[str, ...] = ()) -> list[FieldSpec]:
+    """One spec per field of ``model``, in declaration order."""
+    specs = []
+    for name, info in model.model_fields.items():
+        annotation, optional = _unwrap_optional(info.annotation)
+        choices: tuple = ()
+        sub_model = None
+        if typing.get_origin(annotation) is Literal:
+            kind, choices = "choice", typing.get_args(annotation)
+        elif annotation is bool:
+            kind = "bool"
+        elif annotation is int:
+            kind = "int"
+        elif annotation is float:
+            kind = "float"
+        elif annotation is str:
+            kind = "text"
+        elif isinstance(annotation, type) and issubclass(annotation, BaseModel):
+            kind, sub_model = "section", annotation
+        else:
+            kind = "other"  # lists, mappings, unions: kept as in the file, edited in YAML
+        default = info.get_default(call_default_factory=True)
+        specs.append(
+            FieldSpec(
+                path=(*prefix, name),
+                kind=kind,
+                description=info.description or "",
+                required=info.is_required(),
+                default=None if default is PydanticUndefined else default,
+                optional=optional,
+                choices=choices,
+                bounds=_bounds(info),
+                model=sub_model,
+            )
+        )
+    return specs
+
+
+def display(value) -> str:
+    """A value as the text of an input."""
+    if value is None or value is MISSING:
+        return ""
+    if isinstance(value, BaseModel):
+        return ""
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, str):
+        return " ".join(value.split("\n")).strip()  # an input is one line (YAML folds keep a newline)
+    return str(value)
+
+
+def parse(spec: FieldSpec, text: str):
+    """Input text -> the value stored in the draft. Unparseable text is kept as
+    text, so the headless validator reports it (``must be a number, got 'abc'``)."""
+    if spec.kind == "text":
+        return text
+    text = text.strip()
+    if not text:
+        return MISSING
+    if spec.kind == "int":
+        try:
+            return int(text)
+        except ValueError:
+            pass
+    if spec.kind == "float":
+        try:
+            return float(text)
+        except ValueError:
+            pass
+    try:  # the same reading as the CLI's --set
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+    return value if isinstance(value, str | int | float | bool) else text
+
+
+# ------------------------------------------------------------------ draft
+
+
+def get_path(data: dict, path: tuple[str, ...], default=MISSING):
+    node = data
+    for key in path:
+        if not isinstance(node, dict) or key not in node:
+            return default
+        node = node[key]
+    return node
+
+
+def set_path(data: dict, path: tuple[str, ...], value) -> None:
+    """Set (or with MISSING remove) ``path``, creating mappings on the way."""
+    node = data
+    for key in path[:-1]:
+        child = node.get(key)
+        if not isinstance(child, dict):
+            child = node[key] = {}
+        node = child
+    if value is MISSING:
+        node.pop(path[-1], None)
+    else:
+        node[path[-1]] = value
+
+
+def default_plugin_name(slot: str) -> str | None:
+    info = Preset.model_fields[slot]
+    if info.default_factory is None:
+        return None
+    return info.default_factory().name
+
+
+def problems_of(data: dict, registry) -> list[str]:
+    """The headless validator's problems for ``data`` (empty when it is valid)."""
+    try:
+        build_scene(data, registry=registry)
+    except PresetError as exc:
+        return list(exc.problems)
+    return []
+
+
+def problem_path(problem: str) -> str:
+    return problem.partition(": ")[0]
+
+
+def problems_for(problems: list[str], dotted: str) -> list[str]:
+    return [p for p in problems if problem_path(p) == dotted]
+
+
+def with_value(data: dict, path: tuple[str, ...], value) -> dict:
+    candidate = copy.deepcopy(data)
+    set_path(candidate, path, value)
+    return candidate
+
+
+def preset_from_defaults(name: str, spectrum: str, registry) -> dict:
+    """A new preset: every plugin parameter at its default (required ones left
+    for the user), and a small starter scene for the preset's required fields."""
+    data: dict = {
+        "name": name,
+        "description": "",
+        "seed": 0,
+        "realizations": 50,
+    }
+    for slot, kind in PLUGIN_SLOTS.items():
+        plugin_name = spectrum if slot == "spectrum" else default_plugin_name(slot)
+        cls = registry.get(kind, plugin_name)
+        params = {
+            s.name: s.default
+            for s in field_specs(cls.Params)
+            if not s.required and s.default is not None and s.kind != "other"
+        }
+        data[slot] = {"name": cls.name, "params": params}
+    data["loading"] = {"control": "force", "start": 1.0, "stop": 20.0, "steps": 40, "spacing": "log"}
+    return data
+
+
+SLOT_KINDS = PLUGIN_SLOTS

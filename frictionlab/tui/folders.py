@@ -1,0 +1,165 @@
+"""Where the TUI finds presets and past runs (no Textual here: plain files).
+
+Presets come from ``./presets`` (when it exists) and the user folder
+(``$FRICTIONLAB_PRESETS_DIR``, else ``$XDG_CONFIG_HOME/frictionlab/presets``,
+else ``~/.config/frictionlab/presets``). Runs are the output folders the
+headless ``frictionlab run`` writes, found by their ``summary.json``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from ..cli import DEFAULT_RUNS_DIR
+from ..results import atomic_write
+
+PROJECT_PRESETS_DIR = Path("presets")
+
+
+def user_presets_dir(env=None) -> Path:
+    env = os.environ if env is None else env
+    if env.get("FRICTIONLAB_PRESETS_DIR"):
+        return Path(env["FRICTIONLAB_PRESETS_DIR"]).expanduser()
+    config = Path(env["XDG_CONFIG_HOME"]).expanduser() if env.get("XDG_CONFIG_HOME") else Path.home() / ".config"
+    return config / "frictionlab" / "presets"
+
+
+def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str, Path]]:
+    """(label, folder) pairs to browse: the given folder, or ./presets and the user folder."""
+    if presets_dir is not None:
+        return [("presets", Path(presets_dir))]
+    folders = [("project", PROJECT_PRESETS_DIR)] if PROJECT_PRESETS_DIR.is_dir() else []
+    return folders + [("user", user_presets_dir(env))]
+
+
+def writable_folder(folders: list[tuple[str, Path]]) -> Path:
+    """Where new presets and copies go: the user folder (or the only one given)."""
+    return folders[-1][1]
+
+
+@dataclass(frozen=True)
+class PresetEntry:
+    label: str  # which folder
+    path: Path
+    name: str  # the preset's own name, or the file stem if unreadable
+    description: str
+    error: str = ""
+
+
+def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
+    entries = []
+    for label, folder in folders:
+        if not folder.is_dir():
+            continue
+        for path in sorted(folder.glob("*.y*ml")):
+            try:
+                data = yaml.safe_load(path.read_text(encoding="utf-8"))
+            except (OSError, yaml.YAMLError) as exc:
+                entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
+                continue
+            data = data if isinstance(data, dict) else {}
+            description = " ".join(str(data.get("description") or "").split())
+            entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
+    return entries
+
+
+def save_preset(path: Path, data: dict) -> None:
+    """Write preset data as YAML, atomically (comments of the original are not kept)."""
+    text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    atomic_write(Path(path), lambda fh: fh.write(text))
+
+
+def new_run_folder(runs_dir: Path, name: str) -> Path:
+    """``runs_dir/<name>-<timestamp>``, like the CLI's default, made unique."""
+    base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    candidate, n = base, 2
+    while candidate.exists():
+        candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
+    return candidate
+
+
+def default_runs_dir() -> Path:
+    return DEFAULT_RUNS_DIR
+
+
+# ------------------------------------------------------------------ past runs
+
+
+def _number(value) -> float:
+    return float(value) if isinstance(value, int | float) else math.nan
+
+
+@dataclass
+class RunEntry:
+    path: Path
+    name: str
+    status: str
+    done: int
+    requested: int
+    fit: dict | None
+    summary: dict
+    mtime: float
+    curve: dict[str, list[float]] = field(default_factory=dict)
+
+    @property
+    def a(self) -> float:
+        return _number((self.fit or {}).get("a"))
+
+    @property
+    def b(self) -> float:
+        return _number((self.fit or {}).get("b"))
+
+    @property
+    def r2(self) -> float:
+        return _number((self.fit or {}).get("r2"))
+
+
+def read_run(folder: Path) -> RunEntry:
+    """A run folder's summary; raises OSError/ValueError if it has none readable."""
+    folder = Path(folder)
+    summary_path = folder / "summary.json"
+    summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    realizations = summary.get("realizations") or {}
+    preset = summary.get("preset") or {}
+    return RunEntry(
+        path=folder,
+        name=str(preset.get("name") or folder.name),
+        status=str(summary.get("status", "?")),
+        done=int(realizations.get("done") or 0),
+        requested=int(realizations.get("requested") or 0),
+        fit=summary.get("fit"),
+        summary=summary,
+        mtime=summary_path.stat().st_mtime,
+    )
+
+
+def read_curve(folder: Path) -> dict[str, list[float]]:
+    """``curve.csv`` as columns of floats (empty cells become NaN)."""
+    with open(Path(folder) / "curve.csv", encoding="utf-8", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    columns = rows[0].keys() if rows else ()
+    return {c: [float(r[c]) if r[c] else math.nan for r in rows] for c in columns}
+
+
+def list_runs(runs_dir: Path) -> list[RunEntry]:
+    """Every folder under ``runs_dir`` with a readable summary.json, newest first."""
+    runs_dir = Path(runs_dir)
+    if not runs_dir.is_dir():
+        return []
+    entries = []
+    for folder in runs_dir.iterdir():
+        if not (folder / "summary.json").is_file():
+            continue
+        try:
+            entries.append(read_run(folder))
+        except (OSError, ValueError, TypeError):
+            continue  # a half-written or foreign folder: not a run to list
+    return sorted(entries, key=lambda e: (-e.mtime, e.path.name))

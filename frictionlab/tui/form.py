@@ -1,0 +1,317 @@
+"""The preset edit form, built from the models: ``Preset`` for the scene and
+each plugin's ``Params`` for its section. Numbers become inputs checked by the
+headless validator (so the message is the same text ``frictionlab validate``
+prints), literals become selects, booleans switches. Choosing another plugin
+swaps its parameter section; the old plugin's values are kept in case the
+user switches back."""
+
+from __future__ import annotations
+
+import copy
+
+import yaml
+from rich.markup import escape
+
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.message import Message
+from textual.validation import ValidationResult, Validator
+from textual.widget import Widget
+from textual.widgets import Input, Label, Select, Static, Switch
+
+from ..preset import PLUGIN_SLOTS, Preset
+from .fields import (
+    MISSING,
+    FieldSpec,
+    default_plugin_name,
+    display,
+    field_specs,
+    get_path,
+    parse,
+    problem_path,
+    problems_for,
+    problems_of,
+    set_path,
+    with_value,
+)
+
+
+class HeadlessCheck(Validator):
+    """Validates one field by running the headless validator on the draft with
+    this value in place, and reports that field's messages verbatim."""
+
+    def __init__(self, form: PresetForm, spec: FieldSpec):
+        super().__init__()
+        self.form = form
+        self.spec = spec
+
+    def validate(self, value: str) -> ValidationResult:
+        candidate = with_value(self.form.data, self.spec.path, parse(self.spec, value))
+        self.form.ensure_plugin_name(candidate, self.spec.path)
+        problems = problems_for(problems_of(candidate, self.form.registry), self.spec.dotted)
+        return self.failure("\n".join(problems)) if problems else self.success()
+
+
+def _flow(value) -> str:
+    text = yaml.safe_dump(value, default_flow_style=True, width=10_000).strip()
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _section_id(path: tuple[str, ...]) -> str:
+    return "section--" + "--".join(path)
+
+
+class PresetForm(VerticalScroll):
+    """Edits ``data`` (the preset as a plain mapping, unknown sections kept)."""
+
+    class Edited(Message):
+        """The draft changed (or was loaded): ``problems`` is the headless list."""
+
+        def __init__(self, problems: list[str], changed: bool):
+            super().__init__()
+            self.problems = problems
+            self.changed = changed
+
+    class FieldFocused(Message):
+        def __init__(self, spec: FieldSpec | None):
+            super().__init__()
+            self.spec = spec
+
+    def __init__(self, registry, **kwargs):
+        super().__init__(**kwargs)
+        self.registry = registry
+        self.data: dict | None = None
+        self.problems: list[str] = []
+        self._specs: dict[str, FieldSpec] = {}
+        self._stash: dict[tuple[str, str], dict] = {}  # (slot, plugin) -> params left behind
+        # the value each select or switch shows: Textual also posts Changed when one is mounted
+        self._seen: dict[str, object] = {}
+
+    # ------------------------------------------------------------ building
+
+    async def load(self, data: dict) -> None:
+        self.data = copy.deepcopy(data)
+        self._stash.clear()
+        await self.recompose()
+        self.revalidate(changed=False)
+
+    def compose(self):
+        self._specs = {}
+        self._seen = {}
+        if self.data is None:
+            yield Static("No preset open. F2 lists the presets: Enter opens one, n makes a new one.")
+            return
+        sections = []
+        yield Label("Scene", classes="heading")
+        for spec in field_specs(Preset):
+            if spec.kind == "section" and not spec.optional:
+                sections.append(spec)
+            else:
+                yield from self.field_rows(spec)
+        for spec in sections:
+            if spec.name in PLUGIN_SLOTS:
+                yield from self.plugin_rows(spec.name)
+            else:
+                yield Label(spec.name.capitalize(), classes="heading")
+                for sub in field_specs(spec.model, prefix=spec.path):
+                    yield from self.field_rows(sub)
+                yield Static("", id=_section_id(spec.path), classes="field-error")
+        unknown = [key for key in self.data if key not in Preset.model_fields]
+        if unknown:
+            yield Static(
+                f"Kept as in the file (edit the YAML to change): {', '.join(unknown)}", classes="note"
+            )
+
+    def field_rows(self, spec: FieldSpec) -> list[Widget]:
+        self._specs[spec.widget_id] = spec
+        value = get_path(self.data, spec.path)
+        current = spec.default if value is MISSING else value
+        if spec.kind == "bool":
+            widget = Switch(value=bool(current), id=spec.widget_id)
+        elif spec.kind == "choice":
+            options = [(str(c), c) for c in spec.choices]
+            known = current in spec.choices
+            widget = Select(
+                options,
+                value=current if known else Select.NULL,
+                allow_blank=spec.optional or not known,
+                compact=True,
+                id=spec.widget_id,
+            )
+        elif spec.kind in ("int", "float", "text"):
+            placeholder = "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
+            widget = Input(
+                value=display(value),
+                placeholder=placeholder,
+                validators=[HeadlessCheck(self, spec)],
+                validate_on=["changed"],
+                compact=True,
+                id=spec.widget_id,
+            )
+        else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
+            shown = "(none)" if value in (MISSING, None) else _flow(value)
+            widget = Static(f"{escape(shown)}  [dim](edit in the YAML)[/dim]", id=spec.widget_id, classes="other")
+        if spec.kind == "bool":
+            self._seen[spec.widget_id] = bool(current)
+        elif spec.kind == "choice":
+            self._seen[spec.widget_id] = current if current in spec.choices else Select.NULL
+        widget.tooltip = spec.tooltip()
+        label = Label(spec.name, classes="field-label")
+        label.tooltip = spec.tooltip()
+        return [
+            Horizontal(label, widget, classes="row"),
+            Static("", id=spec.widget_id + "--error", classes="field-error"),
+        ]
+
+    def plugin_rows(self, slot: str) -> list[Widget]:
+        kind = PLUGIN_SLOTS[slot]
+        name = get_path(self.data, (slot, "name"), default_plugin_name(slot))
+        names = self.registry.names(kind)
+        known = self._known_name(kind, name)
+        select = Select(
+            [(n, n) for n in names],
+            value=known if known else Select.NULL,
+            allow_blank=known is None,
+            compact=True,
+            id=f"plugin--{slot}",
+        )
+        select.tooltip = f"{slot} plugin: one of {', '.join(names)}"
+        self._seen[select.id] = known if known else Select.NULL
+        return [
+            Label(slot.capitalize(), classes="heading"),
+            Horizontal(Label("name", classes="field-label"), select, classes="row"),
+            Static("", id=f"field--{slot}--name--error", classes="field-error"),
+            Vertical(*self.param_rows(slot), id=f"params--{slot}", classes="params"),
+            Static("", id=_section_id((slot, "params")), classes="field-error"),
+        ]
+
+    def _known_name(self, kind: str, name) -> str | None:
+        if not isinstance(name, str):
+            return None
+        try:
+            return self.registry.info(kind, name).name
+        except Exception:
+            return None
+
+    def param_rows(self, slot: str) -> list[Widget]:
+        kind = PLUGIN_SLOTS[slot]
+        known = self._known_name(kind, get_path(self.data, (slot, "name"), default_plugin_name(slot)))
+        if known is None:
+            return [Static("(choose a plugin to see its parameters)", classes="note")]
+        cls = self.registry.get(kind, known)
+        rows: list[Widget] = [Static(cls.summary, classes="summary")]
+        for spec in field_specs(cls.Params, prefix=(slot, "params")):
+            rows += self.field_rows(spec)
+        return rows
+
+    # ------------------------------------------------------------ editing
+
+    def ensure_plugin_name(self, data: dict, path: tuple[str, ...]) -> None:
+        """Editing a parameter of a slot the file leaves at its default writes the
+        slot out, with the plugin name shown in the form."""
+        slot = path[0]
+        if slot in PLUGIN_SLOTS and len(path) > 2 and get_path(data, (slot, "name")) is MISSING:
+            set_path(data, (slot, "name"), default_plugin_name(slot))
+
+    def _store(self, spec: FieldSpec, value) -> None:
+        if get_path(self.data, spec.path) == value:
+            return
+        self.ensure_plugin_name(self.data, spec.path)
+        set_path(self.data, spec.path, value)
+        self.revalidate(changed=True)
+
+    def _is_new(self, widget_id: str, value) -> bool:
+        if widget_id in self._seen and self._seen[widget_id] == value:
+            return False
+        self._seen[widget_id] = value
+        return True
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        spec = self._specs.get(event.input.id or "")
+        # only typing is an edit: the Changed that mounting an input posts is not
+        if spec is not None and self.data is not None and event.input.has_focus:
+            event.stop()
+            self._store(spec, parse(spec, event.value))
+
+    def on_switch_changed(self, event: Switch.Changed) -> None:
+        spec = self._specs.get(event.switch.id or "")
+        if spec is not None and self.data is not None and self._is_new(spec.widget_id, event.value):
+            event.stop()
+            self._store(spec, bool(event.value))
+
+    async def on_select_changed(self, event: Select.Changed) -> None:
+        if self.data is None:
+            return
+        select_id = event.select.id or ""
+        event.stop()
+        if not self._is_new(select_id, event.value):
+            return
+        if select_id.startswith("plugin--"):
+            await self._switch_plugin(select_id.removeprefix("plugin--"), event.value)
+            return
+        spec = self._specs.get(select_id)
+        if spec is not None:
+            self._store(spec, MISSING if event.value is Select.NULL else event.value)
+
+    async def _switch_plugin(self, slot: str, new_name) -> None:
+        kind = PLUGIN_SLOTS[slot]
+        old_name = get_path(self.data, (slot, "name"), default_plugin_name(slot))
+        old_known = self._known_name(kind, old_name)
+        if new_name is Select.NULL or new_name == old_known:
+            return
+        old_params = get_path(self.data, (slot, "params"), {})
+        if old_known is not None:
+            self._stash[(slot, old_known)] = copy.deepcopy(old_params if isinstance(old_params, dict) else {})
+        self.data[slot] = {"name": new_name, "params": self._stash.get((slot, new_name), {})}
+        for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
+            del self._specs[spec_id]
+        container = self.query_one(f"#params--{slot}", Vertical)
+        await container.remove_children()
+        await container.mount_all(self.param_rows(slot))
+        self.revalidate(changed=True)
+
+    # ------------------------------------------------------------ messages
+
+    def revalidate(self, changed: bool) -> None:
+        """Run the headless validator on the draft and mark every field."""
+        self.problems = problems_of(self.data, self.registry) if self.data is not None else []
+        shown = set()
+        for widget_id, spec in self._specs.items():
+            messages = problems_for(self.problems, spec.dotted)
+            shown.update(messages)
+            self._set_error(widget_id, messages)
+        for slot in PLUGIN_SLOTS:
+            messages = problems_for(self.problems, f"{slot}.name")
+            shown.update(messages)
+            self._set_error(f"field--{slot}--name", messages, widget=False)
+        for section in self.query(".field-error"):
+            if section.id and section.id.startswith("section--"):
+                dotted = section.id.removeprefix("section--").replace("--", ".")
+                messages = [p for p in self.problems if p not in shown and problem_path(p) == dotted]
+                section.update("\n".join(messages))
+                section.display = bool(messages)
+        self.post_message(self.Edited(self.problems, changed))
+
+    def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
+        try:
+            label = self.query_one(f"#{widget_id}--error", Static)
+        except Exception:
+            return
+        label.update("\n".join(messages))
+        label.display = bool(messages)
+        if widget:
+            try:
+                self.query_one(f"#{widget_id}").set_class(bool(messages), "-invalid")
+            except Exception:
+                pass
+
+    def on_descendant_focus(self, event) -> None:
+        widget = event.widget
+        spec = self._specs.get(widget.id or "")
+        if spec is None and (widget.id or "").startswith("plugin--"):
+            slot = widget.id.removeprefix("plugin--")
+            kind = PLUGIN_SLOTS[slot]
+            spec = FieldSpec(
+                (slot, "name"), "choice", f"{slot} plugin ({kind})", False, default_plugin_name(slot),
+                choices=tuple(self.registry.names(kind)),
+            )
+        self.post_message(self.FieldFocused(spec))

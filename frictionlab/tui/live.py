@@ -1,0 +1,131 @@
+"""The TUI's run listener: running sums and an interim fit, handed on as snapshots.
+
+It runs in the engine's thread and never touches the UI: it calls ``post`` with
+a ``Snapshot`` at most every ``interval`` seconds (and always at the start,
+for the first and the last realization, and at the end). Each snapshot is cumulative, so the UI may drop
+all but the newest one (Textual coalesces them, see ``app.RunProgress``). The
+interim fit is least squares of the mean curve so far; the bootstrap intervals
+come only with the final ``RunOutcome``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..fit import least_squares
+from ..hookspecs import hookimpl
+
+
+@dataclass(frozen=True)
+class InterimFit:
+    a: float
+    b: float
+    r2: float
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    done: int  # finished, ok or failed
+    total: int
+    failed: int
+    elapsed: float
+    f: np.ndarray | None  # dimensionless force of the mean curve (None before the first result)
+    xi: np.ndarray | None  # mean xi over the finished realizations
+    contact_count: np.ndarray | None
+    fit: InterimFit | None
+    first_error: str | None = None
+    finished: bool = False
+
+    @property
+    def rate(self) -> float:
+        return self.done / self.elapsed if self.elapsed > 0 else 0.0
+
+    @property
+    def seconds_left(self) -> float:
+        return (self.total - self.done) / self.rate if self.rate > 0 else math.nan
+
+
+class LiveListener:
+    def __init__(self, post: Callable[[Snapshot], None], interval: float = 0.1, clock=time.perf_counter):
+        self.post = post
+        self.interval = interval
+        self.clock = clock
+
+    @hookimpl
+    def run_started(self, run):
+        scene = run.scene
+        steps = scene.loads.size
+        self._loads = scene.loads.astype(float)
+        self._force_control = scene.control == "force"
+        self._scale = float(scene.solver.stiffness()) * float(scene.spectrum.rms_height())
+        self._length = math.nan
+        self._ok = 0
+        self._failed = 0
+        self._first_error = None
+        self._xi_sum = np.zeros(steps)
+        self._count_sum = np.zeros(steps)
+        self._force_sum = np.zeros(steps)
+        self._started = self.clock()
+        self._last_post = self._started
+        self.post(self._snapshot(0, run.total))
+
+    @hookimpl
+    def realization_done(self, result, done, total):
+        self._ok += 1
+        self._length = result.length
+        self._xi_sum += result.xi
+        self._count_sum += result.contact_count
+        if result.force is not None:
+            self._force_sum += result.force
+        self._maybe_post(done, total)
+
+    @hookimpl
+    def realization_failed(self, result, done, total):
+        self._failed += 1
+        self._first_error = self._first_error or f"realization {result.index}: {result.error}"
+        self._maybe_post(done, total)
+
+    @hookimpl
+    def run_finished(self, run, outcome):
+        self.post(self._snapshot(outcome.done + len(outcome.failures), run.total, finished=True))
+
+    def _maybe_post(self, done: int, total: int) -> None:
+        now = self.clock()
+        if done in (1, total) or now - self._last_post >= self.interval:  # the plot appears at once
+            self._last_post = now
+            self.post(self._snapshot(done, total))
+
+    def _snapshot(self, done: int, total: int, finished: bool = False) -> Snapshot:
+        f = xi = count = fit = None
+        if self._ok:
+            force = self._loads if self._force_control else self._force_sum / self._ok
+            f = force / (self._scale * self._length)
+            xi = self._xi_sum / self._ok
+            count = self._count_sum / self._ok
+            fit = interim_fit(f, xi)
+        return Snapshot(
+            done=done,
+            total=total,
+            failed=self._failed,
+            elapsed=self.clock() - self._started,
+            f=f,
+            xi=xi,
+            contact_count=count,
+            fit=fit,
+            first_error=self._first_error,
+            finished=finished,
+        )
+
+
+def interim_fit(f: np.ndarray, xi: np.ndarray) -> InterimFit | None:
+    keep = np.isfinite(f) & np.isfinite(xi) & (f > 0)
+    try:
+        coef, _, r2, _ = least_squares(f[keep], xi[keep])
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    return InterimFit(float(coef[0]), float(coef[1]), float(r2))

@@ -1,0 +1,473 @@
+"""The terminal UI driven as a user drives it (Textual's Pilot at 80x24): what it
+shows is checked against the headless validator and the headless run, and the
+files it writes against what ``frictionlab run`` accepts."""
+
+import asyncio
+import functools
+import json
+import subprocess
+import sys
+from typing import ClassVar, Literal
+
+import numpy as np
+import pytest
+import yaml
+from pydantic import Field
+
+from frictionlab import PluginParams, SlopeEstimator
+from frictionlab.cli import main
+from frictionlab.engine import run as engine_run
+from frictionlab.errors import ExitCode, PresetError
+from frictionlab.fit import least_squares
+from frictionlab.preset import build_scene, load_scene
+from frictionlab.runner import run_to_folder
+from frictionlab.tui.app import FrictionlabApp
+from frictionlab.tui.live import LiveListener
+from frictionlab.tui.form import PresetForm
+from textual.widgets import Input, Select, Static, Switch
+
+from .conftest import ROOT, SMALL_PRESET, merge
+
+SIZE = (80, 24)
+
+
+def sync(scenario):
+    """Run an async Pilot scenario as a plain test (no async pytest plugin needed)."""
+
+    @functools.wraps(scenario)
+    def test(*args, **kwargs):
+        asyncio.run(scenario(*args, **kwargs))
+
+    return test
+TINY = merge(SMALL_PRESET, {"spectrum": {"params": {"points": 512}}, "fit": {"bootstrap": 50}})
+
+
+def headless_problems(data, registry):
+    try:
+        build_scene(data, registry=registry)
+    except PresetError as exc:
+        return exc.problems
+    return []
+
+
+@pytest.fixture
+def folders(tmp_path, monkeypatch):
+    """A presets folder with one tiny preset and an empty runs folder, as relative
+    paths (so snapshots do not show the temporary directory)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "presets" / "tiny.yaml").write_text(yaml.safe_dump(TINY, sort_keys=False))
+    return tmp_path
+
+
+def make_app(registry, preset=None, workers=1):
+    return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", workers=workers, registry=registry)
+
+
+async def open_first_preset(pilot):
+    await pilot.pause()
+    await pilot.press("enter")
+    await pilot.pause()
+    form = pilot.app.query_one(PresetForm)
+    assert form.data is not None, "Enter on the presets list did not open the preset"
+    return form
+
+
+async def type_into(pilot, widget_id, text):
+    field = pilot.app.query_one(f"#{widget_id}", Input)
+    field.focus()
+    await pilot.press("end", "ctrl+u", *text)
+    await pilot.pause()
+
+
+async def choose(pilot, select_id, value):
+    """Pick an option of a Select with the keyboard: Enter opens it, arrows move, Enter picks."""
+    select = pilot.app.query_one(f"#{select_id}", Select)
+    select.focus()
+    await pilot.press("enter")
+    options = [v for _, v in select._options if v is not Select.NULL]
+    current = options.index(select.value) if select.value in options else -1
+    target = options.index(value)
+    await pilot.press(*(["down"] * (target - current) if target > current else ["up"] * (current - target)))
+    await pilot.press("enter")
+    await pilot.pause()
+    assert select.value == value
+
+
+async def wait_until(pilot, condition, timeout=60.0):
+    for _ in range(int(timeout / 0.05)):
+        if condition():
+            return
+        await pilot.pause(0.05)
+    raise AssertionError("timed out waiting for the app")
+
+
+def error_text(app, widget_id):
+    label = app.query_one(f"#{widget_id}--error", Static)
+    return str(label.render()) if label.display else ""
+
+
+# ------------------------------------------------------------------ edit and save
+
+
+@sync
+async def test_invalid_value_shows_the_headless_message_then_save_round_trips(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await type_into(pilot, "field--spectrum--params--hurst", "2.0")
+        expected = headless_problems(merge(TINY, {"spectrum": {"params": {"hurst": 2.0}}}), registry)
+        assert expected == ["spectrum.params.hurst: must be <= 1.5, got 2.0"]
+        assert form.problems == expected
+        assert error_text(app, "field--spectrum--params--hurst") == expected[0]
+        assert app.query_one("#field--spectrum--params--hurst", Input).has_class("-invalid")
+        assert expected[0] in str(app.query_one("#problems", Static).render())
+
+        # text where a number belongs: the same words as `frictionlab validate`
+        await type_into(pilot, "field--loading--steps", "abc")
+        assert form.problems == headless_problems(
+            merge(TINY, {"spectrum": {"params": {"hurst": 2.0}}, "loading": {"steps": "abc"}}), registry
+        )
+        assert error_text(app, "field--loading--steps") == "loading.steps: must be a whole number, got 'abc'"
+
+        await type_into(pilot, "field--loading--steps", "12")
+        await type_into(pilot, "field--spectrum--params--hurst", "0.9")
+        assert form.problems == []
+        assert error_text(app, "field--spectrum--params--hurst") == ""
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert not app.modified
+
+    saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+    assert saved == merge(TINY, {"spectrum": {"params": {"hurst": 0.9}}, "loading": {"steps": 12}})
+    # accepted unchanged by the headless front end
+    scene = load_scene(folders / "presets" / "tiny.yaml", registry=registry)
+    assert scene.spectrum.params.hurst == 0.9 and scene.preset.loading.steps == 12
+    assert main(["run", "presets/tiny.yaml", "--out", "runs/headless", "--quiet", "--workers", "1"]) == ExitCode.OK
+
+
+@sync
+async def test_save_with_problems_asks_first_and_keeps_unknown_sections(folders, registry):
+    data = merge(TINY, {"realizations": 0, "notes": {"author": "me", "tags": ["a", "b"]}})
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert form.problems == headless_problems(data, registry)
+        assert any(p.startswith("notes: ") for p in form.problems)
+        await type_into(pilot, "field--seed", "11")
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert app.modified, "saved a preset with problems without asking"
+        await pilot.press("n")  # no: nothing is written
+        await pilot.pause()
+        assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == TINY["seed"]
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        await pilot.press("y")
+        await pilot.pause()
+        assert not app.modified
+        # and a run is refused, with the problems named
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        assert app.last_snapshot is None and not app.running
+    saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+    assert saved == {**data, "seed": 11}
+
+
+@sync
+async def test_switching_the_solver_swaps_its_parameters(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert app.query("#field--solver--params--youngs_modulus")
+        await choose(pilot, "plugin--solver", "winkler")
+        assert not app.query("#field--solver--params--youngs_modulus")
+        modulus = app.query_one("#field--solver--params--modulus", Input)
+        assert "stiffness per unit length" in str(modulus.tooltip)
+        await type_into(pilot, "field--solver--params--modulus", "-1")
+        assert form.problems == ["solver.params.modulus: must be > 0.0, got -1.0"]
+        await type_into(pilot, "field--solver--params--modulus", "4")
+        assert form.data["solver"] == {"name": "winkler", "params": {"modulus": 4.0}}
+        # back to mdr: its values come back
+        await choose(pilot, "plugin--solver", "mdr")
+        assert form.data["solver"] == TINY["solver"]
+        assert app.query_one("#field--solver--params--youngs_modulus", Input).value == "1.0"
+        assert form.problems == []
+
+
+class SmoothedSlope(SlopeEstimator):
+    """A third-party plugin registered only in this test: the form has no code for it."""
+
+    name: ClassVar[str] = "smoothed-difference"
+    summary: ClassVar[str] = "test plugin: central difference of a smoothed line"
+
+    class Params(PluginParams):
+        window: int = Field(3, ge=1, le=99, description="points in the moving average")
+        weight: float = Field(0.5, gt=0.0, lt=1.0, description="weight of the centre point (dimensionless)")
+        edge: Literal["wrap", "reflect"] = Field("wrap", description="how the line's ends are treated")
+        normalise: bool = Field(False, description="divide by the rms slope")
+
+    def slopes(self, heights, spacing):
+        return np.gradient(heights, spacing)
+
+
+@sync
+async def test_a_third_party_plugin_gets_a_form_without_code(folders, register_plugin):
+    registry = register_plugin(SmoothedSlope)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await choose(pilot, "plugin--slope", "smoothed-difference")
+        prefix = "#field--slope--params--"
+        assert isinstance(app.query_one(prefix + "window"), Input)
+        assert isinstance(app.query_one(prefix + "weight"), Input)
+        assert isinstance(app.query_one(prefix + "edge"), Select)
+        assert isinstance(app.query_one(prefix + "normalise"), Switch)
+        assert "allowed: >= 1, <= 99" in str(app.query_one(prefix + "window").tooltip)
+        await type_into(pilot, "field--slope--params--window", "200")
+        expected = headless_problems(merge(TINY, {"slope": {"name": "smoothed-difference", "params": {"window": 200}}}), registry)
+        assert form.problems == expected == ["slope.params.window: must be <= 99, got 200"]
+        await type_into(pilot, "field--slope--params--window", "5")
+        await choose(pilot, "field--slope--params--edge", "reflect")
+        app.query_one(prefix + "normalise", Switch).focus()
+        await pilot.press("space")
+        await pilot.pause()
+        assert form.data["slope"] == {
+            "name": "smoothed-difference",
+            "params": {"window": 5, "edge": "reflect", "normalise": True},
+        }
+        assert form.problems == []
+
+
+@sync
+async def test_new_preset_from_a_plugins_defaults(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("n")
+        await pilot.pause()
+        await pilot.press("ctrl+u", *"fresh", "enter")
+        await pilot.pause()
+        form = app.query_one(PresetForm)
+        assert form.data["spectrum"]["name"] == "power-law"
+        # power-law's hurst and points have no default: the user is told, as headless would
+        assert form.problems == headless_problems(form.data, registry)
+        assert {p.split(":")[0] for p in form.problems} == {"spectrum.params.hurst", "spectrum.params.points"}
+        await type_into(pilot, "field--spectrum--params--hurst", "0.7")
+        await type_into(pilot, "field--spectrum--params--points", "256")
+        assert form.problems == []
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+    assert app.draft_path is not None and app.draft_path.name == "fresh.yaml"
+    assert load_scene(app.draft_path, registry=registry).spectrum.params.points == 256
+
+
+# ------------------------------------------------------------------ running
+
+
+@sync
+async def test_a_run_shows_the_headless_coefficients(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        shown = str(app.query_one("#run-fit", Static).render())
+        out_dir = app.last_out_dir
+        runs_listed = [entry.path.name for entry in app.runs]
+
+    outcome, _ = run_to_folder(build_scene(TINY, registry=registry), folders / "headless", workers=2)
+    fit = outcome.fit
+    assert app.last_outcome.fit == fit  # same seed, any worker count: the same numbers
+    assert f"a = {fit.a:.4f} [{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]" in shown
+    assert f"b = {fit.b:.4f} [{fit.b_ci[0]:.4f}, {fit.b_ci[1]:.4f}]" in shown
+    assert f"R^2 = {fit.r2:.4f}" in shown
+    assert f"{outcome.contact_count[-1]:.2f} at last load" in shown
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["fit"]["a"] == fit.a
+    assert runs_listed == [out_dir.name]
+
+
+@sync
+async def test_cancel_keeps_and_writes_what_finished(folders, registry):
+    big = merge(TINY, {"name": "long", "realizations": 100_000})
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        await pilot.press("c")  # the Run tab has focus
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        outcome, out_dir = app.last_outcome, app.last_out_dir
+        stats = str(app.query_one("#run-stats", Static).render())
+    assert outcome.status == "cancelled" and 3 <= outcome.done < 100_000
+    assert stats.startswith(f"cancelled: {outcome.done}/100000")
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["status"] == "cancelled"
+    assert summary["realizations"]["done"] == outcome.done
+    with np.load(out_dir / "realizations.npz") as arrays:
+        assert arrays["xi"].shape[0] == outcome.done
+
+
+def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate(registry):
+    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
+    posted = []
+    outcome = engine_run(scene, workers=1, listeners=[LiveListener(posted.append, interval=3600.0)])
+    # started, the first and the last realization, finished: nothing for the ten in between
+    assert [s.done for s in posted] == [0, 1, 12, 12]
+    last = posted[-1]
+    assert last.finished and last.failed == 0
+    np.testing.assert_allclose(last.xi, outcome.xi, rtol=1e-12)
+    np.testing.assert_allclose(last.f, outcome.f, rtol=1e-12)
+    coef, *_ = least_squares(outcome.f, outcome.xi)
+    assert last.fit.a == pytest.approx(outcome.fit.a, rel=1e-10) == pytest.approx(coef[0], rel=1e-10)
+    assert last.fit.b == pytest.approx(outcome.fit.b, rel=1e-10)
+
+    every = []
+    engine_run(scene, workers=1, listeners=[LiveListener(every.append, interval=0.0)])
+    assert [s.done for s in every] == [0, *range(1, 13), 12]
+
+
+# ------------------------------------------------------------------ results
+
+
+def make_runs(folders, registry):
+    for seed in (1, 2):
+        data = merge(TINY, {"seed": seed, "name": f"seed{seed}"})
+        run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", workers=1)
+
+
+@sync
+async def test_results_lists_opens_and_overlays_runs(folders, registry):
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert {entry.path.name for entry in app.runs} == {"seed1", "seed2"}
+        await pilot.press("enter")
+        assert [e.path.name for e in app.overlay] == [app.runs[0].path.name]
+        await pilot.press("down", "space")
+        assert {e.path.name for e in app.overlay} == {"seed1", "seed2"}
+        info = str(app.query_one("#results-info", Static).render())
+    for seed in (1, 2):
+        summary = json.loads((folders / "runs" / f"seed{seed}" / "summary.json").read_text())
+        assert f"a={summary['fit']['a']:.4f}" in info
+
+
+# ------------------------------------------------------------------ help, README, CLI
+
+
+def test_help_lists_every_binding_and_the_readme_has_them(registry):
+    app = FrictionlabApp(registry=registry)
+    keys = [key for _, rows in app.help_groups() for key, _ in rows]
+    from frictionlab.tui.app import PresetsPane, ResultsPane, RunPane
+
+    for bindings in (FrictionlabApp.BINDINGS, PresetsPane.BINDINGS, RunPane.BINDINGS, ResultsPane.BINDINGS):
+        for binding in bindings:
+            for key in binding.key.split(","):
+                from textual.binding import Binding
+
+                assert app.get_key_display(Binding(key, binding.action)) in keys
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Terminal UI", 1)[1].split("\n## ", 1)[0]
+    for description in {d for _, rows in app.help_groups() for _, d in rows}:
+        assert description in section, f"README's key table misses {description!r}"
+
+
+def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path, monkeypatch):
+    import frictionlab.tui
+
+    calls = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda *a, **k: calls.append((a, k)) or 0)
+    assert main(["tui", "--presets", str(tmp_path), "--runs", str(tmp_path / "r"), "--workers", "1"]) == 0
+    assert calls == [((None,), {"presets_dir": str(tmp_path), "runs_dir": str(tmp_path / "r"), "workers": 1})]
+
+    # the headless commands, and `tui` refusing a missing file, never import Textual
+    code = (
+        "import sys; from frictionlab.cli import main; import frictionlab.tui; "
+        f"rc = main(['tui', {str(tmp_path / 'missing.yaml')!r}]); "
+        f"rc2 = main(['validate', {str(ROOT / 'presets' / 'quickstart.yaml')!r}]); "
+        "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'textual', 'rich'}); "
+        "print(rc, rc2, bad)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.strip().splitlines()[-1] == "2 0 []", result.stderr
+    assert "no such preset file" in result.stderr
+
+
+POOL_UNDER_TEXTUAL = """
+import sys, threading
+import frictionlab.tui
+from frictionlab.engine import run
+from frictionlab.preset import build_scene
+
+class Capture:  # what Textual puts in sys.stderr while an app runs: fileno() is -1
+    def write(self, text): return len(text)
+    def flush(self): pass
+    def fileno(self): return -1
+
+if {prestart}:
+    frictionlab.tui.start_process_helpers()  # what run_app does before the app starts
+scene = build_scene({{"name": "t", "realizations": 4, "fit": {{"bootstrap": 0}},
+    "spectrum": {{"name": "power-law", "params": {{"hurst": 0.8, "points": 256}}}},
+    "loading": {{"start": 1, "stop": 5, "steps": 4}}}})
+status = []
+real, sys.stderr = sys.stderr, Capture()
+def work():
+    try:
+        status.append(run(scene, workers=2).status)
+    except Exception as exc:
+        status.append(type(exc).__name__)
+worker = threading.Thread(target=work)
+worker.start(); worker.join()
+sys.stderr = real
+print(status)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="forkserver start method")
+def test_a_process_pool_starts_from_the_app_thread():
+    """Found in tmux: a pool run from the app failed with 'bad value(s) in
+    fds_to_keep' because Textual's stderr has no file descriptor."""
+    for prestart, expected in ((False, "['ValueError']"), (True, "['completed']")):
+        result = subprocess.run(
+            [sys.executable, "-c", POOL_UNDER_TEXTUAL.format(prestart=prestart)],
+            capture_output=True, text=True, timeout=120,
+        )
+        assert result.stdout.strip().splitlines()[-1] == expected, result.stderr[-2000:]
+
+
+# ------------------------------------------------------------------ snapshots (80x24)
+
+
+def _no_blink(pilot):
+    for field in pilot.app.query(Input):
+        field.cursor_blink = False
+
+
+def test_snapshot_presets(folders, registry, snap_compare):
+    assert snap_compare(make_app(registry), terminal_size=SIZE, run_before=_no_blink)
+
+
+def test_snapshot_editor_with_a_problem(folders, registry, snap_compare):
+    async def edit(pilot):
+        await open_first_preset(pilot)
+        await type_into(pilot, "field--spectrum--params--hurst", "2.0")
+        _no_blink(pilot)
+
+    assert snap_compare(make_app(registry), terminal_size=SIZE, run_before=edit)
+
+
+def test_snapshot_help(folders, registry, snap_compare):
+    assert snap_compare(make_app(registry), press=["f1"], terminal_size=SIZE, run_before=_no_blink)
+
+
+def test_snapshot_results_overlay(folders, registry, snap_compare):
+    make_runs(folders, registry)
+    assert snap_compare(
+        make_app(registry), press=["f5", "enter", "down", "space"], terminal_size=SIZE, run_before=_no_blink
+    )
