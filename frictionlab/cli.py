@@ -73,10 +73,28 @@ def cmd_run(args) -> ExitCode:
     scene = load_scene(args.preset, overrides)
     if args.workers is not None and args.workers < 1:
         raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
+    if args.resume and not args.out:
+        raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     out_dir = Path(args.out) if args.out else _default_out(scene.preset.name)
+    if scene.preset.sweep is not None:  # one ensemble per point (issue 6)
+        from .sweep import run_sweep_command
+
+        run_options = {k: getattr(args, k, None) for k in ("executor", "scheduler", "resume")}
+        if hasattr(args, "no_memory_check"):
+            run_options["memory_check"] = not args.no_memory_check
+        return run_sweep_command(args, overrides, out_dir, run_options)
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        outcome, files = run_to_folder(scene, out_dir, workers=args.workers, listeners=listeners)
+        outcome, files = run_to_folder(
+            scene,
+            out_dir,
+            workers=args.workers,
+            listeners=listeners,
+            executor=args.executor,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            memory_check=not args.no_memory_check,
+        )
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
@@ -101,6 +119,10 @@ def cmd_validate(args) -> ExitCode:
     for path in args.presets:
         try:
             scene = load_scene(path, args.set or [])
+            if scene.preset.sweep is not None:  # every point too (issue 6)
+                from .sweep import load_sweep
+
+                points = len(load_sweep(path, args.set or []).points)
         except PresetError as exc:
             print(str(exc), file=sys.stderr)
             worst = ExitCode.USAGE
@@ -108,7 +130,8 @@ def cmd_validate(args) -> ExitCode:
         preset = scene.preset
         print(
             f"{path}: ok ({preset.realizations} realizations, {scene.spectrum.name} / {scene.solver.name} / "
-            f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps)"
+            f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
+            + (f", sweep of {points} points)" if scene.preset.sweep is not None else ")")
         )
     return worst
 
@@ -149,7 +172,49 @@ def cmd_plugins(args) -> ExitCode:
     return ExitCode.OK
 
 
+def cmd_tui(args) -> ExitCode:
+    if args.preset is not None:
+        from .preset import load_preset_file
+
+        load_preset_file(args.preset)  # a missing or unreadable file is a usage error, before the UI starts
+    if args.workers is not None and args.workers < 1:
+        raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
+    from .tui import run_app  # Textual is imported here only: headless commands never load it
+
+    return run_app(args.preset, presets_dir=args.presets, runs_dir=args.runs, workers=args.workers)
+
+
+def cmd_resume(args) -> ExitCode:
+    from .rundir import PRESET_FILE, RunDirectory
+
+    run_dir = Path(args.run_dir)
+    RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume
+    args.preset, args.out, args.resume, args.set, args.seed = str(run_dir / PRESET_FILE), str(run_dir), True, None, None
+    return cmd_run(args)
+
+
+def cmd_study(args) -> ExitCode:
+    from .study.command import run_command
+
+    return run_command(args)
+
+
 # ------------------------------------------------------------------ parser
+
+
+def _add_executor_options(parser) -> None:
+    parser.add_argument(
+        "--executor",
+        choices=("serial", "processes", "dask"),
+        help="where realizations run (default: processes, or serial for --workers 1)",
+    )
+    parser.add_argument(
+        "--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler (with --executor dask)"
+    )
+    parser.add_argument(
+        "--no-memory-check", action="store_true", help="skip the peak-memory estimate made before the run starts"
+    )
+
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -170,7 +235,17 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
     run.add_argument("--quiet", action="store_true", help="no progress on stderr")
     run.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    _add_executor_options(run)
+    run.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
     run.set_defaults(handler=cmd_run)
+
+    resume = sub.add_parser("resume", help="continue an interrupted run in DIR with the preset stored there")
+    resume.add_argument("run_dir", metavar="DIR", help="the output folder of the interrupted run")
+    resume.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in-process)")
+    resume.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    resume.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    _add_executor_options(resume)
+    resume.set_defaults(handler=cmd_resume)
 
     validate = sub.add_parser("validate", help="check presets and report every problem")
     validate.add_argument("presets", nargs="+", metavar="PRESET")
@@ -184,6 +259,24 @@ def build_parser() -> argparse.ArgumentParser:
     plugins = sub.add_parser("plugins", help="list installed plugins")
     plugins.add_argument("--json", action="store_true", help="as JSON")
     plugins.set_defaults(handler=cmd_plugins)
+
+    from . import predict, report  # their subcommands (issue 6)
+
+    report.add_parser(sub)
+    predict.add_parser(sub)
+
+    tui = sub.add_parser("tui", help="terminal UI: edit presets, run with live progress, compare results")
+    tui.add_argument("preset", nargs="?", help="preset YAML file to open (optional)")
+    tui.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
+    tui.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")
+    tui.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores; 1: in-process)")
+    tui.set_defaults(handler=cmd_tui)
+
+    from .study.command import add_arguments as add_study_arguments  # argparse only: cheap
+
+    study = sub.add_parser("study", help="error against cost of grid, realizations, steps, solver and tolerance")
+    add_study_arguments(study)
+    study.set_defaults(handler=cmd_study)
     return parser
 
 

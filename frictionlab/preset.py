@@ -68,6 +68,65 @@ class OutputSettings(_Strict):
     plot: bool = Field(True, description="Draw plot.png (xi against f with the fit).")
 
 
+SweepScalar = str | bool | int | float | None
+
+
+class SweepParameter(_Strict):
+    """The values one swept parameter takes: a list, or a range start..stop with num values."""
+
+    values: list[SweepScalar] | None = Field(None, description="Explicit values (YAML scalars); or give a range.")
+    start: float | None = Field(None, allow_inf_nan=False, description="First value of a range.")
+    stop: float | None = Field(None, allow_inf_nan=False, description="Last value of a range (included).")
+    num: int | None = Field(None, ge=1, le=100_000, description="Number of values of a range, >= 1.")
+    spacing: Literal["linear", "log"] = Field("linear", description="Range values evenly spaced in value or in log.")
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        ranged = {"start": self.start, "stop": self.stop, "num": self.num}
+        given = [k for k, v in ranged.items() if v is not None]
+        if self.values is not None and given:
+            raise ValueError(f"give either values or a range (start, stop, num), not both. Got values and {', '.join(given)}")
+        if self.values is None and not given:
+            raise ValueError("give values: [...] or a range start, stop, num")
+        if self.values is not None and not self.values:
+            raise ValueError("values must not be empty")
+        if given and len(given) < 3:
+            missing = [k for k in ranged if k not in given]
+            raise ValueError(f"a range needs start, stop and num; missing: {', '.join(missing)}")
+        if given and self.spacing == "log" and (self.start <= 0 or self.stop <= 0):
+            raise ValueError(f"a log range needs start > 0 and stop > 0. Got start={self.start!r}, stop={self.stop!r} instead")
+        return self
+
+    def points(self) -> list:
+        """The values, in order (ranges rounded to 12 significant digits so labels and --set stay clean)."""
+        if self.values is not None:
+            return list(self.values)
+        make = np.geomspace if self.spacing == "log" else np.linspace
+        raw = [float(f"{v:.12g}") for v in make(self.start, self.stop, self.num)]
+        whole = float(self.start).is_integer() and float(self.stop).is_integer()
+        return [int(v) if whole and v.is_integer() else v for v in raw]
+
+
+class SweepSettings(_Strict):
+    """A sweep: every point is the preset with the swept paths set (see frictionlab/sweep.py)."""
+
+    mode: Literal["grid", "zip"] = Field(
+        "grid", description="grid: every combination of the values; zip: the i-th values of every list together."
+    )
+    parameters: dict[str, SweepParameter] = Field(
+        min_length=1, description="Dotted preset path -> its values, e.g. spectrum.params.hurst: {values: [0.5, 1.0]}."
+    )
+
+    @model_validator(mode="after")
+    def _zip_lengths(self):
+        if self.mode == "zip":
+            lengths = {path: len(p.points()) for path, p in self.parameters.items()}
+            if len(set(lengths.values())) > 1:
+                listed = ", ".join(f"{path}: {n}" for path, n in lengths.items())
+                raise ValueError(f"mode zip needs the same number of values for every parameter. Got {listed} instead")
+        return self
+
+
 class Preset(_Strict):
     name: str = Field(min_length=1, description="Short name of the scene; names the default output folder.")
     description: str = Field("", description="What the scene is and where its numbers come from.")
@@ -83,6 +142,9 @@ class Preset(_Strict):
     loading: Loading = Field(description="The load sweep.")
     fit: FitSettings = Field(default_factory=FitSettings, description="Fit of xi = a + b ln f.")
     output: OutputSettings = Field(default_factory=OutputSettings, description="What is written.")
+    sweep: SweepSettings | None = Field(
+        None, description="Optional parameter sweep: `frictionlab run` then runs one ensemble per point."
+    )
 
 
 @dataclass(frozen=True)
@@ -93,6 +155,16 @@ class Scene:
     spectrum: SpectrumGenerator
     solver: ContactSolver
     slope: SlopeEstimator
+    # The 2D generator the preset named when the solver presses lines only: ``spectrum`` is
+    # then its MDR-equivalent line (SPEC section 7), and ``geometry`` says so.
+    surface: SpectrumGenerator | None = None
+
+    @property
+    def geometry(self) -> str:
+        """Which geometry runs: 'line', 'surface', or 'mdr-equivalent line of a surface'."""
+        if self.surface is not None:
+            return "mdr-equivalent line of a surface"
+        return "surface" if self.spectrum.dimension == 2 else "line"
 
     @functools.cached_property
     def loads(self) -> np.ndarray:
@@ -105,8 +177,10 @@ class Scene:
     def resolved(self) -> dict:
         """The preset with every default filled in, plugin params included."""
         data = self.preset.model_dump(mode="json")
+        if data.get("sweep") is None:
+            data.pop("sweep", None)  # a plain run (or one sweep point) has no sweep section
         for slot in PLUGIN_SLOTS:
-            plugin = getattr(self, slot)
+            plugin = self.surface if slot == "spectrum" and self.surface is not None else getattr(self, slot)
             data[slot] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
         return data
 
@@ -258,7 +332,36 @@ def build_scene(data: dict, registry: Registry | None = None, source: str | None
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in PLUGIN_SLOTS:
         getattr(preset, slot).name = plugins[slot].name
-    return Scene(preset=preset, **plugins)
+    return Scene(preset=preset, **_match_dimensions(plugins, source))
+
+
+def _match_dimensions(plugins: dict, source: str | None) -> dict:
+    """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
+    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError."""
+    spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
+    made = spectrum.dimension
+    shape = {1: "lines", 2: "surfaces"}
+    if made not in solver.dimensions:
+        line = getattr(spectrum, "equivalent_line", None)
+        if made != 2 or 1 not in solver.dimensions or line is None:
+            raise PresetError(
+                [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
+                 f"only, but spectrum {spectrum.name} makes {shape[made]}"
+                 + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
+                source=source,
+            )
+        try:
+            plugins = {**plugins, "spectrum": line(), "surface": spectrum}
+        except ValueError as exc:
+            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        made = 1
+    if made not in slope.dimensions:
+        raise PresetError(
+            [f"slope.name: {slope.name} takes {' and '.join(shape[d] for d in slope.dimensions)} only, "
+             f"but the {shape[made][:-1]} that runs here is {'2D' if made == 2 else '1D'}"],
+            source=source,
+        )
+    return plugins
 
 
 def _plugin_problems(registry: Registry, slot: str, kind: str, choice: PluginChoice):
