@@ -34,6 +34,7 @@ from frictionlab import engine
 from frictionlab.executors import make_executor
 from frictionlab.preset import load_scene
 from frictionlab.runner import run_to_folder
+from bench_fig2 import best_of  # the same timing rule in every benchmark (run as a script: its folder is on sys.path)
 
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
 
@@ -55,15 +56,6 @@ def line_scene(points: int, steps: int = 400):
     return load_scene(
         PRESET, [f"spectrum.params.points={points}", f"spectrum.params.length={float(points)}", f"loading.steps={steps}"]
     )
-
-
-def best_of(repeat: int, work) -> float:
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def per_realization(scene, count: int, repeat: int) -> float:

@@ -30,10 +30,11 @@ class ProgressReporter:
         self.last_draw = 0.0
         self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
         self.failed = 0
+        self.resumed = 0  # restored on a resume: done before this process started
 
     def _line(self, done: int, total: int) -> str:
         elapsed = time.perf_counter() - self.started
-        rate = done / elapsed if elapsed > 0 else 0.0
+        rate = (done - self.resumed) / elapsed if elapsed > 0 else 0.0
         left = (total - done) / rate if rate > 0 else float("nan")
         eta = _duration(left) if rate > 0 else "?"
         failed = f", {self.failed} failed" if self.failed else ""
@@ -42,9 +43,11 @@ class ProgressReporter:
     @hookimpl
     def run_started(self, run):
         self.started = time.perf_counter()
+        self.resumed = getattr(run, "resumed", 0)
         preset = run.scene.preset
+        restored = f" ({self.resumed} restored from the run folder)" if self.resumed else ""
         self.stream.write(
-            f"{preset.name}: {run.total} realizations of {run.scene.spectrum.name} lines, "
+            f"{preset.name}: {run.total} realizations of {run.scene.spectrum.name} lines{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)\n"
         )
         self.stream.flush()

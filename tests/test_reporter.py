@@ -29,3 +29,16 @@ def test_log_file_gets_one_plain_line_per_tenth(make_scene):
     lines = stream.getvalue().split("\n")[:-1]
     assert [line.split(" ")[0] for line in lines[1:]] == [f"{2 * i}/20" for i in range(1, 11)]
     assert "\r" not in stream.getvalue()
+
+
+def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make_scene):
+    import time
+    from types import SimpleNamespace
+
+    stream = io.StringIO()
+    reporter = ProgressReporter(stream)
+    reporter.run_started(run=SimpleNamespace(scene=make_scene({}), total=10, workers=1, resumed=8))
+    assert "(8 restored from the run folder)" in stream.getvalue()
+    reporter.started = time.perf_counter() - 2.0  # 2 s for the 2 realizations left: 1 per second
+    line = reporter._line(10, 10)
+    assert ", 1.0/s," in line, line

@@ -30,10 +30,10 @@ import numpy as np
 import scipy.fft
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, PluginParams, Profile
+from frictionlab import ContactCurve, ContactSolver, Profile
 from frictionlab.plugin import Control
 
-from .springs import _check_control, _check_loads, effective_modulus
+from .springs import ElasticParams, _check_control, _check_loads, elastic_stiffness
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
 
@@ -259,17 +259,7 @@ class PeriodicBEM(ContactSolver):
 
     references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER,)
 
-    class Params(PluginParams):
-        youngs_modulus: float = Field(
-            1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body"
-        )
-        poisson_ratio: float = Field(
-            0.0,
-            gt=-1.0,
-            le=0.5,
-            allow_inf_nan=False,
-            description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
-        )
+    class Params(ElasticParams):
         tolerance: float = Field(
             1e-8,
             ge=1e-14,
@@ -283,7 +273,7 @@ class PeriodicBEM(ContactSolver):
 
     def stiffness(self) -> float:
         """E* = E / (1 - nu^2), so f = F / (E* h L) matches the MDR springs."""
-        return effective_modulus(self.params.youngs_modulus, self.params.poisson_ratio)
+        return elastic_stiffness(self.params)
 
     def _checked(self, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
         heights = np.asarray(profile.heights, dtype=float)

@@ -33,7 +33,7 @@ MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality
 # errors of the bound itself. Extra candidates cost nothing but sorting time.
 _BOUND_SLACK = 16 * np.finfo(float).eps
 
-__all__ = ["BisectionSprings", "MDRSprings", "SpringRow", "WinklerSprings", "effective_modulus"]
+__all__ = ["BisectionSprings", "ElasticParams", "MDRSprings", "SpringRow", "WinklerSprings", "effective_modulus"]
 
 
 def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
@@ -45,6 +45,23 @@ def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
             "the effective modulus E/(1 - nu^2) is not finite"
         )
     return youngs_modulus / denominator
+
+
+class ElasticParams(PluginParams):
+    """The elastic body of MDR and of the exact (BEM) solvers: E and nu, giving E*."""
+
+    youngs_modulus: float = Field(1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body")
+    poisson_ratio: float = Field(
+        0.0,
+        gt=-1.0,
+        le=0.5,
+        allow_inf_nan=False,
+        description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
+    )
+
+
+def elastic_stiffness(params: ElasticParams) -> float:
+    return effective_modulus(params.youngs_modulus, params.poisson_ratio)
 
 
 # --------------------------------------------------------------- validation
@@ -215,21 +232,11 @@ class MDRSprings(SpringRow):
     # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene)
     dimensions: ClassVar[tuple[int, ...]] = (1,)
 
-    class Params(PluginParams):
-        youngs_modulus: float = Field(
-            1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body"
-        )
-        poisson_ratio: float = Field(
-            0.0,
-            gt=-1.0,
-            le=0.5,
-            allow_inf_nan=False,
-            description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
-        )
+    Params = ElasticParams
 
     def stiffness(self) -> float:
         """E* = E / (1 - nu^2)."""
-        return effective_modulus(self.params.youngs_modulus, self.params.poisson_ratio)
+        return elastic_stiffness(self.params)
 
 
 class WinklerSprings(SpringRow):
