@@ -33,7 +33,7 @@ from pydantic import Field
 from frictionlab import ContactCurve, ContactSolver, Profile
 from frictionlab.plugin import Control
 
-from .springs import ElasticParams, _check_control, _check_loads, elastic_stiffness
+from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
 
@@ -275,32 +275,14 @@ class PeriodicBEM(ContactSolver):
         """E* = E / (1 - nu^2), so f = F / (E* h L) matches the MDR springs."""
         return elastic_stiffness(self.params)
 
-    def _checked(self, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
-        heights = np.asarray(profile.heights, dtype=float)
-        if heights.ndim not in self.dimensions or heights.size == 0:
-            shape = "(N,)" if self.dimensions == (1,) else "(Ny, Nx)"
-            raise ValueError(
-                f"{self.name} presses a {'line' if self.dimensions == (1,) else 'surface'}: heights must have "
-                f"shape {shape} with at least one point. Got shape {heights.shape} instead."
-            )
-        if not np.isfinite(heights).all():
-            raise ValueError("heights must be finite")
-        slopes = np.asarray(slopes, dtype=float)
-        if slopes.shape != heights.shape:
-            raise ValueError(
-                f"slopes must have the shape of the heights {heights.shape}. Got {slopes.shape} instead."
-            )
-        spacing = float(profile.spacing)
-        if not (np.isfinite(spacing) and spacing > 0.0):
-            raise ValueError(f"profile spacing must be finite and positive. Got {spacing!r} instead.")
-        return heights, slopes, spacing
-
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
     ) -> ContactCurve:
         _check_control(control)
         loads = _check_loads(loads, control)
-        heights, slopes, spacing = self._checked(profile, slopes)
+        heights, slopes, spacing = check_profile(self, profile, slopes)
+        if not np.isfinite(heights).all():
+            raise ValueError("heights must be finite")
         points = heights.size
         depth = heights.max() - heights
         scale = float(depth.max())  # the height range s

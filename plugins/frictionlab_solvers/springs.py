@@ -90,14 +90,16 @@ def _check_loads(loads, control: str) -> np.ndarray:
     return loads
 
 
-def _check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
-    """Heights and slopes flattened (views when contiguous), and the spacing."""
+def check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
+    """Heights and slopes as float arrays of the profile's shape, and the spacing;
+    a shape the solver cannot press is an error naming what it presses."""
     heights = np.asarray(profile.heights, dtype=float)
     if heights.ndim not in solver.dimensions or heights.size == 0:
         shapes = " or ".join({1: "(N,)", 2: "(Ny, Nx)"}[d] for d in solver.dimensions)
+        what = " or ".join({1: "a line", 2: "a surface"}[d] for d in solver.dimensions)
         raise ValueError(
-            f"{solver.name} presses {'a line' if solver.dimensions == (1,) else 'a line or a surface'}: "
-            f"heights must have shape {shapes} with at least one point. Got shape {heights.shape} instead."
+            f"{solver.name} presses {what}: heights must have shape {shapes} with at least one point. "
+            f"Got shape {heights.shape} instead."
         )
     slopes = np.asarray(slopes, dtype=float)
     if slopes.shape != heights.shape:
@@ -107,15 +109,16 @@ def _check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.
     spacing = float(profile.spacing)
     if not (np.isfinite(spacing) and spacing > 0.0):
         raise ValueError(f"profile spacing must be finite and positive. Got {spacing!r} instead.")
-    return heights.ravel(), slopes.ravel(), spacing
+    return heights, slopes, spacing
 
 
 def _prepare(solver: ContactSolver, profile: Profile, loads, control: str, slopes):
     """Checked (loads, flat heights, flat slopes, spring stiffness K = k dx^ndim) for a sweep."""
     _check_control(control)
     loads = _check_loads(loads, control)
-    ndim = np.ndim(profile.heights)
-    heights, slopes, spacing = _check_profile(solver, profile, slopes)
+    heights, slopes, spacing = check_profile(solver, profile, slopes)
+    ndim = heights.ndim
+    heights, slopes = heights.ravel(), slopes.ravel()  # views when contiguous
     spring = solver.stiffness() * spacing**ndim
     if not (np.isfinite(spring) and spring > 0.0):
         raise ValueError(f"spring stiffness k dx^{ndim} must be finite and positive. Got {spring!r} instead.")
