@@ -216,7 +216,6 @@ def _add_executor_options(parser) -> None:
     )
 
 
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="frictionlab",
