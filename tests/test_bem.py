@@ -139,6 +139,21 @@ def _pressure(solver, z, force, dx):
     return p * unit
 
 
+def test_the_cg_carries_the_requested_load_whatever_pressure_it_starts_from():
+    from frictionlab_solvers.bem import ConstrainedCG
+
+    x = np.arange(64)
+    depth = 1.0 - np.cos(2 * np.pi * x / 64)  # one touching crest
+    depth /= depth.max()
+    answers = []
+    for start in (np.full(64, 0.01), np.full(64, 5.0), np.zeros(64)):
+        # the same converged pressure however far the start's mean is from the load
+        p, *_ = ConstrainedCG(depth).solve(start, mean_pressure=0.01, tolerance=1e-11, max_iterations=10_000)
+        assert p.mean() == pytest.approx(0.01, rel=1e-12)
+        answers.append(p.copy())
+    assert np.allclose(answers[1], answers[0], rtol=0, atol=1e-9) and np.allclose(answers[2], answers[0], rtol=0, atol=1e-9)
+
+
 # ------------------------------------------------------------------ Hertz
 
 

@@ -120,6 +120,12 @@ class ConstrainedCG:
         restart = True
         previous_norm = 1.0
         level = approach
+        if force_control:  # the load is part of the answer: start from a pressure that carries it
+            total = float(p.mean())
+            if total > 0.0:
+                p *= mean_pressure / total
+            else:
+                p.fill(mean_pressure)
         self.displacement(p, w)
         exact, since_exact = True, 0
         iteration = 0
