@@ -5,6 +5,7 @@ files it writes against what ``frictionlab run`` accepts."""
 import asyncio
 import functools
 import json
+import re
 import subprocess
 import sys
 from typing import ClassVar, Literal
@@ -21,6 +22,7 @@ from frictionlab.errors import ExitCode, PresetError
 from frictionlab.fit import least_squares
 from frictionlab.preset import build_scene, load_scene
 from frictionlab.runner import run_to_folder
+from frictionlab.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.live import LiveListener
 from frictionlab.tui.form import PresetForm
@@ -310,6 +312,86 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
     assert summary["realizations"]["done"] == outcome.done
     with np.load(out_dir / "realizations.npz") as arrays:
         assert arrays["xi"].shape[0] == outcome.done
+
+
+SWEEP = merge(
+    TINY,
+    {
+        "name": "tinysweep",
+        "realizations": 4,
+        "spectrum": {"params": {"points": 256}},
+        "loading": {"steps": 8},
+        "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7, 0.9]}}},
+    },
+)
+
+
+def _numbers(cell):
+    return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", str(cell))]
+
+
+@sync
+async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, registry):
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_sweep is not None)
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        columns = [str(c.label) for c in table.columns.values()]
+        point_text = str(app.query_one("#sweep-point", Static).render())
+        out_dir = app.last_out_dir
+    assert app.last_sweep.status == "completed" and point_text.startswith("completed: 3/3 points")
+    assert out_dir.parent.name == "runs" and out_dir.name.startswith("tinysweep-")
+    assert columns == ["#", "hurst", "status", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+    rows = read_table(out_dir / "sweep.csv")
+    assert len(cells) == len(rows) == 3
+    for shown, row in zip(cells, rows, strict=True):
+        number, hurst, status, a, b, r2, contacts = shown
+        assert int(number) == int(row["point"]) and float(hurst) == float(row["spectrum.params.hurst"])
+        for cell, name in ((a, "a"), (b, "b")):  # the estimate to 4 decimals, its interval to 3
+            assert _numbers(cell)[0] == pytest.approx(float(row[name]), abs=5e-5)
+            assert _numbers(cell)[1:] == pytest.approx([float(row[f"{name}_lo"]), float(row[f"{name}_hi"])], abs=5e-4)
+        assert _numbers(r2) == pytest.approx([float(row["r2"])], abs=5e-4)
+        assert _numbers(contacts) == pytest.approx([float(row["contact_first"]), float(row["contact_last"])], rel=5e-3)
+        assert status == row["status"] == "completed"
+    # the same numbers as a headless sweep of the same preset
+    headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", workers=1)
+    assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_sweep.results] == [
+        (r.outcome.fit.a, r.outcome.fit.b) for r in headless.results
+    ]
+    assert [r.point.scene.spectrum.params.hurst for r in headless.results] == [0.5, 0.7, 0.9]
+    assert (out_dir / "sweep.png").stat().st_size > 0
+    assert {p.name for p in (out_dir / "points").iterdir()} == {"01-hurst-0.5", "02-hurst-0.7", "03-hurst-0.9"}
+
+
+@sync
+async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders, registry):
+    big = merge(SWEEP, {"realizations": 100_000})
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(big, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        await pilot.press("c")
+        await wait_until(pilot, lambda: app.last_sweep is not None)
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        out_dir = app.last_out_dir
+    assert app.last_sweep.status == "interrupted"
+    rows = read_table(out_dir / "sweep.csv")
+    assert [r["status"] for r in rows] == ["cancelled", "pending", "pending"]
+    assert [c[2] for c in cells] == ["cancelled"]  # only finished points get a row
+    first = app.last_sweep.results[0].outcome
+    assert 3 <= first.done < 100_000 and int(rows[0]["done"]) == first.done
+    with np.load(out_dir / rows[0]["folder"] / "realizations.npz") as arrays:
+        assert arrays["xi"].shape[0] == first.done
+    assert not (out_dir / "points" / "02-hurst-0.7").exists()
 
 
 def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate(registry):

@@ -1,7 +1,8 @@
 """The frictionlab terminal UI: presets, edit form, live run, past results.
 
 The engine runs in a thread worker through ``runner.run_to_folder`` (the path
-``frictionlab run`` takes, so the same files are written). The ``LiveListener``
+``frictionlab run`` takes, so the same files are written); a preset with a
+``sweep`` section runs through ``sweep.run_sweep`` the same way. The ``LiveListener``
 hands snapshots over with ``post_message`` (thread safe); ``RunProgress``
 messages coalesce in the queue, so a fast run cannot flood the UI.
 """
@@ -25,6 +26,7 @@ from ..preset import build_scene, load_preset_file
 from ..registry import default_registry
 from ..reporter import _duration
 from ..runner import run_to_folder
+from ..sweep import plan_sweep, run_sweep
 from .chart import Series
 from .fields import preset_from_defaults
 from .folders import (
@@ -40,6 +42,7 @@ from .folders import (
 from .form import PresetForm
 from .live import LiveListener, Snapshot
 from .screens import Chart, ConfirmScreen, HelpScreen, NewPresetScreen, PathScreen
+from .sweepview import SweepPoster, point_line, table_cells, table_columns
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
 STATUS_MARKS = {"completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!"}
@@ -63,6 +66,22 @@ class RunDone(Message):
     def __init__(self, scene, outcome, out_dir: Path):
         super().__init__()
         self.scene = scene
+        self.outcome = outcome
+        self.out_dir = out_dir
+
+
+class SweepEvent(Message):
+    """A sweep point started (``result`` None) or finished."""
+
+    def __init__(self, sweep, kind: str, point, result):
+        super().__init__()
+        self.sweep, self.kind, self.point, self.result = sweep, kind, point, result
+
+
+class SweepDone(Message):
+    def __init__(self, sweep, outcome, out_dir: Path):
+        super().__init__()
+        self.sweep = sweep
         self.outcome = outcome
         self.out_dir = out_dir
 
@@ -158,11 +177,13 @@ class RunPane(Vertical, can_focus=True):
 
     def compose(self) -> ComposeResult:
         yield Static("No run yet: open a preset and press Ctrl+R.", id="run-title")
+        yield Static("", id="sweep-point")
         yield ProgressBar(id="run-bar", show_eta=False)
         yield Static("", id="run-stats")
         with Horizontal(id="run-body"):
             yield Chart(id="run-chart")
             yield Static("", id="run-fit")
+        yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="none")
         yield Static("", id="run-error")
 
     def action_start(self) -> None:
@@ -237,6 +258,7 @@ class FrictionlabApp(App):
         self.last_out_dir: Path | None = None
         self.run_error: str | None = None
         self.last_snapshot: Snapshot | None = None
+        self.last_sweep = None  # sweep.SweepOutcome of the last sweep run here
 
     # ------------------------------------------------------------ layout
 
@@ -515,6 +537,10 @@ class FrictionlabApp(App):
             return
         try:
             scene = build_scene(data, registry=self.registry)
+            sweep = None
+            if getattr(scene.preset, "sweep", None) is not None:  # every point is checked before any runs
+                source = str(self.draft_path) if self.draft_path else None
+                sweep = plan_sweep(data, registry=self.registry, source=source)
         except PresetError as exc:
             count = len(exc.problems)
             self.notify(
@@ -524,17 +550,15 @@ class FrictionlabApp(App):
             )
             self.action_show_tab("edit")
             return
-        if getattr(scene.preset, "sweep", None) is not None:
-            self.notify(
-                "This preset has a sweep section: run it with `frictionlab run` (the TUI runs one ensemble).",
-                title="Cannot run here",
-                severity="warning",
-            )
-            return
         out_dir = new_run_folder(self.runs_dir, scene.preset.name)
         self.cancel_event = threading.Event()
         self.run_error = None
+        self.last_outcome = self.last_sweep = None
         pane = self.query_one("#run-pane", RunPane)
+        pane.set_class(sweep is not None, "-sweep")
+        if sweep is not None:
+            self._start_sweep(sweep, out_dir, pane)
+            return
         preset = scene.preset
         pane.query_one("#run-title", Static).update(
             f"[b]{preset.name}[/b]: {preset.realizations} realizations, {preset.loading.steps} "
@@ -562,6 +586,73 @@ class FrictionlabApp(App):
             self.post_message(RunCrashed(f"internal error: {type(exc).__name__}: {exc}"))
         else:
             self.post_message(RunDone(scene, outcome, out_dir))
+
+    def _start_sweep(self, sweep, out_dir: Path, pane: RunPane) -> None:
+        preset = sweep.points[0].scene.preset
+        pane.query_one("#run-title", Static).update(
+            f"[b]{sweep.name}[/b]: {len(sweep.points)} points x {preset.realizations} realizations"
+            f" -> {out_dir.parent.name}/{out_dir.name}"
+        )
+        pane.query_one("#sweep-point", Static).update(f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
+        pane.query_one("#run-bar", ProgressBar).update(total=preset.realizations, progress=0)
+        pane.query_one("#run-stats", Static).update("")
+        pane.query_one("#run-error", Static).update("")
+        table = pane.query_one("#sweep-table", DataTable)
+        table.clear(columns=True)
+        table.add_columns(*table_columns(sweep))
+        self.action_show_tab("run")
+        self.run_worker(
+            partial(self._sweep_in_thread, sweep, out_dir, self.cancel_event),
+            thread=True,
+            group="run",
+            exit_on_error=False,
+        )
+
+    def _sweep_in_thread(self, sweep, out_dir: Path, cancel: threading.Event) -> None:
+        poster = SweepPoster(lambda kind, point, result: self.post_message(SweepEvent(sweep, kind, point, result)))
+
+        def point_listeners(point):
+            return [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))]
+
+        try:
+            outcome = run_sweep(
+                sweep,
+                out_dir,
+                workers=self.run_workers,
+                listeners=[poster],
+                point_listeners=point_listeners,
+                cancel=cancel,
+            )
+        except OSError as exc:
+            self.post_message(RunCrashed(f"cannot write results to {out_dir}: {exc}"))
+        except Exception as exc:  # an internal error: shown, never a crash of the UI
+            self.post_message(RunCrashed(f"internal error: {type(exc).__name__}: {exc}"))
+        else:
+            self.post_message(SweepDone(sweep, outcome, out_dir))
+
+    def on_sweep_event(self, message: SweepEvent) -> None:
+        pane = self.query_one("#run-pane", RunPane)
+        if message.kind == "started":
+            total = message.point.scene.preset.realizations
+            pane.query_one("#sweep-point", Static).update(point_line(message.sweep, message.point))
+            pane.query_one("#run-bar", ProgressBar).update(total=total, progress=0)
+            return
+        result = message.result
+        pane.query_one("#sweep-table", DataTable).add_row(*table_cells(message.sweep, result))
+        if result.error:
+            pane.query_one("#run-error", Static).update(f"[red]point {result.point.number}: {result.error}[/red]")
+
+    def on_sweep_done(self, message: SweepDone) -> None:
+        outcome = message.outcome
+        self.cancel_event = None
+        self.last_sweep, self.last_out_dir = outcome, message.out_dir
+        finished = sum(r.status != "pending" for r in outcome.results)
+        pane = self.query_one("#run-pane", RunPane)
+        pane.query_one("#sweep-point", Static).update(
+            f"{outcome.status}: {finished}/{len(outcome.results)} points in {_duration(outcome.elapsed)}"
+            " (sweep.csv, sweep.png)"
+        )
+        self.notify(f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points")
 
     def action_cancel_run(self) -> None:
         if not self.running:

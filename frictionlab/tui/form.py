@@ -10,9 +10,9 @@ from __future__ import annotations
 import copy
 
 import yaml
-from rich.markup import escape
 
 from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.content import Content
 from textual.message import Message
 from textual.validation import ValidationResult, Validator
 from textual.widget import Widget
@@ -149,7 +149,9 @@ class PresetForm(VerticalScroll):
             )
         else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
             shown = "(none)" if value in (MISSING, None) else _flow(value)
-            widget = Static(f"{escape(shown)}  [dim](edit in the YAML)[/dim]", id=spec.widget_id, classes="other")
+            # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
+            note = Content.assemble(shown, "  ", ("(edit in the YAML)", "dim"))
+            widget = Static(note, id=spec.widget_id, classes="other")
         if spec.kind == "bool":
             self._seen[spec.widget_id] = bool(current)
         elif spec.kind == "choice":

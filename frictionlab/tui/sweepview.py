@@ -1,0 +1,66 @@
+"""What the Run tab shows of a sweep: the point line and one table row per finished point.
+
+No Textual here: the app runs ``sweep.run_sweep`` in its thread worker and gives
+it a ``SweepPoster`` (the sweep listener protocol), which only forwards the
+events to ``post`` (the app's thread-safe ``post_message`` wrapped by the app).
+The cells are formatted from ``PointResult.row()``, the same dict ``sweep.csv``
+is written from.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
+
+
+class SweepPoster:
+    """A ``run_sweep`` listener: calls ``post(kind, point, result)`` from the run thread."""
+
+    def __init__(self, post: Callable[[str, SweepPoint, PointResult | None], None]):
+        self.post = post
+
+    def point_started(self, sweep: Sweep, point: SweepPoint) -> None:
+        self.post("started", point, None)
+
+    def point_finished(self, sweep: Sweep, point: SweepPoint, result: PointResult) -> None:
+        self.post("finished", point, result)
+
+
+def short_name(path: str) -> str:
+    return path.rsplit(".", 1)[-1]
+
+
+def point_line(sweep: Sweep, point: SweepPoint) -> str:
+    """``point 3/8: hurst=0.7``"""
+    values = ", ".join(f"{short_name(p)}={yaml_scalar(v)}" for p, v in point.values.items())
+    return f"point {point.number}/{len(sweep.points)}: {values}"
+
+
+def table_columns(sweep: Sweep) -> list[str]:
+    return ["#", *(short_name(p) for p in sweep.paths), "status", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+
+
+def _estimate(row: dict[str, Any], name: str) -> str:
+    value, low, high = row[name], row[f"{name}_lo"], row[f"{name}_hi"]
+    if value is None:
+        return "-"
+    interval = "" if low is None or high is None else f" [{low:.3f},{high:.3f}]"  # 80 columns
+    return f"{value:.4f}{interval}"
+
+
+def table_cells(sweep: Sweep, result: PointResult) -> list[str]:
+    """One row of the table: the swept values, the point's status, a and b with
+    their intervals, R^2, points in contact at the first .. last load."""
+    row = result.row()
+    contacts = "-" if row["contact_first"] is None else f"{row['contact_first']:.3g}..{row['contact_last']:.3g}"
+    return [
+        str(result.point.number),
+        *(yaml_scalar(result.point.values[p]) for p in sweep.paths),
+        row["status"],
+        _estimate(row, "a"),
+        _estimate(row, "b"),
+        "-" if row["r2"] is None else f"{row['r2']:.3f}",
+        contacts,
+    ]
