@@ -108,27 +108,47 @@ def refit(f, per, method: str, *, bootstrap: int, confidence: float, seed: int) 
 # ------------------------------------------------------------------ normalisation readings
 
 
-def calibrated_rms_height(data: dict, targets: dict[float, float] = COUNT_TARGETS, workers=None) -> float:
-    """h that gives the target mean contact counts, as tools/calibrate_rms_height.py finds it:
-    the count depends on F / (E* h) only (fixed amplitudes), so one ensemble at h = 1 over a
-    wide force range gives n(F/h) for every h; least squares in log over the targets."""
-    from scipy.optimize import minimize_scalar
+@dataclass(frozen=True)
+class CountCurve:
+    """Mean contact count against F / h, from one ensemble at h = 1: with fixed
+    amplitudes the count depends on F / (E* h) only, so this serves every h."""
 
+    log_g: np.ndarray  # log(F / h)
+    log_n: np.ndarray  # log(mean count), non-decreasing in log_g
+
+    def mean_count(self, force: float, h: float) -> float:
+        return math.exp(float(np.interp(math.log(force / h), self.log_g, self.log_n)))
+
+    def rms_height_alone(self, force: float, count: float) -> float:
+        """The h that gives ``count`` at ``force`` (the curve inverted)."""
+        return force / math.exp(float(np.interp(math.log(count), self.log_n, self.log_g)))
+
+    def fit_rms_height(self, targets: dict[float, float]) -> float:
+        """Least squares in log count over the targets."""
+        from scipy.optimize import minimize_scalar
+
+        def misfit(log_h):
+            return sum((np.interp(math.log(F) - log_h, self.log_g, self.log_n) - math.log(n)) ** 2 for F, n in targets.items())
+
+        alone = [math.log(self.rms_height_alone(F, n)) for F, n in targets.items()]
+        best = minimize_scalar(misfit, bounds=(min(alone) - 1e-9, max(alone) + 1e-9), method="bounded")
+        return math.exp(best.x)
+
+
+def count_curve(data: dict, workers=None) -> CountCurve:
+    """One ensemble of the preset ``data`` at h = 1 over a wide log force range."""
     wide = [
         "spectrum.params.rms_height=1.0", "spectrum.params.c0=null", "loading.start=1.0e-6", "loading.stop=1.0e+3",
         "loading.steps=2000", "loading.spacing=log", "fit.bootstrap=0", "sweep=null",
     ]  # fmt: skip
-    scene = build_scene(apply_overrides(data, wide))
-    outcome = engine.run(scene, workers=workers)
-    log_g = np.log(outcome.loads)  # F / h at h = 1
-    log_n = np.log(outcome.contact_count)
+    outcome = engine.run(build_scene(apply_overrides(data, wide)), workers=workers)
+    return CountCurve(np.log(outcome.loads), np.log(outcome.contact_count))
 
-    def misfit(log_h):
-        return sum((np.interp(math.log(F) - log_h, log_g, log_n) - math.log(n)) ** 2 for F, n in targets.items())
 
-    alone = [math.log(F) - float(np.interp(math.log(n), log_n, log_g)) for F, n in targets.items()]
-    best = minimize_scalar(misfit, bounds=(min(alone) - 1e-9, max(alone) + 1e-9), method="bounded")
-    return float(f"{math.exp(best.x):.3g}")
+def calibrated_rms_height(data: dict, targets: dict[float, float] = COUNT_TARGETS, workers=None) -> float:
+    """h that gives the target mean contact counts (3 significant figures), as
+    tools/calibrate_rms_height.py finds it."""
+    return float(f"{count_curve(data, workers).fit_rms_height(targets):.3g}")
 
 
 @dataclass(frozen=True)
