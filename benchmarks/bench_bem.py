@@ -10,9 +10,13 @@ noisy shared machine shifts the figures together:
 * a 20-load sweep (contact fraction about 2 .. 30 %) warm-started, against
   20 times one cold load of the sweep's middle;
 * bem-halfplane on an 8192-point line, one load and a 20-load sweep;
-* the same 512 x 512 load with FFTs on all cores (``FFT_WORKERS = -1``).
+* the same 512 x 512 load with FFTs on all cores (``FFT_WORKERS = -1``);
+* the warm-start law (``--law``): CG iterations of a start from the solution
+  at a nearby load against a cold start, for load steps 1e-4 .. 50 % and
+  tolerances 1e-4 .. 1e-8 (iteration counts are deterministic, so this table
+  does not depend on the machine's load), and a sweep over a narrow load range.
 
-    python benchmarks/bench_bem.py [--repeat 3] [--points 512]
+    python benchmarks/bench_bem.py [--repeat 3] [--points 512] [--law] [--law-points 256]
 """
 
 from __future__ import annotations
@@ -62,6 +66,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3, help="best of this many runs")
     parser.add_argument("--points", type=int, default=512, help="surface side (pixels)")
     parser.add_argument("--line-points", type=int, default=8192, help="line length (pixels)")
+    parser.add_argument("--law", action="store_true", help="also print the warm-start law (iteration counts)")
+    parser.add_argument("--law-points", type=int, default=256, help="surface side for the warm-start law")
     args = parser.parse_args()
     rng = np.random.default_rng(np.random.SeedSequence(2024))
     n = args.points
@@ -119,6 +125,42 @@ def main() -> None:
     finally:
         bem.FFT_WORKERS = saved
     print(f"  512 x 512 at 10 % with FFT_WORKERS = -1: {threaded:7.3f} s  ({singles[0.1] / threaded:4.2f} x the default)")
+
+    if args.law:
+        narrow = loads_for(surface, np.geomspace(0.1, 0.11, 20))
+        narrow_curve = solver.solve(profile, narrow, "force", slopes)
+        total = int(narrow_curve.extras["iterations"].sum())
+        print(
+            f"  20-load sweep within 10 % of one load (contact {narrow_curve.contact_fraction[0]:.1%} .. "
+            f"{narrow_curve.contact_fraction[-1]:.1%}): {total} iterations = "
+            f"{total / int(curve_mid.extras['iterations'][0]):4.1f} x one load"
+        )
+        warm_start_law(power_law((args.law_points,) * 2, 0.8, 4, rng))
+
+
+def warm_start_law(surface: np.ndarray) -> None:
+    """Iterations from the converged solution at load W, scaled to W (1 + step),
+    against the solver's cold start at W (1 + step): what a warm start saves
+    depends on how close the loads are, and little on the tolerance."""
+    depth = surface.max() - surface
+    depth /= depth.max()
+    cg = bem.ConstrainedCG(depth)
+    load = loads_for(surface, [0.1])[0] / surface.size  # scaled mean pressure, about 10 % contact
+    exact, *_ = cg.solve(bem._cold_start(depth, load), mean_pressure=load, tolerance=1e-12, max_iterations=100_000)
+    exact = exact.copy()
+    steps = (1e-4, 1e-3, 1e-2, 0.05, 0.15, 0.5)
+    print(f"warm-start law, {surface.shape[0]} x {surface.shape[1]}, about 10 % contact: "
+          "CG iterations warm / cold at load W (1 + step)")
+    print("  tolerance " + "".join(f"{step:>12g}" for step in steps))
+    for tolerance in (1e-4, 1e-6, 1e-8):
+        cells = []
+        for step in steps:
+            target = load * (1 + step)
+            solve = lambda start: cg.solve(start, mean_pressure=target, tolerance=tolerance, max_iterations=100_000)[2]
+            warm = solve(exact * (1 + step))
+            cold = solve(bem._cold_start(depth, target))
+            cells.append(f"{warm:>5d} / {cold:<4d}")
+        print(f"  {tolerance:9g} " + "".join(f"{cell:>12s}" for cell in cells))
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@ with its figures, the study's numbers beside frictionlab's (SPEC section 7).
 
 With ``--readings`` it also runs readings of the study's method (cut-off,
 amplitudes, slope estimator, averaging over realizations, normalisation per H)
-and tabulates what each gives. Every reading is a preset plus ``--set``
+and tabulates what each gives, and reruns Fig. 5 with h calibrated at each H
+(``fig5_calibrated_readings``). Every reading is a preset plus ``--set``
 options (printed in the table, so any row can be rerun with ``frictionlab run``),
 except the averaging readings, which re-average the default run's
 ``realizations.npz`` (``average_curve``).
@@ -187,6 +188,13 @@ READINGS = (
 )  # fmt: skip
 
 
+def fig5_calibrated_readings(sweep) -> tuple[Reading, ...]:
+    """Fig. 5 with h calibrated at each H: one reading per point of the sweep, the
+    point's own ``--set`` options with h fitted to Fig. 2's counts on its own lines."""
+    return tuple(Reading("fig5", f"h calibrated at {point.describe()}", ("sweep=null", *point.assignments),
+                         calibrate=True) for point in sweep.points)  # fmt: skip
+
+
 # ------------------------------------------------------------------ running
 
 
@@ -213,6 +221,7 @@ class ReadingRow:
     counts: tuple[float, float]
     loads: tuple[float, float]
     folder: Path | None
+    rms_height: float | None = None  # the calibrated h, when the reading calibrates
 
 
 def find_presets(presets_dir: str | Path | None) -> Path:
@@ -244,7 +253,8 @@ def run_figures(presets: Path, out_dir: Path, *, workers=None) -> list[FigureRun
     return runs
 
 
-def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings=READINGS) -> list[ReadingRow]:
+def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings=READINGS,
+                 folder_name="readings") -> list[ReadingRow]:  # fmt: skip
     by_key = {run.study.key: run for run in runs}
     rows = []
     for number, reading in enumerate(readings, start=1):
@@ -254,6 +264,7 @@ def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings
         if reading.same_c0_as:
             c0 = by_key[reading.same_c0_as].scene.spectrum.c0()
             overrides += ["spectrum.params.rms_height=null", f"spectrum.params.c0={float(f'{c0:.6g}')!r}"]
+        h = None
         if reading.calibrate:
             h = calibrated_rms_height(apply_overrides(data, overrides), workers=workers)
             overrides.append(f"spectrum.params.rms_height={h!r}")
@@ -261,14 +272,14 @@ def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings
             scene, outcome, folder = base.scene, base.outcome, base.folder
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
-            folder = out_dir / "readings" / f"{number:02d}-{reading.figure}"
+            folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
             outcome, _ = run_to_folder(scene, folder, workers=workers)
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip
         counts = (float(outcome.contact_count[0]), float(outcome.contact_count[-1]))
         loads = (float(outcome.loads[0]), float(outcome.loads[-1]))
-        rows.append(ReadingRow(reading, overrides, fit.a, fit.b, fit.a_ci, fit.b_ci, fit.r2, counts, loads, folder))
+        rows.append(ReadingRow(reading, overrides, fit.a, fit.b, fit.a_ci, fit.b_ci, fit.r2, counts, loads, folder, h))
     return rows
 
 
@@ -314,27 +325,76 @@ def plot_figure(run: FigureRun, fh, dpi: int = 90) -> None:
     plt.close(fig)
 
 
-def plot_fig5(run: FigureRun, fh, dpi: int = 90) -> None:
-    """a and b against H with intervals, the study's points marked."""
-    from .plot import plt
-
+def _sweep_series(run: FigureRun) -> dict:
+    """The Fig. 5 sweep's finished points as arrays: H, and each coefficient with its interval."""
     path = run.sweep.paths[0]
     rows = [r for r in run.sweep_outcome.rows if r["a"] is not None]
-    h = np.array([r[path] for r in rows], float)
-    fig, axes = plt.subplots(1, 2, figsize=(8.4, 3.6), layout="constrained")
+    series = {"H": np.array([r[path] for r in rows], float)}
+    for coef in ("a", "b"):
+        series[coef] = np.array([[r[coef], r[f"{coef}_lo"], r[f"{coef}_hi"]] for r in rows], float).reshape(-1, 3)
+    return series
+
+
+def _calibrated_series(rows: list[ReadingRow]) -> dict:
+    """The same arrays from the per-H calibrated readings of Fig. 5."""
+    return {"H": np.array([_reading_hurst(r) for r in rows], float),
+            "a": np.array([[r.a, *r.a_ci] for r in rows], float).reshape(-1, 3),
+            "b": np.array([[r.b, *r.b_ci] for r in rows], float).reshape(-1, 3)}  # fmt: skip
+
+
+def _preset_h(run: FigureRun) -> str:
+    """The Fig. 5 preset's own rms height, as the text shows it."""
+    return f"{run.sweep.base['spectrum']['params'].get('rms_height'):g}"
+
+
+def _plot_against_h(axes, series, label: str, color: str, offset: float = 0.0) -> None:
+    """a and b (with their intervals) against H on two axes."""
     for ax, coef in zip(axes, ("a", "b"), strict=True):
-        y = np.array([r[coef] for r in rows])
-        err = np.array([[r[coef] - r[f"{coef}_lo"], r[f"{coef}_hi"] - r[coef]] for r in rows]).T
-        ax.errorbar(h, y, yerr=err, fmt="o-", ms=4, capsize=3, color="C0", label="frictionlab (95% CI)")
-        col = 1 if coef == "a" else 2
+        y, low, high = series[coef].T
+        ax.errorbar(series["H"] + offset, y, yerr=[y - low, high - y], fmt="o-", ms=4, capsize=3, color=color,
+                    label=label)  # fmt: skip
+
+
+def _mark_study_against_h(axes) -> None:
+    for ax, col in zip(axes, (1, 2), strict=True):
         ax.plot([STUDY_H07[0]], [STUDY_H07[col]], "*", ms=14, color="C3", label="study, H ~ 0.7 (about)")
         ax.plot([p[0] for p in STUDY_POINTS_VS_H], [p[col] for p in STUDY_POINTS_VS_H], "ks", ms=6,
                 label="study, Figs. 2 and 4")  # fmt: skip
         ax.set_xlabel("Hurst exponent H")
-        ax.set_ylabel(coef)
+        ax.set_ylabel("ab"[col - 1])
         ax.grid(True, alpha=0.3)
+
+
+def plot_fig5(run: FigureRun, fh, dpi: int = 90) -> None:
+    """a and b against H with intervals, the study's points marked."""
+    from .plot import plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(8.4, 3.6), layout="constrained")
+    _plot_against_h(axes, _sweep_series(run), "frictionlab (95% CI)", "C0")
+    _mark_study_against_h(axes)
     axes[0].legend(fontsize=7)
     fig.suptitle("Fig. 5: xi = a + b ln f against H (each point as Fig. 2, h = 1e4)", fontsize=10)
+    fig.savefig(fh, format="png", dpi=dpi)
+    plt.close(fig)
+
+
+def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 90) -> None:
+    """a and b against H with h = 1e4 and with h calibrated at each H, the study's
+    points marked; a third panel shows the calibrated h."""
+    from .plot import plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(11.4, 3.6), layout="constrained")
+    _plot_against_h(axes[:2], _sweep_series(run), f"h = {_preset_h(run)} at every H (the preset)", "C0", offset=-0.006)
+    _plot_against_h(axes[:2], _calibrated_series(rows), "h calibrated at each H to Fig. 2's counts", "C2", offset=0.006)
+    _mark_study_against_h(axes[:2])
+    axes[0].legend(fontsize=7)
+    axes[2].semilogy([_reading_hurst(r) for r in rows], [r.rms_height for r in rows], "o-", color="C2", ms=4)
+    axes[2].axhline(float(_preset_h(run)), color="C0", ls="--", lw=1, label=f"h = {_preset_h(run)} (the preset)")
+    axes[2].set_xlabel("Hurst exponent H")
+    axes[2].set_ylabel("calibrated rms height h")
+    axes[2].grid(True, which="both", alpha=0.3)
+    axes[2].legend(fontsize=7)
+    fig.suptitle("Fig. 5 with h calibrated at each H (counts 4 at F = 1, 12 at F = 20; 95% CI)", fontsize=10)
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)
 
@@ -369,7 +429,8 @@ def _row_for_h(run: FigureRun, value: float):
 
 
 def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, readings_elapsed=None,
-             workers=None, command="frictionlab report") -> str:  # fmt: skip
+             fig5_calibrated=None, fig5_calibrated_elapsed=None, workers=None,
+             command="frictionlab report") -> str:  # fmt: skip
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     lines = [
         "# Reproducing Benad (2012) with frictionlab",
@@ -377,7 +438,9 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         f"Generated by `{command}` (frictionlab {__version__}, {datetime.date.today().isoformat()}). "
         f"**Wall time of the whole report (Figs. 2 to 5): {elapsed:.1f} s** on a {cores}-core machine"
         + (f" with `--workers {workers}`" if workers else "")
-        + (f"; the readings below took another {readings_elapsed:.1f} s." if readings_elapsed is not None else ".")
+        + (f"; the readings below took another {readings_elapsed:.1f} s" if readings_elapsed is not None else "")
+        + (f", Fig. 5 with h calibrated at each H {fig5_calibrated_elapsed:.1f} s" if fig5_calibrated_elapsed else "")
+        + "."
         + " The study's numbers are from SPEC section 7; the presets are in `presets/` (their comments say"
         " how h = 1e4 was calibrated). Intervals are 95% percentile bootstrap over realizations;"
         " † marks a study value outside frictionlab's interval.",
@@ -446,7 +509,78 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         lines += ["", f"![{s.title}]({images[s.key]})"]
     if readings is not None:
         lines += readings_markdown(readings)
+    if fig5_calibrated is not None:
+        fig5 = next(run for run in runs if run.sweep is not None)
+        lines += fig5_calibrated_markdown(fig5, fig5_calibrated, images["fig5-calibrated"], fig5_calibrated_elapsed)
     return "\n".join(lines) + "\n"
+
+
+def _reading_hurst(row: ReadingRow) -> float:
+    """H of a Fig. 5 reading, from its ``--set`` options."""
+    import yaml
+
+    prefix = "spectrum.params.hurst="
+    return float(yaml.safe_load(next(o for o in row.overrides if o.startswith(prefix))[len(prefix):]))
+
+
+def _study_at_h(hurst: float):
+    """(a, b, label) the study states at this H, or None (SPEC 7)."""
+    known = [(h, a, b, f"{label}: {a}, {b}") for h, a, b, label in STUDY_POINTS_VS_H]
+    known.append((*STUDY_H07, f"about {STUDY_H07[1]}, about {STUDY_H07[2]}"))
+    return next(((a, b, text) for h, a, b, text in known if abs(h - hurst) < 1e-9), None)
+
+
+def fig5_calibrated_markdown(run: FigureRun, rows: list[ReadingRow], image: str, elapsed: float | None) -> list[str]:
+    """Fig. 5 rerun with h calibrated at each H, beside the preset's h = 1e4 and the study."""
+    path = run.sweep.paths[0]
+    default = {r[path]: r for r in run.sweep_outcome.rows if r["a"] is not None}
+    took = f" {len(rows)} calibrations and runs took {elapsed:.1f} s." if elapsed is not None else ""
+    lines = [
+        "",
+        "## Fig. 5 with h calibrated at each H",
+        "",
+        "Each point of Fig. 5 rerun with its own h: fitted, as for the readings above, to Fig. 2's contact"
+        f" counts (4 at F = 1, 12 at F = 20) on that point's lines, instead of h = {_preset_h(run)} at every H. Rerun a"
+        " point: `frictionlab run presets/benad2012-fig5.yaml --set sweep=null --set spectrum.params.hurst=H"
+        f" --set spectrum.params.rms_height=h` with h from the table.{took} The study states a and b at"
+        " H = 1 (Fig. 2), H = 0.5 (Fig. 4) and near H = 0.7 (about); † marks a study value outside the"
+        " calibrated interval.",
+        "",
+        "| H | calibrated h | a (95% CI) | b (95% CI) | R² | points in contact at F = 1 / 20 "
+        f"| h = {_preset_h(run)}: a, b | study a, b |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    verdicts = []
+    for r in rows:
+        hurst = _reading_hurst(r)
+        study = _study_at_h(hurst)
+        a_mark = _inside(study[0], r.a_ci) if study else ""
+        b_mark = _inside(study[1], r.b_ci) if study else ""
+        base = default.get(hurst)
+        base_text = f"{base['a']:.4f}, {base['b']:.4f}" if base else "n/a"
+        lines.append(
+            f"| {hurst:g} | {r.rms_height:g} | {r.a:.4f} {_ci(r.a_ci)}{a_mark} | {r.b:.4f} {_ci(r.b_ci)}{b_mark} | "
+            f"{r.r2:.3f} | {r.counts[0]:.2f} / {r.counts[1]:.2f} | {base_text} | {study[2] if study else ''} |"
+        )
+        if study:
+            inside = [name for name, mark in (("a", a_mark), ("b", b_mark)) if not mark]
+            verdicts.append(f"H = {hurst:g}: " + (" and ".join(inside) + " inside" if inside else "neither inside"))
+    top = max(rows, key=lambda r: r.a)
+    lines += ["", f"Largest a with h calibrated: {top.a:.4f} {_ci(top.a_ci)} at H = {_reading_hurst(top):g}"]
+    if default:
+        top_h = max(default, key=lambda h: default[h]["a"])
+        lines[-1] += f"; with h = {_preset_h(run)}: {default[top_h]['a']:.4f} at H = {top_h:g}"
+    lines[-1] += f"; the study: about {STUDY_H07[1]} near H = {STUDY_H07[0]:g}."
+    top_holders = ", ".join(f"{_reading_hurst(r):g}" for r in rows if r.a_ci[0] <= top.a <= r.a_ci[1])
+    lines[-1] += f" The a intervals that hold this largest a: H = {top_holders}."
+    near = next((r for r in rows if abs(_reading_hurst(r) - STUDY_H07[0]) < 1e-9), None)
+    if near is not None:
+        lines[-1] += (f" At H = {STUDY_H07[0]:g}: a {near.a / STUDY_H07[1] - 1:+.0%} and b {near.b / STUDY_H07[2] - 1:+.0%}"
+                      " from the study's values.")  # fmt: skip
+    if verdicts:
+        lines += ["", "The study's values against the calibrated intervals: " + "; ".join(verdicts) + "."]
+    lines += ["", f"![Fig. 5 with h calibrated at each H]({image})"]
+    return lines
 
 
 def readings_markdown(rows: list[ReadingRow]) -> list[str]:
@@ -513,15 +647,25 @@ def write_report(
         atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
         images[run.study.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
     elapsed = time.perf_counter() - started
-    reading_rows = readings_elapsed = None
+    reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
     if readings:
         log(f"report: running {len(READINGS)} readings")
         t0 = time.perf_counter()
         reading_rows = run_readings(runs, out_dir, workers=workers)
         readings_elapsed = time.perf_counter() - t0
+        fig5 = next(run for run in runs if run.sweep is not None)
+        log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
+        t0 = time.perf_counter()
+        fig5_rows = run_readings(runs, out_dir, workers=workers, readings=fig5_calibrated_readings(fig5.sweep),
+                                 folder_name="fig5-calibrated")  # fmt: skip
+        fig5_elapsed = time.perf_counter() - t0
+        name = "fig5-calibrated.png"
+        atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
+        images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
     command = "frictionlab report" + (" --readings" if readings else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
-                    workers=workers, command=command)  # fmt: skip
+                    fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=workers,
+                    command=command)  # fmt: skip
     atomic_write(markdown_path, lambda fh: fh.write(text))
     log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

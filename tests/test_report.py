@@ -1,6 +1,7 @@
 """The reproduction report: averaging readings against brute force, the h calibration
 against a known h, and the report's content on tiny presets (numbers from summary.json)."""
 
+import io
 import json
 import math
 
@@ -12,8 +13,9 @@ from frictionlab import engine
 from frictionlab.cli import main
 from frictionlab.preset import apply_overrides, build_scene, load_preset_file
 from frictionlab.report import (
-    STUDY, Reading, average_curve, calibrated_rms_height, find_presets, readings_markdown, refit, run_figures,
-    run_readings, write_report,
+    COUNT_TARGETS, STUDY, Reading, average_curve, calibrated_rms_height, fig5_calibrated_markdown,
+    fig5_calibrated_readings, find_presets, plot_fig5_calibrated, readings_markdown, refit, run_figures, run_readings,
+    write_report,
 )  # fmt: skip
 from frictionlab.runner import run_to_folder
 
@@ -107,8 +109,13 @@ def test_report_on_tiny_presets(tmp_path, tiny_presets):
     assert "| Fig. 5 at H = 0.6 | about 2.9 |" in text  # the point nearest H = 0.7
 
 
-def test_readings_rerun_as_documented(tmp_path, tiny_presets):
-    runs = run_figures(tiny_presets, tmp_path, workers=1)
+@pytest.fixture(scope="module")
+def tiny_runs(tmp_path_factory, tiny_presets):
+    return run_figures(tiny_presets, tmp_path_factory.mktemp("runs"), workers=1)
+
+
+def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
+    runs = tiny_runs
     readings = (Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
                 Reading("fig2", "spectral", ("slope.name=spectral",)), Reading("fig2", "pooled", average="pooled"))  # fmt: skip
     rows = run_readings(runs, tmp_path, workers=1, readings=readings)
@@ -131,3 +138,36 @@ def test_presets_folder_errors(tmp_path, capsys):
         find_presets(tmp_path)
     assert main(["report", "--presets", str(tmp_path), "--quiet"]) == 2
     assert "--presets: no folder with the study's presets" in capsys.readouterr().err
+
+
+def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
+    fig5 = next(run for run in tiny_runs if run.sweep is not None)
+    rows = run_readings(tiny_runs, tmp_path, workers=1, readings=fig5_calibrated_readings(fig5.sweep))
+    assert [r.overrides[:2] for r in rows] == [["sweep=null", "spectrum.params.hurst=0.6"],
+                                               ["sweep=null", "spectrum.params.hurst=1.0"]]  # fmt: skip
+    targets = (COUNT_TARGETS[1.0], COUNT_TARGETS[20.0])
+    for r in rows:  # each point's own lines hit Fig. 2's counts at F = 1 and 20
+        assert r.loads == (1.0, 20.0)
+        assert r.overrides[2] == f"spectrum.params.rms_height={r.rms_height!r}"
+        # least squares in log balances the two misfits: geometric mean of count/target near 1
+        # (6 lines: the mean count moves in steps of 1/6, hence the tolerance; h off by 1.5 gives ~1.2)
+        assert math.sqrt(r.counts[0] / targets[0] * r.counts[1] / targets[1]) == pytest.approx(1.0, abs=0.12)
+        assert r.counts == pytest.approx(targets, rel=0.35)
+    # at fixed h the rougher line (smaller H) has fewer points near its top (the default
+    # sweep's counts at h = 300), so it needs a smaller h for the same counts
+    default = {row["spectrum.params.hurst"]: row for row in fig5.sweep_outcome.rows}
+    assert default[0.6]["contact_last"] < default[1.0]["contact_last"]
+    assert rows[0].rms_height < rows[1].rms_height / 1.5
+    # a point reruns from the preset and its --set options, as the section says
+    data = apply_overrides(load_preset_file(tiny_presets / fig5.preset_path.name), rows[0].overrides)
+    outcome, _ = run_to_folder(build_scene(data), tmp_path / "again", workers=1)
+    assert (outcome.fit.a, outcome.fit.b) == pytest.approx((rows[0].a, rows[0].b), rel=1e-12)
+    text = "\n".join(fig5_calibrated_markdown(fig5, rows, "fig.png", elapsed=1.0))
+    assert f"| 0.6 | {rows[0].rms_height:g} | {rows[0].a:.4f} [{rows[0].a_ci[0]:.4f}, {rows[0].a_ci[1]:.4f}] |" in text
+    at_one = next(line for line in text.splitlines() if line.startswith(f"| 1 | {rows[1].rms_height:g} | "))
+    assert at_one.endswith("| Fig. 2: 1.8847, 0.0805 |")  # the study's value at H = 1, Fig. 2's
+    outside = not (rows[1].a_ci[0] <= 1.8847 <= rows[1].a_ci[1] and rows[1].b_ci[0] <= 0.0805 <= rows[1].b_ci[1])
+    assert ("†" in at_one) == outside
+    image = io.BytesIO()
+    plot_fig5_calibrated(fig5, rows, image)
+    assert image.getvalue().startswith(b"\x89PNG") and len(image.getvalue()) > 1000

@@ -25,10 +25,11 @@ from frictionlab.runner import run_to_folder
 from frictionlab.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.live import LiveListener
+from frictionlab.tui.folders import save_preset
 from frictionlab.tui.form import PresetForm
 from textual.widgets import Input, Select, Static, Switch
 
-from .conftest import ROOT, SMALL_PRESET, merge
+from .conftest import PRESETS, ROOT, SMALL_PRESET, merge
 
 SIZE = (80, 24)
 
@@ -198,6 +199,103 @@ async def test_switching_the_solver_swaps_its_parameters(folders, registry):
         assert form.problems == []
 
 
+COMMENTED = """\
+# why this preset
+name: commented  # the name
+description: >
+  folded text
+  over two lines
+spectrum:
+  name: power-law
+  params:
+    hurst: 0.8    # H
+    points: 1024
+solver:
+  name: mdr
+  params:
+    # the modulus first
+    youngs_modulus: 1.0  # E
+    poisson_ratio: 0.0  # nu: zero, so E* = E
+# the slope estimator below
+slope:
+  name: forward-difference
+loading:
+  stop: 2.0e+1
+  values:
+    - 1  # one
+fit: {bootstrap: 50}
+"""
+
+
+def _comment_lines(text):
+    return [line.split("#", 1)[1].strip() for line in text.splitlines() if "#" in line]
+
+
+def test_save_keeps_comments_order_and_spelling_with_nested_removed_and_added_keys(tmp_path):
+    path, source = tmp_path / "saved.yaml", tmp_path / "source.yaml"
+    source.write_text(COMMENTED)
+    data = yaml.safe_load(COMMENTED)
+    data["spectrum"]["params"]["hurst"] = 0.6  # a nested change
+    data["solver"] = {"name": "winkler", "params": {"modulus": 1e-05}}  # two keys removed, one added
+    data["fit"]["confidence"] = 0.9
+    data["seed"] = 3  # a new top-level key: last, as in the edited data
+    save_preset(path, data, template=source)
+    text = path.read_text()
+    assert yaml.safe_load(text) == data  # PyYAML (what frictionlab loads with) reads the new values
+    assert _comment_lines(text) == _comment_lines(COMMENTED)  # every comment, in order
+    lines = text.splitlines()
+    # untouched lines are byte for byte the same, in the same order ("2.0e+1" is not rewritten as 20.0)
+    kept = [line for line in COMMENTED.splitlines() if line in lines]
+    assert kept == [line for line in lines if line in COMMENTED.splitlines()]
+    for line in ("name: commented  # the name", "description: >", "  folded text", "  stop: 2.0e+1", "    - 1  # one"):
+        assert line in lines
+    assert "    hurst: 0.6    # H" in lines and "    modulus: 1.0e-05" in lines
+    # the comment above `slope` stays above it; the removed keys' own comments stay in the solver section
+    assert lines[lines.index("slope:") - 1] == "# the slope estimator below"
+    assert lines.index("    modulus: 1.0e-05") < lines.index("    # E") < lines.index("slope:")
+    assert "youngs_modulus" not in text and "poisson_ratio" not in text
+    assert list(yaml.safe_load(text)) == ["name", "description", "spectrum", "solver", "slope", "loading", "fit", "seed"]
+
+
+def test_save_without_changes_rewrites_every_shipped_preset_byte_for_byte(tmp_path):
+    for preset in sorted(PRESETS.glob("*.yaml")):
+        original = preset.read_text()
+        save_preset(tmp_path / preset.name, yaml.safe_load(original), template=preset)
+        assert (tmp_path / preset.name).read_text() == original, preset.name
+
+
+def test_new_text_values_are_spelled_so_pyyaml_reads_them_back(tmp_path):
+    source = tmp_path / "source.yaml"
+    source.write_text("name: x  # n\nseed: 1\n")
+    data = {"name": "yes", "seed": 1, "description": "1e4", "notes": {"on": "0o17", "nan": float("inf")}}
+    save_preset(tmp_path / "out.yaml", data, template=source)
+    text = (tmp_path / "out.yaml").read_text()
+    assert yaml.safe_load(text) == data and "# n" in text
+
+
+@sync
+async def test_editing_a_commented_shipped_preset_keeps_its_comments(folders, registry):
+    original = (PRESETS / "benad2012-fig2.yaml").read_text()
+    path = folders / "presets" / "tiny.yaml"  # the first row of the list
+    path.write_text(original)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert form.data["name"] == "benad2012-fig2"
+        await type_into(pilot, "field--spectrum--params--hurst", "0.75")
+        assert form.problems == []
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert not app.modified
+    text = path.read_text()
+    assert _comment_lines(text) == _comment_lines(original) and "h = 1e4" in text
+    changed = [(a, b) for a, b in zip(original.splitlines(), text.splitlines(), strict=True) if a != b]
+    assert changed == [("    hurst: 1.0", "    hurst: 0.75")]
+    assert main(["validate", str(path)]) == ExitCode.OK
+    scene = load_scene(path, registry=registry)
+    assert scene.spectrum.params.hurst == 0.75 and scene.spectrum.params.rms_height == 1e4
+
+
 class SmoothedSlope(SlopeEstimator):
     """A third-party plugin registered only in this test: the form has no code for it."""
 
@@ -326,6 +424,11 @@ SWEEP = merge(
 )
 
 
+def fits_width(table):
+    """Every column of a DataTable is on screen: nothing to scroll sideways to."""
+    return table.max_scroll_x == 0 and table.virtual_size.width <= table.scrollable_content_region.width
+
+
 def _numbers(cell):
     return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", str(cell))]
 
@@ -344,9 +447,11 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
         columns = [str(c.label) for c in table.columns.values()]
         point_text = str(app.query_one("#sweep-point", Static).render())
         out_dir = app.last_out_dir
+        fits = fits_width(table)
     assert app.last_sweep.status == "completed" and point_text.startswith("completed: 3/3 points")
     assert out_dir.parent.name == "runs" and out_dir.name.startswith("tinysweep-")
-    assert columns == ["#", "hurst", "status", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+    assert columns == ["#", "hurst", "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+    assert fits, "the sweep table is cut at 80 columns"
     rows = read_table(out_dir / "sweep.csv")
     assert len(cells) == len(rows) == 3
     for shown, row in zip(cells, rows, strict=True):
@@ -357,7 +462,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
             assert _numbers(cell)[1:] == pytest.approx([float(row[f"{name}_lo"]), float(row[f"{name}_hi"])], abs=5e-4)
         assert _numbers(r2) == pytest.approx([float(row["r2"])], abs=5e-4)
         assert _numbers(contacts) == pytest.approx([float(row["contact_first"]), float(row["contact_last"])], rel=5e-3)
-        assert status == row["status"] == "completed"
+        assert status == "✓" and row["status"] == "completed"
     # the same numbers as a headless sweep of the same preset
     headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", workers=1)
     assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_sweep.results] == [
@@ -386,7 +491,7 @@ async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders
     assert app.last_sweep.status == "interrupted"
     rows = read_table(out_dir / "sweep.csv")
     assert [r["status"] for r in rows] == ["cancelled", "pending", "pending"]
-    assert [c[2] for c in cells] == ["cancelled"]  # only finished points get a row
+    assert [c[2] for c in cells] == ["c"]  # only finished points get a row, marked cancelled
     first = app.last_sweep.results[0].outcome
     assert 3 <= first.done < 100_000 and int(rows[0]["done"]) == first.done
     with np.load(out_dir / rows[0]["folder"] / "realizations.npz") as arrays:
@@ -437,6 +542,50 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
         info = str(app.query_one("#results-info", Static).render())
     for seed in (1, 2):
         summary = json.loads((folders / "runs" / f"seed{seed}" / "summary.json").read_text())
+        assert f"a={summary['fit']['a']:.4f}" in info
+
+
+@sync
+async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
+    make_runs(folders, registry)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", workers=1, plot=False)
+    rows = read_table(folders / "runs" / "sw" / "sweep.csv")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert sorted(e.path.name for e in app.runs) == ["seed1", "seed2", "sw"]
+        index = [e.path.name for e in app.runs].index("sw")
+        listed = [str(c) for c in app.query_one("#runs-table").get_row_at(index)]
+        assert listed[1:] == ["sw", "sweep", "3 pts"]  # marked as a sweep
+        await pilot.press(*["down"] * index, "enter")
+        await pilot.pause()
+        points = app.query_one("#results-sweep")
+        assert points.display and points.has_focus
+        cells = [[str(c) for c in points.get_row_at(i)] for i in range(points.row_count)]
+        assert fits_width(points), "the sweep table is cut at 80 columns"
+        await pilot.press("down", "enter")  # the second point's own run
+        await pilot.pause()
+        overlay = [e.path for e in app.overlay]
+        await pilot.press("up", "space")  # and the first point's, for comparison
+        await pilot.pause()
+        compared = [e.path for e in app.overlay]
+        info = str(app.query_one("#results-info", Static).render())
+    assert len(cells) == 3
+    for shown, row in zip(cells, rows, strict=True):
+        number, hurst, mark, a, b, r2, contacts = shown
+        assert int(number) == int(row["point"]) and float(hurst) == float(row["spectrum.params.hurst"])
+        assert mark == "✓" and row["status"] == "completed"
+        assert _numbers(a)[0] == pytest.approx(float(row["a"]), abs=5e-5)
+        assert _numbers(b)[1:] == pytest.approx([float(row["b_lo"]), float(row["b_hi"])], abs=5e-4)
+        assert _numbers(r2) == pytest.approx([float(row["r2"])], abs=5e-4)
+    point_dirs = [folders / "runs" / "sw" / r["folder"] for r in rows]
+    overlay, compared = [p.resolve() for p in overlay], [p.resolve() for p in compared]
+    assert overlay == [point_dirs[1]]
+    assert compared == [point_dirs[1], point_dirs[0]]
+    for folder in point_dirs[:2]:
+        summary = json.loads((folder / "summary.json").read_text())
         assert f"a={summary['fit']['a']:.4f}" in info
 
 

@@ -35,17 +35,18 @@ from .folders import (
     list_runs,
     new_run_folder,
     preset_folders,
+    SweepEntry,
     read_curve,
+    read_run,
     save_preset,
     writable_folder,
 )
 from .form import PresetForm
 from .live import LiveListener, Snapshot
 from .screens import Chart, ConfirmScreen, HelpScreen, NewPresetScreen, PathScreen
-from .sweepview import SweepPoster, point_line, table_cells, table_columns
+from .sweepview import STATUS_MARKS, SweepPoster, point_line, row_cells, table_cells, table_columns
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
-STATUS_MARKS = {"completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!"}
 
 
 # ------------------------------------------------------------------ messages from the run thread
@@ -193,17 +194,22 @@ class RunPane(Vertical, can_focus=True):
         self.app.action_cancel_run()
 
 
-class ResultsPane(Horizontal):
+class ResultsPane(Vertical):
+    """Runs and sweeps on the left, the open runs' curves on the right; an open
+    sweep's table of points below them (Enter on a point opens its run)."""
+
     BINDINGS = [
         Binding("space", "compare", "Compare", tooltip="Compare: add the run to the overlay, or remove it"),
         Binding("r", "reload", "Reload", tooltip="Reload the list of runs"),
     ]
 
     def compose(self) -> ComposeResult:
-        yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True)
-        with Vertical(id="results-body"):
-            yield Chart(id="results-chart")
-            yield Static("Enter opens a run; Space adds it to the overlay.", id="results-info")
+        with Horizontal(id="results-top"):
+            yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True)
+            with Vertical(id="results-body"):
+                yield Chart(id="results-chart")
+                yield Static("Enter opens a run; Space adds it to the overlay.", id="results-info")
+        yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
     def action_compare(self) -> None:
         self.app.open_selected_run(overlay=True)
@@ -248,6 +254,7 @@ class FrictionlabApp(App):
         self.run_workers = workers
         self.registry = registry or default_registry()
         self.draft_path: Path | None = None
+        self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
         self.problems: list[str] = []
         self.presets = []
@@ -259,6 +266,7 @@ class FrictionlabApp(App):
         self.run_error: str | None = None
         self.last_snapshot: Snapshot | None = None
         self.last_sweep = None  # sweep.SweepOutcome of the last sweep run here
+        self.open_sweep: SweepEntry | None = None  # the sweep whose points the Results tab shows
 
     # ------------------------------------------------------------ layout
 
@@ -376,7 +384,7 @@ class FrictionlabApp(App):
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         if event.data_table.id == "preset-table":
             self.open_selected_preset()
-        elif event.data_table.id == "runs-table":
+        elif event.data_table.id in ("runs-table", "results-sweep"):
             self.open_selected_run(overlay=False)
 
     def _selected_preset(self):
@@ -402,6 +410,9 @@ class FrictionlabApp(App):
             except PresetError as exc:
                 self.notify("\n".join(exc.problems), title=f"Cannot open {path.name}", severity="error")
                 return
+            self.draft_source = path
+        else:
+            self.draft_source = None
         self.draft_path = path
         await self.query_one("#form", PresetForm).load(data)
         self.modified = modified
@@ -422,7 +433,7 @@ class FrictionlabApp(App):
 
         def done(path: Path | None) -> None:
             if path is not None:
-                self._write(path, data, then_open=True)
+                self._write(path, data, then_open=True, template=entry.path)
 
         self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default), done)
 
@@ -500,7 +511,7 @@ class FrictionlabApp(App):
     def _save_checked(self, path: Path) -> None:
         data = self._draft()
         if not self.problems:
-            self._write(path, data)
+            self._write(path, data, template=self.draft_source)
             return
         count = len(self.problems)
         question = (
@@ -508,11 +519,13 @@ class FrictionlabApp(App):
             + "\n".join(self.problems[:6])
             + "\n\nSave it anyway?"
         )
-        self.push_screen(ConfirmScreen(question), lambda yes: yes and self._write(path, data))
+        self.push_screen(
+            ConfirmScreen(question), lambda yes: yes and self._write(path, data, template=self.draft_source)
+        )
 
-    def _write(self, path: Path, data: dict, then_open: bool = False) -> None:
+    def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
         try:
-            save_preset(path, data)
+            save_preset(path, data, template=template)
         except OSError as exc:
             self.notify(f"{path}: {exc.strerror or exc}", title="Not saved", severity="error")
             return
@@ -521,7 +534,7 @@ class FrictionlabApp(App):
         if then_open:
             self.run_worker(self.open_preset(path), group="open")
         else:
-            self.draft_path = path
+            self.draft_path = self.draft_source = path
             self.modified = False
             self._show_edit_title()
 
@@ -599,7 +612,7 @@ class FrictionlabApp(App):
         pane.query_one("#run-error", Static).update("")
         table = pane.query_one("#sweep-table", DataTable)
         table.clear(columns=True)
-        table.add_columns(*table_columns(sweep))
+        table.add_columns(*table_columns(sweep.paths))
         self.action_show_tab("run")
         self.run_worker(
             partial(self._sweep_in_thread, sweep, out_dir, self.cancel_event),
@@ -653,6 +666,7 @@ class FrictionlabApp(App):
             " (sweep.csv, sweep.png)"
         )
         self.notify(f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points")
+        self.reload_runs()
 
     def action_cancel_run(self) -> None:
         if not self.running:
@@ -733,15 +747,35 @@ class FrictionlabApp(App):
         table = self.query_one("#runs-table", DataTable)
         table.clear()
         for entry in self.runs:
-            a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
-            b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
+            if isinstance(entry, SweepEntry):
+                a, b = "sweep", f"{len(entry.points)} pts"
+            else:
+                a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
+                b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
             table.add_row(STATUS_MARKS.get(entry.status, "?"), entry.path.name, a, b)
 
     def open_selected_run(self, overlay: bool) -> None:
-        row = self.query_one("#runs-table", DataTable).cursor_row
-        if not 0 <= row < len(self.runs):
-            return
-        entry = self.runs[row]
+        """Enter/Space on the list of runs, or on the open sweep's table of points."""
+        points = self.query_one("#results-sweep", DataTable)
+        if points.has_focus and self.open_sweep is not None:
+            row = points.cursor_row
+            if not 0 <= row < len(self.open_sweep.points):
+                return
+            folder = self.open_sweep.point_folder(self.open_sweep.points[row])
+            try:
+                entry = read_run(folder)
+            except (OSError, ValueError, TypeError):
+                self.notify(f"{folder.name}: this point has no finished run", severity="warning")
+                return
+        else:
+            row = self.query_one("#runs-table", DataTable).cursor_row
+            if not 0 <= row < len(self.runs):
+                return
+            entry = self.runs[row]
+            if isinstance(entry, SweepEntry):
+                if not overlay:
+                    self._show_sweep(entry)
+                return
         if overlay:
             paths = [e.path for e in self.overlay]
             if entry.path in paths:
@@ -751,6 +785,21 @@ class FrictionlabApp(App):
         else:
             self.overlay = [entry]
         self._show_overlay()
+
+    def _show_sweep(self, entry: SweepEntry) -> None:
+        """The sweep's table of points, formatted as the Run tab formats a live sweep."""
+        self.open_sweep = entry
+        table = self.query_one("#results-sweep", DataTable)
+        table.clear(columns=True)
+        table.add_columns(*table_columns(entry.paths))
+        for row in entry.points:
+            table.add_row(*row_cells(entry.paths, row))
+        self.query_one("#results-pane", ResultsPane).set_class(True, "-sweep")
+        self.query_one("#results-info", Static).update(
+            f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
+            "Enter on a point opens its run; Space adds it to the overlay."
+        )
+        table.focus()
 
     def _show_overlay(self) -> None:
         series, lines = [], []

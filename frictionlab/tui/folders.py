@@ -3,7 +3,8 @@
 Presets come from ``./presets`` (when it exists) and the user folder
 (``$FRICTIONLAB_PRESETS_DIR``, else ``$XDG_CONFIG_HOME/frictionlab/presets``,
 else ``~/.config/frictionlab/presets``). Runs are the output folders the
-headless ``frictionlab run`` writes, found by their ``summary.json``.
+headless ``frictionlab run`` writes, found by their ``summary.json``, and sweep
+folders, found by their ``sweep.json``.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import yaml
 
 from ..cli import DEFAULT_RUNS_DIR
 from ..results import atomic_write
+from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
 
@@ -71,9 +73,18 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
     return entries
 
 
-def save_preset(path: Path, data: dict) -> None:
-    """Write preset data as YAML, atomically (comments of the original are not kept)."""
-    text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
+    """Write preset data as YAML, atomically. With ``template`` (the file the draft
+    was read from) the text keeps that file's comments, key order and formatting,
+    only the edited values change; without one, or if it cannot be read, plain YAML."""
+    text = None
+    if template is not None:
+        try:
+            text = dump_preserving(Path(template).read_text(encoding="utf-8"), data)
+        except (OSError, UnicodeDecodeError):
+            text = None
+    if text is None:
+        text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     atomic_write(Path(path), lambda fh: fh.write(text))
 
 
@@ -149,17 +160,53 @@ def read_curve(folder: Path) -> dict[str, list[float]]:
     return {c: [float(r[c]) if r[c] else math.nan for r in rows] for c in columns}
 
 
-def list_runs(runs_dir: Path) -> list[RunEntry]:
-    """Every folder under ``runs_dir`` with a readable summary.json, newest first."""
+@dataclass
+class SweepEntry:
+    """A sweep folder (``frictionlab.sweep``): its sweep.json, one row per point."""
+
+    path: Path
+    name: str
+    status: str
+    paths: list[str]  # the swept dotted paths
+    points: list[dict]  # sweep.json's rows: the swept values and the columns of sweep.csv
+    mtime: float
+
+    def point_folder(self, row: dict) -> Path:
+        return self.path / str(row.get("folder") or "")
+
+
+def read_sweep(folder: Path) -> SweepEntry:
+    """A sweep folder's sweep.json; raises OSError/ValueError/TypeError if unreadable."""
+    folder = Path(folder)
+    summary_path = folder / "sweep.json"
+    summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    points = summary["points"]
+    if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
+        raise TypeError("sweep.json: points must be a list of rows")
+    return SweepEntry(
+        path=folder,
+        name=str(summary.get("name") or folder.name),
+        status=str(summary.get("status", "?")),
+        paths=list((summary.get("sweep") or {}).get("parameters") or {}),
+        points=points,
+        mtime=summary_path.stat().st_mtime,
+    )
+
+
+def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
+    """Every folder under ``runs_dir`` with a readable summary.json (a run) or
+    sweep.json (a sweep), newest first."""
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
     entries = []
     for folder in runs_dir.iterdir():
-        if not (folder / "summary.json").is_file():
-            continue
-        try:
-            entries.append(read_run(folder))
-        except (OSError, ValueError, TypeError):
-            continue  # a half-written or foreign folder: not a run to list
+        for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
+            if not (folder / marker).is_file():
+                continue
+            try:
+                entries.append(read(folder))
+            except (OSError, ValueError, TypeError, KeyError):
+                pass  # a half-written or foreign folder: not one to list
+            break
     return sorted(entries, key=lambda e: (-e.mtime, e.path.name))

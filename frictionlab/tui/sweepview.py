@@ -38,8 +38,14 @@ def point_line(sweep: Sweep, point: SweepPoint) -> str:
     return f"point {point.number}/{len(sweep.points)}: {values}"
 
 
-def table_columns(sweep: Sweep) -> list[str]:
-    return ["#", *(short_name(p) for p in sweep.paths), "status", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+STATUS_MARKS = {
+    "completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!", "error": "!", "pending": "-",
+}  # fmt: skip
+
+
+def table_columns(paths: list[str]) -> list[str]:
+    """The sweep table's headers: short, so a one-parameter sweep fits 80 columns."""
+    return ["#", *(short_name(p) for p in paths), "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
 
 
 def _estimate(row: dict[str, Any], name: str) -> str:
@@ -50,17 +56,22 @@ def _estimate(row: dict[str, Any], name: str) -> str:
     return f"{value:.4f}{interval}"
 
 
-def table_cells(sweep: Sweep, result: PointResult) -> list[str]:
-    """One row of the table: the swept values, the point's status, a and b with
-    their intervals, R^2, points in contact at the first .. last load."""
-    row = result.row()
+def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
+    """One row of the table from a row of sweep.csv (``PointResult.row()`` or a
+    point of sweep.json): the point number, the swept values, a status mark,
+    a and b with their intervals, R^2, points in contact at the first .. last load."""
     contacts = "-" if row["contact_first"] is None else f"{row['contact_first']:.3g}..{row['contact_last']:.3g}"
     return [
-        str(result.point.number),
-        *(yaml_scalar(result.point.values[p]) for p in sweep.paths),
-        row["status"],
+        str(row["point"]),
+        *(yaml_scalar(row[p]) for p in paths),
+        STATUS_MARKS.get(row["status"], "?"),
         _estimate(row, "a"),
         _estimate(row, "b"),
         "-" if row["r2"] is None else f"{row['r2']:.3f}",
         contacts,
     ]
+
+
+def table_cells(sweep: Sweep, result: PointResult) -> list[str]:
+    """The row of a point that just finished."""
+    return row_cells(sweep.paths, result.row())
