@@ -127,6 +127,14 @@ def main() -> None:
     print(f"  512 x 512 at 10 % with FFT_WORKERS = -1: {threaded:7.3f} s  ({singles[0.1] / threaded:4.2f} x the default)")
 
     if args.law:
+        cold_total = sum(
+            int(solver.solve(profile, sweep_loads[j : j + 1], "force", slopes).extras["iterations"][0])
+            for j in range(sweep_loads.size)
+        )
+        print(
+            f"  the same 20 loads solved independently (cold): {cold_total} iterations; "
+            f"the warm sweep is {int(curve.extras['iterations'].sum()) / cold_total:.2f} x that"
+        )
         narrow = loads_for(surface, np.geomspace(0.1, 0.11, 20))
         narrow_curve = solver.solve(profile, narrow, "force", slopes)
         total = int(narrow_curve.extras["iterations"].sum())

@@ -210,6 +210,40 @@ def import_distributed():
     return distributed
 
 
+def connect_scheduler(address: str):
+    """A ``distributed.Client`` on the scheduler at ``address``, or a RunError."""
+    distributed = import_distributed()
+    try:
+        return distributed.Client(address, timeout="10s")
+    except (OSError, TimeoutError) as exc:
+        raise RunError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+
+
+def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[str, int | None], float]:
+    """Each worker's memory limit on the cluster at ``scheduler`` (bytes by
+    address; 0 or None: no limit), or without one those the ``LocalCluster`` of
+    ``workers`` single-thread processes will get (Dask's "auto": the machine's
+    memory over its cores, each); and the fraction of it at which Dask's nanny
+    kills a worker (this process's ``distributed.worker.memory.terminate``;
+    1 when it is off: the operating system's OOM killer is then the limit)."""
+    import dask
+
+    if scheduler:
+        with connect_scheduler(scheduler) as client:
+            found = client.scheduler_info().get("workers", {})
+            limits = {address: info.get("memory_limit") for address, info in found.items()}
+    else:
+        try:
+            from distributed.worker_memory import parse_memory_limit
+
+            each = parse_memory_limit("auto", 1, logger=logging.getLogger(__name__))
+        except (ImportError, TypeError):  # another Dask version: its limit is unknown here
+            each = None
+        limits = {f"{i} of the LocalCluster on 127.0.0.1": each for i in range(1, workers + 1)}
+    terminate = dask.config.get("distributed.worker.memory.terminate", 0.95)
+    return limits, float(terminate) if terminate else 1.0
+
+
 class DaskExecutor:
     """Chunks as Dask tasks. With ``scheduler`` (``tcp://HOST:PORT``) the run uses
     that cluster's workers; without, a ``LocalCluster`` of ``workers`` single-thread
@@ -227,10 +261,7 @@ class DaskExecutor:
     def _connect(self):
         distributed = import_distributed()
         if self.scheduler:
-            try:
-                client = distributed.Client(self.scheduler, timeout="10s")
-            except (OSError, TimeoutError) as exc:
-                raise RunError(f"cannot reach the Dask scheduler at {self.scheduler}: {exc}") from None
+            client = connect_scheduler(self.scheduler)
             self.workers = max(1, len(client.scheduler_info().get("workers", {})))
             return client, None
         cluster = distributed.LocalCluster(

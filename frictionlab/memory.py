@@ -14,6 +14,7 @@ the growth of ``ru_maxrss`` over one realization (benchmarks/bench_scale.py):
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,7 +26,10 @@ GiB = 2**30
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
 PROCESS_BASE = 160 * MiB  # main process: interpreter, numpy, scipy, pydantic, matplotlib for the plot
-WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process
+WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process (Dask: with its nanny)
+# What a Dask worker's ``memory_limit`` watches: the worker process alone, without
+# its nanny (measured 95 MiB with frictionlab and the plugins imported, after a run).
+DASK_WORKER_PROCESS = 128 * MiB
 KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the file being written
 
 
@@ -111,15 +115,24 @@ def available_memory() -> tuple[int, str]:
     return min(found)
 
 
-def _most_points(scene: Scene, executor: str, available: int) -> int:
-    """The largest ``spectrum.params.points`` whose one-worker estimate fits."""
+def _total(guess: MemoryEstimate) -> int:
+    return guess.total
+
+
+def _in_dask_worker(guess: MemoryEstimate) -> int:
+    return DASK_WORKER_PROCESS + guess.per_realization
+
+
+def _most_points(scene: Scene, executor: str, available: int, need=_total) -> int:
+    """The largest ``spectrum.params.points`` whose one-worker estimate fits:
+    ``need(estimate) <= available`` (by default the run's whole peak)."""
     dimension = getattr(scene.spectrum, "dimension", 1)
     low, high = 1, 2
-    while estimate(scene, workers=1, executor=executor, points=high**dimension).total <= available:
+    while need(estimate(scene, workers=1, executor=executor, points=high**dimension)) <= available:
         low, high = high, 2 * high
     while high - low > 1:
         middle = (low + high) // 2
-        fits = estimate(scene, workers=1, executor=executor, points=middle**dimension).total <= available
+        fits = need(estimate(scene, workers=1, executor=executor, points=middle**dimension)) <= available
         low, high = (middle, high) if fits else (low, middle)
     return low
 
@@ -149,4 +162,32 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
         f"({source}). It would fit with {advice[0]}. (--no-memory-check skips this estimate, an upper bound.)"
+    )
+
+
+def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usable: float = 1.0) -> MemoryEstimate:
+    """Refuse (RunError) a run whose realization cannot fit in the smallest
+    memory limit of the Dask workers, naming that worker, its limit, the
+    per-task estimate and a grid that would fit. ``limits``: bytes by worker
+    address, 0 or None for a worker without a limit (skipped). ``usable``: the
+    fraction of its limit at which a worker is killed (Dask's
+    ``distributed.worker.memory.terminate``)."""
+    guess = estimate(scene, workers=1, executor="dask")
+    bounded = {address: limit for address, limit in limits.items() if limit}
+    if not bounded:
+        return guess
+    address, limit = min(bounded.items(), key=lambda item: item[1])
+    need, room = _in_dask_worker(guess), int(limit * usable)
+    if need <= room:
+        return guess
+    smallest = f"the smallest of {len(bounded)} workers with a limit; " if len(bounded) > 1 else ""
+    advice = f"workers with a memory limit of at least {gib(math.ceil(need / usable))}"
+    one_point = estimate(scene, workers=1, executor="dask", points=1)
+    if hasattr(scene.spectrum.params, "points") and _in_dask_worker(one_point) <= room:
+        advice = f"spectrum.params.points <= {_most_points(scene, 'dask', room, _in_dask_worker):,}, or on " + advice
+    raise RunError(
+        f"one realization of {guess.points:,} points would need about {gib(need)} in a Dask worker "
+        f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "
+        f"{address} has a memory limit of {gib(limit)} ({smallest}Dask kills a worker at {usable:.0%} of its limit). "
+        f"It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
     )

@@ -9,8 +9,8 @@ from pathlib import Path
 
 from . import engine
 from .ensemble import RunOutcome
-from .executors import default_workers
-from .memory import check_fits
+from .executors import dask_memory_limits, default_workers
+from .memory import check_fits, check_worker_limits
 from .preset import Scene
 from .results import write_results
 from .rundir import RunDirectory
@@ -36,7 +36,8 @@ def run_to_folder(
     and every chunk of realizations as it finishes. ``resume=True`` continues a
     run left there (interrupted, killed, crashed) with the same preset,
     computing only what is missing. ``memory_check`` refuses, before anything
-    starts, a run whose estimated peak memory exceeds what is available.
+    starts, a run whose estimated peak memory exceeds what is available (and
+    on Dask, one whose realization exceeds a worker's memory limit).
 
     What finished is written even when the run was cancelled or interrupted.
     Returns the outcome and the paths of the files written.
@@ -44,8 +45,11 @@ def run_to_folder(
     total = scene.preset.realizations
     count = min(total, default_workers() if workers is None else max(1, int(workers)))
     if memory_check:
-        kind = executor or ("processes" if count > 1 else "serial")
+        kind = executor or ("dask" if scheduler else "processes" if count > 1 else "serial")
         check_fits(scene, workers=count, executor=kind, remote_workers=bool(scheduler))
+        if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
+            limits, usable = dask_memory_limits(scheduler, count)
+            check_worker_limits(scene, limits, usable=usable)
     with RunDirectory(out_dir) as run_dir:
         restored = run_dir.start(scene, resume=resume)
         outcome = engine.run(

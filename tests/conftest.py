@@ -1,4 +1,6 @@
+import contextlib
 import copy
+import logging
 from pathlib import Path
 
 import pytest
@@ -48,3 +50,23 @@ def make_scene(registry):
         return build_scene(merge(base, changes or {}), registry=registry)
 
     return make
+
+
+@contextlib.contextmanager
+def loopback_cluster(n_workers: int, **options):
+    """A real Dask LocalCluster of worker processes on 127.0.0.1, dashboards off
+    (tests never leave this machine)."""
+    import distributed
+
+    with distributed.LocalCluster(
+        n_workers=n_workers,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+        silence_logs=logging.ERROR,
+        **options,
+    ) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        yield cluster

@@ -18,6 +18,8 @@ from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
 from frictionlab_spectra.power_law import PowerLaw
 
+from .conftest import loopback_cluster
+
 
 def same_numbers(one, two):
     assert one.per_realization.keys() == two.per_realization.keys()
@@ -148,18 +150,7 @@ needs_dask = pytest.mark.skipif(distributed is None, reason='dask is not install
 
 @pytest.fixture(scope="module")
 def dask_scheduler():
-    import logging
-
-    with distributed.LocalCluster(
-        n_workers=2,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-        silence_logs=logging.ERROR,
-    ) as cluster:
-        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+    with loopback_cluster(2) as cluster:
         yield cluster.scheduler_address
 
 
@@ -184,3 +175,17 @@ def test_dask_own_local_cluster_of_one_worker_gives_the_serial_numbers(scene_24,
     outcome = engine.run(scene_24, workers=1, executor="dask")
     assert outcome.status == "completed" and outcome.workers == 1
     same_numbers(serial_24, outcome)
+
+
+@needs_dask
+def test_dask_memory_limits_foresee_those_of_the_local_cluster(dask_scheduler):
+    from frictionlab.executors import dask_memory_limits
+
+    # the fixture's cluster is built like the executor's own LocalCluster: what
+    # the memory check expects without starting one is what Dask then gives
+    reported, usable = dask_memory_limits(dask_scheduler)
+    foreseen, _ = dask_memory_limits(None, 2)
+    assert len(reported) == 2 and all(address.startswith("tcp://127.0.0.1:") for address in reported)
+    assert sorted(foreseen.values()) == sorted(reported.values())
+    assert all(limit > 0 for limit in reported.values())
+    assert 0 < usable <= 1

@@ -16,7 +16,7 @@ from frictionlab.cli import main
 from frictionlab.errors import RunError
 from frictionlab.preset import build_scene
 
-from .conftest import SMALL_PRESET, merge
+from .conftest import SMALL_PRESET, loopback_cluster, merge
 
 GiB = 2**30
 
@@ -120,3 +120,106 @@ def test_available_memory_is_positive_and_below_the_machine_total():
     total = next(int(line.split()[1]) * 1024 for line in Path("/proc/meminfo").read_text().splitlines() if line.startswith("MemTotal:"))
     assert 0 < available <= total
     assert source
+
+
+# ------------------------------------------------------------------ Dask workers' memory limits
+
+MiB = 2**20
+
+
+def test_worker_check_takes_the_smallest_limit_and_skips_workers_without_one(registry):
+    scene = build_scene(line_of(1_000_000), registry=registry)  # 1e6 x 112 B = 107 MiB, plus the worker
+    need = memory.DASK_WORKER_PROCESS + memory.estimate(scene, workers=1, executor="dask").per_realization
+    # no limit (0, None) is never the smallest; a roomy limit passes
+    memory.check_worker_limits(scene, {"tcp://a:1": 0, "tcp://b:2": None, "tcp://c:3": need}, usable=1.0)
+    # the margin: Dask kills a worker at a fraction of its limit
+    with pytest.raises(RunError, match=r"worker tcp://c:3 has a memory limit of 0\.\d\d GiB \(Dask kills a worker at 95% of its limit\)"):
+        memory.check_worker_limits(scene, {"tcp://c:3": need}, usable=0.95)
+    with pytest.raises(RunError) as caught:
+        memory.check_worker_limits(scene, {"tcp://big:1": 4 * GiB, "tcp://small:2": 200 * MiB, "tcp://none:3": 0}, usable=0.95)
+    message = str(caught.value)
+    assert "Dask worker tcp://small:2 has a memory limit of 0.20 GiB (the smallest of 2 workers with a limit;" in message
+    assert message.startswith(f"one realization of 1,000,000 points would need about {need / GiB:.2f} GiB in a Dask worker")
+    offered = int(message.split("points <= ")[1].split(", or")[0].replace(",", ""))
+    room = int(200 * MiB * 0.95)
+    assert memory.DASK_WORKER_PROCESS + offered * memory.BYTES_PER_POINT < room
+    assert memory.DASK_WORKER_PROCESS + (offered + 1) * memory.BYTES_PER_POINT + 16 * memory.BYTES_PER_STEP > room
+    # when even the worker process alone does not fit, only a larger limit helps
+    with pytest.raises(RunError, match=r"It would fit with workers with a memory limit of at least 0\.\d\d GiB\."):
+        memory.check_worker_limits(scene, {"tcp://tiny:1": 100 * MiB}, usable=0.95)
+
+
+try:
+    import distributed
+except ImportError:
+    distributed = None
+
+
+@pytest.fixture(scope="module")
+def small_worker_cluster():
+    """One worker process on loopback whose nanny kills it above 95% of 200 MiB."""
+    with loopback_cluster(1, memory_limit="200MiB") as cluster:
+        yield cluster.scheduler_address, next(iter(cluster.scheduler_info["workers"]))
+
+
+needs_dask = pytest.mark.skipif(distributed is None, reason='dask is not installed: pip install "frictionlab[dask]"')
+
+
+@needs_dask
+def test_cli_refuses_a_grid_too_large_for_the_dask_worker_before_submitting_anything(tmp_path, capsys, small_worker_cluster):
+    scheduler, worker = small_worker_cluster
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(line_of(1_000_000, realizations=4)))
+    out = tmp_path / "out"
+    code = main(["run", str(path), "--out", str(out), "--executor", "dask", "--scheduler", scheduler, "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert err.startswith("error: one realization of 1,000,000 points would need about ")
+    assert f"Dask worker {worker} has a memory limit of 0.20 GiB" in err
+    assert not out.exists()  # no run directory, no chunk
+    # the grid it offers really runs on that worker (a wrong bound would get it killed)
+    offered = int(err.split("points <= ")[1].split(", or")[0].replace(",", ""))
+    assert 300_000 < offered < 1_000_000
+    path.write_text(yaml.safe_dump(line_of(offered, realizations=2, **FULL_CONTACT)))
+    code = main(["run", str(path), "--out", str(out), "--executor", "dask", "--scheduler", scheduler, "--quiet", "--json"])
+    assert code == 0, capsys.readouterr().err
+
+
+@needs_dask
+def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the_refusal(registry, tmp_path, small_worker_cluster):
+    import threading
+
+    from frictionlab import engine
+    from frictionlab.runner import run_to_folder
+
+    from .test_executors import same_numbers
+
+    scheduler, _ = small_worker_cluster
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 12}), registry=registry)
+    outcome, _ = run_to_folder(scene, tmp_path / "small", executor="dask", scheduler=scheduler)
+    assert outcome.status == "completed" and outcome.extra["executor"] == "dask"
+    same_numbers(engine.run(scene, workers=1, executor="serial"), outcome)
+
+    # too large: refused by the check, not by the cluster; skipped with the check off
+    # (cancelled before the first realization, so nothing large ever runs)
+    large = build_scene(line_of(1_000_000, realizations=4), registry=registry)
+    cancelled = threading.Event()
+    cancelled.set()
+    with pytest.raises(RunError, match="has a memory limit of 0.20 GiB"):
+        run_to_folder(large, tmp_path / "large", executor="dask", scheduler=scheduler, cancel=cancelled)
+    outcome, _ = run_to_folder(large, tmp_path / "large", executor="dask", scheduler=scheduler, cancel=cancelled, memory_check=False)
+    assert outcome.status == "cancelled" and outcome.done == 0
+
+
+@needs_dask
+def test_own_local_cluster_is_checked_before_it_starts(registry, tmp_path, monkeypatch):
+    from distributed import worker_memory
+
+    from frictionlab.runner import run_to_folder
+
+    # as on a many-core machine, where "auto" gives each worker memory/cores
+    monkeypatch.setattr(worker_memory, "parse_memory_limit", lambda *args, **kwargs: 200 * MiB)
+    large = build_scene(line_of(1_000_000, realizations=4), registry=registry)
+    with pytest.raises(RunError, match=r"Dask worker 1 of the LocalCluster on 127\.0\.0\.1 has a memory limit of 0\.20 GiB"):
+        run_to_folder(large, tmp_path / "out", workers=2, executor="dask")
+    assert not (tmp_path / "out").exists()

@@ -546,6 +546,7 @@ def _builtin_cases():
         ("spectrum", "power-law"): [{"hurst": 0.8, "points": 256}, {"hurst": 0.3, "points": 255, "amplitudes": "rayleigh"}],
         ("spectrum", "rolloff"): [{"hurst": 1.0, "points": 256, "rolloff_wavelength": 64.0}],
         ("spectrum", "profile-file"): [{"path": "<profile>", "spacing": 0.5}],
+        ("spectrum", "surface-file"): [{"path": "<surface>", "spacing": 0.5}],
         ("spectrum", "power-law-2d"): [{"hurst": 0.8, "points": 32}, {"hurst": 0.3, "points": 31, "points_y": 40}],
         ("spectrum", "rolloff-2d"): [{"hurst": 1.0, "points": 48, "rolloff_wavelength": 16.0, "amplitudes": "rayleigh"}],
     }
@@ -563,6 +564,10 @@ def test_builtins_pass_the_conformance_checks(kind, cls, params, tmp_path):
         path = tmp_path / "profile.txt"
         np.savetxt(path, np.random.default_rng(3).standard_normal(200).cumsum())
         params["path"] = str(path)
+        deterministic = True
+    if params.get("path") == "<surface>":
+        params["path"] = str(tmp_path / "surface.npy")
+        np.save(params["path"], np.random.default_rng(3).standard_normal((16, 24)).cumsum(axis=1))
         deterministic = True
     fltesting.check_plugin(kind, cls, deterministic=deterministic, **params)
 

@@ -5,6 +5,7 @@ from frictionlab import hookimpl
 from .power_law import PowerLaw, Rolloff
 from .profile_file import ProfileFile
 from .surface import PowerLawSurface, RolloffSurface
+from .surface_file import SurfaceFile
 
 
 @hookimpl
@@ -14,3 +15,4 @@ def register_spectra(register):
     register(ProfileFile)
     register(PowerLawSurface)
     register(RolloffSurface)
+    register(SurfaceFile)

@@ -86,13 +86,13 @@ class ProfileFile(SpectrumGenerator):
         where = f"profile-file {str(path)!r}"
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
-        _check_finite(where, "heights", z)
+        check_finite(where, "heights", z)
         if x is None:
             if p.spacing is None:
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
             dx = p.spacing
         else:
-            _check_finite(where, "x", x)
+            check_finite(where, "x", x)
             dx = _uniform_spacing(where, x)
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
@@ -117,16 +117,9 @@ class ProfileFile(SpectrumGenerator):
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     """(x or None, z) as float64 arrays, from a .npy or a text file."""
     where = f"profile-file {str(path)!r}"
-    if not path.is_file():
-        raise ValueError(f"{where}: no such file")
-    suffix = path.suffix.lower()
+    suffix = file_suffix(path, where)
     if suffix == ".npy":
-        try:
-            data = np.load(path, allow_pickle=False)
-        except Exception as exc:  # corrupt file, pickled objects, ...
-            raise ValueError(f"{where}: not a readable .npy array ({exc})") from None
-        if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
-            raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
+        data = load_npy(path, where)
         if data.ndim == 2 and 1 in data.shape:
             data = data.reshape(-1)
         if data.ndim == 1:
@@ -136,9 +129,7 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
         if data.ndim == 2 and data.shape[0] == 2:
             return data[0].astype(np.float64), data[1].astype(np.float64)
         raise ValueError(f"{where}: array of shape {data.shape}; expected (N,), (N, 2) or (2, N)")
-    if suffix not in (".csv", ".txt"):
-        raise ValueError(f"{where}: unknown file type {suffix!r}; use .csv, .txt or .npy")
-    data = _read_text(path, where)
+    data = read_text_table(path, where)
     if data.shape[1] == 1:
         return None, data[:, 0].copy()
     if data.shape[1] == 2:
@@ -146,7 +137,28 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z) or 2 (x, z)")
 
 
-def _read_text(path: Path, where: str) -> np.ndarray:
+def file_suffix(path: Path, where: str) -> str:
+    """".npy", ".csv" or ".txt" (lower case) of an existing file; ValueError otherwise."""
+    if not path.is_file():
+        raise ValueError(f"{where}: no such file")
+    suffix = path.suffix.lower()
+    if suffix not in (".npy", ".csv", ".txt"):
+        raise ValueError(f"{where}: unknown file type {suffix!r}; use .csv, .txt or .npy")
+    return suffix
+
+
+def load_npy(path: Path, where: str) -> np.ndarray:
+    """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
+    try:
+        data = np.load(path, allow_pickle=False)
+    except Exception as exc:  # corrupt file, pickled objects, ...
+        raise ValueError(f"{where}: not a readable .npy array ({exc})") from None
+    if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
+        raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
+    return data
+
+
+def read_text_table(path: Path, where: str) -> np.ndarray:
     """Rows x columns of float64; one non-numeric header line is skipped."""
     skip, delimiter = 0, None
     try:
@@ -173,13 +185,13 @@ def _read_text(path: Path, where: str) -> np.ndarray:
     return data
 
 
-def _check_finite(where: str, what: str, values: np.ndarray) -> None:
+def check_finite(where: str, what: str, values: np.ndarray) -> None:
+    """ValueError counting the NaN/inf in ``values`` and locating the first (index, or row and column)."""
     bad = ~np.isfinite(values)
     if bad.any():
-        raise ValueError(
-            f"{where}: {int(bad.sum())} non-finite value(s) (NaN or inf) in {what}, "
-            f"the first at index {int(np.argmax(bad))}"
-        )
+        first = np.unravel_index(int(np.argmax(bad)), bad.shape)
+        at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
+        raise ValueError(f"{where}: {int(bad.sum())} non-finite value(s) (NaN or inf) in {what}, the first at {at}")
 
 
 def _uniform_spacing(where: str, x: np.ndarray) -> float:
@@ -196,10 +208,15 @@ def _uniform_spacing(where: str, x: np.ndarray) -> float:
     return float(dx)
 
 
+def remove_mean(z: np.ndarray) -> np.ndarray:
+    """A new array: ``z`` minus its mean (a line or a map)."""
+    return z - z.mean()
+
+
 def _detrend(z: np.ndarray, mode: str) -> np.ndarray:
     if mode == "none":
         return z.copy()
-    out = z - z.mean()
+    out = remove_mean(z)
     if mode == "tilt":
         t = np.arange(z.size, dtype=np.float64)
         t -= t.mean()

@@ -12,7 +12,10 @@ Conventions
   (no 2 pi factors): <z^2> = integral of C2D over the whole q plane
   = 2 pi integral_0^inf q C2D(q) dq, and <|grad z|^2> = 2 pi integral q^3 C2D dq.
   With this convention the MDR rule C1D(q) = pi q C2D(q) keeps both moments:
-  2 integral pi q C2D dq = 2 pi integral q C2D dq (and likewise with q^2).
+  2 integral pi q C2D dq = 2 pi integral q C2D dq (and likewise with q^2). That is the
+  continuum: on the grid the line (1.128 times the side) has its lowest mode below the
+  band when long_cutoff is the side, so ``equivalent_line()`` then misses the longest
+  wave (README, "Known limit" under the MDR mapping; not yet fixed).
 - Every mode q of the plane with q_min <= |q| <= q_max (edges inclusive to a relative
   1e-9) has variance a_q^2 = C2D(|q|) dqx dqy; the surface is real (modes q and -q are
   conjugate), so <z> = 0 and, for fixed amplitudes, mean(z^2) = sum_q a_q^2 exactly.
