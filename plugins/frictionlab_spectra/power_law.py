@@ -180,6 +180,40 @@ class _Synthesis:
     amplitudes: np.ndarray  # a_k, k_lo .. k_hi (Nyquist included)
 
 
+def line_coefficients(amplitudes: np.ndarray, points: int, k_hi: int) -> tuple[np.ndarray, float]:
+    """irfft coefficients of mode amplitudes a_k ending at mode ``k_hi`` of an
+    N-point line: ((N/2) a_k for the regular modes, N a / sqrt(2) for the Nyquist
+    mode if the modes reach it, else 0.0). The Nyquist coefficient is real, and
+    N a/sqrt(2) (-1)^j has variance a^2/2 after irfft."""
+    if points % 2 == 0 and k_hi == points // 2:
+        return (0.5 * points) * amplitudes[:-1], points * amplitudes[-1] * SQRT_HALF
+    return (0.5 * points) * amplitudes, 0.0
+
+
+def random_phase_line(coeff: np.ndarray, nyquist: float, k_lo: int, points: int, rng: np.random.Generator,
+                      *, rayleigh: bool = False) -> np.ndarray:  # fmt: skip
+    """An N-point line from the irfft coefficients of ``line_coefficients`` (modes
+    k_lo ..), with uniform random phases (fixed amplitudes) or complex Gaussian
+    modes (Rayleigh amplitudes), the Nyquist coefficient with a random sign (or a
+    Gaussian factor)."""
+    m = coeff.size
+    # only up to the top mode: irfft zero-pads the rest, and a short fresh buffer is
+    # markedly cheaper than an N/2 one (large fresh allocations cost page faults)
+    spectrum = np.zeros(k_lo + m + (1 if nyquist else 0), dtype=np.complex128)
+    # draw only for the modes in the band: with the default cut-off that is N/10 of them
+    if not rayleigh:
+        spectrum[k_lo : k_lo + m] = coeff * np.exp(1j * (TWO_PI * rng.random(m)))
+        if nyquist:
+            spectrum[-1] = nyquist if rng.random() < 0.5 else -nyquist
+    else:
+        # complex Gaussian, E|g|^2 = 1 after the 1/sqrt(2): uniform phase, Rayleigh modulus
+        g = rng.standard_normal(2 * m).view(np.complex128)
+        spectrum[k_lo : k_lo + m] = (SQRT_HALF * coeff) * g
+        if nyquist:
+            spectrum[-1] = nyquist * rng.standard_normal()
+    return scipy.fft.irfft(spectrum, n=points)  # ~10% faster than numpy here
+
+
 class BandLimitedSpectrum(SpectrumGenerator):
     """Shared synthesis of ``power-law`` and ``rolloff`` (not registered itself)."""
 
@@ -262,13 +296,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
             psd_knee = (0.5 * scale) ** 2 / band.dq
         if not (math.isfinite(h) and h > 0 and np.all(np.isfinite(amplitudes))):
             raise ValueError(f"c0={p.c0!r} gives amplitudes that are not finite positive numbers")
-        nyquist = 0.0
-        coeff = amplitudes
-        if n % 2 == 0 and band.k_hi == n // 2:
-            # the Nyquist coefficient is real: N a/sqrt(2) (-1)^j has variance a^2/2 after irfft
-            nyquist = n * amplitudes[-1] * SQRT_HALF
-            coeff = amplitudes[:-1]
-        coeff = (0.5 * n) * coeff
+        coeff, nyquist = line_coefficients(amplitudes, n, band.k_hi)
         self._cache = _Synthesis(key, band, psd_knee, h, coeff, nyquist, amplitudes)
         return self._cache
 
@@ -294,22 +322,10 @@ class BandLimitedSpectrum(SpectrumGenerator):
     def generate(self, rng: np.random.Generator) -> Profile:
         """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes)."""
         s = self._synthesis()
-        n, lo, m = s.band.points, s.band.k_lo, s.coeff.size
-        # only up to the band's top mode: irfft zero-pads the rest, and a short fresh buffer is
-        # markedly cheaper than an N/2 one (large fresh allocations cost page faults)
-        spectrum = np.zeros(s.band.k_hi + 1, dtype=np.complex128)
-        # draw only for the modes in the band: with the default cut-off that is N/10 of them
-        if self.params.amplitudes == "fixed":
-            spectrum[lo : lo + m] = s.coeff * np.exp(1j * (TWO_PI * rng.random(m)))
-            if s.nyquist:
-                spectrum[-1] = s.nyquist if rng.random() < 0.5 else -s.nyquist
-        else:
-            # complex Gaussian, E|g|^2 = 1 after the 1/sqrt(2): uniform phase, Rayleigh modulus
-            g = rng.standard_normal(2 * m).view(np.complex128)
-            spectrum[lo : lo + m] = (SQRT_HALF * s.coeff) * g
-            if s.nyquist:
-                spectrum[-1] = s.nyquist * rng.standard_normal()
-        return Profile(heights=scipy.fft.irfft(spectrum, n=n), spacing=s.band.spacing)  # ~10% faster than numpy here
+        heights = random_phase_line(
+            s.coeff, s.nyquist, s.band.k_lo, s.band.points, rng, rayleigh=self.params.amplitudes != "fixed"
+        )
+        return Profile(heights=heights, spacing=s.band.spacing)
 
     def rms_height(self) -> float:
         """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude line,

@@ -34,11 +34,11 @@ from pydantic import Field, model_validator
 
 from frictionlab import PluginParams, Profile, SpectrumGenerator
 
+from .power_law import TWO_PI, line_coefficients, random_phase_line
 from .profile_file import check_finite, file_suffix, load_npy, read_text_table, remove_mean
 from .surface import GEIKE_POPOV_2007, MDR_BOOK
 
 MIN_SIDE = 8
-TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -192,6 +192,8 @@ class _LineSynthesis:
     wavenumber: np.ndarray  # q_k, k = 1 .. N // 2
     amplitude: np.ndarray  # a_k of z = sum a_k cos(q_k x + phi_k), sum a_k^2 / 2 == h^2
     scale: float  # the normalisation to h: line C1D / (pi q C2D)
+    coeff: np.ndarray  # irfft coefficients of the regular modes (``line_coefficients``)
+    nyquist: float  # and of the Nyquist mode (0.0 for odd N)
 
 
 class MeasuredEquivalentLine(SpectrumGenerator):
@@ -234,17 +236,16 @@ class MeasuredEquivalentLine(SpectrumGenerator):
         q = dq * np.arange(1, p.points // 2 + 1)
         shape = 2.0 * np.sqrt(math.pi * q * np.asarray(p.surface_psd) * dq)  # a_k^2 / 2 = 2 C1D dq
         factor = p.rms_height / math.sqrt(0.5 * float(np.dot(shape, shape)))
-        self._cache = _LineSynthesis(key, q, factor * shape, factor**2)
+        amplitude = factor * shape
+        coeff, nyquist = line_coefficients(amplitude, p.points, p.points // 2)
+        self._cache = _LineSynthesis(key, q, amplitude, factor**2, coeff, nyquist)
         return self._cache
 
     def generate(self, rng: np.random.Generator) -> Profile:
         """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform from ``rng``."""
-        s, n = self._synthesis(), self.params.points
-        spectrum = np.zeros(n // 2 + 1, dtype=np.complex128)
-        spectrum[1:] = (0.5 * n) * s.amplitude * np.exp(1j * (TWO_PI * rng.random(s.amplitude.size)))
-        if n % 2 == 0:  # the Nyquist coefficient is real: N a / sqrt(2) (+-1) has variance a^2 / 2
-            spectrum[-1] = (1.0 if rng.random() < 0.5 else -1.0) * n * s.amplitude[-1] * math.sqrt(0.5)
-        return Profile(heights=scipy.fft.irfft(spectrum, n=n), spacing=self.params.spacing)
+        s = self._synthesis()
+        return Profile(heights=random_phase_line(s.coeff, s.nyquist, 1, self.params.points, rng),
+                       spacing=self.params.spacing)  # fmt: skip
 
     def rms_height(self) -> float:
         """The map's rms height: exact for every line (fixed amplitudes)."""
