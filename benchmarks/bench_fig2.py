@@ -38,6 +38,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3, help="best of this many runs")
     parser.add_argument("--naive-realizations", type=int, default=2, help="realizations timed with the naive solver")
     args = parser.parse_args()
+    for name in ("repeat", "naive_realizations"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be >= 1. Got {getattr(args, name)} instead.")
 
     scene = load_scene(PRESET, ["fit.bootstrap=1000"])
     m = scene.preset.realizations
