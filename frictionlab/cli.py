@@ -125,7 +125,7 @@ def cmd_validate(args) -> ExitCode:
                 points = len(load_sweep(path, args.set or []).points)
         except PresetError as exc:
             print(str(exc), file=sys.stderr)
-            worst = ExitCode.USAGE
+            worst = ExitCode(max(worst, exc.exit_code))
             continue
         preset = scene.preset
         print(

@@ -143,7 +143,7 @@ def test_missing_required_and_file_errors(tmp_path, capsys):
     del data["loading"]
     assert main(["validate", str(write_preset(tmp_path, data))]) == ExitCode.USAGE
     assert "loading: is required" in capsys.readouterr().err
-    assert main(["validate", str(tmp_path / "nope.yaml")]) == ExitCode.USAGE
+    assert main(["validate", str(tmp_path / "nope.yaml")]) == ExitCode.INPUT_FILE
     assert "no such preset file" in capsys.readouterr().err
     broken = tmp_path / "broken.yaml"
     broken.write_text("name: x\nspectrum: [unclosed\n")
