@@ -10,6 +10,7 @@ hooks as any third-party plugin.
 from importlib.metadata import PackageNotFoundError, version
 
 from .hookspecs import hookimpl
+from .inputs import InputFile, InputFileProblem, open_regular_file
 from .plugin import (
     ContactCurve,
     ContactSolver,
@@ -28,6 +29,8 @@ except PackageNotFoundError:  # running from a source tree without install
 __all__ = [
     "ContactCurve",
     "ContactSolver",
+    "InputFile",
+    "InputFileProblem",
     "Plugin",
     "PluginParams",
     "Profile",
@@ -35,4 +38,5 @@ __all__ = [
     "SpectrumGenerator",
     "__version__",
     "hookimpl",
+    "open_regular_file",
 ]

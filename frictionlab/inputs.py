@@ -57,11 +57,11 @@ def regular_file_problem(path: str | Path) -> str | None:
     return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, not a regular file"
 
 
-def read_regular_file(path: str | Path, limit: int | None = None, what: str = "file") -> bytes:
-    """The bytes of the regular file ``path``; InputFileProblem if it is
-    missing, not a regular file, unreadable or larger than ``limit`` bytes
-    (refused by its size, before anything is read). The message says what is
-    wrong (``no such <what>``, ``is a FIFO ...``), the caller says where."""
+def open_regular_file(path: str | Path, what: str = "file"):
+    """``path`` opened for binary reading, once it is known to be a regular file
+    (opened without blocking, checked on the open descriptor); InputFileProblem
+    otherwise. The message says what is wrong (``no such <what>``, ``is a FIFO
+    ...``); the caller says where."""
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
     except (FileNotFoundError, NotADirectoryError):
@@ -69,12 +69,21 @@ def read_regular_file(path: str | Path, limit: int | None = None, what: str = "f
     except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
         reason = getattr(exc, "strerror", None) or "cannot be opened"
         raise InputFileProblem(f"{what} cannot be read: {reason[:1].lower() + reason[1:]}") from None
-    with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise InputFileProblem(f"{what} is {file_kind(info.st_mode)}, not a regular file")
-        if limit is not None and info.st_size > limit:
-            raise InputFileProblem(f"{what} of {info.st_size:,} bytes, more than the limit of {limit:,} bytes")
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise InputFileProblem(f"{what} is {file_kind(mode)}, not a regular file")
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def read_regular_file(path: str | Path, limit: int | None = None, what: str = "file") -> bytes:
+    """The bytes of the regular file ``path`` (see ``open_regular_file``), refused
+    by its size before anything is read when it is over ``limit`` bytes."""
+    with open_regular_file(path, what) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if limit is not None and size > limit:
+            raise InputFileProblem(f"{what} of {size:,} bytes, more than the limit of {limit:,} bytes")
         data = fh.read() if limit is None else fh.read(limit + 1)
     if limit is not None and len(data) > limit:  # it grew while read
         raise InputFileProblem(f"{what} of more than the limit of {limit:,} bytes")
@@ -84,19 +93,10 @@ def read_regular_file(path: str | Path, limit: int | None = None, what: str = "f
 def sha256_of(path: str | Path) -> str:
     """SHA-256 (hex) of the regular file ``path``, read in blocks."""
     digest = hashlib.sha256()
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
-    with os.fdopen(fd, "rb") as fh:
-        mode = os.fstat(fd).st_mode
-        if not stat.S_ISREG(mode):
-            raise InputFileProblem(f"is {file_kind(mode)}, not a regular file")
+    with open_regular_file(path) as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
-
-
-def text_line_of(data: bytes, offset: int) -> int:
-    """The 1-based line number of byte ``offset`` in ``data``."""
-    return data.count(b"\n", 0, offset) + 1
 
 
 # ------------------------------------------------------------------ plugin parameters

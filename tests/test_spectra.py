@@ -571,7 +571,7 @@ def test_profile_file_errors(tmp_path):
     assert "7 points" in message and "8" in message
 
     message = _profile_error(path=_write(tmp_path, "text.csv", heights.replace("\n", "\nabc\n", 1)), spacing=1.0)
-    assert "non-numeric" in message and "abc" in message
+    assert "non-numeric content at line 2" in message and "abc" not in message  # named, never quoted
 
     message = _profile_error(path=_write(tmp_path, "flat.txt", "\n".join(["2.5"] * 20)), spacing=1.0)
     assert "constant" in message

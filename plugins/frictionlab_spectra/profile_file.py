@@ -25,7 +25,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -48,8 +48,8 @@ class ProfileFile(SpectrumGenerator):
     references: ClassVar[tuple[str, ...]] = ()
 
     class Params(PluginParams):
-        path: str = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z",
-                          min_length=1)
+        path: InputFile = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z; "
+                                "a relative path is taken from the preset file's folder", min_length=1)
         spacing: float | None = Field(
             None,
             description="grid spacing dx; required if the file has only heights, must agree with x otherwise",
@@ -81,7 +81,7 @@ class ProfileFile(SpectrumGenerator):
         if cached is not None and cached.key == key:
             return cached
         p = self.params
-        path = Path(p.path).expanduser()
+        path = Path(p.path)
         x, z = _read_columns(path)
         where = f"profile-file {str(path)!r}"
         if z.size < MIN_POINTS:
@@ -139,7 +139,7 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
 
 def file_suffix(path: Path, where: str) -> str:
     """".npy", ".csv" or ".txt" (lower case) of an existing file; ValueError otherwise."""
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"{where}: no such file")
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv", ".txt"):
@@ -147,42 +147,77 @@ def file_suffix(path: Path, where: str) -> str:
     return suffix
 
 
+def _open(path: Path, where: str):
+    """The file opened for reading if it is a regular file (never a FIFO or a device)."""
+    try:
+        return open_regular_file(path)
+    except InputFileProblem as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
 def load_npy(path: Path, where: str) -> np.ndarray:
     """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:  # corrupt file, pickled objects, ...
-        raise ValueError(f"{where}: not a readable .npy array ({exc})") from None
+    with _open(path, where) as fh:
+        try:
+            data = np.load(fh, allow_pickle=False)
+        except Exception as exc:  # corrupt file, pickled objects, ...: named, never quoted
+            raise ValueError(f"{where}: not a readable .npy array ({type(exc).__name__})") from None
     if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
     return data
 
 
-def read_text_table(path: Path, where: str) -> np.ndarray:
-    """Rows x columns of float64; one non-numeric header line is skipped."""
-    skip, delimiter = 0, None
+def _numbers(text: str, delimiter: str | None) -> bool:
     try:
-        with path.open() as fh:
-            for lineno, line in enumerate(fh, start=1):
-                text = line.split("#", 1)[0].strip()
-                if not text:
-                    continue
-                delimiter = "," if "," in text else None
-                try:
-                    [float(tok) for tok in text.split(delimiter)]
-                except ValueError:
-                    skip = lineno  # a header such as "x,z"
-                break
+        [float(token) for token in text.split(delimiter)]
+    except ValueError:
+        return False
+    return True
+
+
+def read_text_table(path: Path, where: str) -> np.ndarray:
+    """Rows x columns of float64; one non-numeric header line is skipped. A
+    problem names the line, never its content."""
+    with _open(path, where) as fh:
+        raw = fh.read()
+    try:
+        lines = raw.decode("utf-8").splitlines()
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line})") from None
+    skip, delimiter = 0, None
+    for lineno, line in enumerate(lines, start=1):
+        text = line.split("#", 1)[0].strip()
+        if text:
+            delimiter = "," if "," in text else None
+            skip = 0 if _numbers(text, delimiter) else lineno  # a header such as "x,z"
+            break
+    try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
-            data = np.loadtxt(path, dtype=np.float64, delimiter=delimiter, comments="#", skiprows=skip, ndmin=2)
-    except UnicodeDecodeError:
-        raise ValueError(f"{where}: not a text file") from None
-    except ValueError as exc:
-        raise ValueError(f"{where}: non-numeric content ({exc})") from None
+            data = np.loadtxt(lines[skip:], dtype=np.float64, delimiter=delimiter, comments="#", ndmin=2)
+    except ValueError:
+        raise ValueError(f"{where}: {_first_bad_line(lines, skip, delimiter)}") from None
     if data.size == 0:
         data = np.zeros((0, 1))
     return data
+
+
+def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
+    """Where a table stops being one: the first line that is not numbers, or
+    whose column count differs from the first data line's."""
+    columns = None
+    for lineno, line in enumerate(lines[skip:], start=skip + 1):
+        text = line.split("#", 1)[0].strip()
+        if not text:
+            continue
+        if not _numbers(text, delimiter):
+            return f"non-numeric content at line {lineno} (expected numbers separated by {delimiter or 'spaces'})"
+        count = len(text.split(delimiter))
+        if columns is not None and count != columns:
+            return f"line {lineno} has {count} columns, the lines before it {columns}"
+        columns = count
+    return "not a table of numbers"
 
 
 def check_finite(where: str, what: str, values: np.ndarray) -> None:

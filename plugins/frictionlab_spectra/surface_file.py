@@ -32,7 +32,7 @@ import numpy as np
 import scipy.fft
 from pydantic import Field, model_validator
 
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
 from .power_law import TWO_PI, line_coefficients, random_phase_line
 from .profile_file import check_finite, file_suffix, load_npy, read_text_table, remove_mean
@@ -87,8 +87,8 @@ class SurfaceFile(SpectrumGenerator):
     dimension: ClassVar[int] = 2
 
     class Params(PluginParams):
-        path: str = Field(description="file of heights (.npy 2D array, or .csv/.txt matrix: one map row per line)",
-                          min_length=1)
+        path: InputFile = Field(description="file of heights (.npy 2D array, or .csv/.txt matrix: one map row per "
+                                "line); a relative path is taken from the preset file's folder", min_length=1)
         spacing: float = Field(description="pixel side dx (square pixels), in the units of the heights' x", gt=0.0)
         detrend: Literal["none", "mean", "plane"] = Field(
             "mean",
@@ -135,7 +135,7 @@ class SurfaceFile(SpectrumGenerator):
         if cached is not None and cached.key == key:
             return cached
         p = self.params
-        path = Path(p.path).expanduser()
+        path = Path(p.path)
         where = f"surface-file {str(path)!r}"
         z = _read_map(path, where)
         check_finite(where, "heights", z)
