@@ -6,12 +6,13 @@ depend on the executor: every realization draws from its own seed, and the
 statistics are formed by index afterwards.
 
 * ``serial``: in this process, realization by realization.
-* ``processes``: a ``ProcessPoolExecutor`` on this machine. A worker that dies
-  (killed, out of memory) breaks the pool: the pool is rebuilt and only the
-  unfinished chunks are submitted again, a bounded number of times.
+* ``processes``: a pool of worker processes on this machine (``pool``). A
+  worker that dies at any moment (killed, out of memory, even while it sends
+  its result) is replaced and its chunk runs again, a bounded number of times.
 * ``dask``: a ``distributed.Client`` on an existing scheduler, or on a
-  ``LocalCluster`` bound to loopback. The scene is broadcast once; Dask itself
-  reschedules the tasks of a worker that dies.
+  ``LocalCluster`` of this user's own on loopback, reached over TLS with
+  credentials made for the run (``dask_security``). The scene is broadcast
+  once; Dask itself reschedules the tasks of a worker that dies.
 """
 
 from __future__ import annotations
@@ -26,10 +27,9 @@ import threading
 import time
 import uuid
 from collections.abc import Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 
 from .errors import FrictionlabError, RunError
+from .pool import JobFailed, WorkerLost, WorkerPool
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk
 
@@ -47,6 +47,7 @@ def default_workers() -> int:
 
 TARGET_CHUNK_SECONDS = 0.5  # task overhead is ~1 ms (pool) to ~5 ms (Dask): well under 2% of this
 CHUNKS_PER_WORKER = 4  # at least this many, for load balance and progress
+MAX_CHUNKS = 4096  # at most this many per run: the run folder's manifest lists every chunk
 
 
 def plan_chunks(
@@ -55,16 +56,18 @@ def plan_chunks(
     seconds_each: float,
     target: float = TARGET_CHUNK_SECONDS,
     per_worker: int = CHUNKS_PER_WORKER,
+    max_chunks: int = MAX_CHUNKS,
 ) -> list[Chunk]:
     """Split ``indices`` into consecutive chunks of about ``target`` seconds each
     (from the measured ``seconds_each`` of one realization), but into at least
-    ``per_worker`` chunks per worker while there are enough indices."""
+    ``per_worker`` chunks per worker while there are enough indices, and into
+    no more than ``max_chunks``."""
     indices = list(indices)
     if not indices:
         return []
     by_cost = max(1, int(target / max(seconds_each, 1e-9)))
     by_balance = max(1, math.ceil(len(indices) / (max(1, workers) * per_worker)))
-    size = min(by_cost, by_balance)
+    size = max(min(by_cost, by_balance), math.ceil(len(indices) / max_chunks))
     return [indices[i : i + size] for i in range(0, len(indices), size)]
 
 
@@ -120,7 +123,6 @@ def _die_with_parent() -> None:
 def _init_worker(scene: Scene) -> None:
     global _worker_scene
     _worker_scene = scene
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     _die_with_parent()
 
 
@@ -138,8 +140,8 @@ def pool_context():
 
 
 class ProcessExecutor:
-    """A local process pool. ``retries``: how many times a chunk is submitted
-    again after the pool broke while it ran (a worker died)."""
+    """A local pool of worker processes. ``retries``: how many times a chunk
+    runs again after its worker died (then the run fails, naming the chunk)."""
 
     name = "processes"
 
@@ -148,55 +150,22 @@ class ProcessExecutor:
         self.retries = retries
 
     def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
-        todo = dict(enumerate(chunks))
-        attempts = dict.fromkeys(todo, 0)
-        while todo:
-            broken, running = yield from self._one_pool(scene, todo, cancel)
-            if not broken:
-                return
-            # Charge the chunks that were running when a worker died; submit the rest again.
-            for key in (running & todo.keys()) or todo.keys():
-                attempts[key] += 1
-                if attempts[key] > self.retries:
-                    raise RunError(
-                        f"a worker process died {attempts[key]} times while running realizations "
-                        f"{chunk_label(todo[key])} ({broken}); giving up"
-                    )
-
-    def _one_pool(self, scene, todo: dict[int, Chunk], cancel):
-        """Run ``todo`` on a fresh pool, removing each chunk as it finishes.
-        Returns (why the pool broke or None, keys of the chunks seen running)."""
-        running: set[int] = set()
-        pool = ProcessPoolExecutor(
-            max_workers=min(self.workers, len(todo)),
-            mp_context=pool_context(),
-            initializer=_init_worker,
-            initargs=(scene,),
+        jobs = dict(enumerate(chunks))
+        pool = WorkerPool(
+            min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
-            futures = {pool.submit(_run_chunk, chunk): key for key, chunk in todo.items()}
-            pending = set(futures)
-            while pending:
-                if cancel.is_set():
-                    # Chunks already running finish and are kept; the rest never start.
-                    pending = {future for future in pending if not future.cancel()}
-                    finished, pending = wait(pending).done, set()
-                else:
-                    running |= {futures[f] for f in pending if f.running()}
-                    finished, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    key = futures[future]
-                    try:
-                        results = future.result()
-                    except BrokenProcessPool as exc:
-                        return str(exc) or "the pool broke", running
-                    chunk = todo.pop(key)
-                    yield chunk, results
-            if cancel.is_set():
-                todo.clear()
-            return None, running
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+            for key, results in pool.run(jobs, cancel):
+                yield jobs[key], results
+        except WorkerLost as lost:
+            raise RunError(
+                f"a worker process died {lost.deaths} times while running realizations "
+                f"{chunk_label(jobs[lost.key])} ({lost.how}); giving up"
+            ) from None
+        except JobFailed as failed:
+            raise RunError(
+                f"realizations {chunk_label(jobs[failed.key])} failed in a worker process: {failed.error}"
+            ) from None
 
 
 # ------------------------------------------------------------------ dask
