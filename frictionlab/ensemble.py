@@ -62,9 +62,12 @@ class Accumulator:
         return len(self.results) + len(self.failures)
 
     def add(self, result) -> None:
+        """Keep ``result``, replacing any earlier one of its index (never counted twice)."""
         if result.ok:
+            self.failures.pop(result.index, None)
             self.results[result.index] = result
         else:
+            self.results.pop(result.index, None)
             self.failures[result.index] = result.error
 
     def stack(self, name: str) -> np.ndarray:
@@ -96,7 +99,15 @@ class Accumulator:
         xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
         count = per["contact_count"].mean(axis=0) if n else nan_row
         fit = None
-        if n:
+        if n and not np.all(np.isfinite(f) & (f > 0)):
+            # a plugin's numbers overflowed: say which, rather than fail in the fit
+            status, error = "failed", (
+                f"the dimensionless force f = F / (stiffness h L) is not finite and > 0 at every load step "
+                f"(stiffness = {stiffness:g}, h = {rms_height:g}, L = {length:g}, F from {np.min(force):g} to "
+                f"{np.max(force):g}): the preset's magnitudes (solver.params, spectrum.params, loading) "
+                "leave double precision"
+            )
+        elif n:
             settings = scene.preset.fit
             fit = fit_log_law(
                 f,

@@ -28,13 +28,14 @@ import time
 import uuid
 from collections.abc import Iterator, Sequence
 
+from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .errors import FrictionlabError, RunError
 from .pool import JobFailed, WorkerLost, WorkerPool
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk
 
 EXECUTORS = ("serial", "processes", "dask")
-DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+__all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
 Chunk = list[int]
 
@@ -171,23 +172,6 @@ class ProcessExecutor:
 # ------------------------------------------------------------------ dask
 
 
-def import_distributed():
-    try:
-        import distributed
-    except ImportError:
-        raise FrictionlabError(DASK_MISSING) from None
-    return distributed
-
-
-def connect_scheduler(address: str):
-    """A ``distributed.Client`` on the scheduler at ``address``, or a RunError."""
-    distributed = import_distributed()
-    try:
-        return distributed.Client(address, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise RunError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
-
-
 def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[str, int | None], float]:
     """Each worker's memory limit on the cluster at ``scheduler`` (bytes by
     address; 0 or None: no limit), or without one those the ``LocalCluster`` of
@@ -214,35 +198,27 @@ def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[st
 
 
 class DaskExecutor:
-    """Chunks as Dask tasks. With ``scheduler`` (``tcp://HOST:PORT``) the run uses
-    that cluster's workers; without, a ``LocalCluster`` of ``workers`` single-thread
-    processes on 127.0.0.1, dashboard off, closed at the end. ``retries``: Dask
-    retries of a task that raised (a task whose worker died is rescheduled by Dask
-    up to its ``allowed-failures``)."""
+    """Chunks as Dask tasks. With ``scheduler`` (``tcp://`` or ``tls://HOST:PORT``)
+    the run uses that cluster's workers; without, a ``LocalCluster`` of
+    ``workers`` single-thread processes on 127.0.0.1 reached over TLS
+    (``dask_security``), dashboard off unless ``dashboard``, closed at the end.
+    ``retries``: Dask retries of a task that raised (a task whose worker died is
+    rescheduled by Dask up to its ``allowed-failures``)."""
 
     name = "dask"
 
-    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2):
+    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2, dashboard: bool = False):
         self.workers = workers
         self.scheduler = scheduler
         self.retries = retries
+        self.dashboard = dashboard
 
     def _connect(self):
-        distributed = import_distributed()
         if self.scheduler:
             client = connect_scheduler(self.scheduler)
             self.workers = max(1, len(client.scheduler_info().get("workers", {})))
             return client, None
-        cluster = distributed.LocalCluster(
-            n_workers=self.workers,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=None,
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # health routes only, loopback, any port
-            silence_logs=logging.ERROR,
-        )
-        return distributed.Client(cluster), cluster
+        return start_local_cluster(self.workers, dashboard=self.dashboard)
 
     def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         distributed = import_distributed()
@@ -288,7 +264,9 @@ class DaskExecutor:
                 cluster.close()
 
 
-def make_executor(name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2):
+def make_executor(
+    name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2, dashboard: bool = False
+):
     """The executor called ``name``; ``None`` is the embedded default: a process
     pool for more than one worker, in this process for one."""
     if name is None:
@@ -302,4 +280,4 @@ def make_executor(name: str | None, workers: int, *, scheduler: str | None = Non
     if name == "processes":
         return ProcessExecutor(workers, retries=retries)
     import_distributed()  # fail before anything starts
-    return DaskExecutor(workers, scheduler=scheduler, retries=retries)
+    return DaskExecutor(workers, scheduler=scheduler, retries=retries, dashboard=dashboard)

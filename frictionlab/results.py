@@ -84,7 +84,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "normalisation": {
             "rms_height": json_safe(outcome.rms_height),
             "length": json_safe(outcome.length),
-            "stiffness": outcome.stiffness,
+            "stiffness": json_safe(outcome.stiffness),
             "f": "F / (stiffness * rms_height * length)",
         },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,

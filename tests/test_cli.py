@@ -35,7 +35,7 @@ def run_cli(*args, env=None, **kwargs):
     )
 
 
-RUN_DIRECTORY = {"run.lock", "run.json", "chunks"}  # the run directory's own files (frictionlab.rundir)
+RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.rundir; run.lock is gone once it ends)
 
 
 def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
