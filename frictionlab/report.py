@@ -235,7 +235,7 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     )
 
 
-def run_figures(presets: Path, out_dir: Path, *, workers=None) -> list[FigureRun]:
+def run_figures(presets: Path, out_dir: Path, *, workers=None, force: bool = False) -> list[FigureRun]:
     from .sweep import load_sweep, run_sweep
 
     runs = []
@@ -245,16 +245,16 @@ def run_figures(presets: Path, out_dir: Path, *, workers=None) -> list[FigureRun
         data = load_preset_file(path)
         if data.get("sweep") is not None:
             run.sweep = load_sweep(path)
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, workers=workers, plot=False)
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, workers=workers, plot=False, force=force)
         else:
             run.scene = build_scene(data, source=str(path))
-            run.outcome, _ = run_to_folder(run.scene, run.folder, workers=workers)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, workers=workers, force=force)
         runs.append(run)
     return runs
 
 
 def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings=READINGS,
-                 folder_name="readings") -> list[ReadingRow]:  # fmt: skip
+                 folder_name="readings", force: bool = False) -> list[ReadingRow]:  # fmt: skip
     by_key = {run.study.key: run for run in runs}
     rows = []
     for number, reading in enumerate(readings, start=1):
@@ -273,7 +273,7 @@ def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
             folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
-            outcome, _ = run_to_folder(scene, folder, workers=workers)
+            outcome, _ = run_to_folder(scene, folder, workers=workers, force=force)
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip
@@ -624,21 +624,41 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
 # ------------------------------------------------------------------ the command
 
 
+FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
+
+
+def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: bool = False) -> tuple[Path, Path, Path]:
+    """The run folders, the markdown and the figures folder of a report: by
+    default all in a fresh folder ``runs/report-<timestamp>/`` (``REPRODUCTION.md``,
+    ``figures/``). An existing markdown or figure is refused unless ``force``."""
+    from .errors import OutputRefused
+
+    out_dir = Path(out_dir) if out_dir else Path("runs") / f"report-{time.strftime('%Y%m%d-%H%M%S')}"
+    markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
+    figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
+    taken = [p for p in (markdown_path, *(figures_dir / name for name in FIGURE_FILES)) if os.path.lexists(p)]
+    if taken and not force:
+        shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
+        raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")
+    return out_dir, markdown_path, figures_dir
+
+
 def write_report(
-    *, presets_dir=None, out_dir="runs/report", markdown_path="REPRODUCTION.md", figures_dir="docs/reproduction",
-    workers=None, readings=False, quiet=False, dpi=90,
+    *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
+    workers=None, readings=False, quiet=False, dpi=90, force=False,
 ) -> Path:  # fmt: skip
-    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path."""
+    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
+    Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless ``force``."""
     import sys
 
     from .results import atomic_write
 
     presets = find_presets(presets_dir)
-    out_dir, markdown_path, figures_dir = Path(out_dir), Path(markdown_path), Path(figures_dir)
+    out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=force)
     log = (lambda text: None) if quiet else (lambda text: print(text, file=sys.stderr, flush=True))
     started = time.perf_counter()
     log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-    runs = run_figures(presets, out_dir, workers=workers)
+    runs = run_figures(presets, out_dir, workers=workers, force=force)
     log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
     images = {}
     for run in runs:
@@ -651,13 +671,13 @@ def write_report(
     if readings:
         log(f"report: running {len(READINGS)} readings")
         t0 = time.perf_counter()
-        reading_rows = run_readings(runs, out_dir, workers=workers)
+        reading_rows = run_readings(runs, out_dir, workers=workers, force=force)
         readings_elapsed = time.perf_counter() - t0
         fig5 = next(run for run in runs if run.sweep is not None)
         log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
         t0 = time.perf_counter()
         fig5_rows = run_readings(runs, out_dir, workers=workers, readings=fig5_calibrated_readings(fig5.sweep),
-                                 folder_name="fig5-calibrated")  # fmt: skip
+                                 folder_name="fig5-calibrated", force=force)  # fmt: skip
         fig5_elapsed = time.perf_counter() - t0
         name = "fig5-calibrated.png"
         atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
@@ -678,7 +698,7 @@ def cmd_report(args) -> int:
         raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
     path = write_report(
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-        workers=args.workers, readings=args.readings, quiet=args.quiet,
+        workers=args.workers, readings=args.readings, quiet=args.quiet, force=args.force,
     )  # fmt: skip
     print(path)
     return ExitCode.OK
@@ -688,9 +708,10 @@ def add_parser(sub) -> None:
     """The ``report`` subcommand (registered by cli.build_parser)."""
     p = sub.add_parser("report", help="run the study's Figs. 2 to 5 and write REPRODUCTION.md with figures")
     p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets)")
-    p.add_argument("--out", metavar="DIR", default="runs/report", help="run folders (default: runs/report)")
-    p.add_argument("--markdown", metavar="FILE", default="REPRODUCTION.md", help="the report (default: REPRODUCTION.md)")
-    p.add_argument("--figures", metavar="DIR", default="docs/reproduction", help="PNG folder (default: docs/reproduction)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
+    p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
+    p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing report, its figures and runs")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores)")
     p.add_argument("--readings", action="store_true", help="also run the readings of the study's method (slower)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")

@@ -121,7 +121,7 @@ def command_line(args) -> str:
 
 
 def run_command(args) -> ExitCode:
-    from ..preset import apply_overrides, load_preset_file
+    from ..preset import read_preset
     from ..registry import default_registry
     from .axes import Study
     from .report import recommendation, write_outputs
@@ -131,7 +131,7 @@ def run_command(args) -> ExitCode:
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
-    data = apply_overrides(load_preset_file(args.preset), overrides)
+    data = read_preset(args.preset, overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=str(args.preset))
     out_dir = Path(args.out) if args.out else Path("runs") / f"{factory.base.preset.name}-study-{time.strftime('%Y%m%d-%H%M%S')}"
 

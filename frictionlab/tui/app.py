@@ -22,7 +22,7 @@ from textual.message import Message
 from textual.widgets import DataTable, Footer, ProgressBar, Static, TabbedContent, TabPane
 
 from ..errors import FrictionlabError, PresetError
-from ..preset import build_scene, load_preset_file
+from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
 from ..reporter import _duration
 from ..runner import run_to_folder
@@ -549,6 +549,8 @@ class FrictionlabApp(App):
             self.notify("No preset open: F2 lists them.", severity="warning")
             return
         try:
+            if self.draft_path is not None:  # relative input files are the preset file's neighbours
+                data = resolve_input_paths(data, self.draft_path.parent, self.registry)
             scene = build_scene(data, registry=self.registry)
             sweep = None
             if getattr(scene.preset, "sweep", None) is not None:  # every point is checked before any runs
