@@ -506,7 +506,12 @@ def _nested_model(annotation) -> type[BaseModel] | None:
 
 def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
     if isinstance(value, bool):
-        return f"{path}: must be a number, not true or false, got {value!r}"
+        return f"{path}: must be a number, not true or false, got {str(value).lower()}"
+    if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
+        try:
+            value = float(value)
+        except ValueError:
+            return None  # not a number at all: pydantic says so
     if isinstance(value, float) and not math.isfinite(value):
         return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
     if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):

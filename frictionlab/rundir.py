@@ -112,8 +112,9 @@ def _output_path_problem(path: Path) -> str | None:
         if candidate.exists() or candidate.is_symlink():
             if candidate.is_dir():
                 return None
-            what = "" if candidate == path else f"{candidate} is not a folder, so "
-            return f"{what}{path} cannot be made a folder: {candidate} is a file"
+            if candidate == path:
+                return f"{path} is a file, not a folder"
+            return f"{path} cannot be made a folder: {candidate} is a file"
     return None
 
 
