@@ -93,7 +93,8 @@ class Accumulator:
         rms_height = float(scene.spectrum.rms_height()) if n else math.nan
         stiffness = float(scene.solver.stiffness())
         force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
-        f = force / (stiffness * rms_height * length) if n else np.full(self.loads.size, math.nan)
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # an overflow is reported below
+            f = force / (stiffness * rms_height * length) if n else np.full(self.loads.size, math.nan)
         nan_row = np.full(self.loads.size, math.nan)
         xi_mean = per["xi"].mean(axis=0) if n else nan_row
         xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
