@@ -340,6 +340,10 @@ def main(argv: list[str] | None = None) -> int:
     except FrictionlabError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return int(exc.exit_code)
+    except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return int(ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
         code = interrupted_exit_code()
         print("terminated" if code == ExitCode.TERMINATED else "interrupted", file=sys.stderr)

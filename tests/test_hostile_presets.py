@@ -167,15 +167,17 @@ def test_a_huge_sweep_grid_is_counted_from_its_axes_and_refused(tmp_path):
 
 
 def test_a_closed_stdout_ends_the_command_quietly(tmp_path):
-    process = subprocess.Popen(
-        [sys.executable, "-m", "frictionlab", "plugins", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )  # fmt: skip
-    assert process.stdout.read(10) == b'{\n  "plugi'
-    process.stdout.close()  # as `| head -c 10` does
-    err = process.stderr.read().decode()
-    assert process.wait(timeout=30) == ExitCode.BROKEN_PIPE
-    assert err == ""
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # the reader is gone before anything is written (as `| head -c 10` once it has its bytes)
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "frictionlab", "plugins", "--json"], stdout=write_end, stderr=subprocess.PIPE,
+            cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
+        )  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert done.returncode == ExitCode.BROKEN_PIPE
+    assert done.stderr == b""
 
 
 # ------------------------------------------------------------------ data files and run folders
@@ -252,3 +254,13 @@ def test_numbers_that_overflow_in_the_run_name_what_overflowed(tmp_path, capsys)
     assert code == ExitCode.RUNTIME_FAILURE and "internal error" not in err.err
     assert "the dimensionless force f = F / (stiffness h L) is not finite" in err.err
     assert "warning" not in err.err
+
+
+def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(
+            [sys.executable, "-m", "frictionlab", "plugins", "--json"], stdout=full, stderr=subprocess.PIPE,
+            text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
+        )  # fmt: skip
+    assert done.returncode == ExitCode.RUNTIME_FAILURE
+    assert done.stderr == "error: No space left on device\n"

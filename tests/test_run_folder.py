@@ -218,3 +218,20 @@ def test_resume_refuses_an_input_file_that_changed(tmp_path, monkeypatch, capsys
     assert main(["resume", str(out), "--quiet"]) == ExitCode.RUN_FOLDER
     err = capsys.readouterr().err
     assert f"the input file spectrum.params.path ({tmp_path / 'scan.csv'}) changed since the run started" in err
+
+
+def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
+    preset = write(tmp_path / "s.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
+        "spectrum.params.hurst": {"values": [0.6, 0.9]}}}}))  # fmt: skip
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert "is not empty and is not the folder of a frictionlab sweep" in capsys.readouterr().err
+    assert [p.name for p in folder.iterdir()] == ["notes.txt"]
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK  # its own: rerun
+    other = write(tmp_path / "t.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
+        "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
+    assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert "holds another sweep" in capsys.readouterr().err

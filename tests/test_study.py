@@ -299,7 +299,7 @@ def test_cli_bad_preset_file(tmp_path, capsys):
     (tmp_path / "bad.yaml").write_text("name: [unclosed\n")
     assert main(["study", str(tmp_path / "bad.yaml")]) == ExitCode.USAGE
     assert "not valid YAML" in capsys.readouterr().err
-    assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.USAGE
+    assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.INPUT_FILE
     assert "no such preset file" in capsys.readouterr().err
 
 
