@@ -18,7 +18,7 @@ from pathlib import Path
 
 from . import __version__
 from .errors import ExitCode, FrictionlabError, short_repr
-from .signals import interrupted_exit_code, raise_on_sigterm
+from .signals import RaiseOnSigterm, interrupted_exit_code
 
 DEFAULT_RUNS_DIR = Path("runs")
 
@@ -329,7 +329,11 @@ def _quiet_stdout() -> None:
 def main(argv: list[str] | None = None) -> int:
     warnings.formatwarning = _plain_warning
     args = build_parser().parse_args(argv)
-    raise_on_sigterm()
+    with RaiseOnSigterm():
+        return _run_command(args)
+
+
+def _run_command(args) -> int:
     try:
         code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe shows here, not at exit

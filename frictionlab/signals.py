@@ -33,12 +33,22 @@ def interrupted_exit_code() -> ExitCode:
     return ExitCode.TERMINATED if signal.SIGTERM in received else ExitCode.INTERRUPTED
 
 
-def raise_on_sigterm() -> None:
-    """Make SIGTERM raise Terminated (the CLI's default outside a run, where Ctrl-C
-    raises KeyboardInterrupt) and forget earlier signals."""
-    received.clear()
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, lambda signum, frame: _raise_for(signum))
+class RaiseOnSigterm:
+    """While a command runs: SIGTERM raises Terminated (as Ctrl-C raises
+    KeyboardInterrupt outside a run); earlier signals are forgotten, and the
+    previous handler comes back at the end."""
+
+    def __enter__(self):
+        received.clear()
+        self.previous = None
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGTERM, lambda signum, frame: _raise_for(signum))
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGTERM, self.previous)
+        return False
 
 
 class CancelOnSignals:

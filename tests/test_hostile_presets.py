@@ -63,7 +63,7 @@ IN_PROCESS = {
                           "realizations: must be a number, not true or false, got true"),
     "bool hurst": (replace("hurst: 0.8", "hurst: true"), ExitCode.USAGE,
                    "spectrum.params.hurst: must be a number, not true or false"),
-    "bool seed via yes": (replace("seed: 7", "seed: false"), ExitCode.USAGE, "seed: must be a number, not true or false"),
+    "bool seed": (replace("seed: 7", "seed: false"), ExitCode.USAGE, "seed: must be a number, not true or false"),
     "inf stop": (replace("stop: 20.0", "stop: .inf"), ExitCode.USAGE, "loading.stop: must be a finite number, got inf"),
     "nan rms height": (replace("rms_height: 1.0", "rms_height: .nan"), ExitCode.USAGE,
                        "spectrum.params.rms_height: must be a finite number"),
