@@ -93,6 +93,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "workers": outcome.workers,
         "executor": outcome.extra.get("executor"),
         "resumed_realizations": outcome.extra.get("resumed", 0),
+        "retried_realizations": outcome.extra.get("retried", 0),  # had failed before the resume, ran again
         "files": files,
     }
 

@@ -173,6 +173,8 @@ def test_failed_realizations_are_retried_on_resume(make_scene, tmp_path, capsys)
     assert second.failures == [] and second.done == 20
     assert second.extra["retried"] == len(first.failures) and second.extra["resumed"] == first.done
     assert f"{len(first.failures)} failed ones retried" in capsys.readouterr().err
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["retried_realizations"] == len(first.failures)
     run_to_folder(scene, tmp_path / "clean", workers=1)
     same_files(tmp_path / "run", tmp_path / "clean")
 
