@@ -13,11 +13,15 @@ from .hookspecs import hookimpl
 from .plugin import (
     ContactCurve,
     ContactSolver,
+    Control,
+    ForceNormalisation,
     Plugin,
     PluginParams,
     Profile,
     SlopeEstimator,
     SpectrumGenerator,
+    force_unit,
+    mdr_length,
 )
 
 try:
@@ -28,11 +32,15 @@ except PackageNotFoundError:  # running from a source tree without install
 __all__ = [
     "ContactCurve",
     "ContactSolver",
+    "Control",
+    "ForceNormalisation",
     "Plugin",
     "PluginParams",
     "Profile",
     "SlopeEstimator",
     "SpectrumGenerator",
     "__version__",
+    "force_unit",
     "hookimpl",
+    "mdr_length",
 ]

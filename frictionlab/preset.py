@@ -18,7 +18,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .errors import PluginError, PresetError
-from .plugin import ContactSolver, SlopeEstimator, SpectrumGenerator
+from .plugin import ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from .registry import Registry, default_registry
 
 PLUGIN_SLOTS = {"spectrum": "spectrum", "solver": "solver", "slope": "slope"}  # preset key -> kind
@@ -156,7 +156,7 @@ class Scene:
     solver: ContactSolver
     slope: SlopeEstimator
     # The 2D generator the preset named when the solver presses lines only: ``spectrum`` is
-    # then its MDR-equivalent line (SPEC section 7), and ``geometry`` says so.
+    # then its MDR-equivalent line, and ``geometry`` says so.
     surface: SpectrumGenerator | None = None
 
     @property
@@ -165,6 +165,16 @@ class Scene:
         if self.surface is not None:
             return "mdr-equivalent line of a surface"
         return "surface" if self.spectrum.dimension == 2 else "line"
+
+    @property
+    def normalisation(self) -> ForceNormalisation:
+        """What the loads mean and how f is formed, for the profiles that run."""
+        return self.solver.normalisation(self.spectrum.dimension)
+
+    @property
+    def named_spectrum(self) -> SpectrumGenerator:
+        """The spectrum the preset names (the surface, when its MDR-equivalent line runs)."""
+        return self.surface if self.surface is not None else self.spectrum
 
     @functools.cached_property
     def loads(self) -> np.ndarray:
@@ -179,8 +189,7 @@ class Scene:
         data = self.preset.model_dump(mode="json")
         if data.get("sweep") is None:
             data.pop("sweep", None)  # a plain run (or one sweep point) has no sweep section
-        for slot in PLUGIN_SLOTS:
-            plugin = self.surface if slot == "spectrum" and self.surface is not None else getattr(self, slot)
+        for slot, plugin in (("spectrum", self.named_spectrum), ("solver", self.solver), ("slope", self.slope)):
             data[slot] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
         return data
 
@@ -337,23 +346,24 @@ def build_scene(data: dict, registry: Registry | None = None, source: str | None
 
 def _match_dimensions(plugins: dict, source: str | None) -> dict:
     """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
-    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError."""
+    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError, and so is
+    a non-periodic profile (a scan) given to a solver or estimator of periodic profiles only."""
     spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
     made = spectrum.dimension
     shape = {1: "lines", 2: "surfaces"}
     if made not in solver.dimensions:
-        line = getattr(spectrum, "equivalent_line", None)
-        if made != 2 or 1 not in solver.dimensions or line is None:
+        try:
+            line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
+        except ValueError as exc:
+            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        if line is None:
             raise PresetError(
                 [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
                  f"only, but spectrum {spectrum.name} makes {shape[made]}"
                  + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
                 source=source,
             )
-        try:
-            plugins = {**plugins, "spectrum": line(), "surface": spectrum}
-        except ValueError as exc:
-            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        plugins = {**plugins, "spectrum": line, "surface": spectrum}
         made = 1
     if made not in slope.dimensions:
         raise PresetError(
@@ -361,6 +371,18 @@ def _match_dimensions(plugins: dict, source: str | None) -> dict:
              f"but the {shape[made][:-1]} that runs here is {'2D' if made == 2 else '1D'}"],
             source=source,
         )
+    if not plugins["spectrum"].periodic():
+        scan = f"spectrum {spectrum.name} is not periodic (periodic: false, a scan whose ends do not meet)"
+        make_periodic = "set spectrum.params.periodic: true if its ends meet (after detrend)"
+        problems = []
+        if solver.periodic_only:
+            problems.append(f"solver.name: {solver.name} presses periodic profiles only, but {scan}: "
+                            f"use a solver of independent springs (mdr, winkler), or {make_periodic}")
+        if slope.periodic_only:
+            problems.append(f"slope.name: {slope.name} differentiates periodic profiles only, but {scan}: "
+                            f"use forward-difference or central-difference, or {make_periodic}")
+        if problems:
+            raise PresetError(problems, source=source)
     return plugins
 
 

@@ -18,14 +18,28 @@ import importlib.metadata as md
 import os
 import sys
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import get_args
 
+import numpy as np
 import pluggy
 from pydantic import BaseModel
 
 from .errors import PluginError
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
-from .plugin import KINDS, NAME_PATTERN, Plugin
+from .plugin import (
+    KINDS,
+    NAME_PATTERN,
+    ContactMeasure,
+    ContactSolver,
+    ForceNormalisation,
+    IndentationReference,
+    Plugin,
+    Profile,
+    SlopeEstimator,
+    SpectrumGenerator,
+)
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
@@ -108,6 +122,59 @@ def validate_plugin_class(kind: str, cls) -> None:
     for field_name, info in params.model_fields.items():
         if not info.description:
             raise PluginError(f"{label}: Params.{field_name} has no description")
+    for problem in declaration_problems(cls):
+        raise PluginError(f"{label}: {problem}")
+
+
+def declaration_problems(cls) -> list[str]:
+    """What is wrong with the contract declarations of a plugin class (see ``plugin.py``)."""
+    fields = set(cls.Params.model_fields)
+    problems = []
+
+    def named_fields(what: str, names) -> None:
+        unknown = [n for n in names if n not in fields]
+        if unknown:
+            problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
+
+    if issubclass(cls, SpectrumGenerator):
+        if cls.dimension not in (1, 2):
+            problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
+        if cls.points_param is not None:
+            named_fields("points_param", [cls.points_param])
+    if issubclass(cls, (ContactSolver, SlopeEstimator)):
+        dims = cls.dimensions
+        if not (isinstance(dims, tuple) and dims and set(dims) <= {1, 2}):
+            problems.append(f"dimensions must be a non-empty tuple of 1 and/or 2. Got {dims!r} instead.")
+        if not isinstance(cls.periodic_only, bool):
+            problems.append(f"periodic_only must be True or False. Got {cls.periodic_only!r} instead.")
+    if issubclass(cls, ContactSolver):
+        declared = cls.normalisations
+        if not isinstance(declared, Mapping) or set(declared) != set(cls.dimensions) or not all(
+            isinstance(n, ForceNormalisation) for n in declared.values()
+        ):
+            problems.append(
+                "normalisations must map each of its dimensions "
+                f"{cls.dimensions!r} to a ForceNormalisation (what its load means and how f is formed). "
+                f"Got {declared!r} instead."
+            )
+        else:
+            for dimension, normalisation in declared.items():
+                try:
+                    normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
+                except ValueError as exc:
+                    problems.append(f"normalisations[{dimension}]: {exc}")
+        if not (isinstance(cls.problem, str) and cls.problem.strip()):
+            problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
+        for attr, value, allowed in (
+            ("contact_measure", cls.contact_measure, ContactMeasure),
+            ("indentation_reference", cls.indentation_reference, IndentationReference),
+        ):
+            if value not in get_args(allowed):
+                problems.append(f"{attr} must be one of {', '.join(map(repr, get_args(allowed)))}. Got {value!r} instead.")
+        named_fields("body_params", cls.body_params)
+        if cls.tolerance_param is not None:
+            named_fields("tolerance_param", [cls.tolerance_param])
+    return problems
 
 
 class Registry:

@@ -185,7 +185,7 @@ class RunDirectory:
             "seconds": np.array([r.seconds for r in ok]),
             "slope_rms_line": np.array([r.slope_rms_line for r in ok]),
             "points": np.array([r.points for r in ok], dtype=np.int64),
-            "length": np.array([r.length for r in ok]),
+            "force_unit": np.array([r.force_unit for r in ok]),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed]),
             "failed_error": np.array([r.error for r in failed], dtype=str),
@@ -213,6 +213,9 @@ class RunDirectory:
             except (OSError, ValueError, KeyError) as exc:
                 warnings.warn(f"skipping unreadable chunk {path.name} ({exc}); its realizations are recomputed")
                 continue
+            if "force_unit" not in arrays:  # written before f had its solver's normalisation
+                warnings.warn(f"skipping chunk {path.name} of an older format; its realizations are recomputed")
+                continue
             for row, index in enumerate(arrays["index"].tolist()):
                 results[index] = RealizationResult(
                     index=index,
@@ -223,7 +226,7 @@ class RunDirectory:
                     force=arrays["force"][row] if "force" in arrays else None,
                     slope_rms_line=float(arrays["slope_rms_line"][row]),
                     points=int(arrays["points"][row]),
-                    length=float(arrays["length"][row]),
+                    force_unit=float(arrays["force_unit"][row]),
                 )
             for row, index in enumerate(arrays["failed_index"].tolist()):
                 results[index] = RealizationResult(

@@ -27,12 +27,14 @@ S = 1000.0  # every length
 M = 7.0  # every modulus
 
 LINE_SPECTRA = ("power-law", "rolloff", "profile-file")
+COSINE = "power-law cosine series"  # the non-periodic series of power-law (series: cosine)
 SURFACE_SPECTRA = ("power-law-2d", "rolloff-2d", "surface-file")
-# solver -> the spectra it takes (a line solver takes a surface as its MDR-equivalent line)
+# solver -> the spectra it takes (a line solver takes a surface as its MDR-equivalent line;
+# the periodic BEM takes the scans declared periodic, not the cosine series)
 PAIRS = {
-    "mdr": LINE_SPECTRA + SURFACE_SPECTRA,
-    "mdr-bisection": LINE_SPECTRA + SURFACE_SPECTRA,
-    "winkler": LINE_SPECTRA + SURFACE_SPECTRA,
+    "mdr": LINE_SPECTRA + (COSINE,) + SURFACE_SPECTRA,
+    "mdr-bisection": LINE_SPECTRA + (COSINE,) + SURFACE_SPECTRA,
+    "winkler": LINE_SPECTRA + (COSINE,) + SURFACE_SPECTRA,
     "bem-halfplane": LINE_SPECTRA,
     "bem-halfspace": SURFACE_SPECTRA,
 }
@@ -46,16 +48,8 @@ SPACING = 0.5
 
 def test_every_builtin_solver_and_spectrum_is_covered(registry):
     covered_spectra = set(LINE_SPECTRA + SURFACE_SPECTRA)
-    made = {i.name for i in registry.infos("spectrum") if i.provider != "frictionlab-gaussian"}
-    assert made <= covered_spectra | _extra_spectra(), f"spectra without a unit test: {made - covered_spectra}"
-    assert {i.name for i in registry.infos("solver")} <= set(PAIRS)
-
-
-def _extra_spectra() -> set[str]:
-    return set(EXTRA_LINE_SPECTRA)
-
-
-EXTRA_LINE_SPECTRA: dict[str, dict] = {}
+    assert set(registry.names("spectrum")) <= covered_spectra, "a spectrum without a unit-invariance test"
+    assert set(registry.names("solver")) <= set(PAIRS), "a solver without a unit-invariance test"
 
 
 # ------------------------------------------------------------------ scenes
@@ -66,9 +60,13 @@ def _write_scan(path, heights):
     return str(path)
 
 
-def spectrum_choice(name: str, tmp_path, length: float = 1.0, tag: str = "") -> dict:
-    """The spectrum ``name`` with every length multiplied by ``length``."""
+def spectrum_choice(name: str, tmp_path, length: float = 1.0, tag: str = "", periodic: bool = False) -> dict:
+    """The spectrum ``name`` with every length multiplied by ``length`` (a scan declared
+    ``periodic`` for the solvers of periodic profiles)."""
     dx = SPACING * length
+    if name == COSINE:
+        return {"name": "power-law", "params": {**LINE, "rms_height": LINE["rms_height"] * length, "spacing": dx,
+                                                "series": "cosine", "short_cutoff": 20 * dx}}  # fmt: skip
     if name in ("power-law", "rolloff"):
         params = {**LINE, "rms_height": LINE["rms_height"] * length, "spacing": dx}
         if name == "rolloff":
@@ -83,24 +81,15 @@ def spectrum_choice(name: str, tmp_path, length: float = 1.0, tag: str = "") -> 
         base = build_scene(_preset({"name": "power-law", "params": {**LINE, "spacing": SPACING}}, "mdr"))
         z = base.spectrum.generate(realization_rng(5, 0)).heights
         path = _write_scan(tmp_path / f"scan{tag}.npy", z * length)
-        return {"name": name, "params": {"path": path, "spacing": dx, **_periodic(name)}}
+        return {"name": name, "params": {"path": path, "spacing": dx, "periodic": periodic}}
     if name == "surface-file":
         base = build_scene(
             _preset({"name": "power-law-2d", "params": {**SURFACE, "spacing": SPACING, "short_cutoff": 2.0}}, "winkler")
         )
         z = base.spectrum.generate(realization_rng(5, 0)).heights
         path = _write_scan(tmp_path / f"map{tag}.npy", z * length)
-        return {"name": name, "params": {"path": path, "spacing": dx, **_periodic(name)}}
-    if name in EXTRA_LINE_SPECTRA:
-        return EXTRA_LINE_SPECTRA[name](length)
+        return {"name": name, "params": {"path": path, "spacing": dx, "periodic": periodic}}
     raise AssertionError(f"no unit test for spectrum {name!r}")
-
-
-_PERIODIC_FOR_BEM: set[str] = set()
-
-
-def _periodic(name: str) -> dict:
-    return {"periodic": True} if name in _PERIODIC_FOR_BEM else {}
 
 
 def solver_choice(name: str, surface: bool, modulus: float = 1.0, length: float = 1.0) -> dict:
@@ -163,8 +152,8 @@ def run(preset: dict):
 
 def scene_pair(solver: str, spectrum: str, tmp_path, control: str):
     """(base outcome, scaled outcome, base scene, f asked for)."""
-    surface = spectrum in SURFACE_SPECTRA
-    base = build_scene(_preset(spectrum_choice(spectrum, tmp_path), solver_choice(solver, surface)))
+    surface, periodic = spectrum in SURFACE_SPECTRA, solver in BEM
+    base = build_scene(_preset(spectrum_choice(spectrum, tmp_path, periodic=periodic), solver_choice(solver, surface)))
     unit = expected_force_unit(solver, base)
     f = np.array(F_GRID[solver])
     if control == "force":
@@ -175,10 +164,12 @@ def scene_pair(solver: str, spectrum: str, tmp_path, control: str):
     loading = {"control": control, "start": float(loads[0]), "stop": float(loads[-1]), "steps": 3, "spacing": "log"}
     # three log-spaced loads reproduce the grid exactly up to rounding
     scaled_loading = {**loading, "start": loading["start"] * load_scale, "stop": loading["stop"] * load_scale}
-    base_scene, base_out = run(_preset(spectrum_choice(spectrum, tmp_path), solver_choice(solver, surface), loading))
+    base_scene, base_out = run(
+        _preset(spectrum_choice(spectrum, tmp_path, periodic=periodic), solver_choice(solver, surface), loading)
+    )
     _, scaled_out = run(
         _preset(
-            spectrum_choice(spectrum, tmp_path, length=S, tag="-scaled"),
+            spectrum_choice(spectrum, tmp_path, length=S, tag="-scaled", periodic=periodic),
             solver_choice(solver, surface, modulus=M, length=S),
             scaled_loading,
         )

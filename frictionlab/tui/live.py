@@ -62,8 +62,7 @@ class LiveListener:
         steps = scene.loads.size
         self._loads = scene.loads.astype(float)
         self._force_control = scene.control == "force"
-        self._scale = float(scene.solver.stiffness()) * float(scene.spectrum.rms_height())
-        self._length = math.nan
+        self._force_unit = math.nan
         self._ok = 0
         self._failed = 0
         self._first_error = None
@@ -77,7 +76,7 @@ class LiveListener:
     @hookimpl
     def realization_done(self, result, done, total):
         self._ok += 1
-        self._length = result.length
+        self._force_unit = result.force_unit
         self._xi_sum += result.xi
         self._count_sum += result.contact_count
         if result.force is not None:
@@ -104,7 +103,7 @@ class LiveListener:
         f = xi = count = fit = None
         if self._ok:
             force = self._loads if self._force_control else self._force_sum / self._ok
-            f = force / (self._scale * self._length)
+            f = force / self._force_unit
             xi = self._xi_sum / self._ok
             count = self._count_sum / self._ok
             fit = interim_fit(f, xi)
