@@ -109,6 +109,7 @@ def run(
     retries: int = 2,
     store=None,
     restored: Iterable[RealizationResult] = (),
+    registry=None,
 ) -> RunOutcome:
     """Run the ensemble of ``scene``, telling ``listeners`` as it goes.
 
@@ -117,6 +118,9 @@ def run(
     worker. ``restored``: results already finished (a resume): only the missing
     realizations are computed. ``store``: anything with ``save_chunk(results)``,
     called as each chunk finishes, before its listeners hear of it.
+
+    The installed plugins that implement lifecycle hooks (of ``registry``, by default the
+    process-wide one) hear the run as ``listeners`` do.
 
     ``cancel`` (anything with ``set()``/``is_set()``) or Ctrl-C ends the run
     early; what finished is kept and summarised, and ``outcome.status`` says
@@ -131,7 +135,9 @@ def run(
     resumed = accumulator.done
     todo = [i for i in range(total) if i not in accumulator.results and i not in accumulator.failures]
     info = RunInfo(scene=scene, total=total, workers=workers, executor=pool.name, resumed=resumed)
-    hooks = _listener_manager(listeners).hook
+    from .registry import default_registry
+
+    hooks = _listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     hooks.run_started(run=info)

@@ -225,6 +225,7 @@ class ForceNormalisation:
         """The normalisation as summary.json records it."""
         return {
             "f": self.definition,
+            "formula": self.formula,
             "load": self.load,
             "load_symbol": self.load_symbol,
             "load_unit": self.load_unit,

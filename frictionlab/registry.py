@@ -27,7 +27,7 @@ import pluggy
 from pydantic import BaseModel
 
 from .errors import PluginError
-from .hookspecs import PROJECT_NAME, RegistrationSpecs
+from .hookspecs import PROJECT_NAME, LifecycleSpecs, RegistrationSpecs
 from .plugin import (
     KINDS,
     NAME_PATTERN,
@@ -43,6 +43,7 @@ from .plugin import (
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
+LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
 KIND_HOOKS = {
     "spectrum": "register_spectra",
     "solver": "register_solvers",
@@ -184,6 +185,7 @@ class Registry:
         env = os.environ if env is None else env
         self.pm = pluggy.PluginManager(PROJECT_NAME)
         self.pm.add_hookspecs(RegistrationSpecs)
+        self.pm.add_hookspecs(LifecycleSpecs)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
@@ -268,6 +270,15 @@ class Registry:
         self._plugins = tables
 
     # ------------------------------------------------------------- queries
+
+    def run_listeners(self) -> list[object]:
+        """The registered plugins that implement a lifecycle hook: ``engine.run`` tells them
+        of every run, besides the listeners it is given."""
+        found: dict[int, object] = {}
+        for name in LIFECYCLE_HOOKS:
+            for impl in getattr(self.pm.hook, name).get_hookimpls():
+                found.setdefault(id(impl.plugin), impl.plugin)
+        return list(found.values())
 
     def names(self, kind: str) -> list[str]:
         return sorted(self._plugins[kind])

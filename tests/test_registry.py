@@ -1022,3 +1022,31 @@ def test_testing_module_import_is_cheap():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "['frictionlab.testing']", out.stdout
+
+
+def test_an_installed_plugin_can_listen_to_every_run(register_plugin, small_preset):
+    """Lifecycle hooks are registry hooks too: a plugin implementing one is accepted (a misspelled
+    one is not) and hears the runs made with its registry."""
+    from frictionlab import engine
+    from frictionlab.preset import build_scene
+
+    heard = []
+
+    class RunLog:
+        @hookimpl
+        def run_finished(self, run, outcome):
+            heard.append((run.scene.preset.name, outcome.done))
+
+    registry = register_plugin(RunLog())
+    assert len(registry.run_listeners()) == 1
+    small_preset["realizations"] = 2
+    engine.run(build_scene(small_preset, registry=registry), workers=1, registry=registry)
+    assert heard == [("small", 2)]
+
+    class Misspelled:
+        @hookimpl
+        def run_finnished(self, run, outcome):
+            pass
+
+    with pytest.raises(pluggy.PluginValidationError):
+        register_plugin(Misspelled())

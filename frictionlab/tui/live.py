@@ -40,6 +40,7 @@ class Snapshot:
     fit: InterimFit | None
     first_error: str | None = None
     finished: bool = False
+    f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
 
     @property
     def rate(self) -> float:
@@ -63,6 +64,7 @@ class LiveListener:
         self._loads = scene.loads.astype(float)
         self._force_control = scene.control == "force"
         self._force_unit = math.nan
+        self._f_formula = scene.normalisation.formula
         self._ok = 0
         self._failed = 0
         self._first_error = None
@@ -118,6 +120,7 @@ class LiveListener:
             fit=fit,
             first_error=self._first_error,
             finished=finished,
+            f_formula=self._f_formula,
         )
 
 
