@@ -183,10 +183,12 @@ def _as_hook_plugin(obj):
 
 
 def _label(cls) -> str:
-    module = getattr(cls, "__module__", "?")
-    qualname = getattr(cls, "__qualname__", repr(cls))
-    name = getattr(cls, "name", None)
-    return f"{module}.{qualname}" + (f" ({name!r})" if name else "")
+    from frictionlab.plugin import Plugin
+
+    if not isinstance(cls, type):
+        return repr(cls)
+    name = cls.name if issubclass(cls, Plugin) else None
+    return f"{cls.__module__}.{cls.__qualname__}" + (f" ({name!r})" if name else "")
 
 
 def _fail(cls, message: str, cause: BaseException | None = None):
@@ -355,7 +357,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
         hint = "" if params else " (pass the required values: check_plugin_class(kind, cls, params={...}))"
         _fail(cls, f"Params(**{params!r}) is invalid{hint}: {exc}", exc)
     instance = _instantiate(cls, params)
-    if getattr(instance, "params", None) != model:
+    if instance.__dict__.get("params") != model:
         _fail(cls, "the constructor must store its validated Params as self.params")
 
     # unknown keys are rejected
@@ -625,6 +627,17 @@ def check_solver(cls, **params) -> None:
     _check_solver_units(cls, solver, heights, spacing, slopes)
 
 
+def _must_refuse(cls, what: str, call: Callable[[], Any]) -> None:
+    """A ``periodic_only`` plugin must refuse ``what`` with a ValueError."""
+    try:
+        call()
+    except ValueError:
+        return
+    except Exception as exc:
+        _fail(cls, f"periodic_only: {what} must raise ValueError. Got {type(exc).__name__}: {exc}", exc)
+    _fail(cls, f"periodic_only is True, but {what} was accepted; it must raise ValueError")
+
+
 def _solve(cls, solver, heights, spacing, slopes, loads, control="force", periodic=True):
     from frictionlab.plugin import Profile
 
@@ -648,14 +661,8 @@ def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) ->
     if cls.periodic_only:
         from frictionlab.plugin import Profile
 
-        try:
-            solver.solve(Profile(heights.copy(), spacing, periodic=False), forces.copy(), "force", slopes.copy())
-        except ValueError:
-            pass
-        except Exception as exc:
-            _fail(cls, f"a non-periodic profile must raise ValueError (periodic_only). Got {type(exc).__name__}: {exc}", exc)
-        else:
-            _fail(cls, "periodic_only is True, but a non-periodic profile was solved; it must raise ValueError")
+        profile = Profile(heights.copy(), spacing, periodic=False)
+        _must_refuse(cls, "a non-periodic profile", lambda: solver.solve(profile, forces.copy(), "force", slopes.copy()))
     else:
         _solve(cls, solver, heights, spacing, slopes, forces, periodic=False)
 
@@ -752,14 +759,7 @@ def check_slope_estimator(cls, **params) -> None:
         grade = np.array([0.3, -0.2])[: len(shape)]
         ramp = sum(g * x for g, x in zip(grade, grids))
         if cls.periodic_only:
-            try:
-                estimator.slopes(ramp, spacing, False)
-            except ValueError:
-                pass
-            except Exception as exc:
-                _fail(cls, f"periodic_only: a non-periodic profile must raise ValueError. Got {type(exc).__name__}", exc)
-            else:
-                _fail(cls, "periodic_only is True, but slopes() accepted periodic=False; it must raise ValueError")
+            _must_refuse(cls, "a non-periodic profile", lambda ramp=ramp: estimator.slopes(ramp, spacing, False))
             continue
         tilted = run(f"non-periodic tilted {kind}", ramp, periodic=False)
         exact = grade[0] if kind == "line" else float(np.hypot(*grade))

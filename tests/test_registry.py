@@ -789,7 +789,7 @@ def test_the_half_plane_with_the_old_f_fails_the_kit():
 
 def test_solver_check_fails_when_periodic_only_is_not_kept():
     cls = type("Loose", (GoodSolver,), {"name": "loose", "periodic_only": True})
-    with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was solved"):
+    with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was accepted"):
         fltesting.check_solver(cls)
 
 
