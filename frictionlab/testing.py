@@ -75,7 +75,13 @@ classes::
     > 0 and agrees within a factor of 3 with the rms (about the mean) of the
     generated lines, pooled over 8 seeds. If ``psd`` is implemented it is
     vectorised (array in, array of the same shape out), finite and >= 0; if
-    ``rms_slope`` is implemented it is finite and > 0.
+    ``rms_slope`` is implemented it is finite and > 0. The declarations:
+    ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes;
+    ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
+    None, gives 2 N points (per side) over the same length; ``equivalent_line()``
+    is None or, for a surface, a spectrum of lines 2 sqrt(A / pi) long with the
+    surface's rms height, itself checked; ``c0()`` is NotImplementedError or
+    finite > 0; ``hurst_exponent()`` is None or finite >= 0.
 
 ``check_solver(cls, **params)``
     ``cls(**params).solve(profile, loads, control, slopes)`` on a small smooth
@@ -92,10 +98,19 @@ classes::
     ``contact_fraction == contact_count / N``; ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
-    ``stiffness()`` is finite and > 0.
+    ``stiffness()`` is finite and > 0. The declarations: the forces come from
+    ``frictionlab.force_unit``, so ``normalisations`` must cover the profile;
+    f is dimensionless as declared: every length x 1000 with each load scaled by
+    its unit (a force x 1000^2, a force per unit depth x 1000, an indentation x
+    1000), and the spacing alone x 10 at equal f, leave the contact counts and
+    the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
+    of f; ``tolerance()`` is None exactly when ``tolerance_param`` is; a
+    ``periodic_only`` solver raises ValueError on a non-periodic profile, any
+    other solves it. (Registration itself checks that every declaration is
+    well formed: ``registry.declaration_problems``.)
 
 ``check_slope_estimator(cls, **params)``
-    ``cls(**params).slopes(heights, spacing)`` on a random periodic line returns
+    ``cls(**params).slopes(heights, spacing, periodic)`` on a random periodic line returns
     a finite floating-point array of the same shape, does not modify its input
     and is repeatable; a constant line gives zero slopes; on a periodic sine
     (3 periods over 128 points, spacing 0.1) the slopes match the exact
@@ -103,7 +118,9 @@ classes::
     relative rms error below 0.5). An estimator whose ``dimensions`` include 2
     gets the same checks on a 24 x 40 surface, with a plane wave across both
     axes whose exact slope is |grad z| (so its slopes must be >= 0); lines are
-    checked only if ``dimensions`` include 1.
+    checked only if ``dimensions`` include 1. ``slopes(..., periodic=False)``
+    on a tilted plane gives the tilt at every point (no difference across the
+    ends), or, for a ``periodic_only`` estimator, raises ValueError.
 
 ``check_plugin(kind, cls, *, deterministic=False, **params)``
     ``check_plugin_class`` followed by the check of ``kind``
