@@ -14,11 +14,15 @@ from .inputs import InputFile, InputFileProblem, open_regular_file
 from .plugin import (
     ContactCurve,
     ContactSolver,
+    Control,
+    ForceNormalisation,
     Plugin,
     PluginParams,
     Profile,
     SlopeEstimator,
     SpectrumGenerator,
+    force_unit,
+    mdr_length,
 )
 
 try:
@@ -29,6 +33,8 @@ except PackageNotFoundError:  # running from a source tree without install
 __all__ = [
     "ContactCurve",
     "ContactSolver",
+    "Control",
+    "ForceNormalisation",
     "InputFile",
     "InputFileProblem",
     "Plugin",
@@ -37,6 +43,8 @@ __all__ = [
     "SlopeEstimator",
     "SpectrumGenerator",
     "__version__",
+    "force_unit",
     "hookimpl",
+    "mdr_length",
     "open_regular_file",
 ]

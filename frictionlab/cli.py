@@ -42,9 +42,10 @@ def result_table(scene, outcome, out_dir: Path) -> str:
             f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {_interval(fit.a_ci)}",
             f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {_interval(fit.b_ci)}",
             f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
+            f"  {outcome.normalisation.definition}",
         ]
         count = outcome.contact_count
-        unit = "F" if scene.control == "force" else "d"
+        unit = outcome.normalisation.load_symbol if scene.control == "force" else "d"
         lines.append(
             f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
             f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"

@@ -86,6 +86,7 @@ def run(
     dashboard: bool = False,
     store=None,
     restored: Iterable[RealizationResult] = (),
+    registry=None,
 ) -> RunOutcome:
     """Run the ensemble of ``scene``, telling ``listeners`` as it goes.
 
@@ -95,6 +96,9 @@ def run(
     realizations, and those that had failed, are computed. ``store``: anything
     with ``save_chunk(results)``, called as each chunk finishes, before its
     listeners hear of it.
+
+    The installed plugins that implement lifecycle hooks (of ``registry``, by default the
+    process-wide one) hear the run as ``listeners`` do.
 
     ``cancel`` (anything with ``set()``/``is_set()``), Ctrl-C or SIGTERM ends the
     run early; what finished is kept and summarised, and ``outcome.status``
@@ -113,7 +117,9 @@ def run(
     resumed = accumulator.done
     todo = [i for i in range(total) if i not in accumulator.results]
     info = RunInfo(scene=scene, total=total, workers=workers, executor=pool.name, resumed=resumed, retried=retried)
-    hooks = _listener_manager(listeners).hook
+    from .registry import default_registry
+
+    hooks = _listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     hooks.run_started(run=info)

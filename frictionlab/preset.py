@@ -22,7 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .errors import FrictionlabError, PluginError, PresetError, PresetFileError, short_repr
 from .inputs import InputFileProblem, input_fields, is_relative, read_regular_file, regular_file_problem
-from .plugin import ContactSolver, SlopeEstimator, SpectrumGenerator
+from .plugin import ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from .registry import Registry, default_registry
 from .safe_yaml import YamlLimit, YamlProblem, load_yaml
 
@@ -188,7 +188,7 @@ class Scene:
     solver: ContactSolver
     slope: SlopeEstimator
     # The 2D generator the preset named when the solver presses lines only: ``spectrum`` is
-    # then its MDR-equivalent line (SPEC section 7), and ``geometry`` says so.
+    # then its MDR-equivalent line, and ``geometry`` says so.
     surface: SpectrumGenerator | None = None
 
     @property
@@ -197,6 +197,16 @@ class Scene:
         if self.surface is not None:
             return "mdr-equivalent line of a surface"
         return "surface" if self.spectrum.dimension == 2 else "line"
+
+    @property
+    def normalisation(self) -> ForceNormalisation:
+        """What the loads mean and how f is formed, for the profiles that run."""
+        return self.solver.normalisation(self.spectrum.dimension)
+
+    @property
+    def named_spectrum(self) -> SpectrumGenerator:
+        """The spectrum the preset names (the surface, when its MDR-equivalent line runs)."""
+        return self.surface if self.surface is not None else self.spectrum
 
     @functools.cached_property
     def loads(self) -> np.ndarray:
@@ -208,10 +218,7 @@ class Scene:
 
     def slot_plugins(self) -> dict:
         """The plugin the preset named in each slot (the surface, not its equivalent line)."""
-        return {
-            slot: self.surface if slot == "spectrum" and self.surface is not None else getattr(self, slot)
-            for slot in PLUGIN_SLOTS
-        }
+        return {"spectrum": self.named_spectrum, "solver": self.solver, "slope": self.slope}
 
     def resolved(self) -> dict:
         """The preset with every default filled in, plugin params included."""
@@ -444,23 +451,24 @@ def build_scene(
 
 def _match_dimensions(plugins: dict, source: str | None) -> dict:
     """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
-    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError."""
+    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError, and so is
+    a non-periodic profile (a scan) given to a solver or estimator of periodic profiles only."""
     spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
     made = spectrum.dimension
     shape = {1: "lines", 2: "surfaces"}
     if made not in solver.dimensions:
-        line = getattr(spectrum, "equivalent_line", None)
-        if made != 2 or 1 not in solver.dimensions or line is None:
+        try:
+            line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
+        except ValueError as exc:
+            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        if line is None:
             raise PresetError(
                 [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
                  f"only, but spectrum {spectrum.name} makes {shape[made]}"
                  + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
                 source=source,
             )
-        try:
-            plugins = {**plugins, "spectrum": line(), "surface": spectrum}
-        except ValueError as exc:
-            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        plugins = {**plugins, "spectrum": line, "surface": spectrum}
         made = 1
     if made not in slope.dimensions:
         raise PresetError(
@@ -468,6 +476,18 @@ def _match_dimensions(plugins: dict, source: str | None) -> dict:
              f"but the {shape[made][:-1]} that runs here is {'2D' if made == 2 else '1D'}"],
             source=source,
         )
+    if not plugins["spectrum"].periodic():
+        scan = f"spectrum {spectrum.name} is not periodic (periodic: false, a scan whose ends do not meet)"
+        make_periodic = "set spectrum.params.periodic: true if its ends meet (after detrend)"
+        problems = []
+        if solver.periodic_only:
+            problems.append(f"solver.name: {solver.name} presses periodic profiles only, but {scan}: "
+                            f"use a solver of independent springs (mdr, winkler), or {make_periodic}")
+        if slope.periodic_only:
+            problems.append(f"slope.name: {slope.name} differentiates periodic profiles only, but {scan}: "
+                            f"use forward-difference or central-difference, or {make_periodic}")
+        if problems:
+            raise PresetError(problems, source=source)
     return plugins
 
 

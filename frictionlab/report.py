@@ -1,5 +1,5 @@
 """``frictionlab report``: run the study's Figs. 2 to 5 and write REPRODUCTION.md
-with its figures, the study's numbers beside frictionlab's (SPEC section 7).
+with its figures, the study's numbers beside frictionlab's.
 
 With ``--readings`` it also runs readings of the study's method (cut-off,
 amplitudes, slope estimator, averaging over realizations, normalisation per H)
@@ -31,7 +31,7 @@ from .seeds import bootstrap_rng
 
 @dataclass(frozen=True)
 class StudyFigure:
-    """What the study reports for one figure (SPEC section 7)."""
+    """What the study reports for one figure."""
 
     key: str
     preset: str  # file name in the presets folder
@@ -50,7 +50,7 @@ STUDY = (
     StudyFigure("fig5", "benad2012-fig5.yaml", "Fig. 5: a and b against H, each point as Fig. 2", 2.9, 0.14, {},
                 "the study: a about 2.9 and b about 0.14 near H = 0.7"),
 )  # fmt: skip
-STUDY_H07 = (0.7, 2.9, 0.14)  # H, a, b "about" (SPEC 7)
+STUDY_H07 = (0.7, 2.9, 0.14)  # H, a, b "about", as the study states them
 STUDY_POINTS_VS_H = ((1.0, 1.8847, 0.0805, "Fig. 2"), (0.5, 2.6252, 0.1341, "Fig. 4"))
 COUNT_TARGETS = {1.0: 4.0, 20.0: 12.0}  # the study's Fig. 2 contact counts, used to calibrate h
 
@@ -58,7 +58,7 @@ COUNT_TARGETS = {1.0: 4.0, 20.0: 12.0}  # the study's Fig. 2 contact counts, use
 # ------------------------------------------------------------------ averaging readings
 
 AVERAGES = {
-    "mean": "mean of xi over realizations (SPEC 4, the default)",
+    "mean": "mean of xi over realizations (the default)",
     "pooled": "rms slope over the contact points of all realizations pooled, over the pooled line rms slope",
     "rms": "root mean square of xi over realizations",
 }
@@ -162,8 +162,13 @@ class Reading:
     same_c0_as: str | None = None  # a figure key: take its C0 (normalise by C0 instead of h)
 
 
+# The study's eq. 6 read literally: pi / L <= q <= pi / (10 dx), a sum of cosines with q_k = k pi / L,
+# k = 1 .. N / 10, on [0, L]: not periodic, the wave vectors twice as dense as the FFT grid's.
+LITERAL = "eq. 6 literally: cosine series q_k = k pi / L, k = 1 .. N/10, not periodic, h calibrated to the counts"
+LITERAL_SETS = ("spectrum.params.series=cosine", "spectrum.params.short_cutoff=20.0")  # q_max = pi / (10 dx), dx = 1
+
 READINGS = (
-    Reading("fig2", "SPEC defaults (the preset)"),
+    Reading("fig2", "defaults (the preset)"),
     Reading("fig2", "no short cut-off (lambda_s = 2 dx), h = 1e4", ("spectrum.params.short_cutoff=2.0",)),
     Reading("fig2", "no short cut-off, h calibrated to the counts", ("spectrum.params.short_cutoff=2.0",), calibrate=True),
     Reading("fig2", "short cut-off 20 dx, h calibrated to the counts", ("spectrum.params.short_cutoff=20.0",), calibrate=True),
@@ -174,10 +179,12 @@ READINGS = (
             ("spectrum.params.short_cutoff=2.0", "slope.name=spectral"), calibrate=True),
     Reading("fig2", "average: pooled contact points", average="pooled"),
     Reading("fig2", "average: rms of xi", average="rms"),
-    Reading("fig3", "SPEC defaults (the preset)"),
+    Reading("fig2", LITERAL, LITERAL_SETS, calibrate=True),
+    Reading("fig3", "defaults (the preset)"),
     Reading("fig3", "no short cut-off, h calibrated to the counts", ("spectrum.params.short_cutoff=2.0",), calibrate=True),
     Reading("fig3", "Rayleigh amplitudes", ("spectrum.params.amplitudes=rayleigh",)),
     Reading("fig3", "average: pooled contact points", average="pooled"),
+    Reading("fig3", LITERAL, LITERAL_SETS, calibrate=True),
     Reading("fig4", "same h as Fig. 2 (the preset)"),
     Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
     Reading("fig4", "h calibrated to Fig. 2's counts at H = 0.5", calibrate=True),
@@ -185,6 +192,7 @@ READINGS = (
     Reading("fig4", "Rayleigh amplitudes, h calibrated at H = 0.5", ("spectrum.params.amplitudes=rayleigh",),
             calibrate=True),
     Reading("fig4", "average: pooled contact points", average="pooled"),
+    Reading("fig4", LITERAL + " at H = 0.5", LITERAL_SETS, calibrate=True),
 )  # fmt: skip
 
 
@@ -441,7 +449,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         + (f"; the readings below took another {readings_elapsed:.1f} s" if readings_elapsed is not None else "")
         + (f", Fig. 5 with h calibrated at each H {fig5_calibrated_elapsed:.1f} s" if fig5_calibrated_elapsed else "")
         + "."
-        + " The study's numbers are from SPEC section 7; the presets are in `presets/` (their comments say"
+        + " The study's numbers are those its Figs. 2 to 5 state; the presets are in `presets/` (their comments say"
         " how h = 1e4 was calibrated). Intervals are 95% percentile bootstrap over realizations;"
         " † marks a study value outside frictionlab's interval.",
         "",
@@ -524,7 +532,7 @@ def _reading_hurst(row: ReadingRow) -> float:
 
 
 def _study_at_h(hurst: float):
-    """(a, b, label) the study states at this H, or None (SPEC 7)."""
+    """(a, b, label) the study states at this H, or None."""
     known = [(h, a, b, f"{label}: {a}, {b}") for h, a, b, label in STUDY_POINTS_VS_H]
     known.append((*STUDY_H07, f"about {STUDY_H07[1]}, about {STUDY_H07[2]}"))
     return next(((a, b, text) for h, a, b, text in known if abs(h - hurst) < 1e-9), None)
@@ -590,7 +598,8 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         "## Readings of the study's method",
         "",
         "Each row is one reading of what the study may have done, run for real (`frictionlab report --readings`)."
-        " The defaults follow SPEC.md; no reading is tuned to the study's numbers: a calibrated h is found"
+        " The defaults are frictionlab's (periodic lines, q_k = 2 pi k / L); no reading is tuned to the study's"
+        " numbers: a calibrated h is found"
         " from the study's Fig. 2 contact counts (4 at F = 1, 12 at F = 20) by the method of"
         " `tools/calibrate_rms_height.py`, applied to the reading's own lines. Averages: "
         + "; ".join(f"`{k}`: {v}" for k, v in AVERAGES.items())

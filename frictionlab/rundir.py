@@ -55,7 +55,7 @@ PRESET_FILE = "preset.yaml"
 MANIFEST_FORMAT = 2
 MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
-OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "length")
+OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 
@@ -354,7 +354,7 @@ class RunDirectory:
             "seconds": np.array([r.seconds for r in ok], dtype=np.float64),
             "slope_rms_line": np.array([r.slope_rms_line for r in ok], dtype=np.float64),
             "points": np.array([r.points for r in ok], dtype=np.int64),
-            "length": np.array([r.length for r in ok], dtype=np.float64),
+            "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
@@ -495,7 +495,7 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             force=arrays["force"][row] if "force" in curves else None,
             slope_rms_line=float(arrays["slope_rms_line"][row]),
             points=int(arrays["points"][row]),
-            length=float(arrays["length"][row]),
+            force_unit=float(arrays["force_unit"][row]),
         ))  # fmt: skip
     for row, index in enumerate(arrays["failed_index"].tolist()):
         out.append(RealizationResult(

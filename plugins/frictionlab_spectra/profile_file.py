@@ -1,4 +1,4 @@
-"""A measured line as a spectrum generator: ``profile-file`` (SPEC section 2).
+"""A measured line as a spectrum generator: ``profile-file``.
 
 The file holds heights on a uniform grid, optionally with their x positions:
 
@@ -7,11 +7,13 @@ The file holds heights on a uniform grid, optionally with their x positions:
   non-numeric header line (e.g. ``x,z``) before the data is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z.
 
-Like a synthetic line, a measured line is treated as periodic (the engine wraps
-it): its last point is followed by its first. Removing the tilt
-(``detrend="tilt"``) takes out the least-squares line, which is what makes the
-two ends meet for a scan that was not levelled; any remaining step at the
-wrap is part of the profile the solver sees.
+A measured line is not periodic (``periodic: false``, the default): a scan's
+ends do not meet, so no slope is taken across them and solvers of periodic
+lines refuse it. ``periodic: true`` declares a profile whose last point is
+followed by its first (one period of a periodic surface, say); removing the
+tilt (``detrend="tilt"``, the least-squares line) is what can make the ends of
+an unlevelled scan meet, and any step left between them is then part of the
+profile the solver sees.
 """
 
 from __future__ import annotations
@@ -56,9 +58,10 @@ class ProfileFile(SpectrumGenerator):
             gt=0.0,
         )
         detrend: Literal["none", "mean", "tilt"] = Field(
-            "mean",
-            description="remove nothing, the mean, or the least-squares line (tilt) before use; "
-            "the line is treated as periodic",
+            "mean", description="remove nothing, the mean, or the least-squares line (tilt) before use"
+        )
+        periodic: bool = Field(
+            False, description="whether the line repeats (its last point is followed by its first); a scan does not"
         )
 
     # ------------------------------------------------------------ contract
@@ -66,7 +69,10 @@ class ProfileFile(SpectrumGenerator):
     def generate(self, rng: np.random.Generator) -> Profile:
         """The measured line (a fresh copy each call); ``rng`` is not used."""
         line = self._line()
-        return Profile(heights=line.heights.copy(), spacing=line.spacing)
+        return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=self.params.periodic)
+
+    def periodic(self) -> bool:
+        return self.params.periodic
 
     def rms_height(self) -> float:
         """rms of the detrended line about its mean (with ``detrend="none"`` a constant offset,
