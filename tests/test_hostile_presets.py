@@ -252,7 +252,7 @@ def test_numbers_that_overflow_in_the_run_name_what_overflowed(tmp_path, capsys)
     code = main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"])
     err = capsys.readouterr()
     assert code == ExitCode.RUNTIME_FAILURE and "internal error" not in err.err
-    assert "the dimensionless force f = F / (stiffness h L) is not finite" in err.err
+    assert "the dimensionless force f = F / (k h X) is not finite" in err.err
     assert "warning" not in err.err
 
 
