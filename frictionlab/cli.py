@@ -141,7 +141,7 @@ def cmd_schema(args) -> ExitCode:
 
     text = json.dumps(preset_json_schema(), indent=2)
     if args.out:
-        from .results import atomic_write
+        from .files import atomic_write
 
         atomic_write(Path(args.out), lambda fh: fh.write(text + "\n"))
     else:

@@ -660,7 +660,7 @@ def write_report(
     Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless ``force``."""
     import sys
 
-    from .results import atomic_write
+    from .files import atomic_write
 
     presets = find_presets(presets_dir)
     out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=force)

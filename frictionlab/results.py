@@ -16,12 +16,8 @@ The run directory's own files (run.lock, run.json, chunks/) are ``rundir``'s.
 from __future__ import annotations
 
 import csv
-import io
 import json
-import os
 import platform
-import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +25,7 @@ import yaml
 
 from . import __version__
 from .ensemble import RunOutcome
+from .files import atomic_write
 from .fit import json_safe
 from .preset import Scene
 
@@ -42,33 +39,6 @@ INDENTATION_REFERENCES = {
     "undeformed body": "length; from the first touch; against the undeformed body",
     "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
 }
-
-
-def _read_umask() -> int:
-    mask = os.umask(0)  # the only portable way to read it; done once, at import
-    os.umask(mask)
-    return mask
-
-
-_UMASK = _read_umask()
-
-
-def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
-    """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
-    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        os.fchmod(fd, 0o666 & ~_UMASK)
-        with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> dict:

@@ -43,10 +43,10 @@ import yaml
 
 from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, read_regular_file, sha256_of
 from .preset import Scene, load_preset_file
 from .realization import RealizationResult
-from .results import atomic_write
 
 CHUNK_DIR = "chunks"
 LOCK_FILE = "run.lock"
@@ -105,19 +105,6 @@ def _json_copy(data: dict) -> dict:
     return json.loads(json.dumps(data))
 
 
-def _output_path_problem(path: Path) -> str | None:
-    """Why ``path`` cannot be (or become) a folder: it, or the nearest existing
-    folder above it, is a file."""
-    for candidate in (path, *path.parents):
-        if candidate.exists() or candidate.is_symlink():
-            if candidate.is_dir():
-                return None
-            if candidate == path:
-                return f"{path} is a file, not a folder"
-            return f"{path} cannot be made a folder: {candidate} is a file"
-    return None
-
-
 class RunDirectory:
     """One run's folder. ``force``: a fresh run may write into a folder that is
     not a run of its preset (deleting only chunk files its manifest lists)."""
@@ -135,7 +122,7 @@ class RunDirectory:
     # ------------------------------------------------------------ lock
 
     def __enter__(self) -> RunDirectory:
-        problem = _output_path_problem(self.path)
+        problem = output_path_problem(self.path)
         if problem:
             raise OutputRefused(f"{problem}; give --out a folder")
         self.path.mkdir(parents=True, exist_ok=True)

@@ -39,7 +39,7 @@ from .errors import PresetError
 from .fit import json_safe
 from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset
 from .registry import Registry, default_registry
-from .results import atomic_write
+from .files import atomic_write
 
 SWEEP_SCHEMA_VERSION = 1
 RESULT_COLUMNS = (
@@ -353,9 +353,9 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
     (its sweep.json names the same sweep and base preset), or ``force``."""
     from .errors import OutputRefused
-    from .rundir import _output_path_problem
+    from .files import output_path_problem
 
-    problem = _output_path_problem(out_dir)
+    problem = output_path_problem(out_dir)
     if problem:
         raise OutputRefused(f"{problem}; give --out a folder")
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):

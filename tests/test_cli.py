@@ -14,7 +14,8 @@ import yaml
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.results import atomic_write, column_name
+from frictionlab.files import atomic_write
+from frictionlab.results import column_name
 
 from .conftest import PRESETS, SMALL_PRESET, merge
 

@@ -1,6 +1,6 @@
 """What the study writes: study.csv, study.md, study.png, and the recommendation.
 
-Every file goes through ``results.atomic_write``. The plot draws each row's
+Every file goes through ``files.atomic_write``. The plot draws each row's
 error against its wall time with the Pareto front of all rows.
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results import atomic_write
+from ..files import atomic_write
 from .axes import COLUMNS, Row, Study, preset_points
 from .metrics import pareto_front
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import yaml
 
 from ..cli import DEFAULT_RUNS_DIR
-from ..results import atomic_write
+from ..files import atomic_write
 from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
