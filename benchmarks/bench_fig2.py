@@ -18,6 +18,8 @@ import time
 from pathlib import Path
 
 from frictionlab import engine
+from frictionlab.options import RunOptions, default_workers
+from frictionlab.realization import compute_realization
 from frictionlab.preset import load_scene
 from frictionlab.seeds import realization_rng
 
@@ -44,10 +46,10 @@ def main() -> None:
 
     scene = load_scene(PRESET, ["fit.bootstrap=1000"])
     m = scene.preset.realizations
-    workers = engine.default_workers()
+    workers = default_workers()
 
     default = best_of(args.repeat, lambda: engine.run(scene))
-    serial = best_of(args.repeat, lambda: engine.run(scene, workers=1))
+    serial = best_of(args.repeat, lambda: engine.run(scene, RunOptions(workers=1)))
 
     def generate_only():
         for i in range(m):
@@ -59,7 +61,7 @@ def main() -> None:
     k = args.naive_realizations
     start = time.perf_counter()
     for i in range(k):
-        engine.compute_realization(naive_scene, i)
+        compute_realization(naive_scene, i)
     naive_serial = (time.perf_counter() - start) / k * m
 
     print(f"Fig. 2 scene: N = {scene.spectrum.params.points}, {m} realizations, {scene.loads.size} forces")

@@ -32,7 +32,9 @@ from pathlib import Path
 
 from frictionlab import engine
 from frictionlab.executors import make_executor
+from frictionlab.options import RunOptions
 from frictionlab.preset import load_scene
+from frictionlab.realization import compute_realization
 from frictionlab.runner import run_to_folder
 from bench_fig2 import best_of  # the same timing rule in every benchmark (run as a script: its folder is on sys.path)
 
@@ -42,6 +44,8 @@ PEAK_SCRIPT = """
 import sys, time
 from frictionlab.preset import load_scene
 from frictionlab.realization import compute_realization
+from frictionlab.realization import compute_realization
+from frictionlab.options import RunOptions
 n = int(float(sys.argv[2]))
 scene = load_scene(sys.argv[1], [f"spectrum.params.points={n}", f"spectrum.params.length={float(n)}"])
 times = []
@@ -59,8 +63,8 @@ def line_scene(points: int, steps: int = 400):
 
 
 def per_realization(scene, count: int, repeat: int) -> float:
-    engine.compute_realization(scene, 0)  # warm: synthesis cache, FFT plan
-    return best_of(repeat, lambda: [engine.compute_realization(scene, i) for i in range(count)]) / count
+    compute_realization(scene, 0)  # warm: synthesis cache, FFT plan
+    return best_of(repeat, lambda: [compute_realization(scene, i) for i in range(count)]) / count
 
 
 def large_lines(sizes: list[float]) -> None:
@@ -100,20 +104,20 @@ def cost_against_n_and_steps(repeat: int) -> None:
 def executors(repeat: int, skip_dask: bool) -> None:
     scene = load_scene(PRESET)
     m = scene.preset.realizations
-    serial = best_of(repeat, lambda: engine.run(scene, workers=1, executor="serial"))
+    serial = best_of(repeat, lambda: engine.run(scene, RunOptions(workers=1, executor="serial")))
     rows = [("serial", 1, serial)]
     for workers in (1, 2):
-        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, workers=workers, executor="processes"))))
+        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=workers, executor="processes")))))
     tiny = load_scene(PRESET, ["spectrum.params.points=64", "spectrum.params.length=64.0", "loading.steps=2"])
     tasks = [[i] for i in range(400)]
     never = threading.Event()
 
     def overhead(pool) -> float:
-        compute = best_of(repeat, lambda: [engine.compute_realization(tiny, i) for i in range(len(tasks))])
+        compute = best_of(repeat, lambda: [compute_realization(tiny, i) for i in range(len(tasks))])
         wall = best_of(repeat, lambda: list(pool.map_chunks(tiny, tasks, never)))
         return (wall - compute) / len(tasks)
 
-    overheads = [("serial", overhead(make_executor("serial", 1))), ("processes (2, pool start included)", overhead(make_executor("processes", 2)))]
+    overheads = [("serial", overhead(make_executor(RunOptions(executor="serial"), 1))), ("processes (2, pool start included)", overhead(make_executor(RunOptions(executor="processes"), 2)))]
     if not skip_dask:
         import distributed
 
@@ -121,8 +125,8 @@ def executors(repeat: int, skip_dask: bool) -> None:
             n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
         ) as cluster:
             address = cluster.scheduler_address
-            rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, executor="dask", scheduler=address))))
-            overheads.append(("dask (2, connect included)", overhead(make_executor("dask", 2, scheduler=address))))
+            rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address)))))
+            overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
     print(f"Fig. 2 scene ({m} realizations), executors (efficiency = serial / (workers x time)):")
     for name, workers, seconds in rows:
         print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")

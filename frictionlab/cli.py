@@ -74,27 +74,17 @@ def cmd_run(args) -> ExitCode:
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
     scene = load_scene(args.preset, overrides)
-    if args.workers is not None and args.workers < 1:
-        raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
-    _use_executor_options(args)
+    options = run_options(args)
     out_dir = Path(args.out) if args.out else _default_out(scene.preset.name)
-    run_options = {
-        "executor": args.executor,
-        "scheduler": args.scheduler,
-        "resume": args.resume,
-        "memory_check": not args.no_memory_check,
-        "force": args.force,
-        "dashboard": args.dashboard,
-    }
     if scene.preset.sweep is not None:  # one ensemble per point (issue 6)
         from .sweep import run_sweep_command
 
-        return run_sweep_command(args, overrides, out_dir, run_options)
+        return run_sweep_command(args, overrides, out_dir, options)
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        outcome, files = run_to_folder(scene, out_dir, workers=args.workers, listeners=listeners, **run_options)
+        outcome, files = run_to_folder(scene, out_dir, options, listeners=listeners)
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
@@ -221,6 +211,26 @@ def _add_executor_options(parser) -> None:
     parser.add_argument(
         "--no-memory-check", action="store_true", help="skip the peak-memory estimate made before the run starts"
     )
+
+
+def run_options(args):
+    """The ``RunOptions`` of the command line (Dask's TLS files are checked and
+    taken first); a refused value is named by its flag."""
+    from .options import RunOptions
+
+    _use_executor_options(args)
+    try:
+        return RunOptions(
+            workers=args.workers,
+            executor=args.executor,
+            scheduler=args.scheduler,
+            dashboard=args.dashboard,
+            resume=args.resume,
+            memory_check=not args.no_memory_check,
+            force=args.force,
+        )
+    except FrictionlabError as exc:  # each message starts with the field's name
+        raise FrictionlabError(f"--{exc}") from None
 
 
 def _use_executor_options(args) -> None:

@@ -1,4 +1,4 @@
-"""The ensemble engine: a lazy iterator of realizations, and a driver that fans
+"""The ensemble engine: runs the realizations of a scene on an executor and fans
 lifecycle events out to listeners.
 
 Seeding is per realization (see ``seeds``), so numbers do not depend on the
@@ -11,52 +11,27 @@ from __future__ import annotations
 import signal
 import threading
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import pluggy
 
 from .ensemble import Accumulator, RunOutcome
 from .errors import RunError
-from .executors import default_workers, make_executor, plan_chunks, pool_context
+from .executors import make_executor, plan_chunks
 from .hookspecs import PROJECT_NAME, LifecycleSpecs
+from .options import RunOptions
 from .preset import Scene
-from .realization import RealizationResult, compute_chunk, compute_realization
+from .realization import RealizationResult, compute_chunk
 from .signals import CancelOnSignals
 
-__all__ = [
-    "RealizationResult",
-    "RunInfo",
-    "compute_realization",
-    "default_workers",
-    "iter_realizations",
-    "run",
-]
-
-# Re-exported: the per-realization work and the executors live in their own modules.
-_pool_context = pool_context
-
-
-def chunked(indices: list[int], workers: int) -> list[list[int]]:
-    """Chunks for ``workers`` when the cost of a realization is unknown."""
-    return plan_chunks(indices, workers, seconds_each=0.0)
-
-
-def iter_realizations(
-    scene: Scene, indices: Iterable[int], *, workers: int = 1, cancel=None, executor: str | None = None
-) -> Iterator[RealizationResult]:
-    """Yield one result per realization as its chunk finishes (completion order)."""
-    cancel = threading.Event() if cancel is None else cancel
-    runner = make_executor(executor, workers)
-    for _, results in runner.map_chunks(scene, chunked(list(indices), runner.workers), cancel):
-        yield from results
-
-
-# ------------------------------------------------------------------ the driver
+__all__ = ["RunInfo", "run"]
 
 
 @dataclass(frozen=True)
 class RunInfo:
+    """What a run's listeners are told when it starts (``run_started``)."""
+
     scene: Scene
     total: int  # realizations of the run, including those restored on a resume
     workers: int
@@ -76,23 +51,18 @@ def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
 
 def run(
     scene: Scene,
+    options: RunOptions = RunOptions(),
     *,
-    workers: int | None = None,
     listeners: Iterable[object] = (),
     cancel=None,
-    executor: str | None = None,
-    scheduler: str | None = None,
-    retries: int = 2,
-    dashboard: bool = False,
     store=None,
     restored: Iterable[RealizationResult] = (),
     registry=None,
 ) -> RunOutcome:
-    """Run the ensemble of ``scene``, telling ``listeners`` as it goes.
+    """Run the ensemble of ``scene`` as ``options`` say (workers, executor), telling
+    ``listeners`` (``listeners.RunListener``) as it goes.
 
-    ``executor``: ``serial``, ``processes`` or ``dask`` (``scheduler``: the address
-    of an existing Dask scheduler); by default a process pool for more than one
-    worker. ``restored``: results already finished (a resume): only the missing
+    ``restored``: results already finished (a resume): only the missing
     realizations, and those that had failed, are computed. ``store``: anything
     with ``save_chunk(results)``, called as each chunk finishes, before its
     listeners hear of it.
@@ -105,8 +75,8 @@ def run(
     says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
     total = scene.preset.realizations
-    workers = min(total, default_workers() if workers is None else max(1, int(workers)))
-    pool = make_executor(executor, workers, scheduler=scheduler, retries=retries, dashboard=dashboard)
+    workers = options.workers_for(total)
+    pool = make_executor(options, workers)
     accumulator = Accumulator(scene)
     retried = 0
     for result in restored:

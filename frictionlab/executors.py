@@ -29,19 +29,15 @@ import uuid
 from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
-from .errors import FrictionlabError, RunError
+from .errors import RunError
+from .options import RunOptions
 from .pool import JobFailed, WorkerLost, WorkerPool
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk
 
-EXECUTORS = ("serial", "processes", "dask")
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
 Chunk = list[int]
-
-
-def default_workers() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
 # ------------------------------------------------------------------ chunking
@@ -264,20 +260,12 @@ class DaskExecutor:
                 cluster.close()
 
 
-def make_executor(
-    name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2, dashboard: bool = False
-):
-    """The executor called ``name``; ``None`` is the embedded default: a process
-    pool for more than one worker, in this process for one."""
-    if name is None:
-        name = "dask" if scheduler else "processes" if workers > 1 else "serial"
-    if name not in EXECUTORS:
-        raise FrictionlabError(f"executor must be one of {', '.join(EXECUTORS)}. Got {name!r} instead.")
-    if scheduler and name != "dask":
-        raise FrictionlabError(f"--scheduler {scheduler} needs the dask executor. Got executor {name!r} instead.")
+def make_executor(options: RunOptions, workers: int):
+    """The executor ``options`` ask for (``RunOptions.executor_for``) with ``workers``."""
+    name = options.executor_for(workers)
     if name == "serial":
         return SerialExecutor()
     if name == "processes":
-        return ProcessExecutor(workers, retries=retries)
+        return ProcessExecutor(workers, retries=options.retries)
     import_distributed()  # fail before anything starts
-    return DaskExecutor(workers, scheduler=scheduler, retries=retries, dashboard=dashboard)
+    return DaskExecutor(workers, scheduler=options.scheduler, retries=options.retries, dashboard=options.dashboard)

@@ -24,6 +24,7 @@ import numpy as np
 from . import __version__, engine
 from .errors import FrictionlabError
 from .fit import least_squares
+from .options import RunOptions
 from .preset import apply_overrides, build_scene, load_preset_file
 from .runner import run_to_folder
 from .seeds import bootstrap_rng
@@ -136,20 +137,20 @@ class CountCurve:
         return math.exp(best.x)
 
 
-def count_curve(data: dict, workers=None) -> CountCurve:
+def count_curve(data: dict, options: RunOptions = RunOptions()) -> CountCurve:
     """One ensemble of the preset ``data`` at h = 1 over a wide log force range."""
     wide = [
         "spectrum.params.rms_height=1.0", "spectrum.params.c0=null", "loading.start=1.0e-6", "loading.stop=1.0e+3",
         "loading.steps=2000", "loading.spacing=log", "fit.bootstrap=0", "sweep=null",
     ]  # fmt: skip
-    outcome = engine.run(build_scene(apply_overrides(data, wide)), workers=workers)
+    outcome = engine.run(build_scene(apply_overrides(data, wide)), options)
     return CountCurve(np.log(outcome.loads), np.log(outcome.contact_count))
 
 
-def calibrated_rms_height(data: dict, targets: dict[float, float] = COUNT_TARGETS, workers=None) -> float:
+def calibrated_rms_height(data: dict, targets: dict[float, float] = COUNT_TARGETS, options: RunOptions = RunOptions()) -> float:
     """h that gives the target mean contact counts (3 significant figures), as
     tools/calibrate_rms_height.py finds it."""
-    return float(f"{count_curve(data, workers).fit_rms_height(targets):.3g}")
+    return float(f"{count_curve(data, options).fit_rms_height(targets):.3g}")
 
 
 @dataclass(frozen=True)
@@ -243,7 +244,7 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     )
 
 
-def run_figures(presets: Path, out_dir: Path, *, workers=None, force: bool = False) -> list[FigureRun]:
+def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()) -> list[FigureRun]:
     from .sweep import load_sweep, run_sweep
 
     runs = []
@@ -253,16 +254,16 @@ def run_figures(presets: Path, out_dir: Path, *, workers=None, force: bool = Fal
         data = load_preset_file(path)
         if data.get("sweep") is not None:
             run.sweep = load_sweep(path)
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, workers=workers, plot=False, force=force)
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False)
         else:
             run.scene = build_scene(data, source=str(path))
-            run.outcome, _ = run_to_folder(run.scene, run.folder, workers=workers, force=force)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, options)
         runs.append(run)
     return runs
 
 
-def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings=READINGS,
-                 folder_name="readings", force: bool = False) -> list[ReadingRow]:  # fmt: skip
+def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = RunOptions(), *, readings=READINGS,
+                 folder_name="readings") -> list[ReadingRow]:  # fmt: skip
     by_key = {run.study.key: run for run in runs}
     rows = []
     for number, reading in enumerate(readings, start=1):
@@ -274,14 +275,14 @@ def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings
             overrides += ["spectrum.params.rms_height=null", f"spectrum.params.c0={float(f'{c0:.6g}')!r}"]
         h = None
         if reading.calibrate:
-            h = calibrated_rms_height(apply_overrides(data, overrides), workers=workers)
+            h = calibrated_rms_height(apply_overrides(data, overrides), options=options)
             overrides.append(f"spectrum.params.rms_height={h!r}")
         if not overrides:  # the figure's own run, maybe re-averaged
             scene, outcome, folder = base.scene, base.outcome, base.folder
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
             folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
-            outcome, _ = run_to_folder(scene, folder, workers=workers, force=force)
+            outcome, _ = run_to_folder(scene, folder, options)
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip
@@ -437,7 +438,7 @@ def _row_for_h(run: FigureRun, value: float):
 
 
 def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, readings_elapsed=None,
-             fig5_calibrated=None, fig5_calibrated_elapsed=None, workers=None,
+             fig5_calibrated=None, fig5_calibrated_elapsed=None, workers: int | None = None,
              command="frictionlab report") -> str:  # fmt: skip
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     lines = [
@@ -654,7 +655,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
 
 def write_report(
     *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
-    workers=None, readings=False, quiet=False, dpi=90, force=False,
+    options: RunOptions = RunOptions(), readings=False, quiet=False, dpi=90,
 ) -> Path:  # fmt: skip
     """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
     Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless ``force``."""
@@ -663,11 +664,11 @@ def write_report(
     from .files import atomic_write
 
     presets = find_presets(presets_dir)
-    out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=force)
+    out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
     log = (lambda text: None) if quiet else (lambda text: print(text, file=sys.stderr, flush=True))
     started = time.perf_counter()
     log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-    runs = run_figures(presets, out_dir, workers=workers, force=force)
+    runs = run_figures(presets, out_dir, options)
     log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
     images = {}
     for run in runs:
@@ -680,20 +681,20 @@ def write_report(
     if readings:
         log(f"report: running {len(READINGS)} readings")
         t0 = time.perf_counter()
-        reading_rows = run_readings(runs, out_dir, workers=workers, force=force)
+        reading_rows = run_readings(runs, out_dir, options)
         readings_elapsed = time.perf_counter() - t0
         fig5 = next(run for run in runs if run.sweep is not None)
         log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
         t0 = time.perf_counter()
-        fig5_rows = run_readings(runs, out_dir, workers=workers, readings=fig5_calibrated_readings(fig5.sweep),
-                                 folder_name="fig5-calibrated", force=force)  # fmt: skip
+        fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
+                                 folder_name="fig5-calibrated")  # fmt: skip
         fig5_elapsed = time.perf_counter() - t0
         name = "fig5-calibrated.png"
         atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
         images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
     command = "frictionlab report" + (" --readings" if readings else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
-                    fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=workers,
+                    fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
     atomic_write(markdown_path, lambda fh: fh.write(text))
     log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
@@ -703,11 +704,13 @@ def write_report(
 def cmd_report(args) -> int:
     from .errors import ExitCode
 
-    if args.workers is not None and args.workers < 1:
-        raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
+    try:
+        options = RunOptions(workers=args.workers, force=args.force)
+    except FrictionlabError as exc:  # named by its flag
+        raise FrictionlabError(f"--{exc}") from None
     path = write_report(
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-        workers=args.workers, readings=args.readings, quiet=args.quiet, force=args.force,
+        options=options, readings=args.readings, quiet=args.quiet,
     )  # fmt: skip
     print(path)
     return ExitCode.OK

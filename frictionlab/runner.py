@@ -9,8 +9,9 @@ from pathlib import Path
 
 from . import engine
 from .ensemble import RunOutcome
-from .executors import dask_memory_limits, default_workers
+from .executors import dask_memory_limits
 from .memory import check_fits, check_worker_limits
+from .options import RunOptions
 from .preset import Scene
 from .results import write_results
 from .rundir import RunDirectory
@@ -19,56 +20,38 @@ from .rundir import RunDirectory
 def run_to_folder(
     scene: Scene,
     out_dir: str | Path,
+    options: RunOptions = RunOptions(),
     *,
-    workers: int | None = None,
     listeners: Iterable[object] = (),
     cancel=None,
-    executor: str | None = None,
-    scheduler: str | None = None,
-    resume: bool = False,
-    memory_check: bool = True,
-    retries: int = 2,
-    force: bool = False,
-    dashboard: bool = False,
 ) -> tuple[RunOutcome, dict[str, Path]]:
-    """Run ``scene`` and write its result files into ``out_dir``.
+    """Run ``scene`` as ``options`` say and write its result files into ``out_dir``.
 
     ``out_dir`` is also the run directory: it is locked while the run goes on
     (a second run into it is refused), holds the resolved preset from the start
-    and every chunk of realizations as it finishes. ``resume=True`` continues a
+    and every chunk of realizations as it finishes. ``options.resume`` continues a
     run left there (interrupted, killed, crashed) with the same preset,
     computing only what is missing (after verifying every stored chunk).
     ``out_dir`` must be new, empty, or a run of this preset: anything else is
-    refused unless ``force`` (see ``rundir``). ``memory_check`` refuses, before
-    anything starts, a run whose estimated peak memory exceeds what is
-    available (and on Dask, one whose realization exceeds a worker's memory
-    limit). ``dashboard``: serve the Dask dashboard of the local cluster.
+    refused unless ``options.force`` (see ``rundir``). ``options.memory_check``
+    refuses, before anything starts, a run whose estimated peak memory exceeds
+    what is available (and on Dask, one whose realization exceeds a worker's
+    memory limit).
 
     What finished is written even when the run was cancelled or interrupted.
     Returns the outcome and the paths of the files written.
     """
     total = scene.preset.realizations
-    count = min(total, default_workers() if workers is None else max(1, int(workers)))
-    if memory_check:
-        kind = executor or ("dask" if scheduler else "processes" if count > 1 else "serial")
-        check_fits(scene, workers=count, executor=kind, remote_workers=bool(scheduler))
+    workers = options.workers_for(total)
+    if options.memory_check:
+        kind = options.executor_for(workers)
+        check_fits(scene, workers=workers, executor=kind, remote_workers=bool(options.scheduler))
         if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
-            limits, usable = dask_memory_limits(scheduler, count)
+            limits, usable = dask_memory_limits(options.scheduler, workers)
             check_worker_limits(scene, limits, usable=usable)
-    with RunDirectory(out_dir, force=force) as run_dir:
-        restored = run_dir.start(scene, resume=resume)
-        outcome = engine.run(
-            scene,
-            workers=workers,
-            listeners=listeners,
-            cancel=cancel,
-            executor=executor,
-            scheduler=scheduler,
-            retries=retries,
-            dashboard=dashboard,
-            store=run_dir,
-            restored=restored,
-        )
+    with RunDirectory(out_dir, force=options.force) as run_dir:
+        restored = run_dir.start(scene, resume=options.resume)
+        outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=run_dir, restored=restored)
         files = write_results(out_dir, scene, outcome)
         run_dir.finish(scene, outcome.status)
     return outcome, files

@@ -19,7 +19,6 @@ each point's run gets the engine listeners that ``point_listeners(point)`` retur
 from __future__ import annotations
 
 import csv
-import inspect
 import itertools
 import json
 import math
@@ -35,11 +34,13 @@ import yaml
 from pydantic import BaseModel
 
 from . import __version__
-from .errors import PresetError
+from .errors import FrictionlabError, OutputRefused, PresetError
 from .fit import json_safe
 from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset
+from .options import RunOptions
 from .registry import Registry, default_registry
-from .files import atomic_write
+from .runner import run_to_folder
+from .files import atomic_write, output_path_problem
 
 SWEEP_SCHEMA_VERSION = 1
 RESULT_COLUMNS = (
@@ -252,22 +253,13 @@ def _notify(listeners, method: str, **kwargs) -> None:
             handler(**kwargs)
 
 
-def _run_options(options: dict) -> dict:
-    """Pass ``executor=``/``resume=`` etc. on only when run_to_folder accepts them."""
-    from .runner import run_to_folder
-
-    accepted = inspect.signature(run_to_folder).parameters
-    return {k: v for k, v in options.items() if v is not None and k in accepted}
-
-
 def iter_sweep(
     sweep: Sweep,
     out_dir: str | Path,
+    options: RunOptions = RunOptions(),
     *,
-    workers: int | None = None,
     point_listeners: Callable[[SweepPoint], list] = lambda point: [],
     cancel=None,
-    **run_options,
 ) -> Iterator[PointResult]:
     """Run the points in order, yielding each PointResult as it finishes.
 
@@ -275,20 +267,14 @@ def iter_sweep(
     written); a point that raises a FrictionlabError is recorded as ``error``
     and the sweep goes on.
     """
-    from .errors import FrictionlabError
-    from .runner import run_to_folder
-
     out_dir = Path(out_dir)
     cancel = threading.Event() if cancel is None else cancel
-    options = _run_options(run_options)
     for point in sweep.points:
         folder = out_dir / "points" / point.folder_name
         if cancel.is_set():
             return
         try:
-            outcome, _ = run_to_folder(
-                point.scene, folder, workers=workers, listeners=point_listeners(point), cancel=cancel, **options
-            )
+            outcome, _ = run_to_folder(point.scene, folder, options, listeners=point_listeners(point), cancel=cancel)
         except FrictionlabError as exc:
             yield PointResult(point, "error", folder, error=str(exc))
             continue
@@ -300,20 +286,18 @@ def iter_sweep(
 def run_sweep(
     sweep: Sweep,
     out_dir: str | Path,
+    options: RunOptions = RunOptions(),
     *,
-    workers: int | None = None,
     listeners: Iterable[object] = (),
     point_listeners: Callable[[SweepPoint], list] = lambda point: [],
     cancel=None,
     plot: bool = True,
-    force: bool = False,
-    **run_options,
 ) -> SweepOutcome:
-    """Run every point and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end.
-    ``out_dir`` must be new, empty or a folder of this same sweep unless ``force``."""
+    """Run every point as ``options`` say and keep ``sweep.csv``/``sweep.json`` current;
+    draw ``sweep.png`` at the end. ``out_dir`` must be new, empty or a folder of this
+    same sweep unless ``options.force``."""
     out_dir = Path(out_dir)
-    check_sweep_folder(sweep, out_dir, force)
-    run_options["force"] = force
+    check_sweep_folder(sweep, out_dir, options.force)
     listeners = list(listeners)
     started = time.perf_counter()
     results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
@@ -322,8 +306,7 @@ def run_sweep(
     write_tables(sweep, outcome, out_dir)
     interrupted = False
     iterator = iter_sweep(
-        sweep, out_dir, workers=workers, cancel=cancel, point_listeners=_announcing(sweep, listeners, point_listeners),
-        **run_options,
+        sweep, out_dir, options, cancel=cancel, point_listeners=_announcing(sweep, listeners, point_listeners)
     )
     try:
         for result in iterator:
@@ -352,9 +335,6 @@ def run_sweep(
 def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
     """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
     (its sweep.json names the same sweep and base preset), or ``force``."""
-    from .errors import OutputRefused
-    from .files import output_path_problem
-
     problem = output_path_problem(out_dir)
     if problem:
         raise OutputRefused(f"{problem}; give --out a folder")
@@ -515,7 +495,7 @@ def sweep_table(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> str:
     return "\n".join(lines)
 
 
-def run_sweep_command(args, overrides: list[str], out_dir: Path, run_options: dict) -> int:
+def run_sweep_command(args, overrides: list[str], out_dir: Path, options: RunOptions) -> int:
     """``frictionlab run`` on a preset with a sweep section; returns an ExitCode."""
     import sys
 
@@ -526,9 +506,7 @@ def run_sweep_command(args, overrides: list[str], out_dir: Path, run_options: di
     listeners = [] if args.quiet else [SweepProgress()]
     point_listeners = (lambda point: []) if args.quiet else (lambda point: [ProgressReporter()])
     try:
-        outcome = run_sweep(
-            sweep, out_dir, workers=args.workers, listeners=listeners, point_listeners=point_listeners, **run_options
-        )
+        outcome = run_sweep(sweep, out_dir, options, listeners=listeners, point_listeners=point_listeners)
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE

@@ -7,7 +7,10 @@ import pytest
 
 from frictionlab import SpectrumGenerator, engine, hookimpl
 from frictionlab.plugin import PluginParams, Profile
+from frictionlab.realization import compute_realization
 from frictionlab.preset import Scene
+from frictionlab.executors import pool_context
+from frictionlab.options import RunOptions
 
 
 def same_outcome(one, two):
@@ -20,16 +23,16 @@ def same_outcome(one, two):
 
 def test_same_seed_same_numbers_for_one_and_two_workers(make_scene):
     scene = make_scene({"realizations": 12})
-    serial = engine.run(scene, workers=1)
-    pooled = engine.run(scene, workers=2)
+    serial = engine.run(scene, RunOptions(workers=1))
+    pooled = engine.run(scene, RunOptions(workers=2))
     assert serial.status == pooled.status == "completed"
     assert serial.done == 12
     same_outcome(serial, pooled)
 
 
 def test_other_seed_other_numbers(make_scene):
-    one = engine.run(make_scene({"seed": 1}), workers=1)
-    two = engine.run(make_scene({"seed": 2}), workers=1)
+    one = engine.run(make_scene({"seed": 1}), RunOptions(workers=1))
+    two = engine.run(make_scene({"seed": 2}), RunOptions(workers=1))
     assert not np.array_equal(one.per_realization["xi"], two.per_realization["xi"])
 
 
@@ -37,8 +40,8 @@ def test_a_realization_does_not_depend_on_the_others(make_scene):
     """Realization 5 computed alone equals row 5 of a full run: seeds are addressed,
     not drawn in sequence."""
     scene = make_scene({"realizations": 8})
-    full = engine.run(scene, workers=1)
-    alone = engine.compute_realization(scene, 5)
+    full = engine.run(scene, RunOptions(workers=1))
+    alone = compute_realization(scene, 5)
     np.testing.assert_array_equal(alone.xi, full.per_realization["xi"][5])
     np.testing.assert_array_equal(alone.contact_count, full.per_realization["contact_count"][5])
 
@@ -69,7 +72,7 @@ class Recorder:
 
 def test_listeners_see_every_realization_between_start_and_finish(make_scene):
     recorder = Recorder()
-    outcome = engine.run(make_scene({"realizations": 6}), workers=2, listeners=[recorder])
+    outcome = engine.run(make_scene({"realizations": 6}), RunOptions(workers=2), listeners=[recorder])
     kinds = [e[0] for e in recorder.events]
     assert kinds[0] == "started" and kinds[-1] == "finished"
     assert kinds.count("done") == 6
@@ -83,13 +86,13 @@ def test_cancel_keeps_what_finished(make_scene, workers):
     cancel = threading.Event()
     recorder = Recorder(cancel_after=3, cancel=cancel)
     scene = make_scene({"realizations": 400, "spectrum": {"params": {"points": 4096}}})
-    outcome = engine.run(scene, workers=workers, listeners=[recorder], cancel=cancel)
+    outcome = engine.run(scene, RunOptions(workers=workers), listeners=[recorder], cancel=cancel)
     assert outcome.status == "cancelled"
     assert 3 <= outcome.done < 400
     assert outcome.fit is not None
     # the kept rows are exactly those realizations, as a full run would give them
     for row, index in enumerate(outcome.indices[:3]):
-        np.testing.assert_array_equal(outcome.per_realization["xi"][row], engine.compute_realization(scene, index).xi)
+        np.testing.assert_array_equal(outcome.per_realization["xi"][row], compute_realization(scene, index).xi)
 
 
 class Flaky(SpectrumGenerator):
@@ -115,7 +118,7 @@ def test_failures_are_carried_on_results_and_the_run_goes_on(make_scene):
     base = make_scene({"realizations": 30})
     scene = Scene(preset=base.preset, spectrum=Flaky(), solver=base.solver, slope=base.slope)
     recorder = Recorder()
-    outcome = engine.run(scene, workers=2, listeners=[recorder])
+    outcome = engine.run(scene, RunOptions(workers=2), listeners=[recorder])
     failed = [e[1] for e in recorder.events if e[0] == "failed"]
     assert outcome.status == "completed"
     assert 0 < len(outcome.failures) < 30
@@ -135,7 +138,7 @@ def test_a_constant_line_fails_with_a_clear_message(make_scene):
             return Profile(np.ones(64), 1.0)
 
     scene = Scene(preset=base.preset, spectrum=Flat(), solver=base.solver, slope=base.slope)
-    result = engine.compute_realization(scene, 0)
+    result = compute_realization(scene, 0)
     assert not result.ok
     assert "rms slope of the whole line is 0.0" in result.error
 
@@ -152,8 +155,8 @@ SCALINGS = {
 
 @pytest.mark.parametrize("changes, s, rtol", SCALINGS.values(), ids=SCALINGS)
 def test_scaling_laws_leave_counts_xi_and_f_unchanged(make_scene, changes, s, rtol):
-    base = engine.run(make_scene(), workers=1)
-    scaled = engine.run(make_scene({**changes, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}), workers=1)
+    base = engine.run(make_scene(), RunOptions(workers=1))
+    scaled = engine.run(make_scene({**changes, "loading": {"start": 0.5 * s, "stop": 20.0 * s}}), RunOptions(workers=1))
     np.testing.assert_array_equal(base.per_realization["contact_count"], scaled.per_realization["contact_count"])
     np.testing.assert_allclose(scaled.xi, base.xi, rtol=rtol)
     np.testing.assert_allclose(scaled.f, base.f, rtol=rtol)
@@ -161,45 +164,35 @@ def test_scaling_laws_leave_counts_xi_and_f_unchanged(make_scene, changes, s, rt
 
 def test_full_contact_gives_xi_one(make_scene):
     """Far past full contact every point touches and xi must be exactly 1."""
-    outcome = engine.run(make_scene({"loading": {"start": 1e5, "stop": 1e6, "steps": 4}}), workers=1)
+    outcome = engine.run(make_scene({"loading": {"start": 1e5, "stop": 1e6, "steps": 4}}), RunOptions(workers=1))
     assert np.all(outcome.per_realization["contact_count"] == 1024)
     np.testing.assert_array_equal(outcome.per_realization["xi"], 1.0)
 
 
 def test_only_what_the_scene_needs_is_kept(make_scene):
-    force = engine.run(make_scene({"realizations": 3}), workers=1)
+    force = engine.run(make_scene({"realizations": 3}), RunOptions(workers=1))
     assert set(force.per_realization) == {"index", "xi", "contact_count", "indentation", "slope_rms_line"}
-    indentation = engine.run(
-        make_scene({"realizations": 3, "loading": {"control": "indentation", "start": 0.1, "stop": 2.0}}),
-        workers=1,
-    )
+    indentation = engine.run(make_scene({"realizations": 3, "loading": {"control": "indentation", "start": 0.1, "stop": 2.0}}), RunOptions(workers=1))
     assert "force" in indentation.per_realization
     assert indentation.per_realization["force"].shape == (3, 16)
     # forces grow with indentation in every realization
     assert np.all(np.diff(indentation.per_realization["force"], axis=1) > 0)
 
 
-def test_chunks_cover_every_index_once():
-    indices = list(range(1000))
-    chunks = engine.chunked(indices, workers=2)
-    assert [i for c in chunks for i in c] == indices
-    assert len(chunks) == 8  # cost unknown: 4 per worker (sizing by cost: test_executors.py)
-
-
 def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(make_scene):
     """Forking a threaded process is unsafe (a front end runs the engine in a
     thread): then the pool starts by forkserver, which pickles the scene."""
     scene = make_scene({"realizations": 6})
-    serial = engine.run(scene, workers=1)
+    serial = engine.run(scene, RunOptions(workers=1))
     release = threading.Event()
     bystander = threading.Thread(target=release.wait)
     bystander.start()
     try:
-        assert engine._pool_context().get_start_method() == "forkserver"
-        pooled = engine.run(scene, workers=2)
+        assert pool_context().get_start_method() == "forkserver"
+        pooled = engine.run(scene, RunOptions(workers=2))
     finally:
         release.set()
         bystander.join()
     # fork again once the bystander is gone (unless a Dask client left its threads in this process)
-    assert engine._pool_context().get_start_method() == ("fork" if threading.active_count() == 1 else "forkserver")
+    assert pool_context().get_start_method() == ("fork" if threading.active_count() == 1 else "forkserver")
     same_outcome(serial, pooled)

@@ -20,6 +20,7 @@ from frictionlab.testing import check_plugin
 from frictionlab_slopes import ForwardDifference, Spectral
 from frictionlab_spectra import PowerLawSurface, RolloffSurface, SurfaceFile
 from frictionlab_spectra.equivalent_line import EquivalentLine, line_grid, line_mode_powers
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 
@@ -182,10 +183,10 @@ def test_mdr_on_a_surface_runs_its_line_at_the_surfaces_3d_f(registry):
     assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "power-law-2d"
     assert scene.geometry == "mdr-equivalent line of a surface"
     assert scene.resolved()["spectrum"]["name"] == "power-law-2d"  # what the user wrote, re-runnable
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.extent == pytest.approx(2 * math.sqrt(48 * 48 / math.pi), rel=1e-14)  # f = F / (E* h L)
     np.testing.assert_allclose(outcome.f, outcome.loads / (1.0 * 1.0 * outcome.extent), rtol=1e-14)
     assert np.all(outcome.per_realization["contact_count"] <= scene.spectrum.params.points)
     again = build_scene(scene.resolved(), registry=registry)
-    np.testing.assert_array_equal(engine.run(again, workers=1).xi, outcome.xi)
+    np.testing.assert_array_equal(engine.run(again, RunOptions(workers=1)).xi, outcome.xi)

@@ -13,10 +13,11 @@ import pytest
 
 from frictionlab import engine
 from frictionlab.errors import FrictionlabError
-from frictionlab.executors import DASK_MISSING, make_executor, plan_chunks
+from frictionlab.executors import DASK_MISSING, plan_chunks
 from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
 from frictionlab_spectra.power_law import PowerLaw
+from frictionlab.options import RunOptions
 
 from .conftest import loopback_cluster
 
@@ -73,7 +74,7 @@ def scene_24(registry):
 
 @pytest.fixture(scope="module")
 def serial_24(scene_24):
-    return engine.run(scene_24, workers=1, executor="serial")
+    return engine.run(scene_24, RunOptions(workers=1, executor="serial"))
 
 
 # ------------------------------------------------------------------ chunking
@@ -103,7 +104,7 @@ def test_chunks_are_sized_by_cost_and_keep_every_worker_busy():
 
 @pytest.mark.parametrize("executor, workers", [("processes", 1), ("processes", 2)])
 def test_process_pool_gives_the_serial_numbers_bitwise(scene_24, serial_24, executor, workers):
-    outcome = engine.run(scene_24, workers=workers, executor=executor)
+    outcome = engine.run(scene_24, RunOptions(workers=workers, executor=executor))
     assert outcome.status == "completed" and outcome.done == 24
     assert outcome.extra["executor"] == "processes"
     same_numbers(serial_24, outcome)
@@ -111,14 +112,14 @@ def test_process_pool_gives_the_serial_numbers_bitwise(scene_24, serial_24, exec
 
 def test_a_worker_killed_mid_chunk_is_retried_with_the_same_numbers(scene_24, serial_24, tmp_path):
     flag = tmp_path / "crashed"
-    outcome = engine.run(crashing(scene_24, flag), workers=2, executor="processes")
+    outcome = engine.run(crashing(scene_24, flag), RunOptions(workers=2, executor="processes"))
     assert flag.exists(), "no worker died: the test did not test anything"
     assert outcome.status == "completed" and outcome.done == 24
     same_numbers(serial_24, outcome)
 
 
 def test_a_worker_that_always_dies_fails_the_run_after_bounded_retries(scene_24, tmp_path):
-    outcome = engine.run(crashing(scene_24, tmp_path / "x", always=True), workers=2, executor="processes", retries=1)
+    outcome = engine.run(crashing(scene_24, tmp_path / "x", always=True), RunOptions(workers=2, executor="processes", retries=1))
     assert outcome.status == "failed"
     assert "a worker process died 2 times" in outcome.error
     assert outcome.done == 1  # only the realization measured in the main process
@@ -126,15 +127,15 @@ def test_a_worker_that_always_dies_fails_the_run_after_bounded_retries(scene_24,
 
 def test_unknown_executor_and_scheduler_without_dask_are_refused():
     with pytest.raises(FrictionlabError, match="executor must be one of serial, processes, dask. Got 'mpi'"):
-        make_executor("mpi", 2)
+        RunOptions(executor="mpi", workers=2)
     with pytest.raises(FrictionlabError, match="needs the dask executor"):
-        make_executor("processes", 2, scheduler="tcp://127.0.0.1:1")
+        RunOptions(executor="processes", workers=2, scheduler="tcp://127.0.0.1:1")
 
 
 def test_missing_dask_names_the_extra_to_install(monkeypatch, scene_24):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     with pytest.raises(FrictionlabError) as caught:
-        engine.run(scene_24, executor="dask")
+        engine.run(scene_24, RunOptions(executor="dask"))
     assert str(caught.value) == DASK_MISSING
     assert 'pip install "frictionlab[dask]"' in DASK_MISSING
 
@@ -156,7 +157,7 @@ def dask_scheduler():
 
 @needs_dask
 def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_24, serial_24, dask_scheduler):
-    outcome = engine.run(scene_24, executor="dask", scheduler=dask_scheduler)
+    outcome = engine.run(scene_24, RunOptions(executor="dask", scheduler=dask_scheduler))
     assert outcome.status == "completed" and outcome.workers == 2
     same_numbers(serial_24, outcome)
 
@@ -164,7 +165,7 @@ def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_2
 @needs_dask
 def test_dask_killed_worker_is_rescheduled_with_the_same_numbers(scene_24, serial_24, dask_scheduler, tmp_path):
     flag = tmp_path / "crashed"
-    outcome = engine.run(crashing(scene_24, flag), executor="dask", scheduler=dask_scheduler)
+    outcome = engine.run(crashing(scene_24, flag), RunOptions(executor="dask", scheduler=dask_scheduler))
     assert flag.exists(), "no worker died: the test did not test anything"
     assert outcome.status == "completed"
     same_numbers(serial_24, outcome)
@@ -172,7 +173,7 @@ def test_dask_killed_worker_is_rescheduled_with_the_same_numbers(scene_24, seria
 
 @needs_dask
 def test_dask_own_local_cluster_of_one_worker_gives_the_serial_numbers(scene_24, serial_24):
-    outcome = engine.run(scene_24, workers=1, executor="dask")
+    outcome = engine.run(scene_24, RunOptions(workers=1, executor="dask"))
     assert outcome.status == "completed" and outcome.workers == 1
     same_numbers(serial_24, outcome)
 

@@ -23,6 +23,7 @@ from frictionlab.seeds import realization_rng
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
 from frictionlab_solvers import BisectionSprings, MDRSprings, WinklerSprings
 from frictionlab_spectra import PowerLaw, PowerLawSurface, ProfileFile, Rolloff, RolloffSurface
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 
@@ -149,7 +150,7 @@ def test_far_past_full_contact(registry, solver, base):
     d = F / (K N) + max(z) - mean(z), K = k dx^ndim, from sum_i (d - u_i) = F / K."""
     data = {**base, "solver": {"name": solver}, "loading": {"start": 1e6, "stop": 1e12, "steps": 3, "spacing": "log"}}
     scene = build_scene(data, registry=registry)
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     assert not outcome.failures
     np.testing.assert_array_equal(outcome.per_realization["xi"], 1.0)
     np.testing.assert_array_equal(outcome.contact_fraction, 1.0)
@@ -214,7 +215,7 @@ def test_results_do_not_depend_on_the_height_scale(registry, scale, solver, base
             "spectrum": {"params": {"rms_height": s}},
             "loading": {"start": 0.01 * s, "stop": 3.0 * s, "steps": 12, "spacing": "log"},
         })
-        return engine.run(build_scene(data, registry=registry), workers=1)
+        return engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
 
     one, scaled = run(1.0), run(scale)
     np.testing.assert_array_equal(scaled.per_realization["contact_count"], one.per_realization["contact_count"])

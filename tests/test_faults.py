@@ -21,6 +21,7 @@ import pytest
 import yaml
 
 from frictionlab import engine
+from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.runner import run_to_folder
 
@@ -35,12 +36,13 @@ import numpy as np
 from frictionlab import engine
 from frictionlab.preset import build_scene
 from frictionlab.registry import Registry
+from frictionlab.options import RunOptions
 from tests.conftest import SMALL_PRESET, merge
 from tests.faults import MidSendKiller, with_spectrum
 
 scene = build_scene(merge(SMALL_PRESET, {"realizations": 24}), registry=Registry(discover=False))
 killer = with_spectrum(scene, MidSendKiller, flag=sys.argv[1], parent=os.getpid())
-outcome = engine.run(killer, workers=2, executor="processes")
+outcome = engine.run(killer, RunOptions(workers=2, executor="processes"))
 np.save(sys.argv[2], outcome.per_realization["xi"])
 print(json.dumps({"status": outcome.status, "done": outcome.done, "a": outcome.fit.a, "b": outcome.fit.b}))
 """
@@ -61,7 +63,7 @@ def test_a_worker_killed_while_sending_its_result_is_retried_and_the_run_finishe
     summary = json.loads(done.stdout)
     assert summary["status"] == "completed" and summary["done"] == 24
 
-    serial = engine.run(build_scene(merge(SMALL_PRESET, {"realizations": 24}), registry=registry), workers=1)
+    serial = engine.run(build_scene(merge(SMALL_PRESET, {"realizations": 24}), registry=registry), RunOptions(workers=1))
     np.testing.assert_array_equal(np.load(xi_file), serial.per_realization["xi"])
     assert (summary["a"], summary["b"]) == (serial.fit.a, serial.fit.b)
 
@@ -102,7 +104,7 @@ def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry,
     )  # fmt: skip
     assert resumed.returncode == 0, resumed.stderr
     assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < 80
-    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", workers=2)
+    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")
 
 
@@ -117,9 +119,9 @@ def partial_and_whole(registry, tmp_path_factory):
     scene = build_scene(DAMAGE_PRESET, registry=registry)
     root = tmp_path_factory.mktemp("damage")
     cancel = threading.Event()
-    first, _ = run_to_folder(scene, root / "partial", workers=1, listeners=[CancelAfter(30, cancel)], cancel=cancel)
+    first, _ = run_to_folder(scene, root / "partial", RunOptions(workers=1), listeners=[CancelAfter(30, cancel)], cancel=cancel)
     assert first.status == "cancelled" and len(json.loads((root / "partial" / "run.json").read_text())["chunks"]) >= 3
-    run_to_folder(scene, root / "whole", workers=1)
+    run_to_folder(scene, root / "whole", RunOptions(workers=1))
     return scene, root / "partial", root / "whole"
 
 
@@ -221,7 +223,7 @@ def test_resume_recomputes_damaged_chunks_and_ends_bitwise_whole(partial_and_who
     shutil.copytree(partial, folder)
     damage(folder)
     workers = 2 if damage is truncated else 1  # one case through a real process pool
-    outcome, _ = run_to_folder(scene, folder, workers=workers, resume=True)
+    outcome, _ = run_to_folder(scene, folder, RunOptions(workers=workers, resume=True))
     messages = [str(w.message) for w in recwarn if "resume of" in str(w.message)]
     expected = DAMAGE[damage]
     if expected is None:

@@ -15,6 +15,7 @@ from frictionlab import memory
 from frictionlab.cli import main
 from frictionlab.errors import RunError
 from frictionlab.preset import build_scene
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, loopback_cluster, merge
 
@@ -196,9 +197,9 @@ def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the
 
     scheduler, _ = small_worker_cluster
     scene = build_scene(merge(SMALL_PRESET, {"realizations": 12}), registry=registry)
-    outcome, _ = run_to_folder(scene, tmp_path / "small", executor="dask", scheduler=scheduler)
+    outcome, _ = run_to_folder(scene, tmp_path / "small", RunOptions(executor="dask", scheduler=scheduler))
     assert outcome.status == "completed" and outcome.extra["executor"] == "dask"
-    same_numbers(engine.run(scene, workers=1, executor="serial"), outcome)
+    same_numbers(engine.run(scene, RunOptions(workers=1, executor="serial")), outcome)
 
     # too large: refused by the check, not by the cluster; skipped with the check off
     # (cancelled before the first realization, so nothing large ever runs)
@@ -206,8 +207,8 @@ def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the
     cancelled = threading.Event()
     cancelled.set()
     with pytest.raises(RunError, match="has a memory limit of 0.20 GiB"):
-        run_to_folder(large, tmp_path / "large", executor="dask", scheduler=scheduler, cancel=cancelled)
-    outcome, _ = run_to_folder(large, tmp_path / "large", executor="dask", scheduler=scheduler, cancel=cancelled, memory_check=False)
+        run_to_folder(large, tmp_path / "large", RunOptions(executor="dask", scheduler=scheduler), cancel=cancelled)
+    outcome, _ = run_to_folder(large, tmp_path / "large", RunOptions(executor="dask", scheduler=scheduler, memory_check=False), cancel=cancelled)
     assert outcome.status == "cancelled" and outcome.done == 0
 
 
@@ -221,5 +222,5 @@ def test_own_local_cluster_is_checked_before_it_starts(registry, tmp_path, monke
     monkeypatch.setattr(worker_memory, "parse_memory_limit", lambda *args, **kwargs: 200 * MiB)
     large = build_scene(line_of(1_000_000, realizations=4), registry=registry)
     with pytest.raises(RunError, match=r"Dask worker 1 of the LocalCluster on 127\.0\.0\.1 has a memory limit of 0\.20 GiB"):
-        run_to_folder(large, tmp_path / "out", workers=2, executor="dask")
+        run_to_folder(large, tmp_path / "out", RunOptions(workers=2, executor="dask"))
     assert not (tmp_path / "out").exists()

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from frictionlab import engine
+from frictionlab.realization import compute_realization
 from frictionlab.preset import load_scene
 
 from .conftest import PRESETS
@@ -66,7 +67,7 @@ def test_fig2_lines_solved_exactly_agree_with_the_naive_bisection(registry, real
         registry,
     )
     for index in range(realizations):
-        one, two = engine.compute_realization(exact, index), engine.compute_realization(naive, index)
+        one, two = compute_realization(exact, index), compute_realization(naive, index)
         np.testing.assert_array_equal(one.contact_count, two.contact_count)
         np.testing.assert_allclose(one.xi, two.xi, rtol=1e-12)
         np.testing.assert_allclose(one.indentation, two.indentation, rtol=1e-8)

@@ -35,6 +35,7 @@ from frictionlab import registry as registry_module
 from frictionlab import testing as fltesting
 from frictionlab.errors import ExitCode, PluginError
 from frictionlab.hookspecs import PROJECT_NAME, LifecycleSpecs, RegistrationSpecs
+from frictionlab.options import RunOptions
 from frictionlab.plugin import KINDS
 from frictionlab.registry import (
     BUILTIN_MODULES,
@@ -1040,7 +1041,7 @@ def test_an_installed_plugin_can_listen_to_every_run(register_plugin, small_pres
     registry = register_plugin(RunLog())
     assert len(registry.run_listeners()) == 1
     small_preset["realizations"] = 2
-    engine.run(build_scene(small_preset, registry=registry), workers=1, registry=registry)
+    engine.run(build_scene(small_preset, registry=registry), RunOptions(workers=1), registry=registry)
     assert heard == [("small", 2)]
 
     class Misspelled:

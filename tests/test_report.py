@@ -18,6 +18,7 @@ from frictionlab.report import (
     write_report,
 )  # fmt: skip
 from frictionlab.runner import run_to_folder
+from frictionlab.options import RunOptions
 
 from .conftest import PRESETS, SMALL_PRESET
 
@@ -72,7 +73,7 @@ def test_bootstrap_weights_equal_repeated_realizations(method):
 
 def test_refit_of_the_mean_is_the_runs_own_fit(make_scene):
     scene = make_scene({"realizations": 12})
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     fit = refit(outcome.f, outcome.per_realization, "mean", bootstrap=200, confidence=0.95, seed=scene.preset.seed)
     assert (fit.a, fit.b) == pytest.approx((outcome.fit.a, outcome.fit.b), rel=1e-12)
     assert fit.a_ci == pytest.approx(outcome.fit.a_ci, rel=1e-12)
@@ -83,15 +84,15 @@ def test_calibration_recovers_a_known_rms_height(registry):
     # counts measured at h = 37 must calibrate back to h = 37 (3 significant digits, grid interpolation)
     data = {**SMALL_PRESET, "realizations": 8, "loading": {"start": 0.5, "stop": 20.0, "steps": 2}}
     data = apply_overrides(data, ["spectrum.params.rms_height=37.0"])
-    outcome = engine.run(build_scene(data, registry=registry), workers=1)
+    outcome = engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
     targets = dict(zip(outcome.loads.tolist(), outcome.contact_count.tolist(), strict=True))
-    assert calibrated_rms_height(data, targets, workers=1) == pytest.approx(37.0, rel=0.03)
+    assert calibrated_rms_height(data, targets, options=RunOptions(workers=1)) == pytest.approx(37.0, rel=0.03)
 
 
 def test_report_on_tiny_presets(tmp_path, tiny_presets):
     md = tmp_path / "REPRODUCTION.md"
     write_report(presets_dir=tiny_presets, out_dir=tmp_path / "runs", markdown_path=md,
-                 figures_dir=tmp_path / "docs" / "fig", workers=1, quiet=True)  # fmt: skip
+                 figures_dir=tmp_path / "docs" / "fig", options=RunOptions(workers=1), quiet=True)  # fmt: skip
     text = md.read_text()
     assert "Wall time of the whole report (Figs. 2 to 5):" in text
     for fig in STUDY:
@@ -111,21 +112,21 @@ def test_report_on_tiny_presets(tmp_path, tiny_presets):
 
 @pytest.fixture(scope="module")
 def tiny_runs(tmp_path_factory, tiny_presets):
-    return run_figures(tiny_presets, tmp_path_factory.mktemp("runs"), workers=1)
+    return run_figures(tiny_presets, tmp_path_factory.mktemp("runs"), RunOptions(workers=1))
 
 
 def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     runs = tiny_runs
     readings = (Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
                 Reading("fig2", "spectral", ("slope.name=spectral",)), Reading("fig2", "pooled", average="pooled"))  # fmt: skip
-    rows = run_readings(runs, tmp_path, workers=1, readings=readings)
+    rows = run_readings(runs, tmp_path, RunOptions(workers=1), readings=readings)
     c0 = runs[0].scene.spectrum.c0()
     assert rows[0].overrides[-1].startswith("spectrum.params.c0=")
     assert float(rows[0].overrides[-1].split("=")[1]) == pytest.approx(c0, rel=1e-5)
     for row in rows[:2]:  # each row reruns from its preset and --set options, as the table says
         preset = next(s.preset for s in STUDY if s.key == row.reading.figure)
         data = apply_overrides(load_preset_file(tiny_presets / preset), row.overrides)
-        outcome, _ = run_to_folder(build_scene(data), tmp_path / f"again-{row.reading.name}", workers=1)
+        outcome, _ = run_to_folder(build_scene(data), tmp_path / f"again-{row.reading.name}", RunOptions(workers=1))
         assert (outcome.fit.a, outcome.fit.b) == pytest.approx((row.a, row.b), rel=1e-12)
     pooled = average_curve(runs[0].outcome.per_realization, "pooled")
     assert rows[2].a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
@@ -142,7 +143,7 @@ def test_presets_folder_errors(tmp_path, capsys):
 
 def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
     fig5 = next(run for run in tiny_runs if run.sweep is not None)
-    rows = run_readings(tiny_runs, tmp_path, workers=1, readings=fig5_calibrated_readings(fig5.sweep))
+    rows = run_readings(tiny_runs, tmp_path, RunOptions(workers=1), readings=fig5_calibrated_readings(fig5.sweep))
     assert [r.overrides[:2] for r in rows] == [["sweep=null", "spectrum.params.hurst=0.6"],
                                                ["sweep=null", "spectrum.params.hurst=1.0"]]  # fmt: skip
     targets = (COUNT_TARGETS[1.0], COUNT_TARGETS[20.0])
@@ -160,7 +161,7 @@ def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
     assert rows[0].rms_height < rows[1].rms_height / 1.5
     # a point reruns from the preset and its --set options, as the section says
     data = apply_overrides(load_preset_file(tiny_presets / fig5.preset_path.name), rows[0].overrides)
-    outcome, _ = run_to_folder(build_scene(data), tmp_path / "again", workers=1)
+    outcome, _ = run_to_folder(build_scene(data), tmp_path / "again", RunOptions(workers=1))
     assert (outcome.fit.a, outcome.fit.b) == pytest.approx((rows[0].a, rows[0].b), rel=1e-12)
     text = "\n".join(fig5_calibrated_markdown(fig5, rows, "fig.png", elapsed=1.0))
     assert f"| 0.6 | {rows[0].rms_height:g} | {rows[0].a:.4f} [{rows[0].a_ci[0]:.4f}, {rows[0].a_ci[1]:.4f}] |" in text

@@ -4,6 +4,7 @@ import io
 
 from frictionlab import engine
 from frictionlab.reporter import ProgressReporter
+from frictionlab.options import RunOptions
 
 
 class FakeTerminal(io.StringIO):
@@ -13,7 +14,7 @@ class FakeTerminal(io.StringIO):
 
 def test_terminal_gets_one_redrawn_bar_and_a_final_newline(make_scene):
     stream = FakeTerminal()
-    engine.run(make_scene({"realizations": 30}), workers=1, listeners=[ProgressReporter(stream)])
+    engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream)])
     text = stream.getvalue()
     assert text.startswith("small: 30 realizations of power-law lines, 16 force steps, 1 worker(s)\n")
     bar = text.split("\n")[1]
@@ -25,7 +26,7 @@ def test_terminal_gets_one_redrawn_bar_and_a_final_newline(make_scene):
 def test_log_file_gets_one_plain_line_per_tenth(make_scene):
     stream = io.StringIO()
     reporter = ProgressReporter(stream)
-    engine.run(make_scene({"realizations": 20}), workers=1, listeners=[reporter])
+    engine.run(make_scene({"realizations": 20}), RunOptions(workers=1), listeners=[reporter])
     lines = stream.getvalue().split("\n")[:-1]
     assert [line.split(" ")[0] for line in lines[1:]] == [f"{2 * i}/20" for i in range(1, 11)]
     assert "\r" not in stream.getvalue()

@@ -23,6 +23,7 @@ from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
 from frictionlab.preset import build_scene
 from frictionlab.rundir import RunDirectory
 from frictionlab.runner import run_to_folder
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 
@@ -56,23 +57,23 @@ class CancelAfter:
 def test_cancelled_run_resumes_to_the_uninterrupted_numbers(make_scene, tmp_path):
     scene = make_scene({"realizations": 40, **NO_PLOT})
     cancel = threading.Event()
-    first, _ = run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(5, cancel)], cancel=cancel)
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(5, cancel)], cancel=cancel)
     assert first.status == "cancelled" and 5 <= first.done < 40
     stored = sorted(p.name for p in (tmp_path / "run" / "chunks").glob("*.npz"))
     assert stored, "no chunk was kept"
 
-    resumed, _ = run_to_folder(scene, tmp_path / "run", workers=2, resume=True)
+    resumed, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=2, resume=True))
     assert resumed.status == "completed"
     assert resumed.extra["resumed"] == first.done  # only the missing ones were computed
-    run_to_folder(scene, tmp_path / "whole", workers=1)
+    run_to_folder(scene, tmp_path / "whole", RunOptions(workers=1))
     same_files(tmp_path / "run", tmp_path / "whole")
 
 
 def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
     scene = make_scene({"realizations": 12, **NO_PLOT})
-    run_to_folder(scene, tmp_path / "run", workers=1)
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     before = (tmp_path / "run" / "curve.csv").read_text()
-    again, _ = run_to_folder(scene, tmp_path / "run", workers=1, resume=True)
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
     assert again.extra["resumed"] == 12 and again.done == 12
     assert (tmp_path / "run" / "curve.csv").read_text() == before
 
@@ -80,8 +81,8 @@ def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
 def test_a_second_run_into_a_locked_directory_is_refused(make_scene, tmp_path):
     with RunDirectory(tmp_path / "run"):
         with pytest.raises(RunFolderError, match=rf"{tmp_path / 'run'} is in use by another run \(pid {os.getpid()}, started"):
-            run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)
-    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)  # released: now it runs
+            run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1))
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1))  # released: now it runs
 
 
 def test_a_forked_child_does_not_keep_the_lock(tmp_path):
@@ -105,10 +106,10 @@ def test_a_forked_child_does_not_keep_the_lock(tmp_path):
 def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, tmp_path):
     cancel = threading.Event()
     cancel.set()  # nothing computed, but the directory is started
-    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1, cancel=cancel)
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1), cancel=cancel)
     other = make_scene({"realizations": 9, "spectrum": {"params": {"hurst": 0.7}}})
     with pytest.raises(FrictionlabError) as caught:
-        run_to_folder(other, tmp_path / "run", workers=1, resume=True)
+        run_to_folder(other, tmp_path / "run", RunOptions(workers=1, resume=True))
     message = str(caught.value)
     assert message.startswith(f"cannot resume {tmp_path / 'run'}: its preset differs from the one given")
     assert "realizations: 8 in the run directory, 9 given" in message
@@ -118,9 +119,9 @@ def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, t
 def test_a_fresh_run_over_an_unfinished_one_is_refused(make_scene, tmp_path):
     scene = make_scene({"realizations": 30, **NO_PLOT})
     cancel = threading.Event()
-    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(3, cancel)], cancel=cancel)
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(3, cancel)], cancel=cancel)
     with pytest.raises(FrictionlabError, match="holds an unfinished run .* continue it with --resume"):
-        run_to_folder(scene, tmp_path / "run", workers=1)
+        run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
 
 
 def test_resume_of_a_folder_without_a_run_says_so(tmp_path, capsys):
@@ -173,5 +174,5 @@ def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tm
     assert 0 < summary["resumed_realizations"] < 80
     assert kept >= 2
 
-    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", workers=2)
+    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")

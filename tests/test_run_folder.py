@@ -19,6 +19,7 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.rundir import RunDirectory
 from frictionlab.runner import run_to_folder
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 from .faults import FlakyPowerLaw, with_spectrum
@@ -80,13 +81,13 @@ def test_a_finished_run_of_another_preset_is_refused_and_the_same_preset_reruns(
 def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists(make_scene, tmp_path):
     scene = make_scene({"realizations": 30, **NO_PLOT})
     cancel = threading.Event()
-    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(12, cancel)], cancel=cancel)
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(12, cancel)], cancel=cancel)
     chunks = tmp_path / "run" / "chunks"
     listed = set(json.loads((tmp_path / "run" / "run.json").read_text())["chunks"])
     (chunks / "mine.npz").write_bytes(b"user data")
     with pytest.raises(OutputRefused, match="holds an unfinished run"):
-        run_to_folder(scene, tmp_path / "run", workers=1)
-    outcome, _ = run_to_folder(scene, tmp_path / "run", workers=1, force=True)
+        run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, force=True))
     assert outcome.status == "completed" and outcome.extra["resumed"] == 0
     assert (chunks / "mine.npz").read_bytes() == b"user data"
     now = set(json.loads((tmp_path / "run" / "run.json").read_text())["chunks"])
@@ -139,7 +140,7 @@ def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_sc
             seen.append(len(manifest["chunks"]))
 
     cancel = threading.Event()
-    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[Check(), CancelAfter(25, cancel)], cancel=cancel)
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[Check(), CancelAfter(25, cancel)], cancel=cancel)
     assert seen and seen[-1] >= 3 and seen == sorted(seen)
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     assert manifest["status"] == "cancelled" and manifest["fingerprint"] and manifest["preset"]["seed"] == 7
@@ -147,13 +148,13 @@ def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_sc
 
 def test_a_finished_run_leaves_no_lock_and_its_chunks_compacted_into_one(make_scene, tmp_path):
     scene = make_scene({"realizations": 30, **NO_PLOT})
-    outcome, _ = run_to_folder(scene, tmp_path / "run", workers=2)
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=2))
     assert outcome.status == "completed"
     assert not (tmp_path / "run" / "run.lock").exists()
     files = [p.name for p in (tmp_path / "run" / "chunks").iterdir()]
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     assert files == list(manifest["chunks"]) == ["00000000-00000029.npz"]
-    again, _ = run_to_folder(scene, tmp_path / "run", workers=1, resume=True)  # verified, nothing recomputed
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))  # verified, nothing recomputed
     assert again.extra["resumed"] == 30
     with RunDirectory(tmp_path / "run"):  # the lock is free and taken anew
         assert (tmp_path / "run" / "run.lock").exists()
@@ -164,18 +165,18 @@ def test_failed_realizations_are_retried_on_resume(make_scene, tmp_path, capsys)
     flag = tmp_path / "flaky"
     flag.touch()
     scene = with_spectrum(make_scene({"realizations": 20, **NO_PLOT}), FlakyPowerLaw, flag=str(flag))
-    first, _ = run_to_folder(scene, tmp_path / "run", workers=1)
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     assert first.status == "completed" and 3 <= len(first.failures) <= 15
     flag.unlink()
     from frictionlab.reporter import ProgressReporter
 
-    second, _ = run_to_folder(scene, tmp_path / "run", workers=2, resume=True, listeners=[ProgressReporter()])
+    second, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=2, resume=True), listeners=[ProgressReporter()])
     assert second.failures == [] and second.done == 20
     assert second.extra["retried"] == len(first.failures) and second.extra["resumed"] == first.done
     assert f"{len(first.failures)} failed ones retried" in capsys.readouterr().err
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["retried_realizations"] == len(first.failures)
-    run_to_folder(scene, tmp_path / "clean", workers=1)
+    run_to_folder(scene, tmp_path / "clean", RunOptions(workers=1))
     same_files(tmp_path / "run", tmp_path / "clean")
 
 

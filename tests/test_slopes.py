@@ -11,6 +11,7 @@ from frictionlab.preset import build_scene
 from frictionlab.registry import validate_plugin_class
 from frictionlab.testing import check_plugin
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
+from frictionlab.options import RunOptions
 
 ESTIMATORS = (ForwardDifference, CentralDifference, Spectral)
 
@@ -164,11 +165,11 @@ def test_a_scan_on_a_ramp_has_its_true_rms_slope(tmp_path, registry, slope, detr
         "slope": {"name": slope},
         "loading": {"start": 1.0, "stop": 10.0, "steps": 3}, "fit": {"bootstrap": 0}, "output": {"plot": False},
     }  # fmt: skip
-    outcome = engine.run(build_scene(data, registry=registry), workers=1)
+    outcome = engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
     assert not outcome.failures
     assert outcome.per_realization["slope_rms_line"][0] == pytest.approx(truth, rel=0.01)
     data["spectrum"]["params"]["periodic"] = True
-    wrapped = engine.run(build_scene(data, registry=registry), workers=1)
+    wrapped = engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
     assert wrapped.per_realization["slope_rms_line"][0] > 1.1 * truth
 
 

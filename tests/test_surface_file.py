@@ -19,6 +19,7 @@ from frictionlab.preset import build_scene, load_scene
 from frictionlab.testing import check_plugin
 from frictionlab_spectra import PowerLawSurface, SurfaceFile
 from frictionlab_spectra.equivalent_line import EquivalentLine
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 
@@ -140,7 +141,7 @@ def test_bem_halfspace_runs_on_the_measured_surface(tmp_path, registry):
         build_scene(surface_preset(path, "bem-halfspace"), registry=registry)
     scene = build_scene(surface_preset(path, "bem-halfspace", periodic=True), registry=registry)
     assert scene.geometry == "surface" and scene.spectrum.name == "surface-file"
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)
     assert outcome.extent == pytest.approx(2 * math.sqrt(256 / math.pi), rel=1e-15)
@@ -159,7 +160,7 @@ def test_mdr_runs_the_measured_equivalent_line(tmp_path, registry):
     scene = load_scene(preset, [], registry)
     assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "surface-file"
     assert scene.resolved()["spectrum"]["name"] == "surface-file"  # re-runnable as written
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.extent == pytest.approx(2 * math.sqrt(64 * 64 / math.pi), rel=1e-14)
     assert outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)

@@ -22,6 +22,7 @@ from frictionlab.testing import check_plugin
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
 from frictionlab_solvers import BisectionSprings, MDRSprings, WinklerSprings
 from frictionlab_spectra import PowerLawSurface, RolloffSurface
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
 
@@ -177,7 +178,7 @@ SURFACE_PRESET = merge(SMALL_PRESET, {
 def test_winkler_on_a_surface_runs_the_surface(registry):
     scene = build_scene({**SURFACE_PRESET, "solver": {"name": "winkler"}}, registry=registry)
     assert scene.surface is None and scene.geometry == "surface"
-    outcome = engine.run(scene, workers=1)
+    outcome = engine.run(scene, RunOptions(workers=1))
     assert not outcome.failures
     assert outcome.extent == 48 * 48  # f = F / (k h A) on a surface
     assert outcome.per_realization["contact_count"].max() <= 48 * 48

@@ -13,6 +13,7 @@ from frictionlab.errors import PresetError
 from frictionlab.preset import load_scene
 from frictionlab.runner import run_to_folder
 from frictionlab.sweep import load_sweep, plan_sweep, read_table, run_sweep, yaml_scalar
+from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET
 
@@ -35,12 +36,12 @@ def test_points_equal_separate_runs_with_the_same_seed(tmp_path, registry):
     data = sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.9]}, "loading.stop": {"values": [5.0, 50.0]}})
     path = write(tmp_path, data)
     sweep = load_sweep(path, registry=registry)
-    outcome = run_sweep(sweep, tmp_path / "out", workers=1, plot=False)
+    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1), plot=False)
     assert outcome.status == "completed" and len(outcome.results) == 4
     for result in outcome.results:
         # the documented way to rerun one point: the preset, sweep off, the point's --set options
         alone = load_scene(path, ["sweep=null", *result.point.assignments], registry=registry)
-        single, _ = run_to_folder(alone, tmp_path / f"alone-{result.point.number}", workers=2)
+        single, _ = run_to_folder(alone, tmp_path / f"alone-{result.point.number}", RunOptions(workers=2))
         assert np.array_equal(result.outcome.per_realization["xi"], single.per_realization["xi"])
         assert (result.outcome.fit.a, result.outcome.fit.b) == (single.fit.a, single.fit.b)
         assert result.outcome.fit.a_ci == single.fit.a_ci
@@ -55,7 +56,7 @@ def test_table_and_json_hold_each_points_fit(tmp_path, registry):
     data = sweep_preset({"spectrum.params.hurst": {"values": [0.6, 0.8]}})
     sweep = plan_sweep(data, registry=registry)
     out = tmp_path / "out"
-    run_sweep(sweep, out, workers=1)
+    run_sweep(sweep, out, RunOptions(workers=1))
     rows = read_table(out / "sweep.csv")
     summary = json.loads((out / "sweep.json").read_text())
     assert [r["spectrum.params.hurst"] for r in rows] == ["0.6", "0.8"]
@@ -144,7 +145,7 @@ def test_cancel_after_the_first_point_keeps_it_and_marks_the_rest(tmp_path, regi
             cancel.set()
 
     sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2, 3]}}), registry=registry)
-    outcome = run_sweep(sweep, tmp_path, workers=1, listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    outcome = run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
     assert outcome.status == "interrupted"
     assert [r["status"] for r in read_table(tmp_path / "sweep.csv")] == ["completed", "pending", "pending"]
     assert not (tmp_path / "points" / sweep.points[1].folder_name).exists()

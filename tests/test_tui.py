@@ -20,6 +20,7 @@ from frictionlab.cli import main
 from frictionlab.engine import run as engine_run
 from frictionlab.errors import ExitCode, PresetError
 from frictionlab.fit import least_squares
+from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene, load_scene
 from frictionlab.runner import run_to_folder
 from frictionlab.sweep import load_sweep, read_table, run_sweep
@@ -378,7 +379,7 @@ async def test_a_run_shows_the_headless_coefficients(folders, registry):
         out_dir = app.last_out_dir
         runs_listed = [entry.path.name for entry in app.runs]
 
-    outcome, _ = run_to_folder(build_scene(TINY, registry=registry), folders / "headless", workers=2)
+    outcome, _ = run_to_folder(build_scene(TINY, registry=registry), folders / "headless", RunOptions(workers=2))
     fit = outcome.fit
     assert app.last_outcome.fit == fit  # same seed, any worker count: the same numbers
     assert f"a = {fit.a:.4f} [{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]" in shown
@@ -464,7 +465,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
         assert _numbers(contacts) == pytest.approx([float(row["contact_first"]), float(row["contact_last"])], rel=5e-3)
         assert status == "✓" and row["status"] == "completed"
     # the same numbers as a headless sweep of the same preset
-    headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", workers=1)
+    headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", RunOptions(workers=1))
     assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_sweep.results] == [
         (r.outcome.fit.a, r.outcome.fit.b) for r in headless.results
     ]
@@ -502,7 +503,7 @@ async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders
 def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate(registry):
     scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
     posted = []
-    outcome = engine_run(scene, workers=1, listeners=[LiveListener(posted.append, interval=3600.0)])
+    outcome = engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(posted.append, interval=3600.0)])
     # started, the first and the last realization, finished: nothing for the ten in between
     assert [s.done for s in posted] == [0, 1, 12, 12]
     last = posted[-1]
@@ -514,7 +515,7 @@ def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate
     assert last.fit.b == pytest.approx(outcome.fit.b, rel=1e-10)
 
     every = []
-    engine_run(scene, workers=1, listeners=[LiveListener(every.append, interval=0.0)])
+    engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(every.append, interval=0.0)])
     assert [s.done for s in every] == [0, *range(1, 13), 12]
 
 
@@ -524,7 +525,7 @@ def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate
 def make_runs(folders, registry):
     for seed in (1, 2):
         data = merge(TINY, {"seed": seed, "name": f"seed{seed}"})
-        run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", workers=1)
+        run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", RunOptions(workers=1))
 
 
 @sync
@@ -549,7 +550,7 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
 async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
     make_runs(folders, registry)
     (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
-    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", workers=1, plot=False)
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
     rows = read_table(folders / "runs" / "sw" / "sweep.csv")
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
@@ -635,6 +636,7 @@ import sys, threading
 import frictionlab.tui
 from frictionlab.engine import run
 from frictionlab.preset import build_scene
+from frictionlab.options import RunOptions
 
 class Capture:  # what Textual puts in sys.stderr while an app runs: fileno() is -1
     def write(self, text): return len(text)
@@ -650,7 +652,7 @@ status = []
 real, sys.stderr = sys.stderr, Capture()
 def work():
     try:
-        status.append(run(scene, workers=2).status)
+        status.append(run(scene, RunOptions(workers=2)).status)
     except Exception as exc:
         status.append(type(exc).__name__)
 worker = threading.Thread(target=work)

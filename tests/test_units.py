@@ -22,6 +22,7 @@ import pytest
 from frictionlab import engine
 from frictionlab.preset import build_scene
 from frictionlab.seeds import realization_rng
+from frictionlab.options import RunOptions
 
 S = 1000.0  # every length
 M = 7.0  # every modulus
@@ -147,7 +148,7 @@ F_GRID = {  # dimensionless forces with partial contact for every spectrum of th
 
 def run(preset: dict):
     scene = build_scene(preset)
-    return scene, engine.run(scene, workers=1)
+    return scene, engine.run(scene, RunOptions(workers=1))
 
 
 def scene_pair(solver: str, spectrum: str, tmp_path, control: str):

@@ -19,6 +19,7 @@ from typing import Any
 from .. import engine
 from ..ensemble import RunOutcome
 from ..errors import FrictionlabError
+from ..options import RunOptions
 from ..plugin import force_unit
 from ..preset import Scene, build_scene
 from ..registry import Registry
@@ -109,7 +110,7 @@ def measure(scene: Scene, repeats: int = 1) -> Measurement:
             tracemalloc.reset_peak()
             floor = tracemalloc.get_traced_memory()[0]
             start = time.perf_counter()
-            outcome = engine.run(scene, workers=1)
+            outcome = engine.run(scene, RunOptions(workers=1))
             seconds = time.perf_counter() - start
             peak = max(peak, tracemalloc.get_traced_memory()[1] - floor)
             best = min(best, seconds)

@@ -23,6 +23,7 @@ from textual.widgets import DataTable, Footer, ProgressBar, Static, TabbedConten
 
 from ..errors import FrictionlabError, PresetError
 from ..preset import build_scene, load_preset_file, resolve_input_paths
+from ..options import RunOptions
 from ..registry import default_registry
 from ..reporter import _duration
 from ..runner import run_to_folder
@@ -253,7 +254,7 @@ class FrictionlabApp(App):
         self.preset_path = Path(preset) if preset else None
         self.presets_dir = Path(presets_dir) if presets_dir else None
         self.runs_dir = Path(runs_dir) if runs_dir else default_runs_dir()
-        self.run_workers = workers
+        self.run_options = RunOptions(workers=workers)
         self.registry = registry or default_registry()
         self.draft_path: Path | None = None
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
@@ -594,7 +595,7 @@ class FrictionlabApp(App):
     def _run_in_thread(self, scene, out_dir: Path, cancel: threading.Event) -> None:
         listener = LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))
         try:
-            outcome, _ = run_to_folder(scene, out_dir, workers=self.run_workers, listeners=[listener], cancel=cancel)
+            outcome, _ = run_to_folder(scene, out_dir, self.run_options, listeners=[listener], cancel=cancel)
         except FrictionlabError as exc:
             self.post_message(RunCrashed(str(exc)))
         except OSError as exc:
@@ -635,7 +636,7 @@ class FrictionlabApp(App):
             outcome = run_sweep(
                 sweep,
                 out_dir,
-                workers=self.run_workers,
+                self.run_options,
                 listeners=[poster],
                 point_listeners=point_listeners,
                 cancel=cancel,
