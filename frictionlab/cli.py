@@ -23,12 +23,9 @@ from .signals import RaiseOnSigterm, interrupted_exit_code
 DEFAULT_RUNS_DIR = Path("runs")
 
 
-def _interval(ci) -> str:
-    low, high = ci
-    return "n/a" if low != low else f"[{low:.4f}, {high:.4f}]"  # NaN check without math
-
-
 def result_table(scene, outcome, out_dir: Path) -> str:
+    from .fit import format_interval
+
     preset = scene.preset
     lines = [
         f"{preset.name}: {outcome.done}/{outcome.requested} realizations in {outcome.elapsed:.2f} s "
@@ -39,8 +36,8 @@ def result_table(scene, outcome, out_dir: Path) -> str:
         level = f"{100 * fit.confidence:g}% CI"
         lines += [
             f"  xi = a + b ln f      estimate    std.err    {level} (bootstrap {fit.bootstrap})",
-            f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {_interval(fit.a_ci)}",
-            f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {_interval(fit.b_ci)}",
+            f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {format_interval(fit.a_ci)}",
+            f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {format_interval(fit.b_ci)}",
             f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
             f"  {outcome.normalisation.definition}",
         ]

@@ -1,36 +1,79 @@
-"""The fit xi = a + b ln f.
+"""The fit xi = a + b ln f: one result type (``LogFit``) and one bootstrap.
 
 Least squares of the ensemble-mean xi over the force grid, with:
 * classical standard errors of a and b from the residuals;
 * bootstrap confidence intervals, resampling whole realizations (the
   independent units) with a seeded Generator, and refitting;
 * R^2 and the residual rms, because the log law fits poorly at small H.
+
+The mean over realizations is the usual average; a study may fit another one
+(``average``: a function of the realizations' weights, see ``fit_log_law``)
+with the same resamples.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
+
+NAN2 = (math.nan, math.nan)
+
+Average = Callable[[np.ndarray | None], np.ndarray]
+"""``average(weights)``: the curve xi(f) averaged over realizations with ``weights``
+(M,) or (B, M) (whole-number bootstrap counts), or with weight 1 each for None."""
 
 
 @dataclass(frozen=True)
 class LogFit:
+    """A fit of xi = a + b ln f. What is not known is NaN: an interim fit (no
+    bootstrap) has no intervals; a law given by hand may have no errors."""
+
     a: float
     b: float
-    a_se: float
-    b_se: float
-    a_ci: tuple[float, float]
-    b_ci: tuple[float, float]
-    confidence: float
-    bootstrap: int
-    r2: float
-    residual_rms: float
-    points: int
+    a_se: float = math.nan
+    b_se: float = math.nan
+    a_ci: tuple[float, float] = NAN2
+    b_ci: tuple[float, float] = NAN2
+    confidence: float = 0.95
+    bootstrap: int = 0  # resamples behind the intervals (0: none)
+    r2: float = math.nan
+    residual_rms: float = math.nan
+    points: int = 0  # load steps fitted
 
     def to_dict(self) -> dict:
+        """As summary.json stores it (NaN written as null)."""
         return {k: json_safe(v) for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> LogFit:
+        """The fit of a summary.json (null read as NaN); KeyError without a or b."""
+
+        def number(value) -> float:
+            return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+
+        def interval(value) -> tuple[float, float]:
+            return (number(value[0]), number(value[1])) if isinstance(value, list | tuple) and len(value) == 2 else NAN2
+
+        return cls(
+            a=number(data["a"]),
+            b=number(data["b"]),
+            a_se=number(data.get("a_se")),
+            b_se=number(data.get("b_se")),
+            a_ci=interval(data.get("a_ci")),
+            b_ci=interval(data.get("b_ci")),
+            confidence=number(data.get("confidence", 0.95)),
+            bootstrap=int(data.get("bootstrap") or 0),
+            r2=number(data.get("r2")),
+            residual_rms=number(data.get("residual_rms")),
+            points=int(data.get("points") or 0),
+        )
+
+    def xi(self, f):
+        """a + b ln f."""
+        return self.a + self.b * np.log(f)
 
 
 def json_safe(value):
@@ -40,6 +83,20 @@ def json_safe(value):
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
+
+
+def format_interval(ci, digits: int = 4, missing: str = "n/a", sep: str = ", ") -> str:
+    """``[low, high]`` with ``digits`` decimals, or ``missing`` when the interval is unknown (None or NaN)."""
+    low, high = ci
+    if low is None or high is None or not (math.isfinite(low) and math.isfinite(high)):
+        return missing
+    return f"[{low:.{digits}f}{sep}{high:.{digits}f}]"
+
+
+def percentile_interval(samples: np.ndarray, confidence: float, axis: int | None = None):
+    """The central ``confidence`` interval of bootstrap ``samples``: (low, high) percentiles."""
+    tail = 100 * (1 - confidence) / 2
+    return np.percentile(samples, [tail, 100 - tail], axis=axis)
 
 
 def _design(f: np.ndarray) -> np.ndarray:
@@ -70,19 +127,39 @@ def least_squares(f: np.ndarray, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return coef, se, r2, math.sqrt(ssr / f.size)
 
 
-def bootstrap_coefficients(f, xi_per_realization, bootstrap: int, rng: np.random.Generator) -> np.ndarray:
-    """(bootstrap, 2) resampled (a, b) pairs, resampling whole realizations (rows).
+def fit_curve(f: np.ndarray, xi: np.ndarray) -> LogFit:
+    """Least squares of one curve xi(f): coefficients, standard errors, R^2; no intervals."""
+    coef, se, r2, rms = least_squares(f, xi)
+    return LogFit(
+        a=float(coef[0]),
+        b=float(coef[1]),
+        a_se=float(se[0]),
+        b_se=float(se[1]),
+        r2=float(r2),
+        residual_rms=float(rms),
+        points=int(np.size(f)),
+    )
 
-    The fit is linear in the mean curve, so a resample's coefficients are the
-    resampled mean of each realization's own coefficients: (B, M) @ (M, 2).
-    The same ``rng`` state gives the same pairs (``frictionlab predict`` redraws a run's).
+
+def bootstrap_coefficients(
+    f, xi_per_realization, bootstrap: int, rng: np.random.Generator, average: Average | None = None
+) -> np.ndarray:
+    """(bootstrap, 2) resampled (a, b) pairs, resampling whole realizations (rows):
+    each resample's counts of every realization weight its averaged curve, which is refitted.
+
+    For the mean (``average`` None) the fit is linear in the curve, so a resample's
+    coefficients are the resampled mean of each realization's own coefficients:
+    (B, M) @ (M, 2). The same ``rng`` state gives the same pairs (``frictionlab predict``
+    redraws a run's).
     """
     xi_per_realization = np.atleast_2d(np.asarray(xi_per_realization, float))
     realizations = xi_per_realization.shape[0]
     projector = np.linalg.pinv(_design(np.asarray(f, float)))  # (2, n_forces)
-    per_realization = xi_per_realization @ projector.T  # (M, 2)
     counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=bootstrap)
-    return counts @ per_realization / realizations
+    if average is None:
+        per_realization = xi_per_realization @ projector.T  # (M, 2)
+        return counts @ per_realization / realizations
+    return average(counts) @ projector.T  # (B, n_forces) @ (n_forces, 2)
 
 
 def fit_log_law(
@@ -92,32 +169,27 @@ def fit_log_law(
     bootstrap: int = 1000,
     confidence: float = 0.95,
     rng: np.random.Generator | None = None,
+    average: Average | None = None,
 ) -> LogFit:
-    """Fit the mean over realizations (rows) of xi against f, with bootstrap intervals."""
+    """Fit the mean over realizations (rows) of xi against f (or the curve ``average``
+    gives), with percentile bootstrap intervals over realizations."""
     xi_per_realization = np.atleast_2d(np.asarray(xi_per_realization, float))
     realizations = xi_per_realization.shape[0]
     if realizations == 0:
         raise ValueError("no finished realization to fit")
-    mean = xi_per_realization.mean(axis=0)
-    coef, se, r2, rms = least_squares(f, mean)
-    intervals = [(math.nan, math.nan)] * 2
+    curve = xi_per_realization.mean(axis=0) if average is None else average(None)
+    fit = fit_curve(f, curve)
+    intervals = [NAN2] * 2
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
-        samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng)
-        tail = 100 * (1 - confidence) / 2
-        low, high = np.percentile(samples, [tail, 100 - tail], axis=0)
+        samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng, average)
+        low, high = percentile_interval(samples, confidence, axis=0)
         intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]
-    return LogFit(
-        a=float(coef[0]),
-        b=float(coef[1]),
-        a_se=float(se[0]),
-        b_se=float(se[1]),
+    return replace(
+        fit,
         a_ci=intervals[0],
         b_ci=intervals[1],
         confidence=confidence,
         bootstrap=bootstrap if realizations >= 2 else 0,
-        r2=float(r2),
-        residual_rms=float(rms),
-        points=int(np.size(f)),
     )

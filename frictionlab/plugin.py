@@ -221,6 +221,10 @@ class ForceNormalisation:
             return mdr_length(profile.area)
         return profile.area  # a line's length, or a surface's area
 
+    def force_unit(self, stiffness: float, rms_height: float, extent: float) -> float:
+        """k h X: the load at which f = 1. The one place where f is formed: f = load / force_unit."""
+        return float(stiffness) * float(rms_height) * float(extent)
+
     def describe(self, stiffness: float, rms_height: float, extent: float) -> dict[str, Any]:
         """The normalisation as summary.json records it."""
         return {
@@ -234,7 +238,7 @@ class ForceNormalisation:
             "rms_height": rms_height,
             "extent": self.extent,
             "extent_value": extent,
-            "force_unit": stiffness * rms_height * extent,
+            "force_unit": self.force_unit(stiffness, rms_height, extent),
         }
 
 
@@ -246,9 +250,9 @@ MDR springs in contact, which is not the real area of the surface MDR stands for
 
 def force_unit(solver: "ContactSolver", rms_height: float, profile: Profile) -> float:
     """k h X: the load at which f = 1 for ``solver`` pressing ``profile`` (nominal rms
-    height h). The one place where f is formed: f = load / force_unit."""
+    height h), as the solver's ``normalisation`` forms it (``ForceNormalisation.force_unit``)."""
     normalisation = solver.normalisation(profile.ndim)
-    return float(solver.stiffness()) * float(rms_height) * normalisation.extent_of(profile)
+    return normalisation.force_unit(solver.stiffness(), rms_height, normalisation.extent_of(profile))
 
 
 # ---------------------------------------------------------------- plugin kinds

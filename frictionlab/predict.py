@@ -27,9 +27,12 @@ from pathlib import Path
 import numpy as np
 
 from .errors import FrictionlabError
-from .fit import bootstrap_coefficients
-from .plugin import mdr_length
+from .fit import LogFit, bootstrap_coefficients, format_interval, percentile_interval
+from .plugin import ForceNormalisation, mdr_length
 from .seeds import bootstrap_rng
+
+MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
+"""f of MDR pressing the line that stands for a surface: F / (E* h L), L = 2 sqrt(A / pi)."""
 
 
 def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area: float) -> float:
@@ -37,7 +40,7 @@ def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area
     for name, value in (("force", force), ("modulus", modulus), ("rms_height", rms_height), ("area", area)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
             raise FrictionlabError(f"{name} must be a finite number > 0. Got {value!r} instead.")
-    return force / (modulus * rms_height * mdr_length(area))
+    return force / MDR_OF_A_SURFACE.force_unit(modulus, rms_height, mdr_length(area))
 
 
 @dataclass(frozen=True)
@@ -62,31 +65,28 @@ class Prediction:
 
 
 def predict_xi(
-    a: float,
-    b: float,
+    law: LogFit,
     *,
     force: float,
     modulus: float,
     rms_height: float,
     area: float,
     pairs: np.ndarray | None = None,
-    a_ci: tuple[float, float] | None = None,
-    b_ci: tuple[float, float] | None = None,
-    confidence: float = 0.95,
     fitted_f: tuple[float, float] | None = None,
     rms_slope: float | None = None,
 ) -> Prediction:
-    """xi = a + b ln f at f = sqrt(pi) F / (2 E* h sqrt(A)), with an interval (see the module doc)."""
+    """xi = a + b ln f of ``law`` at f = sqrt(pi) F / (2 E* h sqrt(A)), with an interval
+    (see the module doc): from the bootstrap ``pairs`` if given, else from the corners of
+    the law's ``a_ci`` x ``b_ci`` if known."""
     f = dimensionless_force_3d(force, modulus, rms_height, area)
     ln_f = math.log(f)
-    xi = a + b * ln_f
+    xi = law.a + law.b * ln_f
     if pairs is not None and len(pairs):
         pairs = np.asarray(pairs, float)
-        tail = 100 * (1 - confidence) / 2
-        low, high = np.percentile(pairs[:, 0] + pairs[:, 1] * ln_f, [tail, 100 - tail])
+        low, high = percentile_interval(pairs[:, 0] + pairs[:, 1] * ln_f, law.confidence)
         ci, how = (float(low), float(high)), "bootstrap pairs"
-    elif a_ci is not None and b_ci is not None:
-        corners = [ai + bi * ln_f for ai in a_ci for bi in b_ci]
+    elif all(math.isfinite(v) for v in (*law.a_ci, *law.b_ci)):
+        corners = [ai + bi * ln_f for ai in law.a_ci for bi in law.b_ci]
         ci, how = (min(corners), max(corners)), "rectangle of a_ci x b_ci"
     else:
         ci, how = (math.nan, math.nan), "none"
@@ -95,20 +95,7 @@ def predict_xi(
         if not (math.isfinite(rms_slope) and rms_slope > 0):
             raise FrictionlabError(f"rms_slope must be a finite number > 0. Got {rms_slope!r} instead.")
         slope, slope_ci = xi * rms_slope, (ci[0] * rms_slope, ci[1] * rms_slope)
-    return Prediction(f, xi, ci, how, confidence, fitted_f, rms_slope, slope, slope_ci)
-
-
-@dataclass(frozen=True)
-class RunLaw:
-    """The law fitted by a run, read from its folder."""
-
-    a: float
-    b: float
-    a_ci: tuple[float, float]
-    b_ci: tuple[float, float]
-    confidence: float
-    fitted_f: tuple[float, float]
-    pairs: np.ndarray | None  # (bootstrap, 2), or None without realizations.npz
+    return Prediction(f, xi, ci, how, law.confidence, fitted_f, rms_slope, slope, slope_ci)
 
 
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
@@ -127,7 +114,9 @@ def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
     return bootstrap_coefficients(f, xi, int(fit["bootstrap"]), bootstrap_rng(int(summary["seed"])))
 
 
-def read_run_law(run_dir: str | Path) -> RunLaw:
+def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
+    """The law a run fitted (its summary.json), the range of f it was fitted over, and its
+    bootstrap pairs (None without realizations.npz)."""
     run_dir = Path(run_dir)
     try:
         summary = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
@@ -141,21 +130,12 @@ def read_run_law(run_dir: str | Path) -> RunLaw:
     if npz.exists():
         with np.load(npz) as data:
             f_range = (float(np.min(data["f"])), float(np.max(data["f"])))
-    nan2 = (math.nan, math.nan)
-    return RunLaw(
-        a=fit["a"],
-        b=fit["b"],
-        a_ci=tuple(fit["a_ci"]) if fit.get("a_ci") and None not in fit["a_ci"] else nan2,
-        b_ci=tuple(fit["b_ci"]) if fit.get("b_ci") and None not in fit["b_ci"] else nan2,
-        confidence=fit.get("confidence", 0.95),
-        fitted_f=f_range,
-        pairs=bootstrap_pairs(run_dir),
-    )
+    return LogFit.from_dict(fit), f_range, bootstrap_pairs(run_dir)
 
 
 def prediction_text(p: Prediction) -> str:
     level = f"{100 * p.confidence:g}%"
-    ci = "n/a" if p.xi_ci[0] != p.xi_ci[0] else f"[{p.xi_ci[0]:.4f}, {p.xi_ci[1]:.4f}]"
+    ci = format_interval(p.xi_ci)
     lines = [
         f"f = sqrt(pi) F / (2 E* h sqrt(A)) = {p.f:.6g}   (ln f = {math.log(p.f):.4f})",
         f"xi = grad_z_contact / grad_z = {p.xi:.4f}   {level} interval {ci} ({p.interval})",
@@ -180,29 +160,27 @@ def cmd_predict(args) -> int:
     if args.from_run:
         if args.a is not None or args.b is not None:
             raise FrictionlabError("give either --from RUN_DIR or --a/--b, not both")
-        law = read_run_law(args.from_run)
-        a, b, a_ci, b_ci, confidence = law.a, law.b, law.a_ci, law.b_ci, law.confidence
-        pairs, fitted_f = law.pairs, law.fitted_f
+        law, fitted_f, pairs = read_run_law(args.from_run)
     else:
         if args.a is None or args.b is None:
             raise FrictionlabError("give the law: --a A --b B (with --a-ci/--b-ci for an interval), or --from RUN_DIR")
-        a, b, confidence, pairs, fitted_f = args.a, args.b, args.confidence, None, None
-        a_ci = tuple(args.a_ci) if args.a_ci else None
-        b_ci = tuple(args.b_ci) if args.b_ci else None
-        if (a_ci is None) != (b_ci is None):
+        if (args.a_ci is None) != (args.b_ci is None):
             raise FrictionlabError("--a-ci and --b-ci go together (an interval needs both)")
+        intervals = {"a_ci": tuple(args.a_ci), "b_ci": tuple(args.b_ci)} if args.a_ci else {}
+        law, fitted_f, pairs = LogFit(args.a, args.b, confidence=args.confidence, **intervals), None, None
     prediction = predict_xi(
-        a, b, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
-        pairs=pairs, a_ci=a_ci, b_ci=b_ci, confidence=confidence, fitted_f=fitted_f, rms_slope=args.rms_slope,
+        law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
+        pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
     )  # fmt: skip
     if args.json:
         out = {k: v for k, v in prediction.__dict__.items()}
-        out.update(extrapolated=prediction.extrapolated, beyond_full_contact=prediction.beyond_full_contact, a=a, b=b)
+        out.update(extrapolated=prediction.extrapolated, beyond_full_contact=prediction.beyond_full_contact,
+                   a=law.a, b=law.b)  # fmt: skip
         from .fit import json_safe
 
         print(json.dumps({k: json_safe(v) for k, v in out.items()}, indent=2))
     else:
-        print(f"law: xi = {a:.4f} + {b:.4f} ln f")
+        print(f"law: xi = {law.a:.4f} + {law.b:.4f} ln f")
         print(prediction_text(prediction))
     return ExitCode.OK
 

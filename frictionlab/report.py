@@ -23,7 +23,7 @@ import numpy as np
 
 from . import __version__, engine
 from .errors import FrictionlabError
-from .fit import least_squares
+from .fit import LogFit, fit_log_law, format_interval
 from .options import RunOptions
 from .preset import apply_overrides, build_scene, load_preset_file
 from .runner import run_to_folder
@@ -83,28 +83,12 @@ def average_curve(per: dict[str, np.ndarray], method: str, weights: np.ndarray |
     raise FrictionlabError(f"average must be one of {', '.join(AVERAGES)}. Got {method!r} instead.")
 
 
-@dataclass(frozen=True)
-class Refit:
-    a: float
-    b: float
-    a_ci: tuple[float, float]
-    b_ci: tuple[float, float]
-    r2: float
-
-
-def refit(f, per, method: str, *, bootstrap: int, confidence: float, seed: int) -> Refit:
-    """Fit xi = a + b ln f to ``average_curve(per, method)``, with a percentile bootstrap
-    over realizations drawn like the run's own (same stream, same resample counts):
-    for ``mean`` this gives the run's summary numbers exactly."""
-    coef, _, r2, _ = least_squares(f, average_curve(per, method))
-    m = per["xi"].shape[0]
-    counts = bootstrap_rng(seed).multinomial(m, np.full(m, 1.0 / m), size=bootstrap)
-    curves = average_curve(per, method, counts)  # (B, F)
-    design = np.column_stack([np.ones_like(f), np.log(f)])
-    samples = curves @ np.linalg.pinv(design).T  # (B, 2)
-    tail = 100 * (1 - confidence) / 2
-    low, high = np.percentile(samples, [tail, 100 - tail], axis=0)
-    return Refit(float(coef[0]), float(coef[1]), (low[0], high[0]), (low[1], high[1]), float(r2))
+def refit(f, per, method: str, *, bootstrap: int, confidence: float, seed: int) -> LogFit:
+    """Fit xi = a + b ln f to ``average_curve(per, method)``, with the bootstrap of the
+    run's own fit (same stream, same resamples): for ``mean`` this is the run's fit."""
+    average = None if method == "mean" else (lambda weights: average_curve(per, method, weights))
+    return fit_log_law(f, per["xi"], bootstrap=bootstrap, confidence=confidence, rng=bootstrap_rng(seed),
+                       average=average)  # fmt: skip
 
 
 # ------------------------------------------------------------------ normalisation readings
@@ -411,11 +395,6 @@ def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 
 # ------------------------------------------------------------------ markdown
 
 
-def _ci(ci) -> str:
-    low, high = ci
-    return "n/a" if low is None or high is None or low != low else f"[{low:.4f}, {high:.4f}]"
-
-
 def _inside(value, ci) -> str:
     if value is None or ci[0] is None or ci[0] != ci[0]:
         return ""
@@ -463,16 +442,16 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
             row = _row_for_h(run, STUDY_H07[0])
             path = run.sweep.paths[0]
             lines.append(
-                f"| Fig. 5 at H = {row[path]:g} | about {s.a} | {row['a']:.4f} {_ci((row['a_lo'], row['a_hi']))}"
+                f"| Fig. 5 at H = {row[path]:g} | about {s.a} | {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}"
                 f"{_inside(s.a, (row['a_lo'], row['a_hi']))} | about {s.b} | {row['b']:.4f} "
-                f"{_ci((row['b_lo'], row['b_hi']))}{_inside(s.b, (row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
+                f"{format_interval((row['b_lo'], row['b_hi']))}{_inside(s.b, (row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
                 f"{row['contact_first']:.2f} at F = 1, {row['contact_last']:.2f} at F = 20 (not stated) |"
             )
             continue
         fit = run.outcome.fit
         lines.append(
-            f"| {s.title} | {s.a} | {fit.a:.4f} {_ci(fit.a_ci)}{_inside(s.a, fit.a_ci)} | {s.b} | {fit.b:.4f} "
-            f"{_ci(fit.b_ci)}{_inside(s.b, fit.b_ci)} | {fit.r2:.3f} | {_counts_text(run)}"
+            f"| {s.title} | {s.a} | {fit.a:.4f} {format_interval(fit.a_ci)}{_inside(s.a, fit.a_ci)} | {s.b} | {fit.b:.4f} "
+            f"{format_interval(fit.b_ci)}{_inside(s.b, fit.b_ci)} | {fit.r2:.3f} | {_counts_text(run)}"
             + ("" if s.counts else " (not stated)") + " |"
         )
     for run in runs:
@@ -511,8 +490,8 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
                     lines.append(f"| {row[path]:g} | {row['status']} | | | |")
                     continue
                 lines.append(
-                    f"| {row[path]:g} | {row['a']:.4f} {_ci((row['a_lo'], row['a_hi']))} | {row['b']:.4f} "
-                    f"{_ci((row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
+                    f"| {row[path]:g} | {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))} | {row['b']:.4f} "
+                    f"{format_interval((row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
                     f"{row['contact_first']:.2f} / {row['contact_last']:.2f} |"
                 )
         lines += ["", f"![{s.title}]({images[s.key]})"]
@@ -568,14 +547,14 @@ def fig5_calibrated_markdown(run: FigureRun, rows: list[ReadingRow], image: str,
         base = default.get(hurst)
         base_text = f"{base['a']:.4f}, {base['b']:.4f}" if base else "n/a"
         lines.append(
-            f"| {hurst:g} | {r.rms_height:g} | {r.a:.4f} {_ci(r.a_ci)}{a_mark} | {r.b:.4f} {_ci(r.b_ci)}{b_mark} | "
+            f"| {hurst:g} | {r.rms_height:g} | {r.a:.4f} {format_interval(r.a_ci)}{a_mark} | {r.b:.4f} {format_interval(r.b_ci)}{b_mark} | "
             f"{r.r2:.3f} | {r.counts[0]:.2f} / {r.counts[1]:.2f} | {base_text} | {study[2] if study else ''} |"
         )
         if study:
             inside = [name for name, mark in (("a", a_mark), ("b", b_mark)) if not mark]
             verdicts.append(f"H = {hurst:g}: " + (" and ".join(inside) + " inside" if inside else "neither inside"))
     top = max(rows, key=lambda r: r.a)
-    lines += ["", f"Largest a with h calibrated: {top.a:.4f} {_ci(top.a_ci)} at H = {_reading_hurst(top):g}"]
+    lines += ["", f"Largest a with h calibrated: {top.a:.4f} {format_interval(top.a_ci)} at H = {_reading_hurst(top):g}"]
     if default:
         top_h = max(default, key=lambda h: default[h]["a"])
         lines[-1] += f"; with h = {_preset_h(run)}: {default[top_h]['a']:.4f} at H = {top_h:g}"
@@ -615,8 +594,8 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         sets = " ".join(f"`{o}`" for o in r.overrides) or "(none)"
         counts = f"{r.counts[0]:.2f} at F = {r.loads[0]:g}, {r.counts[1]:.2f} at F = {r.loads[1]:g}"
         lines.append(
-            f"| {s.key[-1]} | {r.reading.name} | {sets} | {r.reading.average} | {r.a:.4f} {_ci(r.a_ci)}"
-            f"{_inside(s.a, r.a_ci)} | {r.b:.4f} {_ci(r.b_ci)}{_inside(s.b, r.b_ci)} | {r.r2:.3f} | {counts} |"
+            f"| {s.key[-1]} | {r.reading.name} | {sets} | {r.reading.average} | {r.a:.4f} {format_interval(r.a_ci)}"
+            f"{_inside(s.a, r.a_ci)} | {r.b:.4f} {format_interval(r.b_ci)}{_inside(s.b, r.b_ci)} | {r.r2:.3f} | {counts} |"
         )
     lines += ["", "Study: " + "; ".join(
         f"Fig. {s.key[-1]}: a = {s.a}, b = {s.b}"

@@ -35,7 +35,7 @@ from pydantic import BaseModel
 
 from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError
-from .fit import json_safe
+from .fit import format_interval, json_safe
 from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset
 from .options import RunOptions
 from .registry import Registry, default_registry
@@ -473,10 +473,6 @@ class SweepProgress:
             self.stream.flush()
 
 
-def _interval(low, high) -> str:
-    return "n/a" if low is None or high is None else f"[{low:.4f}, {high:.4f}]"
-
-
 def sweep_table(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> str:
     """The short table ``frictionlab run`` prints on stdout after a sweep."""
     lines = [f"{sweep.name}: {len(sweep.points)} points in {outcome.elapsed:.1f} s, status {outcome.status}"]
@@ -486,8 +482,8 @@ def sweep_table(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> str:
             lines.append(f"  {row['point']:>3}  {values}: {row['status']}")
             continue
         lines.append(
-            f"  {row['point']:>3}  {values}: a = {row['a']:.4f} {_interval(row['a_lo'], row['a_hi'])}, "
-            f"b = {row['b']:.4f} {_interval(row['b_lo'], row['b_hi'])}, R^2 = {row['r2']:.3f}, "
+            f"  {row['point']:>3}  {values}: a = {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}, "
+            f"b = {row['b']:.4f} {format_interval((row['b_lo'], row['b_hi']))}, R^2 = {row['r2']:.3f}, "
             f"contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
             + ("" if row["status"] == "completed" else f" ({row['status']})")
         )

@@ -8,6 +8,7 @@ import pytest
 
 from frictionlab.cli import main
 from frictionlab import mdr_length
+from frictionlab.fit import LogFit
 from frictionlab.predict import bootstrap_pairs, dimensionless_force_3d, predict_xi, read_run_law
 from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
@@ -25,13 +26,13 @@ def test_f_is_the_line_f_with_the_mdr_length():
 def test_the_specs_worked_law():
     # SPEC 7: grad_z_contact / grad_z = 2.9 + 0.14 ln( sqrt(pi) F / (2 E* h sqrt(A)) )
     kw = dict(modulus=1.0, rms_height=1e4, area=math.pi * 0.25e10)  # L = 1e5, so f = F * 1e-9
-    p = predict_xi(2.9, 0.14, force=7.0, **kw)
+    p = predict_xi(LogFit(2.9, 0.14), force=7.0, **kw)
     assert p.f == pytest.approx(7e-9, rel=1e-12)
     assert p.xi == pytest.approx(2.9 + 0.14 * math.log(7e-9), rel=1e-12)
     # "a 500-fold force changes the rms slope in contact by a factor of 3 to 4": an additive
     # 0.14 ln 500 = 0.87, i.e. a factor 3 to 4 where xi(F) is 0.29 .. 0.435
     force = math.exp((0.3 - 2.9) / 0.14) / 1e-9  # xi(F) = 0.3
-    low, high = predict_xi(2.9, 0.14, force=force, **kw), predict_xi(2.9, 0.14, force=500 * force, **kw)
+    low, high = predict_xi(LogFit(2.9, 0.14), force=force, **kw), predict_xi(LogFit(2.9, 0.14), force=500 * force, **kw)
     assert high.xi - low.xi == pytest.approx(0.14 * math.log(500), rel=1e-12)
     assert 3 <= high.xi / low.xi <= 4
 
@@ -41,9 +42,9 @@ def test_bootstrap_pairs_keep_the_correlation_the_rectangle_loses():
     b = np.linspace(0.05, 0.09, 101)
     pairs = np.column_stack([0.4 - b * math.log(f0), b])
     kw = dict(force=f0, modulus=1.0, rms_height=1.0, area=math.pi / 4)  # L = 1: f = F
-    exact = predict_xi(float(np.mean(pairs[:, 0])), 0.07, pairs=pairs, **kw)
+    exact = predict_xi(LogFit(float(np.mean(pairs[:, 0])), 0.07), pairs=pairs, **kw)
     assert exact.xi_ci == pytest.approx((0.4, 0.4), abs=1e-12) and exact.interval == "bootstrap pairs"
-    box = predict_xi(0.4 - 0.07 * math.log(f0), 0.07, a_ci=(pairs[0, 0], pairs[-1, 0]), b_ci=(0.05, 0.09), **kw)
+    box = predict_xi(LogFit(0.4 - 0.07 * math.log(f0), 0.07, a_ci=(pairs[0, 0], pairs[-1, 0]), b_ci=(0.05, 0.09)), **kw)
     corners = [a + bb * math.log(f0) for a in (pairs[0, 0], pairs[-1, 0]) for bb in (0.05, 0.09)]
     assert box.xi_ci == (min(corners), max(corners)) and box.xi_ci[1] - box.xi_ci[0] > 1.0
 
@@ -55,9 +56,11 @@ def test_pairs_from_a_run_folder_are_the_runs_own(tmp_path, make_scene):
     assert pairs.shape == (summary["fit"]["bootstrap"], 2)
     low, high = np.percentile(pairs, [2.5, 97.5], axis=0)
     assert (low[0], high[0]) == tuple(summary["fit"]["a_ci"]) and (low[1], high[1]) == tuple(summary["fit"]["b_ci"])
-    law = read_run_law(tmp_path)
-    assert law.fitted_f == (outcome.f.min(), outcome.f.max())
-    inside = predict_xi(law.a, law.b, force=1.0, modulus=1.0, rms_height=1.0, area=1.0, pairs=law.pairs)
+    law, fitted_f, law_pairs = read_run_law(tmp_path)
+    assert fitted_f == (outcome.f.min(), outcome.f.max())
+    assert (law.a, law.b, law.a_ci, law.b_ci) == (outcome.fit.a, outcome.fit.b, outcome.fit.a_ci, outcome.fit.b_ci)
+    np.testing.assert_array_equal(law_pairs, pairs)
+    inside = predict_xi(law, force=1.0, modulus=1.0, rms_height=1.0, area=1.0, pairs=law_pairs)
     assert inside.xi_ci[0] <= inside.xi <= inside.xi_ci[1]
 
 

@@ -22,6 +22,7 @@ from textual.message import Message
 from textual.widgets import DataTable, Footer, ProgressBar, Static, TabbedContent, TabPane
 
 from ..errors import FrictionlabError, PresetError
+from ..fit import format_interval
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..options import RunOptions
 from ..registry import default_registry
@@ -97,11 +98,6 @@ class RunCrashed(Message):
 # ------------------------------------------------------------------ formatting
 
 
-def _interval(ci) -> str:
-    low, high = ci
-    return "" if low is None or not math.isfinite(low) else f"[{low:.4f}, {high:.4f}]"
-
-
 def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
     """The coefficients as the Run tab and Results tab show them, with what f is."""
     what = [f"  f = {f_formula}"] if f_formula else []
@@ -114,8 +110,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
         lines = [
             head,
             *what,
-            f"  a = {fit.a:.4f} {_interval(fit.a_ci)}",
-            f"  b = {fit.b:.4f} {_interval(fit.b_ci)}",
+            f"  a = {fit.a:.4f} {format_interval(fit.a_ci, missing='')}",
+            f"  b = {fit.b:.4f} {format_interval(fit.b_ci, missing='')}",
             f"  {level} CI, bootstrap {fit.bootstrap}",
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
@@ -827,10 +823,10 @@ class FrictionlabApp(App):
             lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
             if fit:
                 lines.append(
-                    f"  a={fit.get('a', math.nan):.4f} {_interval(tuple(fit.get('a_ci') or (None, None)))}"
+                    f"  a={fit.get('a', math.nan):.4f} {format_interval(tuple(fit.get('a_ci') or (None, None)), missing='')}"
                     f" R^2={fit.get('r2', math.nan):.4f}"
                 )
-                lines.append(f"  b={fit.get('b', math.nan):.4f} {_interval(tuple(fit.get('b_ci') or (None, None)))}")
+                lines.append(f"  b={fit.get('b', math.nan):.4f} {format_interval(tuple(fit.get('b_ci') or (None, None)), missing='')}")
         self.query_one("#results-chart", Chart).show(series)
         info = "\n".join(lines) if lines else "Enter opens a run; Space adds it to the overlay."
         self.query_one("#results-info", Static).update(info)

@@ -17,15 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fit import least_squares
+from ..fit import LogFit, fit_curve
 from ..hookspecs import hookimpl
-
-
-@dataclass(frozen=True)
-class InterimFit:
-    a: float
-    b: float
-    r2: float
 
 
 @dataclass(frozen=True)
@@ -37,7 +30,7 @@ class Snapshot:
     f: np.ndarray | None  # dimensionless force of the mean curve (None before the first result)
     xi: np.ndarray | None  # mean xi over the finished realizations
     contact_count: np.ndarray | None
-    fit: InterimFit | None
+    fit: LogFit | None  # least squares of the mean curve so far: no intervals
     first_error: str | None = None
     finished: bool = False
     f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
@@ -124,10 +117,10 @@ class LiveListener:
         )
 
 
-def interim_fit(f: np.ndarray, xi: np.ndarray) -> InterimFit | None:
+def interim_fit(f: np.ndarray, xi: np.ndarray) -> LogFit | None:
+    """The fit of the mean curve so far (None until it can be fitted)."""
     keep = np.isfinite(f) & np.isfinite(xi) & (f > 0)
     try:
-        coef, _, r2, _ = least_squares(f[keep], xi[keep])
+        return fit_curve(f[keep], xi[keep])
     except (ValueError, np.linalg.LinAlgError):
         return None
-    return InterimFit(float(coef[0]), float(coef[1]), float(r2))

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..fit import format_interval
 from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
 
 
@@ -49,11 +50,11 @@ def table_columns(paths: list[str]) -> list[str]:
 
 
 def _estimate(row: dict[str, Any], name: str) -> str:
-    value, low, high = row[name], row[f"{name}_lo"], row[f"{name}_hi"]
+    value, ci = row[name], (row[f"{name}_lo"], row[f"{name}_hi"])
     if value is None:
         return "-"
-    interval = "" if low is None or high is None else f" [{low:.3f},{high:.3f}]"  # 80 columns
-    return f"{value:.4f}{interval}"
+    interval = format_interval(ci, digits=3, missing="", sep=",")  # 80 columns
+    return f"{value:.4f}" + (f" {interval}" if interval else "")
 
 
 def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
