@@ -116,7 +116,7 @@ def cmd_validate(args) -> ExitCode:
             continue
         preset = scene.preset
         print(
-            f"{path}: ok ({preset.realizations} realizations, {scene.spectrum.name} / {scene.solver.name} / "
+            f"{path}: ok ({preset.realizations} realizations, {scene.generator.name} / {scene.solver.name} / "
             f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
             + (f", sweep of {points} points)" if scene.preset.sweep is not None else ")")
         )

@@ -97,7 +97,7 @@ class Accumulator:
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
         unit = first.force_unit if first else math.nan  # every realization has the grid of the first
-        rms_height = float(scene.spectrum.rms_height()) if n else math.nan
+        rms_height = float(scene.generator.rms_height()) if n else math.nan
         stiffness = float(scene.solver.stiffness())
         force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
         with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # an overflow is reported below

@@ -62,13 +62,13 @@ def gib(n: float) -> str:
 def grid_points(scene: Scene) -> int:
     """Points of one realization: from the spectrum's ``grid_shape()``, else by
     generating realization 0 once (0 if that fails)."""
-    shape = scene.spectrum.grid_shape()
+    shape = scene.generator.grid_shape()
     if shape is not None:
         return math.prod(shape)
     from .seeds import realization_rng
 
     try:
-        return scene.spectrum.generate(realization_rng(scene.preset.seed, 0)).points
+        return scene.generator.generate(realization_rng(scene.preset.seed, 0)).points
     except Exception:  # the run itself reports a spectrum that fails, per realization
         return 0
 
@@ -117,7 +117,7 @@ def available_memory() -> tuple[int, str]:
 
 def _points_path(scene: Scene) -> str | None:
     """The preset path of the spectrum's points parameter, if it has one."""
-    name = scene.named_spectrum.points_param
+    name = scene.spectrum.points_param
     return f"spectrum.params.{name}" if name else None
 
 
@@ -132,7 +132,7 @@ def _in_dask_worker(guess: MemoryEstimate) -> int:
 def _most_points(scene: Scene, executor: str, available: int, need=_total) -> int:
     """The largest points per side (``SpectrumGenerator.points_param``) whose one-worker
     estimate fits: ``need(estimate) <= available`` (by default the run's whole peak)."""
-    dimension = scene.spectrum.dimension
+    dimension = scene.generator.dimension
     low, high = 1, 2
     while need(estimate(scene, workers=1, executor=executor, points=high**dimension)) <= available:
         low, high = high, 2 * high

@@ -32,7 +32,7 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         )
     ax.set_xscale("log")
     ax.set_ylabel(r"$\xi = \nabla z_{contact} / \nabla z$")
-    ax.set_title(f"{scene.preset.name}: {scene.spectrum.name}, {scene.solver.name}, {scene.slope.name}", fontsize=10)
+    ax.set_title(f"{scene.preset.name}: {scene.generator.name}, {scene.solver.name}, {scene.slope.name}", fontsize=10)
     ax.legend(fontsize=8, loc="best")
     ax.grid(True, which="both", alpha=0.3)
     ax_count.plot(f, outcome.contact_count, "-", color="C2")

@@ -286,6 +286,7 @@ class SpectrumGenerator(Plugin):
     """
 
     kind: ClassVar[str] = "spectrum"
+    register_hook: ClassVar[str] = "register_spectra"
     dimension: ClassVar[int] = 1  # 1: makes lines (N,); 2: makes surfaces (Ny, Nx)
     points_param: ClassVar[str | None] = None
 
@@ -334,6 +335,7 @@ class SlopeEstimator(Plugin):
     """
 
     kind: ClassVar[str] = "slope"
+    register_hook: ClassVar[str] = "register_slope_estimators"
     dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
     periodic_only: ClassVar[bool] = False
 
@@ -381,6 +383,7 @@ class ContactSolver(Plugin):
     """
 
     kind: ClassVar[str] = "solver"
+    register_hook: ClassVar[str] = "register_solvers"
     dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
     normalisations: ClassVar[Mapping[int, ForceNormalisation]] = {}
     problem: ClassVar[str] = ""
@@ -419,7 +422,7 @@ class ContactSolver(Plugin):
         return float(self.params.model_dump()[self.tolerance_param])
 
 
-KINDS: dict[str, type[Plugin]] = {
+KINDS: dict[str, type[Plugin]] = {  # by the name of each kind's section in a preset
     "spectrum": SpectrumGenerator,
     "solver": ContactSolver,
     "slope": SlopeEstimator,

@@ -46,7 +46,7 @@ def compute_realization(scene: Scene, index: int) -> RealizationResult:
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
-        profile = scene.spectrum.generate(rng)
+        profile = scene.generator.generate(rng)
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
         slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
@@ -63,7 +63,7 @@ def compute_realization(scene: Scene, index: int) -> RealizationResult:
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             slope_rms_line=slope_rms_line,
             points=profile.points,
-            force_unit=force_unit(scene.solver, scene.spectrum.rms_height(), profile),
+            force_unit=force_unit(scene.solver, scene.generator.rms_height(), profile),
         )
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]

@@ -44,11 +44,6 @@ from .plugin import (
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
 LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
-KIND_HOOKS = {
-    "spectrum": "register_spectra",
-    "solver": "register_solvers",
-    "slope": "register_slope_estimators",
-}
 
 
 def normalize_name(name: str) -> str:
@@ -250,7 +245,7 @@ class Registry:
 
     def _collect(self) -> None:
         tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
-        for kind, hook_name in KIND_HOOKS.items():
+        for kind, base in KINDS.items():
 
             def register(cls, _kind=kind):
                 validate_plugin_class(_kind, cls)
@@ -266,7 +261,7 @@ class Registry:
                     )
                 tables[_kind][key] = PluginInfo(_kind, key, cls, provider, version)
 
-            getattr(self.pm.hook, hook_name)(register=register)
+            getattr(self.pm.hook, base.register_hook)(register=register)
         self._plugins = tables
 
     # ------------------------------------------------------------- queries

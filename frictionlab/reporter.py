@@ -52,7 +52,7 @@ class ProgressReporter:
         )
         restored = f" ({restored})" if restored else ""
         self.stream.write(
-            f"{preset.name}: {run.total} realizations of {run.scene.spectrum.name} lines{restored}, "
+            f"{preset.name}: {run.total} realizations of {run.scene.generator.name} lines{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)\n"
         )
         self.stream.flush()

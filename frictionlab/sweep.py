@@ -21,7 +21,6 @@ from __future__ import annotations
 import csv
 import itertools
 import json
-import math
 import re
 import threading
 import time
@@ -30,13 +29,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import BaseModel
 
 from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError
 from .fit import format_interval, json_safe
-from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset
+from .plugin import KINDS
+from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .options import RunOptions
 from .registry import Registry, default_registry
 from .runner import run_to_folder
@@ -50,21 +49,6 @@ RESULT_COLUMNS = (
 
 
 # ------------------------------------------------------------------ planning
-
-
-def yaml_scalar(value: Any) -> str:
-    """The ``--set`` spelling of ``value``: YAML that reads back as the same value."""
-    if isinstance(value, float) and math.isfinite(value):
-        text = repr(value)
-        if "e" in text and "." not in text:  # PyYAML reads 1e-05 as text; 1.0e-05 as a float
-            text = text.replace("e", ".0e", 1)
-        if "e" in text and text.split("e")[1][0] not in "+-":
-            text = text.replace("e", "e+", 1)
-    else:
-        text = yaml.safe_dump(value, default_flow_style=True).removesuffix("\n...\n").strip()
-    if yaml.safe_load(text) != value or type(yaml.safe_load(text)) is not type(value):
-        raise ValueError(f"cannot spell {value!r} as a YAML scalar")
-    return text
 
 
 @dataclass(frozen=True)
@@ -133,7 +117,7 @@ def path_problem(path: str, data: dict, spec: SweepSettings, registry: Registry)
         if key not in model.model_fields:
             allowed = ", ".join(sorted(k for k in model.model_fields if k != "sweep"))
             return f"{where}: {done} has no field {key!r}; allowed: {allowed}"
-        if depth == 1 and keys[0] in PLUGIN_SLOTS and key == "params":
+        if depth == 1 and keys[0] in KINDS and key == "params":
             return _plugin_param_problem(where, keys, data, spec, registry)
         model = _model_of(model.model_fields[key].annotation)
     if model is not None:
@@ -152,7 +136,7 @@ def _plugin_param_problem(where, keys, data, spec, registry) -> str | None:
     known: set[str] = set()
     for name in names:
         try:
-            known |= set(registry.get(PLUGIN_SLOTS[slot], str(name)).Params.model_fields)
+            known |= set(registry.get(slot, str(name)).Params.model_fields)
         except Exception:  # an unknown plugin name is reported when the points are validated
             return None
     if keys[2] not in known:

@@ -145,8 +145,6 @@ __all__ = [
     "register_plugin",
 ]
 
-KIND_CHOICES = ("spectrum", "solver", "slope")
-
 # ------------------------------------------------------------------ fixtures
 
 
@@ -187,12 +185,10 @@ def _as_hook_plugin(obj):
         import types
 
         from frictionlab.hookspecs import hookimpl
-        from frictionlab.registry import KIND_HOOKS
-
         def _register(register):
             register(obj)
 
-        return types.SimpleNamespace(**{KIND_HOOKS[obj.kind]: hookimpl(_register)})
+        return types.SimpleNamespace(**{obj.register_hook: hookimpl(_register)})
     return obj
 
 
@@ -342,10 +338,11 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     from pydantic import ValidationError
 
     from frictionlab.errors import PluginError
+    from frictionlab.plugin import KINDS
     from frictionlab.registry import normalize_name, validate_plugin_class
 
-    if kind not in KIND_CHOICES:
-        raise ValueError(f"kind must be one of {', '.join(KIND_CHOICES)}. Got {kind!r} instead.")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {', '.join(KINDS)}. Got {kind!r} instead.")
     params = dict(params or {})
 
     try:

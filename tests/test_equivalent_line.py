@@ -180,13 +180,14 @@ def test_mdr_on_a_surface_runs_its_line_at_the_surfaces_3d_f(registry):
         "fit": {"bootstrap": 0},
     })  # fmt: skip
     scene = build_scene(data, registry=registry)
-    assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "power-law-2d"
+    assert isinstance(scene.equivalent_line, EquivalentLine) and scene.generator is scene.equivalent_line
+    assert scene.spectrum.name == "power-law-2d"
     assert scene.geometry == "mdr-equivalent line of a surface"
     assert scene.resolved()["spectrum"]["name"] == "power-law-2d"  # what the user wrote, re-runnable
     outcome = engine.run(scene, RunOptions(workers=1))
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.extent == pytest.approx(2 * math.sqrt(48 * 48 / math.pi), rel=1e-14)  # f = F / (E* h L)
     np.testing.assert_allclose(outcome.f, outcome.loads / (1.0 * 1.0 * outcome.extent), rtol=1e-14)
-    assert np.all(outcome.per_realization["contact_count"] <= scene.spectrum.params.points)
+    assert np.all(outcome.per_realization["contact_count"] <= scene.equivalent_line.params.points)
     again = build_scene(scene.resolved(), registry=registry)
     np.testing.assert_array_equal(engine.run(again, RunOptions(workers=1)).xi, outcome.xi)

@@ -40,7 +40,6 @@ from frictionlab.plugin import KINDS
 from frictionlab.registry import (
     BUILTIN_MODULES,
     ENTRY_POINT_GROUP,
-    KIND_HOOKS,
     LoadFailure,
     Registry,
     normalize_name,
@@ -48,6 +47,8 @@ from frictionlab.registry import (
 )
 
 ROOT = Path(__file__).resolve().parents[1]
+
+KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
 
 
 # =========================================================================== fakes

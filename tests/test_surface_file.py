@@ -158,13 +158,13 @@ def test_mdr_runs_the_measured_equivalent_line(tmp_path, registry):
 
     preset.write_text(yaml.safe_dump(surface_preset(path, "mdr")))
     scene = load_scene(preset, [], registry)
-    assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "surface-file"
+    assert isinstance(scene.equivalent_line, EquivalentLine) and scene.spectrum.name == "surface-file"
     assert scene.resolved()["spectrum"]["name"] == "surface-file"  # re-runnable as written
     outcome = engine.run(scene, RunOptions(workers=1))
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.extent == pytest.approx(2 * math.sqrt(64 * 64 / math.pi), rel=1e-14)
     assert outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)
-    assert np.all(outcome.per_realization["contact_count"] <= scene.spectrum.params.points)
+    assert np.all(outcome.per_realization["contact_count"] <= scene.equivalent_line.params.points)
     assert np.all(np.isfinite(outcome.xi))
 
 

@@ -177,7 +177,7 @@ SURFACE_PRESET = merge(SMALL_PRESET, {
 
 def test_winkler_on_a_surface_runs_the_surface(registry):
     scene = build_scene({**SURFACE_PRESET, "solver": {"name": "winkler"}}, registry=registry)
-    assert scene.surface is None and scene.geometry == "surface"
+    assert scene.equivalent_line is None and scene.geometry == "surface"
     outcome = engine.run(scene, RunOptions(workers=1))
     assert not outcome.failures
     assert outcome.extent == 48 * 48  # f = F / (k h A) on a surface

@@ -121,8 +121,8 @@ def _preset(spectrum: dict, solver: str | dict, loading: dict | None = None) -> 
 
 def expected_force_unit(solver: str, scene) -> float:
     """k h X of f = F / (k h X), from the solver's physics (see the module docstring)."""
-    profile = scene.spectrum.generate(realization_rng(scene.preset.seed, 0))
-    h = scene.spectrum.rms_height()
+    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
+    h = scene.generator.rms_height()
     k = scene.solver.stiffness()
     area = profile.heights.size * profile.spacing**profile.heights.ndim
     if solver == "bem-halfplane":
@@ -131,8 +131,8 @@ def expected_force_unit(solver: str, scene) -> float:
         return k * h * area  # F / (k h A)
     if profile.heights.ndim == 2:  # the half-space, and MDR on a surface
         return k * h * 2.0 * math.sqrt(area / math.pi)
-    if scene.surface is not None:  # MDR's line of a surface: L = 2 sqrt(A / pi) of the surface
-        surface = scene.surface.generate(realization_rng(scene.preset.seed, 0))
+    if scene.equivalent_line is not None:  # MDR's line of a surface: L = 2 sqrt(A / pi) of the surface
+        surface = scene.spectrum.generate(realization_rng(scene.preset.seed, 0))
         return k * h * 2.0 * math.sqrt(surface.heights.size * surface.spacing**2 / math.pi)
     return k * h * profile.heights.size * profile.spacing  # F / (k h L)
 

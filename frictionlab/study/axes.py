@@ -165,7 +165,7 @@ def compare(rows: list[Row], reference: Row, *, curves: bool = True, approaches:
 
 def preset_points(scene: Scene) -> int | None:
     """The preset's points per side (the named spectrum's ``points_param``), if it has one."""
-    spectrum = scene.named_spectrum
+    spectrum = scene.spectrum
     if spectrum.points_param is None:
         return None
     return int(spectrum.params.model_dump()[spectrum.points_param])
@@ -187,7 +187,7 @@ class Study:
         self.base = factory.base
         preset = self.base.preset
         self.grid_m = min(preset.realizations, options.grid_realizations)
-        generator = self.base.named_spectrum
+        generator = self.base.spectrum
         compare_points = options.compare_points if generator.dimension == 1 else options.compare_points_surface
         points = preset_points(self.base)
         # The comparison scene: the preset on a smaller grid, fewer lines and loads, same f range.
@@ -221,7 +221,7 @@ class Study:
             except PresetError as exc:
                 raise FrictionlabError(f"--reference: {reference.name} cannot run the preset: {_first_problem(exc)}") from None
             return choice
-        dimension = self.base.named_spectrum.dimension
+        dimension = self.base.spectrum.dimension
         exact = [info.cls for info in self.factory.registry.infos("solver") if _exact_for(info.cls, base, dimension)]
         if not exact:
             shape = {1: "lines", 2: "surfaces"}[dimension]
@@ -267,7 +267,7 @@ class Study:
         changes = {"realizations": self.grid_m} if changes is None else changes
         factors = sorted(self.options.grid_factors if factors is None else factors)
         start = self.factory.make(changes)
-        generator, points = start.named_spectrum, preset_points(start)
+        generator, points = start.spectrum, preset_points(start)
         if points is None:
             self.notes.append(f"{label}: skipped, spectrum {generator.name!r} declares no points parameter")
             return []
@@ -355,8 +355,8 @@ class Study:
             compare(rows, reference, approaches={id(row): approach(scene, row.outcome) for row, scene in measured})
         else:
             compare(rows, reference)
-        what = "surfaces" if base.named_spectrum.dimension == 2 else "lines"
-        mapped = f" ({base.solver.name} presses their MDR-equivalent lines)" if base.surface is not None else ""
+        what = "surfaces" if base.spectrum.dimension == 2 else "lines"
+        mapped = f" ({base.solver.name} presses their MDR-equivalent lines)" if base.equivalent_line is not None else ""
         definitions = "; ".join(dict.fromkeys(scene.normalisation.definition for _, scene in measured))
         self.notes.append(
             f"solver: {self._describe_compare(base)}; every solver sees the same {what}{mapped}; errors against "

@@ -130,7 +130,7 @@ def axis_table(rows: list[Row], axis: str) -> str:
 
 def scene_summary(study: Study) -> str:
     base = study.base
-    generator = base.named_spectrum
+    generator = base.spectrum
     preset, hurst, points = base.preset, generator.hurst_exponent(), preset_points(base)
     loading = preset.loading
     return (
@@ -242,7 +242,7 @@ def _needed_realizations(measured: int, ci_rel: float, target: float) -> tuple[i
 
 def recommendation(study: Study) -> str:
     target = study.options.target
-    hurst = study.base.named_spectrum.hurst_exponent()
+    hurst = study.base.spectrum.hurst_exponent()
     head = f"for {100 * target:g}% error in b" + (f" at H = {hurst:g}" if hurst is not None else "")
     by_axis = {axis: [r for r in study.rows if r.axis == axis] for axis in dict.fromkeys(r.axis for r in study.rows)}
     solver = study.base.solver.name
@@ -300,7 +300,7 @@ def recommendation(study: Study) -> str:
             f"{reference.solver} needs {tol_text}M = {m_ref}{how} at N = {reference.points}, "
             f"about {per_line * m_ref:.2g} s serial"
         )
-        what = "surfaces" if study.base.named_spectrum.dimension == 2 else "lines"
+        what = "surfaces" if study.base.spectrum.dimension == 2 else "lines"
         for row in solver_rows:
             if row.reference:
                 continue

@@ -21,24 +21,15 @@ from ..ensemble import RunOutcome
 from ..errors import FrictionlabError
 from ..options import RunOptions
 from ..plugin import force_unit
-from ..preset import Scene, build_scene
+from ..preset import Scene, build_scene, set_path
 from ..registry import Registry
 from ..seeds import realization_rng
 
 
-def assign(data: dict, path: str, value: Any) -> None:
-    """Set ``data[a][b][c] = value`` for ``path = "a.b.c"`` (typed values: no YAML round trip)."""
-    *parents, last = path.split(".")
-    node = data
-    for key in parents:
-        node = node.setdefault(key, {})
-    node[last] = copy.deepcopy(value)
-
-
 def force_scale(scene: Scene) -> float:
     """The load at f = 1 (``force_unit``) for realization 0's profile."""
-    profile = scene.spectrum.generate(realization_rng(scene.preset.seed, 0))
-    return force_unit(scene.solver, scene.spectrum.rms_height(), profile)
+    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
+    return force_unit(scene.solver, scene.generator.rms_height(), profile)
 
 
 class SceneFactory:
@@ -57,15 +48,15 @@ class SceneFactory:
         (a shorter line or another stiffness would otherwise shift it)."""
         data = copy.deepcopy(self.data)
         for path, value in changes.items():
-            assign(data, path, value)
+            set_path(data, path, value)
         where = f"{self.source} with " + ", ".join(f"{k}={v}" for k, v in changes.items())
         scene = build_scene(data, registry=self.registry, source=where)
         if keep_f_range:
             ratio = force_scale(scene) / self._base_scale
             if not math.isclose(ratio, 1.0, rel_tol=1e-12):
                 loading = self.base.preset.loading
-                assign(data, "loading.start", loading.start * ratio)
-                assign(data, "loading.stop", loading.stop * ratio)
+                set_path(data, "loading.start", loading.start * ratio)
+                set_path(data, "loading.stop", loading.stop * ratio)
                 scene = build_scene(data, registry=self.registry, source=where)
         return scene
 

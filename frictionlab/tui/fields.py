@@ -18,9 +18,8 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
-from ..preset import PLUGIN_SLOTS, Preset, build_scene
-
-MISSING = object()  # "remove this key": the model's default applies (or 'is required')
+from ..plugin import KINDS
+from ..preset import MISSING, Preset, build_scene, set_path
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 
@@ -157,29 +156,6 @@ def parse(spec: FieldSpec, text: str):
 # ------------------------------------------------------------------ draft
 
 
-def get_path(data: dict, path: tuple[str, ...], default=MISSING):
-    node = data
-    for key in path:
-        if not isinstance(node, dict) or key not in node:
-            return default
-        node = node[key]
-    return node
-
-
-def set_path(data: dict, path: tuple[str, ...], value) -> None:
-    """Set (or with MISSING remove) ``path``, creating mappings on the way."""
-    node = data
-    for key in path[:-1]:
-        child = node.get(key)
-        if not isinstance(child, dict):
-            child = node[key] = {}
-        node = child
-    if value is MISSING:
-        node.pop(path[-1], None)
-    else:
-        node[path[-1]] = value
-
-
 def default_plugin_name(slot: str) -> str | None:
     info = Preset.model_fields[slot]
     if info.default_factory is None:
@@ -206,7 +182,7 @@ def problems_for(problems: list[str], dotted: str) -> list[str]:
 
 def with_value(data: dict, path: tuple[str, ...], value) -> dict:
     candidate = copy.deepcopy(data)
-    set_path(candidate, path, value)
+    set_path(candidate, path, value, replace_values=True)
     return candidate
 
 
@@ -219,9 +195,9 @@ def preset_from_defaults(name: str, spectrum: str, registry) -> dict:
         "seed": 0,
         "realizations": 50,
     }
-    for slot, kind in PLUGIN_SLOTS.items():
+    for slot in KINDS:
         plugin_name = spectrum if slot == "spectrum" else default_plugin_name(slot)
-        cls = registry.get(kind, plugin_name)
+        cls = registry.get(slot, plugin_name)
         params = {
             s.name: s.default
             for s in field_specs(cls.Params)
@@ -231,5 +207,3 @@ def preset_from_defaults(name: str, spectrum: str, registry) -> dict:
     data["loading"] = {"control": "force", "start": 1.0, "stop": 20.0, "steps": 40, "spacing": "log"}
     return data
 
-
-SLOT_KINDS = PLUGIN_SLOTS

@@ -18,19 +18,17 @@ from textual.validation import ValidationResult, Validator
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static, Switch
 
-from ..preset import PLUGIN_SLOTS, Preset
+from ..plugin import KINDS
+from ..preset import MISSING, Preset, get_path, set_path
 from .fields import (
-    MISSING,
     FieldSpec,
     default_plugin_name,
     display,
     field_specs,
-    get_path,
     parse,
     problem_path,
     problems_for,
     problems_of,
-    set_path,
     with_value,
 )
 
@@ -108,7 +106,7 @@ class PresetForm(VerticalScroll):
             else:
                 yield from self.field_rows(spec)
         for spec in sections:
-            if spec.name in PLUGIN_SLOTS:
+            if spec.name in KINDS:
                 yield from self.plugin_rows(spec.name)
             else:
                 yield Label(spec.name.capitalize(), classes="heading")
@@ -165,10 +163,9 @@ class PresetForm(VerticalScroll):
         ]
 
     def plugin_rows(self, slot: str) -> list[Widget]:
-        kind = PLUGIN_SLOTS[slot]
         name = get_path(self.data, (slot, "name"), default_plugin_name(slot))
-        names = self.registry.names(kind)
-        known = self._known_name(kind, name)
+        names = self.registry.names(slot)
+        known = self._known_name(slot, name)
         select = Select(
             [(n, n) for n in names],
             value=known if known else Select.NULL,
@@ -195,11 +192,10 @@ class PresetForm(VerticalScroll):
             return None
 
     def param_rows(self, slot: str) -> list[Widget]:
-        kind = PLUGIN_SLOTS[slot]
-        known = self._known_name(kind, get_path(self.data, (slot, "name"), default_plugin_name(slot)))
+        known = self._known_name(slot, get_path(self.data, (slot, "name"), default_plugin_name(slot)))
         if known is None:
             return [Static("(choose a plugin to see its parameters)", classes="note")]
-        cls = self.registry.get(kind, known)
+        cls = self.registry.get(slot, known)
         rows: list[Widget] = [Static(cls.summary, classes="summary")]
         for spec in field_specs(cls.Params, prefix=(slot, "params")):
             rows += self.field_rows(spec)
@@ -211,14 +207,14 @@ class PresetForm(VerticalScroll):
         """Editing a parameter of a slot the file leaves at its default writes the
         slot out, with the plugin name shown in the form."""
         slot = path[0]
-        if slot in PLUGIN_SLOTS and len(path) > 2 and get_path(data, (slot, "name")) is MISSING:
-            set_path(data, (slot, "name"), default_plugin_name(slot))
+        if slot in KINDS and len(path) > 2 and get_path(data, (slot, "name")) is MISSING:
+            set_path(data, (slot, "name"), default_plugin_name(slot), replace_values=True)
 
     def _store(self, spec: FieldSpec, value) -> None:
         if get_path(self.data, spec.path) == value:
             return
         self.ensure_plugin_name(self.data, spec.path)
-        set_path(self.data, spec.path, value)
+        set_path(self.data, spec.path, value, replace_values=True)
         self.revalidate(changed=True)
 
     def _is_new(self, widget_id: str, value) -> bool:
@@ -255,9 +251,8 @@ class PresetForm(VerticalScroll):
             self._store(spec, MISSING if event.value is Select.NULL else event.value)
 
     async def _switch_plugin(self, slot: str, new_name) -> None:
-        kind = PLUGIN_SLOTS[slot]
         old_name = get_path(self.data, (slot, "name"), default_plugin_name(slot))
-        old_known = self._known_name(kind, old_name)
+        old_known = self._known_name(slot, old_name)
         if new_name is Select.NULL or new_name == old_known:
             return
         old_params = get_path(self.data, (slot, "params"), {})
@@ -281,7 +276,7 @@ class PresetForm(VerticalScroll):
             messages = problems_for(self.problems, spec.dotted)
             shown.update(messages)
             self._set_error(widget_id, messages)
-        for slot in PLUGIN_SLOTS:
+        for slot in KINDS:
             messages = problems_for(self.problems, f"{slot}.name")
             shown.update(messages)
             self._set_error(f"field--{slot}--name", messages, widget=False)
@@ -311,9 +306,8 @@ class PresetForm(VerticalScroll):
         spec = self._specs.get(widget.id or "")
         if spec is None and (widget.id or "").startswith("plugin--"):
             slot = widget.id.removeprefix("plugin--")
-            kind = PLUGIN_SLOTS[slot]
             spec = FieldSpec(
-                (slot, "name"), "choice", f"{slot} plugin ({kind})", False, default_plugin_name(slot),
-                choices=tuple(self.registry.names(kind)),
+                (slot, "name"), "choice", f"{slot} plugin ({slot})", False, default_plugin_name(slot),
+                choices=tuple(self.registry.names(slot)),
             )
         self.post_message(self.FieldFocused(spec))

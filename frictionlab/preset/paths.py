@@ -1,0 +1,89 @@
+"""Dotted paths into preset data (``spectrum.params.hurst``): the one setter that
+``--set``, the sweeps, the trade-off study's variants and the TUI's form all use,
+and the ``--set`` spelling of a value."""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import yaml
+
+from ..errors import PresetError
+from ..safe_yaml import YamlProblem, load_yaml
+
+MISSING = object()
+"""As a value for ``set_path``: remove the key (the model's default then applies)."""
+
+
+def _keys(path: str | Sequence[str]) -> list[str]:
+    return [k.strip() for k in path.split(".")] if isinstance(path, str) else list(path)
+
+
+def get_path(data: dict, path: str | Sequence[str], default=MISSING):
+    """``data[a][b][c]`` for ``a.b.c``, or ``default`` where the path does not lead."""
+    node = data
+    for key in _keys(path):
+        if not isinstance(node, dict) or key not in node:
+            return default
+        node = node[key]
+    return node
+
+
+def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_values: bool = False) -> None:
+    """Set ``data[a][b][c] = value`` for ``a.b.c`` (or ``("a", "b", "c")``), making mappings
+    where keys are missing or None; ``MISSING`` removes the key. A value in the way
+    (``a.b`` is 3) is a ValueError naming it, unless ``replace_values`` replaces it."""
+    keys = _keys(path)
+    node = data
+    for depth, key in enumerate(keys[:-1]):
+        child = node.get(key)
+        if child is None or (replace_values and not isinstance(child, dict)):
+            child = node[key] = {}
+        elif not isinstance(child, dict):
+            raise ValueError(f"{'.'.join(keys[: depth + 1])} is a value, not a mapping")
+        node = child
+    if value is MISSING:
+        node.pop(keys[-1], None)
+    else:
+        node[keys[-1]] = copy.deepcopy(value)
+
+
+def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
+    """A copy of ``data`` with ``dotted.path=value`` assignments applied (values read as YAML scalars)."""
+    data = copy.deepcopy(data)
+    problems = []
+    for assignment in assignments:
+        path, sep, raw = assignment.partition("=")
+        keys = [k.strip() for k in path.split(".")]
+        if not sep or not all(keys):
+            problems.append(f"--set {assignment!r}: must look like dotted.path=value, e.g. spectrum.params.hurst=0.8")
+            continue
+        try:
+            value = load_yaml(raw) if raw.strip() else ""
+        except YamlProblem:
+            value = raw
+        try:
+            set_path(data, keys, value)
+        except ValueError as exc:
+            problems.append(f"--set {assignment!r}: {exc}")
+    if problems:
+        raise PresetError(problems, source="--set")
+    return data
+
+
+def yaml_scalar(value: Any) -> str:
+    """The ``--set`` spelling of ``value``: YAML that reads back as the same value."""
+    if isinstance(value, float) and math.isfinite(value):
+        text = repr(value)
+        if "e" in text and "." not in text:  # PyYAML reads 1e-05 as text; 1.0e-05 as a float
+            text = text.replace("e", ".0e", 1)
+        if "e" in text and text.split("e")[1][0] not in "+-":
+            text = text.replace("e", "e+", 1)
+    else:
+        text = yaml.safe_dump(value, default_flow_style=True).removesuffix("\n...\n").strip()
+    if yaml.safe_load(text) != value or type(yaml.safe_load(text)) is not type(value):
+        raise ValueError(f"cannot spell {value!r} as a YAML scalar")
+    return text

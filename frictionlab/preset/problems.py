@@ -1,0 +1,145 @@
+"""Problems of preset data, each as ``dotted.path: what is wrong, got VALUE``:
+pydantic's errors worded for people, and the numbers pydantic would let through."""
+
+from __future__ import annotations
+
+import math
+import types
+import typing
+
+from pydantic import BaseModel, ValidationError
+
+from ..errors import short_repr
+from .schema import NAME_PATTERN, NAME_RULE
+
+MAX_MAGNITUDE = 1e100  # numbers in a preset: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
+
+
+def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
+    """Field names of the model reached by walking ``loc`` into ``model``."""
+    for part in loc:
+        if model is None or not isinstance(part, str) or part not in model.model_fields:
+            return []
+        annotation = model.model_fields[part].annotation
+        model = annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+    return sorted(model.model_fields) if model is not None else []
+
+
+def _describe(error: dict, model: type[BaseModel]) -> str:
+    kind, ctx = error["type"], error.get("ctx", {})
+    comparisons = {
+        "less_than_equal": ("<=", "le"),
+        "less_than": ("<", "lt"),
+        "greater_than_equal": (">=", "ge"),
+        "greater_than": (">", "gt"),
+    }
+    if kind in comparisons:
+        symbol, key = comparisons[kind]
+        return f"must be {symbol} {ctx[key]}"
+    if kind == "extra_forbidden":
+        allowed = _allowed_keys(model, tuple(error["loc"][:-1]))
+        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "")
+    if kind == "missing":
+        return "is required"
+    if kind == "literal_error":
+        return f"must be one of {ctx['expected']}"
+    if kind in {"int_parsing", "int_type", "int_from_float"}:
+        return "must be a whole number"
+    if kind in {"float_parsing", "float_type", "finite_number"}:
+        return "must be a finite number" if kind == "finite_number" else "must be a number"
+    if kind in {"bool_parsing", "bool_type"}:
+        return "must be true or false"
+    if kind in {"string_type"}:
+        return "must be text"
+    if kind in {"dict_type", "model_type", "model_attributes_type"}:
+        return "must be a mapping of keys to values"
+    if kind == "string_too_short":
+        return "must not be empty"
+    if kind == "string_pattern_mismatch" and ctx.get("pattern") == NAME_PATTERN:
+        return NAME_RULE
+    message = error["msg"]
+    for prefix in ("Value error, ", "Assertion failed, "):
+        message = message.removeprefix(prefix)
+    return message[:1].lower() + message[1:]
+
+
+def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix: str = "") -> list[str]:
+    """One line per pydantic error: ``path: message, got value``."""
+    lines = []
+    for error in exc.errors(include_url=False):
+        path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
+        line = f"{path or '(preset)'}: {_describe(error, model)}"
+        if error["type"] != "missing" and not (error["type"] == "value_error" and not error["loc"]):
+            line += f", got {short_repr(error['input'])}"
+        lines.append(line)
+    return lines
+
+
+# ------------------------------------------------------------------ numbers
+# pydantic takes true as 1 for a number, and .inf / .nan for a float unless told
+# otherwise; a plugin's Params would each have to say so. One walk over the
+# data against the model's annotations refuses them everywhere instead.
+
+
+def _kinds(annotation) -> set:
+    """The plain types a field accepts (unions and Optional unpacked)."""
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return set().union(*(_kinds(arg) for arg in typing.get_args(annotation)))
+    return {annotation}
+
+
+def _nested_model(annotation) -> type[BaseModel] | None:
+    for kind in _kinds(annotation):
+        if isinstance(kind, type) and issubclass(kind, BaseModel):
+            return kind
+    return None
+
+
+def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
+    if isinstance(value, bool):
+        return f"{path}: must be a number, not true or false, got {str(value).lower()}"
+    if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
+        try:
+            value = float(value)
+        except ValueError:
+            return None  # not a number at all: pydantic says so
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
+    if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):
+        return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+    return None
+
+
+def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]:
+    """Numeric fields of ``model`` given true/false, infinity or NaN (unless the
+    field allows them), or a magnitude beyond MAX_MAGNITUDE, in ``data``."""
+    if not isinstance(data, dict):
+        return []
+    problems = []
+    for name, field in model.model_fields.items():
+        if name not in data:
+            continue
+        value, path = data[name], f"{prefix}.{name}" if prefix else name
+        nested = _nested_model(field.annotation)
+        item = typing.get_args(field.annotation)[-1] if typing.get_origin(field.annotation) is dict else None
+        kinds = _kinds(field.annotation)
+        allow = any(getattr(m, "allow_inf_nan", False) for m in field.metadata)
+        if nested is not None and isinstance(value, dict):
+            problems += number_problems(nested, value, path)
+        elif isinstance(item, type) and issubclass(item, BaseModel) and isinstance(value, dict):
+            for key, entry in value.items():
+                problems += number_problems(item, entry, f"{path}.{key}")
+        elif kinds & {int, float} and bool not in kinds:
+            problem = _number_problem(value, path, allow)
+            problems += [problem] if problem else []
+        elif typing.get_origin(field.annotation) in (list, tuple) and isinstance(value, list):
+            items = set().union(*(_kinds(a) for a in typing.get_args(field.annotation) if a is not Ellipsis))
+            if items & {int, float} and bool not in items:
+                problems += [p for i, v in enumerate(value) if (p := _number_problem(v, f"{path}[{i}]", allow))]
+    return problems
+
+
+def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
+    """Both lists, without a pydantic line for a field the number check already named."""
+    named = {line.split(": ", 1)[0] for line in numbers}
+    return numbers + [line for line in pydantic_lines if line.split(": ", 1)[0] not in named]

@@ -1,0 +1,185 @@
+"""The ``Scene``: a validated preset with its plugins instantiated, what the engine runs;
+and ``build_scene``, phase two of the validation (each plugin's own ``Params``)."""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pydantic import ValidationError
+
+from ..errors import PluginError, PresetError, short_repr
+from ..inputs import input_fields, regular_file_problem
+from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
+from ..registry import Registry, default_registry
+from .problems import format_validation_error, merge_problems, number_problems
+from .reading import read_preset, resolve_input_paths
+from .schema import PluginChoice, Preset
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated preset with its plugins instantiated: what the engine runs."""
+
+    preset: Preset
+    spectrum: SpectrumGenerator  # the spectrum the preset names
+    solver: ContactSolver
+    slope: SlopeEstimator
+    # When the solver presses lines only and the spectrum makes surfaces: the spectrum's
+    # MDR-equivalent line, whose lines are pressed instead (``generator``).
+    equivalent_line: SpectrumGenerator | None = None
+
+    @property
+    def generator(self) -> SpectrumGenerator:
+        """What makes the profiles that are pressed: the spectrum, or its MDR-equivalent line."""
+        return self.equivalent_line if self.equivalent_line is not None else self.spectrum
+
+    @property
+    def geometry(self) -> str:
+        """Which geometry runs: 'line', 'surface', or 'mdr-equivalent line of a surface'."""
+        if self.equivalent_line is not None:
+            return "mdr-equivalent line of a surface"
+        return "surface" if self.spectrum.dimension == 2 else "line"
+
+    @property
+    def normalisation(self) -> ForceNormalisation:
+        """What the loads mean and how f is formed, for the profiles that are pressed."""
+        return self.solver.normalisation(self.generator.dimension)
+
+    @functools.cached_property
+    def loads(self) -> np.ndarray:
+        return self.preset.loading.values()
+
+    @property
+    def control(self) -> str:
+        return self.preset.loading.control
+
+    def plugins(self) -> dict:
+        """The plugin the preset names for each kind (the spectrum, not its equivalent line)."""
+        return {"spectrum": self.spectrum, "solver": self.solver, "slope": self.slope}
+
+    def resolved(self) -> dict:
+        """The preset with every default filled in, plugin params included."""
+        data = self.preset.model_dump(mode="json")
+        if data.get("sweep") is None:
+            data.pop("sweep", None)  # a plain run (or one sweep point) has no sweep section
+        for kind, plugin in self.plugins().items():
+            data[kind] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
+        return data
+
+    def input_files(self) -> dict[str, str]:
+        """The files the run reads, by dotted parameter (absolute paths)."""
+        return {
+            f"{kind}.params.{field}": getattr(plugin.params, field)
+            for kind, plugin in self.plugins().items()
+            for field in input_fields(type(plugin.params))
+        }
+
+
+def build_scene(
+    data: dict, registry: Registry | None = None, source: str | None = None, base_dir: str | Path | None = None
+) -> Scene:
+    """Validate preset data (structure, then each plugin's params) into a Scene.
+    ``base_dir``: the folder relative input-file paths in ``data`` are taken
+    from (the preset file's; without it, the current folder)."""
+    registry = registry or default_registry()
+    if not isinstance(data, dict):
+        raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
+    if base_dir is not None:
+        data = resolve_input_paths(data, base_dir, registry)
+    numbers = number_problems(Preset, data)
+    try:
+        preset = Preset.model_validate(data)
+    except ValidationError as exc:
+        problems = merge_problems(numbers, format_validation_error(exc, Preset))
+        # Check the plugin sections that are well formed too, so every problem shows at once.
+        for slot in KINDS:
+            try:
+                choice = PluginChoice.model_validate(data.get(slot))
+            except ValidationError:
+                continue
+            problems += _plugin_problems(registry, slot, choice)[1]
+        raise PresetError(problems, source=source) from None
+    plugins, problems = {}, list(numbers)
+    for slot in KINDS:
+        instance, slot_problems = _plugin_problems(registry, slot, getattr(preset, slot))
+        plugins[slot] = instance
+        problems += slot_problems
+    if problems:
+        raise PresetError(problems, source=source)
+    problems = [
+        f"{slot}.params.{field}: {problem}, got {short_repr(getattr(plugin.params, field))}"
+        for slot, plugin in plugins.items()
+        for field in input_fields(type(plugin.params))
+        if (problem := regular_file_problem(getattr(plugin.params, field)))
+    ]
+    if problems:  # before anything reads them (an equivalent line reads its map now)
+        raise PresetError(problems, source=source)
+    # Store normalised plugin names so the resolved preset is canonical.
+    for slot in KINDS:
+        getattr(preset, slot).name = plugins[slot].name
+    return Scene(preset=preset, **_match_dimensions(plugins, registry, source))
+
+
+def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> dict:
+    """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
+    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError, and so is
+    a non-periodic profile (a scan) given to a solver or estimator of periodic profiles only."""
+    spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
+    made = spectrum.dimension
+    shape = {1: "lines", 2: "surfaces"}
+    if made not in solver.dimensions:
+        try:
+            line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
+        except ValueError as exc:
+            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        if line is None:
+            raise PresetError(
+                [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
+                 f"only, but spectrum {spectrum.name} makes {shape[made]}"
+                 + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
+                source=source,
+            )
+        plugins = {**plugins, "equivalent_line": line}
+        made = 1
+    if made not in slope.dimensions:
+        raise PresetError(
+            [f"slope.name: {slope.name} takes {' and '.join(shape[d] for d in slope.dimensions)} only, "
+             f"but the {shape[made][:-1]} that runs here is {'2D' if made == 2 else '1D'}"],
+            source=source,
+        )
+    if not plugins.get("equivalent_line", spectrum).periodic():
+        scan = f"spectrum {spectrum.name} is not periodic (periodic: false, a scan whose ends do not meet)"
+        make_periodic = "set spectrum.params.periodic: true if its ends meet (after detrend)"
+        problems = []
+        for kind, plugin, verb in (("solver", solver, "presses"), ("slope", slope, "differentiates")):
+            if plugin.periodic_only:
+                others = [i.name for i in registry.infos(kind) if not i.cls.periodic_only and made in i.cls.dimensions]
+                instead = f"use {' or '.join(others)}, or " if others else ""
+                problems.append(f"{kind}.name: {plugin.name} {verb} periodic profiles only, but {scan}: "
+                                f"{instead}{make_periodic}")
+        if problems:
+            raise PresetError(problems, source=source)
+    return plugins
+
+
+def _plugin_problems(registry: Registry, slot: str, choice: PluginChoice):
+    try:
+        cls = registry.get(slot, choice.name)
+    except PluginError as exc:
+        return None, [f"{slot}.name: {exc}"]
+    numbers = number_problems(cls.Params, choice.params, f"{slot}.params")
+    try:
+        params = cls.Params.model_validate(choice.params)
+    except ValidationError as exc:
+        return None, merge_problems(numbers, format_validation_error(exc, cls.Params, prefix=f"{slot}.params"))
+    return (None, numbers) if numbers else (cls(params), [])
+
+
+def load_scene(
+    path: str | Path, overrides: list[str] = (), registry: Registry | None = None
+) -> Scene:
+    """File -> overrides -> validated Scene."""
+    return build_scene(read_preset(path, overrides, registry), registry=registry, source=str(path))

@@ -1,0 +1,190 @@
+"""The structure of a preset: pydantic models of every section (phase one of the
+validation), and the JSON Schema of a preset with the installed plugins' params."""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from ..plugin import KINDS
+from ..registry import Registry, default_registry
+
+MAX_SWEEP_POINTS = 1000  # counted from the axes, before any point is built
+NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._+-]{0,99}$"
+NAME_RULE = (
+    "must be 1 to 100 letters, digits, '.', '_', '+' or '-', starting with a letter or digit "
+    "(it names the output folder)"
+)
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class PluginChoice(_Strict):
+    name: str = Field(description="Name of the plugin (see `frictionlab plugins`).")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="The plugin's parameters (see `frictionlab schema`)."
+    )
+
+
+class Loading(_Strict):
+    control: Literal["force", "indentation"] = Field(
+        "force", description="Whether the loads are total normal forces or indentations (rigid-body approach)."
+    )
+    start: float = Field(gt=0, description="First load (force, or indentation), > 0.")
+    stop: float = Field(gt=0, description="Last load, >= start.")
+    steps: int = Field(ge=2, le=1_000_000, description="Number of load steps, start and stop included.")
+    spacing: Literal["linear", "log"] = Field("linear", description="Load steps evenly spaced in value or in log.")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if self.stop <= self.start:
+            raise ValueError(f"stop must be > start ({self.start}). Got {self.stop} instead.")
+        return self
+
+    def values(self) -> np.ndarray:
+        if self.spacing == "log":
+            return np.geomspace(self.start, self.stop, self.steps)
+        return np.linspace(self.start, self.stop, self.steps)
+
+
+class FitSettings(_Strict):
+    bootstrap: int = Field(
+        1000, ge=0, le=100_000, description="Bootstrap resamples over realizations for the intervals (0: none)."
+    )
+    confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level of the intervals.")
+
+
+class OutputSettings(_Strict):
+    realizations: bool = Field(True, description="Keep per-realization curves in realizations.npz.")
+    plot: bool = Field(True, description="Draw plot.png (xi against f with the fit).")
+
+
+SweepScalar = str | bool | int | float | None
+
+
+class SweepParameter(_Strict):
+    """The values one swept parameter takes: a list, or a range start..stop with num values."""
+
+    values: list[SweepScalar] | None = Field(None, description="Explicit values (YAML scalars); or give a range.")
+    start: float | None = Field(None, allow_inf_nan=False, description="First value of a range.")
+    stop: float | None = Field(None, allow_inf_nan=False, description="Last value of a range (included).")
+    num: int | None = Field(None, ge=1, le=100_000, description="Number of values of a range, >= 1.")
+    spacing: Literal["linear", "log"] = Field("linear", description="Range values evenly spaced in value or in log.")
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        ranged = {"start": self.start, "stop": self.stop, "num": self.num}
+        given = [k for k, v in ranged.items() if v is not None]
+        if self.values is not None and given:
+            raise ValueError(f"give either values or a range (start, stop, num), not both. Got values and {', '.join(given)}")
+        if self.values is None and not given:
+            raise ValueError("give values: [...] or a range start, stop, num")
+        if self.values is not None and not self.values:
+            raise ValueError("values must not be empty")
+        if given and len(given) < 3:
+            missing = [k for k in ranged if k not in given]
+            raise ValueError(f"a range needs start, stop and num; missing: {', '.join(missing)}")
+        if given and self.spacing == "log" and (self.start <= 0 or self.stop <= 0):
+            raise ValueError(f"a log range needs start > 0 and stop > 0. Got start={self.start!r}, stop={self.stop!r} instead")
+        return self
+
+    def count(self) -> int:
+        """How many values, without making them."""
+        return len(self.values) if self.values is not None else int(self.num)
+
+    def points(self) -> list:
+        """The values, in order (ranges rounded to 12 significant digits so labels and --set stay clean)."""
+        if self.values is not None:
+            return list(self.values)
+        make = np.geomspace if self.spacing == "log" else np.linspace
+        raw = [float(f"{v:.12g}") for v in make(self.start, self.stop, self.num)]
+        whole = float(self.start).is_integer() and float(self.stop).is_integer()
+        return [int(v) if whole and v.is_integer() else v for v in raw]
+
+
+class SweepSettings(_Strict):
+    """A sweep: every point is the preset with the swept paths set (see frictionlab/sweep.py)."""
+
+    mode: Literal["grid", "zip"] = Field(
+        "grid", description="grid: every combination of the values; zip: the i-th values of every list together."
+    )
+    parameters: dict[str, SweepParameter] = Field(
+        min_length=1, description="Dotted preset path -> its values, e.g. spectrum.params.hurst: {values: [0.5, 1.0]}."
+    )
+
+    @model_validator(mode="after")
+    def _zip_lengths(self):
+        if self.mode == "zip":
+            lengths = {path: p.count() for path, p in self.parameters.items()}
+            if len(set(lengths.values())) > 1:
+                listed = ", ".join(f"{path}: {n}" for path, n in lengths.items())
+                raise ValueError(f"mode zip needs the same number of values for every parameter. Got {listed} instead")
+        points = self.count()
+        if points > MAX_SWEEP_POINTS:
+            axes = " x ".join(str(p.count()) for p in self.parameters.values())
+            raise ValueError(
+                f"the sweep has {points:,} points ({self.mode} of {axes}); at most {MAX_SWEEP_POINTS:,} are allowed"
+            )
+        return self
+
+    def count(self) -> int:
+        """Points of the sweep, counted from its axes (none is made)."""
+        counts = [p.count() for p in self.parameters.values()]
+        return math.prod(counts) if self.mode == "grid" else (counts[0] if counts else 0)
+
+
+class Preset(_Strict):
+    name: str = Field(
+        pattern=NAME_PATTERN,
+        description="Short name of the scene (letters, digits, '.', '_', '+', '-'); names the default output folder.",
+    )
+    description: str = Field("", description="What the scene is and where its numbers come from.")
+    seed: int = Field(0, ge=0, description="Root seed: realization i uses SeedSequence(seed, spawn_key=(0, i)).")
+    realizations: int = Field(ge=1, le=10_000_000, description="Number of independent random lines (M).")
+    spectrum: PluginChoice = Field(description="Spectrum generator: how the rough lines are made.")
+    solver: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(name="mdr"), description="Contact solver."
+    )
+    slope: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(name="forward-difference"), description="Slope estimator."
+    )
+    loading: Loading = Field(description="The load sweep.")
+    fit: FitSettings = Field(default_factory=FitSettings, description="Fit of xi = a + b ln f.")
+    output: OutputSettings = Field(default_factory=OutputSettings, description="What is written.")
+    sweep: SweepSettings | None = Field(
+        None, description="Optional parameter sweep: `frictionlab run` then runs one ensemble per point."
+    )
+
+
+def preset_json_schema(registry: Registry | None = None) -> dict:
+    """JSON Schema of a preset, with each installed plugin's params, for editors."""
+    registry = registry or default_registry()
+    schema = Preset.model_json_schema()
+    defs = schema.setdefault("$defs", {})
+    for slot in KINDS:  # a preset names one plugin of each kind, under the kind's name
+        variants = []
+        for info in registry.infos(slot):
+            params_schema = info.cls.Params.model_json_schema(ref_template="#/$defs/{model}")
+            for def_name, definition in params_schema.pop("$defs", {}).items():
+                defs.setdefault(def_name, definition)
+            variants.append(
+                {
+                    "type": "object",
+                    "title": info.name,
+                    "description": info.summary,
+                    "properties": {"name": {"const": info.name}, "params": params_schema},
+                    "required": ["name"],
+                    "additionalProperties": False,
+                }
+            )
+        description = schema["properties"][slot].get("description", "")
+        schema["properties"][slot] = {"description": description, "oneOf": variants}
+    defs.pop("PluginChoice", None)
+    schema["title"] = "frictionlab preset"
+    return schema
+
