@@ -19,7 +19,8 @@ import pluggy
 from .ensemble import Accumulator, RunOutcome
 from .errors import RunError
 from .executors import make_executor, plan_chunks
-from .hookspecs import PROJECT_NAME, LifecycleSpecs
+from .hookspecs import PROJECT_NAME
+from .listeners import RunListener
 from .options import RunOptions
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk
@@ -42,7 +43,7 @@ class RunInfo:
 
 def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
     pm = pluggy.PluginManager(PROJECT_NAME)
-    pm.add_hookspecs(LifecycleSpecs)
+    pm.add_hookspecs(RunListener)
     for listener in listeners:
         pm.register(listener)
     pm.check_pending()

@@ -27,7 +27,8 @@ import pluggy
 from pydantic import BaseModel
 
 from .errors import PluginError
-from .hookspecs import PROJECT_NAME, LifecycleSpecs, RegistrationSpecs
+from .hookspecs import PROJECT_NAME, RegistrationSpecs
+from .listeners import LIFECYCLE_HOOKS, RunListener
 from .plugin import (
     KINDS,
     NAME_PATTERN,
@@ -43,7 +44,6 @@ from .plugin import (
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
-LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
 
 
 def normalize_name(name: str) -> str:
@@ -180,7 +180,7 @@ class Registry:
         env = os.environ if env is None else env
         self.pm = pluggy.PluginManager(PROJECT_NAME)
         self.pm.add_hookspecs(RegistrationSpecs)
-        self.pm.add_hookspecs(LifecycleSpecs)  # an installed plugin may listen to every run
+        self.pm.add_hookspecs(RunListener)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):

@@ -48,6 +48,7 @@ from .inputs import InputFileProblem, read_regular_file, sha256_of
 from .preset import Scene, load_preset_file
 from .realization import RealizationResult
 
+DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 CHUNK_DIR = "chunks"
 LOCK_FILE = "run.lock"
 STATE_FILE = "run.json"
@@ -74,6 +75,16 @@ def _close_locks_in_child() -> None:
 
 
 os.register_at_fork(after_in_child=_close_locks_in_child)
+
+
+def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
+    """``runs_dir/<name>-<timestamp>``, a folder that does not exist yet (``-2``, ``-3``, ... appended
+    when one does): where a run goes when the user names no folder."""
+    base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    candidate, n = base, 2
+    while os.path.lexists(candidate):
+        candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
+    return candidate
 
 
 def fingerprint(resolved: dict) -> str:

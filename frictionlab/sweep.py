@@ -10,10 +10,8 @@ Every point runs through ``runner.run_to_folder`` (the single run path) into
 ``<out>/points/<NN>-<label>/``. ``sweep.csv`` (one row per point, rewritten
 atomically as points finish), ``sweep.json`` and ``sweep.png`` sit in ``<out>``.
 
-Front ends follow a sweep through listeners: any object with some of the
-methods ``sweep_started(sweep)``, ``point_started(sweep, point)``,
-``point_finished(sweep, point, result)``, ``sweep_finished(sweep, outcome)``;
-each point's run gets the engine listeners that ``point_listeners(point)`` returns.
+Front ends follow a sweep through ``listeners.SweepListener``s; each point's
+run tells the run listeners that ``SweepListener.run_listeners(point)`` gives.
 """
 
 from __future__ import annotations
@@ -24,7 +22,7 @@ import json
 import re
 import threading
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,13 +31,14 @@ from pydantic import BaseModel
 
 from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError
-from .fit import format_interval, json_safe
+from .files import atomic_write, output_path_problem
+from .fit import json_safe
+from .listeners import SweepListener
+from .options import RunOptions
 from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
-from .options import RunOptions
 from .registry import Registry, default_registry
 from .runner import run_to_folder
-from .files import atomic_write, output_path_problem
 
 SWEEP_SCHEMA_VERSION = 1
 RESULT_COLUMNS = (
@@ -230,20 +229,8 @@ class SweepOutcome:
         return [r.row() for r in self.results]
 
 
-def _notify(listeners, method: str, **kwargs) -> None:
-    for listener in listeners:
-        handler = getattr(listener, method, None)
-        if handler is not None:
-            handler(**kwargs)
-
-
-def iter_sweep(
-    sweep: Sweep,
-    out_dir: str | Path,
-    options: RunOptions = RunOptions(),
-    *,
-    point_listeners: Callable[[SweepPoint], list] = lambda point: [],
-    cancel=None,
+def _run_points(
+    sweep: Sweep, out_dir: Path, options: RunOptions, listeners: list[SweepListener], cancel
 ) -> Iterator[PointResult]:
     """Run the points in order, yielding each PointResult as it finishes.
 
@@ -251,14 +238,15 @@ def iter_sweep(
     written); a point that raises a FrictionlabError is recorded as ``error``
     and the sweep goes on.
     """
-    out_dir = Path(out_dir)
-    cancel = threading.Event() if cancel is None else cancel
     for point in sweep.points:
         folder = out_dir / "points" / point.folder_name
         if cancel.is_set():
             return
+        for listener in listeners:
+            listener.point_started(sweep, point)
+        run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         try:
-            outcome, _ = run_to_folder(point.scene, folder, options, listeners=point_listeners(point), cancel=cancel)
+            outcome, _ = run_to_folder(point.scene, folder, options, listeners=run_listeners, cancel=cancel)
         except FrictionlabError as exc:
             yield PointResult(point, "error", folder, error=str(exc))
             continue
@@ -272,33 +260,32 @@ def run_sweep(
     out_dir: str | Path,
     options: RunOptions = RunOptions(),
     *,
-    listeners: Iterable[object] = (),
-    point_listeners: Callable[[SweepPoint], list] = lambda point: [],
+    listeners: Iterable[SweepListener] = (),
     cancel=None,
     plot: bool = True,
 ) -> SweepOutcome:
-    """Run every point as ``options`` say and keep ``sweep.csv``/``sweep.json`` current;
-    draw ``sweep.png`` at the end. ``out_dir`` must be new, empty or a folder of this
-    same sweep unless ``options.force``."""
+    """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``),
+    and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end. ``out_dir``
+    must be new, empty or a folder of this same sweep unless ``options.force``."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
     listeners = list(listeners)
+    cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
     outcome = SweepOutcome(status="completed", results=list(results.values()), elapsed=0.0)
-    _notify(listeners, "sweep_started", sweep=sweep)
+    for listener in listeners:
+        listener.sweep_started(sweep)
     write_tables(sweep, outcome, out_dir)
     interrupted = False
-    iterator = iter_sweep(
-        sweep, out_dir, options, cancel=cancel, point_listeners=_announcing(sweep, listeners, point_listeners)
-    )
     try:
-        for result in iterator:
+        for result in _run_points(sweep, out_dir, options, listeners, cancel):
             results[result.point.number] = result
             outcome.results = list(results.values())
             outcome.elapsed = time.perf_counter() - started
             write_tables(sweep, outcome, out_dir)
-            _notify(listeners, "point_finished", sweep=sweep, point=result.point, result=result)
+            for listener in listeners:
+                listener.point_finished(sweep, result.point, result)
     except KeyboardInterrupt:  # Ctrl-C between two points
         interrupted = True
     statuses = {r.status for r in outcome.results}
@@ -309,10 +296,13 @@ def run_sweep(
     outcome.elapsed = time.perf_counter() - started
     outcome.files = write_tables(sweep, outcome, out_dir)
     if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
+        from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+
         outcome.files["plot"] = out_dir / "sweep.png"
         atomic_write(outcome.files["plot"], lambda fh: plot_sweep(sweep, outcome.rows, fh), binary=True)
         write_tables(sweep, outcome, out_dir)
-    _notify(listeners, "sweep_finished", sweep=sweep, outcome=outcome)
+    for listener in listeners:
+        listener.sweep_finished(sweep, outcome)
     return outcome
 
 
@@ -335,14 +325,6 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
         raise OutputRefused(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
-
-
-def _announcing(sweep, listeners, point_listeners):
-    def make(point):
-        _notify(listeners, "point_started", sweep=sweep, point=point)
-        return point_listeners(point)
-
-    return make
 
 
 def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:
@@ -380,122 +362,3 @@ def read_table(path: str | Path) -> list[dict[str, str]]:
     """sweep.csv as a list of rows (strings), for scripts and tests."""
     with open(path, newline="", encoding="utf-8") as fh:
         return list(csv.DictReader(fh))
-
-
-# ------------------------------------------------------------------ plot
-
-
-def _numeric(values) -> bool:
-    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
-
-
-def plot_sweep(sweep: Sweep, rows: list[dict[str, Any]], fh, dpi: int = 90) -> None:
-    """sweep.png: a and b (rows of panels) against each swept parameter (columns),
-    with their bootstrap intervals; in a grid the other parameters' values make the series."""
-    from .plot import plt  # matplotlib (Agg) is slow to import: only when drawing
-
-    paths = sweep.paths
-    fig, axes = plt.subplots(2, len(paths), figsize=(4.2 * len(paths), 5.6), squeeze=False, layout="constrained")
-    done = [r for r in rows if r["a"] is not None]
-    for col, path in enumerate(paths):
-        xs_all = [r[path] for r in done]
-        numeric = _numeric(xs_all)
-        order = sorted({repr(x) for x in xs_all})  # categorical positions when not numeric
-        others = [p for p in paths if p != path]
-        series: dict[str, list] = {}
-        for r in done:
-            key = ", ".join(f"{p.rsplit('.', 1)[-1]}={r[p]}" for p in others)
-            series.setdefault(key, []).append(r)
-        for row, coef in enumerate(("a", "b")):
-            ax = axes[row][col]
-            for i, (key, members) in enumerate(series.items()):
-                members = sorted(members, key=lambda r: r[path] if numeric else repr(r[path]))
-                x = [m[path] if numeric else order.index(repr(m[path])) for m in members]
-                y = [m[coef] for m in members]
-                lo = [m[coef] - m[f"{coef}_lo"] if m[f"{coef}_lo"] is not None else 0 for m in members]
-                hi = [m[f"{coef}_hi"] - m[coef] if m[f"{coef}_hi"] is not None else 0 for m in members]
-                ax.errorbar(x, y, yerr=[lo, hi], fmt="o-", ms=4, capsize=3, color=f"C{i}", label=key or None)
-            if not numeric:
-                ax.set_xticks(range(len(order)), [o.strip("'") for o in order], rotation=20, fontsize=8)
-            elif sweep.spec.parameters[path].spacing == "log" and min(xs_all, default=1) > 0:
-                ax.set_xscale("log")
-            ax.set_ylabel(coef)
-            ax.grid(True, alpha=0.3)
-            if row == 1:
-                ax.set_xlabel(path)
-            if any(series) and row == 0 and col == 0 and len(series) > 1:
-                ax.legend(fontsize=7)
-    fig.suptitle(f"{sweep.name}: xi = a + b ln f per point (95% bootstrap intervals)", fontsize=10)
-    fig.savefig(fh, format="png", dpi=dpi)
-    plt.close(fig)
-
-
-# ------------------------------------------------------------------ command line
-
-
-class SweepProgress:
-    """The CLI's sweep listener: one counter line per point on stderr (each point's
-    own realization progress comes from a ProgressReporter)."""
-
-    def __init__(self, stream=None):
-        import sys
-
-        self.stream = stream or sys.stderr
-
-    def sweep_started(self, sweep):
-        mode = sweep.spec.mode
-        self.stream.write(f"{sweep.name}: sweep of {len(sweep.points)} points ({mode} over {', '.join(sweep.paths)})\n")
-        self.stream.flush()
-
-    def point_started(self, sweep, point):
-        self.stream.write(f"point {point.number}/{len(sweep.points)}: {point.describe()}\n")
-        self.stream.flush()
-
-    def point_finished(self, sweep, point, result):
-        if result.status == "error":
-            self.stream.write(f"point {point.number} failed: {result.error}\n")
-            self.stream.flush()
-
-
-def sweep_table(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> str:
-    """The short table ``frictionlab run`` prints on stdout after a sweep."""
-    lines = [f"{sweep.name}: {len(sweep.points)} points in {outcome.elapsed:.1f} s, status {outcome.status}"]
-    for row, result in zip(outcome.rows, outcome.results, strict=True):
-        values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(result.point.values[p])}" for p in sweep.paths)
-        if row["a"] is None:
-            lines.append(f"  {row['point']:>3}  {values}: {row['status']}")
-            continue
-        lines.append(
-            f"  {row['point']:>3}  {values}: a = {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}, "
-            f"b = {row['b']:.4f} {format_interval((row['b_lo'], row['b_hi']))}, R^2 = {row['r2']:.3f}, "
-            f"contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
-            + ("" if row["status"] == "completed" else f" ({row['status']})")
-        )
-    lines.append(f"  results in {out_dir}/ (sweep.csv, sweep.png, points/)")
-    return "\n".join(lines)
-
-
-def run_sweep_command(args, overrides: list[str], out_dir: Path, options: RunOptions) -> int:
-    """``frictionlab run`` on a preset with a sweep section; returns an ExitCode."""
-    import sys
-
-    from .errors import ExitCode
-    from .reporter import ProgressReporter
-
-    sweep = load_sweep(args.preset, overrides)
-    listeners = [] if args.quiet else [SweepProgress()]
-    point_listeners = (lambda point: []) if args.quiet else (lambda point: [ProgressReporter()])
-    try:
-        outcome = run_sweep(sweep, out_dir, options, listeners=listeners, point_listeners=point_listeners)
-    except OSError as exc:
-        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
-        return ExitCode.RUNTIME_FAILURE
-    if args.json:
-        print((out_dir / "sweep.json").read_text(encoding="utf-8"))
-    else:
-        print(sweep_table(sweep, outcome, out_dir))
-    if outcome.status == "interrupted":
-        from .signals import interrupted_exit_code
-
-        return interrupted_exit_code()
-    return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK

@@ -9,7 +9,7 @@ import pytest
 from frictionlab.cli import main
 from frictionlab import mdr_length
 from frictionlab.fit import LogFit
-from frictionlab.predict import bootstrap_pairs, dimensionless_force_3d, predict_xi, read_run_law
+from frictionlab.paper.predict import bootstrap_pairs, dimensionless_force_3d, predict_xi, read_run_law
 from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
 

@@ -34,7 +34,8 @@ from frictionlab import (
 from frictionlab import registry as registry_module
 from frictionlab import testing as fltesting
 from frictionlab.errors import ExitCode, PluginError
-from frictionlab.hookspecs import PROJECT_NAME, LifecycleSpecs, RegistrationSpecs
+from frictionlab.hookspecs import PROJECT_NAME, RegistrationSpecs
+from frictionlab.listeners import RunListener as LifecycleSpecs
 from frictionlab.options import RunOptions
 from frictionlab.plugin import KINDS
 from frictionlab.registry import (

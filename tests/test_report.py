@@ -12,11 +12,12 @@ import yaml
 from frictionlab import engine
 from frictionlab.cli import main
 from frictionlab.preset import apply_overrides, build_scene, load_preset_file
-from frictionlab.report import (
-    COUNT_TARGETS, STUDY, Reading, average_curve, calibrated_rms_height, fig5_calibrated_markdown,
-    fig5_calibrated_readings, find_presets, plot_fig5_calibrated, readings_markdown, refit, run_figures, run_readings,
-    write_report,
-)  # fmt: skip
+from frictionlab.paper.calibration import COUNT_TARGETS, calibrated_rms_height
+from frictionlab.paper.figures import FIGURES, find_presets, run_figures
+from frictionlab.paper.markdown import fig5_calibrated_markdown, readings_markdown
+from frictionlab.paper.plots import plot_fig5_calibrated
+from frictionlab.paper.readings import Reading, average_curve, fig5_calibrated_readings, refit, run_readings
+from frictionlab.paper.reproduce import write_report
 from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
 
@@ -29,7 +30,7 @@ TINY = ["realizations=6", "spectrum.params.points=1024", "spectrum.params.length
 @pytest.fixture(scope="module")
 def tiny_presets(tmp_path_factory):
     folder = tmp_path_factory.mktemp("presets")
-    for fig in STUDY:
+    for fig in FIGURES:
         data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
         if data.get("sweep"):
             data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
@@ -92,15 +93,15 @@ def test_calibration_recovers_a_known_rms_height(registry):
 def test_report_on_tiny_presets(tmp_path, tiny_presets):
     md = tmp_path / "REPRODUCTION.md"
     write_report(presets_dir=tiny_presets, out_dir=tmp_path / "runs", markdown_path=md,
-                 figures_dir=tmp_path / "docs" / "fig", options=RunOptions(workers=1), quiet=True)  # fmt: skip
+                 figures_dir=tmp_path / "docs" / "fig", options=RunOptions(workers=1))  # fmt: skip
     text = md.read_text()
     assert "Wall time of the whole report (Figs. 2 to 5):" in text
-    for fig in STUDY:
+    for fig in FIGURES:
         assert f"![{fig.title}](docs/fig/{fig.key}.png)" in text
         assert (tmp_path / "docs" / "fig" / f"{fig.key}.png").stat().st_size > 1000
     for key in ("fig2", "fig3", "fig4"):
         fit = json.loads((tmp_path / "runs" / key / "summary.json").read_text())["fit"]
-        study = next(s for s in STUDY if s.key == key)
+        study = next(s for s in FIGURES if s.key == key)
         cell = f"| {study.a} | {fit['a']:.4f} [{fit['a_ci'][0]:.4f}, {fit['a_ci'][1]:.4f}]"
         assert cell in text
         assert f"{fit['b']:.4f} [{fit['b_ci'][0]:.4f}, {fit['b_ci'][1]:.4f}]" in text
@@ -124,21 +125,21 @@ def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     assert rows[0].overrides[-1].startswith("spectrum.params.c0=")
     assert float(rows[0].overrides[-1].split("=")[1]) == pytest.approx(c0, rel=1e-5)
     for row in rows[:2]:  # each row reruns from its preset and --set options, as the table says
-        preset = next(s.preset for s in STUDY if s.key == row.reading.figure)
+        preset = next(s.preset for s in FIGURES if s.key == row.reading.figure)
         data = apply_overrides(load_preset_file(tiny_presets / preset), row.overrides)
         outcome, _ = run_to_folder(build_scene(data), tmp_path / f"again-{row.reading.name}", RunOptions(workers=1))
-        assert (outcome.fit.a, outcome.fit.b) == pytest.approx((row.a, row.b), rel=1e-12)
+        assert (outcome.fit.a, outcome.fit.b) == pytest.approx((row.fit.a, row.fit.b), rel=1e-12)
     pooled = average_curve(runs[0].outcome.per_realization, "pooled")
-    assert rows[2].a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
+    assert rows[2].fit.a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
     text = "\n".join(readings_markdown(rows))
-    assert "`slope.name=spectral`" in text and f"{rows[1].a:.4f}" in text
+    assert "`slope.name=spectral`" in text and f"{rows[1].fit.a:.4f}" in text
 
 
 def test_presets_folder_errors(tmp_path, capsys):
-    with pytest.raises(Exception, match="no folder with the study's presets"):
+    with pytest.raises(Exception, match="no folder with the paper's presets"):
         find_presets(tmp_path)
     assert main(["report", "--presets", str(tmp_path), "--quiet"]) == 2
-    assert "--presets: no folder with the study's presets" in capsys.readouterr().err
+    assert "--presets: no folder with the paper's presets" in capsys.readouterr().err
 
 
 def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
@@ -162,12 +163,12 @@ def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
     # a point reruns from the preset and its --set options, as the section says
     data = apply_overrides(load_preset_file(tiny_presets / fig5.preset_path.name), rows[0].overrides)
     outcome, _ = run_to_folder(build_scene(data), tmp_path / "again", RunOptions(workers=1))
-    assert (outcome.fit.a, outcome.fit.b) == pytest.approx((rows[0].a, rows[0].b), rel=1e-12)
+    assert (outcome.fit.a, outcome.fit.b) == pytest.approx((rows[0].fit.a, rows[0].fit.b), rel=1e-12)
     text = "\n".join(fig5_calibrated_markdown(fig5, rows, "fig.png", elapsed=1.0))
-    assert f"| 0.6 | {rows[0].rms_height:g} | {rows[0].a:.4f} [{rows[0].a_ci[0]:.4f}, {rows[0].a_ci[1]:.4f}] |" in text
+    assert f"| 0.6 | {rows[0].rms_height:g} | {rows[0].fit.a:.4f} [{rows[0].fit.a_ci[0]:.4f}, {rows[0].fit.a_ci[1]:.4f}] |" in text
     at_one = next(line for line in text.splitlines() if line.startswith(f"| 1 | {rows[1].rms_height:g} | "))
-    assert at_one.endswith("| Fig. 2: 1.8847, 0.0805 |")  # the study's value at H = 1, Fig. 2's
-    outside = not (rows[1].a_ci[0] <= 1.8847 <= rows[1].a_ci[1] and rows[1].b_ci[0] <= 0.0805 <= rows[1].b_ci[1])
+    assert at_one.endswith("| Fig. 2: 1.8847, 0.0805 |")  # the paper's value at H = 1, Fig. 2's
+    outside = not (rows[1].fit.a_ci[0] <= 1.8847 <= rows[1].fit.a_ci[1] and rows[1].fit.b_ci[0] <= 0.0805 <= rows[1].fit.b_ci[1])
     assert ("†" in at_one) == outside
     image = io.BytesIO()
     plot_fig5_calibrated(fig5, rows, image)

@@ -3,7 +3,7 @@
 import io
 
 from frictionlab import engine
-from frictionlab.reporter import ProgressReporter
+from frictionlab.cli.progress import ProgressReporter
 from frictionlab.options import RunOptions
 
 
@@ -34,11 +34,12 @@ def test_log_file_gets_one_plain_line_per_tenth(make_scene):
 
 def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make_scene):
     import time
-    from types import SimpleNamespace
+
+    from frictionlab.engine import RunInfo
 
     stream = io.StringIO()
     reporter = ProgressReporter(stream)
-    reporter.run_started(run=SimpleNamespace(scene=make_scene({}), total=10, workers=1, resumed=8))
+    reporter.run_started(run=RunInfo(scene=make_scene({}), total=10, workers=1, resumed=8))
     assert "(8 restored from the run folder)" in stream.getvalue()
     reporter.started = time.perf_counter() - 2.0  # 2 s for the 2 realizations left: 1 per second
     line = reporter._line(10, 10)

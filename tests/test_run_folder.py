@@ -97,13 +97,13 @@ def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists
 
 def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(tmp_path, monkeypatch, capsys):
     from frictionlab.preset import apply_overrides, load_preset_file
-    from frictionlab.report import STUDY
+    from frictionlab.paper.figures import FIGURES
 
     from .conftest import PRESETS
     from .test_report import TINY
 
     presets = tmp_path / "presets"
-    for fig in STUDY:
+    for fig in FIGURES:
         data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
         if data.get("sweep"):
             data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
@@ -168,7 +168,7 @@ def test_failed_realizations_are_retried_on_resume(make_scene, tmp_path, capsys)
     first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     assert first.status == "completed" and 3 <= len(first.failures) <= 15
     flag.unlink()
-    from frictionlab.reporter import ProgressReporter
+    from frictionlab.cli.progress import ProgressReporter
 
     second, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=2, resume=True), listeners=[ProgressReporter()])
     assert second.failures == [] and second.done == 20

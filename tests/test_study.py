@@ -20,10 +20,11 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode, FrictionlabError
 from frictionlab.registry import Registry
 from frictionlab.seeds import realization_rng
-from frictionlab.study import report
-from frictionlab.study.axes import AXES, COLUMNS, Study, StudyOptions
-from frictionlab.study.metrics import curve_errors, interval_half_width, pareto_front
-from frictionlab.study.scenes import SceneFactory
+from frictionlab.tradeoff import outputs as report
+from frictionlab.tradeoff.axes import COLUMNS, Study
+from frictionlab.tradeoff.metrics import curve_errors, interval_half_width, pareto_front
+from frictionlab.tradeoff.options import AXES, StudyOptions
+from frictionlab.tradeoff.scenes import SceneFactory
 
 # A small line whose preset gives `spacing` (not `length`): shrinking N shortens the
 # line, so keeping the f range needs the loads rescaled.

@@ -12,6 +12,7 @@ from frictionlab.cli import main
 from frictionlab.errors import PresetError
 from frictionlab.preset import load_scene
 from frictionlab.runner import run_to_folder
+from frictionlab.listeners import SweepListener
 from frictionlab.preset import yaml_scalar
 from frictionlab.sweep import load_sweep, plan_sweep, read_table, run_sweep
 from frictionlab.options import RunOptions
@@ -141,7 +142,7 @@ def test_a_bad_point_value_names_the_point_and_field(registry):
 def test_cancel_after_the_first_point_keeps_it_and_marks_the_rest(tmp_path, registry):
     cancel = threading.Event()
 
-    class StopAfterFirst:
+    class StopAfterFirst(SweepListener):
         def point_finished(self, sweep, point, result):
             cancel.set()
 

@@ -65,7 +65,7 @@ def folders(tmp_path, monkeypatch):
 
 
 def make_app(registry, preset=None, workers=1):
-    return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", workers=workers, registry=registry)
+    return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", options=RunOptions(workers=workers), registry=registry)
 
 
 async def open_first_preset(pilot):
@@ -616,7 +616,7 @@ def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path,
     calls = []
     monkeypatch.setattr(frictionlab.tui, "run_app", lambda *a, **k: calls.append((a, k)) or 0)
     assert main(["tui", "--presets", str(tmp_path), "--runs", str(tmp_path / "r"), "--workers", "1"]) == 0
-    assert calls == [((None,), {"presets_dir": str(tmp_path), "runs_dir": str(tmp_path / "r"), "workers": 1})]
+    assert calls == [((None,), {"presets_dir": str(tmp_path), "runs_dir": str(tmp_path / "r"), "options": RunOptions(workers=1)})]
 
     # the headless commands, and `tui` refusing a missing file, never import Textual
     code = (

@@ -13,12 +13,13 @@ def run_app(
     *,
     presets_dir: str | Path | None = None,
     runs_dir: str | Path | None = None,
-    workers: int | None = None,
+    options=None,
 ) -> int:
+    """Run the app until it quits; ``options`` (``RunOptions``): how its runs are carried out."""
     from .app import FrictionlabApp
 
     start_process_helpers()
-    app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, workers=workers)
+    app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, options=options)
     app.run()
     return app.return_code or 0
 

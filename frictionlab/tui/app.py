@@ -26,16 +26,15 @@ from ..fit import format_interval
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..options import RunOptions
 from ..registry import default_registry
-from ..reporter import _duration
+from ..rundir import DEFAULT_RUNS_DIR, new_run_folder
+from ..listeners import format_duration, progress_text
 from ..runner import run_to_folder
 from ..sweep import plan_sweep, run_sweep
 from .chart import Series
 from .fields import preset_from_defaults
 from .folders import (
-    default_runs_dir,
     list_presets,
     list_runs,
-    new_run_folder,
     preset_folders,
     SweepEntry,
     read_curve,
@@ -243,14 +242,14 @@ class FrictionlabApp(App):
         *,
         presets_dir: str | Path | None = None,
         runs_dir: str | Path | None = None,
-        workers: int | None = None,
+        options: RunOptions | None = None,
         registry=None,
     ):
         super().__init__()
         self.preset_path = Path(preset) if preset else None
         self.presets_dir = Path(presets_dir) if presets_dir else None
-        self.runs_dir = Path(runs_dir) if runs_dir else default_runs_dir()
-        self.run_options = RunOptions(workers=workers)
+        self.runs_dir = Path(runs_dir) if runs_dir else DEFAULT_RUNS_DIR
+        self.run_options = options or RunOptions()
         self.registry = registry or default_registry()
         self.draft_path: Path | None = None
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
@@ -564,7 +563,7 @@ class FrictionlabApp(App):
             )
             self.action_show_tab("edit")
             return
-        out_dir = new_run_folder(self.runs_dir, scene.preset.name)
+        out_dir = new_run_folder(scene.preset.name, self.runs_dir)
         self.cancel_event = threading.Event()
         self.run_error = None
         self.last_outcome = self.last_sweep = None
@@ -623,10 +622,10 @@ class FrictionlabApp(App):
         )
 
     def _sweep_in_thread(self, sweep, out_dir: Path, cancel: threading.Event) -> None:
-        poster = SweepPoster(lambda kind, point, result: self.post_message(SweepEvent(sweep, kind, point, result)))
-
-        def point_listeners(point):
-            return [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))]
+        poster = SweepPoster(
+            lambda kind, point, result: self.post_message(SweepEvent(sweep, kind, point, result)),
+            lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
+        )
 
         try:
             outcome = run_sweep(
@@ -634,7 +633,6 @@ class FrictionlabApp(App):
                 out_dir,
                 self.run_options,
                 listeners=[poster],
-                point_listeners=point_listeners,
                 cancel=cancel,
             )
         except OSError as exc:
@@ -663,7 +661,7 @@ class FrictionlabApp(App):
         finished = sum(r.status != "pending" for r in outcome.results)
         pane = self.query_one("#run-pane", RunPane)
         pane.query_one("#sweep-point", Static).update(
-            f"{outcome.status}: {finished}/{len(outcome.results)} points in {_duration(outcome.elapsed)}"
+            f"{outcome.status}: {finished}/{len(outcome.results)} points in {format_duration(outcome.elapsed)}"
             " (sweep.csv, sweep.png)"
         )
         self.notify(f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points")
@@ -680,13 +678,8 @@ class FrictionlabApp(App):
         snap = self.last_snapshot = message.snapshot
         pane = self.query_one("#run-pane", RunPane)
         pane.query_one("#run-bar", ProgressBar).update(total=snap.total, progress=snap.done)
-        failed = f", {snap.failed} failed" if snap.failed else ""
-        left = _duration(snap.seconds_left) if math.isfinite(snap.seconds_left) else "?"
         if not (self.cancel_event is not None and self.cancel_event.is_set()):
-            pane.query_one("#run-stats", Static).update(
-                f"{snap.done}/{snap.total} realizations{failed}, {snap.rate:.1f}/s, "
-                f"elapsed {_duration(snap.elapsed)}, left {left}"
-            )
+            pane.query_one("#run-stats", Static).update(progress_text(snap.done, snap.total, snap.failed, snap.elapsed))
         if snap.f is not None:
             series = [Series(snap.f, snap.xi, "cyan")]
             if snap.fit is not None:
@@ -705,7 +698,7 @@ class FrictionlabApp(App):
         pane = self.query_one("#run-pane", RunPane)
         pane.query_one("#run-bar", ProgressBar).update(total=outcome.requested, progress=outcome.done)
         pane.query_one("#run-stats", Static).update(
-            f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in {_duration(outcome.elapsed)}"
+            f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in {format_duration(outcome.elapsed)}"
             f", {outcome.workers} worker{'s' if outcome.workers != 1 else ''}"
         )
         if outcome.fit is not None:

@@ -13,13 +13,11 @@ import csv
 import json
 import math
 import os
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
 
-from ..cli import DEFAULT_RUNS_DIR
 from ..files import atomic_write
 from .roundtrip import dump_preserving
 
@@ -86,19 +84,6 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
     if text is None:
         text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
     atomic_write(Path(path), lambda fh: fh.write(text))
-
-
-def new_run_folder(runs_dir: Path, name: str) -> Path:
-    """``runs_dir/<name>-<timestamp>``, like the CLI's default, made unique."""
-    base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
-    candidate, n = base, 2
-    while candidate.exists():
-        candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
-    return candidate
-
-
-def default_runs_dir() -> Path:
-    return DEFAULT_RUNS_DIR
 
 
 # ------------------------------------------------------------------ past runs

@@ -35,14 +35,6 @@ class Snapshot:
     finished: bool = False
     f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
 
-    @property
-    def rate(self) -> float:
-        return self.done / self.elapsed if self.elapsed > 0 else 0.0
-
-    @property
-    def seconds_left(self) -> float:
-        return (self.total - self.done) / self.rate if self.rate > 0 else math.nan
-
 
 class LiveListener:
     def __init__(self, post: Callable[[Snapshot], None], interval: float = 0.1, clock=time.perf_counter):

@@ -13,14 +13,20 @@ from collections.abc import Callable
 from typing import Any
 
 from ..fit import format_interval
+from ..listeners import SweepListener
 from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
 
 
-class SweepPoster:
-    """A ``run_sweep`` listener: calls ``post(kind, point, result)`` from the run thread."""
+class SweepPoster(SweepListener):
+    """A sweep's listener: calls ``post(kind, point, result)`` from the run thread;
+    each point's run tells the listeners ``run_listeners(point)`` makes."""
 
-    def __init__(self, post: Callable[[str, SweepPoint, PointResult | None], None]):
+    def __init__(self, post: Callable[[str, SweepPoint, PointResult | None], None], run_listeners=lambda point: []):
         self.post = post
+        self.make_run_listeners = run_listeners
+
+    def run_listeners(self, point: SweepPoint) -> list[object]:
+        return self.make_run_listeners(point)
 
     def point_started(self, sweep: Sweep, point: SweepPoint) -> None:
         self.post("started", point, None)

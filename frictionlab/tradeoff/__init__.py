@@ -2,10 +2,11 @@
 against the cost (wall time, peak memory) of each knob a user turns: grid
 points, realizations, force steps, contact solver and the reference solver's
 tolerance. Orchestration and measurement only; the physics is the plugins'.
+Built on the framework's public modules only.
 
-Modules: ``axes`` runs the variants along each axis, ``scenes`` builds and
-measures them, ``metrics`` holds the error definitions and the Pareto front,
-``report`` writes study.csv, study.md and study.png and words the
-recommendation, ``command`` is the CLI front end. Nothing is imported here, so
+Modules: ``options`` (the axes and settings), ``axes`` runs the variants along
+each axis, ``scenes`` builds and measures them, ``metrics`` holds the error
+definitions and the Pareto front, ``outputs`` writes study.csv, study.md and
+study.png and words the recommendation. Nothing is imported here, so
 ``frictionlab --help`` stays fast.
 """

@@ -1,5 +1,5 @@
-"""The fitted law in 3D: the rms slope in contact of a rough
-surface of apparent area A pressed with force F, by MDR.
+"""The fitted law in 3D (``frictionlab predict``): the rms slope in contact of a rough
+surface of apparent area A pressed with force F, by MDR, as the paper applies it.
 
 MDR maps the surface to a line of length L = 2 sqrt(A / pi), so the line's
 f = F / (E* h L) becomes
@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FrictionlabError
-from .fit import LogFit, bootstrap_coefficients, format_interval, percentile_interval
-from .plugin import ForceNormalisation, mdr_length
-from .seeds import bootstrap_rng
+from ..errors import FrictionlabError
+from ..fit import LogFit, bootstrap_coefficients, format_interval, percentile_interval
+from ..plugin import ForceNormalisation, mdr_length
+from ..seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
 """f of MDR pressing the line that stands for a surface: F / (E* h L), L = 2 sqrt(A / pi)."""
@@ -151,53 +151,3 @@ def prediction_text(p: Prediction) -> str:
     if p.xi <= 0:
         lines.append("warning: xi <= 0: below the law's range (too few points in contact)")
     return "\n".join(lines)
-
-
-def cmd_predict(args) -> int:
-    """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
-    from .errors import ExitCode
-
-    if args.from_run:
-        if args.a is not None or args.b is not None:
-            raise FrictionlabError("give either --from RUN_DIR or --a/--b, not both")
-        law, fitted_f, pairs = read_run_law(args.from_run)
-    else:
-        if args.a is None or args.b is None:
-            raise FrictionlabError("give the law: --a A --b B (with --a-ci/--b-ci for an interval), or --from RUN_DIR")
-        if (args.a_ci is None) != (args.b_ci is None):
-            raise FrictionlabError("--a-ci and --b-ci go together (an interval needs both)")
-        intervals = {"a_ci": tuple(args.a_ci), "b_ci": tuple(args.b_ci)} if args.a_ci else {}
-        law, fitted_f, pairs = LogFit(args.a, args.b, confidence=args.confidence, **intervals), None, None
-    prediction = predict_xi(
-        law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
-        pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
-    )  # fmt: skip
-    if args.json:
-        out = {k: v for k, v in prediction.__dict__.items()}
-        out.update(extrapolated=prediction.extrapolated, beyond_full_contact=prediction.beyond_full_contact,
-                   a=law.a, b=law.b)  # fmt: skip
-        from .fit import json_safe
-
-        print(json.dumps({k: json_safe(v) for k, v in out.items()}, indent=2))
-    else:
-        print(f"law: xi = {law.a:.4f} + {law.b:.4f} ln f")
-        print(prediction_text(prediction))
-    return ExitCode.OK
-
-
-def add_parser(sub) -> None:
-    """The ``predict`` subcommand (registered by cli.build_parser)."""
-    p = sub.add_parser("predict", help="rms slope in contact of a 3D contact from a fitted law")
-    p.add_argument("--a", type=float, help="the law's a")
-    p.add_argument("--b", type=float, help="the law's b")
-    p.add_argument("--a-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of a")
-    p.add_argument("--b-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of b")
-    p.add_argument("--confidence", type=float, default=0.95, help="level of the given intervals (default 0.95)")
-    p.add_argument("--from", dest="from_run", metavar="RUN_DIR", help="take the law from a run folder (summary.json)")
-    p.add_argument("--area", type=float, required=True, metavar="A", help="apparent contact area A")
-    p.add_argument("--modulus", type=float, required=True, metavar="ESTAR", help="effective modulus E*")
-    p.add_argument("--rms-height", type=float, required=True, metavar="H", help="rms height h of the surface")
-    p.add_argument("--force", type=float, required=True, metavar="F", help="normal force F")
-    p.add_argument("--rms-slope", type=float, metavar="S", help="the surface's rms slope: also print S * xi")
-    p.add_argument("--json", action="store_true", help="as JSON")
-    p.set_defaults(handler=cmd_predict)

@@ -1,31 +1,39 @@
-"""``frictionlab study``: options, validation and the run. Heavy modules are
-imported inside ``run_command`` so building the CLI parser stays cheap."""
+"""``frictionlab study PRESET``: the trade-off study (``frictionlab.tradeoff``) from the
+command line: its options, checked, and the run. Heavy modules are imported inside
+``run`` so building the parser stays cheap."""
 
 from __future__ import annotations
 
 import shlex
 import sys
-import time
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError
+from ..tradeoff.options import AXES, StudyOptions
 
-DEFAULTS = {
-    "reference": None,
-    "axes": "grid,realizations,steps,solver,tolerance",
-    "target": 0.02,
-    "points": None,
-    "compare_realizations": 10,
-    "compare_steps": 40,
-    "grid_realizations": 50,
-    "grid_factors": "0.25,0.5,1,2,4",
-    "tolerances": "1e-2,1e-4,1e-6,1e-8",
-    "reference_grid": "",
-    "repeats": 1,
+
+def _listed(values) -> str:
+    return ",".join(f"{v:g}" for v in values)
+
+
+_D = StudyOptions()
+DEFAULTS = {  # the flags' defaults, as typed: StudyOptions' own
+    "reference": _D.reference,
+    "axes": ",".join(_D.axes),
+    "target": _D.target,
+    "points": None,  # the preset's N up to compare_points (compare_points_surface per side)
+    "compare_realizations": _D.compare_realizations,
+    "compare_steps": _D.compare_steps,
+    "grid_realizations": _D.grid_realizations,
+    "grid_factors": _listed(_D.grid_factors),
+    "tolerances": _listed(_D.tolerances),
+    "reference_grid": _listed(_D.reference_grid),
+    "repeats": _D.repeats,
 }
 
 
-def add_arguments(parser) -> None:
+def add_parser(sub) -> None:
+    parser = sub.add_parser("study", help="error against cost of grid, realizations, steps, solver and tolerance")
     d = DEFAULTS
     parser.add_argument("preset", help="preset YAML file")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-study-<timestamp>)")
@@ -37,11 +45,11 @@ def add_arguments(parser) -> None:
         "(default: the installed exact solver of that problem, e.g. bem-halfspace for mdr on a surface)",
     )
     parser.add_argument("--axes", default=d["axes"], metavar="LIST", help=f"axes to run (default {d['axes']})")
-    parser.add_argument("--target", type=float, default=d["target"], help="relative error in b to recommend for (default 0.02)")
+    parser.add_argument("--target", type=float, default=d["target"], help=f"relative error in b to recommend for (default {d['target']:g})")
     parser.add_argument(
         "--points", type=int, default=d["points"], metavar="N",
         help="grid of the solver and tolerance axes, where the reference runs (default: the preset's N up to "
-        "131072 points on a line, 128 per side on a surface)",
+        f"{_D.compare_points} points on a line, {_D.compare_points_surface} per side on a surface)",
     )
     parser.add_argument("--compare-realizations", type=int, default=d["compare_realizations"], metavar="M",
                         help=f"realizations on the solver and tolerance axes (default {d['compare_realizations']})")
@@ -57,6 +65,7 @@ def add_arguments(parser) -> None:
                         help="also refine the reference solver's grid by these factors of --points (e.g. 0.5,1,2)")
     parser.add_argument("--repeats", type=int, default=d["repeats"], metavar="R", help="time each setting R times, keep the best")
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    parser.set_defaults(handler=run)
 
 
 def _numbers(option: str, text: str, kind=float, low: float = 0.0) -> tuple:
@@ -76,9 +85,7 @@ def _at_least(option: str, value: int, low: int) -> int:
     return value
 
 
-def options_from_args(args):
-    from .axes import AXES, StudyOptions
-
+def options_from_args(args) -> StudyOptions:
     axes = tuple(a.strip() for a in args.axes.split(",") if a.strip())
     unknown = [a for a in axes if a not in AXES]
     if unknown or not axes:
@@ -99,7 +106,7 @@ def options_from_args(args):
         compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
         grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
         grid_factors=_numbers("--grid-factors", args.grid_factors),
-        tolerances=_numbers("--tolerances", args.tolerances) or (1e-8,),
+        tolerances=_numbers("--tolerances", args.tolerances) or (min(_D.tolerances),),
         reference_grid=_numbers("--reference-grid", args.reference_grid),
         repeats=_at_least("--repeats", args.repeats, 1),
     )
@@ -121,12 +128,13 @@ def command_line(args) -> str:
     return shlex.join(words)
 
 
-def run_command(args) -> ExitCode:
+def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..registry import default_registry
-    from .axes import Study
-    from .report import recommendation, write_outputs
-    from .scenes import SceneFactory
+    from ..rundir import new_run_folder
+    from ..tradeoff.axes import Study
+    from ..tradeoff.outputs import recommendation, write_outputs
+    from ..tradeoff.scenes import SceneFactory
 
     options = options_from_args(args)
     overrides = list(args.set or [])
@@ -134,7 +142,7 @@ def run_command(args) -> ExitCode:
         overrides.append(f"seed={args.seed}")
     data = read_preset(args.preset, overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=str(args.preset))
-    out_dir = Path(args.out) if args.out else Path("runs") / f"{factory.base.preset.name}-study-{time.strftime('%Y%m%d-%H%M%S')}"
+    out_dir = Path(args.out) if args.out else new_run_folder(f"{factory.base.preset.name}-study")
 
     def progress(message: str) -> None:
         if not args.quiet:

@@ -1,8 +1,8 @@
-"""The CLI's listener: progress on stderr while a run goes on.
+"""The CLI's listeners: progress on stderr while a run or a sweep goes on.
 
-On a terminal it redraws one progress line at most ten times a second; into a
-file or pipe it prints a plain line every tenth of the run, so logs of
-headless runs stay short.
+On a terminal ``ProgressReporter`` redraws one progress line at most ten times
+a second; into a file or pipe it prints a plain line every tenth of the run, so
+logs of headless runs stay short.
 """
 
 from __future__ import annotations
@@ -10,18 +10,13 @@ from __future__ import annotations
 import sys
 import time
 
-from .hookspecs import hookimpl
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 60:
-        return f"{seconds:.1f} s"
-    minutes, seconds = divmod(int(seconds), 60)
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}:{minutes:02d}:{seconds:02d}" if hours else f"{minutes}:{seconds:02d}"
+from ..hookspecs import hookimpl
+from ..listeners import SweepListener, progress_text
 
 
 class ProgressReporter:
+    """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr)."""
+
     def __init__(self, stream=None, interactive: bool | None = None, width: int = 30):
         self.stream = stream or sys.stderr
         self.interactive = self.stream.isatty() if interactive is None else interactive
@@ -33,22 +28,16 @@ class ProgressReporter:
         self.resumed = 0  # restored on a resume: done before this process started
 
     def _line(self, done: int, total: int) -> str:
-        elapsed = time.perf_counter() - self.started
-        rate = (done - self.resumed) / elapsed if elapsed > 0 else 0.0
-        left = (total - done) / rate if rate > 0 else float("nan")
-        eta = _duration(left) if rate > 0 else "?"
-        failed = f", {self.failed} failed" if self.failed else ""
-        return f"{done}/{total} realizations{failed}, {rate:.1f}/s, elapsed {_duration(elapsed)}, left {eta}"
+        return progress_text(done, total, self.failed, time.perf_counter() - self.started, restored=self.resumed)
 
     @hookimpl
     def run_started(self, run):
         self.started = time.perf_counter()
-        self.resumed = getattr(run, "resumed", 0)
+        self.resumed = run.resumed
         preset = run.scene.preset
-        retried = getattr(run, "retried", 0)
         restored = ", ".join(
             [f"{self.resumed} restored from the run folder"] * bool(self.resumed)
-            + [f"{retried} failed ones retried"] * bool(retried)
+            + [f"{run.retried} failed ones retried"] * bool(run.retried)
         )
         restored = f" ({restored})" if restored else ""
         self.stream.write(
@@ -90,3 +79,28 @@ class ProgressReporter:
         if outcome.status != "completed":
             self.stream.write(f"run {outcome.status}: {outcome.done} of {outcome.requested} realizations finished\n")
         self.stream.flush()
+
+
+class SweepProgress(SweepListener):
+    """One counter line per point on stderr; each point's run reports its own
+    realizations through a ``ProgressReporter``."""
+
+    def __init__(self, stream=None):
+        self.stream = stream or sys.stderr
+
+    def sweep_started(self, sweep):
+        mode = sweep.spec.mode
+        self.stream.write(f"{sweep.name}: sweep of {len(sweep.points)} points ({mode} over {', '.join(sweep.paths)})\n")
+        self.stream.flush()
+
+    def point_started(self, sweep, point):
+        self.stream.write(f"point {point.number}/{len(sweep.points)}: {point.describe()}\n")
+        self.stream.flush()
+
+    def run_listeners(self, point):
+        return [ProgressReporter(self.stream)]
+
+    def point_finished(self, sweep, point, result):
+        if result.status == "error":
+            self.stream.write(f"point {point.number} failed: {result.error}\n")
+            self.stream.flush()

@@ -1,0 +1,75 @@
+"""Flags several commands share, and the ``RunOptions`` they make. Reading flags
+happens here only; what an option means is ``frictionlab.options``."""
+
+from __future__ import annotations
+
+from ..errors import FrictionlabError
+from ..options import EXECUTORS
+
+
+def add_workers_option(parser, default_help: str = "all cores; 1: in-process") -> None:
+    parser.add_argument("--workers", type=int, metavar="N", help=f"worker processes (default: {default_help})")
+
+
+def add_executor_options(parser) -> None:
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        help="where realizations run (default: processes, or serial for --workers 1)",
+    )
+    parser.add_argument(
+        "--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, tls://HOST:PORT or tcp://HOST:PORT"
+    )
+    parser.add_argument("--tls-ca-file", metavar="FILE", help="CA certificate of a tls:// Dask scheduler")
+    parser.add_argument("--tls-cert", metavar="FILE", help="client certificate for a tls:// Dask scheduler")
+    parser.add_argument("--tls-key", metavar="FILE", help="client key for a tls:// Dask scheduler")
+    parser.add_argument(
+        "--dashboard", action="store_true", help="serve the Dask dashboard of the local cluster (on 127.0.0.1)"
+    )
+    parser.add_argument(
+        "--no-memory-check", action="store_true", help="skip the peak-memory estimate made before the run starts"
+    )
+
+
+def run_options(**fields):
+    """``RunOptions(**fields)``, a refused value named by its flag (``--workers``)."""
+    from ..options import RunOptions
+
+    try:
+        return RunOptions(**fields)
+    except FrictionlabError as exc:  # each message starts with the field's name
+        raise FrictionlabError(f"--{exc}") from None
+
+
+def executor_run_options(args, **fields):
+    """The ``RunOptions`` of a command with the executor flags (Dask's TLS files and
+    scheduler address are checked, and the TLS files taken, before anything starts)."""
+    _use_tls_options(args)
+    return run_options(
+        workers=args.workers,
+        executor=args.executor,
+        scheduler=args.scheduler,
+        dashboard=args.dashboard,
+        memory_check=not args.no_memory_check,
+        **fields,
+    )
+
+
+def _use_tls_options(args) -> None:
+    tls = {"ca_file": args.tls_ca_file, "cert": args.tls_cert, "key": args.tls_key}
+    if any(tls.values()) or (args.scheduler and args.scheduler.startswith("tls://")):
+        for name, value in tls.items():
+            if value:
+                from ..inputs import regular_file_problem
+
+                problem = regular_file_problem(value)
+                if problem:
+                    flag = "--tls-" + ("ca-file" if name == "ca_file" else name)
+                    raise FrictionlabError(f"{flag} {value}: {problem}")
+        from ..dask_security import use_tls_files
+
+        use_tls_files(**tls)
+    if args.scheduler:
+        from ..dask_security import check_address
+
+        check_address(args.scheduler)

@@ -1,0 +1,56 @@
+"""``frictionlab predict``: the rms slope in contact of a 3D contact from a fitted law
+(given, or a run folder's), with its interval."""
+
+from __future__ import annotations
+
+import json
+
+from ..errors import ExitCode, FrictionlabError
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("predict", help="rms slope in contact of a 3D contact from a fitted law")
+    p.add_argument("--a", type=float, help="the law's a")
+    p.add_argument("--b", type=float, help="the law's b")
+    p.add_argument("--a-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of a")
+    p.add_argument("--b-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of b")
+    p.add_argument("--confidence", type=float, default=0.95, help="level of the given intervals (default 0.95)")
+    p.add_argument("--from", dest="from_run", metavar="RUN_DIR", help="take the law from a run folder (summary.json)")
+    p.add_argument("--area", type=float, required=True, metavar="A", help="apparent contact area A")
+    p.add_argument("--modulus", type=float, required=True, metavar="ESTAR", help="effective modulus E*")
+    p.add_argument("--rms-height", type=float, required=True, metavar="H", help="rms height h of the surface")
+    p.add_argument("--force", type=float, required=True, metavar="F", help="normal force F")
+    p.add_argument("--rms-slope", type=float, metavar="S", help="the surface's rms slope: also print S * xi")
+    p.add_argument("--json", action="store_true", help="as JSON")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
+    from ..fit import LogFit, json_safe
+    from ..paper.predict import predict_xi, prediction_text, read_run_law
+
+    if args.from_run:
+        if args.a is not None or args.b is not None:
+            raise FrictionlabError("give either --from RUN_DIR or --a/--b, not both")
+        law, fitted_f, pairs = read_run_law(args.from_run)
+    else:
+        if args.a is None or args.b is None:
+            raise FrictionlabError("give the law: --a A --b B (with --a-ci/--b-ci for an interval), or --from RUN_DIR")
+        if (args.a_ci is None) != (args.b_ci is None):
+            raise FrictionlabError("--a-ci and --b-ci go together (an interval needs both)")
+        intervals = {"a_ci": tuple(args.a_ci), "b_ci": tuple(args.b_ci)} if args.a_ci else {}
+        law, fitted_f, pairs = LogFit(args.a, args.b, confidence=args.confidence, **intervals), None, None
+    prediction = predict_xi(
+        law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
+        pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
+    )  # fmt: skip
+    if args.json:
+        out = {k: v for k, v in prediction.__dict__.items()}
+        out.update(extrapolated=prediction.extrapolated, beyond_full_contact=prediction.beyond_full_contact,
+                   a=law.a, b=law.b)  # fmt: skip
+        print(json.dumps({k: json_safe(v) for k, v in out.items()}, indent=2))
+    else:
+        print(f"law: xi = {law.a:.4f} + {law.b:.4f} ln f")
+        print(prediction_text(prediction))
+    return ExitCode.OK

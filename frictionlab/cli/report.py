@@ -1,0 +1,33 @@
+"""``frictionlab report``: reproduce the source paper's Figs. 2 to 5 (``frictionlab.paper``)."""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import ExitCode
+from .options import add_workers_option, run_options
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("report", help="run the source paper's Figs. 2 to 5 and write REPRODUCTION.md with figures")
+    p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
+    p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
+    p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing report, its figures and runs")
+    add_workers_option(p, "all cores")
+    p.add_argument("--readings", action="store_true", help="also run the readings of the paper's method (slower)")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..paper.reproduce import write_report
+
+    path = write_report(
+        presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
+        options=run_options(workers=args.workers, force=args.force), readings=args.readings,
+        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+    )  # fmt: skip
+    print(path)
+    return ExitCode.OK

@@ -1,0 +1,29 @@
+"""``frictionlab resume DIR``: continue an interrupted run with the preset stored in its folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ExitCode
+from . import run as run_command
+from .options import add_executor_options, add_workers_option
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("resume", help="continue an interrupted run in DIR with the preset stored there")
+    p.add_argument("run_dir", metavar="DIR", help="the output folder of the interrupted run")
+    add_workers_option(p)
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    add_executor_options(p)
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..rundir import PRESET_FILE, RunDirectory
+
+    run_dir = Path(args.run_dir)
+    RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
+    args.preset, args.out, args.resume, args.set, args.seed = str(run_dir / PRESET_FILE), str(run_dir), True, None, None
+    args.force = False
+    return run_command.run(args)

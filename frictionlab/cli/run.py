@@ -1,0 +1,149 @@
+"""``frictionlab run PRESET``: one ensemble (or one per point of a sweep) into a
+run folder; a short table (or the summary as JSON) on stdout, progress on stderr."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..errors import ExitCode, FrictionlabError
+from .options import add_executor_options, add_workers_option, executor_run_options
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("run", help="run a preset headless and write its results")
+    p.add_argument("preset", help="preset YAML file")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
+    p.add_argument(
+        "--set", action="append", metavar="PATH=VALUE", help="override a preset value, e.g. spectrum.params.hurst=0.8"
+    )
+    add_workers_option(p)
+    p.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    add_executor_options(p)
+    p.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="write into --out DIR even if it is not empty and not a run of this preset (never deletes your files)",
+    )
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..preset import build_scene, read_preset
+    from ..rundir import new_run_folder
+
+    overrides = list(args.set or [])
+    if args.seed is not None:
+        overrides.append(f"seed={args.seed}")
+    data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
+    scene = build_scene(data, source=str(args.preset))
+    if args.resume and not args.out:
+        raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
+    options = executor_run_options(args, resume=args.resume, force=args.force)
+    out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
+    if scene.preset.sweep is not None:  # one ensemble per point
+        return _run_sweep(args, data, out_dir, options)
+    return _run_scene(args, scene, out_dir, options)
+
+
+def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
+    from ..results import summary_dict
+    from ..runner import run_to_folder
+    from ..signals import interrupted_exit_code
+    from .progress import ProgressReporter
+
+    listeners = [] if args.quiet else [ProgressReporter()]
+    try:
+        outcome, files = run_to_folder(scene, out_dir, options, listeners=listeners)
+    except OSError as exc:
+        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    if args.json:
+        summary = summary_dict(scene, outcome, {k: str(p) for k, p in files.items()})
+        print(json.dumps(summary, indent=2, allow_nan=False))
+    else:
+        print(result_table(scene, outcome, out_dir))
+    if outcome.status in ("interrupted", "cancelled"):
+        return interrupted_exit_code()
+    if outcome.failures or outcome.status == "failed":
+        if outcome.error:
+            print(f"error: {outcome.error}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    return ExitCode.OK
+
+
+def _run_sweep(args, data: dict, out_dir: Path, options) -> ExitCode:
+    from ..signals import interrupted_exit_code
+    from ..sweep import plan_sweep, run_sweep
+    from .progress import SweepProgress
+
+    sweep = plan_sweep(data, source=str(args.preset))
+    try:
+        outcome = run_sweep(sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()])
+    except OSError as exc:
+        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    if args.json:
+        print((out_dir / "sweep.json").read_text(encoding="utf-8"))
+    else:
+        print(sweep_table(sweep, outcome, out_dir))
+    if outcome.status == "interrupted":
+        return interrupted_exit_code()
+    return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK
+
+
+def result_table(scene, outcome, out_dir: Path) -> str:
+    """What ``frictionlab run`` prints on stdout after a run: the fit and the contact counts."""
+    from ..fit import format_interval
+
+    preset = scene.preset
+    lines = [
+        f"{preset.name}: {outcome.done}/{outcome.requested} realizations in {outcome.elapsed:.2f} s "
+        f"({outcome.workers} worker{'s' if outcome.workers != 1 else ''}), status {outcome.status}"
+    ]
+    fit = outcome.fit
+    if fit is not None:
+        level = f"{100 * fit.confidence:g}% CI"
+        lines += [
+            f"  xi = a + b ln f      estimate    std.err    {level} (bootstrap {fit.bootstrap})",
+            f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {format_interval(fit.a_ci)}",
+            f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {format_interval(fit.b_ci)}",
+            f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
+            f"  {outcome.normalisation.definition}",
+        ]
+        count = outcome.contact_count
+        unit = outcome.normalisation.load_symbol if scene.control == "force" else "d"
+        lines.append(
+            f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
+            f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
+        )
+    if outcome.failures:
+        index, error = outcome.failures[0]
+        lines.append(f"  {len(outcome.failures)} realization(s) failed; first: #{index}: {error}")
+    lines.append(f"  results in {out_dir}/")
+    return "\n".join(lines)
+
+
+def sweep_table(sweep, outcome, out_dir: Path) -> str:
+    """What ``frictionlab run`` prints on stdout after a sweep: one line per point."""
+    from ..fit import format_interval
+    from ..preset import yaml_scalar
+
+    lines = [f"{sweep.name}: {len(sweep.points)} points in {outcome.elapsed:.1f} s, status {outcome.status}"]
+    for row, result in zip(outcome.rows, outcome.results, strict=True):
+        values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(result.point.values[p])}" for p in sweep.paths)
+        if row["a"] is None:
+            lines.append(f"  {row['point']:>3}  {values}: {row['status']}")
+            continue
+        lines.append(
+            f"  {row['point']:>3}  {values}: a = {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}, "
+            f"b = {row['b']:.4f} {format_interval((row['b_lo'], row['b_hi']))}, R^2 = {row['r2']:.3f}, "
+            f"contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
+            + ("" if row["status"] == "completed" else f" ({row['status']})")
+        )
+    lines.append(f"  results in {out_dir}/ (sweep.csv, sweep.png, points/)")
+    return "\n".join(lines)

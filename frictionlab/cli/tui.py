@@ -1,0 +1,27 @@
+"""``frictionlab tui``: start the terminal UI. The one place the CLI reaches the TUI,
+lazily: headless commands never import Textual."""
+
+from __future__ import annotations
+
+from ..errors import ExitCode
+from .options import add_workers_option, run_options
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("tui", help="terminal UI: edit presets, run with live progress, compare results")
+    p.add_argument("preset", nargs="?", help="preset YAML file to open (optional)")
+    p.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
+    p.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")
+    add_workers_option(p)
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    if args.preset is not None:
+        from ..preset import load_preset_file
+
+        load_preset_file(args.preset)  # a missing or unreadable file is a usage error, before the UI starts
+    options = run_options(workers=args.workers)
+    from ..tui import run_app  # Textual is imported here only
+
+    return run_app(args.preset, presets_dir=args.presets, runs_dir=args.runs, options=options)

@@ -1,0 +1,94 @@
+"""What a run and a sweep tell their front ends as they go: the interfaces the
+CLI's progress printers and the TUI's listeners implement, and the wording of
+progress they share.
+
+* ``RunListener``: the lifecycle hooks of one ensemble run. ``engine.run``
+  calls them on the listeners it is given and on the installed plugins that
+  implement them, in the order ``run_started``, then ``realization_done`` or
+  ``realization_failed`` once per realization, then ``run_finished``. A
+  listener implements any of them, each marked ``@frictionlab.hookimpl``
+  (pluggy calls marked methods only, and checks their argument names; a method
+  may take fewer of the arguments).
+* ``SweepListener``: the events of a sweep (``sweep.run_sweep``); a listener
+  subclasses it and overrides what it needs.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Protocol
+
+from .hookspecs import hookspec
+
+if TYPE_CHECKING:  # annotations only: the engine imports this module
+    from .engine import RunInfo
+    from .ensemble import RunOutcome
+    from .realization import RealizationResult
+    from .sweep import PointResult, Sweep, SweepOutcome, SweepPoint
+
+
+class RunListener(Protocol):
+    """The lifecycle hooks of one run (the pluggy hook specifications themselves)."""
+
+    @hookspec
+    def run_started(self, run: RunInfo) -> None:
+        """A run begins. ``run`` is the ``RunInfo``: scene, realizations to do,
+        realizations already done, seed, workers."""
+
+    @hookspec
+    def realization_done(self, run: RunInfo, result: RealizationResult, done: int, total: int) -> None:
+        """One realization finished. ``result`` is its ``RealizationResult``;
+        ``done`` of ``total`` realizations are now finished (ok or failed)."""
+
+    @hookspec
+    def realization_failed(self, run: RunInfo, result: RealizationResult, done: int, total: int) -> None:
+        """One realization raised. ``result.error`` holds the message; the run
+        goes on with the others."""
+
+    @hookspec
+    def run_finished(self, run: RunInfo, outcome: RunOutcome) -> None:
+        """The run ended (completed, cancelled or failed). ``outcome`` is the
+        ``RunOutcome`` with the statistics and the fit of what finished."""
+
+
+LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
+
+
+class SweepListener:
+    """The events of a sweep, in order: ``sweep_started``, then per point
+    ``point_started`` (whose run then tells ``run_listeners(point)``) and
+    ``point_finished``, then ``sweep_finished``. Every method does nothing here."""
+
+    def sweep_started(self, sweep: Sweep) -> None:
+        """The sweep begins: every point is planned and valid."""
+
+    def point_started(self, sweep: Sweep, point: SweepPoint) -> None:
+        """A point's run begins."""
+
+    def run_listeners(self, point: SweepPoint) -> list[object]:
+        """The ``RunListener``s of this point's run."""
+        return []
+
+    def point_finished(self, sweep: Sweep, point: SweepPoint, result: PointResult) -> None:
+        """A point ended (``result.status`` says how), its files written."""
+
+    def sweep_finished(self, sweep: Sweep, outcome: SweepOutcome) -> None:
+        """The sweep ended: sweep.csv, sweep.json (and sweep.png) are written."""
+
+
+def format_duration(seconds: float) -> str:
+    """``12.3 s`` below a minute, ``4:05`` below an hour, then ``1:02:03``."""
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    minutes, seconds = divmod(int(seconds), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{seconds:02d}" if hours else f"{minutes}:{seconds:02d}"
+
+
+def progress_text(done: int, total: int, failed: int, elapsed: float, restored: int = 0) -> str:
+    """``12/40 realizations, 1 failed, 3.1/s, elapsed 3.9 s, left 9.0 s``: the rate counts
+    only what this process computed (not the ``restored`` realizations of a resume)."""
+    rate = (done - restored) / elapsed if elapsed > 0 else 0.0
+    left = format_duration((total - done) / rate) if rate > 0 else "?"
+    failures = f", {failed} failed" if failed else ""
+    return f"{done}/{total} realizations{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
+

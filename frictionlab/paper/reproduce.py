@@ -1,0 +1,80 @@
+"""``frictionlab report``: run the paper's Figs. 2 to 5 and write REPRODUCTION.md with its
+figures, the paper's numbers beside frictionlab's; with ``readings`` also the readings
+of the paper's method and Fig. 5 with h calibrated at each H."""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from ..errors import OutputRefused
+from ..files import atomic_write
+from ..options import RunOptions
+from ..rundir import new_run_folder
+from .figures import find_presets, run_figures
+from .markdown import markdown
+from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
+from .readings import READINGS, fig5_calibrated_readings, run_readings
+
+
+FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
+
+
+def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: bool = False) -> tuple[Path, Path, Path]:
+    """The run folders, the markdown and the figures folder of a report: by
+    default all in a fresh folder ``runs/report-<timestamp>/`` (``REPRODUCTION.md``,
+    ``figures/``). An existing markdown or figure is refused unless ``force``."""
+    out_dir = Path(out_dir) if out_dir else new_run_folder("report")
+    markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
+    figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
+    taken = [p for p in (markdown_path, *(figures_dir / name for name in FIGURE_FILES)) if os.path.lexists(p)]
+    if taken and not force:
+        shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
+        raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")
+    return out_dir, markdown_path, figures_dir
+
+
+def write_report(
+    *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
+    options: RunOptions = RunOptions(), readings=False, dpi=90, log: Callable[[str], None] = lambda text: None,
+) -> Path:  # fmt: skip
+    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
+    Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless
+    ``options.force``. ``log`` hears what is going on, a line at a time."""
+    presets = find_presets(presets_dir)
+    out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
+    started = time.perf_counter()
+    log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
+    runs = run_figures(presets, out_dir, options)
+    log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
+    images = {}
+    for run in runs:
+        name = f"{run.figure.key}.png"
+        draw = plot_fig5 if run.sweep is not None else plot_figure
+        atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
+        images[run.figure.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+    elapsed = time.perf_counter() - started
+    reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
+    if readings:
+        log(f"report: running {len(READINGS)} readings")
+        t0 = time.perf_counter()
+        reading_rows = run_readings(runs, out_dir, options)
+        readings_elapsed = time.perf_counter() - t0
+        fig5 = next(run for run in runs if run.sweep is not None)
+        log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
+        t0 = time.perf_counter()
+        fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
+                                 folder_name="fig5-calibrated")  # fmt: skip
+        fig5_elapsed = time.perf_counter() - t0
+        name = "fig5-calibrated.png"
+        atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
+        images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+    command = "frictionlab report" + (" --readings" if readings else "")
+    text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
+                    fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
+                    command=command)  # fmt: skip
+    atomic_write(markdown_path, lambda fh: fh.write(text))
+    log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
+    return markdown_path
