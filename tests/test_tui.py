@@ -27,7 +27,7 @@ from frictionlab.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.live import LiveListener
 from frictionlab.tui.folders import save_preset
-from frictionlab.tui.form import PresetForm
+from frictionlab.tui.widgets import PresetForm, ResultsPane
 from textual.widgets import Input, Select, Static, Switch
 
 from .conftest import PRESETS, ROOT, SMALL_PRESET, merge
@@ -377,7 +377,7 @@ async def test_a_run_shows_the_headless_coefficients(folders, registry):
         await pilot.pause()
         shown = str(app.query_one("#run-fit", Static).render())
         out_dir = app.last_out_dir
-        runs_listed = [entry.path.name for entry in app.runs]
+        runs_listed = [entry.path.name for entry in app.query_one(ResultsPane).runs]
 
     outcome, _ = run_to_folder(build_scene(TINY, registry=registry), folders / "headless", RunOptions(workers=2))
     fit = outcome.fit
@@ -441,7 +441,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: app.last_sweep is not None)
+        await wait_until(pilot, lambda: app.last_outcome is not None)
         await pilot.pause()
         table = app.query_one("#sweep-table")
         cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
@@ -449,7 +449,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
         point_text = str(app.query_one("#sweep-point", Static).render())
         out_dir = app.last_out_dir
         fits = fits_width(table)
-    assert app.last_sweep.status == "completed" and point_text.startswith("completed: 3/3 points")
+    assert app.last_outcome.status == "completed" and point_text.startswith("completed: 3/3 points")
     assert out_dir.parent.name == "runs" and out_dir.name.startswith("tinysweep-")
     assert columns == ["#", "hurst", "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
     assert fits, "the sweep table is cut at 80 columns"
@@ -466,7 +466,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
         assert status == "✓" and row["status"] == "completed"
     # the same numbers as a headless sweep of the same preset
     headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", RunOptions(workers=1))
-    assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_sweep.results] == [
+    assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_outcome.results] == [
         (r.outcome.fit.a, r.outcome.fit.b) for r in headless.results
     ]
     assert [r.point.scene.spectrum.params.hurst for r in headless.results] == [0.5, 0.7, 0.9]
@@ -484,16 +484,16 @@ async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders
         await pilot.press("ctrl+r")
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
         await pilot.press("c")
-        await wait_until(pilot, lambda: app.last_sweep is not None)
+        await wait_until(pilot, lambda: app.last_outcome is not None)
         await pilot.pause()
         table = app.query_one("#sweep-table")
         cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
         out_dir = app.last_out_dir
-    assert app.last_sweep.status == "interrupted"
+    assert app.last_outcome.status == "interrupted"
     rows = read_table(out_dir / "sweep.csv")
     assert [r["status"] for r in rows] == ["cancelled", "pending", "pending"]
     assert [c[2] for c in cells] == ["c"]  # only finished points get a row, marked cancelled
-    first = app.last_sweep.results[0].outcome
+    first = app.last_outcome.results[0].outcome
     assert 3 <= first.done < 100_000 and int(rows[0]["done"]) == first.done
     with np.load(out_dir / rows[0]["folder"] / "realizations.npz") as arrays:
         assert arrays["xi"].shape[0] == first.done
@@ -535,11 +535,11 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await pilot.press("f5")
-        assert {entry.path.name for entry in app.runs} == {"seed1", "seed2"}
+        assert {entry.path.name for entry in app.query_one(ResultsPane).runs} == {"seed1", "seed2"}
         await pilot.press("enter")
-        assert [e.path.name for e in app.overlay] == [app.runs[0].path.name]
+        assert [e.path.name for e in app.query_one(ResultsPane).overlay] == [app.query_one(ResultsPane).runs[0].path.name]
         await pilot.press("down", "space")
-        assert {e.path.name for e in app.overlay} == {"seed1", "seed2"}
+        assert {e.path.name for e in app.query_one(ResultsPane).overlay} == {"seed1", "seed2"}
         info = str(app.query_one("#results-info", Static).render())
     for seed in (1, 2):
         summary = json.loads((folders / "runs" / f"seed{seed}" / "summary.json").read_text())
@@ -556,8 +556,8 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await pilot.press("f5")
-        assert sorted(e.path.name for e in app.runs) == ["seed1", "seed2", "sw"]
-        index = [e.path.name for e in app.runs].index("sw")
+        assert sorted(e.path.name for e in app.query_one(ResultsPane).runs) == ["seed1", "seed2", "sw"]
+        index = [e.path.name for e in app.query_one(ResultsPane).runs].index("sw")
         listed = [str(c) for c in app.query_one("#runs-table").get_row_at(index)]
         assert listed[1:] == ["sw", "sweep", "3 pts"]  # marked as a sweep
         await pilot.press(*["down"] * index, "enter")
@@ -568,10 +568,10 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
         assert fits_width(points), "the sweep table is cut at 80 columns"
         await pilot.press("down", "enter")  # the second point's own run
         await pilot.pause()
-        overlay = [e.path for e in app.overlay]
+        overlay = [e.path for e in app.query_one(ResultsPane).overlay]
         await pilot.press("up", "space")  # and the first point's, for comparison
         await pilot.pause()
-        compared = [e.path for e in app.overlay]
+        compared = [e.path for e in app.query_one(ResultsPane).overlay]
         info = str(app.query_one("#results-info", Static).render())
     assert len(cells) == 3
     for shown, row in zip(cells, rows, strict=True):
@@ -596,7 +596,7 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
 def test_help_lists_every_binding_and_the_readme_has_them(registry):
     app = FrictionlabApp(registry=registry)
     keys = [key for _, rows in app.help_groups() for key, _ in rows]
-    from frictionlab.tui.app import PresetsPane, ResultsPane, RunPane
+    from frictionlab.tui.widgets import PresetsPane, ResultsPane, RunPane
 
     for bindings in (FrictionlabApp.BINDINGS, PresetsPane.BINDINGS, RunPane.BINDINGS, ResultsPane.BINDINGS):
         for binding in bindings:

@@ -1,68 +1,14 @@
-"""Small widgets and modal screens of the TUI: the chart, help, confirm, save as, new preset."""
+"""Small modal dialogs: confirm, ask for a path (save as, duplicate), a new preset."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
-from textual.widget import Widget
 from textual.widgets import Button, Input, Label, Select, Static
-
-from .chart import Series, render_chart
-
-
-class Chart(Widget):
-    """xi against f (log axis), braille dots; redrawn when ``series`` is set."""
-
-    DEFAULT_CSS = "Chart { height: 1fr; min-height: 6; }"
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.series: list[Series] = []
-
-    def show(self, series: list[Series]) -> None:
-        self.series = series
-        self.refresh()
-
-    def render(self) -> Text:
-        text = Text(no_wrap=True, overflow="crop")
-        rows = render_chart(self.series, self.size.width, self.size.height)
-        for i, row in enumerate(rows):
-            for chunk, style in row:
-                text.append(chunk, style=style or None)
-            if i < len(rows) - 1:
-                text.append("\n")
-        return text
-
-
-class HelpScreen(ModalScreen[None]):
-    """Every key binding of the app, grouped by where it works."""
-
-    BINDINGS = [
-        Binding("escape", "dismiss", "Close"),
-        Binding("f1", "dismiss", "Close", show=False),
-        Binding("q", "dismiss", "Close", show=False),
-    ]
-
-    def __init__(self, groups: list[tuple[str, list[tuple[str, str]]]]):
-        super().__init__()
-        self.groups = groups
-
-    def compose(self) -> ComposeResult:
-        text = Text()
-        for title, rows in self.groups:
-            text.append(f"{title}\n", style="bold")
-            for key, description in rows:
-                text.append(f"  {key:<14}", style="bold cyan")
-                text.append(f"{description}\n")
-        with Vertical(id="help-box"):
-            yield Label("Keys  (Esc closes)", classes="heading")
-            with VerticalScroll():
-                yield Static(text)
 
 
 class ConfirmScreen(ModalScreen[bool]):

@@ -18,9 +18,9 @@ from textual.validation import ValidationResult, Validator
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static, Switch
 
-from ..plugin import KINDS
-from ..preset import MISSING, Preset, get_path, set_path
-from .fields import (
+from ...plugin import KINDS
+from ...preset import MISSING, Preset, get_path, set_path
+from ..fields import (
     FieldSpec,
     default_plugin_name,
     display,

@@ -1,0 +1,51 @@
+"""The Edit tab: the preset form with the draft's name and state, the focused field's
+help, and the headless validator's problems."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.app import ComposeResult
+from textual.containers import Vertical
+from textual.widgets import Static
+
+from .form import PresetForm
+
+
+class EditPane(Vertical):
+    def __init__(self, registry, **kwargs):
+        super().__init__(**kwargs)
+        self.registry = registry
+
+    def compose(self) -> ComposeResult:
+        yield Static("", id="edit-title")
+        yield PresetForm(self.registry, id="form")
+        yield Static("", id="field-help")
+        yield Static("", id="problems")
+
+    def show_title(self, path: Path | None, modified: bool, problems: list[str]) -> None:
+        title = self.query_one("#edit-title", Static)
+        if path is None:
+            title.update("No preset open")
+            return
+        state = "modified" if modified else "saved"
+        count = f", {len(problems)} problem(s)" if problems else ""
+        title.update(f"[b]{path.name}[/b]  ({state}{count})")
+
+    def show_problems(self, problems: list[str]) -> None:
+        panel = self.query_one("#problems", Static)
+        if problems:
+            count = len(problems)
+            panel.update(
+                f"[b]{count} problem{'s' if count != 1 else ''}[/b] (as frictionlab validate says):\n"
+                + "\n".join(problems)
+            )
+            panel.set_class(True, "-invalid")
+        else:
+            panel.update("valid: Ctrl+R runs it, Ctrl+S saves it")
+            panel.set_class(False, "-invalid")
+
+    def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
+        spec = event.spec
+        text = "" if spec is None else f"{spec.dotted}: " + spec.tooltip().replace("\n", "; ")
+        self.query_one("#field-help", Static).update(text)

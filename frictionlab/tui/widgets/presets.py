@@ -1,0 +1,69 @@
+"""The Presets tab: the presets of the project and user folders, with a line about each."""
+
+from __future__ import annotations
+
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Vertical
+from textual.widgets import DataTable, Static
+
+from ..folders import PresetEntry, list_presets
+from .tables import ListTable
+
+
+class PresetsPane(Vertical):
+    BINDINGS = [
+        Binding("d", "duplicate", "Duplicate", tooltip="Duplicate the preset (asks for a file name)"),
+        Binding("n", "new", "New", tooltip="New preset from a spectrum plugin's defaults"),
+        Binding("r", "reload", "Reload", tooltip="Reload the list of presets"),
+    ]
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.presets: list[PresetEntry] = []
+
+    def compose(self) -> ComposeResult:
+        yield ListTable(id="preset-table", cursor_type="row", zebra_stripes=True)
+        yield Static("", id="preset-info")
+
+    def on_mount(self) -> None:
+        self.query_one("#preset-table", DataTable).add_columns("name", "folder", "file")
+
+    def reload(self, folders: list) -> None:
+        """List the presets of ``folders`` (``folders.preset_folders``)."""
+        self.presets = list_presets(folders)
+        table = self.query_one("#preset-table", DataTable)
+        table.clear()
+        for entry in self.presets:
+            table.add_row(entry.name, entry.label, entry.path.name)
+        if not self.presets:
+            shown = ", ".join(str(f) for _, f in folders)
+            self.query_one("#preset-info", Static).update(f"No presets in {shown}. n makes a new one.")
+        else:
+            self._show_info(0)
+
+    def selected(self) -> PresetEntry | None:
+        row = self.query_one("#preset-table", DataTable).cursor_row
+        return self.presets[row] if 0 <= row < len(self.presets) else None
+
+    def _show_info(self, row: int) -> None:
+        if 0 <= row < len(self.presets):
+            entry = self.presets[row]
+            text = entry.error or entry.description or "(no description)"
+            self.query_one("#preset-info", Static).update(f"{entry.path}\n{text}")
+
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        self._show_info(event.cursor_row)
+
+    def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
+        event.stop()
+        self.app.open_selected_preset()
+
+    def action_duplicate(self) -> None:
+        self.app.duplicate_selected_preset()
+
+    def action_new(self) -> None:
+        self.app.new_preset()
+
+    def action_reload(self) -> None:
+        self.app.reload_presets()

@@ -1,0 +1,152 @@
+"""The Results tab: runs and sweeps on the left, the open runs' curves on the right;
+an open sweep's table of points below them (Enter on a point opens its run)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.widgets import DataTable, Static
+
+from ...fit import format_interval
+from ..chart import Series
+from ..folders import RunEntry, SweepEntry, list_runs, read_curve, read_run
+from ..sweepview import STATUS_MARKS, row_cells, table_columns
+from .chart import Chart
+from .run import fit_series
+from .tables import ListTable
+
+OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
+HINT = "Enter opens a run; Space adds it to the overlay."
+
+
+class ResultsPane(Vertical):
+    BINDINGS = [
+        Binding("space", "compare", "Compare", tooltip="Compare: add the run to the overlay, or remove it"),
+        Binding("r", "reload", "Reload", tooltip="Reload the list of runs"),
+    ]
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.runs: list[RunEntry | SweepEntry] = []
+        self.overlay: list[RunEntry] = []  # the runs drawn, at most one per style
+        self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
+
+    def compose(self) -> ComposeResult:
+        with Horizontal(id="results-top"):
+            yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True)
+            with Vertical(id="results-body"):
+                yield Chart(id="results-chart")
+                yield Static(HINT, id="results-info")
+        yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        runs = self.query_one("#runs-table", DataTable)
+        runs.add_column("", width=1, key="status")
+        runs.add_column("run", width=17)
+        runs.add_column("a", width=7)
+        runs.add_column("b", width=7)
+
+    def action_compare(self) -> None:
+        self.open_selected(overlay=True)
+
+    def action_reload(self) -> None:
+        self.app.reload_runs()
+
+    def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
+        event.stop()
+        self.open_selected(overlay=False)
+
+    def reload(self, runs_dir: Path) -> None:
+        self.runs = list_runs(runs_dir)
+        table = self.query_one("#runs-table", DataTable)
+        table.clear()
+        for entry in self.runs:
+            if isinstance(entry, SweepEntry):
+                a, b = "sweep", f"{len(entry.points)} pts"
+            else:
+                a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
+                b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
+            table.add_row(STATUS_MARKS.get(entry.status, "?"), entry.path.name, a, b)
+
+    def open_selected(self, overlay: bool) -> None:
+        """Enter/Space on the list of runs, or on the open sweep's table of points."""
+        points = self.query_one("#results-sweep", DataTable)
+        if points.has_focus and self.open_sweep is not None:
+            row = points.cursor_row
+            if not 0 <= row < len(self.open_sweep.points):
+                return
+            folder = self.open_sweep.point_folder(self.open_sweep.points[row])
+            try:
+                entry = read_run(folder)
+            except (OSError, ValueError, TypeError):
+                self.app.notify(f"{folder.name}: this point has no finished run", severity="warning")
+                return
+        else:
+            row = self.query_one("#runs-table", DataTable).cursor_row
+            if not 0 <= row < len(self.runs):
+                return
+            entry = self.runs[row]
+            if isinstance(entry, SweepEntry):
+                if not overlay:
+                    self._show_sweep(entry)
+                return
+        if overlay:
+            paths = [e.path for e in self.overlay]
+            if entry.path in paths:
+                self.overlay = [e for e in self.overlay if e.path != entry.path]
+            else:
+                self.overlay = (self.overlay + [entry])[-len(OVERLAY_STYLES):]
+        else:
+            self.overlay = [entry]
+        self._show_overlay()
+
+    def _show_sweep(self, entry: SweepEntry) -> None:
+        """The sweep's table of points, formatted as the Run tab formats a live sweep."""
+        self.open_sweep = entry
+        table = self.query_one("#results-sweep", DataTable)
+        table.clear(columns=True)
+        table.add_columns(*table_columns(entry.paths))
+        for row in entry.points:
+            table.add_row(*row_cells(entry.paths, row))
+        self.set_class(True, "-sweep")
+        self.query_one("#results-info", Static).update(
+            f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
+            "Enter on a point opens its run; Space adds it to the overlay."
+        )
+        table.focus()
+
+    def _show_overlay(self) -> None:
+        series, lines = [], []
+        for style, entry in zip(OVERLAY_STYLES, self.overlay):
+            try:
+                curve = read_curve(entry.path)
+            except (OSError, ValueError, KeyError) as exc:
+                lines.append(f"[{style}]{entry.path.name}[/]: no curve ({exc})")
+                continue
+            f, xi = np.array(curve.get("f", []), float), np.array(curve.get("xi", []), float)
+            series.append(Series(f, xi, style))
+            if math.isfinite(entry.a):
+                series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
+            lines += _entry_lines(entry, style)
+        self.query_one("#results-chart", Chart).show(series)
+        self.query_one("#results-info", Static).update("\n".join(lines) if lines else HINT)
+
+
+def _entry_lines(entry: RunEntry, style: str) -> list[str]:
+    """What the overlay says of one run: f, its status and contacts, its fit."""
+    fit = entry.fit or {}
+    counts = entry.summary.get("contact_count_at_first_load"), entry.summary.get("contact_count_at_last_load")
+    formula = (entry.summary.get("normalisation") or {}).get("formula")
+    lines = [f"[{style}]■ {entry.path.name}[/]" + (f" f = {formula}" if formula else "")]
+    contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if counts[0] is not None else ""
+    lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
+    if fit:
+        interval = lambda key: format_interval(tuple(fit.get(key) or (None, None)), missing="")  # noqa: E731
+        lines.append(f"  a={fit.get('a', math.nan):.4f} {interval('a_ci')} R^2={fit.get('r2', math.nan):.4f}")
+        lines.append(f"  b={fit.get('b', math.nan):.4f} {interval('b_ci')}")
+    return lines

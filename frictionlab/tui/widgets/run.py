@@ -1,0 +1,162 @@
+"""The Run tab: a run's (or a sweep's) progress, the live mean curve with its
+interim fit, and at the end the fit with its bootstrap intervals; for a sweep also
+the point running and a table row per finished point."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.widgets import DataTable, ProgressBar, Static
+
+from ...fit import format_interval
+from ...listeners import format_duration, progress_text
+from ..chart import Series
+from ..live import Snapshot
+from ..sweepview import point_line, table_cells, table_columns
+from .chart import Chart
+
+
+def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
+    """The coefficients as the Run tab and Results tab show them, with what f is."""
+    what = [f"  f = {f_formula}"] if f_formula else []
+    if fit is None:
+        return ["xi = a + b ln f", *what, "  (no realization yet)"]
+    head = "xi = a + b ln f" + ("" if final else "  (interim)")
+    lines = [head, *what, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
+    if final:
+        level = f"{100 * fit.confidence:g}%"
+        lines = [
+            head,
+            *what,
+            f"  a = {fit.a:.4f} {format_interval(fit.a_ci, missing='')}",
+            f"  b = {fit.b:.4f} {format_interval(fit.b_ci, missing='')}",
+            f"  {level} CI, bootstrap {fit.bootstrap}",
+        ]
+    lines.append(f"  R^2 = {fit.r2:.4f}")
+    return lines
+
+
+def fit_series(f: np.ndarray, a: float, b: float, style: str) -> Series:
+    """The fitted line a + b ln f over the range of ``f``."""
+    f = np.asarray(f, float)
+    f = f[np.isfinite(f) & (f > 0)]
+    if f.size < 2:
+        return Series(np.empty(0), np.empty(0), style, line=True)
+    ends = np.array([f.min(), f.max()])
+    return Series(ends, a + b * np.log(ends), style, line=True)
+
+
+def _contact_lines(count) -> list[str]:
+    if count is None or not np.size(count):
+        return []
+    return ["", "points in contact", f"  {count[0]:.2f} at first load", f"  {count[-1]:.2f} at last load"]
+
+
+class RunPane(Vertical, can_focus=True):
+    BINDINGS = [
+        Binding("r", "start", "Run", tooltip="Run the open preset (again)"),
+        Binding("c", "cancel", "Cancel", tooltip="Cancel the run: what finished is kept and saved"),
+    ]
+
+    def compose(self) -> ComposeResult:
+        yield Static("No run yet: open a preset and press Ctrl+R.", id="run-title")
+        yield Static("", id="sweep-point")
+        yield ProgressBar(id="run-bar", show_eta=False)
+        yield Static("", id="run-stats")
+        with Horizontal(id="run-body"):
+            yield Chart(id="run-chart")
+            yield Static("", id="run-fit")
+        yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="none")
+        yield Static("", id="run-error")
+
+    def action_start(self) -> None:
+        self.app.action_start_run()
+
+    def action_cancel(self) -> None:
+        self.app.action_cancel_run()
+
+    def _set(self, widget_id: str, text: str) -> None:
+        self.query_one(f"#{widget_id}", Static).update(text)
+
+    # ------------------------------------------------------------ a run starts
+
+    def start(self, scene, sweep, out_dir: Path) -> None:
+        """Clear the tab for the run of ``scene`` (or of ``sweep``, when not None) into ``out_dir``."""
+        self.set_class(sweep is not None, "-sweep")
+        where = f"{out_dir.parent.name}/{out_dir.name}"
+        preset = scene.preset
+        if sweep is None:
+            self._set("run-title", f"[b]{preset.name}[/b]: {preset.realizations} realizations, "
+                                   f"{preset.loading.steps} {preset.loading.control} steps -> {where}")  # fmt: skip
+        else:
+            preset = sweep.points[0].scene.preset
+            self._set("run-title", f"[b]{sweep.name}[/b]: {len(sweep.points)} points x {preset.realizations} "
+                                   f"realizations -> {where}")  # fmt: skip
+            self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
+            self._set("run-stats", "")
+            table = self.query_one("#sweep-table", DataTable)
+            table.clear(columns=True)
+            table.add_columns(*table_columns(sweep.paths))
+        self.query_one("#run-bar", ProgressBar).update(total=preset.realizations, progress=0)
+        self._set("run-error", "")
+
+    # ------------------------------------------------------------ while it runs
+
+    def show_progress(self, snap: Snapshot, cancelling: bool) -> None:
+        self.query_one("#run-bar", ProgressBar).update(total=snap.total, progress=snap.done)
+        if not cancelling:
+            self._set("run-stats", progress_text(snap.done, snap.total, snap.failed, snap.elapsed))
+        if snap.f is not None:
+            series = [Series(snap.f, snap.xi, "cyan")]
+            if snap.fit is not None:
+                series.append(fit_series(snap.f, snap.fit.a, snap.fit.b, "yellow"))
+            self.query_one("#run-chart", Chart).show(series)
+            lines = fit_lines(snap.fit, final=False, f_formula=snap.f_formula) + _contact_lines(snap.contact_count)
+            self._set("run-fit", "\n".join(lines))
+        if snap.first_error:
+            self._set("run-error", f"[red]{snap.first_error}[/red]")
+
+    def show_cancelling(self) -> None:
+        self._set("run-stats", "cancelling: the realizations already running finish and are kept")
+
+    def show_point(self, sweep, kind: str, point, result) -> None:
+        """A sweep point started (``result`` None) or finished."""
+        if kind == "started":
+            self._set("sweep-point", point_line(sweep, point))
+            self.query_one("#run-bar", ProgressBar).update(total=point.scene.preset.realizations, progress=0)
+            return
+        self.query_one("#sweep-table", DataTable).add_row(*table_cells(sweep, result))
+        if result.error:
+            self._set("run-error", f"[red]point {result.point.number}: {result.error}[/red]")
+
+    # ------------------------------------------------------------ at the end
+
+    def show_outcome(self, outcome) -> str:
+        """Show a finished run's ``RunOutcome``; return the line the app notifies."""
+        self.query_one("#run-bar", ProgressBar).update(total=outcome.requested, progress=outcome.done)
+        self._set("run-stats", f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in "
+                               f"{format_duration(outcome.elapsed)}, {outcome.workers} worker"
+                               f"{'s' if outcome.workers != 1 else ''}")  # fmt: skip
+        if outcome.fit is not None:
+            series = [Series(outcome.f, outcome.xi, "cyan"), fit_series(outcome.f, outcome.fit.a, outcome.fit.b, "yellow")]
+            self.query_one("#run-chart", Chart).show(series)
+        lines = fit_lines(outcome.fit, final=True, f_formula=outcome.normalisation.formula)
+        self._set("run-fit", "\n".join(lines + _contact_lines(outcome.contact_count)))
+        if outcome.failures or outcome.error:
+            first = outcome.error or f"#{outcome.failures[0][0]}: {outcome.failures[0][1]}"
+            self._set("run-error", f"[red]{len(outcome.failures)} realization(s) failed; {first}[/red]")
+        return f"Run {outcome.status}: {outcome.done}/{outcome.requested} realizations"
+
+    def show_sweep_outcome(self, outcome) -> str:
+        """Show a finished sweep's ``SweepOutcome``; return the line the app notifies."""
+        finished = sum(r.status != "pending" for r in outcome.results)
+        self._set("sweep-point", f"{outcome.status}: {finished}/{len(outcome.results)} points in "
+                                 f"{format_duration(outcome.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
+        return f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points"
+
+    def show_crash(self, error: str) -> None:
+        self._set("run-error", f"[red]run failed: {error}[/red]")
