@@ -151,7 +151,6 @@ Extent = Literal["one", "length", "area", "mdr length"]
 """The size X in f = F / (k h X): nothing (one), the line's length L = N dx, the
 surface's apparent area A, or a surface's MDR length 2 sqrt(A / pi)."""
 
-LOAD_UNITS: dict[str, str] = {"force": "modulus x length^2", "force per unit depth": "modulus x length"}
 _LOAD_SYMBOLS = {"force": "F", "force per unit depth": "F'"}
 _EXTENT_SYMBOLS = {"one": "", "length": " L", "area": " A", "mdr length": " L"}
 _EXTENT_DEFINITIONS = {
@@ -161,6 +160,7 @@ _EXTENT_DEFINITIONS = {
     "mdr length": "L = 2 sqrt(A / pi), A the surface's apparent area",
 }
 _EXTENT_DIMENSIONS = {"one": (1, 2), "length": (1,), "area": (2,), "mdr length": (2,)}
+_EXTENT_POWERS = {"one": 0, "length": 1, "area": 2, "mdr length": 1}  # X ~ length^power
 
 
 @dataclass(frozen=True)
@@ -170,10 +170,11 @@ class ForceNormalisation:
     ``"E*"``), h the spectrum's ``rms_height()``, X the profile's ``extent``.
 
     A quantity so formed does not change when the unit of length or of force
-    changes (every length x s, every modulus x m, a force x m s^2, a force per
-    unit depth x m s), provided ``stiffness()`` is a modulus of the right unit:
-    a stress (E*, or a foundation modulus per unit length of a line) when the
-    extent is a length or one, a stress per length when it is an area.
+    changes (every length x s, every modulus x m, the load as k h X: a force x m s^2
+    against a stress), provided ``stiffness()`` is a modulus of the right unit: a
+    stress (E*, or a foundation modulus per unit length of a line) when the extent
+    is a length or one, a stress per length when it is an area. So the extent fixes
+    the load: a force per unit depth over k h (extent one), a force otherwise.
     """
 
     load: LoadMeaning
@@ -181,10 +182,16 @@ class ForceNormalisation:
     extent: Extent
 
     def __post_init__(self):
-        if self.load not in LOAD_UNITS:
-            raise ValueError(f"load must be one of {', '.join(LOAD_UNITS)}. Got {self.load!r} instead.")
+        if self.load not in _LOAD_SYMBOLS:
+            raise ValueError(f"load must be one of {', '.join(_LOAD_SYMBOLS)}. Got {self.load!r} instead.")
         if self.extent not in _EXTENT_SYMBOLS:
             raise ValueError(f"extent must be one of {', '.join(_EXTENT_SYMBOLS)}. Got {self.extent!r} instead.")
+        expected = "force per unit depth" if self.extent == "one" else "force"
+        if self.load != expected:
+            raise ValueError(
+                f"a load over k h{_EXTENT_SYMBOLS[self.extent]} is a {expected} (k a modulus of the right unit), "
+                f"not a {self.load}: f would not be dimensionless"
+            )
         if not (isinstance(self.modulus, str) and self.modulus.strip()):
             raise ValueError(f"modulus must name the stiffness, e.g. 'E*'. Got {self.modulus!r} instead.")
 
@@ -195,8 +202,10 @@ class ForceNormalisation:
 
     @property
     def load_unit(self) -> str:
-        """The unit of the load in the units of the preset: ``modulus x length^2`` for a force."""
-        return LOAD_UNITS[self.load]
+        """The unit of the load in the units of the preset, that of k h X: ``modulus x length^2``
+        for a force against a stress (``modulus x length^3`` against a modulus per area)."""
+        power = 1 + _EXTENT_POWERS[self.extent]
+        return "modulus x length" + (f"^{power}" if power > 1 else "")
 
     @property
     def formula(self) -> str:

@@ -132,6 +132,12 @@ def declaration_problems(cls) -> list[str]:
         if unknown:
             problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
 
+    base = next(base for base in KINDS.values() if issubclass(cls, base))
+    if (cls.kind, cls.register_hook) != (base.kind, base.register_hook):
+        problems.append(
+            f"kind and register_hook are {base.__name__}'s ({base.kind!r}, {base.register_hook!r}), "
+            "not a plugin's to change"
+        )
     if issubclass(cls, SpectrumGenerator):
         if cls.dimension not in (1, 2):
             problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
@@ -159,6 +165,8 @@ def declaration_problems(cls) -> list[str]:
                     normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
                 except ValueError as exc:
                     problems.append(f"normalisations[{dimension}]: {exc}")
+        if not isinstance(cls.approximation, bool):
+            problems.append(f"approximation must be True or False. Got {cls.approximation!r} instead.")
         if not (isinstance(cls.problem, str) and cls.problem.strip()):
             problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
         for attr, value, allowed in (

@@ -1,0 +1,92 @@
+"""What every check shares: failing with a message that names the plugin class,
+calling plugin code so that its exceptions become such failures, and checking
+arrays and numbers. numpy is imported only when a check runs."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+
+def label(cls) -> str:
+    from frictionlab.plugin import Plugin
+
+    if not isinstance(cls, type):
+        return repr(cls)
+    name = cls.name if issubclass(cls, Plugin) else None
+    return f"{cls.__module__}.{cls.__qualname__}" + (f" ({name!r})" if name else "")
+
+
+def fail(cls, message: str, cause: BaseException | None = None):
+    error = AssertionError(f"{label(cls)}: {message}")
+    if cause is not None:
+        raise error from cause
+    raise error
+
+
+def call(cls, what: str, fn: Callable[..., Any], *args, **kwargs):
+    """Run plugin code; any exception becomes an AssertionError naming the call."""
+    try:
+        return fn(*args, **kwargs)
+    except AssertionError:
+        raise
+    except Exception as exc:
+        fail(cls, f"{what} raised {type(exc).__name__}: {exc}", exc)
+
+
+def instantiate(cls, params: Mapping[str, Any]):
+    return call(
+        cls,
+        f"{cls.__qualname__}(**{dict(params)!r}) (give the check the parameters it needs)",
+        cls,
+        **params,
+    )
+
+
+def check_array(cls, what: str, value, shape=None, floating=True):
+    import numpy as np
+
+    if not isinstance(value, np.ndarray):
+        fail(cls, f"{what} must be a numpy array. Got {type(value).__name__} instead.")
+    if shape is not None and value.shape != tuple(shape):
+        fail(cls, f"{what} must have shape {tuple(shape)}. Got {value.shape} instead.")
+    if floating and not np.issubdtype(value.dtype, np.floating):
+        fail(cls, f"{what} must be floating point. Got dtype {value.dtype} instead.")
+    if not np.issubdtype(value.dtype, np.number):
+        fail(cls, f"{what} must be numeric. Got dtype {value.dtype} instead.")
+    if not np.all(np.isfinite(value)):
+        bad = int(np.size(value) - np.count_nonzero(np.isfinite(value)))
+        fail(cls, f"{what} must be finite. Got {bad} non-finite value(s).")
+    return value
+
+
+def check_positive_number(cls, what: str, value) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        fail(cls, f"{what} must be a number. Got {value!r} instead.")
+    if not math.isfinite(number) or number <= 0:
+        fail(cls, f"{what} must be finite and > 0. Got {number!r} instead.")
+    return number
+
+
+def is_not_implemented(cls, what: str, fn, *args):
+    """Call an optional method: (True, None) if it raises NotImplementedError."""
+    try:
+        return False, fn(*args)
+    except NotImplementedError:
+        return True, None
+    except Exception as exc:
+        fail(cls, f"{what} raised {type(exc).__name__}: {exc}", exc)
+
+
+def must_refuse(cls, what: str, call: Callable[[], Any]) -> None:
+    """A ``periodic_only`` plugin must refuse ``what`` with a ValueError."""
+    try:
+        call()
+    except ValueError:
+        return
+    except Exception as exc:
+        fail(cls, f"periodic_only: {what} must raise ValueError. Got {type(exc).__name__}: {exc}", exc)
+    fail(cls, f"periodic_only is True, but {what} was accepted; it must raise ValueError")

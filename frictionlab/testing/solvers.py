@@ -1,0 +1,210 @@
+"""The check of a contact solver."""
+
+from __future__ import annotations
+
+from .common import call, check_array, check_positive_number, fail, instantiate, must_refuse
+
+
+def _test_line(points: int = 64, seed: int = 20240613):
+    """A smooth random periodic line with rms 1 and its forward-difference slopes."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    k = np.arange(points // 2 + 1)
+    amplitude = np.zeros(k.size)
+    amplitude[1:-1] = k[1:-1] ** -1.5
+    spectrum = amplitude * np.exp(2j * np.pi * rng.random(k.size))
+    heights = np.fft.irfft(spectrum, n=points)
+    heights = (heights - heights.mean()) / heights.std()
+    spacing = 1.0
+    slopes = (np.roll(heights, -1) - heights) / spacing
+    return heights, spacing, slopes
+
+
+def _test_surface(points: int = 16, seed: int = 20240613):
+    """A smooth random periodic surface with rms 1 and its forward-difference gradient magnitude."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    k = np.hypot(*np.meshgrid(np.fft.fftfreq(points, 1 / points), np.arange(points // 2 + 1), indexing="ij"))
+    amplitude = np.where(k > 0, k, np.inf) ** -2.0
+    heights = np.fft.irfft2(amplitude * np.exp(2j * np.pi * rng.random(k.shape)), s=(points, points))
+    heights = (heights - heights.mean()) / heights.std()
+    spacing = 1.0
+    slopes = np.hypot(np.roll(heights, -1, axis=0) - heights, np.roll(heights, -1, axis=1) - heights) / spacing
+    return heights, spacing, slopes
+
+
+def check_solver(cls, **params) -> None:
+    """``cls(**params).solve(profile, loads, control, slopes)``, for each of the
+    solver's ``dimensions``, on a small smooth random periodic line (64 points)
+    with forward-difference slopes, or a 16 x 16 surface with forward-difference
+    gradient magnitudes, under force
+    control (forces F = f k h L, L = ``Profile.length``, f from 0.005 to 1, k = ``stiffness()``) and
+    under indentation control (2.5 % to 95 % of max z - mean z, the approach at
+    which a periodic elastic half-space reaches full contact): it returns a ``ContactCurve``
+    whose arrays all have the shape of ``loads`` and are finite; the controlled
+    quantity is reported back (``force`` resp. ``indentation`` equal to the
+    loads within 1 %); force and indentation do not decrease with load; contact
+    counts are whole numbers, do not decrease with load, and lie in 1 .. N;
+    ``contact_fraction == contact_count / N``; ``slope_rms_contact`` is >= 0 and
+    no larger than the largest |slope|; every ``extras`` array has one entry per
+    load; the inputs are not modified; the same input gives the same output.
+    ``stiffness()`` is finite and > 0. The declarations: the forces come from
+    ``frictionlab.force_unit``, so ``normalisations`` must cover the profile;
+    f is dimensionless as declared: every length x 1000 with each load scaled as
+    its declared unit k h X scales (k fixed: a force x 1000^2 against a stress, a
+    force per unit depth x 1000, an indentation x 1000), and the spacing alone x 10
+    at equal f, leave the contact counts and the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
+    of f; ``tolerance()`` is None exactly when ``tolerance_param`` is; a
+    ``periodic_only`` solver raises ValueError on a non-periodic profile, any
+    other solves it. (Registration itself checks that every declaration is
+    well formed: ``registry.declaration_problems``.)
+    """
+    solver = instantiate(cls, params)
+    check_positive_number(cls, "stiffness()", call(cls, "stiffness()", solver.stiffness))
+    for dimension in cls.dimensions:
+        heights, spacing, slopes = _test_line() if dimension == 1 else _test_surface()
+        _check_solves(cls, solver, heights, spacing, slopes)
+
+
+def _check_solves(cls, solver, heights, spacing, slopes) -> None:
+    """Everything ``check_solver`` says, on one profile."""
+    import numpy as np
+
+    from frictionlab.plugin import ContactCurve, Profile, force_unit
+
+    n = heights.size
+    shape = "line" if heights.ndim == 1 else "surface"
+    h = float(heights.std())
+    unit = call(cls, "force_unit() (from normalisations)", force_unit, solver, h, Profile(heights, spacing))
+    cases = {
+        "force": np.array([0.005, 0.02, 0.1, 0.4, 1.0]) * unit,
+        # below max z - mean z: past it an elastic half-space would need an infinite force
+        "indentation": np.array([0.025, 0.1, 0.25, 0.5, 0.95]) * float(heights.max() - heights.mean()),
+    }
+    names = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
+
+    for control, loads in cases.items():
+        where = f"solve(..., control={control!r}) on a {shape}"
+
+        def run():
+            profile = Profile(heights=heights.copy(), spacing=spacing)
+            args = (profile, loads.copy(), control, slopes.copy())
+            curve = call(cls, where, solver.solve, *args)
+            if not (
+                np.array_equal(args[0].heights, heights)
+                and np.array_equal(args[1], loads)
+                and np.array_equal(args[3], slopes)
+            ):
+                fail(cls, f"{where} modified its inputs")
+            return curve
+
+        curve = run()
+        if not isinstance(curve, ContactCurve):
+            fail(cls, f"{where} must return a frictionlab.ContactCurve. Got {type(curve).__name__} instead.")
+        arrays = {}
+        for name in names:
+            value = getattr(curve, name)
+            floating = name != "contact_count"
+            arrays[name] = check_array(cls, f"{where}.{name}", np.asarray(value), loads.shape, floating)
+        for name, value in curve.extras.items():
+            if np.shape(value)[:1] != loads.shape:
+                fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")
+
+        reported = arrays[control]
+        if not np.allclose(reported, loads, rtol=1e-2, atol=0):
+            fail(cls, f"{where}.{control} must report the loads asked for: {loads!r}. Got {reported!r} instead.")
+        for name in ("force", "indentation", "contact_count"):
+            if np.any(np.diff(arrays[name]) < 0):
+                fail(cls, f"{where}.{name} must not decrease as the load grows. Got {arrays[name]!r}.")
+        count = arrays["contact_count"]
+        if not np.array_equal(count, np.round(count)):
+            fail(cls, f"{where}.contact_count must hold whole numbers. Got {count!r}.")
+        if np.any(count < 1) or np.any(count > n):
+            fail(cls, f"{where}.contact_count must lie in 1 .. {n} (points of the {shape}). Got {count!r}.")
+        if not np.allclose(arrays["contact_fraction"], count / n, rtol=1e-12, atol=1e-12):
+            fail(
+                cls,
+                f"{where}.contact_fraction must equal contact_count / N = {count / n!r}. "
+                f"Got {arrays['contact_fraction']!r} instead.",
+            )
+        rms = arrays["slope_rms_contact"]
+        if np.any(rms < 0) or np.any(rms > np.abs(slopes).max() * (1 + 1e-12)):
+            fail(
+                cls,
+                f"{where}.slope_rms_contact must lie in [0, max |slope| = {np.abs(slopes).max():.6g}]. "
+                f"Got {rms!r}.",
+            )
+
+        again = run()
+        for name in names:
+            if not np.array_equal(np.asarray(getattr(again, name)), arrays[name]):
+                fail(cls, f"{where} is not repeatable: {name} differs between two identical calls")
+    _check_solver_declarations(cls, solver, heights, spacing, slopes, cases["force"])
+    _check_solver_units(cls, solver, heights, spacing, slopes)
+
+
+def _solve(cls, solver, heights, spacing, slopes, loads, control="force", periodic=True):
+    from frictionlab.plugin import Profile
+
+    where = f"solve(..., control={control!r}) on a profile of spacing {spacing:g}" + ("" if periodic else ", not periodic")
+    return call(cls, where, solver.solve, Profile(heights.copy(), spacing, periodic), loads.copy(), control, slopes.copy())
+
+
+def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) -> None:
+    """mean_displacement(), tolerance(), and periodic_only against a non-periodic profile."""
+    import numpy as np
+
+    f = np.array([0.01, 0.1])
+    shift = np.asarray(call(cls, "mean_displacement(f, h)", solver.mean_displacement, f, 1.0))
+    if shift.shape != f.shape or not np.all(np.isfinite(shift)):
+        fail(cls, f"mean_displacement(f, h) must return a finite array of the shape of f. Got {shift!r}.")
+    tolerance = call(cls, "tolerance()", solver.tolerance)
+    if (tolerance is None) != (cls.tolerance_param is None):
+        fail(cls, f"tolerance() must be None exactly when tolerance_param is None. Got {tolerance!r}.")
+    if tolerance is not None:
+        check_positive_number(cls, "tolerance()", tolerance)
+    if cls.periodic_only:
+        from frictionlab.plugin import Profile
+
+        profile = Profile(heights.copy(), spacing, periodic=False)
+        must_refuse(cls, "a non-periodic profile", lambda: solver.solve(profile, forces.copy(), "force", slopes.copy()))
+    else:
+        _solve(cls, solver, heights, spacing, slopes, forces, periodic=False)
+
+
+def _check_solver_units(cls, solver, heights, spacing, slopes) -> None:
+    """f is dimensionless as declared: every length x 1000 with each load scaled as its
+    declared unit k h X scales (the moduli are the solver's own, only lengths change: a
+    force x 1000^2 against a stress E*, x 1000^3 against a foundation modulus per area; a
+    force per unit depth x 1000; an indentation x 1000), and the spacing alone x 10 at equal
+    f, leave the contact counts and the rms slope in contact as they were."""
+    import numpy as np
+
+    from frictionlab.plugin import Profile, force_unit
+
+    h = float(heights.std())
+    f = np.array([0.01, 0.05, 0.2])
+    base = _solve(cls, solver, heights, spacing, slopes, f * force_unit(solver, h, Profile(heights, spacing)))
+    s = 1000.0
+    normalisation = solver.normalisation(heights.ndim)
+    scaled = _solve(cls, solver, heights * s, spacing * s, slopes, f * force_unit(solver, h * s, Profile(heights * s, spacing * s)))
+    refined = _solve(cls, solver, heights, spacing * 10, slopes / 10,
+                     f * force_unit(solver, h, Profile(heights, spacing * 10)))  # fmt: skip
+
+    def compare(what, other, slope_factor=1.0):
+        counts, expected = np.asarray(other.contact_count), np.asarray(base.contact_count)
+        slope = np.asarray(other.slope_rms_contact) * slope_factor
+        if not np.array_equal(counts, expected) or not np.allclose(slope, base.slope_rms_contact, rtol=1e-6, atol=0):
+            fail(
+                cls,
+                f"f = {normalisation.formula} is not dimensionless as declared ({normalisation.definition}): with "
+                f"{what} the contact counts went from {expected.tolist()} to {counts.tolist()}, the rms slope in "
+                f"contact from {np.asarray(base.slope_rms_contact).tolist()} to {slope.tolist()}",
+            )
+
+    compare(f"every length x {s:g}, each load by its unit ({normalisation.load})", scaled)
+    compare("only the spacing x 10 at equal f", refined, 10.0)
+    depth = _solve(cls, solver, heights * s, spacing * s, slopes, np.asarray(base.indentation) * s, "indentation")
+    compare(f"every length x {s:g} under indentation control", depth)

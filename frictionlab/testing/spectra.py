@@ -1,0 +1,137 @@
+"""The check of a spectrum generator."""
+
+from __future__ import annotations
+
+import math
+
+from .common import call, check_array, check_positive_number, fail, instantiate, is_not_implemented
+
+
+def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
+    """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
+    floating-point heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
+    identical heights; a different seed gives different heights (pass
+    ``deterministic=True`` for a generator that ignores randomness by design,
+    e.g. one that reads a measured profile); ``rms_height()`` is finite and
+    > 0 and agrees within a factor of 3 with the rms (about the mean) of the
+    generated lines, pooled over 8 seeds. If ``psd`` is implemented it is
+    vectorised (array in, array of the same shape out), finite and >= 0; if
+    ``rms_slope`` is implemented it is finite and > 0. The declarations:
+    ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes;
+    ``points_param``, if not None, names the field whose value is the points (per
+    side) that ``generate()`` makes;
+    ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
+    None, gives 2 N points (per side) over the same length; ``equivalent_line()``
+    is None or, for a surface, a spectrum of lines 2 sqrt(A / pi) long with the
+    surface's rms height, itself checked; ``c0()`` is NotImplementedError or
+    finite > 0; ``hurst_exponent()`` is None or finite >= 0.
+    """
+    import numpy as np
+
+    from frictionlab.plugin import Profile
+
+    gen = instantiate(cls, params)
+
+    def generate(seed: int):
+        profile = call(cls, f"generate(default_rng({seed}))", gen.generate, np.random.default_rng(seed))
+        if not isinstance(profile, Profile):
+            fail(cls, f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead.")
+        heights = check_array(cls, "Profile.heights", profile.heights)
+        dimension = cls.dimension
+        if heights.ndim != dimension:
+            fail(cls, f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {heights.shape} instead.")
+        if heights.size < 2:
+            fail(cls, f"Profile.heights must have at least 2 points. Got {heights.size}.")
+        check_positive_number(cls, "Profile.spacing", profile.spacing)
+        return profile
+
+    first = generate(1234)
+    second = generate(1234)
+    if first.heights.shape != second.heights.shape or not np.array_equal(first.heights, second.heights):
+        fail(cls, "the same seed gave different heights; draw all randomness from the rng argument")
+    if first.spacing != second.spacing:
+        fail(cls, "the same seed gave different spacings")
+    other = generate(4321)
+    if not deterministic and other.heights.shape == first.heights.shape:
+        if np.array_equal(other.heights, first.heights):
+            fail(
+                cls,
+                "different seeds gave identical heights; use the rng argument "
+                "(or pass deterministic=True if the generator is deterministic by design)",
+            )
+
+    h = check_positive_number(cls, "rms_height()", call(cls, "rms_height()", gen.rms_height))
+    variances = [np.var(first.heights), np.var(other.heights)]
+    variances += [np.var(generate(seed).heights) for seed in range(6)]
+    measured = float(np.sqrt(np.mean(variances)))
+    if not (h / 3 <= measured <= 3 * h):
+        fail(
+            cls,
+            f"rms_height() = {h:.6g} but the generated lines have rms {measured:.6g} "
+            "(pooled over 8 seeds); they should agree within a factor of 3",
+        )
+
+    q = 2 * np.pi / (first.heights.size * first.spacing) * np.array([1.0, 2.0, 4.0, 8.0])
+    missing, psd = is_not_implemented(cls, "psd(q)", gen.psd, q)
+    if not missing:
+        psd = np.asarray(psd)
+        check_array(cls, "psd(q) for q of shape (4,)", psd, shape=q.shape)
+        if np.any(psd < 0):
+            fail(cls, f"psd(q) must be >= 0. Got {psd!r}.")
+    missing, slope = is_not_implemented(cls, "rms_slope()", gen.rms_slope)
+    if not missing:
+        check_positive_number(cls, "rms_slope()", slope)
+    _check_spectrum_declarations(cls, gen, first, params, deterministic)
+
+
+def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
+    """periodic(), points_param, grid_shape(), refined(), equivalent_line(), c0(), hurst_exponent()."""
+    import numpy as np
+
+    from frictionlab.plugin import SpectrumGenerator, mdr_length
+
+    periodic = call(cls, "periodic()", gen.periodic)
+    if not isinstance(periodic, bool) or profile.periodic is not periodic:
+        fail(cls, f"periodic() must be True or False and equal Profile.periodic of what generate() makes "
+                   f"({profile.periodic!r}). Got {periodic!r} instead.")  # fmt: skip
+    if cls.points_param is not None:
+        points = gen.params.model_dump()[cls.points_param]
+        if points != profile.heights.shape[-1]:
+            fail(cls, f"points_param names {cls.points_param!r} = {points!r}, but generate() makes "
+                      f"{profile.heights.shape[-1]} points (per side)")  # fmt: skip
+    shape = call(cls, "grid_shape()", gen.grid_shape)
+    if shape is not None and tuple(shape) != profile.heights.shape:
+        fail(cls, f"grid_shape() must be None or the shape generate() makes, {profile.heights.shape}. Got {shape!r}.")
+
+    finer_points = 2 * profile.heights.shape[-1]
+    changes = call(cls, f"refined({finer_points})", gen.refined, finer_points)
+    if changes is not None:
+        finer = instantiate(cls, {**params, **changes})
+        made = call(cls, f"generate() with refined({finer_points})", finer.generate, np.random.default_rng(1))
+        extent = profile.heights.shape[-1] * profile.spacing
+        if made.heights.shape[-1] != finer_points or not math.isclose(
+            made.heights.shape[-1] * made.spacing, extent, rel_tol=1e-9
+        ):
+            fail(cls, f"refined({finer_points}) must give {finer_points} points (per side) over the same length "
+                       f"{extent:g}. Got shape {made.heights.shape}, spacing {made.spacing!r}.")  # fmt: skip
+
+    line = call(cls, "equivalent_line()", gen.equivalent_line)
+    if line is not None:
+        if cls.dimension != 2 or not isinstance(line, SpectrumGenerator) or line.dimension != 1:
+            fail(cls, "equivalent_line() must be None, or (for a surface) a SpectrumGenerator of lines. "
+                       f"Got {line!r} instead.")  # fmt: skip
+        made = call(cls, "equivalent_line().generate()", line.generate, np.random.default_rng(3))
+        length, wanted = made.heights.size * made.spacing, mdr_length(profile.area)
+        if not math.isclose(length, wanted, rel_tol=1e-9):
+            fail(cls, f"the MDR-equivalent line must be 2 sqrt(A / pi) = {wanted:.9g} long. Got {length:.9g}.")
+        line_h, h = call(cls, "equivalent_line().rms_height()", line.rms_height), gen.rms_height()
+        if not math.isclose(line_h, h, rel_tol=1e-9):
+            fail(cls, f"the MDR-equivalent line must have the surface's rms height {h:.9g}. Got {line_h:.9g}.")
+        check_spectrum(type(line), **line.params.model_dump())
+
+    missing, c0 = is_not_implemented(cls, "c0()", gen.c0)
+    if not missing:
+        check_positive_number(cls, "c0()", c0)
+    hurst = call(cls, "hurst_exponent()", gen.hurst_exponent)
+    if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
+        fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")
