@@ -58,11 +58,12 @@ class Plugin:
     validates keyword arguments through ``Params``.
     """
 
-    name: ClassVar[str] = ""
-    summary: ClassVar[str] = ""
-    references: ClassVar[tuple[str, ...]] = ()
+    name: ClassVar[str] = ""  # kebab-case, the plugin's key in a preset
+    summary: ClassVar[str] = ""  # one line
+    references: ClassVar[tuple[str, ...]] = ()  # DOIs
     Params: ClassVar[type[PluginParams]] = PluginParams
-    kind: ClassVar[str] = ""
+    kind: ClassVar[str] = ""  # set by the kind's base class, never by a plugin
+    params: PluginParams  # the validated parameters, the only state the constructor keeps
 
     def __init__(self, params: PluginParams | None = None, **kwargs):
         if params is not None and kwargs:
@@ -429,6 +430,14 @@ class ContactSolver(Plugin):
         if self.tolerance_param is None:
             return None
         return float(self.params.model_dump()[self.tolerance_param])
+
+
+def contract(kind: str) -> frozenset[str]:
+    """Every name the framework may use of a plugin of ``kind``: the public attributes and
+    methods of its base class (and of ``Plugin``), declared above; nothing else."""
+    base = KINDS[kind]
+    annotated = {name for cls in base.__mro__ for name in cls.__dict__.get("__annotations__", {})}
+    return frozenset(name for name in {*dir(base), *annotated} if not name.startswith("_"))
 
 
 KINDS: dict[str, type[Plugin]] = {  # by the name of each kind's section in a preset

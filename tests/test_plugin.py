@@ -32,3 +32,88 @@ def test_a_rejected_edit_leaves_the_old_value():
     assert params.hurst == 0.8
     params.short_cutoff = 20.0
     assert params.short_cutoff == 20.0
+
+
+# ------------------------------------------------------------------ the contract, all of it
+
+
+def test_the_conformance_kit_covers_every_declared_item():
+    """Whatever a kind's base class declares (``plugin.contract``), its check says how it is
+    checked: a new declaration without a check fails here."""
+    import re
+
+    from frictionlab import testing
+    from frictionlab.plugin import KINDS, contract
+
+    checks = {"spectrum": testing.check_spectrum, "solver": testing.check_solver, "slope": testing.check_slope_estimator}
+    assert set(checks) == set(KINDS)
+    for kind, check in checks.items():
+        documented = testing.check_plugin_class.__doc__ + check.__doc__
+        missing = [name for name in sorted(contract(kind)) if not re.search(rf"\b{re.escape(name)}\b", documented)]
+        assert not missing, f"the {kind} check does not say how it checks {missing}"
+
+
+def _strict(cls):
+    """``cls`` under another name, whose instances refuse the framework (any module of the
+    ``frictionlab`` package) every attribute its contract does not declare."""
+    import sys
+
+    from frictionlab.plugin import contract
+
+    allowed = contract(cls.kind)
+
+    def __getattribute__(self, name):
+        if not name.startswith("__") and name not in allowed:
+            caller = sys._getframe(1).f_globals.get("__name__", "")
+            if caller == "frictionlab" or caller.startswith("frictionlab."):
+                raise AssertionError(f"{caller} read {name!r} of a {cls.kind} plugin: not in its contract")
+        return object.__getattribute__(self, name)
+
+    return type(cls.__name__, (cls,), {"name": f"strict-{cls.name}", "__getattribute__": __getattribute__})
+
+
+def test_the_framework_uses_nothing_of_a_plugin_beyond_the_contract(tmp_path, register_plugin, monkeypatch):
+    """Runs, sweeps, result files, the memory check and its advice, and the trade-off study,
+    on plugins that refuse the framework anything undeclared."""
+    import math
+
+    from frictionlab import memory
+    from frictionlab.errors import RunError
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import build_scene
+    from frictionlab.runner import run_to_folder
+    from frictionlab.sweep import plan_sweep, run_sweep
+    from frictionlab.tradeoff.axes import Study
+    from frictionlab.tradeoff.options import StudyOptions
+    from frictionlab.tradeoff.scenes import SceneFactory
+    from frictionlab_slopes import ForwardDifference
+    from frictionlab_solvers import BEMHalfSpace, WinklerSprings
+    from frictionlab_spectra import PowerLawSurface
+
+    for plugin in (PowerLaw, PowerLawSurface, MDRSprings, WinklerSprings, BEMHalfSpace, ForwardDifference):
+        registry = register_plugin(_strict(plugin))
+    line = {
+        "name": "strict", "seed": 3, "realizations": 3, "fit": {"bootstrap": 20},
+        "spectrum": {"name": "strict-power-law", "params": {"hurst": 0.8, "points": 256, "rms_height": 1.0}},
+        "solver": {"name": "strict-mdr"}, "slope": {"name": "strict-forward-difference"},
+        "loading": {"start": 0.5, "stop": 5.0, "steps": 5, "spacing": "log"},
+    }  # fmt: skip
+    surface = {**line, "spectrum": {"name": "strict-power-law-2d", "params": {"hurst": 0.8, "points": 16}}}
+    one = RunOptions(workers=1)
+    for data, solver in ((line, "strict-mdr"), (surface, "strict-mdr"), (surface, "strict-winkler"),
+                         (surface, "strict-bem-halfspace")):  # fmt: skip
+        scene = build_scene({**data, "solver": {"name": solver}}, registry=registry)
+        outcome, _ = run_to_folder(scene, tmp_path / f"{solver}-{scene.geometry}", one)
+        assert outcome.status == "completed" and not outcome.failures, outcome.failures
+    sweep = plan_sweep({**line, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}, registry=registry)
+    assert run_sweep(sweep, tmp_path / "sweep", one).status == "completed"
+    monkeypatch.setattr(memory, "available_memory", lambda: (200 * 2**20, "a test"))
+    with pytest.raises(RunError, match="spectrum.params.points <= "):  # the advice names points_param
+        memory.check_fits(build_scene({**line, "realizations": 1, "spectrum": {**line["spectrum"], "params": {
+            "hurst": 0.8, "points": 10_000_000}}}, registry=registry), workers=1, executor="serial")  # fmt: skip
+    study = Study(SceneFactory(surface, registry, "strict"), StudyOptions(
+        axes=("grid", "solver", "tolerance"), grid_factors=(0.5, 1.0), grid_realizations=2, compare_realizations=2,
+        compare_steps=3, compare_points_surface=16, tolerances=(1e-3, 1e-6), reference="strict-bem-halfspace"))  # fmt: skip
+    rows = study.run()
+    assert {row.axis for row in rows} == {"grid", "solver", "tolerance"}
+    assert all(math.isfinite(row.b) for row in rows)

@@ -69,7 +69,14 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
     ``"slope"``): ``frictionlab.registry.validate_plugin_class`` passes (right
     base class, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
-    forbidding unknown keys, every field described); ``references`` is a tuple
+    forbidding unknown keys, every field described, and every declaration well
+    formed: ``kind`` and ``register_hook`` are the base class's own; a spectrum's
+    ``dimension`` is 1 or 2 and its ``points_param`` names a field; the
+    ``dimensions`` of a solver or an estimator are 1 and/or 2 and ``periodic_only``
+    is a bool; a solver's ``normalisations`` give one ``normalisation`` per
+    dimension, ``problem`` names the physical problem, ``approximation`` is a bool,
+    ``contact_measure`` and ``indentation_reference`` take allowed values,
+    ``body_params`` and ``tolerance_param`` name fields); ``references`` is a tuple
     of strings; ``Params`` has a JSON Schema; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
     field has no default); an unknown key raises ``pydantic.ValidationError``

@@ -47,16 +47,17 @@ def check_solver(cls, **params) -> None:
     quantity is reported back (``force`` resp. ``indentation`` equal to the
     loads within 1 %); force and indentation do not decrease with load; contact
     counts are whole numbers, do not decrease with load, and lie in 1 .. N;
-    ``contact_fraction == contact_count / N``; ``slope_rms_contact`` is >= 0 and
+    ``contact_fraction == contact_count / N`` (the fraction of points, of the
+    real contact or of MDR springs as ``contact_measure`` says); ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
     ``stiffness()`` is finite and > 0. The declarations: the forces come from
-    ``frictionlab.force_unit``, so ``normalisations`` must cover the profile;
+    ``frictionlab.force_unit``, the solver's ``normalisation`` of the profile;
     f is dimensionless as declared: every length x 1000 with each load scaled as
     its declared unit k h X scales (k fixed: a force x 1000^2 against a stress, a
     force per unit depth x 1000, an indentation x 1000), and the spacing alone x 10
     at equal f, leave the contact counts and the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
-    of f; ``tolerance()`` is None exactly when ``tolerance_param`` is; a
+    of f, and is zero where the ``indentation_reference`` is the mean surface; ``tolerance()`` is None exactly when ``tolerance_param`` is; a
     ``periodic_only`` solver raises ValueError on a non-periodic profile, any
     other solves it. (Registration itself checks that every declaration is
     well formed: ``registry.declaration_problems``.)
@@ -160,6 +161,9 @@ def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) ->
     shift = np.asarray(call(cls, "mean_displacement(f, h)", solver.mean_displacement, f, 1.0))
     if shift.shape != f.shape or not np.all(np.isfinite(shift)):
         fail(cls, f"mean_displacement(f, h) must return a finite array of the shape of f. Got {shift!r}.")
+    if cls.indentation_reference == "mean surface" and np.any(shift != 0):
+        fail(cls, "indentation_reference is the mean surface, so mean_displacement(f, h) must be zero "
+                  f"(the indentation is already measured from it). Got {shift!r}.")  # fmt: skip
     tolerance = call(cls, "tolerance()", solver.tolerance)
     if (tolerance is None) != (cls.tolerance_param is None):
         fail(cls, f"tolerance() must be None exactly when tolerance_param is None. Got {tolerance!r}.")
