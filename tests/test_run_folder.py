@@ -100,7 +100,7 @@ def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(
     from frictionlab.paper.figures import FIGURES
 
     from .conftest import PRESETS
-    from .test_report import TINY
+    from .paper.test_reproduce import TINY
 
     presets = tmp_path / "presets"
     for fig in FIGURES:

@@ -11,17 +11,23 @@ import yaml
 
 from frictionlab import engine
 from frictionlab.cli import main
-from frictionlab.preset import apply_overrides, build_scene, load_preset_file
+from frictionlab.options import RunOptions
 from frictionlab.paper.calibration import COUNT_TARGETS, calibrated_rms_height
 from frictionlab.paper.figures import FIGURES, find_presets, run_figures
 from frictionlab.paper.markdown import fig5_calibrated_markdown, readings_markdown
 from frictionlab.paper.plots import plot_fig5_calibrated
-from frictionlab.paper.readings import Reading, average_curve, fig5_calibrated_readings, refit, run_readings
+from frictionlab.paper.readings import (
+    Reading,
+    average_curve,
+    fig5_calibrated_readings,
+    refit,
+    run_readings,
+)
 from frictionlab.paper.reproduce import write_report
+from frictionlab.preset import apply_overrides, build_scene, load_preset_file
 from frictionlab.runner import run_to_folder
-from frictionlab.options import RunOptions
 
-from .conftest import PRESETS, SMALL_PRESET
+from ..conftest import PRESETS, SMALL_PRESET
 
 TINY = ["realizations=6", "spectrum.params.points=1024", "spectrum.params.length=1024.0", "output.plot=false",
         "spectrum.params.rms_height=300.0", "loading.steps=12", "fit.bootstrap=40"]  # fmt: skip

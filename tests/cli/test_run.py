@@ -2,7 +2,6 @@
 
 import csv
 import json
-import os
 import signal
 import subprocess
 import sys
@@ -10,33 +9,13 @@ import time
 
 import numpy as np
 import pytest
-import yaml
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.files import atomic_write
 from frictionlab.results import column_name
 
-from .conftest import PRESETS, SMALL_PRESET, merge
-
-
-def write_preset(tmp_path, data, name="preset.yaml"):
-    path = tmp_path / name
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
-def run_cli(*args, env=None, **kwargs):
-    return subprocess.run(
-        [sys.executable, "-m", "frictionlab", *map(str, args)],
-        capture_output=True,
-        text=True,
-        env={**os.environ, **(env or {})},
-        **kwargs,
-    )
-
-
-RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.rundir; run.lock is gone once it ends)
+from ..conftest import SMALL_PRESET, merge
+from .conftest import RUN_DIRECTORY, run_cli, write_preset
 
 
 def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
@@ -168,64 +147,6 @@ def test_missing_required_and_file_errors(tmp_path, capsys):
     assert "must be a mapping" in capsys.readouterr().err
 
 
-def test_validate_reports_every_problem_at_once(tmp_path, capsys):
-    bad = merge(SMALL_PRESET, {"realizations": -3, "spectrum": {"params": {"hurst": -1}}, "solver": {"name": "nope"}})
-    assert main(["validate", str(write_preset(tmp_path, bad))]) == ExitCode.USAGE
-    err = capsys.readouterr().err
-    assert "3 problems in preset" in err
-    for fragment in ("realizations: must be >= 1", "spectrum.params.hurst: must be >= 0", "solver.name: no solver"):
-        assert fragment in err
-
-
-def test_bad_set_override_is_a_usage_error(tmp_path, capsys):
-    preset = write_preset(tmp_path, SMALL_PRESET)
-    assert main(["validate", str(preset), "--set", "spectrum.params.hurst"]) == ExitCode.USAGE
-    assert "must look like dotted.path=value" in capsys.readouterr().err
-    assert main(["validate", str(preset), "--set", "seed.x=1"]) == ExitCode.USAGE
-    assert "seed is a value, not a mapping" in capsys.readouterr().err
-
-
-def test_bad_command_line_is_a_usage_error_without_traceback():
-    result = run_cli("run")
-    assert result.returncode == ExitCode.USAGE
-    assert "usage:" in result.stderr and "Traceback" not in result.stderr
-    result = run_cli("run", PRESETS / "quickstart.yaml", "--workers", "0")
-    assert result.returncode == ExitCode.USAGE
-    assert "--workers must be >= 1. Got 0 instead." in result.stderr
-
-
-def test_schema_lists_installed_plugins_with_their_params(capsys):
-    assert main(["schema"]) == ExitCode.OK
-    schema = json.loads(capsys.readouterr().out)
-    spectra = {v["properties"]["name"]["const"]: v for v in schema["properties"]["spectrum"]["oneOf"]}
-    assert {"power-law", "rolloff", "profile-file"} <= set(spectra)
-    hurst = spectra["power-law"]["properties"]["params"]["properties"]["hurst"]
-    assert hurst["maximum"] == 1.5 and hurst["description"]
-    assert spectra["power-law"]["properties"]["params"]["additionalProperties"] is False
-
-
-def test_plugins_lists_kind_name_provider_and_version(capsys):
-    assert main(["plugins"]) == ExitCode.OK
-    out = capsys.readouterr().out
-    for kind, name in [("spectrum", "power-law"), ("solver", "mdr"), ("slope", "forward-difference")]:
-        line = next(line for line in out.splitlines() if line.split()[:2] == [kind, name])
-        assert "frictionlab" in line and "0." in line  # provider and its version
-    assert main(["plugins", "--json"]) == ExitCode.OK
-    rows = json.loads(capsys.readouterr().out)["plugins"]
-    assert {r["name"] for r in rows if r["kind"] == "slope"} >= {"forward-difference", "central-difference", "spectral"}
-
-
-def test_headless_run_never_imports_textual(tmp_path):
-    code = (
-        "import sys; from frictionlab.cli import main; "
-        f"rc = main(['run', {str(PRESETS / 'quickstart.yaml')!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet']); "
-        "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'textual', 'rich'}); "
-        "print(rc, bad)"
-    )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.stdout.strip().splitlines()[-1] == "0 []", result.stderr
-
-
 def test_ctrl_c_keeps_finished_realizations_and_exits_130(tmp_path):
     """A real SIGINT to a running pool run: the chunks already running finish, and
     everything finished is written."""
@@ -252,28 +173,6 @@ def test_ctrl_c_keeps_finished_realizations_and_exits_130(tmp_path):
     assert summary["realizations"]["failed"] == 0
     arrays = np.load(out / "realizations.npz")
     assert arrays["xi"].shape[0] == summary["realizations"]["done"]
-
-
-def test_atomic_write_gives_the_usual_permissions_not_mkstemps(tmp_path):
-    target = tmp_path / "out.txt"
-    atomic_write(target, lambda fh: fh.write("x"))
-    mask = os.umask(0)
-    os.umask(mask)
-    assert target.stat().st_mode & 0o777 == 0o666 & ~mask
-
-
-def test_atomic_write_leaves_the_old_file_when_writing_fails(tmp_path):
-    target = tmp_path / "summary.json"
-    target.write_text("old")
-
-    def explode(fh):
-        fh.write("half a fi")
-        raise RuntimeError("disk on fire")
-
-    with pytest.raises(RuntimeError):
-        atomic_write(target, explode)
-    assert target.read_text() == "old"
-    assert list(tmp_path.iterdir()) == [target]  # no temporary left behind
 
 
 def test_a_measured_profile_runs_end_to_end_with_its_own_rms_height(tmp_path, capsys):
@@ -315,11 +214,3 @@ def test_output_switches_leave_out_the_per_realization_file_and_the_plot(tmp_pat
     assert {p.name for p in (tmp_path / "o").iterdir()} == {"summary.json", "curve.csv", "preset.yaml", *RUN_DIRECTORY}
     files = json.loads((tmp_path / "o" / "summary.json").read_text())["files"]
     assert set(files) == {"curve", "preset"}
-
-
-def test_schema_out_writes_the_schema_to_a_file(tmp_path, capsys):
-    assert main(["schema", "--out", str(tmp_path / "schema.json")]) == ExitCode.OK
-    assert capsys.readouterr().out == ""
-    schema = json.loads((tmp_path / "schema.json").read_text())
-    assert schema["title"] == "frictionlab preset"
-    assert set(schema["required"]) == {"name", "realizations", "spectrum", "loading"}

@@ -1,75 +1,20 @@
-"""The trade-off study (``frictionlab study``): its axes, metrics, outputs and CLI.
+"""The axes of the trade-off study: measured rows, references, errors against known limits."""
 
-Tiny scenes throughout; ``mdr-bisection`` stands in for the exact reference where
-the machinery is tested (it solves the same springs as ``mdr`` by another route,
-so their agreement is a known answer), and ``bem-halfplane`` is used once it is
-installed.
-"""
 
-import csv
 import itertools
 import math
 
-import matplotlib.image
 import numpy as np
 import pytest
-import yaml
 from scipy.optimize import brentq
 
-from frictionlab.cli import main
-from frictionlab.errors import ExitCode, FrictionlabError
-from frictionlab.registry import Registry
+from frictionlab.errors import FrictionlabError
 from frictionlab.seeds import realization_rng
-from frictionlab.tradeoff import outputs as report
-from frictionlab.tradeoff.axes import COLUMNS, Study
-from frictionlab.tradeoff.metrics import curve_errors, interval_half_width, pareto_front
+from frictionlab.tradeoff.axes import Study
 from frictionlab.tradeoff.options import AXES, StudyOptions
 from frictionlab.tradeoff.scenes import SceneFactory
 
-# A small line whose preset gives `spacing` (not `length`): shrinking N shortens the
-# line, so keeping the f range needs the loads rescaled.
-TINY = {
-    "name": "tiny",
-    "seed": 11,
-    "realizations": 8,
-    "spectrum": {"name": "power-law", "params": {"hurst": 0.8, "points": 256, "spacing": 1.0, "rms_height": 2.0}},
-    "solver": {"name": "mdr", "params": {"youngs_modulus": 3.0, "poisson_ratio": 0.3}},
-    "loading": {"start": 1.0, "stop": 60.0, "steps": 12, "spacing": "log"},
-    "fit": {"bootstrap": 100},
-}
-
-TINY_OPTIONS = dict(
-    reference="mdr-bisection",
-    grid_factors=(0.5, 1, 2),
-    grid_realizations=4,
-    realizations_min=2,
-    step_levels=(3, 6),
-    compare_points=128,
-    compare_realizations=4,
-    compare_steps=8,
-    tolerances=(1e-2, 1e-9),
-)
-
-
-@pytest.fixture(scope="module")
-def builtins():
-    return Registry(discover=False)
-
-
-def study_of(data, registry, **options):
-    return Study(SceneFactory(data, registry, "test"), StudyOptions(**{**TINY_OPTIONS, **options}))
-
-
-@pytest.fixture(scope="module")
-def tiny_study(builtins):
-    study = study_of(TINY, builtins)
-    study.run()
-    return study
-
-
-def by_axis(study, axis):
-    return [r for r in study.rows if r.axis == axis]
-
+from .conftest import TINY, by_axis, study_of
 
 # ------------------------------------------------------------------ axes
 
@@ -173,140 +118,6 @@ def test_statistical_error_shrinks_like_one_over_sqrt_m(builtins):
         assert 2.0 < width[1] / width[-1] < 8.0  # 16x the lines: 4x narrower
 
 
-# ------------------------------------------------------------------ metrics
-
-
-def brute_force_front(cost, error):
-    n = len(cost)
-    front = []
-    for i in range(n):
-        dominated = any(
-            cost[j] <= cost[i] and error[j] <= error[i] and (cost[j] < cost[i] or error[j] < error[i])
-            for j in range(n)
-        )
-        front.append(not dominated)
-    return np.array(front)
-
-
-def test_pareto_front_matches_brute_force_with_ties():
-    rng = np.random.default_rng(5)
-    for _ in range(200):
-        n = int(rng.integers(1, 12))
-        cost = rng.integers(1, 6, n).astype(float)  # few distinct values: many ties and duplicates
-        error = rng.integers(1, 6, n).astype(float)
-        np.testing.assert_array_equal(pareto_front(cost, error), brute_force_front(cost, error))
-
-
-def test_pareto_front_of_a_hand_made_set():
-    cost = [1.0, 2.0, 3.0, 2.5, 0.5, np.nan, 4.0]
-    error = [0.5, 0.2, 0.1, 0.3, 0.9, 0.01, 0.1]
-    assert pareto_front(cost, error).tolist() == [True, True, True, False, True, False, False]
-
-
-def test_curve_errors_on_one_axis_and_across_axes():
-    x_ref = np.geomspace(1e-3, 1e-1, 9)
-    xi_ref = 1 + 0.1 * np.log(x_ref)
-    assert curve_errors(x_ref, xi_ref, x_ref, xi_ref) == (0.0, 0.0, 9)
-    # 10% above the reference, sampled on another, wider grid: linear in ln x, so interpolation is exact.
-    x = np.geomspace(5e-4, 0.2, 40)
-    rms, bias, n = curve_errors(x, 1.1 * (1 + 0.1 * np.log(x)), x_ref, xi_ref)
-    assert n == 9 and rms == pytest.approx(0.1, rel=1e-9) and bias == pytest.approx(0.1, rel=1e-9)
-    # Only part of the reference range covered: compared there only.
-    _, _, n = curve_errors(x_ref[:4], xi_ref[:4], x_ref, xi_ref)
-    assert n == 4
-    rms, bias, n = curve_errors([1.0, 2.0], [1.0, 1.0], x_ref, xi_ref)
-    assert n == 0 and math.isnan(rms) and math.isnan(bias)
-    assert interval_half_width((0.9, 1.3), 1.0) == pytest.approx(0.2)
-
-
-# ------------------------------------------------------------------ outputs
-
-
-def test_outputs_are_written_and_parse(tiny_study, tmp_path):
-    text = report.recommendation(tiny_study)
-    assert text.startswith("for 2% error in b at H = 0.8: mdr needs N = ")
-    files = report.write_outputs(tiny_study, tmp_path, text, command="frictionlab study x.yaml")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.csv", "study.md", "study.png"]
-    with open(files["csv"], newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    assert tuple(rows[0]) == COLUMNS and len(rows) == len(tiny_study.rows)
-    for parsed, row in zip(rows, tiny_study.rows):
-        assert parsed["axis"] == row.axis and float(parsed["seconds"]) == row.seconds
-        assert parsed["b_err"] == ("" if math.isnan(row.b_err) else repr(row.b_err))
-    markdown = files["md"].read_text()
-    for axis in AXES:
-        assert f"## {axis}\n\n| " in markdown
-    table_lines = [line for line in markdown.splitlines() if line.startswith("| ") and not line.startswith("| N ")]
-    assert sum(1 for line in table_lines if line[2].isdigit() or line.startswith("| **") or line[2:5] in ("mdr", "win")) >= len(tiny_study.rows)
-    assert text in markdown and "`frictionlab study x.yaml`" in markdown
-    image = matplotlib.image.imread(files["png"])
-    assert image.ndim == 3 and image.shape[0] > 100
-
-
-def test_a_failed_write_leaves_no_partial_file(tiny_study, tmp_path, monkeypatch):
-    def broken(study, fh):
-        fh.write(b"\x89PNG half")
-        raise RuntimeError("disk full")
-
-    monkeypatch.setattr(report, "plot", broken)
-    with pytest.raises(RuntimeError):
-        report.write_outputs(tiny_study, tmp_path, "text")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.csv"]  # written before; no png, no temp file
-
-
-# ------------------------------------------------------------------ CLI
-
-
-def write(tmp_path, data):
-    path = tmp_path / "preset.yaml"
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
-def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
-    preset = write(tmp_path, TINY)
-    out = tmp_path / "study"
-    code = main([
-        "study", str(preset), "--out", str(out), "--reference", "mdr-bisection", "--points", "128",
-        "--compare-realizations", "3", "--compare-steps", "5", "--grid-realizations", "3",
-        "--grid-factors", "1,2", "--tolerances", "1e-3,1e-9", "--axes", "grid,solver,tolerance",
-    ])
-    captured = capsys.readouterr()
-    assert code == ExitCode.OK, captured.err
-    assert captured.out.startswith("for 2% error in b at H = 0.8: mdr needs N = 256")
-    assert "study: grid" in captured.err and "study: solver" in captured.err
-    assert {p.name for p in out.iterdir()} == {"study.csv", "study.md", "study.png"}
-    assert "--reference mdr-bisection" in (out / "study.md").read_text()
-
-
-@pytest.mark.parametrize(
-    "args, message",
-    [
-        (["--reference", "bem-nowhere"], "--reference: no solver plugin named 'bem-nowhere'"),
-        (["--axes", "grid,speed"], "--axes must name some of grid, realizations, steps, solver, tolerance"),
-        (["--target", "2"], "--target must be > 0 and < 1"),
-        (["--tolerances", "1e-3,abc"], "--tolerances must be a comma-separated list of numbers"),
-        (["--grid-factors", "1,-2"], "--grid-factors values must be > 0. Got -2.0 instead."),
-        (["--points", "4"], "--points must be >= 8. Got 4 instead."),
-        (["--set", "spectrum.params.hurst=7"], "spectrum.params.hurst: must be <= 1.5"),
-    ],
-)
-def test_cli_usage_errors_name_the_option(tmp_path, capsys, args, message):
-    code = main(["study", str(write(tmp_path, TINY)), "--out", str(tmp_path / "o"), *args])
-    err = capsys.readouterr().err
-    assert code == ExitCode.USAGE
-    assert message in err and "Traceback" not in err
-    assert not (tmp_path / "o").exists()
-
-
-def test_cli_bad_preset_file(tmp_path, capsys):
-    (tmp_path / "bad.yaml").write_text("name: [unclosed\n")
-    assert main(["study", str(tmp_path / "bad.yaml")]) == ExitCode.USAGE
-    assert "not valid YAML" in capsys.readouterr().err
-    assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.INPUT_FILE
-    assert "no such preset file" in capsys.readouterr().err
-
-
 def test_a_reference_must_solve_the_same_problem_on_the_presets_geometry(builtins):
     with pytest.raises(FrictionlabError, match="--reference: bem-halfplane solves the elastic half-plane "
                                                r"\(plane strain\), but the preset's solver mdr the elastic half-space"):
@@ -355,4 +166,3 @@ def test_mdr_against_the_elastic_half_space_on_the_same_surfaces(builtins):
     tightest = next(r for r in tolerance if r.reference)
     assert tightest.tolerance == 1e-8 and tightest.xi_err_f == 0 and tightest.b_err == 0
     assert all(math.isfinite(r.xi_err_f) for r in tolerance)
-    assert any("every solver sees the same surfaces (mdr presses their MDR-equivalent lines)" in n for n in study.notes)

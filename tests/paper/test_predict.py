@@ -6,12 +6,17 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.cli import main
 from frictionlab import mdr_length
+from frictionlab.cli import main
 from frictionlab.fit import LogFit
-from frictionlab.paper.predict import bootstrap_pairs, dimensionless_force_3d, predict_xi, read_run_law
-from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
+from frictionlab.paper.predict import (
+    bootstrap_pairs,
+    dimensionless_force_3d,
+    predict_xi,
+    read_run_law,
+)
+from frictionlab.runner import run_to_folder
 
 
 def test_f_is_the_line_f_with_the_mdr_length():

@@ -1,0 +1,29 @@
+"""The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
+
+import subprocess
+import sys
+
+from frictionlab.errors import ExitCode
+
+from ..conftest import PRESETS
+from .conftest import run_cli
+
+
+def test_bad_command_line_is_a_usage_error_without_traceback():
+    result = run_cli("run")
+    assert result.returncode == ExitCode.USAGE
+    assert "usage:" in result.stderr and "Traceback" not in result.stderr
+    result = run_cli("run", PRESETS / "quickstart.yaml", "--workers", "0")
+    assert result.returncode == ExitCode.USAGE
+    assert "--workers must be >= 1. Got 0 instead." in result.stderr
+
+
+def test_headless_run_never_imports_textual(tmp_path):
+    code = (
+        "import sys; from frictionlab.cli import main; "
+        f"rc = main(['run', {str(PRESETS / 'quickstart.yaml')!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet']); "
+        "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'textual', 'rich'}); "
+        "print(rc, bad)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.strip().splitlines()[-1] == "0 []", result.stderr

@@ -1,0 +1,26 @@
+"""The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
+
+
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+
+from ..conftest import SMALL_PRESET, merge
+from .conftest import write_preset
+
+
+def test_validate_reports_every_problem_at_once(tmp_path, capsys):
+    bad = merge(SMALL_PRESET, {"realizations": -3, "spectrum": {"params": {"hurst": -1}}, "solver": {"name": "nope"}})
+    assert main(["validate", str(write_preset(tmp_path, bad))]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "3 problems in preset" in err
+    for fragment in ("realizations: must be >= 1", "spectrum.params.hurst: must be >= 0", "solver.name: no solver"):
+        assert fragment in err
+
+
+def test_bad_set_override_is_a_usage_error(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    assert main(["validate", str(preset), "--set", "spectrum.params.hurst"]) == ExitCode.USAGE
+    assert "must look like dotted.path=value" in capsys.readouterr().err
+    assert main(["validate", str(preset), "--set", "seed.x=1"]) == ExitCode.USAGE
+    assert "seed is a value, not a mapping" in capsys.readouterr().err

@@ -1,0 +1,96 @@
+"""The class check (what every kind shares) fails for classes broken in one way each."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pydantic import BaseModel, ConfigDict, Field
+
+from frictionlab import (
+    PluginParams,
+)
+from frictionlab import testing as fltesting
+from frictionlab.plugin import KINDS
+
+from .fakes import GoodSlopes, GoodSpectrum, spectrum_variant
+
+ROOT = Path(__file__).resolve().parents[2]
+
+KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
+
+
+# =========================================================================== fakes
+
+
+# --------------------------------------------------------- class-level failures
+
+
+class _NoAssignmentParams(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    points: int = Field(128, ge=8, description="number of grid points")
+
+
+class _UnenforcedParams(PluginParams):
+    points: int = Field(128, description="number of grid points", json_schema_extra={"minimum": 8})
+
+
+class _RequiredParams(PluginParams):
+    points: int = Field(ge=8, description="number of grid points")
+    spacing: float = Field(1.0, gt=0, description="grid spacing")
+
+
+class _NotStoring(GoodSpectrum):
+    name = "not-storing"
+
+    def __init__(self, params=None, **kwargs):
+        self.params = None
+
+
+CLASS_BREAKAGES = [
+    ("BadName", {"name": "Bad_Name"}, "name must be kebab-case"),
+    ("NoSummary", {"summary": " "}, "summary must be one non-empty line"),
+    ("LooseParams", {"Params": type("P", (BaseModel,), {"__annotations__": {"x": int}, "x": Field(1, description="x")})},
+     "must forbid unknown keys"),
+    ("Undescribed", {"Params": type("P", (PluginParams,), {"__annotations__": {"x": int}, "x": 1})}, "no description"),
+    ("StringReferences", {"references": "10.1000/xyz"}, "references must be a tuple of strings"),
+    ("NoAssignmentCheck", {"Params": _NoAssignmentParams}, "validate on assignment"),
+    ("UnenforcedBound", {"Params": _UnenforcedParams}, r"Params.points = 7 \(past its minimum 8\) was accepted"),
+    ("RequiredField", {"Params": _RequiredParams}, r"Params\(\*\*\{\}\) is invalid \(pass the required values"),
+]
+
+
+@pytest.mark.parametrize("qualname,attrs,match", CLASS_BREAKAGES, ids=[b[0] for b in CLASS_BREAKAGES])
+def test_class_check_fails_for_broken_classes(qualname, attrs, match):
+    cls = type(qualname, (GoodSpectrum,), dict(attrs))
+    with pytest.raises(AssertionError, match=match) as excinfo:
+        fltesting.check_plugin_class("spectrum", cls)
+    assert qualname in str(excinfo.value)
+
+
+def test_class_check_uses_given_params():
+    cls = type("NeedsPoints", (GoodSpectrum,), {"Params": _RequiredParams})
+    fltesting.check_plugin_class("spectrum", cls, params={"points": 64})
+    fltesting.check_plugin("spectrum", cls, points=64)
+
+
+def test_class_check_fails_when_constructor_drops_params():
+    with pytest.raises(AssertionError, match="self.params"):
+        fltesting.check_plugin_class("spectrum", _NotStoring)
+
+
+def test_class_check_rejects_unknown_kind():
+    with pytest.raises(ValueError, match="kind must be one of"):
+        fltesting.check_plugin_class("surface", GoodSpectrum)
+
+
+def test_class_check_skips_bounds_when_none():
+    fltesting.check_plugin_class("slope", GoodSlopes)  # no fields at all
+
+
+def test_check_plugin_runs_the_kind_check():
+    cls = spectrum_variant("IgnoresSeedAgain", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0)))
+    fltesting.check_plugin_class("spectrum", cls)
+    with pytest.raises(AssertionError, match="different seeds"):
+        fltesting.check_plugin("spectrum", cls)

@@ -1,0 +1,49 @@
+"""The slope estimator check fails for estimators broken in one way each."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frictionlab import testing as fltesting
+from frictionlab.plugin import KINDS
+
+from .fakes import forward_differences, slopes_variant
+
+ROOT = Path(__file__).resolve().parents[2]
+
+KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
+
+
+# =========================================================================== fakes
+
+
+def _demean_in_place(self, heights, spacing, periodic=True):
+    heights -= heights.mean()
+    return forward_differences(heights, spacing, periodic)
+
+
+SLOPE_BREAKAGES = [
+    ("WrongShape", lambda self, z, dx, periodic=True: np.diff(z) / dx, r"must have shape \(128,\)"),
+    ("ForgetsSpacing", lambda self, z, dx, periodic=True: np.roll(z, -1) - z, "order of magnitude"),
+    ("SignFlipped", lambda self, z, dx, periodic=True: -forward_differences(z, dx), "order of magnitude and sign"),
+    ("Offset", lambda self, z, dx, periodic=True: forward_differences(z, dx) + 1e-3, "constant line must have zero slopes"),
+    ("ReturnsList", lambda self, z, dx, periodic=True: list(forward_differences(z, dx)), "must be a numpy array"),
+    ("NaN", lambda self, z, dx, periodic=True: np.where(np.arange(z.size) == 0, np.nan, forward_differences(z, dx)), "must be finite"),
+    ("Integer", lambda self, z, dx, periodic=True: np.round(forward_differences(z, dx)).astype(int), "floating point"),
+    ("MutatesInput", _demean_in_place, "modified its input"),
+    ("Random", lambda self, z, dx, periodic=True: forward_differences(z, dx) + 1e-12 * np.random.default_rng().random(z.size),
+     "not repeatable"),
+    ("WrapsAScan", lambda self, z, dx, periodic=True: forward_differences(z, dx), "a difference across the ends"),
+    ("NoPeriodicArgument", lambda self, z, dx: forward_differences(z, dx), "raised TypeError"),
+]
+
+
+@pytest.mark.parametrize("qualname,slopes,match", SLOPE_BREAKAGES, ids=[b[0] for b in SLOPE_BREAKAGES])
+def test_slope_check_fails_for_broken_estimators(qualname, slopes, match):
+    cls = slopes_variant(qualname, slopes)
+    with pytest.raises(AssertionError, match=match) as excinfo:
+        fltesting.check_slope_estimator(cls)
+    assert qualname in str(excinfo.value)

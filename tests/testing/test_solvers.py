@@ -1,0 +1,124 @@
+"""The solver check fails for solvers broken in one way each, and for a wrong meaning of f."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frictionlab import (
+    ForceNormalisation,
+)
+from frictionlab import registry as registry_module
+from frictionlab import testing as fltesting
+from frictionlab.errors import PluginError
+from frictionlab.plugin import KINDS
+
+from .fakes import GoodSolver, replace_curve, solver_variant
+
+ROOT = Path(__file__).resolve().parents[2]
+
+KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
+
+
+# =========================================================================== fakes
+
+
+def _noisy(curve, profile, loads):
+    return replace_curve(curve, force=curve.force * (1 + 1e-9 * np.random.default_rng().random(loads.size)))
+
+
+def _sorts_in_place(curve, profile, loads):
+    profile.heights.sort()
+    return curve
+
+
+SOLVER_BREAKAGES = [
+    ("WrongShape", lambda c, p, l: replace_curve(c, contact_count=c.contact_count[:-1]), r"must have shape \(5,\)"),
+    ("Decreasing", lambda c, p, l: replace_curve(c, contact_count=c.contact_count[::-1],
+                                                   contact_fraction=c.contact_fraction[::-1]), "must not decrease"),
+    ("NoContact", lambda c, p, l: replace_curve(c, contact_count=c.contact_count * 0,
+                                                  contact_fraction=c.contact_fraction * 0), r"must lie in 1 \.\. 64"),
+    ("TooMany", lambda c, p, l: replace_curve(c, contact_count=c.contact_count + 64,
+                                                contact_fraction=(c.contact_count + 64) / 64), r"must lie in 1 \.\. 64"),
+    ("WrongFraction", lambda c, p, l: replace_curve(c, contact_fraction=c.contact_fraction / 2), "contact_count / N"),
+    ("FractionalCount", lambda c, p, l: replace_curve(c, contact_count=c.contact_count + 0.5,
+                                                        contact_fraction=(c.contact_count + 0.5) / 64), "whole numbers"),
+    ("DimensionlessForce", lambda c, p, l: replace_curve(c, force=c.force / 1000), "must report the loads"),
+    ("NaNSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact * np.nan), "must be finite"),
+    ("HugeSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact + 100), r"max \|slope\|"),
+    ("ShortExtras", lambda c, p, l: replace_curve(c, extras={"iterations": np.ones(2)}), "one entry per load"),
+    ("NotRepeatable", _noisy, "not repeatable"),
+    ("MutatesInput", _sorts_in_place, "modified its inputs"),
+    ("NotACurve", lambda c, p, l: {"force": c.force}, "must return a frictionlab.ContactCurve"),
+]
+
+
+@pytest.mark.parametrize("qualname,change,match", SOLVER_BREAKAGES, ids=[b[0] for b in SOLVER_BREAKAGES])
+def test_solver_check_fails_for_broken_solvers(qualname, change, match):
+    cls = solver_variant(qualname, change)
+    with pytest.raises(AssertionError, match=match) as excinfo:
+        fltesting.check_solver(cls)
+    assert qualname in str(excinfo.value)
+
+
+def test_solver_check_fails_for_bad_stiffness():
+    cls = type("Soft", (GoodSolver,), {"name": "soft", "stiffness": lambda self: -1.0})
+    with pytest.raises(AssertionError, match=r"stiffness\(\) must be finite and > 0"):
+        fltesting.check_solver(cls)
+
+
+def test_solver_check_fails_for_a_wrong_normalisation():
+    """Springs of stiffness k dx under a force, declared as a force per unit depth over k h:
+    the load scales as k h L, not as k h, so f is not dimensionless."""
+    wrong = ForceNormalisation(load="force per unit depth", modulus="k", extent="one")
+    cls = type("PerUnitDepth", (GoodSolver,), {"name": "wrong-f", "normalisations": {1: wrong}})
+    with pytest.raises(AssertionError, match="is not dimensionless as declared"):
+        fltesting.check_solver(cls)
+
+
+@pytest.mark.parametrize("load,extent", [("force per unit depth", "length"), ("force", "one"),
+                                         ("force per unit depth", "area")])  # fmt: skip
+def test_a_load_that_does_not_match_its_extent_is_refused(load, extent):
+    """k h X has the unit of the load only as the contract pairs them (k a stress, or a stress
+    per length over an area): any other pairing could never give a dimensionless f."""
+    with pytest.raises(ValueError, match=f"not a {load}: f would not be dimensionless"):
+        ForceNormalisation(load=load, modulus="k", extent=extent)
+
+
+def test_the_half_plane_with_the_old_f_fails_the_kit():
+    """f = F' / (E* h L) for a force per unit depth (the half-plane's f before) fails the unit check."""
+    from frictionlab_solvers import BEMHalfPlane
+
+    with pytest.raises(ValueError, match="not a force per unit depth"):  # refused as declared then
+        ForceNormalisation(load="force per unit depth", modulus="E*", extent="length")
+    old = ForceNormalisation(load="force", modulus="E*", extent="length")  # its load taken for a force
+    cls = type("OldHalfPlane", (BEMHalfPlane,), {"name": "old-halfplane", "normalisations": {1: old}})
+    with pytest.raises(AssertionError, match="is not dimensionless as declared"):
+        fltesting.check_solver(cls)
+    fltesting.check_solver(BEMHalfPlane)
+
+
+def test_solver_check_fails_when_periodic_only_is_not_kept():
+    cls = type("Loose", (GoodSolver,), {"name": "loose", "periodic_only": True})
+    with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was accepted"):
+        fltesting.check_solver(cls)
+
+
+@pytest.mark.parametrize(
+    "attributes,match",
+    [
+        ({"normalisations": {}}, "normalisations must map each of its dimensions"),
+        ({"dimensions": (1, 2)}, "normalisations must map each of its dimensions"),
+        ({"problem": ""}, "problem must name the physical problem"),
+        ({"contact_measure": "area"}, "contact_measure must be one of"),
+        ({"body_params": ("youngs_modulus",)}, "body_params names 'youngs_modulus', not fields of Params"),
+        ({"tolerance_param": "tol"}, "tolerance_param names 'tol'"),
+        ({"normalisations": {1: ForceNormalisation(load="force", modulus="k", extent="area")}}, "not defined for a 1D"),
+    ],
+)
+def test_solver_declarations_are_checked_at_registration(attributes, match):
+    cls = type("Undeclared", (GoodSolver,), {"name": "undeclared", **attributes})
+    with pytest.raises(PluginError, match=match):
+        registry_module.validate_plugin_class("solver", cls)

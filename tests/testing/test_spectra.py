@@ -1,0 +1,75 @@
+"""The spectrum check fails for generators broken in one way each."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frictionlab import (
+    Profile,
+)
+from frictionlab import testing as fltesting
+from frictionlab.plugin import KINDS
+
+from .fakes import GoodSpectrum, spectrum_variant
+
+ROOT = Path(__file__).resolve().parents[2]
+
+KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
+
+
+# =========================================================================== fakes
+
+
+SPECTRUM_BREAKAGES = [
+    ("NonDeterministic", {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())},
+     "same seed gave different heights"),
+    ("IgnoresSeed", {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0))},
+     "different seeds gave identical heights"),
+    ("NaNHeights", {"generate": lambda self, rng: Profile(np.full(8, np.nan), 1.0)}, "must be finite"),
+    ("TwoDimensional", {"generate": lambda self, rng: Profile(rng.random((4, 4)), 1.0)}, "must be 1-D"),
+    ("IntegerHeights", {"generate": lambda self, rng: Profile(rng.integers(0, 9, 16), 1.0)}, "floating point"),
+    ("ZeroSpacing", {"generate": lambda self, rng: Profile(rng.random(16), 0.0)}, r"spacing must be finite and > 0"),
+    ("NotAProfile", {"generate": lambda self, rng: rng.random(16)}, "must return a frictionlab.Profile"),
+    ("ZeroRms", {"rms_height": lambda self: 0.0}, r"rms_height\(\) must be finite and > 0"),
+    ("WrongRms", {"rms_height": lambda self: 10.0}, "within a factor of 3"),
+    ("ScalarPsd", {"psd": lambda self, q: 1.0}, r"psd\(q\)"),
+    ("NegativePsd", {"psd": lambda self, q: -np.ones_like(q)}, r"psd\(q\) must be >= 0"),
+    ("Raises", {"generate": lambda self, rng: 1 / 0}, "raised ZeroDivisionError"),
+    ("BadRmsSlope", {"rms_slope": lambda self: float("nan")}, r"rms_slope\(\)"),
+]
+
+
+@pytest.mark.parametrize("qualname,methods,match", SPECTRUM_BREAKAGES, ids=[b[0] for b in SPECTRUM_BREAKAGES])
+def test_spectrum_check_fails_for_broken_generators(qualname, methods, match):
+    cls = spectrum_variant(qualname, **methods)
+    with pytest.raises(AssertionError, match=match) as excinfo:
+        fltesting.check_spectrum(cls)
+    assert qualname in str(excinfo.value)
+
+
+def test_deterministic_flag_allows_seed_independence():
+    cls = spectrum_variant("FixedLine", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0)))
+    fltesting.check_spectrum(cls, deterministic=True)
+    with pytest.raises(AssertionError):  # but not a different answer for the same seed
+        fltesting.check_spectrum(
+            spectrum_variant("Drifting", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())),
+            deterministic=True,
+        )
+
+
+def test_spectrum_check_fails_for_wrong_declarations():
+    cls = spectrum_variant("SaysPeriodic", periodic=lambda self: False)
+    with pytest.raises(AssertionError, match=r"periodic\(\) must be True or False and equal Profile.periodic"):
+        fltesting.check_spectrum(cls)
+    cls = spectrum_variant("WrongShape", grid_shape=lambda self: (3,))
+    with pytest.raises(AssertionError, match=r"grid_shape\(\) must be None or the shape"):
+        fltesting.check_spectrum(cls)
+    cls = spectrum_variant("LineOfALine", equivalent_line=lambda self: GoodSpectrum())
+    with pytest.raises(AssertionError, match=r"equivalent_line\(\) must be None"):
+        fltesting.check_spectrum(cls)
+    cls = spectrum_variant("NegativeHurst", hurst_exponent=lambda self: -1.0)
+    with pytest.raises(AssertionError, match=r"hurst_exponent\(\)"):
+        fltesting.check_spectrum(cls)

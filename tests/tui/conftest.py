@@ -1,0 +1,125 @@
+"""Helpers of the TUI tests: the terminal UI driven as a user drives it (Textual's Pilot at 80x24): what it
+shows is checked against the headless validator and the headless run, and the
+files it writes against what ``frictionlab run`` accepts."""
+
+import asyncio
+import functools
+import re
+
+import pytest
+import yaml
+from textual.widgets import Input, Select, Static
+
+from frictionlab.errors import PresetError
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.runner import run_to_folder
+from frictionlab.tui.app import FrictionlabApp
+from frictionlab.tui.widgets import PresetForm
+
+from ..conftest import SMALL_PRESET, merge
+
+SIZE = (80, 24)
+
+
+def sync(scenario):
+    """Run an async Pilot scenario as a plain test (no async pytest plugin needed)."""
+
+    @functools.wraps(scenario)
+    def test(*args, **kwargs):
+        asyncio.run(scenario(*args, **kwargs))
+
+    return test
+TINY = merge(SMALL_PRESET, {"spectrum": {"params": {"points": 512}}, "fit": {"bootstrap": 50}})
+
+
+def headless_problems(data, registry):
+    try:
+        build_scene(data, registry=registry)
+    except PresetError as exc:
+        return exc.problems
+    return []
+
+
+@pytest.fixture
+def folders(tmp_path, monkeypatch):
+    """A presets folder with one tiny preset and an empty runs folder, as relative
+    paths (so snapshots do not show the temporary directory)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "presets" / "tiny.yaml").write_text(yaml.safe_dump(TINY, sort_keys=False))
+    return tmp_path
+
+
+def make_app(registry, preset=None, workers=1):
+    return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", options=RunOptions(workers=workers), registry=registry)
+
+
+async def open_first_preset(pilot):
+    await pilot.pause()
+    await pilot.press("enter")
+    await pilot.pause()
+    form = pilot.app.query_one(PresetForm)
+    assert form.data is not None, "Enter on the presets list did not open the preset"
+    return form
+
+
+async def type_into(pilot, widget_id, text):
+    field = pilot.app.query_one(f"#{widget_id}", Input)
+    field.focus()
+    await pilot.press("end", "ctrl+u", *text)
+    await pilot.pause()
+
+
+async def choose(pilot, select_id, value):
+    """Pick an option of a Select with the keyboard: Enter opens it, arrows move, Enter picks."""
+    select = pilot.app.query_one(f"#{select_id}", Select)
+    select.focus()
+    await pilot.press("enter")
+    options = [v for _, v in select._options if v is not Select.NULL]
+    current = options.index(select.value) if select.value in options else -1
+    target = options.index(value)
+    await pilot.press(*(["down"] * (target - current) if target > current else ["up"] * (current - target)))
+    await pilot.press("enter")
+    await pilot.pause()
+    assert select.value == value
+
+
+async def wait_until(pilot, condition, timeout=60.0):
+    for _ in range(int(timeout / 0.05)):
+        if condition():
+            return
+        await pilot.pause(0.05)
+    raise AssertionError("timed out waiting for the app")
+
+
+def error_text(app, widget_id):
+    label = app.query_one(f"#{widget_id}--error", Static)
+    return str(label.render()) if label.display else ""
+
+
+SWEEP = merge(
+    TINY,
+    {
+        "name": "tinysweep",
+        "realizations": 4,
+        "spectrum": {"params": {"points": 256}},
+        "loading": {"steps": 8},
+        "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7, 0.9]}}},
+    },
+)
+
+
+def fits_width(table):
+    """Every column of a DataTable is on screen: nothing to scroll sideways to."""
+    return table.max_scroll_x == 0 and table.virtual_size.width <= table.scrollable_content_region.width
+
+
+def numbers_in(cell):
+    return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", str(cell))]
+
+
+def make_runs(folders, registry):
+    for seed in (1, 2):
+        data = merge(TINY, {"seed": seed, "name": f"seed{seed}"})
+        run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", RunOptions(workers=1))

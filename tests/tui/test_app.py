@@ -1,0 +1,95 @@
+"""The app's keys and help, the ``tui`` command, and a process pool started from the app's thread."""
+
+import subprocess
+import sys
+
+import pytest
+
+from frictionlab.cli import main
+from frictionlab.options import RunOptions
+from frictionlab.tui.app import FrictionlabApp
+
+from ..conftest import ROOT
+
+# ------------------------------------------------------------------ help, README, CLI
+
+
+def test_help_lists_every_binding_and_the_readme_has_them(registry):
+    app = FrictionlabApp(registry=registry)
+    keys = [key for _, rows in app.help_groups() for key, _ in rows]
+    from frictionlab.tui.widgets import PresetsPane, ResultsPane, RunPane
+
+    for bindings in (FrictionlabApp.BINDINGS, PresetsPane.BINDINGS, RunPane.BINDINGS, ResultsPane.BINDINGS):
+        for binding in bindings:
+            for key in binding.key.split(","):
+                from textual.binding import Binding
+
+                assert app.get_key_display(Binding(key, binding.action)) in keys
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Terminal UI", 1)[1].split("\n## ", 1)[0]
+    for description in {d for _, rows in app.help_groups() for _, d in rows}:
+        assert description in section, f"README's key table misses {description!r}"
+
+
+def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path, monkeypatch):
+    import frictionlab.tui
+
+    calls = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda *a, **k: calls.append((a, k)) or 0)
+    assert main(["tui", "--presets", str(tmp_path), "--runs", str(tmp_path / "r"), "--workers", "1"]) == 0
+    assert calls == [((None,), {"presets_dir": str(tmp_path), "runs_dir": str(tmp_path / "r"), "options": RunOptions(workers=1)})]
+
+    # the headless commands, and `tui` refusing a missing file, never import Textual
+    code = (
+        "import sys; from frictionlab.cli import main; import frictionlab.tui; "
+        f"rc = main(['tui', {str(tmp_path / 'missing.yaml')!r}]); "
+        f"rc2 = main(['validate', {str(ROOT / 'presets' / 'quickstart.yaml')!r}]); "
+        "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'textual', 'rich'}); "
+        "print(rc, rc2, bad)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.strip().splitlines()[-1] == "3 0 []", result.stderr  # 3: ExitCode.INPUT_FILE
+    assert "no such preset file" in result.stderr
+
+
+POOL_UNDER_TEXTUAL = """
+import sys, threading
+import frictionlab.tui
+from frictionlab.engine import run
+from frictionlab.preset import build_scene
+from frictionlab.options import RunOptions
+
+class Capture:  # what Textual puts in sys.stderr while an app runs: fileno() is -1
+    def write(self, text): return len(text)
+    def flush(self): pass
+    def fileno(self): return -1
+
+if {prestart}:
+    frictionlab.tui.start_process_helpers()  # what run_app does before the app starts
+scene = build_scene({{"name": "t", "realizations": 4, "fit": {{"bootstrap": 0}},
+    "spectrum": {{"name": "power-law", "params": {{"hurst": 0.8, "points": 256}}}},
+    "loading": {{"start": 1, "stop": 5, "steps": 4}}}})
+status = []
+real, sys.stderr = sys.stderr, Capture()
+def work():
+    try:
+        status.append(run(scene, RunOptions(workers=2)).status)
+    except Exception as exc:
+        status.append(type(exc).__name__)
+worker = threading.Thread(target=work)
+worker.start(); worker.join()
+sys.stderr = real
+print(status)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="forkserver start method")
+def test_a_process_pool_starts_from_the_app_thread():
+    """Found in tmux: a pool run from the app failed with 'bad value(s) in
+    fds_to_keep' because Textual's stderr has no file descriptor."""
+    for prestart, expected in ((False, "['ValueError']"), (True, "['completed']")):
+        result = subprocess.run(
+            [sys.executable, "-c", POOL_UNDER_TEXTUAL.format(prestart=prestart)],
+            capture_output=True, text=True, timeout=120,
+        )
+        assert result.stdout.strip().splitlines()[-1] == expected, result.stderr[-2000:]

@@ -1,0 +1,81 @@
+"""Saving presets: comments, key order and spelling kept (``folders.save_preset``)."""
+
+
+import yaml
+
+from frictionlab.tui.folders import save_preset
+
+from ..conftest import PRESETS
+
+COMMENTED = """\
+# why this preset
+name: commented  # the name
+description: >
+  folded text
+  over two lines
+spectrum:
+  name: power-law
+  params:
+    hurst: 0.8    # H
+    points: 1024
+solver:
+  name: mdr
+  params:
+    # the modulus first
+    youngs_modulus: 1.0  # E
+    poisson_ratio: 0.0  # nu: zero, so E* = E
+# the slope estimator below
+slope:
+  name: forward-difference
+loading:
+  stop: 2.0e+1
+  values:
+    - 1  # one
+fit: {bootstrap: 50}
+"""
+
+
+def comment_lines(text):
+    return [line.split("#", 1)[1].strip() for line in text.splitlines() if "#" in line]
+
+
+def test_save_keeps_comments_order_and_spelling_with_nested_removed_and_added_keys(tmp_path):
+    path, source = tmp_path / "saved.yaml", tmp_path / "source.yaml"
+    source.write_text(COMMENTED)
+    data = yaml.safe_load(COMMENTED)
+    data["spectrum"]["params"]["hurst"] = 0.6  # a nested change
+    data["solver"] = {"name": "winkler", "params": {"modulus": 1e-05}}  # two keys removed, one added
+    data["fit"]["confidence"] = 0.9
+    data["seed"] = 3  # a new top-level key: last, as in the edited data
+    save_preset(path, data, template=source)
+    text = path.read_text()
+    assert yaml.safe_load(text) == data  # PyYAML (what frictionlab loads with) reads the new values
+    assert comment_lines(text) == comment_lines(COMMENTED)  # every comment, in order
+    lines = text.splitlines()
+    # untouched lines are byte for byte the same, in the same order ("2.0e+1" is not rewritten as 20.0)
+    kept = [line for line in COMMENTED.splitlines() if line in lines]
+    assert kept == [line for line in lines if line in COMMENTED.splitlines()]
+    for line in ("name: commented  # the name", "description: >", "  folded text", "  stop: 2.0e+1", "    - 1  # one"):
+        assert line in lines
+    assert "    hurst: 0.6    # H" in lines and "    modulus: 1.0e-05" in lines
+    # the comment above `slope` stays above it; the removed keys' own comments stay in the solver section
+    assert lines[lines.index("slope:") - 1] == "# the slope estimator below"
+    assert lines.index("    modulus: 1.0e-05") < lines.index("    # E") < lines.index("slope:")
+    assert "youngs_modulus" not in text and "poisson_ratio" not in text
+    assert list(yaml.safe_load(text)) == ["name", "description", "spectrum", "solver", "slope", "loading", "fit", "seed"]
+
+
+def test_save_without_changes_rewrites_every_shipped_preset_byte_for_byte(tmp_path):
+    for preset in sorted(PRESETS.glob("*.yaml")):
+        original = preset.read_text()
+        save_preset(tmp_path / preset.name, yaml.safe_load(original), template=preset)
+        assert (tmp_path / preset.name).read_text() == original, preset.name
+
+
+def test_new_text_values_are_spelled_so_pyyaml_reads_them_back(tmp_path):
+    source = tmp_path / "source.yaml"
+    source.write_text("name: x  # n\nseed: 1\n")
+    data = {"name": "yes", "seed": 1, "description": "1e4", "notes": {"on": "0o17", "nan": float("inf")}}
+    save_preset(tmp_path / "out.yaml", data, template=source)
+    text = (tmp_path / "out.yaml").read_text()
+    assert yaml.safe_load(text) == data and "# n" in text

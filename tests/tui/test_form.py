@@ -1,0 +1,209 @@
+"""Editing a preset in the form: the headless validator's messages, saving, switching plugins."""
+
+from typing import ClassVar, Literal
+
+import numpy as np
+import yaml
+from pydantic import Field
+from textual.widgets import Input, Select, Static, Switch
+
+from frictionlab import PluginParams, SlopeEstimator
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.preset import load_scene
+from frictionlab.tui.widgets import PresetForm
+
+from ..conftest import PRESETS, merge
+from .conftest import (
+    SIZE,
+    TINY,
+    choose,
+    error_text,
+    headless_problems,
+    make_app,
+    open_first_preset,
+    sync,
+    type_into,
+)
+
+# ------------------------------------------------------------------ edit and save
+
+
+@sync
+async def test_invalid_value_shows_the_headless_message_then_save_round_trips(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await type_into(pilot, "field--spectrum--params--hurst", "2.0")
+        expected = headless_problems(merge(TINY, {"spectrum": {"params": {"hurst": 2.0}}}), registry)
+        assert expected == ["spectrum.params.hurst: must be <= 1.5, got 2.0"]
+        assert form.problems == expected
+        assert error_text(app, "field--spectrum--params--hurst") == expected[0]
+        assert app.query_one("#field--spectrum--params--hurst", Input).has_class("-invalid")
+        assert expected[0] in str(app.query_one("#problems", Static).render())
+
+        # text where a number belongs: the same words as `frictionlab validate`
+        await type_into(pilot, "field--loading--steps", "abc")
+        assert form.problems == headless_problems(
+            merge(TINY, {"spectrum": {"params": {"hurst": 2.0}}, "loading": {"steps": "abc"}}), registry
+        )
+        assert error_text(app, "field--loading--steps") == "loading.steps: must be a whole number, got 'abc'"
+
+        await type_into(pilot, "field--loading--steps", "12")
+        await type_into(pilot, "field--spectrum--params--hurst", "0.9")
+        assert form.problems == []
+        assert error_text(app, "field--spectrum--params--hurst") == ""
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert not app.modified
+
+    saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+    assert saved == merge(TINY, {"spectrum": {"params": {"hurst": 0.9}}, "loading": {"steps": 12}})
+    # accepted unchanged by the headless front end
+    scene = load_scene(folders / "presets" / "tiny.yaml", registry=registry)
+    assert scene.spectrum.params.hurst == 0.9 and scene.preset.loading.steps == 12
+    assert main(["run", "presets/tiny.yaml", "--out", "runs/headless", "--quiet", "--workers", "1"]) == ExitCode.OK
+
+
+@sync
+async def test_save_with_problems_asks_first_and_keeps_unknown_sections(folders, registry):
+    data = merge(TINY, {"realizations": 0, "notes": {"author": "me", "tags": ["a", "b"]}})
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert form.problems == headless_problems(data, registry)
+        assert any(p.startswith("notes: ") for p in form.problems)
+        await type_into(pilot, "field--seed", "11")
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert app.modified, "saved a preset with problems without asking"
+        await pilot.press("n")  # no: nothing is written
+        await pilot.pause()
+        assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == TINY["seed"]
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        await pilot.press("y")
+        await pilot.pause()
+        assert not app.modified
+        # and a run is refused, with the problems named
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        assert app.last_snapshot is None and not app.running
+    saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+    assert saved == {**data, "seed": 11}
+
+
+@sync
+async def test_switching_the_solver_swaps_its_parameters(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert app.query("#field--solver--params--youngs_modulus")
+        await choose(pilot, "plugin--solver", "winkler")
+        assert not app.query("#field--solver--params--youngs_modulus")
+        modulus = app.query_one("#field--solver--params--modulus", Input)
+        assert "stiffness per unit length" in str(modulus.tooltip)
+        await type_into(pilot, "field--solver--params--modulus", "-1")
+        assert form.problems == ["solver.params.modulus: must be > 0.0, got -1.0"]
+        await type_into(pilot, "field--solver--params--modulus", "4")
+        assert form.data["solver"] == {"name": "winkler", "params": {"modulus": 4.0}}
+        # back to mdr: its values come back
+        await choose(pilot, "plugin--solver", "mdr")
+        assert form.data["solver"] == TINY["solver"]
+        assert app.query_one("#field--solver--params--youngs_modulus", Input).value == "1.0"
+        assert form.problems == []
+
+
+def comment_lines(text):
+    return [line.split("#", 1)[1].strip() for line in text.splitlines() if "#" in line]
+
+
+@sync
+async def test_editing_a_commented_shipped_preset_keeps_its_comments(folders, registry):
+    original = (PRESETS / "benad2012-fig2.yaml").read_text()
+    path = folders / "presets" / "tiny.yaml"  # the first row of the list
+    path.write_text(original)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert form.data["name"] == "benad2012-fig2"
+        await type_into(pilot, "field--spectrum--params--hurst", "0.75")
+        assert form.problems == []
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert not app.modified
+    text = path.read_text()
+    assert comment_lines(text) == comment_lines(original) and "h = 1e4" in text
+    changed = [(a, b) for a, b in zip(original.splitlines(), text.splitlines(), strict=True) if a != b]
+    assert changed == [("    hurst: 1.0", "    hurst: 0.75")]
+    assert main(["validate", str(path)]) == ExitCode.OK
+    scene = load_scene(path, registry=registry)
+    assert scene.spectrum.params.hurst == 0.75 and scene.spectrum.params.rms_height == 1e4
+
+
+class SmoothedSlope(SlopeEstimator):
+    """A third-party plugin registered only in this test: the form has no code for it."""
+
+    name: ClassVar[str] = "smoothed-difference"
+    summary: ClassVar[str] = "test plugin: central difference of a smoothed line"
+
+    class Params(PluginParams):
+        window: int = Field(3, ge=1, le=99, description="points in the moving average")
+        weight: float = Field(0.5, gt=0.0, lt=1.0, description="weight of the centre point (dimensionless)")
+        edge: Literal["wrap", "reflect"] = Field("wrap", description="how the line's ends are treated")
+        normalise: bool = Field(False, description="divide by the rms slope")
+
+    def slopes(self, heights, spacing):
+        return np.gradient(heights, spacing)
+
+
+@sync
+async def test_a_third_party_plugin_gets_a_form_without_code(folders, register_plugin):
+    registry = register_plugin(SmoothedSlope)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await choose(pilot, "plugin--slope", "smoothed-difference")
+        prefix = "#field--slope--params--"
+        assert isinstance(app.query_one(prefix + "window"), Input)
+        assert isinstance(app.query_one(prefix + "weight"), Input)
+        assert isinstance(app.query_one(prefix + "edge"), Select)
+        assert isinstance(app.query_one(prefix + "normalise"), Switch)
+        assert "allowed: >= 1, <= 99" in str(app.query_one(prefix + "window").tooltip)
+        await type_into(pilot, "field--slope--params--window", "200")
+        expected = headless_problems(merge(TINY, {"slope": {"name": "smoothed-difference", "params": {"window": 200}}}), registry)
+        assert form.problems == expected == ["slope.params.window: must be <= 99, got 200"]
+        await type_into(pilot, "field--slope--params--window", "5")
+        await choose(pilot, "field--slope--params--edge", "reflect")
+        app.query_one(prefix + "normalise", Switch).focus()
+        await pilot.press("space")
+        await pilot.pause()
+        assert form.data["slope"] == {
+            "name": "smoothed-difference",
+            "params": {"window": 5, "edge": "reflect", "normalise": True},
+        }
+        assert form.problems == []
+
+
+@sync
+async def test_new_preset_from_a_plugins_defaults(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("n")
+        await pilot.pause()
+        await pilot.press("ctrl+u", *"fresh", "enter")
+        await pilot.pause()
+        form = app.query_one(PresetForm)
+        assert form.data["spectrum"]["name"] == "power-law"
+        # power-law's hurst and points have no default: the user is told, as headless would
+        assert form.problems == headless_problems(form.data, registry)
+        assert {p.split(":")[0] for p in form.problems} == {"spectrum.params.hurst", "spectrum.params.points"}
+        await type_into(pilot, "field--spectrum--params--hurst", "0.7")
+        await type_into(pilot, "field--spectrum--params--points", "256")
+        assert form.problems == []
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+    assert app.draft_path is not None and app.draft_path.name == "fresh.yaml"
+    assert load_scene(app.draft_path, registry=registry).spectrum.params.points == 256

@@ -1,0 +1,33 @@
+"""The run listener's snapshots: coalesced, and the interim fit is the final point estimate."""
+
+
+import numpy as np
+import pytest
+
+from frictionlab.engine import run as engine_run
+from frictionlab.fit import least_squares
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.tui.live import LiveListener
+
+from ..conftest import merge
+from .conftest import TINY
+
+
+def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate(registry):
+    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
+    posted = []
+    outcome = engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(posted.append, interval=3600.0)])
+    # started, the first and the last realization, finished: nothing for the ten in between
+    assert [s.done for s in posted] == [0, 1, 12, 12]
+    last = posted[-1]
+    assert last.finished and last.failed == 0
+    np.testing.assert_allclose(last.xi, outcome.xi, rtol=1e-12)
+    np.testing.assert_allclose(last.f, outcome.f, rtol=1e-12)
+    coef, *_ = least_squares(outcome.f, outcome.xi)
+    assert last.fit.a == pytest.approx(outcome.fit.a, rel=1e-10) == pytest.approx(coef[0], rel=1e-10)
+    assert last.fit.b == pytest.approx(outcome.fit.b, rel=1e-10)
+
+    every = []
+    engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(every.append, interval=0.0)])
+    assert [s.done for s in every] == [0, *range(1, 13), 12]

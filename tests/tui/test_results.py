@@ -1,0 +1,85 @@
+"""The Results tab: runs and sweeps listed, opened and overlaid."""
+
+import json
+
+import pytest
+import yaml
+from textual.widgets import Static
+
+from frictionlab.options import RunOptions
+from frictionlab.sweep import load_sweep, read_table, run_sweep
+from frictionlab.tui.widgets import ResultsPane
+
+from .conftest import (
+    SIZE,
+    SWEEP,
+    fits_width,
+    make_app,
+    make_runs,
+    numbers_in,
+    sync,
+)
+
+# ------------------------------------------------------------------ results
+
+
+@sync
+async def test_results_lists_opens_and_overlays_runs(folders, registry):
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert {entry.path.name for entry in app.query_one(ResultsPane).runs} == {"seed1", "seed2"}
+        await pilot.press("enter")
+        assert [e.path.name for e in app.query_one(ResultsPane).overlay] == [app.query_one(ResultsPane).runs[0].path.name]
+        await pilot.press("down", "space")
+        assert {e.path.name for e in app.query_one(ResultsPane).overlay} == {"seed1", "seed2"}
+        info = str(app.query_one("#results-info", Static).render())
+    for seed in (1, 2):
+        summary = json.loads((folders / "runs" / f"seed{seed}" / "summary.json").read_text())
+        assert f"a={summary['fit']['a']:.4f}" in info
+
+
+@sync
+async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
+    make_runs(folders, registry)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    rows = read_table(folders / "runs" / "sw" / "sweep.csv")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert sorted(e.path.name for e in app.query_one(ResultsPane).runs) == ["seed1", "seed2", "sw"]
+        index = [e.path.name for e in app.query_one(ResultsPane).runs].index("sw")
+        listed = [str(c) for c in app.query_one("#runs-table").get_row_at(index)]
+        assert listed[1:] == ["sw", "sweep", "3 pts"]  # marked as a sweep
+        await pilot.press(*["down"] * index, "enter")
+        await pilot.pause()
+        points = app.query_one("#results-sweep")
+        assert points.display and points.has_focus
+        cells = [[str(c) for c in points.get_row_at(i)] for i in range(points.row_count)]
+        assert fits_width(points), "the sweep table is cut at 80 columns"
+        await pilot.press("down", "enter")  # the second point's own run
+        await pilot.pause()
+        overlay = [e.path for e in app.query_one(ResultsPane).overlay]
+        await pilot.press("up", "space")  # and the first point's, for comparison
+        await pilot.pause()
+        compared = [e.path for e in app.query_one(ResultsPane).overlay]
+        info = str(app.query_one("#results-info", Static).render())
+    assert len(cells) == 3
+    for shown, row in zip(cells, rows, strict=True):
+        number, hurst, mark, a, b, r2, contacts = shown
+        assert int(number) == int(row["point"]) and float(hurst) == float(row["spectrum.params.hurst"])
+        assert mark == "✓" and row["status"] == "completed"
+        assert numbers_in(a)[0] == pytest.approx(float(row["a"]), abs=5e-5)
+        assert numbers_in(b)[1:] == pytest.approx([float(row["b_lo"]), float(row["b_hi"])], abs=5e-4)
+        assert numbers_in(r2) == pytest.approx([float(row["r2"])], abs=5e-4)
+    point_dirs = [folders / "runs" / "sw" / r["folder"] for r in rows]
+    overlay, compared = [p.resolve() for p in overlay], [p.resolve() for p in compared]
+    assert overlay == [point_dirs[1]]
+    assert compared == [point_dirs[1], point_dirs[0]]
+    for folder in point_dirs[:2]:
+        summary = json.loads((folder / "summary.json").read_text())
+        assert f"a={summary['fit']['a']:.4f}" in info

@@ -1,0 +1,140 @@
+"""A run and a sweep from the Run tab: the headless numbers, cancelling keeps what finished."""
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+from textual.widgets import Static
+
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.runner import run_to_folder
+from frictionlab.sweep import load_sweep, read_table, run_sweep
+from frictionlab.tui.widgets import ResultsPane
+
+from ..conftest import merge
+from .conftest import (
+    SIZE,
+    SWEEP,
+    TINY,
+    fits_width,
+    make_app,
+    numbers_in,
+    sync,
+    wait_until,
+)
+
+# ------------------------------------------------------------------ running
+
+
+@sync
+async def test_a_run_shows_the_headless_coefficients(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        shown = str(app.query_one("#run-fit", Static).render())
+        out_dir = app.last_out_dir
+        runs_listed = [entry.path.name for entry in app.query_one(ResultsPane).runs]
+
+    outcome, _ = run_to_folder(build_scene(TINY, registry=registry), folders / "headless", RunOptions(workers=2))
+    fit = outcome.fit
+    assert app.last_outcome.fit == fit  # same seed, any worker count: the same numbers
+    assert f"a = {fit.a:.4f} [{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]" in shown
+    assert f"b = {fit.b:.4f} [{fit.b_ci[0]:.4f}, {fit.b_ci[1]:.4f}]" in shown
+    assert f"R^2 = {fit.r2:.4f}" in shown
+    assert f"{outcome.contact_count[-1]:.2f} at last load" in shown
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["fit"]["a"] == fit.a
+    assert runs_listed == [out_dir.name]
+
+
+@sync
+async def test_cancel_keeps_and_writes_what_finished(folders, registry):
+    big = merge(TINY, {"name": "long", "realizations": 100_000})
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        await pilot.press("c")  # the Run tab has focus
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        outcome, out_dir = app.last_outcome, app.last_out_dir
+        stats = str(app.query_one("#run-stats", Static).render())
+    assert outcome.status == "cancelled" and 3 <= outcome.done < 100_000
+    assert stats.startswith(f"cancelled: {outcome.done}/100000")
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["status"] == "cancelled"
+    assert summary["realizations"]["done"] == outcome.done
+    with np.load(out_dir / "realizations.npz") as arrays:
+        assert arrays["xi"].shape[0] == outcome.done
+
+
+@sync
+async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, registry):
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        columns = [str(c.label) for c in table.columns.values()]
+        point_text = str(app.query_one("#sweep-point", Static).render())
+        out_dir = app.last_out_dir
+        fits = fits_width(table)
+    assert app.last_outcome.status == "completed" and point_text.startswith("completed: 3/3 points")
+    assert out_dir.parent.name == "runs" and out_dir.name.startswith("tinysweep-")
+    assert columns == ["#", "hurst", "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+    assert fits, "the sweep table is cut at 80 columns"
+    rows = read_table(out_dir / "sweep.csv")
+    assert len(cells) == len(rows) == 3
+    for shown, row in zip(cells, rows, strict=True):
+        number, hurst, status, a, b, r2, contacts = shown
+        assert int(number) == int(row["point"]) and float(hurst) == float(row["spectrum.params.hurst"])
+        for cell, name in ((a, "a"), (b, "b")):  # the estimate to 4 decimals, its interval to 3
+            assert numbers_in(cell)[0] == pytest.approx(float(row[name]), abs=5e-5)
+            assert numbers_in(cell)[1:] == pytest.approx([float(row[f"{name}_lo"]), float(row[f"{name}_hi"])], abs=5e-4)
+        assert numbers_in(r2) == pytest.approx([float(row["r2"])], abs=5e-4)
+        assert numbers_in(contacts) == pytest.approx([float(row["contact_first"]), float(row["contact_last"])], rel=5e-3)
+        assert status == "✓" and row["status"] == "completed"
+    # the same numbers as a headless sweep of the same preset
+    headless = run_sweep(load_sweep(folders / "presets" / "sweep.yaml", registry=registry), folders / "hl", RunOptions(workers=1))
+    assert [(r.outcome.fit.a, r.outcome.fit.b) for r in app.last_outcome.results] == [
+        (r.outcome.fit.a, r.outcome.fit.b) for r in headless.results
+    ]
+    assert [r.point.scene.spectrum.params.hurst for r in headless.results] == [0.5, 0.7, 0.9]
+    assert (out_dir / "sweep.png").stat().st_size > 0
+    assert {p.name for p in (out_dir / "points").iterdir()} == {"01-hurst-0.5", "02-hurst-0.7", "03-hurst-0.9"}
+
+
+@sync
+async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders, registry):
+    big = merge(SWEEP, {"realizations": 100_000})
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(big, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        await pilot.press("c")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        out_dir = app.last_out_dir
+    assert app.last_outcome.status == "interrupted"
+    rows = read_table(out_dir / "sweep.csv")
+    assert [r["status"] for r in rows] == ["cancelled", "pending", "pending"]
+    assert [c[2] for c in cells] == ["c"]  # only finished points get a row, marked cancelled
+    first = app.last_outcome.results[0].outcome
+    assert 3 <= first.done < 100_000 and int(rows[0]["done"]) == first.done
+    with np.load(out_dir / rows[0]["folder"] / "realizations.npz") as arrays:
+        assert arrays["xi"].shape[0] == first.done
+    assert not (out_dir / "points" / "02-hurst-0.7").exists()
