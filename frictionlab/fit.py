@@ -93,6 +93,11 @@ def format_interval(ci, digits: int = 4, missing: str = "n/a", sep: str = ", ") 
     return f"[{low:.{digits}f}{sep}{high:.{digits}f}]"
 
 
+def format_estimate(value: float, ci, digits: int = 4, missing: str = "n/a") -> str:
+    """``1.2345 [1.2000, 1.3000]``: a coefficient and its interval (``missing`` for an unknown one)."""
+    return f"{value:.{digits}f} {format_interval(ci, digits, missing)}"
+
+
 def percentile_interval(samples: np.ndarray, confidence: float, axis: int | None = None):
     """The central ``confidence`` interval of bootstrap ``samples``: (low, high) percentiles."""
     tail = 100 * (1 - confidence) / 2

@@ -32,7 +32,7 @@ from pydantic import BaseModel
 from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError
 from .files import atomic_write, output_path_problem
-from .fit import json_safe
+from .fit import LogFit, json_safe
 from .listeners import SweepListener
 from .options import RunOptions
 from .plugin import KINDS
@@ -215,6 +215,14 @@ class PointResult:
             if o.done:
                 row.update(contact_first=float(o.contact_count[0]), contact_last=float(o.contact_count[-1]))
         return {k: json_safe(v) if isinstance(v, float) else v for k, v in row.items()}
+
+
+def row_fit(row: dict[str, Any]) -> LogFit | None:
+    """The fit of a point from its row (``PointResult.row()``, or a row of sweep.json), None without one."""
+    if row["a"] is None:
+        return None
+    return LogFit.from_dict({"a": row["a"], "b": row["b"], "a_ci": [row["a_lo"], row["a_hi"]],
+                             "b_ci": [row["b_lo"], row["b_hi"]], "r2": row["r2"]})  # fmt: skip
 
 
 @dataclass

@@ -59,23 +59,6 @@ IN_PROCESS = {
     "duplicate key": (BASE + "seed: 8\n", ExitCode.USAGE, "duplicate key 'seed' at lines 2 and"),
     "duplicate nested key": (replace("hurst: 0.8", "hurst: 0.8\n    hurst: 0.9"), ExitCode.USAGE,
                              "spectrum.params: duplicate key 'hurst'"),
-    "bool realizations": (replace("realizations: 8", "realizations: true"), ExitCode.USAGE,
-                          "realizations: must be a number, not true or false, got true"),
-    "bool hurst": (replace("hurst: 0.8", "hurst: true"), ExitCode.USAGE,
-                   "spectrum.params.hurst: must be a number, not true or false"),
-    "bool seed": (replace("seed: 7", "seed: false"), ExitCode.USAGE, "seed: must be a number, not true or false"),
-    "inf stop": (replace("stop: 20.0", "stop: .inf"), ExitCode.USAGE, "loading.stop: must be a finite number, got inf"),
-    "nan rms height": (replace("rms_height: 1.0", "rms_height: .nan"), ExitCode.USAGE,
-                       "spectrum.params.rms_height: must be a finite number"),
-    "inf c0": (replace("rms_height: 1.0", "rms_height: null\n    c0: .inf"), ExitCode.USAGE,
-               "spectrum.params.c0: must be a finite number"),
-    "1e308 modulus": (replace("youngs_modulus: 1.0", "youngs_modulus: 1e308"), ExitCode.USAGE,
-                      "solver.params.youngs_modulus: must be 0 or between 1e-100 and 1e+100 in magnitude"),
-    "1e308 height": (replace("rms_height: 1.0", "rms_height: 1.0e+308"), ExitCode.USAGE,
-                     "spectrum.params.rms_height: must be 0 or between"),
-    "absolute name": (replace("name: small", "name: /tmp/escape"), ExitCode.USAGE, "name: must be 1 to 100 letters"),
-    "dotdot name": (replace("name: small", "name: ../../escape"), ExitCode.USAGE, "name: must be 1 to 100 letters"),
-    "newline name": (replace("name: small", 'name: "a\\nb"'), ExitCode.USAGE, "name: must be 1 to 100 letters"),
     "NUL name": (replace("name: small", 'name: "a\\0b"'), ExitCode.USAGE, "got 'a\\x00b'"),
     "NUL byte in the file": (BASE + "description: a\x00b\n", ExitCode.USAGE, "character #x0000 is not allowed"),
     "int past the digit limit": (replace("seed: 7", "seed: " + "1" * 5000), ExitCode.USAGE,
@@ -85,6 +68,24 @@ IN_PROCESS = {
         "hurst: 0.8\n    points: 1024\n    rms_height: 1.0", 'path: "scan\\n.csv"\n    spacing: 1.0'),
         ExitCode.USAGE, "spectrum.params.path: must not contain control characters"),
 }
+
+
+# id: (a line of the preset, what replaces it, what the message says): numbers pydantic alone would take
+NUMBERS = {
+    "bool realizations": ("realizations: 8", "realizations: true", "realizations: must be a number, not true or false, got true"),
+    "bool hurst": ("hurst: 0.8", "hurst: true", "spectrum.params.hurst: must be a number, not true or false"),
+    "bool seed": ("seed: 7", "seed: false", "seed: must be a number, not true or false"),
+    "inf stop": ("stop: 20.0", "stop: .inf", "loading.stop: must be a finite number, got inf"),
+    "nan rms height": ("rms_height: 1.0", "rms_height: .nan", "spectrum.params.rms_height: must be a finite number"),
+    "inf c0": ("rms_height: 1.0", "rms_height: null\n    c0: .inf", "spectrum.params.c0: must be a finite number"),
+    "1e308 modulus": ("youngs_modulus: 1.0", "youngs_modulus: 1e308", "solver.params.youngs_modulus: must be 0 or between 1e-100 and 1e+100 in magnitude"),
+    "1e308 height": ("rms_height: 1.0", "rms_height: 1.0e+308", "spectrum.params.rms_height: must be 0 or between"),
+}  # fmt: skip
+# names that would take the output folder elsewhere, or are no folder name at all
+FOLDER_ESCAPES = ("/tmp/escape", "../../escape", '"a\\nb"')
+IN_PROCESS.update({case: (replace(old, new), ExitCode.USAGE, message) for case, (old, new, message) in NUMBERS.items()})
+IN_PROCESS.update({f"name {name}": (replace("name: small", f"name: {name}"), ExitCode.USAGE,
+                                    "name: must be 1 to 100 letters") for name in FOLDER_ESCAPES})  # fmt: skip
 
 
 @pytest.mark.parametrize("case", list(IN_PROCESS))

@@ -9,17 +9,12 @@ import inspect
 import sys
 import textwrap
 import warnings
-from pathlib import Path
 
 import pluggy
 import pytest
 from pydantic import BaseModel, Field
 
-from frictionlab import (
-    ContactSolver,
-    PluginParams,
-    hookimpl,
-)
+from frictionlab import ContactSolver, PluginParams, hookimpl
 from frictionlab import registry as registry_module
 from frictionlab.errors import ExitCode, PluginError
 from frictionlab.hookspecs import PROJECT_NAME, RegistrationSpecs
@@ -35,14 +30,8 @@ from frictionlab.registry import (
     validate_plugin_class,
 )
 
-from .testing.fakes import provider, spectrum_class
-
-ROOT = Path(__file__).resolve().parents[1]
-
-KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
-
-
-# =========================================================================== fakes
+from .conftest import ROOT
+from .testing.fakes import KIND_HOOKS, provider, spectrum_class
 
 
 @pytest.fixture
@@ -270,25 +259,10 @@ def test_unregister_plugin(reg):
 
 
 GOOD_SOURCE = '''
-import numpy as np
-from pydantic import Field
-
 import frictionlab
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from tests.testing.fakes import spectrum_class
 
-
-class {cls}(SpectrumGenerator):
-    name = "{name}"
-    summary = "White-noise line from a fake distribution"
-
-    class Params(PluginParams):
-        points: int = Field(32, ge=8, le=4096, description="number of grid points")
-
-    def generate(self, rng):
-        return Profile(heights=rng.standard_normal(self.params.points), spacing=1.0)
-
-    def rms_height(self):
-        return 1.0
+{cls} = spectrum_class("{name}", __name__, "{cls}")  # a class of this module, as a distribution's
 
 
 @frictionlab.hookimpl

@@ -94,11 +94,15 @@ def test_plugin_contract(cls):
             assert bounds, f"{cls.__name__}.Params.{name} has no numeric bounds"
 
 
-def test_constructor_computes_nothing():
+def test_constructor_computes_nothing_and_an_edit_recomputes():
     gen = PowerLaw(hurst=0.8, points=1000)
-    assert not hasattr(gen, "_cache")
-    gen.generate(np.random.default_rng(0))
-    assert hasattr(gen, "_cache")
+    assert set(vars(gen)) == {"params"}  # the constructor only stores parameters
+    first = gen.generate(np.random.default_rng(0)).heights
+    assert set(vars(gen)) == {"params", "_cached__synthesis"}
+    gen.params.hurst = 0.5  # edited in place, as the TUI does: the synthesis follows
+    assert not np.array_equal(gen.generate(np.random.default_rng(0)).heights, first)
+    assert np.array_equal(PowerLaw(hurst=0.5, points=1000).generate(np.random.default_rng(0)).heights,
+                          gen.generate(np.random.default_rng(0)).heights)  # fmt: skip
 
 
 # ---------------------------------------------------------------- exact properties of fixed amplitudes

@@ -130,18 +130,20 @@ def result_table(scene, outcome, out_dir: Path) -> str:
 
 def sweep_table(sweep, outcome, out_dir: Path) -> str:
     """What ``frictionlab run`` prints on stdout after a sweep: one line per point."""
-    from ..fit import format_interval
+    from ..fit import format_estimate
     from ..preset import yaml_scalar
+    from ..sweep import row_fit
 
     lines = [f"{sweep.name}: {len(sweep.points)} points in {outcome.elapsed:.1f} s, status {outcome.status}"]
     for row, result in zip(outcome.rows, outcome.results, strict=True):
         values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(result.point.values[p])}" for p in sweep.paths)
-        if row["a"] is None:
+        fit = row_fit(row)
+        if fit is None:
             lines.append(f"  {row['point']:>3}  {values}: {row['status']}")
             continue
         lines.append(
-            f"  {row['point']:>3}  {values}: a = {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}, "
-            f"b = {row['b']:.4f} {format_interval((row['b_lo'], row['b_hi']))}, R^2 = {row['r2']:.3f}, "
+            f"  {row['point']:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
+            f"b = {format_estimate(fit.b, fit.b_ci)}, R^2 = {fit.r2:.3f}, "
             f"contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
             + ("" if row["status"] == "completed" else f" ({row['status']})")
         )

@@ -8,7 +8,8 @@ import math
 import os
 
 from .. import __version__
-from ..fit import format_interval
+from ..fit import format_estimate
+from ..sweep import row_fit
 from .figures import FIGURES, PAPER_H07, PAPER_POINTS_VS_H, FigureRun
 from .plots import F_UNIT
 from .readings import AVERAGES, ReadingRow
@@ -59,18 +60,17 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         s = run.figure
         if run.sweep is not None:
             row = _row_for_h(run, PAPER_H07[0])
-            path = run.sweep.paths[0]
+            fit = row_fit(row)
             lines.append(
-                f"| Fig. 5 at H = {row[path]:g} | about {s.a} | {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))}"
-                f"{_inside(s.a, (row['a_lo'], row['a_hi']))} | about {s.b} | {row['b']:.4f} "
-                f"{format_interval((row['b_lo'], row['b_hi']))}{_inside(s.b, (row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
-                f"{row['contact_first']:.2f} at F = 1, {row['contact_last']:.2f} at F = 20 (not stated) |"
+                f"| Fig. 5 at H = {row[run.sweep.paths[0]]:g} | about {s.a} | {format_estimate(fit.a, fit.a_ci)}"
+                f"{_inside(s.a, fit.a_ci)} | about {s.b} | {format_estimate(fit.b, fit.b_ci)}{_inside(s.b, fit.b_ci)} | "
+                f"{fit.r2:.3f} | {row['contact_first']:.2f} at F = 1, {row['contact_last']:.2f} at F = 20 (not stated) |"
             )
             continue
         fit = run.outcome.fit
         lines.append(
-            f"| {s.title} | {s.a} | {fit.a:.4f} {format_interval(fit.a_ci)}{_inside(s.a, fit.a_ci)} | {s.b} | {fit.b:.4f} "
-            f"{format_interval(fit.b_ci)}{_inside(s.b, fit.b_ci)} | {fit.r2:.3f} | {_counts_text(run)}"
+            f"| {s.title} | {s.a} | {format_estimate(fit.a, fit.a_ci)}{_inside(s.a, fit.a_ci)} | {s.b} | "
+            f"{format_estimate(fit.b, fit.b_ci)}{_inside(s.b, fit.b_ci)} | {fit.r2:.3f} | {_counts_text(run)}"
             + ("" if s.counts else " (not stated)") + " |"
         )
     for run in runs:
@@ -105,14 +105,12 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
                 "|---|---|---|---|---|",
             ]
             for row in run.sweep_outcome.rows:
-                if row["a"] is None:
+                fit = row_fit(row)
+                if fit is None:
                     lines.append(f"| {row[path]:g} | {row['status']} | | | |")
                     continue
-                lines.append(
-                    f"| {row[path]:g} | {row['a']:.4f} {format_interval((row['a_lo'], row['a_hi']))} | {row['b']:.4f} "
-                    f"{format_interval((row['b_lo'], row['b_hi']))} | {row['r2']:.3f} | "
-                    f"{row['contact_first']:.2f} / {row['contact_last']:.2f} |"
-                )
+                lines.append(f"| {row[path]:g} | {format_estimate(fit.a, fit.a_ci)} | {format_estimate(fit.b, fit.b_ci)} | "
+                             f"{fit.r2:.3f} | {row['contact_first']:.2f} / {row['contact_last']:.2f} |")  # fmt: skip
         lines += ["", f"![{s.title}]({images[s.key]})"]
     if readings is not None:
         lines += readings_markdown(readings)
@@ -158,14 +156,14 @@ def fig5_calibrated_markdown(run: FigureRun, rows: list[ReadingRow], image: str,
         base = default.get(hurst)
         base_text = f"{base['a']:.4f}, {base['b']:.4f}" if base else "n/a"
         lines.append(
-            f"| {hurst:g} | {r.rms_height:g} | {r.fit.a:.4f} {format_interval(r.fit.a_ci)}{a_mark} | {r.fit.b:.4f} {format_interval(r.fit.b_ci)}{b_mark} | "
+            f"| {hurst:g} | {r.rms_height:g} | {format_estimate(r.fit.a, r.fit.a_ci)}{a_mark} | {format_estimate(r.fit.b, r.fit.b_ci)}{b_mark} | "
             f"{r.fit.r2:.3f} | {r.counts[0]:.2f} / {r.counts[1]:.2f} | {base_text} | {paper[2] if paper else ''} |"
         )
         if paper:
             inside = [name for name, mark in (("a", a_mark), ("b", b_mark)) if not mark]
             verdicts.append(f"H = {hurst:g}: " + (" and ".join(inside) + " inside" if inside else "neither inside"))
     top = max(rows, key=lambda r: r.fit.a)
-    lines += ["", f"Largest a with h calibrated: {top.fit.a:.4f} {format_interval(top.fit.a_ci)} at H = {top.hurst():g}"]
+    lines += ["", f"Largest a with h calibrated: {format_estimate(top.fit.a, top.fit.a_ci)} at H = {top.hurst():g}"]
     if default:
         top_h = max(default, key=lambda h: default[h]["a"])
         lines[-1] += f"; with h = {run.preset_rms_height()}: {default[top_h]['a']:.4f} at H = {top_h:g}"
@@ -205,8 +203,8 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         sets = " ".join(f"`{o}`" for o in r.overrides) or "(none)"
         counts = f"{r.counts[0]:.2f} at F = {r.loads[0]:g}, {r.counts[1]:.2f} at F = {r.loads[1]:g}"
         lines.append(
-            f"| {s.key[-1]} | {r.reading.name} | {sets} | {r.reading.average} | {r.fit.a:.4f} {format_interval(r.fit.a_ci)}"
-            f"{_inside(s.a, r.fit.a_ci)} | {r.fit.b:.4f} {format_interval(r.fit.b_ci)}{_inside(s.b, r.fit.b_ci)} | {r.fit.r2:.3f} | {counts} |"
+            f"| {s.key[-1]} | {r.reading.name} | {sets} | {r.reading.average} | {format_estimate(r.fit.a, r.fit.a_ci)}"
+            f"{_inside(s.a, r.fit.a_ci)} | {format_estimate(r.fit.b, r.fit.b_ci)}{_inside(s.b, r.fit.b_ci)} | {r.fit.r2:.3f} | {counts} |"
         )
     lines += ["", "Paper: " + "; ".join(
         f"Fig. {s.key[-1]}: a = {s.a}, b = {s.b}"

@@ -139,6 +139,13 @@ def _line_rms(slopes: np.ndarray) -> float:
 # ------------------------------------------------------------ the sorted sweep
 
 
+def _curve(force, indentation, count, points: int, slope_rms, extras: dict) -> ContactCurve:
+    """The answer over the sweep: ``count`` of the ``points`` springs in contact at each load."""
+    count = np.asarray(count).astype(np.int64, copy=False)
+    return ContactCurve(force=force, indentation=indentation, contact_count=count, contact_fraction=count / points,
+                        slope_rms_contact=slope_rms, extras=extras)  # fmt: skip
+
+
 class SpringRow(ContactSolver):
     """Independent springs of stiffness ``stiffness() * dx``: exact sweep from one
     (partial) sort. Not registered itself; subclasses define ``stiffness`` and
@@ -223,15 +230,8 @@ class SpringRow(ContactSolver):
             if full.any():  # xi = 1 to the last bit at full contact
                 slope_rms[full] = _line_rms(slopes)
 
-        n = n.astype(np.int64, copy=False)
-        return ContactCurve(
-            force=force,
-            indentation=indentation,
-            contact_count=n,
-            contact_fraction=n / points,
-            slope_rms_contact=slope_rms,
-            extras={"candidates": np.full(loads.size, count, dtype=np.int64)},
-        )
+        candidates = np.full(loads.size, count, dtype=np.int64)
+        return _curve(force, indentation, n, points, slope_rms, {"candidates": candidates})
 
 
 # -------------------------------------------------------------------- plugins
@@ -372,11 +372,4 @@ class BisectionSprings(MDRSprings):
             count[j] = int(contact.sum())
             slope_rms[j] = _line_rms(slopes[contact])
 
-        return ContactCurve(
-            force=force,
-            indentation=indentation,
-            contact_count=count,
-            contact_fraction=count / points,
-            slope_rms_contact=slope_rms,
-            extras={"iterations": iterations, "residual": residual},
-        )
+        return _curve(force, indentation, count, points, slope_rms, {"iterations": iterations, "residual": residual})

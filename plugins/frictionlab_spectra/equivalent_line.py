@@ -34,6 +34,7 @@ from pydantic import Field, model_validator
 
 from frictionlab import PluginParams, Profile, SpectrumGenerator, mdr_length
 
+from .params_cache import cached_on_params
 from .power_law import TWO_PI, line_coefficients, random_phase_line
 
 MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
@@ -71,7 +72,6 @@ def line_mode_powers(wavenumber: np.ndarray, power: np.ndarray, points: int, spa
 
 @dataclass(frozen=True)
 class _Synthesis:
-    key: tuple
     wavenumber: np.ndarray  # q_k, k = 1 .. N // 2
     amplitude: np.ndarray  # a_k of z = sum a_k cos(q_k x + phi_k), sum a_k^2 / 2 == h^2
     coeff: np.ndarray  # irfft coefficients of the regular modes (``line_coefficients``)
@@ -119,18 +119,14 @@ class EquivalentLine(SpectrumGenerator):
         return cls(points=points, spacing=line_spacing, rms_height=rms_height,
                    mode_power=tuple(powers.tolist()), amplitudes=amplitudes)  # fmt: skip
 
+    @cached_on_params
     def _synthesis(self) -> _Synthesis:
-        key = tuple(self.params.__dict__.items())  # Params may be edited in place
-        cached = getattr(self, "_cache", None)
-        if cached is not None and cached.key == key:
-            return cached
         p = self.params
         q = (TWO_PI / (p.points * p.spacing)) * np.arange(1, p.points // 2 + 1)
         power = np.asarray(p.mode_power, dtype=np.float64)
         amplitude = np.sqrt(2.0 * power) * (p.rms_height / math.sqrt(float(power.sum())))  # a_k^2 / 2 = P_k
         coeff, nyquist = line_coefficients(amplitude, p.points, p.points // 2)
-        self._cache = _Synthesis(key, q, amplitude, coeff, nyquist)
-        return self._cache
+        return _Synthesis(q, amplitude, coeff, nyquist)
 
     def generate(self, rng: np.random.Generator) -> Profile:
         """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes)."""

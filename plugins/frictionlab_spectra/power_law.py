@@ -38,6 +38,8 @@ from pydantic import Field, model_validator
 
 from frictionlab import PluginParams, Profile, SpectrumGenerator
 
+from .params_cache import cached_on_params
+
 TWO_PI = 2.0 * math.pi
 REL_TOL = 1e-9  # band edges and length/spacing consistency are checked to this relative tolerance
 SQRT_HALF = math.sqrt(0.5)
@@ -192,7 +194,6 @@ def band_integral(band: Band, power: float, above: float, below: float) -> float
 class _Synthesis:
     """Everything ``generate`` needs, derived once from the parameters."""
 
-    key: tuple
     band: Band
     psd_knee: float  # psd at the knee (flat level below it)
     rms_height: float  # discrete: sqrt(sum a_k^2 / 2)
@@ -308,12 +309,8 @@ class BandLimitedSpectrum(SpectrumGenerator):
 
     # ------------------------------------------------------------ cache
 
+    @cached_on_params
     def _synthesis(self) -> _Synthesis:
-        # keyed on the parameter values: Params may be edited in place (validate_assignment)
-        key = tuple(self.params.__dict__.items())
-        cached = getattr(self, "_cache", None)
-        if cached is not None and cached.key == key:
-            return cached
         p = self.params
         band = p.resolve_band()
         a = 2.0 * p.hurst + 1.0
@@ -338,8 +335,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
         if not (math.isfinite(h) and h > 0 and np.all(np.isfinite(amplitudes))):
             raise ValueError(f"c0={p.c0!r} gives amplitudes that are not finite positive numbers")
         coeff, nyquist = line_coefficients(amplitudes, band.period_points, band.k_hi)
-        self._cache = _Synthesis(key, band, psd_knee, h, coeff, nyquist, amplitudes)
-        return self._cache
+        return _Synthesis(band, psd_knee, h, coeff, nyquist, amplitudes)
 
     # ------------------------------------------------------------ geometry
 

@@ -29,6 +29,8 @@ from pydantic import Field
 
 from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
 
+from .params_cache import cached_on_params
+
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -36,7 +38,6 @@ SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param w
 
 @dataclass(frozen=True)
 class _Line:
-    key: tuple
     heights: np.ndarray
     spacing: float
     rms_height: float
@@ -81,11 +82,8 @@ class ProfileFile(SpectrumGenerator):
 
     # ------------------------------------------------------------ reading
 
+    @cached_on_params
     def _line(self) -> _Line:
-        key = tuple(self.params.__dict__.items())
-        cached = getattr(self, "_cache", None)
-        if cached is not None and cached.key == key:
-            return cached
         p = self.params
         path = Path(p.path)
         x, z = _read_columns(path)
@@ -116,8 +114,7 @@ class ProfileFile(SpectrumGenerator):
                 "a flat line has no roughness"
             )
         heights.flags.writeable = False
-        self._cache = _Line(key, heights, float(dx), rms)
-        return self._cache
+        return _Line(heights, float(dx), rms)
 
 
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:

@@ -37,6 +37,7 @@ from pydantic import Field
 from frictionlab import Profile, SpectrumGenerator
 
 from .equivalent_line import EquivalentLine
+from .params_cache import cached_on_params
 from .power_law import (
     JACOBS_JUNGE_PASTEWKA_2017,
     PERSSON_2005,
@@ -74,7 +75,6 @@ class _SurfaceSynthesis:
     array, columns 0 .. Kx): only |ky| <= Ky and kx <= Kx can lie in the band.
     """
 
-    key: tuple
     band: Band
     shape: tuple[int, int]  # (Ny, Nx)
     psd_knee: float  # C2D at the knee (flat level below it)
@@ -121,11 +121,8 @@ class BandLimitedSurface(SpectrumGenerator):
 
     # ------------------------------------------------------------ cache
 
+    @cached_on_params
     def _synthesis(self) -> _SurfaceSynthesis:
-        key = tuple(self.params.__dict__.items())  # Params may be edited in place
-        cached = getattr(self, "_cache", None)
-        if cached is not None and cached.key == key:
-            return cached
         p = self.params
         band, ny, nx = _surface_band(p)
         dx = band.spacing
@@ -166,11 +163,10 @@ class BandLimitedSurface(SpectrumGenerator):
         positive = np.arange(1, min(ky_max, (ny - 1) // 2) + 1)  # ky whose partner -ky is another row
         pairs = (np.searchsorted(rows, positive), np.searchsorted(rows, ny - positive))
         real = [0] + ([ny // 2] if ny % 2 == 0 and ky_max == ny // 2 else [])
-        self._cache = _SurfaceSynthesis(
-            key, band, (ny, nx), psd_knee, h, rows, amplitude, q, weight, tuple(columns), pairs,
+        return _SurfaceSynthesis(
+            band, (ny, nx), psd_knee, h, rows, amplitude, q, weight, tuple(columns), pairs,
             np.searchsorted(rows, real),
         )
-        return self._cache
 
     # ------------------------------------------------------------ geometry
 

@@ -38,6 +38,7 @@ from pydantic import Field
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
 from .equivalent_line import EquivalentLine
+from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, read_text_table, remove_mean
 
@@ -46,7 +47,6 @@ MIN_SIDE = 8
 
 @dataclass(frozen=True)
 class _Map:
-    key: tuple
     heights: np.ndarray  # detrended, read-only
     spacing: float
     rms_height: float
@@ -144,11 +144,8 @@ class SurfaceFile(SpectrumGenerator):
 
     # ------------------------------------------------------------ reading
 
+    @cached_on_params
     def _map(self) -> _Map:
-        key = tuple(self.params.__dict__.items())
-        cached = getattr(self, "_cache", None)
-        if cached is not None and cached.key == key:
-            return cached
         p = self.params
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
@@ -162,8 +159,7 @@ class SurfaceFile(SpectrumGenerator):
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
-        self._cache = _Map(key, heights, float(p.spacing), rms)
-        return self._cache
+        return _Map(heights, float(p.spacing), rms)
 
 
 def _read_map(path: Path, where: str) -> np.ndarray:

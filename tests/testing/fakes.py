@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import types
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,15 +21,7 @@ from frictionlab import (
 from frictionlab import testing as fltesting
 from frictionlab.plugin import KINDS
 
-ROOT = Path(__file__).resolve().parents[2]
-
 KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
-
-
-# =========================================================================== fakes
-
-
-# ========================================= conformance: broken plugins fail
 
 
 class GoodSpectrum(SpectrumGenerator):
@@ -181,3 +172,10 @@ def forward_differences(heights, spacing, periodic=True):
     if not periodic:
         out[-1] = out[-2]
     return out
+
+
+def fails_naming(check, cls, match: str) -> None:
+    """``check(cls)`` fails with a message that matches ``match`` and names the class."""
+    with pytest.raises(AssertionError, match=match) as excinfo:
+        check(cls)
+    assert cls.__qualname__ in str(excinfo.value)

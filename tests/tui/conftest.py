@@ -93,6 +93,19 @@ async def wait_until(pilot, condition, timeout=60.0):
     raise AssertionError("timed out waiting for the app")
 
 
+async def press_run(pilot):
+    """Ctrl+R once the app has settled."""
+    await pilot.pause()
+    await pilot.press("ctrl+r")
+
+
+async def run_to_the_end(pilot):
+    """Ctrl+R, then wait for the run (or sweep) to finish and the app to show it."""
+    await press_run(pilot)
+    await wait_until(pilot, lambda: pilot.app.last_outcome is not None)
+    await pilot.pause()
+
+
 def error_text(app, widget_id):
     label = app.query_one(f"#{widget_id}--error", Static)
     return str(label.render()) if label.display else ""

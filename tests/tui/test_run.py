@@ -21,6 +21,8 @@ from .conftest import (
     fits_width,
     make_app,
     numbers_in,
+    press_run,
+    run_to_the_end,
     sync,
     wait_until,
 )
@@ -32,10 +34,7 @@ from .conftest import (
 async def test_a_run_shows_the_headless_coefficients(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: app.last_outcome is not None)
-        await pilot.pause()
+        await run_to_the_end(pilot)
         shown = str(app.query_one("#run-fit", Static).render())
         out_dir = app.last_out_dir
         runs_listed = [entry.path.name for entry in app.query_one(ResultsPane).runs]
@@ -58,8 +57,7 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
     (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
     app = make_app(registry, preset="presets/long.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
+        await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
         await pilot.press("c")  # the Run tab has focus
         await wait_until(pilot, lambda: app.last_outcome is not None)
@@ -79,10 +77,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
     (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
     app = make_app(registry, preset="presets/sweep.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: app.last_outcome is not None)
-        await pilot.pause()
+        await run_to_the_end(pilot)
         table = app.query_one("#sweep-table")
         cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
         columns = [str(c.label) for c in table.columns.values()]
@@ -120,8 +115,7 @@ async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders
     (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(big, sort_keys=False))
     app = make_app(registry, preset="presets/sweep.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
+        await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
         await pilot.press("c")
         await wait_until(pilot, lambda: app.last_outcome is not None)

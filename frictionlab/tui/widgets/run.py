@@ -12,7 +12,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.widgets import DataTable, ProgressBar, Static
 
-from ...fit import format_interval
+from ...fit import format_estimate
 from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
@@ -32,8 +32,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
         lines = [
             head,
             *what,
-            f"  a = {fit.a:.4f} {format_interval(fit.a_ci, missing='')}",
-            f"  b = {fit.b:.4f} {format_interval(fit.b_ci, missing='')}",
+            f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
+            f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
             f"  {level} CI, bootstrap {fit.bootstrap}",
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
