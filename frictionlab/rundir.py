@@ -45,7 +45,7 @@ from . import __version__
 from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
 from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, read_regular_file, sha256_of
-from .preset import Scene, load_preset_file
+from .preset import Scene, differences, load_preset_file
 from .realization import RealizationResult
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
@@ -90,22 +90,6 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
 def fingerprint(resolved: dict) -> str:
     text = json.dumps(resolved, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def preset_differences(old, new, path: str = "") -> list[str]:
-    """Dotted paths where two resolved presets differ, with both values."""
-    if isinstance(old, dict) and isinstance(new, dict):
-        out = []
-        for key in list(old) + [k for k in new if k not in old]:
-            where = f"{path}.{key}" if path else str(key)
-            if key not in old or key not in new:
-                out.append(f"{where}: {old.get(key, '(absent)')!r} in the run directory, {new.get(key, '(absent)')!r} given")
-            else:
-                out.extend(preset_differences(old[key], new[key], where))
-        return out
-    if old != new:
-        return [f"{path}: {old!r} in the run directory, {new!r} given"]
-    return []
 
 
 class ChunkDamage(ValueError):
@@ -276,8 +260,8 @@ class RunDirectory:
         status = state.get("status")
         if status == "completed" and state.get("fingerprint") != fingerprint(resolved):
             old = state.get("preset")
-            differences = preset_differences(old, resolved) if isinstance(old, dict) else []
-            fields = ", ".join(d.split(":", 1)[0] for d in differences[:5]) or "its fingerprint"
+            changed = differences(old, resolved) if isinstance(old, dict) else []
+            fields = ", ".join(d.split(":", 1)[0] for d in changed[:5]) or "its fingerprint"
             raise OutputRefused(
                 f"{self.path} holds a finished run of another preset (it differs in {fields}): "
                 f"{hint} (its results are then replaced)"
@@ -305,10 +289,10 @@ class RunDirectory:
             raise RunFolderError(f"{self.path} holds no run to resume (no {STATE_FILE})")
         if state.get("fingerprint") != fingerprint(resolved):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
-            differences = preset_differences(stored, resolved)
+            changed = differences(stored, resolved)
             raise RunFolderError(
                 f"cannot resume {self.path}: its preset differs from the one given\n  "
-                + "\n  ".join(differences or ["(the fingerprints differ)"])
+                + "\n  ".join(changed or ["(the fingerprints differ)"])
             )
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in inputs.items():

@@ -7,7 +7,7 @@ plugin and validates its ``params`` with the plugin's own ``Params`` model
 preset files safely; ``paths`` sets values by dotted path (``--set``).
 """
 
-from .paths import MISSING, apply_overrides, get_path, set_path, yaml_scalar
+from .paths import MISSING, apply_overrides, differences, get_path, set_path, yaml_scalar
 from .problems import format_validation_error, number_problems
 from .reading import MAX_PRESET_BYTES, load_preset_file, read_preset, resolve_input_paths
 from .scene import Scene, build_scene, load_scene
@@ -37,6 +37,7 @@ __all__ = [
     "SweepSettings",
     "apply_overrides",
     "build_scene",
+    "differences",
     "format_validation_error",
     "get_path",
     "load_preset_file",

@@ -87,3 +87,20 @@ def yaml_scalar(value: Any) -> str:
     if yaml.safe_load(text) != value or type(yaml.safe_load(text)) is not type(value):
         raise ValueError(f"cannot spell {value!r} as a YAML scalar")
     return text
+
+
+def differences(old, new, path: str = "") -> list[str]:
+    """The dotted paths where two (resolved) presets differ, each with both values
+    (the first as stored in a run directory, the second as given)."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for key in list(old) + [k for k in new if k not in old]:
+            where = f"{path}.{key}" if path else str(key)
+            if key not in old or key not in new:
+                out.append(f"{where}: {old.get(key, '(absent)')!r} in the run directory, {new.get(key, '(absent)')!r} given")
+            else:
+                out.extend(differences(old[key], new[key], where))
+        return out
+    if old != new:
+        return [f"{path}: {old!r} in the run directory, {new!r} given"]
+    return []
