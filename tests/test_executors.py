@@ -150,9 +150,19 @@ needs_dask = pytest.mark.skipif(distributed is None, reason='dask is not install
 
 
 @pytest.fixture(scope="module")
-def dask_scheduler():
+def two_worker_cluster():
     with loopback_cluster(2) as cluster:
-        yield cluster.scheduler_address
+        yield cluster
+
+
+@pytest.fixture
+def dask_scheduler(two_worker_cluster):
+    """The module's cluster with both its workers: a test that kills one leaves it to
+    its nanny, which restarts it in the background; the next test waits for it
+    (reading the cluster at once would see one worker, now and then)."""
+    with distributed.Client(two_worker_cluster.scheduler_address, timeout="30s") as client:
+        client.wait_for_workers(2, timeout=120)
+    return two_worker_cluster.scheduler_address
 
 
 @needs_dask
