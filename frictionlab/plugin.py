@@ -9,9 +9,12 @@ all work happens in the methods, and randomness arrives as a
 
 The framework reads a plugin only through the class attributes and methods
 declared on ``SpectrumGenerator``, ``ContactSolver`` and ``SlopeEstimator``
-below (optional ones have defaults); ``frictionlab.testing.check_plugin``
-checks each of them. The dimensionless force f is formed in one place,
-``force_unit``, from what the solver declares its load to mean
+below (optional ones have defaults), listed by ``contract(kind)``;
+``frictionlab.testing.check_plugin`` checks each of them. Of ``params`` it reads
+the values (the resolved preset) and the fields annotated ``frictionlab.InputFile``:
+files it takes relative to the preset's folder, checks before the run and records
+with their SHA-256. The dimensionless force f is formed in one place,
+``ForceNormalisation.force_unit``, from what the solver declares its load to mean
 (``ContactSolver.normalisations``).
 
 Nothing here is physics: the built-in physics lives in ``plugins/``.
