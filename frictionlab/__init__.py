@@ -1,16 +1,19 @@
 """frictionlab: rms slope in contact against normal force, over ensembles of
 random rough lines pressed into elastic bodies.
 
-The framework (hooks, registry, presets, engine, fit, result files, CLI) lives
-here; the physics lives in plugins (``frictionlab_spectra``,
+The framework (the plugin contract, hooks, registry, presets, engine, fit, result
+files) lives here, with its front ends (``cli``, ``tui``) and the studies built on
+it (``paper``, ``tradeoff``); the physics lives in plugins (``frictionlab_spectra``,
 ``frictionlab_solvers``, ``frictionlab_slopes``) that register through the same
-hooks as any third-party plugin.
+hooks as any third-party plugin. ARCHITECTURE.md draws the layers.
 """
 
 from importlib.metadata import PackageNotFoundError, version
 
 from .hookspecs import hookimpl
 from .inputs import InputFile, InputFileProblem, open_regular_file
+from .listeners import RunListener, SweepListener
+from .options import RunOptions
 from .plugin import (
     ContactCurve,
     ContactSolver,
@@ -21,6 +24,7 @@ from .plugin import (
     Profile,
     SlopeEstimator,
     SpectrumGenerator,
+    contract,
     force_unit,
     mdr_length,
 )
@@ -40,9 +44,13 @@ __all__ = [
     "Plugin",
     "PluginParams",
     "Profile",
+    "RunListener",
+    "RunOptions",
     "SlopeEstimator",
     "SpectrumGenerator",
+    "SweepListener",
     "__version__",
+    "contract",
     "force_unit",
     "hookimpl",
     "mdr_length",
