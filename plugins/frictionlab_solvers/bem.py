@@ -69,13 +69,11 @@ class ConstrainedCG:
         self.compliance = _compliance(self.shape)
         # pressure on one point per unit of its own displacement
         self.point_stiffness = 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
-        self.displaced = np.empty(self.shape)
-        self.gap = np.empty(self.shape)
-        self.direction = np.empty(self.shape)
+        self.gap = np.empty(self.shape)  # displacement + depth, before the rigid level
+        self.direction = np.zeros(self.shape)  # the search direction, zero off its contact set
         self.response = np.empty(self.shape)
-        self.scratch = np.empty(self.shape)
-        self.mask = np.empty(self.shape)
-        self.free_gap = np.empty(self.shape)
+        self.below = np.empty(self.shape, dtype=bool)
+        self.unloaded = np.empty(self.shape, dtype=bool)
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Zero-mean surface displacement under ``pressure``."""
@@ -110,28 +108,29 @@ class ConstrainedCG:
         Returns ``(pressure, approach, iterations, residual)``; raises
         ``_NotConverged`` after ``max_iterations`` steps.
 
-        The search direction is conjugate only on a fixed contact set. After a
-        step that clipped or added points it is carried over (masked to the new
-        set) only if the gap norm did not grow; otherwise the CG restarts from
-        steepest descent. The CG factor ``|gap|^2 / |previous gap|^2`` compares
-        gaps on two different sets there: after a warm start whose contact gaps
-        were already closed it reached 1e30, the stale direction swamped the
-        gap while still passing the descent test, and the steps shrank to 1e-31
-        (the iteration froze). Restarting at every set change, as Polonsky &
-        Keer do when points are added, is as safe but took 1.1-1.6x more
-        iterations on random surfaces at 0.5-20 % contact.
+        The CG works on the contact set's points only (gathered vectors); whole
+        grids are touched by one FFT pair (the response to the direction), one
+        update and one minimum of the gap per iteration. The gap is updated from
+        the step's response while the contact set is unchanged; it is recomputed
+        exactly (a second FFT pair) when points are clipped or added, every
+        ``REFRESH`` steps, and before convergence is accepted. Under force
+        control the direction has zero sum, so a step keeps the load; the load
+        is restored exactly after points are clipped or added.
 
-        The displacement is updated from the CG step's response (one FFT pair per
-        iteration instead of two) while the contact set is unchanged by the step;
-        it is recomputed exactly when points are clipped or added, every
-        ``REFRESH`` steps, and before convergence is accepted.
+        The search direction is conjugate only on a fixed contact set. After a
+        step that clipped or added points it is carried over (restricted to the
+        new set) only if the gap norm did not grow; otherwise the CG restarts
+        from steepest descent. The CG factor ``|gap|^2 / |previous gap|^2``
+        compares gaps on two different sets there: after a warm start whose
+        contact gaps were already closed it reached 1e30, the stale direction
+        swamped the gap while still passing the descent test, and the steps
+        shrank to 1e-31 (the iteration froze). Restarting at every set change,
+        as Polonsky & Keer do when points are added, is as safe but took
+        1.1-1.6x more iterations on random surfaces at 0.5-20 % contact.
         """
         force_control = approach is None
-        p, w, g, t, r = pressure, self.displaced, self.gap, self.direction, self.response
-        mask, gap_on_contact = self.mask, self.scratch
-        flat = lambda a: a.reshape(-1)  # noqa: E731 - views for BLAS and dot
-        restart, changed = True, True
-        previous_norm = 1.0
+        p, g, r, t_grid = pressure.reshape(-1), self.gap.reshape(-1), self.response, self.direction
+        t_flat, depth = t_grid.reshape(-1), self.depth.reshape(-1)
         level = approach
         if force_control:  # the load is part of the answer: start from a pressure that carries it
             total = float(p.mean())
@@ -139,92 +138,111 @@ class ConstrainedCG:
                 p *= mean_pressure / total
             else:
                 p.fill(mean_pressure)
-        self.displacement(p, w)
+        t_flat.fill(0.0)
+        direction_on = np.empty(0, dtype=np.intp)  # where t_grid is non-zero
+        contact = np.flatnonzero(p)
+        p_c = p[contact]
+        self._exact_gap(pressure)
         exact, since_exact = True, 0
+        restart, changed, previous_norm = True, True, 1.0
         iteration = 0
         while True:
-            # gap g = w + u - d: zero on contact points, >= 0 elsewhere
-            np.add(w, self.depth, out=g)
-            np.sign(p, out=mask)  # 1 on contact points (p > 0), 0 elsewhere
-            touching = float(mask.sum())
-            if touching == 0.0:  # only possible under indentation control
-                np.subtract(level, self.depth, out=p)
+            if contact.size == 0:  # only possible under indentation control
+                np.subtract(level, depth, out=p)
                 np.maximum(p, 0.0, out=p)
-                self.displacement(p, w)
+                contact = np.flatnonzero(p)
+                p_c = p[contact]
+                self._exact_gap(pressure)
                 exact, since_exact, restart = True, 0, True
                 continue
+            # gap on contact points: g - level, zero at the solution
+            g_c = g[contact]
             if force_control:
-                level = float(np.dot(flat(g), flat(mask))) / touching
-            g -= level
-
-            np.multiply(g, mask, out=gap_on_contact)
-            worst_contact = max(float(gap_on_contact.max()), -float(gap_on_contact.min()))
-            # g - gap_on_contact is the gap of free points (0 on contact ones)
-            np.subtract(g, gap_on_contact, out=self.free_gap)
-            worst_free = max(0.0, -float(self.free_gap.min()))
+                level = float(g_c.mean())
+            g_c -= level
+            worst_contact = float(np.abs(g_c).max())
+            # the penetration of free points: the lowest gap overall is either a free
+            # point's or a contact point's, and then worst_contact already covers it
+            worst_free = max(0.0, level - float(g.min()))
             residual = max(worst_contact, worst_free) / self.rms
             if residual <= tolerance:
-                if not exact:  # accept only what an exact displacement confirms
-                    self.displacement(p, w)
+                if not exact:  # accept only what an exact gap confirms
+                    p[contact] = p_c
+                    self._exact_gap(pressure)
                     exact, since_exact = True, 0
                     continue
-                return p, float(level), iteration, residual
+                p[contact] = p_c
+                return pressure, float(level), iteration, residual
             if iteration == max_iterations:
                 raise _NotConverged(iteration, residual)
             iteration += 1
 
-            norm = float(np.dot(flat(gap_on_contact), flat(gap_on_contact)))
+            norm = float(np.dot(g_c, g_c))
             if norm > 0.0:
                 if restart or (changed and norm > previous_norm):
-                    t[...] = gap_on_contact
-                else:  # conjugate to the last direction on the current contact set
-                    t *= mask
-                    t *= norm / previous_norm
-                    t += gap_on_contact
-                    if not float(np.dot(flat(gap_on_contact), flat(t))) > 0.0:
-                        t[...] = gap_on_contact
+                    t_c = g_c.copy()
+                else:  # conjugate to the last direction, restricted to the current contact set
+                    t_c = t_flat[contact]
+                    t_c *= norm / previous_norm
+                    t_c += g_c
+                if force_control:  # a zero-sum direction keeps the load
+                    t_c -= t_c.mean()
+                if not float(np.dot(g_c, t_c)) > 0.0:
+                    t_c = g_c.copy()
                 previous_norm = norm
-                self.displacement(t, r)
-                curvature = float(np.dot(flat(t), flat(r)))
-                if force_control:  # the step keeps the mean pressure: r minus its contact mean
-                    curvature -= float(np.dot(flat(r), flat(mask))) / touching * float(t.sum())
+                if changed:
+                    t_flat[direction_on] = 0.0
+                    direction_on = contact
+                t_flat[contact] = t_c
+                self.displacement(t_grid, r)
+                r_c = r.reshape(-1)[contact]
+                curvature = float(np.dot(t_c, r_c))
                 if not curvature > 0.0:  # no descent left along t: stuck
                     raise _NotConverged(iteration, residual)
-                step = float(np.dot(flat(gap_on_contact), flat(t))) / curvature
-                _axpy(-step, t, p)
-                clipped = float(p.min()) < 0.0
+                step = float(np.dot(g_c, t_c)) / curvature
+                _axpy(-step, t_c, p_c)
+                clipped = float(p_c.min()) < 0.0
                 if clipped:
-                    np.maximum(p, 0.0, out=p)
+                    np.maximum(p_c, 0.0, out=p_c)
             else:  # contact gaps already closed (a scaled warm start): only add points,
                 step = self.point_stiffness  # each with the pressure that lifts it alone
                 clipped = False
             # free points that penetrate get pressure -step * gap (Polonsky & Keer)
-            added = worst_free > 0.0 or clipped
-            if added:
-                np.minimum(g, 0.0, out=gap_on_contact)
-                np.equal(p, 0.0, out=mask)  # only points without pressure now
-                gap_on_contact *= mask
-                added = bool(gap_on_contact.min() < 0.0)
-                if added:
-                    _axpy(-step, gap_on_contact, p)
+            added = False
+            if worst_free > 0.0 or clipped:
+                p[contact] = p_c
+                below, unloaded = self.below.reshape(-1), self.unloaded.reshape(-1)
+                np.less(g, level, out=below)
+                np.equal(p, 0.0, out=unloaded)
+                below &= unloaded
+                entering = np.flatnonzero(below)
+                if entering.size:
+                    p[entering] = step * (level - g[entering])
+                    added = True
             changed = clipped or added or norm == 0.0
             restart = norm == 0.0  # no direction was built to carry on
             if changed or since_exact >= REFRESH:
-                self.displacement(p, w)
+                p[contact] = p_c
+                if force_control:
+                    total = float(p.mean())
+                    if not total > 0.0:  # cannot happen in exact arithmetic; start over
+                        p.fill(mean_pressure)
+                        restart = changed = True
+                    else:
+                        p *= mean_pressure / total
+                if changed:
+                    contact = np.flatnonzero(p)
+                p_c = p[contact]
+                self._exact_gap(pressure)
                 exact, since_exact = True, 0
-            else:  # linear in p: w(p - step t) = w - step r
-                _axpy(-step, r, w)
+            else:  # linear in p: g(p - step t) = g - step r
+                _axpy(-step, r, self.gap)
                 exact, since_exact = False, since_exact + 1
-            if force_control:
-                total = float(p.mean())
-                if not total > 0.0:  # cannot happen in exact arithmetic; start over
-                    p.fill(mean_pressure)
-                    self.displacement(p, w)
-                    exact, since_exact = True, 0
-                else:
-                    ratio = mean_pressure / total
-                    p *= ratio
-                    w *= ratio
+
+    def _exact_gap(self, pressure: np.ndarray) -> None:
+        """``gap = displacement(pressure) + depth``, from the pressure itself."""
+        self.displacement(pressure, self.gap)
+        self.gap += self.depth
 
 
 def _axpy(a: float, x: np.ndarray, y: np.ndarray) -> None:
