@@ -159,6 +159,47 @@ def law(repeat: int) -> None:
         f"  largest relative difference from them: xi {xi_error.max():.2e}, real contact area {area_error.max():.2e}; "
         f"contact counts differ at {np.count_nonzero(sweep.contact_count != count)} of 20 loads  (target 1e-6)"
     )
+    where_the_iterations_go(z, forces)
+
+
+def where_the_iterations_go(z: np.ndarray, forces: np.ndarray) -> None:
+    """The earliest any stopping rule on the contact set could stop: the iteration
+    after which the set no longer changes (known only in hindsight), for the sweep's
+    warm starts and for cold starts, at the default tolerance."""
+    scale = float(z.max() - z.min())
+    depth = (z.max() - z) / scale
+    cg = bem.ConstrainedCG(depth)
+    means = forces / z.size / scale
+    tolerance = bem.PeriodicBEM.Params().tolerance
+
+    def settle(start, mean):
+        last = {"set": None, "since": 0}
+
+        def watch(iteration, _residual, contact):
+            if last["set"] is None or not np.array_equal(contact, last["set"]):
+                last["set"], last["since"] = contact.copy(), iteration
+
+        pressure, _, iterations, _ = cg.solve(start, mean_pressure=mean, tolerance=tolerance,
+                                              max_iterations=100_000, monitor=watch)
+        return pressure.copy(), iterations, last["since"]
+
+    rows, previous = [], None
+    for j, mean in enumerate(means):
+        _, cold_its, cold_settled = settle(bem._cold_start(depth, mean), mean)
+        start = bem._cold_start(depth, mean) if previous is None else previous * (mean / means[j - 1])
+        previous, warm_its, warm_settled = settle(start, mean)
+        rows.append((cold_its, cold_settled, warm_its, warm_settled))
+    rows = np.array(rows)
+    print("  where the iterations go: iterations to the tolerance / iteration after which the contact set stayed final")
+    print("    load:  " + " ".join(f"{j:>7d}" for j in range(0, 20, 3)))
+    print("    cold:  " + " ".join(f"{a:>3d}/{b:<3d}" for a, b in rows[::3, :2]))
+    print("    warm:  " + " ".join(f"{a:>3d}/{b:<3d}" for a, b in rows[::3, 2:]))
+    median_cold = np.median(rows[[0, 10, 19], 0])
+    median_settled = np.median(rows[[0, 10, 19], 1])
+    print(
+        f"    sweep / one cold load in iterations: {rows[:, 2].sum() / median_cold:5.2f} x at the tolerance; "
+        f"{rows[:, 3].sum() / median_settled:5.2f} x for a rule that stopped the moment each set is final"
+    )
 
 
 def versus_tamaas(sides: list[int]) -> None:

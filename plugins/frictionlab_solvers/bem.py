@@ -24,6 +24,7 @@ reached at full contact, and no finite force pushes past it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
@@ -101,10 +102,13 @@ class ConstrainedCG:
         approach: float | None = None,
         tolerance: float,
         max_iterations: int,
+        monitor: Callable[[int, float, np.ndarray], None] | None = None,
     ) -> tuple[np.ndarray, float, int, float]:
         """Iterate from ``pressure`` (modified in place) until the residual is at
         most ``tolerance``. Exactly one of ``mean_pressure`` (force control) and
-        ``approach`` (indentation control) is given.
+        ``approach`` (indentation control) is given. ``monitor``, if given, is
+        called before each step with the iteration, the residual and the flat
+        indices of the contact points (for studies of convergence).
 
         Returns ``(pressure, approach, iterations, residual)``; raises
         ``_NotConverged`` after ``max_iterations`` steps.
@@ -177,6 +181,8 @@ class ConstrainedCG:
                     continue
                 p[contact] = p_c
                 return pressure, float(level), iteration, residual
+            if monitor is not None:
+                monitor(iteration, residual, contact)
             if iteration == max_iterations:
                 raise _NotConverged(iteration, residual)
             iteration += 1
