@@ -75,7 +75,6 @@ class ConstrainedCG:
         self.last_gap = np.zeros(self.shape)  # the last step's gap on its contact set, zero elsewhere
         self.response = np.empty(self.shape)
         self.below = np.empty(self.shape, dtype=bool)
-        self.unloaded = np.empty(self.shape, dtype=bool)
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Zero-mean surface displacement under ``pressure``."""
@@ -169,9 +168,11 @@ class ConstrainedCG:
                 level = float(g_c.mean())
             g_c -= level
             worst_contact = float(np.abs(g_c).max())
-            # the penetration of free points: the lowest gap overall is either a free
-            # point's or a contact point's, and then worst_contact already covers it
-            worst_free = max(0.0, level - float(g.min()))
+            # points below the level: contact points with a negative gap error, and free
+            # points that penetrate (p is exactly 0 off the contact set)
+            below = np.flatnonzero(np.less(g, level, out=self.below.reshape(-1)))
+            penetrating = below[p[below] == 0.0]
+            worst_free = level - float(g[penetrating].min()) if penetrating.size else 0.0
             residual = max(worst_contact, worst_free) / self.rms
             if residual <= tolerance:
                 if not exact:  # accept only what an exact gap confirms
@@ -221,32 +222,34 @@ class ConstrainedCG:
             else:  # contact gaps already closed (a scaled warm start): only add points,
                 step = self.point_stiffness  # each with the pressure that lifts it alone
                 clipped = False
-            # free points that penetrate get pressure -step * gap (Polonsky & Keer)
-            added = False
-            if worst_free > 0.0 or clipped:
-                p[contact] = p_c
-                below, unloaded = self.below.reshape(-1), self.unloaded.reshape(-1)
-                np.less(g, level, out=below)
-                np.equal(p, 0.0, out=unloaded)
-                below &= unloaded
-                entering = np.flatnonzero(below)
-                if entering.size:
-                    p[entering] = step * (level - g[entering])
-                    added = True
+            # points without pressure after the step whose gap was negative before it
+            # get pressure -step * gap (Polonsky & Keer): penetrating free points and
+            # clipped contact points
+            entering = penetrating
+            if clipped:  # disjoint from the free ones
+                entering = np.sort(np.concatenate([entering, contact[(p_c == 0.0) & (g_c < 0.0)]]))
+            added = entering.size > 0
             changed = clipped or added or norm == 0.0
             restart = norm == 0.0  # no direction was built to carry on
+            if changed:
+                if clipped:
+                    p[contact] = p_c  # zeros where clipped
+                    contact = contact[p_c > 0.0]
+                if added:
+                    p[entering] = step * (level - g[entering])
+                    contact = np.sort(np.concatenate([contact, entering]))  # disjoint
+                p_c = p[contact]
             if changed or since_exact >= REFRESH:
-                p[contact] = p_c
-                if force_control:
-                    total = float(p.mean())
+                if force_control:  # restore the load exactly
+                    total = float(p_c.sum()) / p.size
                     if not total > 0.0:  # cannot happen in exact arithmetic; start over
                         p.fill(mean_pressure)
+                        contact = np.arange(p.size)
+                        p_c = p[contact]
                         restart = changed = True
                     else:
-                        p *= mean_pressure / total
-                if changed:
-                    contact = np.flatnonzero(p)
-                p_c = p[contact]
+                        p_c *= mean_pressure / total
+                p[contact] = p_c
                 self._exact_gap(pressure)
                 exact, since_exact = True, 0
             else:  # linear in p: g(p - step t) = g - step r
