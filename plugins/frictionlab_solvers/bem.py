@@ -38,10 +38,6 @@ from .springs import ElasticParams, _check_control, _check_loads, check_profile,
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
 
-# Threads per FFT. One: the engine already runs a process per core, and on the
-# shared 2-core machine two threads were 20 % faster when idle but slower when busy.
-FFT_WORKERS = 1
-
 # Steps between exact recomputations of the displacement when it is updated
 # incrementally: bounds the drift of the update to ~REFRESH rounding errors.
 REFRESH = 50
@@ -75,22 +71,27 @@ class ConstrainedCG:
         self.response = np.empty(self.shape)
         self.below = np.empty(self.shape, dtype=bool)
         self.scratch = np.empty(self.shape)
+        self.axes = tuple(range(depth.ndim))
+        self.spectrum = np.empty(self.compliance.shape, dtype=complex)
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Zero-mean surface displacement under ``pressure``."""
-        spectrum = scipy.fft.rfftn(pressure, workers=FFT_WORKERS)
+        """Zero-mean surface displacement under ``pressure``, written into ``out``.
+
+        numpy's FFTs write into the buffers given (``out``), so a step allocates
+        nothing: half the time of ``scipy.fft``, which returns new arrays."""
+        spectrum = np.fft.rfftn(pressure, axes=self.axes, out=self.spectrum)
         spectrum *= self.compliance
-        out[...] = scipy.fft.irfftn(spectrum, s=self.shape, workers=FFT_WORKERS, overwrite_x=True)
+        np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
         return out
 
     def full_contact_pressure(self, mean_pressure: float) -> np.ndarray:
         """The pressure that closes every gap: ``mean + (stiffness) (z - mean z)``,
         exact in Fourier space (``E* |q| / 2`` applied to the heights)."""
-        spectrum = scipy.fft.rfftn(self.depth, workers=FFT_WORKERS)
+        spectrum = scipy.fft.rfftn(self.depth)
         stiffness = np.zeros_like(self.compliance)
         np.divide(1.0, self.compliance, out=stiffness, where=self.compliance > 0)
         spectrum *= -stiffness  # heights are minus depths
-        fluctuation = scipy.fft.irfftn(spectrum, s=self.shape, workers=FFT_WORKERS, overwrite_x=True)
+        fluctuation = scipy.fft.irfftn(spectrum, s=self.shape, overwrite_x=True)
         return fluctuation + mean_pressure
 
     def solve(
