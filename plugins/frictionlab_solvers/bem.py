@@ -1,6 +1,6 @@
 """Exact elastic references: a rigid periodic rough line on an elastic
 half-plane (plane strain) or surface on an elastic half-space, solved by the
-boundary element method (SPEC section 3).
+boundary element method.
 
 The elastic surface answers a pressure p with the displacement
 ``u_q = 2 p_q / (E* |q|)`` in Fourier space (surface stiffness ``E* |q| / 2``,
@@ -50,8 +50,8 @@ class ConstrainedCG:
 
     Works in scaled units (pixels, depths divided by the height range, E* = 1):
     ``depth`` holds ``u_i = (max z - z_i) / s`` in [0, 1]. The compliance
-    kernel ``2 / |q|`` is built once; the work buffers are reused by every
-    solve, so a sweep allocates nothing per iteration but the FFT outputs.
+    kernel ``2 / |q|`` is built once; the grid-sized work buffers are reused by
+    every solve, so a step allocates only vectors on the contact set.
 
     The residual of a state is the largest violation of the contact conditions,
     relative to the rms height: ``max(max_contact |gap|, max_free (-gap)) / h``
@@ -115,9 +115,10 @@ class ConstrainedCG:
 
         The CG works on the contact set's points only (gathered vectors); whole
         grids are touched by one FFT pair (the response to the direction), one
-        update and one minimum of the gap per iteration. The gap is updated from
-        the step's response while the contact set is unchanged; it is recomputed
-        exactly (a second FFT pair) when points are clipped or added, every
+        update of the gap and one comparison with the level per step. The gap
+        is updated from the step's response while the contact set is unchanged;
+        it is recomputed exactly (a second FFT pair) when points are clipped or
+        added, every
         ``REFRESH`` steps, and before convergence is accepted. Under force
         control the direction has zero sum, so a step keeps the load; the load
         is restored exactly after points are clipped or added.
