@@ -234,8 +234,8 @@ class ConstrainedCG:
             changed = clipped or added or norm == 0.0
             restart = norm == 0.0  # no direction was built to carry on
             if changed:
+                p[contact] = p_c  # zeros where clipped
                 if clipped:
-                    p[contact] = p_c  # zeros where clipped
                     contact = contact[p_c > 0.0]
                 if added:
                     p[entering] = step * (level - g[entering])
