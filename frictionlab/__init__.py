@@ -10,14 +10,19 @@ hooks as any third-party plugin.
 from importlib.metadata import PackageNotFoundError, version
 
 from .hookspecs import hookimpl
+from .inputs import InputFile, InputFileProblem, open_regular_file
 from .plugin import (
     ContactCurve,
     ContactSolver,
+    Control,
+    ForceNormalisation,
     Plugin,
     PluginParams,
     Profile,
     SlopeEstimator,
     SpectrumGenerator,
+    force_unit,
+    mdr_length,
 )
 
 try:
@@ -28,11 +33,18 @@ except PackageNotFoundError:  # running from a source tree without install
 __all__ = [
     "ContactCurve",
     "ContactSolver",
+    "Control",
+    "ForceNormalisation",
+    "InputFile",
+    "InputFileProblem",
     "Plugin",
     "PluginParams",
     "Profile",
     "SlopeEstimator",
     "SpectrumGenerator",
     "__version__",
+    "force_unit",
     "hookimpl",
+    "mdr_length",
+    "open_regular_file",
 ]

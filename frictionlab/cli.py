@@ -3,6 +3,7 @@
 Results go to stdout (a short table, or JSON with ``--json``), progress and
 errors to stderr. Exit codes are ``ExitCode``. A user error never prints a
 traceback (set ``FRICTIONLAB_DEBUG=1`` to see one for an internal error).
+SIGTERM ends a run as Ctrl-C does; a closed stdout ends the command quietly.
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ import warnings
 from pathlib import Path
 
 from . import __version__
-from .errors import ExitCode, FrictionlabError, PresetError
+from .errors import ExitCode, FrictionlabError, short_repr
+from .signals import RaiseOnSigterm, interrupted_exit_code
 
 DEFAULT_RUNS_DIR = Path("runs")
 
@@ -40,9 +42,10 @@ def result_table(scene, outcome, out_dir: Path) -> str:
             f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {_interval(fit.a_ci)}",
             f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {_interval(fit.b_ci)}",
             f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
+            f"  {outcome.normalisation.definition}",
         ]
         count = outcome.contact_count
-        unit = "F" if scene.control == "force" else "d"
+        unit = outcome.normalisation.load_symbol if scene.control == "force" else "d"
         lines.append(
             f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
             f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
@@ -75,28 +78,25 @@ def cmd_run(args) -> ExitCode:
         raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
+    _use_executor_options(args)
     out_dir = Path(args.out) if args.out else _default_out(scene.preset.name)
+    run_options = {
+        "executor": args.executor,
+        "scheduler": args.scheduler,
+        "resume": args.resume,
+        "memory_check": not args.no_memory_check,
+        "force": args.force,
+        "dashboard": args.dashboard,
+    }
     if scene.preset.sweep is not None:  # one ensemble per point (issue 6)
         from .sweep import run_sweep_command
 
-        run_options = {k: getattr(args, k, None) for k in ("executor", "scheduler", "resume")}
-        if hasattr(args, "no_memory_check"):
-            run_options["memory_check"] = not args.no_memory_check
         return run_sweep_command(args, overrides, out_dir, run_options)
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        outcome, files = run_to_folder(
-            scene,
-            out_dir,
-            workers=args.workers,
-            listeners=listeners,
-            executor=args.executor,
-            scheduler=args.scheduler,
-            resume=args.resume,
-            memory_check=not args.no_memory_check,
-        )
+        outcome, files = run_to_folder(scene, out_dir, workers=args.workers, listeners=listeners, **run_options)
     except OSError as exc:
-        print(f"error: cannot write results to {out_dir}: {exc}", file=sys.stderr)
+        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         summary = summary_dict(scene, outcome, {k: str(p) for k, p in files.items()})
@@ -104,7 +104,7 @@ def cmd_run(args) -> ExitCode:
     else:
         print(result_table(scene, outcome, out_dir))
     if outcome.status == "interrupted" or outcome.status == "cancelled":
-        return ExitCode.INTERRUPTED
+        return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
         if outcome.error:
             print(f"error: {outcome.error}", file=sys.stderr)
@@ -123,9 +123,9 @@ def cmd_validate(args) -> ExitCode:
                 from .sweep import load_sweep
 
                 points = len(load_sweep(path, args.set or []).points)
-        except PresetError as exc:
+        except FrictionlabError as exc:
             print(str(exc), file=sys.stderr)
-            worst = ExitCode.USAGE
+            worst = ExitCode(max(worst, exc.exit_code))
             continue
         preset = scene.preset
         print(
@@ -188,8 +188,9 @@ def cmd_resume(args) -> ExitCode:
     from .rundir import PRESET_FILE, RunDirectory
 
     run_dir = Path(args.run_dir)
-    RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume
+    RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
     args.preset, args.out, args.resume, args.set, args.seed = str(run_dir / PRESET_FILE), str(run_dir), True, None, None
+    args.force = False
     return cmd_run(args)
 
 
@@ -209,11 +210,38 @@ def _add_executor_options(parser) -> None:
         help="where realizations run (default: processes, or serial for --workers 1)",
     )
     parser.add_argument(
-        "--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask scheduler (with --executor dask)"
+        "--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, tls://HOST:PORT or tcp://HOST:PORT"
+    )
+    parser.add_argument("--tls-ca-file", metavar="FILE", help="CA certificate of a tls:// Dask scheduler")
+    parser.add_argument("--tls-cert", metavar="FILE", help="client certificate for a tls:// Dask scheduler")
+    parser.add_argument("--tls-key", metavar="FILE", help="client key for a tls:// Dask scheduler")
+    parser.add_argument(
+        "--dashboard", action="store_true", help="serve the Dask dashboard of the local cluster (on 127.0.0.1)"
     )
     parser.add_argument(
         "--no-memory-check", action="store_true", help="skip the peak-memory estimate made before the run starts"
     )
+
+
+def _use_executor_options(args) -> None:
+    """Check the Dask options before anything starts."""
+    tls = {"ca_file": args.tls_ca_file, "cert": args.tls_cert, "key": args.tls_key}
+    if any(tls.values()) or (args.scheduler and args.scheduler.startswith("tls://")):
+        for name, value in tls.items():
+            if value:
+                from .inputs import regular_file_problem
+
+                problem = regular_file_problem(value)
+                if problem:
+                    flag = "--tls-" + ("ca-file" if name == "ca_file" else name)
+                    raise FrictionlabError(f"{flag} {value}: {problem}")
+        from .dask_security import use_tls_files
+
+        use_tls_files(**tls)
+    if args.scheduler:
+        from .dask_security import check_address
+
+        check_address(args.scheduler)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -236,6 +264,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     _add_executor_options(run)
     run.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
+    run.add_argument(
+        "--force",
+        action="store_true",
+        help="write into --out DIR even if it is not empty and not a run of this preset (never deletes your files)",
+    )
     run.set_defaults(handler=cmd_run)
 
     resume = sub.add_parser("resume", help="continue an interrupted run in DIR with the preset stored there")
@@ -283,25 +316,52 @@ def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {message}\n"
 
 
+def _quiet_stdout() -> None:
+    """After a BrokenPipeError: point stdout at /dev/null so the interpreter's
+    final flush does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # stdout without a descriptor (a test's capture)
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     warnings.formatwarning = _plain_warning
     args = build_parser().parse_args(argv)
+    with RaiseOnSigterm():
+        return _run_command(args)
+
+
+def _run_command(args) -> int:
     try:
-        return int(args.handler(args))
+        code = int(args.handler(args))
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return code
+    except BrokenPipeError:  # `frictionlab plugins --json | head -c 10`: the reader has enough
+        _quiet_stdout()
+        return int(ExitCode.BROKEN_PIPE)
     except FrictionlabError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return int(exc.exit_code)
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return int(ExitCode.INTERRUPTED)
-    except Exception as exc:  # an internal error: say so plainly, traceback on request
+    except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return int(ExitCode.RUNTIME_FAILURE)
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
+        code = interrupted_exit_code()
+        print("terminated" if code == ExitCode.TERMINATED else "interrupted", file=sys.stderr)
+        return int(code)
+    except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
         print(
-            f"internal error: {type(exc).__name__}: {exc}\n(set FRICTIONLAB_DEBUG=1 for the traceback)",
+            f"internal error: {type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}\n"
+            "(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)",
             file=sys.stderr,
         )
-        return int(ExitCode.RUNTIME_FAILURE)
+        return int(ExitCode.INTERNAL)
 
 
 if __name__ == "__main__":

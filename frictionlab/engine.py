@@ -22,6 +22,7 @@ from .executors import default_workers, make_executor, plan_chunks, pool_context
 from .hookspecs import PROJECT_NAME, LifecycleSpecs
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk, compute_realization
+from .signals import CancelOnSignals
 
 __all__ = [
     "RealizationResult",
@@ -61,6 +62,7 @@ class RunInfo:
     workers: int
     executor: str = "serial"
     resumed: int = 0  # realizations restored from the run directory, not recomputed
+    retried: int = 0  # realizations that had failed before the resume and run again
 
 
 def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
@@ -72,32 +74,6 @@ def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
     return pm
 
 
-class _CtrlCToCancel:
-    """The first Ctrl-C sets ``cancel`` (running work finishes and is kept); a
-    second one interrupts at once. Only in the main thread, where signals land."""
-
-    def __init__(self, cancel):
-        self.cancel = cancel
-        self.pressed = False
-        self.previous = None
-
-    def _handle(self, signum, frame):
-        if self.pressed:
-            raise KeyboardInterrupt
-        self.pressed = True
-        self.cancel.set()
-
-    def __enter__(self):
-        if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, self._handle)
-        return self
-
-    def __exit__(self, *exc):
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
-        return False
-
-
 def run(
     scene: Scene,
     *,
@@ -107,31 +83,43 @@ def run(
     executor: str | None = None,
     scheduler: str | None = None,
     retries: int = 2,
+    dashboard: bool = False,
     store=None,
     restored: Iterable[RealizationResult] = (),
+    registry=None,
 ) -> RunOutcome:
     """Run the ensemble of ``scene``, telling ``listeners`` as it goes.
 
     ``executor``: ``serial``, ``processes`` or ``dask`` (``scheduler``: the address
     of an existing Dask scheduler); by default a process pool for more than one
     worker. ``restored``: results already finished (a resume): only the missing
-    realizations are computed. ``store``: anything with ``save_chunk(results)``,
-    called as each chunk finishes, before its listeners hear of it.
+    realizations, and those that had failed, are computed. ``store``: anything
+    with ``save_chunk(results)``, called as each chunk finishes, before its
+    listeners hear of it.
 
-    ``cancel`` (anything with ``set()``/``is_set()``) or Ctrl-C ends the run
-    early; what finished is kept and summarised, and ``outcome.status`` says
-    ``cancelled`` or ``interrupted``.
+    The installed plugins that implement lifecycle hooks (of ``registry``, by default the
+    process-wide one) hear the run as ``listeners`` do.
+
+    ``cancel`` (anything with ``set()``/``is_set()``), Ctrl-C or SIGTERM ends the
+    run early; what finished is kept and summarised, and ``outcome.status``
+    says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
     total = scene.preset.realizations
     workers = min(total, default_workers() if workers is None else max(1, int(workers)))
-    pool = make_executor(executor, workers, scheduler=scheduler, retries=retries)
+    pool = make_executor(executor, workers, scheduler=scheduler, retries=retries, dashboard=dashboard)
     accumulator = Accumulator(scene)
+    retried = 0
     for result in restored:
-        accumulator.add(result)
+        if result.ok:
+            accumulator.add(result)
+        else:
+            retried += 1  # a failure is not kept: the realization runs again
     resumed = accumulator.done
-    todo = [i for i in range(total) if i not in accumulator.results and i not in accumulator.failures]
-    info = RunInfo(scene=scene, total=total, workers=workers, executor=pool.name, resumed=resumed)
-    hooks = _listener_manager(listeners).hook
+    todo = [i for i in range(total) if i not in accumulator.results]
+    info = RunInfo(scene=scene, total=total, workers=workers, executor=pool.name, resumed=resumed, retried=retried)
+    from .registry import default_registry
+
+    hooks = _listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     hooks.run_started(run=info)
@@ -145,7 +133,7 @@ def run(
             event(run=info, result=result, done=accumulator.done, total=total)
 
     status, error = "completed", None
-    with _CtrlCToCancel(cancel) as ctrl_c:
+    with CancelOnSignals(cancel) as signals:
         try:
             if todo and not cancel.is_set():
                 # The first missing realization runs here: its time sizes the chunks.
@@ -154,15 +142,17 @@ def run(
                 chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds)
                 for _, results in pool.map_chunks(scene, chunks, cancel):
                     record(results)
-        except KeyboardInterrupt:  # the second Ctrl-C
+        except KeyboardInterrupt:  # the second Ctrl-C or SIGTERM (Terminated)
             pass
         except RunError as exc:  # keep what finished before the executor failed
             status, error = "failed", str(exc)
         if status == "completed" and accumulator.done < total:
-            status = "interrupted" if ctrl_c.pressed else "cancelled"
+            status = "interrupted" if signals.pressed else "cancelled"
     outcome = accumulator.finish(
         status=status, elapsed=time.perf_counter() - started, workers=pool.workers, error=error
     )
-    outcome.extra.update(executor=pool.name, resumed=resumed)
+    outcome.extra.update(executor=pool.name, resumed=resumed, retried=retried)
+    if signals.pressed:
+        outcome.extra["signal"] = signal.Signals(signals.signal).name
     hooks.run_finished(run=info, outcome=outcome)
     return outcome

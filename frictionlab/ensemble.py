@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .fit import LogFit, fit_log_law
+from .plugin import ForceNormalisation
 from .preset import Scene
 from .seeds import bootstrap_rng
 
@@ -26,8 +27,8 @@ class RunOutcome:
     indices: np.ndarray  # finished ok, ascending
     failures: list[tuple[int, str]]
     loads: np.ndarray
-    force: np.ndarray  # mean total force per step
-    f: np.ndarray  # dimensionless force F / (k h L)
+    force: np.ndarray  # mean total load per step (its meaning: ``normalisation.load``)
+    f: np.ndarray  # dimensionless force: force / force_unit (``normalisation.definition``)
     xi: np.ndarray  # ensemble mean of slope_rms_contact / slope_rms_line
     xi_sem: np.ndarray
     contact_count: np.ndarray  # ensemble mean
@@ -36,8 +37,9 @@ class RunOutcome:
     per_realization: dict[str, np.ndarray]
     fit: LogFit | None
     rms_height: float
-    length: float
+    force_unit: float  # k h X: the load at f = 1
     stiffness: float
+    normalisation: ForceNormalisation
     elapsed: float
     workers: int
     error: str | None = None
@@ -46,6 +48,11 @@ class RunOutcome:
     @property
     def done(self) -> int:
         return int(self.indices.size)
+
+    @property
+    def extent(self) -> float:
+        """X of f = F / (k h X): the profile's length, area, MDR length, or 1."""
+        return self.force_unit / (self.stiffness * self.rms_height)
 
 
 class Accumulator:
@@ -62,9 +69,12 @@ class Accumulator:
         return len(self.results) + len(self.failures)
 
     def add(self, result) -> None:
+        """Keep ``result``, replacing any earlier one of its index (never counted twice)."""
         if result.ok:
+            self.failures.pop(result.index, None)
             self.results[result.index] = result
         else:
+            self.results.pop(result.index, None)
             self.failures[result.index] = result.error
 
     def stack(self, name: str) -> np.ndarray:
@@ -86,17 +96,26 @@ class Accumulator:
         n = indices.size
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
-        length = first.length if first else math.nan
+        unit = first.force_unit if first else math.nan  # every realization has the grid of the first
         rms_height = float(scene.spectrum.rms_height()) if n else math.nan
         stiffness = float(scene.solver.stiffness())
         force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
-        f = force / (stiffness * rms_height * length) if n else np.full(self.loads.size, math.nan)
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # an overflow is reported below
+            f = force / unit if n else np.full(self.loads.size, math.nan)
         nan_row = np.full(self.loads.size, math.nan)
         xi_mean = per["xi"].mean(axis=0) if n else nan_row
         xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
         count = per["contact_count"].mean(axis=0) if n else nan_row
         fit = None
-        if n:
+        if n and not np.all(np.isfinite(f) & (f > 0)):
+            # a plugin's numbers overflowed: say which, rather than fail in the fit
+            status, error = "failed", (
+                f"the dimensionless force f = F / (k h X) is not finite and > 0 at every load step "
+                f"(k h X = {unit:g} with stiffness k = {stiffness:g}, h = {rms_height:g}; F from {np.min(force):g} "
+                f"to {np.max(force):g}): the preset's magnitudes (solver.params, spectrum.params, loading) "
+                "leave double precision"
+            )
+        elif n:
             settings = scene.preset.fit
             fit = fit_log_law(
                 f,
@@ -121,8 +140,9 @@ class Accumulator:
             per_realization=per,
             fit=fit,
             rms_height=rms_height,
-            length=length,
+            force_unit=unit,
             stiffness=stiffness,
+            normalisation=scene.normalisation,
             elapsed=elapsed,
             workers=workers,
             error=error,

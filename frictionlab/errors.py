@@ -6,12 +6,18 @@ import enum
 
 
 class ExitCode(enum.IntEnum):
-    """What ``frictionlab`` returns to the shell."""
+    """What ``frictionlab`` returns to the shell (the table is in docs/data-safety.md)."""
 
     OK = 0
-    RUNTIME_FAILURE = 1  # a realization or a write failed
-    USAGE = 2  # bad command line, invalid preset, unknown or broken plugin
-    INTERRUPTED = 130  # Ctrl-C / cancel: finished work was kept
+    RUNTIME_FAILURE = 1  # a realization, the executor or a write failed; what finished is kept
+    USAGE = 2  # bad command line, invalid preset (a field's value), unknown or broken plugin
+    INPUT_FILE = 3  # a preset file that cannot be used as one: missing, not a regular file, too large, not UTF-8
+    OUTPUT_REFUSED = 4  # the output would replace or delete what frictionlab did not write (see --force)
+    RUN_FOLDER = 5  # a run folder that cannot be resumed: damaged, in use, another preset, a changed input file
+    INTERNAL = 70  # a bug in frictionlab or a plugin (sysexits' EX_SOFTWARE)
+    INTERRUPTED = 130  # Ctrl-C (SIGINT): finished work was kept, the run folder is resumable
+    BROKEN_PIPE = 141  # stdout was closed by the reader (as a process killed by SIGPIPE)
+    TERMINATED = 143  # SIGTERM: as Ctrl-C
 
 
 class FrictionlabError(Exception):
@@ -37,7 +43,43 @@ class PresetError(FrictionlabError):
         super().__init__("\n".join([head, *("  " + p for p in self.problems)]))
 
 
+class PresetFileError(PresetError):
+    """The preset file itself cannot be used: missing, not a regular file, too
+    large, not UTF-8 text, or beyond the YAML limits (nesting, aliases)."""
+
+    exit_code = ExitCode.INPUT_FILE
+
+
 class RunError(FrictionlabError):
     """The run could not complete (every realization failed, a write failed)."""
 
     exit_code = ExitCode.RUNTIME_FAILURE
+
+
+class OutputRefused(FrictionlabError):
+    """Writing where asked would replace or delete files frictionlab did not
+    write (or the output path cannot be a folder)."""
+
+    exit_code = ExitCode.OUTPUT_REFUSED
+
+
+class RunFolderError(FrictionlabError):
+    """A run folder cannot be resumed or used: its manifest or stored preset is
+    damaged, another run holds it, or an input file changed since it started."""
+
+    exit_code = ExitCode.RUN_FOLDER
+
+
+def short_repr(value, limit: int = 80) -> str:
+    """``repr(value)`` cut to about ``limit`` characters, built without ever
+    forming the whole repr (a value from a hostile preset may be huge or deep)."""
+    import reprlib
+
+    shortener = reprlib.Repr()
+    shortener.maxlevel, shortener.maxstring, shortener.maxother, shortener.maxlong = 3, limit, limit, limit
+    shortener.maxlist = shortener.maxtuple = shortener.maxdict = shortener.maxset = 8
+    try:
+        text = shortener.repr(value)
+    except ValueError:  # an int past Python's digit limit
+        text = f"<{type(value).__name__} too long to show>"
+    return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -6,12 +6,13 @@ depend on the executor: every realization draws from its own seed, and the
 statistics are formed by index afterwards.
 
 * ``serial``: in this process, realization by realization.
-* ``processes``: a ``ProcessPoolExecutor`` on this machine. A worker that dies
-  (killed, out of memory) breaks the pool: the pool is rebuilt and only the
-  unfinished chunks are submitted again, a bounded number of times.
+* ``processes``: a pool of worker processes on this machine (``pool``). A
+  worker that dies at any moment (killed, out of memory, even while it sends
+  its result) is replaced and its chunk runs again, a bounded number of times.
 * ``dask``: a ``distributed.Client`` on an existing scheduler, or on a
-  ``LocalCluster`` bound to loopback. The scene is broadcast once; Dask itself
-  reschedules the tasks of a worker that dies.
+  ``LocalCluster`` of this user's own on loopback, reached over TLS with
+  credentials made for the run (``dask_security``). The scene is broadcast
+  once; Dask itself reschedules the tasks of a worker that dies.
 """
 
 from __future__ import annotations
@@ -26,15 +27,15 @@ import threading
 import time
 import uuid
 from collections.abc import Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 
+from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .errors import FrictionlabError, RunError
+from .pool import JobFailed, WorkerLost, WorkerPool
 from .preset import Scene
 from .realization import RealizationResult, compute_chunk
 
 EXECUTORS = ("serial", "processes", "dask")
-DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+__all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
 Chunk = list[int]
 
@@ -47,6 +48,7 @@ def default_workers() -> int:
 
 TARGET_CHUNK_SECONDS = 0.5  # task overhead is ~1 ms (pool) to ~5 ms (Dask): well under 2% of this
 CHUNKS_PER_WORKER = 4  # at least this many, for load balance and progress
+MAX_CHUNKS = 4096  # at most this many per run: the run folder's manifest lists every chunk
 
 
 def plan_chunks(
@@ -55,16 +57,18 @@ def plan_chunks(
     seconds_each: float,
     target: float = TARGET_CHUNK_SECONDS,
     per_worker: int = CHUNKS_PER_WORKER,
+    max_chunks: int = MAX_CHUNKS,
 ) -> list[Chunk]:
     """Split ``indices`` into consecutive chunks of about ``target`` seconds each
     (from the measured ``seconds_each`` of one realization), but into at least
-    ``per_worker`` chunks per worker while there are enough indices."""
+    ``per_worker`` chunks per worker while there are enough indices, and into
+    no more than ``max_chunks``."""
     indices = list(indices)
     if not indices:
         return []
     by_cost = max(1, int(target / max(seconds_each, 1e-9)))
     by_balance = max(1, math.ceil(len(indices) / (max(1, workers) * per_worker)))
-    size = min(by_cost, by_balance)
+    size = max(min(by_cost, by_balance), math.ceil(len(indices) / max_chunks))
     return [indices[i : i + size] for i in range(0, len(indices), size)]
 
 
@@ -120,7 +124,6 @@ def _die_with_parent() -> None:
 def _init_worker(scene: Scene) -> None:
     global _worker_scene
     _worker_scene = scene
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     _die_with_parent()
 
 
@@ -138,8 +141,8 @@ def pool_context():
 
 
 class ProcessExecutor:
-    """A local process pool. ``retries``: how many times a chunk is submitted
-    again after the pool broke while it ran (a worker died)."""
+    """A local pool of worker processes. ``retries``: how many times a chunk
+    runs again after its worker died (then the run fails, naming the chunk)."""
 
     name = "processes"
 
@@ -148,75 +151,25 @@ class ProcessExecutor:
         self.retries = retries
 
     def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
-        todo = dict(enumerate(chunks))
-        attempts = dict.fromkeys(todo, 0)
-        while todo:
-            broken, running = yield from self._one_pool(scene, todo, cancel)
-            if not broken:
-                return
-            # Charge the chunks that were running when a worker died; submit the rest again.
-            for key in (running & todo.keys()) or todo.keys():
-                attempts[key] += 1
-                if attempts[key] > self.retries:
-                    raise RunError(
-                        f"a worker process died {attempts[key]} times while running realizations "
-                        f"{chunk_label(todo[key])} ({broken}); giving up"
-                    )
-
-    def _one_pool(self, scene, todo: dict[int, Chunk], cancel):
-        """Run ``todo`` on a fresh pool, removing each chunk as it finishes.
-        Returns (why the pool broke or None, keys of the chunks seen running)."""
-        running: set[int] = set()
-        pool = ProcessPoolExecutor(
-            max_workers=min(self.workers, len(todo)),
-            mp_context=pool_context(),
-            initializer=_init_worker,
-            initargs=(scene,),
+        jobs = dict(enumerate(chunks))
+        pool = WorkerPool(
+            min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
-            futures = {pool.submit(_run_chunk, chunk): key for key, chunk in todo.items()}
-            pending = set(futures)
-            while pending:
-                if cancel.is_set():
-                    # Chunks already running finish and are kept; the rest never start.
-                    pending = {future for future in pending if not future.cancel()}
-                    finished, pending = wait(pending).done, set()
-                else:
-                    running |= {futures[f] for f in pending if f.running()}
-                    finished, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    key = futures[future]
-                    try:
-                        results = future.result()
-                    except BrokenProcessPool as exc:
-                        return str(exc) or "the pool broke", running
-                    chunk = todo.pop(key)
-                    yield chunk, results
-            if cancel.is_set():
-                todo.clear()
-            return None, running
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+            for key, results in pool.run(jobs, cancel):
+                yield jobs[key], results
+        except WorkerLost as lost:
+            raise RunError(
+                f"a worker process died {lost.deaths} times while running realizations "
+                f"{chunk_label(jobs[lost.key])} ({lost.how}); giving up"
+            ) from None
+        except JobFailed as failed:
+            raise RunError(
+                f"realizations {chunk_label(jobs[failed.key])} failed in a worker process: {failed.error}"
+            ) from None
 
 
 # ------------------------------------------------------------------ dask
-
-
-def import_distributed():
-    try:
-        import distributed
-    except ImportError:
-        raise FrictionlabError(DASK_MISSING) from None
-    return distributed
-
-
-def connect_scheduler(address: str):
-    """A ``distributed.Client`` on the scheduler at ``address``, or a RunError."""
-    distributed = import_distributed()
-    try:
-        return distributed.Client(address, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise RunError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
 
 
 def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[str, int | None], float]:
@@ -245,35 +198,27 @@ def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[st
 
 
 class DaskExecutor:
-    """Chunks as Dask tasks. With ``scheduler`` (``tcp://HOST:PORT``) the run uses
-    that cluster's workers; without, a ``LocalCluster`` of ``workers`` single-thread
-    processes on 127.0.0.1, dashboard off, closed at the end. ``retries``: Dask
-    retries of a task that raised (a task whose worker died is rescheduled by Dask
-    up to its ``allowed-failures``)."""
+    """Chunks as Dask tasks. With ``scheduler`` (``tcp://`` or ``tls://HOST:PORT``)
+    the run uses that cluster's workers; without, a ``LocalCluster`` of
+    ``workers`` single-thread processes on 127.0.0.1 reached over TLS
+    (``dask_security``), dashboard off unless ``dashboard``, closed at the end.
+    ``retries``: Dask retries of a task that raised (a task whose worker died is
+    rescheduled by Dask up to its ``allowed-failures``)."""
 
     name = "dask"
 
-    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2):
+    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2, dashboard: bool = False):
         self.workers = workers
         self.scheduler = scheduler
         self.retries = retries
+        self.dashboard = dashboard
 
     def _connect(self):
-        distributed = import_distributed()
         if self.scheduler:
             client = connect_scheduler(self.scheduler)
             self.workers = max(1, len(client.scheduler_info().get("workers", {})))
             return client, None
-        cluster = distributed.LocalCluster(
-            n_workers=self.workers,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=None,
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # health routes only, loopback, any port
-            silence_logs=logging.ERROR,
-        )
-        return distributed.Client(cluster), cluster
+        return start_local_cluster(self.workers, dashboard=self.dashboard)
 
     def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         distributed = import_distributed()
@@ -319,7 +264,9 @@ class DaskExecutor:
                 cluster.close()
 
 
-def make_executor(name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2):
+def make_executor(
+    name: str | None, workers: int, *, scheduler: str | None = None, retries: int = 2, dashboard: bool = False
+):
     """The executor called ``name``; ``None`` is the embedded default: a process
     pool for more than one worker, in this process for one."""
     if name is None:
@@ -333,4 +280,4 @@ def make_executor(name: str | None, workers: int, *, scheduler: str | None = Non
     if name == "processes":
         return ProcessExecutor(workers, retries=retries)
     import_distributed()  # fail before anything starts
-    return DaskExecutor(workers, scheduler=scheduler, retries=retries)
+    return DaskExecutor(workers, scheduler=scheduler, retries=retries, dashboard=dashboard)

@@ -1,4 +1,4 @@
-"""The fit xi = a + b ln f (SPEC section 6).
+"""The fit xi = a + b ln f.
 
 Least squares of the ensemble-mean xi over the force grid, with:
 * classical standard errors of a and b from the residuals;

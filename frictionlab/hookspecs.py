@@ -13,7 +13,9 @@ Two families:
           register(MySpectrum)
 
 * Lifecycle hooks of an ensemble run. The engine calls them on the listeners of
-  a run (the CLI's reporter, the TUI's), in the order: ``run_started``, then
+  a run (the CLI's reporter, the TUI's, any passed to ``engine.run``) and on the
+  installed plugins that implement them (the registry holds these specs too, so
+  a plugin may, say, log every run), in the order: ``run_started``, then
   ``realization_done`` or ``realization_failed`` once per realization, then
   ``run_finished``.
 """
@@ -48,7 +50,8 @@ class RegistrationSpecs:
 
 
 class LifecycleSpecs:
-    """Hooks the engine calls on the listeners of one run."""
+    """Hooks the engine calls on the listeners of one run and on the installed plugins
+    that implement them."""
 
     @hookspec
     def run_started(self, run):

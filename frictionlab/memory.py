@@ -60,11 +60,11 @@ def gib(n: float) -> str:
 
 
 def grid_points(scene: Scene) -> int:
-    """Points of one realization: from the spectrum's ``points`` parameter
-    (squared for a surface), else by generating realization 0 once (0 if that fails)."""
-    points = getattr(scene.spectrum.params, "points", None)
-    if isinstance(points, int) and points > 0:
-        return points ** getattr(scene.spectrum, "dimension", 1)
+    """Points of one realization: from the spectrum's ``grid_shape()``, else by
+    generating realization 0 once (0 if that fails)."""
+    shape = scene.spectrum.grid_shape()
+    if shape is not None:
+        return math.prod(shape)
     from .seeds import realization_rng
 
     try:
@@ -115,6 +115,12 @@ def available_memory() -> tuple[int, str]:
     return min(found)
 
 
+def _points_path(scene: Scene) -> str | None:
+    """The preset path of the spectrum's points parameter, if it has one."""
+    name = scene.named_spectrum.points_param
+    return f"spectrum.params.{name}" if name else None
+
+
 def _total(guess: MemoryEstimate) -> int:
     return guess.total
 
@@ -124,9 +130,9 @@ def _in_dask_worker(guess: MemoryEstimate) -> int:
 
 
 def _most_points(scene: Scene, executor: str, available: int, need=_total) -> int:
-    """The largest ``spectrum.params.points`` whose one-worker estimate fits:
-    ``need(estimate) <= available`` (by default the run's whole peak)."""
-    dimension = getattr(scene.spectrum, "dimension", 1)
+    """The largest points per side (``SpectrumGenerator.points_param``) whose one-worker
+    estimate fits: ``need(estimate) <= available`` (by default the run's whole peak)."""
+    dimension = scene.spectrum.dimension
     low, high = 1, 2
     while need(estimate(scene, workers=1, executor=executor, points=high**dimension)) <= available:
         low, high = high, 2 * high
@@ -153,8 +159,9 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
             break
     if not advice:
         one = estimate(scene, workers=1, executor=executor, points=guess.points)
-        if one.total - one.per_realization + BYTES_PER_POINT < available and hasattr(scene.spectrum.params, "points"):
-            advice.append(f"--workers 1 and spectrum.params.points <= {_most_points(scene, executor, available):,}")
+        points_param = _points_path(scene)
+        if one.total - one.per_realization + BYTES_PER_POINT < available and points_param:
+            advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * (4 if scene.control == "indentation" else 3) * KEPT_COPIES + 512
             spare = available - PROCESS_BASE - one.per_realization
@@ -183,8 +190,8 @@ def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usabl
     smallest = f"the smallest of {len(bounded)} workers with a limit; " if len(bounded) > 1 else ""
     advice = f"workers with a memory limit of at least {gib(math.ceil(need / usable))}"
     one_point = estimate(scene, workers=1, executor="dask", points=1)
-    if hasattr(scene.spectrum.params, "points") and _in_dask_worker(one_point) <= room:
-        advice = f"spectrum.params.points <= {_most_points(scene, 'dask', room, _in_dask_worker):,}, or on " + advice
+    if _points_path(scene) and _in_dask_worker(one_point) <= room:
+        advice = f"{_points_path(scene)} <= {_most_points(scene, 'dask', room, _in_dask_worker):,}, or on " + advice
     raise RunError(
         f"one realization of {guess.points:,} points would need about {gib(need)} in a Dask worker "
         f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "

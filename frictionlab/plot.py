@@ -38,7 +38,7 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax_count.plot(f, outcome.contact_count, "-", color="C2")
     ax_count.set_yscale("log")
     ax_count.set_ylabel("points in contact")
-    ax_count.set_xlabel(r"$f = F / (E^* h L)$")
+    ax_count.set_xlabel(scene.normalisation.definition, fontsize=8)
     ax_count.grid(True, which="both", alpha=0.3)
     fig.savefig(fh, format="png", dpi=110)
     plt.close(fig)

@@ -1,5 +1,5 @@
-"""The plugin contract: what a spectrum generator, a contact solver and a slope
-estimator look like to the engine.
+"""The plugin contract: everything the framework may use of a spectrum
+generator, a contact solver and a slope estimator, declared here and nowhere else.
 
 A plugin is a class with a kebab-case ``name`` (its key in a preset), a one-line
 ``summary``, optional ``references`` (DOIs) and a nested pydantic ``Params``
@@ -7,14 +7,23 @@ model. The constructor only stores validated parameters (scikit-learn style);
 all work happens in the methods, and randomness arrives as a
 ``numpy.random.Generator`` argument.
 
+The framework reads a plugin only through the class attributes and methods
+declared on ``SpectrumGenerator``, ``ContactSolver`` and ``SlopeEstimator``
+below (optional ones have defaults); ``frictionlab.testing.check_plugin``
+checks each of them. The dimensionless force f is formed in one place,
+``force_unit``, from what the solver declares its load to mean
+(``ContactSolver.normalisations``).
+
 Nothing here is physics: the built-in physics lives in ``plugins/``.
 """
 
 from __future__ import annotations
 
+import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
@@ -22,6 +31,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 NAME_PATTERN = re.compile(r"^[a-z][a-z0-9]*(-[a-z0-9]+)*$")
 
 Control = Literal["force", "indentation"]
+"""What a sweep's loads are: total loads (see ``LoadMeaning``) or indentations."""
 
 
 class PluginParams(BaseModel):
@@ -74,13 +84,25 @@ class Plugin:
 # --------------------------------------------------------------------------- data
 
 
+def mdr_length(area: float) -> float:
+    """L = 2 sqrt(A / pi): the length of the MDR line that stands for a surface of
+    apparent area A (the diameter of a disc of that area)."""
+    return 2.0 * math.sqrt(area / math.pi)
+
+
 @dataclass(frozen=True)
 class Profile:
-    """One periodic rough line, shape (N,), or surface, shape (Ny, Nx), with
-    heights on a uniform grid of ``spacing`` (square pixels on a surface)."""
+    """One rough line, shape (N,), or surface, shape (Ny, Nx), with heights on a
+    uniform grid of ``spacing`` (square pixels on a surface).
+
+    ``periodic``: whether the profile repeats (its last point is followed by its
+    first), as a synthetic spectrum's lines do; a measured scan's ends do not
+    meet, so slopes are never taken across them and periodic solvers refuse it.
+    """
 
     heights: np.ndarray
     spacing: float
+    periodic: bool = True
 
     @property
     def ndim(self) -> int:
@@ -92,17 +114,8 @@ class Profile:
 
     @property
     def area(self) -> float:
-        """Apparent (nominal) area of a surface; the length of a line."""
+        """The measure of the grid: a line's length N dx, a surface's apparent area A."""
         return self.points * self.spacing**self.ndim
-
-    @property
-    def length(self) -> float:
-        """The L of f = F / (k h L): the line's length, or for a surface of
-        apparent area A the MDR-equivalent length 2 sqrt(A / pi) (SPEC section 7),
-        so lines and surfaces share one f axis."""
-        if self.ndim == 1:
-            return self.points * self.spacing
-        return 2.0 * float(np.sqrt(self.area / np.pi))
 
 
 @dataclass(frozen=True)
@@ -110,6 +123,11 @@ class ContactCurve:
     """A solver's answer for one profile over a whole load sweep.
 
     Every array has one entry per load step, in the order of the loads given.
+    ``force`` holds the total loads (their meaning: the solver's ``LoadMeaning``);
+    ``indentation`` the rigid-body approach from the first touch, in the frame the
+    solver declares (``ContactSolver.indentation_reference``).
+    ``contact_fraction`` is ``contact_count / points`` (what it measures: the
+    solver's ``contact_measure``).
     ``slope_rms_contact`` is the rms, over the points in contact, of the slopes
     the engine passed in (from the chosen slope estimator).
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
@@ -123,22 +141,149 @@ class ContactCurve:
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
 
+# ------------------------------------------------------------ what a load means
+
+LoadMeaning = Literal["force", "force per unit depth"]
+"""A solver's load: a total force (a 3D contact, or a line of springs), or a force
+per unit depth (plane strain: a profile straight in the third direction)."""
+
+Extent = Literal["one", "length", "area", "mdr length"]
+"""The size X in f = F / (k h X): nothing (one), the line's length L = N dx, the
+surface's apparent area A, or a surface's MDR length 2 sqrt(A / pi)."""
+
+LOAD_UNITS: dict[str, str] = {"force": "modulus x length^2", "force per unit depth": "modulus x length"}
+_LOAD_SYMBOLS = {"force": "F", "force per unit depth": "F'"}
+_EXTENT_SYMBOLS = {"one": "", "length": " L", "area": " A", "mdr length": " L"}
+_EXTENT_DEFINITIONS = {
+    "one": "",
+    "length": "L the line's length",
+    "area": "A the surface's apparent area",
+    "mdr length": "L = 2 sqrt(A / pi), A the surface's apparent area",
+}
+_EXTENT_DIMENSIONS = {"one": (1, 2), "length": (1,), "area": (2,), "mdr length": (2,)}
+
+
+@dataclass(frozen=True)
+class ForceNormalisation:
+    """What a solver's load means and which combination of it is dimensionless:
+    ``f = F / (k h X)``, k the solver's ``stiffness()`` (named ``modulus``, e.g.
+    ``"E*"``), h the spectrum's ``rms_height()``, X the profile's ``extent``.
+
+    A quantity so formed does not change when the unit of length or of force
+    changes (every length x s, every modulus x m, a force x m s^2, a force per
+    unit depth x m s), provided ``stiffness()`` is a modulus of the right unit:
+    a stress (E*, or a foundation modulus per unit length of a line) when the
+    extent is a length or one, a stress per length when it is an area.
+    """
+
+    load: LoadMeaning
+    modulus: str
+    extent: Extent
+
+    def __post_init__(self):
+        if self.load not in LOAD_UNITS:
+            raise ValueError(f"load must be one of {', '.join(LOAD_UNITS)}. Got {self.load!r} instead.")
+        if self.extent not in _EXTENT_SYMBOLS:
+            raise ValueError(f"extent must be one of {', '.join(_EXTENT_SYMBOLS)}. Got {self.extent!r} instead.")
+        if not (isinstance(self.modulus, str) and self.modulus.strip()):
+            raise ValueError(f"modulus must name the stiffness, e.g. 'E*'. Got {self.modulus!r} instead.")
+
+    @property
+    def load_symbol(self) -> str:
+        """F for a force, F' for a force per unit depth."""
+        return _LOAD_SYMBOLS[self.load]
+
+    @property
+    def load_unit(self) -> str:
+        """The unit of the load in the units of the preset: ``modulus x length^2`` for a force."""
+        return LOAD_UNITS[self.load]
+
+    @property
+    def formula(self) -> str:
+        """``F / (E* h L)``: the dimensionless force in symbols."""
+        return f"{self.load_symbol} / ({self.modulus} h{_EXTENT_SYMBOLS[self.extent]})"
+
+    @property
+    def definition(self) -> str:
+        """``f = F / (E* h L), L = 2 sqrt(A / pi), ...``: the formula with its symbols explained."""
+        where = [f"{self.load_symbol} the {self.load}", "h the rms height"]
+        if self.extent != "one":
+            where.append(_EXTENT_DEFINITIONS[self.extent])
+        return f"f = {self.formula}, " + ", ".join(where)
+
+    def extent_of(self, profile: Profile) -> float:
+        """X of f = F / (k h X) for ``profile``."""
+        if profile.ndim not in _EXTENT_DIMENSIONS[self.extent]:
+            raise ValueError(f"the extent {self.extent!r} is not defined for a {profile.ndim}D profile")
+        if self.extent == "one":
+            return 1.0
+        if self.extent == "mdr length":
+            return mdr_length(profile.area)
+        return profile.area  # a line's length, or a surface's area
+
+    def describe(self, stiffness: float, rms_height: float, extent: float) -> dict[str, Any]:
+        """The normalisation as summary.json records it."""
+        return {
+            "f": self.definition,
+            "formula": self.formula,
+            "load": self.load,
+            "load_symbol": self.load_symbol,
+            "load_unit": self.load_unit,
+            "modulus": self.modulus,
+            "stiffness": stiffness,
+            "rms_height": rms_height,
+            "extent": self.extent,
+            "extent_value": extent,
+            "force_unit": stiffness * rms_height * extent,
+        }
+
+
+ContactMeasure = Literal["real contact", "mdr springs"]
+"""What ``contact_fraction`` measures: the real contact (area fraction of a surface,
+length fraction of a line, of the solver's physical problem), or the fraction of
+MDR springs in contact, which is not the real area of the surface MDR stands for."""
+
+
+def force_unit(solver: "ContactSolver", rms_height: float, profile: Profile) -> float:
+    """k h X: the load at which f = 1 for ``solver`` pressing ``profile`` (nominal rms
+    height h). The one place where f is formed: f = load / force_unit."""
+    normalisation = solver.normalisation(profile.ndim)
+    return float(solver.stiffness()) * float(rms_height) * normalisation.extent_of(profile)
+
+
 # ---------------------------------------------------------------- plugin kinds
 
 
 class SpectrumGenerator(Plugin):
-    """Makes random rough lines.
+    """Makes random rough lines (``dimension`` 1) or surfaces (``dimension`` 2).
 
-    Subclasses implement ``generate(rng) -> Profile`` and ``rms_height()``, the
-    h used in the dimensionless force f = F / (k h L) (the ensemble's nominal rms
-    height: exact for fixed amplitudes, the expectation for random ones).
-    Synthetic spectra also implement ``psd(q)`` (vectorised, one-sided 1D PSD
-    with <z^2> = 2 * integral of psd over q > 0) and, where closed forms exist,
-    ``rms_slope()``.
+    Required: ``generate(rng) -> Profile`` and ``rms_height()``, the h of the
+    dimensionless force f (the ensemble's nominal rms height: exact for fixed
+    amplitudes, the expectation for random ones).
+
+    Optional, with the default the framework then uses:
+
+    - ``psd(q)``: vectorised one-sided PSD (1D: <z^2> = 2 * integral of psd over
+      q > 0); ``rms_slope()``: a closed-form rms slope. Default: NotImplementedError.
+    - ``periodic()``: whether generated profiles repeat (default True). A measured
+      scan is not periodic: slopes never wrap, periodic solvers refuse it.
+    - ``grid_shape()``: the shape of a generated profile, known without generating
+      (memory estimates). Default None: the framework generates one profile.
+    - ``points_param``: the ``Params`` field that sets the points (per side); the
+      framework names it in advice ("spectrum.params.points <= ..."). Default None.
+    - ``refined(points)``: the ``Params`` changes that sample the same continuous
+      spectrum (same length, same cut-off wavelengths) on ``points`` points per
+      side: the trade-off study's grid axis. Default None (cannot be refined).
+    - ``equivalent_line()``: for a surface, its MDR-equivalent line (a spectrum of
+      lines whose length is ``mdr_length`` of the surface's area), which a solver
+      of lines presses instead. Default None (no MDR mapping).
+    - ``c0()``: the prefactor C0 of a power-law PSD. Default NotImplementedError.
+    - ``hurst_exponent()``: H of a self-affine spectrum, or None (the default).
     """
 
     kind: ClassVar[str] = "spectrum"
     dimension: ClassVar[int] = 1  # 1: makes lines (N,); 2: makes surfaces (Ny, Nx)
+    points_param: ClassVar[str | None] = None
 
     def generate(self, rng: np.random.Generator) -> Profile:  # pragma: no cover - interface
         raise NotImplementedError
@@ -152,34 +297,95 @@ class SpectrumGenerator(Plugin):
     def rms_slope(self) -> float:
         raise NotImplementedError(f"{self.name} has no closed-form rms slope")
 
+    def periodic(self) -> bool:
+        return True
+
+    def grid_shape(self) -> tuple[int, ...] | None:
+        return None
+
+    def refined(self, points: int) -> dict[str, Any] | None:
+        return None
+
+    def equivalent_line(self) -> SpectrumGenerator | None:
+        return None
+
+    def c0(self) -> float:
+        raise NotImplementedError(f"{self.name} is not a power-law spectrum: it has no prefactor C0")
+
+    def hurst_exponent(self) -> float | None:
+        return None
+
 
 class SlopeEstimator(Plugin):
     """Turns a profile into pointwise slopes.
 
-    ``slopes(heights, spacing)`` returns an array of the same shape as
+    ``slopes(heights, spacing, periodic)`` returns an array of the same shape as
     ``heights``: the slope attributed to each point. The rms slope of the whole
     line and the rms slope over the points in contact are both formed from it,
-    so the two always use the same estimator.
+    so the two always use the same estimator. With ``periodic=False`` (a scan
+    whose ends do not meet) no difference may reach across the ends.
+
+    ``periodic_only``: True for an estimator that cannot treat a non-periodic
+    profile (a preset pairing it with one is refused).
     """
 
     kind: ClassVar[str] = "slope"
     dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
+    periodic_only: ClassVar[bool] = False
 
-    def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:  # pragma: no cover
+    def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
+
+
+IndentationReference = Literal["undeformed body", "mean surface"]
+"""Where a solver's indentation is measured from: both start at the first touch of
+the highest point; "undeformed body": against the elastic body far from the
+contact (springs: their base does not move); "mean surface": against the mean
+plane of the deformed elastic surface (a periodic elastic body, whose mean
+displacement is its rigid-body mode)."""
 
 
 class ContactSolver(Plugin):
     """Presses a rigid profile into an elastic body over a sweep of loads.
 
-    ``solve(profile, loads, control, slopes)`` returns a ``ContactCurve``;
-    ``control`` says whether ``loads`` are total forces or indentations (rigid
-    body approach, measured from the first touch). ``stiffness()`` is the
-    modulus k in f = F / (k h L): E* for MDR, the foundation modulus for Winkler.
+    Required:
+
+    - ``solve(profile, loads, control, slopes) -> ContactCurve``: ``control`` says
+      whether ``loads`` are total loads or indentations (rigid-body approach from
+      the first touch).
+    - ``stiffness()``: the modulus k of f = F / (k h X).
+    - ``normalisations``: for each profile dimension in ``dimensions``, what the
+      load means and which combination is dimensionless (``ForceNormalisation``).
+      The framework forms f from it only (``force_unit``).
+    - ``problem``: the physical problem solved, in a few words ("elastic
+      half-space"); solvers of one problem can be compared at equal f.
+
+    Optional, with defaults:
+
+    - ``approximation`` (False): True when the solver models its problem only
+      approximately (MDR for the half-space); the study compares it with an exact one.
+    - ``contact_measure`` ("real contact"): what ``contact_fraction`` measures.
+    - ``indentation_reference`` ("undeformed body") and ``mean_displacement(f, h)``
+      (zero): the mean displacement of the elastic surface in the indentation's
+      frame, so that ``indentation - mean_displacement`` is measured from the mean
+      plane of the deformed surface for every solver.
+    - ``periodic_only`` (False): True for a solver of periodic profiles only.
+    - ``body_params`` (()): the ``Params`` fields describing the elastic body (not
+      the numerics); a study carries them from one solver to another that has them.
+    - ``tolerance_param`` (None): the ``Params`` field of the relative tolerance of
+      an iterative solver; ``tolerance()`` reads it (None for a direct solver).
     """
 
     kind: ClassVar[str] = "solver"
     dimensions: ClassVar[tuple[int, ...]] = (1,)  # profile dimensions it accepts
+    normalisations: ClassVar[Mapping[int, ForceNormalisation]] = {}
+    problem: ClassVar[str] = ""
+    approximation: ClassVar[bool] = False
+    contact_measure: ClassVar[ContactMeasure] = "real contact"
+    indentation_reference: ClassVar[IndentationReference] = "undeformed body"
+    periodic_only: ClassVar[bool] = False
+    body_params: ClassVar[tuple[str, ...]] = ()
+    tolerance_param: ClassVar[str | None] = None
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
@@ -188,6 +394,25 @@ class ContactSolver(Plugin):
 
     def stiffness(self) -> float:  # pragma: no cover - interface
         raise NotImplementedError
+
+    @classmethod
+    def normalisation(cls, dimension: int) -> ForceNormalisation:
+        """The normalisation of f on a profile of ``dimension`` (1 or 2)."""
+        try:
+            return cls.normalisations[dimension]
+        except KeyError:
+            raise ValueError(f"{cls.name} declares no normalisation of f for {dimension}D profiles") from None
+
+    def mean_displacement(self, f: np.ndarray, rms_height: float) -> np.ndarray:
+        """Mean displacement of the elastic surface at dimensionless force ``f``, in
+        the frame of the reported indentation (zero: measured from the mean plane)."""
+        return np.zeros_like(np.asarray(f, dtype=float))
+
+    def tolerance(self) -> float | None:
+        """The relative tolerance the solver iterates to; None for a direct solver."""
+        if self.tolerance_param is None:
+            return None
+        return float(self.params.model_dump()[self.tolerance_param])
 
 
 KINDS: dict[str, type[Plugin]] = {

@@ -1,4 +1,4 @@
-"""The fitted law in 3D (SPEC section 7): the rms slope in contact of a rough
+"""The fitted law in 3D: the rms slope in contact of a rough
 surface of apparent area A pressed with force F, by MDR.
 
 MDR maps the surface to a line of length L = 2 sqrt(A / pi), so the line's
@@ -28,12 +28,8 @@ import numpy as np
 
 from .errors import FrictionlabError
 from .fit import bootstrap_coefficients
+from .plugin import mdr_length
 from .seeds import bootstrap_rng
-
-
-def mdr_length(area: float) -> float:
-    """The MDR line length L = 2 sqrt(A / pi) of an apparent contact area A."""
-    return 2.0 * math.sqrt(area / math.pi)
 
 
 def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area: float) -> float:
@@ -41,7 +37,7 @@ def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area
     for name, value in (("force", force), ("modulus", modulus), ("rms_height", rms_height), ("area", area)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
             raise FrictionlabError(f"{name} must be a finite number > 0. Got {value!r} instead.")
-    return math.sqrt(math.pi) * force / (2.0 * modulus * rms_height * math.sqrt(area))
+    return force / (modulus * rms_height * mdr_length(area))
 
 
 @dataclass(frozen=True)
@@ -62,7 +58,7 @@ class Prediction:
 
     @property
     def beyond_full_contact(self) -> bool:
-        return self.xi > 1.0  # xi = 1 at full contact (SPEC 5): the log law no longer holds
+        return self.xi > 1.0  # xi = 1 at full contact: the log law no longer holds
 
 
 def predict_xi(
@@ -213,7 +209,7 @@ def cmd_predict(args) -> int:
 
 def add_parser(sub) -> None:
     """The ``predict`` subcommand (registered by cli.build_parser)."""
-    p = sub.add_parser("predict", help="rms slope in contact of a 3D contact from a fitted law (SPEC 7)")
+    p = sub.add_parser("predict", help="rms slope in contact of a 3D contact from a fitted law")
     p.add_argument("--a", type=float, help="the law's a")
     p.add_argument("--b", type=float, help="the law's b")
     p.add_argument("--a-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of a")

@@ -9,19 +9,33 @@ from __future__ import annotations
 
 import copy
 import functools
+import math
+import os
+import types
+import typing
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from .errors import PluginError, PresetError
-from .plugin import ContactSolver, SlopeEstimator, SpectrumGenerator
+from .errors import FrictionlabError, PluginError, PresetError, PresetFileError, short_repr
+from .inputs import InputFileProblem, input_fields, is_relative, read_regular_file, regular_file_problem
+from .plugin import ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from .registry import Registry, default_registry
+from .safe_yaml import YamlLimit, YamlProblem, load_yaml
 
 PLUGIN_SLOTS = {"spectrum": "spectrum", "solver": "solver", "slope": "slope"}  # preset key -> kind
+
+MAX_PRESET_BYTES = 256 * 1024  # presets are a few kB; refused by size before anything is read
+MAX_SWEEP_POINTS = 1000  # counted from the axes, before any point is built
+MAX_MAGNITUDE = 1e100  # numbers in a preset: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
+NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._+-]{0,99}$"
+NAME_RULE = (
+    "must be 1 to 100 letters, digits, '.', '_', '+' or '-', starting with a letter or digit "
+    "(it names the output folder)"
+)
 
 
 class _Strict(BaseModel):
@@ -97,6 +111,10 @@ class SweepParameter(_Strict):
             raise ValueError(f"a log range needs start > 0 and stop > 0. Got start={self.start!r}, stop={self.stop!r} instead")
         return self
 
+    def count(self) -> int:
+        """How many values, without making them."""
+        return len(self.values) if self.values is not None else int(self.num)
+
     def points(self) -> list:
         """The values, in order (ranges rounded to 12 significant digits so labels and --set stay clean)."""
         if self.values is not None:
@@ -120,15 +138,29 @@ class SweepSettings(_Strict):
     @model_validator(mode="after")
     def _zip_lengths(self):
         if self.mode == "zip":
-            lengths = {path: len(p.points()) for path, p in self.parameters.items()}
+            lengths = {path: p.count() for path, p in self.parameters.items()}
             if len(set(lengths.values())) > 1:
                 listed = ", ".join(f"{path}: {n}" for path, n in lengths.items())
                 raise ValueError(f"mode zip needs the same number of values for every parameter. Got {listed} instead")
+        points = self.count()
+        if points > MAX_SWEEP_POINTS:
+            axes = " x ".join(str(p.count()) for p in self.parameters.values())
+            raise ValueError(
+                f"the sweep has {points:,} points ({self.mode} of {axes}); at most {MAX_SWEEP_POINTS:,} are allowed"
+            )
         return self
+
+    def count(self) -> int:
+        """Points of the sweep, counted from its axes (none is made)."""
+        counts = [p.count() for p in self.parameters.values()]
+        return math.prod(counts) if self.mode == "grid" else (counts[0] if counts else 0)
 
 
 class Preset(_Strict):
-    name: str = Field(min_length=1, description="Short name of the scene; names the default output folder.")
+    name: str = Field(
+        pattern=NAME_PATTERN,
+        description="Short name of the scene (letters, digits, '.', '_', '+', '-'); names the default output folder.",
+    )
     description: str = Field("", description="What the scene is and where its numbers come from.")
     seed: int = Field(0, ge=0, description="Root seed: realization i uses SeedSequence(seed, spawn_key=(0, i)).")
     realizations: int = Field(ge=1, le=10_000_000, description="Number of independent random lines (M).")
@@ -156,7 +188,7 @@ class Scene:
     solver: ContactSolver
     slope: SlopeEstimator
     # The 2D generator the preset named when the solver presses lines only: ``spectrum`` is
-    # then its MDR-equivalent line (SPEC section 7), and ``geometry`` says so.
+    # then its MDR-equivalent line, and ``geometry`` says so.
     surface: SpectrumGenerator | None = None
 
     @property
@@ -166,6 +198,16 @@ class Scene:
             return "mdr-equivalent line of a surface"
         return "surface" if self.spectrum.dimension == 2 else "line"
 
+    @property
+    def normalisation(self) -> ForceNormalisation:
+        """What the loads mean and how f is formed, for the profiles that run."""
+        return self.solver.normalisation(self.spectrum.dimension)
+
+    @property
+    def named_spectrum(self) -> SpectrumGenerator:
+        """The spectrum the preset names (the surface, when its MDR-equivalent line runs)."""
+        return self.surface if self.surface is not None else self.spectrum
+
     @functools.cached_property
     def loads(self) -> np.ndarray:
         return self.preset.loading.values()
@@ -174,15 +216,26 @@ class Scene:
     def control(self) -> str:
         return self.preset.loading.control
 
+    def slot_plugins(self) -> dict:
+        """The plugin the preset named in each slot (the surface, not its equivalent line)."""
+        return {"spectrum": self.named_spectrum, "solver": self.solver, "slope": self.slope}
+
     def resolved(self) -> dict:
         """The preset with every default filled in, plugin params included."""
         data = self.preset.model_dump(mode="json")
         if data.get("sweep") is None:
             data.pop("sweep", None)  # a plain run (or one sweep point) has no sweep section
-        for slot in PLUGIN_SLOTS:
-            plugin = self.surface if slot == "spectrum" and self.surface is not None else getattr(self, slot)
+        for slot, plugin in self.slot_plugins().items():
             data[slot] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
         return data
+
+    def input_files(self) -> dict[str, str]:
+        """The files the run reads, by dotted parameter (absolute paths)."""
+        return {
+            f"{slot}.params.{field}": getattr(plugin.params, field)
+            for slot, plugin in self.slot_plugins().items()
+            for field in input_fields(type(plugin.params))
+        }
 
 
 # ------------------------------------------------------------------ messages
@@ -228,6 +281,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be a mapping of keys to values"
     if kind == "string_too_short":
         return "must not be empty"
+    if kind == "string_pattern_mismatch" and ctx.get("pattern") == NAME_PATTERN:
+        return NAME_RULE
     message = error["msg"]
     for prefix in ("Value error, ", "Assertion failed, "):
         message = message.removeprefix(prefix)
@@ -241,7 +296,7 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
         path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
         if error["type"] != "missing" and not (error["type"] == "value_error" and not error["loc"]):
-            line += f", got {error['input']!r}"
+            line += f", got {short_repr(error['input'])}"
         lines.append(line)
     return lines
 
@@ -250,27 +305,71 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
 
 
 def load_preset_file(path: str | Path) -> dict:
-    """Read a preset file with ``yaml.safe_load``; errors become PresetError."""
+    """Read a preset file: a regular file of at most MAX_PRESET_BYTES of UTF-8
+    YAML within the limits of ``safe_yaml``. A file that cannot be used is a
+    PresetFileError, bad YAML a PresetError; neither quotes the file."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise PresetError([f"(file): no such preset file: {path}"], source=str(path)) from None
-    except OSError as exc:
-        raise PresetError([f"(file): cannot read {path}: {exc.strerror}"], source=str(path)) from None
+        raw = read_regular_file(path, limit=MAX_PRESET_BYTES, what="preset file")
+    except InputFileProblem as exc:
+        raise PresetFileError([f"(file): {exc}"], source=str(path)) from None
     try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise PresetError([f"(file): not valid YAML{where}: {problem}"], source=str(path)) from None
+        text = raw.decode("utf-8").removeprefix("\ufeff")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise PresetFileError(
+            [f"(file): not UTF-8 text (byte {exc.start + 1}, line {line}); save the preset as UTF-8"], source=str(path)
+        ) from None
+    try:
+        data = load_yaml(text)
+    except YamlLimit as exc:
+        raise PresetFileError([f"(file): {exc}"], source=str(path)) from None
+    except YamlProblem as exc:
+        raise PresetError([f"(file): {exc}"], source=str(path)) from None
     if not isinstance(data, dict):
         raise PresetError(
             [f"(file): a preset must be a mapping of keys to values. Got {type(data).__name__} instead."],
             source=str(path),
         )
     return data
+
+
+def resolve_input_paths(data: dict, base_dir: str | Path, registry: Registry | None = None) -> dict:
+    """A copy of preset ``data`` whose relative input-file paths (plugin
+    parameters declared ``InputFile``, and swept values of one) are taken from
+    ``base_dir``, the folder of the preset file they were written in."""
+    registry = registry or default_registry()
+    data = copy.deepcopy(data)
+    base = Path(os.path.abspath(base_dir))
+    sweep = data.get("sweep") if isinstance(data.get("sweep"), dict) else {}
+    swept = sweep.get("parameters") if isinstance(sweep.get("parameters"), dict) else {}
+    for slot, kind in PLUGIN_SLOTS.items():
+        choice = data.get(slot) if isinstance(data.get(slot), dict) else {}
+        names = [choice.get("name")]
+        if isinstance(swept.get(f"{slot}.name"), dict):
+            names += list(swept[f"{slot}.name"].get("values") or [])
+        fields: set[str] = set()
+        for name in names:
+            try:
+                fields.update(input_fields(registry.get(kind, name).Params))
+            except (FrictionlabError, TypeError, AttributeError):  # reported when the preset is validated
+                continue
+        for field in fields:
+            params = choice.get("params")
+            if isinstance(params, dict) and is_relative(params.get(field)):
+                params[field] = str(base / params[field])
+            axis = swept.get(f"{slot}.params.{field}")
+            if isinstance(axis, dict) and isinstance(axis.get("values"), list):
+                axis["values"] = [str(base / v) if is_relative(v) else v for v in axis["values"]]
+    return data
+
+
+def read_preset(path: str | Path, overrides: list[str] = (), registry: Registry | None = None) -> dict:
+    """Preset data from a file, its relative input paths taken from the file's
+    folder, then ``--set`` overrides applied (a relative path given there is
+    taken from the current folder, as in any command line)."""
+    data = resolve_input_paths(load_preset_file(path), Path(path).parent, registry)
+    return apply_overrides(data, list(overrides))
 
 
 def apply_overrides(data: dict, assignments: list[str]) -> dict:
@@ -284,8 +383,8 @@ def apply_overrides(data: dict, assignments: list[str]) -> dict:
             problems.append(f"--set {assignment!r}: must look like dotted.path=value, e.g. spectrum.params.hurst=0.8")
             continue
         try:
-            value = yaml.safe_load(raw) if raw.strip() else ""
-        except yaml.YAMLError:
+            value = load_yaml(raw) if raw.strip() else ""
+        except YamlProblem:
             value = raw
         node = data
         for depth, key in enumerate(keys[:-1]):
@@ -305,15 +404,22 @@ def apply_overrides(data: dict, assignments: list[str]) -> dict:
     return data
 
 
-def build_scene(data: dict, registry: Registry | None = None, source: str | None = None) -> Scene:
-    """Validate preset data (structure, then each plugin's params) into a Scene."""
+def build_scene(
+    data: dict, registry: Registry | None = None, source: str | None = None, base_dir: str | Path | None = None
+) -> Scene:
+    """Validate preset data (structure, then each plugin's params) into a Scene.
+    ``base_dir``: the folder relative input-file paths in ``data`` are taken
+    from (the preset file's; without it, the current folder)."""
     registry = registry or default_registry()
     if not isinstance(data, dict):
         raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
+    if base_dir is not None:
+        data = resolve_input_paths(data, base_dir, registry)
+    numbers = number_problems(Preset, data)
     try:
         preset = Preset.model_validate(data)
     except ValidationError as exc:
-        problems = format_validation_error(exc, Preset)
+        problems = _merge_problems(numbers, format_validation_error(exc, Preset))
         # Check the plugin sections that are well formed too, so every problem shows at once.
         for slot, kind in PLUGIN_SLOTS.items():
             try:
@@ -322,12 +428,20 @@ def build_scene(data: dict, registry: Registry | None = None, source: str | None
                 continue
             problems += _plugin_problems(registry, slot, kind, choice)[1]
         raise PresetError(problems, source=source) from None
-    plugins, problems = {}, []
+    plugins, problems = {}, list(numbers)
     for slot, kind in PLUGIN_SLOTS.items():
         instance, slot_problems = _plugin_problems(registry, slot, kind, getattr(preset, slot))
         plugins[slot] = instance
         problems += slot_problems
     if problems:
+        raise PresetError(problems, source=source)
+    problems = [
+        f"{slot}.params.{field}: {problem}, got {short_repr(getattr(plugin.params, field))}"
+        for slot, plugin in plugins.items()
+        for field in input_fields(type(plugin.params))
+        if (problem := regular_file_problem(getattr(plugin.params, field)))
+    ]
+    if problems:  # before anything reads them (an equivalent line reads its map now)
         raise PresetError(problems, source=source)
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in PLUGIN_SLOTS:
@@ -337,23 +451,24 @@ def build_scene(data: dict, registry: Registry | None = None, source: str | None
 
 def _match_dimensions(plugins: dict, source: str | None) -> dict:
     """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
-    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError."""
+    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError, and so is
+    a non-periodic profile (a scan) given to a solver or estimator of periodic profiles only."""
     spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
     made = spectrum.dimension
     shape = {1: "lines", 2: "surfaces"}
     if made not in solver.dimensions:
-        line = getattr(spectrum, "equivalent_line", None)
-        if made != 2 or 1 not in solver.dimensions or line is None:
+        try:
+            line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
+        except ValueError as exc:
+            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        if line is None:
             raise PresetError(
                 [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
                  f"only, but spectrum {spectrum.name} makes {shape[made]}"
                  + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
                 source=source,
             )
-        try:
-            plugins = {**plugins, "spectrum": line(), "surface": spectrum}
-        except ValueError as exc:
-            raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
+        plugins = {**plugins, "spectrum": line, "surface": spectrum}
         made = 1
     if made not in slope.dimensions:
         raise PresetError(
@@ -361,6 +476,18 @@ def _match_dimensions(plugins: dict, source: str | None) -> dict:
              f"but the {shape[made][:-1]} that runs here is {'2D' if made == 2 else '1D'}"],
             source=source,
         )
+    if not plugins["spectrum"].periodic():
+        scan = f"spectrum {spectrum.name} is not periodic (periodic: false, a scan whose ends do not meet)"
+        make_periodic = "set spectrum.params.periodic: true if its ends meet (after detrend)"
+        problems = []
+        if solver.periodic_only:
+            problems.append(f"solver.name: {solver.name} presses periodic profiles only, but {scan}: "
+                            f"use a solver of independent springs (mdr, winkler), or {make_periodic}")
+        if slope.periodic_only:
+            problems.append(f"slope.name: {slope.name} differentiates periodic profiles only, but {scan}: "
+                            f"use forward-difference or central-difference, or {make_periodic}")
+        if problems:
+            raise PresetError(problems, source=source)
     return plugins
 
 
@@ -369,19 +496,89 @@ def _plugin_problems(registry: Registry, slot: str, kind: str, choice: PluginCho
         cls = registry.get(kind, choice.name)
     except PluginError as exc:
         return None, [f"{slot}.name: {exc}"]
+    numbers = number_problems(cls.Params, choice.params, f"{slot}.params")
     try:
         params = cls.Params.model_validate(choice.params)
     except ValidationError as exc:
-        return None, format_validation_error(exc, cls.Params, prefix=f"{slot}.params")
-    return cls(params), []
+        return None, _merge_problems(numbers, format_validation_error(exc, cls.Params, prefix=f"{slot}.params"))
+    return (None, numbers) if numbers else (cls(params), [])
+
+
+# ------------------------------------------------------------------ numbers
+# pydantic takes true as 1 for a number, and .inf / .nan for a float unless told
+# otherwise; a plugin's Params would each have to say so. One walk over the
+# data against the model's annotations refuses them everywhere instead.
+
+
+def _kinds(annotation) -> set:
+    """The plain types a field accepts (unions and Optional unpacked)."""
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return set().union(*(_kinds(arg) for arg in typing.get_args(annotation)))
+    return {annotation}
+
+
+def _nested_model(annotation) -> type[BaseModel] | None:
+    for kind in _kinds(annotation):
+        if isinstance(kind, type) and issubclass(kind, BaseModel):
+            return kind
+    return None
+
+
+def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
+    if isinstance(value, bool):
+        return f"{path}: must be a number, not true or false, got {str(value).lower()}"
+    if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
+        try:
+            value = float(value)
+        except ValueError:
+            return None  # not a number at all: pydantic says so
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
+    if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):
+        return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+    return None
+
+
+def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]:
+    """Numeric fields of ``model`` given true/false, infinity or NaN (unless the
+    field allows them), or a magnitude beyond MAX_MAGNITUDE, in ``data``."""
+    if not isinstance(data, dict):
+        return []
+    problems = []
+    for name, field in model.model_fields.items():
+        if name not in data:
+            continue
+        value, path = data[name], f"{prefix}.{name}" if prefix else name
+        nested = _nested_model(field.annotation)
+        item = typing.get_args(field.annotation)[-1] if typing.get_origin(field.annotation) is dict else None
+        kinds = _kinds(field.annotation)
+        allow = any(getattr(m, "allow_inf_nan", False) for m in field.metadata)
+        if nested is not None and isinstance(value, dict):
+            problems += number_problems(nested, value, path)
+        elif isinstance(item, type) and issubclass(item, BaseModel) and isinstance(value, dict):
+            for key, entry in value.items():
+                problems += number_problems(item, entry, f"{path}.{key}")
+        elif kinds & {int, float} and bool not in kinds:
+            problem = _number_problem(value, path, allow)
+            problems += [problem] if problem else []
+        elif typing.get_origin(field.annotation) in (list, tuple) and isinstance(value, list):
+            items = set().union(*(_kinds(a) for a in typing.get_args(field.annotation) if a is not Ellipsis))
+            if items & {int, float} and bool not in items:
+                problems += [p for i, v in enumerate(value) if (p := _number_problem(v, f"{path}[{i}]", allow))]
+    return problems
+
+
+def _merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
+    """Both lists, without a pydantic line for a field the number check already named."""
+    named = {line.split(": ", 1)[0] for line in numbers}
+    return numbers + [line for line in pydantic_lines if line.split(": ", 1)[0] not in named]
 
 
 def load_scene(
     path: str | Path, overrides: list[str] = (), registry: Registry | None = None
 ) -> Scene:
     """File -> overrides -> validated Scene."""
-    data = apply_overrides(load_preset_file(path), list(overrides))
-    return build_scene(data, registry=registry, source=str(path))
+    return build_scene(read_preset(path, overrides, registry), registry=registry, source=str(path))
 
 
 # ------------------------------------------------------------------ schema

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .plugin import force_unit
 from .preset import Scene
 from .seeds import realization_rng
 
@@ -32,7 +33,7 @@ class RealizationResult:
     force: np.ndarray | None = None  # kept only under indentation control (forces vary)
     slope_rms_line: float = math.nan
     points: int = 0
-    length: float = math.nan
+    force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
     error: str | None = None
 
     @property
@@ -46,7 +47,7 @@ def compute_realization(scene: Scene, index: int) -> RealizationResult:
     try:
         rng = realization_rng(scene.preset.seed, index)
         profile = scene.spectrum.generate(rng)
-        slopes = scene.slope.slopes(profile.heights, profile.spacing)
+        slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
         slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
@@ -62,7 +63,7 @@ def compute_realization(scene: Scene, index: int) -> RealizationResult:
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             slope_rms_line=slope_rms_line,
             points=profile.points,
-            length=profile.length,
+            force_unit=force_unit(scene.solver, scene.spectrum.rms_height(), profile),
         )
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]

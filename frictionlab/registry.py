@@ -18,17 +18,32 @@ import importlib.metadata as md
 import os
 import sys
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import get_args
 
+import numpy as np
 import pluggy
 from pydantic import BaseModel
 
 from .errors import PluginError
-from .hookspecs import PROJECT_NAME, RegistrationSpecs
-from .plugin import KINDS, NAME_PATTERN, Plugin
+from .hookspecs import PROJECT_NAME, LifecycleSpecs, RegistrationSpecs
+from .plugin import (
+    KINDS,
+    NAME_PATTERN,
+    ContactMeasure,
+    ContactSolver,
+    ForceNormalisation,
+    IndentationReference,
+    Plugin,
+    Profile,
+    SlopeEstimator,
+    SpectrumGenerator,
+)
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
+LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
 KIND_HOOKS = {
     "spectrum": "register_spectra",
     "solver": "register_solvers",
@@ -108,6 +123,59 @@ def validate_plugin_class(kind: str, cls) -> None:
     for field_name, info in params.model_fields.items():
         if not info.description:
             raise PluginError(f"{label}: Params.{field_name} has no description")
+    for problem in declaration_problems(cls):
+        raise PluginError(f"{label}: {problem}")
+
+
+def declaration_problems(cls) -> list[str]:
+    """What is wrong with the contract declarations of a plugin class (see ``plugin.py``)."""
+    fields = set(cls.Params.model_fields)
+    problems = []
+
+    def named_fields(what: str, names) -> None:
+        unknown = [n for n in names if n not in fields]
+        if unknown:
+            problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
+
+    if issubclass(cls, SpectrumGenerator):
+        if cls.dimension not in (1, 2):
+            problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
+        if cls.points_param is not None:
+            named_fields("points_param", [cls.points_param])
+    if issubclass(cls, (ContactSolver, SlopeEstimator)):
+        dims = cls.dimensions
+        if not (isinstance(dims, tuple) and dims and set(dims) <= {1, 2}):
+            problems.append(f"dimensions must be a non-empty tuple of 1 and/or 2. Got {dims!r} instead.")
+        if not isinstance(cls.periodic_only, bool):
+            problems.append(f"periodic_only must be True or False. Got {cls.periodic_only!r} instead.")
+    if issubclass(cls, ContactSolver):
+        declared = cls.normalisations
+        if not isinstance(declared, Mapping) or set(declared) != set(cls.dimensions) or not all(
+            isinstance(n, ForceNormalisation) for n in declared.values()
+        ):
+            problems.append(
+                "normalisations must map each of its dimensions "
+                f"{cls.dimensions!r} to a ForceNormalisation (what its load means and how f is formed). "
+                f"Got {declared!r} instead."
+            )
+        else:
+            for dimension, normalisation in declared.items():
+                try:
+                    normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
+                except ValueError as exc:
+                    problems.append(f"normalisations[{dimension}]: {exc}")
+        if not (isinstance(cls.problem, str) and cls.problem.strip()):
+            problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
+        for attr, value, allowed in (
+            ("contact_measure", cls.contact_measure, ContactMeasure),
+            ("indentation_reference", cls.indentation_reference, IndentationReference),
+        ):
+            if value not in get_args(allowed):
+                problems.append(f"{attr} must be one of {', '.join(map(repr, get_args(allowed)))}. Got {value!r} instead.")
+        named_fields("body_params", cls.body_params)
+        if cls.tolerance_param is not None:
+            named_fields("tolerance_param", [cls.tolerance_param])
+    return problems
 
 
 class Registry:
@@ -117,6 +185,7 @@ class Registry:
         env = os.environ if env is None else env
         self.pm = pluggy.PluginManager(PROJECT_NAME)
         self.pm.add_hookspecs(RegistrationSpecs)
+        self.pm.add_hookspecs(LifecycleSpecs)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
@@ -201,6 +270,15 @@ class Registry:
         self._plugins = tables
 
     # ------------------------------------------------------------- queries
+
+    def run_listeners(self) -> list[object]:
+        """The registered plugins that implement a lifecycle hook: ``engine.run`` tells them
+        of every run, besides the listeners it is given."""
+        found: dict[int, object] = {}
+        for name in LIFECYCLE_HOOKS:
+            for impl in getattr(self.pm.hook, name).get_hookimpls():
+                found.setdefault(id(impl.plugin), impl.plugin)
+        return list(found.values())
 
     def names(self, kind: str) -> list[str]:
         return sorted(self._plugins[kind])

@@ -1,5 +1,5 @@
 """``frictionlab report``: run the study's Figs. 2 to 5 and write REPRODUCTION.md
-with its figures, the study's numbers beside frictionlab's (SPEC section 7).
+with its figures, the study's numbers beside frictionlab's.
 
 With ``--readings`` it also runs readings of the study's method (cut-off,
 amplitudes, slope estimator, averaging over realizations, normalisation per H)
@@ -31,7 +31,7 @@ from .seeds import bootstrap_rng
 
 @dataclass(frozen=True)
 class StudyFigure:
-    """What the study reports for one figure (SPEC section 7)."""
+    """What the study reports for one figure."""
 
     key: str
     preset: str  # file name in the presets folder
@@ -50,7 +50,7 @@ STUDY = (
     StudyFigure("fig5", "benad2012-fig5.yaml", "Fig. 5: a and b against H, each point as Fig. 2", 2.9, 0.14, {},
                 "the study: a about 2.9 and b about 0.14 near H = 0.7"),
 )  # fmt: skip
-STUDY_H07 = (0.7, 2.9, 0.14)  # H, a, b "about" (SPEC 7)
+STUDY_H07 = (0.7, 2.9, 0.14)  # H, a, b "about", as the study states them
 STUDY_POINTS_VS_H = ((1.0, 1.8847, 0.0805, "Fig. 2"), (0.5, 2.6252, 0.1341, "Fig. 4"))
 COUNT_TARGETS = {1.0: 4.0, 20.0: 12.0}  # the study's Fig. 2 contact counts, used to calibrate h
 
@@ -58,7 +58,7 @@ COUNT_TARGETS = {1.0: 4.0, 20.0: 12.0}  # the study's Fig. 2 contact counts, use
 # ------------------------------------------------------------------ averaging readings
 
 AVERAGES = {
-    "mean": "mean of xi over realizations (SPEC 4, the default)",
+    "mean": "mean of xi over realizations (the default)",
     "pooled": "rms slope over the contact points of all realizations pooled, over the pooled line rms slope",
     "rms": "root mean square of xi over realizations",
 }
@@ -162,8 +162,13 @@ class Reading:
     same_c0_as: str | None = None  # a figure key: take its C0 (normalise by C0 instead of h)
 
 
+# The study's eq. 6 read literally: pi / L <= q <= pi / (10 dx), a sum of cosines with q_k = k pi / L,
+# k = 1 .. N / 10, on [0, L]: not periodic, the wave vectors twice as dense as the FFT grid's.
+LITERAL = "eq. 6 literally: cosine series q_k = k pi / L, k = 1 .. N/10, not periodic, h calibrated to the counts"
+LITERAL_SETS = ("spectrum.params.series=cosine", "spectrum.params.short_cutoff=20.0")  # q_max = pi / (10 dx), dx = 1
+
 READINGS = (
-    Reading("fig2", "SPEC defaults (the preset)"),
+    Reading("fig2", "defaults (the preset)"),
     Reading("fig2", "no short cut-off (lambda_s = 2 dx), h = 1e4", ("spectrum.params.short_cutoff=2.0",)),
     Reading("fig2", "no short cut-off, h calibrated to the counts", ("spectrum.params.short_cutoff=2.0",), calibrate=True),
     Reading("fig2", "short cut-off 20 dx, h calibrated to the counts", ("spectrum.params.short_cutoff=20.0",), calibrate=True),
@@ -174,10 +179,12 @@ READINGS = (
             ("spectrum.params.short_cutoff=2.0", "slope.name=spectral"), calibrate=True),
     Reading("fig2", "average: pooled contact points", average="pooled"),
     Reading("fig2", "average: rms of xi", average="rms"),
-    Reading("fig3", "SPEC defaults (the preset)"),
+    Reading("fig2", LITERAL, LITERAL_SETS, calibrate=True),
+    Reading("fig3", "defaults (the preset)"),
     Reading("fig3", "no short cut-off, h calibrated to the counts", ("spectrum.params.short_cutoff=2.0",), calibrate=True),
     Reading("fig3", "Rayleigh amplitudes", ("spectrum.params.amplitudes=rayleigh",)),
     Reading("fig3", "average: pooled contact points", average="pooled"),
+    Reading("fig3", LITERAL, LITERAL_SETS, calibrate=True),
     Reading("fig4", "same h as Fig. 2 (the preset)"),
     Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
     Reading("fig4", "h calibrated to Fig. 2's counts at H = 0.5", calibrate=True),
@@ -185,6 +192,7 @@ READINGS = (
     Reading("fig4", "Rayleigh amplitudes, h calibrated at H = 0.5", ("spectrum.params.amplitudes=rayleigh",),
             calibrate=True),
     Reading("fig4", "average: pooled contact points", average="pooled"),
+    Reading("fig4", LITERAL + " at H = 0.5", LITERAL_SETS, calibrate=True),
 )  # fmt: skip
 
 
@@ -235,7 +243,7 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     )
 
 
-def run_figures(presets: Path, out_dir: Path, *, workers=None) -> list[FigureRun]:
+def run_figures(presets: Path, out_dir: Path, *, workers=None, force: bool = False) -> list[FigureRun]:
     from .sweep import load_sweep, run_sweep
 
     runs = []
@@ -245,16 +253,16 @@ def run_figures(presets: Path, out_dir: Path, *, workers=None) -> list[FigureRun
         data = load_preset_file(path)
         if data.get("sweep") is not None:
             run.sweep = load_sweep(path)
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, workers=workers, plot=False)
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, workers=workers, plot=False, force=force)
         else:
             run.scene = build_scene(data, source=str(path))
-            run.outcome, _ = run_to_folder(run.scene, run.folder, workers=workers)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, workers=workers, force=force)
         runs.append(run)
     return runs
 
 
 def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings=READINGS,
-                 folder_name="readings") -> list[ReadingRow]:  # fmt: skip
+                 folder_name="readings", force: bool = False) -> list[ReadingRow]:  # fmt: skip
     by_key = {run.study.key: run for run in runs}
     rows = []
     for number, reading in enumerate(readings, start=1):
@@ -273,7 +281,7 @@ def run_readings(runs: list[FigureRun], out_dir: Path, *, workers=None, readings
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
             folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
-            outcome, _ = run_to_folder(scene, folder, workers=workers)
+            outcome, _ = run_to_folder(scene, folder, workers=workers, force=force)
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip
@@ -441,7 +449,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         + (f"; the readings below took another {readings_elapsed:.1f} s" if readings_elapsed is not None else "")
         + (f", Fig. 5 with h calibrated at each H {fig5_calibrated_elapsed:.1f} s" if fig5_calibrated_elapsed else "")
         + "."
-        + " The study's numbers are from SPEC section 7; the presets are in `presets/` (their comments say"
+        + " The study's numbers are those its Figs. 2 to 5 state; the presets are in `presets/` (their comments say"
         " how h = 1e4 was calibrated). Intervals are 95% percentile bootstrap over realizations;"
         " † marks a study value outside frictionlab's interval.",
         "",
@@ -524,7 +532,7 @@ def _reading_hurst(row: ReadingRow) -> float:
 
 
 def _study_at_h(hurst: float):
-    """(a, b, label) the study states at this H, or None (SPEC 7)."""
+    """(a, b, label) the study states at this H, or None."""
     known = [(h, a, b, f"{label}: {a}, {b}") for h, a, b, label in STUDY_POINTS_VS_H]
     known.append((*STUDY_H07, f"about {STUDY_H07[1]}, about {STUDY_H07[2]}"))
     return next(((a, b, text) for h, a, b, text in known if abs(h - hurst) < 1e-9), None)
@@ -590,7 +598,8 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         "## Readings of the study's method",
         "",
         "Each row is one reading of what the study may have done, run for real (`frictionlab report --readings`)."
-        " The defaults follow SPEC.md; no reading is tuned to the study's numbers: a calibrated h is found"
+        " The defaults are frictionlab's (periodic lines, q_k = 2 pi k / L); no reading is tuned to the study's"
+        " numbers: a calibrated h is found"
         " from the study's Fig. 2 contact counts (4 at F = 1, 12 at F = 20) by the method of"
         " `tools/calibrate_rms_height.py`, applied to the reading's own lines. Averages: "
         + "; ".join(f"`{k}`: {v}" for k, v in AVERAGES.items())
@@ -624,21 +633,41 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
 # ------------------------------------------------------------------ the command
 
 
+FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
+
+
+def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: bool = False) -> tuple[Path, Path, Path]:
+    """The run folders, the markdown and the figures folder of a report: by
+    default all in a fresh folder ``runs/report-<timestamp>/`` (``REPRODUCTION.md``,
+    ``figures/``). An existing markdown or figure is refused unless ``force``."""
+    from .errors import OutputRefused
+
+    out_dir = Path(out_dir) if out_dir else Path("runs") / f"report-{time.strftime('%Y%m%d-%H%M%S')}"
+    markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
+    figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
+    taken = [p for p in (markdown_path, *(figures_dir / name for name in FIGURE_FILES)) if os.path.lexists(p)]
+    if taken and not force:
+        shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
+        raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")
+    return out_dir, markdown_path, figures_dir
+
+
 def write_report(
-    *, presets_dir=None, out_dir="runs/report", markdown_path="REPRODUCTION.md", figures_dir="docs/reproduction",
-    workers=None, readings=False, quiet=False, dpi=90,
+    *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
+    workers=None, readings=False, quiet=False, dpi=90, force=False,
 ) -> Path:  # fmt: skip
-    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path."""
+    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
+    Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless ``force``."""
     import sys
 
     from .results import atomic_write
 
     presets = find_presets(presets_dir)
-    out_dir, markdown_path, figures_dir = Path(out_dir), Path(markdown_path), Path(figures_dir)
+    out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=force)
     log = (lambda text: None) if quiet else (lambda text: print(text, file=sys.stderr, flush=True))
     started = time.perf_counter()
     log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-    runs = run_figures(presets, out_dir, workers=workers)
+    runs = run_figures(presets, out_dir, workers=workers, force=force)
     log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
     images = {}
     for run in runs:
@@ -651,13 +680,13 @@ def write_report(
     if readings:
         log(f"report: running {len(READINGS)} readings")
         t0 = time.perf_counter()
-        reading_rows = run_readings(runs, out_dir, workers=workers)
+        reading_rows = run_readings(runs, out_dir, workers=workers, force=force)
         readings_elapsed = time.perf_counter() - t0
         fig5 = next(run for run in runs if run.sweep is not None)
         log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
         t0 = time.perf_counter()
         fig5_rows = run_readings(runs, out_dir, workers=workers, readings=fig5_calibrated_readings(fig5.sweep),
-                                 folder_name="fig5-calibrated")  # fmt: skip
+                                 folder_name="fig5-calibrated", force=force)  # fmt: skip
         fig5_elapsed = time.perf_counter() - t0
         name = "fig5-calibrated.png"
         atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
@@ -678,7 +707,7 @@ def cmd_report(args) -> int:
         raise FrictionlabError(f"--workers must be >= 1. Got {args.workers} instead.")
     path = write_report(
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-        workers=args.workers, readings=args.readings, quiet=args.quiet,
+        workers=args.workers, readings=args.readings, quiet=args.quiet, force=args.force,
     )  # fmt: skip
     print(path)
     return ExitCode.OK
@@ -688,9 +717,10 @@ def add_parser(sub) -> None:
     """The ``report`` subcommand (registered by cli.build_parser)."""
     p = sub.add_parser("report", help="run the study's Figs. 2 to 5 and write REPRODUCTION.md with figures")
     p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets)")
-    p.add_argument("--out", metavar="DIR", default="runs/report", help="run folders (default: runs/report)")
-    p.add_argument("--markdown", metavar="FILE", default="REPRODUCTION.md", help="the report (default: REPRODUCTION.md)")
-    p.add_argument("--figures", metavar="DIR", default="docs/reproduction", help="PNG folder (default: docs/reproduction)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
+    p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
+    p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing report, its figures and runs")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: all cores)")
     p.add_argument("--readings", action="store_true", help="also run the readings of the study's method (slower)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")

@@ -45,7 +45,12 @@ class ProgressReporter:
         self.started = time.perf_counter()
         self.resumed = getattr(run, "resumed", 0)
         preset = run.scene.preset
-        restored = f" ({self.resumed} restored from the run folder)" if self.resumed else ""
+        retried = getattr(run, "retried", 0)
+        restored = ", ".join(
+            [f"{self.resumed} restored from the run folder"] * bool(self.resumed)
+            + [f"{retried} failed ones retried"] * bool(retried)
+        )
+        restored = f" ({restored})" if restored else ""
         self.stream.write(
             f"{preset.name}: {run.total} realizations of {run.scene.spectrum.name} lines{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)\n"

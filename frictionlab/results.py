@@ -32,8 +32,16 @@ from .ensemble import RunOutcome
 from .fit import json_safe
 from .preset import Scene
 
-SUMMARY_SCHEMA_VERSION = 1
+SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
 CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
+CONTACT_MEASURES = {
+    "real contact": "real contact fraction",
+    "mdr springs": "fraction of MDR springs in contact; not the real area",
+}
+INDENTATION_REFERENCES = {
+    "undeformed body": "length; from the first touch; against the undeformed body",
+    "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
+}
 
 
 def _read_umask() -> int:
@@ -82,10 +90,8 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         },
         "fit": fit,
         "normalisation": {
-            "rms_height": json_safe(outcome.rms_height),
-            "length": json_safe(outcome.length),
-            "stiffness": outcome.stiffness,
-            "f": "F / (stiffness * rms_height * length)",
+            key: json_safe(value) if isinstance(value, float) else value
+            for key, value in outcome.normalisation.describe(outcome.stiffness, outcome.rms_height, outcome.extent).items()
         },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
@@ -93,13 +99,33 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "workers": outcome.workers,
         "executor": outcome.extra.get("executor"),
         "resumed_realizations": outcome.extra.get("resumed", 0),
+        "retried_realizations": outcome.extra.get("retried", 0),  # had failed before the resume, ran again
         "files": files,
     }
 
 
-def _write_curve(outcome: RunOutcome, fh) -> None:
+def curve_header(scene: Scene) -> list[str]:
+    """The columns of curve.csv, each a short name (``CURVE_COLUMNS``) with what it
+    means in brackets: the load with its unit, f with its definition."""
+    n = scene.normalisation
+    f = n.definition.removeprefix("f = ").replace(", ", "; ")
+    labels = {
+        "F": f"{n.load_symbol} [{n.load}: {n.load_unit}]",
+        "f": f"f [{f}]",
+        "contact_fraction": f"contact_fraction [{CONTACT_MEASURES[scene.solver.contact_measure]}]",
+        "indentation": f"indentation [{INDENTATION_REFERENCES[scene.solver.indentation_reference]}]",
+    }
+    return [labels.get(column, column) for column in CURVE_COLUMNS]
+
+
+def column_name(header: str) -> str:
+    """The short name of a curve.csv column (``F'`` of ``F' [force per unit depth: ...]``)."""
+    return header.split(" [", 1)[0]
+
+
+def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     writer = csv.writer(fh, lineterminator="\n")
-    writer.writerow(CURVE_COLUMNS)
+    writer.writerow(curve_header(scene))
     columns = (
         outcome.force,
         outcome.f,
@@ -119,7 +145,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     files: dict[str, Path] = {}
 
     files["curve"] = out / "curve.csv"
-    atomic_write(files["curve"], lambda fh: _write_curve(outcome, fh))
+    atomic_write(files["curve"], lambda fh: _write_curve(scene, outcome, fh))
 
     files["preset"] = out / "preset.yaml"
     atomic_write(files["preset"], lambda fh: yaml.safe_dump(scene.resolved(), fh, sort_keys=False))

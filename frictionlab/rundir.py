@@ -1,18 +1,29 @@
-"""The run directory: a lock, the preset the run was started with, and every
-finished chunk of realizations, so that no finished work is lost.
+"""The run directory: a small database of one run, so that no finished work is
+lost, no damaged data is used, and no file frictionlab did not write is touched.
 
 Layout inside the output folder::
 
-    run.lock            held (fcntl.flock) while a run writes here; the kernel
-                        releases it when the process ends, even by kill -9
-    run.json            fingerprint of the resolved preset, status of the run
-    preset.yaml         the resolved preset, written before the first realization
-    chunks/00000012-00000023.npz   one file per finished chunk, written atomically
+    run.lock      held (fcntl.flock) while a run writes here, removed when it
+                  ends; the kernel releases the lock even on kill -9
+    run.json      the manifest: status, the resolved preset and its
+                  fingerprint, every input file with its SHA-256, and every
+                  chunk file with its SHA-256
+    preset.yaml   the resolved preset, written before the first realization
+    chunks/00000012-00000023.npz   one file per finished chunk, written to a
+                  temporary name and renamed; the manifest is updated after
+                  the rename. A completed run's chunks are compacted into one.
 
-A resume reads the chunks, checks the preset is the one the directory was
-started with, and computes only the missing realizations. Since every
-realization has its own seed and the statistics are formed by index, the
-result is bitwise the one of an uninterrupted run.
+A resume trusts nothing it has not verified: every chunk listed in the
+manifest is read and its SHA-256 and arrays checked; a missing or damaged one
+is recomputed (with a warning that says how many), a file in ``chunks/`` the
+manifest does not list is ignored. Realizations are keyed by index, so none is
+counted twice, and since each has its own seed the resumed result is bitwise
+the one of an uninterrupted run. A resume refuses another preset and an input
+file whose content changed.
+
+A fresh run refuses a folder that holds anything but a run of its own preset
+(another preset's finished run, an unfinished run, files of the user's) unless
+``force``; even then it deletes only chunk files its manifest lists.
 """
 
 from __future__ import annotations
@@ -22,6 +33,7 @@ import hashlib
 import io
 import json
 import os
+import re
 import time
 import warnings
 from pathlib import Path
@@ -30,8 +42,9 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, RunError
-from .preset import Scene
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from .inputs import InputFileProblem, read_regular_file, sha256_of
+from .preset import Scene, load_preset_file
 from .realization import RealizationResult
 from .results import atomic_write
 
@@ -39,6 +52,12 @@ CHUNK_DIR = "chunks"
 LOCK_FILE = "run.lock"
 STATE_FILE = "run.json"
 PRESET_FILE = "preset.yaml"
+MANIFEST_FORMAT = 2
+MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
+CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
+OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
+FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
+CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 
 # Lock descriptors of this process: a forked pool worker closes its copies, so
 # the lock goes with the main process (flock is shared by every copy of the fd).
@@ -78,10 +97,36 @@ def preset_differences(old, new, path: str = "") -> list[str]:
     return []
 
 
+class ChunkDamage(ValueError):
+    """A chunk file whose content is not what a chunk of this run can hold."""
+
+
+def _json_copy(data: dict) -> dict:
+    return json.loads(json.dumps(data))
+
+
+def _output_path_problem(path: Path) -> str | None:
+    """Why ``path`` cannot be (or become) a folder: it, or the nearest existing
+    folder above it, is a file."""
+    for candidate in (path, *path.parents):
+        if candidate.exists() or candidate.is_symlink():
+            if candidate.is_dir():
+                return None
+            if candidate == path:
+                return f"{path} is a file, not a folder"
+            return f"{path} cannot be made a folder: {candidate} is a file"
+    return None
+
+
 class RunDirectory:
-    def __init__(self, path: str | Path):
+    """One run's folder. ``force``: a fresh run may write into a folder that is
+    not a run of its preset (deleting only chunk files its manifest lists)."""
+
+    def __init__(self, path: str | Path, *, force: bool = False):
         self.path = Path(path)
+        self.force = force
         self._lock_fd: int | None = None
+        self._manifest: dict | None = None
 
     @property
     def chunks(self) -> Path:
@@ -90,18 +135,30 @@ class RunDirectory:
     # ------------------------------------------------------------ lock
 
     def __enter__(self) -> RunDirectory:
+        problem = _output_path_problem(self.path)
+        if problem:
+            raise OutputRefused(f"{problem}; give --out a folder")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "unknown"
+        while True:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "unknown"
+                os.close(fd)
+                raise RunFolderError(
+                    f"{self.path} is in use by another run ({holder}): wait for it to end, "
+                    "or give another output folder"
+                ) from None
+            # The run that held it may have removed the file between our open and flock:
+            # then we hold a lock on a file nobody else will find; take the new one.
+            try:
+                if os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino:
+                    break
+            except FileNotFoundError:
+                pass
             os.close(fd)
-            raise RunError(
-                f"{self.path} is in use by another run ({holder}): wait for it to end, "
-                "or give another output folder"
-            ) from None
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"pid {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n".encode(), 0)
         self._lock_fd = fd
@@ -111,122 +168,337 @@ class RunDirectory:
     def __exit__(self, *exc) -> bool:
         if self._lock_fd is not None:
             _held_locks.discard(self._lock_fd)
+            try:
+                (self.path / LOCK_FILE).unlink()  # still ours: removed while held
+            except OSError:
+                pass
             os.close(self._lock_fd)  # releases the flock
             self._lock_fd = None
         return False
 
-    # ------------------------------------------------------------ state
+    # ------------------------------------------------------------ manifest
 
     def state(self) -> dict | None:
-        try:
-            return json.loads((self.path / STATE_FILE).read_text(encoding="utf-8"))
-        except FileNotFoundError:
+        """The manifest (run.json), None if there is none; RunFolderError if it is damaged."""
+        path = self.path / STATE_FILE
+        if not os.path.lexists(path):
             return None
-        except (OSError, ValueError) as exc:
-            raise RunError(f"{self.path / STATE_FILE} is unreadable: {exc}") from None
+        try:
+            state = json.loads(read_regular_file(path, limit=MAX_MANIFEST_BYTES, what="manifest"))
+        except InputFileProblem as exc:
+            raise RunFolderError(f"{path}: {exc}") from None
+        except ValueError as exc:  # not JSON, not UTF-8
+            where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
+            raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
+        if not isinstance(state, dict):
+            raise RunFolderError(f"{path} is damaged (not a JSON object)")
+        return state
 
-    def _write_state(self, resolved: dict, status: str) -> None:
-        state = {
-            "fingerprint": fingerprint(resolved),
-            "status": status,
-            "realizations": resolved.get("realizations"),
-            "frictionlab_version": __version__,
-        }
-        atomic_write(self.path / STATE_FILE, lambda fh: json.dump(state, fh, indent=2))
+    def _write_manifest(self) -> None:
+        manifest = self._manifest
+        atomic_write(self.path / STATE_FILE, lambda fh: json.dump(manifest, fh, indent=1))
 
     def stored_preset(self) -> dict:
+        """The preset the run was started with (preset.yaml), read as any preset is."""
+        path = self.path / PRESET_FILE
+        if not os.path.lexists(path):
+            raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:
-            return yaml.safe_load((self.path / PRESET_FILE).read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise FrictionlabError(f"{self.path} holds no run to resume (no {PRESET_FILE})") from None
+            return load_preset_file(path)
+        except PresetError as exc:
+            raise RunFolderError(
+                f"{path} is damaged ({exc.problems[0].removeprefix('(file): ')}): this run cannot be resumed"
+            ) from None
+
+    # ------------------------------------------------------------ start, finish
 
     def start(self, scene: Scene, *, resume: bool) -> list[RealizationResult]:
         """Prepare the directory for ``scene``; return the results already stored
-        (resume) or none (a fresh run). Refuses to resume another preset, and to
-        start afresh over an unfinished run."""
-        resolved = json.loads(json.dumps(scene.resolved()))
-        state = self.state()
-        if state is not None and resume:
-            if state.get("fingerprint") != fingerprint(resolved):
-                differences = preset_differences(self.stored_preset(), resolved)
-                raise FrictionlabError(
-                    f"cannot resume {self.path}: its preset differs from the one given\n  "
-                    + "\n  ".join(differences or ["(the fingerprints differ)"])
-                )
-            self._write_state(resolved, "running")
-            return self.load()
-        if state is not None and state.get("status") != "completed":
-            stored = sum(1 for _ in self.chunks.glob("[0-9]*.npz")) if self.chunks.exists() else 0
-            if stored:
-                raise FrictionlabError(
-                    f"{self.path} holds an unfinished run ({stored} chunk file(s) in {CHUNK_DIR}/, status "
-                    f"{state.get('status')}): continue it with --resume (or `frictionlab resume {self.path}`), "
-                    "or give another output folder"
-                )
-        for old in self.chunks.glob("*"):  # a fresh run: an earlier completed run's chunks go
-            old.unlink()
+        and verified (resume) or none (a fresh run)."""
+        resolved = _json_copy(scene.resolved())
+        inputs = self._input_hashes(scene)
+        if resume:
+            return self._resume(scene, resolved, inputs)
+        try:
+            state = self.state()
+        except RunFolderError:
+            if not self.force:
+                raise
+            state = None  # a damaged manifest lists nothing: nothing is deleted
+        self._refuse_unless_ours(state, resolved)
+        listed = [*self._listed(state), *((state or {}).get("retired") or [])]
+        for name in listed:  # chunks of the run that was here: frictionlab wrote them
+            if isinstance(name, str) and CHUNK_NAME.fullmatch(name):
+                (self.chunks / name).unlink(missing_ok=True)
         self.chunks.mkdir(parents=True, exist_ok=True)
         atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
-        self._write_state(resolved, "running")
+        self._manifest = {
+            "format": MANIFEST_FORMAT,
+            "frictionlab_version": __version__,
+            "status": "running",
+            "fingerprint": fingerprint(resolved),
+            "realizations": resolved.get("realizations"),
+            "preset": resolved,
+            "inputs": inputs,
+            "chunks": {},
+        }
+        self._write_manifest()
         return []
 
     def finish(self, scene: Scene, status: str) -> None:
-        self._write_state(json.loads(json.dumps(scene.resolved())), status)
+        """Record the final status; a completed run's chunks are compacted into one file."""
+        if self._manifest is None:
+            return
+        self._manifest["status"] = status
+        self._manifest["frictionlab_version"] = __version__
+        self._write_manifest()
+        if status == "completed":
+            self._compact(scene)
+
+    @staticmethod
+    def _listed(state: dict | None) -> list[str]:
+        chunks = (state or {}).get("chunks")
+        return list(chunks) if isinstance(chunks, dict) else []
+
+    def _refuse_unless_ours(self, state: dict | None, resolved: dict) -> None:
+        """OutputRefused when a fresh run here would replace what is not a
+        finished run of the same preset (unless ``force``)."""
+        if self.force:
+            return
+        hint = "give another --out folder, or --force to write into it anyway"
+        if state is None:
+            others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
+            if others:
+                shown = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
+                raise OutputRefused(
+                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {shown}): "
+                    f"{hint} (frictionlab then replaces only the files it writes and deletes none)"
+                )
+            return
+        status = state.get("status")
+        if status == "completed" and state.get("fingerprint") != fingerprint(resolved):
+            old = state.get("preset")
+            differences = preset_differences(old, resolved) if isinstance(old, dict) else []
+            fields = ", ".join(d.split(":", 1)[0] for d in differences[:5]) or "its fingerprint"
+            raise OutputRefused(
+                f"{self.path} holds a finished run of another preset (it differs in {fields}): "
+                f"{hint} (its results are then replaced)"
+            )
+        if status != "completed" and self._listed(state):
+            raise OutputRefused(
+                f"{self.path} holds an unfinished run ({len(self._listed(state))} chunk file(s) in {CHUNK_DIR}/, "
+                f"status {status}): continue it with --resume (or `frictionlab resume {self.path}`), "
+                "or give another output folder, or --force to start it again"
+            )
+
+    def _input_hashes(self, scene: Scene) -> dict:
+        hashes = {}
+        for field, path in scene.input_files().items():
+            try:
+                hashes[field] = {"path": path, "sha256": sha256_of(path)}
+            except (InputFileProblem, OSError) as exc:
+                reason = exc if isinstance(exc, InputFileProblem) else exc.strerror
+                raise FrictionlabError(f"{field}: cannot read {path}: {reason}") from None
+        return hashes
+
+    def _resume(self, scene: Scene, resolved: dict, inputs: dict) -> list[RealizationResult]:
+        state = self.state()
+        if state is None:
+            raise RunFolderError(f"{self.path} holds no run to resume (no {STATE_FILE})")
+        if state.get("fingerprint") != fingerprint(resolved):
+            stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
+            differences = preset_differences(stored, resolved)
+            raise RunFolderError(
+                f"cannot resume {self.path}: its preset differs from the one given\n  "
+                + "\n  ".join(differences or ["(the fingerprints differ)"])
+            )
+        recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
+        for field, now in inputs.items():
+            then = recorded.get(field)
+            if isinstance(then, dict) and then.get("sha256") != now["sha256"]:
+                raise RunFolderError(
+                    f"cannot resume {self.path}: the input file {field} ({now['path']}) changed since the run "
+                    f"started (SHA-256 {str(then.get('sha256'))[:12]}... then, {now['sha256'][:12]}... now); "
+                    "restore it, or start a new run in another folder"
+                )
+        self._manifest = {**state, "format": MANIFEST_FORMAT, "status": "running", "preset": resolved,
+                          "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}}}  # fmt: skip
+        self._manifest["chunks"] = dict(state.get("chunks") or {}) if state.get("format") == MANIFEST_FORMAT else {}
+        for name in self._manifest.pop("retired", None) or []:  # a compaction that did not finish
+            if isinstance(name, str) and CHUNK_NAME.fullmatch(name) and name not in self._manifest["chunks"]:
+                (self.chunks / name).unlink(missing_ok=True)
+        results = self._verified(scene, warn=True)
+        self._write_manifest()
+        return results
 
     # ------------------------------------------------------------ chunks
 
-    def save_chunk(self, results: list[RealizationResult]) -> Path:
-        """Write one finished chunk atomically; its name is its index range."""
+    def _free_name(self, first: int, last: int) -> str:
+        """The chunk's file name, or a variant of it when a file the manifest does
+        not list already has it (never overwritten)."""
+        listed = self._manifest["chunks"]
+        name, copy = f"{first:08d}-{last:08d}.npz", 0
+        while os.path.lexists(self.chunks / name) and name not in listed:
+            copy += 1
+            name = f"{first:08d}-{last:08d}.{copy}.npz"
+        return name
+
+    def save_chunk(self, results: list[RealizationResult], compressed: bool = False) -> Path:
+        """Write one finished chunk atomically, then list it with its SHA-256 in
+        the manifest; its name is its index range."""
         ok = [r for r in results if r.ok]
         failed = [r for r in results if not r.ok]
         indices = sorted(r.index for r in results)
         arrays: dict[str, np.ndarray] = {
             "index": np.array([r.index for r in ok], dtype=np.int64),
-            "seconds": np.array([r.seconds for r in ok]),
-            "slope_rms_line": np.array([r.slope_rms_line for r in ok]),
+            "seconds": np.array([r.seconds for r in ok], dtype=np.float64),
+            "slope_rms_line": np.array([r.slope_rms_line for r in ok], dtype=np.float64),
             "points": np.array([r.points for r in ok], dtype=np.int64),
-            "length": np.array([r.length for r in ok]),
+            "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
-            "failed_seconds": np.array([r.seconds for r in failed]),
+            "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
         }
-        for name in ("xi", "contact_count", "indentation", "force"):
+        for name in (*CURVE_ARRAYS, "force"):
             rows = [getattr(r, name) for r in ok]
             if ok and rows[0] is not None:
                 arrays[name] = np.vstack(rows)
-        path = self.chunks / f"{indices[0]:08d}-{indices[-1]:08d}.npz"
         buffer = io.BytesIO()
-        np.savez(buffer, **arrays)
-        atomic_write(path, lambda fh: fh.write(buffer.getbuffer()), binary=True)
+        (np.savez_compressed if compressed else np.savez)(buffer, **arrays)
+        data = buffer.getvalue()
+        name = self._free_name(indices[0], indices[-1])
+        path = self.chunks / name
+        atomic_write(path, lambda fh: fh.write(data), binary=True)
+        chunks = self._manifest["chunks"]
+        chunks.pop(name, None)  # listed again last: later chunks win where they overlap (a retried failure)
+        chunks[name] = hashlib.sha256(data).hexdigest()
+        self._write_manifest()
         return path
 
-    def load(self) -> list[RealizationResult]:
-        """Every result stored in ``chunks/``; an unreadable file is skipped (its
-        realizations are recomputed) with a warning."""
+    def _verified(self, scene: Scene, *, warn: bool) -> list[RealizationResult]:
+        """The results of every listed chunk whose SHA-256 and arrays check out, a
+        later chunk winning where two hold the same index; the others are
+        dropped from the manifest (and, with ``warn``, counted in a warning)."""
+        chunks = self._manifest["chunks"]
         results: dict[int, RealizationResult] = {}
-        if not self.chunks.exists():
-            return []
-        for path in sorted(self.chunks.glob("[0-9]*.npz")):
+        damaged: dict[str, str] = {}
+        for name, digest in list(chunks.items()):
             try:
-                with np.load(path, allow_pickle=False) as data:
-                    arrays = {name: data[name] for name in data.files}
-            except (OSError, ValueError, KeyError) as exc:
-                warnings.warn(f"skipping unreadable chunk {path.name} ({exc}); its realizations are recomputed")
+                rows = self._read_chunk(name, digest, scene)
+            except ChunkDamage as exc:
+                damaged[name] = str(exc)
+                del chunks[name]
                 continue
-            for row, index in enumerate(arrays["index"].tolist()):
-                results[index] = RealizationResult(
-                    index=index,
-                    seconds=float(arrays["seconds"][row]),
-                    xi=arrays["xi"][row],
-                    contact_count=arrays["contact_count"][row],
-                    indentation=arrays["indentation"][row],
-                    force=arrays["force"][row] if "force" in arrays else None,
-                    slope_rms_line=float(arrays["slope_rms_line"][row]),
-                    points=int(arrays["points"][row]),
-                    length=float(arrays["length"][row]),
-                )
-            for row, index in enumerate(arrays["failed_index"].tolist()):
-                results[index] = RealizationResult(
-                    index=index, seconds=float(arrays["failed_seconds"][row]), error=str(arrays["failed_error"][row])
-                )
+            results.update((r.index, r) for r in rows)
+        if warn:
+            self._warn_damage(damaged, results, scene.preset.realizations)
         return [results[i] for i in sorted(results)]
+
+    def _read_chunk(self, name: str, digest, scene: Scene) -> list[RealizationResult]:
+        match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
+        if match is None or not isinstance(digest, str):
+            raise ChunkDamage("not a chunk name")
+        try:
+            raw = read_regular_file(self.chunks / name, what="file")
+        except InputFileProblem as exc:
+            raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
+        if hashlib.sha256(raw).hexdigest() != digest:
+            raise ChunkDamage("checksum mismatch")
+        try:
+            with np.load(io.BytesIO(raw), allow_pickle=False) as data:
+                arrays = {key: data[key] for key in data.files}
+        except Exception as exc:  # a damaged zip or array header
+            raise ChunkDamage(f"unreadable ({type(exc).__name__})") from None
+        first, last = int(match[1]), int(match[2])
+        return _chunk_results(arrays, first, last, scene)
+
+    def _warn_damage(self, damaged: dict[str, str], results: dict, total: int) -> None:
+        listed = set(self._manifest["chunks"])
+        unlisted = sorted(
+            p.name for p in self.chunks.glob("*.npz") if p.name not in listed and p.name not in damaged
+        ) if self.chunks.is_dir() else []  # fmt: skip
+        if not damaged and not unlisted:
+            return
+        lost = set()
+        for name in [*damaged, *unlisted]:
+            match = CHUNK_NAME.fullmatch(name)
+            if match:
+                lost.update(range(int(match[1]), min(int(match[2]), total - 1) + 1))
+        lost -= set(results)
+        reasons: dict[str, int] = {}
+        for why in damaged.values():
+            reasons[why] = reasons.get(why, 0) + 1
+        parts = []
+        if damaged:
+            detail = ", ".join(f"{n} {why}" for why, n in reasons.items())
+            parts.append(f"{len(damaged)} chunk file(s) failed verification ({detail})")
+        if unlisted:
+            parts.append(f"{len(unlisted)} file(s) in {CHUNK_DIR}/ are not in the manifest and are ignored")
+        warnings.warn(
+            f"resume of {self.path}: " + "; ".join(parts) + f"; {len(lost)} realization(s) they held are recomputed",
+            stacklevel=3,
+        )
+
+    def _compact(self, scene: Scene) -> None:
+        """Merge the chunks of a completed run into one compressed file: written
+        and listed first, the old ones deleted after (a crash in between leaves
+        them listed as retired, deleted by the next start)."""
+        old = list(self._manifest["chunks"])
+        if len(old) <= 1:
+            return
+        results = self._verified(scene, warn=False)
+        if len(self._manifest["chunks"]) != len(old) or not results:
+            return  # something changed under us: leave the chunks as they are
+        self._manifest["chunks"] = {}
+        self._manifest["retired"] = old
+        self.save_chunk(results, compressed=True)
+        kept = set(self._manifest["chunks"])
+        for name in old:
+            if name not in kept:
+                (self.chunks / name).unlink(missing_ok=True)
+        self._manifest.pop("retired")
+        self._write_manifest()
+
+
+def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
+    """The RealizationResults of one chunk's arrays; ChunkDamage if anything is
+    missing, misshapen, or indexes a realization the chunk cannot hold."""
+    needed = (*OK_ARRAYS, *FAILED_ARRAYS)
+    missing = [name for name in needed if name not in arrays]
+    if missing:
+        raise ChunkDamage(f"no array {missing[0]}")
+    n, k, steps = arrays["index"].shape[0], arrays["failed_index"].shape[0], scene.loads.size
+    curves = (*CURVE_ARRAYS, "force") if scene.control == "indentation" else CURVE_ARRAYS
+    for name in OK_ARRAYS + (curves if n else ()):
+        if name not in arrays:
+            raise ChunkDamage(f"no array {name}")
+        shape = (n, steps) if name in curves else (n,)
+        if arrays[name].shape != shape:
+            raise ChunkDamage(f"array {name} of shape {arrays[name].shape}, expected {shape}")
+    for name in FAILED_ARRAYS:
+        if arrays[name].shape != (k,):
+            raise ChunkDamage(f"array {name} of shape {arrays[name].shape}, expected {(k,)}")
+    indices = np.concatenate([arrays["index"], arrays["failed_index"]])
+    if indices.dtype.kind not in "iu":
+        raise ChunkDamage("indices are not integers")
+    low, high = max(first, 0), min(last, scene.preset.realizations - 1)
+    if indices.size == 0 or indices.min() < low or indices.max() > high or np.unique(indices).size != indices.size:
+        raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
+    out = []
+    for row, index in enumerate(arrays["index"].tolist()):
+        out.append(RealizationResult(
+            index=index,
+            seconds=float(arrays["seconds"][row]),
+            xi=arrays["xi"][row],
+            contact_count=arrays["contact_count"][row],
+            indentation=arrays["indentation"][row],
+            force=arrays["force"][row] if "force" in curves else None,
+            slope_rms_line=float(arrays["slope_rms_line"][row]),
+            points=int(arrays["points"][row]),
+            force_unit=float(arrays["force_unit"][row]),
+        ))  # fmt: skip
+    for row, index in enumerate(arrays["failed_index"].tolist()):
+        out.append(RealizationResult(
+            index=index, seconds=float(arrays["failed_seconds"][row]), error=str(arrays["failed_error"][row])
+        ))  # fmt: skip
+    return out

@@ -28,6 +28,8 @@ def run_to_folder(
     resume: bool = False,
     memory_check: bool = True,
     retries: int = 2,
+    force: bool = False,
+    dashboard: bool = False,
 ) -> tuple[RunOutcome, dict[str, Path]]:
     """Run ``scene`` and write its result files into ``out_dir``.
 
@@ -35,9 +37,12 @@ def run_to_folder(
     (a second run into it is refused), holds the resolved preset from the start
     and every chunk of realizations as it finishes. ``resume=True`` continues a
     run left there (interrupted, killed, crashed) with the same preset,
-    computing only what is missing. ``memory_check`` refuses, before anything
-    starts, a run whose estimated peak memory exceeds what is available (and
-    on Dask, one whose realization exceeds a worker's memory limit).
+    computing only what is missing (after verifying every stored chunk).
+    ``out_dir`` must be new, empty, or a run of this preset: anything else is
+    refused unless ``force`` (see ``rundir``). ``memory_check`` refuses, before
+    anything starts, a run whose estimated peak memory exceeds what is
+    available (and on Dask, one whose realization exceeds a worker's memory
+    limit). ``dashboard``: serve the Dask dashboard of the local cluster.
 
     What finished is written even when the run was cancelled or interrupted.
     Returns the outcome and the paths of the files written.
@@ -50,7 +55,7 @@ def run_to_folder(
         if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
             limits, usable = dask_memory_limits(scheduler, count)
             check_worker_limits(scene, limits, usable=usable)
-    with RunDirectory(out_dir) as run_dir:
+    with RunDirectory(out_dir, force=force) as run_dir:
         restored = run_dir.start(scene, resume=resume)
         outcome = engine.run(
             scene,
@@ -60,6 +65,7 @@ def run_to_folder(
             executor=executor,
             scheduler=scheduler,
             retries=retries,
+            dashboard=dashboard,
             store=run_dir,
             restored=restored,
         )

@@ -37,7 +37,7 @@ from pydantic import BaseModel
 from . import __version__
 from .errors import PresetError
 from .fit import json_safe
-from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, load_preset_file
+from .preset import PLUGIN_SLOTS, Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset
 from .registry import Registry, default_registry
 from .results import atomic_write
 
@@ -201,8 +201,7 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
     """File -> overrides -> planned Sweep (the preset must have a sweep section)."""
-    data = apply_overrides(load_preset_file(path), list(overrides))
-    return plan_sweep(data, registry=registry, source=str(path))
+    return plan_sweep(read_preset(path, list(overrides), registry), registry=registry, source=str(path))
 
 
 # ------------------------------------------------------------------ running
@@ -307,10 +306,14 @@ def run_sweep(
     point_listeners: Callable[[SweepPoint], list] = lambda point: [],
     cancel=None,
     plot: bool = True,
+    force: bool = False,
     **run_options,
 ) -> SweepOutcome:
-    """Run every point and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end."""
+    """Run every point and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end.
+    ``out_dir`` must be new, empty or a folder of this same sweep unless ``force``."""
     out_dir = Path(out_dir)
+    check_sweep_folder(sweep, out_dir, force)
+    run_options["force"] = force
     listeners = list(listeners)
     started = time.perf_counter()
     results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
@@ -344,6 +347,30 @@ def run_sweep(
         write_tables(sweep, outcome, out_dir)
     _notify(listeners, "sweep_finished", sweep=sweep, outcome=outcome)
     return outcome
+
+
+def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
+    """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
+    (its sweep.json names the same sweep and base preset), or ``force``."""
+    from .errors import OutputRefused
+    from .rundir import _output_path_problem
+
+    problem = _output_path_problem(out_dir)
+    if problem:
+        raise OutputRefused(f"{problem}; give --out a folder")
+    if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
+        return
+    hint = "give another --out folder, or --force to write into it anyway"
+    try:
+        old = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        raise OutputRefused(
+            f"{out_dir} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
+        ) from None
+    mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
+    mine = json.loads(json.dumps(mine, default=str))
+    if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
+        raise OutputRefused(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
 
 
 def _announcing(sweep, listeners, point_listeners):
@@ -503,12 +530,14 @@ def run_sweep_command(args, overrides: list[str], out_dir: Path, run_options: di
             sweep, out_dir, workers=args.workers, listeners=listeners, point_listeners=point_listeners, **run_options
         )
     except OSError as exc:
-        print(f"error: cannot write results to {out_dir}: {exc}", file=sys.stderr)
+        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         print((out_dir / "sweep.json").read_text(encoding="utf-8"))
     else:
         print(sweep_table(sweep, outcome, out_dir))
     if outcome.status == "interrupted":
-        return ExitCode.INTERRUPTED
+        from .signals import interrupted_exit_code
+
+        return interrupted_exit_code()
     return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK

@@ -75,7 +75,13 @@ classes::
     > 0 and agrees within a factor of 3 with the rms (about the mean) of the
     generated lines, pooled over 8 seeds. If ``psd`` is implemented it is
     vectorised (array in, array of the same shape out), finite and >= 0; if
-    ``rms_slope`` is implemented it is finite and > 0.
+    ``rms_slope`` is implemented it is finite and > 0. The declarations:
+    ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes;
+    ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
+    None, gives 2 N points (per side) over the same length; ``equivalent_line()``
+    is None or, for a surface, a spectrum of lines 2 sqrt(A / pi) long with the
+    surface's rms height, itself checked; ``c0()`` is NotImplementedError or
+    finite > 0; ``hurst_exponent()`` is None or finite >= 0.
 
 ``check_solver(cls, **params)``
     ``cls(**params).solve(profile, loads, control, slopes)`` on a small smooth
@@ -92,10 +98,19 @@ classes::
     ``contact_fraction == contact_count / N``; ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
-    ``stiffness()`` is finite and > 0.
+    ``stiffness()`` is finite and > 0. The declarations: the forces come from
+    ``frictionlab.force_unit``, so ``normalisations`` must cover the profile;
+    f is dimensionless as declared: every length x 1000 with each load scaled by
+    its unit (a force x 1000^2, a force per unit depth x 1000, an indentation x
+    1000), and the spacing alone x 10 at equal f, leave the contact counts and
+    the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
+    of f; ``tolerance()`` is None exactly when ``tolerance_param`` is; a
+    ``periodic_only`` solver raises ValueError on a non-periodic profile, any
+    other solves it. (Registration itself checks that every declaration is
+    well formed: ``registry.declaration_problems``.)
 
 ``check_slope_estimator(cls, **params)``
-    ``cls(**params).slopes(heights, spacing)`` on a random periodic line returns
+    ``cls(**params).slopes(heights, spacing, periodic)`` on a random periodic line returns
     a finite floating-point array of the same shape, does not modify its input
     and is repeatable; a constant line gives zero slopes; on a periodic sine
     (3 periods over 128 points, spacing 0.1) the slopes match the exact
@@ -103,7 +118,9 @@ classes::
     relative rms error below 0.5). An estimator whose ``dimensions`` include 2
     gets the same checks on a 24 x 40 surface, with a plane wave across both
     axes whose exact slope is |grad z| (so its slopes must be >= 0); lines are
-    checked only if ``dimensions`` include 1.
+    checked only if ``dimensions`` include 1. ``slopes(..., periodic=False)``
+    on a tilted plane gives the tilt at every point (no difference across the
+    ends), or, for a ``periodic_only`` estimator, raises ValueError.
 
 ``check_plugin(kind, cls, *, deterministic=False, **params)``
     ``check_plugin_class`` followed by the check of ``kind``
@@ -183,10 +200,12 @@ def _as_hook_plugin(obj):
 
 
 def _label(cls) -> str:
-    module = getattr(cls, "__module__", "?")
-    qualname = getattr(cls, "__qualname__", repr(cls))
-    name = getattr(cls, "name", None)
-    return f"{module}.{qualname}" + (f" ({name!r})" if name else "")
+    from frictionlab.plugin import Plugin
+
+    if not isinstance(cls, type):
+        return repr(cls)
+    name = cls.name if issubclass(cls, Plugin) else None
+    return f"{cls.__module__}.{cls.__qualname__}" + (f" ({name!r})" if name else "")
 
 
 def _fail(cls, message: str, cause: BaseException | None = None):
@@ -355,7 +374,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
         hint = "" if params else " (pass the required values: check_plugin_class(kind, cls, params={...}))"
         _fail(cls, f"Params(**{params!r}) is invalid{hint}: {exc}", exc)
     instance = _instantiate(cls, params)
-    if getattr(instance, "params", None) != model:
+    if instance.__dict__.get("params") != model:
         _fail(cls, "the constructor must store its validated Params as self.params")
 
     # unknown keys are rejected
@@ -418,7 +437,7 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
         if not isinstance(profile, Profile):
             _fail(cls, f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead.")
         heights = _check_array(cls, "Profile.heights", profile.heights)
-        dimension = getattr(cls, "dimension", 1)
+        dimension = cls.dimension
         if heights.ndim != dimension:
             _fail(cls, f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {heights.shape} instead.")
         if heights.size < 2:
@@ -462,6 +481,55 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     missing, slope = _is_not_implemented(cls, "rms_slope()", gen.rms_slope)
     if not missing:
         _check_positive_number(cls, "rms_slope()", slope)
+    _check_spectrum_declarations(cls, gen, first, params, deterministic)
+
+
+def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
+    """periodic(), grid_shape(), refined(), equivalent_line(), c0(), hurst_exponent()."""
+    import numpy as np
+
+    from frictionlab.plugin import SpectrumGenerator, mdr_length
+
+    periodic = _call(cls, "periodic()", gen.periodic)
+    if not isinstance(periodic, bool) or profile.periodic is not periodic:
+        _fail(cls, f"periodic() must be True or False and equal Profile.periodic of what generate() makes "
+                   f"({profile.periodic!r}). Got {periodic!r} instead.")  # fmt: skip
+    shape = _call(cls, "grid_shape()", gen.grid_shape)
+    if shape is not None and tuple(shape) != profile.heights.shape:
+        _fail(cls, f"grid_shape() must be None or the shape generate() makes, {profile.heights.shape}. Got {shape!r}.")
+
+    finer_points = 2 * profile.heights.shape[-1]
+    changes = _call(cls, f"refined({finer_points})", gen.refined, finer_points)
+    if changes is not None:
+        finer = _instantiate(cls, {**params, **changes})
+        made = _call(cls, f"generate() with refined({finer_points})", finer.generate, np.random.default_rng(1))
+        extent = profile.heights.shape[-1] * profile.spacing
+        if made.heights.shape[-1] != finer_points or not math.isclose(
+            made.heights.shape[-1] * made.spacing, extent, rel_tol=1e-9
+        ):
+            _fail(cls, f"refined({finer_points}) must give {finer_points} points (per side) over the same length "
+                       f"{extent:g}. Got shape {made.heights.shape}, spacing {made.spacing!r}.")  # fmt: skip
+
+    line = _call(cls, "equivalent_line()", gen.equivalent_line)
+    if line is not None:
+        if cls.dimension != 2 or not isinstance(line, SpectrumGenerator) or line.dimension != 1:
+            _fail(cls, "equivalent_line() must be None, or (for a surface) a SpectrumGenerator of lines. "
+                       f"Got {line!r} instead.")  # fmt: skip
+        made = _call(cls, "equivalent_line().generate()", line.generate, np.random.default_rng(3))
+        length, wanted = made.heights.size * made.spacing, mdr_length(profile.area)
+        if not math.isclose(length, wanted, rel_tol=1e-9):
+            _fail(cls, f"the MDR-equivalent line must be 2 sqrt(A / pi) = {wanted:.9g} long. Got {length:.9g}.")
+        line_h, h = _call(cls, "equivalent_line().rms_height()", line.rms_height), gen.rms_height()
+        if not math.isclose(line_h, h, rel_tol=1e-9):
+            _fail(cls, f"the MDR-equivalent line must have the surface's rms height {h:.9g}. Got {line_h:.9g}.")
+        check_spectrum(type(line), **line.params.model_dump())
+
+    missing, c0 = _is_not_implemented(cls, "c0()", gen.c0)
+    if not missing:
+        _check_positive_number(cls, "c0()", c0)
+    hurst = _call(cls, "hurst_exponent()", gen.hurst_exponent)
+    if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
+        _fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")
 
 
 def _test_line(points: int = 64, seed: int = 20240613):
@@ -498,19 +566,19 @@ def check_solver(cls, **params) -> None:
     """Check a contact solver class (see the module docstring)."""
     import numpy as np
 
-    from frictionlab.plugin import ContactCurve, Profile
+    from frictionlab.plugin import ContactCurve, Profile, force_unit
 
     solver = _instantiate(cls, params)
-    k = _check_positive_number(cls, "stiffness()", _call(cls, "stiffness()", solver.stiffness))
-    if 1 in getattr(cls, "dimensions", (1,)):
+    _check_positive_number(cls, "stiffness()", _call(cls, "stiffness()", solver.stiffness))
+    if 1 in cls.dimensions:
         heights, spacing, slopes = _test_line()
     else:  # a solver of surfaces only
         heights, spacing, slopes = _test_surface()
     n = heights.size
     h = float(heights.std())
-    length = Profile(heights, spacing).length
+    unit = _call(cls, "force_unit() (from normalisations)", force_unit, solver, h, Profile(heights, spacing))
     cases = {
-        "force": np.array([0.005, 0.02, 0.1, 0.4, 1.0]) * k * h * length,
+        "force": np.array([0.005, 0.02, 0.1, 0.4, 1.0]) * unit,
         # below max z - mean z: past it an elastic half-space would need an infinite force
         "indentation": np.array([0.025, 0.1, 0.25, 0.5, 0.95]) * float(heights.max() - heights.mean()),
     }
@@ -572,6 +640,84 @@ def check_solver(cls, **params) -> None:
         for name in names:
             if not np.array_equal(np.asarray(getattr(again, name)), arrays[name]):
                 _fail(cls, f"{where} is not repeatable: {name} differs between two identical calls")
+    _check_solver_declarations(cls, solver, heights, spacing, slopes, cases["force"])
+    _check_solver_units(cls, solver, heights, spacing, slopes)
+
+
+def _must_refuse(cls, what: str, call: Callable[[], Any]) -> None:
+    """A ``periodic_only`` plugin must refuse ``what`` with a ValueError."""
+    try:
+        call()
+    except ValueError:
+        return
+    except Exception as exc:
+        _fail(cls, f"periodic_only: {what} must raise ValueError. Got {type(exc).__name__}: {exc}", exc)
+    _fail(cls, f"periodic_only is True, but {what} was accepted; it must raise ValueError")
+
+
+def _solve(cls, solver, heights, spacing, slopes, loads, control="force", periodic=True):
+    from frictionlab.plugin import Profile
+
+    where = f"solve(..., control={control!r}) on a profile of spacing {spacing:g}" + ("" if periodic else ", not periodic")
+    return _call(cls, where, solver.solve, Profile(heights.copy(), spacing, periodic), loads.copy(), control, slopes.copy())
+
+
+def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) -> None:
+    """mean_displacement(), tolerance(), and periodic_only against a non-periodic profile."""
+    import numpy as np
+
+    f = np.array([0.01, 0.1])
+    shift = np.asarray(_call(cls, "mean_displacement(f, h)", solver.mean_displacement, f, 1.0))
+    if shift.shape != f.shape or not np.all(np.isfinite(shift)):
+        _fail(cls, f"mean_displacement(f, h) must return a finite array of the shape of f. Got {shift!r}.")
+    tolerance = _call(cls, "tolerance()", solver.tolerance)
+    if (tolerance is None) != (cls.tolerance_param is None):
+        _fail(cls, f"tolerance() must be None exactly when tolerance_param is None. Got {tolerance!r}.")
+    if tolerance is not None:
+        _check_positive_number(cls, "tolerance()", tolerance)
+    if cls.periodic_only:
+        from frictionlab.plugin import Profile
+
+        profile = Profile(heights.copy(), spacing, periodic=False)
+        _must_refuse(cls, "a non-periodic profile", lambda: solver.solve(profile, forces.copy(), "force", slopes.copy()))
+    else:
+        _solve(cls, solver, heights, spacing, slopes, forces, periodic=False)
+
+
+def _check_solver_units(cls, solver, heights, spacing, slopes) -> None:
+    """f is dimensionless as declared: every length x 1000 with each load scaled by its unit
+    (a force by 1000^2, a force per unit depth by 1000, an indentation by 1000), and the
+    spacing alone x 10 at equal f, leave the contact counts and the rms slope in contact as
+    they were (the moduli are the solver's own; only lengths change)."""
+    import numpy as np
+
+    from frictionlab.plugin import Profile, force_unit
+
+    h = float(heights.std())
+    f = np.array([0.01, 0.05, 0.2])
+    base = _solve(cls, solver, heights, spacing, slopes, f * force_unit(solver, h, Profile(heights, spacing)))
+    s = 1000.0
+    normalisation = solver.normalisation(heights.ndim)
+    load_scale = s * s if normalisation.load == "force" else s
+    scaled = _solve(cls, solver, heights * s, spacing * s, slopes, f * force_unit(solver, h, Profile(heights, spacing)) * load_scale)
+    refined = _solve(cls, solver, heights, spacing * 10, slopes / 10,
+                     f * force_unit(solver, h, Profile(heights, spacing * 10)))  # fmt: skip
+
+    def compare(what, other, slope_factor=1.0):
+        counts, expected = np.asarray(other.contact_count), np.asarray(base.contact_count)
+        slope = np.asarray(other.slope_rms_contact) * slope_factor
+        if not np.array_equal(counts, expected) or not np.allclose(slope, base.slope_rms_contact, rtol=1e-6, atol=0):
+            _fail(
+                cls,
+                f"f = {normalisation.formula} is not dimensionless as declared ({normalisation.definition}): with "
+                f"{what} the contact counts went from {expected.tolist()} to {counts.tolist()}, the rms slope in "
+                f"contact from {np.asarray(base.slope_rms_contact).tolist()} to {slope.tolist()}",
+            )
+
+    compare(f"every length x {s:g}, each load by its unit ({normalisation.load})", scaled)
+    compare("only the spacing x 10 at equal f", refined, 10.0)
+    depth = _solve(cls, solver, heights * s, spacing * s, slopes, np.asarray(base.indentation) * s, "indentation")
+    compare(f"every length x {s:g} under indentation control", depth)
 
 
 def check_slope_estimator(cls, **params) -> None:
@@ -580,11 +726,12 @@ def check_slope_estimator(cls, **params) -> None:
 
     estimator = _instantiate(cls, params)
     spacing = 0.1
-    dimensions = getattr(cls, "dimensions", (1,))
+    dimensions = cls.dimensions
 
-    def run(what, heights):
+    def run(what, heights, periodic=True):
         original = heights.copy()
-        slopes = _call(cls, f"slopes({what}, spacing={spacing})", estimator.slopes, heights, spacing)
+        call = f"slopes({what}, spacing={spacing}, periodic={periodic})"
+        slopes = _call(cls, call, estimator.slopes, heights, spacing, periodic)
         if not np.array_equal(heights, original):
             _fail(cls, f"slopes({what}) modified its input")
         _check_array(cls, f"slopes({what})", slopes, heights.shape)
@@ -623,6 +770,22 @@ def check_slope_estimator(cls, **params) -> None:
                 f"on A sin(q . x) (A = {amplitude}, q = {np.round(q, 4).tolist()}, spacing = {spacing}, shape {shape}) "
                 f"the slopes have rms {rms_estimate:.4g} and relative rms error {error:.3g} against the exact "
                 f"derivative (rms {rms_exact:.4g}); expected the same order of magnitude and sign (divide by spacing?)",
+            )
+
+        # a scan whose ends do not meet: a plane, tilted along every axis; no slope may cross the ends
+        grade = np.array([0.3, -0.2])[: len(shape)]
+        ramp = sum(g * x for g, x in zip(grade, grids))
+        if cls.periodic_only:
+            _must_refuse(cls, "a non-periodic profile", lambda ramp=ramp: estimator.slopes(ramp, spacing, False))
+            continue
+        tilted = run(f"non-periodic tilted {kind}", ramp, periodic=False)
+        exact = grade[0] if kind == "line" else float(np.hypot(*grade))
+        if not np.allclose(tilted, exact, rtol=1e-9, atol=1e-12):
+            worst = np.unravel_index(int(np.argmax(np.abs(tilted - exact))), shape)
+            _fail(
+                cls,
+                f"on a non-periodic {kind} tilted by {grade.tolist()} every slope must be {exact:.6g}; "
+                f"point {tuple(int(i) for i in worst)} has {tilted[worst]:.6g} (a difference across the ends?)",
             )
 
 

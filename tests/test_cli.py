@@ -14,7 +14,7 @@ import yaml
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.results import atomic_write
+from frictionlab.results import atomic_write, column_name
 
 from .conftest import PRESETS, SMALL_PRESET, merge
 
@@ -35,7 +35,7 @@ def run_cli(*args, env=None, **kwargs):
     )
 
 
-RUN_DIRECTORY = {"run.lock", "run.json", "chunks"}  # the run directory's own files (frictionlab.rundir)
+RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.rundir; run.lock is gone once it ends)
 
 
 def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
@@ -63,9 +63,21 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
     assert fit["b_ci"][0] < fit["b"] < fit["b_ci"][1]
     assert 0 < fit["r2"] <= 1
     with open(out / "curve.csv") as fh:
-        rows = list(csv.DictReader(fh))
+        rows = [{column_name(k): v for k, v in row.items()} for row in csv.DictReader(fh)]
     assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"]
     assert len(rows) == 16
+    # the load and f say what they are: MDR's load is a force, f = F / (E* h L)
+    header = (out / "curve.csv").read_text().splitlines()[0]
+    assert header.startswith("F [force: modulus x length^2],f [F / (E* h L); F the force; h the rms height; L the line's length]")
+    assert "contact_fraction [fraction of MDR springs in contact; not the real area]" in header
+    normalisation = summary["normalisation"]
+    assert normalisation["f"] == "f = F / (E* h L), F the force, h the rms height, L the line's length"
+    assert normalisation["load"] == "force" and normalisation["extent"] == "length"
+    assert normalisation["extent_value"] == 1024.0 and normalisation["rms_height"] == 1.0
+    np.testing.assert_allclose(
+        [float(r["f"]) for r in rows], [float(r["F"]) / normalisation["force_unit"] for r in rows], rtol=1e-15
+    )
+    assert "f = F / (E* h L)" in captured.out
     arrays = np.load(out / "realizations.npz")
     assert arrays["xi"].shape == (8, 16)
     # the curve is the mean of the per-realization rows
@@ -143,7 +155,7 @@ def test_missing_required_and_file_errors(tmp_path, capsys):
     del data["loading"]
     assert main(["validate", str(write_preset(tmp_path, data))]) == ExitCode.USAGE
     assert "loading: is required" in capsys.readouterr().err
-    assert main(["validate", str(tmp_path / "nope.yaml")]) == ExitCode.USAGE
+    assert main(["validate", str(tmp_path / "nope.yaml")]) == ExitCode.INPUT_FILE
     assert "no such preset file" in capsys.readouterr().err
     broken = tmp_path / "broken.yaml"
     broken.write_text("name: x\nspectrum: [unclosed\n")
@@ -280,7 +292,7 @@ def test_a_measured_profile_runs_end_to_end_with_its_own_rms_height(tmp_path, ca
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["workers"] == 1  # one realization runs in-process, and says so
     assert summary["normalisation"]["rms_height"] == pytest.approx(np.std(heights), rel=1e-12)
-    assert summary["normalisation"]["length"] == 1024.0
+    assert summary["normalisation"]["extent_value"] == 1024.0
 
 
 def test_a_run_whose_every_realization_fails_still_writes_and_exits_1(tmp_path, capsys):

@@ -189,3 +189,123 @@ def test_dask_memory_limits_foresee_those_of_the_local_cluster(dask_scheduler):
     assert sorted(foreseen.values()) == sorted(reported.values())
     assert all(limit > 0 for limit in reported.values())
     assert 0 < usable <= 1
+
+
+# ------------------------------------------------------------------ dask security (last: they start clusters)
+
+
+def _http_status(address: str, path: str) -> int:
+    import urllib.error
+    import urllib.request
+
+    try:
+        return urllib.request.urlopen(f"{address}{path}", timeout=5).status
+    except urllib.error.HTTPError as exc:
+        return exc.code
+
+
+def _http_address(cluster) -> str:
+    port = next(iter(cluster.scheduler.http_server._sockets.values())).getsockname()[1]
+    return f"http://127.0.0.1:{port}"
+
+
+INTRUDER = """
+import sys
+from distributed import Client, Security
+address, how = sys.argv[1:]
+where = address.replace("tls://", "tcp://") if how == "plain tcp" else address
+security = Security.temporary() if how == "its own credentials" else None
+try:
+    Client(where, timeout="3s", security=security).close()
+    print("got in")
+except Exception as exc:
+    print("refused", type(exc).__name__)
+"""
+
+
+@needs_dask
+def test_the_executors_own_cluster_admits_only_this_runs_credentials():
+    import subprocess
+
+    from frictionlab.executors import DaskExecutor
+
+    client, cluster = DaskExecutor(1)._connect()  # what `--executor dask` without --scheduler starts
+    try:
+        address = cluster.scheduler_address
+        assert address.startswith("tls://127.0.0.1:")
+        assert client.submit(sum, [1, 2]).result() == 3  # the run's own client gets in
+        # another local process (another user's, as far as the cluster can tell) tries to connect:
+        # without credentials, with credentials of its own, in plain TCP (one process each:
+        # a failed distributed.Client can leave its process unable to try again)
+        for how in ("no credentials", "its own credentials", "plain tcp"):
+            intruder = subprocess.run([sys.executable, "-c", INTRUDER, address, how], capture_output=True, text=True,
+                                      timeout=60)  # fmt: skip
+            assert intruder.stdout.startswith("refused "), (how, intruder.stdout, intruder.stderr[-2000:])
+        assert _http_status(_http_address(cluster), "/health") == 404  # no dashboard, no routes at all
+    finally:
+        client.close()
+        cluster.close()
+
+
+@needs_dask
+def test_the_dashboard_is_served_on_loopback_only_when_asked(capsys):
+    from frictionlab.dask_security import start_local_cluster
+
+    client, cluster = start_local_cluster(1, dashboard=True)
+    try:
+        http = _http_address(cluster)
+        assert http.startswith("http://127.0.0.1:") and _http_status(http, "/health") == 200
+        assert "Dask dashboard: http://127.0.0.1:" in capsys.readouterr().err
+    finally:
+        client.close()
+        cluster.close()
+
+
+def test_scheduler_addresses_neither_loopback_nor_tls_get_a_warning():
+    import warnings
+
+    from frictionlab.dask_security import check_address
+
+    with pytest.warns(UserWarning, match="reached without TLS: anyone who can reach that address can run code"):
+        check_address("tcp://10.1.2.3:8786")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for quiet in ("tls://10.1.2.3:8786", "tcp://127.0.0.1:8786", "localhost:8786", "tcp://[::1]:8786"):
+            check_address(quiet)
+    with pytest.raises(FrictionlabError, match="--scheduler must be an address like"):
+        check_address("ftp://host:1")
+
+
+@needs_dask
+def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, serial_24):
+    import json
+    import logging
+    import subprocess
+
+    import yaml
+    from distributed import LocalCluster, Security
+
+    from .conftest import ROOT, SMALL_PRESET, merge
+
+    security = Security.temporary()
+    files = {}
+    for name, pem in (("ca", security.tls_ca_file), ("cert", security.tls_client_cert), ("key", security.tls_client_key)):
+        files[name] = tmp_path / f"{name}.pem"
+        files[name].write_text(pem)
+    preset = tmp_path / "p.yaml"
+    preset.write_text(yaml.safe_dump(merge(SMALL_PRESET, {"realizations": 24, "output": {"plot": False}})))
+    with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", protocol="tls://", security=security,
+                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:  # fmt: skip
+        command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--executor", "dask",
+                   "--scheduler", cluster.scheduler_address, "--quiet"]  # fmt: skip
+        bare = subprocess.run([*command, "--out", str(tmp_path / "bare")], capture_output=True, text=True, cwd=ROOT,
+                              timeout=120)  # fmt: skip
+        assert bare.returncode == 1 and "a tls:// scheduler needs TLS certificates" in bare.stderr, bare.stderr
+        tls = ["--tls-ca-file", str(files["ca"]), "--tls-cert", str(files["cert"]), "--tls-key", str(files["key"])]
+        done = subprocess.run([*command, *tls, "--out", str(tmp_path / "o"), "--json"], capture_output=True,
+                              text=True, cwd=ROOT, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "warning" not in done.stderr
+    summary = json.loads(done.stdout)
+    assert summary["executor"] == "dask" and summary["workers"] == 2
+    assert (summary["fit"]["a"], summary["fit"]["b"]) == (serial_24.fit.a, serial_24.fit.b)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from frictionlab.cli import main
-from frictionlab.predict import bootstrap_pairs, dimensionless_force_3d, mdr_length, predict_xi, read_run_law
+from frictionlab import mdr_length
+from frictionlab.predict import bootstrap_pairs, dimensionless_force_3d, predict_xi, read_run_law
 from frictionlab.runner import run_to_folder
 
 

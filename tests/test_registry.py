@@ -24,6 +24,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from frictionlab import (
     ContactCurve,
     ContactSolver,
+    ForceNormalisation,
     PluginParams,
     Profile,
     SlopeEstimator,
@@ -602,6 +603,8 @@ class GoodSolver(ContactSolver):
 
     name = "good-solver"
     summary = "Exact spring row for conformance tests"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
 
     class Params(PluginParams):
         modulus: float = Field(2.0, gt=0, le=1e12, description="spring modulus k")
@@ -646,8 +649,8 @@ class GoodSlopes(SlopeEstimator):
     class Params(PluginParams):
         pass
 
-    def slopes(self, heights, spacing):
-        return (np.roll(heights, -1) - heights) / spacing
+    def slopes(self, heights, spacing, periodic=True):
+        return _fd(heights, spacing, periodic)
 
 
 def _replace_curve(curve, **changes):
@@ -759,25 +762,95 @@ def test_solver_check_fails_for_bad_stiffness():
         fltesting.check_solver(cls)
 
 
-def _fd(heights, spacing):
-    return (np.roll(heights, -1) - heights) / spacing
+WRONG_NORMALISATIONS = [
+    ("PerUnitDepth", ForceNormalisation(load="force per unit depth", modulus="k", extent="length")),
+    ("NoLength", ForceNormalisation(load="force", modulus="k", extent="one")),
+]
 
 
-def _demean_in_place(self, heights, spacing):
+@pytest.mark.parametrize("qualname,normalisation", WRONG_NORMALISATIONS, ids=[w[0] for w in WRONG_NORMALISATIONS])
+def test_solver_check_fails_for_a_wrong_normalisation(qualname, normalisation):
+    """Springs of stiffness k dx under a force: any other declared meaning of f is not dimensionless."""
+    cls = type(qualname, (GoodSolver,), {"name": "wrong-f", "normalisations": {1: normalisation}})
+    with pytest.raises(AssertionError, match="is not dimensionless as declared"):
+        fltesting.check_solver(cls)
+
+
+def test_the_half_plane_with_the_old_f_fails_the_kit():
+    """f = F' / (E* h L) for a force per unit depth (the half-plane's f before) fails the unit check."""
+    from frictionlab_solvers import BEMHalfPlane
+
+    old = ForceNormalisation(load="force per unit depth", modulus="E*", extent="length")
+    cls = type("OldHalfPlane", (BEMHalfPlane,), {"name": "old-halfplane", "normalisations": {1: old}})
+    with pytest.raises(AssertionError, match="is not dimensionless as declared"):
+        fltesting.check_solver(cls)
+    fltesting.check_solver(BEMHalfPlane)
+
+
+def test_solver_check_fails_when_periodic_only_is_not_kept():
+    cls = type("Loose", (GoodSolver,), {"name": "loose", "periodic_only": True})
+    with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was accepted"):
+        fltesting.check_solver(cls)
+
+
+@pytest.mark.parametrize(
+    "attributes,match",
+    [
+        ({"normalisations": {}}, "normalisations must map each of its dimensions"),
+        ({"dimensions": (1, 2)}, "normalisations must map each of its dimensions"),
+        ({"problem": ""}, "problem must name the physical problem"),
+        ({"contact_measure": "area"}, "contact_measure must be one of"),
+        ({"body_params": ("youngs_modulus",)}, "body_params names 'youngs_modulus', not fields of Params"),
+        ({"tolerance_param": "tol"}, "tolerance_param names 'tol'"),
+        ({"normalisations": {1: ForceNormalisation(load="force", modulus="k", extent="area")}}, "not defined for a 1D"),
+    ],
+)
+def test_solver_declarations_are_checked_at_registration(attributes, match):
+    cls = type("Undeclared", (GoodSolver,), {"name": "undeclared", **attributes})
+    with pytest.raises(PluginError, match=match):
+        registry_module.validate_plugin_class("solver", cls)
+
+
+def test_spectrum_check_fails_for_wrong_declarations():
+    cls = _spectrum_variant("SaysPeriodic", periodic=lambda self: False)
+    with pytest.raises(AssertionError, match=r"periodic\(\) must be True or False and equal Profile.periodic"):
+        fltesting.check_spectrum(cls)
+    cls = _spectrum_variant("WrongShape", grid_shape=lambda self: (3,))
+    with pytest.raises(AssertionError, match=r"grid_shape\(\) must be None or the shape"):
+        fltesting.check_spectrum(cls)
+    cls = _spectrum_variant("LineOfALine", equivalent_line=lambda self: GoodSpectrum())
+    with pytest.raises(AssertionError, match=r"equivalent_line\(\) must be None"):
+        fltesting.check_spectrum(cls)
+    cls = _spectrum_variant("NegativeHurst", hurst_exponent=lambda self: -1.0)
+    with pytest.raises(AssertionError, match=r"hurst_exponent\(\)"):
+        fltesting.check_spectrum(cls)
+
+
+def _fd(heights, spacing, periodic=True):
+    out = (np.roll(heights, -1) - heights) / spacing
+    if not periodic:
+        out[-1] = out[-2]
+    return out
+
+
+def _demean_in_place(self, heights, spacing, periodic=True):
     heights -= heights.mean()
-    return _fd(heights, spacing)
+    return _fd(heights, spacing, periodic)
 
 
 SLOPE_BREAKAGES = [
-    ("WrongShape", lambda self, z, dx: np.diff(z) / dx, r"must have shape \(128,\)"),
-    ("ForgetsSpacing", lambda self, z, dx: np.roll(z, -1) - z, "order of magnitude"),
-    ("SignFlipped", lambda self, z, dx: -_fd(z, dx), "order of magnitude and sign"),
-    ("Offset", lambda self, z, dx: _fd(z, dx) + 1e-3, "constant line must have zero slopes"),
-    ("ReturnsList", lambda self, z, dx: list(_fd(z, dx)), "must be a numpy array"),
-    ("NaN", lambda self, z, dx: np.where(np.arange(z.size) == 0, np.nan, _fd(z, dx)), "must be finite"),
-    ("Integer", lambda self, z, dx: np.round(_fd(z, dx)).astype(int), "floating point"),
+    ("WrongShape", lambda self, z, dx, periodic=True: np.diff(z) / dx, r"must have shape \(128,\)"),
+    ("ForgetsSpacing", lambda self, z, dx, periodic=True: np.roll(z, -1) - z, "order of magnitude"),
+    ("SignFlipped", lambda self, z, dx, periodic=True: -_fd(z, dx), "order of magnitude and sign"),
+    ("Offset", lambda self, z, dx, periodic=True: _fd(z, dx) + 1e-3, "constant line must have zero slopes"),
+    ("ReturnsList", lambda self, z, dx, periodic=True: list(_fd(z, dx)), "must be a numpy array"),
+    ("NaN", lambda self, z, dx, periodic=True: np.where(np.arange(z.size) == 0, np.nan, _fd(z, dx)), "must be finite"),
+    ("Integer", lambda self, z, dx, periodic=True: np.round(_fd(z, dx)).astype(int), "floating point"),
     ("MutatesInput", _demean_in_place, "modified its input"),
-    ("Random", lambda self, z, dx: _fd(z, dx) + 1e-12 * np.random.default_rng().random(z.size), "not repeatable"),
+    ("Random", lambda self, z, dx, periodic=True: _fd(z, dx) + 1e-12 * np.random.default_rng().random(z.size),
+     "not repeatable"),
+    ("WrapsAScan", lambda self, z, dx, periodic=True: _fd(z, dx), "a difference across the ends"),
+    ("NoPeriodicArgument", lambda self, z, dx: _fd(z, dx), "raised TypeError"),
 ]
 
 
@@ -949,3 +1022,31 @@ def test_testing_module_import_is_cheap():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "['frictionlab.testing']", out.stdout
+
+
+def test_an_installed_plugin_can_listen_to_every_run(register_plugin, small_preset):
+    """Lifecycle hooks are registry hooks too: a plugin implementing one is accepted (a misspelled
+    one is not) and hears the runs made with its registry."""
+    from frictionlab import engine
+    from frictionlab.preset import build_scene
+
+    heard = []
+
+    class RunLog:
+        @hookimpl
+        def run_finished(self, run, outcome):
+            heard.append((run.scene.preset.name, outcome.done))
+
+    registry = register_plugin(RunLog())
+    assert len(registry.run_listeners()) == 1
+    small_preset["realizations"] = 2
+    engine.run(build_scene(small_preset, registry=registry), workers=1, registry=registry)
+    assert heard == [("small", 2)]
+
+    class Misspelled:
+        @hookimpl
+        def run_finnished(self, run, outcome):
+            pass
+
+    with pytest.raises(pluggy.PluginValidationError):
+        register_plugin(Misspelled())

@@ -19,7 +19,7 @@ import yaml
 
 from frictionlab import hookimpl
 from frictionlab.cli import main
-from frictionlab.errors import FrictionlabError, RunError
+from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
 from frictionlab.preset import build_scene
 from frictionlab.rundir import RunDirectory
 from frictionlab.runner import run_to_folder
@@ -79,7 +79,7 @@ def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
 
 def test_a_second_run_into_a_locked_directory_is_refused(make_scene, tmp_path):
     with RunDirectory(tmp_path / "run"):
-        with pytest.raises(RunError, match=rf"{tmp_path / 'run'} is in use by another run \(pid {os.getpid()}, started"):
+        with pytest.raises(RunFolderError, match=rf"{tmp_path / 'run'} is in use by another run \(pid {os.getpid()}, started"):
             run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)
     run_to_folder(make_scene(NO_PLOT), tmp_path / "run", workers=1)  # released: now it runs
 
@@ -124,7 +124,7 @@ def test_a_fresh_run_over_an_unfinished_one_is_refused(make_scene, tmp_path):
 
 
 def test_resume_of_a_folder_without_a_run_says_so(tmp_path, capsys):
-    assert main(["resume", str(tmp_path)]) == 2
+    assert main(["resume", str(tmp_path)]) == ExitCode.RUN_FOLDER
     assert f"{tmp_path} holds no run to resume (no preset.yaml)" in capsys.readouterr().err
 
 

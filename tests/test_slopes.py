@@ -1,10 +1,13 @@
-"""Slope estimators against closed forms on periodic sines (SPEC section 4)."""
+"""Slope estimators against closed forms: periodic sines, and scans whose ends do not meet."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from frictionlab import engine
+from frictionlab.errors import PresetError
+from frictionlab.preset import build_scene
 from frictionlab.registry import validate_plugin_class
 from frictionlab.testing import check_plugin
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
@@ -114,6 +117,79 @@ def test_central_difference_wraps_both_ends():
     z = np.array([0.0, 1.0, 4.0, 9.0, 16.0])
     expected = (np.roll(z, -1) - np.roll(z, 1)) / (2 * 0.5)
     np.testing.assert_array_equal(CentralDifference().slopes(z, 0.5), expected)
+
+
+# --------------------------------------------------------- scans: not periodic
+
+
+def test_on_a_scan_no_difference_crosses_the_ends():
+    z = np.array([0.0, 1.0, 4.0, 9.0, 16.0])
+    # forward: the last point takes its segment's slope; central: one-sided at both ends
+    np.testing.assert_array_equal(ForwardDifference().slopes(z, 0.5, periodic=False), [2, 6, 10, 14, 14])
+    np.testing.assert_array_equal(CentralDifference().slopes(z, 0.5, periodic=False), [2, 4, 8, 12, 14])
+    surface = np.add.outer(np.arange(4.0) * 3, np.arange(5.0))  # z = 3 y + x
+    for cls in (ForwardDifference, CentralDifference):
+        np.testing.assert_allclose(cls().slopes(surface, 1.0, periodic=False), np.hypot(3.0, 1.0), rtol=1e-15)
+    with pytest.raises(ValueError, match="spectral slopes need a periodic profile"):
+        Spectral().slopes(z, 0.5, periodic=False)
+
+
+RAMP = 0.1  # the scan's grade
+ROUGHNESS = ((0.4, 173.0, 0.3), (0.25, 61.0, 1.1), (0.1, 29.0, 2.0))  # amplitude, wavelength, phase
+
+
+def ramp_scan(points=4000, spacing=0.5):
+    """A tilted scan with small roughness (wavelengths incommensurate with its length), and its
+    exact derivative at the grid points."""
+    x = np.arange(points) * spacing
+    z = RAMP * x + sum(a * np.sin(2 * np.pi * x / w + p) for a, w, p in ROUGHNESS)
+    dz = RAMP + sum(a * 2 * np.pi / w * np.cos(2 * np.pi * x / w + p) for a, w, p in ROUGHNESS)
+    return x, z, dz
+
+
+@pytest.mark.parametrize("slope", ["forward-difference", "central-difference"])
+@pytest.mark.parametrize("detrend", ["mean", "tilt"])
+def test_a_scan_on_a_ramp_has_its_true_rms_slope(tmp_path, registry, slope, detrend):
+    """A profile-file scan (not periodic by default) run end to end: the whole-line rms slope is
+    the rms of the exact derivative within 1 % (of what is left after detrend: the grade, unless
+    the tilt is removed). Declared periodic, the jump between the ends inflates it many times."""
+    x, z, dz = ramp_scan()
+    np.savetxt(tmp_path / "scan.csv", np.column_stack([x, z]), delimiter=",", header="x,z", comments="")
+    if detrend == "tilt":
+        dz = dz - np.polyfit(x, z, 1)[0]  # the least-squares grade goes with the tilt
+    truth = rms(dz)
+    data = {
+        "name": "scan", "realizations": 1,
+        "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "scan.csv"), "detrend": detrend}},
+        "slope": {"name": slope},
+        "loading": {"start": 1.0, "stop": 10.0, "steps": 3}, "fit": {"bootstrap": 0}, "output": {"plot": False},
+    }  # fmt: skip
+    outcome = engine.run(build_scene(data, registry=registry), workers=1)
+    assert not outcome.failures
+    assert outcome.per_realization["slope_rms_line"][0] == pytest.approx(truth, rel=0.01)
+    data["spectrum"]["params"]["periodic"] = True
+    wrapped = engine.run(build_scene(data, registry=registry), workers=1)
+    assert wrapped.per_realization["slope_rms_line"][0] > 1.1 * truth
+
+
+def test_a_scan_is_refused_by_spectral_slopes_and_periodic_solvers(tmp_path, registry):
+    _, z, _ = ramp_scan(points=64)
+    np.save(tmp_path / "scan.npy", z)
+    data = {
+        "name": "scan", "realizations": 1,
+        "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "scan.npy"), "spacing": 0.5}},
+        "solver": {"name": "bem-halfplane"}, "slope": {"name": "spectral"},
+        "loading": {"start": 1.0, "stop": 10.0, "steps": 3},
+    }  # fmt: skip
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    problems = info.value.problems
+    assert problems[0].startswith("solver.name: bem-halfplane presses periodic profiles only, but spectrum "
+                                  "profile-file is not periodic (periodic: false")  # fmt: skip
+    assert problems[1].startswith("slope.name: spectral differentiates periodic profiles only")
+    assert all("set spectrum.params.periodic: true" in p for p in problems)
+    data["spectrum"]["params"]["periodic"] = True
+    assert build_scene(data, registry=registry).spectrum.periodic()
 
 
 @pytest.mark.parametrize("cls", ESTIMATORS)

@@ -487,6 +487,43 @@ PROFILE_FORMATS = {
 }
 
 
+# ------------------------------------------------------------------ the cosine series
+
+
+@pytest.mark.parametrize("amplitudes", ["fixed", "rayleigh"])
+def test_cosine_series_has_the_covariance_of_q_k_pi_over_l(amplitudes):
+    """The study's eq. 6 read literally: z = sum_k a_k cos(k pi x / L + phi_k), k = 1 .. N / 10, on
+    [0, L). Over random phases its covariance is sum_k a_k^2 / 2 cos(k pi (x - x') / L), with
+    a_k = 2 sqrt(psd(q_k) dq), dq = pi / L, scaled to sum a_k^2 / 2 = h^2: measured over 2000 lines."""
+    n, dx, h = 200, 0.5, 2.0
+    gen = PowerLaw(hurst=0.8, points=n, spacing=dx, rms_height=h, series="cosine", short_cutoff=20 * dx,
+                   amplitudes=amplitudes)  # fmt: skip
+    assert gen.periodic() is False and (gen.band.k_lo, gen.band.k_hi) == (1, n // 10)
+    length = n * dx
+    q = np.arange(1, n // 10 + 1) * np.pi / length
+    np.testing.assert_allclose(gen.wavevectors(), q, rtol=1e-14)
+    power = gen.psd(q) * np.pi / length  # a_k^2 / 4
+    power *= h**2 / (2 * power.sum())  # sum a_k^2 / 2 = h^2
+    lines = np.array([gen.generate(np.random.default_rng(seed)).heights for seed in range(2000)])
+    assert not gen.generate(np.random.default_rng(0)).periodic
+    for lag in (0, n // 4, n // 2, 3 * n // 4):
+        measured = np.mean(lines[:, : n - lag] * lines[:, lag:])
+        expected = np.sum(2 * power * np.cos(q * lag * dx))
+        assert measured == pytest.approx(expected, abs=0.05 * h**2), lag
+    assert gen.rms_height() == pytest.approx(h, rel=1e-14)
+
+
+def test_cosine_series_long_cutoff_is_twice_the_length():
+    gen = PowerLaw(hurst=1.0, points=100, series="cosine")
+    assert gen.band.long_cutoff == 200.0 and gen.band.k_lo == 1 and gen.band.period == 200.0
+    with pytest.raises(ValidationError, match=r"long_cutoff=300.0 must not exceed the period of the cosine "
+                                              r"series 2 L = 2 \* points \* spacing = 200.0"):
+        PowerLaw(hurst=1.0, points=100, series="cosine", long_cutoff=300.0)
+    with pytest.raises(ValidationError, match="series"):
+        PowerLaw(hurst=1.0, points=100, series="sine")
+
+
+
 @pytest.mark.parametrize("kind", PROFILE_FORMATS)
 def test_profile_file_formats(tmp_path, kind):
     file_name, write, spacing, dtype = PROFILE_FORMATS[kind]
@@ -571,7 +608,7 @@ def test_profile_file_errors(tmp_path):
     assert "7 points" in message and "8" in message
 
     message = _profile_error(path=_write(tmp_path, "text.csv", heights.replace("\n", "\nabc\n", 1)), spacing=1.0)
-    assert "non-numeric" in message and "abc" in message
+    assert "non-numeric content at line 2" in message and "abc" not in message  # named, never quoted
 
     message = _profile_error(path=_write(tmp_path, "flat.txt", "\n".join(["2.5"] * 20)), spacing=1.0)
     assert "constant" in message

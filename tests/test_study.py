@@ -89,16 +89,19 @@ def test_every_axis_gives_measured_rows_and_one_reference(tiny_study):
         assert reference.a_err == 0 and reference.b_err == 0, axis
 
 
-def test_mdr_and_winkler_agree_with_the_bisection_reference_on_the_same_lines(tiny_study):
-    # Same springs solved by a sort and by bisection (contact counts exact for any
-    # tolerance), and Winkler given the base solver's stiffness: the same xi(f).
+def test_mdr_agrees_with_the_bisection_reference_on_the_same_lines(tiny_study):
+    # Same springs solved by a sort and by bisection (contact counts exact for any tolerance): the same
+    # xi(f), the same indentation to the bisection's tolerance; the springs' fraction is named as such.
     rows = {r.solver: r for r in by_axis(tiny_study, "solver")}
-    assert set(rows) == {"mdr", "winkler", "mdr-bisection"}
+    assert set(rows) == {"mdr", "mdr-bisection"}
     assert rows["mdr-bisection"].reference and rows["mdr-bisection"].tolerance == 1e-9
-    for name in ("mdr", "winkler"):
-        assert rows[name].xi_err_f < 1e-12
-        assert rows[name].xi_err_phi < 1e-12
-        assert rows[name].b_err < 1e-9
+    mdr = rows["mdr"]
+    assert mdr.xi_err_f < 1e-12 and mdr.b_err < 1e-9 and mdr.approach_err_f < 1e-6
+    assert math.isnan(mdr.real_area_first) and 0 < mdr.mdr_springs_first < mdr.mdr_springs_last < 1
+    # the indentation from the mean plane: the springs' indentation less their mean compression f h
+    outcome = mdr.outcome
+    expected = (outcome.indentation - outcome.f * outcome.rms_height) / outcome.rms_height
+    assert (mdr.approach_first, mdr.approach_last) == pytest.approx((expected[0], expected[-1]), rel=1e-12)
     for row in by_axis(tiny_study, "tolerance"):
         assert row.xi_err_f < 1e-12
 
@@ -299,47 +302,56 @@ def test_cli_bad_preset_file(tmp_path, capsys):
     (tmp_path / "bad.yaml").write_text("name: [unclosed\n")
     assert main(["study", str(tmp_path / "bad.yaml")]) == ExitCode.USAGE
     assert "not valid YAML" in capsys.readouterr().err
-    assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.USAGE
+    assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.INPUT_FILE
     assert "no such preset file" in capsys.readouterr().err
 
 
-def test_a_reference_must_press_the_presets_own_geometry(frictionlab_registry, register_plugin):
-    from frictionlab_solvers.springs import WinklerSprings
+def test_a_reference_must_solve_the_same_problem_on_the_presets_geometry(builtins):
+    with pytest.raises(FrictionlabError, match="--reference: bem-halfplane solves the elastic half-plane "
+                                               r"\(plane strain\), but the preset's solver mdr the elastic half-space"):
+        study_of(TINY, builtins, reference="bem-halfplane")
+    with pytest.raises(FrictionlabError, match="--reference: winkler solves the Winkler foundation"):
+        study_of(TINY, builtins, reference="winkler")
+    with pytest.raises(FrictionlabError, match="--reference: bem-halfspace cannot run the preset: solver.name: "
+                                               "bem-halfspace presses surfaces only"):
+        study_of(TINY, builtins, reference="bem-halfspace")
 
-    class SurfaceOnly(WinklerSprings):
-        name = "surface-only"
-        dimensions = (2,)
 
-    registry = register_plugin(SurfaceOnly)
-    with pytest.raises(FrictionlabError, match="--reference: solver 'surface-only' accepts 2D profiles; "
-                                               "the preset's spectrum 'power-law' makes 1D ones"):
-        study_of(TINY, registry, reference="surface-only")
-    if "power-law-2d" in registry.names("spectrum"):  # mdr runs a surface as its equivalent line, but cannot be its reference
-        surface = {**TINY, "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 32}}}
-        with pytest.raises(FrictionlabError, match="accepts 1D profiles; the preset's spectrum 'power-law-2d' makes 2D"):
-            study_of(surface, registry, reference="mdr")
+def test_mdr_on_lines_has_no_exact_reference_and_says_where_to_find_one(builtins):
+    study = study_of(TINY, builtins, reference=None, axes=("steps", "solver", "tolerance"))
+    assert study.reference_choice is None
+    study.run()
+    assert {r.axis for r in study.rows} == {"steps"}
+    assert any("bem-halfspace, presses an isotropic surface" in note for note in study.notes)
 
 
 # ------------------------------------------------------------------ the exact reference
 
+SURFACE = {
+    **TINY,
+    "realizations": 3,
+    "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 32, "rms_height": 1.0, "short_cutoff": 4.0}},
+    "loading": {"start": 0.2, "stop": 2.0, "steps": 5, "spacing": "log"},
+}
 
-def has_bem(registry):
-    return "bem-halfplane" in registry.names("solver")
 
-
-def test_mdr_against_the_elastic_half_plane(builtins):
-    if not has_bem(builtins):
-        pytest.skip("bem-halfplane is not installed yet")
-    study = study_of(
-        TINY, builtins, reference="bem-halfplane", axes=("solver", "tolerance"), compare_points=128,
-        compare_realizations=3, compare_steps=5, tolerances=(1e-3, 1e-8),
-    )
+def test_mdr_against_the_elastic_half_space_on_the_same_surfaces(builtins):
+    study = study_of(SURFACE, builtins, reference=None, axes=("solver", "tolerance"), compare_points_surface=32,
+                     compare_realizations=3, compare_steps=5, tolerances=(1e-3, 1e-8))  # fmt: skip
+    assert study.reference_choice["name"] == "bem-halfspace"  # the exact solver of MDR's problem
     study.run()
     solver = {r.solver: r for r in by_axis(study, "solver")}
-    reference = solver["bem-halfplane"]
+    mdr, reference = solver["mdr"], solver["bem-halfspace"]
     assert reference.reference and reference.xi_err_f == 0 and reference.b_err == 0
-    assert math.isfinite(solver["mdr"].xi_err_f) and solver["mdr"].xi_err_f > 0
+    # one f axis: MDR's line is 2 sqrt(A / pi) long, the half-space's f uses that L
+    np.testing.assert_allclose(mdr.outcome.f, reference.outcome.f, rtol=1e-12)
+    assert math.isfinite(mdr.xi_err_f) and mdr.xi_err_f > 0 and math.isfinite(mdr.approach_err_f)
+    # each contact measure in its own column; MDR's springs are not the real area
+    assert math.isnan(mdr.real_area_first) and math.isnan(reference.mdr_springs_first)
+    assert 0 < reference.real_area_first < reference.real_area_last < 1
+    assert mdr.mdr_springs_first > reference.real_area_first
     tolerance = by_axis(study, "tolerance")
     tightest = next(r for r in tolerance if r.reference)
     assert tightest.tolerance == 1e-8 and tightest.xi_err_f == 0 and tightest.b_err == 0
     assert all(math.isfinite(r.xi_err_f) for r in tolerance)
+    assert any("every solver sees the same surfaces (mdr presses their MDR-equivalent lines)" in n for n in study.notes)

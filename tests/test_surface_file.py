@@ -1,9 +1,8 @@
-"""Measured surfaces: ``surface-file`` and its MDR-equivalent line ``measured-equivalent-line``.
+"""Measured surfaces: ``surface-file`` (its MDR-equivalent line: ``test_equivalent_line.py``).
 
 Oracles: the arrays written by the test itself (read back exactly), a plane added by the test
 (removed exactly), the surface convention <z^2> = integral of C2D over the q plane measured with
-the test's own FFTs, the exponent -2H-2 of a power-law map, the MDR rule C1D = pi q C2D (which
-keeps <|grad z|^2> = <z'^2>), and the analytic ``power-law-2d`` equivalent line.
+the test's own FFTs, the exponent -2H-2 of a power-law map.
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ from frictionlab.errors import ExitCode, PresetError
 from frictionlab.preset import build_scene, load_scene
 from frictionlab.testing import check_plugin
 from frictionlab_spectra import PowerLawSurface, SurfaceFile
-from frictionlab_spectra.surface_file import MeasuredEquivalentLine
+from frictionlab_spectra.equivalent_line import EquivalentLine
 
 from .conftest import SMALL_PRESET, merge
 
@@ -34,23 +33,6 @@ def power_law_map(tmp_path, name="map.npy", seed=0, **params):
     return str(path), heights
 
 
-def map_power(heights):
-    """|z_q|^2 (sums to mean(z^2)) and |q| of every mode of a map of spacing 1."""
-    ny, nx = heights.shape
-    power = np.abs(np.fft.fft2(heights)) ** 2 / heights.size**2
-    q = np.hypot(TWO_PI * np.fft.fftfreq(ny)[:, None], TWO_PI * np.fft.fftfreq(nx)[None, :])
-    return power, q
-
-
-def spectral_rms_slope(z, spacing):
-    """rms of the exact derivative of a periodic line (Nyquist term dropped)."""
-    k = TWO_PI * np.fft.rfftfreq(z.size, spacing)
-    coeff = 1j * k * np.fft.rfft(z)
-    if z.size % 2 == 0:
-        coeff[-1] = 0.0
-    return math.sqrt(np.mean(np.fft.irfft(coeff, n=z.size) ** 2))
-
-
 # ------------------------------------------------------------------ reading
 
 
@@ -63,7 +45,7 @@ def test_a_power_law_map_reads_back_exactly(tmp_path):
     assert profile.heights.shape == (160, 200) and profile.spacing == 0.25
     np.testing.assert_allclose(profile.heights, offset - offset.mean(), rtol=0, atol=1e-13)
     assert gen.rms_height() == pytest.approx(np.std(heights), rel=1e-12)
-    assert profile.length == pytest.approx(2 * math.sqrt(160 * 200 * 0.25**2 / math.pi), rel=1e-15)
+    assert profile.periodic is False  # a scan, unless declared periodic
     profile.heights[0, 0] = 99.0  # a copy: the next surface is untouched
     assert gen.generate(np.random.default_rng(5)).heights[0, 0] != 99.0
     none = SurfaceFile(path=path, spacing=0.25, detrend="none").generate(None).heights
@@ -120,9 +102,8 @@ def test_radial_psd_recovers_the_power_law_exponent(tmp_path):
     assert np.all(psd.psd[psd.wavenumber > 1.05 * band.q_max * math.sqrt(2)] < 1e-20)  # nothing past the band
 
 
-def test_a_single_wave_lands_in_its_annulus_and_in_the_nearest_line_mode(tmp_path):
-    """z = 2 cos(2 pi (3 x + 4 y) / 64) on 64 x 64 pixels: all power 2 at |q| = 5 dq, dq = 2 pi / 64.
-    The line has N = round(128 / sqrt(pi)) = 72 points, so |q| = 5 dq = 5.625 dq_line: mode 6."""
+def test_a_single_wave_lands_in_its_annulus(tmp_path):
+    """z = 2 cos(2 pi (3 x + 4 y) / 64) on 64 x 64 pixels: all power 2 at |q| = 5 dq, dq = 2 pi / 64."""
     rows, cols = np.mgrid[0:64, 0:64]
     np.save(tmp_path / "wave.npy", 2.0 * np.cos(TWO_PI * (3 * cols + 4 * rows) / 64))
     gen = SurfaceFile(path=str(tmp_path / "wave.npy"), spacing=1.0)
@@ -131,101 +112,38 @@ def test_a_single_wave_lands_in_its_annulus_and_in_the_nearest_line_mode(tmp_pat
     expected = np.zeros(psd.psd.size)
     expected[4] = 2.0 / (TWO_PI * 5 * dq * dq)  # annulus power / annulus area 2 pi q width
     np.testing.assert_allclose(psd.psd, expected, rtol=1e-12, atol=1e-12 * expected[4])
-    line = gen.equivalent_line()
-    assert line.params.points == 72
-    z = line.generate(np.random.default_rng(0)).heights
-    spectrum = np.abs(np.fft.rfft(z)) / 36  # a_k of z = sum a_k cos(q_k x + phi_k)
-    assert spectrum[6] == pytest.approx(2.0, rel=1e-12)
-    assert np.max(np.delete(spectrum, 6)) < 1e-12
-
-
-def test_the_measured_line_has_the_maps_rms_height_and_differs_by_seed(tmp_path):
-    path, heights = power_law_map(tmp_path, points=96, points_y=64, seed=1)
-    line = SurfaceFile(path=path, spacing=0.5).equivalent_line()
-    assert isinstance(line, MeasuredEquivalentLine) and line.dimension == 1
-    assert line.params.points == round(2 * math.sqrt(96 * 64 / math.pi)) and line.params.spacing == 0.5
-    drawn = [line.generate(np.random.default_rng(seed)).heights for seed in (0, 0, 1, 2)]
-    np.testing.assert_array_equal(drawn[0], drawn[1])
-    assert not np.allclose(drawn[0], drawn[2]) and not np.allclose(drawn[2], drawn[3])
-    for z in drawn:
-        assert z.shape == (line.params.points,)
-        assert np.std(z) == pytest.approx(np.std(heights), rel=1e-12)  # random phases, fixed amplitudes
-    assert line.rms_height() == pytest.approx(np.std(heights), rel=1e-12)
-
-
-def test_the_measured_line_keeps_the_maps_rms_gradient(tmp_path):
-    """MDR: <z'^2> of the line = <|grad z|^2> of the map. Each map mode's power goes to the line
-    mode q_k nearest its |q| (|q_k - |q|| <= dq_line / 2), which bounds the line's slope^2."""
-    path, heights = power_law_map(tmp_path, hurst=0.5, points=256, seed=2, short_cutoff=4.0)
-    line = SurfaceFile(path=path, spacing=1.0).equivalent_line()
-    half_step = 0.5 * TWO_PI / line.params.points
-    power, q = map_power(heights)
-    low, high = np.sum(power * np.maximum(q - half_step, 0) ** 2), np.sum(power * (q + half_step) ** 2)
-    spectral = line.rms_slope_discrete() ** 2
-    assert low <= spectral <= high
-    assert math.sqrt(low / high) > 0.9  # the bound is tight enough to mean something
-    z = line.generate(np.random.default_rng(4)).heights  # the spectral slope of a drawn line agrees
-    assert spectral_rms_slope(z, 1.0) ** 2 == pytest.approx(spectral, rel=1e-10)
-
-
-def test_the_measured_line_matches_the_analytic_equivalent_line(tmp_path):
-    """Rayleigh maps of power-law-2d with c0 given, whose analytic equivalent line is C1D = pi q C2D
-    exactly, so its continuum rms slope is the surface's. The measured line's rms slope differs
-    from it by: sampling (each conjugate pair of modes has |z_q|^2 ~ a_q^2 Exp(1)), the surface's
-    discrete vs continuum slope, and the binning of |q| onto the line's grid (<= dq_line / 2)."""
-    params = {"hurst": 0.5, "points": 512, "c0": 1.0, "amplitudes": "rayleigh"}
-    surface = PowerLawSurface(**params)
-    analytic = surface.equivalent_line().rms_slope()
-    assert analytic == pytest.approx(surface.rms_slope(), rel=1e-12)
-    seeds = range(4)
-    slopes = []
-    for seed in seeds:
-        path, _ = power_law_map(tmp_path, seed=seed, **params)
-        line = SurfaceFile(path=path, spacing=1.0).equivalent_line()
-        drawn = [line.generate(np.random.default_rng(r)) for r in range(3)]
-        slopes.append(np.mean([spectral_rms_slope(z.heights, z.spacing) for z in drawn]))
-    # sampling: relative sd of sum_q |q|^2 |z_q|^2 (one Exp(1) per conjugate pair, weight 2), halved
-    # for the rms, over the mean of the maps (the line's phases do not change its spectral slope)
-    s = surface._synthesis()
-    pair = (s.wavenumber * s.amplitude) ** 2
-    sampling = 0.5 * math.sqrt(np.sum(s.weight**2 * pair**2 / s.weight)) / np.sum(s.weight * pair)
-    sampling /= math.sqrt(len(seeds))
-    discrete = abs(surface.rms_slope_discrete() / surface.rms_slope() - 1)
-    # binning: every mode's |q| moves by at most half the line's dq
-    half_step = 0.5 * TWO_PI / round(2 * 512 / math.sqrt(math.pi))
-    power = s.weight * s.amplitude**2
-    binning = math.sqrt(np.sum(power * (s.wavenumber + half_step) ** 2) / np.sum(power * s.wavenumber**2)) - 1
-    tolerance = 4 * sampling + discrete + binning  # about 0.06 (4 x 0.004 + 0.008 + 0.034)
-    assert tolerance < 0.07
-    assert np.mean(slopes) == pytest.approx(analytic, rel=tolerance)
 
 
 # ------------------------------------------------------------------ conformance and runs
 
 
-def test_both_classes_pass_the_conformance_checks(tmp_path):
+@pytest.mark.parametrize("periodic", [False, True])
+def test_both_classes_pass_the_conformance_checks(tmp_path, periodic):
     path, _ = power_law_map(tmp_path, points=32, points_y=24)
-    check_plugin("spectrum", SurfaceFile, deterministic=True, path=path, spacing=0.5, detrend="plane")
-    line = SurfaceFile(path=path, spacing=0.5).equivalent_line()
-    check_plugin("spectrum", MeasuredEquivalentLine, **line.params.model_dump())
+    check_plugin("spectrum", SurfaceFile, deterministic=True, path=path, spacing=0.5, detrend="plane", periodic=periodic)
+    line = SurfaceFile(path=path, spacing=0.5, periodic=periodic).equivalent_line()
+    check_plugin("spectrum", EquivalentLine, **line.params.model_dump())
 
 
-def surface_preset(path, solver):
+def surface_preset(path, solver, periodic=False):
     data = merge(SMALL_PRESET, {"realizations": 2, "loading": {"start": 0.05, "stop": 1.0, "steps": 3},
                                 "fit": {"bootstrap": 0}})
-    data["spectrum"] = {"name": "surface-file", "params": {"path": path, "spacing": 1.0}}
+    data["spectrum"] = {"name": "surface-file", "params": {"path": path, "spacing": 1.0, "periodic": periodic}}
     data["solver"] = {"name": solver, "params": {"youngs_modulus": 1.0}}
     return data
 
 
 def test_bem_halfspace_runs_on_the_measured_surface(tmp_path, registry):
     path, heights = power_law_map(tmp_path, points=16, hurst=0.8)
-    scene = build_scene(surface_preset(path, "bem-halfspace"), registry=registry)
+    with pytest.raises(PresetError, match="bem-halfspace presses periodic profiles only, but spectrum surface-file is "
+                                          "not periodic .* set spectrum.params.periodic: true"):  # fmt: skip
+        build_scene(surface_preset(path, "bem-halfspace"), registry=registry)
+    scene = build_scene(surface_preset(path, "bem-halfspace", periodic=True), registry=registry)
     assert scene.geometry == "surface" and scene.spectrum.name == "surface-file"
     outcome = engine.run(scene, workers=1)
     assert outcome.status == "completed" and not outcome.failures
     assert outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)
-    assert outcome.length == pytest.approx(2 * math.sqrt(256 / math.pi), rel=1e-15)
+    assert outcome.extent == pytest.approx(2 * math.sqrt(256 / math.pi), rel=1e-15)
     counts = outcome.per_realization["contact_count"]
     np.testing.assert_array_equal(counts[0], counts[1])  # the same surface twice
     assert np.all(np.diff(counts[0]) >= 0) and 0 < counts[0, -1] <= 256
@@ -239,13 +157,13 @@ def test_mdr_runs_the_measured_equivalent_line(tmp_path, registry):
 
     preset.write_text(yaml.safe_dump(surface_preset(path, "mdr")))
     scene = load_scene(preset, [], registry)
-    assert isinstance(scene.spectrum, MeasuredEquivalentLine) and scene.surface.name == "surface-file"
+    assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "surface-file"
     assert scene.resolved()["spectrum"]["name"] == "surface-file"  # re-runnable as written
     outcome = engine.run(scene, workers=1)
     assert outcome.status == "completed" and not outcome.failures
-    n_line = round(2 * math.sqrt(64 * 64 / math.pi))
-    assert outcome.length == n_line and outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)
-    assert np.all(outcome.per_realization["contact_count"] <= n_line)
+    assert outcome.extent == pytest.approx(2 * math.sqrt(64 * 64 / math.pi), rel=1e-14)
+    assert outcome.rms_height == pytest.approx(np.std(heights), rel=1e-12)
+    assert np.all(outcome.per_realization["contact_count"] <= scene.spectrum.params.points)
     assert np.all(np.isfinite(outcome.xi))
 
 

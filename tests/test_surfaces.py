@@ -22,7 +22,6 @@ from frictionlab.testing import check_plugin
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
 from frictionlab_solvers import BisectionSprings, MDRSprings, WinklerSprings
 from frictionlab_spectra import PowerLawSurface, RolloffSurface
-from frictionlab_spectra.surface import EquivalentLine
 
 from .conftest import SMALL_PRESET, merge
 
@@ -165,41 +164,6 @@ def test_bad_surfaces_name_the_field():
         PowerLawSurface(hurst=0.5, points=64, points_y=4)
 
 
-# ---------------------------------------------------------------- the MDR mapping
-
-
-@pytest.mark.parametrize("cls, extra", [(PowerLawSurface, {}), (RolloffSurface, {"rolloff_wavelength": 12.0})])
-@pytest.mark.parametrize("shape", [(64, 64), (48, 80)])
-def test_equivalent_line_with_c0_keeps_the_continuum_moments(cls, extra, shape):
-    ny, nx = shape
-    surface = cls(hurst=0.7, points=nx, points_y=ny, spacing=0.5, c0=2.0, **extra)
-    line = surface.equivalent_line()
-    assert isinstance(line, EquivalentLine) and line.dimension == 1
-    length = 2.0 * math.sqrt(nx * ny * 0.25 / math.pi)  # 2 sqrt(A / pi)
-    assert line.params.points == round(length / 0.5) and line.params.spacing == 0.5
-    assert abs(line.band.length - length) <= 0.25  # within dx / 2
-    b, lb = surface.band, line.band
-    assert (lb.q_min, lb.q_max, lb.q_knee) == pytest.approx((b.q_min, b.q_max, b.q_knee), rel=1e-12)
-    q = np.geomspace(b.q_min, b.q_max, 50)
-    np.testing.assert_allclose(line.psd(q), math.pi * q * surface.psd(q), rtol=1e-12)
-    assert line.psd(0.5 * b.q_min) == 0.0 and line.psd(2.0 * b.q_max) == 0.0
-    # h_1D^2 = 2 integral pi q C2D dq = h_2D^2, and the same for the slopes
-    assert line.rms_height_continuum() == pytest.approx(surface.rms_height_continuum(), rel=1e-12)
-    assert line.rms_slope() == pytest.approx(surface.rms_slope(), rel=1e-12)
-    z = line.generate(np.random.default_rng(0)).heights
-    assert z.shape == (line.params.points,) and rms(z) == pytest.approx(line.rms_height(), rel=1e-12)
-
-
-def test_equivalent_line_keeps_the_nominal_rms_height():
-    surface = RolloffSurface(hurst=0.8, points=128, rolloff_wavelength=20.0, rms_height=3.0)
-    line = surface.equivalent_line()
-    assert line.rms_height() == surface.rms_height() == 3.0  # the h of f is the same number
-    q = np.geomspace(surface.band.q_min, surface.band.q_max, 40)
-    ratio = line.psd(q) / (math.pi * q * surface.psd(q))
-    np.testing.assert_allclose(ratio, ratio[0], rtol=1e-12)  # the shape pi q C2D exactly
-    assert ratio[0] == pytest.approx(1.0, rel=0.1)  # the scale up to the two grids' Riemann sums
-
-
 # ---------------------------------------------------------------- scenes
 
 SURFACE_PRESET = merge(SMALL_PRESET, {
@@ -210,28 +174,12 @@ SURFACE_PRESET = merge(SMALL_PRESET, {
 })
 
 
-def test_mdr_on_a_surface_runs_its_equivalent_line(registry):
-    scene = build_scene(SURFACE_PRESET, registry=registry)
-    assert isinstance(scene.spectrum, EquivalentLine) and scene.surface.name == "power-law-2d"
-    assert scene.geometry == "mdr-equivalent line of a surface"
-    assert scene.resolved()["spectrum"]["name"] == "power-law-2d"  # what the user wrote, re-runnable
-    again = build_scene(scene.resolved(), registry=registry)
-    assert again.geometry == scene.geometry
-    outcome = engine.run(scene, workers=1)
-    assert outcome.status == "completed" and not outcome.failures
-    n_line = round(2 * math.sqrt(48 * 48 / math.pi))
-    assert outcome.length == n_line * 1.0
-    assert np.all(outcome.per_realization["contact_count"] <= n_line)
-    assert np.all(np.isfinite(outcome.xi))
-    np.testing.assert_array_equal(engine.run(again, workers=1).xi, outcome.xi)
-
-
 def test_winkler_on_a_surface_runs_the_surface(registry):
     scene = build_scene({**SURFACE_PRESET, "solver": {"name": "winkler"}}, registry=registry)
     assert scene.surface is None and scene.geometry == "surface"
     outcome = engine.run(scene, workers=1)
     assert not outcome.failures
-    assert outcome.length == pytest.approx(2 * math.sqrt(48 * 48 / math.pi), rel=1e-15)  # Profile.length
+    assert outcome.extent == 48 * 48  # f = F / (k h A) on a surface
     assert outcome.per_realization["contact_count"].max() <= 48 * 48
 
 
@@ -240,12 +188,13 @@ def test_dimension_mismatches_are_preset_errors(register_plugin):
         name = "line-only-slope"
         summary = "forward difference on lines only"
 
-        def slopes(self, heights, spacing):
-            return ForwardDifference().slopes(heights, spacing)
+        def slopes(self, heights, spacing, periodic=True):
+            return ForwardDifference().slopes(heights, spacing, periodic)
 
     class SurfaceSolver(WinklerSprings):
         name = "surface-only-springs"
         dimensions = (2,)
+        normalisations = {2: WinklerSprings.normalisations[2]}
 
     reg = register_plugin(LineSlope)
     register_plugin(SurfaceSolver)

@@ -626,7 +626,7 @@ def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path,
         "print(rc, rc2, bad)"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert result.stdout.strip().splitlines()[-1] == "2 0 []", result.stderr
+    assert result.stdout.strip().splitlines()[-1] == "3 0 []", result.stderr  # 3: ExitCode.INPUT_FILE
     assert "no such preset file" in result.stderr
 
 

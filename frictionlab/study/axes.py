@@ -7,19 +7,29 @@ axis           what varies (everything else fixed)       error against
 grid           points N at fixed L and cut-offs          the finest grid (same lines)
 realizations   M, the first M of the preset's lines      none: the 95% bootstrap interval
 steps          load steps K over the same f range        the densest grid (the preset's K)
-solver         contact solver, same lines, same loads    the reference solver
+solver         contact solver, same surfaces, same f     the reference solver
 tolerance      the reference solver's tolerance          the tightest tolerance
 =============  ========================================  ==================================
+
+The reference solves the preset solver's own physical problem (``ContactSolver.problem``):
+for MDR, an approximation of the elastic half-space, that is ``bem-halfspace`` on the
+same isotropic surface whose MDR-equivalent line MDR presses, compared at equal f (the 3D
+f of both). Solvers of other problems (the half-plane's ridged surface, a Winkler
+foundation) are their own scenes, never an exact MDR.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 
+import numpy as np
+
 from ..ensemble import RunOutcome
 from ..errors import FrictionlabError, PresetError
+from ..plugin import ContactSolver
 from ..preset import Scene
 from .metrics import curve_errors, interval_half_width, mean_curve_half_width, relative_difference
 from .scenes import Measurement, SceneFactory, measure
@@ -32,7 +42,7 @@ UNRESOLVED = 3  # fewer mean points in contact than this at the first load: the 
 
 @dataclass
 class StudyOptions:
-    reference: str = "bem-halfplane"
+    reference: str | None = None  # None: the exact solver of the preset solver's problem, for its geometry
     axes: tuple[str, ...] = AXES
     grid_factors: tuple[float, ...] = (0.25, 0.5, 1.0, 2.0, 4.0)  # times the preset's N; the largest is the reference
     grid_realizations: int = 50  # M on the grid and steps axes (the same lines at every setting)
@@ -70,14 +80,18 @@ class Row:
     a_ci_rel: float
     b_ci_rel: float
     xi_ci_rel: float
-    phi_first: float
-    phi_last: float
-    count_first: float  # mean points in contact at the first load
+    count_first: float  # mean points in contact at the first load (springs, or pixels)
     count_last: float
+    real_area_first: float  # real contact fraction (NaN for MDR springs, which are not the real area)
+    real_area_last: float
+    mdr_springs_first: float  # fraction of MDR springs in contact (NaN for a solver of the real contact)
+    mdr_springs_last: float
+    approach_first: float  # indentation from the mean plane of the elastic surface, over h
+    approach_last: float
     reference: bool = False
     xi_err_f: float = math.nan
     xi_bias_f: float = math.nan
-    xi_err_phi: float = math.nan
+    approach_err_f: float = math.nan
     a_err: float = math.nan
     b_err: float = math.nan
     note: str = ""
@@ -87,9 +101,19 @@ class Row:
 COLUMNS = tuple(f.name for f in fields(Row) if f.name != "outcome")
 
 
+def approach(scene: Scene, outcome: RunOutcome):
+    """Mean indentation over h, measured for every solver from one reference: the first touch of
+    the highest point, against the mean plane of the deformed elastic surface."""
+    h = outcome.rms_height
+    return (outcome.indentation - scene.solver.mean_displacement(outcome.f, h)) / h
+
+
 def make_row(axis: str, setting: str, value: float, scene: Scene, measured: Measurement, note: str = "") -> Row:
     outcome, fit = measured.outcome, measured.outcome.fit
     nan = math.nan
+    springs = scene.solver.contact_measure == "mdr springs"
+    fraction = outcome.contact_fraction
+    indentation = approach(scene, outcome) if outcome.done else np.full(2, nan)
     failures = f"{len(outcome.failures)} realization(s) failed, first: {outcome.failures[0][1]}" if outcome.failures else ""
     if outcome.done and outcome.contact_count[0] < UNRESOLVED:
         note = "; ".join(n for n in (note, f"{outcome.contact_count[0]:.2g} points in contact at the first load: "
@@ -99,10 +123,10 @@ def make_row(axis: str, setting: str, value: float, scene: Scene, measured: Meas
         solver=scene.solver.name,
         setting=setting,
         value=float(value),
-        points=int(getattr(preset_generator(scene).params, "points", 0) or 0),
+        points=preset_points(scene) or 0,
         realizations=outcome.done,
         steps=int(outcome.loads.size),
-        tolerance=float(getattr(scene.solver.params, "tolerance", nan)),
+        tolerance=nan if scene.solver.tolerance() is None else scene.solver.tolerance(),
         seconds=measured.seconds,
         peak_bytes=measured.peak_bytes,
         a=fit.a if fit else nan,
@@ -110,17 +134,22 @@ def make_row(axis: str, setting: str, value: float, scene: Scene, measured: Meas
         a_ci_rel=interval_half_width(fit.a_ci, fit.a) if fit else nan,
         b_ci_rel=interval_half_width(fit.b_ci, fit.b) if fit else nan,
         xi_ci_rel=mean_curve_half_width(outcome.xi, outcome.xi_sem, fit.confidence) if fit else nan,
-        phi_first=float(outcome.contact_fraction[0]),
-        phi_last=float(outcome.contact_fraction[-1]),
         count_first=float(outcome.contact_count[0]),
         count_last=float(outcome.contact_count[-1]),
+        real_area_first=nan if springs else float(fraction[0]),
+        real_area_last=nan if springs else float(fraction[-1]),
+        mdr_springs_first=float(fraction[0]) if springs else nan,
+        mdr_springs_last=float(fraction[-1]) if springs else nan,
+        approach_first=float(indentation[0]),
+        approach_last=float(indentation[-1]),
         note="; ".join(n for n in (note, failures) if n),
         outcome=outcome,
     )
 
 
-def compare(rows: list[Row], reference: Row, *, curves: bool = True, contact_fraction: bool = False) -> None:
-    """Fill the error columns of ``rows`` against ``reference`` (which gets zeros by the same formulas)."""
+def compare(rows: list[Row], reference: Row, *, curves: bool = True, approaches: dict | None = None) -> None:
+    """Fill the error columns of ``rows`` against ``reference`` (which gets zeros by the same formulas).
+    ``approaches``: each row's indentation curve from the common reference (``approach``), by row id."""
     ref = reference.outcome
     for row in rows:
         row.reference = row is reference
@@ -130,21 +159,16 @@ def compare(rows: list[Row], reference: Row, *, curves: bool = True, contact_fra
             continue
         if curves:
             row.xi_err_f, row.xi_bias_f, _ = curve_errors(row.outcome.f, row.outcome.xi, ref.f, ref.xi)
-        if contact_fraction:
-            row.xi_err_phi, _, overlap = curve_errors(
-                row.outcome.contact_fraction, row.outcome.xi, ref.contact_fraction, ref.xi
-            )
-            if overlap < 2 and row is not reference:
-                row.note = "; ".join(
-                    n for n in (row.note, f"contact fractions overlap the reference's at {overlap} load(s)") if n
-                )
+        if approaches is not None:
+            row.approach_err_f, _, _ = curve_errors(row.outcome.f, approaches[id(row)], ref.f, approaches[id(reference)])
 
 
-def preset_generator(scene: Scene):
-    """The spectrum generator the preset names: for a surface pressed by a line solver the scene
-    runs its MDR-equivalent line, but the grid and the geometry are the surface's."""
-    surface = getattr(scene, "surface", None)
-    return surface if surface is not None else scene.spectrum
+def preset_points(scene: Scene) -> int | None:
+    """The preset's points per side (the named spectrum's ``points_param``), if it has one."""
+    spectrum = scene.named_spectrum
+    if spectrum.points_param is None:
+        return None
+    return int(spectrum.params.model_dump()[spectrum.points_param])
 
 
 def _first_problem(exc: PresetError) -> str:
@@ -163,28 +187,51 @@ class Study:
         self.base = factory.base
         preset = self.base.preset
         self.grid_m = min(preset.realizations, options.grid_realizations)
-        generator = preset_generator(self.base)
+        generator = self.base.named_spectrum
         compare_points = options.compare_points if generator.dimension == 1 else options.compare_points_surface
-        points = int(getattr(generator.params, "points", compare_points))
+        points = preset_points(self.base)
         # The comparison scene: the preset on a smaller grid, fewer lines and loads, same f range.
         self.compare_changes = {
-            "spectrum.params.points": min(points, compare_points),
             "realizations": min(preset.realizations, options.compare_realizations),
             "loading.steps": min(preset.loading.steps, options.compare_steps),
         }
-        self.reference_choice = factory.solver_choice(options.reference, tolerance=min(options.tolerances))
-        self._check_dimensions(self.reference_choice["name"])
+        if points is not None:  # a smaller system at the same resolution (spacing and cut-offs in dx)
+            self.compare_changes[f"spectrum.params.{generator.points_param}"] = min(points, compare_points)
+        self.reference_choice = self._reference_choice()
         self._reference_row: Row | None = None
+        self._reference_scene: Scene | None = None
 
-    def _check_dimensions(self, solver: str) -> None:
-        accepts = self.factory.registry.get("solver", solver).dimensions
-        generator = preset_generator(self.base)
-        if generator.dimension not in accepts:
-            raise FrictionlabError(
-                f"--reference: solver {solver!r} accepts {' or '.join(f'{d}D' for d in accepts)} profiles; "
-                f"the preset's spectrum {generator.name!r} makes {generator.dimension}D ones. "
-                f"Choose a reference solver that presses the preset's own geometry."
-            )
+    def _reference_choice(self) -> dict | None:
+        """The reference solver: the one named by ``--reference``, which must solve the preset solver's
+        problem and press its geometry; by default the exact solver of that problem for the preset's
+        geometry (none: the solver and tolerance axes are skipped, with a note)."""
+        base = self.base.solver
+        tolerance = min(self.options.tolerances)
+        if self.options.reference is not None:
+            choice = self.factory.solver_choice(self.options.reference, tolerance=tolerance)
+            reference = self.factory.registry.get("solver", choice["name"])
+            if reference.problem != base.problem:
+                raise FrictionlabError(
+                    f"--reference: {reference.name} solves the {reference.problem}, but the preset's solver "
+                    f"{base.name} the {base.problem}: a different physical problem, not an exact {base.name}. "
+                    f"Compare with a solver of the {base.problem}."
+                )
+            try:
+                self.factory.make({**self.compare_changes, "solver": choice})
+            except PresetError as exc:
+                raise FrictionlabError(f"--reference: {reference.name} cannot run the preset: {_first_problem(exc)}") from None
+            return choice
+        dimension = self.base.named_spectrum.dimension
+        exact = [info.cls for info in self.factory.registry.infos("solver") if _exact_for(info.cls, base, dimension)]
+        if not exact:
+            shape = {1: "lines", 2: "surfaces"}[dimension]
+            self.notes.append(
+                f"solver, tolerance: skipped: no installed solver solves the {base.problem} exactly on {shape}"
+                + (" (MDR's exact counterpart, bem-halfspace, presses an isotropic surface: run the study on a "
+                   "surface preset such as power-law-2d)" if base.approximation and dimension == 1 else "")
+            )  # fmt: skip
+            return None
+        return self.factory.solver_choice(exact[0].name, tolerance=tolerance)
 
     # ------------------------------------------------------------ running
 
@@ -201,10 +248,11 @@ class Study:
         for axis in self.options.axes:
             if axis not in AXES:
                 raise FrictionlabError(f"--axes: unknown axis {axis!r}; the axes are {', '.join(AXES)}")
+        runs = {"grid": self.grid_axis, "realizations": self.realizations_axis, "steps": self.steps_axis,
+                "solver": self.solver_axis, "tolerance": self.tolerance_axis}  # fmt: skip
         for axis in self.options.axes:
-            new = getattr(self, f"{axis}_axis")()
-            self.rows += new
-        if self.options.reference_grid:
+            self.rows += runs[axis]()
+        if self.options.reference_grid and self.reference_choice is not None:
             choice = self.reference_choice
             self.rows += self.grid_axis(
                 {**self.compare_changes, "solver": choice},
@@ -219,34 +267,26 @@ class Study:
         changes = {"realizations": self.grid_m} if changes is None else changes
         factors = sorted(self.options.grid_factors if factors is None else factors)
         start = self.factory.make(changes)
-        generator = preset_generator(start)
-        points = getattr(generator.params, "points", None)
+        generator, points = start.named_spectrum, preset_points(start)
         if points is None:
-            self.notes.append(f"{label}: skipped, spectrum {generator.name!r} has no 'points' parameter")
+            self.notes.append(f"{label}: skipped, spectrum {generator.name!r} declares no points parameter")
             return []
-        band = getattr(generator, "band", None)
-        fixed = {}
-        if band is not None:  # refine the same continuous line: L and the cut-off wavelengths stay put
-            fixed = {
-                "spectrum.params.length": band.length,
-                "spectrum.params.spacing": None,
-                "spectrum.params.long_cutoff": band.long_cutoff,
-                "spectrum.params.short_cutoff": band.short_cutoff,
-            }
-            self.notes.append(
-                f"{label}: L = {band.length:g}, long cut-off {band.long_cutoff:g}, short cut-off "
-                f"{band.short_cutoff:g} held fixed (lengths in the preset's units); dx = L / N varies, "
-                f"so the same seed gives the same continuous line sampled more finely; M = {start.preset.realizations}"
-            )
+        if generator.refined(points) is None:
+            self.notes.append(f"{label}: spectrum {generator.name!r} cannot be refined at fixed length: only N varies")
         else:
+            fixed = ", ".join(f"{k} = {v:g}" for k, v in generator.refined(points).items()
+                              if k != generator.points_param and isinstance(v, float))  # fmt: skip
             self.notes.append(
-                f"{label}: spectrum {generator.name!r} exposes no band: only N varies, its cut-offs follow its defaults"
+                f"{label}: {fixed} held fixed (lengths in the preset's units); the spacing varies with N, so the "
+                f"same seed gives the same continuous {'line' if generator.dimension == 1 else 'surface'} sampled "
+                f"more finely; M = {start.preset.realizations}"
             )
         rows = []
         for factor in factors:
             n = int(round(points * factor))
+            refined = generator.refined(n) or {generator.points_param: n}
             try:
-                scene = self.factory.make({**changes, **fixed, "spectrum.params.points": n})
+                scene = self.factory.make({**changes, **{f"spectrum.params.{k}": v for k, v in refined.items()}})
             except PresetError as exc:
                 self.notes.append(f"{label}: N = {n} skipped: {_first_problem(exc)}")
                 continue
@@ -287,53 +327,59 @@ class Study:
     def _reference(self) -> Row:
         if self._reference_row is None:
             scene = self.factory.make({**self.compare_changes, "solver": self.reference_choice})
-            tolerance = self.reference_choice["params"].get("tolerance")
+            tolerance = scene.solver.tolerance()
             setting = f"tol={tolerance:g}" if tolerance is not None else "reference"
             self._reference_row = self._run("solver", setting, math.nan, scene, note="reference")
+            self._reference_scene = scene
         return self._reference_row
 
     def _describe_compare(self, scene: Scene) -> str:
         loading = scene.preset.loading
+        points = preset_points(scene)
         return (
-            f"N = {self.compare_changes['spectrum.params.points']}, M = {scene.preset.realizations}, "
-            f"K = {loading.steps} loads from {loading.start:g} to {loading.stop:g} "
-            "(the preset's f range)"
+            (f"N = {points}, " if points is not None else "")
+            + f"M = {scene.preset.realizations}, K = {loading.steps} loads from {loading.start:g} to "
+            f"{loading.stop:g} (the preset's f range)"
         )
 
     def solver_axis(self) -> list[Row]:
-        registry = self.factory.registry
-        names = [self.base.solver.name]
-        if "winkler" in registry.names("solver") and self.base.spectrum.dimension in registry.get("solver", "winkler").dimensions:
-            names.append("winkler")
+        if self.reference_choice is None:
+            return []
+        base = self.factory.make(self.compare_changes)
         reference = self._reference()
-        rows = []
-        for name in dict.fromkeys(names):
-            if name == reference.solver:
-                continue
-            scene = self.factory.make({**self.compare_changes, "solver": self.factory.solver_choice(name)})
-            rows.append(self._run("solver", name, math.nan, scene))
-        rows.append(reference)
-        compare(rows, reference, contact_fraction=True)
+        measured = [(reference, self._reference_scene)]
+        if base.solver.name != reference.solver:
+            measured.insert(0, (self._run("solver", base.solver.name, math.nan, base), base))
+        rows = [row for row, _ in measured]
+        if all(row.outcome.done for row in rows):
+            compare(rows, reference, approaches={id(row): approach(scene, row.outcome) for row, scene in measured})
+        else:
+            compare(rows, reference)
+        what = "surfaces" if base.named_spectrum.dimension == 2 else "lines"
+        mapped = f" ({base.solver.name} presses their MDR-equivalent lines)" if base.surface is not None else ""
+        definitions = "; ".join(dict.fromkeys(scene.normalisation.definition for _, scene in measured))
         self.notes.append(
-            f"solver: {self._describe_compare(self.factory.make(self.compare_changes))}; every solver sees the same "
-            f"lines; errors against {reference.solver} ({reference.setting}); xi_err_f compares at equal f, "
-            "xi_err_phi at equal mean contact fraction"
+            f"solver: {self._describe_compare(base)}; every solver sees the same {what}{mapped}; errors against "
+            f"{reference.solver} ({reference.setting}) at equal f ({definitions}); the indentation of every solver "
+            "is measured from the first touch of the highest point, against the mean plane of the deformed "
+            "elastic surface"
         )
         return rows
 
     def tolerance_axis(self) -> list[Row]:
+        if self.reference_choice is None:
+            return []
         name = self.reference_choice["name"]
-        if "tolerance" not in self.factory.registry.get("solver", name).Params.model_fields:
-            self.notes.append(f"tolerance: skipped, {name} has no 'tolerance' parameter")
+        if self.factory.registry.get("solver", name).tolerance_param is None:
+            self.notes.append(f"tolerance: skipped, {name} declares no tolerance (a direct solver)")
             return []
         tightest = min(self.options.tolerances)
         rows = []
         for tolerance in sorted(set(self.options.tolerances), reverse=True):
             if tolerance == tightest:
                 reference = self._reference()
-                row = Row(**{**{c: getattr(reference, c) for c in COLUMNS}, "outcome": reference.outcome})
-                row.axis, row.value, row.setting = "tolerance", tolerance, f"tol={tolerance:g}"
-                row.note = "the solver axis's reference run"
+                row = dataclasses.replace(reference, axis="tolerance", value=tolerance, setting=f"tol={tolerance:g}",
+                                          note="the solver axis's reference run")  # fmt: skip
             else:
                 choice = self.factory.solver_choice(name, tolerance=tolerance)
                 scene = self.factory.make({**self.compare_changes, "solver": choice})
@@ -342,3 +388,9 @@ class Study:
         compare(rows, rows[-1])
         self.notes.append(f"tolerance: {name} on the solver axis's scene; errors against tolerance {tightest:g}")
         return rows
+
+
+def _exact_for(cls: type[ContactSolver], base: ContactSolver, dimension: int) -> bool:
+    """Whether ``cls`` solves ``base``'s problem exactly on profiles of ``dimension``."""
+    return cls.problem == base.problem and not cls.approximation and dimension in cls.dimensions
+

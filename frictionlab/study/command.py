@@ -11,7 +11,7 @@ from pathlib import Path
 from ..errors import ExitCode, FrictionlabError
 
 DEFAULTS = {
-    "reference": "bem-halfplane",
+    "reference": None,
     "axes": "grid,realizations,steps,solver,tolerance",
     "target": 0.02,
     "points": None,
@@ -33,7 +33,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
     parser.add_argument(
         "--reference", default=d["reference"], metavar="SOLVER",
-        help=f"contact solver the others are compared with (default {d['reference']})",
+        help="contact solver the preset's solver is compared with; it must solve the same physical problem "
+        "(default: the installed exact solver of that problem, e.g. bem-halfspace for mdr on a surface)",
     )
     parser.add_argument("--axes", default=d["axes"], metavar="LIST", help=f"axes to run (default {d['axes']})")
     parser.add_argument("--target", type=float, default=d["target"], help="relative error in b to recommend for (default 0.02)")
@@ -121,7 +122,7 @@ def command_line(args) -> str:
 
 
 def run_command(args) -> ExitCode:
-    from ..preset import apply_overrides, load_preset_file
+    from ..preset import read_preset
     from ..registry import default_registry
     from .axes import Study
     from .report import recommendation, write_outputs
@@ -131,7 +132,7 @@ def run_command(args) -> ExitCode:
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
-    data = apply_overrides(load_preset_file(args.preset), overrides)
+    data = read_preset(args.preset, overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=str(args.preset))
     out_dir = Path(args.out) if args.out else Path("runs") / f"{factory.base.preset.name}-study-{time.strftime('%Y%m%d-%H%M%S')}"
 
@@ -140,7 +141,8 @@ def run_command(args) -> ExitCode:
             print(f"study: {message}", file=sys.stderr, flush=True)
 
     study = Study(factory, options, progress)
-    progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {study.reference_choice['name']}")
+    reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"
+    progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {reference}")
     interrupted = False
     try:
         study.run()

@@ -13,21 +13,28 @@ from pathlib import Path
 import numpy as np
 
 from ..results import atomic_write
-from .axes import COLUMNS, Row, Study, preset_generator
+from .axes import COLUMNS, Row, Study, preset_points
 from .metrics import pareto_front
 
 METRICS = {
     "xi_err_f": "rms over the loads of (xi - xi_ref) / xi_ref, ensemble means compared at equal f "
     "(the reference's f points, ln-f interpolation if the grids differ)",
     "xi_bias_f": "the mean of the same signed: > 0 when xi lies above the reference",
-    "xi_err_phi": "as xi_err_f, but at equal mean contact fraction (the reference's contact fractions inside "
-    "the row's range, ln interpolation); solver axis only",
+    "approach_err_f": "as xi_err_f for the mean indentation over h, every solver's measured from the first touch of "
+    "the highest point against the mean plane of the deformed elastic surface (MDR's springs: their indentation "
+    "less their mean compression f h); solver axis only",
     "a_err, b_err": "|a - a_ref| / |a_ref|, |b - b_ref| / |b_ref| of the fits xi = a + b ln f",
     "a_ci_rel, b_ci_rel": "half-width of the bootstrap confidence interval of a, b (over realizations) / |a|, |b|: "
     "the statistical error",
     "xi_ci_rel": "rms over the loads of z sem(xi) / xi, the normal-theory half-width of the mean curve",
-    "phi_first, phi_last": "mean contact fraction at the first and the last load",
-    "count_first, count_last": "mean number of points in contact at the first and the last load",
+    "count_first, count_last": "mean number of points in contact at the first and the last load (MDR: springs of "
+    "its line; a surface solver: pixels)",
+    "real_area_first, real_area_last": "real contact area fraction at the first and the last load (of a surface; of "
+    "a line's length on the half-plane); not defined for MDR",
+    "mdr_springs_first, mdr_springs_last": "fraction of the MDR line's springs in contact: a length measure of the "
+    "line, not the real contact area of the surface it stands for",
+    "approach_first, approach_last": "mean indentation over h at the first and the last load, from the reference "
+    "of approach_err_f",
     "seconds": "wall time of the whole ensemble (generate, solve, fit with bootstrap), serial in one process, "
     "best of the repeats",
     "peak_bytes": "tracemalloc peak above the level before the run (numpy buffers included; memory that C "
@@ -74,6 +81,10 @@ def _pct(value: float) -> str:
     return "0" if value == 0 else f"{100 * value:.3g} %"
 
 
+def _signed_pct(value: float) -> str:
+    return "–" if not math.isfinite(value) else f"{100 * value:+.3g} %"
+
+
 def _num(value: float, digits: int = 4) -> str:
     return f"{value:.{digits}g}" if math.isfinite(value) else "–"
 
@@ -83,10 +94,12 @@ TABLES = {
     "grid (reference)": ("N", "xi_err_f", "a_err", "b_err", "b_ci_rel", "a", "b", "count_first", "count_last"),
     "realizations": ("M", "b_ci_rel", "a_ci_rel", "xi_ci_rel", "a", "b"),
     "steps": ("K", "a_err", "b_err", "a", "b"),
-    "solver": ("solver", "xi_err_f", "xi_bias_f", "xi_err_phi", "a_err", "b_err", "b_ci_rel", "a", "b", "count_first", "count_last", "phi_first", "phi_last"),
+    "solver": ("solver", "xi_err_f", "xi_bias_f", "a_err", "b_err", "b_ci_rel", "a", "b", "approach_err_f",
+               "approach_first", "approach_last", "real_area_first", "real_area_last", "mdr_springs_first",
+               "mdr_springs_last"),
     "tolerance": ("tolerance", "xi_err_f", "a_err", "b_err", "a", "b"),
 }
-PERCENT = {"xi_err_f", "xi_bias_f", "xi_err_phi", "a_err", "b_err", "a_ci_rel", "b_ci_rel", "xi_ci_rel"}
+PERCENT = {"xi_err_f", "xi_bias_f", "approach_err_f", "a_err", "b_err", "a_ci_rel", "b_ci_rel", "xi_ci_rel"}
 
 
 def _table_cell(row: Row, column: str) -> str:
@@ -98,7 +111,7 @@ def _table_cell(row: Row, column: str) -> str:
         text = row.solver
     elif column in PERCENT:
         text = _pct(getattr(row, column))
-    elif column.startswith(("phi", "count")):
+    elif column.startswith(("count", "real_area", "mdr_springs", "approach")):
         text = _num(getattr(row, column), 3)
     else:
         text = _num(getattr(row, column))
@@ -117,13 +130,13 @@ def axis_table(rows: list[Row], axis: str) -> str:
 
 def scene_summary(study: Study) -> str:
     base = study.base
-    generator = preset_generator(base)
-    preset, params = base.preset, generator.params
-    hurst = getattr(params, "hurst", None)
+    generator = base.named_spectrum
+    preset, hurst, points = base.preset, generator.hurst_exponent(), preset_points(base)
     loading = preset.loading
     return (
         f"{preset.name}: {generator.name}" + (f", H = {hurst:g}" if hurst is not None else "")
-        + f", N = {getattr(params, 'points', '?')}, M = {preset.realizations}, K = {loading.steps} "
+        + (f", N = {points}" + (" per side" if generator.dimension == 2 else "") if points is not None else "")
+        + f", M = {preset.realizations}, K = {loading.steps} "
         f"{loading.control} steps from {loading.start:g} to {loading.stop:g}, solver {base.solver.name}, "
         f"slope {base.slope.name}, seed {preset.seed}"
     )
@@ -229,7 +242,7 @@ def _needed_realizations(measured: int, ci_rel: float, target: float) -> tuple[i
 
 def recommendation(study: Study) -> str:
     target = study.options.target
-    hurst = getattr(preset_generator(study.base).params, "hurst", None)
+    hurst = study.base.named_spectrum.hurst_exponent()
     head = f"for {100 * target:g}% error in b" + (f" at H = {hurst:g}" if hurst is not None else "")
     by_axis = {axis: [r for r in study.rows if r.axis == axis] for axis in dict.fromkeys(r.axis for r in study.rows)}
     solver = study.base.solver.name
@@ -287,17 +300,15 @@ def recommendation(study: Study) -> str:
             f"{reference.solver} needs {tol_text}M = {m_ref}{how} at N = {reference.points}, "
             f"about {per_line * m_ref:.2g} s serial"
         )
+        what = "surfaces" if study.base.named_spectrum.dimension == 2 else "lines"
         for row in solver_rows:
             if row.reference:
                 continue
-            verdict = (
-                "a model error no number of points or lines removes"
-                if row.b_err > target
-                else "within the target"
-            )
             parts.append(
-                f"against {reference.solver} on the same {row.realizations} lines at N = {row.points}, {row.solver}'s b "
-                f"is off by {_pct(row.b_err)} and its xi(f) by {_pct(row.xi_err_f)} rms ({verdict})"
+                f"against {reference.solver} on the same {row.realizations} {what} at N = {row.points} and equal f, "
+                f"{row.solver}'s xi(f) is off by {_pct(row.xi_err_f)} rms (mean {_signed_pct(row.xi_bias_f)}), its b by "
+                f"{_pct(row.b_err)} (b's 95% interval from {reference.realizations} {what}: +-{_pct(reference.b_ci_rel)}), "
+                f"its indentation by {_pct(row.approach_err_f)} rms"
             )
     if not parts:
         return f"{head}: no axis measured enough to recommend anything."

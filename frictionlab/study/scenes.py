@@ -3,9 +3,8 @@
 A variant is the preset's data with a few dotted-path changes, validated by
 ``preset.build_scene`` like any preset, so every variant is a scene a user
 could run. Nothing here knows physics: solvers are swapped by copying the
-parameters their ``Params`` share, and the f range is kept through the
-contract's own normalisation f = F / (k h L) (``stiffness()``, ``rms_height()``,
-``Profile.length``).
+parameters of the elastic body both declare (``ContactSolver.body_params``), and
+the f range is kept through the contract's own normalisation (``force_unit``).
 """
 
 from __future__ import annotations
@@ -20,12 +19,10 @@ from typing import Any
 from .. import engine
 from ..ensemble import RunOutcome
 from ..errors import FrictionlabError
+from ..plugin import force_unit
 from ..preset import Scene, build_scene
 from ..registry import Registry
 from ..seeds import realization_rng
-
-# Parameters that tune a solver's iteration, not the body: never carried from one solver to another.
-ITERATION_PARAMS = ("tolerance", "max_iterations")
 
 
 def assign(data: dict, path: str, value: Any) -> None:
@@ -38,9 +35,9 @@ def assign(data: dict, path: str, value: Any) -> None:
 
 
 def force_scale(scene: Scene) -> float:
-    """k h L of f = F / (k h L), with L from realization 0's profile (lines and surfaces alike)."""
+    """The load at f = 1 (``force_unit``) for realization 0's profile."""
     profile = scene.spectrum.generate(realization_rng(scene.preset.seed, 0))
-    return float(scene.solver.stiffness()) * float(scene.spectrum.rms_height()) * float(profile.length)
+    return force_unit(scene.solver, scene.spectrum.rms_height(), profile)
 
 
 class SceneFactory:
@@ -72,21 +69,18 @@ class SceneFactory:
         return scene
 
     def solver_choice(self, name: str, tolerance: float | None = None) -> dict:
-        """``{"name", "params"}`` for solver ``name`` with the base solver's body:
-        the parameters both ``Params`` declare (E, nu), or, for a solver with a
-        single ``modulus`` (Winkler), the base solver's stiffness. Raises
-        FrictionlabError naming the option when the solver is not installed."""
+        """``{"name", "params"}`` for solver ``name`` with the base solver's elastic body
+        (the ``body_params`` both solvers declare) and, for an iterative solver, the
+        ``tolerance``. Raises FrictionlabError naming the option when the solver is
+        not installed."""
         try:
             cls = self.registry.get("solver", name)
         except FrictionlabError as exc:
             raise FrictionlabError(f"--reference: {exc}") from None
-        fields = cls.Params.model_fields
         base = self.base.solver.params.model_dump()
-        params = {k: v for k, v in base.items() if k in fields and k not in ITERATION_PARAMS}
-        if not params and "modulus" in fields:
-            params["modulus"] = float(self.base.solver.stiffness())
-        if tolerance is not None and "tolerance" in fields:
-            params["tolerance"] = tolerance
+        params = {k: base[k] for k in cls.body_params if k in self.base.solver.body_params}
+        if tolerance is not None and cls.tolerance_param is not None:
+            params[cls.tolerance_param] = tolerance
         return {"name": cls.name, "params": params}
 
 

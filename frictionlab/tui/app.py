@@ -22,7 +22,7 @@ from textual.message import Message
 from textual.widgets import DataTable, Footer, ProgressBar, Static, TabbedContent, TabPane
 
 from ..errors import FrictionlabError, PresetError
-from ..preset import build_scene, load_preset_file
+from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
 from ..reporter import _duration
 from ..runner import run_to_folder
@@ -101,16 +101,18 @@ def _interval(ci) -> str:
     return "" if low is None or not math.isfinite(low) else f"[{low:.4f}, {high:.4f}]"
 
 
-def fit_lines(fit, *, final: bool) -> list[str]:
-    """The coefficients as the Run tab and Results tab show them."""
+def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
+    """The coefficients as the Run tab and Results tab show them, with what f is."""
+    what = [f"  f = {f_formula}"] if f_formula else []
     if fit is None:
-        return ["xi = a + b ln f", "  (no realization yet)"]
+        return ["xi = a + b ln f", *what, "  (no realization yet)"]
     head = "xi = a + b ln f" + ("" if final else "  (interim)")
-    lines = [head, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
+    lines = [head, *what, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
     if final:
         level = f"{100 * fit.confidence:g}%"
         lines = [
             head,
+            *what,
             f"  a = {fit.a:.4f} {_interval(fit.a_ci)}",
             f"  b = {fit.b:.4f} {_interval(fit.b_ci)}",
             f"  {level} CI, bootstrap {fit.bootstrap}",
@@ -549,6 +551,8 @@ class FrictionlabApp(App):
             self.notify("No preset open: F2 lists them.", severity="warning")
             return
         try:
+            if self.draft_path is not None:  # relative input files are the preset file's neighbours
+                data = resolve_input_paths(data, self.draft_path.parent, self.registry)
             scene = build_scene(data, registry=self.registry)
             sweep = None
             if getattr(scene.preset, "sweep", None) is not None:  # every point is checked before any runs
@@ -691,7 +695,7 @@ class FrictionlabApp(App):
             if snap.fit is not None:
                 series.append(_fit_series(snap.f, snap.fit.a, snap.fit.b, "yellow"))
             pane.query_one("#run-chart", Chart).show(series)
-            lines = fit_lines(snap.fit, final=False)
+            lines = fit_lines(snap.fit, final=False, f_formula=snap.f_formula)
             lines += _contact_lines(snap.contact_count)
             pane.query_one("#run-fit", Static).update("\n".join(lines))
         if snap.first_error:
@@ -713,7 +717,8 @@ class FrictionlabApp(App):
                 _fit_series(outcome.f, outcome.fit.a, outcome.fit.b, "yellow"),
             ]
             pane.query_one("#run-chart", Chart).show(series)
-        lines = fit_lines(outcome.fit, final=True) + _contact_lines(outcome.contact_count)
+        lines = fit_lines(outcome.fit, final=True, f_formula=outcome.normalisation.formula)
+        lines += _contact_lines(outcome.contact_count)
         pane.query_one("#run-fit", Static).update("\n".join(lines))
         if outcome.failures or outcome.error:
             first = outcome.error or f"#{outcome.failures[0][0]}: {outcome.failures[0][1]}"
@@ -815,7 +820,8 @@ class FrictionlabApp(App):
                 series.append(_fit_series(f, entry.a, entry.b, f"dim {style}"))
             fit = entry.fit or {}
             counts = entry.summary.get("contact_count_at_first_load"), entry.summary.get("contact_count_at_last_load")
-            lines.append(f"[{style}]■ {entry.path.name}[/]")
+            formula = (entry.summary.get("normalisation") or {}).get("formula")
+            lines.append(f"[{style}]■ {entry.path.name}[/]" + (f" f = {formula}" if formula else ""))
             contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if counts[0] is not None else ""
             lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
             if fit:

@@ -153,11 +153,13 @@ def read_run(folder: Path) -> RunEntry:
 
 
 def read_curve(folder: Path) -> dict[str, list[float]]:
-    """``curve.csv`` as columns of floats (empty cells become NaN)."""
+    """``curve.csv`` as columns of floats by short name (``f``, ``xi``, ...; empty cells become NaN)."""
+    from ..results import column_name
+
     with open(Path(folder) / "curve.csv", encoding="utf-8", newline="") as fh:
         rows = list(csv.DictReader(fh))
     columns = rows[0].keys() if rows else ()
-    return {c: [float(r[c]) if r[c] else math.nan for r in rows] for c in columns}
+    return {column_name(c): [float(r[c]) if r[c] else math.nan for r in rows] for c in columns}
 
 
 @dataclass

@@ -40,6 +40,7 @@ class Snapshot:
     fit: InterimFit | None
     first_error: str | None = None
     finished: bool = False
+    f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
 
     @property
     def rate(self) -> float:
@@ -62,8 +63,8 @@ class LiveListener:
         steps = scene.loads.size
         self._loads = scene.loads.astype(float)
         self._force_control = scene.control == "force"
-        self._scale = float(scene.solver.stiffness()) * float(scene.spectrum.rms_height())
-        self._length = math.nan
+        self._force_unit = math.nan
+        self._f_formula = scene.normalisation.formula
         self._ok = 0
         self._failed = 0
         self._first_error = None
@@ -77,7 +78,7 @@ class LiveListener:
     @hookimpl
     def realization_done(self, result, done, total):
         self._ok += 1
-        self._length = result.length
+        self._force_unit = result.force_unit
         self._xi_sum += result.xi
         self._count_sum += result.contact_count
         if result.force is not None:
@@ -104,7 +105,7 @@ class LiveListener:
         f = xi = count = fit = None
         if self._ok:
             force = self._loads if self._force_control else self._force_sum / self._ok
-            f = force / (self._scale * self._length)
+            f = force / self._force_unit
             xi = self._xi_sum / self._ok
             count = self._count_sum / self._ok
             fit = interim_fit(f, xi)
@@ -119,6 +120,7 @@ class LiveListener:
             fit=fit,
             first_error=self._first_error,
             finished=finished,
+            f_formula=self._f_formula,
         )
 
 

@@ -1,4 +1,4 @@
-"""Built-in slope estimators of frictionlab (SPEC section 4)."""
+"""Built-in slope estimators of frictionlab."""
 
 from frictionlab import hookimpl
 

@@ -1,9 +1,20 @@
-"""Pointwise slopes of a periodic rough line or surface (SPEC section 4).
+"""Pointwise slopes of a rough line or surface.
 
-Every estimator maps heights of shape (N,) on a periodic grid of spacing dx to
-an array of the same shape: the slope attributed to each point. The engine
-forms both the whole-line rms slope and the rms over the points in contact from
-it, so the two always use the same estimator.
+Every estimator maps heights of shape (N,) on a grid of spacing dx to an array
+of the same shape: the slope attributed to each point. The engine forms both the
+whole-line rms slope and the rms over the points in contact from it, so the two
+always use the same estimator.
+
+On a periodic profile the differences wrap around (the last point's forward
+neighbour is the first). On a non-periodic one (a measured scan, whose ends do
+not meet) they never do: the jump from the last point to the first is not a
+slope. There the end points take the one-sided difference of the segment they
+end (``numpy.gradient``'s first-order edges): the forward difference of the last
+point is the slope of the last segment, and the central difference of either
+end is that of its own segment. Every point keeps a slope, so a contact at an
+end of the scan still has one; the last segment counts twice in the whole-line
+rms, a bias of order 1/N. The spectral derivative needs a periodic profile and
+refuses any other.
 
 On a surface, shape (Ny, Nx) with square pixels, the slope of a pixel is the
 gradient magnitude |grad z| = sqrt(dz/dx^2 + dz/dy^2), each component formed
@@ -34,7 +45,7 @@ def _checked(heights, spacing, minimum: int) -> tuple[np.ndarray, float]:
     if min(heights.shape) < minimum:
         what = "line" if heights.ndim == 1 else "surface (along each axis)"
         raise ValueError(
-            f"a periodic {what} needs at least {minimum} points for a slope. Got shape {heights.shape} instead."
+            f"a {what} needs at least {minimum} points for a slope. Got shape {heights.shape} instead."
         )
     spacing = float(spacing)
     if not (np.isfinite(spacing) and spacing > 0.0):
@@ -46,22 +57,31 @@ def _checked(heights, spacing, minimum: int) -> tuple[np.ndarray, float]:
     return heights, spacing
 
 
-def _gradient_magnitude(z: np.ndarray, dx: float, derivative: Callable[[np.ndarray, float, int], np.ndarray]):
-    """|grad z| of a surface from a periodic derivative along one axis."""
-    along_x = derivative(z, dx, 1)
-    along_y = derivative(z, dx, 0)
+def _gradient_magnitude(z: np.ndarray, dx: float, derivative: Callable[..., np.ndarray], periodic: bool):
+    """|grad z| of a surface from a derivative along one axis."""
+    along_x = derivative(z, dx, 1, periodic)
+    along_y = derivative(z, dx, 0, periodic)
     return np.hypot(along_x, along_y, out=along_x)
 
 
-def _forward(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
-    return (np.roll(z, -1, axis=axis) - z) / dx
+def _forward(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.ndarray:
+    out = (np.roll(z, -1, axis=axis) - z) / dx
+    if not periodic:  # the last point: the last segment's slope, not the wrap
+        last = [slice(None)] * z.ndim
+        last[axis] = -1
+        before = [slice(None)] * z.ndim
+        before[axis] = -2
+        out[tuple(last)] = out[tuple(before)]
+    return out
 
 
-def _central(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
+def _central(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.ndarray:
+    if not periodic:
+        return np.gradient(z, dx, axis=axis, edge_order=1)
     return (np.roll(z, -1, axis=axis) - np.roll(z, 1, axis=axis)) / (2.0 * dx)
 
 
-def _spectral(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
+def _spectral(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.ndarray:
     points = z.shape[axis]
     spectrum = np.fft.rfft(z, axis=axis)
     q = (2.0 * np.pi / (points * dx)) * np.arange(spectrum.shape[axis])
@@ -74,30 +94,33 @@ def _spectral(z: np.ndarray, dx: float, axis: int) -> np.ndarray:
 class ForwardDifference(SlopeEstimator):
     name: ClassVar[str] = "forward-difference"
     summary: ClassVar[str] = (
-        "forward difference (z[i+1] - z[i]) / dx, periodic: the study's definition; |grad z| on a surface"
+        "forward difference (z[i+1] - z[i]) / dx: the study's definition; |grad z| on a surface"
     )
     dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
-    def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
+    def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
         if z.ndim == 2:
-            return _gradient_magnitude(z, dx, _forward)
+            return _gradient_magnitude(z, dx, _forward, periodic)
         out = np.empty_like(z)
         np.subtract(z[1:], z[:-1], out=out[:-1])
-        out[-1] = z[0] - z[-1]  # periodic wrap: z[N] = z[0]
+        # periodic: z[N] = z[0]; otherwise the last point has no forward neighbour: its segment's slope
+        out[-1] = z[0] - z[-1] if periodic else out[-2]
         np.divide(out, dx, out=out)
         return out
 
 
 class CentralDifference(SlopeEstimator):
     name: ClassVar[str] = "central-difference"
-    summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx), periodic; |grad z| on a surface"
+    summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx); one-sided at the ends of a scan; |grad z| on a surface"
     dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
-    def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
+    def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
         if z.ndim == 2:
-            return _gradient_magnitude(z, dx, _central)
+            return _gradient_magnitude(z, dx, _central, periodic)
+        if not periodic:
+            return np.gradient(z, dx, edge_order=1)
         out = np.empty_like(z)
         np.subtract(z[2:], z[:-2], out=out[1:-1])
         out[0] = z[1] - z[-1]
@@ -112,11 +135,17 @@ class Spectral(SlopeEstimator):
         "spectral derivative by FFT (multiply by i q), Nyquist term dropped for even N; |grad z| on a surface"
     )
     dimensions: ClassVar[tuple[int, ...]] = (1, 2)
+    periodic_only: ClassVar[bool] = True
 
-    def slopes(self, heights: np.ndarray, spacing: float) -> np.ndarray:
+    def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:
+        if not periodic:
+            raise ValueError(
+                "spectral slopes need a periodic profile: this one's ends do not meet, and the jump between "
+                "them would spread over every slope. Use forward-difference or central-difference."
+            )
         z, dx = _checked(heights, spacing, 2)
         if z.ndim == 2:
-            return _gradient_magnitude(z, dx, _spectral)
+            return _gradient_magnitude(z, dx, _spectral, True)
         points = z.size
         spectrum = np.fft.rfft(z)
         q = (2.0 * np.pi / (points * dx)) * np.arange(spectrum.size)

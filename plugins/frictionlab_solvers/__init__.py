@@ -1,4 +1,4 @@
-"""Built-in contact solvers of frictionlab (SPEC section 3)."""
+"""Built-in contact solvers of frictionlab."""
 
 from frictionlab import hookimpl
 

@@ -31,8 +31,7 @@ import numpy as np
 import scipy.fft
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Profile
-from frictionlab.plugin import Control
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile
 
 from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
@@ -318,6 +317,10 @@ class PeriodicBEM(ContactSolver):
     in the dimension of the wave vectors (and so of the profile)."""
 
     references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER,)
+    indentation_reference: ClassVar[str] = "mean surface"
+    periodic_only: ClassVar[bool] = True
+    body_params: ClassVar[tuple[str, ...]] = ("youngs_modulus", "poisson_ratio")
+    tolerance_param: ClassVar[str | None] = "tolerance"
 
     class Params(ElasticParams):
         tolerance: float = Field(
@@ -332,7 +335,7 @@ class PeriodicBEM(ContactSolver):
         )
 
     def stiffness(self) -> float:
-        """E* = E / (1 - nu^2), so f = F / (E* h L) matches the MDR springs."""
+        """E* = E / (1 - nu^2)."""
         return elastic_stiffness(self.params)
 
     def solve(
@@ -341,6 +344,12 @@ class PeriodicBEM(ContactSolver):
         _check_control(control)
         loads = _check_loads(loads, control)
         heights, slopes, spacing = check_profile(self, profile, slopes)
+        if not profile.periodic:
+            raise ValueError(
+                f"{self.name} presses periodic profiles only, and this one is not (a scan whose ends do not "
+                "meet). Make it periodic (remove its tilt, check that its ends meet, then set the spectrum's "
+                "periodic: true) or press it with a solver of independent springs (mdr, winkler)."
+            )
         if not np.isfinite(heights).all():
             raise ValueError("heights must be finite")
         points = heights.size
@@ -451,6 +460,9 @@ class BEMHalfPlane(PeriodicBEM):
         "exact elastic half-plane (plane strain) under a periodic line: FFT boundary elements, Polonsky-Keer CG"
     )
     dimensions: ClassVar[tuple[int, ...]] = (1,)
+    # plane strain: the line is a ridged surface, straight in depth; its load is a force per unit depth
+    normalisations = {1: ForceNormalisation(load="force per unit depth", modulus="E*", extent="one")}
+    problem: ClassVar[str] = "elastic half-plane (plane strain)"
 
 
 class BEMHalfSpace(PeriodicBEM):
@@ -459,3 +471,5 @@ class BEMHalfSpace(PeriodicBEM):
         "exact elastic half-space under a periodic surface: FFT boundary elements, Polonsky-Keer CG"
     )
     dimensions: ClassVar[tuple[int, ...]] = (2,)
+    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
+    problem: ClassVar[str] = "elastic half-space"

@@ -1,4 +1,4 @@
-"""Rows of independent springs under a rigid rough line (SPEC section 3).
+"""Rows of independent springs under a rigid rough line.
 
 Each grid point is a spring of stiffness ``K = k dx`` (on a surface, each pixel
 a spring of stiffness ``k dx^2``: the springs are independent, so a surface is
@@ -24,8 +24,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, PluginParams, Profile
-from frictionlab.plugin import Control
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile
 
 MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
 
@@ -142,13 +141,25 @@ def _line_rms(slopes: np.ndarray) -> float:
 
 class SpringRow(ContactSolver):
     """Independent springs of stiffness ``stiffness() * dx``: exact sweep from one
-    (partial) sort. Not registered itself; subclasses only define ``stiffness``.
+    (partial) sort. Not registered itself; subclasses define ``stiffness`` and
+    their declarations.
+
+    The indentation is the rigid body's travel since the first touch against the
+    springs' base, which does not move. The springs' mean compression is
+    F / (k N dx^ndim) = f h (their f is F / (k h L) on a line, F / (k h A) on a
+    surface): ``mean_displacement``.
 
     ``extras["candidates"]`` (one entry per load, the same for the whole sweep):
     how many points were sorted. Only points shallower than the largest load can
     reach (``u < F_max / (k dx)`` or ``u < d_max``) are candidates: a single
     point in contact already carries ``k dx * d``, so ``d <= F / (k dx)``.
     """
+
+    indentation_reference: ClassVar[str] = "undeformed body"
+
+    def mean_displacement(self, f: np.ndarray, rms_height: float) -> np.ndarray:
+        """The springs' mean compression f h."""
+        return np.asarray(f, dtype=float) * rms_height
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
@@ -232,8 +243,14 @@ class MDRSprings(SpringRow):
         "MDR springs of stiffness E* dx: exact load sweep from one partial sort of the heights"
     )
     references: ClassVar[tuple[str, ...]] = (MDR_BOOK,)
-    # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene)
+    # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene),
+    # whose length is 2 sqrt(A / pi): F / (E* h L) is then the surface's own 3D f
     dimensions: ClassVar[tuple[int, ...]] = (1,)
+    normalisations = {1: ForceNormalisation(load="force", modulus="E*", extent="length")}
+    problem: ClassVar[str] = "elastic half-space"
+    approximation: ClassVar[bool] = True  # the 3D contact of an isotropic surface, reduced to a line
+    contact_measure: ClassVar[str] = "mdr springs"
+    body_params: ClassVar[tuple[str, ...]] = ("youngs_modulus", "poisson_ratio")
 
     Params = ElasticParams
 
@@ -249,14 +266,21 @@ class WinklerSprings(SpringRow):
     )
     references: ClassVar[tuple[str, ...]] = ()
     dimensions: ClassVar[tuple[int, ...]] = (1, 2)  # one spring per point, or per pixel of a surface
+    # k per unit length of a line is a stress (N/m^2); per unit area of a surface a stress per length (N/m^3)
+    normalisations = {
+        1: ForceNormalisation(load="force", modulus="k", extent="length"),
+        2: ForceNormalisation(load="force", modulus="k", extent="area"),
+    }
+    problem: ClassVar[str] = "Winkler foundation"
+    body_params: ClassVar[tuple[str, ...]] = ("modulus",)
 
     class Params(PluginParams):
         modulus: float = Field(
             1.0,
             gt=0.0,
             allow_inf_nan=False,
-            description="foundation modulus: stiffness per unit length of line, or per unit area of a surface "
-            "(e.g. E/t for a thin layer of thickness t)",
+            description="foundation modulus k: stiffness per unit length of a line (a stress, N/m^2), or per unit "
+            "area of a surface (a stress per length, N/m^3; E/t for a thin layer of thickness t)",
         )
 
     def stiffness(self) -> float:
@@ -286,6 +310,7 @@ class BisectionSprings(MDRSprings):
         "MDR springs solved by bisection per load: the slow baseline for benchmarks and checks"
     )
     references: ClassVar[tuple[str, ...]] = (MDR_BOOK,)
+    tolerance_param: ClassVar[str | None] = "tolerance"
 
     class Params(MDRSprings.Params):
         tolerance: float = Field(

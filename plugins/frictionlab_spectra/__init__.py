@@ -1,4 +1,4 @@
-"""Built-in spectrum generators of frictionlab (SPEC section 2)."""
+"""Built-in spectrum generators of frictionlab."""
 
 from frictionlab import hookimpl
 

@@ -1,4 +1,4 @@
-"""Band-limited self-affine rough lines (SPEC section 2): ``power-law`` and ``rolloff``.
+"""Band-limited self-affine rough lines: ``power-law`` and ``rolloff``.
 
 Both are one generator, a PSD that is flat from the long cut-off q_min up to a
 knee q_r and a power law C0 q^(-2H-1) from q_r up to the short cut-off q_max
@@ -8,6 +8,13 @@ random phases by one inverse real FFT.
 Conventions
 -----------
 - Grid: N points, spacing dx, length L = N dx, periodic; q_k = 2 pi k / L, dq = 2 pi / L.
+- ``series: cosine`` instead: the non-periodic sum of cosines with q_k = k pi / L
+  (dq = pi / L, twice as dense) on [0, L), the source study's eq. 6 read literally
+  (pi / L <= q <= pi / (10 dx): short_cutoff = 20 dx). Its modes are those of a
+  periodic line of length 2L, of which the line is the first half; the
+  long cut-off then defaults to, and may not exceed, 2L. The ends do not meet
+  (``periodic()`` is False), and the modes are not orthogonal on [0, L), so a
+  line's rms height scatters about the nominal one.
 - One-sided 1D PSD with <z^2> = 2 * integral_0^inf psd(q) dq.
 - Mode k (kept when q_min <= q_k <= q_max, both inclusive up to a relative 1e-9)
   is a_k cos(q_k x + phi_k) with a_k = 2 sqrt(psd(q_k) dq), i.e. variance
@@ -54,10 +61,16 @@ class Band:
     knee: float  # wavelength where the power law starts (= long_cutoff for power-law)
     k_lo: int  # first kept mode
     k_hi: int  # last kept mode (inclusive)
+    period: float  # the period of the modes q_k = 2 pi k / period: L, or 2 L for the cosine series
 
     @property
     def dq(self) -> float:
-        return TWO_PI / self.length
+        return TWO_PI / self.period
+
+    @property
+    def period_points(self) -> int:
+        """Grid points of one period of the modes (N, or 2 N for the cosine series)."""
+        return int(round(self.period / self.spacing))
 
     @property
     def q_min(self) -> float:
@@ -90,26 +103,33 @@ def resolve_spacing(p, points: int | None = None) -> tuple[float, float]:
 
 
 def resolve_band(p: "PowerLaw.Params", *, spacing: float | None = None, points: int | None = None,
-                 extent: str = "line length L = points * spacing") -> Band:
+                 extent: str = "line length L = points * spacing", series: str = "fft") -> Band:  # fmt: skip
     """Fill in defaults and check the geometry; ValueError (naming the fields) if inconsistent.
 
     A surface passes its resolved ``spacing`` and the ``points`` of its shorter side (the band's
-    longest wave must fit every direction); ``extent`` names that length in messages."""
+    longest wave must fit every direction); ``extent`` names that length in messages. ``series``
+    "cosine": the modes q_k = k pi / L of the non-periodic cosine series (period 2 L)."""
     if spacing is None:
         dx, length = resolve_spacing(p)
         n = p.points
     else:
         n = points
         dx, length = spacing, n * spacing
+    cosine = series == "cosine"
+    period = 2.0 * length if cosine else length
+    if cosine:
+        extent = "period of the cosine series 2 L = 2 * points * spacing"
 
-    long_cutoff = length if p.long_cutoff is None else p.long_cutoff
+    long_cutoff = period if p.long_cutoff is None else p.long_cutoff
     short_cutoff = 10.0 * dx if p.short_cutoff is None else p.short_cutoff
-    long_txt = "long_cutoff" + (f" (default: length = {length!r})" if p.long_cutoff is None else f"={long_cutoff!r}")
+    long_txt = "long_cutoff" + (
+        f" (default: {'2 * length' if cosine else 'length'} = {period!r})" if p.long_cutoff is None else f"={long_cutoff!r}"
+    )
     short_txt = "short_cutoff" + (
         f" (default: 10 * spacing = {short_cutoff!r})" if p.short_cutoff is None else f"={short_cutoff!r}"
     )
-    if long_cutoff > length * (1 + REL_TOL):
-        raise ValueError(f"{long_txt} must not exceed the {extent} = {length!r}")
+    if long_cutoff > period * (1 + REL_TOL):
+        raise ValueError(f"{long_txt} must not exceed the {extent} = {period!r}")
     if short_cutoff < 2.0 * dx * (1 - REL_TOL):
         raise ValueError(
             f"{short_txt} is below the Nyquist wavelength 2 * spacing = {2.0 * dx!r}; "
@@ -127,15 +147,16 @@ def resolve_band(p: "PowerLaw.Params", *, spacing: float | None = None, points: 
             )
         knee = min(max(rolloff, short_cutoff), long_cutoff)
 
-    # mode k has wavelength L / k: keep L / long_cutoff <= k <= L / short_cutoff (inclusive, tolerant)
-    k_lo = max(1, math.ceil(length / long_cutoff * (1 - REL_TOL)))
-    k_hi = min(n // 2, math.floor(length / short_cutoff * (1 + REL_TOL)))
+    # mode k has wavelength P / k (P the period): keep P / long_cutoff <= k <= P / short_cutoff
+    # (inclusive, tolerant), up to the grid's Nyquist wave 2 dx
+    k_lo = max(1, math.ceil(period / long_cutoff * (1 - REL_TOL)))
+    k_hi = min(n if cosine else n // 2, math.floor(period / short_cutoff * (1 + REL_TOL)))
     if k_lo > k_hi:
+        modes = "k pi / L (wavelength 2 L / k" if cosine else "2 pi k / L (wavelength L / k"
         raise ValueError(
-            f"no mode q_k = 2 pi k / L (wavelength L / k, L = {length!r}) lies between "
-            f"{short_txt} and {long_txt}: widen the band"
+            f"no mode q_k = {modes}, L = {length!r}) lies between {short_txt} and {long_txt}: widen the band"
         )
-    return Band(n, dx, length, long_cutoff, short_cutoff, knee, k_lo, k_hi)
+    return Band(n, dx, length, long_cutoff, short_cutoff, knee, k_lo, k_hi, period)
 
 
 def _log_integral(p: float, ln_r: float) -> float:
@@ -214,56 +235,76 @@ def random_phase_line(coeff: np.ndarray, nyquist: float, k_lo: int, points: int,
     return scipy.fft.irfft(spectrum, n=points)  # ~10% faster than numpy here
 
 
+class BandParams(PluginParams):
+    """The parameters every band-limited spectrum shares, lines and surfaces."""
+
+    hurst: float = Field(
+        description="Hurst exponent H: psd ~ q^(-2H-1); 0 <= H <= 1.5 (0 < H <= 1 is usual)",
+        ge=0.0,
+        le=1.5,
+    )
+    points: int = Field(description="number of grid points N", ge=8)
+    spacing: float | None = Field(
+        None, description="grid spacing dx (default 1.0, or length / points); give spacing or length", gt=0.0
+    )
+    length: float | None = Field(
+        None, description="line length L = points * spacing; give spacing or length", gt=0.0
+    )
+    long_cutoff: float | None = Field(
+        None, description="long cut-off wavelength lambda_L = 2 pi / q_min (default: length)", gt=0.0
+    )
+    short_cutoff: float | None = Field(
+        None,
+        description="short cut-off wavelength lambda_s = 2 pi / q_max, >= 2 * spacing (default: 10 * spacing)",
+        gt=0.0,
+    )
+    rms_height: float | None = Field(
+        None, description="rms height h of the line (default 1.0); give rms_height or c0", gt=0.0
+    )
+    c0: float | None = Field(
+        None, description="PSD prefactor C0 in psd = C0 q^(-2H-1); give rms_height or c0", gt=0.0
+    )
+    amplitudes: Literal["fixed", "rayleigh"] = Field(
+        "fixed",
+        description="'fixed': amplitudes sqrt(psd), random phases (the study); "
+        "'rayleigh': complex Gaussian modes (random amplitudes too)",
+    )
+
+    @model_validator(mode="after")
+    def _check_geometry(self):
+        if self.rms_height is not None and self.c0 is not None:
+            raise ValueError(
+                f"rms_height={self.rms_height!r} and c0={self.c0!r} both given: "
+                "give at most one of rms_height and c0"
+            )
+        self.resolve_band()
+        return self
+
+    def resolve_band(self) -> Band:
+        """The band of these parameters (ValueError naming the fields if inconsistent)."""
+        return resolve_band(self)
+
+
+class LineParams(BandParams):
+    """A band-limited line: the shared parameters and the choice of series."""
+
+    series: Literal["fft", "cosine"] = Field(
+        "fft",
+        description="'fft': periodic line, q_k = 2 pi k / L; 'cosine': non-periodic sum of cosines with "
+        "q_k = k pi / L on [0, L) (the study's eq. 6 read literally; long_cutoff defaults to 2 L)",
+    )
+
+    def resolve_band(self) -> Band:
+        return resolve_band(self, series=self.series)
+
+
 class BandLimitedSpectrum(SpectrumGenerator):
     """Shared synthesis of ``power-law`` and ``rolloff`` (not registered itself)."""
 
     references: ClassVar[tuple[str, ...]] = (PERSSON_2005, JACOBS_JUNGE_PASTEWKA_2017)
-    # psd ~ q^below_knee under the knee: 0 (flat) for rolloff; 1 for the MDR-equivalent line of a
-    # rolloff surface, whose C1D = pi q C2D grows with q where C2D is flat
-    below_knee_exponent: ClassVar[float] = 0.0
+    points_param: ClassVar[str | None] = "points"
 
-    class Params(PluginParams):
-        hurst: float = Field(
-            description="Hurst exponent H: psd ~ q^(-2H-1); 0 <= H <= 1.5 (0 < H <= 1 is usual)",
-            ge=0.0,
-            le=1.5,
-        )
-        points: int = Field(description="number of grid points N", ge=8)
-        spacing: float | None = Field(
-            None, description="grid spacing dx (default 1.0, or length / points); give spacing or length", gt=0.0
-        )
-        length: float | None = Field(
-            None, description="line length L = points * spacing; give spacing or length", gt=0.0
-        )
-        long_cutoff: float | None = Field(
-            None, description="long cut-off wavelength lambda_L = 2 pi / q_min (default: length)", gt=0.0
-        )
-        short_cutoff: float | None = Field(
-            None,
-            description="short cut-off wavelength lambda_s = 2 pi / q_max, >= 2 * spacing (default: 10 * spacing)",
-            gt=0.0,
-        )
-        rms_height: float | None = Field(
-            None, description="rms height h of the line (default 1.0); give rms_height or c0", gt=0.0
-        )
-        c0: float | None = Field(
-            None, description="PSD prefactor C0 in psd = C0 q^(-2H-1); give rms_height or c0", gt=0.0
-        )
-        amplitudes: Literal["fixed", "rayleigh"] = Field(
-            "fixed",
-            description="'fixed': amplitudes sqrt(psd), random phases (the study); "
-            "'rayleigh': complex Gaussian modes (random amplitudes too)",
-        )
-
-        @model_validator(mode="after")
-        def _check_geometry(self):
-            if self.rms_height is not None and self.c0 is not None:
-                raise ValueError(
-                    f"rms_height={self.rms_height!r} and c0={self.c0!r} both given: "
-                    "give at most one of rms_height and c0"
-                )
-            resolve_band(self)
-            return self
+    Params = LineParams
 
     # ------------------------------------------------------------ cache
 
@@ -274,12 +315,12 @@ class BandLimitedSpectrum(SpectrumGenerator):
         if cached is not None and cached.key == key:
             return cached
         p = self.params
-        band = resolve_band(p)
-        n, a = band.points, 2.0 * p.hurst + 1.0
+        band = p.resolve_band()
+        a = 2.0 * p.hurst + 1.0
         k = np.arange(band.k_lo, band.k_hi + 1, dtype=np.float64)
         # shape relative to the knee, in (0, 1]: no overflow whatever q_min, H and C0
-        k_knee = band.length / band.knee
-        shape = relative_psd(k / k_knee, 0.5 * a, 0.5 * self.below_knee_exponent)  # a_k / a_knee = sqrt(psd ratio)
+        k_knee = band.period / band.knee
+        shape = relative_psd(k / k_knee, 0.5 * a, 0.0)  # a_k / a_knee = sqrt(psd ratio)
         if p.c0 is not None:
             # psd at the knee = C0 q_knee^(-a), formed in logs (C0 and q_knee may be extreme)
             log_psd_knee = math.log(p.c0) - a * math.log(band.q_knee)
@@ -296,7 +337,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
             psd_knee = (0.5 * scale) ** 2 / band.dq
         if not (math.isfinite(h) and h > 0 and np.all(np.isfinite(amplitudes))):
             raise ValueError(f"c0={p.c0!r} gives amplitudes that are not finite positive numbers")
-        coeff, nyquist = line_coefficients(amplitudes, n, band.k_hi)
+        coeff, nyquist = line_coefficients(amplitudes, band.period_points, band.k_hi)
         self._cache = _Synthesis(key, band, psd_knee, h, coeff, nyquist, amplitudes)
         return self._cache
 
@@ -317,19 +358,37 @@ class BandLimitedSpectrum(SpectrumGenerator):
         s = self._synthesis()
         return math.exp(math.log(s.psd_knee) + (2.0 * self.params.hurst + 1.0) * math.log(s.band.q_knee))
 
+    def hurst_exponent(self) -> float:
+        return float(self.params.hurst)
+
+    def grid_shape(self) -> tuple[int, ...]:
+        return (self.params.points,)
+
+    def refined(self, points: int) -> dict:
+        """The same continuous line on ``points`` points: length and cut-off wavelengths kept."""
+        band = self.band
+        return {"points": points, "length": band.length, "spacing": None,
+                "long_cutoff": band.long_cutoff, "short_cutoff": band.short_cutoff}  # fmt: skip
+
     # ------------------------------------------------------------ contract
 
+    def periodic(self) -> bool:
+        """True, except for the cosine series, whose line is half a period."""
+        return self.params.series == "fft"
+
     def generate(self, rng: np.random.Generator) -> Profile:
-        """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes)."""
+        """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes);
+        the cosine series is the first half of a line of twice the length."""
         s = self._synthesis()
         heights = random_phase_line(
-            s.coeff, s.nyquist, s.band.k_lo, s.band.points, rng, rayleigh=self.params.amplitudes != "fixed"
+            s.coeff, s.nyquist, s.band.k_lo, s.band.period_points, rng, rayleigh=self.params.amplitudes != "fixed"
         )
-        return Profile(heights=heights, spacing=s.band.spacing)
+        return Profile(heights=heights[: s.band.points], spacing=s.band.spacing, periodic=self.periodic())
 
     def rms_height(self) -> float:
-        """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude line,
-        the expectation (sqrt of the expected mean square) for Rayleigh amplitudes."""
+        """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude periodic line,
+        the expectation (sqrt of the expected mean square) for Rayleigh amplitudes and for the
+        cosine series (whose modes are not orthogonal on the line)."""
         return self._synthesis().rms_height
 
     def rms_slope_discrete(self) -> float:
@@ -346,7 +405,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
         b = s.band
         q = np.asarray(q, dtype=np.float64)
         inside = (q >= b.q_min * (1 - REL_TOL)) & (q <= b.q_max * (1 + REL_TOL))
-        shape = relative_psd(q / b.q_knee, 2.0 * self.params.hurst + 1.0, self.below_knee_exponent)
+        shape = relative_psd(q / b.q_knee, 2.0 * self.params.hurst + 1.0, 0.0)
         out = np.where(inside, s.psd_knee * shape, 0.0)
         return out[()] if out.ndim == 0 else out
 
@@ -354,7 +413,7 @@ class BandLimitedSpectrum(SpectrumGenerator):
         """2 * integral_{q_min}^{q_max} q^order psd(q) dq in closed form (order 0 or 2)."""
         s = self._synthesis()
         above = 2.0 * self.params.hurst + 1.0
-        return 2.0 * s.psd_knee * band_integral(s.band, order, above, self.below_knee_exponent)
+        return 2.0 * s.psd_knee * band_integral(s.band, order, above, 0.0)
 
     def rms_height_continuum(self) -> float:
         """sqrt(2 * integral psd dq) over the band: the continuum limit of ``rms_height()``."""

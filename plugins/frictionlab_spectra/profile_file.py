@@ -1,4 +1,4 @@
-"""A measured line as a spectrum generator: ``profile-file`` (SPEC section 2).
+"""A measured line as a spectrum generator: ``profile-file``.
 
 The file holds heights on a uniform grid, optionally with their x positions:
 
@@ -7,11 +7,13 @@ The file holds heights on a uniform grid, optionally with their x positions:
   non-numeric header line (e.g. ``x,z``) before the data is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z.
 
-Like a synthetic line, a measured line is treated as periodic (the engine wraps
-it): its last point is followed by its first. Removing the tilt
-(``detrend="tilt"``) takes out the least-squares line, which is what makes the
-two ends meet for a scan that was not levelled; any remaining step at the
-wrap is part of the profile the solver sees.
+A measured line is not periodic (``periodic: false``, the default): a scan's
+ends do not meet, so no slope is taken across them and solvers of periodic
+lines refuse it. ``periodic: true`` declares a profile whose last point is
+followed by its first (one period of a periodic surface, say); removing the
+tilt (``detrend="tilt"``, the least-squares line) is what can make the ends of
+an unlevelled scan meet, and any step left between them is then part of the
+profile the solver sees.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -48,17 +50,18 @@ class ProfileFile(SpectrumGenerator):
     references: ClassVar[tuple[str, ...]] = ()
 
     class Params(PluginParams):
-        path: str = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z",
-                          min_length=1)
+        path: InputFile = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z; "
+                                "a relative path is taken from the preset file's folder", min_length=1)
         spacing: float | None = Field(
             None,
             description="grid spacing dx; required if the file has only heights, must agree with x otherwise",
             gt=0.0,
         )
         detrend: Literal["none", "mean", "tilt"] = Field(
-            "mean",
-            description="remove nothing, the mean, or the least-squares line (tilt) before use; "
-            "the line is treated as periodic",
+            "mean", description="remove nothing, the mean, or the least-squares line (tilt) before use"
+        )
+        periodic: bool = Field(
+            False, description="whether the line repeats (its last point is followed by its first); a scan does not"
         )
 
     # ------------------------------------------------------------ contract
@@ -66,7 +69,10 @@ class ProfileFile(SpectrumGenerator):
     def generate(self, rng: np.random.Generator) -> Profile:
         """The measured line (a fresh copy each call); ``rng`` is not used."""
         line = self._line()
-        return Profile(heights=line.heights.copy(), spacing=line.spacing)
+        return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=self.params.periodic)
+
+    def periodic(self) -> bool:
+        return self.params.periodic
 
     def rms_height(self) -> float:
         """rms of the detrended line about its mean (with ``detrend="none"`` a constant offset,
@@ -81,7 +87,7 @@ class ProfileFile(SpectrumGenerator):
         if cached is not None and cached.key == key:
             return cached
         p = self.params
-        path = Path(p.path).expanduser()
+        path = Path(p.path)
         x, z = _read_columns(path)
         where = f"profile-file {str(path)!r}"
         if z.size < MIN_POINTS:
@@ -139,7 +145,7 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
 
 def file_suffix(path: Path, where: str) -> str:
     """".npy", ".csv" or ".txt" (lower case) of an existing file; ValueError otherwise."""
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"{where}: no such file")
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv", ".txt"):
@@ -147,42 +153,77 @@ def file_suffix(path: Path, where: str) -> str:
     return suffix
 
 
+def _open(path: Path, where: str):
+    """The file opened for reading if it is a regular file (never a FIFO or a device)."""
+    try:
+        return open_regular_file(path)
+    except InputFileProblem as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
 def load_npy(path: Path, where: str) -> np.ndarray:
     """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
-    try:
-        data = np.load(path, allow_pickle=False)
-    except Exception as exc:  # corrupt file, pickled objects, ...
-        raise ValueError(f"{where}: not a readable .npy array ({exc})") from None
+    with _open(path, where) as fh:
+        try:
+            data = np.load(fh, allow_pickle=False)
+        except Exception as exc:  # corrupt file, pickled objects, ...: named, never quoted
+            raise ValueError(f"{where}: not a readable .npy array ({type(exc).__name__})") from None
     if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
     return data
 
 
-def read_text_table(path: Path, where: str) -> np.ndarray:
-    """Rows x columns of float64; one non-numeric header line is skipped."""
-    skip, delimiter = 0, None
+def _numbers(text: str, delimiter: str | None) -> bool:
     try:
-        with path.open() as fh:
-            for lineno, line in enumerate(fh, start=1):
-                text = line.split("#", 1)[0].strip()
-                if not text:
-                    continue
-                delimiter = "," if "," in text else None
-                try:
-                    [float(tok) for tok in text.split(delimiter)]
-                except ValueError:
-                    skip = lineno  # a header such as "x,z"
-                break
+        [float(token) for token in text.split(delimiter)]
+    except ValueError:
+        return False
+    return True
+
+
+def read_text_table(path: Path, where: str) -> np.ndarray:
+    """Rows x columns of float64; one non-numeric header line is skipped. A
+    problem names the line, never its content."""
+    with _open(path, where) as fh:
+        raw = fh.read()
+    try:
+        lines = raw.decode("utf-8").splitlines()
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line})") from None
+    skip, delimiter = 0, None
+    for lineno, line in enumerate(lines, start=1):
+        text = line.split("#", 1)[0].strip()
+        if text:
+            delimiter = "," if "," in text else None
+            skip = 0 if _numbers(text, delimiter) else lineno  # a header such as "x,z"
+            break
+    try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
-            data = np.loadtxt(path, dtype=np.float64, delimiter=delimiter, comments="#", skiprows=skip, ndmin=2)
-    except UnicodeDecodeError:
-        raise ValueError(f"{where}: not a text file") from None
-    except ValueError as exc:
-        raise ValueError(f"{where}: non-numeric content ({exc})") from None
+            data = np.loadtxt(lines[skip:], dtype=np.float64, delimiter=delimiter, comments="#", ndmin=2)
+    except ValueError:
+        raise ValueError(f"{where}: {_first_bad_line(lines, skip, delimiter)}") from None
     if data.size == 0:
         data = np.zeros((0, 1))
     return data
+
+
+def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
+    """Where a table stops being one: the first line that is not numbers, or
+    whose column count differs from the first data line's."""
+    columns = None
+    for lineno, line in enumerate(lines[skip:], start=skip + 1):
+        text = line.split("#", 1)[0].strip()
+        if not text:
+            continue
+        if not _numbers(text, delimiter):
+            return f"non-numeric content at line {lineno} (expected numbers separated by {delimiter or 'spaces'})"
+        count = len(text.split(delimiter))
+        if columns is not None and count != columns:
+            return f"line {lineno} has {count} columns, the lines before it {columns}"
+        columns = count
+    return "not a table of numbers"
 
 
 def check_finite(where: str, what: str, values: np.ndarray) -> None:

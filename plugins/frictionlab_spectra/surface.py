@@ -12,10 +12,8 @@ Conventions
   (no 2 pi factors): <z^2> = integral of C2D over the whole q plane
   = 2 pi integral_0^inf q C2D(q) dq, and <|grad z|^2> = 2 pi integral q^3 C2D dq.
   With this convention the MDR rule C1D(q) = pi q C2D(q) keeps both moments:
-  2 integral pi q C2D dq = 2 pi integral q C2D dq (and likewise with q^2). That is the
-  continuum: on the grid the line (1.128 times the side) has its lowest mode below the
-  band when long_cutoff is the side, so ``equivalent_line()`` then misses the longest
-  wave (README, "Known limit" under the MDR mapping; not yet fixed).
+  2 integral pi q C2D dq = 2 pi integral q C2D dq (and likewise with q^2);
+  ``equivalent_line()`` keeps them on the grids too (``equivalent_line.py``).
 - Every mode q of the plane with q_min <= |q| <= q_max (edges inclusive to a relative
   1e-9) has variance a_q^2 = C2D(|q|) dqx dqy; the surface is real (modes q and -q are
   conjugate), so <z> = 0 and, for fixed amplitudes, mean(z^2) = sum_q a_q^2 exactly.
@@ -34,10 +32,11 @@ from typing import ClassVar
 
 import numpy as np
 import scipy.fft
-from pydantic import Field, model_validator
+from pydantic import Field
 
 from frictionlab import Profile, SpectrumGenerator
 
+from .equivalent_line import EquivalentLine
 from .power_law import (
     JACOBS_JUNGE_PASTEWKA_2017,
     PERSSON_2005,
@@ -45,15 +44,12 @@ from .power_law import (
     SQRT_HALF,
     TWO_PI,
     Band,
-    BandLimitedSpectrum,
+    BandParams,
     band_integral,
     relative_psd,
     resolve_band,
     resolve_spacing,
 )
-
-MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
-GEIKE_POPOV_2007 = "10.1103/PhysRevE.76.036710"  # MDR mapping of a random rough surface
 
 
 def _surface_band(p) -> tuple[Band, int, int]:
@@ -97,8 +93,9 @@ class BandLimitedSurface(SpectrumGenerator):
 
     dimension: ClassVar[int] = 2
     references: ClassVar[tuple[str, ...]] = (PERSSON_2005, JACOBS_JUNGE_PASTEWKA_2017)
+    points_param: ClassVar[str | None] = "points"
 
-    class Params(BandLimitedSpectrum.Params):
+    class Params(BandParams):
         hurst: float = Field(
             description="Hurst exponent H: C2D ~ q^(-2H-2); 0 <= H <= 1.5 (0 < H <= 1 is usual)", ge=0.0, le=1.5
         )
@@ -119,15 +116,8 @@ class BandLimitedSurface(SpectrumGenerator):
             None, description="PSD prefactor C0 in C2D = C0 q^(-2H-2); give rms_height or c0", gt=0.0
         )
 
-        @model_validator(mode="after")
-        def _check_geometry(self):  # overrides the line's check: the band lives on the shorter side
-            if self.rms_height is not None and self.c0 is not None:
-                raise ValueError(
-                    f"rms_height={self.rms_height!r} and c0={self.c0!r} both given: "
-                    "give at most one of rms_height and c0"
-                )
-            _surface_band(self)
-            return self
+        def resolve_band(self) -> Band:  # the band lives on the shorter side
+            return _surface_band(self)[0]
 
     # ------------------------------------------------------------ cache
 
@@ -189,10 +179,22 @@ class BandLimitedSurface(SpectrumGenerator):
         """Resolved spacing and cut-offs (``band.length`` is the shorter side)."""
         return self._synthesis().band
 
-    @property
     def grid_shape(self) -> tuple[int, int]:
         """(Ny, Nx) of a generated surface."""
         return self._synthesis().shape
+
+    def hurst_exponent(self) -> float:
+        return float(self.params.hurst)
+
+    def refined(self, points: int) -> dict:
+        """The same continuous surface on ``points`` pixels per side (``points_y`` in proportion):
+        side and cut-off wavelengths kept."""
+        band, (ny, nx) = self.band, self.grid_shape()
+        changes = {"points": points, "length": nx * band.spacing, "spacing": None,
+                   "long_cutoff": band.long_cutoff, "short_cutoff": band.short_cutoff}  # fmt: skip
+        if self.params.points_y is not None:
+            changes["points_y"] = max(8, round(points * ny / nx))
+        return changes
 
     def c0(self) -> float:
         """The C2D prefactor C0 in use (given, or implied by ``rms_height``)."""
@@ -257,31 +259,17 @@ class BandLimitedSurface(SpectrumGenerator):
 
     # ------------------------------------------------------------ MDR
 
-    def equivalent_line(self) -> "EquivalentLine":
-        """The MDR-equivalent line (SPEC section 7): C1D(q) = pi q C2D(q) over the same band,
-        same spacing, N = round(2 sqrt(Nx Ny / pi)) points, so its length N dx is
-        L = 2 sqrt(A / pi) to within dx / 2.
-
-        It is normalised the way this surface is: with ``c0`` given, C1D = pi q C2D exactly
-        (so the continuum rms heights and slopes of line and surface are equal); otherwise to
-        the same nominal rms height ``rms_height()`` (the h of f), each exact for its own modes.
-        """
-        p = self.params
-        band, (ny, nx) = self.band, self.grid_shape
-        params = dict(
-            hurst=p.hurst,
-            points=int(round(2.0 * math.sqrt(nx * ny / math.pi))),
-            spacing=band.spacing,
-            long_cutoff=band.long_cutoff,
-            short_cutoff=band.short_cutoff,
-            amplitudes=p.amplitudes,
-            rolloff_wavelength=band.knee if band.knee < band.long_cutoff else None,
-        )
-        if p.c0 is not None:
-            params["c0"] = math.pi * p.c0  # pi q C0 q^(-2H-2) = (pi C0) q^(-2H-1)
-        else:
-            params["rms_height"] = self.rms_height()
-        return EquivalentLine(**params)
+    def equivalent_line(self) -> EquivalentLine:
+        """The MDR-equivalent line: length 2 sqrt(A / pi), each of its modes carrying the
+        power of this surface's modes around it (``equivalent_line.py``), so that it keeps the
+        surface's mean square height and mean square gradient; same amplitudes option, scaled
+        to ``rms_height()`` (the h of f)."""
+        s = self._synthesis()
+        ny, nx = s.shape
+        return EquivalentLine.of_surface(
+            area=nx * ny * s.band.spacing**2, spacing=s.band.spacing, wavenumber=s.wavenumber,
+            power=s.weight * s.amplitude**2, rms_height=s.rms_height, amplitudes=self.params.amplitudes,
+        )  # fmt: skip
 
 
 class PowerLawSurface(BandLimitedSurface):
@@ -309,20 +297,4 @@ class RolloffSurface(BandLimitedSurface):
             description="rolloff wavelength lambda_r = 2 pi / q_r, between short_cutoff and long_cutoff; "
             "C2D is flat for longer waves",
             gt=0.0,
-        )
-
-
-class EquivalentLine(BandLimitedSpectrum):
-    """The MDR-equivalent line of a band-limited surface (made by ``equivalent_line()``, not
-    named in presets): C1D = pi q C2D, i.e. C0' q^(-2H-1) above the knee and growing like q
-    below it, where C2D is flat."""
-
-    name: ClassVar[str] = "mdr-equivalent-line"
-    summary: ClassVar[str] = "MDR-equivalent line of a 2D surface: C1D(q) = pi q C2D(q), L = 2 sqrt(A / pi)"
-    references: ClassVar[tuple[str, ...]] = (MDR_BOOK, GEIKE_POPOV_2007)
-    below_knee_exponent: ClassVar[float] = 1.0
-
-    class Params(BandLimitedSpectrum.Params):
-        rolloff_wavelength: float | None = Field(
-            None, description="the surface's rolloff wavelength (none: pure power law)", gt=0.0
         )

@@ -59,6 +59,8 @@ class Gaussian(SpectrumGenerator):
     name = "gaussian"
     summary = "Gaussian-correlated random line: random phases, fixed amplitudes, exact rms height"
     references = ("10.1088/0953-8984/17/1/R01",)  # Persson et al. 2005, rough-surface spectra
+    # What frictionlab may use besides generate() and rms_height() (see frictionlab.plugin):
+    points_param = "points"  # named in memory advice ("spectrum.params.points <= ...")
 
     class Params(PluginParams):
         points: int = Field(1024, ge=8, le=2**24, description="Number of grid points N of the periodic line.")
@@ -85,6 +87,17 @@ class Gaussian(SpectrumGenerator):
         """sqrt(2) h / xi, of the continuous spectrum (the discrete line approaches
         it for dx << xi << L)."""
         return math.sqrt(2.0) * self.params.rms_height / self.params.correlation_length
+
+    # ------------------------------------------------------------ declarations
+
+    def grid_shape(self) -> tuple[int, ...]:
+        """The shape of every line, known without generating one (memory estimates)."""
+        return (self.params.points,)
+
+    def refined(self, points: int) -> dict:
+        """The same line (length, correlation length) sampled on ``points`` points."""
+        length = self.params.points * self.params.spacing
+        return {"points": points, "spacing": length / points}
 
     # ------------------------------------------------------------ the line
 

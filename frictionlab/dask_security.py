@@ -1,0 +1,130 @@
+"""Who can reach the Dask cluster a run uses.
+
+Anyone who can connect to a Dask scheduler can run code as the user of its
+workers. So:
+
+* without ``--scheduler``, frictionlab starts its own cluster on 127.0.0.1
+  over TLS, with a certificate authority and keys made for this run alone
+  (``distributed.Security.temporary()``, kept in memory): another user of the
+  machine can reach the port but cannot complete the handshake. Its HTTP
+  servers (scheduler and workers) serve nothing unless the dashboard is asked
+  for (``--dashboard``, on 127.0.0.1 only).
+* with ``--scheduler``, the connection uses Dask's own TLS settings (the
+  ``distributed.comm.tls.*`` configuration, or ``--tls-ca-file``,
+  ``--tls-cert``, ``--tls-key``); a ``tls://`` address needs them. An address
+  that is neither loopback nor TLS gets a warning.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+import warnings
+from urllib.parse import urlsplit
+
+from .errors import FrictionlabError, RunError, short_repr
+
+DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+ENCRYPTED = ("tls", "wss")
+
+
+def import_distributed():
+    try:
+        import distributed
+    except ImportError:
+        raise FrictionlabError(DASK_MISSING) from None
+    return distributed
+
+
+def use_tls_files(ca_file: str | None = None, cert: str | None = None, key: str | None = None) -> None:
+    """Set Dask's TLS configuration for this process (what ``--tls-*`` give)."""
+    import dask
+
+    given = {"ca-file": ca_file, "client.cert": cert, "client.key": key}
+    dask.config.set({f"distributed.comm.tls.{name}": value for name, value in given.items() if value})
+
+
+def check_address(address: str) -> str:
+    """``address`` if it is a scheduler address (``tcp://HOST:PORT``,
+    ``tls://HOST:PORT``, or ``HOST:PORT`` for tcp); warns when it is neither
+    loopback nor encrypted."""
+    scheme, sep, _ = address.partition("://")
+    scheme = scheme if sep else "tcp"
+    try:
+        host = urlsplit(address if sep else f"tcp://{address}").hostname
+    except ValueError:
+        host = None
+    if scheme not in SCHEMES or not host:
+        raise FrictionlabError(
+            f"--scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. Got {short_repr(address)} instead."
+        )
+    if scheme not in ENCRYPTED and not _loopback(host):
+        warnings.warn(
+            f"the Dask scheduler at {address} is reached without TLS: anyone who can reach that address can run "
+            "code as the user of its workers; use a tls:// address (see --tls-ca-file, --tls-cert, --tls-key)",
+            stacklevel=2,
+        )
+    return address
+
+
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def connect_scheduler(address: str):
+    """A ``distributed.Client`` on the scheduler at ``address`` with Dask's TLS
+    configuration, or a RunError that says why not."""
+    distributed = import_distributed()
+    check_address(address)
+    try:
+        return distributed.Client(address, timeout="10s", security=distributed.Security())
+    except Exception as exc:  # refused, timed out, a TLS handshake or configuration that fails, ...
+        reason = f"{type(exc).__name__}: {exc}"
+        if address.startswith("tls://") and "ssl_context" in reason:
+            reason = "a tls:// scheduler needs TLS certificates: give --tls-ca-file, --tls-cert and --tls-key"
+        raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}") from None
+
+
+def start_local_cluster(workers: int, dashboard: bool = False):
+    """This user's own ``LocalCluster`` of ``workers`` single-thread processes on
+    127.0.0.1 over TLS with credentials made now, and a client of it. Returns
+    ``(client, cluster)``."""
+    import dask
+
+    distributed = import_distributed()
+    try:
+        security = distributed.Security.temporary()
+    except ImportError:
+        raise FrictionlabError(
+            'the local Dask cluster is reached over TLS, which needs the cryptography package: '
+            'pip install "frictionlab[dask]"'
+        ) from None
+    routes = {} if dashboard else {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
+    with dask.config.set(routes):
+        cluster = distributed.LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            protocol="tls://",
+            security=security,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # loopback, any free port
+            silence_logs=logging.ERROR,
+        )
+    try:
+        client = distributed.Client(cluster, security=security)
+    except BaseException:
+        cluster.close()
+        raise
+    if dashboard:
+        import sys
+
+        print(f"Dask dashboard: {cluster.dashboard_link}", file=sys.stderr, flush=True)
+    return client, cluster

@@ -1,0 +1,133 @@
+"""Input files: presets and the data files plugins read (measured profiles,
+surfaces).
+
+Only regular files are read, so a FIFO or a device never blocks a run; a file
+is opened without blocking and checked on its open descriptor, so it cannot be
+swapped between the check and the read. Messages name the file and a line,
+never its content.
+
+A plugin parameter that names a file is declared ``InputFile``: the framework
+then resolves a relative path in a preset against the preset's folder, checks
+the file exists when the preset is validated, and records its SHA-256 in the
+run folder so that a resume refuses a file that changed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import stat
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import AfterValidator
+
+
+class InputFileProblem(ValueError):
+    """A file that cannot be read as input; the message names the file, not its content."""
+
+
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def file_kind(mode: int) -> str:
+    """What a non-regular file is, in words."""
+    return next((name for test, name in _KINDS if test(mode)), "not a regular file")
+
+
+def regular_file_problem(path: str | Path) -> str | None:
+    """Why ``path`` is not an existing regular file (from ``stat``, which never
+    blocks), or None."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "no such file"
+    except NotADirectoryError:
+        return "no such file (a parent of it is a file)"
+    except PermissionError:
+        return "permission denied"
+    except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
+        return f"cannot be read ({getattr(exc, 'strerror', None) or type(exc).__name__})"
+    return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, not a regular file"
+
+
+def open_regular_file(path: str | Path, what: str = "file"):
+    """``path`` opened for binary reading, once it is known to be a regular file
+    (opened without blocking, checked on the open descriptor); InputFileProblem
+    otherwise. The message says what is wrong (``no such <what>``, ``is a FIFO
+    ...``); the caller says where."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
+    except (FileNotFoundError, NotADirectoryError):
+        raise InputFileProblem(f"no such {what}") from None
+    except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
+        reason = getattr(exc, "strerror", None) or "cannot be opened"
+        raise InputFileProblem(f"{what} cannot be read: {reason[:1].lower() + reason[1:]}") from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise InputFileProblem(f"{what} is {file_kind(mode)}, not a regular file")
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def read_regular_file(path: str | Path, limit: int | None = None, what: str = "file") -> bytes:
+    """The bytes of the regular file ``path`` (see ``open_regular_file``), refused
+    by its size before anything is read when it is over ``limit`` bytes."""
+    with open_regular_file(path, what) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if limit is not None and size > limit:
+            raise InputFileProblem(f"{what} of {size:,} bytes, more than the limit of {limit:,} bytes")
+        data = fh.read() if limit is None else fh.read(limit + 1)
+    if limit is not None and len(data) > limit:  # it grew while read
+        raise InputFileProblem(f"{what} of more than the limit of {limit:,} bytes")
+    return data
+
+
+def sha256_of(path: str | Path) -> str:
+    """SHA-256 (hex) of the regular file ``path``, read in blocks."""
+    digest = hashlib.sha256()
+    with open_regular_file(path) as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+# ------------------------------------------------------------------ plugin parameters
+
+
+class _InputFileMarker:
+    """Metadata of a plugin parameter that names an input file."""
+
+    def __repr__(self) -> str:
+        return "InputFile"
+
+
+INPUT_FILE_MARKER = _InputFileMarker()
+
+
+def _absolute_path(value: str) -> str:
+    if any(ord(c) < 32 or ord(c) == 127 for c in value):
+        raise ValueError("must not contain control characters (NUL, newline, tab, ...)")
+    return os.path.abspath(os.path.expanduser(value))
+
+
+InputFile = Annotated[str, INPUT_FILE_MARKER, AfterValidator(_absolute_path)]
+"""A parameter that names an input file: stored as an absolute path (a
+relative one is taken from the current folder, or from the preset's folder
+when it was written in a preset file)."""
+
+
+def input_fields(params_model) -> list[str]:
+    """Names of the ``InputFile`` parameters of a plugin's ``Params`` model."""
+    return [name for name, field in params_model.model_fields.items() if INPUT_FILE_MARKER in field.metadata]
+
+
+def is_relative(value) -> bool:
+    return isinstance(value, str) and bool(value) and not os.path.isabs(os.path.expanduser(value))

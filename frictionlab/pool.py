@@ -1,0 +1,171 @@
+"""A pool of worker processes that notices a worker's death at any moment.
+
+``concurrent.futures.ProcessPoolExecutor`` sends every worker's results
+through one shared queue: a worker killed while it writes its result leaves
+half a message in the queue (and the queue's write lock taken), and the pool
+waits for the rest forever. Here each worker has a pipe of its own for its
+results, and the parent holds no copy of its write end: a worker that dies
+mid-send is an end of file on its own pipe, seen at once, like a death at any
+other moment (its process sentinel). Its job is then given to a fresh worker,
+a bounded number of times.
+"""
+
+from __future__ import annotations
+
+import pickle
+import signal
+from collections import Counter, deque
+from collections.abc import Callable, Hashable, Iterator
+from multiprocessing.connection import wait
+
+WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
+ERROR_CHARS = 500  # an error carried back from a worker is cut to this
+
+
+class WorkerLost(Exception):
+    """A job whose worker died more often than ``retries`` allows."""
+
+    def __init__(self, key: Hashable, deaths: int, how: str):
+        super().__init__(f"{deaths} deaths, the last {how}")
+        self.key, self.deaths, self.how = key, deaths, how
+
+
+class JobFailed(Exception):
+    """The job raised in its worker (not a death: retrying would fail again)."""
+
+    def __init__(self, key: Hashable, error: str):
+        super().__init__(error)
+        self.key, self.error = key, error
+
+
+def _serve(tasks, results, initializer, initargs, function) -> None:
+    """A worker: run each job received on ``tasks``, send back ``("ok", result)``
+    or ``("error", text)`` on ``results``; stop on None or when ``tasks`` closes."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C and SIGTERM are the parent's to handle:
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it lets running jobs finish, then stops workers
+    if initializer is not None:
+        initializer(*initargs)
+    while True:
+        try:
+            job = tasks.recv()
+        except EOFError:
+            return
+        if job is None:
+            return
+        try:
+            reply = pickle.dumps(("ok", function(job)), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # the job raised, or its result does not pickle
+            reply = pickle.dumps(("error", f"{type(exc).__name__}: {exc}"[:ERROR_CHARS]))
+        results.send_bytes(reply)
+
+
+def _how(exitcode: int | None) -> str:
+    if exitcode is None:
+        return "still running"
+    if exitcode < 0:
+        try:
+            return f"killed by {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"exit code {exitcode}"
+
+
+class _Worker:
+    def __init__(self, context, initializer, initargs, function):
+        task_read, self.tasks = context.Pipe(duplex=False)
+        self.results, result_write = context.Pipe(duplex=False)
+        self.process = context.Process(
+            target=_serve, args=(task_read, result_write, initializer, initargs, function), daemon=True
+        )
+        self.process.start()
+        task_read.close()  # the worker's ends: the parent keeps none, so a dead
+        result_write.close()  # worker's pipe reaches end of file
+        self.job: Hashable | None = None
+
+    def give(self, key: Hashable, payload) -> bool:
+        """Send a job; False if the worker is already gone."""
+        try:
+            self.tasks.send(payload)
+        except (BrokenPipeError, ConnectionResetError, OSError):
+            return False
+        self.job = key
+        return True
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Ask it to stop, and kill it if it has not within ``timeout`` (at once for 0)."""
+        try:
+            self.tasks.send(None)
+        except OSError:
+            pass
+        if timeout:
+            self.process.join(timeout)
+        if self.process.is_alive():
+            self.process.kill()
+            self.process.join()
+        self.tasks.close()
+        self.results.close()
+
+
+class WorkerPool:
+    """``size`` worker processes started from ``context``, each running
+    ``initializer(*initargs)`` once, then ``function(payload)`` per job."""
+
+    def __init__(self, size: int, context, function: Callable, initializer=None, initargs=(), retries: int = 2):
+        self.size, self.context, self.function = max(1, size), context, function
+        self.initializer, self.initargs, self.retries = initializer, initargs, retries
+
+    def _start(self) -> _Worker:
+        return _Worker(self.context, self.initializer, self.initargs, self.function)
+
+    def run(self, jobs: dict[Hashable, object], cancel) -> Iterator[tuple[Hashable, object]]:
+        """Yield ``(key, result)`` as each job finishes. After ``cancel.set()``
+        no job starts; running ones finish and are yielded. A job whose worker
+        dies runs again on a fresh worker, at most ``retries`` more times
+        (then WorkerLost); a job that raises ends the run (JobFailed)."""
+        pending = deque(jobs)
+        deaths: Counter = Counter()
+        workers: list[_Worker] = []
+        try:
+            while True:
+                if cancel.is_set():
+                    pending.clear()
+                while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
+                    worker = next((w for w in workers if w.job is None), None)
+                    if worker is None:
+                        worker = self._start()
+                        workers.append(worker)
+                    key = pending.popleft()
+                    if not worker.give(key, jobs[key]):  # it died idle: no charge to the job
+                        pending.appendleft(key)
+                        workers.remove(worker)
+                        worker.stop(0)
+                busy = [w for w in workers if w.job is not None]
+                if not busy:
+                    return
+                ready = set(wait([w.results for w in busy] + [w.process.sentinel for w in workers], WAIT_SECONDS))
+                for worker in list(workers):
+                    died = worker.process.sentinel in ready
+                    if worker.job is not None and worker.results in ready:
+                        try:
+                            status, value = pickle.loads(worker.results.recv_bytes())
+                        except (EOFError, OSError):  # it died while sending: half a message, then end of file
+                            died = True
+                        else:
+                            key, worker.job = worker.job, None
+                            if status == "error":
+                                raise JobFailed(key, value)
+                            yield key, value
+                            continue  # had it died too, its sentinel stays ready for the next round
+                    if died:
+                        workers.remove(worker)
+                        worker.stop()  # it has ended, or ends now (its pipe is closed)
+                        if worker.job is not None:
+                            deaths[worker.job] += 1
+                            if deaths[worker.job] > self.retries:
+                                raise WorkerLost(worker.job, deaths[worker.job], _how(worker.process.exitcode))
+                            if not cancel.is_set():
+                                pending.appendleft(worker.job)
+        finally:  # idle workers stop; busy ones (an error or an interrupt got here) are killed
+            for worker in workers:
+                worker.stop(0 if worker.job is not None else 2.0)
+

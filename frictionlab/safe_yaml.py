@@ -1,0 +1,157 @@
+"""YAML for presets, read with limits a hostile file cannot get past.
+
+``yaml.safe_load`` builds no arbitrary objects, but it accepts an alias bomb
+(a few lines whose aliases expand to billions of values), nesting deep enough
+to exhaust the stack, recursive aliases, and it keeps the last of two equal
+keys without a word. Here the document is composed into nodes first, with
+its nesting bounded; the nodes are then measured with aliases expanded (in
+time proportional to the file, not to the expansion), duplicate keys are
+refused, and only then are Python objects built.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import yaml
+
+MAX_DEPTH = 64  # presets nest four or five levels
+MAX_VALUES = 20_000  # scalars, lists and mappings once aliases are expanded (a preset has ~50)
+
+
+class YamlProblem(ValueError):
+    """A document that is not valid YAML, or breaks a rule of presets
+    (duplicate key). The message names a line, never the content."""
+
+
+class YamlLimit(YamlProblem):
+    """A document beyond the limits (nesting, expanded size, recursive aliases)."""
+
+
+def _line(node_or_mark) -> int:
+    mark = getattr(node_or_mark, "start_mark", node_or_mark)
+    return mark.line + 1 if mark is not None else 0
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """SafeLoader that refuses nesting deeper than MAX_DEPTH while composing
+    (the composer recurses once per level)."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+        self._nodes = 0
+
+    def compose_node(self, parent, index):
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                raise YamlLimit(
+                    f"nested more than {MAX_DEPTH} levels deep at line {_line(self.peek_event())}"
+                )
+            self._nodes += 1  # aliases count too: composing stops early on a long file
+            if self._nodes > MAX_VALUES:
+                raise YamlLimit(f"more than {MAX_VALUES:,} values (at line {_line(self.peek_event())})")
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
+def _children(node) -> list:
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    if isinstance(node, yaml.MappingNode):
+        return [part for pair in node.value for part in pair]
+    return []
+
+
+def _duplicate_key(node: yaml.MappingNode, path: str) -> str | None:
+    seen: dict[tuple[str, str], int] = {}
+    for key, _ in node.value:
+        if not isinstance(key, yaml.ScalarNode) or key.tag == "tag:yaml.org,2002:merge":
+            continue
+        ident = (key.tag, key.value)
+        if ident in seen:
+            where = f"{path}: " if path else ""
+            name = key.value if len(key.value) <= 40 else key.value[:37] + "..."
+            return f"{where}duplicate key {name!r} at lines {seen[ident]} and {_line(key)}"
+        seen[ident] = _line(key)
+    return None
+
+
+def check_nodes(root) -> None:
+    """Refuse recursive aliases, more than MAX_VALUES values once aliases are
+    expanded, and duplicate keys. Each node is visited once (iterative
+    depth-first walk: aliases can chain deeper than the stack)."""
+    size: dict[int, int] = {}  # expanded size of each finished node
+    open_nodes: set[int] = set()  # the nodes on the current path
+    paths: dict[int, str] = {id(root): ""}
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, leaving = stack.pop()
+        key = id(node)
+        if leaving:
+            open_nodes.discard(key)
+            total = 1 + sum(size[id(child)] for child in _children(node))
+            if total > MAX_VALUES:
+                raise YamlLimit(
+                    f"the value at line {_line(node)} expands to more than {MAX_VALUES:,} values "
+                    "(aliases repeat what they refer to)"
+                )
+            size[key] = total
+            if isinstance(node, yaml.MappingNode):
+                duplicate = _duplicate_key(node, paths.get(key, ""))
+                if duplicate:
+                    raise YamlProblem(duplicate)
+            continue
+        if key in size:
+            continue
+        if key in open_nodes:
+            raise YamlLimit(f"an alias at line {_line(node)} refers to a value that contains it (a recursive value)")
+        open_nodes.add(key)
+        stack.append((node, True))
+        if isinstance(node, yaml.MappingNode):
+            base = paths.get(key, "")
+            for name, value in node.value:
+                if isinstance(name, yaml.ScalarNode):
+                    paths.setdefault(id(value), f"{base}.{name.value}" if base else str(name.value))
+        for child in reversed(_children(node)):
+            if id(child) in open_nodes:
+                raise YamlLimit(
+                    f"an alias at line {_line(child)} refers to a value that contains it (a recursive value)"
+                )
+            if id(child) not in size:
+                stack.append((child, False))
+
+
+def load_yaml(text: str) -> Any:
+    """The single YAML document in ``text`` as Python objects (None if empty).
+    YamlLimit / YamlProblem name a line and never quote the text."""
+    try:
+        loader = _BoundedLoader(text)  # checks every character first
+    except yaml.reader.ReaderError as exc:  # a control character such as NUL
+        line = text.count("\n", 0, exc.position) + 1
+        raise YamlProblem(f"not valid YAML at line {line}: character #x{exc.character:04x} is not allowed") from None
+    try:
+        try:
+            root = loader.get_single_node()
+        except yaml.MarkedYAMLError as exc:
+            mark = exc.problem_mark or exc.context_mark
+            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+            problem = (exc.problem or exc.context or "syntax error")[:80]
+            raise YamlProblem(f"not valid YAML{where}: {problem}") from None
+        except yaml.YAMLError:
+            raise YamlProblem("not valid YAML") from None
+        if root is None:
+            return None
+        check_nodes(root)
+        try:
+            return loader.construct_document(root)
+        except yaml.MarkedYAMLError as exc:
+            mark = exc.problem_mark or exc.context_mark
+            where = f" at line {mark.line + 1}" if mark else ""
+            raise YamlProblem(f"a value YAML cannot read{where}: {exc.problem or 'bad value'}") from None
+        except (ValueError, OverflowError) as exc:  # a date like 2020-13-45, an int past Python's digit limit
+            raise YamlProblem(f"a value YAML cannot convert ({type(exc).__name__})") from None
+    finally:
+        loader.dispose()

@@ -1,0 +1,83 @@
+"""Ctrl-C (SIGINT) and SIGTERM end a run the same way: the first one lets the
+running chunks finish and be kept, the run ends "interrupted" and its folder
+can be resumed; a second one interrupts at once. The exit code says which
+signal it was (130 or 143).
+
+Signal handlers live in the main thread only; the TUI, which runs the engine
+in a worker thread, cancels through its own event instead.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+
+from .errors import ExitCode
+
+HANDLED = (signal.SIGINT, signal.SIGTERM)
+received: list[int] = []  # the signals that ended work in this process, in order
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where Ctrl-C raises KeyboardInterrupt (so every path that
+    keeps finished work on Ctrl-C keeps it on SIGTERM too)."""
+
+
+def _raise_for(signum: int):
+    received.append(signum)
+    raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def interrupted_exit_code() -> ExitCode:
+    """TERMINATED if a SIGTERM ended the work, else INTERRUPTED."""
+    return ExitCode.TERMINATED if signal.SIGTERM in received else ExitCode.INTERRUPTED
+
+
+class RaiseOnSigterm:
+    """While a command runs: SIGTERM raises Terminated (as Ctrl-C raises
+    KeyboardInterrupt outside a run); earlier signals are forgotten, and the
+    previous handler comes back at the end."""
+
+    def __enter__(self):
+        received.clear()
+        self.previous = None
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGTERM, lambda signum, frame: _raise_for(signum))
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGTERM, self.previous)
+        return False
+
+
+class CancelOnSignals:
+    """While a run goes on: the first SIGINT or SIGTERM sets ``cancel`` (running
+    work finishes and is kept); a second one raises KeyboardInterrupt or
+    Terminated. Only in the main thread, where signals land."""
+
+    def __init__(self, cancel):
+        self.cancel = cancel
+        self.signal: int | None = None  # the first one received
+        self.previous: dict[int, object] = {}
+
+    @property
+    def pressed(self) -> bool:
+        return self.signal is not None
+
+    def _handle(self, signum, frame):
+        if self.signal is not None:
+            _raise_for(signum)
+        received.append(signum)
+        self.signal = signum
+        self.cancel.set()
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {signum: signal.signal(signum, self._handle) for signum in HANDLED}
+        return self
+
+    def __exit__(self, *exc):
+        for signum, handler in self.previous.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+        return False

@@ -1,0 +1,235 @@
+"""Fault injection: a pool worker killed while it sends its result, SIGTERM in
+the middle of a run, and chunk files damaged in every way we could think of.
+Each time the run ends (or resumes) to exactly the numbers of an
+uninterrupted run, bit for bit, and never counts a realization twice."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab import engine
+from frictionlab.preset import build_scene
+from frictionlab.runner import run_to_folder
+
+from .conftest import ROOT, SMALL_PRESET, merge
+from .test_resume import KILL_PRESET, NO_PLOT, CancelAfter, same_files
+
+# ------------------------------------------------------------------ a worker killed mid-send
+
+MID_SEND_SCRIPT = """
+import json, os, sys
+import numpy as np
+from frictionlab import engine
+from frictionlab.preset import build_scene
+from frictionlab.registry import Registry
+from tests.conftest import SMALL_PRESET, merge
+from tests.faults import MidSendKiller, with_spectrum
+
+scene = build_scene(merge(SMALL_PRESET, {"realizations": 24}), registry=Registry(discover=False))
+killer = with_spectrum(scene, MidSendKiller, flag=sys.argv[1], parent=os.getpid())
+outcome = engine.run(killer, workers=2, executor="processes")
+np.save(sys.argv[2], outcome.per_realization["xi"])
+print(json.dumps({"status": outcome.status, "done": outcome.done, "a": outcome.fit.a, "b": outcome.fit.b}))
+"""
+
+
+def test_a_worker_killed_while_sending_its_result_is_retried_and_the_run_finishes_bitwise(registry, tmp_path):
+    flag, xi_file = tmp_path / "died", tmp_path / "xi.npy"
+    try:  # in a subprocess with a deadline: a pool that hangs here fails the test instead of the suite
+        done = subprocess.run(
+            [sys.executable, "-c", MID_SEND_SCRIPT, str(flag), str(xi_file)],
+            cwd=ROOT, capture_output=True, text=True, timeout=90,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        pytest.fail("the run hung after a worker died while sending its result")
+    assert done.returncode == 0, done.stderr
+    sent, size = map(int, flag.read_text().split())
+    assert 0 < sent < size, "the worker did not die in the middle of its message"
+    summary = json.loads(done.stdout)
+    assert summary["status"] == "completed" and summary["done"] == 24
+
+    serial = engine.run(build_scene(merge(SMALL_PRESET, {"realizations": 24}), registry=registry), workers=1)
+    np.testing.assert_array_equal(np.load(xi_file), serial.per_realization["xi"])
+    assert (summary["a"], summary["b"]) == (serial.fit.a, serial.fit.b)
+
+
+# ------------------------------------------------------------------ SIGTERM
+
+
+def _listed_chunks(run_dir: Path) -> int:
+    try:
+        return len(json.loads((run_dir / "run.json").read_text())["chunks"])
+    except (OSError, ValueError, KeyError):  # not written yet, or being replaced
+        return 0
+
+
+def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry, tmp_path):
+    preset = tmp_path / "long.yaml"
+    preset.write_text(yaml.safe_dump(KILL_PRESET))
+    run_dir = tmp_path / "run"
+    command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(run_dir), "--workers", "2"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while _listed_chunks(run_dir) < 2:
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "no chunk written in 60 s"
+        time.sleep(0.01)
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 143, err
+    assert "status interrupted" in out and "Traceback" not in err
+    state = json.loads((run_dir / "run.json").read_text())
+    assert state["status"] == "interrupted"
+    kept = len(state["chunks"])
+    assert 2 <= kept and not (run_dir / "run.lock").exists()
+
+    resumed = subprocess.run(
+        [sys.executable, "-m", "frictionlab", "resume", str(run_dir), "--workers", "2", "--json"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert resumed.returncode == 0, resumed.stderr
+    assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < 80
+    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", workers=2)
+    same_files(run_dir, tmp_path / "whole")
+
+
+# ------------------------------------------------------------------ damaged chunks
+
+DAMAGE_PRESET = merge(SMALL_PRESET, {"realizations": 40, **NO_PLOT})
+
+
+@pytest.fixture(scope="module")
+def partial_and_whole(registry, tmp_path_factory):
+    """A run cancelled after 30 of 40 realizations (several chunk files), and the uninterrupted run."""
+    scene = build_scene(DAMAGE_PRESET, registry=registry)
+    root = tmp_path_factory.mktemp("damage")
+    cancel = threading.Event()
+    first, _ = run_to_folder(scene, root / "partial", workers=1, listeners=[CancelAfter(30, cancel)], cancel=cancel)
+    assert first.status == "cancelled" and len(json.loads((root / "partial" / "run.json").read_text())["chunks"]) >= 3
+    run_to_folder(scene, root / "whole", workers=1)
+    return scene, root / "partial", root / "whole"
+
+
+def _manifest(folder: Path) -> dict:
+    return json.loads((folder / "run.json").read_text())
+
+
+def _rewrite(folder: Path, name: str, change, update_checksum: bool) -> None:
+    """Rewrite chunk ``name`` with ``change(arrays)`` applied; list its new
+    checksum in the manifest when ``update_checksum`` (as a careful hand would)."""
+    path = folder / "chunks" / name
+    with np.load(path) as data:
+        arrays = {key: data[key].copy() for key in data.files}
+    change(arrays)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    path.write_bytes(buffer.getvalue())
+    if update_checksum:
+        manifest = _manifest(folder)
+        manifest["chunks"][name] = hashlib.sha256(buffer.getvalue()).hexdigest()
+        (folder / "run.json").write_text(json.dumps(manifest))
+
+
+def _second(folder: Path) -> str:
+    return list(_manifest(folder)["chunks"])[1]  # realizations 1..10: the first chunk is realization 0 alone
+
+
+def truncated(folder):
+    path = folder / "chunks" / _second(folder)
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+
+
+def emptied(folder):
+    (folder / "chunks" / _second(folder)).write_bytes(b"")
+
+
+def deleted(folder):
+    (folder / "chunks" / _second(folder)).unlink()
+
+
+def edited_value(folder):
+    _rewrite(folder, _second(folder), lambda a: a["xi"].__setitem__((0, 3), a["xi"][0, 3] * 1.001), False)
+
+
+def nan_row(folder):
+    _rewrite(folder, _second(folder), lambda a: a["xi"].__setitem__(2, np.nan), False)
+
+
+def missing_array(folder):
+    _rewrite(folder, _second(folder), lambda a: a.pop("xi"), True)
+
+
+def index_out_of_range(folder):
+    _rewrite(folder, _second(folder), lambda a: a["index"].__setitem__(0, 3000), True)
+
+
+def negative_index(folder):
+    _rewrite(folder, _second(folder), lambda a: a["index"].__setitem__(0, -1), True)
+
+
+def misshapen_rows(folder):
+    _rewrite(folder, _second(folder), lambda a: a.__setitem__("xi", a["xi"][:, :-1]), True)
+
+
+def unlisted_overlapping_copy(folder):
+    """A copy of one chunk under a name that overlaps another, not in the manifest."""
+    chunks = folder / "chunks"
+    shutil.copy(chunks / _second(folder), chunks / "00000005-00000014.npz")
+
+
+def listed_twice(folder):
+    """The same chunk listed under two names: its realizations must count once."""
+    chunks, name = folder / "chunks", _second(folder)
+    shutil.copy(chunks / name, chunks / name.replace(".npz", ".1.npz"))
+    manifest = _manifest(folder)
+    manifest["chunks"][name.replace(".npz", ".1.npz")] = manifest["chunks"][name]
+    (folder / "run.json").write_text(json.dumps(manifest))
+
+
+DAMAGE = {
+    truncated: "1 checksum mismatch",
+    emptied: "1 checksum mismatch",
+    deleted: "1 missing",
+    edited_value: "1 checksum mismatch",
+    nan_row: "1 checksum mismatch",
+    missing_array: "1 no array xi",
+    index_out_of_range: "indices outside",
+    negative_index: "indices outside",
+    misshapen_rows: "array xi of shape",
+    unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",
+    listed_twice: None,  # nothing is damaged: no warning
+}
+
+
+@pytest.mark.parametrize("damage", list(DAMAGE), ids=[f.__name__ for f in DAMAGE])
+def test_resume_recomputes_damaged_chunks_and_ends_bitwise_whole(partial_and_whole, tmp_path, damage, recwarn):
+    scene, partial, whole = partial_and_whole
+    folder = tmp_path / "run"
+    shutil.copytree(partial, folder)
+    damage(folder)
+    workers = 2 if damage is truncated else 1  # one case through a real process pool
+    outcome, _ = run_to_folder(scene, folder, workers=workers, resume=True)
+    messages = [str(w.message) for w in recwarn if "resume of" in str(w.message)]
+    expected = DAMAGE[damage]
+    if expected is None:
+        assert messages == []
+    else:
+        assert len(messages) == 1 and expected in messages[0], messages
+        if damage is not unlisted_overlapping_copy:
+            assert "1 chunk file(s) failed verification" in messages[0]
+            assert "10 realization(s) they held are recomputed" in messages[0]
+    assert outcome.status == "completed" and outcome.done == 40 and len(outcome.failures) == 0
+    same_files(folder, whole)

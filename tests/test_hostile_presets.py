@@ -1,0 +1,266 @@
+"""Hostile and malformed input, as an attacker or a careless user would give
+it: each is refused fast with a message that names the field or the file
+(never quoting the file's content) and its own exit code, never the
+catch-all internal error. Cases that could hang or exhaust memory run in a
+subprocess with a deadline and a memory limit, so a regression fails the
+test instead of the machine."""
+
+from __future__ import annotations
+
+import os
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+
+from .conftest import ROOT, SMALL_PRESET, merge
+
+BASE = yaml.safe_dump(merge(SMALL_PRESET, {"output": {"plot": False}}), sort_keys=False)
+
+
+def preset_text(**changes) -> str:
+    return yaml.safe_dump(merge(SMALL_PRESET, {"output": {"plot": False}, **changes}), sort_keys=False)
+
+
+def replace(old: str, new: str) -> str:
+    assert old in BASE
+    return BASE.replace(old, new, 1)
+
+
+def _limit_memory() -> None:  # pragma: no cover - runs in the child
+    resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+
+def cli(*args: str, cwd: Path, timeout: float = 30) -> subprocess.CompletedProcess:
+    try:
+        return subprocess.run(
+            [sys.executable, "-m", "frictionlab", *args], capture_output=True, text=True, timeout=timeout,
+            cwd=cwd, preexec_fn=_limit_memory, env={**os.environ, "PYTHONPATH": str(ROOT)},
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"frictionlab {' '.join(args)} still ran after {timeout} s")
+
+
+ALIAS_BOMB = (
+    'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
+    + "".join(f"{chr(98 + i)}: &{chr(98 + i)} [" + ",".join([f"*{chr(97 + i)}"] * 9) + "]\n" for i in range(8))
+)
+
+# id: (preset text, exit code, what the message says); each validated by `frictionlab validate`
+IN_PROCESS = {
+    "recursive alias": ("description: &d [*d]\n" + BASE, ExitCode.INPUT_FILE, "refers to a value that contains it"),
+    "not UTF-8": (b"\xff\xfe".decode("latin-1") + BASE, ExitCode.INPUT_FILE, "not UTF-8 text (byte 1, line 1)"),
+    "duplicate key": (BASE + "seed: 8\n", ExitCode.USAGE, "duplicate key 'seed' at lines 2 and"),
+    "duplicate nested key": (replace("hurst: 0.8", "hurst: 0.8\n    hurst: 0.9"), ExitCode.USAGE,
+                             "spectrum.params: duplicate key 'hurst'"),
+    "bool realizations": (replace("realizations: 8", "realizations: true"), ExitCode.USAGE,
+                          "realizations: must be a number, not true or false, got true"),
+    "bool hurst": (replace("hurst: 0.8", "hurst: true"), ExitCode.USAGE,
+                   "spectrum.params.hurst: must be a number, not true or false"),
+    "bool seed": (replace("seed: 7", "seed: false"), ExitCode.USAGE, "seed: must be a number, not true or false"),
+    "inf stop": (replace("stop: 20.0", "stop: .inf"), ExitCode.USAGE, "loading.stop: must be a finite number, got inf"),
+    "nan rms height": (replace("rms_height: 1.0", "rms_height: .nan"), ExitCode.USAGE,
+                       "spectrum.params.rms_height: must be a finite number"),
+    "inf c0": (replace("rms_height: 1.0", "rms_height: null\n    c0: .inf"), ExitCode.USAGE,
+               "spectrum.params.c0: must be a finite number"),
+    "1e308 modulus": (replace("youngs_modulus: 1.0", "youngs_modulus: 1e308"), ExitCode.USAGE,
+                      "solver.params.youngs_modulus: must be 0 or between 1e-100 and 1e+100 in magnitude"),
+    "1e308 height": (replace("rms_height: 1.0", "rms_height: 1.0e+308"), ExitCode.USAGE,
+                     "spectrum.params.rms_height: must be 0 or between"),
+    "absolute name": (replace("name: small", "name: /tmp/escape"), ExitCode.USAGE, "name: must be 1 to 100 letters"),
+    "dotdot name": (replace("name: small", "name: ../../escape"), ExitCode.USAGE, "name: must be 1 to 100 letters"),
+    "newline name": (replace("name: small", 'name: "a\\nb"'), ExitCode.USAGE, "name: must be 1 to 100 letters"),
+    "NUL name": (replace("name: small", 'name: "a\\0b"'), ExitCode.USAGE, "got 'a\\x00b'"),
+    "NUL byte in the file": (BASE + "description: a\x00b\n", ExitCode.USAGE, "character #x0000 is not allowed"),
+    "int past the digit limit": (replace("seed: 7", "seed: " + "1" * 5000), ExitCode.USAGE,
+                                 "a value YAML cannot convert"),
+    "impossible date": (replace("name: small", "name: 2020-13-45"), ExitCode.USAGE, "a value YAML cannot convert"),
+    "control char in a file path": (replace("name: power-law", "name: profile-file").replace(
+        "hurst: 0.8\n    points: 1024\n    rms_height: 1.0", 'path: "scan\\n.csv"\n    spacing: 1.0'),
+        ExitCode.USAGE, "spectrum.params.path: must not contain control characters"),
+}
+
+
+@pytest.mark.parametrize("case", list(IN_PROCESS))
+def test_malformed_presets_are_refused_naming_the_field(case, tmp_path, capsys):
+    text, code, message = IN_PROCESS[case]
+    path = tmp_path / "p.yaml"
+    path.write_bytes(text.encode("latin-1") if case == "not UTF-8" else text.encode())
+    assert main(["validate", str(path)]) == code
+    err = capsys.readouterr().err
+    assert message in err, err
+    assert "internal error" not in err and len(err) < 2000
+
+
+def test_a_folder_given_as_preset_is_refused(tmp_path, capsys):
+    assert main(["validate", str(tmp_path)]) == ExitCode.INPUT_FILE
+    assert "preset file is a folder, not a regular file" in capsys.readouterr().err
+
+
+def test_a_bad_name_writes_nothing_outside_the_runs_folder(tmp_path, monkeypatch, capsys):
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    path = tmp_path / "work" / "p.yaml"
+    path.write_text(replace("name: small", "name: ../../escape"))
+    assert main(["run", str(path), "--quiet"]) == ExitCode.USAGE
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["p.yaml", "work"]
+
+
+def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    assert main(["validate", str(path), "--set", "realizations=true"]) == ExitCode.USAGE
+    assert "realizations: must be a number, not true or false" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ cases that hang or eat memory on their own
+
+
+def test_an_alias_bomb_is_refused_at_once_with_a_short_message(tmp_path):
+    (tmp_path / "p.yaml").write_text(BASE + ALIAS_BOMB + "description: *i\n")
+    done = cli("validate", "p.yaml", cwd=tmp_path)
+    assert done.returncode == ExitCode.INPUT_FILE
+    assert "expands to more than 20,000 values (aliases repeat what they refer to)" in done.stderr
+    assert len(done.stderr) < 1000
+
+
+def test_a_huge_preset_is_refused_by_its_size_before_it_is_read(tmp_path):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    os.truncate(path, 50 * 1024 * 1024)  # 50 MB (sparse: cheap to make)
+    done = cli("validate", "p.yaml", cwd=tmp_path, timeout=10)
+    assert done.returncode == ExitCode.INPUT_FILE
+    assert "preset file of 52,428,800 bytes, more than the limit of 262,144 bytes" in done.stderr
+
+
+def test_deep_nesting_is_refused(tmp_path):
+    (tmp_path / "p.yaml").write_text(BASE + "description: " + "[" * 5000 + "]" * 5000 + "\n")
+    done = cli("validate", "p.yaml", cwd=tmp_path)
+    assert done.returncode == ExitCode.INPUT_FILE
+    assert "nested more than 64 levels deep at line" in done.stderr
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device"])
+def test_a_fifo_or_a_device_as_preset_is_refused_without_blocking(tmp_path, kind):
+    if kind == "fifo":
+        os.mkfifo(tmp_path / "p.yaml")
+        target, what = "p.yaml", "a FIFO (named pipe)"
+    else:
+        target, what = "/dev/zero", "a character device"
+    done = cli("validate", target, cwd=tmp_path, timeout=10)
+    assert done.returncode == ExitCode.INPUT_FILE
+    assert f"preset file is {what}, not a regular file" in done.stderr
+
+
+def test_a_huge_sweep_grid_is_counted_from_its_axes_and_refused(tmp_path):
+    axes = {"spectrum.params.hurst": {"start": 0.1, "stop": 1.0, "num": 1000}, "seed": {"start": 0, "stop": 999, "num": 1000}}
+    (tmp_path / "p.yaml").write_text(preset_text(sweep={"parameters": axes}))
+    done = cli("validate", "p.yaml", cwd=tmp_path)
+    assert done.returncode == ExitCode.USAGE
+    assert "the sweep has 1,000,000 points (grid of 1000 x 1000); at most 1,000 are allowed" in done.stderr
+
+
+def test_a_closed_stdout_ends_the_command_quietly(tmp_path):
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # the reader is gone before anything is written (as `| head -c 10` once it has its bytes)
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "frictionlab", "plugins", "--json"], stdout=write_end, stderr=subprocess.PIPE,
+            cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
+        )  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert done.returncode == ExitCode.BROKEN_PIPE
+    assert done.stderr == b""
+
+
+# ------------------------------------------------------------------ data files and run folders
+
+
+SECRET = "root:x:0:0:the-secret-line-of-a-system-file"
+
+
+def profile_preset(tmp_path: Path, path: str) -> Path:
+    data = {**merge(SMALL_PRESET, {"output": {"plot": False}}), "realizations": 2,
+            "spectrum": {"name": "profile-file", "params": {"path": path, "spacing": 1.0}}}  # fmt: skip
+    preset = tmp_path / "p.yaml"
+    preset.write_text(yaml.safe_dump(data))
+    return preset
+
+
+def test_a_profile_file_that_is_not_numbers_is_named_never_quoted(tmp_path, capsys):
+    (tmp_path / "passwd.txt").write_text(f"{SECRET}\n" * 20)
+    preset = profile_preset(tmp_path, "passwd.txt")
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--json"]) == ExitCode.RUNTIME_FAILURE
+    captured = capsys.readouterr()
+    written = "".join(p.read_text(errors="replace") for p in (tmp_path / "o").glob("*.json"))
+    assert "non-numeric content at line 2" in captured.out  # line 1 is taken for a header
+    assert str(tmp_path / "passwd.txt") in captured.out
+    for text in (captured.out, captured.err, written):
+        assert "the-secret-line" not in text
+
+
+def test_a_fifo_as_profile_file_is_refused_when_the_preset_is_validated(tmp_path, capsys):
+    os.mkfifo(tmp_path / "scan.csv")
+    assert main(["validate", str(profile_preset(tmp_path, "scan.csv"))]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "spectrum.params.path: is a FIFO (named pipe), not a regular file" in err
+
+
+def test_a_missing_profile_file_is_refused_when_the_preset_is_validated(tmp_path, capsys):
+    assert main(["validate", str(profile_preset(tmp_path, "gone.csv"))]) == ExitCode.USAGE
+    assert f"spectrum.params.path: no such file, got '{tmp_path / 'gone.csv'}'" in capsys.readouterr().err
+
+
+def test_a_damaged_preset_in_a_run_folder_is_named(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    assert main(["run", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == ExitCode.OK
+    (tmp_path / "run" / "preset.yaml").write_text("name: [unclosed\n")
+    assert main(["resume", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'run' / 'preset.yaml'} is damaged (not valid YAML at line 2" in err
+    (tmp_path / "run" / "run.json").write_text("{ damaged")
+    (tmp_path / "run" / "preset.yaml").write_text(BASE)
+    assert main(["resume", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
+    assert f"{tmp_path / 'run' / 'run.json'} is damaged (not valid JSON at line 1)" in capsys.readouterr().err
+
+
+def test_an_output_path_under_a_file_is_refused_naming_the_file(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    (tmp_path / "results").write_text("a file, not a folder")
+    assert main(["run", str(path), "--out", str(tmp_path / "results" / "run"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert f"cannot be made a folder: {tmp_path / 'results'} is a file" in capsys.readouterr().err
+    assert main(["run", str(path), "--out", str(tmp_path / "results"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert f"{tmp_path / 'results'} is a file, not a folder" in capsys.readouterr().err
+
+
+def test_numbers_that_overflow_in_the_run_name_what_overflowed(tmp_path, capsys):
+    # each value within the limit, their product not: the run says which numbers, and fails cleanly
+    data = merge(SMALL_PRESET, {"output": {"plot": False}, "realizations": 2, "solver": {"params": {"youngs_modulus": 1e-100}},
+                                "spectrum": {"params": {"rms_height": 1e-100, "spacing": 1e-100}},
+                                "loading": {"start": 1e99, "stop": 1e100}})  # fmt: skip
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(data))
+    code = main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"])
+    err = capsys.readouterr()
+    assert code == ExitCode.RUNTIME_FAILURE and "internal error" not in err.err
+    assert "the dimensionless force f = F / (k h X) is not finite" in err.err
+    assert "warning" not in err.err
+
+
+def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(
+            [sys.executable, "-m", "frictionlab", "plugins", "--json"], stdout=full, stderr=subprocess.PIPE,
+            text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
+        )  # fmt: skip
+    assert done.returncode == ExitCode.RUNTIME_FAILURE
+    assert done.stderr == "error: No space left on device\n"

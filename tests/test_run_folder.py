@@ -1,0 +1,239 @@
+"""The run folder keeps its promises: nothing of the user's is deleted or
+overwritten without --force, the manifest lists every chunk and input file
+with its SHA-256, failed realizations are retried on resume, relative input
+files are the preset's neighbours whatever the current folder, a changed
+input file stops a resume, and a finished folder has no lock and one chunk."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode, OutputRefused
+from frictionlab.rundir import RunDirectory
+from frictionlab.runner import run_to_folder
+
+from .conftest import SMALL_PRESET, merge
+from .faults import FlakyPowerLaw, with_spectrum
+from .test_resume import NO_PLOT, CancelAfter, same_files
+
+
+def write(path: Path, data: dict) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+QUICK = merge(SMALL_PRESET, NO_PLOT)
+
+
+# ------------------------------------------------------------------ never delete or overwrite
+
+
+def test_out_into_a_folder_that_is_not_a_run_is_refused_and_force_deletes_nothing(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    folder = tmp_path / "thesis"
+    (folder / "chunks").mkdir(parents=True)
+    (folder / "notes.txt").write_text("three years of notes")
+    (folder / "chunks" / "00000000-00000003.npz").write_bytes(b"my own file, named like a chunk")
+    (folder / "summary.json").write_text("{}")
+    before = tree(folder)
+
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"{folder} is not empty and is not a frictionlab run folder" in err and "--force" in err
+    assert tree(folder) == before
+
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--force"]) == ExitCode.OK
+    after = tree(folder)
+    assert after["notes.txt"] == before["notes.txt"]  # never touched
+    assert after["chunks/00000000-00000003.npz"] == before["chunks/00000000-00000003.npz"]  # not ours: kept
+    assert json.loads(after["summary.json"])["status"] == "completed"  # --force: our file replaces theirs
+
+
+def test_a_finished_run_of_another_preset_is_refused_and_the_same_preset_reruns(tmp_path, capsys):
+    first = write(tmp_path / "a.yaml", QUICK)
+    other = write(tmp_path / "b.yaml", merge(QUICK, {"seed": 8, "spectrum": {"params": {"hurst": 0.7}}}))
+    out = tmp_path / "run"
+    assert main(["run", str(first), "--out", str(out), "--quiet"]) == ExitCode.OK
+    before = tree(out)
+    assert main(["run", str(other), "--out", str(out), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert "holds a finished run of another preset (it differs in seed, spectrum.params.hurst)" in err
+    assert tree(out) == before
+    assert main(["run", str(first), "--out", str(out), "--quiet"]) == ExitCode.OK  # the same preset: rerun
+    assert main(["run", str(other), "--out", str(out), "--quiet", "--force"]) == ExitCode.OK
+    assert json.loads((out / "summary.json").read_text())["seed"] == 8
+
+
+def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists(make_scene, tmp_path):
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    cancel = threading.Event()
+    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[CancelAfter(12, cancel)], cancel=cancel)
+    chunks = tmp_path / "run" / "chunks"
+    listed = set(json.loads((tmp_path / "run" / "run.json").read_text())["chunks"])
+    (chunks / "mine.npz").write_bytes(b"user data")
+    with pytest.raises(OutputRefused, match="holds an unfinished run"):
+        run_to_folder(scene, tmp_path / "run", workers=1)
+    outcome, _ = run_to_folder(scene, tmp_path / "run", workers=1, force=True)
+    assert outcome.status == "completed" and outcome.extra["resumed"] == 0
+    assert (chunks / "mine.npz").read_bytes() == b"user data"
+    now = set(json.loads((tmp_path / "run" / "run.json").read_text())["chunks"])
+    assert {p.name for p in chunks.iterdir()} == now | {"mine.npz"}  # the old chunks went, the user's stayed
+    assert listed
+
+
+def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(tmp_path, monkeypatch, capsys):
+    from frictionlab.preset import apply_overrides, load_preset_file
+    from frictionlab.report import STUDY
+
+    from .conftest import PRESETS
+    from .test_report import TINY
+
+    presets = tmp_path / "presets"
+    for fig in STUDY:
+        data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
+        if data.get("sweep"):
+            data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
+        write(presets / fig.preset, data)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "REPRODUCTION.md").write_text("# my tracked report\n\n## Readings\n")
+    assert main(["report", "--presets", str(presets), "--quiet", "--workers", "1"]) == ExitCode.OK
+    assert (tmp_path / "REPRODUCTION.md").read_text() == "# my tracked report\n\n## Readings\n"
+    written = Path(capsys.readouterr().out.strip())
+    assert written.parent.parent == Path("runs") and written.parent.name.startswith("report-")
+    assert "Wall time of the whole report" in written.read_text()
+    assert (written.parent / "figures" / "fig2.png").stat().st_size > 1000
+
+    assert main(["report", "--presets", str(presets), "--markdown", "REPRODUCTION.md"]) == ExitCode.OUTPUT_REFUSED
+    assert "the report would overwrite REPRODUCTION.md" in capsys.readouterr().err
+    assert (tmp_path / "REPRODUCTION.md").read_text() == "# my tracked report\n\n## Readings\n"
+
+
+# ------------------------------------------------------------------ manifest, lock, chunks
+
+
+def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_scene, tmp_path):
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    seen = []
+
+    class Check:
+        from frictionlab import hookimpl
+
+        @hookimpl
+        def realization_done(self, done):  # the chunk holding it is already written and listed
+            manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+            for name, digest in manifest["chunks"].items():
+                assert hashlib.sha256((tmp_path / "run" / "chunks" / name).read_bytes()).hexdigest() == digest
+            seen.append(len(manifest["chunks"]))
+
+    cancel = threading.Event()
+    run_to_folder(scene, tmp_path / "run", workers=1, listeners=[Check(), CancelAfter(25, cancel)], cancel=cancel)
+    assert seen and seen[-1] >= 3 and seen == sorted(seen)
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert manifest["status"] == "cancelled" and manifest["fingerprint"] and manifest["preset"]["seed"] == 7
+
+
+def test_a_finished_run_leaves_no_lock_and_its_chunks_compacted_into_one(make_scene, tmp_path):
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    outcome, _ = run_to_folder(scene, tmp_path / "run", workers=2)
+    assert outcome.status == "completed"
+    assert not (tmp_path / "run" / "run.lock").exists()
+    files = [p.name for p in (tmp_path / "run" / "chunks").iterdir()]
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert files == list(manifest["chunks"]) == ["00000000-00000029.npz"]
+    again, _ = run_to_folder(scene, tmp_path / "run", workers=1, resume=True)  # verified, nothing recomputed
+    assert again.extra["resumed"] == 30
+    with RunDirectory(tmp_path / "run"):  # the lock is free and taken anew
+        assert (tmp_path / "run" / "run.lock").exists()
+    assert not (tmp_path / "run" / "run.lock").exists()
+
+
+def test_failed_realizations_are_retried_on_resume(make_scene, tmp_path, capsys):
+    flag = tmp_path / "flaky"
+    flag.touch()
+    scene = with_spectrum(make_scene({"realizations": 20, **NO_PLOT}), FlakyPowerLaw, flag=str(flag))
+    first, _ = run_to_folder(scene, tmp_path / "run", workers=1)
+    assert first.status == "completed" and 3 <= len(first.failures) <= 15
+    flag.unlink()
+    from frictionlab.reporter import ProgressReporter
+
+    second, _ = run_to_folder(scene, tmp_path / "run", workers=2, resume=True, listeners=[ProgressReporter()])
+    assert second.failures == [] and second.done == 20
+    assert second.extra["retried"] == len(first.failures) and second.extra["resumed"] == first.done
+    assert f"{len(first.failures)} failed ones retried" in capsys.readouterr().err
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["retried_realizations"] == len(first.failures)
+    run_to_folder(scene, tmp_path / "clean", workers=1)
+    same_files(tmp_path / "run", tmp_path / "clean")
+
+
+# ------------------------------------------------------------------ input files
+
+
+PROFILE = {**QUICK, "realizations": 2, "spectrum": {"name": "profile-file", "params": {"path": "scan.csv", "spacing": 0.5}}}
+
+
+def _scan(path: Path, wiggle: float = 0.05) -> None:
+    x = np.arange(512)
+    np.savetxt(path, 3.0 * np.cos(2 * np.pi * x / 128) + wiggle * np.sin(2 * np.pi * x / 16))
+
+
+def test_a_relative_profile_path_is_the_preset_files_neighbour_whatever_the_current_folder(tmp_path, monkeypatch):
+    preset = write(tmp_path / "study" / "scan.yaml", PROFILE)
+    _scan(tmp_path / "study" / "scan.csv")
+    (tmp_path / "elsewhere").mkdir()
+    _scan(tmp_path / "elsewhere" / "scan.csv", wiggle=0.5)  # another line of the same name: must not be read
+    results = {}
+    for cwd in ("study", "elsewhere"):
+        monkeypatch.chdir(tmp_path / cwd)
+        assert main(["run", str(preset), "--out", str(tmp_path / f"from-{cwd}"), "--quiet"]) == ExitCode.OK
+        results[cwd] = (tmp_path / f"from-{cwd}" / "curve.csv").read_text()
+    assert results["study"] == results["elsewhere"]
+    manifest = json.loads((tmp_path / "from-elsewhere" / "run.json").read_text())
+    recorded = manifest["inputs"]["spectrum.params.path"]
+    assert recorded["path"] == str(tmp_path / "study" / "scan.csv")
+    assert recorded["sha256"] == hashlib.sha256((tmp_path / "study" / "scan.csv").read_bytes()).hexdigest()
+    assert manifest["preset"]["spectrum"]["params"]["path"] == recorded["path"]
+
+
+def test_resume_refuses_an_input_file_that_changed(tmp_path, monkeypatch, capsys):
+    preset = write(tmp_path / "scan.yaml", merge(PROFILE, {"realizations": 6}))
+    _scan(tmp_path / "scan.csv")
+    out = tmp_path / "run"
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OK
+    assert main(["resume", str(out), "--quiet"]) == ExitCode.OK  # unchanged: fine
+    _scan(tmp_path / "scan.csv", wiggle=0.06)
+    capsys.readouterr()
+    assert main(["resume", str(out), "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"the input file spectrum.params.path ({tmp_path / 'scan.csv'}) changed since the run started" in err
+
+
+def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
+    preset = write(tmp_path / "s.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
+        "spectrum.params.hurst": {"values": [0.6, 0.9]}}}}))  # fmt: skip
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert "is not empty and is not the folder of a frictionlab sweep" in capsys.readouterr().err
+    assert [p.name for p in folder.iterdir()] == ["notes.txt"]
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK  # its own: rerun
+    other = write(tmp_path / "t.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
+        "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
+    assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert "holds another sweep" in capsys.readouterr().err
