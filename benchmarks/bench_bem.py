@@ -34,6 +34,7 @@ import numpy as np
 from frictionlab import Profile
 from frictionlab.seeds import realization_rng
 from frictionlab_solvers import bem
+from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
 
 SEED = 2024
@@ -103,9 +104,7 @@ def single_loads(repeat: int) -> None:
             f"{seconds / its * 1e3:6.2f} ms/iteration = {seconds / its / floor:4.1f} FFT pairs"
         )
 
-    line = PowerLawSurface(hurst=0.8, points=128, spacing=1.0).equivalent_line()
-    line = type(line)(**{**line.params.model_dump(), "points": 8192, "long_cutoff": None})
-    line_profile = line.generate(realization_rng(SEED, 1))
+    line_profile = PowerLaw(hurst=0.8, points=8192, spacing=1.0).generate(realization_rng(SEED, 1))
     heights = line_profile.heights
     plane = bem.BEMHalfPlane()
     forces = np.geomspace(0.5, 20.0, 20)
