@@ -6,15 +6,7 @@ Known answers used here:
   from the mean pressure p* = pi E* h0 / lambda; below it the contact half-width
   a obeys p / p* = sin^2(pi a / lambda), with pressure
   p(x) = 2 p cos(pi x / lambda) / sin^2(pi a / lambda) * sqrt(sin^2(pi a / lambda) - sin^2(pi x / lambda)).
-* Hertz, cylinder in plane strain (F per unit length): a^2 = 4 F R / (pi E*).
-  With the zero-mean displacement of a periodic line, the periodic Green's
-  function is -(2 F / (pi E*)) ln|2 sin(pi x / L)|, which integrated against the
-  Hertz pressure gives the approach d = (2 F / (pi E*)) (ln(L / (pi a)) + 1/2) + O((a/L)^2).
-* Hertz, sphere on a half-space: a^3 = 3 F R / (4 E*), d = a^2 / R for an
-  isolated contact. On a periodic square cell of side L the zero-mean
-  displacement near the load is the isolated one plus Z F / (pi E* L), with
-  Z = sum'_{n in Z^2} 1/|n| (analytically continued) = 4 zeta(1/2) beta(1/2)
-  = -3.900264920 (the Madelung constant of the square lattice), up to O((a/L)^2).
+* Hertz (sphere and cylinder, both controls): tests/test_bem_closed_forms.py.
 * One point in contact on a line of N pixels: the pressure F/dx on one pixel
   displaces it by w = (F / (pi E*)) * sum over modes m != 0 of 1/|m|.
 """
@@ -28,9 +20,6 @@ from frictionlab import Profile
 from frictionlab.registry import Registry
 from frictionlab.testing import check_plugin
 from frictionlab_solvers import BEMHalfPlane, BEMHalfSpace
-
-MADELUNG_SQUARE = -3.900264920001955  # 4 zeta(1/2) beta(1/2)
-
 
 def solve(solver, z, loads, control="force", dx=1.0, slopes=None):
     z = np.asarray(z)
@@ -154,44 +143,7 @@ def test_the_cg_carries_the_requested_load_whatever_pressure_it_starts_from():
     assert np.allclose(answers[1], answers[0], rtol=0, atol=1e-9) and np.allclose(answers[2], answers[0], rtol=0, atol=1e-9)
 
 
-# ------------------------------------------------------------------ Hertz
-
-
-@pytest.mark.parametrize("radius_pixels", [8.0, 12.0])
-def test_hertz_sphere_on_periodic_half_space(radius_pixels):
-    points, dx, curvature_radius = 128, 0.25, 40.0
-    solver = BEMHalfSpace(youngs_modulus=1.5, poisson_ratio=0.25, tolerance=1e-10)
-    e_star = solver.stiffness()
-    a = radius_pixels * dx
-    force = 4 * e_star * a**3 / (3 * curvature_radius)
-    y, x = (np.mgrid[0:points, 0:points] - points / 2) * dx
-    z = -(x**2 + y**2) / (2 * curvature_radius)
-    curve = solve(solver, z, force, dx=dx)
-
-    measured_radius = np.sqrt(curve.contact_count[0] / np.pi)  # in pixels
-    assert abs(measured_radius - radius_pixels) < 1.0
-    cell = points * dx
-    expected = a**2 / curvature_radius + MADELUNG_SQUARE * force / (np.pi * e_star * cell)
-    assert curve.indentation[0] == pytest.approx(expected, rel=5e-3)
-    # without the periodic correction the answer would be off by more than 5 %
-    assert abs(curve.indentation[0] / (a**2 / curvature_radius) - 1) > 0.05
-
-
-@pytest.mark.parametrize("half_width_pixels", [10.0, 20.0])
-def test_hertz_cylinder_on_periodic_half_plane(half_width_pixels):
-    points, dx, curvature_radius = 1024, 2.0, 5000.0
-    solver = BEMHalfPlane(youngs_modulus=0.7, tolerance=1e-10)
-    e_star = solver.stiffness()
-    a = half_width_pixels * dx
-    force = np.pi * e_star * a**2 / (4 * curvature_radius)  # per unit length
-    x = (np.arange(points) - points / 2) * dx
-    z = -(x**2) / (2 * curvature_radius)
-    curve = solve(solver, z, force, dx=dx)
-
-    assert abs(curve.contact_count[0] / 2 - half_width_pixels) <= 1.0
-    length = points * dx
-    expected = 2 * force / (np.pi * e_star) * (np.log(length / (np.pi * a)) + 0.5)
-    assert curve.indentation[0] == pytest.approx(expected, rel=2e-3)
+# ------------------------------------------------------------------ one point
 
 
 def test_one_point_in_contact_matches_the_lattice_sum():
