@@ -11,7 +11,6 @@ Environment switches (read when a registry is built):
 
 from __future__ import annotations
 
-import difflib
 import functools
 import importlib
 import importlib.metadata as md
@@ -26,7 +25,7 @@ import numpy as np
 import pluggy
 from pydantic import BaseModel
 
-from .errors import PluginError
+from .errors import PluginError, did_you_mean
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .plugin import (
@@ -304,10 +303,7 @@ class Registry:
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)
-        close = difflib.get_close_matches(normalize_name(name), installed, n=3, cutoff=0.5)
-        message = f"no {kind} plugin named {name!r}"
-        if close:
-            message += f"; did you mean {' or '.join(repr(c) for c in close)}?"
+        message = f"no {kind} plugin named {name!r}{did_you_mean(normalize_name(name), installed)}"
         message += f" Installed {kind} plugins: {', '.join(installed) or 'none'}."
         if self.failures:
             broken = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error}" for f in self.failures)

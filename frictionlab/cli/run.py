@@ -13,7 +13,7 @@ from .options import add_executor_options, add_workers_option, executor_run_opti
 
 def add_parser(sub) -> None:
     p = sub.add_parser("run", help="run a preset headless and write its results")
-    p.add_argument("preset", help="preset YAML file")
+    p.add_argument("preset", help="preset YAML file, or a built-in preset's name (frictionlab presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
     p.add_argument(
         "--set", action="append", metavar="PATH=VALUE", help="override a preset value, e.g. spectrum.params.hurst=0.8"
@@ -34,11 +34,13 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..rundir import new_run_folder
 
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
+    args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
     scene = build_scene(data, source=str(args.preset))
     if args.resume and not args.out:

@@ -35,7 +35,7 @@ DEFAULTS = {  # the flags' defaults, as typed: StudyOptions' own
 def add_parser(sub) -> None:
     parser = sub.add_parser("study", help="error against cost of grid, realizations, steps, solver and tolerance")
     d = DEFAULTS
-    parser.add_argument("preset", help="preset YAML file")
+    parser.add_argument("preset", help="preset YAML file, or a built-in preset's name")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-study-<timestamp>)")
     parser.add_argument("--set", action="append", metavar="PATH=VALUE", help="override a preset value first")
     parser.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
@@ -130,6 +130,7 @@ def command_line(args) -> str:
 
 def run(args) -> ExitCode:
     from ..preset import read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..registry import default_registry
     from ..rundir import new_run_folder
     from ..tradeoff.axes import Study
@@ -140,7 +141,7 @@ def run(args) -> ExitCode:
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
-    data = read_preset(args.preset, overrides)  # relative input files taken from the preset's folder
+    data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=str(args.preset))
     out_dir = Path(args.out) if args.out else new_run_folder(f"{factory.base.preset.name}-study")
 

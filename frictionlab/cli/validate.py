@@ -9,19 +9,20 @@ from ..errors import ExitCode, FrictionlabError
 
 def add_parser(sub) -> None:
     p = sub.add_parser("validate", help="check presets and report every problem")
-    p.add_argument("presets", nargs="+", metavar="PRESET")
+    p.add_argument("presets", nargs="+", metavar="PRESET", help="preset YAML files or built-in names")
     p.add_argument("--set", action="append", metavar="PATH=VALUE", help="override before validating")
     p.set_defaults(handler=run)
 
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..sweep import plan_sweep
 
     worst = ExitCode.OK
     for path in args.presets:
         try:
-            data = read_preset(path, args.set or [])
+            data = read_preset(resolve_preset_path(path), args.set or [])
             scene = build_scene(data, source=str(path))
             if scene.preset.sweep is not None:  # every point too
                 points = len(plan_sweep(data, source=str(path)).points)
