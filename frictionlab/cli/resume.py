@@ -15,6 +15,7 @@ def add_parser(sub) -> None:
     add_workers_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.add_argument("--no-plot", action="store_true", help="draw no plot.png")
     add_executor_options(p)
     p.set_defaults(handler=run)
 

@@ -22,6 +22,9 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.add_argument(
+        "--no-plot", action="store_true", help="draw no plot.png (sweep.png): the fastest run; the numbers are the same"
+    )
     add_executor_options(p)
     p.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
     p.add_argument(
@@ -53,22 +56,25 @@ def run(args) -> ExitCode:
 
 
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
+    from ..api import run_scene
+    from ..progress import ProgressReporter
     from ..results import summary_dict
-    from ..runner import run_to_folder
     from ..signals import interrupted_exit_code
-    from .progress import ProgressReporter
+
+    def print_table(result) -> None:  # before the figure is drawn: nobody waits for matplotlib
+        if not args.json:
+            print(result_table(scene, result.outcome, out_dir), flush=True)
 
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        outcome, files = run_to_folder(scene, out_dir, options, listeners=listeners)
+        result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
+    outcome = result.outcome
     if args.json:
-        summary = summary_dict(scene, outcome, {k: str(p) for k, p in files.items()})
+        summary = summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()})
         print(json.dumps(summary, indent=2, allow_nan=False))
-    else:
-        print(result_table(scene, outcome, out_dir))
     if outcome.status in ("interrupted", "cancelled"):
         return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
@@ -81,11 +87,13 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 def _run_sweep(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..signals import interrupted_exit_code
     from ..sweep import plan_sweep, run_sweep
-    from .progress import SweepProgress
+    from ..progress import SweepProgress
 
     sweep = plan_sweep(data, source=str(args.preset))
     try:
-        outcome = run_sweep(sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()])
+        outcome = run_sweep(
+            sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
+        )
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
@@ -123,6 +131,8 @@ def result_table(scene, outcome, out_dir: Path) -> str:
             f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
             f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
         )
+    for caveat in outcome.caveats:
+        lines.append(f"  caveat: {caveat}")
     if outcome.failures:
         index, error = outcome.failures[0]
         lines.append(f"  {len(outcome.failures)} realization(s) failed; first: #{index}: {error}")

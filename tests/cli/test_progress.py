@@ -3,7 +3,7 @@
 import io
 
 from frictionlab import engine
-from frictionlab.cli.progress import ProgressReporter
+from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
 
 
@@ -12,15 +12,28 @@ class FakeTerminal(io.StringIO):
         return True
 
 
-def test_terminal_gets_one_redrawn_bar_and_a_final_newline(make_scene):
+def test_terminal_gets_a_rich_bar_that_ends_full(make_scene):
     stream = FakeTerminal()
     engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream)])
     text = stream.getvalue()
     assert text.startswith("small: 30 realizations of power-law lines, 16 force steps, 1 worker(s)\n")
-    bar = text.split("\n")[1]
-    assert bar.startswith("\r[") and "\n" not in bar
-    assert bar.split("\r")[-1].startswith("[" + "#" * 30 + "] 30/30 realizations")
-    assert text.endswith("\n")
+    last = text.split("\r")[-1]
+    assert "realizations" in last and "30/30" in last and "━" in last  # rich's bar, drawn in place
+    assert text.removesuffix("\x1b[?25h").endswith("\n")  # the cursor shown again after the last line
+
+
+def test_a_phase_shows_a_line_per_tenth_in_a_log_and_nothing_when_quiet():
+    from frictionlab.progress import phase
+
+    stream = io.StringIO()
+    with phase("calibrations", 5, stream=stream) as step:
+        for _ in range(5):
+            step.advance()
+    assert [line.split(",")[0] for line in stream.getvalue().splitlines()] == [f"calibrations: {i}/5" for i in range(1, 6)]
+    quiet = io.StringIO()
+    with phase("calibrations", 5, quiet=True, stream=quiet) as step:
+        step.advance()
+    assert quiet.getvalue() == ""
 
 
 def test_log_file_gets_one_plain_line_per_tenth(make_scene):
