@@ -13,47 +13,49 @@ reads a finished run back (``frictionlab.api``). They are imported on first use,
 so ``import frictionlab`` stays cheap.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+# Every public name is imported on first use (PEP 562), so that ``import frictionlab``
+# (and ``frictionlab --help``) costs almost nothing: numpy and pydantic come with the
+# first name that needs them.
+_LAZY = {
+    "hookimpl": "hookspecs",
+    **dict.fromkeys(("InputFile", "InputFileProblem", "open_regular_file"), "inputs"),
+    **dict.fromkeys(("RunListener", "SweepListener"), "listeners"),
+    "RunOptions": "options",
+    **dict.fromkeys(
+        (
+            "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
+            "SlopeEstimator", "SpectrumGenerator", "contract", "force_unit", "mdr_length",
+        ),
+        "plugin",
+    ),  # fmt: skip
+    **dict.fromkeys(("run", "load", "Result"), "api"),
+}
 
-from .hookspecs import hookimpl
-from .inputs import InputFile, InputFileProblem, open_regular_file
-from .listeners import RunListener, SweepListener
-from .options import RunOptions
-from .plugin import (
-    ContactCurve,
-    ContactSolver,
-    Control,
-    ForceNormalisation,
-    Plugin,
-    PluginParams,
-    Profile,
-    SlopeEstimator,
-    SpectrumGenerator,
-    contract,
-    force_unit,
-    mdr_length,
-)
 
-try:
-    __version__ = version("frictionlab")
-except PackageNotFoundError:  # running from a source tree without install
-    __version__ = "0.0.0+unknown"
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
 
-_LAZY = {"run": "api", "load": "api", "Result": "api"}  # imported on first use (PEP 562)
+    try:
+        return version("frictionlab")
+    except PackageNotFoundError:  # running from a source tree without install
+        return "0.0.0+unknown"
 
 
 def __getattr__(name: str):
-    if name in _LAZY:
+    if name == "__version__":
+        value = _version()
+    elif name in _LAZY:
         from importlib import import_module
 
         value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'frictionlab' has no attribute {name!r}")
+    else:
+        raise AttributeError(f"module 'frictionlab' has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
 def __dir__():
-    return sorted([*globals(), *_LAZY])
+    return sorted([*globals(), *_LAZY, "__version__"])
 
 
 __all__ = [

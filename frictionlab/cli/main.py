@@ -13,7 +13,6 @@ import os
 import sys
 import warnings
 
-from .. import __version__
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import plugins, predict, presets, report, resume, run, schema, study, tui, validate
@@ -22,12 +21,24 @@ COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tu
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
 
 
+class _Version(argparse.Action):
+    """``--version``, its number read only when asked (importlib.metadata is slow to import)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .. import __version__
+
+        parser.exit(message=f"frictionlab {__version__}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="frictionlab",
         description="rms slope in contact against normal force, over ensembles of random rough lines.",
     )
-    parser.add_argument("--version", action="version", version=f"frictionlab {__version__}")
+    parser.add_argument("-V", "--version", action=_Version, help="print the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in COMMANDS:
         command.add_parser(sub)
