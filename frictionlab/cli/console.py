@@ -14,8 +14,12 @@ from collections.abc import Sequence
 
 def use_colour(stream=None) -> bool:
     """Colour (and rich's layout) only on a terminal, and never with NO_COLOR set (no-color.org)."""
-    stream = stream or sys.stdout
-    return bool(getattr(stream, "isatty", lambda: False)()) and not os.environ.get("NO_COLOR")
+    return is_terminal(stream) and not os.environ.get("NO_COLOR")
+
+
+def error_label(stream=None) -> str:
+    """``error``, in red on a terminal that takes colour."""
+    return "\x1b[31merror\x1b[0m" if use_colour(stream or sys.stderr) else "error"
 
 
 def is_terminal(stream=None) -> bool:
@@ -34,7 +38,7 @@ def print_table(header: Sequence[str], rows: Sequence[Sequence[str]], *, stream=
         from rich.console import Console
         from rich.table import Table
 
-        table = Table(box=None, header_style="bold", pad_edge=False)
+        table = Table(box=None, header_style="bold cyan", pad_edge=False)
         for i, name in enumerate(header):
             table.add_column(name, overflow="fold", no_wrap=i < len(header) - 1)
         for row in rows:

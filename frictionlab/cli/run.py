@@ -12,7 +12,14 @@ from .options import add_executor_options, add_workers_option, executor_run_opti
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("run", help="run a preset headless and write its results")
+    p = sub.add_parser(
+        "run",
+        help="run a preset headless and write its results",
+        description="Run a preset (a file, or a built-in's name) and write its run folder: summary.json, "
+        "curve.csv, realizations.npz, preset.yaml, then plot.png after the fit is printed.",
+        epilog="examples:\n  frictionlab run quickstart\n  frictionlab run quickstart --set spectrum.params.hurst=0.6 --out runs/h06\n"
+        "  frictionlab run presets/benad2012-fig2.yaml --no-plot --json",
+    )
     p.add_argument("preset", help="preset YAML file, or a built-in preset's name (frictionlab presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
     p.add_argument(
