@@ -33,9 +33,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from .main import build_parser
-
-    print(completion_script(args.shell, build_parser()), end="")
+    print(completion_script(args.shell, args.parser), end="")
     return ExitCode.OK
 
 

@@ -112,7 +112,9 @@ def main(argv: list[str] | None = None) -> int:
     if problem:
         print(problem, file=sys.stderr)
         return int(ExitCode.USAGE)
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    args.parser = parser  # a command that describes the CLI itself (completion) reads it
     if args.command is None:  # only options, none of which exits (there are none today)
         return _print(short_help())
     with RaiseOnSigterm():
