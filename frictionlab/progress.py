@@ -1,4 +1,4 @@
-"""Progress of a run, of a sweep and of any long phase, as people read it: a rich
+"""Progress of a run and of a sweep, as people read it: a rich
 progress bar on a terminal or in a Jupyter notebook, plain lines elsewhere (a log
 file, a pipe), one every tenth of the work so that logs stay short.
 
@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import sys
 import time
-from contextlib import contextmanager
 
 from .hookspecs import hookimpl
-from .listeners import SweepListener, format_duration, progress_text
+from .listeners import SweepListener, progress_text
 
 
 def _in_notebook() -> bool:
@@ -57,13 +56,19 @@ class _Bar:
         self.progress.stop()
 
 
+SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond its first line
+
+
 class ProgressReporter:
     """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr): a bar
-    when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth."""
+    when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth;
+    either only once the run has gone on ``after`` seconds (a short run stays one line)."""
 
-    def __init__(self, stream=None, interactive: bool | None = None):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
         self.stream = stream or sys.stderr
         self.interactive = wants_bar(self.stream) if interactive is None else interactive
+        self.after = after
+        self.total = 0
         self.bar: _Bar | None = None
         self.started = 0.0
         self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
@@ -94,10 +99,14 @@ class ProgressReporter:
             f"{preset.name}: {run.total} realizations of {run.scene.generator.name} lines{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)"
         )
-        if self.interactive:
-            self.bar = _Bar(self.stream, "realizations", run.total, completed=run.resumed)
 
     def _progress(self, done: int, total: int) -> None:
+        if time.perf_counter() - self.started < self.after:
+            while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
+                self.next_tenth += 1
+            return
+        if self.interactive and self.bar is None:
+            self.bar = _Bar(self.stream, "realizations", total, completed=done)
         if self.bar is not None:
             self.bar.update(done, f"{self.failed} failed" if self.failed else "")
         elif done == total or 10 * done >= self.next_tenth * total:
@@ -129,9 +138,10 @@ class SweepProgress(SweepListener):
     """One line per point on ``stream`` (stderr); each point's run reports its own
     realizations through a ``ProgressReporter``."""
 
-    def __init__(self, stream=None, interactive: bool | None = None):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
         self.stream = stream or sys.stderr
         self.interactive = interactive
+        self.after = after
 
     def _write(self, text: str) -> None:
         self.stream.write(text + "\n")
@@ -145,56 +155,8 @@ class SweepProgress(SweepListener):
         self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")
 
     def run_listeners(self, point):
-        return [ProgressReporter(self.stream, self.interactive)]
+        return [ProgressReporter(self.stream, self.interactive, self.after)]
 
     def point_finished(self, sweep, point, result):
         if result.status == "error":
             self._write(f"point {point.number} failed: {result.error}")
-
-
-class Phase:
-    """The progress of one long phase of a study (calibrations, readings, steps of a
-    solver): ``advance()`` per item done; a bar on a terminal, else a line per tenth."""
-
-    def __init__(self, description: str, total: int, stream=None, interactive: bool | None = None):
-        self.stream = stream or sys.stderr
-        self.description, self.total, self.done = description, max(1, int(total)), 0
-        self.started = time.perf_counter()
-        self.next_tenth = 1
-        interactive = wants_bar(self.stream) if interactive is None else interactive
-        self.bar = _Bar(self.stream, description, self.total) if interactive else None
-
-    def advance(self, steps: int = 1, note: str = "") -> None:
-        self.done = min(self.total, self.done + steps)
-        if self.bar is not None:
-            self.bar.update(self.done, note)
-        elif self.done == self.total or 10 * self.done >= self.next_tenth * self.total:
-            elapsed = time.perf_counter() - self.started
-            self.stream.write(f"{self.description}: {self.done}/{self.total}, elapsed {format_duration(elapsed)}\n")
-            self.stream.flush()
-            while self.next_tenth * self.total <= 10 * self.done:
-                self.next_tenth += 1
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.stop()
-            self.bar = None
-
-
-class _NoPhase:
-    def advance(self, steps: int = 1, note: str = "") -> None:
-        pass
-
-    def close(self) -> None:
-        pass
-
-
-@contextmanager
-def phase(description: str, total: int, *, quiet: bool = False, stream=None):
-    """``with phase("calibrations", 12) as step: ... step.advance()``: progress of a
-    phase, nothing at all when ``quiet``."""
-    shown = _NoPhase() if quiet else Phase(description, total, stream)
-    try:
-        yield shown
-    finally:
-        shown.close()

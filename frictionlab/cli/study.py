@@ -157,7 +157,9 @@ def run(args) -> ExitCode:
         if not args.quiet:
             print(f"study: {message}", file=sys.stderr, flush=True)
 
-    study = Study(factory, options, progress)
+    from ..progress import ProgressReporter
+
+    study = Study(factory, options, progress, run_listeners=list if args.quiet else (lambda: [ProgressReporter()]))
     reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"
     progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {reference}")
     interrupted = False

@@ -14,7 +14,7 @@ class FakeTerminal(io.StringIO):
 
 def test_terminal_gets_a_rich_bar_that_ends_full(make_scene):
     stream = FakeTerminal()
-    engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream)])
+    engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream, after=0)])
     text = stream.getvalue()
     assert text.startswith("small: 30 realizations of power-law lines, 16 force steps, 1 worker(s)\n")
     last = text.split("\r")[-1]
@@ -22,23 +22,17 @@ def test_terminal_gets_a_rich_bar_that_ends_full(make_scene):
     assert text.removesuffix("\x1b[?25h").endswith("\n")  # the cursor shown again after the last line
 
 
-def test_a_phase_shows_a_line_per_tenth_in_a_log_and_nothing_when_quiet():
-    from frictionlab.progress import phase
-
-    stream = io.StringIO()
-    with phase("calibrations", 5, stream=stream) as step:
-        for _ in range(5):
-            step.advance()
-    assert [line.split(",")[0] for line in stream.getvalue().splitlines()] == [f"calibrations: {i}/5" for i in range(1, 6)]
-    quiet = io.StringIO()
-    with phase("calibrations", 5, quiet=True, stream=quiet) as step:
-        step.advance()
-    assert quiet.getvalue() == ""
+def test_a_run_shorter_than_two_seconds_stays_one_line(make_scene):
+    for interactive in (False, True):
+        stream = FakeTerminal()
+        reporter = ProgressReporter(stream, interactive=interactive)  # 2 s before anything more is shown
+        engine.run(make_scene({"realizations": 4}), RunOptions(workers=1), listeners=[reporter])
+        assert stream.getvalue().startswith("small: 4 realizations") and stream.getvalue().count("\n") == 1
 
 
 def test_log_file_gets_one_plain_line_per_tenth(make_scene):
     stream = io.StringIO()
-    reporter = ProgressReporter(stream)
+    reporter = ProgressReporter(stream, after=0)
     engine.run(make_scene({"realizations": 20}), RunOptions(workers=1), listeners=[reporter])
     lines = stream.getvalue().split("\n")[:-1]
     assert [line.split(" ")[0] for line in lines[1:]] == [f"{2 * i}/20" for i in range(1, 11)]
