@@ -67,9 +67,14 @@ def wrap_title(title: str, width_inches: float, fontsize: float) -> str:
 
 
 def plot_sweep(sweep, rows: list[dict[str, Any]], fh, dpi: int = 90) -> None:
-    """sweep.png: a and b (rows of panels) against each swept parameter (columns), each
-    axis named by what it is (``sweep.axis_label``), with their bootstrap intervals;
-    in a grid the other parameters' values make the series."""
+    """sweep.png (``sweep_figure``)."""
+    sweep_figure(sweep, rows).savefig(fh, format="png", dpi=dpi)
+
+
+def sweep_figure(sweep, rows: list[dict[str, Any]]) -> Figure:
+    """a and b (rows of panels) against each swept parameter (columns), each axis
+    named by what it is (``sweep.axis_label``), with their bootstrap intervals; in a
+    grid the other parameters' values make the series."""
     paths = sweep.paths
     width = 4.2 * len(paths)
     fig = Figure(figsize=(width, 5.6), layout="constrained")
@@ -105,4 +110,4 @@ def plot_sweep(sweep, rows: list[dict[str, Any]], fh, dpi: int = 90) -> None:
                 ax.legend(fontsize=7)
     title = f"{sweep.name}: xi = a + b ln f per point (95% bootstrap intervals)"
     fig.suptitle(wrap_title(title, width, 10), fontsize=10)
-    fig.savefig(fh, format="png", dpi=dpi)
+    return fig

@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+import frictionlab
+
 from frictionlab.errors import ExitCode, PresetFileError
 from frictionlab.preset.builtin import builtin_presets, find_builtin, resolve_preset_path
 
@@ -92,6 +94,10 @@ def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, t
     assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
     for row in listed:  # the installed copies, not the checkout's
         assert Path(row["path"]).is_relative_to(installed / "frictionlab" / "builtin_presets")
-    result = cli("run", "quickstart", "--out", "q", "--quiet", "--workers", "1")
+    result = cli("run", "quickstart", "--out", "q", "--quiet", "--workers", "1", "--no-plot")
     assert result.returncode == 0, result.stderr
     assert (empty / "q" / "summary.json").is_file() and "a  " in result.stdout
+    code = "import frictionlab; r = frictionlab.run('quickstart', progress=False); print(frictionlab.__file__, r.fit.a, r.fit.b)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=empty, env=env, timeout=300)
+    where, a, b = done.stdout.split()
+    assert Path(where).is_relative_to(installed) and float(a) == frictionlab.load(empty / "q").fit.a

@@ -51,3 +51,22 @@ def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make
     reporter.started = time.perf_counter() - 2.0  # 2 s for the 2 realizations left: 1 per second
     line = reporter._line(10, 10)
     assert ", 1.0/s," in line, line
+
+
+def test_a_notebook_gets_a_bar_even_without_a_terminal(monkeypatch):
+    import sys
+    import types
+
+    from frictionlab.progress import wants_bar
+
+    assert not wants_bar(io.StringIO())
+    ipython = types.ModuleType("IPython")
+
+    class ZMQInteractiveShell:  # Jupyter's kernel shell, by its class name as IPython reports it
+        pass
+
+    ipython.get_ipython = ZMQInteractiveShell
+    monkeypatch.setitem(sys.modules, "IPython", ipython)
+    assert wants_bar(io.StringIO())
+    ipython.get_ipython = lambda: None  # IPython imported, but a plain terminal shell or none
+    assert not wants_bar(io.StringIO())
