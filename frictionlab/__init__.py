@@ -28,7 +28,7 @@ _LAZY = {
         ),
         "plugin",
     ),  # fmt: skip
-    **dict.fromkeys(("run", "load", "Result"), "api"),
+    **dict.fromkeys(("run", "load", "Result", "SweepResult"), "api"),
 }
 
 
@@ -74,6 +74,7 @@ __all__ = [
     "SlopeEstimator",
     "SpectrumGenerator",
     "SweepListener",
+    "SweepResult",
     "__version__",
     "contract",
     "force_unit",

@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from .ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "load", "read_preset_input", "run", "run_scene"]
+__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene"]
 
 @dataclass(frozen=True)
 class Result:
@@ -127,6 +127,37 @@ class Result:
         where = f", folder {str(self.folder)!r}" if self.folder else ""
         done, requested = self.realizations
         return f"<Result {self.name!r}: {self.status}, {done}/{requested} realizations, {fit}{where}>"
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A finished sweep: one row per point (``rows``: the swept values by dotted path,
+    ``a``, ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``,
+    ``contact_last``, ``status``, ``folder``), each point's run in ``folder``/points/."""
+
+    name: str
+    status: str  # completed | interrupted | failed
+    parameters: list[str]  # the swept dotted paths
+    rows: list[dict]
+    folder: Path
+    elapsed: float
+
+    @property
+    def points(self) -> list[Result]:
+        """Each finished point's ``Result``, read from its folder."""
+        return [load(self.folder / row["folder"]) for row in self.rows if row.get("a") is not None]
+
+    def to_pandas(self):
+        """The rows as a pandas DataFrame, or without pandas a dict of numpy arrays by column."""
+        columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
+        try:
+            import pandas as pd
+        except ImportError:
+            return {key: np.array(values) for key, values in columns.items()}
+        return pd.DataFrame(columns)
+
+    def __repr__(self) -> str:
+        return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"
 
 
 def read_preset_input(
@@ -205,20 +236,26 @@ def run(
     same whatever they are). ``progress``: a bar on stderr (on a terminal, or in
     Jupyter), plain lines elsewhere.
 
-    A preset with a ``sweep`` is refused here: ``frictionlab run`` runs sweeps.
-    Bad input raises a ``frictionlab.errors.FrictionlabError`` naming the field.
+    A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
+    point) and returns a ``SweepResult``. Bad input raises a
+    ``frictionlab.errors.FrictionlabError`` naming the field.
     """
     from .preset import build_scene
+    from .progress import ProgressReporter, SweepProgress
 
     data, source, _ = read_preset_input(preset, overrides, **keys)
     scene = build_scene(data, source=source)
-    if scene.preset.sweep is not None:
-        raise FrictionlabError(f"{source}: a sweep; run it with `frictionlab run` (or set sweep=None to run one point)")
     options = RunOptions(
         workers=workers, executor=executor, scheduler=scheduler, resume=resume, force=force, memory_check=memory_check
     )
-    from .progress import ProgressReporter
+    if scene.preset.sweep is not None:
+        from .sweep import plan_sweep, run_sweep
 
+        if out is None:
+            raise FrictionlabError(f"{source}: a sweep writes a run folder per point: give out=FOLDER")
+        sweep = plan_sweep(data, source=source)
+        run_sweep(sweep, out, options, listeners=[SweepProgress()] if progress else [], plot=plot)
+        return load(out)
     return run_scene(scene, out, options, listeners=[ProgressReporter()] if progress else [], plot=plot)
 
 
@@ -274,15 +311,18 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
     )  # fmt: skip
 
 
-def load(folder: str | Path) -> Result:
+def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers
-    to the last bit. A folder without summary.json is a ``RunFolderError``."""
+    to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. A folder
+    with neither is a ``RunFolderError``."""
     folder = Path(folder)
+    if not (folder / "summary.json").exists() and (folder / "sweep.json").exists():
+        return _load_sweep(folder)
     try:
         summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise RunFolderError(f"{folder}: no summary.json; not a finished run (a sweep? see its points/)") from None
+        raise RunFolderError(f"{folder}: no summary.json (nor sweep.json): not a finished run") from None
     except (OSError, ValueError) as exc:
         raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
     with open(folder / summary.get("files", {}).get("curve", "curve.csv"), newline="", encoding="utf-8") as fh:
@@ -306,3 +346,15 @@ def load(folder: str | Path) -> Result:
         folder=folder,
         files={k: folder / v for k, v in (summary.get("files") or {}).items()},
     )
+
+
+def _load_sweep(folder: Path) -> SweepResult:
+    try:
+        summary = json.loads((folder / "sweep.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise RunFolderError(f"{folder}/sweep.json cannot be read: {exc}") from None
+    rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
+    return SweepResult(
+        name=summary["name"], status=summary["status"], parameters=list(summary["sweep"]["parameters"]), rows=rows,
+        folder=folder, elapsed=float(summary.get("elapsed_seconds") or 0.0),
+    )  # fmt: skip

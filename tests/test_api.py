@@ -56,8 +56,20 @@ def test_bad_input_is_a_clear_error_naming_the_field():
         frictionlab.run("quickstrt", **FAST)
     with pytest.raises(FrictionlabError, match="preset must be"):
         frictionlab.run(42, **FAST)
-    with pytest.raises(FrictionlabError, match="sweep"):
+    with pytest.raises(FrictionlabError, match="a sweep writes a run folder per point: give out=FOLDER"):
         frictionlab.run(PRESETS / "benad2012-fig5.yaml", **FAST)
+
+
+def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
+    sweep = {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    result = frictionlab.run(SMALL_PRESET, out=tmp_path / "sweep", sweep=sweep, plot=False, **FAST)
+    assert isinstance(result, api.SweepResult) and result.status == "completed"
+    assert result.parameters == ["spectrum.params.hurst"] and [r["spectrum.params.hurst"] for r in result.rows] == [0.5, 0.9]
+    for row, point in zip(result.rows, result.points, strict=True):
+        alone = frictionlab.run(SMALL_PRESET, spectrum__params__hurst=row["spectrum.params.hurst"], **FAST)
+        assert point.fit == alone.fit and row["a"] == alone.fit.a and row["b_hi"] == alone.fit.b_ci[1]
+    assert frictionlab.load(tmp_path / "sweep").rows == result.rows
+    assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
 
 
 def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path):

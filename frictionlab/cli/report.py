@@ -18,7 +18,7 @@ def add_parser(sub) -> None:
         "(markdown and figures); --readings adds the readings of the paper's method (minutes).",
         epilog="examples:\n  frictionlab report --out runs/report\n  frictionlab report --readings --json",
     )
-    p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets)")
+    p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets if it holds them, else the built-in presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
     p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
     p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
