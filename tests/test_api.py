@@ -140,3 +140,9 @@ def test_import_frictionlab_imports_neither_the_api_nor_matplotlib_nor_scipy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"
     assert callable(frictionlab.run) and frictionlab.Result is api.Result
+
+
+def test_every_public_name_resolves_lazily():
+    code = "import frictionlab; [getattr(frictionlab, n) for n in frictionlab.__all__]; from frictionlab import *; print('ok')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.strip() == "ok", done.stderr
