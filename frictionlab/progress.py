@@ -34,7 +34,7 @@ def wants_bar(stream) -> bool:
 class _Bar:
     """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
 
-    def __init__(self, stream, description: str, total: int, completed: int = 0):
+    def __init__(self, stream, description: str, total: int, completed: int = 0, started: float | None = None):
         from rich.console import Console
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
@@ -42,8 +42,11 @@ class _Bar:
         self.progress = Progress(
             TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=10,
+            get_time=time.perf_counter,
         )  # fmt: skip
         self.task = self.progress.add_task(description, total=total, completed=completed, note="")
+        if started is not None:  # drawn late (a run shows its bar after 2 s): the clock is the run's
+            self.progress.tasks[0].start_time = started
         self.progress.start()
 
     def update(self, completed: int, note: str = "") -> None:
@@ -106,7 +109,7 @@ class ProgressReporter:
                 self.next_tenth += 1
             return
         if self.interactive and self.bar is None:
-            self.bar = _Bar(self.stream, "realizations", total, completed=done)
+            self.bar = _Bar(self.stream, "realizations", total, completed=done, started=self.started)
         if self.bar is not None:
             self.bar.update(done, f"{self.failed} failed" if self.failed else "")
         elif done == total or 10 * done >= self.next_tenth * total:
