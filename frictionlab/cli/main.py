@@ -1,9 +1,19 @@
 """The parser and the dispatch of ``frictionlab COMMAND``.
 
-Results go to stdout, progress and errors to stderr. Exit codes are
-``ExitCode``. A user error never prints a traceback (set ``FRICTIONLAB_DEBUG=1``
-to see one for an internal error). SIGTERM ends a run as Ctrl-C does; a closed
-stdout ends the command quietly.
+Conventions every command keeps (tested in tests/cli/test_conventions.py):
+
+* results go to stdout, progress and errors to stderr; ``--json`` puts the results as
+  JSON on stdout (run, validate, plugins, presets, study, report, predict);
+* a bare ``frictionlab`` prints a short help with examples; ``-V``/``--version`` the
+  version; every ``COMMAND --help`` a description and examples;
+* a mistyped command, plugin or preset name is answered with the closest names;
+* tables fit the terminal (rich) and are plain aligned columns in a pipe; colour only
+  on a terminal, never with ``NO_COLOR`` set; progress is a bar on a terminal and a
+  line per tenth in a log, shown once a run passes 2 s, none with ``--quiet``;
+* ``frictionlab completion bash|zsh|fish`` prints a completion script;
+* exit codes are ``ExitCode``; a user error never prints a traceback (set
+  ``FRICTIONLAB_DEBUG=1`` to see one for an internal error); SIGTERM ends a run as
+  Ctrl-C does; a closed stdout ends the command quietly (141).
 """
 
 from __future__ import annotations
@@ -15,8 +25,8 @@ import warnings
 
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
-from .console import error_label
 from . import completion, plugins, predict, presets, report, resume, run, schema, study, tui, validate
+from .console import error_label
 
 COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
