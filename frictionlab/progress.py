@@ -65,7 +65,8 @@ SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond it
 class ProgressReporter:
     """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr): a bar
     when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth;
-    either only once the run has gone on ``after`` seconds (a short run stays one line)."""
+    either only once the run has gone on ``after`` seconds (a short run shows its first
+    line and, in a log, its last)."""
 
     def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
         self.stream = stream or sys.stderr
@@ -104,7 +105,7 @@ class ProgressReporter:
         )
 
     def _progress(self, done: int, total: int) -> None:
-        if time.perf_counter() - self.started < self.after:
+        if time.perf_counter() - self.started < self.after and not (done == total and not self.interactive):
             while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
                 self.next_tenth += 1
             return

@@ -22,12 +22,14 @@ def test_terminal_gets_a_rich_bar_that_ends_full(make_scene):
     assert text.removesuffix("\x1b[?25h").endswith("\n")  # the cursor shown again after the last line
 
 
-def test_a_run_shorter_than_two_seconds_stays_one_line(make_scene):
-    for interactive in (False, True):
+def test_a_run_shorter_than_two_seconds_shows_its_first_line_and_in_a_log_its_last(make_scene):
+    for interactive, lines in ((True, 1), (False, 2)):
         stream = FakeTerminal()
         reporter = ProgressReporter(stream, interactive=interactive)  # 2 s before anything more is shown
         engine.run(make_scene({"realizations": 4}), RunOptions(workers=1), listeners=[reporter])
-        assert stream.getvalue().startswith("small: 4 realizations") and stream.getvalue().count("\n") == 1
+        text = stream.getvalue()
+        assert text.startswith("small: 4 realizations") and text.count("\n") == lines
+        assert interactive or text.splitlines()[1].startswith("4/4 realizations")
 
 
 def test_log_file_gets_one_plain_line_per_tenth(make_scene):
