@@ -32,12 +32,15 @@ def test_every_preset_of_the_folder_is_listed_with_its_own_description():
         assert own.startswith(words) and 10 < len(preset.description) <= 104, preset.description
 
 
-def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path):
+def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     assert resolve_preset_path("quickstart") == find_builtin("quickstart.yaml").path
     mine = tmp_path / "quickstart.yaml"
     assert resolve_preset_path(mine) == mine  # a path is never swapped for a built-in
     with pytest.raises(PresetFileError, match=r"did you mean 'quickstart'\?"):
         resolve_preset_path("quikstart")
+    with pytest.raises(PresetFileError, match=r"no file 'quickstart.yaml' here; the built-in preset of that name is 'quickstart'"):
+        resolve_preset_path("quickstart.yaml")  # from a folder without that file
 
 
 def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):
