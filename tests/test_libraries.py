@@ -50,10 +50,13 @@ FORK_AND_DIE = """
 import os, signal, sys, time
 from frictionlab.rundir import RunDirectory
 with RunDirectory(sys.argv[1]):
+    started, ready = os.pipe()
     child = os.fork()
     if child == 0:  # a pool worker that outlives the main process
+        os.write(ready, b"1")  # fork has returned here: the at-fork handlers have run
         time.sleep(30)
         os._exit(0)
+    os.read(started, 1)
     print(child, flush=True)
     os.kill(os.getpid(), signal.SIGKILL)  # the main process dies holding the lock
 """
