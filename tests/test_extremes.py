@@ -1,7 +1,7 @@
 """Numerical extremes (issue 4): each gives the right answer, checked against a known value or
 limit, or a clear error; never a NaN, an overflow, a hang or a traceback.
 
-The README's "Numerical extremes" table lists each case with the test that checks it here
+The "Numerical extremes" page (docs/explanation/extremes.md) lists each case with the test that checks it here
 (or in the older test files, where the case was already covered).
 """
 

@@ -17,12 +17,12 @@ import json
 import re
 from pathlib import Path
 
-from mkdocs.structure.files import File
-
 ROOT = Path(__file__).resolve().parents[2]
 
 
 def on_files(files, config):
+    from mkdocs.structure.files import File
+
     pages = {
         "reference/cli.md": cli_reference(),
         "reference/presets.md": preset_reference(),
