@@ -5,7 +5,8 @@
 - reference/presets.md: every section of a preset and every built-in plugin's
   parameters, from their pydantic models' JSON Schema;
 - explanation/reproduction.md: REPRODUCTION.md as ``frictionlab report`` wrote it,
-  its figure paths made relative to the page.
+  its figure paths made relative to the page;
+- architecture.md: ARCHITECTURE.md, the layers of the code.
 
 Nothing here is written to the source tree: the pages exist in the built site only.
 """
@@ -27,6 +28,7 @@ def on_files(files, config):
         "reference/cli.md": cli_reference(),
         "reference/presets.md": preset_reference(),
         "explanation/reproduction.md": reproduction_page(),
+        "architecture.md": (ROOT / "ARCHITECTURE.md").read_text(encoding="utf-8"),
     }
     for src_uri, content in pages.items():
         files.append(File.generated(config, src_uri, content=content))
