@@ -28,8 +28,8 @@ def _shown_block(page: str, first_line: str) -> list[str]:
 
 
 def _comparable(line: str) -> bool:
-    """Lines that hold no wall time and no output folder (those differ run to run)."""
-    return not re.search(r" in \d+\.\d+ s\b|^results in |^\.\.\.$", line.strip())
+    """Output lines that hold no wall time and no output folder (those differ run to run)."""
+    return not re.search(r" in \d+\.\d+ s\b|^results in |^\.\.\.$|^\$ ", line.strip())
 
 
 def _check(page: str, first_line: str, printed: str):
@@ -75,3 +75,15 @@ def test_the_predictions_shown_are_what_predict_prints(fig2_run, capsys):
 def test_the_calibration_shown_is_what_it_prints(capsys):
     calibration.main(str(ROOT / "presets" / "benad2012-fig2.yaml"))
     _check("docs/tutorials/reproduce-fig2.md", "least-squares (in log) h =", capsys.readouterr().out)
+
+
+def test_the_validation_errors_shown_are_what_validate_prints(tmp_path, monkeypatch, capsys):
+    quickstart = (ROOT / "presets" / "quickstart.yaml").read_text(encoding="utf-8")
+    bad = quickstart.replace("hurst: 0.8", "hurst: 2.0").replace("steps: 40", "steps: abc")
+    bad = re.sub(r"(?m)^  name: mdr$", "  name: mdrr", bad)
+    assert bad.count("2.0") and "abc" in bad and "mdrr" in bad, "the quickstart preset changed: update the page's bad.yaml"
+    (tmp_path / "bad.yaml").write_text(bad, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate", "bad.yaml"]) == 2
+    captured = capsys.readouterr()
+    _check("docs/how-to/presets.md", "$ frictionlab validate bad.yaml", captured.out + captured.err)
