@@ -6,32 +6,32 @@ xi = a + b ln f with its intervals and R², the table per load step, a plot. Wit
 ``out=FOLDER`` it writes the same run folder as ``frictionlab run --out FOLDER``;
 ``load(FOLDER)`` reads any finished run back, with the same numbers.
 
->>> import frictionlab
->>> r = frictionlab.run("quickstart", realizations=8, workers=1, progress=False)
->>> r.status, r.realizations
-('completed', (8, 8))
->>> import numpy as np
->>> ln_f, xi = np.log(r.table["f"]), r.table["xi"]  # a least-squares line passes through the means:
->>> bool(abs(r.fit.a + r.fit.b * ln_f.mean() - xi.mean()) < 1e-9)
-True
->>> sorted(r.table)[:3]
-['F', 'contact_count', 'contact_fraction']
+    >>> import frictionlab
+    >>> r = frictionlab.run("quickstart", realizations=8, workers=1, progress=False)
+    >>> r.status, r.realizations
+    ('completed', (8, 8))
+    >>> import numpy as np
+    >>> ln_f, xi = np.log(r.table["f"]), r.table["xi"]  # a least-squares line passes through the means:
+    >>> bool(abs(r.fit.a + r.fit.b * ln_f.mean() - xi.mean()) < 1e-9)
+    True
+    >>> sorted(r.table)[:3]
+    ['F', 'contact_count', 'contact_fraction']
 
 Overrides are dotted paths into the preset. Python keywords cannot hold dots: give
 them as a dict, or spell each dot as a double underscore:
 
->>> a = frictionlab.run("quickstart", {"spectrum.params.hurst": 0.6}, realizations=8, workers=1, progress=False)
->>> b = frictionlab.run("quickstart", spectrum__params__hurst=0.6, realizations=8, workers=1, progress=False)
->>> a.fit.a == b.fit.a and a.preset["spectrum"]["params"]["hurst"] == 0.6
-True
+    >>> a = frictionlab.run("quickstart", {"spectrum.params.hurst": 0.6}, realizations=8, workers=1, progress=False)
+    >>> b = frictionlab.run("quickstart", spectrum__params__hurst=0.6, realizations=8, workers=1, progress=False)
+    >>> a.fit.a == b.fit.a and a.preset["spectrum"]["params"]["hurst"] == 0.6
+    True
 
 A run folder, read back:
 
->>> import tempfile, pathlib
->>> folder = pathlib.Path(tempfile.mkdtemp()) / "run"
->>> r = frictionlab.run("quickstart", realizations=8, workers=1, progress=False, plot=False, out=folder)
->>> frictionlab.load(folder).fit == r.fit
-True
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp()) / "run"
+    >>> r = frictionlab.run("quickstart", realizations=8, workers=1, progress=False, plot=False, out=folder)
+    >>> frictionlab.load(folder).fit == r.fit
+    True
 
 The CLI's ``frictionlab run`` goes through ``run_scene`` here, so both write the
 same files; ``--no-plot`` is ``plot=False``.
