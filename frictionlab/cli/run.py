@@ -68,9 +68,14 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     from ..results import summary_dict
     from ..signals import interrupted_exit_code
 
+    closed = []  # a closed stdout, raised again once the run folder is finished
+
     def print_table(result) -> None:  # before the figure is drawn: nobody waits for matplotlib
         if not args.json:
-            print(result_table(scene, result.outcome, out_dir), flush=True)
+            try:
+                print(result_table(scene, result.outcome, out_dir), flush=True)
+            except BrokenPipeError as exc:
+                closed.append(exc)
 
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
@@ -78,6 +83,8 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
+    if closed:
+        raise closed[0]
     outcome = result.outcome
     if args.json:
         summary = summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()})

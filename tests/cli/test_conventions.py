@@ -183,3 +183,16 @@ def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path):
     assert out["recommendation"] and not out["interrupted"]
     assert {row["axis"] for row in out["rows"]} == {"realizations"}
     assert (tmp_path / "study" / "study.csv").is_file() and out["files"]["csv"].endswith("study.csv")
+
+
+def test_a_run_whose_reader_left_still_finishes_its_folder(tmp_path):
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run([sys.executable, "-m", "frictionlab", "run", "quickstart", "--out", str(tmp_path / "q"),
+                               "--quiet", "--workers", "1"], stdout=write_end, stderr=subprocess.PIPE, timeout=120)  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert done.returncode == ExitCode.BROKEN_PIPE and done.stderr == b""
+    state = json.loads((tmp_path / "q" / "run.json").read_text())
+    assert state["status"] == "completed" and (tmp_path / "q" / "plot.png").is_file()
