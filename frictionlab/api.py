@@ -61,7 +61,8 @@ if TYPE_CHECKING:
 
 __all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene"]
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
 class Result:
     """One finished run: what ``frictionlab.run`` returns and ``frictionlab.load`` reads.
 
@@ -129,7 +130,7 @@ class Result:
         return f"<Result {self.name!r}: {self.status}, {done}/{requested} realizations, {fit}{where}>"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SweepResult:
     """A finished sweep: one row per point (``rows``: the swept values by dotted path,
     ``a``, ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``,
