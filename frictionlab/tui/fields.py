@@ -11,6 +11,7 @@ import copy
 import types
 import typing
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Literal
 
 import yaml
@@ -19,7 +20,7 @@ from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
 from ..plugin import KINDS
-from ..preset import MISSING, Preset, build_scene, set_path
+from ..preset import MISSING, Preset, build_scene, resolve_input_paths, set_path
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 
@@ -163,9 +164,18 @@ def default_plugin_name(slot: str) -> str | None:
     return info.default_factory().name
 
 
-def problems_of(data: dict, registry) -> list[str]:
-    """The headless validator's problems for ``data`` (empty when it is valid)."""
+def default_spectrum(registry) -> str:
+    """The spectrum a preset gets when it names none (else the first registered)."""
+    return default_plugin_name("spectrum") or registry.names("spectrum")[0]
+
+
+def problems_of(data: dict, registry, base_dir: Path | None = None) -> list[str]:
+    """The headless validator's problems for ``data`` (empty when it is valid);
+    relative input files are taken from ``base_dir``, the preset file's folder,
+    as ``frictionlab validate`` takes them."""
     try:
+        if base_dir is not None:
+            data = resolve_input_paths(data, base_dir, registry)
         build_scene(data, registry=registry)
     except PresetError as exc:
         return list(exc.problems)

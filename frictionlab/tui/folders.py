@@ -19,6 +19,7 @@ from pathlib import Path
 import yaml
 
 from ..files import atomic_write
+from ..preset import load_preset_file, resolve_input_paths
 from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
@@ -41,8 +42,13 @@ def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str,
 
 
 def writable_folder(folders: list[tuple[str, Path]]) -> Path:
-    """Where new presets and copies go: the user folder (or the only one given)."""
+    """Where copies go by default: the user folder (or the only one given)."""
     return folders[-1][1]
+
+
+def new_preset_path(name: str, folder: Path | None = None) -> Path:
+    """Where a new preset is saved unless the user says otherwise: the current folder."""
+    return (folder or Path(".")) / f"{name}.yaml"
 
 
 @dataclass(frozen=True)
@@ -69,6 +75,25 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
             description = " ".join(str(data.get("description") or "").split())
             entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
     return entries
+
+
+def templates(entries: list[PresetEntry]) -> list[PresetEntry]:
+    """The presets a new one may start from: the listed ones that can be read.
+
+    The presets shipped in the package (``preset.builtin``) are to be listed
+    here first once they exist; until then a new preset starts from one of the
+    project's or user's presets."""
+    return [entry for entry in entries if not entry.error]
+
+
+def preset_from_template(template: Path, name: str, new_path: Path, registry=None) -> dict:
+    """A template preset's data renamed ``name``, its relative input files
+    made to work from ``new_path``'s folder (raises ``PresetError``)."""
+    data = load_preset_file(template)
+    if Path(template).resolve().parent != Path(new_path).resolve().parent:
+        data = resolve_input_paths(data, Path(template).parent, registry)
+    data["name"] = name
+    return data
 
 
 def save_preset(path: Path, data: dict, template: Path | None = None) -> None:

@@ -136,3 +136,14 @@ def make_runs(folders, registry):
     for seed in (1, 2):
         data = merge(TINY, {"seed": seed, "name": f"seed{seed}"})
         run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", RunOptions(workers=1))
+
+
+def screen_text(app) -> str:
+    """What the terminal shows now, line by line (the top screen, toasts and dialogs included)."""
+    return "\n".join(strip.text for strip in app.screen._compositor.render_strips())
+
+
+def status_text(app) -> str:
+    """The status line's message ("" if the app has none)."""
+    lines = app.query("#status")
+    return str(lines.first().render()) if lines else ""

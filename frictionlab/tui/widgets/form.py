@@ -8,6 +8,7 @@ user switches back."""
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import yaml
 
@@ -45,7 +46,7 @@ class HeadlessCheck(Validator):
     def validate(self, value: str) -> ValidationResult:
         candidate = with_value(self.form.data, self.spec.path, parse(self.spec, value))
         self.form.ensure_plugin_name(candidate, self.spec.path)
-        problems = problems_for(problems_of(candidate, self.form.registry), self.spec.dotted)
+        problems = problems_for(problems_of(candidate, self.form.registry, self.form.base_dir), self.spec.dotted)
         return self.failure("\n".join(problems)) if problems else self.success()
 
 
@@ -78,6 +79,7 @@ class PresetForm(VerticalScroll):
         super().__init__(**kwargs)
         self.registry = registry
         self.data: dict | None = None
+        self.base_dir: Path | None = None  # the preset file's folder: relative input files are taken from it
         self.problems: list[str] = []
         self._specs: dict[str, FieldSpec] = {}
         self._stash: dict[tuple[str, str], dict] = {}  # (slot, plugin) -> params left behind
@@ -86,8 +88,9 @@ class PresetForm(VerticalScroll):
 
     # ------------------------------------------------------------ building
 
-    async def load(self, data: dict) -> None:
+    async def load(self, data: dict, base_dir: Path | None = None) -> None:
         self.data = copy.deepcopy(data)
+        self.base_dir = base_dir
         self._stash.clear()
         await self.recompose()
         self.revalidate(changed=False)
@@ -115,9 +118,7 @@ class PresetForm(VerticalScroll):
                 yield Static("", id=_section_id(spec.path), classes="field-error")
         unknown = [key for key in self.data if key not in Preset.model_fields]
         if unknown:
-            yield Static(
-                f"Kept as in the file (edit the YAML to change): {', '.join(unknown)}", classes="note"
-            )
+            yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(map(str, unknown))}"), classes="note")
 
     def field_rows(self, spec: FieldSpec) -> list[Widget]:
         self._specs[spec.widget_id] = spec
@@ -143,8 +144,11 @@ class PresetForm(VerticalScroll):
                 validators=[HeadlessCheck(self, spec)],
                 validate_on=["changed"],
                 compact=True,
+                # a text (a description) is read from its start: selecting it on focus would show its end
+                select_on_focus=spec.kind != "text",
                 id=spec.widget_id,
             )
+            widget.cursor_position = 0
         else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
             shown = "(none)" if value in (MISSING, None) else _flow(value)
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
@@ -154,9 +158,9 @@ class PresetForm(VerticalScroll):
             self._seen[spec.widget_id] = bool(current)
         elif spec.kind == "choice":
             self._seen[spec.widget_id] = current if current in spec.choices else Select.NULL
-        widget.tooltip = spec.tooltip()
-        label = Label(spec.name, classes="field-label")
-        label.tooltip = spec.tooltip()
+        widget.tooltip = Content(spec.tooltip())  # descriptions are text, never markup
+        label = Label(Content(spec.name), classes="field-label")
+        label.tooltip = Content(spec.tooltip())
         return [
             Horizontal(label, widget, classes="row"),
             Static("", id=spec.widget_id + "--error", classes="field-error"),
@@ -173,7 +177,7 @@ class PresetForm(VerticalScroll):
             compact=True,
             id=f"plugin--{slot}",
         )
-        select.tooltip = f"{slot} plugin: one of {', '.join(names)}"
+        select.tooltip = Content(f"{slot} plugin: one of {', '.join(names)}")
         self._seen[select.id] = known if known else Select.NULL
         return [
             Label(slot.capitalize(), classes="heading"),
@@ -196,7 +200,7 @@ class PresetForm(VerticalScroll):
         if known is None:
             return [Static("(choose a plugin to see its parameters)", classes="note")]
         cls = self.registry.get(slot, known)
-        rows: list[Widget] = [Static(cls.summary, classes="summary")]
+        rows: list[Widget] = [Static(Content(cls.summary), classes="summary")]
         for spec in field_specs(cls.Params, prefix=(slot, "params")):
             rows += self.field_rows(spec)
         return rows
@@ -270,7 +274,7 @@ class PresetForm(VerticalScroll):
 
     def revalidate(self, changed: bool) -> None:
         """Run the headless validator on the draft and mark every field."""
-        self.problems = problems_of(self.data, self.registry) if self.data is not None else []
+        self.problems = problems_of(self.data, self.registry, self.base_dir) if self.data is not None else []
         shown = set()
         for widget_id, spec in self._specs.items():
             messages = problems_for(self.problems, spec.dotted)
@@ -284,7 +288,7 @@ class PresetForm(VerticalScroll):
             if section.id and section.id.startswith("section--"):
                 dotted = section.id.removeprefix("section--").replace("--", ".")
                 messages = [p for p in self.problems if p not in shown and problem_path(p) == dotted]
-                section.update("\n".join(messages))
+                section.update(Content("\n".join(messages)))
                 section.display = bool(messages)
         self.post_message(self.Edited(self.problems, changed))
 
@@ -293,13 +297,27 @@ class PresetForm(VerticalScroll):
             label = self.query_one(f"#{widget_id}--error", Static)
         except Exception:
             return
-        label.update("\n".join(messages))
+        label.update(Content("\n".join(messages)))
         label.display = bool(messages)
         if widget:
             try:
                 self.query_one(f"#{widget_id}").set_class(bool(messages), "-invalid")
             except Exception:
                 pass
+
+    def focus_problem(self, problems: list[str]) -> None:
+        """Focus the field of the first problem that has one (else the first field), scrolled into view."""
+        for problem in problems:
+            dotted = problem_path(problem)
+            slot, _, rest = dotted.partition(".")
+            for widget_id in ("field--" + dotted.replace(".", "--"), f"plugin--{slot}" if rest == "name" else ""):
+                widgets = self.query(f"#{widget_id}") if widget_id else []
+                if widgets and widgets.first().focusable:
+                    widgets.first().focus()
+                    return
+        fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
+        if fields:
+            fields[0].focus()
 
     def on_descendant_focus(self, event) -> None:
         widget = event.widget
