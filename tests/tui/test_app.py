@@ -89,3 +89,15 @@ def test_a_process_pool_starts_from_the_app_thread():
             capture_output=True, text=True, timeout=120,
         )
         assert result.stdout.strip().splitlines()[-1] == expected, result.stderr[-2000:]
+
+
+def test_the_docs_screenshot_is_made_by_its_command(tmp_path, monkeypatch):
+    """docs/tui/main.svg comes from `python -m frictionlab.tui.screenshot docs/tui/main.svg`."""
+    from frictionlab.tui.screenshot import main as screenshot
+
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "main.svg"
+    assert screenshot([str(out)]) == 0
+    text = out.read_text()
+    assert text.startswith("<svg") and "quickstart" in text
+    assert (ROOT / "docs" / "tui" / "main.svg").read_text().startswith("<svg")
