@@ -238,7 +238,6 @@ class FrictionlabApp(App):
             self.modified = True
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems)
-        self.refresh_bindings()
 
     def _show_edit_state(self) -> None:
         self.query_one(EditPane).show_title(self.draft_path, self.modified, self.problems)

@@ -18,6 +18,7 @@ class EditPane(Vertical):
     def __init__(self, registry, **kwargs):
         super().__init__(**kwargs)
         self.registry = registry
+        self._shown: list[str] | None = None  # the problems the panel shows
 
     def compose(self) -> ComposeResult:
         yield PathLine(id="edit-title")
@@ -35,6 +36,9 @@ class EditPane(Vertical):
         title.show("", str(path), f"  ({state}{count})")
 
     def show_problems(self, problems: list[str]) -> None:
+        if problems == self._shown:
+            return  # unchanged: no new layout for a keystroke that changes nothing here
+        self._shown = list(problems)
         panel = self.query_one("#problems", Static)
         if problems:
             count = len(problems)

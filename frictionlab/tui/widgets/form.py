@@ -15,7 +15,6 @@ import yaml
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.message import Message
-from textual.validation import ValidationResult, Validator
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static, Switch
 
@@ -32,22 +31,6 @@ from ..fields import (
     problems_of,
     with_value,
 )
-
-
-class HeadlessCheck(Validator):
-    """Validates one field by running the headless validator on the draft with
-    this value in place, and reports that field's messages verbatim."""
-
-    def __init__(self, form: PresetForm, spec: FieldSpec):
-        super().__init__()
-        self.form = form
-        self.spec = spec
-
-    def validate(self, value: str) -> ValidationResult:
-        candidate = with_value(self.form.data, self.spec.path, parse(self.spec, value))
-        self.form.ensure_plugin_name(candidate, self.spec.path)
-        problems = problems_for(problems_of(candidate, self.form.registry, self.form.base_dir), self.spec.dotted)
-        return self.failure("\n".join(problems)) if problems else self.success()
 
 
 def _flow(value) -> str:
@@ -85,6 +68,7 @@ class PresetForm(VerticalScroll):
         self._stash: dict[tuple[str, str], dict] = {}  # (slot, plugin) -> params left behind
         # the value each select or switch shows: Textual also posts Changed when one is mounted
         self._seen: dict[str, object] = {}
+        self._marked: dict[str, list[str]] = {}  # widget id -> the messages shown under it
 
     # ------------------------------------------------------------ building
 
@@ -98,6 +82,7 @@ class PresetForm(VerticalScroll):
     def compose(self):
         self._specs = {}
         self._seen = {}
+        self._marked = {}
         if self.data is None:
             yield Static("No preset open. F2 lists the presets: Enter opens one, n makes a new one.")
             return
@@ -141,9 +126,8 @@ class PresetForm(VerticalScroll):
             widget = Input(
                 value=display(value),
                 placeholder=placeholder,
-                validators=[HeadlessCheck(self, spec)],
-                validate_on=["changed"],
                 compact=True,
+                validate_on=[],  # the form marks it, from the headless validator's problems (revalidate)
                 # a text (a description) is read from its start: selecting it on focus would show its end
                 select_on_focus=spec.kind != "text",
                 id=spec.widget_id,
@@ -265,6 +249,7 @@ class PresetForm(VerticalScroll):
         self.data[slot] = {"name": new_name, "params": self._stash.get((slot, new_name), {})}
         for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
             del self._specs[spec_id]
+            self._marked.pop(spec_id, None)  # its new row starts unmarked
         container = self.query_one(f"#params--{slot}", Vertical)
         await container.remove_children()
         await container.mount_all(self.param_rows(slot))
@@ -273,7 +258,9 @@ class PresetForm(VerticalScroll):
     # ------------------------------------------------------------ messages
 
     def revalidate(self, changed: bool) -> None:
-        """Run the headless validator on the draft and mark every field."""
+        """Run the headless validator on the draft and mark every field whose
+        messages changed (only those: each change lays the form out again, and
+        that, not the validator, is what a keystroke costs)."""
         self.problems = problems_of(self.data, self.registry, self.base_dir) if self.data is not None else []
         shown = set()
         for widget_id, spec in self._specs.items():
@@ -288,11 +275,16 @@ class PresetForm(VerticalScroll):
             if section.id and section.id.startswith("section--"):
                 dotted = section.id.removeprefix("section--").replace("--", ".")
                 messages = [p for p in self.problems if p not in shown and problem_path(p) == dotted]
-                section.update(Content("\n".join(messages)))
-                section.display = bool(messages)
+                if self._marked.get(section.id, []) != messages:
+                    self._marked[section.id] = messages
+                    section.update(Content("\n".join(messages)))
+                    section.display = bool(messages)
         self.post_message(self.Edited(self.problems, changed))
 
     def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
+        if self._marked.get(widget_id, []) == messages:
+            return
+        self._marked[widget_id] = messages
         try:
             label = self.query_one(f"#{widget_id}--error", Static)
         except Exception:
