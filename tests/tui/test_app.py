@@ -11,20 +11,20 @@ from frictionlab.tui.app import FrictionlabApp
 
 from ..conftest import ROOT
 
-# ------------------------------------------------------------------ keys in the README, CLI
+# ------------------------------------------------------------------ keys in the docs, CLI
 
 
-def test_the_readme_lists_every_key():
-    """F1 shows Textual's key panel, built from the bindings; the README's table has each one."""
+def test_the_docs_list_every_key():
+    """F1 shows Textual's key panel, built from the bindings; the docs' key table has each one."""
     from frictionlab.tui.widgets import PresetsPane, ResultsPane, RunPane
     from frictionlab.tui.widgets.tables import ListTable
 
-    readme = (ROOT / "README.md").read_text()
-    section = readme.split("## Terminal UI", 1)[1].split("\n## ", 1)[0]
+    page = (ROOT / "docs" / "how-to" / "tui.md").read_text()
+    section = page.split("## Keys", 1)[1]
     for owner in (FrictionlabApp, ListTable, PresetsPane, RunPane, ResultsPane):
         for binding in owner.BINDINGS:
             text = binding.tooltip or binding.description
-            assert text in section, f"README's key table misses {text!r}"
+            assert text in section, f"docs/how-to/tui.md's key table misses {text!r}"
 
 
 def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path, monkeypatch):
