@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from textual.app import App, ComposeResult
@@ -20,15 +21,15 @@ from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 from textual.widgets._tabbed_content import ContentTabs
 
-from ..errors import FrictionlabError, PresetError
+from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
-from ..rundir import DEFAULT_RUNS_DIR, new_run_folder
+from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
 from ..runner import run_to_folder
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
 from .fields import default_spectrum, preset_from_defaults
-from .folders import preset_folders, preset_from_template, save_preset, templates, writable_folder
+from .folders import preset_folders, preset_from_template, read_run, save_preset, templates, writable_folder
 from .live import LiveListener
 from .messages import RunCrashed, RunFinished, RunProgress, SweepPointEvent
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
@@ -314,21 +315,53 @@ class FrictionlabApp(App):
             self.query_one("#tabs", TabbedContent).active = "edit"
             self.query_one("#form", PresetForm).focus_problem(exc.problems)
             return
-        out_dir = new_run_folder(scene.preset.name, self.runs_dir)
+        self._start(scene, sweep, new_run_folder(scene.preset.name, self.runs_dir), self.run_options)
+
+    def resume_run(self, folder: Path | None) -> None:
+        """Continue a cancelled or interrupted run in ``folder`` with the preset stored
+        there (``frictionlab resume``): only the missing realizations are computed."""
+        if self.running:
+            self.say("A run is going; c on the Run tab cancels it.", "warning")
+            return
+        if folder is None:
+            self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
+            return
+        try:
+            if read_run(folder).status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                return
+        except (OSError, ValueError, TypeError):
+            pass  # no summary yet (a run killed early): the stored preset says whether it can go on
+        try:
+            data = RunDirectory(folder).stored_preset()
+            scene = build_scene(data, registry=self.registry)
+        except RunFolderError as exc:
+            self.say(str(exc), "error", title="Cannot resume")
+            return
+        except PresetError as exc:
+            self.say(exc.problems[0], "error", title=f"Cannot resume {folder.name}")
+            return
+        if scene.preset.sweep is not None:
+            self.say(f"{folder.name} is a sweep: frictionlab run PRESET --out {folder} --resume continues it.", "warning")
+            return
+        self._start(scene, None, folder, replace(self.run_options, resume=True))
+
+    def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         cancel = self.cancel_event = threading.Event()
         self.last_outcome = None
         self.query_one(RunPane).start(scene, sweep, out_dir)
         self.action_show_tab("run")
-        self.say(f"Running {scene.preset.name} into {out_dir}")
+        verb = "Resuming" if options.resume else "Running"
+        self.say(f"{verb} {scene.preset.name} into {out_dir}")
         progress = LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))
         if sweep is None:
-            work = lambda: run_to_folder(scene, out_dir, self.run_options, listeners=[progress], cancel=cancel)[0]  # noqa: E731
+            work = lambda: run_to_folder(scene, out_dir, options, listeners=[progress], cancel=cancel)[0]  # noqa: E731
         else:
             poster = SweepPoster(
                 lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
                 lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
             )
-            work = lambda: run_sweep(sweep, out_dir, self.run_options, listeners=[poster], cancel=cancel)  # noqa: E731
+            work = lambda: run_sweep(sweep, out_dir, options, listeners=[poster], cancel=cancel)  # noqa: E731
         self.run_worker(lambda: self._run_in_thread(work, out_dir), thread=True, group="run", exit_on_error=False)
 
     def _run_in_thread(self, work: Callable[[], object], out_dir: Path) -> None:

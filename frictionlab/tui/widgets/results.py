@@ -34,6 +34,7 @@ class ResultsPane(Vertical):
     BINDINGS = [
         Binding("space", "compare", "Compare", tooltip="Compare: add the run to the overlay, or remove it"),
         Binding("r", "reload", "Reload", tooltip="Reload the list of runs"),
+        Binding("u", "resume", "Resume", tooltip="Resume the highlighted run: only the missing realizations are computed"),
     ]
 
     def __init__(self, **kwargs):
@@ -63,6 +64,13 @@ class ResultsPane(Vertical):
 
     def action_reload(self) -> None:
         self.app.reload_runs()
+
+    def action_resume(self) -> None:
+        row = self.query_one("#runs-table", DataTable).cursor_row
+        if not 0 <= row < len(self.runs):
+            self.app.say(NO_RUNS, "warning")
+            return
+        self.app.resume_run(self.runs[row].path)
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         event.stop()

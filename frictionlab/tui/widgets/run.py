@@ -64,6 +64,7 @@ class RunPane(Vertical, can_focus=True):
     BINDINGS = [
         Binding("r", "start", "Run", tooltip="Run the open preset (again)"),
         Binding("c", "cancel", "Cancel", tooltip="Cancel the run: what finished is kept and saved"),
+        Binding("u", "resume", "Resume", tooltip="Resume the last run: only the missing realizations are computed"),
     ]
 
     def compose(self) -> ComposeResult:
@@ -83,6 +84,9 @@ class RunPane(Vertical, can_focus=True):
 
     def action_cancel(self) -> None:
         self.app.action_cancel_run()
+
+    def action_resume(self) -> None:
+        self.app.resume_run(self.app.last_out_dir)
 
     def _set(self, widget_id: str, text: str | Content) -> None:
         """Show ``text`` as it is: names, values and errors are never read as markup."""
