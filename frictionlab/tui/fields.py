@@ -190,12 +190,6 @@ def problems_for(problems: list[str], dotted: str) -> list[str]:
     return [p for p in problems if problem_path(p) == dotted]
 
 
-def with_value(data: dict, path: tuple[str, ...], value) -> dict:
-    candidate = copy.deepcopy(data)
-    set_path(candidate, path, value, replace_values=True)
-    return candidate
-
-
 def preset_from_defaults(name: str, spectrum: str, registry) -> dict:
     """A new preset: every plugin parameter at its default (required ones left
     for the user), and a small starter scene for the preset's required fields."""

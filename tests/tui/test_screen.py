@@ -205,22 +205,48 @@ async def test_tab_in_the_results_tab_stops_only_where_focus_shows(folders, regi
     assert stops == ["runs-table"] * 3
 
 
+def post_keys(app, keys):
+    """Keys as the terminal driver hands them to the app: posted, not waited for."""
+    for key in keys:
+        character = key if len(key) == 1 else {"ctrl+u": "\x15"}.get(key)
+        app.post_message(events.Key(_character_to_key(key) if len(key) == 1 else key, character))
+
+
+@pytest.mark.parametrize("gap", [0.03, 0.0], ids=["30ms", "burst"])
 @sync
-async def test_six_keys_30_ms_apart_into_a_cleared_field_all_arrive(folders, registry):
-    """Keys posted as a terminal delivers them: without waiting for the app between them."""
+async def test_six_keys_typed_into_a_cleared_field_all_arrive(folders, registry, gap):
+    """Found in tmux: Ctrl+U and the keys after it in one burst left the field empty.
+    Textual ran Ctrl+U's binding only after it bubbled up to the app, by which time
+    the printable keys behind it were inserted, and then cleared."""
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         field = app.query_one("#field--spectrum--params--hurst", Input)
         field.focus()
-        await pilot.press("end", "ctrl+u")
+        await pilot.press("end")
+        post_keys(app, ["ctrl+u"])
         for character in "0.7531":
-            app.post_message(events.Key(_character_to_key(character), character))  # as the driver does
-            await asyncio.sleep(0.03)
-        await wait_until(pilot, lambda: field.value == "0.7531" or len(field.value) >= 6, timeout=5)
+            post_keys(app, [character])
+            await asyncio.sleep(gap)
+        await wait_until(pilot, lambda: len(field.value) >= 6, timeout=5)
+        await pilot.pause()
         value, data = field.value, app.query_one("#form").data
     assert value == "0.7531"
     assert data["spectrum"]["params"]["hurst"] == 0.7531
+
+
+@sync
+async def test_home_then_a_key_types_at_the_start(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        field = app.query_one("#field--name", Input)
+        field.focus()
+        await pilot.press("end")
+        post_keys(app, ["home", "x"])
+        await wait_until(pilot, lambda: "x" in field.value, timeout=5)
+        value = field.value
+    assert value == "xsmall"
 
 
 @sync

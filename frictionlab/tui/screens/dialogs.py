@@ -12,6 +12,7 @@ from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Select, Static
 
 from ..folders import new_preset_path
+from ..widgets.keyinput import KeyInput
 
 
 class ConfirmScreen(ModalScreen[bool]):
@@ -62,7 +63,7 @@ class PathScreen(ModalScreen[Path | None]):
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
             yield Label(Content(self.title_text), classes="heading")
-            yield Input(str(self.default), id="path-input")
+            yield KeyInput(str(self.default), id="path-input")
             yield Static("", id="path-error", classes="field-error")
             yield Label("Enter: save    Esc: cancel", classes="hint")
 
@@ -95,7 +96,7 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
             yield Label("New preset", classes="heading")
             with Horizontal(classes="row"):
                 yield Label("name", classes="field-label")
-                yield Input("my-scene", id="new-name", compact=True)
+                yield KeyInput("my-scene", id="new-name", compact=True)
             with Horizontal(classes="row"):
                 yield Label("start from", classes="field-label")
                 if self.templates:
@@ -107,7 +108,7 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
                     yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
             with Horizontal(classes="row"):
                 yield Label("save as", classes="field-label")
-                yield Input(str(new_preset_path("my-scene")), id="new-path", compact=True)
+                yield KeyInput(str(new_preset_path("my-scene")), id="new-path", compact=True)
             yield Static("", id="new-error", classes="field-error")
             yield Button("Create", id="new-create", compact=True)
             yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")

@@ -29,8 +29,8 @@ from ..fields import (
     problem_path,
     problems_for,
     problems_of,
-    with_value,
 )
+from .keyinput import KeyInput
 
 
 def _flow(value) -> str:
@@ -123,7 +123,7 @@ class PresetForm(VerticalScroll):
             )
         elif spec.kind in ("int", "float", "text"):
             placeholder = "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
-            widget = Input(
+            widget = KeyInput(
                 value=display(value),
                 placeholder=placeholder,
                 compact=True,
