@@ -46,16 +46,16 @@ class FrictionlabApp(App):
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
-        Binding("f1", "help", "Keys", tooltip="Show or hide the keys of the focused part", priority=True),
-        Binding("question_mark", "help", "Keys", tooltip="Show or hide the keys (outside a text field)", show=False),
+        Binding("f1", "help", "Keys", tooltip="(show or hide): those of the focused part and the app's", priority=True),
+        Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
         Binding("f4", "show_tab('run')", "Run tab", show=False, priority=True),
         Binding("f5", "show_tab('results')", "Results tab", show=False, priority=True),
-        Binding("ctrl+s", "save", "Save", tooltip="Save the preset (asks first if it has problems)", priority=True),
-        Binding("ctrl+o", "save_as", "Save as", tooltip="Save the preset under another name", show=False, priority=True),
-        Binding("ctrl+r", "start_run", "Run", tooltip="Run the open preset", priority=True),
-        Binding("ctrl+q", "quit", "Quit", tooltip="Quit (asks if the preset has unsaved changes)", priority=True),
+        Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
+        Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
+        Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
+        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes)", priority=True),
     ]
 
     def __init__(

@@ -19,9 +19,9 @@ NO_PRESETS = "No preset to open here: n makes a new one."
 
 class PresetsPane(Vertical):
     BINDINGS = [
-        Binding("d", "duplicate", "Duplicate", tooltip="Duplicate the preset (asks for a file name)"),
-        Binding("n", "new", "New", tooltip="New preset from a listed one (asks its name and file)"),
-        Binding("r", "reload", "Reload", tooltip="Reload the list of presets"),
+        Binding("d", "duplicate", "Duplicate", tooltip="the preset (asks for a file name)"),
+        Binding("n", "new", "New", tooltip="preset from a listed one (asks its name and file)"),
+        Binding("r", "reload", "Reload", tooltip="the list of presets"),
     ]
 
     def __init__(self, **kwargs):

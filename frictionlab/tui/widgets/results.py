@@ -32,9 +32,9 @@ FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of t
 
 class ResultsPane(Vertical):
     BINDINGS = [
-        Binding("space", "compare", "Compare", tooltip="Compare: add the run to the overlay, or remove it"),
-        Binding("r", "reload", "Reload", tooltip="Reload the list of runs"),
-        Binding("u", "resume", "Resume", tooltip="Resume the highlighted run: only the missing realizations are computed"),
+        Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
+        Binding("r", "reload", "Reload", tooltip="the list of runs"),
+        Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
     ]
 
     def __init__(self, **kwargs):

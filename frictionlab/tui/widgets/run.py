@@ -62,9 +62,9 @@ def _contact_lines(count) -> list[str]:
 
 class RunPane(Vertical, can_focus=True):
     BINDINGS = [
-        Binding("r", "start", "Run", tooltip="Run the open preset (again)"),
-        Binding("c", "cancel", "Cancel", tooltip="Cancel the run: what finished is kept and saved"),
-        Binding("u", "resume", "Resume", tooltip="Resume the last run: only the missing realizations are computed"),
+        Binding("r", "start", "Run", tooltip="the open preset (again)"),
+        Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
+        Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
     ]
 
     def compose(self) -> ComposeResult:
