@@ -2,7 +2,7 @@
 
 Presets come from ``./presets`` (when it exists) and the user folder
 (``$FRICTIONLAB_PRESETS_DIR``, else ``$XDG_CONFIG_HOME/frictionlab/presets``,
-else ``~/.config/frictionlab/presets``). Runs are the output folders the
+else the platform's config folder: ``~/.config/frictionlab/presets`` on Linux). Runs are the output folders the
 headless ``frictionlab run`` writes, found by their ``summary.json``, and sweep
 folders, found by their ``sweep.json``.
 """
@@ -29,8 +29,11 @@ def user_presets_dir(env=None) -> Path:
     env = os.environ if env is None else env
     if env.get("FRICTIONLAB_PRESETS_DIR"):
         return Path(env["FRICTIONLAB_PRESETS_DIR"]).expanduser()
-    config = Path(env["XDG_CONFIG_HOME"]).expanduser() if env.get("XDG_CONFIG_HOME") else Path.home() / ".config"
-    return config / "frictionlab" / "presets"
+    if env.get("XDG_CONFIG_HOME"):
+        return Path(env["XDG_CONFIG_HOME"]).expanduser() / "frictionlab" / "presets"
+    from platformdirs import user_config_path  # ~/.config on Linux, the platform's own folder elsewhere
+
+    return user_config_path("frictionlab") / "presets"
 
 
 def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str, Path]]:
