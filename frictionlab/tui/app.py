@@ -29,7 +29,16 @@ from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
 from ..runner import run_to_folder
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
 from .fields import default_spectrum, preset_from_defaults
-from .folders import preset_folders, preset_from_template, read_run, save_preset, templates, writable_folder
+from .folders import (
+    is_builtin,
+    new_preset_path,
+    preset_folders,
+    preset_from_template,
+    read_run,
+    save_preset,
+    templates,
+    writable_folder,
+)
 from .live import LiveListener
 from .messages import RunCrashed, RunFinished, RunProgress, SweepPointEvent
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
@@ -208,7 +217,7 @@ class FrictionlabApp(App):
     def new_preset(self) -> None:
         """A new preset from a template that runs (a listed preset; a plugin's
         defaults only when there is none), saved where the user says."""
-        choices = templates(self.query_one(PresetsPane).presets)
+        choices = templates(self.query_one(PresetsPane).presets)  # the built-in presets first
 
         def done(answer) -> None:
             if answer is None:
@@ -224,7 +233,7 @@ class FrictionlabApp(App):
                 return
             self.run_worker(self._open_new(path, data, template), group="open")
 
-        self.push_screen(NewPresetScreen([(e.name, e.path) for e in choices]), done)
+        self.push_screen(NewPresetScreen(choices), done)
 
     async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
         await self.open_preset(path, data, modified=True)
@@ -249,6 +258,13 @@ class FrictionlabApp(App):
     def action_save(self) -> None:
         if self.draft_path is None or self._draft() is None:
             self.say(NO_PRESET, "warning")
+            return
+        if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
+            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
+            self.push_screen(
+                PathScreen("Save the built-in preset's changes as", new_preset_path(self.draft_path.stem)),
+                lambda path: path is not None and self._save_checked(path),
+            )
             return
         self._save_checked(self.draft_path)
 

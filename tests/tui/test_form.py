@@ -188,8 +188,11 @@ async def test_a_third_party_plugin_gets_a_form_without_code(folders, register_p
 
 
 @sync
-async def test_new_preset_from_a_plugins_defaults_when_no_preset_is_listed(folders, registry):
-    (folders / "presets" / "tiny.yaml").unlink()  # nothing to start from
+async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all(folders, registry, monkeypatch):
+    import frictionlab.tui.folders
+
+    (folders / "presets" / "tiny.yaml").unlink()  # nothing to start from: none listed, none shipped
+    monkeypatch.setattr(frictionlab.tui.folders, "builtin_presets", lambda: [])
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()

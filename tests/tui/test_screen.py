@@ -18,7 +18,11 @@ from textual.widgets import Input
 from frictionlab import SlopeEstimator
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
+from frictionlab.options import RunOptions
 from frictionlab.preset import load_scene
+from frictionlab.preset.builtin import find_builtin
+from frictionlab.tui.app import FrictionlabApp
+from frictionlab.tui.screens import PathScreen
 
 from ..conftest import merge
 from .conftest import (
@@ -31,6 +35,7 @@ from .conftest import (
     screen_text,
     status_text,
     sync,
+    type_into,
     wait_until,
 )
 
@@ -338,7 +343,9 @@ async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_current_folde
         await pilot.pause()
     assert problems == []
     assert path == Path("fresh.yaml")
-    assert yaml.safe_load((folders / "fresh.yaml").read_text())["name"] == "fresh"
+    quickstart = find_builtin("quickstart").path  # the template offered first: it runs in about a second
+    assert yaml.safe_load((folders / "fresh.yaml").read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
+    assert quickstart.read_text().splitlines()[0] in (folders / "fresh.yaml").read_text()  # its comments kept
     assert load_scene(folders / "fresh.yaml", registry=registry).preset.name == "fresh"
     assert main(["run", "fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
     assert json.loads((folders / "runs" / "fresh" / "summary.json").read_text())["status"] == "completed"
@@ -364,3 +371,26 @@ async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, 
     assert "exists" in refused
     assert (folders / "fresh.yaml").read_text() == "keep me\n"
     assert load_scene(folders / "elsewhere" / "fresh.yaml", registry=registry).preset.name == "fresh"
+
+
+@sync
+async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monkeypatch, registry):
+    monkeypatch.chdir(tmp_path)  # no ./presets here: the built-in ones are listed beside the user's
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    quickstart = find_builtin("quickstart").path
+    original = quickstart.read_text()
+    app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        listed = screen_text(app)
+        await app.open_preset(quickstart)
+        await type_into(pilot, "field--realizations", "20")
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        asked = isinstance(app.screen, PathScreen)
+        app.screen.query_one(Input).value = "mine.yaml"
+        await pilot.press("enter")
+        await pilot.pause()
+    assert "quickstart" in listed and "built-in" in listed
+    assert asked and quickstart.read_text() == original
+    assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
