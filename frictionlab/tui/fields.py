@@ -7,7 +7,6 @@ parameters appear in the form with no code of its own. No Textual here.
 
 from __future__ import annotations
 
-import copy
 import types
 import typing
 from dataclasses import dataclass
@@ -20,7 +19,7 @@ from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
 from ..plugin import KINDS
-from ..preset import MISSING, Preset, build_scene, resolve_input_paths, set_path
+from ..preset import MISSING, Preset, build_scene, resolve_input_paths
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 

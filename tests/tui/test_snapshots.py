@@ -11,7 +11,15 @@ from frictionlab.options import RunOptions
 from frictionlab.sweep import load_sweep, run_sweep
 
 from ..conftest import merge
-from .conftest import SIZE, SWEEP, make_app, make_runs, open_first_preset, type_into, wait_until
+from .conftest import (
+    SIZE,
+    SWEEP,
+    make_app,
+    make_runs,
+    open_first_preset,
+    type_into,
+    wait_until,
+)
 
 SIZES = pytest.mark.parametrize("size", [SIZE, (120, 40)], ids=["80x24", "120x40"])
 

@@ -11,7 +11,6 @@ import copy
 from pathlib import Path
 
 import yaml
-
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.message import Message

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
-from rich.text import Text
 from textual.containers import Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
@@ -12,7 +12,6 @@ from textual.widgets import DataTable, Static
 from ..folders import PresetEntry, list_presets
 from .pathline import PathLine
 from .tables import ListTable
-
 
 NO_PRESETS = "No preset to open here: n makes a new one."
 

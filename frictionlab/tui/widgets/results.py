@@ -19,8 +19,8 @@ from ...fit import format_interval
 from ..chart import Series
 from ..folders import RunEntry, SweepEntry, list_runs, read_curve, read_run
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
-from .chart import Chart
 from ..text import shorten_middle
+from .chart import Chart
 from .run import fit_series
 from .tables import ListTable
 
