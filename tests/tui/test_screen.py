@@ -386,3 +386,19 @@ async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monke
     assert "quickstart" in listed and "built-in" in listed
     assert asked and quickstart.read_text() == original
     assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
+
+
+@sync
+async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders, registry):
+    (folders / "runs").write_text("a file where the runs folder should be\n")
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: not app.running)
+        await pilot.pause()
+        status = status_text(app)
+        error = str(app.query_one("#run-error").render())
+    assert status.startswith("Run failed: runs/small-") and "runs is a file" in status
+    assert "Traceback" not in error and "Error" not in status
+    assert (folders / "runs").read_text().startswith("a file")  # left as it was
