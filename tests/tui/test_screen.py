@@ -6,14 +6,15 @@ is, no keystroke lost."""
 import asyncio
 import json
 from pathlib import Path
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
 import pytest
 import yaml
+from pydantic import Field
 from textual.widgets import Input
 
-from frictionlab import SlopeEstimator
+from frictionlab import PluginParams, SlopeEstimator
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.options import RunOptions
@@ -55,6 +56,9 @@ class BracketSlope(SlopeEstimator):
     name: ClassVar[str] = "bracket-difference"
     summary: ClassVar[str] = "forward difference as in [1]; [bold]not bold[/bold]"
 
+    class Params(PluginParams):
+        ends: Literal["wrap [1]", "[b]cut[/b]"] = Field("[b]cut[/b]", description="ends of the line, as in [2]")
+
     def slopes(self, heights, spacing):
         return np.diff(heights, append=heights[:1]) / spacing
 
@@ -78,6 +82,7 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
         results_tab = screen_text(app)
     assert BRACKETS in presets_tab
     assert BracketSlope.summary in edit_tab
+    assert "[b]cut[/b]" in edit_tab  # a choice's text
     assert "try[1]" in results_tab
 
 

@@ -111,7 +111,7 @@ class PresetForm(VerticalScroll):
         if spec.kind == "bool":
             widget = Switch(value=bool(current), id=spec.widget_id)
         elif spec.kind == "choice":
-            options = [(str(c), c) for c in spec.choices]
+            options = [(Content(str(c)), c) for c in spec.choices]  # text, never markup
             known = current in spec.choices
             widget = Select(
                 options,
@@ -154,7 +154,7 @@ class PresetForm(VerticalScroll):
         names = self.registry.names(slot)
         known = self._known_name(slot, name)
         select = Select(
-            [(n, n) for n in names],
+            [(Content(n), n) for n in names],
             value=known if known else Select.NULL,
             allow_blank=known is None,
             compact=True,
