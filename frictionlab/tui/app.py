@@ -19,7 +19,6 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
-from textual.widgets._tabbed_content import ContentTabs
 
 from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..options import RunOptions
@@ -91,7 +90,6 @@ class FrictionlabApp(App):
         self.last_snapshot = None
         self.last_outcome = None
         self.last_out_dir: Path | None = None
-        self.messages: list[tuple[str, str]] = []  # (severity, text): what the status line said, oldest first
 
     # ------------------------------------------------------------ layout
 
@@ -110,7 +108,7 @@ class FrictionlabApp(App):
 
     async def on_mount(self) -> None:
         # F2..F5 switch tabs: the tab bar as a Tab stop would only take focus where nothing shows it
-        self.query_one(ContentTabs).can_focus = False
+        self.query_one("ContentTabs").can_focus = False
         self.reload_presets()
         self.reload_runs()
         self._show_edit_state()
@@ -153,7 +151,6 @@ class FrictionlabApp(App):
     def say(self, text: str, severity: str = "information", title: str = "") -> None:
         """Show ``text`` in the status line above the footer (never over the data); it
         stays until the next message. ``text`` is shown as it is, never as markup."""
-        self.messages.append((severity, f"{title}: {text}" if title else text))
         line = Content.assemble((f"{title}: ", "bold") if title else "", text)
         status = self.query_one("#status", Static)
         status.update(line)
