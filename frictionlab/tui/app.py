@@ -326,7 +326,9 @@ class FrictionlabApp(App):
             count = len(exc.problems)
             self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
             self.query_one("#tabs", TabbedContent).active = "edit"
-            self.query_one("#form", PresetForm).focus_problem(exc.problems)
+            form = self.query_one("#form", PresetForm)
+            form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
+            form.focus_problem(exc.problems)
             return
         self._start(scene, sweep, new_run_folder(scene.preset.name, self.runs_dir), self.run_options)
 

@@ -300,8 +300,10 @@ async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, re
         await pilot.press("ctrl+r")
         await pilot.pause()
         status, focused = status_text(app), app.focused.id
+        panel = str(app.query_one("#problems").render())
     assert not app.running and app.last_out_dir is None
     assert focused == "field--spectrum--params--path"
+    assert "spectrum.params.path: no such file" in panel  # the form says it too, not "valid"
     assert status.startswith("Cannot run: 1 problem: spectrum.params.path: no such file")
     assert "presets/line.csv'" in status  # the file beside the preset (the core shortens a long path)
 
