@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import json
+import os
+import re
 import sys
-from pathlib import Path
 
 from ..errors import ExitCode
 from .options import add_workers_option, run_options
@@ -39,10 +40,9 @@ def run(args) -> ExitCode:
         log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
         quiet=args.quiet,
     )  # fmt: skip
-    if args.json:
-        figures = sorted(str(p) for p in path.parent.glob("**/*.png")) if args.figures is None else sorted(
-            str(p) for p in Path(args.figures).glob("*.png")
-        )
+    if args.json:  # the figures the report shows, as its image links name them
+        images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
+        figures = list(dict.fromkeys(os.path.normpath(path.parent / image) for image in images))
         print(json.dumps({"report": str(path), "figures": figures}, indent=2))
     else:
         print(path)
