@@ -16,9 +16,9 @@ import warnings
 from .. import __version__
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
-from . import plugins, predict, report, resume, run, schema, study, tui, validate
+from . import exact3d, plugins, predict, report, resume, run, schema, study, tui, validate
 
-COMMANDS = (run, resume, validate, schema, plugins, report, predict, tui, study)
+COMMANDS = (run, resume, validate, schema, plugins, report, predict, tui, study, exact3d)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
 
 
