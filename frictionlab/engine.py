@@ -110,7 +110,7 @@ def run(
                 # The first missing realization runs here: its time sizes the chunks.
                 first = compute_chunk(scene, todo[:1])
                 record(first)
-                chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds)
+                chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
                 for _, results in pool.map_chunks(scene, chunks, cancel):
                     record(results)
         except KeyboardInterrupt:  # the second Ctrl-C or SIGTERM (Terminated)
