@@ -393,6 +393,9 @@ class ContactSolver(Plugin):
       the numerics); a study carries them from one solver to another that has them.
     - ``tolerance_param`` (None): the ``Params`` field of the relative tolerance of
       an iterative solver; ``tolerance()`` reads it (None for a direct solver).
+    - ``bytes_per_point`` (None): the peak memory ``solve`` allocates per grid point,
+      beyond the profile and slopes it is given (memory estimates before a run).
+      None: the framework's figure for a line solver (``memory.BYTES_PER_POINT``).
     """
 
     kind: ClassVar[str] = "solver"
@@ -406,6 +409,7 @@ class ContactSolver(Plugin):
     periodic_only: ClassVar[bool] = False
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None
+    bytes_per_point: ClassVar[int | None] = None
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
