@@ -26,6 +26,7 @@ from .plugin import (
     SpectrumGenerator,
     contract,
     force_unit,
+    load_finished,
     mdr_length,
 )
 
@@ -53,6 +54,7 @@ __all__ = [
     "contract",
     "force_unit",
     "hookimpl",
+    "load_finished",
     "mdr_length",
     "open_regular_file",
 ]

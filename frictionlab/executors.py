@@ -31,9 +31,9 @@ from collections.abc import Iterator, Sequence
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .errors import RunError
 from .options import RunOptions
-from .pool import JobFailed, WorkerLost, WorkerPool
+from .pool import JobFailed, WorkerLost, WorkerPool, send_progress
 from .preset import Scene
-from .realization import RealizationResult, compute_chunk
+from .realization import LoadListener, RealizationResult, compute_chunk
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -97,13 +97,15 @@ class SerialExecutor:
     def __init__(self):
         self.workers = 1
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
             done = []
             for index in chunk:
                 if cancel.is_set():
                     break
-                done.extend(compute_chunk(scene, [index]))
+                done.extend(compute_chunk(scene, [index], on_load))
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():
@@ -136,8 +138,12 @@ def _init_worker(scene: Scene) -> None:
     _die_with_parent()
 
 
+def _send_load(index: int, done: int, total: int) -> None:
+    send_progress((index, done, total))
+
+
 def _run_chunk(indices: Chunk) -> list[RealizationResult]:
-    return compute_chunk(_worker_scene, indices)
+    return compute_chunk(_worker_scene, indices, on_load=_send_load)
 
 
 def pool_context():
@@ -160,13 +166,16 @@ class ProcessExecutor:
         self.workers = workers
         self.retries = retries
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         jobs = dict(enumerate(chunks))
+        on_progress = None if on_load is None else (lambda payload: on_load(*payload))
         pool = WorkerPool(
             min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
-            for key, results in pool.run(jobs, cancel):
+            for key, results in pool.run(jobs, cancel, on_progress):
                 yield jobs[key], results
         except WorkerLost as lost:
             raise RunError(
@@ -231,7 +240,10 @@ class DaskExecutor:
             return client, None
         return start_local_cluster(self.workers, dashboard=self.dashboard)
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        """``on_load`` is not heard: a Dask worker reports whole chunks only."""
         distributed = import_distributed()
         client, cluster = self._connect()
         futures = []

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
@@ -437,6 +438,30 @@ class ContactSolver(Plugin):
         if self.tolerance_param is None:
             return None
         return float(self.params.model_dump()[self.tolerance_param])
+
+
+# ------------------------------------------------------------ progress of a solve
+
+_load_listener: Callable[[int, int], None] | None = None
+
+
+def load_finished(done: int, total: int) -> None:
+    """A solver whose loads take long calls this after each load of ``solve``: ``done``
+    of its ``total`` loads are solved. The run forwards it to its listeners
+    (``RunListener.load_done``); outside a run that listens it does nothing."""
+    if _load_listener is not None:
+        _load_listener(done, total)
+
+
+@contextmanager
+def listening_to_loads(listener: Callable[[int, int], None] | None):
+    """Within the block, ``load_finished(done, total)`` calls ``listener`` (this process only)."""
+    global _load_listener
+    previous, _load_listener = _load_listener, listener
+    try:
+        yield
+    finally:
+        _load_listener = previous
 
 
 def contract(kind: str) -> frozenset[str]:

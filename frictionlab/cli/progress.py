@@ -14,6 +14,9 @@ from ..hookspecs import hookimpl
 from ..listeners import SweepListener, progress_text
 
 
+LOAD_LINE_SECONDS = 30.0
+
+
 class ProgressReporter:
     """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr)."""
 
@@ -26,6 +29,8 @@ class ProgressReporter:
         self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
         self.failed = 0
         self.resumed = 0  # restored on a resume: done before this process started
+        self.done, self.total = 0, 1
+        self.last_load_line = 0.0  # into a file: a load line at most every LOAD_LINE_SECONDS
 
     def _line(self, done: int, total: int) -> str:
         return progress_text(done, total, self.failed, time.perf_counter() - self.started, restored=self.resumed)
@@ -47,6 +52,7 @@ class ProgressReporter:
         self.stream.flush()
 
     def _progress(self, done: int, total: int) -> None:
+        self.done, self.total = done, total
         now = time.perf_counter()
         if self.interactive:
             if done == total or now - self.last_draw >= 0.1:
@@ -64,6 +70,21 @@ class ProgressReporter:
     @hookimpl
     def realization_done(self, done, total):
         self._progress(done, total)
+
+    @hookimpl
+    def load_done(self, index, done, total):
+        """A long solve's loads: on the progress line (a terminal), or a line now and then (a file)."""
+        now = time.perf_counter()
+        text = f"realization {index}: load {done}/{total}"
+        if self.interactive:
+            if now - self.last_draw >= 0.1:
+                self.stream.write(f"\r{self._line(self.done, self.total)}, {text}\x1b[K")
+                self.stream.flush()
+                self.last_draw = now
+        elif now - max(self.last_load_line, self.started) >= LOAD_LINE_SECONDS:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+            self.last_load_line = now
 
     @hookimpl
     def realization_failed(self, result, done, total):

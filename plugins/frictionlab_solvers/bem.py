@@ -31,7 +31,7 @@ import numpy as np
 import scipy.fft
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
 from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
@@ -446,6 +446,7 @@ class PeriodicBEM(ContactSolver):
                 slope_rms[j] = line_rms
             else:
                 slope_rms[j] = float(np.sqrt(np.mean(np.square(slopes[contact]))))
+            load_finished(j + 1, steps)  # a load of a large surface takes seconds: progress per load
 
         return ContactCurve(
             force=force,
