@@ -8,8 +8,9 @@ same process (or, for peak memory, in a fresh one per size):
 * cost per realization against N (1e3..1e7, at 400 steps) and against the
   number of force steps (10..1e4, at N = 1e5): time / (N log2 N) should stay
   flat in N, and the time flat in steps;
-* the Fig. 2 scene with each executor (serial; processes 1, 2; Dask
-  LocalCluster of 2, cluster start excluded), efficiency = serial / (workers x time);
+* the Fig. 2 scene and an exact 3D ensemble (exact3d-h08 on 256^2 pixels) with each
+  executor (serial; processes 1, 2; Dask LocalCluster of 2, cluster start and the
+  workers' first import excluded), efficiency = serial / (workers x time);
 * overhead per task of each executor (tiny realizations, one per task);
 * the Fig. 2 scene end to end (run + chunk files + result files and plot) with
   the default executor.
@@ -101,13 +102,32 @@ def cost_against_n_and_steps(repeat: int) -> None:
         print(f"  {steps:>6} steps: {seconds * 1e3:7.3f} ms  ({seconds / base:5.2f} x 10 steps)")
 
 
+SURFACE_PRESET = PRESET.parent / "exact3d-h08.yaml"
+
+
+def efficiency_rows(scene, repeat: int, address: str | None) -> list[tuple[str, int, float]]:
+    """(executor, workers, best seconds) of ``scene`` run serially, on 1 and 2 processes and
+    on the Dask cluster at ``address`` (None: no Dask)."""
+    rows = [("serial", 1, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=1, executor="serial"))))]
+    for workers in (1, 2):
+        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=workers, executor="processes")))))
+    if address:
+        rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address)))))
+    return rows
+
+
+def print_efficiencies(title: str, rows) -> None:
+    serial = rows[0][2]
+    print(f"{title} (efficiency = serial / (workers x time)):")
+    for name, workers, seconds in rows:
+        print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")
+
+
 def executors(repeat: int, skip_dask: bool) -> None:
     scene = load_scene(PRESET)
     m = scene.preset.realizations
-    serial = best_of(repeat, lambda: engine.run(scene, RunOptions(workers=1, executor="serial")))
-    rows = [("serial", 1, serial)]
-    for workers in (1, 2):
-        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=workers, executor="processes")))))
+    # exact 3D ensembles: the family's preset on 256^2 pixels, 8 surfaces (about 0.5 s each)
+    surface = load_scene(SURFACE_PRESET, ["spectrum.params.points=256", "realizations=8"])
     tiny = load_scene(PRESET, ["spectrum.params.points=64", "spectrum.params.length=64.0", "loading.steps=2"])
     tasks = [[i] for i in range(400)]
     never = threading.Event()
@@ -118,18 +138,20 @@ def executors(repeat: int, skip_dask: bool) -> None:
         return (wall - compute) / len(tasks)
 
     overheads = [("serial", overhead(make_executor(RunOptions(executor="serial"), 1))), ("processes (2, pool start included)", overhead(make_executor(RunOptions(executor="processes"), 2)))]
-    if not skip_dask:
+    if skip_dask:
+        rows, rows_3d = efficiency_rows(scene, repeat, None), efficiency_rows(surface, 1, None)
+    else:
         import distributed
 
         with distributed.LocalCluster(
             n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
         ) as cluster:
             address = cluster.scheduler_address
-            rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address)))))
+            engine.run(scene, RunOptions(executor="dask", scheduler=address))  # the workers import frictionlab once
+            rows, rows_3d = efficiency_rows(scene, repeat, address), efficiency_rows(surface, 1, address)
             overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
-    print(f"Fig. 2 scene ({m} realizations), executors (efficiency = serial / (workers x time)):")
-    for name, workers, seconds in rows:
-        print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")
+    print_efficiencies(f"Fig. 2 scene ({m} realizations), executors", rows)
+    print_efficiencies(f"Exact 3D ensemble ({SURFACE_PRESET.name} on 256^2 pixels, 8 surfaces), executors", rows_3d)
     print("Overhead per task (400 one-realization tasks of a 64-point line):")
     for name, seconds in overheads:
         print(f"  {name:36} {seconds * 1e3:8.3f} ms")
