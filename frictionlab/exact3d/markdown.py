@@ -70,6 +70,27 @@ def _shift_of_b(runs: StudyRuns, hurst: float) -> tuple[float, float]:
     return finest.b - coarser.b, 0.5 * (finest.b_ci[1] - finest.b_ci[0])
 
 
+def kappa_trend(runs: StudyRuns, kappas: dict[tuple[float, int], Kappa]) -> str:
+    """A sentence on how kappa moves as the grid is refined, from the numbers."""
+    falling = rising = 0
+    spans = []
+    for hurst in runs.plan.hursts:
+        values = [kappas[(e.hurst, e.points)].value for e in runs.exact_grids(hurst)]
+        steps = np.diff(values)
+        falling += bool(np.all(steps < 0))
+        rising += bool(np.all(steps > 0))
+        spans.append(f"{values[0]:.2f} to {values[-1]:.2f} at H = {hurst:g}")
+    count = len(runs.plan.hursts)
+    if falling == count:
+        trend = ("κ falls at every H as the grid is refined, as for a contact area overestimated on coarse grids: "
+                 "if the trend goes on, the converged κ lies below the finest grid's")
+    elif rising == count:
+        trend = "κ rises at every H as the grid is refined"
+    else:
+        trend = "κ does not move one way at every H as the grid is refined"
+    return f"{trend} ({'; '.join(spans)}, coarsest to finest grid)."
+
+
 def answer(runs: StudyRuns, kappas: dict[tuple[float, int], Kappa]) -> list[str]:
     """The plain answer, formed from the numbers."""
     finest = runs.plan.resolutions[-1]
@@ -106,5 +127,6 @@ def answer(runs: StudyRuns, kappas: dict[tuple[float, int], Kappa]) -> list[str]
         f"- **How far is MDR?** On the same surfaces (their MDR-equivalent lines) at equal f, MDR's mean ξ is "
         f"{_pct(gaps.min())} to {_pct(gaps.max())} off the exact one over all loads and H.",
         f"- **Known-answer check:** κ of the real contact area at small loads is {min(kappa_all):.2f} to "
-        f"{max(kappa_all):.2f} over H on the finest grid (literature: about 1.6, Persson, to about 2, simulations).",
+        f"{max(kappa_all):.2f} over H on the finest grid (literature: about 1.6, Persson, to about 2, simulations); "
+        + kappa_trend(runs, kappas),
     ]
