@@ -281,7 +281,7 @@ class SpectrumGenerator(Plugin):
 
     Optional, with the default the framework then uses:
 
-    - ``psd(q)``: vectorised one-sided PSD (1D: <z^2> = 2 * integral of psd over
+    - ``psd(q)``: vectorised one-sided PSD (1D: ``<z^2> = 2 * integral of psd`` over
       q > 0); ``rms_slope()``: a closed-form rms slope. Default: NotImplementedError.
     - ``periodic()``: whether generated profiles repeat (default True). A measured
       scan is not periodic: slopes never wrap, periodic solvers refuse it.

@@ -144,7 +144,7 @@ def test_a_constant_line_fails_with_a_clear_message(make_scene):
 
 
 SCALINGS = {
-    # SPEC 5: z -> s z with F -> s F. s a power of two scales every operation exactly.
+    # exact scaling laws: z -> s z with F -> s F. s a power of two scales every operation exactly.
     "heights": ({"spectrum": {"params": {"rms_height": 4.0}}}, 4.0, 1e-13),
     # E -> s E with F -> s F.
     "modulus": ({"solver": {"params": {"youngs_modulus": 3.7}}}, 3.7, 1e-12),

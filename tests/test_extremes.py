@@ -1,7 +1,7 @@
 """Numerical extremes (issue 4): each gives the right answer, checked against a known value or
 limit, or a clear error; never a NaN, an overflow, a hang or a traceback.
 
-The README's "Numerical extremes" table lists each case with the test that checks it here
+The "Numerical extremes" page (docs/explanation/extremes.md) lists each case with the test that checks it here
 (or in the older test files, where the case was already covered).
 """
 
@@ -209,7 +209,7 @@ SCALES = [1e-12, 1e12]
 @pytest.mark.parametrize("solver, base", [("mdr", LINE), ("mdr", SURFACE), ("winkler", SURFACE)],
                          ids=["line", "surface-mdr", "surface-winkler"])
 def test_results_do_not_depend_on_the_height_scale(registry, scale, solver, base):
-    """z -> s z, F -> s F (SPEC 5): counts identical, xi and f within rounding."""
+    """z -> s z, F -> s F (an exact scaling law): counts identical, xi and f within rounding."""
     def run(s):
         data = merge({**base, "solver": {"name": solver}}, {
             "spectrum": {"params": {"rms_height": s}},

@@ -44,7 +44,7 @@ FULL_CONTACT = {"loading": {"start": 1e9, "stop": 1e10, "steps": 16}}
     [
         (300_000, FULL_CONTACT),
         (2_000_000, {**FULL_CONTACT, "output": {"plot": False}}),
-        # the large grid of the README (1e7 points, about 1 GiB at full contact)
+        # the large grid of the docs' memory example (1e7 points, about 1 GiB at full contact)
         pytest.param(10_000_000, {**FULL_CONTACT, "output": {"plot": False}}, marks=pytest.mark.slow),
     ],
     ids=["3e5-with-plot", "2e6", "1e7"],

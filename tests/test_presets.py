@@ -36,7 +36,7 @@ def test_fig2_scene_matches_the_study_setup(registry):
 
 
 def test_fig2_run_in_full_lands_on_the_studys_contact_counts(registry):
-    """SPEC 7: about 4 points in contact at F = 1 and 12 at F = 20, over 300 lines.
+    """The paper: about 4 points in contact at F = 1 and 12 at F = 20, over 300 lines.
     "About 4" is read as 4 +- 0.5 (a rounded count); we allow that plus three
     standard errors of our ensemble mean."""
     scene = load_scene(PRESETS / "benad2012-fig2.yaml", registry=registry)

@@ -1,4 +1,4 @@
-"""Spring contact solvers (SPEC sections 3 and 5) against closed forms, a
+"""Spring contact solvers (exact nested contact sets, scaling laws) against closed forms, a
 brute-force force balance and the bisection baseline.
 
 Grid tolerances for the closed forms (Euler-Maclaurin): on a uniform grid the

@@ -1,4 +1,4 @@
-"""Tests of the built-in spectrum generators (SPEC section 2).
+"""Tests of the built-in spectrum generators (random lines from a spectrum).
 
 Expected values come from the definitions, never from a previous run:
 psd convention <z^2> = 2 * integral psd dq, mode k of amplitude a_k = 2 sqrt(psd(q_k) dq),
@@ -385,7 +385,7 @@ def test_params_edited_in_place():
         gen.params.hurst = 3.0
 
 
-# ---------------------------------------------------------------- scaling (SPEC section 5)
+# ---------------------------------------------------------------- scaling (exact scaling laws)
 
 
 @pytest.mark.parametrize("amplitudes", ["fixed", "rayleigh"])

@@ -1,4 +1,4 @@
-"""The 3D law (SPEC 7): closed form, the worked example, intervals, run folders, CLI."""
+"""The 3D law (the paper's, by MDR): closed form, the worked example, intervals, run folders, CLI."""
 
 import json
 import math
@@ -29,7 +29,7 @@ def test_f_is_the_line_f_with_the_mdr_length():
 
 
 def test_the_specs_worked_law():
-    # SPEC 7: grad_z_contact / grad_z = 2.9 + 0.14 ln( sqrt(pi) F / (2 E* h sqrt(A)) )
+    # the paper: grad_z_contact / grad_z = 2.9 + 0.14 ln( sqrt(pi) F / (2 E* h sqrt(A)) )
     kw = dict(modulus=1.0, rms_height=1e4, area=math.pi * 0.25e10)  # L = 1e5, so f = F * 1e-9
     p = predict_xi(LogFit(2.9, 0.14), force=7.0, **kw)
     assert p.f == pytest.approx(7e-9, rel=1e-12)

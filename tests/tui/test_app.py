@@ -11,10 +11,10 @@ from frictionlab.tui.app import FrictionlabApp
 
 from ..conftest import ROOT
 
-# ------------------------------------------------------------------ help, README, CLI
+# ------------------------------------------------------------------ help, docs, CLI
 
 
-def test_help_lists_every_binding_and_the_readme_has_them(registry):
+def test_help_lists_every_binding_and_the_docs_have_them(registry):
     app = FrictionlabApp(registry=registry)
     keys = [key for _, rows in app.help_groups() for key, _ in rows]
     from frictionlab.tui.widgets import PresetsPane, ResultsPane, RunPane
@@ -25,10 +25,10 @@ def test_help_lists_every_binding_and_the_readme_has_them(registry):
                 from textual.binding import Binding
 
                 assert app.get_key_display(Binding(key, binding.action)) in keys
-    readme = (ROOT / "README.md").read_text()
-    section = readme.split("## Terminal UI", 1)[1].split("\n## ", 1)[0]
+    page = (ROOT / "docs" / "how-to" / "tui.md").read_text()
+    section = page.split("## Keys", 1)[1]
     for description in {d for _, rows in app.help_groups() for _, d in rows}:
-        assert description in section, f"README's key table misses {description!r}"
+        assert description in section, f"docs/how-to/tui.md's key table misses {description!r}"
 
 
 def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path, monkeypatch):

@@ -1,0 +1,89 @@
+"""The outputs the README and the docs show are what the commands beside them print
+today: each is rerun here (serially: the numbers do not depend on the workers) and
+every line shown must be printed, but for wall times and output paths. When the
+physics or the output changes, these fail until the pages show the new output."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+
+import pytest
+
+from frictionlab.cli.main import main
+from frictionlab.paper import calibration
+
+from .conftest import ROOT
+
+
+def _shown_block(page: str, first_line: str) -> list[str]:
+    """The lines of the fenced block of ``page`` that starts with ``first_line``."""
+    text = (ROOT / page).read_text(encoding="utf-8")
+    for block in re.findall(r"^```text\n(.*?)^```", text, flags=re.S | re.M):
+        lines = block.splitlines()
+        if lines and lines[0].startswith(first_line):
+            return lines
+    raise AssertionError(f"{page} shows no output starting with {first_line!r}")
+
+
+def _comparable(line: str) -> bool:
+    """Output lines that hold no wall time and no output folder (those differ run to run)."""
+    return not re.search(r" in \d+\.\d+ s\b|^results in |^\.\.\.$|^\$ ", line.strip())
+
+
+def _check(page: str, first_line: str, printed: str):
+    shown = [line.strip() for line in _shown_block(page, first_line) if _comparable(line)]
+    printed_lines = {line.strip() for line in printed.splitlines()}
+    stale = [line for line in shown if line not in printed_lines]
+    assert len(shown) >= 3
+    assert not stale, f"{page} shows output the command no longer prints:\n" + "\n".join(stale) + "\n--- printed:\n" + printed
+
+
+@pytest.fixture(scope="module")
+def fig2_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fig2") / "fig2"
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        code = main(["run", str(ROOT / "presets" / "benad2012-fig2.yaml"), "--out", str(out), "--workers", "1", "--quiet"])
+    assert code == 0
+    return out, stdout.getvalue()
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/getting-started.md", "docs/tutorials/dask-cluster.md"])
+def test_the_quickstart_output_shown_is_what_it_prints(page, tmp_path, capsys):
+    preset = ROOT / "presets" / "quickstart.yaml"
+    assert main(["run", str(preset), "--out", str(tmp_path / "qs"), "--workers", "1", "--quiet"]) == 0
+    _check(page, "quickstart: 50/50", capsys.readouterr().out)
+
+
+def test_the_fig2_output_shown_is_what_it_prints(fig2_run):
+    _check("docs/tutorials/reproduce-fig2.md", "benad2012-fig2: 300/300", fig2_run[1])
+
+
+def test_the_predictions_shown_are_what_predict_prints(fig2_run, capsys):
+    folder = str(fig2_run[0])
+    args = ["--area", "1e10", "--modulus", "1", "--rms-height", "1e4", "--force", "5"]
+    assert main(["predict", "--from", folder, *args]) == 0
+    _check("docs/how-to/predict.md", "law: xi = 1.6059", capsys.readouterr().out)
+    given = ["--a", "2.9", "--b", "0.14", "--a-ci", "2.8", "3.0", "--b-ci", "0.13", "0.15"]
+    given += ["--area", "1e-4", "--modulus", "1e6", "--rms-height", "1e-6", "--force", "1e-9"]
+    assert main(["predict", *given]) == 0
+    _check("docs/how-to/predict.md", "law: xi = 2.9000", capsys.readouterr().out)
+
+
+def test_the_calibration_shown_is_what_it_prints(capsys):
+    calibration.main(str(ROOT / "presets" / "benad2012-fig2.yaml"))
+    _check("docs/tutorials/reproduce-fig2.md", "least-squares (in log) h =", capsys.readouterr().out)
+
+
+def test_the_validation_errors_shown_are_what_validate_prints(tmp_path, monkeypatch, capsys):
+    quickstart = (ROOT / "presets" / "quickstart.yaml").read_text(encoding="utf-8")
+    bad = quickstart.replace("hurst: 0.8", "hurst: 2.0").replace("steps: 40", "steps: abc")
+    bad = re.sub(r"(?m)^  name: mdr$", "  name: mdrr", bad)
+    assert bad.count("2.0") and "abc" in bad and "mdrr" in bad, "the quickstart preset changed: update the page's bad.yaml"
+    (tmp_path / "bad.yaml").write_text(bad, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    assert main(["validate", "bad.yaml"]) == 2
+    captured = capsys.readouterr()
+    _check("docs/how-to/presets.md", "$ frictionlab validate bad.yaml", captured.out + captured.err)
