@@ -9,15 +9,17 @@ import platform
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import OutputRefused
 from ..files import atomic_write
 from ..listeners import format_duration
 from ..options import RunOptions
 from ..rundir import new_run_folder
-from ..seeds import bootstrap_rng
+from ..seeds import bootstrap_rng, realization_rng
 from .analysis import SMALL_LOAD_FRACTION, Kappa, contact_area_law
 from .figures import plot_convergence, plot_xi_against_f
-from .markdown import YASTREBOV, answer, convergence_table, law_table
+from .markdown import YASTREBOV, answer, convergence_table, ensemble_text, law_table, paired_extra_grids
 from .plan import FULL, QUICK, Plan, StudyRuns, preset_name, run_plan
 
 PAGE = "exact-3d-law.md"
@@ -50,6 +52,17 @@ def kappas_of(runs: StudyRuns) -> dict[tuple[float, int], Kappa]:
             bootstrap=runs.plan.bootstrap,
         )  # fmt: skip
     return found
+
+
+def same_surfaces(runs: StudyRuns) -> bool:
+    """Whether the coarsest and the finest grid of the first H hold the same surface
+    (realization 0) at the coarse grid's points."""
+    hurst = runs.plan.hursts[0]
+    coarse, fine = runs.find(hurst, runs.plan.resolutions[0]), runs.find(hurst)
+    heights = [e.scene.spectrum.generate(realization_rng(e.scene.preset.seed, 0)).heights for e in (coarse, fine)]
+    stride = fine.points // coarse.points
+    sampled = heights[1][::stride, ::stride]
+    return sampled.shape == heights[0].shape and bool(np.allclose(sampled, heights[0], rtol=0, atol=1e-9 * heights[0].std()))
 
 
 def machine() -> str:
@@ -104,7 +117,6 @@ def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) ->
     o = finest.outcome
     realizations = ", ".join(f"{m} on {n}²" for n, m in zip(plan.resolutions, plan.realizations))
     extra = "".join(f"; {m} on {n}² at H = {h:g}" for h, n, m in plan.extra)
-    widths = [0.5 * (runs.find(h).outcome.fit.b_ci[1] - runs.find(h).outcome.fit.b_ci[0]) for h in plan.hursts]
     figures = FIGURES_DIR
     presets = ", ".join(f"`presets/{preset_name(h)}`" for h in plan.hursts)
     tolerance = finest.scene.solver.tolerance()
@@ -155,8 +167,11 @@ def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) ->
         "## Convergence in the grid",
         "",
         f"Each surface has side {finest.spacing * finest.points:g} (length units), rms height 1, long cut-off "
-        f"the side ({finest.long_cutoff:g}) and short cut-off λs = {finest.short_cutoff:g}; the grids sample that "
-        f"same surface with {', '.join(f'{n}²' for n in plan.resolutions)} pixels"
+        f"the side ({finest.long_cutoff:g}) and short cut-off λs = {finest.short_cutoff:g}; the grids sample the "
+        + ("same surfaces (the same modes and random phases: a grid's heights are those of a finer one at its "
+           "points) with " if same_surfaces(runs) else "same spectrum (not the same surfaces: the coarsest grid "
+           "holds the short cut-off at its Nyquist mode, drawn otherwise) with ")
+        + f"{', '.join(f'{n}²' for n in plan.resolutions)} pixels"
         + "".join(f" (and {n}² at H = {h:g})" for h, n, _ in plan.extra)
         + ", that is "
         + ", ".join(f"{n * finest.short_cutoff / (finest.spacing * finest.points):g}" for n in plan.resolutions)
@@ -175,9 +190,9 @@ def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) ->
         "",
         f"![a and b against the pixels on the short cut-off]({figures}/convergence.png)",
         "",
-        f"Ensemble sizes: {realizations}{extra}. On the finest grid the 95 % interval of b is ±"
-        f"{min(widths):.4f} to ±{max(widths):.4f} over H: the surfaces are enough when that is small against "
-        "the differences the page draws conclusions from (b between grids and against MDR).",
+        *paired_extra_grids(runs),
+        "",
+        f"Ensemble sizes: {realizations}{extra}. " + ensemble_text(runs),
         "",
         "## Known-answer check: the contact area at small loads",
         "",

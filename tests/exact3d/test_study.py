@@ -73,3 +73,24 @@ def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, capsy
     after = (quick_study / PAGE).read_text()
     tables = lambda text: [line for line in text.splitlines() if line.startswith("| ") and "run time" not in line]
     assert [row.rsplit("|", 2)[0] for row in tables(after)] == [row.rsplit("|", 2)[0] for row in tables(before)]
+
+
+@pytest.mark.parametrize("hurst", HURSTS)
+def test_every_grid_samples_the_same_surfaces(registry, hurst):
+    """The page compares grids on the same surfaces: a coarse grid's heights are a fine
+    one's at its points (same modes, same random phases), for every realization."""
+    from frictionlab.preset import build_scene, read_preset
+    from frictionlab.seeds import realization_rng
+    from frictionlab.variants import SceneFactory
+
+    path = PRESETS / preset_name(hurst)
+    factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+
+    def heights(points, index):
+        changes = {f"spectrum.params.{k}": v for k, v in factory.base.spectrum.refined(points).items()}
+        scene = factory.make(changes)
+        return scene.spectrum.generate(realization_rng(scene.preset.seed, index)).heights
+
+    for index in (0, 5):  # the full plan's grids (on 64^2 the short cut-off is at the Nyquist mode: not these)
+        coarse, fine = heights(128, index), heights(512, index)
+        np.testing.assert_allclose(fine[::4, ::4], coarse, rtol=0, atol=1e-12 * coarse.std())
