@@ -110,6 +110,16 @@ def test_a_solver_declaring_more_bytes_per_point_raises_the_estimate(registry):
     assert memory.bytes_per_point(surface) == declared + memory.PROFILE_BYTES_PER_POINT
 
 
+def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fits(registry, monkeypatch):
+    scene = build_scene(surface_of(4096), registry=registry)
+    monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
+    with pytest.raises(RunError, match=r"spectrum.params.points <= ([\d,]+)\.") as caught:
+        memory.check_fits(scene, workers=2, executor="processes")
+    side = int(caught.value.args[0].split("points <= ")[1].split(".")[0].replace(",", ""))
+    assert memory.estimate(scene, workers=1, executor="processes", points=side**2).total <= GiB
+    assert memory.estimate(scene, workers=1, executor="processes", points=(side + 1) ** 2).total > GiB
+
+
 def test_estimate_grows_with_points_workers_and_kept_rows(registry):
     small = build_scene(line_of(10_000), registry=registry)
     large = build_scene(line_of(1_000_000), registry=registry)
