@@ -6,34 +6,57 @@ files) lives here, with its front ends (``cli``, ``tui``) and the studies built 
 it (``paper``, ``tradeoff``); the physics lives in plugins (``frictionlab_spectra``,
 ``frictionlab_solvers``, ``frictionlab_slopes``) that register through the same
 hooks as any third-party plugin. ARCHITECTURE.md draws the layers.
+
+For notebooks and scripts: ``frictionlab.run(preset, **overrides)`` returns a
+``Result`` (the fit, the table per load step, a plot); ``frictionlab.load(folder)``
+reads a finished run back (``frictionlab.api``). They are imported on first use,
+so ``import frictionlab`` stays cheap.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+# Every public name is imported on first use (PEP 562), so that ``import frictionlab``
+# (and ``frictionlab --help``) costs almost nothing: numpy and pydantic come with the
+# first name that needs them.
+_LAZY = {
+    "hookimpl": "hookspecs",
+    **dict.fromkeys(("InputFile", "InputFileProblem", "open_regular_file"), "inputs"),
+    **dict.fromkeys(("RunListener", "SweepListener"), "listeners"),
+    "RunOptions": "options",
+    **dict.fromkeys(
+        (
+            "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
+            "SlopeEstimator", "SpectrumGenerator", "contract", "force_unit", "load_finished", "mdr_length",
+        ),
+        "plugin",
+    ),  # fmt: skip
+    **dict.fromkeys(("run", "load", "Result", "SweepResult"), "api"),
+}
 
-from .hookspecs import hookimpl
-from .inputs import InputFile, InputFileProblem, open_regular_file
-from .listeners import RunListener, SweepListener
-from .options import RunOptions
-from .plugin import (
-    ContactCurve,
-    ContactSolver,
-    Control,
-    ForceNormalisation,
-    Plugin,
-    PluginParams,
-    Profile,
-    SlopeEstimator,
-    SpectrumGenerator,
-    contract,
-    force_unit,
-    load_finished,
-    mdr_length,
-)
 
-try:
-    __version__ = version("frictionlab")
-except PackageNotFoundError:  # running from a source tree without install
-    __version__ = "0.0.0+unknown"
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("frictionlab")
+    except PackageNotFoundError:  # running from a source tree without install
+        return "0.0.0+unknown"
+
+
+def __getattr__(name: str):
+    if name == "__version__":
+        value = _version()
+    elif name in _LAZY:
+        from importlib import import_module
+
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+    else:
+        raise AttributeError(f"module 'frictionlab' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *_LAZY, "__version__"])
+
 
 __all__ = [
     "ContactCurve",
@@ -45,16 +68,20 @@ __all__ = [
     "Plugin",
     "PluginParams",
     "Profile",
+    "Result",
     "RunListener",
     "RunOptions",
     "SlopeEstimator",
     "SpectrumGenerator",
     "SweepListener",
+    "SweepResult",
     "__version__",
     "contract",
     "force_unit",
     "hookimpl",
+    "load",
     "load_finished",
     "mdr_length",
     "open_regular_file",
+    "run",
 ]

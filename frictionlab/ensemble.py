@@ -17,6 +17,17 @@ from .preset import Scene
 from .seeds import bootstrap_rng
 
 
+MIN_CONTACTS_FIRST_LOAD = 3  # mean points in contact at the first load below which a fit carries a caveat
+
+
+def few_contacts_caveat(count: float) -> str:
+    """The caveat of a fit whose first load touches fewer than 3 points (mean ``count``)."""
+    return (
+        f"fewer than {MIN_CONTACTS_FIRST_LOAD} points in contact at the first load (mean {count:.2f}): "
+        "xi there rests on one or two slopes, so the low-f end of the fit is unreliable"
+    )
+
+
 @dataclass
 class RunOutcome:
     """The statistics of what finished. Per-force arrays have one entry per load
@@ -48,6 +59,14 @@ class RunOutcome:
     @property
     def done(self) -> int:
         return int(self.indices.size)
+
+    @property
+    def caveats(self) -> list[str]:
+        """What a reader of the fit must know: today, too few points in contact at the
+        first load (the rms slope in contact of one or two points is mostly noise)."""
+        if self.fit is None or not self.contact_count.size or not self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
+            return []
+        return [few_contacts_caveat(float(self.contact_count[0]))]
 
     @property
     def extent(self) -> float:

@@ -83,3 +83,12 @@ def short_repr(value, limit: int = 80) -> str:
     except ValueError:  # an int past Python's digit limit
         text = f"<{type(value).__name__} too long to show>"
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
+    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the
+    hint every unknown-name message (commands, plugins, presets) ends with."""
+    import difflib
+
+    close = difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+    return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""

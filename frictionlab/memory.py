@@ -103,12 +103,12 @@ def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = 
 def available_memory() -> tuple[int, str]:
     """Bytes this process may still use, and where the figure comes from: the
     smaller of MemAvailable and the room left under a cgroup limit."""
+    import psutil  # the machine's available memory on every platform (MemAvailable on Linux)
+
     found: list[tuple[int, str]] = []
     try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                found.append((int(line.split()[1]) * 1024, "MemAvailable in /proc/meminfo"))
-    except (OSError, ValueError, IndexError):
+        found.append((int(psutil.virtual_memory().available), "available memory (MemAvailable on Linux)"))
+    except (OSError, RuntimeError):
         pass
     for limit_file, usage_file in (
         ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),  # cgroup v2
@@ -122,7 +122,7 @@ def available_memory() -> tuple[int, str]:
         if limit.isdigit() and int(limit) < 2**60:
             found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
     if not found:
-        return 2**62, "unknown (no /proc/meminfo)"
+        return 2**62, "unknown (the platform does not say)"
     return min(found)
 
 

@@ -11,7 +11,6 @@ Environment switches (read when a registry is built):
 
 from __future__ import annotations
 
-import difflib
 import functools
 import importlib
 import importlib.metadata as md
@@ -26,7 +25,7 @@ import numpy as np
 import pluggy
 from pydantic import BaseModel
 
-from .errors import PluginError
+from .errors import PluginError, did_you_mean
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .plugin import (
@@ -64,12 +63,20 @@ class PluginInfo:
     kind: str
     name: str
     cls: type[Plugin]
-    provider: str
-    version: str
 
     @property
     def summary(self) -> str:
         return self.cls.summary
+
+    @property
+    def provider(self) -> str:
+        """The distribution that ships the plugin (looked up when asked: the lookup
+        reads every installed distribution's metadata, too slow for each start)."""
+        return _provider_of(self.cls)[0]
+
+    @property
+    def version(self) -> str:
+        return _provider_of(self.cls)[1]
 
 
 @dataclass(frozen=True)
@@ -84,6 +91,7 @@ def _module_distributions() -> dict[str, list[str]]:
     return md.packages_distributions()
 
 
+@functools.cache
 def _provider_of(cls: type) -> tuple[str, str]:
     """The distribution (and version) that ships ``cls``, from its module."""
     top = cls.__module__.split(".")[0]
@@ -260,17 +268,16 @@ class Registry:
 
             def register(cls, _kind=kind):
                 validate_plugin_class(_kind, cls)
-                provider, version = _provider_of(cls)
                 key = normalize_name(cls.name)
                 previous = tables[_kind].get(key)
                 if previous is not None and previous.cls is not cls:
                     raise PluginError(
                         f"two {_kind} plugins are named {key!r}: "
                         f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
-                        f"and {cls.__module__}.{cls.__qualname__} from {provider}; "
+                        f"and {cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}; "
                         "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
                     )
-                tables[_kind][key] = PluginInfo(_kind, key, cls, provider, version)
+                tables[_kind][key] = PluginInfo(_kind, key, cls)
 
             getattr(self.pm.hook, base.register_hook)(register=register)
         self._plugins = tables
@@ -307,10 +314,7 @@ class Registry:
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)
-        close = difflib.get_close_matches(normalize_name(name), installed, n=3, cutoff=0.5)
-        message = f"no {kind} plugin named {name!r}"
-        if close:
-            message += f"; did you mean {' or '.join(repr(c) for c in close)}?"
+        message = f"no {kind} plugin named {name!r}{did_you_mean(normalize_name(name), installed)}"
         message += f" Installed {kind} plugins: {', '.join(installed) or 'none'}."
         if self.failures:
             broken = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error}" for f in self.failures)

@@ -8,7 +8,8 @@ Files in the output folder::
     curve.csv          one row per load step
     realizations.npz   per-realization curves (output.realizations)
     preset.yaml        the resolved preset (every default filled in)
-    plot.png           xi against f with the fit (output.plot)
+    plot.png           xi against f with the fit (output.plot); drawn last, after
+                       summary.json, which is then rewritten to list it
 
 The run directory's own files (run.lock, run.json, chunks/) are ``rundir``'s.
 """
@@ -65,6 +66,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
+        "caveats": outcome.caveats,
         "elapsed_seconds": round(outcome.elapsed, 6),
         "workers": outcome.workers,
         "executor": outcome.extra.get("executor"),
@@ -110,7 +112,8 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
 
 
 def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dict[str, Path]:
-    """Write every output file of ``outcome`` into ``out_dir``; return their paths."""
+    """Write the numbers of ``outcome`` into ``out_dir`` (every file but the figure,
+    which is ``add_plot``'s); return their paths."""
     out = Path(out_dir)
     files: dict[str, Path] = {}
 
@@ -125,13 +128,25 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
         arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f}
         atomic_write(files["realizations"], lambda fh: np.savez_compressed(fh, **arrays), binary=True)
 
-    if scene.preset.output.plot and outcome.done:
-        from .plot import plot_curve  # matplotlib is slow to import: only when drawing
-
-        files["plot"] = out / "plot.png"
-        atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
-
-    files["summary"] = out / "summary.json"  # last: its presence means the rest is complete
-    summary = summary_dict(scene, outcome, {k: p.name for k, p in files.items() if k != "summary"})
-    atomic_write(files["summary"], lambda fh: json.dump(summary, fh, indent=2, allow_nan=False))
+    files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete
+    _write_summary(out, scene, outcome, files)
     return files
+
+
+def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> dict[str, Path]:
+    """Draw plot.png (if the preset asks for it and anything finished) after the other
+    files, and list it in summary.json (rewritten); ``files`` with the plot's path."""
+    if not (scene.preset.output.plot and outcome.done):
+        return files
+    from .plot import plot_curve  # matplotlib is slow to import: only when drawing
+
+    out = Path(out_dir)
+    files = {**files, "plot": out / "plot.png"}
+    atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
+    _write_summary(out, scene, outcome, files)
+    return files
+
+
+def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:
+    summary = summary_dict(scene, outcome, {k: p.name for k, p in files.items() if k != "summary"})
+    atomic_write(out / "summary.json", lambda fh: json.dump(summary, fh, indent=2, allow_nan=False))

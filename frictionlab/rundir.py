@@ -3,7 +3,7 @@ lost, no damaged data is used, and no file frictionlab did not write is touched.
 
 Layout inside the output folder::
 
-    run.lock      held (fcntl.flock) while a run writes here, removed when it
+    run.lock      held (filelock: flock on POSIX) while a run writes here, removed when it
                   ends; the kernel releases the lock even on kill -9
     run.json      the manifest: status, the resolved preset and its
                   fingerprint, every input file with its SHA-256, and every
@@ -28,7 +28,6 @@ A fresh run refuses a folder that holds anything but a run of its own preset
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import io
 import json
@@ -60,21 +59,10 @@ OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 
-# Lock descriptors of this process: a forked pool worker closes its copies, so
-# the lock goes with the main process (flock is shared by every copy of the fd).
-_held_locks: set[int] = set()
-
-
-def _close_locks_in_child() -> None:
-    for fd in _held_locks:
-        try:
-            os.close(fd)
-        except OSError:
-            pass
-    _held_locks.clear()
-
-
-os.register_at_fork(after_in_child=_close_locks_in_child)
+def _write_holder(fd: int) -> None:
+    """Who holds run.lock, for the message of a run refused because of it."""
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"pid {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n".encode(), 0)
 
 
 def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
@@ -107,7 +95,7 @@ class RunDirectory:
     def __init__(self, path: str | Path, *, force: bool = False):
         self.path = Path(path)
         self.force = force
-        self._lock_fd: int | None = None
+        self._lock = None  # a filelock.FileLock while held
         self._manifest: dict | None = None
 
     @property
@@ -117,45 +105,38 @@ class RunDirectory:
     # ------------------------------------------------------------ lock
 
     def __enter__(self) -> RunDirectory:
+        from filelock import FileLock, Timeout
+
         problem = output_path_problem(self.path)
         if problem:
             raise OutputRefused(f"{problem}; give --out a folder")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
-        while True:
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC | os.O_NOFOLLOW, 0o644)
+        # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
+        # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
+        # file the holder then removed takes the lock on the new file.
+        self._lock = FileLock(lock, timeout=0, mode=0o644, thread_local=False, on_acquired=_write_holder)
+        try:
+            self._lock.acquire()
+        except Timeout:
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "unknown"
-                os.close(fd)
-                raise RunFolderError(
-                    f"{self.path} is in use by another run ({holder}): wait for it to end, "
-                    "or give another output folder"
-                ) from None
-            # The run that held it may have removed the file between our open and flock:
-            # then we hold a lock on a file nobody else will find; take the new one.
-            try:
-                if os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino:
-                    break
-            except FileNotFoundError:
-                pass
-            os.close(fd)
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"pid {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n".encode(), 0)
-        self._lock_fd = fd
-        _held_locks.add(fd)
+                holder = lock.read_text(errors="replace").strip()[:200] or "unknown"
+            except OSError:
+                holder = "unknown"
+            raise RunFolderError(
+                f"{self.path} is in use by another run ({holder}): wait for it to end, "
+                "or give another output folder"
+            ) from None
         return self
 
     def __exit__(self, *exc) -> bool:
-        if self._lock_fd is not None:
-            _held_locks.discard(self._lock_fd)
+        if self._lock is not None:
             try:
-                (self.path / LOCK_FILE).unlink()  # still ours: removed while held
+                (self.path / LOCK_FILE).unlink()  # while still held: a waiter that opened it retries on the new one
             except OSError:
                 pass
-            os.close(self._lock_fd)  # releases the flock
-            self._lock_fd = None
+            self._lock.release()
+            self._lock = None
         return False
 
     # ------------------------------------------------------------ manifest

@@ -4,7 +4,7 @@ same files, hold the same lock and can all be resumed."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from . import engine
@@ -13,8 +13,20 @@ from .executors import dask_memory_limits
 from .memory import check_fits, check_worker_limits
 from .options import RunOptions
 from .preset import Scene
-from .results import write_results
+from .results import add_plot, write_results
 from .rundir import RunDirectory
+
+
+def check_memory(scene: Scene, options: RunOptions) -> None:
+    """Refuse, before anything starts, a run whose estimated peak memory exceeds what
+    is available (on Dask, one whose realization exceeds a worker's memory limit)."""
+    total = scene.preset.realizations
+    workers = options.workers_for(total)
+    kind = options.executor_for(workers)
+    check_fits(scene, workers=workers, executor=kind, remote_workers=bool(options.scheduler))
+    if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
+        limits, usable = dask_memory_limits(options.scheduler, workers)
+        check_worker_limits(scene, limits, usable=usable)
 
 
 def run_to_folder(
@@ -24,6 +36,8 @@ def run_to_folder(
     *,
     listeners: Iterable[object] = (),
     cancel=None,
+    plot: bool = True,
+    on_results: Callable[[RunOutcome, dict[str, Path]], None] | None = None,
 ) -> tuple[RunOutcome, dict[str, Path]]:
     """Run ``scene`` as ``options`` say and write its result files into ``out_dir``.
 
@@ -39,19 +53,20 @@ def run_to_folder(
     memory limit).
 
     What finished is written even when the run was cancelled or interrupted.
-    Returns the outcome and the paths of the files written.
+    The figure comes last: ``on_results(outcome, files)`` is called once the
+    numbers are written (a front end prints the fit there, so nobody waits for
+    matplotlib), then plot.png is drawn unless ``plot`` is False or the preset
+    says ``output.plot: false``. Returns the outcome and the paths of the files written.
     """
-    total = scene.preset.realizations
-    workers = options.workers_for(total)
     if options.memory_check:
-        kind = options.executor_for(workers)
-        check_fits(scene, workers=workers, executor=kind, remote_workers=bool(options.scheduler))
-        if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
-            limits, usable = dask_memory_limits(options.scheduler, workers)
-            check_worker_limits(scene, limits, usable=usable)
+        check_memory(scene, options)
     with RunDirectory(out_dir, force=options.force) as run_dir:
         restored = run_dir.start(scene, resume=options.resume)
         outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=run_dir, restored=restored)
         files = write_results(out_dir, scene, outcome)
+        if on_results is not None:
+            on_results(outcome, files)
+        if plot:
+            files = add_plot(out_dir, scene, outcome, files)
         run_dir.finish(scene, outcome.status)
     return outcome, files

@@ -82,6 +82,22 @@ class Sweep:
     def paths(self) -> list[str]:
         return list(self.spec.parameters)
 
+    def axis_label(self, path: str) -> str:
+        """What a swept ``path`` is, for a figure: the head of its field's description
+        (``spectrum.params.hurst``: "Hurst exponent H"), else its last key."""
+        keys = path.split(".")
+        field = None
+        if len(keys) == 3 and keys[1] == "params" and self.points:
+            plugin = self.points[0].scene.plugins().get(keys[0])
+            field = type(plugin.params).model_fields.get(keys[2]) if plugin is not None else None
+        else:
+            model = Preset
+            for key in keys:
+                field = model.model_fields.get(key) if model is not None else None
+                model = _model_of(field.annotation) if field is not None else None
+        head = re.split(r"[:;(,]", (field.description or "") if field is not None else "")[0].strip()
+        return head if 0 < len(head) <= 40 else keys[-1].replace("_", " ")
+
 
 def _label(values: dict[str, Any]) -> str:
     parts = []
@@ -238,7 +254,7 @@ class SweepOutcome:
 
 
 def _run_points(
-    sweep: Sweep, out_dir: Path, options: RunOptions, listeners: list[SweepListener], cancel
+    sweep: Sweep, out_dir: Path, options: RunOptions, listeners: list[SweepListener], cancel, plot: bool = True
 ) -> Iterator[PointResult]:
     """Run the points in order, yielding each PointResult as it finishes.
 
@@ -254,7 +270,9 @@ def _run_points(
             listener.point_started(sweep, point)
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         try:
-            outcome, _ = run_to_folder(point.scene, folder, options, listeners=run_listeners, cancel=cancel)
+            outcome, _ = run_to_folder(
+                point.scene, folder, options, listeners=run_listeners, cancel=cancel, plot=plot
+            )
         except FrictionlabError as exc:
             yield PointResult(point, "error", folder, error=str(exc))
             continue
@@ -273,7 +291,8 @@ def run_sweep(
     plot: bool = True,
 ) -> SweepOutcome:
     """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``),
-    and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end. ``out_dir``
+    and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end (and each
+    point's plot.png) unless ``plot`` is False. ``out_dir``
     must be new, empty or a folder of this same sweep unless ``options.force``."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
@@ -287,7 +306,7 @@ def run_sweep(
     write_tables(sweep, outcome, out_dir)
     interrupted = False
     try:
-        for result in _run_points(sweep, out_dir, options, listeners, cancel):
+        for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
             results[result.point.number] = result
             outcome.results = list(results.values())
             outcome.elapsed = time.perf_counter() - started

@@ -8,7 +8,7 @@ from collections import defaultdict
 import pytest
 
 from frictionlab import engine, hookimpl, load_finished
-from frictionlab.cli.progress import ProgressReporter
+from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
 from frictionlab.plugin import listening_to_loads
 from frictionlab.preset import build_scene
@@ -67,8 +67,40 @@ def test_every_load_of_every_realization_is_heard_before_its_realization(registr
     assert sorted(loads) == list(range(6))
 
 
-def test_the_progress_line_shows_the_load_of_a_long_solve(registry):
+def test_the_progress_bar_notes_the_load_of_a_long_solve(registry, monkeypatch):
+    import frictionlab.progress as progress
+
+    notes = []
+
+    class Bar:  # rich draws the bar; what it is told is under test here
+        def __init__(self, stream, description, total, completed=0, started=None):
+            pass
+
+        def update(self, completed, note=""):
+            notes.append(note)
+
+        def print(self, text):
+            pass
+
+        def stop(self):
+            pass
+
+    monkeypatch.setattr(progress, "_Bar", Bar)
+    scene = build_scene(SURFACE, registry=registry)
+    engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(io.StringIO(), interactive=True, after=0.0)])
+    for index in range(6):
+        assert [n for n in notes if n.startswith(f"realization {index}: ")] == [f"realization {index}: load {d}/{STEPS}" for d in range(1, STEPS + 1)]
+
+
+def test_a_log_gets_a_load_line_only_now_and_then(registry, monkeypatch):
+    import frictionlab.progress as progress
+
+    monkeypatch.setattr(progress, "LOAD_LINE_SECONDS", 0.0)
     scene = build_scene(SURFACE, registry=registry)
     stream = io.StringIO()
-    engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(stream, interactive=True)])
-    assert "realization 0: load " in stream.getvalue()
+    engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(stream, interactive=False, after=0.0)])
+    assert "realization 0: load 1/5" in stream.getvalue()
+    stream = io.StringIO()
+    monkeypatch.setattr(progress, "LOAD_LINE_SECONDS", 3600.0)
+    engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(stream, interactive=False, after=0.0)])
+    assert "load" not in stream.getvalue()

@@ -168,7 +168,7 @@ def test_failed_realizations_are_retried_on_resume(make_scene, tmp_path, capsys)
     first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     assert first.status == "completed" and 3 <= len(first.failures) <= 15
     flag.unlink()
-    from frictionlab.cli.progress import ProgressReporter
+    from frictionlab.progress import ProgressReporter
 
     second, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=2, resume=True), listeners=[ProgressReporter()])
     assert second.failures == [] and second.done == 20

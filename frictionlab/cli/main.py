@@ -1,9 +1,19 @@
 """The parser and the dispatch of ``frictionlab COMMAND``.
 
-Results go to stdout, progress and errors to stderr. Exit codes are
-``ExitCode``. A user error never prints a traceback (set ``FRICTIONLAB_DEBUG=1``
-to see one for an internal error). SIGTERM ends a run as Ctrl-C does; a closed
-stdout ends the command quietly.
+Conventions every command keeps (tested in tests/cli/test_conventions.py):
+
+* results go to stdout, progress and errors to stderr; ``--json`` puts the results as
+  JSON on stdout (run, validate, plugins, presets, study, report, predict);
+* a bare ``frictionlab`` prints a short help with examples; ``-V``/``--version`` the
+  version; every ``COMMAND --help`` a description and examples;
+* a mistyped command, plugin or preset name is answered with the closest names;
+* tables fit the terminal (rich) and are plain aligned columns in a pipe; colour only
+  on a terminal, never with ``NO_COLOR`` set; progress is a bar on a terminal and a
+  line per tenth in a log, shown once a run passes 2 s, none with ``--quiet``;
+* ``frictionlab completion bash|zsh|fish`` prints a completion script;
+* exit codes are ``ExitCode``; a user error never prints a traceback (set
+  ``FRICTIONLAB_DEBUG=1`` to see one for an internal error); SIGTERM ends a run as
+  Ctrl-C does; a closed stdout ends the command quietly (141).
 """
 
 from __future__ import annotations
@@ -13,25 +23,79 @@ import os
 import sys
 import warnings
 
-from .. import __version__
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
-from . import exact3d, plugins, predict, report, resume, run, schema, study, tui, validate
+from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
+from .console import error_label
 
-COMMANDS = (run, resume, validate, schema, plugins, report, predict, tui, study, exact3d)
+COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
 
 
+class _Version(argparse.Action):
+    """``--version``, its number read only when asked (importlib.metadata is slow to import)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .. import __version__
+
+        print(f"frictionlab {__version__}")  # on stdout, where a script reads it
+        parser.exit()
+
+
+DESCRIPTION = "rms slope in contact against normal force, over ensembles of random rough lines and surfaces."
+EXAMPLES = """examples:
+  frictionlab run quickstart                  a first run: the fit, the table, plot.png
+  frictionlab presets                         the built-in presets
+  frictionlab run my.yaml --set seed=3        a preset of your own, one value changed
+  frictionlab tui                             edit, run and compare in the terminal
+  frictionlab COMMAND --help                  what a command does, with examples
+"""
+
+
+class _Parser(argparse.ArgumentParser):
+    """Every parser keeps the line breaks of its description and examples."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="frictionlab",
-        description="rms slope in contact against normal force, over ensembles of random rough lines.",
-    )
-    parser.add_argument("--version", action="version", version=f"frictionlab {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EXAMPLES)
+    parser.add_argument("-V", "--version", action=_Version, help="print the version and exit")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for command in COMMANDS:
         command.add_parser(sub)
     return parser
+
+
+def command_names() -> list[str]:
+    return [command.__name__.rsplit(".", 1)[-1] for command in COMMANDS]
+
+
+def short_help() -> str:
+    """What a bare ``frictionlab`` prints: what it is, its commands, examples."""
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    width = max(len(c.dest) for c in sub._choices_actions)
+    lines = [f"frictionlab: {DESCRIPTION}", "", "usage: frictionlab COMMAND [options]", "", "commands:"]
+    lines += [f"  {c.dest.ljust(width)}  {c.help}" for c in sub._choices_actions]
+    return "\n".join([*lines, "", EXAMPLES.rstrip()])
+
+
+def _unknown_command(argv: list[str]) -> str | None:
+    """The error for a first word that is no command (argparse's own names no close one)."""
+    from ..errors import did_you_mean
+
+    first = next((word for word in argv if not word.startswith("-")), None)
+    names = command_names()
+    if first is None or first in names or any(word in ("-h", "--help", "-V", "--version") for word in argv[: argv.index(first)]):
+        return None
+    hint = did_you_mean(first, names)
+    return f"frictionlab: no command {first!r}{hint or '.'} Commands: {', '.join(names)} (frictionlab --help)"
 
 
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
@@ -51,9 +115,29 @@ def _quiet_stdout() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     warnings.formatwarning = _plain_warning
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv:
+        return _print(short_help())
+    problem = _unknown_command(argv)
+    if problem:
+        print(problem, file=sys.stderr)
+        return int(ExitCode.USAGE)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    args.parser = parser  # a command that describes the CLI itself (completion) reads it
+    if args.command is None:  # only options, none of which exits (there are none today)
+        return _print(short_help())
     with RaiseOnSigterm():
         return _run_command(args)
+
+
+def _print(text: str) -> int:
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        _quiet_stdout()
+        return int(ExitCode.BROKEN_PIPE)
+    return int(ExitCode.OK)
 
 
 def _run_command(args) -> int:
@@ -65,7 +149,7 @@ def _run_command(args) -> int:
         _quiet_stdout()
         return int(ExitCode.BROKEN_PIPE)
     except FrictionlabError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"{error_label()}: {exc}", file=sys.stderr)
         return int(exc.exit_code)
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         where = f": {exc.filename}" if exc.filename else ""

@@ -9,7 +9,12 @@ from ..errors import ExitCode
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("plugins", help="list installed plugins")
+    p = sub.add_parser(
+        "plugins",
+        help="list installed plugins",
+        description="The installed spectra, solvers and slope estimators, with the distribution that ships each.",
+        epilog="examples:\n  frictionlab plugins\n  frictionlab plugins --json",
+    )
     p.add_argument("--json", action="store_true", help="as JSON")
     p.set_defaults(handler=run)
 
@@ -27,11 +32,9 @@ def run(args) -> ExitCode:
         failures = [f.__dict__ for f in registry.failures]
         print(json.dumps({"plugins": rows, "failed": failures}, indent=2))
         return ExitCode.OK
-    header = ("KIND", "NAME", "PROVIDER", "VERSION", "SUMMARY")
-    rows = [(i.kind, i.name, i.provider, i.version, i.summary) for i in infos]
-    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(4)]
-    for row in [header, *rows]:
-        print("  ".join(cell.ljust(w) for cell, w in zip(row[:4], widths)) + "  " + row[4])
+    from .console import print_table
+
+    print_table(("KIND", "NAME", "PROVIDER", "VERSION", "SUMMARY"), [(i.kind, i.name, i.provider, i.version, i.summary) for i in infos])
     for failure in registry.failures:
         print(f"failed to load: {failure.entry_point} ({failure.distribution}): {failure.error}", file=sys.stderr)
     return ExitCode.OK

@@ -2,15 +2,23 @@
 
 from __future__ import annotations
 
+import json
 import sys
+from pathlib import Path
 
 from ..errors import ExitCode
 from .options import add_workers_option, run_options
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("report", help="run the source paper's Figs. 2 to 5 and write REPRODUCTION.md with figures")
-    p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets)")
+    p = sub.add_parser(
+        "report",
+        help="run the source paper's Figs. 2 to 5 and write REPRODUCTION.md with figures",
+        description="Reproduce the source paper's Figs. 2 to 5 from the built-in presets and write a report "
+        "(markdown and figures); --readings adds the readings of the paper's method (minutes).",
+        epilog="examples:\n  frictionlab report --out runs/report\n  frictionlab report --readings --json",
+    )
+    p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets if it holds them, else the built-in presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
     p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
     p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
@@ -18,6 +26,7 @@ def add_parser(sub) -> None:
     add_workers_option(p, "all cores")
     p.add_argument("--readings", action="store_true", help="also run the readings of the paper's method (slower)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--json", action="store_true", help="print where the report and its figures are, as JSON")
     p.set_defaults(handler=run)
 
 
@@ -28,6 +37,13 @@ def run(args) -> ExitCode:
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
         options=run_options(workers=args.workers, force=args.force), readings=args.readings,
         log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+        quiet=args.quiet,
     )  # fmt: skip
-    print(path)
+    if args.json:
+        figures = sorted(str(p) for p in path.parent.glob("**/*.png")) if args.figures is None else sorted(
+            str(p) for p in Path(args.figures).glob("*.png")
+        )
+        print(json.dumps({"report": str(path), "figures": figures}, indent=2))
+    else:
+        print(path)
     return ExitCode.OK

@@ -10,11 +10,17 @@ from .options import add_executor_options, add_workers_option
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("resume", help="continue an interrupted run in DIR with the preset stored there")
+    p = sub.add_parser(
+        "resume",
+        help="continue an interrupted run in DIR with the preset stored there",
+        description="Continue a run that was interrupted, killed or crashed: only the missing realizations are computed.",
+        epilog="example:\n  frictionlab resume runs/quickstart-20250101-120000",
+    )
     p.add_argument("run_dir", metavar="DIR", help="the output folder of the interrupted run")
     add_workers_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.add_argument("--no-plot", action="store_true", help="draw no plot.png")
     add_executor_options(p)
     p.set_defaults(handler=run)
 

@@ -12,8 +12,15 @@ from .options import add_executor_options, add_workers_option, executor_run_opti
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("run", help="run a preset headless and write its results")
-    p.add_argument("preset", help="preset YAML file")
+    p = sub.add_parser(
+        "run",
+        help="run a preset headless and write its results",
+        description="Run a preset (a file, or a built-in's name) and write its run folder: summary.json, "
+        "curve.csv, realizations.npz, preset.yaml, then plot.png after the fit is printed.",
+        epilog="examples:\n  frictionlab run quickstart\n  frictionlab run quickstart --set spectrum.params.hurst=0.6 --out runs/h06\n"
+        "  frictionlab run presets/benad2012-fig2.yaml --no-plot --json",
+    )
+    p.add_argument("preset", help="preset YAML file, or a built-in preset's name (frictionlab presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
     p.add_argument(
         "--set", action="append", metavar="PATH=VALUE", help="override a preset value, e.g. spectrum.params.hurst=0.8"
@@ -22,6 +29,9 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.add_argument(
+        "--no-plot", action="store_true", help="draw no plot.png (sweep.png): the fastest run; the numbers are the same"
+    )
     add_executor_options(p)
     p.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
     p.add_argument(
@@ -34,11 +44,13 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..rundir import new_run_folder
 
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
+    args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
     scene = build_scene(data, source=str(args.preset))
     if args.resume and not args.out:
@@ -51,22 +63,25 @@ def run(args) -> ExitCode:
 
 
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
+    from ..api import run_scene
+    from ..progress import ProgressReporter
     from ..results import summary_dict
-    from ..runner import run_to_folder
     from ..signals import interrupted_exit_code
-    from .progress import ProgressReporter
+
+    def print_table(result) -> None:  # before the figure is drawn: nobody waits for matplotlib
+        if not args.json:
+            print(result_table(scene, result.outcome, out_dir), flush=True)
 
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        outcome, files = run_to_folder(scene, out_dir, options, listeners=listeners)
+        result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
+    outcome = result.outcome
     if args.json:
-        summary = summary_dict(scene, outcome, {k: str(p) for k, p in files.items()})
+        summary = summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()})
         print(json.dumps(summary, indent=2, allow_nan=False))
-    else:
-        print(result_table(scene, outcome, out_dir))
     if outcome.status in ("interrupted", "cancelled"):
         return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
@@ -79,11 +94,13 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 def _run_sweep(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..signals import interrupted_exit_code
     from ..sweep import plan_sweep, run_sweep
-    from .progress import SweepProgress
+    from ..progress import SweepProgress
 
     sweep = plan_sweep(data, source=str(args.preset))
     try:
-        outcome = run_sweep(sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()])
+        outcome = run_sweep(
+            sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
+        )
     except OSError as exc:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
@@ -121,6 +138,8 @@ def result_table(scene, outcome, out_dir: Path) -> str:
             f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
             f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
         )
+    for caveat in outcome.caveats:
+        lines.append(f"  caveat: {caveat}")
     if outcome.failures:
         index, error = outcome.failures[0]
         lines.append(f"  {len(outcome.failures)} realization(s) failed; first: #{index}: {error}")

@@ -9,7 +9,12 @@ from ..errors import ExitCode
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("schema", help="JSON Schema of presets with the installed plugins")
+    p = sub.add_parser(
+        "schema",
+        help="JSON Schema of presets with the installed plugins",
+        description="Print the JSON Schema of a preset, with the parameters of every installed plugin (for editors).",
+        epilog="example:\n  frictionlab schema --out preset.schema.json",
+    )
     p.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout")
     p.set_defaults(handler=run)
 

@@ -33,9 +33,16 @@ DEFAULTS = {  # the flags' defaults, as typed: StudyOptions' own
 
 
 def add_parser(sub) -> None:
-    parser = sub.add_parser("study", help="error against cost of grid, realizations, steps, solver and tolerance")
+    parser = sub.add_parser(
+        "study",
+        help="error against cost of grid, realizations, steps, solver and tolerance",
+        description="The speed/accuracy study of a preset: the error of b against the cost along each axis "
+        "(grid, realizations, steps, solver, tolerance), and the cheapest settings that reach --target.",
+        epilog="examples:\n  frictionlab study quickstart --axes grid,realizations\n"
+        "  frictionlab study mdr-vs-halfspace --tolerances 1e-4,1e-6 --json",
+    )
     d = DEFAULTS
-    parser.add_argument("preset", help="preset YAML file")
+    parser.add_argument("preset", help="preset YAML file, or a built-in preset's name")
     parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-study-<timestamp>)")
     parser.add_argument("--set", action="append", metavar="PATH=VALUE", help="override a preset value first")
     parser.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
@@ -65,6 +72,7 @@ def add_parser(sub) -> None:
                         help="also refine the reference solver's grid by these factors of --points (e.g. 0.5,1,2)")
     parser.add_argument("--repeats", type=int, default=d["repeats"], metavar="R", help="time each setting R times, keep the best")
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    parser.add_argument("--json", action="store_true", help="the recommendation, the rows and the files as JSON on stdout")
     parser.set_defaults(handler=run)
 
 
@@ -130,6 +138,7 @@ def command_line(args) -> str:
 
 def run(args) -> ExitCode:
     from ..preset import read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..registry import default_registry
     from ..rundir import new_run_folder
     from ..tradeoff.axes import Study
@@ -140,7 +149,7 @@ def run(args) -> ExitCode:
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
-    data = read_preset(args.preset, overrides)  # relative input files taken from the preset's folder
+    data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=str(args.preset))
     out_dir = Path(args.out) if args.out else new_run_folder(f"{factory.base.preset.name}-study")
 
@@ -148,7 +157,9 @@ def run(args) -> ExitCode:
         if not args.quiet:
             print(f"study: {message}", file=sys.stderr, flush=True)
 
-    study = Study(factory, options, progress)
+    from ..progress import ProgressReporter
+
+    study = Study(factory, options, progress, run_listeners=list if args.quiet else (lambda: [ProgressReporter()]))
     reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"
     progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {reference}")
     interrupted = False
@@ -162,8 +173,21 @@ def run(args) -> ExitCode:
     except OSError as exc:
         print(f"error: cannot write the study to {out_dir}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
-    print(text)
-    print(f"  {', '.join(p.name for p in files.values())} in {out_dir}/")
+    if args.json:
+        import json
+
+        from ..fit import json_safe
+        from ..tradeoff.axes import COLUMNS
+
+        def cell(value):
+            return json_safe(float(value)) if isinstance(value, float) else value
+
+        rows = [{c: cell(getattr(row, c)) for c in COLUMNS} for row in study.rows]
+        print(json.dumps({"recommendation": text, "rows": rows, "files": {k: str(p) for k, p in files.items()},
+                          "interrupted": interrupted}, indent=2))  # fmt: skip
+    else:
+        print(text)
+        print(f"  {', '.join(p.name for p in files.values())} in {out_dir}/")
     if interrupted:
         print("interrupted: the files hold the axes finished before the interrupt", file=sys.stderr)
         return ExitCode.INTERRUPTED

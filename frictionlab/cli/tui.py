@@ -8,7 +8,12 @@ from .options import add_workers_option, run_options
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("tui", help="terminal UI: edit presets, run with live progress, compare results")
+    p = sub.add_parser(
+        "tui",
+        help="terminal UI: edit presets, run with live progress, compare results",
+        description="The terminal UI: browse and edit presets, run them with live progress, compare results.",
+        epilog="examples:\n  frictionlab tui\n  frictionlab tui presets/quickstart.yaml",
+    )
     p.add_argument("preset", nargs="?", help="preset YAML file to open (optional)")
     p.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
     p.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")

@@ -2,37 +2,59 @@
 
 from __future__ import annotations
 
+import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser("validate", help="check presets and report every problem")
-    p.add_argument("presets", nargs="+", metavar="PRESET")
+    p = sub.add_parser(
+        "validate",
+        help="check presets and report every problem",
+        description="Check presets (every point of a sweep too) without running them; every problem is named by its field.",
+        epilog="examples:\n  frictionlab validate my.yaml\n  frictionlab validate quickstart --set realizations=0 --json",
+    )
+    p.add_argument("presets", nargs="+", metavar="PRESET", help="preset YAML files or built-in names")
     p.add_argument("--set", action="append", metavar="PATH=VALUE", help="override before validating")
+    p.add_argument("--json", action="store_true", help="one record per preset on stdout: ok, problems, what would run")
     p.set_defaults(handler=run)
 
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
+    from ..preset.builtin import resolve_preset_path
     from ..sweep import plan_sweep
 
     worst = ExitCode.OK
+    records = []
     for path in args.presets:
+        points = None
         try:
-            data = read_preset(path, args.set or [])
+            data = read_preset(resolve_preset_path(path), args.set or [])
             scene = build_scene(data, source=str(path))
             if scene.preset.sweep is not None:  # every point too
                 points = len(plan_sweep(data, source=str(path)).points)
         except FrictionlabError as exc:
-            print(str(exc), file=sys.stderr)
             worst = ExitCode(max(worst, exc.exit_code))
+            problems = getattr(exc, "problems", None) or [str(exc)]
+            records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
+            if not args.json:
+                print(str(exc), file=sys.stderr)
             continue
         preset = scene.preset
-        print(
-            f"{path}: ok ({preset.realizations} realizations, {scene.generator.name} / {scene.solver.name} / "
-            f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
-            + (f", sweep of {points} points)" if scene.preset.sweep is not None else ")")
-        )
+        record = {
+            "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
+            "spectrum": scene.generator.name, "solver": scene.solver.name, "slope": scene.slope.name,
+            "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
+        }  # fmt: skip
+        records.append(record)
+        if not args.json:
+            print(
+                f"{path}: ok ({preset.realizations} realizations, {scene.generator.name} / {scene.solver.name} / "
+                f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
+                + (f", sweep of {points} points)" if points is not None else ")")
+            )
+    if args.json:
+        print(json.dumps(records, indent=2))
     return worst

@@ -51,21 +51,22 @@ class CountCurve:
         return math.exp(best.x)
 
 
-def count_curve(data: dict, options: RunOptions = RunOptions()) -> CountCurve:
+def count_curve(data: dict, options: RunOptions = RunOptions(), listeners=()) -> CountCurve:
     """One ensemble of the preset ``data`` at h = 1 over a wide log force range."""
     wide = [
         "spectrum.params.rms_height=1.0", "spectrum.params.c0=null", "loading.start=1.0e-6", "loading.stop=1.0e+3",
         "loading.steps=2000", "loading.spacing=log", "fit.bootstrap=0", "sweep=null",
     ]  # fmt: skip
-    outcome = engine.run(build_scene(apply_overrides(data, wide)), options)
+    outcome = engine.run(build_scene(apply_overrides(data, wide)), options, listeners=listeners)
     return CountCurve(np.log(outcome.loads), np.log(outcome.contact_count))
 
 
 def calibrated_rms_height(
-    data: dict, targets: dict[float, float] = COUNT_TARGETS, options: RunOptions = RunOptions()
+    data: dict, targets: dict[float, float] = COUNT_TARGETS, options: RunOptions = RunOptions(), listeners=()
 ) -> float:
-    """h that gives the target mean contact counts (3 significant figures)."""
-    return float(f"{count_curve(data, options).fit_rms_height(targets):.3g}")
+    """h that gives the target mean contact counts (3 significant figures); ``listeners``
+    hear the calibration's ensemble (its progress)."""
+    return float(f"{count_curve(data, options, listeners).fit_rms_height(targets):.3g}")
 
 
 def main(path: str) -> None:

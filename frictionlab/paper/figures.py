@@ -55,7 +55,9 @@ class FigureRun:
 
 
 def find_presets(presets_dir: str | Path | None) -> Path:
-    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), Path(__file__).resolve().parents[2] / "presets"]
+    from ..preset.builtin import builtin_folder
+
+    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
     for folder in candidates:
         if all((folder / fig.preset).is_file() for fig in FIGURES):
             return folder
@@ -65,7 +67,10 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     )
 
 
-def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()) -> list[FigureRun]:
+def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
+    """Run each figure's preset into ``out_dir``; with ``progress``, each run's progress on stderr."""
+    from ..progress import ProgressReporter, SweepProgress
+
     runs = []
     for fig in FIGURES:
         path = presets / fig.preset
@@ -73,9 +78,11 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
         data = read_preset(path)
         if data.get("sweep") is not None:
             run.sweep = plan_sweep(data, source=str(path))
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False)
+            listeners = [SweepProgress()] if progress else []
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False, listeners=listeners)
         else:
             run.scene = build_scene(data, source=str(path))
-            run.outcome, _ = run_to_folder(run.scene, run.folder, options)
+            listeners = [ProgressReporter()] if progress else []
+            run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
         runs.append(run)
     return runs

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..plot import plt
+from matplotlib.figure import Figure
 from .figures import PAPER_H07, PAPER_POINTS_VS_H, FigureRun
 from .readings import ReadingRow
 
@@ -14,9 +14,8 @@ F_UNIT = 1e-9  # the paper's f axis is in units of 1e-9
 def plot_figure(run: FigureRun, fh, dpi: int = 90) -> None:
     """xi(f) on the paper's axes (f in units of 1e-9, log), the fit, the paper's law; counts below."""
     o, fig_info = run.outcome, run.figure
-    fig, (ax, ax_n) = plt.subplots(
-        2, 1, figsize=(6.0, 5.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}, layout="constrained"
-    )
+    fig = Figure(figsize=(6.0, 5.2), layout="constrained")
+    ax, ax_n = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
     x = o.f / F_UNIT
     ax.fill_between(x, o.xi - 1.96 * o.xi_sem, o.xi + 1.96 * o.xi_sem, color="C0", alpha=0.25, lw=0,
                     label="95% band of the mean")  # fmt: skip
@@ -43,7 +42,6 @@ def plot_figure(run: FigureRun, fh, dpi: int = 90) -> None:
     ax_n.grid(True, which="both", alpha=0.3)
     ax_n.legend(fontsize=7, loc="upper left")
     fig.savefig(fh, format="png", dpi=dpi)
-    plt.close(fig)
 
 
 def _sweep_series(run: FigureRun) -> dict:
@@ -83,19 +81,20 @@ def _mark_paper_against_h(axes) -> None:
 
 def plot_fig5(run: FigureRun, fh, dpi: int = 90) -> None:
     """a and b against H with intervals, the paper's points marked."""
-    fig, axes = plt.subplots(1, 2, figsize=(8.4, 3.6), layout="constrained")
+    fig = Figure(figsize=(8.4, 3.6), layout="constrained")
+    axes = fig.subplots(1, 2)
     _plot_against_h(axes, _sweep_series(run), "frictionlab (95% CI)", "C0")
     _mark_paper_against_h(axes)
     axes[0].legend(fontsize=7)
     fig.suptitle("Fig. 5: xi = a + b ln f against H (each point as Fig. 2, h = 1e4)", fontsize=10)
     fig.savefig(fh, format="png", dpi=dpi)
-    plt.close(fig)
 
 
 def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 90) -> None:
     """a and b against H with h = 1e4 and with h calibrated at each H, the paper's
     points marked; a third panel shows the calibrated h."""
-    fig, axes = plt.subplots(1, 3, figsize=(11.4, 3.6), layout="constrained")
+    fig = Figure(figsize=(11.4, 3.6), layout="constrained")
+    axes = fig.subplots(1, 3)
     _plot_against_h(axes[:2], _sweep_series(run), f"h = {run.preset_rms_height()} at every H (the preset)", "C0", offset=-0.006)
     _plot_against_h(axes[:2], _calibrated_series(rows), "h calibrated at each H to Fig. 2's counts", "C2", offset=0.006)
     _mark_paper_against_h(axes[:2])
@@ -108,4 +107,3 @@ def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 
     axes[2].legend(fontsize=7)
     fig.suptitle("Fig. 5 with h calibrated at each H (counts 4 at F = 1, 12 at F = 20; 95% CI)", fontsize=10)
     fig.savefig(fh, format="png", dpi=dpi)
-    plt.close(fig)

@@ -7,6 +7,7 @@ except the averaging readings, which re-average the default run's
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -126,10 +127,15 @@ class ReadingRow:
 
 
 def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = RunOptions(), *, readings=READINGS,
-                 folder_name="readings") -> list[ReadingRow]:  # fmt: skip
+                 folder_name="readings", progress: bool = False) -> list[ReadingRow]:  # fmt: skip
+    from ..progress import ProgressReporter
+
     by_key = {run.figure.key: run for run in runs}
+    listeners = (lambda: [ProgressReporter()]) if progress else list
     rows = []
     for number, reading in enumerate(readings, start=1):
+        if progress:
+            print(f"reading {number}/{len(readings)}: {reading.figure}, {reading.name}", file=sys.stderr, flush=True)
         base = by_key[reading.figure]
         data = load_preset_file(base.preset_path)
         overrides = list(reading.overrides)
@@ -138,14 +144,14 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
             overrides += ["spectrum.params.rms_height=null", f"spectrum.params.c0={float(f'{c0:.6g}')!r}"]
         h = None
         if reading.calibrate:
-            h = calibrated_rms_height(apply_overrides(data, overrides), options=options)
+            h = calibrated_rms_height(apply_overrides(data, overrides), options=options, listeners=listeners())
             overrides.append(f"spectrum.params.rms_height={h!r}")
         if not overrides:  # the figure's own run, maybe re-averaged
             scene, outcome, folder = base.scene, base.outcome, base.folder
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
             folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
-            outcome, _ = run_to_folder(scene, folder, options)
+            outcome, _ = run_to_folder(scene, folder, options, listeners=listeners())
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip

@@ -39,15 +39,17 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
 def write_report(
     *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
     options: RunOptions = RunOptions(), readings=False, dpi=90, log: Callable[[str], None] = lambda text: None,
+    quiet: bool = True,
 ) -> Path:  # fmt: skip
     """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
     Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless
-    ``options.force``. ``log`` hears what is going on, a line at a time."""
+    ``options.force``. ``log`` hears what is going on, a line at a time; unless ``quiet``,
+    every run shows its progress on stderr (``frictionlab.progress``)."""
     presets = find_presets(presets_dir)
     out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
     started = time.perf_counter()
     log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-    runs = run_figures(presets, out_dir, options)
+    runs = run_figures(presets, out_dir, options, progress=not quiet)
     log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
     images = {}
     for run in runs:
@@ -60,13 +62,13 @@ def write_report(
     if readings:
         log(f"report: running {len(READINGS)} readings")
         t0 = time.perf_counter()
-        reading_rows = run_readings(runs, out_dir, options)
+        reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
         readings_elapsed = time.perf_counter() - t0
         fig5 = next(run for run in runs if run.sweep is not None)
         log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
         t0 = time.perf_counter()
         fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
-                                 folder_name="fig5-calibrated")  # fmt: skip
+                                 folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
         fig5_elapsed = time.perf_counter() - t0
         name = "fig5-calibrated.png"
         atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)

@@ -156,8 +156,13 @@ def _first_problem(exc: PresetError) -> str:
 class Study:
     """Runs the axes of one preset; ``rows`` collects what is measured."""
 
-    def __init__(self, factory: SceneFactory, options: StudyOptions, progress: Progress = lambda _: None):
+    def __init__(
+        self, factory: SceneFactory, options: StudyOptions, progress: Progress = lambda _: None, run_listeners=list
+    ):
+        """``progress`` hears a line per measured setting; ``run_listeners()`` gives the
+        listeners of each run (a progress bar per run)."""
         self.factory = factory
+        self.run_listeners = run_listeners
         self.options = options
         self.progress = progress
         self.rows: list[Row] = []
@@ -214,7 +219,7 @@ class Study:
     # ------------------------------------------------------------ running
 
     def _run(self, axis: str, setting: str, value: float, scene: Scene, note: str = "") -> Row:
-        measured = measure(scene, repeats=self.options.repeats)
+        measured = measure(scene, repeats=self.options.repeats, listeners=self.run_listeners())
         row = make_row(axis, setting, value, scene, measured, note)
         self.progress(
             f"{axis:<12} {setting:<16} {row.solver:<14} {row.seconds:9.3f} s {row.peak_bytes / 2**20:9.1f} MiB"

@@ -177,13 +177,11 @@ def markdown(study: Study, recommendation: str, command: str = "") -> str:
 
 
 def plot(study: Study, fh) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")  # headless, as plot.py
-    import matplotlib.pyplot as plt
     import matplotlib.ticker
+    from matplotlib.figure import Figure  # no pyplot: headless, and a notebook's backend is left alone
 
-    fig, panels = plt.subplots(1, 2, figsize=(11, 4.8), layout="constrained")
+    fig = Figure(figsize=(11, 4.8), layout="constrained")
+    panels = fig.subplots(1, 2)
     axes_order = list(dict.fromkeys(r.axis for r in study.rows))
     markers = dict(zip(axes_order, "osD^v<>p"))
     for panel, (error, label) in zip(
@@ -217,7 +215,6 @@ def plot(study: Study, fh) -> None:
         panel.legend(fontsize=7, loc="best")
     fig.suptitle(f"{scene_summary(study)}\n(not drawn: reference rows and errors below 1e-12, agreement to rounding)", fontsize=8)
     fig.savefig(fh, format="png", dpi=110)
-    plt.close(fig)
 
 
 # ------------------------------------------------------------------ recommendation

@@ -27,14 +27,15 @@ class Measurement:
     peak_bytes: int  # tracemalloc peak above the level before the run
 
 
-def measure(scene: Scene, repeats: int = 1) -> Measurement:
+def measure(scene: Scene, repeats: int = 1, listeners=()) -> Measurement:
     """Run ``scene`` serially in this process (so one clock and one allocator
     see all the work) and measure wall time and peak traced memory.
 
     Memory is tracemalloc's peak, which includes numpy's data buffers (numpy
     reports them to tracemalloc); ru_maxrss would not do: it is the process's
     high-water mark, so any variant smaller than an earlier one would read as
-    zero. tracemalloc is started here if it is not running.
+    zero. tracemalloc is started here if it is not running. ``listeners`` hear each
+    run (its progress).
     """
     started_tracing = not tracemalloc.is_tracing()
     if started_tracing:
@@ -45,7 +46,7 @@ def measure(scene: Scene, repeats: int = 1) -> Measurement:
             tracemalloc.reset_peak()
             floor = tracemalloc.get_traced_memory()[0]
             start = time.perf_counter()
-            outcome = engine.run(scene, RunOptions(workers=1))
+            outcome = engine.run(scene, RunOptions(workers=1), listeners=listeners)
             seconds = time.perf_counter() - start
             peak = max(peak, tracemalloc.get_traced_memory()[1] - floor)
             best = min(best, seconds)

@@ -12,26 +12,41 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from textual.app import App, ComposeResult
 from textual.binding import Binding
-from textual.widgets import Footer, TabbedContent, TabPane
+from textual.content import Content
+from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..errors import FrictionlabError, PresetError
+from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
-from ..rundir import DEFAULT_RUNS_DIR, new_run_folder
+from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
 from ..runner import run_to_folder
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
-from .fields import preset_from_defaults
-from .folders import preset_folders, save_preset, writable_folder
+from .fields import default_spectrum, preset_from_defaults
+from .folders import (
+    is_builtin,
+    new_preset_path,
+    preset_folders,
+    preset_from_template,
+    read_run,
+    save_preset,
+    templates,
+    writable_folder,
+)
 from .live import LiveListener
 from .messages import RunCrashed, RunFinished, RunProgress, SweepPointEvent
-from .screens import ConfirmScreen, HelpScreen, NewPresetScreen, PathScreen
+from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .sweepview import SweepPoster
-from .widgets import EditPane, ListTable, PresetForm, PresetsPane, ResultsPane, RunPane
+from .text import failure_message
+from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
+from .widgets.presets import NO_PRESETS
+
+NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
 
 
 class FrictionlabApp(App):
@@ -39,16 +54,16 @@ class FrictionlabApp(App):
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
-        Binding("f1", "help", "Help", tooltip="This list of keys", priority=True),
-        Binding("question_mark", "help", "Help", tooltip="This list of keys (outside a text field)", show=False),
+        Binding("f1", "help", "Keys", tooltip="(show or hide): those of the focused part and the app's", priority=True),
+        Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
         Binding("f4", "show_tab('run')", "Run tab", show=False, priority=True),
         Binding("f5", "show_tab('results')", "Results tab", show=False, priority=True),
-        Binding("ctrl+s", "save", "Save", tooltip="Save the preset (asks first if it has problems)", priority=True),
-        Binding("ctrl+o", "save_as", "Save as", tooltip="Save the preset under another name", priority=True),
-        Binding("ctrl+r", "start_run", "Run", tooltip="Run the open preset", priority=True),
-        Binding("ctrl+q", "quit", "Quit", tooltip="Quit (asks if the preset has unsaved changes)", priority=True),
+        Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
+        Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
+        Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
+        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes)", priority=True),
     ]
 
     def __init__(
@@ -88,9 +103,12 @@ class FrictionlabApp(App):
                 yield RunPane(id="run-pane")
             with TabPane("F5 Results", id="results"):
                 yield ResultsPane(id="results-pane")
+        yield Static("", id="status")
         yield Footer()
 
     async def on_mount(self) -> None:
+        # F2..F5 switch tabs: the tab bar as a Tab stop would only take focus where nothing shows it
+        self.query_one("ContentTabs").can_focus = False
         self.reload_presets()
         self.reload_runs()
         self._show_edit_state()
@@ -121,37 +139,23 @@ class FrictionlabApp(App):
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         self.refresh_bindings()
 
-    def help_groups(self) -> list[tuple[str, list[tuple[str, str]]]]:
-        def rows(bindings):
-            out = []
-            for binding in bindings:
-                for key in binding.key.split(","):
-                    description = binding.tooltip or binding.description
-                    out.append((self.get_key_display(Binding(key, binding.action)), description))
-            return out
-
-        return [
-            ("Everywhere", rows(self.BINDINGS)),
-            (
-                "Presets tab (the list)",
-                rows(ListTable.BINDINGS) + rows(PresetsPane.BINDINGS) + [("Up/Down", "Move in the list")],
-            ),
-            (
-                "Edit tab (the form)",
-                [
-                    ("Tab/Shift+Tab", "Next / previous field"),
-                    ("Enter", "Open a choice list (on a select)"),
-                    ("Space", "Toggle a switch"),
-                ],
-            ),
-            ("Run tab", rows(RunPane.BINDINGS)),
-            ("Results tab (the list)", rows(ListTable.BINDINGS) + rows(ResultsPane.BINDINGS)),
-            ("Dialogs", [("Enter", "Confirm"), ("Esc", "Cancel / close"), ("y / n", "Yes / no")]),
-        ]
-
     def action_help(self) -> None:
-        if not isinstance(self.screen, HelpScreen):
-            self.push_screen(HelpScreen(self.help_groups()))
+        """Textual's key panel: the keys of the focused widget and of the app, as they change."""
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            self.action_show_help_panel()
+
+    # ------------------------------------------------------------ the status line
+
+    def say(self, text: str, severity: str = "information", title: str = "") -> None:
+        """Show ``text`` in the status line above the footer (never over the data); it
+        stays until the next message. ``text`` is shown as it is, never as markup."""
+        line = Content.assemble((f"{title}: ", "bold") if title else "", text)
+        status = self.query_one("#status", Static)
+        status.update(line)
+        for name in ("information", "warning", "error"):
+            status.set_class(name == severity, f"-{name}")
 
     # ------------------------------------------------------------ presets
 
@@ -160,8 +164,10 @@ class FrictionlabApp(App):
 
     def open_selected_preset(self) -> None:
         entry = self.query_one(PresetsPane).selected()
-        if entry is not None:
-            self.run_worker(self._open_after_confirm(entry.path), exclusive=True, group="open")
+        if entry is None:
+            self.say(NO_PRESETS, "warning")
+            return
+        self.run_worker(self._open_after_confirm(entry.path), exclusive=True, group="open")
 
     async def _open_after_confirm(self, path: Path) -> None:
         if self.modified and not await self.push_screen_wait(
@@ -175,13 +181,13 @@ class FrictionlabApp(App):
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.notify("\n".join(exc.problems), title=f"Cannot open {path.name}", severity="error")
+                self.say("; ".join(exc.problems), "error", title=f"Cannot open {path.name}")
                 return
             self.draft_source = path
         else:
             self.draft_source = None
         self.draft_path = path
-        await self.query_one("#form", PresetForm).load(data)
+        await self.query_one("#form", PresetForm).load(data, base_dir=path.parent)
         self.modified = modified
         self._show_edit_state()
         self.action_show_tab("edit")
@@ -189,11 +195,12 @@ class FrictionlabApp(App):
     def duplicate_selected_preset(self) -> None:
         entry = self.query_one(PresetsPane).selected()
         if entry is None:
+            self.say("No preset to duplicate here: n makes a new one.", "warning")
             return
         try:
             data = load_preset_file(entry.path)
         except PresetError as exc:
-            self.notify("\n".join(exc.problems), title="Cannot duplicate", severity="error")
+            self.say("; ".join(exc.problems), "error", title="Cannot duplicate")
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
         default = writable_folder(self.folders) / f"{entry.path.stem}-copy.yaml"
@@ -205,15 +212,30 @@ class FrictionlabApp(App):
         self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default), done)
 
     def new_preset(self) -> None:
+        """A new preset from a template that runs (a listed preset; a plugin's
+        defaults only when there is none), saved where the user says."""
+        choices = templates(self.query_one(PresetsPane).presets)  # the built-in presets first
+
         def done(answer) -> None:
             if answer is None:
                 return
-            name, spectrum = answer
-            data = preset_from_defaults(name, spectrum, self.registry)
-            path = writable_folder(self.folders) / f"{name}.yaml"
-            self.run_worker(self.open_preset(path, data, modified=True), group="open")
+            name, template, path = answer
+            try:
+                if template is None:
+                    data = preset_from_defaults(name, default_spectrum(self.registry), self.registry)
+                else:
+                    data = preset_from_template(template, name, path, self.registry)
+            except PresetError as exc:
+                self.say("; ".join(exc.problems), "error", title="Cannot read the template")
+                return
+            self.run_worker(self._open_new(path, data, template), group="open")
 
-        self.push_screen(NewPresetScreen(self.registry.names("spectrum")), done)
+        self.push_screen(NewPresetScreen(choices), done)
+
+    async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
+        await self.open_preset(path, data, modified=True)
+        self.draft_source = template  # its comments are kept when the new preset is saved
+        self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.")
 
     # ------------------------------------------------------------ editing and saving
 
@@ -223,31 +245,29 @@ class FrictionlabApp(App):
             self.modified = True
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems)
-        self.refresh_bindings()
 
     def _show_edit_state(self) -> None:
         self.query_one(EditPane).show_title(self.draft_path, self.modified, self.problems)
-
-    def check_action(self, action: str, parameters) -> bool | None:
-        if action in ("save", "save_as"):
-            # shown on the Edit tab only: the footer has no room for keys that do nothing here
-            return self.draft_path is not None and self.query_one("#tabs", TabbedContent).active == "edit"
-        if action == "start_run" and self.draft_path is None:
-            return None  # shown, dimmed
-        return True
 
     def _draft(self) -> dict | None:
         return self.query_one("#form", PresetForm).data
 
     def action_save(self) -> None:
         if self.draft_path is None or self._draft() is None:
-            self.notify("No preset open: F2 lists them.", severity="warning")
+            self.say(NO_PRESET, "warning")
+            return
+        if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
+            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
+            self.push_screen(
+                PathScreen("Save the built-in preset's changes as", new_preset_path(self.draft_path.stem)),
+                lambda path: path is not None and self._save_checked(path),
+            )
             return
         self._save_checked(self.draft_path)
 
     def action_save_as(self) -> None:
         if self.draft_path is None or self._draft() is None:
-            self.notify("No preset open: F2 lists them.", severity="warning")
+            self.say(NO_PRESET, "warning")
             return
         self.push_screen(
             PathScreen("Save preset as", self.draft_path),
@@ -273,9 +293,9 @@ class FrictionlabApp(App):
         try:
             save_preset(path, data, template=template)
         except OSError as exc:
-            self.notify(f"{path}: {exc.strerror or exc}", title="Not saved", severity="error")
+            self.say(f"{path}: {exc.strerror or exc}", "error", title="Not saved")
             return
-        self.notify(f"Saved {path}")
+        self.say(f"Saved {path}")
         self.reload_presets()
         if then_open:
             self.run_worker(self.open_preset(path), group="open")
@@ -288,11 +308,11 @@ class FrictionlabApp(App):
 
     def action_start_run(self) -> None:
         if self.running:
-            self.notify("A run is going; c on the Run tab cancels it.", severity="warning")
+            self.say("A run is going; c on the Run tab cancels it.", "warning")
             return
         data = self._draft()
         if data is None:
-            self.notify("No preset open: F2 lists them.", severity="warning")
+            self.say(NO_PRESET, "warning")
             return
         try:
             if self.draft_path is not None:  # relative input files are the preset file's neighbours
@@ -304,27 +324,59 @@ class FrictionlabApp(App):
                 sweep = plan_sweep(data, registry=self.registry, source=source)
         except PresetError as exc:
             count = len(exc.problems)
-            self.notify(
-                "\n".join(exc.problems[:5]),
-                title=f"Cannot run: {count} problem{'s' if count != 1 else ''}",
-                severity="error",
-            )
-            self.action_show_tab("edit")
+            self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
+            self.query_one("#tabs", TabbedContent).active = "edit"
+            form = self.query_one("#form", PresetForm)
+            form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
+            form.focus_problem(exc.problems)
             return
-        out_dir = new_run_folder(scene.preset.name, self.runs_dir)
+        self._start(scene, sweep, new_run_folder(scene.preset.name, self.runs_dir), self.run_options)
+
+    def resume_run(self, folder: Path | None) -> None:
+        """Continue a cancelled or interrupted run in ``folder`` with the preset stored
+        there (``frictionlab resume``): only the missing realizations are computed."""
+        if self.running:
+            self.say("A run is going; c on the Run tab cancels it.", "warning")
+            return
+        if folder is None:
+            self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
+            return
+        try:
+            if read_run(folder).status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                return
+        except (OSError, ValueError, TypeError):
+            pass  # no summary yet (a run killed early): the stored preset says whether it can go on
+        try:
+            data = RunDirectory(folder).stored_preset()
+            scene = build_scene(data, registry=self.registry)
+        except RunFolderError as exc:
+            self.say(str(exc), "error", title="Cannot resume")
+            return
+        except PresetError as exc:
+            self.say(exc.problems[0], "error", title=f"Cannot resume {folder.name}")
+            return
+        if scene.preset.sweep is not None:
+            self.say(f"{folder.name} is a sweep: frictionlab run PRESET --out {folder} --resume continues it.", "warning")
+            return
+        self._start(scene, None, folder, replace(self.run_options, resume=True))
+
+    def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         cancel = self.cancel_event = threading.Event()
         self.last_outcome = None
         self.query_one(RunPane).start(scene, sweep, out_dir)
         self.action_show_tab("run")
+        verb = "Resuming" if options.resume else "Running"
+        self.say(f"{verb} {scene.preset.name} into {out_dir}")
         progress = LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))
         if sweep is None:
-            work = lambda: run_to_folder(scene, out_dir, self.run_options, listeners=[progress], cancel=cancel)[0]  # noqa: E731
+            work = lambda: run_to_folder(scene, out_dir, options, listeners=[progress], cancel=cancel)[0]  # noqa: E731
         else:
             poster = SweepPoster(
                 lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
                 lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
             )
-            work = lambda: run_sweep(sweep, out_dir, self.run_options, listeners=[poster], cancel=cancel)  # noqa: E731
+            work = lambda: run_sweep(sweep, out_dir, options, listeners=[poster], cancel=cancel)  # noqa: E731
         self.run_worker(lambda: self._run_in_thread(work, out_dir), thread=True, group="run", exit_on_error=False)
 
     def _run_in_thread(self, work: Callable[[], object], out_dir: Path) -> None:
@@ -334,15 +386,15 @@ class FrictionlabApp(App):
         except FrictionlabError as exc:
             self.post_message(RunCrashed(str(exc)))
         except OSError as exc:
-            self.post_message(RunCrashed(f"cannot write results to {out_dir}: {exc}"))
+            self.post_message(RunCrashed(f"cannot write results to {out_dir}: {exc.strerror or exc}"))
         except Exception as exc:  # an internal error: shown, never a crash of the UI
-            self.post_message(RunCrashed(f"internal error: {type(exc).__name__}: {exc}"))
+            self.post_message(RunCrashed(f"internal error ({type(exc).__name__}: {exc}); please report it"))
         else:
             self.post_message(RunFinished(outcome, out_dir))
 
     def action_cancel_run(self) -> None:
         if not self.running:
-            self.notify("No run is going.", severity="warning")
+            self.say("No run is going: Ctrl+R starts one.", "warning")
             return
         self.cancel_event.set()
         self.query_one(RunPane).show_cancelling()
@@ -360,14 +412,22 @@ class FrictionlabApp(App):
         self.cancel_event = None
         self.last_outcome, self.last_out_dir = outcome, message.out_dir
         pane = self.query_one(RunPane)
-        sweep = isinstance(outcome, SweepOutcome)
-        self.notify(pane.show_sweep_outcome(outcome) if sweep else pane.show_outcome(outcome))
+        if isinstance(outcome, SweepOutcome):
+            self.say(pane.show_sweep_outcome(outcome))
+        else:
+            line = pane.show_outcome(outcome)
+            if outcome.done == 0 and outcome.failures:  # nothing to show: say why, as the user can fix it
+                self.say(failure_message(outcome.failures[0][1]), "error", title="Run failed: no realization finished")
+            elif outcome.failures:
+                self.say(f"{line}; {len(outcome.failures)} failed: {failure_message(outcome.failures[0][1])}", "warning")
+            else:
+                self.say(line)
         self.reload_runs()
 
     def on_run_crashed(self, message: RunCrashed) -> None:
         self.cancel_event = None
         self.query_one(RunPane).show_crash(message.error)
-        self.notify(message.error, title="Run failed", severity="error")
+        self.say(message.error, "error", title="Run failed")
 
     async def action_quit(self) -> None:
         if self.running:

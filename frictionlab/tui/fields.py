@@ -7,10 +7,10 @@ parameters appear in the form with no code of its own. No Textual here.
 
 from __future__ import annotations
 
-import copy
 import types
 import typing
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Literal
 
 import yaml
@@ -19,7 +19,7 @@ from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
 from ..plugin import KINDS
-from ..preset import MISSING, Preset, build_scene, set_path
+from ..preset import MISSING, Preset, build_scene, resolve_input_paths
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 
@@ -163,9 +163,18 @@ def default_plugin_name(slot: str) -> str | None:
     return info.default_factory().name
 
 
-def problems_of(data: dict, registry) -> list[str]:
-    """The headless validator's problems for ``data`` (empty when it is valid)."""
+def default_spectrum(registry) -> str:
+    """The spectrum a preset gets when it names none (else the first registered)."""
+    return default_plugin_name("spectrum") or registry.names("spectrum")[0]
+
+
+def problems_of(data: dict, registry, base_dir: Path | None = None) -> list[str]:
+    """The headless validator's problems for ``data`` (empty when it is valid);
+    relative input files are taken from ``base_dir``, the preset file's folder,
+    as ``frictionlab validate`` takes them."""
     try:
+        if base_dir is not None:
+            data = resolve_input_paths(data, base_dir, registry)
         build_scene(data, registry=registry)
     except PresetError as exc:
         return list(exc.problems)
@@ -178,12 +187,6 @@ def problem_path(problem: str) -> str:
 
 def problems_for(problems: list[str], dotted: str) -> list[str]:
     return [p for p in problems if problem_path(p) == dotted]
-
-
-def with_value(data: dict, path: tuple[str, ...], value) -> dict:
-    candidate = copy.deepcopy(data)
-    set_path(candidate, path, value, replace_values=True)
-    return candidate
 
 
 def preset_from_defaults(name: str, spectrum: str, registry) -> dict:

@@ -2,7 +2,7 @@
 
 Presets come from ``./presets`` (when it exists) and the user folder
 (``$FRICTIONLAB_PRESETS_DIR``, else ``$XDG_CONFIG_HOME/frictionlab/presets``,
-else ``~/.config/frictionlab/presets``). Runs are the output folders the
+else the platform's config folder: ``~/.config/frictionlab/presets`` on Linux). Runs are the output folders the
 headless ``frictionlab run`` writes, found by their ``summary.json``, and sweep
 folders, found by their ``sweep.json``.
 """
@@ -19,6 +19,8 @@ from pathlib import Path
 import yaml
 
 from ..files import atomic_write
+from ..preset import load_preset_file, resolve_input_paths
+from ..preset.builtin import builtin_folder, builtin_presets
 from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
@@ -28,21 +30,44 @@ def user_presets_dir(env=None) -> Path:
     env = os.environ if env is None else env
     if env.get("FRICTIONLAB_PRESETS_DIR"):
         return Path(env["FRICTIONLAB_PRESETS_DIR"]).expanduser()
-    config = Path(env["XDG_CONFIG_HOME"]).expanduser() if env.get("XDG_CONFIG_HOME") else Path.home() / ".config"
-    return config / "frictionlab" / "presets"
+    if env.get("XDG_CONFIG_HOME"):
+        return Path(env["XDG_CONFIG_HOME"]).expanduser() / "frictionlab" / "presets"
+    from platformdirs import user_config_path  # ~/.config on Linux, the platform's own folder elsewhere
+
+    return user_config_path("frictionlab") / "presets"
+
+
+BUILTIN = "built-in"  # the label of the presets shipped with frictionlab: read, copied, never written
 
 
 def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str, Path]]:
-    """(label, folder) pairs to browse: the given folder, or ./presets and the user folder."""
+    """(label, folder) pairs to browse: the given folder, or ./presets, the user
+    folder and the built-in presets (unless ./presets is that folder: a checkout)."""
     if presets_dir is not None:
         return [("presets", Path(presets_dir))]
     folders = [("project", PROJECT_PRESETS_DIR)] if PROJECT_PRESETS_DIR.is_dir() else []
-    return folders + [("user", user_presets_dir(env))]
+    folders.append(("user", user_presets_dir(env)))
+    shipped = builtin_folder()
+    if shipped is not None and not any(folder.resolve() == shipped.resolve() for _, folder in folders):
+        folders.append((BUILTIN, shipped))
+    return folders
 
 
 def writable_folder(folders: list[tuple[str, Path]]) -> Path:
-    """Where new presets and copies go: the user folder (or the only one given)."""
-    return folders[-1][1]
+    """Where copies go by default: the user folder (or the only one given)."""
+    return next(folder for label, folder in reversed(folders) if label != BUILTIN)
+
+
+def is_builtin(path: Path) -> bool:
+    """Whether ``path`` is one of the presets shipped in the installed package (not to be written)."""
+    shipped = builtin_folder()
+    return shipped is not None and shipped.resolve() != PROJECT_PRESETS_DIR.resolve() and \
+        Path(path).resolve().parent == shipped.resolve()  # fmt: skip
+
+
+def new_preset_path(name: str, folder: Path | None = None) -> Path:
+    """Where a new preset is saved unless the user says otherwise: the current folder."""
+    return (folder or Path(".")) / f"{name}.yaml"
 
 
 @dataclass(frozen=True)
@@ -69,6 +94,31 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
             description = " ".join(str(data.get("description") or "").split())
             entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
     return entries
+
+
+FIRST_TEMPLATE = "quickstart"  # runs in about a second: the template a new preset starts from
+
+
+def templates(entries: list[PresetEntry]) -> list[tuple[str, Path]]:
+    """(label, file) of the presets a new one may start from: the built-in ones
+    (quickstart first), then the listed ones that can be read."""
+    shipped = sorted(builtin_presets(), key=lambda p: p.name != FIRST_TEMPLATE)
+    choices = [(f"{p.name} ({BUILTIN})", p.path) for p in shipped]
+    seen = {p.path.resolve() for p in shipped}
+    for entry in entries:
+        if not entry.error and entry.path.resolve() not in seen:
+            choices.append((f"{entry.name} ({entry.label})", entry.path))
+    return choices
+
+
+def preset_from_template(template: Path, name: str, new_path: Path, registry=None) -> dict:
+    """A template preset's data renamed ``name``, its relative input files
+    made to work from ``new_path``'s folder (raises ``PresetError``)."""
+    data = load_preset_file(template)
+    if Path(template).resolve().parent != Path(new_path).resolve().parent:
+        data = resolve_input_paths(data, Path(template).parent, registry)
+    data["name"] = name
+    return data
 
 
 def save_preset(path: Path, data: dict, template: Path | None = None) -> None:

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..fit import LogFit, fit_curve
 from ..hookspecs import hookimpl
+from .text import failure_message
 
 
 @dataclass(frozen=True)
@@ -73,7 +74,7 @@ class LiveListener:
     @hookimpl
     def realization_failed(self, result, done, total):
         self._failed += 1
-        self._first_error = self._first_error or f"realization {result.index}: {result.error}"
+        self._first_error = self._first_error or f"realization {result.index}: {failure_message(result.error)}"
         self._maybe_post(done, total)
 
     @hookimpl

@@ -28,7 +28,6 @@ from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
-import scipy.fft
 from pydantic import Field
 
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
@@ -62,6 +61,8 @@ class ConstrainedCG:
         self.depth = depth
         self.rms = float(np.sqrt(np.mean(np.square(depth - depth.mean()))))
         self.compliance = _compliance(self.shape)
+        import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
+
         # pressure on one point per unit of its own displacement
         self.point_stiffness = 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
         self.gap = np.empty(self.shape)  # displacement + depth, before the rigid level
@@ -86,6 +87,7 @@ class ConstrainedCG:
     def full_contact_pressure(self, mean_pressure: float) -> np.ndarray:
         """The pressure that closes every gap: ``mean + (stiffness) (z - mean z)``,
         exact in Fourier space (``E* |q| / 2`` applied to the heights)."""
+        import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
         spectrum = scipy.fft.rfftn(self.depth)
         stiffness = np.zeros_like(self.compliance)
         np.divide(1.0, self.compliance, out=stiffness, where=self.compliance > 0)
@@ -300,6 +302,7 @@ def _cold_start(depth: np.ndarray, mean_pressure: float) -> np.ndarray:
 
 def _compliance(shape: tuple[int, ...]) -> np.ndarray:
     """``2 / |q|`` in pixel units on the rfftn grid, zero for the mean mode."""
+    import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
     axes = [2 * np.pi * scipy.fft.fftfreq(n) for n in shape[:-1]]
     axes.append(2 * np.pi * scipy.fft.rfftfreq(shape[-1]))
     grids = np.meshgrid(*axes, indexing="ij", sparse=True)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
-import scipy.fft
+
 from pydantic import Field, model_validator
 
 from frictionlab import PluginParams, Profile, SpectrumGenerator
@@ -233,7 +233,7 @@ def random_phase_line(coeff: np.ndarray, nyquist: float, k_lo: int, points: int,
         spectrum[k_lo : k_lo + m] = (SQRT_HALF * coeff) * g
         if nyquist:
             spectrum[-1] = nyquist * rng.standard_normal()
-    return scipy.fft.irfft(spectrum, n=points)  # ~10% faster than numpy here
+    return np.fft.irfft(spectrum, n=points)  # the pocketfft of scipy.fft (same numbers), without its 0.15 s import
 
 
 class BandParams(PluginParams):

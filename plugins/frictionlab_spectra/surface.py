@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
-import scipy.fft
 from pydantic import Field
 
 from frictionlab import Profile, SpectrumGenerator
@@ -218,6 +217,7 @@ class BandLimitedSurface(SpectrumGenerator):
             entries[s.real_rows] = coeff[s.real_rows, column] * signs
         half = np.zeros((ny, block.shape[1]), dtype=np.complex128)
         half[s.rows] = block
+        import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
         heights = scipy.fft.irfft2(half, s=(ny, nx))  # zero-pads the columns past Kx
         return Profile(heights=heights, spacing=s.band.spacing)
 

@@ -32,7 +32,6 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 import numpy as np
-import scipy.fft
 from pydantic import Field
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
@@ -72,6 +71,7 @@ def radial_psd(heights: np.ndarray, spacing: float, width: float | None = None) 
     ny, nx = heights.shape
     dqx, dqy = TWO_PI / (nx * spacing), TWO_PI / (ny * spacing)
     width = min(dqx, dqy) if width is None else width
+    import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
     power = np.abs(scipy.fft.fft2(heights)) ** 2 / float(nx * ny) ** 2  # sums to mean(z^2)
     power[0, 0] = 0.0  # the mean is no roughness
     q = np.hypot((dqy * np.fft.fftfreq(ny, 1.0 / ny))[:, None], (dqx * np.fft.fftfreq(nx, 1.0 / nx))[None, :])
@@ -131,6 +131,7 @@ class SurfaceFile(SpectrumGenerator):
         if not self.params.periodic:  # the even extension: periodic, no step where it repeats
             heights = np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
         ny, nx = heights.shape
+        import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
         power = np.abs(scipy.fft.fft2(heights)) ** 2
         power[0, 0] = 0.0  # the mean is no roughness
         wavenumber = np.hypot(

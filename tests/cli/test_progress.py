@@ -3,7 +3,7 @@
 import io
 
 from frictionlab import engine
-from frictionlab.cli.progress import ProgressReporter
+from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
 
 
@@ -12,20 +12,29 @@ class FakeTerminal(io.StringIO):
         return True
 
 
-def test_terminal_gets_one_redrawn_bar_and_a_final_newline(make_scene):
+def test_terminal_gets_a_rich_bar_that_ends_full(make_scene):
     stream = FakeTerminal()
-    engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream)])
+    engine.run(make_scene({"realizations": 30}), RunOptions(workers=1), listeners=[ProgressReporter(stream, after=0)])
     text = stream.getvalue()
     assert text.startswith("small: 30 realizations of power-law lines, 16 force steps, 1 worker(s)\n")
-    bar = text.split("\n")[1]
-    assert bar.startswith("\r[") and "\n" not in bar
-    assert bar.split("\r")[-1].startswith("[" + "#" * 30 + "] 30/30 realizations")
-    assert text.endswith("\n")
+    last = text.split("\r")[-1]
+    assert "realizations" in last and "30/30" in last and "━" in last  # rich's bar, drawn in place
+    assert text.removesuffix("\x1b[?25h").endswith("\n")  # the cursor shown again after the last line
+
+
+def test_a_run_shorter_than_two_seconds_shows_its_first_line_and_in_a_log_its_last(make_scene):
+    for interactive, lines in ((True, 1), (False, 2)):
+        stream = FakeTerminal()
+        reporter = ProgressReporter(stream, interactive=interactive)  # 2 s before anything more is shown
+        engine.run(make_scene({"realizations": 4}), RunOptions(workers=1), listeners=[reporter])
+        text = stream.getvalue()
+        assert text.startswith("small: 4 realizations") and text.count("\n") == lines
+        assert interactive or text.splitlines()[1].startswith("4/4 realizations")
 
 
 def test_log_file_gets_one_plain_line_per_tenth(make_scene):
     stream = io.StringIO()
-    reporter = ProgressReporter(stream)
+    reporter = ProgressReporter(stream, after=0)
     engine.run(make_scene({"realizations": 20}), RunOptions(workers=1), listeners=[reporter])
     lines = stream.getvalue().split("\n")[:-1]
     assert [line.split(" ")[0] for line in lines[1:]] == [f"{2 * i}/20" for i in range(1, 11)]
@@ -44,3 +53,22 @@ def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make
     reporter.started = time.perf_counter() - 2.0  # 2 s for the 2 realizations left: 1 per second
     line = reporter._line(10, 10)
     assert ", 1.0/s," in line, line
+
+
+def test_a_notebook_gets_a_bar_even_without_a_terminal(monkeypatch):
+    import sys
+    import types
+
+    from frictionlab.progress import wants_bar
+
+    assert not wants_bar(io.StringIO())
+    ipython = types.ModuleType("IPython")
+
+    class ZMQInteractiveShell:  # Jupyter's kernel shell, by its class name as IPython reports it
+        pass
+
+    ipython.get_ipython = ZMQInteractiveShell
+    monkeypatch.setitem(sys.modules, "IPython", ipython)
+    assert wants_bar(io.StringIO())
+    ipython.get_ipython = lambda: None  # IPython imported, but a plain terminal shell or none
+    assert not wants_bar(io.StringIO())

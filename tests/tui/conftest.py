@@ -8,6 +8,8 @@ import re
 
 import pytest
 import yaml
+from textual import events
+from textual.keys import _character_to_key
 from textual.widgets import Input, Select, Static
 
 from frictionlab.errors import PresetError
@@ -64,10 +66,22 @@ async def open_first_preset(pilot):
     return form
 
 
+def post_keys(app, keys):
+    """Keys as the terminal driver hands them to the app when typed fast: posted
+    in one burst, not waited for one by one (``pilot.press`` waits for the app to
+    go idle after each key, some 50 ms)."""
+    for key in keys:
+        if len(key) == 1:
+            app.post_message(events.Key(_character_to_key(key), key))
+        else:
+            app.post_message(events.Key(key, {"ctrl+u": "\x15"}.get(key)))
+
+
 async def type_into(pilot, widget_id, text):
+    """Clear a field and type ``text`` into it, as fast as a terminal delivers keys."""
     field = pilot.app.query_one(f"#{widget_id}", Input)
     field.focus()
-    await pilot.press("end", "ctrl+u", *text)
+    post_keys(pilot.app, ["end", "ctrl+u", *text])
     await pilot.pause()
 
 
@@ -136,3 +150,14 @@ def make_runs(folders, registry):
     for seed in (1, 2):
         data = merge(TINY, {"seed": seed, "name": f"seed{seed}"})
         run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", RunOptions(workers=1))
+
+
+def screen_text(app) -> str:
+    """What the terminal shows now, line by line (the top screen, toasts and dialogs included)."""
+    return "\n".join(strip.text for strip in app.screen._compositor.render_strips())
+
+
+def status_text(app) -> str:
+    """The status line's message ("" if the app has none)."""
+    lines = app.query("#status")
+    return str(lines.first().render()) if lines else ""

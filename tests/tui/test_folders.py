@@ -79,3 +79,16 @@ def test_new_text_values_are_spelled_so_pyyaml_reads_them_back(tmp_path):
     save_preset(tmp_path / "out.yaml", data, template=source)
     text = (tmp_path / "out.yaml").read_text()
     assert yaml.safe_load(text) == data and "# n" in text
+
+
+def test_the_built_in_presets_are_listed_after_the_users_and_copies_go_to_the_user(tmp_path, monkeypatch):
+    from frictionlab.preset.builtin import builtin_folder
+    from frictionlab.tui.folders import preset_folders, writable_folder
+
+    monkeypatch.chdir(tmp_path)  # no ./presets
+    env = {"FRICTIONLAB_PRESETS_DIR": str(tmp_path / "mine")}
+    folders = preset_folders(env=env)
+    assert folders == [("user", tmp_path / "mine"), ("built-in", builtin_folder())]
+    assert writable_folder(folders) == tmp_path / "mine"
+    (tmp_path / "presets").mkdir()  # a project folder is listed first
+    assert [label for label, _ in preset_folders(env=env)] == ["project", "user", "built-in"]

@@ -1,5 +1,6 @@
 """Editing a preset in the form: the headless validator's messages, saving, switching plugins."""
 
+from pathlib import Path
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -187,7 +188,11 @@ async def test_a_third_party_plugin_gets_a_form_without_code(folders, register_p
 
 
 @sync
-async def test_new_preset_from_a_plugins_defaults(folders, registry):
+async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all(folders, registry, monkeypatch):
+    import frictionlab.tui.folders
+
+    (folders / "presets" / "tiny.yaml").unlink()  # nothing to start from: none listed, none shipped
+    monkeypatch.setattr(frictionlab.tui.folders, "builtin_presets", lambda: [])
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
@@ -205,5 +210,5 @@ async def test_new_preset_from_a_plugins_defaults(folders, registry):
         assert form.problems == []
         await pilot.press("ctrl+s")
         await pilot.pause()
-    assert app.draft_path is not None and app.draft_path.name == "fresh.yaml"
-    assert load_scene(app.draft_path, registry=registry).spectrum.params.points == 256
+    assert app.draft_path == Path("fresh.yaml")  # the current folder
+    assert load_scene(folders / "fresh.yaml", registry=registry).spectrum.params.points == 256

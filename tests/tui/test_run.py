@@ -1,12 +1,14 @@
 """A run and a sweep from the Run tab: the headless numbers, cancelling keeps what finished."""
 
 import json
+import threading
 
 import numpy as np
 import pytest
 import yaml
 from textual.widgets import Static
 
+from frictionlab.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.runner import run_to_folder
@@ -132,3 +134,32 @@ async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders
     with np.load(out_dir / rows[0]["folder"] / "realizations.npz") as arrays:
         assert arrays["xi"].shape[0] == first.done
     assert not (out_dir / "points" / "02-hurst-0.7").exists()
+
+
+@sync
+async def test_u_resumes_a_cancelled_run_to_the_numbers_of_an_uncancelled_one(folders, registry):
+    data = merge(TINY, {"realizations": 24})
+    scene = build_scene(data, registry=registry)
+    cancel = threading.Event()
+
+    class CancelAfterThree:
+        @hookimpl
+        def realization_done(self, result, done, total):
+            if done >= 3:
+                cancel.set()
+
+    stopped, _ = run_to_folder(scene, folders / "runs" / "stopped", RunOptions(workers=1), listeners=[CancelAfterThree()], cancel=cancel)
+    assert stopped.status == "cancelled" and stopped.done < 24
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5", "u")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        outcome, out_dir = app.last_outcome, app.last_out_dir
+        await pilot.press("u")  # again: nothing left to do, and it says so
+        said = str(app.query_one("#status").render())
+    whole, _ = run_to_folder(scene, folders / "whole", RunOptions(workers=1))
+    assert out_dir == folders / "runs" / "stopped" or out_dir.resolve() == (folders / "runs" / "stopped").resolve()
+    assert outcome.status == "completed" and outcome.done == 24
+    assert outcome.fit == whole.fit  # same seed: the same numbers as a run never stopped
+    assert said == "stopped is complete: nothing to resume."

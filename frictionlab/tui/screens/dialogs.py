@@ -7,8 +7,12 @@ from pathlib import Path
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
+from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Select, Static
+
+from ..folders import new_preset_path
+from ..widgets.keyinput import KeyInput
 
 
 class ConfirmScreen(ModalScreen[bool]):
@@ -23,15 +27,30 @@ class ConfirmScreen(ModalScreen[bool]):
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Static(self.question)
+            yield Static(Content(self.question))  # it quotes problems and paths: text, not markup
             yield Label("y: yes    n / Esc: no", classes="hint")
 
     def action_answer(self, value: bool) -> None:
         self.dismiss(value)
 
 
+def preset_path_problem(text: str) -> tuple[Path | None, str]:
+    """The path a user typed for a preset (``.yaml`` added), or why it cannot be one."""
+    text = text.strip()
+    if not text:
+        return None, "path: must not be empty"
+    path = Path(text).expanduser()
+    if path.suffix not in (".yaml", ".yml"):
+        path = path.with_name(path.name + ".yaml")
+    if path.is_dir():
+        return None, f"path: {path} is a folder; give a file name"
+    if not path.parent.is_dir():
+        return None, f"path: the folder {path.parent} does not exist"
+    return path, ""
+
+
 class PathScreen(ModalScreen[Path | None]):
-    """Ask for a file path (save as, duplicate)."""
+    """Ask for a file path (save as, duplicate); replacing a file asks a second Enter."""
 
     BINDINGS = [Binding("escape", "dismiss(None)", "Cancel")]
 
@@ -39,60 +58,82 @@ class PathScreen(ModalScreen[Path | None]):
         super().__init__()
         self.title_text = title
         self.default = default
+        self.confirmed: Path | None = None  # an existing file the user pressed Enter on once
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label(self.title_text, classes="heading")
-            yield Input(str(self.default), id="path-input")
+            yield Label(Content(self.title_text), classes="heading")
+            yield KeyInput(str(self.default), id="path-input")
             yield Static("", id="path-error", classes="field-error")
             yield Label("Enter: save    Esc: cancel", classes="hint")
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
-        text = event.value.strip()
+        path, problem = preset_path_problem(event.value)
         error = self.query_one("#path-error", Static)
-        if not text:
-            error.update("path: must not be empty")
+        if path is None:
+            error.update(Content(problem))
             return
-        path = Path(text).expanduser()
-        if path.suffix not in (".yaml", ".yml"):
-            path = path.with_name(path.name + ".yaml")
-        if path.is_dir():
-            error.update(f"path: {path} is a folder; give a file name")
+        if path.exists() and path != self.confirmed:
+            self.confirmed = path
+            error.update(Content(f"{path} exists: Enter again replaces it, Esc keeps it"))
             return
         self.dismiss(path)
 
 
-class NewPresetScreen(ModalScreen[tuple[str, str] | None]):
-    """A new preset from a spectrum plugin's defaults: ask its name and spectrum."""
+class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
+    """A new preset: its name, the preset it starts from (one that runs), and where it
+    is saved (the current folder unless the user says otherwise)."""
 
     BINDINGS = [Binding("escape", "dismiss(None)", "Cancel")]
 
-    def __init__(self, spectra: list[str]):
+    def __init__(self, templates: list[tuple[str, Path]]):
         super().__init__()
-        self.spectra = spectra
+        self.templates = templates
+        self.path_edited = False  # the file follows the name until the user types a path
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
-            yield Label("New preset from a plugin's defaults", classes="heading")
+            yield Label("New preset", classes="heading")
             with Horizontal(classes="row"):
                 yield Label("name", classes="field-label")
-                yield Input("my-scene", id="new-name", compact=True)
+                yield KeyInput("my-scene", id="new-name", compact=True)
             with Horizontal(classes="row"):
-                yield Label("spectrum", classes="field-label")
-                yield Select(
-                    [(s, s) for s in self.spectra], value=self.spectra[0], allow_blank=False,
-                    compact=True, id="new-spectrum",
-                )
+                yield Label("start from", classes="field-label")
+                if self.templates:
+                    yield Select(
+                        [(Content(label), path) for label, path in self.templates],
+                        value=self.templates[0][1], allow_blank=False, compact=True, id="new-template",
+                    )
+                else:
+                    yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
+            with Horizontal(classes="row"):
+                yield Label("save as", classes="field-label")
+                yield KeyInput(str(new_preset_path("my-scene")), id="new-path", compact=True)
             yield Static("", id="new-error", classes="field-error")
             yield Button("Create", id="new-create", compact=True)
             yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
+    def on_input_changed(self, event: Input.Changed) -> None:
+        if event.input.id == "new-name" and not self.path_edited:
+            self.query_one("#new-path", Input).value = str(new_preset_path(event.value.strip() or "my-scene"))
+        elif event.input.id == "new-path" and event.input.has_focus:
+            self.path_edited = True
+
     def _create(self) -> None:
+        error = self.query_one("#new-error", Static)
         name = self.query_one("#new-name", Input).value.strip()
         if not name:
-            self.query_one("#new-error", Static).update("name: must not be empty")
+            error.update("name: must not be empty")
             return
-        self.dismiss((name, self.query_one("#new-spectrum", Select).value))
+        path, problem = preset_path_problem(self.query_one("#new-path", Input).value)
+        if path is None:
+            error.update(Content(problem))
+            return
+        if path.exists():
+            error.update(Content(f"{path} exists: give another file (a new preset never replaces one)"))
+            return
+        template = self.query_one("#new-template", Select).value if self.templates else None
+        self.dismiss((name, template, path))
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         self._create()

@@ -7,39 +7,43 @@ from pathlib import Path
 
 from textual.app import ComposeResult
 from textual.containers import Vertical
+from textual.content import Content
 from textual.widgets import Static
 
 from .form import PresetForm
+from .pathline import PathLine
 
 
 class EditPane(Vertical):
     def __init__(self, registry, **kwargs):
         super().__init__(**kwargs)
         self.registry = registry
+        self._shown: list[str] | None = None  # the problems the panel shows
 
     def compose(self) -> ComposeResult:
-        yield Static("", id="edit-title")
+        yield PathLine(id="edit-title")
         yield PresetForm(self.registry, id="form")
         yield Static("", id="field-help")
         yield Static("", id="problems")
 
     def show_title(self, path: Path | None, modified: bool, problems: list[str]) -> None:
-        title = self.query_one("#edit-title", Static)
+        title = self.query_one("#edit-title", PathLine)
         if path is None:
-            title.update("No preset open")
+            title.show("No preset open")
             return
         state = "modified" if modified else "saved"
-        count = f", {len(problems)} problem(s)" if problems else ""
-        title.update(f"[b]{path.name}[/b]  ({state}{count})")
+        count = f", {len(problems)} problem{'s' if len(problems) != 1 else ''}" if problems else ""
+        title.show("", str(path), f"  ({state}{count})")
 
     def show_problems(self, problems: list[str]) -> None:
+        if problems == self._shown:
+            return  # unchanged: no new layout for a keystroke that changes nothing here
+        self._shown = list(problems)
         panel = self.query_one("#problems", Static)
         if problems:
             count = len(problems)
-            panel.update(
-                f"[b]{count} problem{'s' if count != 1 else ''}[/b] (as frictionlab validate says):\n"
-                + "\n".join(problems)
-            )
+            head = (f"{count} problem{'s' if count != 1 else ''}", "bold")
+            panel.update(Content.assemble(head, " (as frictionlab validate says):\n", "\n".join(problems)))
             panel.set_class(True, "-invalid")
         else:
             panel.update("valid: Ctrl+R runs it, Ctrl+S saves it")
@@ -48,4 +52,4 @@ class EditPane(Vertical):
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
         spec = event.spec
         text = "" if spec is None else f"{spec.dotted}: " + spec.tooltip().replace("\n", "; ")
-        self.query_one("#field-help", Static).update(text)
+        self.query_one("#field-help", Static).update(Content(text))

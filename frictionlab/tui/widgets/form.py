@@ -8,13 +8,12 @@ user switches back."""
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import yaml
-
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.message import Message
-from textual.validation import ValidationResult, Validator
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static, Switch
 
@@ -29,24 +28,8 @@ from ..fields import (
     problem_path,
     problems_for,
     problems_of,
-    with_value,
 )
-
-
-class HeadlessCheck(Validator):
-    """Validates one field by running the headless validator on the draft with
-    this value in place, and reports that field's messages verbatim."""
-
-    def __init__(self, form: PresetForm, spec: FieldSpec):
-        super().__init__()
-        self.form = form
-        self.spec = spec
-
-    def validate(self, value: str) -> ValidationResult:
-        candidate = with_value(self.form.data, self.spec.path, parse(self.spec, value))
-        self.form.ensure_plugin_name(candidate, self.spec.path)
-        problems = problems_for(problems_of(candidate, self.form.registry), self.spec.dotted)
-        return self.failure("\n".join(problems)) if problems else self.success()
+from .keyinput import KeyInput
 
 
 def _flow(value) -> str:
@@ -78,16 +61,19 @@ class PresetForm(VerticalScroll):
         super().__init__(**kwargs)
         self.registry = registry
         self.data: dict | None = None
+        self.base_dir: Path | None = None  # the preset file's folder: relative input files are taken from it
         self.problems: list[str] = []
         self._specs: dict[str, FieldSpec] = {}
         self._stash: dict[tuple[str, str], dict] = {}  # (slot, plugin) -> params left behind
         # the value each select or switch shows: Textual also posts Changed when one is mounted
         self._seen: dict[str, object] = {}
+        self._marked: dict[str, list[str]] = {}  # widget id -> the messages shown under it
 
     # ------------------------------------------------------------ building
 
-    async def load(self, data: dict) -> None:
+    async def load(self, data: dict, base_dir: Path | None = None) -> None:
         self.data = copy.deepcopy(data)
+        self.base_dir = base_dir
         self._stash.clear()
         await self.recompose()
         self.revalidate(changed=False)
@@ -95,6 +81,7 @@ class PresetForm(VerticalScroll):
     def compose(self):
         self._specs = {}
         self._seen = {}
+        self._marked = {}
         if self.data is None:
             yield Static("No preset open. F2 lists the presets: Enter opens one, n makes a new one.")
             return
@@ -115,9 +102,7 @@ class PresetForm(VerticalScroll):
                 yield Static("", id=_section_id(spec.path), classes="field-error")
         unknown = [key for key in self.data if key not in Preset.model_fields]
         if unknown:
-            yield Static(
-                f"Kept as in the file (edit the YAML to change): {', '.join(unknown)}", classes="note"
-            )
+            yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(map(str, unknown))}"), classes="note")
 
     def field_rows(self, spec: FieldSpec) -> list[Widget]:
         self._specs[spec.widget_id] = spec
@@ -126,7 +111,7 @@ class PresetForm(VerticalScroll):
         if spec.kind == "bool":
             widget = Switch(value=bool(current), id=spec.widget_id)
         elif spec.kind == "choice":
-            options = [(str(c), c) for c in spec.choices]
+            options = [(Content(str(c)), c) for c in spec.choices]  # text, never markup
             known = current in spec.choices
             widget = Select(
                 options,
@@ -137,14 +122,16 @@ class PresetForm(VerticalScroll):
             )
         elif spec.kind in ("int", "float", "text"):
             placeholder = "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
-            widget = Input(
+            widget = KeyInput(
                 value=display(value),
                 placeholder=placeholder,
-                validators=[HeadlessCheck(self, spec)],
-                validate_on=["changed"],
                 compact=True,
+                validate_on=[],  # the form marks it, from the headless validator's problems (revalidate)
+                # a text (a description) is read from its start: selecting it on focus would show its end
+                select_on_focus=spec.kind != "text",
                 id=spec.widget_id,
             )
+            widget.cursor_position = 0
         else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
             shown = "(none)" if value in (MISSING, None) else _flow(value)
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
@@ -154,9 +141,9 @@ class PresetForm(VerticalScroll):
             self._seen[spec.widget_id] = bool(current)
         elif spec.kind == "choice":
             self._seen[spec.widget_id] = current if current in spec.choices else Select.NULL
-        widget.tooltip = spec.tooltip()
-        label = Label(spec.name, classes="field-label")
-        label.tooltip = spec.tooltip()
+        widget.tooltip = Content(spec.tooltip())  # descriptions are text, never markup
+        label = Label(Content(spec.name), classes="field-label")
+        label.tooltip = Content(spec.tooltip())
         return [
             Horizontal(label, widget, classes="row"),
             Static("", id=spec.widget_id + "--error", classes="field-error"),
@@ -167,13 +154,13 @@ class PresetForm(VerticalScroll):
         names = self.registry.names(slot)
         known = self._known_name(slot, name)
         select = Select(
-            [(n, n) for n in names],
+            [(Content(n), n) for n in names],
             value=known if known else Select.NULL,
             allow_blank=known is None,
             compact=True,
             id=f"plugin--{slot}",
         )
-        select.tooltip = f"{slot} plugin: one of {', '.join(names)}"
+        select.tooltip = Content(f"{slot} plugin: one of {', '.join(names)}")
         self._seen[select.id] = known if known else Select.NULL
         return [
             Label(slot.capitalize(), classes="heading"),
@@ -196,7 +183,7 @@ class PresetForm(VerticalScroll):
         if known is None:
             return [Static("(choose a plugin to see its parameters)", classes="note")]
         cls = self.registry.get(slot, known)
-        rows: list[Widget] = [Static(cls.summary, classes="summary")]
+        rows: list[Widget] = [Static(Content(cls.summary), classes="summary")]
         for spec in field_specs(cls.Params, prefix=(slot, "params")):
             rows += self.field_rows(spec)
         return rows
@@ -261,6 +248,7 @@ class PresetForm(VerticalScroll):
         self.data[slot] = {"name": new_name, "params": self._stash.get((slot, new_name), {})}
         for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
             del self._specs[spec_id]
+            self._marked.pop(spec_id, None)  # its new row starts unmarked
         container = self.query_one(f"#params--{slot}", Vertical)
         await container.remove_children()
         await container.mount_all(self.param_rows(slot))
@@ -269,8 +257,10 @@ class PresetForm(VerticalScroll):
     # ------------------------------------------------------------ messages
 
     def revalidate(self, changed: bool) -> None:
-        """Run the headless validator on the draft and mark every field."""
-        self.problems = problems_of(self.data, self.registry) if self.data is not None else []
+        """Run the headless validator on the draft and mark every field whose
+        messages changed (only those: each change lays the form out again, and
+        that, not the validator, is what a keystroke costs)."""
+        self.problems = problems_of(self.data, self.registry, self.base_dir) if self.data is not None else []
         shown = set()
         for widget_id, spec in self._specs.items():
             messages = problems_for(self.problems, spec.dotted)
@@ -284,22 +274,41 @@ class PresetForm(VerticalScroll):
             if section.id and section.id.startswith("section--"):
                 dotted = section.id.removeprefix("section--").replace("--", ".")
                 messages = [p for p in self.problems if p not in shown and problem_path(p) == dotted]
-                section.update("\n".join(messages))
-                section.display = bool(messages)
+                if self._marked.get(section.id, []) != messages:
+                    self._marked[section.id] = messages
+                    section.update(Content("\n".join(messages)))
+                    section.display = bool(messages)
         self.post_message(self.Edited(self.problems, changed))
 
     def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
+        if self._marked.get(widget_id, []) == messages:
+            return
+        self._marked[widget_id] = messages
         try:
             label = self.query_one(f"#{widget_id}--error", Static)
         except Exception:
             return
-        label.update("\n".join(messages))
+        label.update(Content("\n".join(messages)))
         label.display = bool(messages)
         if widget:
             try:
                 self.query_one(f"#{widget_id}").set_class(bool(messages), "-invalid")
             except Exception:
                 pass
+
+    def focus_problem(self, problems: list[str]) -> None:
+        """Focus the field of the first problem that has one (else the first field), scrolled into view."""
+        for problem in problems:
+            dotted = problem_path(problem)
+            slot, _, rest = dotted.partition(".")
+            for widget_id in ("field--" + dotted.replace(".", "--"), f"plugin--{slot}" if rest == "name" else ""):
+                widgets = self.query(f"#{widget_id}") if widget_id else []
+                if widgets and widgets.first().focusable:
+                    widgets.first().focus()
+                    return
+        fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
+        if fields:
+            fields[0].focus()
 
     def on_descendant_focus(self, event) -> None:
         widget = event.widget

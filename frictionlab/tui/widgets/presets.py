@@ -2,20 +2,25 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Vertical
+from textual.containers import Vertical, VerticalScroll
+from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ..folders import PresetEntry, list_presets
+from .pathline import PathLine
 from .tables import ListTable
+
+NO_PRESETS = "No preset to open here: n makes a new one."
 
 
 class PresetsPane(Vertical):
     BINDINGS = [
-        Binding("d", "duplicate", "Duplicate", tooltip="Duplicate the preset (asks for a file name)"),
-        Binding("n", "new", "New", tooltip="New preset from a spectrum plugin's defaults"),
-        Binding("r", "reload", "Reload", tooltip="Reload the list of presets"),
+        Binding("d", "duplicate", "Duplicate", tooltip="the preset (asks for a file name)"),
+        Binding("n", "new", "New", tooltip="preset from a listed one (asks its name and file)"),
+        Binding("r", "reload", "Reload", tooltip="the list of presets"),
     ]
 
     def __init__(self, **kwargs):
@@ -23,8 +28,10 @@ class PresetsPane(Vertical):
         self.presets: list[PresetEntry] = []
 
     def compose(self) -> ComposeResult:
-        yield ListTable(id="preset-table", cursor_type="row", zebra_stripes=True)
-        yield Static("", id="preset-info")
+        yield ListTable(id="preset-table", cursor_type="row", zebra_stripes=True, empty=NO_PRESETS)
+        yield PathLine(id="preset-path")
+        with VerticalScroll(id="preset-info-box", can_focus=False):
+            yield Static("", id="preset-info")
 
     def on_mount(self) -> None:
         self.query_one("#preset-table", DataTable).add_columns("name", "folder", "file")
@@ -35,10 +42,11 @@ class PresetsPane(Vertical):
         table = self.query_one("#preset-table", DataTable)
         table.clear()
         for entry in self.presets:
-            table.add_row(entry.name, entry.label, entry.path.name)
+            table.add_row(Text(entry.name), Text(entry.label), Text(entry.path.name))  # Text: never markup
         if not self.presets:
             shown = ", ".join(str(f) for _, f in folders)
-            self.query_one("#preset-info", Static).update(f"No presets in {shown}. n makes a new one.")
+            self.query_one("#preset-path", PathLine).show("")
+            self.query_one("#preset-info", Static).update(Content(f"No presets in {shown}. n makes a new one."))
         else:
             self._show_info(0)
 
@@ -50,7 +58,9 @@ class PresetsPane(Vertical):
         if 0 <= row < len(self.presets):
             entry = self.presets[row]
             text = entry.error or entry.description or "(no description)"
-            self.query_one("#preset-info", Static).update(f"{entry.path}\n{text}")
+            self.query_one("#preset-path", PathLine).show("", str(entry.path))
+            self.query_one("#preset-info", Static).update(Content(text))
+            self.query_one("#preset-info-box").scroll_home(animate=False)  # a description is read from its start
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         self._show_info(event.cursor_row)

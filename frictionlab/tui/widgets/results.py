@@ -7,27 +7,34 @@ import math
 from pathlib import Path
 
 import numpy as np
+from rich.text import Text
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
+from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ...fit import format_interval
 from ..chart import Series
 from ..folders import RunEntry, SweepEntry, list_runs, read_curve, read_run
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
+from ..text import shorten_middle
 from .chart import Chart
 from .run import fit_series
 from .tables import ListTable
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
 HINT = "Enter opens a run; Space adds it to the overlay."
+NO_RUNS = "No runs yet: Ctrl+R runs the open preset (F2 lists the presets)."
+FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of the list's width
 
 
 class ResultsPane(Vertical):
     BINDINGS = [
-        Binding("space", "compare", "Compare", tooltip="Compare: add the run to the overlay, or remove it"),
-        Binding("r", "reload", "Reload", tooltip="Reload the list of runs"),
+        Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
+        Binding("r", "reload", "Reload", tooltip="the list of runs"),
+        Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
     ]
 
     def __init__(self, **kwargs):
@@ -38,18 +45,19 @@ class ResultsPane(Vertical):
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
-            yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True)
+            yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True, empty=NO_RUNS)
             with Vertical(id="results-body"):
                 yield Chart(id="results-chart")
                 yield Static(HINT, id="results-info")
         yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
-    def on_mount(self) -> None:
-        runs = self.query_one("#runs-table", DataTable)
-        runs.add_column("", width=1, key="status")
-        runs.add_column("run", width=17)
-        runs.add_column("a", width=7)
-        runs.add_column("b", width=7)
+    def _name_width(self) -> int:
+        table = self.query_one("#runs-table", DataTable)
+        padding = 2 * table.cell_padding * (len(FIXED_COLUMNS) + 1)
+        return max(12, table.scrollable_content_region.width - sum(FIXED_COLUMNS) - padding)
+
+    def on_resize(self, event: events.Resize) -> None:
+        self.call_after_refresh(self._fill)  # the list's width is known once laid out
 
     def action_compare(self) -> None:
         self.open_selected(overlay=True)
@@ -57,21 +65,41 @@ class ResultsPane(Vertical):
     def action_reload(self) -> None:
         self.app.reload_runs()
 
+    def action_resume(self) -> None:
+        row = self.query_one("#runs-table", DataTable).cursor_row
+        if not 0 <= row < len(self.runs):
+            self.app.say(NO_RUNS, "warning")
+            return
+        self.app.resume_run(self.runs[row].path)
+
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         event.stop()
         self.open_selected(overlay=False)
 
     def reload(self, runs_dir: Path) -> None:
         self.runs = list_runs(runs_dir)
+        self._fill()
+
+    def _fill(self) -> None:
+        """The list of runs, each name shortened from the middle to the width the list has."""
         table = self.query_one("#runs-table", DataTable)
-        table.clear()
+        row = table.cursor_row
+        width = self._name_width()
+        table.clear(columns=True)
+        table.add_column("", width=FIXED_COLUMNS[0], key="status")
+        table.add_column("run", width=width)
+        table.add_column("a", width=FIXED_COLUMNS[1])
+        table.add_column("b", width=FIXED_COLUMNS[2])
         for entry in self.runs:
             if isinstance(entry, SweepEntry):
                 a, b = "sweep", f"{len(entry.points)} pts"
             else:
                 a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
                 b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
-            table.add_row(STATUS_MARKS.get(entry.status, "?"), entry.path.name, a, b)
+            name = Text(shorten_middle(entry.path.name, width))  # Text: never markup
+            table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
+        if self.runs:
+            table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
 
     def open_selected(self, overlay: bool) -> None:
         """Enter/Space on the list of runs, or on the open sweep's table of points."""
@@ -84,15 +112,18 @@ class ResultsPane(Vertical):
             try:
                 entry = read_run(folder)
             except (OSError, ValueError, TypeError):
-                self.app.notify(f"{folder.name}: this point has no finished run", severity="warning")
+                self.app.say(f"{folder.name}: this point has no finished run", "warning")
                 return
         else:
             row = self.query_one("#runs-table", DataTable).cursor_row
             if not 0 <= row < len(self.runs):
+                self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
             if isinstance(entry, SweepEntry):
-                if not overlay:
+                if overlay:
+                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.", "warning")
+                else:
                     self._show_sweep(entry)
                 return
         if overlay:
@@ -112,11 +143,13 @@ class ResultsPane(Vertical):
         table.clear(columns=True)
         table.add_columns(*table_columns(entry.paths))
         for row in entry.points:
-            table.add_row(*row_cells(entry.paths, row))
+            table.add_row(*map(Text, row_cells(entry.paths, row)))
         self.set_class(True, "-sweep")
         self.query_one("#results-info", Static).update(
-            f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
-            "Enter on a point opens its run; Space adds it to the overlay."
+            Content(
+                f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
+                "Enter on a point opens its run; Space adds it to the overlay; Tab goes back to the list."
+            )
         )
         table.focus()
 
@@ -126,7 +159,7 @@ class ResultsPane(Vertical):
             try:
                 curve = read_curve(entry.path)
             except (OSError, ValueError, KeyError) as exc:
-                lines.append(f"[{style}]{entry.path.name}[/]: no curve ({exc})")
+                lines.append(Content.assemble((entry.path.name, style), f": no curve ({exc})"))
                 continue
             f, xi = np.array(curve.get("f", []), float), np.array(curve.get("xi", []), float)
             series.append(Series(f, xi, style))
@@ -134,19 +167,19 @@ class ResultsPane(Vertical):
                 series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
             lines += _entry_lines(entry, style)
         self.query_one("#results-chart", Chart).show(series)
-        self.query_one("#results-info", Static).update("\n".join(lines) if lines else HINT)
+        self.query_one("#results-info", Static).update(Content("\n").join(lines) if lines else HINT)
 
 
-def _entry_lines(entry: RunEntry, style: str) -> list[str]:
+def _entry_lines(entry: RunEntry, style: str) -> list[Content]:
     """What the overlay says of one run: f, its status and contacts, its fit."""
     fit = entry.fit or {}
     counts = entry.summary.get("contact_count_at_first_load"), entry.summary.get("contact_count_at_last_load")
     formula = (entry.summary.get("normalisation") or {}).get("formula")
-    lines = [f"[{style}]■ {entry.path.name}[/]" + (f" f = {formula}" if formula else "")]
+    lines = [Content.assemble((f"■ {entry.path.name}", style), f" f = {formula}" if formula else "")]
     contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if counts[0] is not None else ""
     lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
     if fit:
         interval = lambda key: format_interval(tuple(fit.get(key) or (None, None)), missing="")  # noqa: E731
         lines.append(f"  a={fit.get('a', math.nan):.4f} {interval('a_ci')} R^2={fit.get('r2', math.nan):.4f}")
         lines.append(f"  b={fit.get('b', math.nan):.4f} {interval('b_ci')}")
-    return lines
+    return [Content(line) if isinstance(line, str) else line for line in lines]

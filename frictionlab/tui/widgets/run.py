@@ -7,9 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
+from textual.content import Content
 from textual.widgets import DataTable, ProgressBar, Static
 
 from ...fit import format_estimate
@@ -17,7 +19,9 @@ from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
 from ..sweepview import point_line, table_cells, table_columns
+from ..text import failure_message
 from .chart import Chart
+from .pathline import PathLine
 
 
 def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
@@ -58,12 +62,14 @@ def _contact_lines(count) -> list[str]:
 
 class RunPane(Vertical, can_focus=True):
     BINDINGS = [
-        Binding("r", "start", "Run", tooltip="Run the open preset (again)"),
-        Binding("c", "cancel", "Cancel", tooltip="Cancel the run: what finished is kept and saved"),
+        Binding("r", "start", "Run", tooltip="the open preset (again)"),
+        Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
+        Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
     ]
 
     def compose(self) -> ComposeResult:
         yield Static("No run yet: open a preset and press Ctrl+R.", id="run-title")
+        yield PathLine(id="run-folder")
         yield Static("", id="sweep-point")
         yield ProgressBar(id="run-bar", show_eta=False)
         yield Static("", id="run-stats")
@@ -79,28 +85,35 @@ class RunPane(Vertical, can_focus=True):
     def action_cancel(self) -> None:
         self.app.action_cancel_run()
 
-    def _set(self, widget_id: str, text: str) -> None:
-        self.query_one(f"#{widget_id}", Static).update(text)
+    def action_resume(self) -> None:
+        self.app.resume_run(self.app.last_out_dir)
+
+    def _set(self, widget_id: str, text: str | Content) -> None:
+        """Show ``text`` as it is: names, values and errors are never read as markup."""
+        self.query_one(f"#{widget_id}", Static).update(Content(text) if isinstance(text, str) else text)
+
+    def _error(self, text: str) -> None:
+        self._set("run-error", Content.styled(text, "red"))
 
     # ------------------------------------------------------------ a run starts
 
     def start(self, scene, sweep, out_dir: Path) -> None:
         """Clear the tab for the run of ``scene`` (or of ``sweep``, when not None) into ``out_dir``."""
         self.set_class(sweep is not None, "-sweep")
-        where = f"{out_dir.parent.name}/{out_dir.name}"
         preset = scene.preset
         if sweep is None:
-            self._set("run-title", f"[b]{preset.name}[/b]: {preset.realizations} realizations, "
-                                   f"{preset.loading.steps} {preset.loading.control} steps -> {where}")  # fmt: skip
+            what = f": {preset.realizations} realizations, {preset.loading.steps} {preset.loading.control} steps"
+            self._set("run-title", Content.assemble((preset.name, "bold"), what))
         else:
             preset = sweep.points[0].scene.preset
-            self._set("run-title", f"[b]{sweep.name}[/b]: {len(sweep.points)} points x {preset.realizations} "
-                                   f"realizations -> {where}")  # fmt: skip
+            what = f": {len(sweep.points)} points x {preset.realizations} realizations"
+            self._set("run-title", Content.assemble((sweep.name, "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
             table = self.query_one("#sweep-table", DataTable)
             table.clear(columns=True)
             table.add_columns(*table_columns(sweep.paths))
+        self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
         self.query_one("#run-bar", ProgressBar).update(total=preset.realizations, progress=0)
         self._set("run-error", "")
 
@@ -118,7 +131,7 @@ class RunPane(Vertical, can_focus=True):
             lines = fit_lines(snap.fit, final=False, f_formula=snap.f_formula) + _contact_lines(snap.contact_count)
             self._set("run-fit", "\n".join(lines))
         if snap.first_error:
-            self._set("run-error", f"[red]{snap.first_error}[/red]")
+            self._error(snap.first_error)
 
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the realizations already running finish and are kept")
@@ -129,16 +142,17 @@ class RunPane(Vertical, can_focus=True):
             self._set("sweep-point", point_line(sweep, point))
             self.query_one("#run-bar", ProgressBar).update(total=point.scene.preset.realizations, progress=0)
             return
-        self.query_one("#sweep-table", DataTable).add_row(*table_cells(sweep, result))
+        self.query_one("#sweep-table", DataTable).add_row(*map(Text, table_cells(sweep, result)))
         if result.error:
-            self._set("run-error", f"[red]point {result.point.number}: {result.error}[/red]")
+            self._error(f"point {result.point.number}: {result.error}")
 
     # ------------------------------------------------------------ at the end
 
     def show_outcome(self, outcome) -> str:
         """Show a finished run's ``RunOutcome``; return the line the app notifies."""
         self.query_one("#run-bar", ProgressBar).update(total=outcome.requested, progress=outcome.done)
-        self._set("run-stats", f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in "
+        status = "failed" if outcome.done == 0 and outcome.failures else outcome.status  # "completed" with nothing done says too little
+        self._set("run-stats", f"{status}: {outcome.done}/{outcome.requested} realizations in "
                                f"{format_duration(outcome.elapsed)}, {outcome.workers} worker"
                                f"{'s' if outcome.workers != 1 else ''}")  # fmt: skip
         if outcome.fit is not None:
@@ -147,8 +161,8 @@ class RunPane(Vertical, can_focus=True):
         lines = fit_lines(outcome.fit, final=True, f_formula=outcome.normalisation.formula)
         self._set("run-fit", "\n".join(lines + _contact_lines(outcome.contact_count)))
         if outcome.failures or outcome.error:
-            first = outcome.error or f"#{outcome.failures[0][0]}: {outcome.failures[0][1]}"
-            self._set("run-error", f"[red]{len(outcome.failures)} realization(s) failed; {first}[/red]")
+            first = outcome.error or f"#{outcome.failures[0][0]}: {failure_message(outcome.failures[0][1])}"
+            self._error(f"{len(outcome.failures)} realization(s) failed; {first}")
         return f"Run {outcome.status}: {outcome.done}/{outcome.requested} realizations"
 
     def show_sweep_outcome(self, outcome) -> str:
@@ -159,4 +173,4 @@ class RunPane(Vertical, can_focus=True):
         return f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points"
 
     def show_crash(self, error: str) -> None:
-        self._set("run-error", f"[red]run failed: {error}[/red]")
+        self._error(f"run failed: {error}")

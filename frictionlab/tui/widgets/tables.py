@@ -7,6 +7,17 @@ from textual.widgets import DataTable
 
 
 class ListTable(DataTable):
-    """A row list whose Enter is shown in the footer as Open."""
+    """A row list whose Enter is shown in the footer as Open; Enter on an empty
+    list says what to do instead (``empty``)."""
 
-    BINDINGS = [Binding("enter", "select_cursor", "Open", tooltip="Open the highlighted row")]
+    BINDINGS = [Binding("enter", "select_cursor", "Open", tooltip="the highlighted row")]
+
+    def __init__(self, *args, empty: str = "Nothing here.", **kwargs):
+        super().__init__(*args, **kwargs)
+        self.empty = empty
+
+    def action_select_cursor(self) -> None:
+        if self.row_count == 0:
+            self.app.say(self.empty, "warning")
+            return
+        super().action_select_cursor()

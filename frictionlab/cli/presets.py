@@ -1,0 +1,70 @@
+"""``frictionlab presets``: the presets shipped with frictionlab, and ``presets copy``
+to take one out to edit (never over an existing file without ``--force``)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean
+
+EXAMPLES = """examples:
+  frictionlab presets                         list the built-in presets
+  frictionlab presets copy quickstart         copy quickstart.yaml here, to edit
+  frictionlab run quickstart                  run a built-in by its name
+"""
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "presets",
+        help="list the built-in presets, or copy one out to edit",
+        description="The presets that ship with frictionlab. Run one by name (frictionlab run quickstart) "
+        "or copy it out to edit.",
+        epilog=EXAMPLES,
+    )
+    p.add_argument("--json", action="store_true", help="as JSON: name, description, path")
+    actions = p.add_subparsers(dest="action", metavar="ACTION")
+    c = actions.add_parser(
+        "copy",
+        help="copy a built-in preset to a file or folder",
+        description="Copy a built-in preset out, to edit; an existing file is kept unless --force.",
+        epilog="example:\n  frictionlab presets copy benad2012-fig2 my-fig2.yaml",
+    )
+    c.add_argument("name", metavar="NAME", help="a built-in preset (frictionlab presets lists them)")
+    c.add_argument("dest", nargs="?", default=".", metavar="DEST", help="file or existing folder (default: .)")
+    c.add_argument("--force", action="store_true", help="replace DEST if it exists")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..preset.builtin import builtin_presets
+
+    if getattr(args, "action", None) == "copy":
+        return copy_preset(args.name, Path(args.dest), force=args.force)
+    presets = builtin_presets()
+    if args.json:
+        rows = [{"name": p.name, "description": p.description, "path": str(p.path)} for p in presets]
+        print(json.dumps(rows, indent=2))
+        return ExitCode.OK
+    from .console import print_table
+
+    print_table(["NAME", "DESCRIPTION"], [(p.name, p.description) for p in presets])
+    return ExitCode.OK
+
+
+def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
+    from ..preset.builtin import builtin_presets, find_builtin
+
+    preset = find_builtin(name)
+    if preset is None:
+        names = [p.name for p in builtin_presets()]
+        raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
+    target = dest / preset.path.name if dest.is_dir() else dest
+    try:
+        with open(target, "wb" if force else "xb") as out:  # "x": never over a file that appeared meanwhile
+            out.write(preset.path.read_bytes())
+    except FileExistsError:
+        raise OutputRefused(f"{target} exists; give another DEST or --force to replace it") from None
+    print(f"copied {preset.name} to {target}")
+    return ExitCode.OK

@@ -1,0 +1,98 @@
+"""The presets that ship with frictionlab (the repository's ``presets/`` folder).
+
+An installed package carries them as ``frictionlab/builtin_presets/`` (setup.py maps
+the folder there); a source checkout or an editable install reads ``presets/`` beside
+the package. Either way each is a real file, so a front end can open, show or copy it.
+A preset argument that is not a path to a file but a built-in's name
+(``frictionlab run quickstart``) means that file (``resolve_preset_path``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import PresetFileError, did_you_mean
+
+_LONGEST = 100  # characters of a one-line description
+_PACKAGE = Path(__file__).resolve().parent.parent
+
+
+@dataclass(frozen=True)
+class BuiltinPreset:
+    """A preset shipped with frictionlab: its ``name`` (the file's stem, what
+    ``frictionlab run NAME`` takes), a one-line ``description`` and its file."""
+
+    name: str
+    description: str
+    path: Path
+
+
+def builtin_folder() -> Path | None:
+    """The folder holding the built-in presets, or None if this install has none."""
+    for folder in (_PACKAGE / "builtin_presets", _PACKAGE.parent / "presets"):
+        if folder.is_dir() and any(folder.glob("*.yaml")):
+            return folder
+    return None
+
+
+def builtin_presets() -> list[BuiltinPreset]:
+    """Every built-in preset, by name; the description is the first line of the
+    preset's own ``description`` (or of its leading comment if it has none)."""
+    folder = builtin_folder()
+    if folder is None:
+        return []
+    return [BuiltinPreset(p.stem, _one_line(p), p) for p in sorted(folder.glob("*.yaml"))]
+
+
+def find_builtin(name: str) -> BuiltinPreset | None:
+    """The built-in preset called ``name`` (``quickstart`` or ``quickstart.yaml``), or None."""
+    stem = name.removesuffix(".yaml")
+    return next((p for p in builtin_presets() if p.name == stem), None)
+
+
+def resolve_preset_path(argument: str | Path) -> Path:
+    """The preset file a command-line argument means: an existing path as given,
+    else the built-in of that name. Neither is a PresetFileError naming the closest
+    built-in names (a path that merely does not exist is reported by the reader)."""
+    path = Path(argument)
+    if not path.exists() and len(path.parts) == 1 and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):
+        raise PresetFileError(
+            [f"(file): no file {str(argument)!r} here; the built-in preset of that name is {path.stem!r} "
+             f"(give the name alone: frictionlab run {path.stem})"],
+            source=str(argument),
+        )  # fmt: skip
+    if path.exists() or path.suffix or len(path.parts) > 1:
+        return path  # a path: read (and, if missing, reported) as one
+    found = find_builtin(str(argument))
+    if found is not None:
+        return found.path
+    names = [p.name for p in builtin_presets()]
+    raise PresetFileError(
+        [
+            f"(file): no file {str(argument)!r} and no built-in preset of that name{did_you_mean(str(argument), names) or '.'} "
+            f"Built-ins: {', '.join(names) or '(none installed)'} (`frictionlab presets` lists them)"
+        ],
+        source=str(argument),
+    )
+
+
+def _one_line(path: Path) -> str:
+    """The preset's description, cut at its first sentence or line; read without
+    validating (a listing must not fail on one odd file)."""
+    from ..safe_yaml import YamlProblem, load_yaml
+
+    text = path.read_text(encoding="utf-8")
+    try:
+        data = load_yaml(text)
+    except YamlProblem:
+        data = None
+    description = data.get("description") if isinstance(data, dict) else None
+    if not isinstance(description, str) or not description.strip():
+        comments = [ln.lstrip("# ").strip() for ln in text.splitlines() if ln.startswith("#")]
+        description = comments[0] if comments else ""
+    line = re.split(r"(?<!Fig)\.\s+(?=[A-Z])|;\s", " ".join(description.split()), maxsplit=1)[0].rstrip(".")
+    if len(line) > _LONGEST:  # cut at a comma, so that a listing keeps one line per preset
+        line = line[: line.rfind(", ", 0, _LONGEST)] + " ..."
+    return line

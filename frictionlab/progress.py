@@ -1,0 +1,186 @@
+"""Progress of a run and of a sweep, as people read it: a rich
+progress bar on a terminal or in a Jupyter notebook, plain lines elsewhere (a log
+file, a pipe), one every tenth of the work so that logs stay short.
+
+The CLI, the Python API (``frictionlab.run``) and the studies use these; rich is
+imported only when a bar is drawn. ``NO_COLOR`` is honoured by rich itself.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from .hookspecs import hookimpl
+from .listeners import SweepListener, progress_text
+
+
+def _in_notebook() -> bool:
+    shell = sys.modules.get("IPython")
+    try:
+        return shell is not None and type(shell.get_ipython()).__name__ == "ZMQInteractiveShell"
+    except AttributeError:
+        return False
+
+
+def wants_bar(stream) -> bool:
+    """A live bar on a terminal or in a notebook; plain lines anywhere else."""
+    try:
+        return bool(stream.isatty()) or _in_notebook()
+    except (AttributeError, ValueError):
+        return False
+
+
+class _Bar:
+    """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
+
+    def __init__(self, stream, description: str, total: int, completed: int = 0, started: float | None = None):
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+        console = Console(file=stream, highlight=False)
+        self.progress = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
+            TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=10,
+            get_time=time.perf_counter,
+        )  # fmt: skip
+        self.task = self.progress.add_task(description, total=total, completed=completed, note="")
+        if started is not None:  # drawn late (a run shows its bar after 2 s): the clock is the run's
+            self.progress.tasks[0].start_time = started
+        self.progress.start()
+
+    def update(self, completed: int, note: str = "") -> None:
+        self.progress.update(self.task, completed=completed, note=note)
+
+    def print(self, text: str) -> None:
+        self.progress.console.print(text, markup=False)
+
+    def stop(self) -> None:
+        self.progress.stop()
+
+
+SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond its first line
+LOAD_LINE_SECONDS = 30.0  # in a log: a long solve's load at most this often
+
+
+class ProgressReporter:
+    """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr): a bar
+    when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth;
+    either only once the run has gone on ``after`` seconds (a short run shows its first
+    line and, in a log, its last)."""
+
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
+        self.stream = stream or sys.stderr
+        self.interactive = wants_bar(self.stream) if interactive is None else interactive
+        self.after = after
+        self.total = 0
+        self.bar: _Bar | None = None
+        self.started = 0.0
+        self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
+        self.failed = 0
+        self.resumed = 0  # restored on a resume: done before this process started
+        self.done = 0
+        self.last_load_line = 0.0
+
+    def _line(self, done: int, total: int) -> str:
+        return progress_text(done, total, self.failed, time.perf_counter() - self.started, restored=self.resumed)
+
+    def _write(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.print(text)
+        else:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+
+    @hookimpl
+    def run_started(self, run):
+        self.started = time.perf_counter()
+        self.resumed = self.done = run.resumed
+        self.total = run.total
+        preset = run.scene.preset
+        restored = ", ".join(
+            [f"{self.resumed} restored from the run folder"] * bool(self.resumed)
+            + [f"{run.retried} failed ones retried"] * bool(run.retried)
+        )
+        restored = f" ({restored})" if restored else ""
+        self._write(
+            f"{preset.name}: {run.total} realizations of {run.scene.generator.name} lines{restored}, "
+            f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)"
+        )
+
+    def _progress(self, done: int, total: int) -> None:
+        self.done, self.total = done, total
+        if time.perf_counter() - self.started < self.after and not (done == total and not self.interactive):
+            while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
+                self.next_tenth += 1
+            return
+        if self.interactive and self.bar is None:
+            self.bar = _Bar(self.stream, "realizations", total, completed=done, started=self.started)
+        if self.bar is not None:
+            self.bar.update(done, f"{self.failed} failed" if self.failed else "")
+        elif done == total or 10 * done >= self.next_tenth * total:
+            self._write(self._line(done, total))
+            while self.next_tenth * total <= 10 * done:
+                self.next_tenth += 1
+
+    @hookimpl
+    def realization_done(self, done, total):
+        self._progress(done, total)
+
+    @hookimpl
+    def load_done(self, index, done, total):
+        """A long solve's loads: the bar's note, or a line now and then in a log."""
+        now = time.perf_counter()
+        if now - self.started < self.after or not self.total:
+            return
+        text = f"realization {index}: load {done}/{total}"
+        if self.interactive:
+            if self.bar is None:
+                self.bar = _Bar(self.stream, "realizations", self.total, completed=self.done, started=self.started)
+            self.bar.update(self.done, text)
+        elif now - max(self.last_load_line, self.started) >= LOAD_LINE_SECONDS:
+            self._write(text)
+            self.last_load_line = now
+
+    @hookimpl
+    def realization_failed(self, result, done, total):
+        self.failed += 1
+        if self.failed == 1:  # the first error says what is wrong; the rest only count
+            self._write(f"realization {result.index} failed: {result.error}")
+        self._progress(done, total)
+
+    @hookimpl
+    def run_finished(self, outcome):
+        if self.bar is not None:
+            self.bar.stop()
+            self.bar = None
+        if outcome.status != "completed":
+            self._write(f"run {outcome.status}: {outcome.done} of {outcome.requested} realizations finished")
+
+
+class SweepProgress(SweepListener):
+    """One line per point on ``stream`` (stderr); each point's run reports its own
+    realizations through a ``ProgressReporter``."""
+
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
+        self.stream = stream or sys.stderr
+        self.interactive = interactive
+        self.after = after
+
+    def _write(self, text: str) -> None:
+        self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def sweep_started(self, sweep):
+        mode = sweep.spec.mode
+        self._write(f"{sweep.name}: sweep of {len(sweep.points)} points ({mode} over {', '.join(sweep.paths)})")
+
+    def point_started(self, sweep, point):
+        self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")
+
+    def run_listeners(self, point):
+        return [ProgressReporter(self.stream, self.interactive, self.after)]
+
+    def point_finished(self, sweep, point, result):
+        if result.status == "error":
+            self._write(f"point {point.number} failed: {result.error}")

@@ -1,0 +1,26 @@
+"""A text input whose editing keys act in the order they were typed."""
+
+from __future__ import annotations
+
+from textual import events
+from textual.widgets import Input
+
+
+class KeyInput(Input):
+    """An ``Input`` that runs its own key bindings (Ctrl+U, Home, Ctrl+W, ...) at once.
+
+    Textual runs a widget's bindings only after the key has bubbled up to the app,
+    one message queue at a time, while a printable key is inserted where it lands.
+    Keys a terminal delivers together (fast typing) then act out of order: ``Ctrl+U``
+    followed by ``123`` inserted 123 and then cleared it with the late Ctrl+U, and
+    ``Home 7`` put the 7 at the end. Run here, a binding acts before the next key.
+    """
+
+    async def _on_key(self, event: events.Key) -> None:
+        bindings = self._bindings.key_to_bindings.get(event.key)
+        if bindings and not event.is_printable:
+            event.stop()
+            event.prevent_default()
+            await self.run_action(bindings[0].action)
+            return
+        await super()._on_key(event)

@@ -1,0 +1,185 @@
+"""The CLI's conventions, each as a user meets it in a real process: version, a bare
+command, help with examples, --json, did-you-mean, a closed pipe, tables that fit the
+terminal, colour on a terminal only (NO_COLOR honoured), shell completion."""
+
+from __future__ import annotations
+
+import json
+import os
+import pty
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from frictionlab.cli.main import COMMANDS, build_parser
+from frictionlab.errors import ExitCode
+
+from ..conftest import ROOT
+from .conftest import run_cli
+
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+COLOUR = re.compile(r"\x1b\[[0-9;]*3[0-7]m|\x1b\[[0-9;]*38;")  # a foreground colour, not bold or cursor moves
+NAMES = [command.__name__.rsplit(".", 1)[-1] for command in COMMANDS]
+
+
+def subparsers():
+    parser = build_parser()
+    action = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    return action.choices
+
+
+def test_version_short_and_long():
+    for flag in ("-V", "--version"):
+        done = run_cli(flag)
+        assert done.returncode == 0 and re.fullmatch(r"frictionlab \d+\.\d+\S*\n", done.stdout), done.stdout
+
+
+def test_bare_command_shows_a_short_help_with_every_command_and_examples():
+    done = run_cli()
+    assert done.returncode == 0 and done.stderr == ""
+    assert "commands:" in done.stdout and "examples:" in done.stdout
+    for name in NAMES:
+        assert re.search(rf"^  {name} ", done.stdout, re.M), name
+    assert len(done.stdout.splitlines()) < 30  # short
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_command_help_has_a_description_and_examples_that_parse(name):
+    command = subparsers()[name]
+    assert command.description and len(command.description) > 20
+    assert command.epilog and command.epilog.startswith("example")
+    examples = [line.split("  ")[1] if line.startswith("  ") else line for line in command.epilog.splitlines()[1:]]
+    commands = [shlex.split(e.strip())[1:] for e in examples if e.strip().startswith("frictionlab ")]
+    assert commands, command.epilog
+    parsed = [build_parser().parse_args(argv[: argv.index(">")] if ">" in argv else argv) for argv in commands]
+    assert name in {args.command for args in parsed}  # each parses; at least one shows this command
+    assert "example" in run_cli(name, "--help").stdout
+
+
+@pytest.mark.parametrize("name", ["run", "validate", "plugins", "study", "report", "predict", "presets"])
+def test_every_reporting_command_takes_json(name):
+    options = {o for a in subparsers()[name]._actions for o in a.option_strings}
+    assert "--json" in options
+
+
+def test_json_output_of_validate_plugins_and_predict_parses(tmp_path):
+    done = run_cli("validate", "quickstart", "--json")
+    record = json.loads(done.stdout)[0]
+    assert done.returncode == 0 and record["ok"] and record["name"] == "quickstart"
+    done = run_cli("validate", "quickstart", "--set", "realizations=0", "--json")
+    record = json.loads(done.stdout)[0]
+    assert done.returncode == ExitCode.USAGE and not record["ok"] and record["problems"][0].startswith("realizations")
+    assert json.loads(run_cli("plugins", "--json").stdout)["plugins"]
+    done = run_cli("predict", "--a", "1.5", "--b", "0.1", "--area", "1", "--modulus", "1", "--rms-height", "1",
+                   "--force", "1", "--json")  # fmt: skip
+    out = json.loads(done.stdout)
+    assert out["a"] == 1.5 and out["b"] == 0.1
+
+
+def test_did_you_mean_for_commands_and_plugins(tmp_path):
+    done = run_cli("rn", "quickstart")
+    assert done.returncode == ExitCode.USAGE and "did you mean 'run'?" in done.stderr and "Traceback" not in done.stderr
+    done = run_cli("valdate", "quickstart")
+    assert "did you mean 'validate'?" in done.stderr
+    done = run_cli("validate", "quickstart", "--set", "spectrum.name=power-lw")
+    assert done.returncode == ExitCode.USAGE and "did you mean 'power-law'" in done.stderr
+
+
+@pytest.mark.parametrize("argv", [[], ["presets"], ["completion", "bash"], ["--help"]])
+def test_a_closed_pipe_ends_quietly(argv, tmp_path):
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], stdout=write_end, stderr=subprocess.PIPE,
+                              cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=60)  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert done.stderr == b""
+    # argparse writes --help itself and ignores a failed write: it exits 0, quietly too
+    assert done.returncode == (0 if argv == ["--help"] else ExitCode.BROKEN_PIPE)
+
+
+def in_terminal(*argv: str, columns: int = 60, **env: str) -> str:
+    """The output of ``frictionlab ARGV`` on a pseudo-terminal ``columns`` wide."""
+    main, child = pty.openpty()
+    environment = {k: v for k, v in os.environ.items() if k != "NO_COLOR"}
+    environment.update(COLUMNS=str(columns), LINES="40", TERM="xterm-256color", **env)
+    process = subprocess.Popen([sys.executable, "-m", "frictionlab", *argv], stdin=child, stdout=child, stderr=child,
+                               env=environment, close_fds=True)  # fmt: skip
+    os.close(child)
+    chunks = []
+    while True:
+        try:
+            chunk = os.read(main, 65536)
+        except OSError:  # the child closed its side
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    process.wait(timeout=60)
+    os.close(main)
+    return b"".join(chunks).decode("utf-8", "replace")
+
+
+def test_tables_fit_the_terminal_width_and_wrap_rather_than_cut():
+    text = in_terminal("plugins", columns=60)
+    lines = [ANSI.sub("", line) for line in text.replace("\r", "").splitlines() if line.strip()]
+    assert lines and max(map(len, lines)) <= 60, max(lines, key=len)
+    assert "power-law" in "".join(lines) and "forward-difference" in "".join(lines)
+    piped = run_cli("plugins").stdout  # in a pipe: one line per plugin, however long
+    assert max(map(len, piped.splitlines())) > 60 and not ANSI.search(piped)
+
+
+def test_colour_on_a_terminal_only_and_never_with_no_color():
+    assert COLOUR.search(in_terminal("presets"))
+    assert not COLOUR.search(in_terminal("presets", NO_COLOR="1"))
+    assert not COLOUR.search(run_cli("presets").stdout)
+    error = in_terminal("run", "no-such-preset")
+    assert COLOUR.search(error) and "error" in ANSI.sub("", error)
+    assert not COLOUR.search(in_terminal("run", "no-such-preset", NO_COLOR="1"))
+
+
+def bash_complete(script: str, *words: str) -> list[str]:
+    line = " ".join(shlex.quote(w) for w in words)
+    code = f'source {shlex.quote(script)}\nCOMP_WORDS=({line})\nCOMP_CWORD={len(words) - 1}\n_frictionlab\nprintf "%s\\n" "${{COMPREPLY[@]}}"'
+    done = subprocess.run(["bash", "--norc", "-c", code], capture_output=True, text=True, timeout=30)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.split()
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="bash is not installed")
+def test_bash_completion_sourced_in_bash_completes_commands_options_and_presets(tmp_path):
+    script = tmp_path / "frictionlab.bash"
+    script.write_text(run_cli("completion", "bash").stdout)
+    assert set(bash_complete(str(script), "frictionlab", "re")) == {"resume", "report"}
+    assert set(bash_complete(str(script), "frictionlab", "")) >= set(NAMES)
+    assert "--no-plot" in bash_complete(str(script), "frictionlab", "run", "--no")
+    assert "quickstart" in bash_complete(str(script), "frictionlab", "run", "qu")
+    assert bash_complete(str(script), "frictionlab", "completion", "f") == ["fish"]
+    assert "benad2012-fig2" in bash_complete(str(script), "frictionlab", "presets", "copy", "bena")
+
+
+def test_zsh_and_fish_scripts_name_every_command():
+    zsh = run_cli("completion", "zsh").stdout
+    assert zsh.startswith("#compdef frictionlab\n") and "bashcompinit" in zsh and "complete -o filenames -F _frictionlab" in zsh
+    fish = run_cli("completion", "fish").stdout
+    for name in NAMES:
+        assert f"-n __fish_use_subcommand -a {name} " in fish
+    assert "-n '__fish_seen_subcommand_from run' -l no-plot" in fish
+    if shutil.which("fish"):
+        done = subprocess.run(["fish", "--no-execute"], input=fish, capture_output=True, text=True, timeout=30)
+        assert done.returncode == 0, done.stderr
+
+
+def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path):
+    done = run_cli("study", "quickstart", "--axes", "realizations", "--grid-realizations", "4", "--repeats", "1",
+                   "--json", "--quiet", "--out", tmp_path / "study")  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert out["recommendation"] and not out["interrupted"]
+    assert {row["axis"] for row in out["rows"]} == {"realizations"}
+    assert (tmp_path / "study" / "study.csv").is_file() and out["files"]["csv"].endswith("study.csv")

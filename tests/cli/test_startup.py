@@ -1,0 +1,35 @@
+"""Start-up costs nothing it need not: what a command imports, checked in a fresh process
+(the times themselves are measured by benchmarks/bench_startup.py, not asserted here)."""
+
+import subprocess
+import sys
+
+from ..conftest import PRESETS
+
+HEAVY = ("numpy", "pydantic", "scipy", "matplotlib", "rich", "textual", "importlib.metadata")
+
+
+def imported_after(code: str) -> set[str]:
+    probe = f"import sys\n{code}\nprint(sorted(m for m in {HEAVY!r} if m in sys.modules))"
+    result = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    return set(eval(result.stdout.strip().splitlines()[-1]))
+
+
+def test_help_imports_nothing_heavy():
+    code = "from frictionlab.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass"
+    assert imported_after(code) == set()
+
+
+def test_a_line_run_without_plot_imports_neither_scipy_nor_matplotlib(tmp_path):
+    quickstart = PRESETS / "quickstart.yaml"
+    code = f"from frictionlab.cli import main\nmain(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet', '--no-plot'])"
+    assert imported_after(code) & {"scipy", "matplotlib"} == set()
+    assert (tmp_path / "o" / "summary.json").is_file() and not (tmp_path / "o" / "plot.png").exists()
+
+
+def test_the_figure_imports_matplotlib_only_when_drawn(tmp_path):
+    quickstart = PRESETS / "quickstart.yaml"
+    code = f"from frictionlab.cli import main\nmain(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet'])"
+    assert "matplotlib" in imported_after(code)
+    assert (tmp_path / "o" / "plot.png").is_file()

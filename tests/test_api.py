@@ -1,0 +1,148 @@
+"""The Python API: ``frictionlab.run`` in every input form, overrides, ``Result``
+(table, pandas, plot, caveats) and ``frictionlab.load`` reading a CLI run back."""
+
+from __future__ import annotations
+
+import doctest
+import json
+import subprocess
+import sys
+import types
+
+import numpy as np
+import pytest
+import yaml
+
+import frictionlab
+from frictionlab import api
+from frictionlab.errors import FrictionlabError, PresetError, RunFolderError
+from frictionlab.preset import Preset
+
+from .cli.conftest import run_cli
+from .conftest import PRESETS, SMALL_PRESET
+
+FAST = {"workers": 1, "progress": False}
+
+
+def test_the_docstring_examples_run():
+    failures, tried = doctest.testmod(api, optionflags=doctest.ELLIPSIS)
+    assert tried > 5 and failures == 0
+
+
+def test_every_input_form_gives_the_same_numbers(tmp_path):
+    path = tmp_path / "small.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    forms = [path, str(path), path.read_text(), dict(SMALL_PRESET), Preset.model_validate(SMALL_PRESET)]
+    results = [frictionlab.run(form, **FAST) for form in forms]
+    for result in results[1:]:
+        assert result.fit == results[0].fit
+        np.testing.assert_array_equal(result.table["xi"], results[0].table["xi"])
+    assert results[0].folder is None and results[0].realizations == (8, 8)
+
+
+def test_overrides_by_dict_and_by_double_underscore_agree_and_are_applied():
+    by_dict = frictionlab.run(SMALL_PRESET, {"spectrum.params.hurst": 0.5, "seed": 3}, **FAST)
+    by_keywords = frictionlab.run(SMALL_PRESET, spectrum__params__hurst=0.5, seed=3, **FAST)
+    plain = frictionlab.run(SMALL_PRESET, **FAST)
+    assert by_dict.fit == by_keywords.fit != plain.fit
+    assert by_dict.preset["spectrum"]["params"]["hurst"] == 0.5 and by_dict.preset["seed"] == 3
+    assert SMALL_PRESET["spectrum"]["params"]["hurst"] == 0.8  # the caller's dict is left as it was
+
+
+def test_bad_input_is_a_clear_error_naming_the_field():
+    with pytest.raises(PresetError, match="spectrum.params.hurst"):
+        frictionlab.run(SMALL_PRESET, spectrum__params__hurst=7.0, **FAST)
+    with pytest.raises(FrictionlabError, match="did you mean 'quickstart'"):
+        frictionlab.run("quickstrt", **FAST)
+    with pytest.raises(FrictionlabError, match="preset must be"):
+        frictionlab.run(42, **FAST)
+    with pytest.raises(FrictionlabError, match="a sweep writes a run folder per point: give out=FOLDER"):
+        frictionlab.run(PRESETS / "benad2012-fig5.yaml", **FAST)
+
+
+def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
+    sweep = {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    result = frictionlab.run(SMALL_PRESET, out=tmp_path / "sweep", sweep=sweep, plot=False, **FAST)
+    assert isinstance(result, api.SweepResult) and result.status == "completed"
+    assert result.parameters == ["spectrum.params.hurst"] and [r["spectrum.params.hurst"] for r in result.rows] == [0.5, 0.9]
+    for row, point in zip(result.rows, result.points, strict=True):
+        alone = frictionlab.run(SMALL_PRESET, spectrum__params__hurst=row["spectrum.params.hurst"], **FAST)
+        assert point.fit == alone.fit and row["a"] == alone.fit.a and row["b_hi"] == alone.fit.b_ci[1]
+    assert frictionlab.load(tmp_path / "sweep").rows == result.rows
+    assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
+
+
+def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path):
+    folder = tmp_path / "cli-run"
+    result = run_cli("run", "quickstart", "--out", folder, "--quiet", "--workers", "2", "--set", "realizations=12")
+    assert result.returncode == 0, result.stderr
+    loaded = frictionlab.load(folder)
+    again = frictionlab.run("quickstart", realizations=12, **FAST)  # in memory, one worker: the same numbers
+    assert loaded.fit == again.fit and loaded.fit.bootstrap > 0
+    for name, values in again.table.items():
+        np.testing.assert_array_equal(loaded.table[name], values, err_msg=name)
+    assert loaded.realizations == (12, 12) and loaded.folder == folder
+    assert loaded.preset == again.preset and loaded.normalisation == again.normalisation
+    assert loaded.files["plot"].is_file()
+    with pytest.raises(RunFolderError, match="no summary.json"):
+        frictionlab.load(tmp_path)
+
+
+def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path):
+    r = frictionlab.run(SMALL_PRESET, out=tmp_path / "a", plot=False, **FAST)
+    assert {p.name for p in (tmp_path / "a").iterdir()} >= {"summary.json", "curve.csv", "preset.yaml"}
+    assert not (tmp_path / "a" / "plot.png").exists()
+    assert "plot" not in json.loads((tmp_path / "a" / "summary.json").read_text())["files"]
+    drawn = frictionlab.run(SMALL_PRESET, out=tmp_path / "b", **FAST)
+    assert json.loads((tmp_path / "b" / "summary.json").read_text())["files"]["plot"] == "plot.png"
+    assert drawn.fit == r.fit  # the figure changes no number
+
+
+def test_to_pandas_gives_a_frame_with_pandas_and_the_arrays_without(monkeypatch):
+    result = frictionlab.run(SMALL_PRESET, **FAST)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # as if not installed
+    arrays = result.to_pandas()
+    assert set(arrays) == {"F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"}
+    fake = types.ModuleType("pandas")
+    fake.DataFrame = lambda data: ("frame", data)
+    monkeypatch.setitem(sys.modules, "pandas", fake)
+    kind, data = result.to_pandas()
+    assert kind == "frame" and data["xi"] is result.table["xi"]
+
+
+def test_plot_draws_the_points_and_the_fit_on_the_given_axes():
+    from matplotlib.figure import Figure
+
+    result = frictionlab.run(SMALL_PRESET, **FAST)
+    ax = Figure().subplots()
+    assert result.plot(ax) is ax
+    points, fit_line = ax.lines[0], ax.lines[1]
+    np.testing.assert_array_equal(points.get_ydata(), result.table["xi"])
+    x, y = fit_line.get_data()
+    np.testing.assert_allclose(y, result.fit.a + result.fit.b * np.log(x))
+    assert ax.get_xscale() == "log" and ax.get_title() == "small"
+
+
+def test_few_contacts_at_the_first_load_carry_a_caveat_everywhere(tmp_path):
+    tiny = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1e-6}}
+    result = frictionlab.run(tiny, out=tmp_path / "tiny", **FAST)
+    assert result.table["contact_count"][0] < 3
+    assert len(result.caveats) == 1 and "fewer than 3 points in contact" in result.caveats[0]
+    assert json.loads((tmp_path / "tiny" / "summary.json").read_text())["caveats"] == result.caveats
+    ax = __import__("matplotlib.figure").figure.Figure().subplots()
+    result.plot(ax)
+    assert any("caveat: fewer than 3" in t.get_text() for t in ax.texts)
+    assert frictionlab.run(SMALL_PRESET, **FAST).caveats == []
+
+
+def test_import_frictionlab_imports_neither_the_api_nor_matplotlib_nor_scipy():
+    code = "import sys, frictionlab; print(sorted(m for m in ('frictionlab.api', 'matplotlib', 'scipy', 'rich') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+    assert callable(frictionlab.run) and frictionlab.Result is api.Result
+
+
+def test_every_public_name_resolves_lazily():
+    code = "import frictionlab; [getattr(frictionlab, n) for n in frictionlab.__all__]; from frictionlab import *; print('ok')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.strip() == "ok", done.stderr

@@ -1,0 +1,106 @@
+"""The built-in presets: listed from the package, run by name, copied out, and
+shipped inside a real (non-editable) install that works from an empty folder."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+import frictionlab
+
+from frictionlab.errors import ExitCode, PresetFileError
+from frictionlab.preset.builtin import builtin_presets, find_builtin, resolve_preset_path
+
+from .cli.conftest import run_cli
+from .conftest import PRESETS, ROOT
+
+
+def test_every_preset_of_the_folder_is_listed_with_its_own_description():
+    listed = {p.name: p for p in builtin_presets()}
+    assert set(listed) == {p.stem for p in PRESETS.glob("*.yaml")}
+    for name, preset in listed.items():
+        assert preset.path.is_file() and preset.path.name == f"{name}.yaml"
+        own = " ".join(yaml.safe_load(preset.path.read_text())["description"].split())
+        words = preset.description.removesuffix(" ...")
+        assert own.startswith(words) and 10 < len(preset.description) <= 104, preset.description
+
+
+def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert resolve_preset_path("quickstart") == find_builtin("quickstart.yaml").path
+    mine = tmp_path / "quickstart.yaml"
+    assert resolve_preset_path(mine) == mine  # a path is never swapped for a built-in
+    with pytest.raises(PresetFileError, match=r"did you mean 'quickstart'\?"):
+        resolve_preset_path("quikstart")
+    with pytest.raises(PresetFileError, match=r"no file 'quickstart.yaml' here; the built-in preset of that name is 'quickstart'"):
+        resolve_preset_path("quickstart.yaml")  # from a folder without that file
+
+
+def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):
+    listed = json.loads(run_cli("presets", "--json").stdout)
+    assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
+    result = run_cli("presets", "copy", "quickstart", tmp_path)
+    assert result.returncode == 0, result.stderr
+    copy = tmp_path / "quickstart.yaml"
+    assert copy.read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
+    copy.write_text("mine")
+    result = run_cli("presets", "copy", "quickstart", copy)
+    assert result.returncode == ExitCode.OUTPUT_REFUSED and "--force" in result.stderr
+    assert copy.read_text() == "mine"
+    assert run_cli("presets", "copy", "quickstart", copy, "--force").returncode == 0
+    assert copy.read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
+    result = run_cli("presets", "copy", "fig2")
+    assert result.returncode == ExitCode.USAGE and "benad2012-fig2" in result.stderr
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> Path:
+    """frictionlab installed as a user would (a built wheel, not editable), offline,
+    into a folder of its own; returns that folder, to put on PYTHONPATH."""
+    work = tmp_path_factory.mktemp("install")
+    source = work / "src"
+    source.mkdir()
+    for name in ("frictionlab", "plugins", "presets"):
+        shutil.copytree(ROOT / name, source / name, ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    for name in ("pyproject.toml", "setup.py", "README.md"):
+        shutil.copy(ROOT / name, source / name)
+    target = work / "site"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env.update(PIP_NO_INDEX="1", PIP_DISABLE_PIP_VERSION_CHECK="1", PIP_NO_INPUT="1")
+    result = subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation", "--no-index",
+         "--target", str(target), str(source)],
+        capture_output=True, text=True, env=env, timeout=300,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    return target
+
+
+def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, tmp_path):
+    empty = tmp_path / "anywhere"
+    empty.mkdir()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FRICTIONLAB_")}
+    env["PYTHONPATH"] = str(installed)
+
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "frictionlab", *args], capture_output=True, text=True,
+                              cwd=empty, env=env, timeout=300)  # fmt: skip
+
+    listed = json.loads(cli("presets", "--json").stdout)
+    assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
+    for row in listed:  # the installed copies, not the checkout's
+        assert Path(row["path"]).is_relative_to(installed / "frictionlab" / "builtin_presets")
+    result = cli("run", "quickstart", "--out", "q", "--quiet", "--workers", "1", "--no-plot")
+    assert result.returncode == 0, result.stderr
+    assert (empty / "q" / "summary.json").is_file() and "a  " in result.stdout
+    code = "import frictionlab; r = frictionlab.run('quickstart', progress=False); print(frictionlab.__file__, r.fit.a, r.fit.b)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=empty, env=env, timeout=300)
+    where, a, b = done.stdout.split()
+    assert Path(where).is_relative_to(installed) and float(a) == frictionlab.load(empty / "q").fit.a

@@ -1,0 +1,411 @@
+"""What a person sees and what each key does, checked on the screen itself (its
+text at 80x24 or 120x40), not only in the app's state: text shown verbatim,
+names and paths that fit, messages in the status line, focus where the problem
+is, no keystroke lost."""
+
+import asyncio
+import json
+from pathlib import Path
+from typing import ClassVar, Literal
+
+import numpy as np
+import pytest
+import yaml
+from pydantic import Field
+from textual.widgets import Input
+
+from frictionlab import PluginParams, SlopeEstimator
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.options import RunOptions
+from frictionlab.preset import load_scene
+from frictionlab.preset.builtin import find_builtin
+from frictionlab.tui.app import FrictionlabApp
+from frictionlab.tui.screens import PathScreen
+
+from ..conftest import merge
+from .conftest import (
+    SIZE,
+    TINY,
+    make_app,
+    make_runs,
+    open_first_preset,
+    post_keys,
+    run_to_the_end,
+    screen_text,
+    status_text,
+    sync,
+    type_into,
+    wait_until,
+)
+
+BIG = (120, 40)
+BRACKETS = "Uses [bold] and [1] as written; [red]not red[/red] either."
+
+
+def write_preset(folder, name, data):
+    (folder / "presets" / f"{name}.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+# ------------------------------------------------------------------ text shown verbatim
+
+
+class BracketSlope(SlopeEstimator):
+    """A third-party plugin whose summary has square brackets (a citation, a markup tag)."""
+
+    name: ClassVar[str] = "bracket-difference"
+    summary: ClassVar[str] = "forward difference as in [1]; [bold]not bold[/bold]"
+
+    class Params(PluginParams):
+        ends: Literal["wrap [1]", "[b]cut[/b]"] = Field("[b]cut[/b]", description="ends of the line, as in [2]")
+
+    def slopes(self, heights, spacing):
+        return np.diff(heights, append=heights[:1]) / spacing
+
+
+@sync
+async def test_descriptions_summaries_and_names_show_their_brackets(folders, register_plugin):
+    registry = register_plugin(BracketSlope)
+    write_preset(folders, "tiny", merge(TINY, {"description": BRACKETS, "slope": {"name": "bracket-difference"}}))
+    make_runs(folders, registry)
+    (folders / "runs" / "seed1").rename(folders / "runs" / "try[1]")
+    app = make_app(registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        presets_tab = screen_text(app)
+        await open_first_preset(pilot)
+        app.query_one("#plugin--slope").focus()  # its summary is under the select
+        await pilot.pause()
+        edit_tab = screen_text(app)
+        await pilot.press("f5")
+        await pilot.pause()
+        results_tab = screen_text(app)
+    assert BRACKETS in presets_tab
+    assert BracketSlope.summary in edit_tab
+    assert "[b]cut[/b]" in edit_tab  # a choice's text
+    assert "try[1]" in results_tab
+
+
+# ------------------------------------------------------------------ layouts that fit and grow
+
+
+LONG_NAME = "a-longer-study-20261125-210620"
+
+
+@pytest.mark.parametrize("size", [SIZE, BIG])
+@sync
+async def test_run_names_use_the_width_they_have(folders, registry, size):
+    make_runs(folders, registry)
+    (folders / "runs" / "seed1").rename(folders / "runs" / LONG_NAME)
+    app = make_app(registry)
+    async with app.run_test(size=size) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        await pilot.pause()
+        shown = screen_text(app)
+    if size == BIG:
+        assert LONG_NAME in shown  # 30 characters: whole at 120 columns
+    else:  # shortened from the middle: where it starts and its time stamp stay
+        assert "a-longer…5-210620" in shown
+
+
+@sync
+async def test_the_run_header_shows_the_output_folder_at_80_columns(folders, registry, tmp_path):
+    deep = tmp_path / "a-folder-with-a-long-name" / "and-another-one-below-it" / "runs"
+    app = make_app(registry, preset="presets/tiny.yaml")
+    app.runs_dir = deep
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        shown = screen_text(app)
+        out_dir = app.last_out_dir
+    assert len(str(out_dir)) > 80
+    assert out_dir.name in shown  # the end of the path: the run's own folder
+    assert str(out_dir)[:10] in shown  # and where it starts
+
+
+@sync
+async def test_a_long_description_is_shown_from_its_start(folders, registry):
+    description = "Starts here: " + " ".join(f"word{i}" for i in range(40)) + " ends here."
+    write_preset(folders, "tiny", merge(TINY, {"description": description}))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert "Starts here: word0" in screen_text(app)  # the presets list's line about it
+        await open_first_preset(pilot)
+        app.query_one("#field--description", Input).focus()
+        await pilot.pause()
+        shown = screen_text(app)
+    assert "Starts here: word0" in shown
+
+
+@sync
+async def test_messages_never_cover_the_data(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        toasts = list(app.query("Toast"))
+        status = status_text(app)
+        fit = str(app.query_one("#run-fit").render())
+        shown = screen_text(app)
+    assert toasts == []
+    assert status.startswith("Run completed: 8/8 realizations")
+    assert all(line in shown for line in fit.splitlines()[:4])  # the fit is on screen, whole
+
+
+# ------------------------------------------------------------------ keys
+
+
+@sync
+async def test_ctrl_r_with_a_problem_says_it_and_focuses_the_field_at_fault(folders, registry):
+    write_preset(folders, "tiny", merge(TINY, {"spectrum": {"params": {"rms_height": -1.0}}}))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#field--seed").focus()
+        await pilot.press("f4", "ctrl+r")
+        await pilot.pause()
+        focused = app.focused.id
+        status = status_text(app)
+        shown = screen_text(app)
+    assert focused == "field--spectrum--params--rms_height"
+    assert status == "Cannot run: 1 problem: spectrum.params.rms_height: must be > 0.0, got -1.0"
+    assert "rms_height" in shown and "-1.0" in shown  # the field scrolled into view
+
+
+CANNOT_ACT = [  # pressed one after the other, in an app with no preset and no run
+    (["ctrl+r"], "No preset open"),
+    (["ctrl+s"], "No preset open"),
+    (["ctrl+o"], "No preset open"),
+    (["enter"], "No preset to open here"),
+    (["d"], "No preset to duplicate here"),
+    (["f4", "c"], "No run is going"),
+    (["f5", "space"], "No runs yet"),
+    (["enter"], "No runs yet"),
+]
+
+
+@sync
+async def test_every_key_that_cannot_act_says_why(tmp_path, monkeypatch, registry):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "presets").mkdir()  # nothing to open, nothing run
+    app = make_app(registry)
+    said = []
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        for keys, _ in CANNOT_ACT:
+            app.query_one("#status").update("")
+            await pilot.press(*keys)
+            said.append(status_text(app))
+    for (keys, expected), status in zip(CANNOT_ACT, said, strict=True):
+        assert status.startswith(expected), (keys, status)
+
+
+@sync
+async def test_tab_in_the_results_tab_stops_only_where_focus_shows(folders, registry):
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        stops = []
+        for _ in range(3):
+            await pilot.press("tab")
+            stops.append(app.focused.id)
+    assert stops == ["runs-table"] * 3
+
+
+@pytest.mark.parametrize("gap", [0.03, 0.0], ids=["30ms", "burst"])
+@sync
+async def test_six_keys_typed_into_a_cleared_field_all_arrive(folders, registry, gap):
+    """Found in tmux: Ctrl+U and the keys after it in one burst left the field empty.
+    Textual ran Ctrl+U's binding only after it bubbled up to the app, by which time
+    the printable keys behind it were inserted, and then cleared."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        field = app.query_one("#field--spectrum--params--hurst", Input)
+        field.focus()
+        await pilot.press("end")
+        post_keys(app, ["ctrl+u"])
+        for character in "0.7531":
+            post_keys(app, [character])
+            await asyncio.sleep(gap)
+        await wait_until(pilot, lambda: len(field.value) >= 6, timeout=5)
+        await pilot.pause()
+        value, data = field.value, app.query_one("#form").data
+    assert value == "0.7531"
+    assert data["spectrum"]["params"]["hurst"] == 0.7531
+
+
+@sync
+async def test_home_then_a_key_types_at_the_start(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        field = app.query_one("#field--name", Input)
+        field.focus()
+        await pilot.press("end")
+        post_keys(app, ["home", "x"])
+        await wait_until(pilot, lambda: "x" in field.value, timeout=5)
+        value = field.value
+    assert value == "xsmall"
+
+
+@sync
+async def test_f1_shows_and_hides_the_key_panel_of_the_focused_part(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f1")
+        await pilot.pause()
+        presets_keys = screen_text(app)
+        await pilot.press("f5")
+        await pilot.pause()
+        results_keys = screen_text(app)
+        await pilot.press("f1")
+        await pilot.pause()
+        hidden = not app.screen.query("HelpPanel")
+    assert "Duplicate" in presets_keys and "Compare" not in presets_keys
+    assert "Compare" in results_keys and "Duplicate" not in results_keys
+    assert hidden
+
+
+# ------------------------------------------------------------------ run-time input errors
+
+
+def profile_preset(folders, content):
+    (folders / "presets" / "line.csv").write_text(content)
+    data = {**TINY, "spectrum": {"name": "profile-file", "params": {"path": "line.csv", "spacing": 1.0}}}
+    write_preset(folders, "tiny", data)
+
+
+@sync
+async def test_a_profile_file_beside_the_preset_is_found_by_the_form(folders, registry):
+    profile_preset(folders, "\n".join(str(x) for x in np.random.default_rng(1).normal(size=256)))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        problems = app.problems
+    assert problems == []  # as `frictionlab validate presets/tiny.yaml` says
+    assert main(["validate", "presets/tiny.yaml"]) == ExitCode.OK
+
+
+@sync
+async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, registry):
+    profile_preset(folders, "1\n2\n")
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        (folders / "presets" / "line.csv").unlink()  # gone after the preset was opened
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        status, focused = status_text(app), app.focused.id
+        panel = str(app.query_one("#problems").render())
+    assert not app.running and app.last_out_dir is None
+    assert focused == "field--spectrum--params--path"
+    assert "spectrum.params.path: no such file" in panel  # the form says it too, not "valid"
+    assert status.startswith("Cannot run: 1 problem: spectrum.params.path: no such file")
+    assert "presets/line.csv'" in status  # the file beside the preset (the core shortens a long path)
+
+
+@sync
+async def test_an_unreadable_profile_file_fails_the_run_with_its_message(folders, registry):
+    profile_preset(folders, "1.0\nabc\n")
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        status = status_text(app)
+        stats = str(app.query_one("#run-stats").render())
+        error = str(app.query_one("#run-error").render())
+    assert status.startswith("Run failed: no realization finished: profile-file")
+    assert "non-numeric content at line 2" in status
+    for text in (status, error):  # what the user can act on, not the internals
+        assert "ValueError" not in text and ".py:" not in text
+    assert stats.startswith("failed: 0/8 realizations")
+
+
+# ------------------------------------------------------------------ New
+
+
+@sync
+async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_current_folder(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("n")
+        await pilot.pause()
+        await pilot.press("ctrl+u", *"fresh", "enter")
+        await pilot.pause()
+        problems, path = app.problems, app.draft_path
+        assert not (folders / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+    assert problems == []
+    assert path == Path("fresh.yaml")
+    quickstart = find_builtin("quickstart").path  # the template offered first: it runs in about a second
+    assert yaml.safe_load((folders / "fresh.yaml").read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
+    assert quickstart.read_text().splitlines()[0] in (folders / "fresh.yaml").read_text()  # its comments kept
+    assert load_scene(folders / "fresh.yaml", registry=registry).preset.name == "fresh"
+    assert main(["run", "fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
+    assert json.loads((folders / "runs" / "fresh" / "summary.json").read_text())["status"] == "completed"
+
+
+@sync
+async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, registry):
+    (folders / "fresh.yaml").write_text("keep me\n")
+    (folders / "elsewhere").mkdir()
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("n")
+        await pilot.pause()
+        await pilot.press("ctrl+u", *"fresh", "enter")
+        await pilot.pause()
+        refused = str(app.screen.query_one("#new-error").render())
+        app.screen.query_one("#new-path", Input).focus()
+        await pilot.press("ctrl+u", *"elsewhere/fresh", "enter")
+        await pilot.pause()
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+    assert "exists" in refused
+    assert (folders / "fresh.yaml").read_text() == "keep me\n"
+    assert load_scene(folders / "elsewhere" / "fresh.yaml", registry=registry).preset.name == "fresh"
+
+
+@sync
+async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monkeypatch, registry):
+    monkeypatch.chdir(tmp_path)  # no ./presets here: the built-in ones are listed beside the user's
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    quickstart = find_builtin("quickstart").path
+    original = quickstart.read_text()
+    app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        listed = screen_text(app)
+        await app.open_preset(quickstart)
+        await type_into(pilot, "field--realizations", "20")
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        asked = isinstance(app.screen, PathScreen)
+        app.screen.query_one(Input).value = "mine.yaml"
+        await pilot.press("enter")
+        await pilot.pause()
+    assert "quickstart" in listed and "built-in" in listed
+    assert asked and quickstart.read_text() == original
+    assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
+
+
+@sync
+async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders, registry):
+    (folders / "runs").write_text("a file where the runs folder should be\n")
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: not app.running)
+        await pilot.pause()
+        status = status_text(app)
+        error = str(app.query_one("#run-error").render())
+    assert status.startswith("Run failed: runs/small-") and "runs is a file" in status
+    assert "Traceback" not in error and "Error" not in status
+    assert (folders / "runs").read_text().startswith("a file")  # left as it was
