@@ -37,6 +37,18 @@ def preset_name(hurst: float) -> str:
     return f"exact3d-h{round(hurst * 10):02d}.yaml"
 
 
+def find_presets(presets_dir: str | Path | None, plan: Plan) -> Path:
+    """``presets_dir``, or else ./presets if it holds the family, else the built-in presets."""
+    from ..preset.builtin import builtin_folder
+
+    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
+    for folder in candidates:
+        if all((folder / preset_name(h)).is_file() for h in plan.hursts):
+            return folder
+    wanted = ", ".join(preset_name(h) for h in plan.hursts)
+    raise FrictionlabError(f"--presets: no folder with {wanted}; looked in {', '.join(map(str, candidates))}")
+
+
 @dataclass(frozen=True)
 class Plan:
     """Grids and ensembles of one study. The last resolution is the result's; ``extra``

@@ -20,7 +20,7 @@ from ..seeds import bootstrap_rng, realization_rng
 from .analysis import SMALL_LOAD_FRACTION, Kappa, contact_area_law
 from .figures import plot_convergence, plot_xi_against_f
 from .markdown import YASTREBOV, answer, convergence_table, ensemble_text, law_table, paired_extra_grids
-from .plan import FULL, QUICK, Plan, StudyRuns, preset_name, run_plan
+from .plan import FULL, QUICK, Plan, StudyRuns, find_presets, preset_name, run_plan
 
 PAGE = "exact-3d-law.md"
 FIGURES_DIR = "exact-3d-law"
@@ -83,7 +83,7 @@ def write_page(
     *,
     runs_dir: str | Path | None = None,
     quick: bool = False,
-    presets_dir: str | Path = "presets",
+    presets_dir: str | Path | None = None,
     options: RunOptions = RunOptions(),
     plan: Plan | None = None,
     command: str | None = None,
@@ -97,7 +97,7 @@ def write_page(
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
-    runs = run_plan(Path(presets_dir), runs_dir, plan, options, log=log)
+    runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
     kappas = kappas_of(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
     atomic_write(figures / FIGURES[0], lambda fh: plot_xi_against_f(runs, fh, kappas, dpi=dpi), binary=True)

@@ -94,3 +94,11 @@ def test_every_grid_samples_the_same_surfaces(registry, hurst):
     for index in (0, 5):  # the full plan's grids (on 64^2 the short cut-off is at the Nyquist mode: not these)
         coarse, fine = heights(128, index), heights(512, index)
         np.testing.assert_allclose(fine[::4, ::4], coarse, rtol=0, atol=1e-12 * coarse.std())
+
+
+def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, capsys):
+    code = main(["exact3d", "--quick", "--presets", str(tmp_path), "--out", str(tmp_path / "out"), "--quiet"])
+    assert code == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "--presets" in err and "exact3d-h03.yaml" in err and str(tmp_path) in err
+    assert not (tmp_path / "out").exists()
