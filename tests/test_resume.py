@@ -76,10 +76,12 @@ def test_cancelled_run_resumes_to_the_uninterrupted_numbers(make_scene, tmp_path
 
 def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
     scene = make_scene({"realizations": 12, **NO_PLOT})
-    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     before = (tmp_path / "run" / "curve.csv").read_text()
     again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
     assert again.extra["resumed"] == 12 and again.done == 12
+    # what the realizations cost is read back with them, however little the resume took
+    assert first.compute_seconds > 0 and again.compute_seconds == first.compute_seconds
     assert (tmp_path / "run" / "curve.csv").read_text() == before
 
 

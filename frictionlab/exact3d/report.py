@@ -184,7 +184,9 @@ def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) ->
         "with load depends on the breadth of the spectrum, measured by the Nayak parameter α = m0 m4 / m2² "
         "(m_n the spectral moments of a profile; 1 for a single wave, large for a broad band). The α of these "
         "surfaces is in the first table (computed from the spectrum of one surface of each grid). Here the "
-        "convergence is shown, not corrected: the same a, b and κ on each grid.",
+        "convergence is shown, not corrected: the same a, b and κ on each grid. The compute time is the "
+        "surfaces' solve times summed (seconds of one core), kept in the run folders, so a regenerated page "
+        "shows what the runs cost, not what reading them back took.",
         "",
         *convergence_table(runs, kappas),
         "",
