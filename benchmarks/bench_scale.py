@@ -8,8 +8,9 @@ same process (or, for peak memory, in a fresh one per size):
 * cost per realization against N (1e3..1e7, at 400 steps) and against the
   number of force steps (10..1e4, at N = 1e5): time / (N log2 N) should stay
   flat in N, and the time flat in steps;
-* the Fig. 2 scene with each executor (serial; processes 1, 2; Dask
-  LocalCluster of 2, cluster start excluded), efficiency = serial / (workers x time);
+* the Fig. 2 scene and an exact 3D ensemble (exact3d-h08 on 128^2 pixels, 32 surfaces) with each
+  executor (serial; processes 1, 2; Dask LocalCluster of 2, cluster start and the
+  workers' first import excluded), efficiency = serial / (workers x time);
 * overhead per task of each executor (tiny realizations, one per task);
 * the Fig. 2 scene end to end (run + chunk files + result files and plot) with
   the default executor.
@@ -31,6 +32,7 @@ import time
 from pathlib import Path
 
 from frictionlab import engine
+from frictionlab.dask_security import WORKER_CONFIG
 from frictionlab.executors import make_executor
 from frictionlab.options import RunOptions
 from frictionlab.preset import load_scene
@@ -101,13 +103,34 @@ def cost_against_n_and_steps(repeat: int) -> None:
         print(f"  {steps:>6} steps: {seconds * 1e3:7.3f} ms  ({seconds / base:5.2f} x 10 steps)")
 
 
+SURFACE_PRESET = PRESET.parent / "exact3d-h08.yaml"
+
+
+def efficiency_rows(scene, repeat: int) -> list[tuple[str, int, float]]:
+    """(executor, workers, best seconds) of ``scene`` run serially and on 1 and 2 processes
+    (before any Dask cluster starts: its threads would make the pool use forkserver)."""
+    rows = [("serial", 1, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=1, executor="serial"))))]
+    for workers in (1, 2):
+        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=workers, executor="processes")))))
+    return rows
+
+
+def dask_row(scene, repeat: int, address: str) -> tuple[str, int, float]:
+    return ("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address))))
+
+
+def print_efficiencies(title: str, rows) -> None:
+    serial = rows[0][2]
+    print(f"{title} (efficiency = serial / (workers x time)):")
+    for name, workers, seconds in rows:
+        print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")
+
+
 def executors(repeat: int, skip_dask: bool) -> None:
     scene = load_scene(PRESET)
     m = scene.preset.realizations
-    serial = best_of(repeat, lambda: engine.run(scene, RunOptions(workers=1, executor="serial")))
-    rows = [("serial", 1, serial)]
-    for workers in (1, 2):
-        rows.append(("processes", workers, best_of(repeat, lambda: engine.run(scene, RunOptions(workers=workers, executor="processes")))))
+    # exact 3D ensembles: the family's preset on 128^2 pixels, 32 surfaces (about 0.15 s each)
+    surface = load_scene(SURFACE_PRESET, ["spectrum.params.points=128", "realizations=32"])
     tiny = load_scene(PRESET, ["spectrum.params.points=64", "spectrum.params.length=64.0", "loading.steps=2"])
     tasks = [[i] for i in range(400)]
     never = threading.Event()
@@ -118,18 +141,25 @@ def executors(repeat: int, skip_dask: bool) -> None:
         return (wall - compute) / len(tasks)
 
     overheads = [("serial", overhead(make_executor(RunOptions(executor="serial"), 1))), ("processes (2, pool start included)", overhead(make_executor(RunOptions(executor="processes"), 2)))]
+    rows, rows_3d = efficiency_rows(scene, repeat), efficiency_rows(surface, min(repeat, 2))
     if not skip_dask:
+        import dask
         import distributed
 
-        with distributed.LocalCluster(
+        with dask.config.set(WORKER_CONFIG), distributed.LocalCluster(  # the workers frictionlab's own cluster has
             n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
         ) as cluster:
             address = cluster.scheduler_address
-            rows.append(("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address)))))
+            engine.run(scene, RunOptions(executor="dask", scheduler=address))  # the workers import frictionlab once
+            rows.append(dask_row(scene, repeat, address))
+            rows_3d.append(dask_row(surface, min(repeat, 2), address))
             overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
-    print(f"Fig. 2 scene ({m} realizations), executors (efficiency = serial / (workers x time)):")
-    for name, workers, seconds in rows:
-        print(f"  {name:18} {workers} worker(s): {seconds:7.3f} s   speed-up {serial / seconds:5.2f}   efficiency {serial / (workers * seconds):5.2f}")
+    print_efficiencies(f"Fig. 2 scene ({m} realizations), executors", rows)
+    print_efficiencies(f"Exact 3D ensemble ({SURFACE_PRESET.name} on 128^2 pixels, 32 surfaces), executors", rows_3d)
+    # the engine runs the first realization alone (its time sizes the chunks): with M equal
+    # realizations on W workers the efficiency is at most M / (W (1 + ceil((M - 1) / W)))
+    bound = 32 / (2 * (1 + math.ceil(31 / 2)))
+    print(f"  (bound for 32 equal realizations on 2 workers, the first run alone: {bound:.2f})")
     print("Overhead per task (400 one-realization tasks of a 64-point line):")
     for name, seconds in overheads:
         print(f"  {name:36} {seconds * 1e3:8.3f} ms")

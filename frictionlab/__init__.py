@@ -24,7 +24,7 @@ _LAZY = {
     **dict.fromkeys(
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
-            "SlopeEstimator", "SpectrumGenerator", "contract", "force_unit", "mdr_length",
+            "SlopeEstimator", "SpectrumGenerator", "contract", "force_unit", "load_finished", "mdr_length",
         ),
         "plugin",
     ),  # fmt: skip
@@ -80,6 +80,7 @@ __all__ = [
     "force_unit",
     "hookimpl",
     "load",
+    "load_finished",
     "mdr_length",
     "open_regular_file",
     "run",

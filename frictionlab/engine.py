@@ -95,6 +95,9 @@ def run(
     started = time.perf_counter()
     hooks.run_started(run=info)
 
+    def load_done(index: int, done: int, total_loads: int) -> None:
+        hooks.load_done(run=info, index=index, done=done, total=total_loads)
+
     def record(results: list[RealizationResult]) -> None:
         if store is not None:
             store.save_chunk(results)
@@ -108,10 +111,10 @@ def run(
         try:
             if todo and not cancel.is_set():
                 # The first missing realization runs here: its time sizes the chunks.
-                first = compute_chunk(scene, todo[:1])
+                first = compute_chunk(scene, todo[:1], on_load=load_done)
                 record(first)
-                chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds)
-                for _, results in pool.map_chunks(scene, chunks, cancel):
+                chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
+                for _, results in pool.map_chunks(scene, chunks, cancel, on_load=load_done):
                     record(results)
         except KeyboardInterrupt:  # the second Ctrl-C or SIGTERM (Terminated)
             pass

@@ -51,9 +51,10 @@ class RunOutcome:
     force_unit: float  # k h X: the load at f = 1
     stiffness: float
     normalisation: ForceNormalisation
-    elapsed: float
+    elapsed: float  # wall time of this invocation (a resumed run counts only what it ran)
     workers: int
     error: str | None = None
+    compute_seconds: float = 0.0  # summed over the finished realizations, restored ones included
     extra: dict = field(default_factory=dict)
 
     @property
@@ -165,4 +166,5 @@ class Accumulator:
             elapsed=elapsed,
             workers=workers,
             error=error,
+            compute_seconds=float(sum(self.results[i].seconds for i in indices)),
         )

@@ -31,9 +31,9 @@ from collections.abc import Iterator, Sequence
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .errors import RunError
 from .options import RunOptions
-from .pool import JobFailed, WorkerLost, WorkerPool
+from .pool import JobFailed, WorkerLost, WorkerPool, send_progress
 from .preset import Scene
-from .realization import RealizationResult, compute_chunk
+from .realization import LoadListener, RealizationResult, compute_chunk
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -42,9 +42,10 @@ Chunk = list[int]
 
 # ------------------------------------------------------------------ chunking
 
-TARGET_CHUNK_SECONDS = 0.5  # task overhead is ~1 ms (pool) to ~5 ms (Dask): well under 2% of this
-CHUNKS_PER_WORKER = 4  # at least this many, for load balance and progress
+TARGET_CHUNK_SECONDS = 0.5  # a chunk's length when there is work enough: resume and progress granularity
+CHUNKS_PER_WORKER = 4  # at most this many per worker when chunks are short, for load balance and progress
 MAX_CHUNKS = 4096  # at most this many per run: the run folder's manifest lists every chunk
+MAX_OVERHEAD_SHARE = 0.02  # a task lasts at least 50 times its executor's overhead per task
 
 
 def plan_chunks(
@@ -54,16 +55,27 @@ def plan_chunks(
     target: float = TARGET_CHUNK_SECONDS,
     per_worker: int = CHUNKS_PER_WORKER,
     max_chunks: int = MAX_CHUNKS,
+    overhead: float = 0.0,
 ) -> list[Chunk]:
     """Split ``indices`` into consecutive chunks of about ``target`` seconds each
-    (from the measured ``seconds_each`` of one realization), but into at least
+    (from the measured ``seconds_each`` of one realization), but into up to
     ``per_worker`` chunks per worker while there are enough indices, and into
-    no more than ``max_chunks``."""
+    no more than ``max_chunks``.
+
+    ``overhead``: what the executor spends per task (submitting it, sending its
+    results). Chunks are never made so short that it exceeds ``MAX_OVERHEAD_SHARE``
+    of their work: a short run gets fewer chunks per worker, down to one each
+    (a whole number per worker keeps equal realizations balanced)."""
     indices = list(indices)
     if not indices:
         return []
-    by_cost = max(1, int(target / max(seconds_each, 1e-9)))
-    by_balance = max(1, math.ceil(len(indices) / (max(1, workers) * per_worker)))
+    seconds_each = max(seconds_each, 1e-9)
+    workers = max(1, workers)
+    by_cost = max(1, int(target / seconds_each))
+    if overhead > 0:
+        shortest = overhead / MAX_OVERHEAD_SHARE
+        per_worker = max(1, min(per_worker, int(len(indices) * seconds_each / (workers * shortest))))
+    by_balance = max(1, math.ceil(len(indices) / (workers * per_worker)))
     size = max(min(by_cost, by_balance), math.ceil(len(indices) / max_chunks))
     return [indices[i : i + size] for i in range(0, len(indices), size)]
 
@@ -80,17 +92,20 @@ class SerialExecutor:
     cancelled chunk yields what it finished."""
 
     name = "serial"
+    task_overhead = 0.0  # seconds per chunk (see ``plan_chunks``)
 
     def __init__(self):
         self.workers = 1
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
             done = []
             for index in chunk:
                 if cancel.is_set():
                     break
-                done.extend(compute_chunk(scene, [index]))
+                done.extend(compute_chunk(scene, [index], on_load))
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():
@@ -123,8 +138,12 @@ def _init_worker(scene: Scene) -> None:
     _die_with_parent()
 
 
+def _send_load(index: int, done: int, total: int) -> None:
+    send_progress((index, done, total))
+
+
 def _run_chunk(indices: Chunk) -> list[RealizationResult]:
-    return compute_chunk(_worker_scene, indices)
+    return compute_chunk(_worker_scene, indices, on_load=_send_load)
 
 
 def pool_context():
@@ -141,18 +160,22 @@ class ProcessExecutor:
     runs again after its worker died (then the run fails, naming the chunk)."""
 
     name = "processes"
+    task_overhead = 0.5e-3  # measured 0.2 ms per task, pool start included (benchmarks/bench_scale.py)
 
     def __init__(self, workers: int, retries: int = 2):
         self.workers = workers
         self.retries = retries
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         jobs = dict(enumerate(chunks))
+        on_progress = None if on_load is None else (lambda payload: on_load(*payload))
         pool = WorkerPool(
             min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
-            for key, results in pool.run(jobs, cancel):
+            for key, results in pool.run(jobs, cancel, on_progress):
                 yield jobs[key], results
         except WorkerLost as lost:
             raise RunError(
@@ -202,6 +225,7 @@ class DaskExecutor:
     rescheduled by Dask up to its ``allowed-failures``)."""
 
     name = "dask"
+    task_overhead = 5e-3  # measured 3.5-4.7 ms per task on a LocalCluster of 2 (benchmarks/bench_scale.py)
 
     def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2, dashboard: bool = False):
         self.workers = workers
@@ -216,7 +240,10 @@ class DaskExecutor:
             return client, None
         return start_local_cluster(self.workers, dashboard=self.dashboard)
 
-    def map_chunks(self, scene: Scene, chunks: list[Chunk], cancel) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+    def map_chunks(
+        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+    ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        """``on_load`` is not heard: a Dask worker reports whole chunks only."""
         distributed = import_distributed()
         client, cluster = self._connect()
         futures = []

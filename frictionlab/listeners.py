@@ -5,7 +5,8 @@ progress they share.
 * ``RunListener``: the lifecycle hooks of one ensemble run. ``engine.run``
   calls them on the listeners it is given and on the installed plugins that
   implement them, in the order ``run_started``, then ``realization_done`` or
-  ``realization_failed`` once per realization, then ``run_finished``. A
+  ``realization_failed`` once per realization (each maybe preceded by ``load_done``
+  per load of its solve), then ``run_finished``. A
   listener implements any of them, each marked ``@frictionlab.hookimpl``
   (pluggy calls marked methods only, and checks their argument names; a method
   may take fewer of the arguments).
@@ -45,12 +46,19 @@ class RunListener(Protocol):
         goes on with the others."""
 
     @hookspec
+    def load_done(self, run: RunInfo, index: int, done: int, total: int) -> None:
+        """Realization ``index`` has solved ``done`` of its ``total`` loads: a solver of
+        long loads reports each (``frictionlab.load_finished``). Heard from realizations
+        computed in this process and in a process pool's workers, not on Dask (there
+        ``realization_done`` is the finest grain)."""
+
+    @hookspec
     def run_finished(self, run: RunInfo, outcome: RunOutcome) -> None:
         """The run ended (completed, cancelled or failed). ``outcome`` is the
         ``RunOutcome`` with the statistics and the fit of what finished."""
 
 
-LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "run_finished")
+LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "load_done", "run_finished")
 
 
 class SweepListener:

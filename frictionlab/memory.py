@@ -2,7 +2,9 @@
 
 The estimate is an upper bound for the built-in line pipeline (power-law
 synthesis, a slope estimator, the sorted spring sweep), calibrated by measuring
-the growth of ``ru_maxrss`` over one realization (benchmarks/bench_scale.py):
+the growth of ``ru_maxrss`` over one realization (benchmarks/bench_scale.py); a
+solver that needs more per point declares it (``ContactSolver.bytes_per_point``,
+the boundary elements of the half-space: about 1.5x the line pipeline):
 
 * 32 bytes per grid point in the usual case (few candidate points sorted),
   97 when the largest load reaches full contact and every point is sorted;
@@ -24,6 +26,7 @@ from .preset import Scene
 MiB = 2**20
 GiB = 2**30
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
+PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
 PROCESS_BASE = 160 * MiB  # main process: interpreter, numpy, scipy, pydantic, matplotlib for the plot
 WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process (Dask: with its nanny)
@@ -73,12 +76,20 @@ def grid_points(scene: Scene) -> int:
         return 0
 
 
+def bytes_per_point(scene: Scene) -> int:
+    """Peak bytes of one realization per grid point: the solver's declaration
+    (``ContactSolver.bytes_per_point``) plus the profile and slopes it is given, never
+    less than the line pipeline's figure."""
+    declared = scene.solver.bytes_per_point
+    return BYTES_PER_POINT if declared is None else max(BYTES_PER_POINT, declared + PROFILE_BYTES_PER_POINT)
+
+
 def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = None) -> MemoryEstimate:
     points = grid_points(scene) if points is None else points
     steps = int(scene.loads.size)
     arrays = 4 if scene.control == "indentation" else 3
     kept = scene.preset.realizations * (steps * 8 * arrays * KEPT_COPIES + 512)
-    per_realization = points * BYTES_PER_POINT + steps * BYTES_PER_STEP
+    per_realization = points * bytes_per_point(scene) + steps * BYTES_PER_STEP
     main = PROCESS_BASE + kept
     if executor == "serial":
         per_worker, total, workers = 0, main + per_realization, 1
@@ -160,7 +171,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
     if not advice:
         one = estimate(scene, workers=1, executor=executor, points=guess.points)
         points_param = _points_path(scene)
-        if one.total - one.per_realization + BYTES_PER_POINT < available and points_param:
+        if one.total - one.per_realization + bytes_per_point(scene) < available and points_param:
             advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * (4 if scene.control == "indentation" else 3) * KEPT_COPIES + 512

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
@@ -393,6 +394,9 @@ class ContactSolver(Plugin):
       the numerics); a study carries them from one solver to another that has them.
     - ``tolerance_param`` (None): the ``Params`` field of the relative tolerance of
       an iterative solver; ``tolerance()`` reads it (None for a direct solver).
+    - ``bytes_per_point`` (None): the peak memory ``solve`` allocates per grid point,
+      beyond the profile and slopes it is given (memory estimates before a run).
+      None: the framework's figure for a line solver (``memory.BYTES_PER_POINT``).
     """
 
     kind: ClassVar[str] = "solver"
@@ -406,6 +410,7 @@ class ContactSolver(Plugin):
     periodic_only: ClassVar[bool] = False
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None
+    bytes_per_point: ClassVar[int | None] = None
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
@@ -433,6 +438,30 @@ class ContactSolver(Plugin):
         if self.tolerance_param is None:
             return None
         return float(self.params.model_dump()[self.tolerance_param])
+
+
+# ------------------------------------------------------------ progress of a solve
+
+_load_listener: Callable[[int, int], None] | None = None
+
+
+def load_finished(done: int, total: int) -> None:
+    """A solver whose loads take long calls this after each load of ``solve``: ``done``
+    of its ``total`` loads are solved. The run forwards it to its listeners
+    (``RunListener.load_done``); outside a run that listens it does nothing."""
+    if _load_listener is not None:
+        _load_listener(done, total)
+
+
+@contextmanager
+def listening_to_loads(listener: Callable[[int, int], None] | None):
+    """Within the block, ``load_finished(done, total)`` calls ``listener`` (this process only)."""
+    global _load_listener
+    previous, _load_listener = _load_listener, listener
+    try:
+        yield
+    finally:
+        _load_listener = previous
 
 
 def contract(kind: str) -> frozenset[str]:

@@ -38,9 +38,22 @@ class JobFailed(Exception):
         self.key, self.error = key, error
 
 
+_results = None  # in a worker: the pipe of its results, for ``send_progress``
+
+
+def send_progress(payload) -> None:
+    """In a worker, during a job: send ``payload`` to the parent's ``on_progress``
+    (``WorkerPool.run``) at once. Elsewhere it does nothing."""
+    if _results is not None:
+        _results.send_bytes(pickle.dumps(("progress", payload), protocol=pickle.HIGHEST_PROTOCOL))
+
+
 def _serve(tasks, results, initializer, initargs, function) -> None:
     """A worker: run each job received on ``tasks``, send back ``("ok", result)``
-    or ``("error", text)`` on ``results``; stop on None or when ``tasks`` closes."""
+    or ``("error", text)`` on ``results`` (after any ``("progress", payload)`` the job
+    sent); stop on None or when ``tasks`` closes."""
+    global _results
+    _results = results
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C and SIGTERM are the parent's to handle:
     signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it lets running jobs finish, then stops workers
     if initializer is not None:
@@ -117,8 +130,9 @@ class WorkerPool:
     def _start(self) -> _Worker:
         return _Worker(self.context, self.initializer, self.initargs, self.function)
 
-    def run(self, jobs: dict[Hashable, object], cancel) -> Iterator[tuple[Hashable, object]]:
-        """Yield ``(key, result)`` as each job finishes. After ``cancel.set()``
+    def run(self, jobs: dict[Hashable, object], cancel, on_progress=None) -> Iterator[tuple[Hashable, object]]:
+        """Yield ``(key, result)`` as each job finishes; ``on_progress(payload)`` hears what
+        a job sends on the way (``send_progress``). After ``cancel.set()``
         no job starts; running ones finish and are yielded. A job whose worker
         dies runs again on a fresh worker, at most ``retries`` more times
         (then WorkerLost); a job that raises ends the run (JobFailed)."""
@@ -151,6 +165,10 @@ class WorkerPool:
                         except (EOFError, OSError):  # it died while sending: half a message, then end of file
                             died = True
                         else:
+                            if status == "progress":
+                                if on_progress is not None:
+                                    on_progress(value)
+                                continue  # the job goes on; its next message wakes the wait again
                             key, worker.job = worker.job, None
                             if status == "error":
                                 raise JobFailed(key, value)

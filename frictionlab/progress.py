@@ -60,6 +60,7 @@ class _Bar:
 
 
 SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond its first line
+LOAD_LINE_SECONDS = 30.0  # in a log: a long solve's load at most this often
 
 
 class ProgressReporter:
@@ -78,6 +79,8 @@ class ProgressReporter:
         self.next_tenth = 1  # integer tenths: repeated += 0.1 drifts and skips lines
         self.failed = 0
         self.resumed = 0  # restored on a resume: done before this process started
+        self.done = 0
+        self.last_load_line = 0.0
 
     def _line(self, done: int, total: int) -> str:
         return progress_text(done, total, self.failed, time.perf_counter() - self.started, restored=self.resumed)
@@ -92,7 +95,8 @@ class ProgressReporter:
     @hookimpl
     def run_started(self, run):
         self.started = time.perf_counter()
-        self.resumed = run.resumed
+        self.resumed = self.done = run.resumed
+        self.total = run.total
         preset = run.scene.preset
         restored = ", ".join(
             [f"{self.resumed} restored from the run folder"] * bool(self.resumed)
@@ -105,6 +109,7 @@ class ProgressReporter:
         )
 
     def _progress(self, done: int, total: int) -> None:
+        self.done, self.total = done, total
         if time.perf_counter() - self.started < self.after and not (done == total and not self.interactive):
             while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
                 self.next_tenth += 1
@@ -121,6 +126,21 @@ class ProgressReporter:
     @hookimpl
     def realization_done(self, done, total):
         self._progress(done, total)
+
+    @hookimpl
+    def load_done(self, index, done, total):
+        """A long solve's loads: the bar's note, or a line now and then in a log."""
+        now = time.perf_counter()
+        if now - self.started < self.after or not self.total:
+            return
+        text = f"realization {index}: load {done}/{total}"
+        if self.interactive:
+            if self.bar is None:
+                self.bar = _Bar(self.stream, "realizations", self.total, completed=self.done, started=self.started)
+            self.bar.update(self.done, text)
+        elif now - max(self.last_load_line, self.started) >= LOAD_LINE_SECONDS:
+            self._write(text)
+            self.last_load_line = now
 
     @hookimpl
     def realization_failed(self, result, done, total):

@@ -10,12 +10,12 @@ import math
 import os
 import time
 import traceback
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import force_unit
+from .plugin import force_unit, listening_to_loads
 from .preset import Scene
 from .seeds import realization_rng
 
@@ -41,8 +41,19 @@ class RealizationResult:
         return self.error is None
 
 
-def compute_realization(scene: Scene, index: int) -> RealizationResult:
-    """Realization ``index`` of ``scene``. Never raises: a failure is carried on the result."""
+LoadListener = Callable[[int, int, int], None]
+"""Hears ``(realization index, loads done, loads)`` as a solver reports each load (``plugin.load_finished``)."""
+
+
+def compute_realization(scene: Scene, index: int, on_load: LoadListener | None = None) -> RealizationResult:
+    """Realization ``index`` of ``scene``; ``on_load`` hears its solver's progress per load.
+    Never raises: a failure is carried on the result."""
+    listener = None if on_load is None else (lambda done, total: on_load(index, done, total))
+    with listening_to_loads(listener):
+        return _compute(scene, index)
+
+
+def _compute(scene: Scene, index: int) -> RealizationResult:
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
@@ -71,6 +82,6 @@ def compute_realization(scene: Scene, index: int) -> RealizationResult:
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
 
 
-def compute_chunk(scene: Scene, indices: Iterable[int]) -> list[RealizationResult]:
+def compute_chunk(scene: Scene, indices: Iterable[int], on_load: LoadListener | None = None) -> list[RealizationResult]:
     """The task every executor runs: a chunk of realizations, in order."""
-    return [compute_realization(scene, int(i)) for i in indices]
+    return [compute_realization(scene, int(i), on_load) for i in indices]

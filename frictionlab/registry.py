@@ -186,6 +186,9 @@ def declaration_problems(cls) -> list[str]:
         named_fields("body_params", cls.body_params)
         if cls.tolerance_param is not None:
             named_fields("tolerance_param", [cls.tolerance_param])
+        declared = cls.bytes_per_point
+        if declared is not None and (isinstance(declared, bool) or not isinstance(declared, int) or declared <= 0):
+            problems.append(f"bytes_per_point must be None or a whole number > 0. Got {declared!r} instead.")
     return problems
 
 

@@ -6,6 +6,7 @@ switch the process pool to forkserver."""
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -99,6 +100,20 @@ def test_chunks_are_sized_by_cost_and_keep_every_worker_busy():
     assert len(plan_chunks(list(range(7)), workers=2, seconds_each=30.0)) == 7
 
 
+def test_short_runs_get_fewer_longer_chunks_where_tasks_cost_more():
+    fig2 = list(range(300))  # the Fig. 2 scene: 300 realizations of about 1.6 ms
+    # on 2 Dask workers (5 ms a task) 8 chunks of 60 ms would lose 6 %: one chunk per worker
+    assert [len(c) for c in plan_chunks(fig2, workers=2, seconds_each=1.6e-3, overhead=5e-3)] == [150, 150]
+    # on a process pool (0.5 ms a task) 4 per worker still cost under 1 %
+    assert len(plan_chunks(fig2, workers=2, seconds_each=1.6e-3, overhead=0.5e-3)) == 8
+    for each in (1e-5, 1e-4, 1e-3, 1e-2, 1.0, 30.0):
+        for count in (7, 300, 5000):
+            chunks = plan_chunks(list(range(count)), workers=2, seconds_each=each, overhead=5e-3)
+            assert [i for c in chunks for i in c] == list(range(count))
+            # a task lasts at least 50 overheads, unless the run is too short for two of that length
+            assert min(len(c) for c in chunks[:-1] or chunks) * each >= 50 * 5e-3 or len(chunks) <= 2
+
+
 # ------------------------------------------------------------------ same numbers
 
 
@@ -173,6 +188,20 @@ def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_2
 
 
 @needs_dask
+@pytest.mark.parametrize("size", [1, 5, 23])
+def test_numbers_do_not_depend_on_the_chunk_size(monkeypatch, scene_24, serial_24, dask_scheduler, size):
+    def fixed(indices, *args, **kwargs):
+        indices = list(indices)
+        return [indices[i : i + size] for i in range(0, len(indices), size)]
+
+    monkeypatch.setattr(engine, "plan_chunks", fixed)
+    for options in (RunOptions(executor="dask", scheduler=dask_scheduler), RunOptions(workers=2, executor="processes")):
+        outcome = engine.run(scene_24, options)
+        assert outcome.status == "completed"
+        same_numbers(serial_24, outcome)
+
+
+@needs_dask
 def test_dask_killed_worker_is_rescheduled_with_the_same_numbers(scene_24, serial_24, dask_scheduler, tmp_path):
     flag = tmp_path / "crashed"
     outcome = engine.run(crashing(scene_24, flag), RunOptions(executor="dask", scheduler=dask_scheduler))
@@ -186,6 +215,25 @@ def test_dask_own_local_cluster_of_one_worker_gives_the_serial_numbers(scene_24,
     outcome = engine.run(scene_24, RunOptions(workers=1, executor="dask"))
     assert outcome.status == "completed" and outcome.workers == 1
     same_numbers(serial_24, outcome)
+
+
+@needs_dask
+def test_the_own_cluster_s_workers_keep_the_adaptive_malloc_thresholds():
+    """Dask's default MALLOC_TRIM_THRESHOLD_ made every large array a fresh mapping in its
+    workers (the half-space solver 1.5x slower): the executor's own cluster unsets it. In a
+    fresh process: a nanny started here before (another test's cluster) leaves Dask's value
+    in this process's environment, which a worker inherits."""
+    script = (
+        "from frictionlab.dask_security import start_local_cluster\n"
+        "import os\n"
+        "client, cluster = start_local_cluster(1)\n"
+        "print(list(client.run(os.environ.get, 'MALLOC_TRIM_THRESHOLD_').values()))\n"
+        "client.close(); cluster.close()\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "[None]"
 
 
 @needs_dask

@@ -65,6 +65,61 @@ def test_the_estimate_bounds_the_measured_peak_of_a_real_run(registry, tmp_path,
     assert estimate.total < 4 * peak
 
 
+def surface_of(points: int, solver: str = "bem-halfspace", **changes) -> dict:
+    return merge(SMALL_PRESET, {
+        "realizations": 1,
+        "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": points, "length": 128.0, "short_cutoff": 4.0}},
+        "solver": {"name": solver, "params": {}}, "slope": {"name": "forward-difference"},
+        # up to 99.7 % contact: the contact set's index arrays are largest there
+        "loading": {"control": "force", "start": 1.5, "stop": 3000.0, "steps": 6, "spacing": "log"}, **changes,
+    })  # fmt: skip
+
+
+def test_the_half_space_declares_what_its_realization_allocates(registry):
+    """tracemalloc sees numpy's buffers: the peak of one realization (synthesis, slopes,
+    the solve) per point lies under the declared estimate, and not far under it."""
+    import tracemalloc
+
+    from frictionlab.realization import compute_realization
+
+    scene = build_scene(surface_of(256), registry=registry)
+    compute_realization(scene, 0)  # caches (the synthesis, FFT plans) are not per realization
+    tracemalloc.start()
+    try:
+        floor = tracemalloc.get_traced_memory()[0]
+        result = compute_realization(scene, 1)
+        peak = tracemalloc.get_traced_memory()[1] - floor
+    finally:
+        tracemalloc.stop()
+    assert result.ok and result.contact_count[-1] > 0.99 * 256**2
+    estimate = memory.estimate(scene, workers=1, executor="serial")
+    assert estimate.points == 256**2
+    assert peak <= estimate.per_realization
+    assert estimate.per_realization < 1.6 * peak
+    # the line pipeline's figure would not have covered it
+    assert peak > 256**2 * memory.BYTES_PER_POINT
+
+
+def test_a_solver_declaring_more_bytes_per_point_raises_the_estimate(registry):
+    surface = build_scene(surface_of(256), registry=registry)
+    declared = type(surface.solver).bytes_per_point
+    assert declared is not None
+    line = build_scene(surface_of(256, solver="mdr"), registry=registry)  # presses the equivalent line
+    assert type(line.solver).bytes_per_point is None
+    assert memory.bytes_per_point(line) == memory.BYTES_PER_POINT
+    assert memory.bytes_per_point(surface) == declared + memory.PROFILE_BYTES_PER_POINT
+
+
+def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fits(registry, monkeypatch):
+    scene = build_scene(surface_of(4096), registry=registry)
+    monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
+    with pytest.raises(RunError, match=r"spectrum.params.points <= ([\d,]+)\.") as caught:
+        memory.check_fits(scene, workers=2, executor="processes")
+    side = int(caught.value.args[0].split("points <= ")[1].split(".")[0].replace(",", ""))
+    assert memory.estimate(scene, workers=1, executor="processes", points=side**2).total <= GiB
+    assert memory.estimate(scene, workers=1, executor="processes", points=(side + 1) ** 2).total > GiB
+
+
 def test_estimate_grows_with_points_workers_and_kept_rows(registry):
     small = build_scene(line_of(10_000), registry=registry)
     large = build_scene(line_of(1_000_000), registry=registry)

@@ -30,6 +30,11 @@ from .conftest import SMALL_PRESET, merge
 # ~20 ms per realization: 150 of them last long enough to be killed mid-run
 NO_PLOT = {"output": {"plot": False}}  # matplotlib costs a second per folder and is not under test
 KILL_PRESET = merge(SMALL_PRESET, {"realizations": 80, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
+# exact half-space contact of a surface with a rolloff, ~0.1 s per realization
+KILL_SURFACE = merge(
+    yaml.safe_load((Path(__file__).parents[1] / "presets" / "exact3d-h08-rolloff.yaml").read_text()),
+    {"realizations": 40, "spectrum": {"params": {"points": 128}}, **NO_PLOT},
+)
 
 
 def same_files(one: Path, two: Path) -> None:
@@ -71,10 +76,12 @@ def test_cancelled_run_resumes_to_the_uninterrupted_numbers(make_scene, tmp_path
 
 def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
     scene = make_scene({"realizations": 12, **NO_PLOT})
-    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
     before = (tmp_path / "run" / "curve.csv").read_text()
     again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
     assert again.extra["resumed"] == 12 and again.done == 12
+    # what the realizations cost is read back with them, however little the resume took
+    assert first.compute_seconds > 0 and again.compute_seconds == first.compute_seconds
     assert (tmp_path / "run" / "curve.csv").read_text() == before
 
 
@@ -144,9 +151,10 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
-def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path):
+@pytest.mark.parametrize("data", [KILL_PRESET, KILL_SURFACE], ids=["line", "exact-3d-surface"])
+def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path, data):
     preset = tmp_path / "kill.yaml"
-    preset.write_text(yaml.safe_dump(KILL_PRESET))
+    preset.write_text(yaml.safe_dump(data))
     run_dir = tmp_path / "run"
     command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(run_dir), "--workers", "2", "--quiet"]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -171,8 +179,8 @@ def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tm
     )
     assert resumed.returncode == 0, resumed.stderr
     summary = json.loads(resumed.stdout)
-    assert 0 < summary["resumed_realizations"] < 80
+    assert 0 < summary["resumed_realizations"] < data["realizations"]
     assert kept >= 2
 
-    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
+    run_to_folder(build_scene(data, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")

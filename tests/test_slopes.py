@@ -238,3 +238,62 @@ def test_bad_spacing_and_shape_are_rejected(cls):
         cls().slopes(np.zeros((4, 4, 4)), 1.0)  # lines and surfaces only
     with pytest.raises(ValueError, match="at least 2 points"):
         cls().slopes(np.zeros((1, 8)), 1.0)
+
+
+# ------------------------------------------------------------------ xi on a surface, by brute force
+
+
+def brute_force_gradient(z, dx, scheme):
+    """|grad z| pixel by pixel with explicit loops and wrap-around indices."""
+    ny, nx = z.shape
+    out = np.empty_like(z)
+    for i in range(ny):
+        for j in range(nx):
+            if scheme == "forward-difference":
+                gx = (z[i, (j + 1) % nx] - z[i, j]) / dx
+                gy = (z[(i + 1) % ny, j] - z[i, j]) / dx
+            else:
+                gx = (z[i, (j + 1) % nx] - z[i, (j - 1) % nx]) / (2 * dx)
+                gy = (z[(i + 1) % ny, j] - z[(i - 1) % ny, j]) / (2 * dx)
+            out[i, j] = np.sqrt(gx * gx + gy * gy)
+    return out
+
+
+@pytest.mark.parametrize("scheme", ["forward-difference", "central-difference"])
+def test_xi_on_a_surface_is_the_rms_gradient_over_contact_pixels_over_the_whole_one(registry, monkeypatch, scheme):
+    """An exact half-space run on a 24 x 20 surface: the engine's xi at each load equals
+    rms |grad z| (both components) over the pixels the solver put in contact, over rms
+    |grad z| of every pixel, both formed here by loops."""
+    import frictionlab_solvers.bem as bem
+
+    from frictionlab.realization import compute_realization
+    from frictionlab.seeds import realization_rng
+
+    contact_sets = []
+    solve = bem.ConstrainedCG.solve
+
+    def recording(self, pressure, **kwargs):
+        answer = solve(self, pressure, **kwargs)
+        contact_sets.append(answer[0] > 0.0)
+        return answer
+
+    monkeypatch.setattr(bem.ConstrainedCG, "solve", recording)
+    data = {"name": "xi", "seed": 5, "realizations": 1,
+            "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.7, "points": 24, "points_y": 20,
+                                                            "spacing": 0.5, "short_cutoff": 2.0, "rms_height": 3.0}},
+            "solver": {"name": "bem-halfspace", "params": {"youngs_modulus": 2.0}}, "slope": {"name": scheme},
+            "loading": {"control": "force", "start": 0.5, "stop": 60.0, "steps": 6, "spacing": "log"}}  # fmt: skip
+    scene = build_scene(data, registry=registry)
+    result = compute_realization(scene, 0)
+    assert result.ok, result.error
+    heights = scene.spectrum.generate(realization_rng(5, 0)).heights
+    assert heights.shape == (20, 24)
+    gradient = brute_force_gradient(heights, 0.5, scheme)
+    whole = np.sqrt(np.mean(gradient**2))
+    assert result.slope_rms_line == pytest.approx(whole, rel=1e-12)
+    assert len(contact_sets) == 6
+    counts = [int(c.sum()) for c in contact_sets]
+    assert counts == list(result.contact_count) and 0 < counts[0] < counts[-1] < heights.size
+    for j, contact in enumerate(contact_sets):
+        in_contact = np.sqrt(np.mean(gradient[contact] ** 2))
+        assert result.xi[j] == pytest.approx(in_contact / whole, rel=1e-12)

@@ -1,79 +1,23 @@
 """Variant scenes of one preset for the trade-off study, and their measurement.
 
-A variant is the preset's data with a few dotted-path changes, validated by
-``preset.build_scene`` like any preset, so every variant is a scene a user
-could run. Nothing here knows physics: solvers are swapped by copying the
-parameters of the elastic body both declare (``ContactSolver.body_params``), and
-the f range is kept through the contract's own normalisation (``force_unit``).
+The variants themselves are made by ``frictionlab.variants.SceneFactory`` (shared
+with the other studies); here they are measured.
 """
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 import tracemalloc
 from dataclasses import dataclass
-from typing import Any
 
 from .. import engine
 from ..ensemble import RunOutcome
-from ..errors import FrictionlabError
 from ..options import RunOptions
-from ..plugin import force_unit
-from ..preset import Scene, build_scene, set_path
-from ..registry import Registry
-from ..seeds import realization_rng
+from ..preset import Scene
+from ..variants import SceneFactory, force_scale
 
-
-def force_scale(scene: Scene) -> float:
-    """The load at f = 1 (``force_unit``) for realization 0's profile."""
-    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
-    return force_unit(scene.solver, scene.generator.rms_height(), profile)
-
-
-class SceneFactory:
-    """Builds validated variants of one preset's data."""
-
-    def __init__(self, data: dict, registry: Registry, source: str):
-        self.data = copy.deepcopy(data)
-        self.registry = registry
-        self.source = source
-        self.base = build_scene(self.data, registry=registry, source=source)
-        self._base_scale = force_scale(self.base)
-
-    def make(self, changes: dict[str, Any], *, keep_f_range: bool = True) -> Scene:
-        """The preset with ``changes`` (dotted path -> value). With ``keep_f_range``
-        the force grid is rescaled so the variant sweeps the base scene's f range
-        (a shorter line or another stiffness would otherwise shift it)."""
-        data = copy.deepcopy(self.data)
-        for path, value in changes.items():
-            set_path(data, path, value)
-        where = f"{self.source} with " + ", ".join(f"{k}={v}" for k, v in changes.items())
-        scene = build_scene(data, registry=self.registry, source=where)
-        if keep_f_range:
-            ratio = force_scale(scene) / self._base_scale
-            if not math.isclose(ratio, 1.0, rel_tol=1e-12):
-                loading = self.base.preset.loading
-                set_path(data, "loading.start", loading.start * ratio)
-                set_path(data, "loading.stop", loading.stop * ratio)
-                scene = build_scene(data, registry=self.registry, source=where)
-        return scene
-
-    def solver_choice(self, name: str, tolerance: float | None = None) -> dict:
-        """``{"name", "params"}`` for solver ``name`` with the base solver's elastic body
-        (the ``body_params`` both solvers declare) and, for an iterative solver, the
-        ``tolerance``. Raises FrictionlabError naming the option when the solver is
-        not installed."""
-        try:
-            cls = self.registry.get("solver", name)
-        except FrictionlabError as exc:
-            raise FrictionlabError(f"--reference: {exc}") from None
-        base = self.base.solver.params.model_dump()
-        params = {k: base[k] for k in cls.body_params if k in self.base.solver.body_params}
-        if tolerance is not None and cls.tolerance_param is not None:
-            params[cls.tolerance_param] = tolerance
-        return {"name": cls.name, "params": params}
+__all__ = ["Measurement", "SceneFactory", "force_scale", "measure"]  # the factory: re-exported from the core
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
 from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
@@ -324,6 +324,9 @@ class PeriodicBEM(ContactSolver):
     periodic_only: ClassVar[bool] = True
     body_params: ClassVar[tuple[str, ...]] = ("youngs_modulus", "poisson_ratio")
     tolerance_param: ClassVar[str | None] = "tolerance"
+    # measured 147 B per point (tracemalloc, 128^2 to 512^2 surfaces pressed to full contact:
+    # the CG's grids, two FFT buffers, the full-contact pressure, index arrays), plus 20 %
+    bytes_per_point: ClassVar[int | None] = 176
 
     class Params(ElasticParams):
         tolerance: float = Field(
@@ -446,6 +449,7 @@ class PeriodicBEM(ContactSolver):
                 slope_rms[j] = line_rms
             else:
                 slope_rms[j] = float(np.sqrt(np.mean(np.square(slopes[contact]))))
+            load_finished(j + 1, steps)  # a load of a large surface takes seconds: progress per load
 
         return ContactCurve(
             force=force,

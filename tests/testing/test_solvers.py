@@ -113,6 +113,8 @@ def test_solver_check_fails_when_periodic_only_is_not_kept():
         ({"contact_measure": "area"}, "contact_measure must be one of"),
         ({"body_params": ("youngs_modulus",)}, "body_params names 'youngs_modulus', not fields of Params"),
         ({"tolerance_param": "tol"}, "tolerance_param names 'tol'"),
+        ({"bytes_per_point": 0}, "bytes_per_point must be None or a whole number > 0. Got 0"),
+        ({"bytes_per_point": 12.5}, "bytes_per_point must be None or a whole number > 0. Got 12.5"),
         ({"normalisations": {1: ForceNormalisation(load="force", modulus="k", extent="area")}}, "not defined for a 1D"),
     ],
 )

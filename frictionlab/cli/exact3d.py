@@ -1,0 +1,42 @@
+"""``frictionlab exact3d``: the exact 3D law (``frictionlab.exact3d``): run the study and
+write the page exact-3d-law.md with its figures."""
+
+from __future__ import annotations
+
+import sys
+
+from ..errors import ExitCode
+from .options import add_workers_option, run_options
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "exact3d",
+        help="xi against f in exact half-space contact for H = 0.3..1, beside MDR: write exact-3d-law.md",
+        description="The exact 3D law: run the presets exact3d-h03..h10 on three grids of the same surfaces "
+        "(exact half-space contact) and MDR on their equivalent lines, fit xi = a + b ln f with bootstrap "
+        "intervals, and write the page exact-3d-law.md with its figures. The full plan takes tens of minutes "
+        "on two cores; --quick a few minutes (not converged).",
+        epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
+        "  frictionlab exact3d --out docs --force",
+    )
+    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: a few minutes, not converged")
+    p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")
+    p.add_argument("--runs", metavar="DIR", help="folder of the ensembles' runs; an earlier one is resumed (default: a new runs/exact3d-<plan>-<timestamp>)")
+    p.add_argument("--presets", metavar="DIR", help="folder with exact3d-h03..h10.yaml (default: ./presets if it holds them, else the built-in presets)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing page and its figures")
+    add_workers_option(p, "all cores")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..exact3d.report import write_page
+
+    page = write_page(
+        args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
+        options=run_options(workers=args.workers, force=args.force),
+        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+    )  # fmt: skip
+    print(page)
+    return ExitCode.OK

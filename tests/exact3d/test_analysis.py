@@ -1,0 +1,93 @@
+"""The study's numbers beyond the fit: kappa against an exact area law, the Nayak
+parameter against closed forms."""
+
+import math
+
+import numpy as np
+import pytest
+
+from frictionlab.exact3d.analysis import SMALL_LOAD_FRACTION, contact_area_law, nayak_parameter, relative_gap
+from frictionlab.preset import build_scene
+from frictionlab.seeds import realization_rng
+
+
+def law_fractions(kappa, force, area, stiffness, gradient):
+    """A / A0 = kappa p / (E* g), p = F / A0, per realization (rows) and load."""
+    return kappa * (force / area)[None, :] / (stiffness * gradient[:, None])
+
+
+def test_kappa_of_an_exact_area_law_is_kappa():
+    rng = np.random.default_rng(1)
+    force = np.geomspace(1.0, 50.0, 8)
+    gradient = rng.uniform(0.05, 0.1, 6)
+    fraction = law_fractions(1.8, force, 1e5, 2.0, gradient)
+    kappa = contact_area_law(fraction, force, 1e5, 2.0, gradient, rng=np.random.default_rng(0), bootstrap=200)
+    assert kappa.value == pytest.approx(1.8, rel=1e-12)
+    assert kappa.interval[0] == pytest.approx(1.8, rel=1e-12) and kappa.interval[1] == pytest.approx(1.8, rel=1e-12)
+    assert kappa.loads == 8 and kappa.largest_fraction <= SMALL_LOAD_FRACTION
+
+
+def test_kappa_uses_only_the_small_loads_and_is_unit_free():
+    force = np.geomspace(1.0, 1000.0, 10)
+    gradient = np.array([0.1, 0.12, 0.08])
+    fraction = law_fractions(2.0, force, 1e4, 1.0, gradient)
+    large = fraction.mean(axis=0) > SMALL_LOAD_FRACTION
+    assert large.any() and not large.all()
+    fraction[:, large] *= 1.5  # off the law: these loads must not count
+    kappa = contact_area_law(fraction, force, 1e4, 1.0, gradient, rng=np.random.default_rng(0))
+    assert kappa.value == pytest.approx(2.0, rel=1e-12)
+    assert kappa.loads == int((~large).sum())
+    # lengths x s, moduli x m, forces x m s^2: the same kappa
+    s, m = 7.0, 3.0
+    scaled = contact_area_law(fraction, force * m * s**2, 1e4 * s**2, m, gradient, rng=np.random.default_rng(0))
+    assert scaled.value == pytest.approx(kappa.value, rel=1e-12)
+
+
+def test_kappa_interval_brackets_the_mean_of_scattered_surfaces():
+    rng = np.random.default_rng(4)
+    force = np.geomspace(1.0, 10.0, 4)
+    gradient = np.full(40, 0.1)
+    per_surface = rng.normal(1.7, 0.2, 40)
+    fraction = per_surface[:, None] * (force / 1e4)[None, :] / 0.1
+    kappa = contact_area_law(fraction, force, 1e4, 1.0, gradient, rng=np.random.default_rng(0), bootstrap=2000)
+    assert kappa.value == pytest.approx(per_surface.mean(), rel=1e-12)
+    half = 1.96 * per_surface.std(ddof=1) / math.sqrt(40)
+    assert kappa.interval[0] == pytest.approx(kappa.value - half, abs=0.3 * half)
+    assert kappa.interval[1] == pytest.approx(kappa.value + half, abs=0.3 * half)
+
+
+def test_nayak_of_one_wave_is_one_and_of_two_waves_is_the_moment_ratio():
+    n, dx = 64, 0.5
+    x = np.arange(n) * dx
+    xx, yy = np.meshgrid(x, x)
+    q1, q2 = 2 * np.pi * 3 / (n * dx), 2 * np.pi * 11 / (n * dx)
+    one = np.cos(q1 * xx + 0.3) + 0.0 * yy
+    assert nayak_parameter(one, dx) == pytest.approx(1.0, rel=1e-12)
+    a, b = 1.0, 0.4
+    two = a * np.cos(q1 * xx) + b * np.cos(q2 * xx + 2 * np.pi * 5 * yy / (n * dx))
+    m0, m2, m4 = ((a**2 * q1**k + b**2 * q2**k) / 2 for k in (0, 2, 4))
+    assert nayak_parameter(two, dx) == pytest.approx(m0 * m4 / m2**2, rel=1e-12)
+
+
+@pytest.mark.parametrize("hurst", [0.5, 0.8])
+def test_nayak_of_a_power_law_surface_is_the_continuum_one(registry, hurst):
+    """Isotropic C2D ~ q^(-2H-2) on [q0, q1]: the profile moments are 2 pi I1, pi I3 and
+    3 pi / 4 I5 with I_n = integral q^n C2D dq, so alpha = 1.5 I1 I5 / I3^2."""
+    data = {"name": "n", "seed": 1, "realizations": 1,
+            "spectrum": {"name": "power-law-2d", "params": {"hurst": hurst, "points": 256, "short_cutoff": 8.0}},
+            "solver": {"name": "bem-halfspace"}, "slope": {"name": "forward-difference"},
+            "loading": {"control": "force", "start": 1.0, "stop": 2.0, "steps": 2}}  # fmt: skip
+    scene = build_scene(data, registry=registry)
+    profile = scene.spectrum.generate(realization_rng(1, 0))
+    q0, q1 = 2 * np.pi / 256, 2 * np.pi / 8
+
+    def integral(n):
+        power = n - 2 * hurst - 1
+        return (q1**power - q0**power) / power
+
+    expected = 1.5 * integral(1) * integral(5) / integral(3) ** 2
+    assert nayak_parameter(profile.heights, profile.spacing) == pytest.approx(expected, rel=0.05)
+
+
+def test_relative_gap():
+    np.testing.assert_allclose(relative_gap([2.0, 3.0], [1.0, 4.0]), [1.0, -0.25])
