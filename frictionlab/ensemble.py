@@ -127,6 +127,10 @@ class Accumulator:
         xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
         count = per["contact_count"].mean(axis=0) if n else nan_row
         fit = None
+        if not n and self.failures and status == "completed":
+            # every realization failed: nothing was computed, whatever the count says
+            index, reason = min(self.failures.items())
+            status, error = "failed", f"no realization finished: {len(self.failures)} failed; the first, #{index}: {reason}"
         if n and not np.all(np.isfinite(f) & (f > 0)):
             # a plugin's numbers overflowed: say which, rather than fail in the fit
             status, error = "failed", (

@@ -196,3 +196,19 @@ def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(
     # fork again once the bystander is gone (unless a Dask client left its threads in this process)
     assert pool_context().get_start_method() == ("fork" if threading.active_count() == 1 else "forkserver")
     same_outcome(serial, pooled)
+
+
+def test_a_run_where_every_realization_failed_is_failed_not_completed(make_scene):
+    base = make_scene({"realizations": 4})
+
+    class Broken(Flaky):
+        name = "broken"
+
+        def generate(self, rng):
+            raise RuntimeError("unreadable scan")
+
+    scene = Scene(preset=base.preset, spectrum=Broken(), solver=base.solver, slope=base.slope)
+    outcome = engine.run(scene, RunOptions(workers=1))
+    assert outcome.done == 0 and len(outcome.failures) == 4
+    assert outcome.status == "failed"
+    assert "no realization finished" in outcome.error and "unreadable scan" in outcome.error

@@ -83,5 +83,26 @@ def main(path: str) -> None:
     print(f"  h = 1e4 (the presets'): {counts_at}")
 
 
+def cli(argv: list[str] | None = None) -> int:
+    """``python -m frictionlab.paper.calibration PRESET``: usage and input errors said in a line."""
+    import argparse
+
+    from ..errors import FrictionlabError
+
+    parser = argparse.ArgumentParser(
+        prog="python -m frictionlab.paper.calibration",
+        description="Find the rms height h that gives the paper's mean contact counts (4 at F = 1, 12 at F = 20).",
+        epilog="example: python -m frictionlab.paper.calibration presets/benad2012-fig2.yaml",
+    )
+    parser.add_argument("preset", help="a preset of the Fig. 2 scene (its h is ignored: one ensemble at h = 1)")
+    args = parser.parse_args(argv)
+    try:
+        main(args.preset)
+    except FrictionlabError as exc:
+        print(f"frictionlab: {exc}", file=sys.stderr)
+        return int(exc.exit_code)
+    return 0
+
+
 if __name__ == "__main__":
-    main(sys.argv[1])
+    sys.exit(cli())
