@@ -12,9 +12,9 @@ def add_parser(sub) -> None:
         "tui",
         help="terminal UI: edit presets, run with live progress, compare results",
         description="The terminal UI: browse and edit presets, run them with live progress, compare results.",
-        epilog="examples:\n  frictionlab tui\n  frictionlab tui presets/quickstart.yaml",
+        epilog="examples:\n  frictionlab tui\n  frictionlab tui quickstart",
     )
-    p.add_argument("preset", nargs="?", help="preset YAML file to open (optional)")
+    p.add_argument("preset", nargs="?", help="preset YAML file, or a built-in's name, to open (optional)")
     p.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
     p.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")
     add_workers_option(p)
@@ -24,7 +24,9 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     if args.preset is not None:
         from ..preset import load_preset_file
+        from ..preset.builtin import resolve_preset_path
 
+        args.preset = str(resolve_preset_path(args.preset))  # a file, or a built-in's name
         load_preset_file(args.preset)  # a missing or unreadable file is a usage error, before the UI starts
     options = run_options(workers=args.workers)
     from ..tui import run_app  # Textual is imported here only

@@ -219,3 +219,17 @@ def test_report_json_names_the_report_and_the_figures_it_shows(tmp_path, capsys)
     assert printed["report"] == str(out / "REPRODUCTION.md")
     assert printed["figures"] == [str(out / "figures" / f"{fig.key}.png") for fig in FIGURES]
     assert all(os.path.getsize(figure) > 1000 for figure in printed["figures"])
+
+
+def test_tui_takes_a_builtin_name_and_a_mistyped_one_gets_the_closest_before_the_ui_starts(monkeypatch):
+    from argparse import Namespace
+
+    import frictionlab.tui
+    from frictionlab.cli import tui
+
+    done = run_cli("tui", "quikstart")
+    assert done.returncode == ExitCode.INPUT_FILE and "did you mean 'quickstart'?" in done.stderr
+    opened = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(preset) or 0)
+    tui.run(Namespace(preset="quickstart", presets=None, runs=None, workers=1))
+    assert len(opened) == 1 and opened[0].endswith("quickstart.yaml")
