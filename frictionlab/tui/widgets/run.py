@@ -151,8 +151,7 @@ class RunPane(Vertical, can_focus=True):
     def show_outcome(self, outcome) -> str:
         """Show a finished run's ``RunOutcome``; return the line the app notifies."""
         self.query_one("#run-bar", ProgressBar).update(total=outcome.requested, progress=outcome.done)
-        status = "failed" if outcome.done == 0 and outcome.failures else outcome.status  # "completed" with nothing done says too little
-        self._set("run-stats", f"{status}: {outcome.done}/{outcome.requested} realizations in "
+        self._set("run-stats", f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in "
                                f"{format_duration(outcome.elapsed)}, {outcome.workers} worker"
                                f"{'s' if outcome.workers != 1 else ''}")  # fmt: skip
         if outcome.fit is not None:
@@ -161,7 +160,9 @@ class RunPane(Vertical, can_focus=True):
         lines = fit_lines(outcome.fit, final=True, f_formula=outcome.normalisation.formula)
         self._set("run-fit", "\n".join(lines + _contact_lines(outcome.contact_count)))
         if outcome.failures or outcome.error:
-            first = outcome.error or f"#{outcome.failures[0][0]}: {failure_message(outcome.failures[0][1])}"
+            # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
+            index, reason = outcome.failures[0] if outcome.failures else (None, None)
+            first = f"#{index}: {failure_message(reason)}" if outcome.failures else outcome.error
             self._error(f"{len(outcome.failures)} realization(s) failed; {first}")
         return f"Run {outcome.status}: {outcome.done}/{outcome.requested} realizations"
 
