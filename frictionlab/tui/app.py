@@ -2,8 +2,8 @@
 
 The app holds what the tabs share: the draft preset (open, edit, save), the run
 going on, and the keys that work everywhere. Each tab's pane shows its part
-(``widgets``). The engine runs in a thread worker through ``runner.run_to_folder``
-(the path ``frictionlab run`` takes, so the same files are written), a preset with
+(``widgets``). The engine runs in a thread worker through ``api.run_scene``
+(the path ``frictionlab run`` and ``frictionlab.run`` take, so the same files are written), a preset with
 a ``sweep`` section through ``sweep.run_sweep``; the thread hands progress over
 with ``post_message`` (``messages``).
 """
@@ -25,7 +25,7 @@ from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
 from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
-from ..runner import run_to_folder
+from ..api import run_scene
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
 from .fields import default_spectrum, preset_from_defaults
 from .folders import (
@@ -370,7 +370,7 @@ class FrictionlabApp(App):
         self.say(f"{verb} {scene.preset.name} into {out_dir}")
         progress = LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))
         if sweep is None:
-            work = lambda: run_to_folder(scene, out_dir, options, listeners=[progress], cancel=cancel)[0]  # noqa: E731
+            work = lambda: run_scene(scene, out_dir, options, listeners=[progress], cancel=cancel).outcome  # noqa: E731
         else:
             poster = SweepPoster(
                 lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
