@@ -116,13 +116,19 @@ def paired_extra_grids(runs: StudyRuns) -> list[str]:
     return lines
 
 
+def _span(values, fmt: str) -> str:
+    """'low to high' of ``values`` in ``fmt``, or the one value when they print alike."""
+    low, high = format(min(values), fmt), format(max(values), fmt)
+    return low if low == high else f"{low} to {high}"
+
+
 def _mdr_full_contact(runs: StudyRuns) -> str:
     """How near MDR's line is to being pressed flat at the largest load, against the real area."""
     springs = [runs.find(h, exact=False).outcome.contact_fraction[-1] for h in runs.plan.hursts]
     real = [runs.find(h).outcome.contact_fraction[-1] for h in runs.plan.hursts]
-    return (f"; at the largest f, {min(springs):.0%} to {max(springs):.0%} of MDR's springs are in contact (so its ξ "
+    return (f"; at the largest f, {_span(springs, '.0%')} of MDR's springs are in contact (so its ξ "
             f"tends to 1 and its curve bends: MDR R² in the table) where the real contact area is "
-            f"{min(real):.0%} to {max(real):.0%}")
+            f"{_span(real, '.0%')}")
 
 
 def ensemble_text(runs: StudyRuns) -> str:
@@ -149,6 +155,7 @@ def answer(runs: StudyRuns, kappas: dict[tuple[float, int], Kappa]) -> list[str]
     fits = {h: runs.find(h).outcome.fit for h in runs.plan.hursts}
     held = [h for h, fit in fits.items() if fit.r2 >= GOOD_R2]
     r2 = [fit.r2 for fit in fits.values()]
+    r2_missed = [fit.r2 for h, fit in fits.items() if h not in held]
     b_low = min(fit.b for fit in fits.values())
     b_high = max(fit.b for fit in fits.values())
     a_low = min(fit.a for fit in fits.values())
@@ -157,14 +164,14 @@ def answer(runs: StudyRuns, kappas: dict[tuple[float, int], Kappa]) -> list[str]
     settled = [h for h in runs.plan.hursts if abs(_shift_of_b(runs, h)[0]) <= _shift_of_b(runs, h)[1]]
     kappa_all = [kappas[(h, finest)].value for h in runs.plan.hursts]
     if len(held) == len(fits):
-        verdict = f"Yes, over this range: at every H the mean curve follows a + b ln f with R² from {min(r2):.2f} to {max(r2):.2f}."
+        verdict = f"Yes, over this range: at every H the mean curve follows a + b ln f with R² {_span(r2, '.2f')}."
     elif held:
         verdict = (
             f"Only in part: a + b ln f explains the mean curve (R² >= {GOOD_R2}) at H = "
-            f"{', '.join(f'{h:g}' for h in held)}, not at the others (R² from {min(r2):.2f} to {max(r2):.2f})."
+            f"{', '.join(f'{h:g}' for h in held)}, not at the others (R² {_span(r2_missed, '.2f')})."
         )
     else:
-        verdict = f"No: at no H does a + b ln f explain the mean curve well (R² from {min(r2):.2f} to {max(r2):.2f})."
+        verdict = f"No: at no H does a + b ln f explain the mean curve well (R² {_span(r2, '.2f')})."
     return [
         f"- **Does a log law hold for exact contact?** {verdict}",
         f"- **Which a and b?** On the finest grid ({finest}² pixels), a runs from {a_low:.3f} to {a_high:.3f} and "

@@ -94,6 +94,7 @@ def write_page(
     into ``out_dir`` (default: the runs folder). Runs go to ``runs_dir`` (default: a new
     ``runs/exact3d-<timestamp>``); giving an earlier one resumes it. Returns the page's path."""
     plan = plan or (QUICK if quick else FULL)
+    command = command or _command(quick, out_dir, runs_dir)
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
@@ -102,13 +103,16 @@ def write_page(
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
     atomic_write(figures / FIGURES[0], lambda fh: plot_xi_against_f(runs, fh, kappas, dpi=dpi), binary=True)
     atomic_write(figures / FIGURES[1], lambda fh: plot_convergence(runs, fh, dpi=dpi), binary=True)
-    text = page_text(runs, kappas, command or _command(quick, out_dir), machine())
+    text = page_text(runs, kappas, command, machine())
     atomic_write(page, lambda fh: fh.write(text))
     return page
 
 
-def _command(quick: bool, out_dir: Path) -> str:
-    return f"frictionlab exact3d{' --quick' if quick else ''} --out {out_dir} --force"
+def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | None) -> str:
+    """The command that regenerates the page: with the runs folder it was given, so
+    that rerunning it reads those runs back instead of computing them again."""
+    return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {out_dir}" if out_dir else "")
+            + (f" --runs {runs_dir}" if runs_dir else "") + " --force")  # fmt: skip
 
 
 def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) -> str:

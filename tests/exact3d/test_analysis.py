@@ -91,3 +91,10 @@ def test_nayak_of_a_power_law_surface_is_the_continuum_one(registry, hurst):
 
 def test_relative_gap():
     np.testing.assert_allclose(relative_gap([2.0, 3.0], [1.0, 4.0]), [1.0, -0.25])
+
+
+def test_a_span_prints_one_value_when_its_ends_print_alike():
+    from frictionlab.exact3d.markdown import _span
+
+    assert _span([0.995, 0.996, 1.0], ".0%") == "100%"
+    assert _span([0.85, 0.91, 0.88], ".2f") == "0.85 to 0.91"
