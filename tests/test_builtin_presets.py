@@ -104,3 +104,13 @@ def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, t
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=empty, env=env, timeout=300)
     where, a, b = done.stdout.split()
     assert Path(where).is_relative_to(installed) and float(a) == frictionlab.load(empty / "q").fit.a
+
+
+@pytest.mark.parametrize("command", ["run", "validate"])
+def test_a_bad_set_on_a_built_in_names_the_built_in_and_the_set_not_the_installed_file(command, tmp_path):
+    result = run_cli(command, "quickstart", "--set", "realizations=-5", cwd=tmp_path)
+    assert result.returncode == ExitCode.USAGE
+    assert "built-in preset 'quickstart' --set realizations=-5: 1 problem" in result.stderr
+    assert "realizations: must be >= 1, got -5" in result.stderr
+    assert str(find_builtin("quickstart").path) not in result.stderr
+    assert not (tmp_path / "runs").exists()  # nothing started

@@ -44,15 +44,16 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
-    from ..preset.builtin import resolve_preset_path
+    from ..preset.builtin import preset_source, resolve_preset_path
     from ..rundir import new_run_folder
 
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
+    source = preset_source(args.preset, args.set or [])
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
-    scene = build_scene(data, source=str(args.preset))
+    scene = build_scene(data, source=source)
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     options = executor_run_options(args, resume=args.resume, force=args.force)

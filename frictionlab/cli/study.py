@@ -138,7 +138,7 @@ def command_line(args) -> str:
 
 def run(args) -> ExitCode:
     from ..preset import read_preset
-    from ..preset.builtin import resolve_preset_path
+    from ..preset.builtin import preset_source, resolve_preset_path
     from ..registry import default_registry
     from ..rundir import new_run_folder
     from ..tradeoff.axes import Study
@@ -150,7 +150,7 @@ def run(args) -> ExitCode:
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
     data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
-    factory = SceneFactory(data, default_registry(), source=str(args.preset))
+    factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []))
     out_dir = Path(args.out) if args.out else new_run_folder(f"{factory.base.preset.name}-study")
 
     def progress(message: str) -> None:

@@ -23,7 +23,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
-    from ..preset.builtin import resolve_preset_path
+    from ..preset.builtin import preset_source, resolve_preset_path
     from ..sweep import plan_sweep
 
     worst = ExitCode.OK
@@ -32,9 +32,10 @@ def run(args) -> ExitCode:
         points = None
         try:
             data = read_preset(resolve_preset_path(path), args.set or [])
-            scene = build_scene(data, source=str(path))
+            source = preset_source(path, args.set or [])
+            scene = build_scene(data, source=source)
             if scene.preset.sweep is not None:  # every point too
-                points = len(plan_sweep(data, source=str(path)).points)
+                points = len(plan_sweep(data, source=source).points)
         except FrictionlabError as exc:
             worst = ExitCode(max(worst, exc.exit_code))
             problems = getattr(exc, "problems", None) or [str(exc)]

@@ -96,3 +96,11 @@ def _one_line(path: Path) -> str:
     if len(line) > _LONGEST:  # cut at a comma, so that a listing keeps one line per preset
         line = line[: line.rfind(", ", 0, _LONGEST)] + " ..."
     return line
+
+
+def preset_source(argument: str | Path, overrides=()) -> str:
+    """How a message names a preset: as the user gave it (a path, or a built-in's name,
+    never the installed file they did not touch), with the ``--set`` overrides they
+    typed, since a problem may come from one of those."""
+    where = str(argument) if Path(argument).suffix or len(Path(argument).parts) > 1 else f"built-in preset {str(argument)!r}"
+    return where + "".join(f" --set {item}" for item in overrides)
