@@ -18,7 +18,7 @@ def add_parser(sub) -> None:
         "intervals, and write the page exact-3d-law.md with its figures. The full plan takes tens of minutes "
         "on two cores; --quick a few minutes (not converged).",
         epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
-        "  frictionlab exact3d --out docs --force",
+        "  frictionlab exact3d --out docs --runs runs/exact3d-full --force",
     )
     p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: a few minutes, not converged")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")

@@ -57,6 +57,15 @@ def make_app(registry, preset=None, workers=1):
     return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", options=RunOptions(workers=workers), registry=registry)
 
 
+async def new_preset(pilot, name: str) -> None:
+    """Press n and accept the New dialog with ``name`` (its default template and file)."""
+    await pilot.pause()
+    await pilot.press("n")
+    await pilot.pause()
+    await pilot.press("ctrl+u", *name, "enter")
+    await pilot.pause()
+
+
 async def open_first_preset(pilot):
     await pilot.pause()
     await pilot.press("enter")

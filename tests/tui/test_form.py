@@ -22,6 +22,7 @@ from .conftest import (
     error_text,
     headless_problems,
     make_app,
+    new_preset,
     open_first_preset,
     sync,
     type_into,
@@ -195,11 +196,7 @@ async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all
     monkeypatch.setattr(frictionlab.tui.folders, "builtin_presets", lambda: [])
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("n")
-        await pilot.pause()
-        await pilot.press("ctrl+u", *"fresh", "enter")
-        await pilot.pause()
+        await new_preset(pilot, "fresh")
         form = app.query_one(PresetForm)
         assert form.data["spectrum"]["name"] == "power-law"
         # power-law's hurst and points have no default: the user is told, as headless would

@@ -28,6 +28,7 @@ from .conftest import (
     SIZE,
     TINY,
     make_app,
+    new_preset,
     make_runs,
     open_first_preset,
     post_keys,
@@ -331,11 +332,7 @@ async def test_an_unreadable_profile_file_fails_the_run_with_its_message(folders
 async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_current_folder(folders, registry):
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("n")
-        await pilot.pause()
-        await pilot.press("ctrl+u", *"fresh", "enter")
-        await pilot.pause()
+        await new_preset(pilot, "fresh")
         problems, path = app.problems, app.draft_path
         assert not (folders / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
         await pilot.press("ctrl+s")
@@ -356,11 +353,7 @@ async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, 
     (folders / "elsewhere").mkdir()
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("n")
-        await pilot.pause()
-        await pilot.press("ctrl+u", *"fresh", "enter")
-        await pilot.pause()
+        await new_preset(pilot, "fresh")
         refused = str(app.screen.query_one("#new-error").render())
         app.screen.query_one("#new-path", Input).focus()
         await pilot.press("ctrl+u", *"elsewhere/fresh", "enter")
