@@ -17,8 +17,8 @@ from .conftest import (
     make_app,
     make_runs,
     open_first_preset,
+    run_to_the_end,
     type_into,
-    wait_until,
 )
 
 SIZES = pytest.mark.parametrize("size", [SIZE, (120, 40)], ids=["80x24", "120x40"])
@@ -45,6 +45,12 @@ def no_blink(pilot):
 async def settle(pilot):
     no_blink(pilot)
     await pilot.pause()
+
+
+async def run_and_settle(pilot):
+    """Ctrl+R, the run (or sweep) to its end, then the screen at rest."""
+    await run_to_the_end(pilot)
+    await settle(pilot)
 
 
 @SIZES
@@ -94,26 +100,14 @@ def test_snapshot_save_with_problems_asks(folders, registry, snap_compare, size)
 
 @SIZES
 def test_snapshot_run_finished(folders, registry, snap_compare, size):
-    async def run(pilot):
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: pilot.app.last_outcome is not None)
-        await settle(pilot)
-
-    assert snap_compare(make_app(registry, preset="presets/tiny.yaml"), terminal_size=size, run_before=run)
+    assert snap_compare(make_app(registry, preset="presets/tiny.yaml"), terminal_size=size, run_before=run_and_settle)
 
 
 @SIZES
 def test_snapshot_sweep_finished(folders, registry, snap_compare, size):
     (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
 
-    async def run(pilot):
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: pilot.app.last_outcome is not None)
-        await settle(pilot)
-
-    assert snap_compare(make_app(registry, preset="presets/sweep.yaml"), terminal_size=size, run_before=run)
+    assert snap_compare(make_app(registry, preset="presets/sweep.yaml"), terminal_size=size, run_before=run_and_settle)
 
 
 @SIZES
