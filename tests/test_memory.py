@@ -4,6 +4,7 @@ refusal that names the estimate, the limit and a setting that fits."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -18,6 +19,12 @@ from frictionlab.preset import build_scene
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, loopback_cluster, merge
+
+
+def offered_points(message: str) -> int:
+    """The grid a memory refusal offers instead ("... points <= 1,234,567 ...")."""
+    return int(re.search(r"points <= ([\d,]+)", message).group(1).replace(",", ""))
+
 
 GiB = 2**30
 
@@ -115,7 +122,7 @@ def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fi
     monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
     with pytest.raises(RunError, match=r"spectrum.params.points <= ([\d,]+)\.") as caught:
         memory.check_fits(scene, workers=2, executor="processes")
-    side = int(caught.value.args[0].split("points <= ")[1].split(".")[0].replace(",", ""))
+    side = offered_points(caught.value.args[0])
     assert memory.estimate(scene, workers=1, executor="processes", points=side**2).total <= GiB
     assert memory.estimate(scene, workers=1, executor="processes", points=(side + 1) ** 2).total > GiB
 
@@ -150,7 +157,7 @@ def test_refusal_offers_fewer_points_when_one_worker_is_too_many(registry, monke
     monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
     with pytest.raises(RunError, match=r"It would fit with --workers 1 and spectrum.params.points <= ([\d,]+)\.") as caught:
         memory.check_fits(scene, workers=2, executor="processes")
-    offered = int(caught.value.args[0].split("points <= ")[1].split(".")[0].replace(",", ""))
+    offered = offered_points(caught.value.args[0])
     fits = memory.estimate(scene, workers=1, executor="processes", points=offered).total
     too_many = memory.estimate(scene, workers=1, executor="processes", points=offered + 1).total
     assert fits <= GiB < too_many
@@ -196,7 +203,7 @@ def test_worker_check_takes_the_smallest_limit_and_skips_workers_without_one(reg
     message = str(caught.value)
     assert "Dask worker tcp://small:2 has a memory limit of 0.20 GiB (the smallest of 2 workers with a limit;" in message
     assert message.startswith(f"one realization of 1,000,000 points would need about {need / GiB:.2f} GiB in a Dask worker")
-    offered = int(message.split("points <= ")[1].split(", or")[0].replace(",", ""))
+    offered = offered_points(message)
     room = int(200 * MiB * 0.95)
     assert memory.DASK_WORKER_PROCESS + offered * memory.BYTES_PER_POINT < room
     assert memory.DASK_WORKER_PROCESS + (offered + 1) * memory.BYTES_PER_POINT + 16 * memory.BYTES_PER_STEP > room
@@ -234,7 +241,7 @@ def test_cli_refuses_a_grid_too_large_for_the_dask_worker_before_submitting_anyt
     assert f"Dask worker {worker} has a memory limit of 0.20 GiB" in err
     assert not out.exists()  # no run directory, no chunk
     # the grid it offers really runs on that worker (a wrong bound would get it killed)
-    offered = int(err.split("points <= ")[1].split(", or")[0].replace(",", ""))
+    offered = offered_points(err)
     assert 300_000 < offered < 1_000_000
     path.write_text(yaml.safe_dump(line_of(offered, realizations=2, **FULL_CONTACT)))
     code = main(["run", str(path), "--out", str(out), "--executor", "dask", "--scheduler", scheduler, "--quiet", "--json"])
