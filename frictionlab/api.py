@@ -40,7 +40,6 @@ same files; ``--no-plot`` is ``plot=False``.
 from __future__ import annotations
 
 import copy
-import csv
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -53,7 +52,7 @@ import numpy as np
 from .errors import FrictionlabError, PresetError, RunFolderError
 from .fit import LogFit
 from .options import RunOptions
-from .results import CURVE_COLUMNS, column_name
+from .results import CURVE_COLUMNS, read_curve
 
 if TYPE_CHECKING:
     from .ensemble import RunOutcome
@@ -326,13 +325,10 @@ def load(folder: str | Path) -> Result | SweepResult:
         raise RunFolderError(f"{folder}: no summary.json (nor sweep.json): not a finished run") from None
     except (OSError, ValueError) as exc:
         raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
-    with open(folder / summary.get("files", {}).get("curve", "curve.csv"), newline="", encoding="utf-8") as fh:
-        rows = list(csv.reader(fh))
-    if [column_name(h).rstrip("'") for h in rows[0]] != list(CURVE_COLUMNS):
-        raise RunFolderError(f"{folder}/curve.csv: columns {rows[0]} are not those frictionlab writes")
-    table = {
-        name: np.array([float(row[i]) if row[i] else math.nan for row in rows[1:]]) for i, name in enumerate(CURVE_COLUMNS)
-    }
+    curve = read_curve(folder / summary.get("files", {}).get("curve", "curve.csv"))
+    if [name.rstrip("'") for name in curve] != list(CURVE_COLUMNS):  # F' on the half-plane
+        raise RunFolderError(f"{folder}/curve.csv: columns {list(curve)} are not those frictionlab writes")
+    table = dict(zip(CURVE_COLUMNS, curve.values()))
     realizations = summary.get("realizations") or {}
     return Result(
         name=summary["preset"]["name"],

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import platform
 from pathlib import Path
 
@@ -93,6 +94,19 @@ def curve_header(scene: Scene) -> list[str]:
 def column_name(header: str) -> str:
     """The short name of a curve.csv column (``F'`` of ``F' [force per unit depth: ...]``)."""
     return header.split(" [", 1)[0]
+
+
+def read_curve(path: Path) -> dict[str, np.ndarray]:
+    """curve.csv read back: each column by its short name (``column_name``), empty
+    cells as NaN; an empty file has no columns."""
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        return {}
+    return {
+        column_name(header): np.array([float(row[i]) if row[i] else math.nan for row in rows[1:]])
+        for i, header in enumerate(rows[0])
+    }
 
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:

@@ -9,7 +9,6 @@ folders, found by their ``sweep.json``.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import os
@@ -185,16 +184,6 @@ def read_run(folder: Path) -> RunEntry:
         summary=summary,
         mtime=summary_path.stat().st_mtime,
     )
-
-
-def read_curve(folder: Path) -> dict[str, list[float]]:
-    """``curve.csv`` as columns of floats by short name (``f``, ``xi``, ...; empty cells become NaN)."""
-    from ..results import column_name
-
-    with open(Path(folder) / "curve.csv", encoding="utf-8", newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    columns = rows[0].keys() if rows else ()
-    return {column_name(c): [float(r[c]) if r[c] else math.nan for r in rows] for c in columns}
 
 
 @dataclass

@@ -17,7 +17,8 @@ from textual.widgets import DataTable, Static
 
 from ...fit import format_interval
 from ..chart import Series
-from ..folders import RunEntry, SweepEntry, list_runs, read_curve, read_run
+from ...results import read_curve
+from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
 from ..text import shorten_middle
 from .chart import Chart
@@ -157,7 +158,7 @@ class ResultsPane(Vertical):
         series, lines = [], []
         for style, entry in zip(OVERLAY_STYLES, self.overlay):
             try:
-                curve = read_curve(entry.path)
+                curve = read_curve(entry.path / "curve.csv")
             except (OSError, ValueError, KeyError) as exc:
                 lines.append(Content.assemble((entry.path.name, style), f": no curve ({exc})"))
                 continue
