@@ -88,6 +88,19 @@ def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path):
         frictionlab.load(tmp_path)
 
 
+def test_load_refuses_a_curve_it_did_not_write_naming_the_file(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
+    curve = folder / "curve.csv"
+    lines = curve.read_text().splitlines()
+    curve.write_text("\n".join(["F,f,xi", *lines[1:]]) + "\n")  # columns missing
+    with pytest.raises(RunFolderError, match=r"curve.csv: columns \['F', 'f', 'xi'\] are not those frictionlab writes"):
+        frictionlab.load(folder)
+    curve.write_text("")  # emptied
+    with pytest.raises(RunFolderError, match=r"curve.csv: columns \[\] are not those"):
+        frictionlab.load(folder)
+
+
 def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path):
     r = frictionlab.run(SMALL_PRESET, out=tmp_path / "a", plot=False, **FAST)
     assert {p.name for p in (tmp_path / "a").iterdir()} >= {"summary.json", "curve.csv", "preset.yaml"}
