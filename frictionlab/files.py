@@ -1,14 +1,22 @@
 """Writing files safely: every file frictionlab writes goes through ``atomic_write``,
 so a reader never sees half a file and an interrupted write leaves the previous
-version intact; ``output_path_problem`` says why a path cannot be an output folder."""
+version intact; ``output_path_problem`` says why a path cannot be an output folder;
+``write_npz`` writes arrays compressed where compressing them pays."""
 
 from __future__ import annotations
 
 import io
 import os
 import tempfile
-from collections.abc import Callable
+import zipfile
+import zlib
+from collections.abc import Callable, Mapping
 from pathlib import Path
+
+import numpy as np
+
+_SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
+_WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size
 
 
 def _read_umask() -> int:
@@ -50,3 +58,25 @@ def output_path_problem(path: Path) -> str | None:
                 return f"{path} is a file, not a folder"
             return f"{path} cannot be made a folder: {candidate} is a file"
     return None
+
+
+def write_npz(fh, arrays: Mapping[str, np.ndarray]) -> None:
+    """Write ``arrays`` to the open binary file ``fh`` as an ``.npz`` (what ``np.load``
+    reads), each array deflated as by ``np.savez_compressed`` unless a sample of it
+    shrinks by less than a quarter: rough floating-point data (the indentations of a
+    run) costs 25 ms a megabyte to deflate and keeps 87 % of its size, while the
+    contact counts and xi shrink 35-100 fold. Same arrays, same bytes: members carry
+    no time stamp."""
+    with zipfile.ZipFile(fh, "w", allowZip64=True) as archive:
+        for name, value in arrays.items():
+            array = np.asanyarray(value)
+            member = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            member.compress_type = zipfile.ZIP_DEFLATED if _deflates(array) else zipfile.ZIP_STORED
+            with archive.open(member, "w", force_zip64=True) as out:
+                np.lib.format.write_array(out, array, allow_pickle=False)
+
+
+def _deflates(array: np.ndarray) -> bool:
+    items = max(1, _SAMPLE_BYTES // max(array.itemsize, 1))
+    sample = np.ascontiguousarray(array.reshape(-1)[:items]).tobytes()
+    return bool(sample) and len(zlib.compress(sample, 1)) < _WORTH_IT * len(sample)

@@ -99,9 +99,30 @@ def format_estimate(value: float, ci, digits: int = 4, missing: str = "n/a") -> 
 
 
 def percentile_interval(samples: np.ndarray, confidence: float, axis: int | None = None):
-    """The central ``confidence`` interval of bootstrap ``samples``: (low, high) percentiles."""
+    """The central ``confidence`` interval of bootstrap ``samples``: (low, high) percentiles.
+
+    The numbers of ``np.percentile(samples, [tail, 100 - tail], axis)`` (its default,
+    linear interpolation), bit for bit, computed from one sort: numpy's own percentile
+    imports ``numpy.ma`` on first use, a sixth of a short run's start-up.
+    """
     tail = 100 * (1 - confidence) / 2
-    return np.percentile(samples, [tail, 100 - tail], axis=axis)
+    ordered = np.sort(np.asarray(samples, dtype=float), axis=axis)
+    axis = 0 if axis is None else axis
+    n = ordered.shape[axis]
+    if n == 0:
+        raise ValueError("percentile_interval needs at least one sample")
+    has_nan = np.isnan(np.take(ordered, -1, axis=axis))  # a NaN sorts last, and makes the percentile NaN
+    bounds = []
+    for percent in (tail, 100 - tail):
+        q = percent / 100
+        position = (n - 1) * q  # numpy's virtual index for the linear method
+        below = min(max(math.floor(position), 0), n - 1)
+        gamma = position - math.floor(position)
+        low, high = np.take(ordered, below, axis=axis), np.take(ordered, min(below + 1, n - 1), axis=axis)
+        step = high - low
+        bound = high - step * (1 - gamma) if gamma >= 0.5 else low + step * gamma  # numpy's lerp, both halves
+        bounds.append(np.where(has_nan, np.nan, bound))
+    return np.array(bounds)
 
 
 def _design(f: np.ndarray) -> np.ndarray:

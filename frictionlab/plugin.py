@@ -40,9 +40,11 @@ Control = Literal["force", "indentation"]
 
 class PluginParams(BaseModel):
     """Base for every plugin's ``Params``: unknown keys are errors, values are
-    validated on assignment too (the TUI edits them in place)."""
+    validated on assignment too (the TUI edits them in place). Each validator is built
+    when its plugin is first used, not when its module is imported (``defer_build``):
+    a run pays for its own plugins only."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, defer_build=True)
 
     def __setattr__(self, name, value):
         # pydantic keeps a value that fails a model-level check on assignment;

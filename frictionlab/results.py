@@ -27,7 +27,7 @@ import yaml
 
 from . import __version__
 from .ensemble import RunOutcome
-from .files import atomic_write
+from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
 
@@ -140,7 +140,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     if scene.preset.output.realizations:
         files["realizations"] = out / "realizations.npz"
         arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f}
-        atomic_write(files["realizations"], lambda fh: np.savez_compressed(fh, **arrays), binary=True)
+        atomic_write(files["realizations"], lambda fh: write_npz(fh, arrays), binary=True)
 
     files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete
     _write_summary(out, scene, outcome, files)

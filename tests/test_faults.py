@@ -182,6 +182,10 @@ def negative_index(folder):
     _rewrite(folder, _second(folder), lambda a: a["index"].__setitem__(0, -1), True)
 
 
+def repeated_index(folder):
+    _rewrite(folder, _second(folder), lambda a: a["index"].__setitem__(1, a["index"][0]), True)
+
+
 def misshapen_rows(folder):
     _rewrite(folder, _second(folder), lambda a: a.__setitem__("xi", a["xi"][:, :-1]), True)
 
@@ -210,6 +214,7 @@ DAMAGE = {
     missing_array: "1 no array xi",
     index_out_of_range: "indices outside",
     negative_index: "indices outside",
+    repeated_index: "or repeated",
     misshapen_rows: "array xi of shape",
     unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",
     listed_twice: None,  # nothing is damaged: no warning

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.fit import fit_log_law, least_squares
+from frictionlab.fit import fit_log_law, least_squares, percentile_interval
 
 
 def test_exact_log_law_is_recovered_exactly():
@@ -88,3 +88,19 @@ def test_bootstrap_equals_refitting_every_resampled_mean_curve():
     low, high = np.percentile(refits, [10, 90], axis=0)
     assert fit.a_ci == pytest.approx((low[0], high[0]), rel=1e-12)
     assert fit.b_ci == pytest.approx((low[1], high[1]), rel=1e-12)
+
+
+@pytest.mark.parametrize("samples", [1, 2, 3, 7, 40, 1000])
+@pytest.mark.parametrize("confidence", [0.0, 0.5, 0.683, 0.9, 0.95, 0.99, 1.0])
+def test_percentile_interval_is_numpys_percentile_bit_for_bit(samples, confidence):
+    rng = np.random.default_rng(samples)
+    tail = 100 * (1 - confidence) / 2
+    pairs = rng.normal(size=(samples, 2))
+    expected = np.percentile(pairs, [tail, 100 - tail], axis=0)
+    np.testing.assert_array_equal(percentile_interval(pairs, confidence, axis=0), expected)
+    flat = rng.lognormal(size=samples)
+    np.testing.assert_array_equal(percentile_interval(flat, confidence), np.percentile(flat, [tail, 100 - tail]))
+    pairs[rng.integers(samples), 1] = np.nan  # a NaN makes its column's bounds NaN, as numpy's
+    np.testing.assert_array_equal(
+        percentile_interval(pairs, confidence, axis=0), np.percentile(pairs, [tail, 100 - tail], axis=0)
+    )

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 from ..errors import PresetFileError, did_you_mean
@@ -22,11 +23,14 @@ _PACKAGE = Path(__file__).resolve().parent.parent
 @dataclass(frozen=True)
 class BuiltinPreset:
     """A preset shipped with frictionlab: its ``name`` (the file's stem, what
-    ``frictionlab run NAME`` takes), a one-line ``description`` and its file."""
+    ``frictionlab run NAME`` takes), its file, and a one-line ``description``."""
 
     name: str
-    description: str
     path: Path
+
+    @cached_property
+    def description(self) -> str:  # read when asked: finding one preset by name reads no file
+        return _one_line(self.path)
 
 
 def builtin_folder() -> Path | None:
@@ -43,7 +47,7 @@ def builtin_presets() -> list[BuiltinPreset]:
     folder = builtin_folder()
     if folder is None:
         return []
-    return [BuiltinPreset(p.stem, _one_line(p), p) for p in sorted(folder.glob("*.yaml"))]
+    return [BuiltinPreset(p.stem, p) for p in sorted(folder.glob("*.yaml"))]
 
 
 def find_builtin(name: str) -> BuiltinPreset | None:
