@@ -163,6 +163,59 @@ def test_bash_completion_sourced_in_bash_completes_commands_options_and_presets(
     assert "benad2012-fig2" in bash_complete(str(script), "frictionlab", "presets", "copy", "bena")
 
 
+ZSH_TAB = r"""
+zmodload zsh/zpty
+zpty shell 'zsh -f -i'
+zpty -w shell "PS1='> '; autoload -U compinit && compinit -u -D; source ${(q)1}"
+zpty -n -w shell "$2"$'\t'
+local out="" chunk
+integer quiet=0 i
+for i in {1..200}; do  # read until a second of silence after the completion, at most 20 s
+  if zpty -r -t shell chunk; then out+=$chunk; quiet=0; else sleep 0.1; (( quiet++ )); fi
+  [[ $out == *$'\a'* || $out == *"$2"?* ]] && (( quiet >= 10 )) && break
+done
+zpty -d shell
+print -r -- "$out"
+"""
+
+
+def zsh_tab(script, line: str) -> str:
+    """What an interactive zsh shows after ``line`` and one TAB, the script loaded
+    as its completion: the completed line, or the listed candidates."""
+    done = subprocess.run(["zsh", "-f", "-c", ZSH_TAB, "zsh", str(script), line], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    return ANSI.sub("", done.stdout).replace("\r", "\n")
+
+
+@pytest.mark.skipif(shutil.which("zsh") is None, reason="zsh is not installed (the script is still checked as text below)")
+def test_zsh_completion_by_tab_in_an_interactive_zsh(tmp_path):
+    script = tmp_path / "_frictionlab"
+    script.write_text(run_cli("completion", "zsh").stdout)
+    listed = zsh_tab(script, "frictionlab re")
+    assert "report" in listed and "resume" in listed and "validate" not in listed
+    assert "frictionlab run quickstart" in zsh_tab(script, "frictionlab run qu")
+    assert "frictionlab completion fish" in zsh_tab(script, "frictionlab completion f")
+    assert "frictionlab presets copy benad2012-fig" in zsh_tab(script, "frictionlab presets copy bena")
+
+
+@pytest.mark.skipif(shutil.which("fish") is None, reason="fish is not installed (the script is still checked as text below)")
+def test_fish_completion_in_a_real_fish(tmp_path):
+    script = tmp_path / "frictionlab.fish"
+    script.write_text(run_cli("completion", "fish").stdout)
+
+    def complete(line: str) -> list[str]:
+        code = f"source {shlex.quote(str(script))}; complete -C {shlex.quote(line)}"
+        done = subprocess.run(["fish", "--no-config", "-c", code], capture_output=True, text=True, timeout=30)
+        assert done.returncode == 0, done.stderr
+        return [row.split("\t")[0] for row in done.stdout.splitlines()]
+
+    assert set(complete("frictionlab re")) == {"report", "resume"}
+    assert "--no-plot" in complete("frictionlab run --no")
+    assert complete("frictionlab completion f") == ["fish"]
+    assert "quickstart" in complete("frictionlab run qu")
+    assert "benad2012-fig2" in complete("frictionlab presets copy bena")
+
+
 def test_zsh_and_fish_scripts_name_every_command():
     zsh = run_cli("completion", "zsh").stdout
     assert zsh.startswith("#compdef frictionlab\n") and "bashcompinit" in zsh and "complete -o filenames -F _frictionlab" in zsh
