@@ -57,11 +57,17 @@ EXAMPLES = """examples:
 
 
 class _Parser(argparse.ArgumentParser):
-    """Every parser keeps the line breaks of its description and examples."""
+    """Every parser keeps the line breaks of its description and examples, and lets a
+    failed write of its help through (argparse drops it), so that ``--help`` into a
+    closed pipe ends as any other output does."""
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
+
+    def _print_message(self, message, file=None):
+        if message:
+            (file or sys.stderr).write(message)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -136,7 +142,15 @@ def main(argv: list[str] | None = None) -> int:
         print(problem, file=sys.stderr)
         return int(ExitCode.USAGE)
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version or a usage error: argparse has printed it
+        if exc.code not in (0, None):
+            raise
+        return _print(None)  # a closed pipe under --help shows in this flush, as under any command
+    except BrokenPipeError:  # `frictionlab --help | head -1`: the reader has enough
+        _quiet_stdout()
+        return int(ExitCode.BROKEN_PIPE)
     args.parser = parser  # a command that describes the CLI itself (completion) reads it
     if args.command is None:  # only options, none of which exits (there are none today)
         return _print(short_help())
@@ -144,9 +158,12 @@ def main(argv: list[str] | None = None) -> int:
         return _run_command(args)
 
 
-def _print(text: str) -> int:
+def _print(text: str | None) -> int:
+    """Print ``text`` (None: only flush what is already written) and say how it went."""
     try:
-        print(text, flush=True)
+        if text is not None:
+            print(text)
+        sys.stdout.flush()
     except BrokenPipeError:
         _quiet_stdout()
         return int(ExitCode.BROKEN_PIPE)

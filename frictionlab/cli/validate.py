@@ -52,7 +52,7 @@ def run(args) -> ExitCode:
         records.append(record)
         if not args.json:
             print(
-                f"{path}: ok ({preset.realizations} realizations, {scene.generator.name} / {scene.solver.name} / "
+                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.generator.name} / {scene.solver.name} / "
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {points} points)" if points is not None else ")")
             )

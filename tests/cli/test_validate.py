@@ -1,6 +1,6 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
-
+import pytest
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
@@ -24,3 +24,10 @@ def test_bad_set_override_is_a_usage_error(tmp_path, capsys):
     assert "must look like dotted.path=value" in capsys.readouterr().err
     assert main(["validate", str(preset), "--set", "seed.x=1"]) == ExitCode.USAGE
     assert "seed is a value, not a mapping" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("count, said", [(1, "(1 realization, "), (2, "(2 realizations, ")])
+def test_validate_counts_realizations_in_good_english(tmp_path, capsys, count, said):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": count}))
+    assert main(["validate", str(preset)]) == ExitCode.OK
+    assert said in capsys.readouterr().out
