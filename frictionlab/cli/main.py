@@ -125,8 +125,10 @@ def program() -> None:
     # Start-up makes some 10^5 objects that live as long as the process (modules, classes,
     # validators), and the cycle collector would walk them about a hundred times for nothing
     # (15 ms of a short run); collect every 10^5 new objects instead of every 700. The
-    # numbers live in numpy arrays, which the collector does not walk.
-    gc.set_threshold(100_000, 20, 20)
+    # numbers live in numpy arrays, which the collector does not walk. The TUI keeps
+    # Python's defaults: it lives long, and wants many short pauses rather than a few long.
+    if sys.argv[1:2] != ["tui"]:
+        gc.set_threshold(100_000, 20, 20)
     code = main()
     gc.freeze()  # the interpreter's exit then skips a last collection of everything imported (40 ms)
     sys.exit(code)
