@@ -22,6 +22,7 @@ import logging
 import math
 import multiprocessing
 import os
+import pickle
 import signal
 import threading
 import time
@@ -253,7 +254,7 @@ class DaskExecutor:
             chunk_of = {}
             for chunk in chunks:
                 future = client.submit(
-                    compute_chunk,
+                    _packed_chunk,
                     scene_future,
                     chunk,
                     key=f"frictionlab-{run_id}-{chunk_label(chunk)}",
@@ -268,11 +269,11 @@ class DaskExecutor:
                     return
                 batch = stream.next_batch(block=False)
                 if not batch:
-                    time.sleep(0.02)
+                    time.sleep(0.005)  # a finished chunk is noticed within 5 ms (a short run ends on it)
                     continue
                 for future in batch:
                     try:
-                        results = future.result()
+                        results = pickle.loads(future.result())
                     except Exception as exc:  # KilledWorker, a plugin missing on a worker, ...
                         raise RunError(
                             f"Dask task for realizations {chunk_label(chunk_of[future.key])} failed: "
@@ -285,6 +286,13 @@ class DaskExecutor:
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+def _packed_chunk(scene: Scene, indices: Chunk) -> bytes:
+    """A Dask task: ``compute_chunk``'s results as one pickle. Dask sends each of a
+    result's arrays as a message part of its own: 40 ms for a chunk of 150 line
+    realizations against 12 ms for the same numbers in one piece."""
+    return pickle.dumps(compute_chunk(scene, indices), protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def make_executor(options: RunOptions, workers: int):
