@@ -109,7 +109,7 @@ class RunDirectory:
 
         problem = output_path_problem(self.path)
         if problem:
-            raise OutputRefused(f"{problem}; give --out a folder")
+            raise OutputRefused(f"{problem}; give a folder for the output")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
@@ -228,7 +228,7 @@ class RunDirectory:
         finished run of the same preset (unless ``force``)."""
         if self.force:
             return
-        hint = "give another --out folder, or --force to write into it anyway"
+        hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
         if state is None:
             others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
             if others:
@@ -250,8 +250,8 @@ class RunDirectory:
         if status != "completed" and self._listed(state):
             raise OutputRefused(
                 f"{self.path} holds an unfinished run ({len(self._listed(state))} chunk file(s) in {CHUNK_DIR}/, "
-                f"status {status}): continue it with --resume (or `frictionlab resume {self.path}`), "
-                "or give another output folder, or --force to start it again"
+                f"status {status}): continue it with --resume (resume=True in Python, or `frictionlab resume {self.path}`), "
+                "or give another output folder, or force it (--force; force=True) to start it again"
             )
 
     def _input_hashes(self, scene: Scene) -> dict:

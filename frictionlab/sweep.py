@@ -338,10 +338,10 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     (its sweep.json names the same sweep and base preset), or ``force``."""
     problem = output_path_problem(out_dir)
     if problem:
-        raise OutputRefused(f"{problem}; give --out a folder")
+        raise OutputRefused(f"{problem}; give a folder for the output")
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
         return
-    hint = "give another --out folder, or --force to write into it anyway"
+    hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
         old = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):

@@ -46,13 +46,13 @@ def run(args) -> ExitCode:
         preset = scene.preset
         record = {
             "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
-            "spectrum": scene.generator.name, "solver": scene.solver.name, "slope": scene.slope.name,
+            "spectrum": scene.spectrum.name, "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
             "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
         }  # fmt: skip
         records.append(record)
         if not args.json:
             print(
-                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.generator.name} / {scene.solver.name} / "
+                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.pressed} / {scene.solver.name} / "
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {points} points)" if points is not None else ")")
             )
