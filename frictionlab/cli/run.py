@@ -69,13 +69,13 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     from ..results import summary_dict
     from ..signals import interrupted_exit_code
 
-    closed = []  # a closed stdout, raised again once the run folder is finished
+    closed = []  # stdout closed or full: raised again once the run folder is finished
 
     def print_table(result) -> None:  # before the figure is drawn: nobody waits for matplotlib
         if not args.json:
             try:
                 print(result_table(scene, result.outcome, out_dir), flush=True)
-            except BrokenPipeError as exc:
+            except OSError as exc:
                 closed.append(exc)
 
     listeners = [] if args.quiet else [ProgressReporter()]
