@@ -27,6 +27,7 @@ import yaml
 
 from . import __version__
 from .ensemble import RunOutcome
+from .errors import RunError
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
@@ -152,11 +153,16 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
     files, and list it in summary.json (rewritten); ``files`` with the plot's path."""
     if not (scene.preset.output.plot and outcome.done):
         return files
-    from .plot import plot_curve  # matplotlib is slow to import: only when drawing
-
     out = Path(out_dir)
     files = {**files, "plot": out / "plot.png"}
-    atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
+    try:
+        from .plot import plot_curve  # matplotlib is slow to import: only when drawing
+
+        atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
+    except OSError as exc:  # the folder said no: named as any failed write
+        raise RunError(f"cannot write {files['plot']}: {exc.strerror or exc}; the numbers are written") from None
+    except Exception as exc:  # matplotlib refused (a bad MPLBACKEND, a broken font cache)
+        raise RunError(f"cannot draw {files['plot']}: {type(exc).__name__}: {exc}; the numbers are written") from None
     _write_summary(out, scene, outcome, files)
     return files
 

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -238,3 +241,27 @@ def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
         "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
     assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
     assert "holds another sweep" in capsys.readouterr().err
+
+
+def _status(folder: Path) -> str:
+    return json.loads((folder / "run.json").read_text())["status"]
+
+
+def test_a_figure_that_cannot_be_written_fails_the_command_but_the_run_is_finished(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
+    out = tmp_path / "run"
+    (out / "plot.png").mkdir(parents=True)  # plot.png cannot be written: it is a folder
+    assert main(["run", str(preset), "--out", str(out), "--quiet", "--force"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "plot.png" in err and "the numbers are written" in err
+    assert _status(out) == "completed" and json.loads((out / "summary.json").read_text())["status"] == "completed"
+    assert main(["run", str(preset), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK  # not "unfinished"
+
+
+def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
+    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(tmp_path / "run"), "--quiet"],
+                          capture_output=True, text=True, timeout=120, env={**os.environ, "MPLBACKEND": "no-such-backend"})  # fmt: skip
+    assert done.returncode == ExitCode.RUNTIME_FAILURE and "internal error" not in done.stderr
+    assert "cannot draw" in done.stderr and "no-such-backend" in done.stderr
+    assert _status(tmp_path / "run") == "completed"
