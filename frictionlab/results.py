@@ -155,16 +155,27 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
         return files
     out = Path(out_dir)
     files = {**files, "plot": out / "plot.png"}
-    try:
+
+    def draw(fh) -> None:
         from .plot import plot_curve  # matplotlib is slow to import: only when drawing
 
-        atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
-    except OSError as exc:  # the folder said no: named as any failed write
-        raise RunError(f"cannot write {files['plot']}: {exc.strerror or exc}; the numbers are written") from None
-    except Exception as exc:  # matplotlib refused (a bad MPLBACKEND, a broken font cache)
-        raise RunError(f"cannot draw {files['plot']}: {type(exc).__name__}: {exc}; the numbers are written") from None
+        plot_curve(scene, outcome, fh)
+
+    write_figure(files["plot"], draw)
     _write_summary(out, scene, outcome, files)
     return files
+
+
+def write_figure(path: Path, draw) -> None:
+    """Write a figure file with ``draw(file)``, which imports matplotlib itself. A
+    failure is a RunError naming the file: a folder that said no, or matplotlib
+    refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then."""
+    try:
+        atomic_write(path, draw, binary=True)
+    except OSError as exc:
+        raise RunError(f"cannot write {path}: {exc.strerror or exc}; the numbers are written") from None
+    except Exception as exc:
+        raise RunError(f"cannot draw {path}: {type(exc).__name__}: {exc}; the numbers are written") from None
 
 
 def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:
