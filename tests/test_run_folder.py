@@ -265,3 +265,28 @@ def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
     assert done.returncode == ExitCode.RUNTIME_FAILURE and "internal error" not in done.stderr
     assert "cannot draw" in done.stderr and "no-such-backend" in done.stderr
     assert _status(tmp_path / "run") == "completed"
+
+
+@pytest.mark.parametrize(
+    "damage, said",
+    [
+        (lambda d: {**d, "chunks": "abc"}, "chunks is not a mapping"),
+        (lambda d: {**d, "chunks": ["a"]}, "chunks is not a mapping"),
+        (lambda d: {**d, "chunks": {"00000000-00000005.npz": 5}}, "chunks is not a mapping"),
+        (lambda d: {**d, "status": 5}, "status is not a word"),
+        (lambda d: {**d, "preset": "x"}, "preset is not a mapping"),
+        (lambda d: {**d, "inputs": [1]}, "inputs is not a mapping"),
+        (lambda d: "[" * 100_000 + "]" * 100_000, "nested too deep"),
+    ],
+)
+def test_a_damaged_manifest_is_a_run_folder_error_naming_what_is_wrong(tmp_path, capsys, damage, said):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    out = tmp_path / "run"
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OK
+    damaged = damage(json.loads((out / "run.json").read_text()))
+    (out / "run.json").write_text(damaged if isinstance(damaged, str) else json.dumps(damaged))
+    capsys.readouterr()
+    for argv in (["resume", str(out)], ["run", str(preset), "--out", str(out), "--quiet"]):
+        assert main(argv) == ExitCode.RUN_FOLDER
+        err = capsys.readouterr().err
+        assert "run.json is damaged" in err and said in err
