@@ -66,13 +66,18 @@ def _write_holder(fd: int) -> None:
 
 
 def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
-    """``runs_dir/<name>-<timestamp>``, a folder that does not exist yet (``-2``, ``-3``, ... appended
-    when one does): where a run goes when the user names no folder."""
+    """``runs_dir/<name>-<timestamp>``, made now and empty (``-2``, ``-3``, ... appended when
+    the name is taken, also by a run started in the same second by another process: making
+    the folder is what claims it): where a run goes when the user names no folder."""
     base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    base.parent.mkdir(parents=True, exist_ok=True)
     candidate, n = base, 2
-    while os.path.lexists(candidate):
-        candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
-    return candidate
+    while True:
+        try:
+            candidate.mkdir()
+            return candidate
+        except FileExistsError:
+            candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
 
 
 def fingerprint(resolved: dict) -> str:

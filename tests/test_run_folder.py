@@ -290,3 +290,24 @@ def test_a_damaged_manifest_is_a_run_folder_error_naming_what_is_wrong(tmp_path,
         assert main(argv) == ExitCode.RUN_FOLDER
         err = capsys.readouterr().err
         assert "run.json is damaged" in err and said in err
+
+
+def test_runs_started_together_without_out_each_get_a_folder_of_their_own(tmp_path):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--quiet", "--workers", "1"]
+    runs = [subprocess.Popen([*command, "--seed", str(seed)], cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+            for seed in range(4)]  # fmt: skip
+    errors = [run.communicate(timeout=120)[1].decode() for run in runs]
+    assert [run.returncode for run in runs] == [0] * 4, errors
+    folders = sorted((tmp_path / "runs").iterdir())
+    assert len(folders) == 4 and all((f / "summary.json").is_file() for f in folders)
+    seeds = {json.loads((f / "summary.json").read_text())["seed"] for f in folders}
+    assert seeds == {0, 1, 2, 3}
+
+
+def test_a_run_refused_before_it_starts_leaves_no_empty_folder_behind(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    preset = write(tmp_path / "p.yaml", merge(QUICK, {"spectrum": {"params": {"points": 10**9}}}))
+    assert main(["run", str(preset), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    assert "would need about" in capsys.readouterr().err
+    assert list((tmp_path / "runs").iterdir()) == []

@@ -58,9 +58,14 @@ def run(args) -> ExitCode:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     options = executor_run_options(args, resume=args.resume, force=args.force)
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
-    if scene.preset.sweep is not None:  # one ensemble per point
-        return _run_sweep(args, data, out_dir, options)
-    return _run_scene(args, scene, out_dir, options)
+    try:
+        if scene.preset.sweep is not None:  # one ensemble per point
+            return _run_sweep(args, data, out_dir, options)
+        return _run_scene(args, scene, out_dir, options)
+    except FrictionlabError:  # refused before it began (the memory check): the folder made for it goes
+        if not args.out and not any(out_dir.iterdir()):
+            out_dir.rmdir()
+        raise
 
 
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
