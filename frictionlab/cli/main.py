@@ -198,6 +198,10 @@ def _run_command(args) -> int:
             return _write_failed(exc)
         print(f"error: {exc.strerror or exc}: {exc.filename}", file=sys.stderr)
         return int(ExitCode.RUNTIME_FAILURE)
+    except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
+        detail = f": {exc}" if str(exc) else ""
+        print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
+        return int(ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
         code = interrupted_exit_code()
         print("terminated" if code == ExitCode.TERMINATED else "interrupted", file=sys.stderr)
