@@ -193,6 +193,9 @@ class RunDirectory:
     def stored_preset(self) -> dict:
         """The preset the run was started with (preset.yaml), read as any preset is."""
         path = self.path / PRESET_FILE
+        if not self.path.is_dir():
+            what = "is not a folder" if os.path.lexists(self.path) else "does not exist"
+            raise RunFolderError(f"{self.path} {what}: there is no run to resume there")
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:

@@ -311,3 +311,19 @@ def test_a_run_refused_before_it_starts_leaves_no_empty_folder_behind(tmp_path, 
     assert main(["run", str(preset), "--quiet"]) == ExitCode.RUNTIME_FAILURE
     assert "would need about" in capsys.readouterr().err
     assert list((tmp_path / "runs").iterdir()) == []
+
+
+def test_what_cannot_be_resumed_is_said_and_nothing_is_made(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    (tmp_path / "afile").write_text("mine")
+    for argv, said in (
+        (["resume", str(tmp_path / "missing")], "missing does not exist: there is no run to resume there"),
+        (["resume", str(tmp_path / "afile")], "afile is not a folder: there is no run to resume there"),
+        (["run", str(preset), "--resume", "--out", str(tmp_path / "new")], "new is not a run folder to resume"),
+    ):
+        assert main(argv) == ExitCode.RUN_FOLDER
+        assert said in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "p.yaml"]  # no folder made
+    assert (tmp_path / "afile").read_text() == "mine"
+    assert main(["run", str(preset), "--out", "", "--quiet"]) == ExitCode.USAGE
+    assert "--out names no folder" in capsys.readouterr().err

@@ -69,7 +69,8 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
     for error in exc.errors(include_url=False):
         path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
-        if error["type"] != "missing" and not (error["type"] == "value_error" and not error["loc"]):
+        checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
+        if error["type"] != "missing" and not checked_together:  # a check of several fields names their values
             line += f", got {short_repr(error['input'])}"
         lines.append(line)
     return lines
