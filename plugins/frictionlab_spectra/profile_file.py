@@ -236,7 +236,7 @@ def _uniform_spacing(where: str, x: np.ndarray) -> float:
     n = x.size
     dx = (x[-1] - x[0]) / (n - 1)
     if not dx > 0:
-        raise ValueError(f"{where}: x must increase (x[0] = {x[0]!r}, x[-1] = {x[-1]!r})")
+        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
     deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
     if deviation > X_TOLERANCE * dx:
         raise ValueError(
