@@ -10,9 +10,9 @@ import typing
 from pydantic import BaseModel, ValidationError
 
 from ..errors import short_repr
+from ..plugin import MAX_MAGNITUDE
 from .schema import NAME_PATTERN, NAME_RULE
 
-MAX_MAGNITUDE = 1e100  # numbers in a preset: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
 
 
 def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
