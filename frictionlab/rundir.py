@@ -70,6 +70,9 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
     the name is taken, also by a run started in the same second by another process: making
     the folder is what claims it): where a run goes when the user names no folder."""
     base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    problem = output_path_problem(base.parent)
+    if problem:
+        raise OutputRefused(f"{problem}; give a folder for the output")
     base.parent.mkdir(parents=True, exist_ok=True)
     candidate, n = base, 2
     while True:
