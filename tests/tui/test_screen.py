@@ -402,3 +402,27 @@ async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders,
     assert status.startswith("Run failed: runs/small-") and "runs is a file" in status
     assert "Traceback" not in error and "Error" not in status
     assert (folders / "runs").read_text().startswith("a file")  # left as it was
+
+
+# ------------------------------------------------------------------ the help line under the form
+
+
+@sync
+async def test_the_help_line_under_a_field_has_no_doubled_full_stop(folders, registry):
+    """Found by a new user: `(M).; allowed: >= 1` and `realizations.npz.; default: True`."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        shown = {}
+        for field in ("field--realizations", "field--output--realizations"):
+            app.query_one(f"#{field}").focus()
+            await pilot.pause()
+            shown[field] = screen_text(app)
+        every_field = []
+        for widget in app.query_one("#form").query("Input, Select, Switch"):
+            widget.focus()
+            await pilot.pause()
+            every_field.append(str(app.query_one("#field-help").render()))
+    assert "realizations: Number of independent random lines (M); allowed: >= 1" in shown["field--realizations"]
+    assert "Keep per-realization curves in realizations.npz; default: True" in shown["field--output--realizations"]
+    assert every_field and not [line for line in every_field if ".;" in line]
