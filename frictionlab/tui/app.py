@@ -85,6 +85,7 @@ class FrictionlabApp(App):
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
         self.problems: list[str] = []
+        self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.cancel_event: threading.Event | None = None  # set while a run goes on
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -152,6 +153,7 @@ class FrictionlabApp(App):
         """Show ``text`` in the status line above the footer (never over the data); it
         stays until the next message. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{title}: ", "bold") if title else "", text)
+        self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -243,6 +245,14 @@ class FrictionlabApp(App):
         self.problems = event.problems
         if event.changed:
             self.modified = True
+        if self.blocked_by is not None and self.blocked_by not in event.problems:
+            # the status said why Ctrl+R refused: that problem is gone, so is the message;
+            # once no problem is left (a field is empty while retyped), it says so
+            if event.problems:
+                self.say("")
+                self.blocked_by = ""
+            else:
+                self.say("The preset is valid: Ctrl+R runs it.")
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems)
 
@@ -325,6 +335,7 @@ class FrictionlabApp(App):
         except PresetError as exc:
             count = len(exc.problems)
             self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
+            self.blocked_by = exc.problems[0]
             self.query_one("#tabs", TabbedContent).active = "edit"
             form = self.query_one("#form", PresetForm)
             form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now

@@ -173,6 +173,41 @@ async def test_ctrl_r_with_a_problem_says_it_and_focuses_the_field_at_fault(fold
     assert "rms_height" in shown and "-1.0" in shown  # the field scrolled into view
 
 
+@sync
+async def test_the_status_takes_back_why_ctrl_r_refused_once_that_problem_is_fixed(folders, registry):
+    """Found by a new user: `Cannot run: 1 problem: realizations: ...` stayed after the
+    value was fixed and the form said valid."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await type_into(pilot, "field--realizations", "abc")
+        await type_into(pilot, "field--seed", "x")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        refused = screen_text(app)
+        await type_into(pilot, "field--realizations", "8")  # the problem the status does not give: it stays
+        kept = status_text(app)
+        await type_into(pilot, "field--seed", "x2")  # the status's problem gone, another in its field
+        fixed = screen_text(app)
+    assert "Cannot run: 2 problems: seed: must be a whole number, got 'x'" in refused
+    assert kept == "Cannot run: 2 problems: seed: must be a whole number, got 'x'"
+    assert "Cannot run" not in fixed and "got 'x2'" in fixed  # the form gives the new one
+
+
+@sync
+async def test_the_status_says_valid_once_the_one_refused_problem_is_fixed(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await type_into(pilot, "field--realizations", "abc")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        refused = status_text(app)
+        await type_into(pilot, "field--realizations", "8")
+        await pilot.pause()
+        fixed = screen_text(app)
+    assert refused == "Cannot run: 1 problem: realizations: must be a whole number, got 'abc'"
+    assert "Cannot run" not in fixed and "The preset is valid: Ctrl+R runs it." in fixed
+
+
 CANNOT_ACT = [  # pressed one after the other, in an app with no preset and no run
     (["ctrl+r"], "No preset open"),
     (["ctrl+s"], "No preset open"),
