@@ -461,3 +461,45 @@ async def test_the_help_line_under_a_field_has_no_doubled_full_stop(folders, reg
     assert "realizations: Number of independent random lines (M); allowed: >= 1" in shown["field--realizations"]
     assert "Keep per-realization curves in realizations.npz; default: True" in shown["field--output--realizations"]
     assert every_field and not [line for line in every_field if ".;" in line]
+
+
+# ------------------------------------------------------------------ Home and End
+
+
+def status_mark_line(shown, name):
+    return next((line for line in shown.splitlines() if name in line), "")
+
+
+@sync
+async def test_home_and_end_go_to_the_first_and_last_row_of_the_lists(folders, registry):
+    """Found by a new user: End did nothing in the Presets list (Ctrl+End did)."""
+    for name in ("alpha", "beta", "gamma", "zulu"):
+        write_preset(folders, name, merge(TINY, {"name": name, "description": f"the {name} preset"}))
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("end")
+        await pilot.pause()
+        at_end = screen_text(app)  # the line about the highlighted preset, under the list
+        await pilot.press("home")
+        await pilot.pause()
+        at_home = screen_text(app)
+        await pilot.press("f5", "end", "enter")
+        await pilot.pause()
+        last_run = screen_text(app)
+        await pilot.press("home", "enter")
+        await pilot.pause()
+        first_run = screen_text(app)
+        runs = [entry.path.name for entry in app.query_one("#results-pane").runs]
+        await app.open_preset(folders / "presets" / "tiny.yaml")  # Home and End in a text field move its cursor
+        field = app.query_one("#field--name", Input)
+        field.focus()
+        await pilot.press("home")
+        post_keys(app, ["end", "x", "home", "y"])
+        await wait_until(pilot, lambda: "x" in field.value and "y" in field.value, timeout=5)
+        typed = field.value
+    assert "the zulu preset" in at_end and "presets/zulu.yaml" in at_end
+    assert "the alpha preset" in at_home and "presets/alpha.yaml" in at_home
+    assert f"■ {runs[-1]}" in last_run and f"■ {runs[0]}" in first_run  # the overlay names the opened run
+    assert typed == "ysmallx"
