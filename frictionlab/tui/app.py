@@ -34,6 +34,7 @@ from .folders import (
     preset_folders,
     preset_from_template,
     read_run,
+    save_folder,
     save_preset,
     templates,
     writable_folder,
@@ -121,6 +122,11 @@ class FrictionlabApp(App):
     @property
     def folders(self):
         return preset_folders(self.presets_dir)
+
+    @property
+    def save_folder(self) -> Path:
+        """Where New and a built-in preset's copy are saved by default: a listed folder."""
+        return save_folder(self.presets_dir)
 
     @property
     def running(self) -> bool:
@@ -232,7 +238,7 @@ class FrictionlabApp(App):
                 return
             self.run_worker(self._open_new(path, data, template), group="open")
 
-        self.push_screen(NewPresetScreen(choices), done)
+        self.push_screen(NewPresetScreen(choices, self.save_folder), done)
 
     async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
         await self.open_preset(path, data, modified=True)
@@ -269,7 +275,11 @@ class FrictionlabApp(App):
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
             self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
             self.push_screen(
-                PathScreen("Save the built-in preset's changes as", new_preset_path(self.draft_path.stem)),
+                PathScreen(
+                    "Save the built-in preset's changes as",
+                    new_preset_path(self.draft_path.stem, self.save_folder),
+                    self.save_folder,
+                ),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -301,12 +311,15 @@ class FrictionlabApp(App):
 
     def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
         try:
+            if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
+                path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
             save_preset(path, data, template=template)
         except OSError as exc:
             self.say(f"{path}: {exc.strerror or exc}", "error", title="Not saved")
             return
         self.say(f"Saved {path}")
         self.reload_presets()
+        self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:
             self.run_worker(self.open_preset(path), group="open")
         else:

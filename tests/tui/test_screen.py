@@ -364,39 +364,40 @@ async def test_an_unreadable_profile_file_fails_the_run_with_its_message(folders
 
 
 @sync
-async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_current_folder(folders, registry):
+async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_presets_folder(folders, registry):
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")
         problems, path = app.problems, app.draft_path
-        assert not (folders / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
+        assert not (folders / "presets" / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
         await pilot.press("ctrl+s")
         await pilot.pause()
     assert problems == []
-    assert path == Path("fresh.yaml")
+    assert path == Path("presets/fresh.yaml")  # the folder the list shows
+    saved = folders / "presets" / "fresh.yaml"
     quickstart = find_builtin("quickstart").path  # the template offered first: it runs in about a second
-    assert yaml.safe_load((folders / "fresh.yaml").read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
-    assert quickstart.read_text().splitlines()[0] in (folders / "fresh.yaml").read_text()  # its comments kept
-    assert load_scene(folders / "fresh.yaml", registry=registry).preset.name == "fresh"
-    assert main(["run", "fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
+    assert yaml.safe_load(saved.read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
+    assert quickstart.read_text().splitlines()[0] in saved.read_text()  # its comments kept
+    assert load_scene(saved, registry=registry).preset.name == "fresh"
+    assert main(["run", "presets/fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
     assert json.loads((folders / "runs" / "fresh" / "summary.json").read_text())["status"] == "completed"
 
 
 @sync
 async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, registry):
-    (folders / "fresh.yaml").write_text("keep me\n")
+    (folders / "presets" / "fresh.yaml").write_text("keep me\n")
     (folders / "elsewhere").mkdir()
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")
-        refused = str(app.screen.query_one("#new-error").render())
+        refused = screen_text(app)
         app.screen.query_one("#new-path", Input).focus()
         await pilot.press("ctrl+u", *"elsewhere/fresh", "enter")
         await pilot.pause()
         await pilot.press("ctrl+s")
         await pilot.pause()
-    assert "exists" in refused
-    assert (folders / "fresh.yaml").read_text() == "keep me\n"
+    assert "presets/fresh.yaml exists: give another file" in refused  # said in the dialog
+    assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
     assert load_scene(folders / "elsewhere" / "fresh.yaml", registry=registry).preset.name == "fresh"
 
 
@@ -421,6 +422,57 @@ async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monke
     assert "quickstart" in listed and "built-in" in listed
     assert asked and quickstart.read_text() == original
     assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
+
+
+def highlighted_path(app) -> str:
+    """The path line under the Presets list: the highlighted preset's file."""
+    return str(app.query_one("#preset-path").render())
+
+
+@sync
+async def test_a_built_in_presets_copy_goes_by_default_where_the_list_shows_it(tmp_path, monkeypatch, registry):
+    """Found by a new user: Ctrl+S on a built-in preset offered ./quickstart.yaml, a
+    folder the Presets tab does not list, so the saved preset vanished. Its default is
+    now ./presets (made when first saved into), listed, and highlighted after saving."""
+    monkeypatch.chdir(tmp_path)  # no ./presets yet
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    quickstart = find_builtin("quickstart").path
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "presets" / "quickstart.yaml").write_text("keep me\n")  # never replaced unasked
+    app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        await app.open_preset(quickstart)
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        offered = app.screen.query_one(Input).value
+        await pilot.press("enter")  # the file exists: the dialog asks a second Enter
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("ctrl+u", *"presets/my-qs", "enter")
+        await pilot.pause()
+        await pilot.press("f2")
+        await pilot.pause()
+        listed, highlighted = screen_text(app), highlighted_path(app)
+    assert offered == "presets/quickstart.yaml"
+    assert "presets/quickstart.yaml exists: Enter again replaces it" in asked
+    assert (tmp_path / "presets" / "quickstart.yaml").read_text() == "keep me\n"
+    assert load_scene(tmp_path / "presets" / "my-qs.yaml", registry=registry).preset.name == "quickstart"
+    assert "my-qs.yaml" in listed and highlighted == "presets/my-qs.yaml"
+
+
+@sync
+async def test_a_new_preset_goes_by_default_into_the_presets_folder_made_for_it(folders, registry):
+    app = FrictionlabApp(presets_dir="mine", runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await new_preset(pilot, "fresh")  # --presets mine: a folder that does not exist yet
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        await pilot.press("f2")
+        await pilot.pause()
+        listed, highlighted = screen_text(app), highlighted_path(app)
+    assert load_scene(folders / "mine" / "fresh.yaml", registry=registry).preset.name == "fresh"
+    assert "fresh.yaml" in listed and highlighted == "mine/fresh.yaml"
 
 
 @sync
