@@ -26,6 +26,7 @@ from frictionlab.tui.screens import PathScreen
 from ..conftest import merge
 from .conftest import (
     SIZE,
+    fits_width,
     TINY,
     make_app,
     new_preset,
@@ -91,23 +92,31 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
 
 
 LONG_NAME = "a-longer-study-20261125-210620"
+MID = (100, 30)
 
 
-@pytest.mark.parametrize("size", [SIZE, BIG])
+@pytest.mark.parametrize("size", [SIZE, MID, BIG])
 @sync
 async def test_run_names_use_the_width_they_have(folders, registry, size):
+    """Found by a new user: at 100 columns `quickstart…1125-235755` with half the
+    screen free; the list now widens for its names while the plot keeps 40 columns."""
     make_runs(folders, registry)
     (folders / "runs" / "seed1").rename(folders / "runs" / LONG_NAME)
+    (folders / "runs" / "seed2").rename(folders / "runs" / ("x" * 70 + "-20261125-235755"))
     app = make_app(registry)
     async with app.run_test(size=size) as pilot:
         await pilot.pause()
         await pilot.press("f5")
         await pilot.pause()
         shown = screen_text(app)
-    if size == BIG:
-        assert LONG_NAME in shown  # 30 characters: whole at 120 columns
-    else:  # shortened from the middle: where it starts and its time stamp stay
+        table, chart = app.query_one("#runs-table"), app.query_one("#results-chart")
+        whole, plot_width = fits_width(table), chart.size.width
+    if size == SIZE:  # shortened from the middle: where it starts and its time stamp stay
         assert "a-longer…5-210620" in shown
+    else:
+        assert LONG_NAME in shown  # 30 characters: whole at 100 columns and more
+    assert [line for line in shown.splitlines() if "xxx…" in line and "235755 " in line]  # too long: shortened
+    assert whole and plot_width >= 40
 
 
 @sync
