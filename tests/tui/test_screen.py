@@ -564,3 +564,30 @@ async def test_home_and_end_go_to_the_first_and_last_row_of_the_lists(folders, r
     assert "the alpha preset" in at_home and "presets/alpha.yaml" in at_home
     assert f"■ {runs[-1]}" in last_run and f"■ {runs[0]}" in first_run  # the overlay names the opened run
     assert typed == "ysmallx"
+
+
+# ------------------------------------------------------------------ where focus starts
+
+
+def field_line(shown, label):
+    return next(line for line in shown.splitlines() if line.startswith(f"{label} "))
+
+
+@pytest.mark.parametrize("route", ["list", "command line"])
+@sync
+async def test_opening_a_preset_either_way_leaves_focus_on_its_first_field(folders, registry, route):
+    """A new user found Tab x3 reached `realizations` after Enter in the list but `name`
+    with the preset given on the command line. Either way focus is now on `name`, so
+    three Tabs and a number change `realizations`."""
+    app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
+    async with app.run_test(size=SIZE) as pilot:
+        if route == "list":
+            await open_first_preset(pilot)
+        await pilot.pause()
+        first = app.focused.id
+        await pilot.press("tab", "tab", "tab", "7")
+        await pilot.pause()
+        shown = screen_text(app)
+    assert first == "field--name"
+    assert field_line(shown, "realizations").split() == ["realizations", "7"]
+    assert field_line(shown, "name").split() == ["name", "small"]
