@@ -283,6 +283,13 @@ class FrictionlabApp(App):
                 lambda path: path is not None and self._save_checked(path),
             )
             return
+        if self.draft_source != self.draft_path and self.draft_path.exists():
+            # a new preset whose file appeared since the New dialog: replaced only if the user says so
+            self.push_screen(
+                PathScreen(f"{self.draft_path} exists now: save the new preset as", self.draft_path, self.save_folder),
+                lambda path: path is not None and self._save_checked(path),
+            )
+            return
         self._save_checked(self.draft_path)
 
     def action_save_as(self) -> None:

@@ -411,6 +411,21 @@ async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, 
 
 
 @sync
+async def test_ctrl_s_never_replaces_a_file_made_after_the_new_dialog(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await new_preset(pilot, "fresh")
+        (folders / "presets" / "fresh.yaml").write_text("keep me\n")  # made meanwhile, by someone else
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("escape")
+        await pilot.pause()
+    assert "presets/fresh.yaml exists now" in asked
+    assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
+
+
+@sync
 async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monkeypatch, registry):
     monkeypatch.chdir(tmp_path)  # no ./presets here: the built-in ones are listed beside the user's
     monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
