@@ -107,7 +107,7 @@ def available_memory() -> tuple[int, str]:
 
     found: list[tuple[int, str]] = []
     try:
-        found.append((int(psutil.virtual_memory().available), "available memory (MemAvailable on Linux)"))
+        found.append((int(psutil.virtual_memory().available), "the memory the system says is available: MemAvailable on Linux"))
     except (OSError, RuntimeError):
         pass
     for limit_file, usage_file in (
@@ -122,7 +122,7 @@ def available_memory() -> tuple[int, str]:
         if limit.isdigit() and int(limit) < 2**60:
             found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
     if not found:
-        return 2**62, "unknown (the platform does not say)"
+        return 2**62, "unknown: the platform does not say"
     return min(found)
 
 

@@ -38,6 +38,9 @@ Control = Literal["force", "indentation"]
 """What a sweep's loads are: total loads (see ``LoadMeaning``) or indentations."""
 
 
+MAX_MAGNITUDE = 1e100  # numbers frictionlab reads: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
+
+
 class PluginParams(BaseModel):
     """Base for every plugin's ``Params``: unknown keys are errors, values are
     validated on assignment too (the TUI edits them in place). Each validator is built
@@ -187,6 +190,9 @@ class ForceNormalisation:
     load: LoadMeaning
     modulus: str
     extent: Extent
+    # What X is, in words, where the profile's own words would mislead (an MDR-equivalent
+    # line: its length is 2 sqrt(A / pi) of the surface it stands for); "" for the usual ones.
+    extent_words: str = ""
 
     def __post_init__(self):
         if self.load not in _LOAD_SYMBOLS:
@@ -224,7 +230,7 @@ class ForceNormalisation:
         """``f = F / (E* h L), L = 2 sqrt(A / pi), ...``: the formula with its symbols explained."""
         where = [f"{self.load_symbol} the {self.load}", "h the rms height"]
         if self.extent != "one":
-            where.append(_EXTENT_DEFINITIONS[self.extent])
+            where.append(self.extent_words or _EXTENT_DEFINITIONS[self.extent])
         return f"f = {self.formula}, " + ", ".join(where)
 
     def extent_of(self, profile: Profile) -> float:

@@ -104,7 +104,7 @@ class ProgressReporter:
         )
         restored = f" ({restored})" if restored else ""
         self._write(
-            f"{preset.name}: {run.total} realizations of {run.scene.generator.name} lines{restored}, "
+            f"{preset.name}: {run.total} realizations of {run.scene.pressed}{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)"
         )
 

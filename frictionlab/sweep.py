@@ -38,6 +38,7 @@ from .options import RunOptions
 from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
+from .results import write_figure
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
@@ -323,10 +324,14 @@ def run_sweep(
     outcome.elapsed = time.perf_counter() - started
     outcome.files = write_tables(sweep, outcome, out_dir)
     if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
-        from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
 
+        def draw(fh) -> None:
+            from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+
+            plot_sweep(sweep, outcome.rows, fh)
+
+        write_figure(out_dir / "sweep.png", draw)
         outcome.files["plot"] = out_dir / "sweep.png"
-        atomic_write(outcome.files["plot"], lambda fh: plot_sweep(sweep, outcome.rows, fh), binary=True)
         write_tables(sweep, outcome, out_dir)
     for listener in listeners:
         listener.sweep_finished(sweep, outcome)
@@ -338,10 +343,10 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     (its sweep.json names the same sweep and base preset), or ``force``."""
     problem = output_path_problem(out_dir)
     if problem:
-        raise OutputRefused(f"{problem}; give --out a folder")
+        raise OutputRefused(f"{problem}; give a folder for the output")
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
         return
-    hint = "give another --out folder, or --force to write into it anyway"
+    hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
         old = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):

@@ -87,3 +87,8 @@ def test_the_validation_errors_shown_are_what_validate_prints(tmp_path, monkeypa
     assert main(["validate", "bad.yaml"]) == 2
     captured = capsys.readouterr()
     _check("docs/how-to/presets.md", "$ frictionlab validate bad.yaml", captured.out + captured.err)
+
+
+def test_the_built_in_presets_listing_shown_is_what_it_prints(capsys):
+    assert main(["presets"]) == 0
+    _check("docs/getting-started.md", "NAME", capsys.readouterr().out)

@@ -191,3 +191,13 @@ def test_mdr_on_a_surface_runs_its_line_at_the_surfaces_3d_f(registry):
     assert np.all(outcome.per_realization["contact_count"] <= scene.equivalent_line.params.points)
     again = build_scene(scene.resolved(), registry=registry)
     np.testing.assert_array_equal(engine.run(again, RunOptions(workers=1)).xi, outcome.xi)
+
+
+def test_f_of_an_mdr_equivalent_line_is_said_for_the_surface_and_its_length_is_2_sqrt_area_over_pi(registry):
+    data = merge(SMALL_PRESET, {"spectrum": {"name": "power-law-2d", "params": {"points": 32, "length": 64.0}}})
+    scene = build_scene(data, registry=registry)
+    assert scene.pressed == "MDR-equivalent lines of power-law-2d surfaces"
+    n = scene.normalisation
+    assert n.extent == "length" and "L = 2 sqrt(A / pi) the MDR-equivalent line's length" in n.definition
+    profile = scene.generator.generate(np.random.default_rng(0))
+    assert n.extent_of(profile) == pytest.approx(mdr_length(64.0**2), rel=1e-12)

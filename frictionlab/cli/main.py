@@ -27,7 +27,7 @@ import warnings
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
-from .console import error_label
+from .console import error_label, shown
 
 COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
@@ -129,6 +129,9 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
+    for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
     code = main()
     gc.freeze()  # the interpreter's exit then skips a last collection of everything imported (40 ms)
     sys.exit(code)
@@ -150,9 +153,8 @@ def main(argv: list[str] | None = None) -> int:
         if exc.code not in (0, None):
             raise
         return _print(None)  # a closed pipe under --help shows in this flush, as under any command
-    except BrokenPipeError:  # `frictionlab --help | head -1`: the reader has enough
-        _quiet_stdout()
-        return int(ExitCode.BROKEN_PIPE)
+    except OSError as exc:  # the help could not be written: `| head -1` (a closed pipe), `> /dev/full`
+        return _write_failed(exc)
     args.parser = parser  # a command that describes the CLI itself (completion) reads it
     if args.command is None:  # only options, none of which exits (there are none today)
         return _print(short_help())
@@ -166,26 +168,39 @@ def _print(text: str | None) -> int:
         if text is not None:
             print(text)
         sys.stdout.flush()
-    except BrokenPipeError:
-        _quiet_stdout()
-        return int(ExitCode.BROKEN_PIPE)
+    except OSError as exc:
+        return _write_failed(exc)
     return int(ExitCode.OK)
+
+
+def _write_failed(exc: OSError) -> int:
+    """stdout could not be written: a closed pipe ends quietly (its reader has enough),
+    anything else (a full disk) is said on stderr."""
+    _quiet_stdout()  # the interpreter's last flush must not fail again
+    if isinstance(exc, BrokenPipeError):
+        return int(ExitCode.BROKEN_PIPE)
+    print(f"error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
+    return int(ExitCode.RUNTIME_FAILURE)
 
 
 def _run_command(args) -> int:
     try:
         code = int(args.handler(args))
-        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code
-    except BrokenPipeError:  # `frictionlab plugins --json | head -c 10`: the reader has enough
-        _quiet_stdout()
-        return int(ExitCode.BROKEN_PIPE)
+    except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
+        return _write_failed(exc)
     except FrictionlabError as exc:
-        print(f"{error_label()}: {exc}", file=sys.stderr)
+        print(f"{error_label()}: {shown(str(exc))}", file=sys.stderr)
         return int(exc.exit_code)
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
-        where = f": {exc.filename}" if exc.filename else ""
-        print(f"error: {exc.strerror or exc}{where}", file=sys.stderr)
+        if not exc.filename:  # stdout itself (`> /dev/full`)
+            return _write_failed(exc)
+        print(f"error: {exc.strerror or exc}: {exc.filename}", file=sys.stderr)
+        return int(ExitCode.RUNTIME_FAILURE)
+    except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
+        detail = f": {exc}" if str(exc) else ""
+        print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
         return int(ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
         code = interrupted_exit_code()

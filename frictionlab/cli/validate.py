@@ -6,6 +6,7 @@ import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError
+from .console import shown
 
 
 def add_parser(sub) -> None:
@@ -41,18 +42,18 @@ def run(args) -> ExitCode:
             problems = getattr(exc, "problems", None) or [str(exc)]
             records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
             if not args.json:
-                print(str(exc), file=sys.stderr)
+                print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
         record = {
             "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
-            "spectrum": scene.generator.name, "solver": scene.solver.name, "slope": scene.slope.name,
+            "spectrum": scene.spectrum.name, "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
             "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
         }  # fmt: skip
         records.append(record)
         if not args.json:
             print(
-                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.generator.name} / {scene.solver.name} / "
+                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.pressed} / {scene.solver.name} / "
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {points} points)" if points is not None else ")")
             )

@@ -4,7 +4,7 @@ and ``build_scene``, phase two of the validation (each plugin's own ``Params``).
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -44,9 +44,22 @@ class Scene:
         return "surface" if self.spectrum.dimension == 2 else "line"
 
     @property
+    def pressed(self) -> str:
+        """What is pressed, in words and by the name the preset gives: 'power-law lines',
+        'power-law-2d surfaces', 'MDR-equivalent lines of power-law-2d surfaces'."""
+        if self.equivalent_line is not None:
+            return f"MDR-equivalent lines of {self.spectrum.name} surfaces"
+        return f"{self.spectrum.name} {'surfaces' if self.spectrum.dimension == 2 else 'lines'}"
+
+    @property
     def normalisation(self) -> ForceNormalisation:
-        """What the loads mean and how f is formed, for the profiles that are pressed."""
-        return self.solver.normalisation(self.generator.dimension)
+        """What the loads mean and how f is formed, for the profiles that are pressed (an
+        MDR-equivalent line's length said as what it is for the surface)."""
+        normalisation = self.solver.normalisation(self.generator.dimension)
+        if self.equivalent_line is not None and normalisation.extent == "length":
+            words = "L = 2 sqrt(A / pi) the MDR-equivalent line's length, A the surface's apparent area"
+            normalisation = replace(normalisation, extent_words=words)
+        return normalisation
 
     @functools.cached_property
     def loads(self) -> np.ndarray:

@@ -102,6 +102,21 @@ def test_a_closed_pipe_ends_quietly(argv, tmp_path):
     assert done.returncode == ExitCode.BROKEN_PIPE
 
 
+@pytest.mark.parametrize("argv", [["plugins"], ["--help"], ["-V"], ["run", "quickstart", "--no-plot", "--quiet"]])
+def test_a_closed_stdout_is_written_nowhere_and_a_full_one_is_an_error(argv, tmp_path):
+    run = lambda **how: subprocess.run([sys.executable, "-m", "frictionlab", *argv, *(["--out", str(tmp_path / ("closed" if "preexec_fn" in how else "full"))] if argv[0] == "run" else [])],
+                                       stderr=subprocess.PIPE, text=True, cwd=tmp_path, timeout=120, **how)  # fmt: skip
+    closed = run(preexec_fn=lambda: os.close(1))  # `frictionlab ... >&-`: started without a stdout
+    assert (closed.returncode, closed.stderr) == (0, "")
+    if os.path.exists("/dev/full"):
+        with open("/dev/full", "w") as full:
+            done = run(stdout=full)
+        assert done.returncode == ExitCode.RUNTIME_FAILURE
+        assert done.stderr == "error: cannot write the output: No space left on device\n"
+    if argv[0] == "run":  # the run itself is complete either way
+        assert (tmp_path / "closed" / "summary.json").is_file()
+
+
 def in_terminal(*argv: str, columns: int = 60, **env: str) -> str:
     """The output of ``frictionlab ARGV`` on a pseudo-terminal ``columns`` wide."""
     main, child = pty.openpty()

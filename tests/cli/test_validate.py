@@ -1,5 +1,7 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
+import json
+
 import pytest
 
 from frictionlab.cli import main
@@ -31,3 +33,29 @@ def test_validate_counts_realizations_in_good_english(tmp_path, capsys, count, s
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": count}))
     assert main(["validate", str(preset)]) == ExitCode.OK
     assert said in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "spectrum, solver, pressed",
+    [
+        ({"name": "power-law", "params": {"points": 256}}, "mdr", "power-law lines"),
+        ({"name": "power-law-2d", "params": {"points": 32}}, "mdr", "MDR-equivalent lines of power-law-2d surfaces"),
+        ({"name": "power-law-2d", "params": {"points": 32}}, "bem-halfspace", "power-law-2d surfaces"),
+    ],
+)
+def test_validate_says_what_is_pressed_by_the_name_the_preset_gives(tmp_path, capsys, spectrum, solver, pressed):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"spectrum": spectrum, "solver": {"name": solver, "params": {}}}))
+    assert main(["validate", str(preset)]) == ExitCode.OK
+    assert f"realizations, {pressed} / {solver} / " in capsys.readouterr().out
+    assert main(["validate", str(preset), "--json"]) == ExitCode.OK
+    record = json.loads(capsys.readouterr().out)[0]
+    assert record["spectrum"] == spectrum["name"] and record["pressed"] == pressed
+
+
+def test_control_characters_typed_in_a_set_are_shown_escaped_never_sent_to_the_terminal(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    for command in ("validate", "run"):
+        assert main([command, str(preset), "--set", "seed=\x1b[31m1\x07"]) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert "\x1b" not in err and "\x07" not in err
+        assert "--set seed=\\x1b[31m1\\x07" in err
