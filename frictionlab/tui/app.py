@@ -21,6 +21,7 @@ from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
 from ..errors import FrictionlabError, PresetError, RunFolderError
+from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
@@ -361,7 +362,13 @@ class FrictionlabApp(App):
             form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
             form.focus_problem(exc.problems)
             return
-        self._start(scene, sweep, new_run_folder(scene.preset.name, self.runs_dir), self.run_options)
+        try:
+            out_dir = new_run_folder(scene.preset.name, self.runs_dir)  # made now: it claims the name
+        except OSError as exc:
+            problem = output_path_problem(self.runs_dir) or f"{self.runs_dir}: {exc.strerror or exc}"
+            self.say(problem, "error", title="Run failed")
+            return
+        self._start(scene, sweep, out_dir, self.run_options)
 
     def resume_run(self, folder: Path | None) -> None:
         """Continue a cancelled or interrupted run in ``folder`` with the preset stored
