@@ -128,7 +128,8 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if event.input.id == "new-name" and not self.path_edited:
-            self.query_one("#new-path", Input).value = str(new_preset_path(event.value.strip() or "my-scene", self.folder))
+            name = event.value.strip() or "my-scene"
+            self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))
         elif event.input.id == "new-path" and event.input.has_focus:
             self.path_edited = True
 

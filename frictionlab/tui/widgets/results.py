@@ -29,7 +29,8 @@ OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
 HINT = "Enter opens a run; Space adds it to the overlay."
 NO_RUNS = "No runs yet: Ctrl+R runs the open preset (F2 lists the presets)."
 FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of the list's width
-LIST_SHARE, LIST_MIN, CHART_MIN = 0.45, 40, 40  # the list's width: its share, at least LIST_MIN; the plot keeps CHART_MIN
+# the list's width: its share of the pane, at least LIST_MIN; the plot keeps CHART_MIN
+LIST_SHARE, LIST_MIN, CHART_MIN = 0.45, 40, 40
 
 
 class ResultsPane(Vertical):
