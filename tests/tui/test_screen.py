@@ -33,6 +33,7 @@ from .conftest import (
     make_runs,
     open_first_preset,
     post_keys,
+    press_run,
     run_to_the_end,
     screen_text,
     status_text,
@@ -354,19 +355,20 @@ async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, re
 
 
 @sync
-async def test_an_unreadable_profile_file_fails_the_run_with_its_message(folders, registry):
+async def test_an_unreadable_profile_file_is_refused_before_a_run_with_its_message(folders, registry):
+    """The validator reads a measured profile (as `frictionlab validate` does): Ctrl+R
+    refuses the preset with the file's own message instead of running it to fail."""
     profile_preset(folders, "1.0\nabc\n")
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:
-        await run_to_the_end(pilot)
+        await press_run(pilot)
+        await pilot.pause()
         status = status_text(app)
-        stats = str(app.query_one("#run-stats").render())
-        error = str(app.query_one("#run-error").render())
-    assert status.startswith("Run failed: no realization finished: profile-file")
-    assert "non-numeric content at line 2" in status
-    for text in (status, error):  # what the user can act on, not the internals
-        assert "ValueError" not in text and ".py:" not in text
-    assert stats.startswith("failed: 0/8 realizations")
+        panel = str(app.query_one("#problems").render())
+    assert not app.running and app.last_out_dir is None
+    assert status.startswith("Cannot run: 1 problem: spectrum.params: profile-file")
+    assert "non-numeric content at line 2" in status and "non-numeric content at line 2" in panel
+    assert "ValueError" not in status and ".py:" not in status  # what the user can act on, not the internals
 
 
 # ------------------------------------------------------------------ New
