@@ -297,10 +297,10 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         return None
     try:
         with open_regular_file(path, "realizations.npz") as fh:
-            data = np.load(fh, allow_pickle=False)
-            if not isinstance(data, np.lib.npyio.NpzFile):
-                raise RunFolderError(f"{path} is damaged (a single array, not an .npz archive of arrays)")
-            with data:
+            if fh.read(2) != b"PK":  # every zip, so every .npz, starts so
+                raise RunFolderError(f"{path} is damaged (not an .npz archive: it does not start as a zip file does)")
+            fh.seek(0)
+            with np.load(fh, allow_pickle=False) as data:
                 missing = [name for name in ("xi", "f") if name not in data.files]
                 if missing:
                     raise RunFolderError(
@@ -309,9 +309,14 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
                 xi, f = data["xi"], data["f"]
     except InputFileProblem as exc:
         raise RunFolderError(f"{path}: {exc}") from None
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:  # not an .npz, cut short, pickled
-        reason = short_repr(str(exc) or type(exc).__name__, 120)[1:-1]
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:  # cut short, pickled, bad header
+        reason = str(exc) or type(exc).__name__
+        if "allow_pickle" in reason:
+            reason = "it holds pickled Python objects, which are never loaded"
+        reason = short_repr(reason, 120)[1:-1]
         raise RunFolderError(f"{path} is damaged (not an .npz archive of number arrays: {reason})") from None
+    except MemoryError as exc:  # an array's header may claim any shape
+        raise RunFolderError(f"{path}: an array in it is larger than this machine's memory ({exc})") from None
     for name, array, ndim in (("xi", xi, 2), ("f", f, 1)):
         if array.dtype.kind not in "fiu" or array.ndim != ndim or not array.size:
             raise RunFolderError(

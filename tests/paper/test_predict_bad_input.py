@@ -2,10 +2,12 @@
 naming the file and the field), numbers beyond double precision and options out of
 range (exit 2, naming what is out of range); never a traceback or an internal error."""
 
+import io
 import json
 import math
 import shutil
 import threading
+import zipfile
 
 import numpy as np
 import pytest
@@ -210,6 +212,18 @@ def _fewer_rows(path):  # realizations of another run: fewer than summary.json s
         np.savez(fh, **arrays)
 
 
+def _array_larger_than_memory(path):  # a header may claim any shape
+    header = io.BytesIO()
+    claim = {"descr": "<f8", "fortran_order": False, "shape": (10**14, 16)}  # past any address space
+    np.lib.format.write_array_header_1_0(header, claim)
+    with np.load(path) as data:
+        f = data["f"]
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("xi.npy", header.getvalue() + bytes(64))
+        with archive.open("f.npy", "w") as member:
+            np.save(member, f)
+
+
 def _one_array(path):
     with path.open("wb") as fh:
         np.save(fh, np.ones(4))
@@ -223,17 +237,18 @@ def _folder(path):
 @pytest.mark.parametrize(
     "damage, words",
     [
-        (_junk, "is damaged"),
+        (_junk, "is damaged (not an .npz archive"),
         (_empty, "is damaged"),
         (_truncated, "is damaged"),
-        (_pickled, "is damaged"),
+        (_pickled, "pickled Python objects, which are never loaded"),
+        (_array_larger_than_memory, "larger than this machine's memory"),
         (_without_xi, "no array 'xi'"),
         (_all_nan, "'xi' must hold finite numbers"),
         (_f_not_positive, "'f' must hold finite numbers > 0"),
         (_xi_of_other_shape, "one per load step"),
         (_xi_as_text, "'xi' must be 2-D numbers"),
         (_fewer_rows, "not of one run"),
-        (_one_array, "not an .npz archive"),
+        (_one_array, "not an .npz archive: it does not start as a zip file does"),
         (_folder, "a folder"),
     ],
 )
@@ -303,7 +318,8 @@ def test_an_f_double_precision_holds_is_found_whatever_the_products_do(capsys, a
                  "--force", repr(force), "--json"])  # fmt: skip
     out = json.loads(capsys.readouterr().out)
     assert code == 0
-    ln_f = math.log(math.sqrt(math.pi) / 2) + math.log(force) - math.log(modulus) - math.log(rms_height) - 0.5 * math.log(area)
+    ln_f = math.log(math.sqrt(math.pi) / 2) + math.log(force) - math.log(modulus) - math.log(rms_height)
+    ln_f -= 0.5 * math.log(area)
     assert math.log(out["f"]) == pytest.approx(ln_f, abs=1e-12)
     assert out["xi"] == pytest.approx(1 + 0.1 * ln_f, rel=1e-12)
 
