@@ -190,8 +190,10 @@ def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.n
     path = run_dir / "summary.json"
     status = summary.get("status", "completed")
     if status != "completed":
-        done = summary.get("realizations")
-        count = f" ({done.get('done')!r} of {done.get('requested')!r} realizations)" if isinstance(done, dict) else ""
+        counts = summary.get("realizations")
+        count = ""
+        if isinstance(counts, dict):
+            count = f" ({short_repr(counts.get('done'), 20)} of {short_repr(counts.get('requested'), 20)} realizations)"
         raise RunFolderError(
             f"{path}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
             f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {run_dir}`, "
