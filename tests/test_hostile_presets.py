@@ -264,4 +264,4 @@ def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
             text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
         )  # fmt: skip
     assert done.returncode == ExitCode.RUNTIME_FAILURE
-    assert done.stderr == "error: No space left on device\n"
+    assert done.stderr == "error: cannot write the output: No space left on device\n"

@@ -50,3 +50,12 @@ def test_validate_says_what_is_pressed_by_the_name_the_preset_gives(tmp_path, ca
     assert main(["validate", str(preset), "--json"]) == ExitCode.OK
     record = json.loads(capsys.readouterr().out)[0]
     assert record["spectrum"] == spectrum["name"] and record["pressed"] == pressed
+
+
+def test_control_characters_typed_in_a_set_are_shown_escaped_never_sent_to_the_terminal(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    for command in ("validate", "run"):
+        assert main([command, str(preset), "--set", "seed=\x1b[31m1\x07"]) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert "\x1b" not in err and "\x07" not in err
+        assert "--set seed=\\x1b[31m1\\x07" in err
