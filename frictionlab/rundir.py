@@ -135,6 +135,8 @@ class RunDirectory:
             raise OutputRefused(f"{problem}; give a folder for the output")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
+        if os.path.lexists(lock) and not lock.is_file():  # a lock that is a folder, a link to one, ...
+            raise RunFolderError(f"{lock} is not a file: it cannot hold the run's lock (remove it, or give another folder)")
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
         # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
         # file the holder then removed takes the lock on the new file.

@@ -265,3 +265,19 @@ def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
         )  # fmt: skip
     assert done.returncode == ExitCode.RUNTIME_FAILURE
     assert done.stderr == "error: cannot write the output: No space left on device\n"
+
+
+def test_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2_and_quoted_ones_stay_text():
+    from frictionlab.safe_yaml import load_yaml
+
+    data = load_yaml("a: 1e-16\nb: 1E5\nc: -2e+3\nd: 1.5e3\ne: .5e1\nf: '1e5'\ng: 1e\nh: e5\ni: 12\nj: 1.5")
+    assert data == {"a": 1e-16, "b": 1e5, "c": -2e3, "d": 1.5e3, "e": 5.0, "f": "1e5", "g": "1e", "h": "e5", "i": 12, "j": 1.5}
+    assert [type(data[k]) for k in "abcdei"] == [float] * 5 + [int]
+
+
+def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(path), "--set", "spectrum.params.rms_height=1e200"]) == ExitCode.USAGE
+    assert "must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+200" in capsys.readouterr().err
+    assert main(["validate", str(path), "--set", "spectrum.params.rms_height=2e-3"]) == ExitCode.OK

@@ -327,3 +327,11 @@ def test_what_cannot_be_resumed_is_said_and_nothing_is_made(tmp_path, capsys):
     assert (tmp_path / "afile").read_text() == "mine"
     assert main(["run", str(preset), "--out", "", "--quiet"]) == ExitCode.USAGE
     assert "--out names no folder" in capsys.readouterr().err
+
+
+def test_a_lock_that_is_not_a_file_is_named(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    (tmp_path / "run" / "run.lock").mkdir(parents=True)
+    assert main(["run", str(preset), "--out", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
+    assert "run.lock is not a file" in capsys.readouterr().err
+    assert (tmp_path / "run" / "run.lock").is_dir()  # left as it was
