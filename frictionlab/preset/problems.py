@@ -38,7 +38,7 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return f"must be {symbol} {ctx[key]}"
     if kind == "extra_forbidden":
         allowed = _allowed_keys(model, tuple(error["loc"][:-1]))
-        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "")
+        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "; none are allowed here")
     if kind == "missing":
         return "is required"
     if kind == "literal_error":
