@@ -364,9 +364,11 @@ class FrictionlabApp(App):
             return
         try:
             out_dir = new_run_folder(scene.preset.name, self.runs_dir)  # made now: it claims the name
-        except OSError as exc:
-            problem = output_path_problem(self.runs_dir) or f"{self.runs_dir}: {exc.strerror or exc}"
-            self.say(problem, "error", title="Run failed")
+        except FrictionlabError as exc:  # the runs folder is a file
+            self.say(output_path_problem(self.runs_dir) or str(exc), "error", title="Run failed")
+            return
+        except OSError as exc:  # it cannot be made
+            self.say(f"{self.runs_dir}: {exc.strerror or exc}", "error", title="Run failed")
             return
         self._start(scene, sweep, out_dir, self.run_options)
 
