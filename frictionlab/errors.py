@@ -70,6 +70,11 @@ class RunFolderError(FrictionlabError):
     exit_code = ExitCode.RUN_FOLDER
 
 
+def counted(count: int, noun: str) -> str:
+    """``1 point``, ``2 points``: a count and its noun in the number it takes."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
 def short_repr(value, limit: int = 80) -> str:
     """``repr(value)`` cut to about ``limit`` characters, built without ever
     forming the whole repr (a value from a hostile preset may be huge or deep)."""

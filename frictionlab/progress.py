@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 import time
 
+from .errors import counted
 from .hookspecs import hookimpl
 from .listeners import SweepListener, progress_text
 
@@ -205,7 +206,7 @@ class SweepProgress(SweepListener):
 
     def sweep_started(self, sweep):
         mode = sweep.spec.mode
-        self._write(f"{sweep.name}: sweep of {len(sweep.points)} points ({mode} over {', '.join(sweep.paths)})")
+        self._write(f"{sweep.name}: sweep of {counted(len(sweep.points), 'point')} ({mode} over {', '.join(sweep.paths)})")
 
     def point_started(self, sweep, point):
         self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")

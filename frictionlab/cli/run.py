@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, RunFolderError
+from ..errors import ExitCode, FrictionlabError, RunFolderError, counted
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -170,7 +170,7 @@ def sweep_table(sweep, outcome, out_dir: Path) -> str:
     from ..preset import yaml_scalar
     from ..sweep import row_fit
 
-    lines = [f"{sweep.name}: {len(sweep.points)} points in {outcome.elapsed:.1f} s, status {outcome.status}"]
+    lines = [f"{sweep.name}: {counted(len(sweep.points), 'point')} in {outcome.elapsed:.1f} s, status {outcome.status}"]
     for row, result in zip(outcome.rows, outcome.results, strict=True):
         values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(result.point.values[p])}" for p in sweep.paths)
         fit = row_fit(row)

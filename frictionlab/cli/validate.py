@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import sys
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode, FrictionlabError, counted
 from .console import shown
 
 
@@ -53,9 +53,9 @@ def run(args) -> ExitCode:
         records.append(record)
         if not args.json:
             print(
-                f"{path}: ok ({preset.realizations} realization{'s' if preset.realizations != 1 else ''}, {scene.pressed} / {scene.solver.name} / "
+                f"{path}: ok ({counted(preset.realizations, 'realization')}, {scene.pressed} / {scene.solver.name} / "
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
-                + (f", sweep of {points} points)" if points is not None else ")")
+                + (f", sweep of {counted(points, 'point')})" if points is not None else ")")
             )
     if args.json:
         print(json.dumps(records, indent=2))
