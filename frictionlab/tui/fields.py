@@ -13,13 +13,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
 from ..plugin import KINDS
 from ..preset import MISSING, Preset, build_scene, resolve_input_paths
+from ..safe_yaml import load_yaml
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 
@@ -155,8 +155,8 @@ def parse(spec: FieldSpec, text: str):
         except ValueError:
             pass
     try:  # the same reading as the CLI's --set
-        value = yaml.safe_load(text)
-    except yaml.YAMLError:
+        value = load_yaml(text)
+    except ValueError:  # not YAML, or beyond its limits: kept as typed, and refused by the validator
         return text
     return value if isinstance(value, str | int | float | bool) else text
 
