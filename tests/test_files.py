@@ -79,7 +79,7 @@ def test_atomic_write_writes_into_a_fifo_instead_of_replacing_it(tmp_path):
     fifo = tmp_path / "ff"
     os.mkfifo(fifo)
     got = []
-    reader = threading.Thread(target=lambda: got.append(open(fifo).read()))
+    reader = threading.Thread(target=lambda: got.append(open(fifo).read()), daemon=True)  # never blocks the exit
     reader.start()
     atomic_write(fifo, lambda fh: fh.write("through the pipe"))
     reader.join(10)
