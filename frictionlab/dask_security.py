@@ -52,10 +52,11 @@ def check_address(address: str) -> str:
     scheme, sep, _ = address.partition("://")
     scheme = scheme if sep else "tcp"
     try:
-        host = urlsplit(address if sep else f"tcp://{address}").hostname
-    except ValueError:
-        host = None
-    if scheme not in SCHEMES or not host:
+        parts = urlsplit(address if sep else f"tcp://{address}")
+        host, port = parts.hostname, parts.port
+    except ValueError:  # a port that is not a number, or out of range
+        host = port = None
+    if scheme not in SCHEMES or not host or not port:
         raise FrictionlabError(
             f"--scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. Got {short_repr(address)} instead."
         )
@@ -86,8 +87,11 @@ def connect_scheduler(address: str):
         return distributed.Client(address, timeout="10s", security=distributed.Security())
     except Exception as exc:  # refused, timed out, a TLS handshake or configuration that fails, ...
         reason = f"{type(exc).__name__}: {exc}"
-        if address.startswith("tls://") and "ssl_context" in reason:
-            reason = "a tls:// scheduler needs TLS certificates: give --tls-ca-file, --tls-cert and --tls-key"
+        if address.startswith("tls://") and "ssl_context" in reason:  # what was given, not the network
+            raise FrictionlabError(
+                f"--scheduler {address}: a tls:// scheduler needs TLS certificates: give --tls-ca-file, --tls-cert "
+                "and --tls-key (or Dask's distributed.comm.tls configuration)"
+            ) from None
         raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}") from None
 
 

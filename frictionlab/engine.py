@@ -87,7 +87,7 @@ def run(
             retried += 1  # a failure is not kept: the realization runs again
     resumed = accumulator.done
     todo = [i for i in range(total) if i not in accumulator.results]
-    info = RunInfo(scene=scene, total=total, workers=workers, executor=pool.name, resumed=resumed, retried=retried)
+    info = RunInfo(scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried)
     from .registry import default_registry
 
     hooks = _listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook

@@ -38,6 +38,9 @@ Control = Literal["force", "indentation"]
 """What a sweep's loads are: total loads (see ``LoadMeaning``) or indentations."""
 
 
+MAX_MAGNITUDE = 1e100  # numbers frictionlab reads: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
+
+
 class PluginParams(BaseModel):
     """Base for every plugin's ``Params``: unknown keys are errors, values are
     validated on assignment too (the TUI edits them in place). Each validator is built

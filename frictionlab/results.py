@@ -27,6 +27,7 @@ import yaml
 
 from . import __version__
 from .ensemble import RunOutcome
+from .errors import RunError
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
@@ -152,13 +153,29 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
     files, and list it in summary.json (rewritten); ``files`` with the plot's path."""
     if not (scene.preset.output.plot and outcome.done):
         return files
-    from .plot import plot_curve  # matplotlib is slow to import: only when drawing
-
     out = Path(out_dir)
     files = {**files, "plot": out / "plot.png"}
-    atomic_write(files["plot"], lambda fh: plot_curve(scene, outcome, fh), binary=True)
+
+    def draw(fh) -> None:
+        from .plot import plot_curve  # matplotlib is slow to import: only when drawing
+
+        plot_curve(scene, outcome, fh)
+
+    write_figure(files["plot"], draw)
     _write_summary(out, scene, outcome, files)
     return files
+
+
+def write_figure(path: Path, draw) -> None:
+    """Write a figure file with ``draw(file)``, which imports matplotlib itself. A
+    failure is a RunError naming the file: a folder that said no, or matplotlib
+    refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then."""
+    try:
+        atomic_write(path, draw, binary=True)
+    except OSError as exc:
+        raise RunError(f"cannot write {path}: {exc.strerror or exc}; the numbers are written") from None
+    except Exception as exc:
+        raise RunError(f"cannot draw {path}: {type(exc).__name__}: {exc}; the numbers are written") from None
 
 
 def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:

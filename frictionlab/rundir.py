@@ -41,7 +41,7 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
 from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, read_regular_file, sha256_of
 from .preset import Scene, differences, load_preset_file
@@ -66,13 +66,21 @@ def _write_holder(fd: int) -> None:
 
 
 def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
-    """``runs_dir/<name>-<timestamp>``, a folder that does not exist yet (``-2``, ``-3``, ... appended
-    when one does): where a run goes when the user names no folder."""
+    """``runs_dir/<name>-<timestamp>``, made now and empty (``-2``, ``-3``, ... appended when
+    the name is taken, also by a run started in the same second by another process: making
+    the folder is what claims it): where a run goes when the user names no folder."""
     base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    problem = output_path_problem(base.parent)
+    if problem:
+        raise OutputRefused(f"{problem}; give a folder for the output")
+    base.parent.mkdir(parents=True, exist_ok=True)
     candidate, n = base, 2
-    while os.path.lexists(candidate):
-        candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
-    return candidate
+    while True:
+        try:
+            candidate.mkdir()
+            return candidate
+        except FileExistsError:
+            candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
 
 
 def fingerprint(resolved: dict) -> str:
@@ -86,6 +94,24 @@ class ChunkDamage(ValueError):
 
 def _json_copy(data: dict) -> dict:
     return json.loads(json.dumps(data))
+
+
+_MANIFEST_FIELDS = (  # what a manifest's fields must be, when present
+    ("status", str, "a word"),
+    ("fingerprint", str, "a string"),
+    ("preset", dict, "a mapping"),
+    ("inputs", dict, "a mapping of input files"),
+    ("chunks", dict, "a mapping of chunk file names to SHA-256 digests"),
+    ("retired", list, "a list of chunk file names"),
+)
+
+
+def _well_formed(key: str, value) -> bool:
+    if key == "chunks":
+        return all(isinstance(name, str) and isinstance(digest, str) for name, digest in value.items())
+    if key == "retired":
+        return all(isinstance(name, str) for name in value)
+    return True
 
 
 class RunDirectory:
@@ -112,6 +138,8 @@ class RunDirectory:
             raise OutputRefused(f"{problem}; give a folder for the output")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
+        if os.path.lexists(lock) and not lock.is_file():  # a lock that is a folder, a link to one, ...
+            raise RunFolderError(f"{lock} is not a file: it cannot hold the run's lock (remove it, or give another folder)")
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
         # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
         # file the holder then removed takes the lock on the new file.
@@ -153,8 +181,14 @@ class RunDirectory:
         except ValueError as exc:  # not JSON, not UTF-8
             where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
             raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
+        except RecursionError:
+            raise RunFolderError(f"{path} is damaged (nested too deep to be a manifest)") from None
         if not isinstance(state, dict):
             raise RunFolderError(f"{path} is damaged (not a JSON object)")
+        for key, kind, what in _MANIFEST_FIELDS:
+            value = state.get(key)
+            if value is not None and not (isinstance(value, kind) and _well_formed(key, value)):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}: {short_repr(value, 60)})")
         return state
 
     def _write_manifest(self) -> None:
@@ -164,6 +198,9 @@ class RunDirectory:
     def stored_preset(self) -> dict:
         """The preset the run was started with (preset.yaml), read as any preset is."""
         path = self.path / PRESET_FILE
+        if not self.path.is_dir():
+            what = "is not a folder" if os.path.lexists(self.path) else "does not exist"
+            raise RunFolderError(f"{self.path} {what}: there is no run to resume there")
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:

@@ -64,9 +64,11 @@ def run_to_folder(
         restored = run_dir.start(scene, resume=options.resume)
         outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=run_dir, restored=restored)
         files = write_results(out_dir, scene, outcome)
-        if on_results is not None:
-            on_results(outcome, files)
-        if plot:
-            files = add_plot(out_dir, scene, outcome, files)
-        run_dir.finish(scene, outcome.status)
+        try:
+            if on_results is not None:
+                on_results(outcome, files)
+            if plot:
+                files = add_plot(out_dir, scene, outcome, files)
+        finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
+            run_dir.finish(scene, outcome.status)
     return outcome, files

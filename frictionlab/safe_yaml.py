@@ -11,6 +11,7 @@ refused, and only then are Python objects built.
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import yaml
@@ -35,7 +36,8 @@ def _line(node_or_mark) -> int:
 
 class _BoundedLoader(yaml.SafeLoader):
     """SafeLoader that refuses nesting deeper than MAX_DEPTH while composing
-    (the composer recurses once per level)."""
+    (the composer recurses once per level), and reads ``1e-6`` and ``1.5e3`` as numbers, as YAML 1.2
+    and every other reader do (YAML 1.1 wants ``1.0e-6`` and ``1.5e+3``, and took the others for strings)."""
 
     def __init__(self, stream):
         super().__init__(stream)
@@ -56,6 +58,12 @@ class _BoundedLoader(yaml.SafeLoader):
         finally:
             self._depth -= 1
 
+
+_BoundedLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+.0123456789"),
+)
 
 def _children(node) -> list:
     if isinstance(node, yaml.SequenceNode):

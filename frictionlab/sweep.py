@@ -38,6 +38,7 @@ from .options import RunOptions
 from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
+from .results import write_figure
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
@@ -323,10 +324,14 @@ def run_sweep(
     outcome.elapsed = time.perf_counter() - started
     outcome.files = write_tables(sweep, outcome, out_dir)
     if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
-        from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
 
+        def draw(fh) -> None:
+            from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+
+            plot_sweep(sweep, outcome.rows, fh)
+
+        write_figure(out_dir / "sweep.png", draw)
         outcome.files["plot"] = out_dir / "sweep.png"
-        atomic_write(outcome.files["plot"], lambda fh: plot_sweep(sweep, outcome.rows, fh), binary=True)
         write_tables(sweep, outcome, out_dir)
     for listener in listeners:
         listener.sweep_finished(sweep, outcome)

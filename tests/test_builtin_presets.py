@@ -41,6 +41,10 @@ def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch)
         resolve_preset_path("quikstart")
     with pytest.raises(PresetFileError, match=r"no file 'quickstart.yaml' here; the built-in preset of that name is 'quickstart'"):
         resolve_preset_path("quickstart.yaml")  # from a folder without that file
+    (tmp_path / "quickstart").mkdir()  # `frictionlab run quickstart --out quickstart`: a folder is never a preset
+    assert resolve_preset_path("quickstart") == find_builtin("quickstart").path
+    (tmp_path / "mine").mkdir()
+    assert resolve_preset_path("mine") == Path("mine")  # no built-in of that name: read, and refused, as a path
 
 
 def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):

@@ -331,8 +331,9 @@ def test_scheduler_addresses_neither_loopback_nor_tls_get_a_warning():
         warnings.simplefilter("error")
         for quiet in ("tls://10.1.2.3:8786", "tcp://127.0.0.1:8786", "localhost:8786", "tcp://[::1]:8786"):
             check_address(quiet)
-    with pytest.raises(FrictionlabError, match="--scheduler must be an address like"):
-        check_address("ftp://host:1")
+    for wrong in ("ftp://host:1", "garbage", "tcp://host", "tcp://host:port", "tcp://host:99999"):
+        with pytest.raises(FrictionlabError, match="--scheduler must be an address like"):
+            check_address(wrong)
 
 
 @needs_dask
@@ -359,7 +360,7 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
                    "--scheduler", cluster.scheduler_address, "--quiet"]  # fmt: skip
         bare = subprocess.run([*command, "--out", str(tmp_path / "bare")], capture_output=True, text=True, cwd=ROOT,
                               timeout=120)  # fmt: skip
-        assert bare.returncode == 1 and "a tls:// scheduler needs TLS certificates" in bare.stderr, bare.stderr
+        assert bare.returncode == 2 and "a tls:// scheduler needs TLS certificates" in bare.stderr, bare.stderr
         tls = ["--tls-ca-file", str(files["ca"]), "--tls-cert", str(files["cert"]), "--tls-key", str(files["key"])]
         done = subprocess.run([*command, *tls, "--out", str(tmp_path / "o"), "--json"], capture_output=True,
                               text=True, cwd=ROOT, timeout=120)  # fmt: skip

@@ -198,12 +198,12 @@ def profile_preset(tmp_path: Path, path: str) -> Path:
 def test_a_profile_file_that_is_not_numbers_is_named_never_quoted(tmp_path, capsys):
     (tmp_path / "passwd.txt").write_text(f"{SECRET}\n" * 20)
     preset = profile_preset(tmp_path, "passwd.txt")
-    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--json"]) == ExitCode.RUNTIME_FAILURE
+    # refused when the preset is validated, before any run folder is made
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--json"]) == ExitCode.USAGE
     captured = capsys.readouterr()
-    written = "".join(p.read_text(errors="replace") for p in (tmp_path / "o").glob("*.json"))
-    assert "non-numeric content at line 2" in captured.out  # line 1 is taken for a header
-    assert str(tmp_path / "passwd.txt") in captured.out
-    for text in (captured.out, captured.err, written):
+    assert "non-numeric content at line 2" in captured.err  # line 1 is taken for a header
+    assert str(tmp_path / "passwd.txt") in captured.err and not (tmp_path / "o").exists()
+    for text in (captured.out, captured.err):
         assert "the-secret-line" not in text
 
 
@@ -264,4 +264,20 @@ def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
             text=True, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=30,
         )  # fmt: skip
     assert done.returncode == ExitCode.RUNTIME_FAILURE
-    assert done.stderr == "error: No space left on device\n"
+    assert done.stderr == "error: cannot write the output: No space left on device\n"
+
+
+def test_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2_and_quoted_ones_stay_text():
+    from frictionlab.safe_yaml import load_yaml
+
+    data = load_yaml("a: 1e-16\nb: 1E5\nc: -2e+3\nd: 1.5e3\ne: .5e1\nf: '1e5'\ng: 1e\nh: e5\ni: 12\nj: 1.5")
+    assert data == {"a": 1e-16, "b": 1e5, "c": -2e3, "d": 1.5e3, "e": 5.0, "f": "1e5", "g": "1e", "h": "e5", "i": 12, "j": 1.5}
+    assert [type(data[k]) for k in "abcdei"] == [float] * 5 + [int]
+
+
+def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(path), "--set", "spectrum.params.rms_height=1e200"]) == ExitCode.USAGE
+    assert "must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+200" in capsys.readouterr().err
+    assert main(["validate", str(path), "--set", "spectrum.params.rms_height=2e-3"]) == ExitCode.OK

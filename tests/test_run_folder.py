@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -238,3 +241,97 @@ def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
         "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
     assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
     assert "holds another sweep" in capsys.readouterr().err
+
+
+def _status(folder: Path) -> str:
+    return json.loads((folder / "run.json").read_text())["status"]
+
+
+def test_a_figure_that_cannot_be_written_fails_the_command_but_the_run_is_finished(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
+    out = tmp_path / "run"
+    (out / "plot.png").mkdir(parents=True)  # plot.png cannot be written: it is a folder
+    assert main(["run", str(preset), "--out", str(out), "--quiet", "--force"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "plot.png" in err and "the numbers are written" in err
+    assert _status(out) == "completed" and json.loads((out / "summary.json").read_text())["status"] == "completed"
+    assert main(["run", str(preset), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK  # not "unfinished"
+
+
+def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
+    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(tmp_path / "run"), "--quiet"],
+                          capture_output=True, text=True, timeout=120, env={**os.environ, "MPLBACKEND": "no-such-backend"})  # fmt: skip
+    assert done.returncode == ExitCode.RUNTIME_FAILURE and "internal error" not in done.stderr
+    assert "cannot draw" in done.stderr and "no-such-backend" in done.stderr
+    assert _status(tmp_path / "run") == "completed"
+
+
+@pytest.mark.parametrize(
+    "damage, said",
+    [
+        (lambda d: {**d, "chunks": "abc"}, "chunks is not a mapping"),
+        (lambda d: {**d, "chunks": ["a"]}, "chunks is not a mapping"),
+        (lambda d: {**d, "chunks": {"00000000-00000005.npz": 5}}, "chunks is not a mapping"),
+        (lambda d: {**d, "status": 5}, "status is not a word"),
+        (lambda d: {**d, "preset": "x"}, "preset is not a mapping"),
+        (lambda d: {**d, "inputs": [1]}, "inputs is not a mapping"),
+        (lambda d: "[" * 100_000 + "]" * 100_000, "nested too deep"),
+    ],
+)
+def test_a_damaged_manifest_is_a_run_folder_error_naming_what_is_wrong(tmp_path, capsys, damage, said):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    out = tmp_path / "run"
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OK
+    damaged = damage(json.loads((out / "run.json").read_text()))
+    (out / "run.json").write_text(damaged if isinstance(damaged, str) else json.dumps(damaged))
+    capsys.readouterr()
+    for argv in (["resume", str(out)], ["run", str(preset), "--out", str(out), "--quiet"]):
+        assert main(argv) == ExitCode.RUN_FOLDER
+        err = capsys.readouterr().err
+        assert "run.json is damaged" in err and said in err
+
+
+def test_runs_started_together_without_out_each_get_a_folder_of_their_own(tmp_path):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--quiet", "--workers", "1"]
+    runs = [subprocess.Popen([*command, "--seed", str(seed)], cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+            for seed in range(4)]  # fmt: skip
+    errors = [run.communicate(timeout=120)[1].decode() for run in runs]
+    assert [run.returncode for run in runs] == [0] * 4, errors
+    folders = sorted((tmp_path / "runs").iterdir())
+    assert len(folders) == 4 and all((f / "summary.json").is_file() for f in folders)
+    seeds = {json.loads((f / "summary.json").read_text())["seed"] for f in folders}
+    assert seeds == {0, 1, 2, 3}
+
+
+def test_a_run_refused_before_it_starts_leaves_no_empty_folder_behind(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    preset = write(tmp_path / "p.yaml", merge(QUICK, {"spectrum": {"params": {"points": 10**9}}}))
+    assert main(["run", str(preset), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    assert "would need about" in capsys.readouterr().err
+    assert list((tmp_path / "runs").iterdir()) == []
+
+
+def test_what_cannot_be_resumed_is_said_and_nothing_is_made(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    (tmp_path / "afile").write_text("mine")
+    for argv, said in (
+        (["resume", str(tmp_path / "missing")], "missing does not exist: there is no run to resume there"),
+        (["resume", str(tmp_path / "afile")], "afile is not a folder: there is no run to resume there"),
+        (["run", str(preset), "--resume", "--out", str(tmp_path / "new")], "new is not a run folder to resume"),
+    ):
+        assert main(argv) == ExitCode.RUN_FOLDER
+        assert said in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "p.yaml"]  # no folder made
+    assert (tmp_path / "afile").read_text() == "mine"
+    assert main(["run", str(preset), "--out", "", "--quiet"]) == ExitCode.USAGE
+    assert "--out names no folder" in capsys.readouterr().err
+
+
+def test_a_lock_that_is_not_a_file_is_named(tmp_path, capsys):
+    preset = write(tmp_path / "p.yaml", QUICK)
+    (tmp_path / "run" / "run.lock").mkdir(parents=True)
+    assert main(["run", str(preset), "--out", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
+    assert "run.lock is not a file" in capsys.readouterr().err
+    assert (tmp_path / "run" / "run.lock").is_dir()  # left as it was

@@ -190,7 +190,7 @@ def test_bad_maps_are_named_with_what_is_wrong(tmp_path):
     bad[3, 4], bad[7, 1] = np.nan, np.inf
     np.save(tmp_path / "nan.npy", bad)
     message = surface_error(tmp_path / "nan.npy")
-    assert "2 non-finite" in message and "row 3, column 4" in message
+    assert "2 value(s) in heights not finite" in message and "row 3, column 4" in message
     np.save(tmp_path / "flat.npy", np.full((10, 10), 2.5))
     assert "constant" in surface_error(tmp_path / "flat.npy")
     rows, cols = np.mgrid[0:10, 0:12]
@@ -210,6 +210,6 @@ def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys
     preset.write_text(yaml.safe_dump(surface_preset(str(tmp_path / "nan.npy"), "mdr")))
     assert main(["validate", str(preset)]) == ExitCode.USAGE
     err = capsys.readouterr().err
-    assert "surface-file" in err and "nan.npy" in err and "non-finite" in err and "Traceback" not in err
+    assert "surface-file" in err and "nan.npy" in err and "not finite" in err and "Traceback" not in err
     with pytest.raises(PresetError):
         load_scene(preset)

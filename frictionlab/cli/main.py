@@ -27,7 +27,7 @@ import warnings
 from ..errors import ExitCode, FrictionlabError, short_repr
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
-from .console import error_label
+from .console import error_label, shown
 
 COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
@@ -191,12 +191,16 @@ def _run_command(args) -> int:
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
         return _write_failed(exc)
     except FrictionlabError as exc:
-        print(f"{error_label()}: {exc}", file=sys.stderr)
+        print(f"{error_label()}: {shown(str(exc))}", file=sys.stderr)
         return int(exc.exit_code)
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
         print(f"error: {exc.strerror or exc}: {exc.filename}", file=sys.stderr)
+        return int(ExitCode.RUNTIME_FAILURE)
+    except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
+        detail = f": {exc}" if str(exc) else ""
+        print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
         return int(ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
         code = interrupted_exit_code()

@@ -19,9 +19,9 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--a", type=float, help="the law's a")
     p.add_argument("--b", type=float, help="the law's b")
-    p.add_argument("--a-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of a")
-    p.add_argument("--b-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of b")
-    p.add_argument("--confidence", type=float, default=0.95, help="level of the given intervals (default 0.95)")
+    p.add_argument("--a-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of a (LO <= HI)")
+    p.add_argument("--b-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of b (LO <= HI)")
+    p.add_argument("--confidence", type=float, help="level of the given intervals, in (0, 1) (default 0.95)")
     p.add_argument("--from", dest="from_run", metavar="RUN_DIR", help="take the law from a run folder (summary.json)")
     p.add_argument("--area", type=float, required=True, metavar="A", help="apparent contact area A")
     p.add_argument("--modulus", type=float, required=True, metavar="ESTAR", help="effective modulus E*")
@@ -35,11 +35,16 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
     from ..fit import LogFit, json_safe
-    from ..paper.predict import predict_xi, prediction_text, read_run_law
+    from ..paper.predict import check_law, format_number, predict_xi, prediction_text, read_run_law
 
     if args.from_run:
-        if args.a is not None or args.b is not None:
-            raise FrictionlabError("give either --from RUN_DIR or --a/--b, not both")
+        given = [name for name, value in (("--a", args.a), ("--b", args.b), ("--a-ci", args.a_ci), ("--b-ci", args.b_ci),
+                                          ("--confidence", args.confidence)) if value is not None]  # fmt: skip
+        if given:
+            raise FrictionlabError(
+                f"give either --from RUN_DIR or the law by hand, not both: {', '.join(given)} with --from "
+                "(the run's summary.json holds its law, intervals and confidence)"
+            )
         law, fitted_f, pairs = read_run_law(args.from_run)
     else:
         if args.a is None or args.b is None:
@@ -47,7 +52,9 @@ def run(args) -> ExitCode:
         if (args.a_ci is None) != (args.b_ci is None):
             raise FrictionlabError("--a-ci and --b-ci go together (an interval needs both)")
         intervals = {"a_ci": tuple(args.a_ci), "b_ci": tuple(args.b_ci)} if args.a_ci else {}
-        law, fitted_f, pairs = LogFit(args.a, args.b, confidence=args.confidence, **intervals), None, None
+        confidence = 0.95 if args.confidence is None else args.confidence
+        law, fitted_f, pairs = LogFit(args.a, args.b, confidence=confidence, **intervals), None, None
+        check_law(law, {field: "--" + field.replace("_", "-") for field in ("a", "b", "a_ci", "b_ci", "confidence")})
     prediction = predict_xi(
         law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
         pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
@@ -58,6 +65,6 @@ def run(args) -> ExitCode:
                    a=law.a, b=law.b)  # fmt: skip
         print(json.dumps({k: json_safe(v) for k, v in out.items()}, indent=2))
     else:
-        print(f"law: xi = {law.a:.4f} + {law.b:.4f} ln f")
+        print(f"law: xi = {format_number(law.a)} + {format_number(law.b)} ln f")
         print(prediction_text(prediction))
     return ExitCode.OK

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode, FrictionlabError, RunFolderError
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -54,13 +54,22 @@ def run(args) -> ExitCode:
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
     scene = build_scene(data, source=source)
+    if args.out is not None and not args.out.strip():
+        raise FrictionlabError("--out names no folder (it is empty): give a folder, or leave --out out for runs/<name>-<time>")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
+    if args.resume and not Path(args.out).is_dir():
+        raise RunFolderError(f"{args.out} is not a run folder to resume (it does not exist, or is not a folder)")
     options = executor_run_options(args, resume=args.resume, force=args.force)
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
-    if scene.preset.sweep is not None:  # one ensemble per point
-        return _run_sweep(args, data, out_dir, options)
-    return _run_scene(args, scene, out_dir, options)
+    try:
+        if scene.preset.sweep is not None:  # one ensemble per point
+            return _run_sweep(args, data, out_dir, options)
+        return _run_scene(args, scene, out_dir, options)
+    except FrictionlabError:  # refused before it began (the memory check): the folder made for it goes
+        if not args.out and not any(out_dir.iterdir()):
+            out_dir.rmdir()
+        raise
 
 
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:

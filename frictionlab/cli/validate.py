@@ -6,6 +6,7 @@ import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError
+from .console import shown
 
 
 def add_parser(sub) -> None:
@@ -41,7 +42,7 @@ def run(args) -> ExitCode:
             problems = getattr(exc, "problems", None) or [str(exc)]
             records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
             if not args.json:
-                print(str(exc), file=sys.stderr)
+                print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
         record = {

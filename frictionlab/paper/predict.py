@@ -21,13 +21,18 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import sys
+import zipfile
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import FrictionlabError
-from ..fit import LogFit, bootstrap_coefficients, format_interval, percentile_interval
+from ..errors import FrictionlabError, RunFolderError, short_repr
+from ..fit import LogFit, bootstrap_coefficients, percentile_interval
+from ..inputs import InputFileProblem, open_regular_file, read_regular_file
 from ..plugin import ForceNormalisation, mdr_length
 from ..seeds import bootstrap_rng
 
@@ -36,11 +41,34 @@ MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr le
 
 
 def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area: float) -> float:
-    """f = sqrt(pi) F / (2 E* h sqrt(A)) (= F / (E* h L) with L = 2 sqrt(A / pi))."""
+    """f = sqrt(pi) F / (2 E* h sqrt(A)) (= F / (E* h L) with L = 2 sqrt(A / pi)).
+
+    Where a product on the way under- or overflows (F, E*, h, A far from 1) f is
+    formed from logarithms instead; an f that double precision cannot hold
+    (beyond about 1e-308 .. 1e308) is a FrictionlabError naming the four inputs."""
     for name, value in (("force", force), ("modulus", modulus), ("rms_height", rms_height), ("area", area)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
             raise FrictionlabError(f"{name} must be a finite number > 0. Got {value!r} instead.")
-    return force / MDR_OF_A_SURFACE.force_unit(modulus, rms_height, mdr_length(area))
+    force, modulus, rms_height, area = (float(v) for v in (force, modulus, rms_height, area))
+    unit = MDR_OF_A_SURFACE.force_unit(modulus, rms_height, mdr_length(area))
+    f = force / unit if unit > 0 else math.inf
+    if all(_normal(v) for v in (area / math.pi, modulus * rms_height, unit, f)):
+        return f
+    ln_f = math.log(math.sqrt(math.pi) / 2) + math.log(force) - math.log(modulus) - math.log(rms_height)
+    ln_f -= 0.5 * math.log(area)
+    f = math.exp(ln_f) if ln_f < math.log(sys.float_info.max) else math.inf
+    if not _normal(f):
+        raise FrictionlabError(
+            f"f = sqrt(pi) F / (2 E* h sqrt(A)) = e^{ln_f:.6g} is beyond double precision (about 1e-308 to 1e308) "
+            f"for force {force!r}, modulus {modulus!r}, rms_height {rms_height!r}, area {area!r}: "
+            "give them in one consistent system of units"
+        )
+    return f
+
+
+def _normal(value: float) -> bool:
+    """Finite and at least the smallest normal double (a subnormal has lost digits)."""
+    return math.isfinite(value) and value >= sys.float_info.min
 
 
 @dataclass(frozen=True)
@@ -64,6 +92,34 @@ class Prediction:
         return self.xi > 1.0  # xi = 1 at full contact: the log law no longer holds
 
 
+def check_law(
+    law: LogFit, names: dict[str, str] | None = None, error: type[FrictionlabError] = FrictionlabError
+) -> None:
+    """Refuse a law no prediction can come from: a or b not finite, a confidence
+    outside (0, 1), an interval half known, not finite or with low > high (both
+    unknown, NaN, is fine: no interval). ``names`` says how the caller spells each
+    field (``{"a": "--a"}``); the message names it, its value and what is allowed."""
+    names = names or {}
+
+    def name(field: str) -> str:
+        return names.get(field, field)
+
+    for field in ("a", "b"):
+        value = getattr(law, field)
+        if not math.isfinite(value):
+            raise error(f"{name(field)} must be a finite number. Got {value!r} instead.")
+    if not (0 < law.confidence < 1):
+        raise error(
+            f"{name('confidence')} must be a number between 0 and 1 (exclusive). Got {law.confidence!r} instead."
+        )
+    for field in ("a_ci", "b_ci"):
+        low, high = getattr(law, field)
+        if math.isnan(low) and math.isnan(high):
+            continue
+        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+            raise error(f"{name(field)} must be two finite numbers LO <= HI. Got {low!r}, {high!r} instead.")
+
+
 def predict_xi(
     law: LogFit,
     *,
@@ -77,73 +133,238 @@ def predict_xi(
 ) -> Prediction:
     """xi = a + b ln f of ``law`` at f = sqrt(pi) F / (2 E* h sqrt(A)), with an interval
     (see the module doc): from the bootstrap ``pairs`` if given, else from the corners of
-    the law's ``a_ci`` x ``b_ci`` if known."""
+    the law's ``a_ci`` x ``b_ci`` if known. FrictionlabError for a law ``check_law``
+    refuses, and for numbers that leave double precision (every number returned is finite
+    but an unknown interval, NaN)."""
+    check_law(law)
+    if rms_slope is not None and not (math.isfinite(rms_slope) and rms_slope > 0):
+        raise FrictionlabError(f"rms_slope must be a finite number > 0. Got {rms_slope!r} instead.")
     f = dimensionless_force_3d(force, modulus, rms_height, area)
     ln_f = math.log(f)
-    xi = law.a + law.b * ln_f
-    if pairs is not None and len(pairs):
-        pairs = np.asarray(pairs, float)
-        low, high = percentile_interval(pairs[:, 0] + pairs[:, 1] * ln_f, law.confidence)
-        ci, how = (float(low), float(high)), "bootstrap pairs"
-    elif all(math.isfinite(v) for v in (*law.a_ci, *law.b_ci)):
-        corners = [ai + bi * ln_f for ai in law.a_ci for bi in law.b_ci]
-        ci, how = (min(corners), max(corners)), "rectangle of a_ci x b_ci"
-    else:
-        ci, how = (math.nan, math.nan), "none"
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, by name
+        xi = law.a + law.b * ln_f
+        if pairs is not None and len(pairs):
+            pairs = np.asarray(pairs, float)
+            low, high = percentile_interval(pairs[:, 0] + pairs[:, 1] * ln_f, law.confidence)
+            ci, how = (float(low), float(high)), "bootstrap pairs"
+        elif all(math.isfinite(v) for v in (*law.a_ci, *law.b_ci)):
+            corners = [ai + bi * ln_f for ai in law.a_ci for bi in law.b_ci]
+            ci, how = (min(corners), max(corners)), "rectangle of a_ci x b_ci"
+        else:
+            ci, how = (math.nan, math.nan), "none"
+    _refuse_overflow("xi = a + b ln f", xi, law, ln_f)
+    if how != "none":
+        _refuse_overflow(f"the interval of xi ({how})", max(abs(ci[0]), abs(ci[1])), law, ln_f)
     slope = slope_ci = None
     if rms_slope is not None:
-        if not (math.isfinite(rms_slope) and rms_slope > 0):
-            raise FrictionlabError(f"rms_slope must be a finite number > 0. Got {rms_slope!r} instead.")
         slope, slope_ci = xi * rms_slope, (ci[0] * rms_slope, ci[1] * rms_slope)
+        if not math.isfinite(slope) or (how != "none" and not all(map(math.isfinite, slope_ci))):
+            raise FrictionlabError(
+                f"the rms slope in contact, xi * rms_slope = {xi:.6g} * {rms_slope!r}, is beyond double precision: "
+                "rms_slope is too large"
+            )
     return Prediction(f, xi, ci, how, law.confidence, fitted_f, rms_slope, slope, slope_ci)
+
+
+def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
+    if not math.isfinite(value):
+        raise FrictionlabError(
+            f"{what} is beyond double precision (about 1e308) with a = {law.a!r}, b = {law.b!r}, ln f = {ln_f:.6g}: "
+            "the law's coefficients (or their intervals) are too large"
+        )
+
+
+# ------------------------------------------------------------------ a run folder's law
+
+MAX_SUMMARY_BYTES = 64 * 1024 * 1024  # a summary.json is a few kB; a huge one is not a run's
+_NUMBER_FIELDS = ("a_se", "b_se", "r2", "residual_rms")  # optional: null when unknown
+_COUNT_FIELDS = ("bootstrap", "points")
+
+
+def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
+    """The law a run fitted (its summary.json), the range of f it was fitted over, and its
+    bootstrap pairs (None without realizations.npz). RunFolderError, naming the file and
+    the field, for a run that did not complete or whose files are damaged."""
+    run_dir = Path(run_dir)
+    summary = _read_summary(run_dir)
+    path = run_dir / "summary.json"
+    status = summary.get("status", "completed")
+    if status != "completed":
+        counts = summary.get("realizations")
+        count = ""
+        if isinstance(counts, dict):
+            count = f" ({short_repr(counts.get('done'), 20)} of {short_repr(counts.get('requested'), 20)} realizations)"
+        raise RunFolderError(
+            f"{path}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
+            f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {run_dir}`, "
+            "or give its law by hand with --a/--b"
+        )
+    law = _fit_of(summary, path)
+    arrays = _read_realizations(run_dir / "realizations.npz", summary)
+    if arrays is None:
+        return law, (math.nan, math.nan), None
+    xi, f = arrays
+    return law, (float(np.min(f)), float(np.max(f))), _pairs_of(summary, law, xi, f)
 
 
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
     """The run's bootstrap (a, b) pairs, redrawn from realizations.npz with the run's
     seed and resample count: the very pairs behind summary.json's intervals."""
     run_dir = Path(run_dir)
-    summary = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
-    npz = run_dir / "realizations.npz"
-    fit = summary.get("fit") or {}
-    if not npz.exists() or not fit.get("bootstrap"):
-        return None
-    with np.load(npz) as data:
-        xi, f = data["xi"], data["f"]
-    if xi.shape[0] < 2:
-        return None
-    return bootstrap_coefficients(f, xi, int(fit["bootstrap"]), bootstrap_rng(int(summary["seed"])))
+    summary = _read_summary(run_dir)
+    law = _fit_of(summary, run_dir / "summary.json")
+    arrays = _read_realizations(run_dir / "realizations.npz", summary)
+    return None if arrays is None else _pairs_of(summary, law, *arrays)
 
 
-def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
-    """The law a run fitted (its summary.json), the range of f it was fitted over, and its
-    bootstrap pairs (None without realizations.npz)."""
-    run_dir = Path(run_dir)
+def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.ndarray | None:
+    if not law.bootstrap or xi.shape[0] < 2:
+        return None
+    return bootstrap_coefficients(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
+
+
+def _read_summary(run_dir: Path) -> dict:
+    path = run_dir / "summary.json"
     try:
-        summary = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise FrictionlabError(f"--from {run_dir}: no readable summary.json there ({exc})") from None
+        summary = json.loads(read_regular_file(path, limit=MAX_SUMMARY_BYTES, what="summary.json"))
+    except InputFileProblem as exc:
+        raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({exc})") from None
+    except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
+        where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
+        raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
+    except RecursionError:
+        raise RunFolderError(f"{path} is damaged (JSON nested too deeply)") from None
+    if not isinstance(summary, dict):
+        raise RunFolderError(f"{path} is damaged (a JSON {type(summary).__name__}, not an object)")
+    return summary
+
+
+def _fit_of(summary: dict, path: Path) -> LogFit:
+    """summary.json's ``fit``, each field checked for its type (the JSON's value is named
+    in the message), then as a law (``check_law``)."""
     fit = summary.get("fit")
-    if not fit:
-        raise FrictionlabError(f"--from {run_dir}: the run has no fit (status {summary.get('status')!r})")
-    f_range = (math.nan, math.nan)
-    npz = run_dir / "realizations.npz"
-    if npz.exists():
-        with np.load(npz) as data:
-            f_range = (float(np.min(data["f"])), float(np.max(data["f"])))
-    return LogFit.from_dict(fit), f_range, bootstrap_pairs(run_dir)
+    if fit is None:
+        raise RunFolderError(f"{path}: the run has no fit (status {short_repr(summary.get('status'))})")
+    if not isinstance(fit, dict):
+        raise RunFolderError(
+            f"{path}: field 'fit' must be a mapping of the law's numbers. Got {short_repr(fit)} instead."
+        )
+
+    def refuse(field: str, allowed: str):
+        value = short_repr(fit.get(field))
+        return RunFolderError(f"{path}: field 'fit.{field}' must be {allowed}. Got {value} instead.")
+
+    def is_number(value) -> bool:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return False
+        try:
+            float(value)
+        except OverflowError:  # an int past double precision
+            return False
+        return True
+
+    for field in ("a", "b"):
+        if not is_number(fit.get(field)):
+            raise refuse(field, "a finite number")
+    for field in _NUMBER_FIELDS:
+        if fit.get(field) is not None and not is_number(fit[field]):
+            raise refuse(field, "a number or null")
+    if "confidence" in fit and not is_number(fit["confidence"]):
+        raise refuse("confidence", "a number between 0 and 1 (exclusive)")
+    for field in ("a_ci", "b_ci"):
+        value = fit.get(field)
+        if value is not None and not (
+            isinstance(value, list) and len(value) == 2 and all(v is None or is_number(v) for v in value)
+        ):
+            raise refuse(field, "null or [LO, HI], two numbers (or two nulls)")
+    for field in _COUNT_FIELDS:
+        value = fit.get(field)
+        if value is not None and not (isinstance(value, int) and not isinstance(value, bool) and value >= 0):
+            raise refuse(field, "a whole number >= 0")
+    law = LogFit.from_dict(fit)
+    names = {field: f"{path}: field 'fit.{field}'" for field in ("a", "b", "a_ci", "b_ci", "confidence")}
+    check_law(law, names, RunFolderError)
+    if law.bootstrap:
+        seed = summary.get("seed")
+        if not (isinstance(seed, int) and not isinstance(seed, bool) and seed >= 0):
+            raise RunFolderError(
+                f"{path}: field 'seed' must be a whole number >= 0 (the bootstrap's). Got {short_repr(seed)} instead."
+            )
+    return law
+
+
+def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarray] | None:
+    """(xi per realization, f) of realizations.npz, checked; None when the run kept no such file."""
+    if not os.path.lexists(path):
+        return None
+    try:
+        with open_regular_file(path, "realizations.npz") as fh:
+            if fh.read(2) != b"PK":  # every zip, so every .npz, starts so
+                raise RunFolderError(f"{path} is damaged (not an .npz archive: it does not start as a zip file does)")
+            fh.seek(0)
+            with np.load(fh, allow_pickle=False) as data:
+                missing = [name for name in ("xi", "f") if name not in data.files]
+                if missing:
+                    raise RunFolderError(
+                        f"{path} is damaged (no array {missing[0]!r} in it; it holds {short_repr(data.files)})"
+                    )
+                xi, f = data["xi"], data["f"]
+    except InputFileProblem as exc:
+        raise RunFolderError(f"{path}: {exc}") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:  # cut short, pickled, bad header
+        reason = str(exc) or type(exc).__name__
+        if "allow_pickle" in reason:
+            reason = "it holds pickled Python objects, which are never loaded"
+        reason = short_repr(reason, 120)[1:-1]
+        raise RunFolderError(f"{path} is damaged (not an .npz archive of number arrays: {reason})") from None
+    except MemoryError as exc:  # an array's header may claim any shape
+        raise RunFolderError(f"{path}: an array in it is larger than this machine's memory ({exc})") from None
+    for name, array, ndim in (("xi", xi, 2), ("f", f, 1)):
+        if array.dtype.kind not in "fiu" or array.ndim != ndim or not array.size:
+            raise RunFolderError(
+                f"{path}: array {name!r} must be {ndim}-D numbers, not empty. "
+                f"Got shape {array.shape} of {array.dtype} instead."
+            )
+    if xi.shape[1] != f.size:
+        raise RunFolderError(f"{path}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
+    if not np.all(np.isfinite(f) & (f > 0)):
+        raise RunFolderError(f"{path}: array 'f' must hold finite numbers > 0 (some are not)")
+    if not np.all(np.isfinite(xi)):
+        bad = np.count_nonzero(~np.isfinite(xi))
+        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers ({bad} of {xi.size} are not)")
+    counts = summary.get("realizations")
+    done = counts.get("done") if isinstance(counts, dict) else None
+    if isinstance(done, int) and not isinstance(done, bool) and done != xi.shape[0]:
+        raise RunFolderError(
+            f"{path}: array 'xi' has {xi.shape[0]} realizations but summary.json says {done} were done: "
+            "the two files are not of one run"
+        )
+    return xi.astype(float), f.astype(float)
+
+
+def format_number(value: float, decimals: int = 4) -> str:
+    """``value`` with ``decimals`` decimals, or in ``g`` form when that would run long."""
+    return f"{value:.{decimals}f}" if abs(value) < 1e6 else f"{value:.{decimals + 2}g}"
+
+
+def _format_interval(ci: tuple[float, float]) -> str:
+    low, high = ci
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return "n/a"
+    return f"[{format_number(low)}, {format_number(high)}]"
 
 
 def prediction_text(p: Prediction) -> str:
     level = f"{100 * p.confidence:g}%"
-    ci = format_interval(p.xi_ci)
+    ci = _format_interval(p.xi_ci)
     lines = [
         f"f = sqrt(pi) F / (2 E* h sqrt(A)) = {p.f:.6g}   (ln f = {math.log(p.f):.4f})",
-        f"xi = grad_z_contact / grad_z = {p.xi:.4f}   {level} interval {ci} ({p.interval})",
+        f"xi = grad_z_contact / grad_z = {format_number(p.xi)}   {level} interval {ci} ({p.interval})",
     ]
     if p.slope_contact is not None:
-        lines.append(
-            f"rms slope in contact = {p.slope_contact:.4g}   [{p.slope_contact_ci[0]:.4g}, {p.slope_contact_ci[1]:.4g}]"
-        )
+        low, high = p.slope_contact_ci
+        ci = f"[{low:.4g}, {high:.4g}]" if math.isfinite(low) and math.isfinite(high) else "n/a"
+        lines.append(f"rms slope in contact = {p.slope_contact:.4g}   {ci}")
     if p.extrapolated:
         lines.append(f"warning: f is outside the run's fitted range [{p.fitted_f[0]:.3g}, {p.fitted_f[1]:.3g}]: extrapolated")
     if p.beyond_full_contact:

@@ -67,7 +67,10 @@ def resolve_preset_path(argument: str | Path) -> Path:
              f"(give the name alone: frictionlab run {path.stem})"],
             source=str(argument),
         )  # fmt: skip
-    if path.exists() or path.suffix or len(path.parts) > 1:
+    named = len(path.parts) == 1 and not path.suffix
+    if named and path.is_dir() and find_builtin(str(argument)):  # a folder is never a preset: the run folder
+        return find_builtin(str(argument)).path  # of `frictionlab run quickstart --out quickstart`, say
+    if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one
     found = find_builtin(str(argument))
     if found is not None:

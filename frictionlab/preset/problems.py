@@ -10,9 +10,9 @@ import typing
 from pydantic import BaseModel, ValidationError
 
 from ..errors import short_repr
+from ..plugin import MAX_MAGNITUDE
 from .schema import NAME_PATTERN, NAME_RULE
 
-MAX_MAGNITUDE = 1e100  # numbers in a preset: 0, or 1e-100 <= |x| <= 1e100 (products of a few stay finite)
 
 
 def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
@@ -38,7 +38,7 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return f"must be {symbol} {ctx[key]}"
     if kind == "extra_forbidden":
         allowed = _allowed_keys(model, tuple(error["loc"][:-1]))
-        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "")
+        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "; none are allowed here")
     if kind == "missing":
         return "is required"
     if kind == "literal_error":
@@ -69,7 +69,8 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
     for error in exc.errors(include_url=False):
         path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
-        if error["type"] != "missing" and not (error["type"] == "value_error" and not error["loc"]):
+        checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
+        if error["type"] != "missing" and not checked_together:  # a check of several fields names their values
             line += f", got {short_repr(error['input'])}"
         lines.append(line)
     return lines

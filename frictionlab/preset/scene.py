@@ -130,6 +130,12 @@ def build_scene(
     ]
     if problems:  # before anything reads them (an equivalent line reads its map now)
         raise PresetError(problems, source=source)
+    spectrum = plugins["spectrum"]
+    if input_fields(type(spectrum.params)):  # a measured profile or surface: read and checked now, not by a worker
+        try:
+            spectrum.rms_height()
+        except ValueError as exc:
+            raise PresetError([f"spectrum.params: {exc}"], source=source) from None
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in KINDS:
         getattr(preset, slot).name = plugins[slot].name

@@ -36,7 +36,7 @@ class Loading(_Strict):
         "force", description="Whether the loads are total normal forces or indentations (rigid-body approach)."
     )
     start: float = Field(gt=0, description="First load (force, or indentation), > 0.")
-    stop: float = Field(gt=0, description="Last load, >= start.")
+    stop: float = Field(gt=0, description="Last load, > start.")
     steps: int = Field(ge=2, le=1_000_000, description="Number of load steps, start and stop included.")
     spacing: Literal["linear", "log"] = Field("linear", description="Load steps evenly spaced in value or in log.")
 

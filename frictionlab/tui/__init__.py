@@ -5,7 +5,10 @@ Importing this package is cheap; Textual loads when the app is built.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
+
+from ..errors import FrictionlabError
 
 
 def run_app(
@@ -16,6 +19,11 @@ def run_app(
     options=None,
 ) -> int:
     """Run the app until it quits; ``options`` (``RunOptions``): how its runs are carried out."""
+    if not (sys.stdin.isatty() and sys.stdout.isatty()):  # keys come from, and the screen goes to, a terminal
+        raise FrictionlabError(
+            "frictionlab tui needs a terminal for its keys and its screen (stdin and stdout are not one here); "
+            "without one, run presets headless: frictionlab run PRESET"
+        )
     from .app import FrictionlabApp
 
     start_process_helpers()

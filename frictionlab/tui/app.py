@@ -21,6 +21,7 @@ from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
 from ..errors import FrictionlabError, PresetError, RunFolderError
+from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
@@ -34,6 +35,7 @@ from .folders import (
     preset_folders,
     preset_from_template,
     read_run,
+    save_folder,
     save_preset,
     templates,
     writable_folder,
@@ -85,6 +87,7 @@ class FrictionlabApp(App):
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
         self.problems: list[str] = []
+        self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.cancel_event: threading.Event | None = None  # set while a run goes on
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -122,6 +125,11 @@ class FrictionlabApp(App):
         return preset_folders(self.presets_dir)
 
     @property
+    def save_folder(self) -> Path:
+        """Where New and a built-in preset's copy are saved by default: a listed folder."""
+        return save_folder(self.presets_dir)
+
+    @property
     def running(self) -> bool:
         return self.cancel_event is not None
 
@@ -152,6 +160,7 @@ class FrictionlabApp(App):
         """Show ``text`` in the status line above the footer (never over the data); it
         stays until the next message. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{title}: ", "bold") if title else "", text)
+        self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -230,7 +239,7 @@ class FrictionlabApp(App):
                 return
             self.run_worker(self._open_new(path, data, template), group="open")
 
-        self.push_screen(NewPresetScreen(choices), done)
+        self.push_screen(NewPresetScreen(choices, self.save_folder), done)
 
     async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
         await self.open_preset(path, data, modified=True)
@@ -243,6 +252,14 @@ class FrictionlabApp(App):
         self.problems = event.problems
         if event.changed:
             self.modified = True
+        if self.blocked_by is not None and self.blocked_by not in event.problems:
+            # the status said why Ctrl+R refused: that problem is gone, so is the message;
+            # once no problem is left (a field is empty while retyped), it says so
+            if event.problems:
+                self.say("")
+                self.blocked_by = ""
+            else:
+                self.say("The preset is valid: Ctrl+R runs it.")
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems)
 
@@ -259,7 +276,18 @@ class FrictionlabApp(App):
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
             self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
             self.push_screen(
-                PathScreen("Save the built-in preset's changes as", new_preset_path(self.draft_path.stem)),
+                PathScreen(
+                    "Save the built-in preset's changes as",
+                    new_preset_path(self.draft_path.stem, self.save_folder),
+                    self.save_folder,
+                ),
+                lambda path: path is not None and self._save_checked(path),
+            )
+            return
+        if self.draft_source != self.draft_path and self.draft_path.exists():
+            # a new preset whose file appeared since the New dialog: replaced only if the user says so
+            self.push_screen(
+                PathScreen(f"{self.draft_path} exists now: save the new preset as", self.draft_path, self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -291,12 +319,15 @@ class FrictionlabApp(App):
 
     def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
         try:
+            if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
+                path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
             save_preset(path, data, template=template)
         except OSError as exc:
             self.say(f"{path}: {exc.strerror or exc}", "error", title="Not saved")
             return
         self.say(f"Saved {path}")
         self.reload_presets()
+        self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:
             self.run_worker(self.open_preset(path), group="open")
         else:
@@ -325,12 +356,21 @@ class FrictionlabApp(App):
         except PresetError as exc:
             count = len(exc.problems)
             self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
+            self.blocked_by = exc.problems[0]
             self.query_one("#tabs", TabbedContent).active = "edit"
             form = self.query_one("#form", PresetForm)
             form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
             form.focus_problem(exc.problems)
             return
-        self._start(scene, sweep, new_run_folder(scene.preset.name, self.runs_dir), self.run_options)
+        try:
+            out_dir = new_run_folder(scene.preset.name, self.runs_dir)  # made now: it claims the name
+        except FrictionlabError as exc:  # the runs folder is a file
+            self.say(output_path_problem(self.runs_dir) or str(exc), "error", title="Run failed")
+            return
+        except OSError as exc:  # it cannot be made
+            self.say(f"{self.runs_dir}: {exc.strerror or exc}", "error", title="Run failed")
+            return
+        self._start(scene, sweep, out_dir, self.run_options)
 
     def resume_run(self, folder: Path | None) -> None:
         """Continue a cancelled or interrupted run in ``folder`` with the preset stored

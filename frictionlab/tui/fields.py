@@ -49,13 +49,21 @@ class FieldSpec:
         return "field--" + "--".join(self.path)
 
     def tooltip(self) -> str:
+        return "\n".join(self._facts())
+
+    def help_line(self) -> str:
+        """The tooltip on one line (under the form): its parts joined by "; ", each
+        without its own final full stop (a description ends with one)."""
+        return "; ".join(part.removesuffix(".") for part in self._facts())
+
+    def _facts(self) -> list[str]:
         lines = [self.description or self.name]
         if self.bounds:
             lines.append(f"allowed: {self.bounds}")
         if self.choices:
             lines.append("one of: " + ", ".join(map(str, self.choices)))
         lines.append("required" if self.required else f"default: {display(self.default) or 'none'}")
-        return "\n".join(lines)
+        return lines
 
 
 def _unwrap_optional(annotation) -> tuple[Any, bool]:

@@ -1,6 +1,6 @@
 """Where the TUI finds presets and past runs (no Textual here: plain files).
 
-Presets come from ``./presets`` (when it exists) and the user folder
+Presets come from ``./presets`` (when it exists; new ones are saved there) and the user folder
 (``$FRICTIONLAB_PRESETS_DIR``, else ``$XDG_CONFIG_HOME/frictionlab/presets``,
 else the platform's config folder: ``~/.config/frictionlab/presets`` on Linux). Runs are the output folders the
 headless ``frictionlab run`` writes, found by their ``summary.json``, and sweep
@@ -64,9 +64,15 @@ def is_builtin(path: Path) -> bool:
         Path(path).resolve().parent == shipped.resolve()  # fmt: skip
 
 
-def new_preset_path(name: str, folder: Path | None = None) -> Path:
-    """Where a new preset is saved unless the user says otherwise: the current folder."""
-    return (folder or Path(".")) / f"{name}.yaml"
+def save_folder(presets_dir: Path | None = None) -> Path:
+    """Where a new preset (or a built-in one's copy) is saved unless the user says
+    otherwise: the folder given with ``--presets``, else ``./presets`` (made when
+    first saved into). Both are listed, so a saved preset is in the list at once."""
+    return Path(presets_dir) if presets_dir is not None else PROJECT_PRESETS_DIR
+
+
+def new_preset_path(name: str, folder: Path) -> Path:
+    return Path(folder) / f"{name}.yaml"
 
 
 @dataclass(frozen=True)

@@ -432,7 +432,7 @@ class PeriodicBEM(ContactSolver):
             except _NotConverged as failure:
                 what = "force" if control == "force" else "indentation"
                 raise ValueError(
-                    f"{self.name} did not converge at load {j} ({what} {load!r}): residual "
+                    f"{self.name} did not converge at load {j} ({what} {float(load):g}): residual "
                     f"{failure.residual:.3g} > tolerance {tolerance:g} after {failure.iterations} "
                     "iterations. Raise max_iterations or loosen the tolerance."
                 ) from None

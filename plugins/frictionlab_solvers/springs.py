@@ -84,7 +84,7 @@ def _check_loads(loads, control: str) -> np.ndarray:
         value = loads[j]
         problem = "not finite" if not np.isfinite(value) else "not positive"
         raise ValueError(
-            f"every load must be a finite positive {what}: load {j} is {value!r} ({problem})"
+            f"every load must be a finite positive {what}: load {j} is {float(value):g} ({problem})"
         )
     return loads
 
@@ -107,7 +107,7 @@ def check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.n
         )
     spacing = float(profile.spacing)
     if not (np.isfinite(spacing) and spacing > 0.0):
-        raise ValueError(f"profile spacing must be finite and positive. Got {spacing!r} instead.")
+        raise ValueError(f"profile spacing must be finite and positive. Got {float(spacing):g} instead.")
     return heights, slopes, spacing
 
 
@@ -120,14 +120,14 @@ def _prepare(solver: ContactSolver, profile: Profile, loads, control: str, slope
     heights, slopes = heights.ravel(), slopes.ravel()  # views when contiguous
     spring = solver.stiffness() * spacing**ndim
     if not (np.isfinite(spring) and spring > 0.0):
-        raise ValueError(f"spring stiffness k dx^{ndim} must be finite and positive. Got {spring!r} instead.")
+        raise ValueError(f"spring stiffness k dx^{ndim} must be finite and positive. Got {float(spring):g} instead.")
     return loads, heights, slopes, spring
 
 
 def _top(heights: np.ndarray) -> float:
     zmax = float(heights.max())  # NaN propagates through max
     if not np.isfinite(zmax):
-        raise ValueError(f"heights must be finite; their maximum is {zmax!r}")
+        raise ValueError(f"heights must be finite; their maximum is {float(zmax):g}")
     return zmax
 
 

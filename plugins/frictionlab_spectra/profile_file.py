@@ -28,6 +28,7 @@ import numpy as np
 from pydantic import Field
 
 from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
+from frictionlab.plugin import MAX_MAGNITUDE
 
 from .params_cache import cached_on_params
 
@@ -224,19 +225,24 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
 
 
 def check_finite(where: str, what: str, values: np.ndarray) -> None:
-    """ValueError counting the NaN/inf in ``values`` and locating the first (index, or row and column)."""
-    bad = ~np.isfinite(values)
+    """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
+    magnitude (1e100: squares and sums of them must stay finite), locating the first."""
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
         first = np.unravel_index(int(np.argmax(bad)), bad.shape)
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
-        raise ValueError(f"{where}: {int(bad.sum())} non-finite value(s) (NaN or inf) in {what}, the first at {at}")
+        raise ValueError(
+            f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
+            f"in magnitude, the first at {at}"
+        )
 
 
 def _uniform_spacing(where: str, x: np.ndarray) -> float:
     n = x.size
     dx = (x[-1] - x[0]) / (n - 1)
     if not dx > 0:
-        raise ValueError(f"{where}: x must increase (x[0] = {x[0]!r}, x[-1] = {x[-1]!r})")
+        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
     deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
     if deviation > X_TOLERANCE * dx:
         raise ValueError(

@@ -27,3 +27,16 @@ def test_headless_run_never_imports_textual(tmp_path):
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.stdout.strip().splitlines()[-1] == "0 []", result.stderr
+
+
+def test_running_out_of_memory_is_said_as_such_not_as_a_bug(monkeypatch, capsys):
+    import frictionlab.cli.validate
+    from frictionlab.cli import main
+
+    def allocate(args):
+        raise MemoryError("Unable to allocate 29.8 TiB for an array with shape (1000000000, 4096)")
+
+    monkeypatch.setattr(frictionlab.cli.validate, "run", allocate)  # the handler the parser is built with
+    assert main(["validate", "quickstart"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith("error: out of memory: Unable to allocate 29.8 TiB") and "internal error" not in err

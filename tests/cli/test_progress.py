@@ -72,3 +72,9 @@ def test_a_notebook_gets_a_bar_even_without_a_terminal(monkeypatch):
     assert wants_bar(io.StringIO())
     ipython.get_ipython = lambda: None  # IPython imported, but a plain terminal shell or none
     assert not wants_bar(io.StringIO())
+
+
+def test_the_first_line_counts_the_workers_that_run_not_those_asked_for(make_scene):
+    stream = FakeTerminal()
+    engine.run(make_scene({"realizations": 6}), RunOptions(workers=4, executor="serial"), listeners=[ProgressReporter(stream, after=0)])
+    assert stream.getvalue().startswith("small: 6 realizations of power-law lines, 16 force steps, 1 worker(s)\n")

@@ -50,3 +50,23 @@ def test_validate_says_what_is_pressed_by_the_name_the_preset_gives(tmp_path, ca
     assert main(["validate", str(preset), "--json"]) == ExitCode.OK
     record = json.loads(capsys.readouterr().out)[0]
     assert record["spectrum"] == spectrum["name"] and record["pressed"] == pressed
+
+
+def test_control_characters_typed_in_a_set_are_shown_escaped_never_sent_to_the_terminal(tmp_path, capsys):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    for command in ("validate", "run"):
+        assert main([command, str(preset), "--set", "seed=\x1b[31m1\x07"]) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert "\x1b" not in err and "\x07" not in err
+        assert "--set seed=\\x1b[31m1\\x07" in err
+
+
+def test_a_measured_profile_is_read_and_checked_by_validate_not_first_by_a_worker(tmp_path, capsys):
+    (tmp_path / "scan.csv").write_text("\n".join(["0.1", "nan", *[str(0.01 * i) for i in range(30)]]))
+    data = {**SMALL_PRESET, "spectrum": {"name": "profile-file", "params": {"path": "scan.csv", "spacing": 1.0}}}
+    preset = write_preset(tmp_path, data)
+    assert main(["validate", str(preset)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "spectrum.params: profile-file" in err and "1 value(s) in heights not finite" in err and "index 1" in err
+    (tmp_path / "scan.csv").write_text("\n".join(str(0.01 * (i % 7)) for i in range(64)))
+    assert main(["validate", str(preset)]) == ExitCode.OK

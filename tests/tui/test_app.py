@@ -102,3 +102,9 @@ def test_the_docs_screenshot_is_made_by_its_command(tmp_path, monkeypatch):
     text = out.read_text()
     assert text.startswith("<svg") and "quickstart" in text
     assert (ROOT / "docs" / "tui" / "main.svg").read_text().startswith("<svg")
+
+
+def test_the_tui_without_a_terminal_says_so_and_exits_2(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "tui"], stdin=subprocess.DEVNULL, capture_output=True,
+                          text=True, cwd=tmp_path, timeout=60)  # fmt: skip
+    assert done.returncode == 2 and "needs a terminal" in done.stderr and "Traceback" not in done.stderr

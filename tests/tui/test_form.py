@@ -207,5 +207,5 @@ async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all
         assert form.problems == []
         await pilot.press("ctrl+s")
         await pilot.pause()
-    assert app.draft_path == Path("fresh.yaml")  # the current folder
-    assert load_scene(folders / "fresh.yaml", registry=registry).spectrum.params.points == 256
+    assert app.draft_path == Path("presets/fresh.yaml")  # the folder the list shows
+    assert load_scene(folders / "presets" / "fresh.yaml", registry=registry).spectrum.params.points == 256

@@ -26,12 +26,14 @@ from frictionlab.tui.screens import PathScreen
 from ..conftest import merge
 from .conftest import (
     SIZE,
+    fits_width,
     TINY,
     make_app,
     new_preset,
     make_runs,
     open_first_preset,
     post_keys,
+    press_run,
     run_to_the_end,
     screen_text,
     status_text,
@@ -91,23 +93,31 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
 
 
 LONG_NAME = "a-longer-study-20261125-210620"
+MID = (100, 30)
 
 
-@pytest.mark.parametrize("size", [SIZE, BIG])
+@pytest.mark.parametrize("size", [SIZE, MID, BIG])
 @sync
 async def test_run_names_use_the_width_they_have(folders, registry, size):
+    """Found by a new user: at 100 columns `quickstart…1125-235755` with half the
+    screen free; the list now widens for its names while the plot keeps 40 columns."""
     make_runs(folders, registry)
     (folders / "runs" / "seed1").rename(folders / "runs" / LONG_NAME)
+    (folders / "runs" / "seed2").rename(folders / "runs" / ("x" * 70 + "-20261125-235755"))
     app = make_app(registry)
     async with app.run_test(size=size) as pilot:
         await pilot.pause()
         await pilot.press("f5")
         await pilot.pause()
         shown = screen_text(app)
-    if size == BIG:
-        assert LONG_NAME in shown  # 30 characters: whole at 120 columns
-    else:  # shortened from the middle: where it starts and its time stamp stay
+        table, chart = app.query_one("#runs-table"), app.query_one("#results-chart")
+        whole, plot_width = fits_width(table), chart.size.width
+    if size == SIZE:  # shortened from the middle: where it starts and its time stamp stay
         assert "a-longer…5-210620" in shown
+    else:
+        assert LONG_NAME in shown  # 30 characters: whole at 100 columns and more
+    assert [line for line in shown.splitlines() if "xxx…" in line and "235755 " in line]  # too long: shortened
+    assert whole and plot_width >= 40
 
 
 @sync
@@ -171,6 +181,41 @@ async def test_ctrl_r_with_a_problem_says_it_and_focuses_the_field_at_fault(fold
     assert focused == "field--spectrum--params--rms_height"
     assert status == "Cannot run: 1 problem: spectrum.params.rms_height: must be > 0.0, got -1.0"
     assert "rms_height" in shown and "-1.0" in shown  # the field scrolled into view
+
+
+@sync
+async def test_the_status_takes_back_why_ctrl_r_refused_once_that_problem_is_fixed(folders, registry):
+    """Found by a new user: `Cannot run: 1 problem: realizations: ...` stayed after the
+    value was fixed and the form said valid."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await type_into(pilot, "field--realizations", "abc")
+        await type_into(pilot, "field--seed", "x")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        refused = screen_text(app)
+        await type_into(pilot, "field--realizations", "8")  # the problem the status does not give: it stays
+        kept = status_text(app)
+        await type_into(pilot, "field--seed", "x2")  # the status's problem gone, another in its field
+        fixed = screen_text(app)
+    assert "Cannot run: 2 problems: seed: must be a whole number, got 'x'" in refused
+    assert kept == "Cannot run: 2 problems: seed: must be a whole number, got 'x'"
+    assert "Cannot run" not in fixed and "got 'x2'" in fixed  # the form gives the new one
+
+
+@sync
+async def test_the_status_says_valid_once_the_one_refused_problem_is_fixed(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await type_into(pilot, "field--realizations", "abc")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        refused = status_text(app)
+        await type_into(pilot, "field--realizations", "8")
+        await pilot.pause()
+        fixed = screen_text(app)
+    assert refused == "Cannot run: 1 problem: realizations: must be a whole number, got 'abc'"
+    assert "Cannot run" not in fixed and "The preset is valid: Ctrl+R runs it." in fixed
 
 
 CANNOT_ACT = [  # pressed one after the other, in an app with no preset and no run
@@ -310,59 +355,76 @@ async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, re
 
 
 @sync
-async def test_an_unreadable_profile_file_fails_the_run_with_its_message(folders, registry):
+async def test_an_unreadable_profile_file_is_refused_before_a_run_with_its_message(folders, registry):
+    """The validator reads a measured profile (as `frictionlab validate` does): Ctrl+R
+    refuses the preset with the file's own message instead of running it to fail."""
     profile_preset(folders, "1.0\nabc\n")
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:
-        await run_to_the_end(pilot)
+        await press_run(pilot)
+        await pilot.pause()
         status = status_text(app)
-        stats = str(app.query_one("#run-stats").render())
-        error = str(app.query_one("#run-error").render())
-    assert status.startswith("Run failed: no realization finished: profile-file")
-    assert "non-numeric content at line 2" in status
-    for text in (status, error):  # what the user can act on, not the internals
-        assert "ValueError" not in text and ".py:" not in text
-    assert stats.startswith("failed: 0/8 realizations")
+        panel = str(app.query_one("#problems").render())
+    assert not app.running and app.last_out_dir is None
+    assert status.startswith("Cannot run: 1 problem: spectrum.params: profile-file")
+    assert "non-numeric content at line 2" in status and "non-numeric content at line 2" in panel
+    assert "ValueError" not in status and ".py:" not in status  # what the user can act on, not the internals
 
 
 # ------------------------------------------------------------------ New
 
 
 @sync
-async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_current_folder(folders, registry):
+async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_presets_folder(folders, registry):
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")
         problems, path = app.problems, app.draft_path
-        assert not (folders / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
+        assert not (folders / "presets" / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
         await pilot.press("ctrl+s")
         await pilot.pause()
     assert problems == []
-    assert path == Path("fresh.yaml")
+    assert path == Path("presets/fresh.yaml")  # the folder the list shows
+    saved = folders / "presets" / "fresh.yaml"
     quickstart = find_builtin("quickstart").path  # the template offered first: it runs in about a second
-    assert yaml.safe_load((folders / "fresh.yaml").read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
-    assert quickstart.read_text().splitlines()[0] in (folders / "fresh.yaml").read_text()  # its comments kept
-    assert load_scene(folders / "fresh.yaml", registry=registry).preset.name == "fresh"
-    assert main(["run", "fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
+    assert yaml.safe_load(saved.read_text()) == {**yaml.safe_load(quickstart.read_text()), "name": "fresh"}
+    assert quickstart.read_text().splitlines()[0] in saved.read_text()  # its comments kept
+    assert load_scene(saved, registry=registry).preset.name == "fresh"
+    assert main(["run", "presets/fresh.yaml", "--out", "runs/fresh", "--quiet", "--workers", "1"]) == ExitCode.OK
     assert json.loads((folders / "runs" / "fresh" / "summary.json").read_text())["status"] == "completed"
 
 
 @sync
 async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, registry):
-    (folders / "fresh.yaml").write_text("keep me\n")
+    (folders / "presets" / "fresh.yaml").write_text("keep me\n")
     (folders / "elsewhere").mkdir()
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")
-        refused = str(app.screen.query_one("#new-error").render())
+        refused = screen_text(app)
         app.screen.query_one("#new-path", Input).focus()
         await pilot.press("ctrl+u", *"elsewhere/fresh", "enter")
         await pilot.pause()
         await pilot.press("ctrl+s")
         await pilot.pause()
-    assert "exists" in refused
-    assert (folders / "fresh.yaml").read_text() == "keep me\n"
+    assert "presets/fresh.yaml exists: give another file" in refused  # said in the dialog
+    assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
     assert load_scene(folders / "elsewhere" / "fresh.yaml", registry=registry).preset.name == "fresh"
+
+
+@sync
+async def test_ctrl_s_never_replaces_a_file_made_after_the_new_dialog(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await new_preset(pilot, "fresh")
+        (folders / "presets" / "fresh.yaml").write_text("keep me\n")  # made meanwhile, by someone else
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("escape")
+        await pilot.pause()
+    assert "presets/fresh.yaml exists now" in asked
+    assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
 
 
 @sync
@@ -388,6 +450,57 @@ async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monke
     assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
 
 
+def highlighted_path(app) -> str:
+    """The path line under the Presets list: the highlighted preset's file."""
+    return str(app.query_one("#preset-path").render())
+
+
+@sync
+async def test_a_built_in_presets_copy_goes_by_default_where_the_list_shows_it(tmp_path, monkeypatch, registry):
+    """Found by a new user: Ctrl+S on a built-in preset offered ./quickstart.yaml, a
+    folder the Presets tab does not list, so the saved preset vanished. Its default is
+    now ./presets (made when first saved into), listed, and highlighted after saving."""
+    monkeypatch.chdir(tmp_path)  # no ./presets yet
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    quickstart = find_builtin("quickstart").path
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "presets" / "quickstart.yaml").write_text("keep me\n")  # never replaced unasked
+    app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        await app.open_preset(quickstart)
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        offered = app.screen.query_one(Input).value
+        await pilot.press("enter")  # the file exists: the dialog asks a second Enter
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("ctrl+u", *"presets/my-qs", "enter")
+        await pilot.pause()
+        await pilot.press("f2")
+        await pilot.pause()
+        listed, highlighted = screen_text(app), highlighted_path(app)
+    assert offered == "presets/quickstart.yaml"
+    assert "presets/quickstart.yaml exists: Enter again replaces it" in asked
+    assert (tmp_path / "presets" / "quickstart.yaml").read_text() == "keep me\n"
+    assert load_scene(tmp_path / "presets" / "my-qs.yaml", registry=registry).preset.name == "quickstart"
+    assert "my-qs.yaml" in listed and highlighted == "presets/my-qs.yaml"
+
+
+@sync
+async def test_a_new_preset_goes_by_default_into_the_presets_folder_made_for_it(folders, registry):
+    app = FrictionlabApp(presets_dir="mine", runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await new_preset(pilot, "fresh")  # --presets mine: a folder that does not exist yet
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        await pilot.press("f2")
+        await pilot.pause()
+        listed, highlighted = screen_text(app), highlighted_path(app)
+    assert load_scene(folders / "mine" / "fresh.yaml", registry=registry).preset.name == "fresh"
+    assert "fresh.yaml" in listed and highlighted == "mine/fresh.yaml"
+
+
 @sync
 async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders, registry):
     (folders / "runs").write_text("a file where the runs folder should be\n")
@@ -399,6 +512,99 @@ async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders,
         await pilot.pause()
         status = status_text(app)
         error = str(app.query_one("#run-error").render())
-    assert status.startswith("Run failed: runs/small-") and "runs is a file" in status
-    assert "Traceback" not in error and "Error" not in status
+    assert status == "Run failed: runs is a file, not a folder"
+    assert "Traceback" not in error and "Error" not in status and not app.last_out_dir
     assert (folders / "runs").read_text().startswith("a file")  # left as it was
+
+
+# ------------------------------------------------------------------ the help line under the form
+
+
+@sync
+async def test_the_help_line_under_a_field_has_no_doubled_full_stop(folders, registry):
+    """Found by a new user: `(M).; allowed: >= 1` and `realizations.npz.; default: True`."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        shown = {}
+        for field in ("field--realizations", "field--output--realizations"):
+            app.query_one(f"#{field}").focus()
+            await pilot.pause()
+            shown[field] = screen_text(app)
+        every_field = []
+        for widget in app.query_one("#form").query("Input, Select, Switch"):
+            widget.focus()
+            await pilot.pause()
+            every_field.append(str(app.query_one("#field-help").render()))
+    assert "realizations: Number of independent random lines (M); allowed: >= 1" in shown["field--realizations"]
+    assert "Keep per-realization curves in realizations.npz; default: True" in shown["field--output--realizations"]
+    assert every_field and not [line for line in every_field if ".;" in line]
+
+
+# ------------------------------------------------------------------ Home and End
+
+
+def status_mark_line(shown, name):
+    return next((line for line in shown.splitlines() if name in line), "")
+
+
+@sync
+async def test_home_and_end_go_to_the_first_and_last_row_of_the_lists(folders, registry):
+    """Found by a new user: End did nothing in the Presets list (Ctrl+End did)."""
+    for name in ("alpha", "beta", "gamma", "zulu"):
+        write_preset(folders, name, merge(TINY, {"name": name, "description": f"the {name} preset"}))
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("end")
+        await pilot.pause()
+        at_end = screen_text(app)  # the line about the highlighted preset, under the list
+        await pilot.press("home")
+        await pilot.pause()
+        at_home = screen_text(app)
+        await pilot.press("f5", "end", "enter")
+        await pilot.pause()
+        last_run = screen_text(app)
+        await pilot.press("home", "enter")
+        await pilot.pause()
+        first_run = screen_text(app)
+        runs = [entry.path.name for entry in app.query_one("#results-pane").runs]
+        await app.open_preset(folders / "presets" / "tiny.yaml")  # Home and End in a text field move its cursor
+        field = app.query_one("#field--name", Input)
+        field.focus()
+        await pilot.press("home")
+        post_keys(app, ["end", "x", "home", "y"])
+        await wait_until(pilot, lambda: "x" in field.value and "y" in field.value, timeout=5)
+        typed = field.value
+    assert "the zulu preset" in at_end and "presets/zulu.yaml" in at_end
+    assert "the alpha preset" in at_home and "presets/alpha.yaml" in at_home
+    assert f"■ {runs[-1]}" in last_run and f"■ {runs[0]}" in first_run  # the overlay names the opened run
+    assert typed == "ysmallx"
+
+
+# ------------------------------------------------------------------ where focus starts
+
+
+def field_line(shown, label):
+    return next(line for line in shown.splitlines() if line.startswith(f"{label} "))
+
+
+@pytest.mark.parametrize("route", ["list", "command line"])
+@sync
+async def test_opening_a_preset_either_way_leaves_focus_on_its_first_field(folders, registry, route):
+    """A new user found Tab x3 reached `realizations` after Enter in the list but `name`
+    with the preset given on the command line. Either way focus is now on `name`, so
+    three Tabs and a number change `realizations`."""
+    app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
+    async with app.run_test(size=SIZE) as pilot:
+        if route == "list":
+            await open_first_preset(pilot)
+        await pilot.pause()
+        first = app.focused.id
+        await pilot.press("tab", "tab", "tab", "7")
+        await pilot.pause()
+        shown = screen_text(app)
+    assert first == "field--name"
+    assert field_line(shown, "realizations").split() == ["realizations", "7"]
+    assert field_line(shown, "name").split() == ["name", "small"]

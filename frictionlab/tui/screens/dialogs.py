@@ -34,8 +34,9 @@ class ConfirmScreen(ModalScreen[bool]):
         self.dismiss(value)
 
 
-def preset_path_problem(text: str) -> tuple[Path | None, str]:
-    """The path a user typed for a preset (``.yaml`` added), or why it cannot be one."""
+def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | None, str]:
+    """The path a user typed for a preset (``.yaml`` added), or why it cannot be one;
+    ``folder`` (the presets folder, made when first saved into) need not exist yet."""
     text = text.strip()
     if not text:
         return None, "path: must not be empty"
@@ -44,9 +45,19 @@ def preset_path_problem(text: str) -> tuple[Path | None, str]:
         path = path.with_name(path.name + ".yaml")
     if path.is_dir():
         return None, f"path: {path} is a folder; give a file name"
-    if not path.parent.is_dir():
+    if not path.parent.is_dir() and not (folder is not None and _same(path.parent, Path(folder))):
         return None, f"path: the folder {path.parent} does not exist"
     return path, ""
+
+
+def show_error(line: Static, text: str) -> None:
+    """A dialog's error line (hidden, as the form's are, until it has something to say)."""
+    line.update(Content(text))
+    line.display = bool(text)
+
+
+def _same(a: Path, b: Path) -> bool:
+    return a.expanduser().resolve() == b.expanduser().resolve()
 
 
 class PathScreen(ModalScreen[Path | None]):
@@ -54,10 +65,11 @@ class PathScreen(ModalScreen[Path | None]):
 
     BINDINGS = [Binding("escape", "dismiss(None)", "Cancel")]
 
-    def __init__(self, title: str, default: Path):
+    def __init__(self, title: str, default: Path, folder: Path | None = None):
         super().__init__()
         self.title_text = title
         self.default = default
+        self.folder = folder  # the presets folder: made on saving if it does not exist yet
         self.confirmed: Path | None = None  # an existing file the user pressed Enter on once
 
     def compose(self) -> ComposeResult:
@@ -68,27 +80,28 @@ class PathScreen(ModalScreen[Path | None]):
             yield Label("Enter: save    Esc: cancel", classes="hint")
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
-        path, problem = preset_path_problem(event.value)
+        path, problem = preset_path_problem(event.value, self.folder)
         error = self.query_one("#path-error", Static)
         if path is None:
-            error.update(Content(problem))
+            show_error(error, problem)
             return
         if path.exists() and path != self.confirmed:
             self.confirmed = path
-            error.update(Content(f"{path} exists: Enter again replaces it, Esc keeps it"))
+            show_error(error, f"{path} exists: Enter again replaces it, Esc keeps it")
             return
         self.dismiss(path)
 
 
 class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
     """A new preset: its name, the preset it starts from (one that runs), and where it
-    is saved (the current folder unless the user says otherwise)."""
+    is saved (the presets folder the list shows unless the user says otherwise)."""
 
     BINDINGS = [Binding("escape", "dismiss(None)", "Cancel")]
 
-    def __init__(self, templates: list[tuple[str, Path]]):
+    def __init__(self, templates: list[tuple[str, Path]], folder: Path):
         super().__init__()
         self.templates = templates
+        self.folder = folder
         self.path_edited = False  # the file follows the name until the user types a path
 
     def compose(self) -> ComposeResult:
@@ -108,14 +121,15 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
                     yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
             with Horizontal(classes="row"):
                 yield Label("save as", classes="field-label")
-                yield KeyInput(str(new_preset_path("my-scene")), id="new-path", compact=True)
+                yield KeyInput(str(new_preset_path("my-scene", self.folder)), id="new-path", compact=True)
             yield Static("", id="new-error", classes="field-error")
             yield Button("Create", id="new-create", compact=True)
             yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if event.input.id == "new-name" and not self.path_edited:
-            self.query_one("#new-path", Input).value = str(new_preset_path(event.value.strip() or "my-scene"))
+            name = event.value.strip() or "my-scene"
+            self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))
         elif event.input.id == "new-path" and event.input.has_focus:
             self.path_edited = True
 
@@ -123,14 +137,14 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
         error = self.query_one("#new-error", Static)
         name = self.query_one("#new-name", Input).value.strip()
         if not name:
-            error.update("name: must not be empty")
+            show_error(error, "name: must not be empty")
             return
-        path, problem = preset_path_problem(self.query_one("#new-path", Input).value)
+        path, problem = preset_path_problem(self.query_one("#new-path", Input).value, self.folder)
         if path is None:
-            error.update(Content(problem))
+            show_error(error, problem)
             return
         if path.exists():
-            error.update(Content(f"{path} exists: give another file (a new preset never replaces one)"))
+            show_error(error, f"{path} exists: give another file (a new preset never replaces one)")
             return
         template = self.query_one("#new-template", Select).value if self.templates else None
         self.dismiss((name, template, path))

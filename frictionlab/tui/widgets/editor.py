@@ -51,5 +51,5 @@ class EditPane(Vertical):
 
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
         spec = event.spec
-        text = "" if spec is None else f"{spec.dotted}: " + spec.tooltip().replace("\n", "; ")
+        text = "" if spec is None else f"{spec.dotted}: {spec.help_line()}"
         self.query_one("#field-help", Static).update(Content(text))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -49,6 +51,12 @@ class PresetsPane(Vertical):
             self.query_one("#preset-info", Static).update(Content(f"No presets in {shown}. n makes a new one."))
         else:
             self._show_info(0)
+
+    def highlight(self, path: Path) -> None:
+        """Move the list's cursor to the preset in ``path``, if it is listed."""
+        rows = [i for i, entry in enumerate(self.presets) if entry.path.resolve() == Path(path).resolve()]
+        if rows:
+            self.query_one("#preset-table", DataTable).move_cursor(row=rows[0], animate=False)
 
     def selected(self) -> PresetEntry | None:
         row = self.query_one("#preset-table", DataTable).cursor_row

@@ -29,6 +29,8 @@ OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
 HINT = "Enter opens a run; Space adds it to the overlay."
 NO_RUNS = "No runs yet: Ctrl+R runs the open preset (F2 lists the presets)."
 FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of the list's width
+# the list's width: its share of the pane, at least LIST_MIN; the plot keeps CHART_MIN
+LIST_SHARE, LIST_MIN, CHART_MIN = 0.45, 40, 40
 
 
 class ResultsPane(Vertical):
@@ -53,9 +55,19 @@ class ResultsPane(Vertical):
         yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
     def _name_width(self) -> int:
+        """Size the list to the width the pane has: its share, more when a name needs
+        it as long as the plot keeps CHART_MIN columns; the name column gets the rest."""
         table = self.query_one("#runs-table", DataTable)
-        padding = 2 * table.cell_padding * (len(FIXED_COLUMNS) + 1)
-        return max(12, table.scrollable_content_region.width - sum(FIXED_COLUMNS) - padding)
+        others = sum(FIXED_COLUMNS) + 2 * table.cell_padding * (len(FIXED_COLUMNS) + 1)
+        if self.size.width == 0:  # not laid out yet: filled again once it is (on_resize)
+            return 12
+        overflows = len(self.runs) + 1 > table.size.height  # the header row, then the runs
+        gutter = table.styles.scrollbar_size_vertical if overflows else 0
+        longest = max((len(entry.path.name) for entry in self.runs), default=0)
+        share = max(LIST_MIN, int(self.size.width * LIST_SHARE))
+        width = max(share, min(longest + others + gutter, self.size.width - CHART_MIN))
+        table.styles.width = width
+        return max(12, width - others - gutter)
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out

@@ -1,0 +1,366 @@
+"""``frictionlab predict`` on bad input: a damaged or unfinished run folder (exit 5,
+naming the file and the field), numbers beyond double precision and options out of
+range (exit 2, naming what is out of range); never a traceback or an internal error."""
+
+import io
+import json
+import math
+import shutil
+import threading
+import zipfile
+
+import numpy as np
+import pytest
+
+from frictionlab import hookimpl
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.runner import run_to_folder
+
+from ..conftest import SMALL_PRESET, merge
+
+CONTACT = ["--area", "1e-4", "--modulus", "1e9", "--rms-height", "1e-6", "--force", "10"]
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory, registry):
+    folder = tmp_path_factory.mktemp("finished") / "run"
+    scene = build_scene(merge(SMALL_PRESET, {"output": {"plot": False}}), registry=registry)
+    outcome, _ = run_to_folder(scene, folder, RunOptions(workers=1))
+    assert outcome.status == "completed"
+    return folder
+
+
+@pytest.fixture
+def run_copy(finished_run, tmp_path):
+    """A fresh copy of a finished run, to damage."""
+    return shutil.copytree(finished_run, tmp_path / "run")
+
+
+def predict_from(folder, capsys, *extra):
+    code = main(["predict", "--from", str(folder), *CONTACT, *extra])
+    out, err = capsys.readouterr()
+    assert "Traceback" not in err and "internal error" not in err
+    return code, out, err
+
+
+def edit_summary(folder, change):
+    path = folder / "summary.json"
+    summary = json.loads(path.read_text())
+    change(summary)
+    path.write_text(json.dumps(summary))
+
+
+def test_the_undamaged_copy_predicts(run_copy, capsys):
+    code, out, _ = predict_from(run_copy, capsys)
+    assert code == 0 and "(bootstrap pairs)" in out
+
+
+# ------------------------------------------------------------------ summary.json damaged
+
+
+@pytest.mark.parametrize(
+    "text, reason",
+    [
+        ("junk", "not valid JSON"),
+        ("", "not valid JSON"),
+        ("[1, 2]", "not an object"),
+        pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", id="deep-list"),
+        pytest.param('{"a": ' * 100_000 + "1" + "}" * 100_000, "nested too deeply", id="deep-object"),
+        pytest.param("\udcff", "not valid JSON", id="not-utf8"),  # a lone byte 0xff once written
+    ],
+)
+def test_a_summary_that_is_not_a_json_object(run_copy, capsys, text, reason):
+    (run_copy / "summary.json").write_bytes(text.encode("utf-8", "surrogateescape"))
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER
+    assert "summary.json" in err and reason in err
+
+
+def test_a_summary_that_is_a_folder(run_copy, capsys):
+    (run_copy / "summary.json").unlink()
+    (run_copy / "summary.json").mkdir()
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER and "summary.json" in err and "a folder" in err
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("fit", "x"),
+        ("fit", [1, 2]),
+        ("fit", True),
+        ("fit.a", "x"),
+        ("fit.a", None),
+        ("fit.a", True),
+        ("fit.a", 1e400),  # json.dumps writes Infinity, which json reads back
+        pytest.param("fit.a", 10**400, id="fit.a-int-past-double"),
+        ("fit.b", "x"),
+        ("fit.b", float("nan")),
+        ("fit.confidence", "x"),
+        ("fit.confidence", 2),
+        ("fit.confidence", 0),
+        ("fit.bootstrap", "x"),
+        ("fit.bootstrap", -1),
+        ("fit.bootstrap", 2.5),
+        ("fit.points", "x"),
+        ("fit.a_ci", "x"),
+        ("fit.a_ci", [1, 2, 3]),
+        ("fit.a_ci", [2.0, 1.0]),
+        ("fit.a_ci", [None, 1.0]),
+        ("fit.b_ci", ["x", 1]),
+        ("fit.r2", "x"),
+        ("seed", "x"),
+        ("seed", -3),
+    ],
+)
+def test_a_fit_field_of_the_wrong_type_or_range(run_copy, capsys, field, value):
+    def change(summary):
+        *parents, last = field.split(".")
+        target = summary
+        for key in parents:
+            target = target[key]
+        target[last] = value
+
+    edit_summary(run_copy, change)
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER
+    assert "summary.json" in err and f"'{field}'" in err, err
+
+
+def test_a_summary_without_a_fit(run_copy, capsys):
+    edit_summary(run_copy, lambda summary: summary.update(fit=None))
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER and "summary.json" in err and "no fit" in err
+
+
+def test_a_missing_folder_is_a_run_folder_error(tmp_path, capsys):
+    code, _, err = predict_from(tmp_path / "nothing", capsys)
+    assert code == ExitCode.RUN_FOLDER and "no readable summary.json" in err and "no such summary.json" in err
+
+
+# ------------------------------------------------------------------ realizations.npz damaged
+
+
+def _junk(path):
+    path.write_text("junk\n")
+
+
+def _empty(path):
+    path.write_bytes(b"")
+
+
+def _truncated(path):
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+
+
+def _pickled(path):
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"] = arrays["xi"].astype(object)
+    np.savez(path.with_suffix(".tmp.npz"), **arrays)
+    path.with_suffix(".tmp.npz").replace(path)
+
+
+def _without_xi(path):
+    with np.load(path) as data:
+        arrays = {k: data[k] for k in data.files if k != "xi"}
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _all_nan(path):
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"] = np.full_like(arrays["xi"], np.nan)
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _f_not_positive(path):
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["f"][0] = 0.0
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _xi_of_other_shape(path):
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"] = arrays["xi"][:, :3]
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _xi_as_text(path):
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"] = arrays["xi"].astype(str)
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _fewer_rows(path):  # realizations of another run: fewer than summary.json says were done
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"] = arrays["xi"][:3]
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
+def _array_larger_than_memory(path):  # a header may claim any shape
+    header = io.BytesIO()
+    claim = {"descr": "<f8", "fortran_order": False, "shape": (10**14, 16)}  # past any address space
+    np.lib.format.write_array_header_1_0(header, claim)
+    with np.load(path) as data:
+        f = data["f"]
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("xi.npy", header.getvalue() + bytes(64))
+        with archive.open("f.npy", "w") as member:
+            np.save(member, f)
+
+
+def _one_array(path):
+    with path.open("wb") as fh:
+        np.save(fh, np.ones(4))
+
+
+def _folder(path):
+    path.unlink()
+    path.mkdir()
+
+
+@pytest.mark.parametrize(
+    "damage, words",
+    [
+        (_junk, "is damaged (not an .npz archive"),
+        (_empty, "is damaged"),
+        (_truncated, "is damaged"),
+        (_pickled, "pickled Python objects, which are never loaded"),
+        (_array_larger_than_memory, "larger than this machine's memory"),
+        (_without_xi, "no array 'xi'"),
+        (_all_nan, "'xi' must hold finite numbers"),
+        (_f_not_positive, "'f' must hold finite numbers > 0"),
+        (_xi_of_other_shape, "one per load step"),
+        (_xi_as_text, "'xi' must be 2-D numbers"),
+        (_fewer_rows, "not of one run"),
+        (_one_array, "not an .npz archive: it does not start as a zip file does"),
+        (_folder, "a folder"),
+    ],
+)
+def test_damaged_realizations(run_copy, capsys, damage, words):
+    damage(run_copy / "realizations.npz")
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER
+    assert "realizations.npz" in err and words in err, err
+
+
+# ------------------------------------------------------------------ a run that did not complete
+
+
+class CancelAfter:
+    def __init__(self, count: int, cancel: threading.Event):
+        self.count, self.cancel = count, cancel
+
+    @hookimpl
+    def realization_done(self, done):
+        if done >= self.count:
+            self.cancel.set()
+
+
+def test_a_cancelled_run_is_refused_naming_its_status(tmp_path, capsys, registry):
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 40, "output": {"plot": False}}), registry=registry)
+    cancel = threading.Event()
+    outcome, _ = run_to_folder(
+        scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel
+    )
+    assert outcome.status == "cancelled" and outcome.fit is not None and outcome.done < 40
+    code, out, err = predict_from(tmp_path / "run", capsys)
+    assert code == ExitCode.RUN_FOLDER and not out
+    assert "'cancelled'" in err and f"({outcome.done} of 40 realizations)" in err and "frictionlab resume" in err
+
+
+# ------------------------------------------------------------------ numbers beyond double precision
+
+LAW = ["--a", "1", "--b", "0.1"]
+
+
+@pytest.mark.parametrize(
+    "area, modulus, rms_height, force",
+    [
+        ("1e-300", "1e-300", "1e-300", "1e300"),  # f about 1e1050
+        ("1e300", "1e300", "1e300", "1e-300"),  # f about 1e-1050
+        ("1", "1", "1e-300", "1e300"),  # f about 1e600
+    ],
+)
+def test_an_f_beyond_double_precision_is_a_usage_error(capsys, area, modulus, rms_height, force):
+    code = main(["predict", *LAW, "--area", area, "--modulus", modulus, "--rms-height", rms_height, "--force", force])
+    out, err = capsys.readouterr()
+    assert code == ExitCode.USAGE and not out
+    assert "f = sqrt(pi) F / (2 E* h sqrt(A))" in err and "beyond double precision" in err
+    assert f"force {float(force)!r}" in err and f"area {float(area)!r}" in err
+
+
+@pytest.mark.parametrize(
+    "area, modulus, rms_height, force",
+    [
+        (1e-300, 1e300, 1e300, 1e300),  # E* h overflows, f = 0.886e-150 does not
+        (1e300, 1e-300, 1e-300, 1e-300),  # E* h underflows, f = 0.886e150 does not
+        (1e-320, 1.0, 1.0, 1e-160),  # a subnormal area (A / pi keeps 3 of its digits)
+    ],
+)
+def test_an_f_double_precision_holds_is_found_whatever_the_products_do(capsys, area, modulus, rms_height, force):
+    code = main(["predict", *LAW, "--area", repr(area), "--modulus", repr(modulus), "--rms-height", repr(rms_height),
+                 "--force", repr(force), "--json"])  # fmt: skip
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    ln_f = math.log(math.sqrt(math.pi) / 2) + math.log(force) - math.log(modulus) - math.log(rms_height)
+    ln_f -= 0.5 * math.log(area)
+    assert math.log(out["f"]) == pytest.approx(ln_f, abs=1e-12)
+    assert out["xi"] == pytest.approx(1 + 0.1 * ln_f, rel=1e-12)
+
+
+# ------------------------------------------------------------------ options out of range
+
+
+@pytest.mark.parametrize(
+    "options, named",
+    [
+        (["--a", "nan", "--b", "0.1"], "--a must be a finite number. Got nan"),
+        (["--a", "inf", "--b", "0.1"], "--a must be a finite number. Got inf"),
+        (["--a", "1", "--b=-inf"], "--b must be a finite number. Got -inf"),
+        ([*LAW, "--confidence", "2"], "--confidence must be a number between 0 and 1 (exclusive). Got 2.0"),
+        ([*LAW, "--confidence", "-1"], "--confidence must be a number between 0 and 1 (exclusive). Got -1.0"),
+        ([*LAW, "--confidence", "1"], "--confidence must be a number between 0 and 1 (exclusive). Got 1.0"),
+        ([*LAW, "--confidence", "nan"], "--confidence must be a number between 0 and 1 (exclusive). Got nan"),
+        ([*LAW, "--a-ci", "2", "1", "--b-ci", "0", "1"], "--a-ci must be two finite numbers LO <= HI. Got 2.0, 1.0"),
+        ([*LAW, "--a-ci", "nan", "1", "--b-ci", "0", "1"], "--a-ci must be two finite numbers LO <= HI. Got nan, 1.0"),
+        ([*LAW, "--a-ci", "0", "1", "--b-ci", "0", "inf"], "--b-ci must be two finite numbers LO <= HI. Got 0.0, inf"),
+        # xi = a + b ln f, with ln f = -0.12 here (18.3 at F = 1e9), overflows
+        (["--a", "1.7e308", "--b=-1e308"], "xi = a + b ln f is beyond double precision"),
+        ([*LAW, "--a-ci", "0", "1.7e308", "--b-ci", "0", "1e308", "--force", "1e9"], "the interval of xi"),
+        ([*LAW, "--rms-slope", "1e308", "--force", "1e9"], "rms_slope is too large"),
+        ([*LAW, "--rms-slope", "nan"], "rms_slope must be a finite number > 0. Got nan"),
+    ],
+)
+def test_options_out_of_range_are_usage_errors(capsys, options, named):
+    code = main(["predict", *CONTACT, *options])
+    out, err = capsys.readouterr()
+    assert code == ExitCode.USAGE and not out
+    assert named in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("option", [["--a-ci", "0", "1"], ["--confidence", "0.9"], ["--b", "0.1"]])
+def test_the_law_by_hand_and_from_a_run_do_not_mix(finished_run, capsys, option):
+    code, out, err = predict_from(finished_run, capsys, *option)
+    assert code == ExitCode.USAGE and not out and f"{option[0]} with --from" in err
+
+
+def test_huge_but_finite_numbers_print_short(capsys):
+    assert main(["predict", *CONTACT, "--a", "1", "--b", "1e307", "--a-ci", "0", "2", "--b-ci", "1e306", "1e307"]) == 0
+    out = capsys.readouterr().out
+    assert "e+307" in out and max(len(line) for line in out.splitlines()) < 120
