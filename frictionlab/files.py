@@ -4,7 +4,6 @@ version intact, and it never renames over what is not a regular file (a symlink 
 written through, a character device or FIFO is written into, a folder, socket or block
 device is refused); ``output_path_problem`` says why a path cannot be an output folder;
 ``check_output_file`` refuses an existing output file unless ``--force``;
-``claim_new_folder`` makes a folder no other process can also have made;
 ``write_npz`` writes arrays compressed where compressing them pays."""
 
 from __future__ import annotations
@@ -99,21 +98,6 @@ def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
     if kind == "file" and not force:
         raise OutputRefused(f"{option} {path} exists: give another file, or --force to replace it")
     return path
-
-
-def claim_new_folder(base: str | Path) -> Path:
-    """Make and return ``base``, or ``base-2``, ``base-3``... when it exists: made with
-    mkdir, which fails for all but one process, so two commands started in the same
-    second never share a default folder."""
-    base = Path(base)
-    base.parent.mkdir(parents=True, exist_ok=True)
-    candidate, n = base, 2
-    while True:
-        try:
-            candidate.mkdir()
-            return candidate
-        except FileExistsError:
-            candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
 
 
 def output_path_problem(path: Path) -> str | None:

@@ -116,15 +116,3 @@ def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
         with pytest.raises(OutputRefused, match="is a socket"):
             atomic_write(sock_path, lambda fh: fh.write("x"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s", "sdir"] and not any(folder.iterdir())
-
-
-def test_claim_new_folder_never_returns_one_folder_twice(tmp_path):
-    from concurrent.futures import ThreadPoolExecutor
-
-    from frictionlab.files import claim_new_folder
-
-    base = tmp_path / "runs" / "quickstart-study-20260101-000000"
-    with ThreadPoolExecutor(8) as pool:
-        folders = list(pool.map(lambda _: claim_new_folder(base), range(8)))
-    assert len(set(folders)) == 8 and all(f.is_dir() for f in folders)
-    assert sorted(f.name for f in folders)[:2] == [base.name, f"{base.name}-2"]

@@ -99,10 +99,13 @@ def write_page(
     ``runs/exact3d-<timestamp>``); giving an earlier one resumes it. Returns the page's path."""
     plan = plan or (QUICK if quick else FULL)
     command = command or _command(quick, out_dir, runs_dir)
+    if out_dir:  # refused before a default runs folder is made
+        page_paths(Path(out_dir), force=options.force)
+    if runs_dir:
+        check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
-    check_runs_folder(runs_dir, force=options.force, own=(PAGE, FIGURES_DIR))
     runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
     kappas = kappas_of(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")

@@ -9,13 +9,12 @@ from __future__ import annotations
 import csv
 import math
 import os
-import time
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import OutputRefused
-from ..files import atomic_write, claim_new_folder, output_path_problem
+from ..files import atomic_write, output_path_problem
 from .axes import COLUMNS, Row, Study, preset_points
 from .metrics import pareto_front
 
@@ -331,9 +330,9 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     name), or ``force``; by default a new ``runs/<name>-study-<timestamp>``, made here so
     that two studies started in the same second get two folders."""
     if not out_dir:
-        from ..rundir import DEFAULT_RUNS_DIR
+        from ..rundir import new_run_folder
 
-        return claim_new_folder(DEFAULT_RUNS_DIR / f"{name}-study-{time.strftime('%Y%m%d-%H%M%S')}")
+        return new_run_folder(f"{name}-study")
     out = Path(out_dir)
     shown = os.fsencode(out).decode("utf-8", "backslashreplace")
     problem = output_path_problem(out)
