@@ -8,6 +8,7 @@ device is refused); ``output_path_problem`` says why a path cannot be an output 
 
 from __future__ import annotations
 
+import errno
 import io
 import os
 import stat
@@ -41,8 +42,8 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     Only a regular file is ever replaced: a symlink is followed (the file it points at
     is replaced, the link stays); a character device (/dev/null) or a FIFO is written
     into, as any program writing there would (renaming over it would destroy the node:
-    as root, /dev/null itself); a folder, socket or block device is refused
-    (OutputRefused naming the path)."""
+    as root, /dev/null itself); a folder, socket or block device is refused (an
+    OSError naming the path: "is a folder, not a file")."""
     path = Path(path)
     if path.is_symlink():
         path = Path(os.path.realpath(path))  # a dangling link: the file it names is created
@@ -51,8 +52,9 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
         with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
         return
-    if kind is not None and kind != "file":
-        raise OutputRefused(f"{path} is a {kind}, not a file: give a file to write to")
+    if kind is not None and kind != "file":  # an OSError, as renaming over it was: callers say "cannot write"
+        error = IsADirectoryError if kind == "folder" else OSError
+        raise error(errno.EISDIR if kind == "folder" else errno.EINVAL, f"is a {kind}, not a file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

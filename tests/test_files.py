@@ -104,15 +104,15 @@ def test_atomic_write_writes_into_a_character_device_instead_of_replacing_it(tmp
 def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
     import socket
 
-    from frictionlab.errors import OutputRefused
-
     folder = tmp_path / "sdir"
     folder.mkdir()
-    with pytest.raises(OutputRefused, match="sdir is a folder"):
+    with pytest.raises(IsADirectoryError) as raised:
         atomic_write(folder, lambda fh: fh.write("x"))
+    assert raised.value.filename == str(folder) and raised.value.strerror == "is a folder, not a file"
     sock_path = tmp_path / "s"
     with socket.socket(socket.AF_UNIX) as sock:
         sock.bind(str(sock_path))
-        with pytest.raises(OutputRefused, match="is a socket"):
+        with pytest.raises(OSError) as raised:
             atomic_write(sock_path, lambda fh: fh.write("x"))
+    assert raised.value.filename == str(sock_path) and raised.value.strerror == "is a socket, not a file"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s", "sdir"] and not any(folder.iterdir())
