@@ -28,6 +28,17 @@ def few_contacts_caveat(count: float) -> str:
     )
 
 
+FULL_CONTACT = 0.999  # mean contact fraction from which the whole profile is taken to be in contact
+
+
+def full_contact_caveat(first: int, loads: np.ndarray) -> str:
+    """The caveat of a fit whose loads reach full contact, from load index ``first`` on."""
+    return (
+        f"the whole profile is in contact from load {first + 1} of {loads.size} on (load {loads[first]:.4g}): "
+        "xi is 1 there by definition, so those loads measure no roughness; lower the loads"
+    )
+
+
 @dataclass
 class RunOutcome:
     """The statistics of what finished. Per-force arrays have one entry per load
@@ -63,11 +74,18 @@ class RunOutcome:
 
     @property
     def caveats(self) -> list[str]:
-        """What a reader of the fit must know: today, too few points in contact at the
-        first load (the rms slope in contact of one or two points is mostly noise)."""
-        if self.fit is None or not self.contact_count.size or not self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
+        """What a reader of the fit must know: too few points in contact at the first load
+        (the rms slope in contact of one or two points is mostly noise), or the whole
+        profile in contact from some load on (xi is 1 there by definition)."""
+        if self.fit is None or not self.contact_count.size:
             return []
-        return [few_contacts_caveat(float(self.contact_count[0]))]
+        caveats = []
+        if self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
+            caveats.append(few_contacts_caveat(float(self.contact_count[0])))
+        full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
+        if full.size:
+            caveats.append(full_contact_caveat(int(full[0]), self.loads))
+        return caveats
 
     @property
     def extent(self) -> float:

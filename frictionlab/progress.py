@@ -63,6 +63,38 @@ SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond it
 LOAD_LINE_SECONDS = 30.0  # in a log: a long solve's load at most this often
 
 
+class BestEffort:
+    """A stream whose failed writes are dropped from then on: progress is never worth a
+    run (stderr closed under it, or full: ``2>/dev/full``)."""
+
+    def __init__(self, stream):
+        self.stream, self.broken = stream, False
+
+    def write(self, text: str) -> int:
+        if not self.broken:
+            try:
+                return self.stream.write(text)
+            except (OSError, ValueError):  # ValueError: written after it was closed
+                self.broken = True
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.broken:
+            try:
+                self.stream.flush()
+            except (OSError, ValueError):
+                self.broken = True
+
+    def isatty(self) -> bool:
+        try:
+            return self.stream.isatty()
+        except (AttributeError, ValueError):
+            return False
+
+    def __getattr__(self, name):  # what else a console asks of its file: encoding, fileno, ...
+        return getattr(self.stream, name)
+
+
 class ProgressReporter:
     """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr): a bar
     when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth;
@@ -70,7 +102,7 @@ class ProgressReporter:
     line and, in a log, its last)."""
 
     def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
-        self.stream = stream or sys.stderr
+        self.stream = BestEffort(stream or sys.stderr)
         self.interactive = wants_bar(self.stream) if interactive is None else interactive
         self.after = after
         self.total = 0
@@ -163,7 +195,7 @@ class SweepProgress(SweepListener):
     realizations through a ``ProgressReporter``."""
 
     def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
-        self.stream = stream or sys.stderr
+        self.stream = BestEffort(stream or sys.stderr)
         self.interactive = interactive
         self.after = after
 

@@ -34,6 +34,14 @@ def _line(node_or_mark) -> int:
     return mark.line + 1 if mark is not None else 0
 
 
+class _Unconvertible(ValueError):
+    """A scalar YAML parsed but Python cannot hold, with the line it is on."""
+
+    def __init__(self, line: int, cause: Exception):
+        super().__init__(str(cause))
+        self.line, self.cause = line, cause
+
+
 class _BoundedLoader(yaml.SafeLoader):
     """SafeLoader that refuses nesting deeper than MAX_DEPTH while composing
     (the composer recurses once per level), and reads ``1e-6`` and ``1.5e3`` as numbers, as YAML 1.2
@@ -43,6 +51,14 @@ class _BoundedLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
         self._nodes = 0
+
+    def construct_object(self, node, deep=False):
+        try:
+            return super().construct_object(node, deep)
+        except (ValueError, OverflowError) as exc:  # a date like 2020-13-45, an int past Python's digit limit
+            if isinstance(exc, _Unconvertible):
+                raise
+            raise _Unconvertible(_line(node), exc) from None
 
     def compose_node(self, parent, index):
         self._depth += 1
@@ -159,7 +175,10 @@ def load_yaml(text: str) -> Any:
             mark = exc.problem_mark or exc.context_mark
             where = f" at line {mark.line + 1}" if mark else ""
             raise YamlProblem(f"a value YAML cannot read{where}: {exc.problem or 'bad value'}") from None
-        except (ValueError, OverflowError) as exc:  # a date like 2020-13-45, an int past Python's digit limit
+        except _Unconvertible as exc:  # the reason names limits and ranges, never the text
+            reason = str(exc.cause).split(";")[0][:100]
+            raise YamlProblem(f"the value at line {exc.line} cannot be converted ({type(exc.cause).__name__}: {reason})") from None
+        except (ValueError, OverflowError) as exc:
             raise YamlProblem(f"a value YAML cannot convert ({type(exc).__name__})") from None
     finally:
         loader.dispose()

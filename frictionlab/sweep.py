@@ -23,14 +23,14 @@ import re
 import threading
 import time
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from pydantic import BaseModel
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
 from .files import atomic_write, output_path_problem
 from .fit import LogFit, json_safe
 from .listeners import SweepListener
@@ -39,6 +39,7 @@ from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
 from .results import write_figure
+from .rundir import STATE_FILE
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
@@ -270,9 +271,11 @@ def _run_points(
         for listener in listeners:
             listener.point_started(sweep, point)
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
+        started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
+        point_options = options if started or not options.resume else replace(options, resume=False)
         try:
             outcome, _ = run_to_folder(
-                point.scene, folder, options, listeners=run_listeners, cancel=cancel, plot=plot
+                point.scene, folder, point_options, listeners=run_listeners, cancel=cancel, plot=plot
             )
         except FrictionlabError as exc:
             yield PointResult(point, "error", folder, error=str(exc))
@@ -357,6 +360,19 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
         raise OutputRefused(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
+
+
+def stored_sweep(out_dir: Path) -> dict:
+    """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
+    and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
+    try:
+        stored = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        raise RunFolderError(f"{out_dir}/sweep.json cannot be read as a sweep's record: this sweep cannot be resumed") from None
+    base, spec = (stored.get("base_preset"), stored.get("sweep")) if isinstance(stored, dict) else (None, None)
+    if not (isinstance(base, dict) and isinstance(spec, dict)):
+        raise RunFolderError(f"{out_dir}/sweep.json is damaged (no base_preset and sweep mappings): it cannot be resumed")
+    return {**base, "sweep": spec}
 
 
 def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:

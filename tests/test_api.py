@@ -159,3 +159,17 @@ def test_every_public_name_resolves_lazily():
     code = "import frictionlab; [getattr(frictionlab, n) for n in frictionlab.__all__]; from frictionlab import *; print('ok')"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.stdout.strip() == "ok", done.stderr
+
+
+def test_loads_that_press_the_whole_line_flat_carry_a_caveat_from_where_it_starts(tmp_path):
+    # MDR springs: all N springs touch once the load exceeds about N dx E* times the height range
+    heavy = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1.0, "stop": 1e6, "steps": 12}}
+    result = frictionlab.run(heavy, out=tmp_path / "heavy", **FAST)
+    fraction = result.table["contact_fraction"]
+    first = int(np.flatnonzero(fraction >= 0.999)[0])
+    assert 0 < first < fraction.size and np.all(fraction[first:] >= 0.999)
+    assert np.allclose(result.table["xi"][first:], 1.0)  # the rms slope in contact is the whole line's
+    full = [c for c in result.caveats if "the whole profile is in contact" in c]
+    assert full == [f"the whole profile is in contact from load {first + 1} of 12 on (load {result.table['F'][first]:.4g}): "
+                    "xi is 1 there by definition, so those loads measure no roughness; lower the loads"]  # fmt: skip
+    assert json.loads((tmp_path / "heavy" / "summary.json").read_text())["caveats"] == result.caveats

@@ -181,3 +181,26 @@ def test_validate_checks_every_point(tmp_path, capsys):
     bad = write(tmp_path, sweep_preset({"spectrum.params.hurst": {"values": [0.5, 2.0]}}), "bad.yaml")
     assert main(["validate", str(bad)]) == 2
     assert "sweep point 2 (spectrum.params.hurst=2.0): spectrum.params.hurst: must be <= 1.5" in capsys.readouterr().err
+
+
+def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_path, registry, capsys):
+    data = sweep_preset({"seed": {"values": [1, 2, 3]}})
+    preset = write(tmp_path, data)
+    whole = tmp_path / "whole"
+    assert main(["run", str(preset), "--out", str(whole), "--workers", "1", "--quiet"]) == 0
+    fits = lambda folder: [(r["status"], r["a"], r["b"]) for r in read_table(folder / "sweep.csv")]  # noqa: E731
+
+    for how in (["resume", "{out}"], ["run", str(preset), "--out", "{out}", "--resume"]):
+        out = tmp_path / how[0]
+        cancel = threading.Event()
+
+        class StopAfterFirst(SweepListener):
+            def point_finished(self, sweep, point, result):
+                cancel.set()
+
+        sweep = plan_sweep(data, registry=registry, source=str(preset))
+        run_sweep(sweep, out, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+        assert [r["status"] for r in read_table(out / "sweep.csv")] == ["completed", "pending", "pending"]
+        capsys.readouterr()
+        assert main([part.format(out=out) for part in how] + ["--workers", "1", "--quiet"]) == 0, capsys.readouterr().err
+        assert fits(out) == fits(whole)  # the points never reached ran afresh, the finished one was kept

@@ -29,7 +29,13 @@ def run(args) -> ExitCode:
     from ..rundir import PRESET_FILE, RunDirectory
 
     run_dir = Path(args.run_dir)
+    args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
+    if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
+        from ..sweep import stored_sweep
+        from .options import executor_run_options
+
+        args.preset = str(run_dir / "sweep.json")
+        return run_command.run_sweep_into(args, stored_sweep(run_dir), run_dir, executor_run_options(args, resume=True))
     RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
-    args.preset, args.out, args.resume, args.set, args.seed = str(run_dir / PRESET_FILE), str(run_dir), True, None, None
-    args.force = False
+    args.preset = str(run_dir / PRESET_FILE)
     return run_command.run(args)

@@ -64,7 +64,7 @@ def run(args) -> ExitCode:
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
     try:
         if scene.preset.sweep is not None:  # one ensemble per point
-            return _run_sweep(args, data, out_dir, options)
+            return run_sweep_into(args, data, out_dir, options)
         return _run_scene(args, scene, out_dir, options)
     except FrictionlabError:  # refused before it began (the memory check): the folder made for it goes
         if not args.out and not any(out_dir.iterdir()):
@@ -108,7 +108,7 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     return ExitCode.OK
 
 
-def _run_sweep(args, data: dict, out_dir: Path, options) -> ExitCode:
+def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..signals import interrupted_exit_code
     from ..sweep import plan_sweep, run_sweep
     from ..progress import SweepProgress

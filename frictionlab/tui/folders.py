@@ -20,6 +20,7 @@ import yaml
 from ..files import atomic_write
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import builtin_folder, builtin_presets
+from ..safe_yaml import load_yaml
 from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
@@ -90,9 +91,9 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
         if not folder.is_dir():
             continue
         for path in sorted(folder.glob("*.y*ml")):
-            try:
-                data = yaml.safe_load(path.read_text(encoding="utf-8"))
-            except (OSError, yaml.YAMLError) as exc:
+            try:  # read as a preset is: bounded, so that a hostile file cannot stop the listing
+                data = load_yaml(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
                 entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
                 continue
             data = data if isinstance(data, dict) else {}
@@ -145,7 +146,15 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
 
 
 def _number(value) -> float:
-    return float(value) if isinstance(value, int | float) else math.nan
+    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+
+
+def _mapping(value) -> dict:
+    return value if isinstance(value, dict) else {}
+
+
+def _count(value) -> int:
+    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else 0
 
 
 @dataclass
@@ -172,21 +181,38 @@ class RunEntry:
     def r2(self) -> float:
         return _number((self.fit or {}).get("r2"))
 
+    def interval(self, key: str) -> tuple[float, float] | None:
+        """The fit's ``a_ci`` or ``b_ci`` as two numbers, None if it has none (or a damaged one)."""
+        pair = (self.fit or {}).get(key)
+        return (_number(pair[0]), _number(pair[1])) if isinstance(pair, list) and len(pair) == 2 else None
+
+    @property
+    def contact_counts(self) -> tuple[float, float]:
+        """The mean points in contact at the first and the last load (NaN where unknown)."""
+        return _number(self.summary.get("contact_count_at_first_load")), _number(self.summary.get("contact_count_at_last_load"))
+
+    @property
+    def formula(self) -> str:
+        """f's formula as summary.json gives it ("" if it does not)."""
+        formula = _mapping(self.summary.get("normalisation")).get("formula")
+        return formula if isinstance(formula, str) else ""
+
 
 def read_run(folder: Path) -> RunEntry:
     """A run folder's summary; raises OSError/ValueError if it has none readable."""
     folder = Path(folder)
     summary_path = folder / "summary.json"
     summary = json.loads(summary_path.read_text(encoding="utf-8"))
-    realizations = summary.get("realizations") or {}
-    preset = summary.get("preset") or {}
-    return RunEntry(
+    if not isinstance(summary, dict):
+        raise ValueError("summary.json is not a JSON object")
+    realizations, preset = _mapping(summary.get("realizations")), _mapping(summary.get("preset"))
+    return RunEntry(  # a field of the wrong kind is shown as missing, never trusted
         path=folder,
         name=str(preset.get("name") or folder.name),
         status=str(summary.get("status", "?")),
-        done=int(realizations.get("done") or 0),
-        requested=int(realizations.get("requested") or 0),
-        fit=summary.get("fit"),
+        done=_count(realizations.get("done")),
+        requested=_count(realizations.get("requested")),
+        fit=summary.get("fit") if isinstance(summary.get("fit"), dict) else None,
         summary=summary,
         mtime=summary_path.stat().st_mtime,
     )
@@ -212,6 +238,8 @@ def read_sweep(folder: Path) -> SweepEntry:
     folder = Path(folder)
     summary_path = folder / "sweep.json"
     summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    if not isinstance(summary, dict):
+        raise ValueError("sweep.json is not a JSON object")
     points = summary["points"]
     if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
         raise TypeError("sweep.json: points must be a list of rows")
@@ -219,7 +247,7 @@ def read_sweep(folder: Path) -> SweepEntry:
         path=folder,
         name=str(summary.get("name") or folder.name),
         status=str(summary.get("status", "?")),
-        paths=list((summary.get("sweep") or {}).get("parameters") or {}),
+        paths=[str(p) for p in _mapping(_mapping(summary.get("sweep")).get("parameters"))],
         points=points,
         mtime=summary_path.stat().st_mtime,
     )
@@ -238,7 +266,7 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
                 continue
             try:
                 entries.append(read(folder))
-            except (OSError, ValueError, TypeError, KeyError):
-                pass  # a half-written or foreign folder: not one to list
+            except (OSError, ValueError, TypeError, KeyError, RecursionError):
+                pass  # a half-written, damaged or foreign folder: not one to list
             break
     return sorted(entries, key=lambda e: (-e.mtime, e.path.name))

@@ -117,6 +117,19 @@ def test_a_closed_stdout_is_written_nowhere_and_a_full_one_is_an_error(argv, tmp
         assert (tmp_path / "closed" / "summary.json").is_file()
 
 
+def test_progress_that_cannot_be_written_never_stops_a_run(tmp_path):
+    command = [sys.executable, "-m", "frictionlab", "run", "quickstart", "--no-plot"]
+    closed = subprocess.run([*command, "--out", str(tmp_path / "closed")], stdout=subprocess.DEVNULL, cwd=tmp_path,
+                            preexec_fn=lambda: os.close(2), timeout=120)  # fmt: skip
+    assert closed.returncode == 0
+    if os.path.exists("/dev/full"):
+        with open("/dev/full", "w") as full:
+            done = subprocess.run([*command, "--out", str(tmp_path / "full")], stdout=subprocess.DEVNULL, stderr=full,
+                                  cwd=tmp_path, timeout=120)  # fmt: skip
+        assert done.returncode == 0
+        assert json.loads((tmp_path / "full" / "run.json").read_text())["status"] == "completed"
+
+
 def in_terminal(*argv: str, columns: int = 60, **env: str) -> str:
     """The output of ``frictionlab ARGV`` on a pseudo-terminal ``columns`` wide."""
     main, child = pty.openpty()

@@ -608,3 +608,41 @@ async def test_opening_a_preset_either_way_leaves_focus_on_its_first_field(folde
     assert first == "field--name"
     assert field_line(shown, "realizations").split() == ["realizations", "7"]
     assert field_line(shown, "name").split() == ["name", "small"]
+
+
+@sync
+async def test_damaged_runs_and_presets_in_its_folders_never_stop_the_tui(folders, registry):
+    """Found by a bug hunt: one damaged summary.json in ./runs, or a preset with a 5000-digit
+    number, crashed the TUI at start. Each is now listed as far as it can be read, or left out."""
+    make_runs(folders, registry)
+    good = json.loads((folders / "runs" / "seed1" / "summary.json").read_text())
+    damaged = {
+        "a-list": [],
+        "fit-text": {**good, "fit": "x"},
+        "bad-fields": {**good, "fit": {**good["fit"], "a": "x", "a_ci": "zz"}, "normalisation": "x",
+                       "contact_count_at_first_load": "many", "realizations": {"done": "lots"}},  # fmt: skip
+    }
+    for name, summary in damaged.items():
+        (folders / "runs" / name).mkdir()
+        (folders / "runs" / name / "summary.json").write_text(json.dumps(summary))
+    (folders / "runs" / "deep").mkdir()
+    (folders / "runs" / "deep" / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
+    (folders / "presets" / "huge.yaml").write_text("name: huge\nseed: " + "9" * 5000 + "\n")
+    (folders / "presets" / "bomb.yaml").write_text(
+        "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+                                                      for p, c in zip("abcdefg", "bcdefgh"))  # fmt: skip
+    )
+    app = make_app(registry)
+    async with app.run_test(size=BIG) as pilot:
+        await pilot.pause()
+        presets_tab = screen_text(app)
+        await pilot.press("f5")
+        await pilot.pause()
+        for _ in range(6):  # every run into the overlay, one after the other
+            await pilot.press("space", "down")
+            await pilot.pause()
+        results_tab = screen_text(app)
+        assert app.is_running
+    assert "huge" in presets_tab and "bomb" in presets_tab and "unreadable" in presets_tab
+    assert "seed1" in results_tab and "fit-text" in results_tab and "bad-fields" in results_tab
+    assert "a-list" not in results_tab and "deep" not in results_tab

@@ -185,14 +185,13 @@ class ResultsPane(Vertical):
 
 def _entry_lines(entry: RunEntry, style: str) -> list[Content]:
     """What the overlay says of one run: f, its status and contacts, its fit."""
-    fit = entry.fit or {}
-    counts = entry.summary.get("contact_count_at_first_load"), entry.summary.get("contact_count_at_last_load")
-    formula = (entry.summary.get("normalisation") or {}).get("formula")
+    counts = entry.contact_counts
+    formula = entry.formula
     lines = [Content.assemble((f"■ {entry.path.name}", style), f" f = {formula}" if formula else "")]
-    contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if counts[0] is not None else ""
+    contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if math.isfinite(counts[0]) else ""
     lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
-    if fit:
-        interval = lambda key: format_interval(tuple(fit.get(key) or (None, None)), missing="")  # noqa: E731
-        lines.append(f"  a={fit.get('a', math.nan):.4f} {interval('a_ci')} R^2={fit.get('r2', math.nan):.4f}")
-        lines.append(f"  b={fit.get('b', math.nan):.4f} {interval('b_ci')}")
+    if entry.fit is not None:
+        interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731
+        lines.append(f"  a={entry.a:.4f} {interval('a_ci')} R^2={entry.r2:.4f}")
+        lines.append(f"  b={entry.b:.4f} {interval('b_ci')}")
     return [Content(line) if isinstance(line, str) else line for line in lines]
