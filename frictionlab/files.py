@@ -1,12 +1,17 @@
 """Writing files safely: every file frictionlab writes goes through ``atomic_write``,
 so a reader never sees half a file and an interrupted write leaves the previous
-version intact; ``output_path_problem`` says why a path cannot be an output folder;
+version intact, and it never renames over what is not a regular file (a symlink is
+written through, a character device or FIFO is written into, a folder, socket or block
+device is refused); ``output_path_problem`` says why a path cannot be an output folder;
+``check_output_file`` refuses an existing output file unless ``--force``;
 ``write_npz`` writes arrays compressed where compressing them pays."""
 
 from __future__ import annotations
 
+import errno
 import io
 import os
+import stat
 import tempfile
 import zipfile
 import zlib
@@ -14,6 +19,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
+
+from .errors import OutputRefused
 
 _SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
 _WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size
@@ -30,8 +37,24 @@ _UMASK = _read_umask()
 
 def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
     """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
-    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600."""
+    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600.
+
+    Only a regular file is ever replaced: a symlink is followed (the file it points at
+    is replaced, the link stays); a character device (/dev/null) or a FIFO is written
+    into, as any program writing there would (renaming over it would destroy the node:
+    as root, /dev/null itself); a folder, socket or block device is refused (an
+    OSError naming the path: "is a folder, not a file")."""
     path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))  # a dangling link: the file it names is created
+    kind = _kind(path)
+    if kind in ("character device", "FIFO"):
+        with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
+            write(fh)
+        return
+    if kind is not None and kind != "file":  # an OSError, as renaming over it was: callers say "cannot write"
+        error = IsADirectoryError if kind == "folder" else OSError
+        raise error(errno.EISDIR if kind == "folder" else errno.EINVAL, f"is a {kind}, not a file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -44,6 +67,39 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+_KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
+          stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device"}  # fmt: skip
+
+
+def _kind(path: Path) -> str | None:
+    """What is at ``path`` (links followed): "file", "folder", "FIFO"..., None if nothing."""
+    try:
+        mode = os.stat(path).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    return _KINDS.get(stat.S_IFMT(mode), "special file")
+
+
+def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
+    """``path`` as a file a command may write (``option`` names it in messages):
+    OutputRefused for a folder (or a name ending in /), a path under a file, a
+    socket or block device, and an existing file unless ``force``. A character
+    device or FIFO is accepted (written into, see ``atomic_write``)."""
+    text = os.fsdecode(path)
+    path = Path(path)
+    kind = _kind(path)
+    if kind == "folder" or text.endswith(os.sep):
+        raise OutputRefused(f"{option} {text} is a folder: give a file name (e.g. {path / 'name'})")
+    problem = output_path_problem(path.parent)
+    if problem:
+        raise OutputRefused(f"{option} {path}: {problem}")
+    if kind in ("socket", "block device", "special file"):
+        raise OutputRefused(f"{option} {path} is a {kind}, not a file: give a file to write to")
+    if kind == "file" and not force:
+        raise OutputRefused(f"{option} {path} exists: give another file, or --force to replace it")
+    return path
 
 
 def output_path_problem(path: Path) -> str | None:

@@ -33,6 +33,22 @@ def interrupted_exit_code() -> ExitCode:
     return ExitCode.TERMINATED if signal.SIGTERM in received else ExitCode.INTERRUPTED
 
 
+def mark() -> int:
+    """A mark for ``interrupted_since``: the signals received so far."""
+    return len(received)
+
+
+def interrupted_since(seen: int) -> bool:
+    """Whether SIGINT or SIGTERM came since ``mark()`` gave ``seen``: a run whose last chunk
+    was running when it came ends completed, yet the command of several runs must stop."""
+    return len(received) > seen
+
+
+class WorkInterrupted(KeyboardInterrupt):
+    """A command of several runs (report, exact3d) stops after a run that ended
+    interrupted: the finished runs are kept; ``str()`` says where, and how to go on."""
+
+
 class RaiseOnSigterm:
     """While a command runs: SIGTERM raises Terminated (as Ctrl-C raises
     KeyboardInterrupt outside a run); earlier signals are forgotten, and the

@@ -64,6 +64,16 @@ def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):
     assert result.returncode == ExitCode.USAGE and "benad2012-fig2" in result.stderr
 
 
+def test_presets_copy_to_a_name_ending_in_a_slash_makes_that_folder(tmp_path):
+    result = run_cli("presets", "copy", "quickstart", f"{tmp_path / 'newdir'}/")
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "newdir" / "quickstart.yaml").read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
+    (tmp_path / "afile").write_text("mine")
+    result = run_cli("presets", "copy", "quickstart", f"{tmp_path / 'afile' / 'sub'}/")
+    assert result.returncode == ExitCode.OUTPUT_REFUSED and "afile is a file" in result.stderr
+    assert (tmp_path / "afile").read_text() == "mine"
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory) -> Path:
     """frictionlab installed as a user would (a built wheel, not editable), offline,

@@ -60,3 +60,59 @@ def test_write_npz_gives_the_same_bytes_for_the_same_arrays():
     write_npz(first, arrays)
     write_npz(second, arrays)
     assert first.getvalue() == second.getvalue()
+
+
+def test_atomic_write_writes_through_a_symlink_and_keeps_the_link(tmp_path):
+    real = tmp_path / "real.txt"
+    real.write_text("old")
+    link = tmp_path / "link.txt"
+    link.symlink_to(real)
+    atomic_write(link, lambda fh: fh.write("new"))
+    assert link.is_symlink() and os.readlink(link) == str(real)
+    assert real.read_text() == "new"
+
+
+def test_atomic_write_writes_into_a_fifo_instead_of_replacing_it(tmp_path):
+    import stat
+    import threading
+
+    fifo = tmp_path / "ff"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(open(fifo).read()), daemon=True)  # never blocks the exit
+    reader.start()
+    atomic_write(fifo, lambda fh: fh.write("through the pipe"))
+    reader.join(10)
+    assert got == ["through the pipe"]
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+
+
+def test_atomic_write_writes_into_a_character_device_instead_of_replacing_it(tmp_path):
+    null = tmp_path / "mynull"
+    null.symlink_to("/dev/null")  # as a device node a user made (mknod needs root), reached by its path
+    atomic_write(null, lambda fh: fh.write("discarded"))
+    import stat
+
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode) and null.is_symlink()
+    if os.geteuid() == 0:  # a real device node: renaming over it would make it a regular file
+        node = tmp_path / "node"
+        os.mknod(node, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        atomic_write(node, lambda fh: fh.write("discarded"), binary=False)
+        assert stat.S_ISCHR(os.lstat(node).st_mode)
+
+
+def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
+    import socket
+
+    folder = tmp_path / "sdir"
+    folder.mkdir()
+    with pytest.raises(IsADirectoryError) as raised:
+        atomic_write(folder, lambda fh: fh.write("x"))
+    assert raised.value.filename == str(folder) and raised.value.strerror == "is a folder, not a file"
+    sock_path = tmp_path / "s"
+    with socket.socket(socket.AF_UNIX) as sock:
+        sock.bind(str(sock_path))
+        with pytest.raises(OSError) as raised:
+            atomic_write(sock_path, lambda fh: fh.write("x"))
+    assert raised.value.filename == str(sock_path) and raised.value.strerror == "is a socket, not a file"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s", "sdir"] and not any(folder.iterdir())

@@ -22,9 +22,10 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: a few minutes, not converged")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")
-    p.add_argument("--runs", metavar="DIR", help="folder of the ensembles' runs; an earlier one is resumed (default: a new runs/exact3d-<plan>-<timestamp>)")
+    p.add_argument("--runs", metavar="DIR", help="folder of the ensembles' runs; an earlier one is resumed, one holding "
+                   "other files is refused unless --force (default: a new runs/exact3d-<plan>-<timestamp>)")
     p.add_argument("--presets", metavar="DIR", help="folder with exact3d-h03..h10.yaml (default: ./presets if it holds them, else the built-in presets)")
-    p.add_argument("--force", action="store_true", help="overwrite an existing page and its figures")
+    p.add_argument("--force", action="store_true", help="overwrite an existing page and its figures; write runs into a --runs folder holding other files")
     add_workers_option(p, "all cores")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(handler=run)
@@ -32,11 +33,17 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..exact3d.report import write_page
+    from ..signals import WorkInterrupted, interrupted_exit_code
 
-    page = write_page(
-        args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
-        options=run_options(workers=args.workers, force=args.force),
-        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
-    )  # fmt: skip
+    try:
+        page = write_page(
+            args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
+            options=run_options(workers=args.workers, force=args.force),
+            log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+        )  # fmt: skip
+    except WorkInterrupted as exc:
+        code = interrupted_exit_code()
+        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}: {exc}; no page written", file=sys.stderr)
+        return code
     print(page)
     return ExitCode.OK

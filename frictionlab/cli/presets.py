@@ -4,6 +4,7 @@ to take one out to edit (never over an existing file without ``--force``)."""
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean
@@ -32,7 +33,8 @@ def add_parser(sub) -> None:
         epilog="example:\n  frictionlab presets copy benad2012-fig2 my-fig2.yaml",
     )
     c.add_argument("name", metavar="NAME", help="a built-in preset (frictionlab presets lists them)")
-    c.add_argument("dest", nargs="?", default=".", metavar="DEST", help="file or existing folder (default: .)")
+    c.add_argument("dest", nargs="?", default=".", metavar="DEST",
+                   help="file or folder (default: .); a name ending in / is a folder, made if missing")
     c.add_argument("--force", action="store_true", help="replace DEST if it exists")
     p.set_defaults(handler=run)
 
@@ -41,7 +43,15 @@ def run(args) -> ExitCode:
     from ..preset.builtin import builtin_presets
 
     if getattr(args, "action", None) == "copy":
-        return copy_preset(args.name, Path(args.dest), force=args.force)
+        dest = Path(args.dest)
+        if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
+            from ..files import output_path_problem
+
+            problem = output_path_problem(dest)
+            if problem:
+                raise OutputRefused(f"DEST: {problem}; give a folder")
+            dest.mkdir(parents=True)
+        return copy_preset(args.name, dest, force=args.force)
     presets = builtin_presets()
     if args.json:
         rows = [{"name": p.name, "description": p.description, "path": str(p.path)} for p in presets]

@@ -22,7 +22,7 @@ def add_parser(sub) -> None:
     p.add_argument("--presets", metavar="DIR", help="folder with benad2012-fig2..5.yaml (default: ./presets if it holds them, else the built-in presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/report-<timestamp>)")
     p.add_argument("--markdown", metavar="FILE", help="the report (default: REPRODUCTION.md in --out)")
-    p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out)")
+    p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out); a file is refused")
     p.add_argument("--force", action="store_true", help="overwrite an existing report, its figures and runs")
     add_workers_option(p, "all cores")
     p.add_argument("--readings", action="store_true", help="also run the readings of the paper's method (slower)")
@@ -33,13 +33,19 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..paper.reproduce import write_report
+    from ..signals import WorkInterrupted, interrupted_exit_code
 
-    path = write_report(
-        presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-        options=run_options(workers=args.workers, force=args.force), readings=args.readings,
-        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
-        quiet=args.quiet,
-    )  # fmt: skip
+    try:
+        path = write_report(
+            presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
+            options=run_options(workers=args.workers, force=args.force), readings=args.readings,
+            log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+            quiet=args.quiet,
+        )  # fmt: skip
+    except WorkInterrupted as exc:
+        code = interrupted_exit_code()
+        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}: {exc}", file=sys.stderr)
+        return code
     if args.json:  # the figures the report shows, as its image links name them
         images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
         figures = list(dict.fromkeys(os.path.normpath(path.parent / image) for image in images))

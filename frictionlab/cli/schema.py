@@ -15,18 +15,24 @@ def add_parser(sub) -> None:
         description="Print the JSON Schema of a preset, with the parameters of every installed plugin (for editors).",
         epilog="example:\n  frictionlab schema --out preset.schema.json",
     )
-    p.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout")
+    p.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout (an existing FILE is kept unless --force)")
+    p.add_argument("--force", action="store_true", help="replace FILE if it exists")
     p.set_defaults(handler=run)
 
 
 def run(args) -> ExitCode:
     from ..preset import preset_json_schema
 
-    text = json.dumps(preset_json_schema(), indent=2)
+    out = None
     if args.out:
+        from ..files import check_output_file
+
+        out = check_output_file(args.out, "--out", force=args.force)  # before the work: refused at once
+    text = json.dumps(preset_json_schema(), indent=2)
+    if out is not None:
         from ..files import atomic_write
 
-        atomic_write(Path(args.out), lambda fh: fh.write(text + "\n"))
+        atomic_write(out, lambda fh: fh.write(text + "\n"))
     else:
         print(text)
     return ExitCode.OK

@@ -4,6 +4,7 @@ command line: its options, checked, and the run. Heavy modules are imported insi
 
 from __future__ import annotations
 
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -43,7 +44,10 @@ def add_parser(sub) -> None:
     )
     d = DEFAULTS
     parser.add_argument("preset", help="preset YAML file, or a built-in preset's name")
-    parser.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-study-<timestamp>)")
+    parser.add_argument("--out", metavar="DIR", help="output folder (default: a new runs/<name>-study-<timestamp>); "
+                        "one holding anything but a study of the same preset is refused unless --force")
+    parser.add_argument("--force", action="store_true",
+                        help="write into --out even if it holds other files (study.csv, study.md, study.png are replaced)")
     parser.add_argument("--set", action="append", metavar="PATH=VALUE", help="override a preset value first")
     parser.add_argument("--seed", type=int, metavar="S", help="root seed (overrides the preset's)")
     parser.add_argument(
@@ -133,16 +137,23 @@ def command_line(args) -> str:
             words += [f"--{dest.replace('_', '-')}", str(value)]
     if args.out:
         words += ["--out", args.out]
-    return shlex.join(words)
+    if args.force:
+        words.append("--force")
+    # a folder name that is not UTF-8 is shown with its bytes escaped (the page is UTF-8 text)
+    return shlex.join(os.fsencode(w).decode("utf-8", "backslashreplace") for w in words)
+
+
+def shown(path) -> str:
+    """A path as text any terminal takes: bytes that are not UTF-8 escaped."""
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
 
 
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..registry import default_registry
-    from ..rundir import new_run_folder
     from ..tradeoff.axes import Study
-    from ..tradeoff.outputs import recommendation, write_outputs
+    from ..tradeoff.outputs import claim_study_folder, recommendation, write_outputs
     from ..tradeoff.scenes import SceneFactory
 
     options = options_from_args(args)
@@ -151,7 +162,6 @@ def run(args) -> ExitCode:
         overrides.append(f"seed={args.seed}")
     data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
     factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []))
-    out_dir = Path(args.out) if args.out else new_run_folder(f"{factory.base.preset.name}-study")
 
     def progress(message: str) -> None:
         if not args.quiet:
@@ -160,6 +170,8 @@ def run(args) -> ExitCode:
     from ..progress import ProgressReporter
 
     study = Study(factory, options, progress, run_listeners=list if args.quiet else (lambda: [ProgressReporter()]))
+    study.check_memory()  # before a folder is made
+    out_dir = claim_study_folder(args.out, factory.base.preset.name, force=args.force)
     reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"
     progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {reference}")
     interrupted = False
@@ -171,7 +183,7 @@ def run(args) -> ExitCode:
     try:
         files = write_outputs(study, out_dir, text, command_line(args))
     except OSError as exc:
-        print(f"error: cannot write the study to {out_dir}: {exc}", file=sys.stderr)
+        print(f"error: cannot write the study to {shown(out_dir)}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         import json
@@ -187,7 +199,7 @@ def run(args) -> ExitCode:
                           "interrupted": interrupted}, indent=2))  # fmt: skip
     else:
         print(text)
-        print(f"  {', '.join(p.name for p in files.values())} in {out_dir}/")
+        print(f"  {', '.join(p.name for p in files.values())} in {shown(out_dir)}/")
     if interrupted:
         print("interrupted: the files hold the axes finished before the interrupt", file=sys.stderr)
         return ExitCode.INTERRUPTED

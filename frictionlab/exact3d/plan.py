@@ -12,20 +12,23 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..ensemble import RunOutcome
-from ..errors import FrictionlabError
-from ..files import atomic_write
+from ..errors import FrictionlabError, OutputRefused
+from ..files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, read_preset
 from ..registry import Registry, default_registry
 from ..rundir import STATE_FILE
 from ..runner import run_to_folder
 from ..seeds import realization_rng
+from ..signals import WorkInterrupted, interrupted_since, mark
 from ..variants import SceneFactory
 from .analysis import nayak_parameter
 
@@ -138,41 +141,83 @@ def run_plan(
     registry = registry or default_registry()
     runs = StudyRuns(plan)
     started = time.perf_counter()
-    for hurst in plan.hursts:
-        path = Path(presets_dir) / preset_name(hurst)
-        if not path.is_file():
-            raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
-        factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
-        base = factory.base
-        approximation = factory.solver_choice(APPROXIMATION)
-        for points, realizations in plan.grids(hurst):
-            changes = {f"spectrum.params.{k}": v for k, v in base.spectrum.refined(points).items()}
-            changes.update({"realizations": realizations, "fit.bootstrap": plan.bootstrap})
-            if plan.steps is not None:
-                changes["loading.steps"] = plan.steps
-            exact = factory.make(changes)
-            spacing, short, long = _cutoffs(exact)
-            alpha = nayak_parameter(exact.spectrum.generate(realization_rng(exact.preset.seed, 0)).heights, spacing)
-            for solver_choice in (None, approximation):
-                scene = exact if solver_choice is None else factory.make({**changes, "solver": solver_choice})
-                folder = Path(runs_dir) / f"h{hurst:.1f}-n{points}-{scene.solver.name}"
-                resume = (folder / STATE_FILE).is_file()
-                log(f"exact3d: H = {hurst}, {points}^2 pixels, {scene.solver.name}, {realizations} realizations"
-                    + (" (resumed)" if resume else ""))  # fmt: skip
-                outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
-                if outcome.status != "completed":
-                    raise FrictionlabError(
-                        f"the run in {folder} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
-                        + "; run the command again with the same --runs to resume it"
-                    )  # fmt: skip
-                runs.ensembles.append(
-                    Ensemble(hurst, points, scene.solver.name, scene, outcome, folder, spacing, short, long, alpha)
-                )
+    try:
+        for hurst in plan.hursts:
+            path = Path(presets_dir) / preset_name(hurst)
+            if not path.is_file():
+                raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
+            factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+            base = factory.base
+            approximation = factory.solver_choice(APPROXIMATION)
+            for points, realizations in plan.grids(hurst):
+                changes = {f"spectrum.params.{k}": v for k, v in base.spectrum.refined(points).items()}
+                changes.update({"realizations": realizations, "fit.bootstrap": plan.bootstrap})
+                if plan.steps is not None:
+                    changes["loading.steps"] = plan.steps
+                exact = factory.make(changes)
+                spacing, short, long = _cutoffs(exact)
+                alpha = nayak_parameter(exact.spectrum.generate(realization_rng(exact.preset.seed, 0)).heights, spacing)
+                for solver_choice in (None, approximation):
+                    scene = exact if solver_choice is None else factory.make({**changes, "solver": solver_choice})
+                    folder = Path(runs_dir) / f"h{hurst:.1f}-n{points}-{scene.solver.name}"
+                    resume = (folder / STATE_FILE).is_file()
+                    log(f"exact3d: H = {hurst}, {points}^2 pixels, {scene.solver.name}, {realizations} realizations"
+                        + (" (resumed)" if resume else ""))  # fmt: skip
+                    seen = mark()
+                    outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
+                    if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
+                        raise KeyboardInterrupt
+                    if outcome.status != "completed":
+                        raise FrictionlabError(
+                            f"the run in {folder} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
+                            + "; run the command again with the same --runs to resume it"
+                        )  # fmt: skip
+                    runs.ensembles.append(
+                        Ensemble(hurst, points, scene.solver.name, scene, outcome, folder, spacing, short, long, alpha)
+                    )
+    except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
+        raise WorkInterrupted(
+            f"the ensembles that finished are kept in {runs_dir}; run the command again with --runs {runs_dir} to resume"
+        ) from None
     runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started)
     return runs
 
 
 TIME_FILE = "exact3d-time.json"
+ENSEMBLE_FOLDER = re.compile(r"h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # the folder of one ensemble, as run_plan names it
+
+
+def check_runs_folder(runs_dir: Path, *, force: bool, own: tuple[str, ...] = ()) -> None:
+    """Refuse (OutputRefused) a ``--runs`` folder that is a file, or that holds anything but this
+    study's: its ensembles' folders, its TIME_FILE, and the names in ``own`` (its page), unless
+    ``force``. An earlier study's folder is resumed; a user's folder is not filled with runs."""
+    problem = output_path_problem(runs_dir)
+    if problem:
+        raise OutputRefused(f"--runs: {problem}; give a folder")
+    if force or not runs_dir.is_dir():
+        return
+    foreign = sorted(
+        p.name for p in runs_dir.iterdir()
+        if not ((ENSEMBLE_FOLDER.fullmatch(p.name) and p.is_dir() and not p.is_symlink())
+                or (p.name == TIME_FILE and _is_time_file(p)) or p.name in own)
+    )  # fmt: skip
+    if foreign:
+        shown = ", ".join(repr(name) for name in foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+        raise OutputRefused(
+            f"--runs {runs_dir} is not empty and is not the runs folder of an exact 3D study (it holds {shown}): "
+            "give another folder, or --force to write the study's runs into it (its own files are then replaced)"
+        )
+
+
+def _is_time_file(path: Path) -> bool:
+    """Whether ``path`` is a TIME_FILE this study wrote: {"plan": ..., "seconds": ...}."""
+    try:
+        if not path.is_file() or path.is_symlink() or os.path.getsize(path) > 4096:
+            return False
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and set(data) == {"plan", "seconds"}
 
 
 def _add_time(runs_dir: Path, plan: Plan, seconds: float) -> float:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputRefused
-from ..files import atomic_write
+from ..files import atomic_write, output_path_problem
 from ..listeners import format_duration
 from ..options import RunOptions
 from ..rundir import new_run_folder
@@ -20,7 +20,7 @@ from ..seeds import bootstrap_rng, realization_rng
 from .analysis import SMALL_LOAD_FRACTION, Kappa, contact_area_law
 from .figures import plot_convergence, plot_xi_against_f
 from .markdown import YASTREBOV, answer, convergence_table, ensemble_text, law_table, paired_extra_grids
-from .plan import FULL, QUICK, Plan, StudyRuns, find_presets, preset_name, run_plan
+from .plan import FULL, QUICK, Plan, StudyRuns, check_runs_folder, find_presets, preset_name, run_plan
 
 PAGE = "exact-3d-law.md"
 FIGURES_DIR = "exact-3d-law"
@@ -28,7 +28,11 @@ FIGURES = ("xi-vs-f.png", "convergence.png")
 
 
 def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
-    """The page and its figures folder in ``out_dir``; existing ones are refused unless ``force``."""
+    """The page and its figures folder in ``out_dir``; existing ones are refused unless ``force``,
+    and so is an ``out_dir`` that cannot be a folder."""
+    problem = output_path_problem(out_dir)
+    if problem:
+        raise OutputRefused(f"--out: {problem}; give a folder for the page")
     page, figures = out_dir / PAGE, out_dir / FIGURES_DIR
     taken = [p for p in (page, *(figures / name for name in FIGURES)) if os.path.lexists(p)]
     if taken and not force:
@@ -95,6 +99,10 @@ def write_page(
     ``runs/exact3d-<timestamp>``); giving an earlier one resumes it. Returns the page's path."""
     plan = plan or (QUICK if quick else FULL)
     command = command or _command(quick, out_dir, runs_dir)
+    if out_dir:  # refused before a default runs folder is made
+        page_paths(Path(out_dir), force=options.force)
+    if runs_dir:
+        check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)

@@ -10,6 +10,7 @@ from ..errors import FrictionlabError
 from ..options import RunOptions
 from ..preset import build_scene, read_preset
 from ..runner import run_to_folder
+from ..signals import WorkInterrupted, interrupted_since, mark
 from ..sweep import plan_sweep, run_sweep
 
 
@@ -76,6 +77,7 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
         path = presets / fig.preset
         run = FigureRun(fig, path, out_dir / fig.key)
         data = read_preset(path)
+        seen = mark()
         if data.get("sweep") is not None:
             run.sweep = plan_sweep(data, source=str(path))
             listeners = [SweepProgress()] if progress else []
@@ -84,5 +86,12 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
             run.scene = build_scene(data, source=str(path))
             listeners = [ProgressReporter()] if progress else []
             run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
+        status = (run.sweep_outcome or run.outcome).status
+        if status in ("interrupted", "cancelled"):
+            how = (f"frictionlab run {path} --out {run.folder} --resume" if run.sweep is not None
+                   else f"frictionlab resume {run.folder}")  # fmt: skip
+            raise WorkInterrupted(f"{fig.key} ended interrupted in {run.folder} (continue it with `{how}`)")
+        if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
+            raise WorkInterrupted(f"{fig.key} completed in {run.folder}")
         runs.append(run)
     return runs

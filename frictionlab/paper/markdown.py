@@ -11,7 +11,6 @@ from .. import __version__
 from ..fit import format_estimate
 from ..sweep import row_fit
 from .figures import FIGURES, PAPER_H07, PAPER_POINTS_VS_H, FigureRun
-from .plots import F_UNIT
 from .readings import AVERAGES, ReadingRow
 
 
@@ -82,7 +81,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
             law = lambda a, b, f: a + b * math.log(f)  # noqa: E731
             lines.append(
                 f"Preset `{run.preset_path.name}`: {o.done} realizations in {o.elapsed:.2f} s. "
-                f"Over f = {f_lo / F_UNIT:.3g}e-9 .. {f_hi / F_UNIT:.3g}e-9 the paper's law gives "
+                f"Over f = {f_lo:.3g} .. {f_hi:.3g} the paper's law gives "
                 f"xi = {law(s.a, s.b, f_lo):.3f} .. {law(s.a, s.b, f_hi):.3f}; frictionlab measures "
                 f"{o.xi[0]:.3f} .. {o.xi[-1]:.3f} (fit {law(o.fit.a, o.fit.b, f_lo):.3f} .. "
                 f"{law(o.fit.a, o.fit.b, f_hi):.3f}). Mean points in contact: {_counts_text(run)}"
@@ -91,8 +90,8 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
             )
             zero = math.exp(-s.a / s.b)  # where the paper's law reaches xi = 0
             if f_lo < zero:
-                lines += ["", f"The paper's law is negative below f = {zero / F_UNIT:.3g}e-9, so over F = "
-                          f"{o.loads[0]:g}..{o.loads[-1]:g} the paper's f cannot have started at {f_lo / F_UNIT:.3g}e-9:"
+                lines += ["", f"The paper's law is negative below f = {zero:.3g}, so over F = "
+                          f"{o.loads[0]:g}..{o.loads[-1]:g} the paper's f cannot have started at {f_lo:.3g}:"
                           " its normalisation (h, or C0) for this figure must differ from the preset's."]  # fmt: skip
         else:
             path = run.sweep.paths[0]

@@ -19,6 +19,7 @@ from ..fit import LogFit, fit_log_law
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
 from ..runner import run_to_folder
+from ..signals import interrupted_since, mark
 from ..seeds import bootstrap_rng
 from .calibration import calibrated_rms_height
 from .figures import FigureRun
@@ -151,7 +152,10 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
         else:
             scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
             folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
+            seen = mark()
             outcome, _ = run_to_folder(scene, folder, options, listeners=listeners())
+            if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
+                raise KeyboardInterrupt  # the report stops: what finished is kept
         settings = scene.preset.fit
         fit = refit(outcome.f, outcome.per_realization, reading.average,
                     bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip

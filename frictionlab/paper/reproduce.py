@@ -10,9 +10,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import OutputRefused
-from ..files import atomic_write
+from ..files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..rundir import new_run_folder
+from ..signals import WorkInterrupted
 from .figures import find_presets, run_figures
 from .markdown import markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
@@ -25,7 +26,14 @@ FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated
 def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: bool = False) -> tuple[Path, Path, Path]:
     """The run folders, the markdown and the figures folder of a report: by
     default all in a fresh folder ``runs/report-<timestamp>/`` (``REPRODUCTION.md``,
-    ``figures/``). An existing markdown or figure is refused unless ``force``."""
+    ``figures/``). An existing markdown or figure is refused unless ``force``, and so is a
+    folder given for the markdown or a file for a folder."""
+    for option, folder in (("--out", out_dir), ("--figures", figures_dir)):
+        problem = output_path_problem(Path(folder)) if folder else None
+        if problem:
+            raise OutputRefused(f"{option}: {problem}; give a folder")
+    if markdown_path and Path(markdown_path).is_dir():
+        raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
     markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
     figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
@@ -47,32 +55,36 @@ def write_report(
     every run shows its progress on stderr (``frictionlab.progress``)."""
     presets = find_presets(presets_dir)
     out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
-    started = time.perf_counter()
-    log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-    runs = run_figures(presets, out_dir, options, progress=not quiet)
-    log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
-    images = {}
-    for run in runs:
-        name = f"{run.figure.key}.png"
-        draw = plot_fig5 if run.sweep is not None else plot_figure
-        atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
-        images[run.figure.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
-    elapsed = time.perf_counter() - started
-    reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
-    if readings:
-        log(f"report: running {len(READINGS)} readings")
-        t0 = time.perf_counter()
-        reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
-        readings_elapsed = time.perf_counter() - t0
-        fig5 = next(run for run in runs if run.sweep is not None)
-        log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
-        t0 = time.perf_counter()
-        fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
-                                 folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
-        fig5_elapsed = time.perf_counter() - t0
-        name = "fig5-calibrated.png"
-        atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
-        images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+    try:
+        started = time.perf_counter()
+        log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
+        runs = run_figures(presets, out_dir, options, progress=not quiet)
+        log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
+        images = {}
+        for run in runs:
+            name = f"{run.figure.key}.png"
+            draw = plot_fig5 if run.sweep is not None else plot_figure
+            atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
+            images[run.figure.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+        elapsed = time.perf_counter() - started
+        reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
+        if readings:
+            log(f"report: running {len(READINGS)} readings")
+            t0 = time.perf_counter()
+            reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
+            readings_elapsed = time.perf_counter() - t0
+            fig5 = next(run for run in runs if run.sweep is not None)
+            log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
+            t0 = time.perf_counter()
+            fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
+                                     folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
+            fig5_elapsed = time.perf_counter() - t0
+            name = "fig5-calibrated.png"
+            atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
+            images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+    except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
+        said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
+        raise WorkInterrupted(f"{said}the runs that finished are kept in {out_dir}; no {markdown_path} written") from None
     command = "frictionlab report" + (" --readings" if readings else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,

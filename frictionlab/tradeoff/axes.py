@@ -31,6 +31,7 @@ from ..ensemble import RunOutcome
 from ..errors import FrictionlabError, PresetError
 from ..plugin import ContactSolver
 from ..preset import Scene
+from ..memory import gib
 from .metrics import curve_errors, interval_half_width, mean_curve_half_width, relative_difference
 from .options import AXES, StudyOptions
 from .scenes import Measurement, SceneFactory, measure
@@ -231,6 +232,7 @@ class Study:
         for axis in self.options.axes:
             if axis not in AXES:
                 raise FrictionlabError(f"--axes: unknown axis {axis!r}; the axes are {', '.join(AXES)}")
+        self.check_memory()
         runs = {"grid": self.grid_axis, "realizations": self.realizations_axis, "steps": self.steps_axis,
                 "solver": self.solver_axis, "tolerance": self.tolerance_axis}  # fmt: skip
         for axis in self.options.axes:
@@ -243,6 +245,44 @@ class Study:
                 label="grid (reference)",
             )
         return self.rows
+
+    def check_memory(self) -> None:
+        """Refuse (RunError), before anything runs, a study whose largest setting would need more
+        memory than is available: the largest grid factor (and reference grid), else the preset's N."""
+        from ..errors import RunError
+        from ..memory import available_memory, estimate
+
+        largest = []  # (what, what to make smaller, scene)
+        axes = set(self.options.axes)
+        if axes & {"realizations", "steps"}:
+            largest.append(("the preset's grid", "grid (its points)", self.base))
+        grids = []  # (axis, option, changes, factors), as grid_axis runs them
+        if "grid" in axes:
+            grids.append(("grid", "--grid-factors", {"realizations": self.grid_m}, self.options.grid_factors))
+        if self.options.reference_grid and self.reference_choice is not None:
+            grids.append(("grid (reference)", "--reference-grid", {**self.compare_changes, "solver": self.reference_choice},
+                          self.options.reference_grid))  # fmt: skip
+        for axis, option, changes, factors in grids:
+            start = self.factory.make(changes, keep_f_range=False)
+            points, generator = preset_points(start), start.spectrum
+            if points is None or not factors:
+                continue
+            n = int(round(points * max(factors)))
+            refined = generator.refined(n) or {generator.points_param: n}
+            try:
+                scene = self.factory.make({**changes, **{f"spectrum.params.{k}": v for k, v in refined.items()}},
+                                          keep_f_range=False)  # the f range needs a surface generated: not yet
+            except PresetError:
+                continue  # the axis skips it with a note
+            largest.append((f"the {axis} axis at N = {n:,} ({option} {max(factors):g})", option, scene))
+        available, source = available_memory()
+        for what, smaller, scene in largest:
+            guess = estimate(scene, workers=1, executor="serial")
+            if guess.total > available:
+                raise RunError(
+                    f"the study would need about {guess.describe()} at its peak for {what}, but "
+                    f"{gib(available)} is available ({source}): give a smaller {smaller}"
+                )
 
     # ------------------------------------------------------------ axes
 

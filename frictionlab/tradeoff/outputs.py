@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 from pathlib import Path
 
 import numpy as np
 
-from ..files import atomic_write
+from ..errors import OutputRefused
+from ..files import atomic_write, output_path_problem
 from .axes import COLUMNS, Row, Study, preset_points
 from .metrics import pareto_front
 
@@ -143,7 +145,7 @@ def scene_summary(study: Study) -> str:
 
 
 def markdown(study: Study, recommendation: str, command: str = "") -> str:
-    out = [f"# Trade-off study: {study.base.preset.name}", ""]
+    out = [heading(study.base.preset.name), ""]
     if command:
         out += [f"`{command}`", ""]
     out += [
@@ -313,6 +315,49 @@ def recommendation(study: Study) -> str:
 
 
 # ------------------------------------------------------------------ files
+
+
+FILES = ("study.csv", "study.md", "study.png")
+
+
+def heading(name: str) -> str:
+    return f"# Trade-off study: {name}"
+
+
+def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = False) -> Path:
+    """The study's folder: ``out_dir``, refused (OutputRefused) unless it is missing, empty,
+    or a study of preset ``name`` (only the study's files, its study.md headed with that
+    name), or ``force``; by default a new ``runs/<name>-study-<timestamp>``, made here so
+    that two studies started in the same second get two folders."""
+    if not out_dir:
+        from ..rundir import new_run_folder
+
+        return new_run_folder(f"{name}-study")
+    out = Path(out_dir)
+    shown = os.fsencode(out).decode("utf-8", "backslashreplace")
+    problem = output_path_problem(out)
+    if problem:
+        raise OutputRefused(f"--out: {os.fsencode(problem).decode('utf-8', 'backslashreplace')}; give a folder")
+    if force or not out.is_dir():
+        return out
+    held = sorted(p.name for p in out.iterdir())
+    if not held or (set(held) <= set(FILES) and _is_study_of(out / "study.md", name)):
+        return out
+    listed = ", ".join(repr(os.fsencode(n).decode("utf-8", "backslashreplace")) for n in held[:3])
+    raise OutputRefused(
+        f"--out {shown} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
+        "give another folder, or --force to write study.csv, study.md and study.png into it (nothing else is touched)"
+    )
+
+
+def _is_study_of(page: Path, name: str) -> bool:
+    try:
+        if not page.is_file() or page.is_symlink():
+            return False
+        with open(page, encoding="utf-8", errors="replace") as fh:
+            return fh.readline().rstrip("\n") == heading(name)
+    except OSError:
+        return False
 
 
 def write_outputs(study: Study, out_dir: str | Path, recommendation_text: str, command: str = "") -> dict[str, Path]:

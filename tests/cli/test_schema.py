@@ -21,3 +21,24 @@ def test_schema_out_writes_the_schema_to_a_file(tmp_path, capsys):
     assert capsys.readouterr().out == ""
     schema = json.loads((tmp_path / "schema.json").read_text())
     assert schema["title"] == "frictionlab preset"
+
+
+def test_schema_out_keeps_an_existing_file_unless_force(tmp_path, capsys):
+    mine = tmp_path / "existing.json"
+    mine.write_text("mine")
+    assert main(["schema", "--out", str(mine)]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert "--out" in err and str(mine) in err and "--force" in err
+    assert mine.read_text() == "mine"
+    assert main(["schema", "--out", str(mine), "--force"]) == ExitCode.OK
+    assert json.loads(mine.read_text())["title"] == "frictionlab preset"
+
+
+def test_schema_out_a_folder_or_under_a_file_is_refused_naming_the_option(tmp_path, capsys):
+    (tmp_path / "sdir").mkdir()
+    (tmp_path / "afile").write_text("x")
+    for out in (tmp_path / "sdir", f"{tmp_path / 'newdir'}/", tmp_path / "afile" / "x.json"):
+        assert main(["schema", "--out", str(out), "--force"]) == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert "--out" in err and ".tmp" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "sdir"] and not any((tmp_path / "sdir").iterdir())

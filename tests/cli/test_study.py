@@ -61,3 +61,62 @@ def test_cli_bad_preset_file(tmp_path, capsys):
     assert "not valid YAML" in capsys.readouterr().err
     assert main(["study", str(tmp_path / "missing.yaml")]) == ExitCode.INPUT_FILE
     assert "no such preset file" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ where the study writes
+
+QUICK = ["--axes", "realizations", "--grid-realizations", "3", "--quiet"]
+
+
+def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys):
+    mine, other = tmp_path / "mine", tmp_path / "other"
+    mine.mkdir()
+    other.mkdir()
+    (mine / "study.md").write_text("my precious notes")
+    (other / "notes.txt").write_text("keep me")
+    for folder, held in ((mine, "study.md"), (other, "notes.txt")):
+        assert main(["study", "quickstart", *QUICK, "--out", str(folder)]) == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert f"--out {folder} holds '{held}'" in err and "--force" in err
+    assert (mine / "study.md").read_text() == "my precious notes"
+    assert main(["study", "quickstart", *QUICK, "--out", str(other), "--force"]) == ExitCode.OK
+    assert (other / "notes.txt").read_text() == "keep me"
+    assert (other / "study.md").read_text().startswith("# Trade-off study: quickstart")
+    # its own study folder: the same preset's study is run again there, without --force
+    (other / "notes.txt").unlink()
+    assert main(["study", "quickstart", *QUICK, "--out", str(other)]) == ExitCode.OK
+    # another preset's study folder is not its own
+    code = main(["study", str(write(tmp_path, TINY)), *QUICK, "--out", str(other)])
+    assert code == ExitCode.OUTPUT_REFUSED and "not a study of tiny" in capsys.readouterr().err
+
+
+def test_two_studies_started_together_get_two_default_folders(tmp_path):
+    import subprocess
+    import sys
+
+    command = [sys.executable, "-m", "frictionlab", "study", "quickstart", *QUICK]
+    procs = [subprocess.Popen([*command, "--seed", str(seed)], cwd=tmp_path, stdout=subprocess.PIPE, text=True)
+             for seed in (1, 2)]  # fmt: skip
+    outs = [p.communicate(timeout=120)[0] for p in procs]
+    assert [p.returncode for p in procs] == [0, 0]
+    folders = sorted((tmp_path / "runs").iterdir())
+    assert len(folders) == 2 and all((f / "study.md").is_file() for f in folders)
+    assert {out.split(" in ")[-1].strip().rstrip("/") for out in outs} == {f"runs/{f.name}" for f in folders}
+
+
+def test_study_refuses_a_grid_beyond_the_memory_before_starting(tmp_path, capsys):
+    out = tmp_path / "big"
+    code = main(["study", "quickstart", "--axes", "grid", "--grid-factors", "1e9,1", "--quiet", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == ExitCode.RUNTIME_FAILURE, err
+    assert "--grid-factors 1e+09" in err and "GiB is available" in err and "internal error" not in err
+    assert not out.exists()
+
+
+def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys):
+    import os
+
+    out = tmp_path / os.fsdecode(b"st\xff")
+    assert main(["study", "quickstart", *QUICK, "--out", str(out)]) == ExitCode.OK
+    assert "st\\xff/" in capsys.readouterr().out
+    assert "st\\xff" in (out / "study.md").read_text(encoding="utf-8")

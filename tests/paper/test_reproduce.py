@@ -4,6 +4,7 @@ against a known h, and the report's content on tiny presets (numbers from summar
 import io
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -115,6 +116,11 @@ def test_report_on_tiny_presets(tmp_path, tiny_presets):
     for row in rows:
         assert f"| {row['spectrum.params.hurst']:g} | {row['a']:.4f} [{row['a_lo']:.4f}, {row['a_hi']:.4f}]" in text
     assert "| Fig. 5 at H = 0.6 | about 2.9 |" in text  # the point nearest H = 0.7
+    for key in ("fig2", "fig3", "fig4"):  # f as a plain number (was "1.22e+04e-9")
+        with np.load(tmp_path / "runs" / key / "realizations.npz") as data:
+            f = data["f"]
+        assert f"Over f = {f[0]:.3g} .. {f[-1]:.3g} the paper's law" in text
+    assert not re.search(r"\de[+-]\d+e-9", text)
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,73 @@
+"""Where ``frictionlab exact3d`` writes: a --runs folder of the user's is not filled with
+runs, --out must be a folder, and Ctrl-C ends the study with 130 keeping what finished."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.exact3d.report import PAGE
+
+from ..conftest import PRESETS
+
+
+def _ctrl_c_as_in_a_terminal():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # a shell's background job would inherit it ignored
+
+
+def exact3d(*args):
+    return main(["exact3d", "--quick", "--presets", str(PRESETS), "--quiet", *map(str, args)])
+
+
+def test_a_runs_folder_of_the_users_is_refused_before_anything_runs(tmp_path, capsys):
+    userruns, other = tmp_path / "userruns", tmp_path / "other"
+    userruns.mkdir()
+    other.mkdir()
+    (userruns / "exact3d-time.json").write_text("my timing notes")
+    (other / "notes.txt").write_text("keep me")
+    for runs, held in ((userruns, "exact3d-time.json"), (other, "notes.txt")):
+        assert exact3d("--runs", runs, "--out", tmp_path / "page") == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert f"--runs {runs} is not empty" in err and repr(held) in err and "--force" in err
+        assert [p.name for p in runs.iterdir()] == [held]
+    assert (userruns / "exact3d-time.json").read_text() == "my timing notes"
+    assert not (tmp_path / "page").exists()
+
+
+def test_out_or_runs_that_is_a_file_is_refused_naming_the_option(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    assert exact3d("--out", afile, "--runs", tmp_path / "r") == ExitCode.OUTPUT_REFUSED
+    assert f"--out: {afile} is a file, not a folder" in capsys.readouterr().err
+    assert exact3d("--out", tmp_path / "o", "--runs", afile) == ExitCode.OUTPUT_REFUSED
+    assert f"--runs: {afile} is a file, not a folder" in capsys.readouterr().err
+    assert afile.read_text() == "x" and sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+def test_ctrl_c_ends_the_study_with_130_keeping_the_finished_ensembles(tmp_path):
+    runs, out = tmp_path / "runs", tmp_path / "out"
+    first = runs / "h0.3-n64-bem-halfspace"
+    command = [sys.executable, "-m", "frictionlab", "exact3d", "--quick", "--presets", str(PRESETS),
+               "--out", str(out), "--runs", str(runs), "--workers", "1"]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=_ctrl_c_as_in_a_terminal)
+    deadline = time.monotonic() + 120
+    while True:  # the first ensemble finished: the study is in its second
+        try:
+            if json.loads((first / "run.json").read_text())["status"] == "completed":
+                break
+        except (OSError, ValueError, KeyError):
+            pass
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "the first ensemble did not finish in 120 s"
+        time.sleep(0.02)
+    process.send_signal(signal.SIGINT)
+    out_text, err = process.communicate(timeout=120)
+    assert process.returncode == ExitCode.INTERRUPTED, err
+    assert f"the ensembles that finished are kept in {runs}" in err and "no page written" in err
+    assert "Traceback" not in err and out_text == ""
+    assert json.loads((first / "run.json").read_text())["status"] == "completed"
+    assert not (out / PAGE).exists()

@@ -1,0 +1,74 @@
+"""``frictionlab report`` as a user meets it: Ctrl-C and SIGTERM stop the report with 130
+and 143, keeping the finished runs and publishing no report; an output that cannot be
+what its option says is refused naming the option (exit 4)."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.paper.figures import FIGURES
+from frictionlab.preset import apply_overrides, load_preset_file
+
+from ..conftest import PRESETS
+
+SMALL = ["spectrum.params.points=1024", "spectrum.params.length=1024.0", "output.plot=false",
+         "spectrum.params.rms_height=300.0", "loading.steps=12", "fit.bootstrap=20"]  # fmt: skip
+
+
+def _ctrl_c_as_in_a_terminal():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # a shell's background job would inherit it ignored
+
+
+def _listed_chunks(run_dir) -> int:
+    try:
+        return len(json.loads((run_dir / "run.json").read_text())["chunks"])
+    except (OSError, ValueError, KeyError):  # not written yet, or being replaced
+        return 0
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_stops_the_report_keeping_the_runs_and_writing_no_report(tmp_path, signum, code):
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for fig in FIGURES:  # Fig. 2 long enough to be interrupted, the others small
+        many = ["realizations=20000"] if fig.key == "fig2" else ["realizations=4"]
+        data = apply_overrides(load_preset_file(PRESETS / fig.preset), [*SMALL, *many])
+        (presets / fig.preset).write_text(yaml.safe_dump(data, sort_keys=False))
+    out = tmp_path / "r"
+    command = [sys.executable, "-m", "frictionlab", "report", "--presets", str(presets), "--out", str(out),
+               "--workers", "1", "--quiet"]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=_ctrl_c_as_in_a_terminal)
+    deadline = time.monotonic() + 60
+    while _listed_chunks(out / "fig2") < 1:
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "no chunk written in 60 s"
+        time.sleep(0.01)
+    process.send_signal(signum)
+    stdout, err = process.communicate(timeout=120)
+    assert process.returncode == code, err
+    assert f"the runs that finished are kept in {out}" in err and f"frictionlab resume {out / 'fig2'}" in err
+    assert "Traceback" not in err and stdout == ""
+    assert not (out / "REPRODUCTION.md").exists() and not (out / "fig3").exists()
+    state = json.loads((out / "fig2" / "run.json").read_text())
+    assert state["status"] == "interrupted" and state["chunks"]
+
+
+def test_figures_or_out_that_is_a_file_and_markdown_that_is_a_folder_are_refused(tmp_path, capsys):
+    afile, folder = tmp_path / "my.md", tmp_path / "folder"
+    afile.write_text("mine")
+    folder.mkdir()
+    for args, said in ((["--figures", afile], f"--figures: {afile} is a file, not a folder"),
+                       (["--out", afile], f"--out: {afile} is a file, not a folder"),
+                       (["--markdown", folder], f"--markdown {folder} is a folder")):  # fmt: skip
+        code = main(["report", "--presets", str(PRESETS), "--out", str(tmp_path / "r"), *map(str, args), "--quiet"])
+        assert code == ExitCode.OUTPUT_REFUSED
+        assert said in capsys.readouterr().err
+    assert afile.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["folder", "my.md"]
