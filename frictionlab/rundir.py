@@ -83,6 +83,24 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
             candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
 
 
+def read_json_object(path: Path, limit: int, what: str) -> dict:
+    """A run folder's JSON file (``what`` it is, at most ``limit`` bytes) as a mapping:
+    RunFolderError naming the file if it is not JSON, or not a JSON object;
+    InputFileProblem if it cannot be read at all (each caller says what that means)."""
+    try:
+        data = json.loads(read_regular_file(path, limit=limit, what=what))
+    except InputFileProblem:
+        raise
+    except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
+        where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
+        raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
+    except RecursionError:
+        raise RunFolderError(f"{path} is damaged (JSON nested too deeply)") from None
+    if not isinstance(data, dict):
+        raise RunFolderError(f"{path} is damaged (a JSON {type(data).__name__}, not an object)")
+    return data
+
+
 def fingerprint(resolved: dict) -> str:
     text = json.dumps(resolved, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -175,16 +193,9 @@ class RunDirectory:
         if not os.path.lexists(path):
             return None
         try:
-            state = json.loads(read_regular_file(path, limit=MAX_MANIFEST_BYTES, what="manifest"))
+            state = read_json_object(path, MAX_MANIFEST_BYTES, "manifest")
         except InputFileProblem as exc:
             raise RunFolderError(f"{path}: {exc}") from None
-        except ValueError as exc:  # not JSON, not UTF-8
-            where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
-            raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
-        except RecursionError:
-            raise RunFolderError(f"{path} is damaged (nested too deep to be a manifest)") from None
-        if not isinstance(state, dict):
-            raise RunFolderError(f"{path} is damaged (not a JSON object)")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
             if value is not None and not (isinstance(value, kind) and _well_formed(key, value)):

@@ -19,7 +19,6 @@ The interval of xi comes, in order of preference, from
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
@@ -32,8 +31,9 @@ import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
 from ..fit import LogFit, bootstrap_coefficients, percentile_interval
-from ..inputs import InputFileProblem, open_regular_file, read_regular_file
+from ..inputs import InputFileProblem, open_regular_file
 from ..plugin import ForceNormalisation, mdr_length
+from ..rundir import read_json_object
 from ..seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
@@ -226,17 +226,9 @@ def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.n
 def _read_summary(run_dir: Path) -> dict:
     path = run_dir / "summary.json"
     try:
-        summary = json.loads(read_regular_file(path, limit=MAX_SUMMARY_BYTES, what="summary.json"))
+        return read_json_object(path, MAX_SUMMARY_BYTES, "summary.json")
     except InputFileProblem as exc:
         raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({exc})") from None
-    except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
-        where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
-        raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
-    except RecursionError:
-        raise RunFolderError(f"{path} is damaged (JSON nested too deeply)") from None
-    if not isinstance(summary, dict):
-        raise RunFolderError(f"{path} is damaged (a JSON {type(summary).__name__}, not an object)")
-    return summary
 
 
 def _fit_of(summary: dict, path: Path) -> LogFit:

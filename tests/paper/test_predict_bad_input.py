@@ -12,7 +12,6 @@ import zipfile
 import numpy as np
 import pytest
 
-from frictionlab import hookimpl
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.options import RunOptions
@@ -20,6 +19,7 @@ from frictionlab.preset import build_scene
 from frictionlab.runner import run_to_folder
 
 from ..conftest import SMALL_PRESET, merge
+from ..test_resume import CancelAfter
 
 CONTACT = ["--area", "1e-4", "--modulus", "1e9", "--rms-height", "1e-6", "--force", "10"]
 
@@ -260,16 +260,6 @@ def test_damaged_realizations(run_copy, capsys, damage, words):
 
 
 # ------------------------------------------------------------------ a run that did not complete
-
-
-class CancelAfter:
-    def __init__(self, count: int, cancel: threading.Event):
-        self.count, self.cancel = count, cancel
-
-    @hookimpl
-    def realization_done(self, done):
-        if done >= self.count:
-            self.cancel.set()
 
 
 def test_a_cancelled_run_is_refused_naming_its_status(tmp_path, capsys, registry):
