@@ -122,9 +122,11 @@ def run(
             status, error = "failed", str(exc)
         if status == "completed" and accumulator.done < total:
             status = "interrupted" if signals.pressed else "cancelled"
-    outcome = accumulator.finish(
-        status=status, elapsed=time.perf_counter() - started, workers=pool.workers, error=error
-    )
+        # The fit, still under the signal handlers: a first Ctrl-C or SIGTERM during it lets it
+        # finish, so that what finished is summarised and written (a second one stops it).
+        outcome = accumulator.finish(
+            status=status, elapsed=time.perf_counter() - started, workers=pool.workers, error=error
+        )
     outcome.extra.update(executor=pool.name, resumed=resumed, retried=retried)
     if signals.pressed:
         outcome.extra["signal"] = signal.Signals(signals.signal).name

@@ -212,3 +212,23 @@ def test_a_run_where_every_realization_failed_is_failed_not_completed(make_scene
     assert outcome.done == 0 and len(outcome.failures) == 4
     assert outcome.status == "failed"
     assert "no realization finished" in outcome.error and "unreadable scan" in outcome.error
+
+
+def test_ctrl_c_during_the_fit_lets_the_fit_finish_and_the_run_is_summarised(make_scene, monkeypatch):
+    import os
+    import signal
+
+    import frictionlab.ensemble
+
+    fit = frictionlab.ensemble.fit_log_law
+
+    def fit_while_pressed(*args, **kwargs):  # the user presses Ctrl-C as the fit starts
+        os.kill(os.getpid(), signal.SIGINT)
+        return fit(*args, **kwargs)
+
+    scene = make_scene({"realizations": 6})
+    expected = engine.run(scene, RunOptions(workers=1))
+    monkeypatch.setattr(frictionlab.ensemble, "fit_log_law", fit_while_pressed)
+    outcome = engine.run(scene, RunOptions(workers=1))  # before, a KeyboardInterrupt left no outcome
+    assert outcome.status == "completed" and outcome.extra["signal"] == "SIGINT"
+    assert outcome.fit == expected.fit
