@@ -45,6 +45,11 @@ def executor_run_options(args, **fields):
     """The ``RunOptions`` of a command with the executor flags (Dask's TLS files and
     scheduler address are checked, and the TLS files taken, before anything starts)."""
     _use_tls_options(args)
+    if args.dashboard and (args.executor != "dask" or args.scheduler):
+        raise FrictionlabError(
+            "--dashboard serves the dashboard of frictionlab's own Dask cluster: it needs --executor dask "
+            "without --scheduler (a scheduler of yours serves its own)"
+        )
     return run_options(
         workers=args.workers,
         executor=args.executor,

@@ -40,3 +40,11 @@ def test_running_out_of_memory_is_said_as_such_not_as_a_bug(monkeypatch, capsys)
     assert main(["validate", "quickstart"]) == ExitCode.RUNTIME_FAILURE
     err = capsys.readouterr().err
     assert err.startswith("error: out of memory: Unable to allocate 29.8 TiB") and "internal error" not in err
+
+
+def test_the_dashboard_without_frictionlabs_own_dask_cluster_is_refused_not_ignored(capsys):
+    from frictionlab.cli import main
+
+    for extra in ([], ["--executor", "processes"], ["--executor", "dask", "--scheduler", "tcp://127.0.0.1:1"]):
+        assert main(["run", "quickstart", "--dashboard", "--quiet", *extra]) == ExitCode.USAGE
+        assert "--dashboard serves the dashboard of frictionlab's own Dask cluster" in capsys.readouterr().err
