@@ -4,13 +4,13 @@ command line: its options, checked, and the run. Heavy modules are imported insi
 
 from __future__ import annotations
 
-import os
 import shlex
 import sys
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError
 from ..tradeoff.options import AXES, StudyOptions
+from .console import shown
 
 
 def _listed(values) -> str:
@@ -140,12 +140,7 @@ def command_line(args) -> str:
     if args.force:
         words.append("--force")
     # a folder name that is not UTF-8 is shown with its bytes escaped (the page is UTF-8 text)
-    return shlex.join(os.fsencode(w).decode("utf-8", "backslashreplace") for w in words)
-
-
-def shown(path) -> str:
-    """A path as text any terminal takes: bytes that are not UTF-8 escaped."""
-    return os.fsencode(path).decode("utf-8", "backslashreplace")
+    return shlex.join(shown(w) for w in words)
 
 
 def run(args) -> ExitCode:
@@ -161,6 +156,13 @@ def run(args) -> ExitCode:
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
     data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
+    if data.get("sweep") is not None:
+        print(
+            "warning: the preset's sweep is not studied: the study varies its own axes around the preset's "
+            "base values (--set sweep=null says so and silences this)",
+            file=sys.stderr,
+        )
+        data = {**data, "sweep": None}
     factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []))
 
     def progress(message: str) -> None:

@@ -120,3 +120,13 @@ def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys):
     assert main(["study", "quickstart", *QUICK, "--out", str(out)]) == ExitCode.OK
     assert "st\\xff/" in capsys.readouterr().out
     assert "st\\xff" in (out / "study.md").read_text(encoding="utf-8")
+
+
+def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path, capsys):
+    swept = {**TINY, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
+    for preset, warned in ((write(tmp_path, swept), True), (write(tmp_path, {**swept, "sweep": None}), False)):
+        out = tmp_path / f"study-{warned}"
+        assert main(["study", str(preset), "--axes", "realizations", "--grid-realizations", "3", "--out", str(out)]) == 0
+        err = capsys.readouterr().err
+        assert ("the preset's sweep is not studied" in err) is warned
+        assert "H = 0.8" in (out / "study.md").read_text()  # the base value, not a point of the sweep
