@@ -124,8 +124,8 @@ def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys):
 
 def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path, capsys):
     swept = {**TINY, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
-    for preset, warned in ((write(tmp_path, swept), True), (write(tmp_path, {**swept, "sweep": None}), False)):
-        out = tmp_path / f"study-{warned}"
+    for data, warned in ((swept, True), ({**swept, "sweep": None}, False)):
+        preset, out = write(tmp_path, data), tmp_path / f"study-{warned}"
         assert main(["study", str(preset), "--axes", "realizations", "--grid-realizations", "3", "--out", str(out)]) == 0
         err = capsys.readouterr().err
         assert ("the preset's sweep is not studied" in err) is warned
