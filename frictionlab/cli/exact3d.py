@@ -33,17 +33,11 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..exact3d.report import write_page
-    from ..signals import WorkInterrupted, interrupted_exit_code
 
-    try:
-        page = write_page(
-            args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
-            options=run_options(workers=args.workers, force=args.force),
-            log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
-        )  # fmt: skip
-    except WorkInterrupted as exc:
-        code = interrupted_exit_code()
-        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}: {exc}; no page written", file=sys.stderr)
-        return code
+    page = write_page(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
+        args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
+        options=run_options(workers=args.workers, force=args.force),
+        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+    )  # fmt: skip
     print(page)
     return ExitCode.OK

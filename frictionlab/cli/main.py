@@ -202,9 +202,10 @@ def _run_command(args) -> int:
         detail = f": {exc}" if str(exc) else ""
         print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
         return int(ExitCode.RUNTIME_FAILURE)
-    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (signals.Terminated), outside a run's own handling
-        code = interrupted_exit_code()
-        print("terminated" if code == ExitCode.TERMINATED else "interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (signals.Terminated), or a command of several runs
+        code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
+        said = f": {shown(str(exc))}" if str(exc) else ""
+        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", file=sys.stderr)
         return int(code)
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):

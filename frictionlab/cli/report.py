@@ -33,19 +33,13 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..paper.reproduce import write_report
-    from ..signals import WorkInterrupted, interrupted_exit_code
 
-    try:
-        path = write_report(
-            presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-            options=run_options(workers=args.workers, force=args.force), readings=args.readings,
-            log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
-            quiet=args.quiet,
-        )  # fmt: skip
-    except WorkInterrupted as exc:
-        code = interrupted_exit_code()
-        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}: {exc}", file=sys.stderr)
-        return code
+    path = write_report(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
+        presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
+        options=run_options(workers=args.workers, force=args.force), readings=args.readings,
+        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+        quiet=args.quiet,
+    )  # fmt: skip
     if args.json:  # the figures the report shows, as its image links name them
         images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
         figures = list(dict.fromkeys(os.path.normpath(path.parent / image) for image in images))

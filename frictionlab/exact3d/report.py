@@ -17,6 +17,7 @@ from ..listeners import format_duration
 from ..options import RunOptions
 from ..rundir import new_run_folder
 from ..seeds import bootstrap_rng, realization_rng
+from ..signals import WorkInterrupted
 from .analysis import SMALL_LOAD_FRACTION, Kappa, contact_area_law
 from .figures import plot_convergence, plot_xi_against_f
 from .markdown import YASTREBOV, answer, convergence_table, ensemble_text, law_table, paired_extra_grids
@@ -106,7 +107,10 @@ def write_page(
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
-    runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
+    try:
+        runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
+    except WorkInterrupted as exc:
+        raise WorkInterrupted(f"{exc}; no page written") from None
     kappas = kappas_of(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
     atomic_write(figures / FIGURES[0], lambda fh: plot_xi_against_f(runs, fh, kappas, dpi=dpi), binary=True)
