@@ -85,17 +85,22 @@ def json_safe(value):
     return value
 
 
+def format_number(value: float, digits: int = 4) -> str:
+    """``value`` with ``digits`` decimals, or in ``g`` form when that would run long (from 1e6)."""
+    return f"{value:.{digits}f}" if abs(value) < 1e6 else f"{value:.{digits + 2}g}"
+
+
 def format_interval(ci, digits: int = 4, missing: str = "n/a", sep: str = ", ") -> str:
     """``[low, high]`` with ``digits`` decimals, or ``missing`` when the interval is unknown (None or NaN)."""
     low, high = ci
     if low is None or high is None or not (math.isfinite(low) and math.isfinite(high)):
         return missing
-    return f"[{low:.{digits}f}{sep}{high:.{digits}f}]"
+    return f"[{format_number(low, digits)}{sep}{format_number(high, digits)}]"
 
 
 def format_estimate(value: float, ci, digits: int = 4, missing: str = "n/a") -> str:
     """``1.2345 [1.2000, 1.3000]``: a coefficient and its interval (``missing`` for an unknown one)."""
-    return f"{value:.{digits}f} {format_interval(ci, digits, missing)}"
+    return f"{format_number(value, digits)} {format_interval(ci, digits, missing)}"
 
 
 def percentile_interval(samples: np.ndarray, confidence: float, axis: int | None = None):

@@ -34,8 +34,8 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
-    from ..fit import LogFit, json_safe
-    from ..paper.predict import check_law, format_number, predict_xi, prediction_text, read_run_law
+    from ..fit import LogFit, format_number, json_safe
+    from ..paper.predict import check_law, predict_xi, prediction_text, read_run_law
 
     if args.from_run:
         given = [name for name, value in (("--a", args.a), ("--b", args.b), ("--a-ci", args.a_ci), ("--b-ci", args.b_ci),

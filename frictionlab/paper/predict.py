@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
-from ..fit import LogFit, bootstrap_coefficients, percentile_interval
+from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval
 from ..inputs import InputFileProblem, open_regular_file
 from ..plugin import ForceNormalisation, mdr_length
 from ..rundir import read_json_object
@@ -334,21 +334,9 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
     return xi.astype(float), f.astype(float)
 
 
-def format_number(value: float, decimals: int = 4) -> str:
-    """``value`` with ``decimals`` decimals, or in ``g`` form when that would run long."""
-    return f"{value:.{decimals}f}" if abs(value) < 1e6 else f"{value:.{decimals + 2}g}"
-
-
-def _format_interval(ci: tuple[float, float]) -> str:
-    low, high = ci
-    if not (math.isfinite(low) and math.isfinite(high)):
-        return "n/a"
-    return f"[{format_number(low)}, {format_number(high)}]"
-
-
 def prediction_text(p: Prediction) -> str:
     level = f"{100 * p.confidence:g}%"
-    ci = _format_interval(p.xi_ci)
+    ci = format_interval(p.xi_ci)
     lines = [
         f"f = sqrt(pi) F / (2 E* h sqrt(A)) = {p.f:.6g}   (ln f = {math.log(p.f):.4f})",
         f"xi = grad_z_contact / grad_z = {format_number(p.xi)}   {level} interval {ci} ({p.interval})",
