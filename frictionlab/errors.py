@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import os
 
 
 class ExitCode(enum.IntEnum):
@@ -68,6 +69,16 @@ class RunFolderError(FrictionlabError):
     damaged, another run holds it, or an input file changed since it started."""
 
     exit_code = ExitCode.RUN_FOLDER
+
+
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F) if chr(c) not in "\n\t"}
+
+
+def shown(text) -> str:
+    """``text`` (or a path) as any terminal takes it: bytes that are not UTF-8 and control
+    characters escaped (an escape sequence typed in a ``--set`` or a file name must not
+    drive the terminal); lines and tabs kept."""
+    return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
 
 
 def counted(count: int, noun: str) -> str:

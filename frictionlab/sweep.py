@@ -39,10 +39,12 @@ from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
 from .results import write_figure
-from .rundir import STATE_FILE
+from .inputs import InputFileProblem
+from .rundir import STATE_FILE, read_json_object
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
+MAX_SWEEP_RECORD_BYTES = 64 * 1024 * 1024  # a sweep.json holds a row per point: at most 1000 of them
 RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
     "contact_first", "contact_last", "elapsed_s", "folder",
@@ -366,10 +368,10 @@ def stored_sweep(out_dir: Path) -> dict:
     """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
     try:
-        stored = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):
-        raise RunFolderError(f"{out_dir}/sweep.json cannot be read as a sweep's record: this sweep cannot be resumed") from None
-    base, spec = (stored.get("base_preset"), stored.get("sweep")) if isinstance(stored, dict) else (None, None)
+        stored = read_json_object(out_dir / "sweep.json", MAX_SWEEP_RECORD_BYTES, "sweep.json")
+    except InputFileProblem as exc:
+        raise RunFolderError(f"{out_dir}/sweep.json cannot be read ({exc}): this sweep cannot be resumed") from None
+    base, spec = stored.get("base_preset"), stored.get("sweep")
     if not (isinstance(base, dict) and isinstance(spec, dict)):
         raise RunFolderError(f"{out_dir}/sweep.json is damaged (no base_preset and sweep mappings): it cannot be resumed")
     return {**base, "sweep": spec}

@@ -204,3 +204,12 @@ def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_
         capsys.readouterr()
         assert main([part.format(out=out) for part in how] + ["--workers", "1", "--quiet"]) == 0, capsys.readouterr().err
         assert fits(out) == fits(whole)  # the points never reached ran afresh, the finished one was kept
+
+
+@pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),
+                                        ('{"sweep": {}}', "no base_preset and sweep mappings")])  # fmt: skip
+def test_resume_of_a_sweep_folder_whose_record_is_damaged_names_it(tmp_path, capsys, text, said):
+    (tmp_path / "sweep.json").write_text(text)
+    assert main(["resume", str(tmp_path)]) == 5
+    err = capsys.readouterr().err
+    assert "sweep.json" in err and said in err

@@ -22,16 +22,6 @@ def error_label(stream=None) -> str:
     return "\x1b[31merror\x1b[0m" if use_colour(stream or sys.stderr) else "error"
 
 
-_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F) if chr(c) not in "\n\t"}
-
-
-def shown(text) -> str:
-    """``text`` (or a path) as any terminal takes it: bytes that are not UTF-8 and control
-    characters escaped (an escape sequence typed in a ``--set`` or a file name must not
-    drive the terminal); lines and tabs kept."""
-    return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
-
-
 def is_terminal(stream=None) -> bool:
     stream = stream or sys.stdout
     try:

@@ -24,10 +24,10 @@ import os
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, short_repr
+from ..errors import ExitCode, FrictionlabError, short_repr, shown
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
-from .console import error_label, shown
+from .console import error_label
 
 COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""

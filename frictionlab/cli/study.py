@@ -8,9 +8,8 @@ import shlex
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode, FrictionlabError, shown
 from ..tradeoff.options import AXES, StudyOptions
-from .console import shown
 
 
 def _listed(values) -> str:

@@ -5,8 +5,7 @@ from __future__ import annotations
 import json
 import sys
 
-from ..errors import ExitCode, FrictionlabError, counted
-from .console import shown
+from ..errors import ExitCode, FrictionlabError, counted, shown
 
 
 def add_parser(sub) -> None:

@@ -28,10 +28,10 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ..ensemble import RunOutcome
-from ..errors import FrictionlabError, PresetError
+from ..errors import FrictionlabError, PresetError, RunError
 from ..plugin import ContactSolver
 from ..preset import Scene
-from ..memory import gib
+from ..memory import available_memory, estimate, gib
 from .metrics import curve_errors, interval_half_width, mean_curve_half_width, relative_difference
 from .options import AXES, StudyOptions
 from .scenes import Measurement, SceneFactory, measure
@@ -249,9 +249,6 @@ class Study:
     def check_memory(self) -> None:
         """Refuse (RunError), before anything runs, a study whose largest setting would need more
         memory than is available: the largest grid factor (and reference grid), else the preset's N."""
-        from ..errors import RunError
-        from ..memory import available_memory, estimate
-
         largest = []  # (what, what to make smaller, scene)
         axes = set(self.options.axes)
         if axes & {"realizations", "steps"}:

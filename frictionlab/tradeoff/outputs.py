@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import csv
 import math
-import os
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import OutputRefused
+from ..errors import OutputRefused, shown
 from ..files import atomic_write, output_path_problem
 from .axes import COLUMNS, Row, Study, preset_points
 from .metrics import pareto_front
@@ -334,18 +333,17 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
 
         return new_run_folder(f"{name}-study")
     out = Path(out_dir)
-    shown = os.fsencode(out).decode("utf-8", "backslashreplace")
     problem = output_path_problem(out)
     if problem:
-        raise OutputRefused(f"--out: {os.fsencode(problem).decode('utf-8', 'backslashreplace')}; give a folder")
+        raise OutputRefused(f"--out: {shown(problem)}; give a folder")
     if force or not out.is_dir():
         return out
     held = sorted(p.name for p in out.iterdir())
     if not held or (set(held) <= set(FILES) and _is_study_of(out / "study.md", name)):
         return out
-    listed = ", ".join(repr(os.fsencode(n).decode("utf-8", "backslashreplace")) for n in held[:3])
+    listed = ", ".join(repr(shown(n)) for n in held[:3])
     raise OutputRefused(
-        f"--out {shown} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
+        f"--out {shown(out)} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
         "give another folder, or --force to write study.csv, study.md and study.png into it (nothing else is touched)"
     )
 
