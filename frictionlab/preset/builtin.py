@@ -68,8 +68,9 @@ def resolve_preset_path(argument: str | Path) -> Path:
             source=str(argument),
         )  # fmt: skip
     named = len(path.parts) == 1 and not path.suffix
-    if named and path.is_dir() and find_builtin(str(argument)):  # a folder is never a preset: the run folder
-        return find_builtin(str(argument)).path  # of `frictionlab run quickstart --out quickstart`, say
+    # a folder is never a preset: the run folder of `frictionlab run quickstart --out quickstart`, say
+    if named and path.is_dir() and (shadowed := find_builtin(str(argument))) is not None:
+        return shadowed.path
     if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one
     found = find_builtin(str(argument))
