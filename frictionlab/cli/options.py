@@ -24,7 +24,7 @@ def add_executor_options(parser) -> None:
     parser.add_argument("--tls-cert", metavar="FILE", help="client certificate for a tls:// Dask scheduler")
     parser.add_argument("--tls-key", metavar="FILE", help="client key for a tls:// Dask scheduler")
     parser.add_argument(
-        "--dashboard", action="store_true", help="serve the Dask dashboard of the local cluster (on 127.0.0.1)"
+        "--dashboard", action="store_true", help="serve the Dask dashboard of frictionlab's own local cluster (on 127.0.0.1; needs --executor dask, no --scheduler)"
     )
     parser.add_argument(
         "--no-memory-check", action="store_true", help="skip the peak-memory estimate made before the run starts"
