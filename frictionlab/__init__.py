@@ -24,7 +24,8 @@ _LAZY = {
     **dict.fromkeys(
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
-            "SlopeEstimator", "SpectrumGenerator", "contract", "force_unit", "load_finished", "mdr_length",
+            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "force_unit", "iteration_done",
+            "load_finished", "mdr_length",
         ),
         "plugin",
     ),  # fmt: skip
@@ -72,6 +73,7 @@ __all__ = [
     "RunListener",
     "RunOptions",
     "SlopeEstimator",
+    "SolveCancelled",
     "SpectrumGenerator",
     "SweepListener",
     "SweepResult",
@@ -79,6 +81,7 @@ __all__ = [
     "contract",
     "force_unit",
     "hookimpl",
+    "iteration_done",
     "load",
     "load_finished",
     "mdr_length",

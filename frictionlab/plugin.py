@@ -461,6 +461,25 @@ def load_finished(done: int, total: int) -> None:
         _load_listener(done, total)
 
 
+class SolveCancelled(Exception):
+    """Raised by ``iteration_done`` inside a solver's loop when the run it belongs to
+    is cancelled (the TUI's cancel, Ctrl-C, SIGTERM). A solver lets it propagate: the
+    realization is then neither stored nor counted as failed, and runs again on resume."""
+
+
+_iteration_listener: Callable[[int, float], None] | None = None
+
+
+def iteration_done(iteration: int, residual: float) -> None:
+    """An iterative solver calls this once per iteration of its inner loop: ``iteration``
+    steps of the current load are done and its relative residual is ``residual``. The run
+    forwards it, coalesced, to its listeners as progress within a load, and raises
+    ``SolveCancelled`` here once the run is cancelled, so a long solve stops within a
+    fraction of a second. Outside a run that listens it does nothing (and costs a call)."""
+    if _iteration_listener is not None:
+        _iteration_listener(iteration, residual)
+
+
 @contextmanager
 def listening_to_loads(listener: Callable[[int, int], None] | None):
     """Within the block, ``load_finished(done, total)`` calls ``listener`` (this process only)."""
