@@ -131,3 +131,25 @@ def input_fields(params_model) -> list[str]:
 
 def is_relative(value) -> bool:
     return isinstance(value, str) and bool(value) and not os.path.isabs(os.path.expanduser(value))
+
+
+# ------------------------------------------------------------------ what a plugin read
+
+
+def describe_input(summary: dict) -> str:
+    """One line on a spectrum's ``input_summary()``: shape, pixel size, unit and rms height,
+    and where the pixel size and the unit came from."""
+    unit = summary.get("unit")
+    length = f" {unit}" if unit else " (no unit: bare numbers)"
+    shape = " x ".join(str(n) for n in summary["shape"])
+    kind = "points" if len(summary["shape"]) == 1 else "pixels"
+    spacing_from = summary.get("spacing_from")
+    converted = summary.get("file_unit")
+    unit_note = f", converted from the file's {converted}" if converted and unit and converted != unit else ""
+    return (
+        f"{Path(summary['file']).name} ({summary.get('format', '?')}): {shape} {kind} of {summary['spacing']:.6g}"
+        f"{length}{f' (from the {spacing_from})' if spacing_from else ''}, rms height {summary['rms_height']:.6g}"
+        f"{length}{unit_note}" + (", periodic" if summary.get("periodic") else ", not periodic")
+        + (f", {summary['undefined_points']} undefined points filled ({summary['filled_by']})"
+           if summary.get("filled_by") else "")
+    )  # fmt: skip

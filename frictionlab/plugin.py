@@ -305,6 +305,11 @@ class SpectrumGenerator(Plugin):
       of lines presses instead. Default None (no MDR mapping).
     - ``c0()``: the prefactor C0 of a power-law PSD. Default NotImplementedError.
     - ``hurst_exponent()``: H of a self-affine spectrum, or None (the default).
+    - ``input_summary()``: for a profile or surface read from a file, what was read and
+      used, JSON-ready: at least ``file``, ``shape``, ``spacing``, ``unit`` (None when the
+      numbers carry none) and ``rms_height``, and where each came from (the file or the
+      preset). ``frictionlab validate``, the API, the TUI and summary.json show it.
+      Default None (nothing read).
     """
 
     kind: ClassVar[str] = "spectrum"
@@ -340,6 +345,9 @@ class SpectrumGenerator(Plugin):
         raise NotImplementedError(f"{self.name} is not a power-law spectrum: it has no prefactor C0")
 
     def hurst_exponent(self) -> float | None:
+        return None
+
+    def input_summary(self) -> dict[str, Any] | None:
         return None
 
 

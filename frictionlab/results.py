@@ -52,6 +52,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "frictionlab_version": __version__,
         "python": platform.python_version(),
         "preset": scene.resolved(),
+        "input": scene.spectrum.input_summary(),  # a file's shape, pixel size, unit as read (JSON-ready: the kit checks)
         "seed": scene.preset.seed,
         "status": outcome.status,
         "error": outcome.error,

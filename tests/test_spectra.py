@@ -630,7 +630,9 @@ def test_profile_file_errors(tmp_path):
     assert "spacing=0.4" in message and "0.5" in message
 
     assert "3 columns" in _profile_error(path=_write(tmp_path, "wide.txt", "1 2 3\n" * 10))
-    assert "unknown file type" in _profile_error(path=_write(tmp_path, "p.dat", heights), spacing=1.0)
+    noise = tmp_path / "p.opd"
+    noise.write_bytes(bytes(range(256)) * 4)
+    assert "not an instrument file SurfaceTopography reads" in _profile_error(path=str(noise), spacing=1.0)
     path = tmp_path / "cube.npy"
     np.save(path, np.zeros((3, 4, 5)))
     assert "shape" in _profile_error(path=str(path), spacing=1.0)

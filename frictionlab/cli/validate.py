@@ -6,6 +6,7 @@ import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError, counted, shown
+from ..inputs import describe_input
 
 
 def add_parser(sub) -> None:
@@ -48,6 +49,7 @@ def run(args) -> ExitCode:
             "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
             "spectrum": scene.spectrum.name, "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
             "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
+            "input": scene.spectrum.input_summary(),
         }  # fmt: skip
         records.append(record)
         if not args.json:
@@ -56,6 +58,8 @@ def run(args) -> ExitCode:
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {counted(points, 'point')})" if points is not None else ")")
             )
+            if record["input"] is not None:
+                print(f"  read {describe_input(record['input'])}")
     if args.json:
         print(json.dumps(records, indent=2))
     return worst
