@@ -104,7 +104,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: the file's unit {file_unit!r} is not a length unit") from None
     z = np.array(np.ma.getdata(heights), dtype=np.float64) * factor
     return Scan(
-        heights=z.T if dimension == 2 else z,
+        heights=np.ascontiguousarray(z.T) if dimension == 2 else z,  # C order, as a .npy map: the same sums
         spacing=float(pixel.mean()) * factor,
         unit=unit if unit is not None else file_unit,
         file_unit=file_unit,
