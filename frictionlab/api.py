@@ -58,7 +58,7 @@ if TYPE_CHECKING:
     from .ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene"]
+__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
@@ -71,7 +71,9 @@ class Result:
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``contact_count``,
     ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
-    run folder, None for a run kept in memory."""
+    run folder, None for a run kept in memory. ``input``: for a measured profile or
+    surface, what was read from its file (shape, pixel size, unit, rms height and
+    where each came from), else None."""
 
     name: str
     status: str  # completed | cancelled | interrupted | failed
@@ -85,6 +87,7 @@ class Result:
     folder: Path | None = None
     outcome: RunOutcome | None = field(default=None, repr=False, compare=False)  # in-process runs only
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
+    input: dict | None = None
 
     @property
     def a(self) -> float:
@@ -206,6 +209,33 @@ def read_preset_input(
     return data, source, base_dir
 
 
+def scene_record(scene: Scene) -> dict:
+    """What a validated preset would run: its plugins, realizations, load steps, and what
+    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None."""
+    preset = scene.preset
+    return {
+        "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
+        "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
+        "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+    }  # fmt: skip
+
+
+def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
+             **keys: Any) -> dict:  # fmt: skip
+    """Check a preset (any form ``run`` takes, overrides as there) without running it, and
+    return what would run (``scene_record``); a measured file is read once, here. Bad input
+    raises a ``frictionlab.errors.FrictionlabError`` naming every field at fault.
+
+    >>> import frictionlab
+    >>> frictionlab.validate("quickstart")["input"] is None  # a synthetic spectrum reads no file
+    True
+    """
+    from .preset import build_scene
+
+    data, source, _ = read_preset_input(preset, overrides, **keys)
+    return scene_record(build_scene(data, source=source))
+
+
 def run(
     preset: str | Path | Mapping[str, Any] | Preset,
     overrides: Mapping[str, Any] | None = None,
@@ -307,7 +337,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
-        outcome=outcome, files=dict(files),
+        outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
     )  # fmt: skip
 
 
@@ -342,6 +372,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         caveats=list(summary.get("caveats") or []),
         folder=folder,
         files={k: folder / v for k, v in (summary.get("files") or {}).items()},
+        input=summary.get("input"),
     )
 
 

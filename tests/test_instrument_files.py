@@ -214,3 +214,18 @@ def test_a_table_does_not_import_the_extra(tmp_path):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+def test_the_api_shows_what_was_read_before_and_after_the_run(tmp_path):
+    import frictionlab
+
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    checked = frictionlab.validate(preset(tmp_path / "scan.x3p", "nm"))
+    assert checked["input"]["shape"] == [ROWS, COLUMNS] and checked["input"]["unit"] == "nm"
+    assert checked["input"]["spacing"] == pytest.approx(1e3 * PIXEL_UM, rel=1e-12)
+    assert checked["input"]["rms_height"] == pytest.approx(50.0, rel=1e-12)  # scan_um's 0.05 um
+    result = frictionlab.run(preset(tmp_path / "scan.x3p", "um"), out=tmp_path / "run", workers=1, progress=False,
+                             plot=False)  # fmt: skip
+    assert result.input["unit"] == "um" and frictionlab.load(tmp_path / "run").input == result.input
+    with pytest.raises(PresetError, match="spectrum.params.unit"):
+        frictionlab.validate(preset(tmp_path / "scan.x3p", "inch"))

@@ -23,6 +23,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
+    from ..api import scene_record
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..sweep import plan_sweep
@@ -45,12 +46,7 @@ def run(args) -> ExitCode:
                 print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
-        record = {
-            "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
-            "spectrum": scene.spectrum.name, "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
-            "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
-            "input": scene.spectrum.input_summary(),
-        }  # fmt: skip
+        record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         records.append(record)
         if not args.json:
             print(
