@@ -261,7 +261,7 @@ class FrictionlabApp(App):
             else:
                 self.say("The preset is valid: Ctrl+R runs it.")
         self._show_edit_state()
-        self.query_one(EditPane).show_problems(event.problems)
+        self.query_one(EditPane).show_problems(event.problems, event.read)
 
     def _show_edit_state(self) -> None:
         self.query_one(EditPane).show_title(self.draft_path, self.modified, self.problems)
