@@ -30,7 +30,7 @@ from frictionlab import Profile
 from frictionlab.registry import Registry
 from frictionlab.testing import check_plugin
 from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
-from frictionlab_solvers.bem_free import pixel_influence
+from frictionlab_solvers.bem_free import FreeHalfSpace, pixel_influence
 
 
 def solve(solver, z, loads, control="force", dx=1.0, periodic=False):
@@ -67,6 +67,33 @@ def test_pixel_influence_is_love_at_the_centre_and_boussinesq_far_away():
     assert influence[5, 3] == pytest.approx(influence[3, 5], rel=1e-12)
     r = math.hypot(12, 9)  # the square's own size enters as 1 / (24 r^2) relative to the point force
     assert influence[12, 9] == pytest.approx(1 / (math.pi * r), rel=1 / (10 * r**2))
+
+
+def test_the_operator_is_the_direct_sum_over_loaded_pixels_without_wrapping():
+    """Brute force on a small grid: u_i = sum_j K(i - j) p_j over the grid only."""
+    shape = (6, 5)
+    operator = FreeHalfSpace(shape)
+    influence = pixel_influence(shape)  # offsets -N..N-1 each way: every difference on the grid
+    pressure = np.random.default_rng(1).random(shape)
+    direct = np.zeros(shape)
+    for (i, j), p in np.ndenumerate(pressure):
+        for (k, m), _ in np.ndenumerate(direct):
+            direct[k, m] += influence[k - i, m - j] * p
+    np.testing.assert_allclose(operator.displacement(pressure, np.empty(shape)), direct, rtol=1e-12)
+    assert operator.point_stiffness == pytest.approx(1 / influence[0, 0], rel=1e-15)
+
+
+def test_the_preconditioner_is_symmetric_keeps_the_mean_and_works_in_place():
+    operator = FreeHalfSpace((12, 10))
+    rng = np.random.default_rng(2)
+    a, b = rng.random((12, 10)), rng.random((12, 10))
+    pa = operator.precondition(a, np.empty(a.shape))
+    assert np.dot(pa.ravel(), b.ravel()) == pytest.approx(np.dot(a.ravel(), operator.precondition(b, np.empty(b.shape)).ravel()), rel=1e-12)
+    uniform = np.ones((12, 10))  # a uniform displacement needs the body's uniform-pressure stiffness
+    expected = operator.mean_stiffness * uniform
+    np.testing.assert_allclose(operator.precondition(uniform, np.empty(uniform.shape)), expected, rtol=1e-12)
+    in_place = a.copy()
+    np.testing.assert_array_equal(operator.precondition(in_place, in_place), pa)  # the CG calls it in place
 
 
 @pytest.mark.parametrize("control", ["force", "indentation"])

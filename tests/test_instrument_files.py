@@ -229,3 +229,23 @@ def test_the_api_shows_what_was_read_before_and_after_the_run(tmp_path):
     assert result.input["unit"] == "um" and frictionlab.load(tmp_path / "run").input == result.input
     with pytest.raises(PresetError, match="spectrum.params.unit"):
         frictionlab.validate(preset(tmp_path / "scan.x3p", "inch"))
+
+
+def test_the_memory_estimate_counts_the_file_and_the_padded_solver(tmp_path, monkeypatch):
+    """The map's points from the file (grid_shape), times the free solver's bytes per point
+    (its padded grids), plus the profile and slopes; a run that does not fit is refused
+    before it starts."""
+    from frictionlab import memory
+    from frictionlab.errors import RunError
+    from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
+
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    scene = build_scene(preset(tmp_path / "scan.x3p", "um", solver="bem-halfspace-free"))
+    assert memory.grid_points(scene) == ROWS * COLUMNS and scene.spectrum.grid_shape() == (ROWS, COLUMNS)
+    per_point = memory.bytes_per_point(scene)
+    assert per_point == BEMHalfSpaceFree.bytes_per_point + memory.PROFILE_BYTES_PER_POINT
+    assert BEMHalfSpaceFree.bytes_per_point > BEMHalfSpace.bytes_per_point  # the padding counts
+    one = memory.estimate(scene, workers=1, executor="serial")
+    monkeypatch.setattr(memory, "available_memory", lambda: (one.total - 1, "a test"))
+    with pytest.raises(RunError, match="scan|memory"):
+        memory.check_fits(scene, workers=1, executor="serial")

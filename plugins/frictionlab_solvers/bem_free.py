@@ -6,8 +6,8 @@ rectangle: the displacement of a pressure field is the convolution of the pressu
 with the surface response to a uniform pressure on one pixel (Love 1929), and that
 convolution is computed exactly, without wrapping, by one FFT of twice the scan's
 size each way with the pressure padded with zeros (Hockney 1970). The contact
-problem is the periodic solver's (``bem.ConstrainedCG``, Polonsky & Keer): only the
-displacement differs.
+problem is the periodic solver's (``contact_cg.ProjectedCG``): only the elastic
+operator differs, ``FreeHalfSpace``.
 
 The half-space's mean mode is finite here, so the indentation is the true approach
 of the rigid surface from its first touch, against the elastic body far from the
@@ -21,10 +21,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, iteration_done, load_finished
+from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished
 
-from .bem import ConstrainedCG, PeriodicBEM, _cold_start, _NotConverged
-from .springs import _check_control, _check_loads, check_profile
+from .bem import PeriodicBEM
+from .checks import check_control, check_loads, check_profile
+from .contact_cg import NotConverged, cold_start
+from .elastic import PeriodicHalfSpace
 
 LOVE = "Love, Phil. Trans. R. Soc. A 228 (1929) 377"
 HOCKNEY = "Hockney, Methods Comput. Phys. 9 (1970) 135"
@@ -54,14 +56,23 @@ def pixel_influence(shape: tuple[int, int]) -> np.ndarray:
     return total / np.pi
 
 
-class FreeBoundaryCG(ConstrainedCG):
-    """``ConstrainedCG`` on a non-periodic grid: the displacement of a pressure field is its
-    linear (not circular) convolution with ``pixel_influence``, by zero-padded FFTs."""
+class FreeHalfSpace:
+    """The elastic operator (``elastic.ElasticOperator``) of a half-space loaded only on a
+    (Ny, Nx) grid: the displacement of a pressure field is its linear (not circular)
+    convolution with ``pixel_influence``, by zero-padded FFTs. Displacements are measured
+    from the body far away, so a uniform pressure moves the surface by a finite amount.
 
-    def __init__(self, depth: np.ndarray):
-        super().__init__(depth)
-        if depth.ndim != 2:
+    The preconditioner is the periodic half-space's stiffness ``|q| / 2`` on the grid
+    itself, the inverse of this operator away from the edges, with the mean mode, which
+    the periodic body leaves out, given the stiffness of this body under a uniform
+    pressure: the mean pressure does move a free surface (an approach under indentation
+    control needs it)."""
+
+    def __init__(self, shape: tuple[int, int]):
+        if len(shape) != 2:
             raise ValueError("the free-boundary half-space presses surfaces (2D height maps) only")
+        self.shape = tuple(shape)
+        self.axes = (0, 1)
         self.padded_shape = tuple(2 * n for n in self.shape)
         influence = pixel_influence(self.shape)
         # the influence is even in both offsets, so its spectrum is real: half the memory
@@ -71,9 +82,12 @@ class FreeBoundaryCG(ConstrainedCG):
         self.padded = np.zeros(self.padded_shape)  # the pressure on its quarter, zero elsewhere
         self.padded_response = np.empty(self.padded_shape)
         self.window = tuple(slice(0, n) for n in self.shape)
+        self.periodic = PeriodicHalfSpace(self.shape)
+        uniform = self.displacement(np.ones(self.shape), np.empty(self.shape))
+        self.mean_stiffness = 1.0 / float(uniform.mean())  # uniform pressure per unit of mean displacement
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Surface displacement under ``pressure`` (loads outside the scan: none), into ``out``."""
+        """Surface displacement under ``pressure`` (loads outside the grid: none), into ``out``."""
         self.padded[self.window] = pressure
         spectrum = np.fft.rfftn(self.padded, axes=self.axes, out=self.spectrum)
         spectrum *= self.compliance
@@ -81,12 +95,19 @@ class FreeBoundaryCG(ConstrainedCG):
         out[...] = self.padded_response[self.window]
         return out
 
+    def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """``|q| / 2`` on the fluctuation of ``residual`` (zero mean), ``mean_stiffness`` on its mean."""
+        mean = float(residual.mean())  # before ``out``, which may be ``residual`` itself, is written
+        self.periodic.precondition(residual, out)
+        out += self.mean_stiffness * mean
+        return out
+
 
 class BEMHalfSpaceFree(PeriodicBEM):
     name: ClassVar[str] = "bem-halfspace-free"
     summary: ClassVar[str] = (
         "exact elastic half-space under a non-periodic surface (a scan): zero-padded FFT boundary elements, "
-        "Polonsky-Keer CG"
+        "preconditioned projected CG"
     )
     references: ClassVar[tuple[str, ...]] = PeriodicBEM.references + (LOVE, HOCKNEY)
     dimensions: ClassVar[tuple[int, ...]] = (2,)
@@ -94,18 +115,18 @@ class BEMHalfSpaceFree(PeriodicBEM):
     problem: ClassVar[str] = "elastic half-space"
     indentation_reference: ClassVar[str] = "undeformed body"
     periodic_only: ClassVar[bool] = False
-    # measured 271 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
-    # the periodic solver's grids plus the padded pressure, response and their spectra, four
-    # times the scan's points each), plus 20 %
-    bytes_per_point: ClassVar[int | None] = 326
+    # measured 304 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
+    # the CG's grids, the padded pressure, response and their spectra, four times the scan's
+    # points each, and the preconditioner's periodic kernels), plus 20 %
+    bytes_per_point: ClassVar[int | None] = 365
 
     def solve(self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray) -> ContactCurve:
         """Every load of the sweep on the scan as it is (a periodic profile is pressed as one
         patch too). ``extras["mean_displacement"]``: the mean elastic displacement over the
         scan at each load, the shift from this solver's indentation to the approach to the
         mean deformed surface."""
-        _check_control(control)
-        loads = _check_loads(loads, control)
+        check_control(control)
+        loads = check_loads(loads, control)
         heights, slopes, spacing = check_profile(self, profile, slopes)
         if not np.isfinite(heights).all():
             raise ValueError("heights must be finite")
@@ -121,15 +142,16 @@ class BEMHalfSpaceFree(PeriodicBEM):
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
         depth /= scale
-        cg = FreeBoundaryCG(depth)
+        cg = self.contact_cg(FreeHalfSpace(depth.shape), depth)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
+        stop = {"certified": True} if self.params.stop == "certified" else {}
         pressure, previous = None, 1.0
         for j, load in enumerate(loads):
             target = load / force_unit if control == "force" else load / scale
             if pressure is not None:  # warm start: the previous solution scaled to the new load
                 pressure *= target / previous
             elif control == "force":
-                pressure = _cold_start(depth, target)
+                pressure = cold_start(depth, target)
             else:
                 pressure = np.maximum(target - depth, 0.0)
             previous = target
@@ -140,9 +162,9 @@ class BEMHalfSpaceFree(PeriodicBEM):
                     approach=target if control == "indentation" else None,
                     tolerance=tolerance,
                     max_iterations=max_iterations,
-                    monitor=_report_iteration,
+                    **stop,
                 )
-            except _NotConverged as failure:
+            except NotConverged as failure:
                 what = "force" if control == "force" else "indentation"
                 raise ValueError(
                     f"{self.name} did not converge at load {j} ({what} {float(load):g}): residual "
@@ -164,7 +186,3 @@ class BEMHalfSpaceFree(PeriodicBEM):
             slope_rms_contact=slope_rms,
             extras={"iterations": iterations, "residual": residual, "mean_displacement": shift},
         )
-
-
-def _report_iteration(iteration: int, residual: float, contact: np.ndarray) -> None:
-    iteration_done(iteration, residual)  # progress within a load, and the run's cancel
