@@ -101,7 +101,8 @@ def test_conformance_with_an_instrument_file(tmp_path):
 def preset(path, unit, loads=(0.005, 0.2), solver="mdr", **params):  # f from 0.02 to 1 in um
     return {
         "name": "scan", "seed": 1, "realizations": 1, "fit": {"bootstrap": 0},
-        "spectrum": {"name": "surface-file", "params": {"path": str(path), **({"unit": unit} if unit else {}), **params}},
+        "spectrum": {"name": "surface-file",
+                     "params": {"path": str(path), **({"unit": unit} if unit else {}), **params}},
         "solver": {"name": solver}, "slope": {"name": "forward-difference"},
         "loading": {"start": loads[0], "stop": loads[1], "steps": 4, "spacing": "log"},
     }  # fmt: skip
@@ -171,8 +172,8 @@ def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     defined = ~np.isnan(holes)
     np.testing.assert_allclose(filled[defined], z[defined], rtol=1e-12, atol=1e-15)
     for row, column in ((5, 7), (10, 20)):  # harmonic: the mean of its four neighbours
-        neighbours = filled[row - 1, column] + filled[row + 1, column] + filled[row, column - 1] + filled[row, column + 1]
-        assert filled[row, column] == pytest.approx(neighbours / 4, rel=1e-6)
+        around = filled[row - 1, column] + filled[row + 1, column] + filled[row, column - 1] + filled[row, column + 1]
+        assert filled[row, column] == pytest.approx(around / 4, rel=1e-6)
     summary = surface.input_summary()
     assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
 

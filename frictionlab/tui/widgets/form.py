@@ -262,7 +262,9 @@ class PresetForm(VerticalScroll):
         """Run the headless validator on the draft and mark every field whose
         messages changed (only those: each change lays the form out again, and
         that, not the validator, is what a keystroke costs)."""
-        self.problems, read = validation_of(self.data, self.registry, self.base_dir) if self.data is not None else ([], "")
+        self.problems, read = [], ""
+        if self.data is not None:
+            self.problems, read = validation_of(self.data, self.registry, self.base_dir)
         shown = set()
         for widget_id, spec in self._specs.items():
             messages = problems_for(self.problems, spec.dotted)
