@@ -6,7 +6,6 @@ import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError, counted, shown
-from ..inputs import describe_input
 
 
 def add_parser(sub) -> None:
@@ -24,6 +23,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..api import scene_record
+    from ..inputs import describe_input
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..sweep import plan_sweep
