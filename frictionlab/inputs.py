@@ -140,7 +140,7 @@ def describe_input(summary: dict) -> str:
     """One line on a spectrum's ``input_summary()``: shape, pixel size, unit and rms height,
     and where the pixel size and the unit came from."""
     unit = summary.get("unit")
-    length = f" {unit}" if unit else " (no unit: bare numbers)"
+    length = f" {unit}" if unit else ""
     shape = " x ".join(str(n) for n in summary["shape"])
     kind = "points" if len(summary["shape"]) == 1 else "pixels"
     spacing_from = summary.get("spacing_from")
@@ -149,7 +149,8 @@ def describe_input(summary: dict) -> str:
     return (
         f"{Path(summary['file']).name} ({summary.get('format', '?')}): {shape} {kind} of {summary['spacing']:.6g}"
         f"{length}{f' (from the {spacing_from})' if spacing_from else ''}, rms height {summary['rms_height']:.6g}"
-        f"{length}{unit_note}" + (", periodic" if summary.get("periodic") else ", not periodic")
+        f"{length}{unit_note}" + ("" if unit else ", no unit (bare numbers)")
+        + (", periodic" if summary.get("periodic") else ", not periodic")
         + (f", {summary['undefined_points']} undefined points filled ({summary['filled_by']})"
            if summary.get("filled_by") else "")
     )  # fmt: skip

@@ -250,3 +250,12 @@ def test_the_memory_estimate_counts_the_file_and_the_padded_solver(tmp_path, mon
     monkeypatch.setattr(memory, "available_memory", lambda: (one.total - 1, "a test"))
     with pytest.raises(RunError, match="scan|memory"):
         memory.check_fits(scene, workers=1, executor="serial")
+
+
+def test_validate_says_a_table_has_no_unit_unless_the_preset_gives_one(tmp_path, capsys):
+    np.save(tmp_path / "scan.npy", scan_um())
+    for unit, expected in ((None, "of 0.125 (from the preset), rms height 0.05, no unit (bare numbers)"),
+                           ("um", "of 0.125 um (from the preset), rms height 0.05 um, not periodic")):  # fmt: skip
+        (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.npy", unit, spacing=PIXEL_UM)))
+        assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+        assert f"read scan.npy (.npy): 24 x 32 pixels {expected}" in capsys.readouterr().out
