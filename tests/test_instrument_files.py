@@ -93,6 +93,23 @@ def test_the_preset_may_override_the_pixel_size_and_says_so(tmp_path):
     assert SurfaceFile(path=str(tmp_path / "scan.x3p"), periodic=True).periodic() is True
 
 
+def test_a_file_that_says_it_is_periodic_is_periodic_unless_the_preset_says_otherwise(tmp_path):
+    z = scan_um()
+    topography = Topography(z.T.copy(), (COLUMNS * PIXEL_UM, ROWS * PIXEL_UM), unit="um", periodic=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        topography.to_netcdf(str(tmp_path / "tile.nc"))
+    surface = SurfaceFile(path=str(tmp_path / "tile.nc"))
+    assert surface.periodic() is True and surface.generate(None).periodic is True
+    assert surface.input_summary()["periodic_from"] == "file"
+    scene = build_scene(preset(tmp_path / "tile.nc", "um", solver="bem-halfspace"))  # the periodic solver takes it
+    assert scene.spectrum.periodic() is True
+    overridden = SurfaceFile(path=str(tmp_path / "tile.nc"), periodic=False)
+    assert overridden.periodic() is False and overridden.input_summary()["periodic_from"] == "preset"
+    with pytest.raises(PresetError, match="bem-halfspace presses periodic profiles only.*bem-halfspace-free"):
+        build_scene(preset(tmp_path / "tile.nc", "um", solver="bem-halfspace", periodic=False))
+
+
 def test_conformance_with_an_instrument_file(tmp_path):
     write_x3p(tmp_path / "scan.x3p", scan_um())
     check_plugin("spectrum", SurfaceFile, deterministic=True, path=str(tmp_path / "scan.x3p"), unit="nm")
