@@ -42,11 +42,16 @@ def pixel_influence(shape: tuple[int, int]) -> np.ndarray:
     y, x = np.meshgrid(*offsets, indexing="ij", sparse=True)
     a = b = 0.5
 
+    def y_plus_r(x_side, y):
+        # y + sqrt(x^2 + y^2) without cancellation where y < 0 (far from the pixel on that side)
+        r = np.hypot(x_side, y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(y >= 0, y + r, np.square(x_side) / (r - y))
+
     def term(x_side, y_plus, y_minus):
         # x_side * ln((y_plus + r(x_side, y_plus)) / (y_minus + r(x_side, y_minus))), zero where x_side is
-        r_plus, r_minus = np.hypot(x_side, y_plus), np.hypot(x_side, y_minus)
         with np.errstate(divide="ignore", invalid="ignore"):
-            value = x_side * np.log((y_plus + r_plus) / (y_minus + r_minus))
+            value = x_side * np.log(y_plus_r(x_side, y_plus) / y_plus_r(x_side, y_minus))
         return np.where(x_side == 0.0, 0.0, value)
 
     total = (
