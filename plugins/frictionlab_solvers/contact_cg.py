@@ -97,10 +97,11 @@ class ProjectedCG:
         converge in a few steps per decade once the set is found. Under force
         control the direction has zero sum on the set, so a step keeps the
         load. Points the step would push below zero pressure are set to zero
-        (clipped) and leave the set; the load is then restored by scaling and
-        the gap recomputed exactly. Otherwise the gap is updated from the
-        step's response, recomputed exactly every ``REFRESH`` steps and before
-        a stop is accepted.
+        (clipped) and leave the set, and the load is restored by scaling. The
+        gap is updated from the step's response (and, after clipping, from the
+        operator's single-precision displacement under the lift of the clipped
+        points), and recomputed exactly every ``REFRESH`` steps and before a
+        stop is accepted: the stop always judges an exact gap.
 
         The CG factor is Polak-Ribiere's, clipped at zero (Gilbert & Nocedal
         1992), with the last residual restricted to the current set, and is kept
@@ -218,9 +219,19 @@ class ProjectedCG:
             p_w -= step * d
             clipped = float(p_w.min()) <= 0.0
             if clipped:
-                np.maximum(p_w, 0.0, out=p_w)
+                # gap(p - step d + lift) = gap - step w + u(lift), the lift raising clipped points to 0
+                lift = np.maximum(p_w, 0.0)
+                lift -= p_w
+                p_w += lift
                 p[working] = p_w
                 contact = working[p_w > 0.0]
+                z_grid.fill(0.0)
+                z_grid[working] = lift
+                operator.displacement_estimate(self.preconditioned, self.scratch)
+                self.gap -= self.depth  # the displacement, to be scaled with the pressure
+                self.gap += self.scratch
+                np.multiply(self.response, step, out=self.scratch)
+                self.gap -= self.scratch
                 if force_control:  # restore the load exactly
                     total = float(p[contact].sum()) / p.size
                     if not total > 0.0:  # cannot happen in exact arithmetic; start over
@@ -228,10 +239,17 @@ class ProjectedCG:
                         contact = np.arange(p.size)
                         d_grid.fill(0.0)
                         r_grid.fill(0.0)
+                        since_exact = REFRESH  # the gap is recomputed below
                     else:
                         p[contact] *= mean_pressure / total
-                self._exact_gap(pressure)
-                exact, since_exact, stable = True, 0, 0
+                        self.gap *= mean_pressure / total
+                self.gap += self.depth
+                stable = 0
+                if since_exact >= REFRESH:
+                    self._exact_gap(pressure)
+                    exact, since_exact = True, 0
+                else:
+                    exact, since_exact = False, since_exact + 1
             elif not force_control and working.size == p.size and float(r.mean()) > 0.0:
                 # full contact under indentation control, the level above the rigid body's
                 # full-contact level: a uniform pressure has no stiffness (the energy is linear
