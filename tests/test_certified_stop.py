@@ -89,7 +89,9 @@ def test_certified_sweeps_find_the_exact_contact_sets(monkeypatch, hurst, points
 
 @pytest.mark.slow
 @pytest.mark.parametrize("hurst", [0.3, 0.5, 0.8])
-@pytest.mark.parametrize(("points", "seed"), [(128, s) for s in range(4)] + [(256, s) for s in range(3)] + [(512, s) for s in range(2)])
+@pytest.mark.parametrize(
+    ("points", "seed"), [(128, s) for s in range(4)] + [(256, s) for s in range(3)] + [(512, s) for s in range(2)]
+)
 def test_certified_stop_validation_force(monkeypatch, hurst, points, seed):
     check(monkeypatch, hurst, points, 100 + seed, "force")
 

@@ -25,7 +25,9 @@ class Baseline(BEMHalfSpace):
     contact_cg = PolonskyKeerCG
 
 
-@pytest.mark.parametrize("solver", [BEMHalfSpace(stop="tolerance"), BEMHalfSpace(stop="certified"), Baseline(stop="tolerance")])
+@pytest.mark.parametrize(
+    "solver", [BEMHalfSpace(stop="tolerance"), BEMHalfSpace(stop="certified"), Baseline(stop="tolerance")]
+)
 @pytest.mark.parametrize("control", ["force", "indentation"])
 def test_every_iteration_of_every_load_is_reported(monkeypatch, solver, control):
     calls = []

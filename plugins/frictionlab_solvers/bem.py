@@ -209,7 +209,7 @@ class PeriodicBEM(ContactSolver):
 class BEMHalfPlane(PeriodicBEM):
     name: ClassVar[str] = "bem-halfplane"
     summary: ClassVar[str] = (
-        "exact elastic half-plane (plane strain) under a periodic line: FFT boundary elements, preconditioned projected CG"
+        "exact elastic half-plane (plane strain) under a periodic line: FFT boundary elements, preconditioned CG"
     )
     dimensions: ClassVar[tuple[int, ...]] = (1,)
     # plane strain: the line is a ridged surface, straight in depth; its load is a force per unit depth
@@ -220,7 +220,7 @@ class BEMHalfPlane(PeriodicBEM):
 class BEMHalfSpace(PeriodicBEM):
     name: ClassVar[str] = "bem-halfspace"
     summary: ClassVar[str] = (
-        "exact elastic half-space under a periodic surface: FFT boundary elements, preconditioned projected CG"
+        "exact elastic half-space under a periodic surface: FFT boundary elements, preconditioned CG"
     )
     dimensions: ClassVar[tuple[int, ...]] = (2,)
     normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
