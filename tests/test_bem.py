@@ -191,10 +191,10 @@ def test_surface_constant_along_y_is_the_line_on_a_half_plane():
 def test_answer_and_residual_improve_as_the_tolerance_tightens():
     z = rough_surface(48, 7)
     load = 0.1 * 48 * 48  # mean pressure 0.1 E* h / dx
-    reference = solve(BEMHalfSpace(tolerance=1e-13), z, load)
+    reference = solve(BEMHalfSpace(tolerance=1e-13, stop="tolerance"), z, load)
     errors, residuals, iterations = [], [], []
     for tolerance in (1e-2, 1e-5, 1e-8):
-        curve = solve(BEMHalfSpace(tolerance=tolerance), z, load)
+        curve = solve(BEMHalfSpace(tolerance=tolerance, stop="tolerance"), z, load)
         assert curve.extras["residual"][0] <= tolerance
         residuals.append(curve.extras["residual"][0])
         iterations.append(curve.extras["iterations"][0])
@@ -207,7 +207,7 @@ def test_answer_and_residual_improve_as_the_tolerance_tightens():
 
 @pytest.mark.parametrize("cls, z", [(BEMHalfPlane, rough_line(256, 11)), (BEMHalfSpace, rough_surface(32, 11))])
 def test_warm_started_sweep_equals_cold_solves(cls, z):
-    solver = cls(tolerance=1e-11)
+    solver = cls(tolerance=1e-11, stop="tolerance")
     slope = np.sqrt(np.mean(np.square(np.diff(z, axis=-1))))  # contact fraction ~ 2 p / (E* slope)
     loads = np.linspace(0.02, 0.3, 6) * slope * z.size
     sweep = solve(solver, z, loads)
@@ -221,7 +221,7 @@ def test_warm_started_sweep_equals_cold_solves(cls, z):
 
 def test_indentation_control_inverts_force_control():
     z = rough_surface(32, 2)
-    solver = BEMHalfSpace(tolerance=1e-11)
+    solver = BEMHalfSpace(tolerance=1e-11, stop="tolerance")
     forces = np.array([0.02, 0.1, 0.3]) * z.size
     by_force = solve(solver, z, forces)
     assert by_force.contact_count[-1] < z.size  # past full contact the approach stops growing

@@ -56,6 +56,9 @@ class ElasticOperator(Protocol):
     ``precondition`` write into ``out`` (a float array of ``shape``) and return
     it; both are linear and symmetric, ``displacement`` positive definite on
     the pressures of a partial contact, ``precondition`` positive semi-definite.
+    ``displacement_estimate`` is ``displacement`` to single precision (or
+    ``displacement`` itself): the CG corrects its gap with it after clipping
+    points, and recomputes the gap with ``displacement`` before it stops.
     ``precondition`` approximates the inverse of ``displacement`` (a stiffness),
     and may be rough: it only speeds the CG up. ``point_stiffness`` is the
     pressure on one point per unit of its own displacement (the inverse of the
@@ -69,6 +72,8 @@ class ElasticOperator(Protocol):
     point_stiffness: float
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray: ...
+
+    def displacement_estimate(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray: ...
 
     def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray: ...
 
@@ -92,6 +97,8 @@ class PeriodicHalfSpace:
         self.compliance = np.zeros(q.shape)
         np.divide(2.0, q, out=self.compliance, where=q > 0)
         self.stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
+        self.stiffness32 = self.stiffness.astype(np.float32)
+        self.compliance32 = self.compliance.astype(np.float32)
         self.spectrum = np.empty(q.shape, dtype=complex)
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
 
@@ -101,9 +108,16 @@ class PeriodicHalfSpace:
         """Zero-mean surface displacement under ``pressure``, written into ``out``."""
         return self._apply(self.compliance, pressure, out)
 
+    def displacement_estimate(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """``displacement`` in single precision (rounding 6e-8 relative), for the
+        corrections the CG recomputes exactly before it stops."""
+        return self._apply_single(self.compliance32, pressure, out)
+
     def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """The stiffness ``|q| / 2`` applied to ``residual``."""
-        return self._apply(self.stiffness, residual, out)
+        """The stiffness ``|q| / 2`` applied to ``residual``, in single precision:
+        a preconditioner need only be close to the inverse (its rounding changes no
+        stop and no step's exactness)."""
+        return self._apply_single(self.stiffness32, residual, out)
 
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
         """The zero-mean pressure that makes ``displacement`` (exact inverse, zero mean)."""
@@ -113,6 +127,15 @@ class PeriodicHalfSpace:
         spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
         spectrum *= kernel
         np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
+        return out
+
+    def _apply_single(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """``_apply`` in float32 with ``scipy.fft``: about half the time of a float64 pair."""
+        import scipy.fft
+
+        spectrum = scipy.fft.rfftn(field.astype(np.float32), axes=self.axes, workers=1)
+        spectrum *= kernel
+        out[...] = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=1, overwrite_x=True)
         return out
 
 
