@@ -124,10 +124,10 @@ class BEMHalfSpaceFree(PeriodicBEM):
     problem: ClassVar[str] = "elastic half-space"
     indentation_reference: ClassVar[str] = "undeformed body"
     periodic_only: ClassVar[bool] = False
-    # measured 304 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
+    # measured 315 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
     # the CG's grids, the padded pressure, response and their spectra, four times the scan's
     # points each, and the preconditioner's periodic kernels), plus 20 %
-    bytes_per_point: ClassVar[int | None] = 365
+    bytes_per_point: ClassVar[int | None] = 378
 
     def solve(self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray) -> ContactCurve:
         """Every load of the sweep on the scan as it is (a periodic profile is pressed as one
