@@ -1,8 +1,8 @@
 """Writing files safely: every file frictionlab writes goes through ``atomic_write``,
 so a reader never sees half a file and an interrupted write leaves the previous
-version intact, and it never renames over what is not a regular file (a symlink is
-written through, a character device or FIFO is written into, a folder, socket or block
-device is refused); ``output_path_problem`` says why a path cannot be an output folder;
+version intact, and it never writes through a symbolic link (the link is replaced);
+a character device or FIFO the user named as an output is written into, a folder,
+socket or block device is refused; ``output_path_problem`` says why a path cannot be an output folder;
 ``check_output_file`` refuses an existing output file unless ``--force``;
 ``write_npz`` writes arrays compressed where compressing them pays."""
 
@@ -35,24 +35,26 @@ def _read_umask() -> int:
 _UMASK = _read_umask()
 
 
-def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
+def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False, *, devices: bool = False) -> None:
     """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
     The file gets the usual permissions (0666 less the umask), not mkstemp's 0600.
 
-    Only a regular file is ever replaced: a symlink is followed (the file it points at
-    is replaced, the link stays); a character device (/dev/null) or a FIFO is written
-    into, as any program writing there would (renaming over it would destroy the node:
-    as root, /dev/null itself); a folder, socket or block device is refused (an
-    OSError naming the path: "is a folder, not a file")."""
+    Nothing is ever written through a symbolic link: a link at ``path`` is replaced by
+    the new file, and the file it pointed at is left as it was (a run folder, or a
+    tampered copy of one, cannot make frictionlab write outside it). ``devices``: for an
+    output path the user named (``--markdown``), a character device (/dev/null) or a
+    FIFO, or a link to one (/dev/stdout), is written into, as any program writing there
+    would (renaming over it would destroy the node: as root, /dev/null itself); without
+    it (the files of a run folder) such a node is replaced like any file. A folder,
+    socket or block device is refused (an OSError naming the path: "is a folder, not a
+    file")."""
     path = Path(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))  # a dangling link: the file it names is created
-    kind = _kind(path)
-    if kind in ("character device", "FIFO"):
+    if devices and _kind(path) in ("character device", "FIFO"):
         with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
         return
-    if kind is not None and kind != "file":  # an OSError, as renaming over it was: callers say "cannot write"
+    kind = _kind(path, follow_links=False)
+    if kind in ("folder", "socket", "block device"):  # an OSError, as renaming over it was: callers say "cannot write"
         error = IsADirectoryError if kind == "folder" else OSError
         raise error(errno.EISDIR if kind == "folder" else errno.EINVAL, f"is a {kind}, not a file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -63,20 +65,21 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        os.replace(tmp, path)  # renames over a link itself, never its target
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
 
 
 _KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
-          stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device"}  # fmt: skip
+          stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device", stat.S_IFLNK: "symbolic link"}  # fmt: skip
 
 
-def _kind(path: Path) -> str | None:
-    """What is at ``path`` (links followed): "file", "folder", "FIFO"..., None if nothing."""
+def _kind(path: Path, follow_links: bool = True) -> str | None:
+    """What is at ``path`` (links followed unless ``follow_links`` is False: then a
+    link is "symbolic link"): "file", "folder", "FIFO"..., None if nothing."""
     try:
-        mode = os.stat(path).st_mode
+        mode = os.stat(path, follow_symlinks=follow_links).st_mode
     except (FileNotFoundError, NotADirectoryError):
         return None
     return _KINDS.get(stat.S_IFMT(mode), "special file")
@@ -85,8 +88,9 @@ def _kind(path: Path) -> str | None:
 def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
     """``path`` as a file a command may write (``option`` names it in messages):
     OutputRefused for a folder (or a name ending in /), a path under a file, a
-    socket or block device, and an existing file unless ``force``. A character
-    device or FIFO is accepted (written into, see ``atomic_write``)."""
+    socket or block device, and an existing file or a symbolic link unless ``force``
+    (which replaces the link, never the file it points at). A character device or
+    FIFO, or a link to one (/dev/stdout), is accepted (written into, see ``atomic_write``)."""
     text = os.fsdecode(path)
     path = Path(path)
     kind = _kind(path)
@@ -97,6 +101,11 @@ def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
         raise OutputRefused(f"{option} {path}: {problem}")
     if kind in ("socket", "block device", "special file"):
         raise OutputRefused(f"{option} {path} is a {kind}, not a file: give a file to write to")
+    if path.is_symlink() and kind not in ("character device", "FIFO") and not force:
+        raise OutputRefused(
+            f"{option} {path} is a symbolic link: give another file, or --force to replace the link "
+            "(the file it points at is never written)"
+        )
     if kind == "file" and not force:
         raise OutputRefused(f"{option} {path} exists: give another file, or --force to replace it")
     return path

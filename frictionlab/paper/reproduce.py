@@ -89,6 +89,6 @@ def write_report(
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
-    atomic_write(markdown_path, lambda fh: fh.write(text))
+    atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
     log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path
