@@ -1,0 +1,297 @@
+"""A run folder is untrusted input: load(), predict --from, resume, sweeps and the TUI's
+list read only regular files inside it, never through a link, never a FIFO; every
+damaged value ends in a frictionlab error naming the file, never a Python exception
+and never a line of a file outside the folder; nothing is written through a link."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import threading
+from pathlib import Path
+
+import pytest
+
+import frictionlab
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
+from frictionlab.tui.folders import list_runs
+
+from .conftest import SMALL_PRESET, merge
+from .test_resume import NO_PLOT
+
+SECRET = "SECRET-LINE-OF-AN-OUTSIDE-FILE"
+QUICK = merge(SMALL_PRESET, {**NO_PLOT, "realizations": 4, "fit": {"bootstrap": 0}})
+PREDICT = ["predict", "--area", "1e10", "--modulus", "1", "--rms-height", "1e4", "--force", "5"]
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("finished") / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    return folder
+
+
+@pytest.fixture
+def run_copy(finished, tmp_path) -> Path:
+    copy = tmp_path / "run"
+    shutil.copytree(finished, copy)
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    for name in ("curve.csv", "summary.json", "secret.txt"):
+        (outside / name).write_text(f"{SECRET}\n{SECRET},1,2\n")
+    return copy
+
+
+def with_timeout(call, seconds: float = 20.0):
+    """``call()``'s exception (None if it returned): a read that blocks fails the test."""
+    box = []
+
+    def target():
+        try:
+            call()
+            box.append(None)
+        except BaseException as exc:  # noqa: BLE001 - the test inspects it
+            box.append(exc)
+
+    thread = threading.Thread(target=target, daemon=True)
+    thread.start()
+    thread.join(seconds)
+    assert box, f"blocked for more than {seconds} s"
+    return box[0]
+
+
+def edit_summary(folder: Path, change) -> None:
+    data = json.loads((folder / "summary.json").read_text())
+    change(data)
+    (folder / "summary.json").write_text(json.dumps(data))
+
+
+def set_in(data: dict, dotted: str, value) -> None:
+    *parents, last = dotted.split(".")
+    for key in parents:
+        data = data[key]
+    data[last] = value
+
+
+def link(path: Path, target: Path) -> None:
+    path.unlink()
+    path.symlink_to(target)
+
+
+def link_to_a_copy(path: Path) -> None:  # even a link to a file inside the folder is refused
+    shutil.copy(path, path.with_name("copy"))
+    link(path, path.with_name("copy"))
+
+
+def fifo(path: Path) -> None:
+    path.unlink()
+    os.mkfifo(path)
+
+
+# ------------------------------------------------------------------ each kind of hostile folder
+
+HOSTILE = {
+    # reads that would leave the folder
+    "curve entry ../": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", "../elsewhere/curve.csv")),
+    "curve entry absolute": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", str(f.parent / "elsewhere/curve.csv"))),
+    "curve entry a/../../": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", "x/../../elsewhere/curve.csv")),
+    "curve entry not a str": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", 5)),
+    "curve.csv a link out": lambda f: link(f / "curve.csv", f.parent / "elsewhere" / "curve.csv"),
+    "curve.csv a link in": lambda f: link_to_a_copy(f / "curve.csv"),
+    "summary.json a link out": lambda f: link(f / "summary.json", f.parent / "elsewhere" / "summary.json"),
+    "summary.json a dangling link": lambda f: link(f / "summary.json", f.parent / "nothing"),
+    "summary.json a FIFO": lambda f: fifo(f / "summary.json"),
+    "curve.csv a FIFO": lambda f: fifo(f / "curve.csv"),
+    "summary.json a folder": lambda f: (f / "summary.json").unlink() or (f / "summary.json").mkdir(),
+    # JSON of the wrong shape
+    "summary a list": lambda f: (f / "summary.json").write_text("[1, 2]"),
+    "summary not JSON": lambda f: (f / "summary.json").write_bytes(b"\xff\xfe{"),
+    "summary nested deep": lambda f: (f / "summary.json").write_text("[" * 50_000 + "]" * 50_000),
+    "no realizations": lambda f: edit_summary(f, lambda d: d.pop("realizations")),
+    "no preset name": lambda f: edit_summary(f, lambda d: d["preset"].pop("name")),
+    "preset a list": lambda f: edit_summary(f, lambda d: set_in(d, "preset", [1])),
+    "fit.a a string": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a", "0.5")),
+    "fit.b NaN": lambda f: (f / "summary.json").write_text((f / "summary.json").read_text().replace('"b": ', '"b": NaN, "_b": ', 1)),
+    "fit.r2 Infinity": lambda f: edit_summary(f, lambda d: set_in(d, "fit.r2", float("inf"))),
+    "fit a number": lambda f: edit_summary(f, lambda d: set_in(d, "fit", 3)),
+    "done a float": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 2.5)),
+    "done negative": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", -1)),
+    "done true": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", True)),
+    "status unknown": lambda f: edit_summary(f, lambda d: set_in(d, "status", SECRET)),
+    "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
+    "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
+    "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
+    # CSV that is not frictionlab's
+    "curve binary": lambda f: (f / "curve.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00" + os.urandom(64)),
+    "curve NUL": lambda f: (f / "curve.csv").write_bytes((f / "curve.csv").read_bytes() + b"\x00\n"),
+    "curve non-numeric cell": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text().replace("\n", f"\n{SECRET},", 1).replace(",", "", 1)),
+    "curve ragged row": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "1,2\n"),
+    "curve inf cell": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "inf,1,1,1,1,1,1\n"),
+    "curve empty": lambda f: (f / "curve.csv").write_text(""),
+    "curve missing": lambda f: (f / "curve.csv").unlink(),
+    "curve huge": lambda f: (f / "curve.csv").write_bytes(b"1" * (17 * 1024 * 1024)),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_load_refuses_each_kind_of_hostile_folder_naming_the_file(run_copy, case):
+    HOSTILE[case](run_copy)
+    raised = with_timeout(lambda: frictionlab.load(run_copy))
+    assert isinstance(raised, RunFolderError), f"{case}: {type(raised).__name__}: {raised}"
+    message = str(raised)
+    assert "summary.json" in message or "curve.csv" in message, message
+    assert SECRET not in message, message
+
+
+@pytest.mark.parametrize("case", ["summary.json a link out", "summary.json a FIFO", "fit.a a string", "fit.b NaN",
+                                  "future schema", "summary a list", "status unknown"])  # fmt: skip
+def test_predict_from_a_hostile_folder_exits_5(run_copy, case, capsys):
+    HOSTILE[case](run_copy)
+    codes = []
+    assert with_timeout(lambda: codes.append(main([*PREDICT, "--from", str(run_copy)]))) is None
+    err = capsys.readouterr().err
+    assert codes == [ExitCode.RUN_FOLDER] and "summary.json" in err and SECRET not in err, err
+
+
+def test_a_future_schema_is_refused_naming_its_version(run_copy):
+    edit_summary(run_copy, lambda d: set_in(d, "schema_version", 99))
+    with pytest.raises(RunFolderError, match=r"newer frictionlab \(schema_version 99; this one reads up to 2\)"):
+        frictionlab.load(run_copy)
+
+
+def test_a_link_out_of_the_folder_is_named_as_a_link(run_copy):
+    link(run_copy / "curve.csv", run_copy.parent / "elsewhere" / "curve.csv")
+    with pytest.raises(RunFolderError, match=r"curve.csv: curve.csv is a symbolic link, which is never followed"):
+        frictionlab.load(run_copy)
+
+
+def test_an_intact_copy_loads_the_same_numbers(run_copy, finished):
+    assert frictionlab.load(run_copy).fit == frictionlab.load(finished).fit
+
+
+# ------------------------------------------------------------------ sweeps and the TUI's list
+
+
+def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    assert len(frictionlab.load(folder).points) == 2
+    data = json.loads((folder / "sweep.json").read_text())
+    data["points"][0]["folder"] = "../../elsewhere"
+    (folder / "sweep.json").write_text(json.dumps(data))
+    with pytest.raises(RunFolderError, match=r"sweep.json is damaged: field 'points.0.folder'"):
+        frictionlab.load(folder)
+    data["points"][0]["folder"] = "points/" + sorted(p.name for p in (folder / "points").iterdir())[0]
+    (folder / "sweep.json").write_text(json.dumps(data))
+    points = folder / "points"
+    shutil.move(points, tmp_path / "moved")
+    points.symlink_to(tmp_path / "moved")  # the point folders now lie outside, through a link
+    with pytest.raises(RunFolderError, match=r"points is a symbolic link or not a folder"):
+        frictionlab.load(folder).points
+    data["schema_version"] = 7
+    (folder / "sweep.json").write_text(json.dumps(data))
+    with pytest.raises(RunFolderError, match=r"schema_version 7"):
+        frictionlab.load(folder)
+
+
+def test_the_tui_list_skips_fifos_and_links_without_blocking(run_copy, tmp_path):
+    runs = run_copy.parent
+    for name, damage in (("fifo", "summary.json a FIFO"), ("linked", "summary.json a link out")):
+        shutil.copytree(run_copy, runs / name)
+        HOSTILE[damage](runs / name)
+    listed = []
+    assert with_timeout(lambda: listed.extend(list_runs(runs))) is None
+    assert [entry.path.name for entry in listed] == ["run"]
+
+
+# ------------------------------------------------------------------ resume
+
+
+def test_resume_never_reads_a_chunk_through_a_link(tmp_path):
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(merge(QUICK, {"realizations": 8})))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OK
+    expected = frictionlab.load(folder).fit
+    (chunk,) = (folder / "chunks").iterdir()
+    outside = tmp_path / "outside.npz"
+    shutil.copy(chunk, outside)  # the very bytes: its checksum matches the manifest's
+    chunk.unlink()
+    chunk.symlink_to(outside)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest["status"] = "interrupted"
+    (folder / "run.json").write_text(json.dumps(manifest))
+    with pytest.warns(UserWarning, match=r"1 chunk file\(s\) failed verification \(1 file is a symbolic link"):
+        assert main(["resume", str(folder), "--quiet"]) == ExitCode.OK
+    assert frictionlab.load(folder).fit == expected  # recomputed, bitwise
+
+
+@pytest.mark.parametrize("damage", ["chunks a link", "run.json a link", "run.lock a link", "future manifest"])
+def test_resume_refuses_a_folder_whose_own_files_are_links(tmp_path, capsys, damage):
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OK
+    user = tmp_path / "user"
+    user.mkdir()
+    (user / "notes.txt").write_text(SECRET)
+    if damage == "chunks a link":
+        shutil.move(folder / "chunks", user / "chunks")
+        (folder / "chunks").symlink_to(user / "chunks")
+    elif damage == "run.json a link":
+        shutil.move(folder / "run.json", user / "run.json")
+        (folder / "run.json").symlink_to(user / "run.json")
+    elif damage == "run.lock a link":
+        (folder / "run.lock").symlink_to(user / "notes.txt")
+    else:
+        manifest = json.loads((folder / "run.json").read_text())
+        (folder / "run.json").write_text(json.dumps({**manifest, "format": 9}))
+    before = {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()}
+    assert main(["resume", str(folder), "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert SECRET not in err and "Traceback" not in err
+    assert {"chunks a link": "chunks is not a folder", "run.json a link": "run.json: manifest is a symbolic link",
+            "run.lock a link": "run.lock is not a regular file", "future manifest": "format 9"}[damage] in err  # fmt: skip
+    assert {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()} == before
+
+
+# ------------------------------------------------------------------ writing
+
+
+def test_a_summary_that_is_a_link_to_a_user_file_is_replaced_not_written_through(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    user = tmp_path / "thesis.tex"
+    user.write_text(SECRET)
+    for name in ("summary.json", "curve.csv", "preset.yaml"):
+        (folder / name).unlink()
+        (folder / name).symlink_to(user)
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)  # the same preset: rerun in place
+    assert user.read_text() == SECRET
+    assert not any((folder / name).is_symlink() for name in ("summary.json", "curve.csv", "preset.yaml"))
+    assert frictionlab.load(folder).status == "completed"
+
+
+def test_an_output_file_that_is_a_link_needs_force_and_then_replaces_the_link(tmp_path, capsys):
+    user = tmp_path / "user.json"
+    user.write_text(SECRET)
+    out = tmp_path / "schema.json"
+    out.symlink_to(user)
+    assert main(["schema", "--out", str(out)]) == ExitCode.OUTPUT_REFUSED
+    assert "is a symbolic link" in capsys.readouterr().err
+    assert main(["schema", "--out", str(out), "--force"]) == ExitCode.OK
+    assert user.read_text() == SECRET and not out.is_symlink() and json.loads(out.read_text())
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "q.yaml")]) == ExitCode.OK
+    (tmp_path / "q.yaml").unlink()
+    (tmp_path / "q.yaml").symlink_to(user)
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "q.yaml"), "--force"]) == ExitCode.OK
+    assert user.read_text() == SECRET and not (tmp_path / "q.yaml").is_symlink()
+
+
+def test_no_python_exception_reaches_the_user_from_load(tmp_path):
+    for argument in (None, 3, b"", "", "a\0b", tmp_path / "missing", [tmp_path]):
+        raised = with_timeout(lambda argument=argument: frictionlab.load(argument))
+        assert isinstance(raised, FrictionlabError), (argument, raised)
