@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import OutputRefused
+from .errors import OutputRefused, shown
 
 _SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
 _WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size
@@ -112,16 +112,29 @@ def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
 
 
 def output_path_problem(path: Path) -> str | None:
-    """Why ``path`` cannot be (or become) a folder: it, or the nearest existing
-    folder above it, is a file."""
+    """Why ``path`` cannot be (or become) a folder to write in: it, or the nearest
+    existing folder above it, is a file, or files cannot be created in it (read-only,
+    no permission: tried, so that long work does not start only to fail at its end)."""
     path = Path(path)
     for candidate in (path, *path.parents):
         if candidate.exists() or candidate.is_symlink():
             if candidate.is_dir():
-                return None
+                return _unwritable(candidate, path)
             if candidate == path:
-                return f"{path} is a file, not a folder"
-            return f"{path} cannot be made a folder: {candidate} is a file"
+                return f"{shown(path)} is a file, not a folder"
+            return f"{shown(path)} cannot be made a folder: {shown(candidate)} is a file"
+    return None
+
+
+def _unwritable(folder: Path, asked: Path) -> str | None:
+    """Why no file can be created in ``folder`` (where ``asked`` is, or would be made), or None."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".frictionlab-write-check-", dir=folder)
+    except OSError as exc:
+        where = "" if folder == asked else f" (it would be made in {shown(folder)})"
+        return f"{shown(asked)} cannot be written in{where}: {exc.strerror or type(exc).__name__}"
+    os.close(fd)
+    os.unlink(probe)
     return None
 
 

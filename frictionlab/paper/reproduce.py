@@ -32,6 +32,9 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         problem = output_path_problem(Path(folder)) if folder else None
         if problem:
             raise OutputRefused(f"{option}: {problem}; give a folder")
+    problem = output_path_problem(Path(markdown_path).parent) if markdown_path else None
+    if problem:
+        raise OutputRefused(f"--markdown: {problem}; give a file in a folder you can write to")
     if markdown_path and Path(markdown_path).is_dir():
         raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
