@@ -341,7 +341,7 @@ def load(folder: str | Path) -> Result | SweepResult:
     if not os.path.lexists(folder / "summary.json") and os.path.lexists(folder / "sweep.json"):
         return _load_sweep(folder)
     if not os.path.lexists(folder / "summary.json"):
-        where = "" if folder.is_dir() else " (no such folder)"
+        where = "" if folder.is_dir() else " (not a folder)" if os.path.lexists(folder) else " (no such folder)"
         raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
     summary, record = read_summary(folder)
     curve = read_curve(folder, record.files.get("curve", "curve.csv"))

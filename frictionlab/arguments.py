@@ -71,8 +71,8 @@ def overrides_argument(value) -> dict:
     for key in value:
         if not isinstance(key, str):
             raise FrictionlabError(
-                f"overrides must be a mapping of dotted keys to values: key {short_repr(key, 40)} is a "
-                f"{type(key).__name__}, not a str"
+                f"overrides must be a mapping of dotted keys to values: key {short_repr(key, 40)} is of type "
+                f"{type(key).__name__}, not str"
             )
     data_argument(value, "overrides")
     return dict(value)

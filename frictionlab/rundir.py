@@ -41,12 +41,12 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
 from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
 from .realization import RealizationResult
-from .runfolder import check_schema_version, read_json_object, read_member
+from .runfolder import check_schema_version, json_kind, read_json_object, read_member
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 CHUNK_DIR = "chunks"
@@ -186,8 +186,10 @@ class RunDirectory:
         check_schema_version(state, path, MANIFEST_FORMAT, key="format")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
-            if value is not None and not (isinstance(value, kind) and _well_formed(key, value)):
-                raise RunFolderError(f"{path} is damaged ({key} is not {what}: {short_repr(value, 60)})")
+            if value is not None and not isinstance(value, kind):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}, but {json_kind(value)})")
+            if value is not None and not _well_formed(key, value):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}: an entry is not a string)")
         return state
 
     def _write_manifest(self) -> None:

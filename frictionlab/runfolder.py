@@ -124,6 +124,14 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     return data
 
 
+_JSON_KINDS = {dict: "an object", list: "an array", str: "a string", int: "a number", float: "a number", bool: "true or false"}
+
+
+def json_kind(value) -> str:
+    """What a JSON value is, in JSON's words (a message names the kind, never the value)."""
+    return "null" if value is None else _JSON_KINDS.get(type(value), type(value).__name__)
+
+
 def read_json_object(path: Path, limit: int, what: str) -> dict:
     """A run folder's JSON file (``what`` it is, at most ``limit`` bytes, never through a
     link) as a mapping: RunFolderError naming the file if it is not JSON, or not a JSON

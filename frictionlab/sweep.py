@@ -391,12 +391,12 @@ class _SweepSpecRecord(Record):
 class SweepRecord(Record):
     """What load(), resume and the TUI trust of a sweep.json: each value checked."""
 
+    sweep: _SweepSpecRecord  # first: what a resume needs, named first when missing
+    base_preset: dict[str, Any]
     schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
     name: Annotated[str, Field(min_length=1)]
     status: str
     elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
-    sweep: _SweepSpecRecord
-    base_preset: dict[str, Any]
     points: list[_PointRecord]
 
 

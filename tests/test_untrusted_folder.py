@@ -229,8 +229,33 @@ def test_resume_never_reads_a_chunk_through_a_link(tmp_path):
     assert frictionlab.load(folder).fit == expected  # recomputed, bitwise
 
 
-@pytest.mark.parametrize("damage", ["chunks a link", "run.json a link", "run.lock a link", "future manifest"])
-def test_resume_refuses_a_folder_whose_own_files_are_links(tmp_path, capsys, damage):
+def _move_out(folder: Path, name: str, user: Path) -> None:
+    shutil.move(folder / name, user / name)
+    (folder / name).symlink_to(user / name)
+
+
+RESUME_REFUSALS = {  # damage -> what the message says
+    "chunks a link": (lambda f, u: _move_out(f, "chunks", u), "chunks is not a folder"),
+    "run.json a link": (lambda f, u: _move_out(f, "run.json", u), "run.json: manifest is a symbolic link"),
+    "run.json a FIFO": (lambda f, u: fifo(f / "run.json"), "run.json: manifest is a FIFO"),
+    "preset.yaml a link": (lambda f, u: link(f / "preset.yaml", u / "notes.txt"), "preset file is a symbolic link"),
+    "preset.yaml a FIFO": (lambda f, u: fifo(f / "preset.yaml"), "preset file is a FIFO"),
+    "run.lock a link": (lambda f, u: (f / "run.lock").symlink_to(u / "notes.txt"), "run.lock is not a regular file"),
+    "run.lock a FIFO": (lambda f, u: os.mkfifo(f / "run.lock"), "run.lock is not a regular file"),
+    "future manifest": (lambda f, u: _edit_manifest(f, format=9), "format 9; this one reads up to 2"),
+    "status NaN": (lambda f, u: (f / "run.json").write_text('{"status": NaN}'), "status is not a word, but a number"),
+    "status the secret": (lambda f, u: _edit_manifest(f, status=[SECRET]), "status is not a word, but an array"),
+    "chunks a list": (lambda f, u: _edit_manifest(f, chunks=[SECRET]), "chunks is not a mapping"),
+}
+
+
+def _edit_manifest(folder: Path, **changes) -> None:
+    manifest = json.loads((folder / "run.json").read_text())
+    (folder / "run.json").write_text(json.dumps({**manifest, **changes}))
+
+
+@pytest.mark.parametrize("damage", sorted(RESUME_REFUSALS))
+def test_resume_refuses_a_folder_whose_own_files_are_links_fifos_or_damaged(tmp_path, capsys, damage):
     folder = tmp_path / "run"
     preset = tmp_path / "p.yaml"
     preset.write_text(json.dumps(QUICK))
@@ -238,24 +263,27 @@ def test_resume_refuses_a_folder_whose_own_files_are_links(tmp_path, capsys, dam
     user = tmp_path / "user"
     user.mkdir()
     (user / "notes.txt").write_text(SECRET)
-    if damage == "chunks a link":
-        shutil.move(folder / "chunks", user / "chunks")
-        (folder / "chunks").symlink_to(user / "chunks")
-    elif damage == "run.json a link":
-        shutil.move(folder / "run.json", user / "run.json")
-        (folder / "run.json").symlink_to(user / "run.json")
-    elif damage == "run.lock a link":
-        (folder / "run.lock").symlink_to(user / "notes.txt")
-    else:
-        manifest = json.loads((folder / "run.json").read_text())
-        (folder / "run.json").write_text(json.dumps({**manifest, "format": 9}))
+    make, said = RESUME_REFUSALS[damage]
+    make(folder, user)
     before = {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()}
-    assert main(["resume", str(folder), "--quiet"]) == ExitCode.RUN_FOLDER
+    codes = []
+    assert with_timeout(lambda: codes.append(main(["resume", str(folder), "--quiet"]))) is None
     err = capsys.readouterr().err
+    assert codes == [ExitCode.RUN_FOLDER] and said in err, err
     assert SECRET not in err and "Traceback" not in err
-    assert {"chunks a link": "chunks is not a folder", "run.json a link": "run.json: manifest is a symbolic link",
-            "run.lock a link": "run.lock is not a regular file", "future manifest": "format 9"}[damage] in err  # fmt: skip
     assert {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()} == before
+
+
+def test_resume_recomputes_a_chunk_that_is_a_fifo_without_blocking(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    expected = frictionlab.load(folder).fit
+    (chunk,) = (folder / "chunks").iterdir()
+    fifo(chunk)
+    with pytest.warns(UserWarning, match=r"1 file is a FIFO \(named pipe\), not a regular file"):
+        assert with_timeout(lambda: frictionlab.run(QUICK, out=folder, resume=True, workers=1, progress=False,
+                                                    plot=False)) is None  # fmt: skip
+    assert frictionlab.load(folder).fit == expected
 
 
 # ------------------------------------------------------------------ writing
