@@ -251,7 +251,11 @@ def run(
 
     A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
     point) and returns a ``SweepResult``. Bad input raises a
-    ``frictionlab.errors.FrictionlabError`` naming the field.
+    ``frictionlab.errors.FrictionlabError`` naming the field, or the argument
+    (``overrides must be a mapping of dotted keys to values, got int``); a dict (the
+    preset, the overrides) is held to a preset file's limits: 64 levels of nesting,
+    20,000 values. A built-in preset is named as the command line names it
+    (``built-in preset 'quickstart'``).
     """
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
