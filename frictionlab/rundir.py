@@ -41,7 +41,7 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
 from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
@@ -152,9 +152,9 @@ class RunDirectory:
         try:
             self._lock.acquire()
         except Timeout:
-            try:
-                holder = lock.read_text(errors="replace").strip()[:200] or "unknown"
-            except OSError:
+            try:  # what _write_holder wrote: a line, escaped as any text from a folder is
+                holder = shown(read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]) or "unknown"
+            except (OSError, InputFileProblem):
                 holder = "unknown"
             raise RunFolderError(
                 f"{self.path} is in use by another run ({holder}): wait for it to end, "
@@ -275,9 +275,9 @@ class RunDirectory:
         if state is None:
             others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
             if others:
-                shown = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
+                listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputRefused(
-                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {shown}): "
+                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {listed}): "
                     f"{hint} (frictionlab then replaces only the files it writes and deletes none)"
                 )
             return

@@ -323,3 +323,13 @@ def test_no_python_exception_reaches_the_user_from_load(tmp_path):
     for argument in (None, 3, b"", "", "a\0b", tmp_path / "missing", [tmp_path]):
         raised = with_timeout(lambda argument=argument: frictionlab.load(argument))
         assert isinstance(raised, FrictionlabError), (argument, raised)
+
+
+def test_the_tui_preset_list_shows_a_fifo_as_unreadable_without_blocking(tmp_path):
+    from frictionlab.tui.folders import list_presets
+
+    (tmp_path / "good.yaml").write_text("name: good\ndescription: a preset\n")
+    os.mkfifo(tmp_path / "pipe.yaml")
+    listed = []
+    assert with_timeout(lambda: listed.extend(list_presets([("presets", tmp_path)]))) is None
+    assert [(e.name, bool(e.error)) for e in listed] == [("good", False), ("pipe", True)]

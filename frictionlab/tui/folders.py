@@ -18,7 +18,9 @@ import yaml
 
 from ..errors import FrictionlabError
 from ..files import atomic_write
+from ..inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
+from ..preset.reading import MAX_PRESET_BYTES
 from ..preset.builtin import builtin_folder, builtin_presets
 from ..runfolder import read_json, subfolder
 from ..safe_yaml import load_yaml
@@ -92,8 +94,8 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
         if not folder.is_dir():
             continue
         for path in sorted(folder.glob("*.y*ml")):
-            try:  # read as a preset is: bounded, so that a hostile file cannot stop the listing
-                data = load_yaml(path.read_text(encoding="utf-8"))
+            try:  # read as a preset is: bounded, a regular file, so that a hostile file (a FIFO) cannot stop the listing
+                data = load_yaml(read_regular_file(path, MAX_PRESET_BYTES, "preset file").decode("utf-8"))
             except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
                 entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
                 continue
