@@ -348,7 +348,15 @@ def load(folder: str | Path) -> Result | SweepResult:
         where = "" if folder.is_dir() else " (not a folder)" if os.path.lexists(folder) else " (no such folder)"
         raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
     summary, record = read_summary(folder)
-    curve = read_curve(folder, record.files.get("curve", "curve.csv"))
+    curve_name = record.files.get("curve", "curve.csv")
+    curve = read_curve(folder, curve_name)
+    loading = summary["preset"].get("loading")
+    steps = loading.get("steps") if isinstance(loading, dict) else None
+    rows = len(next(iter(curve.values())))
+    if isinstance(steps, int) and not isinstance(steps, bool) and rows != steps:
+        raise RunFolderError(
+            f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
+        )
     return Result(
         name=record.preset.name,
         status=record.status,

@@ -32,7 +32,9 @@ from .errors import RunError, RunFolderError, shown
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
-from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
+from .runfolder import (
+    MAX_CSV_BYTES, Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table,
+)
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
 CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
@@ -99,11 +101,11 @@ def column_name(header: str) -> str:
     return header.split(" [", 1)[0]
 
 
-def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
+def read_curve(folder: Path, name: str = "curve.csv", limit: int = MAX_CSV_BYTES) -> dict[str, np.ndarray]:
     """A run folder's curve.csv read back (``runfolder``: inside the folder, never
     through a link): each column by its short name (``column_name``), empty cells as
     NaN. RunFolderError naming the file for anything but the table frictionlab writes."""
-    header, rows = read_number_table(folder, name)
+    header, rows = read_number_table(folder, name, limit)
     names = [column_name(h) for h in header]
     if [n.rstrip("'") for n in names] != list(CURVE_COLUMNS):  # F' on the half-plane
         raise RunFolderError(
@@ -170,7 +172,18 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
     path = Path(folder) / "summary.json"
     data = read_json(folder, "summary.json")
     check_schema_version(data, path, SUMMARY_SCHEMA_VERSION)
-    return data, checked(SummaryRecord, data, path)
+    record = checked(SummaryRecord, data, path)
+    counts = record.realizations
+    problem = None
+    if counts.done > counts.requested:
+        problem = "field 'realizations.done' is more than 'realizations.requested'"
+    elif record.fit is not None and not counts.done:
+        problem = "field 'fit' holds a fit, but no realization was done"
+    elif record.fit is None and counts.done and record.status != "failed":
+        problem = "field 'fit' is null, but realizations were done and the run did not fail"
+    if problem:
+        raise RunFolderError(f"{shown(path)} is damaged: {problem}")
+    return data, record
 
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:

@@ -123,6 +123,11 @@ HOSTILE = {
     "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
     "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
     "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
+    # values of the right kind that contradict each other: no silent wrong or empty fit
+    "fit null though done": lambda f: edit_summary(f, lambda d: set_in(d, "fit", None)),
+    "fit though none done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 0)),
+    "done above requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 99)),
+    "curve short a row": lambda f: (f / "curve.csv").write_text("".join((f / "curve.csv").read_text().splitlines(True)[:-1])),
     # CSV that is not frictionlab's
     "curve binary": lambda f: (f / "curve.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00" + os.urandom(64)),
     "curve NUL": lambda f: (f / "curve.csv").write_bytes((f / "curve.csv").read_bytes() + b"\x00\n"),
