@@ -49,11 +49,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .arguments import data_argument, flag_argument, overrides_argument, path_argument
 from .errors import FrictionlabError, PresetError, RunFolderError, shown
 from .fit import LogFit
 from .options import RunOptions
 from .results import CURVE_COLUMNS, read_curve, read_summary
-from .arguments import data_argument, flag_argument, overrides_argument, path_argument
 from .runfolder import subfolder
 
 if TYPE_CHECKING:

@@ -32,9 +32,7 @@ from .errors import RunError, RunFolderError, shown
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
-from .runfolder import (
-    MAX_CSV_BYTES, Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table,
-)
+from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
 CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
@@ -101,11 +99,11 @@ def column_name(header: str) -> str:
     return header.split(" [", 1)[0]
 
 
-def read_curve(folder: Path, name: str = "curve.csv", limit: int = MAX_CSV_BYTES) -> dict[str, np.ndarray]:
+def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     """A run folder's curve.csv read back (``runfolder``: inside the folder, never
     through a link): each column by its short name (``column_name``), empty cells as
     NaN. RunFolderError naming the file for anything but the table frictionlab writes."""
-    header, rows = read_number_table(folder, name, limit)
+    header, rows = read_number_table(folder, name)
     names = [column_name(h) for h in header]
     if [n.rstrip("'") for n in names] != list(CURVE_COLUMNS):  # F' on the half-plane
         raise RunFolderError(
@@ -135,7 +133,7 @@ class FitRecord(Record):
     points: Count = 0
 
 
-class Counts(Record):
+class _Counts(Record):
     requested: Count
     done: Count
     failed: Count = 0
@@ -157,7 +155,7 @@ class SummaryRecord(Record):
     status: Literal["completed", "cancelled", "interrupted", "failed"]
     seed: Count | None = None
     fit: FitRecord | None = None
-    realizations: Counts
+    realizations: _Counts
     normalisation: _Normalisation = _Normalisation()
     caveats: list[str] = []
     elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
