@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 import io
 import os
+import re
 import stat
 import tempfile
 import zipfile
@@ -43,13 +44,14 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     the new file, and the file it pointed at is left as it was (a run folder, or a
     tampered copy of one, cannot make frictionlab write outside it). ``devices``: for an
     output path the user named (``--markdown``), a character device (/dev/null) or a
-    FIFO, or a link to one (/dev/stdout), is written into, as any program writing there
-    would (renaming over it would destroy the node: as root, /dev/null itself); without
+    FIFO, or a link to one, and an open stream of this process (/dev/stdout, even
+    redirected to a file) are written into, as any program writing there would
+    (renaming over it would destroy the node: as root, /dev/null itself); without
     it (the files of a run folder) such a node is replaced like any file. A folder,
     socket or block device is refused (an OSError naming the path: "is a folder, not a
     file")."""
     path = Path(path)
-    if devices and _kind(path) in ("character device", "FIFO"):
+    if devices and (_kind(path) in ("character device", "FIFO") or _is_open_stream(path)):
         with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
         return
@@ -69,6 +71,20 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+_OPEN_STREAM = re.compile(r"/(proc/self|dev)/fd/\d+")
+
+
+def _is_open_stream(path: Path) -> bool:
+    """Whether ``path`` names one of this process's open files (/dev/stdout, /dev/fd/1,
+    /proc/self/fd/1, or a link to one): written into, whatever it is redirected to;
+    renaming over /dev/stdout would replace the system's link (as root)."""
+    try:
+        target = os.readlink(path) if path.is_symlink() else str(path)
+    except OSError:
+        return False
+    return bool(_OPEN_STREAM.fullmatch(target)) or str(path) in ("/dev/stdout", "/dev/stderr")
 
 
 _KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
@@ -96,6 +112,8 @@ def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
     kind = _kind(path)
     if kind == "folder" or text.endswith(os.sep):
         raise OutputRefused(f"{option} {text} is a folder: give a file name (e.g. {path / 'name'})")
+    if _is_open_stream(path):  # /dev/stdout: written into, wherever it is redirected
+        return path
     problem = output_path_problem(path.parent)
     if problem:
         raise OutputRefused(f"{option} {path}: {problem}")

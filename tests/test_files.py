@@ -3,6 +3,7 @@
 import io
 import os
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -133,3 +134,19 @@ def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
             atomic_write(sock_path, lambda fh: fh.write("x"))
     assert raised.value.filename == str(sock_path) and raised.value.strerror == "is a socket, not a file"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s", "sdir"] and not any(folder.iterdir())
+
+
+def test_an_open_stream_the_user_named_is_written_into_whatever_it_is_redirected_to(tmp_path):
+    """``--out /dev/stdout > file``: the stream is written into; renaming over the link
+    (as root, /dev/stdout itself) is what must never happen."""
+    from frictionlab.files import check_output_file
+
+    target = tmp_path / "redirected.json"
+    with open(target, "w") as stream:
+        via_proc = Path(f"/proc/self/fd/{stream.fileno()}")
+        link = tmp_path / "stdout"
+        link.symlink_to(via_proc)  # as /dev/stdout -> /proc/self/fd/1
+        assert check_output_file(link, "--out", force=False) == link  # not refused as an existing file
+        atomic_write(link, lambda fh: fh.write("through the stream"), devices=True)
+        assert link.is_symlink() and os.readlink(link) == str(via_proc)
+    assert target.read_text() == "through the stream"
