@@ -40,8 +40,8 @@ same files; ``--no-plot`` is ``plot=False``.
 from __future__ import annotations
 
 import copy
-import json
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,10 +49,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import FrictionlabError, PresetError, RunFolderError
+from .arguments import data_argument, flag_argument, overrides_argument, path_argument
+from .errors import FrictionlabError, PresetError, RunFolderError, shown
 from .fit import LogFit
 from .options import RunOptions
-from .results import CURVE_COLUMNS, read_curve
+from .results import CURVE_COLUMNS, read_curve, read_summary
+from .runfolder import subfolder
 
 if TYPE_CHECKING:
     from .ensemble import RunOutcome
@@ -115,6 +117,8 @@ class Result:
         None, through pyplot, so a notebook shows it); returns the Axes."""
         from .plot import draw_curve
 
+        if ax is not None and not callable(getattr(ax, "errorbar", None)):
+            raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}")
         if ax is None:
             import matplotlib.pyplot as plt
 
@@ -148,7 +152,7 @@ class SweepResult:
     @property
     def points(self) -> list[Result]:
         """Each finished point's ``Result``, read from its folder."""
-        return [load(self.folder / row["folder"]) for row in self.rows if row.get("a") is not None]
+        return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
         """The rows as a pandas DataFrame, or without pandas a dict of numpy arrays by column."""
@@ -171,14 +175,17 @@ def read_preset_input(
     current folder). Forms: a ``Preset``; a dict; a string holding YAML (a newline,
     or a ``{...}`` flow mapping); else a path to a file, or a built-in's name."""
     from .preset import Preset, load_preset_file, set_path
-    from .preset.builtin import resolve_preset_path
+    from .preset.builtin import find_builtin, preset_source, resolve_preset_path
     from .preset.reading import resolve_input_paths
     from .safe_yaml import YamlProblem, load_yaml
 
+    overrides = overrides_argument(overrides)
+    data_argument(keys, "keyword overrides")
     base_dir = None
     if isinstance(preset, Preset):
         data, source = preset.model_dump(mode="json", exclude_none=True), f"<Preset {preset.name}>"
     elif isinstance(preset, Mapping):
+        data_argument(preset, "preset")  # before deepcopy, which recurses
         data, source = copy.deepcopy(dict(preset)), "<dict>"  # never change the caller's dict
     elif isinstance(preset, str) and ("\n" in preset or preset.lstrip().startswith("{")):
         try:
@@ -188,16 +195,22 @@ def read_preset_input(
         if not isinstance(data, dict):
             raise PresetError([f"(text): a preset must be a mapping. Got {type(data).__name__} instead."], "<YAML text>")
         source = "<YAML text>"
-    elif isinstance(preset, str | Path):
-        path = resolve_preset_path(preset)
-        data, source, base_dir = load_preset_file(path), str(path), path.parent
+    elif isinstance(preset, str | os.PathLike):
+        path = resolve_preset_path(path_argument(preset, "preset", "a preset file, or a built-in's name"))
+        # a built-in is named as the CLI names it, not by the installed file the user never touched
+        source = preset_source(preset) if find_builtin(str(preset)) is not None and path != Path(preset) else str(path)
+        try:
+            data = load_preset_file(path)
+        except PresetError as exc:
+            raise type(exc)(exc.problems, source=source) from None
+        base_dir = path.parent
     else:
         raise FrictionlabError(
             f"preset must be a path, a built-in's name, YAML text, a dict or a Preset. Got {type(preset).__name__}."
         )
     if base_dir is not None:
         data = resolve_input_paths(data, base_dir)
-    assignments = {**(overrides or {}), **{key.replace("__", "."): value for key, value in keys.items()}}
+    assignments = {**overrides, **{key.replace("__", "."): value for key, value in keys.items()}}
     problems = []
     for path, value in assignments.items():
         try:
@@ -268,11 +281,21 @@ def run(
 
     A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
     point) and returns a ``SweepResult``. Bad input raises a
-    ``frictionlab.errors.FrictionlabError`` naming the field.
+    ``frictionlab.errors.FrictionlabError`` naming the field, or the argument
+    (``overrides must be a mapping of dotted keys to values, got int``); a dict (the
+    preset, the overrides) is held to a preset file's limits: 64 levels of nesting,
+    20,000 values. A built-in preset is named as the command line names it
+    (``built-in preset 'quickstart'``).
     """
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
 
+    out = None if out is None else path_argument(out, "out", "a folder to write the run into")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise FrictionlabError(f"scheduler must be a Dask scheduler's address (a str), got {type(scheduler).__name__}")
+    for name, value in (("resume", resume), ("force", force), ("plot", plot), ("progress", progress),
+                        ("memory_check", memory_check)):  # fmt: skip
+        flag_argument(value, name)
     data, source, _ = read_preset_input(preset, overrides, **keys)
     scene = build_scene(data, source=source)
     options = RunOptions(
@@ -344,45 +367,48 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
 def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers
-    to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. A folder
-    with neither is a ``RunFolderError``."""
-    folder = Path(folder)
-    if not (folder / "summary.json").exists() and (folder / "sweep.json").exists():
+    to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. The folder is
+    read as untrusted input (``frictionlab.runfolder``: only regular files inside it,
+    never through a link, every value checked): any problem, a folder with neither
+    file too, is a ``RunFolderError`` naming the file and what is wrong."""
+    folder = path_argument(folder, "folder", "a run folder")
+    if not os.path.lexists(folder / "summary.json") and os.path.lexists(folder / "sweep.json"):
         return _load_sweep(folder)
-    try:
-        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RunFolderError(f"{folder}: no summary.json (nor sweep.json): not a finished run") from None
-    except (OSError, ValueError) as exc:
-        raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
-    curve = read_curve(folder / summary.get("files", {}).get("curve", "curve.csv"))
-    if [name.rstrip("'") for name in curve] != list(CURVE_COLUMNS):  # F' on the half-plane
-        raise RunFolderError(f"{folder}/curve.csv: columns {list(curve)} are not those frictionlab writes")
-    table = dict(zip(CURVE_COLUMNS, curve.values()))
-    realizations = summary.get("realizations") or {}
+    if not os.path.lexists(folder / "summary.json"):
+        where = "" if folder.is_dir() else " (not a folder)" if os.path.lexists(folder) else " (no such folder)"
+        raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
+    summary, record = read_summary(folder)
+    curve_name = record.files.get("curve", "curve.csv")
+    curve = read_curve(folder, curve_name)
+    loading = summary["preset"].get("loading")
+    steps = loading.get("steps") if isinstance(loading, dict) else None
+    rows = len(next(iter(curve.values())))
+    if isinstance(steps, int) and not isinstance(steps, bool) and rows != steps:
+        raise RunFolderError(
+            f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
+        )
     return Result(
-        name=summary["preset"]["name"],
-        status=summary.get("status", "completed"),
-        fit=LogFit.from_dict(summary["fit"]) if summary.get("fit") else None,
-        table=table,
-        realizations=(int(realizations.get("done", 0)), int(realizations.get("requested", 0))),
-        normalisation=(summary.get("normalisation") or {}).get("f", ""),
+        name=record.preset.name,
+        status=record.status,
+        fit=LogFit.from_dict(summary["fit"]) if record.fit is not None else None,
+        table=dict(zip(CURVE_COLUMNS, curve.values())),
+        realizations=(record.realizations.done, record.realizations.requested),
+        normalisation=record.normalisation.f,
         preset=summary["preset"],
-        elapsed=float(summary.get("elapsed_seconds") or 0.0),
-        caveats=list(summary.get("caveats") or []),
+        elapsed=record.elapsed_seconds,
+        caveats=list(record.caveats),
         folder=folder,
-        files={k: folder / v for k, v in (summary.get("files") or {}).items()},
-        input=summary.get("input"),
+        files={key: folder / name for key, name in record.files.items()},
+        input=record.input,
     )
 
 
 def _load_sweep(folder: Path) -> SweepResult:
-    try:
-        summary = json.loads((folder / "sweep.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise RunFolderError(f"{folder}/sweep.json cannot be read: {exc}") from None
+    from .sweep import read_sweep_record
+
+    summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
     return SweepResult(
-        name=summary["name"], status=summary["status"], parameters=list(summary["sweep"]["parameters"]), rows=rows,
-        folder=folder, elapsed=float(summary.get("elapsed_seconds") or 0.0),
+        name=record.name, status=record.status, parameters=list(record.sweep.parameters), rows=rows,
+        folder=folder, elapsed=record.elapsed_seconds,
     )  # fmt: skip

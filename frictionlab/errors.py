@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import codecs
 import enum
 import os
+import sys
 
 
 class ExitCode(enum.IntEnum):
@@ -79,6 +81,32 @@ def shown(text) -> str:
     characters escaped (an escape sequence typed in a ``--set`` or a file name must not
     drive the terminal); lines and tabs kept."""
     return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
+
+
+def _escape_unencodable(exc: UnicodeError):
+    """Codec error handler: a byte of a path that was not UTF-8 (a lone surrogate, as
+    Python decodes it) written as ``\xff``, as ``shown`` does; any other character the
+    stream cannot encode as ``\u03be``."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    text = exc.object[exc.start : exc.end]
+    escaped = "".join(
+        f"\\x{ord(c) - 0xDC00:02x}" if 0xDC80 <= ord(c) <= 0xDCFF else c.encode("ascii", "backslashreplace").decode()
+        for c in text
+    )
+    return escaped, exc.end
+
+
+codecs.register_error("frictionlab-escape", _escape_unencodable)
+
+
+def escape_unencodable_output() -> None:
+    """Make stdout and stderr escape what they cannot encode (a path that is not UTF-8, a
+    character beyond a latin-1 terminal) instead of raising UnicodeEncodeError after the
+    work is done and its files are written; called once by the CLI."""
+    for stream in (sys.stdout, sys.stderr):
+        if hasattr(stream, "reconfigure") and getattr(stream, "errors", None) in ("strict", "surrogateescape"):
+            stream.reconfigure(errors="frictionlab-escape")
 
 
 def counted(count: int, noun: str) -> str:

@@ -41,11 +41,12 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
 from .files import atomic_write, output_path_problem
-from .inputs import InputFileProblem, read_regular_file, sha256_of
+from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
 from .realization import RealizationResult
+from .runfolder import check_schema_version, json_kind, read_json_object, read_member
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 CHUNK_DIR = "chunks"
@@ -54,6 +55,7 @@ STATE_FILE = "run.json"
 PRESET_FILE = "preset.yaml"
 MANIFEST_FORMAT = 2
 MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
+MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
@@ -81,24 +83,6 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
             return candidate
         except FileExistsError:
             candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
-
-
-def read_json_object(path: Path, limit: int, what: str) -> dict:
-    """A run folder's JSON file (``what`` it is, at most ``limit`` bytes) as a mapping:
-    RunFolderError naming the file if it is not JSON, or not a JSON object;
-    InputFileProblem if it cannot be read at all (each caller says what that means)."""
-    try:
-        data = json.loads(read_regular_file(path, limit=limit, what=what))
-    except InputFileProblem:
-        raise
-    except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
-        where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
-        raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
-    except RecursionError:
-        raise RunFolderError(f"{path} is damaged (JSON nested too deeply)") from None
-    if not isinstance(data, dict):
-        raise RunFolderError(f"{path} is damaged (a JSON {type(data).__name__}, not an object)")
-    return data
 
 
 def fingerprint(resolved: dict) -> str:
@@ -156,8 +140,11 @@ class RunDirectory:
             raise OutputRefused(f"{problem}; give a folder for the output")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
-        if os.path.lexists(lock) and not lock.is_file():  # a lock that is a folder, a link to one, ...
-            raise RunFolderError(f"{lock} is not a file: it cannot hold the run's lock (remove it, or give another folder)")
+        if lock.is_symlink() or (os.path.lexists(lock) and not lock.is_file()):  # a link would be truncated through
+            raise RunFolderError(
+                f"{lock} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
+                "(remove it, or give another folder)"
+            )
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
         # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
         # file the holder then removed takes the lock on the new file.
@@ -165,9 +152,9 @@ class RunDirectory:
         try:
             self._lock.acquire()
         except Timeout:
-            try:
-                holder = lock.read_text(errors="replace").strip()[:200] or "unknown"
-            except OSError:
+            try:  # what _write_holder wrote: a line, escaped as any text from a folder is
+                holder = shown(read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]) or "unknown"
+            except (OSError, InputFileProblem):
                 holder = "unknown"
             raise RunFolderError(
                 f"{self.path} is in use by another run ({holder}): wait for it to end, "
@@ -196,10 +183,13 @@ class RunDirectory:
             state = read_json_object(path, MAX_MANIFEST_BYTES, "manifest")
         except InputFileProblem as exc:
             raise RunFolderError(f"{path}: {exc}") from None
+        check_schema_version(state, path, MANIFEST_FORMAT, key="format")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
-            if value is not None and not (isinstance(value, kind) and _well_formed(key, value)):
-                raise RunFolderError(f"{path} is damaged ({key} is not {what}: {short_repr(value, 60)})")
+            if value is not None and not isinstance(value, kind):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}, but {json_kind(value)})")
+            if value is not None and not _well_formed(key, value):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}: an entry is not a string)")
         return state
 
     def _write_manifest(self) -> None:
@@ -215,7 +205,7 @@ class RunDirectory:
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:
-            return load_preset_file(path)
+            return load_preset_file(path, follow_links=False)
         except PresetError as exc:
             raise RunFolderError(
                 f"{path} is damaged ({exc.problems[0].removeprefix('(file): ')}): this run cannot be resumed"
@@ -226,6 +216,11 @@ class RunDirectory:
     def start(self, scene: Scene, *, resume: bool) -> list[RealizationResult]:
         """Prepare the directory for ``scene``; return the results already stored
         and verified (resume) or none (a fresh run)."""
+        if os.path.islink(self.chunks) or (os.path.lexists(self.chunks) and not self.chunks.is_dir()):
+            raise RunFolderError(
+                f"{self.chunks} is not a folder (a link, a file, ...): chunks are never written or read through it "
+                "(remove it, or give another folder)"
+            )
         resolved = _json_copy(scene.resolved())
         inputs = self._input_hashes(scene)
         if resume:
@@ -280,9 +275,9 @@ class RunDirectory:
         if state is None:
             others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
             if others:
-                shown = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
+                listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputRefused(
-                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {shown}): "
+                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {listed}): "
                     f"{hint} (frictionlab then replaces only the files it writes and deletes none)"
                 )
             return
@@ -410,7 +405,7 @@ class RunDirectory:
         if match is None or not isinstance(digest, str):
             raise ChunkDamage("not a chunk name")
         try:
-            raw = read_regular_file(self.chunks / name, what="file")
+            raw = read_member(self.path, f"{CHUNK_DIR}/{name}", MAX_CHUNK_BYTES, what="file")
         except InputFileProblem as exc:
             raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
         if hashlib.sha256(raw).hexdigest() != digest:

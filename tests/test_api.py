@@ -93,11 +93,11 @@ def test_load_refuses_a_curve_it_did_not_write_naming_the_file(tmp_path):
     frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
     curve = folder / "curve.csv"
     lines = curve.read_text().splitlines()
-    curve.write_text("\n".join(["F,f,xi", *lines[1:]]) + "\n")  # columns missing
-    with pytest.raises(RunFolderError, match=r"curve.csv: columns \['F', 'f', 'xi'\] are not those frictionlab writes"):
-        frictionlab.load(folder)
+    curve.write_text("\n".join(["F,f,xi", *(",".join(line.split(",")[:3]) for line in lines[1:])]) + "\n")
+    with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(its header does not name the 7 columns"):
+        frictionlab.load(folder)  # columns missing
     curve.write_text("")  # emptied
-    with pytest.raises(RunFolderError, match=r"curve.csv: columns \[\] are not those"):
+    with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(empty: no header\)"):
         frictionlab.load(folder)
 
 
@@ -173,3 +173,70 @@ def test_loads_that_press_the_whole_line_flat_carry_a_caveat_from_where_it_start
     assert full == [f"the whole profile is in contact from load {first + 1} of 12 on (load {result.table['F'][first]:.4g}): "
                     "xi is 1 there by definition, so those loads measure no roughness; lower the loads"]  # fmt: skip
     assert json.loads((tmp_path / "heavy" / "summary.json").read_text())["caveats"] == result.caveats
+
+
+# ------------------------------------------------------------------ arguments, named
+
+
+def _nested(depth: int) -> dict:
+    top = inner = {}
+    for _ in range(depth):
+        inner["a"] = {}
+        inner = inner["a"]
+    return top
+
+
+def _containing_itself() -> dict:
+    data = {"name": "loop"}
+    data["self"] = data
+    return data
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [
+        (lambda: frictionlab.run("quickstart", 5, **FAST), "overrides must be a mapping of dotted keys to values, got int"),
+        (lambda: frictionlab.run("quickstart", [("seed", 3)], **FAST), "overrides must be a mapping of dotted keys to values, got list"),
+        (lambda: frictionlab.run("quickstart", {3: 1}, **FAST), "key 3 is of type int, not str"),
+        (lambda: frictionlab.run("quickstart", {"spectrum": _nested(10_000)}, **FAST), "overrides is nested more than 64 levels deep"),
+        (lambda: frictionlab.run(_nested(10_000), **FAST), "preset is nested more than 64 levels deep"),
+        (lambda: frictionlab.run(_containing_itself(), **FAST), "preset is nested more than 64 levels deep"),
+        (lambda: frictionlab.run({"name": "wide", "x": list(range(30_000))}, **FAST), "preset holds more than 20,000 values"),
+        (lambda: frictionlab.run("quickstart", {"seed": object()}, **FAST), "overrides.seed must be a str, number, bool, None, list or mapping, got object"),
+        (lambda: frictionlab.run("quickstart", seed={1, 2}, **FAST), "keyword overrides.seed must be a str, number"),
+        (lambda: frictionlab.run("quickstart", out=5, **FAST), "out must be a path to a folder to write the run into (a str or pathlib.Path), got int"),
+        (lambda: frictionlab.run("quickstart", scheduler=5, **FAST), "scheduler must be a Dask scheduler's address (a str), got int"),
+        (lambda: frictionlab.run("quickstart", resume="yes", **FAST), "resume must be True or False, got str"),
+        (lambda: frictionlab.run("quickstart", workers=1, progress=1), "progress must be True or False, got int"),
+        (lambda: frictionlab.run("", **FAST), "preset must be a path to a preset file, or a built-in's name, got an empty string"),
+        (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
+        (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
+        (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),
+    ],
+)
+def test_a_wrong_argument_is_a_frictionlab_error_naming_it(call, said):
+    with pytest.raises(FrictionlabError) as raised:
+        call()
+    assert said in str(raised.value)
+
+
+def test_a_result_plot_names_a_wrong_axes(tmp_path):
+    result = frictionlab.run(SMALL_PRESET, realizations=2, **FAST)
+    with pytest.raises(FrictionlabError, match="ax must be a matplotlib Axes or None, got int"):
+        result.plot(ax=5)
+
+
+def test_api_errors_name_a_built_in_preset_as_the_cli_does(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # no file called quickstart here: the built-in
+    with pytest.raises(PresetError) as raised:
+        frictionlab.run("quickstart", {"spectrum.params.hurst": 7}, **FAST)
+    message = str(raised.value)
+    assert message.startswith("built-in preset 'quickstart': 1 problem in preset") and "site-packages" not in message
+    assert "quickstart.yaml" not in message
+    from frictionlab.cli import main
+
+    assert main(["run", "quickstart", "--set", "spectrum.params.hurst=7"]) == 2
+    assert "built-in preset 'quickstart' --set spectrum.params.hurst=7: 1 problem in preset" in capsys.readouterr().err
+    (tmp_path / "mine.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    with pytest.raises(PresetError, match=r"^mine.yaml: 1 problem in preset"):  # a file the user gave: as given
+        frictionlab.run("mine.yaml", {"spectrum.params.hurst": 7}, **FAST)

@@ -24,7 +24,7 @@ import os
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
 from .console import error_label
@@ -139,6 +139,7 @@ def program() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     warnings.formatwarning = _plain_warning
+    escape_unencodable_output()  # a path that is not UTF-8 is printed escaped, never exit 70 after the work
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv:
         return _print(short_help())

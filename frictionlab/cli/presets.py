@@ -64,6 +64,7 @@ def run(args) -> ExitCode:
 
 
 def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
+    from ..files import atomic_write
     from ..preset.builtin import builtin_presets, find_builtin
 
     preset = find_builtin(name)
@@ -71,9 +72,13 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
     target = dest / preset.path.name if dest.is_dir() else dest
+    data = preset.path.read_bytes()
     try:
-        with open(target, "wb" if force else "xb") as out:  # "x": never over a file that appeared meanwhile
-            out.write(preset.path.read_bytes())
+        if force:  # replaced, never written through a link
+            atomic_write(target, lambda out: out.write(data), binary=True, devices=True)
+        else:
+            with open(target, "xb") as out:  # "x": never over a file (or a link) that appeared meanwhile
+                out.write(data)
     except FileExistsError:
         raise OutputRefused(f"{target} exists; give another DEST or --force to replace it") from None
     print(f"copied {preset.name} to {target}")

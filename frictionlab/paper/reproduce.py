@@ -32,6 +32,9 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         problem = output_path_problem(Path(folder)) if folder else None
         if problem:
             raise OutputRefused(f"{option}: {problem}; give a folder")
+    problem = output_path_problem(Path(markdown_path).parent) if markdown_path else None
+    if problem:
+        raise OutputRefused(f"--markdown: {problem}; give a file in a folder you can write to")
     if markdown_path and Path(markdown_path).is_dir():
         raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
@@ -89,6 +92,6 @@ def write_report(
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
-    atomic_write(markdown_path, lambda fh: fh.write(text))
+    atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
     log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

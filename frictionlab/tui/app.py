@@ -385,7 +385,7 @@ class FrictionlabApp(App):
             if read_run(folder).status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
-        except (OSError, ValueError, TypeError):
+        except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
         try:
             data = RunDirectory(folder).stored_preset()
