@@ -32,9 +32,9 @@ from collections.abc import Iterator, Sequence
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .errors import RunError
 from .options import RunOptions
-from .pool import JobFailed, WorkerLost, WorkerPool, send_progress
+from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
 from .preset import Scene
-from .realization import LoadListener, RealizationResult, compute_chunk
+from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -89,8 +89,8 @@ def chunk_label(chunk: Sequence[int]) -> str:
 
 
 class SerialExecutor:
-    """In this process. ``cancel`` is checked before every realization; a
-    cancelled chunk yields what it finished."""
+    """In this process. ``cancel`` is checked before every realization and at every
+    iteration of a solve; a cancelled chunk yields what it finished."""
 
     name = "serial"
     task_overhead = 0.0  # seconds per chunk (see ``plan_chunks``)
@@ -99,14 +99,15 @@ class SerialExecutor:
         self.workers = 1
 
     def map_chunks(
-        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+        self,
+        scene: Scene,
+        chunks: list[Chunk],
+        cancel,
+        on_load: LoadListener | None = None,
+        on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
-            done = []
-            for index in chunk:
-                if cancel.is_set():
-                    break
-                done.extend(compute_chunk(scene, [index], on_load))
+            done = compute_chunk(scene, chunk, on_load, on_iteration, cancel) if not cancel.is_set() else []
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():
@@ -140,11 +141,15 @@ def _init_worker(scene: Scene) -> None:
 
 
 def _send_load(index: int, done: int, total: int) -> None:
-    send_progress((index, done, total))
+    send_progress(("load", index, done, total))
+
+
+def _send_iteration(index: int, load: int, iteration: int, residual: float) -> None:
+    send_progress(("iteration", index, load, iteration, residual))
 
 
 def _run_chunk(indices: Chunk) -> list[RealizationResult]:
-    return compute_chunk(_worker_scene, indices, on_load=_send_load)
+    return compute_chunk(_worker_scene, indices, _send_load, _send_iteration, cancel=stop_event())
 
 
 def pool_context():
@@ -168,16 +173,29 @@ class ProcessExecutor:
         self.retries = retries
 
     def map_chunks(
-        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+        self,
+        scene: Scene,
+        chunks: list[Chunk],
+        cancel,
+        on_load: LoadListener | None = None,
+        on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        """A cancel reaches the workers (``WorkerPool.run``): a chunk then yields what it finished."""
         jobs = dict(enumerate(chunks))
-        on_progress = None if on_load is None else (lambda payload: on_load(*payload))
+        listeners = {"load": on_load, "iteration": on_iteration}
+
+        def on_progress(payload) -> None:
+            listener = listeners[payload[0]]
+            if listener is not None:
+                listener(*payload[1:])
+
         pool = WorkerPool(
             min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
             for key, results in pool.run(jobs, cancel, on_progress):
-                yield jobs[key], results
+                if results:  # none: cancelled within its first realization
+                    yield jobs[key][: len(results)], results
         except WorkerLost as lost:
             raise RunError(
                 f"a worker process died {lost.deaths} times while running realizations "

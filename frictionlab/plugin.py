@@ -491,6 +491,18 @@ def listening_to_loads(listener: Callable[[int, int], None] | None):
         _load_listener = previous
 
 
+@contextmanager
+def listening_to_iterations(listener: Callable[[int, float], None] | None):
+    """Within the block, ``iteration_done(iteration, residual)`` calls ``listener``, which
+    may raise ``SolveCancelled`` (this process only)."""
+    global _iteration_listener
+    previous, _iteration_listener = _iteration_listener, listener
+    try:
+        yield
+    finally:
+        _iteration_listener = previous
+
+
 def contract(kind: str) -> frozenset[str]:
     """Every name the framework may use of a plugin of ``kind``: the public attributes and
     methods of its base class (and of ``Plugin``), declared above; nothing else."""
