@@ -27,7 +27,7 @@ import signal
 import threading
 import time
 import uuid
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .dask_session import current_session
@@ -257,23 +257,18 @@ class DaskExecutor:
         self.dashboard = dashboard
         self.session = session
 
-    def _connect(self) -> tuple[object, Callable[[], None]]:
-        """The client, and what closes what this run started."""
+    def _connect(self):
+        """The client, and the ``LocalCluster`` this run started (None: it uses a scheduler's,
+        or its command's session's)."""
         if self.session is not None:
-            client, close = self.session.connect(), _leave_open
+            client, cluster = self.session.connect(), None
         elif self.scheduler:
-            client = connect_scheduler(self.scheduler)
-            close = client.close
+            client, cluster = connect_scheduler(self.scheduler), None
         else:
-            client, cluster = start_local_cluster(self.workers, dashboard=self.dashboard)
-
-            def close() -> None:
-                client.close()
-                cluster.close()
-
+            return start_local_cluster(self.workers, dashboard=self.dashboard)
         if self.scheduler:
             self.workers = max(1, len(client.scheduler_info().get("workers", {})))
-        return client, close
+        return client, cluster
 
     def map_chunks(
         self,
@@ -287,7 +282,7 @@ class DaskExecutor:
         only. A cancel returns at once, and reaches the running tasks through the run's
         Dask ``Event``: they stop within their solve (``DaskStop``)."""
         distributed = import_distributed()
-        client, close = self._connect()
+        client, cluster = self._connect()
         futures = []
         run_id = uuid.uuid4().hex[:8]
         stop_name = f"frictionlab-{run_id}-stop"
@@ -327,11 +322,10 @@ class DaskExecutor:
         finally:
             if futures:
                 client.cancel([f for f in futures if not f.done()])
-            close()
-
-
-def _leave_open() -> None:
-    """A session's client: its command closes it (``dask_session.one_dask_cluster``)."""
+            if self.session is None:  # else its command closes it
+                client.close()
+            if cluster is not None:
+                cluster.close()
 
 
 STOP_POLL_SECONDS = 0.25  # how often a Dask task asks the scheduler whether its run was cancelled
