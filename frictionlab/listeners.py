@@ -109,3 +109,9 @@ def progress_text(done: int, total: int, failed: int, elapsed: float, restored: 
     failures = f", {failed} failed" if failed else ""
     return f"{done}/{total} realizations{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
 
+
+def solve_text(index: int, load: int, loads: int, iteration: int | None = None, residual: float | None = None) -> str:
+    """``realization 3: load 2/16, iteration 40, residual 3.1e-05``: where a long solve is
+    (``load_done`` says the loads done, without the iteration)."""
+    text = f"realization {index}: load {load}/{loads}"
+    return text if iteration is None else f"{text}, iteration {iteration}, residual {residual:.2g}"

@@ -13,7 +13,7 @@ import time
 
 from .errors import counted
 from .hookspecs import hookimpl
-from .listeners import SweepListener, progress_text
+from .listeners import SweepListener, progress_text, solve_text
 
 
 def _in_notebook() -> bool:
@@ -165,12 +165,12 @@ class ProgressReporter:
     @hookimpl
     def load_done(self, index, done, total):
         """A long solve's loads: the bar's note, or a line now and then in a log."""
-        self._solve_note(f"realization {index}: load {done}/{total}")
+        self._solve_note(solve_text(index, done, total))
 
     @hookimpl
     def iteration_done(self, index, load, iteration, residual):
         """Within a long load: its iteration and residual, as ``load_done``."""
-        self._solve_note(f"realization {index}: load {load}/{self.loads}, iteration {iteration}, residual {residual:.2g}")
+        self._solve_note(solve_text(index, load, self.loads, iteration, residual))
 
     def _solve_note(self, text: str) -> None:
         now = time.perf_counter()
