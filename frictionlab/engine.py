@@ -23,7 +23,7 @@ from .hookspecs import PROJECT_NAME
 from .listeners import RunListener
 from .options import RunOptions
 from .preset import Scene
-from .realization import RealizationResult, compute_chunk
+from .realization import RealizationResult, compute_chunk_here
 from .signals import CancelOnSignals
 
 __all__ = ["RunInfo", "run"]
@@ -118,7 +118,7 @@ def run(
         try:
             if todo and not cancel.is_set():
                 # The first missing realization runs here: its time sizes the chunks.
-                first = compute_chunk(scene, todo[:1], cancel=cancel, **progress)
+                first = compute_chunk_here(scene, todo[:1], cancel=cancel, **progress)
                 if first:  # else cancelled within it
                     record(first)
                     chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)

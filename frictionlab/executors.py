@@ -35,7 +35,7 @@ from .errors import RunError
 from .options import RunOptions
 from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
 from .preset import Scene
-from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk
+from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk, compute_chunk_here
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -90,8 +90,8 @@ def chunk_label(chunk: Sequence[int]) -> str:
 
 
 class SerialExecutor:
-    """In this process. ``cancel`` is checked before every realization and at every
-    iteration of a solve; a cancelled chunk yields what it finished."""
+    """In this process (``compute_chunk_here``). A cancel returns at once: a cancelled
+    chunk yields what it finished."""
 
     name = "serial"
     task_overhead = 0.0  # seconds per chunk (see ``plan_chunks``)
@@ -108,7 +108,7 @@ class SerialExecutor:
         on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
-            done = compute_chunk(scene, chunk, on_load, on_iteration, cancel) if not cancel.is_set() else []
+            done = compute_chunk_here(scene, chunk, on_load, on_iteration, cancel) if not cancel.is_set() else []
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():

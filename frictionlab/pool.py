@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import pickle
 import signal
+import time
 from collections import Counter, deque
 from collections.abc import Callable, Hashable, Iterator
 from multiprocessing.connection import wait
 
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
+STOP_GRACE_SECONDS = 0.5  # after a cancel, a job's time to end by itself before its worker is killed
 ERROR_CHARS = 500  # an error carried back from a worker is cut to this
 
 
@@ -141,18 +143,23 @@ class WorkerPool:
         """Yield ``(key, result)`` as each job finishes; ``on_progress(payload)`` hears what
         a job sends on the way (``send_progress``). After ``cancel.set()``
         no job starts, and running ones see ``stop_event()`` set (within ``WAIT_SECONDS``):
-        they finish, early if they look at it, and are yielded. A job whose worker
+        those that end within ``STOP_GRACE_SECONDS`` are yielded, the others' workers are
+        killed (a step of a large solve cannot be interrupted). A job whose worker
         dies runs again on a fresh worker, at most ``retries`` more times
         (then WorkerLost); a job that raises ends the run (JobFailed)."""
         pending = deque(jobs)
         deaths: Counter = Counter()
         workers: list[_Worker] = []
         stop = self.context.Event()
+        cancelled_at = None
         try:
             while True:
                 if cancel.is_set():
                     pending.clear()
                     stop.set()
+                    cancelled_at = time.monotonic() if cancelled_at is None else cancelled_at
+                    if time.monotonic() - cancelled_at >= STOP_GRACE_SECONDS:
+                        return  # the workers still busy are killed below: their jobs abandoned
                 while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
                     worker = next((w for w in workers if w.job is None), None)
                     if worker is None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable
@@ -146,3 +147,41 @@ def compute_chunk(
         if cancel is not None and cancel.is_set():
             break
     return results
+
+
+CANCEL_POLL_SECONDS = 0.05  # how often ``compute_chunk_here`` looks at the cancel while it waits
+
+
+def compute_chunk_here(
+    scene: Scene,
+    indices: Iterable[int],
+    on_load: LoadListener | None = None,
+    on_iteration: IterationListener | None = None,
+    cancel=None,
+) -> list[RealizationResult]:
+    """``compute_chunk`` for this process: in a helper thread, this one waiting (and
+    handling signals). Once ``cancel`` is set it returns at once with the realizations
+    finished; the one being solved is left to stop at its next iteration by itself: a
+    step of a large solve (FFTs of millions of points) takes seconds and cannot be
+    interrupted. An error of a listener is raised here."""
+    finished: list[RealizationResult] = []
+    errors: list[BaseException] = []
+
+    def work() -> None:
+        try:
+            for index in indices:
+                finished.extend(compute_chunk(scene, [index], on_load, on_iteration, cancel))
+                if cancel is not None and cancel.is_set():
+                    return
+        except BaseException as exc:  # handed to the waiting thread
+            errors.append(exc)
+
+    solver = threading.Thread(target=work, name="frictionlab-solve", daemon=True)
+    solver.start()
+    while solver.is_alive():
+        solver.join(CANCEL_POLL_SECONDS)
+        if cancel is not None and cancel.is_set():
+            return list(finished)
+    if errors:
+        raise errors[0]
+    return finished

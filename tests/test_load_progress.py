@@ -5,6 +5,7 @@ them; a cancel seen at an iteration abandons the realization being solved."""
 
 import io
 import threading
+import time
 from collections import defaultdict
 
 import numpy as np
@@ -209,3 +210,40 @@ def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_s
     assert resumed.status == whole.status == "completed"
     for name, values in whole.per_realization.items():
         np.testing.assert_array_equal(resumed.per_realization[name], values, err_msg=name)
+
+
+def test_in_this_process_a_cancel_returns_at_once_while_a_long_step_still_runs(registry, monkeypatch):
+    import frictionlab.realization as realization
+
+    monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)
+    scene = build_scene(LONG_LOADS, registry=registry)
+    cancel, release, heard = threading.Event(), threading.Event(), []
+
+    def a_long_step(index, load, iteration, residual):  # a step no check can interrupt (an FFT of 4096^2)
+        heard.append(iteration)
+        if len(heard) == 1:
+            cancel.set()
+            release.wait(120)
+
+    results = realization.compute_chunk_here(scene, [0, 1], on_iteration=a_long_step, cancel=cancel)
+    returned_during_the_step = not release.is_set()
+    release.set()
+    assert results == [] and returned_during_the_step
+
+
+def _sleep_through(seconds: float) -> float:
+    time.sleep(seconds)  # a job that never looks at stop_event()
+    return seconds
+
+
+def test_a_pool_kills_a_worker_whose_job_does_not_stop_after_a_cancel():
+    from frictionlab.executors import pool_context
+    from frictionlab.pool import WorkerPool
+
+    cancel = threading.Event()
+    pool = WorkerPool(1, pool_context(), _sleep_through)
+    timer = threading.Timer(0.5, cancel.set)
+    timer.start()
+    finished = list(pool.run({"long": 120.0}, cancel))  # without the kill: two minutes, then [("long", 120.0)]
+    timer.cancel()
+    assert finished == []
