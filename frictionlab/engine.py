@@ -72,9 +72,9 @@ def run(
     process-wide one) hear the run as ``listeners`` do.
 
     ``cancel`` (anything with ``set()``/``is_set()``), Ctrl-C or SIGTERM ends the
-    run early, within an iteration of a solver that reports them
-    (``plugin.iteration_done``): the realizations in progress are abandoned (they run
-    again on resume); what finished is kept and summarised, and ``outcome.status``
+    run at once: the realizations being solved are abandoned (they stop at their
+    solver's next ``plugin.iteration_done`` and run again on resume); what finished is
+    kept and summarised, and ``outcome.status``
     says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
     total = scene.preset.realizations
