@@ -4,6 +4,8 @@ and the stop and preconditioner of the default CG against the baseline CG."""
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import pytest
 
@@ -21,6 +23,13 @@ def surface(points=64, seed=3):
     return PowerLawSurface(hurst=0.8, points=points, spacing=1.0).generate(realization_rng(seed, 0))
 
 
+@pytest.fixture
+def listen():
+    """``listen(listener)``: ``iteration_done`` calls ``listener`` in this thread until the test ends."""
+    with contextlib.ExitStack() as stack:
+        yield lambda listener: stack.enter_context(frictionlab.plugin.listening_to_iterations(listener))
+
+
 class Baseline(BEMHalfSpace):
     contact_cg = PolonskyKeerCG
 
@@ -29,9 +38,9 @@ class Baseline(BEMHalfSpace):
     "solver", [BEMHalfSpace(stop="tolerance"), BEMHalfSpace(stop="certified"), Baseline(stop="tolerance")]
 )
 @pytest.mark.parametrize("control", ["force", "indentation"])
-def test_every_iteration_of_every_load_is_reported(monkeypatch, solver, control):
+def test_every_iteration_of_every_load_is_reported(listen, solver, control):
     calls = []
-    monkeypatch.setattr(frictionlab.plugin, "_iteration_listener", lambda i, r: calls.append((i, r)))
+    listen(lambda i, r: calls.append((i, r)))
     profile = surface()
     loads = np.array([5.0, 50.0, 200.0]) if control == "force" else np.array([0.2, 0.5, 0.9])
     curve = solver.solve(profile, loads, control, np.ones_like(profile.heights))
@@ -45,7 +54,7 @@ def test_every_iteration_of_every_load_is_reported(monkeypatch, solver, control)
 
 
 @pytest.mark.parametrize("cg_class", [ProjectedCG, PolonskyKeerCG])
-def test_a_cancel_raised_by_the_listener_stops_the_solve_at_that_iteration(monkeypatch, cg_class):
+def test_a_cancel_raised_by_the_listener_stops_the_solve_at_that_iteration(listen, cg_class):
     calls = []
 
     def listener(iteration, residual):
@@ -53,7 +62,7 @@ def test_a_cancel_raised_by_the_listener_stops_the_solve_at_that_iteration(monke
         if iteration == 3:
             raise SolveCancelled
 
-    monkeypatch.setattr(frictionlab.plugin, "_iteration_listener", listener)
+    listen(listener)
     z = surface(128).heights
     depth = (z.max() - z) / (z.max() - z.min())
     cg = cg_class(PeriodicHalfSpace(depth.shape), depth)
@@ -62,10 +71,10 @@ def test_a_cancel_raised_by_the_listener_stops_the_solve_at_that_iteration(monke
     assert calls == [0, 1, 2, 3]
 
 
-def test_a_cancelled_run_solve_leaves_no_answer(monkeypatch):
+def test_a_cancelled_run_solve_leaves_no_answer(listen):
     """Through the plugin: the cancel propagates out of solve (nothing is returned
     for the run to store), on the half-plane as on the half-space."""
-    monkeypatch.setattr(frictionlab.plugin, "_iteration_listener", lambda i, r: (_ for _ in ()).throw(SolveCancelled()))
+    listen(lambda i, r: (_ for _ in ()).throw(SolveCancelled()))
     rng = np.random.default_rng(5)
     z = np.cumsum(rng.normal(size=256))
     z -= np.linspace(0, z[-1], 256)

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..fit import LogFit, fit_curve
 from ..hookspecs import hookimpl
+from ..listeners import solve_text
 from .text import failure_message
 
 
@@ -35,6 +36,7 @@ class Snapshot:
     first_error: str | None = None
     finished: bool = False
     f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
+    solving: str = ""  # where a long solve is: realization, load, iteration, residual
 
 
 class LiveListener:
@@ -54,6 +56,8 @@ class LiveListener:
         self._ok = 0
         self._failed = 0
         self._first_error = None
+        self._solving = ""
+        self._done, self._total = 0, run.total
         self._xi_sum = np.zeros(steps)
         self._count_sum = np.zeros(steps)
         self._force_sum = np.zeros(steps)
@@ -78,10 +82,28 @@ class LiveListener:
         self._maybe_post(done, total)
 
     @hookimpl
+    def load_done(self, index, done, total):
+        self._solve_note(solve_text(index, done, total))
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        self._solve_note(solve_text(index, load, self._loads.size, iteration, residual))
+
+    def _solve_note(self, text: str) -> None:
+        """Movement within a long realization: shown with the next snapshot, posted at once
+        if none was for ``interval``."""
+        self._solving = text
+        now = self.clock()
+        if now - self._last_post >= self.interval:
+            self._last_post = now
+            self.post(self._snapshot(self._done, self._total))
+
+    @hookimpl
     def run_finished(self, run, outcome):
         self.post(self._snapshot(outcome.done + len(outcome.failures), run.total, finished=True))
 
     def _maybe_post(self, done: int, total: int) -> None:
+        self._done, self._total, self._solving = done, total, ""
         now = self.clock()
         if done in (1, total) or now - self._last_post >= self.interval:  # the plot appears at once
             self._last_post = now
@@ -107,6 +129,7 @@ class LiveListener:
             first_error=self._first_error,
             finished=finished,
             f_formula=self._f_formula,
+            solving="" if finished else self._solving,
         )
 
 
