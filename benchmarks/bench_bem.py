@@ -23,6 +23,9 @@ the new default, and the contact counts checked at every load against cold
 solves at tolerance 1e-12 (Tamaas's too). Run single-threaded::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_bem.py [--repeat 3] [--side 512] [--no-tamaas]
+
+``--line``: ``bem-halfplane`` on an 8192-point power-law line (H = 0.8), a 20-load
+sweep, old against new.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from frictionlab.seeds import realization_rng
 from frictionlab_solvers import bem
 from frictionlab_solvers.elastic import PeriodicHalfSpace
 from frictionlab_solvers.polonsky_keer import PolonskyKeerCG
+from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
 
 SEED = 2024
@@ -58,6 +62,10 @@ bem.PeriodicHalfSpace = CountingOperator  # the solvers build their operator fro
 
 
 class PolonskyKeer(bem.BEMHalfSpace):
+    contact_cg = PolonskyKeerCG
+
+
+class PolonskyKeerLine(bem.BEMHalfPlane):
     contact_cg = PolonskyKeerCG
 
 
@@ -87,11 +95,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="best of this many runs")
     parser.add_argument("--side", type=int, default=512, help="surface side in pixels (forces scale with the area)")
     parser.add_argument("--no-tamaas", action="store_true", help="skip Tamaas even when it is installed")
+    parser.add_argument("--line", action="store_true", help="bem-halfplane on an 8192-point line instead")
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1. Got {args.repeat} instead.")
     if args.side < 16:
         parser.error(f"--side must be at least 16. Got {args.side} instead.")
+    if args.line:
+        line_sweep(args.repeat)
+        return
     profile, forces = scene(args.side)
     slopes = np.ones_like(profile.heights)
     cold = (0, 9, 19)
@@ -134,6 +146,34 @@ def main() -> None:
             verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
             ratio = seconds[0] / base[what][0][0]
             print(f"  {name:<15}{label:<25}{pairs_text}{seconds[0]:8.2f}{seconds[1]:8.2f}{ratio:16.2f}x  {verdict}")
+
+
+def line_sweep(repeat: int) -> None:
+    """bem-halfplane: a 20-load sweep on an 8192-point power-law line (H = 0.8,
+    spacing 1, forces per unit depth 0.5 .. 20), old against new."""
+    profile = PowerLaw(hurst=0.8, points=8192, spacing=1.0).generate(realization_rng(SEED, 1))
+    forces = np.geomspace(0.5, 20.0, 20)
+    slopes = np.ones_like(profile.heights)
+    solvers = {
+        "polonsky-keer": PolonskyKeerLine(stop="tolerance"),
+        "pcg tolerance": bem.BEMHalfPlane(stop="tolerance"),
+        "pcg certified": bem.BEMHalfPlane(stop="certified"),
+    }
+    runs = {name: [] for name in solvers}
+    for _ in range(repeat):
+        for name, solver in solvers.items():
+            runs[name].append(timed(lambda: solver.solve(profile, forces, "force", slopes)))
+    exact = bem.BEMHalfPlane(tolerance=1e-12, stop="tolerance")
+    reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
+    print(f"bem-halfplane, 8192-point power-law line H = 0.8; 20 forces {forces[0]:g} .. {forces[-1]:g} per unit depth "
+          f"(contact {reference[0] / 8192:.2%} .. {reference[-1] / 8192:.2%}); best of {repeat}")  # fmt: skip
+    print(f"  {'solver':<15}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}{'iterations':>11}  contact counts")
+    for name, results in runs.items():
+        seconds, pairs, curve = best(results)
+        wrong = int(np.count_nonzero(curve.contact_count != reference))
+        verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
+        print(f"  {name:<15}{pairs[0]:11d} + {pairs[1]:6d}{seconds[0]:8.2f}{seconds[1]:8.2f}"
+              f"{int(curve.extras['iterations'].sum()):11d}  {verdict}")  # fmt: skip
 
 
 def load_tamaas():

@@ -74,7 +74,7 @@ class PeriodicBEM(ContactSolver):
             description="when a load is solved: 'tolerance' once the residual is at most the tolerance; "
             "'certified' (force control only) also as soon as the contact set is certified (unchanged for 2 "
             "steps, every point's pressure or gap 10 times its last change): the contact set is final, the "
-            "indentation only as converged as the residual reached (about 1e-5 relative)",
+            "indentation only as converged as the residual reached (within 1e-4 relative)",
         )
 
     # the contact CG: ProjectedCG, or a class with its constructor and solve (the benchmark's baseline)
