@@ -25,7 +25,9 @@ solves at tolerance 1e-12 (Tamaas's too). Run single-threaded::
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_bem.py [--repeat 3] [--side 512] [--no-tamaas]
 
 ``--line``: ``bem-halfplane`` on an 8192-point power-law line (H = 0.8), a 20-load
-sweep, old against new.
+sweep, old against new. ``--tamaas-surface``: the surface made by Tamaas's own
+generator (``SurfaceGeneratorFilter2D``, the same spectrum, scaled to rms height 1)
+instead of frictionlab's.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ import time
 
 import numpy as np
 
+from frictionlab import Profile
 from frictionlab.seeds import realization_rng
 from frictionlab_solvers import bem
 from frictionlab_solvers.elastic import PeriodicHalfSpace
@@ -69,10 +72,20 @@ class PolonskyKeerLine(bem.BEMHalfPlane):
     contact_cg = PolonskyKeerCG
 
 
-def scene(side: int):
-    profile = PowerLawSurface(hurst=0.8, points=side, spacing=1.0, short_cutoff=8.0, rms_height=1.0).generate(
-        realization_rng(SEED, 0)
-    )
+def scene(side: int, tamaas=None):
+    """The surface (frictionlab's power-law-2d, or with ``tamaas`` the same spectrum
+    made by Tamaas's own generator) and the 20 forces."""
+    if tamaas is None:
+        profile = PowerLawSurface(hurst=0.8, points=side, spacing=1.0, short_cutoff=8.0, rms_height=1.0).generate(
+            realization_rng(SEED, 0)
+        )
+    else:
+        spectrum = tamaas.Isopowerlaw2D()  # wave numbers in units of 2 pi / side
+        spectrum.q0, spectrum.q1, spectrum.q2, spectrum.hurst = 1, 1, side // 8, 0.8
+        generator = tamaas.SurfaceGeneratorFilter2D([side, side])
+        generator.spectrum, generator.random_seed = spectrum, SEED
+        z = np.array(generator.buildSurface())
+        profile = Profile(z / z.std(), 1.0)
     forces = np.geomspace(20.0, 1000.0, 20) * (side / 512) ** 2  # the same contact fractions at any side
     return profile, forces
 
@@ -96,6 +109,9 @@ def main() -> None:
     parser.add_argument("--side", type=int, default=512, help="surface side in pixels (forces scale with the area)")
     parser.add_argument("--no-tamaas", action="store_true", help="skip Tamaas even when it is installed")
     parser.add_argument("--line", action="store_true", help="bem-halfplane on an 8192-point line instead")
+    parser.add_argument(
+        "--tamaas-surface", action="store_true", help="the surface made by Tamaas's generator (same spectrum)"
+    )
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1. Got {args.repeat} instead.")
@@ -104,7 +120,10 @@ def main() -> None:
     if args.line:
         line_sweep(args.repeat)
         return
-    profile, forces = scene(args.side)
+    tamaas = None if args.no_tamaas else load_tamaas()
+    if args.tamaas_surface and tamaas is None:
+        parser.error("--tamaas-surface needs Tamaas (pip install tamaas) and no --no-tamaas")
+    profile, forces = scene(args.side, tamaas if args.tamaas_surface else None)
     slopes = np.ones_like(profile.heights)
     cold = (0, 9, 19)
     solvers = {
@@ -114,7 +133,6 @@ def main() -> None:
     }
     default = f"pcg {bem.BEMHalfSpace().params.stop}"
     runs = {name: {"sweep": [], **{j: [] for j in cold}} for name in solvers}
-    tamaas = None if args.no_tamaas else load_tamaas()
     if tamaas is not None:
         runs["Tamaas 1e-10"] = {"sweep": [], **{j: [] for j in cold}}
     for _ in range(args.repeat):
@@ -130,7 +148,8 @@ def main() -> None:
     exact = bem.BEMHalfSpace(tolerance=1e-12, stop="tolerance")
     reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
     side = args.side
-    print(f"bem-halfspace, {side} x {side} power-law-2d H = 0.8, rms height 1, short cut-off 8 px, long cut-off {side} px, "
+    made = "Tamaas's generator" if args.tamaas_surface else "power-law-2d"
+    print(f"bem-halfspace, {side} x {side} surface ({made}) H = 0.8, rms height 1, short cut-off 8 px, long cut-off {side} px, "
           f"E* = 1; 20 forces {forces[0]:g} .. {forces[-1]:g} (contact {reference[0] / side**2:.2%} .. "
           f"{reference[-1] / side**2:.2%}); best of {args.repeat}")  # fmt: skip
     print(f"  {'solver':<15}{'what':<25}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}"
