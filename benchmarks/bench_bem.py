@@ -23,6 +23,11 @@ the new default, and the contact counts checked at every load against cold
 solves at tolerance 1e-12 (Tamaas's too). Run single-threaded::
 
     OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_bem.py [--repeat 3] [--side 512] [--no-tamaas]
+
+``--line``: ``bem-halfplane`` on an 8192-point power-law line (H = 0.8), a 20-load
+sweep, old against new. ``--tamaas-surface``: the surface made by Tamaas's own
+generator (``SurfaceGeneratorFilter2D``, the same spectrum, scaled to rms height 1)
+instead of frictionlab's.
 """
 
 from __future__ import annotations
@@ -32,10 +37,12 @@ import time
 
 import numpy as np
 
+from frictionlab import Profile
 from frictionlab.seeds import realization_rng
 from frictionlab_solvers import bem
 from frictionlab_solvers.elastic import PeriodicHalfSpace
 from frictionlab_solvers.polonsky_keer import PolonskyKeerCG
+from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
 
 SEED = 2024
@@ -61,10 +68,24 @@ class PolonskyKeer(bem.BEMHalfSpace):
     contact_cg = PolonskyKeerCG
 
 
-def scene(side: int):
-    profile = PowerLawSurface(hurst=0.8, points=side, spacing=1.0, short_cutoff=8.0, rms_height=1.0).generate(
-        realization_rng(SEED, 0)
-    )
+class PolonskyKeerLine(bem.BEMHalfPlane):
+    contact_cg = PolonskyKeerCG
+
+
+def scene(side: int, tamaas=None):
+    """The surface (frictionlab's power-law-2d, or with ``tamaas`` the same spectrum
+    made by Tamaas's own generator) and the 20 forces."""
+    if tamaas is None:
+        profile = PowerLawSurface(hurst=0.8, points=side, spacing=1.0, short_cutoff=8.0, rms_height=1.0).generate(
+            realization_rng(SEED, 0)
+        )
+    else:
+        spectrum = tamaas.Isopowerlaw2D()  # wave numbers in units of 2 pi / side
+        spectrum.q0, spectrum.q1, spectrum.q2, spectrum.hurst = 1, 1, side // 8, 0.8
+        generator = tamaas.SurfaceGeneratorFilter2D([side, side])
+        generator.spectrum, generator.random_seed = spectrum, SEED
+        z = np.array(generator.buildSurface())
+        profile = Profile(z / z.std(), 1.0)
     forces = np.geomspace(20.0, 1000.0, 20) * (side / 512) ** 2  # the same contact fractions at any side
     return profile, forces
 
@@ -87,12 +108,22 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="best of this many runs")
     parser.add_argument("--side", type=int, default=512, help="surface side in pixels (forces scale with the area)")
     parser.add_argument("--no-tamaas", action="store_true", help="skip Tamaas even when it is installed")
+    parser.add_argument("--line", action="store_true", help="bem-halfplane on an 8192-point line instead")
+    parser.add_argument(
+        "--tamaas-surface", action="store_true", help="the surface made by Tamaas's generator (same spectrum)"
+    )
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1. Got {args.repeat} instead.")
     if args.side < 16:
         parser.error(f"--side must be at least 16. Got {args.side} instead.")
-    profile, forces = scene(args.side)
+    if args.line:
+        line_sweep(args.repeat)
+        return
+    tamaas = None if args.no_tamaas else load_tamaas()
+    if args.tamaas_surface and tamaas is None:
+        parser.error("--tamaas-surface needs Tamaas (pip install tamaas) and no --no-tamaas")
+    profile, forces = scene(args.side, tamaas if args.tamaas_surface else None)
     slopes = np.ones_like(profile.heights)
     cold = (0, 9, 19)
     solvers = {
@@ -102,7 +133,6 @@ def main() -> None:
     }
     default = f"pcg {bem.BEMHalfSpace().params.stop}"
     runs = {name: {"sweep": [], **{j: [] for j in cold}} for name in solvers}
-    tamaas = None if args.no_tamaas else load_tamaas()
     if tamaas is not None:
         runs["Tamaas 1e-10"] = {"sweep": [], **{j: [] for j in cold}}
     for _ in range(args.repeat):
@@ -118,7 +148,8 @@ def main() -> None:
     exact = bem.BEMHalfSpace(tolerance=1e-12, stop="tolerance")
     reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
     side = args.side
-    print(f"bem-halfspace, {side} x {side} power-law-2d H = 0.8, rms height 1, short cut-off 8 px, long cut-off {side} px, "
+    made = "Tamaas's generator" if args.tamaas_surface else "power-law-2d"
+    print(f"bem-halfspace, {side} x {side} surface ({made}) H = 0.8, rms height 1, short cut-off 8 px, long cut-off {side} px, "
           f"E* = 1; 20 forces {forces[0]:g} .. {forces[-1]:g} (contact {reference[0] / side**2:.2%} .. "
           f"{reference[-1] / side**2:.2%}); best of {args.repeat}")  # fmt: skip
     print(f"  {'solver':<15}{'what':<25}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}"
@@ -134,6 +165,34 @@ def main() -> None:
             verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
             ratio = seconds[0] / base[what][0][0]
             print(f"  {name:<15}{label:<25}{pairs_text}{seconds[0]:8.2f}{seconds[1]:8.2f}{ratio:16.2f}x  {verdict}")
+
+
+def line_sweep(repeat: int) -> None:
+    """bem-halfplane: a 20-load sweep on an 8192-point power-law line (H = 0.8,
+    spacing 1, forces per unit depth 0.5 .. 20), old against new."""
+    profile = PowerLaw(hurst=0.8, points=8192, spacing=1.0).generate(realization_rng(SEED, 1))
+    forces = np.geomspace(0.5, 20.0, 20)
+    slopes = np.ones_like(profile.heights)
+    solvers = {
+        "polonsky-keer": PolonskyKeerLine(stop="tolerance"),
+        "pcg tolerance": bem.BEMHalfPlane(stop="tolerance"),
+        "pcg certified": bem.BEMHalfPlane(stop="certified"),
+    }
+    runs = {name: [] for name in solvers}
+    for _ in range(repeat):
+        for name, solver in solvers.items():
+            runs[name].append(timed(lambda: solver.solve(profile, forces, "force", slopes)))
+    exact = bem.BEMHalfPlane(tolerance=1e-12, stop="tolerance")
+    reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
+    print(f"bem-halfplane, 8192-point power-law line H = 0.8; 20 forces {forces[0]:g} .. {forces[-1]:g} per unit depth "
+          f"(contact {reference[0] / 8192:.2%} .. {reference[-1] / 8192:.2%}); best of {repeat}")  # fmt: skip
+    print(f"  {'solver':<15}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}{'iterations':>11}  contact counts")
+    for name, results in runs.items():
+        seconds, pairs, curve = best(results)
+        wrong = int(np.count_nonzero(curve.contact_count != reference))
+        verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
+        print(f"  {name:<15}{pairs[0]:11d} + {pairs[1]:6d}{seconds[0]:8.2f}{seconds[1]:8.2f}"
+              f"{int(curve.extras['iterations'].sum()):11d}  {verdict}")  # fmt: skip
 
 
 def load_tamaas():

@@ -74,7 +74,10 @@ def test_a_cancel_raised_by_the_listener_stops_the_solve_at_that_iteration(liste
 def test_a_cancelled_run_solve_leaves_no_answer(listen):
     """Through the plugin: the cancel propagates out of solve (nothing is returned
     for the run to store), on the half-plane as on the half-space."""
-    listen(lambda i, r: (_ for _ in ()).throw(SolveCancelled()))
+    def cancel(iteration, residual):
+        raise SolveCancelled
+
+    listen(cancel)
     rng = np.random.default_rng(5)
     z = np.cumsum(rng.normal(size=256))
     z -= np.linspace(0, z[-1], 256)

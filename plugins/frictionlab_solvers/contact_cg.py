@@ -12,8 +12,6 @@ the level is prescribed.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from frictionlab import iteration_done
@@ -80,16 +78,13 @@ class ProjectedCG:
         tolerance: float,
         max_iterations: int,
         certified: bool = False,
-        monitor: Callable[[int, float, np.ndarray], None] | None = None,
     ) -> tuple[np.ndarray, float, int, float]:
         """Iterate from ``pressure`` (modified in place) until the residual is at
         most ``tolerance`` or, with ``certified``, until the contact set is
         certified. Exactly one of ``mean_pressure`` (force control) and
-        ``approach`` (indentation control) is given. ``monitor``, if given, is
-        called before each step with the iteration, the residual and the flat
-        indices of the contact points (for studies of convergence). Each
-        iteration calls ``frictionlab.iteration_done``, which may raise
-        ``SolveCancelled``: the solve then stops where it is.
+        ``approach`` (indentation control) is given. Each iteration calls
+        ``frictionlab.iteration_done``, which may raise ``SolveCancelled``: the
+        solve then stops where it is.
 
         Returns ``(pressure, level, iterations, residual)``; raises
         ``NotConverged`` after ``max_iterations`` steps.
@@ -176,8 +171,6 @@ class ProjectedCG:
                     continue
                 return pressure, float(level), iteration, residual
             iteration_done(iteration, residual)
-            if monitor is not None:
-                monitor(iteration, residual, contact)
             if iteration == max_iterations:
                 raise NotConverged(iteration, residual)
             iteration += 1

@@ -11,6 +11,7 @@ members, and the CGs take it unchanged.
 
 from __future__ import annotations
 
+import functools
 from typing import Protocol
 
 import numpy as np
@@ -100,9 +101,14 @@ class PeriodicHalfSpace:
         self.stiffness32 = self.stiffness.astype(np.float32)
         self.compliance32 = self.compliance.astype(np.float32)
         self.spectrum = np.empty(q.shape, dtype=complex)
+
+    @functools.cached_property
+    def point_stiffness(self) -> float:
+        """Pressure on one point per unit of its own displacement (an inverse FFT:
+        computed when first asked for)."""
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
 
-        self.point_stiffness = 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
+        return 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
 
     def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Zero-mean surface displacement under ``pressure``, written into ``out``."""

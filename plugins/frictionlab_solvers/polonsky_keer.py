@@ -5,8 +5,6 @@ benchmarks/bench_bem.py measures the new one against."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from frictionlab import iteration_done
@@ -53,13 +51,11 @@ class PolonskyKeerCG:
         approach: float | None = None,
         tolerance: float,
         max_iterations: int,
-        monitor: Callable[[int, float, np.ndarray], None] | None = None,
     ) -> tuple[np.ndarray, float, int, float]:
         """Iterate from ``pressure`` (modified in place) until the residual is at
         most ``tolerance``. Exactly one of ``mean_pressure`` (force control) and
-        ``approach`` (indentation control) is given. ``monitor``, if given, is
-        called before each step with the iteration, the residual and the flat
-        indices of the contact points (for studies of convergence).
+        ``approach`` (indentation control) is given. Each iteration calls
+        ``frictionlab.iteration_done``, which may raise ``SolveCancelled``.
 
         Returns ``(pressure, approach, iterations, residual)``; raises
         ``NotConverged`` after ``max_iterations`` steps.
@@ -136,8 +132,6 @@ class PolonskyKeerCG:
                 p[contact] = p_c
                 return pressure, float(level), iteration, residual
             iteration_done(iteration, residual)
-            if monitor is not None:
-                monitor(iteration, residual, contact)
             if iteration == max_iterations:
                 raise NotConverged(iteration, residual)
             iteration += 1
