@@ -68,7 +68,8 @@ class Result:
     ``fit``: the ``LogFit`` of xi = a + b ln f (``a``, ``b``, ``a_ci``, ``b_ci``,
     ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
-    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``contact_count``,
+    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
+    realizations whose xi is defined there), ``contact_count``,
     ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory."""
@@ -300,7 +301,7 @@ def run_scene(
 def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[str, Path]) -> Result:
     table = {
         "F": outcome.force, "f": outcome.f, "xi": outcome.xi, "xi_sem": outcome.xi_sem,
-        "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
+        "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
     return Result(
@@ -326,9 +327,10 @@ def load(folder: str | Path) -> Result | SweepResult:
     except (OSError, ValueError) as exc:
         raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
     curve = read_curve(folder / summary.get("files", {}).get("curve", "curve.csv"))
-    if [name.rstrip("'") for name in curve] != list(CURVE_COLUMNS):  # F' on the half-plane
+    names = [name.rstrip("'") for name in curve]  # F' on the half-plane
+    if names not in (list(CURVE_COLUMNS), [c for c in CURVE_COLUMNS if c != "lines_used"]):  # before lines_used
         raise RunFolderError(f"{folder}/curve.csv: columns {list(curve)} are not those frictionlab writes")
-    table = dict(zip(CURVE_COLUMNS, curve.values()))
+    table = dict(zip(names, curve.values()))
     realizations = summary.get("realizations") or {}
     return Result(
         name=summary["preset"]["name"],

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import force_unit, listening_to_loads
+from .plugin import defined_rms, force_unit, listening_to_loads
 from .preset import Scene
 from .seeds import realization_rng
 
@@ -34,6 +34,8 @@ class RealizationResult:
     slope_rms_line: float = math.nan
     points: int = 0
     force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
+    measured_rms_height: float = math.nan  # the profile's rms height about its own mean
+    own_rms_height: float = math.nan  # the h of f when it is the profile's own (profile_rms_height), else NaN
     error: str | None = None
 
     @property
@@ -59,12 +61,18 @@ def _compute(scene: Scene, index: int) -> RealizationResult:
         rng = realization_rng(scene.preset.seed, index)
         profile = scene.generator.generate(rng)
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-        slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
+        if not scene.slope.undefined_points(profile.periodic) and np.isnan(slopes).any():
+            raise ValueError(
+                f"slope estimator {scene.slope.name} gave NaN slopes, but declares every slope defined "
+                f"(undefined_points({profile.periodic}) is False)"
+            )
+        slope_rms_line = defined_rms(slopes)  # over the points that have a slope
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
         curve = scene.solver.solve(profile, scene.loads, scene.control, slopes)
+        own_h = scene.generator.profile_rms_height(profile)
         return RealizationResult(
             index=index,
             seconds=time.perf_counter() - start,
@@ -74,7 +82,9 @@ def _compute(scene: Scene, index: int) -> RealizationResult:
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             slope_rms_line=slope_rms_line,
             points=profile.points,
-            force_unit=force_unit(scene.solver, scene.generator.rms_height(), profile),
+            force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),
+            measured_rms_height=float(np.std(profile.heights)),
+            own_rms_height=math.nan if own_h is None else float(own_h),
         )
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]

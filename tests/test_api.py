@@ -115,7 +115,7 @@ def test_to_pandas_gives_a_frame_with_pandas_and_the_arrays_without(monkeypatch)
     result = frictionlab.run(SMALL_PRESET, **FAST)
     monkeypatch.setitem(sys.modules, "pandas", None)  # as if not installed
     arrays = result.to_pandas()
-    assert set(arrays) == {"F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"}
+    assert set(arrays) == {"F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation"}
     fake = types.ModuleType("pandas")
     fake.DataFrame = lambda data: ("frame", data)
     monkeypatch.setitem(sys.modules, "pandas", fake)

@@ -24,7 +24,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile, defined_rms
 
 MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
 
@@ -132,8 +132,8 @@ def _top(heights: np.ndarray) -> float:
 
 
 def _line_rms(slopes: np.ndarray) -> float:
-    """The whole-line rms slope, formed exactly as the engine forms it."""
-    return float(np.sqrt(np.mean(np.square(slopes))))
+    """The rms of the defined slopes, formed exactly as the engine forms the whole line's."""
+    return defined_rms(slopes)
 
 
 # ------------------------------------------------------------ the sorted sweep
@@ -163,6 +163,7 @@ class SpringRow(ContactSolver):
     """
 
     indentation_reference: ClassVar[str] = "undeformed body"
+    undefined_slopes: ClassVar[bool] = True
 
     def mean_displacement(self, f: np.ndarray, rms_height: float) -> np.ndarray:
         """The springs' mean compression f h."""
@@ -221,10 +222,18 @@ class SpringRow(ContactSolver):
             force = spring * (onset[n - 1] + n * (indentation - u[n - 1]))
 
         squares = np.square(slopes[order])
+        undefined = np.isnan(squares)  # points without a slope (undefined_slopes): counted in no rms
+        if undefined.any():
+            squares[undefined] = 0.0
         cumulative = np.cumsum(squares)
         if not np.isfinite(cumulative[-1]):
-            raise ValueError("slopes must be finite (and their squares must not overflow)")
-        slope_rms = np.sqrt(cumulative[n - 1] / n)
+            raise ValueError("slopes must be finite or NaN (and their squares must not overflow)")
+        if undefined.any():
+            defined = np.cumsum(~undefined)[n - 1]
+            with np.errstate(invalid="ignore", divide="ignore"):  # no defined slope in contact: NaN
+                slope_rms = np.sqrt(cumulative[n - 1] / defined)
+        else:
+            slope_rms = np.sqrt(cumulative[n - 1] / n)
         if count == points:
             full = n == points
             if full.any():  # xi = 1 to the last bit at full contact
