@@ -200,7 +200,9 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
            " (`--set seed=...` reruns one; h, where calibrated, is calibrated once on the preset's seed)."
            " \"between ensembles\" gives the mean ± standard deviation of a and b over the"
            f" {k}; \"paper inside\" in how many of the {k} the paper's a and b both lie inside that ensemble's"
-           " bootstrap intervals." if spread else ""),
+           " bootstrap intervals. The closest reading of a figure (below the table) is the one whose ensembles"
+           " hold the paper's pair most often; between equals, the one whose mean a and b lie nearest the"
+           " paper's in standard deviations between ensembles." if spread else ""),
         "",
         "| figure | reading | --set | average | a (95% CI) | b (95% CI) | R² | points in contact |"
         + (" a, b between ensembles | paper inside |" if spread else ""),
