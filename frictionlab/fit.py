@@ -203,6 +203,25 @@ def defined_mean(xi_per_realization: np.ndarray, weights: np.ndarray | None = No
         return (w @ np.where(defined, xi_per_realization, 0.0)) / (w @ defined)
 
 
+def _over_defined(f, xi_per_realization: np.ndarray, average: Average | None):
+    """(f, xi, average) of a fit: where some xi is undefined (NaN), the forces where any is
+    defined and the mean over the defined ones (``defined_mean``); else as given."""
+    if average is not None or not np.isnan(xi_per_realization).any():
+        return f, xi_per_realization, average
+    fitted = ~np.isnan(xi_per_realization).all(axis=0)
+    xi = xi_per_realization[:, fitted]
+    return np.asarray(f, float)[fitted], xi, lambda weights: defined_mean(xi, weights)
+
+
+def resample_pairs(f, xi_per_realization, bootstrap: int, rng: np.random.Generator,
+                    average: Average | None = None) -> np.ndarray:  # fmt: skip
+    """The (a, b) pairs of ``fit_log_law``'s bootstrap (``bootstrap_coefficients`` over the
+    forces and the mean it fits), less any resample without a defined xi at a fitted force."""
+    f, xi_per_realization, average = _over_defined(f, np.atleast_2d(np.asarray(xi_per_realization, float)), average)
+    samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng, average)
+    return samples[~np.isnan(samples).any(axis=1)]
+
+
 def fit_log_law(
     f: np.ndarray,
     xi_per_realization: np.ndarray,
@@ -224,18 +243,14 @@ def fit_log_law(
     realizations = xi_per_realization.shape[0]
     if realizations == 0:
         raise ValueError("no finished realization to fit")
-    if average is None and np.isnan(xi_per_realization).any():
-        fitted = ~np.isnan(xi_per_realization).all(axis=0)
-        f, xi_per_realization = np.asarray(f, float)[fitted], xi_per_realization[:, fitted]
-        average = lambda weights, xi=xi_per_realization: defined_mean(xi, weights)  # noqa: E731
+    f, xi_per_realization, average = _over_defined(f, xi_per_realization, average)
     curve = xi_per_realization.mean(axis=0) if average is None else average(None)
     fit = fit_curve(f, curve)
     intervals = [NAN2] * 2
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
-        samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng, average)
-        samples = samples[~np.isnan(samples).any(axis=1)]  # resamples without a defined xi at some fitted force
+        samples = resample_pairs(f, xi_per_realization, bootstrap, rng, average)
         if samples.shape[0]:
             low, high = percentile_interval(samples, confidence, axis=0)
             intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]
