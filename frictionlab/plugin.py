@@ -283,12 +283,11 @@ def defined_rms(values: np.ndarray) -> float:
     estimator may leave points without a slope (``SlopeEstimator.undefined_points``).
     NaN if none is; for all-defined values, exactly sqrt(mean(values^2))."""
     squares = np.square(values)
-    undefined = np.isnan(squares)
-    if undefined.any():
-        squares = squares[~undefined]
-        if not squares.size:
-            return math.nan
-    return float(np.sqrt(np.mean(squares)))
+    mean = float(np.mean(squares))
+    if math.isnan(mean):  # some value is undefined: one more pass, only then
+        squares = squares[~np.isnan(squares)]
+        mean = float(np.mean(squares)) if squares.size else math.nan
+    return math.sqrt(mean)
 
 
 # ---------------------------------------------------------------- plugin kinds

@@ -61,12 +61,10 @@ def _compute(scene: Scene, index: int) -> RealizationResult:
         rng = realization_rng(scene.preset.seed, index)
         profile = scene.generator.generate(rng)
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-        if not scene.slope.undefined_points(profile.periodic) and np.isnan(slopes).any():
-            raise ValueError(
-                f"slope estimator {scene.slope.name} gave NaN slopes, but declares every slope defined "
-                f"(undefined_points({profile.periodic}) is False)"
-            )
-        slope_rms_line = defined_rms(slopes)  # over the points that have a slope
+        if scene.slope.undefined_points(profile.periodic):
+            slope_rms_line = defined_rms(slopes)  # over the points that have a slope
+        else:  # every slope defined: a NaN makes the rms NaN, refused below
+            slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"

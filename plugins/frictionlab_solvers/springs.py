@@ -222,18 +222,20 @@ class SpringRow(ContactSolver):
             force = spring * (onset[n - 1] + n * (indentation - u[n - 1]))
 
         squares = np.square(slopes[order])
-        undefined = np.isnan(squares)  # points without a slope (undefined_slopes): counted in no rms
-        if undefined.any():
-            squares[undefined] = 0.0
         cumulative = np.cumsum(squares)
+        undefined = None
+        if np.isnan(cumulative[-1]):  # points without a slope (undefined_slopes): counted in no rms
+            undefined = np.isnan(squares)
+            squares[undefined] = 0.0
+            cumulative = np.cumsum(squares)
         if not np.isfinite(cumulative[-1]):
             raise ValueError("slopes must be finite or NaN (and their squares must not overflow)")
-        if undefined.any():
+        if undefined is None:
+            slope_rms = np.sqrt(cumulative[n - 1] / n)
+        else:
             defined = np.cumsum(~undefined)[n - 1]
             with np.errstate(invalid="ignore", divide="ignore"):  # no defined slope in contact: NaN
                 slope_rms = np.sqrt(cumulative[n - 1] / defined)
-        else:
-            slope_rms = np.sqrt(cumulative[n - 1] / n)
         if count == points:
             full = n == points
             if full.any():  # xi = 1 to the last bit at full contact
