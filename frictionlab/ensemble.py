@@ -78,8 +78,9 @@ class RunOutcome:
     @property
     def caveats(self) -> list[str]:
         """What a reader of the fit must know: too few points in contact at the first load
-        (the rms slope in contact of one or two points is mostly noise), or the whole
-        profile in contact from some load on (xi is 1 there by definition)."""
+        (the rms slope in contact of one or two points is mostly noise), the whole
+        profile in contact from some load on (xi is 1 there by definition), or lines
+        without xi at some load (averaged over fewer lines there)."""
         if self.fit is None or not self.contact_count.size:
             return []
         caveats = []
@@ -88,6 +89,11 @@ class RunOutcome:
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
         if full.size:
             caveats.append(full_contact_caveat(int(full[0]), self.loads))
+        if self.lines_used.size and self.lines_used.min() < self.done:
+            caveats.append(
+                f"up to {self.done - int(self.lines_used.min())} of {self.done} lines have no xi at a load (no point "
+                "in contact has a slope): xi there is the mean over the others (lines_used in curve.csv)"
+            )
         return caveats
 
     @property

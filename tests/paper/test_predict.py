@@ -98,6 +98,7 @@ def test_pairs_from_a_run_whose_lines_lack_xi_at_low_forces(tmp_path):
     }  # fmt: skip
     outcome, _ = run_to_folder(build_scene(data), tmp_path, RunOptions(workers=1))
     assert outcome.lines_used[0] < 30 and np.isnan(outcome.per_realization["xi"]).any()
+    assert f"up to {30 - outcome.lines_used.min()} of 30 lines have no xi at a load" in outcome.caveats[-1]
     pairs = bootstrap_pairs(tmp_path)
     low, high = np.percentile(pairs, [2.5, 97.5], axis=0)
     assert (low[0], high[0]) == outcome.fit.a_ci and (low[1], high[1]) == outcome.fit.b_ci
