@@ -25,7 +25,7 @@ _LAZY = {
     **dict.fromkeys(
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
-            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "force_unit", "iteration_done",
+            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
             "load_finished", "mdr_length",
         ),
         "plugin",

@@ -53,7 +53,7 @@ from .arguments import data_argument, flag_argument, overrides_argument, path_ar
 from .errors import FrictionlabError, PresetError, RunFolderError, shown
 from .fit import LogFit
 from .options import RunOptions
-from .results import CURVE_COLUMNS, read_curve, read_summary
+from .results import read_curve, read_summary
 from .runfolder import subfolder
 
 if TYPE_CHECKING:
@@ -70,7 +70,8 @@ class Result:
     ``fit``: the ``LogFit`` of xi = a + b ln f (``a``, ``b``, ``a_ci``, ``b_ci``,
     ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
-    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``contact_count``,
+    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
+    realizations whose xi is defined there), ``contact_count``,
     ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
@@ -353,7 +354,7 @@ def run_scene(
 def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[str, Path]) -> Result:
     table = {
         "F": outcome.force, "f": outcome.f, "xi": outcome.xi, "xi_sem": outcome.xi_sem,
-        "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
+        "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
     return Result(
@@ -391,7 +392,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         name=record.preset.name,
         status=record.status,
         fit=LogFit.from_dict(summary["fit"]) if record.fit is not None else None,
-        table=dict(zip(CURVE_COLUMNS, curve.values())),
+        table={name.rstrip("'"): values for name, values in curve.items()},  # F' on the half-plane
         realizations=(record.realizations.done, record.realizations.requested),
         normalisation=record.normalisation.f,
         preset=summary["preset"],

@@ -35,7 +35,9 @@ from .preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
-CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
+CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation")
+# columns a later frictionlab added: a folder written before them is read without them
+ADDED_CURVE_COLUMNS = frozenset({"lines_used"})
 CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
@@ -69,6 +71,12 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
             key: json_safe(value) if isinstance(value, float) else value
             for key, value in outcome.normalisation.describe(outcome.stiffness, outcome.rms_height, outcome.extent).items()
         },
+        "heights": heights_summary(outcome),
+        "lines_used": {
+            "min": int(outcome.lines_used.min()) if outcome.lines_used.size else None,
+            "max": int(outcome.lines_used.max()) if outcome.lines_used.size else None,
+            "meaning": "realizations whose xi is defined at a load step (some point in contact has a slope)",
+        },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
         "caveats": outcome.caveats,
@@ -78,6 +86,28 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "resumed_realizations": outcome.extra.get("resumed", 0),
         "retried_realizations": outcome.extra.get("retried", 0),  # had failed before the resume, ran again
         "files": files,
+    }
+
+
+def heights_summary(outcome: RunOutcome) -> dict:
+    """Which h forms f, and the rms heights the lines measured about their own means."""
+    measured = outcome.per_realization.get("measured_rms_height", np.empty(0))
+    measured = measured[np.isfinite(measured)]
+
+    def stat(op):
+        return json_safe(float(op(measured))) if measured.size else None
+
+    return {
+        "h_in_f": "each line's own rms height about its mean" if outcome.own_rms_height
+        else "the spectrum's nominal rms height",
+        "h": json_safe(outcome.rms_height),
+        "measured_rms_height": {
+            "mean": stat(np.mean),
+            "std": stat(lambda m: np.std(m, ddof=1)) if measured.size >= 2 else None,
+            "min": stat(np.min),
+            "max": stat(np.max),
+            "lines": int(measured.size),
+        },
     }
 
 
@@ -106,7 +136,8 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     NaN. RunFolderError naming the file for anything but the table frictionlab writes."""
     header, rows = read_number_table(folder, name)
     names = [column_name(h) for h in header]
-    if [n.rstrip("'") for n in names] != list(CURVE_COLUMNS):  # F' on the half-plane
+    stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
+    if stripped != [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]:
         raise RunFolderError(
             f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
             f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
@@ -195,6 +226,7 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.f,
         outcome.xi,
         outcome.xi_sem,
+        outcome.lines_used,
         outcome.contact_count,
         outcome.contact_fraction,
         outcome.indentation,
@@ -217,7 +249,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
 
     if scene.preset.output.realizations:
         files["realizations"] = out / "realizations.npz"
-        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f}
+        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f, "lines_used": outcome.lines_used}
         atomic_write(files["realizations"], lambda fh: write_npz(fh, arrays), binary=True)
 
     files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete

@@ -31,6 +31,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
 import re
 import time
@@ -361,6 +362,8 @@ class RunDirectory:
             "slope_rms_line": np.array([r.slope_rms_line for r in ok], dtype=np.float64),
             "points": np.array([r.points for r in ok], dtype=np.int64),
             "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
+            "measured_rms_height": np.array([r.measured_rms_height for r in ok], dtype=np.float64),
+            "own_rms_height": np.array([r.own_rms_height for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
@@ -491,6 +494,11 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
     repeated = indices.size > 1 and bool((np.diff(np.sort(indices)) == 0).any())  # not np.unique: it imports numpy.ma
     if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
         raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
+    heights = {}  # absent from the chunks of older versions: NaN
+    for name in ("measured_rms_height", "own_rms_height"):
+        heights[name] = arrays.get(name, np.full(n, math.nan))
+        if heights[name].shape != (n,):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(
@@ -503,6 +511,8 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             slope_rms_line=float(arrays["slope_rms_line"][row]),
             points=int(arrays["points"][row]),
             force_unit=float(arrays["force_unit"][row]),
+            measured_rms_height=float(heights["measured_rms_height"][row]),
+            own_rms_height=float(heights["own_rms_height"][row]),
         ))  # fmt: skip
     for row, index in enumerate(arrays["failed_index"].tolist()):
         out.append(RealizationResult(

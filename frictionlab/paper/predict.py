@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
-from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval
-from ..inputs import InputFileProblem
+from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval, resample_pairs
+from ..inputs import InputFileProblem, open_regular_file
 from ..plugin import ForceNormalisation, mdr_length
 from ..results import read_summary
 from ..runfolder import read_member
@@ -222,7 +222,7 @@ def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
 def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.ndarray | None:
     if not law.bootstrap or xi.shape[0] < 2:
         return None
-    return bootstrap_coefficients(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
+    return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
 
 
 def _read_summary(run_dir: Path) -> dict:
@@ -277,9 +277,10 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         raise RunFolderError(f"{path}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
     if not np.all(np.isfinite(f) & (f > 0)):
         raise RunFolderError(f"{path}: array 'f' must hold finite numbers > 0 (some are not)")
-    if not np.all(np.isfinite(xi)):
-        bad = np.count_nonzero(~np.isfinite(xi))
-        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers ({bad} of {xi.size} are not)")
+    if np.isinf(xi).any() or np.isnan(xi).all(axis=0).sum() > f.size - 2:  # NaN: a line with no xi at that load
+        bad = np.count_nonzero(np.isinf(xi))
+        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
+                             f"defined at two loads or more ({bad} of {xi.size} are infinite)")  # fmt: skip
     counts = summary.get("realizations")
     done = counts.get("done") if isinstance(counts, dict) else None
     if isinstance(done, int) and not isinstance(done, bool) and done != xi.shape[0]:

@@ -181,6 +181,16 @@ def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> 
                                 f"{instead}{make_periodic}")
         if problems:
             raise PresetError(problems, source=source)
+    periodic = plugins.get("equivalent_line", spectrum).periodic()
+    if slope.undefined_points(periodic) and not solver.undefined_slopes:
+        able = [i.name for i in registry.infos("solver") if i.cls.undefined_slopes and made in i.cls.dimensions]
+        raise PresetError(
+            [f"slope.params: {slope.name} leaves points of this {'periodic' if periodic else 'non-periodic'} profile "
+             f"without a slope, which solver {solver.name} cannot take: use "
+             + (f"solver {' or '.join(able)}, or " if able else "")
+             + "slope parameters that give every point a slope"],
+            source=source,
+        )
     return plugins
 
 

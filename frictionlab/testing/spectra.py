@@ -26,7 +26,9 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     surface's rms height, itself checked; ``c0()`` is NotImplementedError or
     finite > 0; ``hurst_exponent()`` is None or finite >= 0; ``input_summary()`` is None or
     a JSON-ready mapping whose ``shape``, ``spacing`` and ``rms_height`` are those of what
-    ``generate()`` makes and ``rms_height()``, with ``file`` and ``unit``.
+    ``generate()`` makes and ``rms_height()``, with ``file`` and ``unit``;
+    ``profile_rms_height(profile)`` is None or finite > 0 for the generated
+    profiles, and the same for two of them within a relative 1e-9 (f needs one h).
     """
     import numpy as np
 
@@ -135,6 +137,15 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     missing, c0 = is_not_implemented(cls, "c0()", gen.c0)
     if not missing:
         check_positive_number(cls, "c0()", c0)
+    own = [call(cls, "profile_rms_height(profile)", gen.profile_rms_height, p)
+           for p in (profile, gen.generate(np.random.default_rng(11)))]  # fmt: skip
+    if own[0] is not None or own[1] is not None:
+        if own[0] is None or own[1] is None:
+            fail(cls, f"profile_rms_height(profile) must be None for every profile, or a number for every one. Got {own!r}.")
+        first, second = (check_positive_number(cls, "profile_rms_height(profile)", h) for h in own)
+        if not math.isclose(first, second, rel_tol=1e-9):
+            fail(cls, f"profile_rms_height(profile) must be one h for the ensemble's profiles (f is one axis): "
+                      f"two profiles gave {first!r} and {second!r}")  # fmt: skip
     hurst = call(cls, "hurst_exponent()", gen.hurst_exponent)
     if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
         fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")

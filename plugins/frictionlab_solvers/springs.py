@@ -24,7 +24,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile, defined_rms
 
 from .checks import check_control, check_loads, check_profile
 from .elastic import ElasticParams, elastic_stiffness
@@ -59,8 +59,8 @@ def _top(heights: np.ndarray) -> float:
 
 
 def _line_rms(slopes: np.ndarray) -> float:
-    """The whole-line rms slope, formed exactly as the engine forms it."""
-    return float(np.sqrt(np.mean(np.square(slopes))))
+    """The rms of the defined slopes, formed exactly as the engine forms the whole line's."""
+    return defined_rms(slopes)
 
 
 # ------------------------------------------------------------ the sorted sweep
@@ -90,6 +90,7 @@ class SpringRow(ContactSolver):
     """
 
     indentation_reference: ClassVar[str] = "undeformed body"
+    undefined_slopes: ClassVar[bool] = True
 
     def mean_displacement(self, f: np.ndarray, rms_height: float) -> np.ndarray:
         """The springs' mean compression f h."""
@@ -149,9 +150,19 @@ class SpringRow(ContactSolver):
 
         squares = np.square(slopes[order])
         cumulative = np.cumsum(squares)
+        undefined = None
+        if np.isnan(cumulative[-1]):  # points without a slope (undefined_slopes): counted in no rms
+            undefined = np.isnan(squares)
+            squares[undefined] = 0.0
+            cumulative = np.cumsum(squares)
         if not np.isfinite(cumulative[-1]):
-            raise ValueError("slopes must be finite (and their squares must not overflow)")
-        slope_rms = np.sqrt(cumulative[n - 1] / n)
+            raise ValueError("slopes must be finite or NaN (and their squares must not overflow)")
+        if undefined is None:
+            slope_rms = np.sqrt(cumulative[n - 1] / n)
+        else:
+            defined = np.cumsum(~undefined)[n - 1]
+            with np.errstate(invalid="ignore", divide="ignore"):  # no defined slope in contact: NaN
+                slope_rms = np.sqrt(cumulative[n - 1] / defined)
         if count == points:
             full = n == points
             if full.any():  # xi = 1 to the last bit at full contact

@@ -625,8 +625,13 @@ async def test_opening_a_preset_either_way_leaves_focus_on_its_first_field(folde
         await pilot.pause()
         shown = screen_text(app)
     assert first == "field--name"
-    assert field_line(shown, "realizations").split() == ["realizations", "7"]
-    assert field_line(shown, "name").split() == ["name", "small"]
+    scrollbar = set("▁▂▃▄▅▆▇█")  # the form's scrollbar thumb may share a field's line
+
+    def words(line):
+        return [word for word in line.split() if not set(word) <= scrollbar]
+
+    assert words(field_line(shown, "realizations")) == ["realizations", "7"]
+    assert words(field_line(shown, "name")) == ["name", "small"]
 
 
 @sync
