@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import FrictionlabError, PresetError, RunFolderError
+from .errors import FrictionlabError, PresetError, RunFolderError, require
 from .fit import LogFit
 from .options import RunOptions
 from .results import CURVE_COLUMNS, read_curve
@@ -99,13 +99,9 @@ class Result:
         return self.fit.r2 if self.fit else math.nan
 
     def to_pandas(self):
-        """The table as a pandas DataFrame (one row per load step), or, without
-        pandas installed, the dict of numpy arrays itself."""
-        try:
-            import pandas as pd
-        except ImportError:
-            return dict(self.table)
-        return pd.DataFrame(self.table)
+        """The table as a pandas DataFrame, one row per load step (pandas: the ``pandas``
+        extra; without it, a ``MissingDependency`` naming it; ``table`` is the same as numpy arrays)."""
+        return require("pandas", "Result.to_pandas()").DataFrame(self.table)
 
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
@@ -148,13 +144,9 @@ class SweepResult:
         return [load(self.folder / row["folder"]) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
-        """The rows as a pandas DataFrame, or without pandas a dict of numpy arrays by column."""
+        """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
-        try:
-            import pandas as pd
-        except ImportError:
-            return {key: np.array(values) for key, values in columns.items()}
-        return pd.DataFrame(columns)
+        return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
 
     def __repr__(self) -> str:
         return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"

@@ -27,6 +27,31 @@ class FrictionlabError(Exception):
     exit_code = ExitCode.USAGE
 
 
+EXTRAS = {"dask": "dask", "distributed": "dask", "pandas": "pandas", "ipywidgets": "notebook", "tamaas": "bench"}
+"""The optional packages by top-level module, and the extra of pyproject.toml that brings each."""
+
+
+class MissingDependency(FrictionlabError):
+    """A package a feature needs is not installed; the message says how to install it."""
+
+    def __init__(self, module: str, purpose: str):
+        self.module = module.partition(".")[0]
+        extra = EXTRAS.get(self.module)
+        command = f'pip install "frictionlab[{extra}]"' if extra else "pip install --force-reinstall frictionlab"
+        super().__init__(f"{purpose} needs {self.module}, which is not installed: {command}")
+
+
+def require(module: str, purpose: str):
+    """``import module`` (and return it), or raise ``MissingDependency`` naming the pip
+    command that installs it: the one way an optional package is imported."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError:  # it, or a package it needs (the same pip command brings both)
+        raise MissingDependency(module, purpose) from None
+
+
 class PluginError(FrictionlabError):
     """A plugin is missing, broken, or clashes with another."""
 

@@ -105,6 +105,18 @@ def _unknown_command(argv: list[str]) -> str | None:
     return f"frictionlab: no command {first!r}{hint or '.'} Commands: {', '.join(names)} (frictionlab --help)"
 
 
+def _missing_package(exc: Exception, purpose: str):
+    """A package that is not installed (an optional one reached without ``errors.require``,
+    or a dependency of a broken install) as the message with its pip command; None for
+    anything else, a module of frictionlab itself included (that is a bug)."""
+    from ..errors import MissingDependency
+
+    name = exc.name if isinstance(exc, ModuleNotFoundError) else None
+    if not name or name.partition(".")[0].startswith("frictionlab"):
+        return None
+    return MissingDependency(name, purpose)
+
+
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {message}\n"
 
@@ -210,6 +222,10 @@ def _run_command(args) -> int:
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
+        missing = _missing_package(exc, f"frictionlab {args.command}")
+        if missing is not None:
+            print(f"{error_label()}: {missing}", file=sys.stderr)
+            return int(missing.exit_code)
         print(
             f"internal error: {type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}\n"
             "(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)",
