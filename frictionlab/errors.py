@@ -126,10 +126,15 @@ def short_repr(value, limit: int = 80) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
-    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the
-    hint every unknown-name message (commands, plugins, presets) ends with."""
+def close_names(word: str, names, cutoff: float = 0.5) -> list[str]:
+    """The (at most three) of ``names`` closest to ``word``, closest first."""
     import difflib
 
-    close = difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+    return difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+
+
+def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
+    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the hint
+    every unknown-name message (commands, options, plugins, presets, fields) ends with."""
+    close = close_names(word, names, cutoff)
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""

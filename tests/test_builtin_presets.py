@@ -36,7 +36,11 @@ def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch)
     monkeypatch.chdir(tmp_path)
     assert resolve_preset_path("quickstart") == find_builtin("quickstart.yaml").path
     mine = tmp_path / "quickstart.yaml"
+    with pytest.raises(PresetFileError, match=r"no file .*quickstart.yaml' here; the built-in preset of that name"):
+        resolve_preset_path(mine)  # missing: pointed to the built-in, never swapped for it
+    mine.write_text("name: mine\n")
     assert resolve_preset_path(mine) == mine  # a path is never swapped for a built-in
+    mine.unlink()
     with pytest.raises(PresetFileError, match=r"did you mean 'quickstart'\?"):
         resolve_preset_path("quikstart")
     with pytest.raises(PresetFileError, match=r"no file 'quickstart.yaml' here; the built-in preset of that name is 'quickstart'"):

@@ -69,6 +69,23 @@ class _Parser(argparse.ArgumentParser):
         if message:
             (file or sys.stderr).write(message)
 
+    def parse_known_args(self, args=None, namespace=None):
+        """Words no option takes are refused by the parser that met them, with its own
+        usage (``usage: frictionlab run ...``, not the top level's) and the closest options."""
+        namespace, extras = super().parse_known_args(args, namespace)
+        if extras:
+            self.error(unrecognized(extras, [o for a in self._actions for o in a.option_strings]))
+        return namespace, extras
+
+
+def unrecognized(words: list[str], options: list[str]) -> str:
+    """argparse's message for words it did not take, with the options closest to each."""
+    from ..errors import close_names
+
+    close = [name for word in words if word.startswith("-") for name in close_names(word.partition("=")[0], options, 0.7)]
+    hint = f"; did you mean {' or '.join(repr(name) for name in dict.fromkeys(close))}?" if close else ""
+    return f"unrecognized arguments: {' '.join(words)}{hint}"
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EXAMPLES)

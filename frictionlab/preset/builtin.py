@@ -61,8 +61,8 @@ def resolve_preset_path(argument: str | Path) -> Path:
     else the built-in of that name. Neither is a PresetFileError naming the closest
     built-in names (a path that merely does not exist is reported by the reader)."""
     path = Path(argument)
-    if not path.exists() and len(path.parts) == 1 and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):
-        raise PresetFileError(
+    if not path.exists() and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):  # presets/quickstart.yaml
+        raise PresetFileError(  # outside the clone: the file is not there, but the package has it
             [f"(file): no file {str(argument)!r} here; the built-in preset of that name is {path.stem!r} "
              f"(give the name alone: frictionlab run {path.stem})"],
             source=str(argument),
