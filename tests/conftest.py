@@ -11,6 +11,19 @@ from frictionlab.registry import Registry
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS = ROOT / "presets"
 
+LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study): `pytest -m long` runs them
+    "tui/test_screen.py", "tui/test_snapshots.py", "tui/test_form.py", "tui/test_run.py", "exact3d/test_study.py",
+}  # fmt: skip
+
+
+def pytest_collection_modifyitems(items):
+    """Mark the tests of ``LONG_MODULES`` ``long``: the README's `pytest` leaves them out (a
+    newcomer's run takes minutes), CI runs them with `pytest -m long`."""
+    tests = Path(__file__).resolve().parent
+    for item in items:
+        if item.path.is_relative_to(tests) and item.path.relative_to(tests).as_posix() in LONG_MODULES:
+            item.add_marker(pytest.mark.long)
+
 SMALL_PRESET = {
     "name": "small",
     "seed": 7,

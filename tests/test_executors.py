@@ -283,6 +283,7 @@ except Exception as exc:
 
 
 @needs_dask
+@pytest.mark.long
 def test_the_executors_own_cluster_admits_only_this_runs_credentials():
     import subprocess
 

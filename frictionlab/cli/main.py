@@ -61,6 +61,8 @@ class _Parser(argparse.ArgumentParser):
     failed write of its help through (argparse drops it), so that ``--help`` into a
     closed pipe ends as any other output does."""
 
+    refusal: tuple[str, str] | None = None  # (prog, message) of the last usage error
+
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
@@ -68,6 +70,10 @@ class _Parser(argparse.ArgumentParser):
     def _print_message(self, message, file=None):
         if message:
             (file or sys.stderr).write(message)
+
+    def error(self, message):
+        _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
+        super().error(message)
 
     def parse_known_args(self, args=None, namespace=None):
         """Words no option takes are refused by the parser that met them, with its own
@@ -180,6 +186,11 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version or a usage error: argparse has printed it
         if exc.code not in (0, None):
+            refusal = _Parser.refusal
+            if "--json" in argv and refusal is not None:  # a script reading stdout gets the error as JSON too
+                from .jsonout import emit_error
+
+                emit_error(refusal[0].removeprefix("frictionlab").strip() or None, refusal[1], exc.code)
             raise
         return _print(None)  # a closed pipe under --help shows in this flush, as under any command
     except OSError as exc:  # the help could not be written: `| head -1` (a closed pipe), `> /dev/full`
@@ -220,32 +231,44 @@ def _run_command(args) -> int:
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
         return _write_failed(exc)
     except FrictionlabError as exc:
-        print(f"{error_label()}: {shown(str(exc))}", file=sys.stderr)
-        return int(exc.exit_code)
+        return _refused(args, shown(str(exc)), exc.exit_code, f"{error_label()}: ", getattr(exc, "problems", None))
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
-        print(f"error: {exc.strerror or exc}: {exc.filename}", file=sys.stderr)
-        return int(ExitCode.RUNTIME_FAILURE)
+        return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
-        print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
-        return int(ExitCode.RUNTIME_FAILURE)
+        message = f"out of memory{detail}; ask for fewer points, realizations or workers"
+        return _refused(args, message, ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""
-        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", file=sys.stderr)
-        return int(code)
+        return _refused(args, f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", code, "")
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
         missing = _missing_package(exc, f"frictionlab {args.command}")
         if missing is not None:
-            print(f"{error_label()}: {missing}", file=sys.stderr)
-            return int(missing.exit_code)
-        print(
-            f"internal error: {type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}\n"
-            "(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)",
-            file=sys.stderr,
-        )
-        return int(ExitCode.INTERNAL)
+            return _refused(args, str(missing), missing.exit_code, f"{error_label()}: ")
+        message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"
+        return _refused(args, message, ExitCode.INTERNAL, "internal error: ",
+                        suffix="\n(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)")  # fmt: skip
+
+
+def _refused(args, message: str, code: int, label: str = "error: ", problems=None, suffix: str = "") -> int:
+    """Say why the command stopped on stderr and, under ``--json``, as the error object
+    on stdout (``jsonout``); return the exit code."""
+    print(f"{label}{message}{suffix}", file=sys.stderr)
+    if getattr(args, "json", False):
+        from . import jsonout
+
+        try:
+            jsonout.emit_error(_command_path(args), message, int(code), problems)
+            sys.stdout.flush()
+        except OSError as exc:
+            _write_failed(exc)
+    return int(code)
+
+
+def _command_path(args) -> str:
+    return " ".join(filter(None, [args.command, getattr(args, "action", None)]))

@@ -68,6 +68,12 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
     return message[:1].lower() + message[1:]
 
 
+def shown_value(value) -> str:
+    """``value`` as a problem line quotes it: cut short, but a text (a path) long enough to
+    keep its file's name."""
+    return short_repr(value, 240 if isinstance(value, str) else 80)
+
+
 def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix: str = "") -> list[str]:
     """One line per pydantic error: ``path: message, got value``. A required field
     missing because it was misspelt is said once, by the misspelling's suggestion."""
@@ -86,7 +92,7 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
         line = f"{path or '(preset)'}: {_describe(error, model)}"
         checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
         if error["type"] != "missing" and not checked_together:  # a check of several fields names their values
-            line += f", got {short_repr(error['input'])}"
+            line += f", got {shown_value(error['input'])}"
         lines.append(line)
     return lines
 

@@ -67,10 +67,10 @@ def test_every_reporting_command_takes_json(name):
 
 def test_json_output_of_validate_plugins_and_predict_parses(tmp_path):
     done = run_cli("validate", "quickstart", "--json")
-    record = json.loads(done.stdout)[0]
+    record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == 0 and record["ok"] and record["name"] == "quickstart"
     done = run_cli("validate", "quickstart", "--set", "realizations=0", "--json")
-    record = json.loads(done.stdout)[0]
+    record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == ExitCode.USAGE and not record["ok"] and record["problems"][0].startswith("realizations")
     assert json.loads(run_cli("plugins", "--json").stdout)["plugins"]
     done = run_cli("predict", "--a", "1.5", "--b", "0.1", "--area", "1", "--modulus", "1", "--rms-height", "1",
