@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from ..errors import PluginError, PresetError, short_repr
+from ..errors import PluginError, PresetError
 from ..inputs import input_fields, regular_file_problem
 from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from ..registry import Registry, default_registry
