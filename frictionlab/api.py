@@ -118,6 +118,11 @@ class Result:
         ax.set_title(self.name, fontsize=10)
         return ax
 
+    def _repr_html_(self) -> str:  # a notebook's view: the fit's table with its intervals, and the curve
+        from .reprs import result_html
+
+        return result_html(self)
+
     def __repr__(self) -> str:
         fit = "no fit" if self.fit is None else f"a = {self.fit.a:.4f}, b = {self.fit.b:.4f}, R² = {self.fit.r2:.3f}"
         where = f", folder {str(self.folder)!r}" if self.folder else ""
