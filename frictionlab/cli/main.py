@@ -180,6 +180,10 @@ def main(argv: list[str] | None = None) -> int:
     problem = _unknown_command(argv)
     if problem:
         print(problem, file=sys.stderr)
+        if "--json" in argv:
+            from .jsonout import emit_error
+
+            emit_error(None, problem.removeprefix("frictionlab: "), ExitCode.USAGE)
         return int(ExitCode.USAGE)
     parser = build_parser()
     try:

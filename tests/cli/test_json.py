@@ -130,3 +130,10 @@ def _hooks():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def test_a_mistyped_command_under_json_is_an_error_object_too(capsys):
+    assert main(["valdate", "quickstart", "--json"]) == ExitCode.USAGE
+    data = one_object(capsys.readouterr().out)
+    assert data["schema"] == "frictionlab/error/1" and "did you mean 'validate'?" in data["error"]
+    assert data["command"] is None and data["exit_code"] == ExitCode.USAGE
