@@ -62,3 +62,13 @@ def test_a_bad_profile_is_refused_up_front_with_the_exit_code_the_page_gives(tmp
     assert main(["validate", str(preset)]) == ExitCode.USAGE == 2
     assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     assert "scan.csv" in capsys.readouterr().err and not (tmp_path / "o").exists()
+
+
+def test_ci_runs_the_long_tests_the_readmes_command_leaves_out():
+    import tomllib
+
+    options = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["pytest"]["ini_options"]
+    assert "not long" in options["addopts"] and "-n auto" in options["addopts"]
+    assert any(marker.startswith("long:") for marker in options["markers"])
+    ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
+    assert ci.index("pytest -m long") > ci.index('pip install -e ".[test]" && pytest')
