@@ -186,6 +186,7 @@ def main(argv: list[str] | None = None) -> int:
             emit_error(None, problem.removeprefix("frictionlab: "), ExitCode.USAGE)
         return int(ExitCode.USAGE)
     parser = build_parser()
+    _Parser.refusal = None
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version or a usage error: argparse has printed it
