@@ -89,3 +89,12 @@ def test_every_extra_named_is_one_pyproject_declares():
     assert set(EXTRAS.values()) <= set(declared)
     for module, extra in EXTRAS.items():  # the extra really brings the module
         assert any(line.lower().startswith(module.lower()) or f"[{module}" in line for line in declared[extra]), extra
+
+
+def test_a_missing_matplotlib_keeps_the_numbers_and_says_how_to_mend_the_install(tmp_path):
+    done = run_without(["matplotlib"], ["run", "quickstart", "--set", "realizations=4", "--workers", "1", "--quiet",
+                                        "--out", "o"], tmp_path)  # fmt: skip
+    assert done.returncode == ExitCode.RUNTIME_FAILURE, done.stderr
+    assert "cannot draw" in done.stderr and "drawing needs matplotlib, which is not installed: pip install" in done.stderr
+    assert "internal error" not in done.stderr
+    assert (tmp_path / "o" / "summary.json").is_file() and (tmp_path / "o" / "curve.csv").is_file()
