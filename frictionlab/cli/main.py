@@ -3,14 +3,17 @@
 Conventions every command keeps (tested in tests/cli/test_conventions.py):
 
 * results go to stdout, progress and errors to stderr; ``--json`` puts the results as
-  JSON on stdout (run, validate, plugins, presets, study, report, predict);
+  one JSON object on stdout (run, validate, plugins, presets, study, report, predict),
+  an error too, each of a shape named in ``jsonout``;
 * a bare ``frictionlab`` prints a short help with examples; ``-V``/``--version`` the
   version; every ``COMMAND --help`` a description and examples;
-* a mistyped command, plugin or preset name is answered with the closest names;
+* a mistyped command, option, plugin, preset name or preset field is answered with the
+  closest names; an unknown option with its own command's usage;
 * tables fit the terminal (rich) and are plain aligned columns in a pipe; colour only
   on a terminal, never with ``NO_COLOR`` set; progress is a bar on a terminal and a
   line per tenth in a log, shown once a run passes 2 s, none with ``--quiet``;
-* ``frictionlab completion bash|zsh|fish`` prints a completion script;
+* ``frictionlab completion bash|zsh|fish`` prints a completion script made from the parser;
+* a missing optional package is said with the pip command that installs it;
 * exit codes are ``ExitCode``; a user error never prints a traceback (set
   ``FRICTIONLAB_DEBUG=1`` to see one for an internal error); SIGTERM ends a run as
   Ctrl-C does; a closed stdout ends the command quietly (141).
