@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import gc
 import os
+import re
 import sys
 import warnings
 
@@ -75,6 +76,12 @@ class _Parser(argparse.ArgumentParser):
             (file or sys.stderr).write(message)
 
     def error(self, message):
+        choice = re.search(r"invalid choice: '(.*)' \(choose from (.*)\)$", message)
+        if choice:  # argparse lists the choices; the closest goes first
+            from ..errors import did_you_mean
+
+            choices = [c.strip("'") for c in choice.group(2).split(", ")]  # quoted before Python 3.12.8, bare after
+            message += did_you_mean(choice.group(1), choices, 0.7)
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
         super().error(message)
 

@@ -79,3 +79,11 @@ def test_a_missing_file_named_as_a_builtin_points_to_the_builtin(tmp_path):
     assert "frictionlab run quickstart" in done.stderr
     missing = run_cli("validate", "presets/mine.yaml", cwd=tmp_path)  # no built-in of that name: just missing
     assert missing.returncode == ExitCode.INPUT_FILE and "built-in" not in missing.stderr
+
+
+def test_a_misspelt_choice_is_answered_with_the_closest_choice(capsys):
+    err = usage_error(capsys, ["run", "quickstart", "--executor", "dsk"])
+    assert err.startswith("usage: frictionlab run ") and "invalid choice: 'dsk'" in err
+    assert err.rstrip().endswith("dask); did you mean 'dask'?")  # after argparse's list of every choice
+    assert usage_error(capsys, ["completion", "fsh"]).rstrip().endswith("; did you mean 'fish'?")
+    assert "did you mean" not in usage_error(capsys, ["completion", "zzzz"])
