@@ -1,5 +1,7 @@
 """A mistyped field, option or file is answered with the closest right one."""
 
+import re
+
 import pytest
 
 from frictionlab.cli import main
@@ -84,6 +86,6 @@ def test_a_missing_file_named_as_a_builtin_points_to_the_builtin(tmp_path):
 def test_a_misspelt_choice_is_answered_with_the_closest_choice(capsys):
     err = usage_error(capsys, ["run", "quickstart", "--executor", "dsk"])
     assert err.startswith("usage: frictionlab run ") and "invalid choice: 'dsk'" in err
-    assert err.rstrip().endswith("dask); did you mean 'dask'?")  # after argparse's list of every choice
+    assert re.search(r"dask'?\); did you mean 'dask'\?$", err.rstrip())  # after argparse's list of every choice
     assert usage_error(capsys, ["completion", "fsh"]).rstrip().endswith("; did you mean 'fish'?")
     assert "did you mean" not in usage_error(capsys, ["completion", "zzzz"])
