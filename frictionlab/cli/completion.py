@@ -258,9 +258,11 @@ def _fish_values(value: Value, words: dict[str, list[str]]) -> str:
     """The fish flags that complete one value (-r: it takes one; -F files; -x no files)."""
     if value.kind == WORDS:
         return f"-x -a {_fish_quote(' '.join(value.words))}"
-    if value.kind in (FILES, PRESETS):
-        extra = f" -a {_fish_quote(' '.join(words[BUILTINS]))}" if value.kind == PRESETS else ""
-        return "-F" + extra
+    if value.kind == FILES:
+        return "-F"
+    if value.kind == PRESETS:  # a built-in's name, a YAML file, or a folder on the way to one
+        files = "(string match -r -- '.*\\.ya?ml$' (__fish_complete_suffix .yaml)) (__fish_complete_directories)"
+        return f"-x -a {_fish_quote(' '.join(words[BUILTINS]) + ' ' + files)}"
     if value.kind == DIRS:
         return "-x -a '(__fish_complete_directories)'"
     if value.kind in (BUILTINS, SETTINGS):

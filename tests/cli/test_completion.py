@@ -171,16 +171,24 @@ def test_fish_completion_in_a_real_fish(tmp_path):
 
     def complete(line: str) -> list[str]:
         code = f"source {shlex.quote(str(script))}; complete -C {shlex.quote(line)}"
-        done = subprocess.run(["fish", "--no-config", "-c", code], capture_output=True, text=True, timeout=30)
+        done = subprocess.run(["fish", "--no-config", "-c", code], capture_output=True, text=True, timeout=30,
+                              cwd=tmp_path)  # fmt: skip
         assert done.returncode == 0, done.stderr
         return [row.split("\t")[0] for row in done.stdout.splitlines()]
+
+    (tmp_path / "my.yaml").write_text("")
+    (tmp_path / "notes.txt").write_text("")
+    (tmp_path / "presets").mkdir()
+    assert set(complete("frictionlab run ")) == BUILTINS | {"my.yaml", "presets/"}  # not notes.txt
+    assert set(complete("frictionlab run quickstart --tls-cert ")) >= {"my.yaml", "notes.txt"}
+    assert complete("frictionlab run quickstart --set spectrum.params.hu") == ["spectrum.params.hurst="]
 
     assert set(complete("frictionlab re")) == {"report", "resume"}
     assert "--no-plot" in complete("frictionlab run --no")
     assert complete("frictionlab completion f") == ["fish"]
     assert "quickstart" in complete("frictionlab run qu")
     assert "benad2012-fig2" in complete("frictionlab presets copy bena")
-    assert complete("frictionlab run quickstart --executor ") == list(EXECUTORS)
+    assert sorted(complete("frictionlab run quickstart --executor ")) == sorted(EXECUTORS)  # fish sorts them
     assert complete("frictionlab presets ") == ["copy"]
 
 
