@@ -68,7 +68,33 @@ def test_ci_runs_the_long_tests_the_readmes_command_leaves_out():
     import tomllib
 
     options = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["pytest"]["ini_options"]
-    assert "not long" in options["addopts"] and "-n auto" in options["addopts"]
+    assert "-n auto" in options["addopts"]
     assert any(marker.startswith("long:") for marker in options["markers"])
     ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
     assert ci.index("pytest -m long") > ci.index('pip install -e ".[test]" && pytest')
+
+
+def _collected(*args: str) -> str:
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "-n", "0", *args],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-2000:]
+    return done.stdout.strip().splitlines()[-1]
+
+
+def test_a_long_module_named_on_the_command_line_runs_whole():
+    """`pytest tests/exact3d/test_study.py` (as one runs the file one changed) deselects nothing."""
+    assert re.fullmatch(r"\d+ tests collected in .*", _collected("tests/exact3d/test_study.py"))
+    assert re.fullmatch(r"\d+ tests collected in .*", _collected("tests/tui/test_form.py"))
+
+
+@pytest.mark.long  # three collections of the whole suite
+def test_a_bare_pytest_leaves_out_exactly_the_long_and_slow_tests():
+    bare = re.fullmatch(r"(\d+)/(\d+) tests collected \((\d+) deselected\) in .*", _collected())
+    long = re.fullmatch(r"(\d+)/(\d+) tests collected \((\d+) deselected\) in .*", _collected("-m", "long"))
+    assert bare and long and bare.group(2) == long.group(2)  # the same tests, selected two ways
+    slow = re.fullmatch(r"(\d+)/(\d+) tests collected .*", _collected("-m", "slow and not long"))
+    assert int(bare.group(3)) == int(long.group(1)) + int(slow.group(1))
+    assert int(long.group(1)) >= 50  # the TUI sessions and the 3D study at least
