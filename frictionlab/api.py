@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument
-from .errors import FrictionlabError, PresetError, RunFolderError, shown
+from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
 from .fit import LogFit
 from .options import RunOptions
 from .results import read_curve, read_summary
@@ -105,13 +105,9 @@ class Result:
         return self.fit.r2 if self.fit else math.nan
 
     def to_pandas(self):
-        """The table as a pandas DataFrame (one row per load step), or, without
-        pandas installed, the dict of numpy arrays itself."""
-        try:
-            import pandas as pd
-        except ImportError:
-            return dict(self.table)
-        return pd.DataFrame(self.table)
+        """The table as a pandas DataFrame, one row per load step (pandas: the ``pandas``
+        extra; without it, a ``MissingDependency`` naming it; ``table`` is the same as numpy arrays)."""
+        return require("pandas", "Result.to_pandas()").DataFrame(self.table)
 
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
@@ -129,6 +125,11 @@ class Result:
         ax.set_xlabel(self.normalisation, fontsize=8)
         ax.set_title(self.name, fontsize=10)
         return ax
+
+    def _repr_html_(self) -> str:  # a notebook's view: the fit's table with its intervals, and the curve
+        from .reprs import result_html
+
+        return result_html(self)
 
     def __repr__(self) -> str:
         fit = "no fit" if self.fit is None else f"a = {self.fit.a:.4f}, b = {self.fit.b:.4f}, R² = {self.fit.r2:.3f}"
@@ -156,13 +157,9 @@ class SweepResult:
         return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
-        """The rows as a pandas DataFrame, or without pandas a dict of numpy arrays by column."""
+        """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
-        try:
-            import pandas as pd
-        except ImportError:
-            return {key: np.array(values) for key, values in columns.items()}
-        return pd.DataFrame(columns)
+        return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
 
     def __repr__(self) -> str:
         return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"

@@ -22,23 +22,22 @@ import logging
 import warnings
 from urllib.parse import urlsplit
 
-from .errors import FrictionlabError, RunError, short_repr
+from .errors import FrictionlabError, MissingDependency, RunError, require, short_repr
 
-DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+DASK_PURPOSE = "the dask executor"
+DASK_MISSING = str(MissingDependency("distributed", DASK_PURPOSE))
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 ENCRYPTED = ("tls", "wss")
 
 
 def import_distributed():
-    try:
-        import distributed
-    except ImportError:
-        raise FrictionlabError(DASK_MISSING) from None
-    return distributed
+    """``distributed`` (which imports ``dask``), or the message with the pip command."""
+    return require("distributed", DASK_PURPOSE)
 
 
 def use_tls_files(ca_file: str | None = None, cert: str | None = None, key: str | None = None) -> None:
     """Set Dask's TLS configuration for this process (what ``--tls-*`` give)."""
+    import_distributed()
     import dask
 
     given = {"ca-file": ca_file, "client.cert": cert, "client.key": key}

@@ -29,6 +29,31 @@ class FrictionlabError(Exception):
     exit_code = ExitCode.USAGE
 
 
+EXTRAS = {"dask": "dask", "distributed": "dask", "pandas": "pandas", "ipywidgets": "notebook", "tamaas": "bench"}
+"""The optional packages by top-level module, and the extra of pyproject.toml that brings each."""
+
+
+class MissingDependency(FrictionlabError):
+    """A package a feature needs is not installed; the message says how to install it."""
+
+    def __init__(self, module: str, purpose: str):
+        self.module = module.partition(".")[0]
+        extra = EXTRAS.get(self.module)
+        command = f'pip install "frictionlab[{extra}]"' if extra else "pip install --force-reinstall frictionlab"
+        super().__init__(f"{purpose} needs {self.module}, which is not installed: {command}")
+
+
+def require(module: str, purpose: str):
+    """``import module`` (and return it), or raise ``MissingDependency`` naming the pip
+    command that installs it: the one way an optional package is imported."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError:  # it, or a package it needs (the same pip command brings both)
+        raise MissingDependency(module, purpose) from None
+
+
 class PluginError(FrictionlabError):
     """A plugin is missing, broken, or clashes with another."""
 
@@ -129,10 +154,15 @@ def short_repr(value, limit: int = 80) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
-    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the
-    hint every unknown-name message (commands, plugins, presets) ends with."""
+def close_names(word: str, names, cutoff: float = 0.5) -> list[str]:
+    """The (at most three) of ``names`` closest to ``word``, closest first."""
     import difflib
 
-    close = difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+    return difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+
+
+def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
+    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the hint
+    every unknown-name message (commands, options, plugins, presets, fields) ends with."""
+    close = close_names(word, names, cutoff)
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""

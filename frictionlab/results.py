@@ -28,7 +28,7 @@ from pydantic import Field
 
 from . import __version__
 from .ensemble import RunOutcome
-from .errors import RunError, RunFolderError, shown
+from .errors import MissingDependency, RunError, RunFolderError, shown
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
@@ -283,6 +283,9 @@ def write_figure(path: Path, draw) -> None:
         atomic_write(path, draw, binary=True)
     except OSError as exc:
         raise RunError(f"cannot write {path}: {exc.strerror or exc}; the numbers are written") from None
+    except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
+        raise RunError(f"cannot draw {path}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
+                       "the numbers are written") from None  # fmt: skip
     except Exception as exc:
         raise RunError(f"cannot draw {path}: {type(exc).__name__}: {exc}; the numbers are written") from None
 

@@ -283,6 +283,7 @@ except Exception as exc:
 
 
 @needs_dask
+@pytest.mark.long
 def test_the_executors_own_cluster_admits_only_this_runs_credentials():
     import subprocess
 
@@ -355,7 +356,8 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
     preset = tmp_path / "p.yaml"
     preset.write_text(yaml.safe_dump(merge(SMALL_PRESET, {"realizations": 24, "output": {"plot": False}})))
     with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", protocol="tls://", security=security,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:  # fmt: skip
+                      dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # no fixed port
+                      silence_logs=logging.ERROR) as cluster:  # fmt: skip
         command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--executor", "dask",
                    "--scheduler", cluster.scheduler_address, "--quiet"]  # fmt: skip
         bare = subprocess.run([*command, "--out", str(tmp_path / "bare")], capture_output=True, text=True, cwd=ROOT,

@@ -82,6 +82,7 @@ def surface_of(points: int, solver: str = "bem-halfspace", **changes) -> dict:
     })  # fmt: skip
 
 
+@pytest.mark.long
 def test_the_half_space_declares_what_its_realization_allocates(registry):
     """tracemalloc sees numpy's buffers: the peak of one realization (synthesis, slopes,
     the solve) per point lies under the declared estimate, and not far under it."""

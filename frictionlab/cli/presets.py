@@ -3,7 +3,6 @@ to take one out to edit (never over an existing file without ``--force``)."""
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
@@ -24,7 +23,7 @@ def add_parser(sub) -> None:
         "or copy it out to edit.",
         epilog=EXAMPLES,
     )
-    p.add_argument("--json", action="store_true", help="as JSON: name, description, path")
+    p.add_argument("--json", action="store_true", help="as JSON: name, whole description, path")
     actions = p.add_subparsers(dest="action", metavar="ACTION")
     c = actions.add_parser(
         "copy",
@@ -53,9 +52,11 @@ def run(args) -> ExitCode:
             dest.mkdir(parents=True)
         return copy_preset(args.name, dest, force=args.force)
     presets = builtin_presets()
-    if args.json:
-        rows = [{"name": p.name, "description": p.description, "path": str(p.path)} for p in presets]
-        print(json.dumps(rows, indent=2))
+    if args.json:  # the whole description (the table shows its first sentence)
+        from .jsonout import emit
+
+        emit("presets", {"presets": [{"name": p.name, "description": p.full_description, "path": str(p.path)}
+                                     for p in presets]})  # fmt: skip
         return ExitCode.OK
     from .console import print_table
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import sys
@@ -52,7 +51,9 @@ def run(args) -> ExitCode:
     if args.json:  # the figures the report shows, as its image links name them
         images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
         figures = list(dict.fromkeys(os.path.normpath(path.parent / image) for image in images))
-        print(json.dumps({"report": str(path), "figures": figures}, indent=2))
+        from .jsonout import emit
+
+        emit("report", {"report": str(path), "figures": figures})
     else:
         print(path)
     return ExitCode.OK

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError, counted, shown
@@ -57,5 +56,7 @@ def run(args) -> ExitCode:
             if record["input"] is not None:
                 print(f"  read {describe_input(record['input'])}")
     if args.json:
-        print(json.dumps(records, indent=2))
+        from .jsonout import emit
+
+        emit("validate", {"ok": all(record["ok"] for record in records), "presets": records})
     return worst
