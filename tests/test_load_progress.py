@@ -181,17 +181,27 @@ def test_iterations_are_heard_at_most_four_times_a_second(registry, monkeypatch)
 
 
 class CancelMidSolve:
-    """Sets the run's cancel at the first iteration heard from a realization after the
-    first (which the engine runs alone, before the executor's)."""
+    """Sets the run's cancel at the first iteration or load heard from a realization after
+    the first (which the engine runs alone, before the executor's). Iterations are heard at
+    most four times a second, so a fast solve may report none: its first load's end, which
+    is always heard and leaves loads to solve, sets the cancel then."""
 
     def __init__(self, cancel):
         self.cancel, self.solving = cancel, None
 
-    @hookimpl
-    def iteration_done(self, index, load, iteration, residual):
+    def _heard(self, index):
         if index > 0 and self.solving is None:
             self.solving = index
             self.cancel.set()
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        self._heard(index)
+
+    @hookimpl
+    def load_done(self, index, done, total):
+        if done < total:  # loads are left: the cancel comes within the solve
+            self._heard(index)
 
 
 @pytest.mark.parametrize("options", [RunOptions(workers=1, executor="serial"), RunOptions(workers=2, executor="processes")],
