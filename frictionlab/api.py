@@ -385,6 +385,11 @@ def load(folder: str | Path) -> Result | SweepResult:
         raise RunFolderError(
             f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
         )
+    if "lines_used" in curve and np.any(curve["lines_used"] > record.realizations.done):
+        raise RunFolderError(
+            f"{shown(folder / curve_name)} is damaged: lines_used exceeds the {record.realizations.done} "
+            "realizations done"
+        )
     return Result(
         name=record.preset.name,
         status=record.status,
