@@ -195,6 +195,14 @@ def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
 
 
+def test_a_scan_with_no_defined_point_is_refused_even_when_filling(tmp_path):
+    """Harmonic filling has nothing to fill from: the file is refused as empty, not read as flat."""
+    write_x3p(tmp_path / "empty.x3p", np.full((ROWS, COLUMNS), np.nan))
+    for undefined in ("refuse", "harmonic"):
+        with pytest.raises(ValueError, match="all 768 points are undefined in the file"):
+            SurfaceFile(path=str(tmp_path / "empty.x3p"), undefined=undefined).rms_height()
+
+
 def test_validate_shows_what_was_read(tmp_path, capsys):
     write_x3p(tmp_path / "scan.x3p", scan_um())
     (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.x3p", "nm")))
