@@ -166,17 +166,24 @@ class SweepResult:
 
 
 def read_preset_input(
-    preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, **keys: Any
+    preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /, **keys: Any
 ) -> tuple[dict, str, Path | None]:
     """Preset data from any input form, overrides applied; with a name for messages
     and the folder relative input files are taken from (a file's own; else None: the
     current folder). Forms: a ``Preset``; a dict; a string holding YAML (a newline,
-    or a ``{...}`` flow mapping); else a path to a file, or a built-in's name."""
+    or a ``{...}`` flow mapping); else a path to a file, or a built-in's name.
+    ``overrides`` may also come as a keyword (no preset has such a key); ``preset`` may not."""
     from .preset import Preset, load_preset_file, set_path
     from .preset.builtin import find_builtin, preset_source, resolve_preset_path
     from .preset.reading import resolve_input_paths
     from .safe_yaml import YamlProblem, load_yaml
 
+    if "overrides" in keys:  # run(preset, overrides={...}): the positional argument, named
+        if overrides is not None:
+            raise FrictionlabError("overrides given twice: as the second argument and as overrides=; give one")
+        overrides = keys.pop("overrides")
+    if "preset" in keys:
+        raise FrictionlabError("preset given twice: as the first argument and as preset=; give it first, unnamed")
     overrides = overrides_argument(overrides)
     data_argument(keys, "keyword overrides")
     base_dir = None
@@ -266,7 +273,7 @@ def run(
     """Run a preset and return its ``Result``.
 
     ``preset``: a path, a built-in's name (``"quickstart"``), YAML text, a dict or a
-    ``frictionlab.preset.Preset``. ``overrides``: ``{"spectrum.params.hurst": 0.8}``;
+    ``frictionlab.preset.Preset``. ``overrides`` (second, or ``overrides=``): ``{"spectrum.params.hurst": 0.8}``;
     keywords too, a double underscore for each dot (``spectrum__params__hurst=0.8``,
     ``seed=3``, ``realizations=20``), given values taking precedence in that order.
 
@@ -384,6 +391,11 @@ def load(folder: str | Path) -> Result | SweepResult:
     if isinstance(steps, int) and not isinstance(steps, bool) and rows != steps:
         raise RunFolderError(
             f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
+        )
+    if "lines_used" in curve and np.any(curve["lines_used"] > record.realizations.done):
+        raise RunFolderError(
+            f"{shown(folder / curve_name)} is damaged: lines_used exceeds the {record.realizations.done} "
+            "realizations done"
         )
     return Result(
         name=record.preset.name,

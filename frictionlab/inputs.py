@@ -153,6 +153,8 @@ def describe_input(summary: dict) -> str:
     spacing_from = summary.get("spacing_from")
     converted = summary.get("file_unit")
     unit_note = f", converted from the file's {converted}" if converted and unit and converted != unit else ""
+    if "file_unit" in summary and converted is None and unit:  # an instrument file that states no unit
+        unit_note = f", the file states no unit: its numbers taken as {unit}"
     return (
         f"{Path(summary['file']).name} ({summary.get('format', '?')}): {shape} {kind} of {summary['spacing']:.6g}"
         f"{length}{f' (from the {spacing_from})' if spacing_from else ''}, rms height {summary['rms_height']:.6g}"

@@ -143,7 +143,25 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
             f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
         )
     table = np.array(rows, dtype=float).reshape(len(rows), len(names))
-    return {n: table[:, i].copy() for i, n in enumerate(names)}
+    curve = {n: table[:, i].copy() for i, n in enumerate(names)}
+    _check_counts(curve, Path(folder) / name)
+    return curve
+
+
+def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
+    """Counts are counts: ``lines_used`` a whole number >= 0 at every step, the mean
+    ``contact_count`` >= 0 and ``contact_fraction`` in [0, 1] where given."""
+    problems = []
+    if "lines_used" in curve:
+        used = curve["lines_used"]
+        if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
+            problems.append("lines_used must be a whole number >= 0 at every load step")
+    for column, low, high in (("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0)):
+        values = curve[column][~np.isnan(curve[column])]
+        if np.any((values < low) | (values > high)):
+            problems.append(f"{column} must be {'in [0, 1]' if high == 1.0 else '>= 0'}")
+    if problems:
+        raise RunFolderError(f"{shown(path)} is damaged ({'; '.join(problems)})")
 
 
 # ------------------------------------------------------------------ summary.json, read back

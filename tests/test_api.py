@@ -48,6 +48,13 @@ def test_overrides_by_dict_and_by_double_underscore_agree_and_are_applied():
     assert SMALL_PRESET["spectrum"]["params"]["hurst"] == 0.8  # the caller's dict is left as it was
 
 
+def test_overrides_may_be_named_as_in_the_signature():
+    """``overrides=`` is the second argument named (a preset has no key of that name): once a raw TypeError."""
+    named = frictionlab.run(SMALL_PRESET, overrides={"spectrum.params.hurst": 0.5, "seed": 3}, **FAST)
+    assert named.preset["spectrum"]["params"]["hurst"] == 0.5 and named.preset["seed"] == 3
+    assert frictionlab.validate("quickstart", overrides={"realizations": 7})["realizations"] == 7
+
+
 def test_bad_input_is_a_clear_error_naming_the_field():
     with pytest.raises(PresetError, match="spectrum.params.hurst"):
         frictionlab.run(SMALL_PRESET, spectrum__params__hurst=7.0, **FAST)
@@ -206,6 +213,9 @@ def _containing_itself() -> dict:
         (lambda: frictionlab.run("quickstart", resume="yes", **FAST), "resume must be True or False, got str"),
         (lambda: frictionlab.run("quickstart", workers=1, progress=1), "progress must be True or False, got int"),
         (lambda: frictionlab.run("", **FAST), "preset must be a path to a preset file, or a built-in's name, got an empty string"),
+        (lambda: frictionlab.run("quickstart", {"seed": 3}, overrides={"seed": 4}, **FAST), "overrides given twice"),
+        (lambda: frictionlab.run("quickstart", preset="quickstart", **FAST), "preset given twice"),
+        (lambda: frictionlab.validate("quickstart", overrides=5), "overrides must be a mapping of dotted keys to values, got int"),
         (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
         (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
         (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),

@@ -195,6 +195,22 @@ def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
 
 
+def test_a_scan_with_no_defined_point_is_refused_even_when_filling(tmp_path):
+    """Harmonic filling has nothing to fill from: the file is refused as empty, not read as flat."""
+    write_x3p(tmp_path / "empty.x3p", np.full((ROWS, COLUMNS), np.nan))
+    for undefined in ("refuse", "harmonic"):
+        with pytest.raises(ValueError, match="all 768 points are undefined in the file"):
+            SurfaceFile(path=str(tmp_path / "empty.x3p"), undefined=undefined).rms_height()
+
+
+def test_validate_says_when_an_instrument_file_states_no_unit(tmp_path, capsys):
+    """The preset's unit is then an assumption about the file, not a conversion: said so."""
+    write_topography(tmp_path / "bare.nc", scan_um(), PIXEL_UM, None, "to_netcdf")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "bare.nc", "um")))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+    assert "rms height 0.05 um, the file states no unit: its numbers taken as um" in capsys.readouterr().out
+
+
 def test_validate_shows_what_was_read(tmp_path, capsys):
     write_x3p(tmp_path / "scan.x3p", scan_um())
     (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.x3p", "nm")))

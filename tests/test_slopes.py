@@ -275,6 +275,24 @@ def test_a_scan_is_refused_by_spectral_slopes_and_periodic_solvers(tmp_path, reg
     assert build_scene(data, registry=registry).spectrum.periodic()
 
 
+def test_a_cosine_line_given_to_a_periodic_solver_is_told_the_parameter_that_exists(registry):
+    """A synthesised line has no ``periodic`` parameter: the advice names ``series``, and
+    following it builds."""
+    data = {
+        "name": "cosine", "realizations": 1,
+        "spectrum": {"name": "power-law", "params": {"hurst": 0.8, "points": 64, "series": "cosine"}},
+        "solver": {"name": "bem-halfplane"}, "slope": {"name": "forward-difference"},
+        "loading": {"start": 1.0, "stop": 10.0, "steps": 3},
+    }  # fmt: skip
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    (problem,) = info.value.problems
+    assert "is not periodic (series: cosine" in problem and "set spectrum.params.series: fft" in problem
+    assert "spectrum.params.periodic" not in problem
+    data["spectrum"]["params"]["series"] = "fft"
+    assert build_scene(data, registry=registry).spectrum.periodic()
+
+
 @pytest.mark.parametrize("cls", ESTIMATORS)
 def test_shape_dtype_and_input_untouched(cls):
     z = np.random.default_rng(1).normal(size=100)

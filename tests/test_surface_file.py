@@ -215,3 +215,15 @@ def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys
     assert "surface-file" in err and "nan.npy" in err and "not finite" in err and "Traceback" not in err
     with pytest.raises(PresetError):
         load_scene(preset)
+
+
+def test_a_npy_whose_header_asks_for_more_than_memory_is_refused_with_its_size(tmp_path):
+    """A header announcing 2^23 x 2^22 doubles (256 TiB, beyond any address space, so the
+    allocation fails whatever the overcommit policy) over a 64-byte body: the message gives
+    the shape and size announced, not a bare MemoryError."""
+    path = tmp_path / "claims.npy"
+    with path.open("wb") as fh:
+        np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (2**23, 2**22)})
+        fh.write(bytes(64))
+    with pytest.raises(ValueError, match=r"shape \(8388608, 4194304\) \(2.62e\+05 GiB\) does not fit in this process's memory"):
+        SurfaceFile(path=str(path), spacing=1.0).rms_height()

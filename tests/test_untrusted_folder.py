@@ -5,6 +5,7 @@ and never a line of a file outside the folder; nothing is written through a link
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import shutil
@@ -85,6 +86,16 @@ def link_to_a_copy(path: Path) -> None:  # even a link to a file inside the fold
     link(path, path.with_name("copy"))
 
 
+def edit_cell(folder: Path, column: str, value: str) -> None:
+    """Set ``column`` (its short name) of curve.csv's first row to ``value``."""
+    lines = (folder / "curve.csv").read_text().splitlines()
+    index = [name.split(" [")[0] for name in next(csv.reader([lines[0]]))].index(column)
+    cells = lines[1].split(",")  # numbers only: no quoted cells in a data row
+    cells[index] = value
+    lines[1] = ",".join(cells)
+    (folder / "curve.csv").write_text("\n".join(lines) + "\n")
+
+
 def fifo(path: Path) -> None:
     path.unlink()
     os.mkfifo(path)
@@ -135,6 +146,13 @@ HOSTILE = {
     "curve ragged row": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "1,2\n"),
     "curve inf cell": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "inf,1,1,1,1,1,1\n"),
     "curve empty": lambda f: (f / "curve.csv").write_text(""),
+    # counts that cannot be counts
+    "lines_used negative": lambda f: edit_cell(f, "lines_used", "-3"),
+    "lines_used fractional": lambda f: edit_cell(f, "lines_used", "2.5"),
+    "lines_used empty": lambda f: edit_cell(f, "lines_used", ""),
+    "lines_used above done": lambda f: edit_cell(f, "lines_used", "5"),
+    "contact_count negative": lambda f: edit_cell(f, "contact_count", "-1"),
+    "contact_fraction above 1": lambda f: edit_cell(f, "contact_fraction", "1.5"),
     "curve missing": lambda f: (f / "curve.csv").unlink(),
     "curve huge": lambda f: (f / "curve.csv").write_bytes(b"1" * (17 * 1024 * 1024)),
 }

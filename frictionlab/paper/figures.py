@@ -68,22 +68,35 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     )
 
 
-def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
-    """Run each figure's preset into ``out_dir``; with ``progress``, each run's progress on stderr."""
-    from ..progress import ProgressReporter, SweepProgress
-
+def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
+    """Each figure's preset read and checked (its scene built, or its sweep planned), none
+    run: a bad preset is refused before minutes of the others' runs."""
     runs = []
     for fig in FIGURES:
         path = presets / fig.preset
         run = FigureRun(fig, path, out_dir / fig.key)
         data = read_preset(path)
-        seen = mark()
         if data.get("sweep") is not None:
             run.sweep = plan_sweep(data, source=str(path))
+        else:
+            run.scene = build_scene(data, source=str(path))
+        runs.append(run)
+    return runs
+
+
+def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
+    """Run each figure's preset into ``out_dir``, every preset checked first; with
+    ``progress``, each run's progress on stderr."""
+    from ..progress import ProgressReporter, SweepProgress
+
+    runs = plan_figures(presets, out_dir)
+    for run in runs:
+        fig, path = run.figure, run.preset_path
+        seen = mark()
+        if run.sweep is not None:
             listeners = [SweepProgress()] if progress else []
             run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False, listeners=listeners)
         else:
-            run.scene = build_scene(data, source=str(path))
             listeners = [ProgressReporter()] if progress else []
             run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
         status = (run.sweep_outcome or run.outcome).status
@@ -93,5 +106,4 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
             raise WorkInterrupted(f"{fig.key} ended interrupted in {run.folder} (continue it with `{how}`)")
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
             raise WorkInterrupted(f"{fig.key} completed in {run.folder}")
-        runs.append(run)
     return runs

@@ -188,7 +188,8 @@ class Study:
     def _reference_choice(self) -> dict | None:
         """The reference solver: the one named by ``--reference``, which must solve the preset solver's
         problem and press its geometry; by default the exact solver of that problem for the preset's
-        geometry (none: the solver and tolerance axes are skipped, with a note)."""
+        geometry, one for non-periodic profiles when the preset's is a scan (none: the solver and
+        tolerance axes are skipped, with a note)."""
         base = self.base.solver
         tolerance = min(self.options.tolerances)
         if self.options.reference is not None:
@@ -205,8 +206,9 @@ class Study:
             except PresetError as exc:
                 raise FrictionlabError(f"--reference: {reference.name} cannot run the preset: {_first_problem(exc)}") from None
             return choice
-        dimension = self.base.spectrum.dimension
-        exact = [info.cls for info in self.factory.registry.infos("solver") if _exact_for(info.cls, base, dimension)]
+        dimension, periodic = self.base.spectrum.dimension, self.base.spectrum.periodic()
+        exact = [info.cls for info in self.factory.registry.infos("solver")
+                 if _exact_for(info.cls, base, dimension) and (periodic or not info.cls.periodic_only)]  # fmt: skip
         if not exact:
             shape = {1: "lines", 2: "surfaces"}[dimension]
             self.notes.append(

@@ -83,6 +83,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             advice = "use surface-file" if topography.dim == 2 else "use profile-file"
             raise ValueError(f"{where}: the file holds {kind.get(topography.dim, topography.dim)}; {advice}")
         missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
+        if missing == heights.size:  # harmonic filling would have nothing to fill from
+            raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
         if missing:
             if undefined == "refuse":
                 raise ValueError(

@@ -212,11 +212,27 @@ def load_npy(path: Path, where: str) -> np.ndarray:
     with _open(path, where) as fh:
         try:
             data = np.load(fh, allow_pickle=False)
+        except MemoryError:  # the header asks for more than this process can allocate
+            raise ValueError(f"{where}: {_claimed_array(fh)} does not fit in this process's memory; "
+                             "crop or resample the map") from None
         except Exception as exc:  # corrupt file, pickled objects, ...: named, never quoted
             raise ValueError(f"{where}: not a readable .npy array ({type(exc).__name__})") from None
     if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
     return data
+
+
+def _claimed_array(fh) -> str:
+    """The array a .npy header announces, its shape and size (a file may announce more than it holds)."""
+    fh.seek(0)
+    try:
+        version = np.lib.format.read_magic(fh)
+        read_header = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+        shape, _, dtype = read_header[version](fh)
+    except Exception:  # noqa: BLE001 - a header numpy itself could not read a moment ago
+        return "its array"
+    gib = math.prod(shape) * dtype.itemsize / 2**30
+    return f"its array of shape {tuple(shape)} ({gib:.3g} GiB)"
 
 
 def _numbers(text: str, delimiter: str | None) -> bool:

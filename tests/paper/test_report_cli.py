@@ -72,3 +72,25 @@ def test_figures_or_out_that_is_a_file_and_markdown_that_is_a_folder_are_refused
         assert code == ExitCode.OUTPUT_REFUSED
         assert said in capsys.readouterr().err
     assert afile.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["folder", "my.md"]
+
+
+def test_a_bad_preset_among_the_figures_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch):
+    """Fig. 5's preset is the last to run: its mistake is named (exit 2) before Figs. 2 to 4
+    spend their minutes, and no run folder is made."""
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for fig in FIGURES:
+        data = load_preset_file(PRESETS / fig.preset)
+        if fig.key == "fig5":
+            data = apply_overrides(data, ["seed=-4"])
+        (presets / fig.preset).write_text(yaml.safe_dump(data, sort_keys=False))
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a figure ran before every preset was checked")
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    code = main(["report", "--presets", str(presets), "--out", str(tmp_path / "r"), "--quiet"])
+    assert code == ExitCode.USAGE
+    assert "benad2012-fig5.yaml" in (err := capsys.readouterr().err) and "seed: must be >= 0, got -4" in err
+    assert not (tmp_path / "r" / "fig2").exists()

@@ -166,3 +166,17 @@ def test_mdr_against_the_elastic_half_space_on_the_same_surfaces(builtins):
     tightest = next(r for r in tolerance if r.reference)
     assert tightest.tolerance == 1e-8 and tightest.xi_err_f == 0 and tightest.b_err == 0
     assert all(math.isfinite(r.xi_err_f) for r in tolerance)
+
+
+def test_a_scan_is_compared_with_the_free_half_space_by_default(builtins, tmp_path):
+    """A non-periodic measured surface: the periodic half-space refuses it, so the exact
+    reference is the free-boundary one (it was bem-halfspace, and the study ended refused)."""
+    heights = np.random.default_rng(0).standard_normal((24, 24)).cumsum(axis=0).cumsum(axis=1)
+    np.save(tmp_path / "scan.npy", heights)
+    scan = {**SURFACE, "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "scan.npy"), "spacing": 1.0}}}
+    study = study_of(scan, builtins, reference=None, axes=("solver",), compare_points_surface=24,
+                     compare_realizations=1, compare_steps=5, tolerances=(1e-8,))  # fmt: skip
+    assert study.reference_choice["name"] == "bem-halfspace-free"
+    periodic = {**scan, "spectrum": {**scan["spectrum"], "params": {**scan["spectrum"]["params"], "periodic": True}}}
+    assert study_of(periodic, builtins, reference=None, axes=("solver",), compare_points_surface=24,
+                    compare_realizations=1, compare_steps=5, tolerances=(1e-8,)).reference_choice["name"] == "bem-halfspace"
