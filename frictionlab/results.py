@@ -213,7 +213,7 @@ class SummaryRecord(Record):
     contact_count_at_last_load: Finite | None = None
     files: dict[str, MemberName] = {}
     # what a measured file gave (shape, pixel size, unit, rms height, where each came from)
-    input: dict[str, str | int | float | bool | None | list[int | float]] | None = None
+    input: dict[str, str | int | Finite | bool | None | list[int | Finite]] | None = None
 
 
 def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:

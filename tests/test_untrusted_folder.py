@@ -134,6 +134,8 @@ HOSTILE = {
     "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
     "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
     "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
+    "input rms NaN": lambda f: edit_summary(f, lambda d: set_in(d, "input", {"file": "scan.x3p", "rms_height": float("nan")})),
+    "input a list": lambda f: edit_summary(f, lambda d: set_in(d, "input", [1, 2])),
     # values of the right kind that contradict each other: no silent wrong or empty fit
     "fit null though done": lambda f: edit_summary(f, lambda d: set_in(d, "fit", None)),
     "fit though none done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 0)),

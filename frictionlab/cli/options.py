@@ -44,6 +44,11 @@ def run_options(**fields):
 def executor_run_options(args, **fields):
     """The ``RunOptions`` of a command with the executor flags (Dask's TLS files and
     scheduler address are checked, and the TLS files taken, before anything starts)."""
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise FrictionlabError(
+            "--scheduler: the address is empty; give tls://HOST:PORT or tcp://HOST:PORT, "
+            "or leave --scheduler out for frictionlab's own local cluster"
+        )
     _use_tls_options(args)
     if args.dashboard and (args.executor != "dask" or args.scheduler):
         raise FrictionlabError(

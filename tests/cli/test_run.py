@@ -212,3 +212,12 @@ def test_output_switches_leave_out_the_per_realization_file_and_the_plot(tmp_pat
     assert {p.name for p in (tmp_path / "o").iterdir()} == {"summary.json", "curve.csv", "preset.yaml", *RUN_DIRECTORY}
     files = json.loads((tmp_path / "o" / "summary.json").read_text())["files"]
     assert set(files) == {"curve", "preset"}
+
+
+@pytest.mark.parametrize("address", ["", "   "])
+def test_an_empty_scheduler_address_is_refused_not_taken_for_a_local_cluster(tmp_path, address):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    result = run_cli("run", preset, "--out", tmp_path / "o", "--executor", "dask", "--scheduler", address)
+    assert result.returncode == ExitCode.USAGE, result.stderr
+    assert "--scheduler: the address is empty" in result.stderr
+    assert not (tmp_path / "o").exists()
