@@ -71,7 +71,7 @@ class Result:
     ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
-    realizations whose xi is defined there), ``contact_count``,
+    realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,
     ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
