@@ -37,11 +37,27 @@ STARTED_WAIT = 120.0  # seconds ``wait_started`` waits for the run's first event
 # ------------------------------------------------------------------ starting
 
 
-def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions()) -> subprocess.Popen:
+def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
+    """Refuse, before a process is started, what the run would refuse as it begins: a
+    folder in use or not its own (a fresh run), a run that does not fit in memory."""
+    from .runner import check_memory
+
+    if lock_held(out_dir):
+        holder = lock_holder(out_dir)
+        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
+                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+    if not options.resume:
+        RunDirectory(out_dir, force=options.force).check_fresh(scene)
+    if options.memory_check:
+        check_memory(scene, options)
+
+
+def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions(), *,
+                   plot: bool = True) -> subprocess.Popen:  # fmt: skip
     """Start the run of the preset ``resolved`` (``Scene.resolved()``) into ``out_dir`` as
     its own process in a new session, and return at once. The preset and the options
     go through a pipe, read before the run begins: the terminal is none of its files."""
-    request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options)}
+    request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot}
     process = subprocess.Popen(
         [sys.executable, "-m", "frictionlab.detached"],
         stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -106,7 +122,8 @@ def _child() -> int:
     try:
         with RaiseOnSigterm():
             scene = build_scene(request["preset"])
-            outcome, _ = run_to_folder(scene, out, RunOptions(**request["options"]), listeners=[log])
+            options = RunOptions(**request["options"])
+            outcome, _ = run_to_folder(scene, out, options, listeners=[log], plot=bool(request.get("plot", True)))
     except FrictionlabError as exc:
         log.error(str(exc), exc.exit_code)
         return exc.exit_code

@@ -59,9 +59,9 @@ class ProgressLog:
         self.clock = clock
         self._fd: int | None = None
 
-    def _open(self) -> None:
+    def _open(self, truncate: bool) -> None:
         self.close()
-        flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0)
+        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0) | (os.O_TRUNC if truncate else 0)
         try:
             self._fd = os.open(self.path, flags, 0o644)
             if not stat.S_ISREG(os.fstat(self._fd).st_mode):
@@ -87,12 +87,12 @@ class ProgressLog:
     def error(self, message: str, exit_code: int) -> None:
         """The run could not start, or stopped with an error: what a follower shows."""
         if self._fd is None:
-            self._open()
-        self.write({"event": "error", "message": message, "exit_code": int(exit_code)})
+            self._open(truncate=False)  # appended: the log may be another live run's (a folder in use)
+        self.write({"event": "error", "pid": os.getpid(), "message": message, "exit_code": int(exit_code)})
 
     @hookimpl
     def run_started(self, run):
-        self._open()
+        self._open(truncate=True)
         self.write({"event": "started", "pid": os.getpid(), "name": run.scene.preset.name, "total": run.total,
                     "workers": run.workers, "executor": run.executor, "resumed": run.resumed, "retried": run.retried})  # fmt: skip
         for done, result in enumerate(run.restored, start=1):
@@ -265,7 +265,7 @@ class Follower:
                     error = event.get("error")
                     self.finished = Finished(str(event.get("status")), _whole(event.get("done")),
                                              _whole(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
-                elif kind == "error":
+                elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              _whole(event.get("exit_code"), 1))  # fmt: skip
             finally:
