@@ -17,9 +17,12 @@ from pathlib import Path
 
 import yaml
 
+from ..detached import run_state
+from ..errors import FrictionlabError
 from ..files import atomic_write
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import builtin_folder, builtin_presets
+from ..rundir import STATE_FILE
 from ..safe_yaml import load_yaml
 from .roundtrip import dump_preserving
 
@@ -261,12 +264,33 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
         return []
     entries = []
     for folder in runs_dir.iterdir():
+        entry = None
         for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
             if not (folder / marker).is_file():
                 continue
             try:
-                entries.append(read(folder))
+                entry = read(folder)
             except (OSError, ValueError, TypeError, KeyError, RecursionError):
                 pass  # a half-written, damaged or foreign folder: not one to list
             break
-    return sorted(entries, key=lambda e: (-e.mtime, e.path.name))
+        if not isinstance(entry, SweepEntry) and (folder / STATE_FILE).is_file():
+            entry = _with_state(folder, entry)
+        if entry is not None:
+            entries.append(entry)
+    return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
+
+
+def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:
+    """A run folder as its process left it: running (its summary, if any, is an earlier
+    run's), or ended without a summary (killed): listed, so that it can be followed or resumed."""
+    try:
+        state = run_state(folder)
+    except (OSError, FrictionlabError):
+        return entry
+    if entry is None:
+        mtime = (folder / STATE_FILE).stat().st_mtime
+        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
+    entry.status = state.status
+    if state.status == "running":
+        entry.done, entry.fit = state.done or 0, None  # the fit shown would be the earlier run's
+    return entry
