@@ -68,7 +68,9 @@ class FrictionlabApp(App):
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
         Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
-        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes)", priority=True),
+        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
+        Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
+        Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
     ]
 
     def __init__(
@@ -91,6 +93,7 @@ class FrictionlabApp(App):
         self.modified = False
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
+        self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
         self.cancel_event: threading.Event | None = None  # set while a sweep goes on in this process
         self.followed: FollowedRun | None = None  # the run in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
@@ -164,6 +167,10 @@ class FrictionlabApp(App):
         else:
             self.action_show_help_panel()
 
+    def action_help_quit(self) -> None:
+        """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
+        self.say("Ctrl+Q quits (q too, outside a text field); a run goes on after you quit unless you cancel it.")
+
     # ------------------------------------------------------------ the status line
 
     def say(self, text: str, severity: str = "information", title: str = "") -> None:
@@ -171,6 +178,7 @@ class FrictionlabApp(App):
         stays until the next message. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{title}: ", "bold") if title else "", text)
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
+        self.said_valid = False
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -207,6 +215,9 @@ class FrictionlabApp(App):
             self.draft_source = None
         self.draft_path = path
         await self.query_one("#form", PresetForm).load(data, base_dir=path.parent)
+        self.problems = []
+        if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
+            self.say("")
         self.modified = modified
         self._show_edit_state()
         self.action_show_tab("edit")
@@ -270,6 +281,9 @@ class FrictionlabApp(App):
                 self.blocked_by = ""
             else:
                 self.say("The preset is valid: Ctrl+R runs it.")
+                self.said_valid = True
+        elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
+            self.say("")
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems)
 
