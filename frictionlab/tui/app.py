@@ -59,7 +59,7 @@ class FrictionlabApp(App):
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
-        Binding("f1", "help", "Keys", tooltip="(show or hide): those of the focused part and the app's", priority=True),
+        Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
         Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
@@ -161,11 +161,18 @@ class FrictionlabApp(App):
         self.refresh_bindings()
 
     def action_help(self) -> None:
-        """Textual's key panel: the keys of the focused widget and of the app, as they change."""
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
+        """Textual's key panel: the keys of the focused widget and of the app, as they change.
+        Pressed again it shows the next page of a panel taller than the screen (it takes no
+        focus, so no other key scrolls it), and hides it after the last."""
+        panels = self.screen.query("HelpPanel KeyPanel")
+        if not panels:
             self.action_show_help_panel()
+            return
+        keys = panels.first()
+        if keys.scroll_y < keys.max_scroll_y:
+            keys.scroll_page_down(animate=False)
+        else:
+            self.action_hide_help_panel()
 
     def action_help_quit(self) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""

@@ -125,3 +125,64 @@ async def test_the_sweep_table_takes_a_cursor_and_interim_goes_once_the_sweep_is
         row = table.cursor_row
     assert "(interim)" not in fit and "95% CI" in fit
     assert table.cursor_type == "row" and row == 1
+
+
+@sync
+async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        pages = []
+        for _ in range(12):
+            await pilot.press("f1")
+            await pilot.pause()
+            if not app.screen.query("HelpPanel"):
+                break
+            pages.append(screen_text(app))
+        hidden = not app.screen.query("HelpPanel")
+    assert len(pages) >= 2 and hidden  # more than one page at 80x24, then hidden
+    assert "Save as" not in pages[0] and any("Save as" in page for page in pages)
+
+
+@sync
+async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry):
+    from frictionlab.fit import LogFit
+    from frictionlab.tui.widgets import RunPane
+    from frictionlab.tui.widgets.run import fit_lines
+
+    fit = LogFit(a=-12.3456, b=-0.0469, a_se=0.1, b_se=0.01, a_ci=(-12.5678, -12.1234), b_ci=(-0.0712, -0.0231),
+                 confidence=0.95, bootstrap=1000, r2=0.4006, residual_rms=0.01, points=16)  # fmt: skip
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.action_show_tab("run")
+        app.query_one(RunPane)._set("run-fit", "\n".join(fit_lines(fit, final=True, f_formula="F / (E* h L)")))
+        await pilot.pause()
+        screen = screen_text(app)
+    assert "a = -12.3456 [-12.5678, -12.1234]" in screen
+    assert "b = -0.0469 [-0.0712, -0.0231]" in screen
+
+
+@sync
+async def test_a_long_preset_name_is_cut_in_its_middle_and_keeps_every_column_on_screen(folders, registry):
+    from .conftest import fits_width
+
+    long_name = "a-very-long-preset-name-" + "x" * 55 + "-end-0060"  # 88 characters
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": long_name, "realizations": 3})))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        table = app.query_one("#preset-table", DataTable)
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        fits = fits_width(table)
+        await app.open_preset(folders / "presets" / "long.yaml")
+        await pilot.pause()
+        app.action_start_run()
+        title = str(app.query_one("#run-title", Static).render())
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    assert fits, "a column of the presets list is off screen"
+    name, folder, file = next(row for row in cells if row[2] == "long.yaml")
+    assert name.startswith("a-very-long") and name.endswith("-end-0060") and "…" in name
+    assert folder and file == "long.yaml"
+    assert title.startswith("a-very-long") and "-end-0060: 3 realizations, 16 force steps" in title and "…" in title

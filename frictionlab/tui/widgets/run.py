@@ -19,7 +19,7 @@ from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
 from ..sweepview import point_line, table_cells, table_columns
-from ..text import failure_message
+from ..text import failure_message, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
 
@@ -103,11 +103,11 @@ class RunPane(Vertical, can_focus=True):
         preset = scene.preset
         if sweep is None:
             what = f": {preset.realizations} realizations, {preset.loading.steps} {preset.loading.control} steps"
-            self._set("run-title", Content.assemble((preset.name, "bold"), what))
+            self._set("run-title", Content.assemble((self._fitted(preset.name, what), "bold"), what))
         else:
             preset = sweep.points[0].scene.preset
             what = f": {len(sweep.points)} points x {preset.realizations} realizations"
-            self._set("run-title", Content.assemble((sweep.name, "bold"), what))
+            self._set("run-title", Content.assemble((self._fitted(sweep.name, what), "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
             table = self.query_one("#sweep-table", DataTable)
@@ -118,6 +118,11 @@ class RunPane(Vertical, can_focus=True):
         self._set("run-error", "")
         self._set("run-stats", "starting")
         self._clear_fit()
+
+    def _fitted(self, name: str, rest: str) -> str:
+        """``name`` cut in its middle so that the line with ``rest`` fits the tab's width."""
+        width = self.size.width or 80
+        return shorten_middle(name, max(12, width - len(rest)))
 
     def _clear_fit(self) -> None:
         """No curve nor fit of an earlier run under this one's count."""
