@@ -133,3 +133,29 @@ async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(fo
     end(pid)
     assert "unsaved changes. Quit anyway?" in asked
     assert still and alive and "cancelling" not in after and "/100000 realizations" in after
+
+
+@sync
+async def test_a_long_solve_shows_its_load_and_the_elapsed_time_moves_between_events(folders, registry):
+    """An exact solve reports its loads; between two reports the elapsed time still moves."""
+    from frictionlab.engine import RunInfo
+    from frictionlab.progresslog import ProgressLog
+    from frictionlab.rundir import RunDirectory
+
+    out = folders / "runs" / "exact"
+    scene = build_scene(merge(TINY, {"name": "exact", "realizations": 2}), registry=registry)
+    with RunDirectory(out) as run_dir:  # this process plays the run: it holds the lock, writes the events
+        run_dir.start(scene, resume=False)
+        log = ProgressLog(out, clock=lambda: time.time() - 30.0)  # it began 30 s ago
+        log.run_started(RunInfo(scene=scene, total=2, workers=1))
+        log.load_done(index=0, done=3, total=16)
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await wait_until(pilot, lambda: "load 3/16" in stats(app))
+            first = stats(app)
+            await pilot.pause(1.2)
+            later = stats(app)
+        log.close()
+    assert first.startswith("0/2 realizations") and "realization 0: load 3/16" in first
+    seconds = [float(line.split("elapsed ")[1].split(" s")[0]) for line in (first, later)]
+    assert 29.0 < seconds[0] < seconds[1]  # the run's own clock, ticking with no new event
