@@ -10,7 +10,8 @@ same process (or, for peak memory, in a fresh one per size):
   flat in N, and the time flat in steps;
 * the Fig. 2 scene and an exact 3D ensemble (exact3d-h08 on 128^2 pixels, 32 surfaces) with each
   executor (serial; processes 1, 2; Dask LocalCluster of 2, cluster start and the
-  workers' first import excluded), efficiency = serial / (workers x time);
+  workers' first import excluded, with a client per run and with one client for every run
+  as a sweep has), efficiency = serial / (workers x time);
 * overhead per task of each executor (tiny realizations, one per task);
 * the Fig. 2 scene end to end (run + chunk files + result files and plot) with
   the default executor.
@@ -33,6 +34,7 @@ from pathlib import Path
 
 from frictionlab import engine
 from frictionlab.dask_security import WORKER_CONFIG
+from frictionlab.dask_session import one_dask_cluster
 from frictionlab.executors import make_executor
 from frictionlab.options import RunOptions
 from frictionlab.preset import load_scene
@@ -115,8 +117,15 @@ def efficiency_rows(scene, repeat: int) -> list[tuple[str, int, float]]:
     return rows
 
 
-def dask_row(scene, repeat: int, address: str) -> tuple[str, int, float]:
-    return ("dask LocalCluster", 2, best_of(repeat, lambda: engine.run(scene, RunOptions(executor="dask", scheduler=address))))
+def dask_rows(scene, repeat: int, address: str) -> list[tuple[str, int, float]]:
+    """A client per run (a single ``frictionlab run``), and one client for every run (a sweep
+    or a study: ``one_dask_cluster``), connected before the timing as a command's first run does."""
+    options = RunOptions(executor="dask", scheduler=address)
+    rows = [("dask, own client", 2, best_of(repeat, lambda: engine.run(scene, options)))]
+    with one_dask_cluster(options):
+        engine.run(scene, options)
+        rows.append(("dask, one client", 2, best_of(repeat, lambda: engine.run(scene, options))))
+    return rows
 
 
 def print_efficiencies(title: str, rows) -> None:
@@ -151,8 +160,8 @@ def executors(repeat: int, skip_dask: bool) -> None:
         ) as cluster:
             address = cluster.scheduler_address
             engine.run(scene, RunOptions(executor="dask", scheduler=address))  # the workers import frictionlab once
-            rows.append(dask_row(scene, repeat, address))
-            rows_3d.append(dask_row(surface, min(repeat, 2), address))
+            rows.extend(dask_rows(scene, repeat, address))
+            rows_3d.extend(dask_rows(surface, min(repeat, 2), address))
             overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
     print_efficiencies(f"Fig. 2 scene ({m} realizations), executors", rows)
     print_efficiencies(f"Exact 3D ensemble ({SURFACE_PRESET.name} on 128^2 pixels, 32 surfaces), executors", rows_3d)

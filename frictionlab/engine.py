@@ -23,7 +23,7 @@ from .hookspecs import PROJECT_NAME
 from .listeners import RunListener
 from .options import RunOptions
 from .preset import Scene
-from .realization import RealizationResult, compute_chunk
+from .realization import RealizationResult, compute_chunk_here
 from .signals import CancelOnSignals
 
 __all__ = ["RunInfo", "run"]
@@ -74,7 +74,9 @@ def run(
     process-wide one) hear the run as ``listeners`` do.
 
     ``cancel`` (anything with ``set()``/``is_set()``), Ctrl-C or SIGTERM ends the
-    run early; what finished is kept and summarised, and ``outcome.status``
+    run at once: the realizations being solved are abandoned (they stop at their
+    solver's next ``plugin.iteration_done`` and run again on resume); what finished is
+    kept and summarised, and ``outcome.status``
     says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
     total = scene.preset.realizations
@@ -103,6 +105,11 @@ def run(
     def load_done(index: int, done: int, total_loads: int) -> None:
         hooks.load_done(run=info, index=index, done=done, total=total_loads)
 
+    def iteration_done(index: int, load: int, iteration: int, residual: float) -> None:
+        hooks.iteration_done(run=info, index=index, load=load, iteration=iteration, residual=residual)
+
+    progress = {"on_load": load_done, "on_iteration": iteration_done}
+
     def record(results: list[RealizationResult]) -> None:
         if store is not None:
             store.save_chunk(results)
@@ -116,11 +123,12 @@ def run(
         try:
             if todo and not cancel.is_set():
                 # The first missing realization runs here: its time sizes the chunks.
-                first = compute_chunk(scene, todo[:1], on_load=load_done)
-                record(first)
-                chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
-                for _, results in pool.map_chunks(scene, chunks, cancel, on_load=load_done):
-                    record(results)
+                first = compute_chunk_here(scene, todo[:1], cancel=cancel, **progress)
+                if first:  # else cancelled within it
+                    record(first)
+                    chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
+                    for _, results in pool.map_chunks(scene, chunks, cancel, **progress):
+                        record(results)
         except KeyboardInterrupt:  # the second Ctrl-C or SIGTERM (Terminated)
             pass
         except RunError as exc:  # keep what finished before the executor failed

@@ -30,11 +30,12 @@ import uuid
 from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
+from .dask_session import current_session
 from .errors import RunError
 from .options import RunOptions
-from .pool import JobFailed, WorkerLost, WorkerPool, send_progress
+from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
 from .preset import Scene
-from .realization import LoadListener, RealizationResult, compute_chunk
+from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk, compute_chunk_here
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -89,8 +90,8 @@ def chunk_label(chunk: Sequence[int]) -> str:
 
 
 class SerialExecutor:
-    """In this process. ``cancel`` is checked before every realization; a
-    cancelled chunk yields what it finished."""
+    """In this process (``compute_chunk_here``). A cancel returns at once: a cancelled
+    chunk yields what it finished."""
 
     name = "serial"
     task_overhead = 0.0  # seconds per chunk (see ``plan_chunks``)
@@ -99,14 +100,15 @@ class SerialExecutor:
         self.workers = 1
 
     def map_chunks(
-        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+        self,
+        scene: Scene,
+        chunks: list[Chunk],
+        cancel,
+        on_load: LoadListener | None = None,
+        on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
-            done = []
-            for index in chunk:
-                if cancel.is_set():
-                    break
-                done.extend(compute_chunk(scene, [index], on_load))
+            done = compute_chunk_here(scene, chunk, on_load, on_iteration, cancel) if not cancel.is_set() else []
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():
@@ -140,11 +142,15 @@ def _init_worker(scene: Scene) -> None:
 
 
 def _send_load(index: int, done: int, total: int) -> None:
-    send_progress((index, done, total))
+    send_progress(("load", index, done, total))
+
+
+def _send_iteration(index: int, load: int, iteration: int, residual: float) -> None:
+    send_progress(("iteration", index, load, iteration, residual))
 
 
 def _run_chunk(indices: Chunk) -> list[RealizationResult]:
-    return compute_chunk(_worker_scene, indices, on_load=_send_load)
+    return compute_chunk(_worker_scene, indices, _send_load, _send_iteration, cancel=stop_event())
 
 
 def pool_context():
@@ -168,16 +174,29 @@ class ProcessExecutor:
         self.retries = retries
 
     def map_chunks(
-        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+        self,
+        scene: Scene,
+        chunks: list[Chunk],
+        cancel,
+        on_load: LoadListener | None = None,
+        on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
+        """A cancel reaches the workers (``WorkerPool.run``): a chunk then yields what it finished."""
         jobs = dict(enumerate(chunks))
-        on_progress = None if on_load is None else (lambda payload: on_load(*payload))
+        listeners = {"load": on_load, "iteration": on_iteration}
+
+        def on_progress(payload) -> None:
+            listener = listeners[payload[0]]
+            if listener is not None:
+                listener(*payload[1:])
+
         pool = WorkerPool(
             min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene,), retries=self.retries
         )
         try:
             for key, results in pool.run(jobs, cancel, on_progress):
-                yield jobs[key], results
+                if results:  # none: cancelled within its first realization
+                    yield jobs[key][: len(results)], results
         except WorkerLost as lost:
             raise RunError(
                 f"a worker process died {lost.deaths} times while running realizations "
@@ -223,40 +242,59 @@ class DaskExecutor:
     ``workers`` single-thread processes on 127.0.0.1 reached over TLS
     (``dask_security``), dashboard off unless ``dashboard``, closed at the end.
     ``retries``: Dask retries of a task that raised (a task whose worker died is
-    rescheduled by Dask up to its ``allowed-failures``)."""
+    rescheduled by Dask up to its ``allowed-failures``). With ``session``
+    (``dask_session.DaskSession``) the run uses, and leaves open, the client of its command."""
 
     name = "dask"
     task_overhead = 5e-3  # measured 3.5-4.7 ms per task on a LocalCluster of 2 (benchmarks/bench_scale.py)
 
-    def __init__(self, workers: int, scheduler: str | None = None, retries: int = 2, dashboard: bool = False):
+    def __init__(
+        self, workers: int, scheduler: str | None = None, retries: int = 2, dashboard: bool = False, session=None
+    ):
         self.workers = workers
         self.scheduler = scheduler
         self.retries = retries
         self.dashboard = dashboard
+        self.session = session
 
     def _connect(self):
+        """The client, and the ``LocalCluster`` this run started (None: it uses a scheduler's,
+        or its command's session's)."""
+        if self.session is not None:
+            client, cluster = self.session.connect(), None
+        elif self.scheduler:
+            client, cluster = connect_scheduler(self.scheduler), None
+        else:
+            return start_local_cluster(self.workers, dashboard=self.dashboard)
         if self.scheduler:
-            client = connect_scheduler(self.scheduler)
             self.workers = max(1, len(client.scheduler_info().get("workers", {})))
-            return client, None
-        return start_local_cluster(self.workers, dashboard=self.dashboard)
+        return client, cluster
 
     def map_chunks(
-        self, scene: Scene, chunks: list[Chunk], cancel, on_load: LoadListener | None = None
+        self,
+        scene: Scene,
+        chunks: list[Chunk],
+        cancel,
+        on_load: LoadListener | None = None,
+        on_iteration: IterationListener | None = None,
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
-        """``on_load`` is not heard: a Dask worker reports whole chunks only."""
+        """``on_load`` and ``on_iteration`` are not heard: a Dask worker reports whole chunks
+        only. A cancel returns at once, and reaches the running tasks through the run's
+        Dask ``Event``: they stop within their solve (``DaskStop``)."""
         distributed = import_distributed()
         client, cluster = self._connect()
         futures = []
+        run_id = uuid.uuid4().hex[:8]
+        stop_name = f"frictionlab-{run_id}-stop"
         try:
             scene_future = client.scatter(scene, broadcast=True, hash=False)
-            run_id = uuid.uuid4().hex[:8]
             chunk_of = {}
             for chunk in chunks:
                 future = client.submit(
                     _packed_chunk,
                     scene_future,
                     chunk,
+                    stop_name,
                     key=f"frictionlab-{run_id}-{chunk_label(chunk)}",
                     retries=self.retries,
                     pure=False,
@@ -266,6 +304,7 @@ class DaskExecutor:
             stream = distributed.as_completed(futures)
             while not stream.is_empty():
                 if cancel.is_set():
+                    distributed.Event(stop_name, client=client).set()
                     return
                 batch = stream.next_batch(block=False)
                 if not batch:
@@ -283,16 +322,39 @@ class DaskExecutor:
         finally:
             if futures:
                 client.cancel([f for f in futures if not f.done()])
-            client.close()
+            if self.session is None:  # else its command closes it
+                client.close()
             if cluster is not None:
                 cluster.close()
 
 
-def _packed_chunk(scene: Scene, indices: Chunk) -> bytes:
-    """A Dask task: ``compute_chunk``'s results as one pickle. Dask sends each of a
-    result's arrays as a message part of its own: 40 ms for a chunk of 150 line
-    realizations against 12 ms for the same numbers in one piece."""
-    return pickle.dumps(compute_chunk(scene, indices), protocol=pickle.HIGHEST_PROTOCOL)
+STOP_POLL_SECONDS = 0.25  # how often a Dask task asks the scheduler whether its run was cancelled
+
+
+class DaskStop:
+    """In a Dask task: whether the run's ``distributed.Event`` named ``name`` is set, asked
+    of the scheduler at most every ``STOP_POLL_SECONDS`` (a short task never asks)."""
+
+    def __init__(self, name: str):
+        self.name, self.stopped = name, False
+        self.next_poll = time.monotonic() + STOP_POLL_SECONDS
+
+    def is_set(self) -> bool:
+        if not self.stopped and time.monotonic() >= self.next_poll:
+            import distributed
+
+            self.stopped = distributed.Event(self.name).is_set()
+            self.next_poll = time.monotonic() + STOP_POLL_SECONDS
+        return self.stopped
+
+
+def _packed_chunk(scene: Scene, indices: Chunk, stop_name: str) -> bytes:
+    """A Dask task: ``compute_chunk``'s results as one pickle (those finished when the run's
+    stop event was seen). Dask sends each of a result's arrays as a message part of its
+    own: 40 ms for a chunk of 150 line realizations against 12 ms for the same numbers in
+    one piece."""
+    results = compute_chunk(scene, indices, cancel=DaskStop(stop_name))
+    return pickle.dumps(results, protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def make_executor(options: RunOptions, workers: int):
@@ -303,4 +365,10 @@ def make_executor(options: RunOptions, workers: int):
     if name == "processes":
         return ProcessExecutor(workers, retries=options.retries)
     import_distributed()  # fail before anything starts
-    return DaskExecutor(workers, scheduler=options.scheduler, retries=options.retries, dashboard=options.dashboard)
+    return DaskExecutor(
+        workers,
+        scheduler=options.scheduler,
+        retries=options.retries,
+        dashboard=options.dashboard,
+        session=current_session(options),
+    )

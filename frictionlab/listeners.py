@@ -6,7 +6,7 @@ progress they share.
   calls them on the listeners it is given and on the installed plugins that
   implement them, in the order ``run_started``, then ``realization_done`` or
   ``realization_failed`` once per realization (each maybe preceded by ``load_done``
-  per load of its solve), then ``run_finished``. A
+  per load of its solve and ``iteration_done`` within a load), then ``run_finished``. A
   listener implements any of them, each marked ``@frictionlab.hookimpl``
   (pluggy calls marked methods only, and checks their argument names; a method
   may take fewer of the arguments).
@@ -53,12 +53,21 @@ class RunListener(Protocol):
         ``realization_done`` is the finest grain)."""
 
     @hookspec
+    def iteration_done(self, run: RunInfo, index: int, load: int, iteration: int, residual: float) -> None:
+        """Realization ``index`` is solving its ``load``-th load (counted from 1): ``iteration``
+        steps are done and the relative residual is ``residual``. An iterative solver reports
+        each iteration (``frictionlab.iteration_done``); listeners hear it at most twice a
+        second per realization, so a long load shows movement. Heard as ``load_done`` is."""
+
+    @hookspec
     def run_finished(self, run: RunInfo, outcome: RunOutcome) -> None:
         """The run ended (completed, cancelled or failed). ``outcome`` is the
         ``RunOutcome`` with the statistics and the fit of what finished."""
 
 
-LIFECYCLE_HOOKS = ("run_started", "realization_done", "realization_failed", "load_done", "run_finished")
+LIFECYCLE_HOOKS = (
+    "run_started", "realization_done", "realization_failed", "load_done", "iteration_done", "run_finished",
+)  # fmt: skip
 
 
 class SweepListener:
@@ -100,3 +109,9 @@ def progress_text(done: int, total: int, failed: int, elapsed: float, restored: 
     failures = f", {failed} failed" if failed else ""
     return f"{done}/{total} realizations{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
 
+
+def solve_text(index: int, load: int, loads: int, iteration: int | None = None, residual: float | None = None) -> str:
+    """``realization 3: load 2/16, iteration 40, residual 3.1e-05``: where a long solve is
+    (``load_done`` says the loads done, without the iteration)."""
+    text = f"realization {index}: load {load}/{loads}"
+    return text if iteration is None else f"{text}, iteration {iteration}, residual {residual:.2g}"

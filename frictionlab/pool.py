@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import pickle
 import signal
+import time
 from collections import Counter, deque
 from collections.abc import Callable, Hashable, Iterator
 from multiprocessing.connection import wait
 
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
+STOP_GRACE_SECONDS = 0.5  # after a cancel, a job's time to end by itself before its worker is killed
 ERROR_CHARS = 500  # an error carried back from a worker is cut to this
 
 
@@ -39,6 +41,7 @@ class JobFailed(Exception):
 
 
 _results = None  # in a worker: the pipe of its results, for ``send_progress``
+_stop = None  # in a worker: the event its parent sets when the run is cancelled, for ``stop_event``
 
 
 def send_progress(payload) -> None:
@@ -48,14 +51,20 @@ def send_progress(payload) -> None:
         _results.send_bytes(pickle.dumps(("progress", payload), protocol=pickle.HIGHEST_PROTOCOL))
 
 
-def _serve(tasks, results, initializer, initargs, function) -> None:
+def stop_event():
+    """In a worker, during a job: the event (``is_set()``) its pool sets once the run is
+    cancelled, for a long job to end early with what it finished. Elsewhere None."""
+    return _stop
+
+
+def _serve(tasks, results, stop, initializer, initargs, function) -> None:
     """A worker: run each job received on ``tasks``, send back ``("ok", result)``
     or ``("error", text)`` on ``results`` (after any ``("progress", payload)`` the job
     sent); stop on None or when ``tasks`` closes."""
-    global _results
-    _results = results
+    global _results, _stop
+    _results, _stop = results, stop
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C and SIGTERM are the parent's to handle:
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it lets running jobs finish, then stops workers
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it sets ``stop``, then stops workers
     if initializer is not None:
         initializer(*initargs)
     while True:
@@ -84,11 +93,11 @@ def _how(exitcode: int | None) -> str:
 
 
 class _Worker:
-    def __init__(self, context, initializer, initargs, function):
+    def __init__(self, context, stop, initializer, initargs, function):
         task_read, self.tasks = context.Pipe(duplex=False)
         self.results, result_write = context.Pipe(duplex=False)
         self.process = context.Process(
-            target=_serve, args=(task_read, result_write, initializer, initargs, function), daemon=True
+            target=_serve, args=(task_read, result_write, stop, initializer, initargs, function), daemon=True
         )
         self.process.start()
         task_read.close()  # the worker's ends: the parent keeps none, so a dead
@@ -127,26 +136,34 @@ class WorkerPool:
         self.size, self.context, self.function = max(1, size), context, function
         self.initializer, self.initargs, self.retries = initializer, initargs, retries
 
-    def _start(self) -> _Worker:
-        return _Worker(self.context, self.initializer, self.initargs, self.function)
+    def _start(self, stop) -> _Worker:
+        return _Worker(self.context, stop, self.initializer, self.initargs, self.function)
 
     def run(self, jobs: dict[Hashable, object], cancel, on_progress=None) -> Iterator[tuple[Hashable, object]]:
         """Yield ``(key, result)`` as each job finishes; ``on_progress(payload)`` hears what
         a job sends on the way (``send_progress``). After ``cancel.set()``
-        no job starts; running ones finish and are yielded. A job whose worker
+        no job starts, and running ones see ``stop_event()`` set (within ``WAIT_SECONDS``):
+        those that end within ``STOP_GRACE_SECONDS`` are yielded, the others' workers are
+        killed (a step of a large solve cannot be interrupted). A job whose worker
         dies runs again on a fresh worker, at most ``retries`` more times
         (then WorkerLost); a job that raises ends the run (JobFailed)."""
         pending = deque(jobs)
         deaths: Counter = Counter()
         workers: list[_Worker] = []
+        stop = self.context.Event()
+        cancelled_at = None
         try:
             while True:
                 if cancel.is_set():
                     pending.clear()
+                    stop.set()
+                    cancelled_at = time.monotonic() if cancelled_at is None else cancelled_at
+                    if time.monotonic() - cancelled_at >= STOP_GRACE_SECONDS:
+                        return  # the workers still busy are killed below: their jobs abandoned
                 while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
                     worker = next((w for w in workers if w.job is None), None)
                     if worker is None:
-                        worker = self._start()
+                        worker = self._start(stop)
                         workers.append(worker)
                     key = pending.popleft()
                     if not worker.give(key, jobs[key]):  # it died idle: no charge to the job

@@ -13,7 +13,7 @@ import time
 
 from .errors import counted
 from .hookspecs import hookimpl
-from .listeners import SweepListener, progress_text
+from .listeners import SweepListener, progress_text, solve_text
 
 
 def _in_notebook() -> bool:
@@ -62,7 +62,7 @@ class _Bar:
 
 
 SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond its first line
-LOAD_LINE_SECONDS = 30.0  # in a log: a long solve's load at most this often
+LOAD_LINE_SECONDS = 1.5  # in a log: a long solve's load or iteration at most this often (movement every 2 s)
 
 
 class BestEffort:
@@ -115,6 +115,7 @@ class ProgressReporter:
         self.failed = 0
         self.resumed = 0  # restored on a resume: done before this process started
         self.done = 0
+        self.loads = 0  # load steps of each realization
         self.last_load_line = 0.0
 
     def _line(self, done: int, total: int) -> str:
@@ -132,6 +133,7 @@ class ProgressReporter:
         self.started = self.clock()
         self.resumed = self.done = run.resumed
         self.total = run.total
+        self.loads = len(run.scene.loads)
         preset = run.scene.preset
         restored = ", ".join(
             [f"{self.resumed} restored from the run folder"] * bool(self.resumed)
@@ -165,10 +167,17 @@ class ProgressReporter:
     @hookimpl
     def load_done(self, index, done, total):
         """A long solve's loads: the bar's note, or a line now and then in a log."""
+        self._solve_note(solve_text(index, done, total))
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        """Within a long load: its iteration and residual, as ``load_done``."""
+        self._solve_note(solve_text(index, load, self.loads, iteration, residual))
+
+    def _solve_note(self, text: str) -> None:
         now = self.clock()
         if now - self.started < self.after or not self.total:
             return
-        text = f"realization {index}: load {done}/{total}"
         if self.interactive:
             if self.bar is None:
                 self.bar = _Bar(self.stream, "realizations", self.total, completed=self.done, started=self.started, clock=self.clock)

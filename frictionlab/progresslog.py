@@ -2,7 +2,7 @@
 
 A run writes ``progress.jsonl``: one JSON object a line, appended as things happen
 (``started``, one ``realization`` per finished realization with its curve, ``load``
-within a long solve, ``finished``; ``error`` when the run could not start). A TUI
+and ``iteration`` within a long solve, ``finished``; ``error`` when the run could not start). A TUI
 opened later, ``frictionlab follow`` or ``tail -f`` read it; ``Follower`` replays
 it to ``listeners.RunListener``s, the same ones that hear a run in this process.
 
@@ -111,6 +111,10 @@ class ProgressLog:
         self.write({"event": "load", "index": index, "done": done, "total": total})
 
     @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        self.write({"event": "iteration", "index": index, "load": load, "iteration": iteration, "residual": residual})
+
+    @hookimpl
     def run_finished(self, outcome):
         self.write({"event": "finished", "status": outcome.status, "done": outcome.done,
                     "failed": len(outcome.failures), "requested": outcome.requested, "error": outcome.error})  # fmt: skip
@@ -207,7 +211,7 @@ class Finished:
 class Follower:
     """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
     ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
-    or ``realization_failed``, ``load_done``. Call ``poll()`` now and then; ``finished`` is set
+    or ``realization_failed``, ``load_done``, ``iteration_done``. Call ``poll()`` now and then; ``finished`` is set
     once the run's last event came. ``now()`` is the wall-clock time of the event being
     replayed (the present between events): a listener's clock, so that its elapsed time
     and rate are the run's even when followed from the middle."""
@@ -261,6 +265,9 @@ class Follower:
                 elif kind == "load" and self.info is not None:
                     self._tell("load_done", run=self.info, index=_whole(event.get("index")),
                                done=_whole(event.get("done")), total=_whole(event.get("total")))  # fmt: skip
+                elif kind == "iteration" and self.info is not None:
+                    self._tell("iteration_done", run=self.info, index=_whole(event.get("index")), load=_whole(event.get("load")),
+                               iteration=_whole(event.get("iteration")), residual=_number(event.get("residual")))  # fmt: skip
                 elif kind == "finished":
                     error = event.get("error")
                     self.finished = Finished(str(event.get("status")), _whole(event.get("done")),

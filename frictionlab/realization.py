@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable
@@ -15,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import force_unit, listening_to_loads
+from .plugin import SolveCancelled, force_unit, listening_to_iterations, listening_to_loads
 from .preset import Scene
 from .seeds import realization_rng
 
@@ -44,21 +45,64 @@ class RealizationResult:
 LoadListener = Callable[[int, int, int], None]
 """Hears ``(realization index, loads done, loads)`` as a solver reports each load (``plugin.load_finished``)."""
 
+IterationListener = Callable[[int, int, int, float], None]
+"""Hears ``(realization index, load, iteration, residual)`` within a load (``plugin.iteration_done``):
+``load`` counts the scene's loads from 1."""
 
-def compute_realization(scene: Scene, index: int, on_load: LoadListener | None = None) -> RealizationResult:
-    """Realization ``index`` of ``scene``; ``on_load`` hears its solver's progress per load.
-    Never raises: a failure is carried on the result."""
-    listener = None if on_load is None else (lambda done, total: on_load(index, done, total))
-    with listening_to_loads(listener):
-        return _compute(scene, index)
+ITERATION_EVENT_SECONDS = 0.25  # within a load, progress at most this often (a worker's pipe, a bar's redraws)
 
 
-def _compute(scene: Scene, index: int) -> RealizationResult:
+class _SolveWatch:
+    """The listener of one realization's solve: forwards its loads, forwards its iterations
+    at most every ``ITERATION_EVENT_SECONDS``, and raises ``SolveCancelled`` once ``cancel``
+    is set (at every iteration, and between the stages of the realization)."""
+
+    def __init__(self, index: int, on_load, on_iteration, cancel):
+        self.index, self.on_load, self.on_iteration, self.cancel = index, on_load, on_iteration, cancel
+        self.load = 1
+        self.last_event = time.monotonic()
+
+    def check(self) -> None:
+        if self.cancel is not None and self.cancel.is_set():
+            raise SolveCancelled(f"realization {self.index} cancelled")
+
+    def load_done(self, done: int, total: int) -> None:
+        self.load = done + 1
+        if self.on_load is not None:
+            self.on_load(self.index, done, total)
+
+    def iteration_done(self, iteration: int, residual: float) -> None:
+        self.check()
+        if self.on_iteration is not None:
+            now = time.monotonic()
+            if now - self.last_event >= ITERATION_EVENT_SECONDS:
+                self.last_event = now
+                self.on_iteration(self.index, self.load, iteration, residual)
+
+
+def compute_realization(
+    scene: Scene,
+    index: int,
+    on_load: LoadListener | None = None,
+    on_iteration: IterationListener | None = None,
+    cancel=None,
+) -> RealizationResult:
+    """Realization ``index`` of ``scene``; ``on_load`` and ``on_iteration`` hear its solver's
+    progress. A failure is carried on the result; ``SolveCancelled`` is raised once ``cancel``
+    (anything with ``is_set()``) is set, within an iteration of the solver."""
+    watch = _SolveWatch(index, on_load, on_iteration, cancel)
+    with listening_to_loads(watch.load_done), listening_to_iterations(watch.iteration_done):
+        return _compute(scene, index, watch.check)
+
+
+def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> RealizationResult:
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
         profile = scene.generator.generate(rng)
+        check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
+        check_cancel()
         slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
@@ -76,12 +120,68 @@ def _compute(scene: Scene, index: int) -> RealizationResult:
             points=profile.points,
             force_unit=force_unit(scene.solver, scene.generator.rms_height(), profile),
         )
+    except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
+        raise
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]
         error = f"{type(exc).__name__}: {exc} ({os.path.basename(where.filename)}:{where.lineno})"
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
 
 
-def compute_chunk(scene: Scene, indices: Iterable[int], on_load: LoadListener | None = None) -> list[RealizationResult]:
-    """The task every executor runs: a chunk of realizations, in order."""
-    return [compute_realization(scene, int(i), on_load) for i in indices]
+def compute_chunk(
+    scene: Scene,
+    indices: Iterable[int],
+    on_load: LoadListener | None = None,
+    on_iteration: IterationListener | None = None,
+    cancel=None,
+) -> list[RealizationResult]:
+    """The task every executor runs: a chunk of realizations, in order. Once ``cancel`` is
+    set it returns those finished (a prefix of ``indices``, maybe none): the realization
+    in progress is abandoned."""
+    results = []
+    for i in indices:
+        try:
+            results.append(compute_realization(scene, int(i), on_load, on_iteration, cancel))
+        except SolveCancelled:
+            break
+        if cancel is not None and cancel.is_set():
+            break
+    return results
+
+
+CANCEL_POLL_SECONDS = 0.05  # how often ``compute_chunk_here`` looks at the cancel while it waits
+
+
+def compute_chunk_here(
+    scene: Scene,
+    indices: Iterable[int],
+    on_load: LoadListener | None = None,
+    on_iteration: IterationListener | None = None,
+    cancel=None,
+) -> list[RealizationResult]:
+    """``compute_chunk`` for this process: in a helper thread, this one waiting (and
+    handling signals). Once ``cancel`` is set it returns at once with the realizations
+    finished; the one being solved is left to stop at its next iteration by itself: a
+    step of a large solve (FFTs of millions of points) takes seconds and cannot be
+    interrupted. An error of a listener is raised here."""
+    finished: list[RealizationResult] = []
+    errors: list[BaseException] = []
+
+    def work() -> None:
+        try:
+            for index in indices:
+                finished.extend(compute_chunk(scene, [index], on_load, on_iteration, cancel))
+                if cancel is not None and cancel.is_set():
+                    return
+        except BaseException as exc:  # handed to the waiting thread
+            errors.append(exc)
+
+    solver = threading.Thread(target=work, name="frictionlab-solve", daemon=True)
+    solver.start()
+    while solver.is_alive():
+        solver.join(CANCEL_POLL_SECONDS)
+        if cancel is not None and cancel.is_set():
+            return list(finished)
+    if errors:
+        raise errors[0]
+    return finished

@@ -1,6 +1,7 @@
-"""Ctrl-C (SIGINT) and SIGTERM end a run the same way: the first one lets the
-running chunks finish and be kept, the run ends "interrupted" and its folder
-can be resumed; a second one interrupts at once. The exit code says which
+"""Ctrl-C (SIGINT) and SIGTERM end a run the same way: the first one sets the run's
+cancel, which the solves running see at their next iteration (they are abandoned,
+what finished is kept), the run ends "interrupted" and its folder can be resumed;
+a second one interrupts at once. The exit code says which
 signal it was (130 or 143).
 
 Signal handlers live in the main thread only; the TUI, which runs the engine
@@ -69,7 +70,7 @@ class RaiseOnSigterm:
 
 class CancelOnSignals:
     """While a run goes on: the first SIGINT or SIGTERM sets ``cancel`` (running
-    work finishes and is kept); a second one raises KeyboardInterrupt or
+    solves stop at their next iteration; what finished is kept); a second one raises KeyboardInterrupt or
     Terminated. Only in the main thread, where signals land."""
 
     def __init__(self, cancel):

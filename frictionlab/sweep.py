@@ -30,6 +30,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from . import __version__
+from .dask_session import one_dask_cluster
 from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
 from .files import atomic_write, output_path_problem
 from .fit import LogFit, json_safe
@@ -312,13 +313,14 @@ def run_sweep(
     write_tables(sweep, outcome, out_dir)
     interrupted = False
     try:
-        for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
-            results[result.point.number] = result
-            outcome.results = list(results.values())
-            outcome.elapsed = time.perf_counter() - started
-            write_tables(sweep, outcome, out_dir)
-            for listener in listeners:
-                listener.point_finished(sweep, result.point, result)
+        with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
+            for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
+                results[result.point.number] = result
+                outcome.results = list(results.values())
+                outcome.elapsed = time.perf_counter() - started
+                write_tables(sweep, outcome, out_dir)
+                for listener in listeners:
+                    listener.point_finished(sweep, result.point, result)
     except KeyboardInterrupt:  # Ctrl-C between two points
         interrupted = True
     statuses = {r.status for r in outcome.results}

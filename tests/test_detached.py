@@ -190,3 +190,27 @@ def test_a_realization_event_of_the_wrong_shape_is_skipped(tmp_path):
     heard = Collect()
     Follower(tmp_path, scene, [heard]).poll()
     assert [(r.index, done) for r, done, _ in heard.results] == [(1, 1)]
+
+
+def test_iterations_within_a_load_reach_the_follower(tmp_path):
+    from frictionlab.engine import RunInfo
+
+    scene = build_scene(SMALL_PRESET)
+    log = ProgressLog(tmp_path)
+    log.run_started(RunInfo(scene=scene, total=2, workers=1))
+    log.load_done(index=0, done=2, total=16)
+    log.iteration_done(index=0, load=3, iteration=40, residual=3.1e-5)
+    log.close()
+    heard = []
+
+    class Hear:
+        @hookimpl
+        def load_done(self, index, done, total):
+            heard.append(("load", index, done, total))
+
+        @hookimpl
+        def iteration_done(self, index, load, iteration, residual):
+            heard.append(("iteration", index, load, iteration, residual))
+
+    Follower(tmp_path, scene, [Hear()]).poll()
+    assert heard == [("load", 0, 2, 16), ("iteration", 0, 3, 40, 3.1e-5)]

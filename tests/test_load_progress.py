@@ -1,17 +1,23 @@
-"""Progress per load: a solver's ``load_finished`` reaches the run's listeners as
-``load_done``, from this process and from a process pool's workers, and the CLI's
-progress line shows it."""
+"""Progress per load and within a load: a solver's ``load_finished`` and
+``iteration_done`` reach the run's listeners as ``load_done`` and ``iteration_done``,
+from this process and from a process pool's workers, and the CLI's progress line shows
+them; a cancel seen at an iteration abandons the realization being solved."""
 
 import io
+import threading
+import time
 from collections import defaultdict
 
+import numpy as np
 import pytest
 
-from frictionlab import engine, hookimpl, load_finished
+from frictionlab import SolveCancelled, engine, hookimpl, iteration_done, load_finished
 from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
-from frictionlab.plugin import listening_to_loads
+from frictionlab.plugin import listening_to_iterations, listening_to_loads
 from frictionlab.preset import build_scene
+from frictionlab.realization import compute_chunk, compute_realization
+from frictionlab.seeds import realization_rng
 
 from .conftest import SMALL_PRESET, merge
 
@@ -73,7 +79,7 @@ def test_the_progress_bar_notes_the_load_of_a_long_solve(registry, monkeypatch):
     notes = []
 
     class Bar:  # rich draws the bar; what it is told is under test here
-        def __init__(self, stream, description, total, completed=0, started=None):
+        def __init__(self, stream, description, total, completed=0, started=None, clock=None):
             pass
 
         def update(self, completed, note=""):
@@ -89,7 +95,7 @@ def test_the_progress_bar_notes_the_load_of_a_long_solve(registry, monkeypatch):
     scene = build_scene(SURFACE, registry=registry)
     engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(io.StringIO(), interactive=True, after=0.0)])
     for index in range(6):
-        assert [n for n in notes if n.startswith(f"realization {index}: ")] == [f"realization {index}: load {d}/{STEPS}" for d in range(1, STEPS + 1)]
+        assert [n for n in notes if n.startswith(f"realization {index}: ") and "iteration" not in n] == [f"realization {index}: load {d}/{STEPS}" for d in range(1, STEPS + 1)]
 
 
 def test_a_log_gets_a_load_line_only_now_and_then(registry, monkeypatch):
@@ -104,3 +110,140 @@ def test_a_log_gets_a_load_line_only_now_and_then(registry, monkeypatch):
     monkeypatch.setattr(progress, "LOAD_LINE_SECONDS", 3600.0)
     engine.run(scene, RunOptions(workers=1, executor="serial"), listeners=[ProgressReporter(stream, interactive=False, after=0.0)])
     assert "load" not in stream.getvalue()
+
+
+# ------------------------------------------------------------ within a load: iterations and cancel
+
+LONG_LOADS = merge(SURFACE, {
+    "realizations": 3,
+    "spectrum": {"params": {"points": 256, "short_cutoff": 2.0}},
+    "solver": {"params": {"tolerance": 1e-13}},
+    "loading": {"start": 1.0, "stop": 200.0, "steps": 8},
+})  # fmt: skip
+
+
+class CountdownCancel:
+    """A cancel token that becomes set once it has been looked at ``checks`` times."""
+
+    def __init__(self, checks: int):
+        self.checks = checks
+
+    def is_set(self) -> bool:
+        self.checks -= 1
+        return self.checks < 0
+
+
+def test_bem_reports_every_iteration_of_every_load_to_the_listener(registry):
+    scene = build_scene(LONG_LOADS, registry=registry)
+    realization = compute_realization(scene, 0)
+    heard = []
+    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
+    slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
+    with listening_to_loads(lambda done, total: heard.append(("load", done))):
+        with listening_to_iterations(lambda iteration, residual: heard.append((iteration, residual))):
+            curve = scene.solver.solve(profile, scene.loads, scene.control, slopes)
+    iteration_done(1, 0.5)  # outside the block: nobody hears it
+    per_load, current = [], []
+    for event in heard:
+        if event[0] == "load":
+            per_load.append(current)
+            current = []
+        else:
+            current.append(event)
+    assert len(per_load) == scene.loads.size
+    for j, events in enumerate(per_load):
+        # one event per step, before the step: 0, 1, ..., iterations - 1, each with the residual then
+        assert [i for i, _ in events] == list(range(curve.extras["iterations"][j]))
+        assert all(r > scene.solver.params.tolerance for _, r in events)
+    np.testing.assert_array_equal(curve.contact_count, realization.contact_count)
+
+
+def test_a_cancel_seen_within_a_solve_abandons_the_realization(registry):
+    scene = build_scene(LONG_LOADS, registry=registry)
+    with pytest.raises(SolveCancelled):
+        compute_realization(scene, 0, cancel=CountdownCancel(checks=20))  # 2 between stages, then per iteration
+    assert compute_chunk(scene, [0, 1], cancel=CountdownCancel(checks=20)) == []
+    whole = compute_realization(scene, 0, cancel=CountdownCancel(checks=10**9))
+    assert compute_chunk(scene, [0, 1], cancel=CountdownCancel(checks=10**9))[0].xi.tolist() == whole.xi.tolist()
+
+
+def test_iterations_are_heard_at_most_four_times_a_second(registry, monkeypatch):
+    import frictionlab.realization as realization
+
+    clock = iter(np.arange(0.0, 1000.0, 0.1))  # each look at the clock: 0.1 s later
+    monkeypatch.setattr(realization.time, "monotonic", lambda: next(clock))
+    heard = []
+    watch = realization._SolveWatch(4, None, lambda *event: heard.append(event), None)  # started at 0 s
+    for iteration in range(10):
+        watch.iteration_done(iteration, 1.0 / (iteration + 1))
+    # clock at 0.1, 0.2, ... 1.0 s: heard at 0.3 (0.25 s after the start), 0.6 and 0.9 s
+    assert heard == [(4, 1, 2, 1 / 3), (4, 1, 5, 1 / 6), (4, 1, 8, 1 / 9)]
+
+
+class CancelMidSolve:
+    """Sets the run's cancel at the first iteration heard from a realization after the
+    first (which the engine runs alone, before the executor's)."""
+
+    def __init__(self, cancel):
+        self.cancel, self.solving = cancel, None
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        if index > 0 and self.solving is None:
+            self.solving = index
+            self.cancel.set()
+
+
+@pytest.mark.parametrize("options", [RunOptions(workers=1, executor="serial"), RunOptions(workers=2, executor="processes")],
+                         ids=["serial", "processes"])  # fmt: skip
+def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_same_numbers(registry, options):
+    scene = build_scene(LONG_LOADS, registry=registry)
+    cancel = threading.Event()
+    listener = CancelMidSolve(cancel)
+    outcome = engine.run(scene, options, listeners=[listener], cancel=cancel)
+    assert outcome.status == "cancelled"
+    assert listener.solving is not None and listener.solving not in outcome.indices.tolist()
+    assert 0 in outcome.indices.tolist() and outcome.failures == []
+    kept = [compute_realization(scene, int(i)) for i in outcome.indices]
+    resumed = engine.run(scene, options, restored=kept)
+    whole = engine.run(scene, RunOptions(workers=1, executor="serial"))
+    assert resumed.status == whole.status == "completed"
+    for name, values in whole.per_realization.items():
+        np.testing.assert_array_equal(resumed.per_realization[name], values, err_msg=name)
+
+
+def test_in_this_process_a_cancel_returns_at_once_while_a_long_step_still_runs(registry, monkeypatch):
+    import frictionlab.realization as realization
+
+    monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)
+    scene = build_scene(LONG_LOADS, registry=registry)
+    cancel, release, heard = threading.Event(), threading.Event(), []
+
+    def a_long_step(index, load, iteration, residual):  # a step no check can interrupt (an FFT of 4096^2)
+        heard.append(iteration)
+        if len(heard) == 1:
+            cancel.set()
+            release.wait(120)
+
+    results = realization.compute_chunk_here(scene, [0, 1], on_iteration=a_long_step, cancel=cancel)
+    returned_during_the_step = not release.is_set()
+    release.set()
+    assert results == [] and returned_during_the_step
+
+
+def _sleep_through(seconds: float) -> float:
+    time.sleep(seconds)  # a job that never looks at stop_event()
+    return seconds
+
+
+def test_a_pool_kills_a_worker_whose_job_does_not_stop_after_a_cancel():
+    from frictionlab.executors import pool_context
+    from frictionlab.pool import WorkerPool
+
+    cancel = threading.Event()
+    pool = WorkerPool(1, pool_context(), _sleep_through)
+    timer = threading.Timer(0.5, cancel.set)
+    timer.start()
+    finished = list(pool.run({"long": 120.0}, cancel))  # without the kill: two minutes, then [("long", 120.0)]
+    timer.cancel()
+    assert finished == []

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..dask_session import one_dask_cluster
 from ..errors import OutputRefused
 from ..files import atomic_write, output_path_problem
 from ..listeners import format_duration
@@ -108,7 +109,8 @@ def write_page(
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
     try:
-        runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
+        with one_dask_cluster(options):  # on Dask, every ensemble's run uses one client and cluster
+            runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
     except WorkInterrupted as exc:
         raise WorkInterrupted(f"{exc}; no page written") from None
     kappas = kappas_of(runs)

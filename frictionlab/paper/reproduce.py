@@ -9,6 +9,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from ..dask_session import one_dask_cluster
 from ..errors import OutputRefused
 from ..files import atomic_write, output_path_problem
 from ..options import RunOptions
@@ -56,32 +57,33 @@ def write_report(
     presets = find_presets(presets_dir)
     out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
     try:
-        started = time.perf_counter()
-        log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
-        runs = run_figures(presets, out_dir, options, progress=not quiet)
-        log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
-        images = {}
-        for run in runs:
-            name = f"{run.figure.key}.png"
-            draw = plot_fig5 if run.sweep is not None else plot_figure
-            atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
-            images[run.figure.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
-        elapsed = time.perf_counter() - started
-        reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
-        if readings:
-            log(f"report: running {len(READINGS)} readings")
-            t0 = time.perf_counter()
-            reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
-            readings_elapsed = time.perf_counter() - t0
-            fig5 = next(run for run in runs if run.sweep is not None)
-            log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
-            t0 = time.perf_counter()
-            fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
-                                     folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
-            fig5_elapsed = time.perf_counter() - t0
-            name = "fig5-calibrated.png"
-            atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
-            images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+        with one_dask_cluster(options):  # on Dask, every run uses one client and cluster
+            started = time.perf_counter()
+            log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
+            runs = run_figures(presets, out_dir, options, progress=not quiet)
+            log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
+            images = {}
+            for run in runs:
+                name = f"{run.figure.key}.png"
+                draw = plot_fig5 if run.sweep is not None else plot_figure
+                atomic_write(figures_dir / name, lambda fh, run=run, draw=draw: draw(run, fh, dpi=dpi), binary=True)
+                images[run.figure.key] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
+            elapsed = time.perf_counter() - started
+            reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
+            if readings:
+                log(f"report: running {len(READINGS)} readings")
+                t0 = time.perf_counter()
+                reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
+                readings_elapsed = time.perf_counter() - t0
+                fig5 = next(run for run in runs if run.sweep is not None)
+                log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
+                t0 = time.perf_counter()
+                fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
+                                         folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
+                fig5_elapsed = time.perf_counter() - t0
+                name = "fig5-calibrated.png"
+                atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)
+                images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
         raise WorkInterrupted(f"{said}the runs that finished are kept in {out_dir}; no {markdown_path} written") from None

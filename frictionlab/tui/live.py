@@ -19,6 +19,7 @@ import numpy as np
 
 from ..fit import LogFit, fit_curve
 from ..hookspecs import hookimpl
+from ..listeners import solve_text
 from .text import failure_message
 
 
@@ -36,7 +37,7 @@ class Snapshot:
     finished: bool = False
     f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
     restored: int = 0  # of ``done``, restored from the run folder (a resume): not counted in the rate
-    within: str = ""  # progress inside a long solve, e.g. "realization 3: load 5/20"
+    solving: str = ""  # where a long solve is: realization, load, iteration, residual
 
 
 class LiveListener:
@@ -57,11 +58,12 @@ class LiveListener:
         self._ok = 0
         self._failed = 0
         self._first_error = None
+        self._solving = ""
         self._xi_sum = np.zeros(steps)
         self._count_sum = np.zeros(steps)
         self._force_sum = np.zeros(steps)
         self._restored = run.resumed
-        self._done, self._total, self._within = run.resumed, run.total, ""
+        self._done, self._total = run.resumed, run.total
         for result in run.restored:  # a resume: the interim fit covers every realization, not only the new ones
             self._add(result)
         self._started = self.clock()
@@ -79,14 +81,7 @@ class LiveListener:
     @hookimpl
     def realization_done(self, result, done, total):
         self._add(result)
-        self._within = ""
         self._maybe_post(done, total)
-
-    @hookimpl
-    def load_done(self, index, done, total):
-        """A long solve's loads: shown as they come (at most every ``interval``), the count unchanged."""
-        self._within = f"realization {index}: load {done}/{total}"
-        self._maybe_post(self._done, self._total)
 
     def tick(self) -> None:
         """A snapshot now, nothing new heard: the elapsed time moves on while a realization runs."""
@@ -100,11 +95,28 @@ class LiveListener:
         self._maybe_post(done, total)
 
     @hookimpl
+    def load_done(self, index, done, total):
+        self._solve_note(solve_text(index, done, total))
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        self._solve_note(solve_text(index, load, self._loads.size, iteration, residual))
+
+    def _solve_note(self, text: str) -> None:
+        """Movement within a long realization: shown with the next snapshot, posted at once
+        if none was for ``interval``."""
+        self._solving = text
+        now = self.clock()
+        if now - self._last_post >= self.interval:
+            self._last_post = now
+            self.post(self._snapshot(self._done, self._total))
+
+    @hookimpl
     def run_finished(self, run, outcome):
         self.post(self._snapshot(outcome.done + len(outcome.failures), run.total, finished=True))
 
     def _maybe_post(self, done: int, total: int) -> None:
-        self._done, self._total = done, total
+        self._done, self._total, self._solving = done, total, ""
         now = self.clock()
         if done in (1, total) or now - self._last_post >= self.interval:  # the plot appears at once
             self._last_post = now
@@ -131,7 +143,7 @@ class LiveListener:
             finished=finished,
             f_formula=self._f_formula,
             restored=self._restored,
-            within=self._within,
+            solving="" if finished else self._solving,
         )
 
 

@@ -30,7 +30,7 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, iteration_done, load_finished
 
 from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
@@ -185,6 +185,7 @@ class ConstrainedCG:
                     continue
                 p[contact] = p_c
                 return pressure, float(level), iteration, residual
+            iteration_done(iteration, residual)  # progress, and SolveCancelled once the run is cancelled
             if monitor is not None:
                 monitor(iteration, residual, contact)
             if iteration == max_iterations:

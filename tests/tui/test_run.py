@@ -76,6 +76,29 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
 
 
 @sync
+async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_realization(folders, registry):
+    from ..test_load_progress import LONG_LOADS
+
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG_LOADS))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 1
+                         and "iteration" in app.last_snapshot.solving)  # fmt: skip
+        solving = app.last_snapshot.solving
+        stats = str(app.query_one("#run-stats", Static).render())
+        await pilot.press("c")  # SIGTERM to the run's process
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        outcome, out_dir = app.last_outcome, app.last_out_dir
+    assert solving in stats.splitlines()[1] and solving.startswith(("realization 1: load ", "realization 2: load "))
+    index = int(solving.split()[1].rstrip(":"))
+    with np.load(out_dir / "realizations.npz") as arrays:
+        kept = arrays["index"].tolist()
+    # the realization being solved is abandoned, not waited for: never kept, never failed
+    assert outcome.status == "interrupted" and index not in kept and outcome.failures == []
+
+
+@sync
 async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, registry):
     (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
     app = make_app(registry, preset="presets/sweep.yaml", workers=1)

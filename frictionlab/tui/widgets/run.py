@@ -134,8 +134,8 @@ class RunPane(Vertical, can_focus=True):
     def show_progress(self, snap: Snapshot, cancelling: bool) -> None:
         self.query_one("#run-bar", ProgressBar).update(total=snap.total, progress=snap.done)
         if not cancelling:
-            line = progress_text(snap.done, snap.total, snap.failed, snap.elapsed, restored=snap.restored)
-            self._set("run-stats", f"{line}\n{snap.within}" if snap.within else line)
+            stats = progress_text(snap.done, snap.total, snap.failed, snap.elapsed, restored=snap.restored)
+            self._set("run-stats", f"{stats}\n{snap.solving}" if snap.solving else stats)
         if snap.f is not None:
             series = [Series(snap.f, snap.xi, "cyan")]
             if snap.fit is not None:
@@ -147,7 +147,7 @@ class RunPane(Vertical, can_focus=True):
             self._error(snap.first_error)
 
     def show_cancelling(self) -> None:
-        self._set("run-stats", "cancelling: the realizations already running finish and are kept")
+        self._set("run-stats", "cancelling: the solves running stop; what finished is kept")
 
     def show_point(self, sweep, kind: str, point, result) -> None:
         """A sweep point started (``result`` None) or finished."""

@@ -1,0 +1,100 @@
+"""SIGTERM and Ctrl-C stop a run inside a long solve, not after it: real subprocesses,
+real signals. The realization in progress is abandoned (neither kept nor failed), what
+finished is kept, and ``frictionlab resume`` ends with the numbers of a run never stopped."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from frictionlab.errors import ExitCode
+
+from ..conftest import SMALL_PRESET, merge
+from .conftest import run_cli, write_preset
+
+# Each realization solves for seconds at a tight tolerance; the run's first realization
+# is solved alone, so a line about realization 1 or 2 means realization 0 is stored.
+LONG_SOLVES = merge(SMALL_PRESET, {
+    "realizations": 3,
+    "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 512, "short_cutoff": 2.0}},
+    "solver": {"name": "bem-halfspace", "params": {"tolerance": 1e-13}},
+    "loading": {"control": "force", "start": 1.0, "stop": 200.0, "steps": 8, "spacing": "log"},
+    "fit": {"bootstrap": 50},
+    "output": {"plot": False},
+})  # fmt: skip
+STOP_SECONDS = 1.0  # from the signal to the run's end, all its realizations' solves stopped
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("whole")
+    preset = write_preset(folder, LONG_SOLVES)
+    done = run_cli("run", preset, "--out", folder / "out", "--workers", "1")
+    assert done.returncode == 0, done.stderr
+    return preset, folder / "out"
+
+
+def _wait_for_a_later_solve(proc) -> list[str]:
+    """Read the progress until a realization after the first one is solving (after the
+    first lines are shown, 2 s in)."""
+    lines = []
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        line = proc.stderr.readline()
+        if not line:
+            break
+        lines.append(line)
+        if line.startswith(("realization 1:", "realization 2:")) and "iteration" in line:
+            return lines
+    proc.kill()
+    pytest.fail("no progress within a later realization's solve:\n" + "".join(lines))
+
+
+@pytest.mark.parametrize(
+    ("workers", "signum", "code"),
+    [(1, signal.SIGTERM, ExitCode.TERMINATED), (2, signal.SIGINT, ExitCode.INTERRUPTED)],
+    ids=["serial-sigterm", "processes-sigint"],
+)
+def test_a_signal_stops_the_solve_within_a_second_and_resume_gives_the_same_numbers(
+    uninterrupted, tmp_path, workers, signum, code
+):
+    preset, whole = uninterrupted
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(out), "--workers", str(workers)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    _wait_for_a_later_solve(proc)
+    sent = time.monotonic()
+    proc.send_signal(signum)
+    stopped = None
+    rest = []
+    for line in proc.stderr:  # "run interrupted: ..." is written as the run ends, before its files
+        rest.append(line)
+        if line.startswith("run interrupted") and stopped is None:
+            stopped = time.monotonic() - sent
+    proc.wait(timeout=60)
+    stderr = "".join(rest)
+    assert proc.returncode == code, stderr
+    assert "Traceback" not in stderr
+    assert stopped is not None and stopped < STOP_SECONDS, (stopped, stderr)
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted"
+    assert 1 <= summary["realizations"]["done"] < 3  # realization 0 kept, the one solving abandoned
+    assert summary["realizations"]["failed"] == 0
+
+    resumed = run_cli("resume", out)
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads((out / "summary.json").read_text())["status"] == "completed"
+    expected, got = np.load(whole / "realizations.npz"), np.load(out / "realizations.npz")
+    assert sorted(got.files) == sorted(expected.files)
+    for name in expected.files:
+        assert np.array_equal(got[name], expected[name]), name  # bitwise: the same numbers
+    assert (out / "curve.csv").read_text() == (whole / "curve.csv").read_text()
