@@ -149,6 +149,8 @@ class ProgressReader:
             if info.st_size < self.offset:
                 self.offset, self.restarted = 0, True
             data = os.pread(fd, min(READ_BLOCK, info.st_size - self.offset), self.offset)
+        except OSError:  # read next time, if it can be
+            return []
         finally:
             os.close(fd)
         end = data.rfind(b"\n") + 1  # only whole lines: the last one may still be written

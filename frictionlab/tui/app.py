@@ -446,7 +446,11 @@ class FrictionlabApp(App):
             except FrictionlabError as exc:
                 self.say(str(exc), "error", title="Run failed")
                 return
-            process = start_detached(scene.resolved(), out_dir, options)
+            try:
+                process = start_detached(scene.resolved(), out_dir, options)
+            except OSError as exc:  # no process can be started (out of processes, memory)
+                self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
+                return
             self.followed = FollowedRun(out_dir, scene, self._show_snapshot, process=process)
         else:
             self.cancel_event = threading.Event()
