@@ -21,12 +21,12 @@ from textual.binding import Binding
 from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
+from ..detached import check_startable, list_run_states, run_state, start_detached
 from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
-from ..detached import check_startable, list_run_states, run_state, start_detached
 from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
 from .fields import default_spectrum, preset_from_defaults
@@ -222,7 +222,6 @@ class FrictionlabApp(App):
             self.draft_source = None
         self.draft_path = path
         await self.query_one("#form", PresetForm).load(data, base_dir=path.parent)
-        self.problems = []
         if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
             self.say("")
         self.modified = modified
