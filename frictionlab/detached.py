@@ -280,7 +280,9 @@ def _last_count(folder: Path) -> int | None:
         if not events:
             return done
         for event in events:
-            if event["event"] in ("realization", "finished"):
+            if event["event"] == "started":  # none finished yet but those restored
+                done = _count(event.get("resumed")) or 0
+            elif event["event"] in ("realization", "finished"):
                 done = _count(event.get("done"))
 
 

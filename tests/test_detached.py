@@ -86,6 +86,7 @@ def test_a_run_whose_process_was_killed_reads_as_interrupted_and_resumes(tmp_pat
     out = tmp_path / "run"
     process = start_detached(build_scene(data).resolved(), out, RunOptions(workers=1))
     wait_started(process, out)
+    assert run_state(out).done is not None  # 0 before the first realization: a count, not unknown
     wait_for(lambda: (run_state(out).done or 0) >= 2)
     assert run_state(out).status == "running"
     process.kill()  # kill -9: no chance to write anything
