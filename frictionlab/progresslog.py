@@ -30,11 +30,11 @@ from .realization import RealizationResult
 PROGRESS_FILE = "progress.jsonl"
 MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # ~100k realizations of 100 load steps: beyond that it is not ours
 READ_BLOCK = 4 * 1024 * 1024  # read at most this much at a time: a follower stays responsive
-CURVES = ("xi", "contact_count", "indentation", "force")
+CURVES = ("xi", "contact_count", "force")  # what a follower's mean curve needs (force: under indentation control)
 
 
 def _floats(values) -> list | None:
-    return None if values is None else [float(x) for x in np.asarray(values, float).tolist()]
+    return None if values is None else np.asarray(values, float).tolist()
 
 
 def _event_of(result: RealizationResult, done: int, total: int, restored: bool = False) -> dict:
