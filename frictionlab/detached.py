@@ -26,7 +26,7 @@ from pathlib import Path
 
 from .errors import ExitCode, FrictionlabError, RunFolderError
 from .options import RunOptions
-from .progresslog import PROGRESS_FILE, ProgressLog, ProgressReader
+from .progresslog import ProgressLog, ProgressReader
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory, read_json_object
 
 MAX_LOCK_BYTES = 4096

@@ -13,7 +13,13 @@ import time
 import numpy as np
 import pytest
 
-from frictionlab.detached import lock_held, process_alive, run_state, start_detached, wait_started
+from frictionlab.detached import (
+    lock_held,
+    process_alive,
+    run_state,
+    start_detached,
+    wait_started,
+)
 from frictionlab.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene

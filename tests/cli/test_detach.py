@@ -44,7 +44,7 @@ def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path)
     while (run_state(out).done or 0) < 3 and time.monotonic() < deadline:
         time.sleep(0.05)
     os.kill(told["pid"], signal.SIGTERM)
-    stdout, stderr = follow.communicate(timeout=60)
+    stdout, _ = follow.communicate(timeout=60)
     assert follow.returncode == 1
     assert "interrupted" in stdout and f"frictionlab resume {out} continues it" in stdout
 

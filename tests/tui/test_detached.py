@@ -5,7 +5,6 @@ import os
 import signal
 import time
 
-import pytest
 import yaml
 from textual.widgets import Static
 
@@ -15,7 +14,17 @@ from frictionlab.preset import build_scene
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
-from .conftest import SIZE, TINY, make_app, numbers_in, press_run, screen_text, status_text, sync, wait_until
+from .conftest import (
+    SIZE,
+    TINY,
+    make_app,
+    numbers_in,
+    press_run,
+    screen_text,
+    status_text,
+    sync,
+    wait_until,
+)
 
 LONG = merge(TINY, {"name": "long", "realizations": 100_000})
 

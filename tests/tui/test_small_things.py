@@ -5,7 +5,18 @@ import yaml
 from textual.widgets import DataTable, Input, Static
 
 from ..conftest import merge
-from .conftest import SIZE, SWEEP, TINY, make_app, run_to_the_end, screen_text, status_text, sync, type_into, wait_until
+from .conftest import (
+    SIZE,
+    SWEEP,
+    TINY,
+    make_app,
+    run_to_the_end,
+    screen_text,
+    status_text,
+    sync,
+    type_into,
+    wait_until,
+)
 
 
 @sync
