@@ -1,27 +1,33 @@
-"""Benchmark: the boundary-element solvers (bem-halfspace, bem-halfplane).
+"""Benchmark: the exact solvers' contact CG, old against new, and against Tamaas.
 
-Prints wall times and ratios against baselines run in this same process, so a
-noisy shared machine shifts the figures together; iteration counts are printed
-beside them because they do not depend on the machine's load.
+The scene: a 512 x 512 periodic self-affine surface (power-law-2d, H = 0.8, rms
+height 1, short cut-off 8 pixels, long cut-off the side, spacing 1), E* = 1, and
+20 forces log-spaced from 20 to 1000 (about 0.5 % to 19 % contact). Each solver
+runs a cold load (the first, the tenth and the last force, alone) and the
+20-load sweep (warm-started, as a run solves it):
 
-* default: bem-halfspace on a 512 x 512 power-law-2d surface, one cold load at
-  about 1, 3 and 20 % contact (default settings), the FFT floor and the time per
-  CG iteration; bem-halfplane on an 8192-point line, one load and a 20-load sweep.
-* ``--law``: the force sweep of a study at the solver's default settings: a
-  512 x 512 power-law-2d surface (H = 0.8, rms height 1, spacing 1, E = 1,
-  nu = 0), 20 forces log-spaced from 20 to 1000, warm-started, against one cold
-  solve (median of a low, a middle and a high load) and against 20 independent
-  cold solves at tolerance 1e-12 (largest relative difference of xi and of the
-  real contact area, and the number of points whose contact state differs).
-* ``--vs-tamaas``: one load on 512 x 512 and 2048 x 2048 surfaces against
-  Tamaas's Polonsky-Keer solver (``pip install tamaas``; the ``bench`` extra),
-  single-threaded both. Tamaas runs at tolerance 1e-8 of its own error measure;
-  frictionlab then runs to the residual that Tamaas's answer reached in
-  frictionlab's measure (largest gap error on contact points or penetration
-  elsewhere, over the rms height), so it is at least as converged in that
-  measure, and the contact sets are compared point by point.
+* ``polonsky-keer``: the constrained CG of Polonsky & Keer, the solver before
+  this one, at the default tolerance 1e-8;
+* ``pcg tolerance``: the preconditioned projected CG, stopped at the tolerance 1e-8;
+* ``pcg certified``: the same CG with the certified stop (the default);
+* Tamaas's PolonskyKeerRey at tolerance 1e-10 (``pip install tamaas``, the
+  ``bench`` extra), its sweep on one solver object (warm), its cold loads each on
+  a new one.
 
-    python benchmarks/bench_bem.py [--repeat 3] [--law] [--vs-tamaas [--sides 512 2048]]
+It prints FFT pairs (one forward and one inverse transform; the stable measure
+on a shared machine), in double and in single precision (a single-precision
+pair takes about half the time), and seconds of CPU and of wall time (the run of
+least CPU time of ``--repeat``, the solvers alternating; CPU time, all threads
+counted, is what a busy shared machine disturbs least), the ratios of CPU time to
+the new default, and the contact counts checked at every load against cold
+solves at tolerance 1e-12 (Tamaas's too). Run single-threaded::
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_bem.py [--repeat 3] [--side 512] [--no-tamaas]
+
+``--line``: ``bem-halfplane`` on an 8192-point power-law line (H = 0.8), a 20-load
+sweep, old against new. ``--tamaas-surface``: the surface made by Tamaas's own
+generator (``SurfaceGeneratorFilter2D``, the same spectrum, scaled to rms height 1)
+instead of frictionlab's.
 """
 
 from __future__ import annotations
@@ -34,229 +40,187 @@ import numpy as np
 from frictionlab import Profile
 from frictionlab.seeds import realization_rng
 from frictionlab_solvers import bem
+from frictionlab_solvers.elastic import PeriodicHalfSpace
+from frictionlab_solvers.polonsky_keer import PolonskyKeerCG
 from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
 
 SEED = 2024
+FFT_PAIRS = [0, 0]  # float64, float32
 
 
-def study_surface(points: int) -> Profile:
-    """A power-law-2d surface as a study makes it: H = 0.8, rms height 1, spacing 1."""
-    return PowerLawSurface(hurst=0.8, points=points, spacing=1.0).generate(realization_rng(SEED, 0))
+class CountingOperator(PeriodicHalfSpace):
+    """The periodic half-space, counting its FFT pairs in double and single precision."""
+
+    def _apply(self, kernel, field, out):
+        FFT_PAIRS[0] += 1
+        return super()._apply(kernel, field, out)
+
+    def _apply_single(self, kernel, field, out):
+        FFT_PAIRS[1] += 1
+        return super()._apply_single(kernel, field, out)
 
 
-def gradient_norm(z: np.ndarray) -> np.ndarray:
-    """|grad z| by forward differences, both components (the 2D slope of a study)."""
-    return np.hypot(np.roll(z, -1, 0) - z, np.roll(z, -1, 1) - z)
+bem.PeriodicHalfSpace = CountingOperator  # the solvers build their operator from this name
 
 
-def best_of(repeat, work):
-    times, result = [], None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        result = work()
-        times.append(time.perf_counter() - start)
-    return min(times), result
+class PolonskyKeer(bem.BEMHalfSpace):
+    contact_cg = PolonskyKeerCG
 
 
-def residual(depth_like_gap: np.ndarray, pressure: np.ndarray, rms: float) -> tuple[float, float]:
-    """frictionlab's measure of a state: the largest gap on contact points (after
-    removing the rigid level, their mean) and the largest penetration of a free
-    point, over the rms height."""
-    contact = pressure > 0
-    gap = depth_like_gap - depth_like_gap[contact].mean()
-    return float(np.abs(gap[contact]).max() / rms), float(max(0.0, -gap[~contact].min()) / rms)
+class PolonskyKeerLine(bem.BEMHalfPlane):
+    contact_cg = PolonskyKeerCG
+
+
+def scene(side: int, tamaas=None):
+    """The surface (frictionlab's power-law-2d, or with ``tamaas`` the same spectrum
+    made by Tamaas's own generator) and the 20 forces."""
+    if tamaas is None:
+        profile = PowerLawSurface(hurst=0.8, points=side, spacing=1.0, short_cutoff=8.0, rms_height=1.0).generate(
+            realization_rng(SEED, 0)
+        )
+    else:
+        spectrum = tamaas.Isopowerlaw2D()  # wave numbers in units of 2 pi / side
+        spectrum.q0, spectrum.q1, spectrum.q2, spectrum.hurst = 1, 1, side // 8, 0.8
+        generator = tamaas.SurfaceGeneratorFilter2D([side, side])
+        generator.spectrum, generator.random_seed = spectrum, SEED
+        z = np.array(generator.buildSurface())
+        profile = Profile(z / z.std(), 1.0)
+    forces = np.geomspace(20.0, 1000.0, 20) * (side / 512) ** 2  # the same contact fractions at any side
+    return profile, forces
+
+
+def timed(work):
+    """((CPU, wall) seconds, (float64, float32) FFT pairs, answer) of one run of ``work``."""
+    FFT_PAIRS[:] = [0, 0]
+    cpu, wall = time.process_time(), time.perf_counter()
+    answer = work()
+    return (time.process_time() - cpu, time.perf_counter() - wall), tuple(FFT_PAIRS), answer
+
+
+def best(runs):
+    """The run of least CPU time (pairs and answers are the same in each)."""
+    return min(runs, key=lambda run: run[0][0])
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=3, help="best of this many runs")
-    parser.add_argument("--law", action="store_true", help="the 20-force sweep against cold solves")
-    parser.add_argument("--vs-tamaas", action="store_true", help="one load against Tamaas")
-    parser.add_argument("--sides", type=int, nargs="+", default=[512, 2048], help="surface sides for --vs-tamaas")
+    parser.add_argument("--repeat", type=int, default=1, help="best of this many runs")
+    parser.add_argument("--side", type=int, default=512, help="surface side in pixels (forces scale with the area)")
+    parser.add_argument("--no-tamaas", action="store_true", help="skip Tamaas even when it is installed")
+    parser.add_argument("--line", action="store_true", help="bem-halfplane on an 8192-point line instead")
+    parser.add_argument(
+        "--tamaas-surface", action="store_true", help="the surface made by Tamaas's generator (same spectrum)"
+    )
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1. Got {args.repeat} instead.")
-    if args.law:
-        law(args.repeat)
-    if args.vs_tamaas:
-        versus_tamaas(args.sides, args.repeat)
-    if not (args.law or args.vs_tamaas):
-        single_loads(args.repeat)
+    if args.side < 16:
+        parser.error(f"--side must be at least 16. Got {args.side} instead.")
+    if args.line:
+        line_sweep(args.repeat)
+        return
+    tamaas = None if args.no_tamaas else load_tamaas()
+    if args.tamaas_surface and tamaas is None:
+        parser.error("--tamaas-surface needs Tamaas (pip install tamaas) and no --no-tamaas")
+    profile, forces = scene(args.side, tamaas if args.tamaas_surface else None)
+    slopes = np.ones_like(profile.heights)
+    cold = (0, 9, 19)
+    solvers = {
+        "polonsky-keer": PolonskyKeer(stop="tolerance"),
+        "pcg tolerance": bem.BEMHalfSpace(stop="tolerance"),
+        "pcg certified": bem.BEMHalfSpace(stop="certified"),
+    }
+    default = f"pcg {bem.BEMHalfSpace().params.stop}"
+    runs = {name: {"sweep": [], **{j: [] for j in cold}} for name in solvers}
+    if tamaas is not None:
+        runs["Tamaas 1e-10"] = {"sweep": [], **{j: [] for j in cold}}
+    for _ in range(args.repeat):
+        for name, solver in solvers.items():
+            runs[name]["sweep"].append(timed(lambda: solver.solve(profile, forces, "force", slopes).contact_count))
+            for j in cold:
+                runs[name][j].append(timed(lambda: solver.solve(profile, forces[j : j + 1], "force", slopes).contact_count))
+        if tamaas is not None:
+            runs["Tamaas 1e-10"]["sweep"].append(tamaas_sweep(tamaas, profile.heights, forces))
+            for j in cold:
+                runs["Tamaas 1e-10"][j].append(tamaas_sweep(tamaas, profile.heights, forces[j : j + 1]))
+
+    exact = bem.BEMHalfSpace(tolerance=1e-12, stop="tolerance")
+    reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
+    side = args.side
+    made = "Tamaas's generator" if args.tamaas_surface else "power-law-2d"
+    print(f"bem-halfspace, {side} x {side} surface ({made}) H = 0.8, rms height 1, short cut-off 8 px, long cut-off {side} px, "
+          f"E* = 1; 20 forces {forces[0]:g} .. {forces[-1]:g} (contact {reference[0] / side**2:.2%} .. "
+          f"{reference[-1] / side**2:.2%}); best of {args.repeat}")  # fmt: skip
+    print(f"  {'solver':<15}{'what':<25}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}"
+          f"{'x default (CPU)':>17}  contact counts")  # fmt: skip
+    base = {what: best(runs[default][what]) for what in runs[default]}
+    for name, by_what in runs.items():
+        for what, results in by_what.items():
+            seconds, pairs, counts = best(results)
+            loads = slice(None) if what == "sweep" else slice(what, what + 1)
+            wrong = int(np.count_nonzero(np.asarray(counts) != reference[loads]))
+            label = "20-load sweep" if what == "sweep" else f"cold load {what + 1} (F {forces[what]:.4g})"
+            pairs_text = f"{pairs[0]:11d} + {pairs[1]:6d}" if pairs is not None else f"{'-':>20}"
+            verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
+            ratio = seconds[0] / base[what][0][0]
+            print(f"  {name:<15}{label:<25}{pairs_text}{seconds[0]:8.2f}{seconds[1]:8.2f}{ratio:16.2f}x  {verdict}")
 
 
-def single_loads(repeat: int) -> None:
-    profile = study_surface(512)
-    z = profile.heights
-    slopes = gradient_norm(z)
-    solver = bem.BEMHalfSpace()
-
-    cg = bem.ConstrainedCG(z - z.min())
-    out = np.empty_like(z)
-    floor, _ = best_of(repeat * 10, lambda: cg.displacement(z, out))
-    print("bem-halfspace, 512 x 512 power-law-2d H = 0.8, default settings")
-    print(f"  FFT floor: one displacement (rfft2, kernel, irfft2): {floor * 1e3:7.2f} ms")
-    for force in (20.0, 150.0, 1000.0):
-        seconds, curve = best_of(repeat, lambda: solver.solve(profile, np.array([force]), "force", slopes))
-        its = int(curve.extras["iterations"][0])
-        print(
-            f"  force {force:6g}, contact {curve.contact_fraction[0]:6.2%}: {seconds:7.3f} s  {its:4d} iterations  "
-            f"{seconds / its * 1e3:6.2f} ms/iteration = {seconds / its / floor:4.1f} FFT pairs"
-        )
-
-    line_profile = PowerLaw(hurst=0.8, points=8192, spacing=1.0).generate(realization_rng(SEED, 1))
-    heights = line_profile.heights
-    plane = bem.BEMHalfPlane()
+def line_sweep(repeat: int) -> None:
+    """bem-halfplane: a 20-load sweep on an 8192-point power-law line (H = 0.8,
+    spacing 1, forces per unit depth 0.5 .. 20), old against new."""
+    profile = PowerLaw(hurst=0.8, points=8192, spacing=1.0).generate(realization_rng(SEED, 1))
     forces = np.geomspace(0.5, 20.0, 20)
-    line_slopes = np.diff(heights, append=heights[:1])
-    one, c1 = best_of(repeat, lambda: plane.solve(line_profile, forces[10:11], "force", line_slopes))
-    many, c20 = best_of(repeat, lambda: plane.solve(line_profile, forces, "force", line_slopes))
-    print("bem-halfplane, 8192 points, H = 0.8, default settings")
-    print(f"  one load, contact {c1.contact_fraction[0]:6.2%}: {one * 1e3:8.1f} ms  {int(c1.extras['iterations'][0])} iterations")
-    print(
-        f"  20-load sweep ({c20.contact_fraction[0]:.2%} .. {c20.contact_fraction[-1]:.2%}): {many * 1e3:8.1f} ms  "
-        f"{int(c20.extras['iterations'].sum())} iterations  ({many / one:4.1f} x one load)"
-    )
+    slopes = np.ones_like(profile.heights)
+    solvers = {
+        "polonsky-keer": PolonskyKeerLine(stop="tolerance"),
+        "pcg tolerance": bem.BEMHalfPlane(stop="tolerance"),
+        "pcg certified": bem.BEMHalfPlane(stop="certified"),
+    }
+    runs = {name: [] for name in solvers}
+    for _ in range(repeat):
+        for name, solver in solvers.items():
+            runs[name].append(timed(lambda: solver.solve(profile, forces, "force", slopes)))
+    exact = bem.BEMHalfPlane(tolerance=1e-12, stop="tolerance")
+    reference = np.array([exact.solve(profile, forces[j : j + 1], "force", slopes).contact_count[0] for j in range(20)])
+    print(f"bem-halfplane, 8192-point power-law line H = 0.8; 20 forces {forces[0]:g} .. {forces[-1]:g} per unit depth "
+          f"(contact {reference[0] / 8192:.2%} .. {reference[-1] / 8192:.2%}); best of {repeat}")  # fmt: skip
+    print(f"  {'solver':<15}{'FFT pairs f64 + f32':>20}{'CPU s':>8}{'wall s':>8}{'iterations':>11}  contact counts")
+    for name, results in runs.items():
+        seconds, pairs, curve = best(results)
+        wrong = int(np.count_nonzero(curve.contact_count != reference))
+        verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
+        print(f"  {name:<15}{pairs[0]:11d} + {pairs[1]:6d}{seconds[0]:8.2f}{seconds[1]:8.2f}"
+              f"{int(curve.extras['iterations'].sum()):11d}  {verdict}")  # fmt: skip
 
 
-def law(repeat: int) -> None:
-    profile = study_surface(512)
-    z = profile.heights
-    slopes = gradient_norm(z)
-    forces = np.geomspace(20.0, 1000.0, 20)
-    solver = bem.BEMHalfSpace()  # default settings
-    print(f"force sweep, 512 x 512 power-law-2d H = 0.8, 20 forces {forces[0]:g} .. {forces[-1]:g}, default settings")
-    cold_seconds, cold_iterations = [], []
-    for j in (0, 10, 19):
-        seconds, curve = best_of(repeat, lambda: solver.solve(profile, forces[j : j + 1], "force", slopes))
-        cold_seconds.append(seconds)
-        cold_iterations.append(int(curve.extras["iterations"][0]))
-        print(
-            f"  cold load {j:2d} (force {forces[j]:7.1f}, contact {curve.contact_fraction[0]:6.2%}): "
-            f"{seconds:6.3f} s  {cold_iterations[-1]:4d} iterations"
-        )
-    sweep_seconds, sweep = best_of(repeat, lambda: solver.solve(profile, forces, "force", slopes))
-    iterations = sweep.extras["iterations"]
-    print(f"  sweep: {sweep_seconds:6.3f} s  {int(iterations.sum())} iterations  per load: {' '.join(map(str, iterations))}")
-    print(
-        f"  sweep / one cold load (median of the three): {sweep_seconds / np.median(cold_seconds):5.2f} x in time, "
-        f"{iterations.sum() / np.median(cold_iterations):5.2f} x in iterations  (target <= 5)"
-    )
-
-    tight = bem.BEMHalfSpace(tolerance=1e-12)
-    start = time.perf_counter()
-    references = [tight.solve(profile, forces[j : j + 1], "force", slopes) for j in range(forces.size)]
-    tight_seconds = time.perf_counter() - start
-    xi = np.array([c.slope_rms_contact[0] for c in references])
-    count = np.array([c.contact_count[0] for c in references])
-    xi_error = np.abs(sweep.slope_rms_contact / xi - 1)
-    area_error = np.abs(sweep.contact_count / count - 1)
-    print(f"  20 cold solves at tolerance 1e-12: {tight_seconds:6.1f} s")
-    print(
-        f"  largest relative difference from them: xi {xi_error.max():.2e}, real contact area {area_error.max():.2e}; "
-        f"contact counts differ at {np.count_nonzero(sweep.contact_count != count)} of 20 loads  (target 1e-6)"
-    )
-    where_the_iterations_go(z, forces)
-
-
-def where_the_iterations_go(z: np.ndarray, forces: np.ndarray) -> None:
-    """The earliest any stopping rule on the contact set could stop: the iteration
-    after which the set no longer changes (known only in hindsight), for the sweep's
-    warm starts and for cold starts, at the default tolerance."""
-    scale = float(z.max() - z.min())
-    depth = (z.max() - z) / scale
-    cg = bem.ConstrainedCG(depth)
-    means = forces / z.size / scale
-    tolerance = bem.PeriodicBEM.Params().tolerance
-
-    def settle(start, mean):
-        last = {"set": None, "since": 0}
-
-        def watch(iteration, _residual, contact):
-            if last["set"] is None or not np.array_equal(contact, last["set"]):
-                last["set"], last["since"] = contact.copy(), iteration
-
-        pressure, _, iterations, _ = cg.solve(start, mean_pressure=mean, tolerance=tolerance,
-                                              max_iterations=100_000, monitor=watch)
-        return pressure.copy(), iterations, last["since"]
-
-    rows, previous = [], None
-    for j, mean in enumerate(means):
-        _, cold_its, cold_settled = settle(bem._cold_start(depth, mean), mean)
-        start = bem._cold_start(depth, mean) if previous is None else previous * (mean / means[j - 1])
-        previous, warm_its, warm_settled = settle(start, mean)
-        rows.append((cold_its, cold_settled, warm_its, warm_settled))
-    rows = np.array(rows)
-    print("  where the iterations go: iterations to the tolerance / iteration after which the contact set stayed final")
-    print("    load:  " + " ".join(f"{j:>7d}" for j in range(0, 20, 3)))
-    print("    cold:  " + " ".join(f"{a:>3d}/{b:<3d}" for a, b in rows[::3, :2]))
-    print("    warm:  " + " ".join(f"{a:>3d}/{b:<3d}" for a, b in rows[::3, 2:]))
-    median_cold = np.median(rows[[0, 10, 19], 0])
-    median_settled = np.median(rows[[0, 10, 19], 1])
-    print(
-        f"    sweep / one cold load in iterations: {rows[:, 2].sum() / median_cold:5.2f} x at the tolerance; "
-        f"{rows[:, 3].sum() / median_settled:5.2f} x for a rule that stopped the moment each set is final"
-    )
-
-
-def versus_tamaas(sides: list[int], repeat: int) -> None:
-    """Best of ``repeat`` runs each up to 1024 pixels a side, one run above (a
-    2048 x 2048 load took Tamaas 15 minutes on a shared 2-core machine)."""
+def load_tamaas():
     try:
         import tamaas
     except ImportError:
-        print("--vs-tamaas: Tamaas is not installed (pip install tamaas, or the 'bench' extra)")
-        return
+        print("Tamaas is not installed (pip install tamaas, or the 'bench' extra): no comparison with it")
+        return None
+    tamaas.initialize(1)  # one thread, as frictionlab's solve
     tamaas.set_log_level(tamaas.LogLevel.error)
-    print(f"one load against Tamaas {tamaas.__version__} PolonskyKeerRey (single thread both; E* = 1, spacing 1)")
-    print("  side   force  contact   Tamaas s  residual   frictionlab s  its  residual   speed-up  set diff  runs")
-    for side in sides:
-        runs = repeat if side <= 1024 else 1
-        profile = study_surface(side)
-        z = np.ascontiguousarray(profile.heights)
-        rms = float(z.std())
-        force = 150.0 * (side / 512) ** 2  # about 3 % contact
+    return tamaas
 
-        def run_tamaas():
-            model = tamaas.ModelFactory.createModel(tamaas.model_type.basic_2d, [float(side)] * 2, [side, side])
-            model.E, model.nu = 1.0, 0.0
-            solver = tamaas.PolonskyKeerRey(model, z, 1e-8)
-            solver.max_iter = 100_000
-            start = time.perf_counter()
-            solver.solve(force / z.size)
-            return time.perf_counter() - start, model
 
-        def run_ours():  # what bem-halfspace's solve does for one load, with the pressure kept
-            start = time.perf_counter()
-            depth = (z.max() - z) / (z.max() - z.min())
-            cg = bem.ConstrainedCG(depth)
-            mean = force / z.size / (z.max() - z.min())
-            p, _, iterations, _ = cg.solve(
-                bem._cold_start(depth, mean), mean_pressure=mean, tolerance=tolerance, max_iterations=100_000
-            )
-            return time.perf_counter() - start, cg, p, iterations
-
-        # Tamaas first, to find the residual it reaches in frictionlab's measure
-        tamaas_runs = [run_tamaas()]
-        model = tamaas_runs[0][1]
-        p_tamaas = np.array(model.traction).reshape(z.shape)
-        # Tamaas's gap: displacement minus heights (its displacement has its own mean)
-        tamaas_contact, tamaas_free = residual(np.array(model.displacement).reshape(z.shape) - z, p_tamaas, rms)
-        tolerance = max(tamaas_contact, tamaas_free, 1e-14)
-        # then both alternately, so that they see the same load of a shared machine
-        our_runs = [run_ours()]
-        for _ in range(runs - 1):
-            tamaas_runs.append(run_tamaas())
-            our_runs.append(run_ours())
-        tamaas_seconds = min(run[0] for run in tamaas_runs)
-        our_seconds, cg, p_ours, our_iterations = min(our_runs, key=lambda run: run[0])
-        our_contact, our_free = residual(cg.gap.copy(), p_ours, cg.rms)
-        differ = int(np.count_nonzero((p_ours > 0) != (p_tamaas > 0)))
-        print(
-            f"  {side:4d} {force:8.0f} {np.mean(p_tamaas > 0):7.2%}  {tamaas_seconds:8.2f}  "
-            f"{max(tamaas_contact, tamaas_free):9.2e}  {our_seconds:12.2f}  {our_iterations:4d}  "
-            f"{max(our_contact, our_free):9.2e}  {tamaas_seconds / our_seconds:8.2f}x  {differ:8d}  {runs:4d}"
-        )
+def tamaas_sweep(tamaas, heights, forces):
+    """Tamaas's PolonskyKeerRey over ``forces`` on one solver object (each load
+    starts from the last one's state), tolerance 1e-10: ((CPU, wall) seconds, None, counts)."""
+    z = np.ascontiguousarray(heights, dtype=float)
+    ny, nx = z.shape
+    model = tamaas.ModelFactory.createModel(tamaas.model_type.basic_2d, [float(ny), float(nx)], [ny, nx])
+    model.E, model.nu = 1.0, 0.0
+    solver = tamaas.PolonskyKeerRey(model, z, 1e-10)
+    solver.max_iter = 100_000
+    counts = []
+    cpu, wall = time.process_time(), time.perf_counter()
+    for force in forces:
+        solver.solve(force / z.size)  # Tamaas loads by mean pressure
+        counts.append(int(np.count_nonzero(np.asarray(model.traction) > 0)))
+    return (time.process_time() - cpu, time.perf_counter() - wall), None, np.array(counts)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,8 @@ hooks as any third-party plugin. ARCHITECTURE.md draws the layers.
 
 For notebooks and scripts: ``frictionlab.run(preset, **overrides)`` returns a
 ``Result`` (the fit, the table per load step, a plot); ``frictionlab.load(folder)``
-reads a finished run back (``frictionlab.api``). They are imported on first use,
+reads a finished run back; ``frictionlab.validate(preset)`` checks one and says what
+would run (``frictionlab.api``). They are imported on first use,
 so ``import frictionlab`` stays cheap.
 """
 
@@ -24,12 +25,12 @@ _LAZY = {
     **dict.fromkeys(
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
-            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "force_unit", "iteration_done",
+            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
             "load_finished", "mdr_length",
         ),
         "plugin",
     ),  # fmt: skip
-    **dict.fromkeys(("run", "load", "Result", "SweepResult"), "api"),
+    **dict.fromkeys(("run", "load", "validate", "Result", "SweepResult"), "api"),
 }
 
 
@@ -87,4 +88,5 @@ __all__ = [
     "mdr_length",
     "open_regular_file",
     "run",
+    "validate",
 ]

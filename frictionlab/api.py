@@ -40,8 +40,8 @@ same files; ``--no-plot`` is ``plot=False``.
 from __future__ import annotations
 
 import copy
-import json
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,16 +49,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import FrictionlabError, PresetError, RunFolderError
+from .arguments import data_argument, flag_argument, overrides_argument, path_argument
+from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
 from .fit import LogFit
 from .options import RunOptions
-from .results import CURVE_COLUMNS, read_curve
+from .results import read_curve, read_summary
+from .runfolder import subfolder
 
 if TYPE_CHECKING:
     from .ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene"]
+__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
@@ -68,10 +70,13 @@ class Result:
     ``fit``: the ``LogFit`` of xi = a + b ln f (``a``, ``b``, ``a_ci``, ``b_ci``,
     ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
-    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``contact_count``,
+    load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
+    realizations whose xi is defined there), ``contact_count``,
     ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
-    run folder, None for a run kept in memory."""
+    run folder, None for a run kept in memory. ``input``: for a measured profile or
+    surface, what was read from its file (shape, pixel size, unit, rms height and
+    where each came from), else None."""
 
     name: str
     status: str  # completed | cancelled | interrupted | failed
@@ -85,6 +90,7 @@ class Result:
     folder: Path | None = None
     outcome: RunOutcome | None = field(default=None, repr=False, compare=False)  # in-process runs only
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
+    input: dict | None = None
 
     @property
     def a(self) -> float:
@@ -99,19 +105,17 @@ class Result:
         return self.fit.r2 if self.fit else math.nan
 
     def to_pandas(self):
-        """The table as a pandas DataFrame (one row per load step), or, without
-        pandas installed, the dict of numpy arrays itself."""
-        try:
-            import pandas as pd
-        except ImportError:
-            return dict(self.table)
-        return pd.DataFrame(self.table)
+        """The table as a pandas DataFrame, one row per load step (pandas: the ``pandas``
+        extra; without it, a ``MissingDependency`` naming it; ``table`` is the same as numpy arrays)."""
+        return require("pandas", "Result.to_pandas()").DataFrame(self.table)
 
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
         None, through pyplot, so a notebook shows it); returns the Axes."""
         from .plot import draw_curve
 
+        if ax is not None and not callable(getattr(ax, "errorbar", None)):
+            raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}")
         if ax is None:
             import matplotlib.pyplot as plt
 
@@ -121,6 +125,11 @@ class Result:
         ax.set_xlabel(self.normalisation, fontsize=8)
         ax.set_title(self.name, fontsize=10)
         return ax
+
+    def _repr_html_(self) -> str:  # a notebook's view: the fit's table with its intervals, and the curve
+        from .reprs import result_html
+
+        return result_html(self)
 
     def __repr__(self) -> str:
         fit = "no fit" if self.fit is None else f"a = {self.fit.a:.4f}, b = {self.fit.b:.4f}, R² = {self.fit.r2:.3f}"
@@ -145,16 +154,12 @@ class SweepResult:
     @property
     def points(self) -> list[Result]:
         """Each finished point's ``Result``, read from its folder."""
-        return [load(self.folder / row["folder"]) for row in self.rows if row.get("a") is not None]
+        return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
-        """The rows as a pandas DataFrame, or without pandas a dict of numpy arrays by column."""
+        """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
-        try:
-            import pandas as pd
-        except ImportError:
-            return {key: np.array(values) for key, values in columns.items()}
-        return pd.DataFrame(columns)
+        return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
 
     def __repr__(self) -> str:
         return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"
@@ -168,14 +173,17 @@ def read_preset_input(
     current folder). Forms: a ``Preset``; a dict; a string holding YAML (a newline,
     or a ``{...}`` flow mapping); else a path to a file, or a built-in's name."""
     from .preset import Preset, load_preset_file, set_path
-    from .preset.builtin import resolve_preset_path
+    from .preset.builtin import find_builtin, preset_source, resolve_preset_path
     from .preset.reading import resolve_input_paths
     from .safe_yaml import YamlProblem, load_yaml
 
+    overrides = overrides_argument(overrides)
+    data_argument(keys, "keyword overrides")
     base_dir = None
     if isinstance(preset, Preset):
         data, source = preset.model_dump(mode="json", exclude_none=True), f"<Preset {preset.name}>"
     elif isinstance(preset, Mapping):
+        data_argument(preset, "preset")  # before deepcopy, which recurses
         data, source = copy.deepcopy(dict(preset)), "<dict>"  # never change the caller's dict
     elif isinstance(preset, str) and ("\n" in preset or preset.lstrip().startswith("{")):
         try:
@@ -185,16 +193,22 @@ def read_preset_input(
         if not isinstance(data, dict):
             raise PresetError([f"(text): a preset must be a mapping. Got {type(data).__name__} instead."], "<YAML text>")
         source = "<YAML text>"
-    elif isinstance(preset, str | Path):
-        path = resolve_preset_path(preset)
-        data, source, base_dir = load_preset_file(path), str(path), path.parent
+    elif isinstance(preset, str | os.PathLike):
+        path = resolve_preset_path(path_argument(preset, "preset", "a preset file, or a built-in's name"))
+        # a built-in is named as the CLI names it, not by the installed file the user never touched
+        source = preset_source(preset) if find_builtin(str(preset)) is not None and path != Path(preset) else str(path)
+        try:
+            data = load_preset_file(path)
+        except PresetError as exc:
+            raise type(exc)(exc.problems, source=source) from None
+        base_dir = path.parent
     else:
         raise FrictionlabError(
             f"preset must be a path, a built-in's name, YAML text, a dict or a Preset. Got {type(preset).__name__}."
         )
     if base_dir is not None:
         data = resolve_input_paths(data, base_dir)
-    assignments = {**(overrides or {}), **{key.replace("__", "."): value for key, value in keys.items()}}
+    assignments = {**overrides, **{key.replace("__", "."): value for key, value in keys.items()}}
     problems = []
     for path, value in assignments.items():
         try:
@@ -204,6 +218,33 @@ def read_preset_input(
     if problems:
         raise PresetError(problems, source="overrides")
     return data, source, base_dir
+
+
+def scene_record(scene: Scene) -> dict:
+    """What a validated preset would run: its plugins, realizations, load steps, and what
+    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None."""
+    preset = scene.preset
+    return {
+        "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
+        "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
+        "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+    }  # fmt: skip
+
+
+def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
+             **keys: Any) -> dict:  # fmt: skip
+    """Check a preset (any form ``run`` takes, overrides as there) without running it, and
+    return what would run (``scene_record``); a measured file is read once, here. Bad input
+    raises a ``frictionlab.errors.FrictionlabError`` naming every field at fault.
+
+    >>> import frictionlab
+    >>> frictionlab.validate("quickstart")["input"] is None  # a synthetic spectrum reads no file
+    True
+    """
+    from .preset import build_scene
+
+    data, source, _ = read_preset_input(preset, overrides, **keys)
+    return scene_record(build_scene(data, source=source))
 
 
 def run(
@@ -238,11 +279,21 @@ def run(
 
     A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
     point) and returns a ``SweepResult``. Bad input raises a
-    ``frictionlab.errors.FrictionlabError`` naming the field.
+    ``frictionlab.errors.FrictionlabError`` naming the field, or the argument
+    (``overrides must be a mapping of dotted keys to values, got int``); a dict (the
+    preset, the overrides) is held to a preset file's limits: 64 levels of nesting,
+    20,000 values. A built-in preset is named as the command line names it
+    (``built-in preset 'quickstart'``).
     """
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
 
+    out = None if out is None else path_argument(out, "out", "a folder to write the run into")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise FrictionlabError(f"scheduler must be a Dask scheduler's address (a str), got {type(scheduler).__name__}")
+    for name, value in (("resume", resume), ("force", force), ("plot", plot), ("progress", progress),
+                        ("memory_check", memory_check)):  # fmt: skip
+        flag_argument(value, name)
     data, source, _ = read_preset_input(preset, overrides, **keys)
     scene = build_scene(data, source=source)
     options = RunOptions(
@@ -300,58 +351,62 @@ def run_scene(
 def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[str, Path]) -> Result:
     table = {
         "F": outcome.force, "f": outcome.f, "xi": outcome.xi, "xi_sem": outcome.xi_sem,
-        "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
+        "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
     return Result(
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
-        outcome=outcome, files=dict(files),
+        outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
     )  # fmt: skip
 
 
 def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers
-    to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. A folder
-    with neither is a ``RunFolderError``."""
-    folder = Path(folder)
-    if not (folder / "summary.json").exists() and (folder / "sweep.json").exists():
+    to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. The folder is
+    read as untrusted input (``frictionlab.runfolder``: only regular files inside it,
+    never through a link, every value checked): any problem, a folder with neither
+    file too, is a ``RunFolderError`` naming the file and what is wrong."""
+    folder = path_argument(folder, "folder", "a run folder")
+    if not os.path.lexists(folder / "summary.json") and os.path.lexists(folder / "sweep.json"):
         return _load_sweep(folder)
-    try:
-        summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RunFolderError(f"{folder}: no summary.json (nor sweep.json): not a finished run") from None
-    except (OSError, ValueError) as exc:
-        raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
-    curve = read_curve(folder / summary.get("files", {}).get("curve", "curve.csv"))
-    if [name.rstrip("'") for name in curve] != list(CURVE_COLUMNS):  # F' on the half-plane
-        raise RunFolderError(f"{folder}/curve.csv: columns {list(curve)} are not those frictionlab writes")
-    table = dict(zip(CURVE_COLUMNS, curve.values()))
-    realizations = summary.get("realizations") or {}
+    if not os.path.lexists(folder / "summary.json"):
+        where = "" if folder.is_dir() else " (not a folder)" if os.path.lexists(folder) else " (no such folder)"
+        raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
+    summary, record = read_summary(folder)
+    curve_name = record.files.get("curve", "curve.csv")
+    curve = read_curve(folder, curve_name)
+    loading = summary["preset"].get("loading")
+    steps = loading.get("steps") if isinstance(loading, dict) else None
+    rows = len(next(iter(curve.values())))
+    if isinstance(steps, int) and not isinstance(steps, bool) and rows != steps:
+        raise RunFolderError(
+            f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
+        )
     return Result(
-        name=summary["preset"]["name"],
-        status=summary.get("status", "completed"),
-        fit=LogFit.from_dict(summary["fit"]) if summary.get("fit") else None,
-        table=table,
-        realizations=(int(realizations.get("done", 0)), int(realizations.get("requested", 0))),
-        normalisation=(summary.get("normalisation") or {}).get("f", ""),
+        name=record.preset.name,
+        status=record.status,
+        fit=LogFit.from_dict(summary["fit"]) if record.fit is not None else None,
+        table={name.rstrip("'"): values for name, values in curve.items()},  # F' on the half-plane
+        realizations=(record.realizations.done, record.realizations.requested),
+        normalisation=record.normalisation.f,
         preset=summary["preset"],
-        elapsed=float(summary.get("elapsed_seconds") or 0.0),
-        caveats=list(summary.get("caveats") or []),
+        elapsed=record.elapsed_seconds,
+        caveats=list(record.caveats),
         folder=folder,
-        files={k: folder / v for k, v in (summary.get("files") or {}).items()},
+        files={key: folder / name for key, name in record.files.items()},
+        input=record.input,
     )
 
 
 def _load_sweep(folder: Path) -> SweepResult:
-    try:
-        summary = json.loads((folder / "sweep.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise RunFolderError(f"{folder}/sweep.json cannot be read: {exc}") from None
+    from .sweep import read_sweep_record
+
+    summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
     return SweepResult(
-        name=summary["name"], status=summary["status"], parameters=list(summary["sweep"]["parameters"]), rows=rows,
-        folder=folder, elapsed=float(summary.get("elapsed_seconds") or 0.0),
+        name=record.name, status=record.status, parameters=list(record.sweep.parameters), rows=rows,
+        folder=folder, elapsed=record.elapsed_seconds,
     )  # fmt: skip

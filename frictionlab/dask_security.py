@@ -22,23 +22,22 @@ import logging
 import warnings
 from urllib.parse import urlsplit
 
-from .errors import FrictionlabError, RunError, short_repr
+from .errors import FrictionlabError, MissingDependency, RunError, require, short_repr
 
-DASK_MISSING = 'the dask executor needs Dask and distributed: pip install "frictionlab[dask]"'
+DASK_PURPOSE = "the dask executor"
+DASK_MISSING = str(MissingDependency("distributed", DASK_PURPOSE))
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 ENCRYPTED = ("tls", "wss")
 
 
 def import_distributed():
-    try:
-        import distributed
-    except ImportError:
-        raise FrictionlabError(DASK_MISSING) from None
-    return distributed
+    """``distributed`` (which imports ``dask``), or the message with the pip command."""
+    return require("distributed", DASK_PURPOSE)
 
 
 def use_tls_files(ca_file: str | None = None, cert: str | None = None, key: str | None = None) -> None:
     """Set Dask's TLS configuration for this process (what ``--tls-*`` give)."""
+    import_distributed()
     import dask
 
     given = {"ca-file": ca_file, "client.cert": cert, "client.key": key}
@@ -83,8 +82,10 @@ def connect_scheduler(address: str):
     configuration, or a RunError that says why not."""
     distributed = import_distributed()
     check_address(address)
+    security = distributed.Security()
+    _check_answers_as_scheduler(address, security)
     try:
-        return distributed.Client(address, timeout="10s", security=distributed.Security())
+        return distributed.Client(address, timeout=f"{CONNECT_SECONDS}s", security=security)
     except Exception as exc:  # refused, timed out, a TLS handshake or configuration that fails, ...
         reason = f"{type(exc).__name__}: {exc}"
         if address.startswith("tls://") and "ssl_context" in reason:  # what was given, not the network
@@ -93,6 +94,51 @@ def connect_scheduler(address: str):
                 "and --tls-key (or Dask's distributed.comm.tls configuration)"
             ) from None
         raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}") from None
+
+
+CONNECT_SECONDS = 10
+
+
+def _check_answers_as_scheduler(address: str, security, seconds: float = CONNECT_SECONDS) -> None:
+    """RunError unless ``address`` answers Dask's ``identity`` request as a scheduler
+    within ``seconds``: a Client would wait for minutes on a port that accepts and
+    answers something else (an HTTP server, such as the dashboard's port)."""
+    import asyncio
+    import threading
+
+    from distributed.comm import connect
+
+    async def identity():
+        comm = await connect(address, timeout=seconds, **security.get_connection_args("client"))
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    answer: list = []
+
+    def ask() -> None:  # in a thread of its own: the caller may run an event loop (Jupyter)
+        try:
+            answer.append(asyncio.run(asyncio.wait_for(identity(), seconds)))
+        except BaseException as exc:  # noqa: BLE001 - reported below
+            answer.append(exc)
+
+    thread = threading.Thread(target=ask, name="frictionlab-dask-handshake", daemon=True)
+    thread.start()
+    thread.join(seconds + 5)
+    reply = answer[0] if answer else TimeoutError()
+    if isinstance(reply, dict) and reply.get("type") == "Scheduler":
+        return
+    if isinstance(reply, BaseException) and not isinstance(reply, TimeoutError | asyncio.TimeoutError):
+        if address.startswith("tls://") and "ssl_context" in str(reply):
+            return  # the missing certificates: said by the Client below, as before
+        reason = f"{type(reply).__name__}: {reply}"
+        raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}")
+    raise RunError(
+        f"--scheduler {address} did not answer as a Dask scheduler within {seconds:g} s (is it another "
+        "service, such as the dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)"
+    )
 
 
 # Dask's nanny gives its workers MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back at

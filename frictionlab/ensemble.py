@@ -7,6 +7,7 @@ order in which realizations finish (serial, pool, any worker count).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -51,8 +52,9 @@ class RunOutcome:
     loads: np.ndarray
     force: np.ndarray  # mean total load per step (its meaning: ``normalisation.load``)
     f: np.ndarray  # dimensionless force: force / force_unit (``normalisation.definition``)
-    xi: np.ndarray  # ensemble mean of slope_rms_contact / slope_rms_line
+    xi: np.ndarray  # ensemble mean of slope_rms_contact / slope_rms_line, over the lines where it is defined
     xi_sem: np.ndarray
+    lines_used: np.ndarray  # how many realizations have xi defined at each step (all, unless slopes may be undefined)
     contact_count: np.ndarray  # ensemble mean
     contact_fraction: np.ndarray
     indentation: np.ndarray
@@ -60,6 +62,7 @@ class RunOutcome:
     fit: LogFit | None
     rms_height: float
     force_unit: float  # k h X: the load at f = 1
+    own_rms_height: bool  # h of f is each profile's own measured rms height (profile_rms_height), not the nominal
     stiffness: float
     normalisation: ForceNormalisation
     elapsed: float  # wall time of this invocation (a resumed run counts only what it ran)
@@ -75,8 +78,9 @@ class RunOutcome:
     @property
     def caveats(self) -> list[str]:
         """What a reader of the fit must know: too few points in contact at the first load
-        (the rms slope in contact of one or two points is mostly noise), or the whole
-        profile in contact from some load on (xi is 1 there by definition)."""
+        (the rms slope in contact of one or two points is mostly noise), the whole
+        profile in contact from some load on (xi is 1 there by definition), or lines
+        without xi at some load (averaged over fewer lines there)."""
         if self.fit is None or not self.contact_count.size:
             return []
         caveats = []
@@ -85,12 +89,38 @@ class RunOutcome:
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
         if full.size:
             caveats.append(full_contact_caveat(int(full[0]), self.loads))
+        if self.lines_used.size and self.lines_used.min() < self.done:
+            caveats.append(
+                f"up to {self.done - int(self.lines_used.min())} of {self.done} lines have no xi at a load (no point "
+                "in contact has a slope): xi there is the mean over the others (lines_used in curve.csv)"
+            )
         return caveats
 
     @property
     def extent(self) -> float:
         """X of f = F / (k h X): the profile's length, area, MDR length, or 1."""
         return self.force_unit / (self.stiffness * self.rms_height)
+
+
+OWN_H_TOLERANCE = 1e-9  # relative spread allowed between the profiles' own rms heights
+
+
+def defined_statistics(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per step: the mean of xi (realizations in rows) over the realizations where it is
+    defined (not NaN: no point in contact had a slope), its standard error, and how many
+    realizations that is. NaN where fewer than one (two, for the error) are."""
+    used = np.count_nonzero(~np.isnan(xi), axis=0)
+    if not xi.shape[0]:
+        return np.full(xi.shape[1], math.nan), np.full(xi.shape[1], math.nan), used
+    if used.min() == xi.shape[0]:  # every xi defined: the plain mean, bit for bit
+        n = xi.shape[0]
+        sem = xi.std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else np.full(xi.shape[1], math.nan)
+        return xi.mean(axis=0), sem, used
+    with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a step with no (or one) defined xi: NaN, said by used
+        mean = np.nanmean(xi, axis=0)
+        sem = np.nanstd(xi, axis=0, ddof=1) / np.sqrt(used)
+    return mean, np.where(used >= 2, sem, math.nan), used
 
 
 class Accumulator:
@@ -128,34 +158,49 @@ class Accumulator:
             "contact_count": self.stack("contact_count").astype(np.int64),
             "indentation": self.stack("indentation"),
             "slope_rms_line": np.array([self.results[i].slope_rms_line for i in indices]),
+            "measured_rms_height": np.array([self.results[i].measured_rms_height for i in indices]),
         }
+        own = np.array([self.results[i].own_rms_height for i in indices])
+        own_rms_height = bool(np.isfinite(own).any())
+        if own_rms_height:
+            per["own_rms_height"] = own
         if scene.control == "indentation":
             per["force"] = self.stack("force")
         n = indices.size
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
         unit = first.force_unit if first else math.nan  # every realization has the grid of the first
-        rms_height = float(scene.generator.rms_height()) if n else math.nan
+        rms_height = (float(own[0]) if own_rms_height else float(scene.generator.rms_height())) if n else math.nan
         stiffness = float(scene.solver.stiffness())
         force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
         with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # an overflow is reported below
             f = force / unit if n else np.full(self.loads.size, math.nan)
         nan_row = np.full(self.loads.size, math.nan)
-        xi_mean = per["xi"].mean(axis=0) if n else nan_row
-        xi_sem = per["xi"].std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else nan_row
+        xi_mean, xi_sem, used = defined_statistics(per["xi"])
         count = per["contact_count"].mean(axis=0) if n else nan_row
         fit = None
         if not n and self.failures and status == "completed":
             # every realization failed: nothing was computed, whatever the count says
             index, reason = min(self.failures.items())
             status, error = "failed", f"no realization finished: {len(self.failures)} failed; the first, #{index}: {reason}"
-        if n and not np.all(np.isfinite(f) & (f > 0)):
+        if own_rms_height and not np.allclose(own, own[0], rtol=OWN_H_TOLERANCE, atol=0.0):
+            status, error = "failed", (
+                f"the profiles' own rms heights h (the spectrum's profile_rms_height) range from {np.nanmin(own):g} "
+                f"to {np.nanmax(own):g}: f = F / (k h X) needs one h for the whole ensemble"
+            )
+        elif n and not np.all(np.isfinite(f) & (f > 0)):
             # a plugin's numbers overflowed: say which, rather than fail in the fit
             status, error = "failed", (
                 f"the dimensionless force f = F / (k h X) is not finite and > 0 at every load step "
                 f"(k h X = {unit:g} with stiffness k = {stiffness:g}, h = {rms_height:g}; F from {np.min(force):g} "
                 f"to {np.max(force):g}): the preset's magnitudes (solver.params, spectrum.params, loading) "
                 "leave double precision"
+            )
+        elif n and np.count_nonzero(used) < 2:
+            status, error = "failed", (
+                f"xi is defined at {np.count_nonzero(used)} of {used.size} load steps (at the others no point in "
+                "contact has a slope: the slope estimator leaves the ends of the profile without one): a fit needs "
+                "two; raise the loads"
             )
         elif n:
             settings = scene.preset.fit
@@ -176,6 +221,7 @@ class Accumulator:
             f=f,
             xi=xi_mean,
             xi_sem=xi_sem,
+            lines_used=used,
             contact_count=count,
             contact_fraction=count / points if points else nan_row,
             indentation=per["indentation"].mean(axis=0) if n else nan_row,
@@ -183,6 +229,7 @@ class Accumulator:
             fit=fit,
             rms_height=rms_height,
             force_unit=unit,
+            own_rms_height=own_rms_height,
             stiffness=stiffness,
             normalisation=scene.normalisation,
             elapsed=elapsed,

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import codecs
 import enum
 import os
+import sys
 
 
 class ExitCode(enum.IntEnum):
@@ -25,6 +27,31 @@ class FrictionlabError(Exception):
     """Base of the errors a user can cause and fix; shown without a traceback."""
 
     exit_code = ExitCode.USAGE
+
+
+EXTRAS = {"dask": "dask", "distributed": "dask", "pandas": "pandas", "ipywidgets": "notebook", "tamaas": "bench"}
+"""The optional packages by top-level module, and the extra of pyproject.toml that brings each."""
+
+
+class MissingDependency(FrictionlabError):
+    """A package a feature needs is not installed; the message says how to install it."""
+
+    def __init__(self, module: str, purpose: str):
+        self.module = module.partition(".")[0]
+        extra = EXTRAS.get(self.module)
+        command = f'pip install "frictionlab[{extra}]"' if extra else "pip install --force-reinstall frictionlab"
+        super().__init__(f"{purpose} needs {self.module}, which is not installed: {command}")
+
+
+def require(module: str, purpose: str):
+    """``import module`` (and return it), or raise ``MissingDependency`` naming the pip
+    command that installs it: the one way an optional package is imported."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError:  # it, or a package it needs (the same pip command brings both)
+        raise MissingDependency(module, purpose) from None
 
 
 class PluginError(FrictionlabError):
@@ -81,6 +108,32 @@ def shown(text) -> str:
     return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
 
 
+def _escape_unencodable(exc: UnicodeError):
+    """Codec error handler: a byte of a path that was not UTF-8 (a lone surrogate, as
+    Python decodes it) written as ``\xff``, as ``shown`` does; any other character the
+    stream cannot encode as ``\u03be``."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    text = exc.object[exc.start : exc.end]
+    escaped = "".join(
+        f"\\x{ord(c) - 0xDC00:02x}" if 0xDC80 <= ord(c) <= 0xDCFF else c.encode("ascii", "backslashreplace").decode()
+        for c in text
+    )
+    return escaped, exc.end
+
+
+codecs.register_error("frictionlab-escape", _escape_unencodable)
+
+
+def escape_unencodable_output() -> None:
+    """Make stdout and stderr escape what they cannot encode (a path that is not UTF-8, a
+    character beyond a latin-1 terminal) instead of raising UnicodeEncodeError after the
+    work is done and its files are written; called once by the CLI."""
+    for stream in (sys.stdout, sys.stderr):
+        if hasattr(stream, "reconfigure") and getattr(stream, "errors", None) in ("strict", "surrogateescape"):
+            stream.reconfigure(errors="frictionlab-escape")
+
+
 def counted(count: int, noun: str) -> str:
     """``1 point``, ``2 points``: a count and its noun in the number it takes."""
     return f"{count} {noun}{'' if count == 1 else 's'}"
@@ -101,10 +154,15 @@ def short_repr(value, limit: int = 80) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
-    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the
-    hint every unknown-name message (commands, plugins, presets) ends with."""
+def close_names(word: str, names, cutoff: float = 0.5) -> list[str]:
+    """The (at most three) of ``names`` closest to ``word``, closest first."""
     import difflib
 
-    close = difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+    return difflib.get_close_matches(word, list(names), n=3, cutoff=cutoff)
+
+
+def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
+    """``"; did you mean 'run'?"`` naming the closest of ``names``, or ``""``: the hint
+    every unknown-name message (commands, options, plugins, presets, fields) ends with."""
+    close = close_names(word, names, cutoff)
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""

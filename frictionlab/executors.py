@@ -218,6 +218,7 @@ def dask_memory_limits(scheduler: str | None, workers: int = 1) -> tuple[dict[st
     memory over its cores, each); and the fraction of it at which Dask's nanny
     kills a worker (this process's ``distributed.worker.memory.terminate``;
     1 when it is off: the operating system's OOM killer is then the limit)."""
+    import_distributed()  # the memory check comes first: a missing Dask is said here
     import dask
 
     if scheduler:

@@ -1,8 +1,8 @@
 """Writing files safely: every file frictionlab writes goes through ``atomic_write``,
 so a reader never sees half a file and an interrupted write leaves the previous
-version intact, and it never renames over what is not a regular file (a symlink is
-written through, a character device or FIFO is written into, a folder, socket or block
-device is refused); ``output_path_problem`` says why a path cannot be an output folder;
+version intact, and it never writes through a symbolic link (the link is replaced);
+a character device or FIFO the user named as an output is written into, a folder,
+socket or block device is refused; ``output_path_problem`` says why a path cannot be an output folder;
 ``check_output_file`` refuses an existing output file unless ``--force``;
 ``write_npz`` writes arrays compressed where compressing them pays."""
 
@@ -11,6 +11,7 @@ from __future__ import annotations
 import errno
 import io
 import os
+import re
 import stat
 import tempfile
 import zipfile
@@ -20,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import OutputRefused
+from .errors import OutputRefused, shown
 
 _SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
 _WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size
@@ -35,24 +36,27 @@ def _read_umask() -> int:
 _UMASK = _read_umask()
 
 
-def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False) -> None:
+def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False, *, devices: bool = False) -> None:
     """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
     The file gets the usual permissions (0666 less the umask), not mkstemp's 0600.
 
-    Only a regular file is ever replaced: a symlink is followed (the file it points at
-    is replaced, the link stays); a character device (/dev/null) or a FIFO is written
-    into, as any program writing there would (renaming over it would destroy the node:
-    as root, /dev/null itself); a folder, socket or block device is refused (an
-    OSError naming the path: "is a folder, not a file")."""
+    Nothing is ever written through a symbolic link: a link at ``path`` is replaced by
+    the new file, and the file it pointed at is left as it was (a run folder, or a
+    tampered copy of one, cannot make frictionlab write outside it). ``devices``: for an
+    output path the user named (``--markdown``), a character device (/dev/null) or a
+    FIFO, or a link to one, and an open stream of this process (/dev/stdout, even
+    redirected to a file) are written into, as any program writing there would
+    (renaming over it would destroy the node: as root, /dev/null itself); without
+    it (the files of a run folder) such a node is replaced like any file. A folder,
+    socket or block device is refused (an OSError naming the path: "is a folder, not a
+    file")."""
     path = Path(path)
-    if path.is_symlink():
-        path = Path(os.path.realpath(path))  # a dangling link: the file it names is created
-    kind = _kind(path)
-    if kind in ("character device", "FIFO"):
+    if devices and (_kind(path) in ("character device", "FIFO") or _is_open_stream(path)):
         with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
         return
-    if kind is not None and kind != "file":  # an OSError, as renaming over it was: callers say "cannot write"
+    kind = _kind(path, follow_links=False)
+    if kind in ("folder", "socket", "block device"):  # an OSError, as renaming over it was: callers say "cannot write"
         error = IsADirectoryError if kind == "folder" else OSError
         raise error(errno.EISDIR if kind == "folder" else errno.EINVAL, f"is a {kind}, not a file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -63,20 +67,35 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        os.replace(tmp, path)  # renames over a link itself, never its target
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
 
 
-_KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
-          stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device"}  # fmt: skip
+_OPEN_STREAM = re.compile(r"/(proc/self|dev)/fd/\d+")
 
 
-def _kind(path: Path) -> str | None:
-    """What is at ``path`` (links followed): "file", "folder", "FIFO"..., None if nothing."""
+def _is_open_stream(path: Path) -> bool:
+    """Whether ``path`` names one of this process's open files (/dev/stdout, /dev/fd/1,
+    /proc/self/fd/1, or a link to one): written into, whatever it is redirected to;
+    renaming over /dev/stdout would replace the system's link (as root)."""
     try:
-        mode = os.stat(path).st_mode
+        target = os.readlink(path) if path.is_symlink() else str(path)
+    except OSError:
+        return False
+    return bool(_OPEN_STREAM.fullmatch(target)) or str(path) in ("/dev/stdout", "/dev/stderr")
+
+
+_KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
+          stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device", stat.S_IFLNK: "symbolic link"}  # fmt: skip
+
+
+def _kind(path: Path, follow_links: bool = True) -> str | None:
+    """What is at ``path`` (links followed unless ``follow_links`` is False: then a
+    link is "symbolic link"): "file", "folder", "FIFO"..., None if nothing."""
+    try:
+        mode = os.stat(path, follow_symlinks=follow_links).st_mode
     except (FileNotFoundError, NotADirectoryError):
         return None
     return _KINDS.get(stat.S_IFMT(mode), "special file")
@@ -85,34 +104,55 @@ def _kind(path: Path) -> str | None:
 def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
     """``path`` as a file a command may write (``option`` names it in messages):
     OutputRefused for a folder (or a name ending in /), a path under a file, a
-    socket or block device, and an existing file unless ``force``. A character
-    device or FIFO is accepted (written into, see ``atomic_write``)."""
+    socket or block device, and an existing file or a symbolic link unless ``force``
+    (which replaces the link, never the file it points at). A character device or
+    FIFO, or a link to one (/dev/stdout), is accepted (written into, see ``atomic_write``)."""
     text = os.fsdecode(path)
     path = Path(path)
     kind = _kind(path)
     if kind == "folder" or text.endswith(os.sep):
         raise OutputRefused(f"{option} {text} is a folder: give a file name (e.g. {path / 'name'})")
+    if _is_open_stream(path):  # /dev/stdout: written into, wherever it is redirected
+        return path
     problem = output_path_problem(path.parent)
     if problem:
         raise OutputRefused(f"{option} {path}: {problem}")
     if kind in ("socket", "block device", "special file"):
         raise OutputRefused(f"{option} {path} is a {kind}, not a file: give a file to write to")
+    if path.is_symlink() and kind not in ("character device", "FIFO") and not force:
+        raise OutputRefused(
+            f"{option} {path} is a symbolic link: give another file, or --force to replace the link "
+            "(the file it points at is never written)"
+        )
     if kind == "file" and not force:
         raise OutputRefused(f"{option} {path} exists: give another file, or --force to replace it")
     return path
 
 
 def output_path_problem(path: Path) -> str | None:
-    """Why ``path`` cannot be (or become) a folder: it, or the nearest existing
-    folder above it, is a file."""
+    """Why ``path`` cannot be (or become) a folder to write in: it, or the nearest
+    existing folder above it, is a file, or files cannot be created in it (read-only,
+    no permission: tried, so that long work does not start only to fail at its end)."""
     path = Path(path)
     for candidate in (path, *path.parents):
         if candidate.exists() or candidate.is_symlink():
             if candidate.is_dir():
-                return None
+                return _unwritable(candidate, path)
             if candidate == path:
-                return f"{path} is a file, not a folder"
-            return f"{path} cannot be made a folder: {candidate} is a file"
+                return f"{shown(path)} is a file, not a folder"
+            return f"{shown(path)} cannot be made a folder: {shown(candidate)} is a file"
+    return None
+
+
+def _unwritable(folder: Path, asked: Path) -> str | None:
+    """Why no file can be created in ``folder`` (where ``asked`` is, or would be made), or None."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".frictionlab-write-check-", dir=folder)
+    except OSError as exc:
+        where = "" if folder == asked else f" (it would be made in {shown(folder)})"
+        return f"{shown(asked)} cannot be written in{where}: {exc.strerror or type(exc).__name__}"
+    os.close(fd)
+    os.unlink(probe)
     return None
 
 

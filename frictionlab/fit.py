@@ -75,6 +75,13 @@ class LogFit:
         """a + b ln f."""
         return self.a + self.b * np.log(f)
 
+    def __repr__(self) -> str:  # rounded as the CLI prints a fit; the exact numbers are the fields
+        level = f"{100 * self.confidence:g}% CI" + (f", bootstrap {self.bootstrap}" if self.bootstrap else "")
+        return (
+            f"LogFit(a = {format_estimate(self.a, self.a_ci)}, b = {format_estimate(self.b, self.b_ci)} ({level}); "
+            f"R² = {format_number(self.r2)}, {self.points} points)"
+        )
+
 
 def json_safe(value):
     """NaN has no JSON spelling: write null."""
@@ -193,6 +200,35 @@ def bootstrap_coefficients(
     return average(counts) @ projector.T  # (B, n_forces) @ (n_forces, 2)
 
 
+def defined_mean(xi_per_realization: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+    """The mean over realizations (rows) of the xi that are defined (not NaN) at each
+    force, each realization weighted by ``weights`` (M,) or (B, M) (1 for None): an
+    ``Average``. NaN at a force where no weighted realization has xi defined."""
+    defined = ~np.isnan(xi_per_realization)
+    w = np.ones(xi_per_realization.shape[0]) if weights is None else np.asarray(weights, float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (w @ np.where(defined, xi_per_realization, 0.0)) / (w @ defined)
+
+
+def _over_defined(f, xi_per_realization: np.ndarray, average: Average | None):
+    """(f, xi, average) of a fit: where some xi is undefined (NaN), the forces where any is
+    defined and the mean over the defined ones (``defined_mean``); else as given."""
+    if average is not None or not np.isnan(xi_per_realization).any():
+        return f, xi_per_realization, average
+    fitted = ~np.isnan(xi_per_realization).all(axis=0)
+    xi = xi_per_realization[:, fitted]
+    return np.asarray(f, float)[fitted], xi, lambda weights: defined_mean(xi, weights)
+
+
+def resample_pairs(f, xi_per_realization, bootstrap: int, rng: np.random.Generator,
+                    average: Average | None = None) -> np.ndarray:  # fmt: skip
+    """The (a, b) pairs of ``fit_log_law``'s bootstrap (``bootstrap_coefficients`` over the
+    forces and the mean it fits), less any resample without a defined xi at a fitted force."""
+    f, xi_per_realization, average = _over_defined(f, np.atleast_2d(np.asarray(xi_per_realization, float)), average)
+    samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng, average)
+    return samples[~np.isnan(samples).any(axis=1)]
+
+
 def fit_log_law(
     f: np.ndarray,
     xi_per_realization: np.ndarray,
@@ -203,20 +239,28 @@ def fit_log_law(
     average: Average | None = None,
 ) -> LogFit:
     """Fit the mean over realizations (rows) of xi against f (or the curve ``average``
-    gives), with percentile bootstrap intervals over realizations."""
+    gives), with percentile bootstrap intervals over realizations.
+
+    A realization may leave xi undefined (NaN) at some forces (no point in contact with
+    a slope): the mean is then over the realizations where it is defined
+    (``defined_mean``, in the fit and in every resample), the fit leaves out forces
+    where none is, and a resample that has none at a fitted force is left out of the
+    intervals."""
     xi_per_realization = np.atleast_2d(np.asarray(xi_per_realization, float))
     realizations = xi_per_realization.shape[0]
     if realizations == 0:
         raise ValueError("no finished realization to fit")
+    f, xi_per_realization, average = _over_defined(f, xi_per_realization, average)
     curve = xi_per_realization.mean(axis=0) if average is None else average(None)
     fit = fit_curve(f, curve)
     intervals = [NAN2] * 2
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
-        samples = bootstrap_coefficients(f, xi_per_realization, bootstrap, rng, average)
-        low, high = percentile_interval(samples, confidence, axis=0)
-        intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]
+        samples = resample_pairs(f, xi_per_realization, bootstrap, rng, average)
+        if samples.shape[0]:
+            low, high = percentile_interval(samples, confidence, axis=0)
+            intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]
     return replace(
         fit,
         a_ci=intervals[0],

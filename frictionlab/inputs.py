@@ -14,6 +14,7 @@ run folder so that a resume refuses a file that changed.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import os
 import stat
@@ -57,16 +58,20 @@ def regular_file_problem(path: str | Path) -> str | None:
     return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, not a regular file"
 
 
-def open_regular_file(path: str | Path, what: str = "file"):
+def open_regular_file(path: str | Path, what: str = "file", *, dir_fd: int | None = None, follow_links: bool = True):
     """``path`` opened for binary reading, once it is known to be a regular file
     (opened without blocking, checked on the open descriptor); InputFileProblem
     otherwise. The message says what is wrong (``no such <what>``, ``is a FIFO
-    ...``); the caller says where."""
+    ...``); the caller says where. ``follow_links=False``: a symbolic link is refused
+    (O_NOFOLLOW), not followed; ``dir_fd``: ``path`` is taken from that open folder."""
+    flags = os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC | (0 if follow_links else os.O_NOFOLLOW)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
+        fd = os.open(path, flags, dir_fd=dir_fd)
     except (FileNotFoundError, NotADirectoryError):
         raise InputFileProblem(f"no such {what}") from None
     except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
+        if getattr(exc, "errno", None) == errno.ELOOP and not follow_links:
+            raise InputFileProblem(f"{what} is a symbolic link, which is never followed here") from None
         reason = getattr(exc, "strerror", None) or "cannot be opened"
         raise InputFileProblem(f"{what} cannot be read: {reason[:1].lower() + reason[1:]}") from None
     mode = os.fstat(fd).st_mode
@@ -77,10 +82,12 @@ def open_regular_file(path: str | Path, what: str = "file"):
     return os.fdopen(fd, "rb")
 
 
-def read_regular_file(path: str | Path, limit: int | None = None, what: str = "file") -> bytes:
+def read_regular_file(
+    path: str | Path, limit: int | None = None, what: str = "file", *, dir_fd: int | None = None, follow_links: bool = True
+) -> bytes:
     """The bytes of the regular file ``path`` (see ``open_regular_file``), refused
     by its size before anything is read when it is over ``limit`` bytes."""
-    with open_regular_file(path, what) as fh:
+    with open_regular_file(path, what, dir_fd=dir_fd, follow_links=follow_links) as fh:
         size = os.fstat(fh.fileno()).st_size
         if limit is not None and size > limit:
             raise InputFileProblem(f"{what} of {size:,} bytes, more than the limit of {limit:,} bytes")
@@ -131,3 +138,26 @@ def input_fields(params_model) -> list[str]:
 
 def is_relative(value) -> bool:
     return isinstance(value, str) and bool(value) and not os.path.isabs(os.path.expanduser(value))
+
+
+# ------------------------------------------------------------------ what a plugin read
+
+
+def describe_input(summary: dict) -> str:
+    """One line on a spectrum's ``input_summary()``: shape, pixel size, unit and rms height,
+    and where the pixel size and the unit came from."""
+    unit = summary.get("unit")
+    length = f" {unit}" if unit else ""
+    shape = " x ".join(str(n) for n in summary["shape"])
+    kind = "points" if len(summary["shape"]) == 1 else "pixels"
+    spacing_from = summary.get("spacing_from")
+    converted = summary.get("file_unit")
+    unit_note = f", converted from the file's {converted}" if converted and unit and converted != unit else ""
+    return (
+        f"{Path(summary['file']).name} ({summary.get('format', '?')}): {shape} {kind} of {summary['spacing']:.6g}"
+        f"{length}{f' (from the {spacing_from})' if spacing_from else ''}, rms height {summary['rms_height']:.6g}"
+        f"{length}{unit_note}" + ("" if unit else ", no unit (bare numbers)")
+        + (", periodic" if summary.get("periodic") else ", not periodic")
+        + (f", {summary['undefined_points']} undefined points filled ({summary['filled_by']})"
+           if summary.get("filled_by") else "")
+    )  # fmt: skip

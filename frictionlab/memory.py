@@ -102,7 +102,8 @@ def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = 
 
 def available_memory() -> tuple[int, str]:
     """Bytes this process may still use, and where the figure comes from: the
-    smaller of MemAvailable and the room left under a cgroup limit."""
+    smallest of MemAvailable, the room left under a cgroup limit, and under the
+    process limits RLIMIT_AS and RLIMIT_DATA."""
     import psutil  # the machine's available memory on every platform (MemAvailable on Linux)
 
     found: list[tuple[int, str]] = []
@@ -121,9 +122,29 @@ def available_memory() -> tuple[int, str]:
             continue
         if limit.isdigit() and int(limit) < 2**60:
             found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
+    found += _process_limits()
     if not found:
         return 2**62, "unknown: the platform does not say"
     return min(found)
+
+
+def _process_limits() -> list[tuple[int, str]]:
+    """Room left under this process's limits on address space and data (``ulimit -v``,
+    ``ulimit -d``), which the workers inherit: counted against the whole run's peak, an
+    upper bound, since a run past them dies of MemoryError in every realization."""
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return []
+    import psutil
+
+    used = psutil.Process().memory_info()
+    found = []
+    for name, current in (("RLIMIT_AS", used.vms), ("RLIMIT_DATA", getattr(used, "data", used.vms))):
+        soft, _ = resource.getrlimit(getattr(resource, name))
+        if soft != resource.RLIM_INFINITY:
+            found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
+    return found
 
 
 def _points_path(scene: Scene) -> str | None:

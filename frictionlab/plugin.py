@@ -272,10 +272,23 @@ MDR springs in contact, which is not the real area of the surface MDR stands for
 
 
 def force_unit(solver: "ContactSolver", rms_height: float, profile: Profile) -> float:
-    """k h X: the load at which f = 1 for ``solver`` pressing ``profile`` (nominal rms
-    height h), as the solver's ``normalisation`` forms it (``ForceNormalisation.force_unit``)."""
+    """k h X: the load at which f = 1 for ``solver`` pressing ``profile`` of rms height h
+    (the spectrum's ``profile_rms_height``), as the solver's ``normalisation`` forms it
+    (``ForceNormalisation.force_unit``)."""
     normalisation = solver.normalisation(profile.ndim)
     return normalisation.force_unit(solver.stiffness(), rms_height, normalisation.extent_of(profile))
+
+
+def defined_rms(values: np.ndarray) -> float:
+    """The root mean square of the values that are defined (not NaN): a slope
+    estimator may leave points without a slope (``SlopeEstimator.undefined_points``).
+    NaN if none is; for all-defined values, exactly sqrt(mean(values^2))."""
+    squares = np.square(values)
+    mean = float(np.mean(squares))
+    if math.isnan(mean):  # some value is undefined: one more pass, only then
+        squares = squares[~np.isnan(squares)]
+        mean = float(np.mean(squares)) if squares.size else math.nan
+    return math.sqrt(mean)
 
 
 # ---------------------------------------------------------------- plugin kinds
@@ -306,6 +319,15 @@ class SpectrumGenerator(Plugin):
       of lines presses instead. Default None (no MDR mapping).
     - ``c0()``: the prefactor C0 of a power-law PSD. Default NotImplementedError.
     - ``hurst_exponent()``: H of a self-affine spectrum, or None (the default).
+    - ``input_summary()``: for a profile or surface read from a file, what was read and
+      used, JSON-ready: at least ``file``, ``shape``, ``spacing``, ``unit`` (None when the
+      numbers carry none) and ``rms_height``, and where each came from (the file or the
+      preset). ``frictionlab validate``, the API, the TUI and summary.json show it.
+      Default None (nothing read).
+    - ``profile_rms_height(profile)``: the h of f for one generated profile, when it is
+      the profile's own (its measured rms height); None (the default) when it is the
+      nominal ``rms_height()``. The lines of one ensemble must then share one h (to a
+      relative 1e-9: the spectrum scales each to it), since f is one axis for all.
     """
 
     kind: ClassVar[str] = "spectrum"
@@ -343,6 +365,12 @@ class SpectrumGenerator(Plugin):
     def hurst_exponent(self) -> float | None:
         return None
 
+    def input_summary(self) -> dict[str, Any] | None:
+        return None
+
+    def profile_rms_height(self, profile: Profile) -> float | None:
+        return None
+
 
 class SlopeEstimator(Plugin):
     """Turns a profile into pointwise slopes.
@@ -355,6 +383,11 @@ class SlopeEstimator(Plugin):
 
     ``periodic_only``: True for an estimator that cannot treat a non-periodic
     profile (a preset pairing it with one is refused).
+
+    ``undefined_points(periodic)``: True when ``slopes(..., periodic)`` leaves some
+    points (the ends of a non-periodic line) without a slope, as NaN. Those points
+    count in no rms, and a solver must declare ``undefined_slopes`` to be given
+    them. Default False: every slope is finite.
     """
 
     kind: ClassVar[str] = "slope"
@@ -364,6 +397,9 @@ class SlopeEstimator(Plugin):
 
     def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
+
+    def undefined_points(self, periodic: bool) -> bool:
+        return False
 
 
 IndentationReference = Literal["undeformed body", "mean surface"]
@@ -406,6 +442,9 @@ class ContactSolver(Plugin):
     - ``bytes_per_point`` (None): the peak memory ``solve`` allocates per grid point,
       beyond the profile and slopes it is given (memory estimates before a run).
       None: the framework's figure for a line solver (``memory.BYTES_PER_POINT``).
+    - ``undefined_slopes`` (False): True when ``solve`` takes slopes with NaN at
+      points that have no slope, and forms ``slope_rms_contact`` over the contact
+      points whose slope is defined (``defined_rms``), NaN at a load where none is.
     """
 
     kind: ClassVar[str] = "solver"
@@ -420,6 +459,7 @@ class ContactSolver(Plugin):
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None
     bytes_per_point: ClassVar[int | None] = None
+    undefined_slopes: ClassVar[bool] = False
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray

@@ -1,6 +1,8 @@
 """Progress of a run and of a sweep, as people read it: a rich
-progress bar on a terminal or in a Jupyter notebook, plain lines elsewhere (a log
-file, a pipe), one every tenth of the work so that logs stay short.
+progress bar on a terminal or in a Jupyter notebook with ipywidgets (the ``notebook``
+extra), plain lines elsewhere (a log file, a pipe, a notebook without ipywidgets:
+rich would draw nothing there but a warning), one every tenth of the work so that
+logs stay short.
 
 The CLI, the Python API (``frictionlab.run``) and the studies use these; rich is
 imported only when a bar is drawn. ``NO_COLOR`` is honoured by rich itself.
@@ -25,11 +27,18 @@ def _in_notebook() -> bool:
 
 
 def wants_bar(stream) -> bool:
-    """A live bar on a terminal or in a notebook; plain lines anywhere else."""
+    """A live bar on a terminal or in a notebook that can draw one; plain lines anywhere else."""
     try:
-        return bool(stream.isatty()) or _in_notebook()
+        return bool(stream.isatty()) or (_in_notebook() and _has_widgets())
     except (AttributeError, ValueError):
         return False
+
+
+def _has_widgets() -> bool:
+    """ipywidgets is installed: rich draws its bar in a notebook with it."""
+    import importlib.util
+
+    return importlib.util.find_spec("ipywidgets") is not None
 
 
 class _Bar:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import SolveCancelled, force_unit, listening_to_iterations, listening_to_loads
+from .plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from .preset import Scene
 from .seeds import realization_rng
 
@@ -35,6 +35,8 @@ class RealizationResult:
     slope_rms_line: float = math.nan
     points: int = 0
     force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
+    measured_rms_height: float = math.nan  # the profile's rms height about its own mean
+    own_rms_height: float = math.nan  # the h of f when it is the profile's own (profile_rms_height), else NaN
     error: str | None = None
 
     @property
@@ -103,12 +105,16 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
         check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
         check_cancel()
-        slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
+        if scene.slope.undefined_points(profile.periodic):
+            slope_rms_line = defined_rms(slopes)  # over the points that have a slope
+        else:  # every slope defined: a NaN makes the rms NaN, refused below
+            slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
         curve = scene.solver.solve(profile, scene.loads, scene.control, slopes)
+        own_h = scene.generator.profile_rms_height(profile)
         return RealizationResult(
             index=index,
             seconds=time.perf_counter() - start,
@@ -118,7 +124,9 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             slope_rms_line=slope_rms_line,
             points=profile.points,
-            force_unit=force_unit(scene.solver, scene.generator.rms_height(), profile),
+            force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),
+            measured_rms_height=float(np.std(profile.heights)),
+            own_rms_height=math.nan if own_h is None else float(own_h),
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise

@@ -18,22 +18,26 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 import platform
 from pathlib import Path
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
+from pydantic import Field
 
 from . import __version__
 from .ensemble import RunOutcome
-from .errors import RunError
+from .errors import MissingDependency, RunError, RunFolderError, shown
 from .files import atomic_write, write_npz
 from .fit import json_safe
 from .preset import Scene
+from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
-CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation")
+CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation")
+# columns a later frictionlab added: a folder written before them is read without them
+ADDED_CURVE_COLUMNS = frozenset({"lines_used"})
 CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
@@ -52,6 +56,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "frictionlab_version": __version__,
         "python": platform.python_version(),
         "preset": scene.resolved(),
+        "input": scene.spectrum.input_summary(),  # a file's shape, pixel size, unit as read (JSON-ready: the kit checks)
         "seed": scene.preset.seed,
         "status": outcome.status,
         "error": outcome.error,
@@ -66,6 +71,12 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
             key: json_safe(value) if isinstance(value, float) else value
             for key, value in outcome.normalisation.describe(outcome.stiffness, outcome.rms_height, outcome.extent).items()
         },
+        "heights": heights_summary(outcome),
+        "lines_used": {
+            "min": int(outcome.lines_used.min()) if outcome.lines_used.size else None,
+            "max": int(outcome.lines_used.max()) if outcome.lines_used.size else None,
+            "meaning": "realizations whose xi is defined at a load step (some point in contact has a slope)",
+        },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
         "caveats": outcome.caveats,
@@ -75,6 +86,28 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "resumed_realizations": outcome.extra.get("resumed", 0),
         "retried_realizations": outcome.extra.get("retried", 0),  # had failed before the resume, ran again
         "files": files,
+    }
+
+
+def heights_summary(outcome: RunOutcome) -> dict:
+    """Which h forms f, and the rms heights the lines measured about their own means."""
+    measured = outcome.per_realization.get("measured_rms_height", np.empty(0))
+    measured = measured[np.isfinite(measured)]
+
+    def stat(op):
+        return json_safe(float(op(measured))) if measured.size else None
+
+    return {
+        "h_in_f": "each line's own rms height about its mean" if outcome.own_rms_height
+        else "the spectrum's nominal rms height",
+        "h": json_safe(outcome.rms_height),
+        "measured_rms_height": {
+            "mean": stat(np.mean),
+            "std": stat(lambda m: np.std(m, ddof=1)) if measured.size >= 2 else None,
+            "min": stat(np.min),
+            "max": stat(np.max),
+            "lines": int(measured.size),
+        },
     }
 
 
@@ -97,17 +130,92 @@ def column_name(header: str) -> str:
     return header.split(" [", 1)[0]
 
 
-def read_curve(path: Path) -> dict[str, np.ndarray]:
-    """curve.csv read back: each column by its short name (``column_name``), empty
-    cells as NaN; an empty file has no columns."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        return {}
-    return {
-        column_name(header): np.array([float(row[i]) if row[i] else math.nan for row in rows[1:]])
-        for i, header in enumerate(rows[0])
-    }
+def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
+    """A run folder's curve.csv read back (``runfolder``: inside the folder, never
+    through a link): each column by its short name (``column_name``), empty cells as
+    NaN. RunFolderError naming the file for anything but the table frictionlab writes."""
+    header, rows = read_number_table(folder, name)
+    names = [column_name(h) for h in header]
+    stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
+    if stripped != [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]:
+        raise RunFolderError(
+            f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
+            f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
+        )
+    table = np.array(rows, dtype=float).reshape(len(rows), len(names))
+    return {n: table[:, i].copy() for i, n in enumerate(names)}
+
+
+# ------------------------------------------------------------------ summary.json, read back
+
+_Interval = Annotated[list[Finite | None], Field(min_length=2, max_length=2)]
+
+
+class FitRecord(Record):
+    a: Finite
+    b: Finite
+    a_se: Finite | None = None
+    b_se: Finite | None = None
+    a_ci: _Interval | None = None
+    b_ci: _Interval | None = None
+    confidence: Annotated[float, Field(gt=0, lt=1, strict=True)] = 0.95
+    bootstrap: Count = 0
+    r2: Finite | None = None
+    residual_rms: Finite | None = None
+    points: Count = 0
+
+
+class _Counts(Record):
+    requested: Count
+    done: Count
+    failed: Count = 0
+
+
+class _PresetName(Record):
+    name: Annotated[str, Field(min_length=1)]
+
+
+class _Normalisation(Record):
+    f: str = ""
+
+
+class SummaryRecord(Record):
+    """What load() and predict --from trust of a summary.json: each value checked."""
+
+    schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
+    preset: _PresetName
+    status: Literal["completed", "cancelled", "interrupted", "failed"]
+    seed: Count | None = None
+    fit: FitRecord | None = None
+    realizations: _Counts
+    normalisation: _Normalisation = _Normalisation()
+    caveats: list[str] = []
+    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
+    contact_count_at_first_load: Finite | None = None
+    contact_count_at_last_load: Finite | None = None
+    files: dict[str, MemberName] = {}
+    # what a measured file gave (shape, pixel size, unit, rms height, where each came from)
+    input: dict[str, str | int | float | bool | None | list[int | float]] | None = None
+
+
+def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
+    """A run folder's summary.json: the JSON object and its checked record
+    (RunFolderError naming the file and the field, a newer schema by its version)."""
+    path = Path(folder) / "summary.json"
+    data = read_json(folder, "summary.json")
+    check_schema_version(data, path, SUMMARY_SCHEMA_VERSION)
+    record = checked(SummaryRecord, data, path)
+    counts = record.realizations
+    problem = None
+    if counts.done > counts.requested:
+        problem = "field 'realizations.done' is more than 'realizations.requested'"
+    elif record.fit is not None and not counts.done:
+        problem = "field 'fit' holds a fit, but no realization was done"
+    elif record.fit is None and counts.done and record.status != "failed":
+        problem = "field 'fit' is null, but realizations were done and the run did not fail"
+    if problem:
+        raise RunFolderError(f"{shown(path)} is damaged: {problem}")
+    return data, record
 
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
@@ -118,6 +226,7 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.f,
         outcome.xi,
         outcome.xi_sem,
+        outcome.lines_used,
         outcome.contact_count,
         outcome.contact_fraction,
         outcome.indentation,
@@ -140,7 +249,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
 
     if scene.preset.output.realizations:
         files["realizations"] = out / "realizations.npz"
-        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f}
+        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f, "lines_used": outcome.lines_used}
         atomic_write(files["realizations"], lambda fh: write_npz(fh, arrays), binary=True)
 
     files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete
@@ -174,6 +283,9 @@ def write_figure(path: Path, draw) -> None:
         atomic_write(path, draw, binary=True)
     except OSError as exc:
         raise RunError(f"cannot write {path}: {exc.strerror or exc}; the numbers are written") from None
+    except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
+        raise RunError(f"cannot draw {path}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
+                       "the numbers are written") from None  # fmt: skip
     except Exception as exc:
         raise RunError(f"cannot draw {path}: {type(exc).__name__}: {exc}; the numbers are written") from None
 

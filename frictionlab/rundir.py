@@ -31,6 +31,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
 import re
 import time
@@ -41,11 +42,12 @@ import numpy as np
 import yaml
 
 from . import __version__
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
+from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
 from .files import atomic_write, output_path_problem
-from .inputs import InputFileProblem, read_regular_file, sha256_of
+from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
 from .realization import RealizationResult
+from .runfolder import check_schema_version, json_kind, read_json_object, read_member
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 CHUNK_DIR = "chunks"
@@ -54,6 +56,7 @@ STATE_FILE = "run.json"
 PRESET_FILE = "preset.yaml"
 MANIFEST_FORMAT = 2
 MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
+MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
@@ -81,24 +84,6 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
             return candidate
         except FileExistsError:
             candidate, n = base.with_name(f"{base.name}-{n}"), n + 1
-
-
-def read_json_object(path: Path, limit: int, what: str) -> dict:
-    """A run folder's JSON file (``what`` it is, at most ``limit`` bytes) as a mapping:
-    RunFolderError naming the file if it is not JSON, or not a JSON object;
-    InputFileProblem if it cannot be read at all (each caller says what that means)."""
-    try:
-        data = json.loads(read_regular_file(path, limit=limit, what=what))
-    except InputFileProblem:
-        raise
-    except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
-        where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
-        raise RunFolderError(f"{path} is damaged (not valid JSON{where})") from None
-    except RecursionError:
-        raise RunFolderError(f"{path} is damaged (JSON nested too deeply)") from None
-    if not isinstance(data, dict):
-        raise RunFolderError(f"{path} is damaged (a JSON {type(data).__name__}, not an object)")
-    return data
 
 
 def fingerprint(resolved: dict) -> str:
@@ -156,8 +141,11 @@ class RunDirectory:
             raise OutputRefused(f"{problem}; give a folder for the output")
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
-        if os.path.lexists(lock) and not lock.is_file():  # a lock that is a folder, a link to one, ...
-            raise RunFolderError(f"{lock} is not a file: it cannot hold the run's lock (remove it, or give another folder)")
+        if lock.is_symlink() or (os.path.lexists(lock) and not lock.is_file()):  # a link would be truncated through
+            raise RunFolderError(
+                f"{lock} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
+                "(remove it, or give another folder)"
+            )
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
         # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
         # file the holder then removed takes the lock on the new file.
@@ -165,9 +153,9 @@ class RunDirectory:
         try:
             self._lock.acquire()
         except Timeout:
-            try:
-                holder = lock.read_text(errors="replace").strip()[:200] or "unknown"
-            except OSError:
+            try:  # what _write_holder wrote: a line, escaped as any text from a folder is
+                holder = shown(read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]) or "unknown"
+            except (OSError, InputFileProblem):
                 holder = "unknown"
             raise RunFolderError(
                 f"{self.path} is in use by another run ({holder}): wait for it to end, "
@@ -196,10 +184,13 @@ class RunDirectory:
             state = read_json_object(path, MAX_MANIFEST_BYTES, "manifest")
         except InputFileProblem as exc:
             raise RunFolderError(f"{path}: {exc}") from None
+        check_schema_version(state, path, MANIFEST_FORMAT, key="format")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
-            if value is not None and not (isinstance(value, kind) and _well_formed(key, value)):
-                raise RunFolderError(f"{path} is damaged ({key} is not {what}: {short_repr(value, 60)})")
+            if value is not None and not isinstance(value, kind):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}, but {json_kind(value)})")
+            if value is not None and not _well_formed(key, value):
+                raise RunFolderError(f"{path} is damaged ({key} is not {what}: an entry is not a string)")
         return state
 
     def _write_manifest(self) -> None:
@@ -215,7 +206,7 @@ class RunDirectory:
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:
-            return load_preset_file(path)
+            return load_preset_file(path, follow_links=False)
         except PresetError as exc:
             raise RunFolderError(
                 f"{path} is damaged ({exc.problems[0].removeprefix('(file): ')}): this run cannot be resumed"
@@ -226,6 +217,11 @@ class RunDirectory:
     def start(self, scene: Scene, *, resume: bool) -> list[RealizationResult]:
         """Prepare the directory for ``scene``; return the results already stored
         and verified (resume) or none (a fresh run)."""
+        if os.path.islink(self.chunks) or (os.path.lexists(self.chunks) and not self.chunks.is_dir()):
+            raise RunFolderError(
+                f"{self.chunks} is not a folder (a link, a file, ...): chunks are never written or read through it "
+                "(remove it, or give another folder)"
+            )
         resolved = _json_copy(scene.resolved())
         inputs = self._input_hashes(scene)
         if resume:
@@ -296,9 +292,9 @@ class RunDirectory:
         if state is None:
             others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
             if others:
-                shown = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
+                listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputRefused(
-                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {shown}): "
+                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {listed}): "
                     f"{hint} (frictionlab then replaces only the files it writes and deletes none)"
                 )
             return
@@ -382,6 +378,8 @@ class RunDirectory:
             "slope_rms_line": np.array([r.slope_rms_line for r in ok], dtype=np.float64),
             "points": np.array([r.points for r in ok], dtype=np.int64),
             "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
+            "measured_rms_height": np.array([r.measured_rms_height for r in ok], dtype=np.float64),
+            "own_rms_height": np.array([r.own_rms_height for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
@@ -426,7 +424,7 @@ class RunDirectory:
         if match is None or not isinstance(digest, str):
             raise ChunkDamage("not a chunk name")
         try:
-            raw = read_regular_file(self.chunks / name, what="file")
+            raw = read_member(self.path, f"{CHUNK_DIR}/{name}", MAX_CHUNK_BYTES, what="file")
         except InputFileProblem as exc:
             raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
         if hashlib.sha256(raw).hexdigest() != digest:
@@ -512,6 +510,11 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
     repeated = indices.size > 1 and bool((np.diff(np.sort(indices)) == 0).any())  # not np.unique: it imports numpy.ma
     if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
         raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
+    heights = {}  # absent from the chunks of older versions: NaN
+    for name in ("measured_rms_height", "own_rms_height"):
+        heights[name] = arrays.get(name, np.full(n, math.nan))
+        if heights[name].shape != (n,):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(
@@ -524,6 +527,8 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             slope_rms_line=float(arrays["slope_rms_line"][row]),
             points=int(arrays["points"][row]),
             force_unit=float(arrays["force_unit"][row]),
+            measured_rms_height=float(heights["measured_rms_height"][row]),
+            own_rms_height=float(heights["own_rms_height"][row]),
         ))  # fmt: skip
     for row, index in enumerate(arrays["failed_index"].tolist()):
         out.append(RealizationResult(

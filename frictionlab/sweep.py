@@ -25,9 +25,9 @@ import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel
+from pydantic import BaseModel, Field
 
 from . import __version__
 from .dask_session import one_dask_cluster
@@ -40,8 +40,8 @@ from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
 from .results import write_figure
-from .inputs import InputFileProblem
-from .rundir import STATE_FILE, read_json_object
+from .rundir import STATE_FILE
+from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
@@ -355,8 +355,8 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
         return
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
-        old = json.loads((out_dir / "sweep.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+    except RunFolderError:
         raise OutputRefused(
             f"{out_dir} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
         ) from None
@@ -369,14 +369,46 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
 def stored_sweep(out_dir: Path) -> dict:
     """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
-    try:
-        stored = read_json_object(out_dir / "sweep.json", MAX_SWEEP_RECORD_BYTES, "sweep.json")
-    except InputFileProblem as exc:
-        raise RunFolderError(f"{out_dir}/sweep.json cannot be read ({exc}): this sweep cannot be resumed") from None
-    base, spec = stored.get("base_preset"), stored.get("sweep")
-    if not (isinstance(base, dict) and isinstance(spec, dict)):
-        raise RunFolderError(f"{out_dir}/sweep.json is damaged (no base_preset and sweep mappings): it cannot be resumed")
-    return {**base, "sweep": spec}
+    data, _ = read_sweep_record(out_dir)
+    return {**data["base_preset"], "sweep": data["sweep"]}
+
+
+class _PointRecord(Record):
+    folder: MemberName
+    status: str
+    done: Count | None = None
+    a: Finite | None = None
+    a_lo: Finite | None = None
+    a_hi: Finite | None = None
+    b: Finite | None = None
+    b_lo: Finite | None = None
+    b_hi: Finite | None = None
+    r2: Finite | None = None
+
+
+class _SweepSpecRecord(Record):
+    parameters: dict[str, Any]
+
+
+class SweepRecord(Record):
+    """What load(), resume and the TUI trust of a sweep.json: each value checked."""
+
+    sweep: _SweepSpecRecord  # first: what a resume needs, named first when missing
+    base_preset: dict[str, Any]
+    schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
+    name: Annotated[str, Field(min_length=1)]
+    status: str
+    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
+    points: list[_PointRecord]
+
+
+def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
+    """A sweep folder's sweep.json (read as any run folder's file is: ``runfolder``): the
+    JSON object and its checked record; RunFolderError naming the file and the field."""
+    path = Path(out_dir) / "sweep.json"
+    data = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+    check_schema_version(data, path, SWEEP_SCHEMA_VERSION)
+    return data, checked(SweepRecord, data, path)
 
 
 def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:

@@ -11,6 +11,26 @@ from frictionlab.registry import Registry
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS = ROOT / "presets"
 
+LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study): `pytest -m long` runs them
+    "tui/test_screen.py", "tui/test_snapshots.py", "tui/test_form.py", "tui/test_run.py", "exact3d/test_study.py",
+    "tui/test_detached.py", "tui/test_small_things.py",
+}  # fmt: skip
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark the tests of ``LONG_MODULES`` ``long``, and leave the long tests out of a bare
+    `pytest` (the README's command: a newcomer's run takes minutes). CI runs them with
+    `pytest -m long`; a test file or test named on the command line runs whatever it holds."""
+    tests = Path(__file__).resolve().parent
+    for item in items:
+        if item.path.is_relative_to(tests) and item.path.relative_to(tests).as_posix() in LONG_MODULES:
+            item.add_marker(pytest.mark.long)
+    if config.args_source == pytest.Config.ArgsSource.TESTPATHS and config.option.markexpr == "not slow":
+        long = [item for item in items if item.get_closest_marker("long")]
+        if long:
+            config.hook.pytest_deselected(items=long)
+            items[:] = [item for item in items if not item.get_closest_marker("long")]
+
 SMALL_PRESET = {
     "name": "small",
     "seed": 7,

@@ -7,7 +7,6 @@ import doctest
 import json
 import subprocess
 import sys
-import types
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ import yaml
 
 import frictionlab
 from frictionlab import api
-from frictionlab.errors import FrictionlabError, PresetError, RunFolderError
+from frictionlab.errors import FrictionlabError, MissingDependency, PresetError, RunFolderError
 from frictionlab.preset import Preset
 
 from .cli.conftest import run_cli
@@ -93,11 +92,11 @@ def test_load_refuses_a_curve_it_did_not_write_naming_the_file(tmp_path):
     frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
     curve = folder / "curve.csv"
     lines = curve.read_text().splitlines()
-    curve.write_text("\n".join(["F,f,xi", *lines[1:]]) + "\n")  # columns missing
-    with pytest.raises(RunFolderError, match=r"curve.csv: columns \['F', 'f', 'xi'\] are not those frictionlab writes"):
-        frictionlab.load(folder)
+    curve.write_text("\n".join(["F,f,xi", *(",".join(line.split(",")[:3]) for line in lines[1:])]) + "\n")
+    with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(its header does not name the \d+ columns"):
+        frictionlab.load(folder)  # columns missing
     curve.write_text("")  # emptied
-    with pytest.raises(RunFolderError, match=r"curve.csv: columns \[\] are not those"):
+    with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(empty: no header\)"):
         frictionlab.load(folder)
 
 
@@ -111,16 +110,14 @@ def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path)
     assert drawn.fit == r.fit  # the figure changes no number
 
 
-def test_to_pandas_gives_a_frame_with_pandas_and_the_arrays_without(monkeypatch):
+def test_to_pandas_gives_a_frame_with_pandas_and_names_the_extra_without(monkeypatch):
     result = frictionlab.run(SMALL_PRESET, **FAST)
+    frame = result.to_pandas()
+    assert list(frame.columns) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation"]
+    np.testing.assert_array_equal(frame["xi"].to_numpy(), result.table["xi"])
     monkeypatch.setitem(sys.modules, "pandas", None)  # as if not installed
-    arrays = result.to_pandas()
-    assert set(arrays) == {"F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"}
-    fake = types.ModuleType("pandas")
-    fake.DataFrame = lambda data: ("frame", data)
-    monkeypatch.setitem(sys.modules, "pandas", fake)
-    kind, data = result.to_pandas()
-    assert kind == "frame" and data["xi"] is result.table["xi"]
+    with pytest.raises(MissingDependency, match=r'Result.to_pandas\(\) needs pandas, .*pip install "frictionlab\[pandas\]"'):
+        result.to_pandas()
 
 
 def test_plot_draws_the_points_and_the_fit_on_the_given_axes():
@@ -173,3 +170,86 @@ def test_loads_that_press_the_whole_line_flat_carry_a_caveat_from_where_it_start
     assert full == [f"the whole profile is in contact from load {first + 1} of 12 on (load {result.table['F'][first]:.4g}): "
                     "xi is 1 there by definition, so those loads measure no roughness; lower the loads"]  # fmt: skip
     assert json.loads((tmp_path / "heavy" / "summary.json").read_text())["caveats"] == result.caveats
+
+
+# ------------------------------------------------------------------ arguments, named
+
+
+def _nested(depth: int) -> dict:
+    top = inner = {}
+    for _ in range(depth):
+        inner["a"] = {}
+        inner = inner["a"]
+    return top
+
+
+def _containing_itself() -> dict:
+    data = {"name": "loop"}
+    data["self"] = data
+    return data
+
+
+@pytest.mark.parametrize(
+    "call, said",
+    [
+        (lambda: frictionlab.run("quickstart", 5, **FAST), "overrides must be a mapping of dotted keys to values, got int"),
+        (lambda: frictionlab.run("quickstart", [("seed", 3)], **FAST), "overrides must be a mapping of dotted keys to values, got list"),
+        (lambda: frictionlab.run("quickstart", {3: 1}, **FAST), "key 3 is of type int, not str"),
+        (lambda: frictionlab.run("quickstart", {"spectrum": _nested(10_000)}, **FAST), "overrides is nested more than 64 levels deep"),
+        (lambda: frictionlab.run(_nested(10_000), **FAST), "preset is nested more than 64 levels deep"),
+        (lambda: frictionlab.run(_containing_itself(), **FAST), "preset is nested more than 64 levels deep"),
+        (lambda: frictionlab.run({"name": "wide", "x": list(range(30_000))}, **FAST), "preset holds more than 20,000 values"),
+        (lambda: frictionlab.run("quickstart", {"seed": object()}, **FAST), "overrides.seed must be a str, number, bool, None, list or mapping, got object"),
+        (lambda: frictionlab.run("quickstart", seed={1, 2}, **FAST), "keyword overrides.seed must be a str, number"),
+        (lambda: frictionlab.run("quickstart", out=5, **FAST), "out must be a path to a folder to write the run into (a str or pathlib.Path), got int"),
+        (lambda: frictionlab.run("quickstart", scheduler=5, **FAST), "scheduler must be a Dask scheduler's address (a str), got int"),
+        (lambda: frictionlab.run("quickstart", resume="yes", **FAST), "resume must be True or False, got str"),
+        (lambda: frictionlab.run("quickstart", workers=1, progress=1), "progress must be True or False, got int"),
+        (lambda: frictionlab.run("", **FAST), "preset must be a path to a preset file, or a built-in's name, got an empty string"),
+        (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
+        (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
+        (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),
+    ],
+)
+def test_a_wrong_argument_is_a_frictionlab_error_naming_it(call, said):
+    with pytest.raises(FrictionlabError) as raised:
+        call()
+    assert said in str(raised.value)
+
+
+def test_a_result_plot_names_a_wrong_axes(tmp_path):
+    result = frictionlab.run(SMALL_PRESET, realizations=2, **FAST)
+    with pytest.raises(FrictionlabError, match="ax must be a matplotlib Axes or None, got int"):
+        result.plot(ax=5)
+
+
+def test_api_errors_name_a_built_in_preset_as_the_cli_does(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # no file called quickstart here: the built-in
+    with pytest.raises(PresetError) as raised:
+        frictionlab.run("quickstart", {"spectrum.params.hurst": 7}, **FAST)
+    message = str(raised.value)
+    assert message.startswith("built-in preset 'quickstart': 1 problem in preset") and "site-packages" not in message
+    assert "quickstart.yaml" not in message
+    from frictionlab.cli import main
+
+    assert main(["run", "quickstart", "--set", "spectrum.params.hurst=7"]) == 2
+    assert "built-in preset 'quickstart' --set spectrum.params.hurst=7: 1 problem in preset" in capsys.readouterr().err
+    (tmp_path / "mine.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    with pytest.raises(PresetError, match=r"^mine.yaml: 1 problem in preset"):  # a file the user gave: as given
+        frictionlab.run("mine.yaml", {"spectrum.params.hurst": 7}, **FAST)
+
+
+def test_load_reads_a_folder_written_before_the_lines_used_column(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
+    curve = folder / "curve.csv"
+    rows = [line.split(",") for line in curve.read_text().splitlines()]
+    dropped = next(i for i, cell in enumerate(rows[0]) if cell.startswith("lines_used"))
+    curve.write_text("\n".join(",".join(r[:dropped] + r[dropped + 1 :]) for r in rows) + "\n")
+    old = frictionlab.load(folder)
+    assert "lines_used" not in old.table
+    assert np.array_equal(old.table["xi"], frictionlab.run(SMALL_PRESET, plot=False, **FAST).table["xi"])
+    # a column out of its place is still refused
+    curve.write_text("\n".join(",".join([r[1], r[0], *r[2:]]) for r in rows) + "\n")
+    with pytest.raises(RunFolderError, match="is damaged"):
+        frictionlab.load(folder)

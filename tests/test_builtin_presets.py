@@ -36,7 +36,11 @@ def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch)
     monkeypatch.chdir(tmp_path)
     assert resolve_preset_path("quickstart") == find_builtin("quickstart.yaml").path
     mine = tmp_path / "quickstart.yaml"
+    with pytest.raises(PresetFileError, match=r"no file .*quickstart.yaml' here; the built-in preset of that name"):
+        resolve_preset_path(mine)  # missing: pointed to the built-in, never swapped for it
+    mine.write_text("name: mine\n")
     assert resolve_preset_path(mine) == mine  # a path is never swapped for a built-in
+    mine.unlink()
     with pytest.raises(PresetFileError, match=r"did you mean 'quickstart'\?"):
         resolve_preset_path("quikstart")
     with pytest.raises(PresetFileError, match=r"no file 'quickstart.yaml' here; the built-in preset of that name is 'quickstart'"):
@@ -48,7 +52,7 @@ def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch)
 
 
 def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):
-    listed = json.loads(run_cli("presets", "--json").stdout)
+    listed = json.loads(run_cli("presets", "--json").stdout)["presets"]
     assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
     result = run_cli("presets", "copy", "quickstart", tmp_path)
     assert result.returncode == 0, result.stderr
@@ -107,7 +111,7 @@ def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, t
         return subprocess.run([sys.executable, "-m", "frictionlab", *args], capture_output=True, text=True,
                               cwd=empty, env=env, timeout=300)  # fmt: skip
 
-    listed = json.loads(cli("presets", "--json").stdout)
+    listed = json.loads(cli("presets", "--json").stdout)["presets"]
     assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
     for row in listed:  # the installed copies, not the checkout's
         assert Path(row["path"]).is_relative_to(installed / "frictionlab" / "builtin_presets")

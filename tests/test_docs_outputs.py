@@ -92,3 +92,23 @@ def test_the_validation_errors_shown_are_what_validate_prints(tmp_path, monkeypa
 def test_the_built_in_presets_listing_shown_is_what_it_prints(capsys):
     assert main(["presets"]) == 0
     _check("docs/getting-started.md", "NAME", capsys.readouterr().out)
+
+
+def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
+    """docs/tutorials/instrument-file.md, rerun in a copy of the example's folder: the X3P
+    file written by the example's script, validated and run by MDR and by the free half-space."""
+    import runpy
+    import shutil
+
+    page, folder = "docs/tutorials/instrument-file.md", tmp_path / "examples" / "instrument-scan"
+    shutil.copytree(ROOT / "examples" / "instrument-scan", folder)
+    monkeypatch.chdir(tmp_path)
+    runpy.run_path(str(folder / "make_scan.py"))["main"](folder)
+    preset = "examples/instrument-scan/scan.yaml"
+    assert main(["validate", preset]) == 0
+    _check(page, "wrote scan.x3p", capsys.readouterr().out)
+    assert main(["run", preset, "--out", "runs/scan-mdr", "--workers", "1", "--quiet"]) == 0
+    _check(page, "scan: 10/10", capsys.readouterr().out)
+    exact = ["--set", "solver.name=bem-halfspace-free", "--set", "realizations=1"]
+    assert main(["run", preset, *exact, "--out", "runs/scan-exact", "--workers", "1", "--quiet"]) == 0
+    _check(page, "scan: 1/1", capsys.readouterr().out)

@@ -133,3 +133,24 @@ def test_cli_lists_the_example(installed_example):
     blocked = _run(installed_example, ["-m", "frictionlab", "plugins"], FRICTIONLAB_BLOCK_PLUGINS="gaussian")
     assert blocked.returncode == 0, blocked.stdout + blocked.stderr
     assert "frictionlab-gaussian" not in blocked.stdout
+
+
+def test_the_tutorials_step_4_validates_as_shown_and_a_name_switched_alone_is_refused(installed_example, tmp_path):
+    """docs/tutorials/write-a-plugin.md: its preset, saved as gaussian.yaml, and its --set
+    line from quickstart validate with the plugin installed; the name alone does not."""
+    import re
+    import shlex
+
+    page = (ROOT / "docs" / "tutorials" / "write-a-plugin.md").read_text(encoding="utf-8")
+    step = page.split("## 4. Use it", 1)[1]
+    (tmp_path / "gaussian.yaml").write_text(re.search(r"```yaml\n(.*?)```", step, re.S).group(1))
+    commands = [shlex.split(line)[1:] for line in re.findall(r"^frictionlab .*$", step, re.M)]
+    assert commands[0] == ["validate", "gaussian.yaml"] and "--set" in commands[1]
+    for argv in commands:
+        done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, text=True, cwd=tmp_path,
+                              env=_clean_env(PYTHONPATH=str(installed_example)), timeout=120)  # fmt: skip
+        assert done.returncode == 0 and ": ok (" in done.stdout, (argv, done.stderr)
+    alone = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart", "--set", "spectrum.name=gaussian"],
+                           capture_output=True, text=True, cwd=tmp_path, env=_clean_env(PYTHONPATH=str(installed_example)),
+                           timeout=120)  # fmt: skip
+    assert alone.returncode == 2 and "spectrum.params.hurst: is not a known field" in alone.stderr

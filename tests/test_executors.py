@@ -283,6 +283,7 @@ except Exception as exc:
 
 
 @needs_dask
+@pytest.mark.long
 def test_the_executors_own_cluster_admits_only_this_runs_credentials():
     import subprocess
 
@@ -355,7 +356,8 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
     preset = tmp_path / "p.yaml"
     preset.write_text(yaml.safe_dump(merge(SMALL_PRESET, {"realizations": 24, "output": {"plot": False}})))
     with LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", protocol="tls://", security=security,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster:  # fmt: skip
+                      dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # no fixed port
+                      silence_logs=logging.ERROR) as cluster:  # fmt: skip
         command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--executor", "dask",
                    "--scheduler", cluster.scheduler_address, "--quiet"]  # fmt: skip
         bare = subprocess.run([*command, "--out", str(tmp_path / "bare")], capture_output=True, text=True, cwd=ROOT,
@@ -369,3 +371,38 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
     summary = json.loads(done.stdout)
     assert summary["executor"] == "dask" and summary["workers"] == 2
     assert (summary["fit"]["a"], summary["fit"]["b"]) == (serial_24.fit.a, serial_24.fit.b)
+
+
+@needs_dask
+@pytest.mark.parametrize("server", ["http", "silent"])
+def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_connect_timeout(server):
+    """An HTTP server (the dashboard's port, say), or one that accepts and never answers,
+    is refused with a message within the connect timeout: a Client would wait for minutes."""
+    import http.server
+    import socket
+    import threading
+    import time
+
+    from frictionlab.dask_security import CONNECT_SECONDS, connect_scheduler
+    from frictionlab.errors import RunError
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    if server == "http":
+        listener = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Quiet)
+        threading.Thread(target=listener.serve_forever, daemon=True).start()
+        port = listener.server_address[1]
+    else:
+        listener = socket.socket()
+        listener.bind(("127.0.0.1", 0))
+        listener.listen()
+        port = listener.getsockname()[1]
+    started = time.monotonic()
+    try:
+        with pytest.raises(RunError, match=rf"did not answer as a Dask scheduler within {CONNECT_SECONDS} s"):
+            connect_scheduler(f"tcp://127.0.0.1:{port}")
+    finally:
+        (listener.shutdown if server == "http" else listener.close)()
+    assert time.monotonic() - started < 3 * CONNECT_SECONDS  # a bound against a hang (it was minutes), not a speed test

@@ -3,6 +3,7 @@
 import io
 import os
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -62,42 +63,59 @@ def test_write_npz_gives_the_same_bytes_for_the_same_arrays():
     assert first.getvalue() == second.getvalue()
 
 
-def test_atomic_write_writes_through_a_symlink_and_keeps_the_link(tmp_path):
-    real = tmp_path / "real.txt"
-    real.write_text("old")
-    link = tmp_path / "link.txt"
-    link.symlink_to(real)
-    atomic_write(link, lambda fh: fh.write("new"))
-    assert link.is_symlink() and os.readlink(link) == str(real)
-    assert real.read_text() == "new"
+def test_atomic_write_replaces_a_symlink_and_never_writes_through_it(tmp_path):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    real = outside / "user.txt"
+    real.write_text("the user's file")
+    for devices in (False, True):  # a run folder's file, or an output path the user named
+        link = tmp_path / f"link-{devices}.txt"
+        link.symlink_to(real)
+        atomic_write(link, lambda fh: fh.write("new"), devices=devices)
+        assert not link.is_symlink() and link.read_text() == "new"
+    dangling = tmp_path / "dangling.txt"
+    dangling.symlink_to(outside / "created-through-the-link.txt")
+    atomic_write(dangling, lambda fh: fh.write("new"))
+    assert not dangling.is_symlink() and dangling.read_text() == "new"
+    assert real.read_text() == "the user's file" and sorted(p.name for p in outside.iterdir()) == ["user.txt"]
 
 
-def test_atomic_write_writes_into_a_fifo_instead_of_replacing_it(tmp_path):
-    import stat
+def _fifo_reader(fifo):
     import threading
 
-    fifo = tmp_path / "ff"
-    os.mkfifo(fifo)
     got = []
     reader = threading.Thread(target=lambda: got.append(open(fifo).read()), daemon=True)  # never blocks the exit
     reader.start()
-    atomic_write(fifo, lambda fh: fh.write("through the pipe"))
+    return reader, got
+
+
+def test_atomic_write_writes_into_a_fifo_the_user_named_and_replaces_one_in_a_run_folder(tmp_path):
+    import stat
+
+    fifo = tmp_path / "ff"
+    os.mkfifo(fifo)
+    reader, got = _fifo_reader(fifo)
+    atomic_write(fifo, lambda fh: fh.write("through the pipe"), devices=True)
     reader.join(10)
     assert got == ["through the pipe"]
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    atomic_write(fifo, lambda fh: fh.write("a file now"))  # no reader: opening it to write would block
+    assert stat.S_ISREG(os.lstat(fifo).st_mode) and fifo.read_text() == "a file now"
 
 
-def test_atomic_write_writes_into_a_character_device_instead_of_replacing_it(tmp_path):
-    null = tmp_path / "mynull"
-    null.symlink_to("/dev/null")  # as a device node a user made (mknod needs root), reached by its path
-    atomic_write(null, lambda fh: fh.write("discarded"))
+def test_atomic_write_writes_into_a_character_device_the_user_named(tmp_path):
     import stat
 
+    null = tmp_path / "mynull"
+    null.symlink_to("/dev/null")  # a link to a device, as /dev/stdout is
+    atomic_write(null, lambda fh: fh.write("discarded"), devices=True)
     assert stat.S_ISCHR(os.stat("/dev/null").st_mode) and null.is_symlink()
+    atomic_write(null, lambda fh: fh.write("a file now"))  # in a run folder: the link is replaced
+    assert not null.is_symlink() and null.read_text() == "a file now" and stat.S_ISCHR(os.stat("/dev/null").st_mode)
     if os.geteuid() == 0:  # a real device node: renaming over it would make it a regular file
         node = tmp_path / "node"
         os.mknod(node, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
-        atomic_write(node, lambda fh: fh.write("discarded"), binary=False)
+        atomic_write(node, lambda fh: fh.write("discarded"), binary=False, devices=True)
         assert stat.S_ISCHR(os.lstat(node).st_mode)
 
 
@@ -116,3 +134,19 @@ def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
             atomic_write(sock_path, lambda fh: fh.write("x"))
     assert raised.value.filename == str(sock_path) and raised.value.strerror == "is a socket, not a file"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s", "sdir"] and not any(folder.iterdir())
+
+
+def test_an_open_stream_the_user_named_is_written_into_whatever_it_is_redirected_to(tmp_path):
+    """``--out /dev/stdout > file``: the stream is written into; renaming over the link
+    (as root, /dev/stdout itself) is what must never happen."""
+    from frictionlab.files import check_output_file
+
+    target = tmp_path / "redirected.json"
+    with open(target, "w") as stream:
+        via_proc = Path(f"/proc/self/fd/{stream.fileno()}")
+        link = tmp_path / "stdout"
+        link.symlink_to(via_proc)  # as /dev/stdout -> /proc/self/fd/1
+        assert check_output_file(link, "--out", force=False) == link  # not refused as an existing file
+        atomic_write(link, lambda fh: fh.write("through the stream"), devices=True)
+        assert link.is_symlink() and os.readlink(link) == str(via_proc)
+    assert target.read_text() == "through the stream"

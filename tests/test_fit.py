@@ -90,6 +90,51 @@ def test_bootstrap_equals_refitting_every_resampled_mean_curve():
     assert fit.b_ci == pytest.approx((low[1], high[1]), rel=1e-12)
 
 
+def _undefined_at_low_forces(rng, lines=12, forces=25):
+    """Per-line curves where some lines have no xi (NaN) at the first forces (their contact had no slope)."""
+    f = np.geomspace(0.5, 20, forces)
+    xi = 1.2 + 0.05 * np.log(f) + rng.normal(0, 0.1, (lines, forces))
+    for line, first_defined in ((0, 3), (4, 6), (7, 1), (9, 25)):  # line 9: xi nowhere defined
+        xi[line, :first_defined] = np.nan
+    return f, xi
+
+
+def test_undefined_xi_is_left_out_of_the_mean_the_fit_and_every_resample():
+    """Brute force: at each force the mean over the lines whose xi is defined; each resample
+    the same, with the resampled counts as weights; every resample here has a defined xi at
+    every force (line 0 etc. are undefined at a few forces only, most lines everywhere)."""
+    from frictionlab.ensemble import defined_statistics
+
+    f, xi = _undefined_at_low_forces(np.random.default_rng(8))
+    mean, sem, used = defined_statistics(xi)
+    for j in range(f.size):
+        values = [v for v in xi[:, j] if not math.isnan(v)]
+        assert used[j] == len(values)
+        assert mean[j] == pytest.approx(sum(values) / len(values), rel=1e-13)
+        assert sem[j] == pytest.approx(np.std(values, ddof=1) / math.sqrt(len(values)), rel=1e-12)
+    assert used[0] == 8 and used[-1] == 11
+    fit = fit_log_law(f, xi, bootstrap=200, confidence=0.8, rng=np.random.default_rng(4))
+    assert (fit.a, fit.b) == pytest.approx(tuple(least_squares(f, mean)[0]), rel=1e-12)
+    counts = np.random.default_rng(4).multinomial(12, np.full(12, 1 / 12), size=200)
+    refits = []
+    for c in counts:
+        curve = [sum(c[i] * xi[i, j] for i in range(12) if not math.isnan(xi[i, j]))
+                 / sum(c[i] for i in range(12) if not math.isnan(xi[i, j])) for j in range(f.size)]  # fmt: skip
+        refits.append(least_squares(f, np.array(curve))[0])
+    low, high = np.percentile(refits, [10, 90], axis=0)
+    assert fit.a_ci == pytest.approx((low[0], high[0]), rel=1e-12)
+    assert fit.b_ci == pytest.approx((low[1], high[1]), rel=1e-12)
+
+
+def test_a_force_where_no_line_has_xi_is_left_out_of_the_fit():
+    f, xi = _undefined_at_low_forces(np.random.default_rng(9))
+    xi[:, :2] = np.nan
+    fit = fit_log_law(f, xi, bootstrap=50, rng=np.random.default_rng(1))
+    assert fit.points == f.size - 2
+    kept = fit_log_law(f[2:], xi[:, 2:], bootstrap=50, rng=np.random.default_rng(1))
+    assert (fit.a, fit.b, fit.a_ci, fit.b_ci) == (kept.a, kept.b, kept.a_ci, kept.b_ci)
+
+
 @pytest.mark.parametrize("samples", [1, 2, 3, 7, 40, 1000])
 @pytest.mark.parametrize("confidence", [0.0, 0.5, 0.683, 0.9, 0.95, 0.99, 1.0])
 def test_percentile_interval_is_numpys_percentile_bit_for_bit(samples, confidence):

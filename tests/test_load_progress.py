@@ -247,3 +247,24 @@ def test_a_pool_kills_a_worker_whose_job_does_not_stop_after_a_cancel():
     finished = list(pool.run({"long": 120.0}, cancel))  # without the kill: two minutes, then [("long", 120.0)]
     timer.cancel()
     assert finished == []
+
+
+def test_a_log_shows_the_iterations_of_a_long_load(registry, monkeypatch):
+    import re
+
+    import frictionlab.progress as progress
+    import frictionlab.realization as realization
+
+    monkeypatch.setattr(progress, "LOAD_LINE_SECONDS", 0.0)
+    monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)
+    scene = build_scene(merge(LONG_LOADS, {"realizations": 1}), registry=registry)
+    stream = io.StringIO()
+    outcome = engine.run(scene, RunOptions(workers=1), listeners=[ProgressReporter(stream, interactive=False, after=0.0)])
+    lines = re.findall(r"^realization 0: load (\d+)/8, iteration (\d+), residual (\S+)$", stream.getvalue(), re.M)
+    # every step of each load in order, from the first (0), each with a residual above the tolerance
+    per_load = defaultdict(list)
+    for load, iteration, _ in lines:
+        per_load[int(load)].append(int(iteration))
+    assert outcome.status == "completed" and list(per_load) == sorted(per_load) and 1 in per_load
+    assert all(heard == list(range(len(heard))) for heard in per_load.values())
+    assert all(float(residual) > 1e-13 for *_, residual in lines)

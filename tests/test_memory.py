@@ -82,6 +82,7 @@ def surface_of(points: int, solver: str = "bem-halfspace", **changes) -> dict:
     })  # fmt: skip
 
 
+@pytest.mark.long
 def test_the_half_space_declares_what_its_realization_allocates(registry):
     """tracemalloc sees numpy's buffers: the peak of one realization (synthesis, slopes,
     the solve) per point lies under the declared estimate, and not far under it."""
@@ -286,3 +287,62 @@ def test_own_local_cluster_is_checked_before_it_starts(registry, tmp_path, monke
     with pytest.raises(RunError, match=r"Dask worker 1 of the LocalCluster on 127\.0\.0\.1 has a memory limit of 0\.20 GiB"):
         run_to_folder(large, tmp_path / "out", RunOptions(workers=2, executor="dask"))
     assert not (tmp_path / "out").exists()
+
+
+_UNDER_A_LIMIT = """
+import resource, sys
+import frictionlab
+from frictionlab.errors import FrictionlabError
+from frictionlab.memory import available_memory
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+room, source = available_memory()
+print("ROOM", room, source)
+try:
+    frictionlab.run("quickstart", {"spectrum.params.points": int(sys.argv[2])}, realizations=2, workers=1, progress=False)
+    print("RAN")
+except FrictionlabError as exc:
+    print("REFUSED", exc)
+    sys.exit(exc.exit_code)
+"""
+
+
+def test_a_process_limit_on_address_space_is_part_of_the_check(tmp_path):
+    """Under ``ulimit -v``, a run whose estimate passes the limit is refused at once with
+    the limit named (it would otherwise die of MemoryError in every realization); the room
+    reported lies below the limit, and a small run still runs."""
+    vms = __import__("psutil").Process().memory_info().vms
+    limit = vms + 1536 * MiB  # this test's own process plus 1.5 GiB: the child imports less
+    script = tmp_path / "limited.py"
+    script.write_text(_UNDER_A_LIMIT)
+    big = subprocess.run([sys.executable, str(script), str(limit), str(2**25)], capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path)  # fmt: skip
+    assert big.returncode == 1, big.stdout + big.stderr
+    room = int(big.stdout.split("ROOM ")[1].split()[0])
+    assert 0 < room < limit and "RLIMIT_AS" in big.stdout.split("ROOM ")[1].splitlines()[0]
+    assert "REFUSED this run would need about" in big.stdout and "RLIMIT_AS (ulimit -v)" in big.stdout
+    small = subprocess.run([sys.executable, str(script), str(limit), "1024"], capture_output=True, text=True,
+                           timeout=300, cwd=tmp_path)  # fmt: skip
+    assert small.returncode == 0 and "RAN" in small.stdout, small.stdout + small.stderr
+
+
+def test_the_check_of_a_huge_surface_allocates_nothing_in_proportion_to_it(registry, tmp_path):
+    """The estimate is arithmetic: refusing a 65536² half-space (4.3e9 points, 800 GiB)
+    costs the memory of a small run, measured as the growth of ru_maxrss in a fresh process
+    (the surface's synthesis, which the check once ran to learn the grid's shape, grows
+    by 170 MiB at 16384² and 2.7 GiB at 65536²)."""
+    script = tmp_path / "huge.py"
+    script.write_text(
+        "import resource, yaml, frictionlab\n"
+        "from frictionlab.errors import RunError\n"
+        f"data = yaml.safe_load(open({str(Path(__file__).parents[1] / 'presets' / 'exact3d-h08-rolloff.yaml')!r}))\n"
+        "data['spectrum']['params']['points'] = 65536\n"
+        "del data['spectrum']['params']['short_cutoff']\n"  # the default, a few pixels: every mode in the band
+        "before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+        "try:\n    frictionlab.run(data, workers=1, progress=False)\nexcept RunError as exc:\n    print('REFUSED', exc)\n"
+        "print('GROWTH_KIB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before)\n"
+    )
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert "REFUSED this run would need about" in done.stdout and "4,294,967,296 points" in done.stdout, done.stderr
+    growth = int(done.stdout.split("GROWTH_KIB ")[1])
+    assert growth < 200 * 1024  # KiB: a 65536² array of float64 alone is 32 GiB

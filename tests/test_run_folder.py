@@ -333,5 +333,5 @@ def test_a_lock_that_is_not_a_file_is_named(tmp_path, capsys):
     preset = write(tmp_path / "p.yaml", QUICK)
     (tmp_path / "run" / "run.lock").mkdir(parents=True)
     assert main(["run", str(preset), "--out", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
-    assert "run.lock is not a file" in capsys.readouterr().err
+    assert "run.lock is not a regular file" in capsys.readouterr().err
     assert (tmp_path / "run" / "run.lock").is_dir()  # left as it was

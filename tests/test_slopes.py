@@ -33,11 +33,13 @@ def rms(values):
 @pytest.mark.parametrize("cls", ESTIMATORS)
 def test_plugin_contract(cls):
     validate_plugin_class("slope", cls)
-    assert cls.Params.model_fields == {}
+    assert set(cls.Params.model_fields) == ({"line_end"} if cls is not Spectral else set())
     with pytest.raises(ValueError):
         cls(unknown=1)
     assert {c.name for c in ESTIMATORS} == {"forward-difference", "central-difference", "spectral"}
     check_plugin("slope", cls)
+    if cls is not Spectral:
+        check_plugin("slope", cls, line_end="undefined")
 
 
 # ------------------------------------------------------------- closed forms
@@ -133,6 +135,86 @@ def test_on_a_scan_no_difference_crosses_the_ends():
         np.testing.assert_allclose(cls().slopes(surface, 1.0, periodic=False), np.hypot(3.0, 1.0), rtol=1e-15)
     with pytest.raises(ValueError, match="spectral slopes need a periodic profile"):
         Spectral().slopes(z, 0.5, periodic=False)
+
+
+def test_line_end_undefined_leaves_the_ends_without_a_slope():
+    z = np.array([0.0, 1.0, 4.0, 9.0, 16.0])
+    np.testing.assert_array_equal(ForwardDifference(line_end="undefined").slopes(z, 0.5, periodic=False),
+                                  [2, 6, 10, 14, np.nan])  # fmt: skip
+    np.testing.assert_array_equal(CentralDifference(line_end="undefined").slopes(z, 0.5, periodic=False),
+                                  [np.nan, 4, 8, 12, np.nan])  # fmt: skip
+    # a periodic line has no end: the choice changes nothing there
+    for cls in (ForwardDifference, CentralDifference):
+        np.testing.assert_array_equal(cls(line_end="undefined").slopes(z, 0.5), cls().slopes(z, 0.5))
+        assert cls(line_end="undefined").undefined_points(False) and not cls(line_end="undefined").undefined_points(True)
+        assert not cls().undefined_points(False)
+    surface = np.add.outer(np.arange(4.0) * 3, np.arange(5.0))  # z = 3 y + x
+    slopes = ForwardDifference(line_end="undefined").slopes(surface, 1.0, periodic=False)
+    assert np.isnan(slopes[-1]).all() and np.isnan(slopes[:, -1]).all()
+    np.testing.assert_allclose(slopes[:-1, :-1], np.hypot(3.0, 1.0), rtol=1e-15)
+
+
+TOP_LAST = np.array([0.0, 1.0, 0.5, 2.0, 0.0, 2.5, 1.0, 3.0])  # dx = 1: the top is the last point
+
+
+def _hand_made_line_run(tmp_path, registry, line_end, loads):
+    np.save(tmp_path / "line.npy", TOP_LAST)
+    data = {
+        "name": "top-last", "realizations": 1,
+        "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "line.npy"), "spacing": 1.0,
+                                                        "detrend": "none"}},
+        "solver": {"name": "mdr"}, "slope": {"name": "forward-difference", "params": {"line_end": line_end}},
+        "loading": {"start": loads[0], "stop": loads[-1], "steps": len(loads), "spacing": "log"},
+        "fit": {"bootstrap": 0}, "output": {"plot": False},
+    }  # fmt: skip
+    return engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
+
+
+def test_a_line_whose_top_is_its_last_point_has_no_xi_until_another_point_touches(tmp_path, registry):
+    """E* = 1, dx = 1: the top (3.0) alone touches up to F = 0.5 (the next point, 2.5, is 0.5 lower);
+    at F = 0.8 the indentation is (0.8 + 0.5) / 2 = 0.65 < 1 (depth of the 2.0): the top and the 2.5 touch."""
+    slopes = np.diff(TOP_LAST)  # the forward slopes of the first 7 points
+    line_rms_defined = np.sqrt(np.mean(slopes**2))  # the last point has none
+    undefined = _hand_made_line_run(tmp_path, registry, "undefined", (0.25, 0.8))
+    np.testing.assert_array_equal(undefined.per_realization["contact_count"][0], [1, 2])
+    assert undefined.per_realization["slope_rms_line"][0] == pytest.approx(line_rms_defined, rel=1e-15)
+    xi = undefined.per_realization["xi"][0]
+    assert np.isnan(xi[0])  # only the last point in contact: no slope there
+    # at F = 0.8: the rms over the defined one, the 2.5 (slope 1.0 - 2.5 = -1.5)
+    assert xi[1] == pytest.approx(1.5 / line_rms_defined, rel=1e-15)
+    np.testing.assert_array_equal(undefined.lines_used, [0, 1])
+    assert np.isnan(undefined.xi[0]) and undefined.xi[1] == xi[1]
+    assert undefined.status == "failed" and "xi is defined at 1 of 2 load steps" in undefined.error
+    # today's convention: the top takes the last segment's slope (3.0 - 1.0 = 2)
+    segment = _hand_made_line_run(tmp_path, registry, "last-segment", (0.25, 0.8))
+    line_rms_segment = np.sqrt(np.mean(np.append(slopes, slopes[-1]) ** 2))
+    np.testing.assert_allclose(segment.per_realization["xi"][0],
+                               [2.0 / line_rms_segment, np.sqrt((4.0 + 1.5**2) / 2) / line_rms_segment], rtol=1e-15)  # fmt: skip
+    np.testing.assert_array_equal(segment.lines_used, [1, 1])
+
+
+def test_undefined_slopes_need_a_solver_that_takes_them(tmp_path, register_plugin):
+    np.save(tmp_path / "line.npy", TOP_LAST)
+    data = {
+        "name": "top-last", "realizations": 1,
+        "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "line.npy"), "spacing": 1.0}},
+        "solver": {"name": "mdr"}, "slope": {"name": "forward-difference", "params": {"line_end": "undefined"}},
+        "loading": {"start": 1.0, "stop": 2.0, "steps": 2},
+    }  # fmt: skip
+    from frictionlab_solvers import MDRSprings
+
+    class NoUndefined(MDRSprings):
+        name = "mdr-finite-only"
+        undefined_slopes = False
+
+    registry = register_plugin(NoUndefined)
+    data["solver"] = {"name": "mdr-finite-only"}
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    assert info.value.problems[0].startswith(
+        "slope.params: forward-difference leaves points of this non-periodic profile without a slope, which solver "
+        "mdr-finite-only cannot take: use solver mdr or mdr-bisection or winkler, or"
+    )
 
 
 RAMP = 0.1  # the scan's grade
@@ -264,20 +346,20 @@ def test_xi_on_a_surface_is_the_rms_gradient_over_contact_pixels_over_the_whole_
     """An exact half-space run on a 24 x 20 surface: the engine's xi at each load equals
     rms |grad z| (both components) over the pixels the solver put in contact, over rms
     |grad z| of every pixel, both formed here by loops."""
-    import frictionlab_solvers.bem as bem
+    import frictionlab_solvers.contact_cg as contact_cg
 
     from frictionlab.realization import compute_realization
     from frictionlab.seeds import realization_rng
 
     contact_sets = []
-    solve = bem.ConstrainedCG.solve
+    solve = contact_cg.ProjectedCG.solve
 
     def recording(self, pressure, **kwargs):
         answer = solve(self, pressure, **kwargs)
         contact_sets.append(answer[0] > 0.0)
         return answer
 
-    monkeypatch.setattr(bem.ConstrainedCG, "solve", recording)
+    monkeypatch.setattr(contact_cg.ProjectedCG, "solve", recording)
     data = {"name": "xi", "seed": 5, "realizations": 1,
             "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.7, "points": 24, "points_y": 20,
                                                             "spacing": 0.5, "short_cutoff": 2.0, "rms_height": 3.0}},

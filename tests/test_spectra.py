@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 from pydantic import ValidationError
 from scipy.integrate import quad
 
+from frictionlab import Profile
 from frictionlab.registry import validate_plugin_class
 from frictionlab_spectra import PowerLaw, ProfileFile, Rolloff
 
@@ -517,6 +518,95 @@ def test_cosine_series_has_the_covariance_of_q_k_pi_over_l(amplitudes):
     assert gen.rms_height() == pytest.approx(h, rel=1e-14)
 
 
+@pytest.mark.parametrize("series,hurst", [("cosine", 1.0), ("cosine", 0.5), ("fft", 0.8)])
+def test_measured_height_reference_makes_each_lines_own_rms_h(series, hurst):
+    """height_reference: measured: every line, brute force sum((z - mean z)^2) / N, has rms h about its
+    own mean and mean zero; it is the nominal line of the same seed shifted and scaled (so the same
+    shape, slopes in proportion); profile_rms_height is that rms. The nominal cosine lines scatter."""
+    h = 3.0
+    common = {"hurst": hurst, "points": 1000, "rms_height": h, "series": series}
+    measured, nominal = PowerLaw(**common, height_reference="measured"), PowerLaw(**common)
+    assert nominal.profile_rms_height(nominal.generate(np.random.default_rng(0))) is None
+    own = []
+    for seed in range(20):
+        z = measured.generate(np.random.default_rng(seed)).heights
+        mean = sum(float(v) for v in z) / z.size
+        rms = math.sqrt(sum((float(v) - mean) ** 2 for v in z) / z.size)
+        assert rms == pytest.approx(h, rel=1e-12) and abs(mean) < 1e-12 * h
+        assert measured.profile_rms_height(Profile(z, 1.0, False)) == pytest.approx(rms, rel=1e-12)
+        base = nominal.generate(np.random.default_rng(seed)).heights
+        own.append(np.std(base))
+        np.testing.assert_allclose(z, (base - base.mean()) * (h / np.std(base)), rtol=0, atol=1e-12 * h)
+    if series == "cosine":  # the nominal lines' own rms heights scatter about (and below) h
+        assert np.std(own) > 0.05 * h and np.mean(own) < h
+    else:  # a periodic fixed-amplitude line has rms h exactly: measured changes nothing but rounding
+        np.testing.assert_allclose(own, h, rtol=1e-12)
+
+
+def test_measured_h_forms_f_and_keeps_the_contact_scaling(tmp_path):
+    """Runs of the cosine series with h measured: f = F / (E* h L) with each line's own rms h; the
+    springs are linear, so a line scaled by s = h / rms touches at force F as the nominal line
+    (rms rms) does at F / s: the contact counts follow from the nominal run's lines by that law."""
+    from frictionlab import engine
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import build_scene
+    from frictionlab.seeds import realization_rng
+    from frictionlab_solvers import MDRSprings
+
+    h, loads = 2.0, np.geomspace(0.01, 3.0, 7)
+    data = {
+        "name": "measured", "seed": 5, "realizations": 6, "fit": {"bootstrap": 0}, "output": {"plot": False},
+        "spectrum": {"name": "power-law", "params": {"hurst": 1.0, "points": 2048, "rms_height": h,
+                                                     "series": "cosine", "height_reference": "measured"}},
+        "solver": {"name": "mdr"}, "loading": {"start": 0.01, "stop": 3.0, "steps": 7, "spacing": "log"},
+    }  # fmt: skip
+    scene = build_scene(data)
+    outcome = engine.run(scene, RunOptions(workers=1))
+    assert outcome.own_rms_height and outcome.rms_height == pytest.approx(h, rel=1e-12)
+    np.testing.assert_allclose(outcome.f, loads / (1.0 * h * 2048), rtol=1e-12)  # E* = 1, L = 2048
+    np.testing.assert_allclose(outcome.per_realization["measured_rms_height"], h, rtol=1e-12)
+    nominal = PowerLaw(**{**data["spectrum"]["params"], "height_reference": "nominal"})
+    for row, index in enumerate(outcome.indices):
+        line = nominal.generate(realization_rng(5, int(index)))
+        s = h / np.std(line.heights)
+        slopes = np.gradient(line.heights)  # any slopes: only the counts are compared
+        counts = MDRSprings().solve(line, loads / s, "force", slopes).contact_count
+        np.testing.assert_array_equal(outcome.per_realization["contact_count"][row], counts)
+
+
+@pytest.mark.parametrize("reference", ["nominal", "measured"])
+def test_the_summary_says_which_h_and_gives_the_lines_measured_rms(tmp_path, reference):
+    """summary.json: which h formed f, and the mean and spread of the lines' own rms heights,
+    against the lines regenerated from their seeds and measured by brute force."""
+    import json
+
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import build_scene
+    from frictionlab.runner import run_to_folder
+    from frictionlab.seeds import realization_rng
+
+    params = {"hurst": 1.0, "points": 1024, "rms_height": 2.0, "series": "cosine", "height_reference": reference}
+    data = {
+        "name": "heights", "seed": 9, "realizations": 8, "fit": {"bootstrap": 0}, "output": {"plot": False},
+        "spectrum": {"name": "power-law", "params": params}, "solver": {"name": "mdr"},
+        "loading": {"start": 0.1, "stop": 3.0, "steps": 4, "spacing": "log"},
+    }  # fmt: skip
+    run_to_folder(build_scene(data), tmp_path / "run", RunOptions(workers=1))
+    heights = json.loads((tmp_path / "run" / "summary.json").read_text())["heights"]
+    lines = [PowerLaw(**params).generate(realization_rng(9, i)).heights for i in range(8)]
+    rms = [math.sqrt(sum((float(v) - sum(map(float, z)) / z.size) ** 2 for v in z) / z.size) for z in lines]
+    assert heights["measured_rms_height"]["lines"] == 8
+    assert heights["measured_rms_height"]["mean"] == pytest.approx(np.mean(rms), rel=1e-12)
+    assert heights["measured_rms_height"]["std"] == pytest.approx(np.std(rms, ddof=1), rel=1e-6, abs=1e-12)
+    assert heights["h"] == pytest.approx(2.0, rel=1e-12)
+    if reference == "nominal":
+        assert heights["h_in_f"] == "the spectrum's nominal rms height"
+        assert heights["measured_rms_height"]["std"] > 0.05
+    else:
+        assert heights["h_in_f"] == "each line's own rms height about its mean"
+        assert heights["measured_rms_height"]["std"] < 1e-12
+
+
 def test_cosine_series_long_cutoff_is_twice_the_length():
     gen = PowerLaw(hurst=1.0, points=100, series="cosine")
     assert gen.band.long_cutoff == 200.0 and gen.band.k_lo == 1 and gen.band.period == 200.0
@@ -630,7 +720,9 @@ def test_profile_file_errors(tmp_path):
     assert "spacing=0.4" in message and "0.5" in message
 
     assert "3 columns" in _profile_error(path=_write(tmp_path, "wide.txt", "1 2 3\n" * 10))
-    assert "unknown file type" in _profile_error(path=_write(tmp_path, "p.dat", heights), spacing=1.0)
+    noise = tmp_path / "p.opd"
+    noise.write_bytes(bytes(range(256)) * 4)
+    assert "not an instrument file SurfaceTopography reads" in _profile_error(path=str(noise), spacing=1.0)
     path = tmp_path / "cube.npy"
     np.save(path, np.zeros((3, 4, 5)))
     assert "shape" in _profile_error(path=str(path), spacing=1.0)

@@ -198,8 +198,10 @@ def test_bad_maps_are_named_with_what_is_wrong(tmp_path):
     assert "constant" in surface_error(tmp_path / "plane.npy", detrend="plane")
     np.save(tmp_path / "small.npy", np.random.default_rng(1).standard_normal((7, 40)))
     assert "7 x 40" in surface_error(tmp_path / "small.npy") and "8 x 8" in surface_error(tmp_path / "small.npy")
-    (tmp_path / "map.dat").write_text("1 2\n3 4\n")
-    assert "unknown file type" in surface_error(tmp_path / "map.dat")
+    (tmp_path / "map.dat").write_text("1 2\n3 4\n")  # an instrument's text line scan (x, z)
+    assert "holds a line scan; use profile-file" in surface_error(tmp_path / "map.dat")
+    (tmp_path / "noise.sur").write_bytes(bytes(range(256)) * 4)
+    assert "not an instrument file SurfaceTopography reads" in surface_error(tmp_path / "noise.sur")
 
 
 def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys):

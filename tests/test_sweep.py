@@ -207,7 +207,7 @@ def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_
 
 
 @pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),
-                                        ('{"sweep": {}}', "no base_preset and sweep mappings")])  # fmt: skip
+                                        ('{"sweep": {}}', "is damaged: field 'sweep.parameters': field required; field 'base_preset': field required")])  # fmt: skip
 def test_resume_of_a_sweep_folder_whose_record_is_damaged_names_it(tmp_path, capsys, text, said):
     (tmp_path / "sweep.json").write_text(text)
     assert main(["resume", str(tmp_path)]) == 5

@@ -38,9 +38,11 @@ PAIRS = {
     "winkler": LINE_SPECTRA + (COSINE,) + SURFACE_SPECTRA,
     "bem-halfplane": LINE_SPECTRA,
     "bem-halfspace": SURFACE_SPECTRA,
+    "bem-halfspace-free": SURFACE_SPECTRA,
 }
 CASES = [(solver, spectrum) for solver, spectra in PAIRS.items() for spectrum in spectra]
-BEM = {"bem-halfplane", "bem-halfspace"}
+PERIODIC_BEM = {"bem-halfplane", "bem-halfspace"}
+BEM = PERIODIC_BEM | {"bem-halfspace-free"}
 
 LINE = {"hurst": 0.7, "points": 256, "rms_height": 0.2}
 SURFACE = {"hurst": 0.7, "points": 32, "rms_height": 0.2}
@@ -143,6 +145,7 @@ F_GRID = {  # dimensionless forces with partial contact for every spectrum of th
     "winkler": (0.002, 0.01, 0.05),
     "bem-halfplane": (0.005, 0.02, 0.08),
     "bem-halfspace": (0.005, 0.02, 0.08),
+    "bem-halfspace-free": (0.005, 0.02, 0.08),
 }
 
 
@@ -153,7 +156,7 @@ def run(preset: dict):
 
 def scene_pair(solver: str, spectrum: str, tmp_path, control: str):
     """(base outcome, scaled outcome, base scene, f asked for)."""
-    surface, periodic = spectrum in SURFACE_SPECTRA, solver in BEM
+    surface, periodic = spectrum in SURFACE_SPECTRA, solver in PERIODIC_BEM
     base = build_scene(_preset(spectrum_choice(spectrum, tmp_path, periodic=periodic), solver_choice(solver, surface)))
     unit = expected_force_unit(solver, base)
     f = np.array(F_GRID[solver])

@@ -4,6 +4,7 @@
   argument parser (what ``frictionlab COMMAND --help`` prints, as tables);
 - reference/presets.md: every section of a preset and every built-in plugin's
   parameters, from their pydantic models' JSON Schema;
+- reference/json.md: the shapes of ``--json`` output, from ``frictionlab.cli.jsonout``;
 - explanation/reproduction.md: REPRODUCTION.md as ``frictionlab report`` wrote it,
   its figure paths made relative to the page;
 - architecture.md: ARCHITECTURE.md, the layers of the code.
@@ -27,6 +28,7 @@ def on_files(files, config):
     pages = {
         "reference/cli.md": cli_reference(),
         "reference/presets.md": preset_reference(),
+        "reference/json.md": json_reference(),
         "explanation/reproduction.md": reproduction_page(),
         "architecture.md": (ROOT / "ARCHITECTURE.md").read_text(encoding="utf-8"),
     }
@@ -39,8 +41,10 @@ def on_files(files, config):
 
 
 def _cell(text) -> str:
-    """A Markdown table cell: one line, pipes escaped."""
-    return " ".join(str(text).split()).replace("|", "\\|")
+    """A Markdown table cell: one line, pipes escaped, and ``<name>`` shown as written (not
+    taken for an HTML tag, which the page would drop)."""
+    text = " ".join(str(text).split()).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return text.replace("|", "\\|")
 
 
 def _flag(action: argparse.Action) -> str:
@@ -115,6 +119,34 @@ def cli_reference() -> str:
             out += [f"### {name} {nested}", "", _cell(nested_parser.description or nested_help), ""]
             out += ["```text", nested_parser.format_usage().strip(), "```", ""]
             out += _actions_table(nested_parser) + [""]
+    return "\n".join(out)
+
+
+def json_reference() -> str:
+    from frictionlab.cli.jsonout import SHAPES, VERSION, shape
+
+    out = [
+        "# JSON output",
+        "",
+        "With `--json`, a command prints one JSON object on stdout and nothing else there (progress and",
+        "messages go to stderr). Its first key names its shape and version, for example",
+        f'`{{"schema": "{shape("run")}", ...}}`; the version (now {VERSION}) goes up when a key is removed or',
+        "changes meaning, and keys may be added within a version. A command refused or failed under",
+        "`--json` prints the `error` shape, with the process's exit code in it",
+        "(exit codes: [your data and exit codes](../data-safety.md)). `frictionlab schema` prints a JSON",
+        "Schema document for editors, not one of these.",
+        "",
+        "| schema | printed by | holds |",
+        "|---|---|---|",
+        *(f"| `{shape(name)}` | {_cell(commands)} | {holds} |" for name, (commands, holds) in SHAPES.items()),
+        "",
+        "For example, the fit's slope of a run, in a script:",
+        "",
+        "```bash",
+        "frictionlab run quickstart --quiet --json | python -c 'import json, sys; print(json.load(sys.stdin)[\"fit\"][\"b\"])'",
+        "```",
+        "",
+    ]
     return "\n".join(out)
 
 

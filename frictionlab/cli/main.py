@@ -3,14 +3,17 @@
 Conventions every command keeps (tested in tests/cli/test_conventions.py):
 
 * results go to stdout, progress and errors to stderr; ``--json`` puts the results as
-  JSON on stdout (run, validate, plugins, presets, study, report, predict);
+  one JSON object on stdout (run, validate, plugins, presets, study, report, predict),
+  an error too, each of a shape named in ``jsonout``;
 * a bare ``frictionlab`` prints a short help with examples; ``-V``/``--version`` the
   version; every ``COMMAND --help`` a description and examples;
-* a mistyped command, plugin or preset name is answered with the closest names;
+* a mistyped command, option, plugin, preset name or preset field is answered with the
+  closest names; an unknown option with its own command's usage;
 * tables fit the terminal (rich) and are plain aligned columns in a pipe; colour only
   on a terminal, never with ``NO_COLOR`` set; progress is a bar on a terminal and a
   line per tenth in a log, shown once a run passes 2 s, none with ``--quiet``;
-* ``frictionlab completion bash|zsh|fish`` prints a completion script;
+* ``frictionlab completion bash|zsh|fish`` prints a completion script made from the parser;
+* a missing optional package is said with the pip command that installs it;
 * exit codes are ``ExitCode``; a user error never prints a traceback (set
   ``FRICTIONLAB_DEBUG=1`` to see one for an internal error); SIGTERM ends a run as
   Ctrl-C does; a closed stdout ends the command quietly (141).
@@ -21,10 +24,11 @@ from __future__ import annotations
 import argparse
 import gc
 import os
+import re
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -61,6 +65,8 @@ class _Parser(argparse.ArgumentParser):
     failed write of its help through (argparse drops it), so that ``--help`` into a
     closed pipe ends as any other output does."""
 
+    refusal: tuple[str, str] | None = None  # (prog, message) of the last usage error
+
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
@@ -68,6 +74,33 @@ class _Parser(argparse.ArgumentParser):
     def _print_message(self, message, file=None):
         if message:
             (file or sys.stderr).write(message)
+
+    def error(self, message):
+        choice = re.search(r"invalid choice: '(.*)' \(choose from (.*)\)$", message)
+        if choice:  # argparse lists the choices; the closest goes first
+            from ..errors import did_you_mean
+
+            choices = [c.strip("'") for c in choice.group(2).split(", ")]  # quoted before Python 3.12.8, bare after
+            message += did_you_mean(choice.group(1), choices, 0.7)
+        _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
+        super().error(message)
+
+    def parse_known_args(self, args=None, namespace=None):
+        """Words no option takes are refused by the parser that met them, with its own
+        usage (``usage: frictionlab run ...``, not the top level's) and the closest options."""
+        namespace, extras = super().parse_known_args(args, namespace)
+        if extras:
+            self.error(unrecognized(extras, [o for a in self._actions for o in a.option_strings]))
+        return namespace, extras
+
+
+def unrecognized(words: list[str], options: list[str]) -> str:
+    """argparse's message for words it did not take, with the options closest to each."""
+    from ..errors import close_names
+
+    close = [name for word in words if word.startswith("-") for name in close_names(word.partition("=")[0], options, 0.7)]
+    hint = f"; did you mean {' or '.join(repr(name) for name in dict.fromkeys(close))}?" if close else ""
+    return f"unrecognized arguments: {' '.join(words)}{hint}"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -105,6 +138,18 @@ def _unknown_command(argv: list[str]) -> str | None:
     return f"frictionlab: no command {first!r}{hint or '.'} Commands: {', '.join(names)} (frictionlab --help)"
 
 
+def _missing_package(exc: Exception, purpose: str):
+    """A package that is not installed (an optional one reached without ``errors.require``,
+    or a dependency of a broken install) as the message with its pip command; None for
+    anything else, a module of frictionlab itself included (that is a bug)."""
+    from ..errors import MissingDependency
+
+    name = exc.name if isinstance(exc, ModuleNotFoundError) else None
+    if not name or name.partition(".")[0].startswith("frictionlab"):
+        return None
+    return MissingDependency(name, purpose)
+
+
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {message}\n"
 
@@ -139,18 +184,29 @@ def program() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     warnings.formatwarning = _plain_warning
+    escape_unencodable_output()  # a path that is not UTF-8 is printed escaped, never exit 70 after the work
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv:
         return _print(short_help())
     problem = _unknown_command(argv)
     if problem:
         print(problem, file=sys.stderr)
+        if "--json" in argv:
+            from .jsonout import emit_error
+
+            emit_error(None, problem.removeprefix("frictionlab: "), ExitCode.USAGE)
         return int(ExitCode.USAGE)
     parser = build_parser()
+    _Parser.refusal = None
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version or a usage error: argparse has printed it
         if exc.code not in (0, None):
+            refusal = _Parser.refusal
+            if "--json" in argv and refusal is not None:  # a script reading stdout gets the error as JSON too
+                from .jsonout import emit_error
+
+                emit_error(refusal[0].removeprefix("frictionlab").strip() or None, refusal[1], exc.code)
             raise
         return _print(None)  # a closed pipe under --help shows in this flush, as under any command
     except OSError as exc:  # the help could not be written: `| head -1` (a closed pipe), `> /dev/full`
@@ -191,28 +247,44 @@ def _run_command(args) -> int:
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
         return _write_failed(exc)
     except FrictionlabError as exc:
-        print(f"{error_label()}: {shown(str(exc))}", file=sys.stderr)
-        return int(exc.exit_code)
+        return _refused(args, shown(str(exc)), exc.exit_code, f"{error_label()}: ", getattr(exc, "problems", None))
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
-        print(f"error: {exc.strerror or exc}: {exc.filename}", file=sys.stderr)
-        return int(ExitCode.RUNTIME_FAILURE)
+        return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
-        print(f"error: out of memory{detail}; ask for fewer points, realizations or workers", file=sys.stderr)
-        return int(ExitCode.RUNTIME_FAILURE)
+        message = f"out of memory{detail}; ask for fewer points, realizations or workers"
+        return _refused(args, message, ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""
-        print(f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", file=sys.stderr)
-        return int(code)
+        return _refused(args, f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", code, "")
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
-        print(
-            f"internal error: {type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}\n"
-            "(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)",
-            file=sys.stderr,
-        )
-        return int(ExitCode.INTERNAL)
+        missing = _missing_package(exc, f"frictionlab {args.command}")
+        if missing is not None:
+            return _refused(args, str(missing), missing.exit_code, f"{error_label()}: ")
+        message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"
+        return _refused(args, message, ExitCode.INTERNAL, "internal error: ",
+                        suffix="\n(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)")  # fmt: skip
+
+
+def _refused(args, message: str, code: int, label: str = "error: ", problems=None, suffix: str = "") -> int:
+    """Say why the command stopped on stderr and, under ``--json``, as the error object
+    on stdout (``jsonout``); return the exit code."""
+    print(f"{label}{message}{suffix}", file=sys.stderr)
+    if getattr(args, "json", False):
+        from . import jsonout
+
+        try:
+            jsonout.emit_error(_command_path(args), message, int(code), problems)
+            sys.stdout.flush()
+        except OSError as exc:
+            _write_failed(exc)
+    return int(code)
+
+
+def _command_path(args) -> str:
+    return " ".join(filter(None, [args.command, getattr(args, "action", None)]))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 from ..errors import ExitCode
@@ -30,7 +29,9 @@ def run(args) -> ExitCode:
             for i in infos
         ]
         failures = [f.__dict__ for f in registry.failures]
-        print(json.dumps({"plugins": rows, "failed": failures}, indent=2))
+        from .jsonout import emit
+
+        emit("plugins", {"plugins": rows, "failed": failures})
         return ExitCode.OK
     from .console import print_table
 

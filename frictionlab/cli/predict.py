@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import json
-
 from ..errors import ExitCode, FrictionlabError
 
 
@@ -63,7 +61,9 @@ def run(args) -> ExitCode:
         out = {k: v for k, v in prediction.__dict__.items()}
         out.update(extrapolated=prediction.extrapolated, beyond_full_contact=prediction.beyond_full_contact,
                    a=law.a, b=law.b)  # fmt: skip
-        print(json.dumps({k: json_safe(v) for k, v in out.items()}, indent=2))
+        from .jsonout import emit
+
+        emit("predict", {k: json_safe(v) for k, v in out.items()})
     else:
         print(f"law: xi = {format_number(law.a)} + {format_number(law.b)} ln f")
         print(prediction_text(prediction))

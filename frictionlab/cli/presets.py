@@ -3,7 +3,6 @@ to take one out to edit (never over an existing file without ``--force``)."""
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
@@ -24,7 +23,7 @@ def add_parser(sub) -> None:
         "or copy it out to edit.",
         epilog=EXAMPLES,
     )
-    p.add_argument("--json", action="store_true", help="as JSON: name, description, path")
+    p.add_argument("--json", action="store_true", help="as JSON: name, whole description, path")
     actions = p.add_subparsers(dest="action", metavar="ACTION")
     c = actions.add_parser(
         "copy",
@@ -53,9 +52,11 @@ def run(args) -> ExitCode:
             dest.mkdir(parents=True)
         return copy_preset(args.name, dest, force=args.force)
     presets = builtin_presets()
-    if args.json:
-        rows = [{"name": p.name, "description": p.description, "path": str(p.path)} for p in presets]
-        print(json.dumps(rows, indent=2))
+    if args.json:  # the whole description (the table shows its first sentence)
+        from .jsonout import emit
+
+        emit("presets", {"presets": [{"name": p.name, "description": p.full_description, "path": str(p.path)}
+                                     for p in presets]})  # fmt: skip
         return ExitCode.OK
     from .console import print_table
 
@@ -64,6 +65,7 @@ def run(args) -> ExitCode:
 
 
 def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
+    from ..files import atomic_write
     from ..preset.builtin import builtin_presets, find_builtin
 
     preset = find_builtin(name)
@@ -71,9 +73,13 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
     target = dest / preset.path.name if dest.is_dir() else dest
+    data = preset.path.read_bytes()
     try:
-        with open(target, "wb" if force else "xb") as out:  # "x": never over a file that appeared meanwhile
-            out.write(preset.path.read_bytes())
+        if force:  # replaced, never written through a link
+            atomic_write(target, lambda out: out.write(data), binary=True, devices=True)
+        else:
+            with open(target, "xb") as out:  # "x": never over a file (or a link) that appeared meanwhile
+                out.write(data)
     except FileExistsError:
         raise OutputRefused(f"{target} exists; give another DEST or --force to replace it") from None
     print(f"copied {preset.name} to {target}")

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import sys
 
-from ..errors import ExitCode
+from ..errors import ExitCode, FrictionlabError
 from .options import add_workers_option, run_options
+
+MAX_REPLICATES = 100  # each is a full run of every reading
 
 
 def add_parser(sub) -> None:
@@ -26,6 +27,9 @@ def add_parser(sub) -> None:
     p.add_argument("--force", action="store_true", help="overwrite an existing report, its figures and runs")
     add_workers_option(p, "all cores")
     p.add_argument("--readings", action="store_true", help="also run the readings of the paper's method (slower)")
+    p.add_argument("--replicates", type=int, default=1, metavar="K",
+                   help="with --readings: run each reading on K independent ensembles (the preset's seed, then seeds "
+                   "from one SeedSequence) and report the spread of a and b between them (default 1)")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument("--json", action="store_true", help="print where the report and its figures are, as JSON")
     p.set_defaults(handler=run)
@@ -34,16 +38,22 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..paper.reproduce import write_report
 
+    if not 1 <= args.replicates <= MAX_REPLICATES:
+        raise FrictionlabError(f"--replicates must be a whole number from 1 to {MAX_REPLICATES}. Got {args.replicates} instead.")
+    if args.replicates != 1 and not args.readings:
+        raise FrictionlabError(f"--replicates {args.replicates} needs --readings: only the readings run on several ensembles")
     path = write_report(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
-        options=run_options(workers=args.workers, force=args.force), readings=args.readings,
+        options=run_options(workers=args.workers, force=args.force), readings=args.readings, replicates=args.replicates,
         log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
         quiet=args.quiet,
     )  # fmt: skip
     if args.json:  # the figures the report shows, as its image links name them
         images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", path.read_text(encoding="utf-8"))
         figures = list(dict.fromkeys(os.path.normpath(path.parent / image) for image in images))
-        print(json.dumps({"report": str(path), "figures": figures}, indent=2))
+        from .jsonout import emit
+
+        emit("report", {"report": str(path), "figures": figures})
     else:
         print(path)
     return ExitCode.OK

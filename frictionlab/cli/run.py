@@ -126,8 +126,9 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
         raise closed[0]
     outcome = result.outcome
     if args.json:
-        summary = summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()})
-        print(json.dumps(summary, indent=2, allow_nan=False))
+        from .jsonout import emit
+
+        emit("run", summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()}))
     if outcome.status in ("interrupted", "cancelled"):
         return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
@@ -151,7 +152,9 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
         print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
-        print((out_dir / "sweep.json").read_text(encoding="utf-8"))
+        from .jsonout import emit
+
+        emit("sweep", json.loads((out_dir / "sweep.json").read_text(encoding="utf-8")))
     else:
         print(sweep_table(sweep, outcome, out_dir))
     if outcome.status == "interrupted":

@@ -32,7 +32,7 @@ def run(args) -> ExitCode:
     if out is not None:
         from ..files import atomic_write
 
-        atomic_write(out, lambda fh: fh.write(text + "\n"))
+        atomic_write(out, lambda fh: fh.write(text + "\n"), devices=True)
     else:
         print(text)
     return ExitCode.OK

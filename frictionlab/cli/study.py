@@ -187,8 +187,6 @@ def run(args) -> ExitCode:
         print(f"error: cannot write the study to {shown(out_dir)}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
-        import json
-
         from ..fit import json_safe
         from ..tradeoff.axes import COLUMNS
 
@@ -196,8 +194,10 @@ def run(args) -> ExitCode:
             return json_safe(float(value)) if isinstance(value, float) else value
 
         rows = [{c: cell(getattr(row, c)) for c in COLUMNS} for row in study.rows]
-        print(json.dumps({"recommendation": text, "rows": rows, "files": {k: str(p) for k, p in files.items()},
-                          "interrupted": interrupted}, indent=2))  # fmt: skip
+        from .jsonout import emit
+
+        emit("study", {"recommendation": text, "rows": rows, "files": {k: str(p) for k, p in files.items()},
+                       "interrupted": interrupted})  # fmt: skip
     else:
         print(text)
         print(f"  {', '.join(p.name for p in files.values())} in {shown(out_dir)}/")

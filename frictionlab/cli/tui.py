@@ -3,7 +3,9 @@ lazily: headless commands never import Textual."""
 
 from __future__ import annotations
 
-from ..errors import ExitCode
+import os
+
+from ..errors import ExitCode, FrictionlabError
 from .options import add_workers_option, run_options
 
 
@@ -21,7 +23,19 @@ def add_parser(sub) -> None:
     p.set_defaults(handler=run)
 
 
+# Textual draws by cursor addressing, which these terminals lack; it has no line mode to
+# fall back to. Without colour (NO_COLOR set) it draws in monochrome.
+TERMINALS_WITHOUT_CURSOR = ("dumb",)
+
+
 def run(args) -> ExitCode:
+    term = os.environ.get("TERM", "")
+    if term in TERMINALS_WITHOUT_CURSOR:
+        raise FrictionlabError(
+            f"frictionlab tui draws a full screen, and TERM={term} says this terminal cannot move its cursor: "
+            "run it in a terminal emulator (TERM=xterm-256color, ...), or run presets headless: frictionlab run "
+            "PRESET (NO_COLOR=1 draws the TUI without colour)"
+        )
     if args.preset is not None:
         from ..preset import load_preset_file
         from ..preset.builtin import resolve_preset_path

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 
 from ..errors import ExitCode, FrictionlabError, counted, shown
@@ -22,6 +21,8 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
+    from ..api import scene_record
+    from ..inputs import describe_input
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..sweep import plan_sweep
@@ -44,11 +45,7 @@ def run(args) -> ExitCode:
                 print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
-        record = {
-            "preset": str(path), "ok": True, "problems": [], "name": preset.name, "realizations": preset.realizations,
-            "spectrum": scene.spectrum.name, "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
-            "steps": preset.loading.steps, "control": preset.loading.control, "sweep_points": points,
-        }  # fmt: skip
+        record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         records.append(record)
         if not args.json:
             print(
@@ -56,6 +53,10 @@ def run(args) -> ExitCode:
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {counted(points, 'point')})" if points is not None else ")")
             )
+            if record["input"] is not None:
+                print(f"  read {describe_input(record['input'])}")
     if args.json:
-        print(json.dumps(records, indent=2))
+        from .jsonout import emit
+
+        emit("validate", {"ok": all(record["ok"] for record in records), "presets": records})
     return worst

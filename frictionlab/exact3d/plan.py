@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
 import time
 from collections.abc import Callable
@@ -20,12 +19,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..ensemble import RunOutcome
-from ..errors import FrictionlabError, OutputRefused
+from ..errors import FrictionlabError, OutputRefused, RunFolderError
 from ..files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, read_preset
 from ..registry import Registry, default_registry
 from ..rundir import STATE_FILE
+from ..runfolder import read_json
 from ..runner import run_to_folder
 from ..seeds import realization_rng
 from ..signals import WorkInterrupted, interrupted_since, mark
@@ -184,6 +184,7 @@ def run_plan(
 
 
 TIME_FILE = "exact3d-time.json"
+TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
 ENSEMBLE_FOLDER = re.compile(r"h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # the folder of one ensemble, as run_plan names it
 
 
@@ -212,12 +213,10 @@ def check_runs_folder(runs_dir: Path, *, force: bool, own: tuple[str, ...] = ())
 def _is_time_file(path: Path) -> bool:
     """Whether ``path`` is a TIME_FILE this study wrote: {"plan": ..., "seconds": ...}."""
     try:
-        if not path.is_file() or path.is_symlink() or os.path.getsize(path) > 4096:
-            return False
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        data = read_json(path.parent, path.name, TIME_FILE_BYTES)
+    except RunFolderError:  # a link, a FIFO, too large, not a JSON object
         return False
-    return isinstance(data, dict) and set(data) == {"plan", "seconds"}
+    return set(data) == {"plan", "seconds"}
 
 
 def _add_time(runs_dir: Path, plan: Plan, seconds: float) -> float:
@@ -225,10 +224,12 @@ def _add_time(runs_dir: Path, plan: Plan, seconds: float) -> float:
     resumed or regenerated study adds its own), kept in ``TIME_FILE``."""
     path = runs_dir / TIME_FILE
     try:
-        earlier = json.loads(path.read_text())
-        total = float(earlier["seconds"]) if earlier.get("plan") == plan.name else 0.0
-    except (OSError, ValueError, KeyError, TypeError):
-        total = 0.0
+        earlier = read_json(runs_dir, TIME_FILE, TIME_FILE_BYTES)
+    except RunFolderError:  # none yet, or not one this study wrote: started afresh
+        earlier = {}
+    seconds_before = earlier.get("seconds")
+    usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
+    total = float(seconds_before) if usable and math.isfinite(seconds_before) and earlier.get("plan") == plan.name else 0.0
     total += seconds
     atomic_write(path, lambda fh: json.dump({"plan": plan.name, "seconds": total}, fh))
     return total

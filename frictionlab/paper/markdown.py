@@ -181,6 +181,8 @@ def fig5_calibrated_markdown(run: FigureRun, rows: list[ReadingRow], image: str,
 
 def readings_markdown(rows: list[ReadingRow]) -> list[str]:
     by_figure = {s.key: s for s in FIGURES}
+    k = max((len(r.replicates) for r in rows), default=1)
+    spread = k > 1
     lines = [
         "",
         "## Readings of the paper's method",
@@ -192,19 +194,32 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         " `python -m frictionlab.paper.calibration`, applied to the reading's own lines. Averages: "
         + "; ".join(f"`{k}`: {v}" for k, v in AVERAGES.items())
         + ". Rerun a row: `frictionlab run presets/<figure preset> --set ...` with the options shown"
-        " (averaging rows re-average the default run's `realizations.npz`). † marks a paper value outside the interval.",
+        " (averaging rows re-average the default run's `realizations.npz`). † marks a paper value outside the interval."
+        + (f" Each reading ran on {k} independent ensembles (`--replicates {k}`): the preset's seed, whose fit and"
+           " 95% bootstrap interval the a and b columns show, then seeds drawn from one SeedSequence"
+           " (`--set seed=...` reruns one; h, where calibrated, is calibrated once on the preset's seed)."
+           " \"between ensembles\" gives the mean ± standard deviation of a and b over the"
+           f" {k}; \"paper inside\" in how many of the {k} the paper's a and b both lie inside that ensemble's"
+           " bootstrap intervals. The closest reading of a figure (below the table) is the one whose ensembles"
+           " hold the paper's pair most often; between equals, the one whose mean a and b lie nearest the"
+           " paper's in standard deviations between ensembles." if spread else ""),
         "",
-        "| figure | reading | --set | average | a (95% CI) | b (95% CI) | R² | points in contact |",
-        "|---|---|---|---|---|---|---|---|",
+        "| figure | reading | --set | average | a (95% CI) | b (95% CI) | R² | points in contact |"
+        + (" a, b between ensembles | paper inside |" if spread else ""),
+        "|---|---|---|---|---|---|---|---|" + ("---|---|" if spread else ""),
     ]
     for r in rows:
         s = by_figure[r.reading.figure]
         sets = " ".join(f"`{o}`" for o in r.overrides) or "(none)"
         counts = f"{r.counts[0]:.2f} at F = {r.loads[0]:g}, {r.counts[1]:.2f} at F = {r.loads[1]:g}"
-        lines.append(
+        line = (
             f"| {s.key[-1]} | {r.reading.name} | {sets} | {r.reading.average} | {format_estimate(r.fit.a, r.fit.a_ci)}"
             f"{_inside(s.a, r.fit.a_ci)} | {format_estimate(r.fit.b, r.fit.b_ci)}{_inside(s.b, r.fit.b_ci)} | {r.fit.r2:.3f} | {counts} |"
         )
+        if spread:
+            (a, a_sd), (b, b_sd) = r.spread()
+            line += f" {a:.3f} ± {a_sd:.3f}, {b:.4f} ± {b_sd:.4f} | {r.holding(s.a, s.b)} of {len(r.replicates)} |"
+        lines.append(line)
     lines += ["", "Paper: " + "; ".join(
         f"Fig. {s.key[-1]}: a = {s.a}, b = {s.b}"
         + (" (counts " + ", ".join(f"{n:g} at F = {F:g}" for F, n in s.counts.items()) + ")" if s.counts else "")
@@ -214,5 +229,42 @@ def readings_markdown(rows: list[ReadingRow]) -> list[str]:
         for r in rows
         if _inside(by_figure[r.reading.figure].a, r.fit.a_ci) == "" and _inside(by_figure[r.reading.figure].b, r.fit.b_ci) == ""
     ]
-    lines += ["", "Readings whose intervals hold both of the paper's a and b: " + (", ".join(hits) if hits else "none") + "."]
+    lines += ["", "Readings whose intervals hold both of the paper's a and b"
+              + (" (the preset's seed)" if spread else "") + ": " + (", ".join(hits) if hits else "none") + "."]
+    if spread:
+        lines += ["", *closest_readings(rows)]
     return lines
+
+
+def closest_readings(rows: list[ReadingRow]) -> list[str]:
+    """Per figure, the reading whose ensembles most often hold the paper's pair (ties: the one
+    whose mean a and b lie nearest the paper's, in standard deviations between ensembles), and
+    the range of the last load's contact count where the paper states one."""
+    out = []
+    for figure in FIGURES:
+        mine = [r for r in rows if r.reading.figure == figure.key and r.replicates]
+        if not mine or figure.a is None:
+            continue
+
+        def distance(r: ReadingRow) -> float:
+            (a, a_sd), (b, b_sd) = r.spread()
+            return math.hypot((a - figure.a) / a_sd, (b - figure.b) / b_sd) if a_sd > 0 and b_sd > 0 else math.inf
+
+        best = max(mine, key=lambda r: (r.holding(figure.a, figure.b), -distance(r)))
+        (a, a_sd), (b, b_sd) = best.spread()
+        text = (f"**{figure.title}**: closest reading: {best.reading.name} (`{'` `'.join(best.overrides) or 'no --set'}`,"
+                f" average {best.reading.average}): the paper's a = {figure.a} and b = {figure.b} lie inside both"
+                f" intervals in {best.holding(figure.a, figure.b)} of {len(best.replicates)} ensembles;"
+                f" between ensembles a = {a:.3f} ± {a_sd:.3f}, b = {b:.4f} ± {b_sd:.4f}.")  # fmt: skip
+        holding = [r for r in mine if r.holding(figure.a, figure.b)]
+        text += (f" Readings holding the pair in at least one ensemble: {len(holding)} of {len(mine)}"
+                 + (" (" + "; ".join(f"{r.reading.name}: {r.holding(figure.a, figure.b)}" for r in holding) + ")" if holding else "")
+                 + ".")  # fmt: skip
+        last = max(figure.counts, default=None)
+        if last is not None and last > 1.0:
+            counts = [c for r in mine for c in r.last_counts if r.loads[1] == last]
+            if counts:
+                text += (f" Points in contact at F = {last:g} over every ensemble of every reading: {min(counts):.1f}"
+                         f" to {max(counts):.1f}; the paper: about {figure.counts[last]:g}.")  # fmt: skip
+        out += [text, ""]
+    return out[:-1]

@@ -19,6 +19,7 @@ The interval of xi comes, in order of preference, from
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import sys
@@ -30,10 +31,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
-from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval
+from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval, resample_pairs
 from ..inputs import InputFileProblem, open_regular_file
 from ..plugin import ForceNormalisation, mdr_length
-from ..rundir import read_json_object
+from ..results import read_summary
+from ..runfolder import read_member
 from ..seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
@@ -176,9 +178,9 @@ def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
 
 # ------------------------------------------------------------------ a run folder's law
 
-MAX_SUMMARY_BYTES = 64 * 1024 * 1024  # a summary.json is a few kB; a huge one is not a run's
-_NUMBER_FIELDS = ("a_se", "b_se", "r2", "residual_rms")  # optional: null when unknown
-_COUNT_FIELDS = ("bootstrap", "points")
+
+
+MAX_REALIZATIONS_BYTES = 16 * 1024**3  # realizations.npz: curves of every realization
 
 
 def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
@@ -220,68 +222,25 @@ def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
 def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.ndarray | None:
     if not law.bootstrap or xi.shape[0] < 2:
         return None
-    return bootstrap_coefficients(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
+    return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
 
 
 def _read_summary(run_dir: Path) -> dict:
-    path = run_dir / "summary.json"
-    try:
-        return read_json_object(path, MAX_SUMMARY_BYTES, "summary.json")
-    except InputFileProblem as exc:
-        raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({exc})") from None
+    """summary.json of ``--from``, each value checked (``results.read_summary``)."""
+    if not run_dir.is_dir():
+        raise RunFolderError(f"--from {run_dir}: no readable summary.json there (no such folder)")
+    return read_summary(run_dir)[0]
 
 
 def _fit_of(summary: dict, path: Path) -> LogFit:
-    """summary.json's ``fit``, each field checked for its type (the JSON's value is named
-    in the message), then as a law (``check_law``)."""
-    fit = summary.get("fit")
-    if fit is None:
-        raise RunFolderError(f"{path}: the run has no fit (status {short_repr(summary.get('status'))})")
-    if not isinstance(fit, dict):
-        raise RunFolderError(
-            f"{path}: field 'fit' must be a mapping of the law's numbers. Got {short_repr(fit)} instead."
-        )
-
-    def refuse(field: str, allowed: str):
-        value = short_repr(fit.get(field))
-        return RunFolderError(f"{path}: field 'fit.{field}' must be {allowed}. Got {value} instead.")
-
-    def is_number(value) -> bool:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            return False
-        try:
-            float(value)
-        except OverflowError:  # an int past double precision
-            return False
-        return True
-
-    for field in ("a", "b"):
-        if not is_number(fit.get(field)):
-            raise refuse(field, "a finite number")
-    for field in _NUMBER_FIELDS:
-        if fit.get(field) is not None and not is_number(fit[field]):
-            raise refuse(field, "a number or null")
-    if "confidence" in fit and not is_number(fit["confidence"]):
-        raise refuse("confidence", "a number between 0 and 1 (exclusive)")
-    for field in ("a_ci", "b_ci"):
-        value = fit.get(field)
-        if value is not None and not (
-            isinstance(value, list) and len(value) == 2 and all(v is None or is_number(v) for v in value)
-        ):
-            raise refuse(field, "null or [LO, HI], two numbers (or two nulls)")
-    for field in _COUNT_FIELDS:
-        value = fit.get(field)
-        if value is not None and not (isinstance(value, int) and not isinstance(value, bool) and value >= 0):
-            raise refuse(field, "a whole number >= 0")
-    law = LogFit.from_dict(fit)
+    """summary.json's ``fit`` (its types checked by the schema) checked as a law (``check_law``)."""
+    if summary.get("fit") is None:
+        raise RunFolderError(f"{path}: the run has no fit (status {summary.get('status')})")
+    law = LogFit.from_dict(summary["fit"])
     names = {field: f"{path}: field 'fit.{field}'" for field in ("a", "b", "a_ci", "b_ci", "confidence")}
     check_law(law, names, RunFolderError)
-    if law.bootstrap:
-        seed = summary.get("seed")
-        if not (isinstance(seed, int) and not isinstance(seed, bool) and seed >= 0):
-            raise RunFolderError(
-                f"{path}: field 'seed' must be a whole number >= 0 (the bootstrap's). Got {short_repr(seed)} instead."
-            )
+    if law.bootstrap and summary.get("seed") is None:
+        raise RunFolderError(f"{path}: field 'seed' must be a whole number >= 0 (the bootstrap's), not null")
     return law
 
 
@@ -290,17 +249,14 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
     if not os.path.lexists(path):
         return None
     try:
-        with open_regular_file(path, "realizations.npz") as fh:
-            if fh.read(2) != b"PK":  # every zip, so every .npz, starts so
-                raise RunFolderError(f"{path} is damaged (not an .npz archive: it does not start as a zip file does)")
-            fh.seek(0)
-            with np.load(fh, allow_pickle=False) as data:
-                missing = [name for name in ("xi", "f") if name not in data.files]
-                if missing:
-                    raise RunFolderError(
-                        f"{path} is damaged (no array {missing[0]!r} in it; it holds {short_repr(data.files)})"
-                    )
-                xi, f = data["xi"], data["f"]
+        raw = read_member(path.parent, path.name, MAX_REALIZATIONS_BYTES, "realizations.npz")
+        if raw[:2] != b"PK":  # every zip, so every .npz, starts so
+            raise RunFolderError(f"{path} is damaged (not an .npz archive: it does not start as a zip file does)")
+        with np.load(io.BytesIO(raw), allow_pickle=False) as data:
+            missing = [name for name in ("xi", "f") if name not in data.files]
+            if missing:
+                raise RunFolderError(f"{path} is damaged (no array {missing[0]!r} in it)")
+            xi, f = data["xi"], data["f"]
     except InputFileProblem as exc:
         raise RunFolderError(f"{path}: {exc}") from None
     except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:  # cut short, pickled, bad header
@@ -321,9 +277,10 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         raise RunFolderError(f"{path}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
     if not np.all(np.isfinite(f) & (f > 0)):
         raise RunFolderError(f"{path}: array 'f' must hold finite numbers > 0 (some are not)")
-    if not np.all(np.isfinite(xi)):
-        bad = np.count_nonzero(~np.isfinite(xi))
-        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers ({bad} of {xi.size} are not)")
+    if np.isinf(xi).any() or np.isnan(xi).all(axis=0).sum() > f.size - 2:  # NaN: a line with no xi at that load
+        bad = np.count_nonzero(np.isinf(xi))
+        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
+                             f"defined at two loads or more ({bad} of {xi.size} are infinite)")  # fmt: skip
     counts = summary.get("realizations")
     done = counts.get("done") if isinstance(counts, dict) else None
     if isinstance(done, int) and not isinstance(done, bool) and done != xi.shape[0]:

@@ -8,7 +8,7 @@ except the averaging readings, which re-average the default run's
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +20,7 @@ from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
 from ..runner import run_to_folder
 from ..signals import interrupted_since, mark
-from ..seeds import bootstrap_rng
+from ..seeds import bootstrap_rng, replicate_seeds
 from .calibration import calibrated_rms_height
 from .figures import FigureRun
 
@@ -73,6 +73,28 @@ class Reading:
 LITERAL = "eq. 6 literally: cosine series q_k = k pi / L, k = 1 .. N/10, not periodic, h calibrated to the counts"
 LITERAL_SETS = ("spectrum.params.series=cosine", "spectrum.params.short_cutoff=20.0")  # q_max = pi / (10 dx), dx = 1
 
+# The study's h (its eq. 8: the rms of the line's own heights about their mean) and its slope read literally
+# (forward differences "only for points in contact": the last point of a line that does not repeat has none)
+MEASURED_H = "spectrum.params.height_reference=measured"
+LAST_POINT_UNDEFINED = "slope.params.line_end=undefined"
+
+
+def literal_readings(figure: str, suffix: str = "") -> tuple[Reading, ...]:
+    """Eq. 6 read literally, crossed with h nominal or measured per line and the last point's slope
+    (the last segment's, or none), at h = 1e4 and calibrated: the calibrated nominal one with the
+    last segment's slope is ``LITERAL`` itself, listed with the older readings."""
+    readings = []
+    for h_sets, h_name in (((), "h nominal"), ((MEASURED_H,), "h measured per line")):
+        for end_sets, end_name in (((), "last point: last segment's slope"), ((LAST_POINT_UNDEFINED,), "last point: no slope")):
+            for calibrate in (False, True):
+                if calibrate and not h_sets and not end_sets:
+                    continue
+                h_value = "h calibrated to the counts" if calibrate else "h = 1e4"
+                readings.append(Reading(figure, f"eq. 6 literally, {h_name}, {end_name}, {h_value}{suffix}",
+                                        (*LITERAL_SETS, *h_sets, *end_sets), calibrate=calibrate))  # fmt: skip
+    return tuple(readings)
+
+
 READINGS = (
     Reading("fig2", "defaults (the preset)"),
     Reading("fig2", "no short cut-off (lambda_s = 2 dx), h = 1e4", ("spectrum.params.short_cutoff=2.0",)),
@@ -86,11 +108,13 @@ READINGS = (
     Reading("fig2", "average: pooled contact points", average="pooled"),
     Reading("fig2", "average: rms of xi", average="rms"),
     Reading("fig2", LITERAL, LITERAL_SETS, calibrate=True),
+    *literal_readings("fig2"),
     Reading("fig3", "defaults (the preset)"),
     Reading("fig3", "no short cut-off, h calibrated to the counts", ("spectrum.params.short_cutoff=2.0",), calibrate=True),
     Reading("fig3", "Rayleigh amplitudes", ("spectrum.params.amplitudes=rayleigh",)),
     Reading("fig3", "average: pooled contact points", average="pooled"),
     Reading("fig3", LITERAL, LITERAL_SETS, calibrate=True),
+    *literal_readings("fig3"),
     Reading("fig4", "same h as Fig. 2 (the preset)"),
     Reading("fig4", "same C0 as Fig. 2", same_c0_as="fig2"),
     Reading("fig4", "h calibrated to Fig. 2's counts at H = 0.5", calibrate=True),
@@ -99,6 +123,7 @@ READINGS = (
             calibrate=True),
     Reading("fig4", "average: pooled contact points", average="pooled"),
     Reading("fig4", LITERAL + " at H = 0.5", LITERAL_SETS, calibrate=True),
+    *literal_readings("fig4", " at H = 0.5"),
 )  # fmt: skip
 
 
@@ -111,7 +136,8 @@ def fig5_calibrated_readings(sweep) -> tuple[Reading, ...]:
 
 @dataclass
 class ReadingRow:
-    """What one reading gave: its fit of the averaged curve, contact counts at the first and last load."""
+    """What one reading gave: its fit of the averaged curve, contact counts at the first and last load;
+    with replicates, the fit of each of K independent ensembles (the first is ``fit``, the preset's seed)."""
 
     reading: Reading
     overrides: list[str]
@@ -120,6 +146,20 @@ class ReadingRow:
     loads: tuple[float, float]
     folder: Path | None
     rms_height: float | None = None  # the calibrated h, when the reading calibrates
+    replicates: list[LogFit] = field(default_factory=list)  # one fit per ensemble, the first being ``fit``
+    seeds: list[int] = field(default_factory=list)  # their root seeds
+    last_counts: list[float] = field(default_factory=list)  # mean points in contact at the last load, per ensemble
+
+    def spread(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """((mean, standard deviation) of a, the same of b) between the ensembles (sd NaN for one)."""
+        a = np.array([fit.a for fit in self.replicates])
+        b = np.array([fit.b for fit in self.replicates])
+        sd = (lambda v: float(np.std(v, ddof=1)) if v.size >= 2 else float("nan"))  # noqa: E731
+        return (float(a.mean()), sd(a)), (float(b.mean()), sd(b))
+
+    def holding(self, a: float, b: float) -> int:
+        """In how many ensembles both ``a`` and ``b`` lie inside the bootstrap intervals."""
+        return sum(fit.a_ci[0] <= a <= fit.a_ci[1] and fit.b_ci[0] <= b <= fit.b_ci[1] for fit in self.replicates)
 
     def hurst(self) -> float:
         """H of a Fig. 5 reading, from its ``--set`` options."""
@@ -128,11 +168,32 @@ class ReadingRow:
 
 
 def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = RunOptions(), *, readings=READINGS,
-                 folder_name="readings", progress: bool = False) -> list[ReadingRow]:  # fmt: skip
+                 folder_name="readings", progress: bool = False, replicates: int = 1) -> list[ReadingRow]:  # fmt: skip
+    """Run each reading (calibrating h first where it says so) on ``replicates`` independent
+    ensembles: the preset's seed, then seeds from one ``SeedSequence`` (``seeds.replicate_seeds``).
+    h is calibrated once per reading, on the preset's seed, and kept for every ensemble."""
     from ..progress import ProgressReporter
 
     by_key = {run.figure.key: run for run in runs}
     listeners = (lambda: [ProgressReporter()]) if progress else list
+    ensembles = {}  # (figure, --set options, seed) -> (scene, outcome): the averaging readings share them
+    calibrated = {}  # (figure, --set options but the slopes') -> calibrated h
+
+    def ensemble(base: FigureRun, data: dict, overrides: list[str], seed: int | None, folder: Path):
+        """The reading's ensemble of root ``seed`` (None: the preset's own)."""
+        if not overrides and seed is None:  # the figure's own run
+            return base.scene, base.outcome
+        key = (base.figure.key, tuple(overrides), seed)
+        if key not in ensembles:
+            seeded = overrides + ([] if seed is None else [f"seed={seed}"])
+            scene = build_scene(apply_overrides(data, [*seeded, "output.plot=false"]), source=str(base.preset_path))
+            seen = mark()
+            outcome, _ = run_to_folder(scene, folder, options, listeners=listeners())
+            if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
+                raise KeyboardInterrupt  # the report stops: what finished is kept
+            ensembles[key] = scene, outcome
+        return ensembles[key]
+
     rows = []
     for number, reading in enumerate(readings, start=1):
         if progress:
@@ -144,22 +205,26 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
             c0 = by_key[reading.same_c0_as].scene.spectrum.c0()
             overrides += ["spectrum.params.rms_height=null", f"spectrum.params.c0={float(f'{c0:.6g}')!r}"]
         h = None
-        if reading.calibrate:
-            h = calibrated_rms_height(apply_overrides(data, overrides), options=options, listeners=listeners())
+        if reading.calibrate:  # the counts do not depend on the slopes: one calibration serves every estimator
+            lines = (reading.figure, *(o for o in overrides if not o.startswith("slope.")))
+            if lines not in calibrated:
+                calibrated[lines] = calibrated_rms_height(apply_overrides(data, overrides), options=options,
+                                                          listeners=listeners())  # fmt: skip
+            h = calibrated[lines]
             overrides.append(f"spectrum.params.rms_height={h!r}")
-        if not overrides:  # the figure's own run, maybe re-averaged
-            scene, outcome, folder = base.scene, base.outcome, base.folder
-        else:
-            scene = build_scene(apply_overrides(data, [*overrides, "output.plot=false"]), source=str(base.preset_path))
-            folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
-            seen = mark()
-            outcome, _ = run_to_folder(scene, folder, options, listeners=listeners())
-            if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
-                raise KeyboardInterrupt  # the report stops: what finished is kept
-        settings = scene.preset.fit
-        fit = refit(outcome.f, outcome.per_realization, reading.average,
-                    bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed)  # fmt: skip
-        counts = (float(outcome.contact_count[0]), float(outcome.contact_count[-1]))
-        loads = (float(outcome.loads[0]), float(outcome.loads[-1]))
-        rows.append(ReadingRow(reading, overrides, fit, counts, loads, folder, h))
+        folder = out_dir / folder_name / f"{number:02d}-{reading.figure}"
+        first_scene, first = ensemble(base, data, overrides, None, folder)
+        seeds = replicate_seeds(first_scene.preset.seed, replicates)
+        fits, last_counts = [], []
+        for k, seed in enumerate(seeds):
+            scene, outcome = (first_scene, first) if k == 0 else ensemble(
+                base, data, overrides, seed, folder.with_name(f"{folder.name}-r{k + 1}"))  # fmt: skip
+            settings = scene.preset.fit
+            fits.append(refit(outcome.f, outcome.per_realization, reading.average,
+                              bootstrap=settings.bootstrap, confidence=settings.confidence, seed=scene.preset.seed))  # fmt: skip
+            last_counts.append(float(outcome.contact_count[-1]))
+        counts = (float(first.contact_count[0]), float(first.contact_count[-1]))
+        loads = (float(first.loads[0]), float(first.loads[-1]))
+        rows.append(ReadingRow(reading, overrides, fits[0], counts, loads, folder if overrides else base.folder, h,
+                               fits, seeds, last_counts))  # fmt: skip
     return rows

@@ -33,6 +33,9 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         problem = output_path_problem(Path(folder)) if folder else None
         if problem:
             raise OutputRefused(f"{option}: {problem}; give a folder")
+    problem = output_path_problem(Path(markdown_path).parent) if markdown_path else None
+    if problem:
+        raise OutputRefused(f"--markdown: {problem}; give a file in a folder you can write to")
     if markdown_path and Path(markdown_path).is_dir():
         raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
@@ -47,10 +50,11 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
 
 def write_report(
     *, presets_dir=None, out_dir=None, markdown_path=None, figures_dir=None,
-    options: RunOptions = RunOptions(), readings=False, dpi=90, log: Callable[[str], None] = lambda text: None,
-    quiet: bool = True,
+    options: RunOptions = RunOptions(), readings=False, replicates: int = 1, dpi=90,
+    log: Callable[[str], None] = lambda text: None, quiet: bool = True,
 ) -> Path:  # fmt: skip
-    """Run Figs. 2 to 5 (and the readings), write the figures and the markdown; return its path.
+    """Run Figs. 2 to 5 (and the readings, each on ``replicates`` independent ensembles), write the
+    figures and the markdown; return its path.
     Paths default to a fresh folder (``report_paths``); nothing existing is overwritten unless
     ``options.force``. ``log`` hears what is going on, a line at a time; unless ``quiet``,
     every run shows its progress on stderr (``frictionlab.progress``)."""
@@ -71,9 +75,9 @@ def write_report(
             elapsed = time.perf_counter() - started
             reading_rows = readings_elapsed = fig5_rows = fig5_elapsed = None
             if readings:
-                log(f"report: running {len(READINGS)} readings")
+                log(f"report: running {len(READINGS)} readings" + (f", each on {replicates} ensembles" if replicates > 1 else ""))
                 t0 = time.perf_counter()
-                reading_rows = run_readings(runs, out_dir, options, progress=not quiet)
+                reading_rows = run_readings(runs, out_dir, options, progress=not quiet, replicates=replicates)
                 readings_elapsed = time.perf_counter() - t0
                 fig5 = next(run for run in runs if run.sweep is not None)
                 log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
@@ -87,10 +91,10 @@ def write_report(
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
         raise WorkInterrupted(f"{said}the runs that finished are kept in {out_dir}; no {markdown_path} written") from None
-    command = "frictionlab report" + (" --readings" if readings else "")
+    command = "frictionlab report" + (" --readings" if readings else "") + (f" --replicates {replicates}" if replicates > 1 else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
-    atomic_write(markdown_path, lambda fh: fh.write(text))
+    atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
     log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

@@ -29,8 +29,12 @@ class BuiltinPreset:
     path: Path
 
     @cached_property
-    def description(self) -> str:  # read when asked: finding one preset by name reads no file
-        return _one_line(self.path)
+    def full_description(self) -> str:  # read when asked: finding one preset by name reads no file
+        return _whole_description(self.path)
+
+    @property
+    def description(self) -> str:
+        return _one_line(self.full_description)
 
 
 def builtin_folder() -> Path | None:
@@ -61,8 +65,8 @@ def resolve_preset_path(argument: str | Path) -> Path:
     else the built-in of that name. Neither is a PresetFileError naming the closest
     built-in names (a path that merely does not exist is reported by the reader)."""
     path = Path(argument)
-    if not path.exists() and len(path.parts) == 1 and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):
-        raise PresetFileError(
+    if not path.exists() and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):  # presets/quickstart.yaml
+        raise PresetFileError(  # outside the clone: the file is not there, but the package has it
             [f"(file): no file {str(argument)!r} here; the built-in preset of that name is {path.stem!r} "
              f"(give the name alone: frictionlab run {path.stem})"],
             source=str(argument),
@@ -86,8 +90,8 @@ def resolve_preset_path(argument: str | Path) -> Path:
     )
 
 
-def _one_line(path: Path) -> str:
-    """The preset's description, cut at its first sentence or line; read without
+def _whole_description(path: Path) -> str:
+    """The preset's description (or its leading comment), on one line; read without
     validating (a listing must not fail on one odd file)."""
     from ..safe_yaml import YamlProblem, load_yaml
 
@@ -100,7 +104,12 @@ def _one_line(path: Path) -> str:
     if not isinstance(description, str) or not description.strip():
         comments = [ln.lstrip("# ").strip() for ln in text.splitlines() if ln.startswith("#")]
         description = comments[0] if comments else ""
-    line = re.split(r"(?<!Fig)\.\s+(?=[A-Z])|;\s", " ".join(description.split()), maxsplit=1)[0].rstrip(".")
+    return " ".join(description.split())
+
+
+def _one_line(description: str) -> str:
+    """``description`` cut at its first sentence, and at a comma to fit a listing's line."""
+    line = re.split(r"(?<!Fig)\.\s+(?=[A-Z])|;\s", description, maxsplit=1)[0].rstrip(".")
     if len(line) > _LONGEST:  # cut at a comma, so that a listing keeps one line per preset
         line = line[: line.rfind(", ", 0, _LONGEST)] + " ..."
     return line

@@ -9,10 +9,12 @@ import typing
 
 from pydantic import BaseModel, ValidationError
 
-from ..errors import short_repr
+from ..errors import close_names, did_you_mean, short_repr
 from ..plugin import MAX_MAGNITUDE
 from .schema import NAME_PATTERN, NAME_RULE
 
+
+FIELD_CUTOFF = 0.7  # field names are short and alike (seed, sweep; stop, steps): only a near miss is a guess
 
 
 def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
@@ -38,7 +40,10 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return f"must be {symbol} {ctx[key]}"
     if kind == "extra_forbidden":
         allowed = _allowed_keys(model, tuple(error["loc"][:-1]))
-        return "is not a known field" + (f"; allowed: {', '.join(allowed)}" if allowed else "; none are allowed here")
+        if not allowed:
+            return "is not a known field; none are allowed here"
+        hint = did_you_mean(str(error["loc"][-1]), allowed, FIELD_CUTOFF)
+        return f"is not a known field{hint or ';'} allowed: {', '.join(allowed)}"
     if kind == "missing":
         return "is required"
     if kind == "literal_error":
@@ -63,15 +68,31 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
     return message[:1].lower() + message[1:]
 
 
+def shown_value(value) -> str:
+    """``value`` as a problem line quotes it: cut short, but a text (a path) long enough to
+    keep its file's name."""
+    return short_repr(value, 240 if isinstance(value, str) else 80)
+
+
 def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix: str = "") -> list[str]:
-    """One line per pydantic error: ``path: message, got value``."""
+    """One line per pydantic error: ``path: message, got value``. A required field
+    missing because it was misspelt is said once, by the misspelling's suggestion."""
+    errors = exc.errors(include_url=False)
+    misspelt = {
+        (*error["loc"][:-1], name)
+        for error in errors
+        if error["type"] == "extra_forbidden"
+        for name in close_names(str(error["loc"][-1]), _allowed_keys(model, tuple(error["loc"][:-1])), FIELD_CUTOFF)[:1]
+    }
     lines = []
-    for error in exc.errors(include_url=False):
+    for error in errors:
+        if error["type"] == "missing" and tuple(error["loc"]) in misspelt:
+            continue
         path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
         checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
         if error["type"] != "missing" and not checked_together:  # a check of several fields names their values
-            line += f", got {short_repr(error['input'])}"
+            line += f", got {shown_value(error['input'])}"
         lines.append(line)
     return lines
 

@@ -16,13 +16,14 @@ from .paths import apply_overrides
 MAX_PRESET_BYTES = 256 * 1024  # presets are a few kB; refused by size before anything is read
 
 
-def load_preset_file(path: str | Path) -> dict:
+def load_preset_file(path: str | Path, *, follow_links: bool = True) -> dict:
     """Read a preset file: a regular file of at most MAX_PRESET_BYTES of UTF-8
     YAML within the limits of ``safe_yaml``. A file that cannot be used is a
-    PresetFileError, bad YAML a PresetError; neither quotes the file."""
+    PresetFileError, bad YAML a PresetError; neither quotes the file.
+    ``follow_links=False`` (a run folder's copy): a symbolic link is refused."""
     path = Path(path)
     try:
-        raw = read_regular_file(path, limit=MAX_PRESET_BYTES, what="preset file")
+        raw = read_regular_file(path, limit=MAX_PRESET_BYTES, what="preset file", follow_links=follow_links)
     except InputFileProblem as exc:
         raise PresetFileError([f"(file): {exc}"], source=str(path)) from None
     try:

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from ..errors import PluginError, PresetError, short_repr
+from ..errors import PluginError, PresetError
 from ..inputs import input_fields, regular_file_problem
 from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from ..registry import Registry, default_registry
-from .problems import format_validation_error, merge_problems, number_problems
+from .problems import format_validation_error, merge_problems, number_problems, shown_value
 from .reading import read_preset, resolve_input_paths
 from .schema import PluginChoice, Preset
 
@@ -123,7 +123,7 @@ def build_scene(
     if problems:
         raise PresetError(problems, source=source)
     problems = [
-        f"{slot}.params.{field}: {problem}, got {short_repr(getattr(plugin.params, field))}"
+        f"{slot}.params.{field}: {problem}, got {shown_value(getattr(plugin.params, field))}"
         for slot, plugin in plugins.items()
         for field in input_fields(type(plugin.params))
         if (problem := regular_file_problem(getattr(plugin.params, field)))
@@ -181,6 +181,16 @@ def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> 
                                 f"{instead}{make_periodic}")
         if problems:
             raise PresetError(problems, source=source)
+    periodic = plugins.get("equivalent_line", spectrum).periodic()
+    if slope.undefined_points(periodic) and not solver.undefined_slopes:
+        able = [i.name for i in registry.infos("solver") if i.cls.undefined_slopes and made in i.cls.dimensions]
+        raise PresetError(
+            [f"slope.params: {slope.name} leaves points of this {'periodic' if periodic else 'non-periodic'} profile "
+             f"without a slope, which solver {solver.name} cannot take: use "
+             + (f"solver {' or '.join(able)}, or " if able else "")
+             + "slope parameters that give every point a slope"],
+            source=source,
+        )
     return plugins
 
 

@@ -16,7 +16,11 @@ def check_slope_estimator(cls, **params) -> None:
     axes whose exact slope is |grad z| (so its slopes must be >= 0); lines are
     checked only if ``dimensions`` include 1. ``slopes(..., periodic=False)``
     on a tilted plane gives the tilt at every point (no difference across the
-    ends), or, for a ``periodic_only`` estimator, raises ValueError.
+    ends), or, for a ``periodic_only`` estimator, raises ValueError; there
+    ``undefined_points(False)`` says whether some points may have no slope (NaN):
+    if True, NaN appears only on the profile's edge (first or last point along an
+    axis) and every other slope is the tilt; if False, none is NaN. On a periodic
+    profile every slope is finite, and ``undefined_points(True)`` is False.
     """
     import numpy as np
 
@@ -24,12 +28,24 @@ def check_slope_estimator(cls, **params) -> None:
     spacing = 0.1
     dimensions = cls.dimensions
 
+    if call(cls, "undefined_points(True)", estimator.undefined_points, True) is not False:
+        fail(cls, "undefined_points(True) must be False: a periodic profile has no end, every point a slope")
+    undefined_ends = call(cls, "undefined_points(False)", estimator.undefined_points, False)
+    if not isinstance(undefined_ends, bool):
+        fail(cls, f"undefined_points(False) must be True or False. Got {undefined_ends!r} instead.")
+
     def run(what, heights, periodic=True):
         original = heights.copy()
         where = f"slopes({what}, spacing={spacing}, periodic={periodic})"
         slopes = call(cls, where, estimator.slopes, heights, spacing, periodic)
         if not np.array_equal(heights, original):
             fail(cls, f"slopes({what}) modified its input")
+        if not periodic and undefined_ends and isinstance(slopes, np.ndarray) and slopes.shape == heights.shape:
+            inner = tuple(slice(1, -1) for _ in heights.shape)
+            if np.isnan(slopes[inner]).any():
+                fail(cls, f"slopes({what}): NaN (no slope) is allowed on the edge of the profile only")
+            check_array(cls, f"slopes({what}) inside the edge", slopes[inner])
+            return slopes
         check_array(cls, f"slopes({what})", slopes, heights.shape)
         return slopes
 
@@ -76,6 +92,7 @@ def check_slope_estimator(cls, **params) -> None:
             continue
         tilted = run(f"non-periodic tilted {kind}", ramp, periodic=False)
         exact = grade[0] if kind == "line" else float(np.hypot(*grade))
+        tilted = np.where(np.isnan(tilted), exact, tilted)  # points without a slope (undefined_points)
         if not np.allclose(tilted, exact, rtol=1e-9, atol=1e-12):
             worst = np.unravel_index(int(np.argmax(np.abs(tilted - exact))), shape)
             fail(

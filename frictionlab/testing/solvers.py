@@ -61,7 +61,11 @@ def check_solver(cls, **params) -> None:
     (memory estimates) is None or a whole number > 0 (registration checks it; that it
     bounds the solver's peak is for the plugin's own tests, measured on a large grid); a
     ``periodic_only`` solver raises ValueError on a non-periodic profile, any
-    other solves it. (Registration itself checks that every declaration is
+    other solves it. A solver declaring ``undefined_slopes`` is given NaN slopes
+    too: with every slope NaN, ``slope_rms_contact`` is NaN at every load; with
+    slopes 1 but a NaN at the top point, it is 1 wherever it is finite, and finite
+    at every load with 2 or more points in contact (the rms over the defined ones).
+    A solver declaring no ``undefined_slopes`` is never given NaN. (Registration itself checks that every declaration is
     well formed: ``registry.declaration_problems``.)
     """
     solver = instantiate(cls, params)
@@ -178,6 +182,27 @@ def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) ->
         must_refuse(cls, "a non-periodic profile", lambda: solver.solve(profile, forces.copy(), "force", slopes.copy()))
     else:
         _solve(cls, solver, heights, spacing, slopes, forces, periodic=False)
+    if cls.undefined_slopes:
+        _check_undefined_slopes(cls, solver, heights, spacing, forces)
+
+
+def _check_undefined_slopes(cls, solver, heights, spacing, forces) -> None:
+    """NaN slopes count in no rms: none defined gives NaN, the rest defined gives their rms."""
+    import numpy as np
+
+    curve = _solve(cls, solver, heights, spacing, np.full(heights.shape, np.nan), forces)
+    if not np.all(np.isnan(np.asarray(curve.slope_rms_contact, float))):
+        fail(cls, f"undefined_slopes: with every slope NaN, slope_rms_contact must be NaN at every load. "
+                  f"Got {curve.slope_rms_contact!r}.")  # fmt: skip
+    ones = np.ones(heights.shape)
+    ones[np.unravel_index(int(np.argmax(heights)), heights.shape)] = np.nan  # the first point to touch
+    curve = _solve(cls, solver, heights, spacing, ones, forces)
+    rms, count = np.asarray(curve.slope_rms_contact, float), np.asarray(curve.contact_count)
+    finite = np.isfinite(rms)
+    if not np.allclose(rms[finite], 1.0, rtol=1e-12) or not np.all(finite[count >= 2]):
+        fail(cls, "undefined_slopes: with slopes 1 and NaN at the top point, slope_rms_contact must be 1 at every "
+                  f"load with 2 or more points in contact (the rms of the defined slopes). Got {rms!r} "
+                  f"with contact counts {count!r}.")  # fmt: skip
 
 
 def _check_solver_units(cls, solver, heights, spacing, slopes) -> None:

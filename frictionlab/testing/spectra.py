@@ -24,7 +24,11 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     None, gives 2 N points (per side) over the same length; ``equivalent_line()``
     is None or, for a surface, a spectrum of lines 2 sqrt(A / pi) long with the
     surface's rms height, itself checked; ``c0()`` is NotImplementedError or
-    finite > 0; ``hurst_exponent()`` is None or finite >= 0.
+    finite > 0; ``hurst_exponent()`` is None or finite >= 0; ``input_summary()`` is None or
+    a JSON-ready mapping whose ``shape``, ``spacing`` and ``rms_height`` are those of what
+    ``generate()`` makes and ``rms_height()``, with ``file`` and ``unit``;
+    ``profile_rms_height(profile)`` is None or finite > 0 for the generated
+    profiles, and the same for two of them within a relative 1e-9 (f needs one h).
     """
     import numpy as np
 
@@ -85,7 +89,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
 
 
 def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
-    """periodic(), points_param, grid_shape(), refined(), equivalent_line(), c0(), hurst_exponent()."""
+    """periodic(), points_param, grid_shape(), refined(), equivalent_line(), c0(), hurst_exponent(),
+    input_summary()."""
     import numpy as np
 
     from frictionlab.plugin import SpectrumGenerator, mdr_length
@@ -132,6 +137,34 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     missing, c0 = is_not_implemented(cls, "c0()", gen.c0)
     if not missing:
         check_positive_number(cls, "c0()", c0)
+    own = [call(cls, "profile_rms_height(profile)", gen.profile_rms_height, p)
+           for p in (profile, gen.generate(np.random.default_rng(11)))]  # fmt: skip
+    if own[0] is not None or own[1] is not None:
+        if own[0] is None or own[1] is None:
+            fail(cls, f"profile_rms_height(profile) must be None for every profile, or a number for every one. Got {own!r}.")
+        first, second = (check_positive_number(cls, "profile_rms_height(profile)", h) for h in own)
+        if not math.isclose(first, second, rel_tol=1e-9):
+            fail(cls, f"profile_rms_height(profile) must be one h for the ensemble's profiles (f is one axis): "
+                      f"two profiles gave {first!r} and {second!r}")  # fmt: skip
     hurst = call(cls, "hurst_exponent()", gen.hurst_exponent)
     if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
         fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")
+    _check_input_summary(cls, gen, profile)
+
+
+def _check_input_summary(cls, gen, profile) -> None:
+    import json
+
+    summary = call(cls, "input_summary()", gen.input_summary)
+    if summary is None:
+        return
+    try:
+        json.dumps(summary, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        fail(cls, f"input_summary() must be None or a JSON-ready mapping. Got {summary!r} ({exc}).")
+    if not isinstance(summary, dict) or not {"file", "shape", "spacing", "unit", "rms_height"} <= set(summary):
+        fail(cls, f"input_summary() must give at least file, shape, spacing, unit and rms_height. Got {summary!r}.")
+    if (tuple(summary["shape"]) != profile.heights.shape or summary["spacing"] != profile.spacing
+            or summary["rms_height"] != gen.rms_height()):
+        fail(cls, f"input_summary() must give the shape {profile.heights.shape}, spacing {profile.spacing!r} and "
+                  f"rms height {gen.rms_height()!r} of what generate() makes. Got {summary!r}.")  # fmt: skip

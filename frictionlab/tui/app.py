@@ -291,7 +291,7 @@ class FrictionlabApp(App):
         elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
             self.say("")
         self._show_edit_state()
-        self.query_one(EditPane).show_problems(event.problems)
+        self.query_one(EditPane).show_problems(event.problems, event.read)
 
     def _show_edit_state(self) -> None:
         self.query_one(EditPane).show_title(self.draft_path, self.modified, self.problems)
@@ -421,7 +421,7 @@ class FrictionlabApp(App):
             if read_run(folder).status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
-        except (OSError, ValueError, TypeError):
+        except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
         try:
             data = RunDirectory(folder).stored_preset()

@@ -17,6 +17,7 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
+from ..inputs import describe_input
 from ..plugin import KINDS
 from ..preset import MISSING, Preset, build_scene, resolve_input_paths
 from ..safe_yaml import load_yaml
@@ -176,17 +177,20 @@ def default_spectrum(registry) -> str:
     return default_plugin_name("spectrum") or registry.names("spectrum")[0]
 
 
-def problems_of(data: dict, registry, base_dir: Path | None = None) -> list[str]:
-    """The headless validator's problems for ``data`` (empty when it is valid);
-    relative input files are taken from ``base_dir``, the preset file's folder,
-    as ``frictionlab validate`` takes them."""
+def validation_of(data: dict, registry, base_dir: Path | None = None) -> tuple[list[str], str]:
+    """The headless validator's problems for ``data`` (empty when it is valid; relative
+    input files taken from ``base_dir``, the preset file's folder, as ``frictionlab
+    validate`` takes them) and, for a valid preset whose spectrum reads a file, the line
+    ``frictionlab validate`` prints on what it read (shape, pixel size, unit, rms height);
+    else ""."""
     try:
         if base_dir is not None:
             data = resolve_input_paths(data, base_dir, registry)
-        build_scene(data, registry=registry)
+        scene = build_scene(data, registry=registry)
     except PresetError as exc:
-        return list(exc.problems)
-    return []
+        return list(exc.problems), ""
+    summary = scene.spectrum.input_summary()
+    return [], "" if summary is None else f"read {describe_input(summary)}"
 
 
 def problem_path(problem: str) -> str:

@@ -9,7 +9,6 @@ folders, found by their ``sweep.json``.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -20,9 +19,12 @@ import yaml
 from ..detached import run_state
 from ..errors import FrictionlabError
 from ..files import atomic_write
+from ..inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
+from ..preset.reading import MAX_PRESET_BYTES
 from ..preset.builtin import builtin_folder, builtin_presets
 from ..rundir import STATE_FILE
+from ..runfolder import read_json, subfolder
 from ..safe_yaml import load_yaml
 from .roundtrip import dump_preserving
 
@@ -94,8 +96,8 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
         if not folder.is_dir():
             continue
         for path in sorted(folder.glob("*.y*ml")):
-            try:  # read as a preset is: bounded, so that a hostile file cannot stop the listing
-                data = load_yaml(path.read_text(encoding="utf-8"))
+            try:  # read as a preset is: bounded, a regular file, so that a hostile file (a FIFO) cannot stop the listing
+                data = load_yaml(read_regular_file(path, MAX_PRESET_BYTES, "preset file").decode("utf-8"))
             except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
                 entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
                 continue
@@ -202,12 +204,11 @@ class RunEntry:
 
 
 def read_run(folder: Path) -> RunEntry:
-    """A run folder's summary; raises OSError/ValueError if it has none readable."""
+    """A run folder's summary (read as untrusted input: ``runfolder``); RunFolderError
+    if it has none readable."""
     folder = Path(folder)
     summary_path = folder / "summary.json"
-    summary = json.loads(summary_path.read_text(encoding="utf-8"))
-    if not isinstance(summary, dict):
-        raise ValueError("summary.json is not a JSON object")
+    summary = read_json(folder, "summary.json")
     realizations, preset = _mapping(summary.get("realizations")), _mapping(summary.get("preset"))
     return RunEntry(  # a field of the wrong kind is shown as missing, never trusted
         path=folder,
@@ -217,7 +218,7 @@ def read_run(folder: Path) -> RunEntry:
         requested=_count(realizations.get("requested")),
         fit=summary.get("fit") if isinstance(summary.get("fit"), dict) else None,
         summary=summary,
-        mtime=summary_path.stat().st_mtime,
+        mtime=os.lstat(summary_path).st_mtime,
     )
 
 
@@ -233,26 +234,23 @@ class SweepEntry:
     mtime: float
 
     def point_folder(self, row: dict) -> Path:
-        return self.path / str(row.get("folder") or "")
+        """The folder of a point (RunFolderError if sweep.json names one outside the sweep's, or a link)."""
+        return subfolder(self.path, row["folder"])
 
 
 def read_sweep(folder: Path) -> SweepEntry:
-    """A sweep folder's sweep.json; raises OSError/ValueError/TypeError if unreadable."""
+    """A sweep folder's sweep.json, checked (``sweep.read_sweep_record``); RunFolderError if unreadable."""
+    from ..sweep import read_sweep_record
+
     folder = Path(folder)
-    summary_path = folder / "sweep.json"
-    summary = json.loads(summary_path.read_text(encoding="utf-8"))
-    if not isinstance(summary, dict):
-        raise ValueError("sweep.json is not a JSON object")
-    points = summary["points"]
-    if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
-        raise TypeError("sweep.json: points must be a list of rows")
+    summary, record = read_sweep_record(folder)
     return SweepEntry(
         path=folder,
-        name=str(summary.get("name") or folder.name),
-        status=str(summary.get("status", "?")),
-        paths=[str(p) for p in _mapping(_mapping(summary.get("sweep")).get("parameters"))],
-        points=points,
-        mtime=summary_path.stat().st_mtime,
+        name=record.name,
+        status=record.status,
+        paths=[str(p) for p in record.sweep.parameters],
+        points=summary["points"],
+        mtime=os.lstat(folder / "sweep.json").st_mtime,
     )
 
 
@@ -266,14 +264,14 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
     for folder in runs_dir.iterdir():
         entry = None
         for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
-            if not (folder / marker).is_file():
+            if not os.path.lexists(folder / marker):
                 continue
             try:
                 entry = read(folder)
-            except (OSError, ValueError, TypeError, KeyError, RecursionError):
-                pass  # a half-written, damaged or foreign folder: not one to list
+            except (OSError, FrictionlabError):
+                pass  # a damaged or foreign folder, a link, a FIFO: not one to list
             break
-        if not isinstance(entry, SweepEntry) and (folder / STATE_FILE).is_file():
+        if not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
             entry = _with_state(folder, entry)
         if entry is not None:
             entries.append(entry)
@@ -288,7 +286,7 @@ def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:
     except (OSError, FrictionlabError):
         return entry
     if entry is None:
-        mtime = (folder / STATE_FILE).stat().st_mtime
+        mtime = os.lstat(folder / STATE_FILE).st_mtime
         return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
     entry.status = state.status
     if state.status == "running":

@@ -13,8 +13,12 @@ end (``numpy.gradient``'s first-order edges): the forward difference of the last
 point is the slope of the last segment, and the central difference of either
 end is that of its own segment. Every point keeps a slope, so a contact at an
 end of the scan still has one; the last segment counts twice in the whole-line
-rms, a bias of order 1/N. The spectral derivative needs a periodic profile and
-refuses any other.
+rms, a bias of order 1/N. With ``line_end: undefined`` an end point that has no
+neighbour on the estimator's side (the last point for forward differences, both
+ends for central ones) gets no slope instead (NaN): the study's slope read
+literally, defined only where z(x_{i+1}) exists. Such a point then counts neither
+in the whole-line rms nor in the rms over the contact. The spectral derivative
+needs a periodic profile and refuses any other.
 
 On a surface, shape (Ny, Nx) with square pixels, the slope of a pixel is the
 gradient magnitude |grad z| = sqrt(dz/dx^2 + dz/dy^2), each component formed
@@ -26,11 +30,12 @@ original, unchanged code path).
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
+from pydantic import Field
 
-from frictionlab import SlopeEstimator
+from frictionlab import PluginParams, SlopeEstimator
 
 __all__ = ["CentralDifference", "ForwardDifference", "Spectral"]
 
@@ -57,27 +62,35 @@ def _checked(heights, spacing, minimum: int) -> tuple[np.ndarray, float]:
     return heights, spacing
 
 
-def _gradient_magnitude(z: np.ndarray, dx: float, derivative: Callable[..., np.ndarray], periodic: bool):
-    """|grad z| of a surface from a derivative along one axis."""
-    along_x = derivative(z, dx, 1, periodic)
-    along_y = derivative(z, dx, 0, periodic)
+def _gradient_magnitude(z: np.ndarray, dx: float, derivative: Callable[..., np.ndarray], periodic: bool, *extra):
+    """|grad z| of a surface from a derivative along one axis (NaN where a component is undefined)."""
+    along_x = derivative(z, dx, 1, periodic, *extra)
+    along_y = derivative(z, dx, 0, periodic, *extra)
     return np.hypot(along_x, along_y, out=along_x)
 
 
-def _forward(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.ndarray:
+def _along(ndim: int, axis: int, index: int) -> tuple:
+    """The index of the slice ``index`` along ``axis`` of an ``ndim``-dimensional array."""
+    where = [slice(None)] * ndim
+    where[axis] = index
+    return tuple(where)
+
+
+def _forward(z: np.ndarray, dx: float, axis: int, periodic: bool = True, undefined_end: bool = False) -> np.ndarray:
     out = (np.roll(z, -1, axis=axis) - z) / dx
-    if not periodic:  # the last point: the last segment's slope, not the wrap
-        last = [slice(None)] * z.ndim
-        last[axis] = -1
-        before = [slice(None)] * z.ndim
-        before[axis] = -2
-        out[tuple(last)] = out[tuple(before)]
+    if not periodic:  # the last point: no slope, or the last segment's; never the wrap
+        last = _along(z.ndim, axis, -1)
+        out[last] = np.nan if undefined_end else out[_along(z.ndim, axis, -2)]
     return out
 
 
-def _central(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.ndarray:
+def _central(z: np.ndarray, dx: float, axis: int, periodic: bool = True, undefined_end: bool = False) -> np.ndarray:
     if not periodic:
-        return np.gradient(z, dx, axis=axis, edge_order=1)
+        out = np.gradient(z, dx, axis=axis, edge_order=1)
+        if undefined_end:  # both ends lack a neighbour on one side
+            out[_along(z.ndim, axis, 0)] = np.nan
+            out[_along(z.ndim, axis, -1)] = np.nan
+        return out
     return (np.roll(z, -1, axis=axis) - np.roll(z, 1, axis=axis)) / (2.0 * dx)
 
 
@@ -91,7 +104,28 @@ def _spectral(z: np.ndarray, dx: float, axis: int, periodic: bool = True) -> np.
     return np.fft.irfft(spectrum, n=points, axis=axis)
 
 
-class ForwardDifference(SlopeEstimator):
+class LineEndParams(PluginParams):
+    """The choice at the ends of a non-periodic profile (a periodic one wraps and has no end)."""
+
+    line_end: Literal["last-segment", "undefined"] = Field(
+        "last-segment",
+        description="an end point of a non-periodic profile without a neighbour on the difference's side: "
+        "'last-segment' gives it the one-sided slope of its own segment; 'undefined' gives it no slope (NaN), "
+        "so it counts in no rms and a contact made of such points alone has no xi",
+    )
+
+
+class _EndAwareDifference(SlopeEstimator):
+    """A finite difference whose ends, on a non-periodic profile, follow ``line_end`` (not registered)."""
+
+    Params = LineEndParams
+
+    def undefined_points(self, periodic: bool) -> bool:
+        """True on a non-periodic profile with ``line_end: undefined``."""
+        return not periodic and self.params.line_end == "undefined"
+
+
+class ForwardDifference(_EndAwareDifference):
     name: ClassVar[str] = "forward-difference"
     summary: ClassVar[str] = (
         "forward difference (z[i+1] - z[i]) / dx: the study's definition; |grad z| on a surface"
@@ -100,27 +134,29 @@ class ForwardDifference(SlopeEstimator):
 
     def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
+        undefined = self.undefined_points(periodic)
         if z.ndim == 2:
-            return _gradient_magnitude(z, dx, _forward, periodic)
+            return _gradient_magnitude(z, dx, _forward, periodic, undefined)
         out = np.empty_like(z)
         np.subtract(z[1:], z[:-1], out=out[:-1])
-        # periodic: z[N] = z[0]; otherwise the last point has no forward neighbour: its segment's slope
-        out[-1] = z[0] - z[-1] if periodic else out[-2]
+        # periodic: z[N] = z[0]; otherwise the last point has no forward neighbour: no slope, or its segment's
+        out[-1] = z[0] - z[-1] if periodic else (np.nan if undefined else out[-2])
         np.divide(out, dx, out=out)
         return out
 
 
-class CentralDifference(SlopeEstimator):
+class CentralDifference(_EndAwareDifference):
     name: ClassVar[str] = "central-difference"
     summary: ClassVar[str] = "central difference (z[i+1] - z[i-1]) / (2 dx); one-sided at the ends of a scan; |grad z| on a surface"
     dimensions: ClassVar[tuple[int, ...]] = (1, 2)
 
     def slopes(self, heights: np.ndarray, spacing: float, periodic: bool = True) -> np.ndarray:
         z, dx = _checked(heights, spacing, 2)
+        undefined = self.undefined_points(periodic)
         if z.ndim == 2:
-            return _gradient_magnitude(z, dx, _central, periodic)
+            return _gradient_magnitude(z, dx, _central, periodic, undefined)
         if not periodic:
-            return np.gradient(z, dx, edge_order=1)
+            return _central(z, dx, 0, False, undefined)
         out = np.empty_like(z)
         np.subtract(z[2:], z[:-2], out=out[1:-1])
         out[0] = z[1] - z[-1]

@@ -3,6 +3,7 @@
 from frictionlab import hookimpl
 
 from .bem import BEMHalfPlane, BEMHalfSpace
+from .bem_free import BEMHalfSpaceFree
 from .springs import BisectionSprings, MDRSprings, WinklerSprings
 
 
@@ -13,3 +14,4 @@ def register_solvers(register):
     register(BisectionSprings)
     register(BEMHalfPlane)
     register(BEMHalfSpace)
+    register(BEMHalfSpaceFree)

@@ -24,6 +24,11 @@ Conventions
   amplitudes); ``rms_height_continuum()`` is sqrt(2 * integral psd dq). Likewise
   ``rms_slope_discrete()`` = sqrt(sum_k q_k^2 a_k^2 / 2) and ``rms_slope()``, the
   continuum integral. They differ by the Riemann-sum error of the band.
+- ``height_reference: measured``: each generated line is shifted to zero mean and
+  scaled so that its own rms height about its mean is h (``rms_height()``), and f
+  is formed with that measured rms (``profile_rms_height``): the study's h, the rms
+  of the line's height distribution (eq. 8). With the default ``nominal`` h is the
+  expected rms of the ensemble; a cosine-series line then scatters about it.
 """
 
 from __future__ import annotations
@@ -295,6 +300,13 @@ class LineParams(BandParams):
         "q_k = k pi / L on [0, L) (the study's eq. 6 read literally; long_cutoff defaults to 2 L)",
     )
 
+    height_reference: Literal["nominal", "measured"] = Field(
+        "nominal",
+        description="'nominal': h (rms_height, or the rms C0 implies) is the ensemble's expected rms height; "
+        "'measured': each line is shifted to zero mean and scaled so that its own rms height is h, and f uses "
+        "that measured rms (the study's definition of h)",
+    )
+
     def resolve_band(self) -> Band:
         return resolve_band(self, series=self.series)
 
@@ -378,8 +390,18 @@ class BandLimitedSpectrum(SpectrumGenerator):
         s = self._synthesis()
         heights = random_phase_line(
             s.coeff, s.nyquist, s.band.k_lo, s.band.period_points, rng, rayleigh=self.params.amplitudes != "fixed"
-        )
-        return Profile(heights=heights[: s.band.points], spacing=s.band.spacing, periodic=self.periodic())
+        )[: s.band.points]
+        if self.params.height_reference == "measured":  # the line's own rms about its mean is h
+            heights = heights - heights.mean()
+            heights *= s.rms_height / np.sqrt(np.mean(np.square(heights)))
+        return Profile(heights=heights, spacing=s.band.spacing, periodic=self.periodic())
+
+    def profile_rms_height(self, profile: Profile) -> float | None:
+        """With ``height_reference: measured``, the line's rms height about its mean (h, to rounding);
+        None (the nominal ``rms_height()``) otherwise."""
+        if self.params.height_reference != "measured":
+            return None
+        return float(np.std(profile.heights))
 
     def rms_height(self) -> float:
         """Discrete rms height sqrt(sum_k a_k^2 / 2): exact for every fixed-amplitude periodic line,

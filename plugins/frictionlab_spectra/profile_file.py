@@ -5,9 +5,13 @@ The file holds heights on a uniform grid, optionally with their x positions:
 - ``.csv`` / ``.txt``: one column (heights) or two columns (x, z), separated by
   commas or whitespace; lines starting with ``#`` are comments and one
   non-numeric header line (e.g. ``x,z``) before the data is skipped.
-- ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z.
+- ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z;
+- any other file: an instrument's line scan (X3P, SUR, NetCDF...) read by the optional
+  extra ``topography`` (``instrument_file.py``), with its own spacing and unit, converted
+  to ``unit``; ``spacing`` then replaces the file's.
 
-A measured line is not periodic (``periodic: false``, the default): a scan's
+A measured line is not periodic (``periodic`` unset: as an instrument file says, else
+false): a scan's
 ends do not meet, so no slope is taken across them and solvers of periodic
 lines refuse it. ``periodic: true`` declares a profile whose last point is
 followed by its first (one period of a periodic surface, say); removing the
@@ -22,7 +26,7 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -30,6 +34,7 @@ from pydantic import Field
 from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
+from .instrument_file import Undefined, Unit, is_instrument_file, read_scan
 from .params_cache import cached_on_params
 
 MIN_POINTS = 8
@@ -42,13 +47,18 @@ class _Line:
     heights: np.ndarray
     spacing: float
     rms_height: float
+    periodic: bool
+    summary: dict[str, Any]
 
 
 class ProfileFile(SpectrumGenerator):
     """A measured height profile read from a file; every ``generate`` returns the same line."""
 
     name: ClassVar[str] = "profile-file"
-    summary: ClassVar[str] = "Measured line read from a .csv/.txt/.npy file of heights (or x, z) on a uniform grid"
+    summary: ClassVar[str] = (
+        "Measured line read from an instrument's line scan, or a .csv/.txt/.npy file of heights (or x, z) on a "
+        "uniform grid"
+    )
     references: ClassVar[tuple[str, ...]] = ()
 
     class Params(PluginParams):
@@ -56,14 +66,27 @@ class ProfileFile(SpectrumGenerator):
                                 "a relative path is taken from the preset file's folder", min_length=1)
         spacing: float | None = Field(
             None,
-            description="grid spacing dx; required if the file has only heights, must agree with x otherwise",
+            description="grid spacing dx in the run's length unit; required if a table has only heights, must agree "
+            "with its x otherwise; for an instrument file it replaces the file's spacing",
             gt=0.0,
+        )
+        unit: Unit | None = Field(
+            None,
+            description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
+            "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
+        )
+        undefined: Undefined = Field(
+            "refuse",
+            description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
+            "from their neighbours (harmonic)",
         )
         detrend: Literal["none", "mean", "tilt"] = Field(
             "mean", description="remove nothing, the mean, or the least-squares line (tilt) before use"
         )
-        periodic: bool = Field(
-            False, description="whether the line repeats (its last point is followed by its first); a scan does not"
+        periodic: bool | None = Field(
+            None,
+            description="whether the line repeats (its last point is followed by its first); default: as an "
+            "instrument file says, else false (a scan does not)",
         )
 
     # ------------------------------------------------------------ contract
@@ -71,10 +94,17 @@ class ProfileFile(SpectrumGenerator):
     def generate(self, rng: np.random.Generator) -> Profile:
         """The measured line (a fresh copy each call); ``rng`` is not used."""
         line = self._line()
-        return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=self.params.periodic)
+        return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=line.periodic)
 
     def periodic(self) -> bool:
-        return self.params.periodic
+        return self._line().periodic
+
+    def grid_shape(self) -> tuple[int]:
+        return self._line().heights.shape
+
+    def input_summary(self) -> dict[str, Any]:
+        """The line as read: file, format, points, spacing, unit, rms height, and where each came from."""
+        return dict(self._line().summary)
 
     def rms_height(self) -> float:
         """rms of the detrended line about its mean (with ``detrend="none"`` a constant offset,
@@ -87,15 +117,33 @@ class ProfileFile(SpectrumGenerator):
     def _line(self) -> _Line:
         p = self.params
         path = Path(p.path)
-        x, z = _read_columns(path)
         where = f"profile-file {str(path)!r}"
+        if is_instrument_file(path):
+            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined)
+            x, z = None, scan.heights
+            summary = {
+                "format": scan.format, "channel": scan.channel, "file_spacing": scan.spacing,
+                "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
+                "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
+                "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
+                "periodic_from": "file" if p.periodic is None else "preset",
+            }  # fmt: skip
+            periodic = scan.periodic if p.periodic is None else p.periodic
+        else:
+            x, z = _read_columns(path)
+            summary = {
+                "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset", "unit": p.unit,
+                "unit_from": "preset" if p.unit is not None else "none",
+                "periodic_from": "preset" if p.periodic is not None else "default",
+            }  # fmt: skip
+            periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         check_finite(where, "heights", z)
         if x is None:
-            if p.spacing is None:
+            if p.spacing is None and not is_instrument_file(path):
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
-            dx = p.spacing
+            dx = scan.spacing if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
             dx = _uniform_spacing(where, x)
@@ -115,7 +163,9 @@ class ProfileFile(SpectrumGenerator):
                 "a flat line has no roughness"
             )
         heights.flags.writeable = False
-        return _Line(heights, float(dx), rms)
+        summary = {"file": str(path), **summary, "shape": [int(z.size)], "spacing": float(dx), "periodic": periodic,
+                   "rms_height": rms}  # fmt: skip
+        return _Line(heights, float(dx), rms, periodic, summary)
 
 
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
@@ -142,13 +192,11 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
 
 
 def file_suffix(path: Path, where: str) -> str:
-    """".npy", ".csv" or ".txt" (lower case) of an existing file; ValueError otherwise."""
+    """".npy", ".csv" or ".txt" (lower case) of an existing table (any other suffix is an
+    instrument file: ``instrument_file.py``); ValueError otherwise."""
     if not path.exists():
         raise ValueError(f"{where}: no such file")
-    suffix = path.suffix.lower()
-    if suffix not in (".npy", ".csv", ".txt"):
-        raise ValueError(f"{where}: unknown file type {suffix!r}; use .csv, .txt or .npy")
-    return suffix
+    return path.suffix.lower()
 
 
 def _open(path: Path, where: str):

@@ -175,8 +175,10 @@ class BandLimitedSurface(SpectrumGenerator):
         return self._synthesis().band
 
     def grid_shape(self) -> tuple[int, int]:
-        """(Ny, Nx) of a generated surface."""
-        return self._synthesis().shape
+        """(Ny, Nx) of a generated surface, from the parameters alone: the memory check
+        asks for it before a run, and the synthesis allocates in proportion to Ny Nx."""
+        _, ny, nx = _surface_band(self.params)
+        return (ny, nx)
 
     def hurst_exponent(self) -> float:
         return float(self.params.hurst)

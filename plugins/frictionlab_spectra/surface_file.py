@@ -1,15 +1,22 @@
 """A measured surface as a spectrum generator: ``surface-file``, and its MDR-equivalent line.
 
-The file holds a height map z[row, column] of shape (Ny, Nx) on square pixels of side
-``spacing`` (an AFM or profilometer topography):
+The file holds a height map z[row, column] of shape (Ny, Nx) on square pixels (an AFM,
+profilometer or interferometer topography):
 
 - ``.npy``: a 2D array of real numbers;
 - ``.csv`` / ``.txt``: a matrix of numbers, one row of the map per line, separated by
-  commas or whitespace; ``#`` starts a comment and one non-numeric header line is skipped.
+  commas or whitespace; ``#`` starts a comment and one non-numeric header line is skipped;
+- any other file: an instrument file (X3P, SUR, DATX, OPD, NetCDF...) read by the optional
+  extra ``topography`` (``instrument_file.py``), with its own pixel size and unit.
 
-A measured map is not periodic (``periodic: false``, the default): its opposite edges do
-not meet, so slopes are not taken across them and solvers of periodic surfaces refuse it.
-``periodic: true`` declares a map that does tile the plane. ``detrend="plane"`` removes the
+Bare numbers carry no length: ``spacing`` (and ``unit``, a label then) say what they are.
+An instrument file's heights and pixel size are converted to ``unit`` (by default the
+file's own); ``spacing`` then replaces the file's pixel size. ``input_summary()`` says
+which were used.
+
+A measured map is not periodic (``periodic`` unset: as an instrument file says, else
+false): its opposite edges do not meet, so slopes are not taken across them and solvers of
+periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane. ``detrend="plane"`` removes the
 least-squares plane a + b x + c y (a scan that was not levelled).
 
 Solvers of lines (``mdr``, ``mdr-bisection``) get ``equivalent_line()``: the surface's
@@ -29,7 +36,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -37,6 +44,7 @@ from pydantic import Field
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
 from .equivalent_line import EquivalentLine
+from .instrument_file import Undefined, Unit, is_instrument_file, read_scan
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, read_text_table, remove_mean
@@ -49,6 +57,8 @@ class _Map:
     heights: np.ndarray  # detrended, read-only
     spacing: float
     rms_height: float
+    periodic: bool
+    summary: dict[str, Any]
 
 
 @dataclass(frozen=True)
@@ -87,20 +97,38 @@ class SurfaceFile(SpectrumGenerator):
     """A measured height map read from a file; every ``generate`` returns the same surface."""
 
     name: ClassVar[str] = "surface-file"
-    summary: ClassVar[str] = "Measured surface read from a .npy/.csv/.txt height map (Ny, Nx) on square pixels"
+    summary: ClassVar[str] = (
+        "Measured surface read from an instrument file (X3P, SUR, DATX...) or a .npy/.csv/.txt height map (Ny, Nx)"
+    )
     references: ClassVar[tuple[str, ...]] = ()
     dimension: ClassVar[int] = 2
 
     class Params(PluginParams):
         path: InputFile = Field(description="file of heights (.npy 2D array, or .csv/.txt matrix: one map row per "
                                 "line); a relative path is taken from the preset file's folder", min_length=1)
-        spacing: float = Field(description="pixel side dx (square pixels), in the units of the heights' x", gt=0.0)
+        spacing: float | None = Field(
+            None,
+            description="pixel side dx (square pixels), in the run's length unit: required for a .npy/.csv/.txt map; "
+            "for an instrument file it replaces the pixel size the file gives",
+            gt=0.0,
+        )
+        unit: Unit | None = Field(
+            None,
+            description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
+            "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
+        )
+        undefined: Undefined = Field(
+            "refuse",
+            description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
+            "from their neighbours (harmonic: the solution of Laplace's equation)",
+        )
         detrend: Literal["none", "mean", "plane"] = Field(
             "mean", description="remove nothing, the mean, or the least-squares plane before use"
         )
-        periodic: bool = Field(
-            False,
-            description="whether the map tiles the plane (opposite edges meet); a measured scan does not",
+        periodic: bool | None = Field(
+            None,
+            description="whether the map tiles the plane (opposite edges meet); default: as an instrument file says, "
+            "else false (a measured scan does not)",
         )
 
     # ------------------------------------------------------------ contract
@@ -108,10 +136,17 @@ class SurfaceFile(SpectrumGenerator):
     def generate(self, rng: np.random.Generator) -> Profile:
         """The measured map (a fresh copy each call); ``rng`` is not used."""
         surface = self._map()
-        return Profile(heights=surface.heights.copy(), spacing=surface.spacing, periodic=self.params.periodic)
+        return Profile(heights=surface.heights.copy(), spacing=surface.spacing, periodic=surface.periodic)
 
     def periodic(self) -> bool:
-        return self.params.periodic
+        return self._map().periodic
+
+    def grid_shape(self) -> tuple[int, int]:
+        return self._map().heights.shape
+
+    def input_summary(self) -> dict[str, Any]:
+        """The map as read: file, format, shape, pixel size, unit, rms height, and where each came from."""
+        return dict(self._map().summary)
 
     def rms_height(self) -> float:
         """rms of the detrended map about its mean (a constant offset does not count)."""
@@ -128,7 +163,7 @@ class SurfaceFile(SpectrumGenerator):
         ``rms_height()``. A non-periodic map is reflected across its edges for its FFT."""
         surface = self._map()
         heights = surface.heights
-        if not self.params.periodic:  # the even extension: periodic, no step where it repeats
+        if not surface.periodic:  # the even extension: periodic, no step where it repeats
             heights = np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
         ny, nx = heights.shape
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
@@ -150,7 +185,7 @@ class SurfaceFile(SpectrumGenerator):
         p = self.params
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
-        z = _read_map(path, where)
+        z, spacing, summary = _read_map(path, where, p)
         check_finite(where, "heights", z)
         heights = _detrend(z, p.detrend)
         rms = float(np.std(heights))
@@ -160,15 +195,38 @@ class SurfaceFile(SpectrumGenerator):
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
-        return _Map(heights, float(p.spacing), rms)
+        summary["rms_height"] = rms
+        return _Map(heights, spacing, rms, summary["periodic"], summary)
 
 
-def _read_map(path: Path, where: str) -> np.ndarray:
-    """The (Ny, Nx) float64 map of a .npy or text file, at least MIN_SIDE points each way."""
-    if file_suffix(path, where) == ".npy":
-        data = load_npy(path, where)
+def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, float, dict[str, Any]]:
+    """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
+    way), its pixel size in the run's unit, and what was read and used (``input_summary``)."""
+    if is_instrument_file(path):
+        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined)
+        data, spacing = scan.heights, scan.spacing if p.spacing is None else p.spacing
+        summary = {
+            "format": scan.format, "channel": scan.channel, "file_spacing": scan.spacing,
+            "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
+            "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
+            "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
+            "periodic_from": "file" if p.periodic is None else "preset",
+        }  # fmt: skip
+        periodic = scan.periodic if p.periodic is None else p.periodic
     else:
-        data = read_text_table(path, where)
+        if p.spacing is None:
+            raise ValueError(
+                f"{where}: a {path.suffix.lower()} map holds bare numbers, so the parameter spacing (the pixel side) "
+                "is required"
+            )
+        data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
+        spacing = p.spacing
+        summary = {
+            "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
+            "unit_from": "preset" if p.unit is not None else "none",
+            "periodic_from": "preset" if p.periodic is not None else "default",
+        }  # fmt: skip
+        periodic = bool(p.periodic)
     if data.ndim != 2 or 1 in data.shape:
         raise ValueError(
             f"{where}: array of shape {data.shape}; expected a 2D height map (Ny, Nx) "
@@ -177,7 +235,8 @@ def _read_map(path: Path, where: str) -> np.ndarray:
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
         raise ValueError(f"{where}: map of {ny} x {nx} points; at least {MIN_SIDE} x {MIN_SIDE} are needed")
-    return data.astype(np.float64)
+    summary = {"file": str(path), **summary, "shape": list(data.shape), "spacing": float(spacing), "periodic": periodic}
+    return data.astype(np.float64), float(spacing), summary
 
 
 def _detrend(z: np.ndarray, mode: str) -> np.ndarray:

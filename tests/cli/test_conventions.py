@@ -9,7 +9,6 @@ import os
 import pty
 import re
 import shlex
-import shutil
 import subprocess
 import sys
 
@@ -68,10 +67,10 @@ def test_every_reporting_command_takes_json(name):
 
 def test_json_output_of_validate_plugins_and_predict_parses(tmp_path):
     done = run_cli("validate", "quickstart", "--json")
-    record = json.loads(done.stdout)[0]
+    record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == 0 and record["ok"] and record["name"] == "quickstart"
     done = run_cli("validate", "quickstart", "--set", "realizations=0", "--json")
-    record = json.loads(done.stdout)[0]
+    record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == ExitCode.USAGE and not record["ok"] and record["problems"][0].startswith("realizations")
     assert json.loads(run_cli("plugins", "--json").stdout)["plugins"]
     done = run_cli("predict", "--a", "1.5", "--b", "0.1", "--area", "1", "--modulus", "1", "--rms-height", "1",
@@ -168,91 +167,6 @@ def test_colour_on_a_terminal_only_and_never_with_no_color():
     error = in_terminal("run", "no-such-preset")
     assert COLOUR.search(error) and "error" in ANSI.sub("", error)
     assert not COLOUR.search(in_terminal("run", "no-such-preset", NO_COLOR="1"))
-
-
-def bash_complete(script: str, *words: str) -> list[str]:
-    line = " ".join(shlex.quote(w) for w in words)
-    code = f'source {shlex.quote(script)}\nCOMP_WORDS=({line})\nCOMP_CWORD={len(words) - 1}\n_frictionlab\nprintf "%s\\n" "${{COMPREPLY[@]}}"'
-    done = subprocess.run(["bash", "--norc", "-c", code], capture_output=True, text=True, timeout=30)
-    assert done.returncode == 0, done.stderr
-    return done.stdout.split()
-
-
-@pytest.mark.skipif(shutil.which("bash") is None, reason="bash is not installed")
-def test_bash_completion_sourced_in_bash_completes_commands_options_and_presets(tmp_path):
-    script = tmp_path / "frictionlab.bash"
-    script.write_text(run_cli("completion", "bash").stdout)
-    assert set(bash_complete(str(script), "frictionlab", "re")) == {"resume", "report"}
-    assert set(bash_complete(str(script), "frictionlab", "")) >= set(NAMES)
-    assert "--no-plot" in bash_complete(str(script), "frictionlab", "run", "--no")
-    assert "quickstart" in bash_complete(str(script), "frictionlab", "run", "qu")
-    assert bash_complete(str(script), "frictionlab", "completion", "f") == ["fish"]
-    assert "benad2012-fig2" in bash_complete(str(script), "frictionlab", "presets", "copy", "bena")
-
-
-ZSH_TAB = r"""
-zmodload zsh/zpty
-zpty shell 'zsh -f -i'
-zpty -w shell "PS1='> '; autoload -U compinit && compinit -u -D; source ${(q)1}"
-zpty -n -w shell "$2"$'\t'
-local out="" chunk
-integer quiet=0 i
-for i in {1..200}; do  # read until a second of silence after the completion, at most 20 s
-  if zpty -r -t shell chunk; then out+=$chunk; quiet=0; else sleep 0.1; (( quiet++ )); fi
-  [[ $out == *$'\a'* || $out == *"$2"?* ]] && (( quiet >= 10 )) && break
-done
-zpty -d shell
-print -r -- "$out"
-"""
-
-
-def zsh_tab(script, line: str) -> str:
-    """What an interactive zsh shows after ``line`` and one TAB, the script loaded
-    as its completion: the completed line, or the listed candidates."""
-    done = subprocess.run(["zsh", "-f", "-c", ZSH_TAB, "zsh", str(script), line], capture_output=True, text=True, timeout=60)
-    assert done.returncode == 0, done.stderr
-    return ANSI.sub("", done.stdout).replace("\r", "\n")
-
-
-@pytest.mark.skipif(shutil.which("zsh") is None, reason="zsh is not installed (the script is still checked as text below)")
-def test_zsh_completion_by_tab_in_an_interactive_zsh(tmp_path):
-    script = tmp_path / "_frictionlab"
-    script.write_text(run_cli("completion", "zsh").stdout)
-    listed = zsh_tab(script, "frictionlab re")
-    assert "report" in listed and "resume" in listed and "validate" not in listed
-    assert "frictionlab run quickstart" in zsh_tab(script, "frictionlab run qu")
-    assert "frictionlab completion fish" in zsh_tab(script, "frictionlab completion f")
-    assert "frictionlab presets copy benad2012-fig" in zsh_tab(script, "frictionlab presets copy bena")
-
-
-@pytest.mark.skipif(shutil.which("fish") is None, reason="fish is not installed (the script is still checked as text below)")
-def test_fish_completion_in_a_real_fish(tmp_path):
-    script = tmp_path / "frictionlab.fish"
-    script.write_text(run_cli("completion", "fish").stdout)
-
-    def complete(line: str) -> list[str]:
-        code = f"source {shlex.quote(str(script))}; complete -C {shlex.quote(line)}"
-        done = subprocess.run(["fish", "--no-config", "-c", code], capture_output=True, text=True, timeout=30)
-        assert done.returncode == 0, done.stderr
-        return [row.split("\t")[0] for row in done.stdout.splitlines()]
-
-    assert set(complete("frictionlab re")) == {"report", "resume"}
-    assert "--no-plot" in complete("frictionlab run --no")
-    assert complete("frictionlab completion f") == ["fish"]
-    assert "quickstart" in complete("frictionlab run qu")
-    assert "benad2012-fig2" in complete("frictionlab presets copy bena")
-
-
-def test_zsh_and_fish_scripts_name_every_command():
-    zsh = run_cli("completion", "zsh").stdout
-    assert zsh.startswith("#compdef frictionlab\n") and "bashcompinit" in zsh and "complete -o filenames -F _frictionlab" in zsh
-    fish = run_cli("completion", "fish").stdout
-    for name in NAMES:
-        assert f"-n __fish_use_subcommand -a {name} " in fish
-    assert "-n '__fish_seen_subcommand_from run' -l no-plot" in fish
-    if shutil.which("fish"):
-        done = subprocess.run(["fish", "--no-execute"], input=fish, capture_output=True, text=True, timeout=30)
-        assert done.returncode == 0, done.stderr
 
 
 def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path):

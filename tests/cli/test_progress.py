@@ -55,13 +55,12 @@ def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make
     assert ", 1.0/s," in line, line
 
 
-def test_a_notebook_gets_a_bar_even_without_a_terminal(monkeypatch):
+def in_a_notebook(monkeypatch, widgets: bool):
+    """As in a Jupyter kernel, with or without ipywidgets installed."""
+    import importlib.machinery
     import sys
     import types
 
-    from frictionlab.progress import wants_bar
-
-    assert not wants_bar(io.StringIO())
     ipython = types.ModuleType("IPython")
 
     class ZMQInteractiveShell:  # Jupyter's kernel shell, by its class name as IPython reports it
@@ -69,9 +68,32 @@ def test_a_notebook_gets_a_bar_even_without_a_terminal(monkeypatch):
 
     ipython.get_ipython = ZMQInteractiveShell
     monkeypatch.setitem(sys.modules, "IPython", ipython)
+    fake = types.ModuleType("ipywidgets")
+    fake.__spec__ = importlib.machinery.ModuleSpec("ipywidgets", None)
+    monkeypatch.setitem(sys.modules, "ipywidgets", fake if widgets else None)  # None: not installed
+    return ipython
+
+
+def test_a_notebook_with_ipywidgets_gets_a_bar_even_without_a_terminal(monkeypatch):
+    from frictionlab.progress import wants_bar
+
+    assert not wants_bar(io.StringIO())
+    ipython = in_a_notebook(monkeypatch, widgets=True)
     assert wants_bar(io.StringIO())
     ipython.get_ipython = lambda: None  # IPython imported, but a plain terminal shell or none
     assert not wants_bar(io.StringIO())
+
+
+def test_a_notebook_without_ipywidgets_gets_plain_lines_and_no_warning(monkeypatch, make_scene, recwarn):
+    in_a_notebook(monkeypatch, widgets=False)
+    stream = io.StringIO()
+    reporter = ProgressReporter(stream, after=0)
+    assert not reporter.interactive
+    engine.run(make_scene({"realizations": 10}), RunOptions(workers=1), listeners=[reporter])
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("small: 10 realizations") and lines[-1].startswith("10/10 realizations")
+    assert "\r" not in stream.getvalue() and "\x1b" not in stream.getvalue()
+    assert not [w for w in recwarn if "ipywidgets" in str(w.message)]
 
 
 def test_the_first_line_counts_the_workers_that_run_not_those_asked_for(make_scene):

@@ -44,7 +44,7 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
     assert 0 < fit["r2"] <= 1
     with open(out / "curve.csv") as fh:
         rows = [{column_name(k): v for k, v in row.items()} for row in csv.DictReader(fh)]
-    assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "contact_count", "contact_fraction", "indentation"]
+    assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation"]
     assert len(rows) == 16
     # the load and f say what they are: MDR's load is a force, f = F / (E* h L)
     header = (out / "curve.csv").read_text().splitlines()[0]
@@ -106,7 +106,7 @@ def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path):
 
 BAD_PRESETS = [
     ({"spectrum": {"params": {"hurst": 2.0}}}, "spectrum.params.hurst: must be <= 1.5, got 2.0"),
-    ({"spectrum": {"params": {"hurts": 0.5}}}, "spectrum.params.hurts: is not a known field; allowed:"),
+    ({"spectrum": {"params": {"hurts": 0.5}}}, "spectrum.params.hurts: is not a known field; did you mean 'hurst'? allowed:"),
     ({"spectrum": {"name": "power-lw"}}, "spectrum.name: no spectrum plugin named 'power-lw'; did you mean 'power-law'"),
     ({"solver": {"name": "bem"}}, "solver.name: no solver plugin named 'bem'"),
     ({"realizations": 0}, "realizations: must be >= 1, got 0"),
@@ -114,7 +114,7 @@ BAD_PRESETS = [
     ({"loading": {"start": -1.0}}, "loading.start: must be > 0.0, got -1.0"),
     ({"loading": {"start": 5.0, "stop": 1.0}}, "loading: stop must be > start (5.0). Got 1.0 instead."),
     ({"loading": {"control": "pressure"}}, "loading.control: must be one of 'force' or 'indentation'"),
-    ({"seeds": 3}, "seeds: is not a known field; allowed: description, fit, loading"),
+    ({"seeds": 3}, "seeds: is not a known field; did you mean 'seed'? allowed: description, fit, loading"),
     ({"solver": {"params": {"poisson_ratio": 0.7}}}, "solver.params.poisson_ratio: must be <= 0.5, got 0.7"),
 ]
 

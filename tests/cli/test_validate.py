@@ -48,7 +48,7 @@ def test_validate_says_what_is_pressed_by_the_name_the_preset_gives(tmp_path, ca
     assert main(["validate", str(preset)]) == ExitCode.OK
     assert f"realizations, {pressed} / {solver} / " in capsys.readouterr().out
     assert main(["validate", str(preset), "--json"]) == ExitCode.OK
-    record = json.loads(capsys.readouterr().out)[0]
+    record = json.loads(capsys.readouterr().out)["presets"][0]
     assert record["spectrum"] == spectrum["name"] and record["pressed"] == pressed
 
 

@@ -99,7 +99,8 @@ def test_every_grid_samples_the_same_surfaces(registry, hurst):
         np.testing.assert_allclose(fine[::4, ::4], coarse, rtol=0, atol=1e-12 * coarse.std())
 
 
-def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, capsys):
+def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # its default runs/ folder is made here, not in the checkout
     code = main(["exact3d", "--quick", "--presets", str(tmp_path), "--out", str(tmp_path / "out"), "--quiet"])
     assert code == ExitCode.USAGE
     err = capsys.readouterr().err

@@ -83,3 +83,22 @@ def test_cli(tmp_path, capsys, make_scene):
     assert "area must be a finite number > 0. Got -1.0 instead." in capsys.readouterr().err
     assert main([*args, "--from", str(tmp_path / "nothing")]) == 5  # a run folder that cannot be used
     assert "no readable summary.json" in capsys.readouterr().err
+
+
+def test_pairs_from_a_run_whose_lines_lack_xi_at_low_forces(tmp_path):
+    """The cosine series with the last point's slope undefined: some lines have no xi at the
+    first loads (NaN in realizations.npz); the pairs redrawn from the folder are still the run's own."""
+    from frictionlab.preset import build_scene
+
+    data = {
+        "name": "ends", "seed": 4, "realizations": 30, "fit": {"bootstrap": 200}, "output": {"plot": False},
+        "spectrum": {"name": "power-law", "params": {"hurst": 1.0, "points": 2048, "series": "cosine"}},
+        "slope": {"name": "forward-difference", "params": {"line_end": "undefined"}},
+        "loading": {"start": 1e-7, "stop": 1e-2, "steps": 12, "spacing": "log"},
+    }  # fmt: skip
+    outcome, _ = run_to_folder(build_scene(data), tmp_path, RunOptions(workers=1))
+    assert outcome.lines_used[0] < 30 and np.isnan(outcome.per_realization["xi"]).any()
+    assert f"up to {30 - outcome.lines_used.min()} of 30 lines have no xi at a load" in outcome.caveats[-1]
+    pairs = bootstrap_pairs(tmp_path)
+    low, high = np.percentile(pairs, [2.5, 97.5], axis=0)
+    assert (low[0], high[0]) == outcome.fit.a_ci and (low[1], high[1]) == outcome.fit.b_ci

@@ -127,18 +127,18 @@ def test_a_fit_field_of_the_wrong_type_or_range(run_copy, capsys, field, value):
     edit_summary(run_copy, change)
     code, _, err = predict_from(run_copy, capsys)
     assert code == ExitCode.RUN_FOLDER
-    assert "summary.json" in err and f"'{field}'" in err, err
+    assert "summary.json" in err and f"'{field}" in err, err  # the field, or an item of it ('fit.b_ci.0')
 
 
 def test_a_summary_without_a_fit(run_copy, capsys):
     edit_summary(run_copy, lambda summary: summary.update(fit=None))
     code, _, err = predict_from(run_copy, capsys)
-    assert code == ExitCode.RUN_FOLDER and "summary.json" in err and "no fit" in err
+    assert code == ExitCode.RUN_FOLDER and "summary.json" in err and "field 'fit' is null, but realizations were done" in err
 
 
 def test_a_missing_folder_is_a_run_folder_error(tmp_path, capsys):
     code, _, err = predict_from(tmp_path / "nothing", capsys)
-    assert code == ExitCode.RUN_FOLDER and "no readable summary.json" in err and "no such summary.json" in err
+    assert code == ExitCode.RUN_FOLDER and "no readable summary.json there (no such folder)" in err
 
 
 # ------------------------------------------------------------------ realizations.npz damaged

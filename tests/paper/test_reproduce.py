@@ -185,3 +185,47 @@ def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
     image = io.BytesIO()
     plot_fig5_calibrated(fig5, rows, image)
     assert image.getvalue().startswith(b"\x89PNG") and len(image.getvalue()) > 1000
+
+
+def test_replicates_are_independent_runs_and_their_spread_is_theirs(tmp_path, tiny_presets, tiny_runs):
+    """Each of K ensembles is the preset run with one of K seeds (the preset's, then one SeedSequence's):
+    rerun alone with ``--set seed=...``, each gives the same fit; the spread and the count of ensembles
+    holding the paper's pair are those of the K independent fits."""
+    from frictionlab.seeds import replicate_seeds
+
+    reading = Reading("fig2", "literal, h measured, last point without slope",
+                      ("spectrum.params.series=cosine", "spectrum.params.short_cutoff=20.0",
+                       "spectrum.params.height_reference=measured", "slope.params.line_end=undefined"))  # fmt: skip
+    (row,) = run_readings(tiny_runs, tmp_path, RunOptions(workers=1), readings=(reading,), replicates=4)
+    seeds = replicate_seeds(2012, 4)
+    assert row.seeds == seeds and seeds[0] == 2012 and len(set(seeds)) == 4
+    data = load_preset_file(tiny_presets / "benad2012-fig2.yaml")
+    fits = []
+    for seed in seeds:
+        scene = build_scene(apply_overrides(data, [*reading.overrides, f"seed={seed}"]))
+        fits.append(engine.run(scene, RunOptions(workers=1)).fit)
+    for mine, alone in zip(row.replicates, fits, strict=True):
+        assert (mine.a, mine.b, mine.a_ci, mine.b_ci) == (alone.a, alone.b, alone.a_ci, alone.b_ci)
+    assert row.fit is row.replicates[0]
+    a = [fit.a for fit in fits]
+    b = [fit.b for fit in fits]
+    (a_mean, a_sd), (b_mean, b_sd) = row.spread()
+    assert a_mean == pytest.approx(sum(a) / 4, rel=1e-12)
+    assert a_sd == pytest.approx(math.sqrt(sum((x - a_mean) ** 2 for x in a) / 3), rel=1e-12)
+    assert b_sd == pytest.approx(math.sqrt(sum((x - b_mean) ** 2 for x in b) / 3), rel=1e-12)
+    assert a_sd > 0 and b_sd > 0  # the ensembles differ
+    inside = lambda fit, pa, pb: fit.a_ci[0] <= pa <= fit.a_ci[1] and fit.b_ci[0] <= pb <= fit.b_ci[1]  # noqa: E731
+    for pa, pb in ((fits[0].a, fits[0].b), (a_mean, b_mean), (10.0, 1.0)):
+        assert row.holding(pa, pb) == sum(inside(fit, pa, pb) for fit in fits)
+    assert row.holding(10.0, 1.0) == 0 and row.holding(fits[0].a, fits[0].b) >= 1
+    text = "\n".join(readings_markdown([row]))
+    assert "a, b between ensembles | paper inside |" in text
+    assert f"{a_mean:.3f} ± {a_sd:.3f}, {b_mean:.4f} ± {b_sd:.4f} | {row.holding(1.8847, 0.0805)} of 4 |" in text
+    assert "**Fig. 2: H = 1, F = 1..20**: closest reading: literal, h measured" in text
+
+
+def test_replicates_need_readings(capsys):
+    assert main(["report", "--replicates", "3", "--quiet"]) == 2
+    assert "--replicates 3 needs --readings" in capsys.readouterr().err
+    assert main(["report", "--readings", "--replicates", "0", "--quiet"]) == 2
+    assert "--replicates must be a whole number from 1 to 100. Got 0 instead." in capsys.readouterr().err

@@ -27,7 +27,10 @@ KIND_HOOKS = {kind: base.register_hook for kind, base in KINDS.items()}
 def _builtin_cases():
     cases = []
     extra = {
-        ("spectrum", "power-law"): [{"hurst": 0.8, "points": 256}, {"hurst": 0.3, "points": 255, "amplitudes": "rayleigh"}],
+        ("spectrum", "power-law"): [{"hurst": 0.8, "points": 256}, {"hurst": 0.3, "points": 255, "amplitudes": "rayleigh"},
+                                    {"hurst": 1.0, "points": 256, "series": "cosine", "height_reference": "measured"}],
+        ("slope", "forward-difference"): [{}, {"line_end": "undefined"}],
+        ("slope", "central-difference"): [{}, {"line_end": "undefined"}],
         ("spectrum", "rolloff"): [{"hurst": 1.0, "points": 256, "rolloff_wavelength": 64.0}],
         ("spectrum", "profile-file"): [{"path": "<profile>", "spacing": 0.5}],
         ("spectrum", "surface-file"): [{"path": "<surface>", "spacing": 0.5}],

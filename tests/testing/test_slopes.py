@@ -45,3 +45,29 @@ SLOPE_BREAKAGES = [
 def test_slope_check_fails_for_broken_estimators(qualname, slopes, match):
     cls = slopes_variant(qualname, slopes)
     fails_naming(fltesting.check_slope_estimator, cls, match)
+
+
+def _nan_at(index):
+    def slopes(self, z, dx, periodic=True):
+        out = forward_differences(z, dx, periodic)
+        if not periodic:
+            out[index] = np.nan
+        return out
+
+    return slopes
+
+
+@pytest.mark.parametrize(
+    "qualname,slopes,undefined,match",
+    [
+        ("UndeclaredEnd", _nan_at(-1), lambda self, periodic: False, "must be finite"),
+        ("InnerNaN", _nan_at(5), lambda self, periodic: not periodic, "on the edge of the profile only"),
+        ("UndefinedWhenPeriodic", _nan_at(-1), lambda self, periodic: True, r"undefined_points\(True\) must be False"),
+    ],
+)
+def test_slope_check_holds_undefined_points_to_the_edge_of_a_scan(qualname, slopes, undefined, match):
+    cls = type(qualname, (slopes_variant(qualname, slopes),), {"undefined_points": undefined})
+    fails_naming(fltesting.check_slope_estimator, cls, match)
+    ends = type("UndefinedEnd", (slopes_variant("UndefinedEnd", _nan_at(-1)),),
+                {"undefined_points": lambda self, periodic: not periodic})  # fmt: skip
+    fltesting.check_slope_estimator(ends)

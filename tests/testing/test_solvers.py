@@ -104,9 +104,17 @@ def test_solver_check_fails_when_periodic_only_is_not_kept():
         fltesting.check_solver(cls)
 
 
+def test_solver_check_fails_when_undefined_slopes_are_not_left_out():
+    """GoodSolver's rms takes NaN slopes in, and NaN out at every load: it may not declare them."""
+    cls = type("NaNPropagating", (GoodSolver,), {"name": "nan-propagating", "undefined_slopes": True})
+    with pytest.raises(AssertionError, match="undefined_slopes: with slopes 1 and NaN at the top point"):
+        fltesting.check_solver(cls)
+
+
 @pytest.mark.parametrize(
     "attributes,match",
     [
+        ({"undefined_slopes": "yes"}, "undefined_slopes must be True or False. Got 'yes'"),
         ({"normalisations": {}}, "normalisations must map each of its dimensions"),
         ({"dimensions": (1, 2)}, "normalisations must map each of its dimensions"),
         ({"problem": ""}, "problem must name the physical problem"),

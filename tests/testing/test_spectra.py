@@ -68,6 +68,32 @@ def test_spectrum_check_fails_for_wrong_declarations():
     cls = spectrum_variant("LineOfALine", equivalent_line=lambda self: GoodSpectrum())
     with pytest.raises(AssertionError, match=r"equivalent_line\(\) must be None"):
         fltesting.check_spectrum(cls)
+    # GoodSpectrum's lines all have rms 1: an own h that follows each line's first height differs between them
+    cls = spectrum_variant("OwnHeightPerLine", profile_rms_height=lambda self, profile: 1.0 + abs(float(profile.heights[0])))
+    with pytest.raises(AssertionError, match=r"profile_rms_height\(profile\) must be one h for the ensemble"):
+        fltesting.check_spectrum(cls)
     cls = spectrum_variant("NegativeHurst", hurst_exponent=lambda self: -1.0)
     with pytest.raises(AssertionError, match=r"hurst_exponent\(\)"):
         fltesting.check_spectrum(cls)
+
+
+def _summary(self, **changes):
+    made = GoodSpectrum.generate(self, np.random.default_rng(0))
+    summary = {"file": "scan.x3p", "shape": list(made.heights.shape), "spacing": made.spacing, "unit": "um",
+               "rms_height": self.rms_height()}  # fmt: skip
+    return {**summary, **changes}
+
+
+@pytest.mark.parametrize("qualname,summary,match", [
+    ("NotJson", lambda self: {**_summary(self), "shape": np.array([3])}, "JSON-ready"),
+    ("NaNInSummary", lambda self: _summary(self, rms_height=float("nan")), "JSON-ready"),
+    ("NoUnit", lambda self: {k: v for k, v in _summary(self).items() if k != "unit"}, "at least file, shape"),
+    ("WrongSpacing", lambda self: _summary(self, spacing=123.0), "spacing"),
+    ("WrongShape", lambda self: _summary(self, shape=[2, 2]), "the shape"),
+])  # fmt: skip
+def test_spectrum_check_fails_for_a_wrong_input_summary(qualname, summary, match):
+    fails_naming(fltesting.check_spectrum, spectrum_variant(qualname, input_summary=summary), match)
+
+
+def test_spectrum_check_passes_a_true_input_summary():
+    fltesting.check_spectrum(spectrum_variant("TrueSummary", input_summary=_summary))

@@ -1,5 +1,6 @@
 """The app's keys and help, the ``tui`` command, and a process pool started from the app's thread."""
 
+import os
 import subprocess
 import sys
 
@@ -108,3 +109,17 @@ def test_the_tui_without_a_terminal_says_so_and_exits_2(tmp_path):
     done = subprocess.run([sys.executable, "-m", "frictionlab", "tui"], stdin=subprocess.DEVNULL, capture_output=True,
                           text=True, cwd=tmp_path, timeout=60)  # fmt: skip
     assert done.returncode == 2 and "needs a terminal" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_the_tui_on_a_dumb_terminal_says_so_and_exits_2_before_importing_textual(tmp_path):
+    """TERM=dumb has no cursor addressing, which Textual needs to draw at all: refused with
+    a message (NO_COLOR, which Textual draws in monochrome, is named as the way without colour)."""
+    code = (
+        "import sys; from frictionlab.cli import main; rc = main(['tui']); "
+        "print(rc, sorted(m for m in sys.modules if m.split('.')[0] == 'textual'))"
+    )
+    env = {**os.environ, "TERM": "dumb"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=60)
+    assert done.stdout.strip().splitlines()[-1] == "2 []", done.stderr
+    assert "TERM=dumb says this terminal cannot move its cursor" in done.stderr and "NO_COLOR=1" in done.stderr
+    assert "Traceback" not in done.stderr

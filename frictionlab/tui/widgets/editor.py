@@ -18,7 +18,7 @@ class EditPane(Vertical):
     def __init__(self, registry, **kwargs):
         super().__init__(**kwargs)
         self.registry = registry
-        self._shown: list[str] | None = None  # the problems the panel shows
+        self._shown: tuple[list[str], str] | None = None  # the problems the panel shows, and what was read
 
     def compose(self) -> ComposeResult:
         yield PathLine(id="edit-title")
@@ -35,10 +35,11 @@ class EditPane(Vertical):
         count = f", {len(problems)} problem{'s' if len(problems) != 1 else ''}" if problems else ""
         title.show("", str(path), f"  ({state}{count})")
 
-    def show_problems(self, problems: list[str]) -> None:
-        if problems == self._shown:
+    def show_problems(self, problems: list[str], read: str = "") -> None:
+        """The validator's problems, or that the draft is valid with what it read from a file."""
+        if (problems, read) == self._shown:
             return  # unchanged: no new layout for a keystroke that changes nothing here
-        self._shown = list(problems)
+        self._shown = (list(problems), read)
         panel = self.query_one("#problems", Static)
         if problems:
             count = len(problems)
@@ -46,7 +47,7 @@ class EditPane(Vertical):
             panel.update(Content.assemble(head, " (as frictionlab validate says):\n", "\n".join(problems)))
             panel.set_class(True, "-invalid")
         else:
-            panel.update("valid: Ctrl+R runs it, Ctrl+S saves it")
+            panel.update("valid: Ctrl+R runs it, Ctrl+S saves it" + (f"\n{read}" if read else ""))
             panel.set_class(False, "-invalid")
 
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:

@@ -27,7 +27,7 @@ from ..fields import (
     parse,
     problem_path,
     problems_for,
-    problems_of,
+    validation_of,
 )
 from .keyinput import KeyInput
 
@@ -45,12 +45,14 @@ class PresetForm(VerticalScroll):
     """Edits ``data`` (the preset as a plain mapping, unknown sections kept)."""
 
     class Edited(Message):
-        """The draft changed (or was loaded): ``problems`` is the headless list."""
+        """The draft changed (or was loaded): ``problems`` is the headless list; ``read``,
+        what a valid draft's spectrum read from its file ("" when none)."""
 
-        def __init__(self, problems: list[str], changed: bool):
+        def __init__(self, problems: list[str], changed: bool, read: str = ""):
             super().__init__()
             self.problems = problems
             self.changed = changed
+            self.read = read
 
     class FieldFocused(Message):
         def __init__(self, spec: FieldSpec | None):
@@ -266,7 +268,9 @@ class PresetForm(VerticalScroll):
         """Run the headless validator on the draft and mark every field whose
         messages changed (only those: each change lays the form out again, and
         that, not the validator, is what a keystroke costs)."""
-        self.problems = problems_of(self.data, self.registry, self.base_dir) if self.data is not None else []
+        self.problems, read = [], ""
+        if self.data is not None:
+            self.problems, read = validation_of(self.data, self.registry, self.base_dir)
         shown = set()
         for widget_id, spec in self._specs.items():
             messages = problems_for(self.problems, spec.dotted)
@@ -284,7 +288,7 @@ class PresetForm(VerticalScroll):
                     self._marked[section.id] = messages
                     section.update(Content("\n".join(messages)))
                     section.display = bool(messages)
-        self.post_message(self.Edited(self.problems, changed))
+        self.post_message(self.Edited(self.problems, changed, read))
 
     def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
         if self._marked.get(widget_id, []) == messages:

@@ -15,6 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
+from ...errors import FrictionlabError
 from ...fit import format_interval
 from ..chart import Series
 from ...results import read_curve
@@ -121,11 +122,10 @@ class ResultsPane(Vertical):
             row = points.cursor_row
             if not 0 <= row < len(self.open_sweep.points):
                 return
-            folder = self.open_sweep.point_folder(self.open_sweep.points[row])
             try:
-                entry = read_run(folder)
-            except (OSError, ValueError, TypeError):
-                self.app.say(f"{folder.name}: this point has no finished run", "warning")
+                entry = read_run(self.open_sweep.point_folder(self.open_sweep.points[row]))
+            except (OSError, FrictionlabError) as exc:
+                self.app.say(f"this point has no finished run to show ({exc})", "warning")
                 return
         else:
             row = self.query_one("#runs-table", DataTable).cursor_row
@@ -173,8 +173,8 @@ class ResultsPane(Vertical):
         series, lines = [], []
         for style, entry in zip(OVERLAY_STYLES, self.overlay):
             try:
-                curve = read_curve(entry.path / "curve.csv")
-            except (OSError, ValueError, KeyError) as exc:
+                curve = read_curve(entry.path)
+            except (OSError, FrictionlabError) as exc:
                 lines.append(Content.assemble((entry.path.name, style), f": no curve ({exc})"))
                 continue
             f, xi = np.array(curve.get("f", []), float), np.array(curve.get("xi", []), float)

@@ -1,0 +1,78 @@
+"""Checking the arguments of the Python API (``frictionlab.run``, ``frictionlab.load``,
+``Result``): a value of the wrong kind, or data beyond the limits a preset file has,
+is a FrictionlabError naming the argument, never a TypeError or RecursionError from
+deep inside."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+from .errors import FrictionlabError, short_repr
+from .safe_yaml import MAX_DEPTH, MAX_VALUES
+
+_SCALARS = (str, int, float, bool, type(None), os.PathLike)
+
+
+def path_argument(value, name: str, what: str) -> Path:
+    """``value`` as a Path to ``what``: a str or os.PathLike, not empty, without NUL."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if isinstance(value, bytes):
+        value = os.fsdecode(value)
+    if not isinstance(value, str):
+        raise FrictionlabError(f"{name} must be a path to {what} (a str or pathlib.Path), got {type(value).__name__}")
+    if not value:
+        raise FrictionlabError(f"{name} must be a path to {what}, got an empty string")
+    if "\0" in value:
+        raise FrictionlabError(f"{name} must be a path to {what}, got a string with a NUL character")
+    return Path(value)
+
+
+def flag_argument(value, name: str) -> bool:
+    if not isinstance(value, bool):
+        raise FrictionlabError(f"{name} must be True or False, got {type(value).__name__}")
+    return value
+
+
+def data_argument(value, name: str) -> None:
+    """Refuse preset data a preset file could not hold: nesting deeper than the YAML
+    limit, more values than it, a mapping key that is not a string, or an object that
+    is not a str, number, bool, None, path, list or mapping. Walked without recursion,
+    so a dict nested 10,000 deep (or one that contains itself) is refused, not a crash."""
+    stack, count = [(value, 0, name)], 0
+    while stack:
+        item, depth, where = stack.pop()
+        count += 1
+        if count > MAX_VALUES:
+            raise FrictionlabError(f"{name} holds more than {MAX_VALUES:,} values, the limit of a preset")
+        if depth > MAX_DEPTH:
+            raise FrictionlabError(f"{name} is nested more than {MAX_DEPTH} levels deep, the limit of a preset")
+        if isinstance(item, Mapping):
+            for key, child in item.items():
+                if not isinstance(key, str):
+                    raise FrictionlabError(f"{where}: keys must be strings, got {type(key).__name__} {short_repr(key, 40)}")
+                stack.append((child, depth + 1, f"{where}.{key}"[:200]))
+        elif isinstance(item, list | tuple):
+            stack.extend((child, depth + 1, f"{where}[{i}]"[:200]) for i, child in enumerate(item))
+        elif not isinstance(item, _SCALARS):
+            raise FrictionlabError(
+                f"{where} must be a str, number, bool, None, list or mapping, got {type(item).__name__}"
+            )
+
+
+def overrides_argument(value) -> dict:
+    """``overrides`` (None, or a mapping of dotted paths to values) as a dict."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise FrictionlabError(f"overrides must be a mapping of dotted keys to values, got {type(value).__name__}")
+    for key in value:
+        if not isinstance(key, str):
+            raise FrictionlabError(
+                f"overrides must be a mapping of dotted keys to values: key {short_repr(key, 40)} is of type "
+                f"{type(key).__name__}, not str"
+            )
+    data_argument(value, "overrides")
+    return dict(value)

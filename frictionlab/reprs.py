@@ -1,0 +1,60 @@
+"""How a run's result shows in a notebook (``Result._repr_html_``): the fit as a table
+with its intervals, rounded as the CLI prints it, and the curve as an inline image.
+Every text is escaped: a preset's name or a caveat is data, not markup."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+
+from .fit import format_interval, format_number
+
+
+def result_html(result) -> str:
+    """A ``frictionlab.Result`` as HTML: status, the fit's table, the curve, caveats."""
+    done, requested = result.realizations
+    parts = [
+        f"<p><strong>{html.escape(result.name)}</strong>: {html.escape(result.status)}, "
+        f"{done}/{requested} realizations in {result.elapsed:.2f} s</p>"
+    ]
+    fit = result.fit
+    if fit is None:
+        parts.append("<p>no fit: no realization finished</p>")
+    else:
+        level = f"{100 * fit.confidence:g}% CI" + (f" (bootstrap {fit.bootstrap})" if fit.bootstrap else "")
+        rows = "".join(
+            f"<tr><td>{name}</td><td>{format_number(value)}</td><td>{_number(se)}</td>"
+            f"<td>{html.escape(format_interval(ci))}</td></tr>"
+            for name, value, se, ci in (("a", fit.a, fit.a_se, fit.a_ci), ("b", fit.b, fit.b_se, fit.b_ci))
+        )
+        parts.append(
+            "<table><thead><tr><th>xi = a + b ln f</th><th>estimate</th><th>std. err.</th>"
+            f"<th>{html.escape(level)}</th></tr></thead><tbody>{rows}</tbody></table>"
+        )
+        parts.append(
+            f"<p>R² = {_number(fit.r2)}, residual rms = {_number(fit.residual_rms)}, {fit.points} load steps; "
+            f"{html.escape(result.normalisation)}</p>"
+        )
+    if len(result.table.get("f", ())):
+        parts.append(f'<img alt="xi against f" src="data:image/png;base64,{_curve_png(result)}">')
+    parts += [f"<p>caveat: {html.escape(caveat)}</p>" for caveat in result.caveats]
+    if result.folder is not None:
+        parts.append(f"<p>results in <code>{html.escape(str(result.folder))}</code></p>")
+    return "<div>" + "".join(parts) + "</div>"
+
+
+def _number(value: float) -> str:
+    return format_number(value) if math.isfinite(value) else "n/a"
+
+
+def _curve_png(result) -> str:
+    """``result.plot()`` on a bare figure (no pyplot: a notebook's backend is left alone), as base64 PNG."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.4, 4.2), layout="constrained")
+    result.plot(figure.subplots())
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=72)
+    return base64.b64encode(buffer.getvalue()).decode("ascii")

@@ -1,0 +1,115 @@
+"""Instrument files (X3P, SUR, DATX, OPD, IBW, NMD, DI, NetCDF, Gwyddion...) read by
+SurfaceTopography, the optional extra ``topography``: the heights with the pixel size
+and the length unit the file carries, converted to the unit a preset asks for.
+
+SurfaceTopography is imported here only when such a file is read (its import takes
+seconds). It lays a map out as heights[x, y]; a map here is z[row, column] = z[y, x],
+so its array is transposed. Undefined points (an optical scan's dropouts) are refused,
+or filled by the solution of Laplace's equation from their defined neighbours (SurfaceTopography's
+harmonic interpolation) when the preset chooses ``undefined: harmonic``.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from frictionlab import InputFileProblem, open_regular_file
+
+TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
+TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
+# the units a preset may ask for, in metres
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
+Unit = Literal["m", "mm", "um", "nm", "pm"]
+Undefined = Literal["refuse", "harmonic"]
+SQUARE_TOLERANCE = 1e-6  # relative difference of a pixel's two sides still taken as square
+
+
+@dataclass(frozen=True)
+class Scan:
+    """What an instrument file gave: heights and pixel size in ``unit`` (the preset's, or the
+    file's own when the preset names none)."""
+
+    heights: np.ndarray  # float64, (Ny, Nx) for a map, (N,) for a line
+    spacing: float
+    unit: str | None
+    file_unit: str | None  # as the file says it (SurfaceTopography's spelling)
+    periodic: bool
+    format: str
+    channel: str
+    undefined: int  # points the file leaves undefined (filled when the preset says how)
+
+
+def is_instrument_file(path: Path) -> bool:
+    """Whether ``path`` is not one of frictionlab's own tables (.npy, .csv, .txt)."""
+    return path.suffix.lower() not in TABLE_SUFFIXES
+
+
+def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str) -> Scan:
+    """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and spacing
+    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
+    try:
+        from SurfaceTopography import open_topography
+        from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
+    except ImportError:
+        raise ValueError(
+            f"{where}: {path.suffix or 'a file without suffix'} is not a .npy, .csv or .txt table; instrument "
+            f"files (X3P, SUR, DATX, OPD, IBW, NetCDF...) are read by the optional extra topography: "
+            f"{TOPOGRAPHY_EXTRA}"
+        ) from None
+    try:
+        fh = open_regular_file(path)
+    except InputFileProblem as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    with fh, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
+        try:
+            reader = open_topography(fh)
+            channel = reader.default_channel
+            topography = reader.topography(channel_index=channel.index)
+            heights = topography.heights()
+        except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
+            raise ValueError(
+                f"{where}: not an instrument file SurfaceTopography reads ({type(exc).__name__}); "
+                "use an instrument format it lists, or a .npy, .csv or .txt table with spacing"
+            ) from None
+        if topography.dim != dimension:
+            kind = {1: "a line scan", 2: "a 2D map"}
+            advice = "use surface-file" if topography.dim == 2 else "use profile-file"
+            raise ValueError(f"{where}: the file holds {kind.get(topography.dim, topography.dim)}; {advice}")
+        missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
+        if missing:
+            if undefined == "refuse":
+                raise ValueError(
+                    f"{where}: {missing} of {heights.size} points are undefined in the file (not measured); "
+                    "set undefined: harmonic to fill them from their neighbours, or fix the scan"
+                )
+            topography = topography.interpolate_undefined_data(method=undefined)
+            heights = topography.heights()
+        pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
+        periodic = bool(topography.is_periodic)
+    if not np.all(pixel > 0) or not math.isclose(pixel.min(), pixel.max(), rel_tol=SQUARE_TOLERANCE):
+        raise ValueError(f"{where}: pixels of {' x '.join(f'{p:g}' for p in pixel)}; square pixels are needed")
+    file_unit = topography.unit if isinstance(topography.unit, str) else None
+    factor = 1.0
+    if unit is not None and file_unit is not None:
+        try:
+            factor = float(get_unit_conversion_factor(file_unit, unit))
+        except Exception:
+            raise ValueError(f"{where}: the file's unit {file_unit!r} is not a length unit") from None
+    z = np.array(np.ma.getdata(heights), dtype=np.float64) * factor
+    return Scan(
+        heights=np.ascontiguousarray(z.T) if dimension == 2 else z,  # C order, as a .npy map: the same sums
+        spacing=float(pixel.mean()) * factor,
+        unit=unit if unit is not None else file_unit,
+        file_unit=file_unit,
+        periodic=periodic,
+        format=str(reader.name()),
+        channel=str(channel.name),
+        undefined=missing,
+    )

@@ -1,0 +1,49 @@
+"""Output folders are tried for writing before long work starts: exact3d, study and report
+refuse one where no file can be created (exit 4, naming the option and the folder) before
+any run, and make no folder."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab.files import output_path_problem
+
+# /proc/1 refuses new files to every user, root too (a chmod'ed folder would not stop root)
+UNWRITABLE = Path("/proc/1")
+pytestmark = pytest.mark.skipif(not UNWRITABLE.is_dir(), reason="needs Linux's /proc")
+
+
+@pytest.mark.parametrize(
+    "argv, option",
+    [
+        (["exact3d", "--quick", "--quiet", "--out", "OUT"], "--out"),
+        (["exact3d", "--quick", "--quiet", "--runs", "OUT"], "--runs"),
+        (["study", "quickstart", "--quiet", "--out", "OUT"], "--out"),
+        (["report", "--out", "OUT"], "--out"),
+        (["report", "--markdown", "OUT/REPRODUCTION.md"], "--markdown"),
+        (["run", "quickstart", "--quiet", "--out", "OUT"], ""),
+    ],
+)
+def test_an_output_folder_no_file_can_be_written_in_is_refused_before_any_work(tmp_path, monkeypatch, capsys, argv, option):
+    monkeypatch.chdir(tmp_path)
+    out = UNWRITABLE / "frictionlab-out"
+    code = main([arg.replace("OUT", str(out)) for arg in argv])
+    err = capsys.readouterr().err
+    assert code == ExitCode.OUTPUT_REFUSED, err
+    assert f"{out} cannot be written in (it would be made in {UNWRITABLE})" in err and option in err
+    assert list(tmp_path.iterdir()) == []  # no default runs/ folder, no run started
+
+
+def test_output_path_problem_tries_a_file_and_leaves_nothing(tmp_path):
+    assert output_path_problem(tmp_path / "new" / "deeper") is None
+    assert list(tmp_path.iterdir()) == []  # the probe file is gone, no folder made
+    assert "cannot be written in" in output_path_problem(UNWRITABLE)
+    if os.geteuid() != 0:  # permissions stop any user but root
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o555)
+        assert "Permission denied" in output_path_problem(locked / "out")

@@ -1,0 +1,100 @@
+"""Claims of the docs checked against what the code does: the generated CLI reference
+shows every help text as written, and the measured-profile page's exit codes are those
+the commands return."""
+
+import importlib.util
+import re
+
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+
+from .conftest import ROOT, SMALL_PRESET
+
+
+def _hooks():
+    spec = importlib.util.spec_from_file_location("docs_reference_hooks", ROOT / "docs" / "hooks" / "reference.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _outside_code(page: str) -> list[str]:
+    lines, fenced = [], False
+    for line in page.splitlines():
+        if line.startswith("```"):
+            fenced = not fenced
+        elif not fenced:
+            lines.append(re.sub(r"`[^`]*`", "", line))  # an inline code span shows <name> as written
+    return lines
+
+
+def test_the_cli_reference_shows_angle_brackets_instead_of_dropping_them_as_tags():
+    page = _hooks().cli_reference()
+    assert "(default: runs/&lt;name&gt;-&lt;timestamp&gt;)" in page  # run --out
+    assert page.count("-&lt;timestamp&gt;)") >= 4  # and report's, study's --out, exact3d's --runs
+    assert "runs/-" not in page and "(LO &lt;= HI)" in page
+    tags = [line for line in _outside_code(page) if re.search(r"<[A-Za-z/!]", line)]
+    assert tags == [], tags[:3]  # Markdown would take them for HTML and show nothing
+
+
+def test_the_json_reference_has_no_bare_tags_either():
+    assert [line for line in _outside_code(_hooks().json_reference()) if re.search(r"<[A-Za-z/!]", line)] == []
+
+
+PROFILE_PAGE = ROOT / "docs" / "tutorials" / "measured-profile.md"
+
+
+@pytest.mark.parametrize(
+    "heights", [None, ["1.0"] * 50 + ["nan"] + ["2.0"] * 50, ["1.0"] * 100, ["1.0", "2.0"]],
+    ids=["missing", "nan", "constant", "too-short"],
+)  # fmt: skip
+def test_a_bad_profile_is_refused_up_front_with_the_exit_code_the_page_gives(tmp_path, capsys, heights):
+    text = " ".join(PROFILE_PAGE.read_text(encoding="utf-8").split())
+    assert "refuse it with exit code 2 before any run folder is made" in text and "exit code 1" not in text
+    if heights is not None:
+        (tmp_path / "scan.csv").write_text("\n".join(heights) + "\n")
+    preset = tmp_path / "scan.yaml"
+    preset.write_text(yaml.safe_dump({**SMALL_PRESET, "spectrum": {"name": "profile-file",
+                                                                    "params": {"path": "scan.csv", "spacing": 1.0}}}))  # fmt: skip
+    assert main(["validate", str(preset)]) == ExitCode.USAGE == 2
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert "scan.csv" in capsys.readouterr().err and not (tmp_path / "o").exists()
+
+
+def test_ci_runs_the_long_tests_the_readmes_command_leaves_out():
+    import tomllib
+
+    options = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["pytest"]["ini_options"]
+    assert "-n auto" in options["addopts"]
+    assert any(marker.startswith("long:") for marker in options["markers"])
+    ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
+    assert ci.index("pytest -m long") > ci.index('pip install -e ".[test]" && pytest')
+
+
+def _collected(*args: str) -> str:
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "-n", "0", *args],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-2000:]
+    return done.stdout.strip().splitlines()[-1]
+
+
+def test_a_long_module_named_on_the_command_line_runs_whole():
+    """`pytest tests/exact3d/test_study.py` (as one runs the file one changed) deselects nothing."""
+    assert re.fullmatch(r"\d+ tests collected in .*", _collected("tests/exact3d/test_study.py"))
+    assert re.fullmatch(r"\d+ tests collected in .*", _collected("tests/tui/test_form.py"))
+
+
+@pytest.mark.long  # three collections of the whole suite
+def test_a_bare_pytest_leaves_out_exactly_the_long_and_slow_tests():
+    bare = re.fullmatch(r"(\d+)/(\d+) tests collected \((\d+) deselected\) in .*", _collected())
+    long = re.fullmatch(r"(\d+)/(\d+) tests collected \((\d+) deselected\) in .*", _collected("-m", "long"))
+    assert bare and long and bare.group(2) == long.group(2)  # the same tests, selected two ways
+    slow = re.fullmatch(r"(\d+)/(\d+) tests collected .*", _collected("-m", "slow and not long"))
+    assert int(bare.group(3)) == int(long.group(1)) + int(slow.group(1))
+    assert int(long.group(1)) >= 50  # the TUI sessions and the 3D study at least

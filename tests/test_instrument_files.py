@@ -1,0 +1,278 @@
+"""Instrument files (the extra ``topography``) read by surface-file and profile-file.
+
+The files are written here by the writers that exist, with known heights and pixel
+sizes: X3P by x3pio (ISO 5436-2000 revision, heights and sizes in metres), NetCDF
+and Gwyddion by SurfaceTopography. What is checked:
+
+* the numbers read are the numbers written, in the unit the preset asks for;
+* f and xi do not depend on the unit: the same scan in um and in nm, pressed with
+  loads scaled as the unit of a force (E* h L: length^2), gives the same f and xi;
+* a scan and the same heights as a .npy with the matching spacing give identical
+  results from a preset, end to end;
+* undefined points are refused, or filled and recorded; without the extra a file
+  of such a format gets a message naming it, exit 2.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+
+import numpy as np
+import pytest
+import x3pio
+import yaml
+from SurfaceTopography import Topography, UniformLineScan
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode, PresetError
+from frictionlab.preset import build_scene
+from frictionlab.testing import check_plugin
+from frictionlab_spectra import ProfileFile, SurfaceFile
+
+PIXEL_UM = 0.125  # exact in float32, which NetCDF stores sizes in
+ROWS, COLUMNS = 24, 32
+
+
+def scan_um(seed=0):
+    """A rough map z[row, column] in um (rows along y, columns along x)."""
+    rng = np.random.default_rng(seed)
+    z = np.cumsum(np.cumsum(rng.standard_normal((ROWS, COLUMNS)), axis=0), axis=1)
+    return 0.05 * (z - z.mean()) / z.std()
+
+
+def write_x3p(path, z_um, pixel_um=PIXEL_UM):
+    x3pio.write(path, z_um * 1e-6, x_scale=pixel_um * 1e-6, y_scale=pixel_um * 1e-6,
+                revision=x3pio.Revision.ISO5436_2000)  # the revision SurfaceTopography 1.27 reads  # fmt: skip
+
+
+def write_topography(path, z, pixel, unit, writer):
+    """Through SurfaceTopography, which lays a map out as heights[x, y]."""
+    topography = Topography(z.T.copy(), (z.shape[1] * pixel, z.shape[0] * pixel), unit=unit)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        getattr(topography, writer)(str(path))
+
+
+WRITERS = {
+    "x3p": lambda path, z: write_x3p(path, z),
+    "nc": lambda path, z: write_topography(path, z, PIXEL_UM, "um", "to_netcdf"),
+    "gwy": lambda path, z: write_topography(path, z * 1e3, PIXEL_UM * 1e3, "nm", "to_gwy"),
+}
+
+
+@pytest.mark.parametrize("suffix", sorted(WRITERS))
+@pytest.mark.parametrize("unit, factor", [("um", 1.0), ("nm", 1e3), (None, None)])
+def test_the_numbers_read_are_the_numbers_written_in_the_unit_asked(tmp_path, suffix, unit, factor):
+    z = scan_um()
+    path = tmp_path / f"scan.{suffix}"
+    WRITERS[suffix](path, z)
+    surface = SurfaceFile(path=str(path), unit=unit, detrend="none")
+    made = surface.generate(None)
+    summary = surface.input_summary()
+    if unit is None:  # the file's own unit
+        factor = {"x3p": 1e-6, "nc": 1.0, "gwy": 1e-6}[suffix]  # X3P and Gwyddion store metres
+        assert summary["unit_from"] == "file"
+    else:
+        assert summary["unit"] == unit and summary["unit_from"] == "preset"
+    assert made.heights.shape == (ROWS, COLUMNS)
+    np.testing.assert_allclose(made.heights, z * factor, rtol=1e-12, atol=1e-15 * factor)
+    assert made.spacing == pytest.approx(PIXEL_UM * factor, rel=1e-12)
+    assert summary["spacing_from"] == "file" and summary["shape"] == [ROWS, COLUMNS]
+    assert summary["rms_height"] == pytest.approx(np.std(z) * factor, rel=1e-12)
+    assert made.periodic is False and summary["periodic_from"] == "file"
+
+
+def test_the_preset_may_override_the_pixel_size_and_says_so(tmp_path):
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    surface = SurfaceFile(path=str(tmp_path / "scan.x3p"), unit="um", spacing=0.5)
+    assert surface.generate(None).spacing == 0.5
+    summary = surface.input_summary()
+    assert summary["spacing_from"] == "preset" and summary["file_spacing"] == pytest.approx(PIXEL_UM, rel=1e-12)
+    assert SurfaceFile(path=str(tmp_path / "scan.x3p"), periodic=True).periodic() is True
+
+
+def test_a_file_that_says_it_is_periodic_is_periodic_unless_the_preset_says_otherwise(tmp_path):
+    z = scan_um()
+    topography = Topography(z.T.copy(), (COLUMNS * PIXEL_UM, ROWS * PIXEL_UM), unit="um", periodic=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        topography.to_netcdf(str(tmp_path / "tile.nc"))
+    surface = SurfaceFile(path=str(tmp_path / "tile.nc"))
+    assert surface.periodic() is True and surface.generate(None).periodic is True
+    assert surface.input_summary()["periodic_from"] == "file"
+    scene = build_scene(preset(tmp_path / "tile.nc", "um", solver="bem-halfspace"))  # the periodic solver takes it
+    assert scene.spectrum.periodic() is True
+    overridden = SurfaceFile(path=str(tmp_path / "tile.nc"), periodic=False)
+    assert overridden.periodic() is False and overridden.input_summary()["periodic_from"] == "preset"
+    with pytest.raises(PresetError, match="bem-halfspace presses periodic profiles only.*bem-halfspace-free"):
+        build_scene(preset(tmp_path / "tile.nc", "um", solver="bem-halfspace", periodic=False))
+
+
+def test_conformance_with_an_instrument_file(tmp_path):
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    check_plugin("spectrum", SurfaceFile, deterministic=True, path=str(tmp_path / "scan.x3p"), unit="nm")
+
+
+def preset(path, unit, loads=(0.005, 0.2), solver="mdr", **params):  # f from 0.02 to 1 in um
+    return {
+        "name": "scan", "seed": 1, "realizations": 1, "fit": {"bootstrap": 0},
+        "spectrum": {"name": "surface-file",
+                     "params": {"path": str(path), **({"unit": unit} if unit else {}), **params}},
+        "solver": {"name": solver}, "slope": {"name": "forward-difference"},
+        "loading": {"start": loads[0], "stop": loads[1], "steps": 4, "spacing": "log"},
+    }  # fmt: skip
+
+
+def run(tmp_path, data, name):
+    from frictionlab.api import run_scene
+    from frictionlab.options import RunOptions
+
+    return run_scene(build_scene(data), tmp_path / name, RunOptions(workers=1), plot=False)
+
+
+@pytest.mark.parametrize("solver", ["mdr", "bem-halfspace-free"])
+def test_f_and_xi_do_not_depend_on_the_unit(tmp_path, solver):
+    """um to nm: every length x 1e3, so a force (E* h L, E* unchanged) x 1e6."""
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    loads = (0.005, 0.2)
+    in_um = run(tmp_path, preset(tmp_path / "scan.x3p", "um", loads, solver), "um")
+    in_nm = run(tmp_path, preset(tmp_path / "scan.x3p", "nm", tuple(1e6 * f for f in loads), solver), "nm")
+    np.testing.assert_allclose(in_nm.table["f"], in_um.table["f"], rtol=1e-12)
+    np.testing.assert_allclose(in_nm.table["xi"], in_um.table["xi"], rtol=1e-9)
+    np.testing.assert_array_equal(in_nm.table["contact_count"], in_um.table["contact_count"])
+    np.testing.assert_allclose(in_nm.table["indentation"], 1e3 * in_um.table["indentation"], rtol=1e-9)
+    assert in_um.table["contact_count"][0] >= 3  # the loads press more than a point
+
+
+@pytest.mark.parametrize("suffix", sorted(WRITERS))
+@pytest.mark.parametrize("solver", ["mdr", "bem-halfspace-free"])
+def test_a_scan_and_its_heights_as_npy_give_identical_results(tmp_path, suffix, solver):
+    path = tmp_path / f"scan.{suffix}"
+    WRITERS[suffix](path, scan_um())
+    read = SurfaceFile(path=str(path), unit="um", detrend="none").generate(None)
+    np.save(tmp_path / "scan.npy", read.heights)
+    from_file = run(tmp_path, preset(path, "um", solver=solver), "file")
+    from_npy = run(tmp_path, preset(tmp_path / "scan.npy", "um", solver=solver, spacing=read.spacing), "npy")
+    for column in ("f", "xi", "contact_count", "indentation"):
+        np.testing.assert_array_equal(from_file.table[column], from_npy.table[column])
+    assert from_file.fit.a == from_npy.fit.a and from_file.fit.b == from_npy.fit.b
+    summary = json.loads((tmp_path / "file" / "summary.json").read_text())
+    assert summary["input"]["unit"] == "um" and summary["input"]["spacing_from"] == "file"
+    assert summary["input"]["shape"] == [ROWS, COLUMNS]
+
+
+def test_a_line_scan_reads_as_a_profile(tmp_path):
+    z = scan_um()[0]
+    line = UniformLineScan(z, z.size * PIXEL_UM, unit="um")
+    line.to_netcdf(str(tmp_path / "line.nc"))
+    profile = ProfileFile(path=str(tmp_path / "line.nc"), unit="nm", detrend="none")
+    made = profile.generate(None)
+    np.testing.assert_allclose(made.heights, 1e3 * z, rtol=1e-12)
+    assert made.spacing == pytest.approx(1e3 * PIXEL_UM, rel=1e-12)
+    assert profile.input_summary()["shape"] == [z.size]
+    with pytest.raises(ValueError, match="holds a 2D map; use surface-file"):
+        write_x3p(tmp_path / "map.x3p", scan_um())
+        ProfileFile(path=str(tmp_path / "map.x3p")).generate(None)
+
+
+def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
+    z = scan_um()
+    holes = z.copy()
+    holes[5, 7] = holes[10, 20] = np.nan  # x3pio writes NaN as a point not measured
+    write_x3p(tmp_path / "holes.x3p", holes)
+    with pytest.raises(ValueError, match="2 of 768 points are undefined .* undefined: harmonic"):
+        SurfaceFile(path=str(tmp_path / "holes.x3p")).rms_height()
+    surface = SurfaceFile(path=str(tmp_path / "holes.x3p"), unit="um", undefined="harmonic", detrend="none")
+    filled = surface.generate(None).heights
+    defined = ~np.isnan(holes)
+    np.testing.assert_allclose(filled[defined], z[defined], rtol=1e-12, atol=1e-15)
+    for row, column in ((5, 7), (10, 20)):  # harmonic: the mean of its four neighbours
+        around = filled[row - 1, column] + filled[row + 1, column] + filled[row, column - 1] + filled[row, column + 1]
+        assert filled[row, column] == pytest.approx(around / 4, rel=1e-6)
+    summary = surface.input_summary()
+    assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
+
+
+def test_validate_shows_what_was_read(tmp_path, capsys):
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.x3p", "nm")))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+    out = capsys.readouterr().out
+    assert "24 x 32 pixels of 125 nm (from the file)" in out and "converted from the file's m" in out
+    assert "rms height 50 nm" in out
+
+
+def test_without_the_extra_the_message_names_it_and_exits_2(tmp_path, capsys, monkeypatch):
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.x3p", "um")))
+    monkeypatch.setitem(sys.modules, "SurfaceTopography", None)  # import SurfaceTopography: ImportError
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert 'pip install "frictionlab[topography]"' in err and "Traceback" not in err
+    with pytest.raises(PresetError, match="optional extra topography"):
+        build_scene(preset(tmp_path / "scan.x3p", "um"))
+
+
+def test_a_table_still_needs_its_spacing(tmp_path):
+    np.save(tmp_path / "scan.npy", scan_um())
+    with pytest.raises(PresetError, match="spacing .* is required"):
+        build_scene(preset(tmp_path / "scan.npy", "um"))
+
+
+def test_a_table_does_not_import_the_extra(tmp_path):
+    import subprocess
+
+    np.save(tmp_path / "scan.npy", scan_um())
+    code = (
+        "import sys, frictionlab_spectra as s; "
+        f"s.SurfaceFile(path={str(tmp_path / 'scan.npy')!r}, spacing=1.0).rms_height(); "
+        "print('SurfaceTopography' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"
+
+
+def test_the_api_shows_what_was_read_before_and_after_the_run(tmp_path):
+    import frictionlab
+
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    checked = frictionlab.validate(preset(tmp_path / "scan.x3p", "nm"))
+    assert checked["input"]["shape"] == [ROWS, COLUMNS] and checked["input"]["unit"] == "nm"
+    assert checked["input"]["spacing"] == pytest.approx(1e3 * PIXEL_UM, rel=1e-12)
+    assert checked["input"]["rms_height"] == pytest.approx(50.0, rel=1e-12)  # scan_um's 0.05 um
+    result = frictionlab.run(preset(tmp_path / "scan.x3p", "um"), out=tmp_path / "run", workers=1, progress=False,
+                             plot=False)  # fmt: skip
+    assert result.input["unit"] == "um" and frictionlab.load(tmp_path / "run").input == result.input
+    with pytest.raises(PresetError, match="spectrum.params.unit"):
+        frictionlab.validate(preset(tmp_path / "scan.x3p", "inch"))
+
+
+def test_the_memory_estimate_counts_the_file_and_the_padded_solver(tmp_path, monkeypatch):
+    """The map's points from the file (grid_shape), times the free solver's bytes per point
+    (its padded grids), plus the profile and slopes; a run that does not fit is refused
+    before it starts."""
+    from frictionlab import memory
+    from frictionlab.errors import RunError
+    from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
+
+    write_x3p(tmp_path / "scan.x3p", scan_um())
+    scene = build_scene(preset(tmp_path / "scan.x3p", "um", solver="bem-halfspace-free"))
+    assert memory.grid_points(scene) == ROWS * COLUMNS and scene.spectrum.grid_shape() == (ROWS, COLUMNS)
+    per_point = memory.bytes_per_point(scene)
+    assert per_point == BEMHalfSpaceFree.bytes_per_point + memory.PROFILE_BYTES_PER_POINT
+    assert BEMHalfSpaceFree.bytes_per_point > BEMHalfSpace.bytes_per_point  # the padding counts
+    one = memory.estimate(scene, workers=1, executor="serial")
+    monkeypatch.setattr(memory, "available_memory", lambda: (one.total - 1, "a test"))
+    with pytest.raises(RunError, match="scan|memory"):
+        memory.check_fits(scene, workers=1, executor="serial")
+
+
+def test_validate_says_a_table_has_no_unit_unless_the_preset_gives_one(tmp_path, capsys):
+    np.save(tmp_path / "scan.npy", scan_um())
+    for unit, expected in ((None, "of 0.125 (from the preset), rms height 0.05, no unit (bare numbers)"),
+                           ("um", "of 0.125 um (from the preset), rms height 0.05 um, not periodic")):  # fmt: skip
+        (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.npy", unit, spacing=PIXEL_UM)))
+        assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+        assert f"read scan.npy (.npy): 24 x 32 pixels {expected}" in capsys.readouterr().out

@@ -1,0 +1,85 @@
+"""What a notebook shows of a result: the fit's table (rounded, with its intervals) and the curve."""
+
+import base64
+import dataclasses
+import math
+import re
+from html.parser import HTMLParser
+
+import numpy as np
+
+import frictionlab
+from frictionlab.fit import LogFit
+
+from .conftest import SMALL_PRESET
+
+FAST = {"workers": 1, "progress": False}
+
+
+class Cells(HTMLParser):
+    """The text of every table cell and the source of every image, and whether the tags balance."""
+
+    def __init__(self):
+        super().__init__()
+        self.cells, self.images, self.open, self.in_cell = [], [], [], False
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "img":
+            self.images.append(dict(attrs)["src"])
+            return
+        self.open.append(tag)
+        if tag in ("td", "th"):
+            self.cells.append("")
+            self.in_cell = True
+
+    def handle_endtag(self, tag):
+        assert self.open.pop() == tag
+        self.in_cell = self.in_cell and tag not in ("td", "th")
+
+    def handle_data(self, data):
+        if self.in_cell:
+            self.cells[-1] += data
+
+
+def parsed(html: str) -> Cells:
+    cells = Cells()
+    cells.feed(html)
+    cells.close()
+    assert cells.open == []
+    return cells
+
+
+def test_a_results_html_is_its_fit_rounded_with_intervals_and_its_curve():
+    result = frictionlab.run(SMALL_PRESET, **FAST)
+    html = result._repr_html_()
+    cells = parsed(html).cells
+    fit = result.fit
+    level = f"{100 * fit.confidence:g}% CI (bootstrap {fit.bootstrap})"
+    assert cells[:4] == ["xi = a + b ln f", "estimate", "std. err.", level]
+    assert cells[4:8] == ["a", f"{fit.a:.4f}", f"{fit.a_se:.4f}", f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]"]
+    assert cells[8:12] == ["b", f"{fit.b:.4f}", f"{fit.b_se:.4f}", f"[{fit.b_ci[0]:.4f}, {fit.b_ci[1]:.4f}]"]
+    assert f"R² = {fit.r2:.4f}" in html and f"{result.realizations[0]}/{result.realizations[1]} realizations" in html
+    (image,) = parsed(html).images
+    png = base64.b64decode(image.removeprefix("data:image/png;base64,"))
+    assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 2000  # a drawn figure, not an empty one
+
+
+def test_the_html_escapes_what_comes_from_data_and_says_when_there_is_no_fit():
+    result = frictionlab.run(SMALL_PRESET, **FAST)
+    odd = dataclasses.replace(result, caveats=["fewer than 3 points <b>in contact</b> & more"], fit=None,
+                              table={name: np.array([]) for name in result.table})  # fmt: skip
+    html = odd._repr_html_()
+    assert "&lt;b&gt;in contact&lt;/b&gt; &amp; more" in html and "<b>" not in html
+    assert "no fit" in html and "<table>" not in html and "<img" not in html
+    parsed(html)
+
+
+def test_a_fit_shows_rounded_and_keeps_its_exact_numbers():
+    fit = LogFit(1.127512345678, 0.0312345678, a_ci=(1.035612, 1.234712), b_ci=(0.015812, 0.047612), bootstrap=500,
+                 r2=0.841312345, points=40)  # fmt: skip
+    text = repr(fit)
+    assert text == ("LogFit(a = 1.1275 [1.0356, 1.2347], b = 0.0312 [0.0158, 0.0476] (95% CI, bootstrap 500); "
+                    "R² = 0.8413, 40 points)")  # fmt: skip
+    assert not re.search(r"\d{6}", text)  # no 16-digit floats
+    assert fit.a == 1.127512345678  # the field itself is exact
+    assert "n/a" in repr(LogFit(2.0, 0.1)) and math.isnan(LogFit(2.0, 0.1).r2)

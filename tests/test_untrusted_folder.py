@@ -1,0 +1,340 @@
+"""A run folder is untrusted input: load(), predict --from, resume, sweeps and the TUI's
+list read only regular files inside it, never through a link, never a FIFO; every
+damaged value ends in a frictionlab error naming the file, never a Python exception
+and never a line of a file outside the folder; nothing is written through a link."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import threading
+from pathlib import Path
+
+import pytest
+
+import frictionlab
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
+from frictionlab.tui.folders import list_runs
+
+from .conftest import SMALL_PRESET, merge
+from .test_resume import NO_PLOT
+
+SECRET = "SECRET-LINE-OF-AN-OUTSIDE-FILE"
+QUICK = merge(SMALL_PRESET, {**NO_PLOT, "realizations": 4, "fit": {"bootstrap": 0}})
+PREDICT = ["predict", "--area", "1e10", "--modulus", "1", "--rms-height", "1e4", "--force", "5"]
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("finished") / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    return folder
+
+
+@pytest.fixture
+def run_copy(finished, tmp_path) -> Path:
+    copy = tmp_path / "run"
+    shutil.copytree(finished, copy)
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    for name in ("curve.csv", "summary.json", "secret.txt"):
+        (outside / name).write_text(f"{SECRET}\n{SECRET},1,2\n")
+    return copy
+
+
+def with_timeout(call, seconds: float = 20.0):
+    """``call()``'s exception (None if it returned): a read that blocks fails the test."""
+    box = []
+
+    def target():
+        try:
+            call()
+            box.append(None)
+        except BaseException as exc:  # noqa: BLE001 - the test inspects it
+            box.append(exc)
+
+    thread = threading.Thread(target=target, daemon=True)
+    thread.start()
+    thread.join(seconds)
+    assert box, f"blocked for more than {seconds} s"
+    return box[0]
+
+
+def edit_summary(folder: Path, change) -> None:
+    data = json.loads((folder / "summary.json").read_text())
+    change(data)
+    (folder / "summary.json").write_text(json.dumps(data))
+
+
+def set_in(data: dict, dotted: str, value) -> None:
+    *parents, last = dotted.split(".")
+    for key in parents:
+        data = data[key]
+    data[last] = value
+
+
+def link(path: Path, target: Path) -> None:
+    path.unlink()
+    path.symlink_to(target)
+
+
+def link_to_a_copy(path: Path) -> None:  # even a link to a file inside the folder is refused
+    shutil.copy(path, path.with_name("copy"))
+    link(path, path.with_name("copy"))
+
+
+def fifo(path: Path) -> None:
+    path.unlink()
+    os.mkfifo(path)
+
+
+# ------------------------------------------------------------------ each kind of hostile folder
+
+HOSTILE = {
+    # reads that would leave the folder
+    "curve entry ../": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", "../elsewhere/curve.csv")),
+    "curve entry absolute": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", str(f.parent / "elsewhere/curve.csv"))),
+    "curve entry a/../../": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", "x/../../elsewhere/curve.csv")),
+    "curve entry not a str": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", 5)),
+    "curve.csv a link out": lambda f: link(f / "curve.csv", f.parent / "elsewhere" / "curve.csv"),
+    "curve.csv a link in": lambda f: link_to_a_copy(f / "curve.csv"),
+    "summary.json a link out": lambda f: link(f / "summary.json", f.parent / "elsewhere" / "summary.json"),
+    "summary.json a dangling link": lambda f: link(f / "summary.json", f.parent / "nothing"),
+    "summary.json a FIFO": lambda f: fifo(f / "summary.json"),
+    "curve.csv a FIFO": lambda f: fifo(f / "curve.csv"),
+    "summary.json a folder": lambda f: (f / "summary.json").unlink() or (f / "summary.json").mkdir(),
+    # JSON of the wrong shape
+    "summary a list": lambda f: (f / "summary.json").write_text("[1, 2]"),
+    "summary not JSON": lambda f: (f / "summary.json").write_bytes(b"\xff\xfe{"),
+    "summary nested deep": lambda f: (f / "summary.json").write_text("[" * 50_000 + "]" * 50_000),
+    "no realizations": lambda f: edit_summary(f, lambda d: d.pop("realizations")),
+    "no preset name": lambda f: edit_summary(f, lambda d: d["preset"].pop("name")),
+    "preset a list": lambda f: edit_summary(f, lambda d: set_in(d, "preset", [1])),
+    "fit.a a string": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a", "0.5")),
+    "fit.b NaN": lambda f: (f / "summary.json").write_text((f / "summary.json").read_text().replace('"b": ', '"b": NaN, "_b": ', 1)),
+    "fit.r2 Infinity": lambda f: edit_summary(f, lambda d: set_in(d, "fit.r2", float("inf"))),
+    "fit a number": lambda f: edit_summary(f, lambda d: set_in(d, "fit", 3)),
+    "done a float": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 2.5)),
+    "done negative": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", -1)),
+    "done true": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", True)),
+    "status unknown": lambda f: edit_summary(f, lambda d: set_in(d, "status", SECRET)),
+    "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
+    "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
+    "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
+    # values of the right kind that contradict each other: no silent wrong or empty fit
+    "fit null though done": lambda f: edit_summary(f, lambda d: set_in(d, "fit", None)),
+    "fit though none done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 0)),
+    "done above requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 99)),
+    "curve short a row": lambda f: (f / "curve.csv").write_text("".join((f / "curve.csv").read_text().splitlines(True)[:-1])),
+    # CSV that is not frictionlab's
+    "curve binary": lambda f: (f / "curve.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00" + os.urandom(64)),
+    "curve NUL": lambda f: (f / "curve.csv").write_bytes((f / "curve.csv").read_bytes() + b"\x00\n"),
+    "curve non-numeric cell": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text().replace("\n", f"\n{SECRET},", 1).replace(",", "", 1)),
+    "curve ragged row": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "1,2\n"),
+    "curve inf cell": lambda f: (f / "curve.csv").write_text((f / "curve.csv").read_text() + "inf,1,1,1,1,1,1\n"),
+    "curve empty": lambda f: (f / "curve.csv").write_text(""),
+    "curve missing": lambda f: (f / "curve.csv").unlink(),
+    "curve huge": lambda f: (f / "curve.csv").write_bytes(b"1" * (17 * 1024 * 1024)),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_load_refuses_each_kind_of_hostile_folder_naming_the_file(run_copy, case):
+    HOSTILE[case](run_copy)
+    raised = with_timeout(lambda: frictionlab.load(run_copy))
+    assert isinstance(raised, RunFolderError), f"{case}: {type(raised).__name__}: {raised}"
+    message = str(raised)
+    assert "summary.json" in message or "curve.csv" in message, message
+    assert SECRET not in message, message
+
+
+@pytest.mark.parametrize("case", ["summary.json a link out", "summary.json a FIFO", "fit.a a string", "fit.b NaN",
+                                  "future schema", "summary a list", "status unknown"])  # fmt: skip
+def test_predict_from_a_hostile_folder_exits_5(run_copy, case, capsys):
+    HOSTILE[case](run_copy)
+    codes = []
+    assert with_timeout(lambda: codes.append(main([*PREDICT, "--from", str(run_copy)]))) is None
+    err = capsys.readouterr().err
+    assert codes == [ExitCode.RUN_FOLDER] and "summary.json" in err and SECRET not in err, err
+
+
+def test_a_future_schema_is_refused_naming_its_version(run_copy):
+    edit_summary(run_copy, lambda d: set_in(d, "schema_version", 99))
+    with pytest.raises(RunFolderError, match=r"newer frictionlab \(schema_version 99; this one reads up to 2\)"):
+        frictionlab.load(run_copy)
+
+
+def test_a_link_out_of_the_folder_is_named_as_a_link(run_copy):
+    link(run_copy / "curve.csv", run_copy.parent / "elsewhere" / "curve.csv")
+    with pytest.raises(RunFolderError, match=r"curve.csv: curve.csv is a symbolic link, which is never followed"):
+        frictionlab.load(run_copy)
+
+
+def test_an_intact_copy_loads_the_same_numbers(run_copy, finished):
+    assert frictionlab.load(run_copy).fit == frictionlab.load(finished).fit
+
+
+# ------------------------------------------------------------------ sweeps and the TUI's list
+
+
+def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    assert len(frictionlab.load(folder).points) == 2
+    data = json.loads((folder / "sweep.json").read_text())
+    data["points"][0]["folder"] = "../../elsewhere"
+    (folder / "sweep.json").write_text(json.dumps(data))
+    with pytest.raises(RunFolderError, match=r"sweep.json is damaged: field 'points.0.folder'"):
+        frictionlab.load(folder)
+    data["points"][0]["folder"] = "points/" + sorted(p.name for p in (folder / "points").iterdir())[0]
+    (folder / "sweep.json").write_text(json.dumps(data))
+    points = folder / "points"
+    shutil.move(points, tmp_path / "moved")
+    points.symlink_to(tmp_path / "moved")  # the point folders now lie outside, through a link
+    with pytest.raises(RunFolderError, match=r"points is a symbolic link or not a folder"):
+        frictionlab.load(folder).points
+    data["schema_version"] = 7
+    (folder / "sweep.json").write_text(json.dumps(data))
+    with pytest.raises(RunFolderError, match=r"schema_version 7"):
+        frictionlab.load(folder)
+
+
+def test_the_tui_list_skips_fifos_and_links_without_blocking(run_copy, tmp_path):
+    runs = run_copy.parent
+    for name, damage in (("fifo", "summary.json a FIFO"), ("linked", "summary.json a link out")):
+        shutil.copytree(run_copy, runs / name)
+        HOSTILE[damage](runs / name)
+    listed = []
+    assert with_timeout(lambda: listed.extend(list_runs(runs))) is None
+    assert [entry.path.name for entry in listed] == ["run"]
+
+
+# ------------------------------------------------------------------ resume
+
+
+def test_resume_never_reads_a_chunk_through_a_link(tmp_path):
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(merge(QUICK, {"realizations": 8})))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OK
+    expected = frictionlab.load(folder).fit
+    (chunk,) = (folder / "chunks").iterdir()
+    outside = tmp_path / "outside.npz"
+    shutil.copy(chunk, outside)  # the very bytes: its checksum matches the manifest's
+    chunk.unlink()
+    chunk.symlink_to(outside)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest["status"] = "interrupted"
+    (folder / "run.json").write_text(json.dumps(manifest))
+    with pytest.warns(UserWarning, match=r"1 chunk file\(s\) failed verification \(1 file is a symbolic link"):
+        assert main(["resume", str(folder), "--quiet"]) == ExitCode.OK
+    assert frictionlab.load(folder).fit == expected  # recomputed, bitwise
+
+
+def _move_out(folder: Path, name: str, user: Path) -> None:
+    shutil.move(folder / name, user / name)
+    (folder / name).symlink_to(user / name)
+
+
+RESUME_REFUSALS = {  # damage -> what the message says
+    "chunks a link": (lambda f, u: _move_out(f, "chunks", u), "chunks is not a folder"),
+    "run.json a link": (lambda f, u: _move_out(f, "run.json", u), "run.json: manifest is a symbolic link"),
+    "run.json a FIFO": (lambda f, u: fifo(f / "run.json"), "run.json: manifest is a FIFO"),
+    "preset.yaml a link": (lambda f, u: link(f / "preset.yaml", u / "notes.txt"), "preset file is a symbolic link"),
+    "preset.yaml a FIFO": (lambda f, u: fifo(f / "preset.yaml"), "preset file is a FIFO"),
+    "run.lock a link": (lambda f, u: (f / "run.lock").symlink_to(u / "notes.txt"), "run.lock is not a regular file"),
+    "run.lock a FIFO": (lambda f, u: os.mkfifo(f / "run.lock"), "run.lock is not a regular file"),
+    "future manifest": (lambda f, u: _edit_manifest(f, format=9), "format 9; this one reads up to 2"),
+    "status NaN": (lambda f, u: (f / "run.json").write_text('{"status": NaN}'), "status is not a word, but a number"),
+    "status the secret": (lambda f, u: _edit_manifest(f, status=[SECRET]), "status is not a word, but an array"),
+    "chunks a list": (lambda f, u: _edit_manifest(f, chunks=[SECRET]), "chunks is not a mapping"),
+}
+
+
+def _edit_manifest(folder: Path, **changes) -> None:
+    manifest = json.loads((folder / "run.json").read_text())
+    (folder / "run.json").write_text(json.dumps({**manifest, **changes}))
+
+
+@pytest.mark.parametrize("damage", sorted(RESUME_REFUSALS))
+def test_resume_refuses_a_folder_whose_own_files_are_links_fifos_or_damaged(tmp_path, capsys, damage):
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet"]) == ExitCode.OK
+    user = tmp_path / "user"
+    user.mkdir()
+    (user / "notes.txt").write_text(SECRET)
+    make, said = RESUME_REFUSALS[damage]
+    make(folder, user)
+    before = {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()}
+    codes = []
+    assert with_timeout(lambda: codes.append(main(["resume", str(folder), "--quiet"]))) is None
+    err = capsys.readouterr().err
+    assert codes == [ExitCode.RUN_FOLDER] and said in err, err
+    assert SECRET not in err and "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in user.rglob("*") if p.is_file()} == before
+
+
+def test_resume_recomputes_a_chunk_that_is_a_fifo_without_blocking(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    expected = frictionlab.load(folder).fit
+    (chunk,) = (folder / "chunks").iterdir()
+    fifo(chunk)
+    with pytest.warns(UserWarning, match=r"1 file is a FIFO \(named pipe\), not a regular file"):
+        assert with_timeout(lambda: frictionlab.run(QUICK, out=folder, resume=True, workers=1, progress=False,
+                                                    plot=False)) is None  # fmt: skip
+    assert frictionlab.load(folder).fit == expected
+
+
+# ------------------------------------------------------------------ writing
+
+
+def test_a_summary_that_is_a_link_to_a_user_file_is_replaced_not_written_through(tmp_path):
+    folder = tmp_path / "run"
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)
+    user = tmp_path / "thesis.tex"
+    user.write_text(SECRET)
+    for name in ("summary.json", "curve.csv", "preset.yaml"):
+        (folder / name).unlink()
+        (folder / name).symlink_to(user)
+    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)  # the same preset: rerun in place
+    assert user.read_text() == SECRET
+    assert not any((folder / name).is_symlink() for name in ("summary.json", "curve.csv", "preset.yaml"))
+    assert frictionlab.load(folder).status == "completed"
+
+
+def test_an_output_file_that_is_a_link_needs_force_and_then_replaces_the_link(tmp_path, capsys):
+    user = tmp_path / "user.json"
+    user.write_text(SECRET)
+    out = tmp_path / "schema.json"
+    out.symlink_to(user)
+    assert main(["schema", "--out", str(out)]) == ExitCode.OUTPUT_REFUSED
+    assert "is a symbolic link" in capsys.readouterr().err
+    assert main(["schema", "--out", str(out), "--force"]) == ExitCode.OK
+    assert user.read_text() == SECRET and not out.is_symlink() and json.loads(out.read_text())
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "q.yaml")]) == ExitCode.OK
+    (tmp_path / "q.yaml").unlink()
+    (tmp_path / "q.yaml").symlink_to(user)
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "q.yaml"), "--force"]) == ExitCode.OK
+    assert user.read_text() == SECRET and not (tmp_path / "q.yaml").is_symlink()
+
+
+def test_no_python_exception_reaches_the_user_from_load(tmp_path):
+    for argument in (None, 3, b"", "", "a\0b", tmp_path / "missing", [tmp_path]):
+        raised = with_timeout(lambda argument=argument: frictionlab.load(argument))
+        assert isinstance(raised, FrictionlabError), (argument, raised)
+
+
+def test_the_tui_preset_list_shows_a_fifo_as_unreadable_without_blocking(tmp_path):
+    from frictionlab.tui.folders import list_presets
+
+    (tmp_path / "good.yaml").write_text("name: good\ndescription: a preset\n")
+    os.mkfifo(tmp_path / "pipe.yaml")
+    listed = []
+    assert with_timeout(lambda: listed.extend(list_presets([("presets", tmp_path)]))) is None
+    assert [(e.name, bool(e.error)) for e in listed] == [("good", False), ("pipe", True)]
