@@ -27,7 +27,9 @@ from pathlib import Path
 from .errors import ExitCode, FrictionlabError, RunFolderError
 from .options import RunOptions
 from .progresslog import ProgressLog, ProgressReader
-from .rundir import LOCK_FILE, STATE_FILE, RunDirectory, read_json_object
+from .inputs import InputFileProblem
+from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
+from .runfolder import read_json, read_member
 
 MAX_LOCK_BYTES = 4096
 TAIL_BYTES = 256 * 1024  # of progress.jsonl, read for the count of a listed run
@@ -149,17 +151,10 @@ def _child() -> int:
 def lock_holder(folder: str | Path) -> int | None:
     """The pid that ``run.lock`` names, None if there is no lock (or it names none).
     Read as a regular file, never through a link."""
-    path = Path(folder) / LOCK_FILE
     try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
+        text = read_member(folder, LOCK_FILE, MAX_LOCK_BYTES).decode(errors="replace")
+    except (InputFileProblem, OSError):
         return None
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return None
-        text = os.read(fd, MAX_LOCK_BYTES).decode(errors="replace")
-    finally:
-        os.close(fd)
     words = text.replace(",", " ").split()
     if len(words) >= 2 and words[0] == "pid" and words[1].isdigit():
         return int(words[1])
@@ -262,8 +257,8 @@ def run_state(folder: str | Path) -> RunState:
 
 def _summary(folder: Path) -> dict | None:
     try:
-        return read_json_object(folder / "summary.json", 16 * 1024 * 1024, "summary")
-    except (OSError, FrictionlabError, ValueError):
+        return read_json(folder, "summary.json")
+    except (OSError, FrictionlabError):
         return None
 
 

@@ -262,17 +262,18 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
         return []
     entries = []
     for folder in runs_dir.iterdir():
-        entry = None
+        entry, marked = None, False
         for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
             if not os.path.lexists(folder / marker):
                 continue
+            marked = True
             try:
                 entry = read(folder)
             except (OSError, FrictionlabError):
                 pass  # a damaged or foreign folder, a link, a FIFO: not one to list
             break
-        if not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
-            entry = _with_state(folder, entry)
+        if (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
+            entry = _with_state(folder, entry)  # a run going on, or one that ended before its summary
         if entry is not None:
             entries.append(entry)
     return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))

@@ -79,7 +79,8 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
 async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_realization(folders, registry):
     from ..test_load_progress import LONG_LOADS
 
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG_LOADS))
+    # 512 x 512: seconds a realization, so that the run's file, read every 0.25 s, is met within a solve
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(LONG_LOADS, {"spectrum": {"params": {"points": 512}}})))
     app = make_app(registry, preset="presets/long.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
