@@ -12,7 +12,7 @@ import signal
 import threading
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import pluggy
 
@@ -39,9 +39,11 @@ class RunInfo:
     executor: str = "serial"
     resumed: int = 0  # realizations restored from the run directory, not recomputed
     retried: int = 0  # realizations that had failed before the resume and run again
+    # the restored results themselves (by index): a listener's running sums start from them
+    restored: tuple[RealizationResult, ...] = field(default=(), repr=False)
 
 
-def _listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
+def listener_manager(listeners: Iterable[object]) -> pluggy.PluginManager:
     pm = pluggy.PluginManager(PROJECT_NAME)
     pm.add_hookspecs(RunListener)
     for listener in listeners:
@@ -89,10 +91,13 @@ def run(
             retried += 1  # a failure is not kept: the realization runs again
     resumed = accumulator.done
     todo = [i for i in range(total) if i not in accumulator.results]
-    info = RunInfo(scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried)
+    info = RunInfo(
+        scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried,
+        restored=tuple(accumulator.results[i] for i in sorted(accumulator.results)),
+    )  # fmt: skip
     from .registry import default_registry
 
-    hooks = _listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
+    hooks = listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     hooks.run_started(run=info)

@@ -44,7 +44,8 @@ def _has_widgets() -> bool:
 class _Bar:
     """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
 
-    def __init__(self, stream, description: str, total: int, completed: int = 0, started: float | None = None):
+    def __init__(self, stream, description: str, total: int, completed: int = 0, started: float | None = None,
+                 clock=time.perf_counter):
         from rich.console import Console
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
@@ -52,7 +53,7 @@ class _Bar:
         self.progress = Progress(
             TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=10,
-            get_time=time.perf_counter,
+            get_time=clock,
         )  # fmt: skip
         self.task = self.progress.add_task(description, total=total, completed=completed, note="")
         if started is not None:  # drawn late (a run shows its bar after 2 s): the clock is the run's
@@ -111,10 +112,11 @@ class ProgressReporter:
     either only once the run has gone on ``after`` seconds (a short run shows its first
     line and, in a log, its last)."""
 
-    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER, clock=time.perf_counter):
         self.stream = BestEffort(stream or sys.stderr)
         self.interactive = wants_bar(self.stream) if interactive is None else interactive
         self.after = after
+        self.clock = clock  # a followed run's (progresslog.Follower.now): its times are the run's
         self.total = 0
         self.bar: _Bar | None = None
         self.started = 0.0
@@ -126,7 +128,7 @@ class ProgressReporter:
         self.last_load_line = 0.0
 
     def _line(self, done: int, total: int) -> str:
-        return progress_text(done, total, self.failed, time.perf_counter() - self.started, restored=self.resumed)
+        return progress_text(done, total, self.failed, self.clock() - self.started, restored=self.resumed)
 
     def _write(self, text: str) -> None:
         if self.bar is not None:
@@ -137,7 +139,7 @@ class ProgressReporter:
 
     @hookimpl
     def run_started(self, run):
-        self.started = time.perf_counter()
+        self.started = self.clock()
         self.resumed = self.done = run.resumed
         self.total = run.total
         self.loads = len(run.scene.loads)
@@ -154,12 +156,12 @@ class ProgressReporter:
 
     def _progress(self, done: int, total: int) -> None:
         self.done, self.total = done, total
-        if time.perf_counter() - self.started < self.after and not (done == total and not self.interactive):
+        if self.clock() - self.started < self.after and not (done == total and not self.interactive):
             while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
                 self.next_tenth += 1
             return
         if self.interactive and self.bar is None:
-            self.bar = _Bar(self.stream, "realizations", total, completed=done, started=self.started)
+            self.bar = _Bar(self.stream, "realizations", total, completed=done, started=self.started, clock=self.clock)
         if self.bar is not None:
             self.bar.update(done, f"{self.failed} failed" if self.failed else "")
         elif done == total or 10 * done >= self.next_tenth * total:
@@ -182,12 +184,12 @@ class ProgressReporter:
         self._solve_note(solve_text(index, load, self.loads, iteration, residual))
 
     def _solve_note(self, text: str) -> None:
-        now = time.perf_counter()
+        now = self.clock()
         if now - self.started < self.after or not self.total:
             return
         if self.interactive:
             if self.bar is None:
-                self.bar = _Bar(self.stream, "realizations", self.total, completed=self.done, started=self.started)
+                self.bar = _Bar(self.stream, "realizations", self.total, completed=self.done, started=self.started, clock=self.clock)
             self.bar.update(self.done, text)
         elif now - max(self.last_load_line, self.started) >= LOAD_LINE_SECONDS:
             self._write(text)

@@ -262,6 +262,22 @@ class RunDirectory:
         if status == "completed":
             self._compact(scene)
 
+    def check_fresh(self, scene: Scene) -> None:
+        """Refuse now, writing nothing, what a fresh ``start(scene)`` would refuse here
+        (a front end that starts the run in another process says it at once)."""
+        problem = output_path_problem(self.path)
+        if problem:
+            raise OutputRefused(f"{problem}; give a folder for the output")
+        if not self.path.is_dir():
+            return
+        try:
+            state = self.state()
+        except RunFolderError:
+            if not self.force:
+                raise
+            state = None
+        self._refuse_unless_ours(state, _json_copy(scene.resolved()))
+
     @staticmethod
     def _listed(state: dict | None) -> list[str]:
         chunks = (state or {}).get("chunks")

@@ -13,6 +13,7 @@ PRESETS = ROOT / "presets"
 
 LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study): `pytest -m long` runs them
     "tui/test_screen.py", "tui/test_snapshots.py", "tui/test_form.py", "tui/test_run.py", "exact3d/test_study.py",
+    "tui/test_detached.py", "tui/test_small_things.py",
 }  # fmt: skip
 
 

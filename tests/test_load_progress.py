@@ -79,7 +79,7 @@ def test_the_progress_bar_notes_the_load_of_a_long_solve(registry, monkeypatch):
     notes = []
 
     class Bar:  # rich draws the bar; what it is told is under test here
-        def __init__(self, stream, description, total, completed=0, started=None):
+        def __init__(self, stream, description, total, completed=0, started=None, clock=None):
             pass
 
         def update(self, completed, note=""):

@@ -30,10 +30,10 @@ import warnings
 
 from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown
 from ..signals import RaiseOnSigterm, interrupted_exit_code
-from . import completion, exact3d, plugins, predict, presets, report, resume, run, schema, study, tui, validate
+from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
-COMMANDS = (run, resume, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
+COMMANDS = (run, resume, runs, follow, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
 
 

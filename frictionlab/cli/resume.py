@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode
+from ..errors import ExitCode, FrictionlabError
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
+from .run import add_detach_option
 
 
 def add_parser(sub) -> None:
@@ -14,7 +15,8 @@ def add_parser(sub) -> None:
         "resume",
         help="continue an interrupted run in DIR with the preset stored there",
         description="Continue a run that was interrupted, killed or crashed: only the missing realizations are computed.",
-        epilog="example:\n  frictionlab resume runs/quickstart-20250101-120000",
+        epilog="examples:\n  frictionlab resume runs/quickstart-20250101-120000\n"
+        "  frictionlab resume runs/quickstart-20250101-120000 --detach",
     )
     p.add_argument("run_dir", metavar="DIR", help="the output folder of the interrupted run")
     add_workers_option(p)
@@ -22,6 +24,7 @@ def add_parser(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     p.add_argument("--no-plot", action="store_true", help="draw no plot.png")
     add_executor_options(p)
+    add_detach_option(p)
     p.set_defaults(handler=run)
 
 
@@ -31,6 +34,8 @@ def run(args) -> ExitCode:
     run_dir = Path(args.run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
+        if args.detach:
+            raise FrictionlabError("--detach resumes one ensemble, not a sweep: resume the sweep without --detach")
         from ..sweep import stored_sweep
         from .options import executor_run_options
 

@@ -18,7 +18,8 @@ def add_parser(sub) -> None:
         description="Run a preset (a file, or a built-in's name) and write its run folder: summary.json, "
         "curve.csv, realizations.npz, preset.yaml, then plot.png after the fit is printed.",
         epilog="examples:\n  frictionlab run quickstart\n  frictionlab run quickstart --set spectrum.params.hurst=0.6 --out runs/h06\n"
-        "  frictionlab run presets/benad2012-fig2.yaml --no-plot --json",
+        "  frictionlab run presets/benad2012-fig2.yaml --no-plot --json\n"
+        "  frictionlab run quickstart --detach      runs on after the terminal closes (frictionlab follow DIR)",
     )
     p.add_argument("preset", help="preset YAML file, or a built-in preset's name (frictionlab presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
@@ -34,6 +35,7 @@ def add_parser(sub) -> None:
     )
     add_executor_options(p)
     p.add_argument("--resume", action="store_true", help="continue the run left in --out DIR: compute only what is missing")
+    add_detach_option(p)
     p.add_argument(
         "--force",
         action="store_true",
@@ -63,6 +65,8 @@ def run(args) -> ExitCode:
     options = executor_run_options(args, resume=args.resume, force=args.force)
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
     try:
+        if args.detach:
+            return _detach(args, scene, out_dir, options)
         if scene.preset.sweep is not None:  # one ensemble per point
             return run_sweep_into(args, data, out_dir, options)
         return _run_scene(args, scene, out_dir, options)
@@ -70,6 +74,31 @@ def run(args) -> ExitCode:
         if not args.out and not any(out_dir.iterdir()):
             out_dir.rmdir()
         raise
+
+
+def add_detach_option(p) -> None:
+    p.add_argument(
+        "--detach", action="store_true",
+        help="run as a process of its own that outlives the terminal; print its folder and pid once it has "
+        "started (frictionlab follow DIR shows its progress, kill -TERM PID cancels it)",
+    )  # fmt: skip
+
+
+def _detach(args, scene, out_dir: Path, options) -> ExitCode:
+    from ..detached import check_startable, start_detached, wait_started
+
+    if scene.preset.sweep is not None:
+        raise FrictionlabError("--detach runs one ensemble, not a sweep: run the sweep without --detach (under nohup or tmux)")
+    check_startable(scene, out_dir, options)
+    process = start_detached(scene.resolved(), out_dir, options, plot=not args.no_plot)
+    wait_started(process, out_dir)
+    if args.json:
+        print(json.dumps({"folder": str(out_dir), "pid": process.pid, "status": "running"}, indent=2))
+    else:
+        print(f"{scene.preset.name}: running detached in {out_dir}/ (pid {process.pid})\n"
+              f"  frictionlab follow {out_dir}    shows its progress\n"
+              f"  kill -TERM {process.pid}    cancels it (what finished is kept; frictionlab resume continues it)")  # fmt: skip
+    return ExitCode.OK
 
 
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:

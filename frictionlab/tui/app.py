@@ -2,10 +2,11 @@
 
 The app holds what the tabs share: the draft preset (open, edit, save), the run
 going on, and the keys that work everywhere. Each tab's pane shows its part
-(``widgets``). The engine runs in a thread worker through ``api.run_scene``
-(the path ``frictionlab run`` and ``frictionlab.run`` take, so the same files are written), a preset with
-a ``sweep`` section through ``sweep.run_sweep``; the thread hands progress over
-with ``post_message`` (``messages``).
+(``widgets``). A run is a process of its own (``detached``: it goes on when the
+TUI or its terminal goes away), followed by reading its folder (``following``),
+as a TUI opened later follows it. A preset with a ``sweep`` section runs in a
+thread worker through ``sweep.run_sweep``, which hands progress over with
+``post_message`` (``messages``).
 """
 
 from __future__ import annotations
@@ -20,13 +21,13 @@ from textual.binding import Binding
 from textual.content import Content
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
+from ..detached import check_startable, list_run_states, run_state, start_detached
 from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
 from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
-from ..api import run_scene
 from ..sweep import SweepOutcome, plan_sweep, run_sweep
 from .fields import default_spectrum, preset_from_defaults
 from .folders import (
@@ -40,15 +41,17 @@ from .folders import (
     templates,
     writable_folder,
 )
+from .following import FollowedRun, read_finished
 from .live import LiveListener
 from .messages import RunCrashed, RunFinished, RunProgress, SweepPointEvent
-from .screens import ConfirmScreen, NewPresetScreen, PathScreen
+from .screens import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen
 from .sweepview import SweepPoster
 from .text import failure_message
 from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
 from .widgets.presets import NO_PRESETS
 
 NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
+FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
 
 
 class FrictionlabApp(App):
@@ -56,7 +59,7 @@ class FrictionlabApp(App):
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
-        Binding("f1", "help", "Keys", tooltip="(show or hide): those of the focused part and the app's", priority=True),
+        Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
         Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
@@ -65,7 +68,9 @@ class FrictionlabApp(App):
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
         Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
-        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes)", priority=True),
+        Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
+        Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
+        Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
     ]
 
     def __init__(
@@ -88,7 +93,9 @@ class FrictionlabApp(App):
         self.modified = False
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
-        self.cancel_event: threading.Event | None = None  # set while a run goes on
+        self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
+        self.cancel_event: threading.Event | None = None  # set while a sweep goes on in this process
+        self.followed: FollowedRun | None = None  # the run in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
         self.last_outcome = None
@@ -115,8 +122,14 @@ class FrictionlabApp(App):
         self.reload_presets()
         self.reload_runs()
         self._show_edit_state()
+        self.set_interval(FOLLOW_SECONDS, self._follow_tick)
+        going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
+        if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
+            self.follow_run(going[0].folder)
         if self.preset_path is not None:
             await self.open_preset(self.preset_path)
+        elif going:
+            self.action_show_tab("run")
         else:
             self.query_one("#preset-table").focus()
 
@@ -131,7 +144,7 @@ class FrictionlabApp(App):
 
     @property
     def running(self) -> bool:
-        return self.cancel_event is not None
+        return self.cancel_event is not None or self.followed is not None
 
     # ------------------------------------------------------------ navigation and help
 
@@ -148,11 +161,22 @@ class FrictionlabApp(App):
         self.refresh_bindings()
 
     def action_help(self) -> None:
-        """Textual's key panel: the keys of the focused widget and of the app, as they change."""
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
+        """Textual's key panel: the keys of the focused widget and of the app, as they change.
+        Pressed again it shows the next page of a panel taller than the screen (it takes no
+        focus, so no other key scrolls it), and hides it after the last."""
+        panels = self.screen.query("HelpPanel KeyPanel")
+        if not panels:
             self.action_show_help_panel()
+            return
+        keys = panels.first()
+        if keys.scroll_y < keys.max_scroll_y:
+            keys.scroll_page_down(animate=False)
+        else:
+            self.action_hide_help_panel()
+
+    def action_help_quit(self) -> None:
+        """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
+        self.say("Ctrl+Q quits (q too, outside a text field); a run goes on after you quit unless you cancel it.")
 
     # ------------------------------------------------------------ the status line
 
@@ -161,6 +185,7 @@ class FrictionlabApp(App):
         stays until the next message. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{title}: ", "bold") if title else "", text)
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
+        self.said_valid = False
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -197,6 +222,8 @@ class FrictionlabApp(App):
             self.draft_source = None
         self.draft_path = path
         await self.query_one("#form", PresetForm).load(data, base_dir=path.parent)
+        if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
+            self.say("")
         self.modified = modified
         self._show_edit_state()
         self.action_show_tab("edit")
@@ -260,6 +287,9 @@ class FrictionlabApp(App):
                 self.blocked_by = ""
             else:
                 self.say("The preset is valid: Ctrl+R runs it.")
+                self.said_valid = True
+        elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
+            self.say("")
         self._show_edit_state()
         self.query_one(EditPane).show_problems(event.problems, event.read)
 
@@ -382,6 +412,12 @@ class FrictionlabApp(App):
             self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
             return
         try:
+            if run_state(folder).status == "running":
+                self.show_running(folder)
+                return
+        except FrictionlabError:
+            pass  # not a run folder (yet): said below
+        try:
             if read_run(folder).status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
@@ -402,25 +438,86 @@ class FrictionlabApp(App):
         self._start(scene, None, folder, replace(self.run_options, resume=True))
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
-        cancel = self.cancel_event = threading.Event()
         self.last_outcome = None
+        if sweep is None:
+            try:  # refused here, at once, what the run would refuse as it begins
+                check_startable(scene, out_dir, options)
+            except FrictionlabError as exc:
+                self.say(str(exc), "error", title="Run failed")
+                return
+            try:
+                process = start_detached(scene.resolved(), out_dir, options)
+            except OSError as exc:  # no process can be started (out of processes, memory)
+                self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
+                return
+            self.followed = FollowedRun(out_dir, scene, self._show_snapshot, process=process)
+        else:
+            self.cancel_event = threading.Event()
         self.query_one(RunPane).start(scene, sweep, out_dir)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
-        self.say(f"{verb} {scene.preset.name} into {out_dir}")
-        progress = LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))
         if sweep is None:
-            work = lambda: run_scene(scene, out_dir, options, listeners=[progress], cancel=cancel).outcome  # noqa: E731
-        else:
-            poster = SweepPoster(
-                lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
-                lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
-            )
-            work = lambda: run_sweep(sweep, out_dir, options, listeners=[poster], cancel=cancel)  # noqa: E731
+            self.say(f"{verb} {scene.preset.name} into {out_dir} as a process of its own "
+                     f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
+            return
+        self.say(f"{verb} {scene.preset.name} into {out_dir}")
+        cancel = self.cancel_event
+        poster = SweepPoster(
+            lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
+            lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
+        )
+        work = lambda: run_sweep(sweep, out_dir, options, listeners=[poster], cancel=cancel)  # noqa: E731
         self.run_worker(lambda: self._run_in_thread(work, out_dir), thread=True, group="run", exit_on_error=False)
 
+    def show_running(self, folder: Path) -> None:
+        """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
+        if self.followed is None or self.followed.folder.resolve() != folder.resolve():
+            if self.running:
+                self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).", "warning")
+                return
+            self.follow_run(folder)
+        self.action_show_tab("run")
+
+    def follow_run(self, folder: Path) -> None:
+        """Show the run going on in ``folder`` (another process's) live on the Run tab."""
+        try:
+            scene = build_scene(RunDirectory(folder).stored_preset(), registry=self.registry)
+        except RunFolderError as exc:
+            self.say(str(exc), "error", title="Cannot follow")
+            return
+        except PresetError as exc:
+            self.say(exc.problems[0], "error", title=f"Cannot follow {folder.name}")
+            return
+        self.followed = FollowedRun(folder, scene, self._show_snapshot)
+        self.last_outcome = None
+        self.query_one(RunPane).start(scene, None, folder)
+        self.say(f"{scene.preset.name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
+        self._follow_tick()
+
+    def _show_snapshot(self, snapshot) -> None:
+        self.last_snapshot = snapshot
+        self.query_one(RunPane).show_progress(snapshot, self.followed is not None and self.followed.cancelling)
+
+    def _follow_tick(self) -> None:
+        followed = self.followed
+        if followed is None or not followed.poll():
+            return
+        self.followed = None
+        if followed.error:
+            self.on_run_crashed(RunCrashed(followed.error))
+            self.reload_runs()
+            return
+        try:
+            finished = read_finished(followed.folder)
+        except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
+            error = f"the run's process ended without writing its results (u on the Results tab resumes it from {followed.folder})"
+            self.on_run_crashed(RunCrashed(error))
+            self.reload_runs()
+            return
+        self.on_run_finished(RunFinished(finished, followed.folder))
+
     def _run_in_thread(self, work: Callable[[], object], out_dir: Path) -> None:
-        """Run ``work`` (a run or a sweep) and post how it ended: never a crash of the UI."""
+        """Run ``work`` (a sweep) and post how it ended: never a crash of the UI."""
         try:
             outcome = work()
         except FrictionlabError as exc:
@@ -436,7 +533,11 @@ class FrictionlabApp(App):
         if not self.running:
             self.say("No run is going: Ctrl+R starts one.", "warning")
             return
-        self.cancel_event.set()
+        if self.followed is not None:
+            if not self.followed.cancel():
+                return  # its process is gone: the next tick shows how it ended
+        else:
+            self.cancel_event.set()
         self.query_one(RunPane).show_cancelling()
 
     def on_run_progress(self, message: RunProgress) -> None:
@@ -459,7 +560,7 @@ class FrictionlabApp(App):
             if outcome.done == 0 and outcome.failures:  # nothing to show: say why, as the user can fix it
                 self.say(failure_message(outcome.failures[0][1]), "error", title="Run failed: no realization finished")
             elif outcome.failures:
-                self.say(f"{line}; {len(outcome.failures)} failed: {failure_message(outcome.failures[0][1])}", "warning")
+                self.say(f"{line}; {outcome.failed} failed: {failure_message(outcome.failures[0][1])}", "warning")
             else:
                 self.say(line)
         self.reload_runs()
@@ -469,9 +570,30 @@ class FrictionlabApp(App):
         self.query_one(RunPane).show_crash(message.error)
         self.say(message.error, "error", title="Run failed")
 
-    async def action_quit(self) -> None:
-        if self.running:
-            self.cancel_event.set()  # what finished is still written by the run thread
+    def action_quit(self) -> None:
+        """Quit at once; while a run goes on, ask first whether to leave it running or cancel it."""
+        followed = self.followed
+        if followed is not None:
+            def answered(choice: str | None) -> None:
+                if choice is None:
+                    return
+                if choice == "cancel":
+                    followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
+                self._quit_unless_unsaved()
+
+            question = (f"A run is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
+                        "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
+                        "(what finished is kept)?")  # fmt: skip
+            self.push_screen(QuitDuringRunScreen(question), answered)
+            return
+        if self.cancel_event is not None:  # a sweep, in this process: quitting cancels it
+            cancel = self.cancel_event
+            question = "A sweep is running in this window: quitting cancels it (what finished is kept). Quit?"
+            self.push_screen(ConfirmScreen(question), lambda yes: yes and (cancel.set() or self._quit_unless_unsaved()))
+            return
+        self._quit_unless_unsaved()
+
+    def _quit_unless_unsaved(self) -> None:
         if self.modified:
             self.push_screen(
                 ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),

@@ -16,12 +16,14 @@ from pathlib import Path
 
 import yaml
 
+from ..detached import run_state
 from ..errors import FrictionlabError
 from ..files import atomic_write
 from ..inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.reading import MAX_PRESET_BYTES
 from ..preset.builtin import builtin_folder, builtin_presets
+from ..rundir import STATE_FILE
 from ..runfolder import read_json, subfolder
 from ..safe_yaml import load_yaml
 from .roundtrip import dump_preserving
@@ -260,12 +262,34 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
         return []
     entries = []
     for folder in runs_dir.iterdir():
+        entry, marked = None, False
         for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
             if not os.path.lexists(folder / marker):
                 continue
+            marked = True
             try:
-                entries.append(read(folder))
+                entry = read(folder)
             except (OSError, FrictionlabError):
                 pass  # a damaged or foreign folder, a link, a FIFO: not one to list
             break
-    return sorted(entries, key=lambda e: (-e.mtime, e.path.name))
+        if (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
+            entry = _with_state(folder, entry)  # a run going on, or one that ended before its summary
+        if entry is not None:
+            entries.append(entry)
+    return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
+
+
+def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:
+    """A run folder as its process left it: running (its summary, if any, is an earlier
+    run's), or ended without a summary (killed): listed, so that it can be followed or resumed."""
+    try:
+        state = run_state(folder)
+    except (OSError, FrictionlabError):
+        return entry
+    if entry is None:
+        mtime = os.lstat(folder / STATE_FILE).st_mtime
+        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
+    entry.status = state.status
+    if state.status == "running":
+        entry.done, entry.fit = state.done or 0, None  # the fit shown would be the earlier run's
+    return entry

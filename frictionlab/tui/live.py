@@ -36,6 +36,7 @@ class Snapshot:
     first_error: str | None = None
     finished: bool = False
     f_formula: str = ""  # what f is, e.g. "F / (E* h L)"
+    restored: int = 0  # of ``done``, restored from the run folder (a resume): not counted in the rate
     solving: str = ""  # where a long solve is: realization, load, iteration, residual
 
 
@@ -43,7 +44,8 @@ class LiveListener:
     def __init__(self, post: Callable[[Snapshot], None], interval: float = 0.1, clock=time.perf_counter):
         self.post = post
         self.interval = interval
-        self.clock = clock
+        self.clock = clock  # a followed run's: ``progresslog.Follower.now``
+        self._total = 0
 
     @hookimpl
     def run_started(self, run):
@@ -57,23 +59,34 @@ class LiveListener:
         self._failed = 0
         self._first_error = None
         self._solving = ""
-        self._done, self._total = 0, run.total
         self._xi_sum = np.zeros(steps)
         self._count_sum = np.zeros(steps)
         self._force_sum = np.zeros(steps)
+        self._restored = run.resumed
+        self._done, self._total = run.resumed, run.total
+        for result in run.restored:  # a resume: the interim fit covers every realization, not only the new ones
+            self._add(result)
         self._started = self.clock()
         self._last_post = self._started
-        self.post(self._snapshot(0, run.total))
+        self.post(self._snapshot(run.resumed, run.total))
 
-    @hookimpl
-    def realization_done(self, result, done, total):
+    def _add(self, result) -> None:
         self._ok += 1
         self._force_unit = result.force_unit
         self._xi_sum += result.xi
         self._count_sum += result.contact_count
         if result.force is not None:
             self._force_sum += result.force
+
+    @hookimpl
+    def realization_done(self, result, done, total):
+        self._add(result)
         self._maybe_post(done, total)
+
+    def tick(self) -> None:
+        """A snapshot now, nothing new heard: the elapsed time moves on while a realization runs."""
+        if self._total:
+            self.post(self._snapshot(self._done, self._total))
 
     @hookimpl
     def realization_failed(self, result, done, total):
@@ -129,6 +142,7 @@ class LiveListener:
             first_error=self._first_error,
             finished=finished,
             f_formula=self._f_formula,
+            restored=self._restored,
             solving="" if finished else self._solving,
         )
 

@@ -46,7 +46,7 @@ def point_line(sweep: Sweep, point: SweepPoint) -> str:
 
 
 STATUS_MARKS = {
-    "completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!", "error": "!", "pending": "-",
+    "running": "▶", "completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!", "error": "!", "pending": "-",
 }  # fmt: skip
 
 

@@ -31,3 +31,30 @@ def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate
     every = []
     engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(every.append, interval=0.0)])
     assert [s.done for s in every] == [0, *range(1, 13), 12]
+
+
+def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(registry, tmp_path):
+    import threading
+
+    from frictionlab.hookspecs import hookimpl
+    from frictionlab.runner import run_to_folder
+
+    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
+    cancel = threading.Event()
+
+    class StopAfterFive:
+        @hookimpl
+        def realization_done(self, done):
+            if done >= 5:
+                cancel.set()
+
+    stopped, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[StopAfterFive()], cancel=cancel)
+    posted = []
+    resumed, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True),
+                               listeners=[LiveListener(posted.append, interval=0.0)])  # fmt: skip
+    assert posted[0].done == posted[0].restored == stopped.done  # the restored ones, shown at once
+    np.testing.assert_allclose(posted[0].xi, stopped.xi, rtol=1e-12)
+    last = posted[-1]
+    assert last.done == 12 and resumed.done == 12
+    np.testing.assert_allclose(last.xi, resumed.xi, rtol=1e-12)  # the mean over all 12, not the 7 new
+    assert last.fit.b == pytest.approx(resumed.fit.b, rel=1e-10)

@@ -33,7 +33,7 @@ def steady(monkeypatch):
     monkeypatch.setattr(frictionlab.tui.app, "new_run_folder", lambda name, runs_dir: runs_dir / f"{name}-run")
     monkeypatch.setattr(frictionlab.tui.widgets.run, "format_duration", lambda seconds: "1.0 s")
     monkeypatch.setattr(
-        frictionlab.tui.widgets.run, "progress_text", lambda done, total, failed, elapsed: f"{done}/{total} realizations"
+        frictionlab.tui.widgets.run, "progress_text", lambda done, total, failed, elapsed, restored=0: f"{done}/{total} realizations"
     )
 
 

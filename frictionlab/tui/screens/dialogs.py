@@ -34,6 +34,28 @@ class ConfirmScreen(ModalScreen[bool]):
         self.dismiss(value)
 
 
+class QuitDuringRunScreen(ModalScreen[str | None]):
+    """Quit while a run goes on: leave it running ("leave"), cancel it ("cancel"), or stay (None)."""
+
+    BINDINGS = [
+        Binding("l", "answer('leave')", "Leave it running"),
+        Binding("c", "answer('cancel')", "Cancel it"),
+        Binding("escape,n", "answer(None)", "Stay"),
+    ]
+
+    def __init__(self, question: str):
+        super().__init__()
+        self.question = question
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield Static(Content(self.question))
+            yield Label("l: leave it running and quit    c: cancel it and quit    Esc: stay", classes="hint")
+
+    def action_answer(self, value: str | None) -> None:
+        self.dismiss(value)
+
+
 def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | None, str]:
     """The path a user typed for a preset (``.yaml`` added), or why it cannot be one;
     ``folder`` (the presets folder, made when first saved into) need not exist yet."""

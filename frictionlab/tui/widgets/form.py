@@ -133,7 +133,7 @@ class PresetForm(VerticalScroll):
                 select_on_focus=spec.kind != "text",
                 id=spec.widget_id,
             )
-            widget.cursor_position = 0
+            widget.cursor_position = len(widget.value) if spec.kind == "text" else 0  # typing adds to a name
         else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
             shown = "(none)" if value in (MISSING, None) else _flow(value)
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
@@ -146,8 +146,11 @@ class PresetForm(VerticalScroll):
         widget.tooltip = Content(spec.tooltip())  # descriptions are text, never markup
         label = Label(Content(spec.name), classes="field-label")
         label.tooltip = Content(spec.tooltip())
+        row = [label, widget]
+        if spec.kind == "bool":  # the state in words, not in colour only
+            row.append(Static(_on_off(bool(current)), id=spec.widget_id + "--state", classes="switch-state"))
         return [
-            Horizontal(label, widget, classes="row"),
+            Horizontal(*row, classes="row"),
             Static("", id=spec.widget_id + "--error", classes="field-error"),
         ]
 
@@ -220,6 +223,9 @@ class PresetForm(VerticalScroll):
             self._store(spec, parse(spec, event.value))
 
     def on_switch_changed(self, event: Switch.Changed) -> None:
+        shown = self.query(f"#{event.switch.id}--state")
+        if shown:
+            shown.first().update(_on_off(event.value))
         spec = self._specs.get(event.switch.id or "")
         if spec is not None and self.data is not None and self._is_new(spec.widget_id, event.value):
             event.stop()
@@ -305,7 +311,10 @@ class PresetForm(VerticalScroll):
         for problem in problems:
             dotted = problem_path(problem)
             slot, _, rest = dotted.partition(".")
-            for widget_id in ("field--" + dotted.replace(".", "--"), f"plugin--{slot}" if rest == "name" else ""):
+            # a section's problem that names its field first ("loading: stop must be > start"): that field
+            named = f"{dotted}.{problem.partition(': ')[2].split(' ', 1)[0]}".replace(".", "--")
+            for widget_id in ("field--" + dotted.replace(".", "--"), "field--" + named,
+                              f"plugin--{slot}" if rest == "name" else ""):  # fmt: skip
                 widgets = self.query(f"#{widget_id}") if widget_id else []
                 if widgets and widgets.first().focusable:
                     widgets.first().focus()
@@ -324,3 +333,7 @@ class PresetForm(VerticalScroll):
                 choices=tuple(self.registry.names(slot)),
             )
         self.post_message(self.FieldFocused(spec))
+
+
+def _on_off(value: bool) -> str:
+    return "on" if value else "off"

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rich.text import Text
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Vertical, VerticalScroll
@@ -12,6 +13,7 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ..folders import PresetEntry, list_presets
+from ..text import shorten_middle
 from .pathline import PathLine
 from .tables import ListTable
 
@@ -35,16 +37,41 @@ class PresetsPane(Vertical):
         with VerticalScroll(id="preset-info-box", can_focus=False):
             yield Static("", id="preset-info")
 
-    def on_mount(self) -> None:
-        self.query_one("#preset-table", DataTable).add_columns("name", "folder", "file")
+    def on_resize(self, event: events.Resize) -> None:
+        self.call_after_refresh(self._fill)  # the names are cut to the width the list has
+
+    def _widths(self, table: DataTable) -> tuple[int, int, int]:
+        """The name, folder and file columns' widths: all three on screen, a long name or file
+        name cut in its middle, the name given at least half of what the folder leaves."""
+        names = max((len(e.name) for e in self.presets), default=4)
+        labels = max((len(e.label) for e in self.presets), default=6)
+        files = max((len(e.path.name) for e in self.presets), default=4)
+        if self.size.width == 0:  # not laid out yet: filled again once it is (on_resize)
+            return names, labels, files
+        room = self.size.width - 6 * table.cell_padding - table.styles.scrollbar_size_vertical
+        folder = min(labels, max(6, room // 5))
+        room -= folder
+        name = min(names, max(room // 2, room - files))
+        return max(4, name), folder, max(4, min(files, room - name))
+
+    def _fill(self) -> None:
+        table = self.query_one("#preset-table", DataTable)
+        row = table.cursor_row
+        name, folder, file = self._widths(table)
+        table.clear(columns=True)
+        table.add_column("name", width=name)
+        table.add_column("folder", width=folder)
+        table.add_column("file", width=file)
+        for entry in self.presets:  # Text: never markup
+            table.add_row(*(Text(shorten_middle(text, width)) for text, width in
+                            ((entry.name, name), (entry.label, folder), (entry.path.name, file))))  # fmt: skip
+        if self.presets:
+            table.move_cursor(row=min(max(row, 0), len(self.presets) - 1), animate=False)
 
     def reload(self, folders: list) -> None:
         """List the presets of ``folders`` (``folders.preset_folders``)."""
         self.presets = list_presets(folders)
-        table = self.query_one("#preset-table", DataTable)
-        table.clear()
-        for entry in self.presets:
-            table.add_row(Text(entry.name), Text(entry.label), Text(entry.path.name))  # Text: never markup
+        self._fill()
         if not self.presets:
             shown = ", ".join(str(f) for _, f in folders)
             self.query_one("#preset-path", PathLine).show("")

@@ -133,6 +133,9 @@ class ResultsPane(Vertical):
                 self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
+            if entry.status == "running" and not isinstance(entry, SweepEntry):  # its process goes on: shown live
+                self.app.show_running(entry.path)
+                return
             if isinstance(entry, SweepEntry):
                 if overlay:
                     self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.", "warning")

@@ -19,7 +19,7 @@ from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
 from ..sweepview import point_line, table_cells, table_columns
-from ..text import failure_message
+from ..text import failure_message, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
 
@@ -76,7 +76,7 @@ class RunPane(Vertical, can_focus=True):
         with Horizontal(id="run-body"):
             yield Chart(id="run-chart")
             yield Static("", id="run-fit")
-        yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="none")
+        yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
         yield Static("", id="run-error")
 
     def action_start(self) -> None:
@@ -103,11 +103,11 @@ class RunPane(Vertical, can_focus=True):
         preset = scene.preset
         if sweep is None:
             what = f": {preset.realizations} realizations, {preset.loading.steps} {preset.loading.control} steps"
-            self._set("run-title", Content.assemble((preset.name, "bold"), what))
+            self._set("run-title", Content.assemble((self._fitted(preset.name, what), "bold"), what))
         else:
             preset = sweep.points[0].scene.preset
             what = f": {len(sweep.points)} points x {preset.realizations} realizations"
-            self._set("run-title", Content.assemble((sweep.name, "bold"), what))
+            self._set("run-title", Content.assemble((self._fitted(sweep.name, what), "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
             table = self.query_one("#sweep-table", DataTable)
@@ -116,13 +116,25 @@ class RunPane(Vertical, can_focus=True):
         self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
         self.query_one("#run-bar", ProgressBar).update(total=preset.realizations, progress=0)
         self._set("run-error", "")
+        self._set("run-stats", "starting")
+        self._clear_fit()
+
+    def _fitted(self, name: str, rest: str) -> str:
+        """``name`` cut in its middle so that the line with ``rest`` fits the tab's width."""
+        width = self.size.width or 80
+        return shorten_middle(name, max(12, width - len(rest)))
+
+    def _clear_fit(self) -> None:
+        """No curve nor fit of an earlier run under this one's count."""
+        self.query_one("#run-chart", Chart).show([])
+        self._set("run-fit", "\n".join(fit_lines(None, final=False)))
 
     # ------------------------------------------------------------ while it runs
 
     def show_progress(self, snap: Snapshot, cancelling: bool) -> None:
         self.query_one("#run-bar", ProgressBar).update(total=snap.total, progress=snap.done)
         if not cancelling:
-            stats = progress_text(snap.done, snap.total, snap.failed, snap.elapsed)
+            stats = progress_text(snap.done, snap.total, snap.failed, snap.elapsed, restored=snap.restored)
             self._set("run-stats", f"{stats}\n{snap.solving}" if snap.solving else stats)
         if snap.f is not None:
             series = [Series(snap.f, snap.xi, "cyan")]
@@ -149,27 +161,33 @@ class RunPane(Vertical, can_focus=True):
 
     # ------------------------------------------------------------ at the end
 
-    def show_outcome(self, outcome) -> str:
-        """Show a finished run's ``RunOutcome``; return the line the app notifies."""
-        self.query_one("#run-bar", ProgressBar).update(total=outcome.requested, progress=outcome.done)
-        self._set("run-stats", f"{outcome.status}: {outcome.done}/{outcome.requested} realizations in "
-                               f"{format_duration(outcome.elapsed)}, {outcome.workers} worker"
-                               f"{'s' if outcome.workers != 1 else ''}")  # fmt: skip
-        if outcome.fit is not None:
-            series = [Series(outcome.f, outcome.xi, "cyan"), fit_series(outcome.f, outcome.fit.a, outcome.fit.b, "yellow")]
+    def show_outcome(self, run) -> str:
+        """Show a finished run (``FinishedRun``, read back from its folder); return the line the app notifies."""
+        result = run.result
+        done, requested = result.realizations
+        self.query_one("#run-bar", ProgressBar).update(total=requested, progress=done)
+        self._set("run-stats", f"{result.status}: {done}/{requested} realizations in "
+                               f"{format_duration(result.elapsed)}, {run.workers} worker"
+                               f"{'s' if run.workers != 1 else ''}")  # fmt: skip
+        f, xi = result.table["f"], result.table["xi"]
+        if result.fit is not None:
+            series = [Series(f, xi, "cyan"), fit_series(f, result.fit.a, result.fit.b, "yellow")]
             self.query_one("#run-chart", Chart).show(series)
-        lines = fit_lines(outcome.fit, final=True, f_formula=outcome.normalisation.formula)
-        self._set("run-fit", "\n".join(lines + _contact_lines(outcome.contact_count)))
-        if outcome.failures or outcome.error:
+        lines = fit_lines(result.fit, final=True, f_formula=run.f_formula)
+        self._set("run-fit", "\n".join(lines + _contact_lines(result.table["contact_count"])))
+        if run.failures or run.error:
             # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
-            index, reason = outcome.failures[0] if outcome.failures else (None, None)
-            first = f"#{index}: {failure_message(reason)}" if outcome.failures else outcome.error
-            self._error(f"{len(outcome.failures)} realization(s) failed; {first}")
-        return f"Run {outcome.status}: {outcome.done}/{outcome.requested} realizations"
+            index, reason = run.failures[0] if run.failures else (None, None)
+            first = f"#{index}: {failure_message(reason)}" if run.failures else run.error
+            self._error(f"{run.failed} realization(s) failed; {first}")
+        return f"Run {result.status}: {done}/{requested} realizations"
 
     def show_sweep_outcome(self, outcome) -> str:
         """Show a finished sweep's ``SweepOutcome``; return the line the app notifies."""
         finished = sum(r.status != "pending" for r in outcome.results)
+        last = next((r.outcome for r in reversed(outcome.results) if r.outcome is not None), None)
+        if last is not None:  # the last point's final fit: no "(interim)" left once the sweep is over
+            self._set("run-fit", "\n".join(fit_lines(last.fit, final=True, f_formula=last.normalisation.formula)))
         self._set("sweep-point", f"{outcome.status}: {finished}/{len(outcome.results)} points in "
                                  f"{format_duration(outcome.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
         return f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points"

@@ -1,0 +1,55 @@
+"""``frictionlab runs [DIR]``: the run folders under DIR with their status: running
+(with the pid of its process), completed, or ended early and resumable."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import ExitCode, RunFolderError
+
+EXAMPLES = """examples:
+  frictionlab runs                            the runs under runs/
+  frictionlab runs /scratch/me/runs --json    as one JSON object
+  frictionlab follow runs/quickstart-20250101-120000   follow a running one
+"""
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "runs",
+        help="list run folders with their status (running, completed, interrupted...)",
+        description="The run folders under DIR, running ones first: a run whose process is gone reads as "
+        "interrupted (frictionlab resume continues it), never as running.",
+        epilog=EXAMPLES,
+    )
+    p.add_argument("runs_dir", nargs="?", default=None, metavar="DIR", help="the folder of run folders (default: runs)")
+    p.add_argument("--json", action="store_true", help='as one JSON object: {"runs_dir": ..., "runs": [...]}')
+    p.set_defaults(handler=run)
+
+
+def run(args) -> ExitCode:
+    from ..detached import list_run_states
+    from ..rundir import DEFAULT_RUNS_DIR
+
+    runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
+    if args.runs_dir is not None and not runs_dir.is_dir():
+        what = "is not a folder" if runs_dir.exists() else "does not exist"
+        raise RunFolderError(f"DIR: {runs_dir} {what}: give the folder that holds run folders")
+    states = list_run_states(runs_dir)
+    if args.json:
+        print(json.dumps({"runs_dir": str(runs_dir), "runs": [s.to_dict() for s in states]}, indent=2))
+        return ExitCode.OK
+    if not states:
+        print(f"no run folders in {runs_dir}/")
+        return ExitCode.OK
+    from .console import print_table
+
+    rows = []
+    for state in states:
+        done = "?" if state.done is None else str(state.done)
+        total = "?" if state.total is None else str(state.total)
+        status = f"running (pid {state.pid})" if state.pid else state.status
+        rows.append((str(state.folder), state.name, status, f"{done}/{total}"))
+    print_table(["FOLDER", "NAME", "STATUS", "DONE"], rows)
+    return ExitCode.OK

@@ -1,0 +1,303 @@
+"""Runs that do not depend on the terminal that started them, and the state of a run folder.
+
+``start_detached`` starts a run as its own process in its own session (a closed
+terminal's SIGHUP does not reach it; its stdin, stdout and stderr are not the
+terminal): it holds the folder's lock (``run.lock`` names its pid) and writes its
+events to ``progress.jsonl`` (``progresslog``), which any front end can follow.
+Cancelling it is SIGTERM to that pid: what finished is kept, the run ends
+"interrupted" and can be resumed.
+
+``run_state`` tells what a folder holds: a run going on, or one that ended and how.
+A manifest that still says "running" while no live process holds the lock was left
+by a run that died: it reads as interrupted, never as running.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from .errors import ExitCode, FrictionlabError, RunFolderError
+from .options import RunOptions
+from .progresslog import ProgressLog, ProgressReader
+from .inputs import InputFileProblem
+from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
+from .runfolder import read_json, read_member
+
+MAX_LOCK_BYTES = 4096
+TAIL_BYTES = 256 * 1024  # of progress.jsonl, read for the count of a listed run
+STARTED_WAIT = 120.0  # seconds ``wait_started`` waits for the run's first event
+
+
+# ------------------------------------------------------------------ starting
+
+
+def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
+    """Refuse, before a process is started, what the run would refuse as it begins: a
+    folder in use or not its own (a fresh run), a run that does not fit in memory."""
+    from .runner import check_memory
+
+    if lock_held(out_dir):
+        holder = lock_holder(out_dir)
+        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
+                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+    if not options.resume:
+        RunDirectory(out_dir, force=options.force).check_fresh(scene)
+    if options.memory_check:
+        check_memory(scene, options)
+
+
+def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions(), *,
+                   plot: bool = True) -> subprocess.Popen:  # fmt: skip
+    """Start the run of the preset ``resolved`` (``Scene.resolved()``) into ``out_dir`` as
+    its own process in a new session, and return at once. The preset and the options
+    go through a pipe, read before the run begins: the terminal is none of its files."""
+    request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot}
+    process = subprocess.Popen(
+        [sys.executable, "-m", "frictionlab.detached"],
+        stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        start_new_session=True, close_fds=True,
+    )  # fmt: skip
+    process.stdin.write(json.dumps(request).encode())
+    process.stdin.close()
+    return process
+
+
+def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float = STARTED_WAIT) -> None:
+    """Return once the detached run has begun (its ``started`` event is written); raise
+    FrictionlabError with the run's own message (and exit code) if it could not begin."""
+    reader = ProgressReader(out_dir)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        for event in reader.new_events():
+            if event["event"] == "started":
+                return
+            if event["event"] == "error":
+                _raise_run_error(event)
+        if process.poll() is not None:
+            for event in reader.new_events():
+                if event["event"] == "error":
+                    _raise_run_error(event)
+            if any(event["event"] == "started" for event in ProgressReader(out_dir).new_events()):
+                return  # a run so short it ended already
+            raise FrictionlabError(f"the run into {out_dir} ended at once (exit code {process.returncode}) without a word")
+        time.sleep(0.05)
+    raise FrictionlabError(f"the run into {out_dir} has not started after {timeout:g} s (pid {process.pid}); "
+                           f"`frictionlab follow {out_dir}` shows it if it does")  # fmt: skip
+
+
+def _raise_run_error(event: dict) -> None:
+    error = FrictionlabError(str(event.get("message")))
+    code = event.get("exit_code")
+    error.exit_code = ExitCode(code) if code in ExitCode._value2member_map_ else ExitCode.RUNTIME_FAILURE
+    raise error
+
+
+def cancel(pid: int) -> bool:
+    """Ask the run ``pid`` to stop (SIGTERM): what finished is kept, the run ends interrupted.
+    False if there is no such process any more."""
+    try:
+        os.kill(pid, signal.SIGTERM)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def _child() -> int:
+    """The detached process: read the request from stdin, run it, tell the folder how it went."""
+    from .preset import build_scene
+    from .runner import run_to_folder
+    from .signals import RaiseOnSigterm
+
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)  # no terminal of its own; a stray hangup is not a cancel
+    request = json.loads(sys.stdin.read())
+    out = Path(request["out"])
+    log = ProgressLog(out)
+    try:
+        with RaiseOnSigterm():
+            scene = build_scene(request["preset"])
+            options = RunOptions(**request["options"])
+            outcome, _ = run_to_folder(scene, out, options, listeners=[log], plot=bool(request.get("plot", True)))
+    except FrictionlabError as exc:
+        log.error(str(exc), exc.exit_code)
+        return exc.exit_code
+    except KeyboardInterrupt:  # SIGTERM before the run began, or a second one during it
+        log.error("the run was stopped (SIGTERM) before it could write its results", ExitCode.TERMINATED)
+        return ExitCode.TERMINATED
+    except OSError as exc:
+        log.error(f"cannot write results to {out}: {exc.strerror or exc}", ExitCode.RUNTIME_FAILURE)
+        return ExitCode.RUNTIME_FAILURE
+    except Exception as exc:  # a bug: said where a follower looks, since stderr is nobody's
+        log.error(f"internal error ({type(exc).__name__}: {exc}); please report it", ExitCode.INTERNAL)
+        return ExitCode.INTERNAL
+    finally:
+        log.close()
+    if outcome.status in ("interrupted", "cancelled"):
+        return ExitCode.TERMINATED
+    return ExitCode.OK if outcome.status == "completed" and not outcome.failures else ExitCode.RUNTIME_FAILURE
+
+
+# ------------------------------------------------------------------ the state of a folder
+
+
+def lock_holder(folder: str | Path) -> int | None:
+    """The pid that ``run.lock`` names, None if there is no lock (or it names none).
+    Read as a regular file, never through a link."""
+    try:
+        text = read_member(folder, LOCK_FILE, MAX_LOCK_BYTES).decode(errors="replace")
+    except (InputFileProblem, OSError):
+        return None
+    words = text.replace(",", " ").split()
+    if len(words) >= 2 and words[0] == "pid" and words[1].isdigit():
+        return int(words[1])
+    return None
+
+
+def process_alive(pid: int) -> bool:
+    """Whether ``pid`` is a live process (a zombie, dead but not yet reaped, is not)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass  # another user's process: alive
+    except OverflowError:
+        return False
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[-1].split()[0] != b"Z"
+    except (OSError, IndexError):
+        return True  # no /proc (macOS): kill said it is there
+
+
+def lock_held(folder: str | Path) -> bool:
+    """Whether some process holds the folder's run lock now (a flock is released by the
+    kernel when its holder dies, even on kill -9). Where it cannot be probed, True."""
+    try:
+        import fcntl
+    except ImportError:
+        return True
+    try:
+        fd = os.open(Path(folder) / LOCK_FILE, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | os.O_NONBLOCK)
+    except OSError:
+        return False
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return False
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    except OSError:
+        return True
+    else:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return False
+    finally:
+        os.close(fd)
+
+
+@dataclass
+class RunState:
+    """What a run folder holds now. ``status``: running, completed, cancelled,
+    interrupted or failed; ``pid`` the live run's process (running only)."""
+
+    folder: Path
+    name: str
+    status: str
+    done: int | None  # realizations finished, None where nothing says
+    total: int | None
+    pid: int | None = None
+
+    @property
+    def resumable(self) -> bool:
+        return self.status in ("cancelled", "interrupted", "failed")
+
+    def to_dict(self) -> dict:
+        return {"folder": str(self.folder), "name": self.name, "status": self.status, "done": self.done,
+                "total": self.total, "pid": self.pid}  # fmt: skip
+
+
+def _count(value) -> int | None:
+    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else None
+
+
+def run_state(folder: str | Path) -> RunState:
+    """The state of the run in ``folder``; RunFolderError if it holds none (or a damaged one)."""
+    folder = Path(folder)
+    if folder.is_symlink() or not folder.is_dir():
+        raise RunFolderError(f"{folder} is not a run folder (not a folder, or a link to one)")
+    manifest = RunDirectory(folder).state()  # read as untrusted input
+    if manifest is None:
+        raise RunFolderError(f"{folder} holds no run (no {STATE_FILE})")
+    preset = manifest.get("preset") if isinstance(manifest.get("preset"), dict) else {}
+    name = str(preset.get("name") or folder.name)
+    status = str(manifest.get("status") or "?")
+    total = _count(manifest.get("realizations"))
+    done, pid = _last_count(folder), None
+    if status == "running":
+        holder = lock_holder(folder)
+        if holder is not None and process_alive(holder) and lock_held(folder):
+            pid = holder
+        else:
+            status = "interrupted"  # the process that wrote "running" is gone
+    summary = _summary(folder)
+    if summary is not None and status != "running":
+        counts = summary.get("realizations") if isinstance(summary.get("realizations"), dict) else {}
+        done = _count(counts.get("done")) if _count(counts.get("done")) is not None else done
+    return RunState(folder, name, status, done, total, pid)
+
+
+def _summary(folder: Path) -> dict | None:
+    try:
+        return read_json(folder, "summary.json")
+    except (OSError, FrictionlabError):
+        return None
+
+
+def _last_count(folder: Path) -> int | None:
+    """Realizations finished as the progress log's last counting event says (read from its tail)."""
+    reader = ProgressReader(folder)
+    try:
+        reader.offset = max(0, os.lstat(reader.path).st_size - TAIL_BYTES)  # a cut first line is skipped
+    except OSError:
+        return None
+    done = None
+    while True:
+        events = reader.new_events()
+        if not events:
+            return done
+        for event in events:
+            if event["event"] == "started":  # none finished yet but those restored
+                done = _count(event.get("resumed")) or 0
+            elif event["event"] in ("realization", "finished"):
+                done = _count(event.get("done"))
+
+
+def list_run_states(runs_dir: str | Path) -> list[RunState]:
+    """The state of every run folder directly under ``runs_dir`` (one holding a
+    ``run.json``), running ones first, then the newest; links are not followed."""
+    runs_dir = Path(runs_dir)
+    if not runs_dir.is_dir():
+        return []
+    states = []
+    for folder in runs_dir.iterdir():
+        if folder.is_symlink() or not (folder / STATE_FILE).is_file():
+            continue
+        try:
+            states.append((folder.stat().st_mtime, run_state(folder)))
+        except (OSError, FrictionlabError):
+            continue  # damaged or foreign: not one to list
+    states.sort(key=lambda item: (item[1].status != "running", -item[0], item[1].folder.name))
+    return [state for _, state in states]
+
+
+if __name__ == "__main__":
+    sys.exit(int(_child()))

@@ -1,0 +1,282 @@
+"""A run's progress as a file in its folder, so that whoever comes later can follow it.
+
+A run writes ``progress.jsonl``: one JSON object a line, appended as things happen
+(``started``, one ``realization`` per finished realization with its curve, ``load``
+and ``iteration`` within a long solve, ``finished``; ``error`` when the run could not start). A TUI
+opened later, ``frictionlab follow`` or ``tail -f`` read it; ``Follower`` replays
+it to ``listeners.RunListener``s, the same ones that hear a run in this process.
+
+The file is rewritten from the start when a run (or its resume) starts; a resume
+first lists the realizations it restored, so a follower's sums cover them all.
+It is read as the rest of a run folder is: untrusted, a regular file only (never
+through a link), capped in size, a line that is not an event skipped.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import stat
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .hookspecs import hookimpl
+from .realization import RealizationResult
+
+PROGRESS_FILE = "progress.jsonl"
+MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # ~100k realizations of 100 load steps: beyond that it is not ours
+READ_BLOCK = 4 * 1024 * 1024  # read at most this much at a time: a follower stays responsive
+CURVES = ("xi", "contact_count", "force")  # what a follower's mean curve needs (force: under indentation control)
+
+
+def _floats(values) -> list | None:
+    return None if values is None else np.asarray(values, float).tolist()
+
+
+def _event_of(result: RealizationResult, done: int, total: int, restored: bool = False) -> dict:
+    event = {"event": "realization", "index": result.index, "done": done, "total": total,
+             "seconds": result.seconds, "ok": result.ok}  # fmt: skip
+    if restored:
+        event["restored"] = True
+    if result.ok:
+        event.update({name: _floats(getattr(result, name)) for name in CURVES})
+        event.update(force_unit=result.force_unit, slope_rms_line=result.slope_rms_line, points=result.points)
+    else:
+        event["error"] = result.error
+    return event
+
+
+class ProgressLog:
+    """A ``listeners.RunListener`` that writes the run's events to ``folder/progress.jsonl``.
+    Progress is never worth a run: a write that fails stops the log, not the run."""
+
+    def __init__(self, folder: str | Path, clock=time.time):
+        self.path = Path(folder) / PROGRESS_FILE
+        self.clock = clock
+        self._fd: int | None = None
+
+    def _open(self, truncate: bool) -> None:
+        self.close()
+        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0) | (os.O_TRUNC if truncate else 0)
+        try:
+            self._fd = os.open(self.path, flags, 0o644)
+            if not stat.S_ISREG(os.fstat(self._fd).st_mode):
+                self.close()
+        except OSError:
+            self._fd = None
+
+    def close(self) -> None:
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
+
+    def write(self, event: dict) -> None:
+        """Append one event (with the wall-clock ``time``) as one line, written at once."""
+        if self._fd is None:
+            return
+        line = json.dumps({**event, "time": self.clock()}, separators=(",", ":")) + "\n"
+        try:
+            os.write(self._fd, line.encode())
+        except OSError:
+            self.close()
+
+    def error(self, message: str, exit_code: int) -> None:
+        """The run could not start, or stopped with an error: what a follower shows."""
+        if self._fd is None:
+            self._open(truncate=False)  # appended: the log may be another live run's (a folder in use)
+        self.write({"event": "error", "pid": os.getpid(), "message": message, "exit_code": int(exit_code)})
+
+    @hookimpl
+    def run_started(self, run):
+        self._open(truncate=True)
+        self.write({"event": "started", "pid": os.getpid(), "name": run.scene.preset.name, "total": run.total,
+                    "workers": run.workers, "executor": run.executor, "resumed": run.resumed, "retried": run.retried})  # fmt: skip
+        for done, result in enumerate(run.restored, start=1):
+            self.write(_event_of(result, done, run.total, restored=True))
+
+    @hookimpl
+    def realization_done(self, result, done, total):
+        self.write(_event_of(result, done, total))
+
+    @hookimpl
+    def realization_failed(self, result, done, total):
+        self.write(_event_of(result, done, total))
+
+    @hookimpl
+    def load_done(self, index, done, total):
+        self.write({"event": "load", "index": index, "done": done, "total": total})
+
+    @hookimpl
+    def iteration_done(self, index, load, iteration, residual):
+        self.write({"event": "iteration", "index": index, "load": load, "iteration": iteration, "residual": residual})
+
+    @hookimpl
+    def run_finished(self, outcome):
+        self.write({"event": "finished", "status": outcome.status, "done": outcome.done,
+                    "failed": len(outcome.failures), "requested": outcome.requested, "error": outcome.error})  # fmt: skip
+
+
+# ------------------------------------------------------------------ reading
+
+
+class ProgressReader:
+    """Reads the events appended to a folder's progress.jsonl since the last call.
+    A file that shrank was rewritten by a new start: reading begins again (``restarted``)."""
+
+    def __init__(self, folder: str | Path):
+        self.path = Path(folder) / PROGRESS_FILE
+        self.offset = 0
+        self.restarted = False
+        self.too_large = False
+
+    def new_events(self) -> list[dict]:
+        self.restarted = False
+        try:
+            fd = os.open(self.path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+        except OSError:
+            return []  # not there yet, or a link: nothing to follow
+        try:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
+                return []
+            if info.st_size > MAX_PROGRESS_BYTES:
+                self.too_large = True
+                return []
+            if info.st_size < self.offset:
+                self.offset, self.restarted = 0, True
+            data = os.pread(fd, min(READ_BLOCK, info.st_size - self.offset), self.offset)
+        except OSError:  # read next time, if it can be
+            return []
+        finally:
+            os.close(fd)
+        end = data.rfind(b"\n") + 1  # only whole lines: the last one may still be written
+        self.offset += end
+        return [event for event in map(_parse, data[:end].splitlines()) if event is not None]
+
+
+def _parse(line: bytes) -> dict | None:
+    try:
+        event = json.loads(line)
+    except (ValueError, RecursionError):
+        return None
+    return event if isinstance(event, dict) and isinstance(event.get("event"), str) else None
+
+
+def _whole(value, default: int = 0) -> int:
+    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else default
+
+
+def _number(value) -> float:
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
+
+
+def _curve(value, steps: int) -> np.ndarray | None:
+    if not isinstance(value, list) or len(value) != steps:
+        return None
+    try:
+        return np.array([math.nan if x is None else x for x in value], dtype=float)
+    except (TypeError, ValueError):
+        return None
+
+
+def result_of(event: dict, steps: int) -> RealizationResult | None:
+    """The RealizationResult a ``realization`` event tells, None if it does not hold one
+    (a curve of another length than the run's load steps, a field of the wrong kind)."""
+    index = _whole(event.get("index"), -1)
+    if index < 0:
+        return None
+    seconds = _number(event.get("seconds"))
+    if event.get("ok") is not True:
+        return RealizationResult(index=index, seconds=seconds, error=str(event.get("error") or "failed"))
+    curves = {name: _curve(event.get(name), steps) for name in CURVES}
+    if curves["xi"] is None or curves["contact_count"] is None:
+        return None
+    return RealizationResult(index=index, seconds=seconds, **curves, force_unit=_number(event.get("force_unit")),
+                             slope_rms_line=_number(event.get("slope_rms_line")), points=_whole(event.get("points")))  # fmt: skip
+
+
+@dataclass
+class Finished:
+    """How a followed run ended, as its last event says (or ``interrupted`` when its process went without one)."""
+
+    status: str
+    done: int
+    requested: int
+    error: str | None = None
+    exit_code: int | None = None  # an ``error`` event's: the run could not start
+
+
+class Follower:
+    """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
+    ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
+    or ``realization_failed``, ``load_done``, ``iteration_done``. Call ``poll()`` now and then; ``finished`` is set
+    once the run's last event came. ``now()`` is the wall-clock time of the event being
+    replayed (the present between events): a listener's clock, so that its elapsed time
+    and rate are the run's even when followed from the middle."""
+
+    def __init__(self, folder: str | Path, scene, listeners=()):
+        self.reader = ProgressReader(folder)
+        self.scene = scene
+        self.listeners = list(listeners)
+        self.info = None
+        self.pid: int | None = None
+        self.finished: Finished | None = None
+        self.done = self.total = 0
+        self._event_time: float | None = None
+        self._hooks = None
+
+    def now(self) -> float:
+        return time.time() if self._event_time is None else self._event_time
+
+    def _tell(self, hook: str, **kwargs) -> None:
+        from .engine import listener_manager
+
+        if self._hooks is None:
+            self._hooks = listener_manager(self.listeners).hook
+        getattr(self._hooks, hook)(**kwargs)
+
+    def poll(self) -> int:
+        """Replay the events written since the last call; return how many."""
+        from .engine import RunInfo
+
+        events = self.reader.new_events()
+        if self.reader.restarted:
+            self.info, self.finished = None, None
+        for event in events:
+            kind = event["event"]
+            self._event_time = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
+            try:
+                if kind == "started":
+                    self.pid = _whole(event.get("pid")) or None
+                    self.total = _whole(event.get("total"))
+                    self.done, self.finished = 0, None
+                    self.info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
+                                        executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
+                    self._tell("run_started", run=self.info)
+                elif kind == "realization" and self.info is not None:
+                    result = result_of(event, self.scene.loads.size)
+                    if result is None:
+                        continue
+                    self.done = _whole(event.get("done"), self.done)
+                    hook = "realization_done" if result.ok else "realization_failed"
+                    self._tell(hook, run=self.info, result=result, done=self.done, total=self.total)
+                elif kind == "load" and self.info is not None:
+                    self._tell("load_done", run=self.info, index=_whole(event.get("index")),
+                               done=_whole(event.get("done")), total=_whole(event.get("total")))  # fmt: skip
+                elif kind == "iteration" and self.info is not None:
+                    self._tell("iteration_done", run=self.info, index=_whole(event.get("index")), load=_whole(event.get("load")),
+                               iteration=_whole(event.get("iteration")), residual=_number(event.get("residual")))  # fmt: skip
+                elif kind == "finished":
+                    error = event.get("error")
+                    self.finished = Finished(str(event.get("status")), _whole(event.get("done")),
+                                             _whole(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
+                elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
+                    self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
+                                             _whole(event.get("exit_code"), 1))  # fmt: skip
+            finally:
+                self._event_time = None
+        return len(events)

@@ -1,0 +1,104 @@
+"""A run the TUI shows that goes on in a process of its own (``frictionlab.detached``),
+started here or found running in the runs folder; and a finished run read back
+from its folder. No Textual here: the app polls ``FollowedRun`` on a timer."""
+
+from __future__ import annotations
+
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..api import Result, load
+from ..detached import cancel, lock_held
+from ..progresslog import Follower
+from .folders import read_run
+from .live import LiveListener
+
+
+class FollowedRun:
+    """The run in ``folder`` of ``scene``, read from its progress file; ``post`` gets the
+    ``Snapshot``s of a ``LiveListener`` (elapsed and rate in the run's own times).
+    ``process``: the run's process when this TUI started it (reaped here), else None."""
+
+    def __init__(self, folder: Path, scene, post, process: subprocess.Popen | None = None, pid: int | None = None):
+        self.folder = Path(folder)
+        self.scene = scene
+        self.process = process
+        self._pid = pid
+        self.live = LiveListener(post)
+        self.follower = Follower(folder, scene, [self.live])
+        self.live.clock = self.follower.now
+        self.cancelling = False
+
+    @property
+    def pid(self) -> int | None:
+        if self.process is not None:
+            return self.process.pid
+        return self.follower.pid or self._pid
+
+    @property
+    def error(self) -> str | None:
+        """Why the run could not begin or go on, as it said (None if it did not)."""
+        finished = self.follower.finished
+        return finished.error if finished is not None and finished.exit_code is not None else None
+
+    def poll(self) -> bool:
+        """Read what the run wrote since the last call (a snapshot even when nothing came:
+        the elapsed time moves); True once its process has ended."""
+        if not self.follower.poll():
+            self.live.tick()
+        if self.process is not None:
+            over = self.process.poll() is not None  # also reaps it: no zombie reads as alive
+        else:
+            over = not lock_held(self.folder)
+        if over:
+            self.follower.poll()  # what it wrote last
+        return over
+
+    def cancel(self) -> bool:
+        """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone."""
+        pid = self.pid
+        self.cancelling = pid is not None and cancel(pid)
+        return self.cancelling
+
+
+@dataclass
+class FinishedRun:
+    """A finished run as its folder holds it: the numbers (``api.Result``) and what the Run tab adds."""
+
+    result: Result
+    workers: int
+    f_formula: str
+    failures: list[tuple[int, str]] = field(default_factory=list)
+    failed: int = 0
+    error: str | None = None
+
+    @property
+    def status(self) -> str:
+        return self.result.status
+
+    @property
+    def done(self) -> int:
+        return self.result.realizations[0]
+
+    @property
+    def fit(self):
+        return self.result.fit
+
+
+def read_finished(folder: Path) -> FinishedRun:
+    """The run in ``folder`` read back (RunFolderError, OSError, ValueError if it wrote no results)."""
+    result = load(folder)
+    entry = read_run(folder)
+    counts = entry.summary.get("realizations") if isinstance(entry.summary.get("realizations"), dict) else {}
+    failures = [(f.get("index"), str(f.get("error"))) for f in counts.get("failures") or [] if isinstance(f, dict)]
+    workers = entry.summary.get("workers")
+    error = entry.summary.get("error")
+    return FinishedRun(
+        result=result,
+        workers=workers if isinstance(workers, int) and workers > 0 else 1,
+        f_formula=entry.formula,
+        failures=failures,
+        failed=counts.get("failed") if isinstance(counts.get("failed"), int) else len(failures),
+        error=error if isinstance(error, str) else None,
+    )

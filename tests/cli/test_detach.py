@@ -1,0 +1,70 @@
+"""``run --detach``, ``runs`` and ``follow``: one JSON object each, the exit codes of errors.ExitCode."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from frictionlab.detached import run_state
+
+from ..conftest import SMALL_PRESET, merge
+from .conftest import run_cli, write_preset
+
+
+def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
+    out = tmp_path / "runs" / "one"
+    started = run_cli("run", preset, "--detach", "--json", "--workers", "1", "--out", out)
+    assert started.returncode == 0, started.stderr
+    told = json.loads(started.stdout)  # one JSON object
+    assert told["folder"] == str(out) and told["status"] == "running" and told["pid"] > 0
+    listed = run_cli("runs", tmp_path / "runs", "--json")
+    runs = json.loads(listed.stdout)["runs"]
+    assert [r["folder"] for r in runs] == [str(out)] and runs[0]["status"] in ("running", "completed")
+    followed = run_cli("follow", out, "--json")
+    assert followed.returncode == 0, followed.stderr
+    end = json.loads(followed.stdout)
+    assert (end["status"], end["done"], end["total"], end["pid"]) == ("completed", 40, 40, None)
+    assert json.loads((out / "summary.json").read_text())["realizations"]["done"] == 40
+    table = run_cli("runs", tmp_path / "runs")
+    assert "completed" in table.stdout and "40/40" in table.stdout
+
+
+def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
+    out = tmp_path / "long"
+    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+    heading = follow.stderr.readline()  # the progress it follows (then a line a tenth, in a pipe)
+    assert "100000 realizations of" in heading
+    deadline = time.monotonic() + 60
+    while (run_state(out).done or 0) < 3 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.kill(told["pid"], signal.SIGTERM)
+    stdout, _ = follow.communicate(timeout=60)
+    assert follow.returncode == 1
+    assert "interrupted" in stdout and f"frictionlab resume {out} continues it" in stdout
+
+
+def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep")
+    refused = run_cli("run", preset, "--detach", "--out", mine)
+    assert refused.returncode == 4 and "not empty" in refused.stderr
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]  # nothing written into the user's folder
+    sweep = write_preset(tmp_path, merge(SMALL_PRESET, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}}), "sweep.yaml")
+    refused = run_cli("run", sweep, "--detach", "--out", tmp_path / "s")
+    assert refused.returncode == 2 and "--detach runs one ensemble, not a sweep" in refused.stderr
+
+
+def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
+    missing = run_cli("runs", tmp_path / "nowhere")
+    assert missing.returncode == 5 and "DIR:" in missing.stderr and "does not exist" in missing.stderr
+    (tmp_path / "plain").mkdir()
+    followed = run_cli("follow", tmp_path / "plain")
+    assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr

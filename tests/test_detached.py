@@ -1,0 +1,223 @@
+"""Runs that outlive their front end: a detached run finishes after the session that
+started it is gone, a run whose process died reads as interrupted, its progress
+file is followed as untrusted input and tells what the run computed."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+from frictionlab.detached import (
+    lock_held,
+    process_alive,
+    run_state,
+    start_detached,
+    wait_started,
+)
+from frictionlab.hookspecs import hookimpl
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.progresslog import PROGRESS_FILE, Follower, ProgressLog, ProgressReader
+from frictionlab.rundir import LOCK_FILE, RunDirectory
+from frictionlab.runner import run_to_folder
+
+from .conftest import SMALL_PRESET, merge
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="sessions and signals are POSIX")
+
+
+def wait_for(condition, timeout=120.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return
+        time.sleep(0.05)
+    raise AssertionError("timed out")
+
+
+class Collect:
+    """A run listener that keeps what it hears."""
+
+    def __init__(self):
+        self.results, self.started = [], None
+
+    @hookimpl
+    def run_started(self, run):
+        self.started, self.results = run, []
+
+    @hookimpl
+    def realization_done(self, result, done, total):
+        self.results.append((result, done, total))
+
+
+def test_a_detached_run_completes_after_the_session_that_started_it_is_killed(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 60, "spectrum": {"params": {"points": 2048}}})
+    out = tmp_path / "run"
+    starter = textwrap.dedent(f"""
+        import sys, time
+        from frictionlab.detached import start_detached, wait_started
+        from frictionlab.options import RunOptions
+        from frictionlab.preset import build_scene
+        scene = build_scene({data!r})
+        process = start_detached(scene.resolved(), {str(out)!r}, RunOptions(workers=1))
+        wait_started(process, {str(out)!r})
+        print(process.pid, flush=True)
+        time.sleep(600)  # the terminal's session, until it is killed
+    """)
+    # the starter leads a session of its own, as a shell in a terminal does
+    parent = subprocess.Popen([sys.executable, "-c", starter], stdout=subprocess.PIPE, text=True, start_new_session=True)
+    run_pid = int(parent.stdout.readline())
+    os.killpg(parent.pid, signal.SIGHUP)  # the terminal goes: its whole session hears the hangup
+    os.killpg(parent.pid, signal.SIGKILL)
+    parent.wait()
+    assert run_state(out).status == "running" and run_state(out).pid == run_pid  # not done yet when the session died
+    wait_for(lambda: run_state(out).status != "running")
+    state = run_state(out)
+    assert (state.status, state.done, state.total) == ("completed", 60, 60)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["realizations"]["done"] == 60
+    # the same numbers as a run in this process (same preset, same seed)
+    whole, _ = run_to_folder(build_scene(data), tmp_path / "here", RunOptions(workers=1))
+    assert summary["fit"]["a"] == whole.fit.a and summary["fit"]["b"] == whole.fit.b
+
+
+def test_a_run_whose_process_was_killed_reads_as_interrupted_and_resumes(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 100_000})
+    out = tmp_path / "run"
+    process = start_detached(build_scene(data).resolved(), out, RunOptions(workers=1))
+    wait_started(process, out)
+    assert run_state(out).done is not None  # 0 before the first realization: a count, not unknown
+    wait_for(lambda: (run_state(out).done or 0) >= 2)
+    assert run_state(out).status == "running"
+    process.kill()  # kill -9: no chance to write anything
+    process.wait()
+    assert json.loads((out / "run.json").read_text())["status"] == "running"  # what the dead run left
+    state = run_state(out)
+    assert state.status == "interrupted" and state.pid is None and state.resumable and 2 <= state.done < 100_000
+
+
+def test_a_lock_naming_a_dead_or_unrelated_process_is_not_a_running_run(tmp_path):
+    scene = build_scene(SMALL_PRESET)
+    with RunDirectory(tmp_path) as run_dir:  # a run that began and was never finished
+        run_dir.start(scene, resume=False)
+        assert run_state(tmp_path).status == "running"  # this process holds the lock
+    (tmp_path / LOCK_FILE).write_text("pid 999999999, started 2025-01-01 00:00:00\n")  # left by kill -9
+    assert not process_alive(999999999)
+    assert run_state(tmp_path).status == "interrupted"
+    (tmp_path / LOCK_FILE).write_text(f"pid {os.getpid()}, started 2025-01-01 00:00:00\n")  # a reused pid
+    assert process_alive(os.getpid()) and not lock_held(tmp_path)
+    assert run_state(tmp_path).status == "interrupted"
+
+
+def test_sigterm_ends_a_detached_run_interrupted_keeping_what_finished(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 100_000})
+    out = tmp_path / "run"
+    process = start_detached(build_scene(data).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    wait_for(lambda: (run_state(out).done or 0) >= 3)
+    os.kill(process.pid, signal.SIGTERM)
+    assert process.wait(timeout=60) == 143
+    state = run_state(out)
+    summary = json.loads((out / "summary.json").read_text())
+    assert state.status == summary["status"] == "interrupted"
+    assert 3 <= summary["realizations"]["done"] == state.done < 100_000
+    with np.load(out / "realizations.npz") as arrays:
+        assert arrays["xi"].shape[0] == state.done
+
+
+def test_the_follower_hears_every_realization_as_the_run_computed_it_and_a_resume_lists_the_restored(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 12})
+    scene = build_scene(data)
+    here = Collect()
+    cancel = __import__("threading").Event()
+
+    class StopAfterFive:
+        @hookimpl
+        def realization_done(self, done):
+            if done >= 5:
+                cancel.set()
+
+    run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[ProgressLog(tmp_path), StopAfterFive()], cancel=cancel)
+    first = Collect()
+    Follower(tmp_path, scene, [first]).poll()
+    assert 5 <= len(first.results) < 12
+    run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True), listeners=[ProgressLog(tmp_path), here])
+    heard = Collect()
+    follower = Follower(tmp_path, scene, [heard])
+    follower.poll()
+    assert follower.finished.status == "completed" and heard.started.resumed == len(first.results)
+    assert sorted(r.index for r, _, _ in heard.results) == list(range(12))  # restored, then the new ones
+    assert [done for _, done, _ in heard.results] == list(range(1, 13))
+    computed = {r.index: r for r, _, _ in here.results}
+    with np.load(tmp_path / "realizations.npz") as arrays:
+        for result, _, _ in heard.results:  # every number as written: JSON keeps a float's every bit
+            assert np.array_equal(result.xi, arrays["xi"][result.index])
+            if result.index in computed:
+                assert np.array_equal(result.contact_count, computed[result.index].contact_count)
+
+
+def test_the_progress_file_is_read_as_untrusted_input(tmp_path, monkeypatch):
+    reader = ProgressReader(tmp_path)
+    path = tmp_path / PROGRESS_FILE
+    path.write_bytes(b'{"event": "started", "total": 3}\nnot json\n[1, 2]\n{"no_event": 1}\n{"event": "realiz')
+    assert [e["event"] for e in reader.new_events()] == ["started"]  # bad lines skipped, a cut last line waits
+    with open(path, "ab") as fh:
+        fh.write(b'ation", "index": 0}\n')
+    assert [e["event"] for e in reader.new_events()] == ["realization"]
+    path.write_bytes(b'{"event": "started"}\n')  # rewritten by a new start: read again from the top
+    assert [e["event"] for e in reader.new_events()] == ["started"] and reader.restarted
+    path.unlink()
+    target = tmp_path / "elsewhere.jsonl"
+    target.write_bytes(b'{"event": "started"}\n')
+    path.symlink_to(target)
+    assert ProgressReader(tmp_path).new_events() == []  # never through a link
+    path.unlink()
+    path.write_bytes(b'{"event": "started"}\n' * 100)
+    monkeypatch.setattr("frictionlab.progresslog.MAX_PROGRESS_BYTES", 1000)
+    capped = ProgressReader(tmp_path)
+    assert capped.new_events() == [] and capped.too_large
+
+
+def test_a_realization_event_of_the_wrong_shape_is_skipped(tmp_path):
+    scene = build_scene(SMALL_PRESET)
+    steps = scene.loads.size
+    lines = [
+        {"event": "started", "total": 2, "pid": 1},
+        {"event": "realization", "index": 0, "done": 1, "ok": True, "xi": [1.0] * (steps - 1), "contact_count": [1] * steps},
+        {"event": "realization", "index": "one", "done": 1, "ok": True},
+        {"event": "realization", "index": 1, "done": 1, "ok": True, "xi": [0.5] * steps, "contact_count": [2] * steps},
+    ]
+    (tmp_path / PROGRESS_FILE).write_text("".join(json.dumps(line) + "\n" for line in lines))
+    heard = Collect()
+    Follower(tmp_path, scene, [heard]).poll()
+    assert [(r.index, done) for r, done, _ in heard.results] == [(1, 1)]
+
+
+def test_iterations_within_a_load_reach_the_follower(tmp_path):
+    from frictionlab.engine import RunInfo
+
+    scene = build_scene(SMALL_PRESET)
+    log = ProgressLog(tmp_path)
+    log.run_started(RunInfo(scene=scene, total=2, workers=1))
+    log.load_done(index=0, done=2, total=16)
+    log.iteration_done(index=0, load=3, iteration=40, residual=3.1e-5)
+    log.close()
+    heard = []
+
+    class Hear:
+        @hookimpl
+        def load_done(self, index, done, total):
+            heard.append(("load", index, done, total))
+
+        @hookimpl
+        def iteration_done(self, index, load, iteration, residual):
+            heard.append(("iteration", index, load, iteration, residual))
+
+    Follower(tmp_path, scene, [Hear()]).poll()
+    assert heard == [("load", 0, 2, 16), ("iteration", 0, 3, 40, 3.1e-5)]

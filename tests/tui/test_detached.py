@@ -1,0 +1,170 @@
+"""The TUI and runs in processes of their own: a TUI opened later shows a running run
+live; quitting during a run leaves it running or cancels it, as answered, at once."""
+
+import os
+import signal
+import time
+
+import yaml
+from textual.widgets import Static
+
+from frictionlab.detached import process_alive, run_state, start_detached, wait_started
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.tui.widgets import ResultsPane
+
+from ..conftest import merge
+from .conftest import (
+    SIZE,
+    TINY,
+    make_app,
+    numbers_in,
+    press_run,
+    screen_text,
+    status_text,
+    sync,
+    wait_until,
+)
+
+LONG = merge(TINY, {"name": "long", "realizations": 100_000})
+
+
+def stats(app) -> str:
+    return str(app.query_one("#run-stats", Static).render())
+
+
+def end(pid: int) -> None:
+    """Stop a test's run that goes on (it would run for minutes)."""
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def wait_for(condition, timeout=60.0):
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.05)
+
+
+@sync
+async def test_a_tui_opened_later_shows_the_running_run_live_and_lists_it(folders, registry):
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    try:
+        wait_started(process, out)
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+            first = numbers_in(stats(app))[0]
+            await wait_until(pilot, lambda: numbers_in(stats(app))[0] > first)  # live: the count moves
+            shown, said = screen_text(app), status_text(app)
+            await pilot.press("f5")
+            await pilot.pause()
+            listed = app.query_one(ResultsPane).runs
+            results = screen_text(app)
+        assert "long: 100000 realizations" in shown and "/100000 realizations" in shown
+        assert said.startswith("long is running in runs/long (a process of its own)")
+        assert [(e.path.name, e.status) for e in listed] == [("long", "running")]
+        assert "▶" in results and "long" in results
+        assert process.poll() is None  # the TUI quit; the run goes on
+    finally:
+        end(process.pid)
+        process.wait()
+    assert run_state(out).status == "interrupted"  # killed: never read as running
+
+
+@sync
+async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_waiting(folders, registry):
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        pid, out = app.followed.pid, app.followed.folder
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("escape")  # stay: nothing is cancelled
+        await pilot.pause(0.5)
+        stayed = app.is_running and app.followed is not None and not app.followed.cancelling
+        await pilot.press("ctrl+q", "l")
+        await pilot.pause()
+        quit_at_once = not app.is_running and process_alive(pid)
+    try:
+        assert "Leave it running" in asked and "cancel it" in asked and f"pid {pid}" in asked
+        assert stayed and quit_at_once
+        assert run_state(out).status == "running"  # the TUI is gone, the run is not
+    finally:
+        end(pid)
+
+
+@sync
+async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(folders, registry):
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        pid, out = app.followed.pid, app.followed.folder
+        await pilot.press("ctrl+q", "c")
+        await pilot.pause()
+        quit_at_once = not app.is_running
+    try:
+        wait_for(lambda: not process_alive(pid))
+        state = run_state(out)
+        assert quit_at_once and state.status == "interrupted" and 2 <= state.done < 100_000
+    finally:
+        end(pid)
+
+
+@sync
+async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(folders, registry):
+    """Ctrl+Q during a run, l, then n to "Quit anyway?": the app stays, the run goes on (it was cancelled before)."""
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        pid = app.followed.pid
+        app.modified = True  # the preset was edited meanwhile
+        await pilot.press("ctrl+q", "l")
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("n")
+        await pilot.pause(0.5)
+        before = app.last_snapshot.done
+        await wait_until(pilot, lambda: app.last_snapshot.done > before)
+        after = stats(app)
+        still = app.is_running and app.followed is not None and not app.followed.cancelling
+        alive = process_alive(pid)
+    end(pid)
+    assert "unsaved changes. Quit anyway?" in asked
+    assert still and alive and "cancelling" not in after and "/100000 realizations" in after
+
+
+@sync
+async def test_a_long_solve_shows_its_load_and_the_elapsed_time_moves_between_events(folders, registry):
+    """An exact solve reports its loads; between two reports the elapsed time still moves."""
+    from frictionlab.engine import RunInfo
+    from frictionlab.progresslog import ProgressLog
+    from frictionlab.rundir import RunDirectory
+
+    out = folders / "runs" / "exact"
+    scene = build_scene(merge(TINY, {"name": "exact", "realizations": 2}), registry=registry)
+    with RunDirectory(out) as run_dir:  # this process plays the run: it holds the lock, writes the events
+        run_dir.start(scene, resume=False)
+        log = ProgressLog(out, clock=lambda: time.time() - 30.0)  # it began 30 s ago
+        log.run_started(RunInfo(scene=scene, total=2, workers=1))
+        log.load_done(index=0, done=3, total=16)
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await wait_until(pilot, lambda: "load 3/16" in stats(app))
+            first = stats(app)
+            await pilot.pause(1.2)
+            later = stats(app)
+        log.close()
+    assert first.startswith("0/2 realizations") and "realization 0: load 3/16" in first
+    seconds = [float(line.split("elapsed ")[1].split(" s")[0]) for line in (first, later)]
+    assert 29.0 < seconds[0] < seconds[1]  # the run's own clock, ticking with no new event

@@ -1,0 +1,224 @@
+"""What a person on a remote terminal met (the keys, the status line, the form, the
+Run tab), each read off the screen."""
+
+import yaml
+from textual.widgets import DataTable, Input, Static
+
+from ..conftest import merge
+from .conftest import (
+    SIZE,
+    SWEEP,
+    TINY,
+    make_app,
+    run_to_the_end,
+    screen_text,
+    status_text,
+    sync,
+    type_into,
+    wait_until,
+)
+
+
+@sync
+async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await type_into(pilot, "field--loading--stop", "0.1")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        focused = app.focused.id
+        said = status_text(app)
+    assert said.startswith("Cannot run: 1 problem: loading: stop must be > start")
+    assert focused == "field--loading--stop"
+
+
+@sync
+async def test_the_status_line_takes_back_valid_when_a_new_problem_appears(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await type_into(pilot, "field--loading--stop", "0.1")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        await type_into(pilot, "field--loading--stop", "20")
+        await pilot.pause()
+        valid = status_text(app)
+        await type_into(pilot, "field--realizations", "0")
+        await pilot.pause()
+        after = status_text(app)
+        screen = screen_text(app)
+    assert valid == "The preset is valid: Ctrl+R runs it."
+    assert "1 problem" in screen and "valid" not in after
+
+
+@sync
+async def test_opening_another_preset_clears_the_error_about_the_first(folders, registry):
+    (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await type_into(pilot, "field--loading--stop", "0.1")
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        before = status_text(app)
+        app.modified = False  # no question about the edit: the point is the old message
+        await pilot.press("f2")
+        await pilot.pause()
+        await app.open_preset(folders / "presets" / "other.yaml")
+        await pilot.pause()
+        after = status_text(app)
+    assert before.startswith("Cannot run") and after == ""
+
+
+@sync
+async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_line(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#field--name", Input).focus()
+        await pilot.press("q")  # typed into the field, not a quit
+        await pilot.pause()
+        typed = app.query_one("#field--name", Input).value
+        await pilot.press("f2", "ctrl+c")  # in a text field Ctrl+C copies
+        await pilot.pause()
+        said, toasts = status_text(app), len(app.query("Toast"))
+        app.modified = False
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert typed == "smallq"  # and typed at the end of the name: the cursor starts there
+    assert said.startswith("Ctrl+Q quits (q too, outside a text field)") and toasts == 0
+    assert quit_by_q
+
+
+@sync
+async def test_on_off_switches_say_their_state_in_words(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(80, 60)) as pilot:
+        await pilot.pause()
+        state = app.query_one("#field--output--plot--state", Static)
+        before = str(state.render())
+        app.query_one("#field--output--plot").focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        after = str(state.render())
+    assert (before, after) == ("on", "off")
+
+
+@sync
+async def test_a_new_run_shows_no_fit_of_the_run_before(folders, registry):
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "long", "realizations": 100_000})))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        finished = str(app.query_one("#run-fit", Static).render())
+        await app.open_preset(folders / "presets" / "long.yaml")
+        app.action_start_run()  # Ctrl+R, read before its run has finished a realization
+        started = str(app.query_one("#run-fit", Static).render())
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    assert "95% CI" in finished
+    assert "(no realization yet)" in started and "95% CI" not in started and "a = " not in started
+
+
+@sync
+async def test_the_sweep_table_takes_a_cursor_and_interim_goes_once_the_sweep_is_over(folders, registry):
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        fit = str(app.query_one("#run-fit", Static).render())
+        table = app.query_one("#sweep-table", DataTable)
+        table.focus()
+        await pilot.press("down")
+        await pilot.pause()
+        row = table.cursor_row
+    assert "(interim)" not in fit and "95% CI" in fit
+    assert table.cursor_type == "row" and row == 1
+
+
+@sync
+async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        pages = []
+        for _ in range(12):
+            await pilot.press("f1")
+            await pilot.pause()
+            if not app.screen.query("HelpPanel"):
+                break
+            pages.append(screen_text(app))
+        hidden = not app.screen.query("HelpPanel")
+    assert len(pages) >= 2 and hidden  # more than one page at 80x24, then hidden
+    assert "Save as" not in pages[0] and any("Save as" in page for page in pages)
+
+
+@sync
+async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry):
+    from frictionlab.fit import LogFit
+    from frictionlab.tui.widgets import RunPane
+    from frictionlab.tui.widgets.run import fit_lines
+
+    fit = LogFit(a=-12.3456, b=-0.0469, a_se=0.1, b_se=0.01, a_ci=(-12.5678, -12.1234), b_ci=(-0.0712, -0.0231),
+                 confidence=0.95, bootstrap=1000, r2=0.4006, residual_rms=0.01, points=16)  # fmt: skip
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.action_show_tab("run")
+        app.query_one(RunPane)._set("run-fit", "\n".join(fit_lines(fit, final=True, f_formula="F / (E* h L)")))
+        await pilot.pause()
+        screen = screen_text(app)
+    assert "a = -12.3456 [-12.5678, -12.1234]" in screen
+    assert "b = -0.0469 [-0.0712, -0.0231]" in screen
+
+
+@sync
+async def test_a_long_preset_name_is_cut_in_its_middle_and_keeps_every_column_on_screen(folders, registry):
+    from .conftest import fits_width
+
+    long_name = "a-very-long-preset-name-" + "x" * 55 + "-end-0060"  # 88 characters
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": long_name, "realizations": 3})))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        table = app.query_one("#preset-table", DataTable)
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        fits = fits_width(table)
+        await app.open_preset(folders / "presets" / "long.yaml")
+        await pilot.pause()
+        app.action_start_run()
+        title = str(app.query_one("#run-title", Static).render())
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    assert fits, "a column of the presets list is off screen"
+    name, folder, file = next(row for row in cells if row[2] == "long.yaml")
+    assert name.startswith("a-very-long") and name.endswith("-end-0060") and "…" in name
+    assert folder and file == "long.yaml"
+    assert title.startswith("a-very-long") and "-end-0060: 3 realizations, 16 force steps" in title and "…" in title
+
+
+@sync
+async def test_quitting_during_a_sweep_asks_and_n_cancels_nothing(folders, registry):
+    long_sweep = merge(SWEEP, {"realizations": 100_000})
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(long_sweep, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        cancel = app.cancel_event
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        asked = getattr(app.screen, "question", "")  # the dialog on screen (its lines wrap)
+        await pilot.press("n")
+        await pilot.pause()
+        before = app.last_snapshot.done
+        await wait_until(pilot, lambda: app.last_snapshot.done > before)  # it goes on
+        kept_going = not cancel.is_set() and "cancelling" not in str(app.query_one("#run-stats", Static).render())
+        await pilot.press("ctrl+q", "y")
+        await pilot.pause()
+        quit_and_cancelled = not app.is_running and cancel.is_set()
+    assert asked == "A sweep is running in this window: quitting cancels it (what finished is kept). Quit?"
+    assert kept_going and quit_and_cancelled
