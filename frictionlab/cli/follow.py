@@ -3,7 +3,6 @@ the TUI, or anyone) until it ends; Ctrl-C stops following, never the run."""
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -60,7 +59,9 @@ def run(args) -> ExitCode:
         if follower.finished is not None:
             error = follower.finished.error
     if args.json:
-        print(json.dumps({**state.to_dict(), "error": error}, indent=2))
+        from .jsonout import emit
+
+        emit("follow", {**state.to_dict(), "error": error})
     else:
         done = "?" if state.done is None else state.done
         hint = f"; frictionlab resume {folder} continues it" if state.resumable else ""

@@ -93,7 +93,9 @@ def _detach(args, scene, out_dir: Path, options) -> ExitCode:
     process = start_detached(scene.resolved(), out_dir, options, plot=not args.no_plot)
     wait_started(process, out_dir)
     if args.json:
-        print(json.dumps({"folder": str(out_dir), "pid": process.pid, "status": "running"}, indent=2))
+        from .jsonout import emit
+
+        emit("detached", {"folder": str(out_dir), "pid": process.pid, "status": "running"})
     else:
         print(f"{scene.preset.name}: running detached in {out_dir}/ (pid {process.pid})\n"
               f"  frictionlab follow {out_dir}    shows its progress\n"

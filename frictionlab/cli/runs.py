@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from ..errors import ExitCode, RunFolderError
@@ -38,7 +37,9 @@ def run(args) -> ExitCode:
         raise RunFolderError(f"DIR: {runs_dir} {what}: give the folder that holds run folders")
     states = list_run_states(runs_dir)
     if args.json:
-        print(json.dumps({"runs_dir": str(runs_dir), "runs": [s.to_dict() for s in states]}, indent=2))
+        from .jsonout import emit
+
+        emit("runs", {"runs_dir": str(runs_dir), "runs": [s.to_dict() for s in states]})
         return ExitCode.OK
     if not states:
         print(f"no run folders in {runs_dir}/")

@@ -43,6 +43,8 @@ def refused(tmp_path):
         "predict": [*PREDICT, "--a", "1"],  # no --b
         "study": ["study", "no-such-preset", "--out", str(tmp_path / "s")],
         "report": ["report", "--presets", str(tmp_path / "none"), "--out", str(tmp_path / "r"), "--workers", "0"],
+        "runs": ["runs", str(tmp_path / "no-such-folder")],
+        "follow": ["follow", str(tmp_path / "no-such-run")],
     }
 
 
