@@ -170,6 +170,12 @@ def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) ->
     if cls.indentation_reference == "mean surface" and np.any(shift != 0):
         fail(cls, "indentation_reference is the mean surface, so mean_displacement(f, h) must be zero "
                   f"(the indentation is already measured from it). Got {shift!r}.")  # fmt: skip
+    if cls.indentation_reference == "mean surface" and not cls.mean_displacement_known:
+        fail(cls, "indentation_reference is the mean surface, so its mean displacement is known (zero): "
+                  "mean_displacement_known must be True")  # fmt: skip
+    if not cls.mean_displacement_known and np.any(shift != 0):
+        fail(cls, "mean_displacement_known is False, so mean_displacement(f, h) must stay zero, not a guess. "
+                  f"Got {shift!r}.")  # fmt: skip
     tolerance = call(cls, "tolerance()", solver.tolerance)
     if (tolerance is None) != (cls.tolerance_param is None):
         fail(cls, f"tolerance() must be None exactly when tolerance_param is None. Got {tolerance!r}.")
