@@ -142,8 +142,9 @@ def build_scene(
     # A measured profile or surface is read and checked here, not by a worker: its header
     # first, the whole file once the memory check has seen its shape.
     measured = bool(input_fields(type(spectrum.params)))
-    if measured:
+    if measured:  # what the memory check needs (a table without a header is read whole here)
         _read_checked(spectrum.periodic, source)
+        _read_checked(spectrum.grid_shape, source)
     if measured and spectrum.dimension not in plugins["solver"].dimensions:
         _read_checked(spectrum.rms_height, source)  # its MDR-equivalent line is made from the whole map
     # Store normalised plugin names so the resolved preset is canonical.
