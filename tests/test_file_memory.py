@@ -73,12 +73,10 @@ def check_refused_unread(tmp_path, data: dict, size: int, available: int) -> Non
         assert code == ExitCode.RUNTIME_FAILURE, err
         assert "this run would need about " in err and "a test limit" in err, err
         assert "Traceback" not in err
-        print(command[0], "refused: growth", growth, "of a file of", size)
         assert growth < size / 4, (command, growth, size)
     assert not (tmp_path / "out").exists()
     # given room, validate reads the file: the measurement sees a read
     code, growth, err = measure(tmp_path, 2**50, "validate", "p.yaml")
-    print("read: growth", growth)
     assert growth > size / 2, (growth, size, err)
 
 
