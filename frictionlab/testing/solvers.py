@@ -58,7 +58,8 @@ def check_solver(cls, **params) -> None:
     force per unit depth x 1000, an indentation x 1000), and the spacing alone x 10
     at equal f, leave the contact counts and the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
     of f, and is zero where the ``indentation_reference`` is the mean surface, and where
-    ``mean_displacement_known`` is False (which the mean surface never is); ``tolerance()`` is None exactly when ``tolerance_param`` is; ``bytes_per_point``
+    ``mean_displacement_known`` is False (which the mean surface never is); ``tolerance()``
+    is None exactly when ``tolerance_param`` is; ``bytes_per_point``
     (memory estimates) is None or a whole number > 0 (registration checks it; that it
     bounds the solver's peak is for the plugin's own tests, measured on a large grid); a
     ``periodic_only`` solver raises ValueError on a non-periodic profile, any
