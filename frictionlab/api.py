@@ -249,9 +249,10 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
     True
     """
     from .preset import build_scene
+    from .runner import check_one_realization
 
     data, source, _ = read_preset_input(preset, overrides, **keys)
-    return scene_record(build_scene(data, source=source))
+    return scene_record(build_scene(data, source=source, before_reading=check_one_realization))
 
 
 def run(
@@ -294,6 +295,7 @@ def run(
     """
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
+    from .runner import memory_check_before_reading
 
     out = None if out is None else path_argument(out, "out", "a folder to write the run into")
     if scheduler is not None and not isinstance(scheduler, str):
@@ -302,10 +304,11 @@ def run(
                         ("memory_check", memory_check)):  # fmt: skip
         flag_argument(value, name)
     data, source, _ = read_preset_input(preset, overrides, **keys)
-    scene = build_scene(data, source=source)
     options = RunOptions(
         workers=workers, executor=executor, scheduler=scheduler, resume=resume, force=force, memory_check=memory_check
     )
+    reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
+    scene = build_scene(data, source=source, before_reading=reading)
     if scene.preset.sweep is not None:
         from .sweep import plan_sweep, run_sweep
 

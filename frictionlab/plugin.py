@@ -434,6 +434,9 @@ class ContactSolver(Plugin):
       (zero): the mean displacement of the elastic surface in the indentation's
       frame, so that ``indentation - mean_displacement`` is measured from the mean
       plane of the deformed surface for every solver.
+    - ``mean_displacement_known`` (True): False for a solver whose mean displacement
+      depends on each surface, not on f and h alone, so ``mean_displacement`` cannot
+      give it (a free-boundary half-space): a study then compares no indentations.
     - ``periodic_only`` (False): True for a solver of periodic profiles only.
     - ``body_params`` (()): the ``Params`` fields describing the elastic body (not
       the numerics); a study carries them from one solver to another that has them.
@@ -455,6 +458,7 @@ class ContactSolver(Plugin):
     approximation: ClassVar[bool] = False
     contact_measure: ClassVar[ContactMeasure] = "real contact"
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
+    mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None

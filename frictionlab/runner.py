@@ -29,6 +29,18 @@ def check_memory(scene: Scene, options: RunOptions) -> None:
         check_worker_limits(scene, limits, usable=usable)
 
 
+def memory_check_before_reading(options: RunOptions) -> Callable[[Scene], None] | None:
+    """What ``build_scene`` calls before a measured file is read whole: the run's memory
+    check (None when ``options.memory_check`` is off), so an oversize map is refused unread."""
+    return (lambda scene: check_memory(scene, options)) if options.memory_check else None
+
+
+def check_one_realization(scene: Scene) -> None:
+    """Refuse a scene whose one realization cannot fit even alone in this process (what
+    ``validate`` checks, knowing no worker count), before a measured file is read whole."""
+    check_fits(scene, workers=1, executor="serial")
+
+
 def run_to_folder(
     scene: Scene,
     out_dir: str | Path,

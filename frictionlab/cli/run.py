@@ -48,6 +48,7 @@ def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..rundir import new_run_folder
+    from ..runner import memory_check_before_reading
 
     overrides = list(args.set or [])
     if args.seed is not None:
@@ -55,14 +56,15 @@ def run(args) -> ExitCode:
     source = preset_source(args.preset, args.set or [])
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
-    scene = build_scene(data, source=source)
+    options = executor_run_options(args, resume=args.resume, force=args.force)
+    reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
+    scene = build_scene(data, source=source, before_reading=reading)
     if args.out is not None and not args.out.strip():
         raise FrictionlabError("--out names no folder (it is empty): give a folder, or leave --out out for runs/<name>-<time>")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     if args.resume and not Path(args.out).is_dir():
         raise RunFolderError(f"{args.out} is not a run folder to resume (it does not exist, or is not a folder)")
-    options = executor_run_options(args, resume=args.resume, force=args.force)
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
     try:
         if args.detach:

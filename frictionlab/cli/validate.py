@@ -25,6 +25,7 @@ def run(args) -> ExitCode:
     from ..inputs import describe_input
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
+    from ..runner import check_one_realization
     from ..sweep import plan_sweep
 
     worst = ExitCode.OK
@@ -34,7 +35,7 @@ def run(args) -> ExitCode:
         try:
             data = read_preset(resolve_preset_path(path), args.set or [])
             source = preset_source(path, args.set or [])
-            scene = build_scene(data, source=source)
+            scene = build_scene(data, source=source, before_reading=check_one_realization)
             if scene.preset.sweep is not None:  # every point too
                 points = len(plan_sweep(data, source=source).points)
         except FrictionlabError as exc:

@@ -4,6 +4,7 @@ and ``build_scene``, phase two of the validation (each plugin's own ``Params``).
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -92,11 +93,18 @@ class Scene:
 
 
 def build_scene(
-    data: dict, registry: Registry | None = None, source: str | None = None, base_dir: str | Path | None = None
+    data: dict,
+    registry: Registry | None = None,
+    source: str | None = None,
+    base_dir: str | Path | None = None,
+    before_reading: Callable[[Scene], None] | None = None,
 ) -> Scene:
     """Validate preset data (structure, then each plugin's params) into a Scene.
     ``base_dir``: the folder relative input-file paths in ``data`` are taken
-    from (the preset file's; without it, the current folder)."""
+    from (the preset file's; without it, the current folder). ``before_reading(scene)``
+    is called before a measured file is read whole (the memory check, which needs only
+    the spectrum's ``grid_shape()``), unless the map must be read to make its
+    MDR-equivalent line."""
     registry = registry or default_registry()
     if not isinstance(data, dict):
         raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
@@ -131,15 +139,31 @@ def build_scene(
     if problems:  # before anything reads them (an equivalent line reads its map now)
         raise PresetError(problems, source=source)
     spectrum = plugins["spectrum"]
-    if input_fields(type(spectrum.params)):  # a measured profile or surface: read and checked now, not by a worker
-        try:
-            spectrum.rms_height()
-        except ValueError as exc:
-            raise PresetError([f"spectrum.params: {exc}"], source=source) from None
+    # A measured profile or surface is read and checked here, not by a worker: its header
+    # first, the whole file once the memory check has seen its shape.
+    measured = bool(input_fields(type(spectrum.params)))
+    if measured:  # what the memory check needs (a table without a header is read whole here)
+        _read_checked(spectrum.periodic, source)
+        _read_checked(spectrum.grid_shape, source)
+    if measured and spectrum.dimension not in plugins["solver"].dimensions:
+        _read_checked(spectrum.rms_height, source)  # its MDR-equivalent line is made from the whole map
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in KINDS:
         getattr(preset, slot).name = plugins[slot].name
-    return Scene(preset=preset, **_match_dimensions(plugins, registry, source))
+    scene = Scene(preset=preset, **_match_dimensions(plugins, registry, source))
+    if before_reading is not None:
+        before_reading(scene)
+    if measured:
+        _read_checked(spectrum.rms_height, source)
+    return scene
+
+
+def _read_checked(read: Callable[[], object], source: str | None) -> None:
+    """Call a measured spectrum's ``read``: a problem with its file is a PresetError."""
+    try:
+        read()
+    except ValueError as exc:
+        raise PresetError([f"spectrum.params: {exc}"], source=source) from None
 
 
 def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> dict:

@@ -57,7 +57,9 @@ def check_solver(cls, **params) -> None:
     its declared unit k h X scales (k fixed: a force x 1000^2 against a stress, a
     force per unit depth x 1000, an indentation x 1000), and the spacing alone x 10
     at equal f, leave the contact counts and the rms slope in contact unchanged; ``mean_displacement(f, h)`` has the shape
-    of f, and is zero where the ``indentation_reference`` is the mean surface; ``tolerance()`` is None exactly when ``tolerance_param`` is; ``bytes_per_point``
+    of f, and is zero where the ``indentation_reference`` is the mean surface, and where
+    ``mean_displacement_known`` is False (which the mean surface never is); ``tolerance()``
+    is None exactly when ``tolerance_param`` is; ``bytes_per_point``
     (memory estimates) is None or a whole number > 0 (registration checks it; that it
     bounds the solver's peak is for the plugin's own tests, measured on a large grid); a
     ``periodic_only`` solver raises ValueError on a non-periodic profile, any
@@ -170,6 +172,12 @@ def _check_solver_declarations(cls, solver, heights, spacing, slopes, forces) ->
     if cls.indentation_reference == "mean surface" and np.any(shift != 0):
         fail(cls, "indentation_reference is the mean surface, so mean_displacement(f, h) must be zero "
                   f"(the indentation is already measured from it). Got {shift!r}.")  # fmt: skip
+    if cls.indentation_reference == "mean surface" and not cls.mean_displacement_known:
+        fail(cls, "indentation_reference is the mean surface, so its mean displacement is known (zero): "
+                  "mean_displacement_known must be True")  # fmt: skip
+    if not cls.mean_displacement_known and np.any(shift != 0):
+        fail(cls, "mean_displacement_known is False, so mean_displacement(f, h) must stay zero, not a guess. "
+                  f"Got {shift!r}.")  # fmt: skip
     tolerance = call(cls, "tolerance()", solver.tolerance)
     if (tolerance is None) != (cls.tolerance_param is None):
         fail(cls, f"tolerance() must be None exactly when tolerance_param is None. Got {tolerance!r}.")

@@ -82,8 +82,11 @@ COLUMNS = tuple(f.name for f in fields(Row) if f.name != "outcome")
 
 def approach(scene: Scene, outcome: RunOutcome):
     """Mean indentation over h, measured for every solver from one reference: the first touch of
-    the highest point, against the mean plane of the deformed elastic surface."""
+    the highest point, against the mean plane of the deformed elastic surface. NaN for a solver
+    that cannot say where that plane is (``ContactSolver.mean_displacement_known``)."""
     h = outcome.rms_height
+    if not scene.solver.mean_displacement_known:
+        return np.full(outcome.f.shape, math.nan)
     return (outcome.indentation - scene.solver.mean_displacement(outcome.f, h)) / h
 
 
@@ -102,7 +105,7 @@ def make_row(axis: str, setting: str, value: float, scene: Scene, measured: Meas
         solver=scene.solver.name,
         setting=setting,
         value=float(value),
-        points=preset_points(scene) or 0,
+        points=grid_side(scene) or 0,
         realizations=outcome.done,
         steps=int(outcome.loads.size),
         tolerance=nan if scene.solver.tolerance() is None else scene.solver.tolerance(),
@@ -148,6 +151,16 @@ def preset_points(scene: Scene) -> int | None:
     if spectrum.points_param is None:
         return None
     return int(spectrum.params.model_dump()[spectrum.points_param])
+
+
+def grid_side(scene: Scene) -> int | None:
+    """Points per side of the grid pressed: the preset's (``preset_points``), else a
+    measured file's (the longer side of a map), from the spectrum's ``grid_shape()``."""
+    points = preset_points(scene)
+    if points is not None:
+        return points
+    shape = scene.spectrum.grid_shape()
+    return None if shape is None else max(shape)
 
 
 def _first_problem(exc: PresetError) -> str:
@@ -357,7 +370,7 @@ class Study:
 
     def _describe_compare(self, scene: Scene) -> str:
         loading = scene.preset.loading
-        points = preset_points(scene)
+        points = grid_side(scene)
         return (
             (f"N = {points}, " if points is not None else "")
             + f"M = {scene.preset.realizations}, K = {loading.steps} loads from {loading.start:g} to "
@@ -373,7 +386,8 @@ class Study:
         if base.solver.name != reference.solver:
             measured.insert(0, (self._run("solver", base.solver.name, math.nan, base), base))
         rows = [row for row, _ in measured]
-        if all(row.outcome.done for row in rows):
+        unplaced = [scene.solver.name for _, scene in measured if not scene.solver.mean_displacement_known]
+        if all(row.outcome.done for row in rows) and not unplaced:
             compare(rows, reference, approaches={id(row): approach(scene, row.outcome) for row, scene in measured})
         else:
             compare(rows, reference)
@@ -382,10 +396,13 @@ class Study:
         definitions = "; ".join(dict.fromkeys(scene.normalisation.definition for _, scene in measured))
         self.notes.append(
             f"solver: {self._describe_compare(base)}; every solver sees the same {what}{mapped}; errors against "
-            f"{reference.solver} ({reference.setting}) at equal f ({definitions}); the indentation of every solver "
-            "is measured from the first touch of the highest point, against the mean plane of the deformed "
-            "elastic surface"
-        )
+            f"{reference.solver} ({reference.setting}) at equal f ({definitions}); "
+            + (f"indentations not compared: {' and '.join(unplaced)} measures its indentation from the undeformed "
+               "body and cannot say where the mean plane of the deformed surface is (it differs from surface to "
+               "surface), so approach columns are empty" if unplaced else
+               "the indentation of every solver is measured from the first touch of the highest point, against "
+               "the mean plane of the deformed elastic surface")
+        )  # fmt: skip
         return rows
 
     def tolerance_axis(self) -> list[Row]:

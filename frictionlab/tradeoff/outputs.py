@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import OutputRefused, shown
 from ..files import atomic_write, output_path_problem
-from .axes import COLUMNS, Row, Study, preset_points
+from .axes import COLUMNS, Row, Study, grid_side
 from .metrics import pareto_front
 
 METRICS = {
@@ -132,7 +132,7 @@ def axis_table(rows: list[Row], axis: str) -> str:
 def scene_summary(study: Study) -> str:
     base = study.base
     generator = base.spectrum
-    preset, hurst, points = base.preset, generator.hurst_exponent(), preset_points(base)
+    preset, hurst, points = base.preset, generator.hurst_exponent(), grid_side(base)
     loading = preset.loading
     return (
         f"{preset.name}: {generator.name}" + (f", H = {hurst:g}" if hurst is not None else "")
@@ -306,8 +306,9 @@ def recommendation(study: Study) -> str:
                 f"against {reference.solver} on the same {row.realizations} {what} at N = {row.points} and equal f, "
                 f"{row.solver}'s xi(f) is off by {_pct(row.xi_err_f)} rms (mean {_signed_pct(row.xi_bias_f)}), its b by "
                 f"{_pct(row.b_err)} (b's 95% interval from {reference.realizations} {what}: +-{_pct(reference.b_ci_rel)}), "
-                f"its indentation by {_pct(row.approach_err_f)} rms"
-            )
+                + (f"its indentation by {_pct(row.approach_err_f)} rms" if math.isfinite(row.approach_err_f)
+                   else "its indentation not compared (see the notes)")
+            )  # fmt: skip
     if not parts:
         return f"{head}: no axis measured enough to recommend anything."
     return f"{head}: " + "; ".join(parts) + "."

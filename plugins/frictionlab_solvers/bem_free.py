@@ -123,6 +123,7 @@ class BEMHalfSpaceFree(PeriodicBEM):
     normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
     problem: ClassVar[str] = "elastic half-space"
     indentation_reference: ClassVar[str] = "undeformed body"
+    mean_displacement_known: ClassVar[bool] = False  # per surface: extras["mean_displacement"]
     periodic_only: ClassVar[bool] = False
     # measured 315 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
     # the CG's grids, the padded pressure, response and their spectra, four times the scan's

@@ -50,23 +50,57 @@ def is_instrument_file(path: Path) -> bool:
     return path.suffix.lower() not in TABLE_SUFFIXES
 
 
-def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str) -> Scan:
-    """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and spacing
-    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
+@dataclass(frozen=True)
+class ScanHeader:
+    """What an instrument file's metadata says without its heights being read."""
+
+    shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
+    periodic: bool
+
+
+def scan_header(path: Path, where: str, *, dimension: int) -> ScanHeader | None:
+    """The shape and periodicity ``read_scan`` gives, from the reader's metadata alone: what
+    the memory estimate needs before a run reads the file. None when the metadata does not
+    say, or says another dimension (``read_scan`` then reads the file and names the problem)."""
+    open_topography = _reader_opener(path, where)
+    with open_input(path, where) as fh, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            channel = open_topography(fh).default_channel
+            shape, periodic = tuple(int(n) for n in channel.nb_grid_pts), bool(channel.is_periodic)
+        except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
+            return None
+    return ScanHeader(shape[::-1], periodic) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+
+
+def _reader_opener(path: Path, where: str):
+    """SurfaceTopography's ``open_topography``, or a ValueError naming the extra to install."""
     try:
         from SurfaceTopography import open_topography
-        from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
     except ImportError:
         raise ValueError(
             f"{where}: {path.suffix or 'a file without suffix'} is not a .npy, .csv or .txt table; instrument "
             f"files (X3P, SUR, DATX, OPD, IBW, NetCDF...) are read by the optional extra topography: "
             f"{TOPOGRAPHY_EXTRA}"
         ) from None
+    return open_topography
+
+
+def open_input(path: Path, where: str):
+    """The file opened for reading if it is a regular file (never a FIFO or a device)."""
     try:
-        fh = open_regular_file(path)
+        return open_regular_file(path)
     except InputFileProblem as exc:
         raise ValueError(f"{where}: {exc}") from None
-    with fh, warnings.catch_warnings():
+
+
+def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str) -> Scan:
+    """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and spacing
+    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
+    open_topography = _reader_opener(path, where)
+    from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
+
+    with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         try:
             reader = open_topography(fh)

@@ -31,10 +31,10 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
-from frictionlab import InputFile, InputFileProblem, PluginParams, Profile, SpectrumGenerator, open_regular_file
+from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from .instrument_file import Undefined, Unit, is_instrument_file, read_scan
+from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, open_input, read_scan, scan_header
 from .params_cache import cached_on_params
 
 MIN_POINTS = 8
@@ -97,10 +97,16 @@ class ProfileFile(SpectrumGenerator):
         return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=line.periodic)
 
     def periodic(self) -> bool:
-        return self._line().periodic
+        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path)):
+            return bool(self.params.periodic)  # known without reading the file
+        header = self._header()
+        return header.periodic if header is not None else self._line().periodic
 
     def grid_shape(self) -> tuple[int]:
-        return self._line().heights.shape
+        """The line's points, from the file's header when it has one (a .npy, an instrument
+        file's metadata): the memory estimate refuses a line too long before it is read."""
+        header = self._header()
+        return header.shape if header is not None else self._line().heights.shape
 
     def input_summary(self) -> dict[str, Any]:
         """The line as read: file, format, points, spacing, unit, rms height, and where each came from."""
@@ -112,6 +118,21 @@ class ProfileFile(SpectrumGenerator):
         return self._line().rms_height
 
     # ------------------------------------------------------------ reading
+
+    @cached_on_params
+    def _header(self) -> ScanHeader | None:
+        """The line's points (and an instrument file's periodicity) without reading its heights;
+        None for a text table, or a header that does not describe a valid line."""
+        path = Path(self.params.path)
+        where = f"profile-file {str(path)!r}"
+        if is_instrument_file(path):
+            header = scan_header(path, where, dimension=1)
+        elif file_suffix(path, where) == ".npy" and (shape := npy_shape(path, where)) is not None:
+            points = _npy_line_points(shape)
+            header = None if points is None else ScanHeader((points,), bool(self.params.periodic))
+        else:
+            return None
+        return header if header is not None and header.shape[0] >= MIN_POINTS else None
 
     @cached_on_params
     def _line(self) -> _Line:
@@ -168,6 +189,17 @@ class ProfileFile(SpectrumGenerator):
         return _Line(heights, float(dx), rms, periodic, summary)
 
 
+def _npy_line_points(shape: tuple[int, ...]) -> int | None:
+    """The points of the line a .npy array of ``shape`` holds, as ``_read_columns`` reads it."""
+    if len(shape) == 2 and 1 in shape:
+        return shape[0] * shape[1]
+    if len(shape) == 1:
+        return shape[0]
+    if len(shape) == 2 and 2 in shape:
+        return shape[0] if shape[1] == 2 else shape[1]
+    return None
+
+
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     """(x or None, z) as float64 arrays, from a .npy or a text file."""
     where = f"profile-file {str(path)!r}"
@@ -199,17 +231,9 @@ def file_suffix(path: Path, where: str) -> str:
     return path.suffix.lower()
 
 
-def _open(path: Path, where: str):
-    """The file opened for reading if it is a regular file (never a FIFO or a device)."""
-    try:
-        return open_regular_file(path)
-    except InputFileProblem as exc:
-        raise ValueError(f"{where}: {exc}") from None
-
-
 def load_npy(path: Path, where: str) -> np.ndarray:
     """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
-    with _open(path, where) as fh:
+    with open_input(path, where) as fh:
         try:
             data = np.load(fh, allow_pickle=False)
         except MemoryError:  # the header asks for more than this process can allocate
@@ -222,17 +246,33 @@ def load_npy(path: Path, where: str) -> np.ndarray:
     return data
 
 
-def _claimed_array(fh) -> str:
-    """The array a .npy header announces, its shape and size (a file may announce more than it holds)."""
+def npy_shape(path: Path, where: str) -> tuple[int, ...] | None:
+    """The shape a .npy file's header announces, read without its data (None if the header
+    cannot be read: loading the file then names the problem)."""
+    with open_input(path, where) as fh:
+        header = _npy_header(fh)
+    return None if header is None else header[0]
+
+
+def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype] | None:
+    """The shape and dtype a .npy header announces (a file may announce more than it holds)."""
     fh.seek(0)
     try:
         version = np.lib.format.read_magic(fh)
         read_header = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
         shape, _, dtype = read_header[version](fh)
-    except Exception:  # noqa: BLE001 - a header numpy itself could not read a moment ago
+    except Exception:  # noqa: BLE001 - not a header numpy reads
+        return None
+    return tuple(int(n) for n in shape), dtype
+
+
+def _claimed_array(fh) -> str:
+    """The array a .npy header announces, its shape and size."""
+    header = _npy_header(fh)
+    if header is None:
         return "its array"
-    gib = math.prod(shape) * dtype.itemsize / 2**30
-    return f"its array of shape {tuple(shape)} ({gib:.3g} GiB)"
+    shape, dtype = header
+    return f"its array of shape {shape} ({math.prod(shape) * dtype.itemsize / 2**30:.3g} GiB)"
 
 
 def _numbers(text: str, delimiter: str | None) -> bool:
@@ -246,7 +286,7 @@ def _numbers(text: str, delimiter: str | None) -> bool:
 def read_text_table(path: Path, where: str) -> np.ndarray:
     """Rows x columns of float64; one non-numeric header line is skipped. A
     problem names the line, never its content."""
-    with _open(path, where) as fh:
+    with open_input(path, where) as fh:
         raw = fh.read()
     try:
         lines = raw.decode("utf-8").splitlines()

@@ -44,10 +44,10 @@ from pydantic import Field
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
 from .equivalent_line import EquivalentLine
-from .instrument_file import Undefined, Unit, is_instrument_file, read_scan
+from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
-from .profile_file import check_finite, file_suffix, load_npy, read_text_table, remove_mean
+from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table, remove_mean
 
 MIN_SIDE = 8
 
@@ -139,10 +139,16 @@ class SurfaceFile(SpectrumGenerator):
         return Profile(heights=surface.heights.copy(), spacing=surface.spacing, periodic=surface.periodic)
 
     def periodic(self) -> bool:
-        return self._map().periodic
+        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path)):
+            return bool(self.params.periodic)  # known without reading the file
+        header = self._header()
+        return header.periodic if header is not None else self._map().periodic
 
     def grid_shape(self) -> tuple[int, int]:
-        return self._map().heights.shape
+        """The map's shape, from the file's header when it has one (a .npy, an instrument
+        file's metadata): the memory estimate refuses a map too large before it is read."""
+        header = self._header()
+        return header.shape if header is not None else self._map().heights.shape
 
     def input_summary(self) -> dict[str, Any]:
         """The map as read: file, format, shape, pixel size, unit, rms height, and where each came from."""
@@ -179,6 +185,21 @@ class SurfaceFile(SpectrumGenerator):
         )  # fmt: skip
 
     # ------------------------------------------------------------ reading
+
+    @cached_on_params
+    def _header(self) -> ScanHeader | None:
+        """The map's shape (and an instrument file's periodicity) without reading its heights;
+        None for a text table, or a header that does not describe a valid map."""
+        path = Path(self.params.path)
+        where = f"surface-file {str(path)!r}"
+        if is_instrument_file(path):
+            header = scan_header(path, where, dimension=2)
+        elif file_suffix(path, where) == ".npy" and (shape := npy_shape(path, where)) is not None:
+            header = ScanHeader(shape, bool(self.params.periodic))
+        else:
+            return None
+        valid = header is not None and len(header.shape) == 2 and min(header.shape) >= MIN_SIDE
+        return header if valid else None
 
     @cached_on_params
     def _map(self) -> _Map:

@@ -98,6 +98,21 @@ def test_the_half_plane_with_the_old_f_fails_the_kit():
     fltesting.check_solver(BEMHalfPlane)
 
 
+@pytest.mark.parametrize(
+    "attributes,match",
+    [
+        ({"mean_displacement_known": False, "mean_displacement": lambda self, f, h: 0.1 * np.asarray(f)},
+         "mean_displacement_known is False, so mean_displacement\\(f, h\\) must stay zero"),
+        ({"mean_displacement_known": False, "indentation_reference": "mean surface"},
+         "indentation_reference is the mean surface, so its mean displacement is known"),
+    ],
+)
+def test_solver_check_fails_for_an_unknown_mean_displacement_declared_wrongly(attributes, match):
+    cls = type("Unplaced", (GoodSolver,), {"name": "unplaced", **attributes})
+    with pytest.raises(AssertionError, match=match):
+        fltesting.check_solver(cls)
+
+
 def test_solver_check_fails_when_periodic_only_is_not_kept():
     cls = type("Loose", (GoodSolver,), {"name": "loose", "periodic_only": True})
     with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was accepted"):
@@ -115,6 +130,7 @@ def test_solver_check_fails_when_undefined_slopes_are_not_left_out():
     "attributes,match",
     [
         ({"undefined_slopes": "yes"}, "undefined_slopes must be True or False. Got 'yes'"),
+        ({"mean_displacement_known": None}, "mean_displacement_known must be True or False. Got None"),
         ({"normalisations": {}}, "normalisations must map each of its dimensions"),
         ({"dimensions": (1, 2)}, "normalisations must map each of its dimensions"),
         ({"problem": ""}, "problem must name the physical problem"),

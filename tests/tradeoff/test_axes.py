@@ -180,3 +180,30 @@ def test_a_scan_is_compared_with_the_free_half_space_by_default(builtins, tmp_pa
     periodic = {**scan, "spectrum": {**scan["spectrum"], "params": {**scan["spectrum"]["params"], "periodic": True}}}
     assert study_of(periodic, builtins, reference=None, axes=("solver",), compare_points_surface=24,
                     compare_realizations=1, compare_steps=5, tolerances=(1e-8,)).reference_choice["name"] == "bem-halfspace"
+
+
+def test_a_scan_study_compares_no_indentation_with_the_free_half_space_and_names_its_grid(builtins, tmp_path):
+    """The free half-space measures its indentation from the undeformed body and its mean
+    displacement differs from surface to surface: the study leaves the approach columns
+    empty and says why, instead of comparing against an indentation shifted by nothing.
+    A file's grid is its points per side (the longer side of a 20 x 24 map), never 0."""
+    from frictionlab.tradeoff.outputs import recommendation, scene_summary
+
+    heights = np.random.default_rng(1).standard_normal((20, 24)).cumsum(axis=0).cumsum(axis=1)
+    np.save(tmp_path / "scan.npy", heights)
+    scan = {**SURFACE, "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "scan.npy"), "spacing": 1.0}}}
+    study = study_of(scan, builtins, reference=None, axes=("solver",), compare_points_surface=24,
+                     compare_realizations=1, compare_steps=5, tolerances=(1e-8,))  # fmt: skip
+    study.run()
+    rows = by_axis(study, "solver")
+    assert {r.solver for r in rows} == {"mdr", "bem-halfspace-free"}
+    assert all(r.points == 24 for r in rows)
+    free, mdr = (next(r for r in rows if r.solver == name) for name in ("bem-halfspace-free", "mdr"))
+    assert math.isnan(free.approach_first) and math.isnan(free.approach_last)
+    assert math.isfinite(mdr.approach_first) and math.isfinite(mdr.approach_last)  # MDR knows its mean plane
+    assert all(math.isnan(r.approach_err_f) for r in rows)
+    assert all(math.isfinite(r.xi_err_f) for r in rows)  # xi is still compared
+    assert any("indentations not compared: bem-halfspace-free" in note for note in study.notes)
+    text = recommendation(study)
+    assert "at N = 24" in text and "N = 0" not in text and "its indentation not compared" in text
+    assert "N = 24 per side" in scene_summary(study)
