@@ -19,6 +19,7 @@ from pathlib import Path
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
+from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
 from ..detached import check_startable, list_run_states, run_state, start_detached
@@ -291,10 +292,20 @@ class FrictionlabApp(App):
         elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
             self.say("")
         self._show_edit_state()
-        self.query_one(EditPane).show_problems(event.problems, event.read)
+        if (pane := self._mounted(EditPane)) is not None:
+            pane.show_problems(event.problems, event.read)
 
     def _show_edit_state(self) -> None:
-        self.query_one(EditPane).show_title(self.draft_path, self.modified, self.problems)
+        if (pane := self._mounted(EditPane)) is not None:
+            pane.show_title(self.draft_path, self.modified, self.problems)
+
+    def _mounted(self, pane_class):
+        """The app's pane of that class, or None once the app is closing: its widgets are
+        gone while a late message or a follow tick still arrives."""
+        try:
+            return self.query_one(pane_class)
+        except NoMatches:
+            return None
 
     def _draft(self) -> dict | None:
         return self.query_one("#form", PresetForm).data
@@ -496,7 +507,8 @@ class FrictionlabApp(App):
 
     def _show_snapshot(self, snapshot) -> None:
         self.last_snapshot = snapshot
-        self.query_one(RunPane).show_progress(snapshot, self.followed is not None and self.followed.cancelling)
+        if (pane := self._mounted(RunPane)) is not None:
+            pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
 
     def _follow_tick(self) -> None:
         followed = self.followed
