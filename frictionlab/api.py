@@ -52,7 +52,7 @@ import numpy as np
 from .errors import FrictionlabError, PresetError, RunFolderError
 from .fit import LogFit
 from .options import RunOptions
-from .results import CURVE_COLUMNS, read_curve
+from .results import CORRECTED_AREA, CURVE_COLUMNS, read_curve
 
 if TYPE_CHECKING:
     from .ensemble import RunOutcome
@@ -69,7 +69,9 @@ class Result:
     ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``contact_count``,
-    ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
+    ``contact_fraction``, ``indentation``, and ``real_area_corrected`` (the real area
+    corrected for its perimeter's pixels, a fraction) for a solver that gives it
+    (``bem-halfspace``). ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory."""
 
@@ -303,6 +305,8 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
+    if outcome.real_area_corrected is not None:  # the solvers that correct their area only
+        table[CORRECTED_AREA] = outcome.real_area_corrected
     return Result(
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
@@ -326,9 +330,10 @@ def load(folder: str | Path) -> Result | SweepResult:
     except (OSError, ValueError) as exc:
         raise RunFolderError(f"{folder}/summary.json cannot be read: {exc}") from None
     curve = read_curve(folder / summary.get("files", {}).get("curve", "curve.csv"))
-    if [name.rstrip("'") for name in curve] != list(CURVE_COLUMNS):  # F' on the half-plane
+    names = [name.rstrip("'") for name in curve]  # F' on the half-plane
+    if names not in (list(CURVE_COLUMNS), [*CURVE_COLUMNS, CORRECTED_AREA]):
         raise RunFolderError(f"{folder}/curve.csv: columns {list(curve)} are not those frictionlab writes")
-    table = dict(zip(CURVE_COLUMNS, curve.values()))
+    table = dict(zip(names, curve.values()))
     realizations = summary.get("realizations") or {}
     return Result(
         name=summary["preset"]["name"],

@@ -173,8 +173,9 @@ def declaration_problems(cls) -> list[str]:
                     normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
                 except ValueError as exc:
                     problems.append(f"normalisations[{dimension}]: {exc}")
-        if not isinstance(cls.approximation, bool):
-            problems.append(f"approximation must be True or False. Got {cls.approximation!r} instead.")
+        for attr in ("approximation", "corrected_area"):
+            if not isinstance(getattr(cls, attr), bool):
+                problems.append(f"{attr} must be True or False. Got {getattr(cls, attr)!r} instead.")
         if not (isinstance(cls.problem, str) and cls.problem.strip()):
             problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
         for attr, value, allowed in (

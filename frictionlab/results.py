@@ -38,6 +38,9 @@ CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
 }
+# beside the pixel count, for the solvers that declare corrected_area (others have no such column)
+CORRECTED_AREA = "real_area_corrected"
+CORRECTED_AREA_HEADER = f"{CORRECTED_AREA} [real contact fraction, corrected for the pixels its perimeter crosses]"
 INDENTATION_REFERENCES = {
     "undeformed body": "length; from the first touch; against the undeformed body",
     "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
@@ -68,6 +71,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
+        **_corrected_area_ends(outcome),
         "caveats": outcome.caveats,
         "elapsed_seconds": round(outcome.elapsed, 6),
         "workers": outcome.workers,
@@ -76,6 +80,15 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "retried_realizations": outcome.extra.get("retried", 0),  # had failed before the resume, ran again
         "files": files,
     }
+
+
+def _corrected_area_ends(outcome: RunOutcome) -> dict:
+    """The corrected real area at the first and last load; None where the solver gives none."""
+    corrected = outcome.real_area_corrected
+    ends = {"first": None, "last": None}
+    if corrected is not None and corrected.size:
+        ends = {"first": json_safe(float(corrected[0])), "last": json_safe(float(corrected[-1]))}
+    return {f"{CORRECTED_AREA}_at_{end}_load": value for end, value in ends.items()}
 
 
 def curve_header(scene: Scene) -> list[str]:
@@ -112,7 +125,8 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     writer = csv.writer(fh, lineterminator="\n")
-    writer.writerow(curve_header(scene))
+    corrected = [CORRECTED_AREA_HEADER] if scene.solver.corrected_area else []
+    writer.writerow(curve_header(scene) + corrected)
     columns = (
         outcome.force,
         outcome.f,
@@ -122,6 +136,9 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.contact_fraction,
         outcome.indentation,
     )
+    if corrected:
+        columns = (*columns, outcome.real_area_corrected)
+
     for row in zip(*columns, strict=True):
         writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
 

@@ -32,6 +32,7 @@ from pydantic import Field
 
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, corrected_area_fraction
 from .springs import ElasticParams, _check_control, _check_loads, check_profile, elastic_stiffness
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
@@ -369,6 +370,7 @@ class PeriodicBEM(ContactSolver):
         force = np.empty(steps)
         indentation = np.empty(steps)
         count = np.empty(steps, dtype=np.int64)
+        corrected = np.ones(steps) if self.corrected_area else None  # full contact: no edge to correct
         slope_rms = np.empty(steps)
         iterations = np.zeros(steps, dtype=np.int64)
         residual = np.zeros(steps)
@@ -385,6 +387,7 @@ class PeriodicBEM(ContactSolver):
                 contact_count=np.full(steps, points, dtype=np.int64),
                 contact_fraction=np.ones(steps),
                 slope_rms_contact=np.full(steps, line_rms),
+                real_area_corrected=corrected,
                 extras={"iterations": iterations, "residual": residual},
             )
 
@@ -439,6 +442,8 @@ class PeriodicBEM(ContactSolver):
             contact = pressure > 0.0
             n = int(np.count_nonzero(contact))
             count[j] = n
+            if corrected is not None and n < points:
+                corrected[j] = corrected_area_fraction(contact)
             if control == "force":
                 force[j] = load
                 indentation[j] = approach * scale
@@ -457,6 +462,7 @@ class PeriodicBEM(ContactSolver):
             contact_count=count,
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
+            real_area_corrected=corrected,
             extras={"iterations": iterations, "residual": residual},
         )
 
@@ -480,3 +486,6 @@ class BEMHalfSpace(PeriodicBEM):
     dimensions: ClassVar[tuple[int, ...]] = (2,)
     normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
     problem: ClassVar[str] = "elastic half-space"
+    references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER, YASTREBOV_ANCIAUX_MOLINARI)
+    # the pixel count's perimeter correction (contact_area.py) is derived for a surface's pixel edges
+    corrected_area: ClassVar[bool] = True
