@@ -65,7 +65,7 @@ def test_interface_promised_to_the_study():
     assert registry.get("solver", "bem-halfspace") is BEMHalfSpace
     assert (BEMHalfPlane.dimensions, BEMHalfSpace.dimensions) == ((1,), (2,))
     for cls in (BEMHalfPlane, BEMHalfSpace):
-        assert set(cls.Params.model_fields) == {"youngs_modulus", "poisson_ratio", "tolerance", "max_iterations"}
+        assert set(cls.Params.model_fields) == {"youngs_modulus", "poisson_ratio", "tolerance", "max_iterations", "stop"}
         assert cls(youngs_modulus=2.0, poisson_ratio=0.5).stiffness() == pytest.approx(2.0 / 0.75, rel=1e-15)
     curve = solve(BEMHalfPlane(), rough_line(64, 1), [0.1, 0.3])
     assert set(curve.extras) == {"iterations", "residual"}
@@ -116,12 +116,13 @@ def test_westergaard_contact_width_pressure_and_full_contact():
 
 def _pressure(solver, z, force, dx):
     """The converged pressure field, through the solver's own CG (scaled back)."""
-    from frictionlab_solvers.bem import ConstrainedCG
+    from frictionlab_solvers.contact_cg import ProjectedCG
+    from frictionlab_solvers.elastic import PeriodicHalfSpace
 
     z = np.asarray(z, float)
     depth = z.max() - z
     scale = depth.max()
-    cg = ConstrainedCG(depth / scale)
+    cg = ProjectedCG(PeriodicHalfSpace(z.shape), depth / scale)
     unit = solver.stiffness() * scale / dx
     mean = force / (z.size * dx ** z.ndim) / unit
     p, *_ = cg.solve(np.full(z.shape, mean), mean_pressure=mean, tolerance=1e-10, max_iterations=10_000)
@@ -129,7 +130,8 @@ def _pressure(solver, z, force, dx):
 
 
 def test_the_cg_carries_the_requested_load_whatever_pressure_it_starts_from():
-    from frictionlab_solvers.bem import ConstrainedCG
+    from frictionlab_solvers.contact_cg import ProjectedCG
+    from frictionlab_solvers.elastic import PeriodicHalfSpace
 
     x = np.arange(64)
     depth = 1.0 - np.cos(2 * np.pi * x / 64)  # one touching crest
@@ -137,7 +139,7 @@ def test_the_cg_carries_the_requested_load_whatever_pressure_it_starts_from():
     answers = []
     for start in (np.full(64, 0.01), np.full(64, 5.0), np.zeros(64)):
         # the same converged pressure however far the start's mean is from the load
-        p, *_ = ConstrainedCG(depth).solve(start, mean_pressure=0.01, tolerance=1e-11, max_iterations=10_000)
+        p, *_ = ProjectedCG(PeriodicHalfSpace(depth.shape), depth).solve(start, mean_pressure=0.01, tolerance=1e-11, max_iterations=10_000)
         assert p.mean() == pytest.approx(0.01, rel=1e-12)
         answers.append(p.copy())
     assert np.allclose(answers[1], answers[0], rtol=0, atol=1e-9) and np.allclose(answers[2], answers[0], rtol=0, atol=1e-9)

@@ -264,20 +264,20 @@ def test_xi_on_a_surface_is_the_rms_gradient_over_contact_pixels_over_the_whole_
     """An exact half-space run on a 24 x 20 surface: the engine's xi at each load equals
     rms |grad z| (both components) over the pixels the solver put in contact, over rms
     |grad z| of every pixel, both formed here by loops."""
-    import frictionlab_solvers.bem as bem
+    import frictionlab_solvers.contact_cg as contact_cg
 
     from frictionlab.realization import compute_realization
     from frictionlab.seeds import realization_rng
 
     contact_sets = []
-    solve = bem.ConstrainedCG.solve
+    solve = contact_cg.ProjectedCG.solve
 
     def recording(self, pressure, **kwargs):
         answer = solve(self, pressure, **kwargs)
         contact_sets.append(answer[0] > 0.0)
         return answer
 
-    monkeypatch.setattr(bem.ConstrainedCG, "solve", recording)
+    monkeypatch.setattr(contact_cg.ProjectedCG, "solve", recording)
     data = {"name": "xi", "seed": 5, "realizations": 1,
             "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.7, "points": 24, "points_y": 20,
                                                             "spacing": 0.5, "short_cutoff": 2.0, "rms_height": 3.0}},

@@ -26,95 +26,22 @@ from pydantic import Field
 
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile
 
+from .checks import check_control, check_loads, check_profile
+from .elastic import ElasticParams, elastic_stiffness
+
 MDR_BOOK = "10.1007/978-3-642-53876-6"  # Popov & Hess, Method of Dimensionality Reduction
 
 # Relative widening of the candidate bound under force control: a few rounding
 # errors of the bound itself. Extra candidates cost nothing but sorting time.
 _BOUND_SLACK = 16 * np.finfo(float).eps
 
-__all__ = ["BisectionSprings", "ElasticParams", "MDRSprings", "SpringRow", "WinklerSprings", "effective_modulus"]
-
-
-def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
-    """Plane-strain modulus E* = E / (1 - nu^2); infinite is rejected (nu = +-1)."""
-    denominator = 1.0 - poisson_ratio * poisson_ratio
-    if denominator <= 0.0:
-        raise ValueError(
-            f"poisson_ratio = {poisson_ratio} gives 1 - nu^2 = {denominator}: "
-            "the effective modulus E/(1 - nu^2) is not finite"
-        )
-    return youngs_modulus / denominator
-
-
-class ElasticParams(PluginParams):
-    """The elastic body of MDR and of the exact (BEM) solvers: E and nu, giving E*."""
-
-    youngs_modulus: float = Field(1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body")
-    poisson_ratio: float = Field(
-        0.0,
-        gt=-1.0,
-        le=0.5,
-        allow_inf_nan=False,
-        description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
-    )
-
-
-def elastic_stiffness(params: ElasticParams) -> float:
-    return effective_modulus(params.youngs_modulus, params.poisson_ratio)
-
-
-# --------------------------------------------------------------- validation
-
-
-def _check_control(control: str) -> None:
-    if control not in ("force", "indentation"):
-        raise ValueError(f"control must be 'force' or 'indentation'. Got {control!r} instead.")
-
-
-def _check_loads(loads, control: str) -> np.ndarray:
-    loads = np.asarray(loads, dtype=float)
-    what = "force" if control == "force" else "indentation"
-    if loads.ndim != 1:
-        raise ValueError(f"loads must be a 1D array of {what}s. Got shape {loads.shape} instead.")
-    if loads.size == 0:
-        raise ValueError(f"loads is empty: give at least one {what}")
-    good = np.isfinite(loads) & (loads > 0.0)
-    if not good.all():
-        j = int(np.argmin(good))
-        value = loads[j]
-        problem = "not finite" if not np.isfinite(value) else "not positive"
-        raise ValueError(
-            f"every load must be a finite positive {what}: load {j} is {float(value):g} ({problem})"
-        )
-    return loads
-
-
-def check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.ndarray, np.ndarray, float]:
-    """Heights and slopes as float arrays of the profile's shape, and the spacing;
-    a shape the solver cannot press is an error naming what it presses."""
-    heights = np.asarray(profile.heights, dtype=float)
-    if heights.ndim not in solver.dimensions or heights.size == 0:
-        shapes = " or ".join({1: "(N,)", 2: "(Ny, Nx)"}[d] for d in solver.dimensions)
-        what = " or ".join({1: "a line", 2: "a surface"}[d] for d in solver.dimensions)
-        raise ValueError(
-            f"{solver.name} presses {what}: heights must have shape {shapes} with at least one point. "
-            f"Got shape {heights.shape} instead."
-        )
-    slopes = np.asarray(slopes, dtype=float)
-    if slopes.shape != heights.shape:
-        raise ValueError(
-            f"slopes must have the shape of the heights {heights.shape}. Got {slopes.shape} instead."
-        )
-    spacing = float(profile.spacing)
-    if not (np.isfinite(spacing) and spacing > 0.0):
-        raise ValueError(f"profile spacing must be finite and positive. Got {float(spacing):g} instead.")
-    return heights, slopes, spacing
+__all__ = ["BisectionSprings", "MDRSprings", "SpringRow", "WinklerSprings"]
 
 
 def _prepare(solver: ContactSolver, profile: Profile, loads, control: str, slopes):
     """Checked (loads, flat heights, flat slopes, spring stiffness K = k dx^ndim) for a sweep."""
-    _check_control(control)
-    loads = _check_loads(loads, control)
+    check_control(control)
+    loads = check_loads(loads, control)
     heights, slopes, spacing = check_profile(solver, profile, slopes)
     ndim = heights.ndim
     heights, slopes = heights.ravel(), slopes.ravel()  # views when contiguous

@@ -1,0 +1,305 @@
+"""The contact problem of a rigid rough surface on an elastic body, solved by a
+preconditioned projected conjugate gradient on any elastic operator.
+
+At the solution every point either touches (pressure p > 0, gap g = 0) or not
+(p = 0, g >= 0), where ``g = u(p) + depth - level``: ``u`` the operator's
+displacement, ``depth`` the depths below the top and ``level`` the rigid body's.
+That is the minimum, over p >= 0, of the elastic energy ``p.u(p)/2 + p.(depth -
+level)``, whose gradient is the gap. Under force control the mean pressure is
+prescribed and the level is its Lagrange multiplier; under indentation control
+the level is prescribed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from frictionlab import iteration_done
+
+from .elastic import ElasticOperator
+
+# Steps between exact recomputations of the gap when it is updated
+# incrementally: bounds the drift of the update to ~REFRESH rounding errors.
+REFRESH = 50
+# The certified stop: the contact set has not changed for this many steps, and
+# every point's margin (pressure on contact, gap off it) is this many times its
+# change in the last step.
+STABLE_STEPS = 2
+MARGIN_FACTOR = 10.0
+
+__all__ = ["REFRESH", "NotConverged", "ProjectedCG", "cold_start"]
+
+
+class NotConverged(Exception):
+    def __init__(self, iterations: int, residual: float):
+        super().__init__(iterations, residual)
+        self.iterations = iterations
+        self.residual = residual
+
+
+class ProjectedCG:
+    """Preconditioned projected conjugate gradient on one grid.
+
+    Works in scaled units (pixels, depths divided by the height range, E* = 1):
+    ``depth`` holds ``u_i = (max z - z_i) / s`` in [0, 1]; ``operator`` is the
+    elastic body (:class:`~frictionlab_solvers.elastic.ElasticOperator`). The
+    grid-sized work buffers are reused by every solve.
+
+    The residual of a state is the largest violation of the contact conditions,
+    relative to the rms height: ``max(max_contact |gap|, max_free (-gap)) / h``
+    (a point in contact must have zero gap, a free point must not penetrate).
+    """
+
+    def __init__(self, operator: ElasticOperator, depth: np.ndarray):
+        if tuple(depth.shape) != tuple(operator.shape):
+            raise ValueError(f"depth of shape {depth.shape} on an operator of shape {operator.shape}")
+        self.operator = operator
+        self.shape = depth.shape
+        self.depth = depth
+        self.rms = float(np.sqrt(np.mean(np.square(depth - depth.mean()))))
+        self.gap = np.empty(self.shape)  # displacement + depth, before the rigid level
+        self.direction = np.zeros(self.shape)  # the search direction, zero off its working set
+        self.last_residual = np.zeros(self.shape)  # the last step's residual on its working set, zero elsewhere
+        self.response = np.empty(self.shape)  # the displacement under the direction
+        self.preconditioned = np.empty(self.shape)
+        self.below = np.empty(self.shape, dtype=bool)
+        self.scratch = np.empty(self.shape)
+
+    def solve(
+        self,
+        pressure: np.ndarray,
+        *,
+        mean_pressure: float | None = None,
+        approach: float | None = None,
+        tolerance: float,
+        max_iterations: int,
+        certified: bool = False,
+        monitor: Callable[[int, float, np.ndarray], None] | None = None,
+    ) -> tuple[np.ndarray, float, int, float]:
+        """Iterate from ``pressure`` (modified in place) until the residual is at
+        most ``tolerance`` or, with ``certified``, until the contact set is
+        certified. Exactly one of ``mean_pressure`` (force control) and
+        ``approach`` (indentation control) is given. ``monitor``, if given, is
+        called before each step with the iteration, the residual and the flat
+        indices of the contact points (for studies of convergence). Each
+        iteration calls ``frictionlab.iteration_done``, which may raise
+        ``SolveCancelled``: the solve then stops where it is.
+
+        Returns ``(pressure, level, iterations, residual)``; raises
+        ``NotConverged`` after ``max_iterations`` steps.
+
+        A step works on the *working set*: the contact points and the free
+        points that penetrate. Its gradient there is the gap minus the level;
+        the preconditioner (the operator's approximate stiffness, applied to the
+        gradient spread on the grid and read back on the set) makes the CG
+        converge in a few steps per decade once the set is found. Under force
+        control the direction has zero sum on the set, so a step keeps the
+        load. Points the step would push below zero pressure are set to zero
+        (clipped) and leave the set; the load is then restored by scaling and
+        the gap recomputed exactly. Otherwise the gap is updated from the
+        step's response, recomputed exactly every ``REFRESH`` steps and before
+        a stop is accepted.
+
+        The CG factor is Polak-Ribiere's, clipped at zero (Gilbert & Nocedal
+        1992), with the last residual restricted to the current set, and is kept
+        across set changes: on a fixed set it is the usual factor, and across a
+        change it restarts the CG by itself as soon as successive residuals stop
+        being orthogonal in the preconditioner's metric.
+
+        The certified stop: the set has not changed for ``STABLE_STEPS`` steps
+        (no point clipped, none penetrating), and every point's margin exceeds
+        ``MARGIN_FACTOR`` times its change in the last step: the pressure of a
+        contact point, the gap of a free one. The contact set is then final
+        (checked against tolerance-1e-12 solves, tests/test_certified_stop.py),
+        while the pressures and the level are only as converged as the
+        residual returned.
+        """
+        force_control = approach is None
+        operator = self.operator
+        p, g, depth = pressure.reshape(-1), self.gap.reshape(-1), self.depth.reshape(-1)
+        d_grid, r_grid = self.direction.reshape(-1), self.last_residual.reshape(-1)
+        w_grid, z_grid = self.response.reshape(-1), self.preconditioned.reshape(-1)
+        level = approach
+        if force_control:  # the load is part of the answer: start from a pressure that carries it
+            total = float(p.mean())
+            if total > 0.0:
+                p *= mean_pressure / total
+            else:
+                p.fill(mean_pressure)
+        d_grid.fill(0.0)
+        r_grid.fill(0.0)
+        contact = np.flatnonzero(p)
+        self._exact_gap(pressure)
+        exact, since_exact = True, 0
+        previous_rz = 1.0  # r.z of the last step
+        stable = 0  # steps since the contact set last changed
+        last_step = 0.0  # the last step's length, for the margins of the certified stop
+        last_level = level
+        iteration = 0
+        while True:
+            if contact.size == 0:  # only possible under indentation control
+                np.subtract(level, depth, out=p)
+                np.maximum(p, 0.0, out=p)
+                contact = np.flatnonzero(p)
+                self._exact_gap(pressure)
+                exact, since_exact, stable = True, 0, 0
+                continue
+            g_c = g[contact]
+            if force_control:
+                level = float(g_c.mean())
+            g_c -= level
+            worst_contact = float(np.abs(g_c).max())
+            # points below the level: contact points with a negative gap error, and free
+            # points that penetrate (p is exactly 0 off the contact set)
+            below = np.flatnonzero(np.less(g, level, out=self.below.reshape(-1)))
+            penetrating = below[p[below] == 0.0]
+            worst_free = level - float(g[penetrating].min()) if penetrating.size else 0.0
+            residual = max(worst_contact, worst_free) / self.rms
+            done = residual <= tolerance or (
+                certified and stable >= STABLE_STEPS and self._certain(p, g, contact, level, last_level, last_step)
+            )
+            if done:
+                if not exact:  # accept only what an exact gap confirms
+                    self._exact_gap(pressure)
+                    exact, since_exact = True, 0
+                    continue
+                return pressure, float(level), iteration, residual
+            iteration_done(iteration, residual)
+            if monitor is not None:
+                monitor(iteration, residual, contact)
+            if iteration == max_iterations:
+                raise NotConverged(iteration, residual)
+            iteration += 1
+
+            # the working set and the gradient on it
+            if penetrating.size:
+                working = np.sort(np.concatenate([contact, penetrating]))  # disjoint
+                r = g[working]
+                r -= level
+                if force_control:  # the gradient within zero-sum steps
+                    r -= r.mean()
+            else:
+                working, r = contact, g_c
+            # the preconditioned gradient, zero-sum under force control
+            z_grid.fill(0.0)
+            z_grid[working] = r
+            operator.precondition(self.preconditioned, self.preconditioned)
+            z = z_grid[working]
+            if force_control:
+                z -= z.mean()
+            rz = _dot(r, z)
+            if not rz > 0.0:  # no descent left: stuck (rounding at a converged state)
+                raise NotConverged(iteration, residual)
+            # Polak-Ribiere factor, clipped at 0, with the last residual restricted to this set
+            beta = (rz - _dot(z, r_grid[working])) / previous_rz
+            if beta > 0.0:
+                d = d_grid[working]
+                d *= beta
+                d += z
+                if force_control:
+                    d -= d.mean()
+                if not _dot(r, d) > 0.0:
+                    d = z
+            else:
+                d = z
+            previous_rz = rz
+            d_grid.fill(0.0)
+            d_grid[working] = d
+            r_grid.fill(0.0)
+            r_grid[working] = r
+            operator.displacement(self.direction, self.response)
+            curvature = _dot(d, w_grid[working])
+            if not curvature > 0.0:  # no descent left along d: stuck
+                raise NotConverged(iteration, residual)
+            step = _dot(r, d) / curvature
+            p_w = p[working]
+            p_w -= step * d
+            clipped = float(p_w.min()) <= 0.0
+            if clipped:
+                np.maximum(p_w, 0.0, out=p_w)
+                p[working] = p_w
+                contact = working[p_w > 0.0]
+                if force_control:  # restore the load exactly
+                    total = float(p[contact].sum()) / p.size
+                    if not total > 0.0:  # cannot happen in exact arithmetic; start over
+                        p.fill(mean_pressure)
+                        contact = np.arange(p.size)
+                        d_grid.fill(0.0)
+                        r_grid.fill(0.0)
+                    else:
+                        p[contact] *= mean_pressure / total
+                self._exact_gap(pressure)
+                exact, since_exact, stable = True, 0, 0
+            elif not force_control and working.size == p.size and float(r.mean()) > 0.0:
+                # full contact under indentation control, the level above the rigid body's
+                # full-contact level: a uniform pressure has no stiffness (the energy is linear
+                # along it), so the pressure drops evenly until its lowest point lifts off
+                p[working] = p_w
+                p -= p_w.min()
+                contact = np.flatnonzero(p)
+                self._exact_gap(pressure)
+                exact, since_exact, stable = True, 0, 0
+            else:
+                p[working] = p_w
+                stable = stable + 1 if working is contact else 0
+                contact = working
+                if since_exact >= REFRESH:
+                    self._exact_gap(pressure)
+                    exact, since_exact = True, 0
+                else:  # linear in p: g(p - step d) = g - step w
+                    np.multiply(self.response, step, out=self.scratch)
+                    self.gap -= self.scratch
+                    exact, since_exact = False, since_exact + 1
+            last_step, last_level = step, level
+
+    def _certain(self, p, g, contact, level: float, last_level: float, last_step: float) -> bool:
+        """Every point's margin exceeds MARGIN_FACTOR times its change in the last
+        step (which moved p by ``-last_step * direction`` and the gap by
+        ``-last_step * response``, on an unchanged contact set)."""
+        d_c = self.direction.reshape(-1)[contact]
+        if not np.all(p[contact] > MARGIN_FACTOR * last_step * np.abs(d_c)):
+            return False
+        # free points: gap - level against its change, -step w - (level - last_level)
+        change = np.multiply(self.response, -last_step, out=self.scratch)
+        change -= level - last_level
+        np.abs(change, out=change)
+        change *= MARGIN_FACTOR
+        change += level
+        free = self.below
+        np.less_equal(self.gap, change, out=free)  # gap - level <= 10 |change|
+        free.reshape(-1)[contact] = False
+        return not free.any()
+
+    def _exact_gap(self, pressure: np.ndarray) -> None:
+        """``gap = displacement(pressure) + depth``, from the pressure itself."""
+        self.operator.displacement(pressure, self.gap)
+        self.gap += self.depth
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """The dot product of two vectors without BLAS: a multithreaded BLAS keeps its
+    threads spinning after each call, and on a busy machine they took the core the
+    next FFT needed (the whole solve ran 3x slower)."""
+    return float(np.einsum("i,i->", a, b))
+
+
+def cold_start(depth: np.ndarray, mean_pressure: float) -> np.ndarray:
+    """A first pressure under force control: springs under the points of the
+    contact area that the small-load law A/A0 = 2 p / (E* grad h) predicts
+    (scaled units), so the CG does not start from full contact."""
+    slope_squared = sum(
+        float(np.mean(np.square(np.diff(depth, axis=axis, append=np.take(depth, [0], axis=axis)))))
+        for axis in range(depth.ndim)
+    )
+    fraction = min(1.0, 2.0 * mean_pressure / np.sqrt(slope_squared)) if slope_squared > 0 else 1.0
+    flat = depth.ravel()
+    k = min(flat.size - 1, max(0, int(np.ceil(fraction * flat.size)) - 1))
+    level = np.partition(flat, k)[k]
+    pressure = np.maximum(level - depth, 0.0)
+    total = float(pressure.mean())
+    if not total > 0.0:  # ties at the level: fall back to an even start
+        return np.full(depth.shape, mean_pressure)
+    pressure *= mean_pressure / total
+    return pressure

@@ -1,0 +1,126 @@
+"""The elastic body shared by the solvers: E* = E / (1 - nu^2), its parameters, and
+the operator that turns a surface pressure into a surface displacement.
+
+The exact solvers' conjugate gradients see the elastic body only through an
+*elastic operator* (:class:`ElasticOperator`): the displacement under a pressure
+field, an approximate inverse of it (the preconditioner), and the grid both live
+on. :class:`PeriodicHalfSpace` is the periodic one, a diagonal in Fourier space; a
+body with free (non-periodic) boundaries is another operator with the same three
+members, and the CGs take it unchanged.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+from pydantic import Field
+
+from frictionlab import PluginParams
+
+__all__ = ["ElasticOperator", "ElasticParams", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
+
+
+def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
+    """Plane-strain modulus E* = E / (1 - nu^2); infinite is rejected (nu = +-1)."""
+    denominator = 1.0 - poisson_ratio * poisson_ratio
+    if denominator <= 0.0:
+        raise ValueError(
+            f"poisson_ratio = {poisson_ratio} gives 1 - nu^2 = {denominator}: "
+            "the effective modulus E/(1 - nu^2) is not finite"
+        )
+    return youngs_modulus / denominator
+
+
+class ElasticParams(PluginParams):
+    """The elastic body of MDR and of the exact (BEM) solvers: E and nu, giving E*."""
+
+    youngs_modulus: float = Field(1.0, gt=0.0, allow_inf_nan=False, description="Young's modulus E of the elastic body")
+    poisson_ratio: float = Field(
+        0.0,
+        gt=-1.0,
+        le=0.5,
+        allow_inf_nan=False,
+        description="Poisson ratio nu of the elastic body; E* = E / (1 - nu^2) (nu = 0.5: incompressible)",
+    )
+
+
+def elastic_stiffness(params: ElasticParams) -> float:
+    return effective_modulus(params.youngs_modulus, params.poisson_ratio)
+
+
+class ElasticOperator(Protocol):
+    """What a contact CG needs of the elastic body, in scaled units (pixels, E* = 1).
+
+    ``shape`` is the grid of pressures and displacements. ``displacement`` and
+    ``precondition`` write into ``out`` (a float array of ``shape``) and return
+    it; both are linear and symmetric, ``displacement`` positive definite on
+    the pressures of a partial contact, ``precondition`` positive semi-definite.
+    ``precondition`` approximates the inverse of ``displacement`` (a stiffness),
+    and may be rough: it only speeds the CG up. ``point_stiffness`` is the
+    pressure on one point per unit of its own displacement (the inverse of the
+    diagonal of ``displacement``).
+
+    The displacement's reference (here zero mean, the rigid level of a periodic
+    body) is the operator's: the CG finds the rigid level either way.
+    """
+
+    shape: tuple[int, ...]
+    point_stiffness: float
+
+    def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray: ...
+
+    def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray: ...
+
+
+class PeriodicHalfSpace:
+    """The periodic elastic half-space (2D grids) or half-plane in plane strain (1D):
+    ``u_q = 2 p_q / |q|`` in Fourier space, its inverse ``|q| / 2`` the preconditioner.
+
+    The mean mode q = 0 has no finite stiffness: it is the rigid-body level, and
+    displacements have zero mean. The preconditioner leaves that mode out too (a
+    uniform pressure moves nothing, so no displacement asks for one).
+
+    numpy's FFTs write into the buffers given (``out``), so a call allocates
+    nothing: half the time of ``scipy.fft``, which returns new arrays.
+    """
+
+    def __init__(self, shape: tuple[int, ...]):
+        self.shape = tuple(shape)
+        self.axes = tuple(range(len(self.shape)))
+        q = _wave_number(self.shape)
+        self.compliance = np.zeros(q.shape)
+        np.divide(2.0, q, out=self.compliance, where=q > 0)
+        self.stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
+        self.spectrum = np.empty(q.shape, dtype=complex)
+        import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
+
+        self.point_stiffness = 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
+
+    def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Zero-mean surface displacement under ``pressure``, written into ``out``."""
+        return self._apply(self.compliance, pressure, out)
+
+    def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The stiffness ``|q| / 2`` applied to ``residual``."""
+        return self._apply(self.stiffness, residual, out)
+
+    def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
+        """The zero-mean pressure that makes ``displacement`` (exact inverse, zero mean)."""
+        return self._apply(self.stiffness, displacement, np.empty(self.shape))
+
+    def _apply(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
+        spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
+        spectrum *= kernel
+        np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
+        return out
+
+
+def _wave_number(shape: tuple[int, ...]) -> np.ndarray:
+    """``|q|`` in radians per pixel on the rfftn grid of ``shape``."""
+    import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
+
+    axes = [2 * np.pi * scipy.fft.fftfreq(n) for n in shape[:-1]]
+    axes.append(2 * np.pi * scipy.fft.rfftfreq(shape[-1]))
+    grids = np.meshgrid(*axes, indexing="ij", sparse=True)
+    return np.sqrt(sum(np.square(grid) for grid in grids))
