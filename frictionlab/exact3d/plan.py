@@ -119,8 +119,8 @@ class Job:
 
 FULL = Plan("full", resolutions=(256, 512, 1024), realizations=(32, 32, 32), extra=((FIRST_HURST, 2048, 8),),
             side=(512, 32), spectral=(1024, 8), mdr_lines=64)  # fmt: skip
-QUICK = Plan("quick", resolutions=(64, 128, 256), realizations=(4, 4, 4), side=(128, 4), spectral=(128, 2),
-             mdr_lines=4, steps=8, bootstrap=200)  # fmt: skip
+QUICK = Plan("quick", resolutions=(64, 96, 128), realizations=(4, 4, 4), side=(64, 4), spectral=(128, 2),
+             extra=((FIRST_HURST, 192, 2),), mdr_lines=4, steps=8, bootstrap=200)  # fmt: skip
 
 
 @dataclass
