@@ -84,18 +84,28 @@ class Plan:
         return sorted([*zip(self.resolutions, self.realizations), *more])
 
     def jobs(self) -> list[Job]:
-        """Every ensemble, most valuable first: the main family at FIRST_HURST then at the
-        other H (each grid exact, then MDR), the extra grids, the comparison family, the
-        spectral gradients."""
-        order = sorted(self.hursts, key=lambda h: not math.isclose(h, FIRST_HURST))
+        """Every ensemble, most valuable first, so that an interrupted study holds the most
+        of the answer: at FIRST_HURST the main family (each grid exact, then MDR), its
+        comparison family and its spectral gradients; then the other H, the extremes first,
+        each with its comparison family; the extra grids; the other H's spectral gradients."""
+        first = [h for h in self.hursts if math.isclose(h, FIRST_HURST)]
+        rest = sorted(h for h in self.hursts if not math.isclose(h, FIRST_HURST))
+        rest = [*rest[:1], *rest[-1:], *rest[1:-1]] if len(rest) > 1 else rest
         regular = list(zip(self.resolutions, self.realizations))
-        jobs = [Job(MAIN, h, n, m, exact) for h in order for n, m in regular for exact in (True, False)]
+
+        def main(h):
+            return [Job(MAIN, h, n, m, exact) for n, m in regular for exact in (True, False)]
+
+        def side(h):
+            return [Job(SIDE, h, *self.side, exact) for exact in (True, False)] if self.side else []
+
+        def spectral(h):
+            return [Job(SPECTRAL, h, *self.spectral, True)] if self.spectral else []
+
+        jobs = [job for h in first for job in (*main(h), *side(h), *spectral(h))]
+        jobs += [job for h in rest for job in (*main(h), *side(h))]
         jobs += [Job(MAIN, h, n, m, exact) for h, n, m in self.extra for exact in (True, False)]
-        if self.side:
-            jobs += [Job(SIDE, h, *self.side, exact) for h in order for exact in (True, False)]
-        if self.spectral:
-            jobs += [Job(SPECTRAL, h, *self.spectral, True) for h in order]
-        return jobs
+        return jobs + [job for h in rest for job in spectral(h)]
 
 
 @dataclass(frozen=True)

@@ -49,7 +49,7 @@ def test_out_or_runs_that_is_a_file_is_refused_naming_the_option(tmp_path, capsy
 
 def test_ctrl_c_ends_the_study_with_130_keeping_the_finished_ensembles(tmp_path):
     runs, out = tmp_path / "runs", tmp_path / "out"
-    first = runs / "h0.3-n64-bem-halfspace"
+    first = runs / "h0.8-n64-bem-halfspace"  # the plan runs H = 0.8 first
     command = [sys.executable, "-m", "frictionlab", "exact3d", "--quick", "--presets", str(PRESETS),
                "--out", str(out), "--runs", str(runs), "--workers", "1"]  # fmt: skip
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
