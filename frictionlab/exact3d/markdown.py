@@ -48,8 +48,11 @@ def kappa_place(k: Kappa) -> str:
     sim_low, sim_high = KAPPA_SIMULATIONS
     if not math.isfinite(k.value):
         return "not measured"
-    if low <= sim_high and high >= sim_low:
+    if sim_low <= k.value <= sim_high:
         return f"within the simulations' {sim_low:g} to {sim_high:g}"
+    if low <= sim_high and high >= sim_low:
+        edge = "upper" if k.value > sim_high else "lower"
+        return f"at the {edge} edge of the simulations' {sim_low:g} to {sim_high:g} (its interval reaches into it)"
     if low > sim_high:
         where = f"above the simulations' {sim_low:g} to {sim_high:g}, "
         if high < KAPPA_BUSH:

@@ -144,3 +144,20 @@ def test_a_span_prints_one_value_when_its_ends_print_alike():
 
     assert _span([0.995, 0.996, 1.0], ".0%") == "100%"
     assert _span([0.85, 0.91, 0.88], ".2f") == "0.85 to 0.91"
+
+
+@pytest.mark.parametrize(
+    "value, interval, place",
+    [(2.1, (2.0, 2.2), "within the simulations' 2 to 2.3"),
+     (2.33, (2.28, 2.38), "at the upper edge of the simulations' 2 to 2.3"),
+     (2.4, (2.35, 2.45), "above the simulations' 2 to 2.3, below the vanishing-load limit 2.51"),
+     (2.55, (2.45, 2.65), "above the simulations' 2 to 2.3, at the vanishing-load limit 2.51"),
+     (2.7, (2.6, 2.8), "above even the vanishing-load limit 2.51"),
+     (1.8, (1.7, 1.9), "below the simulations' 2 to 2.3, above Persson's 1.60"),
+     (1.5, (1.4, 1.55), "below Persson's 1.60")],
+)  # fmt: skip
+def test_kappa_is_placed_against_the_literature(value, interval, place):
+    from frictionlab.exact3d.analysis import Kappa
+    from frictionlab.exact3d.markdown import kappa_place
+
+    assert place in kappa_place(Kappa(value, interval, 3, 0.04))
