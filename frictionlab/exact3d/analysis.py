@@ -21,6 +21,11 @@ from ..fit import percentile_interval
 SMALL_LOAD_FRACTION = 0.05  # contact fraction below which the area is taken to grow linearly
 KAPPA_WINDOW = (0.005, SMALL_LOAD_FRACTION)  # contact fractions where simulations find kappa of about 2 to 2.3
 FEW_SPOTS = (0.0, 0.003)  # contact fractions of a handful of spots per surface, shown apart
+# kappa in the literature: the vanishing-load limit (Bush, Gibson and Thomas), Persson's theory,
+# and what simulations find at 0.5-5 % contact
+KAPPA_BUSH = math.sqrt(2 * math.pi)
+KAPPA_PERSSON = math.sqrt(8 / math.pi)
+KAPPA_SIMULATIONS = (2.0, 2.3)
 
 
 @dataclass(frozen=True)

@@ -2,24 +2,19 @@
 
 from __future__ import annotations
 
-import math
-
 import matplotlib
 
 matplotlib.use("Agg")  # headless servers: never ask for a display
 
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import ScalarFormatter  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .analysis import FEW_SPOTS, KAPPA_WINDOW  # noqa: E402
+from .analysis import FEW_SPOTS, KAPPA_BUSH, KAPPA_PERSSON, KAPPA_SIMULATIONS, KAPPA_WINDOW  # noqa: E402
 from .numbers import Numbers  # noqa: E402
 from .plan import MAIN, SIDE, StudyRuns  # noqa: E402
 
 EXACT, APPROX, SIDE_COLOR = "C0", "C3", "0.45"
-# kappa in the literature: the vanishing-load limit, Persson's theory, and what simulations find at 0.5-5 % contact
-KAPPA_BUSH = math.sqrt(2 * math.pi)
-KAPPA_PERSSON = math.sqrt(8 / math.pi)
-KAPPA_SIMULATIONS = (2.0, 2.3)
 
 
 def _shades(count: int) -> list:
@@ -149,10 +144,12 @@ def plot_convergence(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> No
                         mfc="none", color=f"C{i}")  # fmt: skip
     for ax, name in zip(axes, ("a", "b", "κ")):
         ax.set_xscale("log", base=2)
-        ax.set_xlabel("pixels on the short cut-off λs (open circles: < 16, not quoted; squares: MDR)")
+        ax.set_xlabel("pixels on the short cut-off λs")
+        ax.xaxis.set_major_formatter(ScalarFormatter())
         ax.set_ylabel({"a": "a of ξ = a + b ln f", "b": "b of ξ = a + b ln f",
                        "κ": "κ at 0.5-5 % contact (corrected area)"}[name])  # fmt: skip
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
+    fig.suptitle("open circles: fewer than 16 pixels on λs, not quoted; open squares: MDR on the finest grid", fontsize=9)
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)

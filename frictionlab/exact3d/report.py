@@ -3,7 +3,6 @@ exact-3d-law.md with its figures (exact-3d-law/*.png) beside it."""
 
 from __future__ import annotations
 
-import math
 import os
 import platform
 from collections.abc import Callable
@@ -18,7 +17,6 @@ from ..options import RunOptions
 from ..rundir import new_run_folder
 from ..seeds import realization_rng
 from ..signals import WorkInterrupted
-from .analysis import FEW_SPOTS, KAPPA_WINDOW
 from .figures import plot_convergence, plot_kappa, plot_xi_against_f
 from .markdown import (
     FEW_TEXT,
@@ -41,7 +39,6 @@ from .plan import (
     FULL,
     MIN_PIXELS_QUOTED,
     QUICK,
-    SIDE,
     Plan,
     StudyRuns,
     check_runs_folder,
