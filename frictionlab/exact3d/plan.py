@@ -279,11 +279,12 @@ def run_plan(
             spacing, short, long = _cutoffs(scene)
             runs.ensembles.append(Ensemble(job, scene.solver.name, scene, outcome, folder, spacing, short, long))
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
-        _add_time(Path(runs_dir), plan, time.perf_counter() - started)  # what it ran counts in the study's time
         raise WorkInterrupted(
             f"the ensembles that finished are kept in {runs_dir}; run the command again with --runs {runs_dir} to resume"
         ) from None
-    runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started if compute else 0.0)
+    finally:  # the time of an invocation that computed counts in the study's, however it ended
+        if Path(runs_dir).is_dir():
+            runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started if compute else 0.0)
     return runs
 
 
