@@ -17,12 +17,12 @@ def add_parser(sub) -> None:
         "(exact half-space contact) and MDR on their equivalent lines, with a comparison family (long cut-off = "
         "side), spectral gradients and a finer grid at H = 0.8; fit xi = a + b ln f with bootstrap intervals, "
         "measure kappa of the corrected contact area, and write the page exact-3d-law.md with its figures. The "
-        "full plan takes hours of one core (run it resumably with --runs); --quick about a minute (not converged).",
+        "full plan takes hours of one core (run it resumably with --runs); --quick about 20 s of one core (not converged).",
         epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --force\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --finished-only --force",
     )
-    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about a minute, not converged")
+    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about 20 s of one core, not converged")
     p.add_argument("--finished-only", action="store_true", help="run nothing: write the page from the ensembles of "
                    "--runs that finished; the page lists the plan's others as not run")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")

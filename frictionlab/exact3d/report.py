@@ -172,9 +172,9 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         f"The study ({plan.name} plan) took **{format_duration(runs.seconds)}** of wall time (summed over the "
         f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of each ensemble (its surfaces' solve times summed) is "
         "in the convergence table. "
-        + ("`--quick` runs the same pipeline on small grids and ensembles in about a minute: **its numbers are "
+        + ("`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core: **its numbers are "
            "not converged** and answer nothing." if plan.name == "quick" else
-           "`--quick` runs the same pipeline on small grids and ensembles in about a minute (not converged)."),
+           "`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core (not converged)."),
         "",
         "## What ran",
         "",
