@@ -53,7 +53,7 @@ from .arguments import data_argument, flag_argument, overrides_argument, path_ar
 from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
 from .fit import LogFit
 from .options import RunOptions
-from .results import read_curve, read_summary
+from .results import CORRECTED_AREA, read_curve, read_summary
 from .runfolder import subfolder
 
 if TYPE_CHECKING:
@@ -72,7 +72,9 @@ class Result:
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
     realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,
-    ``contact_fraction``, ``indentation``. ``caveats``: what a reader of the fit
+    ``contact_fraction``, ``indentation``, and ``real_area_corrected`` (the real area
+    corrected for its perimeter's pixels, a fraction) for a solver that gives it
+    (``bem-halfspace``). ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
@@ -364,6 +366,8 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
+    if outcome.real_area_corrected is not None:  # the solvers that correct their area only
+        table[CORRECTED_AREA] = outcome.real_area_corrected
     return Result(
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,

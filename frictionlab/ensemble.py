@@ -69,6 +69,7 @@ class RunOutcome:
     workers: int
     error: str | None = None
     compute_seconds: float = 0.0  # summed over the finished realizations, restored ones included
+    real_area_corrected: np.ndarray | None = None  # ensemble mean; None when the solver does not correct its area
     extra: dict = field(default_factory=dict)
 
     @property
@@ -166,6 +167,8 @@ class Accumulator:
             per["own_rms_height"] = own
         if scene.control == "indentation":
             per["force"] = self.stack("force")
+        if scene.solver.corrected_area:
+            per["real_area_corrected"] = self.stack("real_area_corrected")
         n = indices.size
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
@@ -236,4 +239,6 @@ class Accumulator:
             workers=workers,
             error=error,
             compute_seconds=float(sum(self.results[i].seconds for i in indices)),
+            real_area_corrected=(per["real_area_corrected"].mean(axis=0) if n else nan_row)
+            if scene.solver.corrected_area else None,
         )

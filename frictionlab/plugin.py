@@ -141,6 +141,9 @@ class ContactCurve:
     solver's ``contact_measure``).
     ``slope_rms_contact`` is the rms, over the points in contact, of the slopes
     the engine passed in (from the chosen slope estimator).
+    ``real_area_corrected``: the real contact area corrected for the pixels the
+    contact's perimeter crosses, a fraction of the nominal area; given exactly when
+    the solver declares ``corrected_area``, None otherwise.
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
     """
 
@@ -149,6 +152,7 @@ class ContactCurve:
     contact_count: np.ndarray
     contact_fraction: np.ndarray
     slope_rms_contact: np.ndarray
+    real_area_corrected: np.ndarray | None = None
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
 
@@ -430,6 +434,9 @@ class ContactSolver(Plugin):
     - ``approximation`` (False): True when the solver models its problem only
       approximately (MDR for the half-space); the study compares it with an exact one.
     - ``contact_measure`` ("real contact"): what ``contact_fraction`` measures.
+    - ``corrected_area`` (False): True when ``solve`` also gives the real area
+      corrected for the contact's perimeter (``ContactCurve.real_area_corrected``);
+      the results then carry it beside the pixel count.
     - ``indentation_reference`` ("undeformed body") and ``mean_displacement(f, h)``
       (zero): the mean displacement of the elastic surface in the indentation's
       frame, so that ``indentation - mean_displacement`` is measured from the mean
@@ -457,6 +464,7 @@ class ContactSolver(Plugin):
     problem: ClassVar[str] = ""
     approximation: ClassVar[bool] = False
     contact_measure: ClassVar[ContactMeasure] = "real contact"
+    corrected_area: ClassVar[bool] = False
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False

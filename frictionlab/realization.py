@@ -32,6 +32,7 @@ class RealizationResult:
     contact_count: np.ndarray | None = None
     indentation: np.ndarray | None = None
     force: np.ndarray | None = None  # kept only under indentation control (forces vary)
+    real_area_corrected: np.ndarray | None = None  # kept for the solvers that declare corrected_area
     slope_rms_line: float = math.nan
     points: int = 0
     force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
@@ -122,6 +123,7 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
             contact_count=np.asarray(curve.contact_count),
             indentation=np.asarray(curve.indentation),
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
+            real_area_corrected=np.asarray(curve.real_area_corrected, float) if scene.solver.corrected_area else None,
             slope_rms_line=slope_rms_line,
             points=profile.points,
             force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),

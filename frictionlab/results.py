@@ -42,6 +42,9 @@ CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
 }
+# beside the pixel count, for the solvers that declare corrected_area (others have no such column)
+CORRECTED_AREA = "real_area_corrected"
+CORRECTED_AREA_HEADER = f"{CORRECTED_AREA} [real contact fraction, corrected for the pixels its perimeter crosses]"
 INDENTATION_REFERENCES = {
     "undeformed body": "length; from the first touch; against the undeformed body",
     "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
@@ -79,6 +82,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         },
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
+        **_corrected_area_ends(outcome),
         "caveats": outcome.caveats,
         "elapsed_seconds": round(outcome.elapsed, 6),
         "workers": outcome.workers,
@@ -111,6 +115,15 @@ def heights_summary(outcome: RunOutcome) -> dict:
     }
 
 
+def _corrected_area_ends(outcome: RunOutcome) -> dict:
+    """The corrected real area at the first and last load; None where the solver gives none."""
+    corrected = outcome.real_area_corrected
+    ends = {"first": None, "last": None}
+    if corrected is not None and corrected.size:
+        ends = {"first": json_safe(float(corrected[0])), "last": json_safe(float(corrected[-1]))}
+    return {f"{CORRECTED_AREA}_at_{end}_load": value for end, value in ends.items()}
+
+
 def curve_header(scene: Scene) -> list[str]:
     """The columns of curve.csv, each a short name (``CURVE_COLUMNS``) with what it
     means in brackets: the load with its unit, f with its definition."""
@@ -137,7 +150,8 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     header, rows = read_number_table(folder, name)
     names = [column_name(h) for h in header]
     stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
-    if stripped != [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]:
+    expected = [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]
+    if stripped not in (expected, [*expected, CORRECTED_AREA]):  # the last for the solvers that correct the area
         raise RunFolderError(
             f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
             f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
@@ -156,7 +170,9 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
         used = curve["lines_used"]
         if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
             problems.append("lines_used must be a whole number >= 0 at every load step")
-    for column, low, high in (("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0)):
+    for column, low, high in (("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)):
+        if column not in curve:
+            continue
         values = curve[column][~np.isnan(curve[column])]
         if np.any((values < low) | (values > high)):
             problems.append(f"{column} must be {'in [0, 1]' if high == 1.0 else '>= 0'}")
@@ -238,7 +254,8 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     writer = csv.writer(fh, lineterminator="\n")
-    writer.writerow(curve_header(scene))
+    corrected = [CORRECTED_AREA_HEADER] if scene.solver.corrected_area else []
+    writer.writerow(curve_header(scene) + corrected)
     columns = (
         outcome.force,
         outcome.f,
@@ -249,6 +266,9 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.contact_fraction,
         outcome.indentation,
     )
+    if corrected:
+        columns = (*columns, outcome.real_area_corrected)
+
     for row in zip(*columns, strict=True):
         writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
 

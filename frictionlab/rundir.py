@@ -61,6 +61,7 @@ CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
+OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected")  # kept when the control or the solver gives them
 
 def _write_holder(fd: int) -> None:
     """Who holds run.lock, for the message of a run refused because of it."""
@@ -384,7 +385,7 @@ class RunDirectory:
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
         }
-        for name in (*CURVE_ARRAYS, "force"):
+        for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS):
             rows = [getattr(r, name) for r in ok]
             if ok and rows[0] is not None:
                 arrays[name] = np.vstack(rows)
@@ -485,6 +486,11 @@ class RunDirectory:
         self._write_manifest()
 
 
+def _optional_kept(scene: Scene) -> tuple[bool, bool]:
+    """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
+    return scene.control == "indentation", scene.solver.corrected_area
+
+
 def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
     """The RealizationResults of one chunk's arrays; ChunkDamage if anything is
     missing, misshapen, or indexes a realization the chunk cannot hold."""
@@ -493,7 +499,7 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
     if missing:
         raise ChunkDamage(f"no array {missing[0]}")
     n, k, steps = arrays["index"].shape[0], arrays["failed_index"].shape[0], scene.loads.size
-    curves = (*CURVE_ARRAYS, "force") if scene.control == "indentation" else CURVE_ARRAYS
+    curves = (*CURVE_ARRAYS, *(name for name, kept in zip(OPTIONAL_CURVE_ARRAYS, _optional_kept(scene)) if kept))
     for name in OK_ARRAYS + (curves if n else ()):
         if name not in arrays:
             raise ChunkDamage(f"no array {name}")
@@ -524,6 +530,7 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             contact_count=arrays["contact_count"][row],
             indentation=arrays["indentation"][row],
             force=arrays["force"][row] if "force" in curves else None,
+            real_area_corrected=arrays["real_area_corrected"][row] if "real_area_corrected" in curves else None,
             slope_rms_line=float(arrays["slope_rms_line"][row]),
             points=int(arrays["points"][row]),
             force_unit=float(arrays["force_unit"][row]),

@@ -14,13 +14,17 @@ def add_parser(sub) -> None:
         "exact3d",
         help="xi against f in exact half-space contact for H = 0.3..1, beside MDR: write exact-3d-law.md",
         description="The exact 3D law: run the presets exact3d-h03..h10 on three grids of the same surfaces "
-        "(exact half-space contact) and MDR on their equivalent lines, fit xi = a + b ln f with bootstrap "
-        "intervals, and write the page exact-3d-law.md with its figures. The full plan takes tens of minutes "
-        "on two cores; --quick a few minutes (not converged).",
+        "(exact half-space contact) and MDR on their equivalent lines, with a comparison family (long cut-off = "
+        "side), spectral gradients and a finer grid at H = 0.8; fit xi = a + b ln f with bootstrap intervals, "
+        "measure kappa of the corrected contact area, and write the page exact-3d-law.md with its figures. The "
+        "full plan takes hours of one core (run it resumably with --runs); --quick about 20 s of one core (not converged).",
         epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
-        "  frictionlab exact3d --out docs --runs runs/exact3d-full --force",
+        "  frictionlab exact3d --out docs --runs runs/exact3d-full --force\n"
+        "  frictionlab exact3d --out docs --runs runs/exact3d-full --finished-only --force",
     )
-    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: a few minutes, not converged")
+    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about 20 s of one core, not converged")
+    p.add_argument("--finished-only", action="store_true", help="run nothing: write the page from the ensembles of "
+                   "--runs that finished; the page lists the plan's others as not run")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")
     p.add_argument("--runs", metavar="DIR", help="folder of the ensembles' runs; an earlier one is resumed, one holding "
                    "other files is refused unless --force (default: a new runs/exact3d-<plan>-<timestamp>)")
@@ -35,7 +39,7 @@ def run(args) -> ExitCode:
     from ..exact3d.report import write_page
 
     page = write_page(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
-        args.out, runs_dir=args.runs, quick=args.quick, presets_dir=args.presets,
+        args.out, runs_dir=args.runs, quick=args.quick, finished_only=args.finished_only, presets_dir=args.presets,
         options=run_options(workers=args.workers, force=args.force),
         log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
     )  # fmt: skip

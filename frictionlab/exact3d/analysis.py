@@ -1,7 +1,9 @@
 """The numbers of the exact 3D law beyond the log fit: arrays in, numbers out.
 
-* ``contact_area_law``: kappa of A / A0 = kappa p / (E* rms gradient) at small loads,
-  with a bootstrap interval over realizations;
+* ``contact_area_law``: kappa of A / A0 = kappa p / (E* rms gradient) over a window of
+  contact fractions, with a bootstrap interval over realizations; ``kappa_curve``: kappa
+  at each load, against p / (E* rms gradient), with a bootstrap band;
+* ``height_moments``: a surface's height skewness and kurtosis (0 and 3 for a Gaussian);
 * ``nayak_parameter``: the breadth of a surface's spectrum, alpha = m0 m4 / m2^2 of
   its profiles (1 for a single wave, growing with the band);
 * ``relative_gap``: how far one curve is from another at the same loads.
@@ -17,14 +19,53 @@ import numpy as np
 from ..fit import percentile_interval
 
 SMALL_LOAD_FRACTION = 0.05  # contact fraction below which the area is taken to grow linearly
+KAPPA_WINDOW = (0.005, SMALL_LOAD_FRACTION)  # contact fractions where simulations find kappa of about 2 to 2.3
+FEW_SPOTS = (0.0, 0.003)  # contact fractions of a handful of spots per surface, shown apart
+# kappa in the literature: the vanishing-load limit (Bush, Gibson and Thomas), Persson's theory,
+# and what simulations find at 0.5-5 % contact
+KAPPA_BUSH = math.sqrt(2 * math.pi)
+KAPPA_PERSSON = math.sqrt(8 / math.pi)
+KAPPA_SIMULATIONS = (2.0, 2.3)
 
 
 @dataclass(frozen=True)
 class Kappa:
-    value: float
+    value: float  # nan when no load's mean contact fraction lies in the window
     interval: tuple[float, float]
-    loads: int  # load steps averaged (those of mean contact fraction <= the bound)
-    largest_fraction: float  # the mean contact fraction of the largest of them
+    loads: int  # load steps averaged (those whose mean contact fraction lies in the window)
+    largest_fraction: float  # the mean contact fraction of the largest of them (nan without any)
+
+
+@dataclass(frozen=True)
+class KappaCurve:
+    """kappa at each load (the mean over realizations, with a bootstrap band), against
+    x = p / (E* g), g the realizations' mean rms gradient, and the mean contact fraction."""
+
+    x: np.ndarray
+    value: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    fraction: np.ndarray
+
+
+def _per_load_kappa(fraction, force, area, stiffness, gradient) -> tuple[np.ndarray, np.ndarray]:
+    """(kappa per realization and load, the pressure p = F / A0 per load), checked shapes."""
+    fraction = np.atleast_2d(np.asarray(fraction, float))
+    force = np.asarray(force, float)
+    gradient = np.asarray(gradient, float).reshape(-1, 1)
+    if fraction.shape[1] != force.size or gradient.shape[0] != fraction.shape[0]:
+        raise ValueError(f"shapes differ: fraction {fraction.shape}, force {force.shape}, gradient {gradient.shape}")
+    pressure = force / area
+    return fraction * stiffness * gradient / pressure, pressure
+
+
+def _bootstrap_means(rows: np.ndarray, rng: np.random.Generator, bootstrap: int) -> np.ndarray | None:
+    """The means of ``bootstrap`` resamples of the realizations (axis 0), or None for fewer than 2."""
+    count = rows.shape[0]
+    if bootstrap <= 0 or count < 2:
+        return None
+    weights = rng.multinomial(count, np.full(count, 1.0 / count), size=bootstrap) / count
+    return weights @ rows
 
 
 def contact_area_law(
@@ -37,33 +78,55 @@ def contact_area_law(
     rng: np.random.Generator,
     bootstrap: int = 1000,
     confidence: float = 0.95,
-    max_fraction: float = SMALL_LOAD_FRACTION,
+    window: tuple[float, float] = (0.0, SMALL_LOAD_FRACTION),
 ) -> Kappa:
     """kappa = (A / A0) E* g / p per realization (rows of ``fraction``, shape
     (realizations, loads)) and load, with p = F / A0 the nominal pressure and g the
     realization's rms gradient (``gradient``); averaged over the loads whose mean contact
-    fraction is at most ``max_fraction`` (the two smallest loads if none is), then over
-    realizations, with a percentile bootstrap over realizations."""
-    fraction = np.atleast_2d(np.asarray(fraction, float))
-    force = np.asarray(force, float)
-    gradient = np.asarray(gradient, float).reshape(-1, 1)
-    if fraction.shape[1] != force.size or gradient.shape[0] != fraction.shape[0]:
-        raise ValueError(f"shapes differ: fraction {fraction.shape}, force {force.shape}, gradient {gradient.shape}")
-    pressure = force / area
-    per_load = fraction * stiffness * gradient / pressure
-    mean_fraction = fraction.mean(axis=0)
-    small = np.flatnonzero(mean_fraction <= max_fraction)
-    if small.size < 2:
-        small = np.argsort(mean_fraction)[:2]
-    per_realization = per_load[:, small].mean(axis=1)
-    value = float(per_realization.mean())
-    interval = (math.nan, math.nan)
-    rows = per_realization.size
-    if bootstrap > 0 and rows >= 2:
-        counts = rng.multinomial(rows, np.full(rows, 1.0 / rows), size=bootstrap)
-        low, high = percentile_interval(counts @ per_realization / rows, confidence)
-        interval = (float(low), float(high))
-    return Kappa(value, interval, int(small.size), float(mean_fraction[small].max()))
+    fraction lies in ``window`` (low exclusive, high inclusive), then over realizations,
+    with a percentile bootstrap over realizations. No load in the window: kappa is nan."""
+    per_load, _ = _per_load_kappa(fraction, force, area, stiffness, gradient)
+    mean_fraction = np.atleast_2d(np.asarray(fraction, float)).mean(axis=0)
+    inside = np.flatnonzero((mean_fraction > window[0]) & (mean_fraction <= window[1]))
+    if inside.size == 0:
+        return Kappa(math.nan, (math.nan, math.nan), 0, math.nan)
+    per_realization = per_load[:, inside].mean(axis=1)
+    means = _bootstrap_means(per_realization, rng, bootstrap)
+    interval = (math.nan, math.nan) if means is None else tuple(map(float, percentile_interval(means, confidence)))
+    return Kappa(float(per_realization.mean()), interval, int(inside.size), float(mean_fraction[inside].max()))
+
+
+def kappa_curve(
+    fraction: np.ndarray,
+    force: np.ndarray,
+    area: float,
+    stiffness: float,
+    gradient: np.ndarray,
+    *,
+    rng: np.random.Generator,
+    bootstrap: int = 1000,
+    confidence: float = 0.95,
+) -> KappaCurve:
+    """kappa at every load (as ``contact_area_law`` forms it per realization), its mean
+    over realizations and a percentile bootstrap band, against p / (E* g)."""
+    per_load, pressure = _per_load_kappa(fraction, force, area, stiffness, gradient)
+    value = per_load.mean(axis=0)
+    means = _bootstrap_means(per_load, rng, bootstrap)
+    low, high = (np.full(value.shape, math.nan),) * 2 if means is None else percentile_interval(means, confidence, axis=0)
+    x = pressure / (stiffness * float(np.mean(gradient)))
+    fraction = np.atleast_2d(np.asarray(fraction, float)).mean(axis=0)
+    return KappaCurve(x, value, np.asarray(low, float), np.asarray(high, float), fraction)
+
+
+def height_moments(heights: np.ndarray) -> tuple[float, float]:
+    """(skewness, kurtosis) of a surface's heights: <(z - mean)^3> / s^3 and <(z - mean)^4> / s^4
+    (0 and 3 for Gaussian heights)."""
+    z = np.asarray(heights, float).ravel()
+    z = z - z.mean()
+    variance = float(np.mean(z * z))
+    if variance == 0.0:
+        raise ValueError("the surface is flat: its skewness and kurtosis are undefined")
+    return float(np.mean(z**3)) / variance**1.5, float(np.mean(z**4)) / variance**2
 
 
 def nayak_parameter(heights: np.ndarray, spacing: float) -> float:

@@ -1,11 +1,15 @@
 """What the exact 3D study runs, and running it.
 
-For each Hurst exponent the preset ``exact3d-hXX.yaml`` is run by the exact solver it
-names on several grids of the same surface (same side, same cut-off wavelengths:
-``SpectrumGenerator.refined``), and, on each grid, MDR presses the surfaces' MDR-equivalent
-lines (the same spectrum, the same f = F / (E* h L)). Every ensemble is an ordinary run
-into its own folder (``runner.run_to_folder``): resumable, its files those of
-``frictionlab run``.
+For each Hurst exponent the preset ``exact3d-hXX.yaml`` (the main family: a long cut-off
+of a quarter of the side, so each surface self-averages) is run by the exact solver it
+names on several grids of the same surfaces (same side, same cut-off wavelengths:
+``SpectrumGenerator.refined``), and, on each grid, MDR presses the surfaces'
+MDR-equivalent lines (the same spectrum, the same f = F / (E* h L)), many lines per
+surface. Two variants run beside it: the comparison family (long cut-off = the side,
+the family the page used before) and the spectral gradient on the main family's finest
+grid. Every ensemble is an ordinary run into its own folder (``runner.run_to_folder``):
+resumable, its files those of ``frictionlab run``. The jobs run in the plan's order of
+value, so an interrupted study has the most important ensembles.
 """
 
 from __future__ import annotations
@@ -24,16 +28,18 @@ from ..files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, read_preset
 from ..registry import Registry, default_registry
-from ..rundir import STATE_FILE
+from ..rundir import STATE_FILE, RunDirectory
 from ..runfolder import read_json
 from ..runner import run_to_folder
 from ..seeds import realization_rng
 from ..signals import WorkInterrupted, interrupted_since, mark
 from ..variants import SceneFactory
-from .analysis import nayak_parameter
 
 HURSTS = (0.3, 0.5, 0.7, 0.8, 1.0)
+FIRST_HURST = 0.8  # the H whose ensembles run first, and the one with the finest extra grid
 APPROXIMATION = "mdr"  # the solver whose prediction is set beside the exact one
+MAIN, SIDE, SPECTRAL = "main", "side", "spectral"  # the families of surfaces and gradients
+MIN_PIXELS_QUOTED = 16  # pixels on the short cut-off of a grid whose numbers are quoted
 
 
 def preset_name(hurst: float) -> str:
@@ -54,33 +60,84 @@ def find_presets(presets_dir: str | Path | None, plan: Plan) -> Path:
 
 @dataclass(frozen=True)
 class Plan:
-    """Grids and ensembles of one study. The last resolution is the result's; ``extra``
-    adds finer grids for some H, ``(hurst, pixels per side, realizations)``."""
+    """Grids and ensembles of one study. ``resolutions``/``realizations``: the main family's
+    grids at every H, the last the answer's; ``extra``: finer grids for some H,
+    ``(hurst, pixels per side, realizations)``, run on the first surfaces; ``side``: the
+    comparison family's grid ``(pixels, realizations)``; ``spectral``: the main family's
+    grid and surfaces pressed again with spectral gradients; ``mdr_lines``: MDR-equivalent
+    lines pressed per surface."""
 
     name: str
     resolutions: tuple[int, ...]  # pixels per side, coarsest first
     realizations: tuple[int, ...]  # per resolution
     hursts: tuple[float, ...] = HURSTS
     extra: tuple[tuple[float, int, int], ...] = ()
+    side: tuple[int, int] | None = None
+    spectral: tuple[int, int] | None = None
+    mdr_lines: int = 1
     steps: int | None = None  # load steps (None: the preset's)
     bootstrap: int = 1000
 
     def grids(self, hurst: float) -> list[tuple[int, int]]:
-        """(pixels per side, realizations) of ``hurst``, coarsest first."""
+        """(pixels per side, realizations) of the main family at ``hurst``, coarsest first."""
         more = [(n, m) for h, n, m in self.extra if math.isclose(h, hurst)]
         return sorted([*zip(self.resolutions, self.realizations), *more])
 
+    def jobs(self) -> list[Job]:
+        """Every ensemble, most valuable first, so that an interrupted study holds the most
+        of the answer: at FIRST_HURST the main family (each grid exact, then MDR), its
+        comparison family and its spectral gradients; then the other H, the extremes first,
+        each with its comparison family; the extra grids; the other H's spectral gradients."""
+        first = [h for h in self.hursts if math.isclose(h, FIRST_HURST)]
+        rest = sorted(h for h in self.hursts if not math.isclose(h, FIRST_HURST))
+        rest = [*rest[:1], *rest[-1:], *rest[1:-1]] if len(rest) > 1 else rest
+        regular = list(zip(self.resolutions, self.realizations))
 
-FULL = Plan("full", resolutions=(128, 256, 512), realizations=(48, 32, 32), extra=((0.8, 1024, 8),))
-QUICK = Plan("quick", resolutions=(64, 128, 256), realizations=(4, 4, 4), steps=8, bootstrap=200)
+        def main(h):
+            return [Job(MAIN, h, n, m, exact) for n, m in regular for exact in (True, False)]
+
+        def side(h):
+            return [Job(SIDE, h, *self.side, exact) for exact in (True, False)] if self.side else []
+
+        def spectral(h):
+            return [Job(SPECTRAL, h, *self.spectral, True)] if self.spectral else []
+
+        jobs = [job for h in first for job in (*main(h), *side(h), *spectral(h))]
+        jobs += [job for h in rest for job in (*main(h), *side(h))]
+        jobs += [Job(MAIN, h, n, m, exact) for h, n, m in self.extra for exact in (True, False)]
+        return jobs + [job for h in rest for job in spectral(h)]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One ensemble of the plan: exact, or MDR on ``mdr_lines`` lines per surface."""
+
+    family: str
+    hurst: float
+    points: int
+    surfaces: int
+    exact: bool
+
+    def folder(self, solver: str) -> str:
+        prefix = "" if self.family == MAIN else f"{self.family}-"
+        return f"{prefix}h{self.hurst:.1f}-n{self.points}-{solver}"
+
+    def describe(self) -> str:
+        family = {MAIN: "", SIDE: "long cut-off = side, ", SPECTRAL: "spectral gradient, "}[self.family]
+        return f"H = {self.hurst:g}, {family}{self.points}² px, {'exact' if self.exact else 'MDR'}, {self.surfaces} surfaces"
+
+
+FULL = Plan("full", resolutions=(256, 512, 1024), realizations=(32, 32, 32), extra=((FIRST_HURST, 2048, 8),),
+            side=(512, 32), spectral=(1024, 8), mdr_lines=64)  # fmt: skip
+QUICK = Plan("quick", resolutions=(64, 96, 128), realizations=(4, 4, 4), side=(64, 4), spectral=(128, 2),
+             extra=((FIRST_HURST, 192, 2),), mdr_lines=4, steps=8, bootstrap=200)  # fmt: skip
 
 
 @dataclass
 class Ensemble:
     """One finished run of the study."""
 
-    hurst: float
-    points: int  # pixels per side
+    job: Job
     solver: str
     scene: Scene
     outcome: RunOutcome
@@ -88,34 +145,60 @@ class Ensemble:
     spacing: float  # pixel size
     short_cutoff: float  # wavelengths, in the preset's length unit
     long_cutoff: float
-    nayak: float  # of the surface (realization 0)
+
+    @property
+    def hurst(self) -> float:
+        return self.job.hurst
+
+    @property
+    def points(self) -> int:
+        return self.job.points
+
+    @property
+    def family(self) -> str:
+        return self.job.family
 
     @property
     def exact(self) -> bool:
-        return self.solver != APPROXIMATION
+        return self.job.exact
 
     @property
     def pixels_per_short_cutoff(self) -> float:
         return self.short_cutoff / self.spacing
+
+    @property
+    def quoted(self) -> bool:
+        """Whether the grid resolves the short cut-off well enough for its numbers to be quoted."""
+        return self.pixels_per_short_cutoff >= MIN_PIXELS_QUOTED * (1 - 1e-9)
 
 
 @dataclass
 class StudyRuns:
     plan: Plan
     ensembles: list[Ensemble] = field(default_factory=list)
+    missing: list[Job] = field(default_factory=list)  # jobs of the plan that have not finished
     seconds: float = 0.0
 
-    def find(self, hurst: float, points: int | None = None, exact: bool = True) -> Ensemble | None:
-        """The ensemble of ``hurst`` on ``points`` pixels (default: the plan's finest
-        resolution), exact or MDR."""
-        points = self.plan.resolutions[-1] if points is None else points
+    def find(self, hurst: float, points: int | None = None, exact: bool = True, family: str = MAIN) -> Ensemble | None:
+        """The finished ensemble of ``hurst`` on ``points`` pixels (default: the finest
+        finished regular grid of the main family), exact or MDR; None if it did not run."""
+        if points is None:
+            grids = [e.points for e in self.exact_grids(hurst) if e.points in self.plan.resolutions]
+            if not grids:
+                return None
+            points = grids[-1]
         for e in self.ensembles:
-            if math.isclose(e.hurst, hurst) and e.points == points and e.exact == exact:
+            if math.isclose(e.hurst, hurst) and e.points == points and e.exact == exact and e.family == family:
                 return e
         return None
 
-    def exact_grids(self, hurst: float) -> list[Ensemble]:
-        return sorted((e for e in self.ensembles if e.exact and math.isclose(e.hurst, hurst)), key=lambda e: e.points)
+    def exact_grids(self, hurst: float, family: str = MAIN) -> list[Ensemble]:
+        return sorted((e for e in self.ensembles if e.exact and e.family == family and math.isclose(e.hurst, hurst)),
+                      key=lambda e: e.points)  # fmt: skip
+
+    def hursts(self) -> list[float]:
+        """The H whose main family has a finished exact grid and MDR beside it."""
+        return [h for h in self.plan.hursts if self.find(h) is not None and self.find(h, exact=False) is not None]
 
 
 def _cutoffs(scene: Scene) -> tuple[float, float, float]:
@@ -127,65 +210,87 @@ def _cutoffs(scene: Scene) -> tuple[float, float, float]:
     return profile.spacing, float(short), float(params.get("long_cutoff") or side)
 
 
+def _scene(factory: SceneFactory, job: Job, plan: Plan) -> Scene:
+    """The scene of ``job``: the preset refined to the job's grid, with its family's changes."""
+    base = factory.base
+    changes = {f"spectrum.params.{k}": v for k, v in base.spectrum.refined(job.points).items()}
+    if job.family == SIDE:
+        changes["spectrum.params.long_cutoff"] = changes["spectrum.params.length"]
+    if job.family == SPECTRAL:
+        changes["slope.name"] = "spectral"
+    changes.update({"realizations": job.surfaces, "fit.bootstrap": plan.bootstrap})
+    if plan.steps is not None:
+        changes["loading.steps"] = plan.steps
+    if not job.exact:  # the equivalent line depends on the surface only through its spectrum
+        changes.update({"solver": factory.solver_choice(APPROXIMATION), "realizations": job.surfaces * plan.mdr_lines})
+    return factory.make(changes)
+
+
+def finished(folder: Path) -> bool:
+    """Whether ``folder`` holds a run that completed (its manifest says so)."""
+    try:
+        state = RunDirectory(folder).state() if (folder / STATE_FILE).is_file() else None
+    except FrictionlabError:
+        return False
+    return bool(state) and state.get("status") == "completed"
+
+
 def run_plan(
     presets_dir: Path,
     runs_dir: Path,
     plan: Plan,
     options: RunOptions = RunOptions(),
     *,
+    compute: bool = True,
     registry: Registry | None = None,
     log: Callable[[str], None] = lambda text: None,
 ) -> StudyRuns:
-    """Run every ensemble of ``plan`` into ``runs_dir/<H>-<pixels>-<solver>/``; a folder
-    left by an earlier run of the same plan is resumed (nothing finished runs again)."""
+    """Run every ensemble of ``plan`` into ``runs_dir/<family->H-<pixels>-<solver>/``, in
+    the plan's order; a folder left by an earlier run of the same plan is resumed (nothing
+    finished runs again). Without ``compute`` only the finished ensembles are read back,
+    and the others are listed in ``StudyRuns.missing``."""
     registry = registry or default_registry()
     runs = StudyRuns(plan)
     started = time.perf_counter()
+    factories: dict[float, SceneFactory] = {}
     try:
-        for hurst in plan.hursts:
-            path = Path(presets_dir) / preset_name(hurst)
-            if not path.is_file():
-                raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
-            factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
-            base = factory.base
-            approximation = factory.solver_choice(APPROXIMATION)
-            for points, realizations in plan.grids(hurst):
-                changes = {f"spectrum.params.{k}": v for k, v in base.spectrum.refined(points).items()}
-                changes.update({"realizations": realizations, "fit.bootstrap": plan.bootstrap})
-                if plan.steps is not None:
-                    changes["loading.steps"] = plan.steps
-                exact = factory.make(changes)
-                spacing, short, long = _cutoffs(exact)
-                alpha = nayak_parameter(exact.spectrum.generate(realization_rng(exact.preset.seed, 0)).heights, spacing)
-                for solver_choice in (None, approximation):
-                    scene = exact if solver_choice is None else factory.make({**changes, "solver": solver_choice})
-                    folder = Path(runs_dir) / f"h{hurst:.1f}-n{points}-{scene.solver.name}"
-                    resume = (folder / STATE_FILE).is_file()
-                    log(f"exact3d: H = {hurst}, {points}^2 pixels, {scene.solver.name}, {realizations} realizations"
-                        + (" (resumed)" if resume else ""))  # fmt: skip
-                    seen = mark()
-                    outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
-                    if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
-                        raise KeyboardInterrupt
-                    if outcome.status != "completed":
-                        raise FrictionlabError(
-                            f"the run in {folder} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
-                            + "; run the command again with the same --runs to resume it"
-                        )  # fmt: skip
-                    runs.ensembles.append(
-                        Ensemble(hurst, points, scene.solver.name, scene, outcome, folder, spacing, short, long, alpha)
-                    )
+        for job in plan.jobs():
+            if job.hurst not in factories:
+                path = Path(presets_dir) / preset_name(job.hurst)
+                if not path.is_file():
+                    raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
+                factories[job.hurst] = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+            scene = _scene(factories[job.hurst], job, plan)
+            folder = Path(runs_dir) / job.folder(scene.solver.name)
+            if not compute and not finished(folder):
+                runs.missing.append(job)
+                continue
+            resume = (folder / STATE_FILE).is_file()
+            log(f"exact3d: {job.describe()}" + (" (resumed)" if resume else ""))
+            seen = mark()
+            outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
+            if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
+                raise KeyboardInterrupt
+            if outcome.status != "completed":
+                raise FrictionlabError(
+                    f"the run in {folder} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
+                    + "; run the command again with the same --runs to resume it"
+                )  # fmt: skip
+            spacing, short, long = _cutoffs(scene)
+            runs.ensembles.append(Ensemble(job, scene.solver.name, scene, outcome, folder, spacing, short, long))
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
         raise WorkInterrupted(
             f"the ensembles that finished are kept in {runs_dir}; run the command again with --runs {runs_dir} to resume"
         ) from None
-    runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started)
+    finally:  # the time of an invocation that computed counts in the study's, however it ended
+        if Path(runs_dir).is_dir():
+            runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started if compute else 0.0)
     return runs
 
 
 TIME_FILE = "exact3d-time.json"
 TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
-ENSEMBLE_FOLDER = re.compile(r"h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # the folder of one ensemble, as run_plan names it
+ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
 
 
 def check_runs_folder(runs_dir: Path, *, force: bool, own: tuple[str, ...] = ()) -> None:

@@ -3,7 +3,6 @@ exact-3d-law.md with its figures (exact-3d-law/*.png) beside it."""
 
 from __future__ import annotations
 
-import math
 import os
 import platform
 from collections.abc import Callable
@@ -12,21 +11,46 @@ from pathlib import Path
 import numpy as np
 
 from ..dask_session import one_dask_cluster
-from ..errors import OutputRefused
+from ..errors import FrictionlabError, OutputRefused
 from ..files import atomic_write, output_path_problem
 from ..listeners import format_duration
 from ..options import RunOptions
 from ..rundir import new_run_folder
-from ..seeds import bootstrap_rng, realization_rng
+from ..seeds import realization_rng
 from ..signals import WorkInterrupted
-from .analysis import SMALL_LOAD_FRACTION, Kappa, contact_area_law
-from .figures import plot_convergence, plot_xi_against_f
-from .markdown import YASTREBOV, answer, convergence_table, ensemble_text, law_table, paired_extra_grids
-from .plan import FULL, QUICK, Plan, StudyRuns, check_runs_folder, find_presets, preset_name, run_plan
+from .figures import plot_convergence, plot_kappa, plot_xi_against_f
+from .markdown import (
+    FEW_TEXT,
+    WINDOW_TEXT,
+    YASTREBOV,
+    answer,
+    convergence_table,
+    convergence_text,
+    ensemble_text,
+    gradient_text,
+    law_table,
+    missing_text,
+    paired_table,
+    plan_status,
+    self_averaging_text,
+    surfaces_table,
+)
+from .numbers import Numbers, study_numbers
+from .plan import (
+    FULL,
+    MIN_PIXELS_QUOTED,
+    QUICK,
+    Plan,
+    StudyRuns,
+    check_runs_folder,
+    find_presets,
+    preset_name,
+    run_plan,
+)
 
 PAGE = "exact-3d-law.md"
 FIGURES_DIR = "exact-3d-law"
-FIGURES = ("xi-vs-f.png", "convergence.png")
+FIGURES = ("xi-vs-f.png", "kappa.png", "convergence.png")
 
 
 def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
@@ -42,29 +66,11 @@ def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
     return page, figures
 
 
-def kappas_of(runs: StudyRuns) -> dict[tuple[float, int], Kappa]:
-    """kappa of every exact ensemble, from its per-realization contact counts."""
-    found = {}
-    for e in runs.ensembles:
-        if not e.exact:
-            continue
-        o = e.outcome
-        length = o.force_unit / (o.stiffness * o.rms_height)  # L of f = F / (E* h L)
-        area = math.pi * (length / 2) ** 2  # L = 2 sqrt(A / pi)
-        pixels = e.points**2  # the study's grids are square
-        found[(e.hurst, e.points)] = contact_area_law(
-            o.per_realization["contact_count"] / pixels, o.force, area, o.stiffness,
-            o.per_realization["slope_rms_line"], rng=bootstrap_rng(e.scene.preset.seed),
-            bootstrap=runs.plan.bootstrap,
-        )  # fmt: skip
-    return found
-
-
 def same_surfaces(runs: StudyRuns) -> bool:
-    """Whether the coarsest and the finest grid of the first H hold the same surface
+    """Whether the coarsest and the finest finished grid of the first H hold the same surface
     (realization 0) at the coarse grid's points."""
-    hurst = runs.plan.hursts[0]
-    coarse, fine = runs.find(hurst, runs.plan.resolutions[0]), runs.find(hurst)
+    grids = runs.exact_grids(runs.hursts()[0])
+    coarse, fine = grids[0], grids[-1]
     heights = [e.scene.spectrum.generate(realization_rng(e.scene.preset.seed, 0)).heights for e in (coarse, fine)]
     stride = fine.points // coarse.points
     sampled = heights[1][::stride, ::stride]
@@ -89,6 +95,7 @@ def write_page(
     *,
     runs_dir: str | Path | None = None,
     quick: bool = False,
+    finished_only: bool = False,
     presets_dir: str | Path | None = None,
     options: RunOptions = RunOptions(),
     plan: Plan | None = None,
@@ -98,9 +105,13 @@ def write_page(
 ) -> Path:
     """Run the study (``QUICK`` or ``FULL``, or ``plan``) and write the page and its figures
     into ``out_dir`` (default: the runs folder). Runs go to ``runs_dir`` (default: a new
-    ``runs/exact3d-<timestamp>``); giving an earlier one resumes it. Returns the page's path."""
+    ``runs/exact3d-<timestamp>``); giving an earlier one resumes it. ``finished_only``: run
+    nothing, write the page from the ensembles of ``runs_dir`` that finished (the page lists
+    the others). Returns the page's path."""
     plan = plan or (QUICK if quick else FULL)
-    command = command or _command(quick, out_dir, runs_dir)
+    if finished_only and not runs_dir:
+        raise FrictionlabError("--finished-only writes the page from the runs of an earlier study: give its --runs DIR")
+    command = command or _command(quick, out_dir, runs_dir, finished_only)
     if out_dir:  # refused before a default runs folder is made
         page_paths(Path(out_dir), force=options.force)
     if runs_dir:
@@ -110,34 +121,42 @@ def write_page(
     page, figures = page_paths(out_dir, force=options.force)
     try:
         with one_dask_cluster(options):  # on Dask, every ensemble's run uses one client and cluster
-            runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, log=log)
+            runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, compute=not finished_only, log=log)
     except WorkInterrupted as exc:
         raise WorkInterrupted(f"{exc}; no page written") from None
-    kappas = kappas_of(runs)
+    if not runs.hursts():
+        raise FrictionlabError(
+            f"{runs_dir} holds no finished exact ensemble with MDR beside it: nothing to write a page from; "
+            f"run the study (without --finished-only) with --runs {runs_dir}"
+        )
+    numbers = study_numbers(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
-    atomic_write(figures / FIGURES[0], lambda fh: plot_xi_against_f(runs, fh, kappas, dpi=dpi), binary=True)
-    atomic_write(figures / FIGURES[1], lambda fh: plot_convergence(runs, fh, dpi=dpi), binary=True)
-    text = page_text(runs, kappas, command, machine())
+    for name, plot in zip(FIGURES, (plot_xi_against_f, plot_kappa, plot_convergence)):
+        atomic_write(figures / name, lambda fh, plot=plot: plot(runs, numbers, fh, dpi=dpi), binary=True)
+    text = page_text(runs, numbers, command, machine(), _command(quick, out_dir, runs_dir, False))
     atomic_write(page, lambda fh: fh.write(text))
     return page
 
 
-def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | None) -> str:
+def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | None, finished_only: bool) -> str:
     """The command that regenerates the page: with the runs folder it was given, so
     that rerunning it reads those runs back instead of computing them again."""
     return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {out_dir}" if out_dir else "")
-            + (f" --runs {runs_dir}" if runs_dir else "") + " --force")  # fmt: skip
+            + (f" --runs {runs_dir}" if runs_dir else "") + (" --finished-only" if finished_only else "")
+            + " --force")  # fmt: skip
 
 
-def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) -> str:
+def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str, finish_command: str) -> str:
     plan = runs.plan
-    finest = runs.find(plan.hursts[0])
-    o = finest.outcome
-    realizations = ", ".join(f"{m} on {n}²" for n, m in zip(plan.resolutions, plan.realizations))
-    extra = "".join(f"; {m} on {n}² at H = {h:g}" for h, n, m in plan.extra)
+    first = runs.find(runs.hursts()[0])
+    o = first.outcome
     figures = FIGURES_DIR
     presets = ", ".join(f"`presets/{preset_name(h)}`" for h in plan.hursts)
-    tolerance = finest.scene.solver.tolerance()
+    tolerance = first.scene.solver.tolerance()
+    side = first.spacing * first.points
+    grids = sorted({e.points for e in runs.ensembles if e.exact})
+    finish = ([f"The plan's other ensembles are computed (and this page written again) by `{finish_command}`, "
+               "which resumes the finished ones without computing them again.", ""] if runs.missing else [])  # fmt: skip
     lines = [
         "# The exact 3D law",
         "",
@@ -151,89 +170,124 @@ def page_text(runs: StudyRuns, kappas: dict, command: str, machine_text: str) ->
         command,
         "```",
         "",
-        f"This run ({plan.name} plan) took **{format_duration(runs.seconds)}** (wall time of the study, summed over "
-        f"the invocations that ran it) on {machine_text}, with "
-        f"{o.workers} worker process(es) per ensemble on a machine shared with other jobs. "
-        + ("`--quick` runs the same pipeline on smaller grids and ensembles in a few minutes; its numbers are "
-           "not converged." if plan.name == "quick" else
-           "`--quick` runs the same pipeline on smaller grids and ensembles in a few minutes (its numbers are "
-           "not converged); the full plan was sized to finish in tens of minutes on two shared cores."),
+        *finish,
+        f"The study ({plan.name} plan) took **{format_duration(runs.seconds)}** of wall time (summed over the "
+        f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of each ensemble (its surfaces' solve times summed) is "
+        "in the convergence table. "
+        + ("`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core: **its numbers are "
+           "not converged** and answer nothing." if plan.name == "quick" else
+           "`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core (not converged)."),
+        "",
+        "## What ran",
+        "",
+        *plan_status(runs),
+        "",
+        missing_text(runs),
         "",
         "## The answer",
         "",
-        *answer(runs, kappas),
+        *answer(runs, numbers),
         "",
-        f"![xi against f for each H, exact on every grid and MDR on the same surfaces]({figures}/xi-vs-f.png)",
+        f"![xi against f for each H: exact on every grid, MDR and the comparison family; per-surface skewness]"
+        f"({figures}/{FIGURES[0]})",
         "",
         "These surfaces are not the source study's lines: there the MDR line had 10^5 points and f was of order "
-        "1e-9, a few points in contact; here f = F / (E* h L) runs over "
-        f"{o.f.min():.3g} to {o.f.max():.3g} on surfaces whose band spans a factor "
-        f"{finest.long_cutoff / finest.short_cutoff:g} in wavelength, from a few tenths of a percent to tens of "
-        "percent of real contact. The study's 3D law (a about 2.9, b about 0.14 near H = 0.7) belongs to its regime; "
-        "the numbers here belong to this one, exact and MDR alike.",
+        f"1e-9, a few points in contact; here f = F / (E* h L) runs over {o.f.min():.3g} to {o.f.max():.3g}, from "
+        f"{o.real_area_corrected.min():.2%} to {o.real_area_corrected.max():.1%} of real contact on the main family. "
+        "The source study's 3D law (a about 2.9, b about 0.14 near H = 0.7) belongs to its regime; the numbers here "
+        "belong to this one, exact and MDR alike.",
         "",
-        f"## The law on the finest grid ({plan.resolutions[-1]}² pixels)",
+        "## The law",
         "",
         "ξ = rms |∇z| over the contact pixels / rms |∇z| over the whole surface (both components of the "
         "gradient, forward differences), averaged over the surfaces at each load; a and b are the least-squares "
         "fit of ξ = a + b ln f to that mean curve, with 95 % percentile-bootstrap intervals over the surfaces. "
-        "MDR presses the MDR-equivalent line of each surface's spectrum (the same mean square height and "
-        "gradient, length L) at the same loads, so at the same f. κ: below.",
+        f"Each H is quoted on its finest grid that finished; a grid with fewer than {MIN_PIXELS_QUOTED} pixels on "
+        "the short cut-off is marked and not quoted. The Nayak parameter is the mean over the surfaces.",
         "",
-        *law_table(runs, kappas),
+        *law_table(runs, numbers),
+        "",
+        "## The real contact area and κ",
+        "",
+        "A contact pixel counts whole although the contact's edge crosses it, so the pixel count overestimates the "
+        "real area by a strip along the perimeter, an error that shrinks only as one over the resolution. The area "
+        f"here is corrected as {YASTREBOV} do: A* = N - c M pixels, N those in contact, M the edges between a "
+        "contact and a free pixel along rows and columns, c = (π - 1 + ln 2) / 24 = 0.118 (the column "
+        "`real_area_corrected` of every `bem-halfspace` run). On a Hertz contact with 20 pixels on its radius it "
+        "brings the area within 0.6 % of π a² where the count is 1 % to 1.5 % over "
+        "(`tests/test_contact_area.py`).",
+        "",
+        f"κ = (A / A0) E* rms|∇z| / p, p = F / A0 the nominal pressure and rms|∇z| each surface's own (forward "
+        f"differences, as in ξ), per surface and load, then averaged: over the loads whose mean contact fraction "
+        f"is {WINDOW_TEXT} for the number quoted, and below {FEW_TEXT} apart (a handful of spots per surface, where "
+        "κ approaches its vanishing-load limit only slowly and the count of a few spots is noisy). The figure shows "
+        "κ at every load against p / (E* rms|∇z|), with its 95 % bootstrap band, on every grid, the pixel count's "
+        "κ on the finest grid for comparison, and the literature: √(2π) = 2.51 at vanishing load (Bush, Gibson and "
+        "Thomas 1975), √(8/π) = 1.60 in Persson's theory, and about 2 to 2.3 in simulations at 0.5 % to 5 % "
+        "contact, falling slowly with load and with the Nayak parameter (Hyun et al. 2004; Campañá and Müser 2007; "
+        "Prodanov, Dapp and Müser 2014; Yastrebov, Anciaux and Molinari 2017; van Dokkum et al. 2018).",
+        "",
+        f"![kappa against p / (E* rms gradient) for each H, with the literature]({figures}/{FIGURES[1]})",
+        "",
+        "## Surfaces that self-average",
+        "",
+        f"The main family's long cut-off is {first.long_cutoff:g}, a quarter of the side {side:g}: each surface "
+        "holds 16 cells of its longest wave and its heights are close to Gaussian one by one. The comparison "
+        "family, the same spectrum with the long cut-off at the side, is dominated by its few longest waves. "
+        "Skewness and kurtosis are those of each surface's heights (0 and 3 for a Gaussian); the Nayak parameter "
+        "α = m0 m4 / m2² of its profiles (m_n the spectral moments; 1 for a single wave, growing with the band). "
+        "They are computed from each surface on its family's coarsest grid that ran (the same modes as on the "
+        "finer grids).",
+        "",
+        *surfaces_table(runs, numbers),
+        "",
+        self_averaging_text(runs, numbers),
+        "",
+        "## MDR on the same surfaces",
+        "",
+        "MDR presses a line of springs, the MDR-equivalent line of the surface (length L = 2 √(A/π), spectrum "
+        "C1D(q) = π q C2D(q), the same mean square height and gradient), at the same loads, so at the same f. That "
+        "line depends on a surface only through its spectrum, which all surfaces of a family share: one random "
+        f"line per surface is noisy, so each surface's prediction is averaged over {plan.mdr_lines} lines "
+        f"({plan.mdr_lines} times the surfaces in each MDR ensemble). MDR is built to keep the force against the "
+        "approach; it does not keep the real area, and its fraction of springs in contact is not one. "
+        + ensemble_text(runs),
         "",
         "## Convergence in the grid",
         "",
-        f"Each surface has side {finest.spacing * finest.points:g} (length units), rms height 1, long cut-off "
-        f"the side ({finest.long_cutoff:g}) and short cut-off λs = {finest.short_cutoff:g}; the grids sample the "
-        + ("same surfaces (the same modes and random phases: a grid's heights are those of a finer one at its "
-           "points) with " if same_surfaces(runs) else "same spectrum (not the same surfaces: the coarsest grid "
-           "holds the short cut-off at its Nyquist mode, drawn otherwise) with ")
-        + f"{', '.join(f'{n}²' for n in plan.resolutions)} pixels"
-        + "".join(f" (and {n}² at H = {h:g})" for h, n, _ in plan.extra)
-        + ", that is "
-        + ", ".join(f"{n * finest.short_cutoff / (finest.spacing * finest.points):g}" for n in plan.resolutions)
-        + " pixels on the short cut-off λs. The loads, "
-        f"F = {o.force.min():g} to {o.force.max():g} in {o.force.size} log steps, are the same f = "
-        f"{o.f.min():.3g} to {o.f.max():.3g} on every grid.",
+        f"The grids sample the same surfaces ({'the same modes and random phases: a grid' + chr(39) + 's heights are those of a finer one at its points' if same_surfaces(runs) else 'the same spectrum'}) "
+        f"with {', '.join(f'{n}²' for n in grids)} pixels, that is "
+        + ", ".join(f"{n * first.short_cutoff / side:g}" for n in grids)
+        + f" pixels on the short cut-off λs = {first.short_cutoff:g}. The loads, F = {o.force.min():g} to "
+        f"{o.force.max():g} in {o.force.size} log steps, are the same f on every grid. The compute time is the "
+        "surfaces' solve times summed (seconds of one core), kept in the run folders.",
         "",
-        f"The real contact area on a grid carries a discretisation error that decays slowly as the pixels on the "
-        f"short cut-off grow; {YASTREBOV} show how to measure and correct it, and that the growth of the area "
-        "with load depends on the breadth of the spectrum, measured by the Nayak parameter α = m0 m4 / m2² "
-        "(m_n the spectral moments of a profile; 1 for a single wave, large for a broad band). The α of these "
-        "surfaces is in the first table (computed from the spectrum of one surface of each grid). Here the "
-        "convergence is shown, not corrected: the same a, b and κ on each grid. The compute time is the "
-        "surfaces' solve times summed (seconds of one core), kept in the run folders, so a regenerated page "
-        "shows what the runs cost, not what reading them back took.",
+        *convergence_table(runs, numbers),
         "",
-        *convergence_table(runs, kappas),
+        f"![a, b and kappa against the pixels on the short cut-off]({figures}/{FIGURES[2]})",
         "",
-        f"![a and b against the pixels on the short cut-off]({figures}/convergence.png)",
+        convergence_text(runs, numbers),
         "",
-        *paired_extra_grids(runs),
+        *paired_table(numbers.extra, "grid"),
         "",
-        f"Ensemble sizes: {realizations}{extra}. " + ensemble_text(runs),
+        gradient_text(numbers),
         "",
-        "## Known-answer check: the contact area at small loads",
-        "",
-        f"At small loads the real contact area grows as A / A0 = κ p / (E* rms|∇z|), p = F / A0 the nominal "
-        f"pressure; κ is about 1.6 in Persson's theory and about 2 in simulations. Here κ = (A/A0) E* rms|∇z| / p "
-        f"per surface, averaged over the loads where the mean contact fraction is at most {SMALL_LOAD_FRACTION:.0%} "
-        "(the two smallest loads if none is), then over the surfaces, with a bootstrap interval; rms|∇z| is the "
-        "whole surface's, with the same forward differences as ξ.",
+        *paired_table(numbers.spectral, "grid, gradient"),
         "",
         "## The solver under it",
         "",
-        f"`bem-halfspace`: FFT boundary elements (surface stiffness E*|q|/2) and the constrained conjugate "
-        f"gradient of Polonsky and Keer, at its default tolerance ({tolerance:g} of the rms height). Its closed-form "
-        "tests (`tests/test_bem_closed_forms.py`): a Hertz sphere on the periodic half-space (contact radius and "
+        f"`bem-halfspace`: FFT boundary elements (surface stiffness E*|q|/2) and a constrained conjugate gradient, "
+        f"at its default tolerance ({tolerance:g} of the rms height). Its closed-form tests "
+        "(`tests/test_bem_closed_forms.py`): a Hertz sphere on the periodic half-space (contact radius and "
         "approach against Hertz's, under force and indentation control), the Westergaard wave (full-contact "
         "pressure p* and the force under indentation control), a doubly sinusoidal surface (full-contact pressure "
-        "exact; each peak Hertzian at small loads), and the Hertz cylinder on the half-plane.",
+        "exact; each peak Hertzian at small loads), and the Hertz cylinder on the half-plane; the corrected area "
+        "against Hertz's π a² (`tests/test_contact_area.py`).",
         "",
-        f"The presets are {presets}; each runs alone as `frictionlab run presets/exact3d-h08.yaml`. "
+        f"The presets are {presets}; each runs alone as `frictionlab run presets/exact3d-h08.yaml` (its 1024² grid). "
         "The exact runs are ordinary runs: processes or Dask, the memory estimate before the start, resumable "
-        "(`--runs` of an interrupted study resumes every ensemble).",
+        "(`--runs` of an interrupted study resumes every ensemble, and `--finished-only` writes the page from "
+        "those that finished).",
         "",
     ]
     return "\n".join(lines)

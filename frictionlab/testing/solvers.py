@@ -48,7 +48,9 @@ def check_solver(cls, **params) -> None:
     loads within 1 %); force and indentation do not decrease with load; contact
     counts are whole numbers, do not decrease with load, and lie in 1 .. N;
     ``contact_fraction == contact_count / N`` (the fraction of points, of the
-    real contact or of MDR springs as ``contact_measure`` says); ``slope_rms_contact`` is >= 0 and
+    real contact or of MDR springs as ``contact_measure`` says); ``real_area_corrected`` is
+    given exactly when ``corrected_area`` is True, and then lies in (0, contact_fraction];
+    ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
     ``stiffness()`` is finite and > 0. The declarations: the forces come from
@@ -117,6 +119,15 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             value = getattr(curve, name)
             floating = name != "contact_count"
             arrays[name] = check_array(cls, f"{where}.{name}", np.asarray(value), loads.shape, floating)
+        corrected = curve.real_area_corrected
+        if (corrected is not None) != cls.corrected_area:
+            fail(cls, f"{where}.real_area_corrected must be given exactly when corrected_area is True "
+                      f"(it is {cls.corrected_area!r}). Got {corrected!r}.")  # fmt: skip
+        if corrected is not None:
+            corrected = check_array(cls, f"{where}.real_area_corrected", np.asarray(corrected), loads.shape, True)
+            if np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12)):
+                fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
+                          f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")

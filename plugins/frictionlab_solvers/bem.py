@@ -34,6 +34,7 @@ from pydantic import Field
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
 from .checks import check_control, check_loads, check_profile
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, corrected_area_fraction
 from .contact_cg import NotConverged, ProjectedCG, cold_start
 from .elastic import ElasticParams, PeriodicHalfSpace, elastic_stiffness
 
@@ -109,6 +110,7 @@ class PeriodicBEM(ContactSolver):
         force = np.empty(steps)
         indentation = np.empty(steps)
         count = np.empty(steps, dtype=np.int64)
+        corrected = np.ones(steps) if self.corrected_area else None  # full contact: no edge to correct
         slope_rms = np.empty(steps)
         iterations = np.zeros(steps, dtype=np.int64)
         residual = np.zeros(steps)
@@ -125,6 +127,7 @@ class PeriodicBEM(ContactSolver):
                 contact_count=np.full(steps, points, dtype=np.int64),
                 contact_fraction=np.ones(steps),
                 slope_rms_contact=np.full(steps, line_rms),
+                real_area_corrected=corrected,
                 extras={"iterations": iterations, "residual": residual},
             )
 
@@ -184,6 +187,8 @@ class PeriodicBEM(ContactSolver):
             contact = pressure > 0.0
             n = int(np.count_nonzero(contact))
             count[j] = n
+            if corrected is not None and n < points:
+                corrected[j] = corrected_area_fraction(contact)
             if control == "force":
                 force[j] = load
                 indentation[j] = approach * scale
@@ -202,6 +207,7 @@ class PeriodicBEM(ContactSolver):
             contact_count=count,
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
+            real_area_corrected=corrected,
             extras={"iterations": iterations, "residual": residual},
         )
 
@@ -225,3 +231,6 @@ class BEMHalfSpace(PeriodicBEM):
     dimensions: ClassVar[tuple[int, ...]] = (2,)
     normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
     problem: ClassVar[str] = "elastic half-space"
+    references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER, YASTREBOV_ANCIAUX_MOLINARI)
+    # the pixel count's perimeter correction (contact_area.py) is derived for a surface's pixel edges
+    corrected_area: ClassVar[bool] = True

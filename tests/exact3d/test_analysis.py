@@ -6,7 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.exact3d.analysis import SMALL_LOAD_FRACTION, contact_area_law, nayak_parameter, relative_gap
+from frictionlab.exact3d.analysis import (
+    KAPPA_WINDOW, SMALL_LOAD_FRACTION, contact_area_law, height_moments, kappa_curve, nayak_parameter, relative_gap,
+)
 from frictionlab.preset import build_scene
 from frictionlab.seeds import realization_rng
 
@@ -41,6 +43,50 @@ def test_kappa_uses_only_the_small_loads_and_is_unit_free():
     s, m = 7.0, 3.0
     scaled = contact_area_law(fraction, force * m * s**2, 1e4 * s**2, m, gradient, rng=np.random.default_rng(0))
     assert scaled.value == pytest.approx(kappa.value, rel=1e-12)
+
+
+def test_kappa_in_a_window_uses_only_its_loads_and_none_is_nan():
+    force = np.geomspace(1.0, 1000.0, 12)
+    gradient = np.array([0.1, 0.12, 0.08, 0.11])
+    fraction = law_fractions(2.2, force, 1e4, 1.0, gradient)
+    mean = fraction.mean(axis=0)
+    inside = (mean > KAPPA_WINDOW[0]) & (mean <= KAPPA_WINDOW[1])
+    assert inside.any() and not inside.all()
+    fraction[:, mean > KAPPA_WINDOW[1]] *= 1.4  # off the law outside the window (and still outside it):
+    fraction[:, mean <= KAPPA_WINDOW[0]] *= 0.5  # these loads must not count
+    kappa = contact_area_law(fraction, force, 1e4, 1.0, gradient, rng=np.random.default_rng(0), window=KAPPA_WINDOW)
+    assert kappa.value == pytest.approx(2.2, rel=1e-12) and kappa.loads == int(inside.sum())
+    none = contact_area_law(fraction, force, 1e4, 1.0, gradient, rng=np.random.default_rng(0), window=(0.9, 1.0))
+    assert math.isnan(none.value) and none.loads == 0
+
+
+def test_the_kappa_curve_is_kappa_at_each_load_against_p_over_e_g():
+    rng = np.random.default_rng(2)
+    force = np.geomspace(1.0, 30.0, 5)
+    gradient = rng.uniform(0.08, 0.12, 30)
+    per_surface = rng.normal(2.0, 0.1, 30)
+    trend = 1 - 0.05 * np.arange(5)  # kappa falling with load
+    fraction = per_surface[:, None] * trend[None, :] * (force / 1e4)[None, :] / (3.0 * gradient[:, None])
+    curve = kappa_curve(fraction, force, 1e4, 3.0, gradient, rng=np.random.default_rng(0), bootstrap=2000)
+    np.testing.assert_allclose(curve.value, per_surface.mean() * trend, rtol=1e-12)
+    np.testing.assert_allclose(curve.x, force / 1e4 / (3.0 * gradient.mean()), rtol=1e-12)
+    half = 1.96 * per_surface.std(ddof=1) / math.sqrt(30) * trend
+    np.testing.assert_allclose(curve.high - curve.value, half, rtol=0.3)
+    np.testing.assert_allclose(curve.value - curve.low, half, rtol=0.3)
+    np.testing.assert_allclose(curve.fraction, fraction.mean(axis=0), rtol=1e-12)
+
+
+def test_height_moments_of_known_distributions():
+    rng = np.random.default_rng(3)
+    gauss = rng.standard_normal((400, 400))
+    skew, kurt = height_moments(gauss)
+    assert abs(skew) < 0.02 and kurt == pytest.approx(3.0, abs=0.04)
+    two_levels = np.array([0.0, 0.0, 0.0, 1.0])  # p = 1/4: skew (1 - 2p) / sqrt(p q), kurtosis (1 - 3pq) / (pq)
+    skew, kurt = height_moments(two_levels * 5 + 2)
+    assert skew == pytest.approx(0.5 / math.sqrt(3 / 16), rel=1e-12)
+    assert kurt == pytest.approx((1 - 9 / 16) / (3 / 16), rel=1e-12)
+    with pytest.raises(ValueError, match="flat"):
+        height_moments(np.ones((4, 4)))
 
 
 def test_kappa_interval_brackets_the_mean_of_scattered_surfaces():
@@ -98,3 +144,20 @@ def test_a_span_prints_one_value_when_its_ends_print_alike():
 
     assert _span([0.995, 0.996, 1.0], ".0%") == "100%"
     assert _span([0.85, 0.91, 0.88], ".2f") == "0.85 to 0.91"
+
+
+@pytest.mark.parametrize(
+    "value, interval, place",
+    [(2.1, (2.0, 2.2), "within the simulations' 2 to 2.3"),
+     (2.33, (2.28, 2.38), "at the upper edge of the simulations' 2 to 2.3"),
+     (2.4, (2.35, 2.45), "above the simulations' 2 to 2.3, below the vanishing-load limit 2.51"),
+     (2.55, (2.45, 2.65), "above the simulations' 2 to 2.3, at the vanishing-load limit 2.51"),
+     (2.7, (2.6, 2.8), "above even the vanishing-load limit 2.51"),
+     (1.8, (1.7, 1.9), "below the simulations' 2 to 2.3, above Persson's 1.60"),
+     (1.5, (1.4, 1.55), "below Persson's 1.60")],
+)  # fmt: skip
+def test_kappa_is_placed_against_the_literature(value, interval, place):
+    from frictionlab.exact3d.analysis import Kappa
+    from frictionlab.exact3d.markdown import kappa_place
+
+    assert place in kappa_place(Kappa(value, interval, 3, 0.04))

@@ -49,7 +49,7 @@ def test_out_or_runs_that_is_a_file_is_refused_naming_the_option(tmp_path, capsy
 
 def test_ctrl_c_ends_the_study_with_130_keeping_the_finished_ensembles(tmp_path):
     runs, out = tmp_path / "runs", tmp_path / "out"
-    first = runs / "h0.3-n64-bem-halfspace"
+    first = runs / "h0.8-n64-bem-halfspace"  # the plan runs H = 0.8 first
     command = [sys.executable, "-m", "frictionlab", "exact3d", "--quick", "--presets", str(PRESETS),
                "--out", str(out), "--runs", str(runs), "--workers", "1"]  # fmt: skip
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -71,3 +71,32 @@ def test_ctrl_c_ends_the_study_with_130_keeping_the_finished_ensembles(tmp_path)
     assert "Traceback" not in err and out_text == ""
     assert json.loads((first / "run.json").read_text())["status"] == "completed"
     assert not (out / PAGE).exists()
+
+
+def test_a_study_that_fails_midway_still_counts_its_time(tmp_path, monkeypatch):
+    """The study's wall time is summed over the invocations that computed it, including one
+    that ended on an error (a run folder in use by another process, say)."""
+    from pathlib import Path
+
+    from frictionlab.errors import FrictionlabError
+    from frictionlab.exact3d import plan as study
+
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    calls = []
+
+    def refused(scene, folder, options):
+        calls.append(folder)
+        time.sleep(0.05)
+        raise FrictionlabError(f"{folder} is in use by another run")
+
+    monkeypatch.setattr(study, "run_to_folder", refused)
+    try:
+        study.run_plan(Path(PRESETS), runs, study.QUICK)
+    except FrictionlabError:
+        pass
+    else:
+        raise AssertionError("the refusal was swallowed")
+    assert len(calls) == 1
+    recorded = json.loads((runs / study.TIME_FILE).read_text())
+    assert recorded["plan"] == "quick" and recorded["seconds"] >= 0.05

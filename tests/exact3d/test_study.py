@@ -1,5 +1,6 @@
 """``frictionlab exact3d --quick``: the whole study end to end on the real presets, its page
-and figures, the refusal to overwrite, and a second invocation that resumes every ensemble."""
+and figures, the refusal to overwrite, a second invocation that resumes every ensemble, and
+``--finished-only``, which writes the page from what finished and names what did not."""
 
 import json
 
@@ -17,7 +18,8 @@ from ..conftest import PRESETS
 @pytest.fixture(scope="module")
 def quick_study(tmp_path_factory):
     out = tmp_path_factory.mktemp("exact3d")
-    code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"), "--quiet"])
+    code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"), "--quiet",
+                 "--workers", "1"])  # fmt: skip
     assert code == ExitCode.OK
     return out
 
@@ -42,9 +44,28 @@ def test_quick_page_has_every_h_every_grid_and_mdr(quick_study):
     rows = {line.split("|")[1].strip() for line in law}
     assert {f"{h:g}" for h in HURSTS} <= rows
     assert "frictionlab exact3d --quick" in text and "Does a log law hold" in text
-    # every ensemble ran: exact and MDR on each grid, at each H
+    assert "Every ensemble of the plan finished." in text
+    # the quick grids resolve the short cut-off with fewer than 16 pixels: nothing is quoted as converged
+    assert "not converged" in text and "not quoted" in text
+    # every ensemble ran: exact and MDR on each grid at each H, the extra grid, the comparison family, the gradients
     folders = sorted(p.name for p in (quick_study / "runs").iterdir() if p.is_dir())
-    assert len(folders) == len(HURSTS) * len(QUICK.resolutions) * 2
+    assert len(folders) == len(QUICK.jobs()) == len(HURSTS) * (2 * len(QUICK.resolutions) + 3) + 2 * len(QUICK.extra)
+    # the literature kappa is the corrected range, never the old bracket
+    assert "about 1.6 to about 2" not in text and "2 to 2.3" in text and "2.51" in text and "1.60" in text
+
+
+def test_mdr_runs_its_lines_per_surface_and_the_comparison_family_the_whole_side(quick_study):
+    runs = quick_study / "runs"
+    for h in HURSTS:
+        for n in QUICK.resolutions:
+            done = json.loads((runs / f"h{h:.1f}-n{n}-mdr" / "summary.json").read_text())["realizations"]["done"]
+            assert done == QUICK.mdr_lines * QUICK.realizations[0]
+        side = json.loads((runs / f"side-h{h:.1f}-n{QUICK.side[0]}-bem-halfspace" / "summary.json").read_text())
+        main = json.loads((runs / f"h{h:.1f}-n{QUICK.side[0]}-bem-halfspace" / "summary.json").read_text())
+        assert side["preset"]["spectrum"]["params"]["long_cutoff"] == side["preset"]["spectrum"]["params"]["length"]
+        assert main["preset"]["spectrum"]["params"]["long_cutoff"] * 4 == main["preset"]["spectrum"]["params"]["length"]
+        spectral = json.loads((runs / f"spectral-h{h:.1f}-n{QUICK.spectral[0]}-bem-halfspace" / "summary.json").read_text())
+        assert spectral["preset"]["slope"]["name"] == "spectral"
 
 
 def test_exact_and_mdr_ran_at_the_same_f_on_the_same_spectrum(quick_study):
@@ -57,12 +78,40 @@ def test_exact_and_mdr_ran_at_the_same_f_on_the_same_spectrum(quick_study):
             assert spectra[0] == spectra[1] and spectra[0]["params"]["points"] == n
 
 
+def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(quick_study, tmp_path, capsys):
+    import shutil
+
+    runs = tmp_path / "runs"
+    shutil.copytree(quick_study / "runs", runs)
+    for name in ("h0.3-n128-bem-halfspace", "spectral-h1.0-n128-bem-halfspace"):
+        shutil.rmtree(runs / name)
+    chunks = {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")}
+    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / "page"), "--runs", str(runs),
+            "--finished-only", "--quiet"]  # fmt: skip
+    assert main(args) == ExitCode.OK
+    text = (tmp_path / "page" / PAGE).read_text()
+    assert {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")} == chunks  # nothing computed
+    assert not (runs / "h0.3-n128-bem-halfspace").exists()
+    assert "2 of the plan's" in text and "H = 0.3, 128² px, exact, 4 surfaces" in text
+    assert "H = 1, spectral gradient, 128² px, exact, 2 surfaces" in text
+    assert "--finished-only" in text  # the command that regenerates it
+    assert f"frictionlab exact3d --quick --out {tmp_path / 'page'} --runs {runs} --force" in text  # and the one that finishes
+    # H = 0.3 is quoted on its finest grid that finished, 96²
+    law = [line for line in text.splitlines() if line.startswith("| 0.3 | 96² (3 px on λs), not quoted")]
+    assert law
+    capsys.readouterr()
+    assert main(["exact3d", "--quick", "--finished-only", "--out", str(tmp_path / "p2"), "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "--finished-only" in err and "--runs DIR" in err and not (tmp_path / "p2").exists()
+
+
 def f_column(folder):
     return np.loadtxt(folder / "curve.csv", delimiter=",", skiprows=1, usecols=1)
 
 
 def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, capsys):
-    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(quick_study), "--runs", str(quick_study / "runs"), "--quiet"]
+    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(quick_study), "--runs", str(quick_study / "runs"),
+            "--quiet", "--workers", "1"]  # fmt: skip
     before = (quick_study / PAGE).read_text()
     assert main(args) == ExitCode.OUTPUT_REFUSED
     assert "--force" in capsys.readouterr().err

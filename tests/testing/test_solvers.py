@@ -113,6 +113,22 @@ def test_solver_check_fails_for_an_unknown_mean_displacement_declared_wrongly(at
         fltesting.check_solver(cls)
 
 
+def test_solver_check_fails_when_the_corrected_area_and_its_declaration_differ():
+    """A solver that declares corrected_area must give real_area_corrected, one that does not must not."""
+    from frictionlab_solvers import BEMHalfSpace
+
+    undeclared = solver_variant("Undeclared", lambda c, p, loads: replace_curve(c, real_area_corrected=c.contact_fraction))
+    missing = type("Missing", (GoodSolver,), {"name": "missing", "corrected_area": True})
+    for cls in (undeclared, missing):
+        with pytest.raises(AssertionError, match="real_area_corrected must be given exactly when corrected_area is True"):
+            fltesting.check_solver(cls)
+    too_large = type("TooLarge", (solver_variant("Large", lambda c, p, loads: replace_curve(
+        c, real_area_corrected=c.contact_fraction * 1.01)),), {"corrected_area": True})  # fmt: skip
+    with pytest.raises(AssertionError, match=r"real_area_corrected must lie in \(0, contact_fraction\]"):
+        fltesting.check_solver(too_large)
+    fltesting.check_solver(BEMHalfSpace)
+
+
 def test_solver_check_fails_when_periodic_only_is_not_kept():
     cls = type("Loose", (GoodSolver,), {"name": "loose", "periodic_only": True})
     with pytest.raises(AssertionError, match="periodic_only is True, but a non-periodic profile was accepted"):
@@ -135,6 +151,7 @@ def test_solver_check_fails_when_undefined_slopes_are_not_left_out():
         ({"dimensions": (1, 2)}, "normalisations must map each of its dimensions"),
         ({"problem": ""}, "problem must name the physical problem"),
         ({"contact_measure": "area"}, "contact_measure must be one of"),
+        ({"corrected_area": "yes"}, "corrected_area must be True or False. Got 'yes'"),
         ({"body_params": ("youngs_modulus",)}, "body_params names 'youngs_modulus', not fields of Params"),
         ({"tolerance_param": "tol"}, "tolerance_param names 'tol'"),
         ({"bytes_per_point": 0}, "bytes_per_point must be None or a whole number > 0. Got 0"),

@@ -1,0 +1,158 @@
+"""The study's numbers, from its finished ensembles: kappa of every exact ensemble (the
+corrected and the raw pixel area, in the 0.5-5 % window and among few spots, and as a
+curve), the surfaces' own statistics, and the fits redone on paired surfaces. The page
+and the figures read these; nothing here runs a solver."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..fit import LogFit, fit_log_law
+from ..seeds import bootstrap_rng, realization_rng
+from .analysis import (
+    FEW_SPOTS,
+    KAPPA_WINDOW,
+    Kappa,
+    KappaCurve,
+    contact_area_law,
+    height_moments,
+    kappa_curve,
+    nayak_parameter,
+)
+from .plan import MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
+
+
+@dataclass(frozen=True)
+class KappaSet:
+    """kappa of one exact ensemble: from the corrected area and from the pixel count in the
+    window of contact fractions KAPPA_WINDOW, among FEW_SPOTS, and at every load."""
+
+    corrected: Kappa
+    raw: Kappa
+    few_spots: Kappa
+    curve: KappaCurve
+    raw_curve: KappaCurve
+
+
+@dataclass(frozen=True)
+class SurfaceStats:
+    """Per-surface height skewness, kurtosis and Nayak parameter of one ensemble's surfaces."""
+
+    skewness: np.ndarray
+    kurtosis: np.ndarray
+    nayak: np.ndarray
+
+
+def nominal_area(e: Ensemble) -> float:
+    """A0 of the ensemble's surfaces, from f's L = 2 sqrt(A0 / pi)."""
+    o = e.outcome
+    return math.pi * (o.extent / 2) ** 2
+
+
+def kappa_set(e: Ensemble, bootstrap: int) -> KappaSet:
+    o = e.outcome
+    per = o.per_realization
+    corrected, raw = per["real_area_corrected"], per["contact_count"] / e.points**2  # square grids
+    args = (o.force, nominal_area(e), o.stiffness, per["slope_rms_line"])
+
+    def law(fraction, window):
+        return contact_area_law(fraction, *args, rng=bootstrap_rng(e.scene.preset.seed), bootstrap=bootstrap, window=window)
+
+    return KappaSet(
+        corrected=law(corrected, KAPPA_WINDOW),
+        raw=law(raw, KAPPA_WINDOW),
+        few_spots=law(corrected, FEW_SPOTS),
+        curve=kappa_curve(corrected, *args, rng=bootstrap_rng(e.scene.preset.seed), bootstrap=bootstrap),
+        raw_curve=kappa_curve(raw, *args, rng=bootstrap_rng(e.scene.preset.seed), bootstrap=0),
+    )
+
+
+def surface_stats(e: Ensemble) -> SurfaceStats:
+    """Skewness, kurtosis and Nayak parameter of each surface the ensemble pressed."""
+    rows = []
+    for index in e.outcome.indices:
+        heights = e.scene.spectrum.generate(realization_rng(e.scene.preset.seed, int(index))).heights
+        rows.append((*height_moments(heights), nayak_parameter(heights, e.spacing)))
+    skewness, kurtosis, nayak = np.array(rows).T
+    return SurfaceStats(skewness, kurtosis, nayak)
+
+
+def refit_on(e: Ensemble, indices: np.ndarray, bootstrap: int) -> LogFit:
+    """The fit of ``e`` redone on its surfaces ``indices`` only (paired with another ensemble)."""
+    per = e.outcome.per_realization
+    keep = np.isin(per["index"], indices)
+    return fit_log_law(e.outcome.f, per["xi"][keep], bootstrap=bootstrap, rng=bootstrap_rng(e.scene.preset.seed))
+
+
+def kappa_on(e: Ensemble, indices: np.ndarray, bootstrap: int) -> Kappa:
+    """kappa (corrected area, KAPPA_WINDOW) of ``e`` on its surfaces ``indices`` only."""
+    o, per = e.outcome, e.outcome.per_realization
+    keep = np.isin(per["index"], indices)
+    return contact_area_law(
+        per["real_area_corrected"][keep], o.force, nominal_area(e), o.stiffness, per["slope_rms_line"][keep],
+        rng=bootstrap_rng(e.scene.preset.seed), bootstrap=bootstrap, window=KAPPA_WINDOW,
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Paired:
+    """Two ensembles of the same first surfaces: ``other`` (a finer grid, spectral
+    gradients) against ``base`` refitted on those surfaces."""
+
+    base: Ensemble
+    other: Ensemble
+    base_fit: LogFit
+    base_kappa: Kappa
+    other_kappa: Kappa
+    surfaces: int
+
+    @property
+    def xi_gap(self) -> np.ndarray:
+        """other's mean xi - base's, on the same surfaces, per load."""
+        per = self.base.outcome.per_realization
+        keep = np.isin(per["index"], self.other.outcome.indices)
+        return self.other.outcome.xi - per["xi"][keep].mean(axis=0)
+
+
+def paired(base: Ensemble, other: Ensemble, bootstrap: int) -> Paired:
+    indices = other.outcome.indices
+    return Paired(base, other, refit_on(base, indices, bootstrap), kappa_on(base, indices, bootstrap),
+                  kappa_on(other, indices, bootstrap), int(indices.size))  # fmt: skip
+
+
+@dataclass
+class Numbers:
+    """Everything the page quotes, keyed by ensemble folder where per ensemble."""
+
+    kappas: dict[str, KappaSet]
+    stats: dict[tuple[str, float], SurfaceStats]  # (family, H): from the family's coarsest finished grid
+    extra: list[Paired]  # finer grids against the finest regular one, same first surfaces
+    spectral: list[Paired]  # spectral against forward-difference gradients, same grid and surfaces
+
+    def kappa(self, e: Ensemble) -> KappaSet:
+        return self.kappas[e.folder.name]
+
+
+def study_numbers(runs: StudyRuns) -> Numbers:
+    bootstrap = runs.plan.bootstrap
+    kappas = {e.folder.name: kappa_set(e, bootstrap) for e in runs.ensembles if e.exact}
+    stats = {}
+    for family in (MAIN, SIDE):
+        for hurst in runs.plan.hursts:
+            grids = runs.exact_grids(hurst, family)
+            if grids:
+                stats[(family, hurst)] = surface_stats(grids[0])
+    extra, spectral = [], []
+    for hurst in runs.plan.hursts:
+        regular = runs.find(hurst)
+        for e in runs.exact_grids(hurst):
+            if regular is not None and e.points not in runs.plan.resolutions:
+                extra.append(paired(regular, e, bootstrap))
+        for e in runs.exact_grids(hurst, SPECTRAL):
+            base = runs.find(hurst, e.points)
+            if base is not None:
+                spectral.append(paired(base, e, bootstrap))
+    return Numbers(kappas, stats, extra, spectral)

@@ -1,0 +1,46 @@
+"""The real contact area of a pixelated contact, corrected for its perimeter.
+
+A boundary-element solution counts a pixel as in contact when its pressure is
+positive. Near a contact edge the pressure falls to zero as the square root of the
+distance to the edge, and the pixels the edge crosses count whole: the pixel count
+overestimates the area by a strip along the perimeter, an error that decays only as
+1 / resolution. Yastrebov, Anciaux and Molinari (Tribol. Int. 2017, arXiv
+1701.02727) derive the strip from that edge profile, per pixel edge crossed:
+
+    A* = N - c M pixels,  c = (pi - 1 + ln 2) / 24 = 0.1181,
+
+with N the pixels in contact and M the edges between a contact and a free pixel
+along rows and columns. The derivation is for the pixel edges of a surface on a
+half-space; the solvers of lines report no corrected area.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+YASTREBOV_ANCIAUX_MOLINARI = "10.48550/arXiv.1701.02727"  # Tribol. Int. 2017
+PERIMETER_COEFFICIENT = (math.pi - 1.0 + math.log(2.0)) / 24.0
+
+
+def contact_edges(contact: np.ndarray) -> int:
+    """M: edges between a contact and a free pixel along the rows and columns of a
+    periodic map (the last row and column neighbour the first)."""
+    contact = np.asarray(contact, dtype=bool)
+    if contact.ndim != 2:
+        raise ValueError(f"contact must be a map of shape (Ny, Nx). Got shape {contact.shape} instead.")
+    edges = 0
+    for axis in (0, 1):
+        inner = np.count_nonzero(np.diff(contact, axis=axis))  # pairs that differ inside the map
+        wrap = np.count_nonzero(contact.take(0, axis=axis) != contact.take(-1, axis=axis))
+        edges += inner + (wrap if contact.shape[axis] > 1 else 0)
+    return int(edges)
+
+
+def corrected_area_fraction(contact: np.ndarray) -> float:
+    """(N - c M) / pixels: the perimeter-corrected real area, a fraction of the nominal
+    area, of the periodic contact map ``contact`` (True where in contact)."""
+    contact = np.asarray(contact, dtype=bool)
+    count = int(np.count_nonzero(contact))
+    return (count - PERIMETER_COEFFICIENT * contact_edges(contact)) / contact.size
