@@ -132,7 +132,7 @@ def test_the_corrected_area_reaches_every_output_and_reads_back(tmp_path):
     counts = np.load(tmp_path / "run" / "realizations.npz")["contact_count"]
     assert np.all(per < counts / 32**2)  # below the count: every contact has a perimeter
     np.testing.assert_allclose(result.table["real_area_corrected"], per.mean(axis=0), rtol=1e-15)
-    curve = read_curve(tmp_path / "run" / "curve.csv")
+    curve = read_curve(tmp_path / "run")
     np.testing.assert_array_equal(curve["real_area_corrected"], result.table["real_area_corrected"])
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["real_area_corrected_at_last_load"] == result.table["real_area_corrected"][-1]
