@@ -35,7 +35,7 @@ from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation
 
 from .checks import check_control, check_loads, check_profile
 from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, corrected_area_fraction
-from .contact_cg import NotConverged, ProjectedCG, cold_start
+from .contact_cg import ProjectedCG, next_pressure, solve_load
 from .elastic import ElasticParams, PeriodicHalfSpace, elastic_stiffness
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
@@ -136,8 +136,7 @@ class PeriodicBEM(ContactSolver):
         cg = self.contact_cg(operator, depth)
         full_approach = float(depth.mean())  # scaled max z - mean z
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
-        # under indentation control the force is the answer, and only the tolerance converges it
-        stop = {"certified": True} if self.params.stop == "certified" and control == "force" else {}
+        certified = self.params.stop == "certified"  # under force control only (solve_load)
         if control == "indentation":
             too_deep = np.flatnonzero(loads / scale >= full_approach)
             if too_deep.size:
@@ -159,31 +158,12 @@ class PeriodicBEM(ContactSolver):
             target = load / force_unit if control == "force" else load / scale
             if control == "force" and target > full_threshold:
                 pressure = full_fluctuation + target  # exact; the CG only checks it
-            elif pressure is not None:
-                # warm start: the previous solution scaled to the new load (a linear
-                # extrapolation from two loads measured slower: more points clipped)
-                pressure *= target / previous
-            elif control == "force":
-                pressure = cold_start(depth, target)
             else:
-                pressure = np.maximum(target - depth, 0.0)
+                pressure = next_pressure(pressure, previous, target, control, depth)
             previous = target
-            try:
-                pressure, approach, iterations[j], residual[j] = cg.solve(
-                    pressure,
-                    mean_pressure=target if control == "force" else None,
-                    approach=target if control == "indentation" else None,
-                    tolerance=tolerance,
-                    max_iterations=max_iterations,
-                    **stop,
-                )
-            except NotConverged as failure:
-                what = "force" if control == "force" else "indentation"
-                raise ValueError(
-                    f"{self.name} did not converge at load {j} ({what} {float(load):g}): residual "
-                    f"{failure.residual:.3g} > tolerance {tolerance:g} after {failure.iterations} "
-                    "iterations. Raise max_iterations or loosen the tolerance."
-                ) from None
+            pressure, approach, iterations[j], residual[j] = solve_load(
+                cg, self.name, j, load, pressure, target, control, tolerance, max_iterations, certified
+            )
             contact = pressure > 0.0
             n = int(np.count_nonzero(contact))
             count[j] = n

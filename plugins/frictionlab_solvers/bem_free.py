@@ -25,7 +25,7 @@ from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load
 
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
-from .contact_cg import NotConverged, cold_start
+from .contact_cg import next_pressure, solve_load
 from .elastic import PeriodicHalfSpace
 
 LOVE = "Love, Phil. Trans. R. Soc. A 228 (1929) 377"
@@ -154,34 +154,15 @@ class BEMHalfSpaceFree(PeriodicBEM):
         depth /= scale
         cg = self.contact_cg(FreeHalfSpace(depth.shape), depth)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
-        # under indentation control the force is the answer, and only the tolerance converges it
-        stop = {"certified": True} if self.params.stop == "certified" and control == "force" else {}
+        certified = self.params.stop == "certified"  # under force control only (solve_load)
         pressure, previous = None, 1.0
         for j, load in enumerate(loads):
             target = load / force_unit if control == "force" else load / scale
-            if pressure is not None:  # warm start: the previous solution scaled to the new load
-                pressure *= target / previous
-            elif control == "force":
-                pressure = cold_start(depth, target)
-            else:
-                pressure = np.maximum(target - depth, 0.0)
+            pressure = next_pressure(pressure, previous, target, control, depth)
             previous = target
-            try:
-                pressure, approach, iterations[j], residual[j] = cg.solve(
-                    pressure,
-                    mean_pressure=target if control == "force" else None,
-                    approach=target if control == "indentation" else None,
-                    tolerance=tolerance,
-                    max_iterations=max_iterations,
-                    **stop,
-                )
-            except NotConverged as failure:
-                what = "force" if control == "force" else "indentation"
-                raise ValueError(
-                    f"{self.name} did not converge at load {j} ({what} {float(load):g}): residual "
-                    f"{failure.residual:.3g} > tolerance {tolerance:g} after {failure.iterations} "
-                    "iterations. Raise max_iterations or loosen the tolerance."
-                ) from None
+            pressure, approach, iterations[j], residual[j] = solve_load(
+                cg, self.name, j, load, pressure, target, control, tolerance, max_iterations, certified
+            )
             contact = pressure > 0.0
             count[j] = n = int(np.count_nonzero(contact))
             force[j] = load if control == "force" else float(pressure.mean()) * force_unit

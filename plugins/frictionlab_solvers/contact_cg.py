@@ -328,3 +328,38 @@ def cold_start(depth: np.ndarray, mean_pressure: float) -> np.ndarray:
         return np.full(depth.shape, mean_pressure)
     pressure *= mean_pressure / total
     return pressure
+
+
+def next_pressure(pressure: np.ndarray | None, previous: float, target: float, control: str, depth: np.ndarray):
+    """The pressure a load's CG starts from: the last load's solution scaled to this one (a
+    warm start; a linear extrapolation from two loads measured slower: more points clipped),
+    else a cold start under force control, or the overlap under indentation control."""
+    if pressure is not None:
+        pressure *= target / previous
+        return pressure
+    if control == "force":
+        return cold_start(depth, target)
+    return np.maximum(target - depth, 0.0)
+
+
+def solve_load(cg: ProjectedCG, solver: str, j: int, load: float, pressure: np.ndarray, target: float,
+               control: str, tolerance: float, max_iterations: int, certified: bool):  # fmt: skip
+    """Load ``j`` of a sweep solved from ``pressure``: ``(pressure, approach, iterations,
+    residual)``; a ValueError naming ``solver``, the load and what to change if it does not converge."""
+    try:
+        return cg.solve(
+            pressure,
+            mean_pressure=target if control == "force" else None,
+            approach=target if control == "indentation" else None,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
+            # under indentation control only the tolerance converges the force (the baseline CG has no such stop)
+            **({"certified": True} if certified and control == "force" else {}),
+        )
+    except NotConverged as failure:
+        what = "force" if control == "force" else "indentation"
+        raise ValueError(
+            f"{solver} did not converge at load {j} ({what} {float(load):g}): residual "
+            f"{failure.residual:.3g} > tolerance {tolerance:g} after {failure.iterations} "
+            "iterations. Raise max_iterations or loosen the tolerance."
+        ) from None
