@@ -116,12 +116,13 @@ def write_page(
         page_paths(Path(out_dir), force=options.force)
     if runs_dir:
         check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
+    presets = find_presets(presets_dir, plan)  # refused before a default runs folder is made
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
     try:
         with one_dask_cluster(options):  # on Dask, every ensemble's run uses one client and cluster
-            runs = run_plan(find_presets(presets_dir, plan), runs_dir, plan, options, compute=not finished_only, log=log)
+            runs = run_plan(presets, runs_dir, plan, options, compute=not finished_only, log=log)
     except WorkInterrupted as exc:
         raise WorkInterrupted(f"{exc}; no page written") from None
     if not runs.hursts():

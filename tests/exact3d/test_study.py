@@ -149,9 +149,10 @@ def test_every_grid_samples_the_same_surfaces(registry, hurst):
 
 
 def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, capsys, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # its default runs/ folder is made here, not in the checkout
+    monkeypatch.chdir(tmp_path)  # its default runs/ folder would be made here, not in the checkout
     code = main(["exact3d", "--quick", "--presets", str(tmp_path), "--out", str(tmp_path / "out"), "--quiet"])
     assert code == ExitCode.USAGE
     err = capsys.readouterr().err
     assert "--presets" in err and "exact3d-h03.yaml" in err and str(tmp_path) in err
     assert not (tmp_path / "out").exists()
+    assert not (tmp_path / "runs").exists()  # refused before a default runs folder is made
