@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 from frictionlab import engine
-from frictionlab.dask_security import WORKER_CONFIG
+from frictionlab.dask_security import PROFILE_OFF, WORKER_CONFIG
 from frictionlab.dask_session import one_dask_cluster
 from frictionlab.executors import make_executor
 from frictionlab.options import RunOptions
@@ -155,7 +155,7 @@ def executors(repeat: int, skip_dask: bool) -> None:
         import dask
         import distributed
 
-        with dask.config.set(WORKER_CONFIG), distributed.LocalCluster(  # the workers frictionlab's own cluster has
+        with dask.config.set({**WORKER_CONFIG, **PROFILE_OFF}), distributed.LocalCluster(  # the workers frictionlab's own cluster has
             n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
         ) as cluster:
             address = cluster.scheduler_address

@@ -77,6 +77,13 @@ def _loopback(host: str) -> bool:
         return False
 
 
+def _on_this_machine(address: str) -> bool:
+    """Whether the scheduler at ``address`` is on loopback: its workers, on this machine too,
+    can then be asked for results directly (through the scheduler, results travel twice;
+    a remote cluster's workers may not be reachable from here)."""
+    return _loopback(urlsplit(address).hostname or "")
+
+
 def connect_scheduler(address: str):
     """A ``distributed.Client`` on the scheduler at ``address`` with Dask's TLS
     configuration, or a RunError that says why not."""
@@ -85,7 +92,9 @@ def connect_scheduler(address: str):
     security = distributed.Security()
     _check_answers_as_scheduler(address, security)
     try:
-        return distributed.Client(address, timeout=f"{CONNECT_SECONDS}s", security=security)
+        return distributed.Client(
+            address, timeout=f"{CONNECT_SECONDS}s", security=security, direct_to_workers=_on_this_machine(address)
+        )
     except Exception as exc:  # refused, timed out, a TLS handshake or configuration that fails, ...
         reason = f"{type(exc).__name__}: {exc}"
         if address.startswith("tls://") and "ssl_context" in reason:  # what was given, not the network
@@ -144,8 +153,11 @@ def _check_answers_as_scheduler(address: str, security, seconds: float = CONNECT
 # Dask's nanny gives its workers MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back at
 # once); glibc then maps every array above 128 KiB afresh, page faults and all: a 128^2
 # half-space realization took 0.23 s instead of 0.16 s. This user's own cluster keeps glibc's
-# adaptive default (None unsets the variable).
+# adaptive default (None unsets the variable). Its workers do not sample their own stacks
+# every 10 ms for the dashboard's profile page (4 % of a Fig. 2 task's time), unless the
+# dashboard is asked for.
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+PROFILE_OFF = {"distributed.worker.profile.enabled": False}
 
 
 def start_local_cluster(workers: int, dashboard: bool = False):
@@ -162,8 +174,9 @@ def start_local_cluster(workers: int, dashboard: bool = False):
             'the local Dask cluster is reached over TLS, which needs the cryptography package: '
             'pip install "frictionlab[dask]"'
         ) from None
-    routes = {} if dashboard else {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
-    with dask.config.set({**routes, **WORKER_CONFIG}):
+    routes = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
+    quiet = {} if dashboard else {**routes, **PROFILE_OFF}
+    with dask.config.set({**quiet, **WORKER_CONFIG}):
         cluster = distributed.LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -176,7 +189,7 @@ def start_local_cluster(workers: int, dashboard: bool = False):
             silence_logs=logging.ERROR,
         )
     try:
-        client = distributed.Client(cluster, security=security)
+        client = distributed.Client(cluster, security=security, direct_to_workers=True)
     except BaseException:
         cluster.close()
         raise

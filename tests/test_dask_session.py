@@ -8,14 +8,14 @@ import time
 import numpy as np
 import pytest
 
-from frictionlab import engine
+from frictionlab import engine, hookimpl
 from frictionlab.dask_session import one_dask_cluster
 from frictionlab.executors import _packed_chunk
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.sweep import plan_sweep, run_sweep
 
-from .conftest import loopback_cluster
+from .conftest import loopback_cluster, merge
 from .test_load_progress import LONG_LOADS
 from .test_sweep import sweep_preset
 
@@ -83,3 +83,33 @@ def test_a_task_stops_within_its_solve_once_the_run_s_stop_event_is_set(registry
         assert pickle.loads(task.result(timeout=60)) == []
         whole = client.submit(_packed_chunk, scene, [1], "frictionlab-test-other", pure=False)
         assert [r.index for r in pickle.loads(whole.result(timeout=60))] == [1]
+
+
+@needs_dask
+def test_a_dask_run_cancelled_while_it_waits_returns_at_once_with_what_finished(registry):
+    import threading
+
+    scene = build_scene(merge(LONG_LOADS, {"realizations": 6, "spectrum": {"params": {"points": 512}}}), registry=registry)
+    cancel, cancelled_at = threading.Event(), []  # a realization lasts seconds
+
+    def cancel_now():
+        cancelled_at.append(time.monotonic())
+        cancel.set()
+
+    class CancelSoonAfterTheFirst:  # the first runs in this process; then the run waits for Dask's tasks
+        @hookimpl
+        def realization_done(self, run, result, done, total):
+            if done == 1:
+                threading.Timer(0.3, cancel_now).start()
+
+    with loopback_cluster(2) as cluster:
+        options = RunOptions(executor="dask", scheduler=cluster.scheduler_address)
+        with one_dask_cluster(options) as session:
+            session.connect()  # connected before: the tasks are submitted at once, and run when the cancel comes
+            outcome = engine.run(scene, options, cancel=cancel, listeners=[CancelSoonAfterTheFirst()])
+            returned = time.monotonic()
+    assert outcome.status == "cancelled" and 1 <= outcome.indices.size < 6, (outcome.status, outcome.indices)
+    # the workers were within their solves: the run did not wait for one to finish
+    assert returned - cancelled_at[0] < 0.5 * outcome.compute_seconds / outcome.indices.size
+    serial = engine.run(scene, RunOptions(workers=1))
+    assert np.array_equal(outcome.per_realization["xi"], serial.per_realization["xi"][outcome.indices])

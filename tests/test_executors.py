@@ -188,6 +188,36 @@ def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_2
 
 
 @needs_dask
+def test_a_scene_too_large_to_travel_in_each_task_is_broadcast_with_the_same_numbers(
+    monkeypatch, scene_24, serial_24, dask_scheduler
+):
+    from frictionlab import executors
+
+    scattered = []
+    real_scatter = distributed.Client.scatter
+
+    def counted(self, *args, **kwargs):
+        scattered.append(args[0])
+        return real_scatter(self, *args, **kwargs)
+
+    monkeypatch.setattr(distributed.Client, "scatter", counted)
+    engine.run(scene_24, RunOptions(executor="dask", scheduler=dask_scheduler))
+    assert scattered == []  # a preset's scene is small: it goes with each task
+    monkeypatch.setattr(executors, "INLINE_SCENE_BYTES", 0)
+    outcome = engine.run(scene_24, RunOptions(executor="dask", scheduler=dask_scheduler))
+    assert len(scattered) == 1 and scattered[0] is scene_24
+    same_numbers(serial_24, outcome)
+
+
+def test_results_come_straight_from_the_workers_only_of_a_scheduler_on_this_machine():
+    from frictionlab.dask_security import _on_this_machine
+
+    assert _on_this_machine("tcp://127.0.0.1:8786") and _on_this_machine("tls://localhost:8786")
+    assert _on_this_machine("tcp://[::1]:8786")
+    assert not _on_this_machine("tls://10.0.0.5:8786") and not _on_this_machine("tcp://cluster.example.org:8786")
+
+
+@needs_dask
 @pytest.mark.parametrize("size", [1, 5, 23])
 def test_numbers_do_not_depend_on_the_chunk_size(monkeypatch, scene_24, serial_24, dask_scheduler, size):
     def fixed(indices, *args, **kwargs):
