@@ -117,15 +117,40 @@ def efficiency_rows(scene, repeat: int) -> list[tuple[str, int, float]]:
     return rows
 
 
-def dask_rows(scene, repeat: int, address: str) -> list[tuple[str, int, float]]:
+def timed(work) -> float:
+    start = time.perf_counter()
+    work()
+    return time.perf_counter() - start
+
+
+def dask_rows(scene, repeat: int, address: str) -> tuple[list[tuple[str, int, float]], list[float]]:
     """A client per run (a single ``frictionlab run``), and one client for every run (a sweep
-    or a study: ``one_dask_cluster``), connected before the timing as a command's first run does."""
+    or a study: ``one_dask_cluster``), connected before the timing as a command's first run does.
+
+    Rounds of (serial, Dask one client, Dask own client), back to back: the speed of a shared
+    machine drifts between rounds, so each round's efficiency compares runs seconds apart.
+    Returns the best times, and the efficiency of the one-client run of every round."""
     options = RunOptions(executor="dask", scheduler=address)
-    rows = [("dask, own client", 2, best_of(repeat, lambda: engine.run(scene, options)))]
+    serial_options = RunOptions(workers=1, executor="serial")
+    serial, own, one, rounds = [], [], [], []
     with one_dask_cluster(options):
         engine.run(scene, options)
-        rows.append(("dask, one client", 2, best_of(repeat, lambda: engine.run(scene, options))))
-    return rows
+        for _ in range(repeat):
+            serial.append(timed(lambda: engine.run(scene, serial_options)))
+            one.append(timed(lambda: engine.run(scene, options)))
+            rounds.append(serial[-1] / (2 * one[-1]))
+    for _ in range(repeat):  # outside the session: a client per run
+        own.append(timed(lambda: engine.run(scene, options)))
+    rows = [("serial (rounds)", 1, min(serial)), ("dask, own client", 2, min(own)), ("dask, one client", 2, min(one))]
+    return rows, rounds
+
+
+def print_rounds(rounds: list[float]) -> None:
+    ordered = sorted(rounds)
+    print(
+        f"  dask, one client, round by round (serial / (2 x dask), each pair seconds apart): median {ordered[len(ordered) // 2]:.2f}, "
+        f"range {ordered[0]:.2f} .. {ordered[-1]:.2f} over {len(ordered)} rounds"
+    )
 
 
 def print_efficiencies(title: str, rows) -> None:
@@ -160,11 +185,17 @@ def executors(repeat: int, skip_dask: bool) -> None:
         ) as cluster:
             address = cluster.scheduler_address
             engine.run(scene, RunOptions(executor="dask", scheduler=address))  # the workers import frictionlab once
-            rows.extend(dask_rows(scene, repeat, address))
-            rows_3d.extend(dask_rows(surface, min(repeat, 2), address))
+            dask_2d, rounds = dask_rows(scene, repeat, address)
+            dask_3d, rounds_3d = dask_rows(surface, min(repeat, 2), address)
+            rows.extend(dask_2d)
+            rows_3d.extend(dask_3d)
             overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
     print_efficiencies(f"Fig. 2 scene ({m} realizations), executors", rows)
+    if not skip_dask:
+        print_rounds(rounds)
     print_efficiencies(f"Exact 3D ensemble ({SURFACE_PRESET.name} on 128^2 pixels, 32 surfaces), executors", rows_3d)
+    if not skip_dask:
+        print_rounds(rounds_3d)
     # the engine runs the first realization alone (its time sizes the chunks): with M equal
     # realizations on W workers the efficiency is at most M / (W (1 + ceil((M - 1) / W)))
     bound = 32 / (2 * (1 + math.ceil(31 / 2)))

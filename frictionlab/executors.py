@@ -350,9 +350,33 @@ def _scene_argument(client, scene: Scene):
     """What the tasks get as their scene: the scene itself when it pickles small (a
     preset's numbers; each task carries it), else a future of it broadcast to every
     worker once (a measured surface's heights)."""
-    if len(pickle.dumps(scene, protocol=pickle.HIGHEST_PROTOCOL)) <= INLINE_SCENE_BYTES:
+    if _pickles_within(scene, INLINE_SCENE_BYTES):
         return scene
     return client.scatter(scene, broadcast=True, hash=False)
+
+
+class _TooLarge(Exception):
+    pass
+
+
+def _pickles_within(obj, limit: int) -> bool:
+    """Whether ``obj`` pickles to at most ``limit`` bytes, counted as they are written and
+    given up past the limit: a measured surface of gigabytes is never copied to find out."""
+    written = 0
+
+    class Counter:
+        @staticmethod
+        def write(data) -> None:
+            nonlocal written
+            written += memoryview(data).nbytes
+            if written > limit:
+                raise _TooLarge
+
+    try:
+        pickle.Pickler(Counter(), protocol=pickle.HIGHEST_PROTOCOL).dump(obj)
+    except _TooLarge:
+        return False
+    return True
 
 
 STOP_POLL_SECONDS = 0.25  # how often a Dask task asks the scheduler whether its run was cancelled

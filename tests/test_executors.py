@@ -209,6 +209,25 @@ def test_a_scene_too_large_to_travel_in_each_task_is_broadcast_with_the_same_num
     same_numbers(serial_24, outcome)
 
 
+def test_the_size_of_a_scene_s_pickle_is_counted_without_copying_a_large_one():
+    import pickle
+    import tracemalloc
+
+    from frictionlab.executors import _pickles_within
+
+    small = {"hurst": 0.8, "points": 1024}
+    size = len(pickle.dumps(small, protocol=pickle.HIGHEST_PROTOCOL))
+    assert _pickles_within(small, size) and not _pickles_within(small, size - 1)
+    heights = np.zeros(20_000_000)  # 160 MB
+    tracemalloc.start()
+    try:
+        assert not _pickles_within(heights, 64 * 1024)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1_000_000  # given up at the limit, nothing copied
+
+
 def test_results_come_straight_from_the_workers_only_of_a_scheduler_on_this_machine():
     from frictionlab.dask_security import _on_this_machine
 
