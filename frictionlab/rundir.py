@@ -401,11 +401,31 @@ class RunDirectory:
         self._write_manifest()
         return path
 
-    def _verified(self, scene: Scene, *, warn: bool) -> list[RealizationResult]:
-        """The results of every listed chunk whose SHA-256 and arrays check out, a
-        later chunk winning where two hold the same index; the others are
-        dropped from the manifest (and, with ``warn``, counted in a warning)."""
-        chunks = self._manifest["chunks"]
+    def completed_results(self, scene: Scene) -> list[RealizationResult] | None:
+        """Every result of a completed run of ``scene`` in this folder, read without its lock
+        and without writing anything (a reader beside another that holds the lock); None
+        unless the manifest says completed, for this preset and these input files, and every
+        realization's chunk checks out (then resuming the run says what is wrong, or repairs it)."""
+        try:
+            state = self.state()
+        except RunFolderError:
+            return None
+        if not state or state.get("status") != "completed" or state.get("format") != MANIFEST_FORMAT:
+            return None
+        if state.get("fingerprint") != fingerprint(_json_copy(scene.resolved())):
+            return None
+        recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
+        for field, now in self._input_hashes(scene).items():
+            if not isinstance(recorded.get(field), dict) or recorded[field].get("sha256") != now["sha256"]:
+                return None
+        results = self._verified(scene, dict(state.get("chunks") or {}), warn=False)
+        return results if len(results) == scene.preset.realizations else None
+
+    def _verified(self, scene: Scene, chunks: dict | None = None, *, warn: bool) -> list[RealizationResult]:
+        """The results of every chunk listed in ``chunks`` (by default the manifest's) whose
+        SHA-256 and arrays check out, a later chunk winning where two hold the same index;
+        the others are dropped from ``chunks`` (and, with ``warn``, counted in a warning)."""
+        chunks = self._manifest["chunks"] if chunks is None else chunks
         results: dict[int, RealizationResult] = {}
         damaged: dict[str, str] = {}
         for name, digest in list(chunks.items()):

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from .. import engine
 from ..ensemble import RunOutcome
 from ..errors import FrictionlabError, OutputRefused, RunFolderError
 from ..files import atomic_write, output_path_problem
@@ -265,10 +266,17 @@ def run_plan(
             if not compute and not finished(folder):
                 runs.missing.append(job)
                 continue
-            resume = (folder / STATE_FILE).is_file()
-            log(f"exact3d: {job.describe()}" + (" (resumed)" if resume else ""))
+            # a completed ensemble is read, not resumed: no lock taken, nothing written (a
+            # --finished-only page may be reading it while a study walks past it)
+            done = RunDirectory(folder).completed_results(scene) if finished(folder) else None
             seen = mark()
-            outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
+            if done is not None:
+                log(f"exact3d: {job.describe()} (finished: read back)")
+                outcome = engine.run(scene, RunOptions(workers=1), restored=done)
+            else:
+                resume = (folder / STATE_FILE).is_file()
+                log(f"exact3d: {job.describe()}" + (" (resumed)" if resume else ""))
+                outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
             if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
                 raise KeyboardInterrupt
             if outcome.status != "completed":

@@ -156,3 +156,25 @@ def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, caps
     assert "--presets" in err and "exact3d-h03.yaml" in err and str(tmp_path) in err
     assert not (tmp_path / "out").exists()
     assert not (tmp_path / "runs").exists()  # refused before a default runs folder is made
+
+
+def test_finished_ensembles_are_read_without_their_lock_beside_a_process_that_holds_it(quick_study, tmp_path):
+    import shutil
+
+    from frictionlab.rundir import RunDirectory
+
+    runs = tmp_path / "runs"
+    shutil.copytree(quick_study / "runs", runs)
+    files = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file()}
+    busy = runs / "h0.8-n128-bem-halfspace"
+    with RunDirectory(busy):  # another process's hold on it, as a --finished-only page or a study takes
+        for extra in (["--finished-only"], ["--force", "--workers", "1"]):
+            args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / extra[0].strip("-")),
+                    "--runs", str(runs), "--quiet", *extra]  # fmt: skip
+            assert main(args) == ExitCode.OK
+    # nothing of the runs was written: read back, not resumed
+    after = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file() and p.name != "exact3d-time.json"}
+    assert after == {p: t for p, t in files.items() if p.name != "exact3d-time.json"}
+    tables = lambda text: [line for line in text.splitlines() if line.startswith("| ")]
+    original = tables((quick_study / PAGE).read_text())
+    assert tables((tmp_path / "force" / PAGE).read_text()) == original  # the same numbers, the held one's included
