@@ -291,7 +291,7 @@ class DaskExecutor:
         run_id = uuid.uuid4().hex[:8]
         stop_name = f"frictionlab-{run_id}-stop"
         try:
-            scene_arg = _scene_argument(client, scene)
+            scene_arg = _scene_argument(client, scene, len(chunks))
             chunk_of = {}
             for chunk in chunks:
                 future = client.submit(
@@ -333,7 +333,7 @@ class DaskExecutor:
 
 
 CANCEL_POLL_SECONDS = 0.1  # how often a run waiting for Dask tasks looks at its cancel
-INLINE_SCENE_BYTES = 64 * 1024  # a scene this small travels inside each task: no scatter round trips
+INLINE_SCENE_BYTES = 1024 * 1024  # the scene travels inside each task while its copies come to at most this
 
 
 def _next_finished(finished: queue.SimpleQueue, cancel):
@@ -346,11 +346,11 @@ def _next_finished(finished: queue.SimpleQueue, cancel):
     return None
 
 
-def _scene_argument(client, scene: Scene):
-    """What the tasks get as their scene: the scene itself when it pickles small (a
-    preset's numbers; each task carries it), else a future of it broadcast to every
-    worker once (a measured surface's heights)."""
-    if _pickles_within(scene, INLINE_SCENE_BYTES):
+def _scene_argument(client, scene: Scene, tasks: int):
+    """What the ``tasks`` tasks get as their scene: the scene itself when its copies pickle
+    small (a preset's numbers and what its spectrum derived from them: no scatter round
+    trips), else a future of it broadcast to every worker once (a measured surface's heights)."""
+    if _pickles_within(scene, INLINE_SCENE_BYTES // max(1, tasks)):
         return scene
     return client.scatter(scene, broadcast=True, hash=False)
 
