@@ -311,6 +311,9 @@ class SpectrumGenerator(Plugin):
       q > 0); ``rms_slope()``: a closed-form rms slope. Default: NotImplementedError.
     - ``periodic()``: whether generated profiles repeat (default True). A measured
       scan is not periodic: slopes never wrap, periodic solvers refuse it.
+    - ``not_periodic_advice()``: when ``periodic()`` is False, why (with the parameter
+      at cause) and how to make the profile periodic, as ``(why, how)``: a refusal by a
+      periodic-only solver or estimator says both. Default: general advice.
     - ``grid_shape()``: the shape of a generated profile, known without generating
       (memory estimates). Default None: the framework generates one profile.
     - ``points_param``: the ``Params`` field that sets the points (per side); the
@@ -353,6 +356,10 @@ class SpectrumGenerator(Plugin):
 
     def periodic(self) -> bool:
         return True
+
+    def not_periodic_advice(self) -> tuple[str, str]:
+        return (f"spectrum {self.name} is not periodic with these parameters",
+                "choose spectrum parameters that make a periodic profile (frictionlab schema lists them)")  # fmt: skip
 
     def grid_shape(self) -> tuple[int, ...] | None:
         return None

@@ -194,7 +194,7 @@ def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> 
             source=source,
         )
     if not plugins.get("equivalent_line", spectrum).periodic():
-        scan, make_periodic = _why_not_periodic(spectrum)
+        scan, make_periodic = spectrum.not_periodic_advice()
         problems = []
         for kind, plugin, verb in (("solver", solver, "presses"), ("slope", slope, "differentiates")):
             if plugin.periodic_only:
@@ -215,21 +215,6 @@ def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> 
             source=source,
         )
     return plugins
-
-
-def _why_not_periodic(spectrum) -> tuple[str, str]:
-    """What makes ``spectrum``'s profile non-periodic, and the parameter that would make it
-    periodic: only a parameter the spectrum has (a measured file's ``periodic``, a
-    synthesised line's ``series``), else the general advice."""
-    fields = type(spectrum.params).model_fields
-    if "periodic" in fields:
-        return (f"spectrum {spectrum.name} is not periodic (periodic: false, a scan whose ends do not meet)",
-                "set spectrum.params.periodic: true if its ends meet (after detrend)")
-    if "series" in fields:
-        return (f"spectrum {spectrum.name} is not periodic (series: {spectrum.params.series}, a line whose ends "
-                "do not meet)", "set spectrum.params.series: fft (a periodic line)")
-    return (f"spectrum {spectrum.name} is not periodic with these parameters",
-            "choose spectrum parameters that make a periodic profile (frictionlab schema lists them)")
 
 
 def _plugin_problems(registry: Registry, slot: str, choice: PluginChoice):

@@ -17,7 +17,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     generated lines, pooled over 8 seeds. If ``psd`` is implemented it is
     vectorised (array in, array of the same shape out), finite and >= 0; if
     ``rms_slope`` is implemented it is finite and > 0. The declarations:
-    ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes;
+    ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes, and when
+    it is False ``not_periodic_advice()`` gives two sentences (why, how to change it);
     ``points_param``, if not None, names the field whose value is the points (per
     side) that ``generate()`` makes;
     ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
@@ -99,6 +100,10 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     if not isinstance(periodic, bool) or profile.periodic is not periodic:
         fail(cls, f"periodic() must be True or False and equal Profile.periodic of what generate() makes "
                    f"({profile.periodic!r}). Got {periodic!r} instead.")  # fmt: skip
+    if periodic is False:
+        advice = call(cls, "not_periodic_advice()", gen.not_periodic_advice)
+        if not (isinstance(advice, tuple) and len(advice) == 2 and all(isinstance(t, str) and t.strip() for t in advice)):
+            fail(cls, f"not_periodic_advice() must be a (why, how) pair of sentences. Got {advice!r} instead.")
     if cls.points_param is not None:
         points = gen.params.model_dump()[cls.points_param]
         if points != profile.heights.shape[-1]:

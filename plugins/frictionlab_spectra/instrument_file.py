@@ -149,3 +149,9 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         channel=str(channel.name),
         undefined=missing,
     )
+
+
+def scan_not_periodic_advice(name: str) -> tuple[str, str]:
+    """``SpectrumGenerator.not_periodic_advice`` of a measured line or map."""
+    return (f"spectrum {name} is not periodic (periodic: false, a scan whose ends do not meet)",
+            "set spectrum.params.periodic: true if its ends meet (after detrend)")  # fmt: skip

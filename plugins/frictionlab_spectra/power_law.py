@@ -384,6 +384,10 @@ class BandLimitedSpectrum(SpectrumGenerator):
         """True, except for the cosine series, whose line is half a period."""
         return self.params.series == "fft"
 
+    def not_periodic_advice(self) -> tuple[str, str]:
+        return (f"spectrum {self.name} is not periodic (series: {self.params.series}, a line whose ends do not meet)",
+                "set spectrum.params.series: fft (a periodic line)")  # fmt: skip
+
     def generate(self, rng: np.random.Generator) -> Profile:
         """One line z_j = sum_k a_k cos(q_k x_j + phi_k), phi_k uniform (or complex Gaussian modes);
         the cosine series is the first half of a line of twice the length."""

@@ -34,7 +34,9 @@ from pydantic import Field
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, open_input, read_scan, scan_header
+from .instrument_file import (
+    ScanHeader, Undefined, Unit, is_instrument_file, open_input, read_scan, scan_header, scan_not_periodic_advice,
+)
 from .params_cache import cached_on_params
 
 MIN_POINTS = 8
@@ -101,6 +103,9 @@ class ProfileFile(SpectrumGenerator):
             return bool(self.params.periodic)  # known without reading the file
         header = self._header()
         return header.periodic if header is not None else self._line().periodic
+
+    def not_periodic_advice(self) -> tuple[str, str]:
+        return scan_not_periodic_advice(self.name)
 
     def grid_shape(self) -> tuple[int]:
         """The line's points, from the file's header when it has one (a .npy, an instrument

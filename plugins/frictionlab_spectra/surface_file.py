@@ -44,7 +44,9 @@ from pydantic import Field
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
 from .equivalent_line import EquivalentLine
-from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header
+from .instrument_file import (
+    ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header, scan_not_periodic_advice,
+)
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table, remove_mean
@@ -143,6 +145,9 @@ class SurfaceFile(SpectrumGenerator):
             return bool(self.params.periodic)  # known without reading the file
         header = self._header()
         return header.periodic if header is not None else self._map().periodic
+
+    def not_periodic_advice(self) -> tuple[str, str]:
+        return scan_not_periodic_advice(self.name)
 
     def grid_shape(self) -> tuple[int, int]:
         """The map's shape, from the file's header when it has one (a .npy, an instrument

@@ -39,6 +39,9 @@ SPECTRUM_BREAKAGES = [
     ("NegativePsd", {"psd": lambda self, q: -np.ones_like(q)}, r"psd\(q\) must be >= 0"),
     ("Raises", {"generate": lambda self, rng: 1 / 0}, "raised ZeroDivisionError"),
     ("BadRmsSlope", {"rms_slope": lambda self: float("nan")}, r"rms_slope\(\)"),
+    ("NoAdviceWhenNotPeriodic",
+     {"generate": lambda self, rng: Profile(rng.standard_normal(64), 1.0, periodic=False), "periodic": lambda self: False,
+      "not_periodic_advice": lambda self: ("not periodic", "")}, r"not_periodic_advice\(\) must be a \(why, how\)"),
 ]
 
 
@@ -97,3 +100,10 @@ def test_spectrum_check_fails_for_a_wrong_input_summary(qualname, summary, match
 
 def test_spectrum_check_passes_a_true_input_summary():
     fltesting.check_spectrum(spectrum_variant("TrueSummary", input_summary=_summary))
+
+
+def test_a_non_periodic_spectrum_with_its_own_advice_passes_and_the_default_advice_too():
+    line = {"generate": lambda self, rng: Profile(rng.standard_normal(64), 1.0, periodic=False), "periodic": lambda self: False}
+    fltesting.check_spectrum(spectrum_variant("PlainScan", **line))
+    own = ("spectrum scan is not periodic (closed: false)", "set spectrum.params.closed: true")
+    fltesting.check_spectrum(spectrum_variant("OwnScan", **line, not_periodic_advice=lambda self: own))
