@@ -215,10 +215,11 @@ class SweepProgress(SweepListener):
     """One line per point on ``stream`` (stderr); each point's run reports its own
     realizations through a ``ProgressReporter``."""
 
-    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER, clock=time.perf_counter):
         self.stream = BestEffort(stream or sys.stderr)
         self.interactive = interactive
         self.after = after
+        self.clock = clock  # a followed sweep's (sweeplog.SweepFollower.now): its times are the run's
 
     def _write(self, text: str) -> None:
         self.stream.write(text + "\n")
@@ -232,7 +233,7 @@ class SweepProgress(SweepListener):
         self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")
 
     def run_listeners(self, point):
-        return [ProgressReporter(self.stream, self.interactive, self.after)]
+        return [ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock)]
 
     def point_finished(self, sweep, point, result):
         if result.status == "error":

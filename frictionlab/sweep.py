@@ -40,7 +40,7 @@ from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
 from .results import write_figure
-from .rundir import STATE_FILE
+from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
 from .runner import run_to_folder
 
@@ -50,6 +50,7 @@ RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
     "contact_first", "contact_last", "elapsed_s", "folder",
 )  # fmt: skip
+UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that a resume runs again
 
 
 # ------------------------------------------------------------------ planning
@@ -221,8 +222,11 @@ class PointResult:
     folder: Path
     outcome: Any = None  # ensemble.RunOutcome
     error: str | None = None
+    recorded: dict[str, Any] | None = None  # a row read back (a followed sweep's): stands for ``outcome``
 
     def row(self) -> dict[str, Any]:
+        if self.recorded is not None:
+            return {**self.recorded, "point": self.point.number, "label": self.point.folder_name, **self.point.values}
         row: dict[str, Any] = {"point": self.point.number, "label": self.point.folder_name}
         row.update(self.point.values)
         row.update({k: None for k in RESULT_COLUMNS})
@@ -248,7 +252,7 @@ def row_fit(row: dict[str, Any]) -> LogFit | None:
 
 @dataclass
 class SweepOutcome:
-    status: str  # completed | interrupted | failed (some point failed)
+    status: str  # running (until it ends) | completed | interrupted | failed (some point failed)
     results: list[PointResult]
     elapsed: float
     files: dict[str, Path] = field(default_factory=dict)
@@ -307,10 +311,17 @@ def run_sweep(
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
     results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
-    outcome = SweepOutcome(status="completed", results=list(results.values()), elapsed=0.0)
+    outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
+    with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
+        _run_locked(sweep, out_dir, options, listeners, cancel, plot, outcome, results, started)
+    return outcome
+
+
+def _run_locked(sweep, out_dir, options, listeners, cancel, plot, outcome, results, started) -> None:
+    """The body of ``run_sweep``, while it holds the folder's lock (its last event is told before it is released)."""
+    write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json
     for listener in listeners:
         listener.sweep_started(sweep)
-    write_tables(sweep, outcome, out_dir)
     interrupted = False
     try:
         with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
@@ -328,6 +339,8 @@ def run_sweep(
         outcome.status = "interrupted"
     elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
         outcome.status = "failed"
+    else:
+        outcome.status = "completed"
     outcome.elapsed = time.perf_counter() - started
     outcome.files = write_tables(sweep, outcome, out_dir)
     if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
@@ -342,7 +355,6 @@ def run_sweep(
         write_tables(sweep, outcome, out_dir)
     for listener in listeners:
         listener.sweep_finished(sweep, outcome)
-    return outcome
 
 
 def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
@@ -373,10 +385,14 @@ def stored_sweep(out_dir: Path) -> dict:
     return {**data["base_preset"], "sweep": data["sweep"]}
 
 
-class _PointRecord(Record):
+class PointRecord(Record):
+    """A point's row of sweep.json (or of a followed sweep's progress log): each value checked."""
+
     folder: MemberName
     status: str
     done: Count | None = None
+    contact_first: Finite | None = None
+    contact_last: Finite | None = None
     a: Finite | None = None
     a_lo: Finite | None = None
     a_hi: Finite | None = None
@@ -399,7 +415,7 @@ class SweepRecord(Record):
     name: Annotated[str, Field(min_length=1)]
     status: str
     elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
-    points: list[_PointRecord]
+    points: list[PointRecord]
 
 
 def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
