@@ -88,6 +88,11 @@ class Sweep:
     def paths(self) -> list[str]:
         return list(self.spec.parameters)
 
+    @property
+    def preset_data(self) -> dict:
+        """The preset data this sweep is planned from (``plan_sweep`` takes it), as sweep.json stores it."""
+        return {**self.base, "sweep": self.spec.model_dump(mode="json", exclude_none=True)}
+
     def axis_label(self, path: str) -> str:
         """What a swept ``path`` is, for a figure: the head of its field's description
         (``spectrum.params.hurst``: "Hurst exponent H"), else its last key."""
@@ -382,7 +387,7 @@ def stored_sweep(out_dir: Path) -> dict:
     """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
     data, _ = read_sweep_record(out_dir)
-    return {**data["base_preset"], "sweep": data["sweep"]}
+    return {**data["base_preset"], "sweep": data["sweep"]}  # as Sweep.preset_data
 
 
 class PointRecord(Record):
