@@ -122,6 +122,7 @@ class ProgressLog:
     def run_finished(self, outcome):
         self.write({"event": "finished", "status": outcome.status, "done": outcome.done,
                     "failed": len(outcome.failures), "requested": outcome.requested, "error": outcome.error})  # fmt: skip
+        self.close()  # a sweep's child writes one log per point: none stays open
 
 
 # ------------------------------------------------------------------ reading

@@ -416,8 +416,12 @@ class FrictionlabApp(App):
             self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
             return
         try:
-            if run_state(folder).status == "running":
+            state = run_state(folder)
+            if state.status == "running":
                 self.show_running(folder)
+                return
+            if state.kind == "sweep" and state.status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
         except FrictionlabError:
             pass  # not a run folder (yet): said below
