@@ -46,14 +46,18 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
     folder in use or not its own (a fresh run), a run that does not fit in memory."""
     from .runner import check_memory
 
-    if lock_held(out_dir):
-        holder = lock_holder(out_dir)
-        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
-                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+    _check_not_in_use(out_dir)
     if not options.resume:
         RunDirectory(out_dir, force=options.force).check_fresh(scene)
     if options.memory_check:
         check_memory(scene, options)
+
+
+def _check_not_in_use(out_dir: str | Path) -> None:
+    if lock_held(out_dir):
+        holder = lock_holder(out_dir)
+        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
+                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
 
 
 def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
@@ -61,10 +65,7 @@ def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> No
     from .runner import check_memory
     from .sweep import check_sweep_folder
 
-    if lock_held(out_dir):
-        holder = lock_holder(out_dir)
-        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
-                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+    _check_not_in_use(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)
     if options.memory_check:
         for point in sweep.points:

@@ -50,7 +50,7 @@ RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
     "contact_first", "contact_last", "elapsed_s", "folder",
 )  # fmt: skip
-UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that a resume runs again
+UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that do not count it as done
 
 
 # ------------------------------------------------------------------ planning
@@ -309,7 +309,9 @@ def run_sweep(
     """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``),
     and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end (and each
     point's plot.png) unless ``plot`` is False. ``out_dir``
-    must be new, empty or a folder of this same sweep unless ``options.force``."""
+    must be new, empty or a folder of this same sweep unless ``options.force``. It holds
+    the folder's lock (``run.lock``) while it runs, and its sweep.json says "running"
+    until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
     listeners = list(listeners)
@@ -318,48 +320,43 @@ def run_sweep(
     results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
     outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
     with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
-        _run_locked(sweep, out_dir, options, listeners, cancel, plot, outcome, results, started)
+        write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json
+        for listener in listeners:
+            listener.sweep_started(sweep)
+        interrupted = False
+        try:
+            with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
+                for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
+                    results[result.point.number] = result
+                    outcome.results = list(results.values())
+                    outcome.elapsed = time.perf_counter() - started
+                    write_tables(sweep, outcome, out_dir)
+                    for listener in listeners:
+                        listener.point_finished(sweep, result.point, result)
+        except KeyboardInterrupt:  # Ctrl-C between two points
+            interrupted = True
+        statuses = {r.status for r in outcome.results}
+        if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
+            outcome.status = "interrupted"
+        elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
+            outcome.status = "failed"
+        else:
+            outcome.status = "completed"
+        outcome.elapsed = time.perf_counter() - started
+        outcome.files = write_tables(sweep, outcome, out_dir)
+        if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
+
+            def draw(fh) -> None:
+                from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+
+                plot_sweep(sweep, outcome.rows, fh)
+
+            write_figure(out_dir / "sweep.png", draw)
+            outcome.files["plot"] = out_dir / "sweep.png"
+            write_tables(sweep, outcome, out_dir)
+        for listener in listeners:  # before the lock goes: a follower that sees it gone has heard this
+            listener.sweep_finished(sweep, outcome)
     return outcome
-
-
-def _run_locked(sweep, out_dir, options, listeners, cancel, plot, outcome, results, started) -> None:
-    """The body of ``run_sweep``, while it holds the folder's lock (its last event is told before it is released)."""
-    write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json
-    for listener in listeners:
-        listener.sweep_started(sweep)
-    interrupted = False
-    try:
-        with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
-            for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
-                results[result.point.number] = result
-                outcome.results = list(results.values())
-                outcome.elapsed = time.perf_counter() - started
-                write_tables(sweep, outcome, out_dir)
-                for listener in listeners:
-                    listener.point_finished(sweep, result.point, result)
-    except KeyboardInterrupt:  # Ctrl-C between two points
-        interrupted = True
-    statuses = {r.status for r in outcome.results}
-    if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
-        outcome.status = "interrupted"
-    elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
-        outcome.status = "failed"
-    else:
-        outcome.status = "completed"
-    outcome.elapsed = time.perf_counter() - started
-    outcome.files = write_tables(sweep, outcome, out_dir)
-    if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
-
-        def draw(fh) -> None:
-            from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
-
-            plot_sweep(sweep, outcome.rows, fh)
-
-        write_figure(out_dir / "sweep.png", draw)
-        outcome.files["plot"] = out_dir / "sweep.png"
-        write_tables(sweep, outcome, out_dir)
-    for listener in listeners:
-        listener.sweep_finished(sweep, outcome)
 
 
 def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
