@@ -102,3 +102,23 @@ def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
     (tmp_path / "plain").mkdir()
     followed = run_cli("follow", tmp_path / "plain")
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
+
+
+def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path):
+    data = merge(SMALL_PRESET, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}})
+    preset = write_preset(tmp_path, data, "sweep.yaml")
+    out = tmp_path / "sw"
+    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+    heard = [follow.stderr.readline()]
+    while "100000 realizations of" not in heard[-1]:  # up to the second point's run, followed live
+        heard.append(follow.stderr.readline())
+        assert heard[-1], "follow ended before the second point's run"
+    os.kill(told["pid"], signal.SIGTERM)
+    stdout, _ = follow.communicate(timeout=60)
+    row = json.loads((out / "sweep.json").read_text())["points"][0]
+    assert heard[0].startswith("small: sweep of 2 points") and heard[1].startswith("point 1/2: realizations=4")
+    assert any(f"1  realizations=4: a = {row['a']:.4f}" in line for line in heard)  # how the first point ended
+    assert follow.returncode == 1
+    assert stdout.startswith(f"small: interrupted, 1/2 points, in {out}/; frictionlab resume {out} continues it")
