@@ -267,6 +267,11 @@ class SweepOutcome:
         return [r.row() for r in self.results]
 
 
+def point_folder(out_dir: str | Path, point: SweepPoint) -> Path:
+    """Where ``point`` runs in the sweep's folder ``out_dir``."""
+    return Path(out_dir) / "points" / point.folder_name
+
+
 def _run_points(
     sweep: Sweep, out_dir: Path, options: RunOptions, listeners: list[SweepListener], cancel, plot: bool = True
 ) -> Iterator[PointResult]:
@@ -277,7 +282,7 @@ def _run_points(
     and the sweep goes on.
     """
     for point in sweep.points:
-        folder = out_dir / "points" / point.folder_name
+        folder = point_folder(out_dir, point)
         if cancel.is_set():
             return
         for listener in listeners:
@@ -317,7 +322,7 @@ def run_sweep(
     listeners = list(listeners)
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
-    results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
+    results = {p.number: PointResult(p, "pending", point_folder(out_dir, p)) for p in sweep.points}
     outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
     with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
         write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json

@@ -20,11 +20,7 @@ from .errors import RunFolderError
 from .listeners import SweepListener
 from .progresslog import Finished, Follower, ProgressLog, ProgressReader, _number, _whole
 from .runfolder import checked
-from .sweep import UNFINISHED, PointRecord, PointResult, Sweep, SweepPoint
-
-
-def point_folder(out_dir: Path, point: SweepPoint) -> Path:
-    return Path(out_dir) / "points" / point.folder_name
+from .sweep import UNFINISHED, PointRecord, PointResult, Sweep, SweepPoint, point_folder
 
 
 class SweepProgressLog(SweepListener):
