@@ -184,8 +184,8 @@ class RunPane(Vertical, can_focus=True):
 
     def show_sweep_outcome(self, sweep) -> str:
         """Show a finished sweep (``FinishedSweep``, read back from its folder); return the line the app notifies."""
-        if sweep.last is not None:  # the last point's final fit: no "(interim)" left once the sweep is over
-            self._set("run-fit", "\n".join(fit_lines(sweep.last.fit, final=True, f_formula=sweep.last.f_formula)))
+        if sweep.last is not None:  # the last point as it ended (a short one may have been over before it was read)
+            self.show_outcome(sweep.last)
         self._set("sweep-point", f"{sweep.status}: {sweep.finished}/{sweep.total} points in "
                                  f"{format_duration(sweep.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
         return f"Sweep {sweep.status}: {sweep.finished}/{sweep.total} points"
