@@ -70,7 +70,7 @@ def test_a_detached_sweep_completes_every_point_after_the_session_that_started_i
 def test_sigterm_leaves_a_detached_sweep_interrupted_and_resume_detach_completes_it_to_the_same_numbers(tmp_path):
     from frictionlab.cli.main import main
 
-    data = merge(SWEEP, {"realizations": 1500, "spectrum": {"params": {"points": 512}}})
+    data = merge(SWEEP, {"realizations": 3000, "spectrum": {"params": {"points": 512}}})
     out = tmp_path / "sweep"
     process = start_detached(data, out, RunOptions(workers=1), plot=False)
     wait_started(process, out)
@@ -80,7 +80,8 @@ def test_sigterm_leaves_a_detached_sweep_interrupted_and_resume_detach_completes
     assert process.wait(timeout=60) == 143
     state = run_state(out)
     statuses = [status for status, _, _ in fits(out)]
-    assert (state.status, state.done, statuses) == ("interrupted", 1, ["completed", "interrupted", "pending"])
+    assert state.status == "interrupted" and 1 <= state.done < 3 and statuses[0] == "completed"
+    assert statuses[state.done:] in (["interrupted", "pending"], ["interrupted"], ["pending"])  # stopped in a point, or between two
     assert main(["resume", str(out), "--detach", "--workers", "1", "--no-plot"]) == 0
     wait_for(lambda: run_state(out).status != "running", timeout=300)
     here = run_sweep(plan_sweep(data), tmp_path / "here", RunOptions(workers=1), plot=False)
