@@ -85,7 +85,7 @@ def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = Ru
         stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         start_new_session=True, close_fds=True,
     )  # fmt: skip
-    process.stdin.write(json.dumps(request).encode())
+    process.stdin.write(json.dumps(request, default=str).encode())  # a sweep's data as sweep.json stores it
     process.stdin.close()
     return process
 
