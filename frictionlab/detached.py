@@ -1,15 +1,15 @@
 """Runs that do not depend on the terminal that started them, and the state of a run folder.
 
-``start_detached`` starts a run as its own process in its own session (a closed
-terminal's SIGHUP does not reach it; its stdin, stdout and stderr are not the
-terminal): it holds the folder's lock (``run.lock`` names its pid) and writes its
-events to ``progress.jsonl`` (``progresslog``), which any front end can follow.
-Cancelling it is SIGTERM to that pid: what finished is kept, the run ends
-"interrupted" and can be resumed.
+``start_detached`` starts a run (or a sweep: one run per point) as its own process in
+its own session (a closed terminal's SIGHUP does not reach it; its stdin, stdout and
+stderr are not the terminal): it holds the folder's lock (``run.lock`` names its pid)
+and writes its events to ``progress.jsonl`` (``progresslog``; a sweep's, ``sweeplog``),
+which any front end can follow. Cancelling it is SIGTERM to that pid: what finished is
+kept, the run ends "interrupted" and can be resumed.
 
-``run_state`` tells what a folder holds: a run going on, or one that ended and how.
-A manifest that still says "running" while no live process holds the lock was left
-by a run that died: it reads as interrupted, never as running.
+``run_state`` tells what a folder holds: a run or a sweep going on, or one that ended
+and how. A manifest (a sweep's sweep.json) that still says "running" while no live
+process holds the lock was left by one that died: it reads as interrupted, never as running.
 """
 
 from __future__ import annotations
@@ -32,8 +32,10 @@ from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json, read_member
 
 MAX_LOCK_BYTES = 4096
+SWEEP_FILE = "sweep.json"  # what marks a sweep's folder (it has no run.json)
 TAIL_BYTES = 256 * 1024  # of progress.jsonl, read for the count of a listed run
 STARTED_WAIT = 120.0  # seconds ``wait_started`` waits for the run's first event
+STARTED = ("started", "sweep_started")  # the first event of a run, of a sweep
 
 
 # ------------------------------------------------------------------ starting
@@ -44,28 +46,46 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
     folder in use or not its own (a fresh run), a run that does not fit in memory."""
     from .runner import check_memory
 
-    if lock_held(out_dir):
-        holder = lock_holder(out_dir)
-        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
-                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+    _check_not_in_use(out_dir)
     if not options.resume:
         RunDirectory(out_dir, force=options.force).check_fresh(scene)
     if options.memory_check:
         check_memory(scene, options)
 
 
+def _check_not_in_use(out_dir: str | Path) -> None:
+    if lock_held(out_dir):
+        holder = lock_holder(out_dir)
+        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
+                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+
+
+def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
+    """``check_startable`` for a sweep (``sweep.Sweep``): its folder, and each point's memory."""
+    from .runner import check_memory
+    from .sweep import check_sweep_folder
+
+    _check_not_in_use(out_dir)
+    check_sweep_folder(sweep, Path(out_dir), options.force)
+    if options.memory_check:
+        for point in sweep.points:
+            check_memory(point.scene, options)
+
+
 def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions(), *,
-                   plot: bool = True) -> subprocess.Popen:  # fmt: skip
-    """Start the run of the preset ``resolved`` (``Scene.resolved()``) into ``out_dir`` as
-    its own process in a new session, and return at once. The preset and the options
+                   plot: bool = True, source: str | None = None) -> subprocess.Popen:  # fmt: skip
+    """Start the run of the preset ``resolved`` (``Scene.resolved()``; for a sweep, the
+    preset data with its ``sweep`` section, as ``sweep.plan_sweep`` takes it) into ``out_dir``
+    as its own process in a new session, and return at once. The preset and the options
     go through a pipe, read before the run begins: the terminal is none of its files."""
-    request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot}
+    request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot,
+               "source": source}  # fmt: skip
     process = subprocess.Popen(
         [sys.executable, "-m", "frictionlab.detached"],
         stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         start_new_session=True, close_fds=True,
     )  # fmt: skip
-    process.stdin.write(json.dumps(request).encode())
+    process.stdin.write(json.dumps(request, default=str).encode())  # a sweep's data as sweep.json stores it
     process.stdin.close()
     return process
 
@@ -77,7 +97,7 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         for event in reader.new_events():
-            if event["event"] == "started":
+            if event["event"] in STARTED:
                 return
             if event["event"] == "error":
                 _raise_run_error(event)
@@ -85,7 +105,7 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
             for event in reader.new_events():
                 if event["event"] == "error":
                     _raise_run_error(event)
-            if any(event["event"] == "started" for event in ProgressReader(out_dir).new_events()):
+            if any(event["event"] in STARTED for event in ProgressReader(out_dir).new_events()):
                 return  # a run so short it ended already
             raise FrictionlabError(f"the run into {out_dir} ended at once (exit code {process.returncode}) without a word")
         time.sleep(0.05)
@@ -112,20 +132,20 @@ def cancel(pid: int) -> bool:
 
 def _child() -> int:
     """The detached process: read the request from stdin, run it, tell the folder how it went."""
-    from .preset import build_scene
-    from .runner import run_to_folder
     from .signals import RaiseOnSigterm
+    from .sweeplog import SweepProgressLog
 
     if hasattr(signal, "SIGHUP"):
         signal.signal(signal.SIGHUP, signal.SIG_IGN)  # no terminal of its own; a stray hangup is not a cancel
     request = json.loads(sys.stdin.read())
     out = Path(request["out"])
-    log = ProgressLog(out)
+    is_sweep = bool(request["preset"].get("sweep"))
+    log = SweepProgressLog(out) if is_sweep else ProgressLog(out)
     try:
         with RaiseOnSigterm():
-            scene = build_scene(request["preset"])
             options = RunOptions(**request["options"])
-            outcome, _ = run_to_folder(scene, out, options, listeners=[log], plot=bool(request.get("plot", True)))
+            run = _run_sweep if is_sweep else _run_one
+            status = run(request, out, options, log)
     except FrictionlabError as exc:
         log.error(str(exc), exc.exit_code)
         return exc.exit_code
@@ -140,9 +160,27 @@ def _child() -> int:
         return ExitCode.INTERNAL
     finally:
         log.close()
-    if outcome.status in ("interrupted", "cancelled"):
+    if status in ("interrupted", "cancelled"):
         return ExitCode.TERMINATED
-    return ExitCode.OK if outcome.status == "completed" and not outcome.failures else ExitCode.RUNTIME_FAILURE
+    return ExitCode.OK if status == "completed" else ExitCode.RUNTIME_FAILURE
+
+
+def _run_one(request: dict, out: Path, options: RunOptions, log: ProgressLog) -> str:
+    """One ensemble; its status ("failed" when some realization failed)."""
+    from .preset import build_scene
+    from .runner import run_to_folder
+
+    scene = build_scene(request["preset"])
+    outcome, _ = run_to_folder(scene, out, options, listeners=[log], plot=bool(request.get("plot", True)))
+    return "failed" if outcome.status == "completed" and outcome.failures else outcome.status
+
+
+def _run_sweep(request: dict, out: Path, options: RunOptions, log) -> str:
+    """One ensemble per point (a point with failures makes the sweep "failed"); its status."""
+    from .sweep import plan_sweep, run_sweep
+
+    sweep = plan_sweep(request["preset"], source=request.get("source"))
+    return run_sweep(sweep, out, options, listeners=[log], plot=bool(request.get("plot", True))).status
 
 
 # ------------------------------------------------------------------ the state of a folder
@@ -207,33 +245,43 @@ def lock_held(folder: str | Path) -> bool:
 @dataclass
 class RunState:
     """What a run folder holds now. ``status``: running, completed, cancelled,
-    interrupted or failed; ``pid`` the live run's process (running only)."""
+    interrupted or failed; ``pid`` the live run's process (running only). ``kind``:
+    "run", or "sweep" (a sweep's folder: ``done`` and ``total`` count its points)."""
 
     folder: Path
     name: str
     status: str
-    done: int | None  # realizations finished, None where nothing says
+    done: int | None  # realizations (a sweep's points) finished, None where nothing says
     total: int | None
     pid: int | None = None
+    kind: str = "run"
 
     @property
     def resumable(self) -> bool:
         return self.status in ("cancelled", "interrupted", "failed")
 
     def to_dict(self) -> dict:
-        return {"folder": str(self.folder), "name": self.name, "status": self.status, "done": self.done,
-                "total": self.total, "pid": self.pid}  # fmt: skip
+        return {"folder": str(self.folder), "kind": self.kind, "name": self.name, "status": self.status,
+                "done": self.done, "total": self.total, "pid": self.pid}  # fmt: skip
 
 
 def _count(value) -> int | None:
     return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else None
 
 
+def _live_holder(folder: Path) -> int | None:
+    """The pid of the live process that holds the folder's lock, None if none does."""
+    holder = lock_holder(folder)
+    return holder if holder is not None and process_alive(holder) and lock_held(folder) else None
+
+
 def run_state(folder: str | Path) -> RunState:
-    """The state of the run in ``folder``; RunFolderError if it holds none (or a damaged one)."""
+    """The state of the run (or sweep) in ``folder``; RunFolderError if it holds none (or a damaged one)."""
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
         raise RunFolderError(f"{folder} is not a run folder (not a folder, or a link to one)")
+    if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):
+        return sweep_state(folder)
     manifest = RunDirectory(folder).state()  # read as untrusted input
     if manifest is None:
         raise RunFolderError(f"{folder} holds no run (no {STATE_FILE})")
@@ -243,16 +291,29 @@ def run_state(folder: str | Path) -> RunState:
     total = _count(manifest.get("realizations"))
     done, pid = _last_count(folder), None
     if status == "running":
-        holder = lock_holder(folder)
-        if holder is not None and process_alive(holder) and lock_held(folder):
-            pid = holder
-        else:
+        pid = _live_holder(folder)
+        if pid is None:
             status = "interrupted"  # the process that wrote "running" is gone
     summary = _summary(folder)
     if summary is not None and status != "running":
         counts = summary.get("realizations") if isinstance(summary.get("realizations"), dict) else {}
         done = _count(counts.get("done")) if _count(counts.get("done")) is not None else done
     return RunState(folder, name, status, done, total, pid)
+
+
+def sweep_state(folder: str | Path) -> RunState:
+    """The state of the sweep in ``folder`` (its sweep.json, checked); RunFolderError if it holds none."""
+    from .sweep import UNFINISHED, read_sweep_record
+
+    folder = Path(folder)
+    _, record = read_sweep_record(folder)
+    status, pid = record.status, None
+    if status == "running":
+        pid = _live_holder(folder)
+        if pid is None:
+            status = "interrupted"  # the process that wrote "running" is gone
+    done = sum(point.status not in UNFINISHED for point in record.points)
+    return RunState(folder, record.name, status, done, len(record.points), pid, kind="sweep")
 
 
 def _summary(folder: Path) -> dict | None:
@@ -283,13 +344,14 @@ def _last_count(folder: Path) -> int | None:
 
 def list_run_states(runs_dir: str | Path) -> list[RunState]:
     """The state of every run folder directly under ``runs_dir`` (one holding a
-    ``run.json``), running ones first, then the newest; links are not followed."""
+    ``run.json``, or a sweep's ``sweep.json``), running ones first, then the newest;
+    links are not followed."""
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
     states = []
     for folder in runs_dir.iterdir():
-        if folder.is_symlink() or not (folder / STATE_FILE).is_file():
+        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in (STATE_FILE, SWEEP_FILE)):
             continue
         try:
             states.append((folder.stat().st_mtime, run_state(folder)))

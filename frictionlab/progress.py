@@ -213,12 +213,16 @@ class ProgressReporter:
 
 class SweepProgress(SweepListener):
     """One line per point on ``stream`` (stderr); each point's run reports its own
-    realizations through a ``ProgressReporter``."""
+    realizations through a ``ProgressReporter``. ``fits``: a line with each point's fit
+    as it ends, too (where no table follows the sweep: ``frictionlab follow``)."""
 
-    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER, clock=time.perf_counter,
+                 fits: bool = False):  # fmt: skip
+        self.fits = fits
         self.stream = BestEffort(stream or sys.stderr)
         self.interactive = interactive
         self.after = after
+        self.clock = clock  # a followed sweep's (sweeplog.SweepFollower.now): its times are the run's
 
     def _write(self, text: str) -> None:
         self.stream.write(text + "\n")
@@ -232,8 +236,26 @@ class SweepProgress(SweepListener):
         self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")
 
     def run_listeners(self, point):
-        return [ProgressReporter(self.stream, self.interactive, self.after)]
+        return [ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock)]
 
     def point_finished(self, sweep, point, result):
         if result.status == "error":
             self._write(f"point {point.number} failed: {result.error}")
+        elif self.fits:
+            self._write(point_result_line(sweep, point, result.row()))
+
+
+def point_result_line(sweep, point, row: dict) -> str:
+    """``    2  hurst=0.7: a = ..., b = ..., R^2 = ..., contacts ..``: how a point ended."""
+    from .fit import format_estimate
+    from .preset import yaml_scalar
+    from .sweep import row_fit
+
+    values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(point.values[p])}" for p in sweep.paths)
+    fit = row_fit(row)
+    if fit is None:
+        return f"  {point.number:>3}  {values}: {row['status']}"
+    contacts = "" if row["contact_first"] is None else f", contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
+    return (f"  {point.number:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
+            f"b = {format_estimate(fit.b, fit.b_ci)}, R^2 = {fit.r2:.3f}{contacts}"
+            + ("" if row["status"] == "completed" else f" ({row['status']})"))  # fmt: skip

@@ -90,10 +90,14 @@ class ProgressLog:
             self._open(truncate=False)  # appended: the log may be another live run's (a folder in use)
         self.write({"event": "error", "pid": os.getpid(), "message": message, "exit_code": int(exit_code)})
 
+    def begin(self, event: dict) -> None:
+        """Start the file afresh (a new run, or its resume) with ``event``."""
+        self._open(truncate=True)
+        self.write(event)
+
     @hookimpl
     def run_started(self, run):
-        self._open(truncate=True)
-        self.write({"event": "started", "pid": os.getpid(), "name": run.scene.preset.name, "total": run.total,
+        self.begin({"event": "started", "pid": os.getpid(), "name": run.scene.preset.name, "total": run.total,
                     "workers": run.workers, "executor": run.executor, "resumed": run.resumed, "retried": run.retried})  # fmt: skip
         for done, result in enumerate(run.restored, start=1):
             self.write(_event_of(result, done, run.total, restored=True))
@@ -118,6 +122,7 @@ class ProgressLog:
     def run_finished(self, outcome):
         self.write({"event": "finished", "status": outcome.status, "done": outcome.done,
                     "failed": len(outcome.failures), "requested": outcome.requested, "error": outcome.error})  # fmt: skip
+        self.close()  # a sweep's child writes one log per point: none stays open
 
 
 # ------------------------------------------------------------------ reading

@@ -40,7 +40,7 @@ from .plugin import KINDS
 from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from .registry import Registry, default_registry
 from .results import write_figure
-from .rundir import STATE_FILE
+from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
 from .runner import run_to_folder
 
@@ -50,6 +50,7 @@ RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
     "contact_first", "contact_last", "elapsed_s", "folder",
 )  # fmt: skip
+UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that do not count it as done
 
 
 # ------------------------------------------------------------------ planning
@@ -86,6 +87,11 @@ class Sweep:
     @property
     def paths(self) -> list[str]:
         return list(self.spec.parameters)
+
+    @property
+    def preset_data(self) -> dict:
+        """The preset data this sweep is planned from (``plan_sweep`` takes it), as sweep.json stores it."""
+        return {**self.base, "sweep": self.spec.model_dump(mode="json", exclude_none=True)}
 
     def axis_label(self, path: str) -> str:
         """What a swept ``path`` is, for a figure: the head of its field's description
@@ -221,8 +227,11 @@ class PointResult:
     folder: Path
     outcome: Any = None  # ensemble.RunOutcome
     error: str | None = None
+    recorded: dict[str, Any] | None = None  # a row read back (a followed sweep's): stands for ``outcome``
 
     def row(self) -> dict[str, Any]:
+        if self.recorded is not None:
+            return {**self.recorded, "point": self.point.number, "label": self.point.folder_name, **self.point.values}
         row: dict[str, Any] = {"point": self.point.number, "label": self.point.folder_name}
         row.update(self.point.values)
         row.update({k: None for k in RESULT_COLUMNS})
@@ -248,7 +257,7 @@ def row_fit(row: dict[str, Any]) -> LogFit | None:
 
 @dataclass
 class SweepOutcome:
-    status: str  # completed | interrupted | failed (some point failed)
+    status: str  # running (until it ends) | completed | interrupted | failed (some point failed)
     results: list[PointResult]
     elapsed: float
     files: dict[str, Path] = field(default_factory=dict)
@@ -256,6 +265,11 @@ class SweepOutcome:
     @property
     def rows(self) -> list[dict[str, Any]]:
         return [r.row() for r in self.results]
+
+
+def point_folder(out_dir: str | Path, point: SweepPoint) -> Path:
+    """Where ``point`` runs in the sweep's folder ``out_dir``."""
+    return Path(out_dir) / "points" / point.folder_name
 
 
 def _run_points(
@@ -268,7 +282,7 @@ def _run_points(
     and the sweep goes on.
     """
     for point in sweep.points:
-        folder = out_dir / "points" / point.folder_name
+        folder = point_folder(out_dir, point)
         if cancel.is_set():
             return
         for listener in listeners:
@@ -300,48 +314,53 @@ def run_sweep(
     """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``),
     and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end (and each
     point's plot.png) unless ``plot`` is False. ``out_dir``
-    must be new, empty or a folder of this same sweep unless ``options.force``."""
+    must be new, empty or a folder of this same sweep unless ``options.force``. It holds
+    the folder's lock (``run.lock``) while it runs, and its sweep.json says "running"
+    until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
     listeners = list(listeners)
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()
-    results = {p.number: PointResult(p, "pending", out_dir / "points" / p.folder_name) for p in sweep.points}
-    outcome = SweepOutcome(status="completed", results=list(results.values()), elapsed=0.0)
-    for listener in listeners:
-        listener.sweep_started(sweep)
-    write_tables(sweep, outcome, out_dir)
-    interrupted = False
-    try:
-        with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
-            for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
-                results[result.point.number] = result
-                outcome.results = list(results.values())
-                outcome.elapsed = time.perf_counter() - started
-                write_tables(sweep, outcome, out_dir)
-                for listener in listeners:
-                    listener.point_finished(sweep, result.point, result)
-    except KeyboardInterrupt:  # Ctrl-C between two points
-        interrupted = True
-    statuses = {r.status for r in outcome.results}
-    if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
-        outcome.status = "interrupted"
-    elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
-        outcome.status = "failed"
-    outcome.elapsed = time.perf_counter() - started
-    outcome.files = write_tables(sweep, outcome, out_dir)
-    if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
+    results = {p.number: PointResult(p, "pending", point_folder(out_dir, p)) for p in sweep.points}
+    outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
+    with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
+        write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json
+        for listener in listeners:
+            listener.sweep_started(sweep)
+        interrupted = False
+        try:
+            with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
+                for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
+                    results[result.point.number] = result
+                    outcome.results = list(results.values())
+                    outcome.elapsed = time.perf_counter() - started
+                    write_tables(sweep, outcome, out_dir)
+                    for listener in listeners:
+                        listener.point_finished(sweep, result.point, result)
+        except KeyboardInterrupt:  # Ctrl-C between two points
+            interrupted = True
+        statuses = {r.status for r in outcome.results}
+        if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
+            outcome.status = "interrupted"
+        elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
+            outcome.status = "failed"
+        else:
+            outcome.status = "completed"
+        outcome.elapsed = time.perf_counter() - started
+        outcome.files = write_tables(sweep, outcome, out_dir)
+        if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
 
-        def draw(fh) -> None:
-            from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+            def draw(fh) -> None:
+                from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
 
-            plot_sweep(sweep, outcome.rows, fh)
+                plot_sweep(sweep, outcome.rows, fh)
 
-        write_figure(out_dir / "sweep.png", draw)
-        outcome.files["plot"] = out_dir / "sweep.png"
-        write_tables(sweep, outcome, out_dir)
-    for listener in listeners:
-        listener.sweep_finished(sweep, outcome)
+            write_figure(out_dir / "sweep.png", draw)
+            outcome.files["plot"] = out_dir / "sweep.png"
+            write_tables(sweep, outcome, out_dir)
+        for listener in listeners:  # before the lock goes: a follower that sees it gone has heard this
+            listener.sweep_finished(sweep, outcome)
     return outcome
 
 
@@ -370,13 +389,17 @@ def stored_sweep(out_dir: Path) -> dict:
     """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
     data, _ = read_sweep_record(out_dir)
-    return {**data["base_preset"], "sweep": data["sweep"]}
+    return {**data["base_preset"], "sweep": data["sweep"]}  # as Sweep.preset_data
 
 
-class _PointRecord(Record):
+class PointRecord(Record):
+    """A point's row of sweep.json (or of a followed sweep's progress log): each value checked."""
+
     folder: MemberName
     status: str
     done: Count | None = None
+    contact_first: Finite | None = None
+    contact_last: Finite | None = None
     a: Finite | None = None
     a_lo: Finite | None = None
     a_hi: Finite | None = None
@@ -399,7 +422,7 @@ class SweepRecord(Record):
     name: Annotated[str, Field(min_length=1)]
     status: str
     elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
-    points: list[_PointRecord]
+    points: list[PointRecord]
 
 
 def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:

@@ -29,11 +29,14 @@ SHAPES = {
     "predict": ("predict", "`f`, `xi` and `xi_ci`, with the law's `a` and `b`, `extrapolated`, `beyond_full_contact`"),
     "study": ("study", "`recommendation` (text), `rows` (one per setting: error against cost), `files`, `interrupted`"),
     "report": ("report", "`report` (the Markdown file) and `figures` (the files it shows)"),
-    "detached": ("run --detach, resume --detach", "`folder`, `pid` of the run's own process, `status` (`running`)"),
-    "runs": ("runs", "`runs_dir` and `runs`: each run folder's `folder`, `name`, `status` (`running` only while its "
-             "process holds the folder; a run whose process died is `interrupted`), `done`, `total`, `pid`"),
-    "follow": ("follow", "the run's final state: `folder`, `name`, `status`, `done`, `total`, `pid`, and `error` "
-               "(the run's error, or null)"),
+    "detached": ("run --detach, resume --detach", "`folder`, `kind` (`run`, or `sweep` for a preset with a sweep), "
+                 "`pid` of the run's own process, `status` (`running`)"),
+    "runs": ("runs", "`runs_dir` and `runs`: each run folder's `folder`, `kind` (`run`, or `sweep`: a sweep's folder is "
+             "one entry), `name`, `status` (`running` only while its process holds the folder; a run whose process "
+             "died is `interrupted`), `done`, `total` (realizations; a sweep's points), `pid`"),
+    "follow": ("follow", "the run's final state: `folder`, `kind`, `name`, `status`, `done`, `total`, `pid`, and "
+               "`error` (the run's error, or null); for a sweep also `points`: each point's row of sweep.json "
+               "(its values, `status`, fit, `folder`)"),
     "error": ("any, when refused or failed", "`error` (the message), `field` (the preset field or option at fault, "
               "or null), `problems` (every problem of a preset, else the message alone), `exit_code` (the "
               "process's), `command`"),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -34,13 +34,15 @@ def run(args) -> ExitCode:
     run_dir = Path(args.run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
-        if args.detach:
-            raise FrictionlabError("--detach resumes one ensemble, not a sweep: resume the sweep without --detach")
+        from ..preset import build_scene
         from ..sweep import stored_sweep
         from .options import executor_run_options
 
         args.preset = str(run_dir / "sweep.json")
-        return run_command.run_sweep_into(args, stored_sweep(run_dir), run_dir, executor_run_options(args, resume=True))
+        data, options = stored_sweep(run_dir), executor_run_options(args, resume=True)
+        if args.detach:
+            return run_command.detach(args, data, build_scene(data), run_dir, options)
+        return run_command.run_sweep_into(args, data, run_dir, options)
     RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
     args.preset = str(run_dir / PRESET_FILE)
     return run_command.run(args)

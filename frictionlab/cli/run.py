@@ -19,7 +19,8 @@ def add_parser(sub) -> None:
         "curve.csv, realizations.npz, preset.yaml, then plot.png after the fit is printed.",
         epilog="examples:\n  frictionlab run quickstart\n  frictionlab run quickstart --set spectrum.params.hurst=0.6 --out runs/h06\n"
         "  frictionlab run presets/benad2012-fig2.yaml --no-plot --json\n"
-        "  frictionlab run quickstart --detach      runs on after the terminal closes (frictionlab follow DIR)",
+        "  frictionlab run quickstart --detach      runs on after the terminal closes (frictionlab follow DIR);\n"
+        "                                           a preset with a sweep too",
     )
     p.add_argument("preset", help="preset YAML file, or a built-in preset's name (frictionlab presets)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: runs/<name>-<timestamp>)")
@@ -68,7 +69,7 @@ def run(args) -> ExitCode:
     out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
     try:
         if args.detach:
-            return _detach(args, scene, out_dir, options)
+            return detach(args, data, scene, out_dir, options)
         if scene.preset.sweep is not None:  # one ensemble per point
             return run_sweep_into(args, data, out_dir, options)
         return _run_scene(args, scene, out_dir, options)
@@ -86,20 +87,28 @@ def add_detach_option(p) -> None:
     )  # fmt: skip
 
 
-def _detach(args, scene, out_dir: Path, options) -> ExitCode:
-    from ..detached import check_startable, start_detached, wait_started
+def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
+    """Start the run of ``scene`` (a sweep, when ``data`` has one) as a process of its own; say where."""
+    from ..detached import check_startable, check_sweep_startable, start_detached, wait_started
 
-    if scene.preset.sweep is not None:
-        raise FrictionlabError("--detach runs one ensemble, not a sweep: run the sweep without --detach (under nohup or tmux)")
-    check_startable(scene, out_dir, options)
-    process = start_detached(scene.resolved(), out_dir, options, plot=not args.no_plot)
+    if data.get("sweep"):
+        from ..sweep import plan_sweep
+
+        sweep = plan_sweep(data, source=str(args.preset))
+        check_sweep_startable(sweep, out_dir, options)
+        process = start_detached(data, out_dir, options, plot=not args.no_plot, source=str(args.preset))
+        kind, what = "sweep", f"sweep of {counted(len(sweep.points), 'point')}"
+    else:
+        check_startable(scene, out_dir, options)
+        process = start_detached(scene.resolved(), out_dir, options, plot=not args.no_plot)
+        kind, what = "run", "running"
     wait_started(process, out_dir)
     if args.json:
         from .jsonout import emit
 
-        emit("detached", {"folder": str(out_dir), "pid": process.pid, "status": "running"})
+        emit("detached", {"folder": str(out_dir), "kind": kind, "pid": process.pid, "status": "running"})
     else:
-        print(f"{scene.preset.name}: running detached in {out_dir}/ (pid {process.pid})\n"
+        print(f"{scene.preset.name}: {what} detached in {out_dir}/ (pid {process.pid})\n"
               f"  frictionlab follow {out_dir}    shows its progress\n"
               f"  kill -TERM {process.pid}    cancels it (what finished is kept; frictionlab resume continues it)")  # fmt: skip
     return ExitCode.OK
@@ -160,7 +169,7 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
 
         emit("sweep", json.loads((out_dir / "sweep.json").read_text(encoding="utf-8")))
     else:
-        print(sweep_table(sweep, outcome, out_dir))
+        print(sweep_table(sweep, outcome.status, outcome.elapsed, outcome.rows, out_dir))
     if outcome.status == "interrupted":
         return interrupted_exit_code()
     return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK
@@ -200,24 +209,12 @@ def result_table(scene, outcome, out_dir: Path) -> str:
     return "\n".join(lines)
 
 
-def sweep_table(sweep, outcome, out_dir: Path) -> str:
-    """What ``frictionlab run`` prints on stdout after a sweep: one line per point."""
-    from ..fit import format_estimate
-    from ..preset import yaml_scalar
-    from ..sweep import row_fit
+def sweep_table(sweep, status: str, elapsed: float, rows: list[dict], out_dir: Path) -> str:
+    """What ``frictionlab run`` prints on stdout after a sweep: one line per point (``rows``:
+    each point's row of sweep.csv, in the order of the points)."""
+    lines = [f"{sweep.name}: {counted(len(sweep.points), 'point')} in {elapsed:.1f} s, status {status}"]
+    from ..progress import point_result_line
 
-    lines = [f"{sweep.name}: {counted(len(sweep.points), 'point')} in {outcome.elapsed:.1f} s, status {outcome.status}"]
-    for row, result in zip(outcome.rows, outcome.results, strict=True):
-        values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(result.point.values[p])}" for p in sweep.paths)
-        fit = row_fit(row)
-        if fit is None:
-            lines.append(f"  {row['point']:>3}  {values}: {row['status']}")
-            continue
-        lines.append(
-            f"  {row['point']:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
-            f"b = {format_estimate(fit.b, fit.b_ci)}, R^2 = {fit.r2:.3f}, "
-            f"contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
-            + ("" if row["status"] == "completed" else f" ({row['status']})")
-        )
+    lines += [point_result_line(sweep, point, row) for point, row in zip(sweep.points, rows)]
     lines.append(f"  results in {out_dir}/ (sweep.csv, sweep.png, points/)")
     return "\n".join(lines)

@@ -1,5 +1,5 @@
-"""``frictionlab runs [DIR]``: the run folders under DIR with their status: running
-(with the pid of its process), completed, or ended early and resumable."""
+"""``frictionlab runs [DIR]``: the run folders (and sweep folders) under DIR with their
+status: running (with the pid of its process), completed, or ended early and resumable."""
 
 from __future__ import annotations
 
@@ -19,7 +19,8 @@ def add_parser(sub) -> None:
         "runs",
         help="list run folders with their status (running, completed, interrupted...)",
         description="The run folders under DIR, running ones first: a run whose process is gone reads as "
-        "interrupted (frictionlab resume continues it), never as running.",
+        "interrupted (frictionlab resume continues it), never as running. A sweep's folder is one entry, "
+        "its points counted in DONE.",
         epilog=EXAMPLES,
     )
     p.add_argument("runs_dir", nargs="?", default=None, metavar="DIR", help="the folder of run folders (default: runs)")
@@ -51,6 +52,7 @@ def run(args) -> ExitCode:
         done = "?" if state.done is None else str(state.done)
         total = "?" if state.total is None else str(state.total)
         status = f"running (pid {state.pid})" if state.pid else state.status
-        rows.append((str(state.folder), state.name, status, f"{done}/{total}"))
+        unit = " points" if state.kind == "sweep" else ""
+        rows.append((str(state.folder), state.name, status, f"{done}/{total}{unit}"))
     print_table(["FOLDER", "NAME", "STATUS", "DONE"], rows)
     return ExitCode.OK

@@ -2,17 +2,13 @@
 
 The app holds what the tabs share: the draft preset (open, edit, save), the run
 going on, and the keys that work everywhere. Each tab's pane shows its part
-(``widgets``). A run is a process of its own (``detached``: it goes on when the
-TUI or its terminal goes away), followed by reading its folder (``following``),
-as a TUI opened later follows it. A preset with a ``sweep`` section runs in a
-thread worker through ``sweep.run_sweep``, which hands progress over with
-``post_message`` (``messages``).
+(``widgets``). A run, or a sweep (a preset with a ``sweep`` section), is a process
+of its own (``detached``: it goes on when the TUI or its terminal goes away),
+followed by reading its folder (``following``), as a TUI opened later follows it.
 """
 
 from __future__ import annotations
 
-import threading
-from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -22,14 +18,14 @@ from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..detached import check_startable, list_run_states, run_state, start_detached
+from ..detached import check_startable, check_sweep_startable, list_run_states, run_state, start_detached
 from ..errors import FrictionlabError, PresetError, RunFolderError
 from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
 from ..registry import default_registry
 from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
-from ..sweep import SweepOutcome, plan_sweep, run_sweep
+from ..sweep import plan_sweep, stored_sweep
 from .fields import default_spectrum, preset_from_defaults
 from .folders import (
     is_builtin,
@@ -42,11 +38,9 @@ from .folders import (
     templates,
     writable_folder,
 )
-from .following import FollowedRun, read_finished
-from .live import LiveListener
-from .messages import RunCrashed, RunFinished, RunProgress, SweepPointEvent
+from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
+from .messages import RunCrashed, RunFinished
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen
-from .sweepview import SweepPoster
 from .text import failure_message
 from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
 from .widgets.presets import NO_PRESETS
@@ -95,8 +89,7 @@ class FrictionlabApp(App):
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
-        self.cancel_event: threading.Event | None = None  # set while a sweep goes on in this process
-        self.followed: FollowedRun | None = None  # the run in its own process shown on the Run tab
+        self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
         self.last_outcome = None
@@ -145,7 +138,7 @@ class FrictionlabApp(App):
 
     @property
     def running(self) -> bool:
-        return self.cancel_event is not None or self.followed is not None
+        return self.followed is not None
 
     # ------------------------------------------------------------ navigation and help
 
@@ -423,8 +416,12 @@ class FrictionlabApp(App):
             self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
             return
         try:
-            if run_state(folder).status == "running":
+            state = run_state(folder)
+            if state.status == "running":
                 self.show_running(folder)
+                return
+            if state.kind == "sweep" and state.status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
         except FrictionlabError:
             pass  # not a run folder (yet): said below
@@ -435,50 +432,52 @@ class FrictionlabApp(App):
         except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
         try:
-            data = RunDirectory(folder).stored_preset()
-            scene = build_scene(data, registry=self.registry)
+            scene, sweep = self._stored(folder)
         except RunFolderError as exc:
             self.say(str(exc), "error", title="Cannot resume")
             return
         except PresetError as exc:
             self.say(exc.problems[0], "error", title=f"Cannot resume {folder.name}")
             return
-        if scene.preset.sweep is not None:
-            self.say(f"{folder.name} is a sweep: frictionlab run PRESET --out {folder} --resume continues it.", "warning")
-            return
-        self._start(scene, None, folder, replace(self.run_options, resume=True))
+        self._start(scene, sweep, folder, replace(self.run_options, resume=True))
+
+    def _stored(self, folder: Path):
+        """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
+        its first point's); RunFolderError or PresetError if it holds none that can run."""
+        if run_state(folder).kind == "sweep":
+            sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
+            return sweep.points[0].scene, sweep
+        return build_scene(RunDirectory(folder).stored_preset(), registry=self.registry), None
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         self.last_outcome = None
-        if sweep is None:
-            try:  # refused here, at once, what the run would refuse as it begins
+        try:  # refused here, at once, what the run would refuse as it begins
+            if sweep is None:
                 check_startable(scene, out_dir, options)
-            except FrictionlabError as exc:
-                self.say(str(exc), "error", title="Run failed")
-                return
-            try:
-                process = start_detached(scene.resolved(), out_dir, options)
-            except OSError as exc:  # no process can be started (out of processes, memory)
-                self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
-                return
-            self.followed = FollowedRun(out_dir, scene, self._show_snapshot, process=process)
-        else:
-            self.cancel_event = threading.Event()
+            else:
+                check_sweep_startable(sweep, out_dir, options)
+        except FrictionlabError as exc:
+            self.say(str(exc), "error", title="Run failed")
+            return
+        try:
+            preset = scene.resolved() if sweep is None else sweep.preset_data
+            process = start_detached(preset, out_dir, options, source=sweep.source if sweep is not None else None)
+        except OSError as exc:  # no process can be started (out of processes, memory)
+            self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
+            return
+        self.followed = self._follower(out_dir, scene, sweep, process)
         self.query_one(RunPane).start(scene, sweep, out_dir)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
+        name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
+        self.say(f"{verb} {name} into {out_dir} as a process of its own "
+                 f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
+
+    def _follower(self, folder: Path, scene, sweep, process=None) -> FollowedRun:
         if sweep is None:
-            self.say(f"{verb} {scene.preset.name} into {out_dir} as a process of its own "
-                     f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
-            return
-        self.say(f"{verb} {scene.preset.name} into {out_dir}")
-        cancel = self.cancel_event
-        poster = SweepPoster(
-            lambda kind, point, result: self.post_message(SweepPointEvent(sweep, kind, point, result)),
-            lambda point: [LiveListener(lambda snapshot: self.post_message(RunProgress(snapshot)))],
-        )
-        work = lambda: run_sweep(sweep, out_dir, options, listeners=[poster], cancel=cancel)  # noqa: E731
-        self.run_worker(lambda: self._run_in_thread(work, out_dir), thread=True, group="run", exit_on_error=False)
+            return FollowedRun(folder, scene, self._show_snapshot, process=process)
+        show_point = lambda kind, point, result: self._show_point(sweep, kind, point, result)  # noqa: E731
+        return FollowedSweep(folder, sweep, self._show_snapshot, show_point, process=process)
 
     def show_running(self, folder: Path) -> None:
         """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
@@ -490,20 +489,25 @@ class FrictionlabApp(App):
         self.action_show_tab("run")
 
     def follow_run(self, folder: Path) -> None:
-        """Show the run going on in ``folder`` (another process's) live on the Run tab."""
+        """Show the run (or sweep) going on in ``folder`` (another process's) live on the Run tab."""
         try:
-            scene = build_scene(RunDirectory(folder).stored_preset(), registry=self.registry)
+            scene, sweep = self._stored(folder)
         except RunFolderError as exc:
             self.say(str(exc), "error", title="Cannot follow")
             return
         except PresetError as exc:
             self.say(exc.problems[0], "error", title=f"Cannot follow {folder.name}")
             return
-        self.followed = FollowedRun(folder, scene, self._show_snapshot)
         self.last_outcome = None
-        self.query_one(RunPane).start(scene, None, folder)
-        self.say(f"{scene.preset.name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
+        self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
+        self.followed = self._follower(folder, scene, sweep)
+        name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
+        self.say(f"{name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
         self._follow_tick()
+
+    def _show_point(self, sweep, kind: str, point, result) -> None:
+        if (pane := self._mounted(RunPane)) is not None:
+            pane.show_point(sweep, kind, point, result)
 
     def _show_snapshot(self, snapshot) -> None:
         self.last_snapshot = snapshot
@@ -520,7 +524,8 @@ class FrictionlabApp(App):
             self.reload_runs()
             return
         try:
-            finished = read_finished(followed.folder)
+            read = read_finished_sweep if isinstance(followed, FollowedSweep) else read_finished
+            finished = read(followed.folder)
         except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
             error = f"the run's process ended without writing its results (u on the Results tab resumes it from {followed.folder})"
             self.on_run_crashed(RunCrashed(error))
@@ -528,44 +533,19 @@ class FrictionlabApp(App):
             return
         self.on_run_finished(RunFinished(finished, followed.folder))
 
-    def _run_in_thread(self, work: Callable[[], object], out_dir: Path) -> None:
-        """Run ``work`` (a sweep) and post how it ended: never a crash of the UI."""
-        try:
-            outcome = work()
-        except FrictionlabError as exc:
-            self.post_message(RunCrashed(str(exc)))
-        except OSError as exc:
-            self.post_message(RunCrashed(f"cannot write results to {out_dir}: {exc.strerror or exc}"))
-        except Exception as exc:  # an internal error: shown, never a crash of the UI
-            self.post_message(RunCrashed(f"internal error ({type(exc).__name__}: {exc}); please report it"))
-        else:
-            self.post_message(RunFinished(outcome, out_dir))
-
     def action_cancel_run(self) -> None:
         if not self.running:
             self.say("No run is going: Ctrl+R starts one.", "warning")
             return
-        if self.followed is not None:
-            if not self.followed.cancel():
-                return  # its process is gone: the next tick shows how it ended
-        else:
-            self.cancel_event.set()
+        if not self.followed.cancel():
+            return  # its process is gone: the next tick shows how it ended
         self.query_one(RunPane).show_cancelling()
-
-    def on_run_progress(self, message: RunProgress) -> None:
-        self.last_snapshot = message.snapshot
-        cancelling = self.cancel_event is not None and self.cancel_event.is_set()
-        self.query_one(RunPane).show_progress(message.snapshot, cancelling)
-
-    def on_sweep_point_event(self, message: SweepPointEvent) -> None:
-        self.query_one(RunPane).show_point(message.sweep, message.kind, message.point, message.result)
 
     def on_run_finished(self, message: RunFinished) -> None:
         outcome = message.outcome
-        self.cancel_event = None
         self.last_outcome, self.last_out_dir = outcome, message.out_dir
         pane = self.query_one(RunPane)
-        if isinstance(outcome, SweepOutcome):
+        if isinstance(outcome, FinishedSweep):
             self.say(pane.show_sweep_outcome(outcome))
         else:
             line = pane.show_outcome(outcome)
@@ -578,7 +558,6 @@ class FrictionlabApp(App):
         self.reload_runs()
 
     def on_run_crashed(self, message: RunCrashed) -> None:
-        self.cancel_event = None
         self.query_one(RunPane).show_crash(message.error)
         self.say(message.error, "error", title="Run failed")
 
@@ -593,15 +572,11 @@ class FrictionlabApp(App):
                     followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
                 self._quit_unless_unsaved()
 
-            question = (f"A run is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
+            what = "sweep" if isinstance(followed, FollowedSweep) else "run"
+            question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
                         "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
                         "(what finished is kept)?")  # fmt: skip
             self.push_screen(QuitDuringRunScreen(question), answered)
-            return
-        if self.cancel_event is not None:  # a sweep, in this process: quitting cancels it
-            cancel = self.cancel_event
-            question = "A sweep is running in this window: quitting cancels it (what finished is kept). Quit?"
-            self.push_screen(ConfirmScreen(question), lambda yes: yes and (cancel.set() or self._quit_unless_unsaved()))
             return
         self._quit_unless_unsaved()
 

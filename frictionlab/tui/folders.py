@@ -232,6 +232,7 @@ class SweepEntry:
     paths: list[str]  # the swept dotted paths
     points: list[dict]  # sweep.json's rows: the swept values and the columns of sweep.csv
     mtime: float
+    elapsed: float = 0.0  # seconds, as sweep.json says
 
     def point_folder(self, row: dict) -> Path:
         """The folder of a point (RunFolderError if sweep.json names one outside the sweep's, or a link)."""
@@ -251,6 +252,7 @@ def read_sweep(folder: Path) -> SweepEntry:
         paths=[str(p) for p in record.sweep.parameters],
         points=summary["points"],
         mtime=os.lstat(folder / "sweep.json").st_mtime,
+        elapsed=record.elapsed_seconds,
     )
 
 
@@ -272,11 +274,22 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
             except (OSError, FrictionlabError):
                 pass  # a damaged or foreign folder, a link, a FIFO: not one to list
             break
-        if (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
+        if isinstance(entry, SweepEntry) and entry.status == "running":
+            entry = _sweep_with_state(entry)
+        elif (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
             entry = _with_state(folder, entry)  # a run going on, or one that ended before its summary
         if entry is not None:
             entries.append(entry)
     return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
+
+
+def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
+    """A sweep that says it is running: interrupted if no live process holds its folder."""
+    try:
+        entry.status = run_state(entry.path).status
+    except (OSError, FrictionlabError):
+        pass
+    return entry
 
 
 def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:

@@ -1,6 +1,7 @@
-"""A run the TUI shows that goes on in a process of its own (``frictionlab.detached``),
-started here or found running in the runs folder; and a finished run read back
-from its folder. No Textual here: the app polls ``FollowedRun`` on a timer."""
+"""A run (or sweep) the TUI shows that goes on in a process of its own
+(``frictionlab.detached``), started here or found running in the runs folder; and a
+finished run (or sweep) read back from its folder. No Textual here: the app polls
+``FollowedRun`` (``FollowedSweep``) on a timer."""
 
 from __future__ import annotations
 
@@ -11,8 +12,10 @@ from pathlib import Path
 from ..api import Result, load
 from ..detached import cancel, lock_held
 from ..progresslog import Follower
-from .folders import read_run
+from ..sweeplog import SweepFollower
+from .folders import read_run, read_sweep
 from .live import LiveListener
+from .sweepview import SweepPoster
 
 
 class FollowedRun:
@@ -45,7 +48,7 @@ class FollowedRun:
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:
         the elapsed time moves); True once its process has ended."""
-        if not self.follower.poll():
+        if not self.follower.poll() and self.live is not None:
             self.live.tick()
         if self.process is not None:
             over = self.process.poll() is not None  # also reaps it: no zombie reads as alive
@@ -60,6 +63,28 @@ class FollowedRun:
         pid = self.pid
         self.cancelling = pid is not None and cancel(pid)
         return self.cancelling
+
+
+class FollowedSweep(FollowedRun):
+    """The sweep in ``folder`` (a planned ``sweep.Sweep``), read from its progress files:
+    ``post_point(kind, point, result)`` hears each point start and finish (``SweepPoster``),
+    ``post`` the ``Snapshot``s of the point running."""
+
+    def __init__(self, folder: Path, sweep, post, post_point, process: subprocess.Popen | None = None):
+        self.folder = Path(folder)
+        self.sweep = sweep
+        self.scene = sweep.points[0].scene
+        self.process = process
+        self._pid = None
+        self.live: LiveListener | None = None  # the point running's, made as it starts
+        self._post = post
+        self.follower = SweepFollower(folder, sweep, [SweepPoster(post_point, self._listeners_of)])
+        self.cancelling = False
+
+    def _listeners_of(self, point) -> list[object]:
+        self.live = LiveListener(self._post)
+        self.live.clock = self.follower.now
+        return [self.live]
 
 
 @dataclass
@@ -84,6 +109,33 @@ class FinishedRun:
     @property
     def fit(self):
         return self.result.fit
+
+
+@dataclass
+class FinishedSweep:
+    """A finished sweep as its folder holds it: how it ended, and its last finished point's run."""
+
+    status: str
+    finished: int  # points that ended
+    total: int
+    elapsed: float
+    last: FinishedRun | None  # None when no point wrote its results
+
+
+def read_finished_sweep(folder: Path) -> FinishedSweep:
+    """The sweep in ``folder`` read back (RunFolderError, OSError if its sweep.json is unreadable)."""
+    from ..detached import sweep_state
+    from ..errors import FrictionlabError
+
+    entry, state = read_sweep(folder), sweep_state(folder)
+    last = None
+    for row in reversed(entry.points):
+        try:
+            last = read_finished(entry.point_folder(row))
+            break
+        except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
+            continue
+    return FinishedSweep(state.status, state.done or 0, state.total or 0, entry.elapsed, last)
 
 
 def read_finished(folder: Path) -> FinishedRun:

@@ -1,9 +1,9 @@
 """The TUI's run listener: running sums and an interim fit, handed on as snapshots.
 
-It runs in the engine's thread and never touches the UI: it calls ``post`` with
-a ``Snapshot`` at most every ``interval`` seconds (and always at the start,
-for the first and the last realization, and at the end). Each snapshot is cumulative, so the UI may drop
-all but the newest one (Textual coalesces them, see ``app.RunProgress``). The
+It hears a followed run's events (``progresslog.Follower``) and never touches the UI: it
+calls ``post`` with a ``Snapshot`` at most every ``interval`` seconds (and always at the
+start, for the first and the last realization, and at the end). Each snapshot is
+cumulative, so the UI may show only the newest one. The
 interim fit is least squares of the mean curve so far; the bootstrap intervals
 come only with the final ``RunOutcome``.
 """

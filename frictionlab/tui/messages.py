@@ -1,5 +1,4 @@
-"""What the run thread tells the app (``post_message`` is thread safe). ``RunProgress``
-messages coalesce in the queue, so a fast run cannot flood the UI."""
+"""How a followed run (or sweep) ended, as the app tells its panes."""
 
 from __future__ import annotations
 
@@ -7,30 +6,10 @@ from pathlib import Path
 
 from textual.message import Message
 
-from .live import Snapshot
-
-
-class RunProgress(Message):
-    """A cumulative snapshot of the running ensemble: a newer one supersedes any still queued."""
-
-    def __init__(self, snapshot: Snapshot):
-        super().__init__()
-        self.snapshot = snapshot
-
-    def can_replace(self, message: Message) -> bool:
-        return isinstance(message, RunProgress)
-
-
-class SweepPointEvent(Message):
-    """A sweep point started (``result`` None) or finished."""
-
-    def __init__(self, sweep, kind: str, point, result):
-        super().__init__()
-        self.sweep, self.kind, self.point, self.result = sweep, kind, point, result
 
 
 class RunFinished(Message):
-    """The run ended: ``outcome`` is its ``RunOutcome``, or a sweep's ``SweepOutcome``."""
+    """The run ended: ``outcome`` is its ``FinishedRun``, or a sweep's ``FinishedSweep`` (``following``)."""
 
     def __init__(self, outcome, out_dir: Path):
         super().__init__()

@@ -1,10 +1,9 @@
 """What the Run tab shows of a sweep: the point line and one table row per finished point.
 
-No Textual here: the app runs ``sweep.run_sweep`` in its thread worker and gives
-it a ``SweepPoster`` (the sweep listener protocol), which only forwards the
-events to ``post`` (the app's thread-safe ``post_message`` wrapped by the app).
-The cells are formatted from ``PointResult.row()``, the same dict ``sweep.csv``
-is written from.
+No Textual here: the app follows a sweep's process (``following.FollowedSweep``)
+with a ``SweepPoster`` (the sweep listener protocol), which only forwards the
+events to ``post``. The cells are formatted from ``PointResult.row()``, the same
+dict ``sweep.csv`` is written from.
 """
 
 from __future__ import annotations
@@ -18,7 +17,7 @@ from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
 
 
 class SweepPoster(SweepListener):
-    """A sweep's listener: calls ``post(kind, point, result)`` from the run thread;
+    """A sweep's listener: calls ``post(kind, point, result)``;
     each point's run tells the listeners ``run_listeners(point)`` makes."""
 
     def __init__(self, post: Callable[[str, SweepPoint, PointResult | None], None], run_listeners=lambda point: []):

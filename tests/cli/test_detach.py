@@ -58,8 +58,42 @@ def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path):
     assert refused.returncode == 4 and "not empty" in refused.stderr
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]  # nothing written into the user's folder
     sweep = write_preset(tmp_path, merge(SMALL_PRESET, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}}), "sweep.yaml")
-    refused = run_cli("run", sweep, "--detach", "--out", tmp_path / "s")
-    assert refused.returncode == 2 and "--detach runs one ensemble, not a sweep" in refused.stderr
+    refused = run_cli("run", sweep, "--detach", "--out", mine)  # a sweep too
+    assert refused.returncode == 4 and "not empty" in refused.stderr and "Traceback" not in refused.stderr
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+
+
+def test_a_detached_sweep_is_one_entry_of_runs_and_follow_shows_each_point_and_its_fit(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 20, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
+    preset = write_preset(tmp_path, data, "sweep.yaml")
+    out = tmp_path / "runs" / "sw"
+    started = run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out)
+    assert started.returncode == 0, started.stderr
+    told = json.loads(started.stdout)
+    assert (told["folder"], told["kind"], told["status"]) == (str(out), "sweep", "running") and told["pid"] > 0
+    followed = run_cli("follow", out)
+    assert followed.returncode == 0, followed.stderr
+    rows = json.loads((out / "sweep.json").read_text())["points"]
+    assert followed.stdout.startswith(f"small: completed, 2/2 points, in {out}/")
+    for number, row in enumerate(rows, start=1):  # each point and its fit, as sweep.json has it
+        assert f"{number}  hurst={row['spectrum.params.hurst']}: a = {row['a']:.4f}" in followed.stdout
+    end = json.loads(run_cli("follow", out, "--json").stdout)
+    assert (end["kind"], end["status"], end["done"], end["total"], end["pid"]) == ("sweep", "completed", 2, 2, None)
+    assert [p["a"] for p in end["points"]] == [row["a"] for row in rows]
+    listed = json.loads(run_cli("runs", tmp_path / "runs", "--json").stdout)["runs"]
+    assert [(r["folder"], r["kind"], r["status"], r["done"], r["total"]) for r in listed] == [(str(out), "sweep", "completed", 2, 2)]
+    table = run_cli("runs", tmp_path / "runs").stdout
+    assert "completed" in table and "2/2 points" in table
+
+
+def test_runs_and_follow_on_a_sweep_folder_whose_sweep_json_is_a_link_say_so_without_a_traceback(tmp_path):
+    (tmp_path / "runs" / "bad").mkdir(parents=True)
+    (tmp_path / "elsewhere.json").write_text("{}")
+    (tmp_path / "runs" / "bad" / "sweep.json").symlink_to(tmp_path / "elsewhere.json")
+    listed = run_cli("runs", tmp_path / "runs")
+    assert listed.returncode == 0 and "no run folders" in listed.stdout
+    followed = run_cli("follow", tmp_path / "runs" / "bad")
+    assert followed.returncode == 5 and "sweep.json" in followed.stderr and "Traceback" not in followed.stderr
 
 
 def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
@@ -68,3 +102,23 @@ def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
     (tmp_path / "plain").mkdir()
     followed = run_cli("follow", tmp_path / "plain")
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
+
+
+def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path):
+    data = merge(SMALL_PRESET, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}})
+    preset = write_preset(tmp_path, data, "sweep.yaml")
+    out = tmp_path / "sw"
+    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+    heard = [follow.stderr.readline()]
+    while "100000 realizations of" not in heard[-1]:  # up to the second point's run, followed live
+        heard.append(follow.stderr.readline())
+        assert heard[-1], "follow ended before the second point's run"
+    os.kill(told["pid"], signal.SIGTERM)
+    stdout, _ = follow.communicate(timeout=60)
+    row = json.loads((out / "sweep.json").read_text())["points"][0]
+    assert heard[0].startswith("small: sweep of 2 points") and heard[1].startswith("point 1/2: realizations=4")
+    assert any(f"1  realizations=4: a = {row['a']:.4f}" in line for line in heard)  # how the first point ended
+    assert follow.returncode == 1
+    assert stdout.startswith(f"small: interrupted, 1/2 points, in {out}/; frictionlab resume {out} continues it")

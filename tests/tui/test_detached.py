@@ -1,10 +1,12 @@
 """The TUI and runs in processes of their own: a TUI opened later shows a running run
 live; quitting during a run leaves it running or cancels it, as answered, at once."""
 
+import json
 import os
 import signal
 import time
 
+import pytest
 import yaml
 from textual.widgets import Static
 
@@ -16,6 +18,7 @@ from frictionlab.tui.widgets import ResultsPane
 from ..conftest import merge
 from .conftest import (
     SIZE,
+    SWEEP,
     TINY,
     make_app,
     numbers_in,
@@ -168,3 +171,110 @@ async def test_a_long_solve_shows_its_load_and_the_elapsed_time_moves_between_ev
     assert first.startswith("0/2 realizations") and "realization 0: load 3/16" in first
     seconds = [float(line.split("elapsed ")[1].split(" s")[0]) for line in (first, later)]
     assert 29.0 < seconds[0] < seconds[1]  # the run's own clock, ticking with no new event
+
+
+LONG_SWEEP = merge(SWEEP, {"name": "longsweep", "realizations": 100_000})
+# a first point that ends at once, a second that runs for minutes: a sweep met halfway
+HALFWAY_SWEEP = {**merge(SWEEP, {"name": "halfway"}), "sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}}
+
+
+def start_sweep(data, out, registry):
+    from frictionlab.sweep import plan_sweep
+
+    sweep = plan_sweep(data, registry=registry)
+    process = start_detached(sweep.preset_data, out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    return process
+
+
+@sync
+async def test_ctrl_r_on_a_sweep_starts_it_detached_and_quit_leave_keeps_it_running(folders, registry):
+    from frictionlab.tui.following import FollowedSweep
+
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(LONG_SWEEP))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        followed = app.followed
+        pid, out = followed.pid, followed.folder
+        shown = screen_text(app)
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        asked = screen_text(app)
+        await pilot.press("l")
+        await pilot.pause()
+        quit_at_once = not app.is_running and process_alive(pid)
+    try:
+        assert isinstance(followed, FollowedSweep) and pid != os.getpid()  # a process of its own, not this one
+        assert "point 1/3: hurst=0.5" in shown and "/100000 realizations" in shown
+        assert "A sweep is going" in asked and "Leave it running" in asked and f"pid {pid}" in asked
+        assert quit_at_once
+        state = run_state(out)
+        assert (state.kind, state.status, state.pid, state.total) == ("sweep", "running", pid, 3)
+    finally:
+        end(pid)
+    wait_for(lambda: not process_alive(pid))
+    assert run_state(out).status == "interrupted"  # killed: never read as running
+
+
+@sync
+async def test_a_tui_opened_later_attaches_to_a_running_sweep_its_table_and_point_live(folders, registry):
+    out = folders / "runs" / "halfway"
+    process = start_sweep(HALFWAY_SWEEP, out, registry)
+    try:
+        wait_for(lambda: run_state(out).done == 1)  # the first point is over, the second runs
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+            first = app.last_snapshot.done
+            await wait_until(pilot, lambda: app.last_snapshot.done > first)  # live: the count moves
+            table = app.query_one("#sweep-table")
+            cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+            shown = screen_text(app)
+            await pilot.press("f5")
+            await pilot.pause()
+            listed = [(e.path.name, e.status) for e in app.query_one(ResultsPane).runs]
+            await pilot.press("enter")  # on the running sweep: the Run tab, following it
+            await pilot.pause()
+            tab = app.query_one("#tabs").active
+        rows = json.loads((out / "sweep.json").read_text())["points"]
+        assert [c[0] for c in cells] == ["1"] and cells[0][2] == "✓"  # the point that ended, as sweep.json has it
+        assert numbers_in(cells[0][3])[0] == pytest.approx(rows[0]["a"], abs=5e-5) and cells[0][1] == "4"
+        assert "point 2/2: realizations=100000" in shown and "/100000 realizations" in shown
+        assert listed == [("halfway", "running")] and tab == "run"
+        assert process.poll() is None  # the TUI quit; the sweep goes on
+    finally:
+        end(process.pid)
+        process.wait()
+
+
+@sync
+async def test_u_on_an_interrupted_sweep_resumes_it_detached(folders, registry):
+    from frictionlab.tui.following import FollowedSweep
+
+    out = folders / "runs" / "halfway"
+    process = start_sweep(HALFWAY_SWEEP, out, registry)
+    wait_for(lambda: run_state(out).done == 1)
+    process.kill()  # kill -9: its sweep.json still says running
+    process.wait()
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        await pilot.pause()
+        listed = [(e.path.name, e.status) for e in app.query_one(ResultsPane).runs]
+        await pilot.press("u")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.total == 100_000
+                         and app.last_snapshot.done >= 2)  # fmt: skip
+        followed = app.followed
+        said = status_text(app)
+        await pilot.press("ctrl+q", "c")  # cancel it: the test ends
+        await pilot.pause()
+    try:
+        assert listed == [("halfway", "interrupted")]
+        assert isinstance(followed, FollowedSweep) and said.startswith("Resuming the sweep halfway into")
+        wait_for(lambda: not process_alive(followed.pid))
+        state = run_state(out)
+        assert (state.status, state.done) == ("interrupted", 1)  # the first point kept, the second resumable
+    finally:
+        end(followed.pid)

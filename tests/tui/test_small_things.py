@@ -197,28 +197,3 @@ async def test_a_long_preset_name_is_cut_in_its_middle_and_keeps_every_column_on
     assert name.startswith("a-very-long") and name.endswith("-end-0060") and "…" in name
     assert folder and file == "long.yaml"
     assert title.startswith("a-very-long") and "-end-0060: 3 realizations, 16 force steps" in title and "…" in title
-
-
-@sync
-async def test_quitting_during_a_sweep_asks_and_n_cancels_nothing(folders, registry):
-    long_sweep = merge(SWEEP, {"realizations": 100_000})
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(long_sweep, sort_keys=False))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
-        cancel = app.cancel_event
-        await pilot.press("ctrl+q")
-        await pilot.pause()
-        asked = getattr(app.screen, "question", "")  # the dialog on screen (its lines wrap)
-        await pilot.press("n")
-        await pilot.pause()
-        before = app.last_snapshot.done
-        await wait_until(pilot, lambda: app.last_snapshot.done > before)  # it goes on
-        kept_going = not cancel.is_set() and "cancelling" not in str(app.query_one("#run-stats", Static).render())
-        await pilot.press("ctrl+q", "y")
-        await pilot.pause()
-        quit_and_cancelled = not app.is_running and cancel.is_set()
-    assert asked == "A sweep is running in this window: quitting cancels it (what finished is kept). Quit?"
-    assert kept_going and quit_and_cancelled

@@ -133,7 +133,7 @@ class ResultsPane(Vertical):
                 self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
-            if entry.status == "running" and not isinstance(entry, SweepEntry):  # its process goes on: shown live
+            if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return
             if isinstance(entry, SweepEntry):

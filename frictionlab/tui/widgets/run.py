@@ -182,15 +182,13 @@ class RunPane(Vertical, can_focus=True):
             self._error(f"{run.failed} realization(s) failed; {first}")
         return f"Run {result.status}: {done}/{requested} realizations"
 
-    def show_sweep_outcome(self, outcome) -> str:
-        """Show a finished sweep's ``SweepOutcome``; return the line the app notifies."""
-        finished = sum(r.status != "pending" for r in outcome.results)
-        last = next((r.outcome for r in reversed(outcome.results) if r.outcome is not None), None)
-        if last is not None:  # the last point's final fit: no "(interim)" left once the sweep is over
-            self._set("run-fit", "\n".join(fit_lines(last.fit, final=True, f_formula=last.normalisation.formula)))
-        self._set("sweep-point", f"{outcome.status}: {finished}/{len(outcome.results)} points in "
-                                 f"{format_duration(outcome.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
-        return f"Sweep {outcome.status}: {finished}/{len(outcome.results)} points"
+    def show_sweep_outcome(self, sweep) -> str:
+        """Show a finished sweep (``FinishedSweep``, read back from its folder); return the line the app notifies."""
+        if sweep.last is not None:  # the last point as it ended (a short one may have been over before it was read)
+            self.show_outcome(sweep.last)
+        self._set("sweep-point", f"{sweep.status}: {sweep.finished}/{sweep.total} points in "
+                                 f"{format_duration(sweep.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
+        return f"Sweep {sweep.status}: {sweep.finished}/{sweep.total} points"
 
     def show_crash(self, error: str) -> None:
         self._error(f"run failed: {error}")
