@@ -57,31 +57,21 @@ def measure(tmp_path, available: int, *command: str) -> tuple[int, int, str]:
     return int(fields[0]), int(fields[2]) * 1024, done.stderr
 
 
-def sparse_npy(path, shape) -> int:
-    """A .npy whose header announces ``shape`` of float64 zeros, written as a sparse file
-    (no disk and no memory spent on its data); its size in bytes."""
-    with open(path, "wb") as fh:
-        np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": shape})
-        fh.truncate(fh.tell() + 8 * shape[0] * shape[1])
+def rough_npy(path, side: int) -> int:
+    """A .npy of ``side``^2 float64 heights that vary (a constant map is refused once read,
+    and a sparse file of zeros read back left the peak memory 27 MiB up instead of 128 on a
+    loaded machine); its size in bytes."""
+    x = np.sin(np.arange(side) * 0.37)
+    heights = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(side, side))
+    for row in range(0, side, 256):
+        heights[row : row + 256] = x[row : row + 256, None] * x[None, :]
+    heights.flush()
+    del heights
     return path.stat().st_size
 
 
-def check_refused_unread(tmp_path, data: dict, size: int, available: int, control: bool = True) -> None:
-    (tmp_path / "p.yaml").write_text(yaml.safe_dump(data))
-    for command in (["run", "p.yaml", "--out", "out", "--workers", "1", "--quiet"], ["validate", "p.yaml"]):
-        code, growth, err = measure(tmp_path, available, *command)
-        assert code == ExitCode.RUNTIME_FAILURE, err
-        assert "this run would need about " in err and "a test limit" in err, err
-        assert "Traceback" not in err
-        assert growth < size / 4, (command, growth, size)
-    assert not (tmp_path / "out").exists()
-    if control:  # given room, validate reads the file: the measurement sees a read
-        code, growth, err = measure(tmp_path, 2**50, "validate", "p.yaml")
-        assert growth > size / 2, (growth, size, err)
-
-
 def test_an_npy_map_too_large_is_refused_from_its_header_before_it_is_read(tmp_path):
-    size = sparse_npy(tmp_path / "big.npy", (4096, 4096))  # 128 MiB
+    size = rough_npy(tmp_path / "big.npy", 4096)  # 128 MiB
     check_refused_unread(tmp_path, preset(tmp_path / "big.npy", spacing=1.0), size, available=1024 * MiB)
 
 
