@@ -57,6 +57,20 @@ def measure(tmp_path, available: int, *command: str) -> tuple[int, int, str]:
     return int(fields[0]), int(fields[2]) * 1024, done.stderr
 
 
+def check_refused_unread(tmp_path, data: dict, size: int, available: int, control: bool = True) -> None:
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(data))
+    for command in (["run", "p.yaml", "--out", "out", "--workers", "1", "--quiet"], ["validate", "p.yaml"]):
+        code, growth, err = measure(tmp_path, available, *command)
+        assert code == ExitCode.RUNTIME_FAILURE, err
+        assert "this run would need about " in err and "a test limit" in err, err
+        assert "Traceback" not in err
+        assert growth < size / 4, (command, growth, size)
+    assert not (tmp_path / "out").exists()
+    if control:  # given room, validate reads the file: the measurement sees a read
+        code, growth, err = measure(tmp_path, 2**50, "validate", "p.yaml")
+        assert growth > size / 2, (growth, size, err)
+
+
 def rough_npy(path, side: int) -> int:
     """A .npy of ``side``^2 float64 heights that vary (a constant map is refused once read,
     and a sparse file of zeros read back left the peak memory 27 MiB up instead of 128 on a
