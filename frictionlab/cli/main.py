@@ -60,6 +60,10 @@ EXAMPLES = """examples:
 """
 
 
+_NUMBER = r"(?:(?:\d+\.?\d*|\.\d+)(?:e[+-]?\d+)?|inf|infinity|nan)"
+NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(?:,[+-]?{_NUMBER})*$", re.IGNORECASE)  # or a list of numbers, the first < 0
+
+
 class _Parser(argparse.ArgumentParser):
     """Every parser keeps the line breaks of its description and examples, and lets a
     failed write of its help through (argparse drops it), so that ``--help`` into a
@@ -70,6 +74,10 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
+        # A word that is a negative number (or a list of numbers starting with one) is an option's
+        # value in any notation float() reads: argparse takes only -1 and -0.5, and said
+        # "expected one argument" to `--b -1e-3`.
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def _print_message(self, message, file=None):
         if message:
