@@ -282,3 +282,36 @@ def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, c
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=1e200"]) == ExitCode.USAGE
     assert "must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+200" in capsys.readouterr().err
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=2e-3"]) == ExitCode.OK
+
+
+def test_a_set_into_a_sweep_takes_the_swept_path_as_one_key(tmp_path, capsys):
+    """`sweep.parameters.spectrum.params.hurst.values=...`: the swept path is one key of
+    sweep.parameters; it was split at every dot and refused as unknown fields."""
+    from frictionlab.preset import set_path
+
+    data = {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
+    set_path(data, "sweep.parameters.spectrum.params.hurst.values", [0.3, 0.6, 0.9])
+    set_path(data, "sweep.parameters.spectrum.params.spacing", {"values": [1.0, 2.0]})  # a mapping: all of it
+    set_path(data, ("sweep", "parameters", "spectrum.params.hurst", "spacing"), "log")  # already one key
+    assert data["sweep"]["parameters"] == {
+        "spectrum.params.hurst": {"values": [0.3, 0.6, 0.9], "spacing": "log"},
+        "spectrum.params.spacing": {"values": [1.0, 2.0]},
+    }
+    path = tmp_path / "sweep.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}))
+    assert main(["validate", str(path), "--set", "sweep.parameters.spectrum.params.hurst.values=[0.3,0.6,0.9]"]) == 0
+    assert "sweep of 3 points" in capsys.readouterr().out
+    assert main(["validate", str(path), "--set", "sweep.parameters.spectrum.params.hurst.values=abc"]) == ExitCode.USAGE
+    assert "sweep.parameters.spectrum.params.hurst.values: must be a list, got 'abc'" in capsys.readouterr().err
+
+
+def test_a_value_of_none_of_a_unions_types_is_one_problem_at_its_own_path(tmp_path, capsys):
+    """A swept value may be text, a bool or a number: a list there is one problem, not one per
+    type at a path ending in the type's name (values.0.str, values.0.int...)."""
+    path = tmp_path / "sweep.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"spectrum.params.hurst": {"values": [[1, 2], 0.5]}}}))
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "1 problem in preset" in err
+    assert ("sweep.parameters.spectrum.params.hurst.values.0: must be text, true or false, a whole number or a "
+            "number, got [1, 2]") in err  # fmt: skip
