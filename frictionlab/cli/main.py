@@ -22,6 +22,7 @@ Conventions every command keeps (tested in tests/cli/test_conventions.py):
 from __future__ import annotations
 
 import argparse
+import errno
 import gc
 import os
 import re
@@ -259,6 +260,8 @@ def _run_command(args) -> int:
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
+        if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
+            return _refused(args, _name_too_long(exc.filename), ExitCode.USAGE)
         return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
@@ -277,6 +280,18 @@ def _run_command(args) -> int:
         message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"
         return _refused(args, message, ExitCode.INTERNAL, "internal error: ",
                         suffix="\n(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)")  # fmt: skip
+
+
+def _name_too_long(path) -> str:
+    """The refusal of a path longer than the file system allows, with its limits."""
+    limits = []
+    for what, name in (("a name", "PC_NAME_MAX"), ("a path", "PC_PATH_MAX")):
+        try:
+            limits.append(f"{what} {os.pathconf('.', name)} bytes")
+        except (OSError, ValueError):  # a system that does not say
+            pass
+    allowed = f" (at most {' and '.join(limits)} here)" if limits else ""
+    return f"{short_repr(os.fsdecode(path), 120)}: a file name too long for this file system{allowed}; give a shorter path"
 
 
 def _refused(args, message: str, code: int, label: str = "error: ", problems=None, suffix: str = "") -> int:

@@ -68,3 +68,14 @@ def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
     with pytest.raises(SystemExit) as refused:  # an option still is one (argparse's usage error)
         main(["run", str(PRESETS / "quickstart.yaml"), "-x1"])
     assert refused.value.code == ExitCode.USAGE and "unrecognized arguments: -x1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["validate"], ["resume"], ["runs"], ["schema", "--out"]])
+def test_a_path_longer_than_the_file_system_allows_is_a_usage_error(command, tmp_path, capsys):
+    """ENAMETOOLONG from the first look at the path: the argument is wrong, not the run (exit 1)."""
+    from frictionlab.cli import main
+
+    long = str(tmp_path / ("a" * 300))  # one name past any Linux or macOS file system's 255 bytes
+    assert main([*command, long]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "a file name too long for this file system (at most a name 255 bytes" in err and "Traceback" not in err
