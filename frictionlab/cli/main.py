@@ -29,7 +29,7 @@ import re
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -261,7 +261,7 @@ def _run_command(args) -> int:
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
         if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
-            return _refused(args, _name_too_long(exc.filename), ExitCode.USAGE)
+            return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
         return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
@@ -280,18 +280,6 @@ def _run_command(args) -> int:
         message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"
         return _refused(args, message, ExitCode.INTERNAL, "internal error: ",
                         suffix="\n(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)")  # fmt: skip
-
-
-def _name_too_long(path) -> str:
-    """The refusal of a path longer than the file system allows, with its limits."""
-    limits = []
-    for what, name in (("a name", "PC_NAME_MAX"), ("a path", "PC_PATH_MAX")):
-        try:
-            limits.append(f"{what} {os.pathconf('.', name)} bytes")
-        except (OSError, ValueError):  # a system that does not say
-            pass
-    allowed = f" (at most {' and '.join(limits)} here)" if limits else ""
-    return f"{short_repr(os.fsdecode(path), 120)}: a file name too long for this file system{allowed}; give a shorter path"
 
 
 def _refused(args, message: str, code: int, label: str = "error: ", problems=None, suffix: str = "") -> int:
