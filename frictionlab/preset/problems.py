@@ -11,6 +11,7 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import close_names, did_you_mean, short_repr
 from ..plugin import MAX_MAGNITUDE
+from ..safe_yaml import past_double_precision
 from .schema import NAME_PATTERN, NAME_RULE
 
 
@@ -154,9 +155,12 @@ def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
         return f"{path}: must be a number, not true or false, got {str(value).lower()}"
     if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
         try:
-            value = float(value)
+            number = float(value)
         except ValueError:
             return None  # not a number at all: pydantic says so
+        if past_double_precision(value, number):  # 1e400, 1e-400: not infinity, not zero
+            return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+        value = number
     if isinstance(value, float) and not math.isfinite(value):
         return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
     if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):
