@@ -9,7 +9,7 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-from .errors import FrictionlabError, short_repr
+from .errors import FrictionlabError, short_repr, too_long_path
 from .safe_yaml import MAX_DEPTH, MAX_VALUES
 
 _SCALARS = (str, int, float, bool, type(None), os.PathLike)
@@ -27,6 +27,8 @@ def path_argument(value, name: str, what: str) -> Path:
         raise FrictionlabError(f"{name} must be a path to {what}, got an empty string")
     if "\0" in value:
         raise FrictionlabError(f"{name} must be a path to {what}, got a string with a NUL character")
+    if (too_long := too_long_path(value)) is not None:  # else an OSError from the first look at it
+        raise FrictionlabError(f"{name}: {too_long}")
     return Path(value)
 
 

@@ -139,6 +139,29 @@ def counted(count: int, noun: str) -> str:
     return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
+def path_limits() -> dict[str, int]:
+    """The longest name and path this system's file system takes, in bytes ({} if it does not say)."""
+    limits = {}
+    for what, name in (("name", "PC_NAME_MAX"), ("path", "PC_PATH_MAX")):
+        try:
+            limits[what] = os.pathconf(".", name)
+        except (OSError, ValueError):
+            pass
+    return limits
+
+
+def too_long_path(path, *, known: bool = False) -> str | None:
+    """Why ``path`` is longer than the file system allows (one of its names, or the whole), with
+    the limits; None if it is not. ``known``: the system said so (ENAMETOOLONG), say it anyway."""
+    limits = path_limits()
+    raw = os.fsencode(path)
+    longest = max(len(name) for name in raw.split(b"/"))
+    if not known and longest <= limits.get("name", longest) and len(raw) < limits.get("path", len(raw) + 1):
+        return None
+    allowed = f" (at most {' and '.join(f'a {what} {size} bytes' for what, size in limits.items())})" if limits else ""
+    return f"{short_repr(os.fsdecode(path), 120)}: a file name too long for this file system{allowed}; give a shorter path"
+
+
 def short_repr(value, limit: int = 80) -> str:
     """``repr(value)`` cut to about ``limit`` characters, built without ever
     forming the whole repr (a value from a hostile preset may be huge or deep)."""

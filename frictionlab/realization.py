@@ -98,6 +98,20 @@ def compute_realization(
         return _compute(scene, index, watch.check)
 
 
+SAFE_SLOPE = 2.0**400  # slopes up to this in magnitude (and down to its inverse) square and sum without overflow
+
+
+def slope_scale(slopes: np.ndarray) -> float:
+    """1, or the power of two that brings the largest magnitude among ``slopes`` to about 1
+    when their squares would overflow or underflow (heights over spacing past 1e154, say: both
+    numbers a preset allows); a power of two scales every slope exactly."""
+    with np.errstate(invalid="ignore"):
+        largest = float(np.nanmax(np.abs(slopes))) if slopes.size else 0.0
+    if not math.isfinite(largest) or largest == 0.0 or 1 / SAFE_SLOPE <= largest <= SAFE_SLOPE:
+        return 1.0
+    return math.ldexp(1.0, -math.frexp(largest)[1])
+
+
 def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> RealizationResult:
     start = time.perf_counter()
     try:
@@ -106,6 +120,9 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
         check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
         check_cancel()
+        scale = slope_scale(slopes)  # xi is a ratio of two rms slopes: an exact scale cancels
+        if scale != 1.0:
+            slopes = slopes * scale
         if scene.slope.undefined_points(profile.periodic):
             slope_rms_line = defined_rms(slopes)  # over the points that have a slope
         else:  # every slope defined: a NaN makes the rms NaN, refused below
@@ -124,7 +141,7 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
             indentation=np.asarray(curve.indentation),
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             real_area_corrected=np.asarray(curve.real_area_corrected, float) if scene.solver.corrected_area else None,
-            slope_rms_line=slope_rms_line,
+            slope_rms_line=slope_rms_line / scale,
             points=profile.points,
             force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),
             measured_rms_height=float(np.std(profile.heights)),

@@ -11,6 +11,7 @@ refused, and only then are Python objects built.
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Any
 
@@ -80,6 +81,23 @@ _BoundedLoader.add_implicit_resolver(
     re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
     list("-+.0123456789"),
 )
+
+
+def past_double_precision(text: str, number: float) -> bool:
+    """Whether ``number``, read from ``text``, is a finite nonzero number double precision cannot
+    hold: 1e400 read as infinity, 1e-400 as zero."""
+    mantissa = text.lower().partition("e")[0]
+    return (math.isinf(number) and "inf" not in mantissa) or (number == 0.0 and re.search("[1-9]", mantissa) is not None)
+
+
+def _finite_or_text(loader, node):
+    """A float, or its text when it is past double precision: not read as infinity or zero, so
+    the field's check names the number as written."""
+    number = loader.construct_yaml_float(node)
+    return node.value if past_double_precision(node.value, number) else number
+
+
+_BoundedLoader.add_constructor("tag:yaml.org,2002:float", _finite_or_text)
 
 def _children(node) -> list:
     if isinstance(node, yaml.SequenceNode):

@@ -219,6 +219,11 @@ def _containing_itself() -> dict:
         (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
         (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
         (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),
+        # longer than any Linux or macOS file system takes (255 bytes a name): said, not an OSError
+        (lambda: frictionlab.run("a" * 300, **FAST), "preset: 'aaa"),
+        (lambda: frictionlab.validate("a" * 300), "a file name too long for this file system (at most a name 255 bytes"),
+        (lambda: frictionlab.run("quickstart", out="x/" * 3000, **FAST), "out: 'x/x/"),
+        (lambda: frictionlab.load("a" * 300), "folder: 'aaa"),
     ],
 )
 def test_a_wrong_argument_is_a_frictionlab_error_naming_it(call, said):

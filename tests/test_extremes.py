@@ -224,6 +224,23 @@ def test_results_do_not_depend_on_the_height_scale(registry, scale, solver, base
     np.testing.assert_allclose(scaled.indentation, scale * one.indentation, rtol=1e-11)
 
 
+@pytest.mark.parametrize("scale", [1e99, 1e-99])
+def test_heights_over_spacing_past_the_square_root_of_double_precision(registry, scale):
+    """z -> s z, x -> x / s (each within a preset's range): slopes of s^2 ~ 1e198, whose squares
+    overflow, made every realization fail; on a line of springs f and xi are exactly unchanged."""
+    def run(s):
+        data = merge(LINE, {"spectrum": {"params": {"rms_height": s, "spacing": 1 / s}}})
+        return engine.run(build_scene(data, registry=registry), RunOptions(workers=1))
+
+    one, scaled = run(1.0), run(scale)
+    assert scaled.status == "completed"
+    np.testing.assert_array_equal(scaled.per_realization["contact_count"], one.per_realization["contact_count"])
+    np.testing.assert_allclose(scaled.xi, one.xi, rtol=1e-12)
+    np.testing.assert_allclose(scaled.f, one.f, rtol=1e-12)
+    np.testing.assert_allclose(scaled.per_realization["slope_rms_line"],  # kept in the run's units
+                               scale**2 * one.per_realization["slope_rms_line"], rtol=1e-12)
+
+
 # ---------------------------------------------------------------- float32 and ties
 
 

@@ -7,6 +7,7 @@ test instead of the machine."""
 
 from __future__ import annotations
 
+import math
 import os
 import resource
 import subprocess
@@ -282,3 +283,54 @@ def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, c
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=1e200"]) == ExitCode.USAGE
     assert "must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+200" in capsys.readouterr().err
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=2e-3"]) == ExitCode.OK
+
+
+def test_a_set_into_a_sweep_takes_the_swept_path_as_one_key(tmp_path, capsys):
+    """`sweep.parameters.spectrum.params.hurst.values=...`: the swept path is one key of
+    sweep.parameters; it was split at every dot and refused as unknown fields."""
+    from frictionlab.preset import set_path
+
+    data = {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
+    set_path(data, "sweep.parameters.spectrum.params.hurst.values", [0.3, 0.6, 0.9])
+    set_path(data, "sweep.parameters.spectrum.params.spacing", {"values": [1.0, 2.0]})  # a mapping: all of it
+    set_path(data, ("sweep", "parameters", "spectrum.params.hurst", "spacing"), "log")  # already one key
+    assert data["sweep"]["parameters"] == {
+        "spectrum.params.hurst": {"values": [0.3, 0.6, 0.9], "spacing": "log"},
+        "spectrum.params.spacing": {"values": [1.0, 2.0]},
+    }
+    path = tmp_path / "sweep.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}))
+    assert main(["validate", str(path), "--set", "sweep.parameters.spectrum.params.hurst.values=[0.3,0.6,0.9]"]) == 0
+    assert "sweep of 3 points" in capsys.readouterr().out
+    assert main(["validate", str(path), "--set", "sweep.parameters.spectrum.params.hurst.values=abc"]) == ExitCode.USAGE
+    assert "sweep.parameters.spectrum.params.hurst.values: must be a list, got 'abc'" in capsys.readouterr().err
+
+
+def test_a_value_of_none_of_a_unions_types_is_one_problem_at_its_own_path(tmp_path, capsys):
+    """A swept value may be text, a bool or a number: a list there is one problem, not one per
+    type at a path ending in the type's name (values.0.str, values.0.int...)."""
+    path = tmp_path / "sweep.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"spectrum.params.hurst": {"values": [[1, 2], 0.5]}}}))
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "1 problem in preset" in err
+    assert ("sweep.parameters.spectrum.params.hurst.values.0: must be text, true or false, a whole number or a "
+            "number, got [1, 2]") in err  # fmt: skip
+
+
+def test_a_number_past_double_precision_is_named_as_written(tmp_path, capsys):
+    """1e400 was read as infinity ("must be a finite number, got inf") and 1e-400 as zero (a
+    start of 0 said "must be > 0", a field allowing 0 took it silently): both are numbers
+    beyond the range a preset allows, and the message quotes them as the user wrote them."""
+    from frictionlab.safe_yaml import load_yaml
+
+    assert load_yaml("a: 1e400\nb: -1.5E-400\nc: .inf\nd: 0e-500\ne: 1e-300") == {
+        "a": "1e400", "b": "-1.5E-400", "c": math.inf, "d": 0.0, "e": 1e-300}  # fmt: skip
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE.replace("stop: 20.0", "stop: 1e400"))
+    digits = "9" * 5000  # past Python's own limit on the digits of an int read from text
+    assert main(["validate", str(path), "--set", "loading.start=1.5e-400", "--set", f"seed={digits}"]) == 2
+    err = capsys.readouterr().err
+    assert "loading.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1e400'" in err
+    assert "loading.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1.5e-400'" in err
+    assert "seed: must be 0 or between 1e-100 and 1e+100 in magnitude, got '99999" in err and "got inf" not in err

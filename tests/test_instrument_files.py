@@ -195,6 +195,27 @@ def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
 
 
+@pytest.mark.parametrize("pixel, writer, unit, said", [
+    (1e99, "to_gwy", "pm", "pixels of 1e+102 pm"),  # 1e90 m in the file: in range, beyond it once converted
+    (np.inf, "to_netcdf", None, "pixels of inf nm"),
+])
+def test_a_pixel_size_beyond_a_presets_range_is_refused_before_the_run(tmp_path, capsys, pixel, writer, unit, said):
+    """Not a realization failing (exit 70): the file is refused as a preset's spacing would be."""
+    write_topography(tmp_path / "far.scan", scan_um(), pixel, "nm", writer)
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "far.scan", unit, solver="winkler")))
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "out"), "--no-plot"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert said in err and "between 1e-100 and 1e+100" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("pixel, said", [(-PIXEL_UM, "must be > 0"), (np.nan, "must be > 0")])
+def test_a_pixel_size_not_positive_is_named(tmp_path, pixel, said):
+    write_topography(tmp_path / "neg.nc", scan_um(), pixel, "um", "to_netcdf")
+    with pytest.raises(ValueError, match=f"pixels of .*; a pixel's size {said}"):
+        SurfaceFile(path=str(tmp_path / "neg.nc")).rms_height()
+
+
 def test_a_scan_with_no_defined_point_is_refused_even_when_filling(tmp_path):
     """Harmonic filling has nothing to fill from: the file is refused as empty, not read as flat."""
     write_x3p(tmp_path / "empty.x3p", np.full((ROWS, COLUMNS), np.nan))

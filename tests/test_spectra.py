@@ -719,6 +719,14 @@ def test_profile_file_errors(tmp_path):
     message = _profile_error(path=_write(tmp_path, "xz.csv", text), spacing=0.4)
     assert "spacing=0.4" in message and "0.5" in message
 
+
+def test_profile_file_x_spacing_beyond_a_presets_range_is_refused(tmp_path):
+    """x in range but spaced by 1e-200: the slopes (1e200) would square to inf in every realization."""
+    text = "\n".join(f"{1e-200 * k},{v}" for k, v in enumerate(_bumpy(16)))
+    message = _profile_error(path=_write(tmp_path, "xtiny.csv", text))
+    assert "x spaced by 1e-200" in message and "between 1e-100 and 1e+100" in message
+    assert "np.float64" not in _profile_error(path=_write(tmp_path, "xbad.csv", "0,1\n1,2\n2,0\n3,4\n4,1\n5,3\n7,2\n8,5"))
+
     assert "3 columns" in _profile_error(path=_write(tmp_path, "wide.txt", "1 2 3\n" * 10))
     noise = tmp_path / "p.opd"
     noise.write_bytes(bytes(range(256)) * 4)

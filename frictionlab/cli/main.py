@@ -22,13 +22,14 @@ Conventions every command keeps (tested in tests/cli/test_conventions.py):
 from __future__ import annotations
 
 import argparse
+import errno
 import gc
 import os
 import re
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
 from ..signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -60,6 +61,10 @@ EXAMPLES = """examples:
 """
 
 
+_NUMBER = r"(?:(?:\d+\.?\d*|\.\d+)(?:e[+-]?\d+)?|inf|infinity|nan)"
+NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(?:,[+-]?{_NUMBER})*$", re.IGNORECASE)  # or a list of numbers, the first < 0
+
+
 class _Parser(argparse.ArgumentParser):
     """Every parser keeps the line breaks of its description and examples, and lets a
     failed write of its help through (argparse drops it), so that ``--help`` into a
@@ -70,6 +75,10 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
         super().__init__(*args, **kwargs)
+        # A word that is a negative number (or a list of numbers starting with one) is an option's
+        # value in any notation float() reads: argparse takes only -1 and -0.5, and said
+        # "expected one argument" to `--b -1e-3`.
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def _print_message(self, message, file=None):
         if message:
@@ -251,6 +260,8 @@ def _run_command(args) -> int:
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
+        if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
+            return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
         return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""

@@ -13,6 +13,7 @@ import yaml
 
 from ..errors import PresetError
 from ..safe_yaml import YamlProblem, load_yaml
+from .schema import SweepParameter
 
 MISSING = object()
 """As a value for ``set_path``: remove the key (the model's default then applies)."""
@@ -36,7 +37,7 @@ def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_value
     """Set ``data[a][b][c] = value`` for ``a.b.c`` (or ``("a", "b", "c")``), making mappings
     where keys are missing or None; ``MISSING`` removes the key. A value in the way
     (``a.b`` is 3) is a ValueError naming it, unless ``replace_values`` replaces it."""
-    keys = _keys(path)
+    keys = _swept_path_as_one_key(_keys(path), value)
     node = data
     for depth, key in enumerate(keys[:-1]):
         child = node.get(key)
@@ -49,6 +50,17 @@ def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_value
         node.pop(keys[-1], None)
     else:
         node[keys[-1]] = copy.deepcopy(value)
+
+
+def _swept_path_as_one_key(keys: list[str], value: Any) -> list[str]:
+    """``sweep.parameters.spectrum.params.hurst.values``: the swept path is one key of
+    ``sweep.parameters`` (``spectrum.params.hurst``), followed by a field of its values
+    unless the value is their whole mapping."""
+    if keys[:2] != ["sweep", "parameters"] or len(keys) <= 3:
+        return keys
+    if keys[-1] in SweepParameter.model_fields and not isinstance(value, dict):
+        return [*keys[:2], ".".join(keys[2:-1]), keys[-1]]
+    return [*keys[:2], ".".join(keys[2:])]
 
 
 def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:

@@ -11,6 +11,7 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import close_names, did_you_mean, short_repr
 from ..plugin import MAX_MAGNITUDE
+from ..safe_yaml import past_double_precision
 from .schema import NAME_PATTERN, NAME_RULE
 
 
@@ -58,6 +59,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be text"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:
         return "must be a mapping of keys to values"
+    if kind in {"list_type", "tuple_type"}:
+        return "must be a list"
     if kind == "string_too_short":
         return "must not be empty"
     if kind == "string_pattern_mismatch" and ctx.get("pattern") == NAME_PATTERN:
@@ -85,7 +88,7 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
         for name in close_names(str(error["loc"][-1]), _allowed_keys(model, tuple(error["loc"][:-1])), FIELD_CUTOFF)[:1]
     }
     lines = []
-    for error in errors:
+    for error in _one_per_union(errors):
         if error["type"] == "missing" and tuple(error["loc"]) in misspelt:
             continue
         path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
@@ -95,6 +98,36 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
             line += f", got {shown_value(error['input'])}"
         lines.append(line)
     return lines
+
+
+UNION_MEMBERS = {"str": "text", "bool": "true or false", "int": "a whole number", "float": "a number", "none": "null"}
+"""pydantic's tag of a plain type in a union (the last part of its error's path), as a person says it."""
+
+
+def _one_per_union(errors: list[dict]) -> list[dict]:
+    """pydantic's errors, those of one value against each type of a union (``str | int | ...``:
+    one error per type, its path ending in the type's name, ``values.0.str``, ``values.0.int``)
+    made one error at the value's own path that lists what it may be."""
+
+    def union_loc(error):  # the value's path if the error is one type's of a union
+        loc = tuple(error["loc"])
+        member = loc and loc[-1] in UNION_MEMBERS and error["type"] not in {"extra_forbidden", "missing"}
+        return loc[:-1] if member else None
+
+    groups: dict[tuple, list[dict]] = {}
+    for error in errors:
+        if (loc := union_loc(error)) is not None:
+            groups.setdefault(loc, []).append(error)
+    out = []
+    for error in errors:
+        group = groups.get(union_loc(error)) if union_loc(error) is not None else None
+        if group is None or len(group) < 2:  # a key that happens to be named "int", say
+            out.append(error)
+        elif error is group[0]:
+            kinds = [UNION_MEMBERS[e["loc"][-1]] for e in group]
+            out.append({**error, "loc": union_loc(error), "type": "union_of_plain_types",
+                        "msg": f"must be {', '.join(kinds[:-1])} or {kinds[-1]}"})  # fmt: skip
+    return out
 
 
 # ------------------------------------------------------------------ numbers
@@ -122,9 +155,12 @@ def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
         return f"{path}: must be a number, not true or false, got {str(value).lower()}"
     if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
         try:
-            value = float(value)
+            number = float(value)
         except ValueError:
             return None  # not a number at all: pydantic says so
+        if past_double_precision(value, number):  # 1e400, 1e-400: not infinity, not zero
+            return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+        value = number
     if isinstance(value, float) and not math.isfinite(value):
         return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
     if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):

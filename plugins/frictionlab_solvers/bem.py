@@ -142,7 +142,7 @@ class PeriodicBEM(ContactSolver):
             if too_deep.size:
                 j = int(too_deep[0])
                 raise ValueError(
-                    f"indentation {loads[j]!r} (load {j}) is at or past the full-contact approach "
+                    f"indentation {float(loads[j])!r} (load {j}) is at or past the full-contact approach "
                     f"max(z) - mean(z) = {full_approach * scale:.6g}: on a periodic elastic body the "
                     "approach to the mean surface saturates at full contact, and no finite force "
                     "reaches it. Use control 'force' or smaller indentations."

@@ -20,6 +20,7 @@ from typing import Literal
 import numpy as np
 
 from frictionlab import InputFileProblem, open_regular_file
+from frictionlab.plugin import MAX_MAGNITUDE
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
@@ -129,8 +130,11 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         periodic = bool(topography.is_periodic)
-    if not np.all(pixel > 0) or not math.isclose(pixel.min(), pixel.max(), rel_tol=SQUARE_TOLERANCE):
-        raise ValueError(f"{where}: pixels of {' x '.join(f'{p:g}' for p in pixel)}; square pixels are needed")
+    shown = " x ".join(f"{p:g}" for p in pixel)
+    if not np.all(pixel > 0):  # NaN too
+        raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
+    if not math.isclose(pixel.min(), pixel.max(), rel_tol=SQUARE_TOLERANCE):
+        raise ValueError(f"{where}: pixels of {shown}; square pixels are needed")
     file_unit = topography.unit if isinstance(topography.unit, str) else None
     factor = 1.0
     if unit is not None and file_unit is not None:
@@ -138,10 +142,11 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             factor = float(get_unit_conversion_factor(file_unit, unit))
         except Exception:
             raise ValueError(f"{where}: the file's unit {file_unit!r} is not a length unit") from None
+    spacing = check_spacing(where, "pixels of", float(pixel.mean()) * factor, unit or file_unit)
     z = np.array(np.ma.getdata(heights), dtype=np.float64) * factor
     return Scan(
         heights=np.ascontiguousarray(z.T) if dimension == 2 else z,  # C order, as a .npy map: the same sums
-        spacing=float(pixel.mean()) * factor,
+        spacing=spacing,
         unit=unit if unit is not None else file_unit,
         file_unit=file_unit,
         periodic=periodic,
@@ -149,6 +154,16 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         channel=str(channel.name),
         undefined=missing,
     )
+
+
+def check_spacing(where: str, what: str, spacing: float, unit: str | None) -> float:
+    """``spacing`` if it is a length a preset could give (1e-100 to 1e100: slopes, their squares
+    and sums stay finite); else a ValueError saying ``what`` it is and the range allowed."""
+    if not 1 / MAX_MAGNITUDE <= spacing <= MAX_MAGNITUDE:  # inf, NaN and 0 too
+        in_unit = f" {unit}" if unit else ""
+        raise ValueError(f"{where}: {what} {spacing:g}{in_unit}; a spacing must be between "
+                         f"{1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} in the run's length unit")
+    return spacing
 
 
 def scan_not_periodic_advice(name: str) -> tuple[str, str]:

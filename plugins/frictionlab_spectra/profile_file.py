@@ -35,7 +35,8 @@ from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, Undefined, Unit, is_instrument_file, open_input, read_scan, scan_header, scan_not_periodic_advice,
+    ScanHeader, Undefined, Unit, check_spacing, is_instrument_file, open_input, read_scan, scan_header,
+    scan_not_periodic_advice,
 )
 from .params_cache import cached_on_params
 
@@ -172,7 +173,7 @@ class ProfileFile(SpectrumGenerator):
             dx = scan.spacing if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
-            dx = _uniform_spacing(where, x)
+            dx = check_spacing(where, "x spaced by", _uniform_spacing(where, x), p.unit)
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
                     raise ValueError(
@@ -355,7 +356,7 @@ def _uniform_spacing(where: str, x: np.ndarray) -> float:
     deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
     if deviation > X_TOLERANCE * dx:
         raise ValueError(
-            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {dx!r} "
+            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
             f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
         )
     return float(dx)

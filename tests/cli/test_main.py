@@ -1,7 +1,10 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
+import math
 import subprocess
 import sys
+
+import pytest
 
 from frictionlab.errors import ExitCode
 
@@ -48,3 +51,31 @@ def test_the_dashboard_without_frictionlabs_own_dask_cluster_is_refused_not_igno
     for extra in ([], ["--executor", "processes"], ["--executor", "dask", "--scheduler", "tcp://127.0.0.1:1"]):
         assert main(["run", "quickstart", "--dashboard", "--quiet", *extra]) == ExitCode.USAGE
         assert "--dashboard serves the dashboard of frictionlab's own Dask cluster" in capsys.readouterr().err
+
+
+def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
+    """argparse itself takes only -1 and -0.5 as values; -1e-2 was refused as an unknown option."""
+    from frictionlab.cli import main
+
+    contact = ["predict", "--area", "1", "--modulus", "1", "--rms-height", "1", "--force", "1"]
+    assert main([*contact, "--a", "1", "--b", "-1E-2", "--a-ci", "-1e+1", "2", "--b-ci", "-.5e-1", "0"]) == ExitCode.OK
+    f = 0.5 * math.sqrt(math.pi)  # sqrt(pi) F / (2 E* h sqrt(A)) with every number 1
+    assert f"xi = grad_z_contact / grad_z = {1 - 1e-2 * math.log(f):.4f}" in capsys.readouterr().out
+    assert main([*contact, "--a", "-inf", "--b", "1"]) == ExitCode.USAGE  # checked as a number: named, not unknown
+    assert "--a must be a finite number. Got -inf instead." in capsys.readouterr().err
+    assert main(["study", str(PRESETS / "quickstart.yaml"), "--tolerances", "-1e-3,1e-6"]) == ExitCode.USAGE
+    assert "--tolerances values must be > 0. Got -0.001 instead." in capsys.readouterr().err
+    with pytest.raises(SystemExit) as refused:  # an option still is one (argparse's usage error)
+        main(["run", str(PRESETS / "quickstart.yaml"), "-x1"])
+    assert refused.value.code == ExitCode.USAGE and "unrecognized arguments: -x1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["validate"], ["resume"], ["runs"], ["schema", "--out"]])
+def test_a_path_longer_than_the_file_system_allows_is_a_usage_error(command, tmp_path, capsys):
+    """ENAMETOOLONG from the first look at the path: the argument is wrong, not the run (exit 1)."""
+    from frictionlab.cli import main
+
+    long = str(tmp_path / ("a" * 300))  # one name past any Linux or macOS file system's 255 bytes
+    assert main([*command, long]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "a file name too long for this file system (at most a name 255 bytes" in err and "Traceback" not in err

@@ -4,6 +4,7 @@ against a known h, and the report's content on tiny presets (numbers from summar
 import io
 import json
 import math
+import os
 import re
 
 import numpy as np
@@ -152,6 +153,17 @@ def test_presets_folder_errors(tmp_path, capsys):
         find_presets(tmp_path)
     assert main(["report", "--presets", str(tmp_path), "--quiet"]) == 2
     assert "--presets: no folder with the paper's presets" in capsys.readouterr().err
+
+
+def test_a_presets_folder_names_the_files_it_lacks_or_cannot_read(tmp_path, capsys):
+    """The folder exists: which of the paper's presets is missing, or not a regular file."""
+    os.mkfifo(tmp_path / FIGURES[1].preset)
+    for fig in FIGURES[2:]:
+        (tmp_path / fig.preset).write_text("name: x\n")
+    assert main(["report", "--presets", str(tmp_path), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{FIGURES[0].preset}: no such file; {FIGURES[1].preset}: is a FIFO (named pipe), not a regular file)" in err
+    assert FIGURES[2].preset + ":" not in err  # the ones that are there are not named
 
 
 def test_fig5_calibrated_at_each_hurst(tmp_path, tiny_presets, tiny_runs):
