@@ -254,13 +254,14 @@ def run_plan(
     runs = StudyRuns(plan)
     started = time.perf_counter()
     factories: dict[float, SceneFactory] = {}
+    for job in plan.jobs():  # every H's preset read and checked before any ensemble runs
+        if job.hurst not in factories:
+            path = Path(presets_dir) / preset_name(job.hurst)
+            if not path.is_file():
+                raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
+            factories[job.hurst] = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
     try:
         for job in plan.jobs():
-            if job.hurst not in factories:
-                path = Path(presets_dir) / preset_name(job.hurst)
-                if not path.is_file():
-                    raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
-                factories[job.hurst] = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
             scene = _scene(factories[job.hurst], job, plan)
             folder = Path(runs_dir) / job.folder(scene.solver.name)
             if not compute and not finished(folder):

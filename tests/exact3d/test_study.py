@@ -178,3 +178,20 @@ def test_finished_ensembles_are_read_without_their_lock_beside_a_process_that_ho
     tables = lambda text: [line for line in text.splitlines() if line.startswith("| ")]
     original = tables((quick_study / PAGE).read_text())
     assert tables((tmp_path / "force" / PAGE).read_text()) == original  # the same numbers, the held one's included
+
+
+def test_a_broken_preset_of_a_later_h_is_refused_before_any_ensemble_runs(tmp_path, capsys):
+    import shutil
+
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for h in HURSTS:
+        shutil.copy(PRESETS / preset_name(h), presets)
+    broken = presets / preset_name(HURSTS[-1])  # read last: its H runs last
+    broken.write_text(broken.read_text().replace("realizations:", "realizations: -3\nx_realizations:", 1))
+    runs = tmp_path / "runs"
+    code = main(["exact3d", "--quick", "--presets", str(presets), "--out", str(tmp_path / "out"), "--runs", str(runs),
+                 "--quiet", "--workers", "1"])  # fmt: skip
+    assert code == ExitCode.USAGE
+    assert preset_name(HURSTS[-1]) in capsys.readouterr().err
+    assert not runs.exists() or not any(p.is_dir() for p in runs.iterdir())  # no ensemble ran
