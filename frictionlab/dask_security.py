@@ -44,6 +44,9 @@ def use_tls_files(ca_file: str | None = None, cert: str | None = None, key: str 
     dask.config.set({f"distributed.comm.tls.{name}": value for name, value in given.items() if value})
 
 
+_WARNED_PLAIN: set[str] = set()
+
+
 def check_address(address: str) -> str:
     """``address`` if it is a scheduler address (``tcp://HOST:PORT``,
     ``tls://HOST:PORT``, or ``HOST:PORT`` for tcp); warns when it is neither
@@ -59,7 +62,8 @@ def check_address(address: str) -> str:
         raise FrictionlabError(
             f"--scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. Got {short_repr(address)} instead."
         )
-    if scheme not in ENCRYPTED and not _loopback(host):
+    if scheme not in ENCRYPTED and not _loopback(host) and address not in _WARNED_PLAIN:
+        _WARNED_PLAIN.add(address)  # checked by the command line and again on connecting: said once
         warnings.warn(
             f"the Dask scheduler at {address} is reached without TLS: anyone who can reach that address can run "
             "code as the user of its workers; use a tls:// address (see --tls-ca-file, --tls-cert, --tls-key)",

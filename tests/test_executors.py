@@ -377,6 +377,10 @@ def test_scheduler_addresses_neither_loopback_nor_tls_get_a_warning():
 
     with pytest.warns(UserWarning, match="reached without TLS: anyone who can reach that address can run code"):
         check_address("tcp://10.1.2.3:8786")
+    with warnings.catch_warnings(record=True) as again:  # checked again on connecting: said once
+        warnings.simplefilter("always")
+        check_address("tcp://10.1.2.3:8786")
+    assert again == []
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for quiet in ("tls://10.1.2.3:8786", "tcp://127.0.0.1:8786", "localhost:8786", "tcp://[::1]:8786"):
