@@ -12,6 +12,7 @@ harmonic interpolation) when the preset chooses ``undefined: harmonic``.
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,11 +68,19 @@ def scan_header(path: Path, where: str, *, dimension: int) -> ScanHeader | None:
     with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            channel = open_topography(fh).default_channel
+            channel = open_topography(_by_name(fh)).default_channel
             shape, periodic = tuple(int(n) for n in channel.nb_grid_pts), bool(channel.is_periodic)
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
     return ScanHeader(shape[::-1], periodic) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+
+
+def _by_name(fh):
+    """The opened file by a name of its descriptor where the system has one (Linux): the same
+    checked file, no race, and readers given a name may map it (given a stream, the NetCDF
+    reader read all of a 128 MiB map's heights to tell its shape: 256 MiB)."""
+    name = f"/proc/self/fd/{fh.fileno()}"
+    return name if os.path.exists(name) else fh
 
 
 def _reader_opener(path: Path, where: str):
