@@ -128,15 +128,20 @@ class ProgressLog:
 # ------------------------------------------------------------------ reading
 
 
+HEAD_BYTES = 4096  # of the first line, kept to tell a rewritten file (its ``started`` names a new pid and time)
+
+
 class ProgressReader:
     """Reads the events appended to a folder's progress.jsonl since the last call.
-    A file that shrank was rewritten by a new start: reading begins again (``restarted``)."""
+    A file that shrank, or whose first line changed, was rewritten by a new start (a
+    resume rewrites it larger than the run it continues): reading begins again (``restarted``)."""
 
     def __init__(self, folder: str | Path):
         self.path = Path(folder) / PROGRESS_FILE
         self.offset = 0
         self.restarted = False
         self.too_large = False
+        self.head = b""  # the start of the first line read (up to HEAD_BYTES)
 
     def new_events(self) -> list[dict]:
         self.restarted = False
@@ -151,14 +156,16 @@ class ProgressReader:
             if info.st_size > MAX_PROGRESS_BYTES:
                 self.too_large = True
                 return []
-            if info.st_size < self.offset:
-                self.offset, self.restarted = 0, True
+            if info.st_size < self.offset or (self.head and os.pread(fd, len(self.head), 0) != self.head):
+                self.offset, self.restarted, self.head = 0, True, b""
             data = os.pread(fd, min(READ_BLOCK, info.st_size - self.offset), self.offset)
         except OSError:  # read next time, if it can be
             return []
         finally:
             os.close(fd)
         end = data.rfind(b"\n") + 1  # only whole lines: the last one may still be written
+        if self.offset == 0 and end:
+            self.head = data[: min(data.find(b"\n") + 1, HEAD_BYTES)]
         self.offset += end
         return [event for event in map(_parse, data[:end].splitlines()) if event is not None]
 

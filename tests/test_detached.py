@@ -221,3 +221,15 @@ def test_iterations_within_a_load_reach_the_follower(tmp_path):
 
     Follower(tmp_path, scene, [Hear()]).poll()
     assert heard == [("load", 0, 2, 16), ("iteration", 0, 3, 40, 3.1e-5)]
+
+
+def test_a_progress_file_rewritten_larger_by_a_resume_is_read_again_from_its_start(tmp_path):
+    path = tmp_path / PROGRESS_FILE
+    path.write_bytes(b'{"event": "started", "pid": 1}\n{"event": "finished"}\n')
+    reader = ProgressReader(tmp_path)
+    assert [e["event"] for e in reader.new_events()] == ["started", "finished"]
+    path.write_bytes(b'{"event": "started", "pid": 22}\n' + b'{"event": "realization", "restored": true}\n' * 3)
+    assert [e["event"] for e in reader.new_events()] == ["started"] + ["realization"] * 3 and reader.restarted
+    with open(path, "ab") as fh:
+        fh.write(b'{"event": "finished"}\n')
+    assert [e["event"] for e in reader.new_events()] == ["finished"] and not reader.restarted

@@ -278,3 +278,36 @@ async def test_u_on_an_interrupted_sweep_resumes_it_detached(folders, registry):
         assert (state.status, state.done) == ("interrupted", 1)  # the first point kept, the second resumable
     finally:
         end(followed.pid)
+
+
+@sync
+async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the_restored_count(folders, registry):
+    """The resumed run rewrites progress.jsonl, larger than the cancelled run's: the TUI,
+    which may read the old file first, must follow the new one from its start."""
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    wait_for(lambda: (run_state(out).done or 0) >= 30)
+    os.kill(process.pid, signal.SIGTERM)
+    process.wait()
+    restored = run_state(out).done
+    time.sleep(3.0)  # the cancelled run's clock would count this
+    app = make_app(registry)
+    try:
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.press("f5")
+            await pilot.pause()
+            pressed = time.monotonic()
+            await pilot.press("u")
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= restored + 10)
+            shown, waited = stats(app), time.monotonic() - pressed
+            followed = app.followed
+            await pilot.press("ctrl+q", "c")
+            await pilot.pause()
+    finally:
+        end(followed.pid)
+    done, total, kept, rate, elapsed = numbers_in(shown.split(", left")[0])
+    assert (total, kept) == (100_000, restored) and f"({restored} restored)" in shown
+    assert elapsed <= waited  # this invocation's time, not since the cancelled run began
+    new = done - restored  # only what it computed counts in the rate (elapsed is shown to 0.1 s)
+    assert new / (elapsed + 0.05) - 0.05 <= rate <= new / max(elapsed - 0.05, 1e-3) + 0.05
