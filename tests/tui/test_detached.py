@@ -13,6 +13,7 @@ from textual.widgets import Static
 from frictionlab.detached import process_alive, run_state, start_detached, wait_started
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
+from frictionlab.tui.following import FinishedSweep
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
@@ -311,3 +312,32 @@ async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the
     assert elapsed <= waited  # this invocation's time, not since the cancelled run began
     new = done - restored  # only what it computed counts in the rate (elapsed is shown to 0.1 s)
     assert new / (elapsed + 0.05) - 0.05 <= rate <= new / max(elapsed - 0.05, 1e-3) + 0.05
+
+
+@sync
+async def test_a_resumed_sweep_has_one_row_a_point_in_the_run_tabs_table_updated_in_place(folders, registry):
+    data = {**merge(SWEEP, {"name": "thrice"}), "sweep": {"parameters": {"realizations": {"values": [4, 20_000, 5]}}}}
+    out = folders / "runs" / "thrice"
+    process = start_sweep(data, out, registry)
+
+    def second_point_begun() -> bool:
+        folders = list((out / "points").glob("02-*"))
+        return run_state(out).done == 1 and bool(folders) and (folders[0] / "run.json").exists() \
+            and (run_state(folders[0]).done or 0) > 0
+
+    wait_for(second_point_begun)
+    os.kill(process.pid, signal.SIGTERM)  # cancelled during its second point
+    process.wait()
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        await pilot.pause()
+        await pilot.press("u")
+        await wait_until(pilot, lambda: isinstance(app.last_outcome, FinishedSweep), timeout=120)
+        await pilot.press("f4")
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+    rows = json.loads((out / "sweep.json").read_text())["points"]
+    assert [(c[0], c[1], c[2]) for c in cells] == [("1", "4", "✓"), ("2", "20000", "✓"), ("3", "5", "✓")]
+    assert [numbers_in(c[3])[0] for c in cells] == pytest.approx([row["a"] for row in rows], abs=5e-5)

@@ -18,7 +18,7 @@ from ...fit import format_estimate
 from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
-from ..sweepview import point_line, table_cells, table_columns
+from ..sweepview import STATUS_MARKS, point_line, table_cells, table_columns
 from ..text import failure_message, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
@@ -151,11 +151,21 @@ class RunPane(Vertical, can_focus=True):
 
     def show_point(self, sweep, kind: str, point, result) -> None:
         """A sweep point started (``result`` None) or finished."""
+        table = self.query_one("#sweep-table", DataTable)
+        key = str(point.number)  # one row a point: a resume tells again of the points it had
         if kind == "started":
             self._set("sweep-point", point_line(sweep, point))
             self.query_one("#run-bar", ProgressBar).update(total=point.scene.preset.realizations, progress=0)
+            if key in table.rows:  # an interrupted point, running again: its status mark (after #, the values)
+                status = list(table.columns)[1 + len(sweep.paths)]
+                table.update_cell(key, status, Text(STATUS_MARKS["running"]))
             return
-        self.query_one("#sweep-table", DataTable).add_row(*map(Text, table_cells(sweep, result)))
+        cells = list(map(Text, table_cells(sweep, result)))
+        if key in table.rows:
+            for column, cell in zip(table.columns, cells):
+                table.update_cell(key, column, cell)
+        else:
+            table.add_row(*cells, key=key)
         if result.error:
             self._error(f"point {result.point.number}: {result.error}")
 
