@@ -225,7 +225,8 @@ class Finished:
 class Follower:
     """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
     ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
-    or ``realization_failed``, ``load_done``, ``iteration_done``. Call ``poll()`` now and then; ``finished`` is set
+    or ``realization_failed``, ``load_done``, ``iteration_done``, ``run_finished`` (its outcome
+    a ``Finished``: status, done, requested, error). Call ``poll()`` now and then; ``finished`` is set
     once the run's last event came. ``now()`` is the wall-clock time of the event being
     replayed (the present between events): a listener's clock, so that its elapsed time
     and rate are the run's even when followed from the middle."""
@@ -286,6 +287,8 @@ class Follower:
                     error = event.get("error")
                     self.finished = Finished(str(event.get("status")), _whole(event.get("done")),
                                              _whole(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
+                    if self.info is not None:  # as the run told its own: a bar ends, a last snapshot goes out
+                        self._tell("run_finished", run=self.info, outcome=self.finished)
                 elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              _whole(event.get("exit_code"), 1))  # fmt: skip

@@ -112,8 +112,8 @@ class LiveListener:
             self.post(self._snapshot(self._done, self._total))
 
     @hookimpl
-    def run_finished(self, run, outcome):
-        self.post(self._snapshot(outcome.done + len(outcome.failures), run.total, finished=True))
+    def run_finished(self):
+        self.post(self._snapshot(self._done, self._total, finished=True))
 
     def _maybe_post(self, done: int, total: int) -> None:
         self._done, self._total, self._solving = done, total, ""
