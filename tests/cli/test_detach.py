@@ -160,3 +160,15 @@ def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_
     fits = [line for line in shown[:summary] if ": a = " in line]
     assert fits and all(line.startswith(("    1  hurst=0.5: a = ", "    2  hurst=0.7: a = ")) for line in fits)
     assert all("20000/20000" in shown[shown.index(line) - 1] for line in fits)  # each below its point's finished bar
+
+
+def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    out = tmp_path / "runs" / "quiet"
+    started = run_cli("run", preset, "--detach", "--quiet", "--workers", "1", "--no-plot", "--out", out)
+    assert started.returncode == 0, started.stderr
+    assert started.stdout == f"{out}\n" and started.stderr == ""  # what a script captures: $(frictionlab run ...)
+    assert run_cli("follow", out, "--quiet").returncode == 0
+    resumed = run_cli("resume", out, "--detach", "--quiet")  # resume --detach too
+    assert resumed.returncode == 0 and resumed.stdout == f"{out}\n" and resumed.stderr == ""
+    assert run_cli("follow", out, "--quiet").returncode == 0

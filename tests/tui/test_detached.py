@@ -341,3 +341,35 @@ async def test_a_resumed_sweep_has_one_row_a_point_in_the_run_tabs_table_updated
     rows = json.loads((out / "sweep.json").read_text())["points"]
     assert [(c[0], c[1], c[2]) for c in cells] == [("1", "4", "✓"), ("2", "20000", "✓"), ("3", "5", "✓")]
     assert [numbers_in(c[3])[0] for c in cells] == pytest.approx([row["a"] for row in rows], abs=5e-5)
+
+
+@sync
+async def test_the_run_tabs_footer_offers_only_the_keys_that_apply_now(folders, registry):
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(LONG, {"realizations": 20})))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    footer = lambda: screen_text(app).splitlines()[-1]  # noqa: E731
+    async with app.run_test(size=(120, 24)) as pilot:
+        await pilot.press("f4")
+        await pilot.pause()
+        before = footer()
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        completed = footer()
+        app.query_one("#run-pane").focus()
+        (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+        await pilot.press("f2", "enter")  # the preset read again: 100000 realizations
+        await pilot.pause()
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.total == 100_000)
+        await pilot.pause()
+        running = footer()
+        await pilot.press("c")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        cancelled = footer()
+    assert " r Run " in before and "c Cancel" not in before and "u Resume" not in before
+    assert " r Run " in completed and "c Cancel" not in completed and "u Resume" not in completed
+    assert "c Cancel" in running and " r Run " not in running and "u Resume" not in running
+    assert app.last_outcome.status == "interrupted"
+    assert "u Resume" in cancelled and " r Run " in cancelled and "c Cancel" not in cancelled

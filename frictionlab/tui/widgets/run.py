@@ -79,6 +79,16 @@ class RunPane(Vertical, can_focus=True):
         yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
         yield Static("", id="run-error")
 
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers only what applies now: cancel while a run goes, run and resume
+        when none does (resume only a run that ended before it completed)."""
+        app = self.app
+        if action == "cancel":
+            return app.running
+        if action == "resume":
+            return not app.running and app.last_outcome is not None and app.last_outcome.status != "completed"
+        return not app.running if action == "start" else True
+
     def action_start(self) -> None:
         self.app.action_start_run()
 
