@@ -19,7 +19,7 @@ import math
 import os
 import stat
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -225,11 +225,13 @@ class Finished:
 class Follower:
     """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
     ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
-    or ``realization_failed``, ``load_done``, ``iteration_done``, ``run_finished`` (its outcome
-    a ``Finished``: status, done, requested, error). Call ``poll()`` now and then; ``finished`` is set
-    once the run's last event came. ``now()`` is the wall-clock time of the event being
-    replayed (the present between events): a listener's clock, so that its elapsed time
-    and rate are the run's even when followed from the middle."""
+    or ``realization_failed``, ``load_done``, ``iteration_done``, ``run_finished`` (its
+    outcome a ``Finished``: status, done, requested, error). A resume's restored
+    realizations come in ``RunInfo.restored``, as the run's own listeners have them. Call
+    ``poll()`` now and then; ``finished`` is set once the run's last event came. ``now()`` is
+    the wall-clock time of the event being replayed (the present between events): a
+    listener's clock, so that its elapsed time and rate are the run's even when followed
+    from the middle."""
 
     def __init__(self, folder: str | Path, scene, listeners=()):
         self.reader = ProgressReader(folder)
@@ -241,6 +243,8 @@ class Follower:
         self.done = self.total = 0
         self._event_time: float | None = None
         self._hooks = None
+        self._resuming = None  # a resume's RunInfo, told once the realizations it restored are read
+        self._restored: list[RealizationResult] = []
 
     def now(self) -> float:
         return time.time() if self._event_time is None else self._event_time
@@ -252,24 +256,41 @@ class Follower:
             self._hooks = listener_manager(self.listeners).hook
         getattr(self._hooks, hook)(**kwargs)
 
+    def _start(self, info) -> None:
+        self.info, self._resuming = info, None
+        self.done = info.resumed
+        self._tell("run_started", run=info)
+
     def poll(self) -> int:
         """Replay the events written since the last call; return how many."""
         from .engine import RunInfo
 
         events = self.reader.new_events()
         if self.reader.restarted:
-            self.info, self.finished = None, None
+            self.info, self.finished, self._resuming = None, None, None
         for event in events:
             kind = event["event"]
             self._event_time = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
             try:
+                if self._resuming is not None and kind == "realization" and event.get("restored") is True:
+                    result = result_of(event, self.scene.loads.size)  # as the run's own listeners have them:
+                    if result is not None and result.ok:  # in RunInfo.restored, not as realizations done now
+                        self._restored.append(result)
+                    if len(self._restored) >= self._resuming.resumed:
+                        self._start(replace(self._resuming, restored=tuple(self._restored)))
+                    continue
+                if self._resuming is not None:  # the restored ones are over (some were not readable)
+                    self._start(replace(self._resuming, restored=tuple(self._restored)))
                 if kind == "started":
                     self.pid = _whole(event.get("pid")) or None
                     self.total = _whole(event.get("total"))
-                    self.done, self.finished = 0, None
-                    self.info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
-                                        executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
-                    self._tell("run_started", run=self.info)
+                    self.done, self.finished, self.info = 0, None, None
+                    info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
+                                   executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
+                    if info.resumed:
+                        self._resuming, self._restored = info, []
+                    else:
+                        self._start(info)
                 elif kind == "realization" and self.info is not None:
                     result = result_of(event, self.scene.loads.size)
                     if result is None:

@@ -65,7 +65,8 @@ class LiveListener:
         self._restored = run.resumed
         self._done, self._total = run.resumed, run.total
         for result in run.restored:  # a resume: the interim fit covers every realization, not only the new ones
-            self._add(result)
+            if result.ok:
+                self._add(result)
         self._started = self.clock()
         self._last_post = self._started
         self.post(self._snapshot(run.resumed, run.total))
