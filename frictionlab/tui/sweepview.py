@@ -67,7 +67,8 @@ def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
     """One row of the table from a row of sweep.csv (``PointResult.row()`` or a
     point of sweep.json): the point number, the swept values, a status mark,
     a and b with their intervals, R^2, points in contact at the first .. last load."""
-    contacts = "-" if row["contact_first"] is None else f"{format_count(row['contact_first'])}..{format_count(row['contact_last'])}"
+    first, last = row["contact_first"], row["contact_last"]
+    contacts = "-" if first is None else f"{format_count(first)}..{format_count(last)}"
     return [
         str(row["point"]),
         *(yaml_scalar(row[p]) for p in paths),
