@@ -65,6 +65,9 @@ class RunPane(Vertical, can_focus=True):
         Binding("r", "start", "Run", tooltip="the open preset (again)"),
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
+        # the same keys where they cannot act now (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
+          for key, action in (("r", "start"), ("c", "cancel"), ("u", "resume"))),
     ]
 
     def compose(self) -> ComposeResult:
@@ -88,6 +91,10 @@ class RunPane(Vertical, can_focus=True):
         if action == "resume":
             return not app.running and app.last_outcome is not None and app.last_outcome.status != "completed"
         return not app.running if action == "start" else True
+
+    def action_unavailable(self, action: str) -> None:
+        """A key pressed where its action cannot act: the action runs anyway, to say why."""
+        getattr(self, f"action_{action}")()
 
     def action_start(self) -> None:
         self.app.action_start_run()
