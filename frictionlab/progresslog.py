@@ -222,6 +222,28 @@ class Finished:
     exit_code: int | None = None  # an ``error`` event's: the run could not start
 
 
+class StartOf:
+    """Where the run of the process ``pid`` begins in a progress file (all of it when ``pid``
+    is None): a front end that started a resume may read the file of the run it continues
+    before the new process rewrites it, and the old events are not this run's."""
+
+    def __init__(self, pid: int | None, *started: str):
+        self.pid, self.started = pid, started
+        self.seen = pid is None
+
+    def after(self, events: list[dict], restarted: bool) -> list[dict]:
+        """``events`` from this process's start (or its ``error``: it could not start) on."""
+        if restarted:
+            self.seen = self.pid is None
+        if self.seen:
+            return events
+        for at, event in enumerate(events):
+            if (event["event"] in self.started or event["event"] == "error") and event.get("pid") == self.pid:
+                self.seen = True
+                return events[at:]
+        return []
+
+
 class Follower:
     """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
     ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
@@ -231,14 +253,16 @@ class Follower:
     ``poll()`` now and then; ``finished`` is set once the run's last event came. ``now()`` is
     the wall-clock time of the event being replayed (the present between events): a
     listener's clock, so that its elapsed time and rate are the run's even when followed
-    from the middle."""
+    from the middle. ``pid``: the run's process, when known (it was started here); only its
+    events are replayed."""
 
-    def __init__(self, folder: str | Path, scene, listeners=()):
+    def __init__(self, folder: str | Path, scene, listeners=(), pid: int | None = None):
         self.reader = ProgressReader(folder)
         self.scene = scene
         self.listeners = list(listeners)
         self.info = None
-        self.pid: int | None = None
+        self.pid = pid
+        self.awaited = StartOf(pid, "started")
         self.finished: Finished | None = None
         self.done = self.total = 0
         self._event_time: float | None = None
@@ -268,7 +292,7 @@ class Follower:
         events = self.reader.new_events()
         if self.reader.restarted:
             self.info, self.finished, self._resuming = None, None, None
-        for event in events:
+        for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
             self._event_time = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
             try:

@@ -236,3 +236,35 @@ def test_a_progress_file_rewritten_larger_by_a_resume_is_read_again_from_its_sta
     with open(path, "ab") as fh:
         fh.write(b'{"event": "finished"}\n')
     assert [e["event"] for e in reader.new_events()] == ["finished"] and not reader.restarted
+
+
+def test_a_follower_of_a_process_it_started_skips_the_file_of_the_run_that_process_continues(tmp_path):
+    scene = build_scene(SMALL_PRESET)
+    steps = scene.loads.size
+    done = {"event": "realization", "index": 0, "done": 1, "ok": True, "xi": [1.0] * steps, "contact_count": [2] * steps}
+    old = [{"event": "started", "total": 2, "pid": 1}, done, {"event": "finished", "status": "interrupted"}]
+    path = tmp_path / PROGRESS_FILE
+    path.write_text("".join(json.dumps(line) + "\n" for line in old))
+    heard = Collect()
+    follower = Follower(tmp_path, scene, [heard], pid=22)
+    follower.poll()  # the cancelled run's file, not yet rewritten by the resume (pid 22)
+    assert heard.started is None and heard.results == [] and follower.finished is None
+    new = [{"event": "started", "total": 2, "pid": 22, "resumed": 1}, {**done, "restored": True},
+           {**done, "index": 1, "done": 2}]  # fmt: skip
+    path.write_text("".join(json.dumps(line) + "\n" for line in new))
+    follower.poll()
+    assert heard.started.resumed == 1 and [r.index for r in heard.started.restored] == [0]
+    assert [(r.index, n) for r, n, _ in heard.results] == [(1, 2)]
+    refused = Follower(tmp_path, scene, pid=33)
+    path.write_text(json.dumps(old[0]) + "\n" + json.dumps({"event": "error", "pid": 33, "message": "in use", "exit_code": 4}) + "\n")
+    refused.poll()  # a process that could not start: its error is heard
+    assert (refused.finished.error, refused.finished.exit_code) == ("in use", 4)
+
+
+def test_wait_started_waits_for_its_own_process_not_the_run_a_resume_continues(tmp_path):
+    from frictionlab.errors import FrictionlabError
+
+    (tmp_path / PROGRESS_FILE).write_text(json.dumps({"event": "started", "pid": 1, "total": 2}) + "\n")  # the cancelled run's
+    silent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.3)"])  # never writes a start
+    with pytest.raises(FrictionlabError, match="ended at once"):
+        wait_started(silent, tmp_path, timeout=30)
