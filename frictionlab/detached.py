@@ -26,7 +26,7 @@ from pathlib import Path
 
 from .errors import ExitCode, FrictionlabError, RunFolderError
 from .options import RunOptions
-from .progresslog import ProgressLog, ProgressReader
+from .progresslog import ProgressLog, ProgressReader, StartOf
 from .inputs import InputFileProblem
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json, read_member
@@ -94,18 +94,20 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
     """Return once the detached run has begun (its ``started`` event is written); raise
     FrictionlabError with the run's own message (and exit code) if it could not begin."""
     reader = ProgressReader(out_dir)
+    ours = StartOf(process.pid, *STARTED)  # a resume's folder holds the file of the run it continues
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        for event in reader.new_events():
+        for event in ours.after(reader.new_events(), reader.restarted):
             if event["event"] in STARTED:
                 return
             if event["event"] == "error":
                 _raise_run_error(event)
         if process.poll() is not None:
-            for event in reader.new_events():
+            for event in ours.after(reader.new_events(), reader.restarted):
                 if event["event"] == "error":
                     _raise_run_error(event)
-            if any(event["event"] in STARTED for event in ProgressReader(out_dir).new_events()):
+            if any(event["event"] in STARTED and event.get("pid") == process.pid
+                   for event in ProgressReader(out_dir).new_events()):  # fmt: skip
                 return  # a run so short it ended already
             raise FrictionlabError(f"the run into {out_dir} ended at once (exit code {process.returncode}) without a word")
         time.sleep(0.05)

@@ -102,12 +102,14 @@ def format_duration(seconds: float) -> str:
 
 
 def progress_text(done: int, total: int, failed: int, elapsed: float, restored: int = 0) -> str:
-    """``12/40 realizations, 1 failed, 3.1/s, elapsed 3.9 s, left 9.0 s``: the rate counts
-    only what this process computed (not the ``restored`` realizations of a resume)."""
+    """``12/40 realizations (8 restored), 1 failed, 3.1/s, elapsed 3.9 s, left 9.0 s``: of this
+    invocation, the elapsed time and the rate (not counting the ``restored`` realizations of a
+    resume), and the time left at that rate."""
     rate = (done - restored) / elapsed if elapsed > 0 else 0.0
     left = format_duration((total - done) / rate) if rate > 0 else "?"
+    kept = f" ({restored} restored)" if restored else ""
     failures = f", {failed} failed" if failed else ""
-    return f"{done}/{total} realizations{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
+    return f"{done}/{total} realizations{kept}{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
 
 
 def solve_text(index: int, load: int, loads: int, iteration: int | None = None, residual: float | None = None) -> str:

@@ -202,11 +202,15 @@ class ProgressReporter:
             self._write(f"realization {result.index} failed: {result.error}")
         self._progress(done, total)
 
-    @hookimpl
-    def run_finished(self, outcome):
+    def close(self) -> None:
+        """End the bar, if one shows, on a line of its own: what is written next goes below it."""
         if self.bar is not None:
             self.bar.stop()
             self.bar = None
+
+    @hookimpl
+    def run_finished(self, outcome):
+        self.close()
         if outcome.status != "completed":
             self._write(f"run {outcome.status}: {outcome.done} of {outcome.requested} realizations finished")
 
@@ -223,10 +227,19 @@ class SweepProgress(SweepListener):
         self.interactive = interactive
         self.after = after
         self.clock = clock  # a followed sweep's (sweeplog.SweepFollower.now): its times are the run's
+        self.reporter: ProgressReporter | None = None  # the point's running now
 
     def _write(self, text: str) -> None:
-        self.stream.write(text + "\n")
-        self.stream.flush()
+        if self.reporter is not None:  # above its bar, if one shows
+            self.reporter._write(text)
+        else:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+
+    def close(self) -> None:
+        """End the bar of the point running, if one shows (``ProgressReporter.close``)."""
+        if self.reporter is not None:
+            self.reporter.close()
 
     def sweep_started(self, sweep):
         mode = sweep.spec.mode
@@ -236,7 +249,9 @@ class SweepProgress(SweepListener):
         self._write(f"point {point.number}/{len(sweep.points)}: {point.describe()}")
 
     def run_listeners(self, point):
-        return [ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock)]
+        self.close()
+        self.reporter = ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock)
+        return [self.reporter]
 
     def point_finished(self, sweep, point, result):
         if result.status == "error":

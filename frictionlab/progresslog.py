@@ -19,7 +19,7 @@ import math
 import os
 import stat
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -128,15 +128,20 @@ class ProgressLog:
 # ------------------------------------------------------------------ reading
 
 
+HEAD_BYTES = 4096  # of the first line, kept to tell a rewritten file (its ``started`` names a new pid and time)
+
+
 class ProgressReader:
     """Reads the events appended to a folder's progress.jsonl since the last call.
-    A file that shrank was rewritten by a new start: reading begins again (``restarted``)."""
+    A file that shrank, or whose first line changed, was rewritten by a new start (a
+    resume rewrites it larger than the run it continues): reading begins again (``restarted``)."""
 
     def __init__(self, folder: str | Path):
         self.path = Path(folder) / PROGRESS_FILE
         self.offset = 0
         self.restarted = False
         self.too_large = False
+        self.head = b""  # the start of the first line read (up to HEAD_BYTES)
 
     def new_events(self) -> list[dict]:
         self.restarted = False
@@ -151,14 +156,16 @@ class ProgressReader:
             if info.st_size > MAX_PROGRESS_BYTES:
                 self.too_large = True
                 return []
-            if info.st_size < self.offset:
-                self.offset, self.restarted = 0, True
+            if info.st_size < self.offset or (self.head and os.pread(fd, len(self.head), 0) != self.head):
+                self.offset, self.restarted, self.head = 0, True, b""
             data = os.pread(fd, min(READ_BLOCK, info.st_size - self.offset), self.offset)
         except OSError:  # read next time, if it can be
             return []
         finally:
             os.close(fd)
         end = data.rfind(b"\n") + 1  # only whole lines: the last one may still be written
+        if self.offset == 0 and end:
+            self.head = data[: min(data.find(b"\n") + 1, HEAD_BYTES)]
         self.offset += end
         return [event for event in map(_parse, data[:end].splitlines()) if event is not None]
 
@@ -215,24 +222,53 @@ class Finished:
     exit_code: int | None = None  # an ``error`` event's: the run could not start
 
 
+class StartOf:
+    """Where the run of the process ``pid`` begins in a progress file (all of it when ``pid``
+    is None): a front end that started a resume may read the file of the run it continues
+    before the new process rewrites it, and the old events are not this run's."""
+
+    def __init__(self, pid: int | None, *started: str):
+        self.pid, self.started = pid, started
+        self.seen = pid is None
+
+    def after(self, events: list[dict], restarted: bool) -> list[dict]:
+        """``events`` from this process's start (or its ``error``: it could not start) on."""
+        if restarted:
+            self.seen = self.pid is None
+        if self.seen:
+            return events
+        for at, event in enumerate(events):
+            if (event["event"] in self.started or event["event"] == "error") and event.get("pid") == self.pid:
+                self.seen = True
+                return events[at:]
+        return []
+
+
 class Follower:
     """Replays a folder's progress.jsonl to ``listeners`` (``RunListener``s) as it grows:
     ``run_started`` (with a ``RunInfo`` of the stored preset's ``scene``), ``realization_done``
-    or ``realization_failed``, ``load_done``, ``iteration_done``. Call ``poll()`` now and then; ``finished`` is set
-    once the run's last event came. ``now()`` is the wall-clock time of the event being
-    replayed (the present between events): a listener's clock, so that its elapsed time
-    and rate are the run's even when followed from the middle."""
+    or ``realization_failed``, ``load_done``, ``iteration_done``, ``run_finished`` (its
+    outcome a ``Finished``: status, done, requested, error). A resume's restored
+    realizations come in ``RunInfo.restored``, as the run's own listeners have them. Call
+    ``poll()`` now and then; ``finished`` is set once the run's last event came. ``now()`` is
+    the wall-clock time of the event being replayed (the present between events): a
+    listener's clock, so that its elapsed time and rate are the run's even when followed
+    from the middle. ``pid``: the run's process, when known (it was started here); only its
+    events are replayed."""
 
-    def __init__(self, folder: str | Path, scene, listeners=()):
+    def __init__(self, folder: str | Path, scene, listeners=(), pid: int | None = None):
         self.reader = ProgressReader(folder)
         self.scene = scene
         self.listeners = list(listeners)
         self.info = None
-        self.pid: int | None = None
+        self.pid = pid
+        self.awaited = StartOf(pid, "started")
         self.finished: Finished | None = None
         self.done = self.total = 0
         self._event_time: float | None = None
         self._hooks = None
+        self._resuming = None  # a resume's RunInfo, told once the realizations it restored are read
+        self._restored: list[RealizationResult] = []
 
     def now(self) -> float:
         return time.time() if self._event_time is None else self._event_time
@@ -244,24 +280,41 @@ class Follower:
             self._hooks = listener_manager(self.listeners).hook
         getattr(self._hooks, hook)(**kwargs)
 
+    def _start(self, info) -> None:
+        self.info, self._resuming = info, None
+        self.done = info.resumed
+        self._tell("run_started", run=info)
+
     def poll(self) -> int:
         """Replay the events written since the last call; return how many."""
         from .engine import RunInfo
 
         events = self.reader.new_events()
         if self.reader.restarted:
-            self.info, self.finished = None, None
-        for event in events:
+            self.info, self.finished, self._resuming = None, None, None
+        for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
             self._event_time = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
             try:
+                if self._resuming is not None and kind == "realization" and event.get("restored") is True:
+                    result = result_of(event, self.scene.loads.size)  # as the run's own listeners have them:
+                    if result is not None and result.ok:  # in RunInfo.restored, not as realizations done now
+                        self._restored.append(result)
+                    if len(self._restored) >= self._resuming.resumed:
+                        self._start(replace(self._resuming, restored=tuple(self._restored)))
+                    continue
+                if self._resuming is not None:  # the restored ones are over (some were not readable)
+                    self._start(replace(self._resuming, restored=tuple(self._restored)))
                 if kind == "started":
                     self.pid = _whole(event.get("pid")) or None
                     self.total = _whole(event.get("total"))
-                    self.done, self.finished = 0, None
-                    self.info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
-                                        executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
-                    self._tell("run_started", run=self.info)
+                    self.done, self.finished, self.info = 0, None, None
+                    info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
+                                   executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
+                    if info.resumed:
+                        self._resuming, self._restored = info, []
+                    else:
+                        self._start(info)
                 elif kind == "realization" and self.info is not None:
                     result = result_of(event, self.scene.loads.size)
                     if result is None:
@@ -279,6 +332,8 @@ class Follower:
                     error = event.get("error")
                     self.finished = Finished(str(event.get("status")), _whole(event.get("done")),
                                              _whole(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
+                    if self.info is not None:  # as the run told its own: a bar ends, a last snapshot goes out
+                        self._tell("run_finished", run=self.info, outcome=self.finished)
                 elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              _whole(event.get("exit_code"), 1))  # fmt: skip

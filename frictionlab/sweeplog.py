@@ -18,7 +18,7 @@ from pathlib import Path
 
 from .errors import RunFolderError
 from .listeners import SweepListener
-from .progresslog import Finished, Follower, ProgressLog, ProgressReader, _number, _whole
+from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf, _number, _whole
 from .runfolder import checked
 from .sweep import UNFINISHED, PointRecord, PointResult, Sweep, SweepPoint, point_folder
 
@@ -63,14 +63,16 @@ class SweepFollower:
     running, its realizations to the ``run_listeners(point)`` they give (read from the
     point's own progress.jsonl; points that finished before following began are not
     replayed realization by realization). Call ``poll()`` now and then; ``finished`` is
-    set once the sweep's last event came."""
+    set once the sweep's last event came. ``pid``: the sweep's process, when known (it was
+    started here); only its events are replayed (``progresslog.StartOf``)."""
 
-    def __init__(self, folder: str | Path, sweep: Sweep, listeners=()):
+    def __init__(self, folder: str | Path, sweep: Sweep, listeners=(), pid: int | None = None):
         self.folder = Path(folder)
         self.sweep = sweep
         self.listeners = list(listeners)
         self.reader = ProgressReader(folder)
-        self.pid: int | None = None
+        self.pid = pid
+        self.awaited = StartOf(pid, "sweep_started")
         self.finished: Finished | None = None
         self.point: SweepPoint | None = None  # the point running
         self.run: Follower | None = None  # its run's follower, once made
@@ -91,7 +93,7 @@ class SweepFollower:
         count = len(events)
         if self.reader.restarted:
             self.finished, self.point, self.run = None, None, None
-        for event in events:
+        for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
             if kind == "sweep_started":
                 self.pid = _whole(event.get("pid")) or None
@@ -115,7 +117,7 @@ class SweepFollower:
         if self.point is not None and self.finished is None:
             if self.run is None:  # made for the point running now only: earlier points are not replayed
                 listeners = [each for listener in self.listeners for each in listener.run_listeners(self.point)]
-                self.run = Follower(point_folder(self.folder, self.point), self.point.scene, listeners)
+                self.run = Follower(point_folder(self.folder, self.point), self.point.scene, listeners, pid=self.pid)
             count += self.run.poll()
         return count
 

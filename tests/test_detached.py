@@ -151,12 +151,15 @@ def test_the_follower_hears_every_realization_as_the_run_computed_it_and_a_resum
     heard = Collect()
     follower = Follower(tmp_path, scene, [heard])
     follower.poll()
-    assert follower.finished.status == "completed" and heard.started.resumed == len(first.results)
-    assert sorted(r.index for r, _, _ in heard.results) == list(range(12))  # restored, then the new ones
-    assert [done for _, done, _ in heard.results] == list(range(1, 13))
+    resumed = len(first.results)
+    assert follower.finished.status == "completed" and heard.started.resumed == resumed
+    restored = list(heard.started.restored)  # as the run's own listeners have them: not as realizations done now
+    assert sorted(r.index for r in restored) == sorted(r.index for r, _, _ in first.results)
+    assert sorted(r.index for r in restored + [r for r, _, _ in heard.results]) == list(range(12))
+    assert [done for _, done, _ in heard.results] == list(range(resumed + 1, 13))
     computed = {r.index: r for r, _, _ in here.results}
     with np.load(tmp_path / "realizations.npz") as arrays:
-        for result, _, _ in heard.results:  # every number as written: JSON keeps a float's every bit
+        for result in restored + [r for r, _, _ in heard.results]:  # every number as written: JSON keeps a float's every bit
             assert np.array_equal(result.xi, arrays["xi"][result.index])
             if result.index in computed:
                 assert np.array_equal(result.contact_count, computed[result.index].contact_count)
@@ -221,3 +224,47 @@ def test_iterations_within_a_load_reach_the_follower(tmp_path):
 
     Follower(tmp_path, scene, [Hear()]).poll()
     assert heard == [("load", 0, 2, 16), ("iteration", 0, 3, 40, 3.1e-5)]
+
+
+def test_a_progress_file_rewritten_larger_by_a_resume_is_read_again_from_its_start(tmp_path):
+    path = tmp_path / PROGRESS_FILE
+    path.write_bytes(b'{"event": "started", "pid": 1}\n{"event": "finished"}\n')
+    reader = ProgressReader(tmp_path)
+    assert [e["event"] for e in reader.new_events()] == ["started", "finished"]
+    path.write_bytes(b'{"event": "started", "pid": 22}\n' + b'{"event": "realization", "restored": true}\n' * 3)
+    assert [e["event"] for e in reader.new_events()] == ["started"] + ["realization"] * 3 and reader.restarted
+    with open(path, "ab") as fh:
+        fh.write(b'{"event": "finished"}\n')
+    assert [e["event"] for e in reader.new_events()] == ["finished"] and not reader.restarted
+
+
+def test_a_follower_of_a_process_it_started_skips_the_file_of_the_run_that_process_continues(tmp_path):
+    scene = build_scene(SMALL_PRESET)
+    steps = scene.loads.size
+    done = {"event": "realization", "index": 0, "done": 1, "ok": True, "xi": [1.0] * steps, "contact_count": [2] * steps}
+    old = [{"event": "started", "total": 2, "pid": 1}, done, {"event": "finished", "status": "interrupted"}]
+    path = tmp_path / PROGRESS_FILE
+    path.write_text("".join(json.dumps(line) + "\n" for line in old))
+    heard = Collect()
+    follower = Follower(tmp_path, scene, [heard], pid=22)
+    follower.poll()  # the cancelled run's file, not yet rewritten by the resume (pid 22)
+    assert heard.started is None and heard.results == [] and follower.finished is None
+    new = [{"event": "started", "total": 2, "pid": 22, "resumed": 1}, {**done, "restored": True},
+           {**done, "index": 1, "done": 2}]  # fmt: skip
+    path.write_text("".join(json.dumps(line) + "\n" for line in new))
+    follower.poll()
+    assert heard.started.resumed == 1 and [r.index for r in heard.started.restored] == [0]
+    assert [(r.index, n) for r, n, _ in heard.results] == [(1, 2)]
+    refused = Follower(tmp_path, scene, pid=33)
+    path.write_text(json.dumps(old[0]) + "\n" + json.dumps({"event": "error", "pid": 33, "message": "in use", "exit_code": 4}) + "\n")
+    refused.poll()  # a process that could not start: its error is heard
+    assert (refused.finished.error, refused.finished.exit_code) == ("in use", 4)
+
+
+def test_wait_started_waits_for_its_own_process_not_the_run_a_resume_continues(tmp_path):
+    from frictionlab.errors import FrictionlabError
+
+    (tmp_path / PROGRESS_FILE).write_text(json.dumps({"event": "started", "pid": 1, "total": 2}) + "\n")  # the cancelled run's
+    silent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.3)"])  # never writes a start
+    with pytest.raises(FrictionlabError, match="ended at once"):
+        wait_started(silent, tmp_path, timeout=30)

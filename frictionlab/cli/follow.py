@@ -43,11 +43,15 @@ def run(args) -> ExitCode:
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
         try:
-            while state.status == "running":  # until its process ends: its files are written then
-                if not follower.poll():
-                    time.sleep(POLL_SECONDS)
-                    state = run_state(folder)
-            follower.poll()  # the last events, written as it ended
+            try:
+                while state.status == "running":  # until its process ends: its files are written then
+                    if not follower.poll():
+                        time.sleep(POLL_SECONDS)
+                        state = run_state(folder)
+                follower.poll()  # the last events, written as it ended
+            finally:  # a bar still showing ends on its own line, before anything else is printed
+                for listener in follower.listeners:
+                    listener.close()
         except KeyboardInterrupt:
             print(f"stopped following; the run goes on (pid {state.pid})", file=sys.stderr)
             return ExitCode.INTERRUPTED

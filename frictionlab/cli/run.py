@@ -83,7 +83,7 @@ def add_detach_option(p) -> None:
     p.add_argument(
         "--detach", action="store_true",
         help="run as a process of its own that outlives the terminal; print its folder and pid once it has "
-        "started (frictionlab follow DIR shows its progress, kill -TERM PID cancels it)",
+        "started (frictionlab follow DIR shows its progress, kill -TERM PID cancels it); with --quiet only its folder",
     )  # fmt: skip
 
 
@@ -107,6 +107,8 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
         from .jsonout import emit
 
         emit("detached", {"folder": str(out_dir), "kind": kind, "pid": process.pid, "status": "running"})
+    elif args.quiet:  # only the folder: a script captures it
+        print(out_dir)
     else:
         print(f"{scene.preset.name}: {what} detached in {out_dir}/ (pid {process.pid})\n"
               f"  frictionlab follow {out_dir}    shows its progress\n"

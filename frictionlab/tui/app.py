@@ -451,6 +451,7 @@ class FrictionlabApp(App):
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         self.last_outcome = None
+        self.refresh_bindings()
         try:  # refused here, at once, what the run would refuse as it begins
             if sweep is None:
                 check_startable(scene, out_dir, options)
@@ -466,6 +467,7 @@ class FrictionlabApp(App):
             self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
             return
         self.followed = self._follower(out_dir, scene, sweep, process)
+        self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
         self.query_one(RunPane).start(scene, sweep, out_dir)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
@@ -501,6 +503,7 @@ class FrictionlabApp(App):
         self.last_outcome = None
         self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
         self.followed = self._follower(folder, scene, sweep)
+        self.refresh_bindings()
         name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
         self.say(f"{name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
         self._follow_tick()
@@ -519,6 +522,7 @@ class FrictionlabApp(App):
         if followed is None or not followed.poll():
             return
         self.followed = None
+        self.refresh_bindings()
         if followed.error:
             self.on_run_crashed(RunCrashed(followed.error))
             self.reload_runs()
@@ -544,6 +548,7 @@ class FrictionlabApp(App):
     def on_run_finished(self, message: RunFinished) -> None:
         outcome = message.outcome
         self.last_outcome, self.last_out_dir = outcome, message.out_dir
+        self.refresh_bindings()  # resume, if it ended before it completed
         pane = self.query_one(RunPane)
         if isinstance(outcome, FinishedSweep):
             self.say(pane.show_sweep_outcome(outcome))

@@ -29,7 +29,7 @@ class FollowedRun:
         self.process = process
         self._pid = pid
         self.live = LiveListener(post)
-        self.follower = Follower(folder, scene, [self.live])
+        self.follower = Follower(folder, scene, [self.live], pid=process.pid if process is not None else None)
         self.live.clock = self.follower.now
         self.cancelling = False
 
@@ -78,7 +78,8 @@ class FollowedSweep(FollowedRun):
         self._pid = None
         self.live: LiveListener | None = None  # the point running's, made as it starts
         self._post = post
-        self.follower = SweepFollower(folder, sweep, [SweepPoster(post_point, self._listeners_of)])
+        self.follower = SweepFollower(folder, sweep, [SweepPoster(post_point, self._listeners_of)],
+                                      pid=process.pid if process is not None else None)  # fmt: skip
         self.cancelling = False
 
     def _listeners_of(self, point) -> list[object]:

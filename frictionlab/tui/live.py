@@ -65,7 +65,8 @@ class LiveListener:
         self._restored = run.resumed
         self._done, self._total = run.resumed, run.total
         for result in run.restored:  # a resume: the interim fit covers every realization, not only the new ones
-            self._add(result)
+            if result.ok:
+                self._add(result)
         self._started = self.clock()
         self._last_post = self._started
         self.post(self._snapshot(run.resumed, run.total))
@@ -112,8 +113,8 @@ class LiveListener:
             self.post(self._snapshot(self._done, self._total))
 
     @hookimpl
-    def run_finished(self, run, outcome):
-        self.post(self._snapshot(outcome.done + len(outcome.failures), run.total, finished=True))
+    def run_finished(self):
+        self.post(self._snapshot(self._done, self._total, finished=True))
 
     def _maybe_post(self, done: int, total: int) -> None:
         self._done, self._total, self._solving = done, total, ""

@@ -14,6 +14,7 @@ from typing import Any
 from ..fit import format_interval
 from ..listeners import SweepListener
 from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
+from .text import format_count
 
 
 class SweepPoster(SweepListener):
@@ -66,7 +67,8 @@ def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
     """One row of the table from a row of sweep.csv (``PointResult.row()`` or a
     point of sweep.json): the point number, the swept values, a status mark,
     a and b with their intervals, R^2, points in contact at the first .. last load."""
-    contacts = "-" if row["contact_first"] is None else f"{row['contact_first']:.3g}..{row['contact_last']:.3g}"
+    first, last = row["contact_first"], row["contact_last"]
+    contacts = "-" if first is None else f"{format_count(first)}..{format_count(last)}"
     return [
         str(row["point"]),
         *(yaml_scalar(row[p]) for p in paths),

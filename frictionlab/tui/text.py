@@ -1,8 +1,10 @@
 """Text the TUI shows, shaped to fit (no Textual here): paths shortened from the
-middle, a realization's error told as a person needs it."""
+middle, run names keeping their time stamp, counts in one format, a realization's
+error told as a person needs it."""
 
 from __future__ import annotations
 
+import math
 import re
 
 ELLIPSIS = "…"
@@ -20,6 +22,38 @@ def shorten_middle(text: str, width: int) -> str:
     tail = (width - 1) // 2 + (width - 1) % 2
     head = width - 1 - tail
     return text[:head] + ELLIPSIS + text[len(text) - tail :]
+
+
+RUN_STAMP = re.compile(r"(.+)-(\d{4})(\d{4}-\d{6}(?:-\d+)?)")  # name-YYYYMMDD-HHMMSS[-n]: rundir.new_run_folder's
+NAME_KEPT = 5  # of a run's name, at least this much (with its ellipsis) beside the whole time stamp
+
+
+def shorten_run_name(name: str, width: int) -> str:
+    """A run folder's name cut to ``width`` characters keeping its time stamp, which tells
+    apart runs of one preset: the middle of the name goes first, then the stamp's year
+    (``long…1127-172222``); a name with no stamp is cut from its middle."""
+    match = RUN_STAMP.fullmatch(name)
+    if len(name) <= width or match is None:
+        return shorten_middle(name, width)
+    prefix, year, rest = match.groups()
+    room = width - len(year) - len(rest) - 1
+    if room >= NAME_KEPT:
+        return f"{shorten_middle(prefix, room)}-{year}{rest}"
+    room = width - len(rest) - 1
+    if room >= 1:
+        return f"{prefix[:room]}{ELLIPSIS}{rest}"
+    return shorten_middle(name, width)
+
+
+def format_count(value: float) -> str:
+    """A mean count (points in contact) to 3 significant digits, in plain digits below
+    1e5 (``0.750``, ``30.6``, ``621``, ``1350``): one column reads alike from row to row."""
+    rounded = float(f"{value:.3g}")
+    if not math.isfinite(rounded) or abs(rounded) >= 1e5:
+        return f"{value:.3g}"
+    if rounded == 0:
+        return "0"
+    return f"{rounded:.{max(0, 2 - math.floor(math.log10(abs(rounded))))}f}"
 
 
 _WHERE = re.compile(r"\s\([\w.-]+\.py:\d+\)$")  # the source location the engine appends

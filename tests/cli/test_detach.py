@@ -10,7 +10,7 @@ import time
 from frictionlab.detached import run_state
 
 from ..conftest import SMALL_PRESET, merge
-from .conftest import run_cli, write_preset
+from .conftest import InTerminal, run_cli, write_preset
 
 
 def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path):
@@ -122,3 +122,53 @@ def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(
     assert any(f"1  realizations=4: a = {row['a']:.4f}" in line for line in heard)  # how the first point ended
     assert follow.returncode == 1
     assert stdout.startswith(f"small: interrupted, 1/2 points, in {out}/; frictionlab resume {out} continues it")
+
+
+def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path):
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
+    out = tmp_path / "long"
+    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    try:
+        follow = InTerminal("follow", out)
+        deadline = time.monotonic() + 60
+        while b"/100000" not in follow.raw and time.monotonic() < deadline:  # its bar shows
+            time.sleep(0.05)
+        time.sleep(0.5)
+        follow.process.send_signal(signal.SIGINT)
+        code = follow.wait()
+    finally:
+        os.kill(told["pid"], signal.SIGTERM)
+    lines, column = follow.screen()
+    shown = [line for line in lines if line]
+    assert code == 130
+    assert shown[-1] == f"stopped following; the run goes on (pid {told['pid']})" and column == 0  # the prompt's line is free
+    assert "/100000" in shown[-2]  # the bar, as it was left, above
+
+
+def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_bar_after_its_summary(tmp_path):
+    data = merge(SMALL_PRESET, {"realizations": 20_000, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
+    preset = write_preset(tmp_path, data, "sweep.yaml")
+    out = tmp_path / "sw"
+    assert run_cli("run", preset, "--detach", "--workers", "1", "--no-plot", "--out", out).returncode == 0
+    follow = InTerminal("follow", out)
+    assert follow.wait() == 0
+    lines, column = follow.screen()
+    shown = [line for line in lines if line]
+    summary = shown.index(next(line for line in shown if line.startswith("small: completed, 2/2 points")))
+    assert shown[summary + 1].startswith("    1  hurst=0.5: a = ") and shown[summary + 2].startswith("    2  hurst=0.7: a = ")
+    assert len(shown) == summary + 3 and column == 0  # nothing drawn after the summary
+    fits = [line for line in shown[:summary] if ": a = " in line]
+    assert fits and all(line.startswith(("    1  hurst=0.5: a = ", "    2  hurst=0.7: a = ")) for line in fits)
+    assert all("20000/20000" in shown[shown.index(line) - 1] for line in fits)  # each below its point's finished bar
+
+
+def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path):
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    out = tmp_path / "runs" / "quiet"
+    started = run_cli("run", preset, "--detach", "--quiet", "--workers", "1", "--no-plot", "--out", out)
+    assert started.returncode == 0, started.stderr
+    assert started.stdout == f"{out}\n" and started.stderr == ""  # what a script captures: $(frictionlab run ...)
+    assert run_cli("follow", out, "--quiet").returncode == 0
+    resumed = run_cli("resume", out, "--detach", "--quiet")  # resume --detach too
+    assert resumed.returncode == 0 and resumed.stdout == f"{out}\n" and resumed.stderr == ""
+    assert run_cli("follow", out, "--quiet").returncode == 0

@@ -13,6 +13,7 @@ from textual.widgets import Static
 from frictionlab.detached import process_alive, run_state, start_detached, wait_started
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
+from frictionlab.tui.following import FinishedSweep
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
@@ -278,3 +279,97 @@ async def test_u_on_an_interrupted_sweep_resumes_it_detached(folders, registry):
         assert (state.status, state.done) == ("interrupted", 1)  # the first point kept, the second resumable
     finally:
         end(followed.pid)
+
+
+@sync
+async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the_restored_count(folders, registry):
+    """The resumed run rewrites progress.jsonl, larger than the cancelled run's: the TUI,
+    which may read the old file first, must follow the new one from its start."""
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    wait_for(lambda: (run_state(out).done or 0) >= 30)
+    os.kill(process.pid, signal.SIGTERM)
+    process.wait()
+    restored = run_state(out).done
+    time.sleep(3.0)  # the cancelled run's clock would count this
+    app = make_app(registry)
+    try:
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.press("f5")
+            await pilot.pause()
+            pressed = time.monotonic()
+            await pilot.press("u")
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= restored + 10)
+            shown, waited = stats(app), time.monotonic() - pressed
+            followed = app.followed
+            await pilot.press("ctrl+q", "c")
+            await pilot.pause()
+    finally:
+        end(followed.pid)
+    done, total, kept, rate, elapsed = numbers_in(shown.split(", left")[0])
+    assert (total, kept) == (100_000, restored) and f"({restored} restored)" in shown
+    assert elapsed <= waited  # this invocation's time, not since the cancelled run began
+    new = done - restored  # only what it computed counts in the rate (elapsed is shown to 0.1 s)
+    assert new / (elapsed + 0.05) - 0.05 <= rate <= new / max(elapsed - 0.05, 1e-3) + 0.05
+
+
+@sync
+async def test_a_resumed_sweep_has_one_row_a_point_in_the_run_tabs_table_updated_in_place(folders, registry):
+    data = {**merge(SWEEP, {"name": "thrice"}), "sweep": {"parameters": {"realizations": {"values": [4, 20_000, 5]}}}}
+    out = folders / "runs" / "thrice"
+    process = start_sweep(data, out, registry)
+
+    def second_point_begun() -> bool:
+        folders = list((out / "points").glob("02-*"))
+        return run_state(out).done == 1 and bool(folders) and (folders[0] / "run.json").exists() \
+            and (run_state(folders[0]).done or 0) > 0
+
+    wait_for(second_point_begun)
+    os.kill(process.pid, signal.SIGTERM)  # cancelled during its second point
+    process.wait()
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        await pilot.pause()
+        await pilot.press("u")
+        await wait_until(pilot, lambda: isinstance(app.last_outcome, FinishedSweep), timeout=120)
+        await pilot.press("f4")
+        await pilot.pause()
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+    rows = json.loads((out / "sweep.json").read_text())["points"]
+    assert [(c[0], c[1], c[2]) for c in cells] == [("1", "4", "✓"), ("2", "20000", "✓"), ("3", "5", "✓")]
+    assert [numbers_in(c[3])[0] for c in cells] == pytest.approx([row["a"] for row in rows], abs=5e-5)
+
+
+@sync
+async def test_the_run_tabs_footer_offers_only_the_keys_that_apply_now(folders, registry):
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(LONG, {"realizations": 20})))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    footer = lambda: screen_text(app).splitlines()[-1]  # noqa: E731
+    async with app.run_test(size=(120, 24)) as pilot:
+        await pilot.press("f4")
+        await pilot.pause()
+        before = footer()
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        completed = footer()
+        app.query_one("#run-pane").focus()
+        (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+        await pilot.press("f2", "enter")  # the preset read again: 100000 realizations
+        await pilot.pause()
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.total == 100_000)
+        await pilot.pause()
+        running = footer()
+        await pilot.press("c")
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        await pilot.pause()
+        cancelled = footer()
+    assert " r Run " in before and "c Cancel" not in before and "u Resume" not in before
+    assert " r Run " in completed and "c Cancel" not in completed and "u Resume" not in completed
+    assert "c Cancel" in running and " r Run " not in running and "u Resume" not in running
+    assert app.last_outcome.status == "interrupted"
+    assert "u Resume" in cancelled and " r Run " in cancelled and "c Cancel" not in cancelled

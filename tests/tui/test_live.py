@@ -58,3 +58,32 @@ def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(reg
     assert last.done == 12 and resumed.done == 12
     np.testing.assert_allclose(last.xi, resumed.xi, rtol=1e-12)  # the mean over all 12, not the 7 new
     assert last.fit.b == pytest.approx(resumed.fit.b, rel=1e-10)
+
+
+def test_a_followed_resume_counts_its_restored_realizations_once_and_as_restored(registry, tmp_path):
+    """The TUI follows a resume through its progress.jsonl: the restored realizations are the
+    first snapshot's (never counted down from 1 as if computed now, which made the rate negative)."""
+    import threading
+
+    from frictionlab.hookspecs import hookimpl
+    from frictionlab.progresslog import Follower, ProgressLog
+    from frictionlab.runner import run_to_folder
+
+    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
+    cancel = threading.Event()
+
+    class StopAfterFive:
+        @hookimpl
+        def realization_done(self, done):
+            if done >= 5:
+                cancel.set()
+
+    stopped, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[StopAfterFive()], cancel=cancel)
+    resumed, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True), listeners=[ProgressLog(tmp_path)])
+    posted = []
+    Follower(tmp_path, scene, [LiveListener(posted.append, interval=0.0)]).poll()
+    assert [s.restored for s in posted] == [stopped.done] * len(posted)
+    assert [s.done for s in posted] == [stopped.done, *range(stopped.done + 1, 13), 12]  # the last: the run's end
+    np.testing.assert_allclose(posted[0].xi, stopped.xi, rtol=1e-12)
+    np.testing.assert_allclose(posted[-1].xi, resumed.xi, rtol=1e-12)  # each realization once
+    assert posted[-1].finished

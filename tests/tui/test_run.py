@@ -26,6 +26,7 @@ from .conftest import (
     numbers_in,
     press_run,
     run_to_the_end,
+    screen_text,
     sync,
     wait_until,
 )
@@ -193,3 +194,28 @@ async def test_u_resumes_a_cancelled_run_to_the_numbers_of_an_uncancelled_one(fo
     assert outcome.status == "completed" and outcome.done == 24
     assert outcome.fit == whole.fit  # same seed: the same numbers as a run never stopped
     assert said == "stopped is complete: nothing to resume."
+
+
+@pytest.mark.parametrize("size", [SIZE, (100, 50), (120, 40)])
+@sync
+async def test_a_finished_sweeps_plot_keeps_its_whole_legend_and_the_room_the_table_does_not_use(folders, registry, size):
+    """Found by a tester: once the fit was final (its interval lines added), the legend lost
+    its last line; at 120x40 the plot had 9 rows while the table left 20 empty."""
+    from frictionlab.tui.following import FinishedSweep
+
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    async with app.run_test(size=size) as pilot:
+        await run_to_the_end(pilot)
+        assert isinstance(app.last_outcome, FinishedSweep)
+        await pilot.press("f4")
+        await pilot.pause()
+        legend = str(app.query_one("#run-fit").render()).splitlines()
+        table = app.query_one("#sweep-table")
+        body_rows, table_rows, points = app.query_one("#run-body").size.height, table.size.height, table.row_count
+        shown = screen_text(app)
+    assert legend[-1].endswith("at last load") and "CI, bootstrap" in "\n".join(legend)
+    assert body_rows >= len(legend) and legend[-1].strip() in shown  # every line of it on screen
+    if size != SIZE:  # room enough: the table takes its rows (and header), the plot the rest
+        assert table_rows == points + 1
+        assert body_rows >= size[1] - 17

@@ -112,8 +112,8 @@ async def test_run_names_use_the_width_they_have(folders, registry, size):
         shown = screen_text(app)
         table, chart = app.query_one("#runs-table"), app.query_one("#results-chart")
         whole, plot_width = fits_width(table), chart.size.width
-    if size == SIZE:  # shortened from the middle: where it starts and its time stamp stay
-        assert "a-longer…5-210620" in shown
+    if size == SIZE:  # shortened: where it starts and its time stamp stay (the year goes first)
+        assert "a-lon…1125-210620" in shown
     else:
         assert LONG_NAME in shown  # 30 characters: whole at 100 columns and more
     assert [line for line in shown.splitlines() if "xxx…" in line and "235755 " in line]  # too long: shortened

@@ -197,3 +197,27 @@ async def test_a_long_preset_name_is_cut_in_its_middle_and_keeps_every_column_on
     assert name.startswith("a-very-long") and name.endswith("-end-0060") and "…" in name
     assert folder and file == "long.yaml"
     assert title.startswith("a-very-long") and "-end-0060: 3 realizations, 16 force steps" in title and "…" in title
+
+
+def test_a_run_name_cut_to_fit_keeps_its_whole_time_stamp_then_its_date_and_time():
+    from frictionlab.tui.text import shorten_run_name
+
+    assert shorten_run_name("long-20261127-172222", 20) == "long-20261127-172222"
+    assert shorten_run_name("a-longer-study-20261125-210620", 24) == "a-l…tudy-20261125-210620"  # the name's middle
+    assert shorten_run_name("long-20261127-172222", 17) == "long…1127-172222"  # then the year: day and time stay
+    assert shorten_run_name("quickstart-20261127-172222-2", 17) == "qui…1127-172222-2"  # a second run of that second
+    assert shorten_run_name("plain-name-without-stamp-at-all", 17) == "plain-na…p-at-all"  # no stamp: the middle
+    for width in range(1, 40):
+        cut = shorten_run_name("swp-20261127-172325", width)
+        assert len(cut) <= width and (cut == "swp-20261127-172325") == (width >= 19)
+
+
+def test_contact_counts_read_alike_in_every_row_of_the_sweep_table():
+    from frictionlab.tui.sweepview import row_cells
+    from frictionlab.tui.text import format_count
+
+    assert [format_count(v) for v in (0.75, 30.64, 621.3, 1350.4, 99.96, 0.0, 123456.0)] == [
+        "0.750", "30.6", "621", "1350", "100", "0", "1.23e+05"]  # fmt: skip
+    row = {"point": 2, "status": "completed", "a": None, "a_lo": None, "a_hi": None, "b": None, "b_lo": None,
+           "b_hi": None, "r2": None, "contact_first": 119.4, "contact_last": 1349.6}  # fmt: skip
+    assert row_cells([], row)[-1] == "119..1350"

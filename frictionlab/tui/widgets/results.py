@@ -21,7 +21,7 @@ from ..chart import Series
 from ...results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
-from ..text import shorten_middle
+from ..text import format_count, shorten_run_name
 from .chart import Chart
 from .run import fit_series
 from .tables import ListTable
@@ -110,7 +110,7 @@ class ResultsPane(Vertical):
             else:
                 a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
                 b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
-            name = Text(shorten_middle(entry.path.name, width))  # Text: never markup
+            name = Text(shorten_run_name(entry.path.name, width))  # Text: never markup
             table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
         if self.runs:
             table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
@@ -191,7 +191,7 @@ def _entry_lines(entry: RunEntry, style: str) -> list[Content]:
     counts = entry.contact_counts
     formula = entry.formula
     lines = [Content.assemble((f"■ {entry.path.name}", style), f" f = {formula}" if formula else "")]
-    contacts = f", contacts {counts[0]:.3g}..{counts[1]:.3g}" if math.isfinite(counts[0]) else ""
+    contacts = f", contacts {format_count(counts[0])}..{format_count(counts[1])}" if math.isfinite(counts[0]) else ""
     lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
     if entry.fit is not None:
         interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731

@@ -18,7 +18,7 @@ from ...fit import format_estimate
 from ...listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
-from ..sweepview import point_line, table_cells, table_columns
+from ..sweepview import STATUS_MARKS, point_line, table_cells, table_columns
 from ..text import failure_message, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
@@ -65,6 +65,9 @@ class RunPane(Vertical, can_focus=True):
         Binding("r", "start", "Run", tooltip="the open preset (again)"),
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
+        # the same keys where they cannot act now (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
+          for key, action in (("r", "start"), ("c", "cancel"), ("u", "resume"))),
     ]
 
     def compose(self) -> ComposeResult:
@@ -78,6 +81,20 @@ class RunPane(Vertical, can_focus=True):
             yield Static("", id="run-fit")
         yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
         yield Static("", id="run-error")
+
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers only what applies now: cancel while a run goes, run and resume
+        when none does (resume only a run that ended before it completed)."""
+        app = self.app
+        if action == "cancel":
+            return app.running
+        if action == "resume":
+            return not app.running and app.last_outcome is not None and app.last_outcome.status != "completed"
+        return not app.running if action == "start" else True
+
+    def action_unavailable(self, action: str) -> None:
+        """A key pressed where its action cannot act: the action runs anyway, to say why."""
+        getattr(self, f"action_{action}")()
 
     def action_start(self) -> None:
         self.app.action_start_run()
@@ -151,11 +168,21 @@ class RunPane(Vertical, can_focus=True):
 
     def show_point(self, sweep, kind: str, point, result) -> None:
         """A sweep point started (``result`` None) or finished."""
+        table = self.query_one("#sweep-table", DataTable)
+        key = str(point.number)  # one row a point: a resume tells again of the points it had
         if kind == "started":
             self._set("sweep-point", point_line(sweep, point))
             self.query_one("#run-bar", ProgressBar).update(total=point.scene.preset.realizations, progress=0)
+            if key in table.rows:  # an interrupted point, running again: its status mark (after #, the values)
+                status = list(table.columns)[1 + len(sweep.paths)]
+                table.update_cell(key, status, Text(STATUS_MARKS["running"]))
             return
-        self.query_one("#sweep-table", DataTable).add_row(*map(Text, table_cells(sweep, result)))
+        cells = list(map(Text, table_cells(sweep, result)))
+        if key in table.rows:
+            for column, cell in zip(table.columns, cells):
+                table.update_cell(key, column, cell)
+        else:
+            table.add_row(*cells, key=key)
         if result.error:
             self._error(f"point {result.point.number}: {result.error}")
 
