@@ -11,7 +11,8 @@ same process (or, for peak memory, in a fresh one per size):
 * the Fig. 2 scene and an exact 3D ensemble (exact3d-h08 on 128^2 pixels, 32 surfaces) with each
   executor (serial; processes 1, 2; Dask LocalCluster of 2, cluster start and the
   workers' first import excluded, with a client per run and with one client for every run
-  as a sweep has), efficiency = serial / (workers x time);
+  as a sweep has; the Fig. 2 scene on a LocalCluster of 1 too), efficiency = serial /
+  (workers x time); serial and Dask also in back-to-back rounds, each round's efficiency;
 * overhead per task of each executor (tiny realizations, one per task);
 * the Fig. 2 scene end to end (run + chunk files + result files and plot) with
   the default executor.
@@ -190,6 +191,14 @@ def executors(repeat: int, skip_dask: bool) -> None:
             rows.extend(dask_2d)
             rows_3d.extend(dask_3d)
             overheads.append(("dask (2, connect included)", overhead(make_executor(RunOptions(executor="dask", scheduler=address), 2))))
+        # one worker on a machine of two cores: the client and the scheduler have a core of their own
+        with dask.config.set({**WORKER_CONFIG, **PROFILE_OFF}), distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR
+        ) as cluster:
+            options = RunOptions(executor="dask", scheduler=cluster.scheduler_address)
+            with one_dask_cluster(options):
+                engine.run(scene, options)
+                rows.append(("dask, one client", 1, best_of(repeat, lambda: engine.run(scene, options))))
     print_efficiencies(f"Fig. 2 scene ({m} realizations), executors", rows)
     if not skip_dask:
         print_rounds(rounds)
