@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, RunFolderError, counted
+from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, too_long_path
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -62,6 +62,8 @@ def run(args) -> ExitCode:
     scene = build_scene(data, source=source, before_reading=reading)
     if args.out is not None and not args.out.strip():
         raise FrictionlabError("--out names no folder (it is empty): give a folder, or leave --out out for runs/<name>-<time>")
+    if args.out is not None and (too_long := too_long_path(args.out)):
+        raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     if args.resume and not Path(args.out).is_dir():

@@ -70,7 +70,9 @@ def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
     assert refused.value.code == ExitCode.USAGE and "unrecognized arguments: -x1" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("command", [["validate"], ["resume"], ["runs"], ["schema", "--out"]])
+@pytest.mark.parametrize(
+    "command", [["validate"], ["resume"], ["runs"], ["schema", "--out"], ["run", str(PRESETS / "quickstart.yaml"), "--out"]]
+)
 def test_a_path_longer_than_the_file_system_allows_is_a_usage_error(command, tmp_path, capsys):
     """ENAMETOOLONG from the first look at the path: the argument is wrong, not the run (exit 1)."""
     from frictionlab.cli import main
