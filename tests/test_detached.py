@@ -7,8 +7,6 @@ import os
 import signal
 import subprocess
 import sys
-import textwrap
-import time
 
 import numpy as np
 import pytest
@@ -28,17 +26,9 @@ from frictionlab.rundir import LOCK_FILE, RunDirectory
 from frictionlab.runner import run_to_folder
 
 from .conftest import SMALL_PRESET, merge
+from .sessions import start_then_hang_up, wait_for
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="sessions and signals are POSIX")
-
-
-def wait_for(condition, timeout=120.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.05)
-    raise AssertionError("timed out")
 
 
 class Collect:
@@ -59,23 +49,7 @@ class Collect:
 def test_a_detached_run_completes_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 60, "spectrum": {"params": {"points": 2048}}})
     out = tmp_path / "run"
-    starter = textwrap.dedent(f"""
-        import sys, time
-        from frictionlab.detached import start_detached, wait_started
-        from frictionlab.options import RunOptions
-        from frictionlab.preset import build_scene
-        scene = build_scene({data!r})
-        process = start_detached(scene.resolved(), {str(out)!r}, RunOptions(workers=1))
-        wait_started(process, {str(out)!r})
-        print(process.pid, flush=True)
-        time.sleep(600)  # the terminal's session, until it is killed
-    """)
-    # the starter leads a session of its own, as a shell in a terminal does
-    parent = subprocess.Popen([sys.executable, "-c", starter], stdout=subprocess.PIPE, text=True, start_new_session=True)
-    run_pid = int(parent.stdout.readline())
-    os.killpg(parent.pid, signal.SIGHUP)  # the terminal goes: its whole session hears the hangup
-    os.killpg(parent.pid, signal.SIGKILL)
-    parent.wait()
+    run_pid = start_then_hang_up(data, out, resolve=True)
     assert run_state(out).status == "running" and run_state(out).pid == run_pid  # not done yet when the session died
     wait_for(lambda: run_state(out).status != "running")
     state = run_state(out)

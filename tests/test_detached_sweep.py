@@ -5,10 +5,7 @@ same numbers, and its folder and progress file are read as untrusted input."""
 import json
 import os
 import signal
-import subprocess
 import sys
-import textwrap
-import time
 
 import pytest
 
@@ -21,19 +18,11 @@ from frictionlab.sweep import plan_sweep, run_sweep
 from frictionlab.sweeplog import SweepFollower
 
 from .conftest import SMALL_PRESET, merge
+from .sessions import start_then_hang_up, wait_for
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="sessions and signals are POSIX")
 
 SWEEP = merge(SMALL_PRESET, {"realizations": 12, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7, 0.9]}}}})
-
-
-def wait_for(condition, timeout=120.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if condition():
-            return
-        time.sleep(0.05)
-    raise AssertionError("timed out")
 
 
 def fits(folder):
@@ -43,20 +32,7 @@ def fits(folder):
 def test_a_detached_sweep_completes_every_point_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SWEEP, {"realizations": 40})
     out = tmp_path / "sweep"
-    starter = textwrap.dedent(f"""
-        import time
-        from frictionlab.detached import start_detached, wait_started
-        from frictionlab.options import RunOptions
-        process = start_detached({data!r}, {str(out)!r}, RunOptions(workers=1), plot=False)
-        wait_started(process, {str(out)!r})
-        print(process.pid, flush=True)
-        time.sleep(600)  # the terminal's session, until it is killed
-    """)
-    parent = subprocess.Popen([sys.executable, "-c", starter], stdout=subprocess.PIPE, text=True, start_new_session=True)
-    sweep_pid = int(parent.stdout.readline())
-    os.killpg(parent.pid, signal.SIGHUP)  # the terminal goes: its whole session hears the hangup
-    os.killpg(parent.pid, signal.SIGKILL)
-    parent.wait()
+    sweep_pid = start_then_hang_up(data, out, resolve=False)
     wait_for(lambda: run_state(out).status != "running")
     state = run_state(out)
     assert (state.kind, state.status, state.done, state.total) == ("sweep", "completed", 3, 3)

@@ -33,7 +33,8 @@ def test_live_snapshots_coalesce_and_the_interim_fit_is_the_final_point_estimate
     assert [s.done for s in every] == [0, *range(1, 13), 12]
 
 
-def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(registry, tmp_path):
+def twelve_stopped_after_five(registry, folder):
+    """A scene of 12 realizations, and the outcome of its run into ``folder`` cancelled once 5 were done."""
     import threading
 
     from frictionlab.hookspecs import hookimpl
@@ -48,7 +49,14 @@ def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(reg
             if done >= 5:
                 cancel.set()
 
-    stopped, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[StopAfterFive()], cancel=cancel)
+    stopped, _ = run_to_folder(scene, folder, RunOptions(workers=1), listeners=[StopAfterFive()], cancel=cancel)
+    return scene, stopped
+
+
+def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(registry, tmp_path):
+    from frictionlab.runner import run_to_folder
+
+    scene, stopped = twelve_stopped_after_five(registry, tmp_path)
     posted = []
     resumed, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True),
                                listeners=[LiveListener(posted.append, interval=0.0)])  # fmt: skip
@@ -63,22 +71,10 @@ def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(reg
 def test_a_followed_resume_counts_its_restored_realizations_once_and_as_restored(registry, tmp_path):
     """The TUI follows a resume through its progress.jsonl: the restored realizations are the
     first snapshot's (never counted down from 1 as if computed now, which made the rate negative)."""
-    import threading
-
-    from frictionlab.hookspecs import hookimpl
     from frictionlab.progresslog import Follower, ProgressLog
     from frictionlab.runner import run_to_folder
 
-    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
-    cancel = threading.Event()
-
-    class StopAfterFive:
-        @hookimpl
-        def realization_done(self, done):
-            if done >= 5:
-                cancel.set()
-
-    stopped, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[StopAfterFive()], cancel=cancel)
+    scene, stopped = twelve_stopped_after_five(registry, tmp_path)
     resumed, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True), listeners=[ProgressLog(tmp_path)])
     posted = []
     Follower(tmp_path, scene, [LiveListener(posted.append, interval=0.0)]).poll()
