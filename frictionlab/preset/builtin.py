@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from ..errors import PresetFileError, did_you_mean
+from ..errors import PresetFileError, did_you_mean, short_repr
 
 _LONGEST = 100  # characters of a one-line description
 _PACKAGE = Path(__file__).resolve().parent.parent
@@ -120,4 +120,10 @@ def preset_source(argument: str | Path, overrides=()) -> str:
     never the installed file they did not touch), with the ``--set`` overrides they
     typed, since a problem may come from one of those."""
     where = str(argument) if Path(argument).suffix or len(Path(argument).parts) > 1 else f"built-in preset {str(argument)!r}"
-    return where + "".join(f" --set {item}" for item in overrides)
+    overrides = list(overrides)
+    shown = "".join(f" --set {short_repr(str(item), 80)[1:-1]}" for item in overrides[:SHOWN_OVERRIDES])
+    more = len(overrides) - SHOWN_OVERRIDES
+    return where + shown + (f" (and {more} more --set)" if more > 0 else "")
+
+
+SHOWN_OVERRIDES = 5  # a message names this many --set: 20,000 of them made megabytes of every error
