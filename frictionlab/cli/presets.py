@@ -42,6 +42,8 @@ def run(args) -> ExitCode:
     from ..preset.builtin import builtin_presets
 
     if getattr(args, "action", None) == "copy":
+        if not args.dest.strip():
+            raise FrictionlabError("DEST names no file or folder (it is empty): give one, or leave it out for this folder")
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
             from ..files import output_path_problem

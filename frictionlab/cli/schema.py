@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import ExitCode
+from ..errors import ExitCode, FrictionlabError
 
 
 def add_parser(sub) -> None:
@@ -24,6 +24,8 @@ def run(args) -> ExitCode:
     from ..preset import preset_json_schema
 
     out = None
+    if args.out is not None and not args.out.strip():
+        raise FrictionlabError("--out names no file (it is empty): give a file, or leave --out out for stdout")
     if args.out:
         from ..files import check_output_file
 

@@ -64,6 +64,9 @@ def resolve_preset_path(argument: str | Path) -> Path:
     """The preset file a command-line argument means: an existing path as given,
     else the built-in of that name. Neither is a PresetFileError naming the closest
     built-in names (a path that merely does not exist is reported by the reader)."""
+    if not str(argument).strip():  # Path("") is the current folder
+        raise PresetFileError(["(file): the preset is named by an empty string: give a preset file or a built-in's name"],
+                              source=repr(str(argument)))  # fmt: skip
     path = Path(argument)
     if not path.exists() and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):  # presets/quickstart.yaml
         raise PresetFileError(  # outside the clone: the file is not there, but the package has it

@@ -91,3 +91,22 @@ def test_a_refusal_names_the_first_overrides_only(capsys):
     err = capsys.readouterr().err
     assert "--set seed=0 --set seed=1" in err and "(and 19996 more --set)" in err
     assert "realizations: must be >= 1, got -1" in err and len(err) < 2000
+
+
+@pytest.mark.parametrize(
+    "command, code, said",
+    [
+        (["validate", ""], ExitCode.INPUT_FILE, "the preset is named by an empty string"),
+        (["run", ""], ExitCode.INPUT_FILE, "the preset is named by an empty string"),
+        (["schema", "--out", ""], ExitCode.USAGE, "--out names no file (it is empty)"),
+        (["presets", "copy", "quickstart", ""], ExitCode.USAGE, "DEST names no file or folder (it is empty)"),
+    ],
+)
+def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, code, said, tmp_path, monkeypatch, capsys):
+    from frictionlab.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(command) == code
+    captured = capsys.readouterr()
+    assert said in captured.err and "Traceback" not in captured.err and captured.out == ""
+    assert list(tmp_path.iterdir()) == []  # nothing written in this folder
