@@ -78,8 +78,21 @@ def open_regular_file(path: str | Path, what: str = "file", *, dir_fd: int | Non
     if not stat.S_ISREG(mode):
         os.close(fd)
         raise InputFileProblem(f"{what} is {file_kind(mode)}, not a regular file")
+    if _of_the_kernel(fd):
+        os.close(fd)
+        raise InputFileProblem(f"{what} is in the kernel's /proc or /sys (a read may block), not a data file")
     os.set_blocking(fd, True)
     return os.fdopen(fd, "rb")
+
+
+def _of_the_kernel(fd: int) -> bool:
+    """Whether ``fd`` is a file of /proc or /sys (Linux): "regular" files whose reads may
+    block for ever (/proc/kmsg) or never end."""
+    try:
+        where = os.readlink(f"/proc/self/fd/{fd}")
+    except OSError:  # no /proc (not Linux): nothing to tell
+        return False
+    return where.startswith(("/proc/", "/sys/"))
 
 
 def read_regular_file(

@@ -216,6 +216,16 @@ def test_a_fifo_as_profile_file_is_refused_when_the_preset_is_validated(tmp_path
     assert "spectrum.params.path: is a FIFO (named pipe), not a regular file" in err
 
 
+@pytest.mark.skipif(not os.path.exists("/proc/self/fd"), reason="a kernel's /proc is Linux's")
+def test_a_file_of_the_kernel_s_proc_is_refused_as_preset_and_as_data(tmp_path, capsys):
+    """/proc's files say they are regular; some block for ever on read (/proc/kmsg)."""
+    done = cli("validate", "/proc/self/status", cwd=tmp_path, timeout=10)
+    assert done.returncode == ExitCode.INPUT_FILE
+    assert "preset file is in the kernel's /proc or /sys (a read may block), not a data file" in done.stderr
+    assert main(["validate", str(profile_preset(tmp_path, "/proc/cpuinfo"))]) == ExitCode.USAGE
+    assert "profile-file '/proc/cpuinfo': file is in the kernel's /proc or /sys" in capsys.readouterr().err
+
+
 def test_a_missing_profile_file_is_refused_when_the_preset_is_validated(tmp_path, capsys):
     assert main(["validate", str(profile_preset(tmp_path, "gone.csv"))]) == ExitCode.USAGE
     assert f"spectrum.params.path: no such file, got '{tmp_path / 'gone.csv'}'" in capsys.readouterr().err
