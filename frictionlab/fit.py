@@ -13,6 +13,7 @@ with the same resamples.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
@@ -179,6 +180,27 @@ def fit_curve(f: np.ndarray, xi: np.ndarray) -> LogFit:
     )
 
 
+def one_blas_thread(function):
+    """Run ``function`` with BLAS on the calling thread only. A fit's products are small, and
+    OpenBLAS's helper threads, once woken, spin for about 0.1 s of a core's time: taken from
+    the worker processes on a machine with as many cores as workers, after every fit
+    (a sweep's points, the TUI's interim fits)."""
+
+    @functools.wraps(function)
+    def limited(*args, **kwargs):
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+
+    return limited
+
+
+@functools.cache
+def _blas_controller():
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
 def bootstrap_coefficients(
     f, xi_per_realization, bootstrap: int, rng: np.random.Generator, average: Average | None = None
 ) -> np.ndarray:
@@ -220,6 +242,7 @@ def _over_defined(f, xi_per_realization: np.ndarray, average: Average | None):
     return np.asarray(f, float)[fitted], xi, lambda weights: defined_mean(xi, weights)
 
 
+@one_blas_thread
 def resample_pairs(f, xi_per_realization, bootstrap: int, rng: np.random.Generator,
                     average: Average | None = None) -> np.ndarray:  # fmt: skip
     """The (a, b) pairs of ``fit_log_law``'s bootstrap (``bootstrap_coefficients`` over the
@@ -229,6 +252,7 @@ def resample_pairs(f, xi_per_realization, bootstrap: int, rng: np.random.Generat
     return samples[~np.isnan(samples).any(axis=1)]
 
 
+@one_blas_thread
 def fit_log_law(
     f: np.ndarray,
     xi_per_realization: np.ndarray,

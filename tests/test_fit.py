@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.fit import fit_log_law, least_squares, percentile_interval
+from frictionlab.fit import defined_mean, fit_log_law, least_squares, percentile_interval
 
 
 def test_exact_log_law_is_recovered_exactly():
@@ -149,3 +149,27 @@ def test_percentile_interval_is_numpys_percentile_bit_for_bit(samples, confidenc
     np.testing.assert_array_equal(
         percentile_interval(pairs, confidence, axis=0), np.percentile(pairs, [tail, 100 - tail], axis=0)
     )
+
+
+def test_a_fit_runs_blas_on_its_own_thread_only_and_leaves_the_limit_as_it_was():
+    """OpenBLAS's helper threads, once woken by a product, spin for ~0.1 s of a core: on a
+    machine with as many cores as workers that is taken from the workers after every fit."""
+    from threadpoolctl import threadpool_info
+
+    def blas_threads():
+        return [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+    before = blas_threads()
+    seen = []
+
+    def average(weights):  # the fit's own average, heard from inside the fit's products
+        seen.append(blas_threads())
+        return defined_mean(xi, weights)
+
+    f = np.linspace(1.0, 20.0, 40)
+    xi = 1.0 + 0.1 * np.log(f) + 0.01 * np.random.default_rng(3).standard_normal((30, 40))
+    fit = fit_log_law(f, xi, bootstrap=200, rng=np.random.default_rng(4), average=average)
+    assert seen and all(threads == [1] * len(before) for threads in seen)
+    assert blas_threads() == before  # restored for the rest of the program
+    plain = fit_log_law(f, xi, bootstrap=200, rng=np.random.default_rng(4))
+    np.testing.assert_allclose([fit.a, fit.b, *fit.a_ci, *fit.b_ci], [plain.a, plain.b, *plain.a_ci, *plain.b_ci], rtol=1e-12)
