@@ -17,7 +17,7 @@ def wait_for(condition, timeout=120.0):
     raise AssertionError("timed out")
 
 
-def start_then_hang_up(data: dict, out, resolve: bool) -> int:
+def start_then_hang_up(data: dict, out, resolve: bool, plot: bool = True) -> int:
     """Start ``data`` detached into ``out`` (``resolve``: through ``build_scene(...).resolved()``,
     as ``run --detach`` does for one ensemble; else as is, as for a sweep) from a process that
     leads a session of its own, as a shell in a terminal does; then the terminal goes: its whole
@@ -28,7 +28,7 @@ def start_then_hang_up(data: dict, out, resolve: bool) -> int:
         from frictionlab.detached import start_detached, wait_started
         from frictionlab.options import RunOptions
         from frictionlab.preset import build_scene
-        process = start_detached({preset}, {str(out)!r}, RunOptions(workers=1), plot=False)
+        process = start_detached({preset}, {str(out)!r}, RunOptions(workers=1), plot={plot!r})
         wait_started(process, {str(out)!r})
         print(process.pid, flush=True)
         time.sleep(600)  # the terminal's session, until it is killed

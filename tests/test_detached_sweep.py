@@ -32,7 +32,7 @@ def fits(folder):
 def test_a_detached_sweep_completes_every_point_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SWEEP, {"realizations": 40})
     out = tmp_path / "sweep"
-    sweep_pid = start_then_hang_up(data, out, resolve=False)
+    sweep_pid = start_then_hang_up(data, out, resolve=False, plot=False)
     wait_for(lambda: run_state(out).status != "running")
     state = run_state(out)
     assert (state.kind, state.status, state.done, state.total) == ("sweep", "completed", 3, 3)
