@@ -58,6 +58,8 @@ MANIFEST_FORMAT = 2
 MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
 MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
+# what a run killed while it started leaves (atomic_write's temporary files of its own names)
+START_LEFTOVER = re.compile(rf"\.(?:{re.escape(PRESET_FILE)}|{re.escape(STATE_FILE)})\.\w+\.tmp")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
@@ -291,7 +293,7 @@ class RunDirectory:
             return
         hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
         if state is None:
-            others = sorted(p.name for p in self.path.iterdir() if p.name != LOCK_FILE)
+            others = sorted(p.name for p in self.path.iterdir() if not _left_by_a_start(p, resolved))
             if others:
                 listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputRefused(
@@ -504,6 +506,23 @@ class RunDirectory:
                 (self.chunks / name).unlink(missing_ok=True)
         self._manifest.pop("retired")
         self._write_manifest()
+
+
+def _left_by_a_start(path: Path, resolved: dict) -> bool:
+    """Whether ``path`` in a folder with no manifest is what a run of ``resolved`` killed while
+    it started left there (its lock, its empty chunks folder, its preset.yaml to the byte, a
+    temporary file of its preset or manifest): a folder of nothing else is started afresh, as
+    an empty one is (a sweep's point killed as it began was refused as "not empty" on resume)."""
+    if path.name == LOCK_FILE or START_LEFTOVER.fullmatch(path.name):
+        return True
+    if path.is_symlink():
+        return False
+    if path.name == CHUNK_DIR:
+        return path.is_dir() and not any(path.iterdir())
+    if path.name == PRESET_FILE and path.is_file():  # replaced by the same bytes: nothing is lost
+        ours = yaml.safe_dump(resolved, sort_keys=False).encode()
+        return path.stat().st_size == len(ours) and path.read_bytes() == ours
+    return False
 
 
 def _optional_kept(scene: Scene) -> tuple[bool, bool]:

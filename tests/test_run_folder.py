@@ -20,6 +20,7 @@ import yaml
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, OutputRefused
+from frictionlab.preset import build_scene
 from frictionlab.rundir import RunDirectory
 from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
@@ -43,6 +44,38 @@ QUICK = merge(SMALL_PRESET, NO_PLOT)
 
 
 # ------------------------------------------------------------------ never delete or overwrite
+
+
+def test_a_folder_left_by_a_run_killed_as_it_started_is_started_afresh_and_nothing_else_is(tmp_path):
+    """Killed between making its folder and writing its manifest, a run leaves an empty chunks/
+    folder and maybe a temporary file of its preset: a sweep resumed then refused that point
+    as "not empty". Such a folder starts afresh; one more file of anyone's is still refused."""
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 3, **NO_PLOT}))
+    folder = tmp_path / "point"
+    (folder / "chunks").mkdir(parents=True)
+    (folder / ".preset.yaml.t5cpv2ct.tmp").write_text("half a preset")
+    outcome, _ = run_to_folder(scene, folder, RunOptions(workers=1))
+    assert outcome.status == "completed" and outcome.done == 3
+    later = tmp_path / "later"  # killed after its preset.yaml, before its manifest took its name
+    with RunDirectory(later) as run_dir:
+        run_dir.start(scene, resume=False)
+    (later / "run.json").rename(later / ".run.json.qhyeg728.tmp")
+    outcome, _ = run_to_folder(scene, later, RunOptions(workers=1))
+    assert outcome.status == "completed" and outcome.done == 3
+    edited = tmp_path / "edited"  # a preset.yaml that is not this run's to the byte: someone's
+    with RunDirectory(edited) as run_dir:
+        run_dir.start(scene, resume=False)
+    (edited / "run.json").unlink()
+    (edited / "preset.yaml").write_text((edited / "preset.yaml").read_text() + "# my note\n")
+    with pytest.raises(OutputRefused, match="it holds 'preset.yaml'"):
+        run_to_folder(scene, edited, RunOptions(workers=1))
+    assert (edited / "preset.yaml").read_text().endswith("# my note\n")
+    other = tmp_path / "other"
+    (other / "chunks").mkdir(parents=True)
+    (other / "chunks" / "mine.txt").write_text("not frictionlab's")  # a chunks/ folder that is not empty
+    with pytest.raises(OutputRefused, match="is not empty and is not a frictionlab run folder"):
+        run_to_folder(scene, other, RunOptions(workers=1))
+    assert (other / "chunks" / "mine.txt").read_text() == "not frictionlab's"
 
 
 def test_out_into_a_folder_that_is_not_a_run_is_refused_and_force_deletes_nothing(tmp_path, capsys):
