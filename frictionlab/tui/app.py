@@ -431,15 +431,9 @@ class FrictionlabApp(App):
                 return
         except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
-        try:
-            scene, sweep = self._stored(folder)
-        except RunFolderError as exc:
-            self.say(str(exc), "error", title="Cannot resume")
-            return
-        except PresetError as exc:
-            self.say(exc.problems[0], "error", title=f"Cannot resume {folder.name}")
-            return
-        self._start(scene, sweep, folder, replace(self.run_options, resume=True))
+        stored = self._stored_or_say(folder, "resume")
+        if stored is not None:
+            self._start(*stored, folder, replace(self.run_options, resume=True))
 
     def _stored(self, folder: Path):
         """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
@@ -448,6 +442,16 @@ class FrictionlabApp(App):
             sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
             return sweep.points[0].scene, sweep
         return build_scene(RunDirectory(folder).stored_preset(), registry=self.registry), None
+
+    def _stored_or_say(self, folder: Path, verb: str):
+        """``_stored(folder)``, or None once the status line has said why it cannot ``verb`` it."""
+        try:
+            return self._stored(folder)
+        except RunFolderError as exc:
+            self.say(str(exc), "error", title=f"Cannot {verb}")
+        except PresetError as exc:
+            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}")
+        return None
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         self.last_outcome = None
@@ -492,14 +496,10 @@ class FrictionlabApp(App):
 
     def follow_run(self, folder: Path) -> None:
         """Show the run (or sweep) going on in ``folder`` (another process's) live on the Run tab."""
-        try:
-            scene, sweep = self._stored(folder)
-        except RunFolderError as exc:
-            self.say(str(exc), "error", title="Cannot follow")
+        stored = self._stored_or_say(folder, "follow")
+        if stored is None:
             return
-        except PresetError as exc:
-            self.say(exc.problems[0], "error", title=f"Cannot follow {folder.name}")
-            return
+        scene, sweep = stored
         self.last_outcome = None
         self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
         self.followed = self._follower(folder, scene, sweep)
