@@ -114,10 +114,12 @@ class Result:
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
         None, through pyplot, so a notebook shows it); returns the Axes."""
-        from .plot import draw_curve
+        from .plot import AXES_NEEDS, draw_curve
 
-        if ax is not None and not callable(getattr(ax, "errorbar", None)):
-            raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}")
+        missing = [name for name in AXES_NEEDS if not callable(getattr(ax, name, None))] if ax is not None else []
+        if missing or (ax is not None and not hasattr(ax, "transAxes")):
+            needs = ", ".join(missing or ["transAxes"])
+            raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}, which has no {needs}")
         if ax is None:
             import matplotlib.pyplot as plt
 

@@ -17,21 +17,19 @@ from __future__ import annotations
 import json
 import os
 import signal
-import stat
 import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from .errors import ExitCode, FrictionlabError, RunFolderError
+from . import runfolder
+from .errors import ExitCode, FrictionlabError, RunFolderError, shown
 from .options import RunOptions
 from .progresslog import ProgressLog, ProgressReader, StartOf
-from .inputs import InputFileProblem
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
-from .runfolder import read_json, read_member
+from .runfolder import read_json
 
-MAX_LOCK_BYTES = 4096
 SWEEP_FILE = "sweep.json"  # what marks a sweep's folder (it has no run.json)
 TAIL_BYTES = 256 * 1024  # of progress.jsonl, read for the count of a listed run
 STARTED_WAIT = 120.0  # seconds ``wait_started`` waits for the run's first event
@@ -55,9 +53,15 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
 
 def _check_not_in_use(out_dir: str | Path) -> None:
     if lock_held(out_dir):
-        holder = lock_holder(out_dir)
-        raise RunFolderError(f"{out_dir} is in use by another run (pid {holder or 'unknown'}): "
-                             "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
+        raise in_use(out_dir)
+
+
+def in_use(out_dir: str | Path, holder: int | None = None) -> RunFolderError:
+    """The refusal of a folder another run holds, naming its verified process."""
+    holder = holder or lock_holder(out_dir)
+    who = f"pid {holder}" if holder is not None else "a process that cannot be verified"
+    return RunFolderError(f"{shown(out_dir)} is in use by another run ({who}): "
+                          "wait for it to end (frictionlab follow shows it), or give another output folder")  # fmt: skip
 
 
 def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
@@ -109,6 +113,9 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
             if any(event["event"] in STARTED and event.get("pid") == process.pid
                    for event in ProgressReader(out_dir).new_events()):  # fmt: skip
                 return  # a run so short it ended already
+            holder = lock_holder(out_dir)
+            if holder is not None and holder != process.pid:  # it lost the folder to another (its word may be lost)
+                raise in_use(out_dir, holder)
             raise FrictionlabError(f"the run into {out_dir} ended at once (exit code {process.returncode}) without a word")
         time.sleep(0.05)
     raise FrictionlabError(f"the run into {out_dir} has not started after {timeout:g} s (pid {process.pid}); "
@@ -122,14 +129,11 @@ def _raise_run_error(event: dict) -> None:
     raise error
 
 
-def cancel(pid: int) -> bool:
-    """Ask the run ``pid`` to stop (SIGTERM): what finished is kept, the run ends interrupted.
-    False if there is no such process any more."""
-    try:
-        os.kill(pid, signal.SIGTERM)
-    except ProcessLookupError:
-        return False
-    return True
+def cancel(folder: str | Path) -> int:
+    """Ask the run (or sweep) going on in ``folder`` to stop (SIGTERM): what finished is kept,
+    the run ends interrupted. Only the process that holds the folder's lock is signalled, as
+    the kernel says (``runfolder.signal_holder``); return its pid. RunFolderError if none can be."""
+    return runfolder.signal_holder(Path(folder) / LOCK_FILE, signal.SIGTERM, folder)
 
 
 def _child() -> int:
@@ -189,16 +193,9 @@ def _run_sweep(request: dict, out: Path, options: RunOptions, log) -> str:
 
 
 def lock_holder(folder: str | Path) -> int | None:
-    """The pid that ``run.lock`` names, None if there is no lock (or it names none).
-    Read as a regular file, never through a link."""
-    try:
-        text = read_member(folder, LOCK_FILE, MAX_LOCK_BYTES).decode(errors="replace")
-    except (InputFileProblem, OSError):
-        return None
-    words = text.replace(",", " ").split()
-    if len(words) >= 2 and words[0] == "pid" and words[1].isdigit():
-        return int(words[1])
-    return None
+    """The process that holds the folder's lock now, verified with the kernel
+    (``runfolder.lock_holder``), never read from a file; None if none can be."""
+    return runfolder.lock_holder(Path(folder) / LOCK_FILE)
 
 
 def process_alive(pid: int) -> bool:
@@ -221,27 +218,7 @@ def process_alive(pid: int) -> bool:
 def lock_held(folder: str | Path) -> bool:
     """Whether some process holds the folder's run lock now (a flock is released by the
     kernel when its holder dies, even on kill -9). Where it cannot be probed, True."""
-    try:
-        import fcntl
-    except ImportError:
-        return True
-    try:
-        fd = os.open(Path(folder) / LOCK_FILE, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | os.O_NONBLOCK)
-    except OSError:
-        return False
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return False
-        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except BlockingIOError:
-        return True
-    except OSError:
-        return True
-    else:
-        fcntl.flock(fd, fcntl.LOCK_UN)
-        return False
-    finally:
-        os.close(fd)
+    return runfolder.lock_held(Path(folder) / LOCK_FILE)
 
 
 @dataclass
@@ -271,12 +248,6 @@ def _count(value) -> int | None:
     return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else None
 
 
-def _live_holder(folder: Path) -> int | None:
-    """The pid of the live process that holds the folder's lock, None if none does."""
-    holder = lock_holder(folder)
-    return holder if holder is not None and process_alive(holder) and lock_held(folder) else None
-
-
 def run_state(folder: str | Path) -> RunState:
     """The state of the run (or sweep) in ``folder``; RunFolderError if it holds none (or a damaged one)."""
     folder = Path(folder)
@@ -293,8 +264,9 @@ def run_state(folder: str | Path) -> RunState:
     total = _count(manifest.get("realizations"))
     done, pid = _last_count(folder), None
     if status == "running":
-        pid = _live_holder(folder)
-        if pid is None:
+        if lock_held(folder):
+            pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
+        else:
             status = "interrupted"  # the process that wrote "running" is gone
     summary = _summary(folder)
     if summary is not None and status != "running":
@@ -311,8 +283,9 @@ def sweep_state(folder: str | Path) -> RunState:
     _, record = read_sweep_record(folder)
     status, pid = record.status, None
     if status == "running":
-        pid = _live_holder(folder)
-        if pid is None:
+        if lock_held(folder):
+            pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
+        else:
             status = "interrupted"  # the process that wrote "running" is gone
     done = sum(point.status not in UNFINISHED for point in record.points)
     return RunState(folder, record.name, status, done, len(record.points), pid, kind="sweep")

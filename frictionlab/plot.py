@@ -21,6 +21,10 @@ from .preset import Scene
 XI_LABEL = "xi = rms slope in contact / rms slope"
 
 
+AXES_NEEDS = ("errorbar", "fill_between", "grid", "legend", "plot", "set_title", "set_xlabel", "set_xscale",
+              "set_xticks", "set_ylabel", "text")  # what draw_curve (and Result.plot) call on an Axes
+
+
 def draw_curve(ax, f, xi, xi_sem, fit: LogFit | None, *, done: int, caveats=(), fontsize: float = 8) -> None:
     """xi against f (log axis) with its 95% band and the fitted law a + b ln f; each
     caveat written on the axes, where nobody reading the figure can miss it."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .errors import counted
+from .errors import counted, shown
 from .hookspecs import hookimpl
 from .listeners import SweepListener, progress_text, solve_text
 
@@ -154,11 +154,17 @@ class ProgressReporter:
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)"
         )
 
+    def _pass_tenths(self, done: int, total: int) -> None:
+        """Count the tenths of ``total`` that ``done`` passed as said (computed, not looped:
+        a followed run's numbers come from a file)."""
+        if total > 0:
+            self.next_tenth = max(self.next_tenth, 10 * min(done, total) // total + 1)
+
     def _progress(self, done: int, total: int) -> None:
+        done = max(0, min(done, total))  # a followed run's numbers come from a file
         self.done, self.total = done, total
         if self.clock() - self.started < self.after and not (done == total and not self.interactive):
-            while self.next_tenth * total <= 10 * done:  # tenths passed before: not printed late
-                self.next_tenth += 1
+            self._pass_tenths(done, total)  # tenths passed before: not printed late
             return
         if self.interactive and self.bar is None:
             self.bar = _Bar(self.stream, "realizations", total, completed=done, started=self.started, clock=self.clock)
@@ -166,8 +172,7 @@ class ProgressReporter:
             self.bar.update(done, f"{self.failed} failed" if self.failed else "")
         elif done == total or 10 * done >= self.next_tenth * total:
             self._write(self._line(done, total))
-            while self.next_tenth * total <= 10 * done:
-                self.next_tenth += 1
+            self._pass_tenths(done, total)
 
     @hookimpl
     def realization_done(self, done, total):
@@ -199,7 +204,7 @@ class ProgressReporter:
     def realization_failed(self, result, done, total):
         self.failed += 1
         if self.failed == 1:  # the first error says what is wrong; the rest only count
-            self._write(f"realization {result.index} failed: {result.error}")
+            self._write(f"realization {result.index} failed: {shown(result.error)}")
         self._progress(done, total)
 
     def close(self) -> None:
@@ -212,7 +217,7 @@ class ProgressReporter:
     def run_finished(self, outcome):
         self.close()
         if outcome.status != "completed":
-            self._write(f"run {outcome.status}: {outcome.done} of {outcome.requested} realizations finished")
+            self._write(shown(f"run {outcome.status}: {outcome.done} of {outcome.requested} realizations finished"))
 
 
 class SweepProgress(SweepListener):
@@ -255,7 +260,7 @@ class SweepProgress(SweepListener):
 
     def point_finished(self, sweep, point, result):
         if result.status == "error":
-            self._write(f"point {point.number} failed: {result.error}")
+            self._write(f"point {point.number} failed: {shown(result.error)}")
         elif self.fits:
             self._write(point_result_line(sweep, point, result.row()))
 
@@ -268,9 +273,10 @@ def point_result_line(sweep, point, row: dict) -> str:
 
     values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(point.values[p])}" for p in sweep.paths)
     fit = row_fit(row)
-    if fit is None:
-        return f"  {point.number:>3}  {values}: {row['status']}"
+    if fit is None:  # why not, where the row says (a point in error: what to do)
+        reason = f": {row['error']}" if isinstance(row.get("error"), str) and row["error"] else ""
+        return shown(f"  {point.number:>3}  {values}: {row['status']}{reason}")
     contacts = "" if row["contact_first"] is None else f", contacts {row['contact_first']:.2f} .. {row['contact_last']:.2f}"
-    return (f"  {point.number:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
+    return shown(f"  {point.number:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
             f"b = {format_estimate(fit.b, fit.b_ci)}, R^2 = {fit.r2:.3f}{contacts}"
             + ("" if row["status"] == "completed" else f" ({row['status']})"))  # fmt: skip

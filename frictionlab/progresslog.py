@@ -21,15 +21,20 @@ import stat
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field, ValidationError, model_validator
 
 from .hookspecs import hookimpl
 from .realization import RealizationResult
+from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"
 MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # ~100k realizations of 100 load steps: beyond that it is not ours
 READ_BLOCK = 4 * 1024 * 1024  # read at most this much at a time: a follower stays responsive
+MAX_LINE_BYTES = 1024 * 1024  # an event's line, at most (a realization's curves thinned to fit): within READ_BLOCK
+MAX_TEXT = 4000  # characters of a message, in a line that would pass MAX_LINE_BYTES otherwise
 CURVES = ("xi", "contact_count", "force")  # what a follower's mean curve needs (force: under indentation control)
 
 
@@ -75,12 +80,12 @@ class ProgressLog:
             self._fd = None
 
     def write(self, event: dict) -> None:
-        """Append one event (with the wall-clock ``time``) as one line, written at once."""
+        """Append one event (with the wall-clock ``time``) as one line of at most
+        ``MAX_LINE_BYTES`` (``fitted_line``), written at once."""
         if self._fd is None:
             return
-        line = json.dumps({**event, "time": self.clock()}, separators=(",", ":")) + "\n"
         try:
-            os.write(self._fd, line.encode())
+            os.write(self._fd, fitted_line({**event, "time": self.clock()}))
         except OSError:
             self.close()
 
@@ -125,6 +130,37 @@ class ProgressLog:
         self.close()  # a sweep's child writes one log per point: none stays open
 
 
+def _line(event: dict) -> bytes:
+    return (json.dumps(event, separators=(",", ":")) + "\n").encode()
+
+
+def _cut(value):
+    """``value`` with every string in it cut to ``MAX_TEXT`` characters."""
+    if isinstance(value, str):
+        return value if len(value) <= MAX_TEXT else value[:MAX_TEXT] + "..."
+    if isinstance(value, dict):
+        return {key: _cut(item) for key, item in value.items()}
+    return [_cut(item) for item in value] if isinstance(value, list) else value
+
+
+def fitted_line(event: dict) -> bytes:
+    """``event`` as one line of at most ``MAX_LINE_BYTES``, which a reader takes whole: a
+    realization's curves thinned to every ``stride``-th load step (``stride`` in the event;
+    a run of ~40000 load steps or more), a longer message cut, else only the event's kind."""
+    line = _line(event)
+    if len(line) <= MAX_LINE_BYTES:
+        return line
+    if event.get("event") == "realization" and any(isinstance(event.get(name), list) for name in CURVES):
+        stride = -(-len(line) // (MAX_LINE_BYTES // 2))
+        while len(line) > MAX_LINE_BYTES and stride < 2 * MAX_LINE_BYTES:  # each pass halves the curves
+            curves = {name: event[name][::stride] for name in CURVES if isinstance(event.get(name), list)}
+            line, stride = _line({**event, **curves, "stride": stride}), 2 * stride
+        if len(line) <= MAX_LINE_BYTES:
+            return line
+    line = _line(_cut(event))
+    return line if len(line) <= MAX_LINE_BYTES else _line({"event": str(event.get("event"))[:MAX_TEXT], "cut": True})
+
+
 # ------------------------------------------------------------------ reading
 
 
@@ -141,6 +177,7 @@ class ProgressReader:
         self.offset = 0
         self.restarted = False
         self.too_large = False
+        self.skipping = False  # inside a line too long to be an event
         self.head = b""  # the start of the first line read (up to HEAD_BYTES)
 
     def new_events(self) -> list[dict]:
@@ -157,13 +194,20 @@ class ProgressReader:
                 self.too_large = True
                 return []
             if info.st_size < self.offset or (self.head and os.pread(fd, len(self.head), 0) != self.head):
-                self.offset, self.restarted, self.head = 0, True, b""
+                self.offset, self.restarted, self.head, self.skipping = 0, True, b"", False
             data = os.pread(fd, min(READ_BLOCK, info.st_size - self.offset), self.offset)
         except OSError:  # read next time, if it can be
             return []
         finally:
             os.close(fd)
+        if self.skipping:  # the rest of a line longer than any frictionlab writes
+            cut = data.find(b"\n") + 1
+            self.offset, self.skipping = self.offset + (cut or len(data)), not cut
+            data = data[cut:] if cut else b""
         end = data.rfind(b"\n") + 1  # only whole lines: the last one may still be written
+        if not end and len(data) == READ_BLOCK:  # no line ends in a whole block: not one of ours, skipped
+            self.offset, self.skipping = self.offset + len(data), True
+            return []
         if self.offset == 0 and end:
             self.head = data[: min(data.find(b"\n") + 1, HEAD_BYTES)]
         self.offset += end
@@ -175,7 +219,107 @@ def _parse(line: bytes) -> dict | None:
         event = json.loads(line)
     except (ValueError, RecursionError):
         return None
-    return event if isinstance(event, dict) and isinstance(event.get("event"), str) else None
+    return checked_event(event) if isinstance(event, dict) and isinstance(event.get("event"), str) else None
+
+
+# What an event's numbers must be, as summary.json's (``results.SummaryRecord``): a count is a
+# whole number from 0 to MAX_COUNT (a preset's realizations and load steps are far below it),
+# a part never more than its whole. An event that is not so is skipped, as a line that is not JSON.
+MAX_COUNT = 10**9
+MAX_PID = 2**22  # Linux's largest
+Whole = Annotated[int, Field(ge=0, le=MAX_COUNT, strict=True)]
+Pid = Annotated[int, Field(ge=1, le=MAX_PID, strict=True)]
+
+
+class _Event(Record):
+    time: Annotated[float, Field(allow_inf_nan=False, strict=True)] | None = None
+
+    @model_validator(mode="after")
+    def _parts_within_wholes(self):
+        for part, whole in (("done", "total"), ("resumed", "total"), ("done", "requested"), ("number", "total")):
+            if {part, whole} <= self.model_fields_set:  # both written
+                if getattr(self, whole) is not None and getattr(self, part) > getattr(self, whole):
+                    raise ValueError(f"{part} is more than {whole}")
+        return self
+
+
+class _Started(_Event):
+    pid: Pid | None = None
+    total: Whole = 0
+    workers: Whole = 1
+    resumed: Whole = 0
+    retried: Whole = 0
+
+
+class _Realization(_Event):
+    index: Whole = 0
+    done: Whole = 0
+    total: Whole = 0
+    ok: bool = False
+    seconds: Finite | None = None
+    stride: Annotated[int, Field(ge=1, le=MAX_COUNT, strict=True)] = 1
+    error: str | None = None
+
+
+class _Load(_Event):
+    index: Whole = 0
+    done: Whole = 0
+    total: Whole = 0
+
+
+class _Iteration(_Event):
+    index: Whole = 0
+    load: Whole = 0
+    iteration: Whole = 0
+    residual: float | None = None
+
+
+class _Finished(_Event):
+    status: str = "?"
+    done: Whole = 0
+    requested: Whole = 0
+    failed: Whole = 0
+    error: str | None = None
+
+
+class _Error(_Event):
+    pid: Pid | None = None
+    message: str = "failed"
+    exit_code: Annotated[int, Field(ge=0, le=255, strict=True)] = 1
+
+
+class _SweepStarted(_Event):
+    pid: Pid | None = None
+    total: Whole = 0
+
+
+class _PointStarted(_Event):
+    number: Whole = 0
+    total: Whole | None = None
+
+
+class _SweepFinished(_Event):
+    status: str = "?"
+    done: Whole = 0
+    total: Whole = 0
+
+
+EVENT_RECORDS = {"started": _Started, "realization": _Realization, "load": _Load, "iteration": _Iteration,
+                 "finished": _Finished, "error": _Error, "sweep_started": _SweepStarted,
+                 "point_started": _PointStarted, "point_finished": _PointStarted, "sweep_finished": _SweepFinished}  # fmt: skip
+
+
+def checked_event(event: dict) -> dict | None:
+    """``event`` (a parsed line) once its fields are what its kind's record says, None if
+    not. Only those fields are validated (a realization's curves are checked by ``result_of``)."""
+    record = EVENT_RECORDS.get(event["event"])
+    if record is None:
+        return event  # a kind a later frictionlab writes: its followers skip it
+    try:
+        record.model_validate({name: event[name] for name in record.model_fields if name in event})
+    except ValidationError:
+        return None
+    return event
 
 
 def _whole(value, default: int = 0) -> int:
@@ -186,13 +330,19 @@ def _number(value) -> float:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
 
 
-def _curve(value, steps: int) -> np.ndarray | None:
-    if not isinstance(value, list) or len(value) != steps:
+def _curve(value, steps: int, stride: int = 1) -> np.ndarray | None:
+    """A curve of ``steps`` load steps, written at every ``stride``-th (NaN at the others)."""
+    if not isinstance(value, list) or len(value) != -(-steps // stride):
         return None
     try:
-        return np.array([math.nan if x is None else x for x in value], dtype=float)
+        written = np.array([math.nan if x is None else x for x in value], dtype=float)
     except (TypeError, ValueError):
         return None
+    if stride == 1:
+        return written
+    curve = np.full(steps, math.nan)
+    curve[::stride] = written
+    return curve
 
 
 def result_of(event: dict, steps: int) -> RealizationResult | None:
@@ -204,7 +354,7 @@ def result_of(event: dict, steps: int) -> RealizationResult | None:
     seconds = _number(event.get("seconds"))
     if event.get("ok") is not True:
         return RealizationResult(index=index, seconds=seconds, error=str(event.get("error") or "failed"))
-    curves = {name: _curve(event.get(name), steps) for name in CURVES}
+    curves = {name: _curve(event.get(name), steps, event.get("stride", 1)) for name in CURVES}
     if curves["xi"] is None or curves["contact_count"] is None:
         return None
     return RealizationResult(index=index, seconds=seconds, **curves, force_unit=_number(event.get("force_unit")),
@@ -317,7 +467,7 @@ class Follower:
                         self._start(info)
                 elif kind == "realization" and self.info is not None:
                     result = result_of(event, self.scene.loads.size)
-                    if result is None:
+                    if result is None or _whole(event.get("done"), self.done) > self.total:  # not a realization of this run
                         continue
                     self.done = _whole(event.get("done"), self.done)
                     hook = "realization_done" if result.ok else "realization_failed"

@@ -23,6 +23,7 @@ import io
 import json
 import math
 import os
+import stat
 from pathlib import Path, PurePosixPath
 from typing import Annotated
 
@@ -76,6 +77,22 @@ def subfolder(root: Path, name: str) -> Path:
             raise RunFolderError(f"{shown(here)} is a symbolic link or not a folder, which is never followed") from None
         os.close(fd)
     return path
+
+
+def make_subfolder(root: str | Path, name: str) -> Path:
+    """``root / name`` (a relative path), each component made if missing and checked to be
+    a folder, not a symbolic link (``subfolder``'s rule): a sweep writes its points inside
+    its own folder, never through a link someone put there. RunFolderError naming the path."""
+    here = Path(root)
+    for part in PurePosixPath(name).parts:
+        here = here / part
+        try:
+            os.mkdir(here)
+        except FileExistsError:
+            pass
+        except OSError as exc:
+            raise RunFolderError(f"{shown(here)}: cannot make the folder ({exc.strerror or exc})") from None
+    return subfolder(root, name)
 
 
 def read_member(folder: str | Path, name: str, limit: int, what: str | None = None) -> bytes:
@@ -225,3 +242,148 @@ def _cell(cell: str, path: Path, line: int, column: int) -> float:
         if math.isfinite(value):
             return value
     raise RunFolderError(f"{shown(path)} is damaged (line {line}, column {column}: not a finite number)")
+
+
+# ------------------------------------------------------------------ who holds a folder's lock
+
+MAX_LOCK_TABLE_LINES = 1_000_000  # of /proc/locks: a machine's locks, read line by line
+MAX_OPEN_FILES = 1 << 20  # of a process, looked through for the lock file
+
+
+def _open_lock(path: Path) -> int | None:
+    """A descriptor of the lock file ``path`` (a regular file, never through a link), or None."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        return None
+    return fd
+
+
+def _held(fd: int) -> bool:
+    """Whether another open file description holds an flock on ``fd``'s file now (True where it cannot be probed)."""
+    try:
+        import fcntl
+    except ImportError:  # no flock to probe (Windows)
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError:  # BlockingIOError: held
+        return True
+    fcntl.flock(fd, fcntl.LOCK_UN)
+    return False
+
+
+def lock_held(path: str | Path) -> bool:
+    """Whether some process holds the lock file ``path`` now (an flock is released by the
+    kernel when its holder dies, even on kill -9). Not a regular file, or none: False."""
+    fd = _open_lock(Path(path))
+    if fd is None:
+        return False
+    try:
+        return _held(fd)
+    finally:
+        os.close(fd)
+
+
+def _kernel_lockers(info: os.stat_result) -> list[int]:
+    """The pids the kernel's lock table (/proc/locks, Linux) names as holding a lock on the
+    file ``info`` describes; [] where there is no such table."""
+    pids, inode, device = [], str(info.st_ino).encode(), f"{os.major(info.st_dev):02x}:{os.minor(info.st_dev):02x}:"
+    try:
+        with open("/proc/locks", "rb") as fh:
+            for _, line in zip(range(MAX_LOCK_TABLE_LINES), fh):
+                words = line.split()
+                if len(words) < 6 or words[1] == b"->":  # a process waiting for a lock holds none
+                    continue
+                pid, where = words[4], words[5]
+                if where.rpartition(b":")[2] == inode and pid.isdigit():
+                    pids.append((not where.startswith(device.encode()), int(pid)))
+    except OSError:
+        return []
+    return [pid for _, pid in sorted(pids)]  # the same device first (an inode number is per file system)
+
+
+def _has_open(pid: int, info: os.stat_result) -> bool:
+    """Whether the process ``pid`` has the file ``info`` describes open now (/proc/PID/fd)."""
+    try:
+        names = os.listdir(f"/proc/{pid}/fd")
+    except OSError:
+        return False
+    for name in names[:MAX_OPEN_FILES]:
+        try:
+            seen = os.stat(f"/proc/{pid}/fd/{name}")
+        except OSError:
+            continue
+        if (seen.st_dev, seen.st_ino) == (info.st_dev, info.st_ino):
+            return True
+    return False
+
+
+def lock_holder(path: str | Path) -> int | None:
+    """The process that holds the lock file ``path`` now, as the kernel says: the lock is
+    held, the kernel's lock table names the pid, and that process has the file open. Never
+    what a file says (run.lock's text, progress.jsonl's ``pid``: anyone may have written them).
+    None when no lock is held, or its holder cannot be verified (another user's process, no /proc)."""
+    fd = _open_lock(Path(path))
+    if fd is None:
+        return None
+    try:
+        info = os.fstat(fd)
+        if not _held(fd):
+            return None
+        for pid in _kernel_lockers(info):
+            if pid > 0 and _has_open(pid, info) and _held(fd):
+                return pid
+        return None
+    finally:
+        os.close(fd)
+
+
+def signal_holder(path: str | Path, signum: int, folder: str | Path) -> int:
+    """Send ``signum`` to the verified holder of the lock file ``path`` (``lock_holder``) of
+    the run folder ``folder``, and return its pid. Never pid 1, this process, a process of
+    this session or process group, or another user's: RunFolderError saying why not."""
+    pid = lock_holder(path)
+    if pid is None:
+        raise RunFolderError(f"{shown(folder)}: no process that can be verified holds its lock "
+                             "(the run ended, or it is not this user's): nothing was signalled")  # fmt: skip
+    try:
+        handle = os.pidfd_open(pid) if hasattr(os, "pidfd_open") else None  # the process, not a number reused
+    except OSError:
+        raise RunFolderError(f"{shown(folder)}: its run (pid {pid}) has ended: nothing was signalled") from None
+    try:
+        why = _not_to_signal(pid)
+        if why is None and lock_holder(path) != pid:
+            why = "it no longer holds the folder's lock"
+        if why is not None:
+            raise RunFolderError(f"{shown(folder)}: the process holding its lock (pid {pid}) is {why}: it was not signalled")
+        if handle is not None:
+            import signal
+
+            signal.pidfd_send_signal(handle, signum)
+        else:
+            os.kill(pid, signum)
+    except ProcessLookupError:
+        raise RunFolderError(f"{shown(folder)}: its run (pid {pid}) has ended: nothing was signalled") from None
+    finally:
+        if handle is not None:
+            os.close(handle)
+    return pid
+
+
+def _not_to_signal(pid: int) -> str | None:
+    """Why the process ``pid`` is never signalled (None if it may be)."""
+    if pid <= 1:
+        return "the system's first process"
+    if pid == os.getpid():
+        return "this process"
+    try:
+        if os.getsid(pid) == os.getsid(0) or os.getpgid(pid) == os.getpgid(0):
+            return "in this session"
+        owner = os.stat(f"/proc/{pid}").st_uid if os.path.isdir("/proc/self") else os.getuid()
+    except OSError:
+        return "gone, or not this user's"
+    return None if owner == os.getuid() else "another user's"

@@ -41,7 +41,7 @@ from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, 
 from .registry import Registry, default_registry
 from .results import write_figure
 from .rundir import STATE_FILE, RunDirectory
-from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
+from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
 from .runner import run_to_folder
 
 SWEEP_SCHEMA_VERSION = 1
@@ -287,6 +287,11 @@ def _run_points(
             return
         for listener in listeners:
             listener.point_started(sweep, point)
+        try:  # points/ and the point's folder: made here, never a link to elsewhere
+            make_subfolder(out_dir, f"points/{point.folder_name}")
+        except RunFolderError as exc:
+            yield PointResult(point, "error", folder, error=f"{exc}: remove it, then resume the sweep")
+            continue
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
         point_options = options if started or not options.resume else replace(options, resume=False)

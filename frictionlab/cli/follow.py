@@ -3,11 +3,12 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
 
-from ..errors import ExitCode
+from ..errors import ExitCode, shown
 
 POLL_SECONDS = 0.2
 EXAMPLES = """examples:
@@ -34,12 +35,12 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..detached import run_state
+    from ..detached import process_alive, run_state
 
     folder = Path(args.run_dir)
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None
-    error = None
+    error, gone, identity, holder = None, False, _identity(folder), state.pid
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
         try:
@@ -47,7 +48,11 @@ def run(args) -> ExitCode:
                 while state.status == "running":  # until its process ends: its files are written then
                     if not follower.poll():
                         time.sleep(POLL_SECONDS)
-                        state = run_state(folder)
+                        now = _state_unless_gone(folder, identity)
+                        if now is None:  # deleted (or replaced) under the run
+                            gone = True
+                            break
+                        state = now
                 follower.poll()  # the last events, written as it ended
             finally:  # a bar still showing ends on its own line, before anything else is printed
                 for listener in follower.listeners:
@@ -57,24 +62,59 @@ def run(args) -> ExitCode:
             return ExitCode.INTERRUPTED
         if follower.finished is not None:
             error = follower.finished.error
+    if gone:  # what is true: the folder it followed is no more; nothing there to resume
+        still = f"; its process (pid {holder}) still runs, writing nowhere you can see" if holder and process_alive(holder) else ""
+        message = f"{shown(folder)} was deleted or replaced while its run was going: nothing of that run is left to resume{still}"
+        if args.json:
+            from .jsonout import emit
+
+            emit("follow", {**state.to_dict(), "status": "deleted", "pid": holder, "error": message})
+        print(f"error: {message}", file=sys.stderr)
+        return ExitCode.RUNTIME_FAILURE
+    rows = _rows(folder) if sweep is not None else []
     if args.json:
         from .jsonout import emit
 
-        extra = {"points": _rows(folder)} if sweep is not None else {}
+        extra = {"points": rows} if sweep is not None else {}
         emit("follow", {**state.to_dict(), "error": error, **extra})
     else:
         done = "?" if state.done is None else state.done
         hint = f"; frictionlab resume {folder} continues it" if state.resumable else ""
+        if any(row.get("status") == "error" for row in rows):  # a resume fails there again until it is fixed
+            hint = f"; do what the points in error say, then frictionlab resume {folder} continues it"
         what = "points" if sweep is not None else "realizations"
-        print(f"{state.name}: {state.status}, {done}/{state.total} {what}, in {folder}/{hint}")
+        print(shown(f"{state.name}: {state.status}, {done}/{state.total} {what}, in {folder}/{hint}"))
         if sweep is not None:
             from ..progress import point_result_line
 
-            for point, row in zip(sweep.points, _rows(folder)):
+            for point, row in zip(sweep.points, rows):
                 print(point_result_line(sweep, point, row))
         if error:
-            print(f"error: {error}", file=sys.stderr)
+            print(f"error: {shown(error)}", file=sys.stderr)
     return ExitCode.OK if state.status == "completed" else ExitCode.RUNTIME_FAILURE
+
+
+def _state_unless_gone(folder: Path, identity):
+    """The state of the run in ``folder`` now; None if ``folder`` is no longer the folder of ``identity``."""
+    from ..detached import run_state
+    from ..errors import RunFolderError
+
+    try:
+        state = run_state(folder)
+    except RunFolderError:
+        if _identity(folder) != identity:
+            return None
+        raise
+    return state if _identity(folder) == identity else None
+
+
+def _identity(folder: Path) -> tuple[int, int] | None:
+    """Which folder ``folder`` is (its device and inode), None once it is gone."""
+    try:
+        info = os.stat(folder)
+    except OSError:
+        return None
+    return info.st_dev, info.st_ino
 
 
 def _stored_sweep(folder: Path):

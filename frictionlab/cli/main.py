@@ -160,7 +160,7 @@ def _missing_package(exc: Exception, purpose: str):
 
 
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
-    return f"warning: {message}\n"
+    return f"warning: {shown(str(message))}\n"  # a resume's warning names a folder
 
 
 def _quiet_stdout() -> None:

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, too_long_path
+from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, shown, too_long_path
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -137,7 +137,7 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     try:
         result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
     except OSError as exc:
-        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
+        print(shown(f"error: cannot write results to {out_dir}: {exc.strerror or exc}"), file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if closed:
         raise closed[0]
@@ -150,7 +150,7 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
         return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
         if outcome.error:
-            print(f"error: {outcome.error}", file=sys.stderr)
+            print(f"error: {shown(outcome.error)}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     return ExitCode.OK
 
@@ -166,14 +166,14 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
         )
     except OSError as exc:
-        print(f"error: cannot write results to {out_dir}: {exc.strerror or exc}", file=sys.stderr)
+        print(shown(f"error: cannot write results to {out_dir}: {exc.strerror or exc}"), file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         from .jsonout import emit
 
         emit("sweep", json.loads((out_dir / "sweep.json").read_text(encoding="utf-8")))
     else:
-        print(sweep_table(sweep, outcome.status, outcome.elapsed, outcome.rows, out_dir))
+        print(shown(sweep_table(sweep, outcome.status, outcome.elapsed, outcome.rows, out_dir)))
     if outcome.status == "interrupted":
         return interrupted_exit_code()
     return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK

@@ -49,13 +49,13 @@ def run(args) -> ExitCode:
         record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         records.append(record)
         if not args.json:
-            print(
+            print(shown(
                 f"{path}: ok ({counted(preset.realizations, 'realization')}, {scene.pressed} / {scene.solver.name} / "
                 f"{scene.slope.name}, {preset.loading.steps} {preset.loading.control} steps"
                 + (f", sweep of {counted(points, 'point')})" if points is not None else ")")
-            )
-            if record["input"] is not None:
-                print(f"  read {describe_input(record['input'])}")
+            ))
+            if record["input"] is not None:  # its unit, as the instrument file wrote it
+                print(shown(f"  read {describe_input(record['input'])}"))
     if args.json:
         from .jsonout import emit
 

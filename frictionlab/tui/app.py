@@ -19,7 +19,7 @@ from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
 from ..detached import check_startable, check_sweep_startable, list_run_states, run_state, start_detached
-from ..errors import FrictionlabError, PresetError, RunFolderError
+from ..errors import FrictionlabError, PresetError, RunFolderError, shown
 from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
@@ -177,7 +177,7 @@ class FrictionlabApp(App):
     def say(self, text: str, severity: str = "information", title: str = "") -> None:
         """Show ``text`` in the status line above the footer (never over the data); it
         stays until the next message. ``text`` is shown as it is, never as markup."""
-        line = Content.assemble((f"{title}: ", "bold") if title else "", text)
+        line = Content.assemble((f"{shown(title)}: ", "bold") if title else "", shown(text))  # no escape code from a folder
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
         status = self.query_one("#status", Static)
@@ -541,8 +541,8 @@ class FrictionlabApp(App):
         if not self.running:
             self.say("No run is going: Ctrl+R starts one.", "warning")
             return
-        if not self.followed.cancel():
-            return  # its process is gone: the next tick shows how it ended
+        if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
+            return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
         self.query_one(RunPane).show_cancelling()
 
     def on_run_finished(self, message: RunFinished) -> None:

@@ -10,7 +10,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..api import Result, load
-from ..detached import cancel, lock_held
+from ..detached import cancel, lock_held, lock_holder
+from ..errors import RunFolderError
 from ..progresslog import Follower
 from ..sweeplog import SweepFollower
 from .folders import read_run, read_sweep
@@ -32,12 +33,15 @@ class FollowedRun:
         self.follower = Follower(folder, scene, [self.live], pid=process.pid if process is not None else None)
         self.live.clock = self.follower.now
         self.cancelling = False
+        self.refusal: str | None = None  # why a cancel signalled nothing
 
     @property
     def pid(self) -> int | None:
+        """The run's process: the one started here, else the folder's lock holder as the
+        kernel says (never the pid its progress file names: anyone may have written that)."""
         if self.process is not None:
             return self.process.pid
-        return self.follower.pid or self._pid
+        return lock_holder(self.folder)
 
     @property
     def error(self) -> str | None:
@@ -59,9 +63,21 @@ class FollowedRun:
         return over
 
     def cancel(self) -> bool:
-        """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone."""
-        pid = self.pid
-        self.cancelling = pid is not None and cancel(pid)
+        """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone, or
+        (``refusal`` says why) no process could be verified as the one that holds its folder.
+        Signalled: the process started here (not yet reaped: its pid is its own), else only
+        the folder's lock holder (``detached.cancel``)."""
+        self.refusal = None
+        if self.process is not None:
+            if self.process.poll() is None:
+                self.process.terminate()
+                self.cancelling = True
+            return self.cancelling
+        try:
+            cancel(self.folder)
+            self.cancelling = True
+        except RunFolderError as exc:
+            self.refusal = str(exc)
         return self.cancelling
 
 
@@ -81,6 +97,7 @@ class FollowedSweep(FollowedRun):
         self.follower = SweepFollower(folder, sweep, [SweepPoster(post_point, self._listeners_of)],
                                       pid=process.pid if process is not None else None)  # fmt: skip
         self.cancelling = False
+        self.refusal: str | None = None
 
     def _listeners_of(self, point) -> list[object]:
         self.live = LiveListener(self._post)

@@ -14,6 +14,7 @@ from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.widgets import DataTable, ProgressBar, Static
 
+from ...errors import shown
 from ...fit import format_estimate
 from ...listeners import format_duration, progress_text
 from ..chart import Series
@@ -110,7 +111,7 @@ class RunPane(Vertical, can_focus=True):
         self.query_one(f"#{widget_id}", Static).update(Content(text) if isinstance(text, str) else text)
 
     def _error(self, text: str) -> None:
-        self._set("run-error", Content.styled(text, "red"))
+        self._set("run-error", Content.styled(shown(text), "red"))  # a run's error may quote a file
 
     # ------------------------------------------------------------ a run starts
 
