@@ -81,18 +81,28 @@ def subfolder(root: Path, name: str) -> Path:
 
 def make_subfolder(root: str | Path, name: str) -> Path:
     """``root / name`` (a relative path), each component made if missing and checked to be
-    a folder, not a symbolic link (``subfolder``'s rule): a sweep writes its points inside
-    its own folder, never through a link someone put there. RunFolderError naming the path."""
-    here = Path(root)
-    for part in PurePosixPath(name).parts:
-        here = here / part
-        try:
-            os.mkdir(here)
-        except FileExistsError:
-            pass
-        except OSError as exc:
-            raise RunFolderError(f"{shown(here)}: cannot make the folder ({exc.strerror or exc})") from None
-    return subfolder(root, name)
+    a folder, not a symbolic link (``subfolder``'s rule), one at a time from the folder
+    above's descriptor: a sweep writes its points inside its own folder, never through a
+    link someone put there. RunFolderError naming the path."""
+    here, fd = Path(root), os.open(root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    try:
+        for part in PurePosixPath(_member(name)).parts:
+            here = here / part
+            try:
+                os.mkdir(part, dir_fd=fd)
+            except FileExistsError:
+                pass
+            except OSError as exc:
+                raise RunFolderError(f"{shown(here)}: cannot make the folder ({exc.strerror or exc})") from None
+            try:
+                inner = os.open(part, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=fd)
+            except OSError:
+                raise RunFolderError(f"{shown(here)} is a symbolic link or not a folder, which is never followed") from None
+            os.close(fd)
+            fd = inner
+    finally:
+        os.close(fd)
+    return Path(root) / name
 
 
 def read_member(folder: str | Path, name: str, limit: int, what: str | None = None) -> bytes:

@@ -290,7 +290,7 @@ def _run_points(
         try:  # points/ and the point's folder: made here, never a link to elsewhere
             make_subfolder(out_dir, f"points/{point.folder_name}")
         except RunFolderError as exc:
-            yield PointResult(point, "error", folder, error=f"{exc}: remove it, then resume the sweep")
+            yield PointResult(point, "error", folder, error=f"{exc}: remove the link, then resume the sweep")
             continue
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
@@ -299,8 +299,10 @@ def _run_points(
             outcome, _ = run_to_folder(
                 point.scene, folder, point_options, listeners=run_listeners, cancel=cancel, plot=plot
             )
-        except FrictionlabError as exc:
-            yield PointResult(point, "error", folder, error=str(exc))
+        except FrictionlabError as exc:  # a folder not this point's run's: a resume meets it again unless moved
+            hint = f"; move {folder} aside, then resume the sweep to compute the point afresh" if isinstance(
+                exc, (RunFolderError, OutputRefused)) else ""  # fmt: skip
+            yield PointResult(point, "error", folder, error=f"{exc}{hint}")
             continue
         yield PointResult(point, outcome.status, folder, outcome=outcome, error=outcome.error)
         if outcome.status in ("cancelled", "interrupted"):

@@ -112,9 +112,9 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
     elif args.quiet:  # only the folder: a script captures it
         print(out_dir)
     else:
-        print(f"{scene.preset.name}: {what} detached in {out_dir}/ (pid {process.pid})\n"
-              f"  frictionlab follow {out_dir}    shows its progress\n"
-              f"  kill -TERM {process.pid}    cancels it (what finished is kept; frictionlab resume continues it)")  # fmt: skip
+        print(shown(f"{scene.preset.name}: {what} detached in {out_dir}/ (pid {process.pid})\n"
+                    f"  frictionlab follow {out_dir}    shows its progress\n"
+                    f"  kill -TERM {process.pid}    cancels it (what finished is kept; frictionlab resume continues it)"))  # fmt: skip
     return ExitCode.OK
 
 
@@ -129,7 +129,7 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     def print_table(result) -> None:  # before the figure is drawn: nobody waits for matplotlib
         if not args.json:
             try:
-                print(result_table(scene, result.outcome, out_dir), flush=True)
+                print(shown(result_table(scene, result.outcome, out_dir)), flush=True)
             except OSError as exc:
                 closed.append(exc)
 

@@ -1,0 +1,165 @@
+"""No escape code from a file, a log, a folder's name or an exception reaches the terminal:
+each printing path (follow, runs, resume, validate, progress lines, the TUI's status line)
+given a payload that would retitle the terminal and clear its screen prints it escaped."""
+
+import io
+import json
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import yaml
+
+import frictionlab
+from frictionlab.cli.main import main
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.progress import ProgressReporter, SweepProgress
+from frictionlab.progresslog import PROGRESS_FILE
+from frictionlab.realization import RealizationResult
+from frictionlab.rundir import RunDirectory
+from frictionlab.sweep import plan_sweep, run_sweep
+
+from .conftest import SMALL_PRESET, merge
+
+PAYLOAD = "\x1b]2;pwned\x07\x1b[2J"
+ESC = "\x1b"
+
+posix = pytest.mark.skipif(sys.platform == "win32", reason="control characters in file names")
+
+
+def test_follow_prints_a_forged_finished_error_escaped(tmp_path):
+    script = textwrap.dedent(f"""
+        import sys
+        from frictionlab.preset import build_scene
+        from frictionlab.rundir import RunDirectory
+        with RunDirectory({str(tmp_path)!r}) as run_dir:
+            run_dir.start(build_scene({SMALL_PRESET!r}), resume=False)
+            print("held", flush=True)
+            sys.stdin.read()
+    """)
+    holder = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)  # fmt: skip
+    assert holder.stdout.readline().strip() == "held"
+    events = [{"event": "started", "pid": holder.pid, "total": 8},
+              {"event": "finished", "status": "failed", "done": 0, "requested": 8, "error": PAYLOAD}]  # fmt: skip
+    (tmp_path / PROGRESS_FILE).write_text("".join(json.dumps(e) + "\n" for e in events))
+    follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(tmp_path)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        out, err = follow.communicate(timeout=5)
+    except subprocess.TimeoutExpired:  # still following: the run ends now
+        holder.stdin.close()
+        out, err = follow.communicate(timeout=60)
+    if not holder.stdin.closed:
+        holder.stdin.close()
+    holder.wait(timeout=30)
+    assert "pwned" in err and ESC not in out + err and "\x07" not in err
+
+
+@posix
+def test_runs_prints_a_forged_name_escaped(tmp_path, capsys):
+    folder = tmp_path / f"run{PAYLOAD}"
+    with RunDirectory(folder) as run_dir:
+        run_dir.start(build_scene(SMALL_PRESET), resume=False)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest["preset"]["name"], manifest["status"] = PAYLOAD, PAYLOAD
+    (folder / "run.json").write_text(json.dumps(manifest))
+    assert main(["runs", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("pwned") == 3 and ESC not in out
+
+
+@posix
+def test_resume_prints_its_warning_about_a_folder_escaped(tmp_path):
+    folder = tmp_path / f"run{PAYLOAD}"
+    frictionlab.run(SMALL_PRESET, out=folder, workers=1, plot=False, progress=False)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest["status"] = "interrupted"
+    (folder / "run.json").write_text(json.dumps(manifest))
+    [chunk] = (folder / "chunks").iterdir()
+    chunk.write_bytes(chunk.read_bytes() + b"!")  # a checksum that does not match: a warning names the folder
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "resume", str(folder), "--no-plot"], capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0 and "failed verification" in done.stderr
+    assert "pwned" in done.stderr + done.stdout and ESC not in done.stderr + done.stdout
+
+
+@posix
+def test_validate_prints_a_file_name_and_a_preset_value_escaped(tmp_path, capsys):
+    preset = tmp_path / f"p{PAYLOAD}.yaml"
+    preset.write_text(yaml.safe_dump(SMALL_PRESET))
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump({**SMALL_PRESET, "name": PAYLOAD}))
+    assert main(["validate", str(preset)]) == 0
+    assert main(["validate", str(bad)]) == 2
+    said = capsys.readouterr()
+    assert said.out.count("pwned") == 1 and "pwned" in said.err and ESC not in said.out + said.err
+
+
+def test_validate_prints_what_an_input_file_says_escaped(tmp_path, capsys, monkeypatch):
+    """An instrument file's unit reaches the line that describes it: escaped there."""
+    import frictionlab.api
+    import frictionlab.inputs
+
+    real = frictionlab.api.scene_record
+    monkeypatch.setattr(frictionlab.api, "scene_record", lambda scene: {**real(scene), "input": {"unit": PAYLOAD}})
+    monkeypatch.setattr(frictionlab.inputs, "describe_input", lambda summary: f"map.nc: unit {summary['unit']}")
+    preset = tmp_path / "p.yaml"
+    preset.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(preset)]) == 0
+    out = capsys.readouterr().out
+    assert "read map.nc: unit" in out and "pwned" in out and ESC not in out
+
+
+def test_progress_lines_print_a_realization_error_and_a_point_error_escaped():
+    class Run:
+        scene = build_scene(SMALL_PRESET)
+        total, resumed, retried, workers = 2, 0, 0, 1
+
+    stream = io.StringIO()
+    reporter = ProgressReporter(stream=stream, interactive=False, after=0.0)
+    reporter.run_started(Run())
+    reporter.realization_failed(RealizationResult(index=0, seconds=0.1, error=f"ValueError: {PAYLOAD}"), 1, 2)
+    sweep = plan_sweep(merge(SMALL_PRESET, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5]}}}}))
+    point = sweep.points[0]
+    progress = SweepProgress(stream=stream, interactive=False, after=0.0)
+
+    class Failed:
+        status, error = "error", PAYLOAD
+
+    progress.point_finished(sweep, point, Failed())
+    assert stream.getvalue().count("pwned") == 2 and ESC not in stream.getvalue()
+
+
+def test_follow_prints_a_forged_point_error_of_sweep_json_escaped(tmp_path, capsys):
+    data = merge(SMALL_PRESET, {"realizations": 3, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5]}}}})
+    run_sweep(plan_sweep(data), tmp_path, RunOptions(workers=1), plot=False)
+    record = json.loads((tmp_path / "sweep.json").read_text())
+    record["points"][0].update(status="error", error=PAYLOAD, a=None)
+    (tmp_path / "sweep.json").write_text(json.dumps(record))
+    main(["follow", str(tmp_path)])
+    said = capsys.readouterr()
+    assert "pwned" in said.out and ESC not in said.out + said.err
+
+
+def test_the_tui_status_line_shows_a_message_escaped(registry, tmp_path, monkeypatch):
+    import asyncio
+
+    from frictionlab.tui.app import FrictionlabApp
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "presets").mkdir()
+
+    async def scenario():
+        app = FrictionlabApp(None, presets_dir="presets", runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.pause()
+            app.say(f"cannot follow {PAYLOAD}", "error", title=PAYLOAD)
+            await pilot.pause()
+            return str(app.query_one("#status").render())
+
+    shown = asyncio.run(scenario())
+    assert shown.count("pwned") == 2 and ESC not in shown and "\x07" not in shown
