@@ -26,7 +26,7 @@ from pathlib import Path
 from . import runfolder
 from .errors import ExitCode, FrictionlabError, RunFolderError, shown
 from .options import RunOptions
-from .progresslog import ProgressLog, ProgressReader, StartOf
+from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json
 
@@ -245,7 +245,8 @@ class RunState:
 
 
 def _count(value) -> int | None:
-    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else None
+    """A count read from a file: a whole number from 0 to ``MAX_COUNT``, else None (shown as ``?``)."""
+    return value if isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= MAX_COUNT else None
 
 
 def run_state(folder: str | Path) -> RunState:
@@ -272,6 +273,8 @@ def run_state(folder: str | Path) -> RunState:
     if summary is not None and status != "running":
         counts = summary.get("realizations") if isinstance(summary.get("realizations"), dict) else {}
         done = _count(counts.get("done")) if _count(counts.get("done")) is not None else done
+    if done is not None and total is not None and done > total:  # not a count of this run
+        done = None
     return RunState(folder, name, status, done, total, pid)
 
 

@@ -47,7 +47,7 @@ from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
 from .realization import RealizationResult
-from .runfolder import check_schema_version, json_kind, read_json_object, read_member
+from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 CHUNK_DIR = "chunks"
@@ -156,10 +156,12 @@ class RunDirectory:
         try:
             self._lock.acquire()
         except Timeout:
-            try:  # what _write_holder wrote: a line, escaped as any text from a folder is
-                holder = shown(read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]) or "unknown"
+            pid = lock_holder(lock)  # as the kernel says: the lock file's text is anyone's
+            try:  # what _write_holder wrote, believed only where it names that process
+                text = read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]
             except (OSError, InputFileProblem):
-                holder = "unknown"
+                text = ""
+            holder = (shown(text) if text.startswith(f"pid {pid},") else f"pid {pid}") if pid else "a process that cannot be verified"
             raise RunFolderError(
                 f"{self.path} is in use by another run ({holder}): wait for it to end, "
                 "or give another output folder"

@@ -4,6 +4,7 @@ did not check, spin no loop, and a folder swapped or deleted under a run is said
 
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -14,6 +15,8 @@ import time
 
 import numpy as np
 import pytest
+
+import frictionlab
 
 from frictionlab.cli.main import main
 from frictionlab.detached import lock_held, lock_holder, run_state, start_detached, wait_started
@@ -128,10 +131,16 @@ def test_runs_shows_the_verified_holder_and_only_checked_counts(tmp_path, capsys
             run_dir.start(build_scene(merge(SMALL_PRESET, {"realizations": 12})), resume=False)
         forge(dead, {"event": "started", "total": 12}, realization(0, 10**30, 10**31), {"event": "finished", "done": 10**30,
               "requested": 12})  # fmt: skip
+        done = tmp_path / "done"
+        frictionlab.run(SMALL_PRESET, out=done, workers=1, plot=False, progress=False)
+        summary = json.loads((done / "summary.json").read_text())
+        summary["realizations"]["done"] = 10**30
+        (done / "summary.json").write_text(json.dumps(summary))
         assert main(["runs", str(tmp_path)]) == 0
         out = capsys.readouterr().out
     finally:
         release(holder)
+    assert re.search(r"completed +\?/8", out)  # summary.json's done beyond its run's: not shown
     assert f"running (pid {holder.pid})" in out and "pid 1)" not in out
     assert "10000000000" not in out and "interrupted" in out and " 0/12" in out  # the started event's count: none done
     assert run_state(dead).done == 0
@@ -289,8 +298,6 @@ def test_resume_detach_of_a_sweep_whose_point_folder_is_a_link_writes_nothing_ou
 
 
 def test_result_plot_refuses_an_axes_like_object_naming_what_it_lacks(tmp_path):
-    import frictionlab
-
     result = frictionlab.run(SMALL_PRESET, out=tmp_path / "run", workers=1, plot=False, progress=False)
 
     class NotAxes:

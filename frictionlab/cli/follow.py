@@ -58,7 +58,7 @@ def run(args) -> ExitCode:
                 for listener in follower.listeners:
                     listener.close()
         except KeyboardInterrupt:
-            print(f"stopped following; the run goes on (pid {state.pid})", file=sys.stderr)
+            print(f"stopped following; the run goes on{f' (pid {state.pid})' if state.pid else ''}", file=sys.stderr)
             return ExitCode.INTERRUPTED
         if follower.finished is not None:
             error = follower.finished.error
