@@ -25,7 +25,8 @@ def add_parser(sub) -> None:
         description="Follow the run in DIR by reading what it writes there (progress.jsonl): progress on stderr "
         "until it ends, then its state on stdout. For a sweep's folder: each point as it starts, its "
         "realizations, and its fit once it ends. Ctrl-C stops following; the run goes on. The exit code is 0 "
-        "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it).",
+        "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it) or its folder was "
+        "deleted while it ran.",
         epilog=EXAMPLES,
     )
     p.add_argument("run_dir", metavar="DIR", help="a run folder, or a sweep's folder")
