@@ -362,8 +362,10 @@ def signal_holder(path: str | Path, signum: int, folder: str | Path) -> int:
                              "(the run ended, or it is not this user's): nothing was signalled")  # fmt: skip
     try:
         handle = os.pidfd_open(pid) if hasattr(os, "pidfd_open") else None  # the process, not a number reused
-    except OSError:
+    except ProcessLookupError:
         raise RunFolderError(f"{shown(folder)}: its run (pid {pid}) has ended: nothing was signalled") from None
+    except OSError:  # a kernel without pidfds: the pid, verified again just before the signal
+        handle = None
     try:
         why = _not_to_signal(pid)
         if why is None and lock_holder(path) != pid:
