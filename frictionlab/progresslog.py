@@ -151,7 +151,7 @@ def fitted_line(event: dict) -> bytes:
     if len(line) <= MAX_LINE_BYTES:
         return line
     if event.get("event") == "realization" and any(isinstance(event.get(name), list) for name in CURVES):
-        stride = -(-len(line) // (MAX_LINE_BYTES // 2))
+        stride = -(-len(line) // (MAX_LINE_BYTES * 9 // 10))  # the curves are nearly all of it
         while len(line) > MAX_LINE_BYTES and stride < 2 * MAX_LINE_BYTES:  # each pass halves the curves
             curves = {name: event[name][::stride] for name in CURVES if isinstance(event.get(name), list)}
             line, stride = _line({**event, **curves, "stride": stride}), 2 * stride
