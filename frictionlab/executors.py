@@ -404,7 +404,9 @@ def _packed_chunk(scene: Scene, indices: Chunk, stop_name: str) -> bytes:
     return pickle.dumps(results, protocol=pickle.HIGHEST_PROTOCOL)
 
 
-POOL_START_SECONDS = 0.05  # starting and ending a local pool of 2 workers, on a busy 2-core machine (bench_startup.py)
+# starting and ending a local pool of 2 workers: two one-realization chunks took 55-60 ms more
+# on a pool than here, on the 2-core machine under load (load average 12)
+POOL_START_SECONDS = 0.05
 
 
 def sized_executor(executor, options: RunOptions, remaining: int, seconds_each: float):
