@@ -18,7 +18,7 @@ import pluggy
 
 from .ensemble import Accumulator, RunOutcome
 from .errors import RunError
-from .executors import make_executor, plan_chunks
+from .executors import make_executor, plan_chunks, sized_executor
 from .hookspecs import PROJECT_NAME
 from .listeners import RunListener
 from .options import RunOptions
@@ -68,7 +68,11 @@ def run(
     ``restored``: results already finished (a resume): only the missing
     realizations, and those that had failed, are computed. ``store``: anything
     with ``save_chunk(results)``, called as each chunk finishes, before its
-    listeners hear of it.
+    listeners hear of it (the store decides when to write it).
+
+    The first missing realization runs in this process; its time sizes the chunks and,
+    for the default executor, says whether a process pool repays its start
+    (``executors.sized_executor``): the outcome names the executor and workers that ran.
 
     The installed plugins that implement lifecycle hooks (of ``registry``, by default the
     process-wide one) hear the run as ``listeners`` do.
@@ -126,6 +130,7 @@ def run(
                 first = compute_chunk_here(scene, todo[:1], cancel=cancel, **progress)
                 if first:  # else cancelled within it
                     record(first)
+                    pool = sized_executor(pool, options, len(todo) - 1, first[0].seconds)
                     chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
                     for _, results in pool.map_chunks(scene, chunks, cancel, **progress):
                         record(results)

@@ -404,6 +404,22 @@ def _packed_chunk(scene: Scene, indices: Chunk, stop_name: str) -> bytes:
     return pickle.dumps(results, protocol=pickle.HIGHEST_PROTOCOL)
 
 
+# starting and ending a local pool of 2 workers: two one-realization chunks took 55-60 ms more
+# on a pool than here, on the 2-core machine under load (load average 12)
+POOL_START_SECONDS = 0.05
+
+
+def sized_executor(executor, options: RunOptions, remaining: int, seconds_each: float):
+    """``executor``, or this process instead of the default process pool when the work left
+    (``remaining`` realizations of ``seconds_each``, the first one's time) would not repay the
+    pool's start: shared among its workers it would save less than twice that start. An
+    executor asked for by name is kept. The numbers are the same either way."""
+    if options.executor is not None or executor.name != "processes":
+        return executor
+    saved = remaining * seconds_each * (1.0 - 1.0 / max(1, executor.workers))
+    return executor if saved > 2 * POOL_START_SECONDS else SerialExecutor()
+
+
 def make_executor(options: RunOptions, workers: int):
     """The executor ``options`` ask for (``RunOptions.executor_for``) with ``workers``."""
     name = options.executor_for(workers)

@@ -139,6 +139,19 @@ class WorkerPool:
     def _start(self, stop) -> _Worker:
         return _Worker(self.context, stop, self.initializer, self.initargs, self.function)
 
+    def _give_out(self, pending: deque, jobs: dict, workers: list[_Worker], stop) -> None:
+        """A pending job to each idle worker, starting workers up to ``size``."""
+        while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
+            worker = next((w for w in workers if w.job is None), None)
+            if worker is None:
+                worker = self._start(stop)
+                workers.append(worker)
+            key = pending.popleft()
+            if not worker.give(key, jobs[key]):  # it died idle: no charge to the job
+                pending.appendleft(key)
+                workers.remove(worker)
+                worker.stop(0)
+
     def run(self, jobs: dict[Hashable, object], cancel, on_progress=None) -> Iterator[tuple[Hashable, object]]:
         """Yield ``(key, result)`` as each job finishes; ``on_progress(payload)`` hears what
         a job sends on the way (``send_progress``). After ``cancel.set()``
@@ -160,16 +173,7 @@ class WorkerPool:
                     cancelled_at = time.monotonic() if cancelled_at is None else cancelled_at
                     if time.monotonic() - cancelled_at >= STOP_GRACE_SECONDS:
                         return  # the workers still busy are killed below: their jobs abandoned
-                while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
-                    worker = next((w for w in workers if w.job is None), None)
-                    if worker is None:
-                        worker = self._start(stop)
-                        workers.append(worker)
-                    key = pending.popleft()
-                    if not worker.give(key, jobs[key]):  # it died idle: no charge to the job
-                        pending.appendleft(key)
-                        workers.remove(worker)
-                        worker.stop(0)
+                self._give_out(pending, jobs, workers, stop)
                 busy = [w for w in workers if w.job is not None]
                 if not busy:
                     return
@@ -189,6 +193,8 @@ class WorkerPool:
                             key, worker.job = worker.job, None
                             if status == "error":
                                 raise JobFailed(key, value)
+                            if not cancel.is_set():  # its next job first: what the caller does
+                                self._give_out(pending, jobs, workers, stop)  # with the result (a write) overlaps it
                             yield key, value
                             continue  # had it died too, its sentinel stays ready for the next round
                     if died:

@@ -129,6 +129,7 @@ class RunDirectory:
         self.force = force
         self._lock = None  # a filelock.FileLock while held
         self._manifest: dict | None = None
+        self._kept: dict[int, RealizationResult] = {}  # every result stored or verified here, by index
 
     @property
     def chunks(self) -> Path:
@@ -356,6 +357,7 @@ class RunDirectory:
             if isinstance(name, str) and CHUNK_NAME.fullmatch(name) and name not in self._manifest["chunks"]:
                 (self.chunks / name).unlink(missing_ok=True)
         results = self._verified(scene, warn=True)
+        self._kept = {r.index: r for r in results}
         self._write_manifest()
         return results
 
@@ -403,6 +405,7 @@ class RunDirectory:
         chunks.pop(name, None)  # listed again last: later chunks win where they overlap (a retried failure)
         chunks[name] = hashlib.sha256(data).hexdigest()
         self._write_manifest()
+        self._kept.update((r.index, r) for r in results)
         return path
 
     def completed_results(self, scene: Scene) -> list[RealizationResult] | None:
@@ -492,13 +495,14 @@ class RunDirectory:
     def _compact(self, scene: Scene) -> None:
         """Merge the chunks of a completed run into one file: written
         and listed first, the old ones deleted after (a crash in between leaves
-        them listed as retired, deleted by the next start)."""
+        them listed as retired, deleted by the next start). The results are those
+        this object stored or verified (the chunks' content, not read back)."""
         old = list(self._manifest["chunks"])
         if len(old) <= 1:
             return
-        results = self._verified(scene, warn=False)
-        if len(self._manifest["chunks"]) != len(old) or not results:
-            return  # something changed under us: leave the chunks as they are
+        results = [self._kept[i] for i in sorted(self._kept)]
+        if not results:
+            return
         self._manifest["chunks"] = {}
         self._manifest["retired"] = old
         self.save_chunk(results)

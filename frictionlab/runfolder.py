@@ -54,7 +54,7 @@ class Record(BaseModel):
     """The base of a run folder file's schema: values strictly typed (a string is not a
     number), a field a later frictionlab adds kept unchecked."""
 
-    model_config = ConfigDict(extra="allow", strict=True)
+    model_config = ConfigDict(extra="allow", strict=True, defer_build=True)  # built when a folder is read
 
 
 def subfolder(root: Path, name: str) -> Path:

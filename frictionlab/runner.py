@@ -14,7 +14,36 @@ from .memory import check_fits, check_worker_limits
 from .options import RunOptions
 from .preset import Scene
 from .results import add_plot, write_results
+from .realization import RealizationResult
 from .rundir import RunDirectory
+
+UNSAVED_WORK_SECONDS = 0.5  # of computing: finished chunks are written once this much is not on disk yet
+
+
+class BatchedStore:
+    """A run directory's chunks, written in batches: once the finished work not yet on
+    disk reaches ``unsaved`` seconds of computing, and at the end (``flush``). A
+    sub-second run writes one chunk and no compaction; a long one a chunk about every
+    half second of work, what a kill -9 may lose besides the realizations running.
+    A cancel, Ctrl-C or SIGTERM loses nothing: the run ends through ``flush``."""
+
+    def __init__(self, run_dir: RunDirectory, unsaved: float | None = None):
+        self.run_dir = run_dir
+        self.unsaved = UNSAVED_WORK_SECONDS if unsaved is None else unsaved
+        self.pending: list[RealizationResult] = []
+        self.work = 0.0
+
+    def save_chunk(self, results: list[RealizationResult]) -> None:
+        self.pending.extend(results)
+        self.work += sum(r.seconds for r in results)
+        if self.work >= self.unsaved:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write what is pending as one chunk (its name: the range of its indices)."""
+        if self.pending:
+            batch, self.pending, self.work = sorted(self.pending, key=lambda r: r.index), [], 0.0
+            self.run_dir.save_chunk(batch)
 
 
 def check_memory(scene: Scene, options: RunOptions) -> None:
@@ -74,7 +103,11 @@ def run_to_folder(
         check_memory(scene, options)
     with RunDirectory(out_dir, force=options.force) as run_dir:
         restored = run_dir.start(scene, resume=options.resume)
-        outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=run_dir, restored=restored)
+        store = BatchedStore(run_dir)
+        try:
+            outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
+        finally:  # whatever ended the run, what finished is written
+            store.flush()
         files = write_results(out_dir, scene, outcome)
         try:
             if on_results is not None:

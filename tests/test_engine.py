@@ -24,7 +24,7 @@ def same_outcome(one, two):
 def test_same_seed_same_numbers_for_one_and_two_workers(make_scene):
     scene = make_scene({"realizations": 12})
     serial = engine.run(scene, RunOptions(workers=1))
-    pooled = engine.run(scene, RunOptions(workers=2))
+    pooled = engine.run(scene, RunOptions(workers=2, executor="processes"))  # a pool, however short the run
     assert serial.status == pooled.status == "completed"
     assert serial.done == 12
     same_outcome(serial, pooled)
@@ -190,7 +190,7 @@ def test_with_threads_alive_the_pool_uses_forkserver_and_gives_the_same_numbers(
     bystander.start()
     try:
         assert pool_context().get_start_method() == "forkserver"
-        pooled = engine.run(scene, RunOptions(workers=2))
+        pooled = engine.run(scene, RunOptions(workers=2, executor="processes"))
     finally:
         release.set()
         bystander.join()

@@ -14,7 +14,8 @@ import pytest
 
 from frictionlab import engine
 from frictionlab.errors import FrictionlabError
-from frictionlab.executors import DASK_MISSING, plan_chunks
+from frictionlab import executors
+from frictionlab.executors import DASK_MISSING, ProcessExecutor, SerialExecutor, plan_chunks, sized_executor
 from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
 from frictionlab_spectra.power_law import PowerLaw
@@ -112,6 +113,33 @@ def test_short_runs_get_fewer_longer_chunks_where_tasks_cost_more():
             assert [i for c in chunks for i in c] == list(range(count))
             # a task lasts at least 50 overheads, unless the run is too short for two of that length
             assert min(len(c) for c in chunks[:-1] or chunks) * each >= 50 * 5e-3 or len(chunks) <= 2
+
+
+# ------------------------------------------------------------------ executor sized to the work
+
+
+def test_the_default_pool_is_started_only_when_the_work_repays_its_start():
+    pool, default = ProcessExecutor(2), RunOptions(workers=2)
+    start = executors.POOL_START_SECONDS
+    # shared by 2 workers, the work saves half of itself: twice the start is the threshold
+    assert isinstance(sized_executor(pool, default, 100, 3.9 * start / 100), SerialExecutor)
+    assert sized_executor(pool, default, 100, 4.1 * start / 100) is pool
+    assert isinstance(sized_executor(pool, default, 0, 10.0), SerialExecutor)  # one realization: nothing left
+    four = ProcessExecutor(4)  # saves three quarters of the work
+    assert sized_executor(four, default, 100, 2.7 * start / 100) is four
+    assert isinstance(sized_executor(four, default, 100, 2.6 * start / 100), SerialExecutor)
+    named = RunOptions(workers=2, executor="processes")  # asked for by name: kept, whatever the work
+    assert sized_executor(pool, named, 1, 1e-9) is pool
+
+
+def test_a_run_too_short_for_a_pool_runs_here_with_the_numbers_of_any_worker_count(scene_24, serial_24, monkeypatch):
+    short = engine.run(scene_24, RunOptions(workers=2))  # 24 tiny lines: far less than a pool's start
+    assert (short.extra["executor"], short.workers) == ("serial", 1)
+    same_numbers(serial_24, short)
+    monkeypatch.setattr(executors, "POOL_START_SECONDS", 0.0)  # any work repays a free start
+    pooled = engine.run(scene_24, RunOptions(workers=2))
+    assert (pooled.extra["executor"], pooled.workers) == ("processes", 2)
+    same_numbers(serial_24, pooled)
 
 
 # ------------------------------------------------------------------ same numbers

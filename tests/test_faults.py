@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab import engine
+from frictionlab import engine, runner
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.runner import run_to_folder
@@ -119,7 +119,9 @@ def partial_and_whole(registry, tmp_path_factory):
     scene = build_scene(DAMAGE_PRESET, registry=registry)
     root = tmp_path_factory.mktemp("damage")
     cancel = threading.Event()
-    first, _ = run_to_folder(scene, root / "partial", RunOptions(workers=1), listeners=[CancelAfter(30, cancel)], cancel=cancel)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)  # each chunk written as it finishes
+        first, _ = run_to_folder(scene, root / "partial", RunOptions(workers=1), listeners=[CancelAfter(30, cancel)], cancel=cancel)
     assert first.status == "cancelled" and len(json.loads((root / "partial" / "run.json").read_text())["chunks"]) >= 3
     run_to_folder(scene, root / "whole", RunOptions(workers=1))
     return scene, root / "partial", root / "whole"

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import yaml
 
+from frictionlab import files, runner
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.preset import build_scene
@@ -161,7 +162,8 @@ def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(
 # ------------------------------------------------------------------ manifest, lock, chunks
 
 
-def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_scene, tmp_path):
+def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_scene, tmp_path, monkeypatch):
+    monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)  # each chunk written as it finishes
     scene = make_scene({"realizations": 30, **NO_PLOT})
     seen = []
 
@@ -180,6 +182,43 @@ def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_sc
     assert seen and seen[-1] >= 3 and seen == sorted(seen)
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     assert manifest["status"] == "cancelled" and manifest["fingerprint"] and manifest["preset"]["seed"] == 7
+
+
+def test_a_short_run_writes_its_chunks_once_and_the_same_files_as_a_chunk_at_a_time(make_scene, tmp_path, monkeypatch):
+    """Bookkeeping sized to the run: a sub-second run keeps its finished chunks until the
+    end and writes them as one file (no compaction, a third of the writes); the folder
+    holds what a run writing each chunk as it finished leaves, to the bit but for the
+    realizations' own times."""
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    written = []
+    atomic_write = files.atomic_write
+
+    def counting(path, *args, **kwargs):
+        written.append(Path(path).name)
+        return atomic_write(path, *args, **kwargs)
+
+    monkeypatch.setattr("frictionlab.rundir.atomic_write", counting)
+    run_to_folder(scene, tmp_path / "batched", RunOptions(workers=1))
+    batched = list(written)
+    monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)
+    written.clear()
+    run_to_folder(scene, tmp_path / "each", RunOptions(workers=1))
+    assert batched.count("00000000-00000029.npz") == 1 and len([n for n in batched if n.endswith(".npz")]) == 1
+    assert batched.count("run.json") <= 3 and len(written) >= 3 * len(batched)  # each chunk, its manifest, compaction
+    same_files(tmp_path / "batched", tmp_path / "each")
+    for folder in ("batched", "each"):
+        assert sorted(p.name for p in (tmp_path / folder / "chunks").iterdir()) == ["00000000-00000029.npz"]
+    with np.load(tmp_path / "batched" / "chunks" / "00000000-00000029.npz") as one, np.load(
+        tmp_path / "each" / "chunks" / "00000000-00000029.npz"
+    ) as other:
+        assert one.files == other.files
+        for name in one.files:
+            if name != "seconds":
+                np.testing.assert_array_equal(one[name], other[name], err_msg=name)
+    manifests = [json.loads((tmp_path / d / "run.json").read_text()) for d in ("batched", "each")]
+    for manifest in manifests:
+        manifest.pop("chunks")  # their SHA-256 covers the times
+    assert manifests[0] == manifests[1]
 
 
 def test_a_finished_run_leaves_no_lock_and_its_chunks_compacted_into_one(make_scene, tmp_path):

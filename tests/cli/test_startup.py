@@ -6,7 +6,10 @@ import sys
 
 from ..conftest import PRESETS
 
-HEAVY = ("numpy", "numpy.ma", "pydantic", "scipy", "matplotlib", "rich", "textual", "importlib.metadata")
+HEAVY = ("numpy", "numpy.ma", "pydantic", "scipy", "matplotlib", "rich", "textual", "importlib.metadata", "dask",
+         "distributed", "pandas", "SurfaceTopography")
+# what no command of a line preset needs before its figure: none is on the path of validate or run --no-plot
+NOT_FOR_A_LINE = {"scipy", "matplotlib", "numpy.ma", "rich", "textual", "dask", "distributed", "pandas", "SurfaceTopography"}
 
 
 def imported_after(code: str) -> set[str]:
@@ -24,8 +27,14 @@ def test_help_imports_nothing_heavy():
 def test_a_line_run_without_plot_imports_neither_scipy_nor_matplotlib(tmp_path):
     quickstart = PRESETS / "quickstart.yaml"
     code = f"from frictionlab.cli import main\nmain(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet', '--no-plot'])"
-    assert imported_after(code) & {"scipy", "matplotlib", "numpy.ma"} == set()  # numpy.ma: np.percentile, np.unique
+    assert imported_after(code) & NOT_FOR_A_LINE == set()  # numpy.ma: np.percentile, np.unique
     assert (tmp_path / "o" / "summary.json").is_file() and not (tmp_path / "o" / "plot.png").exists()
+
+
+def test_validate_imports_only_what_validating_needs():
+    fig2 = PRESETS / "benad2012-fig2.yaml"
+    code = f"from frictionlab.cli import main\nassert main(['validate', {str(fig2)!r}]) == 0"
+    assert imported_after(code) & NOT_FOR_A_LINE == set()
 
 
 def test_the_figure_imports_matplotlib_only_when_drawn(tmp_path):

@@ -71,7 +71,7 @@ status = []
 real, sys.stderr = sys.stderr, Capture()
 def work():
     try:
-        status.append(run(scene, RunOptions(workers=2)).status)
+        status.append(run(scene, RunOptions(workers=2, executor="processes")).status)  # a pool, however short the run
     except Exception as exc:
         status.append(type(exc).__name__)
 worker = threading.Thread(target=work)
