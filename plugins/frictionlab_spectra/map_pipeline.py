@@ -42,9 +42,9 @@ class Region(BaseModel):
     def _ordered(self):
         for name, span in (("x", self.x), ("y", self.y)):
             if span is not None and not 0 <= span[0] < span[1] < math.inf:
-                raise ValueError(f"region.{name} = {list(span)}: needs 0 <= start < stop")
+                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: needs 0 <= start < stop")
             if span is not None and self.units == "pixels" and not all(float(v).is_integer() for v in span):
-                raise ValueError(f"region.{name} = {list(span)}: pixels are whole numbers")
+                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: pixels are whole numbers")
         return self
 
 
@@ -72,7 +72,7 @@ def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str)
         start, stop = (round(v / side) for v in span) if region.units == "length" else (int(v) for v in span)
         if stop > count or stop - start < 1:
             extent = f"{count} pixels" if region.units == "pixels" else f"{count * side:g} (the run's length unit)"
-            raise ValueError(f"{where}: region.{name} = {list(span)} ({region.units}) is not inside the map, "
+            raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] ({region.units}) is not inside the map, "
                              f"{extent} along {name}")  # fmt: skip
         bounds.append((start, stop))
     (x0, x1), (y0, y1) = bounds

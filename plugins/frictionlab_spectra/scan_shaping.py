@@ -66,7 +66,7 @@ def level(z: np.ndarray, mode: str) -> Levelling:
     for coefficient, basis in removed:
         out -= coefficient * basis
     if mode == "none":
-        out += mean
+        out = z.copy()  # bit for bit what the file holds
     rms_after = math.sqrt(float(np.mean((out - np.mean(out)) ** 2)))
     scale = variance if variance > 0 else math.inf
     return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
