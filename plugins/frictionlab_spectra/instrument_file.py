@@ -23,7 +23,7 @@ import numpy as np
 from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from .instrument_reader import channel_list, choose_reader, describe_failure, pick_channel
+from .instrument_reader import channel_list, check_declared_points, choose_reader, describe_failure, pick_channel
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
@@ -65,6 +65,7 @@ class ScanHeader:
 
     shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
     periodic: bool
+    pixel: tuple[float, ...] | None = None  # (dx, dy) of a map, in the file's unit, when the file says
 
 
 def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | None = None) -> ScanHeader | None:
@@ -77,9 +78,11 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             reader = _open_reader(fh, path, where)
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
+            sizes = chosen.physical_sizes
+            pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
-    return ScanHeader(shape[::-1], periodic) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+    return ScanHeader(shape[::-1], periodic, pixel) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
 
 
 def _by_name(fh):
@@ -146,6 +149,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         reader = _open_reader(fh, path, where)
         chosen, note = pick_channel(reader, channel, where)
+        if chosen.nb_grid_pts is not None:
+            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")

@@ -12,6 +12,7 @@ above ``XML_LIMIT`` is refused (a 0.4 MiB file can inflate to gigabytes of blank
 
 from __future__ import annotations
 
+import math
 import zipfile
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
@@ -81,6 +82,37 @@ def check_zip_members(fh, reader, where: str) -> None:
                 f"more than the {XML_LIMIT // 2**20} MiB an instrument file's description may take; refused unread "
                 "(a damaged or forged file)"
             )
+
+
+HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: the reader's, ours, levelled, resampled
+
+
+def room_to_read() -> tuple[int, str]:
+    """Bytes this process may still allocate, and what sets that: the memory the system has
+    available, or the room left under the process's address-space limit (``ulimit -v``)."""
+    import resource
+
+    import psutil
+
+    found = [(int(psutil.virtual_memory().available), "the memory the system has available")]
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        found.append((soft - psutil.Process().memory_info().vms, "the room left under this process's limit ulimit -v"))
+    return min(found)
+
+
+def check_declared_points(points: tuple[int, ...], where: str) -> None:
+    """Refuse, from the header alone, a file that declares more points than this process can
+    read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit."""
+    need = math.prod(points) * 8 * HEIGHT_COPIES
+    room, source = room_to_read()
+    if need > room:
+        shape = " x ".join(str(n) for n in points)
+        raise ValueError(
+            f"{where}: the file declares {shape} points (x by y); reading them takes about {need / 2**30:.3g} GiB, "
+            f"more than the {room / 2**30:.3g} GiB this process may use ({source}); crop the scan with the "
+            "instrument's software, or export a region of it"
+        )
 
 
 def describe_failure(reader, exc: BaseException, where: str) -> ValueError:

@@ -21,7 +21,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from .scan_shaping import cosine_resample, despike, level, levelling_warning
+from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 FileFormat = Literal["auto", "table", "instrument"]
@@ -62,6 +62,19 @@ class Downsample(BaseModel):
         return self
 
 
+def square_shape(shape: tuple[int, int], pixel: tuple[float, float] | None) -> tuple[int, int]:
+    """The (Ny, Nx) of a map of ``shape`` on pixels (dx, dy) once on square pixels (``shape_map``)."""
+    if pixel is None or not all(0 < p < math.inf for p in pixel) or _nearly_square(*pixel):
+        return shape
+    dx, dy = pixel
+    ny, nx = shape
+    return (resampled_points(ny, dy, dx), nx) if dy > dx else (ny, resampled_points(nx, dx, dy))
+
+
+def _nearly_square(dx: float, dy: float) -> bool:
+    return abs(dx - dy) <= PIXEL_TOLERANCE * max(dx, dy)
+
+
 def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
     ny, nx = z.shape
     bounds = []
@@ -100,7 +113,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     dx, dy = pixel
     if dx != dy:
         difference = abs(dx - dy) / max(dx, dy)
-        if difference <= PIXEL_TOLERANCE:
+        if _nearly_square(dx, dy):
             spacing = 0.5 * (dx + dy)
             done["pixels"] = f"{dx:.6g} x {dy:.6g} taken as square ({100 * difference:.3g} % apart, tolerance " \
                              f"{100 * PIXEL_TOLERANCE:g} %)"

@@ -47,7 +47,7 @@ from .equivalent_line import EquivalentLine
 from .instrument_file import (
     ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header, scan_not_periodic_advice,
 )
-from .map_pipeline import Downsample, FileFormat, Level, Region, shape_map
+from .map_pipeline import Downsample, FileFormat, Level, Region, shape_map, square_shape
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table, remove_mean
@@ -174,9 +174,10 @@ class SurfaceFile(SpectrumGenerator):
         file's metadata) and no crop or downsampling is asked: the memory estimate refuses a
         map too large before it is read."""
         header = self._header()
-        if header is None or self.params.region is not None or self.params.downsample is not None:
+        p = self.params
+        if header is None or p.region is not None or p.downsample is not None:
             return self._map().heights.shape
-        return header.shape
+        return header.shape if p.spacing is not None else square_shape(header.shape, header.pixel)
 
     def input_summary(self) -> dict[str, Any]:
         """The map as read: file, format, shape, pixel size, unit, rms height, and where each came from."""
