@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import runpy
+import struct
 import warnings
 import zipfile
 
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 import x3pio
 import yaml
+from scipy.io import netcdf_file
 from SurfaceTopography import Topography
 
 from frictionlab.cli import main
@@ -212,6 +214,54 @@ def test_an_x3p_declaring_more_points_than_fit_is_refused_from_its_header(tmp_pa
     assert "a test limit of 2 GiB" in err and "Traceback" not in err
 
 
+def forged_netcdf(path, n: int):
+    """A classic NetCDF (64-bit offsets) whose header declares an n x n map: a sparse file."""
+    with netcdf_file(str(path), "w", version=2) as nc:
+        nc.createDimension("x", 4)
+        nc.createDimension("y", 4)
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = np.ones((4, 4))
+        heights.unit = "um"
+        for axis in "xy":
+            var = nc.createVariable(axis, "d", (axis,))
+            var[:] = np.arange(4.0)
+            var.length, var.unit = 4.0, "um"
+    header = bytearray(open(path, "rb").read())
+    for name in (b"x", b"y"):  # the dimensions' lengths
+        at = header.index(b"\x00\x00\x00\x01" + name + b"\x00\x00\x00") + 8
+        header[at:at + 4] = struct.pack(">i", n)
+    first = struct.unpack(">q", header[header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80") + 8:][:8])[0]
+    begins = {b"\x80": first, b"\x20": None}
+    at = header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80")  # heights: vsize, begin
+    header[at + 4:at + 8] = struct.pack(">I", 0xFFFFFFFF)
+    offset = first + n * n * 8
+    for _ in range(2):  # x then y: vsize 32 -> 8 n, begin after the heights
+        at = header.index(b"\x00\x00\x00\x06\x00\x00\x00\x20")
+        header[at + 4:at + 8] = struct.pack(">I", 8 * n)
+        header[at + 8:at + 16] = struct.pack(">q", offset)
+        offset += 8 * n
+    with open(path, "r+b") as fh:
+        fh.write(header[:first])
+        fh.truncate(offset)  # sparse: nothing written but the header
+
+
+@pytest.mark.parametrize("solver", ["mdr", "bem-halfspace-free"])
+def test_a_netcdf_declaring_100000_squared_points_is_refused_from_its_header(tmp_path, capsys, solver):
+    """A sparse file of 80 GB: its header alone is read (SurfaceTopography's NetCDF reader maps the
+    file); the map is refused by what it declares, before a height is read."""
+    forged_netcdf(tmp_path / "huge.nc", 100_000)
+    if (tmp_path / "huge.nc").stat().st_blocks * 512 > 2**20:
+        pytest.skip("this file system does not keep files sparse")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({
+        "name": "huge", "seed": 1, "realizations": 1, "fit": {"bootstrap": 0},
+        "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "huge.nc")}},
+        "solver": {"name": solver}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3}}))  # fmt: skip
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    err = capsys.readouterr().err
+    assert code in (ExitCode.USAGE, ExitCode.RUNTIME_FAILURE) and "Traceback" not in err
+    assert "GiB" in err and ("declares 100000 x 100000 points" in err or "this run would need about" in err), err
+
+
 def test_a_damaged_file_of_a_known_format_is_named_as_such(tmp_path):
     tilted_x3p(tmp_path / "scan.x3p")
     data = (tmp_path / "scan.x3p").read_bytes()
@@ -221,8 +271,6 @@ def test_a_damaged_file_of_a_known_format_is_named_as_such(tmp_path):
 
 
 def netcdf(path, heights_unit: str, length_unit: str):
-    from scipy.io import netcdf_file
-
     z = rough_um(16)
     with netcdf_file(str(path), "w") as nc:
         nc.createDimension("x", 16)

@@ -17,6 +17,7 @@ import numpy as np
 from SurfaceTopography.IO.GWY import _gwy_write_object
 
 from frictionlab_spectra import PowerLawSurface
+from frictionlab_spectra.scan_shaping import cosine_resample
 
 NX, NY, DX_UM, DY_UM, RMS_NM = 160, 64, 0.1, 0.25, 20.0
 
@@ -25,8 +26,8 @@ def heights_nm(seed: int = 2026) -> np.ndarray:
     """z[row, column] = z[y, x] in nm: roughness on pixels of DX_UM, sampled every DY_UM along y."""
     surface = PowerLawSurface(hurst=0.8, points=NX, rms_height=RMS_NM, spacing=DX_UM * 1e3)
     z = surface.generate(np.random.default_rng(np.random.SeedSequence(seed))).heights  # square, NX x NX
-    rows = np.round(np.arange(NY) * DY_UM / DX_UM).astype(int)  # every 2.5th row of the square map
-    z = z[rows, :]
+    z = cosine_resample(z, 0, DX_UM, DY_UM)[:NY]  # the slow axis: rows every DY_UM, the tip's low-pass
+
     x_nm = np.arange(NX) * DX_UM * 1e3
     z = z + x_nm[None, :] / 200.0  # the sample's tilt
     z[30, 70:72] += 15 * RMS_NM  # a spike: dust on the sample

@@ -101,7 +101,8 @@ class SurfaceFile(SpectrumGenerator):
 
     name: ClassVar[str] = "surface-file"
     summary: ClassVar[str] = (
-        "Measured surface read from an instrument file (X3P, SUR, DATX...) or a .npy/.csv/.txt height map (Ny, Nx)"
+        "Measured surface read from an instrument file (X3P, SUR, DATX, GWY...) or a .npy/.csv/.txt height map "
+        "(Ny, Nx); levelled, cropped, resampled onto square pixels as asked"
     )
     references: ClassVar[tuple[str, ...]] = ()
     dimension: ClassVar[int] = 2
@@ -138,10 +139,14 @@ class SurfaceFile(SpectrumGenerator):
             "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
             "numbers), instrument (an instrument's file or export, such as an XYZ .csv, read by SurfaceTopography)",
         )
-        region: Region | None = Field(None, description="a crop of the map, in pixels or in the run's length unit")
+        region: Region | None = Field(
+            None, description="a crop, {x: [start, stop], y: [start, stop], units: pixels | length}: half-open spans "
+            "along the map's columns (x) and rows (y), in the file's pixels (default) or in the run's length unit from "
+            "the first pixel; a side left out is kept whole",
+        )
         downsample: Downsample | None = Field(
-            None, description="coarser pixels: an integer factor or a target pixel size; wavelengths shorter than two "
-            "new pixels are removed first (no aliasing)",
+            None, description="coarser pixels, {factor: N} (N >= 2 pixels) or {pixel: side} (in the run's length "
+            "unit): wavelengths shorter than two new pixels are removed first (no aliasing), longer ones kept whole",
         )
         despike: float | None = Field(
             None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 x 5 "
