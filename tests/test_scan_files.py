@@ -302,3 +302,23 @@ def test_an_escape_code_in_a_files_unit_or_channel_is_printed_escaped(tmp_path, 
     main(["validate", str(tmp_path / "p.yaml")])
     captured = capsys.readouterr()
     assert "\x1b" not in captured.out + captured.err and "\x07" not in captured.out + captured.err
+
+
+def test_a_profilometer_csv_export_goes_to_surfacetopography_when_asked(tmp_path):
+    """A Dektak-style export: a Latin-1 header ("\\xb5m"), then x, z: refused as a table with
+    the remedy, read as an instrument's export with format: instrument, levelled by its line."""
+    from frictionlab_spectra import ProfileFile
+
+    x = np.arange(200) * 0.05
+    z = 0.1 * np.sin(3 * x) + 0.02 * x
+    header = "Meta Data\nScan Length,10 \xb5m\n\nScan Data\nLateral(\xb5m),Total Profile(\xb5m)\n".encode("latin-1")
+    (tmp_path / "dektak.csv").write_bytes(header + "".join(f"{a:.4f},{b:.6f}\n" for a, b in zip(x, z)).encode())
+    with pytest.raises(ValueError, match="not UTF-8 at line 2.*read with format: instrument"):
+        ProfileFile(path=str(tmp_path / "dektak.csv"), spacing=0.05).generate(None)
+    line = ProfileFile(path=str(tmp_path / "dektak.csv"), format="instrument", unit="um")
+    made = line.generate(None)
+    assert made.heights.size == 200 and made.spacing == pytest.approx(0.05, rel=1e-9)
+    t = x - x.mean()
+    expected = z - z.mean() - (t @ (z - z.mean()) / (t @ t)) * t
+    np.testing.assert_allclose(made.heights, expected, atol=1e-6)
+    assert line.input_summary()["detrend"] == "tilt" and line.input_summary()["detrend_from"] == "default"

@@ -201,7 +201,8 @@ def test_bad_maps_are_named_with_what_is_wrong(tmp_path):
     (tmp_path / "map.xyz").write_text("1 2\n3 4\n")  # an instrument's text line scan (x, z)
     assert "holds a line scan; use profile-file" in surface_error(tmp_path / "map.xyz")
     (tmp_path / "noise.sur").write_bytes(bytes(range(256)) * 4)
-    assert "not an instrument file SurfaceTopography reads" in surface_error(tmp_path / "noise.sur")
+    assert "suffix .sur names Digital Surf SUR, but its first bytes are not that format's: a damaged file" in \
+        surface_error(tmp_path / "noise.sur")  # a damaged file of a known format, named as one
 
 
 def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys):

@@ -35,6 +35,10 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     chosen = next((r for r in matches if r in by_suffix), matches[0] if matches else None)
     if chosen is None:
         chosen = next((r for r in by_suffix if r.can_read(head) != MagicMatch.NO), None)
+    if chosen is None and by_suffix:
+        names = " or ".join(dict.fromkeys(reader.name() for reader in by_suffix))
+        raise ValueError(f"{where}: its suffix .{path_suffix} names {names}, but its first bytes are not that "
+                         "format's: a damaged file, or another format under that suffix; copy or export it again")
     if chosen is None:
         told = f"its suffix .{path_suffix}" if path_suffix else "its name (no suffix)"
         raise ValueError(
@@ -53,13 +57,10 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
 
 
 def _looks_like_text(head: bytes) -> bool:
-    if b"\0" in head:
-        return False
-    try:
-        head.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        return exc.start >= len(head) - 3  # a character cut by the end of the buffer
-    return True
+    """No NUL and hardly any control byte: text in any 8-bit encoding (an export's header in
+    Latin-1, its "\xb5m") is text; a binary header is not."""
+    control = sum(1 for byte in head if byte < 32 and byte not in b"\t\n\r\f")
+    return b"\0" not in head and control <= len(head) // 100
 
 
 def check_zip_members(fh, reader, where: str) -> None:

@@ -316,7 +316,8 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
         lines = raw.decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
-        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line})") from None
+        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line}); an instrument's export (a "
+                         "profilometer's .csv) is read with format: instrument") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()
