@@ -26,7 +26,7 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -87,7 +87,7 @@ class ProfileFile(SpectrumGenerator):
             None, description="remove nothing, the mean, or the least-squares line (tilt) before use; default: tilt "
             "for an instrument file (a scan is rarely level), mean for a table",
         )
-        channel: str | int | None = Field(
+        channel: str | Annotated[int, Field(ge=0)] | None = Field(
             None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
             "file's default channel",
         )

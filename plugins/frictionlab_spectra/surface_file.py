@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -131,7 +131,7 @@ class SurfaceFile(SpectrumGenerator):
             description="remove nothing, the mean, the least-squares plane or quadratic before use; default: plane "
             "for an instrument file (a scan is rarely level), mean for a table",
         )
-        channel: str | int | None = Field(
+        channel: str | Annotated[int, Field(ge=0)] | None = Field(
             None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
             "file's default channel (validate lists them when there are several)",
         )
