@@ -322,3 +322,18 @@ def test_a_profilometer_csv_export_goes_to_surfacetopography_when_asked(tmp_path
     expected = z - z.mean() - (t @ (z - z.mean()) / (t @ t)) * t
     np.testing.assert_allclose(made.heights, expected, atol=1e-6)
     assert line.input_summary()["detrend"] == "tilt" and line.input_summary()["detrend_from"] == "default"
+
+
+def test_a_tilt_left_in_is_a_caveat_of_the_run_and_of_its_summary(tmp_path):
+    import frictionlab
+
+    tilted_x3p(tmp_path / "t.x3p")
+    surface = SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um", detrend="mean")
+    result = frictionlab.run(law_preset(tmp_path / "t.x3p", "mdr", surface, unit="um", detrend="mean"),
+                             out=tmp_path / "run", workers=1, progress=False, plot=False)  # fmt: skip
+    assert any(caveat.startswith("a tilt carries") for caveat in result.caveats)
+    stored = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert stored["caveats"] == result.caveats and stored["input"]["caveats"][0] in result.caveats
+    levelled = frictionlab.run(law_preset(tmp_path / "t.x3p", "mdr", SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um"),
+                                          unit="um"), out=tmp_path / "level", workers=1, progress=False, plot=False)  # fmt: skip
+    assert not any("tilt" in caveat for caveat in levelled.caveats)
