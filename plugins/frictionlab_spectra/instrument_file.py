@@ -188,9 +188,15 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
     factor = 1.0 if unit is None or file_unit is None else length_factor(file_unit, unit, where, "the file's unit")
     sides = tuple(check_spacing(where, "pixels of", float(p) * factor, unit or file_unit) for p in pixel)
-    z = np.array(np.ma.getdata(heights), dtype=np.float64) * factor
+    data = np.ma.getdata(heights)
+    # one copy, in C order as a .npy map (the same sums), scaled in place
+    z = np.ascontiguousarray(data.T if dimension == 2 else data, dtype=np.float64)
+    if z is data or (dimension == 2 and np.shares_memory(z, data)):
+        z = z.copy()
+    if factor != 1.0:
+        z *= factor
     return Scan(
-        heights=np.ascontiguousarray(z.T) if dimension == 2 else z,  # C order, as a .npy map: the same sums
+        heights=z,
         pixel=sides,
         unit=unit if unit is not None else file_unit,
         file_unit=file_unit,

@@ -60,14 +60,16 @@ def level(z: np.ndarray, mode: str) -> Levelling:
     if ny > 2:
         curved.append((rows @ y2 / (nx * (y2 @ y2)), y2[:, None]))
     size = float(z.size)
-    variance = float(np.mean(out * out))
+    variance = float(np.vdot(out, out)) / size  # no temporary the size of the map
     share = [sum(c * c * float(np.sum(b * b)) * size / b.size for c, b in terms) / size for terms in (plane, curved)]
     removed = plane if mode == "plane" else plane + curved if mode == "quadratic" else []
     for coefficient, basis in removed:
         out -= coefficient * basis
     if mode == "none":
         out = z.copy()  # bit for bit what the file holds
-    rms_after = math.sqrt(float(np.mean((out - np.mean(out)) ** 2)))
+        rms_after = float(np.std(out))
+    else:  # every term removed is orthogonal to the constant: the mean stays zero
+        rms_after = math.sqrt(float(np.vdot(out, out)) / size)
     scale = variance if variance > 0 else math.inf
     return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
 

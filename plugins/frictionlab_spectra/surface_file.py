@@ -299,5 +299,5 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         ny, nx = data.shape
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic}
-    return data.astype(np.float64), (float(pixel[0]), float(pixel[1])), summary
+    return data.astype(np.float64, copy=False), (float(pixel[0]), float(pixel[1])), summary
 
