@@ -1,7 +1,7 @@
 """A measured surface as a spectrum generator: ``surface-file``, and its MDR-equivalent line.
 
-The file holds a height map z[row, column] of shape (Ny, Nx) on square pixels (an AFM,
-profilometer or interferometer topography):
+The file holds a height map z[row, column] of shape (Ny, Nx) (an AFM, profilometer or
+interferometer topography; printed x by y, Nx x Ny, as instruments give it):
 
 - ``.npy``: a 2D array of real numbers;
 - ``.csv`` / ``.txt``: a matrix of numbers, one row of the map per line, separated by
@@ -16,8 +16,10 @@ which were used.
 
 A measured map is not periodic (``periodic`` unset: as an instrument file says, else
 false): its opposite edges do not meet, so slopes are not taken across them and solvers of
-periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane. ``detrend="plane"`` removes the
-least-squares plane a + b x + c y (a scan that was not levelled).
+periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane.
+Between the file and the solver the map is cropped, levelled (``detrend``: the least-squares
+plane by default for an instrument file), despiked on request, put on square pixels and
+downsampled on request (``map_pipeline.py``); the input summary records each step.
 
 Solvers of lines (``mdr``, ``mdr-bisection``) get ``equivalent_line()``: the surface's
 ``mdr-equivalent-line`` (``equivalent_line.py``) from the map's own modes (one FFT of the
