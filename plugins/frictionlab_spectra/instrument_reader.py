@@ -91,11 +91,13 @@ HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: t
 def room_to_read() -> tuple[int, str]:
     """Bytes this process may still allocate, and what sets that: the memory the system has
     available, or the room left under the process's address-space limit (``ulimit -v``)."""
-    import resource
-
     import psutil
 
     found = [(int(psutil.virtual_memory().available), "the memory the system has available")]
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return min(found)
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
         found.append((soft - psutil.Process().memory_info().vms, "the room left under this process's limit ulimit -v"))
