@@ -71,6 +71,7 @@ class RunOutcome:
     compute_seconds: float = 0.0  # summed over the finished realizations, restored ones included
     real_area_corrected: np.ndarray | None = None  # ensemble mean; None when the solver does not correct its area
     extra: dict = field(default_factory=dict)
+    input_caveats: tuple[str, ...] = ()  # what the spectrum's input_summary says of the file it read (a tilt left in)
 
     @property
     def done(self) -> int:
@@ -84,7 +85,7 @@ class RunOutcome:
         without xi at some load (averaged over fewer lines there)."""
         if self.fit is None or not self.contact_count.size:
             return []
-        caveats = []
+        caveats = list(self.input_caveats)
         if self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
             caveats.append(few_contacts_caveat(float(self.contact_count[0])))
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
@@ -238,6 +239,7 @@ class Accumulator:
             elapsed=elapsed,
             workers=workers,
             error=error,
+            input_caveats=tuple((scene.spectrum.input_summary() or {}).get("caveats", ())),
             compute_seconds=float(sum(self.results[i].seconds for i in indices)),
             real_area_corrected=(per["real_area_corrected"].mean(axis=0) if n else nan_row)
             if scene.solver.corrected_area else None,

@@ -23,6 +23,8 @@ from typing import Annotated
 
 from pydantic import AfterValidator
 
+from .errors import shown
+
 
 class InputFileProblem(ValueError):
     """A file that cannot be read as input; the message names the file, not its content."""
@@ -157,22 +159,56 @@ def is_relative(value) -> bool:
 
 
 def describe_input(summary: dict) -> str:
-    """One line on a spectrum's ``input_summary()``: shape, pixel size, unit and rms height,
-    and where the pixel size and the unit came from."""
-    unit = summary.get("unit")
+    """One line on a spectrum's ``input_summary()``: shape (x by y, as instruments and
+    Gwyddion give it), pixel size, unit and rms height, where the pixel size and the unit
+    came from, and what was done to the scan (levelling, crop, resampling, spikes). Every
+    string from the file is escaped (``errors.shown``)."""
+    unit = shown(summary.get("unit") or "")
     length = f" {unit}" if unit else ""
-    shape = " x ".join(str(n) for n in summary["shape"])
+    shape = " x ".join(str(n) for n in summary["shape"][::-1])  # (Ny, Nx) stored: x first
     kind = "points" if len(summary["shape"]) == 1 else "pixels"
     spacing_from = summary.get("spacing_from")
     converted = summary.get("file_unit")
-    unit_note = f", converted from the file's {converted}" if converted and unit and converted != unit else ""
+    unit_note = f", converted from the file's {shown(converted)}" if converted and unit and converted != unit else ""
     if "file_unit" in summary and converted is None and unit:  # an instrument file that states no unit
         unit_note = f", the file states no unit: its numbers taken as {unit}"
+    channel = summary.get("channel")
+    notes = [f"channel {summary.get('channel_index', '?')} {shown(channel)!r}"] if channel is not None else []
+    if summary.get("region_pixels"):
+        (x0, x1), (y0, y1) = summary["region_pixels"]
+        notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")
+    if summary.get("pixels"):
+        notes.append(f"pixels {summary['pixels']}")
+    if summary.get("downsampled"):
+        down = summary["downsampled"]
+        notes.append(f"downsampled from pixels of {down['from_pixel']:.6g} to {down['to_pixel']:.6g}{length}")
+    if summary.get("despiked"):
+        notes.append(f"despike {summary['despiked']['k']:g} rms: {summary['despiked']['points']} points replaced")
+    if "detrend" in summary:
+        notes.append(f"detrend {summary['detrend']} ({summary.get('detrend_from', 'preset')}) removed "
+                     f"{100 * summary['rms_removed_fraction']:.1f} % of the rms height "
+                     f"({summary['rms_before_detrend']:.4g}{length} before)")
     return (
-        f"{Path(summary['file']).name} ({summary.get('format', '?')}): {shape} {kind} of {summary['spacing']:.6g}"
+        f"{shown(Path(summary['file']).name)} ({shown(summary.get('format', '?'))}): {shape} {kind}"
+        + (" (x by y)" if kind == "pixels" else "") + f" of {summary['spacing']:.6g}"
         f"{length}{f' (from the {spacing_from})' if spacing_from else ''}, rms height {summary['rms_height']:.6g}"
         f"{length}{unit_note}" + ("" if unit else ", no unit (bare numbers)")
         + (", periodic" if summary.get("periodic") else ", not periodic")
         + (f", {summary['undefined_points']} undefined points filled ({summary['filled_by']})"
            if summary.get("filled_by") else "")
+        + "".join(f"; {note}" for note in notes)
     )  # fmt: skip
+
+
+def describe_channels(summary: dict) -> list[str]:
+    """One line per channel of a file with several (index, name, points x by y, units), and
+    which one was taken when several share its name; escaped (``errors.shown``)."""
+    lines = []
+    for channel in summary.get("channels") or ():
+        points = " x ".join(map(str, channel["points"])) if channel.get("points") else "?"
+        units = f"lengths in {shown(channel['unit'] or '?')}, values in {shown(channel['data_unit'] or '?')}"
+        taken = " (taken)" if channel["index"] == summary.get("channel_index") else ""
+        lines.append(f"channel {channel['index']}: {shown(channel['name'])!r}, {points} points, {units}{taken}")
+    if summary.get("channel_note"):
+        lines.append(shown(summary["channel_note"]))
+    return lines

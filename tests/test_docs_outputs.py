@@ -112,3 +112,37 @@ def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, mo
     exact = ["--set", "solver.name=bem-halfspace-free", "--set", "realizations=1"]
     assert main(["run", preset, *exact, "--out", "runs/scan-exact", "--workers", "1", "--quiet"]) == 0
     _check(page, "scan: 1/1", capsys.readouterr().out)
+
+
+def test_the_scan_as_the_microscope_leaves_it_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
+    """docs/tutorials/instrument-file.md, its second half: the AFM file written by the
+    example's script (tilt, holes, a spike, 2.5:1 pixels, four channels), refused, validated,
+    run with and without each default, exactly as the page shows."""
+    import runpy
+    import shutil
+
+    page, folder = "docs/tutorials/instrument-file.md", tmp_path / "examples" / "instrument-scan"
+    shutil.copytree(ROOT / "examples" / "instrument-scan", folder)
+    monkeypatch.chdir(tmp_path)
+    runpy.run_path(str(folder / "make_afm_scan.py"))["main"](folder)
+    preset, filled = "examples/instrument-scan/afm.yaml", ["--set", "spectrum.params.undefined=harmonic"]
+    despiked = [*filled, "--set", "spectrum.params.despike=6"]
+    assert main(["validate", preset]) == 2
+    captured = capsys.readouterr()
+    _check(page, "$ python examples/instrument-scan/make_afm_scan.py",
+           (captured.out + captured.err).replace(str(tmp_path), "/home/me"))  # fmt: skip
+    assert main(["validate", preset, *filled]) == 0
+    _check(page, "$ frictionlab validate examples/instrument-scan/afm.yaml --set spectrum.params.undefined=harmonic\n"
+           .strip(), capsys.readouterr().out)  # fmt: skip
+    runs = {
+        "afm-mdr": filled, "afm-despiked": despiked, "afm-mean": [*despiked, "--set", "spectrum.params.detrend=mean"],
+        "afm-exact": [*despiked, "--set", "solver.name=bem-halfspace-free", "--set", "realizations=1"],
+    }  # fmt: skip
+    for out, extra in runs.items():
+        assert main(["run", preset, *extra, "--out", f"runs/{out}", "--workers", "1", "--quiet", "--no-plot"]) == 0
+        shown = f"$ frictionlab run {preset} {' '.join(extra)} --out runs/{out}"
+        _check(page, shown, capsys.readouterr().out)
+    region = ["--set", "spectrum.params.region={x: [0, 80], y: [0, 32]}", "--set", "spectrum.params.downsample={factor: 2}"]
+    assert main(["validate", preset, *filled, *region]) == 0
+    _check(page, f"$ frictionlab validate {preset} {' '.join(filled)} --set 'spectrum.params.region=",
+           capsys.readouterr().out)  # fmt: skip

@@ -197,11 +197,12 @@ def test_bad_maps_are_named_with_what_is_wrong(tmp_path):
     np.save(tmp_path / "plane.npy", 1.0 + 0.2 * rows - 0.1 * cols)
     assert "constant" in surface_error(tmp_path / "plane.npy", detrend="plane")
     np.save(tmp_path / "small.npy", np.random.default_rng(1).standard_normal((7, 40)))
-    assert "7 x 40" in surface_error(tmp_path / "small.npy") and "8 x 8" in surface_error(tmp_path / "small.npy")
-    (tmp_path / "map.dat").write_text("1 2\n3 4\n")  # an instrument's text line scan (x, z)
-    assert "holds a line scan; use profile-file" in surface_error(tmp_path / "map.dat")
+    assert "40 x 7 pixels (x by y)" in surface_error(tmp_path / "small.npy") and "8 x 8" in surface_error(tmp_path / "small.npy")
+    (tmp_path / "map.xyz").write_text("1 2\n3 4\n")  # an instrument's text line scan (x, z)
+    assert "holds a line scan; use profile-file" in surface_error(tmp_path / "map.xyz")
     (tmp_path / "noise.sur").write_bytes(bytes(range(256)) * 4)
-    assert "not an instrument file SurfaceTopography reads" in surface_error(tmp_path / "noise.sur")
+    assert "suffix .sur names Digital Surf SUR, but its first bytes are not that format's: a damaged file" in \
+        surface_error(tmp_path / "noise.sur")  # a damaged file of a known format, named as one
 
 
 def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys):

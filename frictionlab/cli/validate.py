@@ -22,7 +22,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..api import scene_record
-    from ..inputs import describe_input
+    from ..inputs import describe_channels, describe_input
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..runner import check_one_realization
@@ -56,6 +56,10 @@ def run(args) -> ExitCode:
             ))
             if record["input"] is not None:  # its unit, as the instrument file wrote it
                 print(shown(f"  read {describe_input(record['input'])}"))
+                for line in describe_channels(record["input"]):
+                    print(shown(f"    {line}"))
+                for caveat in record["input"].get("caveats", ()):
+                    print(f"  caveat: {shown(caveat)}")
     if args.json:
         from .jsonout import emit
 

@@ -23,32 +23,39 @@ import numpy as np
 from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
+from .instrument_reader import channel_list, check_declared_points, choose_reader, describe_failure, pick_channel
+
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
 # the units a preset may ask for, in metres
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
 Unit = Literal["m", "mm", "um", "nm", "pm"]
 Undefined = Literal["refuse", "harmonic"]
-SQUARE_TOLERANCE = 1e-6  # relative difference of a pixel's two sides still taken as square
 
 
 @dataclass(frozen=True)
 class Scan:
-    """What an instrument file gave: heights and pixel size in ``unit`` (the preset's, or the
+    """What an instrument file gave: heights and pixel sides in ``unit`` (the preset's, or the
     file's own when the preset names none)."""
 
     heights: np.ndarray  # float64, (Ny, Nx) for a map, (N,) for a line
-    spacing: float
+    pixel: tuple[float, ...]  # (dx, dy) for a map, (dx,) for a line
     unit: str | None
     file_unit: str | None  # as the file says it (SurfaceTopography's spelling)
     periodic: bool
     format: str
     channel: str
+    channel_index: int
+    channel_note: str | None  # which of several channels of one name was taken
+    channels: list  # every channel of the file (index, name, points, units) when it has more than one
     undefined: int  # points the file leaves undefined (filled when the preset says how)
 
 
-def is_instrument_file(path: Path) -> bool:
-    """Whether ``path`` is not one of frictionlab's own tables (.npy, .csv, .txt)."""
+def is_instrument_file(path: Path, format: str = "auto") -> bool:
+    """Whether ``path`` goes to SurfaceTopography: ``format`` instrument, or auto and not one
+    of frictionlab's own tables (.npy, .csv, .txt)."""
+    if format != "auto":
+        return format == "instrument"
     return path.suffix.lower() not in TABLE_SUFFIXES
 
 
@@ -58,21 +65,24 @@ class ScanHeader:
 
     shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
     periodic: bool
+    pixel: tuple[float, ...] | None = None  # (dx, dy) of a map, in the file's unit, when the file says
 
 
-def scan_header(path: Path, where: str, *, dimension: int) -> ScanHeader | None:
+def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | None = None) -> ScanHeader | None:
     """The shape and periodicity ``read_scan`` gives, from the reader's metadata alone: what
     the memory estimate needs before a run reads the file. None when the metadata does not
     say, or says another dimension (``read_scan`` then reads the file and names the problem)."""
-    open_topography = _reader_opener(path, where)
     with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            channel = open_topography(_by_name(fh)).default_channel
-            shape, periodic = tuple(int(n) for n in channel.nb_grid_pts), bool(channel.is_periodic)
+            reader = _open_reader(fh, path, where)
+            chosen, _ = pick_channel(reader, channel, where)
+            shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
+            sizes = chosen.physical_sizes
+            pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
-    return ScanHeader(shape[::-1], periodic) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+    return ScanHeader(shape[::-1], periodic, pixel) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
 
 
 def _by_name(fh):
@@ -83,17 +93,29 @@ def _by_name(fh):
     return name if os.path.exists(name) else fh
 
 
-def _reader_opener(path: Path, where: str):
-    """SurfaceTopography's ``open_topography``, or a ValueError naming the extra to install."""
+def _open_reader(fh, path: Path, where: str):
+    """The reader chosen for the file (``instrument_reader.choose_reader``), opened: its
+    metadata parsed, its heights not read. ValueError naming ``where`` if it cannot be."""
+    _require_extra(path, where)
+    from SurfaceTopography.IO import open_topography
+
+    reader_class = choose_reader(fh, path.suffix.lower().lstrip("."), where)
     try:
-        from SurfaceTopography import open_topography
+        return open_topography(_by_name(fh), format=reader_class.format())
+    except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
+        raise describe_failure(reader_class, exc, where) from None
+
+
+def _require_extra(path: Path, where: str) -> None:
+    """A ValueError naming the extra to install when SurfaceTopography is missing."""
+    try:
+        import SurfaceTopography.IO  # noqa: F401
     except ImportError:
         raise ValueError(
-            f"{where}: {path.suffix or 'a file without suffix'} is not a .npy, .csv or .txt table; instrument "
+            f"{where}: {path.suffix or 'a file without suffix'} is read as an instrument file; instrument "
             f"files (X3P, SUR, DATX, OPD, IBW, NetCDF...) are read by the optional extra topography: "
             f"{TOPOGRAPHY_EXTRA}"
         ) from None
-    return open_topography
 
 
 def open_input(path: Path, where: str):
@@ -104,24 +126,45 @@ def open_input(path: Path, where: str):
         raise ValueError(f"{where}: {exc}") from None
 
 
-def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str) -> Scan:
-    """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and spacing
-    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
-    open_topography = _reader_opener(path, where)
+def length_factor(unit: str | None, to: str, where: str, what: str) -> float:
+    """The factor from ``unit`` (SurfaceTopography's spelling) to ``to``; ValueError naming
+    ``what`` when ``unit`` is not a length."""
     from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
 
+    try:
+        factor = float(get_unit_conversion_factor(unit, to))
+    except Exception:  # noqa: BLE001 - any unit it does not know
+        factor = math.nan
+    if not (math.isfinite(factor) and factor > 0):
+        raise ValueError(f"{where}: {what} {unit!r} is not a length unit (m, mm, um, nm, pm, ...); "
+                         "choose a channel of heights, or convert the file")  # fmt: skip
+    return factor
+
+
+def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str,
+              channel: str | int | None = None) -> Scan:  # fmt: skip
+    """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and pixel sides
+    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
     with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
+        reader = _open_reader(fh, path, where)
+        chosen, note = pick_channel(reader, channel, where)
+        if chosen.nb_grid_pts is not None:
+            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
+        file_unit = chosen.unit if isinstance(chosen.unit, str) else None
+        if file_unit is not None:
+            length_factor(file_unit, "m", where, "the file's length unit")
         try:
-            reader = open_topography(fh)
-            channel = reader.default_channel
-            topography = reader.topography(channel_index=channel.index)
+            data_unit = chosen.data_unit
+        except Exception:  # noqa: BLE001 - a reader that cannot say
+            data_unit = None
+        if isinstance(data_unit, str) and data_unit != file_unit:
+            length_factor(data_unit, "m", where, f"channel {chosen.index}'s values are in")
+        try:
+            topography = reader.topography(channel_index=chosen.index)
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
-            raise ValueError(
-                f"{where}: not an instrument file SurfaceTopography reads ({type(exc).__name__}); "
-                "use an instrument format it lists, or a .npy, .csv or .txt table with spacing"
-            ) from None
+            raise describe_failure(type(reader), exc, where) from None
         if topography.dim != dimension:
             kind = {1: "a line scan", 2: "a 2D map"}
             advice = "use surface-file" if topography.dim == 2 else "use profile-file"
@@ -139,28 +182,30 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         periodic = bool(topography.is_periodic)
+        listed = channel_list(reader) if len(reader.channels) > 1 else []
     shown = " x ".join(f"{p:g}" for p in pixel)
     if not np.all(pixel > 0):  # NaN too
         raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
-    if not math.isclose(pixel.min(), pixel.max(), rel_tol=SQUARE_TOLERANCE):
-        raise ValueError(f"{where}: pixels of {shown}; square pixels are needed")
-    file_unit = topography.unit if isinstance(topography.unit, str) else None
-    factor = 1.0
-    if unit is not None and file_unit is not None:
-        try:
-            factor = float(get_unit_conversion_factor(file_unit, unit))
-        except Exception:
-            raise ValueError(f"{where}: the file's unit {file_unit!r} is not a length unit") from None
-    spacing = check_spacing(where, "pixels of", float(pixel.mean()) * factor, unit or file_unit)
-    z = np.array(np.ma.getdata(heights), dtype=np.float64) * factor
+    factor = 1.0 if unit is None or file_unit is None else length_factor(file_unit, unit, where, "the file's unit")
+    sides = tuple(check_spacing(where, "pixels of", float(p) * factor, unit or file_unit) for p in pixel)
+    data = np.ma.getdata(heights)
+    # one copy, in C order as a .npy map (the same sums), scaled in place
+    z = np.ascontiguousarray(data.T if dimension == 2 else data, dtype=np.float64)
+    if z is data or (dimension == 2 and np.shares_memory(z, data)):
+        z = z.copy()
+    if factor != 1.0:
+        z *= factor
     return Scan(
-        heights=np.ascontiguousarray(z.T) if dimension == 2 else z,  # C order, as a .npy map: the same sums
-        spacing=spacing,
+        heights=z,
+        pixel=sides,
         unit=unit if unit is not None else file_unit,
         file_unit=file_unit,
         periodic=periodic,
         format=str(reader.name()),
-        channel=str(channel.name),
+        channel=str(chosen.name),
+        channel_index=int(chosen.index),
+        channel_note=note,
+        channels=listed,
         undefined=missing,
     )
 

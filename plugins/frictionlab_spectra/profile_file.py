@@ -26,7 +26,7 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -83,8 +83,18 @@ class ProfileFile(SpectrumGenerator):
             description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
             "from their neighbours (harmonic)",
         )
-        detrend: Literal["none", "mean", "tilt"] = Field(
-            "mean", description="remove nothing, the mean, or the least-squares line (tilt) before use"
+        detrend: Literal["none", "mean", "tilt"] | None = Field(
+            None, description="remove nothing, the mean, or the least-squares line (tilt) before use; default: tilt "
+            "for an instrument file (a scan is rarely level), mean for a table",
+        )
+        channel: str | Annotated[int, Field(ge=0)] | None = Field(
+            None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
+            "file's default channel",
+        )
+        format: Literal["auto", "table", "instrument"] = Field(
+            "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
+            "numbers), instrument (an instrument's file or export, such as a profilometer's .csv, read by "
+            "SurfaceTopography)",
         )
         periodic: bool | None = Field(
             None,
@@ -100,7 +110,7 @@ class ProfileFile(SpectrumGenerator):
         return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=line.periodic)
 
     def periodic(self) -> bool:
-        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path)):
+        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path), self.params.format):
             return bool(self.params.periodic)  # known without reading the file
         header = self._header()
         return header.periodic if header is not None else self._line().periodic
@@ -131,8 +141,8 @@ class ProfileFile(SpectrumGenerator):
         None for a text table, or a header that does not describe a valid line."""
         path = Path(self.params.path)
         where = f"profile-file {str(path)!r}"
-        if is_instrument_file(path):
-            header = scan_header(path, where, dimension=1)
+        if is_instrument_file(path, self.params.format):
+            header = scan_header(path, where, dimension=1, channel=self.params.channel)
         elif file_suffix(path, where) == ".npy" and (shape := npy_shape(path, where)) is not None:
             points = _npy_line_points(shape)
             header = None if points is None else ScanHeader((points,), bool(self.params.periodic))
@@ -145,11 +155,15 @@ class ProfileFile(SpectrumGenerator):
         p = self.params
         path = Path(p.path)
         where = f"profile-file {str(path)!r}"
-        if is_instrument_file(path):
-            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined)
+        instrument = is_instrument_file(path, p.format)
+        if instrument:
+            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined, channel=p.channel)
             x, z = None, scan.heights
             summary = {
-                "format": scan.format, "channel": scan.channel, "file_spacing": scan.spacing,
+                "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
+                **({"channel_note": scan.channel_note} if scan.channel_note else {}),
+                **({"channels": scan.channels} if scan.channels else {}),
+                "file_spacing": scan.pixel[0],
                 "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
                 "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
                 "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
@@ -168,9 +182,9 @@ class ProfileFile(SpectrumGenerator):
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         check_finite(where, "heights", z)
         if x is None:
-            if p.spacing is None and not is_instrument_file(path):
+            if p.spacing is None and not instrument:
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
-            dx = scan.spacing if p.spacing is None else p.spacing
+            dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
             dx = check_spacing(where, "x spaced by", _uniform_spacing(where, x), p.unit)
@@ -181,16 +195,20 @@ class ProfileFile(SpectrumGenerator):
                         f"of the file's x column ({dx!r}); drop the parameter or fix the file"
                     )
                 dx = p.spacing
-        heights = _detrend(z, p.detrend)
+        mode = p.detrend if p.detrend is not None else "tilt" if instrument else "mean"
+        heights = _detrend(z, mode)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
         if not rms > 1e-12 * scale:  # also true for scale == 0
             raise ValueError(
-                f"{where}: the profile is constant (rms height zero after detrend={p.detrend!r}); "
+                f"{where}: the profile is constant (rms height zero after detrend={mode!r}); "
                 "a flat line has no roughness"
             )
         heights.flags.writeable = False
+        rms_before = float(np.std(z))
         summary = {"file": str(path), **summary, "shape": [int(z.size)], "spacing": float(dx), "periodic": periodic,
+                   "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
+                   "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
         return _Line(heights, float(dx), rms, periodic, summary)
 
@@ -298,7 +316,8 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
         lines = raw.decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
-        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line})") from None
+        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line}); an instrument's export (a "
+                         "profilometer's .csv) is read with format: instrument") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()

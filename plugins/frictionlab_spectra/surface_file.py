@@ -1,7 +1,7 @@
 """A measured surface as a spectrum generator: ``surface-file``, and its MDR-equivalent line.
 
-The file holds a height map z[row, column] of shape (Ny, Nx) on square pixels (an AFM,
-profilometer or interferometer topography):
+The file holds a height map z[row, column] of shape (Ny, Nx) (an AFM, profilometer or
+interferometer topography; printed x by y, Nx x Ny, as instruments give it):
 
 - ``.npy``: a 2D array of real numbers;
 - ``.csv`` / ``.txt``: a matrix of numbers, one row of the map per line, separated by
@@ -16,8 +16,10 @@ which were used.
 
 A measured map is not periodic (``periodic`` unset: as an instrument file says, else
 false): its opposite edges do not meet, so slopes are not taken across them and solvers of
-periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane. ``detrend="plane"`` removes the
-least-squares plane a + b x + c y (a scan that was not levelled).
+periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane.
+Between the file and the solver the map is cropped, levelled (``detrend``: the least-squares
+plane by default for an instrument file), despiked on request, put on square pixels and
+downsampled on request (``map_pipeline.py``); the input summary records each step.
 
 Solvers of lines (``mdr``, ``mdr-bisection``) get ``equivalent_line()``: the surface's
 ``mdr-equivalent-line`` (``equivalent_line.py``) from the map's own modes (one FFT of the
@@ -36,7 +38,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
@@ -47,6 +49,7 @@ from .equivalent_line import EquivalentLine
 from .instrument_file import (
     ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header, scan_not_periodic_advice,
 )
+from .map_pipeline import Downsample, FileFormat, Level, Region, shape_map, square_shape
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table, remove_mean
@@ -100,7 +103,8 @@ class SurfaceFile(SpectrumGenerator):
 
     name: ClassVar[str] = "surface-file"
     summary: ClassVar[str] = (
-        "Measured surface read from an instrument file (X3P, SUR, DATX...) or a .npy/.csv/.txt height map (Ny, Nx)"
+        "Measured surface read from an instrument file (X3P, SUR, DATX, GWY...) or a .npy/.csv/.txt height map "
+        "(Ny, Nx); levelled, cropped, resampled onto square pixels as asked"
     )
     references: ClassVar[tuple[str, ...]] = ()
     dimension: ClassVar[int] = 2
@@ -124,8 +128,31 @@ class SurfaceFile(SpectrumGenerator):
             description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
             "from their neighbours (harmonic: the solution of Laplace's equation)",
         )
-        detrend: Literal["none", "mean", "plane"] = Field(
-            "mean", description="remove nothing, the mean, or the least-squares plane before use"
+        detrend: Level | None = Field(
+            None,
+            description="remove nothing, the mean, the least-squares plane or quadratic before use; default: plane "
+            "for an instrument file (a scan is rarely level), mean for a table",
+        )
+        channel: str | Annotated[int, Field(ge=0)] | None = Field(
+            None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
+            "file's default channel (validate lists them when there are several)",
+        )
+        format: FileFormat = Field(
+            "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
+            "numbers), instrument (an instrument's file or export, such as an XYZ .csv, read by SurfaceTopography)",
+        )
+        region: Region | None = Field(
+            None, description="a crop, {x: [start, stop], y: [start, stop], units: pixels | length}: half-open spans "
+            "along the map's columns (x) and rows (y), in the file's pixels (default) or in the run's length unit from "
+            "the first pixel; a side left out is kept whole",
+        )
+        downsample: Downsample | None = Field(
+            None, description="coarser pixels, {factor: N} (N >= 2 pixels) or {pixel: side} (in the run's length "
+            "unit): wavelengths shorter than two new pixels are removed first (no aliasing), longer ones kept whole",
+        )
+        despike: float | None = Field(
+            None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 x 5 "
+            "pixels around them by the solution of Laplace's equation from their neighbours (off by default)",
         )
         periodic: bool | None = Field(
             None,
@@ -141,7 +168,7 @@ class SurfaceFile(SpectrumGenerator):
         return Profile(heights=surface.heights.copy(), spacing=surface.spacing, periodic=surface.periodic)
 
     def periodic(self) -> bool:
-        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path)):
+        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path), self.params.format):
             return bool(self.params.periodic)  # known without reading the file
         header = self._header()
         return header.periodic if header is not None else self._map().periodic
@@ -151,9 +178,13 @@ class SurfaceFile(SpectrumGenerator):
 
     def grid_shape(self) -> tuple[int, int]:
         """The map's shape, from the file's header when it has one (a .npy, an instrument
-        file's metadata): the memory estimate refuses a map too large before it is read."""
+        file's metadata) and no crop or downsampling is asked: the memory estimate refuses a
+        map too large before it is read."""
         header = self._header()
-        return header.shape if header is not None else self._map().heights.shape
+        p = self.params
+        if header is None or p.region is not None or p.downsample is not None:
+            return self._map().heights.shape
+        return header.shape if p.spacing is not None else square_shape(header.shape, header.pixel)
 
     def input_summary(self) -> dict[str, Any]:
         """The map as read: file, format, shape, pixel size, unit, rms height, and where each came from."""
@@ -197,8 +228,8 @@ class SurfaceFile(SpectrumGenerator):
         None for a text table, or a header that does not describe a valid map."""
         path = Path(self.params.path)
         where = f"surface-file {str(path)!r}"
-        if is_instrument_file(path):
-            header = scan_header(path, where, dimension=2)
+        if is_instrument_file(path, self.params.format):
+            header = scan_header(path, where, dimension=2, channel=self.params.channel)
         elif file_suffix(path, where) == ".npy" and (shape := npy_shape(path, where)) is not None:
             header = ScanHeader(shape, bool(self.params.periodic))
         else:
@@ -211,28 +242,36 @@ class SurfaceFile(SpectrumGenerator):
         p = self.params
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
-        z, spacing, summary = _read_map(path, where, p)
+        z, pixel, summary = _read_map(path, where, p)
         check_finite(where, "heights", z)
-        heights = _detrend(z, p.detrend)
+        heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
+        summary.update(shaped)
         rms = float(np.std(heights))
         if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
             raise ValueError(
-                f"{where}: the map is constant (rms height zero after detrend={p.detrend!r}); "
+                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}); "
                 "a flat surface has no roughness"
             )
+        if min(heights.shape) < MIN_SIDE:
+            nx, ny = heights.shape[::-1]
+            raise ValueError(f"{where}: after the crop and resampling the map has {nx} x {ny} pixels (x by y); at "
+                             f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         heights.flags.writeable = False
-        summary["rms_height"] = rms
+        summary.update(shape=list(heights.shape), spacing=float(spacing), rms_height=rms)
         return _Map(heights, spacing, rms, summary["periodic"], summary)
 
 
-def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, float, dict[str, Any]]:
+def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
-    way), its pixel size in the run's unit, and what was read and used (``input_summary``)."""
-    if is_instrument_file(path):
-        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined)
-        data, spacing = scan.heights, scan.spacing if p.spacing is None else p.spacing
+    way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
+    if is_instrument_file(path, p.format):
+        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined, channel=p.channel)
+        data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
         summary = {
-            "format": scan.format, "channel": scan.channel, "file_spacing": scan.spacing,
+            "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
+            **({"channel_note": scan.channel_note} if scan.channel_note else {}),
+            **({"channels": scan.channels} if scan.channels else {}),
+            "file_spacing": scan.pixel[0] if scan.pixel[0] == scan.pixel[1] else list(scan.pixel),
             "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
             "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
             "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
@@ -246,7 +285,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                 "is required"
             )
         data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
-        spacing = p.spacing
+        pixel = (p.spacing, p.spacing)
         summary = {
             "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
             "unit_from": "preset" if p.unit is not None else "none",
@@ -260,22 +299,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         )
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
-        raise ValueError(f"{where}: map of {ny} x {nx} points; at least {MIN_SIDE} x {MIN_SIDE} are needed")
-    summary = {"file": str(path), **summary, "shape": list(data.shape), "spacing": float(spacing), "periodic": periodic}
-    return data.astype(np.float64), float(spacing), summary
-
-
-def _detrend(z: np.ndarray, mode: str) -> np.ndarray:
-    if mode == "none":
-        return z.copy()
-    out = remove_mean(z)
-    if mode == "plane":
-        # centred row and column indices are orthogonal on the grid (and to the constant):
-        # projecting on each in turn is the least-squares plane
-        ny, nx = z.shape
-        x = np.arange(nx, dtype=np.float64) - 0.5 * (nx - 1)
-        y = np.arange(ny, dtype=np.float64) - 0.5 * (ny - 1)
-        out -= (np.sum(out * x[None, :]) / (ny * np.dot(x, x))) * x[None, :]
-        out -= (np.sum(out * y[:, None]) / (nx * np.dot(y, y))) * y[:, None]
-    return out
+        raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed")
+    summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic}
+    return data.astype(np.float64, copy=False), (float(pixel[0]), float(pixel[1])), summary
 

@@ -365,14 +365,14 @@ async def test_the_preview_shows_what_an_instrument_file_gave(folders, registry)
 
     z = np.random.default_rng(2).normal(size=(16, 12))
     Topography(z.T.copy(), (12 * 0.5, 16 * 0.5), unit="um").to_netcdf(str(folders / "presets" / "map.nc"))
-    spectrum = {"name": "surface-file", "params": {"path": "map.nc", "unit": "nm"}}
+    spectrum = {"name": "surface-file", "params": {"path": "map.nc", "unit": "nm", "detrend": "mean"}}
     write_preset(folders, "tiny", {**TINY, "spectrum": spectrum, "solver": {"name": "winkler"}})
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         panel = str(app.query_one("#problems").render())
     assert app.problems == [] and panel.startswith("valid: Ctrl+R runs it")
-    assert f"read map.nc (Network Common Data Format (NetCDF)): 16 x 12 pixels of 500 nm (from the file), rms height " \
+    assert f"read map.nc (Network Common Data Format (NetCDF)): 12 x 16 pixels (x by y) of 500 nm (from the file), rms height " \
            f"{1e3 * np.std(z - z.mean()):.6g} nm, converted from the file's µm" in panel  # fmt: skip
 
 

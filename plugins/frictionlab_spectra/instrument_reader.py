@@ -1,0 +1,185 @@
+"""Which of SurfaceTopography's readers opens an instrument file, chosen before any of them
+parses it, and the checks made on the file's own declarations before its data is read.
+
+SurfaceTopography's own detection tries its readers in turn until one accepts the file,
+its text readers first: a 128 MiB binary NetCDF was parsed as CSV for minutes. Here a
+reader is chosen once, from the file's first bytes (its magic number) and its suffix, and
+only that reader opens the file: a binary file never reaches a text reader. A file whose
+bytes and suffix name no format is refused at once. A ZIP container (X3P) has the sizes
+of its members checked from its directory before anything is inflated: an XML member
+above ``XML_LIMIT`` is refused (a 0.4 MiB file can inflate to gigabytes of blanks).
+"""
+
+from __future__ import annotations
+
+import math
+import zipfile
+
+MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
+XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
+TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
+ZIP_MAGIC = b"PK\x03\x04"
+
+
+def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None):
+    """The SurfaceTopography reader class for the open file ``fh`` (suffix without the dot,
+    lower case): one the first bytes match (the suffix breaking ties), else one the suffix
+    names whose magic does not rule the file out. ValueError naming ``where`` when none."""
+    from SurfaceTopography.IO import MagicMatch, readers
+
+    fh.seek(0)
+    head = fh.read(MAGIC_BYTES)
+    fh.seek(0)
+    matches = [reader for reader in readers if reader.can_read(head) == MagicMatch.YES]
+    by_suffix = [reader for reader in readers if path_suffix in getattr(reader, "_file_extensions", ())]
+    chosen = next((r for r in matches if r in by_suffix), matches[0] if matches else None)
+    if chosen is None:
+        chosen = next((r for r in by_suffix if r.can_read(head) != MagicMatch.NO), None)
+    if chosen is None and by_suffix:
+        names = " or ".join(dict.fromkeys(reader.name() for reader in by_suffix))
+        raise ValueError(f"{where}: its suffix .{path_suffix} names {names}, but its first bytes are not that "
+                         "format's: a damaged file, or another format under that suffix; copy or export it again")
+    if chosen is None:
+        told = f"its suffix .{path_suffix}" if path_suffix else "its name (no suffix)"
+        raise ValueError(
+            f"{where}: neither {told} nor its first bytes name an instrument format SurfaceTopography reads; give "
+            "it the suffix of its format (.x3p, .sur, .datx, .nc, .spm...), or export it as a .npy, .csv or .txt "
+            "table with spacing"
+        )
+    if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
+        raise ValueError(
+            f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
+            f"{chosen.name()} file; give a binary format its own suffix"
+        )
+    if head.startswith(ZIP_MAGIC):
+        check_zip_members(fh, chosen, where)
+    return chosen
+
+
+def _looks_like_text(head: bytes) -> bool:
+    """No NUL and hardly any control byte: text in any 8-bit encoding (an export's header in
+    Latin-1, its "\xb5m") is text; a binary header is not."""
+    control = sum(1 for byte in head if byte < 32 and byte not in b"\t\n\r\f")
+    return b"\0" not in head and control <= len(head) // 100
+
+
+def check_zip_members(fh, reader, where: str) -> None:
+    """Refuse a ZIP container (X3P...) whose directory declares an XML member larger than
+    ``XML_LIMIT`` once inflated (a reader inflates it whole to parse it), or that is no ZIP
+    at all: from the central directory, before anything is inflated. Python's zipfile
+    stops inflating a member at the size its directory declares, so the check holds."""
+    try:
+        with zipfile.ZipFile(fh) as archive:
+            members = archive.infolist()
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError):
+        raise ValueError(f"{where}: a damaged {reader.name()} file (its ZIP directory cannot be read); "
+                         "the file may be truncated: copy it again from the instrument") from None  # fmt: skip
+    finally:
+        fh.seek(0)
+    for member in members:
+        if member.filename.lower().endswith(".xml") and member.file_size > XML_LIMIT:
+            raise ValueError(
+                f"{where}: its XML member {member.filename!r} would inflate to {member.file_size / 2**20:.0f} MiB, "
+                f"more than the {XML_LIMIT // 2**20} MiB an instrument file's description may take; refused unread "
+                "(a damaged or forged file)"
+            )
+
+
+HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: the reader's, ours, levelled, resampled
+
+
+def room_to_read() -> tuple[int, str]:
+    """Bytes this process may still allocate, and what sets that: the memory the system has
+    available, or the room left under the process's address-space limit (``ulimit -v``)."""
+    import psutil
+
+    found = [(int(psutil.virtual_memory().available), "the memory the system has available")]
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return min(found)
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft != resource.RLIM_INFINITY:
+        found.append((soft - psutil.Process().memory_info().vms, "the room left under this process's limit ulimit -v"))
+    return min(found)
+
+
+def check_declared_points(points: tuple[int, ...], where: str) -> None:
+    """Refuse, from the header alone, a file that declares more points than this process can
+    read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit."""
+    need = math.prod(points) * 8 * HEIGHT_COPIES
+    room, source = room_to_read()
+    if need > room:
+        shape = " x ".join(str(n) for n in points)
+        raise ValueError(
+            f"{where}: the file declares {shape} points (x by y); reading them takes about {need / 2**30:.3g} GiB, "
+            f"more than the {room / 2**30:.3g} GiB this process may use ({source}); crop the scan with the "
+            "instrument's software, or export a region of it"
+        )
+
+
+def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
+    """What to tell of a file the chosen reader could not read: a damaged file of that
+    format, or its length and height units that differ (named as such)."""
+    from SurfaceTopography.Exceptions import CorruptFile, FileFormatMismatch
+
+    name = reader.name()
+    text = str(exc)
+    if isinstance(exc, ValueError) and "Units for" in text and "differ" in text:  # SurfaceTopography's own words
+        return ValueError(
+            f"{where}: the file's heights and its lateral sizes are in different units, and SurfaceTopography "
+            f"reads a {name} file with one unit for both; convert its heights to the unit of its sizes"
+        )
+    if isinstance(exc, MemoryError):
+        return ValueError(f"{where}: the {name} file declares more points than this process can hold; "
+                          "crop it with the instrument's software")  # fmt: skip
+    kind = "not a valid" if isinstance(exc, FileFormatMismatch) else "a damaged"
+    if isinstance(exc, CorruptFile):
+        kind = "a damaged"
+    return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}); the reader of its format cannot read it: "
+                      "copy it again from the instrument, or export it from there again")  # fmt: skip
+
+
+def channel_list(reader) -> list[dict]:
+    """Every channel of an open reader: index, name, dimension, points (x, y), units; JSON-ready."""
+    listed = []
+    for channel in reader.channels:
+        try:
+            data_unit = channel.data_unit
+        except Exception:  # noqa: BLE001 - a reader that cannot say: nothing to list
+            data_unit = None
+        listed.append({
+            "index": int(channel.index), "name": str(channel.name),
+            "points": [int(n) for n in channel.nb_grid_pts] if channel.nb_grid_pts is not None else None,
+            "unit": channel.unit if isinstance(channel.unit, str) else None,
+            "data_unit": data_unit if isinstance(data_unit, str) else None,
+        })  # fmt: skip
+    return listed
+
+
+def pick_channel(reader, wanted: str | int | None, where: str):
+    """The channel ``wanted`` (an index, or a name: the first of that name), or the reader's
+    default; and a note when other channels share its name (None otherwise)."""
+    channels = list(reader.channels)
+    if wanted is None:
+        channel = reader.default_channel
+    elif isinstance(wanted, int):
+        if not 0 <= wanted < len(channels):
+            raise ValueError(f"{where}: channel {wanted} does not exist; the file has {len(channels)} "
+                             f"(0 to {len(channels) - 1}): {_named(channels)}")  # fmt: skip
+        channel = channels[wanted]
+    else:
+        named = [c for c in channels if str(c.name) == wanted]
+        if not named:
+            raise ValueError(f"{where}: no channel named {wanted!r}; the file has {_named(channels)}")
+        channel = named[0]
+    same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
+    note = None
+    if len(same) > 1:
+        note = (f"{len(same)} channels are named {str(channel.name)!r} (indices {', '.join(map(str, same))}); "
+                f"index {int(channel.index)} was taken (channel: INDEX chooses another)")  # fmt: skip
+    return channel, note
+
+
+def _named(channels) -> str:
+    return ", ".join(f"{int(c.index)}: {str(c.name)!r}" for c in channels)

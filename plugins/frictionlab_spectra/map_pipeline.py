@@ -1,0 +1,144 @@
+"""A measured map from the pixels read to the pixels pressed, in this order: the crop
+(``region``, in the file's own pixels), the levelling (``detrend``), the spikes
+(``despike``, opt-in), square pixels, and the coarser grid (``downsample``). Each step is
+recorded in the input summary.
+
+Square pixels. Pixels whose sides differ by at most ``PIXEL_TOLERANCE`` (a fast and a slow
+scan axis calibrated apart, 0.06 % on an NT-MDT map) are taken as square, of their mean
+side. Truly rectangular pixels (an X3P of 0.128 x 0.315 um) are resampled onto square ones
+of the finer side, along the coarser axis, by the map's band-limited cosine series
+(``scan_shaping.cosine_resample``): it passes through every measured point and adds no
+wavelength the scan did not have, so the rms height and the rms gradient are kept. Every
+solver then presses square pixels: their kernels (the half-space's response to one pixel,
+the spring of one MDR point) stay the ones checked against closed forms.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points
+
+PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
+FileFormat = Literal["auto", "table", "instrument"]
+Level = Literal["none", "mean", "plane", "quadratic"]
+
+
+class Region(BaseModel):
+    """A crop: ``x`` and ``y`` as [start, stop) along the map's columns and rows, in pixels of
+    the file or in the run's length unit from the map's first pixel (``units``); either
+    unset keeps the whole of that side."""
+
+    model_config = ConfigDict(extra="forbid")
+    x: tuple[float, float] | None = Field(None, description="[start, stop) along x (the map's columns)")
+    y: tuple[float, float] | None = Field(None, description="[start, stop) along y (the map's rows)")
+    units: Literal["pixels", "length"] = Field("pixels", description="pixels of the file, or the run's length unit")
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        for name, span in (("x", self.x), ("y", self.y)):
+            if span is not None and not 0 <= span[0] < span[1] < math.inf:
+                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: needs 0 <= start < stop")
+            if span is not None and self.units == "pixels" and not all(float(v).is_integer() for v in span):
+                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: pixels are whole numbers")
+        return self
+
+
+class Downsample(BaseModel):
+    """Coarser pixels: ``factor`` times the pixel side, or a ``pixel`` side in the run's unit."""
+
+    model_config = ConfigDict(extra="forbid")
+    factor: int | None = Field(None, ge=2, description="the new pixel side in pixels (an integer >= 2)")
+    pixel: float | None = Field(None, gt=0.0, description="the new pixel side in the run's length unit")
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.factor is None) == (self.pixel is None):
+            raise ValueError("downsample takes one of factor (an integer) or pixel (a length)")
+        return self
+
+
+def square_shape(shape: tuple[int, int], pixel: tuple[float, float] | None) -> tuple[int, int]:
+    """The (Ny, Nx) of a map of ``shape`` on pixels (dx, dy) once on square pixels (``shape_map``)."""
+    if pixel is None or not all(0 < p < math.inf for p in pixel) or _nearly_square(*pixel):
+        return shape
+    dx, dy = pixel
+    ny, nx = shape
+    return (resampled_points(ny, dy, dx), nx) if dy > dx else (ny, resampled_points(nx, dx, dy))
+
+
+def _nearly_square(dx: float, dy: float) -> bool:
+    return abs(dx - dy) <= PIXEL_TOLERANCE * max(dx, dy)
+
+
+def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
+    ny, nx = z.shape
+    bounds = []
+    for span, side, count, name in ((region.x, pixel[0], nx, "x"), (region.y, pixel[1], ny, "y")):
+        if span is None:
+            bounds.append((0, count))
+            continue
+        start, stop = (round(v / side) for v in span) if region.units == "length" else (int(v) for v in span)
+        if stop > count or stop - start < 1:
+            extent = f"{count} pixels" if region.units == "pixels" else f"{count * side:g} (the run's length unit)"
+            raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] ({region.units}) is not inside the map, "
+                             f"{extent} along {name}")  # fmt: skip
+        bounds.append((start, stop))
+    (x0, x1), (y0, y1) = bounds
+    return z[y0:y1, x0:x1], [[x0, x1], [y0, y1]]
+
+
+def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instrument: bool):
+    """The map to press, its square pixel side, and what was done (the summary's entries)."""
+    done: dict[str, Any] = {}
+    caveats: list[str] = []
+    if p.region is not None:
+        z, done["region_pixels"] = _crop(z, pixel, p.region, where)
+    mode = p.detrend if p.detrend is not None else "plane" if instrument else "mean"
+    levelled = level(z, mode)
+    if p.despike is not None:
+        despiked, count = despike(levelled.heights, p.despike, levelled.rms_after)
+        done["despiked"] = {"k": p.despike, "points": count}
+        if count:
+            levelled = level(despiked, mode)
+    done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
+                rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
+    if (warning := levelling_warning(levelled, mode)) is not None:
+        caveats.append(warning)
+    z, spacing = levelled.heights, pixel[0]
+    dx, dy = pixel
+    if dx != dy:
+        difference = abs(dx - dy) / max(dx, dy)
+        if _nearly_square(dx, dy):
+            spacing = 0.5 * (dx + dy)
+            done["pixels"] = f"{dx:.6g} x {dy:.6g} taken as square ({100 * difference:.3g} % apart, tolerance " \
+                             f"{100 * PIXEL_TOLERANCE:g} %)"
+        else:
+            spacing = min(dx, dy)
+            axis = 0 if dy > dx else 1  # rows are along y
+            before = z.shape
+            z = cosine_resample(z, axis, max(dx, dy), spacing)
+            done["pixels"] = (f"{dx:.6g} x {dy:.6g} resampled onto square pixels of {spacing:.6g} along "
+                              f"{'y' if axis == 0 else 'x'} (band-limited cosine series): {before[1]} x {before[0]} "
+                              f"-> {z.shape[1]} x {z.shape[0]} pixels")  # fmt: skip
+    if p.downsample is not None:
+        new = spacing * p.downsample.factor if p.downsample.factor is not None else p.downsample.pixel
+        if not new > spacing * (1 + 1e-12):
+            raise ValueError(f"{where}: downsample.pixel = {new:g} is not coarser than the map's pixel {spacing:g}")
+        for axis in (0, 1):
+            z = cosine_resample(z, axis, spacing, new)
+        done["downsampled"] = {"from_pixel": spacing, "to_pixel": new}
+        spacing = new
+    z = z - np.mean(z) if mode != "none" else z
+    if caveats:
+        done["caveats"] = caveats
+    return np.ascontiguousarray(z), float(spacing), done
+
+
+def _removed(levelled) -> float:
+    """The share of the rms height (about the mean) that the levelling removed."""
+    return 1.0 - levelled.rms_after / levelled.rms_before if levelled.rms_before > 0 else 0.0

@@ -1,0 +1,147 @@
+"""What a measured map goes through between the file and the solver, each step a pure
+function of the heights: levelling, a crop, removing spikes, and band-limited resampling
+(onto square pixels, or onto coarser ones).
+
+Resampling is done by the map's cosine series: a scan's ends do not meet, so its samples
+are taken as one half of their even extension (the map reflected across its edges, as the
+MDR-equivalent line takes it), whose Fourier series is the discrete cosine transform
+(DCT-II). That series is band-limited and passes through every sample; evaluating it on a
+new grid is interpolation without a step where the scan ends (a plain FFT would put the
+jump between the first and last rows into every mode). For a coarser grid the modes above
+the new grid's Nyquist wavenumber are dropped first: an ideal low-pass, so no wavelength
+shorter than two new pixels folds back as a false long one (aliasing), and every
+wavelength longer than that keeps its amplitude (block averaging damps them by up to 36 %
+at the new Nyquist wavenumber and lets some shorter ones through).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+LEVELS = ("none", "mean", "plane", "quadratic")
+MOST = 0.5  # a tilt or a curvature that carries more than this share of the height variance is warned of
+
+
+@dataclass(frozen=True)
+class Levelling:
+    """A map levelled, and how much each part of the least-squares quadratic carried."""
+
+    heights: np.ndarray
+    rms_before: float  # about the mean
+    rms_after: float  # about the mean, after the levelling
+    plane_share: float  # share of the variance (about the mean) carried by the plane
+    curvature_share: float  # share carried by the quadratic terms beyond the plane
+
+
+def _axis(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centred index t and t^2 less its mean on ``n`` points: with the constant, an orthogonal
+    basis of the quadratics along one axis (t is odd, t^2 - mean even about the middle)."""
+    t = np.arange(n, dtype=np.float64) - 0.5 * (n - 1)
+    return t, t * t - np.mean(t * t)
+
+
+def level(z: np.ndarray, mode: str) -> Levelling:
+    """``z`` less its least-squares ``mode`` (none, mean, plane: a + bx + cy, quadratic: also
+    x^2, xy, y^2). On a grid the basis 1, x, y, x^2 - <x^2>, xy, y^2 - <y^2> is orthogonal, so
+    each term is one projection (no design matrix of six copies of the map)."""
+    mean = float(np.mean(z))
+    out = z - mean
+    ny, nx = z.shape
+    x, x2 = _axis(nx)
+    y, y2 = _axis(ny)
+    rows, columns = out.sum(axis=1), out.sum(axis=0)  # projections of separable terms need only these
+    plane = [(columns @ x / (ny * (x @ x)), x[None, :]), (rows @ y / (nx * (y @ y)), y[:, None])]
+    curved = [(y @ (out @ x) / ((x @ x) * (y @ y)), y[:, None] * x[None, :])]
+    if nx > 2:
+        curved.append((columns @ x2 / (ny * (x2 @ x2)), x2[None, :]))
+    if ny > 2:
+        curved.append((rows @ y2 / (nx * (y2 @ y2)), y2[:, None]))
+    size = float(z.size)
+    variance = float(np.vdot(out, out)) / size  # no temporary the size of the map
+    share = [sum(c * c * float(np.sum(b * b)) * size / b.size for c, b in terms) / size for terms in (plane, curved)]
+    removed = plane if mode == "plane" else plane + curved if mode == "quadratic" else []
+    for coefficient, basis in removed:
+        out -= coefficient * basis
+    if mode == "none":
+        out = z.copy()  # bit for bit what the file holds
+        rms_after = float(np.std(out))
+    else:  # every term removed is orthogonal to the constant: the mean stays zero
+        rms_after = math.sqrt(float(np.vdot(out, out)) / size)
+    scale = variance if variance > 0 else math.inf
+    return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
+
+
+def levelling_warning(levelled: Levelling, mode: str) -> str | None:
+    """The caveat of a map whose height is mostly a tilt or a curvature left in it."""
+    plane, curvature = levelled.plane_share, levelled.curvature_share
+    if mode in ("none", "mean") and plane + curvature > MOST:
+        part = "a tilt" if plane >= curvature else "a curvature"
+        return (f"{part} carries {100 * (plane + curvature):.1f} % of the map's height variance (detrend: {mode}): "
+                "the contact sits where the tilt or the form puts it, not on the roughness; "
+                "detrend: plane (or quadratic) levels it")  # fmt: skip
+    if mode == "plane" and curvature > MOST * (1 - plane):
+        return (f"a curvature carries {100 * curvature / (1 - plane):.1f} % of the levelled map's height variance: "
+                "the contact sits where the form puts it; detrend: quadratic removes it, if it is not the "
+                "surface's own shape")  # fmt: skip
+    return None
+
+
+def cosine_resample(z: np.ndarray, axis: int, step: float, new_step: float) -> np.ndarray:
+    """``z`` sampled every ``step`` along ``axis`` (the first sample at 0), resampled every
+    ``new_step`` from 0 to the last sample, by its band-limited cosine series; for a coarser
+    grid, the modes the new grid cannot hold (shorter than two new pixels) are dropped."""
+    import scipy.fft  # imported on first use
+
+    n = z.shape[axis]
+    points = resampled_points(n, step, new_step)
+    coefficients = scipy.fft.dct(z, type=2, axis=axis, norm="ortho")
+    ratio = step / new_step
+    kept = n if ratio >= 1 else max(1, math.ceil(n * ratio - 1e-9))  # k < n * step / new_step: below the new Nyquist
+    t = np.arange(points, dtype=np.float64) / ratio
+    k = np.arange(kept, dtype=np.float64)
+    # the inverse orthonormal DCT-II, evaluated off the grid: z(t) = sum_k w_k c_k cos(pi k (t + 1/2) / n)
+    weights = np.full(kept, math.sqrt(2.0 / n))
+    weights[0] = math.sqrt(1.0 / n)
+    basis = weights[None, :] * np.cos(np.pi * np.outer(t + 0.5, k) / n)  # (points, kept)
+    kept_coefficients = np.take(coefficients, np.arange(kept), axis=axis)
+    return np.moveaxis(np.tensordot(basis, np.moveaxis(kept_coefficients, axis, 0), axes=1), 0, axis)
+
+
+def resampled_points(n: int, step: float, new_step: float) -> int:
+    """Points of ``n`` samples every ``step`` resampled every ``new_step`` (``cosine_resample``):
+    positions m new_step from the first sample to the last."""
+    return math.floor((n - 1) * step / new_step + 1e-9) + 1
+
+
+def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
+    """``z`` with every point more than ``k`` ``rms`` from the median of the 5 x 5 pixels around
+    it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
+    Laplace's equation from its neighbours; and how many were replaced."""
+    from scipy import ndimage, sparse
+    from scipy.sparse.linalg import spsolve
+
+    local = ndimage.median_filter(z, size=5, mode="reflect")
+    spike = np.abs(z - local) > k * rms
+    count = int(np.count_nonzero(spike))
+    if not count or count == z.size:
+        return z, 0 if count == z.size else count
+    ny, nx = z.shape
+    index = np.full(z.shape, -1, dtype=np.int64)
+    index[spike] = np.arange(count)
+    rows, cols, values = [], [], []
+    rhs = np.zeros(count)
+    where = np.argwhere(spike)
+    for (i, j), row in zip(where, range(count)):  # a handful of points: each an equation
+        neighbours = [(a, b) for a, b in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)) if 0 <= a < ny and 0 <= b < nx]
+        rows.append(row), cols.append(row), values.append(float(len(neighbours)))
+        for a, b in neighbours:
+            if spike[a, b]:
+                rows.append(row), cols.append(int(index[a, b])), values.append(-1.0)
+            else:
+                rhs[row] += z[a, b]
+    out = z.copy()
+    out[spike] = spsolve(sparse.csr_matrix((values, (rows, cols)), shape=(count, count)), rhs)
+    return out, count

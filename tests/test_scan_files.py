@@ -1,0 +1,339 @@
+"""Real scans as a user brings them, written here: a tilted map, pixels 0.06 % apart, pixels
+of 2.5:1, a file of four channels, an instrument's CSV export; each pressed to a law by MDR
+and by the exact free half-space. And files a reader must refuse from what they declare."""
+
+from __future__ import annotations
+
+import json
+import math
+import runpy
+import struct
+import warnings
+import zipfile
+
+import numpy as np
+import pytest
+import x3pio
+import yaml
+from scipy.io import netcdf_file
+from SurfaceTopography import Topography
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab_spectra import PowerLawSurface, SurfaceFile
+
+from .conftest import ROOT
+
+
+def rough_um(n: int, rms: float = 0.05, seed: int = 4) -> np.ndarray:
+    surface = PowerLawSurface(hurst=0.8, points=n, rms_height=rms, spacing=0.125)
+    return surface.generate(np.random.default_rng(np.random.SeedSequence(seed))).heights
+
+
+def tilted_x3p(path, tilt: float = 0.05):
+    z = rough_um(64)
+    x = np.arange(64) * 0.125
+    x3pio.write(path, (z + tilt * x[None, :]) * 1e-6, x_scale=0.125e-6, y_scale=0.125e-6,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+
+
+def rectangular_x3p(path):
+    """0.128 x 0.315 um pixels (the X3P the issue names): the coarse rows of a finer map."""
+    z = rough_um(128)[::2, :64][:40]
+    x3pio.write(path, z * 1e-6, x_scale=0.128e-6, y_scale=0.315e-6, revision=x3pio.Revision.ISO5436_2000)
+
+
+def near_square_nc(path):
+    """NT-MDT's 1.85339 x 1.85455 (0.06 % apart), in nm, as NetCDF."""
+    z = rough_um(64) * 1e3 * 40
+    topography = Topography(z.T.copy(), (64 * 1.85339, 64 * 1.85455), unit="nm")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        topography.to_netcdf(str(path))
+
+
+def four_channel_gwy(path):
+    script = runpy.run_path(str(ROOT / "examples" / "instrument-scan" / "make_afm_scan.py"))
+    return script["main"](path.parent)
+
+
+def csv_export(path):
+    """x, y, z triples, one per line: the XYZ export of a profilometer, with no unit."""
+    z = rough_um(48)[:40] + 0.01 * np.arange(48)[None, :] * 0.125
+    y, x = np.mgrid[0:40, 0:48] * 0.125
+    path.write_text("".join(f"{a:.6f},{b:.6f},{c:.9f}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel())))
+
+
+CASES = {
+    "tilted.x3p": (tilted_x3p, {"unit": "um"}),
+    "near-square.nc": (near_square_nc, {"unit": "um"}),
+    "rectangular.x3p": (rectangular_x3p, {"unit": "um"}),
+    "afm.gwy": (four_channel_gwy, {"unit": "um", "undefined": "harmonic", "channel": 1}),
+    "export.csv": (csv_export, {"unit": "um", "format": "instrument"}),
+}
+
+
+def law_preset(path, solver, surface: SurfaceFile, **params) -> dict:
+    """Loads from f = 0.02 to 0.3: F = f E* h L, L = 2 sqrt(A / pi) (E* = 1 here)."""
+    made = surface.generate(None)
+    area = made.heights.size * made.spacing**2
+    unit = surface.rms_height() * 2 * math.sqrt(area / math.pi)
+    return {
+        "name": "scan", "seed": 1, "realizations": 2 if solver == "mdr" else 1, "fit": {"bootstrap": 0},
+        "spectrum": {"name": "surface-file", "params": {"path": str(path), **params}},
+        "solver": {"name": solver, "params": {"youngs_modulus": 1.0, "poisson_ratio": 0.0}},
+        "slope": {"name": "forward-difference"},
+        "loading": {"start": 0.02 * unit, "stop": 0.3 * unit, "steps": 5, "spacing": "log"},
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize("solver", ["mdr", "bem-halfspace-free"])
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_each_kind_of_scan_gives_a_law(tmp_path, name, solver):
+    import frictionlab
+
+    write, params = CASES[name]
+    path = tmp_path / name
+    write(path)
+    surface = SurfaceFile(path=str(path), **params)
+    result = frictionlab.run(law_preset(path, solver, surface, **params), out=tmp_path / "run", workers=1,
+                             progress=False, plot=False)  # fmt: skip
+    assert result.fit is not None and math.isfinite(result.fit.a) and math.isfinite(result.fit.b)
+    table = result.table
+    assert 0 < table["contact_count"][0] < table["contact_count"][-1] < surface.generate(None).heights.size
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())["input"]
+    assert summary["detrend"] == "plane" and summary["detrend_from"] == "default"
+    assert summary["shape"] == list(surface.generate(None).heights.shape)
+
+
+def test_what_each_scan_says_it_did(tmp_path):
+    tilted_x3p(tmp_path / "t.x3p")
+    levelled = SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um").input_summary()
+    assert levelled["rms_removed_fraction"] > 0.5 and "caveats" not in levelled
+    raw = SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um", detrend="mean").input_summary()
+    assert raw["rms_removed_fraction"] == pytest.approx(0.0, abs=1e-12) and "a tilt carries" in raw["caveats"][0]
+    near_square_nc(tmp_path / "n.nc")
+    near = SurfaceFile(path=str(tmp_path / "n.nc"), unit="nm")
+    assert "taken as square (0.0626 % apart" in near.input_summary()["pixels"]
+    assert near.generate(None).spacing == pytest.approx((1.85339 + 1.85455) / 2, rel=1e-6)
+    rectangular_x3p(tmp_path / "r.x3p")
+    rect = SurfaceFile(path=str(tmp_path / "r.x3p"), unit="um")
+    assert rect.generate(None).spacing == pytest.approx(0.128, rel=1e-9)
+    assert rect.grid_shape() == rect.generate(None).heights.shape == (math.floor(39 * 0.315 / 0.128) + 1, 64)
+    assert "resampled onto square pixels of 0.128 along y" in rect.input_summary()["pixels"]
+
+
+def test_channels_are_listed_chosen_by_name_or_index_and_the_shared_name_is_said(tmp_path, capsys):
+    four_channel_gwy(tmp_path / "afm.gwy")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(law_preset(
+        tmp_path / "afm.gwy", "mdr", SurfaceFile(path=str(tmp_path / "afm.gwy"), unit="um", undefined="harmonic"),
+        unit="um", undefined="harmonic")))  # fmt: skip
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+    out = capsys.readouterr().out
+    assert "channel 3: 'Z Sensor', 160 x 64 points, lengths in m, values in m" in out
+    assert "2 channels are named 'Height' (indices 0, 1); index 0 was taken" in out
+    by_name = SurfaceFile(path=str(tmp_path / "afm.gwy"), unit="um", undefined="harmonic", channel="Z Sensor")
+    by_index = SurfaceFile(path=str(tmp_path / "afm.gwy"), unit="um", undefined="harmonic", channel=3)
+    np.testing.assert_array_equal(by_name.generate(None).heights, by_index.generate(None).heights)
+    assert by_name.input_summary()["channel_index"] == 3
+    with pytest.raises(ValueError, match="no channel named 'Phase'; the file has 0: 'Height', 1: 'Height'"):
+        SurfaceFile(path=str(tmp_path / "afm.gwy"), channel="Phase").generate(None)
+    with pytest.raises(ValueError, match="channel 7 does not exist; the file has 4"):
+        SurfaceFile(path=str(tmp_path / "afm.gwy"), channel=7).generate(None)
+
+
+def test_despike_is_opt_in_and_recorded(tmp_path):
+    four_channel_gwy(tmp_path / "afm.gwy")
+    params = {"path": str(tmp_path / "afm.gwy"), "unit": "um", "undefined": "harmonic"}
+    assert "despiked" not in SurfaceFile(**params).input_summary()
+    summary = SurfaceFile(**params, despike=6.0).input_summary()
+    assert summary["despiked"] == {"k": 6.0, "points": 2}  # the script's 2-pixel spike, and no other point
+
+
+# ------------------------------------------------------------------ files refused from what they declare
+
+
+def test_a_binary_file_never_reaches_a_text_reader(tmp_path, monkeypatch):
+    from SurfaceTopography.IO import AscReader, XYZReader
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a text reader was given the file")
+
+    monkeypatch.setattr(XYZReader, "__init__", refuse)
+    monkeypatch.setattr(AscReader, "__init__", refuse)
+    near_square_nc(tmp_path / "map.nc")
+    assert SurfaceFile(path=str(tmp_path / "map.nc")).generate(None).heights.shape == (64, 64)
+    (tmp_path / "map.nc").rename(tmp_path / "map.csv")  # its first bytes say NetCDF: read as one
+    assert SurfaceFile(path=str(tmp_path / "map.csv"), format="instrument").generate(None).heights.shape == (64, 64)
+    (tmp_path / "noise.bin").write_bytes(bytes(range(256)) * 40)
+    (tmp_path / "noise.csv").write_bytes(bytes(range(256)) * 40)
+    with pytest.raises(ValueError, match=r"a \.csv file that is not text \(binary bytes at its start\)"):
+        SurfaceFile(path=str(tmp_path / "noise.csv"), format="instrument").generate(None)
+    with pytest.raises(ValueError, match=r"neither its suffix \.bin nor its first bytes name an instrument format"):
+        SurfaceFile(path=str(tmp_path / "noise.bin")).generate(None)
+
+
+def test_an_xml_member_that_inflates_beyond_the_cap_is_refused_unread(tmp_path):
+    from frictionlab_spectra.instrument_reader import XML_LIMIT
+
+    tilted_x3p(tmp_path / "good.x3p")
+    with zipfile.ZipFile(tmp_path / "good.x3p") as good, zipfile.ZipFile(tmp_path / "bomb.x3p", "w",
+                                                                           zipfile.ZIP_DEFLATED) as bomb:  # fmt: skip
+        for item in good.infolist():
+            data = good.read(item)
+            if item.filename == "main.xml":
+                data = data + b" " * (XML_LIMIT + 1)
+            bomb.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
+    assert (tmp_path / "bomb.x3p").stat().st_size < XML_LIMIT / 100
+    with pytest.raises(ValueError, match=r"XML member 'main.xml' would inflate to 64 MiB, more than the 64 MiB"):
+        SurfaceFile(path=str(tmp_path / "bomb.x3p")).generate(None)
+
+
+def test_an_x3p_declaring_more_points_than_fit_is_refused_from_its_header(tmp_path, monkeypatch, capsys):
+    """Its data member is deflated zeros in the forged case; here, as small as the original:
+    the refusal comes from the declared size, before the reader looks at the data."""
+    from frictionlab_spectra import instrument_reader
+
+    tilted_x3p(tmp_path / "small.x3p")
+    with zipfile.ZipFile(tmp_path / "small.x3p") as small, zipfile.ZipFile(tmp_path / "huge.x3p", "w") as huge:
+        for item in small.infolist():
+            data = small.read(item)
+            if item.filename == "main.xml":
+                data = data.replace(b"<SizeX>64</SizeX>", b"<SizeX>22000</SizeX>")
+                data = data.replace(b"<SizeY>64</SizeY>", b"<SizeY>22000</SizeY>")
+                assert data.count(b"22000") == 2
+            huge.writestr(item.filename, data)
+    monkeypatch.setattr(instrument_reader, "room_to_read", lambda: (2 * 2**30, "a test limit of 2 GiB"))
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(law_preset(
+        tmp_path / "small.x3p", "mdr", SurfaceFile(path=str(tmp_path / "small.x3p"), unit="um"), unit="um"
+    )).replace("small.x3p", "huge.x3p"))  # fmt: skip
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    err = capsys.readouterr().err
+    assert code == ExitCode.USAGE, err
+    assert "declares 22000 x 22000 points (x by y); reading them takes about 14.4 GiB, more than the 2 GiB" in err
+    assert "a test limit of 2 GiB" in err and "Traceback" not in err
+
+
+def forged_netcdf(path, n: int):
+    """A classic NetCDF (64-bit offsets) whose header declares an n x n map: a sparse file."""
+    with netcdf_file(str(path), "w", version=2) as nc:
+        nc.createDimension("x", 4)
+        nc.createDimension("y", 4)
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = np.ones((4, 4))
+        heights.unit = "um"
+        for axis in "xy":
+            var = nc.createVariable(axis, "d", (axis,))
+            var[:] = np.arange(4.0)
+            var.length, var.unit = 4.0, "um"
+    header = bytearray(open(path, "rb").read())
+    for name in (b"x", b"y"):  # the dimensions' lengths
+        at = header.index(b"\x00\x00\x00\x01" + name + b"\x00\x00\x00") + 8
+        header[at:at + 4] = struct.pack(">i", n)
+    first = struct.unpack(">q", header[header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80") + 8:][:8])[0]
+    begins = {b"\x80": first, b"\x20": None}
+    at = header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80")  # heights: vsize, begin
+    header[at + 4:at + 8] = struct.pack(">I", 0xFFFFFFFF)
+    offset = first + n * n * 8
+    for _ in range(2):  # x then y: vsize 32 -> 8 n, begin after the heights
+        at = header.index(b"\x00\x00\x00\x06\x00\x00\x00\x20")
+        header[at + 4:at + 8] = struct.pack(">I", 8 * n)
+        header[at + 8:at + 16] = struct.pack(">q", offset)
+        offset += 8 * n
+    with open(path, "r+b") as fh:
+        fh.write(header[:first])
+        fh.truncate(offset)  # sparse: nothing written but the header
+
+
+@pytest.mark.parametrize("solver", ["mdr", "bem-halfspace-free"])
+def test_a_netcdf_declaring_100000_squared_points_is_refused_from_its_header(tmp_path, capsys, solver):
+    """A sparse file of 80 GB: its header alone is read (SurfaceTopography's NetCDF reader maps the
+    file); the map is refused by what it declares, before a height is read."""
+    forged_netcdf(tmp_path / "huge.nc", 100_000)
+    if (tmp_path / "huge.nc").stat().st_blocks * 512 > 2**20:
+        pytest.skip("this file system does not keep files sparse")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({
+        "name": "huge", "seed": 1, "realizations": 1, "fit": {"bootstrap": 0},
+        "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "huge.nc")}},
+        "solver": {"name": solver}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3}}))  # fmt: skip
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    err = capsys.readouterr().err
+    assert code in (ExitCode.USAGE, ExitCode.RUNTIME_FAILURE) and "Traceback" not in err
+    assert "GiB" in err and ("declares 100000 x 100000 points" in err or "this run would need about" in err), err
+
+
+def test_a_damaged_file_of_a_known_format_is_named_as_such(tmp_path):
+    tilted_x3p(tmp_path / "scan.x3p")
+    data = (tmp_path / "scan.x3p").read_bytes()
+    (tmp_path / "cut.x3p").write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError, match=r"a damaged XML 3D surface profile \(X3P\) file"):
+        SurfaceFile(path=str(tmp_path / "cut.x3p")).generate(None)
+
+
+def netcdf(path, heights_unit: str, length_unit: str):
+    z = rough_um(16)
+    with netcdf_file(str(path), "w") as nc:
+        nc.createDimension("x", 16)
+        nc.createDimension("y", 16)
+        for axis in ("x", "y"):
+            var = nc.createVariable(axis, "d", (axis,))
+            var[:] = np.arange(16) * 0.125
+            var.length, var.unit = 2.0, length_unit
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = z
+        heights.unit = heights_unit
+
+
+def test_units_that_are_not_lengths_are_refused_and_a_unit_mismatch_is_named(tmp_path):
+    netcdf(tmp_path / "kg.nc", "kg", "kg")
+    with pytest.raises(ValueError, match="the file's length unit 'kg' is not a length unit"):
+        SurfaceFile(path=str(tmp_path / "kg.nc")).generate(None)
+    netcdf(tmp_path / "mixed.nc", "nm", "um")
+    with pytest.raises(ValueError, match="heights and its lateral sizes are in different units"):
+        SurfaceFile(path=str(tmp_path / "mixed.nc")).generate(None)
+
+
+def test_an_escape_code_in_a_files_unit_or_channel_is_printed_escaped(tmp_path, capsys):
+    netcdf(tmp_path / "evil.nc", "\x1b]2;owned\x07\x1b[2J", "\x1b]2;owned\x07\x1b[2J")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({
+        "name": "evil", "seed": 1, "realizations": 1, "spectrum": {"name": "surface-file",
+        "params": {"path": str(tmp_path / "evil.nc")}}, "solver": {"name": "mdr"},
+        "loading": {"start": 0.01, "stop": 0.1, "steps": 3}}))  # fmt: skip
+    main(["validate", str(tmp_path / "p.yaml")])
+    captured = capsys.readouterr()
+    assert "\x1b" not in captured.out + captured.err and "\x07" not in captured.out + captured.err
+
+
+def test_a_profilometer_csv_export_goes_to_surfacetopography_when_asked(tmp_path):
+    """A Dektak-style export: a Latin-1 header ("\\xb5m"), then x, z: refused as a table with
+    the remedy, read as an instrument's export with format: instrument, levelled by its line."""
+    from frictionlab_spectra import ProfileFile
+
+    x = np.arange(200) * 0.05
+    z = 0.1 * np.sin(3 * x) + 0.02 * x
+    header = "Meta Data\nScan Length,10 \xb5m\n\nScan Data\nLateral(\xb5m),Total Profile(\xb5m)\n".encode("latin-1")
+    (tmp_path / "dektak.csv").write_bytes(header + "".join(f"{a:.4f},{b:.6f}\n" for a, b in zip(x, z)).encode())
+    with pytest.raises(ValueError, match="not UTF-8 at line 2.*read with format: instrument"):
+        ProfileFile(path=str(tmp_path / "dektak.csv"), spacing=0.05).generate(None)
+    line = ProfileFile(path=str(tmp_path / "dektak.csv"), format="instrument", unit="um")
+    made = line.generate(None)
+    assert made.heights.size == 200 and made.spacing == pytest.approx(0.05, rel=1e-9)
+    t = x - x.mean()
+    expected = z - z.mean() - (t @ (z - z.mean()) / (t @ t)) * t
+    np.testing.assert_allclose(made.heights, expected, atol=1e-6)
+    assert line.input_summary()["detrend"] == "tilt" and line.input_summary()["detrend_from"] == "default"
+
+
+def test_a_tilt_left_in_is_a_caveat_of_the_run_and_of_its_summary(tmp_path):
+    import frictionlab
+
+    tilted_x3p(tmp_path / "t.x3p")
+    surface = SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um", detrend="mean")
+    result = frictionlab.run(law_preset(tmp_path / "t.x3p", "mdr", surface, unit="um", detrend="mean"),
+                             out=tmp_path / "run", workers=1, progress=False, plot=False)  # fmt: skip
+    assert any(caveat.startswith("a tilt carries") for caveat in result.caveats)
+    stored = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert stored["caveats"] == result.caveats and stored["input"]["caveats"][0] in result.caveats
+    levelled = frictionlab.run(law_preset(tmp_path / "t.x3p", "mdr", SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um"),
+                                          unit="um"), out=tmp_path / "level", workers=1, progress=False, plot=False)  # fmt: skip
+    assert not any("tilt" in caveat for caveat in levelled.caveats)

@@ -1,0 +1,121 @@
+"""What a measured map goes through between the file and the solver (levelling, crop,
+spikes, square pixels, downsampling), checked against what each step must keep or remove,
+on maps built here with known parts."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from frictionlab_spectra import SurfaceFile
+from frictionlab_spectra.scan_shaping import cosine_resample, despike, level, levelling_warning
+
+
+def band_limited(ny: int, nx: int, seed: int = 0, modes: int = 40, top: float = 0.6) -> tuple[np.ndarray, callable]:
+    """A sum of cosine modes of the even extension (every one below ``top`` times each axis'
+    Nyquist wavenumber): its samples on (ny, nx) and the continuous surface z(x, y), x and y in pixels."""
+    rng = np.random.default_rng(seed)
+    kx, ky = rng.integers(0, int(top * nx), modes), rng.integers(0, int(top * ny), modes)
+    amplitude = rng.standard_normal(modes)
+
+    def z(x, y):
+        return sum(a * np.cos(np.pi * i * (x + 0.5) / nx) * np.cos(np.pi * j * (y + 0.5) / ny)
+                   for a, i, j in zip(amplitude, kx, ky))  # fmt: skip
+
+    y, x = np.mgrid[0:ny, 0:nx].astype(float)
+    return z(x, y), z
+
+
+def rms_gradient(z: np.ndarray, dx: float, dy: float) -> float:
+    gy, gx = np.gradient(z, dy, dx)
+    return float(np.sqrt(np.mean(gx[1:-1, 1:-1] ** 2 + gy[1:-1, 1:-1] ** 2)))
+
+
+def test_rectangular_pixels_resampled_keep_the_rms_height_and_gradient_of_a_band_limited_surface():
+    """Pixels 0.128 x 0.315 (2.46:1): the coarse axis resampled onto 0.128 by the cosine series
+    reproduces the continuous surface at the new points, so its rms height and rms gradient
+    are those of the surface sampled finely from the start."""
+    dx, dy = 0.128, 0.315
+    ny, nx = 40, 64
+    z, exact = band_limited(ny, nx, top=0.35)
+    fine = cosine_resample(z, 0, dy, dx)
+    assert fine.shape == (math.floor((ny - 1) * dy / dx + 1e-9) + 1, nx)
+    t = np.arange(fine.shape[0]) * dx / dy  # the new rows, in old pixels
+    truth = exact(np.arange(nx)[None, :].astype(float), t[:, None])
+    np.testing.assert_allclose(fine, truth, atol=1e-9 * np.abs(truth).max())  # interpolation, not an approximation
+    assert np.std(fine) == pytest.approx(np.std(truth), rel=1e-9)
+    assert rms_gradient(fine, dx, dx) == pytest.approx(rms_gradient(truth, dx, dx), rel=1e-9)
+    # and against a wrong resampling: nearest rows lose the gradient along y
+    nearest = z[np.minimum(np.round(t).astype(int), ny - 1)]
+    assert abs(rms_gradient(nearest, dx, dx) / rms_gradient(truth, dx, dx) - 1) > 0.01
+
+
+def test_downsampling_keeps_long_waves_and_removes_short_ones_without_aliasing():
+    n = 128
+    x = np.arange(n, dtype=float)
+    long_wave = np.cos(np.pi * 6 * (x + 0.5) / n)  # 43 pixels: far below the new Nyquist
+    short_wave = np.cos(np.pi * 100 * (x + 0.5) / n)  # 2.6 pixels: above the Nyquist of pixels 4 times larger
+    coarse = cosine_resample(np.outer(long_wave + short_wave, np.ones(8)), 0, 1.0, 4.0)[:, 0]
+    t = np.arange(coarse.size) * 4.0
+    np.testing.assert_allclose(coarse, np.cos(np.pi * 6 * (t + 0.5) / n), atol=1e-9)
+    plain = (long_wave + short_wave)[::4]  # taking every 4th point folds the short wave back
+    assert np.max(np.abs(plain - np.cos(np.pi * 6 * (t + 0.5) / n))) > 0.5
+
+
+def test_levelling_removes_the_least_squares_plane_and_quadratic_and_says_what_they_carried():
+    rng = np.random.default_rng(3)
+    ny, nx = 30, 50
+    rough = rng.standard_normal((ny, nx))
+    y, x = np.mgrid[0:ny, 0:nx].astype(float)
+    tilted = rough + 0.5 * x - 0.3 * y + 7.0
+    curved = tilted + 0.1 * (x - 20) ** 2 + 0.01 * x * y
+    for z, degree in ((tilted, 1), (curved, 2)):
+        design = [np.ones_like(x), x, y] + ([x * x, x * y, y * y] if degree == 2 else [])
+        A = np.stack([d.ravel() for d in design], axis=1)
+        residual = z.ravel() - A @ np.linalg.lstsq(A, z.ravel(), rcond=None)[0]  # brute force
+        out = level(z, "plane" if degree == 1 else "quadratic")
+        np.testing.assert_allclose(out.heights.ravel(), residual, atol=1e-9)
+        assert out.rms_after == pytest.approx(np.std(residual), rel=1e-9)
+    tilt = level(tilted, "mean")
+    assert tilt.plane_share > 0.9 and "a tilt carries" in levelling_warning(tilt, "mean")
+    assert levelling_warning(level(tilted, "plane"), "plane") is None
+    bowl = level(curved, "plane")
+    assert bowl.curvature_share / (1 - bowl.plane_share) > 0.5 and "detrend: quadratic" in levelling_warning(bowl, "plane")
+    assert levelling_warning(level(rough, "mean"), "mean") is None
+
+
+def test_despike_replaces_a_spike_and_nothing_else():
+    z, _ = band_limited(40, 48, seed=5, top=0.2)
+    spiky = z.copy()
+    spiky[20, 30:32] += 13 * np.std(z)
+    cleaned, count = despike(spiky, 6.0, float(np.std(z)))
+    assert count == 2
+    untouched = np.ones(z.shape, bool)
+    untouched[20, 30:32] = False
+    np.testing.assert_array_equal(cleaned[untouched], z[untouched])
+    assert np.max(np.abs(cleaned[20, 30:32] - z[20, 30:32])) < 0.2 * np.std(z)  # smooth surface: Laplace fills it well
+    assert despike(z, 6.0, float(np.std(z)))[1] == 0
+
+
+def test_region_and_downsample_in_the_summary(tmp_path):
+    z, _ = band_limited(60, 80, seed=1, top=0.3)
+    np.save(tmp_path / "map.npy", z)
+    whole = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, unit="um")
+    crop = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, unit="um", detrend="none",
+                       region={"x": [10, 50], "y": [5, 45]})  # fmt: skip
+    by_length = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, unit="um", detrend="none",
+                            region={"x": [5.0, 25.0], "y": [2.5, 22.5], "units": "length"})  # fmt: skip
+    np.testing.assert_array_equal(crop.generate(None).heights, z[5:45, 10:50])
+    np.testing.assert_array_equal(by_length.generate(None).heights, z[5:45, 10:50])
+    assert crop.input_summary()["region_pixels"] == [[10, 50], [5, 45]] and crop.grid_shape() == (40, 40)
+    down = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, unit="um", downsample={"factor": 2})
+    made = down.generate(None)
+    assert made.spacing == 1.0 and made.heights.shape == (30, 40) == down.grid_shape()
+    assert down.input_summary()["downsampled"] == {"from_pixel": 0.5, "to_pixel": 1.0}
+    assert whole.input_summary()["detrend"] == "mean" and whole.input_summary()["detrend_from"] == "default"
+    with pytest.raises(ValueError, match=r"region.x = \[10, 500\] \(pixels\) is not inside the map, 80 pixels"):
+        SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, region={"x": [10, 500]}).generate(None)
+    with pytest.raises(ValueError, match="downsample takes one of factor"):
+        SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, downsample={"factor": 2, "pixel": 1.0})
