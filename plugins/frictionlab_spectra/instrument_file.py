@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -68,8 +69,9 @@ def scan_header(path: Path, where: str, *, dimension: int) -> ScanHeader | None:
     with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            channel = open_topography(_by_name(fh)).default_channel
-            shape, periodic = tuple(int(n) for n in channel.nb_grid_pts), bool(channel.is_periodic)
+            with _closed_after(open_topography(_by_name(fh))) as reader:
+                channel = reader.default_channel
+                shape, periodic = tuple(int(n) for n in channel.nb_grid_pts), bool(channel.is_periodic)
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
     return ScanHeader(shape[::-1], periodic) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
@@ -96,6 +98,19 @@ def _reader_opener(path: Path, where: str):
     return open_topography
 
 
+@contextmanager
+def _closed_after(reader):
+    """``reader``, closed when the block ends, however it ends. A reader left open (the
+    HDF5 one holds its h5py file in a cycle with its channels, which only the cycle collector
+    frees, and the command freezes it at exit) is closed by libhdf5's own exit handler after
+    Python has finalized: h5py's close callback for a Python file object then takes the GIL
+    of an interpreter that is gone, and the process dies of SIGSEGV after its message."""
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
 def open_input(path: Path, where: str):
     """The file opened for reading if it is a regular file (never a FIFO or a device)."""
     try:
@@ -113,10 +128,10 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     with open_input(path, where) as fh, warnings.catch_warnings():
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         try:
-            reader = open_topography(fh)
-            channel = reader.default_channel
-            topography = reader.topography(channel_index=channel.index)
-            heights = topography.heights()
+            with _closed_after(open_topography(fh)) as reader:
+                channel = reader.default_channel
+                topography = reader.topography(channel_index=channel.index)
+                heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
             raise ValueError(
                 f"{where}: not an instrument file SurfaceTopography reads ({type(exc).__name__}); "
