@@ -51,7 +51,7 @@ def test_bootstrap_pairs_keep_the_correlation_the_rectangle_loses():
     assert exact.xi_ci == pytest.approx((0.4, 0.4), abs=1e-12) and exact.interval == "bootstrap pairs"
     box = predict_xi(LogFit(0.4 - 0.07 * math.log(f0), 0.07, a_ci=(pairs[0, 0], pairs[-1, 0]), b_ci=(0.05, 0.09)), **kw)
     corners = [a + bb * math.log(f0) for a in (pairs[0, 0], pairs[-1, 0]) for bb in (0.05, 0.09)]
-    assert box.xi_ci == (min(corners), max(corners)) and box.xi_ci[1] - box.xi_ci[0] > 1.0
+    assert box.xi_ci == pytest.approx((min(corners), max(corners)), rel=1e-12) and box.xi_ci[1] - box.xi_ci[0] > 1.0
 
 
 def test_pairs_from_a_run_folder_are_the_runs_own(tmp_path, make_scene):
