@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import errno
 import hashlib
+import math
 import os
 import stat
 from pathlib import Path
@@ -106,10 +107,30 @@ def read_regular_file(
         size = os.fstat(fh.fileno()).st_size
         if limit is not None and size > limit:
             raise InputFileProblem(f"{what} of {size:,} bytes, more than the limit of {limit:,} bytes")
-        data = fh.read() if limit is None else fh.read(limit + 1)
+        data = read_bounded(fh, size, limit)
     if limit is not None and len(data) > limit:  # it grew while read
         raise InputFileProblem(f"{what} of more than the limit of {limit:,} bytes")
     return data
+
+
+GROWTH_BLOCK = 1 << 20  # what is read at a time of a file that grew past its size
+
+
+def read_bounded(fh, size: int, limit: int | None) -> bytes:
+    """What the open binary file ``fh`` of ``size`` bytes (its fstat) holds, and at
+    most one byte past ``limit``: the buffers are sized by what the file holds, never
+    by the cap (a cap as a buffer is allocated whole: 16 GiB for a chunk of a few kB,
+    which a process under a virtual-memory limit cannot have)."""
+    cap = math.inf if limit is None else limit + 1
+    parts = [fh.read(min(size + 1, cap))]
+    got = len(parts[0])
+    while got > size and got < cap:  # it grew while read: the rest in blocks
+        block = fh.read(min(GROWTH_BLOCK, cap - got))
+        if not block:
+            break
+        parts.append(block)
+        got += len(block)
+    return b"".join(parts) if len(parts) > 1 else parts[0]
 
 
 def sha256_of(path: str | Path) -> str:

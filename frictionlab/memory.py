@@ -104,6 +104,15 @@ def available_memory() -> tuple[int, str]:
     """Bytes this process may still use, and where the figure comes from: the
     smallest of MemAvailable, the room left under a cgroup limit, and under the
     process limits RLIMIT_AS and RLIMIT_DATA."""
+    found = _machine_rooms() + _process_limits()
+    if not found:
+        return 2**62, "unknown: the platform does not say"
+    return min(found)
+
+
+def _machine_rooms() -> list[tuple[int, str]]:
+    """The room the machine leaves to all the run's processes together: MemAvailable, and
+    what a cgroup limit leaves."""
     import psutil  # the machine's available memory on every platform (MemAvailable on Linux)
 
     found: list[tuple[int, str]] = []
@@ -122,16 +131,14 @@ def available_memory() -> tuple[int, str]:
             continue
         if limit.isdigit() and int(limit) < 2**60:
             found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
-    found += _process_limits()
-    if not found:
-        return 2**62, "unknown: the platform does not say"
-    return min(found)
+    return found
 
 
 def _process_limits() -> list[tuple[int, str]]:
     """Room left under this process's limits on address space and data (``ulimit -v``,
-    ``ulimit -d``), which the workers inherit: counted against the whole run's peak, an
-    upper bound, since a run past them dies of MemoryError in every realization."""
+    ``ulimit -d``), which each worker process inherits: a limit of each process, not of the
+    run (``check_fits``). The room is the limit less the address space this process holds,
+    which a worker, importing the same modules, holds too."""
     try:
         import resource
     except ImportError:  # not on Windows
@@ -145,6 +152,31 @@ def _process_limits() -> list[tuple[int, str]]:
         if soft != resource.RLIM_INFINITY:
             found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
     return found
+
+
+def _largest_process(guess: MemoryEstimate) -> int:
+    """The peak of the run's largest process: the main one (its rows, and the realization it
+    measures before the workers start, or runs itself), or a worker."""
+    return max(guess.main + guess.per_realization, guess.per_worker)
+
+
+def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> None:
+    """Refuse (RunError) a run one of whose processes would pass a process limit (``ulimit
+    -v``, ``ulimit -d``), naming it and a grid that would fit: fewer workers never help,
+    since each worker has the whole limit to itself."""
+    need = _largest_process(guess)
+    for room, source in _process_limits():
+        if need <= room:
+            continue
+        points_param = _points_path(scene)
+        fits = _largest_process(estimate(scene, workers=1, executor=executor, points=1)) <= room
+        advice = (f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}" if points_param and fits
+                  else "fewer realizations")  # fmt: skip
+        raise RunError(
+            f"one process of this run would need about {gib(need)} at its peak (a realization of {guess.points:,} points: "
+            f"{gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
+            f"limit to itself). It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
+        )
 
 
 def _points_path(scene: Scene) -> str | None:
@@ -182,6 +214,10 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         executor, workers = "serial", 1
     guess = estimate(scene, workers=workers, executor=executor)
     available, source = available_memory()
+    if executor != "serial" and source.startswith("the process limit"):
+        # a process limit bounds each of the run's processes, not their sum: the sum is the machine's to bound
+        _check_each_process(scene, guess, executor)
+        available, source = min(_machine_rooms(), default=(2**62, "unknown: the platform does not say"))
     if guess.total <= available:
         return guess
     advice = []

@@ -8,6 +8,7 @@ switch): nothing here needs a display, and a notebook's own backend is left alon
 
 from __future__ import annotations
 
+import math
 import textwrap
 from typing import Any
 
@@ -44,6 +45,17 @@ def draw_curve(ax, f, xi, xi_sem, fit: LogFit | None, *, done: int, caveats=(), 
             0.99, 0.02 + 0.09 * i, "caveat: " + textwrap.fill(caveat, 70), transform=ax.transAxes, ha="right",
             va="bottom", fontsize=fontsize - 1, color="C3", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0},
         )  # fmt: skip
+
+
+def draw_interval(ax, x, estimate, low, high, fmt: str, *, color, capsize: float = 3, label=None, **line) -> None:
+    """Each estimate (joined as ``fmt`` says) with its interval drawn from its low end to its
+    high end, wherever the estimate lies: a bootstrap's percentile interval need not contain
+    its estimate (a small ensemble), and error bars measured from the estimate would then
+    have a negative length. A missing end (NaN) draws no interval."""
+    x, estimate, low, high = (np.asarray(v, dtype=float) for v in (x, estimate, low, high))
+    ax.errorbar(x, (low + high) / 2, yerr=np.abs(high - low) / 2, fmt="none", ecolor=color, capsize=capsize,
+                elinewidth=line.get("lw"))  # fmt: skip
+    ax.plot(x, estimate, fmt, color=color, label=label, **line)
 
 
 def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
@@ -98,10 +110,8 @@ def sweep_figure(sweep, rows: list[dict[str, Any]]) -> Figure:
             for i, (key, members) in enumerate(series.items()):
                 members = sorted(members, key=lambda r: r[path] if numeric else repr(r[path]))
                 x = [m[path] if numeric else order.index(repr(m[path])) for m in members]
-                y = [m[coef] for m in members]
-                lo = [m[coef] - m[f"{coef}_lo"] if m[f"{coef}_lo"] is not None else 0 for m in members]
-                hi = [m[f"{coef}_hi"] - m[coef] if m[f"{coef}_hi"] is not None else 0 for m in members]
-                ax.errorbar(x, y, yerr=[lo, hi], fmt="o-", ms=4, capsize=3, color=f"C{i}", label=key or None)
+                ends = [[math.nan if m[f"{coef}_{end}"] is None else m[f"{coef}_{end}"] for m in members] for end in ("lo", "hi")]
+                draw_interval(ax, x, [m[coef] for m in members], *ends, "o-", ms=4, color=f"C{i}", label=key or None)
             if not numeric:
                 ax.set_xticks(range(len(order)), [o.strip("'") for o in order], rotation=20, fontsize=8)
             elif sweep.spec.parameters[path].spacing == "log" and min(xs_all, default=1) > 0:

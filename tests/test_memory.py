@@ -346,3 +346,47 @@ def test_the_check_of_a_huge_surface_allocates_nothing_in_proportion_to_it(regis
     assert "REFUSED this run would need about" in done.stdout and "4,294,967,296 points" in done.stdout, done.stderr
     growth = int(done.stdout.split("GROWTH_KIB ")[1])
     assert growth < 200 * 1024  # KiB: a 65536² array of float64 alone is 32 GiB
+
+
+# ------------------------------------------------------------------ a process limit is each process's
+
+
+def _under_a_process_limit(monkeypatch, room: int, machine: int = 64 * GiB) -> None:
+    source = "the process limit RLIMIT_AS (ulimit -v) less what this process uses"
+    monkeypatch.setattr(memory, "_process_limits", lambda: [(room, source)])
+    monkeypatch.setattr(memory, "_machine_rooms", lambda: [(machine, "a test machine")])
+
+
+def test_workers_under_ulimit_v_each_have_the_limit_to_themselves(registry, monkeypatch):
+    """Under ``ulimit -v`` each worker process has the whole limit: 16 workers of 0.2 GiB
+    realizations fit under a 1 GiB limit (the sum, 4.7 GiB, is the machine's to bound),
+    where they were refused as if the workers shared it ('It would fit with --workers 3')."""
+    scene = build_scene(line_of(2_000_000), registry=registry)
+    guess = memory.estimate(scene, workers=16, executor="processes")
+    assert guess.total > 4 * GiB and memory._largest_process(guess) < GiB
+    _under_a_process_limit(monkeypatch, 1 * GiB)
+    assert memory.check_fits(scene, workers=16, executor="processes") == guess
+    _under_a_process_limit(monkeypatch, 1 * GiB, machine=2 * GiB)  # the machine still bounds the sum
+    with pytest.raises(RunError, match=r"but 2\.00 GiB is available \(a test machine\)\. It would fit with --workers \d+\."):
+        memory.check_fits(scene, workers=16, executor="processes")
+
+
+def test_a_realization_past_the_process_limit_is_refused_naming_it_and_a_grid_that_fits(registry, monkeypatch):
+    scene = build_scene(line_of(20_000_000), registry=registry)  # 2.1 GiB a realization
+    _under_a_process_limit(monkeypatch, 1 * GiB)
+    with pytest.raises(RunError) as caught:
+        memory.check_fits(scene, workers=4, executor="processes")
+    message = str(caught.value)
+    assert message.startswith("one process of this run would need about 2.") and "RLIMIT_AS (ulimit -v)" in message
+    assert "each worker process has the limit to itself" in message
+    offered = offered_points(message)
+    fits = memory.estimate(scene, workers=1, executor="processes", points=offered)
+    too_many = memory.estimate(scene, workers=1, executor="processes", points=offered + 1)
+    assert memory._largest_process(fits) <= GiB < memory._largest_process(too_many)
+
+
+def test_a_serial_run_under_a_process_limit_counts_its_whole_peak_against_it(registry, monkeypatch):
+    scene = build_scene(line_of(8_000_000), registry=registry)  # one process: the limit bounds the whole run
+    _under_a_process_limit(monkeypatch, memory.estimate(scene, workers=1, executor="serial").total - 1)
+    with pytest.raises(RunError, match=r"RLIMIT_AS \(ulimit -v\) less what this process uses\)\. It would fit with"):
+        memory.check_fits(scene, workers=1, executor="serial")

@@ -10,6 +10,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import ScalarFormatter  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..plot import draw_interval  # noqa: E402
 from .analysis import FEW_SPOTS, KAPPA_BUSH, KAPPA_PERSSON, KAPPA_SIMULATIONS, KAPPA_WINDOW  # noqa: E402
 from .numbers import Numbers  # noqa: E402
 from .plan import MAIN, SIDE, StudyRuns  # noqa: E402
@@ -135,7 +136,7 @@ def plot_convergence(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> No
         quoted = np.array([e.quoted for e in grids])
         for ax, (name, values) in zip(axes, rows.items()):
             value, low, high = np.array(values).T
-            ax.errorbar(x, value, yerr=[value - low, high - value], fmt="-", capsize=2, color=f"C{i}", lw=0.9)
+            draw_interval(ax, x, value, low, high, "-", capsize=2, color=f"C{i}", lw=0.9)
             ax.plot(x[quoted], value[quoted], "o", ms=4, color=f"C{i}", label=f"H = {hurst:g}")
             ax.plot(x[~quoted], value[~quoted], "o", ms=4, mfc="white", color=f"C{i}")
             if name != "κ":

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from matplotlib.figure import Figure
+
+from ..plot import draw_interval
 from .figures import PAPER_H07, PAPER_POINTS_VS_H, FigureRun
 from .readings import ReadingRow
 
@@ -65,8 +67,7 @@ def _plot_against_h(axes, series, label: str, color: str, offset: float = 0.0) -
     """a and b (with their intervals) against H on two axes."""
     for ax, coef in zip(axes, ("a", "b"), strict=True):
         y, low, high = series[coef].T
-        ax.errorbar(series["H"] + offset, y, yerr=[y - low, high - y], fmt="o-", ms=4, capsize=3, color=color,
-                    label=label)  # fmt: skip
+        draw_interval(ax, series["H"] + offset, y, low, high, "o-", ms=4, color=color, label=label)
 
 
 def _mark_paper_against_h(axes) -> None:

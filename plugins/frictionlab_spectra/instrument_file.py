@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -72,10 +73,10 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
     """The shape and periodicity ``read_scan`` gives, from the reader's metadata alone: what
     the memory estimate needs before a run reads the file. None when the metadata does not
     say, or says another dimension (``read_scan`` then reads the file and names the problem)."""
-    with open_input(path, where) as fh, warnings.catch_warnings():
+    with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
         warnings.simplefilter("ignore")
         try:
-            reader = _open_reader(fh, path, where)
+            reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
             sizes = chosen.physical_sizes
@@ -118,6 +119,19 @@ def _require_extra(path: Path, where: str) -> None:
         ) from None
 
 
+@contextmanager
+def _closed_after(reader):
+    """``reader``, closed when the block ends, however it ends. A reader left open (the
+    HDF5 one holds its h5py file in a cycle with its channels, which only the cycle collector
+    frees, and the command freezes it at exit) is closed by libhdf5's own exit handler after
+    Python has finalized: h5py's close callback for a Python file object then takes the GIL
+    of an interpreter that is gone, and the process dies of SIGSEGV after its message."""
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
 def open_input(path: Path, where: str):
     """The file opened for reading if it is a regular file (never a FIFO or a device)."""
     try:
@@ -145,9 +159,9 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
               channel: str | int | None = None) -> Scan:  # fmt: skip
     """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and pixel sides
     converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
-    with open_input(path, where) as fh, warnings.catch_warnings():
+    with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
-        reader = _open_reader(fh, path, where)
+        reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
         if chosen.nb_grid_pts is not None:
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
@@ -183,6 +197,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         periodic = bool(topography.is_periodic)
         listed = channel_list(reader) if len(reader.channels) > 1 else []
+        file_format = str(reader.name())
     shown = " x ".join(f"{p:g}" for p in pixel)
     if not np.all(pixel > 0):  # NaN too
         raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
@@ -201,7 +216,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         unit=unit if unit is not None else file_unit,
         file_unit=file_unit,
         periodic=periodic,
-        format=str(reader.name()),
+        format=file_format,
         channel=str(chosen.name),
         channel_index=int(chosen.index),
         channel_note=note,

@@ -8,7 +8,7 @@ import pytest
 
 from frictionlab import mdr_length
 from frictionlab.cli import main
-from frictionlab.fit import LogFit
+from frictionlab.fit import LogFit, percentile_interval
 from frictionlab.options import RunOptions
 from frictionlab.paper.predict import (
     bootstrap_pairs,
@@ -51,7 +51,7 @@ def test_bootstrap_pairs_keep_the_correlation_the_rectangle_loses():
     assert exact.xi_ci == pytest.approx((0.4, 0.4), abs=1e-12) and exact.interval == "bootstrap pairs"
     box = predict_xi(LogFit(0.4 - 0.07 * math.log(f0), 0.07, a_ci=(pairs[0, 0], pairs[-1, 0]), b_ci=(0.05, 0.09)), **kw)
     corners = [a + bb * math.log(f0) for a in (pairs[0, 0], pairs[-1, 0]) for bb in (0.05, 0.09)]
-    assert box.xi_ci == (min(corners), max(corners)) and box.xi_ci[1] - box.xi_ci[0] > 1.0
+    assert box.xi_ci == pytest.approx((min(corners), max(corners)), rel=1e-12) and box.xi_ci[1] - box.xi_ci[0] > 1.0
 
 
 def test_pairs_from_a_run_folder_are_the_runs_own(tmp_path, make_scene):
@@ -59,8 +59,9 @@ def test_pairs_from_a_run_folder_are_the_runs_own(tmp_path, make_scene):
     pairs = bootstrap_pairs(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert pairs.shape == (summary["fit"]["bootstrap"], 2)
-    low, high = np.percentile(pairs, [2.5, 97.5], axis=0)
-    assert (low[0], high[0]) == tuple(summary["fit"]["a_ci"]) and (low[1], high[1]) == tuple(summary["fit"]["b_ci"])
+    low, high = percentile_interval(pairs, outcome.fit.confidence, axis=0)  # the fit's own function, its own tails
+    assert (low[0], high[0]) == pytest.approx(tuple(summary["fit"]["a_ci"]), rel=1e-12, abs=1e-15)
+    assert (low[1], high[1]) == pytest.approx(tuple(summary["fit"]["b_ci"]), rel=1e-12, abs=1e-15)
     law, fitted_f, law_pairs = read_run_law(tmp_path)
     assert fitted_f == (outcome.f.min(), outcome.f.max())
     assert (law.a, law.b, law.a_ci, law.b_ci) == (outcome.fit.a, outcome.fit.b, outcome.fit.a_ci, outcome.fit.b_ci)
@@ -100,5 +101,6 @@ def test_pairs_from_a_run_whose_lines_lack_xi_at_low_forces(tmp_path):
     assert outcome.lines_used[0] < 30 and np.isnan(outcome.per_realization["xi"]).any()
     assert f"up to {30 - outcome.lines_used.min()} of 30 lines have no xi at a load" in outcome.caveats[-1]
     pairs = bootstrap_pairs(tmp_path)
-    low, high = np.percentile(pairs, [2.5, 97.5], axis=0)
-    assert (low[0], high[0]) == outcome.fit.a_ci and (low[1], high[1]) == outcome.fit.b_ci
+    low, high = percentile_interval(pairs, outcome.fit.confidence, axis=0)  # the fit's own function, its own tails
+    assert (low[0], high[0]) == pytest.approx(outcome.fit.a_ci, rel=1e-12, abs=1e-15)
+    assert (low[1], high[1]) == pytest.approx(outcome.fit.b_ci, rel=1e-12, abs=1e-15)

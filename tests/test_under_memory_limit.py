@@ -1,0 +1,180 @@
+"""The user's path under a virtual-memory limit of 2 GiB (``ulimit -v 2097152``), as on a
+login node or in a container where the kernel does not overcommit.
+
+Each command runs in a process of its own whose RLIMIT_AS is set before it starts: a run
+(serial and on worker processes), a resume, ``frictionlab.load``, ``runs``, ``follow``,
+``report --figures`` (the paper's presets shrunk), ``validate`` of an instrument file, a
+sweep and a 256 x 256 exact half-space run. Each must end with exit 0 and the numbers of
+the same work done without the limit (in this process); a run that truly needs more is
+refused before it starts, naming the limit. A buffer sized by a cap instead of by the data
+(16 GiB for a chunk of a few kB) failed every one of them.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.options import RunOptions
+from frictionlab.preset import apply_overrides, build_scene, load_preset_file
+from frictionlab.runner import run_to_folder
+
+from .conftest import PRESETS
+from .test_resume import CancelAfter, same_files
+
+pytestmark = pytest.mark.long  # about twenty processes, each importing numpy, scipy and matplotlib
+
+LIMIT = 2 * 1024**3  # bytes of address space: ulimit -v 2097152
+
+SMALL = {
+    "name": "small", "seed": 3, "realizations": 8, "fit": {"bootstrap": 50},
+    "spectrum": {"name": "power-law", "params": {"hurst": 0.8, "points": 4096, "spacing": 1.0, "rms_height": 1.0}},
+    "solver": {"name": "mdr"}, "loading": {"start": 0.5, "stop": 50.0, "steps": 12, "spacing": "log"},
+}  # fmt: skip
+SWEEP = {**SMALL, "name": "sweep", "realizations": 4, "output": {"plot": False},
+         "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.9]}}}}  # fmt: skip
+HALF_SPACE = {
+    "name": "half-space", "seed": 5, "realizations": 2, "fit": {"bootstrap": 20}, "output": {"plot": False},
+    "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 256, "length": 32.0, "long_cutoff": 16.0,
+                                                    "short_cutoff": 2.0, "rms_height": 1.0}},
+    "solver": {"name": "bem-halfspace"}, "loading": {"start": 1.5, "stop": 30.0, "steps": 4, "spacing": "log"},
+}  # fmt: skip
+REPORT_SMALL = ["spectrum.params.points=1024", "spectrum.params.length=1024.0", "spectrum.params.rms_height=300.0",
+                "loading.steps=12", "fit.bootstrap=20", "realizations=4"]  # fmt: skip
+
+
+def _limit_address_space():
+    resource.setrlimit(resource.RLIMIT_AS, (LIMIT, LIMIT))
+
+
+def limited(*args, cwd, python: str | None = None) -> subprocess.CompletedProcess:
+    """``frictionlab ARGS`` (or ``python -c PYTHON``) in a process whose address space is limited to 2 GiB."""
+    command = [sys.executable, "-c", python] if python else [sys.executable, "-m", "frictionlab", *args]
+    return subprocess.run(command, capture_output=True, text=True, cwd=cwd, timeout=300, preexec_fn=_limit_address_space)
+
+
+def ok(done: subprocess.CompletedProcess) -> subprocess.CompletedProcess:
+    assert done.returncode == 0, (done.returncode, done.stderr[-3000:])
+    assert "Traceback" not in done.stderr and "out of memory" not in done.stderr
+    return done
+
+
+def write(folder, name: str, data: dict) -> str:
+    path = folder / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The small run done without a limit, in this process."""
+    folder = tmp_path_factory.mktemp("reference") / "run"
+    run_to_folder(build_scene(SMALL), folder, RunOptions(workers=1))
+    return folder
+
+
+@pytest.mark.parametrize("workers", [["--workers", "1"], ["--workers", "2", "--executor", "processes"]], ids=["serial", "processes"])
+def test_a_run_ends_with_exit_0_and_the_numbers_of_an_unlimited_run(tmp_path, reference, workers):
+    ok(limited("run", write(tmp_path, "small", SMALL), "--out", str(tmp_path / "run"), *workers, cwd=tmp_path))
+    same_files(tmp_path / "run", reference)
+    assert (tmp_path / "run" / "plot.png").stat().st_size > 0
+
+
+def test_a_resume_ends_where_the_unlimited_run_ends(tmp_path, reference):
+    cancel = threading.Event()
+    first, _ = run_to_folder(build_scene(SMALL), tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(3, cancel)],
+                             cancel=cancel)  # fmt: skip
+    assert first.status == "cancelled" and first.done < SMALL["realizations"]
+    ok(limited("resume", str(tmp_path / "run"), "--workers", "1", cwd=tmp_path))
+    same_files(tmp_path / "run", reference)
+
+
+def test_load_runs_and_follow_read_a_finished_run(tmp_path, reference):
+    import frictionlab
+
+    code = ("import json, sys, frictionlab\nr = frictionlab.load(sys.argv[1])\n"
+            "print(json.dumps({'a': r.fit.a, 'b': r.fit.b, 'xi': [float(x) for x in r.table['xi']]}))\n")  # fmt: skip
+    done = ok(subprocess.run([sys.executable, "-c", code, str(reference)], capture_output=True, text=True, timeout=120,
+                             preexec_fn=_limit_address_space))  # fmt: skip
+    here = frictionlab.load(reference)
+    assert json.loads(done.stdout) == {"a": here.fit.a, "b": here.fit.b, "xi": [float(x) for x in here.table["xi"]]}
+    listed = json.loads(ok(limited("runs", str(reference.parent), "--json", cwd=tmp_path)).stdout)
+    assert "completed" in json.dumps(listed)
+    ok(limited("follow", str(reference), cwd=tmp_path))
+
+
+def test_report_with_figures_of_the_shrunk_paper_presets(tmp_path):
+    from frictionlab.paper.figures import FIGURES
+
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for fig in FIGURES:
+        data = apply_overrides(load_preset_file(PRESETS / fig.preset), REPORT_SMALL)
+        (presets / fig.preset).write_text(yaml.safe_dump(data, sort_keys=False))
+    out, figures = tmp_path / "report", tmp_path / "figures"
+    ok(limited("report", "--presets", str(presets), "--out", str(out), "--figures", str(figures), "--workers", "1", "--quiet",
+               cwd=tmp_path))  # fmt: skip
+    assert (out / "REPRODUCTION.md").is_file() and sorted(p.suffix for p in figures.iterdir()) == [".png"] * len(
+        list(figures.iterdir())
+    ) and any(figures.iterdir())
+    fig2 = next(fig for fig in FIGURES if fig.key == "fig2")
+    data = apply_overrides(load_preset_file(presets / fig2.preset), ["output.plot=false"])
+    run_to_folder(build_scene(data), tmp_path / "fig2", RunOptions(workers=1))
+    with np.load(out / "fig2" / "realizations.npz") as limited_run, np.load(tmp_path / "fig2" / "realizations.npz") as free:
+        for name in free.files:
+            np.testing.assert_array_equal(limited_run[name], free[name], err_msg=name)
+
+
+def test_validate_of_an_instrument_file_says_what_an_unlimited_process_says(tmp_path):
+    from SurfaceTopography import Topography
+
+    z = np.random.default_rng(4).standard_normal((64, 64))
+    Topography(z, (16.0, 16.0), unit="um").to_netcdf(str(tmp_path / "scan.nc"))
+    preset = write(tmp_path, "scan", {**SMALL, "spectrum": {"name": "surface-file", "params": {"path": "scan.nc", "unit": "um"}}})
+    under = ok(limited("validate", preset, cwd=tmp_path))
+    free = subprocess.run([sys.executable, "-m", "frictionlab", "validate", preset], capture_output=True, text=True, cwd=tmp_path,
+                          timeout=120)  # fmt: skip
+    assert free.returncode == 0 and under.stdout == free.stdout and "scan.nc" in under.stdout
+
+
+def test_a_sweep_gives_the_numbers_of_an_unlimited_sweep(tmp_path):
+    from frictionlab.sweep import plan_sweep, run_sweep
+
+    ok(limited("run", write(tmp_path, "sweep", SWEEP), "--out", str(tmp_path / "sweep"), "--workers", "1", cwd=tmp_path))
+    run_sweep(plan_sweep(SWEEP), tmp_path / "free", RunOptions(workers=1), plot=False)
+    points = sorted(p.name for p in (tmp_path / "free" / "points").iterdir())
+    assert len(points) == 2 and points == sorted(p.name for p in (tmp_path / "sweep" / "points").iterdir())
+    for point in points:
+        same_files(tmp_path / "sweep" / "points" / point, tmp_path / "free" / "points" / point)
+    under, free = (_untimed_rows(tmp_path / folder / "sweep.csv") for folder in ("sweep", "free"))
+    assert under == free and len(under) == 2
+
+
+def _untimed_rows(path) -> list[dict]:
+    """sweep.csv's rows without the time each point took."""
+    import csv
+
+    with open(path, newline="") as fh:
+        return [{k: v for k, v in row.items() if k != "elapsed_s"} for row in csv.DictReader(fh)]
+
+
+def test_an_exact_half_space_run_of_256_by_256_pixels(tmp_path):
+    ok(limited("run", write(tmp_path, "half-space", HALF_SPACE), "--out", str(tmp_path / "run"), "--workers", "1", cwd=tmp_path))
+    run_to_folder(build_scene(HALF_SPACE), tmp_path / "free", RunOptions(workers=1))
+    same_files(tmp_path / "run", tmp_path / "free")
+
+
+def test_a_run_that_needs_more_is_refused_before_it_starts_naming_the_limit(tmp_path):
+    preset = write(tmp_path, "large", {**SMALL, "spectrum": {**SMALL["spectrum"], "params": {
+        **SMALL["spectrum"]["params"], "points": 30_000_000}}})  # fmt: skip
+    done = limited("run", preset, "--out", str(tmp_path / "run"), "--workers", "1", cwd=tmp_path)
+    assert done.returncode == 1, done.stderr[-3000:]
+    assert "the process limit RLIMIT_AS (ulimit -v)" in done.stderr and "spectrum.params.points <=" in done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "run").exists()
