@@ -144,6 +144,10 @@ class ContactCurve:
     ``real_area_corrected``: the real contact area corrected for the pixels the
     contact's perimeter crosses, a fraction of the nominal area; given exactly when
     the solver declares ``corrected_area``, None otherwise.
+    ``real_gradient_rms``: g_r, the rms of the slopes over the real contact, each contact
+    pixel weighted by its share of the perimeter-corrected area (N - c M pixels, with
+    ``c = 0`` it is ``slope_rms_contact``); dimensionless, a slope. Given exactly when the
+    solver declares ``real_gradient``, None otherwise.
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
     """
 
@@ -153,6 +157,7 @@ class ContactCurve:
     contact_fraction: np.ndarray
     slope_rms_contact: np.ndarray
     real_area_corrected: np.ndarray | None = None
+    real_gradient_rms: np.ndarray | None = None
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
 
@@ -444,6 +449,9 @@ class ContactSolver(Plugin):
     - ``corrected_area`` (False): True when ``solve`` also gives the real area
       corrected for the contact's perimeter (``ContactCurve.real_area_corrected``);
       the results then carry it beside the pixel count.
+    - ``real_gradient`` (False): True when ``solve`` also gives g_r, the rms slope over
+      the perimeter-corrected real contact (``ContactCurve.real_gradient_rms``); the
+      results then carry it, with kappa and kappa_r, beside the area.
     - ``indentation_reference`` ("undeformed body") and ``mean_displacement(f, h)``
       (zero): the mean displacement of the elastic surface in the indentation's
       frame, so that ``indentation - mean_displacement`` is measured from the mean
@@ -472,6 +480,7 @@ class ContactSolver(Plugin):
     approximation: ClassVar[bool] = False
     contact_measure: ClassVar[ContactMeasure] = "real contact"
     corrected_area: ClassVar[bool] = False
+    real_gradient: ClassVar[bool] = False
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False
