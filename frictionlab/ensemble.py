@@ -75,6 +75,7 @@ class RunOutcome:
     real_gradient_rms: np.ndarray | None = None
     kappa: np.ndarray | None = None
     kappa_r: np.ndarray | None = None
+    contact_spots: np.ndarray | None = None  # mean over realizations; None unless the solver counts spots
     extra: dict = field(default_factory=dict)
 
     @property
@@ -194,6 +195,8 @@ class Accumulator:
             per["real_area_corrected"] = self.stack("real_area_corrected")
         if scene.solver.real_gradient:
             per["real_gradient_rms"] = self.stack("real_gradient_rms")
+        if scene.solver.counts_spots:
+            per["contact_spots"] = self.stack("contact_spots")
         n = indices.size
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
@@ -268,6 +271,7 @@ class Accumulator:
             real_area_corrected=(per["real_area_corrected"].mean(axis=0) if n else nan_row)
             if scene.solver.corrected_area else None,
             **gradients,
+            contact_spots=(per["contact_spots"].mean(axis=0) if n else nan_row) if scene.solver.counts_spots else None,
         )
 
     def _gradients(self, per: dict, force: np.ndarray, points: int, extent: float, stiffness: float) -> dict:

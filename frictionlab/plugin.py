@@ -148,6 +148,8 @@ class ContactCurve:
     pixel weighted by its share of the perimeter-corrected area (N - c M pixels, with
     ``c = 0`` it is ``slope_rms_contact``); dimensionless, a slope. Given exactly when the
     solver declares ``real_gradient``, None otherwise.
+    ``contact_spots``: the number of contact spots (clusters of contact pixels joined along
+    rows and columns), given exactly when the solver declares ``counts_spots``.
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
     """
 
@@ -158,6 +160,7 @@ class ContactCurve:
     slope_rms_contact: np.ndarray
     real_area_corrected: np.ndarray | None = None
     real_gradient_rms: np.ndarray | None = None
+    contact_spots: np.ndarray | None = None
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
 
@@ -452,6 +455,8 @@ class ContactSolver(Plugin):
     - ``real_gradient`` (False): True when ``solve`` also gives g_r, the rms slope over
       the perimeter-corrected real contact (``ContactCurve.real_gradient_rms``); the
       results then carry it, with kappa and kappa_r, beside the area.
+    - ``counts_spots`` (False): True when ``solve`` also counts the contact spots
+      (``ContactCurve.contact_spots``); the results then carry their number.
     - ``indentation_reference`` ("undeformed body") and ``mean_displacement(f, h)``
       (zero): the mean displacement of the elastic surface in the indentation's
       frame, so that ``indentation - mean_displacement`` is measured from the mean
@@ -481,6 +486,7 @@ class ContactSolver(Plugin):
     contact_measure: ClassVar[ContactMeasure] = "real contact"
     corrected_area: ClassVar[bool] = False
     real_gradient: ClassVar[bool] = False
+    counts_spots: ClassVar[bool] = False
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False

@@ -53,6 +53,8 @@ GRADIENT_COLUMNS = {
     "p = F / A0; dimensionless; mean over realizations]",
     "kappa_r": "kappa_r [(A / A0) E* g_r / p; dimensionless; mean over realizations]",
 }
+SPOTS = "contact_spots"  # last, for the solvers that count spots
+SPOTS_HEADER = f"{SPOTS} [number of contact spots: clusters of contact pixels joined along rows and columns; mean over realizations]"
 INDENTATION_REFERENCES = {
     "undeformed body": "length; from the first touch; against the undeformed body",
     "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
@@ -159,7 +161,7 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     names = [column_name(h) for h in header]
     stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
     expected = [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]
-    optional = [CORRECTED_AREA, *GRADIENT_COLUMNS]  # in this order, for the solvers that give them
+    optional = [CORRECTED_AREA, *GRADIENT_COLUMNS, SPOTS]  # in this order, for the solvers that give them
     extra = stripped[len(expected) :]
     if stripped[: len(expected)] != expected or extra != [c for c in optional if c in extra] or len(set(extra)) != len(extra):
         raise RunFolderError(
@@ -181,7 +183,7 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
         if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
             problems.append("lines_used must be a whole number >= 0 at every load step")
     bounds = [("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)]
-    for column, low, high in bounds + [(name, 0.0, np.inf) for name in GRADIENT_COLUMNS]:
+    for column, low, high in bounds + [(name, 0.0, np.inf) for name in (*GRADIENT_COLUMNS, SPOTS)]:
         if column not in curve:
             continue
         values = curve[column][~np.isnan(curve[column])]
@@ -267,7 +269,8 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     writer = csv.writer(fh, lineterminator="\n")
     corrected = [CORRECTED_AREA_HEADER] if scene.solver.corrected_area else []
     gradient = list(GRADIENT_COLUMNS.values()) if scene.solver.real_gradient else []
-    writer.writerow(curve_header(scene) + corrected + gradient)
+    spots = [SPOTS_HEADER] if scene.solver.counts_spots else []
+    writer.writerow(curve_header(scene) + corrected + gradient + spots)
     columns = (
         outcome.force,
         outcome.f,
@@ -282,6 +285,8 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         columns = (*columns, outcome.real_area_corrected)
     if gradient:
         columns = (*columns, outcome.real_gradient_rms, outcome.kappa, outcome.kappa_r)
+    if spots:
+        columns = (*columns, outcome.contact_spots)
 
     for row in zip(*columns, strict=True):
         writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])

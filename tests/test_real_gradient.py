@@ -206,3 +206,57 @@ def test_a_resumed_run_keeps_g_r_and_an_older_chunk_without_it_reads_as_unknown(
     del arrays["real_gradient_rms"]  # as a version before g_r wrote it
     results = _chunk_results(arrays, 0, 2, scene)
     assert all(np.isnan(r.real_gradient_rms).all() for r in results if r.ok)
+
+
+def brute_spots(contact: np.ndarray, periodic: bool) -> int:
+    """Flood fill, pixel by pixel."""
+    ny, nx = contact.shape
+    seen = np.zeros(contact.shape, bool)
+    spots = 0
+    for i in range(ny):
+        for j in range(nx):
+            if contact[i, j] and not seen[i, j]:
+                spots += 1
+                stack = [(i, j)]
+                seen[i, j] = True
+                while stack:
+                    a, b = stack.pop()
+                    for da, db in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+                        c, d = a + da, b + db
+                        if not periodic and not (0 <= c < ny and 0 <= d < nx):
+                            continue
+                        c, d = c % ny, d % nx
+                        if contact[c, d] and not seen[c, d]:
+                            seen[c, d] = True
+                            stack.append((c, d))
+    return spots
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("seed", range(6))
+def test_spots_are_counted_as_a_flood_fill_counts_them(periodic, seed):
+    from frictionlab_solvers.contact_area import contact_spots
+
+    rng = np.random.default_rng(seed)
+    contact = rng.random((9, 11)) < (0.3 + 0.05 * seed)
+    assert contact_spots(contact, periodic=periodic) == brute_spots(contact, periodic)
+
+
+def test_a_band_across_the_periodic_boundary_is_one_spot_and_two_on_a_scan():
+    from frictionlab_solvers.contact_area import contact_spots
+
+    contact = np.zeros((6, 6), bool)
+    contact[:, 0] = contact[:, -1] = True  # one band wrapping round the boundary
+    contact[2, 2:4] = True
+    assert contact_spots(contact, periodic=True) == 2
+    assert contact_spots(contact, periodic=False) == 3
+
+
+def test_spots_reach_curve_csv_and_grow_from_a_few(tmp_path):
+    import frictionlab
+
+    result = frictionlab.run(SURFACE, out=tmp_path / "run", workers=1, progress=False, plot=False)
+    per = np.load(tmp_path / "run" / "realizations.npz")["contact_spots"]
+    assert per.shape == (3, 4) and np.all(per >= 1) and np.all(per == np.round(per))
+    np.testing.assert_allclose(result.table["contact_spots"], per.mean(axis=0), rtol=1e-15)
+    assert np.all(per <= np.load(tmp_path / "run" / "realizations.npz")["contact_count"])

@@ -80,3 +80,31 @@ def corrected_gradient_rms(contact: np.ndarray, slopes: np.ndarray, *, periodic:
         return float("nan")
     inside = weights > 0.0
     return float(np.sqrt(np.sum(weights[inside] * np.square(np.asarray(slopes, float)[inside])) / total))
+
+
+def contact_spots(contact: np.ndarray, *, periodic: bool = True) -> int:
+    """The number of contact spots: clusters of contact pixels joined along rows and
+    columns, a cluster crossing the periodic boundary counted once (``periodic``); on a
+    scan the border joins nothing."""
+    from scipy import ndimage
+
+    contact = np.asarray(contact, dtype=bool)
+    labels, count = ndimage.label(contact)  # 4-connectivity
+    if not periodic or count < 2:
+        return int(count)
+    parent = list(range(count + 1))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    merged = 0
+    for first, last in ((labels[0], labels[-1]), (labels[:, 0], labels[:, -1])):
+        for a, b in set(zip(first[(first > 0) & (last > 0)].tolist(), last[(first > 0) & (last > 0)].tolist())):
+            ra, rb = root(a), root(b)
+            if ra != rb:
+                parent[ra] = rb
+                merged += 1
+    return int(count - merged)
