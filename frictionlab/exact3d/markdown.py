@@ -11,7 +11,7 @@ from ..fit import format_estimate, format_interval
 from ..listeners import format_duration
 from .analysis import FEW_SPOTS, KAPPA_BUSH, KAPPA_PERSSON, KAPPA_SIMULATIONS, KAPPA_WINDOW, Kappa, relative_gap
 from .numbers import Numbers, Paired
-from .plan import MAIN, MIN_PIXELS_QUOTED, SIDE, SPECTRAL, Ensemble, StudyRuns
+from .plan import BROAD, MAIN, MIN_PIXELS_QUOTED, SIDE, SPECTRAL, Ensemble, StudyRuns
 
 GOOD_R2 = 0.9  # a log law "holds" on a grid when its fit explains this much of the mean curve's variance
 YASTREBOV = "Yastrebov, Anciaux and Molinari (Tribol. Int. 2017, arXiv 1701.02727)"
@@ -75,7 +75,7 @@ def plan_status(runs: StudyRuns) -> list[str]:
         groups.setdefault(key, {"done": [], "missing": []})
         groups[key]["missing" if job in runs.missing else "done"].append(job.hurst)
     family = {MAIN: "main (long cut-off = side / 4)", SIDE: "comparison (long cut-off = side)",
-              SPECTRAL: "main, spectral gradient"}  # fmt: skip
+              SPECTRAL: "main, spectral gradient", BROAD: "broad band (long cut-off = side / 4)"}  # fmt: skip
     lines = ["| surfaces | grid | solver | per H | finished at H | not finished at H |", "|---|---|---|---|---|---|"]
     for (name, points, exact, surfaces), hs in groups.items():
         count = f"{surfaces} surfaces" if exact else f"{surfaces * runs.plan.mdr_lines} lines"
@@ -270,9 +270,9 @@ def convergence_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
         f"| κ at {WINDOW_TEXT}, corrected | κ, pixel count | compute time |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    family = {MAIN: "main", SIDE: "long cut-off = side", SPECTRAL: "main, spectral ∇"}
+    family = {MAIN: "main", SIDE: "long cut-off = side", SPECTRAL: "main, spectral ∇", BROAD: "broad band"}
     for hurst in runs.hursts():
-        for name in (MAIN, SIDE, SPECTRAL):
+        for name in (MAIN, BROAD, SIDE, SPECTRAL):
             for e in runs.exact_grids(hurst, name):
                 o, k = e.outcome, numbers.kappa(e)
                 lines.append(
@@ -288,7 +288,7 @@ def surfaces_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
     lines = ["| H | family | surfaces | height skewness (min to max) | kurtosis (min to max) | Nayak α (min to max) |",
              "|---|---|---|---|---|---|"]  # fmt: skip
     for hurst in runs.plan.hursts:
-        for name, label in ((MAIN, "long cut-off = side / 4"), (SIDE, "long cut-off = side")):
+        for name, label in ((MAIN, "long cut-off = side / 4"), (BROAD, "broad band"), (SIDE, "long cut-off = side")):
             s = numbers.stats.get((name, hurst))
             if s is not None:
                 lines.append(f"| {hurst:g} | {label} | {s.skewness.size} | {_span(s.skewness, '+.2f')} "

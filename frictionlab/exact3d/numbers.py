@@ -22,7 +22,7 @@ from .analysis import (
     kappa_curve,
     nayak_parameter,
 )
-from .plan import MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
+from .plan import BROAD, MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
 
 
 @dataclass(frozen=True)
@@ -140,7 +140,7 @@ def study_numbers(runs: StudyRuns) -> Numbers:
     bootstrap = runs.plan.bootstrap
     kappas = {e.folder.name: kappa_set(e, bootstrap) for e in runs.ensembles if e.exact}
     stats = {}
-    for family in (MAIN, SIDE):
+    for family in (MAIN, BROAD, SIDE):
         for hurst in runs.plan.hursts:
             grids = runs.exact_grids(hurst, family)
             if grids:
