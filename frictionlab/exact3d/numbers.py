@@ -22,6 +22,7 @@ from .analysis import (
     kappa_curve,
     nayak_parameter,
 )
+from .evidence import Convergence, FewSpots, GradientCurves, Models, convergence, few_spots, gradient_curves, model_test
 from .plan import BROAD, MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
 
 
@@ -131,6 +132,10 @@ class Numbers:
     stats: dict[tuple[str, float], SurfaceStats]  # (family, H): from the family's coarsest finished grid
     extra: list[Paired]  # finer grids against the finest regular one, same first surfaces
     spectral: list[Paired]  # spectral against forward-difference gradients, same grid and surfaces
+    convergence: dict[float, Convergence]  # per H: the main family's quoted grids, paired
+    models: dict[str, Models]  # per ensemble folder: the finest grid of each family and H
+    gradients: dict[str, GradientCurves]  # per exact ensemble folder that recorded g_r
+    spots: dict[str, FewSpots]  # per exact ensemble folder that counted spots
 
     def kappa(self, e: Ensemble) -> KappaSet:
         return self.kappas[e.folder.name]
@@ -155,4 +160,14 @@ def study_numbers(runs: StudyRuns) -> Numbers:
             base = runs.find(hurst, e.points)
             if base is not None:
                 spectral.append(paired(base, e, bootstrap))
-    return Numbers(kappas, stats, extra, spectral)
+    converged = {h: c for h in runs.plan.hursts if (c := convergence(runs, h, bootstrap)) is not None}
+    models = {}
+    for family in (MAIN, BROAD):
+        for hurst in runs.plan.hursts:
+            grids = runs.exact_grids(hurst, family)
+            if grids:
+                models[grids[-1].folder.name] = model_test(grids[-1])
+    exact = [e for e in runs.ensembles if e.exact]
+    gradients = {e.folder.name: g for e in exact if (g := gradient_curves(e, bootstrap)) is not None}
+    spots = {e.folder.name: s for e in exact if (s := few_spots(e)) is not None}
+    return Numbers(kappas, stats, extra, spectral, converged, models, gradients, spots)

@@ -80,52 +80,82 @@ class Extrapolation:
     reason: str = ""  # why the order was not estimated
 
 
-def richardson(values: Sequence[float], ratio: float = 2.0) -> Extrapolation:
-    """The limit of Q(N) = Q + C N^-p from Q at N, ratio N, ratio^2 N (``values``, coarsest
-    first): p = ln((Q1 - Q2) / (Q2 - Q3)) / ln ratio, Q = Q3 + (Q3 - Q2) / (ratio^p - 1).
-    Where the differences change sign, do not shrink, or give p outside ORDER_RANGE, the
-    order is not estimated: the finest value is the limit, and ``reason`` says why."""
+def _order_ratio(order: float, points: Sequence[float]) -> float:
+    """(Q1 - Q2) / (Q2 - Q3) of Q(N) = Q + C N^-order on the grids ``points``."""
+    h = [1.0 / float(n) for n in points]
+    return (h[0] ** order - h[1] ** order) / (h[1] ** order - h[2] ** order)
+
+
+def _order(d1: float, d2: float, points: Sequence[float]) -> float:
+    """The order p whose ratio of successive changes is d1 / d2 (bisection: the ratio grows with
+    p), or nan when no p in ORDER_RANGE gives it."""
+    target = d1 / d2
+    low, high = ORDER_RANGE
+    if not _order_ratio(low, points) <= target <= _order_ratio(high, points):
+        return math.nan
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if _order_ratio(mid, points) < target else (low, mid)
+    return 0.5 * (low + high)
+
+
+def _limit(values: Sequence[float], points: Sequence[float], order: float) -> float:
+    """Q3 + (Q3 - Q2) N3^-p / (N2^-p - N3^-p): the limit of Q(N) = Q + C N^-p through the last two."""
+    h2, h3 = 1.0 / float(points[1]) ** order, 1.0 / float(points[2]) ** order
+    return float(values[2]) + (float(values[2]) - float(values[1])) * h3 / (h2 - h3)
+
+
+def richardson(values: Sequence[float], points: Sequence[float] = (512, 1024, 2048)) -> Extrapolation:
+    """The limit of Q(N) = Q + C N^-p from Q on three grids of ``points`` pixels a side
+    (``values``, coarsest first), p the observed order: the one whose successive changes
+    have the ratio observed (ln(d1 / d2) / ln 2 on grids doubled each time). Where the
+    changes differ in sign, do not shrink, or need p outside ORDER_RANGE, the order is not
+    estimated: the finest value is the limit, and ``reason`` says why."""
     q1, q2, q3 = map(float, values)
     d1, d2 = q2 - q1, q3 - q2
     if d2 == 0.0:
-        return Extrapolation(q3, math.inf, True) if d1 == 0.0 else Extrapolation(q3, math.nan, False, reason="the last change is zero, the one before is not")
+        if d1 == 0.0:
+            return Extrapolation(q3, math.inf, True)
+        return Extrapolation(q3, math.nan, False, reason="the last change is zero, the one before is not")
     if d1 == 0.0 or d1 * d2 < 0:
         return Extrapolation(q3, math.nan, False, reason="the changes between grids differ in sign")
     if abs(d2) >= abs(d1):
         return Extrapolation(q3, math.nan, False, reason="the changes between grids do not shrink")
-    order = math.log(d1 / d2) / math.log(ratio)
-    if not ORDER_RANGE[0] <= order <= ORDER_RANGE[1]:
-        return Extrapolation(q3, order, False, reason=f"the observed order {order:.2g} is outside {ORDER_RANGE[0]:g} to {ORDER_RANGE[1]:g}")
-    return Extrapolation(q3 + d2 / (ratio**order - 1.0), order, True)
-
-
-def _limit(values: Sequence[float], ratio: float, order: float) -> float:
-    return float(values[-1]) + (float(values[-1]) - float(values[-2])) / (ratio**order - 1.0)
+    order = _order(d1, d2, points)
+    if not math.isfinite(order):
+        return Extrapolation(q3, math.nan, False,
+                             reason=f"their ratio needs an order outside {ORDER_RANGE[0]:g} to {ORDER_RANGE[1]:g}")  # fmt: skip
+    return Extrapolation(_limit(values, points, order), order, True)
 
 
 def extrapolate(
-    values: Sequence[float], draws: np.ndarray, ratio: float = 2.0, confidence: float = 0.95
+    values: Sequence[float], draws: np.ndarray, points: Sequence[float] = (512, 1024, 2048), confidence: float = 0.95
 ) -> Extrapolation:
     """``richardson`` of ``values`` with an interval from ``draws`` (bootstrap, 3: the three
-    grids' values on each paired draw), each draw extrapolated with its own order clipped
+    grids' values on each paired draw), each draw extrapolated with its own order, clipped
     into ORDER_RANGE (FALLBACK_ORDER where its changes differ in sign). Where the order of
     ``values`` is not estimated, the interval spans the finest grid's and the limit at
-    FALLBACK_ORDER, widened by both's sampling: the page then says so."""
-    point = richardson(values, ratio)
+    FALLBACK_ORDER, with both's sampling: the page then says so."""
+    point = richardson(values, points)
     draws = np.asarray(draws, float).reshape(-1, 3)
+    if not draws.shape[0]:
+        return point
     limits = []
+    low_ratio, high_ratio = (_order_ratio(p, points) for p in ORDER_RANGE)
     for row in draws:
         d1, d2 = row[1] - row[0], row[2] - row[1]
-        order = math.log(d1 / d2) / math.log(ratio) if d1 * d2 > 0 else FALLBACK_ORDER
-        limits.append(_limit(row, ratio, float(np.clip(order, *ORDER_RANGE))))
-    limits = np.array(limits)
-    if not limits.size:
-        return point
+        if d1 * d2 > 0:
+            ratio = float(np.clip(d1 / d2, low_ratio, high_ratio))
+            order = _order(ratio * d2, d2, points)
+            order = order if math.isfinite(order) else FALLBACK_ORDER
+        else:
+            order = FALLBACK_ORDER
+        limits.append(_limit(row, points, order))
     if point.estimated:
-        low, high = percentile_interval(limits, confidence)
+        low, high = percentile_interval(np.array(limits), confidence)
         return Extrapolation(point.limit, point.order, True, (float(low), float(high)))
     finest = percentile_interval(draws[:, 2], confidence)
-    fallback = percentile_interval(np.array([_limit(r, ratio, FALLBACK_ORDER) for r in draws]), confidence)
+    fallback = percentile_interval(np.array([_limit(r, points, FALLBACK_ORDER) for r in draws]), confidence)
     interval = (float(min(finest[0], fallback[0])), float(max(finest[1], fallback[1])))
     return Extrapolation(point.limit, point.order, False, interval, point.reason)
 

@@ -40,6 +40,15 @@ def test_richardson_recovers_the_limit_and_order_of_a_known_sequence(order, sign
     assert result.limit == pytest.approx(limit, abs=1e-12)
 
 
+def test_richardson_on_grids_not_doubled_recovers_the_limit():
+    points = (64, 96, 128)
+    values = [0.8 + 40.0 * n**-1.5 for n in points]
+    result = richardson(values, points)
+    assert result.estimated and result.order == pytest.approx(1.5, rel=1e-9)
+    assert result.limit == pytest.approx(0.8, abs=1e-12)
+    assert richardson(values).limit != pytest.approx(0.8, abs=1e-3)  # taken as doubled grids it would be wrong
+
+
 def test_richardson_says_why_it_does_not_extrapolate():
     assert not richardson([1.0, 1.1, 1.05]).estimated and "sign" in richardson([1.0, 1.1, 1.05]).reason
     grows = richardson([1.0, 1.1, 1.3])

@@ -56,6 +56,33 @@ def test_quick_page_has_every_h_every_grid_and_mdr(quick_study):
     assert "about 1.6 to about 2" not in text and "2 to 2.3" in text and "2.51" in text and "1.60" in text
 
 
+def test_quick_page_reads_as_a_referee_wants_it(quick_study):
+    """Definitions first, the quick plan said, the evidence sections, the limitations, and
+    no claim beyond the evidence: "converged" only where the grids resolve the cut-off, a
+    log law "holds" only where the model test prefers it at every H."""
+    text = (quick_study / PAGE).read_text()
+    headings = [line for line in text.splitlines() if line.startswith("## ")]
+    assert headings.index("## Definitions") < headings.index("## The answer")
+    for heading in ("## Convergence in the grid", "## Which law? The model test", "## g_r and κ_r: the rms gradient "
+                    "over the real contact", "## The few-spot regime", "## Limitations"):  # fmt: skip
+        assert heading in headings
+    assert "### κ against the breadth of the spectrum" in text
+    assert "quick plan: small grids and ensembles" in text and "not converged and answer nothing" in text
+    for word in ("A0", "E* = E / (1 - ν²)", "p / (E* g)", "Fixed amplitudes", "stop rule", "g_r", "κ_r"):
+        assert word in text.split("## What ran")[0], word
+    # the quick grids resolve nothing: no "converged" verdict, the convergence said not shown
+    assert "converged within" not in text and "not shown: the grids compared" in text
+    # the log law is said to hold only if the model test prefers it on every H's mean curve
+    rows = [line.split("|") for line in text.splitlines() if "| main, all |" in line]
+    preferred = {row[8].strip() for row in rows}
+    assert rows and (("Yes, over f" in text) == (preferred == {"log law"}))
+    assert "Not as a rule" in text or "Yes, over f" in text
+    # the breadth trend cited to its paper, the area correction to its own, the source study named
+    assert "J. Mech. Phys. Solids 2017, arXiv 1704.05650" in text and "arXiv 1701.02727" in text
+    assert "J. Benad (Physical Mesomechanics, 2012)" in text and "times the real contact area in its springs" in text
+    assert "approaching its vanishing-load limit" not in text and "R²" not in text
+
+
 def test_mdr_runs_its_lines_per_surface_and_the_comparison_family_the_whole_side(quick_study):
     runs = quick_study / "runs"
     for h in HURSTS:
