@@ -260,3 +260,12 @@ def test_spots_reach_curve_csv_and_grow_from_a_few(tmp_path):
     assert per.shape == (3, 4) and np.all(per >= 1) and np.all(per == np.round(per))
     np.testing.assert_allclose(result.table["contact_spots"], per.mean(axis=0), rtol=1e-15)
     assert np.all(per <= np.load(tmp_path / "run" / "realizations.npz")["contact_count"])
+
+
+@pytest.mark.parametrize("attr", ["real_gradient", "counts_spots"])
+def test_a_declaration_that_is_not_a_bool_is_refused_naming_it(attr):
+    from frictionlab.registry import declaration_problems
+
+    broken = type("Broken", (BEMHalfSpace,), {attr: "yes", "name": "broken-bem"})
+    assert any(attr in p and "True or False" in p for p in declaration_problems(broken))
+    assert not declaration_problems(BEMHalfSpace)
