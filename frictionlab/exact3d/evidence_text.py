@@ -16,7 +16,7 @@ from .numbers import Numbers
 from .plan import BROAD, MAIN, MIN_PIXELS_QUOTED, SIDE, StudyRuns
 from .statistics import MODELS, Extrapolation
 
-SOURCE_STUDY = "J. Benad (Physical Mesomechanics, 2012), with the method of reduction of dimensionality (MDR)"
+SOURCE_STUDY = "J. Benad (Physical Mesomechanics, 2012)"
 YASTREBOV_JMPS = "Yastrebov, Anciaux and Molinari, J. Mech. Phys. Solids 2017, arXiv 1704.05650"
 DIGITS = {"a": 3, "b": 4, "κ": 2}
 
@@ -124,7 +124,7 @@ def convergence_verdict(c: Convergence) -> str:
 
 def convergence_text(numbers: Numbers) -> str:
     if not numbers.convergence:
-        return "Fewer than two grids of the main family finished at every H: no convergence can be shown."
+        return "At no H did two grids of the main family finish: no convergence can be shown."
     verdicts = [convergence_verdict(c) for _, c in sorted(numbers.convergence.items())]
     xi = []
     for hurst, c in sorted(numbers.convergence.items()):

@@ -17,6 +17,12 @@ from .plan import BROAD, MAIN, SIDE, StudyRuns  # noqa: E402
 EXACT, APPROX, SIDE_COLOR, BROAD_COLOR = "C0", "C3", "0.45", "C1"
 
 
+def _legend(ax, **options) -> None:
+    """A legend where the panel has labelled artists (a panel of an H with nothing finished has none)."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(**options)
+
+
 def _shades(count: int) -> list:
     """Lighter for coarser grids, the finest darkest."""
     return [plt.cm.Blues(x) for x in np.linspace(0.35, 1.0, count)]
@@ -59,7 +65,7 @@ def plot_xi_against_f(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> N
         ax.set_xlabel("f = F / (E* h L),  L = 2 √(A/π)")
         ax.set_ylabel("ξ = rms |∇z| in contact / rms |∇z|")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=6, loc="best")
+        _legend(ax, fontsize=6, loc="best")
     ax = axes[len(hursts)]
     for family, marker, color, shift in ((MAIN, "o", EXACT, -0.012), (SIDE, "^", SIDE_COLOR, 0.012)):
         label = {MAIN: "long cut-off = side / 4 (main)", SIDE: "long cut-off = side"}[family]
@@ -73,7 +79,7 @@ def plot_xi_against_f(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> N
     ax.set_ylabel("height skewness of each surface")
     ax.set_title("do the surfaces self-average? (Gaussian: 0)", fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    _legend(ax, fontsize=7)
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)
 
@@ -114,7 +120,7 @@ def plot_kappa(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
         ax.set_xlabel("p / (E* rms|∇z|)")
         ax.set_ylabel("κ = (A/A0) E* rms|∇z| / p")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=5.5, loc="upper right")
+        _legend(ax, fontsize=5.5, loc="upper right")
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)
 
@@ -143,7 +149,7 @@ def plot_convergence(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> No
         ax.set_ylabel({"a": "a of ξ = a + b ln f", "b": "b of ξ = a + b ln f",
                        "κ": "κ at 0.5-5 % contact (corrected area)"}[name])  # fmt: skip
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        _legend(ax, fontsize=7)
     fig.suptitle("the same surfaces on every grid; open circles: fewer than 16 pixels on λs, not quoted", fontsize=9)
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)
@@ -176,7 +182,7 @@ def plot_gradient(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
         for ax in (top, bottom):
             ax.set_xscale("log")
             ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=6)
+            _legend(ax, fontsize=6)
         top.set_title(f"H = {hurst:g}", fontsize=10)
         top.set_ylabel("g_r / g (rms gradient in contact / overall)")
         bottom.set_ylabel("κ and κ_r")
@@ -206,7 +212,7 @@ def plot_nayak(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
     ax.set_ylabel("κ at 0.5-5 % contact")
     ax.set_title("o main (side / 4), ◇ broad band, △ long cut-off = side", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=6)
+    _legend(ax, fontsize=6)
     fig.savefig(fh, format="png", dpi=dpi)
     plt.close(fig)
 
@@ -244,7 +250,7 @@ def plot_few_spots(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None
         ax.set_xlabel("f = F / (E* h L)")
         ax.set_ylabel(ylabel)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=6)
+        _legend(ax, fontsize=6)
     fig.suptitle("shaded: fewer than 10 spots per surface, where the finite surface stops standing for an infinite one",
                  fontsize=9)  # fmt: skip
     fig.savefig(fh, format="png", dpi=dpi)

@@ -185,7 +185,8 @@ def answer(runs: StudyRuns, numbers: Numbers) -> list[str]:
         + ("The exact ξ stays below 1: the points in contact are the tops of asperities, flatter than the surface "
            "on average." if xi_max < 1 else ""),
         "- **Converged?** " + ("; ".join(converged) + "." if converged else "Fewer than two grids finished: not shown."),
-        f"- **How far is MDR?** The source study, {SOURCE_STUDY}, answers with MDR; here MDR presses the "
+        f"- **How far is MDR?** The source study, {SOURCE_STUDY}, answers with the method of reduction of "
+        "dimensionality (MDR); here MDR presses the "
         f"MDR-equivalent lines of the same surfaces at equal f ({runs.plan.mdr_lines} per surface). Its mean ξ is "
         + "; ".join(f"{_pct(g.min())} to {_pct(g.max())} (95 % from {_pct(lo.min())} to {_pct(hi.max())})"
                     f" off the exact one at H = {h:g}" for h, (g, lo, hi) in zip(hursts, gaps))  # fmt: skip

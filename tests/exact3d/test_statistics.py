@@ -140,3 +140,42 @@ def test_undecided_when_the_best_two_are_within_the_margin():
 
     fits = {name: ModelFit(name, (), np.zeros(3), 0.0, bic, 0.0) for name, bic in (("a", 1.0), ("b", 2.5), ("c", 9.0))}
     assert preferred(fits) is None and preferred(fits, margin=1.0) == "a"
+
+
+def test_the_convergence_statistic_recovers_a_b_and_kappa_of_known_rows():
+    from frictionlab.exact3d.evidence import _law_and_kappa
+
+    f = np.logspace(-2, 1, 12)
+    rows = [0.8 + 0.03 * np.log(f) + np.zeros((5, 1)), 0.7 + 0.05 * np.log(f) + np.zeros((5, 1))]
+    kappas = [np.full((5, 12), 2.4), np.full((5, 12), 2.2)]
+    kappas[1][:, :6] = 9.0  # outside the window: left out
+    windows = [np.ones(12, bool), np.arange(12) >= 6]
+    np.testing.assert_allclose(_law_and_kappa(f, windows, *rows, *kappas), [0.8, 0.7, 0.03, 0.05, 2.4, 2.2], atol=1e-12)
+
+
+def test_the_drift_of_kappa_is_its_relative_slope_against_ln_p():
+    from frictionlab.exact3d.evidence import _drift
+
+    x = np.logspace(-3, -1, 9)
+    steady = np.full((4, 9), 2.0)
+    falling = 2.0 - 0.1 * np.log(x / x[0]) + np.zeros((4, 1))
+    value = _drift(x, falling, steady)
+    assert value[0] == pytest.approx(-0.1 / falling.mean(), rel=1e-12) and value[1] == pytest.approx(0.0, abs=1e-12)
+    assert value[2] == pytest.approx(abs(value[0]), rel=1e-12)  # the steady one is closer to constant
+
+
+def test_the_few_spot_loads_are_those_below_the_first_with_many_spots():
+    from types import SimpleNamespace
+
+    from frictionlab.exact3d.evidence import MANY_SPOTS, few_spots
+
+    spots = np.array([[1, 3, 8, 30, 80, 40, 5.0]] * 2)  # merging again at the largest loads: not "few"
+    force = np.geomspace(1, 1000, 7)
+    area = 1e-4 * force ** (2 / 3) + np.zeros((2, 1))
+    e = SimpleNamespace(outcome=SimpleNamespace(force=force, per_realization={"contact_spots": spots, "real_area_corrected": area}))
+    s = few_spots(e)
+    np.testing.assert_array_equal(s.few, [True, True, True, False, False, False, False])
+    assert MANY_SPOTS == 10
+    np.testing.assert_allclose(s.exponent, 2 / 3, rtol=1e-12)
+    e.outcome.per_realization["contact_spots"] = np.full((2, 7), np.nan)  # a run from before spots were counted
+    assert few_spots(e) is None
