@@ -36,17 +36,18 @@ def _panels(count: int, width: float = 13, height: float = 7.5):
 
 
 def plot_xi_against_f(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
-    """One panel per H: the exact mean xi(f) of the main family on every grid, the fitted
-    law of the finest, MDR on the same surfaces, and the comparison family (long cut-off
-    = side); the last panel: the surfaces' height skewness in both families."""
+    """One panel per H: the exact mean xi(f) of the main family on every regular grid, on
+    the surfaces all of them ran, the fitted law of the finest (its whole ensemble), MDR
+    on the same surfaces, and the comparison family (long cut-off = side); the last
+    panel: the surfaces' height skewness in both families."""
     hursts = runs.hursts()
     fig, axes = _panels(len(hursts) + 1)
     for ax, hurst in zip(axes, hursts):
-        grids = runs.exact_grids(hurst)
+        grids = [e for e in runs.exact_grids(hurst) if e.folder.name in numbers.paired]
         for e, color in zip(grids, _shades(len(grids))):
-            o = e.outcome
-            ax.errorbar(o.f, o.xi, yerr=1.96 * o.xi_sem, fmt="o", ms=3, color=color, capsize=1.5, lw=0.8,
-                        label=f"exact, {e.points}² px ({e.pixels_per_short_cutoff:g} px on λs), {o.done} surf.")  # fmt: skip
+            p = numbers.paired[e.folder.name]
+            ax.errorbar(e.outcome.f, p.xi, yerr=p.xi_half, fmt="o", ms=3, color=color, capsize=1.5, lw=0.8,
+                        label=f"exact, {e.points}² px ({e.pixels_per_short_cutoff:g} px on λs), same {p.surfaces} surf.")  # fmt: skip
         finest = runs.find(hurst)
         fit = finest.outcome.fit
         grid = np.geomspace(finest.outcome.f.min(), finest.outcome.f.max(), 100)
@@ -86,18 +87,20 @@ def plot_xi_against_f(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> N
 
 def plot_kappa(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
     """One panel per H: kappa = (A/A0) E* rms|∇z| / p against p / (E* rms|∇z|) from the
-    corrected area on each grid of the main family (95 % bootstrap band), the pixel count's
+    corrected area on each regular grid of the main family, on the surfaces all of them
+    ran (95 % bootstrap band), the pixel count's
     on the finest, the comparison family's; the literature as lines and a band; the loads
     of a few spots shaded."""
     hursts = runs.hursts()
     fig, axes = _panels(len(hursts))
     for ax, hurst in zip(axes, hursts):
-        grids = runs.exact_grids(hurst)
+        grids = [e for e in runs.exact_grids(hurst) if e.folder.name in numbers.paired]
         for e, color in zip(grids, _shades(len(grids))):
-            c = numbers.kappa(e).curve
+            p = numbers.paired[e.folder.name]
+            c = p.kappa
             ax.fill_between(c.x, c.low, c.high, color=color, alpha=0.25, lw=0)
             ax.plot(c.x, c.value, "o-", ms=2.5, lw=0.9, color=color,
-                    label=f"{e.points}² ({e.pixels_per_short_cutoff:g} px on λs), corrected area")  # fmt: skip
+                    label=f"{e.points}² ({e.pixels_per_short_cutoff:g} px on λs), same {p.surfaces} surf., corrected area")  # fmt: skip
         finest = runs.find(hurst)
         k = numbers.kappa(finest)
         ax.plot(k.raw_curve.x, k.raw_curve.value, "x--", ms=3, lw=0.8, color=EXACT,

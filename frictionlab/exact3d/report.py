@@ -257,7 +257,7 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "",
         f"κ is averaged over the loads whose mean contact fraction is {WINDOW_TEXT} for the number quoted, and "
         f"below {FEW_TEXT} apart (a handful of spots per surface: the few-spot regime below). The figure shows κ at "
-        "every load against p / (E* g), with its 95 % bootstrap band, on every grid, the pixel count's κ on the "
+        "every load against p / (E* g), with its 95 % bootstrap band, on every grid on the surfaces all grids ran, the pixel count's κ on the "
         "finest grid, and the literature: √(2π) = 2.51 at vanishing load on an infinite surface (Bush, Gibson and "
         "Thomas 1975), √(8/π) = 1.60 in Persson's theory, and about 2 to 2.3 in simulations of broad spectra at "
         "0.5 % to 5 % contact (Hyun et al. 2004; Campañá and Müser 2007; Prodanov, Dapp and Müser 2014; Yastrebov, "
