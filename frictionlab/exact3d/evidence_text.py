@@ -244,6 +244,27 @@ def gradient_text(runs: StudyRuns, numbers: Numbers) -> str:
             "load with numbers.")  # fmt: skip
 
 
+GRADIENT_TABLE_FRACTIONS = (0.001, 0.01, 0.1)  # the loads tabulated: those nearest these mean contact fractions
+
+
+def gradient_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
+    """g_r / g, kappa and kappa_r with 95 % intervals at a few loads, per H and family (finest grid)."""
+    lines = ["| H | family, grid | A / A0 | p / (E* g) | g_r / g [95 % CI] | κ [95 % CI] | κ_r [95 % CI] |",
+             "|---|---|---|---|---|---|---|"]  # fmt: skip
+    for family, name in ((MAIN, "main"), (BROAD, "broad band")):
+        for hurst in runs.plan.hursts:
+            grids = runs.exact_grids(hurst, family)
+            g = numbers.gradients.get(grids[-1].folder.name) if grids else None
+            if g is None:
+                continue
+            area = g.ensemble.outcome.real_area_corrected
+            for j in sorted({int(np.argmin(np.abs(np.log(area / target)))) for target in GRADIENT_TABLE_FRACTIONS}):
+                cells = [_est(float(est.value[j]), (float(est.interval[0][j]), float(est.interval[1][j])), 3)
+                         for est in (g.ratio, g.kappa, g.kappa_r)]  # fmt: skip
+                lines.append(f"| {hurst:g} | {name}, {grids[-1].points}² | {area[j]:.2%} | {g.x[j]:.3g} | " + " | ".join(cells) + " |")
+    return lines if len(lines) > 2 else []
+
+
 def few_spots_text(runs: StudyRuns, numbers: Numbers) -> str:
     parts = []
     for hurst in runs.hursts():

@@ -67,6 +67,7 @@ def test_quick_page_reads_as_a_referee_wants_it(quick_study):
                     "over the real contact", "## The few-spot regime", "## Limitations"):  # fmt: skip
         assert heading in headings
     assert "### κ against the breadth of the spectrum" in text
+    assert "| g_r / g [95 % CI] | κ [95 % CI] | κ_r [95 % CI] |" in text  # g_r and kappa_r published with intervals
     assert "quick plan: small grids and ensembles" in text and "not converged and answer nothing" in text
     for word in ("A0", "E* = E / (1 - ν²)", "p / (E* g)", "Fixed amplitudes", "stop rule", "g_r", "κ_r"):
         assert word in text.split("## What ran")[0], word
