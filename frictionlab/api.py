@@ -74,7 +74,11 @@ class Result:
     realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,
     ``contact_fraction``, ``indentation``, and ``real_area_corrected`` (the real area
     corrected for its perimeter's pixels, a fraction) for a solver that gives it
-    (``bem-halfspace``). ``caveats``: what a reader of the fit
+    (``bem-halfspace``), and ``real_gradient_rms`` (g_r, the rms slope over the corrected
+    real contact), ``kappa`` and ``kappa_r`` ((A / A0) E* g / p with g the surface's rms
+    gradient, and with g_r) for a solver that gives g_r (``bem-halfspace``,
+    ``bem-halfspace-free``), and ``contact_spots`` (the mean number of contact spots) for a
+    solver that counts them (the same two). ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
@@ -370,6 +374,10 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
     }  # fmt: skip
     if outcome.real_area_corrected is not None:  # the solvers that correct their area only
         table[CORRECTED_AREA] = outcome.real_area_corrected
+    if outcome.real_gradient_rms is not None:  # the solvers that give g_r only
+        table.update(real_gradient_rms=outcome.real_gradient_rms, kappa=outcome.kappa, kappa_r=outcome.kappa_r)
+    if outcome.contact_spots is not None:  # the solvers that count spots only
+        table["contact_spots"] = outcome.contact_spots
     return Result(
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,

@@ -70,6 +70,12 @@ class RunOutcome:
     error: str | None = None
     compute_seconds: float = 0.0  # summed over the finished realizations, restored ones included
     real_area_corrected: np.ndarray | None = None  # ensemble mean; None when the solver does not correct its area
+    # g_r (the rms slope over the corrected real contact), kappa and kappa_r (area_law_ratio with the
+    # surface's rms gradient and with g_r): means over the realizations; None unless the solver gives g_r
+    real_gradient_rms: np.ndarray | None = None
+    kappa: np.ndarray | None = None
+    kappa_r: np.ndarray | None = None
+    contact_spots: np.ndarray | None = None  # mean over realizations; None unless the solver counts spots
     extra: dict = field(default_factory=dict)
     input_caveats: tuple[str, ...] = ()  # what the spectrum's input_summary says of the file it read (a tilt left in)
 
@@ -102,6 +108,24 @@ class RunOutcome:
     def extent(self) -> float:
         """X of f = F / (k h X): the profile's length, area, MDR length, or 1."""
         return self.force_unit / (self.stiffness * self.rms_height)
+
+
+def area_law_ratio(fraction, force, nominal_area: float, stiffness: float, gradient) -> np.ndarray:
+    """(A / A0) E* g / p per realization (rows) and load: kappa of A / A0 = kappa p / (E* g),
+    p = F / A0 the nominal pressure; ``gradient`` one rms gradient per realization (the
+    surface's: kappa) or per realization and load (over the real contact, g_r: kappa_r)."""
+    fraction = np.atleast_2d(np.asarray(fraction, float))
+    force = np.asarray(force, float)
+    gradient = np.asarray(gradient, float)
+    gradient = gradient.reshape(-1, 1) if gradient.ndim == 1 else np.atleast_2d(gradient)
+    if fraction.shape[-1] != force.shape[-1] or gradient.shape[0] != fraction.shape[0]:
+        raise ValueError(f"shapes differ: fraction {fraction.shape}, force {force.shape}, gradient {gradient.shape}")
+    return fraction * stiffness * gradient * nominal_area / force
+
+
+def nominal_area(normalisation: ForceNormalisation, extent: float) -> float:
+    """A0 of a surface from the X of its f: X itself, or A0 = pi (X / 2)^2 for X = 2 sqrt(A0 / pi)."""
+    return math.pi * (extent / 2) ** 2 if normalisation.extent == "mdr length" else float(extent)
 
 
 OWN_H_TOLERANCE = 1e-9  # relative spread allowed between the profiles' own rms heights
@@ -170,6 +194,10 @@ class Accumulator:
             per["force"] = self.stack("force")
         if scene.solver.corrected_area:
             per["real_area_corrected"] = self.stack("real_area_corrected")
+        if scene.solver.real_gradient:
+            per["real_gradient_rms"] = self.stack("real_gradient_rms")
+        if scene.solver.counts_spots:
+            per["contact_spots"] = self.stack("contact_spots")
         n = indices.size
         first = self.results[indices[0]] if n else None
         points = first.points if first else 0
@@ -215,6 +243,7 @@ class Accumulator:
                 confidence=settings.confidence,
                 rng=bootstrap_rng(scene.preset.seed),
             )
+        gradients = self._gradients(per, force, points, unit / (stiffness * rms_height) if n else math.nan, stiffness)
         return RunOutcome(
             status=status,
             requested=scene.preset.realizations,
@@ -243,4 +272,23 @@ class Accumulator:
             compute_seconds=float(sum(self.results[i].seconds for i in indices)),
             real_area_corrected=(per["real_area_corrected"].mean(axis=0) if n else nan_row)
             if scene.solver.corrected_area else None,
+            **gradients,
+            contact_spots=(per["contact_spots"].mean(axis=0) if n else nan_row) if scene.solver.counts_spots else None,
         )
+
+    def _gradients(self, per: dict, force: np.ndarray, points: int, extent: float, stiffness: float) -> dict:
+        """g_r, kappa and kappa_r, each the mean over the realizations per load (NaN where a
+        chunk of an older version has no g_r); {} when the solver gives no g_r. The area is
+        the corrected one where the solver corrects it, else the pixel count."""
+        if not self.scene.solver.real_gradient:
+            return {}
+        if not per["index"].size:
+            nan_row = np.full(self.loads.size, math.nan)
+            return {"real_gradient_rms": nan_row, "kappa": nan_row, "kappa_r": nan_row}
+        area = per.get("real_area_corrected", per["contact_count"] / points)
+        loads = per.get("force", force)
+        a0 = nominal_area(self.scene.normalisation, extent)
+        kappa = area_law_ratio(area, loads, a0, stiffness, per["slope_rms_line"])
+        kappa_r = area_law_ratio(area, loads, a0, stiffness, per["real_gradient_rms"])
+        return {"real_gradient_rms": per["real_gradient_rms"].mean(axis=0), "kappa": kappa.mean(axis=0),
+                "kappa_r": kappa_r.mean(axis=0)}  # fmt: skip

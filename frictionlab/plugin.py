@@ -144,6 +144,12 @@ class ContactCurve:
     ``real_area_corrected``: the real contact area corrected for the pixels the
     contact's perimeter crosses, a fraction of the nominal area; given exactly when
     the solver declares ``corrected_area``, None otherwise.
+    ``real_gradient_rms``: g_r, the rms of the slopes over the real contact, each contact
+    pixel weighted by its share of the perimeter-corrected area (N - c M pixels, with
+    ``c = 0`` it is ``slope_rms_contact``); dimensionless, a slope. Given exactly when the
+    solver declares ``real_gradient``, None otherwise.
+    ``contact_spots``: the number of contact spots (clusters of contact pixels joined along
+    rows and columns), given exactly when the solver declares ``counts_spots``.
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
     """
 
@@ -153,6 +159,8 @@ class ContactCurve:
     contact_fraction: np.ndarray
     slope_rms_contact: np.ndarray
     real_area_corrected: np.ndarray | None = None
+    real_gradient_rms: np.ndarray | None = None
+    contact_spots: np.ndarray | None = None
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
 
@@ -444,6 +452,11 @@ class ContactSolver(Plugin):
     - ``corrected_area`` (False): True when ``solve`` also gives the real area
       corrected for the contact's perimeter (``ContactCurve.real_area_corrected``);
       the results then carry it beside the pixel count.
+    - ``real_gradient`` (False): True when ``solve`` also gives g_r, the rms slope over
+      the perimeter-corrected real contact (``ContactCurve.real_gradient_rms``); the
+      results then carry it, with kappa and kappa_r, beside the area.
+    - ``counts_spots`` (False): True when ``solve`` also counts the contact spots
+      (``ContactCurve.contact_spots``); the results then carry their number.
     - ``indentation_reference`` ("undeformed body") and ``mean_displacement(f, h)``
       (zero): the mean displacement of the elastic surface in the indentation's
       frame, so that ``indentation - mean_displacement`` is measured from the mean
@@ -472,6 +485,8 @@ class ContactSolver(Plugin):
     approximation: ClassVar[bool] = False
     contact_measure: ClassVar[ContactMeasure] = "real contact"
     corrected_area: ClassVar[bool] = False
+    real_gradient: ClassVar[bool] = False
+    counts_spots: ClassVar[bool] = False
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False

@@ -33,6 +33,8 @@ class RealizationResult:
     indentation: np.ndarray | None = None
     force: np.ndarray | None = None  # kept only under indentation control (forces vary)
     real_area_corrected: np.ndarray | None = None  # kept for the solvers that declare corrected_area
+    real_gradient_rms: np.ndarray | None = None  # g_r, kept for the solvers that declare real_gradient
+    contact_spots: np.ndarray | None = None  # kept for the solvers that declare counts_spots
     slope_rms_line: float = math.nan
     points: int = 0
     force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
@@ -141,6 +143,8 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
             indentation=np.asarray(curve.indentation),
             force=np.asarray(curve.force) if scene.control == "indentation" else None,
             real_area_corrected=np.asarray(curve.real_area_corrected, float) if scene.solver.corrected_area else None,
+            real_gradient_rms=np.asarray(curve.real_gradient_rms, float) / scale if scene.solver.real_gradient else None,
+            contact_spots=np.asarray(curve.contact_spots, float) if scene.solver.counts_spots else None,
             slope_rms_line=slope_rms_line / scale,
             points=profile.points,
             force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),

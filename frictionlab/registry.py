@@ -173,7 +173,8 @@ def declaration_problems(cls) -> list[str]:
                     normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
                 except ValueError as exc:
                     problems.append(f"normalisations[{dimension}]: {exc}")
-        for attr in ("approximation", "undefined_slopes", "mean_displacement_known", "corrected_area"):
+        for attr in ("approximation", "undefined_slopes", "mean_displacement_known", "corrected_area", "real_gradient",
+                     "counts_spots"):
             if not isinstance(getattr(cls, attr), bool):
                 problems.append(f"{attr} must be True or False. Got {getattr(cls, attr)!r} instead.")
         if not (isinstance(cls.problem, str) and cls.problem.strip()):

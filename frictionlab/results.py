@@ -45,6 +45,16 @@ CONTACT_MEASURES = {
 # beside the pixel count, for the solvers that declare corrected_area (others have no such column)
 CORRECTED_AREA = "real_area_corrected"
 CORRECTED_AREA_HEADER = f"{CORRECTED_AREA} [real contact fraction, corrected for the pixels its perimeter crosses]"
+# beside it, for the solvers that declare real_gradient: g_r and the area law's kappa with g and with g_r
+GRADIENT_COLUMNS = {
+    "real_gradient_rms": "real_gradient_rms [g_r: rms |grad z| over the real contact, each pixel weighted by its share "
+    "of the corrected area; dimensionless; mean over realizations]",
+    "kappa": "kappa [(A / A0) E* g / p: A the real area (corrected where given), g the surface's rms |grad z|, "
+    "p = F / A0; dimensionless; mean over realizations]",
+    "kappa_r": "kappa_r [(A / A0) E* g_r / p; dimensionless; mean over realizations]",
+}
+SPOTS = "contact_spots"  # last, for the solvers that count spots
+SPOTS_HEADER = f"{SPOTS} [number of contact spots: clusters of contact pixels joined along rows and columns; mean over realizations]"
 INDENTATION_REFERENCES = {
     "undeformed body": "length; from the first touch; against the undeformed body",
     "mean surface": "length; from the first touch; against the mean plane of the elastic surface",
@@ -151,7 +161,9 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     names = [column_name(h) for h in header]
     stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
     expected = [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]
-    if stripped not in (expected, [*expected, CORRECTED_AREA]):  # the last for the solvers that correct the area
+    optional = [CORRECTED_AREA, *GRADIENT_COLUMNS, SPOTS]  # in this order, for the solvers that give them
+    extra = stripped[len(expected) :]
+    if stripped[: len(expected)] != expected or extra != [c for c in optional if c in extra] or len(set(extra)) != len(extra):
         raise RunFolderError(
             f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
             f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
@@ -170,7 +182,8 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
         used = curve["lines_used"]
         if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
             problems.append("lines_used must be a whole number >= 0 at every load step")
-    for column, low, high in (("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)):
+    bounds = [("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)]
+    for column, low, high in bounds + [(name, 0.0, np.inf) for name in (*GRADIENT_COLUMNS, SPOTS)]:
         if column not in curve:
             continue
         values = curve[column][~np.isnan(curve[column])]
@@ -255,7 +268,9 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     writer = csv.writer(fh, lineterminator="\n")
     corrected = [CORRECTED_AREA_HEADER] if scene.solver.corrected_area else []
-    writer.writerow(curve_header(scene) + corrected)
+    gradient = list(GRADIENT_COLUMNS.values()) if scene.solver.real_gradient else []
+    spots = [SPOTS_HEADER] if scene.solver.counts_spots else []
+    writer.writerow(curve_header(scene) + corrected + gradient + spots)
     columns = (
         outcome.force,
         outcome.f,
@@ -268,6 +283,10 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     )
     if corrected:
         columns = (*columns, outcome.real_area_corrected)
+    if gradient:
+        columns = (*columns, outcome.real_gradient_rms, outcome.kappa, outcome.kappa_r)
+    if spots:
+        columns = (*columns, outcome.contact_spots)
 
     for row in zip(*columns, strict=True):
         writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])

@@ -63,7 +63,9 @@ START_LEFTOVER = re.compile(rf"\.(?:{re.escape(PRESET_FILE)}|{re.escape(STATE_FI
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
-OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected")  # kept when the control or the solver gives them
+# kept when the control or the solver gives them
+OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected", "real_gradient_rms", "contact_spots")
+ADDED_CURVE_ARRAYS = frozenset({"real_gradient_rms", "contact_spots"})  # absent from the chunks of older versions: NaN
 
 def _write_holder(fd: int) -> None:
     """Who holds run.lock, for the message of a run refused because of it."""
@@ -531,9 +533,10 @@ def _left_by_a_start(path: Path, resolved: dict) -> bool:
     return False
 
 
-def _optional_kept(scene: Scene) -> tuple[bool, bool]:
+def _optional_kept(scene: Scene) -> tuple[bool, ...]:
     """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
-    return scene.control == "indentation", scene.solver.corrected_area
+    solver = scene.solver
+    return scene.control == "indentation", solver.corrected_area, solver.real_gradient, solver.counts_spots
 
 
 def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
@@ -545,6 +548,9 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
         raise ChunkDamage(f"no array {missing[0]}")
     n, k, steps = arrays["index"].shape[0], arrays["failed_index"].shape[0], scene.loads.size
     curves = (*CURVE_ARRAYS, *(name for name, kept in zip(OPTIONAL_CURVE_ARRAYS, _optional_kept(scene)) if kept))
+    for name in ADDED_CURVE_ARRAYS.intersection(curves):
+        if n and name not in arrays:  # a chunk of a version before it: the values are unknown
+            arrays = {**arrays, name: np.full((n, steps), math.nan)}
     for name in OK_ARRAYS + (curves if n else ()):
         if name not in arrays:
             raise ChunkDamage(f"no array {name}")
@@ -576,6 +582,8 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             indentation=arrays["indentation"][row],
             force=arrays["force"][row] if "force" in curves else None,
             real_area_corrected=arrays["real_area_corrected"][row] if "real_area_corrected" in curves else None,
+            real_gradient_rms=arrays["real_gradient_rms"][row] if "real_gradient_rms" in curves else None,
+            contact_spots=arrays["contact_spots"][row] if "contact_spots" in curves else None,
             slope_rms_line=float(arrays["slope_rms_line"][row]),
             points=int(arrays["points"][row]),
             force_unit=float(arrays["force_unit"][row]),

@@ -199,6 +199,9 @@ def test_f_xi_and_contact_do_not_depend_on_the_units(solver, spectrum, control, 
     np.testing.assert_allclose(scaled.f, base.f, rtol=rtol)
     np.testing.assert_array_equal(scaled.per_realization["contact_count"], counts)
     np.testing.assert_allclose(scaled.per_realization["xi"], base.per_realization["xi"], rtol=rtol)
+    if solver in ("bem-halfspace", "bem-halfspace-free"):  # g_r a slope, kappa and kappa_r pure numbers
+        for name in ("real_gradient_rms", "kappa", "kappa_r"):
+            np.testing.assert_allclose(getattr(scaled, name), getattr(base, name), rtol=rtol)
 
 
 SPACING_CASES = [(s, p) for s, p in CASES if p in ("power-law", "power-law-2d")]

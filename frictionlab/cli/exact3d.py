@@ -13,16 +13,19 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "exact3d",
         help="xi against f in exact half-space contact for H = 0.3..1, beside MDR: write exact-3d-law.md",
-        description="The exact 3D law: run the presets exact3d-h03..h10 on three grids of the same surfaces "
-        "(exact half-space contact) and MDR on their equivalent lines, with a comparison family (long cut-off = "
-        "side), spectral gradients and a finer grid at H = 0.8; fit xi = a + b ln f with bootstrap intervals, "
-        "measure kappa of the corrected contact area, and write the page exact-3d-law.md with its figures. The "
-        "full plan takes hours of one core (run it resumably with --runs); --quick about 20 s of one core (not converged).",
+        description="The exact 3D law: run the presets exact3d-h03..h10 on four grids of the same surfaces "
+        "(exact half-space contact, 256² to 2048²) and MDR on their equivalent lines, with a broad-band family, a "
+        "comparison family (long cut-off = side) and spectral gradients; fit xi = a + b ln f with bootstrap "
+        "intervals, show its convergence on paired grids with a Richardson limit, test it against a power law and "
+        "a log law with curvature, measure kappa and kappa_r (the rms gradient over the real contact) of the "
+        "corrected contact area and the contact spots, and write the page exact-3d-law.md with its figures. The "
+        "full plan takes many hours of 2 cores (run it resumably with --runs); --quick about a minute of one core "
+        "(not converged).",
         epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --force\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --finished-only --force",
     )
-    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about 20 s of one core, not converged")
+    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about a minute of one core, not converged")
     p.add_argument("--finished-only", action="store_true", help="run nothing: write the page from the ensembles of "
                    "--runs that finished; the page lists the plan's others as not run")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")

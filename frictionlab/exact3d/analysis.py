@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..ensemble import area_law_ratio
 from ..fit import percentile_interval
 
 SMALL_LOAD_FRACTION = 0.05  # contact fraction below which the area is taken to grow linearly
@@ -50,13 +51,8 @@ class KappaCurve:
 
 def _per_load_kappa(fraction, force, area, stiffness, gradient) -> tuple[np.ndarray, np.ndarray]:
     """(kappa per realization and load, the pressure p = F / A0 per load), checked shapes."""
-    fraction = np.atleast_2d(np.asarray(fraction, float))
     force = np.asarray(force, float)
-    gradient = np.asarray(gradient, float).reshape(-1, 1)
-    if fraction.shape[1] != force.size or gradient.shape[0] != fraction.shape[0]:
-        raise ValueError(f"shapes differ: fraction {fraction.shape}, force {force.shape}, gradient {gradient.shape}")
-    pressure = force / area
-    return fraction * stiffness * gradient / pressure, pressure
+    return area_law_ratio(fraction, force, area, stiffness, np.asarray(gradient, float).ravel()), force / area
 
 
 def _bootstrap_means(rows: np.ndarray, rng: np.random.Generator, bootstrap: int) -> np.ndarray | None:

@@ -11,9 +11,8 @@ from ..fit import format_estimate, format_interval
 from ..listeners import format_duration
 from .analysis import FEW_SPOTS, KAPPA_BUSH, KAPPA_PERSSON, KAPPA_SIMULATIONS, KAPPA_WINDOW, Kappa, relative_gap
 from .numbers import Numbers, Paired
-from .plan import MAIN, MIN_PIXELS_QUOTED, SIDE, SPECTRAL, Ensemble, StudyRuns
+from .plan import BROAD, MAIN, MIN_PIXELS_QUOTED, SIDE, SPECTRAL, Ensemble, StudyRuns
 
-GOOD_R2 = 0.9  # a log law "holds" on a grid when its fit explains this much of the mean curve's variance
 YASTREBOV = "Yastrebov, Anciaux and Molinari (Tribol. Int. 2017, arXiv 1701.02727)"
 WINDOW_TEXT = f"{KAPPA_WINDOW[0]:.1%} to {KAPPA_WINDOW[1]:.0%}".replace(".0%", "%")
 FEW_TEXT = f"{FEW_SPOTS[1]:.1%}"
@@ -75,7 +74,7 @@ def plan_status(runs: StudyRuns) -> list[str]:
         groups.setdefault(key, {"done": [], "missing": []})
         groups[key]["missing" if job in runs.missing else "done"].append(job.hurst)
     family = {MAIN: "main (long cut-off = side / 4)", SIDE: "comparison (long cut-off = side)",
-              SPECTRAL: "main, spectral gradient"}  # fmt: skip
+              SPECTRAL: "main, spectral gradient", BROAD: "broad band (long cut-off = side / 4)"}  # fmt: skip
     lines = ["| surfaces | grid | solver | per H | finished at H | not finished at H |", "|---|---|---|---|---|---|"]
     for (name, points, exact, surfaces), hs in groups.items():
         count = f"{surfaces} surfaces" if exact else f"{surfaces * runs.plan.mdr_lines} lines"
@@ -101,45 +100,8 @@ def _mdr_area_ratio(runs: StudyRuns, hurst: float) -> np.ndarray:
     return mdr.outcome.contact_fraction / exact.outcome.real_area_corrected
 
 
-def _mdr_gap(runs: StudyRuns, hurst: float) -> np.ndarray:
-    exact, mdr = runs.find(hurst), runs.find(hurst, exact=False)
-    return relative_gap(mdr.outcome.xi, exact.outcome.xi)
-
-
 def _half(ci) -> float:
     return 0.5 * (ci[1] - ci[0])
-
-
-def two_finest_changes(runs: StudyRuns, numbers: Numbers) -> list[tuple[float, Ensemble, Ensemble, float, float, float]]:
-    """(H, coarser, finer, change of a, of b, of kappa) between the two finest regular grids per H."""
-    rows = []
-    for hurst in runs.hursts():
-        grids = [e for e in runs.exact_grids(hurst) if e.points in runs.plan.resolutions]
-        if len(grids) >= 2:
-            coarse, fine = grids[-2], grids[-1]
-            rows.append((hurst, coarse, fine, fine.outcome.fit.a - coarse.outcome.fit.a,
-                         fine.outcome.fit.b - coarse.outcome.fit.b,
-                         numbers.kappa(fine).corrected.value - numbers.kappa(coarse).corrected.value))  # fmt: skip
-    return rows
-
-
-def convergence_text(runs: StudyRuns, numbers: Numbers) -> str:
-    rows = two_finest_changes(runs, numbers)
-    if not rows:
-        return "Only one grid finished: no convergence can be shown."
-    parts = []
-    for index, name, digits in ((3, "a", 3), (4, "b", 4), (5, "κ", 2)):
-        worst = max(rows, key=lambda r: abs(r[index]) if math.isfinite(r[index]) else -1)
-        parts.append(f"{name} by {worst[index]:+.{digits}f} (H = {worst[0]:g})")
-    grids = sorted({(r[1].points, r[2].points) for r in rows})
-    text = (f"The largest changes between the two finest grids ({', '.join(f'{c}² to {f}²' for c, f in grids)}) "
-            f"over H = {_hs(r[0] for r in rows)}: " + ", ".join(parts) + ".")  # fmt: skip
-    for p in numbers.extra:
-        e = p.other.outcome.fit
-        text += (f" At H = {p.other.hurst:g}, doubling the resolution once more ({p.base.points}² to {p.other.points}², "
-                 f"the same first {p.surfaces} surfaces) changes a by {e.a - p.base_fit.a:+.3f}, b by "
-                 f"{e.b - p.base_fit.b:+.4f} and κ by {p.other_kappa.value - p.base_kappa.value:+.2f}.")  # fmt: skip
-    return text
 
 
 def self_averaging_text(runs: StudyRuns, numbers: Numbers) -> str:
@@ -181,8 +143,19 @@ def gradient_text(numbers: Numbers) -> str:
             f"H = {_hs(p.other.hurst for p in numbers.spectral)}.")  # fmt: skip
 
 
+def _mdr_gap_interval(runs: StudyRuns, hurst: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """MDR's mean xi over the exact one, minus 1, per load, with a 95 % interval from the two
+    ensembles' standard errors (independent ensembles: MDR's lines are not the surfaces)."""
+    exact, mdr = runs.find(hurst).outcome, runs.find(hurst, exact=False).outcome
+    gap = relative_gap(mdr.xi, exact.xi)
+    half = 1.96 * np.hypot(mdr.xi_sem, exact.xi_sem) / exact.xi
+    return gap, gap - half, gap + half
+
+
 def answer(runs: StudyRuns, numbers: Numbers) -> list[str]:
-    """The plain answer, formed from the numbers."""
+    """The plain answer, formed from the numbers: no claim the evidence on the page does not carry."""
+    from .evidence_text import SOURCE_STUDY, convergence_verdict, few_spots_text, limit_text, model_verdict
+
     hursts = runs.hursts()
     answers = {h: runs.find(h) for h in hursts}
     fits = {h: e.outcome.fit for h, e in answers.items()}
@@ -191,51 +164,45 @@ def answer(runs: StudyRuns, numbers: Numbers) -> list[str]:
     if unquoted:
         caveat = (f" **Not converged:** at H = {_hs(unquoted)} the finest grid that ran has fewer than "
                   f"{MIN_PIXELS_QUOTED} pixels on the short cut-off; its numbers are shown, not quoted as the answer.")
-    held = [h for h, fit in fits.items() if fit.r2 >= GOOD_R2]
-    r2 = [fit.r2 for fit in fits.values()]
-    if len(held) == len(fits):
-        verdict = f"Yes, over this range of f: at every H the mean curve follows a + b ln f with R² {_span(r2, '.2f')}."
-    elif held:
-        verdict = (f"Only in part: a + b ln f explains the mean curve (R² >= {GOOD_R2}) at H = {_hs(held)}, not at "
-                   f"the others (R² {_span([fits[h].r2 for h in fits if h not in held], '.2f')}).")  # fmt: skip
-    else:
-        verdict = f"No: at no H does a + b ln f explain the mean curve well (R² {_span(r2, '.2f')})."
-    law = "; ".join(f"H = {h:g} ({answers[h].points}²): a = {format_estimate(fits[h].a, fits[h].a_ci, 3)}, "
-                    f"b = {format_estimate(fits[h].b, fits[h].b_ci, 4)}" for h in hursts)  # fmt: skip
+    law = "; ".join(f"H = {h:g} ({answers[h].points}², {answers[h].outcome.done} surfaces): a = "
+                    f"{format_estimate(fits[h].a, fits[h].a_ci, 3)}, b = {format_estimate(fits[h].b, fits[h].b_ci, 4)}"
+                    for h in hursts)  # fmt: skip
+    limits = "; ".join(f"H = {h:g}: a = {limit_text(c.quantities['a'].limit, 3)}, b = {limit_text(c.quantities['b'].limit, 4)}"
+                       for h, c in sorted(numbers.convergence.items()) if c.quantities["a"].limit is not None)  # fmt: skip
     xi_max = max(float(np.max(e.outcome.xi)) for e in answers.values())
-    gaps = np.concatenate([_mdr_gap(runs, h) for h in hursts])
+    gaps = [_mdr_gap_interval(runs, h) for h in hursts]
     ratio = np.concatenate([_mdr_area_ratio(runs, h) for h in hursts])
     mdr_fits = {h: runs.find(h, exact=False).outcome.fit for h in hursts}
-    da = [mdr_fits[h].a - fits[h].a for h in hursts]
-    db = [mdr_fits[h].b - fits[h].b for h in hursts]
-    mdr_half_a = [_half(mdr_fits[h].a_ci) for h in hursts]
-    mdr_half_b = [_half(mdr_fits[h].b_ci) for h in hursts]
     kappas = {h: numbers.kappa(answers[h]) for h in hursts}
     kappa_text = "; ".join(f"H = {h:g}: {_kappa(kappas[h].corrected)}, {kappa_place(kappas[h].corrected)}"
                            for h in hursts)  # fmt: skip
-    few = [kappas[h].few_spots.value for h in hursts if math.isfinite(kappas[h].few_spots.value)]
-    raw = [kappas[h].raw.value for h in hursts if math.isfinite(kappas[h].raw.value)]
+    few = [kappas[h].few_spots for h in hursts if math.isfinite(kappas[h].few_spots.value)]
+    converged = [convergence_verdict(c) for _, c in sorted(numbers.convergence.items())]
     return [
-        f"- **Does a log law hold for exact contact?** {verdict}{caveat}",
-        f"- **Which a and b?** {law} (95 % bootstrap intervals over the surfaces). "
+        f"- **Does a log law hold for exact contact?** {model_verdict(runs, numbers)}{caveat}",
+        f"- **Which a and b?** On the finest grid: {law} (95 % bootstrap intervals over the surfaces). "
+        + (f"Extrapolated to the continuum from the three finest grids on the same surfaces: {limits}. " if limits else "")
         + ("The exact ξ stays below 1: the points in contact are the tops of asperities, flatter than the surface "
-           "on average, and they grow steeper as the load spreads the contact." if xi_max < 1 else ""),
-        f"- **How far is MDR?** On the same surfaces at equal f ({runs.plan.mdr_lines} MDR-equivalent lines per "
-        f"surface), MDR's mean ξ is {_pct(gaps.min())} to {_pct(gaps.max())} off the exact one over all loads and H; "
-        f"its a is {_span(da, '+.3f')} from the exact a (MDR's own 95 % half-width ±{max(mdr_half_a):.3f} at most), "
-        f"its b {_span(db, '+.4f')} from the exact b (half-width ±{max(mdr_half_b):.4f} at most). In area it is "
-        f"further off: MDR's fraction of springs in contact is {ratio.min():.1f} to {ratio.max():.1f} times the "
-        "exact real area at the same f. MDR is built to keep the force against the approach, not the area: its "
-        "springs in contact are not the real contact area, and its ξ is an rms slope over a line.",
-        f"- **κ against the literature.** A / A0 = κ p / (E* rms|∇z|) with the corrected area, averaged over the "
-        f"loads at {WINDOW_TEXT} contact: {kappa_text}. The literature: √(2π) = {KAPPA_BUSH:.2f} at vanishing load, "
-        f"√(8/π) = {KAPPA_PERSSON:.2f} in Persson's theory, about {KAPPA_SIMULATIONS[0]:g} to "
-        f"{KAPPA_SIMULATIONS[1]:g} in simulations at 0.5 % to 5 % contact, falling slowly with load and with the "
-        f"Nayak parameter. "
-        + (f"Below {FEW_TEXT} contact (a few spots per surface) κ is {_span(few, '.2f')}, shown apart. " if few else "")
-        + (f"The raw pixel count gives κ = {_span(raw, '.2f')} at {WINDOW_TEXT}." if raw else ""),
-        f"- **Self-averaging.** {self_averaging_text(runs, numbers)}",
-        f"- **Converged?** {convergence_text(runs, numbers)} {gradient_text(numbers)}",
+           "on average." if xi_max < 1 else ""),
+        "- **Converged?** " + ("; ".join(converged) + "." if converged else "Fewer than two grids finished: not shown."),
+        f"- **How far is MDR?** The source study, {SOURCE_STUDY}, answers with the method of reduction of "
+        "dimensionality (MDR); here MDR presses the "
+        f"MDR-equivalent lines of the same surfaces at equal f ({runs.plan.mdr_lines} per surface). Its mean ξ is "
+        + "; ".join(f"{_pct(g.min())} to {_pct(g.max())} (95 % from {_pct(lo.min())} to {_pct(hi.max())})"
+                    f" off the exact one at H = {h:g}" for h, (g, lo, hi) in zip(hursts, gaps))  # fmt: skip
+        + "; its a and b: "
+        + "; ".join(f"H = {h:g}: a = {format_estimate(mdr_fits[h].a, mdr_fits[h].a_ci, 3)}, "
+                    f"b = {format_estimate(mdr_fits[h].b, mdr_fits[h].b_ci, 4)}" for h in hursts)  # fmt: skip
+        + f". At equal f, MDR has {ratio.min():.0f} to {ratio.max():.0f} times the real contact area in its springs "
+        "in contact: MDR is built to keep the force against the approach, not the area.",
+        f"- **κ against the literature.** A / A0 = κ p / (E* g) with the corrected area, averaged over the "
+        f"loads at {WINDOW_TEXT} contact: {kappa_text}. "
+        + (f"Below {FEW_TEXT} contact κ is {_span([k.value for k in few], '.2f')}"
+           + (f", above the vanishing-load limit {KAPPA_BUSH:.2f} of an infinite surface: " if min(k.interval[0] for k in few) > KAPPA_BUSH
+              else ": ")
+           + "the few-spot regime of a finite surface, not an approach to that limit (below). " if few else "")
+        + "See κ against the Nayak parameter below: the literature's band is for broad spectra.",
+        f"- **Few spots.** {few_spots_text(runs, numbers)}",
     ]
 
 
@@ -244,42 +211,44 @@ def answer(runs: StudyRuns, numbers: Numbers) -> list[str]:
 
 def law_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
     lines = [
-        "| H | grid | surfaces | Nayak α | a [95 % CI] | b [95 % CI] | R² | κ at " + WINDOW_TEXT + " [95 % CI] "
-        "| κ below " + FEW_TEXT + " | MDR a [95 % CI] | MDR b [95 % CI] | MDR ξ / exact ξ - 1 | MDR springs / real area |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| H | grid | surfaces | Nayak α | a [95 % CI] | b [95 % CI] | κ at " + WINDOW_TEXT + " [95 % CI] "
+        "| κ below " + FEW_TEXT + " [95 % CI] | MDR a [95 % CI] | MDR b [95 % CI] | MDR ξ / exact ξ - 1 (95 % over all loads) "
+        "| MDR springs / real area |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for hurst in runs.hursts():
         e, m = runs.find(hurst), runs.find(hurst, exact=False)
         fit, mfit, k = e.outcome.fit, m.outcome.fit, numbers.kappa(e)
         stats = numbers.stats.get((MAIN, hurst))
         nayak = f"{np.mean(stats.nayak):.1f}" if stats else "n/a"
-        gap, ratio = _mdr_gap(runs, hurst), _mdr_area_ratio(runs, hurst)
+        (gap, low, high), ratio = _mdr_gap_interval(runs, hurst), _mdr_area_ratio(runs, hurst)
         grid = _grid(e) + ("" if e.quoted else ", not quoted")
         lines.append(
             f"| {hurst:g} | {grid} | {e.outcome.done} | {nayak} | {format_estimate(fit.a, fit.a_ci, 3)} "
-            f"| {format_estimate(fit.b, fit.b_ci, 4)} | {fit.r2:.2f} | {_kappa(k.corrected)} | {_kappa(k.few_spots)} "
+            f"| {format_estimate(fit.b, fit.b_ci, 4)} | {_kappa(k.corrected)} | {_kappa(k.few_spots)} "
             f"| {format_estimate(mfit.a, mfit.a_ci, 3)} | {format_estimate(mfit.b, mfit.b_ci, 4)} "
-            f"| {_pct(gap.min())} to {_pct(gap.max())} | {ratio.min():.1f} to {ratio.max():.1f} |"
+            f"| {_pct(gap.min())} to {_pct(gap.max())} ({_pct(low.min())} to {_pct(high.max())}) "
+            f"| {ratio.min():.1f} to {ratio.max():.1f} |"
         )
     return lines
 
 
 def convergence_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
     lines = [
-        "| H | family | grid | quoted | surfaces | real area (corrected) | a [95 % CI] | b [95 % CI] | R² "
+        "| H | family | grid | quoted | surfaces | real area (corrected) | a [95 % CI] | b [95 % CI] "
         f"| κ at {WINDOW_TEXT}, corrected | κ, pixel count | compute time |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    family = {MAIN: "main", SIDE: "long cut-off = side", SPECTRAL: "main, spectral ∇"}
+    family = {MAIN: "main", SIDE: "long cut-off = side", SPECTRAL: "main, spectral ∇", BROAD: "broad band"}
     for hurst in runs.hursts():
-        for name in (MAIN, SIDE, SPECTRAL):
+        for name in (MAIN, BROAD, SIDE, SPECTRAL):
             for e in runs.exact_grids(hurst, name):
                 o, k = e.outcome, numbers.kappa(e)
                 lines.append(
                     f"| {hurst:g} | {family[name]} | {_grid(e)} | {'yes' if e.quoted else 'no'} | {o.done} "
                     f"| {o.real_area_corrected.min():.2%} to {o.real_area_corrected.max():.1%} "
                     f"| {format_estimate(o.fit.a, o.fit.a_ci, 3)} | {format_estimate(o.fit.b, o.fit.b_ci, 4)} "
-                    f"| {o.fit.r2:.2f} | {_kappa(k.corrected)} | {_kappa(k.raw)} | {format_duration(o.compute_seconds)} |"
+                    f"| {_kappa(k.corrected)} | {_kappa(k.raw)} | {format_duration(o.compute_seconds)} |"
                 )
     return lines
 
@@ -288,7 +257,7 @@ def surfaces_table(runs: StudyRuns, numbers: Numbers) -> list[str]:
     lines = ["| H | family | surfaces | height skewness (min to max) | kurtosis (min to max) | Nayak α (min to max) |",
              "|---|---|---|---|---|---|"]  # fmt: skip
     for hurst in runs.plan.hursts:
-        for name, label in ((MAIN, "long cut-off = side / 4"), (SIDE, "long cut-off = side")):
+        for name, label in ((MAIN, "long cut-off = side / 4"), (BROAD, "broad band"), (SIDE, "long cut-off = side")):
             s = numbers.stats.get((name, hurst))
             if s is not None:
                 lines.append(f"| {hurst:g} | {label} | {s.skewness.size} | {_span(s.skewness, '+.2f')} "

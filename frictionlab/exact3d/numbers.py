@@ -22,7 +22,8 @@ from .analysis import (
     kappa_curve,
     nayak_parameter,
 )
-from .plan import MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
+from .evidence import Convergence, FewSpots, GradientCurves, Models, convergence, few_spots, gradient_curves, model_test
+from .plan import BROAD, MAIN, SIDE, SPECTRAL, Ensemble, StudyRuns
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,38 @@ def paired(base: Ensemble, other: Ensemble, bootstrap: int) -> Paired:
                   kappa_on(other, indices, bootstrap), int(indices.size))  # fmt: skip
 
 
+@dataclass(frozen=True)
+class PairedCurve:
+    """One grid's mean xi (with the 95 % half-width of its standard error) and kappa curve on
+    the surfaces every regular grid of its H ran: the figures set grids side by side on
+    the same surfaces only, so a jump between them is not a change of ensemble."""
+
+    surfaces: int
+    xi: np.ndarray
+    xi_half: np.ndarray
+    kappa: KappaCurve
+
+
+def paired_curves(runs: StudyRuns, bootstrap: int) -> dict[str, PairedCurve]:
+    out = {}
+    for hurst in runs.plan.hursts:
+        grids = [e for e in runs.exact_grids(hurst) if e.points in runs.plan.resolutions]
+        if not grids:
+            continue
+        common = grids[0].outcome.indices
+        for e in grids[1:]:
+            common = np.intersect1d(common, e.outcome.indices)
+        for e in grids:
+            o, per = e.outcome, e.outcome.per_realization
+            keep = np.isin(per["index"], common)
+            xi, n = per["xi"][keep], int(np.count_nonzero(keep))
+            half = 1.96 * xi.std(axis=0, ddof=1) / math.sqrt(n) if n >= 2 else np.full(o.f.size, math.nan)
+            kappa = kappa_curve(per["real_area_corrected"][keep], o.force, nominal_area(e), o.stiffness,
+                                per["slope_rms_line"][keep], rng=bootstrap_rng(e.scene.preset.seed), bootstrap=bootstrap)  # fmt: skip
+            out[e.folder.name] = PairedCurve(n, xi.mean(axis=0), half, kappa)
+    return out
+
+
 @dataclass
 class Numbers:
     """Everything the page quotes, keyed by ensemble folder where per ensemble."""
@@ -131,6 +164,11 @@ class Numbers:
     stats: dict[tuple[str, float], SurfaceStats]  # (family, H): from the family's coarsest finished grid
     extra: list[Paired]  # finer grids against the finest regular one, same first surfaces
     spectral: list[Paired]  # spectral against forward-difference gradients, same grid and surfaces
+    convergence: dict[float, Convergence]  # per H: the main family's quoted grids, paired
+    models: dict[str, Models]  # per ensemble folder: the finest grid of each family and H
+    gradients: dict[str, GradientCurves]  # per exact ensemble folder that recorded g_r
+    spots: dict[str, FewSpots]  # per exact ensemble folder that counted spots
+    paired: dict[str, PairedCurve]  # per regular grid of the main family: on the surfaces all of them ran
 
     def kappa(self, e: Ensemble) -> KappaSet:
         return self.kappas[e.folder.name]
@@ -140,7 +178,7 @@ def study_numbers(runs: StudyRuns) -> Numbers:
     bootstrap = runs.plan.bootstrap
     kappas = {e.folder.name: kappa_set(e, bootstrap) for e in runs.ensembles if e.exact}
     stats = {}
-    for family in (MAIN, SIDE):
+    for family in (MAIN, BROAD, SIDE):
         for hurst in runs.plan.hursts:
             grids = runs.exact_grids(hurst, family)
             if grids:
@@ -155,4 +193,14 @@ def study_numbers(runs: StudyRuns) -> Numbers:
             base = runs.find(hurst, e.points)
             if base is not None:
                 spectral.append(paired(base, e, bootstrap))
-    return Numbers(kappas, stats, extra, spectral)
+    converged = {h: c for h in runs.plan.hursts if (c := convergence(runs, h, bootstrap)) is not None}
+    models = {}
+    for family in (MAIN, BROAD):
+        for hurst in runs.plan.hursts:
+            grids = runs.exact_grids(hurst, family)
+            if grids:
+                models[grids[-1].folder.name] = model_test(grids[-1])
+    exact = [e for e in runs.ensembles if e.exact]
+    gradients = {e.folder.name: g for e in exact if (g := gradient_curves(e, bootstrap)) is not None}
+    spots = {e.folder.name: s for e in exact if (s := few_spots(e)) is not None}
+    return Numbers(kappas, stats, extra, spectral, converged, models, gradients, spots, paired_curves(runs, bootstrap))

@@ -1,13 +1,16 @@
 """What the exact 3D study runs, and running it.
 
 For each Hurst exponent the preset ``exact3d-hXX.yaml`` (the main family: a long cut-off
-of a quarter of the side, so each surface self-averages) is run by the exact solver it
-names on several grids of the same surfaces (same side, same cut-off wavelengths:
-``SpectrumGenerator.refined``), and, on each grid, MDR presses the surfaces'
-MDR-equivalent lines (the same spectrum, the same f = F / (E* h L)), many lines per
-surface. Two variants run beside it: the comparison family (long cut-off = the side,
-the family the page used before) and the spectral gradient on the main family's finest
-grid. Every ensemble is an ordinary run into its own folder (``runner.run_to_folder``):
+of a quarter of the side, so each surface self-averages; a narrow band, Nayak parameter
+4 to 5) is run by the exact solver it names on several grids of the same surfaces (same
+side, same cut-off wavelengths: ``SpectrumGenerator.refined``; the finest grid on the
+first of them, paired), and, on each grid, MDR presses the surfaces' MDR-equivalent
+lines (the same spectrum, the same f = F / (E* h L)), many lines per surface. Three
+variants run beside it: the broad-band family (the same long cut-off, a short cut-off
+of a few pixels of the finest grid: a band of 32 and more, Nayak parameter 10 to 40) at
+some H, the comparison family (long cut-off = the side, the family the page used
+before) and the spectral gradient. Every family is pressed at the same loads, so at the
+same f. Every ensemble is an ordinary run into its own folder (``runner.run_to_folder``):
 resumable, its files those of ``frictionlab run``. The jobs run in the plan's order of
 value, so an interrupted study has the most important ensembles.
 """
@@ -39,7 +42,8 @@ from ..variants import SceneFactory
 HURSTS = (0.3, 0.5, 0.7, 0.8, 1.0)
 FIRST_HURST = 0.8  # the H whose ensembles run first, and the one with the finest extra grid
 APPROXIMATION = "mdr"  # the solver whose prediction is set beside the exact one
-MAIN, SIDE, SPECTRAL = "main", "side", "spectral"  # the families of surfaces and gradients
+MAIN, SIDE, SPECTRAL, BROAD = "main", "side", "spectral", "broad"  # the families of surfaces and gradients
+BROAD_HURSTS = (0.5, 0.8, 1.0)  # the H of the broad-band family
 MIN_PIXELS_QUOTED = 16  # pixels on the short cut-off of a grid whose numbers are quoted
 
 
@@ -65,8 +69,11 @@ class Plan:
     grids at every H, the last the answer's; ``extra``: finer grids for some H,
     ``(hurst, pixels per side, realizations)``, run on the first surfaces; ``side``: the
     comparison family's grid ``(pixels, realizations)``; ``spectral``: the main family's
-    grid and surfaces pressed again with spectral gradients; ``mdr_lines``: MDR-equivalent
-    lines pressed per surface."""
+    grid and surfaces pressed again with spectral gradients; ``broad``: the broad-band
+    family's ``(pixels, realizations, pixels on its short cut-off)`` at ``broad_hursts``
+    (its long cut-off the main family's); ``mdr_lines``: MDR-equivalent lines pressed per
+    surface; ``loads``: ``(first, last, steps)`` log-spaced forces of every ensemble
+    (None: the presets')."""
 
     name: str
     resolutions: tuple[int, ...]  # pixels per side, coarsest first
@@ -75,8 +82,10 @@ class Plan:
     extra: tuple[tuple[float, int, int], ...] = ()
     side: tuple[int, int] | None = None
     spectral: tuple[int, int] | None = None
+    broad: tuple[int, int, float] | None = None
+    broad_hursts: tuple[float, ...] = BROAD_HURSTS
     mdr_lines: int = 1
-    steps: int | None = None  # load steps (None: the preset's)
+    loads: tuple[float, float, int] | None = None
     bootstrap: int = 1000
 
     def grids(self, hurst: float) -> list[tuple[int, int]]:
@@ -87,8 +96,9 @@ class Plan:
     def jobs(self) -> list[Job]:
         """Every ensemble, most valuable first, so that an interrupted study holds the most
         of the answer: at FIRST_HURST the main family (each grid exact, then MDR), its
-        comparison family and its spectral gradients; then the other H, the extremes first,
-        each with its comparison family; the extra grids; the other H's spectral gradients."""
+        broad-band family, comparison family and spectral gradients; then the other H, the
+        extremes first, each with its broad-band and comparison family; the extra grids; the
+        other H's spectral gradients."""
         first = [h for h in self.hursts if math.isclose(h, FIRST_HURST)]
         rest = sorted(h for h in self.hursts if not math.isclose(h, FIRST_HURST))
         rest = [*rest[:1], *rest[-1:], *rest[1:-1]] if len(rest) > 1 else rest
@@ -103,8 +113,12 @@ class Plan:
         def spectral(h):
             return [Job(SPECTRAL, h, *self.spectral, True)] if self.spectral else []
 
-        jobs = [job for h in first for job in (*main(h), *side(h), *spectral(h))]
-        jobs += [job for h in rest for job in (*main(h), *side(h))]
+        def broad(h):
+            wanted = self.broad and any(math.isclose(h, b) for b in self.broad_hursts)
+            return [Job(BROAD, h, *self.broad[:2], True)] if wanted else []
+
+        jobs = [job for h in first for job in (*main(h), *broad(h), *side(h), *spectral(h))]
+        jobs += [job for h in rest for job in (*main(h), *broad(h), *side(h))]
         jobs += [Job(MAIN, h, n, m, exact) for h, n, m in self.extra for exact in (True, False)]
         return jobs + [job for h in rest for job in spectral(h)]
 
@@ -124,14 +138,17 @@ class Job:
         return f"{prefix}h{self.hurst:.1f}-n{self.points}-{solver}"
 
     def describe(self) -> str:
-        family = {MAIN: "", SIDE: "long cut-off = side, ", SPECTRAL: "spectral gradient, "}[self.family]
+        family = {MAIN: "", SIDE: "long cut-off = side, ", SPECTRAL: "spectral gradient, ", BROAD: "broad band, "}[self.family]
         return f"H = {self.hurst:g}, {family}{self.points}² px, {'exact' if self.exact else 'MDR'}, {self.surfaces} surfaces"
 
 
-FULL = Plan("full", resolutions=(256, 512, 1024), realizations=(32, 32, 32), extra=((FIRST_HURST, 2048, 8),),
-            side=(512, 32), spectral=(1024, 8), mdr_lines=64)  # fmt: skip
+# the loads run from a few contact spots per surface to 20 % contact and more: F = 0.15 to 3000 on a
+# surface of side 128 and rms height 1 with E* = 1 is f = 0.00104 to 20.8, 4.3 decades
+FULL = Plan("full", resolutions=(256, 512, 1024, 2048), realizations=(32, 32, 32, 16), side=(512, 32),
+            spectral=(1024, 8), broad=(2048, 16, 16.0), mdr_lines=64, loads=(0.15, 3000.0, 31))  # fmt: skip
 QUICK = Plan("quick", resolutions=(64, 96, 128), realizations=(4, 4, 4), side=(64, 4), spectral=(128, 2),
-             extra=((FIRST_HURST, 192, 2),), mdr_lines=4, steps=8, bootstrap=200)  # fmt: skip
+             extra=((FIRST_HURST, 192, 2),), broad=(128, 3, 2.5), mdr_lines=4, loads=(0.15, 3000.0, 10),
+             bootstrap=200)  # fmt: skip
 
 
 @dataclass
@@ -219,9 +236,12 @@ def _scene(factory: SceneFactory, job: Job, plan: Plan) -> Scene:
         changes["spectrum.params.long_cutoff"] = changes["spectrum.params.length"]
     if job.family == SPECTRAL:
         changes["slope.name"] = "spectral"
+    if job.family == BROAD:  # a short cut-off of plan.broad[2] pixels of the job's grid
+        changes["spectrum.params.short_cutoff"] = plan.broad[2] * changes["spectrum.params.length"] / job.points
     changes.update({"realizations": job.surfaces, "fit.bootstrap": plan.bootstrap})
-    if plan.steps is not None:
-        changes["loading.steps"] = plan.steps
+    if plan.loads is not None:
+        first, last, steps = plan.loads
+        changes.update({"loading.start": first, "loading.stop": last, "loading.steps": steps, "loading.spacing": "log"})
     if not job.exact:  # the equivalent line depends on the surface only through its spectrum
         changes.update({"solver": factory.solver_choice(APPROXIMATION), "realizations": job.surfaces * plan.mdr_lines})
     return factory.make(changes)
@@ -299,7 +319,7 @@ def run_plan(
 
 TIME_FILE = "exact3d-time.json"
 TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
-ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
+ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL}|{BROAD})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
 
 
 def check_runs_folder(runs_dir: Path, *, force: bool, own: tuple[str, ...] = ()) -> None:

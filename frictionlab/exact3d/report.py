@@ -18,16 +18,25 @@ from ..options import RunOptions
 from ..rundir import new_run_folder
 from ..seeds import realization_rng
 from ..signals import WorkInterrupted
-from .figures import plot_convergence, plot_kappa, plot_xi_against_f
+from .evidence import MANY_SPOTS
+from .evidence_text import (
+    convergence_table,
+    convergence_text,
+    definitions,
+    few_spots_text,
+    gradient_table,
+    gradient_text,
+    limitations,
+    model_table,
+    nayak_text,
+)
+from .figures import plot_convergence, plot_few_spots, plot_gradient, plot_kappa, plot_nayak, plot_xi_against_f
 from .markdown import (
     FEW_TEXT,
     WINDOW_TEXT,
     YASTREBOV,
     answer,
-    convergence_table,
-    convergence_text,
     ensemble_text,
-    gradient_text,
     law_table,
     missing_text,
     paired_table,
@@ -35,9 +44,12 @@ from .markdown import (
     self_averaging_text,
     surfaces_table,
 )
+from .markdown import convergence_table as ensembles_table
+from .markdown import gradient_text as spectral_text
 from .numbers import Numbers, study_numbers
 from .plan import (
     FULL,
+    MAIN,
     MIN_PIXELS_QUOTED,
     QUICK,
     Plan,
@@ -50,7 +62,8 @@ from .plan import (
 
 PAGE = "exact-3d-law.md"
 FIGURES_DIR = "exact-3d-law"
-FIGURES = ("xi-vs-f.png", "kappa.png", "convergence.png")
+FIGURES = ("xi-vs-f.png", "kappa.png", "convergence.png", "gradient.png", "nayak.png", "few-spots.png")
+PLOTS = (plot_xi_against_f, plot_kappa, plot_convergence, plot_gradient, plot_nayak, plot_few_spots)
 
 
 def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
@@ -132,7 +145,7 @@ def write_page(
         )
     numbers = study_numbers(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
-    for name, plot in zip(FIGURES, (plot_xi_against_f, plot_kappa, plot_convergence)):
+    for name, plot in zip(FIGURES, PLOTS, strict=True):
         atomic_write(figures / name, lambda fh, plot=plot: plot(runs, numbers, fh, dpi=dpi), binary=True)
     text = page_text(runs, numbers, command, machine(), _command(quick, out_dir, runs_dir, False))
     atomic_write(page, lambda fh: fh.write(text))
@@ -155,9 +168,10 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
     presets = ", ".join(f"`presets/{preset_name(h)}`" for h in plan.hursts)
     tolerance = first.scene.solver.tolerance()
     side = first.spacing * first.points
-    grids = sorted({e.points for e in runs.ensembles if e.exact})
+    grids = sorted({e.points for e in runs.ensembles if e.exact and e.family == MAIN})
     finish = ([f"The plan's other ensembles are computed (and this page written again) by `{finish_command}`, "
                "which resumes the finished ones without computing them again.", ""] if runs.missing else [])  # fmt: skip
+    quick = plan.name == "quick"
     lines = [
         "# The exact 3D law",
         "",
@@ -165,6 +179,8 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "is solved exactly (an elastic half-space, boundary elements), and how far the method of reduction of "
         "dimensionality (MDR) is from it.",
         "",
+        *(["**This page comes from the quick plan: small grids and ensembles, none resolving the short cut-off. "
+           "Its numbers are not converged and answer nothing; they show the pipeline.**", ""] if quick else []),
         "Regenerate this page, its figures and tables with",
         "",
         "```",
@@ -173,12 +189,11 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "",
         *finish,
         f"The study ({plan.name} plan) took **{format_duration(runs.seconds)}** of wall time (summed over the "
-        f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of each ensemble (its surfaces' solve times summed) is "
-        "in the convergence table. "
-        + ("`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core: **its numbers are "
-           "not converged** and answer nothing." if plan.name == "quick" else
-           "`--quick` runs the same pipeline on small grids and ensembles in about 20 s of one core (not converged)."),
+        f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of "
+        "each ensemble (its surfaces' solve times summed) is in the ensembles' table. "
+        "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",
         "",
+        *definitions(runs, numbers),
         "## What ran",
         "",
         *plan_status(runs),
@@ -193,42 +208,88 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         f"({figures}/{FIGURES[0]})",
         "",
         "These surfaces are not the source study's lines: there the MDR line had 10^5 points and f was of order "
-        f"1e-9, a few points in contact; here f = F / (E* h L) runs over {o.f.min():.3g} to {o.f.max():.3g}, from "
+        f"1e-9, a few points in contact; here f runs over {o.f.min():.3g} to {o.f.max():.3g}, from "
         f"{o.real_area_corrected.min():.2%} to {o.real_area_corrected.max():.1%} of real contact on the main family. "
         "The source study's 3D law (a about 2.9, b about 0.14 near H = 0.7) belongs to its regime; the numbers here "
         "belong to this one, exact and MDR alike.",
         "",
-        "## The law",
+        "## The law on the finest grid",
         "",
-        "ξ = rms |∇z| over the contact pixels / rms |∇z| over the whole surface (both components of the "
-        "gradient, forward differences), averaged over the surfaces at each load; a and b are the least-squares "
-        "fit of ξ = a + b ln f to that mean curve, with 95 % percentile-bootstrap intervals over the surfaces. "
-        f"Each H is quoted on its finest grid that finished; a grid with fewer than {MIN_PIXELS_QUOTED} pixels on "
-        "the short cut-off is marked and not quoted. The Nayak parameter is the mean over the surfaces.",
+        "a and b are the least-squares fit of ξ = a + b ln f to the mean curve, with 95 % percentile-bootstrap "
+        f"intervals over the surfaces; the fit is a description, tested against other models below. A grid with "
+        f"fewer than {MIN_PIXELS_QUOTED} pixels on the short cut-off is marked and not quoted. The Nayak parameter "
+        "is the mean over the surfaces. The MDR interval is from the two ensembles' standard errors.",
         "",
         *law_table(runs, numbers),
+        "",
+        "## Convergence in the grid",
+        "",
+        f"The grids sample the same surfaces ({'the same modes and random phases: a grid' + chr(39) + 's heights are those of a finer one at its points' if same_surfaces(runs) else 'the same spectrum'}) "
+        f"with {', '.join(f'{n}²' for n in grids)} pixels, that is "
+        + ", ".join(f"{n * first.short_cutoff / side:g}" for n in grids)
+        + f" pixels on the short cut-off λs = {first.short_cutoff:g}. The loads, F = {o.force.min():g} to "
+        f"{o.force.max():g} in {o.force.size} log steps, are the same f on every grid. The Richardson limit "
+        "Q + (Q - Q') / (2^p - 1) (grids doubled each time) from the three finest grids uses the observed order p; its interval comes from "
+        "re-estimating p on every bootstrap draw (clipped to 0.5 to 4), so it holds the order's uncertainty.",
+        "",
+        *convergence_table(numbers),
+        "",
+        f"![a, b and kappa on the same surfaces against the pixels on the short cut-off]({figures}/{FIGURES[2]})",
+        "",
+        convergence_text(numbers),
+        "",
+        "## Which law? The model test",
+        "",
+        "Three models of ξ(f), each fitted by least squares: the log law a + b ln f, a power law c f^β, and a log "
+        "law with curvature a + b ln f + c (ln f)². ΔBIC is each model's BIC above the best (0: the best; 2 or "
+        "more: positive evidence against it); the runs test counts runs of like sign in the residuals (z below "
+        "-2: a curve left in them). On the mean curve over all loads, and over the loads with at least "
+        f"{MANY_SPOTS} contact spots per surface; per surface, how many prefer each model.",
+        "",
+        *model_table(runs, numbers),
         "",
         "## The real contact area and κ",
         "",
         "A contact pixel counts whole although the contact's edge crosses it, so the pixel count overestimates the "
         "real area by a strip along the perimeter, an error that shrinks only as one over the resolution. The area "
-        f"here is corrected as {YASTREBOV} do: A* = N - c M pixels, N those in contact, M the edges between a "
-        "contact and a free pixel along rows and columns, c = (π - 1 + ln 2) / 24 = 0.118 (the column "
-        "`real_area_corrected` of every `bem-halfspace` run). On a Hertz contact with 20 pixels on its radius it "
-        "brings the area within 0.6 % of π a² where the count is 1 % to 1.5 % over "
-        "(`tests/test_contact_area.py`).",
+        f"here is corrected as {YASTREBOV} do (the column `real_area_corrected` of every `bem-halfspace` run). On a "
+        "Hertz contact with 20 pixels on its radius it brings the area within 0.6 % of π a² where the count is 1 % "
+        "to 1.5 % over (`tests/test_contact_area.py`).",
         "",
-        f"κ = (A / A0) E* rms|∇z| / p, p = F / A0 the nominal pressure and rms|∇z| each surface's own (forward "
-        f"differences, as in ξ), per surface and load, then averaged: over the loads whose mean contact fraction "
-        f"is {WINDOW_TEXT} for the number quoted, and below {FEW_TEXT} apart (a handful of spots per surface, where "
-        "κ approaches its vanishing-load limit only slowly and the count of a few spots is noisy). The figure shows "
-        "κ at every load against p / (E* rms|∇z|), with its 95 % bootstrap band, on every grid, the pixel count's "
-        "κ on the finest grid for comparison, and the literature: √(2π) = 2.51 at vanishing load (Bush, Gibson and "
-        "Thomas 1975), √(8/π) = 1.60 in Persson's theory, and about 2 to 2.3 in simulations at 0.5 % to 5 % "
-        "contact, falling slowly with load and with the Nayak parameter (Hyun et al. 2004; Campañá and Müser 2007; "
-        "Prodanov, Dapp and Müser 2014; Yastrebov, Anciaux and Molinari 2017; van Dokkum et al. 2018).",
+        f"κ is averaged over the loads whose mean contact fraction is {WINDOW_TEXT} for the number quoted, and "
+        f"below {FEW_TEXT} apart (a handful of spots per surface: the few-spot regime below). The figure shows κ at "
+        "every load against p / (E* g), with its 95 % bootstrap band, on every grid on the surfaces all grids ran, the pixel count's κ on the "
+        "finest grid, and the literature: √(2π) = 2.51 at vanishing load on an infinite surface (Bush, Gibson and "
+        "Thomas 1975), √(8/π) = 1.60 in Persson's theory, and about 2 to 2.3 in simulations of broad spectra at "
+        "0.5 % to 5 % contact (Hyun et al. 2004; Campañá and Müser 2007; Prodanov, Dapp and Müser 2014; Yastrebov, "
+        "Anciaux and Molinari 2017; van Dokkum et al. 2018).",
         "",
         f"![kappa against p / (E* rms gradient) for each H, with the literature]({figures}/{FIGURES[1]})",
+        "",
+        "### κ against the breadth of the spectrum",
+        "",
+        nayak_text(runs, numbers),
+        "",
+        f"![kappa against the Nayak parameter, main, broad-band and comparison families]({figures}/{FIGURES[4]})",
+        "",
+        "## g_r and κ_r: the rms gradient over the real contact",
+        "",
+        "g_r / g is ξ with the edge pixels weighted as the corrected area weighs them; κ_r replaces the surface's "
+        "rms gradient by g_r. The drift is the slope of the mean κ (or κ_r) against ln p over the loads named, "
+        "relative to its mean, with paired bootstrap intervals; κ_r is called closer to constant only where the "
+        "paired difference of the two drifts' sizes excludes 0.",
+        "",
+        gradient_text(runs, numbers),
+        "",
+        *gradient_table(runs, numbers),
+        "",
+        f"![g_r / g, kappa and kappa_r against p / (E* g)]({figures}/{FIGURES[3]})",
+        "",
+        "## The few-spot regime",
+        "",
+        few_spots_text(runs, numbers),
+        "",
+        f"![contact spots per surface, the area against f, and its local exponent]({figures}/{FIGURES[5]})",
         "",
         "## Surfaces that self-average",
         "",
@@ -236,9 +297,7 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "holds 16 cells of its longest wave and its heights are close to Gaussian one by one. The comparison "
         "family, the same spectrum with the long cut-off at the side, is dominated by its few longest waves. "
         "Skewness and kurtosis are those of each surface's heights (0 and 3 for a Gaussian); the Nayak parameter "
-        "α = m0 m4 / m2² of its profiles (m_n the spectral moments; 1 for a single wave, growing with the band). "
-        "They are computed from each surface on its family's coarsest grid that ran (the same modes as on the "
-        "finer grids).",
+        "α = m0 m4 / m2² of its profiles (m_n the spectral moments; 1 for a single wave, growing with the band).",
         "",
         *surfaces_table(runs, numbers),
         "",
@@ -249,32 +308,21 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "MDR presses a line of springs, the MDR-equivalent line of the surface (length L = 2 √(A/π), spectrum "
         "C1D(q) = π q C2D(q), the same mean square height and gradient), at the same loads, so at the same f. That "
         "line depends on a surface only through its spectrum, which all surfaces of a family share: one random "
-        f"line per surface is noisy, so each surface's prediction is averaged over {plan.mdr_lines} lines "
-        f"({plan.mdr_lines} times the surfaces in each MDR ensemble). MDR is built to keep the force against the "
-        "approach; it does not keep the real area, and its fraction of springs in contact is not one. "
-        + ensemble_text(runs),
+        f"line per surface is noisy, so each surface's prediction is averaged over {plan.mdr_lines} lines. MDR is "
+        "built to keep the force against the approach; it does not keep the real area, and its fraction of "
+        "springs in contact is not one. " + ensemble_text(runs),
         "",
-        "## Convergence in the grid",
+        "## Every ensemble",
         "",
-        f"The grids sample the same surfaces ({'the same modes and random phases: a grid' + chr(39) + 's heights are those of a finer one at its points' if same_surfaces(runs) else 'the same spectrum'}) "
-        f"with {', '.join(f'{n}²' for n in grids)} pixels, that is "
-        + ", ".join(f"{n * first.short_cutoff / side:g}" for n in grids)
-        + f" pixels on the short cut-off λs = {first.short_cutoff:g}. The loads, F = {o.force.min():g} to "
-        f"{o.force.max():g} in {o.force.size} log steps, are the same f on every grid. The compute time is the "
-        "surfaces' solve times summed (seconds of one core), kept in the run folders.",
-        "",
-        *convergence_table(runs, numbers),
-        "",
-        f"![a, b and kappa against the pixels on the short cut-off]({figures}/{FIGURES[2]})",
-        "",
-        convergence_text(runs, numbers),
+        *ensembles_table(runs, numbers),
         "",
         *paired_table(numbers.extra, "grid"),
         "",
-        gradient_text(numbers),
+        spectral_text(numbers),
         "",
         *paired_table(numbers.spectral, "grid, gradient"),
         "",
+        *limitations(runs),
         "## The solver under it",
         "",
         f"`bem-halfspace`: FFT boundary elements (surface stiffness E*|q|/2) and a constrained conjugate gradient, "
@@ -285,10 +333,10 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "exact; each peak Hertzian at small loads), and the Hertz cylinder on the half-plane; the corrected area "
         "against Hertz's π a² (`tests/test_contact_area.py`).",
         "",
-        f"The presets are {presets}; each runs alone as `frictionlab run presets/exact3d-h08.yaml` (its 1024² grid). "
-        "The exact runs are ordinary runs: processes or Dask, the memory estimate before the start, resumable "
-        "(`--runs` of an interrupted study resumes every ensemble, and `--finished-only` writes the page from "
-        "those that finished).",
+        f"The presets are {presets}; each runs alone as `frictionlab run presets/exact3d-h08.yaml` (its 1024² grid "
+        "and its own loads; the study presses every family at the plan's loads). The exact runs are ordinary runs: "
+        "processes or Dask, the memory estimate before the start, resumable (`--runs` of an interrupted study "
+        "resumes every ensemble, and `--finished-only` writes the page from those that finished).",
         "",
     ]
     return "\n".join(lines)

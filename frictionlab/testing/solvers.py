@@ -50,6 +50,8 @@ def check_solver(cls, **params) -> None:
     ``contact_fraction == contact_count / N`` (the fraction of points, of the
     real contact or of MDR springs as ``contact_measure`` says); ``real_area_corrected`` is
     given exactly when ``corrected_area`` is True, and then lies in (0, contact_fraction];
+    ``real_gradient_rms`` is given exactly when ``real_gradient`` is True, and is then finite and >= 0;
+    ``contact_spots`` is given exactly when ``counts_spots`` is True, whole numbers in 1 .. contact_count;
     ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
@@ -128,6 +130,22 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             if np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12)):
                 fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
                           f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
+        gradient = curve.real_gradient_rms
+        if (gradient is not None) != cls.real_gradient:
+            fail(cls, f"{where}.real_gradient_rms must be given exactly when real_gradient is True "
+                      f"(it is {cls.real_gradient!r}). Got {gradient!r}.")  # fmt: skip
+        if gradient is not None:
+            gradient = check_array(cls, f"{where}.real_gradient_rms", np.asarray(gradient), loads.shape, True)
+            if np.any(gradient < 0):
+                fail(cls, f"{where}.real_gradient_rms is an rms slope and must be >= 0. Got {gradient!r}.")
+        spots = curve.contact_spots
+        if (spots is not None) != cls.counts_spots:
+            fail(cls, f"{where}.contact_spots must be given exactly when counts_spots is True "
+                      f"(it is {cls.counts_spots!r}). Got {spots!r}.")  # fmt: skip
+        if spots is not None:
+            spots = check_array(cls, f"{where}.contact_spots", np.asarray(spots), loads.shape, False)
+            if np.any(spots != np.round(spots)) or np.any(spots < 1) or np.any(spots > arrays["contact_count"]):
+                fail(cls, f"{where}.contact_spots must be whole numbers in 1 .. contact_count. Got {spots!r}.")
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")

@@ -34,7 +34,7 @@ from pydantic import Field
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
 from .checks import check_control, check_loads, check_profile
-from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, corrected_area_fraction
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, contact_spots, corrected_area_fraction, corrected_gradient_rms
 from .contact_cg import ProjectedCG, next_pressure, solve_load
 from .elastic import ElasticParams, PeriodicHalfSpace, elastic_stiffness
 
@@ -111,6 +111,8 @@ class PeriodicBEM(ContactSolver):
         indentation = np.empty(steps)
         count = np.empty(steps, dtype=np.int64)
         corrected = np.ones(steps) if self.corrected_area else None  # full contact: no edge to correct
+        real_gradient = np.full(steps, line_rms) if self.real_gradient else None  # likewise
+        spots = np.ones(steps) if self.counts_spots else None  # full contact: one spot
         slope_rms = np.empty(steps)
         iterations = np.zeros(steps, dtype=np.int64)
         residual = np.zeros(steps)
@@ -128,6 +130,8 @@ class PeriodicBEM(ContactSolver):
                 contact_fraction=np.ones(steps),
                 slope_rms_contact=np.full(steps, line_rms),
                 real_area_corrected=corrected,
+                real_gradient_rms=real_gradient,
+                contact_spots=spots,
                 extras={"iterations": iterations, "residual": residual},
             )
 
@@ -169,6 +173,10 @@ class PeriodicBEM(ContactSolver):
             count[j] = n
             if corrected is not None and n < points:
                 corrected[j] = corrected_area_fraction(contact)
+            if real_gradient is not None and n < points:
+                real_gradient[j] = corrected_gradient_rms(contact, slopes)
+            if spots is not None and n < points:
+                spots[j] = contact_spots(contact)
             if control == "force":
                 force[j] = load
                 indentation[j] = approach * scale
@@ -188,6 +196,8 @@ class PeriodicBEM(ContactSolver):
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
             real_area_corrected=corrected,
+            real_gradient_rms=real_gradient,
+            contact_spots=spots,
             extras={"iterations": iterations, "residual": residual},
         )
 
@@ -214,3 +224,5 @@ class BEMHalfSpace(PeriodicBEM):
     references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER, YASTREBOV_ANCIAUX_MOLINARI)
     # the pixel count's perimeter correction (contact_area.py) is derived for a surface's pixel edges
     corrected_area: ClassVar[bool] = True
+    real_gradient: ClassVar[bool] = True
+    counts_spots: ClassVar[bool] = True

@@ -25,6 +25,7 @@ from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load
 
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
+from .contact_area import contact_spots, corrected_gradient_rms
 from .contact_cg import next_pressure, solve_load
 from .elastic import PeriodicHalfSpace
 
@@ -125,6 +126,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
     indentation_reference: ClassVar[str] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = False  # per surface: extras["mean_displacement"]
     periodic_only: ClassVar[bool] = False
+    real_gradient: ClassVar[bool] = True
+    counts_spots: ClassVar[bool] = True
     # measured 315 B per point (tracemalloc, 256^2 surfaces from first contact to full contact:
     # the CG's grids, the padded pressure, response and their spectra, four times the scan's
     # points each, and the preconditioner's periodic kernels), plus 20 %
@@ -148,6 +151,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
         steps = loads.size
         force, indentation, shift = np.empty(steps), np.empty(steps), np.zeros(steps)
         count, slope_rms = np.empty(steps, dtype=np.int64), np.empty(steps)
+        real_gradient = np.full(steps, line_rms)  # full contact: every pixel counts whole
+        spots = np.ones(steps)  # full contact: one spot
         iterations, residual = np.zeros(steps, dtype=np.int64), np.zeros(steps)
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
@@ -169,6 +174,9 @@ class BEMHalfSpaceFree(PeriodicBEM):
             indentation[j] = approach * scale if control == "force" else load
             shift[j] = float(np.mean(cg.gap - depth)) * scale  # the exact gap holds the displacement
             slope_rms[j] = line_rms if n == points else float(np.sqrt(np.mean(np.square(slopes[contact]))))
+            if n < points:  # a scan's border is no edge of its contact
+                real_gradient[j] = corrected_gradient_rms(contact, slopes, periodic=False)
+                spots[j] = contact_spots(contact, periodic=False)
             load_finished(j + 1, steps)
         return ContactCurve(
             force=force,
@@ -176,5 +184,7 @@ class BEMHalfSpaceFree(PeriodicBEM):
             contact_count=count,
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
+            real_gradient_rms=real_gradient,
+            contact_spots=spots,
             extras={"iterations": iterations, "residual": residual, "mean_displacement": shift},
         )

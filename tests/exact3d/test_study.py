@@ -3,13 +3,14 @@ and figures, the refusal to overwrite, a second invocation that resumes every en
 ``--finished-only``, which writes the page from what finished and names what did not."""
 
 import json
+import math
 
 import numpy as np
 import pytest
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.exact3d.plan import HURSTS, QUICK, preset_name
+from frictionlab.exact3d.plan import BROAD_HURSTS, HURSTS, QUICK, preset_name
 from frictionlab.exact3d.report import FIGURES, FIGURES_DIR, PAGE
 
 from ..conftest import PRESETS
@@ -49,9 +50,38 @@ def test_quick_page_has_every_h_every_grid_and_mdr(quick_study):
     assert "not converged" in text and "not quoted" in text
     # every ensemble ran: exact and MDR on each grid at each H, the extra grid, the comparison family, the gradients
     folders = sorted(p.name for p in (quick_study / "runs").iterdir() if p.is_dir())
-    assert len(folders) == len(QUICK.jobs()) == len(HURSTS) * (2 * len(QUICK.resolutions) + 3) + 2 * len(QUICK.extra)
+    assert len(folders) == len(QUICK.jobs()) == (len(HURSTS) * (2 * len(QUICK.resolutions) + 3) + 2 * len(QUICK.extra)
+                                                 + len(BROAD_HURSTS))
     # the literature kappa is the corrected range, never the old bracket
     assert "about 1.6 to about 2" not in text and "2 to 2.3" in text and "2.51" in text and "1.60" in text
+
+
+def test_quick_page_reads_as_a_referee_wants_it(quick_study):
+    """Definitions first, the quick plan said, the evidence sections, the limitations, and
+    no claim beyond the evidence: "converged" only where the grids resolve the cut-off, a
+    log law "holds" only where the model test prefers it at every H."""
+    text = (quick_study / PAGE).read_text()
+    headings = [line for line in text.splitlines() if line.startswith("## ")]
+    assert headings.index("## Definitions") < headings.index("## The answer")
+    for heading in ("## Convergence in the grid", "## Which law? The model test", "## g_r and κ_r: the rms gradient "
+                    "over the real contact", "## The few-spot regime", "## Limitations"):  # fmt: skip
+        assert heading in headings
+    assert "### κ against the breadth of the spectrum" in text
+    assert "| g_r / g [95 % CI] | κ [95 % CI] | κ_r [95 % CI] |" in text  # g_r and kappa_r published with intervals
+    assert "quick plan: small grids and ensembles" in text and "not converged and answer nothing" in text
+    for word in ("A0", "E* = E / (1 - ν²)", "p / (E* g)", "Fixed amplitudes", "stop rule", "g_r", "κ_r"):
+        assert word in text.split("## What ran")[0], word
+    # the quick grids resolve nothing: no "converged" verdict, the convergence said not shown
+    assert "converged within" not in text and "not shown: the grids compared" in text
+    # the log law is said to hold only if the model test prefers it on every H's mean curve
+    rows = [line.split("|") for line in text.splitlines() if "| main, all |" in line]
+    preferred = {row[8].strip() for row in rows}
+    assert rows and (("Yes, over f" in text) == (preferred == {"log law"}))
+    assert "Not as a rule" in text or "Yes, over f" in text
+    # the breadth trend cited to its paper, the area correction to its own, the source study named
+    assert "J. Mech. Phys. Solids 2017, arXiv 1704.05650" in text and "arXiv 1701.02727" in text
+    assert "J. Benad (Physical Mesomechanics, 2012)" in text and "times the real contact area in its springs" in text
+    assert "approaching its vanishing-load limit" not in text and "R²" not in text
 
 
 def test_mdr_runs_its_lines_per_surface_and_the_comparison_family_the_whole_side(quick_study):
@@ -195,3 +225,33 @@ def test_a_broken_preset_of_a_later_h_is_refused_before_any_ensemble_runs(tmp_pa
     assert code == ExitCode.USAGE
     assert preset_name(HURSTS[-1]) in capsys.readouterr().err
     assert not runs.exists() or not any(p.is_dir() for p in runs.iterdir())  # no ensemble ran
+
+
+def test_the_broad_band_family_keeps_the_long_cut_off_and_every_family_the_same_loads(quick_study):
+    runs = quick_study / "runs"
+    points, _, short_pixels = QUICK.broad
+    first, last, steps = QUICK.loads
+    for h in BROAD_HURSTS:
+        broad = json.loads((runs / f"broad-h{h:.1f}-n{points}-bem-halfspace" / "summary.json").read_text())["preset"]
+        main = json.loads((runs / f"h{h:.1f}-n{points}-bem-halfspace" / "summary.json").read_text())["preset"]
+        b, m = broad["spectrum"]["params"], main["spectrum"]["params"]
+        assert b["long_cutoff"] == m["long_cutoff"] and b["short_cutoff"] == pytest.approx(short_pixels * b["length"] / points)
+        assert b["short_cutoff"] < m["short_cutoff"]
+        for preset in (broad, main):
+            assert (preset["loading"]["start"], preset["loading"]["stop"], preset["loading"]["steps"]) == (first, last, steps)
+    header = (runs / f"h0.8-n{points}-bem-halfspace" / "curve.csv").read_text().splitlines()[0]
+    assert "real_gradient_rms [" in header and "kappa_r [" in header and "contact_spots [" in header
+
+
+def test_the_full_plan_pairs_three_grids_with_16_surfaces_and_a_broad_band_of_32():
+    from frictionlab.exact3d.plan import FULL
+
+    grids = dict(zip(FULL.resolutions, FULL.realizations))
+    assert {512, 1024, 2048} <= set(grids) and grids[2048] >= 16
+    points, surfaces, short_pixels = FULL.broad
+    side, long_cutoff = 128.0, 32.0  # the presets' side and long cut-off
+    assert points == 2048 and surfaces >= 16 and short_pixels >= 16
+    assert long_cutoff <= side / 4 and long_cutoff / (short_pixels * side / points) >= 32
+    first, last, _ = FULL.loads
+    assert math.log10(last / first) >= 3.5
+    assert set(FULL.broad_hursts) == {0.5, 0.8, 1.0}
