@@ -29,11 +29,29 @@ def _size_argument(call: ast.Call) -> ast.expr | None:
     return call.args[position] if len(call.args) > position else None
 
 
-def _bounded(size: ast.expr) -> bool:
-    """A size that cannot be a cap: a constant block, ``len(...)`` of what is held, or a
-    ``min(...)`` (with the file's size, its remaining bytes or a block)."""
+SMALL_BLOCK = 1 << 20  # a named constant up to this many bytes is a block, not a cap
+
+
+def _small_constants(tree: ast.Module) -> set[str]:
+    """The module-level names bound to a literal number of at most ``SMALL_BLOCK`` bytes."""
+    return {
+        target.id
+        for node in tree.body
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Constant)
+        and isinstance(node.value.value, int) and 0 < node.value.value <= SMALL_BLOCK
+        for target in node.targets
+        if isinstance(target, ast.Name)
+    }  # fmt: skip
+
+
+def _bounded(size: ast.expr, small: set[str] = frozenset()) -> bool:
+    """A size that cannot be a cap: a constant block (a literal, or a module constant of at
+    most 1 MiB), ``len(...)`` of what is held, or a ``min(...)`` (with the file's size, its
+    remaining bytes or a block)."""
     if isinstance(size, ast.Constant) or (isinstance(size, ast.BinOp) and all(
             isinstance(side, ast.Constant) for side in (size.left, size.right))):  # fmt: skip
+        return True
+    if isinstance(size, ast.Name) and size.id in small:
         return True
     return isinstance(size, ast.Call) and isinstance(size.func, ast.Name) and size.func.id in {"min", "len"}
 
@@ -41,10 +59,12 @@ def _bounded(size: ast.expr) -> bool:
 def test_no_read_in_the_package_or_the_plugins_takes_a_cap_as_its_buffer_size():
     unbounded = []
     for path in SOURCES:
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        small = _small_constants(tree)
+        for node in ast.walk(tree):
             if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in READS:
                 size = _size_argument(node)
-                if size is not None and not _bounded(size):
+                if size is not None and not _bounded(size, small):
                     unbounded.append(f"{path.relative_to(ROOT)}:{node.lineno}: {ast.unparse(node)}")
     assert not unbounded, "reads sized by something other than the data:\n" + "\n".join(unbounded)
 
@@ -54,6 +74,10 @@ def test_the_check_finds_a_read_sized_by_a_cap():
     assert not any(_bounded(_size_argument(call)) for call in calls)
     fine = [ast.parse(code).body[0].value for code in ("fh.read(min(size + 1, cap))", "fh.read(1 << 20)", "fh.read()")]
     assert all(_size_argument(call) is None or _bounded(_size_argument(call)) for call in fine)
+    module = ast.parse("MAGIC = 512\nMAX_BYTES = 16 << 30\nCAP = 1 << 40\nfh.read(MAGIC)\nfh.read(CAP)")
+    small = _small_constants(module)
+    reads = [node.value for node in module.body[3:]]
+    assert _bounded(_size_argument(reads[0]), small) and not _bounded(_size_argument(reads[1]), small)
 
 
 def test_a_small_file_under_a_huge_cap_is_read_under_a_virtual_memory_limit(tmp_path):
