@@ -104,15 +104,17 @@ def test_the_exact3d_convergence_figure_draws_intervals_that_miss_their_estimate
     from frictionlab.exact3d import figures
 
     calls = _recording(monkeypatch, figures)
-    grids = [SimpleNamespace(pixels_per_short_cutoff=p, quoted=p >= 16, folder=SimpleNamespace(name=f"g{p}"),
-                             outcome=SimpleNamespace(fit=_fit(point, tuple(-v for v in point))))
-             for p, point in zip((8, 16, 32), POINTS)]  # fmt: skip
-    kappas = {f"g{p}": SimpleNamespace(corrected=SimpleNamespace(value=2 + point[0], interval=(2 + point[1], 2 + point[2])))
-              for p, point in zip((8, 16, 32), POINTS)}  # fmt: skip
-    mdr = SimpleNamespace(outcome=SimpleNamespace(fit=SimpleNamespace(a=0.2, b=-0.2)))
-    runs = SimpleNamespace(hursts=lambda: [0.8], exact_grids=lambda hurst: grids, find=lambda hurst, exact=True: mdr)
-    numbers = SimpleNamespace(kappa=lambda e: kappas[e.folder.name])
-    figures.plot_convergence(runs, numbers, io.BytesIO())
-    a, b, kappa = calls
+    grids = [SimpleNamespace(pixels_per_short_cutoff=p, quoted=p >= 16) for p in (8, 16, 32)]
+    value, low, high = np.array(POINTS).T
+    limit = SimpleNamespace(limit=0.4, interval=(0.1, 0.2), estimated=True)  # a limit outside its interval too
+    quantities = {
+        "a": SimpleNamespace(values=value, low=low, high=high, limit=limit),
+        "b": SimpleNamespace(values=-value, low=-high, high=-low, limit=None),
+        "κ": SimpleNamespace(values=2 + value, low=2 + low, high=2 + high, limit=None),
+    }
+    numbers = SimpleNamespace(convergence={0.8: SimpleNamespace(grids=grids, surfaces=16, quantities=quantities)})
+    figures.plot_convergence(SimpleNamespace(), numbers, io.BytesIO())
+    a, a_limit, b, kappa = calls
     assert a == pytest.approx(np.array(POINTS)) and kappa == pytest.approx(2 + np.array(POINTS))
-    assert b == pytest.approx(-np.array(POINTS))
+    assert b == pytest.approx(-np.array(POINTS)[:, [0, 2, 1]])
+    assert a_limit == pytest.approx(np.array([[0.4, 0.1, 0.2]]))
