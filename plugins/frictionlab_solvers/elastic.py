@@ -19,6 +19,8 @@ from pydantic import Field
 
 from frictionlab import PluginParams
 
+from .arrays import host, is_numpy, namespace, on_device
+
 __all__ = ["ElasticOperator", "ElasticParams", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
 
 
@@ -87,20 +89,28 @@ class PeriodicHalfSpace:
     displacements have zero mean. The preconditioner leaves that mode out too (a
     uniform pressure moves nothing, so no displacement asks for one).
 
-    numpy's FFTs write into the buffers given (``out``), so a call allocates
-    nothing: half the time of ``scipy.fft``, which returns new arrays.
+    ``xp`` is the array namespace the fields live in (numpy by default; CuPy on a GPU;
+    any array-API namespace with the ``fft`` extension). On numpy with one FFT thread,
+    numpy's FFTs write into the buffers given (``out``), so a call allocates nothing:
+    half the time of ``scipy.fft``, which returns new arrays; with ``workers`` > 1 the
+    FFTs are ``scipy.fft``'s on that many threads.
     """
 
-    def __init__(self, shape: tuple[int, ...]):
+    def __init__(self, shape: tuple[int, ...], xp=None, workers: int = 1):
         self.shape = tuple(shape)
         self.axes = tuple(range(len(self.shape)))
+        self.xp = namespace("cpu") if xp is None else xp
+        self.workers = workers
+        self.numpy_out = is_numpy(self.xp) and workers == 1  # numpy's FFTs into given buffers
         q = _wave_number(self.shape)
-        self.compliance = np.zeros(q.shape)
-        np.divide(2.0, q, out=self.compliance, where=q > 0)
-        self.stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
-        self.stiffness32 = self.stiffness.astype(np.float32)
-        self.compliance32 = self.compliance.astype(np.float32)
-        self.spectrum = np.empty(q.shape, dtype=complex)
+        compliance = np.zeros(q.shape)
+        np.divide(2.0, q, out=compliance, where=q > 0)
+        stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
+        self.compliance = on_device(self.xp, compliance)
+        self.stiffness = on_device(self.xp, stiffness)
+        self.stiffness32 = on_device(self.xp, stiffness.astype(np.float32))
+        self.compliance32 = on_device(self.xp, compliance.astype(np.float32))
+        self.spectrum = np.empty(q.shape, dtype=complex) if self.numpy_out else None
 
     @functools.cached_property
     def point_stiffness(self) -> float:
@@ -108,41 +118,60 @@ class PeriodicHalfSpace:
         computed when first asked for)."""
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
 
-        return 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
+        return 1.0 / float(scipy.fft.irfftn(host(self.compliance), s=self.shape).flat[0])
 
-    def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def displacement(self, pressure, out):
         """Zero-mean surface displacement under ``pressure``, written into ``out``."""
         return self._apply(self.compliance, pressure, out)
 
-    def displacement_estimate(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def displacement_estimate(self, pressure, out):
         """``displacement`` in single precision (rounding 6e-8 relative), for the
         corrections the CG recomputes exactly before it stops."""
         return self._apply_single(self.compliance32, pressure, out)
 
-    def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def precondition(self, residual, out):
         """The stiffness ``|q| / 2`` applied to ``residual``, in single precision:
         a preconditioner need only be close to the inverse (its rounding changes no
         stop and no step's exactness)."""
         return self._apply_single(self.stiffness32, residual, out)
 
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
-        """The zero-mean pressure that makes ``displacement`` (exact inverse, zero mean)."""
-        return self._apply(self.stiffness, displacement, np.empty(self.shape))
+        """The zero-mean pressure (numpy) that makes ``displacement`` (numpy; exact inverse, zero mean)."""
+        out = self.xp.empty(self.shape, dtype=self.xp.float64) if not self.numpy_out else np.empty(self.shape)
+        return host(self._apply(self.stiffness, on_device(self.xp, displacement), out))
 
-    def _apply(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
-        spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
+    def _apply(self, kernel, field, out):
+        if self.numpy_out:
+            spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
+            spectrum *= kernel
+            np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
+            return out
+        return self._apply_new(kernel, field, out, own=False)
+
+    def _apply_single(self, kernel, field, out):
+        """``_apply`` in float32: about half the time of a float64 pair."""
+        return self._apply_new(kernel, self.xp.astype(field, self.xp.float32), out, own=True)
+
+    def _apply_new(self, kernel, field, out, own: bool):
+        """The FFT pair on new arrays: ``scipy.fft`` on ``workers`` threads on numpy, else
+        the namespace's ``fft``; the result cast into ``out``. ``own``: ``field`` is a copy
+        the transform may overwrite."""
+        if is_numpy_array(field):
+            import scipy.fft
+
+            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers, overwrite_x=own)
+            spectrum *= kernel
+            out[...] = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=self.workers, overwrite_x=True)
+            return out
+        xp = self.xp
+        spectrum = xp.fft.rfftn(field, axes=self.axes)
         spectrum *= kernel
-        np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
+        out[...] = xp.astype(xp.fft.irfftn(spectrum, s=self.shape, axes=self.axes), out.dtype)
         return out
 
-    def _apply_single(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """``_apply`` in float32 with ``scipy.fft``: about half the time of a float64 pair."""
-        import scipy.fft
 
-        spectrum = scipy.fft.rfftn(field.astype(np.float32), axes=self.axes, workers=1)
-        spectrum *= kernel
-        out[...] = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=1, overwrite_x=True)
-        return out
+def is_numpy_array(array) -> bool:
+    return isinstance(array, np.ndarray)
 
 
 def _wave_number(shape: tuple[int, ...]) -> np.ndarray:
