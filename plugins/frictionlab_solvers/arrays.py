@@ -29,15 +29,15 @@ def namespace(device: str):
         import cupy
     except ImportError:
         raise ValueError(
-            "device: 'gpu' needs CuPy, which is not installed (pip install cupy-cuda12x, or the wheel for "
-            "your CUDA version). Use device: cpu."
+            "device 'gpu' needs CuPy, which is not installed (pip install cupy-cuda12x, or the wheel of "
+            "your CUDA version); or use device 'cpu'"
         ) from None
     try:
         count = cupy.cuda.runtime.getDeviceCount()
     except Exception as exc:  # the CUDA runtime's own error (no driver, no device)
-        raise ValueError(f"device: 'gpu' found no usable CUDA GPU ({type(exc).__name__}). Use device: cpu.") from None
+        raise ValueError(f"device 'gpu' needs a CUDA GPU, and CuPy found none ({type(exc).__name__}); or use device 'cpu'") from None
     if count < 1:
-        raise ValueError("device: 'gpu' found no CUDA GPU on this machine. Use device: cpu.")
+        raise ValueError("device 'gpu' needs a CUDA GPU, and CuPy found none on this machine; or use device 'cpu'")
     return array_api_compat.array_namespace(cupy.empty(0))
 
 

@@ -21,7 +21,7 @@ from frictionlab import PluginParams
 
 from .arrays import host, is_numpy, namespace, on_device
 
-__all__ = ["ElasticOperator", "ElasticParams", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
+__all__ = ["ElasticOperator", "ElasticParams", "FFTPair", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
 
 
 def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
@@ -90,10 +90,8 @@ class PeriodicHalfSpace:
     uniform pressure moves nothing, so no displacement asks for one).
 
     ``xp`` is the array namespace the fields live in (numpy by default; CuPy on a GPU;
-    any array-API namespace with the ``fft`` extension). On numpy with one FFT thread,
-    numpy's FFTs write into the buffers given (``out``), so a call allocates nothing:
-    half the time of ``scipy.fft``, which returns new arrays; with ``workers`` > 1 the
-    FFTs are ``scipy.fft``'s on that many threads.
+    any array-API namespace with the ``fft`` extension); ``workers`` the threads of each
+    FFT on numpy (``FFTPair``).
     """
 
     def __init__(self, shape: tuple[int, ...], xp=None, workers: int = 1):
@@ -101,7 +99,7 @@ class PeriodicHalfSpace:
         self.axes = tuple(range(len(self.shape)))
         self.xp = namespace("cpu") if xp is None else xp
         self.workers = workers
-        self.numpy_out = is_numpy(self.xp) and workers == 1  # numpy's FFTs into given buffers
+        self.pair = FFTPair(self.shape, self.xp, workers)
         q = _wave_number(self.shape)
         compliance = np.zeros(q.shape)
         np.divide(2.0, q, out=compliance, where=q > 0)
@@ -110,7 +108,6 @@ class PeriodicHalfSpace:
         self.stiffness = on_device(self.xp, stiffness)
         self.stiffness32 = on_device(self.xp, stiffness.astype(np.float32))
         self.compliance32 = on_device(self.xp, compliance.astype(np.float32))
-        self.spectrum = np.empty(q.shape, dtype=complex) if self.numpy_out else None
 
     @functools.cached_property
     def point_stiffness(self) -> float:
@@ -137,41 +134,56 @@ class PeriodicHalfSpace:
 
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
         """The zero-mean pressure (numpy) that makes ``displacement`` (numpy; exact inverse, zero mean)."""
-        out = self.xp.empty(self.shape, dtype=self.xp.float64) if not self.numpy_out else np.empty(self.shape)
+        out = self.xp.empty(self.shape, dtype=self.xp.float64)
         return host(self._apply(self.stiffness, on_device(self.xp, displacement), out))
 
     def _apply(self, kernel, field, out):
-        if self.numpy_out:
-            spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
-            spectrum *= kernel
-            np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
-            return out
-        return self._apply_new(kernel, field, out, own=False)
+        return self.pair.apply(kernel, field, out)
 
     def _apply_single(self, kernel, field, out):
         """``_apply`` in float32: about half the time of a float64 pair."""
-        return self._apply_new(kernel, self.xp.astype(field, self.xp.float32), out, own=True)
+        return self.pair.apply(kernel, field, out, single=True)
 
-    def _apply_new(self, kernel, field, out, own: bool):
-        """The FFT pair on new arrays: ``scipy.fft`` on ``workers`` threads on numpy, else
-        the namespace's ``fft``; the result cast into ``out``. ``own``: ``field`` is a copy
-        the transform may overwrite."""
-        if is_numpy_array(field):
+
+class FFTPair:
+    """``out = irfftn(kernel * rfftn(field))`` on a grid of ``shape``, in namespace ``xp``.
+
+    On numpy with one thread, numpy's FFTs write into this pair's buffers (``out=``):
+    no allocation, half the time of ``scipy.fft``, which returns new arrays. With
+    ``workers`` > 1 on numpy, ``scipy.fft`` on that many threads; on any other namespace
+    its ``fft`` extension (CuPy's cuFFT on a GPU). Single precision (``single``) always
+    takes the new-array path: numpy's float32 FFTs measured slower than scipy's."""
+
+    def __init__(self, shape: tuple[int, ...], xp, workers: int = 1):
+        self.shape, self.axes, self.xp, self.workers = tuple(shape), tuple(range(len(shape))), xp, workers
+        self.numpy = is_numpy(xp)
+        half = (*self.shape[:-1], self.shape[-1] // 2 + 1)
+        self.buffers = (np.empty(half, dtype=complex), np.empty(self.shape)) if self.numpy and workers == 1 else None
+
+    def apply(self, kernel, field, out=None, single: bool = False):
+        """Into ``out`` (a float64 grid), or into this pair's own buffer (returned) on the
+        numpy path, a new array otherwise."""
+        xp = self.xp
+        if single:
+            field = xp.astype(field, xp.float32)
+        elif self.buffers is not None:
+            spectrum = np.fft.rfftn(field, axes=self.axes, out=self.buffers[0])
+            spectrum *= kernel
+            return np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=self.buffers[1] if out is None else out)
+        if self.numpy:
             import scipy.fft
 
-            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers, overwrite_x=own)
+            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers, overwrite_x=single)
             spectrum *= kernel
-            out[...] = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=self.workers, overwrite_x=True)
-            return out
-        xp = self.xp
-        spectrum = xp.fft.rfftn(field, axes=self.axes)
-        spectrum *= kernel
-        out[...] = xp.astype(xp.fft.irfftn(spectrum, s=self.shape, axes=self.axes), out.dtype)
+            result = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=self.workers, overwrite_x=True)
+        else:
+            spectrum = xp.fft.rfftn(field, axes=self.axes)
+            spectrum *= kernel
+            result = xp.fft.irfftn(spectrum, s=self.shape, axes=self.axes)
+        if out is None:
+            return result
+        out[...] = xp.astype(result, out.dtype)
         return out
-
-
-def is_numpy_array(array) -> bool:
-    return isinstance(array, np.ndarray)
 
 
 def _wave_number(shape: tuple[int, ...]) -> np.ndarray:
