@@ -133,6 +133,9 @@ class ProjectedCG:
         """
         xp = self.xp
         force_control = approach is None
+        # Python floats: a strict namespace takes no numpy scalar (np.float64) in arithmetic
+        mean_pressure = None if mean_pressure is None else float(mean_pressure)
+        approach = None if approach is None else float(approach)
         operator = self.operator
         flat = (-1,)
         p, g, depth = xp.reshape(pressure, flat), xp.reshape(self.gap, flat), xp.reshape(self.depth, flat)
