@@ -151,6 +151,7 @@ class ProjectedCG:
                 p[...] = mean_pressure
         d_grid[...] = 0.0
         r_grid[...] = 0.0
+        spread = None  # the last working set, off which the direction and the residual grids are zero
         contact = xp.nonzero(p)[0]
         self._exact_gap(pressure)
         exact, since_exact = True, 0
@@ -174,9 +175,8 @@ class ProjectedCG:
             worst_contact = float(xp.max(xp.abs(g_c)))
             # points below the level: contact points with a negative gap error, and free
             # points that penetrate (p is exactly 0 off the contact set)
-            below = g < level
-            free_below = below & (p == 0.0)
-            penetrating = xp.nonzero(free_below)[0]
+            below = xp.nonzero(g < level)[0]
+            penetrating = below[xp.take(p, below) == 0.0]
             worst_free = level - float(xp.min(xp.take(g, penetrating))) if penetrating.shape[0] else 0.0
             residual = max(worst_contact, worst_free) / self.rms
             done = residual <= tolerance or (
@@ -193,16 +193,17 @@ class ProjectedCG:
                 raise NotConverged(iteration, residual)
             iteration += 1
 
-            # the working set (sorted indices, and its mask) and the gradient on it
+            # the working set (sorted indices; its mask for a namespace without integer scatter)
+            # and the gradient on it
+            in_working = None if self.int_scatter else (p != 0.0) | (g < level)
             if penetrating.shape[0]:
-                in_working = (p != 0.0) | free_below
-                working = xp.nonzero(in_working)[0]
+                working = xp.sort(xp.concat([contact, penetrating]))  # disjoint
                 r = xp.take(g, working)
                 r -= level
                 if force_control:  # the gradient within zero-sum steps
                     r -= xp.mean(r)
             else:
-                in_working, working, r = p != 0.0, contact, g_c
+                working, r = contact, g_c
             # the preconditioned gradient, zero-sum under force control
             z_grid[...] = 0.0
             self._scatter(z_grid, working, in_working, r)
@@ -226,10 +227,10 @@ class ProjectedCG:
             else:
                 d = z
             previous_rz = rz
-            d_grid[...] = 0.0
-            self._scatter(d_grid, working, in_working, d)
-            r_grid[...] = 0.0
-            self._scatter(r_grid, working, in_working, r)
+            for spread_on_grid, values in ((d_grid, d), (r_grid, r)):
+                self._clear(spread_on_grid, spread)
+                self._scatter(spread_on_grid, working, in_working, values)
+            spread = working
             if rough and residual <= SINGLE_ABOVE:  # from here on every response is exact
                 rough = False
                 since_exact = REFRESH  # and the gap is recomputed exactly after this step
@@ -264,6 +265,7 @@ class ProjectedCG:
                         contact = xp.arange(size)
                         d_grid[...] = 0.0
                         r_grid[...] = 0.0
+                        spread = None
                         since_exact = REFRESH  # the gap is recomputed below
                     else:
                         p *= mean_pressure / total  # zero off the contact set
@@ -302,6 +304,14 @@ class ProjectedCG:
             grid[indices] = values
         else:  # the array API's boolean scatter, in the same (ascending) order
             grid[mask] = values
+
+    def _clear(self, grid, spread) -> None:
+        """Zero ``grid``, which is zero off the indices ``spread`` (None: anywhere): on
+        numpy only those points (a working set is a few percent of the grid)."""
+        if spread is not None and self.int_scatter:
+            grid[spread] = 0.0
+        else:
+            grid[...] = 0.0
 
     def _times(self, field, factor: float):
         """``field * factor``, on numpy into the scratch grid (no allocation)."""

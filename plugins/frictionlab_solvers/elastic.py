@@ -173,17 +173,18 @@ class FFTPair:
         if self.numpy:
             import scipy.fft
 
-            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers, overwrite_x=single)
+            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers)
             spectrum *= kernel
             result = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=self.workers, overwrite_x=True)
+            if out is not None:
+                out[...] = result  # cast from float32 as it is copied: one pass
         else:
             spectrum = xp.fft.rfftn(field, axes=self.axes)
             spectrum *= kernel
             result = xp.fft.irfftn(spectrum, s=self.shape, axes=self.axes)
-        if out is None:
-            return result
-        out[...] = xp.astype(result, out.dtype)
-        return out
+            if out is not None:
+                out[...] = xp.astype(result, out.dtype)  # the array API casts no dtype on assignment
+        return result if out is None else out
 
 
 def _wave_number(shape: tuple[int, ...]) -> np.ndarray:
