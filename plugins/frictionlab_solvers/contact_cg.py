@@ -74,6 +74,11 @@ class ProjectedCG:
         self.response = grid()  # the displacement under the direction
         self.preconditioned = grid()
         self.scratch = grid()
+        # an operator whose preconditioner is a float32 transform takes the residual spread on a
+        # float32 grid, and the CG reads its answer on the working set only: no float64 grid
+        # cleared, converted and written back whole at every step
+        self.precondition_single = getattr(operator, "precondition_single", None)
+        self.spread32 = grid(xp.float32) if self.precondition_single is not None else None
 
     def solve(
         self,
@@ -152,6 +157,8 @@ class ProjectedCG:
         d_grid[...] = 0.0
         r_grid[...] = 0.0
         spread = None  # the last working set, off which the direction and the residual grids are zero
+        spread32 = None  # the same for the float32 grid of the preconditioner (None: anywhere)
+        s_grid = None if self.spread32 is None else xp.reshape(self.spread32, flat)
         contact = xp.nonzero(p)[0]
         self._exact_gap(pressure)
         exact, since_exact = True, 0
@@ -205,10 +212,16 @@ class ProjectedCG:
             else:
                 working, r = contact, g_c
             # the preconditioned gradient, zero-sum under force control
-            z_grid[...] = 0.0
-            self._scatter(z_grid, working, in_working, r)
-            operator.precondition(self.preconditioned, self.preconditioned)
-            z = xp.take(z_grid, working)
+            if self.precondition_single is not None:
+                self._clear(s_grid, spread32)
+                self._scatter(s_grid, working, in_working, xp.astype(r, xp.float32))
+                spread32 = working
+                z = xp.astype(xp.take(xp.reshape(self.precondition_single(self.spread32), flat), working), xp.float64)
+            else:
+                z_grid[...] = 0.0
+                self._scatter(z_grid, working, in_working, r)
+                operator.precondition(self.preconditioned, self.preconditioned)
+                z = xp.take(z_grid, working)
             if force_control:
                 z -= xp.mean(z)
             rz = _dot(r, z, xp)

@@ -132,6 +132,11 @@ class PeriodicHalfSpace:
         stop and no step's exactness)."""
         return self._apply_single(self.stiffness32, residual, out)
 
+    def precondition_single(self, residual32):
+        """``precondition`` of a float32 grid, returned as a new float32 grid (the CG reads
+        it on its working set only)."""
+        return self._apply_single(self.stiffness32, residual32, None)
+
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
         """The zero-mean pressure (numpy) that makes ``displacement`` (numpy; exact inverse, zero mean)."""
         out = self.xp.empty(self.shape, dtype=self.xp.float64)
@@ -165,7 +170,7 @@ class FFTPair:
         numpy path, a new array otherwise."""
         xp = self.xp
         if single:
-            field = xp.astype(field, xp.float32)
+            field = xp.astype(field, xp.float32, copy=False)  # not overwritten below
         elif self.buffers is not None:
             spectrum = np.fft.rfftn(field, axes=self.axes, out=self.buffers[0])
             spectrum *= kernel
