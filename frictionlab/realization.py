@@ -181,6 +181,13 @@ def compute_chunk(
 
 
 CANCEL_POLL_SECONDS = 0.05  # how often ``compute_chunk_here`` looks at the cancel while it waits
+_abandoned: list[threading.Thread] = []  # solves a cancelled run left to stop by themselves
+
+
+def solve_abandoned() -> bool:
+    """Whether a solve that a cancelled run left behind (``compute_chunk_here``) is still
+    inside its step in this process."""
+    return any(thread.is_alive() for thread in _abandoned)
 
 
 def compute_chunk_here(
@@ -212,6 +219,7 @@ def compute_chunk_here(
     while solver.is_alive():
         solver.join(CANCEL_POLL_SECONDS)
         if cancel is not None and cancel.is_set():
+            _abandoned.append(solver)
             return list(finished)
     if errors:
         raise errors[0]

@@ -65,7 +65,7 @@ def test_interface_promised_to_the_study():
     assert registry.get("solver", "bem-halfspace") is BEMHalfSpace
     assert (BEMHalfPlane.dimensions, BEMHalfSpace.dimensions) == ((1,), (2,))
     for cls in (BEMHalfPlane, BEMHalfSpace):
-        assert set(cls.Params.model_fields) == {"youngs_modulus", "poisson_ratio", "tolerance", "max_iterations", "stop"}
+        assert set(cls.Params.model_fields) == {"youngs_modulus", "poisson_ratio", "tolerance", "max_iterations", "stop", "device", "fft_workers"}
         assert cls(youngs_modulus=2.0, poisson_ratio=0.5).stiffness() == pytest.approx(2.0 / 0.75, rel=1e-15)
     curve = solve(BEMHalfPlane(), rough_line(64, 1), [0.1, 0.3])
     assert set(curve.extras) == {"iterations", "residual"}

@@ -188,7 +188,28 @@ def program() -> None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
     code = main()
     gc.freeze()  # the interpreter's exit then skips a last collection of everything imported (40 ms)
+    _leave_an_abandoned_solve(code)
     sys.exit(code)
+
+
+def _leave_an_abandoned_solve(code: int) -> None:
+    """End the process now if a cancelled run left its solve inside a step (SIGTERM or
+    Ctrl-C mid-solve): the interpreter's exit would wait for that step's FFT to end (the
+    FFT library joins its threads as the process ends, and one running on several threads
+    aborted the process instead). The run has written what it keeps by now; the output
+    streams and the log files are flushed first."""
+    realization = sys.modules.get("frictionlab.realization")  # not imported: no run, nothing left
+    if realization is None or not realization.solve_abandoned():
+        return
+    import logging
+
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe, a closed stream: nothing more to say
+            pass
+    os._exit(code)
 
 
 def main(argv: list[str] | None = None) -> int:

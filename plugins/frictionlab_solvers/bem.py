@@ -29,10 +29,11 @@ from __future__ import annotations
 from typing import ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
+from .arrays import namespace
 from .checks import check_control, check_loads, check_profile
 from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, contact_spots, corrected_area_fraction, corrected_gradient_rms
 from .contact_cg import ProjectedCG, next_pressure, solve_load
@@ -77,6 +78,24 @@ class PeriodicBEM(ContactSolver):
             "steps, every point's pressure or gap 10 times its last change): the contact set is final, the "
             "indentation only as converged as the residual reached (within 1e-4 relative)",
         )
+        device: Literal["cpu", "gpu"] = Field(
+            "cpu",
+            description="where the FFTs and the CG run: 'cpu' (numpy) or 'gpu' (CuPy on the first CUDA GPU; "
+            "needs CuPy and a GPU, refused otherwise)",
+        )
+        fft_workers: int = Field(
+            1,
+            ge=1,
+            le=256,
+            description="threads of each FFT on the CPU: 1 when realizations run side by side; the machine's "
+            "cores for a one-realization run",
+        )
+
+        @field_validator("device")
+        @classmethod
+        def _device_there(cls, device: str) -> str:
+            namespace(device)  # 'gpu' without CuPy or without a GPU: refused here, saying which is missing
+            return device
 
     # the contact CG: ProjectedCG, or a class with its constructor and solve (the benchmark's baseline)
     contact_cg: ClassVar[type] = ProjectedCG
@@ -136,7 +155,7 @@ class PeriodicBEM(ContactSolver):
             )
 
         depth /= scale
-        operator = PeriodicHalfSpace(depth.shape)
+        operator = PeriodicHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
         cg = self.contact_cg(operator, depth)
         full_approach = float(depth.mean())  # scaled max z - mean z
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations

@@ -23,11 +23,12 @@ import numpy as np
 
 from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished
 
+from .arrays import host, namespace, on_device
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
 from .contact_area import contact_spots, corrected_gradient_rms
 from .contact_cg import next_pressure, solve_load
-from .elastic import PeriodicHalfSpace
+from .elastic import FFTPair, PeriodicHalfSpace
 
 LOVE = "Love, Phil. Trans. R. Soc. A 228 (1929) 377"
 HOCKNEY = "Hockney, Methods Comput. Phys. 9 (1970) 135"
@@ -74,31 +75,28 @@ class FreeHalfSpace:
     pressure: the mean pressure does move a free surface (an approach under indentation
     control needs it)."""
 
-    def __init__(self, shape: tuple[int, int]):
+    def __init__(self, shape: tuple[int, int], xp=None, workers: int = 1):
         if len(shape) != 2:
             raise ValueError("the free-boundary half-space presses surfaces (2D height maps) only")
         self.shape = tuple(shape)
         self.axes = (0, 1)
         self.padded_shape = tuple(2 * n for n in self.shape)
+        self.periodic = PeriodicHalfSpace(self.shape, xp, workers)
+        self.xp = xp = self.periodic.xp
+        self.pair = FFTPair(self.padded_shape, xp, workers)
         influence = pixel_influence(self.shape)
         # the influence is even in both offsets, so its spectrum is real: half the memory
-        self.compliance = np.fft.rfftn(influence).real
+        self.compliance = on_device(xp, np.fft.rfftn(influence).real)
         self.point_stiffness = 1.0 / float(influence[0, 0])
-        self.spectrum = np.empty(self.compliance.shape, dtype=complex)
-        self.padded = np.zeros(self.padded_shape)  # the pressure on its quarter, zero elsewhere
-        self.padded_response = np.empty(self.padded_shape)
+        self.padded = xp.zeros(self.padded_shape, dtype=xp.float64)  # the pressure on its quarter, zero elsewhere
         self.window = tuple(slice(0, n) for n in self.shape)
-        self.periodic = PeriodicHalfSpace(self.shape)
-        uniform = self.displacement(np.ones(self.shape), np.empty(self.shape))
-        self.mean_stiffness = 1.0 / float(uniform.mean())  # uniform pressure per unit of mean displacement
+        uniform = self.displacement(xp.ones(self.shape, dtype=xp.float64), xp.empty(self.shape, dtype=xp.float64))
+        self.mean_stiffness = 1.0 / float(xp.mean(uniform))  # uniform pressure per unit of mean displacement
 
-    def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def displacement(self, pressure, out):
         """Surface displacement under ``pressure`` (loads outside the grid: none), into ``out``."""
         self.padded[self.window] = pressure
-        spectrum = np.fft.rfftn(self.padded, axes=self.axes, out=self.spectrum)
-        spectrum *= self.compliance
-        np.fft.irfftn(spectrum, s=self.padded_shape, axes=self.axes, out=self.padded_response)
-        out[...] = self.padded_response[self.window]
+        out[...] = self.pair.apply(self.compliance, self.padded)[self.window]
         return out
 
     def displacement_estimate(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
@@ -107,7 +105,7 @@ class FreeHalfSpace:
 
     def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
         """``|q| / 2`` on the fluctuation of ``residual`` (zero mean), ``mean_stiffness`` on its mean."""
-        mean = float(residual.mean())  # before ``out``, which may be ``residual`` itself, is written
+        mean = float(self.xp.mean(residual))  # before ``out``, which may be ``residual`` itself, is written
         self.periodic.precondition(residual, out)
         out += self.mean_stiffness * mean
         return out
@@ -157,7 +155,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
         depth /= scale
-        cg = self.contact_cg(FreeHalfSpace(depth.shape), depth)
+        operator = FreeHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
+        cg = self.contact_cg(operator, depth)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
         certified = self.params.stop == "certified"  # under force control only (solve_load)
         pressure, previous = None, 1.0
@@ -172,7 +171,7 @@ class BEMHalfSpaceFree(PeriodicBEM):
             count[j] = n = int(np.count_nonzero(contact))
             force[j] = load if control == "force" else float(pressure.mean()) * force_unit
             indentation[j] = approach * scale if control == "force" else load
-            shift[j] = float(np.mean(cg.gap - depth)) * scale  # the exact gap holds the displacement
+            shift[j] = float(np.mean(host(cg.gap) - depth)) * scale  # the exact gap holds the displacement
             slope_rms[j] = line_rms if n == points else float(np.sqrt(np.mean(np.square(slopes[contact]))))
             if n < points:  # a scan's border is no edge of its contact
                 real_gradient[j] = corrected_gradient_rms(contact, slopes, periodic=False)

@@ -16,6 +16,7 @@ import numpy as np
 
 from frictionlab import iteration_done
 
+from .arrays import host, is_cupy, is_numpy, namespace_of, on_device
 from .elastic import ElasticOperator
 
 # Steps between exact recomputations of the gap when it is updated
@@ -54,31 +55,41 @@ class ProjectedCG:
     (a point in contact must have zero gap, a free point must not penetrate).
     """
 
-    def __init__(self, operator: ElasticOperator, depth: np.ndarray):
+    def __init__(self, operator: ElasticOperator, depth):
         if tuple(depth.shape) != tuple(operator.shape):
             raise ValueError(f"depth of shape {depth.shape} on an operator of shape {operator.shape}")
         self.operator = operator
-        self.shape = depth.shape
-        self.depth = depth
-        self.rms = float(np.sqrt(np.mean(np.square(depth - depth.mean()))))
-        self.gap = np.empty(self.shape)  # displacement + depth, before the rigid level
-        self.direction = np.zeros(self.shape)  # the search direction, zero off its working set
-        self.last_residual = np.zeros(self.shape)  # the last step's residual on its working set, zero elsewhere
-        self.response = np.empty(self.shape)  # the displacement under the direction
-        self.preconditioned = np.empty(self.shape)
-        self.below = np.empty(self.shape, dtype=bool)
-        self.scratch = np.empty(self.shape)
+        self.xp = xp = getattr(operator, "xp", None) or namespace_of(depth)
+        self.shape = tuple(depth.shape)
+        self.depth = depth = on_device(xp, depth)
+        self.rms = float(xp.sqrt(xp.mean(xp.square(depth - xp.mean(depth)))))
+        self.int_scatter = is_numpy(xp) or is_cupy(xp)  # x[indices] = values: not in the array API
+
+        def grid(dtype=xp.float64):
+            return xp.zeros(self.shape, dtype=dtype)
+
+        self.gap = grid()  # displacement + depth, before the rigid level
+        self.direction = grid()  # the search direction, zero off its working set
+        self.last_residual = grid()  # the last step's residual on its working set, zero elsewhere
+        self.response = grid()  # the displacement under the direction
+        self.preconditioned = grid()
+        self.scratch = grid()
+        # an operator whose preconditioner is a float32 transform takes the residual spread on a
+        # float32 grid, and the CG reads its answer on the working set only: no float64 grid
+        # cleared, converted and written back whole at every step
+        self.precondition_single = getattr(operator, "precondition_single", None)
+        self.spread32 = grid(xp.float32) if self.precondition_single is not None else None
 
     def solve(
         self,
-        pressure: np.ndarray,
+        pressure,
         *,
         mean_pressure: float | None = None,
         approach: float | None = None,
         tolerance: float,
         max_iterations: int,
         certified: bool = False,
-    ) -> tuple[np.ndarray, float, int, float]:
+    ) -> tuple:
         """Iterate from ``pressure`` (modified in place) until the residual is at
         most ``tolerance`` or, with ``certified``, until the contact set is
         certified. Exactly one of ``mean_pressure`` (force control) and
@@ -118,22 +129,37 @@ class ProjectedCG:
         (checked against tolerance-1e-12 solves, tests/test_certified_stop.py),
         while the pressures and the level are only as converged as the
         residual returned.
+
+        The arrays are the operator's namespace's (``xp``): the sets are index
+        vectors (``nonzero``) and masks of the grid, gathered with ``take`` and
+        scattered through the mask where the namespace has no integer scatter.
+        The contact set is always the support of the pressure (``p > 0``), which
+        is zero off it.
         """
+        xp = self.xp
         force_control = approach is None
+        # Python floats: a strict namespace takes no numpy scalar (np.float64) in arithmetic
+        mean_pressure = None if mean_pressure is None else float(mean_pressure)
+        approach = None if approach is None else float(approach)
         operator = self.operator
-        p, g, depth = pressure.reshape(-1), self.gap.reshape(-1), self.depth.reshape(-1)
-        d_grid, r_grid = self.direction.reshape(-1), self.last_residual.reshape(-1)
-        w_grid, z_grid = self.response.reshape(-1), self.preconditioned.reshape(-1)
+        flat = (-1,)
+        p, g, depth = xp.reshape(pressure, flat), xp.reshape(self.gap, flat), xp.reshape(self.depth, flat)
+        d_grid, r_grid = xp.reshape(self.direction, flat), xp.reshape(self.last_residual, flat)
+        w_grid, z_grid = xp.reshape(self.response, flat), xp.reshape(self.preconditioned, flat)
+        size = p.shape[0]
         level = approach
         if force_control:  # the load is part of the answer: start from a pressure that carries it
-            total = float(p.mean())
+            total = float(xp.mean(p))
             if total > 0.0:
                 p *= mean_pressure / total
             else:
-                p.fill(mean_pressure)
-        d_grid.fill(0.0)
-        r_grid.fill(0.0)
-        contact = np.flatnonzero(p)
+                p[...] = mean_pressure
+        d_grid[...] = 0.0
+        r_grid[...] = 0.0
+        spread = None  # the last working set, off which the direction and the residual grids are zero
+        spread32 = None  # the same for the float32 grid of the preconditioner (None: anywhere)
+        s_grid = None if self.spread32 is None else xp.reshape(self.spread32, flat)
+        contact = xp.nonzero(p)[0]
         self._exact_gap(pressure)
         exact, since_exact = True, 0
         previous_rz = 1.0  # r.z of the last step
@@ -143,23 +169,22 @@ class ProjectedCG:
         rough = True  # responses in single precision while the residual is above SINGLE_ABOVE
         iteration = 0
         while True:
-            if contact.size == 0:  # only possible under indentation control
-                np.subtract(level, depth, out=p)
-                np.maximum(p, 0.0, out=p)
-                contact = np.flatnonzero(p)
+            if contact.shape[0] == 0:  # only possible under indentation control
+                p[...] = xp.maximum(level - depth, 0.0)
+                contact = xp.nonzero(p)[0]
                 self._exact_gap(pressure)
                 exact, since_exact, stable = True, 0, 0
                 continue
-            g_c = g[contact]
+            g_c = xp.take(g, contact)
             if force_control:
-                level = float(g_c.mean())
+                level = float(xp.mean(g_c))
             g_c -= level
-            worst_contact = float(np.abs(g_c).max())
+            worst_contact = float(xp.max(xp.abs(g_c)))
             # points below the level: contact points with a negative gap error, and free
             # points that penetrate (p is exactly 0 off the contact set)
-            below = np.flatnonzero(np.less(g, level, out=self.below.reshape(-1)))
-            penetrating = below[p[below] == 0.0]
-            worst_free = level - float(g[penetrating].min()) if penetrating.size else 0.0
+            below = xp.nonzero(g < level)[0]
+            penetrating = below[xp.take(p, below) == 0.0]
+            worst_free = level - float(xp.min(xp.take(g, penetrating))) if penetrating.shape[0] else 0.0
             residual = max(worst_contact, worst_free) / self.rms
             done = residual <= tolerance or (
                 certified and stable >= STABLE_STEPS and self._certain(p, g, contact, level, last_level, last_step)
@@ -175,42 +200,50 @@ class ProjectedCG:
                 raise NotConverged(iteration, residual)
             iteration += 1
 
-            # the working set and the gradient on it
-            if penetrating.size:
-                working = np.sort(np.concatenate([contact, penetrating]))  # disjoint
-                r = g[working]
+            # the working set (sorted indices; its mask for a namespace without integer scatter)
+            # and the gradient on it
+            in_working = None if self.int_scatter else (p != 0.0) | (g < level)
+            if penetrating.shape[0]:
+                working = xp.sort(xp.concat([contact, penetrating]))  # disjoint
+                r = xp.take(g, working)
                 r -= level
                 if force_control:  # the gradient within zero-sum steps
-                    r -= r.mean()
+                    r -= xp.mean(r)
             else:
                 working, r = contact, g_c
             # the preconditioned gradient, zero-sum under force control
-            z_grid.fill(0.0)
-            z_grid[working] = r
-            operator.precondition(self.preconditioned, self.preconditioned)
-            z = z_grid[working]
+            if self.precondition_single is not None:
+                self._clear(s_grid, spread32)
+                self._scatter(s_grid, working, in_working, xp.astype(r, xp.float32))
+                spread32 = working
+                z = xp.astype(xp.take(xp.reshape(self.precondition_single(self.spread32), flat), working), xp.float64)
+            else:
+                z_grid[...] = 0.0
+                self._scatter(z_grid, working, in_working, r)
+                operator.precondition(self.preconditioned, self.preconditioned)
+                z = xp.take(z_grid, working)
             if force_control:
-                z -= z.mean()
-            rz = _dot(r, z)
+                z -= xp.mean(z)
+            rz = _dot(r, z, xp)
             if not rz > 0.0:  # no descent left: stuck (rounding at a converged state)
                 raise NotConverged(iteration, residual)
             # Polak-Ribiere factor, clipped at 0, with the last residual restricted to this set
-            beta = (rz - _dot(z, r_grid[working])) / previous_rz
+            beta = (rz - _dot(z, xp.take(r_grid, working), xp)) / previous_rz
             if beta > 0.0:
-                d = d_grid[working]
+                d = xp.take(d_grid, working)
                 d *= beta
                 d += z
                 if force_control:
-                    d -= d.mean()
-                if not _dot(r, d) > 0.0:
+                    d -= xp.mean(d)
+                if not _dot(r, d, xp) > 0.0:
                     d = z
             else:
                 d = z
             previous_rz = rz
-            d_grid.fill(0.0)
-            d_grid[working] = d
-            r_grid.fill(0.0)
-            r_grid[working] = r
+            for spread_on_grid, values in ((d_grid, d), (r_grid, r)):
+                self._clear(spread_on_grid, spread)
+                self._scatter(spread_on_grid, working, in_working, values)
+            spread = working
             if rough and residual <= SINGLE_ABOVE:  # from here on every response is exact
                 rough = False
                 since_exact = REFRESH  # and the gap is recomputed exactly after this step
@@ -218,37 +251,37 @@ class ProjectedCG:
                 operator.displacement_estimate(self.direction, self.response)
             else:
                 operator.displacement(self.direction, self.response)
-            curvature = _dot(d, w_grid[working])
+            curvature = _dot(d, xp.take(w_grid, working), xp)
             if not curvature > 0.0:  # no descent left along d: stuck
                 raise NotConverged(iteration, residual)
-            step = _dot(r, d) / curvature
-            p_w = p[working]
+            step = _dot(r, d, xp) / curvature
+            p_w = xp.take(p, working)
             p_w -= step * d
-            clipped = float(p_w.min()) <= 0.0
+            clipped = float(xp.min(p_w)) <= 0.0
             if clipped:
                 # gap(p - step d + lift) = gap - step w + u(lift), the lift raising clipped points to 0
-                lift = np.maximum(p_w, 0.0)
+                lift = xp.maximum(p_w, 0.0)
                 lift -= p_w
                 p_w += lift
-                p[working] = p_w
+                self._scatter(p, working, in_working, p_w)
                 contact = working[p_w > 0.0]
-                z_grid.fill(0.0)
-                z_grid[working] = lift
+                z_grid[...] = 0.0
+                self._scatter(z_grid, working, in_working, lift)
                 operator.displacement_estimate(self.preconditioned, self.scratch)
                 self.gap -= self.depth  # the displacement, to be scaled with the pressure
                 self.gap += self.scratch
-                np.multiply(self.response, step, out=self.scratch)
-                self.gap -= self.scratch
+                self.gap -= self._times(self.response, step)
                 if force_control:  # restore the load exactly
-                    total = float(p[contact].sum()) / p.size
+                    total = float(xp.sum(xp.take(p, contact))) / size
                     if not total > 0.0:  # cannot happen in exact arithmetic; start over
-                        p.fill(mean_pressure)
-                        contact = np.arange(p.size)
-                        d_grid.fill(0.0)
-                        r_grid.fill(0.0)
+                        p[...] = mean_pressure
+                        contact = xp.arange(size)
+                        d_grid[...] = 0.0
+                        r_grid[...] = 0.0
+                        spread = None
                         since_exact = REFRESH  # the gap is recomputed below
                     else:
-                        p[contact] *= mean_pressure / total
+                        p *= mean_pressure / total  # zero off the contact set
                         self.gap *= mean_pressure / total
                 self.gap += self.depth
                 stable = 0
@@ -257,57 +290,78 @@ class ProjectedCG:
                     exact, since_exact = True, 0
                 else:
                     exact, since_exact = False, since_exact + 1
-            elif not force_control and working.size == p.size and float(r.mean()) > 0.0:
+            elif not force_control and working.shape[0] == size and float(xp.mean(r)) > 0.0:
                 # full contact under indentation control, the level above the rigid body's
                 # full-contact level: a uniform pressure has no stiffness (the energy is linear
                 # along it), so the pressure drops evenly until its lowest point lifts off
-                p[working] = p_w
-                p -= p_w.min()
-                contact = np.flatnonzero(p)
+                self._scatter(p, working, in_working, p_w)
+                p -= xp.min(p_w)
+                contact = xp.nonzero(p)[0]
                 self._exact_gap(pressure)
                 exact, since_exact, stable = True, 0, 0
             else:
-                p[working] = p_w
+                self._scatter(p, working, in_working, p_w)
                 stable = stable + 1 if working is contact else 0
                 contact = working
                 if since_exact >= REFRESH:
                     self._exact_gap(pressure)
                     exact, since_exact = True, 0
                 else:  # linear in p: g(p - step d) = g - step w
-                    np.multiply(self.response, step, out=self.scratch)
-                    self.gap -= self.scratch
+                    self.gap -= self._times(self.response, step)
                     exact, since_exact = False, since_exact + 1
             last_step, last_level = step, level
+
+    def _scatter(self, grid, indices, mask, values) -> None:
+        """``grid[indices] = values`` (``indices`` the sorted positions of ``mask``)."""
+        if self.int_scatter:
+            grid[indices] = values
+        else:  # the array API's boolean scatter, in the same (ascending) order
+            grid[mask] = values
+
+    def _clear(self, grid, spread) -> None:
+        """Zero ``grid``, which is zero off the indices ``spread`` (None: anywhere): on
+        numpy only those points (a working set is a few percent of the grid)."""
+        if spread is not None and self.int_scatter:
+            grid[spread] = 0.0
+        else:
+            grid[...] = 0.0
+
+    def _times(self, field, factor: float):
+        """``field * factor``, on numpy into the scratch grid (no allocation)."""
+        if is_numpy(self.xp):
+            return np.multiply(field, factor, out=self.scratch)
+        return field * factor
 
     def _certain(self, p, g, contact, level: float, last_level: float, last_step: float) -> bool:
         """Every point's margin exceeds MARGIN_FACTOR times its change in the last
         step (which moved p by ``-last_step * direction`` and the gap by
         ``-last_step * response``, on an unchanged contact set)."""
-        d_c = self.direction.reshape(-1)[contact]
-        if not np.all(p[contact] > MARGIN_FACTOR * last_step * np.abs(d_c)):
+        xp = self.xp
+        d_c = xp.take(xp.reshape(self.direction, (-1,)), contact)
+        if not bool(xp.all(xp.take(p, contact) > MARGIN_FACTOR * last_step * xp.abs(d_c))):
             return False
         # free points: gap - level against its change, -step w - (level - last_level)
-        change = np.multiply(self.response, -last_step, out=self.scratch)
+        change = self._times(self.response, -last_step)
         change -= level - last_level
-        np.abs(change, out=change)
+        change = xp.abs(change)
         change *= MARGIN_FACTOR
         change += level
-        free = self.below
-        np.less_equal(self.gap, change, out=free)  # gap - level <= 10 |change|
-        free.reshape(-1)[contact] = False
-        return not free.any()
+        # a free point (zero pressure: the contact set is the pressure's support) within it
+        return not bool(xp.any((g <= xp.reshape(change, (-1,))) & (p == 0.0)))
 
-    def _exact_gap(self, pressure: np.ndarray) -> None:
+    def _exact_gap(self, pressure) -> None:
         """``gap = displacement(pressure) + depth``, from the pressure itself."""
         self.operator.displacement(pressure, self.gap)
         self.gap += self.depth
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> float:
-    """The dot product of two vectors without BLAS: a multithreaded BLAS keeps its
-    threads spinning after each call, and on a busy machine they took the core the
+def _dot(a, b, xp=None) -> float:
+    """The dot product of two vectors, on numpy without BLAS: a multithreaded BLAS keeps
+    its threads spinning after each call, and on a busy machine they took the core the
     next FFT needed (the whole solve ran 3x slower)."""
-    return float(np.einsum("i,i->", a, b))
+    if xp is None or is_numpy(xp):
+        return float(np.einsum("i,i->", a, b))
+    return float(xp.sum(a * b))
 
 
 def cold_start(depth: np.ndarray, mean_pressure: float) -> np.ndarray:
@@ -347,8 +401,8 @@ def solve_load(cg: ProjectedCG, solver: str, j: int, load: float, pressure: np.n
     """Load ``j`` of a sweep solved from ``pressure``: ``(pressure, approach, iterations,
     residual)``; a ValueError naming ``solver``, the load and what to change if it does not converge."""
     try:
-        return cg.solve(
-            pressure,
+        pressure, approach, iterations, residual = cg.solve(
+            on_device(getattr(cg, "xp", None), pressure),  # the baseline CG has no namespace
             mean_pressure=target if control == "force" else None,
             approach=target if control == "indentation" else None,
             tolerance=tolerance,
@@ -356,6 +410,7 @@ def solve_load(cg: ProjectedCG, solver: str, j: int, load: float, pressure: np.n
             # under indentation control only the tolerance converges the force (the baseline CG has no such stop)
             **({"certified": True} if certified and control == "force" else {}),
         )
+        return host(pressure), approach, iterations, residual  # on the GPU: back to the host
     except NotConverged as failure:
         what = "force" if control == "force" else "indentation"
         raise ValueError(

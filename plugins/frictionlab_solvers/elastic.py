@@ -19,7 +19,9 @@ from pydantic import Field
 
 from frictionlab import PluginParams
 
-__all__ = ["ElasticOperator", "ElasticParams", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
+from .arrays import host, is_numpy, namespace, on_device
+
+__all__ = ["ElasticOperator", "ElasticParams", "FFTPair", "PeriodicHalfSpace", "effective_modulus", "elastic_stiffness"]
 
 
 def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
@@ -87,20 +89,25 @@ class PeriodicHalfSpace:
     displacements have zero mean. The preconditioner leaves that mode out too (a
     uniform pressure moves nothing, so no displacement asks for one).
 
-    numpy's FFTs write into the buffers given (``out``), so a call allocates
-    nothing: half the time of ``scipy.fft``, which returns new arrays.
+    ``xp`` is the array namespace the fields live in (numpy by default; CuPy on a GPU;
+    any array-API namespace with the ``fft`` extension); ``workers`` the threads of each
+    FFT on numpy (``FFTPair``).
     """
 
-    def __init__(self, shape: tuple[int, ...]):
+    def __init__(self, shape: tuple[int, ...], xp=None, workers: int = 1):
         self.shape = tuple(shape)
         self.axes = tuple(range(len(self.shape)))
+        self.xp = namespace("cpu") if xp is None else xp
+        self.workers = workers
+        self.pair = FFTPair(self.shape, self.xp, workers)
         q = _wave_number(self.shape)
-        self.compliance = np.zeros(q.shape)
-        np.divide(2.0, q, out=self.compliance, where=q > 0)
-        self.stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
-        self.stiffness32 = self.stiffness.astype(np.float32)
-        self.compliance32 = self.compliance.astype(np.float32)
-        self.spectrum = np.empty(q.shape, dtype=complex)
+        compliance = np.zeros(q.shape)
+        np.divide(2.0, q, out=compliance, where=q > 0)
+        stiffness = q / 2.0  # zero for the mean mode: exact inverse on zero-mean fields
+        self.compliance = on_device(self.xp, compliance)
+        self.stiffness = on_device(self.xp, stiffness)
+        self.stiffness32 = on_device(self.xp, stiffness.astype(np.float32))
+        self.compliance32 = on_device(self.xp, compliance.astype(np.float32))
 
     @functools.cached_property
     def point_stiffness(self) -> float:
@@ -108,41 +115,81 @@ class PeriodicHalfSpace:
         computed when first asked for)."""
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
 
-        return 1.0 / float(scipy.fft.irfftn(self.compliance, s=self.shape).flat[0])
+        return 1.0 / float(scipy.fft.irfftn(host(self.compliance), s=self.shape).flat[0])
 
-    def displacement(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def displacement(self, pressure, out):
         """Zero-mean surface displacement under ``pressure``, written into ``out``."""
         return self._apply(self.compliance, pressure, out)
 
-    def displacement_estimate(self, pressure: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def displacement_estimate(self, pressure, out):
         """``displacement`` in single precision (rounding 6e-8 relative), for the
         corrections the CG recomputes exactly before it stops."""
         return self._apply_single(self.compliance32, pressure, out)
 
-    def precondition(self, residual: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def precondition(self, residual, out):
         """The stiffness ``|q| / 2`` applied to ``residual``, in single precision:
         a preconditioner need only be close to the inverse (its rounding changes no
         stop and no step's exactness)."""
         return self._apply_single(self.stiffness32, residual, out)
 
+    def precondition_single(self, residual32):
+        """``precondition`` of a float32 grid, returned as a new float32 grid (the CG reads
+        it on its working set only)."""
+        return self._apply_single(self.stiffness32, residual32, None)
+
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
-        """The zero-mean pressure that makes ``displacement`` (exact inverse, zero mean)."""
-        return self._apply(self.stiffness, displacement, np.empty(self.shape))
+        """The zero-mean pressure (numpy) that makes ``displacement`` (numpy; exact inverse, zero mean)."""
+        out = self.xp.empty(self.shape, dtype=self.xp.float64)
+        return host(self._apply(self.stiffness, on_device(self.xp, displacement), out))
 
-    def _apply(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
-        spectrum = np.fft.rfftn(field, axes=self.axes, out=self.spectrum)
-        spectrum *= kernel
-        np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=out)
-        return out
+    def _apply(self, kernel, field, out):
+        return self.pair.apply(kernel, field, out)
 
-    def _apply_single(self, kernel: np.ndarray, field: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """``_apply`` in float32 with ``scipy.fft``: about half the time of a float64 pair."""
-        import scipy.fft
+    def _apply_single(self, kernel, field, out):
+        """``_apply`` in float32: about half the time of a float64 pair."""
+        return self.pair.apply(kernel, field, out, single=True)
 
-        spectrum = scipy.fft.rfftn(field.astype(np.float32), axes=self.axes, workers=1)
-        spectrum *= kernel
-        out[...] = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=1, overwrite_x=True)
-        return out
+
+class FFTPair:
+    """``out = irfftn(kernel * rfftn(field))`` on a grid of ``shape``, in namespace ``xp``.
+
+    On numpy with one thread, numpy's FFTs write into this pair's buffers (``out=``):
+    no allocation, half the time of ``scipy.fft``, which returns new arrays. With
+    ``workers`` > 1 on numpy, ``scipy.fft`` on that many threads; on any other namespace
+    its ``fft`` extension (CuPy's cuFFT on a GPU). Single precision (``single``) always
+    takes the new-array path: numpy's float32 FFTs measured slower than scipy's."""
+
+    def __init__(self, shape: tuple[int, ...], xp, workers: int = 1):
+        self.shape, self.axes, self.xp, self.workers = tuple(shape), tuple(range(len(shape))), xp, workers
+        self.numpy = is_numpy(xp)
+        half = (*self.shape[:-1], self.shape[-1] // 2 + 1)
+        self.buffers = (np.empty(half, dtype=complex), np.empty(self.shape)) if self.numpy and workers == 1 else None
+
+    def apply(self, kernel, field, out=None, single: bool = False):
+        """Into ``out`` (a float64 grid), or into this pair's own buffer (returned) on the
+        numpy path, a new array otherwise."""
+        xp = self.xp
+        if single:
+            field = xp.astype(field, xp.float32, copy=False)  # not overwritten below
+        elif self.buffers is not None:
+            spectrum = np.fft.rfftn(field, axes=self.axes, out=self.buffers[0])
+            spectrum *= kernel
+            return np.fft.irfftn(spectrum, s=self.shape, axes=self.axes, out=self.buffers[1] if out is None else out)
+        if self.numpy:
+            import scipy.fft
+
+            spectrum = scipy.fft.rfftn(field, axes=self.axes, workers=self.workers)
+            spectrum *= kernel
+            result = scipy.fft.irfftn(spectrum, s=self.shape, axes=self.axes, workers=self.workers, overwrite_x=True)
+            if out is not None:
+                out[...] = result  # cast from float32 as it is copied: one pass
+        else:
+            spectrum = xp.fft.rfftn(field, axes=self.axes)
+            spectrum *= kernel
+            result = xp.fft.irfftn(spectrum, s=self.shape, axes=self.axes)
+            if out is not None:
+                out[...] = xp.astype(result, out.dtype)  # the array API casts no dtype on assignment
+        return result if out is None else out
 
 
 def _wave_number(shape: tuple[int, ...]) -> np.ndarray:

@@ -108,3 +108,60 @@ def test_a_signal_stops_the_solve_within_a_second_and_resume_gives_the_same_numb
     for name in expected.files:
         assert np.array_equal(got[name], expected[name]), name  # bitwise: the same numbers
     assert (out / "curve.csv").read_text() == (whole / "curve.csv").read_text()
+
+
+# The CLI with every FFT pair of the exact solver preceded by a step of minutes: FFTs of a
+# 2048^2 grid on two threads (scipy.fft's pool), as a one-realization run on both cores does.
+ENDLESS_STEP = """
+import sys
+import numpy as np
+import scipy.fft
+from frictionlab_solvers import elastic
+
+grid = np.random.default_rng(0).normal(size=(2048, 2048))
+apply = elastic.FFTPair.apply
+
+def endless(self, *args, **kwargs):
+    for _ in range(1000):
+        scipy.fft.rfftn(grid, workers=2)
+    return apply(self, *args, **kwargs)
+
+elastic.FFTPair.apply = endless
+from frictionlab.cli.main import program
+sys.argv = ["frictionlab", *sys.argv[1:]]
+program()
+"""
+LEAVE_SECONDS = 5.0  # generous: the step left running lasts minutes
+
+
+@pytest.mark.parametrize(("signum", "code"), [(signal.SIGTERM, ExitCode.TERMINATED), (signal.SIGINT, ExitCode.INTERRUPTED)])
+def test_the_process_ends_without_waiting_for_the_step_in_progress(tmp_path, signum, code):
+    """Once a signal cancels a run, the process ends at once even though its solve is inside
+    a step that lasts minutes: before, the interpreter's exit waited for the FFT library's
+    threads, and with FFTs on two threads it aborted ('terminate called ...', SIGABRT)."""
+    preset = write_preset(tmp_path, merge(LONG_SOLVES, {
+        "realizations": 1,
+        "spectrum": {"params": {"points": 32}},
+        "solver": {"params": {"fft_workers": 2}},
+    }))  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-c", ENDLESS_STEP, "run", str(preset), "--out", str(tmp_path / "out"), "--workers", "1"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert "realizations" in proc.stderr.readline()  # the run's first line: its solve is starting
+    time.sleep(1.0)  # inside the first step
+    assert proc.poll() is None
+    sent = time.monotonic()
+    proc.send_signal(signum)
+    try:
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    left = time.monotonic() - sent
+    assert proc.returncode == code, stderr
+    assert "terminate called" not in stderr and "Traceback" not in stderr, stderr
+    assert "run interrupted: 0 of 1 realizations finished" in stderr
+    assert left < LEAVE_SECONDS, (left, stderr)
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"] == "interrupted"
