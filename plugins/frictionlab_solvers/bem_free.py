@@ -21,10 +21,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished
+from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, half_load_points, load_finished, mdr_length
 
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, corrected_area_fraction
 from .contact_cg import next_pressure, solve_load
 from .elastic import PeriodicHalfSpace
 
@@ -118,9 +119,15 @@ class BEMHalfSpaceFree(PeriodicBEM):
         "exact elastic half-space under a non-periodic surface (a scan): zero-padded FFT boundary elements, "
         "preconditioned projected CG"
     )
-    references: ClassVar[tuple[str, ...]] = PeriodicBEM.references + (LOVE, HOCKNEY)
+    references: ClassVar[tuple[str, ...]] = PeriodicBEM.references + (LOVE, HOCKNEY, YASTREBOV_ANCIAUX_MOLINARI)
     dimensions: ClassVar[tuple[int, ...]] = (2,)
-    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
+    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length", pressure_area="profile")}
+    # the perimeter correction counts the edges inside the scan only: its border is no contact edge
+    corrected_area: ClassVar[bool] = True
+    # The CG's single-precision steps hold pressures (in units of E* s / dx) up to 3.4e38 and
+    # overflow from f ~ 1e38 on (measured on 32^2 to 256^2 scans); 1e30 leaves 8 decades for
+    # the grid's size. Full contact comes near f ~ 1: no physical load comes near.
+    max_f: ClassVar[float | None] = 1e30
     problem: ClassVar[str] = "elastic half-space"
     indentation_reference: ClassVar[str] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = False  # per surface: extras["mean_displacement"]
@@ -149,8 +156,16 @@ class BEMHalfSpaceFree(PeriodicBEM):
         force, indentation, shift = np.empty(steps), np.empty(steps), np.zeros(steps)
         count, slope_rms = np.empty(steps, dtype=np.int64), np.empty(steps)
         iterations, residual = np.zeros(steps, dtype=np.int64), np.zeros(steps)
+        half, corrected = np.empty(steps, dtype=np.int64), np.empty(steps)
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
+        if control == "force":  # f of this surface: its own rms height h, L = 2 sqrt(A / pi)
+            limit = self.max_f * self.stiffness() * float(np.std(heights)) * mdr_length(profile.area)
+            if float(loads.max()) > limit:
+                raise ValueError(
+                    f"load {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
+                    f"f = F / (E* h L) <= {self.max_f:g}, F <= {limit:.6g} on this surface"
+                )
         depth /= scale
         cg = self.contact_cg(FreeHalfSpace(depth.shape), depth)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
@@ -165,6 +180,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
             )
             contact = pressure > 0.0
             count[j] = n = int(np.count_nonzero(contact))
+            half[j] = half_load_points(pressure)
+            corrected[j] = corrected_area_fraction(contact, periodic=False)
             force[j] = load if control == "force" else float(pressure.mean()) * force_unit
             indentation[j] = approach * scale if control == "force" else load
             shift[j] = float(np.mean(cg.gap - depth)) * scale  # the exact gap holds the displacement
@@ -176,5 +193,11 @@ class BEMHalfSpaceFree(PeriodicBEM):
             contact_count=count,
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
+            real_area_corrected=corrected,
             extras={"iterations": iterations, "residual": residual, "mean_displacement": shift},
+            half_load_points=half,
         )
+
+    def full_contact_load(self, profile: Profile) -> float | None:
+        """Not known short of a solve: the border of a free scan carries the most pressure."""
+        return None
