@@ -72,7 +72,8 @@ class Result:
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
     realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,
-    ``contact_fraction``, ``indentation``, and ``real_area_corrected`` (the real area
+    ``contact_fraction``, ``indentation``, ``half_load_points`` (the fewest points
+    carrying half the load, NaN where the solver does not say), and ``real_area_corrected`` (the real area
     corrected for its perimeter's pixels, a fraction) for a solver that gives it
     (``bem-halfspace``). ``caveats``: what a reader of the fit
     must know (fewer than 3 points in contact at the first load). ``folder``: the
@@ -230,13 +231,19 @@ def read_preset_input(
 
 
 def scene_record(scene: Scene) -> dict:
-    """What a validated preset would run: its plugins, realizations, load steps, and what
-    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None."""
+    """What a validated preset would run: its plugins, realizations, load steps, what
+    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None,
+    and its loads (``loads``: the force unit, the range in every unit, where full contact
+    starts: ``frictionlab.loads.describe_loads``). Loads the solver cannot take are refused."""
+    from .loads import check_loads, describe_loads
+
+    check_loads(scene)
     preset = scene.preset
     return {
         "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
         "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
         "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+        "loads": describe_loads(scene),
     }  # fmt: skip
 
 
@@ -366,6 +373,8 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
+    if outcome.half_load_points is not None:
+        table["half_load_points"] = outcome.half_load_points
     if outcome.real_area_corrected is not None:  # the solvers that correct their area only
         table[CORRECTED_AREA] = outcome.real_area_corrected
     return Result(

@@ -64,6 +64,7 @@ OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected")  # kept when the control or the solver gives them
+ADDED_CURVE_ARRAYS = ("half_load_points",)  # absent from the chunks of older versions: NaN
 
 def _write_holder(fd: int) -> None:
     """Who holds run.lock, for the message of a run refused because of it."""
@@ -383,11 +384,12 @@ class RunDirectory:
             "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
             "measured_rms_height": np.array([r.measured_rms_height for r in ok], dtype=np.float64),
             "own_rms_height": np.array([r.own_rms_height for r in ok], dtype=np.float64),
+            "peak_rms": np.array([r.peak_rms for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
         }
-        for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS):
+        for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS, *ADDED_CURVE_ARRAYS):
             rows = [getattr(r, name) for r in ok]
             if ok and rows[0] is not None:
                 arrays[name] = np.vstack(rows)
@@ -527,7 +529,7 @@ def _left_by_a_start(path: Path, resolved: dict) -> bool:
 
 def _optional_kept(scene: Scene) -> tuple[bool, bool]:
     """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
-    return scene.control == "indentation", scene.solver.corrected_area
+    return scene.forces_vary, scene.solver.corrected_area
 
 
 def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
@@ -556,10 +558,14 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
     if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
         raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
     heights = {}  # absent from the chunks of older versions: NaN
-    for name in ("measured_rms_height", "own_rms_height"):
+    for name in ("measured_rms_height", "own_rms_height", "peak_rms"):
         heights[name] = arrays.get(name, np.full(n, math.nan))
         if heights[name].shape != (n,):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
+    for name in ADDED_CURVE_ARRAYS:
+        heights[name] = arrays.get(name, np.full((n, steps), math.nan))
+        if heights[name].shape != (n, steps):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(
@@ -575,6 +581,8 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             force_unit=float(arrays["force_unit"][row]),
             measured_rms_height=float(heights["measured_rms_height"][row]),
             own_rms_height=float(heights["own_rms_height"][row]),
+            peak_rms=float(heights["peak_rms"][row]),
+            half_load_points=np.asarray(heights["half_load_points"][row], dtype=float),
         ))  # fmt: skip
     for row, index in enumerate(arrays["failed_index"].tolist()):
         out.append(RealizationResult(

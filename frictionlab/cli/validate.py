@@ -23,6 +23,7 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..api import scene_record
     from ..inputs import describe_input
+    from ..loads import loads_lines
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..runner import check_one_realization
@@ -46,7 +47,15 @@ def run(args) -> ExitCode:
                 print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
-        record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
+        try:
+            record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
+        except FrictionlabError as exc:  # loads the solver cannot take
+            worst = ExitCode(max(worst, exc.exit_code))
+            problems = getattr(exc, "problems", None) or [str(exc)]
+            records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
+            if not args.json:
+                print(shown(str(exc)), file=sys.stderr)
+            continue
         records.append(record)
         if not args.json:
             print(
@@ -56,6 +65,8 @@ def run(args) -> ExitCode:
             )
             if record["input"] is not None:
                 print(f"  read {describe_input(record['input'])}")
+            for line in loads_lines(record["loads"], scene.normalisation.load_symbol):
+                print(f"  {line}")
     if args.json:
         from .jsonout import emit
 
