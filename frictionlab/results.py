@@ -40,7 +40,7 @@ CURVE_COLUMNS = (
 )  # fmt: skip
 # columns a later frictionlab added: a folder written before them is read without them
 ADDED_CURVE_COLUMNS = frozenset({"lines_used", "half_load_points"})
-HALF_LOAD_HEADER = "half_load_points [points carrying half the load, the fewest; ensemble mean; empty: not given]"
+HALF_LOAD_HEADER = "half_load_points [the fewest points carrying half the load; ensemble mean; empty: not given]"
 CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
