@@ -129,8 +129,8 @@ class RunOutcome:
         (the rms slope in contact of one or two points is mostly noise), the whole
         profile in contact from some load on (xi is 1 there by definition), or lines
         without xi at some load (averaged over fewer lines there)."""
-        if self.no_law:
-            return [self.no_law]
+        if self.no_law:  # and why, where a spike makes it
+            return [self.no_law] + ([spike_caveat(self.peak_rms)] if self.peak_rms > SPIKE_RMS else [])
         if self.fit is None or not self.contact_count.size:
             return []
         caveats = []
