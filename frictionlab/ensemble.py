@@ -71,7 +71,7 @@ def constant_xi_refusal(per_count: np.ndarray, xi: np.ndarray, points: int, load
     defined = xi[np.isfinite(xi)]
     if not defined.size or np.ptp(defined) > 1e-12 * np.max(np.abs(defined)):
         return None
-    span = f"from load {loads[0]:.4g} to {loads[-1]:.4g}"
+    span = f"from {loads[0]:.4g} to {loads[-1]:.4g}"
     counts = per_count.mean(axis=0) if per_count.size else np.full(loads.size, math.nan)
     if per_count.size and np.all(per_count == points):
         return (

@@ -226,3 +226,22 @@ def test_the_free_boundary_s_corrected_area_of_a_hertz_contact_is_pi_a_squared()
     counted = float(curve.contact_fraction[0])
     assert corrected == pytest.approx(exact, rel=0.02)
     assert abs(corrected - exact) < abs(counted - exact)  # the correction brings the count nearer
+
+
+@pytest.mark.parametrize("command", [
+    "frictionlab validate quickstart --set loading.unit=f --set loading.start=1e-4 --set loading.stop=0.01",
+    "frictionlab validate mdr-vs-halfspace --set solver.name=bem-halfspace-free --set loading.unit=contact-fraction "
+    "--set loading.start=0.01 --set loading.stop=0.2",
+    "frictionlab validate mdr-vs-halfspace --set solver.name=bem-halfspace-free --set loading.stop=1e39",
+    "frictionlab run quickstart --set loading.start=1e4 --set loading.stop=1e5 --no-plot",
+])  # fmt: skip
+def test_the_loads_page_shows_what_the_commands_print(command, tmp_path):
+    """docs/how-to/loads.md: each output shown is printed by its command (wall times and folders aside)."""
+    from tests.test_docs_outputs import ROOT, _comparable, _shown_block
+
+    argv = command.split()
+    done = subprocess.run([sys.executable, "-m", "frictionlab", *argv[1:]], capture_output=True, text=True,
+                          cwd=tmp_path)  # fmt: skip
+    printed = {line.strip() for line in (done.stdout + done.stderr).splitlines()}
+    shown = [line.strip() for line in _shown_block("docs/how-to/loads.md", f"$ {command}") if _comparable(line)]
+    assert ROOT.is_dir() and shown and not [line for line in shown if line not in printed]
