@@ -243,4 +243,7 @@ def loads_lines(record: dict, symbol: str) -> list[str]:
     else:
         pressure = f", p/E* = {full['pressure']:.4g}" if full["pressure"] is not None else ""
         lines.append(f"full contact from {symbol} = {full['force']:.4g} (f = {full['f']:.4g}{pressure}): {full['how']}")
+        if span is not None and span["force"][1] > full["force"]:
+            lines.append(f"caveat: the last loads are past full contact{'' if full['how'].startswith('exact') else ' (estimated)'}: "
+                         "xi is 1 there by definition and they measure no roughness; lower loading.stop")  # fmt: skip
     return lines

@@ -245,3 +245,32 @@ def test_the_loads_page_shows_what_the_commands_print(command, tmp_path):
     printed = {line.strip() for line in (done.stdout + done.stderr).splitlines()}
     shown = [line.strip() for line in _shown_block("docs/how-to/loads.md", f"$ {command}") if _comparable(line)]
     assert ROOT.is_dir() and shown and not [line for line in shown if line not in printed]
+
+
+def test_a_contact_fraction_search_says_its_load_and_stops_on_cancel(monkeypatch):
+    import threading
+
+    from frictionlab import realization
+    from frictionlab.plugin import SolveCancelled
+
+    monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)  # every iteration heard
+    scene = build_scene(with_loading(SURFACE, unit="contact-fraction", start=0.05, stop=0.3, steps=3))
+    cancel, heard = threading.Event(), []
+
+    def on_iteration(index, load, iteration, residual):
+        heard.append(load)
+        if load == 2:  # the search for the second load is under way: cancel
+            cancel.set()
+
+    with pytest.raises(SolveCancelled):
+        realization.compute_realization(scene, 0, on_iteration=on_iteration, cancel=cancel)
+    assert heard[0] == 1 and heard[-1] == 2  # the iterations of the search are said as their load's
+
+
+def test_validate_warns_of_loads_past_full_contact():
+    out = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart", "--set", "loading.stop=1e4"],
+                         capture_output=True, text=True, check=True).stdout  # fmt: skip
+    assert "caveat: the last loads are past full contact" in out
+    out = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart"], capture_output=True,
+                         text=True, check=True).stdout  # fmt: skip
+    assert "past full contact" not in out
