@@ -66,21 +66,25 @@ def spike_caveat(peak: float) -> str:
 
 
 def constant_xi_refusal(per_count: np.ndarray, xi: np.ndarray, points: int, loads: np.ndarray) -> str | None:
-    """Why no law is fitted when xi is the same at every load (to 1e-12 relative): every load
-    presses every point, or the same points; None when xi changes with the load."""
+    """Why no law is fitted when every load presses the same points (each realization's count
+    the same at every load, and the mean xi with it, to 1e-9 relative), all of them or not;
+    None when the contact changes with the load (a profile whose xi stays put while its
+    contact grows, a sawtooth's, has a law: b = 0)."""
     defined = xi[np.isfinite(xi)]
-    if not defined.size or np.ptp(defined) > 1e-12 * np.max(np.abs(defined)):
+    if not (per_count.size and defined.size) or np.any(np.ptp(per_count, axis=1) > 0):
+        return None
+    if np.ptp(defined) > 1e-9 * np.max(np.abs(defined)):
         return None
     span = f"from {loads[0]:.4g} to {loads[-1]:.4g}"
-    counts = per_count.mean(axis=0) if per_count.size else np.full(loads.size, math.nan)
-    if per_count.size and np.all(per_count == points):
+    if np.all(per_count == points):
         return (
             f"no law: the whole profile is in contact at every load {span} (xi is 1 by definition); lower the loads "
             "(frictionlab validate shows where full contact starts)"
         )
     return (
-        f"no law: every load {span} presses the same points (mean {float(counts[0]):.4g} in contact), so xi is "
-        f"{float(defined[0]):.4g} at every load and a law in ln f is undefined; raise the loads or widen their range"
+        f"no law: every load {span} presses the same points (mean {float(per_count[:, 0].mean()):.4g} in contact), "
+        f"so xi is {float(defined[0]):.4g} at every load and a law in ln f is undefined; raise the loads or widen "
+        "their range"
     )
 
 

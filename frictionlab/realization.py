@@ -114,19 +114,16 @@ def slope_scale(slopes: np.ndarray) -> float:
     return math.ldexp(1.0, -math.frexp(largest)[1])
 
 
-def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch | None):
+def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: float):
     """The solver's curve over the scene's loads; contact fractions first turned into this
-    profile's forces by solving (``loads.forces_for_fractions``)."""
+    profile's forces by solving (``loads.forces_for_fractions``, from f = the fraction: ``unit``
+    is the profile's k h X)."""
     if scene.solver_loads is not None:
         return scene.solver.solve(profile, scene.solver_loads, scene.control, slopes)
     from .loads import forces_for_fractions
 
-    own_h = scene.generator.profile_rms_height(profile)
-    unit = force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile)
-
     def seeking(j: int) -> None:  # iterations of the search are said as the load's
-        if watch is not None:
-            watch.load = j + 1
+        watch.load = j + 1
 
     forces = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
     return scene.solver.solve(profile, forces, "force", slopes)
@@ -152,8 +149,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
-        curve = _solve(scene, profile, slopes, watch)
         own_h = scene.generator.profile_rms_height(profile)
+        unit = force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile)
+        curve = _solve(scene, profile, slopes, watch, unit)
         half = curve.half_load_points
         heights = np.asarray(profile.heights, dtype=float)
         rms = float(np.std(heights))
@@ -167,7 +165,7 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             real_area_corrected=np.asarray(curve.real_area_corrected, float) if scene.solver.corrected_area else None,
             slope_rms_line=slope_rms_line / scale,
             points=profile.points,
-            force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),
+            force_unit=unit,
             measured_rms_height=rms,
             own_rms_height=math.nan if own_h is None else float(own_h),
             half_load_points=np.full(scene.loads.size, math.nan) if half is None else np.asarray(half, float),

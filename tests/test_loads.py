@@ -161,9 +161,10 @@ def test_half_load_points_by_brute_force():
         assert half_load_points(loads) == (best if total > 0 else 0)
 
 
-def test_springs_count_the_points_carrying_half_the_load_as_the_bisection_does():
+@pytest.mark.parametrize("steps", [15, 300])  # every share at once; a bisection over k (300 x 300 shares)
+def test_springs_count_the_points_carrying_half_the_load_as_the_bisection_does(steps):
     z = np.random.default_rng(2).standard_normal(300)
-    loads = np.geomspace(1e-3, 100, 15)
+    loads = np.geomspace(1e-3, 100, steps)
     fast = MDRSprings().solve(Profile(z, 1.0), loads, "force", np.ones_like(z))
     slow = BisectionSprings().solve(Profile(z, 1.0), loads, "force", np.ones_like(z))
     np.testing.assert_array_equal(fast.half_load_points, slow.half_load_points)

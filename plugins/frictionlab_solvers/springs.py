@@ -79,12 +79,17 @@ def _half_load_points(u: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray
     """Per load, the fewest springs carrying half its force: the k shallowest of the ``n`` in
     contact at indentation ``d`` (sorted depths ``u``), the smallest k whose share
     k d - sum(u[:k]) reaches half of n d - sum(u[:n]) (a share that grows with k: a
-    bisection over k for every load at once)."""
-    prefix = np.concatenate([[0.0], np.cumsum(u)])
+    bisection over k for every load at once, log2(max n) steps)."""
+    most = int(n.max())
+    prefix = np.concatenate([[0.0], np.cumsum(u[:most])])
     half = 0.5 * (n * d - prefix[n])
+    if n.size * most <= 1 << 16:  # small: every share at once (the bisection's steps cost more)
+        k = np.arange(1, most + 1)
+        short = (k * d[:, None] - prefix[1:] < half[:, None]) & (k <= n[:, None])  # the k short of half, in contact
+        return np.count_nonzero(short, axis=1) + 1
     low, high = np.ones_like(n), n.copy()  # the answer lies in [low, high]
-    while np.any(low < high):
-        middle = (low + high) // 2
+    for _ in range(int(n.max()).bit_length()):
+        middle = (low + high) >> 1
         enough = middle * d - prefix[middle] >= half
         high = np.where(enough, middle, high)
         low = np.where(enough, low, middle + 1)
