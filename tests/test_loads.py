@@ -131,6 +131,8 @@ def test_the_free_solver_itself_refuses_a_load_past_its_arithmetic():
     z = np.random.default_rng(0).standard_normal((8, 8))
     with pytest.raises(ValueError, match=r"f = F / \(E\* h L\) <= 1e\+30"):
         BEMHalfSpaceFree().solve(Profile(z, 1.0, False), np.array([1e39]), "force", np.ones_like(z))
+    with pytest.raises(ValueError, match=r"at most 1e\+30 times the height range"):
+        BEMHalfSpaceFree().solve(Profile(z, 1.0, False), np.array([1e39]), "indentation", np.ones_like(z))
 
 
 def test_loads_that_press_the_same_point_fit_no_law(tmp_path):

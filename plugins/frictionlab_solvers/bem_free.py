@@ -166,6 +166,11 @@ class BEMHalfSpaceFree(PeriodicBEM):
                     f"load {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
                     f"f = F / (E* h L) <= {self.max_f:g}, F <= {limit:.6g} on this surface"
                 )
+        elif float(loads.max()) > self.max_f * scale:  # the pressures of an approach of d grow as E* d / dx
+            raise ValueError(
+                f"indentation {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
+                f"at most {self.max_f:g} times the height range, {self.max_f * scale:.6g} on this surface"
+            )
         depth /= scale
         cg = self.contact_cg(FreeHalfSpace(depth.shape), depth)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
