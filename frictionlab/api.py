@@ -344,12 +344,14 @@ def run_scene(
     ``frictionlab run``. ``on_results(result)`` is called before the figure is drawn."""
     if out is None:
         from . import engine
+        from .loads import check_loads
         from .runner import check_memory
 
         if options.resume:
             raise FrictionlabError("resume needs the run folder: give out=FOLDER")
         if options.memory_check:
             check_memory(scene, options)
+        check_loads(scene)  # as run_to_folder does
         outcome = engine.run(scene, options, listeners=listeners, cancel=cancel)
         result = _result(scene, outcome, None, {})
         if on_results is not None:

@@ -80,6 +80,8 @@ def test_a_unit_the_solver_cannot_take_is_refused_before_the_run(tmp_path, chang
     with pytest.raises(PresetError, match="loading.unit") as caught:
         frictionlab.run(preset, out=tmp_path / "run", **FAST)
     assert words in str(caught.value) and not (tmp_path / "run").exists()
+    with pytest.raises(PresetError, match="loading.unit"):  # a run kept in memory too
+        frictionlab.run(preset, **FAST)
 
 
 @pytest.mark.parametrize("loading, words", [
