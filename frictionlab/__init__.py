@@ -26,7 +26,7 @@ _LAZY = {
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
             "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
-            "load_finished", "mdr_length",
+            "half_load_points", "load_finished", "mdr_length",
         ),
         "plugin",
     ),  # fmt: skip
@@ -81,6 +81,7 @@ __all__ = [
     "__version__",
     "contract",
     "force_unit",
+    "half_load_points",
     "hookimpl",
     "iteration_done",
     "load",

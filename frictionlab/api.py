@@ -72,7 +72,8 @@ class Result:
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
     realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,
-    ``contact_fraction``, ``indentation``, and ``real_area_corrected`` (the real area
+    ``contact_fraction``, ``indentation``, ``half_load_points`` (the fewest points
+    carrying half the load, NaN where the solver does not say), and ``real_area_corrected`` (the real area
     corrected for its perimeter's pixels, a fraction) for a solver that gives it
     (``bem-halfspace``), and ``real_gradient_rms`` (g_r, the rms slope over the corrected
     real contact), ``kappa`` and ``kappa_r`` ((A / A0) E* g / p with g the surface's rms
@@ -236,13 +237,19 @@ def read_preset_input(
 
 
 def scene_record(scene: Scene) -> dict:
-    """What a validated preset would run: its plugins, realizations, load steps, and what
-    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None."""
+    """What a validated preset would run: its plugins, realizations, load steps, what
+    its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None,
+    and its loads (``loads``: the force unit, the range in every unit, where full contact
+    starts: ``frictionlab.loads.describe_loads``). Loads the solver cannot take are refused."""
+    from .loads import check_loads, describe_loads
+
+    check_loads(scene)
     preset = scene.preset
     return {
         "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
         "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
         "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+        "loads": describe_loads(scene),
     }  # fmt: skip
 
 
@@ -343,12 +350,14 @@ def run_scene(
     ``frictionlab run``. ``on_results(result)`` is called before the figure is drawn."""
     if out is None:
         from . import engine
+        from .loads import check_loads
         from .runner import check_memory
 
         if options.resume:
             raise FrictionlabError("resume needs the run folder: give out=FOLDER")
         if options.memory_check:
             check_memory(scene, options)
+        check_loads(scene)  # as run_to_folder does
         outcome = engine.run(scene, options, listeners=listeners, cancel=cancel)
         result = _result(scene, outcome, None, {})
         if on_results is not None:
@@ -372,6 +381,8 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         "lines_used": outcome.lines_used, "contact_count": outcome.contact_count, "contact_fraction": outcome.contact_fraction,
         "indentation": outcome.indentation,
     }  # fmt: skip
+    if outcome.half_load_points is not None:
+        table["half_load_points"] = outcome.half_load_points
     if outcome.real_area_corrected is not None:  # the solvers that correct their area only
         table[CORRECTED_AREA] = outcome.real_area_corrected
     if outcome.real_gradient_rms is not None:  # the solvers that give g_r only

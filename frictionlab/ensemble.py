@@ -40,6 +40,54 @@ def full_contact_caveat(first: int, loads: np.ndarray) -> str:
     )
 
 
+MIN_HALF_LOAD_POINTS = 5  # fewer points carrying half the force, at half the loads or more: a caveat
+SPIKE_RMS = 8.0  # the highest point this many rms heights above the mean: a caveat (a Gaussian map of 1e9 points reaches 6.1)
+
+
+def few_carriers_caveat(half: np.ndarray, f: np.ndarray) -> str | None:
+    """The caveat of a run where, at half its loads or more, fewer than ``MIN_HALF_LOAD_POINTS``
+    points carry half the force (mean ``half`` per load): a spike or one island carries it."""
+    few = np.flatnonzero(half < MIN_HALF_LOAD_POINTS)
+    if not half.size or few.size * 2 < half.size:
+        return None
+    return (
+        f"at {few.size} of {half.size} loads (up to f = {float(f[few[-1]]):.4g}) fewer than {MIN_HALF_LOAD_POINTS} "
+        f"points carry half the force (as few as {float(np.nanmin(half)):.3g}; half_load_points in curve.csv): xi "
+        "there measures a spike or a single island, not the surface's roughness"
+    )
+
+
+def spike_caveat(peak: float) -> str:
+    """The caveat of a profile whose highest point stands ``peak`` rms heights above its mean."""
+    return (
+        f"the highest point stands {peak:.3g} rms heights above the mean height (more than {SPIKE_RMS:g}; a Gaussian "
+        "surface of a billion points reaches about 6): a spike would carry the first loads alone; look at the scan"
+    )
+
+
+def constant_xi_refusal(per_count: np.ndarray, xi: np.ndarray, points: int, loads: np.ndarray) -> str | None:
+    """Why no law is fitted when every load presses the same points (each realization's count
+    the same at every load, and the mean xi with it, to 1e-9 relative), all of them or not;
+    None when the contact changes with the load (a profile whose xi stays put while its
+    contact grows, a sawtooth's, has a law: b = 0)."""
+    defined = xi[np.isfinite(xi)]
+    if not (per_count.size and defined.size) or np.any(np.ptp(per_count, axis=1) > 0):
+        return None
+    if np.ptp(defined) > 1e-9 * np.max(np.abs(defined)):
+        return None
+    span = f"from {loads[0]:.4g} to {loads[-1]:.4g}"
+    if np.all(per_count == points):
+        return (
+            f"no law: the whole profile is in contact at every load {span} (xi is 1 by definition); lower the loads "
+            "(frictionlab validate shows where full contact starts)"
+        )
+    return (
+        f"no law: every load {span} presses the same points (mean {float(per_count[:, 0].mean()):.4g} in contact), "
+        f"so xi is {float(defined[0]):.4g} at every load and a law in ln f is undefined; raise the loads or widen "
+        "their range"
+    )
+
+
 @dataclass
 class RunOutcome:
     """The statistics of what finished. Per-force arrays have one entry per load
@@ -78,6 +126,9 @@ class RunOutcome:
     contact_spots: np.ndarray | None = None  # mean over realizations; None unless the solver counts spots
     extra: dict = field(default_factory=dict)
     input_caveats: tuple[str, ...] = ()  # what the spectrum's input_summary says of the file it read (a tilt left in)
+    half_load_points: np.ndarray | None = None  # ensemble mean of the points carrying half the force (NaN: not said)
+    peak_rms: float = math.nan  # the largest (max z - mean z) / rms height over the profiles
+    no_law: str | None = None  # why no law was fitted though realizations finished (xi the same at every load)
 
     @property
     def done(self) -> int:
@@ -89,6 +140,8 @@ class RunOutcome:
         (the rms slope in contact of one or two points is mostly noise), the whole
         profile in contact from some load on (xi is 1 there by definition), or lines
         without xi at some load (averaged over fewer lines there)."""
+        if self.no_law:  # and why, where a spike makes it
+            return [self.no_law, *self.input_caveats] + ([spike_caveat(self.peak_rms)] if self.peak_rms > SPIKE_RMS else [])
         if self.fit is None or not self.contact_count.size:
             return []
         caveats = list(self.input_caveats)
@@ -97,6 +150,11 @@ class RunOutcome:
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
         if full.size:
             caveats.append(full_contact_caveat(int(full[0]), self.loads))
+        half = self.half_load_points
+        if half is not None and np.isfinite(half).all() and (caveat := few_carriers_caveat(half, self.f)):
+            caveats.append(caveat)
+        if self.peak_rms > SPIKE_RMS:
+            caveats.append(spike_caveat(self.peak_rms))
         if self.lines_used.size and self.lines_used.min() < self.done:
             caveats.append(
                 f"up to {self.done - int(self.lines_used.min())} of {self.done} lines have no xi at a load (no point "
@@ -172,7 +230,9 @@ class Accumulator:
             self.failures[result.index] = result.error
 
     def stack(self, name: str) -> np.ndarray:
-        rows = [getattr(self.results[i], name) for i in sorted(self.results)]
+        """One row per finished realization of its per-load array ``name`` (NaN where it has none)."""
+        missing = np.full(self.loads.size, math.nan)
+        rows = [row if (row := getattr(self.results[i], name)) is not None else missing for i in sorted(self.results)]
         return np.vstack(rows) if rows else np.empty((0, self.loads.size))
 
     def finish(self, *, status: str, elapsed: float, workers: int, error: str | None = None) -> RunOutcome:
@@ -187,11 +247,13 @@ class Accumulator:
             "measured_rms_height": np.array([self.results[i].measured_rms_height for i in indices]),
         }
         own = np.array([self.results[i].own_rms_height for i in indices])
+        peaks = np.array([self.results[i].peak_rms for i in indices])
         own_rms_height = bool(np.isfinite(own).any())
         if own_rms_height:
             per["own_rms_height"] = own
-        if scene.control == "indentation":
+        if scene.forces_vary:
             per["force"] = self.stack("force")
+        per["half_load_points"] = self.stack("half_load_points")
         if scene.solver.corrected_area:
             per["real_area_corrected"] = self.stack("real_area_corrected")
         if scene.solver.real_gradient:
@@ -204,13 +266,14 @@ class Accumulator:
         unit = first.force_unit if first else math.nan  # every realization has the grid of the first
         rms_height = (float(own[0]) if own_rms_height else float(scene.generator.rms_height())) if n else math.nan
         stiffness = float(scene.solver.stiffness())
-        force = per["force"].mean(axis=0) if "force" in per and n else self.loads.astype(float)
+        given = self.loads if scene.solver_loads is None else scene.solver_loads  # NaN-free before any realization
+        force = per["force"].mean(axis=0) if "force" in per and n else given.astype(float)
         with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # an overflow is reported below
             f = force / unit if n else np.full(self.loads.size, math.nan)
         nan_row = np.full(self.loads.size, math.nan)
         xi_mean, xi_sem, used = defined_statistics(per["xi"])
         count = per["contact_count"].mean(axis=0) if n else nan_row
-        fit = None
+        fit, no_law = None, None
         if not n and self.failures and status == "completed":
             # every realization failed: nothing was computed, whatever the count says
             index, reason = min(self.failures.items())
@@ -234,6 +297,8 @@ class Accumulator:
                 "contact has a slope: the slope estimator leaves the ends of the profile without one): a fit needs "
                 "two; raise the loads"
             )
+        elif n and (refusal := constant_xi_refusal(per["contact_count"], xi_mean, points, force)):
+            status, error, no_law = "failed", refusal, refusal
         elif n:
             settings = scene.preset.fit
             fit = fit_log_law(
@@ -274,6 +339,9 @@ class Accumulator:
             if scene.solver.corrected_area else None,
             **gradients,
             contact_spots=(per["contact_spots"].mean(axis=0) if n else nan_row) if scene.solver.counts_spots else None,
+            half_load_points=per["half_load_points"].mean(axis=0) if n else nan_row,
+            peak_rms=float(np.nanmax(peaks)) if np.isfinite(peaks).any() else math.nan,
+            no_law=no_law,
         )
 
     def _gradients(self, per: dict, force: np.ndarray, points: int, extent: float, stiffness: float) -> dict:

@@ -84,11 +84,16 @@ def bytes_per_point(scene: Scene) -> int:
     return BYTES_PER_POINT if declared is None else max(BYTES_PER_POINT, declared + PROFILE_BYTES_PER_POINT)
 
 
+def kept_arrays(scene: Scene) -> int:
+    """Per-load arrays the main process keeps of each realization: xi, contact count,
+    indentation, the points carrying half the load, and the forces where they vary."""
+    return 5 if scene.forces_vary else 4
+
+
 def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = None) -> MemoryEstimate:
     points = grid_points(scene) if points is None else points
     steps = int(scene.loads.size)
-    arrays = 4 if scene.control == "indentation" else 3
-    kept = scene.preset.realizations * (steps * 8 * arrays * KEPT_COPIES + 512)
+    kept = scene.preset.realizations * (steps * 8 * kept_arrays(scene) * KEPT_COPIES + 512)
     per_realization = points * bytes_per_point(scene) + steps * BYTES_PER_STEP
     main = PROCESS_BASE + kept
     if executor == "serial":
@@ -231,7 +236,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         if one.total - one.per_realization + bytes_per_point(scene) < available and points_param:
             advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
         else:
-            rows = scene.loads.size * 8 * (4 if scene.control == "indentation" else 3) * KEPT_COPIES + 512
+            rows = scene.loads.size * 8 * kept_arrays(scene) * KEPT_COPIES + 512
             spare = available - PROCESS_BASE - one.per_realization
             advice.append(f"--workers 1 and realizations <= {max(0, math.floor(spare / rows)):,}")
     raise RunError(

@@ -150,6 +150,9 @@ class ContactCurve:
     solver declares ``real_gradient``, None otherwise.
     ``contact_spots``: the number of contact spots (clusters of contact pixels joined along
     rows and columns), given exactly when the solver declares ``counts_spots``.
+    ``half_load_points``: how many points carry half the load (the fewest whose loads,
+    largest first, sum to half the total): a spike or a single island carrying the
+    load shows as a small number; None when the solver does not say.
     ``extras`` carries solver-specific per-load arrays (iterations, residuals).
     """
 
@@ -162,6 +165,17 @@ class ContactCurve:
     real_gradient_rms: np.ndarray | None = None
     contact_spots: np.ndarray | None = None
     extras: dict[str, np.ndarray] = field(default_factory=dict)
+    half_load_points: np.ndarray | None = None
+
+
+def half_load_points(point_loads: np.ndarray) -> int:
+    """How many points carry half the load: the fewest of ``point_loads`` (each point's
+    share, >= 0), taken largest first, whose sum reaches half the total; 0 for no load."""
+    loads = np.sort(np.ravel(np.asarray(point_loads, dtype=float)))[::-1]
+    total = float(loads.sum())
+    if not total > 0:
+        return 0
+    return int(np.searchsorted(np.cumsum(loads), 0.5 * total) + 1)
 
 
 # ------------------------------------------------------------ what a load means
@@ -185,6 +199,13 @@ _EXTENT_DEFINITIONS = {
 _EXTENT_DIMENSIONS = {"one": (1, 2), "length": (1,), "area": (2,), "mdr length": (2,)}
 _EXTENT_POWERS = {"one": 0, "length": 1, "area": 2, "mdr length": 1}  # X ~ length^power
 
+PressureArea = Literal["", "profile", "mdr disc"]
+"""The area A of a nominal pressure p = load / A, where p over the modulus is dimensionless:
+"profile" (a surface's apparent area; a line's length for a force per unit depth),
+"mdr disc" (the disc of area pi L^2 / 4 whose MDR line has length L), "" (none: the
+modulus is not a stress, or the line stands for no area)."""
+_PRESSURE_EXTENTS = {"profile": ("one", "mdr length"), "mdr disc": ("length",), "": tuple(_EXTENT_SYMBOLS)}
+
 
 @dataclass(frozen=True)
 class ForceNormalisation:
@@ -206,6 +227,8 @@ class ForceNormalisation:
     # What X is, in words, where the profile's own words would mislead (an MDR-equivalent
     # line: its length is 2 sqrt(A / pi) of the surface it stands for); "" for the usual ones.
     extent_words: str = ""
+    # Where a load may be given as a nominal pressure over the modulus, p / k (``PressureArea``).
+    pressure_area: PressureArea = ""
 
     def __post_init__(self):
         if self.load not in _LOAD_SYMBOLS:
@@ -217,6 +240,11 @@ class ForceNormalisation:
             raise ValueError(
                 f"a load over k h{_EXTENT_SYMBOLS[self.extent]} is a {expected} (k a modulus of the right unit), "
                 f"not a {self.load}: f would not be dimensionless"
+            )
+        if self.extent not in _PRESSURE_EXTENTS.get(self.pressure_area, ()):
+            raise ValueError(
+                f"pressure_area {self.pressure_area!r} is not a dimensionless pressure with extent {self.extent!r}: "
+                "'profile' goes with extent 'one' or 'mdr length', 'mdr disc' with 'length'"
             )
         if not (isinstance(self.modulus, str) and self.modulus.strip()):
             raise ValueError(f"modulus must name the stiffness, e.g. 'E*'. Got {self.modulus!r} instead.")
@@ -255,6 +283,15 @@ class ForceNormalisation:
         if self.extent == "mdr length":
             return mdr_length(profile.area)
         return profile.area  # a line's length, or a surface's area
+
+    def nominal_area(self, profile: Profile) -> float | None:
+        """A of the nominal pressure p = load / A on ``profile`` (``pressure_area``); None where
+        p over the modulus is not dimensionless."""
+        if not self.pressure_area:
+            return None
+        if self.pressure_area == "mdr disc":
+            return math.pi * profile.area**2 / 4.0  # the line's length is 2 sqrt(A / pi)
+        return profile.area
 
     def force_unit(self, stiffness: float, rms_height: float, extent: float) -> float:
         """k h X: the load at which f = 1. The one place where f is formed: f = load / force_unit."""
@@ -472,6 +509,12 @@ class ContactSolver(Plugin):
     - ``bytes_per_point`` (None): the peak memory ``solve`` allocates per grid point,
       beyond the profile and slopes it is given (memory estimates before a run).
       None: the framework's figure for a line solver (``memory.BYTES_PER_POINT``).
+    - ``max_f`` (None): the largest dimensionless force f the solver's arithmetic holds
+      (an iterative solver's single-precision steps overflow past it); the framework
+      refuses a load past it before the run. None: no limit short of double precision.
+    - ``full_contact_load(profile)`` (None): the load at which every point of ``profile``
+      is in contact, exactly, where the solver knows it without a solve (springs, from
+      the heights); ``frictionlab validate`` shows it. None: not known short of solving.
     - ``undefined_slopes`` (False): True when ``solve`` takes slopes with NaN at
       points that have no slope, and forms ``slope_rms_contact`` over the contact
       points whose slope is defined (``defined_rms``), NaN at a load where none is.
@@ -494,6 +537,7 @@ class ContactSolver(Plugin):
     tolerance_param: ClassVar[str | None] = None
     bytes_per_point: ClassVar[int | None] = None
     undefined_slopes: ClassVar[bool] = False
+    max_f: ClassVar[float | None] = None
 
     def solve(
         self, profile: Profile, loads: np.ndarray, control: Control, slopes: np.ndarray
@@ -515,6 +559,10 @@ class ContactSolver(Plugin):
         """Mean displacement of the elastic surface at dimensionless force ``f``, in
         the frame of the reported indentation (zero: measured from the mean plane)."""
         return np.zeros_like(np.asarray(f, dtype=float))
+
+    def full_contact_load(self, profile: Profile) -> float | None:
+        """The load at which every point of ``profile`` is in contact; None when only a solve would say."""
+        return None
 
     def tolerance(self) -> float | None:
         """The relative tolerance the solver iterates to; None for a direct solver."""

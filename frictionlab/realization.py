@@ -40,6 +40,8 @@ class RealizationResult:
     force_unit: float = math.nan  # k h X of f = F / (k h X) for this realization's profile
     measured_rms_height: float = math.nan  # the profile's rms height about its own mean
     own_rms_height: float = math.nan  # the h of f when it is the profile's own (profile_rms_height), else NaN
+    half_load_points: np.ndarray | None = None  # points carrying half the load, per load (NaN: the solver does not say)
+    peak_rms: float = math.nan  # (max z - mean z) / rms height of the profile: a spike stands out
     error: str | None = None
 
     @property
@@ -97,7 +99,7 @@ def compute_realization(
     (anything with ``is_set()``) is set, within an iteration of the solver."""
     watch = _SolveWatch(index, on_load, on_iteration, cancel)
     with listening_to_loads(watch.load_done), listening_to_iterations(watch.iteration_done):
-        return _compute(scene, index, watch.check)
+        return _compute(scene, index, watch)
 
 
 SAFE_SLOPE = 2.0**400  # slopes up to this in magnitude (and down to its inverse) square and sum without overflow
@@ -114,7 +116,23 @@ def slope_scale(slopes: np.ndarray) -> float:
     return math.ldexp(1.0, -math.frexp(largest)[1])
 
 
-def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> RealizationResult:
+def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: float):
+    """The solver's curve over the scene's loads; contact fractions first turned into this
+    profile's forces by solving (``loads.forces_for_fractions``, from f = the fraction: ``unit``
+    is the profile's k h X)."""
+    if scene.solver_loads is not None:
+        return scene.solver.solve(profile, scene.solver_loads, scene.control, slopes)
+    from .loads import forces_for_fractions
+
+    def seeking(j: int) -> None:  # iterations of the search are said as the load's
+        watch.load = j + 1
+
+    forces = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
+    return scene.solver.solve(profile, forces, "force", slopes)
+
+
+def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
+    check_cancel = watch.check
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
@@ -133,23 +151,29 @@ def _compute(scene: Scene, index: int, check_cancel: Callable[[], None]) -> Real
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
-        curve = scene.solver.solve(profile, scene.loads, scene.control, slopes)
         own_h = scene.generator.profile_rms_height(profile)
+        unit = force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile)
+        curve = _solve(scene, profile, slopes, watch, unit)
+        half = curve.half_load_points
+        heights = np.asarray(profile.heights, dtype=float)
+        rms = float(np.std(heights))
         return RealizationResult(
             index=index,
             seconds=time.perf_counter() - start,
             xi=curve.slope_rms_contact / slope_rms_line,
             contact_count=np.asarray(curve.contact_count),
             indentation=np.asarray(curve.indentation),
-            force=np.asarray(curve.force) if scene.control == "indentation" else None,
+            force=np.asarray(curve.force) if scene.forces_vary else None,
             real_area_corrected=np.asarray(curve.real_area_corrected, float) if scene.solver.corrected_area else None,
             real_gradient_rms=np.asarray(curve.real_gradient_rms, float) / scale if scene.solver.real_gradient else None,
             contact_spots=np.asarray(curve.contact_spots, float) if scene.solver.counts_spots else None,
             slope_rms_line=slope_rms_line / scale,
             points=profile.points,
-            force_unit=force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile),
-            measured_rms_height=float(np.std(profile.heights)),
+            force_unit=unit,
+            measured_rms_height=rms,
             own_rms_height=math.nan if own_h is None else float(own_h),
+            half_load_points=np.full(scene.loads.size, math.nan) if half is None else np.asarray(half, float),
+            peak_rms=(float(heights.max()) - float(heights.mean())) / rms if rms > 0 else math.nan,
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise

@@ -35,9 +35,12 @@ from .preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
-CURVE_COLUMNS = ("F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation")
+CURVE_COLUMNS = (
+    "F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation", "half_load_points",
+)  # fmt: skip
 # columns a later frictionlab added: a folder written before them is read without them
-ADDED_CURVE_COLUMNS = frozenset({"lines_used"})
+ADDED_CURVE_COLUMNS = frozenset({"lines_used", "half_load_points"})
+HALF_LOAD_HEADER = "half_load_points [the fewest points carrying half the load; ensemble mean; empty: not given]"
 CONTACT_MEASURES = {
     "real contact": "real contact fraction",
     "mdr springs": "fraction of MDR springs in contact; not the real area",
@@ -93,6 +96,8 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "contact_count_at_first_load": json_safe(float(counts[0])) if counts.size else None,
         "contact_count_at_last_load": json_safe(float(counts[-1])) if counts.size else None,
         **_corrected_area_ends(outcome),
+        **_half_load_ends(outcome),
+        "peak_height_rms": json_safe(float(outcome.peak_rms)),
         "caveats": outcome.caveats,
         "elapsed_seconds": round(outcome.elapsed, 6),
         "workers": outcome.workers,
@@ -134,6 +139,15 @@ def _corrected_area_ends(outcome: RunOutcome) -> dict:
     return {f"{CORRECTED_AREA}_at_{end}_load": value for end, value in ends.items()}
 
 
+def _half_load_ends(outcome: RunOutcome) -> dict:
+    """The mean points carrying half the load at the first and last load; None where not said."""
+    half = outcome.half_load_points
+    ends = {"first": None, "last": None}
+    if half is not None and half.size:
+        ends = {"first": json_safe(float(half[0])), "last": json_safe(float(half[-1]))}
+    return {f"half_load_points_at_{end}_load": value for end, value in ends.items()}
+
+
 def curve_header(scene: Scene) -> list[str]:
     """The columns of curve.csv, each a short name (``CURVE_COLUMNS``) with what it
     means in brackets: the load with its unit, f with its definition."""
@@ -144,6 +158,7 @@ def curve_header(scene: Scene) -> list[str]:
         "f": f"f [{f}]",
         "contact_fraction": f"contact_fraction [{CONTACT_MEASURES[scene.solver.contact_measure]}]",
         "indentation": f"indentation [{INDENTATION_REFERENCES[scene.solver.indentation_reference]}]",
+        "half_load_points": HALF_LOAD_HEADER,
     }
     return [labels.get(column, column) for column in CURVE_COLUMNS]
 
@@ -183,7 +198,8 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
         if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
             problems.append("lines_used must be a whole number >= 0 at every load step")
     bounds = [("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)]
-    for column, low, high in bounds + [(name, 0.0, np.inf) for name in (*GRADIENT_COLUMNS, SPOTS)]:
+    extra = (*GRADIENT_COLUMNS, SPOTS, "half_load_points")
+    for column, low, high in bounds + [(name, 0.0, np.inf) for name in extra]:
         if column not in curve:
             continue
         values = curve[column][~np.isnan(curve[column])]
@@ -280,6 +296,7 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.contact_count,
         outcome.contact_fraction,
         outcome.indentation,
+        outcome.half_load_points if outcome.half_load_points is not None else np.full(outcome.f.size, np.nan),
     )
     if corrected:
         columns = (*columns, outcome.real_area_corrected)

@@ -65,7 +65,8 @@ FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
 CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 # kept when the control or the solver gives them
 OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected", "real_gradient_rms", "contact_spots")
-ADDED_CURVE_ARRAYS = frozenset({"real_gradient_rms", "contact_spots"})  # absent from the chunks of older versions: NaN
+ADDED_OPTIONAL_ARRAYS = frozenset({"real_gradient_rms", "contact_spots"})  # of those, absent from older chunks: NaN
+ADDED_CURVE_ARRAYS = ("half_load_points",)  # kept by every run, absent from the chunks of older versions: NaN
 
 def _write_holder(fd: int) -> None:
     """Who holds run.lock, for the message of a run refused because of it."""
@@ -389,11 +390,12 @@ class RunDirectory:
             "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
             "measured_rms_height": np.array([r.measured_rms_height for r in ok], dtype=np.float64),
             "own_rms_height": np.array([r.own_rms_height for r in ok], dtype=np.float64),
+            "peak_rms": np.array([r.peak_rms for r in ok], dtype=np.float64),
             "failed_index": np.array([r.index for r in failed], dtype=np.int64),
             "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
             "failed_error": np.array([r.error for r in failed], dtype=str),
         }
-        for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS):
+        for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS, *ADDED_CURVE_ARRAYS):
             rows = [getattr(r, name) for r in ok]
             if ok and rows[0] is not None:
                 arrays[name] = np.vstack(rows)
@@ -536,7 +538,7 @@ def _left_by_a_start(path: Path, resolved: dict) -> bool:
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:
     """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
     solver = scene.solver
-    return scene.control == "indentation", solver.corrected_area, solver.real_gradient, solver.counts_spots
+    return scene.forces_vary, solver.corrected_area, solver.real_gradient, solver.counts_spots
 
 
 def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
@@ -548,7 +550,7 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
         raise ChunkDamage(f"no array {missing[0]}")
     n, k, steps = arrays["index"].shape[0], arrays["failed_index"].shape[0], scene.loads.size
     curves = (*CURVE_ARRAYS, *(name for name, kept in zip(OPTIONAL_CURVE_ARRAYS, _optional_kept(scene)) if kept))
-    for name in ADDED_CURVE_ARRAYS.intersection(curves):
+    for name in ADDED_OPTIONAL_ARRAYS.intersection(curves):
         if n and name not in arrays:  # a chunk of a version before it: the values are unknown
             arrays = {**arrays, name: np.full((n, steps), math.nan)}
     for name in OK_ARRAYS + (curves if n else ()):
@@ -568,10 +570,14 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
     if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
         raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
     heights = {}  # absent from the chunks of older versions: NaN
-    for name in ("measured_rms_height", "own_rms_height"):
+    for name in ("measured_rms_height", "own_rms_height", "peak_rms"):
         heights[name] = arrays.get(name, np.full(n, math.nan))
         if heights[name].shape != (n,):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
+    for name in ADDED_CURVE_ARRAYS:
+        heights[name] = arrays.get(name, np.full((n, steps), math.nan))
+        if heights[name].shape != (n, steps):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(
@@ -589,6 +595,8 @@ def _chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Re
             force_unit=float(arrays["force_unit"][row]),
             measured_rms_height=float(heights["measured_rms_height"][row]),
             own_rms_height=float(heights["own_rms_height"][row]),
+            peak_rms=float(heights["peak_rms"][row]),
+            half_load_points=np.asarray(heights["half_load_points"][row], dtype=float),
         ))  # fmt: skip
     for row, index in enumerate(arrays["failed_index"].tolist()):
         out.append(RealizationResult(

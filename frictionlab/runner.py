@@ -10,6 +10,7 @@ from pathlib import Path
 from . import engine
 from .ensemble import RunOutcome
 from .executors import dask_memory_limits
+from .loads import check_loads
 from .memory import check_fits, check_worker_limits
 from .options import RunOptions
 from .preset import Scene
@@ -101,6 +102,7 @@ def run_to_folder(
     """
     if options.memory_check:
         check_memory(scene, options)
+    check_loads(scene)  # a unit the solver cannot take, a load past its arithmetic: before the folder is touched
     with RunDirectory(out_dir, force=options.force) as run_dir:
         restored = run_dir.start(scene, resume=options.resume)
         store = BatchedStore(run_dir)

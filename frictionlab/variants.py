@@ -14,16 +14,13 @@ import math
 from typing import Any
 
 from .errors import FrictionlabError
-from .plugin import force_unit
 from .preset import Scene, build_scene, set_path
 from .registry import Registry
-from .seeds import realization_rng
 
 
 def force_scale(scene: Scene) -> float:
-    """The load at f = 1 (``force_unit``) for realization 0's profile."""
-    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
-    return force_unit(scene.solver, scene.generator.rms_height(), profile)
+    """The load at f = 1 (``force_unit``) for realization 0's profile (``Scene.load_scales``)."""
+    return scene.load_scales.force_unit
 
 
 class SceneFactory:
@@ -45,7 +42,7 @@ class SceneFactory:
             set_path(data, path, value)
         where = f"{self.source} with " + ", ".join(f"{k}={v}" for k, v in changes.items())
         scene = build_scene(data, registry=self.registry, source=where)
-        if keep_f_range:
+        if keep_f_range and scene.preset.loading.unit == "force":  # loads in f keep their f range themselves
             ratio = force_scale(scene) / self._base_scale
             if not math.isclose(ratio, 1.0, rel_tol=1e-12):
                 loading = self.base.preset.loading

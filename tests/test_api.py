@@ -120,7 +120,8 @@ def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path)
 def test_to_pandas_gives_a_frame_with_pandas_and_names_the_extra_without(monkeypatch):
     result = frictionlab.run(SMALL_PRESET, **FAST)
     frame = result.to_pandas()
-    assert list(frame.columns) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation"]
+    assert list(frame.columns) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation",
+                                     "half_load_points"]
     np.testing.assert_array_equal(frame["xi"].to_numpy(), result.table["xi"])
     monkeypatch.setitem(sys.modules, "pandas", None)  # as if not installed
     with pytest.raises(MissingDependency, match=r'Result.to_pandas\(\) needs pandas, .*pip install "frictionlab\[pandas\]"'):
@@ -144,7 +145,9 @@ def test_few_contacts_at_the_first_load_carry_a_caveat_everywhere(tmp_path):
     tiny = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1e-6}}
     result = frictionlab.run(tiny, out=tmp_path / "tiny", **FAST)
     assert result.table["contact_count"][0] < 3
-    assert len(result.caveats) == 1 and "fewer than 3 points in contact" in result.caveats[0]
+    assert "fewer than 3 points in contact" in result.caveats[0]
+    # and, from F = 1e-6 on, one point carries half the force at most loads
+    assert len(result.caveats) == 2 and "fewer than 5 points carry half the force" in result.caveats[1]
     assert json.loads((tmp_path / "tiny" / "summary.json").read_text())["caveats"] == result.caveats
     ax = __import__("matplotlib.figure").figure.Figure().subplots()
     result.plot(ax)

@@ -172,7 +172,7 @@ def test_full_contact_gives_xi_one(make_scene):
 def test_only_what_the_scene_needs_is_kept(make_scene):
     force = engine.run(make_scene({"realizations": 3}), RunOptions(workers=1))
     assert set(force.per_realization) == {"index", "xi", "contact_count", "indentation", "slope_rms_line",
-                                           "measured_rms_height"}
+                                           "measured_rms_height", "half_load_points"}
     indentation = engine.run(make_scene({"realizations": 3, "loading": {"control": "indentation", "start": 0.1, "stop": 2.0}}), RunOptions(workers=1))
     assert "force" in indentation.per_realization
     assert indentation.per_realization["force"].shape == (3, 16)

@@ -22,7 +22,8 @@ SHAPES = {
               "(each point's values, fit and folder), `status`"),
     "validate": ("validate", "`ok` (every preset valid) and `presets`: a record per preset given, with `preset`, `ok`, "
                  "`problems` (each `field: what is wrong`), `exit_code` and, when valid, what would run (`name`, "
-                 "`realizations`, `spectrum`, `solver`, `slope`, `steps`, `control`, `sweep_points`)"),
+                 "`realizations`, `spectrum`, `solver`, `slope`, `steps`, `control`, `sweep_points`, and `loads`: the "
+                 "`force_unit`, the `range` in every unit, `full_contact`)"),
     "presets": ("presets", "`presets`: each built-in's `name`, whole `description` and `path`"),
     "plugins": ("plugins", "`plugins` (each `kind`, `name`, `summary`, `provider`, `version`) and `failed` (the entry "
                 "points that did not load, with their error)"),

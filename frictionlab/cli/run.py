@@ -200,9 +200,9 @@ def result_table(scene, outcome, out_dir: Path) -> str:
         ]
         count = outcome.contact_count
         unit = outcome.normalisation.load_symbol if scene.control == "force" else "d"
+        ends = (outcome.force[0], outcome.force[-1]) if scene.control == "force" else (outcome.loads[0], outcome.loads[-1])
         lines.append(
-            f"  mean points in contact: {count[0]:.2f} at {unit} = {outcome.loads[0]:g}, "
-            f"{count[-1]:.2f} at {unit} = {outcome.loads[-1]:g}"
+            f"  mean points in contact: {count[0]:.2f} at {unit} = {ends[0]:g}, {count[-1]:.2f} at {unit} = {ends[1]:g}"
         )
     for caveat in outcome.caveats:
         lines.append(f"  caveat: {caveat}")

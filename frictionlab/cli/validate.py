@@ -23,6 +23,7 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..api import scene_record
     from ..inputs import describe_channels, describe_input
+    from ..loads import loads_lines
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..runner import check_one_realization
@@ -38,6 +39,8 @@ def run(args) -> ExitCode:
             scene = build_scene(data, source=source, before_reading=check_one_realization)
             if scene.preset.sweep is not None:  # every point too
                 points = len(plan_sweep(data, source=source).points)
+            # its loads in every unit: refused here when the solver cannot take them
+            record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         except FrictionlabError as exc:
             worst = ExitCode(max(worst, exc.exit_code))
             problems = getattr(exc, "problems", None) or [str(exc)]
@@ -46,7 +49,6 @@ def run(args) -> ExitCode:
                 print(shown(str(exc)), file=sys.stderr)
             continue
         preset = scene.preset
-        record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         records.append(record)
         if not args.json:
             print(shown(
@@ -60,6 +62,8 @@ def run(args) -> ExitCode:
                     print(shown(f"    {line}"))
                 for caveat in record["input"].get("caveats", ()):
                     print(f"  caveat: {shown(caveat)}")
+            for line in loads_lines(record["loads"], scene.normalisation.load_symbol):
+                print(shown(f"  {line}"))
     if args.json:
         from .jsonout import emit
 

@@ -70,6 +70,27 @@ class Scene:
     def control(self) -> str:
         return self.preset.loading.control
 
+    @functools.cached_property
+    def solver_loads(self) -> np.ndarray | None:
+        """The loads the solver is given: ``loads`` converted from the preset's ``loading.unit``
+        (``frictionlab.loads``); None for contact fractions, whose forces are found per profile."""
+        from ..loads import solver_loads
+
+        return solver_loads(self)
+
+    @functools.cached_property
+    def load_scales(self):
+        """The force at f = 1, at p / E* = 1, and where full contact starts, for the profiles
+        pressed (``frictionlab.loads.load_scales``: realization 0's profile is made once)."""
+        from ..loads import load_scales
+
+        return load_scales(self)
+
+    @property
+    def forces_vary(self) -> bool:
+        """Whether each realization has forces of its own (indentation control, contact fractions)."""
+        return self.control == "indentation" or self.preset.loading.unit == "contact-fraction"
+
     def plugins(self) -> dict:
         """The plugin the preset names for each kind (the spectrum, not its equivalent line)."""
         return {"spectrum": self.spectrum, "solver": self.solver, "slope": self.slope}

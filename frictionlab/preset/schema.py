@@ -39,11 +39,21 @@ class Loading(_Strict):
     stop: float = Field(gt=0, description="Last load, > start.")
     steps: int = Field(ge=2, le=1_000_000, description="Number of load steps, start and stop included.")
     spacing: Literal["linear", "log"] = Field("linear", description="Load steps evenly spaced in value or in log.")
+    unit: Literal["force", "f", "pressure", "contact-fraction"] = Field(
+        "force",
+        description="What start and stop are under force control: 'force' (the solver's load, in E* x length^2), "
+        "'f' (the dimensionless force F / (E* h L)), 'pressure' (the nominal pressure over E*, p / E* = F / (E* A)), "
+        "or 'contact-fraction' (a target real-contact fraction in (0, 1), the force found per surface by solving).",
+    )
 
     @model_validator(mode="after")
     def _ordered(self):
         if self.stop <= self.start:
             raise ValueError(f"stop must be > start ({self.start}). Got {self.stop} instead.")
+        if self.unit != "force" and self.control != "force":
+            raise ValueError(f"unit {self.unit!r} gives loads, not indentations: it needs control 'force'")
+        if self.unit == "contact-fraction" and self.stop >= 1:
+            raise ValueError(f"a contact fraction is below 1 (stop). Got {self.stop} instead")
         return self
 
     def values(self) -> np.ndarray:

@@ -52,6 +52,7 @@ def check_solver(cls, **params) -> None:
     given exactly when ``corrected_area`` is True, and then lies in (0, contact_fraction];
     ``real_gradient_rms`` is given exactly when ``real_gradient`` is True, and is then finite and >= 0;
     ``contact_spots`` is given exactly when ``counts_spots`` is True, whole numbers in 1 .. contact_count;
+    ``half_load_points``, where given, holds whole numbers in 1 .. contact_count;
     ``slope_rms_contact`` is >= 0 and
     no larger than the largest |slope|; every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
@@ -67,7 +68,10 @@ def check_solver(cls, **params) -> None:
     (memory estimates) is None or a whole number > 0 (registration checks it; that it
     bounds the solver's peak is for the plugin's own tests, measured on a large grid); a
     ``periodic_only`` solver raises ValueError on a non-periodic profile, any
-    other solves it. A solver declaring ``undefined_slopes`` is given NaN slopes
+    other solves it. ``max_f`` is None or a number > 0, and a force of 10 ``max_f`` k h X
+    raises ValueError naming the limit (before any overflow); ``full_contact_load(profile)``
+    is None or a finite number >= 0, and the load 1 % above it puts every point in
+    contact. A solver declaring ``undefined_slopes`` is given NaN slopes
     too: with every slope NaN, ``slope_rms_contact`` is NaN at every load; with
     slopes 1 but a NaN at the top point, it is 1 wherever it is finite, and finite
     at every load with 2 or more points in contact (the rms over the defined ones).
@@ -144,8 +148,12 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
                       f"(it is {cls.counts_spots!r}). Got {spots!r}.")  # fmt: skip
         if spots is not None:
             spots = check_array(cls, f"{where}.contact_spots", np.asarray(spots), loads.shape, False)
-            if np.any(spots != np.round(spots)) or np.any(spots < 1) or np.any(spots > arrays["contact_count"]):
+            if np.any(spots != np.round(spots)) or np.any(spots < 1) or np.any(spots > count_of(curve)):
                 fail(cls, f"{where}.contact_spots must be whole numbers in 1 .. contact_count. Got {spots!r}.")
+        if curve.half_load_points is not None:
+            half = check_array(cls, f"{where}.half_load_points", np.asarray(curve.half_load_points), loads.shape, False)
+            if not np.array_equal(half, np.round(half)) or np.any(half < 1) or np.any(half > count_of(curve)):
+                fail(cls, f"{where}.half_load_points must be whole numbers in 1 .. contact_count. Got {half!r}.")
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")
@@ -180,7 +188,44 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             if not np.array_equal(np.asarray(getattr(again, name)), arrays[name]):
                 fail(cls, f"{where} is not repeatable: {name} differs between two identical calls")
     _check_solver_declarations(cls, solver, heights, spacing, slopes, cases["force"])
+    _check_load_limits(cls, solver, heights, spacing, slopes, unit)
     _check_solver_units(cls, solver, heights, spacing, slopes)
+
+
+def count_of(curve):
+    import numpy as np
+
+    return np.asarray(curve.contact_count)
+
+
+def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> None:
+    """``max_f`` refused past it; ``full_contact_load`` puts every point in contact."""
+    import numpy as np
+
+    from frictionlab.plugin import Profile
+
+    limit = cls.max_f
+    if limit is not None:
+        if isinstance(limit, bool) or not isinstance(limit, (int, float)) or not limit > 0:
+            fail(cls, f"max_f must be None or a number > 0. Got {limit!r}.")
+        try:
+            solver.solve(Profile(heights.copy(), spacing), np.array([10 * limit * unit]), "force", slopes.copy())
+        except ValueError as exc:
+            if f"{limit:g}" not in str(exc):
+                fail(cls, f"the refusal of a force at f = 10 max_f must name the limit {limit:g}. Got: {exc}")
+        except Exception as exc:
+            fail(cls, f"a force at f = 10 max_f must raise ValueError. Got {type(exc).__name__}: {exc}", exc)
+        else:
+            fail(cls, f"max_f is {limit:g}, but a force at f = 10 max_f was accepted; it must raise ValueError")
+    full = call(cls, "full_contact_load(profile)", solver.full_contact_load, Profile(heights.copy(), spacing))
+    if full is None:
+        return
+    if isinstance(full, bool) or not isinstance(full, (int, float)) or not (np.isfinite(full) and full >= 0):
+        fail(cls, f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}.")
+    curve = _solve(cls, solver, heights, spacing, slopes, np.array([1.01 * full or unit]))
+    if int(count_of(curve)[0]) != heights.size:
+        fail(cls, f"full_contact_load(profile) = {full:g}, but 1.01 times it puts {int(count_of(curve)[0])} of "
+                  f"{heights.size} points in contact, not all")  # fmt: skip
 
 
 def _solve(cls, solver, heights, spacing, slopes, loads, control="force", periodic=True):

@@ -52,7 +52,9 @@ class LiveListener:
         scene = run.scene
         steps = scene.loads.size
         self._loads = scene.loads.astype(float)
-        self._force_control = scene.control == "force"
+        self._force_control = not scene.forces_vary  # forces the same for every realization: the solver's loads
+        if self._force_control:
+            self._loads = scene.solver_loads.astype(float)
         self._force_unit = math.nan
         self._f_formula = scene.normalisation.formula
         self._ok = 0

@@ -31,7 +31,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, half_load_points, load_finished
 
 from .arrays import namespace
 from .checks import check_control, check_loads, check_profile
@@ -135,6 +135,7 @@ class PeriodicBEM(ContactSolver):
         slope_rms = np.empty(steps)
         iterations = np.zeros(steps, dtype=np.int64)
         residual = np.zeros(steps)
+        half = np.empty(steps, dtype=np.int64)
 
         if scale == 0.0:  # a flat profile: every load presses every point evenly
             if control == "indentation":
@@ -152,6 +153,7 @@ class PeriodicBEM(ContactSolver):
                 real_gradient_rms=real_gradient,
                 contact_spots=spots,
                 extras={"iterations": iterations, "residual": residual},
+                half_load_points=np.full(steps, (points + 1) // 2, dtype=np.int64),
             )
 
         depth /= scale
@@ -190,6 +192,7 @@ class PeriodicBEM(ContactSolver):
             contact = pressure > 0.0
             n = int(np.count_nonzero(contact))
             count[j] = n
+            half[j] = half_load_points(pressure)
             if corrected is not None and n < points:
                 corrected[j] = corrected_area_fraction(contact)
             if real_gradient is not None and n < points:
@@ -218,7 +221,21 @@ class PeriodicBEM(ContactSolver):
             real_gradient_rms=real_gradient,
             contact_spots=spots,
             extras={"iterations": iterations, "residual": residual},
+            half_load_points=half,
         )
+
+    def full_contact_load(self, profile: Profile) -> float | None:
+        """The load whose uniform part, added to the pressure that flattens the periodic
+        profile, leaves no pressure negative (exact: the solver's own full-contact threshold)."""
+        heights = np.asarray(profile.heights, dtype=float)
+        depth = heights.max() - heights
+        scale = float(depth.max())
+        if not profile.periodic or not np.isfinite(scale) or heights.ndim not in self.dimensions:
+            return None
+        if scale == 0.0:
+            return 0.0  # flat: every point touches at once
+        force_unit = self.stiffness() * scale * profile.spacing ** (heights.ndim - 1) * heights.size
+        return -float(PeriodicHalfSpace(depth.shape).pressure_of(-depth / scale).min()) * force_unit
 
 
 class BEMHalfPlane(PeriodicBEM):
@@ -228,7 +245,9 @@ class BEMHalfPlane(PeriodicBEM):
     )
     dimensions: ClassVar[tuple[int, ...]] = (1,)
     # plane strain: the line is a ridged surface, straight in depth; its load is a force per unit depth
-    normalisations = {1: ForceNormalisation(load="force per unit depth", modulus="E*", extent="one")}
+    normalisations = {
+        1: ForceNormalisation(load="force per unit depth", modulus="E*", extent="one", pressure_area="profile")
+    }
     problem: ClassVar[str] = "elastic half-plane (plane strain)"
 
 
@@ -238,7 +257,7 @@ class BEMHalfSpace(PeriodicBEM):
         "exact elastic half-space under a periodic surface: FFT boundary elements, preconditioned CG"
     )
     dimensions: ClassVar[tuple[int, ...]] = (2,)
-    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
+    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length", pressure_area="profile")}
     problem: ClassVar[str] = "elastic half-space"
     references: ClassVar[tuple[str, ...]] = (POLONSKY_KEER, YASTREBOV_ANCIAUX_MOLINARI)
     # the pixel count's perimeter correction (contact_area.py) is derived for a surface's pixel edges

@@ -21,12 +21,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished
+from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, half_load_points, load_finished, mdr_length
 
 from .arrays import host, namespace, on_device
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
-from .contact_area import contact_spots, corrected_gradient_rms
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, contact_spots, corrected_area_fraction, corrected_gradient_rms
 from .contact_cg import next_pressure, solve_load
 from .elastic import FFTPair, PeriodicHalfSpace
 
@@ -117,9 +117,15 @@ class BEMHalfSpaceFree(PeriodicBEM):
         "exact elastic half-space under a non-periodic surface (a scan): zero-padded FFT boundary elements, "
         "preconditioned projected CG"
     )
-    references: ClassVar[tuple[str, ...]] = PeriodicBEM.references + (LOVE, HOCKNEY)
+    references: ClassVar[tuple[str, ...]] = PeriodicBEM.references + (LOVE, HOCKNEY, YASTREBOV_ANCIAUX_MOLINARI)
     dimensions: ClassVar[tuple[int, ...]] = (2,)
-    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length")}
+    normalisations = {2: ForceNormalisation(load="force", modulus="E*", extent="mdr length", pressure_area="profile")}
+    # the perimeter correction counts the edges inside the scan only: its border is no contact edge
+    corrected_area: ClassVar[bool] = True
+    # The CG's single-precision steps hold pressures (in units of E* s / dx) up to 3.4e38 and
+    # overflow from f ~ 1e38 on (measured on 32^2 to 256^2 scans); 1e30 leaves 8 decades for
+    # the grid's size. Full contact comes near f ~ 1: no physical load comes near.
+    max_f: ClassVar[float | None] = 1e30
     problem: ClassVar[str] = "elastic half-space"
     indentation_reference: ClassVar[str] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = False  # per surface: extras["mean_displacement"]
@@ -152,8 +158,21 @@ class BEMHalfSpaceFree(PeriodicBEM):
         real_gradient = np.full(steps, line_rms)  # full contact: every pixel counts whole
         spots = np.ones(steps)  # full contact: one spot
         iterations, residual = np.zeros(steps, dtype=np.int64), np.zeros(steps)
+        half, corrected = np.empty(steps, dtype=np.int64), np.empty(steps)
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
+        if control == "force":  # f of this surface: its own rms height h, L = 2 sqrt(A / pi)
+            limit = self.max_f * self.stiffness() * float(np.std(heights)) * mdr_length(profile.area)
+            if float(loads.max()) > limit:
+                raise ValueError(
+                    f"load {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
+                    f"f = F / (E* h L) <= {self.max_f:g}, F <= {limit:.6g} on this surface"
+                )
+        elif float(loads.max()) > self.max_f * scale:  # the pressures of an approach of d grow as E* d / dx
+            raise ValueError(
+                f"indentation {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
+                f"at most {self.max_f:g} times the height range, {self.max_f * scale:.6g} on this surface"
+            )
         depth /= scale
         operator = FreeHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
         cg = self.contact_cg(operator, depth)
@@ -169,6 +188,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
             )
             contact = pressure > 0.0
             count[j] = n = int(np.count_nonzero(contact))
+            half[j] = half_load_points(pressure)
+            corrected[j] = corrected_area_fraction(contact, periodic=False)
             force[j] = load if control == "force" else float(pressure.mean()) * force_unit
             indentation[j] = approach * scale if control == "force" else load
             shift[j] = float(np.mean(host(cg.gap) - depth)) * scale  # the exact gap holds the displacement
@@ -183,7 +204,13 @@ class BEMHalfSpaceFree(PeriodicBEM):
             contact_count=count,
             contact_fraction=count / points,
             slope_rms_contact=slope_rms,
+            real_area_corrected=corrected,
             real_gradient_rms=real_gradient,
             contact_spots=spots,
             extras={"iterations": iterations, "residual": residual, "mean_displacement": shift},
+            half_load_points=half,
         )
+
+    def full_contact_load(self, profile: Profile) -> float | None:
+        """Not known short of a solve: the border of a free scan carries the most pressure."""
+        return None

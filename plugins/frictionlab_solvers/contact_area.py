@@ -11,7 +11,9 @@ overestimates the area by a strip along the perimeter, an error that decays only
 
 with N the pixels in contact and M the edges between a contact and a free pixel
 along rows and columns. The derivation is for the pixel edges of a surface on a
-half-space; the solvers of lines report no corrected area.
+half-space; the solvers of lines report no corrected area. On a periodic map the
+last row and column neighbour the first; on a scan (a free boundary) they do not,
+and the scan's border is no contact edge (the pressure there is cut, not falling to zero).
 """
 
 from __future__ import annotations
@@ -24,9 +26,10 @@ YASTREBOV_ANCIAUX_MOLINARI = "10.48550/arXiv.1701.02727"  # Tribol. Int. 2017
 PERIMETER_COEFFICIENT = (math.pi - 1.0 + math.log(2.0)) / 24.0
 
 
-def contact_edges(contact: np.ndarray) -> int:
+def contact_edges(contact: np.ndarray, periodic: bool = True) -> int:
     """M: edges between a contact and a free pixel along the rows and columns of a
-    periodic map (the last row and column neighbour the first)."""
+    map: with ``periodic``, the last row and column neighbour the first; without, only
+    the pairs inside the map count."""
     contact = np.asarray(contact, dtype=bool)
     if contact.ndim != 2:
         raise ValueError(f"contact must be a map of shape (Ny, Nx). Got shape {contact.shape} instead.")
@@ -34,16 +37,16 @@ def contact_edges(contact: np.ndarray) -> int:
     for axis in (0, 1):
         inner = np.count_nonzero(np.diff(contact, axis=axis))  # pairs that differ inside the map
         wrap = np.count_nonzero(contact.take(0, axis=axis) != contact.take(-1, axis=axis))
-        edges += inner + (wrap if contact.shape[axis] > 1 else 0)
+        edges += inner + (wrap if periodic and contact.shape[axis] > 1 else 0)
     return int(edges)
 
 
-def corrected_area_fraction(contact: np.ndarray) -> float:
+def corrected_area_fraction(contact: np.ndarray, periodic: bool = True) -> float:
     """(N - c M) / pixels: the perimeter-corrected real area, a fraction of the nominal
-    area, of the periodic contact map ``contact`` (True where in contact)."""
+    area, of the contact map ``contact`` (True where in contact; ``contact_edges``)."""
     contact = np.asarray(contact, dtype=bool)
     count = int(np.count_nonzero(contact))
-    return (count - PERIMETER_COEFFICIENT * contact_edges(contact)) / contact.size
+    return (count - PERIMETER_COEFFICIENT * contact_edges(contact, periodic)) / contact.size
 
 
 def contact_weights(contact: np.ndarray, *, periodic: bool = True) -> np.ndarray:

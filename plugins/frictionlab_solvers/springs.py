@@ -24,7 +24,9 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile, defined_rms
+from frictionlab import (
+    ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile, defined_rms, half_load_points,
+)  # fmt: skip
 
 from .checks import check_control, check_loads, check_profile
 from .elastic import ElasticParams, elastic_stiffness
@@ -66,11 +68,32 @@ def _line_rms(slopes: np.ndarray) -> float:
 # ------------------------------------------------------------ the sorted sweep
 
 
-def _curve(force, indentation, count, points: int, slope_rms, extras: dict) -> ContactCurve:
+def _curve(force, indentation, count, points: int, slope_rms, extras: dict, half) -> ContactCurve:
     """The answer over the sweep: ``count`` of the ``points`` springs in contact at each load."""
     count = np.asarray(count).astype(np.int64, copy=False)
     return ContactCurve(force=force, indentation=indentation, contact_count=count, contact_fraction=count / points,
-                        slope_rms_contact=slope_rms, extras=extras)  # fmt: skip
+                        slope_rms_contact=slope_rms, extras=extras, half_load_points=half)  # fmt: skip
+
+
+def _half_load_points(u: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Per load, the fewest springs carrying half its force: the k shallowest of the ``n`` in
+    contact at indentation ``d`` (sorted depths ``u``), the smallest k whose share
+    k d - sum(u[:k]) reaches half of n d - sum(u[:n]) (a share that grows with k: a
+    bisection over k for every load at once, log2(max n) steps)."""
+    most = int(n.max())
+    prefix = np.concatenate([[0.0], np.cumsum(u[:most])])
+    half = 0.5 * (n * d - prefix[n])
+    if n.size * most <= 1 << 16:  # small: every share at once (the bisection's steps cost more)
+        k = np.arange(1, most + 1)
+        short = (k * d[:, None] - prefix[1:] < half[:, None]) & (k <= n[:, None])  # the k short of half, in contact
+        return np.count_nonzero(short, axis=1) + 1
+    low, high = np.ones_like(n), n.copy()  # the answer lies in [low, high]
+    for _ in range(int(n.max()).bit_length()):
+        middle = (low + high) >> 1
+        enough = middle * d - prefix[middle] >= half
+        high = np.where(enough, middle, high)
+        low = np.where(enough, low, middle + 1)
+    return low
 
 
 class SpringRow(ContactSolver):
@@ -169,7 +192,13 @@ class SpringRow(ContactSolver):
                 slope_rms[full] = _line_rms(slopes)
 
         candidates = np.full(loads.size, count, dtype=np.int64)
-        return _curve(force, indentation, n, points, slope_rms, {"candidates": candidates})
+        half = _half_load_points(u, n, indentation)
+        return _curve(force, indentation, n, points, slope_rms, {"candidates": candidates}, half)
+
+    def full_contact_load(self, profile: Profile) -> float | None:
+        """K sum(z - min z): past it the deepest spring too is compressed."""
+        heights = np.asarray(profile.heights, dtype=float)
+        return float(self.stiffness() * profile.spacing**heights.ndim * np.sum(heights - heights.min()))
 
 
 # -------------------------------------------------------------------- plugins
@@ -184,7 +213,7 @@ class MDRSprings(SpringRow):
     # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene),
     # whose length is 2 sqrt(A / pi): F / (E* h L) is then the surface's own 3D f
     dimensions: ClassVar[tuple[int, ...]] = (1,)
-    normalisations = {1: ForceNormalisation(load="force", modulus="E*", extent="length")}
+    normalisations = {1: ForceNormalisation(load="force", modulus="E*", extent="length", pressure_area="mdr disc")}
     problem: ClassVar[str] = "elastic half-space"
     approximation: ClassVar[bool] = True  # the 3D contact of an isotropic surface, reduced to a line
     contact_measure: ClassVar[str] = "mdr springs"
@@ -277,6 +306,7 @@ class BisectionSprings(MDRSprings):
         slope_rms = np.empty(steps)
         iterations = np.zeros(steps, dtype=np.int64)
         residual = np.zeros(steps)
+        half = np.empty(steps, dtype=np.int64)
         tolerance = self.params.tolerance
 
         for j, load in enumerate(loads):
@@ -309,5 +339,7 @@ class BisectionSprings(MDRSprings):
             indentation[j] = d
             count[j] = int(contact.sum())
             slope_rms[j] = _line_rms(slopes[contact])
+            half[j] = half_load_points(np.where(contact, np.maximum(d - depth, 0.0), 0.0))
 
-        return _curve(force, indentation, count, points, slope_rms, {"iterations": iterations, "residual": residual})
+        extras = {"iterations": iterations, "residual": residual}
+        return _curve(force, indentation, count, points, slope_rms, extras, half)

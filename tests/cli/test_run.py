@@ -44,7 +44,8 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
     assert 0 < fit["r2"] <= 1
     with open(out / "curve.csv") as fh:
         rows = [{column_name(k): v for k, v in row.items()} for row in csv.DictReader(fh)]
-    assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation"]
+    assert list(rows[0]) == ["F", "f", "xi", "xi_sem", "lines_used", "contact_count", "contact_fraction", "indentation",
+                            "half_load_points"]
     assert len(rows) == 16
     # the load and f say what they are: MDR's load is a force, f = F / (E* h L)
     header = (out / "curve.csv").read_text().splitlines()[0]

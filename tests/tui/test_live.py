@@ -83,3 +83,15 @@ def test_a_followed_resume_counts_its_restored_realizations_once_and_as_restored
     np.testing.assert_allclose(posted[0].xi, stopped.xi, rtol=1e-12)
     np.testing.assert_allclose(posted[-1].xi, resumed.xi, rtol=1e-12)  # each realization once
     assert posted[-1].finished
+
+
+@pytest.mark.parametrize("unit, start, stop", [("f", 1e-4, 1e-2), ("pressure", 1e-7, 1e-5)])
+def test_live_f_of_loads_given_as_f_or_a_pressure_is_the_run_s(registry, unit, start, stop):
+    """The snapshot's f is formed from the solver's forces, not from the numbers the preset gives."""
+    loading = {"unit": unit, "start": start, "stop": stop, "spacing": "log"}
+    scene = build_scene(merge(TINY, {"realizations": 3, "loading": loading}), registry=registry)
+    posted = []
+    outcome = engine_run(scene, RunOptions(workers=1), listeners=[LiveListener(posted.append, interval=3600.0)])
+    np.testing.assert_allclose(posted[-1].f, outcome.f, rtol=1e-12)
+    if unit == "f":
+        np.testing.assert_allclose(outcome.f, np.geomspace(start, stop, scene.loads.size), rtol=1e-12)
