@@ -519,6 +519,8 @@ class FrictionlabApp(App):
 
     def _follow_tick(self) -> None:
         followed = self.followed
+        if followed is not None and not isinstance(followed, FollowedSweep) and followed.progress_problem():
+            self._count_from_chunks(followed)
         if followed is None or not followed.poll():
             return
         self.followed = None
@@ -536,6 +538,15 @@ class FrictionlabApp(App):
             self.reload_runs()
             return
         self.on_run_finished(RunFinished(finished, followed.folder))
+
+    def _count_from_chunks(self, followed: FollowedRun) -> None:
+        """A run whose progress file cannot be written: said once; its count read from its chunks."""
+        if not followed.said_progress_problem:
+            followed.said_progress_problem = True
+            self.say(f"{followed.progress_problem()}: the count comes from the run's chunks, without a live plot", "warning")
+        done, total = followed.stored_count()
+        if total and (pane := self._mounted(RunPane)) is not None:
+            pane.show_stored_count(done or 0, total)
 
     def action_cancel_run(self) -> None:
         if not self.running:

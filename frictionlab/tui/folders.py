@@ -16,8 +16,8 @@ from pathlib import Path
 
 import yaml
 
-from ..detached import run_state
-from ..errors import FrictionlabError
+from ..detached import RUN_MARKERS, SWEEP_FILE, damage_reason, run_state
+from ..errors import FrictionlabError, RunFolderError
 from ..files import atomic_write
 from ..inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
@@ -173,6 +173,7 @@ class RunEntry:
     summary: dict
     mtime: float
     curve: dict[str, list[float]] = field(default_factory=dict)
+    reason: str = ""  # why a damaged folder (status "damaged") cannot be read
 
     @property
     def a(self) -> float:
@@ -257,30 +258,51 @@ def read_sweep(folder: Path) -> SweepEntry:
 
 
 def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
-    """Every folder under ``runs_dir`` with a readable summary.json (a run) or
-    sweep.json (a sweep), newest first."""
+    """Every run folder under ``runs_dir`` (one with a summary.json, a run.json, or a
+    sweep's sweep.json), newest first; one whose files cannot be read is listed as
+    damaged with the reason, never left out."""
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
     entries = []
     for folder in runs_dir.iterdir():
-        entry, marked = None, False
-        for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
-            if not os.path.lexists(folder / marker):
-                continue
-            marked = True
-            try:
-                entry = read(folder)
-            except (OSError, FrictionlabError):
-                pass  # a damaged or foreign folder, a link, a FIFO: not one to list
-            break
-        if isinstance(entry, SweepEntry) and entry.status == "running":
-            entry = _sweep_with_state(entry)
-        elif (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
-            entry = _with_state(folder, entry)  # a run going on, or one that ended before its summary
+        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
+            continue
+        try:
+            entry = _entry(folder)
+        except (OSError, FrictionlabError) as exc:
+            entry = _damaged(folder, exc)
         if entry is not None:
             entries.append(entry)
     return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
+
+
+def _entry(folder: Path) -> RunEntry | SweepEntry | None:
+    """The folder's run or sweep as it is now (OSError, FrictionlabError if it cannot be read)."""
+    if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):
+        entry = read_sweep(folder)
+        return _sweep_with_state(entry) if entry.status == "running" else entry
+    if not os.path.lexists(folder / STATE_FILE):  # a summary alone (copied without its run.json)
+        return read_run(folder)
+    state = run_state(folder)  # run.json: running, or ended (and how); damaged if its summary is
+    if state.status == "damaged":
+        return _damaged(folder, RunFolderError(state.reason or "damaged"), state.name)
+    if state.status == "running" or not os.path.lexists(folder / "summary.json"):
+        # a run going on (its summary, if any, is an earlier run's), or one that ended before its summary (killed)
+        mtime = os.lstat(folder / STATE_FILE).st_mtime
+        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
+    entry = read_run(folder)
+    entry.status = state.status
+    return entry
+
+
+def _damaged(folder: Path, error: Exception, name: str = "") -> RunEntry:
+    reason = damage_reason(folder, error) if isinstance(error, FrictionlabError) else (error.strerror or str(error))
+    try:
+        mtime = folder.lstat().st_mtime
+    except OSError:
+        mtime = 0.0
+    return RunEntry(folder, name or folder.name, "damaged", 0, 0, None, {}, mtime, reason=reason)
 
 
 def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
@@ -289,20 +311,4 @@ def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
         entry.status = run_state(entry.path).status
     except (OSError, FrictionlabError):
         pass
-    return entry
-
-
-def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:
-    """A run folder as its process left it: running (its summary, if any, is an earlier
-    run's), or ended without a summary (killed): listed, so that it can be followed or resumed."""
-    try:
-        state = run_state(folder)
-    except (OSError, FrictionlabError):
-        return entry
-    if entry is None:
-        mtime = os.lstat(folder / STATE_FILE).st_mtime
-        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
-    entry.status = state.status
-    if state.status == "running":
-        entry.done, entry.fit = state.done or 0, None  # the fit shown would be the earlier run's
     return entry

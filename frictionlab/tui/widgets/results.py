@@ -15,7 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
-from ...errors import FrictionlabError
+from ...errors import FrictionlabError, shown
 from ...fit import format_interval
 from ..chart import Series
 from ...results import read_curve
@@ -107,6 +107,8 @@ class ResultsPane(Vertical):
         for entry in self.runs:
             if isinstance(entry, SweepEntry):
                 a, b = "sweep", f"{len(entry.points)} pts"
+            elif entry.status == "damaged":
+                a, b = "damaged", ""
             else:
                 a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
                 b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
@@ -133,6 +135,10 @@ class ResultsPane(Vertical):
                 self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
+            if entry.status == "damaged":  # nothing to show but why
+                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning")
+                self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return

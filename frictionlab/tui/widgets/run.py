@@ -163,6 +163,11 @@ class RunPane(Vertical, can_focus=True):
         if snap.first_error:
             self._error(snap.first_error)
 
+    def show_stored_count(self, done: int, total: int) -> None:
+        """The count the run folder's chunks hold (when there is no progress file to read)."""
+        self.query_one("#run-bar", ProgressBar).update(total=total, progress=done)
+        self._set("run-stats", f"{done}/{total} realizations stored (read from the run's chunks)")
+
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the solves running stop; what finished is kept")
 
