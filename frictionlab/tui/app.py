@@ -145,14 +145,11 @@ class FrictionlabApp(App):
     def action_show_tab(self, tab: str) -> None:
         self.query_one("#tabs", TabbedContent).active = tab
         focus = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}[tab]
-        widget = self.query_one(focus)
-        if tab == "edit":
-            fields = [w for w in widget.query("Input, Select, Switch") if w.focusable]
-            widget = fields[0] if fields else widget
-        widget.focus()
+        self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
 
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
-        self.refresh_bindings()
+        if self.screen_stack:  # not once the app has closed (a late message)
+            self.refresh_bindings()
 
     def action_help(self) -> None:
         """Textual's key panel: the keys of the focused widget and of the app, as they change.
@@ -168,9 +165,11 @@ class FrictionlabApp(App):
         else:
             self.action_hide_help_panel()
 
-    def action_help_quit(self) -> None:
+    def action_help_quit(self, in_field: bool = False) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
-        self.say("Ctrl+Q quits (q too, outside a text field); a run goes on after you quit unless you cancel it.")
+        where = "Ctrl+C copies in a text field. " if in_field else ""
+        self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
+                 "a run goes on after you quit unless you cancel it.")  # fmt: skip
 
     # ------------------------------------------------------------ the status line
 

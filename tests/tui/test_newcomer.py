@@ -34,3 +34,46 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
         await pilot.press(*["down"] * row, "enter")
         await pilot.pause()
         assert "seed2 is damaged: summary.json" in status_text(app) and "link" in status_text(app)
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("route", ["command line", "list"])
+@sync
+async def test_q_on_a_freshly_opened_preset_quits_and_never_types(folders, registry, route):
+    """Opened either way, the form has the focus, not its `name` field: q quits (it typed
+    `smallq` into the name before); the footer offers Enter into the fields."""
+    app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        if route == "list":
+            await pilot.press("enter")
+            await pilot.pause()
+        screen = screen_text(app)
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert "(saved)" in screen and "smallq" not in screen
+    assert "Enter or Tab: into the fields" in screen
+    assert "⏎ Edit" in screen.splitlines()[-1] or "enter Edit" in screen.splitlines()[-1]
+    assert quit_by_q
+
+
+@pytest.mark.long
+@sync
+async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("enter", "x")  # into name, typed
+        await pilot.pause()
+        typed = app.query_one("#field--name").value
+        footer_in_field = screen_text(app).splitlines()[-1]
+        await pilot.press("escape")
+        await pilot.pause()
+        left = app.focused.id
+        app.modified = False
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert typed == "smallx" and "Leave field" in footer_in_field
+    assert left == "form" and quit_by_q

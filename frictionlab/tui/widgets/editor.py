@@ -14,6 +14,9 @@ from .form import PresetForm
 from .pathline import PathLine
 
 
+FORM_HINT = "Enter or Tab: into the fields (Esc comes back out); arrows scroll; q quits"
+
+
 class EditPane(Vertical):
     def __init__(self, registry, **kwargs):
         super().__init__(**kwargs)
@@ -52,5 +55,11 @@ class EditPane(Vertical):
 
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
         spec = event.spec
-        text = "" if spec is None else f"{spec.dotted}: {spec.help_line()}"
+        form = self.query_one(PresetForm)
+        if spec is not None:
+            text = f"{spec.dotted}: {spec.help_line()}"
+        elif form.has_focus and form.data is not None:
+            text = FORM_HINT
+        else:
+            text = ""
         self.query_one("#field-help", Static).update(Content(text))

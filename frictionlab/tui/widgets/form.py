@@ -11,6 +11,7 @@ import copy
 from pathlib import Path
 
 import yaml
+from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.message import Message
@@ -42,7 +43,16 @@ def _section_id(path: tuple[str, ...]) -> str:
 
 
 class PresetForm(VerticalScroll):
-    """Edits ``data`` (the preset as a plain mapping, unknown sections kept)."""
+    """Edits ``data`` (the preset as a plain mapping, unknown sections kept).
+
+    A preset opens with the form itself focused, not a field: the app's keys (``q``
+    quits) act there, and typing never edits the preset by surprise. Enter (or Tab)
+    goes into the fields, Esc leaves one."""
+
+    BINDINGS = [
+        Binding("enter", "edit_field", "Edit", tooltip="the fields: Enter or Tab goes in, Esc comes back out"),
+        Binding("escape", "leave_field", "Leave field", tooltip="(back to the form: q, ? and the app's keys act again)"),
+    ]
 
     class Edited(Message):
         """The draft changed (or was loaded): ``problems`` is the headless list; ``read``,
@@ -70,6 +80,7 @@ class PresetForm(VerticalScroll):
         # the value each select or switch shows: Textual also posts Changed when one is mounted
         self._seen: dict[str, object] = {}
         self._marked: dict[str, list[str]] = {}  # widget id -> the messages shown under it
+        self._last_field: Widget | None = None  # the field Enter goes back into
 
     # ------------------------------------------------------------ building
 
@@ -323,7 +334,28 @@ class PresetForm(VerticalScroll):
         if fields:
             fields[0].focus()
 
+    def check_action(self, action: str, parameters) -> bool:
+        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies)."""
+        if action == "edit_field":
+            return self.has_focus and self.data is not None
+        if action == "leave_field":
+            return not self.has_focus
+        return True
+
+    def action_edit_field(self) -> None:
+        fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
+        last = self._last_field if self._last_field in fields else None
+        if last is not None or fields:
+            (last or fields[0]).focus()
+
+    def action_leave_field(self) -> None:
+        self.focus(scroll_visible=False)
+
+    def on_focus(self, event) -> None:
+        self.post_message(self.FieldFocused(None))
+
     def on_descendant_focus(self, event) -> None:
+        self._last_field = event.widget
         widget = event.widget
         spec = self._specs.get(widget.id or "")
         if spec is None and (widget.id or "").startswith("plugin--"):
