@@ -33,6 +33,7 @@ from .folders import (
     preset_folders,
     preset_from_template,
     read_run,
+    runs_signature,
     save_folder,
     save_preset,
     templates,
@@ -47,6 +48,7 @@ from .widgets.presets import NO_PRESETS
 
 NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
+WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
 
 
 class FrictionlabApp(App):
@@ -94,6 +96,7 @@ class FrictionlabApp(App):
         self.last_snapshot = None
         self.last_outcome = None
         self.last_out_dir: Path | None = None
+        self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
 
     # ------------------------------------------------------------ layout
 
@@ -117,6 +120,7 @@ class FrictionlabApp(App):
         self.reload_runs()
         self._show_edit_state()
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
+        self.set_interval(WATCH_SECONDS, self._watch_runs)
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -295,9 +299,10 @@ class FrictionlabApp(App):
         """The app's pane of that class, or None once the app is closing: its widgets are
         gone while a late message or a follow tick still arrives."""
         try:
-            return self.query_one(pane_class)
+            pane = self.query_one(pane_class)
         except NoMatches:
             return None
+        return pane if pane.children else None  # the app is closing: the panes' children go first
 
     def _draft(self) -> dict | None:
         return self.query_one("#form", PresetForm).data
@@ -608,3 +613,14 @@ class FrictionlabApp(App):
 
     def reload_runs(self) -> None:
         self.query_one(ResultsPane).reload(self.runs_dir)
+        self._runs_seen = self._runs_signature()
+
+    def _runs_signature(self) -> tuple:
+        running = [entry.path for entry in self.query_one(ResultsPane).runs if entry.status == "running"]
+        return runs_signature(self.runs_dir, running)
+
+    def _watch_runs(self) -> None:
+        """Results lists every run the moment it starts, from any TUI or the CLI: the runs
+        folder's names and times are looked at, and the list read again only when they changed."""
+        if self._mounted(ResultsPane) is not None and self._runs_signature() != self._runs_seen:
+            self.reload_runs()

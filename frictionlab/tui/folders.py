@@ -277,6 +277,21 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
     return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
 
 
+def runs_signature(runs_dir: Path, running: list[Path] = ()) -> tuple:
+    """What changes when a run starts, writes its manifest or summary, ends, or is removed
+    under ``runs_dir``: the folder's and each run folder's modification time (names and
+    times only, nothing read), and whether each of ``running`` is still held by its process
+    (a run killed with kill -9 changes no file)."""
+    from ..detached import lock_held
+
+    try:
+        top = os.stat(runs_dir).st_mtime_ns
+        folders = sorted((entry.name, entry.stat(follow_symlinks=False).st_mtime_ns) for entry in os.scandir(runs_dir))
+    except OSError:
+        return ()
+    return top, tuple(folders), tuple(lock_held(folder) for folder in running)
+
+
 def _entry(folder: Path) -> RunEntry | SweepEntry | None:
     """The folder's run or sweep as it is now (OSError, FrictionlabError if it cannot be read)."""
     if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):

@@ -4,9 +4,14 @@ offered wherever a run can be resumed."""
 
 import pytest
 
+from frictionlab.detached import start_detached
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.rundir import new_run_folder
 from frictionlab.tui.widgets import ResultsPane
 
-from .conftest import SIZE, make_app, make_runs, screen_text, status_text, sync, wait_until
+from ..conftest import merge
+from .conftest import SIZE, TINY, make_app, make_runs, screen_text, status_text, sync, wait_until
 
 
 @pytest.mark.long
@@ -77,3 +82,33 @@ async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
         quit_by_q = not app.is_running
     assert typed == "smallx" and "Leave field" in footer_in_field
     assert left == "form" and quit_by_q
+
+
+@pytest.mark.long
+@sync
+async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(folders, registry):
+    """A run started by another TUI (here its detached process, as that TUI starts it) is
+    listed while it runs, without r: the runs folder is watched. The highlighted run stays
+    highlighted as rows are added above it."""
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        pane = app.query_one(ResultsPane)
+        await pilot.press("down")
+        await pilot.pause()
+        highlighted = pane.runs[app.query_one("#runs-table").cursor_row].path
+        scene = build_scene(merge(TINY, {"name": "elsewhere", "realizations": 100_000}), registry=registry)
+        out = new_run_folder("elsewhere", "runs")
+        process = start_detached(scene.resolved(), out, RunOptions(workers=1), plot=False)
+        try:
+            await wait_until(pilot, lambda: any(e.path.name == out.name and e.status == "running" for e in pane.runs), 30)
+            screen = screen_text(app)
+            cursor = pane.runs[app.query_one("#runs-table").cursor_row].path
+        finally:
+            process.terminate()
+            process.wait()
+        await wait_until(pilot, lambda: any(e.path.name == out.name and e.status != "running" for e in pane.runs), 30)
+    assert any("▶" in line and "elsew" in line for line in screen.splitlines()), screen  # its name cut to fit
+    assert cursor == highlighted

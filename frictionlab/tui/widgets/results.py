@@ -46,6 +46,7 @@ class ResultsPane(Vertical):
         self.runs: list[RunEntry | SweepEntry] = []
         self.overlay: list[RunEntry] = []  # the runs drawn, at most one per style
         self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
+        self._shown: list[Path] = []  # the folders the list shows, in its order
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -98,6 +99,10 @@ class ResultsPane(Vertical):
         """The list of runs, each name shortened from the middle to the width the list has."""
         table = self.query_one("#runs-table", DataTable)
         row = table.cursor_row
+        was = self._shown[row] if 0 <= row < len(self._shown) else None
+        if was is not None and was in [entry.path for entry in self.runs]:  # the run highlighted stays so
+            row = [entry.path for entry in self.runs].index(was)
+        self._shown = [entry.path for entry in self.runs]
         width = self._name_width()
         table.clear(columns=True)
         table.add_column("", width=FIXED_COLUMNS[0], key="status")
