@@ -18,8 +18,16 @@ from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..detached import check_startable, check_sweep_startable, list_run_states, run_state, start_detached
-from ..errors import FrictionlabError, PresetError, RunFolderError
+from ..detached import (
+    check_startable,
+    check_sweep_startable,
+    list_run_states,
+    lock_held,
+    lock_holder,
+    run_state,
+    start_detached,
+)
+from ..errors import FrictionlabError, PresetError, RunFolderError, shown
 from ..files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, load_preset_file, resolve_input_paths
@@ -96,6 +104,7 @@ class FrictionlabApp(App):
         self.last_snapshot = None
         self.last_outcome = None
         self.last_out_dir: Path | None = None
+        self.last_resumable = False  # the last run shown ended before it completed, and can go on (u)
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
 
     # ------------------------------------------------------------ layout
@@ -422,7 +431,10 @@ class FrictionlabApp(App):
         try:
             state = run_state(folder)
             if state.status == "running":
-                self.show_running(folder)
+                if self.followed is None:
+                    self._follow_the_winner(folder, state.pid)
+                else:
+                    self.show_running(folder)
                 return
             if state.kind == "sweep" and state.status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
@@ -438,6 +450,16 @@ class FrictionlabApp(App):
         stored = self._stored_or_say(folder, "resume")
         if stored is not None:
             self._start(*stored, folder, replace(self.run_options, resume=True))
+
+    def _follow_the_winner(self, folder: Path, pid: int | None = None) -> None:
+        """A resume that another process (a TUI, the CLI) began first: follow that one, and say so."""
+        self.follow_run(folder)
+        if self.followed is None:
+            return  # the status line says why it cannot be followed
+        self.action_show_tab("run")
+        pid = pid or lock_holder(folder)
+        self.say(f"{shown(folder.name)} was resumed by another process first (pid {pid or 'unknown'}): "
+                 "this TUI follows that run; c cancels it", "warning")  # fmt: skip
 
     def _stored(self, folder: Path):
         """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
@@ -459,6 +481,7 @@ class FrictionlabApp(App):
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
         self.last_outcome = None
+        self.last_resumable = False
         self.refresh_bindings()
         try:  # refused here, at once, what the run would refuse as it begins
             if sweep is None:
@@ -466,7 +489,10 @@ class FrictionlabApp(App):
             else:
                 check_sweep_startable(sweep, out_dir, options)
         except FrictionlabError as exc:
-            self.say(str(exc), "error", title="Run failed")
+            if options.resume and lock_held(out_dir):  # another TUI (or the CLI) resumed it first
+                self._follow_the_winner(out_dir)
+                return
+            self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run")
             return
         try:
             preset = scene.resolved() if sweep is None else sweep.preset_data
@@ -505,6 +531,7 @@ class FrictionlabApp(App):
             return
         scene, sweep = stored
         self.last_outcome = None
+        self.last_resumable = False
         self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
         self.followed = self._follower(folder, scene, sweep)
         self.refresh_bindings()
@@ -528,8 +555,13 @@ class FrictionlabApp(App):
         if followed is None or not followed.poll():
             return
         self.followed = None
+        self.last_out_dir = followed.folder
+        self.last_resumable = _resumable(followed.folder)  # however it ended: u offered when it can go on
         self.refresh_bindings()
         if followed.error:
+            if lock_held(followed.folder) and followed.process is not None:  # ours lost the folder to another's resume
+                self._follow_the_winner(followed.folder)
+                return
             self.on_run_crashed(RunCrashed(followed.error))
             self.reload_runs()
             return
@@ -537,7 +569,8 @@ class FrictionlabApp(App):
             read = read_finished_sweep if isinstance(followed, FollowedSweep) else read_finished
             finished = read(followed.folder)
         except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
-            error = f"the run's process ended without writing its results (u on the Results tab resumes it from {followed.folder})"
+            resume = "u resumes it" if self.last_resumable else "it cannot be resumed"
+            error = f"the run's process ended without writing its results ({resume}: {followed.folder})"
             self.on_run_crashed(RunCrashed(error))
             self.reload_runs()
             return
@@ -624,3 +657,11 @@ class FrictionlabApp(App):
         folder's names and times are looked at, and the list read again only when they changed."""
         if self._mounted(ResultsPane) is not None and self._runs_signature() != self._runs_seen:
             self.reload_runs()
+
+
+def _resumable(folder: Path) -> bool:
+    """Whether the run (or sweep) in ``folder`` ended before it completed and can go on."""
+    try:
+        return run_state(folder).resumable
+    except (OSError, FrictionlabError):
+        return False

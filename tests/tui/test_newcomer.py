@@ -2,9 +2,13 @@
 what the footer says, every run listed as it starts, damaged folders named, resume
 offered wherever a run can be resumed."""
 
-import pytest
+import subprocess
+import sys
 
-from frictionlab.detached import start_detached
+import pytest
+import yaml
+
+from frictionlab.detached import run_state, start_detached, wait_started
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.rundir import new_run_folder
@@ -112,3 +116,85 @@ async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(fol
         await wait_until(pilot, lambda: any(e.path.name == out.name and e.status != "running" for e in pane.runs), 30)
     assert any("▶" in line and "elsew" in line for line in screen.splitlines()), screen  # its name cut to fit
     assert cursor == highlighted
+
+
+LONG = merge(TINY, {"name": "long", "realizations": 100_000})
+
+
+def _footer(app) -> str:
+    return screen_text(app).splitlines()[-1]
+
+
+@pytest.mark.long
+@sync
+async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(folders, registry):
+    """A run that ended without its results (a full disk, kill -9) can be resumed: the Run
+    tab offered no u and said "No run to resume" while Results' u resumed it."""
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        folder = app.followed.folder
+        app.followed.process.kill()  # as the disk filled: no summary written
+        await wait_until(pilot, lambda: app.followed is None)
+        await pilot.pause()
+        footer, said = _footer(app), status_text(app)
+        await pilot.press("u")
+        await pilot.pause()
+        resumed = app.followed is not None and app.followed.folder == folder
+        pid = app.followed.pid if resumed else None
+        said_after = status_text(app)
+        if resumed:
+            app.followed.cancel()
+            await wait_until(pilot, lambda: app.followed is None)
+    assert "u Resume" in footer and "u resumes it" in said
+    assert resumed and said_after.startswith("Resuming long") and f"pid {pid}" in said_after
+
+
+@pytest.mark.long
+@sync
+async def test_a_resume_that_another_process_began_first_is_followed_and_said_in_full(folders, registry):
+    """Two TUIs pressing u on one interrupted run: the one that loses the folder's lock
+    follows the run that won, and says so whole (it said "Run failed: … in use by another
+    run (pid …): wait for it to end, or give another", cut, advice it could not follow)."""
+    out = folders / "runs" / "long"
+    scene = build_scene(LONG, registry=registry)
+    process = start_detached(scene.resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    process.terminate()
+    process.wait()
+    assert run_state(out).status == "interrupted"
+    # the winner: a process that holds the folder's lock, as a resume does before its manifest says "running"
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(out / "run.lock")], stdout=subprocess.PIPE)
+    try:
+        assert holder.stdout.readline().strip() == b"held"
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.pause()
+            await pilot.press("f5", "u")
+            await pilot.pause()
+            following = app.followed is not None and app.followed.folder.resolve() == out.resolve()
+            tab = app.query_one("#tabs").active
+            screen = " ".join(screen_text(app).split())
+            said = status_text(app)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert following and tab == "run", said
+    assert said == (f"long was resumed by another process first (pid {holder.pid}): "
+                    "this TUI follows that run; c cancels it")  # fmt: skip
+    assert said in screen  # whole on the screen, not cut
+    assert "in use" not in said and "output folder" not in said
+
+
+HOLD_LOCK = """
+import fcntl, os, sys
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)
+os.ftruncate(fd, 0)
+os.write(fd, f"pid {os.getpid()}, started now\\n".encode())
+fcntl.flock(fd, fcntl.LOCK_EX)
+print("held", flush=True)
+import time; time.sleep(600)
+"""

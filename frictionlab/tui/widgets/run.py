@@ -89,7 +89,7 @@ class RunPane(Vertical, can_focus=True):
         if action == "cancel":
             return app.running
         if action == "resume":
-            return not app.running and app.last_outcome is not None and app.last_outcome.status != "completed"
+            return not app.running and app.last_resumable
         return not app.running if action == "start" else True
 
     def action_unavailable(self, action: str) -> None:
