@@ -2,6 +2,7 @@
 what the footer says, every run listed as it starts, damaged folders named, resume
 offered wherever a run can be resumed."""
 
+import asyncio
 import subprocess
 import sys
 
@@ -15,7 +16,7 @@ from frictionlab.rundir import new_run_folder
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
-from .conftest import SIZE, TINY, make_app, make_runs, screen_text, status_text, sync, wait_until
+from .conftest import SIZE, TINY, make_app, make_runs, numbers_in, screen_text, status_text, sync, wait_until
 
 
 @pytest.mark.long
@@ -198,3 +199,35 @@ fcntl.flock(fd, fcntl.LOCK_EX)
 print("held", flush=True)
 import time; time.sleep(600)
 """
+
+
+@pytest.mark.long
+@sync
+async def test_a_resume_whose_progress_file_is_a_link_says_so_once_and_counts_its_chunks(folders, registry):
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    while run_state(out).done in (None, 0):  # at least one chunk stored
+        await asyncio.sleep(0.05)
+    process.terminate()
+    process.wait()
+    (out / "progress.jsonl").unlink()
+    (folders / "elsewhere.jsonl").write_text("")
+    (out / "progress.jsonl").symlink_to(folders / "elsewhere.jsonl")
+    app = make_app(registry)
+    said = []
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        original = app.say
+        app.say = lambda text, *a, **k: (said.append(text), original(text, *a, **k))
+        await pilot.press("f5", "u")
+        await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+        await pilot.pause(1.0)
+        stats = str(app.query_one("#run-stats").render())
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    told = [text for text in said if "progress.jsonl" in text and "symbolic link" in text]
+    assert len(told) == 1 and "the count comes from the run's chunks" in told[0]
+    done, total = numbers_in(stats.split(" realizations")[0].replace("/", " "))
+    assert total == 100_000 and done >= 1
+    assert (folders / "elsewhere.jsonl").read_text() == ""  # never written through the link
