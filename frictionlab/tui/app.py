@@ -50,7 +50,7 @@ from .folders import (
 from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
 from .messages import RunCrashed, RunFinished
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen
-from .text import failure_message
+from .text import failure_message, problems_text
 from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
 from .widgets.presets import NO_PRESETS
 
@@ -221,7 +221,7 @@ class FrictionlabApp(App):
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.say("; ".join(exc.problems), "error", title=f"Cannot open {path.name}")
+                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}")
                 return
             self.draft_source = path
         else:
@@ -242,7 +242,7 @@ class FrictionlabApp(App):
         try:
             data = load_preset_file(entry.path)
         except PresetError as exc:
-            self.say("; ".join(exc.problems), "error", title="Cannot duplicate")
+            self.say(problems_text(exc.problems), "error", title="Cannot duplicate")
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
         default = writable_folder(self.folders) / f"{entry.path.stem}-copy.yaml"
@@ -268,7 +268,7 @@ class FrictionlabApp(App):
                 else:
                     data = preset_from_template(template, name, path, self.registry)
             except PresetError as exc:
-                self.say("; ".join(exc.problems), "error", title="Cannot read the template")
+                self.say(problems_text(exc.problems), "error", title="Cannot read the template")
                 return
             self.run_worker(self._open_new(path, data, template), group="open")
 

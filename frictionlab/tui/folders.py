@@ -99,12 +99,21 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
             try:  # read as a preset is: bounded, a regular file, so that a hostile file (a FIFO) cannot stop the listing
                 data = load_yaml(read_regular_file(path, MAX_PRESET_BYTES, "preset file").decode("utf-8"))
             except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
-                entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
+                entries.append(PresetEntry(label, path, path.stem, "", f"cannot be read: {_unreadable(exc)}"))
                 continue
             data = data if isinstance(data, dict) else {}
             description = " ".join(str(data.get("description") or "").split())
             entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
     return entries
+
+
+def _unreadable(exc: Exception) -> str:
+    """Why a preset file cannot be read, in words (never a line of it)."""
+    if isinstance(exc, UnicodeDecodeError):
+        return f"not UTF-8 text (byte {exc.start + 1}); save the preset as UTF-8"
+    if isinstance(exc, OSError):
+        return exc.strerror or "an error of the system"
+    return str(exc)  # YamlProblem, InputFileProblem: they name a line, never quote the text
 
 
 FIRST_TEMPLATE = "quickstart"  # runs in about a second: the template a new preset starts from

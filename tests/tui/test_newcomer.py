@@ -231,3 +231,19 @@ async def test_a_resume_whose_progress_file_is_a_link_says_so_once_and_counts_it
     done, total = numbers_in(stats.split(" realizations")[0].replace("/", " "))
     assert total == 100_000 and done >= 1
     assert (folders / "elsewhere.jsonl").read_text() == ""  # never written through the link
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_is_not_yaml_says_what_is_wrong_in_words_at_its_line(folders, registry):
+    (folders / "presets" / "bad.yaml").write_text("name: bad\nseed: 1\nrealizations: [1, 2\n")
+    app = make_app(registry)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        listed = screen_text(app)
+        await pilot.press("enter")  # bad.yaml is listed first
+        await pilot.pause()
+        said = status_text(app)
+    assert "cannot be read: not valid YAML at line 3" in listed and "YamlProblem" not in listed
+    assert said.startswith("Cannot open bad.yaml: not valid YAML at line 3, column 15: a [ list opened here is not closed")
+    assert "(file)" not in said

@@ -673,7 +673,7 @@ async def test_damaged_runs_and_presets_in_its_folders_never_stop_the_tui(folder
             await pilot.pause()
         results_tab = screen_text(app)
         assert app.is_running
-    assert "huge" in presets_tab and "bomb" in presets_tab and "unreadable" in presets_tab
+    assert "huge" in presets_tab and "bomb" in presets_tab and "cannot be read" in presets_tab
     assert "seed1" in results_tab and "fit-text" in results_tab and "bad-fields" in results_tab
     for name in ("a-list", "deep"):  # listed as damaged, with its mark: never hidden
         assert any(name in line and "✗" in line and "damaged" in line for line in results_tab.splitlines())
