@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
+from textual.actions import SkipAction
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
@@ -45,6 +46,7 @@ from .folders import (
     save_folder,
     save_preset,
     templates,
+    user_presets_dir,
     writable_folder,
 )
 from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
@@ -65,11 +67,17 @@ class FrictionlabApp(App):
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
         Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
-        Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
+        Binding("question_mark", "toggle_keys", "Keys", tooltip="(show or hide), outside a text field", show=False),
+        Binding("escape", "hide_keys", show=False, system=True),  # closes the keys panel (a field's Esc leaves it first)
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
         Binding("f4", "show_tab('run')", "Run tab", show=False, priority=True),
         Binding("f5", "show_tab('results')", "Results tab", show=False, priority=True),
+        # the same tabs where the F-keys are the terminal's (GNOME's F1, a Mac without fn): the F-key's digit
+        Binding("2", "show_tab('presets')", "Presets tab", tooltip="(as F2), outside a text field", show=False),
+        Binding("3", "show_tab('edit')", "Edit tab", tooltip="(as F3), outside a text field", show=False),
+        Binding("4", "show_tab('run')", "Run tab", tooltip="(as F4), outside a text field", show=False),
+        Binding("5", "show_tab('results')", "Results tab", tooltip="(as F5), outside a text field", show=False),
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
         Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
@@ -159,6 +167,7 @@ class FrictionlabApp(App):
         self.query_one("#tabs", TabbedContent).active = tab
         focus = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}[tab]
         self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
+        self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
 
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if self.screen_stack:  # not once the app has closed (a late message)
@@ -177,6 +186,19 @@ class FrictionlabApp(App):
             keys.scroll_page_down(animate=False)
         else:
             self.action_hide_help_panel()
+
+    def action_toggle_keys(self) -> None:
+        """? shows the key panel, or hides it (F1 pages through it)."""
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            self.action_show_help_panel()
+
+    def action_hide_keys(self) -> None:
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            raise SkipAction()  # Esc means nothing here: another part may take it
 
     def action_help_quit(self, in_field: bool = False) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
@@ -369,8 +391,10 @@ class FrictionlabApp(App):
             if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
                 path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
             save_preset(path, data, template=template)
-        except OSError as exc:
-            self.say(f"{path}: {exc.strerror or exc}", "error", title="Not saved")
+        except OSError as exc:  # a read-only folder, not the user's, a file in the way
+            elsewhere = user_presets_dir() / path.name
+            self.say(f"{shown(path)} cannot be written ({exc.strerror or exc}): Ctrl+O saves it elsewhere, "
+                     f"e.g. {shown(elsewhere)}", "error", title="Not saved")  # fmt: skip
             return
         self.say(f"Saved {path}")
         self.reload_presets()
@@ -414,8 +438,10 @@ class FrictionlabApp(App):
         except FrictionlabError as exc:  # the runs folder is a file
             self.say(output_path_problem(self.runs_dir) or str(exc), "error", title="Run failed")
             return
-        except OSError as exc:  # it cannot be made
-            self.say(f"{self.runs_dir}: {exc.strerror or exc}", "error", title="Run failed")
+        except OSError as exc:  # it cannot be made: read-only, not the user's
+            self.say(f"no run folder can be made in {shown(self.runs_dir)} ({exc.strerror or exc}): quit and start "
+                     "the TUI in a folder you can write in, or give one: frictionlab tui --runs DIR", "error",
+                     title="Cannot run")  # fmt: skip
             return
         self._start(scene, sweep, out_dir, self.run_options)
 

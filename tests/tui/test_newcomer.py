@@ -58,6 +58,7 @@ async def test_q_on_a_freshly_opened_preset_quits_and_never_types(folders, regis
         if route == "list":
             await pilot.press("enter")
             await pilot.pause()
+        await wait_until(pilot, lambda: "Edit" in screen_text(app).splitlines()[-1], 10)  # the footer, once refreshed
         screen = screen_text(app)
         await pilot.press("q")
         await pilot.pause()

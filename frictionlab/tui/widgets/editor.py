@@ -10,7 +10,7 @@ from textual.containers import Vertical
 from textual.content import Content
 from textual.widgets import Static
 
-from .form import PresetForm
+from .form import PresetForm, flow_text
 from .pathline import PathLine
 
 
@@ -58,6 +58,8 @@ class EditPane(Vertical):
         form = self.query_one(PresetForm)
         if spec is not None:
             text = f"{spec.dotted}: {spec.help_line()}"
+            if spec.dotted in form.swept:
+                text = f"{spec.dotted} is swept ({flow_text(form.swept[spec.dotted])}): this value is only the base; {spec.help_line()}"
         elif form.has_focus and form.data is not None:
             text = FORM_HINT
         else:

@@ -33,9 +33,9 @@ from ..fields import (
 from .keyinput import KeyInput
 
 
-def _flow(value) -> str:
+def flow_text(value) -> str:
     text = yaml.safe_dump(value, default_flow_style=True, width=10_000).strip()
-    return text if len(text) <= 60 else text[:57] + "..."
+    return text if len(text) <= 400 else text[:397] + "..."  # wrapped on the form: a sweep's values whole
 
 
 def _section_id(path: tuple[str, ...]) -> str:
@@ -117,6 +117,13 @@ class PresetForm(VerticalScroll):
         if unknown:
             yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(map(str, unknown))}"), classes="note")
 
+    @property
+    def swept(self) -> dict[str, object]:
+        """The dotted paths the draft's sweep sets, with their values (as the YAML gives them)."""
+        sweep = self.data.get("sweep") if isinstance(self.data, dict) else None
+        parameters = sweep.get("parameters") if isinstance(sweep, dict) else None
+        return {str(k): v for k, v in parameters.items()} if isinstance(parameters, dict) else {}
+
     def field_rows(self, spec: FieldSpec) -> list[Widget]:
         self._specs[spec.widget_id] = spec
         value = get_path(self.data, spec.path)
@@ -145,8 +152,8 @@ class PresetForm(VerticalScroll):
                 id=spec.widget_id,
             )
             widget.cursor_position = len(widget.value) if spec.kind == "text" else 0  # typing adds to a name
-        else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
-            shown = "(none)" if value in (MISSING, None) else _flow(value)
+        else:  # mappings, lists, optional sections (a sweep): shown whole, kept, edited in the YAML
+            shown = "(none)" if value in (MISSING, None) else flow_text(value)
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
             note = Content.assemble(shown, "  ", ("(edit in the YAML)", "dim"))
             widget = Static(note, id=spec.widget_id, classes="other")
@@ -160,8 +167,11 @@ class PresetForm(VerticalScroll):
         row = [label, widget]
         if spec.kind == "bool":  # the state in words, not in colour only
             row.append(Static(_on_off(bool(current)), id=spec.widget_id + "--state", classes="switch-state"))
+        if spec.dotted in self.swept:  # the sweep sets it: the value here is only the base of the others
+            row.append(Static("swept", classes="swept-mark"))
+        tall = spec.kind not in ("bool", "choice", "int", "float", "text")  # a sweep, a list: shown whole, wrapped
         return [
-            Horizontal(*row, classes="row"),
+            Horizontal(*row, classes="row -tall" if tall else "row"),
             Static("", id=spec.widget_id + "--error", classes="field-error"),
         ]
 

@@ -38,7 +38,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
             *what,
             f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
             f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
-            f"  {level} CI, bootstrap {fit.bootstrap}",
+            f"  {level} CI, bootstrap {fit.bootstrap}" if fit.bootstrap else
+            "  no CI: a bootstrap needs 2+ realizations",  # (or the preset asked for none)
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
     return lines
@@ -62,7 +63,7 @@ def _contact_lines(count) -> list[str]:
 
 class RunPane(Vertical, can_focus=True):
     BINDINGS = [
-        Binding("r", "start", "Run", tooltip="the open preset (again)"),
+        Binding("r", "start", "Run", tooltip="the open preset (again)", show=False),  # the footer has ^r Run
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
