@@ -248,3 +248,84 @@ async def test_a_preset_that_is_not_yaml_says_what_is_wrong_in_words_at_its_line
     assert "cannot be read: not valid YAML at line 3" in listed and "YamlProblem" not in listed
     assert said.startswith("Cannot open bad.yaml: not valid YAML at line 3, column 15: a [ list opened here is not closed")
     assert "(file)" not in said
+
+
+@pytest.mark.long
+@sync
+async def test_the_keys_panel_is_readable_at_80x24_and_tabs_are_reached_without_f_keys(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("question_mark")
+        await pilot.pause()
+        panel = app.screen.query("HelpPanel")
+        width = panel.first().size.width if panel else 0
+        await pilot.press("escape")
+        await pilot.pause()
+        closed_by_esc = not app.screen.query("HelpPanel")
+        await pilot.press("question_mark", "question_mark")
+        await pilot.pause()
+        toggled = not app.screen.query("HelpPanel")
+        tabs = []
+        for key in ("5", "4", "2", "3"):
+            await pilot.press(key)
+            await pilot.pause()
+            tabs.append(app.query_one("#tabs").active)
+        await pilot.press("4")
+        await pilot.pause()
+        run_footer = screen_text(app).splitlines()[-1]
+    assert width >= 44 and closed_by_esc and toggled  # Textual's was 29 wide: every key wrapped
+    assert tabs == ["results", "run", "presets", "edit"]
+    assert "^r Run" in run_footer and " r Run" not in run_footer
+
+
+@pytest.mark.long
+@sync
+async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, registry):
+    data = merge(TINY, {"name": "sw", "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.6, 0.7, 0.8, 0.9]}}}})
+    (folders / "presets" / "sw.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    app = make_app(registry, preset="presets/sw.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#field--spectrum--params--hurst").focus()
+        await pilot.pause()
+        screen = screen_text(app)
+        help_text = str(app.query_one("#field-help").render())
+    hurst = next(line for line in screen.splitlines() if line.startswith("hurst"))
+    assert "swept" in hurst
+    assert help_text.startswith("spectrum.params.hurst is swept ({values: [0.5, 0.6, 0.7, 0.8, 0.9]}): this value is only the base")
+    assert "…" not in help_text and " ".join(help_text.split()) in " ".join(screen.split())  # whole on the screen
+    assert "0.9]}}}" in screen or "0.9]" in screen  # the sweep row's values, whole (they were cut)
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folders, registry, monkeypatch):
+    import frictionlab.tui.app
+
+    def refused(path, data, template=None):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(frictionlab.tui.app, "save_preset", refused)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        said = status_text(app)
+    assert said == (f"Not saved: presets/tiny.yaml cannot be written (Permission denied): Ctrl+O saves it "
+                    f"elsewhere, e.g. {folders / 'mine' / 'tiny.yaml'}")  # fmt: skip
+
+
+def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_no_rate():
+    from frictionlab.fit import LogFit
+    from frictionlab.listeners import progress_text
+    from frictionlab.tui.widgets.run import fit_lines
+
+    nan = float("nan")
+    lines = fit_lines(LogFit(a=0.8, b=0.02, r2=0.99, a_ci=(nan, nan), b_ci=(nan, nan), bootstrap=0), final=True)
+    assert "  no CI: a bootstrap needs 2+ realizations" in lines and not any("bootstrap 0" in line for line in lines)
+    assert progress_text(8, 8, 0, 0.5, restored=8) == "8/8 realizations (8 restored), elapsed 0.5 s"
+    assert progress_text(3, 8, 0, 0.5, restored=3) == "3/8 realizations (3 restored), elapsed 0.5 s"
+    assert "2.0/s" in progress_text(4, 8, 0, 0.5, restored=3) and "left" in progress_text(4, 8, 0, 0.5, restored=3)
