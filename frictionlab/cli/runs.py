@@ -54,7 +54,8 @@ def run(args) -> ExitCode:
         total = "?" if state.total is None else str(state.total)
         status = f"running (pid {state.pid})" if state.pid else state.status
         unit = " points" if state.kind == "sweep" else ""
-        rows.append((str(state.folder), state.name, status, f"{done}/{total}{unit}"))
+        count = "-" if state.status == "damaged" else f"{done}/{total}{unit}"  # the reason follows the table
+        rows.append((str(state.folder), state.name, status, count))
     print_table(["FOLDER", "NAME", "STATUS", "DONE"], rows)
     from ..errors import shown
 
