@@ -318,8 +318,10 @@ def damage_reason(folder: Path, error: Exception) -> str:
     text, prefix = str(error), shown(str(folder))
     for start in (prefix + os.sep, prefix + ": ", prefix + " "):
         if text.startswith(start):
-            return text[len(start):]
-    return text
+            text = text[len(start):]
+            break
+    name, colon, rest = text.partition(": ")
+    return rest if colon and rest.startswith(name + " ") else text  # "sweep.json: sweep.json is ..." said once
 
 
 def _chunk_count(chunks, total: int | None) -> int | None:
