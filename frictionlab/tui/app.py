@@ -10,6 +10,7 @@ starting, resuming and following one is ``running.RunControl``'s part of the app
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from textual.actions import SkipAction
@@ -47,6 +48,7 @@ from .widgets.presets import NO_PRESETS
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
 WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
+REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
 class FrictionlabApp(RunControl, App):
@@ -102,6 +104,7 @@ class FrictionlabApp(RunControl, App):
         self.last_out_dir: Path | None = None
         self.last_resumable = False  # the last run shown ended before it completed, and can go on (u)
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
+        self._runs_read_at = 0.0  # when it was (time.monotonic)
 
     # ------------------------------------------------------------ layout
 
@@ -398,6 +401,7 @@ class FrictionlabApp(RunControl, App):
 
     def reload_runs(self) -> None:
         self.query_one(ResultsPane).reload(self.runs_dir)
+        self._runs_read_at = time.monotonic()
         self._runs_seen = self._runs_signature()
 
     def _runs_signature(self) -> tuple:
@@ -407,5 +411,13 @@ class FrictionlabApp(RunControl, App):
     def _watch_runs(self) -> None:
         """Results lists every run the moment it starts, from any TUI or the CLI: the runs
         folder's names and times are looked at, and the list read again only when they changed."""
-        if self._mounted(ResultsPane) is not None and self._runs_signature() != self._runs_seen:
+        if self._mounted(ResultsPane) is None:
+            return
+        now, seen = self._runs_signature(), self._runs_seen
+        if now == seen:
+            return
+        names = lambda signature: [name for name, _ in signature[1]] if signature else None  # noqa: E731
+        # a run started, removed or ended: at once; a run's files written (a chunk): coalesced, the
+        # list read at most every REREAD_SECONDS (a long list of runs is not read twice a second)
+        if names(now) != names(seen) or now[2:] != seen[2:] or time.monotonic() - self._runs_read_at >= REREAD_SECONDS:
             self.reload_runs()

@@ -29,7 +29,7 @@ from ..sweep import plan_sweep, stored_sweep
 from .folders import read_run
 from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
 from .messages import RunCrashed, RunFinished
-from .screens import QuitDuringRunScreen
+from .screens import ConfirmScreen, QuitDuringRunScreen
 from .text import failure_message
 from .widgets import PresetForm, RunPane
 

@@ -77,7 +77,7 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
         await pilot.pause()
         presets_tab = screen_text(app)
         await open_first_preset(pilot)
-        app.query_one("#plugin--slope").focus()  # its summary is under the select
+        app.query_one("#field--slope--params--ends").focus()  # the plugin's summary is above its first field
         await pilot.pause()
         edit_tab = screen_text(app)
         await pilot.press("f5")
@@ -86,6 +86,7 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
     assert BRACKETS in presets_tab
     assert BracketSlope.summary in edit_tab
     assert "[b]cut[/b]" in edit_tab  # a choice's text
+    assert "ends of the line, as in [2]" in edit_tab  # a description, in the help line
     assert "try[1]" in results_tab
 
 
