@@ -31,6 +31,7 @@ from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json
 
 SWEEP_FILE = "sweep.json"  # what marks a sweep's folder (it has no run.json)
+RUN_MARKERS = (STATE_FILE, "summary.json", SWEEP_FILE)  # a folder holding one is a run's (or was meant to be)
 TAIL_BYTES = 256 * 1024  # of progress.jsonl, read for the count of a listed run
 STARTED_WAIT = 120.0  # seconds ``wait_started`` waits for the run's first event
 STARTED = ("started", "sweep_started")  # the first event of a run, of a sweep
@@ -224,8 +225,9 @@ def lock_held(folder: str | Path) -> bool:
 @dataclass
 class RunState:
     """What a run folder holds now. ``status``: running, completed, cancelled,
-    interrupted or failed; ``pid`` the live run's process (running only). ``kind``:
-    "run", or "sweep" (a sweep's folder: ``done`` and ``total`` count its points)."""
+    interrupted, failed, or damaged (``reason`` says what is wrong: a file that cannot
+    be read as frictionlab writes it); ``pid`` the live run's process (running only).
+    ``kind``: "run", or "sweep" (a sweep's folder: ``done`` and ``total`` count its points)."""
 
     folder: Path
     name: str
@@ -234,6 +236,7 @@ class RunState:
     total: int | None
     pid: int | None = None
     kind: str = "run"
+    reason: str | None = None  # why a damaged folder is (None otherwise)
 
     @property
     def resumable(self) -> bool:
@@ -241,7 +244,7 @@ class RunState:
 
     def to_dict(self) -> dict:
         return {"folder": str(self.folder), "kind": self.kind, "name": self.name, "status": self.status,
-                "done": self.done, "total": self.total, "pid": self.pid}  # fmt: skip
+                "done": self.done, "total": self.total, "pid": self.pid, "reason": self.reason}  # fmt: skip
 
 
 def _count(value) -> int | None:
@@ -264,18 +267,52 @@ def run_state(folder: str | Path) -> RunState:
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
     done, pid = _last_count(folder), None
+    if done is None:  # no progress log to read (a link, never followed): the chunks it stored say
+        done = _chunk_count(manifest.get("chunks"), total)
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
         else:
             status = "interrupted"  # the process that wrote "running" is gone
-    summary = _summary(folder)
-    if summary is not None and status != "running":
+    if status == "running":
+        return RunState(folder, name, status, done, total, pid)
+    try:
+        summary = _summary(folder)
+    except RunFolderError as exc:  # never listed as what run.json says: its results cannot be read
+        return RunState(folder, name, "damaged", done, total, reason=damage_reason(folder, exc))
+    if summary is not None:
         counts = summary.get("realizations") if isinstance(summary.get("realizations"), dict) else {}
         done = _count(counts.get("done")) if _count(counts.get("done")) is not None else done
     if done is not None and total is not None and done > total:  # not a count of this run
         done = None
     return RunState(folder, name, status, done, total, pid)
+
+
+def damage_reason(folder: Path, error: Exception) -> str:
+    """What is wrong with ``folder``, as ``error`` says it, without the folder's path in front."""
+    text, prefix = str(error), shown(str(folder))
+    for start in (prefix + os.sep, prefix + ": ", prefix + " "):
+        if text.startswith(start):
+            text = text[len(start):]
+            break
+    name, colon, rest = text.partition(": ")
+    return rest if colon and rest.startswith(name + " ") else text  # "sweep.json: sweep.json is ..." said once
+
+
+def _chunk_count(chunks, total: int | None) -> int | None:
+    """Realizations the manifest's chunks hold (each chunk's name is its index range)."""
+    from .rundir import CHUNK_NAME
+
+    if not isinstance(chunks, dict):
+        return None
+    indices = set()
+    for name in chunks:
+        match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
+        if match is not None:
+            first, last = int(match[1]), int(match[2])
+            end = last if total is None else min(last, first + total)  # a forged name counts no more than the run has
+            indices.update(range(first, end + 1))
+    return len(indices) if total is None else min(len(indices), total)
 
 
 def sweep_state(folder: str | Path) -> RunState:
@@ -295,10 +332,13 @@ def sweep_state(folder: str | Path) -> RunState:
 
 
 def _summary(folder: Path) -> dict | None:
+    """summary.json, None if there is none; RunFolderError if it is damaged (a link, not JSON, ...)."""
+    if not os.path.lexists(folder / "summary.json"):
+        return None
     try:
         return read_json(folder, "summary.json")
-    except (OSError, FrictionlabError):
-        return None
+    except OSError as exc:
+        raise RunFolderError(f"{shown(folder / 'summary.json')} cannot be read ({exc.strerror or exc})") from None
 
 
 def _last_count(folder: Path) -> int | None:
@@ -322,19 +362,26 @@ def _last_count(folder: Path) -> int | None:
 
 def list_run_states(runs_dir: str | Path) -> list[RunState]:
     """The state of every run folder directly under ``runs_dir`` (one holding a
-    ``run.json``, or a sweep's ``sweep.json``), running ones first, then the newest;
-    links are not followed."""
+    ``run.json``, a ``summary.json``, or a sweep's ``sweep.json``), running ones first,
+    then the newest; links are not followed. A folder whose files cannot be read is
+    listed as damaged, with the reason, never left out."""
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
     states = []
     for folder in runs_dir.iterdir():
-        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in (STATE_FILE, SWEEP_FILE)):
+        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
             continue
         try:
-            states.append((folder.stat().st_mtime, run_state(folder)))
-        except (OSError, FrictionlabError):
-            continue  # damaged or foreign: not one to list
+            mtime = folder.lstat().st_mtime
+        except OSError:
+            continue  # gone since it was listed
+        try:
+            states.append((mtime, run_state(folder)))
+        except (OSError, FrictionlabError) as exc:
+            kind = "sweep" if os.path.lexists(folder / SWEEP_FILE) and not os.path.lexists(folder / STATE_FILE) else "run"
+            reason = damage_reason(folder, exc) if isinstance(exc, FrictionlabError) else (exc.strerror or str(exc))
+            states.append((mtime, RunState(folder, folder.name, "damaged", None, None, kind=kind, reason=reason)))
     states.sort(key=lambda item: (item[1].status != "running", -item[0], item[1].folder.name))
     return [state for _, state in states]
 

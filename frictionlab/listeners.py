@@ -104,11 +104,14 @@ def format_duration(seconds: float) -> str:
 def progress_text(done: int, total: int, failed: int, elapsed: float, restored: int = 0) -> str:
     """``12/40 realizations (8 restored), 1 failed, 3.1/s, elapsed 3.9 s, left 9.0 s``: of this
     invocation, the elapsed time and the rate (not counting the ``restored`` realizations of a
-    resume), and the time left at that rate."""
+    resume), and the time left at that rate; no rate (``0.0/s, left ?``) before the first
+    realization computed here."""
     rate = (done - restored) / elapsed if elapsed > 0 else 0.0
-    left = format_duration((total - done) / rate) if rate > 0 else "?"
     kept = f" ({restored} restored)" if restored else ""
     failures = f", {failed} failed" if failed else ""
+    if rate <= 0:  # none computed here yet (a point a resume restored whole): no rate to tell
+        return f"{done}/{total} realizations{kept}{failures}, elapsed {format_duration(elapsed)}"
+    left = format_duration((total - done) / rate)
     return f"{done}/{total} realizations{kept}{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
 
 

@@ -166,6 +166,23 @@ def check_nodes(root) -> None:
                 stack.append((child, False))
 
 
+_OPENED = {"a flow sequence": "a [ list", "a flow mapping": "a { mapping", "a quoted scalar": "a quoted string"}
+
+
+def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
+    """The parser's complaint, at the line where the fault is: a bracket or a quote left
+    open is found only at the end of the file, so it is told where it was opened."""
+    mark, context = exc.problem_mark or exc.context_mark, exc.context_mark
+    at_end = mark is not None and not text[mark.index:].strip()
+    if at_end and context is not None and exc.context:  # "while parsing a flow sequence" ...
+        what = exc.context.removeprefix("while parsing ").removeprefix("while scanning ")[:60]
+        what = _OPENED.get(what, what)
+        return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: "
+                f"{what} opened here is not closed before the end of the file")  # fmt: skip
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+    return f"not valid YAML{where}: {(exc.problem or exc.context or 'syntax error')[:80]}"
+
+
 def load_yaml(text: str) -> Any:
     """The single YAML document in ``text`` as Python objects (None if empty).
     YamlLimit / YamlProblem name a line and never quote the text."""
@@ -178,10 +195,7 @@ def load_yaml(text: str) -> Any:
         try:
             root = loader.get_single_node()
         except yaml.MarkedYAMLError as exc:
-            mark = exc.problem_mark or exc.context_mark
-            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-            problem = (exc.problem or exc.context or "syntax error")[:80]
-            raise YamlProblem(f"not valid YAML{where}: {problem}") from None
+            raise YamlProblem(_syntax_problem(exc, text)) from None
         except yaml.YAMLError:
             raise YamlProblem("not valid YAML") from None
         if root is None:

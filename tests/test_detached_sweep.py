@@ -102,7 +102,7 @@ def test_the_follower_hears_each_point_with_its_fit_and_skips_what_a_sweep_does_
     assert SweepFollower(out, sweep, [never]).poll() == 0 and never.events == []  # never through a link
 
 
-def test_a_sweep_json_that_is_a_link_or_damaged_is_refused_and_not_listed(tmp_path):
+def test_a_sweep_json_that_is_a_link_or_damaged_is_refused_and_listed_as_damaged(tmp_path):
     runs = tmp_path / "runs"
     real = runs / "real"
     run_sweep(plan_sweep(SWEEP), real, RunOptions(workers=1), plot=False)
@@ -116,7 +116,11 @@ def test_a_sweep_json_that_is_a_link_or_damaged_is_refused_and_not_listed(tmp_pa
     for folder in (linked, damaged):
         with pytest.raises(RunFolderError):
             run_state(folder)
-    assert [s.folder.name for s in list_run_states(runs)] == ["real"]
+    listed = {s.folder.name: s for s in list_run_states(runs)}
+    assert listed["real"].status == "completed" and listed["real"].reason is None
+    for name in ("linked", "damaged"):  # never hidden, never shown as completed: damaged, with the reason
+        assert (listed[name].kind, listed[name].status) == ("sweep", "damaged")
+        assert "sweep.json" in listed[name].reason and str(runs) not in listed[name].reason
 
 
 def test_a_sweep_that_says_running_with_no_live_process_reads_as_interrupted(tmp_path):

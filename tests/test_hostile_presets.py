@@ -238,7 +238,7 @@ def test_a_damaged_preset_in_a_run_folder_is_named(tmp_path, capsys):
     (tmp_path / "run" / "preset.yaml").write_text("name: [unclosed\n")
     assert main(["resume", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
     err = capsys.readouterr().err
-    assert f"{tmp_path / 'run' / 'preset.yaml'} is damaged (not valid YAML at line 2" in err
+    assert f"{tmp_path / 'run' / 'preset.yaml'} is damaged (not valid YAML at line 1, column 7: a [ list opened here" in err
     (tmp_path / "run" / "run.json").write_text("{ damaged")
     (tmp_path / "run" / "preset.yaml").write_text(BASE)
     assert main(["resume", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER

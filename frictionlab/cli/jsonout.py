@@ -34,9 +34,10 @@ SHAPES = {
                  "`pid` of the run's own process, `status` (`running`)"),
     "runs": ("runs", "`runs_dir` and `runs`: each run folder's `folder`, `kind` (`run`, or `sweep`: a sweep's folder is "
              "one entry), `name`, `status` (`running` only while its process holds the folder; a run whose process "
-             "died is `interrupted`), `done`, `total` (realizations; a sweep's points), `pid`"),
+             "died is `interrupted`; `damaged` when a file of it cannot be read), `done`, `total` (realizations; a "
+             "sweep's points), `pid`, `reason` (why it is damaged, else null)"),
     "follow": ("follow", "the run's final state: `folder`, `kind`, `name`, `status` (`deleted` when its folder was "
-               "deleted or replaced while it ran), `done`, `total`, `pid`, and "
+               "deleted or replaced while it ran), `done`, `total`, `pid`, `reason`, and "
                "`error` (the run's error, or null); for a sweep also `points`: each point's row of sweep.json "
                "(its values, `status`, fit, `folder`)"),
     "error": ("any, when refused or failed", "`error` (the message), `field` (the preset field or option at fault, "

@@ -1,5 +1,6 @@
 """``frictionlab runs [DIR]``: the run folders (and sweep folders) under DIR with their
-status: running (with the pid of its process), completed, or ended early and resumable."""
+status: running (with the pid of its process), completed, ended early and resumable, or
+damaged (a file of it cannot be read as frictionlab writes it: the reason is said)."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ def add_parser(sub) -> None:
         help="list run folders with their status (running, completed, interrupted...)",
         description="The run folders under DIR, running ones first: a run whose process is gone reads as "
         "interrupted (frictionlab resume continues it), never as running. A sweep's folder is one entry, "
-        "its points counted in DONE.",
+        "its points counted in DONE. A folder whose files cannot be read is listed as damaged, with the reason.",
         epilog=EXAMPLES,
     )
     p.add_argument("runs_dir", nargs="?", default=None, metavar="DIR", help="the folder of run folders (default: runs)")
@@ -53,6 +54,12 @@ def run(args) -> ExitCode:
         total = "?" if state.total is None else str(state.total)
         status = f"running (pid {state.pid})" if state.pid else state.status
         unit = " points" if state.kind == "sweep" else ""
-        rows.append((str(state.folder), state.name, status, f"{done}/{total}{unit}"))
+        count = "-" if state.status == "damaged" else f"{done}/{total}{unit}"  # the reason follows the table
+        rows.append((str(state.folder), state.name, status, count))
     print_table(["FOLDER", "NAME", "STATUS", "DONE"], rows)
+    from ..errors import shown
+
+    for state in states:
+        if state.reason:
+            print(f"{shown(state.folder)} is damaged: {shown(state.reason)}")
     return ExitCode.OK

@@ -4,62 +4,70 @@ The app holds what the tabs share: the draft preset (open, edit, save), the run
 going on, and the keys that work everywhere. Each tab's pane shows its part
 (``widgets``). A run, or a sweep (a preset with a ``sweep`` section), is a process
 of its own (``detached``: it goes on when the TUI or its terminal goes away),
-followed by reading its folder (``following``), as a TUI opened later follows it.
+followed by reading its folder (``following``), as a TUI opened later follows it;
+starting, resuming and following one is ``running.RunControl``'s part of the app.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+import time
 from pathlib import Path
 
+from textual.actions import SkipAction
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..detached import check_startable, check_sweep_startable, list_run_states, run_state, start_detached
-from ..errors import FrictionlabError, PresetError, RunFolderError, shown
-from ..files import output_path_problem
+from ..detached import list_run_states
+from ..errors import PresetError, shown
 from ..options import RunOptions
-from ..preset import build_scene, load_preset_file, resolve_input_paths
+from ..preset import load_preset_file
 from ..registry import default_registry
-from ..rundir import DEFAULT_RUNS_DIR, RunDirectory, new_run_folder
-from ..sweep import plan_sweep, stored_sweep
+from ..rundir import DEFAULT_RUNS_DIR
 from .fields import default_spectrum, preset_from_defaults
 from .folders import (
     is_builtin,
     new_preset_path,
     preset_folders,
     preset_from_template,
-    read_run,
+    runs_signature,
     save_folder,
     save_preset,
     templates,
+    user_presets_dir,
     writable_folder,
 )
-from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
-from .messages import RunCrashed, RunFinished
-from .screens import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen
-from .text import failure_message
+from .following import FollowedRun
+from .running import NO_PRESET, RunControl
+from .screens import ConfirmScreen, NewPresetScreen, PathScreen
+from .text import problems_text
 from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
 from .widgets.presets import NO_PRESETS
 
-NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
+WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
+REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(App):
+class FrictionlabApp(RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     BINDINGS = [
         Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
-        Binding("question_mark", "help", "Keys", tooltip="(show or hide), outside a text field", show=False),
+        Binding("question_mark", "toggle_keys", "Keys", tooltip="(show or hide), outside a text field", show=False),
+        Binding("escape", "hide_keys", show=False, system=True),  # closes the keys panel (a field's Esc leaves it first)
         Binding("f2", "show_tab('presets')", "Presets tab", show=False, priority=True),
         Binding("f3", "show_tab('edit')", "Edit tab", show=False, priority=True),
         Binding("f4", "show_tab('run')", "Run tab", show=False, priority=True),
         Binding("f5", "show_tab('results')", "Results tab", show=False, priority=True),
+        # the same tabs where the F-keys are the terminal's (GNOME's F1, a Mac without fn): the F-key's digit
+        Binding("2", "show_tab('presets')", "Presets tab", tooltip="(as F2), outside a text field", show=False),
+        Binding("3", "show_tab('edit')", "Edit tab", tooltip="(as F3), outside a text field", show=False),
+        Binding("4", "show_tab('run')", "Run tab", tooltip="(as F4), outside a text field", show=False),
+        Binding("5", "show_tab('results')", "Results tab", tooltip="(as F5), outside a text field", show=False),
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
         Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
@@ -94,6 +102,9 @@ class FrictionlabApp(App):
         self.last_snapshot = None
         self.last_outcome = None
         self.last_out_dir: Path | None = None
+        self.last_resumable = False  # the last run shown ended before it completed, and can go on (u)
+        self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
+        self._runs_read_at = 0.0  # when it was (time.monotonic)
 
     # ------------------------------------------------------------ layout
 
@@ -117,6 +128,7 @@ class FrictionlabApp(App):
         self.reload_runs()
         self._show_edit_state()
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
+        self.set_interval(WATCH_SECONDS, self._watch_runs)
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -145,14 +157,12 @@ class FrictionlabApp(App):
     def action_show_tab(self, tab: str) -> None:
         self.query_one("#tabs", TabbedContent).active = tab
         focus = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}[tab]
-        widget = self.query_one(focus)
-        if tab == "edit":
-            fields = [w for w in widget.query("Input, Select, Switch") if w.focusable]
-            widget = fields[0] if fields else widget
-        widget.focus()
+        self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
+        self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
 
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
-        self.refresh_bindings()
+        if self.screen_stack:  # not once the app has closed (a late message)
+            self.refresh_bindings()
 
     def action_help(self) -> None:
         """Textual's key panel: the keys of the focused widget and of the app, as they change.
@@ -168,9 +178,24 @@ class FrictionlabApp(App):
         else:
             self.action_hide_help_panel()
 
-    def action_help_quit(self) -> None:
+    def action_toggle_keys(self) -> None:
+        """? shows the key panel, or hides it (F1 pages through it)."""
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            self.action_show_help_panel()
+
+    def action_hide_keys(self) -> None:
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            raise SkipAction()  # Esc means nothing here: another part may take it
+
+    def action_help_quit(self, in_field: bool = False) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
-        self.say("Ctrl+Q quits (q too, outside a text field); a run goes on after you quit unless you cancel it.")
+        where = "Ctrl+C copies in a text field. " if in_field else ""
+        self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
+                 "a run goes on after you quit unless you cancel it.")  # fmt: skip
 
     # ------------------------------------------------------------ the status line
 
@@ -209,7 +234,7 @@ class FrictionlabApp(App):
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.say("; ".join(exc.problems), "error", title=f"Cannot open {path.name}")
+                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}")
                 return
             self.draft_source = path
         else:
@@ -230,7 +255,7 @@ class FrictionlabApp(App):
         try:
             data = load_preset_file(entry.path)
         except PresetError as exc:
-            self.say("; ".join(exc.problems), "error", title="Cannot duplicate")
+            self.say(problems_text(exc.problems), "error", title="Cannot duplicate")
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
         default = writable_folder(self.folders) / f"{entry.path.stem}-copy.yaml"
@@ -256,7 +281,7 @@ class FrictionlabApp(App):
                 else:
                     data = preset_from_template(template, name, path, self.registry)
             except PresetError as exc:
-                self.say("; ".join(exc.problems), "error", title="Cannot read the template")
+                self.say(problems_text(exc.problems), "error", title="Cannot read the template")
                 return
             self.run_worker(self._open_new(path, data, template), group="open")
 
@@ -296,9 +321,10 @@ class FrictionlabApp(App):
         """The app's pane of that class, or None once the app is closing: its widgets are
         gone while a late message or a follow tick still arrives."""
         try:
-            return self.query_one(pane_class)
+            pane = self.query_one(pane_class)
         except NoMatches:
             return None
+        return pane if pane.children else None  # the app is closing: the panes' children go first
 
     def _draft(self) -> dict | None:
         return self.query_one("#form", PresetForm).data
@@ -356,8 +382,10 @@ class FrictionlabApp(App):
             if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
                 path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
             save_preset(path, data, template=template)
-        except OSError as exc:
-            self.say(f"{path}: {exc.strerror or exc}", "error", title="Not saved")
+        except OSError as exc:  # a read-only folder, not the user's, a file in the way
+            elsewhere = user_presets_dir() / path.name
+            self.say(f"{shown(path)} cannot be written ({exc.strerror or exc}): Ctrl+O saves it elsewhere, "
+                     f"e.g. {shown(elsewhere)}", "error", title="Not saved")  # fmt: skip
             return
         self.say(f"Saved {path}")
         self.reload_presets()
@@ -369,232 +397,27 @@ class FrictionlabApp(App):
             self.modified = False
             self._show_edit_state()
 
-    # ------------------------------------------------------------ running
-
-    def action_start_run(self) -> None:
-        if self.running:
-            self.say("A run is going; c on the Run tab cancels it.", "warning")
-            return
-        data = self._draft()
-        if data is None:
-            self.say(NO_PRESET, "warning")
-            return
-        try:
-            if self.draft_path is not None:  # relative input files are the preset file's neighbours
-                data = resolve_input_paths(data, self.draft_path.parent, self.registry)
-            scene = build_scene(data, registry=self.registry)
-            sweep = None
-            if scene.preset.sweep is not None:  # every point is checked before any runs
-                source = str(self.draft_path) if self.draft_path else None
-                sweep = plan_sweep(data, registry=self.registry, source=source)
-        except PresetError as exc:
-            count = len(exc.problems)
-            self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
-            self.blocked_by = exc.problems[0]
-            self.query_one("#tabs", TabbedContent).active = "edit"
-            form = self.query_one("#form", PresetForm)
-            form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
-            form.focus_problem(exc.problems)
-            return
-        try:
-            out_dir = new_run_folder(scene.preset.name, self.runs_dir)  # made now: it claims the name
-        except FrictionlabError as exc:  # the runs folder is a file
-            self.say(output_path_problem(self.runs_dir) or str(exc), "error", title="Run failed")
-            return
-        except OSError as exc:  # it cannot be made
-            self.say(f"{self.runs_dir}: {exc.strerror or exc}", "error", title="Run failed")
-            return
-        self._start(scene, sweep, out_dir, self.run_options)
-
-    def resume_run(self, folder: Path | None) -> None:
-        """Continue a cancelled or interrupted run in ``folder`` with the preset stored
-        there (``frictionlab resume``): only the missing realizations are computed."""
-        if self.running:
-            self.say("A run is going; c on the Run tab cancels it.", "warning")
-            return
-        if folder is None:
-            self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
-            return
-        try:
-            state = run_state(folder)
-            if state.status == "running":
-                self.show_running(folder)
-                return
-            if state.kind == "sweep" and state.status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
-                return
-        except FrictionlabError:
-            pass  # not a run folder (yet): said below
-        try:
-            if read_run(folder).status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
-                return
-        except (OSError, RunFolderError):
-            pass  # no summary yet (a run killed early): the stored preset says whether it can go on
-        stored = self._stored_or_say(folder, "resume")
-        if stored is not None:
-            self._start(*stored, folder, replace(self.run_options, resume=True))
-
-    def _stored(self, folder: Path):
-        """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
-        its first point's); RunFolderError or PresetError if it holds none that can run."""
-        if run_state(folder).kind == "sweep":
-            sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
-            return sweep.points[0].scene, sweep
-        return build_scene(RunDirectory(folder).stored_preset(), registry=self.registry), None
-
-    def _stored_or_say(self, folder: Path, verb: str):
-        """``_stored(folder)``, or None once the status line has said why it cannot ``verb`` it."""
-        try:
-            return self._stored(folder)
-        except RunFolderError as exc:
-            self.say(str(exc), "error", title=f"Cannot {verb}")
-        except PresetError as exc:
-            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}")
-        return None
-
-    def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
-        self.last_outcome = None
-        self.refresh_bindings()
-        try:  # refused here, at once, what the run would refuse as it begins
-            if sweep is None:
-                check_startable(scene, out_dir, options)
-            else:
-                check_sweep_startable(sweep, out_dir, options)
-        except FrictionlabError as exc:
-            self.say(str(exc), "error", title="Run failed")
-            return
-        try:
-            preset = scene.resolved() if sweep is None else sweep.preset_data
-            process = start_detached(preset, out_dir, options, source=sweep.source if sweep is not None else None)
-        except OSError as exc:  # no process can be started (out of processes, memory)
-            self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
-            return
-        self.followed = self._follower(out_dir, scene, sweep, process)
-        self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
-        self.query_one(RunPane).start(scene, sweep, out_dir)
-        self.action_show_tab("run")
-        verb = "Resuming" if options.resume else "Running"
-        name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
-        self.say(f"{verb} {name} into {out_dir} as a process of its own "
-                 f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
-
-    def _follower(self, folder: Path, scene, sweep, process=None) -> FollowedRun:
-        if sweep is None:
-            return FollowedRun(folder, scene, self._show_snapshot, process=process)
-        show_point = lambda kind, point, result: self._show_point(sweep, kind, point, result)  # noqa: E731
-        return FollowedSweep(folder, sweep, self._show_snapshot, show_point, process=process)
-
-    def show_running(self, folder: Path) -> None:
-        """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
-        if self.followed is None or self.followed.folder.resolve() != folder.resolve():
-            if self.running:
-                self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).", "warning")
-                return
-            self.follow_run(folder)
-        self.action_show_tab("run")
-
-    def follow_run(self, folder: Path) -> None:
-        """Show the run (or sweep) going on in ``folder`` (another process's) live on the Run tab."""
-        stored = self._stored_or_say(folder, "follow")
-        if stored is None:
-            return
-        scene, sweep = stored
-        self.last_outcome = None
-        self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
-        self.followed = self._follower(folder, scene, sweep)
-        self.refresh_bindings()
-        name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
-        self.say(f"{name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
-        self._follow_tick()
-
-    def _show_point(self, sweep, kind: str, point, result) -> None:
-        if (pane := self._mounted(RunPane)) is not None:
-            pane.show_point(sweep, kind, point, result)
-
-    def _show_snapshot(self, snapshot) -> None:
-        self.last_snapshot = snapshot
-        if (pane := self._mounted(RunPane)) is not None:
-            pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
-
-    def _follow_tick(self) -> None:
-        followed = self.followed
-        if followed is None or not followed.poll():
-            return
-        self.followed = None
-        self.refresh_bindings()
-        if followed.error:
-            self.on_run_crashed(RunCrashed(followed.error))
-            self.reload_runs()
-            return
-        try:
-            read = read_finished_sweep if isinstance(followed, FollowedSweep) else read_finished
-            finished = read(followed.folder)
-        except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
-            error = f"the run's process ended without writing its results (u on the Results tab resumes it from {followed.folder})"
-            self.on_run_crashed(RunCrashed(error))
-            self.reload_runs()
-            return
-        self.on_run_finished(RunFinished(finished, followed.folder))
-
-    def action_cancel_run(self) -> None:
-        if not self.running:
-            self.say("No run is going: Ctrl+R starts one.", "warning")
-            return
-        if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
-            return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
-        self.query_one(RunPane).show_cancelling()
-
-    def on_run_finished(self, message: RunFinished) -> None:
-        outcome = message.outcome
-        self.last_outcome, self.last_out_dir = outcome, message.out_dir
-        self.refresh_bindings()  # resume, if it ended before it completed
-        pane = self.query_one(RunPane)
-        if isinstance(outcome, FinishedSweep):
-            self.say(pane.show_sweep_outcome(outcome))
-        else:
-            line = pane.show_outcome(outcome)
-            if outcome.done == 0 and outcome.failures:  # nothing to show: say why, as the user can fix it
-                self.say(failure_message(outcome.failures[0][1]), "error", title="Run failed: no realization finished")
-            elif outcome.failures:
-                self.say(f"{line}; {outcome.failed} failed: {failure_message(outcome.failures[0][1])}", "warning")
-            else:
-                self.say(line)
-        self.reload_runs()
-
-    def on_run_crashed(self, message: RunCrashed) -> None:
-        self.query_one(RunPane).show_crash(message.error)
-        self.say(message.error, "error", title="Run failed")
-
-    def action_quit(self) -> None:
-        """Quit at once; while a run goes on, ask first whether to leave it running or cancel it."""
-        followed = self.followed
-        if followed is not None:
-            def answered(choice: str | None) -> None:
-                if choice is None:
-                    return
-                if choice == "cancel":
-                    followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
-                self._quit_unless_unsaved()
-
-            what = "sweep" if isinstance(followed, FollowedSweep) else "run"
-            question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
-                        "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
-                        "(what finished is kept)?")  # fmt: skip
-            self.push_screen(QuitDuringRunScreen(question), answered)
-            return
-        self._quit_unless_unsaved()
-
-    def _quit_unless_unsaved(self) -> None:
-        if self.modified:
-            self.push_screen(
-                ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),
-                lambda yes: yes and self.exit(),
-            )
-            return
-        self.exit()
-
     # ------------------------------------------------------------ results
 
     def reload_runs(self) -> None:
         self.query_one(ResultsPane).reload(self.runs_dir)
+        self._runs_read_at = time.monotonic()
+        self._runs_seen = self._runs_signature()
+
+    def _runs_signature(self) -> tuple:
+        running = [entry.path for entry in self.query_one(ResultsPane).runs if entry.status == "running"]
+        return runs_signature(self.runs_dir, running)
+
+    def _watch_runs(self) -> None:
+        """Results lists every run the moment it starts, from any TUI or the CLI: the runs
+        folder's names and times are looked at, and the list read again only when they changed."""
+        if self._mounted(ResultsPane) is None:
+            return
+        now, seen = self._runs_signature(), self._runs_seen
+        if now == seen:
+            return
+        names = lambda signature: [name for name, _ in signature[1]] if signature else None  # noqa: E731
+        # a run started, removed or ended: at once; a run's files written (a chunk): coalesced, the
+        # list read at most every REREAD_SECONDS (a long list of runs is not read twice a second)
+        if names(now) != names(seen) or now[2:] != seen[2:] or time.monotonic() - self._runs_read_at >= REREAD_SECONDS:
+            self.reload_runs()

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import yaml
 
-from ..detached import run_state
-from ..errors import FrictionlabError
+from ..detached import RUN_MARKERS, SWEEP_FILE, damage_reason, run_state
+from ..errors import FrictionlabError, RunFolderError
 from ..files import atomic_write
 from ..inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
@@ -99,12 +99,21 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
             try:  # read as a preset is: bounded, a regular file, so that a hostile file (a FIFO) cannot stop the listing
                 data = load_yaml(read_regular_file(path, MAX_PRESET_BYTES, "preset file").decode("utf-8"))
             except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
-                entries.append(PresetEntry(label, path, path.stem, "", f"unreadable: {type(exc).__name__}"))
+                entries.append(PresetEntry(label, path, path.stem, "", f"cannot be read: {_unreadable(exc)}"))
                 continue
             data = data if isinstance(data, dict) else {}
             description = " ".join(str(data.get("description") or "").split())
             entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
     return entries
+
+
+def _unreadable(exc: Exception) -> str:
+    """Why a preset file cannot be read, in words (never a line of it)."""
+    if isinstance(exc, UnicodeDecodeError):
+        return f"not UTF-8 text (byte {exc.start + 1}); save the preset as UTF-8"
+    if isinstance(exc, OSError):
+        return exc.strerror or "an error of the system"
+    return str(exc)  # YamlProblem, InputFileProblem: they name a line, never quote the text
 
 
 FIRST_TEMPLATE = "quickstart"  # runs in about a second: the template a new preset starts from
@@ -173,6 +182,7 @@ class RunEntry:
     summary: dict
     mtime: float
     curve: dict[str, list[float]] = field(default_factory=dict)
+    reason: str = ""  # why a damaged folder (status "damaged") cannot be read
 
     @property
     def a(self) -> float:
@@ -257,30 +267,66 @@ def read_sweep(folder: Path) -> SweepEntry:
 
 
 def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
-    """Every folder under ``runs_dir`` with a readable summary.json (a run) or
-    sweep.json (a sweep), newest first."""
+    """Every run folder under ``runs_dir`` (one with a summary.json, a run.json, or a
+    sweep's sweep.json), newest first; one whose files cannot be read is listed as
+    damaged with the reason, never left out."""
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
     entries = []
     for folder in runs_dir.iterdir():
-        entry, marked = None, False
-        for marker, read in (("summary.json", read_run), ("sweep.json", read_sweep)):
-            if not os.path.lexists(folder / marker):
-                continue
-            marked = True
-            try:
-                entry = read(folder)
-            except (OSError, FrictionlabError):
-                pass  # a damaged or foreign folder, a link, a FIFO: not one to list
-            break
-        if isinstance(entry, SweepEntry) and entry.status == "running":
-            entry = _sweep_with_state(entry)
-        elif (entry is not None or not marked) and not isinstance(entry, SweepEntry) and os.path.lexists(folder / STATE_FILE):
-            entry = _with_state(folder, entry)  # a run going on, or one that ended before its summary
+        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
+            continue
+        try:
+            entry = _entry(folder)
+        except (OSError, FrictionlabError) as exc:
+            entry = _damaged(folder, exc)
         if entry is not None:
             entries.append(entry)
     return sorted(entries, key=lambda e: (e.status != "running", -e.mtime, e.path.name))
+
+
+def runs_signature(runs_dir: Path, running: list[Path] = ()) -> tuple:
+    """What changes when a run starts, writes its manifest or summary, ends, or is removed
+    under ``runs_dir``: the folder's and each run folder's modification time (names and
+    times only, nothing read), and whether each of ``running`` is still held by its process
+    (a run killed with kill -9 changes no file)."""
+    from ..detached import lock_held
+
+    try:
+        top = os.stat(runs_dir).st_mtime_ns
+        folders = sorted((entry.name, entry.stat(follow_symlinks=False).st_mtime_ns) for entry in os.scandir(runs_dir))
+    except OSError:
+        return ()
+    return top, tuple(folders), tuple(lock_held(folder) for folder in running)
+
+
+def _entry(folder: Path) -> RunEntry | SweepEntry | None:
+    """The folder's run or sweep as it is now (OSError, FrictionlabError if it cannot be read)."""
+    if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):
+        entry = read_sweep(folder)
+        return _sweep_with_state(entry) if entry.status == "running" else entry
+    if not os.path.lexists(folder / STATE_FILE):  # a summary alone (copied without its run.json)
+        return read_run(folder)
+    state = run_state(folder)  # run.json: running, or ended (and how); damaged if its summary is
+    if state.status == "damaged":
+        return _damaged(folder, RunFolderError(state.reason or "damaged"), state.name)
+    if state.status == "running" or not os.path.lexists(folder / "summary.json"):
+        # a run going on (its summary, if any, is an earlier run's), or one that ended before its summary (killed)
+        mtime = os.lstat(folder / STATE_FILE).st_mtime
+        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
+    entry = read_run(folder)
+    entry.status = state.status
+    return entry
+
+
+def _damaged(folder: Path, error: Exception, name: str = "") -> RunEntry:
+    reason = damage_reason(folder, error) if isinstance(error, FrictionlabError) else (error.strerror or str(error))
+    try:
+        mtime = folder.lstat().st_mtime
+    except OSError:
+        mtime = 0.0
+    return RunEntry(folder, name or folder.name, "damaged", 0, 0, None, {}, mtime, reason=reason)
 
 
 def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
@@ -289,20 +335,4 @@ def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
         entry.status = run_state(entry.path).status
     except (OSError, FrictionlabError):
         pass
-    return entry
-
-
-def _with_state(folder: Path, entry: RunEntry | None) -> RunEntry | None:
-    """A run folder as its process left it: running (its summary, if any, is an earlier
-    run's), or ended without a summary (killed): listed, so that it can be followed or resumed."""
-    try:
-        state = run_state(folder)
-    except (OSError, FrictionlabError):
-        return entry
-    if entry is None:
-        mtime = os.lstat(folder / STATE_FILE).st_mtime
-        return RunEntry(folder, state.name, state.status, state.done or 0, state.total or 0, None, {}, mtime)
-    entry.status = state.status
-    if state.status == "running":
-        entry.done, entry.fit = state.done or 0, None  # the fit shown would be the earlier run's
     return entry

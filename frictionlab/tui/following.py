@@ -5,14 +5,16 @@ finished run (or sweep) read back from its folder. No Textual here: the app poll
 
 from __future__ import annotations
 
+import os
+import stat
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..api import Result, load
-from ..detached import cancel, lock_held, lock_holder
-from ..errors import RunFolderError
-from ..progresslog import Follower
+from ..detached import cancel, lock_held, lock_holder, run_state
+from ..errors import FrictionlabError, RunFolderError, shown
+from ..progresslog import PROGRESS_FILE, Follower
 from ..sweeplog import SweepFollower
 from .folders import read_run, read_sweep
 from .live import LiveListener
@@ -34,6 +36,7 @@ class FollowedRun:
         self.live.clock = self.follower.now
         self.cancelling = False
         self.refusal: str | None = None  # why a cancel signalled nothing
+        self.said_progress_problem = False  # that its progress file cannot be written (said once)
 
     @property
     def pid(self) -> int | None:
@@ -61,6 +64,28 @@ class FollowedRun:
         if over:
             self.follower.poll()  # what it wrote last
         return over
+
+    def progress_problem(self) -> str | None:
+        """Why the run cannot write (nor this TUI read) its progress file: it is a link or
+        not a regular file, which is never written or read through; None if it is fine
+        or not there yet."""
+        path = self.folder / PROGRESS_FILE
+        try:
+            mode = os.lstat(path).st_mode
+        except OSError:
+            return None
+        if stat.S_ISREG(mode):
+            return None
+        what = "a symbolic link" if stat.S_ISLNK(mode) else "not a regular file"
+        return f"{PROGRESS_FILE} in {shown(self.folder)} is {what}, never written through"
+
+    def stored_count(self) -> tuple[int | None, int | None]:
+        """(done, total) realizations as the run folder's manifest says (its chunks)."""
+        try:
+            state = run_state(self.folder)
+        except (OSError, FrictionlabError):
+            return None, None
+        return state.done, state.total
 
     def cancel(self) -> bool:
         """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone, or

@@ -47,6 +47,7 @@ def point_line(sweep: Sweep, point: SweepPoint) -> str:
 
 STATUS_MARKS = {
     "running": "▶", "completed": "✓", "cancelled": "c", "interrupted": "i", "failed": "!", "error": "!", "pending": "-",
+    "damaged": "✗",
 }  # fmt: skip
 
 

@@ -69,3 +69,9 @@ def failure_message(error: str) -> str:
     if kind in _INPUT_ERRORS and message:
         return _WHERE.sub("", message)
     return f"internal error ({error}); please report it"
+
+
+def problems_text(problems: list[str]) -> str:
+    """A preset's problems on one line, as the status line says them: a problem of the
+    file itself without the ``(file):`` its list marks it with (the file is named in the title)."""
+    return "; ".join(problem.removeprefix("(file): ") for problem in problems)

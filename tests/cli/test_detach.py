@@ -91,7 +91,8 @@ def test_runs_and_follow_on_a_sweep_folder_whose_sweep_json_is_a_link_say_so_wit
     (tmp_path / "elsewhere.json").write_text("{}")
     (tmp_path / "runs" / "bad" / "sweep.json").symlink_to(tmp_path / "elsewhere.json")
     listed = run_cli("runs", tmp_path / "runs")
-    assert listed.returncode == 0 and "no run folders" in listed.stdout
+    assert listed.returncode == 0 and "damaged" in listed.stdout  # listed, never hidden
+    assert f"{tmp_path / 'runs' / 'bad'} is damaged: sweep.json is a symbolic link" in listed.stdout
     followed = run_cli("follow", tmp_path / "runs" / "bad")
     assert followed.returncode == 5 and "sweep.json" in followed.stderr and "Traceback" not in followed.stderr
 

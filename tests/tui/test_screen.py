@@ -77,7 +77,7 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
         await pilot.pause()
         presets_tab = screen_text(app)
         await open_first_preset(pilot)
-        app.query_one("#plugin--slope").focus()  # its summary is under the select
+        app.query_one("#field--slope--params--ends").focus()  # the plugin's summary is above its first field
         await pilot.pause()
         edit_tab = screen_text(app)
         await pilot.press("f5")
@@ -86,6 +86,7 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
     assert BRACKETS in presets_tab
     assert BracketSlope.summary in edit_tab
     assert "[b]cut[/b]" in edit_tab  # a choice's text
+    assert "ends of the line, as in [2]" in edit_tab  # a description, in the help line
     assert "try[1]" in results_tab
 
 
@@ -614,20 +615,23 @@ def field_line(shown, label):
 
 @pytest.mark.parametrize("route", ["list", "command line"])
 @sync
-async def test_opening_a_preset_either_way_leaves_focus_on_its_first_field(folders, registry, route):
+async def test_opening_a_preset_either_way_focuses_the_form_and_enter_its_first_field(folders, registry, route):
     """A new user found Tab x3 reached `realizations` after Enter in the list but `name`
-    with the preset given on the command line. Either way focus is now on `name`, so
-    three Tabs and a number change `realizations`."""
+    with the preset given on the command line. Either way focus is now on the form (not
+    a field: q there quits), Enter goes to `name`, so three Tabs and a number change `realizations`."""
     app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
     async with app.run_test(size=SIZE) as pilot:
         if route == "list":
             await open_first_preset(pilot)
         await pilot.pause()
         first = app.focused.id
+        await pilot.press("enter")
+        await pilot.pause()
+        entered = app.focused.id
         await pilot.press("tab", "tab", "tab", "7")
         await pilot.pause()
         shown = screen_text(app)
-    assert first == "field--name"
+    assert (first, entered) == ("form", "field--name")
     scrollbar = set("▁▂▃▄▅▆▇█")  # the form's scrollbar thumb may share a field's line
 
     def words(line):
@@ -670,6 +674,7 @@ async def test_damaged_runs_and_presets_in_its_folders_never_stop_the_tui(folder
             await pilot.pause()
         results_tab = screen_text(app)
         assert app.is_running
-    assert "huge" in presets_tab and "bomb" in presets_tab and "unreadable" in presets_tab
+    assert "huge" in presets_tab and "bomb" in presets_tab and "cannot be read" in presets_tab
     assert "seed1" in results_tab and "fit-text" in results_tab and "bad-fields" in results_tab
-    assert "a-list" not in results_tab and "deep" not in results_tab
+    for name in ("a-list", "deep"):  # listed as damaged, with its mark: never hidden
+        assert any(name in line and "✗" in line and "damaged" in line for line in results_tab.splitlines())

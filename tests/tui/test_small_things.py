@@ -80,7 +80,10 @@ async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_li
         await pilot.press("q")  # typed into the field, not a quit
         await pilot.pause()
         typed = app.query_one("#field--name", Input).value
-        await pilot.press("f2", "ctrl+c")  # in a text field Ctrl+C copies
+        await pilot.press("ctrl+c")  # in a text field Ctrl+C copies, and says what quits
+        await pilot.pause()
+        said_in_field = status_text(app)
+        await pilot.press("f2", "ctrl+c")
         await pilot.pause()
         said, toasts = status_text(app), len(app.query("Toast"))
         app.modified = False
@@ -88,7 +91,8 @@ async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_li
         await pilot.pause()
         quit_by_q = not app.is_running
     assert typed == "smallq"  # and typed at the end of the name: the cursor starts there
-    assert said.startswith("Ctrl+Q quits (q too, outside a text field)") and toasts == 0
+    assert said.startswith("Ctrl+Q quits (q too, outside a text field") and toasts == 0
+    assert said_in_field.startswith("Ctrl+C copies in a text field. Ctrl+Q quits")
     assert quit_by_q
 
 

@@ -10,8 +10,11 @@ from textual.containers import Vertical
 from textual.content import Content
 from textual.widgets import Static
 
-from .form import PresetForm
+from .form import PresetForm, flow_text
 from .pathline import PathLine
+
+
+FORM_HINT = "Enter or Tab: into the fields (Esc comes back out); arrows scroll; q quits"
 
 
 class EditPane(Vertical):
@@ -52,5 +55,13 @@ class EditPane(Vertical):
 
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
         spec = event.spec
-        text = "" if spec is None else f"{spec.dotted}: {spec.help_line()}"
+        form = self.query_one(PresetForm)
+        if spec is not None:
+            text = f"{spec.dotted}: {spec.help_line()}"
+            if spec.dotted in form.swept:
+                text = f"{spec.dotted} is swept ({flow_text(form.swept[spec.dotted])}): this value is only the base; {spec.help_line()}"
+        elif form.has_focus and form.data is not None:
+            text = FORM_HINT
+        else:
+            text = ""
         self.query_one("#field-help", Static).update(Content(text))

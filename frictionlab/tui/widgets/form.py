@@ -11,6 +11,7 @@ import copy
 from pathlib import Path
 
 import yaml
+from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.message import Message
@@ -32,9 +33,9 @@ from ..fields import (
 from .keyinput import KeyInput
 
 
-def _flow(value) -> str:
+def flow_text(value) -> str:
     text = yaml.safe_dump(value, default_flow_style=True, width=10_000).strip()
-    return text if len(text) <= 60 else text[:57] + "..."
+    return text if len(text) <= 400 else text[:397] + "..."  # wrapped on the form: a sweep's values whole
 
 
 def _section_id(path: tuple[str, ...]) -> str:
@@ -42,7 +43,16 @@ def _section_id(path: tuple[str, ...]) -> str:
 
 
 class PresetForm(VerticalScroll):
-    """Edits ``data`` (the preset as a plain mapping, unknown sections kept)."""
+    """Edits ``data`` (the preset as a plain mapping, unknown sections kept).
+
+    A preset opens with the form itself focused, not a field: the app's keys (``q``
+    quits) act there, and typing never edits the preset by surprise. Enter (or Tab)
+    goes into the fields, Esc leaves one."""
+
+    BINDINGS = [
+        Binding("enter", "edit_field", "Edit", tooltip="the fields: Enter or Tab goes in, Esc comes back out"),
+        Binding("escape", "leave_field", "Leave field", tooltip="(back to the form: q, ? and the app's keys act again)"),
+    ]
 
     class Edited(Message):
         """The draft changed (or was loaded): ``problems`` is the headless list; ``read``,
@@ -70,6 +80,7 @@ class PresetForm(VerticalScroll):
         # the value each select or switch shows: Textual also posts Changed when one is mounted
         self._seen: dict[str, object] = {}
         self._marked: dict[str, list[str]] = {}  # widget id -> the messages shown under it
+        self._last_field: Widget | None = None  # the field Enter goes back into
 
     # ------------------------------------------------------------ building
 
@@ -106,6 +117,13 @@ class PresetForm(VerticalScroll):
         if unknown:
             yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(map(str, unknown))}"), classes="note")
 
+    @property
+    def swept(self) -> dict[str, object]:
+        """The dotted paths the draft's sweep sets, with their values (as the YAML gives them)."""
+        sweep = self.data.get("sweep") if isinstance(self.data, dict) else None
+        parameters = sweep.get("parameters") if isinstance(sweep, dict) else None
+        return {str(k): v for k, v in parameters.items()} if isinstance(parameters, dict) else {}
+
     def field_rows(self, spec: FieldSpec) -> list[Widget]:
         self._specs[spec.widget_id] = spec
         value = get_path(self.data, spec.path)
@@ -134,8 +152,8 @@ class PresetForm(VerticalScroll):
                 id=spec.widget_id,
             )
             widget.cursor_position = len(widget.value) if spec.kind == "text" else 0  # typing adds to a name
-        else:  # mappings, lists, optional sections (a sweep): shown, kept, edited in the YAML
-            shown = "(none)" if value in (MISSING, None) else _flow(value)
+        else:  # mappings, lists, optional sections (a sweep): shown whole, kept, edited in the YAML
+            shown = "(none)" if value in (MISSING, None) else flow_text(value)
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
             note = Content.assemble(shown, "  ", ("(edit in the YAML)", "dim"))
             widget = Static(note, id=spec.widget_id, classes="other")
@@ -149,8 +167,11 @@ class PresetForm(VerticalScroll):
         row = [label, widget]
         if spec.kind == "bool":  # the state in words, not in colour only
             row.append(Static(_on_off(bool(current)), id=spec.widget_id + "--state", classes="switch-state"))
+        if spec.dotted in self.swept:  # the sweep sets it: the value here is only the base of the others
+            row.append(Static("swept", classes="swept-mark"))
+        tall = spec.kind not in ("bool", "choice", "int", "float", "text")  # a sweep, a list: shown whole, wrapped
         return [
-            Horizontal(*row, classes="row"),
+            Horizontal(*row, classes="row -tall" if tall else "row"),
             Static("", id=spec.widget_id + "--error", classes="field-error"),
         ]
 
@@ -323,7 +344,28 @@ class PresetForm(VerticalScroll):
         if fields:
             fields[0].focus()
 
+    def check_action(self, action: str, parameters) -> bool:
+        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies)."""
+        if action == "edit_field":
+            return self.has_focus and self.data is not None
+        if action == "leave_field":
+            return not self.has_focus
+        return True
+
+    def action_edit_field(self) -> None:
+        fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
+        last = self._last_field if self._last_field in fields else None
+        if last is not None or fields:
+            (last or fields[0]).focus()
+
+    def action_leave_field(self) -> None:
+        self.focus(scroll_visible=False)
+
+    def on_focus(self, event) -> None:
+        self.post_message(self.FieldFocused(None))
+
     def on_descendant_focus(self, event) -> None:
+        self._last_field = event.widget
         widget = event.widget
         spec = self._specs.get(widget.id or "")
         if spec is None and (widget.id or "").startswith("plugin--"):

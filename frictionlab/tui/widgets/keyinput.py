@@ -24,3 +24,12 @@ class KeyInput(Input):
             await self.run_action(bindings[0].action)
             return
         await super()._on_key(event)
+
+    def action_copy(self) -> None:
+        """Ctrl+C copies here, and says (as it does elsewhere) what quits."""
+        try:
+            super().action_copy()  # SkipAction when nothing is selected
+        finally:
+            say_quit = getattr(self.app, "action_help_quit", None)
+            if say_quit is not None:
+                say_quit(in_field=True)

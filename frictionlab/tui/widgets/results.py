@@ -15,7 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
-from ...errors import FrictionlabError
+from ...errors import FrictionlabError, shown
 from ...fit import format_interval
 from ..chart import Series
 from ...results import read_curve
@@ -46,6 +46,7 @@ class ResultsPane(Vertical):
         self.runs: list[RunEntry | SweepEntry] = []
         self.overlay: list[RunEntry] = []  # the runs drawn, at most one per style
         self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
+        self._shown: list[Path] = []  # the folders the list shows, in its order
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -98,6 +99,10 @@ class ResultsPane(Vertical):
         """The list of runs, each name shortened from the middle to the width the list has."""
         table = self.query_one("#runs-table", DataTable)
         row = table.cursor_row
+        was = self._shown[row] if 0 <= row < len(self._shown) else None
+        if was is not None and was in [entry.path for entry in self.runs]:  # the run highlighted stays so
+            row = [entry.path for entry in self.runs].index(was)
+        self._shown = [entry.path for entry in self.runs]
         width = self._name_width()
         table.clear(columns=True)
         table.add_column("", width=FIXED_COLUMNS[0], key="status")
@@ -107,6 +112,8 @@ class ResultsPane(Vertical):
         for entry in self.runs:
             if isinstance(entry, SweepEntry):
                 a, b = "sweep", f"{len(entry.points)} pts"
+            elif entry.status == "damaged":
+                a, b = "damaged", ""
             else:
                 a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
                 b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
@@ -133,6 +140,10 @@ class ResultsPane(Vertical):
                 self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
+            if entry.status == "damaged":  # nothing to show but why
+                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning")
+                self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return

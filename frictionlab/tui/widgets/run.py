@@ -39,7 +39,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
             *what,
             f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
             f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
-            f"  {level} CI, bootstrap {fit.bootstrap}",
+            f"  {level} CI, bootstrap {fit.bootstrap}" if fit.bootstrap else
+            "  no CI: a bootstrap needs 2+ realizations",  # (or the preset asked for none)
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
     return lines
@@ -63,7 +64,7 @@ def _contact_lines(count) -> list[str]:
 
 class RunPane(Vertical, can_focus=True):
     BINDINGS = [
-        Binding("r", "start", "Run", tooltip="the open preset (again)"),
+        Binding("r", "start", "Run", tooltip="the open preset (again)", show=False),  # the footer has ^r Run
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
@@ -90,7 +91,7 @@ class RunPane(Vertical, can_focus=True):
         if action == "cancel":
             return app.running
         if action == "resume":
-            return not app.running and app.last_outcome is not None and app.last_outcome.status != "completed"
+            return not app.running and app.last_resumable
         return not app.running if action == "start" else True
 
     def action_unavailable(self, action: str) -> None:
@@ -163,6 +164,11 @@ class RunPane(Vertical, can_focus=True):
             self._set("run-fit", "\n".join(lines))
         if snap.first_error:
             self._error(snap.first_error)
+
+    def show_stored_count(self, done: int, total: int) -> None:
+        """The count the run folder's chunks hold (when there is no progress file to read)."""
+        self.query_one("#run-bar", ProgressBar).update(total=total, progress=done)
+        self._set("run-stats", f"{done}/{total} realizations stored (read from the run's chunks)")
 
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the solves running stop; what finished is kept")

@@ -1,0 +1,308 @@
+"""The app's runs: starting one (or a sweep) as a process of its own, resuming one,
+following one another process started, and showing how each ended on the Run tab.
+
+``RunControl`` is a part of ``FrictionlabApp`` (a mixin): it uses the app's status line
+(``say``), its panes and its draft preset.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+from textual.widgets import TabbedContent
+
+from ..detached import (
+    check_startable,
+    check_sweep_startable,
+    lock_held,
+    lock_holder,
+    run_state,
+    start_detached,
+)
+from ..errors import FrictionlabError, PresetError, RunFolderError, shown
+from ..files import output_path_problem
+from ..options import RunOptions
+from ..preset import build_scene, resolve_input_paths
+from ..rundir import RunDirectory, new_run_folder
+from ..sweep import plan_sweep, stored_sweep
+from .folders import read_run
+from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
+from .messages import RunCrashed, RunFinished
+from .screens import ConfirmScreen, QuitDuringRunScreen
+from .text import failure_message
+from .widgets import PresetForm, RunPane
+
+NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
+
+
+class RunControl:
+    """Starting, resuming, following and cancelling runs (``FrictionlabApp``'s)."""
+
+    def action_start_run(self) -> None:
+        if self.running:
+            self.say("A run is going; c on the Run tab cancels it.", "warning")
+            return
+        data = self._draft()
+        if data is None:
+            self.say(NO_PRESET, "warning")
+            return
+        try:
+            if self.draft_path is not None:  # relative input files are the preset file's neighbours
+                data = resolve_input_paths(data, self.draft_path.parent, self.registry)
+            scene = build_scene(data, registry=self.registry)
+            sweep = None
+            if scene.preset.sweep is not None:  # every point is checked before any runs
+                source = str(self.draft_path) if self.draft_path else None
+                sweep = plan_sweep(data, registry=self.registry, source=source)
+        except PresetError as exc:
+            count = len(exc.problems)
+            self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
+            self.blocked_by = exc.problems[0]
+            self.query_one("#tabs", TabbedContent).active = "edit"
+            form = self.query_one("#form", PresetForm)
+            form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
+            form.focus_problem(exc.problems)
+            return
+        try:
+            out_dir = new_run_folder(scene.preset.name, self.runs_dir)  # made now: it claims the name
+        except FrictionlabError as exc:  # the runs folder is a file
+            self.say(output_path_problem(self.runs_dir) or str(exc), "error", title="Run failed")
+            return
+        except OSError as exc:  # it cannot be made: read-only, not the user's
+            self.say(f"no run folder can be made in {shown(self.runs_dir)} ({exc.strerror or exc}): quit and start "
+                     "the TUI in a folder you can write in, or give one: frictionlab tui --runs DIR", "error",
+                     title="Cannot run")  # fmt: skip
+            return
+        self._start(scene, sweep, out_dir, self.run_options)
+
+    def resume_run(self, folder: Path | None) -> None:
+        """Continue a cancelled or interrupted run in ``folder`` with the preset stored
+        there (``frictionlab resume``): only the missing realizations are computed."""
+        if self.running:
+            self.say("A run is going; c on the Run tab cancels it.", "warning")
+            return
+        if folder is None:
+            self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
+            return
+        try:
+            state = run_state(folder)
+            if state.status == "running":
+                if self.followed is None:
+                    self._follow_the_winner(folder, state.pid)
+                else:
+                    self.show_running(folder)
+                return
+            if state.kind == "sweep" and state.status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                return
+        except FrictionlabError:
+            pass  # not a run folder (yet): said below
+        try:
+            if read_run(folder).status == "completed":
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                return
+        except (OSError, RunFolderError):
+            pass  # no summary yet (a run killed early): the stored preset says whether it can go on
+        stored = self._stored_or_say(folder, "resume")
+        if stored is not None:
+            self._start(*stored, folder, replace(self.run_options, resume=True))
+
+    def _follow_the_winner(self, folder: Path, pid: int | None = None) -> None:
+        """A resume that another process (a TUI, the CLI) began first: follow that one, and say so."""
+        self.follow_run(folder)
+        if self.followed is None:
+            return  # the status line says why it cannot be followed
+        self.action_show_tab("run")
+        pid = pid or lock_holder(folder)
+        self.say(f"{shown(folder.name)} was resumed by another process first (pid {pid or 'unknown'}): "
+                 "this TUI follows that run; c cancels it", "warning")  # fmt: skip
+
+    def _stored(self, folder: Path):
+        """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
+        its first point's); RunFolderError or PresetError if it holds none that can run."""
+        if run_state(folder).kind == "sweep":
+            sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
+            return sweep.points[0].scene, sweep
+        return build_scene(RunDirectory(folder).stored_preset(), registry=self.registry), None
+
+    def _stored_or_say(self, folder: Path, verb: str):
+        """``_stored(folder)``, or None once the status line has said why it cannot ``verb`` it."""
+        try:
+            return self._stored(folder)
+        except RunFolderError as exc:
+            self.say(str(exc), "error", title=f"Cannot {verb}")
+        except PresetError as exc:
+            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}")
+        return None
+
+    def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
+        self.last_outcome = None
+        self.last_resumable = False
+        self.refresh_bindings()
+        try:  # refused here, at once, what the run would refuse as it begins
+            if sweep is None:
+                check_startable(scene, out_dir, options)
+            else:
+                check_sweep_startable(sweep, out_dir, options)
+        except FrictionlabError as exc:
+            if options.resume and lock_held(out_dir):  # another TUI (or the CLI) resumed it first
+                self._follow_the_winner(out_dir)
+                return
+            self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run")
+            return
+        try:
+            preset = scene.resolved() if sweep is None else sweep.preset_data
+            process = start_detached(preset, out_dir, options, source=sweep.source if sweep is not None else None)
+        except OSError as exc:  # no process can be started (out of processes, memory)
+            self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
+            return
+        self.followed = self._follower(out_dir, scene, sweep, process)
+        self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
+        self.query_one(RunPane).start(scene, sweep, out_dir)
+        self.action_show_tab("run")
+        verb = "Resuming" if options.resume else "Running"
+        name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
+        self.say(f"{verb} {name} into {out_dir} as a process of its own "
+                 f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
+
+    def _follower(self, folder: Path, scene, sweep, process=None) -> FollowedRun:
+        if sweep is None:
+            return FollowedRun(folder, scene, self._show_snapshot, process=process)
+        show_point = lambda kind, point, result: self._show_point(sweep, kind, point, result)  # noqa: E731
+        return FollowedSweep(folder, sweep, self._show_snapshot, show_point, process=process)
+
+    def show_running(self, folder: Path) -> None:
+        """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
+        if self.followed is None or self.followed.folder.resolve() != folder.resolve():
+            if self.running:
+                self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).", "warning")
+                return
+            self.follow_run(folder)
+        self.action_show_tab("run")
+
+    def follow_run(self, folder: Path) -> None:
+        """Show the run (or sweep) going on in ``folder`` (another process's) live on the Run tab."""
+        stored = self._stored_or_say(folder, "follow")
+        if stored is None:
+            return
+        scene, sweep = stored
+        self.last_outcome = None
+        self.last_resumable = False
+        self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
+        self.followed = self._follower(folder, scene, sweep)
+        self.refresh_bindings()
+        name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
+        self.say(f"{name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
+        self._follow_tick()
+
+    def _show_point(self, sweep, kind: str, point, result) -> None:
+        if (pane := self._mounted(RunPane)) is not None:
+            pane.show_point(sweep, kind, point, result)
+
+    def _show_snapshot(self, snapshot) -> None:
+        self.last_snapshot = snapshot
+        if (pane := self._mounted(RunPane)) is not None:
+            pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
+
+    def _follow_tick(self) -> None:
+        followed = self.followed
+        if followed is not None and not isinstance(followed, FollowedSweep) and followed.progress_problem():
+            self._count_from_chunks(followed)
+        if followed is None or not followed.poll():
+            return
+        self.followed = None
+        self.last_out_dir = followed.folder
+        self.last_resumable = _resumable(followed.folder)  # however it ended: u offered when it can go on
+        self.refresh_bindings()
+        if followed.error:
+            if lock_held(followed.folder) and followed.process is not None:  # ours lost the folder to another's resume
+                self._follow_the_winner(followed.folder)
+                return
+            self.on_run_crashed(RunCrashed(followed.error))
+            self.reload_runs()
+            return
+        try:
+            read = read_finished_sweep if isinstance(followed, FollowedSweep) else read_finished
+            finished = read(followed.folder)
+        except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
+            resume = "u resumes it" if self.last_resumable else "it cannot be resumed"
+            error = f"the run's process ended without writing its results ({resume}: {followed.folder})"
+            self.on_run_crashed(RunCrashed(error))
+            self.reload_runs()
+            return
+        self.on_run_finished(RunFinished(finished, followed.folder))
+
+    def _count_from_chunks(self, followed: FollowedRun) -> None:
+        """A run whose progress file cannot be written: said once; its count read from its chunks."""
+        if not followed.said_progress_problem:
+            followed.said_progress_problem = True
+            self.say(f"{followed.progress_problem()}: the count comes from the run's chunks, without a live plot", "warning")
+        done, total = followed.stored_count()
+        if total and (pane := self._mounted(RunPane)) is not None:
+            pane.show_stored_count(done or 0, total)
+
+    def action_cancel_run(self) -> None:
+        if not self.running:
+            self.say("No run is going: Ctrl+R starts one.", "warning")
+            return
+        if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
+            return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
+        self.query_one(RunPane).show_cancelling()
+
+    def on_run_finished(self, message: RunFinished) -> None:
+        outcome = message.outcome
+        self.last_outcome, self.last_out_dir = outcome, message.out_dir
+        self.refresh_bindings()  # resume, if it ended before it completed
+        pane = self.query_one(RunPane)
+        if isinstance(outcome, FinishedSweep):
+            self.say(pane.show_sweep_outcome(outcome))
+        else:
+            line = pane.show_outcome(outcome)
+            if outcome.done == 0 and outcome.failures:  # nothing to show: say why, as the user can fix it
+                self.say(failure_message(outcome.failures[0][1]), "error", title="Run failed: no realization finished")
+            elif outcome.failures:
+                self.say(f"{line}; {outcome.failed} failed: {failure_message(outcome.failures[0][1])}", "warning")
+            else:
+                self.say(line)
+        self.reload_runs()
+
+    def on_run_crashed(self, message: RunCrashed) -> None:
+        self.query_one(RunPane).show_crash(message.error)
+        self.say(message.error, "error", title="Run failed")
+
+    def action_quit(self) -> None:
+        """Quit at once; while a run goes on, ask first whether to leave it running or cancel it."""
+        followed = self.followed
+        if followed is not None:
+            def answered(choice: str | None) -> None:
+                if choice is None:
+                    return
+                if choice == "cancel":
+                    followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
+                self._quit_unless_unsaved()
+
+            what = "sweep" if isinstance(followed, FollowedSweep) else "run"
+            question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
+                        "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
+                        "(what finished is kept)?")  # fmt: skip
+            self.push_screen(QuitDuringRunScreen(question), answered)
+            return
+        self._quit_unless_unsaved()
+
+    def _quit_unless_unsaved(self) -> None:
+        if self.modified:
+            self.push_screen(
+                ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),
+                lambda yes: yes and self.exit(),
+            )
+            return
+        self.exit()
+
+
+def _resumable(folder: Path) -> bool:
+    """Whether the run (or sweep) in ``folder`` ended before it completed and can go on."""
+    try:
+        return run_state(folder).resumable
+    except (OSError, FrictionlabError):
+        return False

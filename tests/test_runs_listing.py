@@ -1,0 +1,72 @@
+"""``frictionlab runs`` and the listing under it: a damaged run folder is listed as damaged
+with its reason (never hidden, never shown as completed), and a run whose progress file
+cannot be read is counted from its chunks."""
+
+import json
+import os
+
+from frictionlab.cli import main
+from frictionlab.detached import list_run_states, run_state
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.runner import run_to_folder
+
+from .conftest import SMALL_PRESET, merge
+
+TINY = merge(SMALL_PRESET, {"realizations": 4, "spectrum": {"params": {"points": 256}}, "fit": {"bootstrap": 20}})
+
+
+def _run(folder, registry, seed=1):
+    run_to_folder(build_scene(merge(TINY, {"seed": seed}), registry=registry), folder, RunOptions(workers=1), plot=False)
+
+
+def _damage(runs, registry, tmp_path):
+    """Three damaged folders next to a sound one: a junk summary.json, one that is a
+    link (to the sound one's), a junk sweep.json."""
+    _run(runs / "sound", registry)
+    _run(runs / "junk", registry, seed=2)
+    (runs / "junk" / "summary.json").write_text("{not json")
+    _run(runs / "linked", registry, seed=3)
+    (runs / "linked" / "summary.json").unlink()
+    (runs / "linked" / "summary.json").symlink_to(runs / "sound" / "summary.json")
+    (runs / "sweep").mkdir()
+    (runs / "sweep" / "sweep.json").write_text("[1, 2")
+
+
+def test_damaged_folders_are_listed_as_damaged_with_their_reason(tmp_path, registry, capsys):
+    runs = tmp_path / "runs"
+    _damage(runs, registry, tmp_path)
+    states = {s.folder.name: s for s in list_run_states(runs)}
+    assert set(states) == {"sound", "junk", "linked", "sweep"}
+    assert (states["sound"].status, states["sound"].reason) == ("completed", None)
+    for name in ("junk", "linked", "sweep"):
+        assert states[name].status == "damaged", name
+    assert "summary.json" in states["junk"].reason and "not valid JSON" in states["junk"].reason
+    assert "summary.json" in states["linked"].reason and "link" in states["linked"].reason
+    assert "sweep.json" in states["sweep"].reason and states["sweep"].kind == "sweep"
+
+    assert main(["runs", str(runs), "--json"]) == 0
+    listed = {os.path.basename(r["folder"]): r for r in json.loads(capsys.readouterr().out)["runs"]}
+    assert {name: (r["status"], r["reason"] is None) for name, r in listed.items()} == {
+        "sound": ("completed", True), "junk": ("damaged", False), "linked": ("damaged", False), "sweep": ("damaged", False)}
+    assert main(["runs", str(runs)]) == 0
+    out = capsys.readouterr().out
+    for name in ("junk", "linked", "sweep"):
+        line = next(line for line in out.splitlines() if line.startswith(str(runs / name) + " is damaged: "))
+        assert line.endswith(states[name].reason)
+    assert not any("completed" in line for line in out.splitlines() if "/junk " in line or "/linked " in line)
+
+
+def test_a_run_whose_progress_file_is_a_link_is_counted_from_its_chunks(tmp_path, registry, capsys):
+    out = tmp_path / "runs" / "run"
+    _run(out, registry)
+    (out / "summary.json").unlink()  # ended before its summary: the count must come from somewhere else
+    manifest = json.loads((out / "run.json").read_text())
+    (out / "run.json").write_text(json.dumps({**manifest, "status": "interrupted"}))
+    (out / "progress.jsonl").unlink(missing_ok=True)
+    (tmp_path / "elsewhere.jsonl").write_text("")
+    (out / "progress.jsonl").symlink_to(tmp_path / "elsewhere.jsonl")
+    state = run_state(out)
+    assert (state.status, state.done, state.total) == ("interrupted", 4, 4)
+    assert main(["runs", str(tmp_path / "runs")]) == 0
+    assert "4/4" in capsys.readouterr().out

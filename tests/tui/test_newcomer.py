@@ -1,0 +1,331 @@
+"""What a first-time user trips over (issue 36), each read from the screen: keys that do
+what the footer says, every run listed as it starts, damaged folders named, resume
+offered wherever a run can be resumed."""
+
+import asyncio
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+from frictionlab.detached import run_state, start_detached, wait_started
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+from frictionlab.rundir import new_run_folder
+from frictionlab.tui.widgets import ResultsPane
+
+from ..conftest import merge
+from .conftest import SIZE, TINY, make_app, make_runs, numbers_in, screen_text, status_text, sync, wait_until
+
+
+@pytest.mark.long
+@sync
+async def test_damaged_run_folders_are_listed_with_their_reason(folders, registry):
+    make_runs(folders, registry)
+    runs = folders / "runs"
+    (runs / "seed1" / "summary.json").write_text("{junk")
+    (runs / "seed2" / "summary.json").unlink()
+    (runs / "seed2" / "summary.json").symlink_to(folders / "presets" / "tiny.yaml")
+    (runs / "sw").mkdir()
+    (runs / "sw" / "sweep.json").write_text("not a sweep")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        await pilot.pause()
+        pane = app.query_one(ResultsPane)
+        assert {e.path.name: e.status for e in pane.runs} == {"seed1": "damaged", "seed2": "damaged", "sw": "damaged"}
+        screen = screen_text(app)
+        for name in ("seed1", "seed2", "sw"):
+            line = next(line for line in screen.splitlines() if f" {name} " in line)
+            assert "✗" in line and "damaged" in line, line
+        row = [e.path.name for e in pane.runs].index("seed2")
+        await pilot.press(*["down"] * row, "enter")
+        await pilot.pause()
+        assert "seed2 is damaged: summary.json" in status_text(app) and "link" in status_text(app)
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("route", ["command line", "list"])
+@sync
+async def test_q_on_a_freshly_opened_preset_quits_and_never_types(folders, registry, route):
+    """Opened either way, the form has the focus, not its `name` field: q quits (it typed
+    `smallq` into the name before); the footer offers Enter into the fields."""
+    app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        if route == "list":
+            await pilot.press("enter")
+            await pilot.pause()
+        await wait_until(pilot, lambda: "Edit" in screen_text(app).splitlines()[-1], 10)  # the footer, once refreshed
+        screen = screen_text(app)
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert "(saved)" in screen and "smallq" not in screen
+    assert "Enter or Tab: into the fields" in screen
+    assert "⏎ Edit" in screen.splitlines()[-1] or "enter Edit" in screen.splitlines()[-1]
+    assert quit_by_q
+
+
+@pytest.mark.long
+@sync
+async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("enter", "x")  # into name, typed
+        await pilot.pause()
+        typed = app.query_one("#field--name").value
+        footer_in_field = screen_text(app).splitlines()[-1]
+        await pilot.press("escape")
+        await pilot.pause()
+        left = app.focused.id
+        app.modified = False
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert typed == "smallx" and "Leave field" in footer_in_field
+    assert left == "form" and quit_by_q
+
+
+@pytest.mark.long
+@sync
+async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(folders, registry):
+    """A run started by another TUI (here its detached process, as that TUI starts it) is
+    listed while it runs, without r: the runs folder is watched. The highlighted run stays
+    highlighted as rows are added above it."""
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        pane = app.query_one(ResultsPane)
+        await pilot.press("down")
+        await pilot.pause()
+        highlighted = pane.runs[app.query_one("#runs-table").cursor_row].path
+        scene = build_scene(merge(TINY, {"name": "elsewhere", "realizations": 100_000}), registry=registry)
+        out = new_run_folder("elsewhere", "runs")
+        process = start_detached(scene.resolved(), out, RunOptions(workers=1), plot=False)
+        try:
+            await wait_until(pilot, lambda: any(e.path.name == out.name and e.status == "running" for e in pane.runs), 30)
+            screen = screen_text(app)
+            cursor = pane.runs[app.query_one("#runs-table").cursor_row].path
+        finally:
+            process.terminate()
+            process.wait()
+        await wait_until(pilot, lambda: any(e.path.name == out.name and e.status != "running" for e in pane.runs), 30)
+    assert any("▶" in line and "elsew" in line for line in screen.splitlines()), screen  # its name cut to fit
+    assert cursor == highlighted
+
+
+LONG = merge(TINY, {"name": "long", "realizations": 100_000})
+
+
+def _footer(app) -> str:
+    return screen_text(app).splitlines()[-1]
+
+
+@pytest.mark.long
+@sync
+async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(folders, registry):
+    """A run that ended without its results (a full disk, kill -9) can be resumed: the Run
+    tab offered no u and said "No run to resume" while Results' u resumed it."""
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        folder = app.followed.folder
+        app.followed.process.kill()  # as the disk filled: no summary written
+        await wait_until(pilot, lambda: app.followed is None)
+        await pilot.pause()
+        footer, said = _footer(app), status_text(app)
+        await pilot.press("u")
+        await pilot.pause()
+        resumed = app.followed is not None and app.followed.folder == folder
+        pid = app.followed.pid if resumed else None
+        said_after = status_text(app)
+        if resumed:
+            app.followed.cancel()
+            await wait_until(pilot, lambda: app.followed is None)
+    assert "u Resume" in footer and "u resumes it" in said
+    assert resumed and said_after.startswith("Resuming long") and f"pid {pid}" in said_after
+
+
+@pytest.mark.long
+@sync
+async def test_a_resume_that_another_process_began_first_is_followed_and_said_in_full(folders, registry):
+    """Two TUIs pressing u on one interrupted run: the one that loses the folder's lock
+    follows the run that won, and says so whole (it said "Run failed: … in use by another
+    run (pid …): wait for it to end, or give another", cut, advice it could not follow)."""
+    out = folders / "runs" / "long"
+    scene = build_scene(LONG, registry=registry)
+    process = start_detached(scene.resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    process.terminate()
+    process.wait()
+    assert run_state(out).status == "interrupted"
+    # the winner: a process that holds the folder's lock, as a resume does before its manifest says "running"
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(out / "run.lock")], stdout=subprocess.PIPE)
+    try:
+        assert holder.stdout.readline().strip() == b"held"
+        app = make_app(registry)
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.pause()
+            await pilot.press("f5", "u")
+            await pilot.pause()
+            following = app.followed is not None and app.followed.folder.resolve() == out.resolve()
+            tab = app.query_one("#tabs").active
+            screen = " ".join(screen_text(app).split())
+            said = status_text(app)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert following and tab == "run", said
+    assert said == (f"long was resumed by another process first (pid {holder.pid}): "
+                    "this TUI follows that run; c cancels it")  # fmt: skip
+    assert said in screen  # whole on the screen, not cut
+    assert "in use" not in said and "output folder" not in said
+
+
+HOLD_LOCK = """
+import fcntl, os, sys
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)
+os.ftruncate(fd, 0)
+os.write(fd, f"pid {os.getpid()}, started now\\n".encode())
+fcntl.flock(fd, fcntl.LOCK_EX)
+print("held", flush=True)
+import time; time.sleep(600)
+"""
+
+
+@pytest.mark.long
+@sync
+async def test_a_resume_whose_progress_file_is_a_link_says_so_once_and_counts_its_chunks(folders, registry):
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    while run_state(out).done in (None, 0):  # at least one chunk stored
+        await asyncio.sleep(0.05)
+    process.terminate()
+    process.wait()
+    (out / "progress.jsonl").unlink()
+    (folders / "elsewhere.jsonl").write_text("")
+    (out / "progress.jsonl").symlink_to(folders / "elsewhere.jsonl")
+    app = make_app(registry)
+    said = []
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        original = app.say
+        app.say = lambda text, *a, **k: (said.append(text), original(text, *a, **k))
+        await pilot.press("f5", "u")
+        await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+        await pilot.pause(1.0)
+        stats = str(app.query_one("#run-stats").render())
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    told = [text for text in said if "progress.jsonl" in text and "symbolic link" in text]
+    assert len(told) == 1 and "the count comes from the run's chunks" in told[0]
+    done, total = numbers_in(stats.split(" realizations")[0].replace("/", " "))
+    assert total == 100_000 and done >= 1
+    assert (folders / "elsewhere.jsonl").read_text() == ""  # never written through the link
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_is_not_yaml_says_what_is_wrong_in_words_at_its_line(folders, registry):
+    (folders / "presets" / "bad.yaml").write_text("name: bad\nseed: 1\nrealizations: [1, 2\n")
+    app = make_app(registry)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await pilot.pause()
+        listed = screen_text(app)
+        await pilot.press("enter")  # bad.yaml is listed first
+        await pilot.pause()
+        said = status_text(app)
+    assert "cannot be read: not valid YAML at line 3" in listed and "YamlProblem" not in listed
+    assert said.startswith("Cannot open bad.yaml: not valid YAML at line 3, column 15: a [ list opened here is not closed")
+    assert "(file)" not in said
+
+
+@pytest.mark.long
+@sync
+async def test_the_keys_panel_is_readable_at_80x24_and_tabs_are_reached_without_f_keys(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("question_mark")
+        await pilot.pause()
+        panel = app.screen.query("HelpPanel")
+        width = panel.first().size.width if panel else 0
+        await pilot.press("escape")
+        await pilot.pause()
+        closed_by_esc = not app.screen.query("HelpPanel")
+        await pilot.press("question_mark", "question_mark")
+        await pilot.pause()
+        toggled = not app.screen.query("HelpPanel")
+        tabs = []
+        for key in ("5", "4", "2", "3"):
+            await pilot.press(key)
+            await pilot.pause()
+            tabs.append(app.query_one("#tabs").active)
+        await pilot.press("4")
+        await pilot.pause()
+        run_footer = screen_text(app).splitlines()[-1]
+    assert width >= 44 and closed_by_esc and toggled  # Textual's was 29 wide: every key wrapped
+    assert tabs == ["results", "run", "presets", "edit"]
+    assert "^r Run" in run_footer and " r Run" not in run_footer
+
+
+@pytest.mark.long
+@sync
+async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, registry):
+    data = merge(TINY, {"name": "sw", "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.6, 0.7, 0.8, 0.9]}}}})
+    (folders / "presets" / "sw.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    app = make_app(registry, preset="presets/sw.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        app.query_one("#field--spectrum--params--hurst").focus()
+        await pilot.pause()
+        screen = screen_text(app)
+        help_text = str(app.query_one("#field-help").render())
+    hurst = next(line for line in screen.splitlines() if line.startswith("hurst"))
+    assert "swept" in hurst
+    assert help_text.startswith("spectrum.params.hurst is swept ({values: [0.5, 0.6, 0.7, 0.8, 0.9]}): this value is only the base")
+    assert "…" not in help_text and " ".join(help_text.split()) in " ".join(screen.split())  # whole on the screen
+    assert "0.9]}}}" in screen or "0.9]" in screen  # the sweep row's values, whole (they were cut)
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folders, registry, monkeypatch):
+    import frictionlab.tui.app
+
+    def refused(path, data, template=None):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(frictionlab.tui.app, "save_preset", refused)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        said = status_text(app)
+    assert said == (f"Not saved: presets/tiny.yaml cannot be written (Permission denied): Ctrl+O saves it "
+                    f"elsewhere, e.g. {folders / 'mine' / 'tiny.yaml'}")  # fmt: skip
+
+
+def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_no_rate():
+    from frictionlab.fit import LogFit
+    from frictionlab.listeners import progress_text
+    from frictionlab.tui.widgets.run import fit_lines
+
+    nan = float("nan")
+    lines = fit_lines(LogFit(a=0.8, b=0.02, r2=0.99, a_ci=(nan, nan), b_ci=(nan, nan), bootstrap=0), final=True)
+    assert "  no CI: a bootstrap needs 2+ realizations" in lines and not any("bootstrap 0" in line for line in lines)
+    assert progress_text(8, 8, 0, 0.5, restored=8) == "8/8 realizations (8 restored), elapsed 0.5 s"  # a point restored whole
+    assert progress_text(3, 8, 0, 0.5, restored=3) == "3/8 realizations (3 restored), elapsed 0.5 s"
+    assert "2.0/s" in progress_text(4, 8, 0, 0.5, restored=3) and "left" in progress_text(4, 8, 0, 0.5, restored=3)
