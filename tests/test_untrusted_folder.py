@@ -222,14 +222,17 @@ def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
         frictionlab.load(folder)
 
 
-def test_the_tui_list_skips_fifos_and_links_without_blocking(run_copy, tmp_path):
+def test_the_tui_list_names_fifos_and_links_damaged_without_blocking(run_copy, tmp_path):
     runs = run_copy.parent
     for name, damage in (("fifo", "summary.json a FIFO"), ("linked", "summary.json a link out")):
         shutil.copytree(run_copy, runs / name)
         HOSTILE[damage](runs / name)
     listed = []
     assert with_timeout(lambda: listed.extend(list_runs(runs))) is None
-    assert [entry.path.name for entry in listed] == ["run"]
+    entries = {entry.path.name: entry for entry in listed}
+    assert entries["run"].status == "completed"
+    for name in ("fifo", "linked"):  # listed, never read through, never shown as completed
+        assert entries[name].status == "damaged" and "summary.json" in entries[name].reason
 
 
 # ------------------------------------------------------------------ resume
