@@ -130,6 +130,11 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
             f"{where}: the file's heights and its lateral sizes are in different units, and SurfaceTopography "
             f"reads a {name} file with one unit for both; convert its heights to the unit of its sizes"
         )
+    if isinstance(exc, ValueError) and "physical_sizes" in text:  # SurfaceTopography's own words: not damage
+        return ValueError(
+            f"{where}: the {name} file does not state its physical size, and SurfaceTopography reads none "
+            "without it; export the scan with its pixel size, or as a .npy map with spacing"
+        )
     if isinstance(exc, MemoryError):
         return ValueError(f"{where}: the {name} file declares more points than this process can hold; "
                           "crop it with the instrument's software")  # fmt: skip
