@@ -125,35 +125,18 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             value = getattr(curve, name)
             floating = name != "contact_count"
             arrays[name] = check_array(cls, f"{where}.{name}", np.asarray(value), loads.shape, floating)
-        corrected = curve.real_area_corrected
-        if (corrected is not None) != cls.corrected_area:
-            fail(cls, f"{where}.real_area_corrected must be given exactly when corrected_area is True "
-                      f"(it is {cls.corrected_area!r}). Got {corrected!r}.")  # fmt: skip
-        if corrected is not None:
-            corrected = check_array(cls, f"{where}.real_area_corrected", np.asarray(corrected), loads.shape, True)
-            if np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12)):
-                fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
-                          f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
-        gradient = curve.real_gradient_rms
-        if (gradient is not None) != cls.real_gradient:
-            fail(cls, f"{where}.real_gradient_rms must be given exactly when real_gradient is True "
-                      f"(it is {cls.real_gradient!r}). Got {gradient!r}.")  # fmt: skip
-        if gradient is not None:
-            gradient = check_array(cls, f"{where}.real_gradient_rms", np.asarray(gradient), loads.shape, True)
-            if np.any(gradient < 0):
-                fail(cls, f"{where}.real_gradient_rms is an rms slope and must be >= 0. Got {gradient!r}.")
-        spots = curve.contact_spots
-        if (spots is not None) != cls.counts_spots:
-            fail(cls, f"{where}.contact_spots must be given exactly when counts_spots is True "
-                      f"(it is {cls.counts_spots!r}). Got {spots!r}.")  # fmt: skip
-        if spots is not None:
-            spots = check_array(cls, f"{where}.contact_spots", np.asarray(spots), loads.shape, False)
-            if np.any(spots != np.round(spots)) or np.any(spots < 1) or np.any(spots > count_of(curve)):
-                fail(cls, f"{where}.contact_spots must be whole numbers in 1 .. contact_count. Got {spots!r}.")
-        if curve.half_load_points is not None:
+        corrected = _declared(cls, where, curve, "real_area_corrected", "corrected_area", loads.shape, True)
+        if corrected is not None and (np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12))):
+            fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
+                      f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
+        gradient = _declared(cls, where, curve, "real_gradient_rms", "real_gradient", loads.shape, True)
+        if gradient is not None and np.any(gradient < 0):
+            fail(cls, f"{where}.real_gradient_rms is an rms slope and must be >= 0. Got {gradient!r}.")
+        _whole_counts(cls, where, curve, "contact_spots", _declared(cls, where, curve, "contact_spots", "counts_spots",
+                                                                     loads.shape, False))  # fmt: skip
+        if curve.half_load_points is not None:  # optional: a solver may not say
             half = check_array(cls, f"{where}.half_load_points", np.asarray(curve.half_load_points), loads.shape, False)
-            if not np.array_equal(half, np.round(half)) or np.any(half < 1) or np.any(half > count_of(curve)):
-                fail(cls, f"{where}.half_load_points must be whole numbers in 1 .. contact_count. Got {half!r}.")
+            _whole_counts(cls, where, curve, "half_load_points", half)
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")
@@ -191,6 +174,26 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
     _check_load_limits(cls, solver, heights, spacing, slopes, unit)
     _check_solver_units(cls, solver, heights, spacing, slopes)
 
+
+
+def _declared(cls, where: str, curve, name: str, flag: str, shape, floating: bool):
+    """``curve``'s array ``name``, checked; None. It must be given exactly when the solver
+    class declares ``flag`` True."""
+    import numpy as np
+
+    value, declared = getattr(curve, name), getattr(cls, flag)  # fields the contract declares, by name
+    if (value is not None) != declared:
+        fail(cls, f"{where}.{name} must be given exactly when {flag} is True (it is {declared!r}). Got {value!r}.")
+    return None if value is None else check_array(cls, f"{where}.{name}", np.asarray(value), shape, floating)
+
+
+def _whole_counts(cls, where: str, curve, name: str, values) -> None:
+    """``values`` (None: nothing to check) must be whole numbers in 1 .. contact_count."""
+    import numpy as np
+
+    if values is not None and (not np.array_equal(values, np.round(values)) or np.any(values < 1)
+                               or np.any(values > count_of(curve))):  # fmt: skip
+        fail(cls, f"{where}.{name} must be whole numbers in 1 .. contact_count. Got {values!r}.")
 
 def count_of(curve):
     import numpy as np
