@@ -96,6 +96,10 @@ class RunControl:
             if state.kind == "sweep" and state.status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
+            if state.status == "damaged":  # a resume would rewrite the damaged file: the user did not ask that
+                self.say(f"{folder.name} is damaged: {state.reason}. Nothing of it was changed; move it aside "
+                         "or repair that file to go on.", "error", title="Cannot resume")  # fmt: skip
+                return
         except FrictionlabError:
             pass  # not a run folder (yet): said below
         try:

@@ -44,6 +44,14 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
         await pilot.press(*["down"] * row, "enter")
         await pilot.pause()
         assert "seed2 is damaged: summary.json" in status_text(app) and "link" in status_text(app)
+        junk = (runs / "seed1" / "summary.json").read_bytes()
+        for name in ("seed1", "seed2"):  # u refuses, naming the damage; nothing is rewritten, no link replaced
+            row = [e.path.name for e in pane.runs].index(name)
+            await pilot.press("f5", "home", *["down"] * row, "u")
+            await pilot.pause()
+            said = status_text(app)
+            assert said.startswith("Cannot resume") and f"{name} is damaged" in said and app.followed is None, said
+    assert (runs / "seed1" / "summary.json").read_bytes() == junk and (runs / "seed2" / "summary.json").is_symlink()
 
 
 @pytest.mark.long
@@ -325,7 +333,8 @@ def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_
 
     nan = float("nan")
     lines = fit_lines(LogFit(a=0.8, b=0.02, r2=0.99, a_ci=(nan, nan), b_ci=(nan, nan), bootstrap=0), final=True)
-    assert "  no CI: a bootstrap needs 2+ realizations" in lines and not any("bootstrap 0" in line for line in lines)
+    assert "  no CI (bootstrap off, or < 2 realizations)" in lines
+    assert not any("bootstrap 0 " in line or line.endswith("bootstrap 0") for line in lines)
     assert progress_text(8, 8, 0, 0.5, restored=8) == "8/8 realizations (8 restored), elapsed 0.5 s"  # a point restored whole
     assert progress_text(3, 8, 0, 0.5, restored=3) == "3/8 realizations (3 restored), elapsed 0.5 s"
     assert "2.0/s" in progress_text(4, 8, 0, 0.5, restored=3) and "left" in progress_text(4, 8, 0, 0.5, restored=3)

@@ -40,7 +40,7 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
             f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
             f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
             f"  {level} CI, bootstrap {fit.bootstrap}" if fit.bootstrap else
-            "  no CI: a bootstrap needs 2+ realizations",  # (or the preset asked for none)
+            "  no CI (bootstrap off, or < 2 realizations)",  # either: the fit cannot tell
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
     return lines
