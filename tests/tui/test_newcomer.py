@@ -79,6 +79,25 @@ async def test_q_on_a_freshly_opened_preset_quits_and_never_types(folders, regis
 
 @pytest.mark.long
 @sync
+async def test_q_after_a_refused_run_quits_and_never_types_into_the_field_at_fault(folders, registry):
+    """Ctrl+R refused for a bad seed pointed at the seed field by focusing it: q then typed
+    `q` into it (an outsider's tmux check). The form keeps the focus; Enter goes in."""
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(merge(TINY, {"seed": -5})))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        said = status_text(app)
+        await pilot.press("q")
+        await pilot.pause()
+        quit_by_q = not app.is_running
+    assert said.startswith("Cannot run: 1 problem: seed")
+    assert quit_by_q and yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == -5
+
+
+@pytest.mark.long
+@sync
 async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:

@@ -176,10 +176,12 @@ async def test_ctrl_r_with_a_problem_says_it_and_focuses_the_field_at_fault(fold
         app.query_one("#field--seed").focus()
         await pilot.press("f4", "ctrl+r")
         await pilot.pause()
-        focused = app.focused.id
+        pointed = app.focused.id  # the form: q, ? still act, nothing types into the field
         status = status_text(app)
         shown = screen_text(app)
-    assert focused == "field--spectrum--params--rms_height"
+        await pilot.press("enter")  # into the field at fault
+        focused = app.focused.id
+    assert pointed == "form" and focused == "field--spectrum--params--rms_height"
     assert status == "Cannot run: 1 problem: spectrum.params.rms_height: must be > 0.0, got -1.0"
     assert "rms_height" in shown and "-1.0" in shown  # the field scrolled into view
 
@@ -349,10 +351,12 @@ async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, re
         (folders / "presets" / "line.csv").unlink()  # gone after the preset was opened
         await pilot.press("ctrl+r")
         await pilot.pause()
-        status, focused = status_text(app), app.focused.id
+        status, pointed = status_text(app), app.focused.id
         panel = str(app.query_one("#problems").render())
+        await pilot.press("enter")
+        focused = app.focused.id
     assert not app.running and app.last_out_dir is None
-    assert focused == "field--spectrum--params--path"
+    assert pointed == "form" and focused == "field--spectrum--params--path"
     assert "spectrum.params.path: no such file" in panel  # the form says it too, not "valid"
     assert status.startswith("Cannot run: 1 problem: spectrum.params.path: no such file")
     assert "presets/line.csv'" in status  # the file beside the preset (the core shortens a long path)

@@ -27,10 +27,12 @@ async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, 
         await type_into(pilot, "field--loading--stop", "0.1")
         await pilot.press("ctrl+r")
         await pilot.pause()
-        focused = app.focused.id
+        pointed = app.focused.id
         said = status_text(app)
+        await pilot.press("enter")
+        focused = app.focused.id
     assert said.startswith("Cannot run: 1 problem: loading: stop must be > start")
-    assert focused == "field--loading--stop"
+    assert pointed == "form" and focused == "field--loading--stop"
 
 
 @sync

@@ -328,7 +328,9 @@ class PresetForm(VerticalScroll):
                 pass
 
     def focus_problem(self, problems: list[str]) -> None:
-        """Focus the field of the first problem that has one (else the first field), scrolled into view."""
+        """Point at the field of the first problem that has one (else the first field): scrolled
+        into view and the one Enter goes into, while the focus stays on the form, so that a
+        key the footer lists (q, ?) acts and never types into the field."""
         for problem in problems:
             dotted = problem_path(problem)
             slot, _, rest = dotted.partition(".")
@@ -338,11 +340,16 @@ class PresetForm(VerticalScroll):
                               f"plugin--{slot}" if rest == "name" else ""):  # fmt: skip
                 widgets = self.query(f"#{widget_id}") if widget_id else []
                 if widgets and widgets.first().focusable:
-                    widgets.first().focus()
+                    self._point_at(widgets.first())
                     return
         fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
         if fields:
-            fields[0].focus()
+            self._point_at(fields[0])
+
+    def _point_at(self, field) -> None:
+        self._last_field = field
+        self.focus(scroll_visible=False)
+        field.scroll_visible()
 
     def check_action(self, action: str, parameters) -> bool:
         """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies)."""
