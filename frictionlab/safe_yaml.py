@@ -174,11 +174,14 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     open is found only at the end of the file, so it is told where it was opened."""
     mark, context = exc.problem_mark or exc.context_mark, exc.context_mark
     at_end = mark is not None and not text[mark.index:].strip()
+    what = (exc.context or "").removeprefix("while parsing ").removeprefix("while scanning ")[:60]
     if at_end and context is not None and exc.context:  # "while parsing a flow sequence" ...
-        what = exc.context.removeprefix("while parsing ").removeprefix("while scanning ")[:60]
-        what = _OPENED.get(what, what)
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: "
-                f"{what} opened here is not closed before the end of the file")  # fmt: skip
+                f"{_OPENED.get(what, what)} opened here is not closed before the end of the file")  # fmt: skip
+    if what in _OPENED and context is not None and mark is not None and mark.line > context.line:
+        # found lines later (the next key): the fault is the bracket or quote left open
+        return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_OPENED[what]} "
+                f"opened here is not closed (at line {mark.line + 1}: {(exc.problem or 'syntax error')[:60]})")
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
     return f"not valid YAML{where}: {(exc.problem or exc.context or 'syntax error')[:80]}"
 

@@ -344,3 +344,18 @@ def test_a_number_past_double_precision_is_named_as_written(tmp_path, capsys):
     assert "loading.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1e400'" in err
     assert "loading.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1.5e-400'" in err
     assert "seed: must be 0 or between 1e-100 and 1e+100 in magnitude, got '99999" in err and "got inf" not in err
+
+
+@pytest.mark.parametrize(("text", "opened", "found"), [
+    ("name: x\nseed: 1\nrealizations: [3\nspectrum:\n  name: a\n", "line 3, column 15: a [ list", "at line 4"),
+    ("a: {b: 1\nc: 2\n", "line 1, column 4: a { mapping", "at line 2"),
+])  # fmt: skip
+def test_a_bracket_left_open_mid_file_is_named_at_the_line_it_opened(text, opened, found):
+    """An outsider's check: `realizations: [3` on line 3 was reported at line 4, where the
+    parser stumbled on the next key, in the parser's own words."""
+    from frictionlab.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem) as refused:
+        load_yaml(text)
+    message = str(refused.value)
+    assert message.startswith(f"not valid YAML at {opened} opened here is not closed (") and found in message
