@@ -7,9 +7,11 @@ following one another process started, and showing how each ended on the Run tab
 
 from __future__ import annotations
 
+from contextlib import suppress
 from dataclasses import replace
 from pathlib import Path
 
+from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
 from ..detached import (
@@ -202,12 +204,14 @@ class RunControl:
 
     def _show_point(self, sweep, kind: str, point, result) -> None:
         if (pane := self._mounted(RunPane)) is not None:
-            pane.show_point(sweep, kind, point, result)
+            with suppress(NoMatches):  # the app is closing: the pane's widgets go one by one
+                pane.show_point(sweep, kind, point, result)
 
     def _show_snapshot(self, snapshot) -> None:
         self.last_snapshot = snapshot
         if (pane := self._mounted(RunPane)) is not None:
-            pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
+            with suppress(NoMatches):  # as above: a follow tick late in the close found #run-stats gone
+                pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
 
     def _follow_tick(self) -> None:
         followed = self.followed
