@@ -21,7 +21,7 @@ import threading
 import numpy as np
 import pytest
 
-from frictionlab import Profile, hookimpl
+from frictionlab import Profile
 from frictionlab_solvers import BEMHalfSpace, contact_area
 from frictionlab_solvers.bem_free import BEMHalfSpaceFree
 from frictionlab_solvers.contact_area import (
@@ -30,6 +30,8 @@ from frictionlab_solvers.contact_area import (
     corrected_area_fraction,
     corrected_gradient_rms,
 )
+
+from .test_contact_area import CancelAfter  # the run cancelled after N realizations, as there
 
 
 def brute_weights(contact: np.ndarray, periodic: bool) -> np.ndarray:
@@ -173,16 +175,6 @@ def test_springs_have_no_g_r_and_a_damaged_header_is_refused(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(RunFolderError, match="damaged"):
         read_curve(tmp_path / "run")
-
-
-class CancelAfter:
-    def __init__(self, count: int, cancel):
-        self.count, self.cancel = count, cancel
-
-    @hookimpl
-    def realization_done(self, done):
-        if done >= self.count:
-            self.cancel.set()
 
 
 def test_a_resumed_run_keeps_g_r_and_an_older_chunk_without_it_reads_as_unknown(registry, tmp_path):
