@@ -46,6 +46,7 @@ from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
 from .files import atomic_write, output_path_problem
 from .inputs import InputFileProblem, sha256_of
 from .preset import Scene, differences, load_preset_file
+from .preset.paths import with_new_defaults
 from .realization import RealizationResult
 from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
 
@@ -95,6 +96,18 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
 def fingerprint(resolved: dict) -> str:
     text = json.dumps(resolved, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def same_preset(state: dict, scene: Scene) -> bool:
+    """Whether a manifest's run is of ``scene``'s preset: the same fingerprint, or the same
+    once each field added to frictionlab since the run started is taken at its default."""
+    resolved = _json_copy(scene.resolved())
+    if state.get("fingerprint") == fingerprint(resolved):
+        return True
+    stored = state.get("preset")
+    if not isinstance(stored, dict) or fingerprint(stored) != state.get("fingerprint"):
+        return False
+    return with_new_defaults(stored, resolved, _json_copy(scene.defaults())) == resolved
 
 
 class ChunkDamage(ValueError):
@@ -241,7 +254,7 @@ class RunDirectory:
             if not self.force:
                 raise
             state = None  # a damaged manifest lists nothing: nothing is deleted
-        self._refuse_unless_ours(state, resolved)
+        self._refuse_unless_ours(state, scene)
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
         for name in listed:  # chunks of the run that was here: frictionlab wrote them
             if isinstance(name, str) and CHUNK_NAME.fullmatch(name):
@@ -285,20 +298,21 @@ class RunDirectory:
             if not self.force:
                 raise
             state = None
-        self._refuse_unless_ours(state, _json_copy(scene.resolved()))
+        self._refuse_unless_ours(state, scene)
 
     @staticmethod
     def _listed(state: dict | None) -> list[str]:
         chunks = (state or {}).get("chunks")
         return list(chunks) if isinstance(chunks, dict) else []
 
-    def _refuse_unless_ours(self, state: dict | None, resolved: dict) -> None:
+    def _refuse_unless_ours(self, state: dict | None, scene: Scene) -> None:
         """OutputRefused when a fresh run here would replace what is not a
         finished run of the same preset (unless ``force``)."""
         if self.force:
             return
         hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
         if state is None:
+            resolved = _json_copy(scene.resolved())
             others = sorted(p.name for p in self.path.iterdir() if not _left_by_a_start(p, resolved))
             if others:
                 listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
@@ -308,9 +322,9 @@ class RunDirectory:
                 )
             return
         status = state.get("status")
-        if status == "completed" and state.get("fingerprint") != fingerprint(resolved):
+        if status == "completed" and not same_preset(state, scene):
             old = state.get("preset")
-            changed = differences(old, resolved) if isinstance(old, dict) else []
+            changed = differences(old, _json_copy(scene.resolved())) if isinstance(old, dict) else []
             fields = ", ".join(d.split(":", 1)[0] for d in changed[:5]) or "its fingerprint"
             raise OutputRefused(
                 f"{self.path} holds a finished run of another preset (it differs in {fields}): "
@@ -337,7 +351,7 @@ class RunDirectory:
         state = self.state()
         if state is None:
             raise RunFolderError(f"{self.path} holds no run to resume (no {STATE_FILE})")
-        if state.get("fingerprint") != fingerprint(resolved):
+        if not same_preset(state, scene):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
             changed = differences(stored, resolved)
             raise RunFolderError(
@@ -353,7 +367,10 @@ class RunDirectory:
                     f"started (SHA-256 {str(then.get('sha256'))[:12]}... then, {now['sha256'][:12]}... now); "
                     "restore it, or start a new run in another folder"
                 )
+        if state.get("fingerprint") != fingerprint(resolved):  # started before fields now at their defaults
+            atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
         self._manifest = {**state, "format": MANIFEST_FORMAT, "status": "running", "preset": resolved,
+                          "fingerprint": fingerprint(resolved),
                           "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}}}  # fmt: skip
         self._manifest["chunks"] = dict(state.get("chunks") or {}) if state.get("format") == MANIFEST_FORMAT else {}
         for name in self._manifest.pop("retired", None) or []:  # a compaction that did not finish
@@ -423,7 +440,7 @@ class RunDirectory:
             return None
         if not state or state.get("status") != "completed" or state.get("format") != MANIFEST_FORMAT:
             return None
-        if state.get("fingerprint") != fingerprint(_json_copy(scene.resolved())):
+        if not same_preset(state, scene):
             return None
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in self._input_hashes(scene).items():

@@ -21,7 +21,7 @@ from frictionlab import hookimpl
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
 from frictionlab.preset import build_scene
-from frictionlab.rundir import RunDirectory
+from frictionlab.rundir import RunDirectory, _json_copy, fingerprint
 from frictionlab.runner import run_to_folder
 from frictionlab.options import RunOptions
 
@@ -29,11 +29,14 @@ from .conftest import SMALL_PRESET, merge
 
 # ~20 ms per realization: 150 of them last long enough to be killed mid-run
 NO_PLOT = {"output": {"plot": False}}  # matplotlib costs a second per folder and is not under test
-KILL_PRESET = merge(SMALL_PRESET, {"realizations": 80, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
+# A run killed once two chunks are on disk must still have most of its work ahead: chunks are
+# written every UNSAVED_WORK_SECONDS of computing, so the run is sized at ~20x that per worker
+# (80 realizations finished between the second chunk and the signal on a fast machine).
+KILL_PRESET = merge(SMALL_PRESET, {"realizations": 480, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
 # exact half-space contact of a surface with a rolloff, ~0.1 s per realization
 KILL_SURFACE = merge(
     yaml.safe_load((Path(__file__).parents[1] / "presets" / "exact3d-h08-rolloff.yaml").read_text()),
-    {"realizations": 40, "spectrum": {"params": {"points": 128}}, **NO_PLOT},
+    {"realizations": 64, "spectrum": {"params": {"points": 128}}, **NO_PLOT},
 )
 
 
@@ -121,6 +124,49 @@ def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, t
     assert message.startswith(f"cannot resume {tmp_path / 'run'}: its preset differs from the one given")
     assert "realizations: 8 in the run directory, 9 given" in message
     assert "spectrum.params.hurst: 0.8 in the run directory, 0.7 given" in message
+
+
+def _as_written_before(run: Path, fields: list[tuple[str, ...]]) -> None:
+    """Make ``run`` look started by a frictionlab that did not yet have ``fields``: each
+    dropped from the stored preset, and the manifest's fingerprint that of what is left."""
+    state = json.loads((run / "run.json").read_text())
+    for path in fields:
+        section = state["preset"]
+        for key in path[:-1]:
+            section = section[key]
+        del section[path[-1]]
+    state["fingerprint"] = fingerprint(state["preset"])
+    (run / "run.json").write_text(json.dumps(state))
+    (run / "preset.yaml").write_text(yaml.safe_dump(state["preset"]))
+
+
+ADDED_LATER = [("loading", "unit"), ("solver", "params", "poisson_ratio")]
+
+
+def test_a_run_started_before_a_field_existed_resumes_with_the_field_at_its_default(make_scene, tmp_path):
+    scene = make_scene({"realizations": 20, **NO_PLOT})
+    cancel = threading.Event()
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel)
+    assert first.status == "cancelled" and first.done < 20
+    _as_written_before(tmp_path / "run", ADDED_LATER)
+
+    resumed, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    assert resumed.status == "completed" and resumed.extra["resumed"] == first.done
+    state = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert state["preset"]["loading"]["unit"] == "force"  # the folder now states the field, at its default
+    assert state["fingerprint"] == fingerprint(_json_copy(scene.resolved()))
+    run_to_folder(scene, tmp_path / "whole", RunOptions(workers=1))
+    same_files(tmp_path / "run", tmp_path / "whole")
+
+
+def test_a_field_added_later_but_given_another_value_than_its_default_is_refused(make_scene, tmp_path):
+    cancel = threading.Event()
+    cancel.set()
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1), cancel=cancel)
+    _as_written_before(tmp_path / "run", ADDED_LATER)
+    other = make_scene({"solver": {"params": {"poisson_ratio": 0.3}}})
+    with pytest.raises(FrictionlabError, match=r"solver\.params\.poisson_ratio: '\(absent\)' in the run directory, 0\.3 given"):
+        run_to_folder(other, tmp_path / "run", RunOptions(workers=1, resume=True))
 
 
 def test_a_fresh_run_over_an_unfinished_one_is_refused(make_scene, tmp_path):

@@ -116,3 +116,19 @@ def differences(old, new, path: str = "") -> list[str]:
     if old != new:
         return [f"{path}: {old!r} in the run directory, {new!r} given"]
     return []
+
+
+def with_new_defaults(stored: dict, resolved: dict, defaults: dict) -> dict:
+    """``stored`` (a run folder's resolved preset) with each field it lacks taken from
+    ``resolved`` where that value is the field's default (``defaults``, the shape of
+    ``Scene.defaults()``): a run started before a field existed used what its default is
+    now, so upgrading frictionlab does not orphan unfinished runs."""
+    out = dict(stored)
+    for key, value in resolved.items():
+        default = defaults.get(key) if isinstance(defaults, dict) else None
+        if key not in stored:
+            if isinstance(defaults, dict) and key in defaults and default == value:
+                out[key] = value
+        elif isinstance(stored[key], dict) and isinstance(value, dict):
+            out[key] = with_new_defaults(stored[key], value, default if isinstance(default, dict) else {})
+    return out

@@ -9,7 +9,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from pydantic import ValidationError
+from pydantic import BaseModel, TypeAdapter, ValidationError
+from pydantic.errors import PydanticSchemaGenerationError
 
 from ..errors import PluginError, PresetError
 from ..inputs import input_fields, regular_file_problem
@@ -18,6 +19,21 @@ from ..registry import Registry, default_registry
 from .problems import format_validation_error, merge_problems, number_problems, shown_value
 from .reading import read_preset, resolve_input_paths
 from .schema import PluginChoice, Preset
+
+
+def model_defaults(model: BaseModel) -> dict:
+    """The JSON form of each defaulted field of ``model``, recursing into sub-models."""
+    out = {}
+    for name, field in type(model).model_fields.items():
+        value = getattr(model, name)
+        if isinstance(value, BaseModel):
+            out[name] = model_defaults(value)
+        elif not field.is_required():
+            try:
+                out[name] = TypeAdapter(field.annotation).dump_python(field.get_default(call_default_factory=True), mode="json")
+            except (PydanticSchemaGenerationError, ValueError, TypeError):
+                continue  # a default with no JSON form cannot have been stored either
+    return out
 
 
 @dataclass(frozen=True)
@@ -102,6 +118,14 @@ class Scene:
             data.pop("sweep", None)  # a plain run (or one sweep point) has no sweep section
         for kind, plugin in self.plugins().items():
             data[kind] = {"name": plugin.name, "params": plugin.params.model_dump(mode="json")}
+        return data
+
+    def defaults(self) -> dict:
+        """``resolved()``'s shape, holding only the fields that have a default, each at its
+        default: what a run folder written before a field existed is taken to have used."""
+        data = model_defaults(self.preset)
+        for kind, plugin in self.plugins().items():
+            data[kind] = {"params": model_defaults(plugin.params)}
         return data
 
     def input_files(self) -> dict[str, str]:
