@@ -38,7 +38,7 @@ import time
 import numpy as np
 
 from frictionlab import Profile
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import bem
 from frictionlab_solvers.elastic import PeriodicHalfSpace
 from frictionlab_solvers.polonsky_keer import PolonskyKeerCG

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from frictionlab import Profile
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
 from frictionlab_spectra.surface import PowerLawSurface
 

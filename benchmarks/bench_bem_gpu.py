@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers.arrays import namespace
 from frictionlab_solvers.bem import BEMHalfSpace
 from frictionlab_spectra.surface import PowerLawSurface

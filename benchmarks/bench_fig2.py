@@ -17,11 +17,11 @@ import argparse
 import time
 from pathlib import Path
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.options import RunOptions, default_workers
-from frictionlab.realization import compute_realization
+from frictionlab.compute.realization import compute_realization
 from frictionlab.preset import load_scene
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
 

@@ -22,8 +22,8 @@ from pathlib import Path
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene, read_preset
 from frictionlab.preset.builtin import resolve_preset_path
-from frictionlab.progresslog import PROGRESS_FILE, Follower, ProgressLog
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.progresslog import PROGRESS_FILE, Follower, ProgressLog
+from frictionlab.runs.runner import run_to_folder
 
 
 def main() -> None:

@@ -33,14 +33,14 @@ import threading
 import time
 from pathlib import Path
 
-from frictionlab import engine
-from frictionlab.dask_security import PROFILE_OFF, WORKER_CONFIG
-from frictionlab.dask_session import one_dask_cluster
-from frictionlab.executors import make_executor
+from frictionlab.compute import engine
+from frictionlab.compute.dask_security import PROFILE_OFF, WORKER_CONFIG
+from frictionlab.compute.dask_session import one_dask_cluster
+from frictionlab.compute.executors import make_executor
 from frictionlab.options import RunOptions
 from frictionlab.preset import load_scene
-from frictionlab.realization import compute_realization
-from frictionlab.runner import run_to_folder
+from frictionlab.compute.realization import compute_realization
+from frictionlab.runs.runner import run_to_folder
 from bench_fig2 import best_of  # the same timing rule in every benchmark (run as a script: its folder is on sys.path)
 
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
@@ -48,8 +48,8 @@ PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
 PEAK_SCRIPT = """
 import sys, time
 from frictionlab.preset import load_scene
-from frictionlab.realization import compute_realization
-from frictionlab.realization import compute_realization
+from frictionlab.compute.realization import compute_realization
+from frictionlab.compute.realization import compute_realization
 from frictionlab.options import RunOptions
 n = int(float(sys.argv[2]))
 scene = load_scene(sys.argv[1], [f"spectrum.params.points={n}", f"spectrum.params.length={float(n)}"])

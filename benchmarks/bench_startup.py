@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from frictionlab.preset import load_scene
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 
 CLI = [sys.executable, "-m", "frictionlab"]
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"

@@ -24,7 +24,7 @@ from textual.app import App
 from textual.widgets import Input
 
 from frictionlab.options import RunOptions
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 from frictionlab.tui.app import FrictionlabApp
 
 PRESET = {

@@ -18,9 +18,9 @@ so ``import frictionlab`` stays cheap.
 # (and ``frictionlab --help``) costs almost nothing: numpy and pydantic come with the
 # first name that needs them.
 _LAZY = {
-    "hookimpl": "hookspecs",
-    **dict.fromkeys(("InputFile", "InputFileProblem", "open_regular_file"), "inputs"),
-    **dict.fromkeys(("RunListener", "SweepListener"), "listeners"),
+    "hookimpl": "plugin.hookspecs",
+    **dict.fromkeys(("InputFile", "InputFileProblem", "open_regular_file"), "io.inputs"),
+    **dict.fromkeys(("RunListener", "SweepListener"), "plugin.listeners"),
     "RunOptions": "options",
     **dict.fromkeys(
         (
@@ -32,6 +32,55 @@ _LAZY = {
     ),  # fmt: skip
     **dict.fromkeys(("run", "load", "validate", "Result", "SweepResult"), "api"),
 }
+
+
+# Modules that moved into the packages by job (io, plugin, preset, compute, runs) keep
+# their old names: ``from frictionlab.runner import run_to_folder`` imports the moved module.
+_MOVED = {
+    **dict.fromkeys(("inputs", "files", "safe_yaml"), "io"),
+    **dict.fromkeys(("hookspecs", "listeners", "registry"), "plugin"),
+    **dict.fromkeys(("seeds", "loads"), "preset"),
+    **dict.fromkeys(
+        ("realization", "ensemble", "engine", "executors", "pool", "dask_session", "dask_security", "memory",
+         "signals", "fit"),
+        "compute",
+    ),  # fmt: skip
+    **dict.fromkeys(("rundir", "runfolder", "progresslog", "sweeplog", "detached", "results", "runner", "sweep"), "runs"),
+}
+
+
+class _MovedModules:
+    """A finder whose loader hands out the moved module itself under its old name."""
+
+    @staticmethod
+    def find_spec(fullname, path=None, target=None):
+        old = fullname.removeprefix(__name__ + ".")
+        if old == fullname or old not in _MOVED:
+            return None
+        from importlib.util import spec_from_loader
+
+        return spec_from_loader(fullname, _MovedModules)
+
+    @staticmethod
+    def create_module(spec):
+        from importlib import import_module
+
+        old = spec.name.removeprefix(__name__ + ".")
+        return import_module(f"{__name__}.{_MOVED[old]}.{old}")
+
+    @staticmethod
+    def exec_module(module):
+        pass  # the moved module ran when it was imported under its own name
+
+
+def _install_moved_modules() -> None:
+    import sys
+
+    if not any(finder is _MovedModules for finder in sys.meta_path):
+        sys.meta_path.append(_MovedModules)
+
+
+_install_moved_modules()
 
 
 def _version() -> str:

@@ -51,13 +51,13 @@ import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument
 from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
-from .fit import LogFit
+from .compute.fit import LogFit
 from .options import RunOptions
-from .results import CORRECTED_AREA, read_curve, read_summary
-from .runfolder import subfolder
+from .runs.results import CORRECTED_AREA, read_curve, read_summary
+from .runs.runfolder import subfolder
 
 if TYPE_CHECKING:
-    from .ensemble import RunOutcome
+    from .compute.ensemble import RunOutcome
     from .preset import Preset, Scene
 
 __all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
@@ -185,7 +185,7 @@ def read_preset_input(
     from .preset import Preset, load_preset_file, set_path
     from .preset.builtin import find_builtin, preset_source, resolve_preset_path
     from .preset.reading import resolve_input_paths
-    from .safe_yaml import YamlProblem, load_yaml
+    from .io.safe_yaml import YamlProblem, load_yaml
 
     if "overrides" in keys:  # run(preset, overrides={...}): the positional argument, named
         if overrides is not None:
@@ -240,8 +240,8 @@ def scene_record(scene: Scene) -> dict:
     """What a validated preset would run: its plugins, realizations, load steps, what
     its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None,
     and its loads (``loads``: the force unit, the range in every unit, where full contact
-    starts: ``frictionlab.loads.describe_loads``). Loads the solver cannot take are refused."""
-    from .loads import check_loads, describe_loads
+    starts: ``frictionlab.preset.loads.describe_loads``). Loads the solver cannot take are refused."""
+    from .preset.loads import check_loads, describe_loads
 
     check_loads(scene)
     preset = scene.preset
@@ -264,7 +264,7 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
     True
     """
     from .preset import build_scene
-    from .runner import check_one_realization
+    from .runs.runner import check_one_realization
 
     data, source, _ = read_preset_input(preset, overrides, **keys)
     return scene_record(build_scene(data, source=source, before_reading=check_one_realization))
@@ -310,7 +310,7 @@ def run(
     """
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
-    from .runner import memory_check_before_reading
+    from .runs.runner import memory_check_before_reading
 
     out = None if out is None else path_argument(out, "out", "a folder to write the run into")
     if scheduler is not None and not isinstance(scheduler, str):
@@ -325,7 +325,7 @@ def run(
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
     scene = build_scene(data, source=source, before_reading=reading)
     if scene.preset.sweep is not None:
-        from .sweep import plan_sweep, run_sweep
+        from .runs.sweep import plan_sweep, run_sweep
 
         if out is None:
             raise FrictionlabError(f"{source}: a sweep writes a run folder per point: give out=FOLDER")
@@ -349,9 +349,9 @@ def run_scene(
     when None, in memory (``engine.run``); the one path of ``frictionlab.run`` and of
     ``frictionlab run``. ``on_results(result)`` is called before the figure is drawn."""
     if out is None:
-        from . import engine
-        from .loads import check_loads
-        from .runner import check_memory
+        from .compute import engine
+        from .preset.loads import check_loads
+        from .runs.runner import check_memory
 
         if options.resume:
             raise FrictionlabError("resume needs the run folder: give out=FOLDER")
@@ -363,7 +363,7 @@ def run_scene(
         if on_results is not None:
             on_results(result)
         return result
-    from .runner import run_to_folder
+    from .runs.runner import run_to_folder
 
     def tell(outcome, files):
         if on_results is not None:
@@ -401,7 +401,7 @@ def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers
     to the last bit; a sweep's folder (sweep.json) as a ``SweepResult``. The folder is
-    read as untrusted input (``frictionlab.runfolder``: only regular files inside it,
+    read as untrusted input (``frictionlab.runs.runfolder``: only regular files inside it,
     never through a link, every value checked): any problem, a folder with neither
     file too, is a ``RunFolderError`` naming the file and what is wrong."""
     folder = path_argument(folder, "folder", "a run folder")
@@ -442,7 +442,7 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 
 def _load_sweep(folder: Path) -> SweepResult:
-    from .sweep import read_sweep_record
+    from .runs.sweep import read_sweep_record
 
     summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]

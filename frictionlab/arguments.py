@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from .errors import FrictionlabError, short_repr, too_long_path
-from .safe_yaml import MAX_DEPTH, MAX_VALUES
+from .io.safe_yaml import MAX_DEPTH, MAX_VALUES
 
 _SCALARS = (str, int, float, bool, type(None), os.PathLike)
 

@@ -27,6 +27,7 @@ class FrictionlabError(Exception):
     """Base of the errors a user can cause and fix; shown without a traceback."""
 
     exit_code = ExitCode.USAGE
+    problems: list[str] | None = None  # one line per problem, where an error lists several (PresetError)
 
 
 EXTRAS = {"dask": "dask", "distributed": "dask", "pandas": "pandas", "ipywidgets": "notebook", "tamaas": "bench"}

@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from .ensemble import RunOutcome
-from .fit import LogFit
+from .compute.ensemble import RunOutcome
+from .compute.fit import LogFit
 from .preset import Scene
 
 XI_LABEL = "xi = rms slope in contact / rms slope"

@@ -14,8 +14,8 @@ import sys
 import time
 
 from .errors import counted, shown
-from .hookspecs import hookimpl
-from .listeners import SweepListener, progress_text, solve_text
+from .plugin.hookspecs import hookimpl
+from .plugin.listeners import SweepListener, progress_text, solve_text
 
 
 def _in_notebook() -> bool:
@@ -267,9 +267,9 @@ class SweepProgress(SweepListener):
 
 def point_result_line(sweep, point, row: dict) -> str:
     """``    2  hurst=0.7: a = ..., b = ..., R^2 = ..., contacts ..``: how a point ended."""
-    from .fit import format_estimate
+    from .compute.fit import format_estimate
     from .preset import yaml_scalar
-    from .sweep import row_fit
+    from .runs.sweep import row_fit
 
     values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(point.values[p])}" for p in sweep.paths)
     fit = row_fit(row)

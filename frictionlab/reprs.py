@@ -9,7 +9,7 @@ import html
 import io
 import math
 
-from .fit import format_interval, format_number
+from .compute.fit import format_interval, format_number
 
 
 def result_html(result) -> str:

@@ -15,7 +15,7 @@ from typing import Any
 
 from .errors import FrictionlabError
 from .preset import Scene, build_scene, set_path
-from .registry import Registry
+from .plugin.registry import Registry
 
 
 def force_scale(scene: Scene) -> float:

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from frictionlab.preset import build_scene
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS = ROOT / "presets"

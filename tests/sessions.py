@@ -25,7 +25,7 @@ def start_then_hang_up(data: dict, out, resolve: bool, plot: bool = True) -> int
     preset = f"build_scene({data!r}).resolved()" if resolve else repr(data)
     starter = textwrap.dedent(f"""
         import time
-        from frictionlab.detached import start_detached, wait_started
+        from frictionlab.runs.detached import start_detached, wait_started
         from frictionlab.options import RunOptions
         from frictionlab.preset import build_scene
         process = start_detached({preset}, {str(out)!r}, RunOptions(workers=1), plot={plot!r})

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from frictionlab import Profile
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 from frictionlab.testing import check_plugin
 from frictionlab_solvers import BEMHalfPlane, BEMHalfSpace
 

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from frictionlab import Profile
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 from frictionlab.testing import check_plugin
 from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
 from frictionlab_solvers.bem_free import FreeHalfSpace, pixel_influence

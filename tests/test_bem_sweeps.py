@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from frictionlab import Profile
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import BEMHalfPlane, BEMHalfSpace
 from frictionlab_spectra.surface import PowerLawSurface
 

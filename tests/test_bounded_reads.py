@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from frictionlab.inputs import InputFileProblem, read_regular_file
+from frictionlab.io.inputs import InputFileProblem, read_regular_file
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCES = sorted([*(ROOT / "frictionlab").rglob("*.py"), *(ROOT / "plugins").rglob("*.py")])
@@ -87,7 +87,7 @@ def test_a_small_file_under_a_huge_cap_is_read_under_a_virtual_memory_limit(tmp_
     code = (
         "import resource, sys\n"
         "resource.setrlimit(resource.RLIMIT_AS, (2**30, 2**30))\n"
-        "from frictionlab.inputs import read_regular_file\n"
+        "from frictionlab.io.inputs import read_regular_file\n"
         "data = read_regular_file(sys.argv[1], 16 * 1024**3)\n"
         "assert data == bytes(range(256)) * 20, len(data)\n"
         "print('read', len(data))\n"
@@ -122,7 +122,7 @@ class _Growing:
 
 @pytest.mark.parametrize("limit", [None, 150, 10_000_000])
 def test_a_file_that_grew_while_read_is_read_to_one_byte_past_the_cap_in_small_buffers(limit):
-    from frictionlab.inputs import GROWTH_BLOCK, read_bounded
+    from frictionlab.io.inputs import GROWTH_BLOCK, read_bounded
 
     data = bytes(range(200)) * 10_000  # 2 MB, where the fstat said 100 bytes
     fh = _Growing(data)

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import frictionlab_solvers.contact_cg as contact_cg
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import BEMHalfPlane, BEMHalfSpace
 from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface

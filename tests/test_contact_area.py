@@ -124,7 +124,7 @@ SURFACE = {"name": "area", "seed": 3, "realizations": 3,
 
 def test_the_corrected_area_reaches_every_output_and_reads_back(tmp_path):
     import frictionlab
-    from frictionlab.results import read_curve
+    from frictionlab.runs.results import read_curve
 
     result = frictionlab.run(SURFACE, out=tmp_path / "run", workers=1, progress=False, plot=False)
     per = np.load(tmp_path / "run" / "realizations.npz")["real_area_corrected"]
@@ -154,7 +154,7 @@ def test_a_resumed_run_keeps_the_corrected_area_and_springs_have_none(registry, 
     import frictionlab
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
-    from frictionlab.runner import run_to_folder
+    from frictionlab.runs.runner import run_to_folder
 
     scene = build_scene({**SURFACE, "output": {"plot": False}}, registry=registry)
     cancel = threading.Event()

@@ -8,12 +8,13 @@ import time
 import numpy as np
 import pytest
 
-from frictionlab import engine, hookimpl
-from frictionlab.dask_session import one_dask_cluster
-from frictionlab.executors import _packed_chunk
+from frictionlab.compute import engine
+from frictionlab import hookimpl
+from frictionlab.compute.dask_session import one_dask_cluster
+from frictionlab.compute.executors import _packed_chunk
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.sweep import plan_sweep, run_sweep
+from frictionlab.runs.sweep import plan_sweep, run_sweep
 
 from .conftest import loopback_cluster, merge
 from .test_load_progress import LONG_LOADS

@@ -11,19 +11,13 @@ import sys
 import numpy as np
 import pytest
 
-from frictionlab.detached import (
-    lock_held,
-    process_alive,
-    run_state,
-    start_detached,
-    wait_started,
-)
-from frictionlab.hookspecs import hookimpl
+from frictionlab.runs.detached import lock_held, process_alive, run_state, start_detached, wait_started
+from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.progresslog import PROGRESS_FILE, Follower, ProgressLog, ProgressReader
-from frictionlab.rundir import LOCK_FILE, RunDirectory
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.progresslog import PROGRESS_FILE, Follower, ProgressLog, ProgressReader
+from frictionlab.runs.rundir import LOCK_FILE, RunDirectory
+from frictionlab.runs.runner import run_to_folder
 
 from .conftest import SMALL_PRESET, merge
 from .sessions import start_then_hang_up, wait_for
@@ -156,7 +150,7 @@ def test_the_progress_file_is_read_as_untrusted_input(tmp_path, monkeypatch):
     assert ProgressReader(tmp_path).new_events() == []  # never through a link
     path.unlink()
     path.write_bytes(b'{"event": "started"}\n' * 100)
-    monkeypatch.setattr("frictionlab.progresslog.MAX_PROGRESS_BYTES", 1000)
+    monkeypatch.setattr("frictionlab.runs.progresslog.MAX_PROGRESS_BYTES", 1000)
     capped = ProgressReader(tmp_path)
     assert capped.new_events() == [] and capped.too_large
 
@@ -177,7 +171,7 @@ def test_a_realization_event_of_the_wrong_shape_is_skipped(tmp_path):
 
 
 def test_iterations_within_a_load_reach_the_follower(tmp_path):
-    from frictionlab.engine import RunInfo
+    from frictionlab.compute.engine import RunInfo
 
     scene = build_scene(SMALL_PRESET)
     log = ProgressLog(tmp_path)

@@ -9,13 +9,13 @@ import sys
 
 import pytest
 
-from frictionlab.detached import list_run_states, run_state, start_detached, wait_started
+from frictionlab.runs.detached import list_run_states, run_state, start_detached, wait_started
 from frictionlab.errors import RunFolderError
-from frictionlab.listeners import SweepListener
+from frictionlab.plugin.listeners import SweepListener
 from frictionlab.options import RunOptions
-from frictionlab.progresslog import PROGRESS_FILE
-from frictionlab.sweep import plan_sweep, run_sweep
-from frictionlab.sweeplog import SweepFollower
+from frictionlab.runs.progresslog import PROGRESS_FILE
+from frictionlab.runs.sweep import plan_sweep, run_sweep
+from frictionlab.runs.sweeplog import SweepFollower
 
 from .conftest import SMALL_PRESET, merge
 from .sessions import start_then_hang_up, wait_for

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from frictionlab.cli.main import build_parser
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 
 from .conftest import ROOT
 

@@ -5,11 +5,12 @@ import threading
 import numpy as np
 import pytest
 
-from frictionlab import SpectrumGenerator, engine, hookimpl
+from frictionlab import SpectrumGenerator, hookimpl
+from frictionlab.compute import engine
 from frictionlab.plugin import PluginParams, Profile
-from frictionlab.realization import compute_realization
+from frictionlab.compute.realization import compute_realization
 from frictionlab.preset import Scene
-from frictionlab.executors import pool_context
+from frictionlab.compute.executors import pool_context
 from frictionlab.options import RunOptions
 
 
@@ -219,9 +220,9 @@ def test_ctrl_c_during_the_fit_lets_the_fit_finish_and_the_run_is_summarised(mak
     import os
     import signal
 
-    import frictionlab.ensemble
+    import frictionlab.compute.ensemble
 
-    fit = frictionlab.ensemble.fit_log_law
+    fit = frictionlab.compute.ensemble.fit_log_law
 
     def fit_while_pressed(*args, **kwargs):  # the user presses Ctrl-C as the fit starts
         os.kill(os.getpid(), signal.SIGINT)
@@ -229,7 +230,7 @@ def test_ctrl_c_during_the_fit_lets_the_fit_finish_and_the_run_is_summarised(mak
 
     scene = make_scene({"realizations": 6})
     expected = engine.run(scene, RunOptions(workers=1))
-    monkeypatch.setattr(frictionlab.ensemble, "fit_log_law", fit_while_pressed)
+    monkeypatch.setattr(frictionlab.compute.ensemble, "fit_log_law", fit_while_pressed)
     outcome = engine.run(scene, RunOptions(workers=1))  # before, a KeyboardInterrupt left no outcome
     assert outcome.status == "completed" and outcome.extra["signal"] == "SIGINT"
     assert outcome.fit == expected.fit

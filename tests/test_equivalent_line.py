@@ -14,7 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab import engine, mdr_length
+from frictionlab.compute import engine
+from frictionlab import mdr_length
 from frictionlab.preset import build_scene
 from frictionlab.testing import check_plugin
 from frictionlab_slopes import ForwardDifference, Spectral

@@ -16,10 +16,10 @@ from frictionlab.cli.main import main
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.progress import ProgressReporter, SweepProgress
-from frictionlab.progresslog import PROGRESS_FILE
-from frictionlab.realization import RealizationResult
-from frictionlab.rundir import RunDirectory
-from frictionlab.sweep import plan_sweep, run_sweep
+from frictionlab.runs.progresslog import PROGRESS_FILE
+from frictionlab.compute.realization import RealizationResult
+from frictionlab.runs.rundir import RunDirectory
+from frictionlab.runs.sweep import plan_sweep, run_sweep
 
 from .conftest import SMALL_PRESET, merge
 
@@ -33,7 +33,7 @@ def test_follow_prints_a_forged_finished_error_escaped(tmp_path):
     script = textwrap.dedent(f"""
         import sys
         from frictionlab.preset import build_scene
-        from frictionlab.rundir import RunDirectory
+        from frictionlab.runs.rundir import RunDirectory
         with RunDirectory({str(tmp_path)!r}) as run_dir:
             run_dir.start(build_scene({SMALL_PRESET!r}), resume=False)
             print("held", flush=True)
@@ -101,11 +101,11 @@ def test_validate_prints_a_file_name_and_a_preset_value_escaped(tmp_path, capsys
 def test_validate_prints_what_an_input_file_says_escaped(tmp_path, capsys, monkeypatch):
     """An instrument file's unit reaches the line that describes it: escaped there."""
     import frictionlab.api
-    import frictionlab.inputs
+    import frictionlab.io.inputs
 
     real = frictionlab.api.scene_record
     monkeypatch.setattr(frictionlab.api, "scene_record", lambda scene: {**real(scene), "input": {"unit": PAYLOAD}})
-    monkeypatch.setattr(frictionlab.inputs, "describe_input", lambda summary: f"map.nc: unit {summary['unit']}")
+    monkeypatch.setattr(frictionlab.io.inputs, "describe_input", lambda summary: f"map.nc: unit {summary['unit']}")
     preset = tmp_path / "p.yaml"
     preset.write_text(yaml.safe_dump(SMALL_PRESET))
     assert main(["validate", str(preset)]) == 0

@@ -19,7 +19,7 @@ EXAMPLE = ROOT / "examples" / "frictionlab-gaussian"
 
 LIST_PLUGINS = """
 import json
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 registry = Registry()
 print(json.dumps({
     "plugins": [[i.kind, i.name, i.provider, i.version] for i in registry.infos()],
@@ -115,7 +115,7 @@ def test_listed_example_is_loaded(installed_example):
 
 def test_example_generates_through_the_registry(installed_example):
     code = (
-        "import numpy as np; from frictionlab.registry import Registry; "
+        "import numpy as np; from frictionlab.plugin.registry import Registry; "
         "cls = Registry().get('spectrum', 'Gaussian'); "
         "z = cls(points=64, correlation_length=4.0, rms_height=2.0).generate(np.random.default_rng(1)).heights; "
         "print(cls.__module__, z.size, round(float(np.sqrt(np.mean(z**2))), 9))"

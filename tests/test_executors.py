@@ -12,10 +12,10 @@ import sys
 import numpy as np
 import pytest
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.errors import FrictionlabError
-from frictionlab import executors
-from frictionlab.executors import DASK_MISSING, ProcessExecutor, SerialExecutor, plan_chunks, sized_executor
+from frictionlab.compute import executors
+from frictionlab.compute.executors import DASK_MISSING, ProcessExecutor, SerialExecutor, plan_chunks, sized_executor
 from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
 from frictionlab_spectra.power_law import PowerLaw
@@ -219,7 +219,7 @@ def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_2
 def test_a_scene_too_large_to_travel_in_each_task_is_broadcast_with_the_same_numbers(
     monkeypatch, scene_24, serial_24, dask_scheduler
 ):
-    from frictionlab import executors
+    from frictionlab.compute import executors
 
     scattered = []
     real_scatter = distributed.Client.scatter
@@ -241,7 +241,7 @@ def test_the_size_of_a_scene_s_pickle_is_counted_without_copying_a_large_one():
     import pickle
     import tracemalloc
 
-    from frictionlab.executors import _pickles_within
+    from frictionlab.compute.executors import _pickles_within
 
     small = {"hurst": 0.8, "points": 1024}
     size = len(pickle.dumps(small, protocol=pickle.HIGHEST_PROTOCOL))
@@ -257,7 +257,7 @@ def test_the_size_of_a_scene_s_pickle_is_counted_without_copying_a_large_one():
 
 
 def test_results_come_straight_from_the_workers_only_of_a_scheduler_on_this_machine():
-    from frictionlab.dask_security import _on_this_machine
+    from frictionlab.compute.dask_security import _on_this_machine
 
     assert _on_this_machine("tcp://127.0.0.1:8786") and _on_this_machine("tls://localhost:8786")
     assert _on_this_machine("tcp://[::1]:8786")
@@ -301,7 +301,7 @@ def test_the_own_cluster_s_workers_keep_the_adaptive_malloc_thresholds():
     fresh process: a nanny started here before (another test's cluster) leaves Dask's value
     in this process's environment, which a worker inherits."""
     script = (
-        "from frictionlab.dask_security import start_local_cluster\n"
+        "from frictionlab.compute.dask_security import start_local_cluster\n"
         "import os\n"
         "client, cluster = start_local_cluster(1)\n"
         "print(list(client.run(os.environ.get, 'MALLOC_TRIM_THRESHOLD_').values()))\n"
@@ -315,7 +315,7 @@ def test_the_own_cluster_s_workers_keep_the_adaptive_malloc_thresholds():
 
 @needs_dask
 def test_dask_memory_limits_foresee_those_of_the_local_cluster(dask_scheduler):
-    from frictionlab.executors import dask_memory_limits
+    from frictionlab.compute.executors import dask_memory_limits
 
     # the fixture's cluster is built like the executor's own LocalCluster: what
     # the memory check expects without starting one is what Dask then gives
@@ -364,7 +364,7 @@ except Exception as exc:
 def test_the_executors_own_cluster_admits_only_this_runs_credentials():
     import subprocess
 
-    from frictionlab.executors import DaskExecutor
+    from frictionlab.compute.executors import DaskExecutor
 
     client, cluster = DaskExecutor(1)._connect()  # what `--executor dask` without --scheduler starts
     try:
@@ -386,7 +386,7 @@ def test_the_executors_own_cluster_admits_only_this_runs_credentials():
 
 @needs_dask
 def test_the_dashboard_is_served_on_loopback_only_when_asked(capsys):
-    from frictionlab.dask_security import start_local_cluster
+    from frictionlab.compute.dask_security import start_local_cluster
 
     client, cluster = start_local_cluster(1, dashboard=True)
     try:
@@ -401,7 +401,7 @@ def test_the_dashboard_is_served_on_loopback_only_when_asked(capsys):
 def test_scheduler_addresses_neither_loopback_nor_tls_get_a_warning():
     import warnings
 
-    from frictionlab.dask_security import check_address
+    from frictionlab.compute.dask_security import check_address
 
     with pytest.warns(UserWarning, match="reached without TLS: anyone who can reach that address can run code"):
         check_address("tcp://10.1.2.3:8786")
@@ -464,7 +464,7 @@ def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_co
     import threading
     import time
 
-    from frictionlab.dask_security import CONNECT_SECONDS, connect_scheduler
+    from frictionlab.compute.dask_security import CONNECT_SECONDS, connect_scheduler
     from frictionlab.errors import RunError
 
     class Quiet(http.server.SimpleHTTPRequestHandler):

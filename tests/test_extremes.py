@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.plugin import Profile
 from frictionlab.preset import build_scene
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
 from frictionlab_solvers import BisectionSprings, MDRSprings, WinklerSprings
 from frictionlab_spectra import PowerLaw, PowerLawSurface, ProfileFile, Rolloff, RolloffSurface

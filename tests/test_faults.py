@@ -20,10 +20,11 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab import engine, runner
+from frictionlab.compute import engine
+from frictionlab.runs import runner
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 from .conftest import ROOT, SMALL_PRESET, merge
 from .test_resume import KILL_PRESET, NO_PLOT, CancelAfter, same_files
@@ -35,7 +36,7 @@ import json, os, sys
 import numpy as np
 from frictionlab import engine
 from frictionlab.preset import build_scene
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 from frictionlab.options import RunOptions
 from tests.conftest import SMALL_PRESET, merge
 from tests.faults import MidSendKiller, with_spectrum

@@ -23,7 +23,7 @@ MiB = 2**20
 _MEASURE = """
 import sys
 import numpy, scipy.fft, yaml
-import frictionlab.runner, frictionlab.engine, frictionlab_spectra, frictionlab_solvers
+import frictionlab.runs.runner, frictionlab.compute.engine, frictionlab_spectra, frictionlab_solvers
 from frictionlab import memory
 from frictionlab.cli.main import main
 try:

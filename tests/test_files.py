@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from frictionlab.files import atomic_write, write_npz
+from frictionlab.io.files import atomic_write, write_npz
 
 
 def test_atomic_write_gives_the_usual_permissions_not_mkstemps(tmp_path):
@@ -139,7 +139,7 @@ def test_atomic_write_refuses_a_folder_or_socket_naming_it(tmp_path):
 def test_an_open_stream_the_user_named_is_written_into_whatever_it_is_redirected_to(tmp_path):
     """``--out /dev/stdout > file``: the stream is written into; renaming over the link
     (as root, /dev/stdout itself) is what must never happen."""
-    from frictionlab.files import check_output_file
+    from frictionlab.io.files import check_output_file
 
     target = tmp_path / "redirected.json"
     with open(target, "w") as stream:

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.fit import defined_mean, fit_log_law, least_squares, percentile_interval
+from frictionlab.compute.fit import defined_mean, fit_log_law, least_squares, percentile_interval
 
 
 def test_exact_log_law_is_recovered_exactly():
@@ -103,7 +103,7 @@ def test_undefined_xi_is_left_out_of_the_mean_the_fit_and_every_resample():
     """Brute force: at each force the mean over the lines whose xi is defined; each resample
     the same, with the resampled counts as weights; every resample here has a defined xi at
     every force (line 0 etc. are undefined at a few forces only, most lines everywhere)."""
-    from frictionlab.ensemble import defined_statistics
+    from frictionlab.compute.ensemble import defined_statistics
 
     f, xi = _undefined_at_low_forces(np.random.default_rng(8))
     mean, sem, used = defined_statistics(xi)

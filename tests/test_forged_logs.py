@@ -19,17 +19,17 @@ import pytest
 import frictionlab
 
 from frictionlab.cli.main import main
-from frictionlab.detached import lock_held, lock_holder, run_state, start_detached, wait_started
+from frictionlab.runs.detached import lock_held, lock_holder, run_state, start_detached, wait_started
 from frictionlab.errors import FrictionlabError, RunFolderError
-from frictionlab.hookspecs import hookimpl
+from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.progress import ProgressReporter
-from frictionlab.progresslog import MAX_LINE_BYTES, PROGRESS_FILE, READ_BLOCK, Follower, ProgressLog, ProgressReader
-from frictionlab.realization import RealizationResult
-from frictionlab.rundir import LOCK_FILE, RunDirectory
-from frictionlab.runfolder import _not_to_signal
-from frictionlab.sweep import plan_sweep, run_sweep
+from frictionlab.runs.progresslog import MAX_LINE_BYTES, PROGRESS_FILE, READ_BLOCK, Follower, ProgressLog, ProgressReader
+from frictionlab.compute.realization import RealizationResult
+from frictionlab.runs.rundir import LOCK_FILE, RunDirectory
+from frictionlab.runs.runfolder import _not_to_signal
+from frictionlab.runs.sweep import plan_sweep, run_sweep
 
 from .conftest import SMALL_PRESET, merge
 from .sessions import wait_for
@@ -45,7 +45,7 @@ def hold(folder, data=SMALL_PRESET, own_session=True) -> subprocess.Popen:
     script = textwrap.dedent(f"""
         import sys
         from frictionlab.preset import build_scene
-        from frictionlab.rundir import RunDirectory
+        from frictionlab.runs.rundir import RunDirectory
         with RunDirectory({str(folder)!r}) as run_dir:
             run_dir.start(build_scene({data!r}), resume=False)
             print("held", flush=True)
@@ -106,7 +106,7 @@ def test_cancel_signals_the_verified_lock_holder_never_the_pid_a_forged_log_or_l
 
 
 def test_a_lock_held_by_this_process_or_its_session_is_never_signalled(tmp_path, victim):
-    from frictionlab.detached import cancel
+    from frictionlab.runs.detached import cancel
 
     with RunDirectory(tmp_path) as run_dir:
         run_dir.start(build_scene(SMALL_PRESET), resume=False)
@@ -182,7 +182,7 @@ def test_a_reporter_fed_numbers_out_of_bounds_returns(tmp_path):
 
 
 def test_a_realization_of_200000_load_steps_is_written_in_a_line_a_follower_reads(tmp_path):
-    from frictionlab.engine import RunInfo
+    from frictionlab.compute.engine import RunInfo
 
     scene = build_scene(merge(SMALL_PRESET, {"loading": {"steps": 200_000}}))
     steps = scene.loads.size

@@ -280,7 +280,7 @@ def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
 
 
 def test_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2_and_quoted_ones_stay_text():
-    from frictionlab.safe_yaml import load_yaml
+    from frictionlab.io.safe_yaml import load_yaml
 
     data = load_yaml("a: 1e-16\nb: 1E5\nc: -2e+3\nd: 1.5e3\ne: .5e1\nf: '1e5'\ng: 1e\nh: e5\ni: 12\nj: 1.5")
     assert data == {"a": 1e-16, "b": 1e5, "c": -2e3, "d": 1.5e3, "e": 5.0, "f": "1e5", "g": "1e", "h": "e5", "i": 12, "j": 1.5}
@@ -332,7 +332,7 @@ def test_a_number_past_double_precision_is_named_as_written(tmp_path, capsys):
     """1e400 was read as infinity ("must be a finite number, got inf") and 1e-400 as zero (a
     start of 0 said "must be > 0", a field allowing 0 took it silently): both are numbers
     beyond the range a preset allows, and the message quotes them as the user wrote them."""
-    from frictionlab.safe_yaml import load_yaml
+    from frictionlab.io.safe_yaml import load_yaml
 
     assert load_yaml("a: 1e400\nb: -1.5E-400\nc: .inf\nd: 0e-500\ne: 1e-300") == {
         "a": "1e400", "b": "-1.5E-400", "c": math.inf, "d": 0.0, "e": 1e-300}  # fmt: skip
@@ -353,7 +353,7 @@ def test_a_number_past_double_precision_is_named_as_written(tmp_path, capsys):
 def test_a_bracket_left_open_mid_file_is_named_at_the_line_it_opened(text, opened, found):
     """An outsider's check: `realizations: [3` on line 3 was reported at line 4, where the
     parser stumbled on the next key, in the parser's own words."""
-    from frictionlab.safe_yaml import YamlProblem, load_yaml
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
 
     with pytest.raises(YamlProblem) as refused:
         load_yaml(text)

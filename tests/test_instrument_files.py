@@ -292,7 +292,7 @@ def test_the_memory_estimate_counts_the_file_and_the_padded_solver(tmp_path, mon
     """The map's points from the file (grid_shape), times the free solver's bytes per point
     (its padded grids), plus the profile and slopes; a run that does not fit is refused
     before it starts."""
-    from frictionlab import memory
+    from frictionlab.compute import memory
     from frictionlab.errors import RunError
     from frictionlab_solvers import BEMHalfSpace, BEMHalfSpaceFree
 

@@ -60,7 +60,7 @@ def _rows(path):
 
 
 def test_a_sweeps_figure_draws_intervals_that_miss_their_estimates(registry):
-    from frictionlab.sweep import plan_sweep
+    from frictionlab.runs.sweep import plan_sweep
 
     from .test_sweep import sweep_preset
 

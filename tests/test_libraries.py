@@ -12,13 +12,13 @@ import time
 
 import pytest
 
-from frictionlab import memory
+from frictionlab.compute import memory
 from frictionlab.errors import RunFolderError
-from frictionlab.rundir import LOCK_FILE, RunDirectory
+from frictionlab.runs.rundir import LOCK_FILE, RunDirectory
 
 HOLD = """
 import sys, time
-from frictionlab.rundir import RunDirectory
+from frictionlab.runs.rundir import RunDirectory
 with RunDirectory(sys.argv[1]):
     print("held", flush=True)
     time.sleep(60)
@@ -48,7 +48,7 @@ def test_a_run_folder_held_by_another_process_is_refused_with_its_pid_until_it_d
 
 FORK_AND_DIE = """
 import os, signal, sys, time
-from frictionlab.rundir import RunDirectory
+from frictionlab.runs.rundir import RunDirectory
 with RunDirectory(sys.argv[1]):
     started, ready = os.pipe()
     child = os.fork()

@@ -11,13 +11,14 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
-from frictionlab import SolveCancelled, engine, hookimpl, iteration_done, load_finished
+from frictionlab import SolveCancelled, hookimpl, iteration_done, load_finished
+from frictionlab.compute import engine
 from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
 from frictionlab.plugin import listening_to_iterations, listening_to_loads
 from frictionlab.preset import build_scene
-from frictionlab.realization import compute_chunk, compute_realization
-from frictionlab.seeds import realization_rng
+from frictionlab.compute.realization import compute_chunk, compute_realization
+from frictionlab.preset.seeds import realization_rng
 
 from .conftest import SMALL_PRESET, merge
 
@@ -168,7 +169,7 @@ def test_a_cancel_seen_within_a_solve_abandons_the_realization(registry):
 
 
 def test_iterations_are_heard_at_most_four_times_a_second(registry, monkeypatch):
-    import frictionlab.realization as realization
+    import frictionlab.compute.realization as realization
 
     clock = iter(np.arange(0.0, 1000.0, 0.1))  # each look at the clock: 0.1 s later
     monkeypatch.setattr(realization.time, "monotonic", lambda: next(clock))
@@ -223,7 +224,7 @@ def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_s
 
 
 def test_in_this_process_a_cancel_returns_at_once_while_a_long_step_still_runs(registry, monkeypatch):
-    import frictionlab.realization as realization
+    import frictionlab.compute.realization as realization
 
     monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)
     scene = build_scene(LONG_LOADS, registry=registry)
@@ -247,8 +248,8 @@ def _sleep_through(seconds: float) -> float:
 
 
 def test_a_pool_kills_a_worker_whose_job_does_not_stop_after_a_cancel():
-    from frictionlab.executors import pool_context
-    from frictionlab.pool import WorkerPool
+    from frictionlab.compute.executors import pool_context
+    from frictionlab.compute.pool import WorkerPool
 
     cancel = threading.Event()
     pool = WorkerPool(1, pool_context(), _sleep_through)
@@ -263,7 +264,7 @@ def test_a_log_shows_the_iterations_of_a_long_load(registry, monkeypatch):
     import re
 
     import frictionlab.progress as progress
-    import frictionlab.realization as realization
+    import frictionlab.compute.realization as realization
 
     monkeypatch.setattr(progress, "LOAD_LINE_SECONDS", 0.0)
     monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)

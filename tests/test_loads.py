@@ -103,7 +103,7 @@ def test_validate_prints_the_force_unit_the_loads_in_every_unit_and_full_contact
     assert "p/E* = 3.108e-07 .. 3.108e-05" in out  # 4.096 / (pi 4096^2 / 4)
     record = frictionlab.validate("quickstart")["loads"]
     scene = build_scene(frictionlab.api.read_preset_input("quickstart", {})[0])
-    from frictionlab.loads import probe_profile
+    from frictionlab.preset.loads import probe_profile
 
     z = probe_profile(scene).heights
     assert record["full_contact"]["force"] == pytest.approx(np.sum(z - z.min()), rel=1e-12)  # E* dx sum(z - min z)
@@ -255,7 +255,7 @@ def test_the_loads_page_shows_what_the_commands_print(command, tmp_path):
 def test_a_contact_fraction_search_says_its_load_and_stops_on_cancel(monkeypatch):
     import threading
 
-    from frictionlab import realization
+    from frictionlab.compute import realization
     from frictionlab.plugin import SolveCancelled
 
     monkeypatch.setattr(realization, "ITERATION_EVENT_SECONDS", 0.0)  # every iteration heard

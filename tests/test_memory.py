@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from frictionlab import memory
+from frictionlab.compute import memory
 from frictionlab.cli import main
 from frictionlab.errors import RunError
 from frictionlab.preset import build_scene
@@ -89,7 +89,7 @@ def test_the_half_space_declares_what_its_realization_allocates(registry):
     the solve) per point lies under the declared estimate, and not far under it."""
     import tracemalloc
 
-    from frictionlab.realization import compute_realization
+    from frictionlab.compute.realization import compute_realization
 
     scene = build_scene(surface_of(256), registry=registry)
     compute_realization(scene, 0)  # caches (the synthesis, FFT plans) are not per realization
@@ -254,8 +254,8 @@ def test_cli_refuses_a_grid_too_large_for_the_dask_worker_before_submitting_anyt
 def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the_refusal(registry, tmp_path, small_worker_cluster):
     import threading
 
-    from frictionlab import engine
-    from frictionlab.runner import run_to_folder
+    from frictionlab.compute import engine
+    from frictionlab.runs.runner import run_to_folder
 
     from .test_executors import same_numbers
 
@@ -280,7 +280,7 @@ def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the
 def test_own_local_cluster_is_checked_before_it_starts(registry, tmp_path, monkeypatch):
     from distributed import worker_memory
 
-    from frictionlab.runner import run_to_folder
+    from frictionlab.runs.runner import run_to_folder
 
     # as on a many-core machine, where "auto" gives each worker memory/cores
     monkeypatch.setattr(worker_memory, "parse_memory_limit", lambda *args, **kwargs: 200 * MiB)
@@ -294,7 +294,7 @@ _UNDER_A_LIMIT = """
 import resource, sys
 import frictionlab
 from frictionlab.errors import FrictionlabError
-from frictionlab.memory import available_memory
+from frictionlab.compute.memory import available_memory
 limit = int(sys.argv[1])
 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 room, source = available_memory()

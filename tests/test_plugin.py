@@ -77,12 +77,12 @@ def test_the_framework_uses_nothing_of_a_plugin_beyond_the_contract(tmp_path, re
     on plugins that refuse the framework anything undeclared."""
     import math
 
-    from frictionlab import memory
+    from frictionlab.compute import memory
     from frictionlab.errors import RunError
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
-    from frictionlab.runner import run_to_folder
-    from frictionlab.sweep import plan_sweep, run_sweep
+    from frictionlab.runs.runner import run_to_folder
+    from frictionlab.runs.sweep import plan_sweep, run_sweep
     from frictionlab.tradeoff.axes import Study
     from frictionlab.tradeoff.options import StudyOptions
     from frictionlab.tradeoff.scenes import SceneFactory

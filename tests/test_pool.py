@@ -6,8 +6,8 @@ import threading
 import time
 from pathlib import Path
 
-from frictionlab.executors import pool_context
-from frictionlab.pool import WorkerPool
+from frictionlab.compute.executors import pool_context
+from frictionlab.compute.pool import WorkerPool
 
 
 def _mark_start(path: str) -> str:

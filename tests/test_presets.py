@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab import engine
-from frictionlab.realization import compute_realization
+from frictionlab.compute import engine
+from frictionlab.compute.realization import compute_realization
 from frictionlab.preset import load_scene
 
 from .conftest import PRESETS

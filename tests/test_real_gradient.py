@@ -135,7 +135,7 @@ SURFACE = {"name": "gradient", "seed": 3, "realizations": 3,
 
 def test_g_r_kappa_and_kappa_r_reach_curve_csv_and_read_back(tmp_path):
     import frictionlab
-    from frictionlab.results import read_curve
+    from frictionlab.runs.results import read_curve
 
     result = frictionlab.run(SURFACE, out=tmp_path / "run", workers=1, progress=False, plot=False)
     per = np.load(tmp_path / "run" / "realizations.npz")
@@ -162,7 +162,7 @@ def test_g_r_kappa_and_kappa_r_reach_curve_csv_and_read_back(tmp_path):
 def test_springs_have_no_g_r_and_a_damaged_header_is_refused(tmp_path):
     import frictionlab
     from frictionlab.errors import RunFolderError
-    from frictionlab.results import read_curve
+    from frictionlab.runs.results import read_curve
 
     springs = frictionlab.run({**SURFACE, "solver": {"name": "mdr", "params": {}}}, out=tmp_path / "mdr", workers=1,
                               progress=False, plot=False)  # fmt: skip
@@ -181,8 +181,8 @@ def test_a_resumed_run_keeps_g_r_and_an_older_chunk_without_it_reads_as_unknown(
     import frictionlab
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
-    from frictionlab.rundir import _chunk_results
-    from frictionlab.runner import run_to_folder
+    from frictionlab.runs.chunks import chunk_results
+    from frictionlab.runs.runner import run_to_folder
 
     scene = build_scene({**SURFACE, "output": {"plot": False}}, registry=registry)
     cancel = threading.Event()
@@ -196,7 +196,7 @@ def test_a_resumed_run_keeps_g_r_and_an_older_chunk_without_it_reads_as_unknown(
     chunk = sorted((tmp_path / "run" / "chunks").glob("*.npz"))[0]
     arrays = dict(np.load(chunk))
     del arrays["real_gradient_rms"]  # as a version before g_r wrote it
-    results = _chunk_results(arrays, 0, 2, scene)
+    results = chunk_results(arrays, 0, 2, scene)
     assert all(np.isnan(r.real_gradient_rms).all() for r in results if r.ok)
 
 
@@ -256,7 +256,7 @@ def test_spots_reach_curve_csv_and_grow_from_a_few(tmp_path):
 
 @pytest.mark.parametrize("attr", ["real_gradient", "counts_spots"])
 def test_a_declaration_that_is_not_a_bool_is_refused_naming_it(attr):
-    from frictionlab.registry import declaration_problems
+    from frictionlab.plugin.registry import declaration_problems
 
     broken = type("Broken", (BEMHalfSpace,), {attr: "yes", "name": "broken-bem"})
     assert any(attr in p and "True or False" in p for p in declaration_problems(broken))

@@ -15,20 +15,13 @@ import pytest
 from pydantic import BaseModel, Field
 
 from frictionlab import ContactSolver, PluginParams, hookimpl
-from frictionlab import registry as registry_module
+from frictionlab.plugin import registry as registry_module
 from frictionlab.errors import ExitCode, PluginError
-from frictionlab.hookspecs import PROJECT_NAME, RegistrationSpecs
-from frictionlab.listeners import RunListener as LifecycleSpecs
+from frictionlab.plugin.hookspecs import PROJECT_NAME, RegistrationSpecs
+from frictionlab.plugin.listeners import RunListener as LifecycleSpecs
 from frictionlab.options import RunOptions
 from frictionlab.plugin import KINDS
-from frictionlab.registry import (
-    BUILTIN_MODULES,
-    ENTRY_POINT_GROUP,
-    LoadFailure,
-    Registry,
-    normalize_name,
-    validate_plugin_class,
-)
+from frictionlab.plugin.registry import BUILTIN_MODULES, ENTRY_POINT_GROUP, LoadFailure, Registry, normalize_name, validate_plugin_class
 
 from .conftest import ROOT
 from .testing.fakes import KIND_HOOKS, provider, spectrum_class
@@ -470,7 +463,7 @@ def test_registration_hooks_take_only_register():
 def test_an_installed_plugin_can_listen_to_every_run(register_plugin, small_preset):
     """Lifecycle hooks are registry hooks too: a plugin implementing one is accepted (a misspelled
     one is not) and hears the runs made with its registry."""
-    from frictionlab import engine
+    from frictionlab.compute import engine
     from frictionlab.preset import build_scene
 
     heard = []

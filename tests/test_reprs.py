@@ -9,7 +9,7 @@ from html.parser import HTMLParser
 import numpy as np
 
 import frictionlab
-from frictionlab.fit import LogFit
+from frictionlab.compute.fit import LogFit
 
 from .conftest import SMALL_PRESET
 

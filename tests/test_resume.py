@@ -21,8 +21,8 @@ from frictionlab import hookimpl
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
 from frictionlab.preset import build_scene
-from frictionlab.rundir import RunDirectory, _json_copy, fingerprint
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.rundir import RunDirectory, _json_copy, fingerprint
+from frictionlab.runs.runner import run_to_folder
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge

@@ -18,12 +18,13 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab import files, runner
+from frictionlab.io import files
+from frictionlab.runs import runner
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.preset import build_scene
-from frictionlab.rundir import RunDirectory
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.rundir import RunDirectory
+from frictionlab.runs.runner import run_to_folder
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
@@ -197,7 +198,7 @@ def test_a_short_run_writes_its_chunks_once_and_the_same_files_as_a_chunk_at_a_t
         written.append(Path(path).name)
         return atomic_write(path, *args, **kwargs)
 
-    monkeypatch.setattr("frictionlab.rundir.atomic_write", counting)
+    monkeypatch.setattr("frictionlab.runs.rundir.atomic_write", counting)
     run_to_folder(scene, tmp_path / "batched", RunOptions(workers=1))
     batched = list(written)
     monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)

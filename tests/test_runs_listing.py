@@ -6,10 +6,10 @@ import json
 import os
 
 from frictionlab.cli import main
-from frictionlab.detached import list_run_states, run_state
+from frictionlab.runs.detached import list_run_states, run_state
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 from .conftest import SMALL_PRESET, merge
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.errors import PresetError
 from frictionlab.preset import build_scene
-from frictionlab.registry import validate_plugin_class
+from frictionlab.plugin.registry import validate_plugin_class
 from frictionlab.testing import check_plugin
 from frictionlab_slopes import CentralDifference, ForwardDifference, Spectral
 from frictionlab.options import RunOptions
@@ -366,8 +366,8 @@ def test_xi_on_a_surface_is_the_rms_gradient_over_contact_pixels_over_the_whole_
     |grad z| of every pixel, both formed here by loops."""
     import frictionlab_solvers.contact_cg as contact_cg
 
-    from frictionlab.realization import compute_realization
-    from frictionlab.seeds import realization_rng
+    from frictionlab.compute.realization import compute_realization
+    from frictionlab.preset.seeds import realization_rng
 
     contact_sets = []
     solve = contact_cg.ProjectedCG.solve

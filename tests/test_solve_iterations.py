@@ -11,7 +11,7 @@ import pytest
 
 import frictionlab.plugin
 from frictionlab import Profile, SolveCancelled
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import BEMHalfPlane, BEMHalfSpace
 from frictionlab_solvers.contact_cg import ProjectedCG, cold_start
 from frictionlab_solvers.elastic import PeriodicHalfSpace

@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from frictionlab import Profile
-from frictionlab.registry import validate_plugin_class
+from frictionlab.plugin.registry import validate_plugin_class
 from frictionlab.testing import check_plugin
 from frictionlab_slopes import ForwardDifference
 from frictionlab_solvers import BisectionSprings, MDRSprings, WinklerSprings

@@ -20,7 +20,7 @@ from pydantic import ValidationError
 from scipy.integrate import quad
 
 from frictionlab import Profile
-from frictionlab.registry import validate_plugin_class
+from frictionlab.plugin.registry import validate_plugin_class
 from frictionlab_spectra import PowerLaw, ProfileFile, Rolloff
 
 TWO_PI = 2.0 * math.pi
@@ -549,10 +549,10 @@ def test_measured_h_forms_f_and_keeps_the_contact_scaling(tmp_path):
     """Runs of the cosine series with h measured: f = F / (E* h L) with each line's own rms h; the
     springs are linear, so a line scaled by s = h / rms touches at force F as the nominal line
     (rms rms) does at F / s: the contact counts follow from the nominal run's lines by that law."""
-    from frictionlab import engine
+    from frictionlab.compute import engine
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
-    from frictionlab.seeds import realization_rng
+    from frictionlab.preset.seeds import realization_rng
     from frictionlab_solvers import MDRSprings
 
     h, loads = 2.0, np.geomspace(0.01, 3.0, 7)
@@ -584,8 +584,8 @@ def test_the_summary_says_which_h_and_gives_the_lines_measured_rms(tmp_path, ref
 
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
-    from frictionlab.runner import run_to_folder
-    from frictionlab.seeds import realization_rng
+    from frictionlab.runs.runner import run_to_folder
+    from frictionlab.preset.seeds import realization_rng
 
     params = {"hurst": 1.0, "points": 1024, "rms_height": 2.0, "series": "cosine", "height_reference": reference}
     data = {

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, PresetError
 from frictionlab.preset import build_scene, load_scene

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.errors import PresetError
 from frictionlab.plugin import Profile, SlopeEstimator
 from frictionlab.preset import build_scene

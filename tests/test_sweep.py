@@ -11,10 +11,10 @@ import yaml
 from frictionlab.cli import main
 from frictionlab.errors import PresetError
 from frictionlab.preset import load_scene
-from frictionlab.runner import run_to_folder
-from frictionlab.listeners import SweepListener
+from frictionlab.runs.runner import run_to_folder
+from frictionlab.plugin.listeners import SweepListener
 from frictionlab.preset import yaml_scalar
-from frictionlab.sweep import load_sweep, plan_sweep, read_table, run_sweep
+from frictionlab.runs.sweep import load_sweep, plan_sweep, read_table, run_sweep
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from frictionlab.options import RunOptions
 from frictionlab.plot import sweep_figure
-from frictionlab.sweep import plan_sweep, run_sweep
+from frictionlab.runs.sweep import plan_sweep, run_sweep
 
 from .test_sweep import sweep_preset
 

@@ -24,7 +24,7 @@ import yaml
 
 from frictionlab.options import RunOptions
 from frictionlab.preset import apply_overrides, build_scene, load_preset_file
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 from .conftest import PRESETS
 from .test_resume import CancelAfter, same_files
@@ -145,7 +145,7 @@ def test_validate_of_an_instrument_file_says_what_an_unlimited_process_says(tmp_
 
 
 def test_a_sweep_gives_the_numbers_of_an_unlimited_sweep(tmp_path):
-    from frictionlab.sweep import plan_sweep, run_sweep
+    from frictionlab.runs.sweep import plan_sweep, run_sweep
 
     ok(limited("run", write(tmp_path, "sweep", SWEEP), "--out", str(tmp_path / "sweep"), "--workers", "1", cwd=tmp_path))
     run_sweep(plan_sweep(SWEEP), tmp_path / "free", RunOptions(workers=1), plot=False)

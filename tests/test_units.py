@@ -19,9 +19,9 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.preset import build_scene
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab.options import RunOptions
 
 S = 1000.0  # every length

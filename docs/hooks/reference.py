@@ -218,7 +218,7 @@ def fields_table(model) -> list[str]:
 def preset_reference() -> str:
     from frictionlab.plugin import KINDS
     from frictionlab.preset.schema import FitSettings, Loading, OutputSettings, Preset, SweepParameter, SweepSettings
-    from frictionlab.registry import Registry
+    from frictionlab.plugin.registry import Registry
 
     out = [
         "# Preset reference",

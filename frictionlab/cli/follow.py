@@ -36,7 +36,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..detached import process_alive, run_state
+    from ..runs.detached import process_alive, run_state
 
     folder = Path(args.run_dir)
     state = run_state(folder)  # RunFolderError: not a run folder
@@ -97,7 +97,7 @@ def run(args) -> ExitCode:
 
 def _state_unless_gone(folder: Path, identity):
     """The state of the run in ``folder`` now; None if ``folder`` is no longer the folder of ``identity``."""
-    from ..detached import run_state
+    from ..runs.detached import run_state
     from ..errors import RunFolderError
 
     try:
@@ -119,14 +119,14 @@ def _identity(folder: Path) -> tuple[int, int] | None:
 
 
 def _stored_sweep(folder: Path):
-    from ..sweep import plan_sweep, stored_sweep
+    from ..runs.sweep import plan_sweep, stored_sweep
 
     return plan_sweep(stored_sweep(folder), source=str(folder / "sweep.json"))
 
 
 def _rows(folder: Path) -> list[dict]:
     """Each point's row of the sweep's sweep.json, its values checked."""
-    from ..sweep import read_sweep_record
+    from ..runs.sweep import read_sweep_record
 
     _, record = read_sweep_record(folder)
     return [point.model_dump() for point in record.points]
@@ -136,9 +136,9 @@ def _follower(folder: Path, sweep, quiet: bool):
     """What replays the run's (the sweep's) progress file, printing its progress unless ``quiet``."""
     from ..preset import build_scene
     from ..progress import ProgressReporter, SweepProgress
-    from ..progresslog import Follower
-    from ..rundir import RunDirectory
-    from ..sweeplog import SweepFollower
+    from ..runs.progresslog import Follower
+    from ..runs.rundir import RunDirectory
+    from ..runs.sweeplog import SweepFollower
 
     if sweep is None:
         follower = Follower(folder, build_scene(RunDirectory(folder).stored_preset()))

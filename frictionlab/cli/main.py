@@ -30,7 +30,7 @@ import sys
 import warnings
 
 from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
-from ..signals import RaiseOnSigterm, interrupted_exit_code
+from ..compute.signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
@@ -198,7 +198,7 @@ def _leave_an_abandoned_solve(code: int) -> None:
     FFT library joins its threads as the process ends, and one running on several threads
     aborted the process instead). The run has written what it keeps by now; the output
     streams and the log files are flushed first."""
-    realization = sys.modules.get("frictionlab.realization")  # not imported: no run, nothing left
+    realization = sys.modules.get("frictionlab.compute.realization")  # not imported: no run, nothing left
     if realization is None or not realization.solve_abandoned():
         return
     import logging
@@ -277,7 +277,7 @@ def _run_command(args) -> int:
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
         return _write_failed(exc)
     except FrictionlabError as exc:
-        return _refused(args, shown(str(exc)), exc.exit_code, f"{error_label()}: ", getattr(exc, "problems", None))
+        return _refused(args, shown(str(exc)), exc.exit_code, f"{error_label()}: ", exc.problems)
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
             return _write_failed(exc)
@@ -307,7 +307,7 @@ def _refused(args, message: str, code: int, label: str = "error: ", problems=Non
     """Say why the command stopped on stderr and, under ``--json``, as the error object
     on stdout (``jsonout``); return the exit code."""
     print(f"{label}{message}{suffix}", file=sys.stderr)
-    if getattr(args, "json", False):
+    if getattr(args, "json", False):  # a Namespace holds the flags of its own command only
         from . import jsonout
 
         try:

@@ -70,16 +70,16 @@ def _use_tls_options(args) -> None:
     if any(tls.values()) or (args.scheduler and args.scheduler.startswith("tls://")):
         for name, value in tls.items():
             if value:
-                from ..inputs import regular_file_problem
+                from ..io.inputs import regular_file_problem
 
                 problem = regular_file_problem(value)
                 if problem:
                     flag = "--tls-" + ("ca-file" if name == "ca_file" else name)
                     raise FrictionlabError(f"{flag} {value}: {problem}")
-        from ..dask_security import use_tls_files
+        from ..compute.dask_security import use_tls_files
 
         use_tls_files(**tls)
     if args.scheduler:
-        from ..dask_security import check_address
+        from ..compute.dask_security import check_address
 
         check_address(args.scheduler)

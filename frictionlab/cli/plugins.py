@@ -19,7 +19,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..registry import default_registry
+    from ..plugin.registry import default_registry
 
     registry = default_registry()
     infos = registry.infos()

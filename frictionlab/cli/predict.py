@@ -32,7 +32,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
-    from ..fit import LogFit, format_number, json_safe
+    from ..compute.fit import LogFit, format_number, json_safe
     from ..paper.predict import check_law, predict_xi, prediction_text, read_run_law
 
     if args.from_run:

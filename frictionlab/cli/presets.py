@@ -46,7 +46,7 @@ def run(args) -> ExitCode:
             raise FrictionlabError("DEST names no file or folder (it is empty): give one, or leave it out for this folder")
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
-            from ..files import output_path_problem
+            from ..io.files import output_path_problem
 
             problem = output_path_problem(dest)
             if problem:
@@ -67,7 +67,7 @@ def run(args) -> ExitCode:
 
 
 def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
-    from ..files import atomic_write
+    from ..io.files import atomic_write
     from ..preset.builtin import builtin_presets, find_builtin
 
     preset = find_builtin(name)

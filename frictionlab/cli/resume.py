@@ -29,13 +29,13 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..rundir import PRESET_FILE, RunDirectory
+    from ..runs.rundir import PRESET_FILE, RunDirectory
 
     run_dir = Path(args.run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
         from ..preset import build_scene
-        from ..sweep import stored_sweep
+        from ..runs.sweep import stored_sweep
         from .options import executor_run_options
 
         args.preset = str(run_dir / "sweep.json")

@@ -48,8 +48,8 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
-    from ..rundir import new_run_folder
-    from ..runner import memory_check_before_reading
+    from ..runs.rundir import new_run_folder
+    from ..runs.runner import memory_check_before_reading
 
     overrides = list(args.set or [])
     if args.seed is not None:
@@ -91,10 +91,10 @@ def add_detach_option(p) -> None:
 
 def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
     """Start the run of ``scene`` (a sweep, when ``data`` has one) as a process of its own; say where."""
-    from ..detached import check_startable, check_sweep_startable, start_detached, wait_started
+    from ..runs.detached import check_startable, check_sweep_startable, start_detached, wait_started
 
     if data.get("sweep"):
-        from ..sweep import plan_sweep
+        from ..runs.sweep import plan_sweep
 
         sweep = plan_sweep(data, source=str(args.preset))
         check_sweep_startable(sweep, out_dir, options)
@@ -121,8 +121,8 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
 def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     from ..api import run_scene
     from ..progress import ProgressReporter
-    from ..results import summary_dict
-    from ..signals import interrupted_exit_code
+    from ..runs.results import summary_dict
+    from ..compute.signals import interrupted_exit_code
 
     closed = []  # stdout closed or full: raised again once the run folder is finished
 
@@ -156,8 +156,8 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 
 
 def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
-    from ..signals import interrupted_exit_code
-    from ..sweep import plan_sweep, run_sweep
+    from ..compute.signals import interrupted_exit_code
+    from ..runs.sweep import plan_sweep, run_sweep
     from ..progress import SweepProgress
 
     sweep = plan_sweep(data, source=str(args.preset))
@@ -181,7 +181,7 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
 
 def result_table(scene, outcome, out_dir: Path) -> str:
     """What ``frictionlab run`` prints on stdout after a run: the fit and the contact counts."""
-    from ..fit import format_interval
+    from ..compute.fit import format_interval
 
     preset = scene.preset
     lines = [

@@ -30,8 +30,8 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..detached import list_run_states
-    from ..rundir import DEFAULT_RUNS_DIR
+    from ..runs.detached import list_run_states
+    from ..runs.rundir import DEFAULT_RUNS_DIR
 
     runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
     if args.runs_dir is not None and not runs_dir.is_dir():

@@ -27,12 +27,12 @@ def run(args) -> ExitCode:
     if args.out is not None and not args.out.strip():
         raise FrictionlabError("--out names no file (it is empty): give a file, or leave --out out for stdout")
     if args.out:
-        from ..files import check_output_file
+        from ..io.files import check_output_file
 
         out = check_output_file(args.out, "--out", force=args.force)  # before the work: refused at once
     text = json.dumps(preset_json_schema(), indent=2)
     if out is not None:
-        from ..files import atomic_write
+        from ..io.files import atomic_write
 
         atomic_write(out, lambda fh: fh.write(text + "\n"), devices=True)
     else:

@@ -145,7 +145,7 @@ def command_line(args) -> str:
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
-    from ..registry import default_registry
+    from ..plugin.registry import default_registry
     from ..tradeoff.axes import Study
     from ..tradeoff.outputs import claim_study_folder, recommendation, write_outputs
     from ..tradeoff.scenes import SceneFactory
@@ -187,7 +187,7 @@ def run(args) -> ExitCode:
         print(f"error: cannot write the study to {shown(out_dir)}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
-        from ..fit import json_safe
+        from ..compute.fit import json_safe
         from ..tradeoff.axes import COLUMNS
 
         def cell(value):

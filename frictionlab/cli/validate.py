@@ -22,12 +22,12 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..api import scene_record
-    from ..inputs import describe_channels, describe_input
-    from ..loads import loads_lines
+    from ..io.inputs import describe_channels, describe_input
+    from ..preset.loads import loads_lines
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
-    from ..runner import check_one_realization
-    from ..sweep import plan_sweep
+    from ..runs.runner import check_one_realization
+    from ..runs.sweep import plan_sweep
 
     worst = ExitCode.OK
     records = []
@@ -43,7 +43,7 @@ def run(args) -> ExitCode:
             record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         except FrictionlabError as exc:
             worst = ExitCode(max(worst, exc.exit_code))
-            problems = getattr(exc, "problems", None) or [str(exc)]
+            problems = exc.problems or [str(exc)]
             records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
             if not args.json:
                 print(shown(str(exc)), file=sys.stderr)

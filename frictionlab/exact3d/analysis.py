@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ensemble import area_law_ratio
-from ..fit import percentile_interval
+from ..compute.ensemble import area_law_ratio
+from ..compute.fit import percentile_interval
 
 SMALL_LOAD_FRACTION = 0.05  # contact fraction below which the area is taken to grow linearly
 KAPPA_WINDOW = (0.005, SMALL_LOAD_FRACTION)  # contact fractions where simulations find kappa of about 2 to 2.3

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ensemble import area_law_ratio
-from ..seeds import bootstrap_rng
+from ..compute.ensemble import area_law_ratio
+from ..preset.seeds import bootstrap_rng
 from .analysis import KAPPA_WINDOW
 from .plan import MAIN, Ensemble, StudyRuns
 from .statistics import Estimate, Extrapolation, ModelTest, compare_models, extrapolate, paired_bootstrap

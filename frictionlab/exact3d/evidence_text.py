@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..fit import format_estimate, format_interval
+from ..compute.fit import format_estimate, format_interval
 from .analysis import KAPPA_BUSH, KAPPA_SIMULATIONS
 from .evidence import GRADIENT_WINDOW, MANY_SPOTS, Convergence
 from .numbers import Numbers

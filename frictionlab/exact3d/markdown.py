@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from ..fit import format_estimate, format_interval
-from ..listeners import format_duration
+from ..compute.fit import format_estimate, format_interval
+from ..plugin.listeners import format_duration
 from .analysis import FEW_SPOTS, KAPPA_BUSH, KAPPA_PERSSON, KAPPA_SIMULATIONS, KAPPA_WINDOW, Kappa, relative_gap
 from .numbers import Numbers, Paired
 from .plan import BROAD, MAIN, MIN_PIXELS_QUOTED, SIDE, SPECTRAL, Ensemble, StudyRuns

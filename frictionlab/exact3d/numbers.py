@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fit import LogFit, fit_log_law
-from ..seeds import bootstrap_rng, realization_rng
+from ..compute.fit import LogFit, fit_log_law
+from ..preset.seeds import bootstrap_rng, realization_rng
 from .analysis import (
     FEW_SPOTS,
     KAPPA_WINDOW,

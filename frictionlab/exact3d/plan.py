@@ -25,18 +25,18 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from .. import engine
-from ..ensemble import RunOutcome
+from ..compute import engine
+from ..compute.ensemble import RunOutcome
 from ..errors import FrictionlabError, OutputRefused, RunFolderError
-from ..files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, read_preset
-from ..registry import Registry, default_registry
-from ..rundir import STATE_FILE, RunDirectory
-from ..runfolder import read_json
-from ..runner import run_to_folder
-from ..seeds import realization_rng
-from ..signals import WorkInterrupted, interrupted_since, mark
+from ..plugin.registry import Registry, default_registry
+from ..runs.rundir import STATE_FILE, RunDirectory
+from ..runs.runfolder import read_json
+from ..runs.runner import run_to_folder
+from ..preset.seeds import realization_rng
+from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..variants import SceneFactory
 
 HURSTS = (0.3, 0.5, 0.7, 0.8, 1.0)

@@ -10,14 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..dask_session import one_dask_cluster
+from ..compute.dask_session import one_dask_cluster
 from ..errors import FrictionlabError, OutputRefused
-from ..files import atomic_write, output_path_problem
-from ..listeners import format_duration
+from ..io.files import atomic_write, output_path_problem
+from ..plugin.listeners import format_duration
 from ..options import RunOptions
-from ..rundir import new_run_folder
-from ..seeds import realization_rng
-from ..signals import WorkInterrupted
+from ..runs.rundir import new_run_folder
+from ..preset.seeds import realization_rng
+from ..compute.signals import WorkInterrupted
 from .evidence import MANY_SPOTS
 from .evidence_text import (
     convergence_table,

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fit import percentile_interval
+from ..compute.fit import percentile_interval
 
 # the order of convergence taken when three grids cannot give it (differences of unlike
 # sign, or not shrinking): the slowest a pixel perimeter error decays, one over the resolution

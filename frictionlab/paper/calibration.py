@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import engine
+from ..compute import engine
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
 from .figures import COUNT_TARGETS

@@ -9,9 +9,9 @@ from pathlib import Path
 from ..errors import FrictionlabError
 from ..options import RunOptions
 from ..preset import build_scene, read_preset
-from ..runner import run_to_folder
-from ..signals import WorkInterrupted, interrupted_since, mark
-from ..sweep import plan_sweep, run_sweep
+from ..runs.runner import run_to_folder
+from ..compute.signals import WorkInterrupted, interrupted_since, mark
+from ..runs.sweep import plan_sweep, run_sweep
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,7 @@ class FigureRun:
 
 
 def find_presets(presets_dir: str | Path | None) -> Path:
-    from ..inputs import regular_file_problem
+    from ..io.inputs import regular_file_problem
     from ..preset.builtin import builtin_folder
 
     candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]

@@ -8,8 +8,8 @@ import math
 import os
 
 from .. import __version__
-from ..fit import format_estimate
-from ..sweep import row_fit
+from ..compute.fit import format_estimate
+from ..runs.sweep import row_fit
 from .figures import FIGURES, PAPER_H07, PAPER_POINTS_VS_H, FigureRun
 from .readings import AVERAGES, ReadingRow
 

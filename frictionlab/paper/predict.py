@@ -31,12 +31,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
-from ..fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval, resample_pairs
-from ..inputs import InputFileProblem, open_regular_file
+from ..compute.fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval, resample_pairs
+from ..io.inputs import InputFileProblem, open_regular_file
 from ..plugin import ForceNormalisation, mdr_length
-from ..results import read_summary
-from ..runfolder import read_member
-from ..seeds import bootstrap_rng
+from ..runs.results import read_summary
+from ..runs.runfolder import read_member
+from ..preset.seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
 """f of MDR pressing the line that stands for a surface: F / (E* h L), L = 2 sqrt(A / pi)."""

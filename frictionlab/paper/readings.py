@@ -15,12 +15,12 @@ import numpy as np
 import yaml
 
 from ..errors import FrictionlabError
-from ..fit import LogFit, fit_log_law
+from ..compute.fit import LogFit, fit_log_law
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
-from ..runner import run_to_folder
-from ..signals import interrupted_since, mark
-from ..seeds import bootstrap_rng, replicate_seeds
+from ..runs.runner import run_to_folder
+from ..compute.signals import interrupted_since, mark
+from ..preset.seeds import bootstrap_rng, replicate_seeds
 from .calibration import calibrated_rms_height
 from .figures import FigureRun
 

@@ -9,12 +9,12 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from ..dask_session import one_dask_cluster
+from ..compute.dask_session import one_dask_cluster
 from ..errors import OutputRefused
-from ..files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
-from ..rundir import new_run_folder
-from ..signals import WorkInterrupted
+from ..runs.rundir import new_run_folder
+from ..compute.signals import WorkInterrupted
 from .figures import find_presets, run_figures
 from .markdown import markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure

@@ -96,7 +96,7 @@ def resolve_preset_path(argument: str | Path) -> Path:
 def _whole_description(path: Path) -> str:
     """The preset's description (or its leading comment), on one line; read without
     validating (a listing must not fail on one odd file)."""
-    from ..safe_yaml import YamlProblem, load_yaml
+    from ..io.safe_yaml import YamlProblem, load_yaml
 
     text = path.read_text(encoding="utf-8")
     try:

@@ -12,7 +12,7 @@ from typing import Any
 import yaml
 
 from ..errors import PresetError
-from ..safe_yaml import YamlProblem, load_yaml
+from ..io.safe_yaml import YamlProblem, load_yaml
 from .schema import SweepParameter
 
 MISSING = object()

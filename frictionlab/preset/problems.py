@@ -11,7 +11,7 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import close_names, did_you_mean, short_repr
 from ..plugin import MAX_MAGNITUDE
-from ..safe_yaml import past_double_precision
+from ..io.safe_yaml import past_double_precision
 from .schema import NAME_PATTERN, NAME_RULE
 
 

@@ -7,10 +7,10 @@ import os
 from pathlib import Path
 
 from ..errors import FrictionlabError, PresetError, PresetFileError
-from ..inputs import InputFileProblem, input_fields, is_relative, read_regular_file
+from ..io.inputs import InputFileProblem, input_fields, is_relative, read_regular_file
 from ..plugin import KINDS
-from ..registry import Registry, default_registry
-from ..safe_yaml import YamlLimit, YamlProblem, load_yaml
+from ..plugin.registry import Registry, default_registry
+from ..io.safe_yaml import YamlLimit, YamlProblem, load_yaml
 from .paths import apply_overrides
 
 MAX_PRESET_BYTES = 256 * 1024  # presets are a few kB; refused by size before anything is read

@@ -13,9 +13,9 @@ from pydantic import BaseModel, TypeAdapter, ValidationError
 from pydantic.errors import PydanticSchemaGenerationError
 
 from ..errors import PluginError, PresetError
-from ..inputs import input_fields, regular_file_problem
+from ..io.inputs import input_fields, regular_file_problem
 from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
-from ..registry import Registry, default_registry
+from ..plugin.registry import Registry, default_registry
 from .problems import format_validation_error, merge_problems, number_problems, shown_value
 from .reading import read_preset, resolve_input_paths
 from .schema import PluginChoice, Preset
@@ -89,16 +89,16 @@ class Scene:
     @functools.cached_property
     def solver_loads(self) -> np.ndarray | None:
         """The loads the solver is given: ``loads`` converted from the preset's ``loading.unit``
-        (``frictionlab.loads``); None for contact fractions, whose forces are found per profile."""
-        from ..loads import solver_loads
+        (``frictionlab.preset.loads``); None for contact fractions, whose forces are found per profile."""
+        from .loads import solver_loads
 
         return solver_loads(self)
 
     @functools.cached_property
     def load_scales(self):
         """The force at f = 1, at p / E* = 1, and where full contact starts, for the profiles
-        pressed (``frictionlab.loads.load_scales``: realization 0's profile is made once)."""
-        from ..loads import load_scales
+        pressed (``frictionlab.preset.loads.load_scales``: realization 0's profile is made once)."""
+        from .loads import load_scales
 
         return load_scales(self)
 

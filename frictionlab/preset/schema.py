@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..plugin import KINDS
-from ..registry import Registry, default_registry
+from ..plugin.registry import Registry, default_registry
 
 MAX_SWEEP_POINTS = 1000  # counted from the axes, before any point is built
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._+-]{0,99}$"
@@ -118,7 +118,7 @@ class SweepParameter(_Strict):
 
 
 class SweepSettings(_Strict):
-    """A sweep: every point is the preset with the swept paths set (see frictionlab/sweep.py)."""
+    """A sweep: every point is the preset with the swept paths set (see frictionlab/runs/sweep.py)."""
 
     mode: Literal["grid", "zip"] = Field(
         "grid", description="grid: every combination of the values; zip: the i-th values of every list together."

@@ -14,7 +14,7 @@ Fixtures
 ========
 
 ``frictionlab_registry``
-    A fresh ``frictionlab.registry.Registry(discover=False)`` for one test: the
+    A fresh ``frictionlab.plugin.registry.Registry(discover=False)`` for one test: the
     built-in plugins are loaded, entry-point discovery is blocked (so what other
     distributions happen to be installed cannot change your test).
 
@@ -81,7 +81,7 @@ __all__ = [
 @pytest.fixture
 def frictionlab_registry():
     """A fresh registry: built-ins loaded, entry-point discovery blocked."""
-    from frictionlab.registry import Registry
+    from frictionlab.plugin.registry import Registry
 
     return Registry(discover=False)
 
@@ -114,7 +114,7 @@ def _as_hook_plugin(obj):
     if isinstance(obj, type) and issubclass(obj, Plugin) and obj.kind:
         import types
 
-        from frictionlab.hookspecs import hookimpl
+        from frictionlab.plugin.hookspecs import hookimpl
         def _register(register):
             register(obj)
 

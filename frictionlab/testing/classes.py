@@ -31,7 +31,7 @@ def _metadata_bounds(info) -> list[tuple[str, float, bool]]:
     bounds = []
     for item in info.metadata:
         for attr, keyword in keywords.items():
-            value = getattr(item, attr, None)
+            value = getattr(item, attr, None)  # annotated_types bounds: each item has one of them
             if isinstance(value, (int, float)) and not isinstance(value, bool):
                 bounds.append((keyword, float(value), is_int))
     return bounds
@@ -67,7 +67,7 @@ def _bounded_fields(cls, schema) -> list[tuple[str, str, float, bool]]:
 
 def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) -> None:
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
-    ``"slope"``): ``frictionlab.registry.validate_plugin_class`` passes (right
+    ``"slope"``): ``frictionlab.plugin.registry.validate_plugin_class`` passes (right
     base class, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
     forbidding unknown keys, every field described, and every declaration well
     formed: ``kind`` and ``register_hook`` are the base class's own; a spectrum's
@@ -93,7 +93,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
 
     from frictionlab.errors import PluginError
     from frictionlab.plugin import KINDS
-    from frictionlab.registry import normalize_name, validate_plugin_class
+    from frictionlab.plugin.registry import normalize_name, validate_plugin_class
 
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {', '.join(KINDS)}. Got {kind!r} instead.")

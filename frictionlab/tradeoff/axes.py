@@ -27,11 +27,11 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from ..ensemble import RunOutcome
+from ..compute.ensemble import RunOutcome
 from ..errors import FrictionlabError, PresetError, RunError
 from ..plugin import ContactSolver
 from ..preset import Scene
-from ..memory import available_memory, estimate, gib
+from ..compute.memory import available_memory, estimate, gib
 from .metrics import curve_errors, interval_half_width, mean_curve_half_width, relative_difference
 from .options import AXES, StudyOptions
 from .scenes import Measurement, SceneFactory, measure

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputRefused, shown
-from ..files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem
 from .axes import COLUMNS, Row, Study, grid_side
 from .metrics import pareto_front
 
@@ -330,7 +330,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     name), or ``force``; by default a new ``runs/<name>-study-<timestamp>``, made here so
     that two studies started in the same second get two folders."""
     if not out_dir:
-        from ..rundir import new_run_folder
+        from ..runs.rundir import new_run_folder
 
         return new_run_folder(f"{name}-study")
     out = Path(out_dir)

@@ -11,8 +11,8 @@ import time
 import tracemalloc
 from dataclasses import dataclass
 
-from .. import engine
-from ..ensemble import RunOutcome
+from ..compute import engine
+from ..compute.ensemble import RunOutcome
 from ..options import RunOptions
 from ..preset import Scene
 from ..variants import SceneFactory, force_scale

@@ -20,12 +20,12 @@ from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..detached import list_run_states
+from ..runs.detached import list_run_states
 from ..errors import PresetError, shown
 from ..options import RunOptions
 from ..preset import load_preset_file
-from ..registry import default_registry
-from ..rundir import DEFAULT_RUNS_DIR
+from ..plugin.registry import default_registry
+from ..runs.rundir import DEFAULT_RUNS_DIR
 from .fields import default_spectrum, preset_from_defaults
 from .folders import (
     is_builtin,

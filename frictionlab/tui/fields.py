@@ -17,10 +17,10 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
-from ..inputs import describe_input
+from ..io.inputs import describe_input
 from ..plugin import KINDS
 from ..preset import MISSING, Preset, build_scene, resolve_input_paths
-from ..safe_yaml import load_yaml
+from ..io.safe_yaml import load_yaml
 
 _BOUND_SYMBOLS = (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<"))
 
@@ -80,7 +80,7 @@ def _bounds(info) -> str:
     parts = []
     for item in info.metadata:
         for attr, symbol in _BOUND_SYMBOLS:
-            value = getattr(item, attr, None)
+            value = getattr(item, attr, None)  # annotated_types bounds: each item has one of them
             if value is not None:
                 parts.append(f"{symbol} {value}")
     return ", ".join(parts)

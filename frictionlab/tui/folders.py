@@ -16,16 +16,16 @@ from pathlib import Path
 
 import yaml
 
-from ..detached import RUN_MARKERS, SWEEP_FILE, damage_reason, run_state
+from ..runs.detached import RUN_MARKERS, SWEEP_FILE, damage_reason, run_state
 from ..errors import FrictionlabError, RunFolderError
-from ..files import atomic_write
-from ..inputs import read_regular_file
+from ..io.files import atomic_write
+from ..io.inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.reading import MAX_PRESET_BYTES
 from ..preset.builtin import builtin_folder, builtin_presets
-from ..rundir import STATE_FILE
-from ..runfolder import read_json, subfolder
-from ..safe_yaml import load_yaml
+from ..runs.rundir import STATE_FILE
+from ..runs.runfolder import read_json, subfolder
+from ..io.safe_yaml import load_yaml
 from .roundtrip import dump_preserving
 
 PROJECT_PRESETS_DIR = Path("presets")
@@ -234,7 +234,7 @@ def read_run(folder: Path) -> RunEntry:
 
 @dataclass
 class SweepEntry:
-    """A sweep folder (``frictionlab.sweep``): its sweep.json, one row per point."""
+    """A sweep folder (``frictionlab.runs.sweep``): its sweep.json, one row per point."""
 
     path: Path
     name: str
@@ -251,7 +251,7 @@ class SweepEntry:
 
 def read_sweep(folder: Path) -> SweepEntry:
     """A sweep folder's sweep.json, checked (``sweep.read_sweep_record``); RunFolderError if unreadable."""
-    from ..sweep import read_sweep_record
+    from ..runs.sweep import read_sweep_record
 
     folder = Path(folder)
     summary, record = read_sweep_record(folder)
@@ -291,7 +291,7 @@ def runs_signature(runs_dir: Path, running: list[Path] = ()) -> tuple:
     under ``runs_dir``: the folder's and each run folder's modification time (names and
     times only, nothing read), and whether each of ``running`` is still held by its process
     (a run killed with kill -9 changes no file)."""
-    from ..detached import lock_held
+    from ..runs.detached import lock_held
 
     try:
         top = os.stat(runs_dir).st_mtime_ns

@@ -1,5 +1,5 @@
 """A run (or sweep) the TUI shows that goes on in a process of its own
-(``frictionlab.detached``), started here or found running in the runs folder; and a
+(``frictionlab.runs.detached``), started here or found running in the runs folder; and a
 finished run (or sweep) read back from its folder. No Textual here: the app polls
 ``FollowedRun`` (``FollowedSweep``) on a timer."""
 
@@ -12,10 +12,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..api import Result, load
-from ..detached import cancel, lock_held, lock_holder, run_state
+from ..runs.detached import cancel, lock_held, lock_holder, run_state
 from ..errors import FrictionlabError, RunFolderError, shown
-from ..progresslog import PROGRESS_FILE, Follower
-from ..sweeplog import SweepFollower
+from ..runs.progresslog import PROGRESS_FILE, Follower
+from ..runs.sweeplog import SweepFollower
 from .folders import read_run, read_sweep
 from .live import LiveListener
 from .sweepview import SweepPoster
@@ -167,7 +167,7 @@ class FinishedSweep:
 
 def read_finished_sweep(folder: Path) -> FinishedSweep:
     """The sweep in ``folder`` read back (RunFolderError, OSError if its sweep.json is unreadable)."""
-    from ..detached import sweep_state
+    from ..runs.detached import sweep_state
     from ..errors import FrictionlabError
 
     entry, state = read_sweep(folder), sweep_state(folder)

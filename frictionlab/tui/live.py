@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fit import LogFit, fit_curve
-from ..hookspecs import hookimpl
-from ..listeners import solve_text
+from ..compute.fit import LogFit, fit_curve
+from ..plugin.hookspecs import hookimpl
+from ..plugin.listeners import solve_text
 from .text import failure_message
 
 

@@ -22,7 +22,7 @@ from ruamel.yaml.error import CommentMark
 from ruamel.yaml.representer import RoundTripRepresenter
 from ruamel.yaml.tokens import CommentToken
 
-from ..sweep import yaml_scalar
+from ..runs.sweep import yaml_scalar
 
 
 class _PyYAMLSafeRepresenter(RoundTripRepresenter):

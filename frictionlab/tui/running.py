@@ -14,20 +14,13 @@ from pathlib import Path
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
-from ..detached import (
-    check_startable,
-    check_sweep_startable,
-    lock_held,
-    lock_holder,
-    run_state,
-    start_detached,
-)
+from ..runs.detached import check_startable, check_sweep_startable, lock_held, lock_holder, run_state, start_detached
 from ..errors import FrictionlabError, PresetError, RunFolderError, shown
-from ..files import output_path_problem
+from ..io.files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
-from ..rundir import RunDirectory, new_run_folder
-from ..sweep import plan_sweep, stored_sweep
+from ..runs.rundir import RunDirectory, new_run_folder
+from ..runs.sweep import plan_sweep, stored_sweep
 from .folders import read_run
 from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
 from .messages import RunCrashed, RunFinished

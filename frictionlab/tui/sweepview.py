@@ -11,9 +11,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ..fit import format_interval
-from ..listeners import SweepListener
-from ..sweep import PointResult, Sweep, SweepPoint, yaml_scalar
+from ..compute.fit import format_interval
+from ..plugin.listeners import SweepListener
+from ..runs.sweep import PointResult, Sweep, SweepPoint, yaml_scalar
 from .text import format_count
 
 

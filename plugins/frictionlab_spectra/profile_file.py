@@ -24,20 +24,19 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
 
-from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
+from frictionlab import InputFile, PluginParams
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
     ScanHeader, Undefined, Unit, check_spacing, is_instrument_file, open_input, read_scan, scan_header,
-    scan_not_periodic_advice,
 )
+from .measured import Measured, MeasuredFile
 from .params_cache import cached_on_params
 
 MIN_POINTS = 8
@@ -45,16 +44,7 @@ X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction 
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
 
 
-@dataclass(frozen=True)
-class _Line:
-    heights: np.ndarray
-    spacing: float
-    rms_height: float
-    periodic: bool
-    summary: dict[str, Any]
-
-
-class ProfileFile(SpectrumGenerator):
+class ProfileFile(MeasuredFile):
     """A measured height profile read from a file; every ``generate`` returns the same line."""
 
     name: ClassVar[str] = "profile-file"
@@ -104,34 +94,11 @@ class ProfileFile(SpectrumGenerator):
 
     # ------------------------------------------------------------ contract
 
-    def generate(self, rng: np.random.Generator) -> Profile:
-        """The measured line (a fresh copy each call); ``rng`` is not used."""
-        line = self._line()
-        return Profile(heights=line.heights.copy(), spacing=line.spacing, periodic=line.periodic)
-
-    def periodic(self) -> bool:
-        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path), self.params.format):
-            return bool(self.params.periodic)  # known without reading the file
-        header = self._header()
-        return header.periodic if header is not None else self._line().periodic
-
-    def not_periodic_advice(self) -> tuple[str, str]:
-        return scan_not_periodic_advice(self.name)
-
     def grid_shape(self) -> tuple[int]:
         """The line's points, from the file's header when it has one (a .npy, an instrument
         file's metadata): the memory estimate refuses a line too long before it is read."""
         header = self._header()
-        return header.shape if header is not None else self._line().heights.shape
-
-    def input_summary(self) -> dict[str, Any]:
-        """The line as read: file, format, points, spacing, unit, rms height, and where each came from."""
-        return dict(self._line().summary)
-
-    def rms_height(self) -> float:
-        """rms of the detrended line about its mean (with ``detrend="none"`` a constant offset,
-        which does not change a contact, does not count either)."""
-        return self._line().rms_height
+        return header.shape if header is not None else self._measured().heights.shape
 
     # ------------------------------------------------------------ reading
 
@@ -151,7 +118,7 @@ class ProfileFile(SpectrumGenerator):
         return header if header is not None and header.shape[0] >= MIN_POINTS else None
 
     @cached_on_params
-    def _line(self) -> _Line:
+    def _measured(self) -> Measured:
         p = self.params
         path = Path(p.path)
         where = f"profile-file {str(path)!r}"
@@ -210,7 +177,7 @@ class ProfileFile(SpectrumGenerator):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        return _Line(heights, float(dx), rms, periodic, summary)
+        return Measured(heights, float(dx), rms, periodic, summary)
 
 
 def _npy_line_points(shape: tuple[int, ...]) -> int | None:

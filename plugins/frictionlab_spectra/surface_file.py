@@ -38,32 +38,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
+from frictionlab import InputFile, PluginParams
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header, scan_not_periodic_advice,
+    ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header,
 )
 from .map_pipeline import Downsample, FileFormat, Level, Region, shape_map, square_shape
+from .measured import Measured, MeasuredFile
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
-from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table, remove_mean
+from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table
 
 MIN_SIDE = 8
-
-
-@dataclass(frozen=True)
-class _Map:
-    heights: np.ndarray  # detrended, read-only
-    spacing: float
-    rms_height: float
-    periodic: bool
-    summary: dict[str, Any]
 
 
 @dataclass(frozen=True)
@@ -98,7 +90,7 @@ def radial_psd(heights: np.ndarray, spacing: float, width: float | None = None) 
     return RadialPSD(wavenumber, annulus_power / (TWO_PI * wavenumber * width), count)
 
 
-class SurfaceFile(SpectrumGenerator):
+class SurfaceFile(MeasuredFile):
     """A measured height map read from a file; every ``generate`` returns the same surface."""
 
     name: ClassVar[str] = "surface-file"
@@ -162,20 +154,6 @@ class SurfaceFile(SpectrumGenerator):
 
     # ------------------------------------------------------------ contract
 
-    def generate(self, rng: np.random.Generator) -> Profile:
-        """The measured map (a fresh copy each call); ``rng`` is not used."""
-        surface = self._map()
-        return Profile(heights=surface.heights.copy(), spacing=surface.spacing, periodic=surface.periodic)
-
-    def periodic(self) -> bool:
-        if self.params.periodic is not None or not is_instrument_file(Path(self.params.path), self.params.format):
-            return bool(self.params.periodic)  # known without reading the file
-        header = self._header()
-        return header.periodic if header is not None else self._map().periodic
-
-    def not_periodic_advice(self) -> tuple[str, str]:
-        return scan_not_periodic_advice(self.name)
-
     def grid_shape(self) -> tuple[int, int]:
         """The map's shape, from the file's header when it has one (a .npy, an instrument
         file's metadata) and no crop or downsampling is asked: the memory estimate refuses a
@@ -183,27 +161,19 @@ class SurfaceFile(SpectrumGenerator):
         header = self._header()
         p = self.params
         if header is None or p.region is not None or p.downsample is not None:
-            return self._map().heights.shape
+            return self._measured().heights.shape
         return header.shape if p.spacing is not None else square_shape(header.shape, header.pixel)
-
-    def input_summary(self) -> dict[str, Any]:
-        """The map as read: file, format, shape, pixel size, unit, rms height, and where each came from."""
-        return dict(self._map().summary)
-
-    def rms_height(self) -> float:
-        """rms of the detrended map about its mean (a constant offset does not count)."""
-        return self._map().rms_height
 
     def radial_psd(self) -> RadialPSD:
         """The detrended map's radially averaged C2D in annuli of the map's own finest dq."""
-        surface = self._map()
+        surface = self._measured()
         return radial_psd(surface.heights, surface.spacing)
 
     def equivalent_line(self) -> EquivalentLine:
         """The MDR-equivalent line of this map (``equivalent_line.py``): length 2 sqrt(A / pi),
         each of its modes carrying the power of the map's modes around it, scaled to
         ``rms_height()``. A non-periodic map is reflected across its edges for its FFT."""
-        surface = self._map()
+        surface = self._measured()
         heights = surface.heights
         if not surface.periodic:  # the even extension: periodic, no step where it repeats
             heights = np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
@@ -238,7 +208,7 @@ class SurfaceFile(SpectrumGenerator):
         return header if valid else None
 
     @cached_on_params
-    def _map(self) -> _Map:
+    def _measured(self) -> Measured:
         p = self.params
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
@@ -258,7 +228,7 @@ class SurfaceFile(SpectrumGenerator):
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         heights.flags.writeable = False
         summary.update(shape=list(heights.shape), spacing=float(spacing), rms_height=rms)
-        return _Map(heights, spacing, rms, summary["periodic"], summary)
+        return Measured(heights, spacing, rms, summary["periodic"], summary)
 
 
 def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:

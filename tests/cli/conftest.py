@@ -23,7 +23,7 @@ def run_cli(*args, env=None, **kwargs):
     )
 
 
-RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.rundir; run.lock is gone once it ends)
+RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.runs.rundir; run.lock is gone once it ends)
 
 
 class InTerminal:

@@ -7,7 +7,7 @@ import subprocess
 import sys
 import time
 
-from frictionlab.detached import run_state
+from frictionlab.runs.detached import run_state
 
 from ..conftest import SMALL_PRESET, merge
 from .conftest import InTerminal, run_cli, write_preset
@@ -133,7 +133,9 @@ def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctr
         follow = InTerminal("follow", out)
         deadline = time.monotonic() + 60
         while b"/100000" not in follow.raw and time.monotonic() < deadline:  # its bar shows
+            assert follow.process.poll() is None, f"follow ended by itself: {follow.raw[-600:]!r}"
             time.sleep(0.05)
+        assert b"/100000" in follow.raw, f"no bar in 60 s: {follow.raw[-600:]!r}"
         time.sleep(0.5)
         follow.process.send_signal(signal.SIGINT)
         code = follow.wait()

@@ -110,3 +110,25 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     captured = capsys.readouterr()
     assert said in captured.err and "Traceback" not in captured.err and captured.out == ""
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
+
+
+CTRL_C_WHILE_LOADING = """
+import sys
+loading = sys.argv[1]
+class CtrlC:  # Ctrl-C arriving while the command's modules load
+    def find_spec(self, name, path=None, target=None):
+        if name == loading:
+            raise KeyboardInterrupt
+sys.meta_path.insert(0, CtrlC())
+from frictionlab.__main__ import program
+sys.argv = ["frictionlab", "runs", sys.argv[2]]
+program()
+"""
+
+
+@pytest.mark.parametrize("module", ["frictionlab.cli.main", "frictionlab.runs.detached"])
+def test_ctrl_c_while_the_command_loads_ends_with_130_and_a_line_not_a_traceback(tmp_path, module):
+    done = subprocess.run([sys.executable, "-c", CTRL_C_WHILE_LOADING, module, str(tmp_path)],
+                          capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert done.returncode == 130, done.stderr
+    assert done.stderr == "interrupted\n"

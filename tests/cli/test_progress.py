@@ -2,7 +2,7 @@
 
 import io
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.progress import ProgressReporter
 from frictionlab.options import RunOptions
 
@@ -44,7 +44,7 @@ def test_log_file_gets_one_plain_line_per_tenth(make_scene):
 def test_rate_counts_only_realizations_computed_by_this_process_on_a_resume(make_scene):
     import time
 
-    from frictionlab.engine import RunInfo
+    from frictionlab.compute.engine import RunInfo
 
     stream = io.StringIO()
     reporter = ProgressReporter(stream)

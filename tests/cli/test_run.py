@@ -12,7 +12,7 @@ import pytest
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.results import column_name
+from frictionlab.runs.results import column_name
 
 from ..conftest import SMALL_PRESET, merge
 from .conftest import RUN_DIRECTORY, run_cli, write_preset

@@ -11,7 +11,7 @@ import pytest
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.files import output_path_problem
+from frictionlab.io.files import output_path_problem
 
 # /proc/1 refuses new files to every user, root too (a chmod'ed folder would not stop root)
 UNWRITABLE = Path("/proc/1")

@@ -10,7 +10,7 @@ from frictionlab.exact3d.analysis import (
     KAPPA_WINDOW, SMALL_LOAD_FRACTION, contact_area_law, height_moments, kappa_curve, nayak_parameter, relative_gap,
 )
 from frictionlab.preset import build_scene
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 
 
 def law_fractions(kappa, force, area, stiffness, gradient):

@@ -162,7 +162,7 @@ def test_every_grid_samples_the_same_surfaces(registry, hurst):
     """The page compares grids on the same surfaces: a coarse grid's heights are a fine
     one's at its points (same modes, same random phases), for every realization."""
     from frictionlab.preset import build_scene, read_preset
-    from frictionlab.seeds import realization_rng
+    from frictionlab.preset.seeds import realization_rng
     from frictionlab.variants import SceneFactory
 
     path = PRESETS / preset_name(hurst)
@@ -191,7 +191,7 @@ def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, caps
 def test_finished_ensembles_are_read_without_their_lock_beside_a_process_that_holds_it(quick_study, tmp_path):
     import shutil
 
-    from frictionlab.rundir import RunDirectory
+    from frictionlab.runs.rundir import RunDirectory
 
     runs = tmp_path / "runs"
     shutil.copytree(quick_study / "runs", runs)

@@ -8,7 +8,7 @@ import pytest
 
 from frictionlab import mdr_length
 from frictionlab.cli import main
-from frictionlab.fit import LogFit, percentile_interval
+from frictionlab.compute.fit import LogFit, percentile_interval
 from frictionlab.options import RunOptions
 from frictionlab.paper.predict import (
     bootstrap_pairs,
@@ -16,7 +16,7 @@ from frictionlab.paper.predict import (
     predict_xi,
     read_run_law,
 )
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 
 def test_f_is_the_line_f_with_the_mdr_length():

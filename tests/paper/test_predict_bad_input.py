@@ -16,7 +16,7 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 from ..conftest import SMALL_PRESET, merge
 from ..test_resume import CancelAfter

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab import engine
+from frictionlab.compute import engine
 from frictionlab.cli import main
 from frictionlab.options import RunOptions
 from frictionlab.paper.calibration import COUNT_TARGETS, calibrated_rms_height
@@ -27,7 +27,7 @@ from frictionlab.paper.readings import (
 )
 from frictionlab.paper.reproduce import write_report
 from frictionlab.preset import apply_overrides, build_scene, load_preset_file
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 
 from ..conftest import PRESETS, SMALL_PRESET
 
@@ -203,7 +203,7 @@ def test_replicates_are_independent_runs_and_their_spread_is_theirs(tmp_path, ti
     """Each of K ensembles is the preset run with one of K seeds (the preset's, then one SeedSequence's):
     rerun alone with ``--set seed=...``, each gives the same fit; the spread and the count of ensembles
     holding the paper's pair are those of the K independent fits."""
-    from frictionlab.seeds import replicate_seeds
+    from frictionlab.preset.seeds import replicate_seeds
 
     reading = Reading("fig2", "literal, h measured, last point without slope",
                       ("spectrum.params.series=cosine", "spectrum.params.short_cutoff=20.0",

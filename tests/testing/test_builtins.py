@@ -9,9 +9,7 @@ import pytest
 
 from frictionlab import testing as fltesting
 from frictionlab.plugin import KINDS
-from frictionlab.registry import (
-    Registry,
-)
+from frictionlab.plugin.registry import Registry
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -18,9 +18,7 @@ from frictionlab import (
 )
 from frictionlab.errors import PluginError
 from frictionlab.plugin import KINDS
-from frictionlab.registry import (
-    Registry,
-)
+from frictionlab.plugin.registry import Registry
 
 from .fakes import GoodSlopes, GoodSolver, GoodSpectrum, provider, spectrum_class
 
@@ -74,7 +72,7 @@ def test_pytest_plugin_autoloads_and_unregisters_after_each_test(tmp_path):
             import pytest
 
             import frictionlab
-            from frictionlab.registry import Registry
+            from frictionlab.plugin.registry import Registry
 
             SHARED = Registry(discover=False)
 

@@ -10,7 +10,7 @@ import pytest
 from frictionlab import (
     ForceNormalisation,
 )
-from frictionlab import registry as registry_module
+from frictionlab.plugin import registry as registry_module
 from frictionlab import testing as fltesting
 from frictionlab.errors import PluginError
 from frictionlab.plugin import KINDS

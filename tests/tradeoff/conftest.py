@@ -5,7 +5,7 @@ springs as ``mdr`` by another route, so their agreement is a known answer)."""
 
 import pytest
 
-from frictionlab.registry import Registry
+from frictionlab.plugin.registry import Registry
 from frictionlab.tradeoff.axes import Study
 from frictionlab.tradeoff.options import StudyOptions
 from frictionlab.tradeoff.scenes import SceneFactory

@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import brentq
 
 from frictionlab.errors import FrictionlabError
-from frictionlab.seeds import realization_rng
+from frictionlab.preset.seeds import realization_rng
 from frictionlab.tradeoff.axes import Study
 from frictionlab.tradeoff.options import AXES, StudyOptions
 from frictionlab.tradeoff.scenes import SceneFactory

@@ -15,7 +15,7 @@ from textual.widgets import Input, Select, Static
 from frictionlab.errors import PresetError
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.runner import run_to_folder
+from frictionlab.runs.runner import run_to_folder
 from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.widgets import PresetForm
 

@@ -53,7 +53,7 @@ def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path,
 POOL_UNDER_TEXTUAL = """
 import sys, threading
 import frictionlab.tui
-from frictionlab.engine import run
+from frictionlab.compute.engine import run
 from frictionlab.preset import build_scene
 from frictionlab.options import RunOptions
 

@@ -10,7 +10,7 @@ import pytest
 import yaml
 from textual.widgets import Static
 
-from frictionlab.detached import process_alive, run_state, start_detached, wait_started
+from frictionlab.runs.detached import process_alive, run_state, start_detached, wait_started
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.tui.following import FinishedSweep
@@ -151,9 +151,9 @@ async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(fo
 @sync
 async def test_a_long_solve_shows_its_load_and_the_elapsed_time_moves_between_events(folders, registry):
     """An exact solve reports its loads; between two reports the elapsed time still moves."""
-    from frictionlab.engine import RunInfo
-    from frictionlab.progresslog import ProgressLog
-    from frictionlab.rundir import RunDirectory
+    from frictionlab.compute.engine import RunInfo
+    from frictionlab.runs.progresslog import ProgressLog
+    from frictionlab.runs.rundir import RunDirectory
 
     out = folders / "runs" / "exact"
     scene = build_scene(merge(TINY, {"name": "exact", "realizations": 2}), registry=registry)
@@ -180,7 +180,7 @@ HALFWAY_SWEEP = {**merge(SWEEP, {"name": "halfway"}), "sweep": {"parameters": {"
 
 
 def start_sweep(data, out, registry):
-    from frictionlab.sweep import plan_sweep
+    from frictionlab.runs.sweep import plan_sweep
 
     sweep = plan_sweep(data, registry=registry)
     process = start_detached(sweep.preset_data, out, RunOptions(workers=1), plot=False)

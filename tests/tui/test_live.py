@@ -4,8 +4,8 @@
 import numpy as np
 import pytest
 
-from frictionlab.engine import run as engine_run
-from frictionlab.fit import least_squares
+from frictionlab.compute.engine import run as engine_run
+from frictionlab.compute.fit import least_squares
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.tui.live import LiveListener
@@ -37,8 +37,8 @@ def twelve_stopped_after_five(registry, folder):
     """A scene of 12 realizations, and the outcome of its run into ``folder`` cancelled once 5 were done."""
     import threading
 
-    from frictionlab.hookspecs import hookimpl
-    from frictionlab.runner import run_to_folder
+    from frictionlab.plugin.hookspecs import hookimpl
+    from frictionlab.runs.runner import run_to_folder
 
     scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
     cancel = threading.Event()
@@ -54,7 +54,7 @@ def twelve_stopped_after_five(registry, folder):
 
 
 def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(registry, tmp_path):
-    from frictionlab.runner import run_to_folder
+    from frictionlab.runs.runner import run_to_folder
 
     scene, stopped = twelve_stopped_after_five(registry, tmp_path)
     posted = []
@@ -71,8 +71,8 @@ def test_after_a_resume_the_interim_fit_covers_the_restored_realizations_too(reg
 def test_a_followed_resume_counts_its_restored_realizations_once_and_as_restored(registry, tmp_path):
     """The TUI follows a resume through its progress.jsonl: the restored realizations are the
     first snapshot's (never counted down from 1 as if computed now, which made the rate negative)."""
-    from frictionlab.progresslog import Follower, ProgressLog
-    from frictionlab.runner import run_to_folder
+    from frictionlab.runs.progresslog import Follower, ProgressLog
+    from frictionlab.runs.runner import run_to_folder
 
     scene, stopped = twelve_stopped_after_five(registry, tmp_path)
     resumed, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1, resume=True), listeners=[ProgressLog(tmp_path)])

@@ -9,10 +9,10 @@ import sys
 import pytest
 import yaml
 
-from frictionlab.detached import run_state, start_detached, wait_started
+from frictionlab.runs.detached import run_state, start_detached, wait_started
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.rundir import new_run_folder
+from frictionlab.runs.rundir import new_run_folder
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
@@ -346,8 +346,8 @@ async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folde
 
 
 def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_no_rate():
-    from frictionlab.fit import LogFit
-    from frictionlab.listeners import progress_text
+    from frictionlab.compute.fit import LogFit
+    from frictionlab.plugin.listeners import progress_text
     from frictionlab.tui.widgets.run import fit_lines
 
     nan = float("nan")

@@ -7,7 +7,7 @@ import yaml
 from textual.widgets import Static
 
 from frictionlab.options import RunOptions
-from frictionlab.sweep import load_sweep, read_table, run_sweep
+from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
 from .conftest import (

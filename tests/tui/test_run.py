@@ -9,11 +9,11 @@ import pytest
 import yaml
 from textual.widgets import Static
 
-from frictionlab.hookspecs import hookimpl
+from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
-from frictionlab.runner import run_to_folder
-from frictionlab.sweep import load_sweep, read_table, run_sweep
+from frictionlab.runs.runner import run_to_folder
+from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge

@@ -163,7 +163,7 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
 
 @sync
 async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry):
-    from frictionlab.fit import LogFit
+    from frictionlab.compute.fit import LogFit
     from frictionlab.tui.widgets import RunPane
     from frictionlab.tui.widgets.run import fit_lines
 

@@ -8,7 +8,7 @@ import yaml
 from textual.widgets import Input
 
 from frictionlab.options import RunOptions
-from frictionlab.sweep import load_sweep, run_sweep
+from frictionlab.runs.sweep import load_sweep, run_sweep
 
 from ..conftest import merge
 from .conftest import (

@@ -16,9 +16,9 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown
-from ...fit import format_interval
+from ...compute.fit import format_interval
 from ..chart import Series
-from ...results import read_curve
+from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
 from ..text import format_count, shorten_run_name

@@ -15,8 +15,8 @@ from textual.content import Content
 from textual.widgets import DataTable, ProgressBar, Static
 
 from ...errors import shown
-from ...fit import format_estimate
-from ...listeners import format_duration, progress_text
+from ...compute.fit import format_estimate
+from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
 from ..live import Snapshot
 from ..sweepview import STATUS_MARKS, point_line, table_cells, table_columns

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import OutputRefused, shown
+from ..errors import OutputRefused, shown
 
 _SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
 _WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size

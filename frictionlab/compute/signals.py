@@ -13,7 +13,7 @@ from __future__ import annotations
 import signal
 import threading
 
-from .errors import ExitCode
+from ..errors import ExitCode
 
 HANDLED = (signal.SIGINT, signal.SIGTERM)
 received: list[int] = []  # the signals that ended work in this process, in order

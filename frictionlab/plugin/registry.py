@@ -25,21 +25,13 @@ import numpy as np
 import pluggy
 from pydantic import BaseModel
 
-from .errors import PluginError, did_you_mean
+from ..errors import PluginError, did_you_mean
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
-from .plugin import (
-    KINDS,
-    NAME_PATTERN,
-    ContactMeasure,
-    ContactSolver,
-    ForceNormalisation,
-    IndentationReference,
-    Plugin,
-    Profile,
-    SlopeEstimator,
-    SpectrumGenerator,
-)
+from .base import NAME_PATTERN, Plugin
+from .data import Profile
+from .kinds import KINDS, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator
+from .normalisation import ContactMeasure, ForceNormalisation
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")

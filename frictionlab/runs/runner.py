@@ -7,15 +7,15 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from . import engine
-from .ensemble import RunOutcome
-from .executors import dask_memory_limits
-from .loads import check_loads
-from .memory import check_fits, check_worker_limits
-from .options import RunOptions
-from .preset import Scene
+from ..compute import engine
+from ..compute.ensemble import RunOutcome
+from ..compute.executors import dask_memory_limits
+from ..preset.loads import check_loads
+from ..compute.memory import check_fits, check_worker_limits
+from ..options import RunOptions
+from ..preset import Scene
 from .results import add_plot, write_results
-from .realization import RealizationResult
+from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
 
 UNSAVED_WORK_SECONDS = 0.5  # of computing: finished chunks are written once this much is not on disk yet

@@ -24,7 +24,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator
 
-from .errors import shown
+from ..errors import shown
 
 
 class InputFileProblem(ValueError):

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import ContactSolver, Profile, force_unit, listening_to_loads
+from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
 
 LOAD_UNITS = {
     "force": "the solver's load (a force in E* x length^2, or a force per unit depth)",
@@ -109,7 +109,7 @@ def solver_loads(scene) -> np.ndarray | None:
 
 def check_loads(scene) -> None:
     """Refuse, before a run, loads ``scene``'s solver cannot take (``load_problems``): a PresetError."""
-    from .errors import PresetError
+    from ..errors import PresetError
 
     problems = load_problems(scene)
     if problems:

@@ -22,7 +22,7 @@ import logging
 import warnings
 from urllib.parse import urlsplit
 
-from .errors import FrictionlabError, MissingDependency, RunError, require, short_repr
+from ..errors import FrictionlabError, MissingDependency, RunError, require, short_repr
 
 DASK_PURPOSE = "the dask executor"
 DASK_MISSING = str(MissingDependency("distributed", DASK_PURPOSE))

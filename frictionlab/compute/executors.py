@@ -33,10 +33,10 @@ from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .dask_session import current_session
-from .errors import RunError
-from .options import RunOptions
+from ..errors import RunError
+from ..options import RunOptions
 from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
-from .preset import Scene
+from ..preset import Scene
 from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk, compute_chunk_here
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security

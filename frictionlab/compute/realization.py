@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
-from .preset import Scene
-from .seeds import realization_rng
+from ..plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
+from ..preset import Scene
+from ..preset.seeds import realization_rng
 
 
 @dataclass(frozen=True)
@@ -122,7 +122,7 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
     is the profile's k h X)."""
     if scene.solver_loads is not None:
         return scene.solver.solve(profile, scene.solver_loads, scene.control, slopes)
-    from .loads import forces_for_fractions
+    from ..preset.loads import forces_for_fractions
 
     def seeking(j: int) -> None:  # iterations of the search are said as the load's
         watch.load = j + 1

@@ -16,8 +16,8 @@ import os
 import time
 from pathlib import Path
 
-from .errors import RunFolderError
-from .listeners import SweepListener
+from ..errors import RunFolderError
+from ..plugin.listeners import SweepListener
 from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf, _number, _whole
 from .runfolder import checked
 from .sweep import UNFINISHED, PointRecord, PointResult, Sweep, SweepPoint, point_folder

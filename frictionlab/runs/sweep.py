@@ -29,16 +29,16 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, Field
 
-from . import __version__
-from .dask_session import one_dask_cluster
-from .errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
-from .files import atomic_write, output_path_problem
-from .fit import LogFit, json_safe
-from .listeners import SweepListener
-from .options import RunOptions
-from .plugin import KINDS
-from .preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
-from .registry import Registry, default_registry
+from .. import __version__
+from ..compute.dask_session import one_dask_cluster
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from ..io.files import atomic_write, output_path_problem
+from ..compute.fit import LogFit, json_safe
+from ..plugin.listeners import SweepListener
+from ..options import RunOptions
+from ..plugin import KINDS
+from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
+from ..plugin.registry import Registry, default_registry
 from .results import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
@@ -359,7 +359,7 @@ def run_sweep(
         if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
 
             def draw(fh) -> None:
-                from .plot import plot_sweep  # matplotlib is slow to import: only when drawing
+                from ..plot import plot_sweep  # matplotlib is slow to import: only when drawing
 
                 plot_sweep(sweep, outcome.rows, fh)
 

@@ -20,8 +20,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import RunError
-from .preset import Scene
+from ..errors import RunError
+from ..preset import Scene
 
 MiB = 2**20
 GiB = 2**30
@@ -68,7 +68,7 @@ def grid_points(scene: Scene) -> int:
     shape = scene.generator.grid_shape()
     if shape is not None:
         return math.prod(shape)
-    from .seeds import realization_rng
+    from ..preset.seeds import realization_rng
 
     try:
         return scene.generator.generate(realization_rng(scene.preset.seed, 0)).points
@@ -152,7 +152,7 @@ def _process_limits() -> list[tuple[int, str]]:
 
     used = psutil.Process().memory_info()
     found = []
-    for name, current in (("RLIMIT_AS", used.vms), ("RLIMIT_DATA", getattr(used, "data", used.vms))):
+    for name, current in (("RLIMIT_AS", used.vms), ("RLIMIT_DATA", getattr(used, "data", used.vms))):  # data: Linux only
         soft, _ = resource.getrlimit(getattr(resource, name))
         if soft != resource.RLIM_INFINITY:
             found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))

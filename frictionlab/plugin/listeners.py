@@ -21,10 +21,10 @@ from typing import TYPE_CHECKING, Protocol
 from .hookspecs import hookspec
 
 if TYPE_CHECKING:  # annotations only: the engine imports this module
-    from .engine import RunInfo
-    from .ensemble import RunOutcome
-    from .realization import RealizationResult
-    from .sweep import PointResult, Sweep, SweepOutcome, SweepPoint
+    from ..compute.engine import RunInfo
+    from ..compute.ensemble import RunOutcome
+    from ..compute.realization import RealizationResult
+    from ..runs.sweep import PointResult, Sweep, SweepOutcome, SweepPoint
 
 
 class RunListener(Protocol):

@@ -26,12 +26,12 @@ import numpy as np
 import yaml
 from pydantic import Field
 
-from . import __version__
-from .ensemble import RunOutcome
-from .errors import MissingDependency, RunError, RunFolderError, shown
-from .files import atomic_write, write_npz
-from .fit import json_safe
-from .preset import Scene
+from .. import __version__
+from ..compute.ensemble import RunOutcome
+from ..errors import MissingDependency, RunError, RunFolderError, shown
+from ..io.files import atomic_write, write_npz
+from ..compute.fit import json_safe
+from ..preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
@@ -340,7 +340,7 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
     files = {**files, "plot": out / "plot.png"}
 
     def draw(fh) -> None:
-        from .plot import plot_curve  # matplotlib is slow to import: only when drawing
+        from ..plot import plot_curve  # matplotlib is slow to import: only when drawing
 
         plot_curve(scene, outcome, fh)
 

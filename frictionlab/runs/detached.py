@@ -24,8 +24,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from .errors import ExitCode, FrictionlabError, RunFolderError, shown
-from .options import RunOptions
+from ..errors import ExitCode, FrictionlabError, RunFolderError, shown
+from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json
@@ -86,7 +86,7 @@ def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = Ru
     request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot,
                "source": source}  # fmt: skip
     process = subprocess.Popen(
-        [sys.executable, "-m", "frictionlab.detached"],
+        [sys.executable, "-m", "frictionlab.runs.detached"],
         stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         start_new_session=True, close_fds=True,
     )  # fmt: skip
@@ -139,7 +139,7 @@ def cancel(folder: str | Path) -> int:
 
 def _child() -> int:
     """The detached process: read the request from stdin, run it, tell the folder how it went."""
-    from .signals import RaiseOnSigterm
+    from ..compute.signals import RaiseOnSigterm
     from .sweeplog import SweepProgressLog
 
     if hasattr(signal, "SIGHUP"):
@@ -174,7 +174,7 @@ def _child() -> int:
 
 def _run_one(request: dict, out: Path, options: RunOptions, log: ProgressLog) -> str:
     """One ensemble; its status ("failed" when some realization failed)."""
-    from .preset import build_scene
+    from ..preset import build_scene
     from .runner import run_to_folder
 
     scene = build_scene(request["preset"])
@@ -301,7 +301,7 @@ def damage_reason(folder: Path, error: Exception) -> str:
 
 def _chunk_count(chunks, total: int | None) -> int | None:
     """Realizations the manifest's chunks hold (each chunk's name is its index range)."""
-    from .rundir import CHUNK_NAME
+    from .chunks import CHUNK_NAME
 
     if not isinstance(chunks, dict):
         return None

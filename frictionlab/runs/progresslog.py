@@ -26,8 +26,8 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field, ValidationError, model_validator
 
-from .hookspecs import hookimpl
-from .realization import RealizationResult
+from ..plugin.hookspecs import hookimpl
+from ..compute.realization import RealizationResult
 from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"
@@ -424,7 +424,7 @@ class Follower:
         return time.time() if self._event_time is None else self._event_time
 
     def _tell(self, hook: str, **kwargs) -> None:
-        from .engine import listener_manager
+        from ..compute.engine import listener_manager
 
         if self._hooks is None:
             self._hooks = listener_manager(self.listeners).hook
@@ -437,7 +437,7 @@ class Follower:
 
     def poll(self) -> int:
         """Replay the events written since the last call; return how many."""
-        from .engine import RunInfo
+        from ..compute.engine import RunInfo
 
         events = self.reader.new_events()
         if self.reader.restarted:

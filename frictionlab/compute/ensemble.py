@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .fit import LogFit, fit_log_law
-from .plugin import ForceNormalisation
-from .preset import Scene
-from .seeds import bootstrap_rng
+from ..plugin import ForceNormalisation
+from ..preset import Scene
+from ..preset.seeds import bootstrap_rng
 
 
 MIN_CONTACTS_FIRST_LOAD = 3  # mean points in contact at the first load below which a fit carries a caveat

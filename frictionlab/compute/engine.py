@@ -17,12 +17,12 @@ from dataclasses import dataclass, field
 import pluggy
 
 from .ensemble import Accumulator, RunOutcome
-from .errors import RunError
+from ..errors import RunError
 from .executors import make_executor, plan_chunks, sized_executor
-from .hookspecs import PROJECT_NAME
-from .listeners import RunListener
-from .options import RunOptions
-from .preset import Scene
+from ..plugin.hookspecs import PROJECT_NAME
+from ..plugin.listeners import RunListener
+from ..options import RunOptions
+from ..preset import Scene
 from .realization import RealizationResult, compute_chunk_here
 from .signals import CancelOnSignals
 
@@ -99,7 +99,7 @@ def run(
         scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried,
         restored=tuple(accumulator.results[i] for i in sorted(accumulator.results)),
     )  # fmt: skip
-    from .registry import default_registry
+    from ..plugin.registry import default_registry
 
     hooks = listener_manager([*listeners, *(registry or default_registry()).run_listeners()]).hook
     cancel = threading.Event() if cancel is None else cancel

@@ -12,7 +12,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 
 from . import dask_security
-from .options import RunOptions, default_workers
+from ..options import RunOptions, default_workers
 
 
 class DaskSession:

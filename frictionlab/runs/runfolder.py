@@ -29,8 +29,8 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from .errors import RunFolderError, shown
-from .inputs import InputFileProblem, read_regular_file
+from ..errors import RunFolderError, shown
+from ..io.inputs import InputFileProblem, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
 MAX_CSV_BYTES = 16 * 1024 * 1024  # curve.csv: a row of 7 numbers per load step
