@@ -4,8 +4,9 @@
 from __future__ import annotations
 
 import os
+import signal
 import sys
-import time
+import threading
 from pathlib import Path
 
 from ..errors import ExitCode, shown
@@ -26,13 +27,40 @@ def add_parser(sub) -> None:
         "until it ends, then its state on stdout. For a sweep's folder: each point as it starts, its "
         "realizations, and its fit once it ends. Ctrl-C stops following; the run goes on. The exit code is 0 "
         "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it) or its folder was "
-        "deleted while it ran.",
+        "deleted while it ran, 130 if following was stopped with Ctrl-C (143: SIGTERM).",
         epilog=EXAMPLES,
     )
     p.add_argument("run_dir", metavar="DIR", help="a run folder, or a sweep's folder")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr: only wait for the end")
     p.add_argument("--json", action="store_true", help="print the final state as one JSON object on stdout")
     p.set_defaults(handler=run)
+
+
+class _StopSignals:
+    """Within the block, Ctrl-C and SIGTERM are noted (``signal``) instead of raised: raised
+    at any line they could stop a progress bar while it holds its lock, and closing the bar
+    then waits for ever on the thread that draws it."""
+
+    def __init__(self):
+        self.signal: int | None = None
+        self._noted = threading.Event()
+        self._previous: dict[int, object] = {}
+
+    def _note(self, signum, frame) -> None:
+        self.signal = signum
+        self._noted.set()
+
+    def wait(self, seconds: float) -> None:
+        self._noted.wait(seconds)
+
+    def __enter__(self):
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            self._previous[signum] = signal.signal(signum, self._note)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
 
 
 def run(args) -> ExitCode:
@@ -44,23 +72,28 @@ def run(args) -> ExitCode:
     error, gone, identity, holder = None, False, _identity(folder), state.pid
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
+        stopped = _StopSignals()  # a signal is noted and acted on between polls, never raised mid-draw
         try:
             try:
-                while state.status == "running":  # until its process ends: its files are written then
-                    if not follower.poll():
-                        time.sleep(POLL_SECONDS)
-                        now = _state_unless_gone(folder, identity)
-                        if now is None:  # deleted (or replaced) under the run
-                            gone = True
-                            break
-                        state = now
-                follower.poll()  # the last events, written as it ended
+                with stopped:
+                    while state.status == "running" and stopped.signal is None:  # until its process ends
+                        if not follower.poll():
+                            stopped.wait(POLL_SECONDS)
+                            now = _state_unless_gone(folder, identity)
+                            if now is None:  # deleted (or replaced) under the run
+                                gone = True
+                                break
+                            state = now
+                    if stopped.signal is None:
+                        follower.poll()  # the last events, written as it ended
             finally:  # a bar still showing ends on its own line, before anything else is printed
                 for listener in follower.listeners:
                     listener.close()
+            if stopped.signal is not None:
+                raise KeyboardInterrupt
         except KeyboardInterrupt:
             print(f"stopped following; the run goes on{f' (pid {state.pid})' if state.pid else ''}", file=sys.stderr)
-            return ExitCode.INTERRUPTED
+            return ExitCode.TERMINATED if stopped.signal == signal.SIGTERM else ExitCode.INTERRUPTED
         if follower.finished is not None:
             error = follower.finished.error
     if gone:  # what is true: the folder it followed is no more; nothing there to resume

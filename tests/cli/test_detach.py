@@ -7,6 +7,8 @@ import subprocess
 import sys
 import time
 
+import pytest
+
 from frictionlab.runs.detached import run_state
 
 from ..conftest import SMALL_PRESET, merge
@@ -125,7 +127,8 @@ def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(
     assert stdout.startswith(f"small: interrupted, 1/2 points, in {out}/; frictionlab resume {out} continues it")
 
 
-def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path):
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
+def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path, signum, code):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
     out = tmp_path / "long"
     told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
@@ -137,13 +140,13 @@ def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctr
             time.sleep(0.05)
         assert b"/100000" in follow.raw, f"no bar in 60 s: {follow.raw[-600:]!r}"
         time.sleep(0.5)
-        follow.process.send_signal(signal.SIGINT)
-        code = follow.wait()
+        follow.process.send_signal(signum)
+        ended = follow.wait()
     finally:
         os.kill(told["pid"], signal.SIGTERM)
     lines, column = follow.screen()
     shown = [line for line in lines if line]
-    assert code == 130
+    assert ended == code
     assert shown[-1] == f"stopped following; the run goes on (pid {told['pid']})" and column == 0  # the prompt's line is free
     assert "/100000" in shown[-2]  # the bar, as it was left, above
 
