@@ -1,0 +1,178 @@
+"""The chunk file of a run folder: one ``.npz`` of the realizations it holds, its
+name their index range; written by ``chunk_bytes``, read back by ``read_chunk``,
+which trusts nothing it has not checked (the SHA-256 the manifest lists, every
+array's name and shape, the indices against the run's)."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..compute.realization import RealizationResult
+from ..io.inputs import InputFileProblem
+from ..preset import Scene
+from .runfolder import read_member
+
+CHUNK_DIR = "chunks"
+MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
+CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
+OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
+FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
+CURVE_ARRAYS = ("xi", "contact_count", "indentation")
+OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected", "real_gradient_rms", "contact_spots")
+ADDED_OPTIONAL_ARRAYS = frozenset({"real_gradient_rms", "contact_spots"})  # of those, absent from older chunks: NaN
+ADDED_CURVE_ARRAYS = ("half_load_points",)  # kept by every run, absent from the chunks of older versions: NaN
+
+
+class ChunkDamage(ValueError):
+    """A chunk file whose content is not what a chunk of this run can hold."""
+
+
+def chunk_bytes(results: list[RealizationResult]) -> bytes:
+    """One chunk file's bytes: the arrays of ``results`` (finished and failed), saved by numpy."""
+    ok = [r for r in results if r.ok]
+    failed = [r for r in results if not r.ok]
+    arrays: dict[str, np.ndarray] = {
+        "index": np.array([r.index for r in ok], dtype=np.int64),
+        "seconds": np.array([r.seconds for r in ok], dtype=np.float64),
+        "slope_rms_line": np.array([r.slope_rms_line for r in ok], dtype=np.float64),
+        "points": np.array([r.points for r in ok], dtype=np.int64),
+        "force_unit": np.array([r.force_unit for r in ok], dtype=np.float64),
+        "measured_rms_height": np.array([r.measured_rms_height for r in ok], dtype=np.float64),
+        "own_rms_height": np.array([r.own_rms_height for r in ok], dtype=np.float64),
+        "peak_rms": np.array([r.peak_rms for r in ok], dtype=np.float64),
+        "failed_index": np.array([r.index for r in failed], dtype=np.int64),
+        "failed_seconds": np.array([r.seconds for r in failed], dtype=np.float64),
+        "failed_error": np.array([r.error for r in failed], dtype=str),
+    }
+    for name in (*CURVE_ARRAYS, *OPTIONAL_CURVE_ARRAYS, *ADDED_CURVE_ARRAYS):
+        rows = [getattr(r, name) for r in ok]
+        if ok and rows[0] is not None:
+            arrays[name] = np.vstack(rows)
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)  # not compressed: deflate costs 10x the write, and the chunks are a working store
+    data = buffer.getvalue()
+    return data
+
+
+def damage_report(chunk_dir: Path, listed: set[str], damaged: dict[str, str], kept: set[int], total: int) -> str:
+    """What a resume found wrong in ``chunk_dir``: the ``damaged`` chunks (name: why) and the
+    files the manifest does not ``list``, with how many of the ``total`` realizations they held
+    are not ``kept`` elsewhere and so are recomputed; empty when nothing is wrong."""
+    unlisted = sorted(
+        p.name for p in chunk_dir.glob("*.npz") if p.name not in listed and p.name not in damaged
+    ) if chunk_dir.is_dir() else []  # fmt: skip
+    if not damaged and not unlisted:
+        return ""
+    lost = set()
+    for name in [*damaged, *unlisted]:
+        match = CHUNK_NAME.fullmatch(name)
+        if match:
+            lost.update(range(int(match[1]), min(int(match[2]), total - 1) + 1))
+    lost -= kept
+    reasons: dict[str, int] = {}
+    for why in damaged.values():
+        reasons[why] = reasons.get(why, 0) + 1
+    parts = []
+    if damaged:
+        detail = ", ".join(f"{n} {why}" for why, n in reasons.items())
+        parts.append(f"{len(damaged)} chunk file(s) failed verification ({detail})")
+    if unlisted:
+        parts.append(f"{len(unlisted)} file(s) in {CHUNK_DIR}/ are not in the manifest and are ignored")
+    return "; ".join(parts) + f"; {len(lost)} realization(s) they held are recomputed"
+
+
+def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[RealizationResult]:
+    """The results in chunk ``name`` of the run folder ``folder``, verified against its
+    listed SHA-256 ``digest`` and against ``scene``; ChunkDamage when anything is off."""
+    match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
+    if match is None or not isinstance(digest, str):
+        raise ChunkDamage("not a chunk name")
+    try:
+        raw = read_member(folder, f"{CHUNK_DIR}/{name}", MAX_CHUNK_BYTES, what="file")
+    except InputFileProblem as exc:
+        raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
+    if hashlib.sha256(raw).hexdigest() != digest:
+        raise ChunkDamage("checksum mismatch")
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as data:
+            arrays = {key: data[key] for key in data.files}
+    except Exception as exc:  # a damaged zip or array header
+        raise ChunkDamage(f"unreadable ({type(exc).__name__})") from None
+    first, last = int(match[1]), int(match[2])
+    return chunk_results(arrays, first, last, scene)
+
+
+def _optional_kept(scene: Scene) -> tuple[bool, ...]:
+    """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
+    solver = scene.solver
+    return scene.forces_vary, solver.corrected_area, solver.real_gradient, solver.counts_spots
+
+
+def chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[RealizationResult]:
+    """The RealizationResults of one chunk's arrays; ChunkDamage if anything is
+    missing, misshapen, or indexes a realization the chunk cannot hold."""
+    needed = (*OK_ARRAYS, *FAILED_ARRAYS)
+    missing = [name for name in needed if name not in arrays]
+    if missing:
+        raise ChunkDamage(f"no array {missing[0]}")
+    n, k, steps = arrays["index"].shape[0], arrays["failed_index"].shape[0], scene.loads.size
+    curves = (*CURVE_ARRAYS, *(name for name, kept in zip(OPTIONAL_CURVE_ARRAYS, _optional_kept(scene)) if kept))
+    for name in ADDED_OPTIONAL_ARRAYS.intersection(curves):
+        if n and name not in arrays:  # a chunk of a version before it: the values are unknown
+            arrays = {**arrays, name: np.full((n, steps), math.nan)}
+    for name in OK_ARRAYS + (curves if n else ()):
+        if name not in arrays:
+            raise ChunkDamage(f"no array {name}")
+        shape = (n, steps) if name in curves else (n,)
+        if arrays[name].shape != shape:
+            raise ChunkDamage(f"array {name} of shape {arrays[name].shape}, expected {shape}")
+    for name in FAILED_ARRAYS:
+        if arrays[name].shape != (k,):
+            raise ChunkDamage(f"array {name} of shape {arrays[name].shape}, expected {(k,)}")
+    indices = np.concatenate([arrays["index"], arrays["failed_index"]])
+    if indices.dtype.kind not in "iu":
+        raise ChunkDamage("indices are not integers")
+    low, high = max(first, 0), min(last, scene.preset.realizations - 1)
+    repeated = indices.size > 1 and bool((np.diff(np.sort(indices)) == 0).any())  # not np.unique: it imports numpy.ma
+    if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
+        raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
+    heights = {}  # absent from the chunks of older versions: NaN
+    for name in ("measured_rms_height", "own_rms_height", "peak_rms"):
+        heights[name] = arrays.get(name, np.full(n, math.nan))
+        if heights[name].shape != (n,):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
+    for name in ADDED_CURVE_ARRAYS:
+        heights[name] = arrays.get(name, np.full((n, steps), math.nan))
+        if heights[name].shape != (n, steps):
+            raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
+    out = []
+    for row, index in enumerate(arrays["index"].tolist()):
+        out.append(RealizationResult(
+            index=index,
+            seconds=float(arrays["seconds"][row]),
+            xi=arrays["xi"][row],
+            contact_count=arrays["contact_count"][row],
+            indentation=arrays["indentation"][row],
+            force=arrays["force"][row] if "force" in curves else None,
+            real_area_corrected=arrays["real_area_corrected"][row] if "real_area_corrected" in curves else None,
+            real_gradient_rms=arrays["real_gradient_rms"][row] if "real_gradient_rms" in curves else None,
+            contact_spots=arrays["contact_spots"][row] if "contact_spots" in curves else None,
+            slope_rms_line=float(arrays["slope_rms_line"][row]),
+            points=int(arrays["points"][row]),
+            force_unit=float(arrays["force_unit"][row]),
+            measured_rms_height=float(heights["measured_rms_height"][row]),
+            own_rms_height=float(heights["own_rms_height"][row]),
+            peak_rms=float(heights["peak_rms"][row]),
+            half_load_points=np.asarray(heights["half_load_points"][row], dtype=float),
+        ))  # fmt: skip
+    for row, index in enumerate(arrays["failed_index"].tolist()):
+        out.append(RealizationResult(
+            index=index, seconds=float(arrays["failed_seconds"][row]), error=str(arrays["failed_error"][row])
+        ))  # fmt: skip
+    return out
