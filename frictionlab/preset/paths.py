@@ -13,7 +13,6 @@ import yaml
 
 from ..errors import PresetError
 from ..io.safe_yaml import YamlProblem, load_yaml
-from .schema import SweepParameter
 
 MISSING = object()
 """As a value for ``set_path``: remove the key (the model's default then applies)."""
@@ -58,6 +57,8 @@ def _swept_path_as_one_key(keys: list[str], value: Any) -> list[str]:
     unless the value is their whole mapping."""
     if keys[:2] != ["sweep", "parameters"] or len(keys) <= 3:
         return keys
+    from .schema import SweepParameter  # imported here: reading a preset needs no pydantic model
+
     if keys[-1] in SweepParameter.model_fields and not isinstance(value, dict):
         return [*keys[:2], ".".join(keys[2:-1]), keys[-1]]
     return [*keys[:2], ".".join(keys[2:])]

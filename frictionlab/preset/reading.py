@@ -5,13 +5,15 @@ from __future__ import annotations
 import copy
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import FrictionlabError, PresetError, PresetFileError
 from ..io.inputs import InputFileProblem, input_fields, is_relative, read_regular_file
-from ..plugin import KINDS
-from ..plugin.registry import Registry, default_registry
 from ..io.safe_yaml import YamlLimit, YamlProblem, load_yaml
 from .paths import apply_overrides
+
+if TYPE_CHECKING:
+    from ..plugin.registry import Registry
 
 MAX_PRESET_BYTES = 256 * 1024  # presets are a few kB; refused by size before anything is read
 
@@ -51,6 +53,9 @@ def resolve_input_paths(data: dict, base_dir: str | Path, registry: Registry | N
     """A copy of preset ``data`` whose relative input-file paths (plugin
     parameters declared ``InputFile``, and swept values of one) are taken from
     ``base_dir``, the folder of the preset file they were written in."""
+    from ..plugin import KINDS  # the plugins load only when a preset names its input files
+    from ..plugin.registry import default_registry
+
     registry = registry or default_registry()
     data = copy.deepcopy(data)
     base = Path(os.path.abspath(base_dir))
