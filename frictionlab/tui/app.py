@@ -6,13 +6,17 @@ going on, and the keys that work everywhere. Each tab's pane shows its part
 of its own (``detached``: it goes on when the TUI or its terminal goes away),
 followed by reading its folder (``following``), as a TUI opened later follows it;
 starting, resuming and following one is ``running.RunControl``'s part of the app.
+The first screen, the Presets tab, is drawn before the rest is built (the plugins, the
+other panes, a run to follow): a run's modules are imported only once they are used.
 """
 
 from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from textual import events
 from textual.actions import SkipAction
 from textual.app import App, ComposeResult
 from textual.binding import Binding
@@ -20,13 +24,11 @@ from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Footer, Static, TabbedContent, TabPane
 
-from ..runs.detached import list_run_states
 from ..errors import PresetError, shown
 from ..options import RunOptions
 from ..preset import load_preset_file
 from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
-from .fields import default_spectrum, preset_from_defaults
 from .folders import (
     is_builtin,
     new_preset_path,
@@ -39,12 +41,14 @@ from .folders import (
     user_presets_dir,
     writable_folder,
 )
-from .following import FollowedRun
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .text import problems_text
-from .widgets import EditPane, PresetForm, PresetsPane, ResultsPane, RunPane
-from .widgets.presets import NO_PRESETS
+from .widgets.presets import NO_PRESETS, PresetsPane
+
+if TYPE_CHECKING:
+    from .following import FollowedRun
+    from .widgets import PresetForm
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
 WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
@@ -90,7 +94,7 @@ class FrictionlabApp(RunControl, App):
         self.presets_dir = Path(presets_dir) if presets_dir else None
         self.runs_dir = Path(runs_dir) if runs_dir else DEFAULT_RUNS_DIR
         self.run_options = options or RunOptions()
-        self.registry = registry or default_registry()
+        self._plugins = registry  # the plugins, loaded when first needed (not for the first screen)
         self.draft_path: Path | None = None
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
@@ -105,26 +109,43 @@ class FrictionlabApp(RunControl, App):
         self.last_resumable = False  # the last run shown ended before it completed, and can go on (u)
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
+        self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
 
     # ------------------------------------------------------------ layout
 
     def compose(self) -> ComposeResult:
+        # the first screen is the Presets tab: the other panes are mounted just after it is drawn
         with TabbedContent(initial="presets", id="tabs"):
             with TabPane("F2 Presets", id="presets"):
                 yield PresetsPane(id="presets-pane")
-            with TabPane("F3 Edit", id="edit"):
-                yield EditPane(self.registry, id="edit-pane")
-            with TabPane("F4 Run", id="run"):
-                yield RunPane(id="run-pane")
-            with TabPane("F5 Results", id="results"):
-                yield ResultsPane(id="results-pane")
+            yield TabPane("F3 Edit", id="edit")
+            yield TabPane("F4 Run", id="run")
+            yield TabPane("F5 Results", id="results")
         yield Static("", id="status")
         yield Footer()
 
-    async def on_mount(self) -> None:
+    def on_mount(self) -> None:
         # F2..F5 switch tabs: the tab bar as a Tab stop would only take focus where nothing shows it
         self.query_one("ContentTabs").can_focus = False
         self.reload_presets()
+        self.query_one("#preset-table").focus()
+
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, events.Key) and self._early_keys is not None:
+            self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
+            return
+        await super().on_event(event)
+
+    async def on_ready(self) -> None:
+        """The first frame is on the screen: now the panes and the work it does not show (the
+        form, the runs, a run to follow). This runs in the app's own queue, as the keys do, so a
+        key pressed meanwhile waits for it (as it waited for the whole start before)."""
+        from ..runs.detached import list_run_states
+        from .widgets import EditPane, ResultsPane, RunPane
+
+        await self.query_one("#edit", TabPane).mount(EditPane(self.registry, id="edit-pane"))
+        await self.query_one("#run", TabPane).mount(RunPane(id="run-pane"))
+        await self.query_one("#results", TabPane).mount(ResultsPane(id="results-pane"))
         self.reload_runs()
         self._show_edit_state()
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
@@ -136,8 +157,28 @@ class FrictionlabApp(RunControl, App):
             await self.open_preset(self.preset_path)
         elif going:
             self.action_show_tab("run")
-        else:
-            self.query_one("#preset-table").focus()
+        self.refresh_bindings()  # the footer: the keys of the tabs now mounted
+        # the keys typed so far once the tab shown and its focus have settled (a key typed meanwhile
+        # is held too, after them), in the app's queue, as a key is answered
+        self.call_after_refresh(self.call_later, self._answer_early_keys)
+
+    async def _answer_early_keys(self) -> None:
+        early, self._early_keys = self._early_keys, None
+        for key in early:  # in the order typed
+            await super().on_event(key)
+
+    @property
+    def built(self) -> bool:
+        """Whether every pane is there, and the keys typed before are answered (the Presets tab
+        is drawn first, the rest just after)."""
+        return self._early_keys is None
+
+    @property
+    def registry(self):
+        """The plugins (``Registry``): loaded when first used, after the first screen."""
+        if self._plugins is None:
+            self._plugins = default_registry()
+        return self._plugins
 
     @property
     def folders(self):
@@ -240,7 +281,7 @@ class FrictionlabApp(RunControl, App):
         else:
             self.draft_source = None
         self.draft_path = path
-        await self.query_one("#form", PresetForm).load(data, base_dir=path.parent)
+        await self.query_one("#form").load(data, base_dir=path.parent)
         if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
             self.say("")
         self.modified = modified
@@ -277,6 +318,8 @@ class FrictionlabApp(RunControl, App):
             name, template, path = answer
             try:
                 if template is None:
+                    from .fields import default_spectrum, preset_from_defaults
+
                     data = preset_from_defaults(name, default_spectrum(self.registry), self.registry)
                 else:
                     data = preset_from_template(template, name, path, self.registry)
@@ -310,16 +353,17 @@ class FrictionlabApp(RunControl, App):
         elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
             self.say("")
         self._show_edit_state()
-        if (pane := self._mounted(EditPane)) is not None:
+        if (pane := self._mounted("EditPane")) is not None:
             pane.show_problems(event.problems, event.read)
 
     def _show_edit_state(self) -> None:
-        if (pane := self._mounted(EditPane)) is not None:
+        if (pane := self._mounted("EditPane")) is not None:
             pane.show_title(self.draft_path, self.modified, self.problems)
 
-    def _mounted(self, pane_class):
-        """The app's pane of that class, or None once the app is closing: its widgets are
-        gone while a late message or a follow tick still arrives."""
+    def _mounted(self, pane_class: str):
+        """The app's pane of that class (named: the panes are imported once the first screen is drawn),
+        or None before it is mounted, or once the app is closing: its widgets are gone while a late
+        message or a follow tick still arrives."""
         try:
             pane = self.query_one(pane_class)
         except NoMatches:
@@ -327,7 +371,7 @@ class FrictionlabApp(RunControl, App):
         return pane if pane.children else None  # the app is closing: the panes' children go first
 
     def _draft(self) -> dict | None:
-        return self.query_one("#form", PresetForm).data
+        return self.query_one("#form").data
 
     def action_save(self) -> None:
         if self.draft_path is None or self._draft() is None:
@@ -400,18 +444,18 @@ class FrictionlabApp(RunControl, App):
     # ------------------------------------------------------------ results
 
     def reload_runs(self) -> None:
-        self.query_one(ResultsPane).reload(self.runs_dir)
+        self.query_one("ResultsPane").reload(self.runs_dir)
         self._runs_read_at = time.monotonic()
         self._runs_seen = self._runs_signature()
 
     def _runs_signature(self) -> tuple:
-        running = [entry.path for entry in self.query_one(ResultsPane).runs if entry.status == "running"]
+        running = [entry.path for entry in self.query_one("ResultsPane").runs if entry.status == "running"]
         return runs_signature(self.runs_dir, running)
 
     def _watch_runs(self) -> None:
         """Results lists every run the moment it starts, from any TUI or the CLI: the runs
         folder's names and times are looked at, and the list read again only when they changed."""
-        if self._mounted(ResultsPane) is None:
+        if self._mounted("ResultsPane") is None:
             return
         now, seen = self._runs_signature(), self._runs_seen
         if now == seen:

@@ -16,17 +16,15 @@ from pathlib import Path
 
 import yaml
 
-from ..runs.detached import RUN_MARKERS, SWEEP_FILE, damage_reason, run_state
 from ..errors import FrictionlabError, RunFolderError
-from ..io.files import atomic_write
 from ..io.inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
-from ..preset.reading import MAX_PRESET_BYTES
 from ..preset.builtin import builtin_folder, builtin_presets
-from ..runs.rundir import STATE_FILE
-from ..runs.runfolder import read_json, subfolder
+from ..preset.reading import MAX_PRESET_BYTES
 from ..io.safe_yaml import load_yaml
-from .roundtrip import dump_preserving
+
+# The runs' modules (``detached``, ``runfolder``) and the comment-keeping YAML writer are
+# imported where runs are read or a preset written: the first screen lists presets only.
 
 PROJECT_PRESETS_DIR = Path("presets")
 
@@ -145,6 +143,9 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
     """Write preset data as YAML, atomically. With ``template`` (the file the draft
     was read from) the text keeps that file's comments, key order and formatting,
     only the edited values change; without one, or if it cannot be read, plain YAML."""
+    from ..io.files import atomic_write
+    from .roundtrip import dump_preserving
+
     text = None
     if template is not None:
         try:
@@ -216,6 +217,8 @@ class RunEntry:
 def read_run(folder: Path) -> RunEntry:
     """A run folder's summary (read as untrusted input: ``runfolder``); RunFolderError
     if it has none readable."""
+    from ..runs.runfolder import read_json
+
     folder = Path(folder)
     summary_path = folder / "summary.json"
     summary = read_json(folder, "summary.json")
@@ -246,6 +249,8 @@ class SweepEntry:
 
     def point_folder(self, row: dict) -> Path:
         """The folder of a point (RunFolderError if sweep.json names one outside the sweep's, or a link)."""
+        from ..runs.runfolder import subfolder
+
         return subfolder(self.path, row["folder"])
 
 
@@ -270,6 +275,8 @@ def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:
     """Every run folder under ``runs_dir`` (one with a summary.json, a run.json, or a
     sweep's sweep.json), newest first; one whose files cannot be read is listed as
     damaged with the reason, never left out."""
+    from ..runs.detached import RUN_MARKERS
+
     runs_dir = Path(runs_dir)
     if not runs_dir.is_dir():
         return []
@@ -303,6 +310,9 @@ def runs_signature(runs_dir: Path, running: list[Path] = ()) -> tuple:
 
 def _entry(folder: Path) -> RunEntry | SweepEntry | None:
     """The folder's run or sweep as it is now (OSError, FrictionlabError if it cannot be read)."""
+    from ..runs.detached import SWEEP_FILE, run_state
+    from ..runs.rundir import STATE_FILE
+
     if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):
         entry = read_sweep(folder)
         return _sweep_with_state(entry) if entry.status == "running" else entry
@@ -321,6 +331,8 @@ def _entry(folder: Path) -> RunEntry | SweepEntry | None:
 
 
 def _damaged(folder: Path, error: Exception, name: str = "") -> RunEntry:
+    from ..runs.detached import damage_reason
+
     reason = damage_reason(folder, error) if isinstance(error, FrictionlabError) else (error.strerror or str(error))
     try:
         mtime = folder.lstat().st_mtime
@@ -331,6 +343,8 @@ def _damaged(folder: Path, error: Exception, name: str = "") -> RunEntry:
 
 def _sweep_with_state(entry: SweepEntry) -> SweepEntry:
     """A sweep that says it is running: interrupted if no live process holds its folder."""
+    from ..runs.detached import run_state
+
     try:
         entry.status = run_state(entry.path).status
     except (OSError, FrictionlabError):

@@ -10,23 +10,24 @@ from __future__ import annotations
 from contextlib import suppress
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
-from ..runs.detached import check_startable, check_sweep_startable, lock_held, lock_holder, run_state, start_detached
 from ..errors import FrictionlabError, PresetError, RunFolderError, shown
-from ..io.files import output_path_problem
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
-from ..runs.rundir import RunDirectory, new_run_folder
-from ..runs.sweep import plan_sweep, stored_sweep
 from .folders import read_run
-from .following import FinishedSweep, FollowedRun, FollowedSweep, read_finished, read_finished_sweep
 from .messages import RunCrashed, RunFinished
 from .screens import ConfirmScreen, QuitDuringRunScreen
 from .text import failure_message
-from .widgets import PresetForm, RunPane
+
+if TYPE_CHECKING:
+    from .following import FollowedRun
+
+# A run's modules (its process, its folder, its log, the Run tab) are imported where a run is
+# started or followed: the first screen needs none of them, and it is drawn before they load.
 
 NO_PRESET = "No preset open: F2 lists them (Enter opens one, n makes a new one)."
 
@@ -35,6 +36,10 @@ class RunControl:
     """Starting, resuming, following and cancelling runs (``FrictionlabApp``'s)."""
 
     def action_start_run(self) -> None:
+        from ..io.files import output_path_problem
+        from ..runs.rundir import new_run_folder
+        from ..runs.sweep import plan_sweep
+
         if self.running:
             self.say("A run is going; c on the Run tab cancels it.", "warning")
             return
@@ -55,7 +60,7 @@ class RunControl:
             self.say(exc.problems[0], "error", title=f"Cannot run: {count} problem{'s' if count != 1 else ''}")
             self.blocked_by = exc.problems[0]
             self.query_one("#tabs", TabbedContent).active = "edit"
-            form = self.query_one("#form", PresetForm)
+            form = self.query_one("#form")
             form.revalidate(changed=False)  # a file may have gone since the last keystroke: mark it now
             form.focus_problem(exc.problems)
             return
@@ -80,6 +85,8 @@ class RunControl:
         if folder is None:
             self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
             return
+        from ..runs.detached import run_state
+
         try:
             state = run_state(folder)
             if state.status == "running":
@@ -113,6 +120,8 @@ class RunControl:
         if self.followed is None:
             return  # the status line says why it cannot be followed
         self.action_show_tab("run")
+        from ..runs.detached import lock_holder
+
         pid = pid or lock_holder(folder)
         self.say(f"{shown(folder.name)} was resumed by another process first (pid {pid or 'unknown'}): "
                  "this TUI follows that run; c cancels it", "warning")  # fmt: skip
@@ -120,6 +129,10 @@ class RunControl:
     def _stored(self, folder: Path):
         """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
         its first point's); RunFolderError or PresetError if it holds none that can run."""
+        from ..runs.detached import run_state
+        from ..runs.rundir import RunDirectory
+        from ..runs.sweep import plan_sweep, stored_sweep
+
         if run_state(folder).kind == "sweep":
             sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
             return sweep.points[0].scene, sweep
@@ -136,6 +149,8 @@ class RunControl:
         return None
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
+        from ..runs.detached import check_startable, check_sweep_startable, lock_held, start_detached
+
         self.last_outcome = None
         self.last_resumable = False
         self.refresh_bindings()
@@ -158,7 +173,7 @@ class RunControl:
             return
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
-        self.query_one(RunPane).start(scene, sweep, out_dir)
+        self.query_one("RunPane").start(scene, sweep, out_dir)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
@@ -166,6 +181,8 @@ class RunControl:
                  f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
 
     def _follower(self, folder: Path, scene, sweep, process=None) -> FollowedRun:
+        from .following import FollowedRun, FollowedSweep
+
         if sweep is None:
             return FollowedRun(folder, scene, self._show_snapshot, process=process)
         show_point = lambda kind, point, result: self._show_point(sweep, kind, point, result)  # noqa: E731
@@ -188,7 +205,7 @@ class RunControl:
         scene, sweep = stored
         self.last_outcome = None
         self.last_resumable = False
-        self.query_one(RunPane).start(scene, sweep, folder)  # before the first poll: that fills its table
+        self.query_one("RunPane").start(scene, sweep, folder)  # before the first poll: that fills its table
         self.followed = self._follower(folder, scene, sweep)
         self.refresh_bindings()
         name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
@@ -196,21 +213,26 @@ class RunControl:
         self._follow_tick()
 
     def _show_point(self, sweep, kind: str, point, result) -> None:
-        if (pane := self._mounted(RunPane)) is not None:
+        if (pane := self._mounted("RunPane")) is not None:
             with suppress(NoMatches):  # the app is closing: the pane's widgets go one by one
                 pane.show_point(sweep, kind, point, result)
 
     def _show_snapshot(self, snapshot) -> None:
         self.last_snapshot = snapshot
-        if (pane := self._mounted(RunPane)) is not None:
+        if (pane := self._mounted("RunPane")) is not None:
             with suppress(NoMatches):  # as above: a follow tick late in the close found #run-stats gone
                 pane.show_progress(snapshot, self.followed is not None and self.followed.cancelling)
 
     def _follow_tick(self) -> None:
         followed = self.followed
-        if followed is not None and not isinstance(followed, FollowedSweep) and followed.progress_problem():
+        if followed is None:
+            return
+        from ..runs.detached import lock_held
+        from .following import FollowedSweep, read_finished, read_finished_sweep
+
+        if not isinstance(followed, FollowedSweep) and followed.progress_problem():
             self._count_from_chunks(followed)
-        if followed is None or not followed.poll():
+        if not followed.poll():
             return
         self.followed = None
         self.last_out_dir = followed.folder
@@ -240,7 +262,7 @@ class RunControl:
             followed.said_progress_problem = True
             self.say(f"{followed.progress_problem()}: the count comes from the run's chunks, without a live plot", "warning")
         done, total = followed.stored_count()
-        if total and (pane := self._mounted(RunPane)) is not None:
+        if total and (pane := self._mounted("RunPane")) is not None:
             pane.show_stored_count(done or 0, total)
 
     def action_cancel_run(self) -> None:
@@ -249,13 +271,15 @@ class RunControl:
             return
         if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
             return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
-        self.query_one(RunPane).show_cancelling()
+        self.query_one("RunPane").show_cancelling()
 
     def on_run_finished(self, message: RunFinished) -> None:
         outcome = message.outcome
         self.last_outcome, self.last_out_dir = outcome, message.out_dir
         self.refresh_bindings()  # resume, if it ended before it completed
-        pane = self.query_one(RunPane)
+        pane = self.query_one("RunPane")
+        from .following import FinishedSweep
+
         if isinstance(outcome, FinishedSweep):
             self.say(pane.show_sweep_outcome(outcome))
         else:
@@ -269,13 +293,15 @@ class RunControl:
         self.reload_runs()
 
     def on_run_crashed(self, message: RunCrashed) -> None:
-        self.query_one(RunPane).show_crash(message.error)
+        self.query_one("RunPane").show_crash(message.error)
         self.say(message.error, "error", title="Run failed")
 
     def action_quit(self) -> None:
         """Quit at once; while a run goes on, ask first whether to leave it running or cancel it."""
         followed = self.followed
         if followed is not None:
+            from .following import FollowedSweep
+
             def answered(choice: str | None) -> None:
                 if choice is None:
                     return
@@ -303,6 +329,8 @@ class RunControl:
 
 def _resumable(folder: Path) -> bool:
     """Whether the run (or sweep) in ``folder`` ended before it completed and can go on."""
+    from ..runs.detached import run_state
+
     try:
         return run_state(folder).resumable
     except (OSError, FrictionlabError):

@@ -3,6 +3,7 @@ shows is checked against the headless validator and the headless run, and the
 files it writes against what ``frictionlab run`` accepts."""
 
 import asyncio
+import contextlib
 import functools
 import re
 
@@ -32,6 +33,23 @@ def sync(scenario):
         asyncio.run(scenario(*args, **kwargs))
 
     return test
+@pytest.fixture(autouse=True)
+def built_at_start(request, monkeypatch):
+    """The app draws its Presets tab first and builds the rest just after (test_start.py drives
+    that moment): elsewhere a test drives the app once it is built, as a user does a moment later."""
+    if getattr(request.module, "DRIVES_THE_FIRST_SCREEN", False):
+        return
+    run_test = FrictionlabApp.run_test
+
+    @contextlib.asynccontextmanager
+    async def built(app, *args, **kwargs):
+        async with run_test(app, *args, **kwargs) as pilot:
+            await wait_until(pilot, lambda: app.built or not app.is_running)
+            yield pilot
+
+    monkeypatch.setattr(FrictionlabApp, "run_test", built)
+
+
 TINY = merge(SMALL_PRESET, {"spectrum": {"params": {"points": 512}}, "fit": {"bootstrap": 50}})
 
 

@@ -27,10 +27,11 @@ SIZES = pytest.mark.parametrize("size", [SIZE, (120, 40)], ids=["80x24", "120x40
 @pytest.fixture(autouse=True)
 def steady(monkeypatch):
     """A fixed run folder name and elapsed time, so a snapshot shows the same text each time."""
-    import frictionlab.tui.running
+    import frictionlab.runs.rundir
     import frictionlab.tui.widgets.run
 
-    monkeypatch.setattr(frictionlab.tui.running, "new_run_folder", lambda name, runs_dir: runs_dir / f"{name}-run")
+    # the TUI imports it when a run starts (not for its first screen): patched where it is read then
+    monkeypatch.setattr(frictionlab.runs.rundir, "new_run_folder", lambda name, runs_dir: runs_dir / f"{name}-run")
     monkeypatch.setattr(frictionlab.tui.widgets.run, "format_duration", lambda seconds: "1.0 s")
     monkeypatch.setattr(
         frictionlab.tui.widgets.run, "progress_text", lambda done, total, failed, elapsed, restored=0: f"{done}/{total} realizations"
