@@ -46,6 +46,7 @@ class Collect:
         self.results.append((result, done, total))
 
 
+@pytest.mark.long
 def test_a_detached_run_completes_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 60, "spectrum": {"params": {"points": 2048}}})
     out = tmp_path / "run"

@@ -78,6 +78,7 @@ def _listed_chunks(run_dir: Path) -> int:
         return 0
 
 
+@pytest.mark.long
 def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry, tmp_path):
     preset = tmp_path / "long.yaml"
     preset.write_text(yaml.safe_dump(KILL_PRESET))
