@@ -204,9 +204,16 @@ class CancelMidSolve:
             self._heard(index)
 
 
+@pytest.fixture(scope="module")
+def long_loads_whole(registry):
+    """LONG_LOADS run uninterrupted, once for every test that compares with it."""
+    return engine.run(build_scene(LONG_LOADS, registry=registry), RunOptions(workers=1, executor="serial"))
+
+
 @pytest.mark.parametrize("options", [RunOptions(workers=1, executor="serial"), RunOptions(workers=2, executor="processes")],
                          ids=["serial", "processes"])  # fmt: skip
-def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_same_numbers(registry, options):
+def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_same_numbers(registry, options,
+                                                                                             long_loads_whole):
     scene = build_scene(LONG_LOADS, registry=registry)
     cancel = threading.Event()
     listener = CancelMidSolve(cancel)
@@ -216,7 +223,7 @@ def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_s
     assert 0 in outcome.indices.tolist() and outcome.failures == []
     kept = [compute_realization(scene, int(i)) for i in outcome.indices]
     resumed = engine.run(scene, options, restored=kept)
-    whole = engine.run(scene, RunOptions(workers=1, executor="serial"))
+    whole = long_loads_whole
     assert resumed.status == whole.status == "completed"
     for name, values in whole.per_realization.items():
         np.testing.assert_array_equal(resumed.per_realization[name], values, err_msg=name)
