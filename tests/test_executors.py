@@ -133,7 +133,10 @@ def test_the_default_pool_is_started_only_when_the_work_repays_its_start():
 
 
 def test_a_run_too_short_for_a_pool_runs_here_with_the_numbers_of_any_worker_count(scene_24, serial_24, monkeypatch):
-    short = engine.run(scene_24, RunOptions(workers=2))  # 24 tiny lines: far less than a pool's start
+    # 24 tiny lines: far less than a pool's start, here a minute, so that on a loaded machine a
+    # slow first realization (over the 9 ms that repay the real 0.05 s) cannot tip the choice
+    monkeypatch.setattr(executors, "POOL_START_SECONDS", 60.0)
+    short = engine.run(scene_24, RunOptions(workers=2))
     assert (short.extra["executor"], short.workers) == ("serial", 1)
     same_numbers(serial_24, short)
     monkeypatch.setattr(executors, "POOL_START_SECONDS", 0.0)  # any work repays a free start
