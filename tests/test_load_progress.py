@@ -212,6 +212,7 @@ def long_loads_whole(registry):
 
 @pytest.mark.parametrize("options", [RunOptions(workers=1, executor="serial"), RunOptions(workers=2, executor="processes")],
                          ids=["serial", "processes"])  # fmt: skip
+@pytest.mark.long
 def test_a_run_cancelled_within_a_solve_keeps_what_finished_and_resumes_to_the_same_numbers(registry, options,
                                                                                              long_loads_whole):
     scene = build_scene(LONG_LOADS, registry=registry)

@@ -93,6 +93,7 @@ def test_a_process_pool_starts_from_the_app_thread():
         assert result.stdout.strip().splitlines()[-1] == expected, result.stderr[-2000:]
 
 
+@pytest.mark.long  # a TUI session drawn to SVG
 def test_the_docs_screenshot_is_made_by_its_command(tmp_path, monkeypatch):
     """docs/tui/main.svg comes from `python -m frictionlab.tui.screenshot docs/tui/main.svg`."""
     from frictionlab.tui.screenshot import main as screenshot
