@@ -81,6 +81,7 @@ print(status)
 """
 
 
+@pytest.mark.long  # a TUI session that runs a pool
 @pytest.mark.skipif(sys.platform != "linux", reason="forkserver start method")
 def test_a_process_pool_starts_from_the_app_thread():
     """Found in tmux: a pool run from the app failed with 'bad value(s) in
