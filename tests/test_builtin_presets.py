@@ -101,6 +101,7 @@ def installed(tmp_path_factory) -> Path:
     return target
 
 
+@pytest.mark.long
 def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, tmp_path):
     empty = tmp_path / "anywhere"
     empty.mkdir()

@@ -41,6 +41,7 @@ def clusters_started(monkeypatch):
     return started
 
 
+@pytest.mark.long
 @needs_dask
 def test_a_sweep_on_dask_starts_one_cluster_for_all_its_points(tmp_path, registry, clusters_started):
     sweep = plan_sweep(sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.7, 0.9]}}), registry=registry)
@@ -53,6 +54,7 @@ def test_a_sweep_on_dask_starts_one_cluster_for_all_its_points(tmp_path, registr
         assert np.array_equal(result.outcome.per_realization["xi"], serial.per_realization["xi"])
 
 
+@pytest.mark.long
 @needs_dask
 def test_runs_outside_a_session_start_a_cluster_each_and_inside_one_share_it(make_scene, clusters_started):
     scene = make_scene({"realizations": 4})
@@ -71,6 +73,7 @@ def test_runs_outside_a_session_start_a_cluster_each_and_inside_one_share_it(mak
     assert len(clusters_started) == 3
 
 
+@pytest.mark.long
 @needs_dask
 def test_a_task_stops_within_its_solve_once_the_run_s_stop_event_is_set(registry):
     scene = build_scene(LONG_LOADS, registry=registry)  # about a second a realization
@@ -86,6 +89,7 @@ def test_a_task_stops_within_its_solve_once_the_run_s_stop_event_is_set(registry
         assert [r.index for r in pickle.loads(whole.result(timeout=60))] == [1]
 
 
+@pytest.mark.long
 @needs_dask
 def test_a_dask_run_cancelled_while_it_waits_returns_at_once_with_what_finished(registry):
     import threading

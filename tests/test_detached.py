@@ -40,6 +40,7 @@ class Collect:
         self.results.append((result, done, total))
 
 
+@pytest.mark.long
 def test_a_detached_run_completes_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 60, "spectrum": {"params": {"points": 2048}}})
     out = tmp_path / "run"
@@ -99,6 +100,7 @@ def test_sigterm_ends_a_detached_run_interrupted_keeping_what_finished(tmp_path)
         assert arrays["xi"].shape[0] == state.done
 
 
+@pytest.mark.long
 def test_the_follower_hears_every_realization_as_the_run_computed_it_and_a_resume_lists_the_restored(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 12})
     scene = build_scene(data)

@@ -29,6 +29,7 @@ def fits(folder):
     return [(p["status"], p["a"], p["b"]) for p in json.loads((folder / "sweep.json").read_text())["points"]]
 
 
+@pytest.mark.long
 def test_a_detached_sweep_completes_every_point_after_the_session_that_started_it_is_killed(tmp_path):
     data = merge(SWEEP, {"realizations": 40})
     out = tmp_path / "sweep"
@@ -43,6 +44,7 @@ def test_a_detached_sweep_completes_every_point_after_the_session_that_started_i
     assert sweep_pid > 0 and not (out / "run.lock").exists()
 
 
+@pytest.mark.long
 def test_sigterm_leaves_a_detached_sweep_interrupted_and_resume_detach_completes_it_to_the_same_numbers(tmp_path):
     from frictionlab.cli.main import main
 

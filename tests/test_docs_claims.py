@@ -84,6 +84,7 @@ def _collected(*args: str) -> str:
     return done.stdout.strip().splitlines()[-1]
 
 
+@pytest.mark.long
 def test_a_long_module_named_on_the_command_line_runs_whole():
     """`pytest tests/exact3d/test_study.py` (as one runs the file one changed) deselects nothing."""
     assert re.fullmatch(r"\d+ tests collected in .*", _collected("tests/exact3d/test_study.py"))

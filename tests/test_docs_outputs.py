@@ -72,6 +72,7 @@ def test_the_predictions_shown_are_what_predict_prints(fig2_run, capsys):
     _check("docs/how-to/predict.md", "law: xi = 2.9000", capsys.readouterr().out)
 
 
+@pytest.mark.long  # the fig2 calibration, solved in full
 def test_the_calibration_shown_is_what_it_prints(capsys):
     calibration.main(str(ROOT / "presets" / "benad2012-fig2.yaml"))
     _check("docs/tutorials/reproduce-fig2.md", "least-squares (in log) h =", capsys.readouterr().out)

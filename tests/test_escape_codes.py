@@ -29,6 +29,7 @@ ESC = "\x1b"
 posix = pytest.mark.skipif(sys.platform == "win32", reason="control characters in file names")
 
 
+@pytest.mark.long  # follows a held run for 5 s
 def test_follow_prints_a_forged_finished_error_escaped(tmp_path):
     script = textwrap.dedent(f"""
         import sys

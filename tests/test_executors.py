@@ -1,6 +1,6 @@
 """Executors: the same numbers whatever runs them, chunks sized by cost, a
 worker that dies costs only a retry. Dask tests share one 2-worker LocalCluster
-on loopback (started once: it costs seconds) and come last, since its threads
+on loopback (started once: it costs seconds; they are marked long) and come last, since its threads
 switch the process pool to forkserver."""
 
 from __future__ import annotations
@@ -133,7 +133,10 @@ def test_the_default_pool_is_started_only_when_the_work_repays_its_start():
 
 
 def test_a_run_too_short_for_a_pool_runs_here_with_the_numbers_of_any_worker_count(scene_24, serial_24, monkeypatch):
-    short = engine.run(scene_24, RunOptions(workers=2))  # 24 tiny lines: far less than a pool's start
+    # 24 tiny lines: far less than a pool's start, here a minute, so that on a loaded machine a
+    # slow first realization (over the 9 ms that repay the real 0.05 s) cannot tip the choice
+    monkeypatch.setattr(executors, "POOL_START_SECONDS", 60.0)
+    short = engine.run(scene_24, RunOptions(workers=2))
     assert (short.extra["executor"], short.workers) == ("serial", 1)
     same_numbers(serial_24, short)
     monkeypatch.setattr(executors, "POOL_START_SECONDS", 0.0)  # any work repays a free start
@@ -208,6 +211,7 @@ def dask_scheduler(two_worker_cluster):
     return two_worker_cluster.scheduler_address
 
 
+@pytest.mark.long
 @needs_dask
 def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_24, serial_24, dask_scheduler):
     outcome = engine.run(scene_24, RunOptions(executor="dask", scheduler=dask_scheduler))
@@ -215,6 +219,7 @@ def test_dask_on_an_existing_two_worker_cluster_gives_the_serial_numbers(scene_2
     same_numbers(serial_24, outcome)
 
 
+@pytest.mark.long
 @needs_dask
 def test_a_scene_too_large_to_travel_in_each_task_is_broadcast_with_the_same_numbers(
     monkeypatch, scene_24, serial_24, dask_scheduler
@@ -264,6 +269,7 @@ def test_results_come_straight_from_the_workers_only_of_a_scheduler_on_this_mach
     assert not _on_this_machine("tls://10.0.0.5:8786") and not _on_this_machine("tcp://cluster.example.org:8786")
 
 
+@pytest.mark.long
 @needs_dask
 @pytest.mark.parametrize("size", [1, 5, 23])
 def test_numbers_do_not_depend_on_the_chunk_size(monkeypatch, scene_24, serial_24, dask_scheduler, size):
@@ -278,6 +284,7 @@ def test_numbers_do_not_depend_on_the_chunk_size(monkeypatch, scene_24, serial_2
         same_numbers(serial_24, outcome)
 
 
+@pytest.mark.long
 @needs_dask
 def test_dask_killed_worker_is_rescheduled_with_the_same_numbers(scene_24, serial_24, dask_scheduler, tmp_path):
     flag = tmp_path / "crashed"
@@ -287,6 +294,7 @@ def test_dask_killed_worker_is_rescheduled_with_the_same_numbers(scene_24, seria
     same_numbers(serial_24, outcome)
 
 
+@pytest.mark.long
 @needs_dask
 def test_dask_own_local_cluster_of_one_worker_gives_the_serial_numbers(scene_24, serial_24):
     outcome = engine.run(scene_24, RunOptions(workers=1, executor="dask"))
@@ -294,6 +302,7 @@ def test_dask_own_local_cluster_of_one_worker_gives_the_serial_numbers(scene_24,
     same_numbers(serial_24, outcome)
 
 
+@pytest.mark.long
 @needs_dask
 def test_the_own_cluster_s_workers_keep_the_adaptive_malloc_thresholds():
     """Dask's default MALLOC_TRIM_THRESHOLD_ made every large array a fresh mapping in its
@@ -313,6 +322,7 @@ def test_the_own_cluster_s_workers_keep_the_adaptive_malloc_thresholds():
     assert done.stdout.strip().splitlines()[-1] == "[None]"
 
 
+@pytest.mark.long
 @needs_dask
 def test_dask_memory_limits_foresee_those_of_the_local_cluster(dask_scheduler):
     from frictionlab.compute.executors import dask_memory_limits
@@ -384,6 +394,7 @@ def test_the_executors_own_cluster_admits_only_this_runs_credentials():
         cluster.close()
 
 
+@pytest.mark.long
 @needs_dask
 def test_the_dashboard_is_served_on_loopback_only_when_asked(capsys):
     from frictionlab.compute.dask_security import start_local_cluster
@@ -418,6 +429,7 @@ def test_scheduler_addresses_neither_loopback_nor_tls_get_a_warning():
             check_address(wrong)
 
 
+@pytest.mark.long
 @needs_dask
 def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, serial_24):
     import json
@@ -454,6 +466,7 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
     assert (summary["fit"]["a"], summary["fit"]["b"]) == (serial_24.fit.a, serial_24.fit.b)
 
 
+@pytest.mark.long
 @needs_dask
 @pytest.mark.parametrize("server", ["http", "silent"])
 def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_connect_timeout(server):

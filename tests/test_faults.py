@@ -49,6 +49,7 @@ print(json.dumps({"status": outcome.status, "done": outcome.done, "a": outcome.f
 """
 
 
+@pytest.mark.long
 def test_a_worker_killed_while_sending_its_result_is_retried_and_the_run_finishes_bitwise(registry, tmp_path):
     flag, xi_file = tmp_path / "died", tmp_path / "xi.npy"
     try:  # in a subprocess with a deadline: a pool that hangs here fails the test instead of the suite
@@ -79,6 +80,7 @@ def _listed_chunks(run_dir: Path) -> int:
         return 0
 
 
+@pytest.mark.long
 def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry, tmp_path):
     preset = tmp_path / "long.yaml"
     preset.write_text(yaml.safe_dump(KILL_PRESET))

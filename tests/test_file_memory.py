@@ -92,11 +92,13 @@ def rough_npy(path, side: int) -> int:
     return path.stat().st_size
 
 
+@pytest.mark.long
 def test_an_npy_map_too_large_is_refused_from_its_header_before_it_is_read(tmp_path):
     size = rough_npy(tmp_path / "big.npy", 4096)  # 128 MiB
     check_refused_unread(tmp_path, preset(tmp_path / "big.npy", spacing=1.0), size, available=1024 * MiB)
 
 
+@pytest.mark.long
 def test_an_instrument_map_too_large_is_refused_from_its_metadata_before_it_is_read(tmp_path):
     topography_module = pytest.importorskip("SurfaceTopography")  # the optional extra topography
     side = 4096

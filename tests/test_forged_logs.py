@@ -147,6 +147,7 @@ def test_runs_shows_the_verified_holder_and_only_checked_counts(tmp_path, capsys
     assert run_state(dead).done == 0
 
 
+@pytest.mark.long  # follows for 3 s
 def test_follow_of_a_log_with_numbers_out_of_bounds_ends_and_spins_no_loop(tmp_path):
     holder = hold(tmp_path)
     forge(tmp_path, {"event": "started", "pid": holder.pid, "total": -12}, realization(0, 10**30, -12),
@@ -232,6 +233,7 @@ def test_a_second_detached_resume_that_lost_the_folder_says_it_is_in_use_by_the_
         release(holder)
 
 
+@pytest.mark.long
 def test_follow_of_a_run_whose_folder_is_deleted_says_it_is_gone_and_advises_no_resume(tmp_path):
     out = tmp_path / "run"
     run = start_detached(build_scene(merge(SMALL_PRESET, {"realizations": 100_000})).resolved(), out, RunOptions(workers=1),

@@ -308,6 +308,7 @@ except FrictionlabError as exc:
 """
 
 
+@pytest.mark.long  # two processes under ulimit -v
 def test_a_process_limit_on_address_space_is_part_of_the_check(tmp_path):
     """Under ``ulimit -v``, a run whose estimate passes the limit is refused at once with
     the limit named (it would otherwise die of MemoryError in every realization); the room

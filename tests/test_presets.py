@@ -35,6 +35,7 @@ def test_fig2_scene_matches_the_study_setup(registry):
     assert scene.spectrum.rms_height() * scene.spectrum.params.length == pytest.approx(1e9)
 
 
+@pytest.mark.long  # 300 lines of 100 000 points
 def test_fig2_run_in_full_lands_on_the_studys_contact_counts(registry):
     """The paper: about 4 points in contact at F = 1 and 12 at F = 20, over 300 lines.
     "About 4" is read as 4 +- 0.5 (a rounded count); we allow that plus three

@@ -197,9 +197,8 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
-@pytest.mark.parametrize(
-    "data", [KILL_PRESET, pytest.param(KILL_SURFACE, marks=pytest.mark.long)], ids=["line", "exact-3d-surface"]
-)
+@pytest.mark.long
+@pytest.mark.parametrize("data", [KILL_PRESET, KILL_SURFACE], ids=["line", "exact-3d-surface"])
 def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path, data):
     preset = tmp_path / "kill.yaml"
     preset.write_text(yaml.safe_dump(data))

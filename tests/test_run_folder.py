@@ -365,6 +365,7 @@ def test_a_damaged_manifest_is_a_run_folder_error_naming_what_is_wrong(tmp_path,
         assert "run.json is damaged" in err and said in err
 
 
+@pytest.mark.long  # processes started together
 def test_runs_started_together_without_out_each_get_a_folder_of_their_own(tmp_path):
     preset = write(tmp_path / "p.yaml", QUICK)
     command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--quiet", "--workers", "1"]

@@ -64,6 +64,7 @@ def _wait_for_a_later_solve(proc) -> list[str]:
     pytest.fail("no progress within a later realization's solve:\n" + "".join(lines))
 
 
+@pytest.mark.long
 @pytest.mark.parametrize(
     ("workers", "signum", "code"),
     [(1, signal.SIGTERM, ExitCode.TERMINATED), (2, signal.SIGINT, ExitCode.INTERRUPTED)],
@@ -134,6 +135,7 @@ program()
 LEAVE_SECONDS = 5.0  # generous: the step left running lasts minutes
 
 
+@pytest.mark.long
 @pytest.mark.parametrize(("signum", "code"), [(signal.SIGTERM, ExitCode.TERMINATED), (signal.SIGINT, ExitCode.INTERRUPTED)])
 def test_the_process_ends_without_waiting_for_the_step_in_progress(tmp_path, signum, code):
     """Once a signal cancels a run, the process ends at once even though its solve is inside

@@ -184,7 +184,7 @@ def test_a_run_whose_reader_left_still_finishes_its_folder(tmp_path):
     os.close(read_end)
     try:
         done = subprocess.run([sys.executable, "-m", "frictionlab", "run", "quickstart", "--out", str(tmp_path / "q"),
-                               "--quiet", "--workers", "1"], stdout=write_end, stderr=subprocess.PIPE, timeout=120)  # fmt: skip
+                               "--quiet", "--workers", "1", "--set", "realizations=4"], stdout=write_end, stderr=subprocess.PIPE, timeout=120)  # fmt: skip
     finally:
         os.close(write_end)
     assert done.returncode == ExitCode.BROKEN_PIPE and done.stderr == b""

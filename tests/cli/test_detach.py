@@ -15,6 +15,7 @@ from ..conftest import SMALL_PRESET, merge
 from .conftest import InTerminal, run_cli, write_preset
 
 
+@pytest.mark.long
 def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
     out = tmp_path / "runs" / "one"
@@ -34,6 +35,7 @@ def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path):
     assert "completed" in table.stdout and "40/40" in table.stdout
 
 
+@pytest.mark.long
 def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
     out = tmp_path / "long"
@@ -65,6 +67,7 @@ def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path):
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
 
 
+@pytest.mark.long
 def test_a_detached_sweep_is_one_entry_of_runs_and_follow_shows_each_point_and_its_fit(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 20, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
@@ -107,6 +110,7 @@ def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
 
 
+@pytest.mark.long
 def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path):
     data = merge(SMALL_PRESET, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
@@ -127,6 +131,7 @@ def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(
     assert stdout.startswith(f"small: interrupted, 1/2 points, in {out}/; frictionlab resume {out} continues it")
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
 def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path, signum, code):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
@@ -151,6 +156,7 @@ def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctr
     assert "/100000" in shown[-2]  # the bar, as it was left, above
 
 
+@pytest.mark.long
 def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_bar_after_its_summary(tmp_path):
     data = merge(SMALL_PRESET, {"realizations": 20_000, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
@@ -168,6 +174,7 @@ def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_
     assert all("20000/20000" in shown[shown.index(line) - 1] for line in fits)  # each below its point's finished bar
 
 
+@pytest.mark.long
 def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path):
     preset = write_preset(tmp_path, SMALL_PRESET)
     out = tmp_path / "runs" / "quiet"

@@ -86,10 +86,10 @@ def test_a_path_longer_than_the_file_system_allows_is_a_usage_error(command, tmp
 def test_a_refusal_names_the_first_overrides_only(capsys):
     from frictionlab.cli import main
 
-    overrides = [arg for i in range(20_000) for arg in ("--set", f"seed={i}")]
+    overrides = [arg for i in range(2_000) for arg in ("--set", f"seed={i}")]
     assert main(["validate", "quickstart", *overrides, "--set", "realizations=-1"]) == ExitCode.USAGE
     err = capsys.readouterr().err
-    assert "--set seed=0 --set seed=1" in err and "(and 19996 more --set)" in err
+    assert "--set seed=0 --set seed=1" in err and "(and 1996 more --set)" in err
     assert "realizations: must be >= 1, got -1" in err and len(err) < 2000
 
 

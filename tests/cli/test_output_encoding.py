@@ -15,7 +15,7 @@ import pytest
 @pytest.mark.parametrize(
     "argv, made",
     [
-        (["run", "quickstart", "--quiet", "--out", b"r\xff"], b"r\xff"),
+        (["run", "quickstart", "--quiet", "--set", "realizations=4", "--workers", "1", "--out", b"r\xff"], b"r\xff"),
         (["presets", "copy", "quickstart", b"q\xff.yaml"], b"q\xff.yaml"),
         (["schema", "--out", b"s\xff.json"], b"s\xff.json"),
     ],

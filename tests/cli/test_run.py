@@ -148,6 +148,7 @@ def test_missing_required_and_file_errors(tmp_path, capsys):
     assert "must be a mapping" in capsys.readouterr().err
 
 
+@pytest.mark.long
 def test_ctrl_c_keeps_finished_realizations_and_exits_130(tmp_path):
     """A real SIGINT to a running pool run: everything finished is written."""
     data = merge(SMALL_PRESET, {"realizations": 100000, "spectrum": {"params": {"points": 2048}}})

@@ -90,6 +90,7 @@ def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys):
     assert code == ExitCode.OUTPUT_REFUSED and "not a study of tiny" in capsys.readouterr().err
 
 
+@pytest.mark.long
 def test_two_studies_started_together_get_two_default_folders(tmp_path):
     import subprocess
     import sys

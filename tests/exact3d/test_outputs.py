@@ -7,6 +7,8 @@ import subprocess
 import sys
 import time
 
+import pytest
+
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.exact3d.report import PAGE
@@ -47,6 +49,7 @@ def test_out_or_runs_that_is_a_file_is_refused_naming_the_option(tmp_path, capsy
     assert afile.read_text() == "x" and sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
+@pytest.mark.long
 def test_ctrl_c_ends_the_study_with_130_keeping_the_finished_ensembles(tmp_path):
     runs, out = tmp_path / "runs", tmp_path / "out"
     first = runs / "h0.8-n64-bem-halfspace"  # the plan runs H = 0.8 first

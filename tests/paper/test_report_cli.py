@@ -33,6 +33,7 @@ def _listed_chunks(run_dir) -> int:
         return 0
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_a_signal_stops_the_report_keeping_the_runs_and_writing_no_report(tmp_path, signum, code):
     presets = tmp_path / "presets"

@@ -62,6 +62,7 @@ def test_register_plugin_fixture_propagates_errors(register_plugin, frictionlab_
     assert frictionlab_registry.names("spectrum") == Registry(discover=False).names("spectrum")
 
 
+@pytest.mark.long  # a pytest run of its own
 def test_pytest_plugin_autoloads_and_unregisters_after_each_test(tmp_path):
     """In a separate pytest run: the fixtures exist without any import (pytest11
     entry point), and a plugin registered in one test is gone in the next even

@@ -81,6 +81,7 @@ print(status)
 """
 
 
+@pytest.mark.long  # a TUI session that runs a pool
 @pytest.mark.skipif(sys.platform != "linux", reason="forkserver start method")
 def test_a_process_pool_starts_from_the_app_thread():
     """Found in tmux: a pool run from the app failed with 'bad value(s) in
@@ -93,6 +94,7 @@ def test_a_process_pool_starts_from_the_app_thread():
         assert result.stdout.strip().splitlines()[-1] == expected, result.stderr[-2000:]
 
 
+@pytest.mark.long  # a TUI session drawn to SVG
 def test_the_docs_screenshot_is_made_by_its_command(tmp_path, monkeypatch):
     """docs/tui/main.svg comes from `python -m frictionlab.tui.screenshot docs/tui/main.svg`."""
     from frictionlab.tui.screenshot import main as screenshot

@@ -23,6 +23,7 @@ from .conftest import (
 # ------------------------------------------------------------------ results
 
 
+@pytest.mark.long  # a TUI session
 @sync
 async def test_results_lists_opens_and_overlays_runs(folders, registry):
     make_runs(folders, registry)
@@ -41,6 +42,7 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
         assert f"a={summary['fit']['a']:.4f}" in info
 
 
+@pytest.mark.long  # a TUI session
 @sync
 async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
     make_runs(folders, registry)
