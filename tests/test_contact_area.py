@@ -152,20 +152,27 @@ class CancelAfter:
             self.cancel.set()
 
 
-def test_a_resumed_run_keeps_the_corrected_area_and_springs_have_none(registry, tmp_path):
+def resumed_and_whole(data: dict, registry, folder):
+    """A run of ``data`` into ``folder`` cancelled after its first realization then resumed, and
+    the same run uninterrupted: (its scene, the resumed outcome, the whole run's Result)."""
     import frictionlab
     from frictionlab.options import RunOptions
     from frictionlab.preset import build_scene
     from frictionlab.runs.runner import run_to_folder
 
-    scene = build_scene({**SURFACE, "output": {"plot": False}}, registry=registry)
+    scene = build_scene({**data, "output": {"plot": False}}, registry=registry)
     cancel = threading.Event()
-    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(1, cancel)],
-                             cancel=cancel)  # fmt: skip
-    assert first.status == "cancelled" and 1 <= first.done < 3
-    resumed, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    first, _ = run_to_folder(scene, folder, RunOptions(workers=1), listeners=[CancelAfter(1, cancel)], cancel=cancel)
+    assert first.status == "cancelled" and 1 <= first.done < data["realizations"]
+    resumed, _ = run_to_folder(scene, folder, RunOptions(workers=1, resume=True))
     assert resumed.extra["resumed"] == first.done
-    whole = frictionlab.run(SURFACE, workers=1, progress=False)
+    return scene, resumed, frictionlab.run(data, workers=1, progress=False)
+
+
+def test_a_resumed_run_keeps_the_corrected_area_and_springs_have_none(registry, tmp_path):
+    import frictionlab
+
+    _, resumed, whole = resumed_and_whole(SURFACE, registry, tmp_path / "run")
     np.testing.assert_array_equal(resumed.real_area_corrected, whole.table["real_area_corrected"])
     springs = frictionlab.run({**SURFACE, "solver": {"name": "mdr", "params": {}}}, out=tmp_path / "mdr", workers=1,
                               progress=False, plot=False)  # fmt: skip

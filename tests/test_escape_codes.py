@@ -6,7 +6,6 @@ import io
 import json
 import subprocess
 import sys
-import textwrap
 
 import pytest
 import yaml
@@ -22,27 +21,18 @@ from frictionlab.runs.rundir import RunDirectory
 from frictionlab.runs.sweep import plan_sweep, run_sweep
 
 from .conftest import SMALL_PRESET, merge
+from .test_forged_logs import hold  # a process that holds a run folder, its run "running"
 
 PAYLOAD = "\x1b]2;pwned\x07\x1b[2J"
 ESC = "\x1b"
+
 
 posix = pytest.mark.skipif(sys.platform == "win32", reason="control characters in file names")
 
 
 @pytest.mark.long  # follows a held run for 5 s
 def test_follow_prints_a_forged_finished_error_escaped(tmp_path):
-    script = textwrap.dedent(f"""
-        import sys
-        from frictionlab.preset import build_scene
-        from frictionlab.runs.rundir import RunDirectory
-        with RunDirectory({str(tmp_path)!r}) as run_dir:
-            run_dir.start(build_scene({SMALL_PRESET!r}), resume=False)
-            print("held", flush=True)
-            sys.stdin.read()
-    """)
-    holder = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)  # fmt: skip
-    assert holder.stdout.readline().strip() == "held"
+    holder = hold(tmp_path)  # its run started and "running"
     events = [{"event": "started", "pid": holder.pid, "total": 8},
               {"event": "finished", "status": "failed", "done": 0, "requested": 8, "error": PAYLOAD}]  # fmt: skip
     (tmp_path / PROGRESS_FILE).write_text("".join(json.dumps(e) + "\n" for e in events))

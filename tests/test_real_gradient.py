@@ -16,7 +16,6 @@ Known answers:
 from __future__ import annotations
 
 import math
-import threading
 
 import numpy as np
 import pytest
@@ -31,7 +30,7 @@ from frictionlab_solvers.contact_area import (
     corrected_gradient_rms,
 )
 
-from .test_contact_area import CancelAfter  # the run cancelled after N realizations, as there
+from .test_contact_area import resumed_and_whole  # the run cancelled after its first realization, as there
 
 
 def brute_weights(contact: np.ndarray, periodic: bool) -> np.ndarray:
@@ -178,19 +177,9 @@ def test_springs_have_no_g_r_and_a_damaged_header_is_refused(tmp_path):
 
 
 def test_a_resumed_run_keeps_g_r_and_an_older_chunk_without_it_reads_as_unknown(registry, tmp_path):
-    import frictionlab
-    from frictionlab.options import RunOptions
-    from frictionlab.preset import build_scene
     from frictionlab.runs.chunks import chunk_results
-    from frictionlab.runs.runner import run_to_folder
 
-    scene = build_scene({**SURFACE, "output": {"plot": False}}, registry=registry)
-    cancel = threading.Event()
-    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(1, cancel)],
-                             cancel=cancel)  # fmt: skip
-    assert first.status == "cancelled" and 1 <= first.done < 3
-    resumed, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
-    whole = frictionlab.run(SURFACE, workers=1, progress=False)
+    scene, resumed, whole = resumed_and_whole(SURFACE, registry, tmp_path / "run")
     np.testing.assert_array_equal(resumed.real_gradient_rms, whole.table["real_gradient_rms"])
     np.testing.assert_array_equal(resumed.kappa_r, whole.table["kappa_r"])
     chunk = sorted((tmp_path / "run" / "chunks").glob("*.npz"))[0]

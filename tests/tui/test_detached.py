@@ -1,6 +1,7 @@
 """The TUI and runs in processes of their own: a TUI opened later shows a running run
 live; quitting during a run leaves it running or cancels it, as answered, at once."""
 
+import contextlib
 import json
 import os
 import signal
@@ -79,13 +80,20 @@ async def test_a_tui_opened_later_shows_the_running_run_live_and_lists_it(folder
     assert run_state(out).status == "interrupted"  # killed: never read as running
 
 
-@sync
-async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_waiting(folders, registry):
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
-    app = make_app(registry, preset="presets/long.yaml", workers=1)
+@contextlib.asynccontextmanager
+async def a_long_run_going(folders, registry, preset: str = "long.yaml", data: dict = LONG):
+    """The TUI on a preset of a long run, the run started from it and two realizations done."""
+    (folders / "presets" / preset).write_text(yaml.safe_dump(data))
+    app = make_app(registry, preset=f"presets/{preset}", workers=1)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+        yield app, pilot
+
+
+@sync
+async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_waiting(folders, registry):
+    async with a_long_run_going(folders, registry) as (app, pilot):
         pid, out = app.followed.pid, app.followed.folder
         await pilot.press("ctrl+q")
         await pilot.pause()
@@ -106,11 +114,7 @@ async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_wai
 
 @sync
 async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(folders, registry):
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
-    app = make_app(registry, preset="presets/long.yaml", workers=1)
-    async with app.run_test(size=SIZE) as pilot:
-        await press_run(pilot)
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+    async with a_long_run_going(folders, registry) as (app, pilot):
         pid, out = app.followed.pid, app.followed.folder
         await pilot.press("ctrl+q", "c")
         await pilot.pause()
@@ -126,11 +130,7 @@ async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(fo
 @sync
 async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(folders, registry):
     """Ctrl+Q during a run, l, then n to "Quit anyway?": the app stays, the run goes on (it was cancelled before)."""
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
-    app = make_app(registry, preset="presets/long.yaml", workers=1)
-    async with app.run_test(size=SIZE) as pilot:
-        await press_run(pilot)
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+    async with a_long_run_going(folders, registry) as (app, pilot):
         pid = app.followed.pid
         app.modified = True  # the preset was edited meanwhile
         await pilot.press("ctrl+q", "l")
@@ -192,11 +192,7 @@ def start_sweep(data, out, registry):
 async def test_ctrl_r_on_a_sweep_starts_it_detached_and_quit_leave_keeps_it_running(folders, registry):
     from frictionlab.tui.following import FollowedSweep
 
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(LONG_SWEEP))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
-    async with app.run_test(size=SIZE) as pilot:
-        await press_run(pilot)
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
+    async with a_long_run_going(folders, registry, "sweep.yaml", LONG_SWEEP) as (app, pilot):
         followed = app.followed
         pid, out = followed.pid, followed.folder
         shown = screen_text(app)
