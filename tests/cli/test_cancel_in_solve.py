@@ -36,7 +36,7 @@ STOP_SECONDS = 1.0  # from the signal to the run's end, all its realizations' so
 def uninterrupted(tmp_path_factory):
     folder = tmp_path_factory.mktemp("whole")
     preset = write_preset(folder, LONG_SOLVES)
-    done = run_cli("run", preset, "--out", folder / "out", "--workers", "1")
+    done = run_cli("run", preset, "--out", folder / "out", "--workers", "2")  # the numbers of any worker count
     assert done.returncode == 0, done.stderr
     return preset, folder / "out"
 
