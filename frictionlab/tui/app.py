@@ -39,7 +39,6 @@ from .folders import (
     save_preset,
     templates,
     user_presets_dir,
-    writable_folder,
 )
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
@@ -165,6 +164,8 @@ class FrictionlabApp(RunControl, App):
     async def _answer_early_keys(self) -> None:
         early, self._early_keys = self._early_keys, None
         for key in early:  # in the order typed
+            if key.key == "ctrl+j":  # Enter typed before the terminal was raw: the tty made it a line feed
+                key = events.Key("enter", "\r")
             await super().on_event(key)
 
     @property
@@ -299,13 +300,13 @@ class FrictionlabApp(RunControl, App):
             self.say(problems_text(exc.problems), "error", title="Cannot duplicate")
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
-        default = writable_folder(self.folders) / f"{entry.path.stem}-copy.yaml"
+        default = self.save_folder / f"{entry.path.stem}-copy.yaml"  # where n and Ctrl+S save too
 
         def done(path: Path | None) -> None:
             if path is not None:
                 self._write(path, data, then_open=True, template=entry.path)
 
-        self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default), done)
+        self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default, self.save_folder), done)
 
     def new_preset(self) -> None:
         """A new preset from a template that runs (a listed preset; a plugin's
@@ -461,7 +462,14 @@ class FrictionlabApp(RunControl, App):
         if now == seen:
             return
         names = lambda signature: [name for name, _ in signature[1]] if signature else None  # noqa: E731
-        # a run started, removed or ended: at once; a run's files written (a chunk): coalesced, the
-        # list read at most every REREAD_SECONDS (a long list of runs is not read twice a second)
-        if names(now) != names(seen) or now[2:] != seen[2:] or time.monotonic() - self._runs_read_at >= REREAD_SECONDS:
+        # a run started, removed or ended, or a folder not yet listed written (its run.json): at once;
+        # a listed run's files written (a chunk): coalesced, the list read at most every REREAD_SECONDS
+        listed = {entry.path.name for entry in self._mounted("ResultsPane").runs}
+        unlisted_changed = set(now[1]) - set(seen[1]) if now and seen else set()  # a new folder's run.json, say
+        if (
+            names(now) != names(seen)
+            or now[2:] != seen[2:]
+            or any(name not in listed for name, _ in unlisted_changed)
+            or time.monotonic() - self._runs_read_at >= REREAD_SECONDS
+        ):
             self.reload_runs()

@@ -7,6 +7,8 @@ following one another process started, and showing how each ended on the Run tab
 
 from __future__ import annotations
 
+import os
+
 from contextlib import suppress
 from dataclasses import replace
 from pathlib import Path
@@ -76,6 +78,10 @@ class RunControl:
             return
         self._start(scene, sweep, out_dir, self.run_options)
 
+    def _refuse_damaged(self, folder: Path, reason: str) -> None:
+        self.say(f"{folder.name} is damaged: {reason}. Nothing of it was changed; move it aside "
+                 "or repair that file to go on.", "error", title="Cannot resume")  # fmt: skip
+
     def resume_run(self, folder: Path | None) -> None:
         """Continue a cancelled or interrupted run in ``folder`` with the preset stored
         there (``frictionlab resume``): only the missing realizations are computed."""
@@ -99,11 +105,16 @@ class RunControl:
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")
                 return
             if state.status == "damaged":  # a resume would rewrite the damaged file: the user did not ask that
-                self.say(f"{folder.name} is damaged: {state.reason}. Nothing of it was changed; move it aside "
-                         "or repair that file to go on.", "error", title="Cannot resume")  # fmt: skip
+                self._refuse_damaged(folder, state.reason)
                 return
-        except FrictionlabError:
-            pass  # not a run folder (yet): said below
+        except FrictionlabError as exc:
+            from ..runs.detached import damage_reason
+            from ..runs.rundir import STATE_FILE
+
+            if os.path.lexists(folder / STATE_FILE):  # its manifest cannot be read: never resumed over
+                self._refuse_damaged(folder, damage_reason(folder, exc))
+                return
+            # not a run folder (yet): said below
         try:
             if read_run(folder).status == "completed":
                 self.say(f"{folder.name} is complete: nothing to resume.", "warning")

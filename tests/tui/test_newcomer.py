@@ -4,6 +4,7 @@ offered wherever a run can be resumed."""
 
 import asyncio
 import subprocess
+import shutil
 import sys
 
 import pytest
@@ -24,6 +25,8 @@ from .conftest import SIZE, TINY, make_app, make_runs, numbers_in, screen_text, 
 async def test_damaged_run_folders_are_listed_with_their_reason(folders, registry):
     make_runs(folders, registry)
     runs = folders / "runs"
+    shutil.copytree(runs / "seed1", runs / "seed3")  # a completed run whose manifest is then cut short
+    (runs / "seed3" / "run.json").write_text('{"format": 2, "status": "compl')
     (runs / "seed1" / "summary.json").write_text("{junk")
     (runs / "seed2" / "summary.json").unlink()
     (runs / "seed2" / "summary.json").symlink_to(folders / "presets" / "tiny.yaml")
@@ -35,7 +38,7 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
         await pilot.press("f5")
         await pilot.pause()
         pane = app.query_one(ResultsPane)
-        assert {e.path.name: e.status for e in pane.runs} == {"seed1": "damaged", "seed2": "damaged", "sw": "damaged"}
+        assert {e.path.name: e.status for e in pane.runs} == {"seed1": "damaged", "seed2": "damaged", "seed3": "damaged", "sw": "damaged"}
         screen = screen_text(app)
         for name in ("seed1", "seed2", "sw"):
             line = next(line for line in screen.splitlines() if f" {name} " in line)
@@ -45,7 +48,7 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
         await pilot.pause()
         assert "seed2 is damaged: summary.json" in status_text(app) and "link" in status_text(app)
         junk = (runs / "seed1" / "summary.json").read_bytes()
-        for name in ("seed1", "seed2"):  # u refuses, naming the damage; nothing is rewritten, no link replaced
+        for name in ("seed1", "seed2", "seed3"):  # u refuses, naming the damage; nothing is rewritten, no link replaced
             row = [e.path.name for e in pane.runs].index(name)
             await pilot.press("f5", "home", *["down"] * row, "u")
             await pilot.pause()
@@ -357,3 +360,25 @@ def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_
     assert progress_text(8, 8, 0, 0.5, restored=8) == "8/8 realizations (8 restored), elapsed 0.5 s"  # a point restored whole
     assert progress_text(3, 8, 0, 0.5, restored=3) == "3/8 realizations (3 restored), elapsed 0.5 s"
     assert "2.0/s" in progress_text(4, 8, 0, 0.5, restored=3) and "left" in progress_text(4, 8, 0, 0.5, restored=3)
+
+
+@pytest.mark.long
+@sync
+async def test_a_run_whose_folder_came_before_its_manifest_is_listed_within_a_second(folders, registry):
+    """A run started elsewhere makes its folder first and its run.json a moment later: the
+    list is read again at once for a folder not yet listed, not after the coalescing delay."""
+    make_runs(folders, registry)
+    runs = folders / "runs"
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        pane = app.query_one(ResultsPane)
+        (runs / "later").mkdir()  # as a run starting elsewhere makes it
+        await pilot.pause(0.7)  # looked at: nothing to list there yet
+        assert "later" not in {e.path.name for e in pane.runs}
+        for item in (runs / "seed1").iterdir():  # its files written (a finished run's, as a run's would be)
+            if item.is_file():
+                shutil.copy2(item, runs / "later" / item.name)
+        written = asyncio.get_running_loop().time()
+        await wait_until(pilot, lambda: "later" in {e.path.name for e in pane.runs}, timeout=10.0)
+        assert asyncio.get_running_loop().time() - written < 1.2  # the watch's interval and a read, not 2 s more

@@ -1,8 +1,13 @@
 """What a person on a remote terminal met (the keys, the status line, the form, the
 Run tab), each read off the screen."""
 
+from pathlib import Path
+
 import yaml
 from textual.widgets import DataTable, Input, Static
+
+from frictionlab.options import RunOptions
+from frictionlab.tui.widgets import PresetsPane
 
 from ..conftest import merge
 from .conftest import (
@@ -227,3 +232,22 @@ def test_contact_counts_read_alike_in_every_row_of_the_sweep_table():
     row = {"point": 2, "status": "completed", "a": None, "a_lo": None, "a_hi": None, "b": None, "b_lo": None,
            "b_hi": None, "r2": None, "contact_first": 119.4, "contact_last": 1349.6}  # fmt: skip
     assert row_cells([], row)[-1] == "119..1350"
+
+
+@sync
+async def test_d_on_a_built_in_preset_offers_a_file_it_can_save_and_saves_it(tmp_path, monkeypatch, registry):
+    """With no presets folder of the user's yet, the copy goes where n and Ctrl+S save: ./presets, made then."""
+    from frictionlab.tui.app import FrictionlabApp
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))  # no user presets folder either
+    app = FrictionlabApp(None, runs_dir="runs", options=RunOptions(workers=1), registry=registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        first = app.query_one(PresetsPane).selected().path
+        await pilot.press("d")
+        await pilot.pause()
+        await pilot.press("enter")
+        await wait_until(pilot, lambda: app.draft_path is not None, timeout=10.0)
+    assert app.draft_path == Path("presets") / f"{first.stem}-copy.yaml"
+    assert (tmp_path / "presets" / f"{first.stem}-copy.yaml").is_file()

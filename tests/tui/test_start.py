@@ -92,3 +92,13 @@ async def test_q_pressed_as_the_first_screen_appears_quits(folders, registry):
         post_keys(app, ["q"])
         await settled(pilot, lambda: not app.is_running)
     assert app.return_code == 0
+
+
+@sync
+async def test_enter_typed_before_the_terminal_was_raw_opens_the_highlighted_preset(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        post_keys(app, ["ctrl+j"])  # Enter as the tty hands it on before the app makes it raw
+        await settled(pilot, lambda: app.built)
+        await settled(pilot, lambda: app.query_one("#tabs").active == "edit", seconds=10.0)
+        assert app.draft_path is not None and app.draft_path.name == "tiny.yaml"  # the first preset listed

@@ -89,6 +89,7 @@ class PresetForm(VerticalScroll):
         self.base_dir = base_dir
         self._stash.clear()
         await self.recompose()
+        self.scroll_home(animate=False)  # another preset opens at its top, not where the last one was left
         self.revalidate(changed=False)
 
     def compose(self):
