@@ -308,34 +308,36 @@ class RunControl:
         self.say(message.error, "error", title="Run failed")
 
     def action_quit(self) -> None:
-        """Quit at once; while a run goes on, ask first whether to leave it running or cancel it."""
-        followed = self.followed
-        if followed is not None:
-            from .following import FollowedSweep
-
-            def answered(choice: str | None) -> None:
-                if choice is None:
-                    return
-                if choice == "cancel":
-                    followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
-                self._quit_unless_unsaved()
-
-            what = "sweep" if isinstance(followed, FollowedSweep) else "run"
-            question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
-                        "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
-                        "(what finished is kept)?")  # fmt: skip
-            self.push_screen(QuitDuringRunScreen(question), answered)
-            return
-        self._quit_unless_unsaved()
-
-    def _quit_unless_unsaved(self) -> None:
+        """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
+        goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
+        does not happen)."""
         if self.modified:
             self.push_screen(
                 ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),
-                lambda yes: yes and self.exit(),
+                lambda yes: yes and self._quit_leaving_or_cancelling_the_run(),
             )
             return
-        self.exit()
+        self._quit_leaving_or_cancelling_the_run()
+
+    def _quit_leaving_or_cancelling_the_run(self) -> None:
+        followed = self.followed
+        if followed is None:
+            self.exit()
+            return
+        from .following import FollowedSweep
+
+        def answered(choice: str | None) -> None:
+            if choice is None:
+                return
+            if choice == "cancel":
+                followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
+            self.exit()
+
+        what = "sweep" if isinstance(followed, FollowedSweep) else "run"
+        question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
+                    "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
+                    "(what finished is kept)?")  # fmt: skip
+        self.push_screen(QuitDuringRunScreen(question), answered)
 
 
 def _resumable(folder: Path) -> bool:

@@ -128,12 +128,13 @@ async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(fo
 
 
 @sync
-async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(folders, registry):
-    """Ctrl+Q during a run, l, then n to "Quit anyway?": the app stays, the run goes on (it was cancelled before)."""
+async def test_unsaved_changes_are_asked_about_first_and_keeping_them_cancels_nothing(folders, registry):
+    """Ctrl+Q during a run with unsaved changes: "Quit anyway?" comes first, and n keeps the
+    app and the run (the run's question, which can cancel it, comes only for a quit that happens)."""
     async with a_long_run_going(folders, registry) as (app, pilot):
         pid = app.followed.pid
         app.modified = True  # the preset was edited meanwhile
-        await pilot.press("ctrl+q", "l")
+        await pilot.press("ctrl+q")
         await pilot.pause()
         asked = screen_text(app)
         await pilot.press("n")
@@ -143,9 +144,16 @@ async def test_keeping_unsaved_changes_after_leave_it_running_cancels_nothing(fo
         after = stats(app)
         still = app.is_running and app.followed is not None and not app.followed.cancelling
         alive = process_alive(pid)
+        await pilot.press("ctrl+q", "y")  # now quit: the run's question follows
+        await pilot.pause()
+        then = screen_text(app)
+        await pilot.press("l")
+        await pilot.pause()
+        left = not app.is_running and process_alive(pid)
     end(pid)
-    assert "unsaved changes. Quit anyway?" in asked
+    assert "unsaved changes. Quit anyway?" in asked and "Leave it running" not in asked
     assert still and alive and "cancelling" not in after and "/100000 realizations" in after
+    assert "Leave it running" in then and left
 
 
 @sync

@@ -682,3 +682,22 @@ async def test_damaged_runs_and_presets_in_its_folders_never_stop_the_tui(folder
     assert "seed1" in results_tab and "fit-text" in results_tab and "bad-fields" in results_tab
     for name in ("a-list", "deep"):  # listed as damaged, with its mark: never hidden
         assert any(name in line and "✗" in line and "damaged" in line for line in results_tab.splitlines())
+
+
+@sync
+async def test_every_fields_help_is_shown_whole_at_80x24(folders, registry):
+    """Found by a newcomer: at 80x24 the help of height_reference, line_end and loading.unit
+    stopped at four lines, before its choices or default."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        help_line = app.query_one("#field-help")
+        cut = []
+        for widget in app.query_one("#form").query("Input, Select, Switch"):
+            widget.focus()
+            await pilot.pause()
+            lines = help_line.content_size.height  # what it shows
+            needed = len(help_line.render().wrap(help_line.content_size.width)) if lines else 0
+            if needed > lines:
+                cut.append((widget.id, needed, lines))
+    assert not cut, cut
