@@ -87,10 +87,10 @@ def fingerprint(resolved: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def same_preset(state: dict, scene: Scene) -> bool:
-    """Whether a manifest's run is of ``scene``'s preset: the same fingerprint, or the same
-    once each field added to frictionlab since the run started is taken at its default."""
-    resolved = _json_copy(scene.resolved())
+def same_preset(state: dict, resolved: dict, scene: Scene) -> bool:
+    """Whether a manifest's run is of ``scene``'s preset (``resolved``, its JSON form): the same
+    fingerprint, or the same once each field added to frictionlab since the run started is
+    taken at its default."""
     if state.get("fingerprint") == fingerprint(resolved):
         return True
     stored = state.get("preset")
@@ -239,7 +239,7 @@ class RunDirectory:
             if not self.force:
                 raise
             state = None  # a damaged manifest lists nothing: nothing is deleted
-        self._refuse_unless_ours(state, scene)
+        self._refuse_unless_ours(state, scene, resolved)
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
         for name in listed:  # chunks of the run that was here: frictionlab wrote them
             if isinstance(name, str) and CHUNK_NAME.fullmatch(name):
@@ -283,21 +283,20 @@ class RunDirectory:
             if not self.force:
                 raise
             state = None
-        self._refuse_unless_ours(state, scene)
+        self._refuse_unless_ours(state, scene, _json_copy(scene.resolved()))
 
     @staticmethod
     def _listed(state: dict | None) -> list[str]:
         chunks = (state or {}).get("chunks")
         return list(chunks) if isinstance(chunks, dict) else []
 
-    def _refuse_unless_ours(self, state: dict | None, scene: Scene) -> None:
+    def _refuse_unless_ours(self, state: dict | None, scene: Scene, resolved: dict) -> None:
         """OutputRefused when a fresh run here would replace what is not a
         finished run of the same preset (unless ``force``)."""
         if self.force:
             return
         hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
         if state is None:
-            resolved = _json_copy(scene.resolved())
             others = sorted(p.name for p in self.path.iterdir() if not _left_by_a_start(p, resolved))
             if others:
                 listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
@@ -307,9 +306,9 @@ class RunDirectory:
                 )
             return
         status = state.get("status")
-        if status == "completed" and not same_preset(state, scene):
+        if status == "completed" and not same_preset(state, resolved, scene):
             old = state.get("preset")
-            changed = differences(old, _json_copy(scene.resolved())) if isinstance(old, dict) else []
+            changed = differences(old, resolved) if isinstance(old, dict) else []
             fields = ", ".join(d.split(":", 1)[0] for d in changed[:5]) or "its fingerprint"
             raise OutputRefused(
                 f"{self.path} holds a finished run of another preset (it differs in {fields}): "
@@ -336,7 +335,7 @@ class RunDirectory:
         state = self.state()
         if state is None:
             raise RunFolderError(f"{self.path} holds no run to resume (no {STATE_FILE})")
-        if not same_preset(state, scene):
+        if not same_preset(state, resolved, scene):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
             changed = differences(stored, resolved)
             raise RunFolderError(
@@ -404,7 +403,7 @@ class RunDirectory:
             return None
         if not state or state.get("status") != "completed" or state.get("format") != MANIFEST_FORMAT:
             return None
-        if not same_preset(state, scene):
+        if not same_preset(state, _json_copy(scene.resolved()), scene):
             return None
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in self._input_hashes(scene).items():
@@ -422,7 +421,7 @@ class RunDirectory:
         damaged: dict[str, str] = {}
         for name, digest in list(chunks.items()):
             try:
-                rows = self._read_chunk(name, digest, scene)
+                rows = read_chunk(self.path, name, digest, scene)
             except ChunkDamage as exc:
                 damaged[name] = str(exc)
                 del chunks[name]
@@ -431,9 +430,6 @@ class RunDirectory:
         if warn:
             self._warn_damage(damaged, results, scene.preset.realizations)
         return [results[i] for i in sorted(results)]
-
-    def _read_chunk(self, name: str, digest, scene: Scene) -> list[RealizationResult]:
-        return read_chunk(self.path, name, digest, scene)
 
     def _warn_damage(self, damaged: dict[str, str], results: dict, total: int) -> None:
         report = damage_report(self.chunks, set(self._manifest["chunks"]), damaged, set(results), total)

@@ -7,7 +7,7 @@ import sys
 
 from textual.widgets import DataTable
 
-from .conftest import SIZE, TINY, make_app, post_keys, sync
+from .conftest import SIZE, TINY, make_app, post_keys, sync, wait_until
 
 DRIVES_THE_FIRST_SCREEN = True  # conftest: run_test returns at once, not once the app is built
 
@@ -34,15 +34,6 @@ def test_the_app_module_imports_nothing_a_run_needs():
     loaded = set(json.loads(done.stdout))
     assert "frictionlab.tui.widgets.presets" in loaded  # the check sees the app's own modules
     assert sorted(loaded & set(NOT_ON_THE_FIRST_SCREEN)) == []
-
-
-async def settled(pilot, done, seconds=60.0) -> None:
-    """Pause until ``done()`` (the app answers early keys once built; a loaded machine takes a while)."""
-    for _ in range(int(seconds / 0.05)):
-        if done():
-            return
-        await pilot.pause(0.05)
-    raise AssertionError(f"not settled in {seconds} s")
 
 
 def first_screen(app) -> dict:
@@ -78,11 +69,11 @@ async def test_a_key_pressed_as_the_first_screen_appears_is_answered(folders, re
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         post_keys(app, ["f3"])  # before the other tabs are built: it waits for them
-        await settled(pilot, lambda: app.built)
+        await wait_until(pilot, lambda: app.built)  # a loaded machine builds the app late
         assert app.query_one("#tabs").active == "edit"
         assert app.focused is app.query_one("#form")
         post_keys(app, ["5"])
-        await settled(pilot, lambda: app.query_one("#tabs").active == "results", seconds=10.0)
+        await wait_until(pilot, lambda: app.query_one("#tabs").active == "results", timeout=10.0)
 
 
 @sync
@@ -90,7 +81,7 @@ async def test_q_pressed_as_the_first_screen_appears_quits(folders, registry):
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         post_keys(app, ["q"])
-        await settled(pilot, lambda: not app.is_running)
+        await wait_until(pilot, lambda: not app.is_running)
     assert app.return_code == 0
 
 
@@ -99,6 +90,6 @@ async def test_enter_typed_before_the_terminal_was_raw_opens_the_highlighted_pre
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         post_keys(app, ["ctrl+j"])  # Enter as the tty hands it on before the app makes it raw
-        await settled(pilot, lambda: app.built)
-        await settled(pilot, lambda: app.query_one("#tabs").active == "edit", seconds=10.0)
+        await wait_until(pilot, lambda: app.built)  # a loaded machine builds the app late
+        await wait_until(pilot, lambda: app.query_one("#tabs").active == "edit", timeout=10.0)
         assert app.draft_path is not None and app.draft_path.name == "tiny.yaml"  # the first preset listed
