@@ -174,7 +174,7 @@ def test_iterations_are_heard_at_most_four_times_a_second(registry, monkeypatch)
     clock = iter(np.arange(0.0, 1000.0, 0.1))  # each look at the clock: 0.1 s later
     monkeypatch.setattr(realization.time, "monotonic", lambda: next(clock))
     heard = []
-    watch = realization._SolveWatch(4, None, lambda *event: heard.append(event), None)  # started at 0 s
+    watch = realization._SolveWatch(4, realization.SolveListeners(on_iteration=lambda *event: heard.append(event)), None)  # at 0 s
     for iteration in range(10):
         watch.iteration_done(iteration, 1.0 / (iteration + 1))
     # clock at 0.1, 0.2, ... 1.0 s: heard at 0.3 (0.25 s after the start), 0.6 and 0.9 s
@@ -244,7 +244,7 @@ def test_in_this_process_a_cancel_returns_at_once_while_a_long_step_still_runs(r
             cancel.set()
             release.wait(120)
 
-    results = realization.compute_chunk_here(scene, [0, 1], on_iteration=a_long_step, cancel=cancel)
+    results = realization.compute_chunk_here(scene, [0, 1], realization.SolveListeners(on_iteration=a_long_step), cancel)
     returned_during_the_step = not release.is_set()
     release.set()
     assert results == [] and returned_during_the_step

@@ -268,7 +268,7 @@ def test_a_contact_fraction_search_says_its_load_and_stops_on_cancel(monkeypatch
             cancel.set()
 
     with pytest.raises(SolveCancelled):
-        realization.compute_realization(scene, 0, on_iteration=on_iteration, cancel=cancel)
+        realization.compute_realization(scene, 0, realization.SolveListeners(on_iteration=on_iteration), cancel)
     assert heard[0] == 1 and heard[-1] == 2  # the iterations of the search are said as their load's
 
 

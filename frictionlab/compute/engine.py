@@ -23,7 +23,7 @@ from ..plugin.hookspecs import PROJECT_NAME
 from ..plugin.listeners import RunListener
 from ..options import RunOptions
 from ..preset import Scene
-from .realization import RealizationResult, compute_chunk_here
+from .realization import RealizationResult, SolveListeners, compute_chunk_here
 from .signals import CancelOnSignals
 
 __all__ = ["RunInfo", "run"]
@@ -112,7 +112,7 @@ def run(
     def iteration_done(index: int, load: int, iteration: int, residual: float) -> None:
         hooks.iteration_done(run=info, index=index, load=load, iteration=iteration, residual=residual)
 
-    progress = {"on_load": load_done, "on_iteration": iteration_done}
+    listeners = SolveListeners(load_done, iteration_done)
 
     def record(results: list[RealizationResult]) -> None:
         if store is not None:
@@ -127,12 +127,12 @@ def run(
         try:
             if todo and not cancel.is_set():
                 # The first missing realization runs here: its time sizes the chunks.
-                first = compute_chunk_here(scene, todo[:1], cancel=cancel, **progress)
+                first = compute_chunk_here(scene, todo[:1], listeners, cancel)
                 if first:  # else cancelled within it
                     record(first)
                     pool = sized_executor(pool, options, len(todo) - 1, first[0].seconds)
                     chunks = plan_chunks(todo[1:], pool.workers, first[0].seconds, overhead=pool.task_overhead)
-                    for _, results in pool.map_chunks(scene, chunks, cancel, **progress):
+                    for _, results in pool.map_chunks(scene, chunks, cancel, listeners):
                         record(results)
         except KeyboardInterrupt:  # the second Ctrl-C or SIGTERM (Terminated)
             pass

@@ -37,7 +37,7 @@ from ..errors import RunError
 from ..options import RunOptions
 from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
 from ..preset import Scene
-from .realization import IterationListener, LoadListener, RealizationResult, compute_chunk, compute_chunk_here
+from .realization import UNHEARD, RealizationResult, SolveListeners, compute_chunk, compute_chunk_here
 
 __all__ = ["DASK_MISSING", "connect_scheduler", "import_distributed"]  # re-exported from dask_security
 
@@ -102,15 +102,10 @@ class SerialExecutor:
         self.workers = 1
 
     def map_chunks(
-        self,
-        scene: Scene,
-        chunks: list[Chunk],
-        cancel,
-        on_load: LoadListener | None = None,
-        on_iteration: IterationListener | None = None,
+        self, scene: Scene, chunks: list[Chunk], cancel, listeners: SolveListeners = UNHEARD
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         for chunk in chunks:
-            done = compute_chunk_here(scene, chunk, on_load, on_iteration, cancel) if not cancel.is_set() else []
+            done = compute_chunk_here(scene, chunk, listeners, cancel) if not cancel.is_set() else []
             if done:
                 yield chunk[: len(done)], done
             if cancel.is_set():
@@ -151,8 +146,11 @@ def _send_iteration(index: int, load: int, iteration: int, residual: float) -> N
     send_progress(("iteration", index, load, iteration, residual))
 
 
+_WORKER_LISTENERS = SolveListeners(_send_load, _send_iteration)
+
+
 def _run_chunk(indices: Chunk) -> list[RealizationResult]:
-    return compute_chunk(_worker_scene, indices, _send_load, _send_iteration, cancel=stop_event())
+    return compute_chunk(_worker_scene, indices, _WORKER_LISTENERS, cancel=stop_event())
 
 
 def pool_context():
@@ -176,19 +174,14 @@ class ProcessExecutor:
         self.retries = retries
 
     def map_chunks(
-        self,
-        scene: Scene,
-        chunks: list[Chunk],
-        cancel,
-        on_load: LoadListener | None = None,
-        on_iteration: IterationListener | None = None,
+        self, scene: Scene, chunks: list[Chunk], cancel, listeners: SolveListeners = UNHEARD
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
         """A cancel reaches the workers (``WorkerPool.run``): a chunk then yields what it finished."""
         jobs = dict(enumerate(chunks))
-        listeners = {"load": on_load, "iteration": on_iteration}
+        heard = {"load": listeners.on_load, "iteration": listeners.on_iteration}
 
         def on_progress(payload) -> None:
-            listener = listeners[payload[0]]
+            listener = heard[payload[0]]
             if listener is not None:
                 listener(*payload[1:])
 
@@ -274,14 +267,9 @@ class DaskExecutor:
         return client, cluster
 
     def map_chunks(
-        self,
-        scene: Scene,
-        chunks: list[Chunk],
-        cancel,
-        on_load: LoadListener | None = None,
-        on_iteration: IterationListener | None = None,
+        self, scene: Scene, chunks: list[Chunk], cancel, listeners: SolveListeners = UNHEARD
     ) -> Iterator[tuple[Chunk, list[RealizationResult]]]:
-        """``on_load`` and ``on_iteration`` are not heard: a Dask worker reports whole chunks
+        """``listeners`` are not told: a Dask worker reports whole chunks
         only. A cancel returns at once, and reaches the running tasks through the run's
         Dask ``Event``: they stop within their solve (``DaskStop``)."""
         import_distributed()

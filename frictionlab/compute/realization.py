@@ -56,6 +56,18 @@ IterationListener = Callable[[int, int, int, float], None]
 """Hears ``(realization index, load, iteration, residual)`` within a load (``plugin.iteration_done``):
 ``load`` counts the scene's loads from 1."""
 
+
+
+@dataclass(frozen=True)
+class SolveListeners:
+    """Who hears a realization's solve as it goes: its loads, and its iterations within a load."""
+
+    on_load: LoadListener | None = None
+    on_iteration: IterationListener | None = None
+
+
+UNHEARD = SolveListeners()
+
 ITERATION_EVENT_SECONDS = 0.25  # within a load, progress at most this often (a worker's pipe, a bar's redraws)
 
 
@@ -64,8 +76,9 @@ class _SolveWatch:
     at most every ``ITERATION_EVENT_SECONDS``, and raises ``SolveCancelled`` once ``cancel``
     is set (at every iteration, and between the stages of the realization)."""
 
-    def __init__(self, index: int, on_load, on_iteration, cancel):
-        self.index, self.on_load, self.on_iteration, self.cancel = index, on_load, on_iteration, cancel
+    def __init__(self, index: int, listeners: SolveListeners, cancel):
+        self.index, self.cancel = index, cancel
+        self.on_load, self.on_iteration = listeners.on_load, listeners.on_iteration
         self.load = 1
         self.last_event = time.monotonic()
 
@@ -87,17 +100,10 @@ class _SolveWatch:
                 self.on_iteration(self.index, self.load, iteration, residual)
 
 
-def compute_realization(
-    scene: Scene,
-    index: int,
-    on_load: LoadListener | None = None,
-    on_iteration: IterationListener | None = None,
-    cancel=None,
-) -> RealizationResult:
-    """Realization ``index`` of ``scene``; ``on_load`` and ``on_iteration`` hear its solver's
-    progress. A failure is carried on the result; ``SolveCancelled`` is raised once ``cancel``
+def compute_realization(scene: Scene, index: int, listeners: SolveListeners = UNHEARD, cancel=None) -> RealizationResult:
+    """Realization ``index`` of ``scene``; ``listeners`` hear its solver's progress. A failure is carried on the result; ``SolveCancelled`` is raised once ``cancel``
     (anything with ``is_set()``) is set, within an iteration of the solver."""
-    watch = _SolveWatch(index, on_load, on_iteration, cancel)
+    watch = _SolveWatch(index, listeners, cancel)
     with listening_to_loads(watch.load_done), listening_to_iterations(watch.iteration_done):
         return _compute(scene, index, watch)
 
@@ -184,11 +190,7 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
 
 
 def compute_chunk(
-    scene: Scene,
-    indices: Iterable[int],
-    on_load: LoadListener | None = None,
-    on_iteration: IterationListener | None = None,
-    cancel=None,
+    scene: Scene, indices: Iterable[int], listeners: SolveListeners = UNHEARD, cancel=None
 ) -> list[RealizationResult]:
     """The task every executor runs: a chunk of realizations, in order. Once ``cancel`` is
     set it returns those finished (a prefix of ``indices``, maybe none): the realization
@@ -196,7 +198,7 @@ def compute_chunk(
     results = []
     for i in indices:
         try:
-            results.append(compute_realization(scene, int(i), on_load, on_iteration, cancel))
+            results.append(compute_realization(scene, int(i), listeners, cancel))
         except SolveCancelled:
             break
         if cancel is not None and cancel.is_set():
@@ -215,11 +217,7 @@ def solve_abandoned() -> bool:
 
 
 def compute_chunk_here(
-    scene: Scene,
-    indices: Iterable[int],
-    on_load: LoadListener | None = None,
-    on_iteration: IterationListener | None = None,
-    cancel=None,
+    scene: Scene, indices: Iterable[int], listeners: SolveListeners = UNHEARD, cancel=None
 ) -> list[RealizationResult]:
     """``compute_chunk`` for this process: in a helper thread, this one waiting (and
     handling signals). Once ``cancel`` is set it returns at once with the realizations
@@ -232,7 +230,7 @@ def compute_chunk_here(
     def work() -> None:
         try:
             for index in indices:
-                finished.extend(compute_chunk(scene, [index], on_load, on_iteration, cancel))
+                finished.extend(compute_chunk(scene, [index], listeners, cancel))
                 if cancel is not None and cancel.is_set():
                     return
         except BaseException as exc:  # handed to the waiting thread

@@ -31,12 +31,13 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, half_load_points, load_finished
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
 
 from .arrays import namespace
 from .checks import check_control, check_loads, check_profile
-from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, contact_spots, corrected_area_fraction, corrected_gradient_rms
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI
 from .contact_cg import ProjectedCG, next_pressure, solve_load
+from .contact_record import ContactRecord
 from .elastic import ElasticParams, PeriodicHalfSpace, elastic_stiffness
 
 POLONSKY_KEER = "10.1016/S0043-1648(99)00113-1"  # Wear 231 (1999) 206
@@ -126,16 +127,8 @@ class PeriodicBEM(ContactSolver):
         line_rms = float(np.sqrt(np.mean(np.square(slopes))))  # as the engine forms it
 
         steps = loads.size
-        force = np.empty(steps)
-        indentation = np.empty(steps)
-        count = np.empty(steps, dtype=np.int64)
-        corrected = np.ones(steps) if self.corrected_area else None  # full contact: no edge to correct
-        real_gradient = np.full(steps, line_rms) if self.real_gradient else None  # likewise
-        spots = np.ones(steps) if self.counts_spots else None  # full contact: one spot
-        slope_rms = np.empty(steps)
-        iterations = np.zeros(steps, dtype=np.int64)
-        residual = np.zeros(steps)
-        half = np.empty(steps, dtype=np.int64)
+        record = ContactRecord(steps, points, line_rms, corrected=self.corrected_area, real_gradient=self.real_gradient,
+                               spots=self.counts_spots)  # fmt: skip
 
         if scale == 0.0:  # a flat profile: every load presses every point evenly
             if control == "indentation":
@@ -143,18 +136,10 @@ class PeriodicBEM(ContactSolver):
                     "the profile is flat: it touches everywhere at once, so any indentation past "
                     "the first touch needs an infinite force. Use control 'force'."
                 )
-            return ContactCurve(
-                force=loads.copy(),
-                indentation=np.zeros(steps),
-                contact_count=np.full(steps, points, dtype=np.int64),
-                contact_fraction=np.ones(steps),
-                slope_rms_contact=np.full(steps, line_rms),
-                real_area_corrected=corrected,
-                real_gradient_rms=real_gradient,
-                contact_spots=spots,
-                extras={"iterations": iterations, "residual": residual},
-                half_load_points=np.full(steps, (points + 1) // 2, dtype=np.int64),
-            )
+            record.force[:], record.indentation[:] = loads, 0.0
+            record.count[:], record.slope_rms[:] = points, line_rms
+            record.half[:] = (points + 1) // 2  # an even pressure: half the points carry half the load
+            return record.curve()
 
         depth /= scale
         operator = PeriodicHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
@@ -186,43 +171,18 @@ class PeriodicBEM(ContactSolver):
             else:
                 pressure = next_pressure(pressure, previous, target, control, depth)
             previous = target
-            pressure, approach, iterations[j], residual[j] = solve_load(
+            pressure, approach, record.iterations[j], record.residual[j] = solve_load(
                 cg, self.name, j, load, pressure, target, control, tolerance, max_iterations, certified
             )
-            contact = pressure > 0.0
-            n = int(np.count_nonzero(contact))
-            count[j] = n
-            half[j] = half_load_points(pressure)
-            if corrected is not None and n < points:
-                corrected[j] = corrected_area_fraction(contact)
-            if real_gradient is not None and n < points:
-                real_gradient[j] = corrected_gradient_rms(contact, slopes)
-            if spots is not None and n < points:
-                spots[j] = contact_spots(contact)
+            record.measure(j, pressure, slopes)
             if control == "force":
-                force[j] = load
-                indentation[j] = approach * scale
+                record.force[j] = load
+                record.indentation[j] = approach * scale
             else:
-                force[j] = float(pressure.mean()) * force_unit
-                indentation[j] = load
-            if n == points:  # xi = 1 to the last bit at full contact
-                slope_rms[j] = line_rms
-            else:
-                slope_rms[j] = float(np.sqrt(np.mean(np.square(slopes[contact]))))
+                record.force[j] = float(pressure.mean()) * force_unit
+                record.indentation[j] = load
             load_finished(j + 1, steps)  # a load of a large surface takes seconds: progress per load
-
-        return ContactCurve(
-            force=force,
-            indentation=indentation,
-            contact_count=count,
-            contact_fraction=count / points,
-            slope_rms_contact=slope_rms,
-            real_area_corrected=corrected,
-            real_gradient_rms=real_gradient,
-            contact_spots=spots,
-            extras={"iterations": iterations, "residual": residual},
-            half_load_points=half,
-        )
+        return record.curve()
 
     def full_contact_load(self, profile: Profile) -> float | None:
         """The load whose uniform part, added to the pressure that flattens the periodic

@@ -21,13 +21,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, half_load_points, load_finished, mdr_length
+from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished, mdr_length
 
 from .arrays import host, namespace, on_device
 from .bem import PeriodicBEM
 from .checks import check_control, check_loads, check_profile
-from .contact_area import YASTREBOV_ANCIAUX_MOLINARI, contact_spots, corrected_area_fraction, corrected_gradient_rms
+from .contact_area import YASTREBOV_ANCIAUX_MOLINARI
 from .contact_cg import next_pressure, solve_load
+from .contact_record import ContactRecord
 from .elastic import FFTPair, PeriodicHalfSpace
 
 LOVE = "Love, Phil. Trans. R. Soc. A 228 (1929) 377"
@@ -153,12 +154,8 @@ class BEMHalfSpaceFree(PeriodicBEM):
         force_unit = self.stiffness() * scale * spacing * points  # (scaled mean pressure) E* s / dx x area
         line_rms = float(np.sqrt(np.mean(np.square(slopes))))
         steps = loads.size
-        force, indentation, shift = np.empty(steps), np.empty(steps), np.zeros(steps)
-        count, slope_rms = np.empty(steps, dtype=np.int64), np.empty(steps)
-        real_gradient = np.full(steps, line_rms)  # full contact: every pixel counts whole
-        spots = np.ones(steps)  # full contact: one spot
-        iterations, residual = np.zeros(steps, dtype=np.int64), np.zeros(steps)
-        half, corrected = np.empty(steps, dtype=np.int64), np.empty(steps)
+        record = ContactRecord(steps, points, line_rms, corrected=True, real_gradient=True, spots=True, periodic=False)
+        shift = np.zeros(steps)
         if scale == 0.0:
             raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
         if control == "force":  # f of this surface: its own rms height h, L = 2 sqrt(A / pi)
@@ -183,33 +180,15 @@ class BEMHalfSpaceFree(PeriodicBEM):
             target = load / force_unit if control == "force" else load / scale
             pressure = next_pressure(pressure, previous, target, control, depth)
             previous = target
-            pressure, approach, iterations[j], residual[j] = solve_load(
+            pressure, approach, record.iterations[j], record.residual[j] = solve_load(
                 cg, self.name, j, load, pressure, target, control, tolerance, max_iterations, certified
             )
-            contact = pressure > 0.0
-            count[j] = n = int(np.count_nonzero(contact))
-            half[j] = half_load_points(pressure)
-            corrected[j] = corrected_area_fraction(contact, periodic=False)
-            force[j] = load if control == "force" else float(pressure.mean()) * force_unit
-            indentation[j] = approach * scale if control == "force" else load
+            record.measure(j, pressure, slopes)  # a scan's border is no edge of its contact
+            record.force[j] = load if control == "force" else float(pressure.mean()) * force_unit
+            record.indentation[j] = approach * scale if control == "force" else load
             shift[j] = float(np.mean(host(cg.gap) - depth)) * scale  # the exact gap holds the displacement
-            slope_rms[j] = line_rms if n == points else float(np.sqrt(np.mean(np.square(slopes[contact]))))
-            if n < points:  # a scan's border is no edge of its contact
-                real_gradient[j] = corrected_gradient_rms(contact, slopes, periodic=False)
-                spots[j] = contact_spots(contact, periodic=False)
             load_finished(j + 1, steps)
-        return ContactCurve(
-            force=force,
-            indentation=indentation,
-            contact_count=count,
-            contact_fraction=count / points,
-            slope_rms_contact=slope_rms,
-            real_area_corrected=corrected,
-            real_gradient_rms=real_gradient,
-            contact_spots=spots,
-            extras={"iterations": iterations, "residual": residual, "mean_displacement": shift},
-            half_load_points=half,
-        )
+        return record.curve(mean_displacement=shift)
 
     def full_contact_load(self, profile: Profile) -> float | None:
         """Not known short of a solve: the border of a free scan carries the most pressure."""

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
+from pydantic import Field
 
-from frictionlab import Profile, SpectrumGenerator
+from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
-from .instrument_file import ScanHeader, is_instrument_file, scan_not_periodic_advice
+from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
+from .map_pipeline import FileFormat
 
 
 @dataclass(frozen=True)
@@ -24,6 +26,39 @@ class Measured:
     rms_height: float
     periodic: bool
     summary: dict[str, Any]  # what was read, and where each value came from
+
+
+class MeasuredParams(PluginParams):
+    """The parameters a measured line and a measured map share, in the order of their forms:
+    each file kind words ``path``, ``spacing`` and ``detrend`` for itself."""
+
+    path: InputFile = Field(description="file of heights", min_length=1)
+    spacing: float | None = Field(None, description="grid spacing", gt=0.0)
+    unit: Unit | None = Field(
+        None,
+        description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
+        "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
+    )
+    undefined: Undefined = Field(
+        "refuse",
+        description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
+        "from their neighbours (harmonic: the solution of Laplace's equation)",
+    )
+    detrend: str | None = Field(None, description="levelling")
+    channel: str | Annotated[int, Field(ge=0)] | None = Field(
+        None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
+        "file's default channel (validate lists them when there are several)",
+    )
+    format: FileFormat = Field(
+        "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
+        "numbers), instrument (an instrument's file or export, such as a profilometer's or an XYZ .csv, read by "
+        "SurfaceTopography)",
+    )
+    periodic: bool | None = Field(
+        None,
+        description="whether the heights repeat (a line's last point is followed by its first, a map's opposite "
+        "edges meet); default: as an instrument file says, else false (a measured scan does not)",
+    )
 
 
 class MeasuredFile(SpectrumGenerator):

@@ -25,18 +25,18 @@ from __future__ import annotations
 import math
 import warnings
 from pathlib import Path
-from typing import Annotated, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import Field
 
-from frictionlab import InputFile, PluginParams
+from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, Undefined, Unit, check_spacing, is_instrument_file, open_input, read_scan, scan_header,
+    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header,
 )
-from .measured import Measured, MeasuredFile
+from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 
 MIN_POINTS = 8
@@ -54,7 +54,7 @@ class ProfileFile(MeasuredFile):
     )
     references: ClassVar[tuple[str, ...]] = ()
 
-    class Params(PluginParams):
+    class Params(MeasuredParams):
         path: InputFile = Field(description="file of heights (.csv, .txt or .npy), one column z or two columns x, z; "
                                 "a relative path is taken from the preset file's folder", min_length=1)
         spacing: float | None = Field(
@@ -63,33 +63,9 @@ class ProfileFile(MeasuredFile):
             "with its x otherwise; for an instrument file it replaces the file's spacing",
             gt=0.0,
         )
-        unit: Unit | None = Field(
-            None,
-            description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
-            "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
-        )
-        undefined: Undefined = Field(
-            "refuse",
-            description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
-            "from their neighbours (harmonic)",
-        )
         detrend: Literal["none", "mean", "tilt"] | None = Field(
             None, description="remove nothing, the mean, or the least-squares line (tilt) before use; default: tilt "
             "for an instrument file (a scan is rarely level), mean for a table",
-        )
-        channel: str | Annotated[int, Field(ge=0)] | None = Field(
-            None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
-            "file's default channel",
-        )
-        format: Literal["auto", "table", "instrument"] = Field(
-            "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
-            "numbers), instrument (an instrument's file or export, such as a profilometer's .csv, read by "
-            "SurfaceTopography)",
-        )
-        periodic: bool | None = Field(
-            None,
-            description="whether the line repeats (its last point is followed by its first); default: as an "
-            "instrument file says, else false (a scan does not)",
         )
 
     # ------------------------------------------------------------ contract

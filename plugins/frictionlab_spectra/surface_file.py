@@ -38,19 +38,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
-from frictionlab import InputFile, PluginParams
+from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, Undefined, Unit, is_instrument_file, read_scan, scan_header,
+    ScanHeader, is_instrument_file, read_scan, scan_header,
 )
-from .map_pipeline import Downsample, FileFormat, Level, Region, shape_map, square_shape
-from .measured import Measured, MeasuredFile
+from .map_pipeline import Downsample, Level, Region, shape_map, square_shape
+from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table
@@ -101,7 +101,7 @@ class SurfaceFile(MeasuredFile):
     references: ClassVar[tuple[str, ...]] = ()
     dimension: ClassVar[int] = 2
 
-    class Params(PluginParams):
+    class Params(MeasuredParams):
         path: InputFile = Field(description="file of heights (.npy 2D array, or .csv/.txt matrix: one map row per "
                                 "line); a relative path is taken from the preset file's folder", min_length=1)
         spacing: float | None = Field(
@@ -110,28 +110,10 @@ class SurfaceFile(MeasuredFile):
             "for an instrument file it replaces the pixel size the file gives",
             gt=0.0,
         )
-        unit: Unit | None = Field(
-            None,
-            description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
-            "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
-        )
-        undefined: Undefined = Field(
-            "refuse",
-            description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
-            "from their neighbours (harmonic: the solution of Laplace's equation)",
-        )
         detrend: Level | None = Field(
             None,
             description="remove nothing, the mean, the least-squares plane or quadratic before use; default: plane "
             "for an instrument file (a scan is rarely level), mean for a table",
-        )
-        channel: str | Annotated[int, Field(ge=0)] | None = Field(
-            None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
-            "file's default channel (validate lists them when there are several)",
-        )
-        format: FileFormat = Field(
-            "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
-            "numbers), instrument (an instrument's file or export, such as an XYZ .csv, read by SurfaceTopography)",
         )
         region: Region | None = Field(
             None, description="a crop, {x: [start, stop], y: [start, stop], units: pixels | length}: half-open spans "
@@ -145,11 +127,6 @@ class SurfaceFile(MeasuredFile):
         despike: float | None = Field(
             None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 x 5 "
             "pixels around them by the solution of Laplace's equation from their neighbours (off by default)",
-        )
-        periodic: bool | None = Field(
-            None,
-            description="whether the map tiles the plane (opposite edges meet); default: as an instrument file says, "
-            "else false (a measured scan does not)",
         )
 
     # ------------------------------------------------------------ contract
