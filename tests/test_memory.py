@@ -119,14 +119,20 @@ def test_a_solver_declaring_more_bytes_per_point_raises_the_estimate(registry):
     assert memory.bytes_per_point(surface) == declared + memory.PROFILE_BYTES_PER_POINT
 
 
+def assert_offer_is_the_most_that_fits(scene, message: str, points=lambda offered: offered) -> None:
+    """The points a refusal offers fit in the 1 GiB limit on one worker, and one more would not."""
+    offered = offered_points(message)
+    fits = memory.estimate(scene, workers=1, executor="processes", points=points(offered)).total
+    too_many = memory.estimate(scene, workers=1, executor="processes", points=points(offered + 1)).total
+    assert fits <= GiB < too_many
+
+
 def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fits(registry, monkeypatch):
     scene = build_scene(surface_of(4096), registry=registry)
     monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
     with pytest.raises(RunError, match=r"spectrum.params.points <= ([\d,]+)\.") as caught:
         memory.check_fits(scene, workers=2, executor="processes")
-    side = offered_points(caught.value.args[0])
-    assert memory.estimate(scene, workers=1, executor="processes", points=side**2).total <= GiB
-    assert memory.estimate(scene, workers=1, executor="processes", points=(side + 1) ** 2).total > GiB
+    assert_offer_is_the_most_that_fits(scene, caught.value.args[0], points=lambda side: side**2)
 
 
 def test_estimate_grows_with_points_workers_and_kept_rows(registry):
@@ -159,10 +165,7 @@ def test_refusal_offers_fewer_points_when_one_worker_is_too_many(registry, monke
     monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
     with pytest.raises(RunError, match=r"It would fit with --workers 1 and spectrum.params.points <= ([\d,]+)\.") as caught:
         memory.check_fits(scene, workers=2, executor="processes")
-    offered = offered_points(caught.value.args[0])
-    fits = memory.estimate(scene, workers=1, executor="processes", points=offered).total
-    too_many = memory.estimate(scene, workers=1, executor="processes", points=offered + 1).total
-    assert fits <= GiB < too_many
+    assert_offer_is_the_most_that_fits(scene, caught.value.args[0])
 
 
 def test_cli_refuses_before_writing_anything(tmp_path, monkeypatch, capsys):

@@ -251,20 +251,20 @@ class _Started(_Event):
     retried: Whole = 0
 
 
-class _Realization(_Event):
+class _Load(_Event):
+    """Realization ``index``'s loads solved, ``done`` of ``total``. A realization's event counts
+    the run's realizations instead, and adds its outcome."""
+
     index: Whole = 0
     done: Whole = 0
     total: Whole = 0
+
+
+class _Realization(_Load):
     ok: bool = False
     seconds: Finite | None = None
     stride: Annotated[int, Field(ge=1, le=MAX_COUNT, strict=True)] = 1
     error: str | None = None
-
-
-class _Load(_Event):
-    index: Whole = 0
-    done: Whole = 0
-    total: Whole = 0
 
 
 class _Iteration(_Event):
