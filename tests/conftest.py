@@ -65,6 +65,23 @@ def small_preset():
 
 
 @pytest.fixture
+def users_folders(tmp_path):
+    """``make(own_name)``: two folders of the user's, one holding a file named as the command's
+    own output (``own_name``, text "my own notes"), one another file ("notes.txt", text "keep
+    me"); returns [(folder, the file it holds)]. A command must refuse both without --force."""
+
+    def make(own_name: str) -> list[tuple[Path, str]]:
+        folders = []
+        for folder, held, text in (("mine", own_name, "my own notes"), ("other", "notes.txt", "keep me")):
+            (tmp_path / folder).mkdir()
+            (tmp_path / folder / held).write_text(text)
+            folders.append((tmp_path / folder, held))
+        return folders
+
+    return make
+
+
+@pytest.fixture
 def make_scene(registry):
     def make(changes: dict | None = None, base: dict = SMALL_PRESET):
         return build_scene(merge(base, changes or {}), registry=registry)

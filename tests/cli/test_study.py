@@ -68,17 +68,13 @@ def test_cli_bad_preset_file(tmp_path, capsys):
 QUICK = ["--axes", "realizations", "--grid-realizations", "3", "--quiet"]
 
 
-def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys):
-    mine, other = tmp_path / "mine", tmp_path / "other"
-    mine.mkdir()
-    other.mkdir()
-    (mine / "study.md").write_text("my precious notes")
-    (other / "notes.txt").write_text("keep me")
-    for folder, held in ((mine, "study.md"), (other, "notes.txt")):
+def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_folders):
+    (mine, _), (other, _) = folders = users_folders("study.md")
+    for folder, held in folders:
         assert main(["study", "quickstart", *QUICK, "--out", str(folder)]) == ExitCode.OUTPUT_REFUSED
         err = capsys.readouterr().err
         assert f"--out {folder} holds '{held}'" in err and "--force" in err
-    assert (mine / "study.md").read_text() == "my precious notes"
+    assert (mine / "study.md").read_text() == "my own notes"
     assert main(["study", "quickstart", *QUICK, "--out", str(other), "--force"]) == ExitCode.OK
     assert (other / "notes.txt").read_text() == "keep me"
     assert (other / "study.md").read_text().startswith("# Trade-off study: quickstart")

@@ -24,18 +24,14 @@ def exact3d(*args):
     return main(["exact3d", "--quick", "--presets", str(PRESETS), "--quiet", *map(str, args)])
 
 
-def test_a_runs_folder_of_the_users_is_refused_before_anything_runs(tmp_path, capsys):
-    userruns, other = tmp_path / "userruns", tmp_path / "other"
-    userruns.mkdir()
-    other.mkdir()
-    (userruns / "exact3d-time.json").write_text("my timing notes")
-    (other / "notes.txt").write_text("keep me")
-    for runs, held in ((userruns, "exact3d-time.json"), (other, "notes.txt")):
+def test_a_runs_folder_of_the_users_is_refused_before_anything_runs(tmp_path, capsys, users_folders):
+    (userruns, _), _ = folders = users_folders("exact3d-time.json")
+    for runs, held in folders:
         assert exact3d("--runs", runs, "--out", tmp_path / "page") == ExitCode.OUTPUT_REFUSED
         err = capsys.readouterr().err
         assert f"--runs {runs} is not empty" in err and repr(held) in err and "--force" in err
         assert [p.name for p in runs.iterdir()] == [held]
-    assert (userruns / "exact3d-time.json").read_text() == "my timing notes"
+    assert (userruns / "exact3d-time.json").read_text() == "my own notes"
     assert not (tmp_path / "page").exists()
 
 
