@@ -41,9 +41,9 @@ from frictionlab import Profile
 from frictionlab.preset.seeds import realization_rng
 from frictionlab_solvers import bem
 from frictionlab_solvers.elastic import PeriodicHalfSpace
-from frictionlab_solvers.polonsky_keer import PolonskyKeerCG
 from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
+from polonsky_keer import PolonskyKeerCG  # this folder's: the baseline
 
 SEED = 2024
 FFT_PAIRS = [0, 0]  # float64, float32

@@ -1,7 +1,7 @@
 """The constrained conjugate gradient of Polonsky & Keer (1999) for the contact
 of a rigid rough surface on an elastic body: the exact solvers' CG before the
-preconditioned projected CG (:mod:`.contact_cg`), kept as the baseline that
-benchmarks/bench_bem.py measures the new one against."""
+preconditioned projected CG (``frictionlab_solvers.contact_cg``), kept here as the
+baseline that bench_bem.py measures the new one against (no preset reaches it)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 
 from frictionlab import iteration_done
 
-from .contact_cg import REFRESH, NotConverged, _dot
-from .elastic import ElasticOperator
+from frictionlab_solvers.contact_cg import REFRESH, NotConverged, _dot
+from frictionlab_solvers.elastic import ElasticOperator
 
 __all__ = ["PolonskyKeerCG"]
 
