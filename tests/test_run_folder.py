@@ -409,3 +409,27 @@ def test_a_lock_that_is_not_a_file_is_named(tmp_path, capsys):
     assert main(["run", str(preset), "--out", str(tmp_path / "run"), "--quiet"]) == ExitCode.RUN_FOLDER
     assert "run.lock is not a regular file" in capsys.readouterr().err
     assert (tmp_path / "run" / "run.lock").is_dir()  # left as it was
+
+
+def test_results_keep_the_preset_the_start_wrote_and_restore_one_changed_or_linked(tmp_path, registry, monkeypatch):
+    from frictionlab.runs import results
+
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 4}), registry=registry)
+    written = []
+    real_write = results.atomic_write
+    monkeypatch.setattr(results, "atomic_write", lambda path, *a, **k: (written.append(Path(path).name), real_write(path, *a, **k)))
+    out = tmp_path / "run"
+    outcome, _ = run_to_folder(scene, out, RunOptions(workers=1), plot=False)
+    expected = yaml.safe_dump(scene.resolved(), sort_keys=False)
+    assert (out / "preset.yaml").read_text() == expected
+    assert "preset.yaml" not in written  # the run's start wrote these bytes: not written (and synced) again
+    (out / "preset.yaml").write_text("name: edited by hand\n")
+    results.write_results(out, scene, outcome)
+    assert (out / "preset.yaml").read_text() == expected  # restored
+    mine = tmp_path / "mine.yaml"
+    mine.write_text(expected)
+    (out / "preset.yaml").unlink()
+    (out / "preset.yaml").symlink_to(mine)  # the same bytes, through a link: replaced, never written through
+    results.write_results(out, scene, outcome)
+    assert not (out / "preset.yaml").is_symlink() and (out / "preset.yaml").read_text() == expected
+    assert mine.read_text() == expected and written.count("preset.yaml") == 2

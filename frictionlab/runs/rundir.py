@@ -265,9 +265,8 @@ class RunDirectory:
             return
         self._manifest["status"] = status
         self._manifest["frictionlab_version"] = __version__
-        self._write_manifest()
-        if status == "completed":
-            self._compact(scene)
+        if not (status == "completed" and self._compact(scene)):  # a compaction writes the status with its chunk
+            self._write_manifest()
 
     def check_fresh(self, scene: Scene) -> None:
         """Refuse now, writing nothing, what a fresh ``start(scene)`` would refuse here
@@ -436,17 +435,16 @@ class RunDirectory:
         if report:
             warnings.warn(f"resume of {self.path}: {report}", stacklevel=3)
 
-    def _compact(self, scene: Scene) -> None:
+    def _compact(self, scene: Scene) -> bool:
         """Merge the chunks of a completed run into one file: written
         and listed first, the old ones deleted after (a crash in between leaves
         them listed as retired, deleted by the next start). The results are those
-        this object stored or verified (the chunks' content, not read back)."""
+        this object stored or verified (the chunks' content, not read back).
+        Whether it merged (and so wrote the manifest)."""
         old = list(self._manifest["chunks"])
-        if len(old) <= 1:
-            return
         results = [self._kept[i] for i in sorted(self._kept)]
-        if not results:
-            return
+        if len(old) <= 1 or not results:
+            return False
         self._manifest["chunks"] = {}
         self._manifest["retired"] = old
         self.save_chunk(results)
@@ -456,6 +454,7 @@ class RunDirectory:
                 (self.chunks / name).unlink(missing_ok=True)
         self._manifest.pop("retired")
         self._write_manifest()
+        return True
 
 
 def _left_by_a_start(path: Path, resolved: dict) -> bool:
