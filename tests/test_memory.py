@@ -395,3 +395,17 @@ def test_a_serial_run_under_a_process_limit_counts_its_whole_peak_against_it(reg
     _under_a_process_limit(monkeypatch, memory.estimate(scene, workers=1, executor="serial").total - 1)
     with pytest.raises(RunError, match=r"RLIMIT_AS \(ulimit -v\) less what this process uses\)\. It would fit with"):
         memory.check_fits(scene, workers=1, executor="serial")
+
+
+@pytest.mark.skipif(not Path("/proc/self/statm").exists(), reason="reads /proc directly on Linux only")
+def test_the_memory_read_from_proc_is_psutils(monkeypatch):
+    psutil = pytest.importorskip("psutil")
+    vms, data = memory._address_space()
+    used = psutil.Process().memory_info()
+    assert vms == pytest.approx(used.vms, abs=64 * 2**20) and data == pytest.approx(used.data, abs=64 * 2**20)
+    assert memory._system_available() == pytest.approx(psutil.virtual_memory().available, rel=0.05, abs=256 * 2**20)
+    # without /proc, psutil's figures
+    monkeypatch.setattr(memory, "PROC_MEMINFO", "/nonexistent/meminfo")
+    monkeypatch.setattr(memory, "PROC_STATM", "/nonexistent/statm")
+    assert memory._address_space()[0] == pytest.approx(psutil.Process().memory_info().vms, abs=64 * 2**20)
+    assert memory._system_available() == pytest.approx(psutil.virtual_memory().available, rel=0.05, abs=256 * 2**20)

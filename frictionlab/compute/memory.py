@@ -16,6 +16,7 @@ the boundary elements of the half-space: about 1.5x the line pipeline):
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -118,11 +119,9 @@ def available_memory() -> tuple[int, str]:
 def _machine_rooms() -> list[tuple[int, str]]:
     """The room the machine leaves to all the run's processes together: MemAvailable, and
     what a cgroup limit leaves."""
-    import psutil  # the machine's available memory on every platform (MemAvailable on Linux)
-
     found: list[tuple[int, str]] = []
     try:
-        found.append((int(psutil.virtual_memory().available), "the memory the system says is available: MemAvailable on Linux"))
+        found.append((_system_available(), "the memory the system says is available: MemAvailable on Linux"))
     except (OSError, RuntimeError):
         pass
     for limit_file, usage_file in (
@@ -139,6 +138,39 @@ def _machine_rooms() -> list[tuple[int, str]]:
     return found
 
 
+PROC_MEMINFO, PROC_STATM = "/proc/meminfo", "/proc/self/statm"  # Linux
+
+
+def _system_available() -> int:
+    """MemAvailable of /proc/meminfo on Linux, read directly (psutil's import would be most
+    of a short run's memory check); psutil's figure elsewhere."""
+    try:
+        with open(PROC_MEMINFO, "rb") as fh:
+            for line in fh:
+                if line.startswith(b"MemAvailable:"):
+                    return int(line.split()[1]) * 1024  # kB
+    except (OSError, ValueError, IndexError):
+        pass
+    import psutil  # every platform's available memory
+
+    return int(psutil.virtual_memory().available)
+
+
+def _address_space() -> tuple[int, int]:
+    """(virtual size, data segment) of this process in bytes: /proc/self/statm on Linux,
+    psutil elsewhere (where the data segment is not told, the virtual size stands for it)."""
+    try:
+        with open(PROC_STATM, "rb") as fh:
+            fields = fh.read().split()
+        page = os.sysconf("SC_PAGE_SIZE")
+        return int(fields[0]) * page, int(fields[5]) * page
+    except (OSError, ValueError, IndexError):
+        import psutil
+
+        used = psutil.Process().memory_info()
+        return used.vms, getattr(used, "data", used.vms)  # data: psutil has it on Linux only
+
+
 def _process_limits() -> list[tuple[int, str]]:
     """Room left under this process's limits on address space and data (``ulimit -v``,
     ``ulimit -d``), which each worker process inherits: a limit of each process, not of the
@@ -148,11 +180,9 @@ def _process_limits() -> list[tuple[int, str]]:
         import resource
     except ImportError:  # not on Windows
         return []
-    import psutil
-
-    used = psutil.Process().memory_info()
+    vms, data = _address_space()
     found = []
-    for name, current in (("RLIMIT_AS", used.vms), ("RLIMIT_DATA", getattr(used, "data", used.vms))):  # data: Linux only
+    for name, current in (("RLIMIT_AS", vms), ("RLIMIT_DATA", data)):
         soft, _ = resource.getrlimit(getattr(resource, name))
         if soft != resource.RLIM_INFINITY:
             found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
