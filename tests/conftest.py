@@ -1,6 +1,7 @@
 import contextlib
 import copy
 import logging
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -70,6 +71,36 @@ def make_scene(registry):
         return build_scene(merge(base, changes or {}), registry=registry)
 
     return make
+
+
+@pytest.fixture
+def cli(capsys, monkeypatch):
+    """``frictionlab ARGS`` run in this process by ``cli.main``, as a CompletedProcess
+    (returncode, stdout, stderr): for what a command prints, writes and exits with. A
+    test of the process itself (signals, a closed descriptor, the interpreter's exit,
+    fresh imports, a terminal) runs ``python -m frictionlab`` instead. ``env`` sets
+    variables for the call (None removes one), ``cwd`` its working folder."""
+    from frictionlab.cli import main
+
+    def run(*args, env: dict | None = None, cwd=None) -> subprocess.CompletedProcess:
+        argv = [str(arg) for arg in args]
+        capsys.readouterr()  # what the test printed before is not the command's
+        with monkeypatch.context() as patch:
+            for name, value in (env or {}).items():
+                if value is None:
+                    patch.delenv(name, raising=False)
+                else:
+                    patch.setenv(name, str(value))
+            if cwd is not None:
+                patch.chdir(cwd)
+            try:
+                code = main(argv)
+            except SystemExit as exc:  # argparse: --help, --version, a usage error
+                code = 0 if exc.code is None else exc.code
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
+
+    return run
 
 
 @contextlib.contextmanager
