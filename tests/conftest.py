@@ -1,7 +1,10 @@
 import contextlib
 import copy
+import io
 import logging
+import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -79,13 +82,19 @@ def cli(capsys, monkeypatch):
     (returncode, stdout, stderr): for what a command prints, writes and exits with. A
     test of the process itself (signals, a closed descriptor, the interpreter's exit,
     fresh imports, a terminal) runs ``python -m frictionlab`` instead. ``env`` sets
-    variables for the call (None removes one), ``cwd`` its working folder."""
+    variables for the call (None removes one), ``cwd`` its working folder; with ``encoding``
+    stdout and stderr are streams of that encoding (as PYTHONIOENCODING makes them) and
+    come back as bytes. An argument given as bytes is passed as ``sys.argv`` holds it."""
     from frictionlab.cli import main
 
-    def run(*args, env: dict | None = None, cwd=None) -> subprocess.CompletedProcess:
-        argv = [str(arg) for arg in args]
+    def run(*args, env: dict | None = None, cwd=None, encoding: str | None = None) -> subprocess.CompletedProcess:
+        argv = [os.fsdecode(arg) if isinstance(arg, bytes) else str(arg) for arg in args]  # bytes as sys.argv has them
         capsys.readouterr()  # what the test printed before is not the command's
         with monkeypatch.context() as patch:
+            if encoding is not None:  # streams of this encoding, strict, as PYTHONIOENCODING makes them: bytes out
+                streams = [io.TextIOWrapper(io.BytesIO(), encoding=encoding, errors="strict") for _ in range(2)]
+                patch.setattr(sys, "stdout", streams[0])
+                patch.setattr(sys, "stderr", streams[1])
             for name, value in (env or {}).items():
                 if value is None:
                     patch.delenv(name, raising=False)
@@ -97,7 +106,12 @@ def cli(capsys, monkeypatch):
                 code = main(argv)
             except SystemExit as exc:  # argparse: --help, --version, a usage error
                 code = 0 if exc.code is None else exc.code
-        out, err = capsys.readouterr()
+            if encoding is not None:
+                for stream in streams:
+                    stream.flush()
+                out, err = (stream.buffer.getvalue() for stream in streams)
+        if encoding is None:
+            out, err = capsys.readouterr()
         return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
 
     return run
