@@ -76,45 +76,46 @@ def make_scene(registry):
     return make
 
 
-@pytest.fixture
-def cli(capsys, monkeypatch):
+def run_cli(*args, env: dict | None = None, cwd=None, encoding: str | None = None) -> subprocess.CompletedProcess:
     """``frictionlab ARGS`` run in this process by ``cli.main``, as a CompletedProcess
     (returncode, stdout, stderr): for what a command prints, writes and exits with. A
     test of the process itself (signals, a closed descriptor, the interpreter's exit,
-    fresh imports, a terminal) runs ``python -m frictionlab`` instead. ``env`` sets
-    variables for the call (None removes one), ``cwd`` its working folder; with ``encoding``
-    stdout and stderr are streams of that encoding (as PYTHONIOENCODING makes them) and
-    come back as bytes. An argument given as bytes is passed as ``sys.argv`` holds it."""
+    fresh imports, a terminal) runs ``python -m frictionlab`` instead.
+
+    stdout and stderr are strict streams of ``encoding`` (UTF-8 and text back when not
+    given; bytes back when given, as PYTHONIOENCODING makes them), never a terminal.
+    ``env`` sets variables for the call (None removes one), ``cwd`` its working folder;
+    an argument given as bytes is passed as ``sys.argv`` holds it."""
     from frictionlab.cli import main
 
-    def run(*args, env: dict | None = None, cwd=None, encoding: str | None = None) -> subprocess.CompletedProcess:
-        argv = [os.fsdecode(arg) if isinstance(arg, bytes) else str(arg) for arg in args]  # bytes as sys.argv has them
-        capsys.readouterr()  # what the test printed before is not the command's
-        with monkeypatch.context() as patch:
-            if encoding is not None:  # streams of this encoding, strict, as PYTHONIOENCODING makes them: bytes out
-                streams = [io.TextIOWrapper(io.BytesIO(), encoding=encoding, errors="strict") for _ in range(2)]
-                patch.setattr(sys, "stdout", streams[0])
-                patch.setattr(sys, "stderr", streams[1])
-            for name, value in (env or {}).items():
-                if value is None:
-                    patch.delenv(name, raising=False)
-                else:
-                    patch.setenv(name, str(value))
-            if cwd is not None:
-                patch.chdir(cwd)
-            try:
-                code = main(argv)
-            except SystemExit as exc:  # argparse: --help, --version, a usage error
-                code = 0 if exc.code is None else exc.code
-            if encoding is not None:
-                for stream in streams:
-                    stream.flush()
-                out, err = (stream.buffer.getvalue() for stream in streams)
-        if encoding is None:
-            out, err = capsys.readouterr()
-        return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
+    argv = [os.fsdecode(arg) if isinstance(arg, bytes) else str(arg) for arg in args]
+    streams = [io.TextIOWrapper(io.BytesIO(), encoding=encoding or "utf-8", errors="strict", newline="") for _ in "12"]
+    with pytest.MonkeyPatch.context() as patch:
+        for name, value in (env or {}).items():
+            if value is None:
+                patch.delenv(name, raising=False)
+            else:
+                patch.setenv(name, str(value))
+        if cwd is not None:
+            patch.chdir(cwd)
+        patch.setattr(sys, "stdout", streams[0])
+        patch.setattr(sys, "stderr", streams[1])
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse: --help, --version, a usage error
+            code = 0 if exc.code is None else exc.code
+        for stream in streams:
+            stream.flush()
+    out, err = (stream.buffer.getvalue() for stream in streams)
+    if encoding is None:
+        out, err = out.decode(), err.decode()
+    return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
 
-    return run
+
+@pytest.fixture
+def cli():
+    """``run_cli``: ``cli("validate", "quickstart").stdout``."""
+    return run_cli
 
 
 @contextlib.contextmanager
