@@ -16,7 +16,6 @@ from frictionlab.compute import engine
 from frictionlab.errors import FrictionlabError
 from frictionlab.compute import executors
 from frictionlab.compute.executors import DASK_MISSING, ProcessExecutor, SerialExecutor, plan_chunks, sized_executor
-from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
 from frictionlab.options import RunOptions
 

@@ -193,29 +193,6 @@ def test_a_run_whose_reader_left_still_finishes_its_folder(tmp_path):
     assert state["status"] == "completed" and (tmp_path / "q" / "plot.png").is_file()
 
 
-def test_report_json_names_the_report_and_the_figures_it_shows(tmp_path, capsys):
-    from frictionlab.cli import main
-    from frictionlab.paper.figures import FIGURES
-    from frictionlab.preset import apply_overrides, load_preset_file
-
-    from ..conftest import PRESETS
-    from ..paper.test_reproduce import TINY
-
-    presets = tmp_path / "presets"
-    presets.mkdir()
-    for fig in FIGURES:
-        data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
-        if data.get("sweep"):
-            data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
-        (presets / fig.preset).write_text(json.dumps(data))  # JSON is YAML
-    out = tmp_path / "report"
-    assert main(["report", "--presets", str(presets), "--out", str(out), "--quiet", "--workers", "1", "--json"]) == 0
-    printed = json.loads(capsys.readouterr().out)
-    assert printed["report"] == str(out / "REPRODUCTION.md")
-    assert printed["figures"] == [str(out / "figures" / f"{fig.key}.png") for fig in FIGURES]
-    assert all(os.path.getsize(figure) > 1000 for figure in printed["figures"])
-
-
 def test_tui_takes_a_builtin_name_and_a_mistyped_one_gets_the_closest_before_the_ui_starts(monkeypatch, cli):
     from argparse import Namespace
 
