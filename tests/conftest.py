@@ -5,6 +5,7 @@ import logging
 import os
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import pytest
@@ -100,16 +101,23 @@ def run_cli(*args, env: dict | None = None, cwd=None, encoding: str | None = Non
             patch.chdir(cwd)
         patch.setattr(sys, "stdout", streams[0])
         patch.setattr(sys, "stderr", streams[1])
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse: --help, --version, a usage error
-            code = 0 if exc.code is None else exc.code
+        with warnings.catch_warnings():  # shown on stderr as a process shows them, not kept by pytest
+            warnings.simplefilter("default")
+            warnings.showwarning = _show_warning
+            try:
+                code = main(argv)
+            except SystemExit as exc:  # argparse: --help, --version, a usage error
+                code = 0 if exc.code is None else exc.code
         for stream in streams:
             stream.flush()
     out, err = (stream.buffer.getvalue() for stream in streams)
     if encoding is None:
         out, err = out.decode(), err.decode()
     return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 @pytest.fixture
