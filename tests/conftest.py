@@ -86,7 +86,8 @@ def run_cli(*args, env: dict | None = None, cwd=None, encoding: str | None = Non
     stdout and stderr are strict streams of ``encoding`` (UTF-8 and text back when not
     given; bytes back when given, as PYTHONIOENCODING makes them), never a terminal.
     ``env`` sets variables for the call (None removes one), ``cwd`` its working folder;
-    an argument given as bytes is passed as ``sys.argv`` holds it."""
+    an argument given as bytes is passed as ``sys.argv`` holds it. Warnings are written to
+    stderr, as a process writes them."""
     from frictionlab.cli import main
 
     argv = [os.fsdecode(arg) if isinstance(arg, bytes) else str(arg) for arg in args]
