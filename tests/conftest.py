@@ -104,6 +104,8 @@ def run_cli(*args, env: dict | None = None, cwd=None, encoding: str | None = Non
         patch.setattr(sys, "stderr", streams[1])
         with warnings.catch_warnings():  # shown on stderr as a process shows them, not kept by pytest
             warnings.simplefilter("default")
+            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+                warnings.simplefilter("ignore", category)  # as Python's own filters leave them out
             warnings.showwarning = _show_warning
             try:
                 code = main(argv)
