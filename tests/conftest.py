@@ -1,6 +1,11 @@
 import contextlib
 import copy
+import io
 import logging
+import os
+import subprocess
+import sys
+import warnings
 from pathlib import Path
 
 import pytest
@@ -87,6 +92,58 @@ def make_scene(registry):
         return build_scene(merge(base, changes or {}), registry=registry)
 
     return make
+
+
+def run_cli(*args, env: dict | None = None, cwd=None, encoding: str | None = None) -> subprocess.CompletedProcess:
+    """``frictionlab ARGS`` run in this process by ``cli.main``, as a CompletedProcess
+    (returncode, stdout, stderr): for what a command prints, writes and exits with. A
+    test of the process itself (signals, a closed descriptor, the interpreter's exit,
+    fresh imports, a terminal) runs ``python -m frictionlab`` instead.
+
+    stdout and stderr are strict streams of ``encoding`` (UTF-8 and text back when not
+    given; bytes back when given, as PYTHONIOENCODING makes them), never a terminal.
+    ``env`` sets variables for the call (None removes one), ``cwd`` its working folder;
+    an argument given as bytes is passed as ``sys.argv`` holds it. Warnings are written to
+    stderr, as a process writes them."""
+    from frictionlab.cli import main
+
+    argv = [os.fsdecode(arg) if isinstance(arg, bytes) else str(arg) for arg in args]
+    streams = [io.TextIOWrapper(io.BytesIO(), encoding=encoding or "utf-8", errors="strict", newline="") for _ in "12"]
+    with pytest.MonkeyPatch.context() as patch:
+        for name, value in (env or {}).items():
+            if value is None:
+                patch.delenv(name, raising=False)
+            else:
+                patch.setenv(name, str(value))
+        if cwd is not None:
+            patch.chdir(cwd)
+        patch.setattr(sys, "stdout", streams[0])
+        patch.setattr(sys, "stderr", streams[1])
+        with warnings.catch_warnings():  # shown on stderr as a process shows them, not kept by pytest
+            warnings.simplefilter("default")
+            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning):
+                warnings.simplefilter("ignore", category)  # as Python's own filters leave them out
+            warnings.showwarning = _show_warning
+            try:
+                code = main(argv)
+            except SystemExit as exc:  # argparse: --help, --version, a usage error
+                code = 0 if exc.code is None else exc.code
+        for stream in streams:
+            stream.flush()
+    out, err = (stream.buffer.getvalue() for stream in streams)
+    if encoding is None:
+        out, err = out.decode(), err.decode()
+    return subprocess.CompletedProcess(["frictionlab", *argv], int(code), out, err)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+@pytest.fixture
+def cli():
+    """``run_cli``: ``cli("validate", "quickstart").stdout``."""
+    return run_cli
 
 
 @contextlib.contextmanager

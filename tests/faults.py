@@ -5,6 +5,8 @@ processes started by forkserver or spawn find them too).
   dies while it sends its chunk's result to the parent: half of the message
   is written, then the process is killed (SIGKILL), as an OOM kill or a
   ``kill -9`` at the worst moment would do.
+* ``CrashingPowerLaw``: a power-law line whose worker process (never the
+  parent's) dies on the spot making one: the first to do so, or every one.
 * ``FlakyPowerLaw``: a power-law line that fails (raises) for about a third
   of the realizations while a flag file exists, without touching the
   realization's random stream, so a rerun without the flag gives the clean
@@ -59,6 +61,32 @@ class MidSendKiller(PowerLaw):
                 pass
             else:
                 _kill_mid_send(p.flag)
+        return super().generate(rng)
+
+
+class CrashingPowerLaw(PowerLaw):
+    """The power-law line, but a worker process (never the test's own) that
+    generates one dies on the spot: once per run (the first to create ``flag``),
+    or every time (``always``)."""
+
+    name = "crashing-power-law"
+
+    class Params(PowerLaw.Params):
+        flag: str
+        parent: int
+        always: bool = False
+
+    def generate(self, rng):
+        p = self.params
+        if os.getpid() != p.parent:
+            if p.always:
+                os._exit(3)
+            try:
+                os.close(os.open(p.flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            except FileExistsError:
+                pass
+            else:
+                os._exit(3)  # a killed worker: no exception, no cleanup
         return super().generate(rng)
 
 

@@ -17,7 +17,6 @@ from frictionlab import api
 from frictionlab.errors import FrictionlabError, MissingDependency, PresetError, RunFolderError
 from frictionlab.preset import Preset
 
-from .cli.conftest import run_cli
 from .conftest import PRESETS, SMALL_PRESET
 
 FAST = {"workers": 1, "progress": False}
@@ -78,9 +77,9 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
 
 
-def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path):
+def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path, cli):
     folder = tmp_path / "cli-run"
-    result = run_cli("run", "quickstart", "--out", folder, "--quiet", "--workers", "2", "--set", "realizations=12")
+    result = cli("run", "quickstart", "--out", folder, "--quiet", "--workers", "2", "--set", "realizations=12")
     assert result.returncode == 0, result.stderr
     loaded = frictionlab.load(folder)
     again = frictionlab.run("quickstart", realizations=12, **FAST)  # in memory, one worker: the same numbers

@@ -4,8 +4,6 @@ ndarray) may remain on the path a GPU's CuPy arrays take. Each answer is checked
 against the numpy path's, which the rest of the solver tests check against physics.
 And ``device: gpu`` is refused, naming what is missing, where CuPy is not installed."""
 
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -106,7 +104,7 @@ def _cupy_importable() -> bool:
 
 
 @pytest.mark.skipif(_cupy_importable(), reason="CuPy is installed: the refusal of a missing one cannot be seen")
-def test_device_gpu_without_cupy_is_refused_naming_the_parameter_and_what_is_missing(tmp_path):
+def test_device_gpu_without_cupy_is_refused_naming_the_parameter_and_what_is_missing(tmp_path, cli):
     with pytest.raises(ValueError, match=r"device 'gpu' needs CuPy, which is not installed \(pip install cupy"):
         arrays.namespace("gpu")
     with pytest.raises(ValueError, match="device") as refused:
@@ -118,7 +116,7 @@ def test_device_gpu_without_cupy_is_refused_naming_the_parameter_and_what_is_mis
         "solver: {name: bem-halfspace-free, params: {device: gpu}}\nslope: {name: forward-difference}\n"
         "loading: {control: force, start: 1.0, stop: 2.0, steps: 2, spacing: log}\n"
     )
-    done = subprocess.run([sys.executable, "-m", "frictionlab", "validate", str(preset)], capture_output=True, text=True)
+    done = cli("validate", preset)
     assert done.returncode != 0
     assert "solver.params.device" in done.stderr + done.stdout and "needs CuPy" in done.stderr + done.stdout
     assert "Traceback" not in done.stderr

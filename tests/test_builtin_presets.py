@@ -18,7 +18,6 @@ import frictionlab
 from frictionlab.errors import ExitCode, PresetFileError
 from frictionlab.preset.builtin import builtin_presets, find_builtin, resolve_preset_path
 
-from .cli.conftest import run_cli
 from .conftest import PRESETS, ROOT
 
 
@@ -51,29 +50,29 @@ def test_a_name_means_the_builtin_and_a_path_stays_a_path(tmp_path, monkeypatch)
     assert resolve_preset_path("mine") == Path("mine")  # no built-in of that name: read, and refused, as a path
 
 
-def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path):
-    listed = json.loads(run_cli("presets", "--json").stdout)["presets"]
+def test_presets_command_lists_as_json_and_copies_without_overwriting(tmp_path, cli):
+    listed = json.loads(cli("presets", "--json").stdout)["presets"]
     assert {row["name"] for row in listed} == {p.stem for p in PRESETS.glob("*.yaml")}
-    result = run_cli("presets", "copy", "quickstart", tmp_path)
+    result = cli("presets", "copy", "quickstart", tmp_path)
     assert result.returncode == 0, result.stderr
     copy = tmp_path / "quickstart.yaml"
     assert copy.read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
     copy.write_text("mine")
-    result = run_cli("presets", "copy", "quickstart", copy)
+    result = cli("presets", "copy", "quickstart", copy)
     assert result.returncode == ExitCode.OUTPUT_REFUSED and "--force" in result.stderr
     assert copy.read_text() == "mine"
-    assert run_cli("presets", "copy", "quickstart", copy, "--force").returncode == 0
+    assert cli("presets", "copy", "quickstart", copy, "--force").returncode == 0
     assert copy.read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
-    result = run_cli("presets", "copy", "fig2")
+    result = cli("presets", "copy", "fig2")
     assert result.returncode == ExitCode.USAGE and "benad2012-fig2" in result.stderr
 
 
-def test_presets_copy_to_a_name_ending_in_a_slash_makes_that_folder(tmp_path):
-    result = run_cli("presets", "copy", "quickstart", f"{tmp_path / 'newdir'}/")
+def test_presets_copy_to_a_name_ending_in_a_slash_makes_that_folder(tmp_path, cli):
+    result = cli("presets", "copy", "quickstart", f"{tmp_path / 'newdir'}/")
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "newdir" / "quickstart.yaml").read_bytes() == (PRESETS / "quickstart.yaml").read_bytes()
     (tmp_path / "afile").write_text("mine")
-    result = run_cli("presets", "copy", "quickstart", f"{tmp_path / 'afile' / 'sub'}/")
+    result = cli("presets", "copy", "quickstart", f"{tmp_path / 'afile' / 'sub'}/")
     assert result.returncode == ExitCode.OUTPUT_REFUSED and "afile is a file" in result.stderr
     assert (tmp_path / "afile").read_text() == "mine"
 
@@ -126,8 +125,8 @@ def test_a_real_install_runs_a_builtin_by_name_from_an_empty_folder(installed, t
 
 
 @pytest.mark.parametrize("command", ["run", "validate"])
-def test_a_bad_set_on_a_built_in_names_the_built_in_and_the_set_not_the_installed_file(command, tmp_path):
-    result = run_cli(command, "quickstart", "--set", "realizations=-5", cwd=tmp_path)
+def test_a_bad_set_on_a_built_in_names_the_built_in_and_the_set_not_the_installed_file(command, tmp_path, cli):
+    result = cli(command, "quickstart", "--set", "realizations=-5", cwd=tmp_path)
     assert result.returncode == ExitCode.USAGE
     assert "built-in preset 'quickstart' --set realizations=-5: 1 problem" in result.stderr
     assert "realizations: must be >= 1, got -5" in result.stderr

@@ -63,7 +63,7 @@ def test_runs_prints_a_forged_name_escaped(tmp_path, capsys):
 
 
 @posix
-def test_resume_prints_its_warning_about_a_folder_escaped(tmp_path):
+def test_resume_prints_its_warning_about_a_folder_escaped(tmp_path, cli):
     folder = tmp_path / f"run{PAYLOAD}"
     frictionlab.run(SMALL_PRESET, out=folder, workers=1, plot=False, progress=False)
     manifest = json.loads((folder / "run.json").read_text())
@@ -71,8 +71,7 @@ def test_resume_prints_its_warning_about_a_folder_escaped(tmp_path):
     (folder / "run.json").write_text(json.dumps(manifest))
     [chunk] = (folder / "chunks").iterdir()
     chunk.write_bytes(chunk.read_bytes() + b"!")  # a checksum that does not match: a warning names the folder
-    done = subprocess.run([sys.executable, "-m", "frictionlab", "resume", str(folder), "--no-plot"], capture_output=True,
-                          text=True, timeout=120)  # fmt: skip
+    done = cli("resume", folder, "--no-plot")
     assert done.returncode == 0 and "failed verification" in done.stderr
     assert "pwned" in done.stderr + done.stdout and ESC not in done.stderr + done.stdout
 

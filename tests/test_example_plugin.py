@@ -1,6 +1,8 @@
 """The entry-point path end to end: install the example third-party plugin
 ``examples/frictionlab-gaussian`` (offline, into a temporary directory) and find
-it from a fresh process through ``importlib.metadata`` entry points."""
+it from a fresh process through ``importlib.metadata`` entry points; what the
+environment switches and the commands make of it is checked in this process, the
+folder it is installed in put on ``sys.path``."""
 
 from __future__ import annotations
 
@@ -77,14 +79,39 @@ def _run(site: Path, args: list[str], **env: str) -> subprocess.CompletedProcess
     )
 
 
-def _plugins(site: Path, **env: str) -> dict:
-    result = _run(site, ["-c", LIST_PLUGINS], **env)
-    assert result.returncode == 0, result.stderr
-    return json.loads(result.stdout)
+def _listing(registry) -> dict:
+    return {
+        "plugins": [[i.kind, i.name, i.provider, i.version] for i in registry.infos()],
+        "failures": [[f.entry_point, f.distribution, f.error] for f in registry.failures],
+    }
+
+
+@pytest.fixture
+def example_here(installed_example, monkeypatch):
+    """The installed example found by this process: its folder first on ``sys.path``, no
+    FRICTIONLAB_ switch set, the caches of what is installed (and the CLI's registry)
+    cleared before and after, and its modules forgotten after."""
+    from frictionlab.plugin import registry
+
+    before = set(sys.modules)
+    monkeypatch.syspath_prepend(str(installed_example))
+    for name in [name for name in os.environ if name.startswith("FRICTIONLAB_")]:
+        monkeypatch.delenv(name)
+    caches = (registry._module_distributions, registry._provider_of, registry.default_registry)
+    for cache in caches:
+        cache.cache_clear()
+    yield installed_example
+    for cache in caches:
+        cache.cache_clear()
+    for name in set(sys.modules) - before:
+        if name.partition(".")[0] == "frictionlab_gaussian":
+            del sys.modules[name]
 
 
 def test_installed_example_is_discovered_with_provider_and_version(installed_example):
-    listing = _plugins(installed_example)
+    result = _run(installed_example, ["-c", LIST_PLUGINS])  # a fresh process, as a user's
+    assert result.returncode == 0, result.stderr
+    listing = json.loads(result.stdout)
     assert listing["failures"] == []
     rows = [row for row in listing["plugins"] if row[1] == "gaussian"]
     assert rows == [["spectrum", "gaussian", "frictionlab-gaussian", _example_version()]]
@@ -101,41 +128,48 @@ def test_installed_example_is_discovered_with_provider_and_version(installed_exa
     ],
     ids=["blocked", "discovery-disabled", "not-listed"],
 )
-def test_environment_switches_hide_the_example(installed_example, env):
-    listing = _plugins(installed_example, **env)
-    names = [row[1] for row in listing["plugins"]]
+def test_environment_switches_hide_the_example(example_here, env):
+    from frictionlab.plugin.registry import Registry
+
+    found = [row[1] for row in _listing(Registry(env={})).get("plugins")]
+    assert "gaussian" in found  # without the switch it is there
+    names = [row[1] for row in _listing(Registry(env=env))["plugins"]]
     assert "gaussian" not in names
     assert "power-law" in names
 
 
-def test_listed_example_is_loaded(installed_example):
-    listing = _plugins(installed_example, FRICTIONLAB_PLUGINS="gaussian")
-    assert "gaussian" in [row[1] for row in listing["plugins"]]
+def test_listed_example_is_loaded(example_here):
+    from frictionlab.plugin.registry import Registry
+
+    listing = _listing(Registry(env={"FRICTIONLAB_PLUGINS": "gaussian"}))
+    assert ["spectrum", "gaussian", "frictionlab-gaussian", _example_version()] in listing["plugins"]
 
 
-def test_example_generates_through_the_registry(installed_example):
-    code = (
-        "import numpy as np; from frictionlab.plugin.registry import Registry; "
-        "cls = Registry().get('spectrum', 'Gaussian'); "
-        "z = cls(points=64, correlation_length=4.0, rms_height=2.0).generate(np.random.default_rng(1)).heights; "
-        "print(cls.__module__, z.size, round(float(np.sqrt(np.mean(z**2))), 9))"
-    )
-    result = _run(installed_example, ["-c", code])
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.split() == ["frictionlab_gaussian", "64", "2.0"]
+def test_example_generates_through_the_registry(example_here):
+    import numpy as np
+
+    from frictionlab.plugin.registry import Registry
+
+    cls = Registry(env={}).get("spectrum", "Gaussian")
+    z = cls(points=64, correlation_length=4.0, rms_height=2.0).generate(np.random.default_rng(1)).heights
+    assert cls.__module__ == "frictionlab_gaussian" and z.size == 64
+    assert float(np.sqrt(np.mean(z**2))) == pytest.approx(2.0, abs=1e-9)
 
 
-def test_cli_lists_the_example(installed_example):
-    result = _run(installed_example, ["-m", "frictionlab", "plugins"])
+def test_cli_lists_the_example(example_here, cli):
+    from frictionlab.plugin.registry import default_registry
+
+    result = cli("plugins")
     assert result.returncode == 0, result.stdout + result.stderr
     assert "gaussian" in result.stdout
     assert "frictionlab-gaussian" in result.stdout
-    blocked = _run(installed_example, ["-m", "frictionlab", "plugins"], FRICTIONLAB_BLOCK_PLUGINS="gaussian")
+    default_registry.cache_clear()  # the CLI's registry is built once per process, switches read then
+    blocked = cli("plugins", env={"FRICTIONLAB_BLOCK_PLUGINS": "gaussian"})
     assert blocked.returncode == 0, blocked.stdout + blocked.stderr
     assert "frictionlab-gaussian" not in blocked.stdout
 
 
-def test_the_tutorials_step_4_validates_as_shown_and_a_name_switched_alone_is_refused(installed_example, tmp_path):
+def test_the_tutorials_step_4_validates_as_shown_and_a_name_switched_alone_is_refused(example_here, cli, tmp_path):
     """docs/tutorials/write-a-plugin.md: its preset, saved as gaussian.yaml, and its --set
     line from quickstart validate with the plugin installed; the name alone does not."""
     import re
@@ -147,10 +181,7 @@ def test_the_tutorials_step_4_validates_as_shown_and_a_name_switched_alone_is_re
     commands = [shlex.split(line)[1:] for line in re.findall(r"^frictionlab .*$", step, re.M)]
     assert commands[0] == ["validate", "gaussian.yaml"] and "--set" in commands[1]
     for argv in commands:
-        done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, text=True, cwd=tmp_path,
-                              env=_clean_env(PYTHONPATH=str(installed_example)), timeout=120)  # fmt: skip
+        done = cli(*argv, cwd=tmp_path)
         assert done.returncode == 0 and ": ok (" in done.stdout, (argv, done.stderr)
-    alone = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart", "--set", "spectrum.name=gaussian"],
-                           capture_output=True, text=True, cwd=tmp_path, env=_clean_env(PYTHONPATH=str(installed_example)),
-                           timeout=120)  # fmt: skip
+    alone = cli("validate", "quickstart", "--set", "spectrum.name=gaussian", cwd=tmp_path)
     assert alone.returncode == 2 and "spectrum.params.hurst: is not a known field" in alone.stderr

@@ -16,12 +16,11 @@ from frictionlab.compute import engine
 from frictionlab.errors import FrictionlabError
 from frictionlab.compute import executors
 from frictionlab.compute.executors import DASK_MISSING, ProcessExecutor, SerialExecutor, plan_chunks, sized_executor
-from frictionlab.plugin import PluginParams
 from frictionlab.preset import Scene
-from frictionlab_spectra.power_law import PowerLaw
 from frictionlab.options import RunOptions
 
 from .conftest import loopback_cluster
+from .faults import CrashingPowerLaw, with_spectrum
 
 
 def same_numbers(one, two):
@@ -33,36 +32,8 @@ def same_numbers(one, two):
     assert one.fit == two.fit
 
 
-class CrashingPowerLaw(PowerLaw):
-    """The power-law line, but a worker process (never the test's own) that
-    generates one dies on the spot: once per run (the first to create ``flag``),
-    or every time (``always``)."""
-
-    name = "crashing-power-law"
-
-    class Params(PowerLaw.Params):
-        flag: str
-        parent: int
-        always: bool = False
-
-    def generate(self, rng):
-        p = self.params
-        if os.getpid() != p.parent:
-            if p.always:
-                os._exit(3)
-            try:
-                os.close(os.open(p.flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
-            except FileExistsError:
-                pass
-            else:
-                os._exit(3)  # a killed worker: no exception, no cleanup
-        return super().generate(rng)
-
-
 def crashing(scene: Scene, flag, always: bool = False) -> Scene:
-    params = scene.spectrum.params.model_dump()
-    spectrum = CrashingPowerLaw(**params, flag=str(flag), parent=os.getpid(), always=always)
-    return Scene(preset=scene.preset, spectrum=spectrum, solver=scene.solver, slope=scene.slope)
+    return with_spectrum(scene, CrashingPowerLaw, flag=str(flag), parent=os.getpid(), always=always)
 
 
 @pytest.fixture(scope="module")

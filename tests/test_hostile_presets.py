@@ -7,6 +7,7 @@ test instead of the machine."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import resource
@@ -38,14 +39,18 @@ def _limit_memory() -> None:  # pragma: no cover - runs in the child
     resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
 
 
-def cli(*args: str, cwd: Path, timeout: float = 30) -> subprocess.CompletedProcess:
+def guarded_validate(folder: Path, *presets: str, timeout: float = 30) -> dict[str, dict]:
+    """``frictionlab validate --json PRESETS`` in a process with a deadline and a memory
+    limit: each preset's record (its problems and exit code), by the name it was given."""
     try:
-        return subprocess.run(
-            [sys.executable, "-m", "frictionlab", *args], capture_output=True, text=True, timeout=timeout,
-            cwd=cwd, preexec_fn=_limit_memory, env={**os.environ, "PYTHONPATH": str(ROOT)},
+        done = subprocess.run(
+            [sys.executable, "-m", "frictionlab", "validate", "--json", *presets], capture_output=True, text=True,
+            timeout=timeout, cwd=folder, preexec_fn=_limit_memory, env={**os.environ, "PYTHONPATH": str(ROOT)},
         )  # fmt: skip
     except subprocess.TimeoutExpired:
-        pytest.fail(f"frictionlab {' '.join(args)} still ran after {timeout} s")
+        pytest.fail(f"frictionlab validate {' '.join(presets)} still ran after {timeout} s")
+    assert "Traceback" not in done.stderr, done.stderr[-2000:]
+    return {record["preset"]: record for record in json.loads(done.stdout)["presets"]}
 
 
 ALIAS_BOMB = (
@@ -125,48 +130,43 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
 # ------------------------------------------------------------------ cases that hang or eat memory on their own
 
 
-def test_an_alias_bomb_is_refused_at_once_with_a_short_message(tmp_path):
-    (tmp_path / "p.yaml").write_text(BASE + ALIAS_BOMB + "description: *i\n")
-    done = cli("validate", "p.yaml", cwd=tmp_path)
-    assert done.returncode == ExitCode.INPUT_FILE
-    assert "expands to more than 20,000 values (aliases repeat what they refer to)" in done.stderr
-    assert len(done.stderr) < 1000
-
-
-def test_a_huge_preset_is_refused_by_its_size_before_it_is_read(tmp_path):
-    path = tmp_path / "p.yaml"
-    path.write_text(BASE)
-    os.truncate(path, 50 * 1024 * 1024)  # 50 MB (sparse: cheap to make)
-    done = cli("validate", "p.yaml", cwd=tmp_path, timeout=10)
-    assert done.returncode == ExitCode.INPUT_FILE
-    assert "preset file of 52,428,800 bytes, more than the limit of 262,144 bytes" in done.stderr
-
-
-def test_deep_nesting_is_refused(tmp_path):
-    (tmp_path / "p.yaml").write_text(BASE + "description: " + "[" * 5000 + "]" * 5000 + "\n")
-    done = cli("validate", "p.yaml", cwd=tmp_path)
-    assert done.returncode == ExitCode.INPUT_FILE
-    assert "nested more than 64 levels deep at line" in done.stderr
-
-
-@pytest.mark.parametrize("kind", ["fifo", "device"])
-def test_a_fifo_or_a_device_as_preset_is_refused_without_blocking(tmp_path, kind):
-    if kind == "fifo":
-        os.mkfifo(tmp_path / "p.yaml")
-        target, what = "p.yaml", "a FIFO (named pipe)"
-    else:
-        target, what = "/dev/zero", "a character device"
-    done = cli("validate", target, cwd=tmp_path, timeout=10)
-    assert done.returncode == ExitCode.INPUT_FILE
-    assert f"preset file is {what}, not a regular file" in done.stderr
-
-
-def test_a_huge_sweep_grid_is_counted_from_its_axes_and_refused(tmp_path):
+def write_hostile(folder: Path) -> None:
+    (folder / "bomb.yaml").write_text(BASE + ALIAS_BOMB + "description: *i\n")
+    (folder / "huge.yaml").write_text(BASE)
+    os.truncate(folder / "huge.yaml", 50 * 1024 * 1024)  # 50 MB (sparse: cheap to make)
+    (folder / "deep.yaml").write_text(BASE + "description: " + "[" * 5000 + "]" * 5000 + "\n")
+    os.mkfifo(folder / "fifo.yaml")
     axes = {"spectrum.params.hurst": {"start": 0.1, "stop": 1.0, "num": 1000}, "seed": {"start": 0, "stop": 999, "num": 1000}}
-    (tmp_path / "p.yaml").write_text(preset_text(sweep={"parameters": axes}))
-    done = cli("validate", "p.yaml", cwd=tmp_path)
-    assert done.returncode == ExitCode.USAGE
-    assert "the sweep has 1,000,000 points (grid of 1000 x 1000); at most 1,000 are allowed" in done.stderr
+    (folder / "grid.yaml").write_text(preset_text(sweep={"parameters": axes}))
+
+
+# preset: (exit code, what its one problem says); all validated by one guarded process
+HOSTILE = {
+    "bomb.yaml": (ExitCode.INPUT_FILE, "expands to more than 20,000 values (aliases repeat what they refer to)"),
+    "huge.yaml": (ExitCode.INPUT_FILE, "preset file of 52,428,800 bytes, more than the limit of 262,144 bytes"),
+    "deep.yaml": (ExitCode.INPUT_FILE, "nested more than 64 levels deep at line"),
+    "fifo.yaml": (ExitCode.INPUT_FILE, "preset file is a FIFO (named pipe), not a regular file"),
+    "/dev/zero": (ExitCode.INPUT_FILE, "preset file is a character device, not a regular file"),
+    "grid.yaml": (ExitCode.USAGE, "the sweep has 1,000,000 points (grid of 1000 x 1000); at most 1,000 are allowed"),
+}
+if os.path.exists("/proc/self/fd"):  # a kernel's /proc is Linux's; /proc's files say they are regular, some block for ever
+    HOSTILE["/proc/self/status"] = (ExitCode.INPUT_FILE, "preset file is in the kernel's /proc or /sys (a read may block), not a data file")
+
+
+@pytest.fixture(scope="module")
+def hostile_records(tmp_path_factory) -> dict[str, dict]:
+    folder = tmp_path_factory.mktemp("hostile")
+    write_hostile(folder)
+    return guarded_validate(folder, *HOSTILE)
+
+
+@pytest.mark.parametrize("preset", list(HOSTILE))
+def test_a_preset_that_could_hang_or_eat_memory_is_refused_at_once_with_a_short_message(preset, hostile_records):
+    code, message = HOSTILE[preset]
+    record = hostile_records[preset]
+    assert record["exit_code"] == code and not record["ok"], record
+    assert len(record["problems"]) == 1 and message in record["problems"][0], record
+    assert len(record["problems"][0]) < 1000
 
 
 def test_a_closed_stdout_ends_the_command_quietly(tmp_path):
@@ -217,11 +217,8 @@ def test_a_fifo_as_profile_file_is_refused_when_the_preset_is_validated(tmp_path
 
 
 @pytest.mark.skipif(not os.path.exists("/proc/self/fd"), reason="a kernel's /proc is Linux's")
-def test_a_file_of_the_kernel_s_proc_is_refused_as_preset_and_as_data(tmp_path, capsys):
-    """/proc's files say they are regular; some block for ever on read (/proc/kmsg)."""
-    done = cli("validate", "/proc/self/status", cwd=tmp_path, timeout=10)
-    assert done.returncode == ExitCode.INPUT_FILE
-    assert "preset file is in the kernel's /proc or /sys (a read may block), not a data file" in done.stderr
+def test_a_file_of_the_kernel_s_proc_is_refused_as_data(tmp_path, capsys):
+    """As a preset: ``HOSTILE`` above."""
     assert main(["validate", str(profile_preset(tmp_path, "/proc/cpuinfo"))]) == ExitCode.USAGE
     assert "profile-file '/proc/cpuinfo': file is in the kernel's /proc or /sys" in capsys.readouterr().err
 

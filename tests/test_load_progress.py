@@ -134,9 +134,15 @@ class CountdownCancel:
         return self.checks < 0
 
 
-def test_bem_reports_every_iteration_of_every_load_to_the_listener(registry):
+@pytest.fixture(scope="module")
+def long_loads(registry):
+    """The scene of ``LONG_LOADS`` and its realization 0, computed once for the module (seconds)."""
     scene = build_scene(LONG_LOADS, registry=registry)
-    realization = compute_realization(scene, 0)
+    return scene, compute_realization(scene, 0)
+
+
+def test_bem_reports_every_iteration_of_every_load_to_the_listener(long_loads):
+    scene, realization = long_loads
     heard = []
     profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
     slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
@@ -159,12 +165,12 @@ def test_bem_reports_every_iteration_of_every_load_to_the_listener(registry):
     np.testing.assert_array_equal(curve.contact_count, realization.contact_count)
 
 
-def test_a_cancel_seen_within_a_solve_abandons_the_realization(registry):
-    scene = build_scene(LONG_LOADS, registry=registry)
+def test_a_cancel_seen_within_a_solve_abandons_the_realization(long_loads):
+    scene, whole = long_loads
     with pytest.raises(SolveCancelled):
         compute_realization(scene, 0, cancel=CountdownCancel(checks=20))  # 2 between stages, then per iteration
     assert compute_chunk(scene, [0, 1], cancel=CountdownCancel(checks=20)) == []
-    whole = compute_realization(scene, 0, cancel=CountdownCancel(checks=10**9))
+    # a cancel never set changes nothing: the numbers of the realization computed without one
     assert compute_chunk(scene, [0], cancel=CountdownCancel(checks=10**9))[0].xi.tolist() == whole.xi.tolist()
 
 

@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -94,10 +92,10 @@ def test_bad_units_are_named(loading, words):
         build_scene({**LINE, "loading": loading})
 
 
-def test_validate_prints_the_force_unit_the_loads_in_every_unit_and_full_contact():
-    out = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart", "--set", "loading.unit=f",
-                          "--set", "loading.start=0.001", "--set", "loading.stop=0.1"],
-                         capture_output=True, text=True, check=True).stdout  # fmt: skip
+def test_validate_prints_the_force_unit_the_loads_in_every_unit_and_full_contact(cli):
+    done = cli("validate", "quickstart", "--set", "loading.unit=f", "--set", "loading.start=0.001", "--set", "loading.stop=0.1")
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
     assert "force unit E* h L = 4096 (modulus x length^2)" in out
     assert "f = 0.001 .. 0.1" in out and "F = 4.096 .. 409.6 (modulus x length^2)" in out
     assert "p/E* = 3.108e-07 .. 3.108e-05" in out  # 4.096 / (pi 4096^2 / 4)
@@ -119,13 +117,12 @@ def test_validate_calls_the_free_boundary_s_full_contact_an_estimate():
     assert record["full_contact"]["how"].startswith("estimate") and record["range"]["pressure"] is not None
 
 
-def test_a_load_past_the_free_solver_s_arithmetic_is_refused_naming_the_limit(tmp_path):
+def test_a_load_past_the_free_solver_s_arithmetic_is_refused_naming_the_limit(tmp_path, cli):
     preset = with_loading({**SURFACE, "solver": {"name": "bem-halfspace-free"}}, start=1.0, stop=1e39)
     with pytest.raises(PresetError, match=r"f <= 1e\+30") as caught:
         frictionlab.run(preset, out=tmp_path / "run", **FAST)
     assert "loading.stop" in str(caught.value) and not (tmp_path / "run").exists()
-    done = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "mdr-vs-halfspace", "--set",
-                           "solver.name=bem-halfspace-free", "--set", "loading.stop=1e39"], capture_output=True, text=True)  # fmt: skip
+    done = cli("validate", "mdr-vs-halfspace", "--set", "solver.name=bem-halfspace-free", "--set", "loading.stop=1e39")
     assert done.returncode != 0 and "f <= 1e+30" in done.stderr and "Traceback" not in done.stderr
 
 
@@ -147,11 +144,10 @@ def test_loads_that_press_the_same_point_fit_no_law(tmp_path):
     assert frictionlab.load(tmp_path / "run").fit is None
 
 
-def test_loads_all_in_full_contact_fit_no_law_and_the_cli_says_so(tmp_path):
+def test_loads_all_in_full_contact_fit_no_law_and_the_cli_says_so(tmp_path, cli):
     path = tmp_path / "full.yaml"
     path.write_text(json.dumps(with_loading(LINE, start=1e6, stop=1e7)))
-    done = subprocess.run([sys.executable, "-m", "frictionlab", "run", str(path), "--out", str(tmp_path / "o"),
-                           "--quiet", "--no-plot"], capture_output=True, text=True)  # fmt: skip
+    done = cli("run", path, "--out", tmp_path / "o", "--quiet", "--no-plot")
     assert done.returncode != 0 and "no law: the whole profile is in contact at every load" in done.stderr
     assert "R^2" not in done.stdout and "Traceback" not in done.stderr
 
@@ -240,13 +236,12 @@ def test_the_free_boundary_s_corrected_area_of_a_hertz_contact_is_pi_a_squared()
     "frictionlab validate mdr-vs-halfspace --set solver.name=bem-halfspace-free --set loading.stop=1e39",
     "frictionlab run quickstart --set loading.start=1e4 --set loading.stop=1e5 --no-plot",
 ])  # fmt: skip
-def test_the_loads_page_shows_what_the_commands_print(command, tmp_path):
+def test_the_loads_page_shows_what_the_commands_print(command, tmp_path, cli):
     """docs/how-to/loads.md: each output shown is printed by its command (wall times and folders aside)."""
     from tests.test_docs_outputs import ROOT, _comparable, _shown_block
 
     argv = command.split()
-    done = subprocess.run([sys.executable, "-m", "frictionlab", *argv[1:]], capture_output=True, text=True,
-                          cwd=tmp_path)  # fmt: skip
+    done = cli(*argv[1:], cwd=tmp_path)
     printed = {line.strip() for line in (done.stdout + done.stderr).splitlines()}
     shown = [line.strip() for line in _shown_block("docs/how-to/loads.md", f"$ {command}") if _comparable(line)]
     assert ROOT.is_dir() and shown and not [line for line in shown if line not in printed]
@@ -272,10 +267,8 @@ def test_a_contact_fraction_search_says_its_load_and_stops_on_cancel(monkeypatch
     assert heard[0] == 1 and heard[-1] == 2  # the iterations of the search are said as their load's
 
 
-def test_validate_warns_of_loads_past_full_contact():
-    out = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart", "--set", "loading.stop=1e4"],
-                         capture_output=True, text=True, check=True).stdout  # fmt: skip
-    assert "caveat: the last loads are past full contact" in out
-    out = subprocess.run([sys.executable, "-m", "frictionlab", "validate", "quickstart"], capture_output=True,
-                         text=True, check=True).stdout  # fmt: skip
-    assert "past full contact" not in out
+def test_validate_warns_of_loads_past_full_contact(cli):
+    done = cli("validate", "quickstart", "--set", "loading.stop=1e4")
+    assert done.returncode == 0 and "caveat: the last loads are past full contact" in done.stdout, done.stderr
+    done = cli("validate", "quickstart")
+    assert done.returncode == 0 and "past full contact" not in done.stdout, done.stderr

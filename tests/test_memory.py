@@ -234,6 +234,7 @@ needs_dask = pytest.mark.skipif(distributed is None, reason='dask is not install
 
 
 @needs_dask
+@pytest.mark.long  # a Dask cluster of its own (seconds); the refusal's arithmetic is checked above without one
 def test_cli_refuses_a_grid_too_large_for_the_dask_worker_before_submitting_anything(tmp_path, capsys, small_worker_cluster):
     scheduler, worker = small_worker_cluster
     path = tmp_path / "p.yaml"
@@ -254,6 +255,7 @@ def test_cli_refuses_a_grid_too_large_for_the_dask_worker_before_submitting_anyt
 
 
 @needs_dask
+@pytest.mark.long  # the same cluster
 def test_a_grid_that_fits_gives_the_serial_numbers_and_no_memory_check_skips_the_refusal(registry, tmp_path, small_worker_cluster):
     import threading
 

@@ -100,9 +100,11 @@ def test_the_framework_uses_nothing_of_a_plugin_beyond_the_contract(tmp_path, re
     }  # fmt: skip
     surface = {**line, "spectrum": {"name": "strict-power-law-2d", "params": {"hurst": 0.8, "points": 16}}}
     one = RunOptions(workers=1)
-    for data, solver in ((line, "strict-mdr"), (surface, "strict-mdr"), (surface, "strict-winkler"),
-                         (surface, "strict-bem-halfspace")):  # fmt: skip
-        scene = build_scene({**data, "solver": {"name": solver}}, registry=registry)
+    # plot.png (a second of drawing each) for the line and the half-space: the figure reads the same
+    # plugin attributes whatever the solver, so the other two runs leave it out
+    for data, solver, plot in ((line, "strict-mdr", True), (surface, "strict-mdr", False),
+                               (surface, "strict-winkler", False), (surface, "strict-bem-halfspace", True)):  # fmt: skip
+        scene = build_scene({**data, "solver": {"name": solver}, "output": {"plot": plot}}, registry=registry)
         outcome, _ = run_to_folder(scene, tmp_path / f"{solver}-{scene.geometry}", one)
         assert outcome.status == "completed" and not outcome.failures, outcome.failures
     sweep = plan_sweep({**line, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}, registry=registry)

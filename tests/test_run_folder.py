@@ -133,36 +133,6 @@ def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists
     assert listed
 
 
-def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(tmp_path, monkeypatch, capsys):
-    from frictionlab.preset import apply_overrides, load_preset_file
-    from frictionlab.paper.figures import FIGURES
-
-    from .conftest import PRESETS
-    from .paper.test_reproduce import TINY
-
-    presets = tmp_path / "presets"
-    for fig in FIGURES:
-        data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
-        if data.get("sweep"):
-            data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
-        write(presets / fig.preset, data)
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "REPRODUCTION.md").write_text("# my tracked report\n\n## Readings\n")
-    assert main(["report", "--presets", str(presets), "--quiet", "--workers", "1"]) == ExitCode.OK
-    assert (tmp_path / "REPRODUCTION.md").read_text() == "# my tracked report\n\n## Readings\n"
-    written = Path(capsys.readouterr().out.strip())
-    assert written.parent.parent == Path("runs") and written.parent.name.startswith("report-")
-    assert "Wall time of the whole report" in written.read_text()
-    assert (written.parent / "figures" / "fig2.png").stat().st_size > 1000
-
-    assert main(["report", "--presets", str(presets), "--markdown", "REPRODUCTION.md"]) == ExitCode.OUTPUT_REFUSED
-    assert "the report would overwrite REPRODUCTION.md" in capsys.readouterr().err
-    assert (tmp_path / "REPRODUCTION.md").read_text() == "# my tracked report\n\n## Readings\n"
-
-
-# ------------------------------------------------------------------ manifest, lock, chunks
-
-
 def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_scene, tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)  # each chunk written as it finishes
     scene = make_scene({"realizations": 30, **NO_PLOT})

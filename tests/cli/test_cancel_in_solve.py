@@ -14,8 +14,8 @@ import pytest
 
 from frictionlab.errors import ExitCode
 
-from ..conftest import SMALL_PRESET, merge
-from .conftest import run_cli, write_preset
+from ..conftest import SMALL_PRESET, merge, run_cli
+from .conftest import write_preset
 
 # Each realization solves for a second or more at a tight tolerance; the run's first
 # realization is solved alone, so a line about a later one means realization 0 is stored.
@@ -72,7 +72,7 @@ def _wait_for_a_later_solve(proc) -> list[str]:
 )
 def test_a_signal_stops_the_solve_within_a_second_and_resume_gives_the_same_numbers(
     uninterrupted, tmp_path, workers, signum, code
-):
+, cli):
     preset, whole = uninterrupted
     out = tmp_path / "out"
     proc = subprocess.Popen(
@@ -101,7 +101,7 @@ def test_a_signal_stops_the_solve_within_a_second_and_resume_gives_the_same_numb
     assert 1 <= summary["realizations"]["done"] < REALIZATIONS  # realization 0 kept, the one solving abandoned
     assert summary["realizations"]["failed"] == 0
 
-    resumed = run_cli("resume", out)
+    resumed = cli("resume", out)
     assert resumed.returncode == 0, resumed.stderr
     assert json.loads((out / "summary.json").read_text())["status"] == "completed"
     expected, got = np.load(whole / "realizations.npz"), np.load(out / "realizations.npz")

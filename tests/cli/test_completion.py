@@ -18,8 +18,8 @@ from frictionlab.options import EXECUTORS
 from frictionlab.preset import preset_json_schema, set_path
 from frictionlab.preset.builtin import builtin_presets
 
-from ..conftest import SMALL_PRESET, merge
-from .conftest import run_cli
+from ..conftest import SMALL_PRESET, merge, run_cli
+
 
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 NAMES = [command.__name__.rsplit(".", 1)[-1] for command in COMMANDS]
@@ -153,9 +153,9 @@ def zsh_tab(script, line: str) -> str:
 
 
 @pytest.mark.skipif(shutil.which("zsh") is None, reason="zsh is not installed (the script is still checked as text below)")
-def test_zsh_completion_by_tab_in_an_interactive_zsh(tmp_path):
+def test_zsh_completion_by_tab_in_an_interactive_zsh(tmp_path, cli):
     script = tmp_path / "_frictionlab"
-    script.write_text(run_cli("completion", "zsh").stdout)
+    script.write_text(cli("completion", "zsh").stdout)
     listed = zsh_tab(script, "frictionlab re")
     assert "report" in listed and "resume" in listed and "validate" not in listed
     assert "frictionlab run quickstart" in zsh_tab(script, "frictionlab run qu")
@@ -165,9 +165,9 @@ def test_zsh_completion_by_tab_in_an_interactive_zsh(tmp_path):
 
 
 @pytest.mark.skipif(shutil.which("fish") is None, reason="fish is not installed (the script is still checked as text below)")
-def test_fish_completion_in_a_real_fish(tmp_path):
+def test_fish_completion_in_a_real_fish(tmp_path, cli):
     script = tmp_path / "frictionlab.fish"
-    script.write_text(run_cli("completion", "fish").stdout)
+    script.write_text(cli("completion", "fish").stdout)
 
     def complete(line: str) -> list[str]:
         code = f"source {shlex.quote(str(script))}; complete -C {shlex.quote(line)}"
@@ -192,10 +192,10 @@ def test_fish_completion_in_a_real_fish(tmp_path):
     assert complete("frictionlab presets ") == ["copy"]
 
 
-def test_zsh_and_fish_scripts_are_made_from_the_same_walk():
-    zsh = run_cli("completion", "zsh").stdout
+def test_zsh_and_fish_scripts_are_made_from_the_same_walk(cli):
+    zsh = cli("completion", "zsh").stdout
     assert zsh.startswith("#compdef frictionlab\n") and "bashcompinit" in zsh and "complete -F _frictionlab frictionlab" in zsh
-    fish = run_cli("completion", "fish").stdout
+    fish = cli("completion", "fish").stdout
     for name in NAMES:
         assert f"-n __fish_use_subcommand -a {name} " in fish
     assert "-n '__fish_seen_subcommand_from run' -l no-plot\n" in fish

@@ -1,6 +1,7 @@
-"""The CLI's conventions, each as a user meets it in a real process: version, a bare
-command, help with examples, --json, did-you-mean, a closed pipe, tables that fit the
-terminal, colour on a terminal only (NO_COLOR honoured), shell completion."""
+"""The CLI's conventions: version, a bare command, help with examples, --json,
+did-you-mean, a closed pipe, tables that fit the terminal, colour on a terminal only
+(NO_COLOR honoured), shell completion. What a command prints is checked in this process
+(the ``cli`` fixture); a closed pipe or stdout, and a terminal, in a real process."""
 
 from __future__ import annotations
 
@@ -18,7 +19,6 @@ from frictionlab.cli.main import COMMANDS, build_parser
 from frictionlab.errors import ExitCode
 
 from ..conftest import ROOT
-from .conftest import run_cli
 
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 COLOUR = re.compile(r"\x1b\[[0-9;]*3[0-7]m|\x1b\[[0-9;]*38;")  # a foreground colour, not bold or cursor moves
@@ -31,14 +31,14 @@ def subparsers():
     return action.choices
 
 
-def test_version_short_and_long():
+def test_version_short_and_long(cli):
     for flag in ("-V", "--version"):
-        done = run_cli(flag)
+        done = cli(flag)
         assert done.returncode == 0 and re.fullmatch(r"frictionlab \d+\.\d+\S*\n", done.stdout), done.stdout
 
 
-def test_bare_command_shows_a_short_help_with_every_command_and_examples():
-    done = run_cli()
+def test_bare_command_shows_a_short_help_with_every_command_and_examples(cli):
+    done = cli()
     assert done.returncode == 0 and done.stderr == ""
     assert "commands:" in done.stdout and "examples:" in done.stdout
     for name in NAMES:
@@ -47,7 +47,7 @@ def test_bare_command_shows_a_short_help_with_every_command_and_examples():
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_every_command_help_has_a_description_and_examples_that_parse(name):
+def test_every_command_help_has_a_description_and_examples_that_parse(name, cli):
     command = subparsers()[name]
     assert command.description and len(command.description) > 20
     assert command.epilog and command.epilog.startswith("example")
@@ -56,7 +56,7 @@ def test_every_command_help_has_a_description_and_examples_that_parse(name):
     assert commands, command.epilog
     parsed = [build_parser().parse_args(argv[: argv.index(">")] if ">" in argv else argv) for argv in commands]
     assert name in {args.command for args in parsed}  # each parses; at least one shows this command
-    assert "example" in run_cli(name, "--help").stdout
+    assert "example" in cli(name, "--help").stdout
 
 
 @pytest.mark.parametrize("name", ["run", "validate", "plugins", "study", "report", "predict", "presets"])
@@ -65,26 +65,26 @@ def test_every_reporting_command_takes_json(name):
     assert "--json" in options
 
 
-def test_json_output_of_validate_plugins_and_predict_parses(tmp_path):
-    done = run_cli("validate", "quickstart", "--json")
+def test_json_output_of_validate_plugins_and_predict_parses(cli):
+    done = cli("validate", "quickstart", "--json")
     record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == 0 and record["ok"] and record["name"] == "quickstart"
-    done = run_cli("validate", "quickstart", "--set", "realizations=0", "--json")
+    done = cli("validate", "quickstart", "--set", "realizations=0", "--json")
     record = json.loads(done.stdout)["presets"][0]
     assert done.returncode == ExitCode.USAGE and not record["ok"] and record["problems"][0].startswith("realizations")
-    assert json.loads(run_cli("plugins", "--json").stdout)["plugins"]
-    done = run_cli("predict", "--a", "1.5", "--b", "0.1", "--area", "1", "--modulus", "1", "--rms-height", "1",
+    assert json.loads(cli("plugins", "--json").stdout)["plugins"]
+    done = cli("predict", "--a", "1.5", "--b", "0.1", "--area", "1", "--modulus", "1", "--rms-height", "1",
                    "--force", "1", "--json")  # fmt: skip
     out = json.loads(done.stdout)
     assert out["a"] == 1.5 and out["b"] == 0.1
 
 
-def test_did_you_mean_for_commands_and_plugins(tmp_path):
-    done = run_cli("rn", "quickstart")
+def test_did_you_mean_for_commands_and_plugins(cli):
+    done = cli("rn", "quickstart")
     assert done.returncode == ExitCode.USAGE and "did you mean 'run'" in done.stderr and "Traceback" not in done.stderr
-    done = run_cli("valdate", "quickstart")
+    done = cli("valdate", "quickstart")
     assert "did you mean 'validate'?" in done.stderr
-    done = run_cli("validate", "quickstart", "--set", "spectrum.name=power-lw")
+    done = cli("validate", "quickstart", "--set", "spectrum.name=power-lw")
     assert done.returncode == ExitCode.USAGE and "did you mean 'power-law'" in done.stderr
 
 
@@ -101,7 +101,8 @@ def test_a_closed_pipe_ends_quietly(argv, tmp_path):
     assert done.returncode == ExitCode.BROKEN_PIPE
 
 
-@pytest.mark.parametrize("argv", [["plugins"], ["--help"], ["-V"], ["run", "quickstart", "--no-plot", "--quiet"]])
+# the run's case is long: a whole run twice, its closed and full stdout met on the path the short commands take
+@pytest.mark.parametrize("argv", [["plugins"], ["--help"], ["-V"], pytest.param(["run", "quickstart", "--no-plot", "--quiet"], marks=pytest.mark.long)])
 def test_a_closed_stdout_is_written_nowhere_and_a_full_one_is_an_error(argv, tmp_path):
     run = lambda **how: subprocess.run([sys.executable, "-m", "frictionlab", *argv, *(["--out", str(tmp_path / ("closed" if "preexec_fn" in how else "full"))] if argv[0] == "run" else [])],
                                        stderr=subprocess.PIPE, text=True, cwd=tmp_path, timeout=120, **how)  # fmt: skip
@@ -151,26 +152,26 @@ def in_terminal(*argv: str, columns: int = 60, **env: str) -> str:
     return b"".join(chunks).decode("utf-8", "replace")
 
 
-def test_tables_fit_the_terminal_width_and_wrap_rather_than_cut():
+def test_tables_fit_the_terminal_width_and_wrap_rather_than_cut(cli):
     text = in_terminal("plugins", columns=60)
     lines = [ANSI.sub("", line) for line in text.replace("\r", "").splitlines() if line.strip()]
     assert lines and max(map(len, lines)) <= 60, max(lines, key=len)
     assert "power-law" in "".join(lines) and "forward-difference" in "".join(lines)
-    piped = run_cli("plugins").stdout  # in a pipe: one line per plugin, however long
+    piped = cli("plugins").stdout  # in a pipe: one line per plugin, however long
     assert max(map(len, piped.splitlines())) > 60 and not ANSI.search(piped)
 
 
-def test_colour_on_a_terminal_only_and_never_with_no_color():
+def test_colour_on_a_terminal_only_and_never_with_no_color(cli):
     assert COLOUR.search(in_terminal("presets"))
     assert not COLOUR.search(in_terminal("presets", NO_COLOR="1"))
-    assert not COLOUR.search(run_cli("presets").stdout)
+    assert not COLOUR.search(cli("presets").stdout)
     error = in_terminal("run", "no-such-preset")
     assert COLOUR.search(error) and "error" in ANSI.sub("", error)
     assert not COLOUR.search(in_terminal("run", "no-such-preset", NO_COLOR="1"))
 
 
-def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path):
-    done = run_cli("study", "quickstart", "--axes", "realizations", "--grid-realizations", "4", "--repeats", "1",
+def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path, cli):
+    done = cli("study", "quickstart", "--axes", "realizations", "--grid-realizations", "4", "--repeats", "1",
                    "--json", "--quiet", "--out", tmp_path / "study")  # fmt: skip
     assert done.returncode == 0, done.stderr
     out = json.loads(done.stdout)
@@ -192,36 +193,13 @@ def test_a_run_whose_reader_left_still_finishes_its_folder(tmp_path):
     assert state["status"] == "completed" and (tmp_path / "q" / "plot.png").is_file()
 
 
-def test_report_json_names_the_report_and_the_figures_it_shows(tmp_path, capsys):
-    from frictionlab.cli import main
-    from frictionlab.paper.figures import FIGURES
-    from frictionlab.preset import apply_overrides, load_preset_file
-
-    from ..conftest import PRESETS
-    from ..paper.test_reproduce import TINY
-
-    presets = tmp_path / "presets"
-    presets.mkdir()
-    for fig in FIGURES:
-        data = apply_overrides(load_preset_file(PRESETS / fig.preset), TINY)
-        if data.get("sweep"):
-            data["sweep"]["parameters"] = {"spectrum.params.hurst": {"values": [0.6, 1.0]}}
-        (presets / fig.preset).write_text(json.dumps(data))  # JSON is YAML
-    out = tmp_path / "report"
-    assert main(["report", "--presets", str(presets), "--out", str(out), "--quiet", "--workers", "1", "--json"]) == 0
-    printed = json.loads(capsys.readouterr().out)
-    assert printed["report"] == str(out / "REPRODUCTION.md")
-    assert printed["figures"] == [str(out / "figures" / f"{fig.key}.png") for fig in FIGURES]
-    assert all(os.path.getsize(figure) > 1000 for figure in printed["figures"])
-
-
-def test_tui_takes_a_builtin_name_and_a_mistyped_one_gets_the_closest_before_the_ui_starts(monkeypatch):
+def test_tui_takes_a_builtin_name_and_a_mistyped_one_gets_the_closest_before_the_ui_starts(monkeypatch, cli):
     from argparse import Namespace
 
     import frictionlab.tui
     from frictionlab.cli import tui
 
-    done = run_cli("tui", "quikstart")
+    done = cli("tui", "quikstart")
     assert done.returncode == ExitCode.INPUT_FILE and "did you mean 'quickstart'?" in done.stderr
     opened = []
     monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(preset) or 0)

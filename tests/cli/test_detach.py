@@ -12,34 +12,34 @@ import pytest
 from frictionlab.runs.detached import run_state
 
 from ..conftest import SMALL_PRESET, merge
-from .conftest import InTerminal, run_cli, write_preset
+from .conftest import InTerminal, write_preset
 
 
 @pytest.mark.long
-def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path):
+def test_run_detach_then_runs_and_follow_see_it_to_the_end(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
     out = tmp_path / "runs" / "one"
-    started = run_cli("run", preset, "--detach", "--json", "--workers", "1", "--out", out)
+    started = cli("run", preset, "--detach", "--json", "--workers", "1", "--out", out)
     assert started.returncode == 0, started.stderr
     told = json.loads(started.stdout)  # one JSON object
     assert told["folder"] == str(out) and told["status"] == "running" and told["pid"] > 0
-    listed = run_cli("runs", tmp_path / "runs", "--json")
+    listed = cli("runs", tmp_path / "runs", "--json")
     runs = json.loads(listed.stdout)["runs"]
     assert [r["folder"] for r in runs] == [str(out)] and runs[0]["status"] in ("running", "completed")
-    followed = run_cli("follow", out, "--json")
+    followed = cli("follow", out, "--json")
     assert followed.returncode == 0, followed.stderr
     end = json.loads(followed.stdout)
     assert (end["status"], end["done"], end["total"], end["pid"]) == ("completed", 40, 40, None)
     assert json.loads((out / "summary.json").read_text())["realizations"]["done"] == 40
-    table = run_cli("runs", tmp_path / "runs")
+    table = cli("runs", tmp_path / "runs")
     assert "completed" in table.stdout and "40/40" in table.stdout
 
 
 @pytest.mark.long
-def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path):
+def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
     out = tmp_path / "long"
-    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    told = json.loads(cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
     follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True)  # fmt: skip
     heading = follow.stderr.readline()  # the progress it follows (then a line a tenth, in a pipe)
@@ -53,69 +53,69 @@ def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path)
     assert "interrupted" in stdout and f"frictionlab resume {out} continues it" in stdout
 
 
-def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path):
+def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "notes.txt").write_text("keep")
-    refused = run_cli("run", preset, "--detach", "--out", mine)
+    refused = cli("run", preset, "--detach", "--out", mine)
     assert refused.returncode == 4 and "not empty" in refused.stderr
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]  # nothing written into the user's folder
     sweep = write_preset(tmp_path, merge(SMALL_PRESET, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}}), "sweep.yaml")
-    refused = run_cli("run", sweep, "--detach", "--out", mine)  # a sweep too
+    refused = cli("run", sweep, "--detach", "--out", mine)  # a sweep too
     assert refused.returncode == 4 and "not empty" in refused.stderr and "Traceback" not in refused.stderr
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
 
 
 @pytest.mark.long
-def test_a_detached_sweep_is_one_entry_of_runs_and_follow_shows_each_point_and_its_fit(tmp_path):
+def test_a_detached_sweep_is_one_entry_of_runs_and_follow_shows_each_point_and_its_fit(tmp_path, cli):
     data = merge(SMALL_PRESET, {"realizations": 20, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
     out = tmp_path / "runs" / "sw"
-    started = run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out)
+    started = cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out)
     assert started.returncode == 0, started.stderr
     told = json.loads(started.stdout)
     assert (told["folder"], told["kind"], told["status"]) == (str(out), "sweep", "running") and told["pid"] > 0
-    followed = run_cli("follow", out)
+    followed = cli("follow", out)
     assert followed.returncode == 0, followed.stderr
     rows = json.loads((out / "sweep.json").read_text())["points"]
     assert followed.stdout.startswith(f"small: completed, 2/2 points, in {out}/")
     for number, row in enumerate(rows, start=1):  # each point and its fit, as sweep.json has it
         assert f"{number}  hurst={row['spectrum.params.hurst']}: a = {row['a']:.4f}" in followed.stdout
-    end = json.loads(run_cli("follow", out, "--json").stdout)
+    end = json.loads(cli("follow", out, "--json").stdout)
     assert (end["kind"], end["status"], end["done"], end["total"], end["pid"]) == ("sweep", "completed", 2, 2, None)
     assert [p["a"] for p in end["points"]] == [row["a"] for row in rows]
-    listed = json.loads(run_cli("runs", tmp_path / "runs", "--json").stdout)["runs"]
+    listed = json.loads(cli("runs", tmp_path / "runs", "--json").stdout)["runs"]
     assert [(r["folder"], r["kind"], r["status"], r["done"], r["total"]) for r in listed] == [(str(out), "sweep", "completed", 2, 2)]
-    table = run_cli("runs", tmp_path / "runs").stdout
+    table = cli("runs", tmp_path / "runs").stdout
     assert "completed" in table and "2/2 points" in table
 
 
-def test_runs_and_follow_on_a_sweep_folder_whose_sweep_json_is_a_link_say_so_without_a_traceback(tmp_path):
+def test_runs_and_follow_on_a_sweep_folder_whose_sweep_json_is_a_link_say_so_without_a_traceback(tmp_path, cli):
     (tmp_path / "runs" / "bad").mkdir(parents=True)
     (tmp_path / "elsewhere.json").write_text("{}")
     (tmp_path / "runs" / "bad" / "sweep.json").symlink_to(tmp_path / "elsewhere.json")
-    listed = run_cli("runs", tmp_path / "runs")
+    listed = cli("runs", tmp_path / "runs")
     assert listed.returncode == 0 and "damaged" in listed.stdout  # listed, never hidden
     assert f"{tmp_path / 'runs' / 'bad'} is damaged: sweep.json is a symbolic link" in listed.stdout
-    followed = run_cli("follow", tmp_path / "runs" / "bad")
+    followed = cli("follow", tmp_path / "runs" / "bad")
     assert followed.returncode == 5 and "sweep.json" in followed.stderr and "Traceback" not in followed.stderr
 
 
-def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path):
-    missing = run_cli("runs", tmp_path / "nowhere")
+def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path, cli):
+    missing = cli("runs", tmp_path / "nowhere")
     assert missing.returncode == 5 and "DIR:" in missing.stderr and "does not exist" in missing.stderr
     (tmp_path / "plain").mkdir()
-    followed = run_cli("follow", tmp_path / "plain")
+    followed = cli("follow", tmp_path / "plain")
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
 
 
 @pytest.mark.long
-def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path):
+def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path, cli):
     data = merge(SMALL_PRESET, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
     out = tmp_path / "sw"
-    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    told = json.loads(cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
     follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True)  # fmt: skip
     heard = [follow.stderr.readline()]
@@ -133,10 +133,10 @@ def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(
 
 @pytest.mark.long
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
-def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path, signum, code):
+def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctrl_c(tmp_path, signum, code, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
     out = tmp_path / "long"
-    told = json.loads(run_cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
+    told = json.loads(cli("run", preset, "--detach", "--json", "--workers", "1", "--no-plot", "--out", out).stdout)
     try:
         follow = InTerminal("follow", out)
         deadline = time.monotonic() + 60
@@ -157,11 +157,11 @@ def test_follow_in_a_terminal_ends_its_bar_on_its_own_line_when_stopped_with_ctr
 
 
 @pytest.mark.long
-def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_bar_after_its_summary(tmp_path):
+def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_bar_after_its_summary(tmp_path, cli):
     data = merge(SMALL_PRESET, {"realizations": 20_000, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
     preset = write_preset(tmp_path, data, "sweep.yaml")
     out = tmp_path / "sw"
-    assert run_cli("run", preset, "--detach", "--workers", "1", "--no-plot", "--out", out).returncode == 0
+    assert cli("run", preset, "--detach", "--workers", "1", "--no-plot", "--out", out).returncode == 0
     follow = InTerminal("follow", out)
     assert follow.wait() == 0
     lines, column = follow.screen()
@@ -175,13 +175,13 @@ def test_follow_in_a_terminal_prints_a_sweeps_fits_on_lines_of_their_own_and_no_
 
 
 @pytest.mark.long
-def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path):
+def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
     out = tmp_path / "runs" / "quiet"
-    started = run_cli("run", preset, "--detach", "--quiet", "--workers", "1", "--no-plot", "--out", out)
+    started = cli("run", preset, "--detach", "--quiet", "--workers", "1", "--no-plot", "--out", out)
     assert started.returncode == 0, started.stderr
     assert started.stdout == f"{out}\n" and started.stderr == ""  # what a script captures: $(frictionlab run ...)
-    assert run_cli("follow", out, "--quiet").returncode == 0
-    resumed = run_cli("resume", out, "--detach", "--quiet")  # resume --detach too
+    assert cli("follow", out, "--quiet").returncode == 0
+    resumed = cli("resume", out, "--detach", "--quiet")  # resume --detach too
     assert resumed.returncode == 0 and resumed.stdout == f"{out}\n" and resumed.stderr == ""
-    assert run_cli("follow", out, "--quiet").returncode == 0
+    assert cli("follow", out, "--quiet").returncode == 0

@@ -14,7 +14,7 @@ from frictionlab.errors import ExitCode
 from frictionlab.preset.builtin import builtin_presets
 
 from ..conftest import SMALL_PRESET, merge
-from .conftest import run_cli, write_preset
+from .conftest import write_preset
 
 PREDICT = ["predict", "--area", "1e-4", "--modulus", "1e9", "--rms-height", "1e-6", "--force", "10"]
 
@@ -53,9 +53,9 @@ def test_every_command_with_json_has_its_refusal_checked_here(tmp_path):
 
 
 @pytest.mark.parametrize("command", sorted(commands_with_json()))
-def test_a_refusal_under_json_is_one_error_object_on_stdout(tmp_path, command):
+def test_a_refusal_under_json_is_one_error_object_on_stdout(tmp_path, command, cli):
     argv = refused(tmp_path)[command]
-    done = run_cli(*argv, "--json", cwd=tmp_path)
+    done = cli(*argv, "--json", cwd=tmp_path)
     assert done.returncode not in (ExitCode.OK, ExitCode.INTERNAL), done.stderr
     data = one_object(done.stdout)
     if command == "validate":  # its records say each preset's problems: a refusal of one is one record
@@ -67,9 +67,9 @@ def test_a_refusal_under_json_is_one_error_object_on_stdout(tmp_path, command):
     assert data["error"].splitlines()[0] in done.stderr  # a person watching reads it too
 
 
-def test_a_refused_preset_names_its_field_and_every_problem(tmp_path):
+def test_a_refused_preset_names_its_field_and_every_problem(tmp_path, cli):
     bad = write_preset(tmp_path, merge(SMALL_PRESET, {"spectrum": {"params": {"hurts": 0.8}}, "realizations": 0}))
-    done = run_cli("run", bad, "--json", "--out", tmp_path / "o")
+    done = cli("run", bad, "--json", "--out", tmp_path / "o")
     data = one_object(done.stdout)
     assert data["exit_code"] == ExitCode.USAGE == done.returncode and data["command"] == "run"
     assert data["field"] == "realizations" and len(data["problems"]) == 2

@@ -9,14 +9,13 @@ import pytest
 from frictionlab.errors import ExitCode
 
 from ..conftest import PRESETS
-from .conftest import run_cli
 
 
-def test_bad_command_line_is_a_usage_error_without_traceback():
-    result = run_cli("run")
+def test_bad_command_line_is_a_usage_error_without_traceback(cli):
+    result = cli("run")
     assert result.returncode == ExitCode.USAGE
     assert "usage:" in result.stderr and "Traceback" not in result.stderr
-    result = run_cli("run", PRESETS / "quickstart.yaml", "--workers", "0")
+    result = cli("run", PRESETS / "quickstart.yaml", "--workers", "0")
     assert result.returncode == ExitCode.USAGE
     assert "--workers must be >= 1. Got 0 instead." in result.stderr
 

@@ -20,14 +20,25 @@ import pytest
         (["schema", "--out", b"s\xff.json"], b"s\xff.json"),
     ],
 )
-def test_a_path_that_is_not_utf8_is_printed_escaped(tmp_path, encoding, argv, made):
-    env = {**os.environ, "PYTHONIOENCODING": encoding}  # strict: what raised before
-    done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, cwd=tmp_path, env=env,
-                          timeout=300)  # fmt: skip
+def test_a_path_that_is_not_utf8_is_printed_escaped(tmp_path, cli, encoding, argv, made):
+    done = cli(*argv, cwd=tmp_path, encoding=encoding)  # strict: what raised before
     assert done.returncode == 0, done.stderr
-    assert os.path.lexists(tmp_path / os.fsdecode(made))
+    assert_escaped(done, tmp_path, argv, made)
+
+
+def assert_escaped(done, folder, argv, made):
+    assert os.path.lexists(folder / os.fsdecode(made))
     printed = done.stdout + done.stderr
     assert b"\xff" not in printed  # the raw byte never reaches the terminal
     if argv[0] != "schema":  # schema --out prints nothing
         assert made.replace(b"\xff", b"\\xff") in printed, printed
 
+
+def test_the_streams_a_process_is_started_with_escape_it_too(tmp_path):
+    """The same in a process of its own, its streams made by PYTHONIOENCODING."""
+    argv, made = ["presets", "copy", "quickstart", b"q\xff.yaml"], b"q\xff.yaml"
+    env = {**os.environ, "PYTHONIOENCODING": "ascii"}
+    done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, cwd=tmp_path, env=env,
+                          timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert_escaped(done, tmp_path, argv, made)

@@ -15,7 +15,7 @@ from frictionlab.errors import ExitCode
 from frictionlab.runs.results import column_name
 
 from ..conftest import SMALL_PRESET, merge
-from .conftest import RUN_DIRECTORY, run_cli, write_preset
+from .conftest import RUN_DIRECTORY, write_preset
 
 
 def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, capsys):
@@ -79,9 +79,9 @@ def test_resolved_preset_reruns_to_the_same_numbers(tmp_path, capsys):
     assert (tmp_path / "one" / "curve.csv").read_text() == (tmp_path / "two" / "curve.csv").read_text()
 
 
-def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path):
+def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
-    result = run_cli(
+    result = cli(
         "run", preset, "--out", tmp_path / "o", "--json", "--quiet", "--workers", "1",
         "--set", "spectrum.params.hurst=0.5", "--set", "realizations=5", "--seed", "99",
     )  # fmt: skip
@@ -93,9 +93,9 @@ def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path):
     assert result.stderr == ""  # --quiet
 
 
-def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path):
+def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
-    result = run_cli("run", preset, "--out", tmp_path / "o", "--workers", "2")
+    result = cli("run", preset, "--out", tmp_path / "o", "--workers", "2")
     assert result.returncode == 0
     lines = result.stderr.strip().splitlines()
     assert lines[0].startswith("small: 40 realizations")
@@ -217,9 +217,9 @@ def test_output_switches_leave_out_the_per_realization_file_and_the_plot(tmp_pat
 
 
 @pytest.mark.parametrize("address", ["", "   "])
-def test_an_empty_scheduler_address_is_refused_not_taken_for_a_local_cluster(tmp_path, address):
+def test_an_empty_scheduler_address_is_refused_not_taken_for_a_local_cluster(tmp_path, address, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
-    result = run_cli("run", preset, "--out", tmp_path / "o", "--executor", "dask", "--scheduler", address)
+    result = cli("run", preset, "--out", tmp_path / "o", "--executor", "dask", "--scheduler", address)
     assert result.returncode == ExitCode.USAGE, result.stderr
     assert "--scheduler: the address is empty" in result.stderr
     assert not (tmp_path / "o").exists()

@@ -8,7 +8,7 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 
 from ..conftest import SMALL_PRESET, merge
-from .conftest import run_cli, write_preset
+from .conftest import write_preset
 
 
 def problems_of(tmp_path, capsys, data) -> str:
@@ -44,8 +44,8 @@ def test_a_field_far_from_every_name_gets_the_list_without_a_guess(tmp_path, cap
     assert "zzz: is not a known field; allowed: description, fit, loading" in err and "did you mean" not in err
 
 
-def test_an_unknown_option_gets_its_commands_usage_and_the_closest_option(tmp_path):
-    done = run_cli("run", "quickstart", "--ouy", "x", cwd=tmp_path)
+def test_an_unknown_option_gets_its_commands_usage_and_the_closest_option(tmp_path, cli):
+    done = cli("run", "quickstart", "--ouy", "x", cwd=tmp_path)
     assert done.returncode == ExitCode.USAGE and done.stdout == ""
     assert done.stderr.startswith("usage: frictionlab run ")
     assert "frictionlab run: error: unrecognized arguments: --ouy x; did you mean '--out'?" in done.stderr
@@ -73,13 +73,13 @@ def test_a_stray_word_is_refused_by_its_command_without_a_guess(capsys):
     assert err.splitlines()[-1] == "frictionlab run: error: unrecognized arguments: surplus"
 
 
-def test_a_missing_file_named_as_a_builtin_points_to_the_builtin(tmp_path):
+def test_a_missing_file_named_as_a_builtin_points_to_the_builtin(tmp_path, cli):
     """Outside the clone, the README's `frictionlab run presets/quickstart.yaml` has no file to read."""
-    done = run_cli("run", "presets/quickstart.yaml", cwd=tmp_path)
+    done = cli("run", "presets/quickstart.yaml", cwd=tmp_path)
     assert done.returncode == ExitCode.INPUT_FILE
     assert "no file 'presets/quickstart.yaml' here; the built-in preset of that name is 'quickstart'" in done.stderr
     assert "frictionlab run quickstart" in done.stderr
-    missing = run_cli("validate", "presets/mine.yaml", cwd=tmp_path)  # no built-in of that name: just missing
+    missing = cli("validate", "presets/mine.yaml", cwd=tmp_path)  # no built-in of that name: just missing
     assert missing.returncode == ExitCode.INPUT_FILE and "built-in" not in missing.stderr
 
 

@@ -1,11 +1,13 @@
 """The reproduction report: averaging readings against brute force, the h calibration
-against a known h, and the report's content on tiny presets (numbers from summary.json)."""
+against a known h, and the report's content on tiny presets (numbers from summary.json),
+its --json and where it writes, from one ``frictionlab report`` run for the module."""
 
 import io
 import json
 import math
 import os
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +15,7 @@ import yaml
 
 from frictionlab.compute import engine
 from frictionlab.cli import main
+from frictionlab.errors import ExitCode
 from frictionlab.options import RunOptions
 from frictionlab.paper.calibration import COUNT_TARGETS, calibrated_rms_height
 from frictionlab.paper.figures import FIGURES, find_presets, run_figures
@@ -25,11 +28,10 @@ from frictionlab.paper.readings import (
     refit,
     run_readings,
 )
-from frictionlab.paper.reproduce import write_report
 from frictionlab.preset import apply_overrides, build_scene, load_preset_file
 from frictionlab.runs.runner import run_to_folder
 
-from ..conftest import PRESETS, SMALL_PRESET
+from ..conftest import PRESETS, SMALL_PRESET, run_cli
 
 TINY = ["realizations=6", "spectrum.params.points=1024", "spectrum.params.length=1024.0", "output.plot=false",
         "spectrum.params.rms_height=300.0", "loading.steps=12", "fit.bootstrap=40"]  # fmt: skip
@@ -98,30 +100,64 @@ def test_calibration_recovers_a_known_rms_height(registry):
     assert calibrated_rms_height(data, targets, options=RunOptions(workers=1)) == pytest.approx(37.0, rel=0.03)
 
 
-def test_report_on_tiny_presets(tmp_path, tiny_presets):
-    md = tmp_path / "REPRODUCTION.md"
-    write_report(presets_dir=tiny_presets, out_dir=tmp_path / "runs", markdown_path=md,
-                 figures_dir=tmp_path / "docs" / "fig", options=RunOptions(workers=1))  # fmt: skip
-    text = md.read_text()
+MINE = "# my tracked report\n\n## Readings\n"
+
+
+@pytest.fixture(scope="module")
+def tiny_report(tmp_path_factory, tiny_presets):
+    """``frictionlab report --json`` of the tiny presets, run once for the module in a
+    folder that holds a REPRODUCTION.md of the user's: (that folder, the CompletedProcess)."""
+    folder = tmp_path_factory.mktemp("report")
+    (folder / "REPRODUCTION.md").write_text(MINE)
+    done = run_cli("report", "--presets", tiny_presets, "--quiet", "--workers", "1", "--json", cwd=folder)
+    assert done.returncode == ExitCode.OK, done.stderr
+    return folder, done
+
+
+def test_report_on_tiny_presets(tiny_report):
+    folder, done = tiny_report
+    md = folder / json.loads(done.stdout)["report"]
+    text, runs = md.read_text(), md.parent
     assert "Wall time of the whole report (Figs. 2 to 5):" in text
     for fig in FIGURES:
-        assert f"![{fig.title}](docs/fig/{fig.key}.png)" in text
-        assert (tmp_path / "docs" / "fig" / f"{fig.key}.png").stat().st_size > 1000
+        assert f"![{fig.title}](figures/{fig.key}.png)" in text
+        assert (runs / "figures" / f"{fig.key}.png").stat().st_size > 1000
     for key in ("fig2", "fig3", "fig4"):
-        fit = json.loads((tmp_path / "runs" / key / "summary.json").read_text())["fit"]
+        fit = json.loads((runs / key / "summary.json").read_text())["fit"]
         study = next(s for s in FIGURES if s.key == key)
         cell = f"| {study.a} | {fit['a']:.4f} [{fit['a_ci'][0]:.4f}, {fit['a_ci'][1]:.4f}]"
         assert cell in text
         assert f"{fit['b']:.4f} [{fit['b_ci'][0]:.4f}, {fit['b_ci'][1]:.4f}]" in text
-    rows = list(json.loads((tmp_path / "runs" / "fig5" / "sweep.json").read_text())["points"])
+    rows = list(json.loads((runs / "fig5" / "sweep.json").read_text())["points"])
     for row in rows:
         assert f"| {row['spectrum.params.hurst']:g} | {row['a']:.4f} [{row['a_lo']:.4f}, {row['a_hi']:.4f}]" in text
     assert "| Fig. 5 at H = 0.6 | about 2.9 |" in text  # the point nearest H = 0.7
     for key in ("fig2", "fig3", "fig4"):  # f as a plain number (was "1.22e+04e-9")
-        with np.load(tmp_path / "runs" / key / "realizations.npz") as data:
+        with np.load(runs / key / "realizations.npz") as data:
             f = data["f"]
         assert f"Over f = {f[0]:.3g} .. {f[-1]:.3g} the paper's law" in text
     assert not re.search(r"\de[+-]\d+e-9", text)
+
+
+def test_report_json_names_the_report_and_the_figures_it_shows(tiny_report):
+    folder, done = tiny_report
+    printed = json.loads(done.stdout)  # stdout is only the JSON
+    report = Path(printed["report"])
+    assert report.name == "REPRODUCTION.md"
+    assert printed["figures"] == [str(report.parent / "figures" / f"{fig.key}.png") for fig in FIGURES]
+    assert all(os.path.getsize(folder / figure) > 1000 for figure in printed["figures"])
+
+
+def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(tiny_report, tiny_presets, tmp_path, monkeypatch, capsys):
+    folder, done = tiny_report
+    assert (folder / "REPRODUCTION.md").read_text() == MINE  # the user's, in the folder the report ran from
+    written = Path(json.loads(done.stdout)["report"])
+    assert written.parent.parent == Path("runs") and written.parent.name.startswith("report-")
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "REPRODUCTION.md").write_text(MINE)
+    assert main(["report", "--presets", str(tiny_presets), "--markdown", "REPRODUCTION.md"]) == ExitCode.OUTPUT_REFUSED
+    assert "the report would overwrite REPRODUCTION.md" in capsys.readouterr().err
+    assert (tmp_path / "REPRODUCTION.md").read_text() == MINE
 
 
 @pytest.fixture(scope="module")
