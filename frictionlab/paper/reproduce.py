@@ -38,14 +38,21 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         raise OutputRefused(f"--markdown: {problem}; give a file in a folder you can write to")
     if markdown_path and Path(markdown_path).is_dir():
         raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
+    if not out_dir:  # what a fresh folder would hold is new: only a --markdown or --figures given can be taken
+        _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
     markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
     figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
-    taken = [p for p in (markdown_path, *(figures_dir / name for name in FIGURE_FILES)) if os.path.lexists(p)]
+    _refuse_overwriting(markdown_path, figures_dir, force)
+    return out_dir, markdown_path, figures_dir
+
+
+def _refuse_overwriting(markdown_path: Path | None, figures_dir: Path | None, force: bool) -> None:
+    figures = [figures_dir / name for name in FIGURE_FILES] if figures_dir else []
+    taken = [p for p in ([markdown_path] if markdown_path else []) + figures if os.path.lexists(p)]
     if taken and not force:
         shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
         raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")
-    return out_dir, markdown_path, figures_dir
 
 
 def write_report(

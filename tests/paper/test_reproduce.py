@@ -158,6 +158,7 @@ def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(
     assert main(["report", "--presets", str(tiny_presets), "--markdown", "REPRODUCTION.md"]) == ExitCode.OUTPUT_REFUSED
     assert "the report would overwrite REPRODUCTION.md" in capsys.readouterr().err
     assert (tmp_path / "REPRODUCTION.md").read_text() == MINE
+    assert not (tmp_path / "runs").exists()  # refused before its default folder was made
 
 
 @pytest.fixture(scope="module")
