@@ -37,7 +37,7 @@ def rms(a):
     return float(np.sqrt(np.mean(np.square(a))))
 
 
-def run_cli(tmp_path, data, capsys, *extra):
+def run_preset(tmp_path, data, capsys, *extra):
     """``frictionlab run`` in-process; (exit code, summary or None, stderr)."""
     path = tmp_path / "preset.yaml"
     path.write_text(yaml.safe_dump(data))
@@ -50,7 +50,7 @@ def run_cli(tmp_path, data, capsys, *extra):
 
 
 def finite_run(tmp_path, data, capsys):
-    code, summary, err = run_cli(tmp_path, data, capsys)
+    code, summary, err = run_preset(tmp_path, data, capsys)
     assert code == ExitCode.OK, err
     text = json.dumps(summary)
     assert "NaN" not in text and "Infinity" not in text, text[:500]
@@ -164,7 +164,7 @@ def test_far_past_full_contact(registry, solver, base):
 
 @pytest.mark.parametrize("start", [0.0, -2.0])
 def test_a_force_of_zero_or_below_is_a_usage_error(tmp_path, capsys, start):
-    code, summary, err = run_cli(tmp_path, merge(LINE, {"loading": {"start": start}}), capsys)
+    code, summary, err = run_preset(tmp_path, merge(LINE, {"loading": {"start": start}}), capsys)
     assert code == ExitCode.USAGE and summary is None
     assert f"loading.start: must be > 0.0, got {start}" in err
 
