@@ -5,6 +5,7 @@ and the ``--set`` spelling of a value."""
 from __future__ import annotations
 
 import copy
+import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -88,8 +89,13 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
 
 
 def yaml_scalar(value: Any) -> str:
-    """The ``--set`` spelling of ``value``: YAML that reads back as the same value."""
-    if isinstance(value, float) and math.isfinite(value):
+    """The ``--set`` spelling of ``value``: YAML that ``--set`` reads back as the same value
+    (nan and the infinities as ``.nan``, ``.inf``, ``-.inf``: a swept value its field refuses
+    is then refused by the field, with its message; text that would read as a number, such
+    as ``1e5``, double-quoted)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return ".nan" if math.isnan(value) else (".inf" if value > 0 else "-.inf")
+    if isinstance(value, float):
         text = repr(value)
         if "e" in text and "." not in text:  # PyYAML reads 1e-05 as text; 1.0e-05 as a float
             text = text.replace("e", ".0e", 1)
@@ -97,9 +103,20 @@ def yaml_scalar(value: Any) -> str:
             text = text.replace("e", "e+", 1)
     else:
         text = yaml.safe_dump(value, default_flow_style=True).removesuffix("\n...\n").strip()
-    if yaml.safe_load(text) != value or type(yaml.safe_load(text)) is not type(value):
+        if isinstance(value, str) and not _reads_back(text, value):  # PyYAML's plain 1e5: a number to --set
+            text = json.dumps(value)  # a JSON string is a YAML double-quoted one
+    if not _reads_back(text, value):
         raise ValueError(f"cannot spell {value!r} as a YAML scalar")
     return text
+
+
+def _reads_back(text: str, value: Any) -> bool:
+    """Whether ``--set`` reads ``text`` as ``value``, of its type."""
+    try:
+        read = load_yaml(text) if text.strip() else ""
+    except YamlProblem:
+        return False
+    return read == value and type(read) is type(value)
 
 
 def differences(old, new, path: str = "") -> list[str]:
