@@ -228,3 +228,19 @@ def test_a_npy_whose_header_asks_for_more_than_memory_is_refused_with_its_size(t
         fh.write(bytes(64))
     with pytest.raises(ValueError, match=r"shape \(8388608, 4194304\) \(2.62e\+05 GiB\) does not fit in this process's memory"):
         SurfaceFile(path=str(path), spacing=1.0).rms_height()
+
+
+@pytest.mark.parametrize(("region", "said"), [
+    ({"x": [True, 20]}, "spectrum.params.region.x[0]: must be a number, not true or false, got true"),
+    ({"y": [0, False]}, "spectrum.params.region.y[1]: must be a number, not true or false, got false"),
+    ({"x": [0, float("nan")], "units": "length"}, "spectrum.params.region.x[1]: must be a finite number, got nan"),
+])  # fmt: skip
+def test_a_region_bound_of_true_false_or_nan_is_refused_by_its_place(tmp_path, registry, region, said):
+    """A region's bounds are an optional pair (tuple | None): true was taken as pixel 1 before
+    the number check looked inside optional lists and tuples."""
+    path, _ = power_law_map(tmp_path, points=16)
+    data = surface_preset(path, "mdr")
+    data["spectrum"]["params"]["region"] = region
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    assert said in str(info.value)

@@ -150,6 +150,11 @@ def _nested_model(annotation) -> type[BaseModel] | None:
     return None
 
 
+def _sequence_kind(kinds: set):
+    """The list or tuple type among a field's kinds (``tuple[float, float] | None``: the tuple), or None."""
+    return next((kind for kind in kinds if typing.get_origin(kind) in (list, tuple)), None)
+
+
 def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
     if isinstance(value, bool):
         return f"{path}: must be a number, not true or false, got {str(value).lower()}"
@@ -190,8 +195,8 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
         elif kinds & {int, float} and bool not in kinds:
             problem = _number_problem(value, path, allow)
             problems += [problem] if problem else []
-        elif typing.get_origin(field.annotation) in (list, tuple) and isinstance(value, list):
-            items = set().union(*(_kinds(a) for a in typing.get_args(field.annotation) if a is not Ellipsis))
+        elif (sequence := _sequence_kind(kinds)) is not None and isinstance(value, list):
+            items = set().union(*(_kinds(a) for a in typing.get_args(sequence) if a is not Ellipsis))
             if items & {int, float} and bool not in items:
                 problems += [p for i, v in enumerate(value) if (p := _number_problem(v, f"{path}[{i}]", allow))]
     return problems
