@@ -244,3 +244,13 @@ def test_a_region_bound_of_true_false_or_nan_is_refused_by_its_place(tmp_path, r
     with pytest.raises(PresetError) as info:
         build_scene(data, registry=registry)
     assert said in str(info.value)
+
+
+def test_a_map_of_heights_below_1e_minus_100_is_named_too_small_not_constant(tmp_path):
+    """Heights of 1e-300 vary, but their squares underflow: the rms was 0 and the map was called
+    constant; it is named for its size."""
+    np.save(tmp_path / "tiny.npy", np.random.default_rng(2).standard_normal((16, 16)) * 1e-300)
+    message = surface_error(tmp_path / "tiny.npy")
+    assert "every value in heights is below 1e-100 in magnitude" in message and "constant" not in message
+    np.save(tmp_path / "zero.npy", np.zeros((16, 16)))
+    assert "the map is constant" in surface_error(tmp_path / "zero.npy")  # a flat map stays flat

@@ -298,7 +298,8 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
 
 def check_finite(where: str, what: str, values: np.ndarray) -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
-    magnitude (1e100: squares and sums of them must stay finite), locating the first."""
+    magnitude (1e100: squares and sums of them must stay finite), locating the first; or naming
+    values that are all nonzero and below 1e-100 (their rms underflows: no "constant" map)."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
@@ -307,6 +308,12 @@ def check_finite(where: str, what: str, values: np.ndarray) -> None:
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
             f"in magnitude, the first at {at}"
+        )
+    largest = max(float(np.max(values)), -float(np.min(values))) if values.size else 0.0  # no copy of a large map
+    if 0.0 < largest < 1.0 / MAX_MAGNITUDE:  # not flat: too small for the squares of an rms, which underflow to 0
+        raise ValueError(
+            f"{where}: every value in {what} is below {1.0 / MAX_MAGNITUDE:g} in magnitude (the largest "
+            f"{largest:.3g}), too small for a run's arithmetic; store them in a unit that makes them larger"
         )
 
 
