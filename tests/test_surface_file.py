@@ -254,3 +254,13 @@ def test_a_map_of_heights_below_1e_minus_100_is_named_too_small_not_constant(tmp
     assert "every value in heights is below 1e-100 in magnitude" in message and "constant" not in message
     np.save(tmp_path / "zero.npy", np.zeros((16, 16)))
     assert "the map is constant" in surface_error(tmp_path / "zero.npy")  # a flat map stays flat
+
+
+@pytest.mark.parametrize("downsample", [{"factor": 1_000_000}, {"pixel": 1e9}])
+def test_a_map_downsampled_to_one_pixel_is_named_too_small_not_constant(tmp_path, downsample):
+    """The size after downsampling was checked after the rms: one pixel left has rms 0, and the
+    map was called constant."""
+    path, _ = power_law_map(tmp_path, points=32)
+    message = surface_error(path, downsample=downsample)
+    assert "after the crop, resampling and downsampling the map has 1 x 1 pixels (x by y); at least 8 x 8" in message
+    assert "constant" not in message

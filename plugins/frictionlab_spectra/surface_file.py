@@ -194,16 +194,16 @@ class SurfaceFile(MeasuredFile):
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
         summary.update(shaped)
-        rms = float(np.std(heights))
+        if min(heights.shape) < MIN_SIDE:
+            nx, ny = heights.shape[::-1]
+            raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
+                             f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
+        rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
         if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
             raise ValueError(
                 f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}); "
                 "a flat surface has no roughness"
             )
-        if min(heights.shape) < MIN_SIDE:
-            nx, ny = heights.shape[::-1]
-            raise ValueError(f"{where}: after the crop and resampling the map has {nx} x {ny} pixels (x by y); at "
-                             f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         heights.flags.writeable = False
         summary.update(shape=list(heights.shape), spacing=float(spacing), rms_height=rms)
         return Measured(heights, spacing, rms, summary["periodic"], summary)
