@@ -264,3 +264,20 @@ def test_a_map_downsampled_to_one_pixel_is_named_too_small_not_constant(tmp_path
     message = surface_error(path, downsample=downsample)
     assert "after the crop, resampling and downsampling the map has 1 x 1 pixels (x by y); at least 8 x 8" in message
     assert "constant" not in message
+
+
+@pytest.mark.parametrize(("channel", "said"), [
+    (-1, "spectrum.params.channel: must be >= 0, got -1"),
+    (1.5, "spectrum.params.channel: must be text or a whole number, got 1.5"),
+    ([0], "spectrum.params.channel: must be text or a whole number, got [0]"),
+    (True, "spectrum.params.channel: must be text or a number, not true or false, got true"),
+])  # fmt: skip
+def test_a_bad_channel_is_named_at_its_own_path(tmp_path, registry, channel, said):
+    """channel is text or an index >= 0 (Annotated[int, Field(ge=0)]): -1 was said at
+    'channel.constrained-int', pydantic's tag of the index, and true was taken as channel 1."""
+    path, _ = power_law_map(tmp_path, points=16)
+    data = surface_preset(path, "mdr")
+    data["spectrum"]["params"]["channel"] = channel
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    assert said in str(info.value) and "constrained" not in str(info.value)
