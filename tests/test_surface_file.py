@@ -281,3 +281,13 @@ def test_a_bad_channel_is_named_at_its_own_path(tmp_path, registry, channel, sai
     with pytest.raises(PresetError) as info:
         build_scene(data, registry=registry)
     assert said in str(info.value) and "constrained" not in str(info.value)
+
+
+@pytest.mark.parametrize("name", ["map.npy", "map.csv", "map.sur", "map.dat"])
+def test_an_empty_file_is_named_empty_whatever_its_suffix(tmp_path, registry, name):
+    """A 0-byte file was 'not a readable .npy array (EOFError)', 'array of shape (0, 1)' or 'a
+    damaged Digital Surf SUR file', by suffix; it is refused as empty before any reader."""
+    (tmp_path / name).write_bytes(b"")
+    with pytest.raises(PresetError) as info:
+        build_scene(surface_preset(str(tmp_path / name), "mdr"), registry=registry)
+    assert f"spectrum.params.path: is empty (0 bytes), it holds no heights, got '{tmp_path / name}'" in str(info.value)
