@@ -112,6 +112,19 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
 
 
+def test_presets_copy_into_a_missing_folder_or_under_a_file_is_refused_naming_it(tmp_path, capsys):
+    """open() of DEST in a folder that does not exist said only "No such file or directory"
+    with exit code 1; the folder is named, with exit code 4, and nothing is made."""
+    from frictionlab.cli import main
+
+    (tmp_path / "file.txt").write_text("mine")
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "missing" / "q.yaml")]) == ExitCode.OUTPUT_REFUSED
+    assert f"the folder {tmp_path / 'missing'} does not exist; make the folder first" in capsys.readouterr().err
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "file.txt" / "q.yaml")]) == ExitCode.OUTPUT_REFUSED
+    assert f"{tmp_path / 'file.txt'} is a file, not a folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file.txt"] and (tmp_path / "file.txt").read_text() == "mine"
+
+
 CTRL_C_WHILE_LOADING = """
 import sys
 loading = sys.argv[1]
