@@ -83,3 +83,10 @@ def _use_tls_options(args) -> None:
         from ..compute.dask_security import check_address
 
         check_address(args.scheduler)
+
+
+def refuse_empty_folder(value: str | None, option: str) -> None:
+    """A usage error for a folder argument given as the empty string, which Path() would
+    read as this folder: ``frictionlab resume ""`` resuming whatever run is here."""
+    if value is not None and not value.strip():
+        raise FrictionlabError(f"{option} names no folder (it is empty): give a folder")

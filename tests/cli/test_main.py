@@ -100,6 +100,9 @@ def test_a_refusal_names_the_first_overrides_only(capsys):
         (["run", ""], ExitCode.INPUT_FILE, "the preset is named by an empty string"),
         (["schema", "--out", ""], ExitCode.USAGE, "--out names no file (it is empty)"),
         (["presets", "copy", "quickstart", ""], ExitCode.USAGE, "DEST names no file or folder (it is empty)"),
+        (["resume", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
+        (["follow", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
+        (["runs", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
     ],
 )
 def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, code, said, tmp_path, monkeypatch, capsys):
