@@ -43,6 +43,9 @@ def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_value
         child = node.get(key)
         if child is None or (replace_values and not isinstance(child, dict)):
             child = node[key] = {}
+        elif isinstance(child, list):  # "values.0": an item of a list is not a key
+            where = ".".join(keys[: depth + 1])
+            raise ValueError(f"{where} is a list, not a mapping: set the whole list ({where}=[...])")
         elif not isinstance(child, dict):
             raise ValueError(f"{'.'.join(keys[: depth + 1])} is a value, not a mapping")
         node = child
@@ -62,6 +65,8 @@ def _swept_path_as_one_key(keys: list[str], value: Any) -> list[str]:
 
     if keys[-1] in SweepParameter.model_fields and not isinstance(value, dict):
         return [*keys[:2], ".".join(keys[2:-1]), keys[-1]]
+    if len(keys) > 4 and keys[-2] in SweepParameter.model_fields and keys[-1].isdigit():  # values.0: into the list
+        return [*keys[:2], ".".join(keys[2:-2]), keys[-2], keys[-1]]
     return [*keys[:2], ".".join(keys[2:])]
 
 
