@@ -165,9 +165,17 @@ def output_path_problem(path: Path) -> str | None:
             if candidate.is_dir():
                 return _unwritable(candidate, path)
             if candidate == path:
-                return f"{shown(path)} is a file, not a folder"
+                return f"{shown(path)} is {_not_a_folder(path)}, not a folder"
             return f"{shown(path)} cannot be made a folder: {shown(candidate)} is a file"
     return None
+
+
+def _not_a_folder(path: Path) -> str:
+    """What ``path``, which is there and no folder, is: a file, or the node or dangling link it is."""
+    if path.is_symlink() and not path.exists():
+        return "a symbolic link to nothing"
+    kind = _kind(path)
+    return "a file" if kind == "file" else f"a {kind}" + (" (named pipe)" if kind == "FIFO" else "")
 
 
 def _unwritable(folder: Path, asked: Path) -> str | None:
