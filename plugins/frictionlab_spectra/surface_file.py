@@ -126,7 +126,8 @@ class SurfaceFile(MeasuredFile):
         )
         despike: float | None = Field(
             None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 x 5 "
-            "pixels around them by the solution of Laplace's equation from their neighbours (off by default)",
+            "pixels around them by the solution of Laplace's equation from their neighbours (off by default; a value that "
+            "would replace more than 5 % of the points is refused)",
         )
 
     # ------------------------------------------------------------ contract
