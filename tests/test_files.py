@@ -150,3 +150,28 @@ def test_an_open_stream_the_user_named_is_written_into_whatever_it_is_redirected
         atomic_write(link, lambda fh: fh.write("through the stream"), devices=True)
         assert link.is_symlink() and os.readlink(link) == str(via_proc)
     assert target.read_text() == "through the stream"
+
+
+def test_a_fifo_the_user_named_that_nothing_reads_is_refused_not_waited_on(tmp_path, monkeypatch, capsys):
+    """`frictionlab schema --out FIFO` with no reader blocked for ever in open(); it is refused
+    after a short wait, with the exit code of an output refused, and the FIFO is left as it was."""
+    import stat
+    import threading
+
+    from frictionlab.cli import main
+    from frictionlab.errors import ExitCode
+    from frictionlab.io import files
+
+    monkeypatch.setattr(files, "FIFO_READER_WAIT_S", 0.2, raising=False)
+    fifo = tmp_path / "ff"
+    os.mkfifo(fifo)
+    codes = []
+    command = threading.Thread(target=lambda: codes.append(main(["schema", "--out", str(fifo)])), daemon=True)
+    command.start()
+    command.join(20)
+    if command.is_alive():  # blocked on the FIFO: a reader opened and closed lets it go
+        os.close(os.open(fifo, os.O_RDONLY | os.O_NONBLOCK))
+        command.join(5)
+    assert codes == [ExitCode.OUTPUT_REFUSED]
+    assert "is a FIFO (named pipe) that nothing reads: start its reader first" in capsys.readouterr().err
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)

@@ -252,6 +252,20 @@ def test_an_output_path_under_a_file_is_refused_naming_the_file(tmp_path, capsys
     assert f"{tmp_path / 'results'} is a file, not a folder" in capsys.readouterr().err
 
 
+def test_an_output_path_that_is_a_fifo_or_a_dangling_link_is_refused_naming_what_it_is(tmp_path, capsys):
+    """A FIFO and a link to nothing at --out were each called 'a file'."""
+    import os
+
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    os.mkfifo(tmp_path / "pipe")
+    (tmp_path / "gone").symlink_to(tmp_path / "nowhere")
+    for name, what in (("pipe", "a FIFO (named pipe)"), ("gone", "a symbolic link to nothing")):
+        assert main(["run", str(path), "--out", str(tmp_path / name), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+        assert f"{tmp_path / name} is {what}, not a folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gone", "p.yaml", "pipe"]
+
+
 def test_numbers_that_overflow_in_the_run_name_what_overflowed(tmp_path, capsys):
     # each value within the limit, their product not: the run says which numbers, and fails cleanly
     data = merge(SMALL_PRESET, {"output": {"plot": False}, "realizations": 2, "solver": {"params": {"youngs_modulus": 1e-100}},

@@ -272,3 +272,19 @@ def test_validate_warns_of_loads_past_full_contact(cli):
     assert done.returncode == 0 and "caveat: the last loads are past full contact" in done.stdout, done.stderr
     done = cli("validate", "quickstart")
     assert done.returncode == 0 and "past full contact" not in done.stdout, done.stderr
+
+
+def test_a_contact_fraction_reached_at_the_first_touch_is_found_not_an_error():
+    """A map whose top is a plateau of 128 points: any force touches all of them, so no force
+    has exactly 3 in contact; the search shrank the force to 1e-132 and failed the realization
+    ('no force found ... within 80 solves'). The first touch is accepted, with the plateau's count."""
+    from frictionlab.preset.loads import forces_for_fractions
+
+    heights = np.zeros((16, 16))
+    heights[:, :8] = 1.0
+    profile = Profile(heights=heights, spacing=1.0, periodic=False)
+    solver = BEMHalfSpaceFree(youngs_modulus=1.0, poisson_ratio=0.0)
+    forces = forces_for_fractions(solver, profile, np.array([0.01]), np.zeros_like(heights), first_guess=1.0)
+    assert 0 < forces[0] <= 1e-9  # far below the first guess, 0.01
+    count = solver.solve(profile, forces, "force", np.zeros_like(heights)).contact_count
+    assert int(np.asarray(count)[0]) == 128

@@ -119,3 +119,13 @@ def test_region_and_downsample_in_the_summary(tmp_path):
         SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, region={"x": [10, 500]}).generate(None)
     with pytest.raises(ValueError, match="downsample takes one of factor"):
         SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, downsample={"factor": 2, "pixel": 1.0})
+
+
+def test_a_despike_that_would_replace_the_scan_itself_is_refused():
+    """despike 0.001 took 96 % of a map for spikes and replaced them (the rms fell sixfold), and
+    built one Python equation per point: a large map ran for hours. More than 5 % is refused,
+    before any equation, naming the count."""
+    z = np.random.default_rng(3).standard_normal((32, 32))
+    with pytest.raises(ValueError, match=r"despike 0.001 takes \d+ of 1024 points \(9\d\.\d %\) for spikes.*more than 5 %"):
+        despike(z, 0.001, float(np.std(z)))
+    assert despike(z, 6.0, float(np.std(z)))[1] == 0  # a usual k leaves white noise alone

@@ -228,3 +228,66 @@ def test_a_npy_whose_header_asks_for_more_than_memory_is_refused_with_its_size(t
         fh.write(bytes(64))
     with pytest.raises(ValueError, match=r"shape \(8388608, 4194304\) \(2.62e\+05 GiB\) does not fit in this process's memory"):
         SurfaceFile(path=str(path), spacing=1.0).rms_height()
+
+
+@pytest.mark.parametrize(("region", "said"), [
+    ({"x": [True, 20]}, "spectrum.params.region.x[0]: must be a number, not true or false, got true"),
+    ({"y": [0, False]}, "spectrum.params.region.y[1]: must be a number, not true or false, got false"),
+    ({"x": [0, float("nan")], "units": "length"}, "spectrum.params.region.x[1]: must be a finite number, got nan"),
+])  # fmt: skip
+def test_a_region_bound_of_true_false_or_nan_is_refused_by_its_place(tmp_path, registry, region, said):
+    """A region's bounds are an optional pair (tuple | None): true was taken as pixel 1 before
+    the number check looked inside optional lists and tuples."""
+    path, _ = power_law_map(tmp_path, points=16)
+    data = surface_preset(path, "mdr")
+    data["spectrum"]["params"]["region"] = region
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    assert said in str(info.value)
+
+
+def test_a_map_of_heights_below_1e_minus_100_is_named_too_small_not_constant(tmp_path):
+    """Heights of 1e-300 vary, but their squares underflow: the rms was 0 and the map was called
+    constant; it is named for its size."""
+    np.save(tmp_path / "tiny.npy", np.random.default_rng(2).standard_normal((16, 16)) * 1e-300)
+    message = surface_error(tmp_path / "tiny.npy")
+    assert "every value in heights is below 1e-100 in magnitude" in message and "constant" not in message
+    np.save(tmp_path / "zero.npy", np.zeros((16, 16)))
+    assert "the map is constant" in surface_error(tmp_path / "zero.npy")  # a flat map stays flat
+
+
+@pytest.mark.parametrize("downsample", [{"factor": 1_000_000}, {"pixel": 1e9}])
+def test_a_map_downsampled_to_one_pixel_is_named_too_small_not_constant(tmp_path, downsample):
+    """The size after downsampling was checked after the rms: one pixel left has rms 0, and the
+    map was called constant."""
+    path, _ = power_law_map(tmp_path, points=32)
+    message = surface_error(path, downsample=downsample)
+    assert "after the crop, resampling and downsampling the map has 1 x 1 pixels (x by y); at least 8 x 8" in message
+    assert "constant" not in message
+
+
+@pytest.mark.parametrize(("channel", "said"), [
+    (-1, "spectrum.params.channel: must be >= 0, got -1"),
+    (1.5, "spectrum.params.channel: must be text or a whole number, got 1.5"),
+    ([0], "spectrum.params.channel: must be text or a whole number, got [0]"),
+    (True, "spectrum.params.channel: must be text or a number, not true or false, got true"),
+])  # fmt: skip
+def test_a_bad_channel_is_named_at_its_own_path(tmp_path, registry, channel, said):
+    """channel is text or an index >= 0 (Annotated[int, Field(ge=0)]): -1 was said at
+    'channel.constrained-int', pydantic's tag of the index, and true was taken as channel 1."""
+    path, _ = power_law_map(tmp_path, points=16)
+    data = surface_preset(path, "mdr")
+    data["spectrum"]["params"]["channel"] = channel
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    assert said in str(info.value) and "constrained" not in str(info.value)
+
+
+@pytest.mark.parametrize("name", ["map.npy", "map.csv", "map.sur", "map.dat"])
+def test_an_empty_file_is_named_empty_whatever_its_suffix(tmp_path, registry, name):
+    """A 0-byte file was 'not a readable .npy array (EOFError)', 'array of shape (0, 1)' or 'a
+    damaged Digital Surf SUR file', by suffix; it is refused as empty before any reader."""
+    (tmp_path / name).write_bytes(b"")
+    with pytest.raises(PresetError) as info:
+        build_scene(surface_preset(str(tmp_path / name), "mdr"), registry=registry)
+    assert f"spectrum.params.path: is empty (0 bytes), it holds no heights, got '{tmp_path / name}'" in str(info.value)

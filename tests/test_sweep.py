@@ -13,7 +13,7 @@ from frictionlab.errors import PresetError
 from frictionlab.preset import load_scene
 from frictionlab.runs.runner import run_to_folder
 from frictionlab.plugin.listeners import SweepListener
-from frictionlab.preset import yaml_scalar
+from frictionlab.preset import apply_overrides, yaml_scalar
 from frictionlab.runs.sweep import load_sweep, plan_sweep, read_table, run_sweep
 from frictionlab.options import RunOptions
 
@@ -94,6 +94,26 @@ def test_ranges_linear_and_log(registry):
 def test_yaml_scalar_reads_back_as_the_same_value(value):
     text = yaml_scalar(value)
     assert yaml.safe_load(text) == value and type(yaml.safe_load(text)) is type(value)
+
+
+def test_yaml_scalar_spells_text_that_looks_like_a_number_so_set_reads_text():
+    for value in ("1e5", "2.5E-3", "1e400"):
+        assert apply_overrides({}, [f"description={yaml_scalar(value)}"]) == {"description": value}
+
+
+def test_swept_nan_and_infinities_are_refused_by_the_field_not_an_internal_error(tmp_path, capsys):
+    preset = write(tmp_path, sweep_preset({"loading.start": {"values": [1.0, float("nan"), float("inf"), -float("inf")]}}))
+    assert main(["validate", str(preset)]) == 2
+    err = capsys.readouterr().err
+    assert "sweep point 2 (loading.start=nan): loading.start: must be a finite number, got nan" in err
+    assert "sweep point 3 (loading.start=inf): loading.start: must be a finite number, got inf" in err
+    assert "sweep point 4 (loading.start=-inf): loading.start: must be a finite number, got -inf" in err
+    assert "internal error" not in err and "sweep point 1" not in err
+
+
+def test_swept_text_that_looks_like_a_number_stays_text(registry):
+    sweep = plan_sweep(sweep_preset({"description": {"values": ["1e5", "plain"]}}), registry=registry)
+    assert [p.scene.preset.description for p in sweep.points] == ["1e5", "plain"]
 
 
 BAD_SPECS = [

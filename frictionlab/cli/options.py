@@ -83,3 +83,11 @@ def _use_tls_options(args) -> None:
         from ..compute.dask_security import check_address
 
         check_address(args.scheduler)
+
+
+def refuse_empty_path(value: str | None, option: str, what: str = "folder") -> None:
+    """A usage error for a path argument given as the empty string, which Path() would read
+    as this folder (``frictionlab resume ""`` resuming whatever run is here) and an option
+    would take as not given (``report --out ""``: the default folder)."""
+    if value is not None and not value.strip():
+        raise FrictionlabError(f"{option} names no {what} (it is empty): give a {what}")

@@ -35,6 +35,8 @@ def run(args) -> ExitCode:
     from ..compute.fit import LogFit, format_number, json_safe
     from ..paper.predict import check_law, predict_xi, prediction_text, read_run_law
 
+    if args.from_run is not None and not args.from_run.strip():  # not "no --from": Path("") is this folder
+        raise FrictionlabError("--from names no folder (it is empty): give a run folder, or the law by --a and --b")
     if args.from_run:
         given = [name for name, value in (("--a", args.a), ("--b", args.b), ("--a-ci", args.a_ci), ("--b-ci", args.b_ci),
                                           ("--confidence", args.confidence)) if value is not None]  # fmt: skip
@@ -56,6 +58,7 @@ def run(args) -> ExitCode:
     prediction = predict_xi(
         law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
         pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
+        names={field: "--" + field.replace("_", "-") for field in ("force", "modulus", "rms_height", "area", "rms_slope")},
     )  # fmt: skip
     if args.json:
         out = {k: v for k, v in prediction.__dict__.items()}

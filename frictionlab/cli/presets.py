@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean
+from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean, shown
 
 EXAMPLES = """examples:
   frictionlab presets                         list the built-in presets
@@ -75,6 +75,11 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
     target = dest / preset.path.name if dest.is_dir() else dest
+    if not target.parent.is_dir():  # open() would say only "No such file or directory" (exit 1)
+        from ..io.files import output_path_problem
+
+        problem = output_path_problem(target.parent) or f"the folder {shown(target.parent)} does not exist"
+        raise OutputRefused(f"DEST {shown(target)}: {problem}; make the folder first, or give an existing one")
     data = preset.path.read_bytes()
     try:
         if force:  # replaced, never written through a link

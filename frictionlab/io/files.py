@@ -14,6 +14,7 @@ import os
 import re
 import stat
 import tempfile
+import time
 import zipfile
 import zlib
 from collections.abc import Callable, Mapping
@@ -34,6 +35,7 @@ def _read_umask() -> int:
 
 
 _UMASK = _read_umask()
+FIFO_READER_WAIT_S = 2.0  # how long a FIFO named as an output may go without a reader before it is refused
 
 
 def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False, *, devices: bool = False) -> None:
@@ -52,7 +54,7 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     file")."""
     path = Path(path)
     if devices and (_kind(path) in ("character device", "FIFO") or _is_open_stream(path)):
-        with open(path, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
+        with _open_node(path, binary) as fh:
             write(fh)
         return
     kind = _kind(path, follow_links=False)
@@ -71,6 +73,30 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _open_node(path: Path, binary: bool):
+    """A character device, FIFO or open stream the user named, opened for writing into. A FIFO
+    is opened without blocking: with nothing reading it for FIFO_READER_WAIT_S, the open is
+    refused, rather than waiting for a reader for ever."""
+    mode, text = ("wb", {}) if binary else ("w", {"encoding": "utf-8", "newline": ""})
+    if _kind(path) != "FIFO" or _is_open_stream(path):
+        return open(path, mode, **text)
+    deadline = time.monotonic() + FIFO_READER_WAIT_S
+    while True:
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+            break
+        except OSError as exc:
+            if exc.errno != errno.ENXIO:
+                raise
+            if time.monotonic() > deadline:
+                raise OutputRefused(
+                    f"{shown(path)} is a FIFO (named pipe) that nothing reads: start its reader first, or give a file"
+                ) from None
+            time.sleep(0.05)  # a reader started beside this command may open it a moment later
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, mode, **text)
 
 
 _OPEN_STREAM = re.compile(r"/(proc/self|dev)/fd/\d+")
@@ -139,9 +165,17 @@ def output_path_problem(path: Path) -> str | None:
             if candidate.is_dir():
                 return _unwritable(candidate, path)
             if candidate == path:
-                return f"{shown(path)} is a file, not a folder"
+                return f"{shown(path)} is {_not_a_folder(path)}, not a folder"
             return f"{shown(path)} cannot be made a folder: {shown(candidate)} is a file"
     return None
+
+
+def _not_a_folder(path: Path) -> str:
+    """What ``path``, which is there and no folder, is: a file, or the node or dangling link it is."""
+    if path.is_symlink() and not path.exists():
+        return "a symbolic link to nothing"
+    kind = _kind(path)
+    return "a file" if kind == "file" else f"a {kind}" + (" (named pipe)" if kind == "FIFO" else "")
 
 
 def _unwritable(folder: Path, asked: Path) -> str | None:

@@ -61,6 +61,15 @@ def regular_file_problem(path: str | Path) -> str | None:
     return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, not a regular file"
 
 
+def input_file_problem(path: str | Path) -> str | None:
+    """Why ``path`` cannot be a plugin's input file (``regular_file_problem``, or empty: a
+    reader of each format would otherwise name it damaged or of no shape), or None."""
+    problem = regular_file_problem(path)
+    if problem is None and os.stat(path).st_size == 0 and not os.path.realpath(path).startswith(("/proc/", "/sys/")):
+        return "is empty (0 bytes), it holds no heights"  # the kernel's files say 0 bytes and are refused when opened
+    return problem
+
+
 def open_regular_file(path: str | Path, what: str = "file", *, dir_fd: int | None = None, follow_links: bool = True):
     """``path`` opened for binary reading, once it is known to be a regular file
     (opened without blocking, checked on the open descriptor); InputFileProblem

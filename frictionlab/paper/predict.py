@@ -42,15 +42,18 @@ MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr le
 """f of MDR pressing the line that stands for a surface: F / (E* h L), L = 2 sqrt(A / pi)."""
 
 
-def dimensionless_force_3d(force: float, modulus: float, rms_height: float, area: float) -> float:
+def dimensionless_force_3d(
+    force: float, modulus: float, rms_height: float, area: float, names: dict[str, str] | None = None
+) -> float:
     """f = sqrt(pi) F / (2 E* h sqrt(A)) (= F / (E* h L) with L = 2 sqrt(A / pi)).
 
     Where a product on the way under- or overflows (F, E*, h, A far from 1) f is
     formed from logarithms instead; an f that double precision cannot hold
-    (beyond about 1e-308 .. 1e308) is a FrictionlabError naming the four inputs."""
+    (beyond about 1e-308 .. 1e308) is a FrictionlabError naming the four inputs (as ``names``
+    spells them: ``{"rms_height": "--rms-height"}``)."""
     for name, value in (("force", force), ("modulus", modulus), ("rms_height", rms_height), ("area", area)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-            raise FrictionlabError(f"{name} must be a finite number > 0. Got {value!r} instead.")
+            raise FrictionlabError(f"{(names or {}).get(name, name)} must be a finite number > 0. Got {value!r} instead.")
     force, modulus, rms_height, area = (float(v) for v in (force, modulus, rms_height, area))
     unit = MDR_OF_A_SURFACE.force_unit(modulus, rms_height, mdr_length(area))
     f = force / unit if unit > 0 else math.inf
@@ -132,6 +135,7 @@ def predict_xi(
     pairs: np.ndarray | None = None,
     fitted_f: tuple[float, float] | None = None,
     rms_slope: float | None = None,
+    names: dict[str, str] | None = None,
 ) -> Prediction:
     """xi = a + b ln f of ``law`` at f = sqrt(pi) F / (2 E* h sqrt(A)), with an interval
     (see the module doc): from the bootstrap ``pairs`` if given, else from the corners of
@@ -140,8 +144,10 @@ def predict_xi(
     but an unknown interval, NaN)."""
     check_law(law)
     if rms_slope is not None and not (math.isfinite(rms_slope) and rms_slope > 0):
-        raise FrictionlabError(f"rms_slope must be a finite number > 0. Got {rms_slope!r} instead.")
-    f = dimensionless_force_3d(force, modulus, rms_height, area)
+        raise FrictionlabError(
+            f"{(names or {}).get('rms_slope', 'rms_slope')} must be a finite number > 0. Got {rms_slope!r} instead."
+        )
+    f = dimensionless_force_3d(force, modulus, rms_height, area, names)
     ln_f = math.log(f)
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, by name
         xi = law.a + law.b * ln_f

@@ -28,6 +28,7 @@ LOAD_UNITS = {
 }
 SEARCH_STEPS = 80  # solves allowed to find one contact fraction's force
 SEARCH_PRECISION = 1e-6  # relative width of the bracket at which a jump in the count is accepted
+FIRST_TOUCH = 1e-9  # a force this far below the first guess, still past the target, is the first touch
 
 
 @dataclass(frozen=True)
@@ -176,6 +177,8 @@ def _search(solver, profile, slopes, target: int, low: tuple[float, int], guess:
                 low = (force, count)
             if high is not None and (high[1] == target or (low[0] > 0 and high[0] <= low[0] * (1 + SEARCH_PRECISION))):
                 return high[0], low
+            if high is not None and low[0] == 0.0 and high[0] <= guess * FIRST_TOUCH:
+                return high[0], low  # more than the target touch at first contact: points of equal height (a plateau)
             force = _next_force(low, high, target)
     raise ValueError(
         f"no force found at which {target} of {profile.points} points touch within {SEARCH_STEPS} solves "

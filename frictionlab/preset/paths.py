@@ -5,6 +5,7 @@ and the ``--set`` spelling of a value."""
 from __future__ import annotations
 
 import copy
+import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -42,6 +43,9 @@ def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_value
         child = node.get(key)
         if child is None or (replace_values and not isinstance(child, dict)):
             child = node[key] = {}
+        elif isinstance(child, list):  # "values.0": an item of a list is not a key
+            where = ".".join(keys[: depth + 1])
+            raise ValueError(f"{where} is a list, not a mapping: set the whole list ({where}=[...])")
         elif not isinstance(child, dict):
             raise ValueError(f"{'.'.join(keys[: depth + 1])} is a value, not a mapping")
         node = child
@@ -61,6 +65,8 @@ def _swept_path_as_one_key(keys: list[str], value: Any) -> list[str]:
 
     if keys[-1] in SweepParameter.model_fields and not isinstance(value, dict):
         return [*keys[:2], ".".join(keys[2:-1]), keys[-1]]
+    if len(keys) > 4 and keys[-2] in SweepParameter.model_fields and keys[-1].isdigit():  # values.0: into the list
+        return [*keys[:2], ".".join(keys[2:-2]), keys[-2], keys[-1]]
     return [*keys[:2], ".".join(keys[2:])]
 
 
@@ -88,8 +94,13 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
 
 
 def yaml_scalar(value: Any) -> str:
-    """The ``--set`` spelling of ``value``: YAML that reads back as the same value."""
-    if isinstance(value, float) and math.isfinite(value):
+    """The ``--set`` spelling of ``value``: YAML that ``--set`` reads back as the same value
+    (nan and the infinities as ``.nan``, ``.inf``, ``-.inf``: a swept value its field refuses
+    is then refused by the field, with its message; text that would read as a number, such
+    as ``1e5``, double-quoted)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return ".nan" if math.isnan(value) else (".inf" if value > 0 else "-.inf")
+    if isinstance(value, float):
         text = repr(value)
         if "e" in text and "." not in text:  # PyYAML reads 1e-05 as text; 1.0e-05 as a float
             text = text.replace("e", ".0e", 1)
@@ -97,9 +108,20 @@ def yaml_scalar(value: Any) -> str:
             text = text.replace("e", "e+", 1)
     else:
         text = yaml.safe_dump(value, default_flow_style=True).removesuffix("\n...\n").strip()
-    if yaml.safe_load(text) != value or type(yaml.safe_load(text)) is not type(value):
+        if isinstance(value, str) and not _reads_back(text, value):  # PyYAML's plain 1e5: a number to --set
+            text = json.dumps(value)  # a JSON string is a YAML double-quoted one
+    if not _reads_back(text, value):
         raise ValueError(f"cannot spell {value!r} as a YAML scalar")
     return text
+
+
+def _reads_back(text: str, value: Any) -> bool:
+    """Whether ``--set`` reads ``text`` as ``value``, of its type."""
+    try:
+        read = load_yaml(text) if text.strip() else ""
+    except YamlProblem:
+        return False
+    return read == value and type(read) is type(value)
 
 
 def differences(old, new, path: str = "") -> list[str]:

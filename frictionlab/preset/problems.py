@@ -100,8 +100,13 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
     return lines
 
 
-UNION_MEMBERS = {"str": "text", "bool": "true or false", "int": "a whole number", "float": "a number", "none": "null"}
-"""pydantic's tag of a plain type in a union (the last part of its error's path), as a person says it."""
+UNION_MEMBERS = {"str": "text", "bool": "true or false", "int": "a whole number", "float": "a number", "none": "null",
+                 "constrained-int": "a whole number", "constrained-float": "a number", "constrained-str": "text"}
+"""pydantic's tag of a plain type in a union (the last part of its error's path), as a person says it
+(``constrained-int``: an ``Annotated[int, Field(ge=0)]``)."""
+BOUND_ERRORS = {"greater_than", "greater_than_equal", "less_than", "less_than_equal", "string_too_short",
+                "string_too_long", "multiple_of"}
+"""pydantic's errors of a value of the right type past a bound: in a union, the one that says what is wrong."""
 
 
 def _one_per_union(errors: list[dict]) -> list[dict]:
@@ -123,8 +128,11 @@ def _one_per_union(errors: list[dict]) -> list[dict]:
         group = groups.get(union_loc(error)) if union_loc(error) is not None else None
         if group is None or len(group) < 2:  # a key that happens to be named "int", say
             out.append(error)
+        elif len(bounds := [e for e in group if e["type"] in BOUND_ERRORS]) == 1:  # -1 for text | int >= 0
+            if error is bounds[0]:
+                out.append({**error, "loc": union_loc(error)})
         elif error is group[0]:
-            kinds = [UNION_MEMBERS[e["loc"][-1]] for e in group]
+            kinds = list(dict.fromkeys(UNION_MEMBERS[e["loc"][-1]] for e in group))
             out.append({**error, "loc": union_loc(error), "type": "union_of_plain_types",
                         "msg": f"must be {', '.join(kinds[:-1])} or {kinds[-1]}"})  # fmt: skip
     return out
@@ -140,6 +148,8 @@ def _kinds(annotation) -> set:
     """The plain types a field accepts (unions and Optional unpacked)."""
     if typing.get_origin(annotation) in (typing.Union, types.UnionType):
         return set().union(*(_kinds(arg) for arg in typing.get_args(annotation)))
+    if typing.get_origin(annotation) is typing.Annotated:  # Annotated[int, Field(ge=0)] in a union: an int
+        return _kinds(typing.get_args(annotation)[0])
     return {annotation}
 
 
@@ -150,9 +160,14 @@ def _nested_model(annotation) -> type[BaseModel] | None:
     return None
 
 
-def _number_problem(value, path: str, allow_inf_nan: bool) -> str | None:
+def _sequence_kind(kinds: set):
+    """The list or tuple type among a field's kinds (``tuple[float, float] | None``: the tuple), or None."""
+    return next((kind for kind in kinds if typing.get_origin(kind) in (list, tuple)), None)
+
+
+def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number") -> str | None:
     if isinstance(value, bool):
-        return f"{path}: must be a number, not true or false, got {str(value).lower()}"
+        return f"{path}: must be {what}, not true or false, got {str(value).lower()}"
     if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
         try:
             number = float(value)
@@ -187,11 +202,11 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
         elif isinstance(item, type) and issubclass(item, BaseModel) and isinstance(value, dict):
             for key, entry in value.items():
                 problems += number_problems(item, entry, f"{path}.{key}")
-        elif kinds & {int, float} and bool not in kinds:
-            problem = _number_problem(value, path, allow)
+        elif kinds & {int, float} and bool not in kinds and not (str in kinds and isinstance(value, str)):
+            problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number")
             problems += [problem] if problem else []
-        elif typing.get_origin(field.annotation) in (list, tuple) and isinstance(value, list):
-            items = set().union(*(_kinds(a) for a in typing.get_args(field.annotation) if a is not Ellipsis))
+        elif (sequence := _sequence_kind(kinds)) is not None and isinstance(value, list):
+            items = set().union(*(_kinds(a) for a in typing.get_args(sequence) if a is not Ellipsis))
             if items & {int, float} and bool not in items:
                 problems += [p for i, v in enumerate(value) if (p := _number_problem(v, f"{path}[{i}]", allow))]
     return problems

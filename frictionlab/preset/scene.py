@@ -13,7 +13,7 @@ from pydantic import BaseModel, TypeAdapter, ValidationError
 from pydantic.errors import PydanticSchemaGenerationError
 
 from ..errors import PluginError, PresetError
-from ..io.inputs import input_fields, regular_file_problem
+from ..io.inputs import input_fields, input_file_problem
 from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
 from ..plugin.registry import Registry, default_registry
 from .problems import format_validation_error, merge_problems, number_problems, shown_value
@@ -179,7 +179,7 @@ def build_scene(
         f"{slot}.params.{field}: {problem}, got {shown_value(getattr(plugin.params, field))}"
         for slot, plugin in plugins.items()
         for field in input_fields(type(plugin.params))
-        if (problem := regular_file_problem(getattr(plugin.params, field)))
+        if (problem := input_file_problem(getattr(plugin.params, field)))
     ]
     if problems:  # before anything reads them (an equivalent line reads its map now)
         raise PresetError(problems, source=source)

@@ -101,7 +101,10 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     mode = p.detrend if p.detrend is not None else "plane" if instrument else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
-        despiked, count = despike(levelled.heights, p.despike, levelled.rms_after)
+        try:
+            despiked, count = despike(levelled.heights, p.despike, levelled.rms_after)
+        except ValueError as exc:  # k too small: said with the file's name
+            raise ValueError(f"{where}: {exc}") from None
         done["despiked"] = {"k": p.despike, "points": count}
         if count:
             levelled = level(despiked, mode)

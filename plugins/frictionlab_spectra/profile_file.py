@@ -124,6 +124,7 @@ class ProfileFile(MeasuredFile):
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         check_finite(where, "heights", z)
+        check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
@@ -307,6 +308,17 @@ def check_finite(where: str, what: str, values: np.ndarray) -> None:
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
             f"in magnitude, the first at {at}"
+        )
+
+
+def check_heights_not_underflowing(where: str, heights: np.ndarray) -> None:
+    """ValueError when every height is nonzero-small, below 1e-100 in magnitude: they vary, but the
+    squares of their rms underflow to 0, which would call them flat."""
+    largest = max(float(np.max(heights)), -float(np.min(heights))) if heights.size else 0.0  # no copy of a large map
+    if 0.0 < largest < 1.0 / MAX_MAGNITUDE:
+        raise ValueError(
+            f"{where}: every value in heights is below {1.0 / MAX_MAGNITUDE:g} in magnitude (the largest "
+            f"{largest:.3g}), too small for a run's arithmetic; store them in a unit that makes them larger"
         )
 
 

@@ -116,16 +116,26 @@ def resampled_points(n: int, step: float, new_step: float) -> int:
     return math.floor((n - 1) * step / new_step + 1e-9) + 1
 
 
+MAX_SPIKE_FRACTION = 0.05  # despike replaces at most this share of a map's points
+
+
 def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     """``z`` with every point more than ``k`` ``rms`` from the median of the 5 x 5 pixels around
     it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
-    Laplace's equation from its neighbours; and how many were replaced."""
+    Laplace's equation from its neighbours; and how many were replaced. ValueError when more than
+    MAX_SPIKE_FRACTION of the points would be (``k`` too small: the scan itself, not its spikes)."""
     from scipy import ndimage, sparse
     from scipy.sparse.linalg import spsolve
 
     local = ndimage.median_filter(z, size=5, mode="reflect")
     spike = np.abs(z - local) > k * rms
     count = int(np.count_nonzero(spike))
+    if count > MAX_SPIKE_FRACTION * z.size:  # refused before one equation per point is built (a 4096^2 map: hours)
+        raise ValueError(
+            f"despike {k:g} takes {count} of {z.size} points ({100 * count / z.size:.1f} %) for spikes: a spike is a "
+            f"rare point, and replacing more than {100 * MAX_SPIKE_FRACTION:g} % of a scan replaces the scan itself; "
+            "give a larger despike (6 rms heights is usual)"
+        )
     if not count or count == z.size:
         return z, 0 if count == z.size else count
     ny, nx = z.shape

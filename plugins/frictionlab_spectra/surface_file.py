@@ -53,7 +53,7 @@ from .map_pipeline import Downsample, Level, Region, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
-from .profile_file import check_finite, file_suffix, load_npy, npy_shape, read_text_table
+from .profile_file import check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table
 
 MIN_SIDE = 8
 
@@ -126,7 +126,8 @@ class SurfaceFile(MeasuredFile):
         )
         despike: float | None = Field(
             None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 x 5 "
-            "pixels around them by the solution of Laplace's equation from their neighbours (off by default)",
+            "pixels around them by the solution of Laplace's equation from their neighbours (off by default; a value that "
+            "would replace more than 5 % of the points is refused)",
         )
 
     # ------------------------------------------------------------ contract
@@ -191,18 +192,19 @@ class SurfaceFile(MeasuredFile):
         where = f"surface-file {str(path)!r}"
         z, pixel, summary = _read_map(path, where, p)
         check_finite(where, "heights", z)
+        check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
         summary.update(shaped)
-        rms = float(np.std(heights))
+        if min(heights.shape) < MIN_SIDE:
+            nx, ny = heights.shape[::-1]
+            raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
+                             f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
+        rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
         if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
             raise ValueError(
                 f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}); "
                 "a flat surface has no roughness"
             )
-        if min(heights.shape) < MIN_SIDE:
-            nx, ny = heights.shape[::-1]
-            raise ValueError(f"{where}: after the crop and resampling the map has {nx} x {ny} pixels (x by y); at "
-                             f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         heights.flags.writeable = False
         summary.update(shape=list(heights.shape), spacing=float(spacing), rms_height=rms)
         return Measured(heights, spacing, rms, summary["periodic"], summary)

@@ -99,6 +99,13 @@ def test_a_refusal_names_the_first_overrides_only(capsys):
         (["run", ""], ExitCode.INPUT_FILE, "the preset is named by an empty string"),
         (["schema", "--out", ""], ExitCode.USAGE, "--out names no file (it is empty)"),
         (["presets", "copy", "quickstart", ""], ExitCode.USAGE, "DEST names no file or folder (it is empty)"),
+        (["resume", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
+        (["follow", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
+        (["runs", ""], ExitCode.USAGE, "DIR names no folder (it is empty)"),
+        (["report", "--out", ""], ExitCode.USAGE, "--out names no folder (it is empty)"),
+        (["report", "--presets", ""], ExitCode.USAGE, "--presets names no folder (it is empty)"),
+        (["report", "--figures", ""], ExitCode.USAGE, "--figures names no folder (it is empty)"),
+        (["report", "--markdown", ""], ExitCode.USAGE, "--markdown names no file (it is empty)"),
     ],
 )
 def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, code, said, tmp_path, monkeypatch, capsys):
@@ -109,6 +116,19 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     captured = capsys.readouterr()
     assert said in captured.err and "Traceback" not in captured.err and captured.out == ""
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
+
+
+def test_presets_copy_into_a_missing_folder_or_under_a_file_is_refused_naming_it(tmp_path, capsys):
+    """open() of DEST in a folder that does not exist said only "No such file or directory"
+    with exit code 1; the folder is named, with exit code 4, and nothing is made."""
+    from frictionlab.cli import main
+
+    (tmp_path / "file.txt").write_text("mine")
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "missing" / "q.yaml")]) == ExitCode.OUTPUT_REFUSED
+    assert f"the folder {tmp_path / 'missing'} does not exist; make the folder first" in capsys.readouterr().err
+    assert main(["presets", "copy", "quickstart", str(tmp_path / "file.txt" / "q.yaml")]) == ExitCode.OUTPUT_REFUSED
+    assert f"{tmp_path / 'file.txt'} is a file, not a folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file.txt"] and (tmp_path / "file.txt").read_text() == "mine"
 
 
 CTRL_C_WHILE_LOADING = """

@@ -28,6 +28,19 @@ def test_bad_set_override_is_a_usage_error(tmp_path, capsys):
     assert "seed is a value, not a mapping" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("assignments, said", [
+    (["sweep.parameters.seed.values=[1, 2]", "sweep.parameters.seed.values.0=5"],
+     "sweep.parameters.seed.values is a list, not a mapping: set the whole list (sweep.parameters.seed.values=[...])"),
+    (["loading.stop=[1, 2]", "loading.stop.0=5"], "loading.stop is a list, not a mapping: set the whole list"),
+])  # fmt: skip
+def test_set_into_an_item_of_a_list_says_to_set_the_whole_list(tmp_path, capsys, assignments, said):
+    """values.0 was taken as part of the swept path ('sweep.parameters.seed.values.0: must be a
+    mapping ..., got 5'), and a list elsewhere was 'a value'; an item of a list is not a key."""
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    assert main(["validate", str(preset), *[arg for a in assignments for arg in ("--set", a)]]) == ExitCode.USAGE
+    assert said in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("count, said", [(1, "(1 realization, "), (2, "(2 realizations, ")])
 def test_validate_counts_realizations_in_good_english(tmp_path, capsys, count, said):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": count}))

@@ -81,7 +81,7 @@ def test_cli(tmp_path, capsys, make_scene):
     assert main([*args]) == 2
     assert "--a A --b B" in capsys.readouterr().err
     assert main(["predict", "--a", "1", "--b", "0.1", "--area", "-1", "--modulus", "1", "--rms-height", "1", "--force", "1"]) == 2
-    assert "area must be a finite number > 0. Got -1.0 instead." in capsys.readouterr().err
+    assert "--area must be a finite number > 0. Got -1.0 instead." in capsys.readouterr().err  # the option's name
     assert main([*args, "--from", str(tmp_path / "nothing")]) == 5  # a run folder that cannot be used
     assert "no readable summary.json" in capsys.readouterr().err
 

@@ -334,7 +334,9 @@ def test_an_f_double_precision_holds_is_found_whatever_the_products_do(capsys, a
         (["--a", "1.7e308", "--b=-1e308"], "xi = a + b ln f is beyond double precision"),
         ([*LAW, "--a-ci", "0", "1.7e308", "--b-ci", "0", "1e308", "--force", "1e9"], "the interval of xi"),
         ([*LAW, "--rms-slope", "1e308", "--force", "1e9"], "rms_slope is too large"),
-        ([*LAW, "--rms-slope", "nan"], "rms_slope must be a finite number > 0. Got nan"),
+        ([*LAW, "--rms-slope", "nan"], "--rms-slope must be a finite number > 0. Got nan"),
+        ([*LAW, "--rms-height", "0"], "--rms-height must be a finite number > 0. Got 0.0"),  # not rms_height
+        ([*LAW, "--from", ""], "--from names no folder (it is empty)"),  # not "give the law"
     ],
 )
 def test_options_out_of_range_are_usage_errors(capsys, options, named):
