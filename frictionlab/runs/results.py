@@ -31,7 +31,7 @@ from .. import __version__
 from ..compute.ensemble import RunOutcome
 from ..errors import MissingDependency, RunError, RunFolderError, shown
 from ..io.files import atomic_write, write_npz
-from ..io.inputs import InputFileProblem, open_regular_file
+from ..io.inputs import InputFileProblem, open_regular_file, read_bounded
 from ..compute.fit import json_safe
 from ..preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
@@ -339,7 +339,8 @@ def _holds(path: Path, data: bytes) -> bool:
     """Whether ``path`` is a regular file (never a link) of exactly ``data``."""
     try:
         with open_regular_file(path, follow_links=False) as fh:
-            return os.fstat(fh.fileno()).st_size == len(data) and fh.read(len(data) + 1) == data
+            size = os.fstat(fh.fileno()).st_size
+            return size == len(data) and read_bounded(fh, size, size) == data
     except InputFileProblem:
         return False
 
