@@ -40,6 +40,7 @@ from .folders import (
     templates,
     user_presets_dir,
 )
+from .keyorder import answer_focus_key
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .text import problems_text
@@ -130,9 +131,12 @@ class FrictionlabApp(RunControl, App):
         self.query_one("#preset-table").focus()
 
     async def on_event(self, event: events.Event) -> None:
-        if isinstance(event, events.Key) and self._early_keys is not None:
-            self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
-            return
+        if isinstance(event, events.Key):
+            if self._early_keys is not None:
+                self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
+                return
+            if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
+                return
         await super().on_event(event)
 
     async def on_ready(self) -> None:
@@ -166,7 +170,7 @@ class FrictionlabApp(RunControl, App):
         for key in early:  # in the order typed
             if key.key == "ctrl+j":  # Enter typed before the terminal was raw: the tty made it a line feed
                 key = events.Key("enter", "\r")
-            await super().on_event(key)
+            await self.on_event(key)
 
     @property
     def built(self) -> bool:
