@@ -222,6 +222,9 @@ def lock_held(folder: str | Path) -> bool:
     return runfolder.lock_held(Path(folder) / LOCK_FILE)
 
 
+RESUMABLE = ("cancelled", "interrupted", "failed")  # how a run ended that resume goes on from
+
+
 @dataclass
 class RunState:
     """What a run folder holds now. ``status``: running, completed, cancelled,
@@ -240,7 +243,7 @@ class RunState:
 
     @property
     def resumable(self) -> bool:
-        return self.status in ("cancelled", "interrupted", "failed")
+        return self.status in RESUMABLE
 
     def to_dict(self) -> dict:
         return {"folder": str(self.folder), "kind": self.kind, "name": self.name, "status": self.status,

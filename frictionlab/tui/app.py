@@ -78,6 +78,9 @@ class FrictionlabApp(RunControl, App):
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
+        # the same keys where they cannot act (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True, priority=True)
+          for key, action in (("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"))),
     ]
 
     def __init__(
@@ -197,6 +200,15 @@ class FrictionlabApp(RunControl, App):
     @property
     def running(self) -> bool:
         return self.followed is not None
+
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers Save with a preset open, Run with one open and no run going."""
+        if action in ("save", "save_as"):
+            return self.draft_path is not None
+        return action != "start_run" or (self.draft_path is not None and not self.running)
+
+    def action_unavailable(self, action: str) -> None:
+        getattr(self, f"action_{action}")()  # run anyway where it cannot act: it says why
 
     # ------------------------------------------------------------ navigation and help
 

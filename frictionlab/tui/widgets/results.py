@@ -17,6 +17,7 @@ from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown
 from ...compute.fit import format_interval
+from ...runs.detached import RESUMABLE
 from ..chart import Series
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
@@ -39,6 +40,9 @@ class ResultsPane(Vertical):
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
+        # the same keys on a row where they cannot act (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
+          for key, action in (("space", "compare"), ("u", "resume"))),
     ]
 
     def __init__(self, **kwargs):
@@ -73,6 +77,31 @@ class ResultsPane(Vertical):
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
+
+    def highlighted(self) -> RunEntry | SweepEntry | None:
+        row = self.query_one("#runs-table", DataTable).cursor_row
+        return self.runs[row] if 0 <= row < len(self.runs) else None
+
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers what the highlighted row allows: Resume on a run or sweep that ended
+        before it completed, Compare on a run with a curve (or on a sweep's point)."""
+        if action not in ("resume", "compare"):
+            return True
+        entry = self.highlighted()
+        if action == "compare" and self.open_sweep is not None and self.query_one("#results-sweep").has_focus:
+            return True
+        if entry is None:
+            return False
+        if action == "resume":
+            return entry.status in RESUMABLE
+        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running")
+
+    def action_unavailable(self, action: str) -> None:
+        """A key pressed on a row where its action cannot act: run anyway, to say why."""
+        getattr(self, f"action_{action}")()
+
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        self.app.refresh_bindings()  # the footer: what this row allows
 
     def action_compare(self) -> None:
         self.open_selected(overlay=True)
@@ -121,6 +150,7 @@ class ResultsPane(Vertical):
             table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
         if self.runs:
             table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
+        self.app.refresh_bindings()  # the highlighted row's status may have changed (a run ended)
 
     def open_selected(self, overlay: bool) -> None:
         """Enter/Space on the list of runs, or on the open sweep's table of points."""
