@@ -302,6 +302,17 @@ def damage_reason(folder: Path, error: Exception) -> str:
     return rest if colon and rest.startswith(name + " ") else text  # "sweep.json: sweep.json is ..." said once
 
 
+def stored_count(folder: str | Path) -> tuple[int | None, int | None]:
+    """(stored, total): the realizations the run folder's chunks hold, as its manifest lists
+    them (what a resume restores, before it reads them), and the run's total; None where
+    the manifest does not say."""
+    manifest = RunDirectory(Path(folder)).state()
+    if not isinstance(manifest, dict):
+        return None, None
+    total = _count(manifest.get("realizations"))
+    return _chunk_count(manifest.get("chunks"), total), total
+
+
 def _chunk_count(chunks, total: int | None) -> int | None:
     """Realizations the manifest's chunks hold (each chunk's name is its index range)."""
     from .chunks import CHUNK_NAME

@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from textual import events
-from textual.actions import SkipAction
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
@@ -41,6 +40,7 @@ from .folders import (
     user_presets_dir,
 )
 from .keyorder import answer_focus_key
+from .keyshelp import KeysHelp
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .text import problems_text
@@ -55,7 +55,7 @@ WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started any
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(RunControl, App):
+class FrictionlabApp(KeysHelp, RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -104,6 +104,7 @@ class FrictionlabApp(RunControl, App):
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
+        self.said_about: Path | None = None  # the row the status line speaks of (taken back on leaving it)
         self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -218,51 +219,25 @@ class FrictionlabApp(RunControl, App):
         self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
         self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
 
+    def row_highlighted(self, path: Path | None) -> None:
+        """A list's cursor is on ``path``'s row: a message about another row is taken back."""
+        if self.said_about is not None and self.said_about != path:
+            self.say("")
+
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if self.screen_stack:  # not once the app has closed (a late message)
             self.refresh_bindings()
 
-    def action_help(self) -> None:
-        """Textual's key panel: the keys of the focused widget and of the app, as they change.
-        Pressed again it shows the next page of a panel taller than the screen (it takes no
-        focus, so no other key scrolls it), and hides it after the last."""
-        panels = self.screen.query("HelpPanel KeyPanel")
-        if not panels:
-            self.action_show_help_panel()
-            return
-        keys = panels.first()
-        if keys.scroll_y < keys.max_scroll_y:
-            keys.scroll_page_down(animate=False)
-        else:
-            self.action_hide_help_panel()
-
-    def action_toggle_keys(self) -> None:
-        """? shows the key panel, or hides it (F1 pages through it)."""
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
-            self.action_show_help_panel()
-
-    def action_hide_keys(self) -> None:
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
-            raise SkipAction()  # Esc means nothing here: another part may take it
-
-    def action_help_quit(self, in_field: bool = False) -> None:
-        """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
-        where = "Ctrl+C copies in a text field. " if in_field else ""
-        self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
-                 "a run goes on after you quit unless you cancel it.")  # fmt: skip
-
     # ------------------------------------------------------------ the status line
 
-    def say(self, text: str, severity: str = "information", title: str = "") -> None:
-        """Show ``text`` in the status line above the footer (never over the data); it
-        stays until the next message. ``text`` is shown as it is, never as markup."""
+    def say(self, text: str, severity: str = "information", title: str = "", about: Path | None = None) -> None:
+        """Show ``text`` in the status line above the footer (never over the data); it stays
+        until the next message, or (``about``: the run or preset folder or file it speaks of)
+        until another row of a list is highlighted. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{shown(title)}: ", "bold") if title else "", shown(text))  # no escape code from a folder
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
+        self.said_about = about
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -292,7 +267,7 @@ class FrictionlabApp(RunControl, App):
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}")
+                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}", about=path)
                 return
             self.draft_source = path
         else:
@@ -313,7 +288,7 @@ class FrictionlabApp(RunControl, App):
         try:
             data = load_preset_file(entry.path)
         except PresetError as exc:
-            self.say(problems_text(exc.problems), "error", title="Cannot duplicate")
+            self.say(problems_text(exc.problems), "error", title="Cannot duplicate", about=entry.path)
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
         default = self.save_folder / f"{entry.path.stem}-copy.yaml"  # where n and Ctrl+S save too

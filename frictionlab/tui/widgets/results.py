@@ -102,6 +102,11 @@ class ResultsPane(Vertical):
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         self.app.refresh_bindings()  # the footer: what this row allows
+        if event.data_table.id == "runs-table":
+            entry = self.highlighted()
+            self.app.row_highlighted(entry.path if entry is not None else None)
+        elif self.open_sweep is not None:  # a point of the open sweep
+            self.app.row_highlighted(self.open_sweep.path / f"point {event.cursor_row}")
 
     def action_compare(self) -> None:
         self.open_selected(overlay=True)
@@ -162,7 +167,8 @@ class ResultsPane(Vertical):
             try:
                 entry = read_run(self.open_sweep.point_folder(self.open_sweep.points[row]))
             except (OSError, FrictionlabError) as exc:
-                self.app.say(f"this point has no finished run to show ({exc})", "warning")
+                self.app.say(f"this point has no finished run to show ({exc})", "warning",
+                             about=self.open_sweep.path / f"point {row}")
                 return
         else:
             row = self.query_one("#runs-table", DataTable).cursor_row
@@ -171,7 +177,7 @@ class ResultsPane(Vertical):
                 return
             entry = self.runs[row]
             if entry.status == "damaged":  # nothing to show but why
-                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning")
+                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
                 self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
                 return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
@@ -179,7 +185,8 @@ class ResultsPane(Vertical):
                 return
             if isinstance(entry, SweepEntry):
                 if overlay:
-                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.", "warning")
+                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.",
+                                 "warning", about=entry.path)
                 else:
                     self._show_sweep(entry)
                 return
