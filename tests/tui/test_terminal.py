@@ -59,3 +59,22 @@ def test_nothing_is_held_without_a_terminal(tmp_path):
     with open(tmp_path / "f", "w") as fh:
         assert hold_keys(fh.fileno()) is None
     release_keys(None)  # and nothing to give back
+
+
+def test_frictionlab_tui_holds_the_keys_first_and_drops_the_unread_ones_as_it_ends(monkeypatch):
+    """``frictionlab tui`` holds the keys before anything else loads, and releases them however
+    it ends (here refused at once: TERM=dumb)."""
+    import sys
+
+    import frictionlab.__main__ as entry
+    from frictionlab.tui import terminal
+
+    calls = []
+    monkeypatch.setattr(terminal, "hold_keys", lambda: calls.append("hold") or "held")
+    monkeypatch.setattr(terminal, "release_keys", lambda held: calls.append(("release", held)))
+    monkeypatch.setattr(sys, "argv", ["frictionlab", "tui"])
+    monkeypatch.setenv("TERM", "dumb")
+    with pytest.raises(SystemExit) as ended:
+        entry.program()
+    assert ended.value.code == 2
+    assert calls == ["hold", ("release", "held")]
