@@ -51,6 +51,7 @@ class ResultsPane(Vertical):
         self.overlay: list[RunEntry] = []  # the runs drawn, at most one per style
         self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
         self._shown: list[Path] = []  # the folders the list shows, in its order
+        self._footer_row: tuple | None = None  # the (folder, status) the footer's keys were for
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -100,8 +101,17 @@ class ResultsPane(Vertical):
         """A key pressed on a row where its action cannot act: run anyway, to say why."""
         getattr(self, f"action_{action}")()
 
+    def _refresh_footer(self) -> None:
+        """The footer again when what the highlighted row allows may differ (another row, a status
+        changed), not at each reload: the footer is rebuilt each time."""
+        entry = self.highlighted()
+        now = (entry.path, entry.status) if entry is not None else None
+        if now != self._footer_row:
+            self._footer_row = now
+            self.app.refresh_bindings()
+
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
-        self.app.refresh_bindings()  # the footer: what this row allows
+        self._refresh_footer()  # what this row allows
         if event.data_table.id == "runs-table":
             entry = self.highlighted()
             self.app.row_highlighted(entry.path if entry is not None else None)
@@ -155,7 +165,7 @@ class ResultsPane(Vertical):
             table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
         if self.runs:
             table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
-        self.app.refresh_bindings()  # the highlighted row's status may have changed (a run ended)
+        self._refresh_footer()  # the highlighted row's status may have changed (a run ended)
 
     def open_selected(self, overlay: bool) -> None:
         """Enter/Space on the list of runs, or on the open sweep's table of points."""
