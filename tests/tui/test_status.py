@@ -20,9 +20,11 @@ async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighte
         await pilot.press("enter")
         await pilot.pause()
         damaged = status_text(app)
+        info = str(app.query_one("#results-info").render())
         table.move_cursor(row=names.index("seed1"))
         await pilot.pause()
         after_moving = status_text(app)
+        info_after_moving = str(app.query_one("#results-info").render())
         await pilot.press("u")  # a completed run: nothing to resume
         await pilot.pause()
         complete = status_text(app)
@@ -34,6 +36,7 @@ async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighte
         after_moving_back = status_text(app)
     assert "seed2 is damaged" in damaged
     assert after_moving == ""
+    assert "damaged" in info and "damaged" not in info_after_moving  # the box beside the plot too
     assert "seed1 is complete" in complete and after_reload == complete
     assert after_moving_back == ""
 

@@ -52,6 +52,7 @@ class ResultsPane(Vertical):
         self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
         self._shown: list[Path] = []  # the folders the list shows, in its order
         self._footer_row: tuple | None = None  # the (folder, status) the footer's keys were for
+        self._info_about: Path | None = None  # the damaged run whose reason the info box shows
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -115,6 +116,8 @@ class ResultsPane(Vertical):
         if event.data_table.id == "runs-table":
             entry = self.highlighted()
             self.app.row_highlighted(entry.path if entry is not None else None)
+            if self._info_about is not None and (entry is None or entry.path != self._info_about):
+                self._show_overlay()  # the damaged row's reason goes with it: the overlay's lines again
         elif self.open_sweep is not None:  # a point of the open sweep
             self.app.row_highlighted(self.open_sweep.path / f"point {event.cursor_row}")
 
@@ -189,6 +192,7 @@ class ResultsPane(Vertical):
             if entry.status == "damaged":  # nothing to show but why
                 self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
                 self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                self._info_about = entry.path
                 return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
@@ -228,6 +232,7 @@ class ResultsPane(Vertical):
         table.focus()
 
     def _show_overlay(self) -> None:
+        self._info_about = None
         series, lines = [], []
         for style, entry in zip(OVERLAY_STYLES, self.overlay):
             try:
