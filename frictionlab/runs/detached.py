@@ -222,6 +222,9 @@ def lock_held(folder: str | Path) -> bool:
     return runfolder.lock_held(Path(folder) / LOCK_FILE)
 
 
+RESUMABLE = ("cancelled", "interrupted", "failed")  # how a run ended that resume goes on from
+
+
 @dataclass
 class RunState:
     """What a run folder holds now. ``status``: running, completed, cancelled,
@@ -240,7 +243,7 @@ class RunState:
 
     @property
     def resumable(self) -> bool:
-        return self.status in ("cancelled", "interrupted", "failed")
+        return self.status in RESUMABLE
 
     def to_dict(self) -> dict:
         return {"folder": str(self.folder), "kind": self.kind, "name": self.name, "status": self.status,
@@ -297,6 +300,17 @@ def damage_reason(folder: Path, error: Exception) -> str:
             break
     name, colon, rest = text.partition(": ")
     return rest if colon and rest.startswith(name + " ") else text  # "sweep.json: sweep.json is ..." said once
+
+
+def stored_count(folder: str | Path) -> tuple[int | None, int | None]:
+    """(stored, total): the realizations the run folder's chunks hold, as its manifest lists
+    them (what a resume restores, before it reads them), and the run's total; None where
+    the manifest does not say."""
+    manifest = RunDirectory(Path(folder)).state()
+    if not isinstance(manifest, dict):
+        return None, None
+    total = _count(manifest.get("realizations"))
+    return _chunk_count(manifest.get("chunks"), total), total
 
 
 def _chunk_count(chunks, total: int | None) -> int | None:

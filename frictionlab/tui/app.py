@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from textual import events
-from textual.actions import SkipAction
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
@@ -40,6 +39,8 @@ from .folders import (
     templates,
     user_presets_dir,
 )
+from .keyorder import answer_focus_key
+from .keyshelp import KeysHelp
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .text import problems_text
@@ -54,7 +55,7 @@ WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started any
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(RunControl, App):
+class FrictionlabApp(KeysHelp, RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -77,6 +78,9 @@ class FrictionlabApp(RunControl, App):
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
+        # the same keys where they cannot act (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True, priority=True)
+          for key, action in (("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"))),
     ]
 
     def __init__(
@@ -100,6 +104,7 @@ class FrictionlabApp(RunControl, App):
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
+        self.said_about: Path | None = None  # the row the status line speaks of (taken back on leaving it)
         self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -130,9 +135,12 @@ class FrictionlabApp(RunControl, App):
         self.query_one("#preset-table").focus()
 
     async def on_event(self, event: events.Event) -> None:
-        if isinstance(event, events.Key) and self._early_keys is not None:
-            self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
-            return
+        if isinstance(event, events.Key):
+            if self._early_keys is not None:
+                self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
+                return
+            if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
+                return
         await super().on_event(event)
 
     async def on_ready(self) -> None:
@@ -166,7 +174,7 @@ class FrictionlabApp(RunControl, App):
         for key in early:  # in the order typed
             if key.key == "ctrl+j":  # Enter typed before the terminal was raw: the tty made it a line feed
                 key = events.Key("enter", "\r")
-            await super().on_event(key)
+            await self.on_event(key)
 
     @property
     def built(self) -> bool:
@@ -194,6 +202,15 @@ class FrictionlabApp(RunControl, App):
     def running(self) -> bool:
         return self.followed is not None
 
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers Save with a preset open, Run with one open and no run going."""
+        if action in ("save", "save_as"):
+            return self.draft_path is not None
+        return action != "start_run" or (self.draft_path is not None and not self.running)
+
+    def action_unavailable(self, action: str) -> None:
+        getattr(self, f"action_{action}")()  # run anyway where it cannot act: it says why
+
     # ------------------------------------------------------------ navigation and help
 
     def action_show_tab(self, tab: str) -> None:
@@ -202,51 +219,25 @@ class FrictionlabApp(RunControl, App):
         self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
         self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
 
+    def row_highlighted(self, path: Path | None) -> None:
+        """A list's cursor is on ``path``'s row: a message about another row is taken back."""
+        if self.said_about is not None and self.said_about != path:
+            self.say("")
+
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if self.screen_stack:  # not once the app has closed (a late message)
             self.refresh_bindings()
 
-    def action_help(self) -> None:
-        """Textual's key panel: the keys of the focused widget and of the app, as they change.
-        Pressed again it shows the next page of a panel taller than the screen (it takes no
-        focus, so no other key scrolls it), and hides it after the last."""
-        panels = self.screen.query("HelpPanel KeyPanel")
-        if not panels:
-            self.action_show_help_panel()
-            return
-        keys = panels.first()
-        if keys.scroll_y < keys.max_scroll_y:
-            keys.scroll_page_down(animate=False)
-        else:
-            self.action_hide_help_panel()
-
-    def action_toggle_keys(self) -> None:
-        """? shows the key panel, or hides it (F1 pages through it)."""
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
-            self.action_show_help_panel()
-
-    def action_hide_keys(self) -> None:
-        if self.screen.query("HelpPanel"):
-            self.action_hide_help_panel()
-        else:
-            raise SkipAction()  # Esc means nothing here: another part may take it
-
-    def action_help_quit(self, in_field: bool = False) -> None:
-        """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
-        where = "Ctrl+C copies in a text field. " if in_field else ""
-        self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
-                 "a run goes on after you quit unless you cancel it.")  # fmt: skip
-
     # ------------------------------------------------------------ the status line
 
-    def say(self, text: str, severity: str = "information", title: str = "") -> None:
-        """Show ``text`` in the status line above the footer (never over the data); it
-        stays until the next message. ``text`` is shown as it is, never as markup."""
+    def say(self, text: str, severity: str = "information", title: str = "", about: Path | None = None) -> None:
+        """Show ``text`` in the status line above the footer (never over the data); it stays
+        until the next message, or (``about``: the run or preset folder or file it speaks of)
+        until another row of a list is highlighted. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{shown(title)}: ", "bold") if title else "", shown(text))  # no escape code from a folder
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
+        self.said_about = about
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -276,7 +267,7 @@ class FrictionlabApp(RunControl, App):
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}")
+                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}", about=path)
                 return
             self.draft_source = path
         else:
@@ -297,7 +288,7 @@ class FrictionlabApp(RunControl, App):
         try:
             data = load_preset_file(entry.path)
         except PresetError as exc:
-            self.say(problems_text(exc.problems), "error", title="Cannot duplicate")
+            self.say(problems_text(exc.problems), "error", title="Cannot duplicate", about=entry.path)
             return
         data["name"] = f"{data.get('name') or entry.path.stem}-copy"
         default = self.save_folder / f"{entry.path.stem}-copy.yaml"  # where n and Ctrl+S save too

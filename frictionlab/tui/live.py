@@ -70,6 +70,7 @@ class LiveListener:
             if result.ok:
                 self._add(result)
         self._started = self.clock()
+        self._all_done_at = self._started if run.resumed >= run.total else None
         self._last_post = self._started
         self.post(self._snapshot(run.resumed, run.total))
 
@@ -121,6 +122,8 @@ class LiveListener:
     def _maybe_post(self, done: int, total: int) -> None:
         self._done, self._total, self._solving = done, total, ""
         now = self.clock()
+        if done >= total and self._all_done_at is None:
+            self._all_done_at = now
         if done in (1, total) or now - self._last_post >= self.interval:  # the plot appears at once
             self._last_post = now
             self.post(self._snapshot(done, total))
@@ -133,11 +136,14 @@ class LiveListener:
             xi = self._xi_sum / self._ok
             count = self._count_sum / self._ok
             fit = interim_fit(f, xi)
+        # the time the realizations took: it stops with the last one, as the run's own elapsed
+        # time (its summary's) does, and the rate with it (not falling while the results are written)
+        end = self.clock() if self._all_done_at is None else self._all_done_at
         return Snapshot(
             done=done,
             total=total,
             failed=self._failed,
-            elapsed=self.clock() - self._started,
+            elapsed=end - self._started,
             f=f,
             xi=xi,
             contact_count=count,
@@ -146,7 +152,7 @@ class LiveListener:
             finished=finished,
             f_formula=self._f_formula,
             restored=self._restored,
-            solving="" if finished else self._solving,
+            solving="" if finished else "writing the results" if self._all_done_at is not None else self._solving,
         )
 
 

@@ -80,7 +80,7 @@ class RunControl:
 
     def _refuse_damaged(self, folder: Path, reason: str) -> None:
         self.say(f"{folder.name} is damaged: {reason}. Nothing of it was changed; move it aside "
-                 "or repair that file to go on.", "error", title="Cannot resume")  # fmt: skip
+                 "or repair that file to go on.", "error", title="Cannot resume", about=folder)  # fmt: skip
 
     def resume_run(self, folder: Path | None) -> None:
         """Continue a cancelled or interrupted run in ``folder`` with the preset stored
@@ -102,7 +102,7 @@ class RunControl:
                     self.show_running(folder)
                 return
             if state.kind == "sweep" and state.status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning", about=folder)
                 return
             if state.status == "damaged":  # a resume would rewrite the damaged file: the user did not ask that
                 self._refuse_damaged(folder, state.reason)
@@ -117,7 +117,7 @@ class RunControl:
             # not a run folder (yet): said below
         try:
             if read_run(folder).status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning")
+                self.say(f"{folder.name} is complete: nothing to resume.", "warning", about=folder)
                 return
         except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
@@ -154,9 +154,9 @@ class RunControl:
         try:
             return self._stored(folder)
         except RunFolderError as exc:
-            self.say(str(exc), "error", title=f"Cannot {verb}")
+            self.say(str(exc), "error", title=f"Cannot {verb}", about=folder)
         except PresetError as exc:
-            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}")
+            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}", about=folder)
         return None
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
@@ -174,7 +174,8 @@ class RunControl:
             if options.resume and lock_held(out_dir):  # another TUI (or the CLI) resumed it first
                 self._follow_the_winner(out_dir)
                 return
-            self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run")
+            self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run",
+                     about=out_dir if options.resume else None)
             return
         try:
             preset = scene.resolved() if sweep is None else sweep.preset_data
@@ -185,6 +186,8 @@ class RunControl:
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
         self.query_one("RunPane").start(scene, sweep, out_dir)
+        if options.resume and sweep is None:  # what it restores, at once: not 0 % until its process has begun
+            self._show_stored(out_dir)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
@@ -203,7 +206,8 @@ class RunControl:
         """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
         if self.followed is None or self.followed.folder.resolve() != folder.resolve():
             if self.running:
-                self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).", "warning")
+                self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).",
+                         "warning", about=folder)
                 return
             self.follow_run(folder)
         self.action_show_tab("run")
@@ -266,6 +270,16 @@ class RunControl:
             self.reload_runs()
             return
         self.on_run_finished(RunFinished(finished, followed.folder))
+
+    def _show_stored(self, folder: Path) -> None:
+        from ..runs.detached import stored_count
+
+        try:
+            done, total = stored_count(folder)
+        except (OSError, FrictionlabError):
+            return
+        if done is not None and total:
+            self.query_one("RunPane").show_stored_count(done, total, resuming=True)
 
     def _count_from_chunks(self, followed: FollowedRun) -> None:
         """A run whose progress file cannot be written: said once; its count read from its chunks."""

@@ -95,3 +95,38 @@ def test_live_f_of_loads_given_as_f_or_a_pressure_is_the_run_s(registry, unit, s
     np.testing.assert_allclose(posted[-1].f, outcome.f, rtol=1e-12)
     if unit == "f":
         np.testing.assert_allclose(outcome.f, np.geomspace(start, stop, scene.loads.size), rtol=1e-12)
+
+
+def test_once_every_realization_is_done_the_elapsed_time_and_the_rate_stop(registry):
+    """While a finished run writes its results (seconds on a loaded machine), the progress line's
+    elapsed time went on and its rate fell (50 in 0.3 s read "9.8/s, elapsed 5.1 s") under a final
+    line of "in 0.3 s": the line stops with the last realization, and says what the run does."""
+    from types import SimpleNamespace
+
+    from frictionlab.plugin.hookspecs import hookimpl
+    from frictionlab.plugin.listeners import progress_text
+
+    scene = build_scene(merge(TINY, {"realizations": 4}), registry=registry)
+    now = [100.0]
+    posted = []
+    live = LiveListener(posted.append, interval=0.0, clock=lambda: now[0])
+    live.run_started(run=SimpleNamespace(scene=scene, resumed=0, total=4, restored=[]))
+    results = []
+
+    class Keep:
+        @hookimpl
+        def realization_done(self, result):
+            results.append(result)
+
+    engine_run(scene, RunOptions(workers=1), listeners=[Keep()])
+    for done, result in enumerate(results, start=1):
+        now[0] += 0.25
+        live.realization_done(result=result, done=done, total=4)
+    now[0] += 5.0  # the results written, the process ending
+    live.tick()
+    live.run_finished()
+    writing, finished = posted[-2], posted[-1]
+    assert writing.elapsed == pytest.approx(1.0) and finished.elapsed == pytest.approx(1.0)
+    assert writing.solving == "writing the results" and finished.solving == ""
+    line = progress_text(writing.done, writing.total, writing.failed, writing.elapsed)
+    assert "4.0/s" in line and "elapsed 1.0 s" in line

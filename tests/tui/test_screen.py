@@ -302,6 +302,7 @@ async def test_home_then_a_key_types_at_the_start(folders, registry):
 
 @sync
 async def test_f1_shows_and_hides_the_key_panel_of_the_focused_part(folders, registry):
+    make_runs(folders, registry)  # Results lists Compare with a run to compare
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()

@@ -93,3 +93,15 @@ async def test_enter_typed_before_the_terminal_was_raw_opens_the_highlighted_pre
         await wait_until(pilot, lambda: app.built)  # a loaded machine builds the app late
         await wait_until(pilot, lambda: app.query_one("#tabs").active == "edit", timeout=10.0)
         assert app.draft_path is not None and app.draft_path.name == "tiny.yaml"  # the first preset listed
+
+
+@sync
+async def test_keys_typed_before_the_preset_opened_from_the_command_line_is_built_act_in_order(folders, registry):
+    """``frictionlab tui PRESET``: Tab then typing, before its Edit form exists, goes into the
+    form's first field (the letters were handed to the form, which does not type, and lost)."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        post_keys(app, ["tab", *"abc"])
+        await wait_until(pilot, lambda: app.built)
+        await wait_until(pilot, lambda: app.query_one("#field--name").value == TINY["name"] + "abc", timeout=10.0)
+        await wait_until(pilot, lambda: app.modified, timeout=10.0)  # the form tells the app as it can

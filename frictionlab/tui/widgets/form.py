@@ -364,10 +364,10 @@ class PresetForm(VerticalScroll):
         fields = [w for w in self.query("Input, Select, Switch") if w.focusable]
         last = self._last_field if self._last_field in fields else None
         if last is not None or fields:
-            (last or fields[0]).focus()
+            self.screen.set_focus(last or fields[0])  # now, not after the keys already queued (focus() waits)
 
     def action_leave_field(self) -> None:
-        self.focus(scroll_visible=False)
+        self.screen.set_focus(self, scroll_visible=False)  # the next key (q) is the app's, never the field's
 
     def on_focus(self, event) -> None:
         self.post_message(self.FieldFocused(None))

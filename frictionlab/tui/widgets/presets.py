@@ -99,6 +99,8 @@ class PresetsPane(Vertical):
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         self._show_info(event.cursor_row)
+        entry = self.selected()
+        self.app.row_highlighted(entry.path if entry is not None else None)
 
     def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
         event.stop()

@@ -17,6 +17,7 @@ from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown
 from ...compute.fit import format_interval
+from ...runs.detached import RESUMABLE
 from ..chart import Series
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
@@ -39,6 +40,9 @@ class ResultsPane(Vertical):
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
+        # the same keys on a row where they cannot act (check_action hides those above): the status line says why
+        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
+          for key, action in (("space", "compare"), ("u", "resume"))),
     ]
 
     def __init__(self, **kwargs):
@@ -47,6 +51,8 @@ class ResultsPane(Vertical):
         self.overlay: list[RunEntry] = []  # the runs drawn, at most one per style
         self.open_sweep: SweepEntry | None = None  # the sweep whose points are listed
         self._shown: list[Path] = []  # the folders the list shows, in its order
+        self._footer_row: tuple | None = None  # the (folder, status) the footer's keys were for
+        self._info_about: Path | None = None  # the damaged run whose reason the info box shows
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -73,6 +79,47 @@ class ResultsPane(Vertical):
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
+
+    def highlighted(self) -> RunEntry | SweepEntry | None:
+        row = self.query_one("#runs-table", DataTable).cursor_row
+        return self.runs[row] if 0 <= row < len(self.runs) else None
+
+    def check_action(self, action: str, parameters) -> bool:
+        """The footer offers what the highlighted row allows: Resume on a run or sweep that ended
+        before it completed, Compare on a run with a curve (or on a sweep's point)."""
+        if action not in ("resume", "compare"):
+            return True
+        entry = self.highlighted()
+        if action == "compare" and self.open_sweep is not None and self.query_one("#results-sweep").has_focus:
+            return True
+        if entry is None:
+            return False
+        if action == "resume":
+            return entry.status in RESUMABLE
+        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running")
+
+    def action_unavailable(self, action: str) -> None:
+        """A key pressed on a row where its action cannot act: run anyway, to say why."""
+        getattr(self, f"action_{action}")()
+
+    def _refresh_footer(self) -> None:
+        """The footer again when what the highlighted row allows may differ (another row, a status
+        changed), not at each reload: the footer is rebuilt each time."""
+        entry = self.highlighted()
+        now = (entry.path, entry.status) if entry is not None else None
+        if now != self._footer_row:
+            self._footer_row = now
+            self.app.refresh_bindings()
+
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        self._refresh_footer()  # what this row allows
+        if event.data_table.id == "runs-table":
+            entry = self.highlighted()
+            self.app.row_highlighted(entry.path if entry is not None else None)
+            if self._info_about is not None and (entry is None or entry.path != self._info_about):
+                self._show_overlay()  # the damaged row's reason goes with it: the overlay's lines again
+        elif self.open_sweep is not None:  # a point of the open sweep
+            self.app.row_highlighted(self.open_sweep.path / f"point {event.cursor_row}")
 
     def action_compare(self) -> None:
         self.open_selected(overlay=True)
@@ -121,6 +168,7 @@ class ResultsPane(Vertical):
             table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
         if self.runs:
             table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
+        self._refresh_footer()  # the highlighted row's status may have changed (a run ended)
 
     def open_selected(self, overlay: bool) -> None:
         """Enter/Space on the list of runs, or on the open sweep's table of points."""
@@ -132,7 +180,8 @@ class ResultsPane(Vertical):
             try:
                 entry = read_run(self.open_sweep.point_folder(self.open_sweep.points[row]))
             except (OSError, FrictionlabError) as exc:
-                self.app.say(f"this point has no finished run to show ({exc})", "warning")
+                self.app.say(f"this point has no finished run to show ({exc})", "warning",
+                             about=self.open_sweep.path / f"point {row}")
                 return
         else:
             row = self.query_one("#runs-table", DataTable).cursor_row
@@ -141,15 +190,17 @@ class ResultsPane(Vertical):
                 return
             entry = self.runs[row]
             if entry.status == "damaged":  # nothing to show but why
-                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning")
+                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
                 self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                self._info_about = entry.path
                 return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return
             if isinstance(entry, SweepEntry):
                 if overlay:
-                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.", "warning")
+                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.",
+                                 "warning", about=entry.path)
                 else:
                     self._show_sweep(entry)
                 return
@@ -181,6 +232,7 @@ class ResultsPane(Vertical):
         table.focus()
 
     def _show_overlay(self) -> None:
+        self._info_about = None
         series, lines = [], []
         for style, entry in zip(OVERLAY_STYLES, self.overlay):
             try:

@@ -165,10 +165,12 @@ class RunPane(Vertical, can_focus=True):
         if snap.first_error:
             self._error(snap.first_error)
 
-    def show_stored_count(self, done: int, total: int) -> None:
-        """The count the run folder's chunks hold (when there is no progress file to read)."""
+    def show_stored_count(self, done: int, total: int, resuming: bool = False) -> None:
+        """The count the run folder's chunks hold (when there is no progress file to read, or
+        as a resume begins, before its process says what it restored)."""
         self.query_one("#run-bar", ProgressBar).update(total=total, progress=done)
-        self._set("run-stats", f"{done}/{total} realizations stored (read from the run's chunks)")
+        what = "resuming" if resuming else "read from the run's chunks"
+        self._set("run-stats", f"{done}/{total} realizations stored ({what})")
 
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the solves running stop; what finished is kept")

@@ -1,0 +1,32 @@
+"""Keys that move the focus act before the next key is handed on.
+
+Textual hands a key to the focused widget and runs a binding of a widget above it (Tab's
+focus_next, the form's Enter and Esc) only once the key has bubbled back up, one message
+queue at a time; keys typed meanwhile (fast typing, or the keys held while the app was
+built) are handed to the widget focused before. Tab then ``abc`` lost the letters on the
+form, and Esc then ``q`` in a field typed the q there, though q quits outside a field.
+Such a key's binding is run here, at once, in the app's queue, so each key after it goes
+where the focus now is.
+"""
+
+from __future__ import annotations
+
+from textual import events
+
+# the actions that only move the focus: run at once, they change nothing else than Textual's own order would
+FOCUS_ACTIONS = frozenset({"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field"})
+
+
+async def answer_focus_key(app, key: events.Key) -> bool:
+    """Run ``key``'s binding now if the binding it would reach (the first from the focused
+    widget up) moves the focus; True if it did. A printable key is the focused field's."""
+    if key.is_printable or key.is_forwarded:
+        return False
+    for namespace, bindings in app.screen._modal_binding_chain:
+        for binding in bindings.key_to_bindings.get(key.key, ()):
+            if binding.priority:
+                continue  # the app ran those before
+            if binding.action not in FOCUS_ACTIONS:
+                return False  # another binding comes first: Textual's order
+            return await app.run_action(binding.action, namespace)
+    return False

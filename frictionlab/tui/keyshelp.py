@@ -1,0 +1,43 @@
+"""The keys panel and the quit hint: the app's actions that show what the keys are
+(``FrictionlabApp``'s, a mixin)."""
+
+from __future__ import annotations
+
+from textual.actions import SkipAction
+
+
+class KeysHelp:
+    """F1, ``?``, Esc on the keys panel, and Ctrl+C's hint (``FrictionlabApp``'s)."""
+
+    def action_help(self) -> None:
+        """Textual's key panel: the keys of the focused widget and of the app, as they change.
+        Pressed again it shows the next page of a panel taller than the screen (it takes no
+        focus, so no other key scrolls it), and hides it after the last."""
+        panels = self.screen.query("HelpPanel KeyPanel")
+        if not panels:
+            self.action_show_help_panel()
+            return
+        keys = panels.first()
+        if keys.scroll_y < keys.max_scroll_y:
+            keys.scroll_page_down(animate=False)
+        else:
+            self.action_hide_help_panel()
+
+    def action_toggle_keys(self) -> None:
+        """? shows the key panel, or hides it (F1 pages through it)."""
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            self.action_show_help_panel()
+
+    def action_hide_keys(self) -> None:
+        if self.screen.query("HelpPanel"):
+            self.action_hide_help_panel()
+        else:
+            raise SkipAction()  # Esc means nothing here: another part may take it
+
+    def action_help_quit(self, in_field: bool = False) -> None:
+        """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
+        where = "Ctrl+C copies in a text field. " if in_field else ""
+        self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
+                 "a run goes on after you quit unless you cancel it.")  # fmt: skip

@@ -1,0 +1,68 @@
+"""The footer lists only the keys that can act where the user is: on the highlighted row of
+Results, with a preset open or not, with a run going or not. A listed key that cannot act
+(u Resume on a completed run) sent a newcomer to it for a refusal; unlisted, it still says why."""
+
+import json
+
+from .conftest import SIZE, make_app, make_runs, screen_text, status_text, sync, wait_until
+
+
+def footer(app) -> str:
+    return screen_text(app).splitlines()[-1]
+
+
+def interrupted_copy(folders, name: str) -> None:
+    """A copy of the completed run ``name`` as an interrupted run's summary tells it."""
+    import shutil
+
+    copy = folders / "runs" / "stopped"
+    shutil.copytree(folders / "runs" / name, copy)
+    (copy / "run.json").unlink()  # the summary alone says how it ended
+    summary = json.loads((copy / "summary.json").read_text())
+    summary["status"] = "interrupted"
+    (copy / "summary.json").write_text(json.dumps(summary))
+
+
+@sync
+async def test_results_offers_resume_only_on_a_run_that_can_go_on(folders, registry):
+    make_runs(folders, registry)
+    interrupted_copy(folders, "seed1")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        await pilot.pause()
+        pane = app.query_one("ResultsPane")
+        rows = {entry.status: row for row, entry in enumerate(pane.runs)}
+        table = app.query_one("#runs-table")
+        table.move_cursor(row=rows["completed"])
+        await pilot.pause()
+        on_completed = footer(app)
+        table.move_cursor(row=rows["interrupted"])
+        await pilot.pause()
+        on_interrupted = footer(app)
+        table.move_cursor(row=rows["completed"])
+        await pilot.pause()
+        await pilot.press("u")  # not listed: it still says why
+        await pilot.pause()
+        said = status_text(app)
+    assert "u Resume" not in on_completed and "space Compare" in on_completed
+    assert "u Resume" in on_interrupted
+    assert "complete: nothing to resume" in said
+
+
+@sync
+async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        nothing_open = footer(app)
+        await pilot.press("ctrl+r")  # not listed: it says why
+        await pilot.pause()
+        said = status_text(app)
+        await pilot.press("enter")
+        await wait_until(pilot, lambda: app.draft_path is not None)
+        await pilot.pause()
+        open_ = footer(app)
+    assert "^s Save" not in nothing_open and "^r Run" not in nothing_open
+    assert said.startswith("No preset open")
+    assert "^s Save" in open_ and "^r Run" in open_

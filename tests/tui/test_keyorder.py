@@ -1,0 +1,30 @@
+"""Keys typed fast act in the order typed where one of them moves the focus: the keys after it
+go where the focus went (Textual ran Tab's, Enter's and Esc's bindings only once the key had
+bubbled up, and handed the keys typed meanwhile to the widget focused before)."""
+
+from textual.widgets import Input
+
+from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, sync, wait_until
+
+
+@sync
+async def test_enter_then_typing_on_the_form_types_into_the_field(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        assert app.focused is form
+        post_keys(app, ["enter", *"xy"])
+        await wait_until(pilot, lambda: app.query_one("#field--name", Input).value == TINY["name"] + "xy", timeout=10.0)
+
+
+@sync
+async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, registry):
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        await pilot.press("enter")  # into the name field
+        await pilot.pause()
+        assert isinstance(app.focused, Input)
+        post_keys(app, ["escape", "q"])
+        await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
+        assert not app.modified  # the q was never typed into the name

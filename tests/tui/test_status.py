@@ -1,0 +1,85 @@
+"""The status line speaks of what is there: a message about a row of a list (a damaged
+run, a run that cannot be resumed, a preset that cannot be opened) is taken back once
+another row is highlighted (it stayed, under the row it no longer spoke of)."""
+
+from .conftest import SIZE, make_app, make_runs, status_text, sync, wait_until
+
+
+@sync
+async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighted(folders, registry):
+    make_runs(folders, registry)
+    runs = folders / "runs"
+    (runs / "seed2" / "summary.json").write_text("{junk")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        await pilot.pause()
+        names = [entry.path.name for entry in app.query_one("ResultsPane").runs]
+        table = app.query_one("#runs-table")
+        table.move_cursor(row=names.index("seed2"))
+        await pilot.press("enter")
+        await pilot.pause()
+        damaged = status_text(app)
+        info = str(app.query_one("#results-info").render())
+        table.move_cursor(row=names.index("seed1"))
+        await pilot.pause()
+        after_moving = status_text(app)
+        info_after_moving = str(app.query_one("#results-info").render())
+        await pilot.press("u")  # a completed run: nothing to resume
+        await pilot.pause()
+        complete = status_text(app)
+        await pilot.press("r")  # the list read again, the same row highlighted: it still speaks of it
+        await pilot.pause()
+        after_reload = status_text(app)
+        table.move_cursor(row=names.index("seed2"))
+        await pilot.pause()
+        after_moving_back = status_text(app)
+    assert "seed2 is damaged" in damaged
+    assert after_moving == ""
+    assert "damaged" in info and "damaged" not in info_after_moving  # the box beside the plot too
+    assert "seed1 is complete" in complete and after_reload == complete
+    assert after_moving_back == ""
+
+
+@sync
+async def test_a_preset_that_cannot_be_opened_is_no_longer_named_once_another_is_highlighted(folders, registry):
+    (folders / "presets" / "broken.yaml").write_text("name: [unclosed\n")
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        pane = app.query_one("PresetsPane")
+        rows = {entry.path.name: row for row, entry in enumerate(pane.presets)}
+        table = app.query_one("#preset-table")
+        table.move_cursor(row=rows["broken.yaml"])
+        await pilot.pause()
+        await pilot.press("enter")
+        await pilot.pause()
+        refused = status_text(app)
+        table.move_cursor(row=rows["tiny.yaml"])
+        await pilot.pause()
+        moved = status_text(app)
+    assert "Cannot open broken.yaml" in refused
+    assert moved == ""
+
+
+@sync
+async def test_a_resume_shows_the_realizations_its_folder_stores_at_once(folders, registry):
+    """Not 0 % until the resumed run's process has begun and told its count."""
+    import json
+
+    make_runs(folders, registry)
+    folder = folders / "runs" / "seed1"
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest["status"] = "interrupted"  # as a run killed after its last chunk was stored
+    (folder / "run.json").write_text(json.dumps(manifest))
+    (folder / "summary.json").unlink()
+    total = manifest["realizations"]
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f5")
+        app.resume_run(folder)
+        bar, stats = app.query_one("#run-bar"), str(app.query_one("#run-stats").render())
+        shown = (bar.progress, bar.total)
+        await wait_until(pilot, lambda: app.followed is None)
+    assert shown == (total, total)
+    assert stats == f"{total}/{total} realizations stored (resuming)"
