@@ -75,6 +75,20 @@ def make_app(registry, preset=None, workers=1):
     return FrictionlabApp(preset, presets_dir="presets", runs_dir="runs", options=RunOptions(workers=workers), registry=registry)
 
 
+@contextlib.asynccontextmanager
+async def started(app, size=SIZE):
+    """``app.run_test`` at ``size``; its pilot is handed over once the first screen has settled."""
+    async with app.run_test(size=size) as pilot:
+        await pilot.pause()
+        yield pilot
+
+
+async def press_settled(pilot, *keys) -> None:
+    """Press ``keys``, then let the app answer them (one pause)."""
+    await pilot.press(*keys)
+    await pilot.pause()
+
+
 async def new_preset(pilot, name: str) -> None:
     """Press n and accept the New dialog with ``name`` (its default template and file)."""
     await pilot.pause()

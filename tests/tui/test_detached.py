@@ -25,6 +25,7 @@ from .conftest import (
     make_app,
     numbers_in,
     press_run,
+    press_settled,
     screen_text,
     status_text,
     sync,
@@ -65,8 +66,7 @@ async def test_a_tui_opened_later_shows_the_running_run_live_and_lists_it(folder
             first = numbers_in(stats(app))[0]
             await wait_until(pilot, lambda: numbers_in(stats(app))[0] > first)  # live: the count moves
             shown, said = screen_text(app), status_text(app)
-            await pilot.press("f5")
-            await pilot.pause()
+            await press_settled(pilot, "f5")
             listed = app.query_one(ResultsPane).runs
             results = screen_text(app)
         assert "long: 100000 realizations" in shown and "/100000 realizations" in shown
@@ -95,14 +95,12 @@ async def a_long_run_going(folders, registry, preset: str = "long.yaml", data: d
 async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_waiting(folders, registry):
     async with a_long_run_going(folders, registry) as (app, pilot):
         pid, out = app.followed.pid, app.followed.folder
-        await pilot.press("ctrl+q")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+q")
         asked = screen_text(app)
         await pilot.press("escape")  # stay: nothing is cancelled
         await pilot.pause(0.5)
         stayed = app.is_running and app.followed is not None and not app.followed.cancelling
-        await pilot.press("ctrl+q", "l")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+q", "l")
         quit_at_once = not app.is_running and process_alive(pid)
     try:
         assert "Leave it running" in asked and "cancel it" in asked and f"pid {pid}" in asked
@@ -116,8 +114,7 @@ async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_wai
 async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(folders, registry):
     async with a_long_run_going(folders, registry) as (app, pilot):
         pid, out = app.followed.pid, app.followed.folder
-        await pilot.press("ctrl+q", "c")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+q", "c")
         quit_at_once = not app.is_running
     try:
         wait_for(lambda: not process_alive(pid))
@@ -134,8 +131,7 @@ async def test_unsaved_changes_are_asked_about_first_and_keeping_them_cancels_no
     async with a_long_run_going(folders, registry) as (app, pilot):
         pid = app.followed.pid
         app.modified = True  # the preset was edited meanwhile
-        await pilot.press("ctrl+q")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+q")
         asked = screen_text(app)
         await pilot.press("n")
         await pilot.pause(0.5)
@@ -147,8 +143,7 @@ async def test_unsaved_changes_are_asked_about_first_and_keeping_them_cancels_no
         await pilot.press("ctrl+q", "y")  # now quit: the run's question follows
         await pilot.pause()
         then = screen_text(app)
-        await pilot.press("l")
-        await pilot.pause()
+        await press_settled(pilot, "l")
         left = not app.is_running and process_alive(pid)
     end(pid)
     assert "unsaved changes. Quit anyway?" in asked and "Leave it running" not in asked
@@ -204,11 +199,9 @@ async def test_ctrl_r_on_a_sweep_starts_it_detached_and_quit_leave_keeps_it_runn
         followed = app.followed
         pid, out = followed.pid, followed.folder
         shown = screen_text(app)
-        await pilot.press("ctrl+q")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+q")
         asked = screen_text(app)
-        await pilot.press("l")
-        await pilot.pause()
+        await press_settled(pilot, "l")
         quit_at_once = not app.is_running and process_alive(pid)
     try:
         assert isinstance(followed, FollowedSweep) and pid != os.getpid()  # a process of its own, not this one
@@ -239,8 +232,7 @@ async def test_a_tui_opened_later_attaches_to_a_running_sweep_its_table_and_poin
             table = app.query_one("#sweep-table")
             cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
             shown = screen_text(app)
-            await pilot.press("f5")
-            await pilot.pause()
+            await press_settled(pilot, "f5")
             listed = [(e.path.name, e.status) for e in app.query_one(ResultsPane).runs]
             await pilot.press("enter")  # on the running sweep: the Run tab, following it
             await pilot.pause()
@@ -267,8 +259,7 @@ async def test_u_on_an_interrupted_sweep_resumes_it_detached(folders, registry):
     process.wait()
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         listed = [(e.path.name, e.status) for e in app.query_one(ResultsPane).runs]
         await pilot.press("u")
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.total == 100_000
@@ -302,15 +293,13 @@ async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the
     app = make_app(registry)
     try:
         async with app.run_test(size=SIZE) as pilot:
-            await pilot.press("f5")
-            await pilot.pause()
+            await press_settled(pilot, "f5")
             pressed = time.monotonic()
             await pilot.press("u")
             await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= restored + 10)
             shown, waited = stats(app), time.monotonic() - pressed
             followed = app.followed
-            await pilot.press("ctrl+q", "c")
-            await pilot.pause()
+            await press_settled(pilot, "ctrl+q", "c")
     finally:
         end(followed.pid)
     done, total, kept, rate, elapsed = numbers_in(shown.split(", left")[0])
@@ -336,12 +325,10 @@ async def test_a_resumed_sweep_has_one_row_a_point_in_the_run_tabs_table_updated
     process.wait()
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         await pilot.press("u")
         await wait_until(pilot, lambda: isinstance(app.last_outcome, FinishedSweep), timeout=120)
-        await pilot.press("f4")
-        await pilot.pause()
+        await press_settled(pilot, "f4")
         table = app.query_one("#sweep-table")
         cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
     rows = json.loads((out / "sweep.json").read_text())["points"]
@@ -355,8 +342,7 @@ async def test_the_run_tabs_footer_offers_only_the_keys_that_apply_now(folders, 
     app = make_app(registry, preset="presets/long.yaml", workers=1)
     footer = lambda: screen_text(app).splitlines()[-1]  # noqa: E731
     async with app.run_test(size=(120, 24)) as pilot:
-        await pilot.press("f4")
-        await pilot.pause()
+        await press_settled(pilot, "f4")
         before = footer()
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_outcome is not None)

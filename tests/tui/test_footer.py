@@ -4,7 +4,7 @@ Results, with a preset open or not, with a run going or not. A listed key that c
 
 import json
 
-from .conftest import SIZE, make_app, make_runs, screen_text, status_text, sync, wait_until
+from .conftest import SIZE, make_app, make_runs, press_settled, screen_text, started, status_text, sync, wait_until
 
 
 def footer(app) -> str:
@@ -29,8 +29,7 @@ async def test_results_offers_resume_only_on_a_run_that_can_go_on(folders, regis
     interrupted_copy(folders, "seed1")
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         pane = app.query_one("ResultsPane")
         rows = {entry.status: row for row, entry in enumerate(pane.runs)}
         table = app.query_one("#runs-table")
@@ -53,8 +52,7 @@ async def test_results_offers_resume_only_on_a_run_that_can_go_on(folders, regis
 @sync
 async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         nothing_open = footer(app)
         await pilot.press("ctrl+r")  # not listed: it says why
         await pilot.pause()

@@ -24,6 +24,7 @@ from .conftest import (
     make_app,
     new_preset,
     open_first_preset,
+    press_settled,
     sync,
     type_into,
 )
@@ -55,8 +56,7 @@ async def test_invalid_value_shows_the_headless_message_then_save_round_trips(fo
         await type_into(pilot, "field--spectrum--params--hurst", "0.9")
         assert form.problems == []
         assert error_text(app, "field--spectrum--params--hurst") == ""
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         assert not app.modified
 
     saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
@@ -77,20 +77,16 @@ async def test_save_with_problems_asks_first_and_keeps_unknown_sections(folders,
         assert form.problems == headless_problems(data, registry)
         assert any(p.startswith("notes: ") for p in form.problems)
         await type_into(pilot, "field--seed", "11")
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         assert app.modified, "saved a preset with problems without asking"
         await pilot.press("n")  # no: nothing is written
         await pilot.pause()
         assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == TINY["seed"]
-        await pilot.press("ctrl+s")
-        await pilot.pause()
-        await pilot.press("y")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
+        await press_settled(pilot, "y")
         assert not app.modified
         # and a run is refused, with the problems named
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         assert app.last_snapshot is None and not app.running
     saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
     assert saved == {**data, "seed": 11}
@@ -132,8 +128,7 @@ async def test_editing_a_commented_shipped_preset_keeps_its_comments(folders, re
         assert form.data["name"] == "benad2012-fig2"
         await type_into(pilot, "field--spectrum--params--hurst", "0.75")
         assert form.problems == []
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         assert not app.modified
     text = path.read_text()
     assert comment_lines(text) == comment_lines(original) and "h = 1e4" in text
@@ -179,8 +174,7 @@ async def test_a_third_party_plugin_gets_a_form_without_code(folders, register_p
         await type_into(pilot, "field--slope--params--window", "5")
         await choose(pilot, "field--slope--params--edge", "reflect")
         app.query_one(prefix + "normalise", Switch).focus()
-        await pilot.press("space")
-        await pilot.pause()
+        await press_settled(pilot, "space")
         assert form.data["slope"] == {
             "name": "smoothed-difference",
             "params": {"window": 5, "edge": "reflect", "normalise": True},
@@ -205,7 +199,6 @@ async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all
         await type_into(pilot, "field--spectrum--params--hurst", "0.7")
         await type_into(pilot, "field--spectrum--params--points", "256")
         assert form.problems == []
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
     assert app.draft_path == Path("presets/fresh.yaml")  # the folder the list shows
     assert load_scene(folders / "presets" / "fresh.yaml", registry=registry).spectrum.params.points == 256

@@ -17,7 +17,19 @@ from frictionlab.runs.rundir import new_run_folder
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
-from .conftest import SIZE, TINY, make_app, make_runs, numbers_in, screen_text, status_text, sync, wait_until
+from .conftest import (
+    SIZE,
+    TINY,
+    make_app,
+    make_runs,
+    numbers_in,
+    press_settled,
+    screen_text,
+    started,
+    status_text,
+    sync,
+    wait_until,
+)
 
 
 @pytest.mark.long
@@ -33,10 +45,8 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
     (runs / "sw").mkdir()
     (runs / "sw" / "sweep.json").write_text("not a sweep")
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("f5")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5")
         pane = app.query_one(ResultsPane)
         assert {e.path.name: e.status for e in pane.runs} == {"seed1": "damaged", "seed2": "damaged", "seed3": "damaged", "sw": "damaged"}
         screen = screen_text(app)
@@ -44,14 +54,12 @@ async def test_damaged_run_folders_are_listed_with_their_reason(folders, registr
             line = next(line for line in screen.splitlines() if f" {name} " in line)
             assert "✗" in line and "damaged" in line, line
         row = [e.path.name for e in pane.runs].index("seed2")
-        await pilot.press(*["down"] * row, "enter")
-        await pilot.pause()
+        await press_settled(pilot, *["down"] * row, "enter")
         assert "seed2 is damaged: summary.json" in status_text(app) and "link" in status_text(app)
         junk = (runs / "seed1" / "summary.json").read_bytes()
         for name in ("seed1", "seed2", "seed3"):  # u refuses, naming the damage; nothing is rewritten, no link replaced
             row = [e.path.name for e in pane.runs].index(name)
-            await pilot.press("f5", "home", *["down"] * row, "u")
-            await pilot.pause()
+            await press_settled(pilot, "f5", "home", *["down"] * row, "u")
             said = status_text(app)
             assert said.startswith("Cannot resume") and f"{name} is damaged" in said and app.followed is None, said
     assert (runs / "seed1" / "summary.json").read_bytes() == junk and (runs / "seed2" / "summary.json").is_symlink()
@@ -64,15 +72,12 @@ async def test_q_on_a_freshly_opened_preset_quits_and_never_types(folders, regis
     """Opened either way, the form has the focus, not its `name` field: q quits (it typed
     `smallq` into the name before); the footer offers Enter into the fields."""
     app = make_app(registry, preset="presets/tiny.yaml" if route == "command line" else None)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         if route == "list":
-            await pilot.press("enter")
-            await pilot.pause()
+            await press_settled(pilot, "enter")
         await wait_until(pilot, lambda: "Edit" in screen_text(app).splitlines()[-1], 10)  # the footer, once refreshed
         screen = screen_text(app)
-        await pilot.press("q")
-        await pilot.pause()
+        await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert "(saved)" in screen and "smallq" not in screen
     assert "Enter or Tab: into the fields" in screen
@@ -87,13 +92,10 @@ async def test_q_after_a_refused_run_quits_and_never_types_into_the_field_at_fau
     `q` into it (an outsider's tmux check). The form keeps the focus; Enter goes in."""
     (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(merge(TINY, {"seed": -5})))
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+r")
         said = status_text(app)
-        await pilot.press("q")
-        await pilot.pause()
+        await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert said.startswith("Cannot run: 1 problem: seed")
     assert quit_by_q and yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == -5
@@ -103,18 +105,15 @@ async def test_q_after_a_refused_run_quits_and_never_types_into_the_field_at_fau
 @sync
 async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("enter", "x")  # into name, typed
         await pilot.pause()
         typed = app.query_one("#field--name").value
         footer_in_field = screen_text(app).splitlines()[-1]
-        await pilot.press("escape")
-        await pilot.pause()
+        await press_settled(pilot, "escape")
         left = app.focused.id
         app.modified = False
-        await pilot.press("q")
-        await pilot.pause()
+        await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert typed == "smallx" and "Leave field" in footer_in_field
     assert left == "form" and quit_by_q
@@ -128,12 +127,10 @@ async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(fol
     highlighted as rows are added above it."""
     make_runs(folders, registry)
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("f5")
         pane = app.query_one(ResultsPane)
-        await pilot.press("down")
-        await pilot.pause()
+        await press_settled(pilot, "down")
         highlighted = pane.runs[app.query_one("#runs-table").cursor_row].path
         scene = build_scene(merge(TINY, {"name": "elsewhere", "realizations": 100_000}), registry=registry)
         out = new_run_folder("elsewhere", "runs")
@@ -164,8 +161,7 @@ async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(
     tab offered no u and said "No run to resume" while Results' u resumed it."""
     (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
     app = make_app(registry, preset="presets/long.yaml", workers=1)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("ctrl+r")
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
         folder = app.followed.folder
@@ -173,8 +169,7 @@ async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(
         await wait_until(pilot, lambda: app.followed is None)
         await pilot.pause()
         footer, said = _footer(app), status_text(app)
-        await pilot.press("u")
-        await pilot.pause()
+        await press_settled(pilot, "u")
         resumed = app.followed is not None and app.followed.folder == folder
         pid = app.followed.pid if resumed else None
         said_after = status_text(app)
@@ -203,10 +198,8 @@ async def test_a_resume_that_another_process_began_first_is_followed_and_said_in
     try:
         assert holder.stdout.readline().strip() == b"held"
         app = make_app(registry)
-        async with app.run_test(size=SIZE) as pilot:
-            await pilot.pause()
-            await pilot.press("f5", "u")
-            await pilot.pause()
+        async with started(app) as pilot:
+            await press_settled(pilot, "f5", "u")
             following = app.followed is not None and app.followed.folder.resolve() == out.resolve()
             tab = app.query_one("#tabs").active
             screen = " ".join(screen_text(app).split())
@@ -247,8 +240,7 @@ async def test_a_resume_whose_progress_file_is_a_link_says_so_once_and_counts_it
     (out / "progress.jsonl").symlink_to(folders / "elsewhere.jsonl")
     app = make_app(registry)
     said = []
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         original = app.say
         app.say = lambda text, *a, **k: (said.append(text), original(text, *a, **k))
         await pilot.press("f5", "u")
@@ -284,25 +276,19 @@ async def test_a_preset_that_is_not_yaml_says_what_is_wrong_in_words_at_its_line
 @sync
 async def test_the_keys_panel_is_readable_at_80x24_and_tabs_are_reached_without_f_keys(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("question_mark")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "question_mark")
         panel = app.screen.query("HelpPanel")
         width = panel.first().size.width if panel else 0
-        await pilot.press("escape")
-        await pilot.pause()
+        await press_settled(pilot, "escape")
         closed_by_esc = not app.screen.query("HelpPanel")
-        await pilot.press("question_mark", "question_mark")
-        await pilot.pause()
+        await press_settled(pilot, "question_mark", "question_mark")
         toggled = not app.screen.query("HelpPanel")
         tabs = []
         for key in ("5", "4", "2", "3"):
-            await pilot.press(key)
-            await pilot.pause()
+            await press_settled(pilot, key)
             tabs.append(app.query_one("#tabs").active)
-        await pilot.press("4")
-        await pilot.pause()
+        await press_settled(pilot, "4")
         run_footer = screen_text(app).splitlines()[-1]
     assert width >= 44 and closed_by_esc and toggled  # Textual's was 29 wide: every key wrapped
     assert tabs == ["results", "run", "presets", "edit"]
@@ -315,8 +301,7 @@ async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, regist
     data = merge(TINY, {"name": "sw", "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.6, 0.7, 0.8, 0.9]}}}})
     (folders / "presets" / "sw.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
     app = make_app(registry, preset="presets/sw.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         app.query_one("#field--spectrum--params--hurst").focus()
         await pilot.pause()
         screen = screen_text(app)
@@ -339,10 +324,8 @@ async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folde
     monkeypatch.setattr(frictionlab.tui.app, "save_preset", refused)
     monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+s")
         said = status_text(app)
     assert said == (f"Not saved: presets/tiny.yaml cannot be written (Permission denied): Ctrl+O saves it "
                     f"elsewhere, e.g. {folders / 'mine' / 'tiny.yaml'}")  # fmt: skip

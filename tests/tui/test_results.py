@@ -11,12 +11,13 @@ from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
 from .conftest import (
-    SIZE,
     SWEEP,
     fits_width,
     make_app,
     make_runs,
     numbers_in,
+    press_settled,
+    started,
     sync,
 )
 
@@ -28,8 +29,7 @@ from .conftest import (
 async def test_results_lists_opens_and_overlays_runs(folders, registry):
     make_runs(folders, registry)
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("f5")
         assert {entry.path.name for entry in app.query_one(ResultsPane).runs} == {"seed1", "seed2"}
         await pilot.press("enter")
@@ -50,15 +50,13 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
     run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
     rows = read_table(folders / "runs" / "sw" / "sweep.csv")
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("f5")
         assert sorted(e.path.name for e in app.query_one(ResultsPane).runs) == ["seed1", "seed2", "sw"]
         index = [e.path.name for e in app.query_one(ResultsPane).runs].index("sw")
         listed = [str(c) for c in app.query_one("#runs-table").get_row_at(index)]
         assert listed[1:] == ["sw", "sweep", "3 pts"]  # marked as a sweep
-        await pilot.press(*["down"] * index, "enter")
-        await pilot.pause()
+        await press_settled(pilot, *["down"] * index, "enter")
         points = app.query_one("#results-sweep")
         assert points.display and points.has_focus
         cells = [[str(c) for c in points.get_row_at(i)] for i in range(points.row_count)]

@@ -25,8 +25,10 @@ from .conftest import (
     make_app,
     numbers_in,
     press_run,
+    press_settled,
     run_to_the_end,
     screen_text,
+    started,
     sync,
     wait_until,
 )
@@ -182,8 +184,7 @@ async def test_u_resumes_a_cancelled_run_to_the_numbers_of_an_uncancelled_one(fo
     stopped, _ = run_to_folder(scene, folders / "runs" / "stopped", RunOptions(workers=1), listeners=[CancelAfterThree()], cancel=cancel)
     assert stopped.status == "cancelled" and stopped.done < 24
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("f5", "u")
         await wait_until(pilot, lambda: app.last_outcome is not None)
         outcome, out_dir = app.last_outcome, app.last_out_dir
@@ -208,8 +209,7 @@ async def test_a_finished_sweeps_plot_keeps_its_whole_legend_and_the_room_the_ta
     async with app.run_test(size=size) as pilot:
         await run_to_the_end(pilot)
         assert isinstance(app.last_outcome, FinishedSweep)
-        await pilot.press("f4")
-        await pilot.pause()
+        await press_settled(pilot, "f4")
         legend = str(app.query_one("#run-fit").render()).splitlines()
         table = app.query_one("#sweep-table")
         body_rows, table_rows, points = app.query_one("#run-body").size.height, table.size.height, table.row_count

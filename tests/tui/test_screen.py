@@ -26,16 +26,18 @@ from frictionlab.tui.screens import PathScreen
 from ..conftest import merge
 from .conftest import (
     SIZE,
-    fits_width,
     TINY,
+    fits_width,
     make_app,
-    new_preset,
     make_runs,
+    new_preset,
     open_first_preset,
     post_keys,
     press_run,
+    press_settled,
     run_to_the_end,
     screen_text,
+    started,
     status_text,
     sync,
     type_into,
@@ -73,15 +75,13 @@ async def test_descriptions_summaries_and_names_show_their_brackets(folders, reg
     make_runs(folders, registry)
     (folders / "runs" / "seed1").rename(folders / "runs" / "try[1]")
     app = make_app(registry)
-    async with app.run_test(size=BIG) as pilot:
-        await pilot.pause()
+    async with started(app, size=BIG) as pilot:
         presets_tab = screen_text(app)
         await open_first_preset(pilot)
         app.query_one("#field--slope--params--ends").focus()  # the plugin's summary is above its first field
         await pilot.pause()
         edit_tab = screen_text(app)
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         results_tab = screen_text(app)
     assert BRACKETS in presets_tab
     assert BracketSlope.summary in edit_tab
@@ -106,10 +106,8 @@ async def test_run_names_use_the_width_they_have(folders, registry, size):
     (folders / "runs" / "seed1").rename(folders / "runs" / LONG_NAME)
     (folders / "runs" / "seed2").rename(folders / "runs" / ("x" * 70 + "-20261125-235755"))
     app = make_app(registry)
-    async with app.run_test(size=size) as pilot:
-        await pilot.pause()
-        await pilot.press("f5")
-        await pilot.pause()
+    async with started(app, size=size) as pilot:
+        await press_settled(pilot, "f5")
         shown = screen_text(app)
         table, chart = app.query_one("#runs-table"), app.query_one("#results-chart")
         whole, plot_width = fits_width(table), chart.size.width
@@ -140,8 +138,7 @@ async def test_a_long_description_is_shown_from_its_start(folders, registry):
     description = "Starts here: " + " ".join(f"word{i}" for i in range(40)) + " ends here."
     write_preset(folders, "tiny", merge(TINY, {"description": description}))
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         assert "Starts here: word0" in screen_text(app)  # the presets list's line about it
         await open_first_preset(pilot)
         app.query_one("#field--description", Input).focus()
@@ -171,11 +168,9 @@ async def test_messages_never_cover_the_data(folders, registry):
 async def test_ctrl_r_with_a_problem_says_it_and_focuses_the_field_at_fault(folders, registry):
     write_preset(folders, "tiny", merge(TINY, {"spectrum": {"params": {"rms_height": -1.0}}}))
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         app.query_one("#field--seed").focus()
-        await pilot.press("f4", "ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "f4", "ctrl+r")
         pointed = app.focused.id  # the form: q, ? still act, nothing types into the field
         status = status_text(app)
         shown = screen_text(app)
@@ -194,8 +189,7 @@ async def test_the_status_takes_back_why_ctrl_r_refused_once_that_problem_is_fix
     async with app.run_test(size=SIZE) as pilot:
         await type_into(pilot, "field--realizations", "abc")
         await type_into(pilot, "field--seed", "x")
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         refused = screen_text(app)
         await type_into(pilot, "field--realizations", "8")  # the problem the status does not give: it stays
         kept = status_text(app)
@@ -211,8 +205,7 @@ async def test_the_status_says_valid_once_the_one_refused_problem_is_fixed(folde
     app = make_app(registry, preset="presets/tiny.yaml")
     async with app.run_test(size=SIZE) as pilot:
         await type_into(pilot, "field--realizations", "abc")
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         refused = status_text(app)
         await type_into(pilot, "field--realizations", "8")
         await pilot.pause()
@@ -239,8 +232,7 @@ async def test_every_key_that_cannot_act_says_why(tmp_path, monkeypatch, registr
     (tmp_path / "presets").mkdir()  # nothing to open, nothing run
     app = make_app(registry)
     said = []
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         for keys, _ in CANNOT_ACT:
             app.query_one("#status").update("")
             await pilot.press(*keys)
@@ -253,8 +245,7 @@ async def test_every_key_that_cannot_act_says_why(tmp_path, monkeypatch, registr
 async def test_tab_in_the_results_tab_stops_only_where_focus_shows(folders, registry):
     make_runs(folders, registry)
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("f5")
         stops = []
         for _ in range(3):
@@ -270,8 +261,7 @@ async def test_six_keys_typed_into_a_cleared_field_all_arrive(folders, registry,
     Textual ran Ctrl+U's binding only after it bubbled up to the app, by which time
     the printable keys behind it were inserted, and then cleared."""
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         field = app.query_one("#field--spectrum--params--hurst", Input)
         field.focus()
         await pilot.press("end")
@@ -289,8 +279,7 @@ async def test_six_keys_typed_into_a_cleared_field_all_arrive(folders, registry,
 @sync
 async def test_home_then_a_key_types_at_the_start(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         field = app.query_one("#field--name", Input)
         field.focus()
         await pilot.press("end")
@@ -304,17 +293,13 @@ async def test_home_then_a_key_types_at_the_start(folders, registry):
 async def test_f1_shows_and_hides_the_key_panel_of_the_focused_part(folders, registry):
     make_runs(folders, registry)  # Results lists Compare with a run to compare
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("f1")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "f1")
         presets_keys = screen_text(app)
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         results_keys = screen_text(app)
         for _ in range(6):  # F1 again: the next page of a panel taller than 80x24, then hidden
-            await pilot.press("f1")
-            await pilot.pause()
+            await press_settled(pilot, "f1")
             if not app.screen.query("HelpPanel"):
                 break
         hidden = not app.screen.query("HelpPanel")
@@ -336,8 +321,7 @@ def profile_preset(folders, content):
 async def test_a_profile_file_beside_the_preset_is_found_by_the_form(folders, registry):
     profile_preset(folders, "\n".join(str(x) for x in np.random.default_rng(1).normal(size=256)))
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app):
         problems = app.problems
     assert problems == []  # as `frictionlab validate presets/tiny.yaml` says
     assert main(["validate", "presets/tiny.yaml"]) == ExitCode.OK
@@ -347,11 +331,9 @@ async def test_a_profile_file_beside_the_preset_is_found_by_the_form(folders, re
 async def test_a_missing_profile_file_is_named_and_its_field_focused(folders, registry):
     profile_preset(folders, "1\n2\n")
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         (folders / "presets" / "line.csv").unlink()  # gone after the preset was opened
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         status, pointed = status_text(app), app.focused.id
         panel = str(app.query_one("#problems").render())
         await pilot.press("enter")
@@ -374,8 +356,7 @@ async def test_the_preview_shows_what_an_instrument_file_gave(folders, registry)
     spectrum = {"name": "surface-file", "params": {"path": "map.nc", "unit": "nm", "detrend": "mean"}}
     write_preset(folders, "tiny", {**TINY, "spectrum": spectrum, "solver": {"name": "winkler"}})
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app):
         panel = str(app.query_one("#problems").render())
     assert app.problems == [] and panel.startswith("valid: Ctrl+R runs it")
     assert f"read map.nc (Network Common Data Format (NetCDF)): 12 x 16 pixels (x by y) of 500 nm (from the file), rms height " \
@@ -409,8 +390,7 @@ async def test_new_starts_from_a_preset_that_runs_and_saves_in_the_presets_folde
         await new_preset(pilot, "fresh")
         problems, path = app.problems, app.draft_path
         assert not (folders / "presets" / "fresh.yaml").exists()  # written on Ctrl+S, where the dialog said
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
     assert problems == []
     assert path == Path("presets/fresh.yaml")  # the folder the list shows
     saved = folders / "presets" / "fresh.yaml"
@@ -431,10 +411,8 @@ async def test_new_never_replaces_a_file_and_saves_where_the_user_says(folders, 
         await new_preset(pilot, "fresh")
         refused = screen_text(app)
         app.screen.query_one("#new-path", Input).focus()
-        await pilot.press("ctrl+u", *"elsewhere/fresh", "enter")
-        await pilot.pause()
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+u", *"elsewhere/fresh", "enter")
+        await press_settled(pilot, "ctrl+s")
     assert "presets/fresh.yaml exists: give another file" in refused  # said in the dialog
     assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
     assert load_scene(folders / "elsewhere" / "fresh.yaml", registry=registry).preset.name == "fresh"
@@ -446,11 +424,9 @@ async def test_ctrl_s_never_replaces_a_file_made_after_the_new_dialog(folders, r
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")
         (folders / "presets" / "fresh.yaml").write_text("keep me\n")  # made meanwhile, by someone else
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         asked = screen_text(app)
-        await pilot.press("escape")
-        await pilot.pause()
+        await press_settled(pilot, "escape")
     assert "presets/fresh.yaml exists now" in asked
     assert (folders / "presets" / "fresh.yaml").read_text() == "keep me\n"
 
@@ -462,17 +438,14 @@ async def test_the_built_in_presets_are_listed_and_never_written(tmp_path, monke
     quickstart = find_builtin("quickstart").path
     original = quickstart.read_text()
     app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
-    async with app.run_test(size=BIG) as pilot:
-        await pilot.pause()
+    async with started(app, size=BIG) as pilot:
         listed = screen_text(app)
         await app.open_preset(quickstart)
         await type_into(pilot, "field--realizations", "20")
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         asked = isinstance(app.screen, PathScreen)
         app.screen.query_one(Input).value = "mine.yaml"
-        await pilot.press("enter")
-        await pilot.pause()
+        await press_settled(pilot, "enter")
     assert "quickstart" in listed and "built-in" in listed
     assert asked and quickstart.read_text() == original
     assert yaml.safe_load((tmp_path / "mine.yaml").read_text())["realizations"] == 20
@@ -494,19 +467,15 @@ async def test_a_built_in_presets_copy_goes_by_default_where_the_list_shows_it(t
     (tmp_path / "presets").mkdir()
     (tmp_path / "presets" / "quickstart.yaml").write_text("keep me\n")  # never replaced unasked
     app = FrictionlabApp(runs_dir="runs", options=RunOptions(workers=1), registry=registry)
-    async with app.run_test(size=BIG) as pilot:
-        await pilot.pause()
+    async with started(app, size=BIG) as pilot:
         await app.open_preset(quickstart)
-        await pilot.press("ctrl+s")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
         offered = app.screen.query_one(Input).value
         await pilot.press("enter")  # the file exists: the dialog asks a second Enter
         await pilot.pause()
         asked = screen_text(app)
-        await pilot.press("ctrl+u", *"presets/my-qs", "enter")
-        await pilot.pause()
-        await pilot.press("f2")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+u", *"presets/my-qs", "enter")
+        await press_settled(pilot, "f2")
         listed, highlighted = screen_text(app), highlighted_path(app)
     assert offered == "presets/quickstart.yaml"
     assert "presets/quickstart.yaml exists: Enter again replaces it" in asked
@@ -520,10 +489,8 @@ async def test_a_new_preset_goes_by_default_into_the_presets_folder_made_for_it(
     app = FrictionlabApp(presets_dir="mine", runs_dir="runs", options=RunOptions(workers=1), registry=registry)
     async with app.run_test(size=SIZE) as pilot:
         await new_preset(pilot, "fresh")  # --presets mine: a folder that does not exist yet
-        await pilot.press("ctrl+s")
-        await pilot.pause()
-        await pilot.press("f2")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+s")
+        await press_settled(pilot, "f2")
         listed, highlighted = screen_text(app), highlighted_path(app)
     assert load_scene(folders / "mine" / "fresh.yaml", registry=registry).preset.name == "fresh"
     assert "fresh.yaml" in listed and highlighted == "mine/fresh.yaml"
@@ -533,8 +500,7 @@ async def test_a_new_preset_goes_by_default_into_the_presets_folder_made_for_it(
 async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders, registry):
     (folders / "runs").write_text("a file where the runs folder should be\n")
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await pilot.press("ctrl+r")
         await wait_until(pilot, lambda: not app.running)
         await pilot.pause()
@@ -552,8 +518,7 @@ async def test_a_runs_folder_that_cannot_be_made_is_named_in_the_status(folders,
 async def test_the_help_line_under_a_field_has_no_doubled_full_stop(folders, registry):
     """Found by a new user: `(M).; allowed: >= 1` and `realizations.npz.; default: True`."""
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=BIG) as pilot:
-        await pilot.pause()
+    async with started(app, size=BIG) as pilot:
         shown = {}
         for field in ("field--realizations", "field--output--realizations"):
             app.query_one(f"#{field}").focus()
@@ -583,19 +548,14 @@ async def test_home_and_end_go_to_the_first_and_last_row_of_the_lists(folders, r
         write_preset(folders, name, merge(TINY, {"name": name, "description": f"the {name} preset"}))
     make_runs(folders, registry)
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
-        await pilot.press("end")
-        await pilot.pause()
+    async with started(app) as pilot:
+        await press_settled(pilot, "end")
         at_end = screen_text(app)  # the line about the highlighted preset, under the list
-        await pilot.press("home")
-        await pilot.pause()
+        await press_settled(pilot, "home")
         at_home = screen_text(app)
-        await pilot.press("f5", "end", "enter")
-        await pilot.pause()
+        await press_settled(pilot, "f5", "end", "enter")
         last_run = screen_text(app)
-        await pilot.press("home", "enter")
-        await pilot.pause()
+        await press_settled(pilot, "home", "enter")
         first_run = screen_text(app)
         runs = [entry.path.name for entry in app.query_one("#results-pane").runs]
         await app.open_preset(folders / "presets" / "tiny.yaml")  # Home and End in a text field move its cursor
@@ -630,11 +590,9 @@ async def test_opening_a_preset_either_way_focuses_the_form_and_enter_its_first_
             await open_first_preset(pilot)
         await pilot.pause()
         first = app.focused.id
-        await pilot.press("enter")
-        await pilot.pause()
+        await press_settled(pilot, "enter")
         entered = app.focused.id
-        await pilot.press("tab", "tab", "tab", "7")
-        await pilot.pause()
+        await press_settled(pilot, "tab", "tab", "tab", "7")
         shown = screen_text(app)
     assert (first, entered) == ("form", "field--name")
     scrollbar = set("▁▂▃▄▅▆▇█")  # the form's scrollbar thumb may share a field's line
@@ -669,14 +627,11 @@ async def test_damaged_runs_and_presets_in_its_folders_never_stop_the_tui(folder
                                                       for p, c in zip("abcdefg", "bcdefgh"))  # fmt: skip
     )
     app = make_app(registry)
-    async with app.run_test(size=BIG) as pilot:
-        await pilot.pause()
+    async with started(app, size=BIG) as pilot:
         presets_tab = screen_text(app)
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         for _ in range(6):  # every run into the overlay, one after the other
-            await pilot.press("space", "down")
-            await pilot.pause()
+            await press_settled(pilot, "space", "down")
         results_tab = screen_text(app)
         assert app.is_running
     assert "huge" in presets_tab and "bomb" in presets_tab and "cannot be read" in presets_tab
@@ -690,8 +645,7 @@ async def test_every_fields_help_is_shown_whole_at_80x24(folders, registry):
     """Found by a newcomer: at 80x24 the help of height_reference, line_end and loading.unit
     stopped at four lines, before its choices or default."""
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         help_line = app.query_one("#field-help")
         cut = []
         for widget in app.query_one("#form").query("Input, Select, Switch"):

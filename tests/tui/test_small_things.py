@@ -15,8 +15,10 @@ from .conftest import (
     SWEEP,
     TINY,
     make_app,
+    press_settled,
     run_to_the_end,
     screen_text,
+    started,
     status_text,
     sync,
     type_into,
@@ -27,11 +29,9 @@ from .conftest import (
 @sync
 async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await type_into(pilot, "field--loading--stop", "0.1")
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         pointed = app.focused.id
         said = status_text(app)
         await pilot.press("enter")
@@ -43,11 +43,9 @@ async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, 
 @sync
 async def test_the_status_line_takes_back_valid_when_a_new_problem_appears(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await type_into(pilot, "field--loading--stop", "0.1")
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         await type_into(pilot, "field--loading--stop", "20")
         await pilot.pause()
         valid = status_text(app)
@@ -63,15 +61,12 @@ async def test_the_status_line_takes_back_valid_when_a_new_problem_appears(folde
 async def test_opening_another_preset_clears_the_error_about_the_first(folders, registry):
     (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         await type_into(pilot, "field--loading--stop", "0.1")
-        await pilot.press("ctrl+r")
-        await pilot.pause()
+        await press_settled(pilot, "ctrl+r")
         before = status_text(app)
         app.modified = False  # no question about the edit: the point is the old message
-        await pilot.press("f2")
-        await pilot.pause()
+        await press_settled(pilot, "f2")
         await app.open_preset(folders / "presets" / "other.yaml")
         await pilot.pause()
         after = status_text(app)
@@ -81,8 +76,7 @@ async def test_opening_another_preset_clears_the_error_about_the_first(folders, 
 @sync
 async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_line(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         app.query_one("#field--name", Input).focus()
         await pilot.press("q")  # typed into the field, not a quit
         await pilot.pause()
@@ -90,12 +84,10 @@ async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_li
         await pilot.press("ctrl+c")  # in a text field Ctrl+C copies, and says what quits
         await pilot.pause()
         said_in_field = status_text(app)
-        await pilot.press("f2", "ctrl+c")
-        await pilot.pause()
+        await press_settled(pilot, "f2", "ctrl+c")
         said, toasts = status_text(app), len(app.query("Toast"))
         app.modified = False
-        await pilot.press("q")
-        await pilot.pause()
+        await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert typed == "smallq"  # and typed at the end of the name: the cursor starts there
     assert said.startswith("Ctrl+Q quits (q too, outside a text field") and toasts == 0
@@ -111,8 +103,7 @@ async def test_on_off_switches_say_their_state_in_words(folders, registry):
         state = app.query_one("#field--output--plot--state", Static)
         before = str(state.render())
         app.query_one("#field--output--plot").focus()
-        await pilot.press("enter")
-        await pilot.pause()
+        await press_settled(pilot, "enter")
         after = str(state.render())
     assert (before, after) == ("on", "off")
 
@@ -142,8 +133,7 @@ async def test_the_sweep_table_takes_a_cursor_and_interim_goes_once_the_sweep_is
         fit = str(app.query_one("#run-fit", Static).render())
         table = app.query_one("#sweep-table", DataTable)
         table.focus()
-        await pilot.press("down")
-        await pilot.pause()
+        await press_settled(pilot, "down")
         row = table.cursor_row
     assert "(interim)" not in fit and "95% CI" in fit
     assert table.cursor_type == "row" and row == 1
@@ -152,12 +142,10 @@ async def test_the_sweep_table_takes_a_cursor_and_interim_goes_once_the_sweep_is
 @sync
 async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         pages = []
         for _ in range(12):
-            await pilot.press("f1")
-            await pilot.pause()
+            await press_settled(pilot, "f1")
             if not app.screen.query("HelpPanel"):
                 break
             pages.append(screen_text(app))
@@ -175,8 +163,7 @@ async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folde
     fit = LogFit(a=-12.3456, b=-0.0469, a_se=0.1, b_se=0.01, a_ci=(-12.5678, -12.1234), b_ci=(-0.0712, -0.0231),
                  confidence=0.95, bootstrap=1000, r2=0.4006, residual_rms=0.01, points=16)  # fmt: skip
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         app.action_show_tab("run")
         app.query_one(RunPane)._set("run-fit", "\n".join(fit_lines(fit, final=True, f_formula="F / (E* h L)")))
         await pilot.pause()
@@ -192,8 +179,7 @@ async def test_a_long_preset_name_is_cut_in_its_middle_and_keeps_every_column_on
     long_name = "a-very-long-preset-name-" + "x" * 55 + "-end-0060"  # 88 characters
     (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": long_name, "realizations": 3})))
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         table = app.query_one("#preset-table", DataTable)
         cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
         fits = fits_width(table)
@@ -242,11 +228,9 @@ async def test_d_on_a_built_in_preset_offers_a_file_it_can_save_and_saves_it(tmp
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))  # no user presets folder either
     app = FrictionlabApp(None, runs_dir="runs", options=RunOptions(workers=1), registry=registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         first = app.query_one(PresetsPane).selected().path
-        await pilot.press("d")
-        await pilot.pause()
+        await press_settled(pilot, "d")
         await pilot.press("enter")
         await wait_until(pilot, lambda: app.draft_path is not None, timeout=10.0)
     assert app.draft_path == Path("presets") / f"{first.stem}-copy.yaml"

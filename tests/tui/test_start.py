@@ -7,7 +7,7 @@ import sys
 
 from textual.widgets import DataTable
 
-from .conftest import SIZE, TINY, make_app, post_keys, sync, wait_until
+from .conftest import SIZE, TINY, make_app, post_keys, started, sync, wait_until
 
 DRIVES_THE_FIRST_SCREEN = True  # conftest: run_test returns at once, not once the app is built
 
@@ -58,8 +58,7 @@ async def test_the_first_screen_lists_the_presets_before_the_other_tabs_are_buil
         display(screen, update)
 
     app._display = painted
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app):
         assert app.query("#edit-pane") and app.query("#runs-table")  # built just after it
     assert seen[0] == {"tab": "presets", "focused": "preset-table", "presets": [TINY["name"]], "edit pane": False}
 

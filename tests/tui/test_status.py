@@ -2,7 +2,7 @@
 run, a run that cannot be resumed, a preset that cannot be opened) is taken back once
 another row is highlighted (it stayed, under the row it no longer spoke of)."""
 
-from .conftest import SIZE, make_app, make_runs, status_text, sync, wait_until
+from .conftest import SIZE, make_app, make_runs, press_settled, started, status_text, sync, wait_until
 
 
 @sync
@@ -12,13 +12,11 @@ async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighte
     (runs / "seed2" / "summary.json").write_text("{junk")
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("f5")
-        await pilot.pause()
+        await press_settled(pilot, "f5")
         names = [entry.path.name for entry in app.query_one("ResultsPane").runs]
         table = app.query_one("#runs-table")
         table.move_cursor(row=names.index("seed2"))
-        await pilot.press("enter")
-        await pilot.pause()
+        await press_settled(pilot, "enter")
         damaged = status_text(app)
         info = str(app.query_one("#results-info").render())
         table.move_cursor(row=names.index("seed1"))
@@ -45,15 +43,13 @@ async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighte
 async def test_a_preset_that_cannot_be_opened_is_no_longer_named_once_another_is_highlighted(folders, registry):
     (folders / "presets" / "broken.yaml").write_text("name: [unclosed\n")
     app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+    async with started(app) as pilot:
         pane = app.query_one("PresetsPane")
         rows = {entry.path.name: row for row, entry in enumerate(pane.presets)}
         table = app.query_one("#preset-table")
         table.move_cursor(row=rows["broken.yaml"])
         await pilot.pause()
-        await pilot.press("enter")
-        await pilot.pause()
+        await press_settled(pilot, "enter")
         refused = status_text(app)
         table.move_cursor(row=rows["tiny.yaml"])
         await pilot.pause()
