@@ -275,6 +275,7 @@ def test_follow_of_a_sweep_whose_point_folder_was_swapped_says_why_and_advice_th
     assert run_sweep(sweep, out, RunOptions(workers=1, resume=True), plot=False).status == "completed"
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_resume_detach_of_a_sweep_whose_point_folder_is_a_link_writes_nothing_outside(tmp_path, capsys):
     data = merge(SMALL_PRESET, {"realizations": 4, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
     out, elsewhere = tmp_path / "sw", tmp_path / "elsewhere"

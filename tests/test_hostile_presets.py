@@ -280,6 +280,7 @@ def test_numbers_that_overflow_in_the_run_name_what_overflowed(tmp_path, capsys)
     assert "warning" not in err.err
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_a_full_disk_on_stdout_is_an_error_not_a_bug(tmp_path):
     with open("/dev/full", "w") as full:
         done = subprocess.run(

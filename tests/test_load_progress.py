@@ -261,6 +261,7 @@ def _sleep_through(seconds: float) -> float:
     return seconds
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_a_pool_kills_a_worker_whose_job_does_not_stop_after_a_cancel():
     from frictionlab.compute.executors import pool_context
     from frictionlab.compute.pool import WorkerPool

@@ -57,6 +57,7 @@ FULL_CONTACT = {"loading": {"start": 1.0, "stop": 1e10, "steps": 16, "spacing": 
     ],
     ids=["3e5-with-plot", "2e6", "1e7"],
 )
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_the_estimate_bounds_the_measured_peak_of_a_real_run(registry, tmp_path, points, changes):
     preset = line_of(points, **changes)
     path = tmp_path / "p.yaml"

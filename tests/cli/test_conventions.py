@@ -117,6 +117,7 @@ def test_a_closed_stdout_is_written_nowhere_and_a_full_one_is_an_error(argv, tmp
         assert (tmp_path / "closed" / "summary.json").is_file()
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_progress_that_cannot_be_written_never_stops_a_run(tmp_path):
     command = [sys.executable, "-m", "frictionlab", "run", "quickstart", "--no-plot"]
     closed = subprocess.run([*command, "--out", str(tmp_path / "closed")], stdout=subprocess.DEVNULL, cwd=tmp_path,
@@ -180,6 +181,7 @@ def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path, c
     assert (tmp_path / "study" / "study.csv").is_file() and out["files"]["csv"].endswith("study.csv")
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_a_run_whose_reader_left_still_finishes_its_folder(tmp_path):
     read_end, write_end = os.pipe()
     os.close(read_end)

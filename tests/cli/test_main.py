@@ -20,6 +20,7 @@ def test_bad_command_line_is_a_usage_error_without_traceback(cli):
     assert "--workers must be >= 1. Got 0 instead." in result.stderr
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_headless_run_never_imports_textual(tmp_path):
     code = (
         "import sys; from frictionlab.cli import main; "

@@ -4,6 +4,8 @@
 import subprocess
 import sys
 
+import pytest
+
 from ..conftest import PRESETS
 
 HEAVY = ("numpy", "numpy.ma", "pydantic", "scipy", "matplotlib", "rich", "textual", "importlib.metadata", "dask",
@@ -37,6 +39,7 @@ def test_validate_imports_only_what_validating_needs():
     assert imported_after(code) & NOT_FOR_A_LINE == set()
 
 
+@pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_the_figure_imports_matplotlib_only_when_drawn(tmp_path):
     quickstart = PRESETS / "quickstart.yaml"
     code = f"from frictionlab.cli import main\nmain(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet'])"

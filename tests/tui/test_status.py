@@ -2,6 +2,8 @@
 run, a run that cannot be resumed, a preset that cannot be opened) is taken back once
 another row is highlighted (it stayed, under the row it no longer spoke of)."""
 
+import pytest
+
 from .conftest import SIZE, make_app, make_runs, press_settled, started, status_text, sync, wait_until
 
 
@@ -58,6 +60,7 @@ async def test_a_preset_that_cannot_be_opened_is_no_longer_named_once_another_is
     assert moved == ""
 
 
+@pytest.mark.long  # a run resumed in a process of its own, seconds end to end
 @sync
 async def test_a_resume_shows_the_realizations_its_folder_stores_at_once(folders, registry):
     """Not 0 % until the resumed run's process has begun and told its count."""
