@@ -193,6 +193,18 @@ def make_runs(folders, registry):
         run_to_folder(build_scene(data, registry=registry), folders / "runs" / f"seed{seed}", RunOptions(workers=1))
 
 
+def runs_app(folders, registry):
+    """The app over a runs folder of two finished runs (``make_runs``)."""
+    make_runs(folders, registry)
+    return make_app(registry)
+
+
+def sweep_app(folders, registry, sweep=None):
+    """The app with the sweep preset (``SWEEP``, or ``sweep``) written to presets/sweep.yaml and open."""
+    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(sweep or SWEEP, sort_keys=False))
+    return make_app(registry, preset="presets/sweep.yaml", workers=1)
+
+
 def screen_text(app) -> str:
     """What the terminal shows now, line by line (the top screen, toasts and dialogs included)."""
     return "\n".join(strip.text for strip in app.screen._compositor.render_strips())

@@ -24,6 +24,7 @@ from .conftest import (
     make_runs,
     numbers_in,
     press_settled,
+    runs_app,
     screen_text,
     started,
     status_text,
@@ -125,8 +126,7 @@ async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(fol
     """A run started by another TUI (here its detached process, as that TUI starts it) is
     listed while it runs, without r: the runs folder is watched. The highlighted run stays
     highlighted as rows are added above it."""
-    make_runs(folders, registry)
-    app = make_app(registry)
+    app = runs_app(folders, registry)
     async with started(app) as pilot:
         await pilot.press("f5")
         pane = app.query_one(ResultsPane)

@@ -17,6 +17,7 @@ from .conftest import (
     make_runs,
     numbers_in,
     press_settled,
+    runs_app,
     started,
     sync,
 )
@@ -27,8 +28,7 @@ from .conftest import (
 @pytest.mark.long  # a TUI session
 @sync
 async def test_results_lists_opens_and_overlays_runs(folders, registry):
-    make_runs(folders, registry)
-    app = make_app(registry)
+    app = runs_app(folders, registry)
     async with started(app) as pilot:
         await pilot.press("f5")
         assert {entry.path.name for entry in app.query_one(ResultsPane).runs} == {"seed1", "seed2"}

@@ -29,6 +29,7 @@ from .conftest import (
     run_to_the_end,
     screen_text,
     started,
+    sweep_app,
     sync,
     wait_until,
 )
@@ -108,8 +109,7 @@ async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_
 
 @sync
 async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, registry):
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    app = sweep_app(folders, registry)
     async with app.run_test(size=SIZE) as pilot:
         await run_to_the_end(pilot)
         table = app.query_one("#sweep-table")
@@ -147,8 +147,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
 async def test_cancelling_a_sweep_writes_the_running_points_realizations(folders, registry):
     """c stops the sweep's process (SIGTERM): the point running keeps what finished, ends interrupted."""
     big = merge(SWEEP, {"realizations": 100_000})
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(big, sort_keys=False))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    app = sweep_app(folders, registry, big)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
@@ -204,8 +203,7 @@ async def test_a_finished_sweeps_plot_keeps_its_whole_legend_and_the_room_the_ta
     its last line; at 120x40 the plot had 9 rows while the table left 20 empty."""
     from frictionlab.tui.following import FinishedSweep
 
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    app = sweep_app(folders, registry)
     async with app.run_test(size=size) as pilot:
         await run_to_the_end(pilot)
         assert isinstance(app.last_outcome, FinishedSweep)

@@ -36,6 +36,7 @@ from .conftest import (
     press_run,
     press_settled,
     run_to_the_end,
+    runs_app,
     screen_text,
     started,
     status_text,
@@ -243,8 +244,7 @@ async def test_every_key_that_cannot_act_says_why(tmp_path, monkeypatch, registr
 
 @sync
 async def test_tab_in_the_results_tab_stops_only_where_focus_shows(folders, registry):
-    make_runs(folders, registry)
-    app = make_app(registry)
+    app = runs_app(folders, registry)
     async with started(app) as pilot:
         await pilot.press("f5")
         stops = []
@@ -546,8 +546,7 @@ async def test_home_and_end_go_to_the_first_and_last_row_of_the_lists(folders, r
     """Found by a new user: End did nothing in the Presets list (Ctrl+End did)."""
     for name in ("alpha", "beta", "gamma", "zulu"):
         write_preset(folders, name, merge(TINY, {"name": name, "description": f"the {name} preset"}))
-    make_runs(folders, registry)
-    app = make_app(registry)
+    app = runs_app(folders, registry)
     async with started(app) as pilot:
         await press_settled(pilot, "end")
         at_end = screen_text(app)  # the line about the highlighted preset, under the list

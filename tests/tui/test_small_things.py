@@ -12,7 +12,6 @@ from frictionlab.tui.widgets import PresetsPane
 from ..conftest import merge
 from .conftest import (
     SIZE,
-    SWEEP,
     TINY,
     make_app,
     press_settled,
@@ -20,18 +19,24 @@ from .conftest import (
     screen_text,
     started,
     status_text,
+    sweep_app,
     sync,
     type_into,
     wait_until,
 )
 
 
+async def refuse_a_stop_below_the_start(pilot):
+    """The tiny preset's stop set to 0.1, below its start, then Ctrl+R: refused."""
+    await type_into(pilot, "field--loading--stop", "0.1")
+    await press_settled(pilot, "ctrl+r")
+
+
 @sync
 async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
-        await type_into(pilot, "field--loading--stop", "0.1")
-        await press_settled(pilot, "ctrl+r")
+        await refuse_a_stop_below_the_start(pilot)
         pointed = app.focused.id
         said = status_text(app)
         await pilot.press("enter")
@@ -44,8 +49,7 @@ async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, 
 async def test_the_status_line_takes_back_valid_when_a_new_problem_appears(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
-        await type_into(pilot, "field--loading--stop", "0.1")
-        await press_settled(pilot, "ctrl+r")
+        await refuse_a_stop_below_the_start(pilot)
         await type_into(pilot, "field--loading--stop", "20")
         await pilot.pause()
         valid = status_text(app)
@@ -62,8 +66,7 @@ async def test_opening_another_preset_clears_the_error_about_the_first(folders, 
     (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
-        await type_into(pilot, "field--loading--stop", "0.1")
-        await press_settled(pilot, "ctrl+r")
+        await refuse_a_stop_below_the_start(pilot)
         before = status_text(app)
         app.modified = False  # no question about the edit: the point is the old message
         await press_settled(pilot, "f2")
@@ -126,8 +129,7 @@ async def test_a_new_run_shows_no_fit_of_the_run_before(folders, registry):
 
 @sync
 async def test_the_sweep_table_takes_a_cursor_and_interim_goes_once_the_sweep_is_over(folders, registry):
-    (folders / "presets" / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
-    app = make_app(registry, preset="presets/sweep.yaml", workers=1)
+    app = sweep_app(folders, registry)
     async with app.run_test(size=SIZE) as pilot:
         await run_to_the_end(pilot)
         fit = str(app.query_one("#run-fit", Static).render())
