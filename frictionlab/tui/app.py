@@ -39,7 +39,7 @@ from .folders import (
     templates,
     user_presets_dir,
 )
-from .keyorder import answer_focus_key
+from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
@@ -136,6 +136,10 @@ class FrictionlabApp(KeysHelp, RunControl, App):
 
     async def on_event(self, event: events.Event) -> None:
         if isinstance(event, events.Key):
+            if len(keys := unjoined(event)) > 1:  # Esc and a key the terminal joined as Alt+key
+                for key in keys:
+                    await self.on_event(key)
+                return
             if self._early_keys is not None:
                 self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
                 return

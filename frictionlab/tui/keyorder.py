@@ -7,6 +7,10 @@ built) are handed to the widget focused before. Tab then ``abc`` lost the letter
 form, and Esc then ``q`` in a field typed the q there, though q quits outside a field.
 Such a key's binding is run here, at once, in the app's queue, so each key after it goes
 where the focus now is.
+
+Esc then a key within the terminal's escape delay (0.1 s: a fast typist, or keystrokes that
+SSH sends joined) reaches the app as one Alt+key, and a field typed its letter: this app
+binds no Alt key, so such a key is read as the two keys typed.
 """
 
 from __future__ import annotations
@@ -15,6 +19,13 @@ from textual import events
 
 # the actions that only move the focus: run at once, they change nothing else than Textual's own order would
 FOCUS_ACTIONS = frozenset({"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field"})
+
+
+def unjoined(key: events.Key) -> list[events.Key]:
+    """``key``, or Esc and the key typed after it where the terminal joined them as Alt+key."""
+    if key.key.startswith("alt+") and key.character is not None and len(key.character) == 1:
+        return [events.Key("escape", "\x1b"), events.Key(key.key.removeprefix("alt+"), key.character)]
+    return [key]
 
 
 async def answer_focus_key(app, key: events.Key) -> bool:
