@@ -207,10 +207,11 @@ class FrictionlabApp(KeysHelp, RunControl, App):
         return self.followed is not None
 
     def check_action(self, action: str, parameters) -> bool:
-        """The footer offers Save with a preset open, Run with one open and no run going."""
+        """The footer offers Save with a preset open, Run with one open, without problems, and
+        no run going (Ctrl+R pressed anyway says why, and points at the field at fault)."""
         if action in ("save", "save_as"):
             return self.draft_path is not None
-        return action != "start_run" or (self.draft_path is not None and not self.running)
+        return action != "start_run" or (self.draft_path is not None and not self.running and not self.problems)
 
     def action_unavailable(self, action: str) -> None:
         getattr(self, f"action_{action}")()  # run anyway where it cannot act: it says why
@@ -334,6 +335,8 @@ class FrictionlabApp(KeysHelp, RunControl, App):
     # ------------------------------------------------------------ editing and saving
 
     def on_preset_form_edited(self, event: PresetForm.Edited) -> None:
+        if bool(self.problems) != bool(event.problems):
+            self.call_after_refresh(self.refresh_bindings)  # Run is listed for a valid preset only
         self.problems = event.problems
         if event.changed:
             self.modified = True

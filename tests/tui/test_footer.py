@@ -4,7 +4,18 @@ Results, with a preset open or not, with a run going or not. A listed key that c
 
 import json
 
-from .conftest import SIZE, make_app, make_runs, press_settled, screen_text, started, status_text, sync, wait_until
+from .conftest import (
+    SIZE,
+    make_app,
+    make_runs,
+    press_settled,
+    screen_text,
+    started,
+    status_text,
+    sync,
+    type_into,
+    wait_until,
+)
 
 
 def footer(app) -> str:
@@ -64,3 +75,21 @@ async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
     assert "^s Save" not in nothing_open and "^r Run" not in nothing_open
     assert said.startswith("No preset open")
     assert "^s Save" in open_ and "^r Run" in open_
+
+
+@sync
+async def test_run_is_listed_only_while_the_open_preset_has_no_problem(folders, registry):
+    """Ctrl+R on a preset with a problem is refused (it names the problem and points at the
+    field): the footer lists it only while the preset is valid."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        valid = footer(app)
+        await type_into(pilot, "field--realizations", "x")
+        await wait_until(pilot, lambda: "^r Run" not in footer(app), timeout=10.0)
+        await pilot.press("ctrl+r")  # not listed: still says why
+        await pilot.pause()
+        said = status_text(app)
+        await type_into(pilot, "field--realizations", "3")
+        await wait_until(pilot, lambda: "^r Run" in footer(app), timeout=10.0)
+    assert "^r Run" in valid
+    assert said.startswith("Cannot run: 1 problem: realizations")
