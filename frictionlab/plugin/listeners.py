@@ -101,17 +101,22 @@ def format_duration(seconds: float) -> str:
     return f"{hours}:{minutes:02d}:{seconds:02d}" if hours else f"{minutes}:{seconds:02d}"
 
 
+ESTIMATE_AFTER = 3  # realizations computed before the time left is estimated from their rate
+
+
 def progress_text(done: int, total: int, failed: int, elapsed: float, restored: int = 0) -> str:
     """``12/40 realizations (8 restored), 1 failed, 3.1/s, elapsed 3.9 s, left 9.0 s``: of this
     invocation, the elapsed time and the rate (not counting the ``restored`` realizations of a
     resume), and the time left at that rate; no rate (``0.0/s, left ?``) before the first
-    realization computed here."""
-    rate = (done - restored) / elapsed if elapsed > 0 else 0.0
+    realization computed here, and ``left ?`` until ``ESTIMATE_AFTER`` are (the first ones
+    carry the start: one of 4000 after 0.8 s said 52 minutes left)."""
+    computed = done - restored
+    rate = computed / elapsed if elapsed > 0 else 0.0
     kept = f" ({restored} restored)" if restored else ""
     failures = f", {failed} failed" if failed else ""
     if rate <= 0:  # none computed here yet (a point a resume restored whole): no rate to tell
         return f"{done}/{total} realizations{kept}{failures}, elapsed {format_duration(elapsed)}"
-    left = format_duration((total - done) / rate)
+    left = format_duration((total - done) / rate) if computed >= ESTIMATE_AFTER or done >= total else "?"
     return f"{done}/{total} realizations{kept}{failures}, {rate:.1f}/s, elapsed {format_duration(elapsed)}, left {left}"
 
 

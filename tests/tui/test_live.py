@@ -130,3 +130,16 @@ def test_once_every_realization_is_done_the_elapsed_time_and_the_rate_stop(regis
     assert writing.solving == "writing the results" and finished.solving == ""
     line = progress_text(writing.done, writing.total, writing.failed, writing.elapsed)
     assert "4.0/s" in line and "elapsed 1.0 s" in line
+
+
+def test_the_time_left_waits_for_a_rate_of_a_few_realizations():
+    """One of 4000 after 0.8 s (the pool's start in it) said 52 minutes left; two computed
+    after a resume of 3097 said 33 minutes: no estimate until ESTIMATE_AFTER are computed here."""
+    from frictionlab.plugin.listeners import ESTIMATE_AFTER, progress_text
+
+    assert progress_text(1, 4000, 0, 0.8).endswith("left ?")
+    assert progress_text(3099, 20000, 0, 0.24, restored=3097).endswith("left ?")
+    done = ESTIMATE_AFTER
+    line = progress_text(done, 4000, 0, 1.0)  # a rate of ESTIMATE_AFTER per second
+    assert line.endswith(f"left {(4000 - done) // ESTIMATE_AFTER // 60}:{(4000 - done) // ESTIMATE_AFTER % 60:02d}"), line
+    assert progress_text(2, 2, 0, 0.5).endswith("left 0.0 s")  # all done: nothing is left
