@@ -117,6 +117,8 @@ class LiveListener:
 
     @hookimpl
     def run_finished(self):
+        # the run's own end (a followed run's finished event): its elapsed time, the final line's
+        self._all_done_at = self.clock()
         self.post(self._snapshot(self._done, self._total, finished=True))
 
     def _maybe_post(self, done: int, total: int) -> None:
@@ -136,8 +138,8 @@ class LiveListener:
             xi = self._xi_sum / self._ok
             count = self._count_sum / self._ok
             fit = interim_fit(f, xi)
-        # the time the realizations took: it stops with the last one, as the run's own elapsed
-        # time (its summary's) does, and the rate with it (not falling while the results are written)
+        # the time the realizations took: it stops with the last one (the rate not falling while
+        # the run stores them and ends), then moves to the run's end, the elapsed time of its summary
         end = self.clock() if self._all_done_at is None else self._all_done_at
         return Snapshot(
             done=done,

@@ -122,11 +122,14 @@ def test_once_every_realization_is_done_the_elapsed_time_and_the_rate_stop(regis
     for done, result in enumerate(results, start=1):
         now[0] += 0.25
         live.realization_done(result=result, done=done, total=4)
+    now[0] += 0.3  # the last chunk stored, the pool ended
+    live.tick()
+    live.run_finished()  # the engine's end, the elapsed time of summary.json and of the final line
     now[0] += 5.0  # the results written, the process ending
     live.tick()
-    live.run_finished()
-    writing, finished = posted[-2], posted[-1]
-    assert writing.elapsed == pytest.approx(1.0) and finished.elapsed == pytest.approx(1.0)
+    writing, finished, after = posted[-3], posted[-2], posted[-1]
+    assert writing.elapsed == pytest.approx(1.0) and finished.elapsed == pytest.approx(1.3)
+    assert after.elapsed == pytest.approx(1.3)
     assert writing.solving == "writing the results" and finished.solving == ""
     line = progress_text(writing.done, writing.total, writing.failed, writing.elapsed)
     assert "4.0/s" in line and "elapsed 1.0 s" in line
