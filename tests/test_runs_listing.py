@@ -70,3 +70,20 @@ def test_a_run_whose_progress_file_is_a_link_is_counted_from_its_chunks(tmp_path
     assert (state.status, state.done, state.total) == ("interrupted", 4, 4)
     assert main(["runs", str(tmp_path / "runs")]) == 0
     assert "4/4" in capsys.readouterr().out
+
+
+def test_a_run_that_ended_unfinished_counts_what_its_chunks_hold_not_what_its_log_heard(tmp_path, registry, capsys):
+    """A kill -9 loses the realizations done but not yet stored: `runs` said 3253 done where
+    the resume restored 3097. An ended run counts what a resume restores."""
+    out = tmp_path / "runs" / "run"
+    _run(out, registry)
+    (out / "summary.json").unlink()
+    manifest = json.loads((out / "run.json").read_text())
+    kept = {"00000000-00000001.npz": "0" * 64}  # two realizations stored, the rest lost with the process
+    (out / "run.json").write_text(json.dumps({**manifest, "status": "interrupted", "chunks": kept}))
+    with (out / "progress.jsonl").open("a") as log:  # the log heard all 4 done
+        log.write(json.dumps({"event": "realization", "index": 3, "done": 4, "total": 4, "ok": True}) + "\n")
+    state = run_state(out)
+    assert (state.status, state.done, state.total) == ("interrupted", 2, 4)
+    assert main(["runs", str(tmp_path / "runs")]) == 0
+    assert "2/4" in capsys.readouterr().out

@@ -279,6 +279,9 @@ def run_state(folder: str | Path) -> RunState:
             status = "interrupted"  # the process that wrote "running" is gone
     if status == "running":
         return RunState(folder, name, status, done, total, pid)
+    stored = _chunk_count(manifest.get("chunks"), total)
+    if stored is not None:  # a run that ended: what its chunks hold, as a resume restores (the log also counts the unsaved)
+        done = stored
     try:
         summary = _summary(folder)
     except RunFolderError as exc:  # never listed as what run.json says: its results cannot be read
