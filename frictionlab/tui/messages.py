@@ -18,8 +18,10 @@ class RunFinished(Message):
 
 
 class RunCrashed(Message):
-    """The run could not go on (a refused folder, a full disk, a bug): ``error`` says why."""
+    """The run could not go on (a refused folder, a full disk, a bug): ``error`` says why;
+    ``interrupted``: its process ended without a word (killed) and its folder can be resumed."""
 
-    def __init__(self, error: str):
+    def __init__(self, error: str, interrupted: bool = False):
         super().__init__()
         self.error = error
+        self.interrupted = interrupted

@@ -266,12 +266,14 @@ class RunControl:
         except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
             resume = "u resumes it" if self.last_resumable else "it cannot be resumed"
             error = f"the run's process ended without writing its results ({resume}: {followed.folder})"
-            self.on_run_crashed(RunCrashed(error))
+            if self.last_resumable:  # killed (kill -9, a reboot): interrupted, as Results and runs say
+                self._show_stored(followed.folder, resuming=False)
+            self.on_run_crashed(RunCrashed(error, interrupted=self.last_resumable))
             self.reload_runs()
             return
         self.on_run_finished(RunFinished(finished, followed.folder))
 
-    def _show_stored(self, folder: Path) -> None:
+    def _show_stored(self, folder: Path, resuming: bool = True) -> None:
         from ..runs.detached import stored_count
 
         try:
@@ -279,7 +281,7 @@ class RunControl:
         except (OSError, FrictionlabError):
             return
         if done is not None and total:
-            self.query_one("RunPane").show_stored_count(done, total, resuming=True)
+            self.query_one("RunPane").show_stored_count(done, total, resuming=resuming)
 
     def _count_from_chunks(self, followed: FollowedRun) -> None:
         """A run whose progress file cannot be written: said once; its count read from its chunks."""
@@ -318,8 +320,9 @@ class RunControl:
         self.reload_runs()
 
     def on_run_crashed(self, message: RunCrashed) -> None:
-        self.query_one("RunPane").show_crash(message.error)
-        self.say(message.error, "error", title="Run failed")
+        self.query_one("RunPane").show_crash(message.error, interrupted=message.interrupted)
+        self.say(message.error, "warning" if message.interrupted else "error",
+                 title="Run interrupted" if message.interrupted else "Run failed")  # fmt: skip
 
     def action_quit(self) -> None:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run

@@ -177,6 +177,7 @@ async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(
             app.followed.cancel()
             await wait_until(pilot, lambda: app.followed is None)
     assert "u Resume" in footer and "u resumes it" in said
+    assert said.startswith("Run interrupted: ")  # as Results and frictionlab runs list it, not "Run failed"
     assert resumed and said_after.startswith("Resuming long") and f"pid {pid}" in said_after
 
 

@@ -226,5 +226,5 @@ class RunPane(Vertical, can_focus=True):
                                  f"{format_duration(sweep.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
         return f"Sweep {sweep.status}: {sweep.finished}/{sweep.total} points"
 
-    def show_crash(self, error: str) -> None:
-        self._error(f"run failed: {error}")
+    def show_crash(self, error: str, interrupted: bool = False) -> None:
+        self._error(f"run {'interrupted' if interrupted else 'failed'}: {error}")
