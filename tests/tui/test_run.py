@@ -29,6 +29,7 @@ from .conftest import (
     run_to_the_end,
     screen_text,
     started,
+    status_text,
     sweep_app,
     sync,
     wait_until,
@@ -67,11 +68,13 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
         await pilot.press("c")  # the Run tab has focus
+        said = status_text(app)  # at once, before the run has ended
         await wait_until(pilot, lambda: app.last_outcome is not None)
         outcome, out_dir = app.last_outcome, app.last_out_dir
         stats = str(app.query_one("#run-stats", Static).render())
     # c is SIGTERM to the run's process, as a kill from a shell: it ends interrupted, resumable
     assert outcome.status == "interrupted" and 3 <= outcome.done < 100_000
+    assert said.startswith("Cancelling: ")
     assert stats.startswith(f"interrupted: {outcome.done}/100000")
     summary = json.loads((out_dir / "summary.json").read_text())
     assert summary["status"] == "interrupted"
