@@ -299,6 +299,7 @@ class RunControl:
         if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
             return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
         self.query_one("RunPane").show_cancelling()
+        self.say("Cancelling: the solves running stop; what finished is kept (u resumes it).")  # in place of what was said
 
     def on_run_finished(self, message: RunFinished) -> None:
         outcome = message.outcome
