@@ -256,6 +256,30 @@ async def test_a_resume_that_loses_the_race_after_its_process_began_follows_the_
     assert "c Cancel" in footer, footer
 
 
+@pytest.mark.long
+@sync
+async def test_space_on_a_running_row_says_why_it_cannot_compare(folders, registry):
+    """Space, not listed on a running row of Results, switched to the Run tab without a word."""
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    try:
+        wait_started(process, out)
+        app = make_app(registry)
+        async with started(app) as pilot:
+            await press_settled(pilot, "f5")
+            pane = app.query_one(ResultsPane)
+            await wait_until(pilot, lambda: [(e.path.name, e.status) for e in pane.runs] == [("long", "running")])
+            footer = _footer(app)
+            await press_settled(pilot, "space")
+            tab, said = app.query_one("#tabs").active, status_text(app)
+    finally:
+        process.terminate()
+        process.wait()
+    assert "Compare" not in footer, footer
+    assert tab == "results", said
+    assert said == "long is running: it has no curve to compare until it ends; Enter shows it live on the Run tab"
+
+
 HOLD_LOCK = """
 import fcntl, os, sys
 fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)

@@ -194,6 +194,10 @@ class ResultsPane(Vertical):
                 self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
                 self._info_about = entry.path
                 return
+            if entry.status == "running" and overlay:  # Space is not listed there: say why, as a hidden key does
+                self.app.say(f"{shown(entry.path.name)} is running: it has no curve to compare until it ends; "
+                             "Enter shows it live on the Run tab", "warning", about=entry.path)  # fmt: skip
+                return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return
