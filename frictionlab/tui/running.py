@@ -253,10 +253,10 @@ class RunControl:
         self.last_out_dir = followed.folder
         self.last_resumable = _resumable(followed.folder)  # however it ended: u offered when it can go on
         self.refresh_bindings()
+        if followed.process is not None and lock_held(followed.folder):  # ours ended, the folder is another's:
+            self._follow_the_winner(followed.folder)  # its resume won the race (its word may be lost: the winner
+            return  # rewrote the progress file), never the old summary read as how ours ended
         if followed.error:
-            if lock_held(followed.folder) and followed.process is not None:  # ours lost the folder to another's resume
-                self._follow_the_winner(followed.folder)
-                return
             self.on_run_crashed(RunCrashed(followed.error))
             self.reload_runs()
             return

@@ -93,3 +93,25 @@ async def test_run_is_listed_only_while_the_open_preset_has_no_problem(folders, 
         await wait_until(pilot, lambda: "^r Run" in footer(app), timeout=10.0)
     assert "^r Run" in valid
     assert said.startswith("Cannot run: 1 problem: realizations")
+
+
+@sync
+async def test_a_dialog_footer_lists_its_own_keys_not_those_of_the_screen_behind(folders, registry):
+    """The New dialog's footer said "⏎ Open d Duplicate n New r Reload", the Presets list's
+    keys, none of which acts in the dialog; the unsaved-changes question did the same."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        behind = footer(app)
+        await press_settled(pilot, "n")
+        on_new = footer(app)
+        await press_settled(pilot, "escape", "enter")  # the New dialog closed, tiny opened
+        app.modified = True
+        await press_settled(pilot, "ctrl+q")
+        on_question = footer(app)
+        await press_settled(pilot, "n")
+    assert "Open" in behind and "Duplicate" in behind  # what neither dialog may list
+    assert "⏎ Create" in on_new and "esc Cancel" in on_new, on_new
+    assert "y Yes" in on_question and "n No" in on_question, on_question
+    for said in (on_new, on_question):
+        for key in ("Open", "Duplicate", "New", "Reload", "Save", "Run"):
+            assert key not in said, said

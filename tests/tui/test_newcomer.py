@@ -215,6 +215,72 @@ async def test_a_resume_that_another_process_began_first_is_followed_and_said_in
     assert "in use" not in said and "output folder" not in said
 
 
+@pytest.mark.long
+@sync
+async def test_a_resume_that_loses_the_race_after_its_process_began_follows_the_winner(folders, registry, monkeypatch):
+    """Two TUIs pressing u at the same instant: both see the folder free and start a resume;
+    the loser's process finds the lock taken and ends with nothing of its own left in the
+    progress file (the winner rewrites it). The loser read the old summary and showed
+    "Run interrupted" with no c, no u, following nothing, until a second u."""
+    import frictionlab.runs.detached as detached
+
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    process.terminate()
+    process.wait()
+    assert run_state(out).status == "interrupted"
+    holders = []
+
+    def the_loser_starts(*args, **kwargs):  # the winner takes the lock just after this TUI's check
+        holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(out / "run.lock")], stdout=subprocess.PIPE)
+        holders.append(holder)
+        assert holder.stdout.readline().strip() == b"held"
+        return subprocess.Popen([sys.executable, "-c", "raise SystemExit(5)"])  # in use: its word lost
+
+    monkeypatch.setattr(detached, "start_detached", the_loser_starts)
+    try:
+        app = make_app(registry)
+        async with started(app) as pilot:
+            await press_settled(pilot, "f5", "u")
+            await wait_until(pilot, lambda: app.followed is None or app.followed.process is None)
+            await pilot.pause(0.3)
+            following = app.followed is not None and app.followed.folder.resolve() == out.resolve()
+            said, footer = status_text(app), _footer(app)
+    finally:
+        for holder in holders:
+            holder.kill()
+            holder.wait()
+    assert following, said
+    assert said == (f"long was resumed by another process first (pid {holders[0].pid}): "
+                    "this TUI follows that run; c cancels it")  # fmt: skip
+    assert "c Cancel" in footer, footer
+
+
+@pytest.mark.long
+@sync
+async def test_space_on_a_running_row_says_why_it_cannot_compare(folders, registry):
+    """Space, not listed on a running row of Results, switched to the Run tab without a word."""
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    try:
+        wait_started(process, out)
+        app = make_app(registry)
+        async with started(app) as pilot:
+            await press_settled(pilot, "f5")
+            pane = app.query_one(ResultsPane)
+            await wait_until(pilot, lambda: [(e.path.name, e.status) for e in pane.runs] == [("long", "running")])
+            footer = _footer(app)
+            await press_settled(pilot, "space")
+            tab, said = app.query_one("#tabs").active, status_text(app)
+    finally:
+        process.terminate()
+        process.wait()
+    assert "Compare" not in footer, footer
+    assert tab == "results", said
+    assert said == "long is running: it has no curve to compare until it ends; Enter shows it live on the Run tab"
+
+
 HOLD_LOCK = """
 import fcntl, os, sys
 fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)

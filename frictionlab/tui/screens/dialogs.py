@@ -9,13 +9,36 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.screen import ModalScreen
-from textual.widgets import Button, Input, Label, Select, Static
+from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from ..folders import new_preset_path
 from ..widgets.keyinput import KeyInput
 
 
-class ConfirmScreen(ModalScreen[bool]):
+class Dialog(ModalScreen):
+    """A modal dialog with a footer of its own: the one behind lists the keys of the screen
+    behind (Open, Duplicate, New), none of which acts while the dialog is up."""
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog"):
+            yield from self.body()
+        yield Footer()
+
+    def body(self) -> ComposeResult:
+        raise NotImplementedError
+
+
+class SubmitInput(KeyInput):
+    """A dialog's text field whose Enter the footer lists, as what it does (``submit``):
+    a field's own Enter binding is hidden, and it comes before the dialog's in the footer."""
+
+    def __init__(self, value: str, submit: str, **kwargs):
+        super().__init__(value, **kwargs)
+        self._bindings = self._bindings.copy()  # this field's, not every Input's
+        self._bindings.key_to_bindings["enter"] = [Binding("enter", "submit", submit, key_display="⏎")]
+
+
+class ConfirmScreen(Dialog, ModalScreen[bool]):
     BINDINGS = [
         Binding("y", "answer(True)", "Yes"),
         Binding("n,escape", "answer(False)", "No"),
@@ -25,16 +48,15 @@ class ConfirmScreen(ModalScreen[bool]):
         super().__init__()
         self.question = question
 
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog"):
-            yield Static(Content(self.question))  # it quotes problems and paths: text, not markup
-            yield Label("y: yes    n / Esc: no", classes="hint")
+    def body(self) -> ComposeResult:
+        yield Static(Content(self.question))  # it quotes problems and paths: text, not markup
+        yield Label("y: yes    n / Esc: no", classes="hint")
 
     def action_answer(self, value: bool) -> None:
         self.dismiss(value)
 
 
-class QuitDuringRunScreen(ModalScreen[str | None]):
+class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
     """Quit while a run goes on: leave it running ("leave"), cancel it ("cancel"), or stay (None)."""
 
     BINDINGS = [
@@ -47,10 +69,9 @@ class QuitDuringRunScreen(ModalScreen[str | None]):
         super().__init__()
         self.question = question
 
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog"):
-            yield Static(Content(self.question))
-            yield Label("l: leave it running and quit    c: cancel it and quit    Esc: stay", classes="hint")
+    def body(self) -> ComposeResult:
+        yield Static(Content(self.question))
+        yield Label("l: leave it running and quit    c: cancel it and quit    Esc: stay", classes="hint")
 
     def action_answer(self, value: str | None) -> None:
         self.dismiss(value)
@@ -82,7 +103,7 @@ def _same(a: Path, b: Path) -> bool:
     return a.expanduser().resolve() == b.expanduser().resolve()
 
 
-class PathScreen(ModalScreen[Path | None]):
+class PathScreen(Dialog, ModalScreen[Path | None]):
     """Ask for a file path (save as, duplicate); replacing a file asks a second Enter."""
 
     BINDINGS = [Binding("escape", "dismiss(None)", "Cancel")]
@@ -94,12 +115,11 @@ class PathScreen(ModalScreen[Path | None]):
         self.folder = folder  # the presets folder: made on saving if it does not exist yet
         self.confirmed: Path | None = None  # an existing file the user pressed Enter on once
 
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog"):
-            yield Label(Content(self.title_text), classes="heading")
-            yield KeyInput(str(self.default), id="path-input")
-            yield Static("", id="path-error", classes="field-error")
-            yield Label("Enter: save    Esc: cancel", classes="hint")
+    def body(self) -> ComposeResult:
+        yield Label(Content(self.title_text), classes="heading")
+        yield SubmitInput(str(self.default), "Save", id="path-input")
+        yield Static("", id="path-error", classes="field-error")
+        yield Label("Enter: save    Esc: cancel", classes="hint")
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         path, problem = preset_path_problem(event.value, self.folder)
@@ -114,7 +134,7 @@ class PathScreen(ModalScreen[Path | None]):
         self.dismiss(path)
 
 
-class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
+class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None]):
     """A new preset: its name, the preset it starts from (one that runs), and where it
     is saved (the presets folder the list shows unless the user says otherwise)."""
 
@@ -126,27 +146,26 @@ class NewPresetScreen(ModalScreen[tuple[str, Path | None, Path] | None]):
         self.folder = folder
         self.path_edited = False  # the file follows the name until the user types a path
 
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog"):
-            yield Label("New preset", classes="heading")
-            with Horizontal(classes="row"):
-                yield Label("name", classes="field-label")
-                yield KeyInput("my-scene", id="new-name", compact=True)
-            with Horizontal(classes="row"):
-                yield Label("start from", classes="field-label")
-                if self.templates:
-                    yield Select(
-                        [(Content(label), path) for label, path in self.templates],
-                        value=self.templates[0][1], allow_blank=False, compact=True, id="new-template",
-                    )
-                else:
-                    yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
-            with Horizontal(classes="row"):
-                yield Label("save as", classes="field-label")
-                yield KeyInput(str(new_preset_path("my-scene", self.folder)), id="new-path", compact=True)
-            yield Static("", id="new-error", classes="field-error")
-            yield Button("Create", id="new-create", compact=True)
-            yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
+    def body(self) -> ComposeResult:
+        yield Label("New preset", classes="heading")
+        with Horizontal(classes="row"):
+            yield Label("name", classes="field-label")
+            yield SubmitInput("my-scene", "Create", id="new-name", compact=True)
+        with Horizontal(classes="row"):
+            yield Label("start from", classes="field-label")
+            if self.templates:
+                yield Select(
+                    [(Content(label), path) for label, path in self.templates],
+                    value=self.templates[0][1], allow_blank=False, compact=True, id="new-template",
+                )
+            else:
+                yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
+        with Horizontal(classes="row"):
+            yield Label("save as", classes="field-label")
+            yield SubmitInput(str(new_preset_path("my-scene", self.folder)), "Create", id="new-path", compact=True)
+        yield Static("", id="new-error", classes="field-error")
+        yield Button("Create", id="new-create", compact=True)
+        yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if event.input.id == "new-name" and not self.path_edited:
