@@ -2,6 +2,7 @@
 go where the focus went (Textual ran Tab's, Enter's and Esc's bindings only once the key had
 bubbled up, and handed the keys typed meanwhile to the widget focused before)."""
 
+import pytest
 from textual import events
 from textual.widgets import Input
 
@@ -18,29 +19,20 @@ async def test_enter_then_typing_on_the_form_types_into_the_field(folders, regis
         await wait_until(pilot, lambda: app.query_one("#field--name", Input).value == TINY["name"] + "xy", timeout=10.0)
 
 
+@pytest.mark.parametrize("arriving", ["one after the other", "joined by the terminal"])
 @sync
-async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, registry):
+async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, registry, arriving):
+    """Joined: Esc then q within the terminal's escape delay (0.1 s; keystrokes SSH sends
+    together) arrive as one alt+q, whose character q the field typed."""
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await open_first_preset(pilot)
         await pilot.press("enter")  # into the name field
         await pilot.pause()
         assert isinstance(app.focused, Input)
-        post_keys(app, ["escape", "q"])
-        await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
-        assert not app.modified  # the q was never typed into the name
-
-
-@sync
-async def test_esc_and_q_joined_by_the_terminal_as_alt_q_quit_from_a_field(folders, registry):
-    """Esc then q within the terminal's escape delay (0.1 s; keystrokes SSH sends together)
-    arrive as one alt+q, whose character q the field typed."""
-    app = make_app(registry)
-    async with app.run_test(size=SIZE) as pilot:
-        await open_first_preset(pilot)
-        await pilot.press("enter")  # into the name field
-        await pilot.pause()
-        assert isinstance(app.focused, Input)
-        app.post_message(events.Key("alt+q", "q"))  # what the terminal parser makes of "\x1bq"
+        if arriving == "joined by the terminal":
+            app.post_message(events.Key("alt+q", "q"))  # what the terminal parser makes of "\x1bq"
+        else:
+            post_keys(app, ["escape", "q"])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
         assert not app.modified  # the q was never typed into the name
