@@ -83,3 +83,32 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
     for folder in point_dirs[:2]:
         summary = json.loads((folder / "summary.json").read_text())
         assert f"a={summary['fit']['a']:.4f}" in info
+
+
+@pytest.mark.long  # a TUI session over a sweep run first
+@sync
+async def test_esc_leaves_a_sweeps_points_and_a_damaged_row_opened_after_shows_nothing_of_the_sweep(folders, registry):
+    """Esc did not leave the open sweep's table of points (only Shift+Tab did, unlisted), and
+    Enter on a damaged row left the sweep's points and a point's plot beside its reason."""
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    make_runs(folders, registry)
+    (folders / "runs" / "seed1" / "summary.json").write_text("{not json")  # damaged
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5")
+        names = [e.path.name for e in app.query_one(ResultsPane).runs]
+        await press_settled(pilot, *["down"] * names.index("sw"), "enter")
+        points = app.query_one("#results-sweep")
+        opened = points.display and points.has_focus
+        await press_settled(pilot, "enter")  # a point's run drawn
+        drawn = bool(app.query_one(ResultsPane).overlay)
+        await press_settled(pilot, "escape")
+        back = app.query_one("#runs-table").has_focus
+        await press_settled(pilot, "home", *["down"] * names.index("seed1"), "enter")
+        sweep_shown = app.query_one("#results-sweep").display
+        info = str(app.query_one("#results-info", Static).render())
+        plotted = app.query_one("#results-chart").series
+    assert opened and drawn and back
+    assert not sweep_shown and "seed1: damaged" in info
+    assert not plotted

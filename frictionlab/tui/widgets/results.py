@@ -40,6 +40,7 @@ class ResultsPane(Vertical):
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
+        Binding("escape", "back_to_list", "Back to the runs", tooltip="from the open sweep's points"),
         # the same keys on a row where they cannot act (check_action hides those above): the status line says why
         *(Binding(key, f"unavailable('{action}')", show=False, system=True)
           for key, action in (("space", "compare"), ("u", "resume"))),
@@ -87,6 +88,8 @@ class ResultsPane(Vertical):
     def check_action(self, action: str, parameters) -> bool:
         """The footer offers what the highlighted row allows: Resume on a run or sweep that ended
         before it completed, Compare on a run with a curve (or on a sweep's point)."""
+        if action == "back_to_list":
+            return self.open_sweep is not None and self.query_one("#results-sweep").has_focus
         if action not in ("resume", "compare"):
             return True
         entry = self.highlighted()
@@ -97,6 +100,15 @@ class ResultsPane(Vertical):
         if action == "resume":
             return entry.status in RESUMABLE
         return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running")
+
+    def action_back_to_list(self) -> None:
+        self.query_one("#runs-table").focus()
+
+    def _close_sweep(self) -> None:
+        """The open sweep's points are no longer listed (another row was opened)."""
+        self.open_sweep = None
+        self.set_class(False, "-sweep")
+        self.query_one("#results-sweep", DataTable).clear(columns=True)
 
     def action_unavailable(self, action: str) -> None:
         """A key pressed on a row where its action cannot act: run anyway, to say why."""
@@ -189,7 +201,9 @@ class ResultsPane(Vertical):
                 self.app.say(NO_RUNS, "warning")
                 return
             entry = self.runs[row]
-            if entry.status == "damaged":  # nothing to show but why
+            if entry.status == "damaged":  # nothing to show but why: no sweep's points or curves beside it
+                self._close_sweep()
+                self.query_one("#results-chart", Chart).show([])
                 self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
                 self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
                 self._info_about = entry.path
