@@ -85,9 +85,10 @@ def _use_tls_options(args) -> None:
         check_address(args.scheduler)
 
 
-def refuse_empty_path(value: str | None, option: str, what: str = "folder") -> None:
+def refuse_empty_path(value: str | None, option: str, what: str = "folder", otherwise: str = "") -> None:
     """A usage error for a path argument given as the empty string, which Path() would read
     as this folder (``frictionlab resume ""`` resuming whatever run is here) and an option
-    would take as not given (``report --out ""``: the default folder)."""
+    would take as not given (``report --out ""``: the default folder); ``otherwise``: what
+    the user may give instead (``leave --out out for stdout``)."""
     if value is not None and not value.strip():
-        raise FrictionlabError(f"{option} names no {what} (it is empty): give a {what}")
+        raise FrictionlabError(f"{option} names no {what} (it is empty): give a {what}" + (f", or {otherwise}" if otherwise else ""))

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, shown, too_long_path
-from .options import add_executor_options, add_workers_option, executor_run_options
+from .options import add_executor_options, add_workers_option, executor_run_options, refuse_empty_path
 
 
 def add_parser(sub) -> None:
@@ -60,8 +60,7 @@ def run(args) -> ExitCode:
     options = executor_run_options(args, resume=args.resume, force=args.force)
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
     scene = build_scene(data, source=source, before_reading=reading)
-    if args.out is not None and not args.out.strip():
-        raise FrictionlabError("--out names no folder (it is empty): give a folder, or leave --out out for runs/<name>-<time>")
+    refuse_empty_path(args.out, "--out", otherwise="leave --out out for runs/<name>-<time>")
     if args.out is not None and (too_long := too_long_path(args.out)):
         raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:

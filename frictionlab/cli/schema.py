@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode
 
 
 def add_parser(sub) -> None:
@@ -22,10 +21,10 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import preset_json_schema
+    from .options import refuse_empty_path
 
     out = None
-    if args.out is not None and not args.out.strip():
-        raise FrictionlabError("--out names no file (it is empty): give a file, or leave --out out for stdout")
+    refuse_empty_path(args.out, "--out", "file", "leave --out out for stdout")
     if args.out:
         from ..io.files import check_output_file
 
