@@ -122,6 +122,16 @@ def read_regular_file(
     return data
 
 
+def holds_exactly(path: str | Path, data: bytes) -> bool:
+    """Whether ``path`` is a regular file (never read through a link) of exactly ``data``."""
+    try:
+        with open_regular_file(path, follow_links=False) as fh:
+            size = os.fstat(fh.fileno()).st_size
+            return size == len(data) and read_bounded(fh, size, size) == data
+    except InputFileProblem:
+        return False
+
+
 GROWTH_BLOCK = 1 << 20  # what is read at a time of a file that grew past its size
 
 

@@ -269,19 +269,17 @@ def run_state(folder: str | Path) -> RunState:
     name = str(preset.get("name") or folder.name)
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
-    done, pid = _last_count(folder), None
-    if done is None:  # no progress log to read (a link, never followed): the chunks it stored say
-        done = _chunk_count(manifest.get("chunks"), total)
+    stored, pid = _chunk_count(manifest.get("chunks"), total), None  # what a resume restores
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
         else:
             status = "interrupted"  # the process that wrote "running" is gone
-    if status == "running":
-        return RunState(folder, name, status, done, total, pid)
-    stored = _chunk_count(manifest.get("chunks"), total)
-    if stored is not None:  # a run that ended: what its chunks hold, as a resume restores (the log also counts the unsaved)
-        done = stored
+    if status == "running":  # its log's last count (none to read, a link never followed: what it stored)
+        done = _last_count(folder)
+        return RunState(folder, name, status, stored if done is None else done, total, pid)
+    # a run that ended: what its chunks hold (its log also counted what was never stored)
+    done = stored if stored is not None else _last_count(folder)
     try:
         summary = _summary(folder)
     except RunFolderError as exc:  # never listed as what run.json says: its results cannot be read

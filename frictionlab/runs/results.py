@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import platform
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -31,7 +30,7 @@ from .. import __version__
 from ..compute.ensemble import RunOutcome
 from ..errors import MissingDependency, RunError, RunFolderError, shown
 from ..io.files import atomic_write, write_npz
-from ..io.inputs import InputFileProblem, open_regular_file, read_bounded
+from ..io.inputs import holds_exactly
 from ..compute.fit import json_safe
 from ..preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
@@ -322,7 +321,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
 
     files["preset"] = out / "preset.yaml"
     preset = yaml.safe_dump(scene.resolved(), sort_keys=False)
-    if not _holds(files["preset"], preset.encode()):  # the run's start wrote it: one fsync less
+    if not holds_exactly(files["preset"], preset.encode()):  # the run's start wrote it: one fsync less
         atomic_write(files["preset"], lambda fh: fh.write(preset))
 
     if scene.preset.output.realizations:
@@ -333,16 +332,6 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete
     _write_summary(out, scene, outcome, files)
     return files
-
-
-def _holds(path: Path, data: bytes) -> bool:
-    """Whether ``path`` is a regular file (never a link) of exactly ``data``."""
-    try:
-        with open_regular_file(path, follow_links=False) as fh:
-            size = os.fstat(fh.fileno()).st_size
-            return size == len(data) and read_bounded(fh, size, size) == data
-    except InputFileProblem:
-        return False
 
 
 def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> dict[str, Path]:

@@ -41,7 +41,7 @@ import yaml
 from .. import __version__
 from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
 from ..io.files import atomic_write, output_path_problem
-from ..io.inputs import InputFileProblem, sha256_of
+from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
 from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import with_new_defaults
 from ..compute.realization import RealizationResult
@@ -442,9 +442,9 @@ class RunDirectory:
         this object stored or verified (the chunks' content, not read back).
         Whether it merged (and so wrote the manifest)."""
         old = list(self._manifest["chunks"])
-        results = [self._kept[i] for i in sorted(self._kept)]
-        if len(old) <= 1 or not results:
+        if len(old) <= 1 or not self._kept:
             return False
+        results = [self._kept[i] for i in sorted(self._kept)]
         self._manifest["chunks"] = {}
         self._manifest["retired"] = old
         self.save_chunk(results)
@@ -468,7 +468,6 @@ def _left_by_a_start(path: Path, resolved: dict) -> bool:
         return False
     if path.name == CHUNK_DIR:
         return path.is_dir() and not any(path.iterdir())
-    if path.name == PRESET_FILE and path.is_file():  # replaced by the same bytes: nothing is lost
-        ours = yaml.safe_dump(resolved, sort_keys=False).encode()
-        return path.stat().st_size == len(ours) and path.read_bytes() == ours
+    if path.name == PRESET_FILE:  # replaced by the same bytes: nothing is lost
+        return holds_exactly(path, yaml.safe_dump(resolved, sort_keys=False).encode())
     return False

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..api import Result, load
-from ..runs.detached import cancel, lock_held, lock_holder, run_state
+from ..runs.detached import cancel, lock_held, lock_holder, stored_count
 from ..errors import FrictionlabError, RunFolderError, shown
 from ..runs.progresslog import PROGRESS_FILE, Follower
 from ..runs.sweeplog import SweepFollower
@@ -82,10 +82,9 @@ class FollowedRun:
     def stored_count(self) -> tuple[int | None, int | None]:
         """(done, total) realizations as the run folder's manifest says (its chunks)."""
         try:
-            state = run_state(self.folder)
+            return stored_count(self.folder)
         except (OSError, FrictionlabError):
             return None, None
-        return state.done, state.total
 
     def cancel(self) -> bool:
         """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone, or
