@@ -136,8 +136,8 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
             f"rare point, and replacing more than {100 * MAX_SPIKE_FRACTION:g} % of a scan replaces the scan itself; "
             "give a larger despike (6 rms heights is usual)"
         )
-    if not count or count == z.size:
-        return z, 0 if count == z.size else count
+    if not count:  # (every point a spike was refused above)
+        return z, 0
     ny, nx = z.shape
     index = np.full(z.shape, -1, dtype=np.int64)
     index[spike] = np.arange(count)
