@@ -39,6 +39,7 @@ from .folders import (
     templates,
     user_presets_dir,
 )
+from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
 from .running import NO_PRESET, RunControl
@@ -55,7 +56,7 @@ WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started any
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(KeysHelp, RunControl, App):
+class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -79,8 +80,7 @@ class FrictionlabApp(KeysHelp, RunControl, App):
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
         # the same keys where they cannot act (check_action hides those above): the status line says why
-        *(Binding(key, f"unavailable('{action}')", show=False, system=True, priority=True)
-          for key, action in (("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"))),
+        *said_when_hidden(("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"), priority=True),
     ]
 
     def __init__(
@@ -212,9 +212,6 @@ class FrictionlabApp(KeysHelp, RunControl, App):
         if action in ("save", "save_as"):
             return self.draft_path is not None
         return action != "start_run" or (self.draft_path is not None and not self.running and not self.problems)
-
-    def action_unavailable(self, action: str) -> None:
-        getattr(self, f"action_{action}")()  # run anyway where it cannot act: it says why
 
     # ------------------------------------------------------------ navigation and help
 

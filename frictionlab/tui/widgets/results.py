@@ -21,6 +21,7 @@ from ...runs.detached import RESUMABLE
 from ..chart import Series
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
+from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
 from ..text import format_count, shorten_run_name
 from .chart import Chart
@@ -35,15 +36,14 @@ FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of t
 LIST_SHARE, LIST_MIN, CHART_MIN = 0.45, 40, 40
 
 
-class ResultsPane(Vertical):
+class ResultsPane(SaysWhyUnavailable, Vertical):
     BINDINGS = [
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
         Binding("escape", "back_to_list", "Back to the runs", tooltip="from the open sweep's points"),
         # the same keys on a row where they cannot act (check_action hides those above): the status line says why
-        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
-          for key, action in (("space", "compare"), ("u", "resume"))),
+        *said_when_hidden(("space", "compare"), ("u", "resume")),
     ]
 
     def __init__(self, **kwargs):
@@ -109,10 +109,6 @@ class ResultsPane(Vertical):
         self.open_sweep = None
         self.set_class(False, "-sweep")
         self.query_one("#results-sweep", DataTable).clear(columns=True)
-
-    def action_unavailable(self, action: str) -> None:
-        """A key pressed on a row where its action cannot act: run anyway, to say why."""
-        getattr(self, f"action_{action}")()
 
     def _refresh_footer(self) -> None:
         """The footer again when what the highlighted row allows may differ (another row, a status

@@ -18,6 +18,7 @@ from ...errors import shown
 from ...compute.fit import format_estimate
 from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
+from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
 from ..sweepview import STATUS_MARKS, point_line, table_cells, table_columns
 from ..text import failure_message, shorten_middle
@@ -62,14 +63,13 @@ def _contact_lines(count) -> list[str]:
     return ["", "points in contact", f"  {count[0]:.2f} at first load", f"  {count[-1]:.2f} at last load"]
 
 
-class RunPane(Vertical, can_focus=True):
+class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     BINDINGS = [
         Binding("r", "start", "Run", tooltip="the open preset (again)", show=False),  # the footer has ^r Run
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
-        *(Binding(key, f"unavailable('{action}')", show=False, system=True)
-          for key, action in (("r", "start"), ("c", "cancel"), ("u", "resume"))),
+        *said_when_hidden(("r", "start"), ("c", "cancel"), ("u", "resume")),
     ]
 
     def compose(self) -> ComposeResult:
@@ -93,10 +93,6 @@ class RunPane(Vertical, can_focus=True):
         if action == "resume":
             return not app.running and app.last_resumable
         return not app.running if action == "start" else True
-
-    def action_unavailable(self, action: str) -> None:
-        """A key pressed where its action cannot act: the action runs anyway, to say why."""
-        getattr(self, f"action_{action}")()
 
     def action_start(self) -> None:
         self.app.action_start_run()
