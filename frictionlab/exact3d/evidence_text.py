@@ -68,7 +68,8 @@ def definitions(runs: StudyRuns, numbers: Numbers) -> list[str]:
         "- **Fixed amplitudes.** Each Fourier mode has the amplitude of the spectrum and a random phase (no random "
         "amplitude), so every surface of a family has the same rms height, the same rms gradient g and the same "
         "Nayak parameter to rounding"
-        + (f" (g spreads by {spread:.1g} of its mean over the surfaces)." if math.isfinite(spread) else "."),
+        + (f" (g spreads by {_relative_spread(spread)} of its mean over the surfaces)." if math.isfinite(spread)
+           else "."),
         f"- **Elastic body.** E* = E / (1 - ν²) with E = {solver.get('youngs_modulus', 1):g} and "
         f"ν = {solver.get('poisson_ratio', 0):g}; the rigid rough surface is pressed with the force F.",
         "- **Load.** f = F / (E* h L) with L = 2 √(A0 / π), the dimensionless force of the source study; the "
@@ -303,3 +304,8 @@ def limitations(runs: StudyRuns) -> list[str]:
         "for an infinite one, not a property of the infinite surface.",
         "",
     ]
+
+
+def _relative_spread(spread: float) -> str:
+    """A relative spread as a number a reader can use: rounding-level agreement is a bound, not 0."""
+    return f"{spread:.1g}" if spread >= 1e-12 else "less than 1e-12"

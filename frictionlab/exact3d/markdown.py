@@ -193,7 +193,7 @@ def answer(runs: StudyRuns, numbers: Numbers) -> list[str]:
         + "; its a and b: "
         + "; ".join(f"H = {h:g}: a = {format_estimate(mdr_fits[h].a, mdr_fits[h].a_ci, 3)}, "
                     f"b = {format_estimate(mdr_fits[h].b, mdr_fits[h].b_ci, 4)}" for h in hursts)  # fmt: skip
-        + f". At equal f, MDR has {ratio.min():.0f} to {ratio.max():.0f} times the real contact area in its springs "
+        + f". At equal f, MDR has {ratio.min():.1f} to {ratio.max():.1f} times the real contact area in its springs "
         "in contact: MDR is built to keep the force against the approach, not the area.",
         f"- **κ against the literature.** A / A0 = κ p / (E* g) with the corrected area, averaged over the "
         f"loads at {WINDOW_TEXT} contact: {kappa_text}. "

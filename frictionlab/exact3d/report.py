@@ -188,7 +188,8 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "```",
         "",
         *finish,
-        f"The study ({plan.name} plan) took **{format_duration(runs.seconds)}** of wall time (summed over the "
+        f"The {'ensembles that finished' if runs.missing else f'study ({plan.name} plan)'} took "
+        f"**{format_duration(runs.seconds)}** of wall time (summed over the "
         f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of "
         "each ensemble (its surfaces' solve times summed) is in the ensembles' table. "
         "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",

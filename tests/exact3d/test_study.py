@@ -82,6 +82,10 @@ def test_quick_page_reads_as_a_referee_wants_it(quick_study):
     assert "J. Mech. Phys. Solids 2017, arXiv 1704.05650" in text and "arXiv 1701.02727" in text
     assert "J. Benad (Physical Mesomechanics, 2012)" in text and "times the real contact area in its springs" in text
     assert "approaching its vanishing-load limit" not in text and "R²" not in text
+    assert "The study (quick plan) took **" in text  # every ensemble finished: the plan's time
+    # fixed amplitudes give every surface the same g to rounding: said as a bound, never as a bare "0"
+    spread = text.split("(g spreads by ")[1].split(" of its mean")[0]
+    assert spread == "less than 1e-12" or 1e-12 <= float(spread) < 1e-6
 
 
 def test_mdr_runs_its_lines_per_surface_and_the_comparison_family_the_whole_side(quick_study):
@@ -125,6 +129,7 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     assert "2 of the plan's" in text and "H = 0.3, 128² px, exact, 4 surfaces" in text
     assert "H = 1, spectral gradient, 128² px, exact, 2 surfaces" in text
     assert "--finished-only" in text  # the command that regenerates it
+    assert "The ensembles that finished took **" in text and "plan) took" not in text  # not the whole plan's time
     assert f"frictionlab exact3d --quick --out {tmp_path / 'page'} --runs {runs} --force" in text  # and the one that finishes
     # H = 0.3 is quoted on its finest grid that finished, 96²
     law = [line for line in text.splitlines() if line.startswith("| 0.3 | 96² (3 px on λs), not quoted")]
