@@ -166,7 +166,7 @@ def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, capsy
 def test_every_grid_samples_the_same_surfaces(registry, hurst):
     """The page compares grids on the same surfaces: a coarse grid's heights are a fine
     one's at its points (same modes, same random phases), for every realization."""
-    from frictionlab.preset import build_scene, read_preset
+    from frictionlab.preset import read_preset
     from frictionlab.preset.seeds import realization_rng
     from frictionlab.variants import SceneFactory
 
