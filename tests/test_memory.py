@@ -3,7 +3,6 @@ refusal that names the estimate, the limit and a setting that fits."""
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import sys

@@ -231,7 +231,6 @@ def forged_netcdf(path, n: int):
         at = header.index(b"\x00\x00\x00\x01" + name + b"\x00\x00\x00") + 8
         header[at:at + 4] = struct.pack(">i", n)
     first = struct.unpack(">q", header[header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80") + 8:][:8])[0]
-    begins = {b"\x80": first, b"\x20": None}
     at = header.index(b"\x00\x00\x00\x06\x00\x00\x00\x80")  # heights: vsize, begin
     header[at + 4:at + 8] = struct.pack(">I", 0xFFFFFFFF)
     offset = first + n * n * 8

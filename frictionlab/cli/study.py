@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import shlex
 import sys
-from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, shown
 from ..tradeoff.options import AXES, StudyOptions

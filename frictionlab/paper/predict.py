@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FrictionlabError, RunFolderError, short_repr
-from ..compute.fit import LogFit, bootstrap_coefficients, format_interval, format_number, percentile_interval, resample_pairs
-from ..io.inputs import InputFileProblem, open_regular_file
+from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
+from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
 from ..runs.results import read_summary
 from ..runs.runfolder import read_member
