@@ -272,7 +272,17 @@ def run_plan(
     and the others are listed in ``StudyRuns.missing``."""
     registry = registry or default_registry()
     runs = StudyRuns(plan)
-    started = time.perf_counter()
+    counted = time.perf_counter()
+
+    def count_time() -> None:
+        # after every ensemble, not only at the end: a study killed outright (SIGKILL, a
+        # session closed) keeps its time up to its last finished ensemble
+        nonlocal counted
+        now = time.perf_counter()
+        if Path(runs_dir).is_dir():
+            runs.seconds = _add_time(Path(runs_dir), plan, now - counted if compute else 0.0)
+        counted = now
+
     factories: dict[float, SceneFactory] = {}
     for job in plan.jobs():  # every H's preset read and checked before any ensemble runs
         if job.hurst not in factories:
@@ -307,13 +317,14 @@ def run_plan(
                 )  # fmt: skip
             spacing, short, long = _cutoffs(scene)
             runs.ensembles.append(Ensemble(job, scene.solver.name, scene, outcome, folder, spacing, short, long))
+            if done is None:
+                count_time()
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
         raise WorkInterrupted(
             f"the ensembles that finished are kept in {runs_dir}; run the command again with --runs {runs_dir} to resume"
         ) from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
-        if Path(runs_dir).is_dir():
-            runs.seconds = _add_time(Path(runs_dir), plan, time.perf_counter() - started if compute else 0.0)
+        count_time()
     return runs
 
 

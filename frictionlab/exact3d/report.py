@@ -189,9 +189,10 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "",
         *finish,
         f"The {'ensembles that finished' if runs.missing else f'study ({plan.name} plan)'} took "
-        f"**{format_duration(runs.seconds)}** of wall time (summed over the "
-        f"invocations that computed it) on {machine_text}, a machine shared with other jobs; the compute time of "
-        "each ensemble (its surfaces' solve times summed) is in the ensembles' table. "
+        f"**{format_duration(runs.seconds)}** of wall time (summed over the invocations that computed it, each "
+        f"up to its last finished ensemble) on {machine_text}, a machine shared with other jobs, and "
+        f"**{format_duration(sum(e.outcome.compute_seconds for e in runs.ensembles))}** of compute (the surfaces' "
+        "solve times summed; each ensemble's is in the ensembles' table). "
         "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",
         "",
         *definitions(runs, numbers),

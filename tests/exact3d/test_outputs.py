@@ -99,3 +99,29 @@ def test_a_study_that_fails_midway_still_counts_its_time(tmp_path, monkeypatch):
     assert len(calls) == 1
     recorded = json.loads((runs / study.TIME_FILE).read_text())
     assert recorded["plan"] == "quick" and recorded["seconds"] >= 0.05
+
+
+def test_a_study_counts_its_time_after_every_ensemble(tmp_path, monkeypatch):
+    """A study killed outright (SIGKILL, its session closed) runs no ``finally``: its wall
+    time is on disk up to its last finished ensemble, not lost with it."""
+    from pathlib import Path
+
+    from frictionlab.exact3d import plan as study
+
+    runs = tmp_path / "runs"
+    runs.mkdir()
+    real_run = study.run_to_folder
+    seen_before = []
+
+    def killed_at_the_second(scene, folder, options):
+        if seen_before:  # the second ensemble: what a SIGKILL here would leave on disk
+            raise SystemExit(json.loads((runs / study.TIME_FILE).read_text())["seconds"])
+        started = time.perf_counter()
+        outcome = real_run(scene, folder, options)
+        seen_before.append(time.perf_counter() - started)
+        return outcome
+
+    monkeypatch.setattr(study, "run_to_folder", killed_at_the_second)
+    with pytest.raises(SystemExit) as killed:
+        study.run_plan(Path(PRESETS), runs, study.QUICK)
+    assert killed.value.code >= seen_before[0] > 0

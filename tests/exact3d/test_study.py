@@ -83,6 +83,7 @@ def test_quick_page_reads_as_a_referee_wants_it(quick_study):
     assert "J. Benad (Physical Mesomechanics, 2012)" in text and "times the real contact area in its springs" in text
     assert "approaching its vanishing-load limit" not in text and "R²" not in text
     assert "The study (quick plan) took **" in text  # every ensemble finished: the plan's time
+    assert "of compute (the surfaces' solve times summed" in text  # the cost a killed invocation cannot lose
     # fixed amplitudes give every surface the same g to rounding: said as a bound, never as a bare "0"
     spread = text.split("(g spreads by ")[1].split(" of its mean")[0]
     assert spread == "less than 1e-12" or 1e-12 <= float(spread) < 1e-6
