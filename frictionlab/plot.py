@@ -145,6 +145,7 @@ def sweep_figure(sweep, rows: list[dict[str, Any]]) -> Figure:
                 ax.set_xticks(range(len(order)), [o.strip("'") for o in order], rotation=20, fontsize=8)
             elif sweep.spec.parameters[path].spacing == "log" and min(xs_all, default=1) > 0:
                 ax.set_xscale("log")
+                plain_log_labels(ax.xaxis)
             ax.set_ylabel(coef)
             ax.grid(True, alpha=0.3)
             if row == 1:
