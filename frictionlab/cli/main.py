@@ -216,9 +216,11 @@ def _end_now(code: int) -> None:
     output streams are flushed, then os._exit. Not while a thread that is no daemon
     runs: the interpreter's exit waits for it, and so does this one."""
     import atexit
-    import threading
 
-    if any(t.is_alive() and not t.daemon for t in threading.enumerate() if t is not threading.main_thread()):
+    threading = sys.modules.get("threading")  # never imported: no thread was started (--help)
+    if threading is not None and any(
+        t.is_alive() and not t.daemon for t in threading.enumerate() if t is not threading.main_thread()
+    ):
         return
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
