@@ -24,10 +24,10 @@ UNSAVED_WORK_SECONDS = 0.5  # of the run's time: finished chunks are written onc
 class BatchedStore:
     """A run directory's chunks, written in batches: once the finished work not yet on
     disk reaches ``unsaved`` seconds of the run's time (its computing shared among the
-    run's ``workers``), and at the end (``flush``). A sub-second run writes one chunk and no
-    compaction, whatever its worker count; a long one a chunk about every half second,
-    what a kill -9 may lose besides the realizations running. A cancel, Ctrl-C or SIGTERM
-    loses nothing: the run ends through ``flush``."""
+    run's ``workers``), and at the end (``flush``). A run of under half a second writes one
+    chunk and no compaction, whatever its worker count; a long one a chunk about every half
+    second, what a kill -9 may lose besides the realizations running. A cancel, Ctrl-C or
+    SIGTERM loses nothing: the run ends through ``flush``."""
 
     def __init__(self, run_dir: RunDirectory, unsaved: float | None = None, workers: int = 1):
         self.run_dir = run_dir
