@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatter
 
 from .compute.ensemble import RunOutcome
 from .compute.fit import LogFit
@@ -37,6 +38,7 @@ def draw_curve(ax, f, xi, xi_sem, fit: LogFit | None, *, done: int, caveats=(), 
         label = f"fit a + b ln f: a = {fit.a:.4f}, b = {fit.b:.4f}, R² = {fit.r2:.3f}"
         ax.plot(grid, fit.xi(grid), "-", color="C3", label=label)
     ax.set_xscale("log")
+    plain_log_labels(ax.xaxis)
     ax.set_ylabel(XI_LABEL, fontsize=fontsize + 1)
     ax.legend(fontsize=fontsize, loc="upper left")  # a fixed corner: "best" searches every data point
     ax.grid(True, which="both", alpha=0.3)
@@ -45,6 +47,32 @@ def draw_curve(ax, f, xi, xi_sem, fit: LogFit | None, *, done: int, caveats=(), 
             0.99, 0.02 + 0.09 * i, "caveat: " + textwrap.fill(caveat, 70), transform=ax.transAxes, ha="right",
             va="bottom", fontsize=fontsize - 1, color="C3", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0},
         )  # fmt: skip
+
+
+_SUPERSCRIPTS = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+class PlainLogFormatter(LogFormatter):
+    """The labels of a log axis as plain text: 10⁻⁸ and 2×10⁻⁹ (4 and 20 from 1 to 1000), the
+    ticks labelled being those matplotlib's own formatter labels. Its labels are mathtext,
+    whose parser was half of drawing plot.png."""
+
+    def __call__(self, x, pos=None) -> str:
+        if not super().__call__(x, pos):  # a tick left unlabelled
+            return ""
+        exponent = math.floor(math.log10(abs(x)) + 1e-9)
+        coeff = round(abs(x) / 10.0**exponent, 6)
+        if 0 <= exponent <= 3:
+            return self.fix_minus(f"{x:g}")
+        power = f"10{str(exponent).translate(_SUPERSCRIPTS)}"
+        sign = self.fix_minus("-") if x < 0 else ""
+        return sign + (power if coeff == 1 else f"{coeff:g}\u00d7{power}")
+
+
+def plain_log_labels(axis) -> None:
+    """``axis`` (a log one) labelled by ``PlainLogFormatter``, its major and minor ticks."""
+    axis.set_major_formatter(PlainLogFormatter(labelOnlyBase=False))
+    axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=False))
 
 
 def draw_interval(ax, x, estimate, low, high, fmt: str, *, color, capsize: float = 3, label=None, **line) -> None:
@@ -66,6 +94,7 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax.set_title(f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}", fontsize=10)
     ax_count.plot(outcome.f, outcome.contact_count, "-", color="C2")
     ax_count.set_yscale("log")
+    plain_log_labels(ax_count.yaxis)
     ax_count.set_ylabel("points in contact")
     ax_count.set_xlabel(scene.normalisation.definition, fontsize=8)
     ax_count.grid(True, which="both", alpha=0.3)
@@ -116,6 +145,7 @@ def sweep_figure(sweep, rows: list[dict[str, Any]]) -> Figure:
                 ax.set_xticks(range(len(order)), [o.strip("'") for o in order], rotation=20, fontsize=8)
             elif sweep.spec.parameters[path].spacing == "log" and min(xs_all, default=1) > 0:
                 ax.set_xscale("log")
+                plain_log_labels(ax.xaxis)
             ax.set_ylabel(coef)
             ax.grid(True, alpha=0.3)
             if row == 1:

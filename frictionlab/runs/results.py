@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import platform
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -306,8 +307,9 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     if spots:
         columns = (*columns, outcome.contact_spots)
 
-    for row in zip(*columns, strict=True):
-        writer.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
+    plain = [np.asarray(column, dtype=float).tolist() for column in columns]  # Python floats: no numpy scalar per cell
+    for row in zip(*plain, strict=True):
+        writer.writerow([repr(v) if math.isfinite(v) else "" for v in row])
 
 
 def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dict[str, Path]:

@@ -265,8 +265,9 @@ class RunDirectory:
             return
         self._manifest["status"] = status
         self._manifest["frictionlab_version"] = __version__
-        if not (status == "completed" and self._compact(scene)):  # a compaction writes the status with its chunk
-            self._write_manifest()
+        if status == "completed":
+            self.compact()
+        self._write_manifest()  # the status, and no more the chunks a compaction retired
 
     def check_fresh(self, scene: Scene) -> None:
         """Refuse now, writing nothing, what a fresh ``start(scene)`` would refuse here
@@ -435,25 +436,26 @@ class RunDirectory:
         if report:
             warnings.warn(f"resume of {self.path}: {report}", stacklevel=3)
 
-    def _compact(self, scene: Scene) -> bool:
-        """Merge the chunks of a completed run into one file: written
-        and listed first, the old ones deleted after (a crash in between leaves
-        them listed as retired, deleted by the next start). The results are those
-        this object stored or verified (the chunks' content, not read back).
-        Whether it merged (and so wrote the manifest)."""
+    def compact(self, pending: list[RealizationResult] | tuple = ()) -> bool:
+        """Merge the chunks of a completed run, with ``pending`` (its last results, not yet
+        written: they are not written apart first), into one file: written and listed
+        first, the old ones deleted after (a crash in between leaves them listed as retired,
+        deleted by the next start). The results are those this object stored or verified
+        (the chunks' content, not read back), a pending one winning over a stored one of
+        its index. Whether it merged. The manifest on disk lists the old ones as retired
+        until its next write (``finish``, which follows), which drops them."""
         old = list(self._manifest["chunks"])
-        if len(old) <= 1 or not self._kept:
+        if len(old) + bool(pending) <= 1 or not self._kept:
             return False
-        results = [self._kept[i] for i in sorted(self._kept)]
+        merged = {**self._kept, **{r.index: r for r in pending}}
         self._manifest["chunks"] = {}
         self._manifest["retired"] = old
-        self.save_chunk(results)
+        self.save_chunk([merged[i] for i in sorted(merged)])
         kept = set(self._manifest["chunks"])
         for name in old:
             if name not in kept:
                 (self.chunks / name).unlink(missing_ok=True)
         self._manifest.pop("retired")
-        self._write_manifest()
         return True
 
 

@@ -18,19 +18,20 @@ from .results import add_plot, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
 
-UNSAVED_WORK_SECONDS = 0.5  # of computing: finished chunks are written once this much is not on disk yet
+UNSAVED_WORK_SECONDS = 0.5  # of the run's time: finished chunks are written once this much is not on disk yet
 
 
 class BatchedStore:
     """A run directory's chunks, written in batches: once the finished work not yet on
-    disk reaches ``unsaved`` seconds of computing, and at the end (``flush``). A
-    sub-second run writes one chunk and no compaction; a long one a chunk about every
-    half second of work, what a kill -9 may lose besides the realizations running.
-    A cancel, Ctrl-C or SIGTERM loses nothing: the run ends through ``flush``."""
+    disk reaches ``unsaved`` seconds of the run's time (its computing shared among the
+    run's ``workers``), and at the end (``flush``). A run of under half a second writes one
+    chunk and no compaction, whatever its worker count; a long one a chunk about every half
+    second, what a kill -9 may lose besides the realizations running. A cancel, Ctrl-C or
+    SIGTERM loses nothing: the run ends through ``flush``."""
 
-    def __init__(self, run_dir: RunDirectory, unsaved: float | None = None):
+    def __init__(self, run_dir: RunDirectory, unsaved: float | None = None, workers: int = 1):
         self.run_dir = run_dir
-        self.unsaved = UNSAVED_WORK_SECONDS if unsaved is None else unsaved
+        self.unsaved = (UNSAVED_WORK_SECONDS if unsaved is None else unsaved) * max(1, workers)
         self.pending: list[RealizationResult] = []
         self.work = 0.0
 
@@ -40,10 +41,11 @@ class BatchedStore:
         if self.work >= self.unsaved:
             self.flush()
 
-    def flush(self) -> None:
-        """Write what is pending as one chunk (its name: the range of its indices)."""
-        if self.pending:
-            batch, self.pending, self.work = sorted(self.pending, key=lambda r: r.index), [], 0.0
+    def flush(self, merge: bool = False) -> None:
+        """Write what is pending as one chunk (its name: the range of its indices); with
+        ``merge`` (a completed run), as one chunk with those already written (its compaction)."""
+        batch, self.pending, self.work = sorted(self.pending, key=lambda r: r.index), [], 0.0
+        if not (merge and self.run_dir.compact(batch)) and batch:
             self.run_dir.save_chunk(batch)
 
 
@@ -105,11 +107,12 @@ def run_to_folder(
     check_loads(scene)  # a unit the solver cannot take, a load past its arithmetic: before the folder is touched
     with RunDirectory(out_dir, force=options.force) as run_dir:
         restored = run_dir.start(scene, resume=options.resume)
-        store = BatchedStore(run_dir)
+        store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
+        outcome = None
         try:
             outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
-        finally:  # whatever ended the run, what finished is written
-            store.flush()
+        finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)
+            store.flush(merge=outcome is not None and outcome.status == "completed")
         files = write_results(out_dir, scene, outcome)
         try:
             if on_results is not None:

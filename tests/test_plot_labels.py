@@ -1,0 +1,71 @@
+"""plot.png's log axes are labelled in plain text (10⁻⁸, 2×10⁻⁹, 4), on the ticks
+matplotlib's own log formatter labels: its labels were mathtext, whose parser was about
+half of drawing the figure, the last thing a run waits for."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import pytest
+from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatterSciNotation
+
+from frictionlab.compute import engine
+from frictionlab.options import RunOptions
+from frictionlab.plot import PlainLogFormatter, plain_log_labels, plot_curve
+
+_DIGITS = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹−", "-0123456789-")
+
+
+def value_of(label: str) -> float:
+    """The number a plain label names (``2×10⁻⁹``, ``10⁻⁸``, ``4``)."""
+    if "10" in label and any(c in label for c in "⁻⁰¹²³⁴⁵⁶⁷⁸⁹"):
+        coeff, _, power = label.rpartition("10")
+        return float(coeff.rstrip("×") or 1) * 10.0 ** int(power.translate(_DIGITS))
+    return float(label.translate(_DIGITS))
+
+
+@pytest.mark.parametrize("low, high", [(1e-9, 2e-8), (3.0, 12.0), (1.0, 1000.0), (1e-3, 1e5), (2e-7, 5e-7), (0.2, 0.9)])
+def test_the_same_ticks_are_labelled_each_with_its_value(low, high):
+    ax = Figure().subplots()
+    ax.set_xscale("log")
+    ax.set_xlim(low, high)
+    theirs = [LogFormatterSciNotation(labelOnlyBase=False), LogFormatterSciNotation(labelOnlyBase=False)]
+    plain_log_labels(ax.xaxis)
+    for axis_formatter, reference, minor in ((ax.xaxis.get_major_formatter(), theirs[0], False),
+                                             (ax.xaxis.get_minor_formatter(), theirs[1], True)):  # fmt: skip
+        locs = ax.xaxis.get_minorticklocs() if minor else ax.xaxis.get_majorticklocs()
+        reference.set_axis(ax.xaxis)
+        for formatter in (axis_formatter, reference):
+            formatter.set_locs(locs)
+        labelled = 0
+        for x in locs:
+            ours, expected = axis_formatter(x), reference(x)
+            assert bool(ours) == bool(expected), (x, ours, expected)
+            if ours:
+                labelled += 1
+                assert "$" not in ours
+                assert value_of(ours) == pytest.approx(x, rel=1e-9)
+        assert labelled or minor
+
+
+def test_labels_read_as_written():
+    formatter = PlainLogFormatter(labelOnlyBase=False)
+    formatter.set_axis(Figure().subplots().xaxis)
+    assert [formatter(x) for x in (1e-8, 2e-9, 1e5)] == ["10⁻⁸", "2×10⁻⁹", "10⁵"]
+    assert [formatter(x) for x in (1.0, 4.0, 20.0, 1000.0)] == ["1", "4", "20", "1000"]
+
+
+def test_plot_png_is_drawn_without_mathtext(make_scene, monkeypatch):
+    import matplotlib.mathtext
+
+    def refused(*args, **kwargs):
+        raise AssertionError("mathtext parsed a label")
+
+    monkeypatch.setattr(matplotlib.mathtext.MathTextParser, "parse", refused)
+    scene = make_scene({"realizations": 3})
+    outcome = engine.run(scene, RunOptions(workers=1))
+    fh = io.BytesIO()
+    plot_curve(scene, outcome, fh)
+    assert fh.getvalue().startswith(b"\x89PNG") and math.isfinite(outcome.fit.a)
