@@ -114,6 +114,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
         self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
+        self._terminated = False  # a SIGTERM came before it was built: it quits once it is
 
     # ------------------------------------------------------------ layout
 
@@ -175,10 +176,23 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
     async def _answer_early_keys(self) -> None:
         early, self._early_keys = self._early_keys, None
+        if self._terminated:
+            self.terminate()
+            return
         for key in early:  # in the order typed
             if key.key == "ctrl+j":  # Enter typed before the terminal was raw: the tty made it a line feed
                 key = events.Key("enter", "\r")
             await self.on_event(key)
+
+    def terminate(self) -> None:
+        """SIGTERM: quit without a question (a run goes on: it is a process of its own), exit
+        code 143; while the panes are being mounted, once they are (an exit then fails their mount)."""
+        from ..errors import ExitCode
+
+        if self.built:
+            self.exit(return_code=int(ExitCode.TERMINATED))
+        else:
+            self._terminated = True
 
     @property
     def built(self) -> bool:
