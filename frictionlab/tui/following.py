@@ -52,6 +52,12 @@ class FollowedRun:
         finished = self.follower.finished
         return finished.error if finished is not None and finished.exit_code is not None else None
 
+    @property
+    def ended(self) -> bool:
+        """Whether the run's last event came (how it ended, or why it could not go on): its
+        process may still be writing its files and closing, with nothing left to cancel."""
+        return self.follower.finished is not None
+
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:
         the elapsed time moves); True once its process has ended."""

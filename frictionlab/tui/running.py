@@ -247,7 +247,11 @@ class RunControl:
 
         if not isinstance(followed, FollowedSweep) and followed.progress_problem():
             self._count_from_chunks(followed)
-        if not followed.poll():
+        ended = followed.ended
+        over = followed.poll()
+        if followed.ended != ended:  # its last event: c leaves the footer now, not once its process has closed
+            self.refresh_bindings()
+        if not over:
             return
         self.followed = None
         self.last_out_dir = followed.folder
@@ -296,6 +300,9 @@ class RunControl:
         if not self.running:
             self.say("No run is going: Ctrl+R starts one.", "warning")
             return
+        if self.followed.ended:
+            self.say("The run has ended: its files are being written; nothing is left to cancel.", "warning")
+            return
         if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
             return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
         self.query_one("RunPane").show_cancelling()
@@ -339,7 +346,7 @@ class RunControl:
 
     def _quit_leaving_or_cancelling_the_run(self) -> None:
         followed = self.followed
-        if followed is None:
+        if followed is None or followed.ended:  # nothing left to leave running or cancel
             self.exit()
             return
         from .following import FollowedSweep
