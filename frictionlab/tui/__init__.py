@@ -26,7 +26,9 @@ def run_app(
             "without one, run presets headless: frictionlab run PRESET"
         )
     from .app import FrictionlabApp
+    from .keyorder import keep_escape_before_control_keys
 
+    keep_escape_before_control_keys()
     start_process_helpers()
     app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, options=options)
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: _exit_on_sigterm(app))
