@@ -353,7 +353,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             self.call_after_refresh(self.refresh_bindings)  # Run is listed for a valid preset only
         self.problems = event.problems
         if event.changed:  # against the file, not the last save: an edit's message may come after a save
-            self.modified = self._saved is None or self._draft() != self._saved
+            self.modified = self._saved is None or event.data != self._saved
         if self.blocked_by is not None and self.blocked_by not in event.problems:
             # the status said why Ctrl+R refused: that problem is gone, so is the message;
             # once no problem is left (a field is empty while retyped), it says so

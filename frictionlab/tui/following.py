@@ -55,8 +55,12 @@ class FollowedRun:
     @property
     def ended(self) -> bool:
         """Whether the run's last event came (how it ended, or why it could not go on): its
-        process may still be writing its files and closing, with nothing left to cancel."""
-        return self.follower.finished is not None
+        process may still be writing its files and closing, with nothing left to cancel. Of a
+        run another process holds, only if that process wrote it: a resume that has the folder
+        but has not yet rewritten its progress file leaves the last run's end there."""
+        if self.follower.finished is None:
+            return False
+        return self.process is not None or (self.follower.pid is not None and self.follower.pid == self.pid)
 
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:

@@ -240,7 +240,7 @@ async def test_an_edits_message_that_comes_after_the_save_leaves_the_preset_save
         edited = app.modified
         await pilot.press("ctrl+s")
         await pilot.pause()
-        form.post_message(PresetForm.Edited(form.problems, changed=True))  # the late one
+        form.revalidate(changed=True)  # the late one: an edit message that comes after the save
         await pilot.pause()
         after_save = app.modified
         await pilot.press("ctrl+u", "9")

@@ -58,11 +58,12 @@ class PresetForm(VerticalScroll):
         """The draft changed (or was loaded): ``problems`` is the headless list; ``read``,
         what a valid draft's spectrum read from its file ("" when none)."""
 
-        def __init__(self, problems: list[str], changed: bool, read: str = ""):
+        def __init__(self, problems: list[str], changed: bool, read: str = "", data: dict | None = None):
             super().__init__()
             self.problems = problems
             self.changed = changed
             self.read = read
+            self.data = data  # the draft (the form's, not a copy): compared with the preset's file
 
     class FieldFocused(Message):
         def __init__(self, spec: FieldSpec | None):
@@ -312,7 +313,7 @@ class PresetForm(VerticalScroll):
                     self._marked[section.id] = messages
                     section.update(Content("\n".join(messages)))
                     section.display = bool(messages)
-        self.post_message(self.Edited(self.problems, changed, read))
+        self.post_message(self.Edited(self.problems, changed, read, self.data))
 
     def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
         if self._marked.get(widget_id, []) == messages:
