@@ -1,20 +1,36 @@
 """``python -m frictionlab`` and the ``frictionlab`` command."""
 
+import signal
 import sys
+
+
+class _TerminatedWhileLoading(KeyboardInterrupt):
+    """SIGTERM before the command's own handling (``signals.RaiseOnSigterm``) is in place."""
+
+
+def _terminated(signum, frame):
+    raise _TerminatedWhileLoading()
 
 
 def program() -> None:
     """The ``frictionlab`` command (``cli.program``). A Ctrl-C while it loads, before a
-    command's own handling, ends as one at any other time does: a line and exit code 130."""
+    command's own handling, ends as one at any other time does: a line and exit code 130
+    (SIGTERM: 143)."""
     held = None
     if sys.argv[1:2] == ["tui"]:  # first thing: keys typed while it loads wait for the app as typed
         from .tui.terminal import hold_keys
 
+        # before the terminal is held: a SIGTERM while it loads (its default ends the process
+        # at once) raises here, so the finally below gives the terminal back its echo and line mode
+        signal.signal(signal.SIGTERM, _terminated)
         held = hold_keys()
     try:
         from .cli import program as run_program
 
         run_program()
+    except _TerminatedWhileLoading:
+        print("terminated", file=sys.stderr)
+        raise SystemExit(143) from None
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         raise SystemExit(130) from None

@@ -5,6 +5,7 @@ Importing this package is cheap; Textual loads when the app is built.
 
 from __future__ import annotations
 
+import signal
 import sys
 from pathlib import Path
 
@@ -25,11 +26,31 @@ def run_app(
             "without one, run presets headless: frictionlab run PRESET"
         )
     from .app import FrictionlabApp
+    from .keyorder import keep_escape_before_control_keys
 
+    keep_escape_before_control_keys()
     start_process_helpers()
     app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, options=options)
-    app.run()
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: _exit_on_sigterm(app))
+    try:
+        app.run()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     return app.return_code or 0
+
+
+def _exit_on_sigterm(app) -> None:
+    """SIGTERM while the app runs: it quits (``FrictionlabApp.terminate``), so its terminal
+    is given back whole. Raised where the handler lands, it could
+    stop the app's own cleanup between two escape codes and leave the terminal on the
+    alternate screen. Before the app's loop runs, or once it has closed, it is raised as
+    at any other time (``signals.RaiseOnSigterm``): nothing of the screen is to give back."""
+    from ..compute.signals import _raise_for
+
+    loop = app._loop  # set while the app's loop runs, its cleanup included
+    if loop is None:
+        _raise_for(signal.SIGTERM)
+    loop.call_soon_threadsafe(app.terminate)
 
 
 def start_process_helpers() -> None:

@@ -12,6 +12,7 @@ other panes, a run to follow): a run's modules are imported only once they are u
 
 from __future__ import annotations
 
+import copy
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -101,6 +102,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.draft_path: Path | None = None
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
+        self._saved: dict | None = None  # the draft as its file holds it (None: not saved yet)
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
@@ -114,6 +116,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
         self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
+        self._terminated = False  # a SIGTERM came before it was built: it quits once it is
 
     # ------------------------------------------------------------ layout
 
@@ -175,10 +178,23 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
     async def _answer_early_keys(self) -> None:
         early, self._early_keys = self._early_keys, None
+        if self._terminated:
+            self.terminate()
+            return
         for key in early:  # in the order typed
             if key.key == "ctrl+j":  # Enter typed before the terminal was raw: the tty made it a line feed
                 key = events.Key("enter", "\r")
             await self.on_event(key)
+
+    def terminate(self) -> None:
+        """SIGTERM: quit without a question (a run goes on: it is a process of its own), exit
+        code 143; while the panes are being mounted, once they are (an exit then fails their mount)."""
+        from ..errors import ExitCode
+
+        if self.built:
+            self.exit(return_code=int(ExitCode.TERMINATED))
+        else:
+            self._terminated = True
 
     @property
     def built(self) -> bool:
@@ -279,6 +295,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
             self.say("")
         self.modified = modified
+        self._saved = None if modified else copy.deepcopy(self._draft())
         self._show_edit_state()
         self.action_show_tab("edit")
 
@@ -335,8 +352,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         if bool(self.problems) != bool(event.problems):
             self.call_after_refresh(self.refresh_bindings)  # Run is listed for a valid preset only
         self.problems = event.problems
-        if event.changed:
-            self.modified = True
+        if event.changed:  # against the file, not the last save: an edit's message may come after a save
+            self.modified = self._saved is None or event.data != self._saved
         if self.blocked_by is not None and self.blocked_by not in event.problems:
             # the status said why Ctrl+R refused: that problem is gone, so is the message;
             # once no problem is left (a field is empty while retyped), it says so
@@ -435,6 +452,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         else:
             self.draft_path = self.draft_source = path
             self.modified = False
+            self._saved = copy.deepcopy(data)
             self._show_edit_state()
 
     # ------------------------------------------------------------ results

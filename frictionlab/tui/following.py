@@ -52,6 +52,16 @@ class FollowedRun:
         finished = self.follower.finished
         return finished.error if finished is not None and finished.exit_code is not None else None
 
+    @property
+    def ended(self) -> bool:
+        """Whether the run's last event came (how it ended, or why it could not go on): its
+        process may still be writing its files and closing, with nothing left to cancel. Of a
+        run another process holds, only if that process wrote it: a resume that has the folder
+        but has not yet rewritten its progress file leaves the last run's end there."""
+        if self.follower.finished is None:
+            return False
+        return self.process is not None or (self.follower.pid is not None and self.follower.pid == self.pid)
+
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:
         the elapsed time moves); True once its process has ended."""

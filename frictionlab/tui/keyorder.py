@@ -10,7 +10,8 @@ where the focus now is.
 
 Esc then a key within the terminal's escape delay (0.1 s: a fast typist, or keystrokes that
 SSH sends joined) reaches the app as one Alt+key, and a field typed its letter: this app
-binds no Alt key, so such a key is read as the two keys typed.
+binds no Alt key, so such a key is read as the two keys typed. Esc joined to a control key
+(Ctrl+S, Ctrl+R, Enter) lost the Esc in Textual's parser itself: ``keep_escape_before_control_keys``.
 """
 
 from __future__ import annotations
@@ -41,3 +42,26 @@ async def answer_focus_key(app, key: events.Key) -> bool:
                 return False  # another binding comes first: Textual's order
             return await app.run_action(binding.action, namespace)
     return False
+
+
+def keep_escape_before_control_keys() -> None:
+    """Esc then a control key, joined by the terminal (as above; on a busy machine keys typed
+    0.15 s apart are read together), reached the app as the control key alone: Textual's
+    parser reads ESC and a control character as Alt+key and drops the Alt of a control key
+    (ESC Ctrl+S is Ctrl+S), so Esc then Ctrl+S in a field saved and stayed in it. The parser
+    hands the Esc on first instead. The sequences Textual maps whole (ESC Tab: Shift+Tab,
+    ESC Backspace: Ctrl+W) are not this path and stay as they are."""
+    from textual._xterm_parser import XTermParser
+
+    parse = XTermParser._sequence_to_key_events
+    if getattr(parse, "keeps_escape", False):
+        return
+
+    def sequence_to_key_events(self, sequence: str, alt: bool = False):
+        for key in parse(self, sequence, alt):
+            if alt and key.key != "escape" and not key.key.startswith("alt+"):
+                yield events.Key("escape", "\x1b")  # the Esc the Alt stood for
+            yield key
+
+    sequence_to_key_events.keeps_escape = True
+    XTermParser._sequence_to_key_events = sequence_to_key_events

@@ -186,8 +186,8 @@ class RunControl:
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
         self.query_one("RunPane").start(scene, sweep, out_dir)
-        if options.resume and sweep is None:  # what it restores, at once: not 0 % until its process has begun
-            self._show_stored(out_dir)
+        if options.resume:  # what it restores, at once: not 0 % until its process has begun
+            self._show_stored(out_dir) if sweep is None else self._show_stored_sweep(out_dir, sweep)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
@@ -247,7 +247,11 @@ class RunControl:
 
         if not isinstance(followed, FollowedSweep) and followed.progress_problem():
             self._count_from_chunks(followed)
-        if not followed.poll():
+        ended = followed.ended
+        over = followed.poll()
+        if followed.ended != ended:  # its last event: c leaves the footer now, not once its process has closed
+            self.refresh_bindings()
+        if not over:
             return
         self.followed = None
         self.last_out_dir = followed.folder
@@ -283,6 +287,29 @@ class RunControl:
         if done is not None and total:
             self.query_one("RunPane").show_stored_count(done, total, resuming=resuming)
 
+    def _show_stored_sweep(self, folder: Path, sweep) -> None:
+        """A sweep's resume: the points its sweep.json holds as done, and the first point it
+        goes on with, with the realizations that point's chunks hold."""
+        from ..runs.detached import stored_count
+        from ..runs.sweep import UNFINISHED, point_folder
+        from .folders import read_sweep
+
+        try:
+            rows = read_sweep(folder).points
+        except (OSError, FrictionlabError):
+            return
+        done = {row["point"] for row in rows if row["status"] not in UNFINISHED}
+        going_on = next((point for point in sweep.points if point.number not in done), None)
+        if going_on is None:
+            return
+        try:
+            stored, total = stored_count(point_folder(folder, going_on))
+        except (OSError, FrictionlabError):  # a point never reached: nothing stored
+            stored, total = None, None
+        total = total or going_on.scene.preset.realizations
+        self.query_one("RunPane").show_stored_sweep(sweep, [row for row in rows if row["point"] in done],
+                                                    going_on, min(stored or 0, total), total)  # fmt: skip
+
     def _count_from_chunks(self, followed: FollowedRun) -> None:
         """A run whose progress file cannot be written: said once; its count read from its chunks."""
         if not followed.said_progress_problem:
@@ -295,6 +322,9 @@ class RunControl:
     def action_cancel_run(self) -> None:
         if not self.running:
             self.say("No run is going: Ctrl+R starts one.", "warning")
+            return
+        if self.followed.ended:
+            self.say("The run has ended: its files are being written; nothing is left to cancel.", "warning")
             return
         if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
             return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
@@ -339,7 +369,7 @@ class RunControl:
 
     def _quit_leaving_or_cancelling_the_run(self) -> None:
         followed = self.followed
-        if followed is None:
+        if followed is None or followed.ended:  # nothing left to leave running or cancel
             self.exit()
             return
         from .following import FollowedSweep

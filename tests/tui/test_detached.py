@@ -279,6 +279,42 @@ async def test_u_on_an_interrupted_sweep_resumes_it_detached(folders, registry):
 
 
 @sync
+async def test_a_sweeps_resume_shows_its_done_points_and_the_count_its_next_points_chunks_hold_at_once(folders, registry):
+    """Not 0 % of the first point, "starting", and an empty table until its process has begun
+    and replayed them (2 s and more under load)."""
+    from frictionlab.runs.detached import stored_count
+
+    out = folders / "runs" / "halfway"
+    process = start_sweep(HALFWAY_SWEEP, out, registry)
+    second = lambda: next(iter((out / "points").glob("02-*")), None)  # noqa: E731
+    wait_for(lambda: run_state(out).done == 1 and second() is not None and (second() / "run.json").exists()
+             and (run_state(second()).done or 0) >= 20)  # fmt: skip
+    os.kill(process.pid, signal.SIGTERM)  # cancelled: what finished of the second point is stored
+    process.wait()
+    stored, total = stored_count(second())
+    assert stored and total == 100_000
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_settled(pilot, "f5")
+        app.resume_run(out)  # what the Run tab shows before the resumed process has said anything
+        bar = app.query_one("#run-bar")
+        shown = (bar.progress, bar.total, stats(app), str(app.query_one("#sweep-point").render()))
+        table = app.query_one("#sweep-table")
+        cells = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        followed = app.followed
+        await pilot.press("ctrl+q", "c")  # cancel it: the test ends
+        await pilot.pause()
+    try:
+        assert shown == (stored, total, f"{stored}/{total} realizations stored (resuming)",
+                         "point 2/2: realizations=100000")  # fmt: skip
+        rows = json.loads((out / "sweep.json").read_text())["points"]
+        assert [c[:3] for c in cells] == [["1", "4", "✓"]]
+        assert numbers_in(cells[0][3])[0] == pytest.approx(rows[0]["a"], abs=5e-5)
+    finally:
+        end(followed.pid)
+
+
+@sync
 async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the_restored_count(folders, registry):
     """The resumed run rewrites progress.jsonl, larger than the cancelled run's: the TUI,
     which may read the old file first, must follow the new one from its start."""

@@ -4,8 +4,12 @@ Results, with a preset open or not, with a run going or not. A listed key that c
 
 import json
 
+import pytest
+
 from .conftest import (
     SIZE,
+    SWEEP,
+    TINY,
     make_app,
     make_runs,
     press_settled,
@@ -115,3 +119,39 @@ async def test_a_dialog_footer_lists_its_own_keys_not_those_of_the_screen_behind
     for said in (on_new, on_question):
         for key in ("Open", "Duplicate", "New", "Reload", "Save", "Run"):
             assert key not in said, said
+
+
+@pytest.mark.parametrize("kind", ["run", "sweep"])
+@sync
+async def test_cancel_leaves_the_footer_once_the_runs_last_event_came_while_its_process_closes(folders, registry, kind):
+    """A sweep's process writes its last event, then closes (1 to 2 s on a loaded machine); a
+    run's draws its plot first: c Cancel stayed listed all that while, with nothing left to
+    cancel. Here this process played the run and keeps its folder's lock, as one that is closing."""
+    from frictionlab.preset import build_scene
+    from frictionlab.runs.progresslog import ProgressLog
+    from frictionlab.runs.rundir import RunDirectory
+    from frictionlab.runs.runner import run_to_folder
+    from frictionlab.runs.sweep import plan_sweep, run_sweep
+    from frictionlab.runs.sweeplog import SweepProgressLog
+
+    out = folders / "runs" / kind
+    if kind == "sweep":
+        log = SweepProgressLog(out)
+        run_sweep(plan_sweep(SWEEP, registry=registry), out, listeners=[log], plot=False)
+    else:
+        log = ProgressLog(out)
+        run_to_folder(build_scene(TINY, registry=registry), out, listeners=[log], plot=False)
+    log.close()
+    app = make_app(registry)
+    with RunDirectory(out):  # its lock: the process is still there
+        async with started(app) as pilot:
+            app.follow_run(out)
+            await wait_until(pilot, lambda: app.followed is not None and app.followed.follower.finished is not None)
+            await press_settled(pilot, "f4")
+            listed = footer(app)
+            assert "c Cancel" not in listed  # before c: on main, c signals the lock's holder, this process
+            await press_settled(pilot, "c")
+            said = status_text(app)
+            still_following = app.followed is not None
+    assert still_following  # its outcome is read once its process is gone
+    assert said == "The run has ended: its files are being written; nothing is left to cancel."

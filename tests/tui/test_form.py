@@ -202,3 +202,49 @@ async def test_new_preset_from_a_plugins_defaults_when_there_is_no_preset_at_all
         await press_settled(pilot, "ctrl+s")
     assert app.draft_path == Path("presets/fresh.yaml")  # the folder the list shows
     assert load_scene(folders / "presets" / "fresh.yaml", registry=registry).spectrum.params.points == 256
+
+
+
+@sync
+async def test_keys_typed_just_before_esc_reach_the_draft(folders, registry):
+    """Esc acts at once (keyorder), before the field has handled the keys typed before it: their
+    edit came from a field no longer focused and was dropped as not typed. The field showed 12,
+    the draft (what Ctrl+S saves and Ctrl+R runs) kept 8, the title said (saved)."""
+    from .conftest import post_keys, wait_until
+
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        field = app.query_one("#field--realizations", Input)
+        field.focus()
+        await pilot.pause()
+        post_keys(app, ["end", "ctrl+u", *"12", "escape"])
+        await wait_until(pilot, lambda: field.value == "12" and app.focused is not field)
+        await pilot.pause(0.3)
+        draft, modified = app._draft()["realizations"], app.modified
+    assert draft == 12 and modified
+
+
+@sync
+async def test_an_edits_message_that_comes_after_the_save_leaves_the_preset_saved(folders, registry):
+    """Esc and Ctrl+S read together after typing: the edit's message reached the app after the
+    save had written it, and the title said (modified) over a saved file (q asked about unsaved
+    changes). Modified now says whether the draft differs from its file."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        form = app.query_one(PresetForm)
+        app.query_one("#field--realizations", Input).focus()
+        await pilot.press("end", "ctrl+u", "1", "2")
+        await pilot.pause()
+        edited = app.modified
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        form.revalidate(changed=True)  # the late one: an edit message that comes after the save
+        await pilot.pause()
+        after_save = app.modified
+        await pilot.press("ctrl+u", "9")
+        await pilot.pause()
+        changed_again = app.modified
+    assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"] == 12
+    assert edited and not after_save and changed_again

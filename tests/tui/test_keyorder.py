@@ -36,3 +36,28 @@ async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, regist
             post_keys(app, ["escape", "q"])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
         assert not app.modified  # the q was never typed into the name
+
+
+@pytest.mark.parametrize(
+    ("typed", "keys"),
+    [
+        ("\x1b\x13", ["escape", "ctrl+s"]),  # Esc then Ctrl+S in a field: it saved and stayed in the field
+        ("\x1b\x12", ["escape", "ctrl+r"]),
+        ("\x1b\r", ["escape", "enter"]),
+        ("a\x1b\x11", ["a", "escape", "ctrl+q"]),
+        ("\x1bq", ["alt+q"]),  # unjoined by the app (above), as before
+        ("\x1b\x1b[A", ["escape", "up"]),
+        ("\x13", ["ctrl+s"]),
+    ],
+)
+def test_the_terminals_parser_keeps_an_escape_joined_to_a_control_key(typed, keys):
+    """Esc then a control key read together (within the escape delay, or a busy machine
+    reading keys typed 0.15 s apart at once) reached the app as the control key alone."""
+    from textual._xterm_parser import XTermParser
+
+    from frictionlab.tui.keyorder import keep_escape_before_control_keys
+
+    keep_escape_before_control_keys()
+    parser = XTermParser()
+    read = [*parser.feed(typed), *parser.feed("")]
+    assert [event.key for event in read if isinstance(event, events.Key)] == keys

@@ -2,6 +2,7 @@
 keys typed while ``frictionlab tui`` loads reach the app as typed, and those it never read are
 dropped as it ends instead of reaching the shell."""
 
+import contextlib
 import os
 import pty
 import select
@@ -78,3 +79,63 @@ def test_frictionlab_tui_holds_the_keys_first_and_drops_the_unread_ones_as_it_en
         entry.program()
     assert ended.value.code == 2
     assert calls == ["hold", ("release", "held")]
+
+
+def _spawned_tui(tmp_path):
+    """``frictionlab tui`` in a pseudo-terminal in line mode with echo, as a login shell leaves it:
+    (process, keyboard end, program end, the program end's attributes before it started)."""
+    import subprocess
+    import sys
+
+    keyboard, program = pty.openpty()
+    os.set_blocking(keyboard, False)
+    before = termios.tcgetattr(program)
+    env = {**os.environ, "TERM": "xterm-256color"}
+    process = subprocess.Popen([sys.executable, "-m", "frictionlab", "tui"], stdin=program, stdout=program,
+                               stderr=program, cwd=tmp_path, env=env, start_new_session=True)  # fmt: skip
+    return process, keyboard, program, before
+
+
+def _wait_reading(process, keyboard, until, timeout=60.0) -> bytes:
+    """What the program wrote until ``until(written)`` (its output is read as it comes: a full
+    pseudo-terminal would block it)."""
+    import time
+
+    written = b""
+    deadline = time.monotonic() + timeout
+    while not until(written):
+        assert time.monotonic() < deadline, "timed out"
+        if select.select([keyboard], [], [], 0.001)[0]:
+            with contextlib.suppress(OSError):
+                written += os.read(keyboard, 65536)
+    return written
+
+
+@pytest.mark.parametrize("when", ["while it loads", "as its screen is drawn"])
+def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when):
+    """A SIGTERM while it loads (after it took the terminal out of line mode, before its commands
+    handle signals) killed it there, its terminal left without echo nor line mode; once the app
+    draws, one raised in the app's mount ended it with a traceback. It ends with 143 and the
+    terminal as it found it: line mode, echo, the main screen."""
+    import signal
+
+    process, keyboard, program, before = _spawned_tui(tmp_path)
+    try:
+        if when == "while it loads":  # as soon as the keys are held
+            written = _wait_reading(process, keyboard, lambda _: not termios.tcgetattr(program)[3] & termios.ECHO)
+        else:
+            written = _wait_reading(process, keyboard, lambda written: b"\x1b[?1049h" in written)  # alternate screen
+        process.send_signal(signal.SIGTERM)
+        written += _wait_reading(process, keyboard, lambda _: process.poll() is not None)
+        written += _wait_reading(process, keyboard, lambda _: not select.select([keyboard], [], [], 0.2)[0])
+        after = termios.tcgetattr(program)
+    finally:
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+        os.close(keyboard)
+        os.close(program)
+    assert process.returncode == 143
+    assert after == before
+    assert b"Traceback" not in written and b"Error" not in written
+    assert written.count(b"\x1b[?1049h") == written.count(b"\x1b[?1049l")  # back on the main screen

@@ -58,11 +58,12 @@ class PresetForm(VerticalScroll):
         """The draft changed (or was loaded): ``problems`` is the headless list; ``read``,
         what a valid draft's spectrum read from its file ("" when none)."""
 
-        def __init__(self, problems: list[str], changed: bool, read: str = ""):
+        def __init__(self, problems: list[str], changed: bool, read: str = "", data: dict | None = None):
             super().__init__()
             self.problems = problems
             self.changed = changed
             self.read = read
+            self.data = data  # the draft (the form's, not a copy): compared with the preset's file
 
     class FieldFocused(Message):
         def __init__(self, spec: FieldSpec | None):
@@ -239,8 +240,10 @@ class PresetForm(VerticalScroll):
 
     def on_input_changed(self, event: Input.Changed) -> None:
         spec = self._specs.get(event.input.id or "")
-        # only typing is an edit: the Changed that mounting an input posts is not
-        if spec is not None and self.data is not None and event.input.has_focus:
+        # only typing is an edit: the Changed that mounting an input posts is not. The field typed
+        # into may have lost the focus since (Esc acts at once, before the keys typed before it)
+        typed = event.input.has_focus or event.input is self._last_field
+        if spec is not None and self.data is not None and typed:
             event.stop()
             self._store(spec, parse(spec, event.value))
 
@@ -310,7 +313,7 @@ class PresetForm(VerticalScroll):
                     self._marked[section.id] = messages
                     section.update(Content("\n".join(messages)))
                     section.display = bool(messages)
-        self.post_message(self.Edited(self.problems, changed, read))
+        self.post_message(self.Edited(self.problems, changed, read, self.data))
 
     def _set_error(self, widget_id: str, messages: list[str], widget: bool = True) -> None:
         if self._marked.get(widget_id, []) == messages:

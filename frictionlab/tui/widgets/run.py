@@ -20,7 +20,7 @@ from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
-from ..sweepview import STATUS_MARKS, point_line, table_cells, table_columns
+from ..sweepview import STATUS_MARKS, point_line, row_cells, table_cells, table_columns
 from ..text import failure_message, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
@@ -88,8 +88,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         """The footer offers only what applies now: cancel while a run goes, run and resume
         when none does (resume only a run that ended before it completed)."""
         app = self.app
-        if action == "cancel":
-            return app.running
+        if action == "cancel":  # not once its last event came: its process is only closing
+            return app.running and not app.followed.ended
         if action == "resume":
             return not app.running and app.last_resumable
         return not app.running if action == "start" else True
@@ -167,6 +167,15 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         self.query_one("#run-bar", ProgressBar).update(total=total, progress=done)
         what = "resuming" if resuming else "read from the run's chunks"
         self._set("run-stats", f"{done}/{total} realizations stored ({what})")
+
+    def show_stored_sweep(self, sweep, rows: list[dict], point, done: int, total: int) -> None:
+        """A sweep's resume as it begins: the rows of its points that are done (sweep.json's),
+        and ``point``, which it goes on with, at the count its chunks hold."""
+        table = self.query_one("#sweep-table", DataTable)
+        for row in rows:
+            table.add_row(*map(Text, row_cells(sweep.paths, row)), key=str(row["point"]))
+        self._set("sweep-point", point_line(sweep, point))
+        self.show_stored_count(done, total, resuming=True)
 
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the solves running stop; what finished is kept")
