@@ -79,7 +79,7 @@ def test_a_run_that_ended_unfinished_counts_what_its_chunks_hold_not_what_its_lo
     _run(out, registry)
     (out / "summary.json").unlink()
     manifest = json.loads((out / "run.json").read_text())
-    kept = {"00000000-00000001.npz": "0" * 64}  # two realizations stored, the rest lost with the process
+    kept = _stored_only(out, [0, 1])  # two realizations stored, the rest lost with the process
     (out / "run.json").write_text(json.dumps({**manifest, "status": "interrupted", "chunks": kept}))
     with (out / "progress.jsonl").open("a") as log:  # the log heard all 4 done
         log.write(json.dumps({"event": "realization", "index": 3, "done": 4, "total": 4, "ok": True}) + "\n")
@@ -87,3 +87,76 @@ def test_a_run_that_ended_unfinished_counts_what_its_chunks_hold_not_what_its_lo
     assert (state.status, state.done, state.total) == ("interrupted", 2, 4)
     assert main(["runs", str(tmp_path / "runs")]) == 0
     assert "2/4" in capsys.readouterr().out
+
+
+def _stored_only(out, indices, name=None):
+    """The run's chunks replaced by one chunk holding only the realizations ``indices`` (named
+    by their range, or ``name``): what a run killed with those stored leaves; its manifest entry."""
+    import numpy as np
+
+    chunks = out / "chunks"
+    arrays = {}
+    for path in sorted(chunks.glob("*.npz")):
+        with np.load(path) as data:
+            keep = np.isin(data["index"], indices)
+            for key in data.files:
+                value = data[key][keep] if key not in ("failed_index", "failed_seconds", "failed_error") else data[key]
+                arrays[key] = np.concatenate([arrays[key], value]) if key in arrays else value
+        path.unlink()
+    name = name or f"{min(indices):08d}-{max(indices):08d}.npz"
+    np.savez(chunks / name, **arrays)
+    return {name: "0" * 64}  # the checksum is a resume's to verify, not a count's
+
+
+def _interrupted_with(out, chunks):
+    (out / "summary.json").unlink(missing_ok=True)
+    manifest = json.loads((out / "run.json").read_text())
+    (out / "run.json").write_text(json.dumps({**manifest, "status": "interrupted", "chunks": chunks}))
+
+
+def test_a_chunk_whose_range_has_gaps_counts_the_realizations_it_holds(tmp_path, registry, capsys):
+    """Realizations finish out of order on several workers, so a chunk named 0..3 may hold
+    0, 1 and 3: the count is what it holds (a resume restores 3), not its name's range (4)."""
+    out = tmp_path / "runs" / "run"
+    _run(out, registry)
+    _interrupted_with(out, _stored_only(out, [0, 1, 3]))
+    state = run_state(out)
+    assert (state.status, state.done, state.total) == ("interrupted", 3, 4)
+    assert main(["runs", str(tmp_path / "runs")]) == 0
+    assert "3/4" in capsys.readouterr().out
+
+
+def test_a_forged_chunk_counts_nothing_and_sizes_no_buffer(tmp_path, registry):
+    """A chunk whose index array's header claims 10^12 values, one whose indices lie outside
+    its name's range, one that is not a zip, one that is a link to a sound chunk: each holds
+    none of the count, and none makes the count allocate what a header claims."""
+    import io
+    import zipfile
+
+    import numpy as np
+
+    def npy(value):
+        buffer = io.BytesIO()
+        np.lib.format.write_array(buffer, np.asarray(value, np.int64))
+        return buffer.getvalue()
+
+    def chunk(path, index):
+        with zipfile.ZipFile(path, "w") as archive:
+            archive.writestr("index.npy", index)
+            archive.writestr("failed_index.npy", npy([]))
+
+    out = tmp_path / "runs" / "run"
+    _run(out, registry)
+    entries = _stored_only(out, [0])  # one sound chunk: 1 stored
+    huge = io.BytesIO()
+    np.lib.format.write_array_header_1_0(huge, {"descr": "<i8", "fortran_order": False, "shape": (10**12,)})
+    chunk(out / "chunks" / "00000001-00000001.npz", huge.getvalue())
+    chunk(out / "chunks" / "00000002-00000002.npz", npy([3]))  # outside 2..2
+    (out / "chunks" / "00000003-00000003.npz").write_bytes(b"not a zip")
+    chunk(tmp_path / "elsewhere.npz", npy([2]))  # sound, but reached only through a link
+    (out / "chunks" / "00000002-00000003.npz").symlink_to(tmp_path / "elsewhere.npz")
+    for name in ("00000001-00000001.npz", "00000002-00000002.npz", "00000003-00000003.npz", "00000002-00000003.npz"):
+        entries[name] = "0" * 64
+    _interrupted_with(out, entries)
+    state = run_state(out)
+    assert (state.done, state.total) == (1, 4)

@@ -9,6 +9,7 @@ import hashlib
 import io
 import math
 import re
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ import numpy as np
 from ..compute.realization import RealizationResult
 from ..io.inputs import InputFileProblem
 from ..preset import Scene
-from .runfolder import read_member
+from .runfolder import open_member, read_member
 
 CHUNK_DIR = "chunks"
 MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
@@ -106,6 +107,44 @@ def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[Realizatio
         raise ChunkDamage(f"unreadable ({type(exc).__name__})") from None
     first, last = int(match[1]), int(match[2])
     return chunk_results(arrays, first, last, scene)
+
+
+def chunk_indices(folder: Path, name: str) -> set[int]:
+    """The realizations chunk ``name`` of the run folder ``folder`` holds (finished and
+    failed), read from its two index arrays alone: what a resume restores of it, counted
+    without reading its curves (its name's range may have gaps: realizations finish out of
+    order). Its checksum is not verified here, a resume does; a file that cannot be read as
+    a chunk, or whose indices lie outside its name's range, holds none."""
+    match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
+    if match is None:
+        return set()
+    first, last = int(match[1]), int(match[2])
+    held = []
+    try:
+        with open_member(folder, f"{CHUNK_DIR}/{name}", "chunk") as fh, zipfile.ZipFile(fh) as archive:
+            for array in ("index", "failed_index"):
+                with archive.open(f"{array}.npy") as member:
+                    held.append(_index_array(member, last - first + 1))
+    except (InputFileProblem, KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile):
+        return set()
+    indices = np.concatenate(held)
+    if indices.size and (indices.min() < first or indices.max() > last):
+        return set()
+    return set(indices.tolist())
+
+
+def _index_array(member, most: int) -> np.ndarray:
+    """A 1-D integer .npy array of at most ``most`` values read from ``member``, its header
+    checked before anything is allocated (a forged shape must not size a buffer)."""
+    version = np.lib.format.read_magic(member)
+    read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+    shape, _, dtype = read_header(member)
+    if len(shape) != 1 or dtype.kind not in "iu" or shape[0] > most:
+        raise ValueError("not an index array")
+    raw = member.read(shape[0] * dtype.itemsize)
+    if len(raw) != shape[0] * dtype.itemsize:
+        raise ValueError("a short index array")
+    return np.frombuffer(raw, dtype).astype(np.int64)
 
 
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:

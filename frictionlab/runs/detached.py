@@ -269,7 +269,7 @@ def run_state(folder: str | Path) -> RunState:
     name = str(preset.get("name") or folder.name)
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
-    stored, pid = _chunk_count(manifest.get("chunks"), total), None  # what a resume restores
+    stored, pid = _chunk_count(folder, manifest.get("chunks"), total), None  # what a resume restores
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
@@ -311,23 +311,20 @@ def stored_count(folder: str | Path) -> tuple[int | None, int | None]:
     if not isinstance(manifest, dict):
         return None, None
     total = _count(manifest.get("realizations"))
-    return _chunk_count(manifest.get("chunks"), total), total
+    return _chunk_count(Path(folder), manifest.get("chunks"), total), total
 
 
-def _chunk_count(chunks, total: int | None) -> int | None:
-    """Realizations the manifest's chunks hold (each chunk's name is its index range)."""
-    from .chunks import CHUNK_NAME
+def _chunk_count(folder: Path, chunks, total: int | None) -> int | None:
+    """Realizations the manifest's chunks hold, each chunk's read from its index arrays
+    (``chunks.chunk_indices``); an index past the run's total is none of this run's."""
+    from .chunks import chunk_indices
 
     if not isinstance(chunks, dict):
         return None
     indices = set()
     for name in chunks:
-        match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
-        if match is not None:
-            first, last = int(match[1]), int(match[2])
-            end = last if total is None else min(last, first + total)  # a forged name counts no more than the run has
-            indices.update(range(first, end + 1))
-    return len(indices) if total is None else min(len(indices), total)
+        indices.update(i for i in chunk_indices(folder, name) if total is None or i < total)
+    return len(indices)
 
 
 def sweep_state(folder: str | Path) -> RunState:

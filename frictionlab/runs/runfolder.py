@@ -30,7 +30,7 @@ from typing import Annotated
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
 from ..errors import RunFolderError, shown
-from ..io.inputs import InputFileProblem, read_regular_file
+from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
 MAX_CSV_BYTES = 16 * 1024 * 1024  # curve.csv: a row of 7 numbers per load step
@@ -111,6 +111,20 @@ def read_member(folder: str | Path, name: str, limit: int, what: str | None = No
     FIFO, a device or a file over ``limit`` bytes is refused. InputFileProblem (saying
     what is wrong, not where) when it cannot be read; the caller names the file."""
     what = what or name
+    return _in_folder(folder, name, what, lambda leaf, fd: read_regular_file(leaf, limit, what, dir_fd=fd,
+                                                                              follow_links=False))
+
+
+def open_member(folder: str | Path, name: str, what: str | None = None):
+    """The file ``name`` inside ``folder`` opened for binary reading, as ``read_member``
+    reaches it (no link followed, only a regular file), for a reader that needs a part of it."""
+    what = what or name
+    return _in_folder(folder, name, what, lambda leaf, fd: open_regular_file(leaf, what, dir_fd=fd, follow_links=False))
+
+
+def _in_folder(folder: str | Path, name: str, what: str, leaf):
+    """``leaf(last component, descriptor of its folder)`` once every folder on the way to
+    ``name`` inside ``folder`` is opened without following a link."""
     try:
         parts = PurePosixPath(_member(name)).parts
     except ValueError as exc:
@@ -131,7 +145,7 @@ def read_member(folder: str | Path, name: str, limit: int, what: str | None = No
                 raise InputFileProblem(f"{part}/ is a symbolic link or not a folder, which is never followed") from None
             os.close(fd)
             fd = inner
-        return read_regular_file(parts[-1], limit, what, dir_fd=fd, follow_links=False)
+        return leaf(parts[-1], fd)
     finally:
         os.close(fd)
 

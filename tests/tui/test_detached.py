@@ -293,6 +293,7 @@ async def test_a_sweeps_resume_shows_its_done_points_and_the_count_its_next_poin
     process.wait()
     stored, total = stored_count(second())
     assert stored and total == 100_000
+    rows = json.loads((out / "sweep.json").read_text())["points"]  # before the resume, which rewrites it
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         await press_settled(pilot, "f5")
@@ -307,7 +308,6 @@ async def test_a_sweeps_resume_shows_its_done_points_and_the_count_its_next_poin
     try:
         assert shown == (stored, total, f"{stored}/{total} realizations stored (resuming)",
                          "point 2/2: realizations=100000")  # fmt: skip
-        rows = json.loads((out / "sweep.json").read_text())["points"]
         assert [c[:3] for c in cells] == [["1", "4", "✓"]]
         assert numbers_in(cells[0][3])[0] == pytest.approx(rows[0]["a"], abs=5e-5)
     finally:
