@@ -10,6 +10,7 @@ import yaml
 
 from frictionlab.cli import main
 from frictionlab.errors import PresetError
+from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.preset import load_scene
 from frictionlab.runs.runner import run_to_folder
 from frictionlab.plugin.listeners import SweepListener
@@ -224,6 +225,47 @@ def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_
         capsys.readouterr()
         assert main([part.format(out=out) for part in how] + ["--workers", "1", "--quiet"]) == 0, capsys.readouterr().err
         assert fits(out) == fits(whole)  # the points never reached ran afresh, the finished one was kept
+
+
+def test_a_resumed_sweep_reads_its_completed_points_back_without_rewriting_them(tmp_path, registry):
+    """A completed point is read back, its listeners told it is restored: its files are not
+    written again (it was run again, 2 s a point under load); one missing its figure draws it."""
+    data = sweep_preset({"seed": {"values": [1, 2]}}, output={"plot": True})
+    sweep = plan_sweep(data, registry=registry, source=str(write(tmp_path, data)))
+
+    def interrupted(out):
+        cancel = threading.Event()
+
+        class StopAfterFirst(SweepListener):
+            def point_finished(self, sweep, point, result):
+                cancel.set()
+
+        return run_sweep(sweep, out, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+
+    class Heard(SweepListener):
+        restored = []
+
+        def run_listeners(self, point):
+            class Started:
+                @hookimpl
+                def run_started(self, run):
+                    Heard.restored.append((point.number, run.resumed))
+
+            return [Started()]
+
+    first = interrupted(tmp_path / "out")
+    folder = first.results[0].folder
+    files = {path: path.stat().st_mtime_ns for path in folder.rglob("*") if path.is_file()}
+    resumed = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1, resume=True), listeners=[Heard()], plot=False)
+    assert {path: path.stat().st_mtime_ns for path in folder.rglob("*") if path.is_file()} == files
+    assert [r.status for r in resumed.results] == ["completed", "completed"]
+    assert Heard.restored[0] == (1, sweep.points[0].scene.preset.realizations)
+    whole = run_sweep(sweep, tmp_path / "whole", RunOptions(workers=1), plot=False)
+    assert [(r.outcome.fit.a, r.outcome.fit.b) for r in resumed.results] == [
+        (r.outcome.fit.a, r.outcome.fit.b) for r in whole.results]  # fmt: skip
+    drawn = interrupted(tmp_path / "drawn").results[0].folder
+    run_sweep(sweep, tmp_path / "drawn", RunOptions(workers=1, resume=True), plot=True)
+    assert (drawn / "plot.png").is_file()  # the figure its first run did not draw
 
 
 @pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),

@@ -294,6 +294,10 @@ def _run_points(
             continue
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
+        finished = _read_back(point.scene, folder, run_listeners, plot) if started and options.resume else None
+        if finished is not None:
+            yield PointResult(point, finished.status, folder, outcome=finished, error=finished.error)
+            continue
         point_options = options if started or not options.resume else replace(options, resume=False)
         try:
             outcome, _ = run_to_folder(
@@ -307,6 +311,22 @@ def _run_points(
         yield PointResult(point, outcome.status, folder, outcome=outcome, error=outcome.error)
         if outcome.status in ("cancelled", "interrupted"):
             return
+
+
+def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
+    """The outcome of a point a resumed sweep finds completed with its files, read back (its
+    listeners hear it restored) without writing anything: None where it must run again."""
+    from ..compute import engine
+    from ..io.inputs import InputFileProblem, open_regular_file
+
+    wanted = ["summary.json", "curve.csv"] + (["plot.png"] if plot and scene.preset.output.plot else [])
+    for name in wanted:  # a file the user removed, or a figure that failed: the point's run writes it again
+        try:
+            open_regular_file(folder / name, follow_links=False).close()
+        except InputFileProblem:
+            return None
+    done = RunDirectory(folder).completed_results(scene)
+    return None if done is None else engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
 
 
 def run_sweep(
