@@ -151,11 +151,15 @@ def test_a_forged_chunk_counts_nothing_and_sizes_no_buffer(tmp_path, registry):
     huge = io.BytesIO()
     np.lib.format.write_array_header_1_0(huge, {"descr": "<i8", "fortran_order": False, "shape": (10**12,)})
     chunk(out / "chunks" / "00000001-00000001.npz", huge.getvalue())
+    claims = io.BytesIO()  # a name whose range allows 10^8 indices, a header claiming them, a file of bytes
+    np.lib.format.write_array_header_1_0(claims, {"descr": "<i8", "fortran_order": False, "shape": (10**8,)})
+    chunk(out / "chunks" / "00000001-99999999.npz", claims.getvalue())
     chunk(out / "chunks" / "00000002-00000002.npz", npy([3]))  # outside 2..2
     (out / "chunks" / "00000003-00000003.npz").write_bytes(b"not a zip")
     chunk(tmp_path / "elsewhere.npz", npy([2]))  # sound, but reached only through a link
     (out / "chunks" / "00000002-00000003.npz").symlink_to(tmp_path / "elsewhere.npz")
-    for name in ("00000001-00000001.npz", "00000002-00000002.npz", "00000003-00000003.npz", "00000002-00000003.npz"):
+    for name in ("00000001-00000001.npz", "00000001-99999999.npz", "00000002-00000002.npz", "00000003-00000003.npz",
+                 "00000002-00000003.npz"):  # fmt: skip
         entries[name] = "0" * 64
     _interrupted_with(out, entries)
     state = run_state(out)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import hashlib
 import io
 import math
+import os
 import re
 import zipfile
 from pathlib import Path
@@ -122,9 +123,10 @@ def chunk_indices(folder: Path, name: str) -> set[int]:
     held = []
     try:
         with open_member(folder, f"{CHUNK_DIR}/{name}", "chunk") as fh, zipfile.ZipFile(fh) as archive:
+            size = os.fstat(fh.fileno()).st_size  # no array in it is larger
             for array in ("index", "failed_index"):
                 with archive.open(f"{array}.npy") as member:
-                    held.append(_index_array(member, last - first + 1))
+                    held.append(_index_array(member, last - first + 1, size))
     except (InputFileProblem, KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile):
         return set()
     indices = np.concatenate(held)
@@ -133,15 +135,16 @@ def chunk_indices(folder: Path, name: str) -> set[int]:
     return set(indices.tolist())
 
 
-def _index_array(member, most: int) -> np.ndarray:
-    """A 1-D integer .npy array of at most ``most`` values read from ``member``, its header
-    checked before anything is allocated (a forged shape must not size a buffer)."""
+def _index_array(member, most: int, file_size: int) -> np.ndarray:
+    """A 1-D integer .npy array of at most ``most`` values read from ``member`` of a file of
+    ``file_size`` bytes, its header checked before anything is allocated (a forged shape
+    must not size a buffer)."""
     version = np.lib.format.read_magic(member)
     read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
     shape, _, dtype = read_header(member)
-    if len(shape) != 1 or dtype.kind not in "iu" or shape[0] > most:
+    if len(shape) != 1 or dtype.kind not in "iu" or shape[0] > most or shape[0] * dtype.itemsize > file_size:
         raise ValueError("not an index array")
-    raw = member.read(shape[0] * dtype.itemsize)
+    raw = member.read(min(shape[0] * dtype.itemsize, file_size))
     if len(raw) != shape[0] * dtype.itemsize:
         raise ValueError("a short index array")
     return np.frombuffer(raw, dtype).astype(np.int64)
