@@ -104,6 +104,7 @@ def test_the_built_in_presets_listing_shown_is_what_it_prints(capsys):
     _check("docs/getting-started.md", "NAME", capsys.readouterr().out)
 
 
+@pytest.mark.long  # the tutorial's X3P file written, validated and run twice (one a half-space): seconds
 def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
     """docs/tutorials/instrument-file.md, rerun in a copy of the example's folder: the X3P
     file written by the example's script, validated and run by MDR and by the free half-space."""
@@ -124,6 +125,7 @@ def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, mo
     _check(page, "scan: 1/1", capsys.readouterr().out)
 
 
+@pytest.mark.long  # the AFM file written, validated three times and run four times: seconds
 def test_the_scan_as_the_microscope_leaves_it_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
     """docs/tutorials/instrument-file.md, its second half: the AFM file written by the
     example's script (tilt, holes, a spike, 2.5:1 pixels, four channels), refused, validated,
