@@ -68,16 +68,6 @@ def test_cli_bad_preset_file(tmp_path, capsys):
 QUICK = ["--axes", "realizations", "--grid-realizations", "3", "--quiet"]
 
 
-@pytest.fixture
-def figure_stubbed(monkeypatch):
-    """study.png written as a few bytes, not drawn (a second each): for the tests of where a
-    study writes and what it says. The figure itself: test_cli_runs_a_study_and_prints_the_recommendation
-    above and tests/tradeoff/test_outputs.py."""
-    from frictionlab.tradeoff import outputs
-
-    monkeypatch.setattr(outputs, "plot", lambda study, fh: fh.write(b"not drawn"))
-
-
 def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_folders, figure_stubbed):
     (mine, _), (other, _) = folders = users_folders("study.md")
     for folder, held in folders:
