@@ -114,7 +114,8 @@ async def test_a_dialog_footer_lists_its_own_keys_not_those_of_the_screen_behind
             assert key not in said, said
 
 
-@pytest.mark.parametrize("kind", ["run", "sweep"])
+# the sweep's case is long (a sweep made first, then a TUI session: seconds); the run's is the same path
+@pytest.mark.parametrize("kind", ["run", pytest.param("sweep", marks=pytest.mark.long)])
 @sync
 async def test_cancel_leaves_the_footer_once_the_runs_last_event_came_while_its_process_closes(folders, registry, kind):
     """A sweep's process writes its last event, then closes (1 to 2 s on a loaded machine); a
