@@ -16,9 +16,10 @@ from frictionlab.plugin.registry import Registry
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS = ROOT / "presets"
 
-LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study): `pytest -m long` runs them
+LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study, the example plugin pip-installed
+    # and found from a fresh process; test_registry.py checks discovery without one): `pytest -m long` runs them
     "tui/test_screen.py", "tui/test_snapshots.py", "tui/test_form.py", "tui/test_run.py", "exact3d/test_study.py",
-    "tui/test_detached.py", "tui/test_small_things.py",
+    "tui/test_detached.py", "tui/test_small_things.py", "test_example_plugin.py",
 }  # fmt: skip
 
 

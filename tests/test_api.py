@@ -142,7 +142,7 @@ def test_plot_draws_the_points_and_the_fit_on_the_given_axes():
 
 def test_few_contacts_at_the_first_load_carry_a_caveat_everywhere(tmp_path):
     tiny = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1e-6}}
-    result = frictionlab.run(tiny, out=tmp_path / "tiny", **FAST)
+    result = frictionlab.run(tiny, out=tmp_path / "tiny", plot=False, **FAST)  # its figure: result.plot below
     assert result.table["contact_count"][0] < 3
     assert "fewer than 3 points in contact" in result.caveats[0]
     # and, from F = 1e-6 on, one point carries half the force at most loads
@@ -170,7 +170,7 @@ def test_every_public_name_resolves_lazily():
 def test_loads_that_press_the_whole_line_flat_carry_a_caveat_from_where_it_starts(tmp_path):
     # MDR springs: all N springs touch once the load exceeds about N dx E* times the height range
     heavy = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1.0, "stop": 1e6, "steps": 12}}
-    result = frictionlab.run(heavy, out=tmp_path / "heavy", **FAST)
+    result = frictionlab.run(heavy, out=tmp_path / "heavy", plot=False, **FAST)
     fraction = result.table["contact_fraction"]
     first = int(np.flatnonzero(fraction >= 0.999)[0])
     assert 0 < first < fraction.size and np.all(fraction[first:] >= 0.999)

@@ -40,21 +40,30 @@ def _check(page: str, first_line: str, printed: str):
     assert not stale, f"{page} shows output the command no longer prints:\n" + "\n".join(stale) + "\n--- printed:\n" + printed
 
 
-@pytest.fixture(scope="module")
-def fig2_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fig2") / "fig2"
+def _printed_run(out, preset: str, *options: str) -> tuple:
+    """``frictionlab run PRESET --out OUT --workers 1 --quiet OPTIONS``: (out, what it printed)."""
     stdout = io.StringIO()
     with contextlib.redirect_stdout(stdout):
-        code = main(["run", str(ROOT / "presets" / "benad2012-fig2.yaml"), "--out", str(out), "--workers", "1", "--quiet"])
+        code = main(["run", str(ROOT / "presets" / preset), "--out", str(out), "--workers", "1", "--quiet", *options])
     assert code == 0
     return out, stdout.getvalue()
 
 
+@pytest.fixture(scope="module")
+def fig2_run(tmp_path_factory):
+    # its figure left out: it prints the same without (the quickstart's run below draws one)
+    return _printed_run(tmp_path_factory.mktemp("fig2") / "fig2", "benad2012-fig2.yaml", "--no-plot")
+
+
+@pytest.fixture(scope="module")
+def quickstart_printed(tmp_path_factory):
+    """The README's quickstart run, once for the three pages that show its output."""
+    return _printed_run(tmp_path_factory.mktemp("qs") / "qs", "quickstart.yaml")[1]
+
+
 @pytest.mark.parametrize("page", ["README.md", "docs/getting-started.md", "docs/tutorials/dask-cluster.md"])
-def test_the_quickstart_output_shown_is_what_it_prints(page, tmp_path, capsys):
-    preset = ROOT / "presets" / "quickstart.yaml"
-    assert main(["run", str(preset), "--out", str(tmp_path / "qs"), "--workers", "1", "--quiet"]) == 0
-    _check(page, "quickstart: 50/50", capsys.readouterr().out)
+def test_the_quickstart_output_shown_is_what_it_prints(page, quickstart_printed):
+    _check(page, "quickstart: 50/50", quickstart_printed)
 
 
 def test_the_fig2_output_shown_is_what_it_prints(fig2_run):
@@ -95,6 +104,7 @@ def test_the_built_in_presets_listing_shown_is_what_it_prints(capsys):
     _check("docs/getting-started.md", "NAME", capsys.readouterr().out)
 
 
+@pytest.mark.long  # the tutorial's X3P file written, validated and run twice (one a half-space): seconds
 def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
     """docs/tutorials/instrument-file.md, rerun in a copy of the example's folder: the X3P
     file written by the example's script, validated and run by MDR and by the free half-space."""
@@ -110,11 +120,12 @@ def test_the_instrument_file_tutorial_shows_what_its_commands_print(tmp_path, mo
     _check(page, "wrote scan.x3p", capsys.readouterr().out)
     assert main(["run", preset, "--out", "runs/scan-mdr", "--workers", "1", "--quiet"]) == 0
     _check(page, "scan: 10/10", capsys.readouterr().out)
-    exact = ["--set", "solver.name=bem-halfspace-free", "--set", "realizations=1"]
-    assert main(["run", preset, *exact, "--out", "runs/scan-exact", "--workers", "1", "--quiet"]) == 0
+    exact = ["--set", "solver.name=bem-halfspace-free", "--set", "realizations=1"]  # printed alike without its figure
+    assert main(["run", preset, *exact, "--out", "runs/scan-exact", "--workers", "1", "--quiet", "--no-plot"]) == 0
     _check(page, "scan: 1/1", capsys.readouterr().out)
 
 
+@pytest.mark.long  # the AFM file written, validated three times and run four times: seconds
 def test_the_scan_as_the_microscope_leaves_it_shows_what_its_commands_print(tmp_path, monkeypatch, capsys):
     """docs/tutorials/instrument-file.md, its second half: the AFM file written by the
     example's script (tilt, holes, a spike, 2.5:1 pixels, four channels), refused, validated,

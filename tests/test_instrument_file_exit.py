@@ -19,7 +19,6 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from SurfaceTopography import Topography
 
 from frictionlab.errors import ExitCode
 
@@ -32,6 +31,8 @@ def write_two_data_sets(path):
 
 
 def write_netcdf(path):
+    from SurfaceTopography import Topography  # here, not at the top: its import takes seconds, paid only where a test writes such a file
+
     z = np.random.default_rng(8).standard_normal((16, 16))
     Topography(z, (4.0, 4.0), unit="um").to_netcdf(str(path))
 

@@ -23,7 +23,6 @@ import numpy as np
 import pytest
 import x3pio
 import yaml
-from SurfaceTopography import Topography, UniformLineScan
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, PresetError
@@ -49,6 +48,8 @@ def write_x3p(path, z_um, pixel_um=PIXEL_UM):
 
 def write_topography(path, z, pixel, unit, writer):
     """Through SurfaceTopography, which lays a map out as heights[x, y]."""
+    from SurfaceTopography import Topography  # here, not at the top: its import takes seconds, paid only where a test writes such a file
+
     topography = Topography(z.T.copy(), (z.shape[1] * pixel, z.shape[0] * pixel), unit=unit)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -94,6 +95,8 @@ def test_the_preset_may_override_the_pixel_size_and_says_so(tmp_path):
 
 
 def test_a_file_that_says_it_is_periodic_is_periodic_unless_the_preset_says_otherwise(tmp_path):
+    from SurfaceTopography import Topography
+
     z = scan_um()
     topography = Topography(z.T.copy(), (COLUMNS * PIXEL_UM, ROWS * PIXEL_UM), unit="um", periodic=True)
     with warnings.catch_warnings():
@@ -166,6 +169,8 @@ def test_a_scan_and_its_heights_as_npy_give_identical_results(tmp_path, suffix, 
 
 
 def test_a_line_scan_reads_as_a_profile(tmp_path):
+    from SurfaceTopography import UniformLineScan
+
     z = scan_um()[0]
     line = UniformLineScan(z, z.size * PIXEL_UM, unit="um")
     line.to_netcdf(str(tmp_path / "line.nc"))

@@ -117,7 +117,7 @@ def test_a_log_gets_a_load_line_only_now_and_then(registry, monkeypatch):
 
 LONG_LOADS = merge(SURFACE, {
     "realizations": 3,
-    "spectrum": {"params": {"points": 256, "short_cutoff": 2.0}},
+    "spectrum": {"params": {"points": 128, "short_cutoff": 2.0}},
     "solver": {"params": {"tolerance": 1e-13, "stop": "tolerance"}},  # no early certified stop: solves that last
     "loading": {"start": 1.0, "stop": 200.0, "steps": 8},
 })  # fmt: skip

@@ -180,7 +180,8 @@ def test_cli_refuses_before_writing_anything(tmp_path, monkeypatch, capsys):
     # --no-memory-check takes the user's word for it (a tiny run, so it really runs)
     path.write_text(yaml.safe_dump(line_of(1024)))
     monkeypatch.setattr(memory, "available_memory", lambda: (1, "a test limit"))
-    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet", "--no-memory-check"]) == 0
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet", "--no-memory-check",
+                 "--no-plot"]) == 0  # fmt: skip
 
 
 def test_available_memory_is_positive_and_below_the_machine_total():

@@ -279,7 +279,7 @@ def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
     assert "is not empty and is not the folder of a frictionlab sweep" in capsys.readouterr().err
     assert [p.name for p in folder.iterdir()] == ["notes.txt"]
     assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK
-    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK  # its own: rerun
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet", "--no-plot"]) == ExitCode.OK  # its own: rerun
     other = write(tmp_path / "t.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
         "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
     assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED

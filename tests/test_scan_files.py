@@ -16,7 +16,6 @@ import pytest
 import x3pio
 import yaml
 from scipy.io import netcdf_file
-from SurfaceTopography import Topography
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
@@ -45,6 +44,8 @@ def rectangular_x3p(path):
 
 def near_square_nc(path):
     """NT-MDT's 1.85339 x 1.85455 (0.06 % apart), in nm, as NetCDF."""
+    from SurfaceTopography import Topography  # here, not at the top: its import takes seconds, paid only where a test writes such a file
+
     z = rough_um(64) * 1e3 * 40
     topography = Topography(z.T.copy(), (64 * 1.85339, 64 * 1.85455), unit="nm")
     with warnings.catch_warnings():

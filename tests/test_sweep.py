@@ -181,7 +181,7 @@ def test_cli_runs_a_sweep_and_exit_codes(tmp_path, capsys):
     assert "point 2/2: spectrum.params.hurst=0.9" in captured.err
     assert "2 points" in captured.out and "hurst=0.9: a = " in captured.out
     assert len(read_table(tmp_path / "out" / "sweep.csv")) == 2
-    assert main(["run", str(good), "--out", str(tmp_path / "j"), "--workers", "1", "--quiet", "--json"]) == 0
+    assert main(["run", str(good), "--out", str(tmp_path / "j"), "--workers", "1", "--quiet", "--json", "--no-plot"]) == 0
     assert json.loads(capsys.readouterr().out)["status"] == "completed"
     # one point alone, with sweep=null: a plain run
     assert main(["run", str(good), "--set", "sweep=null", "--set", "spectrum.params.hurst=0.9",
@@ -208,7 +208,7 @@ def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_
     data = sweep_preset({"seed": {"values": [1, 2, 3]}})
     preset = write(tmp_path, data)
     whole = tmp_path / "whole"
-    assert main(["run", str(preset), "--out", str(whole), "--workers", "1", "--quiet"]) == 0
+    assert main(["run", str(preset), "--out", str(whole), "--workers", "1", "--quiet", "--no-plot"]) == 0  # tables only
     fits = lambda folder: [(r["status"], r["a"], r["b"]) for r in read_table(folder / "sweep.csv")]  # noqa: E731
 
     for how in (["resume", "{out}"], ["run", str(preset), "--out", "{out}", "--resume"]):
@@ -223,7 +223,7 @@ def test_an_interrupted_sweep_resumes_to_the_uninterrupted_tables_both_ways(tmp_
         run_sweep(sweep, out, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
         assert [r["status"] for r in read_table(out / "sweep.csv")] == ["completed", "pending", "pending"]
         capsys.readouterr()
-        assert main([part.format(out=out) for part in how] + ["--workers", "1", "--quiet"]) == 0, capsys.readouterr().err
+        assert main([part.format(out=out) for part in how] + ["--workers", "1", "--quiet", "--no-plot"]) == 0, capsys.readouterr().err
         assert fits(out) == fits(whole)  # the points never reached ran afresh, the finished one was kept
 
 

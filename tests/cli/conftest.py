@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 
+import pytest
 import yaml
 
 
@@ -12,6 +13,16 @@ def write_preset(tmp_path, data, name="preset.yaml"):
     path = tmp_path / name
     path.write_text(yaml.safe_dump(data))
     return path
+
+
+@pytest.fixture
+def figure_stubbed(monkeypatch):
+    """A study's study.png written as a few bytes, not drawn (a second each): for the tests of
+    where a study writes and what it says. The figure itself: test_study.py's
+    test_cli_runs_a_study_and_prints_the_recommendation and tests/tradeoff/test_outputs.py."""
+    from frictionlab.tradeoff import outputs
+
+    monkeypatch.setattr(outputs, "plot", lambda study, fh: fh.write(b"not drawn"))
 
 
 RUN_DIRECTORY = {"run.json", "chunks"}  # the run directory's own files (frictionlab.runs.rundir; run.lock is gone once it ends)

@@ -71,7 +71,7 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
 
 def test_resolved_preset_reruns_to_the_same_numbers(tmp_path, capsys):
     preset = write_preset(tmp_path, SMALL_PRESET)
-    main(["run", str(preset), "--out", str(tmp_path / "one"), "--workers", "1", "--quiet"])
+    main(["run", str(preset), "--out", str(tmp_path / "one"), "--workers", "1", "--quiet", "--no-plot"])  # numbers only
     main(["run", str(tmp_path / "one" / "preset.yaml"), "--out", str(tmp_path / "two"), "--workers", "2", "--quiet"])
     one = json.loads((tmp_path / "one" / "summary.json").read_text())
     two = json.loads((tmp_path / "two" / "summary.json").read_text())
@@ -82,7 +82,7 @@ def test_resolved_preset_reruns_to_the_same_numbers(tmp_path, capsys):
 def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
     result = cli(
-        "run", preset, "--out", tmp_path / "o", "--json", "--quiet", "--workers", "1",
+        "run", preset, "--out", tmp_path / "o", "--json", "--quiet", "--workers", "1", "--no-plot",
         "--set", "spectrum.params.hurst=0.5", "--set", "realizations=5", "--seed", "99",
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
@@ -95,7 +95,7 @@ def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path, cli):
 
 def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
-    result = cli("run", preset, "--out", tmp_path / "o", "--workers", "2")
+    result = cli("run", preset, "--out", tmp_path / "o", "--workers", "2", "--no-plot")
     assert result.returncode == 0
     lines = result.stderr.strip().splitlines()
     assert lines[0].startswith("small: 40 realizations")
@@ -189,7 +189,7 @@ def test_a_measured_profile_runs_end_to_end_with_its_own_rms_height(tmp_path, ca
             "loading": {"start": 0.1, "stop": 50.0, "steps": 12, "spacing": "log"},
         },
     )
-    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet"]) == ExitCode.OK
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--no-plot"]) == ExitCode.OK
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["workers"] == 1  # one realization runs in-process, and says so
     assert summary["normalisation"]["rms_height"] == pytest.approx(np.std(heights), rel=1e-12)

@@ -68,7 +68,7 @@ def test_cli_bad_preset_file(tmp_path, capsys):
 QUICK = ["--axes", "realizations", "--grid-realizations", "3", "--quiet"]
 
 
-def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_folders):
+def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_folders, figure_stubbed):
     (mine, _), (other, _) = folders = users_folders("study.md")
     for folder, held in folders:
         assert main(["study", "quickstart", *QUICK, "--out", str(folder)]) == ExitCode.OUTPUT_REFUSED
@@ -110,7 +110,7 @@ def test_study_refuses_a_grid_beyond_the_memory_before_starting(tmp_path, capsys
     assert not out.exists()
 
 
-def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys):
+def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys, figure_stubbed):
     import os
 
     out = tmp_path / os.fsdecode(b"st\xff")
@@ -119,7 +119,7 @@ def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys):
     assert "st\\xff" in (out / "study.md").read_text(encoding="utf-8")
 
 
-def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path, capsys):
+def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path, capsys, figure_stubbed):
     swept = {**TINY, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
     for data, warned in ((swept, True), ({**swept, "sweep": None}, False)):
         preset, out = write(tmp_path, data), tmp_path / f"study-{warned}"

@@ -55,7 +55,7 @@ def test_bootstrap_pairs_keep_the_correlation_the_rectangle_loses():
 
 
 def test_pairs_from_a_run_folder_are_the_runs_own(tmp_path, make_scene):
-    outcome, _ = run_to_folder(make_scene({"realizations": 10}), tmp_path, RunOptions(workers=1))
+    outcome, _ = run_to_folder(make_scene({"realizations": 10, "output": {"plot": False}}), tmp_path, RunOptions(workers=1))
     pairs = bootstrap_pairs(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert pairs.shape == (summary["fit"]["bootstrap"], 2)
@@ -75,7 +75,7 @@ def test_cli(tmp_path, capsys, make_scene):
     assert main([*args, "--a", "2.9", "--b", "0.14", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["xi"] == pytest.approx(2.9 + 0.14 * math.log(out["f"]), rel=1e-12)
-    run_to_folder(make_scene(), tmp_path, RunOptions(workers=1))
+    run_to_folder(make_scene({"output": {"plot": False}}), tmp_path, RunOptions(workers=1))
     assert main([*args, "--from", str(tmp_path)]) == 0
     assert "(bootstrap pairs)" in capsys.readouterr().out
     assert main([*args]) == 2

@@ -6,6 +6,7 @@ import asyncio
 import contextlib
 import functools
 import re
+import time
 
 import pytest
 import yaml
@@ -16,6 +17,7 @@ from textual.widgets import Input, Select, Static
 from frictionlab.errors import PresetError
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
+from frictionlab.runs.detached import run_state, start_detached, wait_started
 from frictionlab.runs.runner import run_to_folder
 from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.widgets import PresetForm
@@ -185,6 +187,43 @@ def fits_width(table):
 
 def numbers_in(cell):
     return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", str(cell))]
+
+
+LONG = merge(TINY, {"name": "long", "realizations": 100_000})  # runs for minutes: each test ends it
+
+
+def start_long_run(folders, registry):
+    """``LONG`` started in a process of its own in runs/long, as the TUI starts a run;
+    (process, folder) once the process has taken the folder."""
+    out = folders / "runs" / "long"
+    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
+    wait_started(process, out)
+    return process, out
+
+
+@contextlib.contextmanager
+def long_run_going(folders, registry):
+    """``start_long_run`` for the ``with`` block; its process killed (kill -9) when the block ends."""
+    process, out = start_long_run(folders, registry)
+    try:
+        yield process, out
+    finally:
+        process.kill()
+        process.wait()
+
+
+def interrupted_long_run(folders, registry, done: int = 0):
+    """runs/long ended by SIGTERM, as a cancel ends it, once it has stored ``done``
+    realizations or more: interrupted, to be resumed. Its folder."""
+    process, out = start_long_run(folders, registry)
+    deadline = time.monotonic() + 60.0
+    while (run_state(out).done or 0) < done:
+        assert time.monotonic() < deadline, f"runs/long stored fewer than {done} realizations in 60 s"
+        time.sleep(0.05)
+    process.terminate()
+    process.wait()
+    assert run_state(out).status == "interrupted"
+    return out
 
 
 def make_runs(folders, registry):

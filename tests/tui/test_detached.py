@@ -19,20 +19,9 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE,
-    SWEEP,
-    TINY,
-    make_app,
-    numbers_in,
-    press_run,
-    press_settled,
-    screen_text,
-    status_text,
-    sync,
-    wait_until,
+    LONG, SIZE, SWEEP, TINY, interrupted_long_run, long_run_going, make_app, numbers_in, press_run, press_settled,
+    screen_text, status_text, sync, wait_until,
 )
-
-LONG = merge(TINY, {"name": "long", "realizations": 100_000})
 
 
 def stats(app) -> str:
@@ -56,10 +45,7 @@ def wait_for(condition, timeout=60.0):
 
 @sync
 async def test_a_tui_opened_later_shows_the_running_run_live_and_lists_it(folders, registry):
-    out = folders / "runs" / "long"
-    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
-    try:
-        wait_started(process, out)
+    with long_run_going(folders, registry) as (process, out):
         app = make_app(registry)
         async with app.run_test(size=SIZE) as pilot:
             await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 2)
@@ -74,10 +60,7 @@ async def test_a_tui_opened_later_shows_the_running_run_live_and_lists_it(folder
         assert [(e.path.name, e.status) for e in listed] == [("long", "running")]
         assert "▶" in results and "long" in results
         assert process.poll() is None  # the TUI quit; the run goes on
-    finally:
-        end(process.pid)
-        process.wait()
-    assert run_state(out).status == "interrupted"  # killed: never read as running
+    assert run_state(out).status == "interrupted"  # killed (kill -9): never read as running
 
 
 @contextlib.asynccontextmanager
@@ -318,12 +301,7 @@ async def test_a_sweeps_resume_shows_its_done_points_and_the_count_its_next_poin
 async def test_u_after_a_cancel_shows_this_invocations_elapsed_time_rate_and_the_restored_count(folders, registry):
     """The resumed run rewrites progress.jsonl, larger than the cancelled run's: the TUI,
     which may read the old file first, must follow the new one from its start."""
-    out = folders / "runs" / "long"
-    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
-    wait_started(process, out)
-    wait_for(lambda: (run_state(out).done or 0) >= 30)
-    os.kill(process.pid, signal.SIGTERM)
-    process.wait()
+    out = interrupted_long_run(folders, registry, done=30)
     restored = run_state(out).done
     time.sleep(3.0)  # the cancelled run's clock would count this
     app = make_app(registry)

@@ -7,17 +7,7 @@ import json
 import pytest
 
 from .conftest import (
-    SIZE,
-    SWEEP,
-    TINY,
-    make_app,
-    make_runs,
-    press_settled,
-    screen_text,
-    started,
-    status_text,
-    sync,
-    type_into,
+    SIZE, SWEEP, TINY, make_app, make_runs, press_settled, screen_text, started, status_text, sync, type_into,
     wait_until,
 )
 
@@ -38,6 +28,7 @@ def interrupted_copy(folders, name: str) -> None:
     (copy / "summary.json").write_text(json.dumps(summary))
 
 
+@pytest.mark.long  # two finished runs made first, then a TUI session: seconds (the footer's fast case: save and run below)
 @sync
 async def test_results_offers_resume_only_on_a_run_that_can_go_on(folders, registry):
     make_runs(folders, registry)
@@ -81,6 +72,7 @@ async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
     assert "^s Save" in open_ and "^r Run" in open_
 
 
+@pytest.mark.long  # a TUI session with a preset open and edited twice: seconds
 @sync
 async def test_run_is_listed_only_while_the_open_preset_has_no_problem(folders, registry):
     """Ctrl+R on a preset with a problem is refused (it names the problem and points at the
@@ -99,6 +91,7 @@ async def test_run_is_listed_only_while_the_open_preset_has_no_problem(folders, 
     assert said.startswith("Cannot run: 1 problem: realizations")
 
 
+@pytest.mark.long  # a TUI session through two dialogs: seconds
 @sync
 async def test_a_dialog_footer_lists_its_own_keys_not_those_of_the_screen_behind(folders, registry):
     """The New dialog's footer said "⏎ Open d Duplicate n New r Reload", the Presets list's
@@ -121,7 +114,8 @@ async def test_a_dialog_footer_lists_its_own_keys_not_those_of_the_screen_behind
             assert key not in said, said
 
 
-@pytest.mark.parametrize("kind", ["run", "sweep"])
+# the sweep's case is long (a sweep made first, then a TUI session: seconds); the run's is the same path
+@pytest.mark.parametrize("kind", ["run", pytest.param("sweep", marks=pytest.mark.long)])
 @sync
 async def test_cancel_leaves_the_footer_once_the_runs_last_event_came_while_its_process_closes(folders, registry, kind):
     """A sweep's process writes its last event, then closes (1 to 2 s on a loaded machine); a

@@ -16,16 +16,7 @@ from frictionlab.tui.widgets import PresetForm
 
 from ..conftest import PRESETS, merge
 from .conftest import (
-    SIZE,
-    TINY,
-    choose,
-    error_text,
-    headless_problems,
-    make_app,
-    new_preset,
-    open_first_preset,
-    press_settled,
-    sync,
+    SIZE, TINY, choose, error_text, headless_problems, make_app, new_preset, open_first_preset, press_settled, sync,
     type_into,
 )
 

@@ -19,6 +19,7 @@ async def test_enter_then_typing_on_the_form_types_into_the_field(folders, regis
         await wait_until(pilot, lambda: app.query_one("#field--name", Input).value == TINY["name"] + "xy", timeout=10.0)
 
 
+@pytest.mark.long  # a TUI session with a preset open, twice: seconds (keys in order: the test above)
 @pytest.mark.parametrize("arriving", ["one after the other", "joined by the terminal"])
 @sync
 async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, registry, arriving):

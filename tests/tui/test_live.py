@@ -40,7 +40,7 @@ def twelve_stopped_after_five(registry, folder):
     from frictionlab.plugin.hookspecs import hookimpl
     from frictionlab.runs.runner import run_to_folder
 
-    scene = build_scene(merge(TINY, {"realizations": 12}), registry=registry)
+    scene = build_scene(merge(TINY, {"realizations": 12, "output": {"plot": False}}), registry=registry)  # numbers only
     cancel = threading.Event()
 
     class StopAfterFive:

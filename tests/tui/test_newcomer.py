@@ -10,7 +10,7 @@ import sys
 import pytest
 import yaml
 
-from frictionlab.runs.detached import run_state, start_detached, wait_started
+from frictionlab.runs.detached import start_detached
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.runs.rundir import new_run_folder
@@ -18,18 +18,8 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE,
-    TINY,
-    make_app,
-    make_runs,
-    numbers_in,
-    press_settled,
-    runs_app,
-    screen_text,
-    started,
-    status_text,
-    sync,
-    wait_until,
+    LONG, SIZE, TINY, interrupted_long_run, long_run_going, make_app, make_runs, numbers_in, press_settled,
+    runs_app, screen_text, started, status_text, sync, wait_until,
 )
 
 
@@ -147,9 +137,6 @@ async def test_a_run_started_elsewhere_is_listed_in_results_without_a_reload(fol
     assert cursor == highlighted
 
 
-LONG = merge(TINY, {"name": "long", "realizations": 100_000})
-
-
 def _footer(app) -> str:
     return screen_text(app).splitlines()[-1]
 
@@ -187,13 +174,7 @@ async def test_a_resume_that_another_process_began_first_is_followed_and_said_in
     """Two TUIs pressing u on one interrupted run: the one that loses the folder's lock
     follows the run that won, and says so whole (it said "Run failed: … in use by another
     run (pid …): wait for it to end, or give another", cut, advice it could not follow)."""
-    out = folders / "runs" / "long"
-    scene = build_scene(LONG, registry=registry)
-    process = start_detached(scene.resolved(), out, RunOptions(workers=1), plot=False)
-    wait_started(process, out)
-    process.terminate()
-    process.wait()
-    assert run_state(out).status == "interrupted"
+    out = interrupted_long_run(folders, registry)
     # the winner: a process that holds the folder's lock, as a resume does before its manifest says "running"
     holder = subprocess.Popen([sys.executable, "-c", HOLD_LOCK, str(out / "run.lock")], stdout=subprocess.PIPE)
     try:
@@ -224,12 +205,7 @@ async def test_a_resume_that_loses_the_race_after_its_process_began_follows_the_
     "Run interrupted" with no c, no u, following nothing, until a second u."""
     import frictionlab.runs.detached as detached
 
-    out = folders / "runs" / "long"
-    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
-    wait_started(process, out)
-    process.terminate()
-    process.wait()
-    assert run_state(out).status == "interrupted"
+    out = interrupted_long_run(folders, registry)
     holders = []
 
     def the_loser_starts(*args, **kwargs):  # the winner takes the lock just after this TUI's check
@@ -261,10 +237,7 @@ async def test_a_resume_that_loses_the_race_after_its_process_began_follows_the_
 @sync
 async def test_space_on_a_running_row_says_why_it_cannot_compare(folders, registry):
     """Space, not listed on a running row of Results, switched to the Run tab without a word."""
-    out = folders / "runs" / "long"
-    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
-    try:
-        wait_started(process, out)
+    with long_run_going(folders, registry):
         app = make_app(registry)
         async with started(app) as pilot:
             await press_settled(pilot, "f5")
@@ -273,9 +246,6 @@ async def test_space_on_a_running_row_says_why_it_cannot_compare(folders, regist
             footer = _footer(app)
             await press_settled(pilot, "space")
             tab, said = app.query_one("#tabs").active, status_text(app)
-    finally:
-        process.terminate()
-        process.wait()
     assert "Compare" not in footer, footer
     assert tab == "results", said
     assert said == "long is running: it has no curve to compare until it ends; Enter shows it live on the Run tab"
@@ -295,13 +265,7 @@ import time; time.sleep(600)
 @pytest.mark.long
 @sync
 async def test_a_resume_whose_progress_file_is_a_link_says_so_once_and_counts_its_chunks(folders, registry):
-    out = folders / "runs" / "long"
-    process = start_detached(build_scene(LONG, registry=registry).resolved(), out, RunOptions(workers=1), plot=False)
-    wait_started(process, out)
-    while run_state(out).done in (None, 0):  # at least one chunk stored
-        await asyncio.sleep(0.05)
-    process.terminate()
-    process.wait()
+    out = interrupted_long_run(folders, registry, done=1)  # at least one chunk stored
     (out / "progress.jsonl").unlink()
     (folders / "elsewhere.jsonl").write_text("")
     (out / "progress.jsonl").symlink_to(folders / "elsewhere.jsonl")

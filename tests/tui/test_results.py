@@ -10,17 +10,7 @@ from frictionlab.options import RunOptions
 from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
-from .conftest import (
-    SWEEP,
-    fits_width,
-    make_app,
-    make_runs,
-    numbers_in,
-    press_settled,
-    runs_app,
-    started,
-    sync,
-)
+from .conftest import SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, runs_app, started, sync
 
 # ------------------------------------------------------------------ results
 

@@ -18,21 +18,8 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE,
-    SWEEP,
-    TINY,
-    fits_width,
-    make_app,
-    numbers_in,
-    press_run,
-    press_settled,
-    run_to_the_end,
-    screen_text,
-    started,
-    status_text,
-    sweep_app,
-    sync,
-    wait_until,
+    SIZE, SWEEP, TINY, fits_width, make_app, numbers_in, press_run, press_settled, run_to_the_end, screen_text,
+    started, status_text, sweep_app, sync, wait_until,
 )
 
 # ------------------------------------------------------------------ running

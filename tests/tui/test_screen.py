@@ -25,24 +25,8 @@ from frictionlab.tui.screens import PathScreen
 
 from ..conftest import merge
 from .conftest import (
-    SIZE,
-    TINY,
-    fits_width,
-    make_app,
-    make_runs,
-    new_preset,
-    open_first_preset,
-    post_keys,
-    press_run,
-    press_settled,
-    run_to_the_end,
-    runs_app,
-    screen_text,
-    started,
-    status_text,
-    sync,
-    type_into,
-    wait_until,
+    SIZE, TINY, fits_width, make_app, make_runs, new_preset, open_first_preset, post_keys, press_run, press_settled,
+    run_to_the_end, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
 )
 
 BIG = (120, 40)

@@ -11,18 +11,8 @@ from frictionlab.tui.widgets import PresetsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE,
-    TINY,
-    make_app,
-    press_settled,
-    run_to_the_end,
-    screen_text,
-    started,
-    status_text,
-    sweep_app,
-    sync,
-    type_into,
-    wait_until,
+    SIZE, TINY, make_app, press_settled, run_to_the_end, screen_text, started, status_text, sweep_app, sync,
+    type_into, wait_until,
 )
 
 

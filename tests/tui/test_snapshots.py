@@ -11,15 +11,7 @@ from frictionlab.options import RunOptions
 from frictionlab.runs.sweep import load_sweep, run_sweep
 
 from ..conftest import merge
-from .conftest import (
-    SIZE,
-    SWEEP,
-    make_app,
-    make_runs,
-    open_first_preset,
-    run_to_the_end,
-    type_into,
-)
+from .conftest import SIZE, SWEEP, make_app, make_runs, open_first_preset, run_to_the_end, type_into
 
 SIZES = pytest.mark.parametrize("size", [SIZE, (120, 40)], ids=["80x24", "120x40"])
 
@@ -59,13 +51,22 @@ def test_snapshot_presets(folders, registry, snap_compare, size):
     assert snap_compare(make_app(registry), terminal_size=size, run_before=settle)
 
 
-@SIZES
-def test_snapshot_editor_with_a_problem(folders, registry, snap_compare, size):
-    async def edit(pilot):
+def typed(field: str, text: str, *keys: str):
+    """A ``run_before``: the first preset opened, ``text`` typed into ``field``, then ``keys`` pressed."""
+
+    async def run_before(pilot):
         await open_first_preset(pilot)
-        await type_into(pilot, "field--spectrum--params--hurst", "2.0")
+        await type_into(pilot, field, text)
+        if keys:
+            await pilot.press(*keys)
         await settle(pilot)
 
+    return run_before
+
+
+@SIZES
+def test_snapshot_editor_with_a_problem(folders, registry, snap_compare, size):
+    edit = typed("field--spectrum--params--hurst", "2.0")
     assert snap_compare(make_app(registry), terminal_size=size, run_before=edit)
 
 
@@ -90,12 +91,7 @@ def test_snapshot_new_preset_dialog(folders, registry, snap_compare, size):
 
 @SIZES
 def test_snapshot_save_with_problems_asks(folders, registry, snap_compare, size):
-    async def save(pilot):
-        await open_first_preset(pilot)
-        await type_into(pilot, "field--realizations", "0")
-        await pilot.press("ctrl+s")
-        await settle(pilot)
-
+    save = typed("field--realizations", "0", "ctrl+s")
     assert snap_compare(make_app(registry), terminal_size=size, run_before=save)
 
 

@@ -5,6 +5,7 @@ import json
 import subprocess
 import sys
 
+import pytest
 from textual.widgets import DataTable
 
 from .conftest import SIZE, TINY, make_app, post_keys, started, sync, wait_until
@@ -84,6 +85,7 @@ async def test_q_pressed_as_the_first_screen_appears_quits(folders, registry):
     assert app.return_code == 0
 
 
+@pytest.mark.long  # a TUI session that opens a preset: seconds (keys at the first screen: the tests above)
 @sync
 async def test_enter_typed_before_the_terminal_was_raw_opens_the_highlighted_preset(folders, registry):
     app = make_app(registry)
@@ -94,6 +96,7 @@ async def test_enter_typed_before_the_terminal_was_raw_opens_the_highlighted_pre
         assert app.draft_path is not None and app.draft_path.name == "tiny.yaml"  # the first preset listed
 
 
+@pytest.mark.long  # a TUI session that opens a preset: seconds
 @sync
 async def test_keys_typed_before_the_preset_opened_from_the_command_line_is_built_act_in_order(folders, registry):
     """``frictionlab tui PRESET``: Tab then typing, before its Edit form exists, goes into the

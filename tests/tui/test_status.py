@@ -7,6 +7,7 @@ import pytest
 from .conftest import SIZE, make_app, make_runs, press_settled, started, status_text, sync, wait_until
 
 
+@pytest.mark.long  # two finished runs made first, then a TUI session: seconds (a message that goes: the test below)
 @sync
 async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighted(folders, registry):
     make_runs(folders, registry)

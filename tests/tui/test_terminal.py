@@ -111,7 +111,8 @@ def _wait_reading(process, keyboard, until, timeout=60.0) -> bytes:
     return written
 
 
-@pytest.mark.parametrize("when", ["while it loads", "as its screen is drawn"])
+# the drawn screen's case is long (a process that imports and draws the whole app: seconds)
+@pytest.mark.parametrize("when", ["while it loads", pytest.param("as its screen is drawn", marks=pytest.mark.long)])
 def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when):
     """A SIGTERM while it loads (after it took the terminal out of line mode, before its commands
     handle signals) killed it there, its terminal left without echo nor line mode; once the app
