@@ -93,6 +93,9 @@ def _order(d1: float, d2: float, points: Sequence[float]) -> float:
     low, high = ORDER_RANGE
     if not _order_ratio(low, points) <= target <= _order_ratio(high, points):
         return math.nan
+    step = float(points[1]) / float(points[0])
+    if math.isclose(float(points[2]) / float(points[1]), step) and step > 1.0:  # a ratio of step^p: closed form
+        return math.log(target) / math.log(step)
     for _ in range(100):
         mid = 0.5 * (low + high)
         low, high = (mid, high) if _order_ratio(mid, points) < target else (low, mid)

@@ -30,7 +30,7 @@ from frictionlab.exact3d.statistics import (
 )
 
 
-@pytest.mark.parametrize("order", [1.0, 2.0])
+@pytest.mark.parametrize("order", [1.0, 1.37, 2.0])
 @pytest.mark.parametrize("sign", [1.0, -1.0])
 def test_richardson_recovers_the_limit_and_order_of_a_known_sequence(order, sign):
     limit, c = 0.8, sign * 3.0
@@ -38,6 +38,13 @@ def test_richardson_recovers_the_limit_and_order_of_a_known_sequence(order, sign
     result = richardson(values)
     assert result.estimated and result.order == pytest.approx(order, rel=1e-9)
     assert result.limit == pytest.approx(limit, abs=1e-12)
+
+
+def test_richardson_on_grids_tripled_recovers_the_order():
+    points = (64, 192, 576)
+    result = richardson([0.8 + 40.0 * n**-1.5 for n in points], points)
+    assert result.estimated and result.order == pytest.approx(1.5, rel=1e-9)
+    assert result.limit == pytest.approx(0.8, abs=1e-12)
 
 
 def test_richardson_on_grids_not_doubled_recovers_the_limit():
