@@ -88,6 +88,22 @@ def users_folders(tmp_path):
 
 
 @pytest.fixture
+def run_folder_writes(monkeypatch) -> list[str]:
+    """The names of the files a run folder writes atomically, in order, as they are written."""
+    from frictionlab.io import files
+
+    written = []
+    atomic_write = files.atomic_write
+
+    def counting(path, *args, **kwargs):
+        written.append(Path(path).name)
+        return atomic_write(path, *args, **kwargs)
+
+    monkeypatch.setattr("frictionlab.runs.rundir.atomic_write", counting)
+    return written
+
+
+@pytest.fixture
 def make_scene(registry):
     def make(changes: dict | None = None, base: dict = SMALL_PRESET):
         return build_scene(merge(base, changes or {}), registry=registry)

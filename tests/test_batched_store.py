@@ -7,7 +7,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 
@@ -35,24 +34,20 @@ def results_of(scene) -> list:
     return sorted(kept.results, key=lambda r: r.index)
 
 
-def counting_writes(monkeypatch) -> list[str]:
-    from frictionlab.io import files
-
-    written = []
-    atomic_write = files.atomic_write
-
-    def counting(path, *args, **kwargs):
-        written.append(Path(path).name)
-        return atomic_write(path, *args, **kwargs)
-
-    monkeypatch.setattr("frictionlab.runs.rundir.atomic_write", counting)
-    return written
+def two_batches(run_dir, scene, first, last, unsaved=0.0) -> BatchedStore:
+    """A fresh run in ``run_dir`` whose store has written ``first`` and holds ``last`` pending."""
+    run_dir.start(scene, resume=False)
+    store = BatchedStore(run_dir, unsaved=unsaved)
+    store.save_chunk(first)
+    store.unsaved = math.inf
+    store.save_chunk(last)
+    return store
 
 
-def test_a_batch_is_half_a_second_of_the_run_s_time_whatever_its_workers(make_scene, tmp_path, monkeypatch):
+def test_a_batch_is_half_a_second_of_the_run_s_time_whatever_its_workers(make_scene, tmp_path, run_folder_writes):
     scene = make_scene({"realizations": 4, **NO_PLOT})
     results = [dataclasses.replace(r, seconds=0.3) for r in results_of(scene)]
-    written = counting_writes(monkeypatch)
+    written = run_folder_writes
     for workers, first_write in ((1, 2), (2, 4)):  # 0.6 s of work is 0.6 s of one worker's time, 0.3 s of two's
         with RunDirectory(tmp_path / f"w{workers}") as run_dir:
             run_dir.start(scene, resume=False)
@@ -63,17 +58,12 @@ def test_a_batch_is_half_a_second_of_the_run_s_time_whatever_its_workers(make_sc
                 assert any(name.endswith(".npz") for name in written) == (done % first_write == 0), (workers, done)
 
 
-def test_a_completed_run_s_last_batch_is_written_only_in_its_merged_chunk(make_scene, tmp_path, monkeypatch):
+def test_a_completed_run_s_last_batch_is_written_only_in_its_merged_chunk(make_scene, tmp_path, run_folder_writes):
     scene = make_scene({"realizations": 6, **NO_PLOT})
     results = results_of(scene)
-    written = counting_writes(monkeypatch)
+    written = run_folder_writes
     with RunDirectory(tmp_path / "run") as run_dir:
-        run_dir.start(scene, resume=False)
-        store = BatchedStore(run_dir, unsaved=0.0)  # the first four written as they come, two by two
-        store.save_chunk(results[0:2])
-        store.save_chunk(results[2:4])
-        store.unsaved = math.inf
-        store.save_chunk(results[4:6])  # pending at the end
+        store = two_batches(run_dir, scene, results[0:4], results[4:6])  # the last two pending at the end
         written.clear()
         store.flush(merge=True)
         run_dir.finish(scene, "completed")
@@ -94,11 +84,7 @@ def test_a_cancelled_run_s_last_batch_is_a_chunk_of_its_own(make_scene, tmp_path
     scene = make_scene({"realizations": 4, **NO_PLOT})
     results = results_of(scene)
     with RunDirectory(tmp_path / "run") as run_dir:
-        run_dir.start(scene, resume=False)
-        store = BatchedStore(run_dir, unsaved=0.0)
-        store.save_chunk(results[0:2])
-        store.unsaved = math.inf
-        store.save_chunk(results[2:3])
+        store = two_batches(run_dir, scene, results[0:2], results[2:3])
         store.flush(merge=False)
         run_dir.finish(scene, "cancelled")
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
@@ -114,11 +100,7 @@ def test_a_run_killed_after_its_merge_resumes_from_the_merged_chunk_alone(make_s
     scene = make_scene({"realizations": 4, **NO_PLOT})
     results = results_of(scene)
     with RunDirectory(tmp_path / "run") as run_dir:
-        run_dir.start(scene, resume=False)
-        store = BatchedStore(run_dir, unsaved=0.0)
-        store.save_chunk(results[0:2])
-        store.unsaved = math.inf
-        store.save_chunk(results[2:4])
+        store = two_batches(run_dir, scene, results[0:2], results[2:4])
         store.flush(merge=True)  # no finish: killed here
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     assert manifest["status"] == "running" and manifest["retired"] == ["00000000-00000001.npz"]

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 import yaml
 
-from frictionlab.io import files
 from frictionlab.runs import runner
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, OutputRefused
@@ -155,20 +154,15 @@ def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_sc
     assert manifest["status"] == "cancelled" and manifest["fingerprint"] and manifest["preset"]["seed"] == 7
 
 
-def test_a_short_run_writes_its_chunks_once_and_the_same_files_as_a_chunk_at_a_time(make_scene, tmp_path, monkeypatch):
+def test_a_short_run_writes_its_chunks_once_and_the_same_files_as_a_chunk_at_a_time(
+    make_scene, tmp_path, monkeypatch, run_folder_writes
+):
     """Bookkeeping sized to the run: a sub-second run keeps its finished chunks until the
     end and writes them as one file (no compaction, a third of the writes); the folder
     holds what a run writing each chunk as it finished leaves, to the bit but for the
     realizations' own times."""
     scene = make_scene({"realizations": 30, **NO_PLOT})
-    written = []
-    atomic_write = files.atomic_write
-
-    def counting(path, *args, **kwargs):
-        written.append(Path(path).name)
-        return atomic_write(path, *args, **kwargs)
-
-    monkeypatch.setattr("frictionlab.runs.rundir.atomic_write", counting)
+    written = run_folder_writes
     run_to_folder(scene, tmp_path / "batched", RunOptions(workers=1))
     batched = list(written)
     monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)
