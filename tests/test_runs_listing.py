@@ -164,3 +164,44 @@ def test_a_forged_chunk_counts_nothing_and_sizes_no_buffer(tmp_path, registry):
     _interrupted_with(out, entries)
     state = run_state(out)
     assert (state.done, state.total) == (1, 4)
+
+
+def test_a_chunk_with_a_forged_central_directory_is_not_parsed(tmp_path, registry):
+    """zipfile parses a zip's whole central directory at once, some 600 bytes of memory for each
+    90-byte entry: a chunk padded with 30000 empty entries beside a sound index array (a few MB
+    here, gigabytes in a file of a few hundred MB) holds none of the count, read with no more
+    memory than its size, and a resume counts it damaged the same way."""
+    import hashlib
+    import tracemalloc
+    import zipfile
+
+    import numpy as np
+
+    from frictionlab.runs.chunks import ChunkDamage, chunk_indices, read_chunk
+
+    out = tmp_path / "runs" / "run"
+    _run(out, registry)
+    entries = _stored_only(out, [0])
+    forged = out / "chunks" / "00000001-00000001.npz"
+    with zipfile.ZipFile(forged, "w") as archive:
+        for key, value in (("index", [1]), ("failed_index", [])):
+            with archive.open(f"{key}.npy", "w") as fh:
+                np.lib.format.write_array(fh, np.asarray(value, np.int64))
+        for i in range(30000):
+            archive.writestr(f"{i}", b"")
+    entries[forged.name] = hashlib.sha256(forged.read_bytes()).hexdigest()
+    _interrupted_with(out, entries)
+    tracemalloc.start()
+    try:
+        assert chunk_indices(out, forged.name) == set()
+        assert tracemalloc.get_traced_memory()[1] < forged.stat().st_size
+    finally:
+        tracemalloc.stop()
+    assert run_state(out).done == 1
+    scene = build_scene(TINY, registry=registry)
+    try:
+        read_chunk(out, forged.name, entries[forged.name], scene)
+    except ChunkDamage as exc:
+        assert "unreadable" in str(exc)
+    else:
+        raise AssertionError("a forged central directory was read as a chunk")

@@ -21,6 +21,7 @@ from ..preset import Scene
 from .runfolder import open_member, read_member
 
 CHUNK_DIR = "chunks"
+MAX_CHUNK_DIRECTORY_BYTES = 256 * 1024  # a chunk's ~30 arrays list in under 8 kB of its zip's central directory
 MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
@@ -102,6 +103,7 @@ def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[Realizatio
     if hashlib.sha256(raw).hexdigest() != digest:
         raise ChunkDamage("checksum mismatch")
     try:
+        _check_archive(io.BytesIO(raw))
         with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
     except Exception as exc:  # a damaged zip or array header
@@ -122,7 +124,7 @@ def chunk_indices(folder: Path, name: str) -> set[int]:
     first, last = int(match[1]), int(match[2])
     held = []
     try:
-        with open_member(folder, f"{CHUNK_DIR}/{name}", "chunk") as fh, zipfile.ZipFile(fh) as archive:
+        with open_member(folder, f"{CHUNK_DIR}/{name}", "chunk") as fh, _check_archive(fh) as archive:
             size = os.fstat(fh.fileno()).st_size  # no array in it is larger
             for array in ("index", "failed_index"):
                 with archive.open(f"{array}.npy") as member:
@@ -133,6 +135,18 @@ def chunk_indices(folder: Path, name: str) -> set[int]:
     if indices.size and (indices.min() < first or indices.max() > last):
         return set()
     return set(indices.tolist())
+
+
+def _check_archive(fh) -> zipfile.ZipFile:
+    """The zip archive ``fh`` once its central directory is known to be a chunk's size: zipfile
+    parses all of it at once, some 600 bytes of memory for each 90-byte entry (a forged chunk of a
+    few hundred MB would take gigabytes). ``zipfile._EndRecData`` reads the end record alone."""
+    end = zipfile._EndRecData(fh)
+    if end is None:
+        raise zipfile.BadZipFile("not a zip archive")
+    if end[zipfile._ECD_SIZE] > MAX_CHUNK_DIRECTORY_BYTES:
+        raise ValueError("a central directory larger than any chunk's")
+    return zipfile.ZipFile(fh)
 
 
 def _index_array(member, most: int, file_size: int) -> np.ndarray:
