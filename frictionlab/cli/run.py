@@ -136,7 +136,7 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     try:
         result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
     except OSError as exc:
-        print(shown(f"error: cannot write results to {out_dir}: {exc.strerror or exc}"), file=sys.stderr)
+        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}"), file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if closed:
         raise closed[0]
@@ -165,7 +165,7 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
         )
     except OSError as exc:
-        print(shown(f"error: cannot write results to {out_dir}: {exc.strerror or exc}"), file=sys.stderr)
+        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}"), file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         from .jsonout import emit

@@ -160,7 +160,7 @@ def _child() -> int:
         log.error("the run was stopped (SIGTERM) before it could write its results", ExitCode.TERMINATED)
         return ExitCode.TERMINATED
     except OSError as exc:
-        log.error(f"cannot write results to {out}: {exc.strerror or exc}", ExitCode.RUNTIME_FAILURE)
+        log.error(f"cannot write results to {exc.filename or out}: {exc.strerror or exc}", ExitCode.RUNTIME_FAILURE)
         return ExitCode.RUNTIME_FAILURE
     except Exception as exc:  # a bug: said where a follower looks, since stderr is nobody's
         log.error(f"internal error ({type(exc).__name__}: {exc}); please report it", ExitCode.INTERNAL)

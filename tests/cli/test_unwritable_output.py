@@ -47,3 +47,30 @@ def test_output_path_problem_tries_a_file_and_leaves_nothing(tmp_path):
         locked = tmp_path / "locked"
         locked.mkdir(mode=0o555)
         assert "Permission denied" in output_path_problem(locked / "out")
+
+
+@pytest.mark.parametrize("sweep", [False, True])
+def test_a_result_file_that_is_a_folder_is_named_in_the_refusal(tmp_path, capsys, sweep):
+    """A run folder whose summary.json is a folder (in a sweep, a point's): the resume stops
+    with exit 1 naming that file, not its run or sweep folder, and the folder and what it holds
+    are left as they were."""
+    import yaml
+
+    from ..conftest import SMALL_PRESET, merge
+
+    preset = merge(SMALL_PRESET, {"realizations": 2, "spectrum": {"params": {"points": 256}}, "fit": {"bootstrap": 20}})
+    if sweep:
+        preset["sweep"] = {"mode": "grid", "parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset, sort_keys=False))
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(out), "--quiet", "--no-plot", "--workers", "1"]) == 0
+    folder = out / "points" / "01-hurst-0.5" if sweep else out
+    (folder / "summary.json").unlink()
+    (folder / "summary.json").mkdir()
+    (folder / "summary.json" / "mine.txt").write_text("keep me")
+    capsys.readouterr()
+    code = main(["resume", str(out), "--quiet", "--no-plot"])
+    err = capsys.readouterr().err
+    assert code == ExitCode.RUNTIME_FAILURE, err
+    assert f"cannot write results to {folder / 'summary.json'}: is a folder, not a file" in err
+    assert (folder / "summary.json" / "mine.txt").read_text() == "keep me"
