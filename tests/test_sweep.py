@@ -268,6 +268,29 @@ def test_a_resumed_sweep_reads_its_completed_points_back_without_rewriting_them(
     assert (drawn / "plot.png").is_file()  # the figure its first run did not draw
 
 
+@pytest.mark.parametrize("damage", ["summary", "curve", "realizations"])
+def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path, registry, damage):
+    """A completed point whose summary.json is not JSON, whose curve.csv was cut short, or
+    whose realizations.npz was removed is run again (restored from its chunks) by the resume,
+    which writes its files again as a resume of a run does: never read back as it is."""
+    data = sweep_preset({"seed": {"values": [1]}}, output={"realizations": True})
+    sweep = plan_sweep(data, registry=registry, source=str(write(tmp_path, data)))
+    run_sweep(sweep, tmp_path / "out", RunOptions(workers=1), plot=False)
+    folder = next((tmp_path / "out" / "points").iterdir())
+    sound = {name: (folder / name).read_bytes() for name in ("curve.csv", "realizations.npz")}
+    if damage == "summary":
+        (folder / "summary.json").write_text("garbage")
+    elif damage == "curve":
+        (folder / "curve.csv").write_bytes(sound["curve.csv"][:100])
+    else:
+        (folder / "realizations.npz").unlink()
+    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1, resume=True), plot=False)
+    assert [r.status for r in outcome.results] == ["completed"]
+    assert json.loads((folder / "summary.json").read_text())["status"] == "completed"
+    assert (folder / "curve.csv").read_bytes() == sound["curve.csv"]
+    assert (folder / "realizations.npz").is_file()
+
+
 @pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),
                                         ('{"sweep": {}}', "is damaged: field 'sweep.parameters': field required; field 'base_preset': field required")])  # fmt: skip
 def test_resume_of_a_sweep_folder_whose_record_is_damaged_names_it(tmp_path, capsys, text, said):

@@ -17,6 +17,7 @@ The run directory's own files (run.lock, run.json, chunks/) are ``rundir``'s.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import platform
@@ -31,7 +32,7 @@ from .. import __version__
 from ..compute.ensemble import RunOutcome
 from ..errors import MissingDependency, RunError, RunFolderError, shown
 from ..io.files import atomic_write, write_npz
-from ..io.inputs import holds_exactly
+from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
 from ..preset import Scene
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
@@ -310,6 +311,26 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     plain = [np.asarray(column, dtype=float).tolist() for column in columns]  # Python floats: no numpy scalar per cell
     for row in zip(*plain, strict=True):
         writer.writerow([repr(v) if math.isfinite(v) else "" for v in row])
+
+
+def results_on_disk(folder: Path, scene: Scene, plot: bool) -> bool:
+    """Whether ``folder`` holds what ``write_results`` (and ``add_plot`` with ``plot``) wrote for
+    a completed run of ``scene``: each file regular (no link), summary.json an object saying so."""
+    out = scene.preset.output
+    wanted = ["curve.csv"] + (["realizations.npz"] if out.realizations else []) + (["plot.png"] if plot and out.plot else [])
+    try:
+        for name in wanted:
+            open_regular_file(folder / name, follow_links=False).close()
+        return read_json(folder, "summary.json").get("status") == "completed"
+    except (InputFileProblem, RunFolderError):
+        return False
+
+
+def holds_curve(folder: Path, scene: Scene, outcome: RunOutcome) -> bool:
+    """Whether curve.csv in ``folder`` is exactly what ``write_results`` writes for ``outcome``."""
+    buffer = io.StringIO(newline="")
+    _write_curve(scene, outcome, buffer)
+    return holds_exactly(folder / "curve.csv", buffer.getvalue().encode())
 
 
 def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dict[str, Path]:

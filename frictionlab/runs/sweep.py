@@ -39,7 +39,7 @@ from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from ..plugin.registry import Registry, default_registry
-from .results import write_figure
+from .results import holds_curve, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
 from .runner import run_to_folder
@@ -315,18 +315,15 @@ def _run_points(
 
 def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
     """The outcome of a point a resumed sweep finds completed with its files, read back (its
-    listeners hear it restored) without writing anything: None where it must run again."""
+    listeners hear it restored) without writing anything: None where it must run again, which
+    writes them again (``results_on_disk``; a curve.csv not of its results)."""
     from ..compute import engine
-    from ..io.inputs import InputFileProblem, open_regular_file
 
-    wanted = ["summary.json", "curve.csv"] + (["plot.png"] if plot and scene.preset.output.plot else [])
-    for name in wanted:  # a file the user removed, or a figure that failed: the point's run writes it again
-        try:
-            open_regular_file(folder / name, follow_links=False).close()
-        except InputFileProblem:
-            return None
+    if not results_on_disk(folder, scene, plot):
+        return None
     done = RunDirectory(folder).completed_results(scene)
-    return None if done is None else engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
+    outcome = None if done is None else engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
+    return outcome if outcome is not None and holds_curve(folder, scene, outcome) else None
 
 
 def run_sweep(
