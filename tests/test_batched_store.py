@@ -109,3 +109,35 @@ def test_a_run_killed_after_its_merge_resumes_from_the_merged_chunk_alone(make_s
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     assert list(manifest["chunks"]) == ["00000000-00000003.npz"] and "retired" not in manifest
     assert [p.name for p in (tmp_path / "run" / "chunks").iterdir()] == ["00000000-00000003.npz"]
+
+
+def test_a_merge_that_does_not_fit_on_the_disk_loses_no_result(make_scene, tmp_path, monkeypatch):
+    """The merged chunk of a completed run is larger than its last batch: where the disk has no
+    room for it (ENOSPC), the last batch is written apart and the old chunks stay listed, none
+    retired, so the error is raised with every result on disk and a resume restores them all."""
+    import errno
+
+    from frictionlab.io import files
+
+    scene = make_scene({"realizations": 6, **NO_PLOT})
+    results = results_of(scene)
+
+    def full_for_the_merge(path, *args, **kwargs):
+        if path.name == "00000000-00000005.npz":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return files.atomic_write(path, *args, **kwargs)
+
+    with RunDirectory(tmp_path / "run") as run_dir:
+        store = two_batches(run_dir, scene, results[0:4], results[4:6])
+        monkeypatch.setattr("frictionlab.runs.rundir.atomic_write", full_for_the_merge)
+        try:
+            store.flush(merge=True)
+        except OSError as exc:
+            assert exc.errno == errno.ENOSPC
+        else:
+            raise AssertionError("the merge's ENOSPC was not raised")
+    monkeypatch.undo()
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert list(manifest["chunks"]) == ["00000000-00000003.npz", "00000004-00000005.npz"] and "retired" not in manifest
+    with RunDirectory(tmp_path / "run") as run_dir:
+        assert [r.index for r in run_dir.start(scene, resume=True)] == list(range(6))

@@ -447,10 +447,15 @@ class RunDirectory:
         old = list(self._manifest["chunks"])
         if len(old) + bool(pending) <= 1 or not self._kept:
             return False
-        merged = {**self._kept, **{r.index: r for r in pending}}
+        merged, listed = {**self._kept, **{r.index: r for r in pending}}, self._manifest["chunks"]
         self._manifest["chunks"] = {}
         self._manifest["retired"] = old
-        self.save_chunk([merged[i] for i in sorted(merged)])
+        try:
+            self.save_chunk([merged[i] for i in sorted(merged)])
+        except BaseException:  # not written (a full disk): the old chunks stay listed, never retired
+            self._manifest["chunks"] = listed
+            self._manifest.pop("retired")
+            raise
         kept = set(self._manifest["chunks"])
         for name in old:
             if name not in kept:

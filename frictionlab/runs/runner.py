@@ -45,7 +45,13 @@ class BatchedStore:
         """Write what is pending as one chunk (its name: the range of its indices); with
         ``merge`` (a completed run), as one chunk with those already written (its compaction)."""
         batch, self.pending, self.work = sorted(self.pending, key=lambda r: r.index), [], 0.0
-        if not (merge and self.run_dir.compact(batch)) and batch:
+        try:
+            merged = merge and self.run_dir.compact(batch)
+        except (OSError, MemoryError):  # the merged chunk did not fit: the last batch apart, as a run not completed
+            if batch:
+                self.run_dir.save_chunk(batch)
+            raise
+        if not merged and batch:
             self.run_dir.save_chunk(batch)
 
 
