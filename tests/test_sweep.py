@@ -284,8 +284,20 @@ def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path,
         (folder / "curve.csv").write_bytes(sound["curve.csv"][:100])
     else:
         (folder / "realizations.npz").unlink()
-    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1, resume=True), plot=False)
+    heard = []
+
+    class Started(SweepListener):
+        def run_listeners(self, point):
+            class Told:
+                @hookimpl
+                def run_started(self, run):
+                    heard.append(run.resumed)
+
+            return [Told()]
+
+    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1, resume=True), listeners=[Started()], plot=False)
     assert [r.status for r in outcome.results] == ["completed"]
+    assert len(heard) == 1  # told once, as the run that writes its files again: never "restored" first
     assert json.loads((folder / "summary.json").read_text())["status"] == "completed"
     assert (folder / "curve.csv").read_bytes() == sound["curve.csv"]
     assert (folder / "realizations.npz").is_file()

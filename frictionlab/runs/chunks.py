@@ -129,7 +129,7 @@ def chunk_indices(folder: Path, name: str) -> set[int]:
             for array in ("index", "failed_index"):
                 with archive.open(f"{array}.npy") as member:
                     held.append(_index_array(member, last - first + 1, size))
-    except (InputFileProblem, KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile):
+    except (InputFileProblem, KeyError, ValueError, OSError, EOFError, MemoryError, zipfile.BadZipFile):
         return set()
     indices = np.concatenate(held)
     if indices.size and (indices.min() < first or indices.max() > last):

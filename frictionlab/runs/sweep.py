@@ -322,8 +322,9 @@ def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
     if not results_on_disk(folder, scene, plot):
         return None
     done = RunDirectory(folder).completed_results(scene)
-    outcome = None if done is None else engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
-    return outcome if outcome is not None and holds_curve(folder, scene, outcome) else None
+    if done is None or not holds_curve(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
+        return None  # its listeners hear it run again, not restored first
+    return engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
 
 
 def run_sweep(
