@@ -269,7 +269,11 @@ def run_state(folder: str | Path) -> RunState:
     name = str(preset.get("name") or folder.name)
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
-    stored, pid = _chunk_count(folder, manifest.get("chunks"), total), None  # what a resume restores
+    pid = None
+
+    def stored() -> int | None:  # what a resume restores; it opens every chunk, so only where asked
+        return _chunk_count(folder, manifest.get("chunks"), total)
+
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
@@ -277,16 +281,20 @@ def run_state(folder: str | Path) -> RunState:
             status = "interrupted"  # the process that wrote "running" is gone
     if status == "running":  # its log's last count (none to read, a link never followed: what it stored)
         done = _last_count(folder)
-        return RunState(folder, name, status, stored if done is None else done, total, pid)
-    # a run that ended: what its chunks hold (its log also counted what was never stored)
-    done = stored if stored is not None else _last_count(folder)
+        return RunState(folder, name, status, stored() if done is None else done, total, pid)
+
+    def ended_count() -> int | None:  # what its chunks hold (its log also counted what was never stored)
+        count = stored()
+        return count if count is not None else _last_count(folder)
+
     try:
         summary = _summary(folder)
     except RunFolderError as exc:  # never listed as what run.json says: its results cannot be read
-        return RunState(folder, name, "damaged", done, total, reason=damage_reason(folder, exc))
-    if summary is not None:
-        counts = summary.get("realizations") if isinstance(summary.get("realizations"), dict) else {}
-        done = _count(counts.get("done")) if _count(counts.get("done")) is not None else done
+        return RunState(folder, name, "damaged", ended_count(), total, reason=damage_reason(folder, exc))
+    counts = summary.get("realizations") if summary is not None and isinstance(summary.get("realizations"), dict) else {}
+    done = _count(counts.get("done"))
+    if done is None:  # no summary, or none that counts: the chunks say
+        done = ended_count()
     if done is not None and total is not None and done > total:  # not a count of this run
         done = None
     return RunState(folder, name, status, done, total, pid)
