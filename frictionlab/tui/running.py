@@ -186,8 +186,10 @@ class RunControl:
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
         self.query_one("RunPane").start(scene, sweep, out_dir)
-        if options.resume:  # what it restores, at once: not 0 % until its process has begun
-            self._show_stored(out_dir) if sweep is None else self._show_stored_sweep(out_dir, sweep)
+        if options.resume and sweep is None:  # what it restores, at once: not 0 % until its process has begun
+            self._show_stored(out_dir)
+        elif options.resume:
+            self._show_stored_sweep(out_dir, sweep)
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
