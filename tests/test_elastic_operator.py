@@ -50,3 +50,52 @@ def test_effective_modulus():
     assert effective_modulus(2.0, 0.5) == pytest.approx(2.0 / 0.75)
     with pytest.raises(ValueError, match="poisson_ratio"):
         effective_modulus(1.0, 1.0)
+
+
+def test_displacement_single_of_a_float32_grid_is_the_displacement_in_single_precision():
+    shape = (24, 40)
+    grids = np.meshgrid(*[np.arange(n) for n in shape], indexing="ij")
+    pressure = np.cos(2 * np.pi * (3 * grids[0] / 24 + 5 * grids[1] / 40))
+    q = np.hypot(2 * np.pi * 3 / 24, 2 * np.pi * 5 / 40)
+    u = PeriodicHalfSpace(shape).displacement_single(pressure.astype(np.float32))
+    assert u.dtype == np.float32
+    np.testing.assert_allclose(u, 2 / q * pressure, atol=2e-6 * 2 / q)
+
+
+@pytest.mark.parametrize("stop", ["certified", "tolerance"])
+def test_the_cg_on_float32_grids_of_its_sets_solves_as_on_float64_grids_converted_whole(monkeypatch, stop):
+    """The CG spreads its direction and its lift on float32 grids over their sets alone
+    (``displacement_single``); an operator without it has the CG convert float64 grids
+    whole. The arithmetic is the same, so the sweeps agree: contact sets, iterations,
+    pressures."""
+    from frictionlab.preset.seeds import realization_rng
+    from frictionlab_solvers import bem
+    from frictionlab_spectra.surface import PowerLawSurface
+
+    calls = {"single": 0, "whole": 0}
+
+    class Counting(PeriodicHalfSpace):
+        def displacement_single(self, pressure32):
+            calls["single"] += 1
+            return super().displacement_single(pressure32)
+
+    class WholeGrids(PeriodicHalfSpace):
+        displacement_single = None
+
+        def displacement_estimate(self, pressure, out):
+            calls["whole"] += 1
+            return super().displacement_estimate(pressure, out)
+
+    profile = PowerLawSurface(hurst=0.8, points=96, spacing=1.0, short_cutoff=6.0, rms_height=1.0).generate(
+        realization_rng(11, 0)
+    )
+    forces = np.geomspace(1.0, 60.0, 6)
+    curves = {}
+    for name, operator in (("single", Counting), ("whole", WholeGrids)):
+        monkeypatch.setattr(bem, "PeriodicHalfSpace", operator)
+        curves[name] = bem.BEMHalfSpace(stop=stop).solve(profile, forces, "force", np.ones_like(profile.heights))
+    assert calls["single"] > 0 and calls["whole"] > 0  # each path ran
+    single, whole = curves["single"], curves["whole"]
+    np.testing.assert_array_equal(single.contact_count, whole.contact_count)
+    np.testing.assert_array_equal(single.extras["iterations"], whole.extras["iterations"])
+    np.testing.assert_allclose(single.indentation, whole.indentation, rtol=1e-12, atol=0)

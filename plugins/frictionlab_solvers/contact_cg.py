@@ -79,6 +79,11 @@ class ProjectedCG:
         # cleared, converted and written back whole at every step
         self.precondition_single = getattr(operator, "precondition_single", None)
         self.spread32 = grid(xp.float32) if self.precondition_single is not None else None
+        # likewise the rough responses and the lift's correction: the direction and the lift
+        # spread on float32 grids over their sets alone, the float32 answer used as it is
+        self.displacement_single = getattr(operator, "displacement_single", None) if self.spread32 is not None else None
+        self.direction32 = grid(xp.float32) if self.displacement_single is not None else None
+        self.last_response = self.response  # the response of the last step (float32 while rough)
 
     def solve(
         self,
@@ -145,7 +150,7 @@ class ProjectedCG:
         flat = (-1,)
         p, g, depth = xp.reshape(pressure, flat), xp.reshape(self.gap, flat), xp.reshape(self.depth, flat)
         d_grid, r_grid = xp.reshape(self.direction, flat), xp.reshape(self.last_residual, flat)
-        w_grid, z_grid = xp.reshape(self.response, flat), xp.reshape(self.preconditioned, flat)
+        z_grid = xp.reshape(self.preconditioned, flat)
         size = p.shape[0]
         level = approach
         if force_control:  # the load is part of the answer: start from a pressure that carries it
@@ -159,6 +164,8 @@ class ProjectedCG:
         spread = None  # the last working set, off which the direction and the residual grids are zero
         spread32 = None  # the same for the float32 grid of the preconditioner (None: anywhere)
         s_grid = None if self.spread32 is None else xp.reshape(self.spread32, flat)
+        spread_d32 = None  # the same for the float32 direction grid
+        d32_grid = None if self.direction32 is None else xp.reshape(self.direction32, flat)
         contact = xp.nonzero(p)[0]
         self._exact_gap(pressure)
         exact, since_exact = True, 0
@@ -247,11 +254,17 @@ class ProjectedCG:
             if rough and residual <= SINGLE_ABOVE:  # from here on every response is exact
                 rough = False
                 since_exact = REFRESH  # and the gap is recomputed exactly after this step
-            if rough:
-                operator.displacement_estimate(self.direction, self.response)
+            if not rough:
+                response = operator.displacement(self.direction, self.response)
+            elif self.displacement_single is not None:
+                self._clear(d32_grid, spread_d32)
+                self._scatter(d32_grid, working, in_working, xp.astype(d, xp.float32))
+                spread_d32 = working
+                response = self.displacement_single(self.direction32)
             else:
-                operator.displacement(self.direction, self.response)
-            curvature = _dot(d, xp.take(w_grid, working), xp)
+                response = operator.displacement_estimate(self.direction, self.response)
+            self.last_response = response
+            curvature = _dot(d, xp.astype(xp.take(xp.reshape(response, flat), working), xp.float64, copy=False), xp)
             if not curvature > 0.0:  # no descent left along d: stuck
                 raise NotConverged(iteration, residual)
             step = _dot(r, d, xp) / curvature
@@ -265,12 +278,18 @@ class ProjectedCG:
                 p_w += lift
                 self._scatter(p, working, in_working, p_w)
                 contact = working[p_w > 0.0]
-                z_grid[...] = 0.0
-                self._scatter(z_grid, working, in_working, lift)
-                operator.displacement_estimate(self.preconditioned, self.scratch)
+                if self.displacement_single is not None:
+                    self._clear(s_grid, spread32)
+                    self._scatter(s_grid, working, in_working, xp.astype(lift, xp.float32))
+                    spread32 = working
+                    correction = self.displacement_single(self.spread32)
+                else:
+                    z_grid[...] = 0.0
+                    self._scatter(z_grid, working, in_working, lift)
+                    correction = operator.displacement_estimate(self.preconditioned, self.scratch)
                 self.gap -= self.depth  # the displacement, to be scaled with the pressure
-                self.gap += self.scratch
-                self.gap -= self._times(self.response, step)
+                self.gap += correction  # float32 or float64: added in float64
+                self.gap -= self._times(response, step)
                 if force_control:  # restore the load exactly
                     total = float(xp.sum(xp.take(p, contact))) / size
                     if not total > 0.0:  # cannot happen in exact arithmetic; start over
@@ -307,7 +326,7 @@ class ProjectedCG:
                     self._exact_gap(pressure)
                     exact, since_exact = True, 0
                 else:  # linear in p: g(p - step d) = g - step w
-                    self.gap -= self._times(self.response, step)
+                    self.gap -= self._times(response, step)
                     exact, since_exact = False, since_exact + 1
             last_step, last_level = step, level
 
@@ -327,10 +346,11 @@ class ProjectedCG:
             grid[...] = 0.0
 
     def _times(self, field, factor: float):
-        """``field * factor``, on numpy into the scratch grid (no allocation)."""
+        """``field * factor`` in float64 (``field`` float32 or float64), on numpy into the
+        scratch grid (no allocation)."""
         if is_numpy(self.xp):
-            return np.multiply(field, factor, out=self.scratch)
-        return field * factor
+            return np.multiply(field, factor, out=self.scratch, dtype=np.float64)
+        return self.xp.astype(field, self.xp.float64, copy=False) * factor
 
     def _certain(self, p, g, contact, level: float, last_level: float, last_step: float) -> bool:
         """Every point's margin exceeds MARGIN_FACTOR times its change in the last
@@ -341,7 +361,7 @@ class ProjectedCG:
         if not bool(xp.all(xp.take(p, contact) > MARGIN_FACTOR * last_step * xp.abs(d_c))):
             return False
         # free points: gap - level against its change, -step w - (level - last_level)
-        change = self._times(self.response, -last_step)
+        change = self._times(self.last_response, -last_step)
         change -= level - last_level
         change = xp.abs(change)
         change *= MARGIN_FACTOR

@@ -137,6 +137,10 @@ class PeriodicHalfSpace:
         it on its working set only)."""
         return self._apply_single(self.stiffness32, residual32, None)
 
+    def displacement_single(self, pressure32):
+        """``displacement_estimate`` of a float32 grid, returned as a new float32 grid."""
+        return self._apply_single(self.compliance32, pressure32, None)
+
     def pressure_of(self, displacement: np.ndarray) -> np.ndarray:
         """The zero-mean pressure (numpy) that makes ``displacement`` (numpy; exact inverse, zero mean)."""
         out = self.xp.empty(self.shape, dtype=self.xp.float64)
