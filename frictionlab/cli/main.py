@@ -71,6 +71,7 @@ class _Parser(argparse.ArgumentParser):
     closed pipe ends as any other output does."""
 
     refusal: tuple[str, str] | None = None  # (prog, message) of the last usage error
+    words: list[str] = []  # what this parser was last given to parse
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
@@ -91,12 +92,20 @@ class _Parser(argparse.ArgumentParser):
 
             choices = [c.strip("'") for c in choice.group(2).split(", ")]  # quoted before Python 3.12.8, bare after
             message += did_you_mean(choice.group(1), choices, 0.7)
+        if message.startswith("the following arguments are required"):
+            # argparse says so before it looks at words it does not know: `run --hlep` is a
+            # misspelt option more often than a forgotten preset
+            options = [o for a in self._actions for o in a.option_strings]
+            strays = [w for w in self.words if _stray_option(w, options)]
+            if strays:
+                message = f"{unrecognized(strays, options)} ({message})"
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
         super().error(message)
 
     def parse_known_args(self, args=None, namespace=None):
         """Words no option takes are refused by the parser that met them, with its own
         usage (``usage: frictionlab run ...``, not the top level's) and the closest options."""
+        self.words = list(sys.argv[1:] if args is None else args)
         namespace, extras = super().parse_known_args(args, namespace)
         if extras:
             self.error(unrecognized(extras, [o for a in self._actions for o in a.option_strings]))
@@ -110,6 +119,14 @@ def unrecognized(words: list[str], options: list[str]) -> str:
     close = [name for word in words if word.startswith("-") for name in close_names(word.partition("=")[0], options, 0.7)]
     hint = f"; did you mean {' or '.join(repr(name) for name in dict.fromkeys(close))}?" if close else ""
     return f"unrecognized arguments: {' '.join(words)}{hint}"
+
+
+def _stray_option(word: str, options: list[str]) -> bool:
+    """Whether ``word`` looks like an option that none of ``options`` (nor a prefix of one) is."""
+    name = word.partition("=")[0]
+    return name.startswith("-") and name != "-" and name != "--" and not NEGATIVE_NUMBER.match(word) and not any(
+        option.startswith(name) for option in options
+    )
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:

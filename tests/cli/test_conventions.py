@@ -88,6 +88,19 @@ def test_did_you_mean_for_commands_and_plugins(cli):
     assert done.returncode == ExitCode.USAGE and "did you mean 'power-law'" in done.stderr
 
 
+def test_a_misspelt_option_is_named_before_a_missing_argument(cli):
+    """argparse reports a missing positional before it looks at unknown words: a misspelt
+    --help left the user told only that the preset is required."""
+    done = cli("run", "--hlep")
+    assert done.returncode == ExitCode.USAGE and "Traceback" not in done.stderr
+    assert "unrecognized arguments: --hlep; did you mean '--help'?" in done.stderr
+    assert "required: preset" in done.stderr
+    done = cli("run", "--wor", "2")  # a prefix of --workers is an option, not a stray word
+    assert "unrecognized" not in done.stderr and "required: preset" in done.stderr
+    done = cli("predict", "--a", "-1.5")  # a negative number is a value
+    assert "unrecognized" not in done.stderr
+
+
 @pytest.mark.parametrize("argv", [[], ["presets"], ["completion", "bash"], ["--help"], ["run", "--help"], ["-V"]])
 def test_a_closed_pipe_ends_quietly(argv, tmp_path):
     read_end, write_end = os.pipe()
