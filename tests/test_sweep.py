@@ -268,11 +268,12 @@ def test_a_resumed_sweep_reads_its_completed_points_back_without_rewriting_them(
     assert (drawn / "plot.png").is_file()  # the figure its first run did not draw
 
 
-@pytest.mark.parametrize("damage", ["summary", "curve", "realizations"])
+@pytest.mark.parametrize("damage", ["summary", "curve", "realizations", "realizations altered"])
 def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path, registry, damage):
     """A completed point whose summary.json is not JSON, whose curve.csv was cut short, or
-    whose realizations.npz was removed is run again (restored from its chunks) by the resume,
-    which writes its files again as a resume of a run does: never read back as it is."""
+    whose realizations.npz was removed or altered (a value changed, a well-formed archive
+    still) is run again (restored from its chunks) by the resume, which writes its files
+    again as a resume of a run does: never read back as it is."""
     data = sweep_preset({"seed": {"values": [1]}}, output={"realizations": True})
     sweep = plan_sweep(data, registry=registry, source=str(write(tmp_path, data)))
     run_sweep(sweep, tmp_path / "out", RunOptions(workers=1), plot=False)
@@ -282,8 +283,13 @@ def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path,
         (folder / "summary.json").write_text("garbage")
     elif damage == "curve":
         (folder / "curve.csv").write_bytes(sound["curve.csv"][:100])
-    else:
+    elif damage == "realizations":
         (folder / "realizations.npz").unlink()
+    else:
+        with np.load(folder / "realizations.npz") as stored:
+            arrays = {name: stored[name] for name in stored.files}
+        arrays["xi"] = arrays["xi"] * 1.01
+        np.savez(folder / "realizations.npz", **arrays)
     heard = []
 
     class Started(SweepListener):
@@ -300,7 +306,7 @@ def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path,
     assert len(heard) == 1  # told once, as the run that writes its files again: never "restored" first
     assert json.loads((folder / "summary.json").read_text())["status"] == "completed"
     assert (folder / "curve.csv").read_bytes() == sound["curve.csv"]
-    assert (folder / "realizations.npz").is_file()
+    assert (folder / "realizations.npz").read_bytes() == sound["realizations.npz"]
 
 
 @pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),

@@ -326,11 +326,23 @@ def results_on_disk(folder: Path, scene: Scene, plot: bool) -> bool:
         return False
 
 
-def holds_curve(folder: Path, scene: Scene, outcome: RunOutcome) -> bool:
-    """Whether curve.csv in ``folder`` is exactly what ``write_results`` writes for ``outcome``."""
+def holds_results(folder: Path, scene: Scene, outcome: RunOutcome) -> bool:
+    """Whether curve.csv in ``folder`` (and realizations.npz where the preset asks for it) is
+    exactly what ``write_results`` writes for ``outcome``: both are the same bytes for the
+    same numbers (the archive's members carry no time stamp)."""
     buffer = io.StringIO(newline="")
     _write_curve(scene, outcome, buffer)
-    return holds_exactly(folder / "curve.csv", buffer.getvalue().encode())
+    if not holds_exactly(folder / "curve.csv", buffer.getvalue().encode()):
+        return False
+    if not scene.preset.output.realizations:
+        return True
+    archive = io.BytesIO()
+    write_npz(archive, _realization_arrays(outcome))
+    return holds_exactly(folder / "realizations.npz", archive.getvalue())
+
+
+def _realization_arrays(outcome: RunOutcome) -> dict:
+    return {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f, "lines_used": outcome.lines_used}
 
 
 def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dict[str, Path]:
@@ -349,7 +361,7 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
 
     if scene.preset.output.realizations:
         files["realizations"] = out / "realizations.npz"
-        arrays = {**outcome.per_realization, "loads": outcome.loads, "f": outcome.f, "lines_used": outcome.lines_used}
+        arrays = _realization_arrays(outcome)
         atomic_write(files["realizations"], lambda fh: write_npz(fh, arrays), binary=True)
 
     files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete

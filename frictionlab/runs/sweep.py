@@ -39,7 +39,7 @@ from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from ..plugin.registry import Registry, default_registry
-from .results import holds_curve, results_on_disk, write_figure
+from .results import holds_results, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
 from .runner import run_to_folder
@@ -316,13 +316,13 @@ def _run_points(
 def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
     """The outcome of a point a resumed sweep finds completed with its files, read back (its
     listeners hear it restored) without writing anything: None where it must run again, which
-    writes them again (``results_on_disk``; a curve.csv not of its results)."""
+    writes them again (``results_on_disk``; a curve.csv or realizations.npz not of its results)."""
     from ..compute import engine
 
     if not results_on_disk(folder, scene, plot):
         return None
     done = RunDirectory(folder).completed_results(scene)
-    if done is None or not holds_curve(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
+    if done is None or not holds_results(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
         return None  # its listeners hear it run again, not restored first
     return engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
 
