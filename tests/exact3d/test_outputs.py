@@ -125,3 +125,17 @@ def test_a_study_counts_its_time_after_every_ensemble(tmp_path, monkeypatch):
     with pytest.raises(SystemExit) as killed:
         study.run_plan(Path(PRESETS), runs, study.QUICK)
     assert killed.value.code >= seen_before[0] > 0
+
+
+@pytest.mark.parametrize(("recorded", "says"), [(5000.0, "**1:23:20** of wall time"), (600.0, "at least **50:00** of wall time")])
+def test_the_pages_wall_time_is_never_less_than_the_compute_its_cores_shared(recorded, says):
+    """The time file misses invocations stopped before they recorded theirs (a session's
+    SIGKILL): the page then gives the compute shared among the machine's cores as a bound."""
+    from types import SimpleNamespace
+
+    from frictionlab.exact3d.report import wall_time_text
+
+    ensembles = [SimpleNamespace(outcome=SimpleNamespace(compute_seconds=s)) for s in (3600.0, 2400.0)]
+    text = wall_time_text(SimpleNamespace(seconds=recorded, ensembles=ensembles), cores=2)
+    assert says in text
+    assert ("10:00" in text) == (recorded == 600.0)  # the record is named beside the bound
