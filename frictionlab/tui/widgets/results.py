@@ -240,7 +240,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         self.query_one("#results-info", Static).update(
             Content(
                 f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
-                "Enter on a point opens its run; Space adds it to the overlay; Tab goes back to the list."
+                "Enter on a point opens its run; Space adds it to the overlay; Esc goes back to the list."
             )
         )
         table.focus()
