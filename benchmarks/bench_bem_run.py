@@ -41,12 +41,13 @@ os.environ.update(ONE_CORE)  # before numpy and Tamaas load their threads
 
 from frictionlab.preset import load_scene  # noqa: E402
 from frictionlab.preset.seeds import realization_rng  # noqa: E402
+from machine_load import busy_beside, check_repeat_and_busy  # noqa: E402  (this folder's)
 
 SEED = 2024
 TARGET = 12.0  # Tamaas's sweep / the run's whole process, at least
 ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}  # as a user's shell has it
 PRESET = """\
-name: bench-bem-run
+name: {name}
 seed: {seed}
 realizations: 1
 spectrum:
@@ -96,10 +97,7 @@ def main() -> None:
     parser.add_argument("--busy", type=int, default=0, help="CPU-bound processes running beside the measurements")
     parser.add_argument("--side", type=int, default=512, help="surface side in pixels (forces scale with the area)")
     args = parser.parse_args()
-    if args.repeat < 1:
-        parser.error(f"--repeat must be >= 1. Got {args.repeat} instead.")
-    if args.busy < 0:
-        parser.error(f"--busy must be >= 0. Got {args.busy} instead.")
+    check_repeat_and_busy(parser, args)
     if args.side < 16:
         parser.error(f"--side must be at least 16. Got {args.side} instead.")
     try:
@@ -109,19 +107,13 @@ def main() -> None:
     tamaas.initialize(1)
     tamaas.set_log_level(tamaas.LogLevel.error)
     scale = (args.side / 512) ** 2  # the same contact fractions at any side
-    busy = [subprocess.Popen([sys.executable, "-c", "while 1: pass"]) for _ in range(args.busy)]
-    try:
-        with tempfile.TemporaryDirectory() as tmp:
-            measure(Path(tmp), tamaas, args, 20.0 * scale, 1000.0 * scale)
-    finally:
-        for process in busy:
-            process.kill()
-            process.wait()
+    with busy_beside(args.busy), tempfile.TemporaryDirectory() as tmp:
+        measure(Path(tmp), tamaas, args, 20.0 * scale, 1000.0 * scale)
 
 
 def measure(tmp: Path, tamaas, args, first: float, last: float) -> None:
     preset = tmp / "bench-bem-run.yaml"
-    preset.write_text(PRESET.format(seed=SEED, side=args.side, first=first, last=last))
+    preset.write_text(PRESET.format(name="bench-bem-run", seed=SEED, side=args.side, first=first, last=last))
     scene = load_scene(preset, [])
     heights = scene.spectrum.generate(realization_rng(SEED, 0)).heights  # the run's surface
     run_process(preset, tmp / "warm")  # fills the bytecode cache, untimed

@@ -21,22 +21,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_bem_run import PRESET, SEED  # this folder's: the same scene, larger
+
 TARGET = 1.0  # seconds from the signal to the exit
 EXPECTED = {"SIGTERM": 143, "SIGINT": 130}
-PRESET = """\
-name: bench-cancel
-seed: 2024
-realizations: 1
-spectrum:
-  name: power-law-2d
-  params: {{hurst: 0.8, points: {side}, spacing: 1.0, short_cutoff: 8.0, rms_height: 1.0}}
-solver:
-  name: bem-halfspace
-  params: {{youngs_modulus: 1.0, poisson_ratio: 0.0}}
-slope:
-  name: forward-difference
-loading: {{control: force, start: {first}, stop: {last}, steps: 20, spacing: log}}
-"""
 
 
 def signalled(preset: Path, out: Path, name: str, after: float) -> tuple[float, int]:
@@ -66,7 +54,7 @@ def main() -> None:
     scale = (args.side / 512) ** 2
     with tempfile.TemporaryDirectory() as tmp:
         preset = Path(tmp) / "bench-cancel.yaml"
-        preset.write_text(PRESET.format(side=args.side, first=20.0 * scale, last=1000.0 * scale))
+        preset.write_text(PRESET.format(name="bench-cancel", seed=SEED, side=args.side, first=20.0 * scale, last=1000.0 * scale))
         print(f"bem-halfspace, {args.side} x {args.side}, frictionlab run --workers 1, signal {args.after:g} s after its start")
         for name, expected in EXPECTED.items():
             seconds, code = signalled(preset, Path(tmp) / name, name, args.after)

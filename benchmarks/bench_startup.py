@@ -40,6 +40,7 @@ import numpy as np
 
 from frictionlab.preset import load_scene
 from frictionlab.preset.seeds import realization_rng
+from machine_load import busy_beside, check_repeat_and_busy  # this folder's
 
 CLI = [sys.executable, "-m", "frictionlab"]
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
@@ -118,18 +119,10 @@ def main() -> None:
     parser.add_argument("--busy", type=int, default=0, help="CPU-bound processes running beside the measurements")
     parser.add_argument("--workers", type=int, help="worker processes of the Fig. 2 run (default: every core)")
     args = parser.parse_args()
-    if args.repeat < 1:
-        parser.error(f"--repeat must be >= 1. Got {args.repeat} instead.")
-    if args.busy < 0:
-        parser.error(f"--busy must be >= 0. Got {args.busy} instead.")
+    check_repeat_and_busy(parser, args)
     extra = [] if args.workers is None else ["--workers", str(args.workers)]
-    busy = [subprocess.Popen([sys.executable, "-c", "while 1: pass"]) for _ in range(args.busy)]
-    try:
+    with busy_beside(args.busy):
         failed = measure(args.repeat, extra)
-    finally:
-        for process in busy:
-            process.kill()
-            process.wait()
     if failed:
         raise SystemExit(failed)
 

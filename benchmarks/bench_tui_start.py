@@ -25,6 +25,8 @@ from pathlib import Path
 
 import yaml
 
+from machine_load import busy_beside, check_repeat_and_busy  # this folder's
+
 TARGET = 1.0  # seconds from the process's start to the first screen
 PRESETS = Path(__file__).resolve().parents[1] / "presets"
 ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}  # as a user's shell has it
@@ -101,28 +103,19 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="best of this many processes")
     parser.add_argument("--busy", type=int, default=0, help="CPU-bound processes running beside the measurements")
     args = parser.parse_args()
-    if args.repeat < 1:
-        parser.error(f"--repeat must be >= 1. Got {args.repeat} instead.")
-    if args.busy < 0:
-        parser.error(f"--busy must be >= 0. Got {args.busy} instead.")
-    busy = [subprocess.Popen([sys.executable, "-c", "while 1: pass"]) for _ in range(args.busy)]
-    try:
-        with tempfile.TemporaryDirectory() as tmp:
-            runs = str(Path(tmp) / "runs")
-            ours_wanted = f"F2 Presets|F5 Results|{first_preset_name()}"
-            timed(FRICTIONLAB, ours_wanted, str(PRESETS), runs)  # fills the bytecode cache, untimed
-            ours, keys, bare = [], [], []
-            for _ in range(args.repeat):
-                frame, key, code = timed(FRICTIONLAB, ours_wanted, str(PRESETS), runs)
-                if code != 0:
-                    raise SystemExit(f"frictionlab tui exited {code:g}")
-                ours.append(frame)
-                keys.append(key)
-                bare.append(timed(BARE, "frictionlab")[0])
-    finally:
-        for process in busy:
-            process.kill()
-            process.wait()
+    check_repeat_and_busy(parser, args)
+    with busy_beside(args.busy), tempfile.TemporaryDirectory() as tmp:
+        runs = str(Path(tmp) / "runs")
+        ours_wanted = f"F2 Presets|F5 Results|{first_preset_name()}"
+        timed(FRICTIONLAB, ours_wanted, str(PRESETS), runs)  # fills the bytecode cache, untimed
+        ours, keys, bare = [], [], []
+        for _ in range(args.repeat):
+            frame, key, code = timed(FRICTIONLAB, ours_wanted, str(PRESETS), runs)
+            if code != 0:
+                raise SystemExit(f"frictionlab tui exited {code:g}")
+            ours.append(frame)
+            keys.append(key)
+            bare.append(timed(BARE, "frictionlab")[0])
     best, floor = min(ours), min(bare)
     print(f"frictionlab tui, first screen (80x24, {len(list(PRESETS.glob('*.yaml')))} presets): {best:6.3f} s "
           f"(target <= {TARGET:g} s: {'met' if best <= TARGET else 'NOT met'})")  # fmt: skip
