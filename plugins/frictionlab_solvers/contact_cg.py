@@ -220,9 +220,7 @@ class ProjectedCG:
                 working, r = contact, g_c
             # the preconditioned gradient, zero-sum under force control
             if self.precondition_single is not None:
-                self._clear(s_grid, spread32)
-                self._scatter(s_grid, working, in_working, xp.astype(r, xp.float32))
-                spread32 = working
+                spread32 = self._respread(s_grid, spread32, working, in_working, r)
                 z = xp.astype(xp.take(xp.reshape(self.precondition_single(self.spread32), flat), working), xp.float64)
             else:
                 z_grid[...] = 0.0
@@ -248,8 +246,7 @@ class ProjectedCG:
                 d = z
             previous_rz = rz
             for spread_on_grid, values in ((d_grid, d), (r_grid, r)):
-                self._clear(spread_on_grid, spread)
-                self._scatter(spread_on_grid, working, in_working, values)
+                self._respread(spread_on_grid, spread, working, in_working, values)
             spread = working
             if rough and residual <= SINGLE_ABOVE:  # from here on every response is exact
                 rough = False
@@ -257,9 +254,7 @@ class ProjectedCG:
             if not rough:
                 response = operator.displacement(self.direction, self.response)
             elif self.displacement_single is not None:
-                self._clear(d32_grid, spread_d32)
-                self._scatter(d32_grid, working, in_working, xp.astype(d, xp.float32))
-                spread_d32 = working
+                spread_d32 = self._respread(d32_grid, spread_d32, working, in_working, d)
                 response = self.displacement_single(self.direction32)
             else:
                 response = operator.displacement_estimate(self.direction, self.response)
@@ -279,9 +274,7 @@ class ProjectedCG:
                 self._scatter(p, working, in_working, p_w)
                 contact = working[p_w > 0.0]
                 if self.displacement_single is not None:
-                    self._clear(s_grid, spread32)
-                    self._scatter(s_grid, working, in_working, xp.astype(lift, xp.float32))
-                    spread32 = working
+                    spread32 = self._respread(s_grid, spread32, working, in_working, lift)
                     correction = self.displacement_single(self.spread32)
                 else:
                     z_grid[...] = 0.0
@@ -336,6 +329,14 @@ class ProjectedCG:
             grid[indices] = values
         else:  # the array API's boolean scatter, in the same (ascending) order
             grid[mask] = values
+
+    def _respread(self, grid, spread, working, mask, values):
+        """Zero ``grid`` (zero off ``spread``) and write ``values`` (cast to its dtype) at the
+        sorted indices ``working`` (``mask`` their positions); returns ``working``, the grid's
+        new spread."""
+        self._clear(grid, spread)
+        self._scatter(grid, working, mask, self.xp.astype(values, grid.dtype, copy=False))
+        return working
 
     def _clear(self, grid, spread) -> None:
         """Zero ``grid``, which is zero off the indices ``spread`` (None: anywhere): on
