@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import matplotlib
 
 matplotlib.use("Agg")  # headless servers: never ask for a display
@@ -30,7 +32,10 @@ def _shades(count: int) -> list:
 
 
 def _panels(count: int, width: float = 13, height: float = 7.5):
-    fig, axes = plt.subplots(2, 3, figsize=(width, height), layout="constrained")
+    """Up to three panels a row, as many rows as ``count`` needs (``width`` x ``height``: two full rows)."""
+    columns, rows = min(max(count, 1), 3), max(1, math.ceil(count / 3))
+    fig, axes = plt.subplots(rows, columns, figsize=(width * columns / 3, height * rows / 2), layout="constrained",
+                             squeeze=False)  # fmt: skip
     for extra in axes.flat[count:]:
         extra.set_visible(False)
     return fig, axes.flat
@@ -71,11 +76,12 @@ def plot_xi_against_f(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> N
     ax = axes[len(hursts)]
     for family, marker, color, shift in ((MAIN, "o", EXACT, -0.012), (SIDE, "^", SIDE_COLOR, 0.012)):
         label = {MAIN: "long cut-off = side / 4 (main)", SIDE: "long cut-off = side"}[family]
-        for i, hurst in enumerate(runs.plan.hursts):
+        for hurst in runs.plan.hursts:
             stats = numbers.stats.get((family, hurst))
-            if stats is not None:
+            if stats is not None:  # the family's first H that ran carries its label
                 ax.plot(np.full(stats.skewness.size, hurst + shift), stats.skewness, marker, ms=3, color=color,
-                        alpha=0.6, label=label if i == 0 else None)  # fmt: skip
+                        alpha=0.6, label=label)  # fmt: skip
+                label = None
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("H")
     ax.set_ylabel("height skewness of each surface")
