@@ -217,6 +217,8 @@ def plot_nayak(runs: StudyRuns, numbers: Numbers, fh, dpi: int = 90) -> None:
     ax.axhspan(*KAPPA_SIMULATIONS, color="C2", alpha=0.15, label="simulations of broad spectra, 0.5-5 %: 2 to 2.3")
     ax.axhline(KAPPA_BUSH, color="k", ls="--", lw=0.8, label="√(2π), vanishing load")
     ax.set_xscale("log")
+    for axis_formatter in (ax.xaxis.set_major_formatter, ax.xaxis.set_minor_formatter):
+        axis_formatter(ScalarFormatter())  # α spans a decade or so: 4, 6, 10, 20, not 4×10⁰
     ax.set_xlabel("Nayak parameter α (mean over the surfaces)")
     ax.set_ylabel("κ at 0.5-5 % contact")
     ax.set_title("o main (side / 4), ◇ broad band, △ long cut-off = side", fontsize=9)
