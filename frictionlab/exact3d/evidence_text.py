@@ -179,12 +179,16 @@ def model_verdict(runs: StudyRuns, numbers: Numbers) -> str:
     by_choice: dict[str | None, list[float]] = {}
     for hurst, test in choices.items():
         by_choice.setdefault(test.mean_choice, []).append(hurst)
-    parts = [f"{'undecided between the best two' if c is None else c} at H = {_hs(h)}" for c, h in by_choice.items()]
+    parts = [f"{c} at H = {_hs(h)}" for c, h in by_choice.items() if c is not None]
+    verdict = f"the mean curve's BIC prefers (by 2 or more) {'; '.join(parts)}" if parts else ""
+    if None in by_choice:  # the best two within 2 of each other
+        undecided = f"does not tell the best two models apart (within 2) at H = {_hs(by_choice[None])}"
+        verdict = f"{verdict}, and {undecided}" if verdict else f"the mean curve's BIC {undecided}"
     f_low, f_high = min(t.f_range[0] for t in choices.values()), max(t.f_range[1] for t in choices.values())
     log_only = set(by_choice) == {"log law"}
     return ((f"Yes, over f = {f_low:.3g} to {f_high:.3g}: " if log_only else
              f"Not as a rule, over f = {f_low:.3g} to {f_high:.3g}: ")
-            + "the mean curve prefers (BIC, by at least 2) " + "; ".join(parts) + ". A log law is said to hold only "
+            + verdict + ". A log law is said to hold only "
             "where it is preferred over a power law and over a log law with curvature; the runs test on the "
             "residuals' signs (z below -2: a curve left in them) is in the model table.")  # fmt: skip
 

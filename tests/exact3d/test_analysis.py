@@ -161,3 +161,25 @@ def test_kappa_is_placed_against_the_literature(value, interval, place):
     from frictionlab.exact3d.markdown import kappa_place
 
     assert place in kappa_place(Kappa(value, interval, 3, 0.04))
+
+
+def test_the_model_verdict_names_what_each_h_prefers_and_where_bic_cannot_tell():
+    from types import SimpleNamespace
+
+    from frictionlab.exact3d.evidence_text import model_verdict
+
+    choices = {0.3: None, 0.8: "log law + curvature", 1.0: "log law + curvature"}
+    runs = SimpleNamespace(
+        hursts=lambda: list(choices),
+        exact_grids=lambda hurst, family: [SimpleNamespace(folder=SimpleNamespace(name=f"h{hurst}"))],
+    )
+    full = {h: SimpleNamespace(mean_choice=c, f_range=(0.001, 20.0)) for h, c in choices.items()}
+    numbers = SimpleNamespace(models={f"h{h}": SimpleNamespace(full=test) for h, test in full.items()})
+    text = model_verdict(runs, numbers)
+    assert text.startswith("Not as a rule, over f = 0.001 to 20: ")
+    assert "prefers (by 2 or more) log law + curvature at H = 0.8, 1, and does not tell the best two models apart (within 2) at H = 0.3." in text
+    full[0.8].mean_choice = full[1.0].mean_choice = None
+    assert "the mean curve's BIC does not tell the best two models apart (within 2) at H = 0.3, 0.8, 1." in model_verdict(runs, numbers)
+    for test in full.values():
+        test.mean_choice = "log law"
+    assert model_verdict(runs, numbers).startswith("Yes, over f")
