@@ -206,7 +206,7 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         f"The {'ensembles that finished' if runs.missing else f'study ({plan.name} plan)'} took "
         f"{wall_time_text(runs, os.cpu_count() or 1)} on {machine_text}, a machine shared with other jobs, and "
         f"**{format_duration(sum(e.outcome.compute_seconds for e in runs.ensembles))}** of compute (the surfaces' "
-        "solve times summed; each ensemble's is in the ensembles' table). "
+        "solve times summed, so waiting for a busy CPU counts in it; each ensemble's is in the ensembles' table). "
         "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",
         "",
         *definitions(runs, numbers),
