@@ -83,7 +83,6 @@ class ProjectedCG:
         # spread on float32 grids over their sets alone, the float32 answer used as it is
         self.displacement_single = getattr(operator, "displacement_single", None) if self.spread32 is not None else None
         self.direction32 = grid(xp.float32) if self.displacement_single is not None else None
-        self.last_response = self.response  # the response of the last step (float32 while rough)
 
     def solve(
         self,
@@ -174,6 +173,7 @@ class ProjectedCG:
         last_step = 0.0  # the last step's length, for the margins of the certified stop
         last_level = level
         rough = True  # responses in single precision while the residual is above SINGLE_ABOVE
+        response = self.response  # the displacement under the last step's direction (float32 while rough)
         iteration = 0
         while True:
             if contact.shape[0] == 0:  # only possible under indentation control
@@ -194,7 +194,7 @@ class ProjectedCG:
             worst_free = level - float(xp.min(xp.take(g, penetrating))) if penetrating.shape[0] else 0.0
             residual = max(worst_contact, worst_free) / self.rms
             done = residual <= tolerance or (
-                certified and stable >= STABLE_STEPS and self._certain(p, g, contact, level, last_level, last_step)
+                certified and stable >= STABLE_STEPS and self._certain(p, g, contact, level, last_level, last_step, response)
             )
             if done:
                 if not exact:  # accept only what an exact gap confirms
@@ -258,7 +258,6 @@ class ProjectedCG:
                 response = self.displacement_single(self.direction32)
             else:
                 response = operator.displacement_estimate(self.direction, self.response)
-            self.last_response = response
             curvature = _dot(d, xp.astype(xp.take(xp.reshape(response, flat), working), xp.float64, copy=False), xp)
             if not curvature > 0.0:  # no descent left along d: stuck
                 raise NotConverged(iteration, residual)
@@ -353,7 +352,7 @@ class ProjectedCG:
             return np.multiply(field, factor, out=self.scratch, dtype=np.float64)
         return self.xp.astype(field, self.xp.float64, copy=False) * factor
 
-    def _certain(self, p, g, contact, level: float, last_level: float, last_step: float) -> bool:
+    def _certain(self, p, g, contact, level: float, last_level: float, last_step: float, response) -> bool:
         """Every point's margin exceeds MARGIN_FACTOR times its change in the last
         step (which moved p by ``-last_step * direction`` and the gap by
         ``-last_step * response``, on an unchanged contact set)."""
@@ -362,7 +361,7 @@ class ProjectedCG:
         if not bool(xp.all(xp.take(p, contact) > MARGIN_FACTOR * last_step * xp.abs(d_c))):
             return False
         # free points: gap - level against its change, -step w - (level - last_level)
-        change = self._times(self.last_response, -last_step)
+        change = self._times(response, -last_step)
         change -= level - last_level
         change = xp.abs(change)
         change *= MARGIN_FACTOR
