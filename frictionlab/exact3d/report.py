@@ -160,23 +160,23 @@ def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | Non
             + " --force")  # fmt: skip
 
 
-def wall_time_text(runs: StudyRuns, cores: int) -> str:
-    """The study's wall time as its time file records it, or, where that is less than its
-    compute shared among the machine's ``cores`` (invocations stopped before they recorded
-    theirs), that bound."""
-    recorded = f"**{format_duration(runs.seconds)}** of wall time (summed over the invocations that computed it, each up to its last finished ensemble)"
-    bound = sum(e.outcome.compute_seconds for e in runs.ensembles) / max(cores, 1)
-    if runs.seconds >= bound:
-        return recorded
+def wall_time_text(recorded: float, compute: float, cores: int) -> str:
+    """The study's wall time as its time file records it (``recorded`` seconds), or, where
+    that is less than its ``compute`` seconds shared among the machine's ``cores``
+    (invocations stopped before they recorded theirs), that bound."""
+    bound = compute / max(cores, 1)
+    if recorded >= bound:
+        return f"**{format_duration(recorded)}** of wall time (summed over the invocations that computed it, each up to its last finished ensemble)"
     return (
         f"at least **{format_duration(bound)}** of wall time (its compute shared among {cores} cores; the "
-        f"invocations' own record, {format_duration(runs.seconds)}, misses those that were stopped before they "
+        f"invocations' own record, {format_duration(recorded)}, misses those that were stopped before they "
         "recorded theirs)"
     )
 
 
 def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str, finish_command: str) -> str:
     plan = runs.plan
+    compute = sum(e.outcome.compute_seconds for e in runs.ensembles)  # seconds: the surfaces' solve times summed
     first = runs.find(runs.hursts()[0])
     o = first.outcome
     figures = FIGURES_DIR
@@ -204,8 +204,8 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "",
         *finish,
         f"The {'ensembles that finished' if runs.missing else f'study ({plan.name} plan)'} took "
-        f"{wall_time_text(runs, os.cpu_count() or 1)} on {machine_text}, a machine shared with other jobs, and "
-        f"**{format_duration(sum(e.outcome.compute_seconds for e in runs.ensembles))}** of compute (the surfaces' "
+        f"{wall_time_text(runs.seconds, compute, os.cpu_count() or 1)} on {machine_text}, a machine shared with "
+        f"other jobs, and **{format_duration(compute)}** of compute (the surfaces' "
         "solve times summed, so waiting for a busy CPU counts in it; each ensemble's is in the ensembles' table). "
         "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",
         "",

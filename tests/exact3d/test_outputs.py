@@ -131,11 +131,8 @@ def test_a_study_counts_its_time_after_every_ensemble(tmp_path, monkeypatch):
 def test_the_pages_wall_time_is_never_less_than_the_compute_its_cores_shared(recorded, says):
     """The time file misses invocations stopped before they recorded theirs (a session's
     SIGKILL): the page then gives the compute shared among the machine's cores as a bound."""
-    from types import SimpleNamespace
-
     from frictionlab.exact3d.report import wall_time_text
 
-    ensembles = [SimpleNamespace(outcome=SimpleNamespace(compute_seconds=s)) for s in (3600.0, 2400.0)]
-    text = wall_time_text(SimpleNamespace(seconds=recorded, ensembles=ensembles), cores=2)
+    text = wall_time_text(recorded, compute=3600.0 + 2400.0, cores=2)
     assert says in text
     assert ("10:00" in text) == (recorded == 600.0)  # the record is named beside the bound
