@@ -95,12 +95,15 @@ class _Parser(argparse.ArgumentParser):
         if message.startswith("the following arguments are required"):
             # argparse says so before it looks at words it does not know: `run --hlep` is a
             # misspelt option more often than a forgotten preset
-            options = [o for a in self._actions for o in a.option_strings]
+            options = self.option_names()
             strays = [w for w in self.words if _stray_option(w, options)]
             if strays:
                 message = f"{unrecognized(strays, options)} ({message})"
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
         super().error(message)
+
+    def option_names(self) -> list[str]:
+        return [name for action in self._actions for name in action.option_strings]
 
     def parse_known_args(self, args=None, namespace=None):
         """Words no option takes are refused by the parser that met them, with its own
@@ -108,7 +111,7 @@ class _Parser(argparse.ArgumentParser):
         self.words = list(sys.argv[1:] if args is None else args)
         namespace, extras = super().parse_known_args(args, namespace)
         if extras:
-            self.error(unrecognized(extras, [o for a in self._actions for o in a.option_strings]))
+            self.error(unrecognized(extras, self.option_names()))
         return namespace, extras
 
 
