@@ -44,6 +44,7 @@ from frictionlab_solvers.elastic import PeriodicHalfSpace
 from frictionlab_spectra.power_law import PowerLaw
 from frictionlab_spectra.surface import PowerLawSurface
 from polonsky_keer import PolonskyKeerCG  # this folder's: the baseline
+from tamaas_reference import load_tamaas, tamaas_sweep  # this folder's
 
 SEED = 2024
 FFT_PAIRS = [0, 0]  # float64, float32
@@ -121,6 +122,8 @@ def main() -> None:
         line_sweep(args.repeat)
         return
     tamaas = None if args.no_tamaas else load_tamaas()
+    if tamaas is None and not args.no_tamaas:
+        print("Tamaas is not installed (pip install tamaas, or the 'bench' extra): no comparison with it")
     if args.tamaas_surface and tamaas is None:
         parser.error("--tamaas-surface needs Tamaas (pip install tamaas) and no --no-tamaas")
     profile, forces = scene(args.side, tamaas if args.tamaas_surface else None)
@@ -193,34 +196,6 @@ def line_sweep(repeat: int) -> None:
         verdict = "= 1e-12 solves" if wrong == 0 else f"{wrong} loads differ from 1e-12 solves"
         print(f"  {name:<15}{pairs[0]:11d} + {pairs[1]:6d}{seconds[0]:8.2f}{seconds[1]:8.2f}"
               f"{int(curve.extras['iterations'].sum()):11d}  {verdict}")  # fmt: skip
-
-
-def load_tamaas():
-    try:
-        import tamaas
-    except ImportError:
-        print("Tamaas is not installed (pip install tamaas, or the 'bench' extra): no comparison with it")
-        return None
-    tamaas.initialize(1)  # one thread, as frictionlab's solve
-    tamaas.set_log_level(tamaas.LogLevel.error)
-    return tamaas
-
-
-def tamaas_sweep(tamaas, heights, forces):
-    """Tamaas's PolonskyKeerRey over ``forces`` on one solver object (each load
-    starts from the last one's state), tolerance 1e-10: ((CPU, wall) seconds, None, counts)."""
-    z = np.ascontiguousarray(heights, dtype=float)
-    ny, nx = z.shape
-    model = tamaas.ModelFactory.createModel(tamaas.model_type.basic_2d, [float(ny), float(nx)], [ny, nx])
-    model.E, model.nu = 1.0, 0.0
-    solver = tamaas.PolonskyKeerRey(model, z, 1e-10)
-    solver.max_iter = 100_000
-    counts = []
-    cpu, wall = time.process_time(), time.perf_counter()
-    for force in forces:
-        solver.solve(force / z.size)  # Tamaas loads by mean pressure
-        counts.append(int(np.count_nonzero(np.asarray(model.traction) > 0)))
-    return (time.process_time() - cpu, time.perf_counter() - wall), None, np.array(counts)
 
 
 if __name__ == "__main__":

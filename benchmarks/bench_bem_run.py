@@ -42,6 +42,7 @@ os.environ.update(ONE_CORE)  # before numpy and Tamaas load their threads
 from frictionlab.preset import load_scene  # noqa: E402
 from frictionlab.preset.seeds import realization_rng  # noqa: E402
 from machine_load import busy_beside, check_repeat_and_busy  # noqa: E402  (this folder's)
+from tamaas_reference import load_tamaas, tamaas_sweep  # noqa: E402  (this folder's)
 
 SEED = 2024
 TARGET = 12.0  # Tamaas's sweep / the run's whole process, at least
@@ -75,22 +76,6 @@ def run_process(preset: Path, out: Path) -> tuple[float, float]:
     return whole, json.loads((out / "summary.json").read_text())["elapsed_seconds"]
 
 
-def tamaas_sweep(tamaas, heights: np.ndarray, forces: np.ndarray) -> tuple[float, np.ndarray]:
-    """(wall seconds, contact counts) of Tamaas's warm sweep at tolerance 1e-10."""
-    z = np.ascontiguousarray(heights, dtype=float)
-    ny, nx = z.shape
-    start = time.perf_counter()
-    model = tamaas.ModelFactory.createModel(tamaas.model_type.basic_2d, [float(ny), float(nx)], [ny, nx])
-    model.E, model.nu = 1.0, 0.0
-    solver = tamaas.PolonskyKeerRey(model, z, 1e-10)
-    solver.max_iter = 100_000
-    counts = []
-    for force in forces:
-        solver.solve(force / z.size)  # Tamaas loads by mean pressure
-        counts.append(int(np.count_nonzero(np.asarray(model.traction) > 0)))
-    return time.perf_counter() - start, np.array(counts)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3, help="best of this many rounds")
@@ -100,12 +85,9 @@ def main() -> None:
     check_repeat_and_busy(parser, args)
     if args.side < 16:
         parser.error(f"--side must be at least 16. Got {args.side} instead.")
-    try:
-        import tamaas
-    except ImportError:
-        raise SystemExit("this benchmark needs Tamaas: pip install tamaas") from None
-    tamaas.initialize(1)
-    tamaas.set_log_level(tamaas.LogLevel.error)
+    tamaas = load_tamaas()
+    if tamaas is None:
+        raise SystemExit("this benchmark needs Tamaas: pip install tamaas")
     scale = (args.side / 512) ** 2  # the same contact fractions at any side
     with busy_beside(args.busy), tempfile.TemporaryDirectory() as tmp:
         measure(Path(tmp), tamaas, args, 20.0 * scale, 1000.0 * scale)
@@ -120,7 +102,8 @@ def measure(tmp: Path, tamaas, args, first: float, last: float) -> None:
     runs, sweeps = [], []
     for i in range(args.repeat):
         runs.append(run_process(preset, tmp / f"run{i}"))
-        sweeps.append(tamaas_sweep(tamaas, heights, scene.loads))
+        (_, wall), _, counts = tamaas_sweep(tamaas, heights, scene.loads)
+        sweeps.append((wall, counts))
     with open(tmp / "run0" / "curve.csv", newline="") as fh:
         counts = np.array([round(float(row["contact_count"])) for row in csv.DictReader(fh)])
     differ = int(np.count_nonzero(counts != sweeps[0][1]))
