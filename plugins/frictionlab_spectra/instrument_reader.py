@@ -166,6 +166,10 @@ def pick_channel(reader, wanted: str | int | None, where: str):
     """The channel ``wanted`` (an index, or a name: the first of that name), or the reader's
     default; and a note when other channels share its name (None otherwise)."""
     channels = list(reader.channels)
+    if not channels:  # a reader keeps only channels of heights (a length over lengths): here, none
+        raise ValueError(f"{where}: the {reader.name()} file holds no channel of heights that SurfaceTopography reads "
+                         "(heights are lengths: m, um, nm...; a channel in degrees, volts, newtons or no unit is "
+                         "not read as heights); export the height channel with its length unit")  # fmt: skip
     if wanted is None:
         channel = reader.default_channel
     elif isinstance(wanted, int):

@@ -1,0 +1,141 @@
+"""Scans at the edges of what a file may say, written here byte by byte: a Gwyddion file
+whose channels are not heights, tables as spreadsheets save them (a byte-order mark,
+semicolons, decimal commas), a map one pixel wide, a pixel size that makes the resampled
+map enormous, X3P files of a kind SurfaceTopography does not read. Each is read with the
+right numbers, or refused with a message that names what is wrong and what to do."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab_spectra import ProfileFile, SurfaceFile
+
+
+def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
+    return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
+
+
+def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, more=()):
+    """A Gwyddion file of the map z[y, x] on pixels dx x dy (in unit_xy), and more channels
+    (title, map, unit of values) on the same grid."""
+    from SurfaceTopography.IO.GWY import _gwy_write_object  # here: its import takes seconds
+
+    ny, nx = z.shape
+
+    def field(values, unit):
+        return ("o", ("GwyDataField", {
+            "xres": ("i", nx), "yres": ("i", ny), "xreal": ("d", nx * dx if xreal is None else xreal),
+            "yreal": ("d", ny * dy), "xoff": ("d", 0.0), "yoff": ("d", 0.0),
+            "si_unit_xy": ("o", ("GwySIUnit", {"unitstr": ("s", unit_xy)})),
+            "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", unit)})), "data": ("D", values.astype("<f8").ravel()),
+        }))  # fmt: skip
+
+    container = {"/0/data/title": ("s", "Height"), "/0/data": field(z, unit_z)}
+    for index, (title, values, unit) in enumerate(more, start=1):
+        container[f"/{index}/data/title"] = ("s", title)
+        container[f"/{index}/data"] = field(values, unit)
+    with open(path, "wb") as fh:
+        fh.write(b"GWYP")
+        _gwy_write_object(fh, "GwyContainer", container)
+    return path
+
+
+def preset(path, **params) -> dict:
+    return {
+        "name": "edge", "seed": 1, "realizations": 1,
+        "spectrum": {"name": "surface-file", "params": {"path": str(path), **params}},
+        "solver": {"name": "mdr", "params": {"youngs_modulus": 1.0, "poisson_ratio": 0.0}},
+        "loading": {"start": 1e-3, "stop": 1e-2, "steps": 3, "spacing": "log"},
+    }  # fmt: skip
+
+
+def validate(tmp_path, capsys, path, **params) -> tuple[int, str]:
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(path, **params)))
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    captured = capsys.readouterr()
+    return code, captured.out + captured.err
+
+
+# ------------------------------------------------------------ channels that are not heights
+
+
+@pytest.mark.parametrize("unit_z", ["V", "deg", ""])
+def test_a_file_with_no_channel_of_heights_is_refused_by_name_not_as_an_internal_error(tmp_path, capsys, unit_z):
+    """SurfaceTopography's Gwyddion reader keeps only channels whose values are lengths: a file
+    of phase, amplitude or unitless channels has none, and its reader's default channel does
+    not exist (an IndexError, the catch-all internal error, exit 70, before)."""
+    path = write_gwy(tmp_path / "phase.gwy", rough(16, 16) * 1e-9, 1e-7, 1e-7, unit_z=unit_z,
+                     more=[("Amplitude", rough(16, 16), unit_z)])  # fmt: skip
+    code, text = validate(tmp_path, capsys, path)
+    assert code == ExitCode.USAGE, text
+    assert "holds no channel of heights that SurfaceTopography reads" in text and "internal error" not in text
+    assert "Traceback" not in text
+
+
+def test_the_channels_of_heights_are_read_beside_ones_that_are_not(tmp_path):
+    z = rough(16, 20, 2) * 1e-9
+    path = write_gwy(tmp_path / "mixed.gwy", z, 1e-7, 1e-7, more=[("Phase", rough(16, 20), "deg"), ("Z", 2 * z, "m")])
+    read = SurfaceFile(path=str(path), unit="nm", detrend="mean", channel="Z").generate(None).heights
+    np.testing.assert_allclose(read, 2e9 * (z - z.mean()), rtol=1e-12, atol=1e-12)
+
+
+# ------------------------------------------------------------ tables as spreadsheets save them
+
+
+def matrix_text(z, separator=",", decimal=".") -> str:
+    return "\n".join(separator.join(f"{v:.9f}".replace(".", decimal) for v in row) for row in z) + "\n"
+
+
+@pytest.mark.parametrize("header", ["", "z\n", "z [nm]\r\n"])
+def test_a_byte_order_mark_is_no_header_and_drops_no_row(tmp_path, header):
+    """A spreadsheet's 'CSV UTF-8' starts with the byte-order mark U+FEFF. Read as part of
+    the first number it made the first row a 'header': a row of the map silently dropped
+    (11 of 12 rows read, before), or with a real header line, the file refused."""
+    z = rough(12, 10, 3)
+    plain, marked = tmp_path / "plain.csv", tmp_path / "marked.csv"
+    plain.write_text(matrix_text(z))
+    marked.write_bytes(b"\xef\xbb\xbf" + (header + matrix_text(z)).replace("\n", "\r\n").encode())
+    expected = SurfaceFile(path=str(plain), spacing=0.1).generate(None).heights
+    read = SurfaceFile(path=str(marked), spacing=0.1).generate(None).heights
+    assert read.shape == (12, 10)
+    np.testing.assert_array_equal(read, expected)
+
+
+def test_a_profile_with_a_byte_order_mark_keeps_its_first_point(tmp_path):
+    x = np.arange(40) * 0.5
+    z = rough(1, 40, 4)[0]
+    (tmp_path / "p.csv").write_bytes(b"\xef\xbb\xbf" + "".join(f"{a},{float(b)!r}\n" for a, b in zip(x, z)).encode())
+    line = ProfileFile(path=str(tmp_path / "p.csv")).generate(None)
+    assert line.heights.size == 40 and line.spacing == pytest.approx(0.5, rel=1e-12)
+    np.testing.assert_allclose(line.heights, z - z.mean(), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("header", ["", "x;z\n"])
+def test_semicolons_separate_numbers(tmp_path, header):
+    """A European spreadsheet separates its columns by semicolons: read as such (refused as
+    'non-numeric content at line 2 (expected numbers separated by spaces)', before)."""
+    z = rough(12, 10, 5)
+    (tmp_path / "s.csv").write_text(header + matrix_text(z, ";"))
+    (tmp_path / "c.csv").write_text(matrix_text(z, ","))
+    read = SurfaceFile(path=str(tmp_path / "s.csv"), spacing=0.1).generate(None).heights
+    np.testing.assert_array_equal(read, SurfaceFile(path=str(tmp_path / "c.csv"), spacing=0.1).generate(None).heights)
+
+
+def test_a_header_over_a_matrix_of_commas_is_skipped(tmp_path):
+    """The separator is the data's, not the header's: a one-word header over comma-separated
+    rows (refused before: the header, with no comma, set whitespace as the separator)."""
+    z = rough(9, 8, 6)
+    (tmp_path / "h.csv").write_text("height\n" + matrix_text(z))
+    read = SurfaceFile(path=str(tmp_path / "h.csv"), spacing=0.1, detrend="none").generate(None).heights
+    np.testing.assert_allclose(read, z, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("separator", [";", "\t"])
+def test_decimal_commas_are_named(tmp_path, separator):
+    (tmp_path / "d.csv").write_text(matrix_text(rough(9, 8, 7), separator, decimal=","))
+    with pytest.raises(ValueError, match=r"decimal commas at line 2 \(as 1,5\); .* export the table with decimal points"):
+        SurfaceFile(path=str(tmp_path / "d.csv"), spacing=0.1).rms_height()
