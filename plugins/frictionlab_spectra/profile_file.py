@@ -3,8 +3,9 @@
 The file holds heights on a uniform grid, optionally with their x positions:
 
 - ``.csv`` / ``.txt``: one column (heights) or two columns (x, z), separated by
-  commas or whitespace; lines starting with ``#`` are comments and one
-  non-numeric header line (e.g. ``x,z``) before the data is skipped.
+  commas, semicolons or whitespace (a UTF-8 byte-order mark is skipped); lines
+  starting with ``#`` are comments and one non-numeric header line (e.g. ``x,z``)
+  before the data is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z;
 - any other file: an instrument's line scan (X3P, SUR, NetCDF...) read by the optional
   extra ``topography`` (``instrument_file.py``), with its own spacing and unit, converted
@@ -257,18 +258,23 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
     with open_input(path, where) as fh:
         raw = fh.read()
     try:
-        lines = raw.decode("utf-8").splitlines()
+        lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
+        line = raw.count(b"\n", 0, exc.start + (3 if raw.startswith(b"\xef\xbb\xbf") else 0)) + 1
         raise ValueError(f"{where}: not a text file (not UTF-8 at line {line}); an instrument's export (a "
                          "profilometer's .csv) is read with format: instrument") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()
-        if text:
-            delimiter = "," if "," in text else None
-            skip = 0 if _numbers(text, delimiter) else lineno  # a header such as "x,z"
+        if not text:
+            continue
+        if skip:  # the first line after a header says how its numbers are separated
+            delimiter = _delimiter(text)
             break
+        delimiter = _delimiter(text)
+        if _numbers(text, delimiter):
+            break
+        skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
@@ -289,12 +295,24 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
         if not text:
             continue
         if not _numbers(text, delimiter):
-            return f"non-numeric content at line {lineno} (expected numbers separated by {delimiter or 'spaces'})"
+            if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
+                return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
+                        "export the table with decimal points")  # fmt: skip
+            return f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _delimiter(text: str) -> str | None:
+    """Semicolons (a spreadsheet's export where the comma is the decimal mark), else commas, else whitespace."""
+    return ";" if ";" in text else "," if "," in text else None
+
+
+def _separator(delimiter: str | None) -> str:
+    return {",": "commas", ";": "semicolons"}.get(delimiter, "spaces")
 
 
 def check_finite(where: str, what: str, values: np.ndarray) -> None:
