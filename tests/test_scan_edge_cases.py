@@ -139,3 +139,24 @@ def test_decimal_commas_are_named(tmp_path, separator):
     (tmp_path / "d.csv").write_text(matrix_text(rough(9, 8, 7), separator, decimal=","))
     with pytest.raises(ValueError, match=r"decimal commas at line 2 \(as 1,5\); .* export the table with decimal points"):
         SurfaceFile(path=str(tmp_path / "d.csv"), spacing=0.1).rms_height()
+
+
+# ------------------------------------------------------------ pixels far from square
+
+
+def test_a_map_too_large_once_on_square_pixels_is_refused_before_it_is_built(tmp_path, capsys, monkeypatch):
+    """Pixels 2000 times longer along x than along y make a 32 x 24 scan 62001 x 24 pixels on
+    square ones (a header that lies makes more: Gwyddion reads a zero width as 1 m, 312500:1
+    here). Refused from the shapes, naming the pixels, the map it would make and the remedy;
+    before, the map was built, and a process short of memory failed on the cosine series'
+    basis with a generic 'out of memory'."""
+    from frictionlab_spectra import instrument_reader
+
+    monkeypatch.setattr(instrument_reader, "room_to_read", lambda: (32 * 2**20, "a test limit of 32 MiB"))
+    path = write_gwy(tmp_path / "wide.gwy", rough(24, 32) * 1e-9, 2e-4, 1e-7)
+    code, text = validate(tmp_path, capsys, path)
+    assert code == ExitCode.USAGE, text
+    assert "pixels of 0.0002 x 1e-07, 2000 times longer along x, make the map on square pixels 62001 x 24" in text
+    assert "a test limit of 32 MiB" in text and "crop it with region" in text and "give spacing" in text
+    code, text = validate(tmp_path, capsys, path, spacing=1e-7)  # the remedy it names
+    assert code == ExitCode.OK, text

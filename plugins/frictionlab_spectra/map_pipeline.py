@@ -21,6 +21,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from . import instrument_reader
 from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
@@ -124,6 +125,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             spacing = min(dx, dy)
             axis = 0 if dy > dx else 1  # rows are along y
             before = z.shape
+            _check_room_to_resample(before, (dx, dy), where)
             z = cosine_resample(z, axis, max(dx, dy), spacing)
             done["pixels"] = (f"{dx:.6g} x {dy:.6g} resampled onto square pixels of {spacing:.6g} along "
                               f"{'y' if axis == 0 else 'x'} (band-limited cosine series): {before[1]} x {before[0]} "
@@ -140,6 +142,29 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if caveats:
         done["caveats"] = caveats
     return np.ascontiguousarray(z), float(spacing), done
+
+
+RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis
+
+
+def _check_room_to_resample(shape: tuple[int, int], pixel: tuple[float, float], where: str) -> None:
+    """Refuse, before it is built, a map on square pixels larger than this process can hold:
+    pixels thousands of times longer one way (a header that lies: Gwyddion reads a zero width
+    as 1 m) would make millions of rows of a small scan."""
+    dx, dy = pixel
+    axis = 0 if dy > dx else 1  # rows are along y
+    points = resampled_points(shape[axis], max(dx, dy), min(dx, dy))
+    other = shape[1 - axis]
+    need = 8 * points * (other * instrument_reader.HEIGHT_COPIES + shape[axis] * RESAMPLE_COPIES)
+    room, source = instrument_reader.room_to_read()  # looked up when called: a test may set the room
+    if need > room:
+        nx, ny = (other, points) if axis == 0 else (points, other)
+        raise ValueError(
+            f"{where}: pixels of {dx:.6g} x {dy:.6g}, {max(dx, dy) / min(dx, dy):.4g} times longer along "
+            f"{'y' if axis == 0 else 'x'}, make the map on square pixels {nx} x {ny} pixels (x by y), about "
+            f"{need / 2**30:.3g} GiB, more than the {room / 2**30:.3g} GiB this process may use ({source}); crop it "
+            "with region, or, if the file's pixel size is wrong, give spacing (square pixels of that side)"
+        )
 
 
 def _removed(levelled) -> float:
