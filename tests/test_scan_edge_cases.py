@@ -160,3 +160,21 @@ def test_a_map_too_large_once_on_square_pixels_is_refused_before_it_is_built(tmp
     assert "a test limit of 32 MiB" in text and "crop it with region" in text and "give spacing" in text
     code, text = validate(tmp_path, capsys, path, spacing=1e-7)  # the remedy it names
     assert code == ExitCode.OK, text
+
+
+# ------------------------------------------------------------ a line stored as a map
+
+
+@pytest.mark.parametrize("shape, pixel, spacing_nm", [((1, 40), (1e-7, 3e-7), 100.0), ((40, 1), (1e-7, 3e-7), 300.0)])
+def test_a_map_one_pixel_wide_is_read_by_profile_file_along_its_long_side(tmp_path, shape, pixel, spacing_nm):
+    """An instrument that stores a line as a map one pixel wide: surface-file sends it to
+    profile-file, which reads it along its long side with that side's pixel (before, each
+    sent it to the other: 'use profile-file', then 'the file holds a 2D map; use surface-file')."""
+    z = rough(*shape, seed=8) * 1e-8
+    path = write_gwy(tmp_path / "line.gwy", z, *pixel)
+    with pytest.raises(ValueError, match=r"a map of \d+ x \d+ pixels \(x by y\), one pixel wide: a line; use profile-file"):
+        SurfaceFile(path=str(path)).rms_height()
+    line = ProfileFile(path=str(path), unit="nm", detrend="mean")
+    made = line.generate(None)
+    assert made.spacing == pytest.approx(spacing_nm, rel=1e-12) and line.grid_shape() == (40,)
+    np.testing.assert_allclose(made.heights, 1e9 * (z.ravel() - z.mean()), rtol=1e-12, atol=1e-9)

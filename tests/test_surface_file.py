@@ -185,7 +185,8 @@ def test_bad_maps_are_named_with_what_is_wrong(tmp_path):
     np.save(tmp_path / "line.npy", np.arange(64.0))
     assert "shape (64,)" in surface_error(tmp_path / "line.npy") and "2D" in surface_error(tmp_path / "line.npy")
     (tmp_path / "column.txt").write_text("\n".join(str(v) for v in range(20)))
-    assert "shape (20, 1)" in surface_error(tmp_path / "column.txt")
+    column = surface_error(tmp_path / "column.txt")
+    assert "a map of 1 x 20 pixels (x by y), one pixel wide: a line; use profile-file" in column
     bad = np.random.default_rng(0).standard_normal((12, 10))
     bad[3, 4], bad[7, 1] = np.nan, np.inf
     np.save(tmp_path / "nan.npy", bad)

@@ -83,6 +83,9 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
+    if dimension == 1 and len(shape) == 2 and 1 in shape:  # a line stored as a map one pixel wide
+        along = 0 if shape[1] == 1 else 1
+        return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1])
     return ScanHeader(shape[::-1], periodic, pixel) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
 
 
@@ -179,7 +182,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
             raise describe_failure(type(reader), exc, where) from None
-        if topography.dim != dimension:
+        along = _line_axis(topography, dimension)
+        if topography.dim != dimension and along is None:
             kind = {1: "a line scan", 2: "a 2D map"}
             advice = "use surface-file" if topography.dim == 2 else "use profile-file"
             raise ValueError(f"{where}: the file holds {kind.get(topography.dim, topography.dim)}; {advice}")
@@ -195,6 +199,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             topography = topography.interpolate_undefined_data(method=undefined)
             heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
+        if along is not None:  # a line stored as a map one pixel wide: its heights along its long side
+            heights, pixel = heights.reshape(-1), pixel[along : along + 1]
         periodic = bool(topography.is_periodic)
         listed = channel_list(reader) if len(reader.channels) > 1 else []
         file_format = str(reader.name())
@@ -223,6 +229,15 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         channels=listed,
         undefined=missing,
     )
+
+
+def _line_axis(topography, dimension: int) -> int | None:
+    """The axis (0: x, 1: y) of a line an instrument stored as a map one pixel wide, read by
+    ``profile-file``; None for any other scan."""
+    points = tuple(topography.nb_grid_pts)
+    if dimension != 1 or topography.dim != 2 or 1 not in points:
+        return None
+    return 1 if points[0] == 1 else 0
 
 
 def check_spacing(where: str, what: str, spacing: float, unit: str | None) -> float:

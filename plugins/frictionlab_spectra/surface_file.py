@@ -242,7 +242,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
         periodic = bool(p.periodic)
-    if data.ndim != 2 or 1 in data.shape:
+    if data.ndim == 2 and 1 in data.shape:
+        ny, nx = data.shape
+        raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y), one pixel wide: a line; use profile-file")
+    if data.ndim != 2:
         raise ValueError(
             f"{where}: array of shape {data.shape}; expected a 2D height map (Ny, Nx) "
             "(for a single line use profile-file)"
