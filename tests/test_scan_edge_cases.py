@@ -178,3 +178,37 @@ def test_a_map_one_pixel_wide_is_read_by_profile_file_along_its_long_side(tmp_pa
     made = line.generate(None)
     assert made.spacing == pytest.approx(spacing_nm, rel=1e-12) and line.grid_shape() == (40,)
     np.testing.assert_allclose(made.heights, 1e9 * (z.ravel() - z.mean()), rtol=1e-12, atol=1e-9)
+
+
+# ------------------------------------------------------------ valid files SurfaceTopography does not read
+
+
+def test_an_x3p_of_another_revision_or_a_profile_is_named_not_called_damaged(tmp_path, capsys):
+    """x3pio writes ISO 25178-72:2017 by default, and a line as a profile (feature type PRF):
+    both valid X3P files that SurfaceTopography's reader refuses. They were called 'a damaged
+    X3P file ... copy it again from the instrument', which no copy mends."""
+    import x3pio
+
+    x3pio.write(tmp_path / "new.x3p", rough(16, 16) * 1e-6, x_scale=1e-7, y_scale=1e-7)
+    code, text = validate(tmp_path, capsys, tmp_path / "new.x3p")
+    assert code == ExitCode.USAGE and "damaged" not in text, text
+    assert "is of a revision SurfaceTopography does not read" in text and "ISO 5436-2 (2000)" in text
+    x3pio.write(tmp_path / "line.x3p", rough(1, 64)[0] * 1e-6, x_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    with pytest.raises(ValueError, match="is not an areal map .* export a profile as a .csv of x, z") as refused:
+        ProfileFile(path=str(tmp_path / "line.x3p")).rms_height()
+    assert "damaged" not in str(refused.value)
+
+
+def test_a_text_export_with_a_byte_order_mark_is_named(tmp_path):
+    """SurfaceTopography's XYZ reader fails on a leading byte-order mark as on damage ('a damaged
+    Plain text file ... copy it again'); the mark is named, and the same file without it is read."""
+    y, x = np.mgrid[0:10, 0:12] * 1e-7
+    z = rough(10, 12, 9) * 1e-8
+    text = "".join(f"{a:.9e},{b:.9e},{c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel()))
+    (tmp_path / "marked.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    with pytest.raises(ValueError, match="starts with a UTF-8 byte-order mark .* save it without one") as refused:
+        SurfaceFile(path=str(tmp_path / "marked.csv"), format="instrument").rms_height()
+    assert "damaged" not in str(refused.value)
+    (tmp_path / "plain.csv").write_text(text)
+    read = SurfaceFile(path=str(tmp_path / "plain.csv"), format="instrument", detrend="mean").generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-15)

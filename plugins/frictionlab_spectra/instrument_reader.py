@@ -13,12 +13,14 @@ above ``XML_LIMIT`` is refused (a 0.4 MiB file can inflate to gigabytes of blank
 from __future__ import annotations
 
 import math
+import re
 import zipfile
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
 ZIP_MAGIC = b"PK\x03\x04"
+UTF8_BOM = b"\xef\xbb\xbf"
 
 
 def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None):
@@ -50,6 +52,11 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
             f"{chosen.name()} file; give a binary format its own suffix"
+        )
+    if chosen.format() in TEXT_FORMATS and head.startswith(UTF8_BOM):  # its readers fail on it, as on damage
+        raise ValueError(
+            f"{where}: a text export that starts with a UTF-8 byte-order mark (as a spreadsheet saves 'CSV UTF-8'), "
+            f"which SurfaceTopography's {chosen.name()} reader does not read; save it without one (plain CSV or text)"
         )
     if head.startswith(ZIP_MAGIC):
         check_zip_members(fh, chosen, where)
@@ -138,11 +145,25 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
     if isinstance(exc, MemoryError):
         return ValueError(f"{where}: the {name} file declares more points than this process can hold; "
                           "crop it with the instrument's software")  # fmt: skip
+    if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
+        return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
     kind = "not a valid" if isinstance(exc, FileFormatMismatch) else "a damaged"
     if isinstance(exc, CorruptFile):
         kind = "a damaged"
     return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}); the reader of its format cannot read it: "
                       "copy it again from the instrument, or export it from there again")  # fmt: skip
+
+
+def _unread_variant(name: str, field: str, value: str, where: str) -> ValueError:
+    """A file of a revision or a kind of its format that SurfaceTopography's reader does not
+    read (an X3P of ISO 25178-72, an X3P profile): named as such, not as damage."""
+    if field == "Revision":
+        return ValueError(f"{where}: this {name} file is of a revision SurfaceTopography does not read (it reads revision "
+                          f"{value!r} only, not ISO 25178-72); export the scan as an ISO 5436-2 (2000) X3P, or in "
+                          "another format")  # fmt: skip
+    return ValueError(f"{where}: this {name} file is not an areal map (SurfaceTopography reads feature type "
+                      f"{value!r} only: no profile or point cloud); export a profile as a .csv of x, z for "
+                      "profile-file, or the map as an areal X3P")  # fmt: skip
 
 
 def channel_list(reader) -> list[dict]:
