@@ -212,3 +212,15 @@ def test_a_text_export_with_a_byte_order_mark_is_named(tmp_path):
     (tmp_path / "plain.csv").write_text(text)
     read = SurfaceFile(path=str(tmp_path / "plain.csv"), format="instrument", detrend="mean").generate(None)
     np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-15)
+
+
+def test_a_region_narrower_than_a_pixel_is_named_as_such(tmp_path):
+    """[0, 0.04] um of a 2 um map on pixels of 0.1 um is inside the map, but no pixel: it was
+    'not inside the map, 2 (the run's length unit) along x'."""
+    path = write_gwy(tmp_path / "m.gwy", rough(16, 20) * 1e-9, 1e-7, 1e-7)
+    with pytest.raises(ValueError, match=r"region.x = \[0, 0.04\] \(length\) is narrower than one pixel, 0.1 "):
+        SurfaceFile(path=str(path), unit="um", region={"x": [0.0, 0.04], "units": "length"}).rms_height()
+    with pytest.raises(ValueError, match=r"region.x = \[0, 3\] \(length\) is not inside the map, 2 "):
+        SurfaceFile(path=str(path), unit="um", region={"x": [0.0, 3.0], "units": "length"}).rms_height()
+    kept = SurfaceFile(path=str(path), unit="um", region={"x": [0.0, 1.0], "units": "length"}).generate(None)
+    assert kept.heights.shape == (16, 10)

@@ -84,7 +84,10 @@ def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str)
             bounds.append((0, count))
             continue
         start, stop = (round(v / side) for v in span) if region.units == "length" else (int(v) for v in span)
-        if stop > count or stop - start < 1:
+        if stop <= count and stop - start < 1:  # inside, in the run's length unit, but rounded to no pixel
+            raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] (length) is narrower than one "
+                             f"pixel, {side:g} (the run's length unit) along {name}")  # fmt: skip
+        if stop > count:
             extent = f"{count} pixels" if region.units == "pixels" else f"{count * side:g} (the run's length unit)"
             raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] ({region.units}) is not inside the map, "
                              f"{extent} along {name}")  # fmt: skip
