@@ -272,6 +272,9 @@ def test_validate_warns_of_loads_past_full_contact(cli):
     assert done.returncode == 0 and "caveat: the last loads are past full contact" in done.stdout, done.stderr
     done = cli("validate", "quickstart")
     assert done.returncode == 0 and "past full contact" not in done.stdout, done.stderr
+    done = cli("validate", "quickstart", "--set", "loading.start=1e4", "--set", "loading.stop=1e5")
+    assert done.returncode == 0 and "caveat: every load is past full contact" in done.stdout, done.stderr
+    assert "lower the loads" in done.stdout and "the last loads" not in done.stdout
 
 
 def test_a_contact_fraction_reached_at_the_first_touch_is_found_not_an_error():

@@ -247,6 +247,8 @@ def loads_lines(record: dict, symbol: str) -> list[str]:
         pressure = f", p/E* = {full['pressure']:.4g}" if full["pressure"] is not None else ""
         lines.append(f"full contact from {symbol} = {full['force']:.4g} (f = {full['f']:.4g}{pressure}): {full['how']}")
         if span is not None and span["force"][1] > full["force"]:
-            lines.append(f"caveat: the last loads are past full contact{'' if full['how'].startswith('exact') else ' (estimated)'}: "
-                         "xi is 1 there by definition and they measure no roughness; lower loading.stop")  # fmt: skip
+            every = span["force"][0] >= full["force"]  # no load measures roughness: the run finds no law
+            lines.append(f"caveat: {'every load is' if every else 'the last loads are'} past full contact"
+                         f"{'' if full['how'].startswith('exact') else ' (estimated)'}: xi is 1 there by definition and "
+                         f"they measure no roughness; lower {'the loads' if every else 'loading.stop'}")  # fmt: skip
     return lines
