@@ -224,3 +224,41 @@ def test_a_region_narrower_than_a_pixel_is_named_as_such(tmp_path):
         SurfaceFile(path=str(path), unit="um", region={"x": [0.0, 3.0], "units": "length"}).rms_height()
     kept = SurfaceFile(path=str(path), unit="um", region={"x": [0.0, 1.0], "units": "length"}).generate(None)
     assert kept.heights.shape == (16, 10)
+
+
+# ------------------------------------------------------------ a file that states no physical size
+
+
+def write_netcdf_without_size(path, z):
+    """A NetCDF map z[y, x] in um whose x and y state a unit and no length (SurfaceTopography's layout)."""
+    from scipy.io import netcdf_file
+
+    ny, nx = z.shape
+    with netcdf_file(str(path), "w") as nc:
+        nc.createDimension("x", nx)
+        nc.createDimension("y", ny)
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = z.T
+        heights.unit = "um"
+        for axis, n in (("x", nx), ("y", ny)):
+            coordinate = nc.createVariable(axis, "d", (axis,))
+            coordinate[:] = np.arange(n, dtype=np.float64)
+            coordinate.unit = "um"  # a unit, and no length
+    return path
+
+
+def test_spacing_gives_the_pixel_size_a_file_does_not_state(tmp_path):
+    """The preset's spacing replaces a file's pixel size; a file that states none was refused
+    even with spacing given ('export the scan with its pixel size, or as a .npy map with
+    spacing', which loses the unit the file states). Now it is read, its heights converted
+    from its unit, and the summary says the pixel size came from the preset, not the file."""
+    z = rough(12, 16, 10)
+    path = write_netcdf_without_size(tmp_path / "bare.nc", z)
+    with pytest.raises(ValueError, match="does not state its physical size; give spacing"):
+        SurfaceFile(path=str(path)).rms_height()
+    surface = SurfaceFile(path=str(path), spacing=40.0, unit="nm", detrend="mean")
+    made = surface.generate(None)
+    assert made.spacing == 40.0 and made.heights.shape == (12, 16)
+    np.testing.assert_allclose(made.heights, 1e3 * (z - z.mean()), rtol=1e-12, atol=1e-9)
+    summary = surface.input_summary()
+    assert summary["spacing_from"] == "preset" and summary["file_spacing"] is None and summary["file_unit"] == "µm"

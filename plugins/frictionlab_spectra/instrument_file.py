@@ -50,6 +50,7 @@ class Scan:
     channel_note: str | None  # which of several channels of one name was taken
     channels: list  # every channel of the file (index, name, points, units) when it has more than one
     undefined: int  # points the file leaves undefined (filled when the preset says how)
+    pixel_stated: bool = True  # false: the file states no size, ``pixel`` is 1 per point and the preset's spacing is used
 
 
 def is_instrument_file(path: Path, format: str = "auto") -> bool:
@@ -159,9 +160,11 @@ def length_factor(unit: str | None, to: str, where: str, what: str) -> float:
 
 
 def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undefined: str,
-              channel: str | int | None = None) -> Scan:  # fmt: skip
+              channel: str | int | None = None, spacing_given: bool = False) -> Scan:  # fmt: skip
     """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and pixel sides
-    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file."""
+    converted to ``unit``. ValueError naming ``where`` for anything wrong with the file.
+    ``spacing_given``: the preset gives the pixel side, so a file that states no physical
+    size is read (its pixel a placeholder of 1, ``Scan.pixel_stated`` false) rather than refused."""
     with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
@@ -177,8 +180,10 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             data_unit = None
         if isinstance(data_unit, str) and data_unit != file_unit:
             length_factor(data_unit, "m", where, f"channel {chosen.index}'s values are in")
+        stated = chosen.physical_sizes is not None or not spacing_given or chosen.nb_grid_pts is None
+        sizes = {} if stated else {"physical_sizes": tuple(float(n) for n in chosen.nb_grid_pts)}
         try:
-            topography = reader.topography(channel_index=chosen.index)
+            topography = reader.topography(channel_index=chosen.index, **sizes)
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
             raise describe_failure(type(reader), exc, where) from None
@@ -228,6 +233,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         channel_note=note,
         channels=listed,
         undefined=missing,
+        pixel_stated=stated,
     )
 
 

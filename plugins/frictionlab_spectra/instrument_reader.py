@@ -139,8 +139,8 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
         )
     if isinstance(exc, ValueError) and "physical_sizes" in text:  # SurfaceTopography's own words: not damage
         return ValueError(
-            f"{where}: the {name} file does not state its physical size, and SurfaceTopography reads none "
-            "without it; export the scan with its pixel size, or as a .npy map with spacing"
+            f"{where}: the {name} file does not state its physical size; give spacing (the pixel side, in the "
+            "run's length unit), or export the scan with its pixel size"
         )
     if isinstance(exc, MemoryError):
         return ValueError(f"{where}: the {name} file declares more points than this process can hold; "

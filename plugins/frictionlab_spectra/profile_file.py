@@ -101,13 +101,14 @@ class ProfileFile(MeasuredFile):
         where = f"profile-file {str(path)!r}"
         instrument = is_instrument_file(path, p.format)
         if instrument:
-            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined, channel=p.channel)
+            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined, channel=p.channel,
+                             spacing_given=p.spacing is not None)  # fmt: skip
             x, z = None, scan.heights
             summary = {
                 "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
                 **({"channel_note": scan.channel_note} if scan.channel_note else {}),
                 **({"channels": scan.channels} if scan.channels else {}),
-                "file_spacing": scan.pixel[0],
+                "file_spacing": scan.pixel[0] if scan.pixel_stated else None,
                 "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
                 "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
                 "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,

@@ -215,13 +215,15 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
     way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
     if is_instrument_file(path, p.format):
-        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined, channel=p.channel)
+        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined, channel=p.channel,
+                         spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
         summary = {
             "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
             **({"channel_note": scan.channel_note} if scan.channel_note else {}),
             **({"channels": scan.channels} if scan.channels else {}),
-            "file_spacing": scan.pixel[0] if scan.pixel[0] == scan.pixel[1] else list(scan.pixel),
+            "file_spacing": None if not scan.pixel_stated else scan.pixel[0] if scan.pixel[0] == scan.pixel[1]
+            else list(scan.pixel),
             "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
             "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
             "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
