@@ -6,6 +6,8 @@ right numbers, or refused with a message that names what is wrong and what to do
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import yaml
@@ -262,3 +264,37 @@ def test_spacing_gives_the_pixel_size_a_file_does_not_state(tmp_path):
     np.testing.assert_allclose(made.heights, 1e3 * (z - z.mean()), rtol=1e-12, atol=1e-9)
     summary = surface.input_summary()
     assert summary["spacing_from"] == "preset" and summary["file_spacing"] is None and summary["file_unit"] == "µm"
+
+
+# ------------------------------------------------------------ an X3P whose payload is not what it declares
+
+
+def rewritten_x3p(source, path, *, xml=lambda text: text, data=lambda payload: payload):
+    """``source`` (an X3P) with its main.xml and its binary heights passed through ``xml`` and ``data``."""
+    import zipfile
+
+    with zipfile.ZipFile(source) as old, zipfile.ZipFile(path, "w") as new:
+        for item in old.infolist():
+            content = old.read(item)
+            content = xml(content) if item.filename == "main.xml" else content
+            new.writestr(item.filename, data(content) if item.filename == "bindata/data.bin" else content)
+    return path
+
+
+@pytest.mark.parametrize("lie, said", [
+    ({"data": lambda payload: payload + payload[:80]}, "take 2640 bytes, and its description declares 320 points "
+                                                       "of data type D (8 bytes each: 2560 bytes)"),
+    ({"xml": lambda text: re.sub(rb"(<CZ>\s*<AxisType>A</AxisType>\s*<DataType>)D", rb"\1F", text)},
+     "320 points of data type F (4 bytes each: 1280"),
+])  # fmt: skip
+def test_an_x3p_whose_heights_are_not_the_size_it_declares_is_refused(tmp_path, lie, said):
+    """SurfaceTopography's X3P reader reads the first points it needs: a payload longer than
+    declared was read without a word, and doubles declared as floats gave heights of 1e37 m."""
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+    assert SurfaceFile(path=str(tmp_path / "good.x3p")).rms_height() < 1e-5
+    path = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "lie.x3p", **lie)
+    with pytest.raises(ValueError, match=f"a damaged .* file: its binary heights .*{re.escape(said)}"):
+        SurfaceFile(path=str(path)).rms_height()

@@ -24,7 +24,9 @@ import numpy as np
 from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from .instrument_reader import channel_list, check_declared_points, choose_reader, describe_failure, pick_channel
+from .instrument_reader import (
+    channel_list, check_declared_points, check_payload, choose_reader, describe_failure, pick_channel,
+)
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
@@ -171,6 +173,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         chosen, note = pick_channel(reader, channel, where)
         if chosen.nb_grid_pts is not None:
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
+        check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")

@@ -92,6 +92,39 @@ def check_zip_members(fh, reader, where: str) -> None:
             )
 
 
+X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int16, int32, float32, float64
+
+
+def check_payload(fh, reader, where: str) -> None:
+    """Refuse an X3P whose binary heights are not the size its main.xml declares (points times
+    the bytes of its data type): SurfaceTopography's reader takes the first points it needs, so
+    a payload longer than declared, or of another type (doubles declared as floats: heights of
+    1e37), was read without a word. Other formats, an X3P with its heights in the XML, or one
+    whose description this cannot follow, are left to the reader. After ``check_declared_points``:
+    a map declared too large is refused as such, whatever its payload."""
+    import xml.etree.ElementTree as ElementTree
+
+    if reader.format() != "x3p":
+        return
+    try:
+        with zipfile.ZipFile(fh) as archive:
+            root = ElementTree.fromstring(archive.read("main.xml"))  # at most XML_LIMIT (check_zip_members)
+            kind = root.findtext("Record1/Axes/CZ/DataType", "").strip()
+            points = math.prod(int(root.findtext(f"Record3/MatrixDimension/Size{axis}", "")) for axis in "XYZ")
+            stored = archive.getinfo(root.findtext("Record3/DataLink/PointDataLink", "").strip()).file_size
+    except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile, ElementTree.ParseError):
+        return
+    finally:
+        fh.seek(0)
+    if kind in X3P_ITEM_BYTES and stored != points * X3P_ITEM_BYTES[kind]:
+        declared = points * X3P_ITEM_BYTES[kind]
+        raise ValueError(
+            f"{where}: a damaged {reader.name()} file: its binary heights take {stored} bytes, and its description "
+            f"declares {points} points of data type {kind} ({X3P_ITEM_BYTES[kind]} bytes each: {declared} bytes); "
+            "copy it again from the instrument, or export it from there again"
+        )
+
+
 HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: the reader's, ours, levelled, resampled
 
 
