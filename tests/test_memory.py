@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -412,3 +413,21 @@ def test_the_memory_read_from_proc_is_psutils(monkeypatch):
     monkeypatch.setattr(memory, "PROC_STATM", "/nonexistent/statm")
     assert memory._address_space()[0] == pytest.approx(psutil.Process().memory_info().vms, abs=64 * 2**20)
     assert memory._system_available() == pytest.approx(psutil.virtual_memory().available, rel=0.05, abs=256 * 2**20)
+
+
+def test_a_grid_too_large_for_one_realization_is_not_offered_no_realizations(tmp_path, monkeypatch):
+    """A measured map has no points parameter to offer: with one realization already too large,
+    the advice was 'It would fit with --workers 1 and realizations <= 0'. It names the points."""
+    np.save(tmp_path / "map.npy", np.random.default_rng(np.random.SeedSequence(3)).normal(size=(512, 512)))
+    scene = build_scene({
+        "name": "scan", "seed": 1, "realizations": 1,
+        "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "map.npy"), "spacing": 1.0}},
+        "solver": {"name": "bem-halfspace-free"}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3},
+    })  # fmt: skip
+    one = memory.estimate(scene, workers=1, executor="serial")
+    monkeypatch.setattr(memory, "available_memory", lambda: (one.per_realization // 2, "a test limit"))
+    with pytest.raises(RunError) as caught:
+        memory.check_fits(scene, workers=1, executor="serial")
+    message = str(caught.value)
+    assert "realizations <= 0" not in message
+    assert "It would fit with fewer points: one realization of 262,144 points alone needs" in message

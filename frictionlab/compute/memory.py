@@ -267,8 +267,12 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
             advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * kept_arrays(scene) * KEPT_COPIES + 512
-            spare = available - PROCESS_BASE - one.per_realization
-            advice.append(f"--workers 1 and realizations <= {max(0, math.floor(spare / rows)):,}")
+            most = math.floor((available - PROCESS_BASE - one.per_realization) / rows)
+            if most >= 1:
+                advice.append(f"--workers 1 and realizations <= {most:,}")
+            else:  # no count of realizations fits (it offered 'realizations <= 0'): only a smaller grid does
+                advice.append(f"fewer points: one realization of {one.points:,} points alone needs "
+                              f"{gib(one.per_realization)} (a measured scan: crop it or make its pixels coarser)")  # fmt: skip
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
         f"({source}). It would fit with {advice[0]}. (--no-memory-check skips this estimate, an upper bound.)"
