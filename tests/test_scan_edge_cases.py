@@ -342,3 +342,25 @@ def test_the_mdr_line_of_a_scan_is_built_in_half_the_memory_with_the_same_modes(
     expected = full_plane_line_powers(heights, 0.5)
     np.testing.assert_allclose(line.params.mode_power, expected, rtol=1e-9, atol=1e-12 * expected.max())
     assert peak < 160 * z.size, f"{peak / z.size:.0f} bytes per point"
+
+
+# ------------------------------------------------------------ a tilt left in a line
+
+
+def test_a_line_whose_height_is_mostly_a_tilt_says_so_as_a_map_does(tmp_path):
+    """A profile read from a table is levelled by its mean only (the default); a map whose tilt
+    carries most of its height variance gets a caveat, a line got none."""
+    x = np.arange(300) * 0.2
+    z = np.cumsum(rough(1, 300, 12)[0]) * 1e-3 + 0.01 * x
+    (tmp_path / "line.csv").write_text("x,z\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    summary = ProfileFile(path=str(tmp_path / "line.csv")).input_summary()
+    coefficients, *_ = np.linalg.lstsq(np.stack([np.ones_like(x), x], axis=1), z, rcond=None)
+    share = 1.0 - np.var(z - coefficients[0] - coefficients[1] * x) / np.var(z)  # independent: least squares
+    assert share > 0.5
+    assert summary["detrend"] == "mean" and summary["caveats"] == [
+        f"a tilt carries {100 * share:.1f} % of the line's height variance (detrend: mean): the contact sits where "
+        "the tilt or the form puts it, not on the roughness; detrend: tilt levels it"
+    ]
+    assert "caveats" not in ProfileFile(path=str(tmp_path / "line.csv"), detrend="tilt").input_summary()
+    (tmp_path / "level.csv").write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z - 0.01 * x)))
+    assert "caveats" not in ProfileFile(path=str(tmp_path / "level.csv")).input_summary()

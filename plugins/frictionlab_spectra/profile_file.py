@@ -39,6 +39,7 @@ from .instrument_file import (
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
+from .scan_shaping import line_tilt_warning
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -156,6 +157,8 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
+        if (caveat := line_tilt_warning(z, mode)) is not None:  # as a map's (map_pipeline.shape_map)
+            summary["caveats"] = [caveat]
         return Measured(heights, float(dx), rms, periodic, summary)
 
 

@@ -79,14 +79,29 @@ def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     plane, curvature = levelled.plane_share, levelled.curvature_share
     if mode in ("none", "mean") and plane + curvature > MOST:
         part = "a tilt" if plane >= curvature else "a curvature"
-        return (f"{part} carries {100 * (plane + curvature):.1f} % of the map's height variance (detrend: {mode}): "
-                "the contact sits where the tilt or the form puts it, not on the roughness; "
-                "detrend: plane (or quadratic) levels it")  # fmt: skip
+        return _form_kept(part, plane + curvature, "map", mode, "detrend: plane (or quadratic) levels it")
     if mode == "plane" and curvature > MOST * (1 - plane):
         return (f"a curvature carries {100 * curvature / (1 - plane):.1f} % of the levelled map's height variance: "
                 "the contact sits where the form puts it; detrend: quadratic removes it, if it is not the "
                 "surface's own shape")  # fmt: skip
     return None
+
+
+def line_tilt_warning(z: np.ndarray, mode: str) -> str | None:
+    """The caveat of a line (as read) whose height is mostly a tilt that ``mode`` (none, mean)
+    leaves in it: the least-squares slope's share of the variance about the mean."""
+    if mode not in ("none", "mean"):
+        return None
+    t, _ = _axis(z.size)
+    centred = z - np.mean(z)
+    variance = float(np.dot(centred, centred))
+    share = float(np.dot(t, centred)) ** 2 / (float(np.dot(t, t)) * variance) if variance > 0 else 0.0
+    return _form_kept("a tilt", share, "line", mode, "detrend: tilt levels it") if share > MOST else None
+
+
+def _form_kept(part: str, share: float, what: str, mode: str, remedy: str) -> str:
+    return (f"{part} carries {100 * share:.1f} % of the {what}'s height variance (detrend: {mode}): the contact sits "
+            f"where the tilt or the form puts it, not on the roughness; {remedy}")  # fmt: skip
 
 
 def cosine_resample(z: np.ndarray, axis: int, step: float, new_step: float) -> np.ndarray:
