@@ -364,3 +364,14 @@ def test_a_line_whose_height_is_mostly_a_tilt_says_so_as_a_map_does(tmp_path):
     assert "caveats" not in ProfileFile(path=str(tmp_path / "line.csv"), detrend="tilt").input_summary()
     (tmp_path / "level.csv").write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z - 0.01 * x)))
     assert "caveats" not in ProfileFile(path=str(tmp_path / "level.csv")).input_summary()
+
+
+def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):
+    """surface-file sends a map one pixel high to profile-file, which refused a single row of
+    heights ('50 columns; expected 1 (z) or 2 (x, z)'): each sent the file away."""
+    z = rough(1, 50, 13)[0]
+    (tmp_path / "row.csv").write_text(",".join(repr(float(v)) for v in z) + "\n")
+    with pytest.raises(ValueError, match="one pixel wide: a line; use profile-file"):
+        SurfaceFile(path=str(tmp_path / "row.csv"), spacing=0.1).rms_height()
+    line = ProfileFile(path=str(tmp_path / "row.csv"), spacing=0.1).generate(None)
+    np.testing.assert_allclose(line.heights, z - z.mean(), rtol=0, atol=1e-12)

@@ -2,10 +2,10 @@
 
 The file holds heights on a uniform grid, optionally with their x positions:
 
-- ``.csv`` / ``.txt``: one column (heights) or two columns (x, z), separated by
-  commas, semicolons or whitespace (a UTF-8 byte-order mark is skipped); lines
-  starting with ``#`` are comments and one non-numeric header line (e.g. ``x,z``)
-  before the data is skipped.
+- ``.csv`` / ``.txt``: one column (heights), one row of heights, or two columns
+  (x, z), separated by commas, semicolons or whitespace (a UTF-8 byte-order mark is
+  skipped); lines starting with ``#`` are comments and one non-numeric header line
+  (e.g. ``x,z``) before the data is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z;
 - any other file: an instrument's line scan (X3P, SUR, NetCDF...) read by the optional
   extra ``topography`` (``instrument_file.py``), with its own spacing and unit, converted
@@ -191,9 +191,11 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     data = read_text_table(path, where)
     if data.shape[1] == 1:
         return None, data[:, 0].copy()
+    if data.shape[0] == 1 and data.shape[1] > 2:  # one row of heights (a map one pixel high, as surface-file says)
+        return None, data[0].copy()
     if data.shape[1] == 2:
         return data[:, 0].copy(), data[:, 1].copy()
-    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z) or 2 (x, z)")
+    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights")
 
 
 def file_suffix(path: Path, where: str) -> str:
