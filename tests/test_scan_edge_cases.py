@@ -375,3 +375,14 @@ def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):
         SurfaceFile(path=str(tmp_path / "row.csv"), spacing=0.1).rms_height()
     line = ProfileFile(path=str(tmp_path / "row.csv"), spacing=0.1).generate(None)
     np.testing.assert_allclose(line.heights, z - z.mean(), rtol=0, atol=1e-12)
+
+
+def test_a_table_under_a_suffix_of_no_format_is_told_format_table(tmp_path):
+    """A .tsv of bare numbers was told to be exported again as a .npy, .csv or .txt; format:
+    table reads it as it is."""
+    z = rough(10, 9, 14)
+    (tmp_path / "map.tsv").write_text(matrix_text(z, "\t"))
+    with pytest.raises(ValueError, match="a table of bare numbers .* is read with format: table and spacing"):
+        SurfaceFile(path=str(tmp_path / "map.tsv"), spacing=0.1).rms_height()
+    read = SurfaceFile(path=str(tmp_path / "map.tsv"), spacing=0.1, format="table", detrend="none").generate(None)
+    np.testing.assert_allclose(read.heights, z, rtol=0, atol=1e-9)

@@ -45,8 +45,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         told = f"its suffix .{path_suffix}" if path_suffix else "its name (no suffix)"
         raise ValueError(
             f"{where}: neither {told} nor its first bytes name an instrument format SurfaceTopography reads; give "
-            "it the suffix of its format (.x3p, .sur, .datx, .nc, .spm...), or export it as a .npy, .csv or .txt "
-            "table with spacing"
+            "it the suffix of its format (.x3p, .sur, .datx, .nc, .spm...); a table of bare numbers (a .tsv) is "
+            "read with format: table and spacing"
         )
     if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
         raise ValueError(
