@@ -303,11 +303,11 @@ def test_an_x3p_whose_heights_are_not_the_size_it_declares_is_refused(tmp_path, 
 # ------------------------------------------------------------ the MDR line of a large scan
 
 
-def full_plane_line_powers(heights, spacing):
-    """The MDR line's mode powers from every mode of the reflected map at once (fft2)."""
+def full_plane_line_powers(heights, spacing, periodic):
+    """The MDR line's mode powers from every mode of the (reflected, unless periodic) map at once (fft2)."""
     from frictionlab_spectra.equivalent_line import line_grid, line_mode_powers
 
-    extended = np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
+    extended = heights if periodic else np.block([[heights, heights[:, ::-1]], [heights[::-1, :], heights[::-1, ::-1]]])
     ny, nx = extended.shape
     power = np.abs(np.fft.fft2(extended)) ** 2
     power[0, 0] = 0.0
@@ -317,8 +317,8 @@ def full_plane_line_powers(heights, spacing):
     return line_mode_powers(wavenumber, power, points, line_spacing)
 
 
-@pytest.mark.parametrize("shape", [(384, 512), (301, 257)])
-def test_the_mdr_line_of_a_scan_is_built_in_half_the_memory_with_the_same_modes(tmp_path, monkeypatch, shape):
+@pytest.mark.parametrize("shape, periodic", [((384, 512), False), ((301, 257), False), ((301, 257), True)])
+def test_the_mdr_line_of_a_scan_is_built_in_half_the_memory_with_the_same_modes(tmp_path, monkeypatch, shape, periodic):
     """Every mode of the reflected map at once, the line's allocations peaked at 250 to 310 bytes
     per point of the map (tracemalloc): a 4096 x 2048 scan, ordinary for an AFM, ran out of
     memory under ulimit -v 2 GiB. Half the plane (the map is real), a block of rows at a time,
@@ -331,7 +331,7 @@ def test_the_mdr_line_of_a_scan_is_built_in_half_the_memory_with_the_same_modes(
     monkeypatch.setattr(surface_file, "MODES_PER_BLOCK", 2**14, raising=False)
     z = rough(*shape, seed=11)
     np.save(tmp_path / "scan.npy", z)
-    surface = SurfaceFile(path=str(tmp_path / "scan.npy"), spacing=0.5)
+    surface = SurfaceFile(path=str(tmp_path / "scan.npy"), spacing=0.5, periodic=periodic)  # odd sides unreflected
     heights = surface.generate(None).heights
     tracemalloc.start()
     try:
@@ -339,7 +339,7 @@ def test_the_mdr_line_of_a_scan_is_built_in_half_the_memory_with_the_same_modes(
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
-    expected = full_plane_line_powers(heights, 0.5)
+    expected = full_plane_line_powers(heights, 0.5, periodic)
     np.testing.assert_allclose(line.params.mode_power, expected, rtol=1e-9, atol=1e-12 * expected.max())
     assert peak < 160 * z.size, f"{peak / z.size:.0f} bytes per point"
 
