@@ -354,16 +354,42 @@ def test_a_line_whose_height_is_mostly_a_tilt_says_so_as_a_map_does(tmp_path):
     z = np.cumsum(rough(1, 300, 12)[0]) * 1e-3 + 0.01 * x
     (tmp_path / "line.csv").write_text("x,z\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)))
     summary = ProfileFile(path=str(tmp_path / "line.csv")).input_summary()
-    coefficients, *_ = np.linalg.lstsq(np.stack([np.ones_like(x), x], axis=1), z, rcond=None)
-    share = 1.0 - np.var(z - coefficients[0] - coefficients[1] * x) / np.var(z)  # independent: least squares
+    share = 1.0 - np.var(z - np.polyval(np.polyfit(x, z, 2), x)) / np.var(z)  # independent: least squares
     assert share > 0.5
     assert summary["detrend"] == "mean" and summary["caveats"] == [
         f"a tilt carries {100 * share:.1f} % of the line's height variance (detrend: mean): the contact sits where "
-        "the tilt or the form puts it, not on the roughness; detrend: tilt levels it"
+        "the tilt or the form puts it, not on the roughness; detrend: tilt (or quadratic) levels it"
     ]
     assert "caveats" not in ProfileFile(path=str(tmp_path / "line.csv"), detrend="tilt").input_summary()
     (tmp_path / "level.csv").write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z - 0.01 * x)))
     assert "caveats" not in ProfileFile(path=str(tmp_path / "level.csv")).input_summary()
+
+
+def test_a_bowed_line_is_levelled_by_detrend_quadratic_and_a_curvature_left_in_is_said(tmp_path):
+    """A bowed scan (a parabola over the roughness): detrend: tilt leaves the bow and says so,
+    naming its share of the levelled variance; detrend: quadratic removes the least-squares
+    parabola (checked against numpy's polyfit) and says nothing. profile-file had no quadratic
+    detrend, so a bowed line could not be levelled."""
+    x = np.arange(400) * 0.25
+    z = rough(1, 400, 15)[0] + 3e-3 * (x - 37.0) ** 2  # the bow: most, not all, of the variance
+    (tmp_path / "bowed.csv").write_text("x,z\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    path = str(tmp_path / "bowed.csv")
+    tilted = ProfileFile(path=path, detrend="tilt").input_summary()
+    after_tilt = z - np.polyval(np.polyfit(x, z, 1), x)
+    after_bow = z - np.polyval(np.polyfit(x, z, 2), x)
+    share = 1.0 - np.var(after_bow) / np.var(after_tilt)
+    assert 0.5 < share < 0.95
+    assert tilted["caveats"] == [
+        f"a curvature carries {100 * share:.1f} % of the levelled line's height variance: the contact sits where the "
+        "form puts it; detrend: quadratic removes it, if it is not the surface's own shape"
+    ]
+    levelled = ProfileFile(path=path, detrend="quadratic")
+    assert "caveats" not in levelled.input_summary()
+    np.testing.assert_allclose(levelled.generate(None).heights, after_bow, rtol=0, atol=1e-12)
+    assert levelled.input_summary()["rms_height"] == pytest.approx(np.std(after_bow), rel=1e-12)
+    mean_only = ProfileFile(path=path).input_summary()["caveats"][0]  # tilt and bow left: their joint share
+    joint = 1.0 - np.var(after_bow) / np.var(z)
+    assert 0.5 < joint < 0.99 and f"carries {100 * joint:.1f} % of the line's height variance (detrend: mean)" in mean_only
 
 
 def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):

@@ -39,7 +39,7 @@ from .instrument_file import (
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import line_tilt_warning
+from .scan_shaping import line_form_warning
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -65,9 +65,9 @@ class ProfileFile(MeasuredFile):
             "with its x otherwise; for an instrument file it replaces the file's spacing",
             gt=0.0,
         )
-        detrend: Literal["none", "mean", "tilt"] | None = Field(
-            None, description="remove nothing, the mean, or the least-squares line (tilt) before use; default: tilt "
-            "for an instrument file (a scan is rarely level), mean for a table",
+        detrend: Literal["none", "mean", "tilt", "quadratic"] | None = Field(
+            None, description="remove nothing, the mean, the least-squares line (tilt) or parabola (quadratic: a bowed "
+            "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table",
         )
 
     # ------------------------------------------------------------ contract
@@ -157,7 +157,7 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        if (caveat := line_tilt_warning(z, mode)) is not None:  # as a map's (map_pipeline.shape_map)
+        if (caveat := line_form_warning(z, mode)) is not None:  # as a map's (map_pipeline.shape_map)
             summary["caveats"] = [caveat]
         return Measured(heights, float(dx), rms, periodic, summary)
 
@@ -369,8 +369,12 @@ def _detrend(z: np.ndarray, mode: str) -> np.ndarray:
     if mode == "none":
         return z.copy()
     out = remove_mean(z)
-    if mode == "tilt":
+    if mode in ("tilt", "quadratic"):
         t = np.arange(z.size, dtype=np.float64)
         t -= t.mean()
         out -= (np.dot(t, out) / np.dot(t, t)) * t  # least-squares slope (t and out are centred)
+        if mode == "quadratic" and z.size > 2:  # t^2 less its mean is orthogonal to 1 and t: one more projection
+            s = t * t
+            s -= s.mean()
+            out -= (np.dot(s, out) / np.dot(s, s)) * s
     return out

@@ -87,16 +87,29 @@ def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     return None
 
 
-def line_tilt_warning(z: np.ndarray, mode: str) -> str | None:
-    """The caveat of a line (as read) whose height is mostly a tilt that ``mode`` (none, mean)
-    leaves in it: the least-squares slope's share of the variance about the mean."""
-    if mode not in ("none", "mean"):
+def line_form_warning(z: np.ndarray, mode: str) -> str | None:
+    """The caveat of a line (as read) whose height is mostly a form that ``mode`` leaves in
+    it: a tilt and a curvature (none, mean) or a curvature (tilt), the least-squares terms'
+    share of the variance about the mean (of the variance about the line, after a tilt)."""
+    if mode not in ("none", "mean", "tilt"):
         return None
-    t, _ = _axis(z.size)
+    t, t2 = _axis(z.size)
     centred = z - np.mean(z)
     variance = float(np.dot(centred, centred))
-    share = float(np.dot(t, centred)) ** 2 / (float(np.dot(t, t)) * variance) if variance > 0 else 0.0
-    return _form_kept("a tilt", share, "line", mode, "detrend: tilt levels it") if share > MOST else None
+    if not variance > 0:
+        return None
+    tilt = float(np.dot(t, centred)) ** 2 / float(np.dot(t, t)) / variance
+    curvature = float(np.dot(t2, centred)) ** 2 / float(np.dot(t2, t2)) / variance if z.size > 2 else 0.0
+    if mode == "tilt":
+        if curvature > MOST * (1 - tilt):
+            return (f"a curvature carries {100 * curvature / (1 - tilt):.1f} % of the levelled line's height "
+                    "variance: the contact sits where the form puts it; detrend: quadratic removes it, if it is "
+                    "not the surface's own shape")  # fmt: skip
+        return None
+    if tilt + curvature <= MOST:
+        return None
+    part = "a tilt" if tilt >= curvature else "a curvature"
+    return _form_kept(part, tilt + curvature, "line", mode, "detrend: tilt (or quadratic) levels it")
 
 
 def _form_kept(part: str, share: float, what: str, mode: str, remedy: str) -> str:
