@@ -412,3 +412,37 @@ def test_a_table_under_a_suffix_of_no_format_is_told_format_table(tmp_path):
         SurfaceFile(path=str(tmp_path / "map.tsv"), spacing=0.1).rms_height()
     read = SurfaceFile(path=str(tmp_path / "map.tsv"), spacing=0.1, format="table", detrend="none").generate(None)
     np.testing.assert_allclose(read.heights, z, rtol=0, atol=1e-9)
+
+
+# ------------------------------------------------------------ a text export's header units
+
+
+def write_xyz(path, z, pixel, header: bytes) -> None:
+    """An x, y, z text export of the map z[y, x] on square pixels, under ``header``."""
+    rows = "".join(f"{i * pixel!r}\t{j * pixel!r}\t{float(z[j, i])!r}\n" for j in range(z.shape[0]) for i in range(z.shape[1]))
+    path.write_bytes(header + rows.encode())
+
+
+@pytest.mark.parametrize("header", [
+    "# x [µm]\ty [µm]\tz [nm]\n".encode(), b"x (um), y (um), z (nm)\n", b"# x/mm y/mm z/um\n",
+])  # fmt: skip
+def test_a_text_export_whose_header_names_two_length_units_is_refused(tmp_path, header):
+    """SurfaceTopography's XYZ reader skips the header: lateral positions in µm and heights in nm
+    were read as bare numbers in one unit, every slope a thousand times off, and the scan said
+    'no unit (bare numbers)' only. Refused, naming the units; one unit for all is read."""
+    z = rough(8, 9, 16)
+    write_xyz(tmp_path / "scan.xyz", z, 0.5, header)
+    with pytest.raises(ValueError, match=r"its header names the length units (um, nm|mm, um), .* convert the columns"):
+        SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
+    write_xyz(tmp_path / "same.xyz", z, 0.5, header.replace(b"nm", b"um").replace(b"z/um", b"z/mm"))
+    read = SurfaceFile(path=str(tmp_path / "same.xyz"), detrend="none").generate(None)
+    np.testing.assert_allclose(read.heights, z, rtol=0, atol=1e-12)
+    assert read.spacing == pytest.approx(0.5, rel=1e-12)
+
+
+def test_a_text_export_in_latin_1_is_told_to_be_saved_as_utf_8(tmp_path):
+    """An export whose header is Latin-1 (its "\\xb5m") failed in the reader and was called a
+    damaged file, to be copied again from the instrument, which no copy mends."""
+    write_xyz(tmp_path / "scan.xyz", rough(8, 9, 17), 0.5, "# x [\xb5m]\ty [\xb5m]\tz [\xb5m]\n".encode("latin-1"))
+    with pytest.raises(ValueError, match="a text export that is not UTF-8 .* save it as UTF-8"):
+        SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()

@@ -25,7 +25,7 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_points, check_payload, choose_reader, describe_failure, pick_channel,
+    channel_list, check_declared_points, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
 )
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -175,6 +175,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
         check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
+        check_header_units(fh, type(reader), file_unit, where)
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")
         try:

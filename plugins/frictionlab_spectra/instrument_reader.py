@@ -95,6 +95,44 @@ def check_zip_members(fh, reader, where: str) -> None:
 X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int16, int32, float32, float64
 
 
+HEADER_BYTES = 4096  # of a text export read for the units its header names
+_LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "mm": "mm", "cm": "cm", "m": "m"}
+_UNIT_TOKEN = re.compile(r"[\[(/]\s*(pm|nm|um|\u00b5m|\u03bcm|mm|cm|m)\s*(?=[\])\s,;]|$)")
+_NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")
+
+
+def header_units(fh, reader) -> list[str]:
+    """The length units the header of a text export names (``x [\u00b5m]``, ``z (nm)``, ``z/nm``),
+    in order, from the lines before its first row of numbers; empty for a binary format."""
+    if reader.format() not in TEXT_FORMATS:
+        return []
+    fh.seek(0)
+    head = fh.read(HEADER_BYTES)
+    fh.seek(0)
+    text = head.decode("utf-8", errors="replace")  # the reader has read it as UTF-8
+    units = []
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
+        if _NUMBERS.match(line):
+            break
+        units += [_LENGTH_UNIT[token] for token in _UNIT_TOKEN.findall(line)]
+    return units
+
+
+def check_header_units(fh, reader, file_unit: str | None, where: str) -> None:
+    """Refuse a text export whose header names different length units (``x [\u00b5m]``, ``z
+    [nm]``) that its reader does not read: the heights and the pixel would be taken as bare
+    numbers in one unit, every slope off by their ratio, without a word."""
+    units = header_units(fh, reader)
+    if file_unit is not None or len(set(units)) < 2:
+        return
+    named = ", ".join(dict.fromkeys(units))
+    raise ValueError(
+        f"{where}: its header names the length units {named}, which SurfaceTopography's {reader.name()} reader "
+        "does not read: the heights and the pixel would be taken as bare numbers in one unit, the slopes off by "
+        "their ratio; convert the columns to one length unit"
+    )
+
+
 def check_payload(fh, reader, where: str) -> None:
     """Refuse an X3P whose binary heights are not the size its main.xml declares (points times
     the bytes of its data type): SurfaceTopography's reader takes the first points it needs, so
@@ -175,6 +213,9 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
             f"{where}: the {name} file does not state its physical size; give spacing (the pixel side, in the "
             "run's length unit), or export the scan with its pixel size"
         )
+    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS:
+        return ValueError(f"{where}: a text export that is not UTF-8 (a header in Latin-1: its µ?), which "
+                          f"SurfaceTopography's {name} reader does not read; save it as UTF-8")  # fmt: skip
     if isinstance(exc, MemoryError):
         return ValueError(f"{where}: the {name} file declares more points than this process can hold; "
                           "crop it with the instrument's software")  # fmt: skip
