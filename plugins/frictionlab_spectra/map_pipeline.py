@@ -22,7 +22,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from . import instrument_reader
-from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points
+from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points, spike_warning
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 FileFormat = Literal["auto", "table", "instrument"]
@@ -115,6 +115,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
     if (warning := levelling_warning(levelled, mode)) is not None:
+        caveats.append(warning)
+    if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after)) is not None:
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel

@@ -147,6 +147,42 @@ def resampled_points(n: int, step: float, new_step: float) -> int:
 MAX_SPIKE_FRACTION = 0.05  # despike replaces at most this share of a map's points
 
 
+SPIKE_K = 6.0  # rms heights above the median around it: what despike's usual value calls a spike
+SPIKE_LOOKED_AT = 16  # the highest points looked at for spikes: those that carry the first contact
+
+
+def spike_warning(z: np.ndarray, rms: float) -> str | None:
+    """The caveat of a map (levelled, not despiked) among whose SPIKE_LOOKED_AT highest points
+    some stand more than SPIKE_K ``rms`` above the median of the 5 x 5 pixels around them
+    (edges reflected, as ``despike`` reads them): spikes take the first contact alone, and
+    ``despike: 6`` would replace exactly them. Only the highest points are looked at (cheap on
+    any map), those above 3 rms: a spike lower than that touches no earlier than the surface."""
+    if not rms > 0 or min(z.shape) < 3:
+        return None
+    high = np.flatnonzero(z > 3.0 * rms)  # a boolean of the map, the indices of its tallest points
+    if high.size > SPIKE_LOOKED_AT:
+        high = high[np.argpartition(z.ravel()[high], high.size - SPIKE_LOOKED_AT)[-SPIKE_LOOKED_AT:]]
+    ny, nx = z.shape
+    spikes = 0
+    for index in high:
+        row, column = divmod(int(index), nx)
+        rows = [_reflect(r, ny) for r in range(row - 2, row + 3)]
+        columns = [_reflect(c, nx) for c in range(column - 2, column + 3)]
+        if z[row, column] - np.median(z[np.ix_(rows, columns)]) > SPIKE_K * rms:
+            spikes += 1
+    if not spikes:
+        return None
+    return (f"{spikes} of the map's {max(high.size, SPIKE_LOOKED_AT)} highest points stand more than {SPIKE_K:g} rms "
+            "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
+            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
+            "they are not the surface's own")  # fmt: skip
+
+
+def _reflect(i: int, n: int) -> int:
+    """Index ``i`` on ``n`` points with the edges reflected (d c b a | a b c d), scipy's ``reflect``."""
+    return -i - 1 if i < 0 else 2 * n - i - 1 if i >= n else i
+
+
 def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     """``z`` with every point more than ``k`` ``rms`` from the median of the 5 x 5 pixels around
     it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
