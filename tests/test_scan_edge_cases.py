@@ -300,6 +300,34 @@ def test_an_x3p_whose_heights_are_not_the_size_it_declares_is_refused(tmp_path, 
         SurfaceFile(path=str(path)).rms_height()
 
 
+def test_an_x3p_whose_heights_are_not_the_bytes_its_checksum_declares_is_refused(tmp_path):
+    """One byte changed in the heights (a damaged copy; the heights still finite) was read
+    without a word: SurfaceTopography's reader does not check the MD5 checksum main.xml gives.
+    The same file with its checksum mended, or with none declared, is read."""
+    import hashlib
+    import zipfile
+
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+
+    def flipped(payload: bytes) -> bytes:  # the lowest mantissa byte of the first height: still finite
+        return bytes([payload[0] ^ 0x01]) + payload[1:]
+
+    damaged = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "damaged.x3p", data=flipped)
+    with pytest.raises(ValueError, match=r"a damaged .* file: its binary heights' MD5 checksum is [0-9a-f]{32}, and "
+                                         r"its description declares [0-9a-f]{32}; copy it again"):  # fmt: skip
+        SurfaceFile(path=str(damaged)).rms_height()
+    payload = flipped(zipfile.ZipFile(tmp_path / "good.x3p").read("bindata/data.bin"))
+    mended = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "mended.x3p", data=flipped, xml=lambda text: re.sub(
+        rb"(<MD5ChecksumPointData>)[0-9a-fA-F]+", rb"\g<1>" + hashlib.md5(payload).hexdigest().upper().encode(), text))
+    unsigned = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "unsigned.x3p", data=flipped,
+                             xml=lambda text: re.sub(rb"<MD5ChecksumPointData>[^<]*</MD5ChecksumPointData>", b"", text))
+    for path in (mended, unsigned):
+        assert 0 < SurfaceFile(path=str(path)).rms_height() < 1e-5
+
+
 # ------------------------------------------------------------ the MDR line of a large scan
 
 

@@ -135,31 +135,48 @@ def check_header_units(fh, reader, file_unit: str | None, where: str) -> None:
 
 def check_payload(fh, reader, where: str) -> None:
     """Refuse an X3P whose binary heights are not the size its main.xml declares (points times
-    the bytes of its data type): SurfaceTopography's reader takes the first points it needs, so
-    a payload longer than declared, or of another type (doubles declared as floats: heights of
-    1e37), was read without a word. Other formats, an X3P with its heights in the XML, or one
-    whose description this cannot follow, are left to the reader. After ``check_declared_points``:
-    a map declared too large is refused as such, whatever its payload."""
+    the bytes of its data type), or not the bytes its MD5 checksum declares: SurfaceTopography's
+    reader checks neither, so a payload longer than declared, of another type (doubles declared
+    as floats: heights of 1e37), or damaged in copying, was read without a word. Other formats,
+    an X3P with its heights in the XML, or one whose description this cannot follow, are left to
+    the reader. After ``check_declared_points``: a map declared too large is refused as such,
+    whatever its payload."""
+    import hashlib
     import xml.etree.ElementTree as ElementTree
 
     if reader.format() != "x3p":
         return
+    found = None
     try:
         with zipfile.ZipFile(fh) as archive:
             root = ElementTree.fromstring(archive.read("main.xml"))  # at most XML_LIMIT (check_zip_members)
             kind = root.findtext("Record1/Axes/CZ/DataType", "").strip()
             points = math.prod(int(root.findtext(f"Record3/MatrixDimension/Size{axis}", "")) for axis in "XYZ")
-            stored = archive.getinfo(root.findtext("Record3/DataLink/PointDataLink", "").strip()).file_size
+            link = root.findtext("Record3/DataLink/PointDataLink", "").strip()
+            stored = archive.getinfo(link).file_size
+            checksum = root.findtext("Record3/DataLink/MD5ChecksumPointData", "").strip().lower()
+            sized = kind not in X3P_ITEM_BYTES or stored == points * X3P_ITEM_BYTES[kind]
+            if sized and re.fullmatch(r"[0-9a-f]{32}", checksum):
+                digest = hashlib.md5(usedforsecurity=False)
+                with archive.open(link) as member:  # in blocks: no second copy of the heights
+                    for block in iter(lambda: member.read(1 << 20), b""):
+                        digest.update(block)
+                found = digest.hexdigest()
     except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile, ElementTree.ParseError):
         return
     finally:
         fh.seek(0)
-    if kind in X3P_ITEM_BYTES and stored != points * X3P_ITEM_BYTES[kind]:
+    if not sized:
         declared = points * X3P_ITEM_BYTES[kind]
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights take {stored} bytes, and its description "
             f"declares {points} points of data type {kind} ({X3P_ITEM_BYTES[kind]} bytes each: {declared} bytes); "
             "copy it again from the instrument, or export it from there again"
+        )
+    if found is not None and found != checksum:
+        raise ValueError(
+            f"{where}: a damaged {reader.name()} file: its binary heights' MD5 checksum is {found}, and its "
+            f"description declares {checksum}; copy it again from the instrument, or export it from there again"
         )
 
 
