@@ -241,6 +241,22 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     )
 
 
+def scan_summary(scan: Scan, p) -> dict:
+    """What an input summary says of a scan read from an instrument file, and of where each of
+    its settings came from (``p``: the measured plugin's parameters)."""
+    same = all(side == scan.pixel[0] for side in scan.pixel)
+    return {
+        "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
+        **({"channel_note": scan.channel_note} if scan.channel_note else {}),
+        **({"channels": scan.channels} if scan.channels else {}),
+        "file_spacing": None if not scan.pixel_stated else scan.pixel[0] if same else list(scan.pixel),
+        "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
+        "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
+        "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
+        "periodic_from": "file" if p.periodic is None else "preset",
+    }  # fmt: skip
+
+
 def _line_axis(topography, dimension: int) -> int | None:
     """The axis (0: x, 1: y) of a line an instrument stored as a map one pixel wide, read by
     ``profile-file``; None for any other scan."""

@@ -35,7 +35,7 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header,
+    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
@@ -105,16 +105,7 @@ class ProfileFile(MeasuredFile):
             scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined, channel=p.channel,
                              spacing_given=p.spacing is not None)  # fmt: skip
             x, z = None, scan.heights
-            summary = {
-                "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
-                **({"channel_note": scan.channel_note} if scan.channel_note else {}),
-                **({"channels": scan.channels} if scan.channels else {}),
-                "file_spacing": scan.pixel[0] if scan.pixel_stated else None,
-                "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
-                "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
-                "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
-                "periodic_from": "file" if p.periodic is None else "preset",
-            }  # fmt: skip
+            summary = scan_summary(scan, p)
             periodic = scan.periodic if p.periodic is None else p.periodic
         else:
             x, z = _read_columns(path)

@@ -48,7 +48,7 @@ from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, is_instrument_file, read_scan, scan_header,
+    ScanHeader, is_instrument_file, read_scan, scan_header, scan_summary,
 )
 from .map_pipeline import Downsample, Level, Region, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
@@ -231,17 +231,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined, channel=p.channel,
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
-        summary = {
-            "format": scan.format, "channel": scan.channel, "channel_index": scan.channel_index,
-            **({"channel_note": scan.channel_note} if scan.channel_note else {}),
-            **({"channels": scan.channels} if scan.channels else {}),
-            "file_spacing": None if not scan.pixel_stated else scan.pixel[0] if scan.pixel[0] == scan.pixel[1]
-            else list(scan.pixel),
-            "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
-            "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
-            "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
-            "periodic_from": "file" if p.periodic is None else "preset",
-        }  # fmt: skip
+        summary = scan_summary(scan, p)
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         if p.spacing is None:
