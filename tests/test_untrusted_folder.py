@@ -361,3 +361,28 @@ def test_the_tui_preset_list_shows_a_fifo_as_unreadable_without_blocking(tmp_pat
     listed = []
     assert with_timeout(lambda: listed.extend(list_presets([("presets", tmp_path)]))) is None
     assert [(e.name, bool(e.error)) for e in listed] == [("good", False), ("pipe", True)]
+
+
+@pytest.mark.parametrize("kind", ["run", "sweep"])
+def test_resume_of_a_folder_whose_stored_preset_is_not_valid_is_a_run_folder_error(tmp_path, capsys, kind):
+    """A value edited in the preset stored in a run folder (preset.yaml, or a sweep.json's base preset)
+    ended a resume as a command-line error (exit code 2); it is the folder that cannot be resumed (5)."""
+    folder = tmp_path / "run"
+    data = QUICK if kind == "run" else {**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(data))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    if kind == "run":
+        stored = folder / "preset.yaml"
+        stored.write_text(stored.read_text().replace("realizations: 4", "realizations: -4"))
+    else:
+        stored = folder / "sweep.json"
+        record = json.loads(stored.read_text())
+        record["base_preset"]["realizations"] = -4
+        stored.write_text(json.dumps(record))
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", "--json"]) == ExitCode.RUN_FOLDER
+    captured = capsys.readouterr()
+    assert "realizations: must be >= 1, got -4" in captured.err
+    assert f"{folder} cannot be resumed: the preset stored there is not valid here" in captured.err
+    assert json.loads(captured.out)["field"] == "realizations"
