@@ -386,3 +386,6 @@ def test_resume_of_a_folder_whose_stored_preset_is_not_valid_is_a_run_folder_err
     assert "realizations: must be >= 1, got -4" in captured.err
     assert f"{folder} cannot be resumed: the preset stored there is not valid here" in captured.err
     assert json.loads(captured.out)["field"] == "realizations"
+    if kind == "sweep":  # following it plans its points from the same stored preset
+        assert main(["follow", str(folder), "--quiet"]) == ExitCode.RUN_FOLDER
+        assert f"{folder} cannot be followed: the preset stored there is not valid here" in capsys.readouterr().err

@@ -43,20 +43,20 @@ def run(args) -> ExitCode:
         args.preset = str(run_dir / "sweep.json")
         data, options = stored_sweep(run_dir), executor_run_options(args, resume=True)
         if args.detach:
-            return _stored(run_dir, lambda: run_command.detach(args, data, build_scene(data), run_dir, options))
-        return _stored(run_dir, lambda: run_command.run_sweep_into(args, data, run_dir, options))
+            return stored_run(run_dir, lambda: run_command.detach(args, data, build_scene(data), run_dir, options))
+        return stored_run(run_dir, lambda: run_command.run_sweep_into(args, data, run_dir, options))
     RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
     args.preset = str(run_dir / PRESET_FILE)
-    return _stored(run_dir, lambda: run_command.run(args))
+    return stored_run(run_dir, lambda: run_command.run(args))
 
 
-def _stored(run_dir: Path, start) -> ExitCode:
-    """``start()``, the run or sweep stored in ``run_dir``: a preset stored there that is not
+def stored_run(run_dir: Path, start, doing: str = "resumed"):
+    """``start()``, on the run or sweep stored in ``run_dir``: a preset stored there that is not
     valid (a value edited, a plugin not installed here) refuses the folder (exit code 5), as a
     damaged manifest does, not the command line (2); the problems are named as any preset's."""
     try:
         return start()
     except PresetError as exc:
-        refused = RunFolderError(f"{exc}\n{run_dir} cannot be resumed: the preset stored there is not valid here")
+        refused = RunFolderError(f"{exc}\n{run_dir} cannot be {doing}: the preset stored there is not valid here")
         refused.problems = exc.problems
         raise refused from None
