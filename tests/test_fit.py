@@ -175,18 +175,21 @@ def test_a_fit_runs_blas_on_its_own_thread_only_and_leaves_the_limit_as_it_was()
     np.testing.assert_allclose([fit.a, fit.b, *fit.a_ci, *fit.b_ci], [plain.a, plain.b, *plain.a_ci, *plain.b_ci], rtol=1e-12)
 
 
-@pytest.mark.parametrize("averaged", [False, True])
-def test_the_bootstrap_forms_its_counts_a_block_at_a_time_with_the_draws_of_one_call(monkeypatch, averaged):
-    """The counts of every resample and realization (B x M int64) were formed at once, after the run:
-    a bootstrap of 100,000 over 10,000 realizations needed 7.5 GiB and failed there under a 2 GiB limit.
-    They now come in blocks (of a 1 MiB budget here), the same draws as one call, the same pairs."""
+@pytest.mark.parametrize(("averaged", "realizations", "forces"), [(False, 2000, 12), (True, 2000, 12), (True, 20, 2000)])
+def test_the_bootstrap_forms_its_counts_a_block_at_a_time_with_the_draws_of_one_call(
+    monkeypatch, averaged, realizations, forces
+):
+    """The counts of every resample and realization (B x M int64), and under an average each resample's
+    curve (B x forces), were formed at once, after the run: a bootstrap of 100,000 over 10,000
+    realizations needed 7.5 GiB and failed there under a 2 GiB limit. They now come in blocks (of a
+    1 MiB budget here), the same draws as one call, the same pairs."""
     import tracemalloc
 
     from frictionlab.compute import fit
 
     monkeypatch.setattr(fit, "BOOTSTRAP_BLOCK_BYTES", 2**20, raising=False)
-    realizations, resamples = 2000, 1000  # counts drawn whole: 16 MB, and as much again in float
-    f = np.geomspace(1e-3, 1e-1, 12)
+    resamples = 1000  # drawn whole: 16 MB of counts or curves, and as much again in float
+    f = np.geomspace(1e-3, 1e-1, forces)
     xi = np.random.default_rng(0).normal(0.5, 0.1, size=(realizations, f.size))
     average = (lambda weights: defined_mean(xi, weights)) if averaged else None
     tracemalloc.start()

@@ -23,8 +23,9 @@ import numpy as np
 NAN2 = (math.nan, math.nan)
 
 BOOTSTRAP_BLOCK_BYTES = 64 * 2**20
-"""The most bytes of bootstrap counts (resamples x realizations, int64) formed at once: a bootstrap
-of 100,000 over 10,000 realizations drawn whole took 7.5 GiB after the run, and failed there."""
+"""The most bytes of bootstrap counts (resamples x realizations, int64), or of resampled curves
+(resamples x forces), formed at once: a bootstrap of 100,000 over 10,000 realizations drawn whole
+took 7.5 GiB after the run, and failed there."""
 
 Average = Callable[[np.ndarray | None], np.ndarray]
 """``average(weights)``: the curve xi(f) averaged over realizations with ``weights``
@@ -220,7 +221,8 @@ def bootstrap_coefficients(
     realizations = xi_per_realization.shape[0]
     projector = np.linalg.pinv(_design(np.asarray(f, float)))  # (2, n_forces)
     per_realization = xi_per_realization @ projector.T if average is None else None  # (M, 2)
-    rows = max(1, BOOTSTRAP_BLOCK_BYTES // (8 * realizations))  # the counts of this many resamples at once
+    widest = realizations if average is None else max(realizations, projector.shape[1])  # counts, or curves
+    rows = max(1, BOOTSTRAP_BLOCK_BYTES // (8 * widest))  # this many resamples at once
     pairs = []
     for start in range(0, bootstrap, rows):  # the draws of one call of size=bootstrap, block by block
         counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=min(rows, bootstrap - start))
