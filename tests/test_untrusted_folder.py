@@ -389,3 +389,25 @@ def test_resume_of_a_folder_whose_stored_preset_is_not_valid_is_a_run_folder_err
     if kind == "sweep":  # following it plans its points from the same stored preset
         assert main(["follow", str(folder), "--quiet"]) == ExitCode.RUN_FOLDER
         assert f"{folder} cannot be followed: the preset stored there is not valid here" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["summary.json", "curve.csv", "realizations.npz"])
+def test_a_result_file_that_is_a_folder_refuses_the_run_before_any_work(tmp_path, capsys, name):
+    """The run computed every realization, then failed to write over the folder (exit code 1, the status
+    left 'running'); it is refused before anything runs, naming the folder: exit code 5 for a resume,
+    4 for a run into the folder."""
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    (folder / name).unlink()
+    (folder / name).mkdir()
+    (folder / name / "mine.txt").write_text(SECRET)
+    manifest = (folder / "run.json").read_bytes()
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", "--workers", "1"]) == ExitCode.RUN_FOLDER
+    assert f"{folder / name} is a folder, not a file: the run writes its {name} there" in capsys.readouterr().err
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OUTPUT_REFUSED
+    assert f"{folder / name} is a folder, not a file" in capsys.readouterr().err
+    assert (folder / "run.json").read_bytes() == manifest  # nothing started: the status is still 'completed'
+    assert (folder / name / "mine.txt").read_text() == SECRET
