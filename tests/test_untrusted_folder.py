@@ -411,3 +411,20 @@ def test_a_result_file_that_is_a_folder_refuses_the_run_before_any_work(tmp_path
     assert f"{folder / name} is a folder, not a file" in capsys.readouterr().err
     assert (folder / "run.json").read_bytes() == manifest  # nothing started: the status is still 'completed'
     assert (folder / name / "mine.txt").read_text() == SECRET
+
+
+@pytest.mark.parametrize("detach", [False, True])
+def test_resume_of_a_sweep_whose_sweep_json_disagrees_with_itself_is_a_run_folder_error(tmp_path, capsys, detach):
+    """Its name edited: the resume was refused as 'another sweep' with exit code 4 and the advice to
+    force it, which resume has no option for; the folder is what cannot be resumed (5)."""
+    folder = tmp_path / "sweep"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps({**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    record = json.loads((folder / "sweep.json").read_text())
+    (folder / "sweep.json").write_text(json.dumps({**record, "name": "another-name"}))
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", *(["--detach"] if detach else [])]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"{folder / 'sweep.json'} is damaged: its name, sweep and base preset are not those of one sweep" in err
+    assert "--force" not in err
