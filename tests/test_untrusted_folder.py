@@ -428,3 +428,18 @@ def test_resume_of_a_sweep_whose_sweep_json_disagrees_with_itself_is_a_run_folde
     err = capsys.readouterr().err
     assert f"{folder / 'sweep.json'} is damaged: its name, sweep and base preset are not those of one sweep" in err
     assert "--force" not in err
+
+
+def test_predict_from_a_sweeps_folder_names_it_as_one_and_where_its_points_laws_are(tmp_path, capsys):
+    """It said only 'no such summary.json', of a folder the user had just run; a sweep's folder holds a law
+    per point, and the message says where they are."""
+    folder = tmp_path / "sweep"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps({**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    capsys.readouterr()
+    assert main([*PREDICT, "--from", str(folder)]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"--from {folder} is a sweep's folder, which holds a law per point" in err
+    assert f"frictionlab runs {folder / 'points'} lists them" in err
+    assert main([*PREDICT, "--from", str(folder / "points" / "01-seed-1")]) == ExitCode.OK
