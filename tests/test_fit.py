@@ -173,3 +173,33 @@ def test_a_fit_runs_blas_on_its_own_thread_only_and_leaves_the_limit_as_it_was()
     assert blas_threads() == before  # restored for the rest of the program
     plain = fit_log_law(f, xi, bootstrap=200, rng=np.random.default_rng(4))
     np.testing.assert_allclose([fit.a, fit.b, *fit.a_ci, *fit.b_ci], [plain.a, plain.b, *plain.a_ci, *plain.b_ci], rtol=1e-12)
+
+
+@pytest.mark.parametrize(("averaged", "realizations", "forces"), [(False, 2000, 12), (True, 2000, 12), (True, 20, 2000)])
+def test_the_bootstrap_forms_its_counts_a_block_at_a_time_with_the_draws_of_one_call(
+    monkeypatch, averaged, realizations, forces
+):
+    """The counts of every resample and realization (B x M int64), and under an average each resample's
+    curve (B x forces), were formed at once, after the run: a bootstrap of 100,000 over 10,000
+    realizations needed 7.5 GiB and failed there under a 2 GiB limit. They now come in blocks (of a
+    1 MiB budget here), the same draws as one call, the same pairs."""
+    import tracemalloc
+
+    from frictionlab.compute import fit
+
+    monkeypatch.setattr(fit, "BOOTSTRAP_BLOCK_BYTES", 2**20, raising=False)
+    resamples = 1000  # drawn whole: 16 MB of counts or curves, and as much again in float
+    f = np.geomspace(1e-3, 1e-1, forces)
+    xi = np.random.default_rng(0).normal(0.5, 0.1, size=(realizations, f.size))
+    average = (lambda weights: defined_mean(xi, weights)) if averaged else None
+    tracemalloc.start()
+    try:
+        pairs = fit.bootstrap_coefficients(f, xi, resamples, np.random.default_rng(3), average)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 6 * 2**20, peak
+    counts = np.random.default_rng(3).multinomial(realizations, np.full(realizations, 1 / realizations), size=resamples)
+    projector = np.linalg.pinv(np.column_stack([np.ones(f.size), np.log(f)]))
+    whole = (defined_mean(xi, counts) if averaged else counts @ xi / realizations) @ projector.T
+    np.testing.assert_allclose(pairs, whole, rtol=1e-10, atol=1e-13)

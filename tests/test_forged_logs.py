@@ -296,8 +296,9 @@ def test_resume_detach_of_a_sweep_whose_point_folder_is_a_link_writes_nothing_ou
     points = tmp_path / "points-elsewhere"
     points.mkdir()
     shutil.rmtree(out / "points")
-    (out / "points").symlink_to(points)  # the level above: points/ itself
-    run_sweep(sweep, out, RunOptions(workers=1, resume=True), plot=False)
+    (out / "points").symlink_to(points)  # the level above: points/ itself refuses the whole sweep
+    with pytest.raises(RunFolderError, match="points is a symbolic link or not a folder"):
+        run_sweep(sweep, out, RunOptions(workers=1, resume=True), plot=False)
     assert list(points.iterdir()) == []
 
 

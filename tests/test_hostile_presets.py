@@ -371,3 +371,24 @@ def test_a_bracket_left_open_mid_file_is_named_at_the_line_it_opened(text, opene
         load_yaml(text)
     message = str(refused.value)
     assert message.startswith(f"not valid YAML at {opened} opened here is not closed (") and found in message
+
+
+def test_a_whole_number_past_double_precision_in_a_plugins_field_is_named_not_an_internal_error(tmp_path, capsys):
+    """A plugin's own check computed with it (points * spacing): 10**400 points raised OverflowError,
+    which ended `frictionlab validate` in the catch-all internal error (exit code 70) and left
+    frictionlab.validate with a Python exception; the number check had already named it."""
+    import frictionlab
+    from frictionlab.errors import PresetError
+
+    huge, field = 10**400, "spectrum.params.points"
+    data = yaml.safe_load(BASE)
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path), "--set", f"{field}={huge}"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"{field}: must be 0 or between 1e-100 and 1e+100 in magnitude, got 1000" in err
+    assert "internal error" not in err
+    slot, params, name = field.split(".")
+    data = merge(data, {slot: {params: {name: huge}}})
+    with pytest.raises(PresetError, match=rf"{field}: must be 0 or between 1e-100 and 1e\+100 in magnitude"):
+        frictionlab.validate(data)

@@ -316,3 +316,52 @@ def test_resume_of_a_sweep_folder_whose_record_is_damaged_names_it(tmp_path, cap
     assert main(["resume", str(tmp_path)]) == 5
     err = capsys.readouterr().err
     assert "sweep.json" in err and said in err
+
+
+def test_a_points_entry_that_is_a_file_or_a_link_refuses_the_whole_sweep_before_any_point(tmp_path, capsys):
+    """Each point failed on it one by one (exit code 1) and, with --quiet, nothing said why; now the sweep
+    is refused up front, naming it: output refused (4) for a run, run folder (5) for a resume."""
+    import os
+
+    from frictionlab.errors import ExitCode
+
+    preset = write(tmp_path, sweep_preset({"seed": {"values": [1, 2]}}))
+    out = tmp_path / "out"
+    assert main(["run", str(preset), "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.OK
+    capsys.readouterr()
+    keep = tmp_path / "keep"
+    keep.mkdir()
+    for made in ("file", "link"):
+        os.rename(out / "points", tmp_path / f"points-{made}")
+        if made == "file":
+            (out / "points").write_text("mine\n")
+        else:
+            (out / "points").symlink_to(keep)
+        assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.RUN_FOLDER
+        err = capsys.readouterr().err
+        assert f"{out / 'points'} is a symbolic link or not a folder" in err and "then resume the sweep" in err
+        forced = ["run", str(preset), "--out", str(out), "--force", "--workers", "1", "--quiet", "--no-plot"]
+        assert main(forced) == ExitCode.OUTPUT_REFUSED
+        assert f"{out / 'points'} is a symbolic link or not a folder" in capsys.readouterr().err
+        assert list(keep.iterdir()) == []  # nothing written through the link
+        (out / "points").unlink()
+        os.rename(tmp_path / f"points-{made}", out / "points")
+    assert (out / "points" / "01-seed-1" / "summary.json").is_file()
+
+
+def test_the_table_after_a_sweep_says_why_a_point_failed_even_with_quiet(tmp_path, capsys):
+    """The last lines of a sweep said only 'error' for a point in error (its reason went to the progress,
+    which --quiet silences), and listed sweep.png under --no-plot."""
+    preset = write(tmp_path, sweep_preset({"seed": {"values": [1, 2]}}))
+    out = tmp_path / "out"
+    assert main(["run", str(preset), "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    capsys.readouterr()
+    point = out / "points" / "01-seed-1"
+    elsewhere = tmp_path / "elsewhere"
+    point.rename(elsewhere)
+    point.symlink_to(elsewhere)
+    assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 1
+    printed = capsys.readouterr().out
+    assert f"seed=1: error: {point} is a symbolic link or not a folder" in printed
+    assert "seed=2: a = " in printed
+    assert "(sweep.csv, points/)" in printed

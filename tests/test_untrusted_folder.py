@@ -361,3 +361,85 @@ def test_the_tui_preset_list_shows_a_fifo_as_unreadable_without_blocking(tmp_pat
     listed = []
     assert with_timeout(lambda: listed.extend(list_presets([("presets", tmp_path)]))) is None
     assert [(e.name, bool(e.error)) for e in listed] == [("good", False), ("pipe", True)]
+
+
+@pytest.mark.parametrize("kind", ["run", "sweep"])
+def test_resume_of_a_folder_whose_stored_preset_is_not_valid_is_a_run_folder_error(tmp_path, capsys, kind):
+    """A value edited in the preset stored in a run folder (preset.yaml, or a sweep.json's base preset)
+    ended a resume as a command-line error (exit code 2); it is the folder that cannot be resumed (5)."""
+    folder = tmp_path / "run"
+    data = QUICK if kind == "run" else {**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(data))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    if kind == "run":
+        stored = folder / "preset.yaml"
+        stored.write_text(stored.read_text().replace("realizations: 4", "realizations: -4"))
+    else:
+        stored = folder / "sweep.json"
+        record = json.loads(stored.read_text())
+        record["base_preset"]["realizations"] = -4
+        stored.write_text(json.dumps(record))
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", "--json"]) == ExitCode.RUN_FOLDER
+    captured = capsys.readouterr()
+    assert "realizations: must be >= 1, got -4" in captured.err
+    assert f"{folder} cannot be resumed: the preset stored there is not valid here" in captured.err
+    assert json.loads(captured.out)["field"] == "realizations"
+    if kind == "sweep":  # following it plans its points from the same stored preset
+        assert main(["follow", str(folder), "--quiet"]) == ExitCode.RUN_FOLDER
+        assert f"{folder} cannot be followed: the preset stored there is not valid here" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["summary.json", "curve.csv", "realizations.npz"])
+def test_a_result_file_that_is_a_folder_refuses_the_run_before_any_work(tmp_path, capsys, name):
+    """The run computed every realization, then failed to write over the folder (exit code 1, the status
+    left 'running'); it is refused before anything runs, naming the folder: exit code 5 for a resume,
+    4 for a run into the folder."""
+    folder = tmp_path / "run"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    (folder / name).unlink()
+    (folder / name).mkdir()
+    (folder / name / "mine.txt").write_text(SECRET)
+    manifest = (folder / "run.json").read_bytes()
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", "--workers", "1"]) == ExitCode.RUN_FOLDER
+    assert f"{folder / name} is a folder, not a file: the run writes its {name} there" in capsys.readouterr().err
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OUTPUT_REFUSED
+    assert f"{folder / name} is a folder, not a file" in capsys.readouterr().err
+    assert (folder / "run.json").read_bytes() == manifest  # nothing started: the status is still 'completed'
+    assert (folder / name / "mine.txt").read_text() == SECRET
+
+
+@pytest.mark.parametrize("detach", [False, True])
+def test_resume_of_a_sweep_whose_sweep_json_disagrees_with_itself_is_a_run_folder_error(tmp_path, capsys, detach):
+    """Its name edited: the resume was refused as 'another sweep' with exit code 4 and the advice to
+    force it, which resume has no option for; the folder is what cannot be resumed (5)."""
+    folder = tmp_path / "sweep"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps({**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    record = json.loads((folder / "sweep.json").read_text())
+    (folder / "sweep.json").write_text(json.dumps({**record, "name": "another-name"}))
+    capsys.readouterr()
+    assert main(["resume", str(folder), "--quiet", *(["--detach"] if detach else [])]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"{folder / 'sweep.json'} is damaged: its name, sweep and base preset are not those of one sweep" in err
+    assert "--force" not in err
+
+
+def test_predict_from_a_sweeps_folder_names_it_as_one_and_where_its_points_laws_are(tmp_path, capsys):
+    """It said only 'no such summary.json', of a folder the user had just run; a sweep's folder holds a law
+    per point, and the message says where they are."""
+    folder = tmp_path / "sweep"
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps({**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}}))
+    assert main(["run", str(preset), "--out", str(folder), "--quiet", "--workers", "1"]) == ExitCode.OK
+    capsys.readouterr()
+    assert main([*PREDICT, "--from", str(folder)]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"--from {folder} is a sweep's folder, which holds a law per point" in err
+    assert f"frictionlab runs {folder / 'points'} lists them" in err
+    assert main([*PREDICT, "--from", str(folder / "points" / "01-seed-1")]) == ExitCode.OK

@@ -155,8 +155,9 @@ def _identity(folder: Path) -> tuple[int, int] | None:
 
 def _stored_sweep(folder: Path):
     from ..runs.sweep import plan_sweep, stored_sweep
+    from .resume import stored_run
 
-    return plan_sweep(stored_sweep(folder), source=str(folder / "sweep.json"))
+    return stored_run(folder, lambda: plan_sweep(stored_sweep(folder), source=str(folder / "sweep.json")), "followed")
 
 
 def _rows(folder: Path) -> list[dict]:

@@ -99,6 +99,7 @@ class _Parser(argparse.ArgumentParser):
             strays = [w for w in self.words if _stray_option(w, options)]
             if strays:
                 message = f"{unrecognized(strays, options)} ({message})"
+        message = shown(message)  # the words it quotes as typed: an escape sequence must not drive the terminal
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
         super().error(message)
 

@@ -67,6 +67,15 @@ def executor_run_options(args, **fields):
 
 def _use_tls_options(args) -> None:
     tls = {"ca_file": args.tls_ca_file, "cert": args.tls_cert, "key": args.tls_key}
+    given = [_tls_flag(name) for name, value in tls.items() if value is not None]
+    if given and not (args.scheduler and args.scheduler.startswith("tls://")):
+        scheduler = "no --scheduler (frictionlab's own cluster makes its own)" if not args.scheduler else (
+            f"--scheduler {args.scheduler}, which is not encrypted")
+        raise FrictionlabError(
+            f"{' and '.join(given)} {'are' if len(given) > 1 else 'is'} for a tls:// Dask scheduler, but there is "
+            f"{scheduler}: {'they' if len(given) > 1 else 'it'} would be ignored; give --scheduler tls://HOST:PORT, "
+            f"or leave {'them' if len(given) > 1 else 'it'} out"
+        )
     if any(tls.values()) or (args.scheduler and args.scheduler.startswith("tls://")):
         for name, value in tls.items():
             if value:
@@ -74,8 +83,7 @@ def _use_tls_options(args) -> None:
 
                 problem = regular_file_problem(value)
                 if problem:
-                    flag = "--tls-" + ("ca-file" if name == "ca_file" else name)
-                    raise FrictionlabError(f"{flag} {value}: {problem}")
+                    raise FrictionlabError(f"{_tls_flag(name)} {value}: {problem}")
         from ..compute.dask_security import use_tls_files
 
         use_tls_files(**tls)
@@ -83,6 +91,10 @@ def _use_tls_options(args) -> None:
         from ..compute.dask_security import check_address
 
         check_address(args.scheduler)
+
+
+def _tls_flag(name: str) -> str:
+    return "--tls-" + ("ca-file" if name == "ca_file" else name)
 
 
 def refuse_empty_path(value: str | None, option: str, what: str = "folder", otherwise: str = "") -> None:

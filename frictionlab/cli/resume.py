@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode
+from ..errors import ExitCode, OutputRefused, PresetError, RunFolderError
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -42,9 +42,27 @@ def run(args) -> ExitCode:
 
         args.preset = str(run_dir / "sweep.json")
         data, options = stored_sweep(run_dir), executor_run_options(args, resume=True)
-        if args.detach:
-            return run_command.detach(args, data, build_scene(data), run_dir, options)
-        return run_command.run_sweep_into(args, data, run_dir, options)
+        try:
+            if args.detach:
+                return stored_run(run_dir, lambda: run_command.detach(args, data, build_scene(data), run_dir, options))
+            return stored_run(run_dir, lambda: run_command.run_sweep_into(args, data, run_dir, options))
+        except OutputRefused:  # the folder checked against the sweep its own sweep.json gives: they differ
+            raise RunFolderError(
+                f"{args.preset} is damaged: its name, sweep and base preset are not those of one sweep "
+                "(a field edited): it cannot be resumed"
+            ) from None
     RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
     args.preset = str(run_dir / PRESET_FILE)
-    return run_command.run(args)
+    return stored_run(run_dir, lambda: run_command.run(args))
+
+
+def stored_run(run_dir: Path, start, doing: str = "resumed"):
+    """``start()``, on the run or sweep stored in ``run_dir``: a preset stored there that is not
+    valid (a value edited, a plugin not installed here) refuses the folder (exit code 5), as a
+    damaged manifest does, not the command line (2); the problems are named as any preset's."""
+    try:
+        return start()
+    except PresetError as exc:
+        refused = RunFolderError(f"{exc}\n{run_dir} cannot be {doing}: the preset stored there is not valid here")
+        refused.problems = exc.problems
+        raise refused from None

@@ -172,7 +172,8 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
 
         emit("sweep", json.loads((out_dir / "sweep.json").read_text(encoding="utf-8")))
     else:
-        print(shown(sweep_table(sweep, outcome.status, outcome.elapsed, outcome.rows, out_dir)))
+        rows = [{**result.row(), "error": result.error} for result in outcome.results]  # why a point failed
+        print(shown(sweep_table(sweep, outcome.status, outcome.elapsed, rows, out_dir, "plot" in outcome.files)))
     if outcome.status == "interrupted":
         return interrupted_exit_code()
     return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK
@@ -212,12 +213,12 @@ def result_table(scene, outcome, out_dir: Path) -> str:
     return "\n".join(lines)
 
 
-def sweep_table(sweep, status: str, elapsed: float, rows: list[dict], out_dir: Path) -> str:
+def sweep_table(sweep, status: str, elapsed: float, rows: list[dict], out_dir: Path, drawn: bool = True) -> str:
     """What ``frictionlab run`` prints on stdout after a sweep: one line per point (``rows``:
-    each point's row of sweep.csv, in the order of the points)."""
+    each point's row of sweep.json, in the order of the points); ``drawn``: sweep.png was drawn."""
     lines = [f"{sweep.name}: {counted(len(sweep.points), 'point')} in {elapsed:.1f} s, status {status}"]
     from ..progress import point_result_line
 
     lines += [point_result_line(sweep, point, row) for point, row in zip(sweep.points, rows)]
-    lines.append(f"  results in {out_dir}/ (sweep.csv, sweep.png, points/)")
+    lines.append(f"  results in {out_dir}/ (sweep.csv, {'sweep.png, ' if drawn else ''}points/)")
     return "\n".join(lines)

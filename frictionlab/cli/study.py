@@ -4,6 +4,7 @@ command line: its options, checked, and the run. Heavy modules are imported insi
 
 from __future__ import annotations
 
+import math
 import shlex
 import sys
 
@@ -78,14 +79,16 @@ def add_parser(sub) -> None:
     parser.set_defaults(handler=run)
 
 
-def _numbers(option: str, text: str, kind=float, low: float = 0.0) -> tuple:
+def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: bool = False) -> tuple:
     try:
         values = tuple(kind(v) for v in text.split(",") if v.strip())
     except ValueError:
         raise FrictionlabError(f"{option} must be a comma-separated list of numbers. Got {text!r} instead.") from None
-    bad = [v for v in values if not v > low]
+    bad = [v for v in values if not (v > low and math.isfinite(v))]  # inf made a grid of int(inf) points
     if bad:
-        raise FrictionlabError(f"{option} values must be > {low:g}. Got {bad[0]!r} instead.")
+        raise FrictionlabError(f"{option} values must be finite numbers > {low:g}. Got {bad[0]!r} instead.")
+    if required and not values:  # an empty list left its axis out without a word
+        raise FrictionlabError(f"{option} names no value: give a comma-separated list of numbers. Got {text!r} instead.")
     return values
 
 
@@ -115,7 +118,7 @@ def options_from_args(args) -> StudyOptions:
         compare_realizations=_at_least("--compare-realizations", args.compare_realizations, 2),
         compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
         grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
-        grid_factors=_numbers("--grid-factors", args.grid_factors),
+        grid_factors=_numbers("--grid-factors", args.grid_factors, required="grid" in axes),
         tolerances=_numbers("--tolerances", args.tolerances) or (min(_D.tolerances),),
         reference_grid=_numbers("--reference-grid", args.reference_grid),
         repeats=_at_least("--repeats", args.repeats, 1),

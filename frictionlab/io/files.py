@@ -57,10 +57,10 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
         with _open_node(path, binary) as fh:
             write(fh)
         return
-    kind = _kind(path, follow_links=False)
-    if kind in ("folder", "socket", "block device"):  # an OSError, as renaming over it was: callers say "cannot write"
-        error = IsADirectoryError if kind == "folder" else OSError
-        raise error(errno.EISDIR if kind == "folder" else errno.EINVAL, f"is a {kind}, not a file", str(path))
+    problem = replace_problem(path)
+    if problem:  # an OSError, as renaming over it was: callers say "cannot write"
+        error = IsADirectoryError if "folder" in problem else OSError
+        raise error(errno.EISDIR if "folder" in problem else errno.EINVAL, problem, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -115,6 +115,13 @@ def _is_open_stream(path: Path) -> bool:
 
 _KINDS = {stat.S_IFREG: "file", stat.S_IFDIR: "folder", stat.S_IFCHR: "character device", stat.S_IFIFO: "FIFO",
           stat.S_IFSOCK: "socket", stat.S_IFBLK: "block device", stat.S_IFLNK: "symbolic link"}  # fmt: skip
+
+
+def replace_problem(path: Path) -> str | None:
+    """Why ``atomic_write`` cannot replace what is at ``path`` ("is a folder, not a file"; a
+    socket or block device too), or None: a file, a link, a FIFO or nothing there."""
+    kind = _kind(path, follow_links=False)
+    return f"is a {kind}, not a file" if kind in ("folder", "socket", "block device") else None
 
 
 def _kind(path: Path, follow_links: bool = True) -> str | None:

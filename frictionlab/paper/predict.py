@@ -235,6 +235,11 @@ def _read_summary(run_dir: Path) -> dict:
     """summary.json of ``--from``, each value checked (``results.read_summary``)."""
     if not run_dir.is_dir():
         raise RunFolderError(f"--from {run_dir}: no readable summary.json there (no such folder)")
+    if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
+        raise RunFolderError(  # a law per point: the user names one
+            f"--from {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
+            f"{run_dir / 'points'}/<NN-label> (frictionlab runs {run_dir / 'points'} lists them)"
+        )
     return read_summary(run_dir)[0]
 
 

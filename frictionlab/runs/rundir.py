@@ -40,7 +40,7 @@ import yaml
 
 from .. import __version__
 from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
 from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import with_new_defaults
@@ -229,6 +229,7 @@ class RunDirectory:
                 f"{self.chunks} is not a folder (a link, a file, ...): chunks are never written or read through it "
                 "(remove it, or give another folder)"
             )
+        self._check_replaceable(scene, resume)
         resolved = _json_copy(scene.resolved())
         inputs = self._input_hashes(scene)
         if resume:
@@ -258,6 +259,16 @@ class RunDirectory:
         }
         self._write_manifest()
         return []
+
+    def _check_replaceable(self, scene: Scene, resume: bool) -> None:
+        """Refuse before any work a file of the run that is a folder (a socket...) here: its
+        results, written at the end, could never replace it (plot.png only where one is drawn)."""
+        written = [STATE_FILE, PRESET_FILE, "summary.json", "curve.csv"]
+        written += ["realizations.npz"] if scene.preset.output.realizations else []
+        for name in written:
+            if problem := replace_problem(self.path / name):
+                refused, then = (RunFolderError, "resume") if resume else (OutputRefused, "run again")
+                raise refused(f"{shown(self.path / name)} {problem}: the run writes its {name} there; move it aside, then {then}")
 
     def finish(self, scene: Scene, status: str) -> None:
         """Record the final status; a completed run's chunks are compacted into one file."""

@@ -6,9 +6,8 @@ is the preset's, so a point is reproducible on its own::
 
     frictionlab run PRESET --set sweep=null --set spectrum.params.hurst=0.7
 
-Every point runs through ``runner.run_to_folder`` (the single run path) into
-``<out>/points/<NN>-<label>/``. ``sweep.csv`` (one row per point, rewritten
-atomically as points finish), ``sweep.json`` and ``sweep.png`` sit in ``<out>``.
+Every point runs through ``runner.run_to_folder`` (the single run path) into ``<out>/points/<NN>-<label>/``.
+``sweep.csv`` (a row per point, rewritten atomically as points finish), ``sweep.json``, ``sweep.png`` sit in ``<out>``.
 
 Front ends follow a sweep through ``listeners.SweepListener``s; each point's
 run tells the run listeners that ``SweepListener.run_listeners(point)`` gives.
@@ -336,12 +335,11 @@ def run_sweep(
     cancel=None,
     plot: bool = True,
 ) -> SweepOutcome:
-    """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``),
-    and keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end (and each
-    point's plot.png) unless ``plot`` is False. ``out_dir``
-    must be new, empty or a folder of this same sweep unless ``options.force``. It holds
-    the folder's lock (``run.lock``) while it runs, and its sweep.json says "running"
-    until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
+    """Run every point as ``options`` say, telling ``listeners`` (``listeners.SweepListener``), and
+    keep ``sweep.csv``/``sweep.json`` current; draw ``sweep.png`` at the end (and each point's plot.png)
+    unless ``plot`` is False. ``out_dir`` must be new, empty or a folder of this same sweep unless
+    ``options.force``. It holds the folder's lock (``run.lock``) while it runs, and its sweep.json says
+    "running" until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
     listeners = list(listeners)
@@ -350,6 +348,11 @@ def run_sweep(
     results = {p.number: PointResult(p, "pending", point_folder(out_dir, p)) for p in sweep.points}
     outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
     with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
+        try:  # every point's folder is in points/: a file or a link there refuses the sweep, not each point
+            make_subfolder(out_dir, "points")
+        except RunFolderError as exc:
+            then = "resume the sweep" if options.resume else "run again"
+            raise (RunFolderError if options.resume else OutputRefused)(f"{exc}: move it aside, then {then}") from None
         write_tables(sweep, outcome, out_dir)  # first: a sweep that is heard of has its sweep.json
         for listener in listeners:
             listener.sweep_started(sweep)

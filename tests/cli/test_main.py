@@ -53,6 +53,23 @@ def test_the_dashboard_without_frictionlabs_own_dask_cluster_is_refused_not_igno
         assert "--dashboard serves the dashboard of frictionlab's own Dask cluster" in capsys.readouterr().err
 
 
+def test_tls_files_without_a_tls_scheduler_are_refused_not_ignored(tmp_path, capsys):
+    """--tls-* only ever reach a tls:// scheduler: given without one, the run went on, unencrypted or on
+    frictionlab's own cluster, as if they had been used."""
+    from frictionlab.cli import main
+
+    cert = tmp_path / "cert.pem"
+    cert.write_text("not read\n")
+    out = tmp_path / "out"
+    for extra, said in (([], "there is no --scheduler"), (["--scheduler", "tcp://127.0.0.1:1"], "tcp://127.0.0.1:1, which is not encrypted")):
+        code = main(["run", "quickstart", "--tls-cert", str(cert), "--out", str(out), "--quiet", *extra])
+        err = capsys.readouterr().err
+        assert code == ExitCode.USAGE, err
+        assert "--tls-cert is for a tls:// Dask scheduler" in err and said in err
+        assert not out.exists()
+    assert main(["run", "quickstart", "--tls-ca-file", str(cert), "--tls-key", str(cert), "--out", str(out), "--quiet"]) == ExitCode.USAGE
+    assert "--tls-ca-file and --tls-key are for a tls:// Dask scheduler" in capsys.readouterr().err
+
 def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
     """argparse itself takes only -1 and -0.5 as values; -1e-2 was refused as an unknown option."""
     from frictionlab.cli import main
@@ -64,7 +81,7 @@ def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
     assert main([*contact, "--a", "-inf", "--b", "1"]) == ExitCode.USAGE  # checked as a number: named, not unknown
     assert "--a must be a finite number. Got -inf instead." in capsys.readouterr().err
     assert main(["study", str(PRESETS / "quickstart.yaml"), "--tolerances", "-1e-3,1e-6"]) == ExitCode.USAGE
-    assert "--tolerances values must be > 0. Got -0.001 instead." in capsys.readouterr().err
+    assert "--tolerances values must be finite numbers > 0. Got -0.001 instead." in capsys.readouterr().err
     with pytest.raises(SystemExit) as refused:  # an option still is one (argparse's usage error)
         main(["run", str(PRESETS / "quickstart.yaml"), "-x1"])
     assert refused.value.code == ExitCode.USAGE and "unrecognized arguments: -x1" in capsys.readouterr().err

@@ -42,7 +42,10 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--axes", "grid,speed"], "--axes must name some of grid, realizations, steps, solver, tolerance"),
         (["--target", "2"], "--target must be > 0 and < 1"),
         (["--tolerances", "1e-3,abc"], "--tolerances must be a comma-separated list of numbers"),
-        (["--grid-factors", "1,-2"], "--grid-factors values must be > 0. Got -2.0 instead."),
+        (["--grid-factors", "1,-2"], "--grid-factors values must be finite numbers > 0. Got -2.0 instead."),
+        (["--grid-factors", "1,inf"], "--grid-factors values must be finite numbers > 0. Got inf instead."),  # was exit 70
+        (["--reference-grid", "Infinity"], "--reference-grid values must be finite numbers > 0. Got inf instead."),
+        (["--grid-factors", ",,"], "--grid-factors names no value"),  # the grid axis was left out without a word
         (["--points", "4"], "--points must be >= 8. Got 4 instead."),
         (["--set", "spectrum.params.hurst=7"], "spectrum.params.hurst: must be <= 1.5"),
     ],

@@ -89,3 +89,17 @@ def test_a_misspelt_choice_is_answered_with_the_closest_choice(capsys):
     assert re.search(r"dask'?\); did you mean 'dask'\?$", err.rstrip())  # after argparse's list of every choice
     assert usage_error(capsys, ["completion", "fsh"]).rstrip().endswith("; did you mean 'fish'?")
     assert "did you mean" not in usage_error(capsys, ["completion", "zzzz"])
+
+
+@pytest.mark.parametrize("words", [["run", "quickstart", "--\x1b]0;owned\x07x"], ["run", "quickstart", "\x1b[2J"],
+                                   ["runs", "here", "\x1b[2J", "--json"]])
+def test_a_word_the_parser_refuses_is_quoted_escaped_never_as_terminal_control(capsys, words):
+    """argparse quoted an unrecognized word as typed: an escape sequence in it reached the terminal (a
+    title set, the screen cleared) and the JSON error object."""
+    with pytest.raises(SystemExit) as refused:
+        main(words)
+    captured = capsys.readouterr()
+    assert refused.value.code == ExitCode.USAGE
+    assert "unrecognized arguments: " in captured.err
+    assert "\x1b" not in captured.err + captured.out and "\x07" not in captured.err + captured.out
+    assert "\\x1b" in captured.err

@@ -51,9 +51,9 @@ def test_output_path_problem_tries_a_file_and_leaves_nothing(tmp_path):
 
 @pytest.mark.parametrize("sweep", [False, True])
 def test_a_result_file_that_is_a_folder_is_named_in_the_refusal(tmp_path, capsys, sweep):
-    """A run folder whose summary.json is a folder (in a sweep, a point's): the resume stops
-    with exit 1 naming that file, not its run or sweep folder, and the folder and what it holds
-    are left as they were."""
+    """A run folder whose summary.json is a folder (in a sweep, a point's): the resume is refused
+    before any work, naming that file, not its run or sweep folder (exit code 5; a sweep's point
+    in error, exit code 1), and the folder and what it holds are left as they were."""
     import yaml
 
     from ..conftest import SMALL_PRESET, merge
@@ -70,7 +70,8 @@ def test_a_result_file_that_is_a_folder_is_named_in_the_refusal(tmp_path, capsys
     (folder / "summary.json" / "mine.txt").write_text("keep me")
     capsys.readouterr()
     code = main(["resume", str(out), "--quiet", "--no-plot"])
-    err = capsys.readouterr().err
-    assert code == ExitCode.RUNTIME_FAILURE, err
-    assert f"cannot write results to {folder / 'summary.json'}: is a folder, not a file" in err
+    captured = capsys.readouterr()
+    said = captured.err + captured.out  # a sweep's table says why its point failed
+    assert code == (ExitCode.RUNTIME_FAILURE if sweep else ExitCode.RUN_FOLDER), said
+    assert f"{folder / 'summary.json'} is a folder, not a file: the run writes its summary.json there" in said
     assert (folder / "summary.json" / "mine.txt").read_text() == "keep me"
