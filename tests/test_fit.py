@@ -1,6 +1,7 @@
 """The fit xi = a + b ln f against exact data, numpy's polyfit and bootstrap coverage."""
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -173,6 +174,37 @@ def test_a_fit_runs_blas_on_its_own_thread_only_and_leaves_the_limit_as_it_was()
     assert blas_threads() == before  # restored for the rest of the program
     plain = fit_log_law(f, xi, bootstrap=200, rng=np.random.default_rng(4))
     np.testing.assert_allclose([fit.a, fit.b, *fit.a_ci, *fit.b_ci], [plain.a, plain.b, *plain.a_ci, *plain.b_ci], rtol=1e-12)
+
+
+def test_a_blas_library_loaded_after_the_first_fit_is_limited_too():
+    """scipy brings an OpenBLAS of its own. The fit's controller of the BLAS libraries was made
+    once, at the first fit: a library loaded later (scipy imported after it, as a run's solver
+    or the TUI does) ran the fit's products on all its threads. In a fresh process: a fit, then
+    scipy.linalg imported, then a fit that hears the BLAS thread counts from inside it."""
+    script = """
+import json, numpy as np
+from threadpoolctl import threadpool_info
+from frictionlab.compute.fit import fit_log_law, defined_mean
+f = np.linspace(1.0, 20.0, 40)
+xi = 1.0 + 0.1 * np.log(f) + 0.01 * np.random.default_rng(3).standard_normal((30, 40))
+fit_log_law(f, xi, bootstrap=20, rng=np.random.default_rng(4))
+import scipy.linalg
+libraries = [lib for lib in threadpool_info() if lib["user_api"] == "blas"]
+seen = []
+def average(weights):
+    seen.append([lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"])
+    return defined_mean(xi, weights)
+fit_log_law(f, xi, bootstrap=20, rng=np.random.default_rng(4), average=average)
+print(json.dumps({"libraries": len(libraries), "seen": seen}))
+"""
+    import json
+    import subprocess
+    import sys
+
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"}  # more than one thread to limit
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    heard = json.loads(done.stdout.strip().splitlines()[-1])
+    assert heard["seen"] and all(threads == [1] * heard["libraries"] for threads in heard["seen"])
 
 
 @pytest.mark.parametrize(("averaged", "realizations", "forces"), [(False, 2000, 12), (True, 2000, 12), (True, 20, 2000)])

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
 
@@ -199,11 +200,19 @@ def one_blas_thread(function):
     return limited
 
 
-@functools.cache
+_controller: tuple[int, object] | None = None  # (modules loaded when it was made, the controller)
+
+
 def _blas_controller():
+    """A controller of the BLAS libraries loaded now: made again once a module has been imported
+    since (scipy brings an OpenBLAS of its own, which a controller made before it would not limit)."""
+    global _controller
     from threadpoolctl import ThreadpoolController
 
-    return ThreadpoolController()
+    loaded = len(sys.modules)
+    if _controller is None or _controller[0] != loaded:
+        _controller = (loaded, ThreadpoolController())
+    return _controller[1]
 
 
 def bootstrap_coefficients(
