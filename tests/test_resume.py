@@ -113,6 +113,21 @@ def test_a_forked_child_does_not_keep_the_lock(tmp_path):
         os.waitpid(child, 0)
 
 
+def test_resume_of_a_manifest_whose_fingerprint_is_not_its_presets_says_so(make_scene, tmp_path):
+    """A run.json whose fingerprint was edited, resumed with its own preset: it was refused as
+    'its preset differs from the one given' with nothing named, though nothing differs."""
+    cancel = threading.Event()
+    cancel.set()
+    scene = make_scene(NO_PLOT)
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), cancel=cancel)
+    manifest = tmp_path / "run" / "run.json"
+    state = json.loads(manifest.read_text())
+    state["fingerprint"] = "0" * 64
+    manifest.write_text(json.dumps(state))
+    with pytest.raises(FrictionlabError, match=r"the fingerprint in its run.json is not that of the preset it holds"):
+        run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+
+
 def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, tmp_path):
     cancel = threading.Event()
     cancel.set()  # nothing computed, but the directory is started

@@ -349,9 +349,13 @@ class RunDirectory:
         if not same_preset(state, resolved, scene):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
             changed = differences(stored, resolved)
+            if not changed:  # the same preset, and a fingerprint that is not its own
+                raise RunFolderError(
+                    f"cannot resume {self.path}: the fingerprint in its {STATE_FILE} is not that of the preset it "
+                    f"holds (the file damaged or edited); run the preset again into a new folder"
+                )
             raise RunFolderError(
-                f"cannot resume {self.path}: its preset differs from the one given\n  "
-                + "\n  ".join(changed or ["(the fingerprints differ)"])
+                f"cannot resume {self.path}: its preset differs from the one given\n  " + "\n  ".join(changed)
             )
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in inputs.items():
