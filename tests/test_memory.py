@@ -136,6 +136,18 @@ def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fi
     assert_offer_is_the_most_that_fits(scene, caught.value.args[0], points=lambda side: side**2)
 
 
+def test_an_absurd_grid_is_refused_in_numbers_a_person_reads(registry, monkeypatch):
+    """10**99 points: the refusal printed the points and the GiB in full, about 200 digits."""
+    scene = build_scene(line_of(10**99), registry=registry)
+    monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
+    with pytest.raises(RunError) as caught:
+        memory.check_fits(scene, workers=1, executor="processes")
+    message = caught.value.args[0]
+    assert "1e+99 points" in message and re.search(r"about \d\.\d\de\+\d+ GiB", message)
+    assert max(len(word) for word in message.split()) < 30, message
+    assert memory.gib(2.5 * GiB) == "2.50 GiB" and memory.points_text(1_234_567) == "1,234,567"
+
+
 def test_estimate_grows_with_points_workers_and_kept_rows(registry):
     small = build_scene(line_of(10_000), registry=registry)
     large = build_scene(line_of(1_000_000), registry=registry)

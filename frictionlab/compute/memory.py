@@ -50,17 +50,25 @@ class MemoryEstimate:
     def describe(self) -> str:
         if self.executor == "serial":
             return (
-                f"{gib(self.total)} (one realization of {self.points:,} points: {gib(self.per_realization)}, "
+                f"{gib(self.total)} (one realization of {points_text(self.points)} points: {gib(self.per_realization)}, "
                 f"in this process, which keeps {gib(self.main)})"
             )
         return (
             f"{gib(self.total)} ({self.workers} worker(s) x {gib(self.per_worker)} for realizations of "
-            f"{self.points:,} points, plus {gib(self.main)} in the main process)"
+            f"{points_text(self.points)} points, plus {gib(self.main)} in the main process)"
         )
 
 
 def gib(n: float) -> str:
+    """``n`` bytes in GiB (two decimals; three significant digits from 100,000 GiB on), or MiB below 0.1 GiB."""
+    if n >= 1e5 * GiB:  # a preset's absurd grid: its digits would fill the screen
+        return f"{n / GiB:.3g} GiB"
     return f"{n / GiB:.2f} GiB" if n >= 0.1 * GiB else f"{n / MiB:.0f} MiB"
+
+
+def points_text(n: int) -> str:
+    """A count of points with thousands separated, or in three significant digits from 1e12 on."""
+    return f"{n:,}" if n < 10**12 else f"{float(n):.3g}"
 
 
 def grid_points(scene: Scene) -> int:
@@ -208,7 +216,7 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
         advice = (f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}" if points_param and fits
                   else "fewer realizations")  # fmt: skip
         raise RunError(
-            f"one process of this run would need about {gib(need)} at its peak (a realization of {guess.points:,} points: "
+            f"one process of this run would need about {gib(need)} at its peak (a realization of {points_text(guess.points)} points: "
             f"{gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
             f"limit to itself). It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
         )
@@ -300,7 +308,7 @@ def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usabl
     if _points_path(scene) and _in_dask_worker(one_point) <= room:
         advice = f"{_points_path(scene)} <= {_most_points(scene, 'dask', room, _in_dask_worker):,}, or on " + advice
     raise RunError(
-        f"one realization of {guess.points:,} points would need about {gib(need)} in a Dask worker "
+        f"one realization of {points_text(guess.points)} points would need about {gib(need)} in a Dask worker "
         f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "
         f"{address} has a memory limit of {gib(limit)} ({smallest}Dask kills a worker at {usable:.0%} of its limit). "
         f"It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
