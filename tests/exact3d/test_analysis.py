@@ -183,3 +183,18 @@ def test_the_model_verdict_names_what_each_h_prefers_and_where_bic_cannot_tell()
     for test in full.values():
         test.mean_choice = "log law"
     assert model_verdict(runs, numbers).startswith("Yes, over f")
+
+
+@pytest.mark.parametrize(("other", "said"), [
+    ((2.18, (2.15, 2.20)), "lower, the intervals apart"), ((2.36, (2.29, 2.43)), "not resolved apart"),
+    ((2.60, (2.50, 2.70)), "higher, the intervals apart"), ((2.30, (2.25, 2.29)), "not resolved apart"),
+])  # fmt: skip
+def test_a_familys_kappa_against_the_main_familys_is_apart_only_where_the_intervals_are(other, said):
+    """The comparison family at H = 1 (kappa 2.36 [2.29, 2.43]) is not below the main family's
+    (2.38 [2.30, 2.45]), though its Nayak parameter is six times larger: said, not left out."""
+    from types import SimpleNamespace
+
+    from frictionlab.exact3d.evidence_text import kappa_versus
+
+    reference = SimpleNamespace(value=2.38, interval=(2.29, 2.45))
+    assert kappa_versus(SimpleNamespace(value=other[0], interval=other[1]), reference) == said
