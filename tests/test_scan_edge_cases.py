@@ -474,3 +474,15 @@ def test_a_text_export_in_latin_1_is_told_to_be_saved_as_utf_8(tmp_path):
     write_xyz(tmp_path / "scan.xyz", rough(8, 9, 17), 0.5, "# x [\xb5m]\ty [\xb5m]\tz [\xb5m]\n".encode("latin-1"))
     with pytest.raises(ValueError, match="a text export that is not UTF-8 .* save it as UTF-8"):
         SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
+
+
+@pytest.mark.parametrize(("text", "line"), [
+    ("0.1,0.2,0.3,\n0.4,0.5,0.6,\n0.7,0.8,0.1,\n", 1), ("0.1;0.2;0.3;\n0.4;0.5;0.6;\n0.7;0.8;0.1;\n", 1),
+    ("0.1,0.2,0.3\n0.4,0.5,0.6,\n0.7,0.8,0.1\n", 2), ("x,y,z\n0.1,0.2,0.3,\n0.4,0.5,0.6,\n", 2),
+])  # fmt: skip
+def test_a_table_whose_lines_end_with_a_separator_is_told_so(tmp_path, text, line):
+    """A trailing separator (an empty last column) on the first line made it a header, dropped
+    without a word, and the table was refused as 'non-numeric content at line 2'."""
+    (tmp_path / "map.csv").write_text(text)
+    with pytest.raises(ValueError, match=rf"line {line} ends with a separator \((comma|semicolon)\), an empty column"):
+        SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()

@@ -271,6 +271,8 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
         delimiter = _delimiter(text)
         if _numbers(text, delimiter):
             break
+        if _ends_with_separator(text, delimiter):  # numbers and an empty column: no header
+            raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     try:
         with warnings.catch_warnings():
@@ -292,6 +294,8 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
         if not text:
             continue
         if not _numbers(text, delimiter):
+            if _ends_with_separator(text, delimiter):
+                return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
                         "export the table with decimal points")  # fmt: skip
@@ -301,6 +305,16 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _ends_with_separator(text: str, delimiter: str | None) -> bool:
+    """Numbers followed by a separator and nothing (``1.5,2.5,``): an empty last column."""
+    return delimiter is not None and text.endswith(delimiter) and _numbers(text[: -len(delimiter)].rstrip(), delimiter)
+
+
+def _trailing_text(lineno: int, delimiter: str | None) -> str:
+    return (f"line {lineno} ends with a separator ({_separator(delimiter)[:-1]}), an empty column after its last "
+            "number; export the table without a separator at the end of its lines")
 
 
 def _delimiter(text: str) -> str | None:
