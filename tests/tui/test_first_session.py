@@ -1,0 +1,37 @@
+"""What a new user met in a first session at a terminal over SSH, each read off the screen
+or the disk: a refusal read whole, no empty folder left by a refused run, a folder typed
+as a file name refused, a preset name the New dialog checks as the form does."""
+
+from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
+
+from .conftest import make_app, press_settled, screen_text, started, status_text, sync, type_into
+
+
+async def refuse_for_memory(pilot):
+    """The tiny preset's line made 10^12 points long, then Ctrl+R: refused, as it cannot fit."""
+    await type_into(pilot, "field--spectrum--params--points", "1000000000000")
+    await press_settled(pilot, "escape", "ctrl+r")
+
+
+@sync
+async def test_a_long_refusal_is_on_screen_whole(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app, size=(80, 24)) as pilot:
+        await refuse_for_memory(pilot)
+        said = status_text(app)
+        screen = " ".join(screen_text(app).split())
+    assert said.startswith("Cannot run: this run would need about"), said
+    # its advice comes last: the status line kept its first three lines only
+    assert said.endswith("an upper bound.)") and "It would fit with" in screen and "an upper bound.)" in screen, screen
+
+
+@sync
+async def test_a_run_refused_leaves_no_folder_behind(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        for _ in range(2):
+            await refuse_for_memory(pilot)
+        said = status_text(app)
+    assert said.startswith("Cannot run"), said
+    runs = folders / "runs"
+    assert not runs.exists() or list(runs.iterdir()) == []
