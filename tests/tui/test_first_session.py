@@ -35,3 +35,16 @@ async def test_a_run_refused_leaves_no_folder_behind(folders, registry):
     assert said.startswith("Cannot run"), said
     runs = folders / "runs"
     assert not runs.exists() or list(runs.iterdir()) == []
+
+
+@sync
+async def test_save_as_a_folder_is_refused_not_saved_beside_it(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+o")
+        assert isinstance(app.screen, PathScreen)
+        await press_settled(pilot, "end", "ctrl+u", *str(folders / "presets"), "enter")
+        still_asking = isinstance(app.screen, PathScreen)
+        said = str(app.screen.query_one("#path-error").render())
+    assert still_asking and said == f"path: {folders / 'presets'} is a folder; give a file name", said
+    assert sorted(p.name for p in folders.iterdir()) == ["presets"]  # no presets.yaml beside the folder

@@ -84,6 +84,8 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
     if not text:
         return None, "path: must not be empty"
     path = Path(text).expanduser()
+    if path.is_dir():  # before .yaml is added: a folder typed was saved as <folder>.yaml beside it
+        return None, f"path: {path} is a folder; give a file name"
     if path.suffix not in (".yaml", ".yml"):
         path = path.with_name(path.name + ".yaml")
     if path.is_dir():
