@@ -2,6 +2,7 @@
 or the disk: a refusal read whole, no empty folder left by a refused run, a folder typed
 as a file name refused, a preset name the New dialog checks as the form does."""
 
+from frictionlab.preset.schema import NAME_RULE
 from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
 
 from .conftest import make_app, press_settled, screen_text, started, status_text, sync, type_into
@@ -48,3 +49,18 @@ async def test_save_as_a_folder_is_refused_not_saved_beside_it(folders, registry
         said = str(app.screen.query_one("#path-error").render())
     assert still_asking and said == f"path: {folders / 'presets'} is a folder; give a file name", said
     assert sorted(p.name for p in folders.iterdir()) == ["presets"]  # no presets.yaml beside the folder
+
+
+@sync
+async def test_the_new_dialog_refuses_a_name_the_form_would(folders, registry):
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n")
+        assert isinstance(app.screen, NewPresetScreen)
+        await press_settled(pilot, "ctrl+u", *"my scene", "enter")
+        still_asking = isinstance(app.screen, NewPresetScreen)
+        said = str(app.screen.query_one("#new-error").render())
+        opened = app.query_one("#form").data
+    assert still_asking and opened is None, said
+    assert said == f"name: {NAME_RULE}, got 'my scene'"
+    assert sorted(p.name for p in (folders / "presets").iterdir()) == ["tiny.yaml"]
