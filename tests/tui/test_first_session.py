@@ -3,9 +3,10 @@ or the disk: a refusal read whole, no empty folder left by a refused run, a fold
 as a file name refused, a preset name the New dialog checks as the form does."""
 
 from frictionlab.preset.schema import NAME_RULE
+from frictionlab.tui.running import NO_PRESET
 from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
 
-from .conftest import make_app, press_settled, screen_text, started, status_text, sync, type_into
+from .conftest import make_app, open_first_preset, press_settled, screen_text, started, status_text, sync, type_into
 
 
 async def refuse_for_memory(pilot):
@@ -64,3 +65,15 @@ async def test_the_new_dialog_refuses_a_name_the_form_would(folders, registry):
     assert still_asking and opened is None, said
     assert said == f"name: {NAME_RULE}, got 'my scene'"
     assert sorted(p.name for p in (folders / "presets").iterdir()) == ["tiny.yaml"]
+
+
+@sync
+async def test_no_preset_open_is_taken_back_once_one_opens(folders, registry):
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+s")
+        before = status_text(app)
+        await open_first_preset(pilot)
+        after = status_text(app)
+    assert before == NO_PRESET
+    assert after == "", after
