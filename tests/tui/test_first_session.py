@@ -2,11 +2,18 @@
 or the disk: a refusal read whole, no empty folder left by a refused run, a folder typed
 as a file name refused, a preset name the New dialog checks as the form does."""
 
+import pytest
+from textual.widgets import DataTable
+
 from frictionlab.preset.schema import NAME_RULE
 from frictionlab.tui.running import NO_PRESET
 from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
 
-from .conftest import make_app, open_first_preset, press_settled, screen_text, started, status_text, sync, type_into
+from ..conftest import merge
+from .conftest import (
+    SWEEP, make_app, open_first_preset, press_settled, run_to_the_end, screen_text, started, status_text, sweep_app, sync,
+    type_into,
+)
 
 
 async def refuse_for_memory(pilot):
@@ -77,3 +84,22 @@ async def test_no_preset_open_is_taken_back_once_one_opens(folders, registry):
         after = status_text(app)
     assert before == NO_PRESET
     assert after == "", after
+
+
+@pytest.mark.long
+@sync
+async def test_a_sweeps_table_of_eight_points_shows_each_row_at_80x24(folders, registry):
+    """Its last rows lay below the tab: 4 of 8 on screen, and the arrows on the table did not reach them."""
+    hursts = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
+    app = sweep_app(folders, registry, merge(SWEEP, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": hursts}}}}))
+    async with started(app) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        table, pane = app.query_one("#sweep-table", DataTable), app.query_one("RunPane")
+        inside = table.region.bottom <= pane.region.bottom
+        legend_whole = app.query_one("#run-body").size.height >= len(str(app.query_one("#run-fit").render()).splitlines())
+        table.focus()
+        await press_settled(pilot, *["down"] * 7)
+        last_row = [line for line in screen_text(app).splitlines() if line.split()[:2] == ["8", "1.0"]]
+    assert table.row_count == 8 and inside, (table.region, pane.region)
+    assert legend_whole and last_row
