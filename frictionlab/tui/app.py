@@ -30,6 +30,7 @@ from ..preset import load_preset_file
 from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
+    copy_name,
     is_builtin,
     new_preset_path,
     preset_folders,
@@ -316,6 +317,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
         def done(path: Path | None) -> None:
             if path is not None:
+                data["name"] = copy_name(data["name"], path, default)
                 self._write(path, data, then_open=True, template=entry.path)
 
         self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default, self.save_folder), done)

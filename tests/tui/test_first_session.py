@@ -3,6 +3,7 @@ or the disk: a refusal read whole, no empty folder left by a refused run, a fold
 as a file name refused, a preset name the New dialog checks as the form does."""
 
 import pytest
+import yaml
 from textual.widgets import DataTable
 
 from frictionlab.preset.schema import NAME_RULE
@@ -12,7 +13,7 @@ from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
 from ..conftest import merge
 from .conftest import (
     SWEEP, make_app, open_first_preset, press_settled, run_to_the_end, screen_text, started, status_text, sweep_app, sync,
-    type_into,
+    type_into, wait_until,
 )
 
 
@@ -103,3 +104,27 @@ async def test_a_sweeps_table_of_eight_points_shows_each_row_at_80x24(folders, r
         last_row = [line for line in screen_text(app).splitlines() if line.split()[:2] == ["8", "1.0"]]
     assert table.row_count == 8 and inside, (table.region, pane.region)
     assert legend_whole and last_row
+
+
+@sync
+async def test_a_duplicate_saved_under_another_file_name_takes_that_name(folders, registry):
+    """It stayed '<name>-copy' whatever file it went to: the list showed 'small-copy' beside rough.yaml."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "d")
+        assert isinstance(app.screen, PathScreen)
+        await press_settled(pilot, "end", "ctrl+u", *str(folders / "presets" / "rough.yaml"), "enter")
+        await wait_until(pilot, lambda: app.draft_path is not None and app.draft_path.name == "rough.yaml")
+        shown = app.query_one("#form").data["name"]
+    saved = yaml.safe_load((folders / "presets" / "rough.yaml").read_text())
+    assert saved["name"] == shown == "rough"
+    assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["name"] == "small"
+
+
+@sync
+async def test_a_duplicate_saved_where_offered_is_named_copy(folders, registry):
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "d", "enter")
+        await wait_until(pilot, lambda: app.draft_path is not None)
+    assert yaml.safe_load((folders / "presets" / "tiny-copy.yaml").read_text())["name"] == "small-copy"
