@@ -108,7 +108,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
         self.said_about: Path | None = None  # the row the status line speaks of (taken back on leaving it)
-        self.said_no_preset = False  # the status line says no preset is open (taken back when one opens)
+        self.taken_back_on = ""  # "open": the status line says no preset is open; "edit": why a run could not start
         self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -258,7 +258,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
         self.said_about = about
-        self.said_no_preset = text == NO_PRESET
+        self.taken_back_on = "open" if text == NO_PRESET else ""
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -295,7 +295,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             self.draft_source = None
         self.draft_path = path
         await self.query_one("#form").load(data, base_dir=path.parent)
-        if self.query_one("#status").has_class("-error") or self.said_no_preset:  # about before: not this one
+        if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one
             self.say("")
         self.modified = modified
         self._saved = None if modified else copy.deepcopy(self._draft())
@@ -367,8 +367,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             else:
                 self.say("The preset is valid: Ctrl+R runs it.")
                 self.said_valid = True
-        elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
-            self.say("")
+        elif (self.said_valid and event.problems) or (self.taken_back_on == "edit" and event.changed):
+            self.say("")  # no longer valid (the title counts the problem), or edited since a run could not start
         self._show_edit_state()
         if (pane := self._mounted("EditPane")) is not None:
             pane.show_problems(event.problems, event.read)

@@ -176,6 +176,7 @@ class RunControl:
                 return
             self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run",
                      about=out_dir if options.resume else None)
+            self.taken_back_on = "" if options.resume else "edit"  # memory, say: an edit may change it
             self._unclaim(out_dir, options)
             return
         try:

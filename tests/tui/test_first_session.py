@@ -128,3 +128,16 @@ async def test_a_duplicate_saved_where_offered_is_named_copy(folders, registry):
         await press_settled(pilot, "d", "enter")
         await wait_until(pilot, lambda: app.draft_path is not None)
     assert yaml.safe_load((folders / "presets" / "tiny-copy.yaml").read_text())["name"] == "small-copy"
+
+
+@sync
+async def test_why_a_run_could_not_start_is_taken_back_once_the_preset_is_edited(folders, registry):
+    """It stayed under the fixed preset ('Cannot run: this run would need ...') above 'valid: Ctrl+R runs it'."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await refuse_for_memory(pilot)
+        refused = status_text(app)
+        await type_into(pilot, "field--spectrum--params--points", "512")
+        after = status_text(app)
+    assert refused.startswith("Cannot run: this run would need")
+    assert after == "", after
