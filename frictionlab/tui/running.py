@@ -372,11 +372,12 @@ class RunControl:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
         goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
         does not happen)."""
+        if isinstance(self.screen, QuitDuringRunScreen) or getattr(self.screen, "asks_to_quit", False):
+            return  # Ctrl+Q again: the question is up; stacked, one n left the same question there
         if self.modified:
-            self.push_screen(
-                ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),
-                lambda yes: yes and self._quit_leaving_or_cancelling_the_run(),
-            )
+            question = ConfirmScreen("The open preset has unsaved changes. Quit anyway?")
+            question.asks_to_quit = True
+            self.push_screen(question, lambda yes: yes and self._quit_leaving_or_cancelling_the_run())
             return
         self._quit_leaving_or_cancelling_the_run()
 

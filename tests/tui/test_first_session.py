@@ -8,11 +8,11 @@ from textual.widgets import DataTable
 
 from frictionlab.preset.schema import NAME_RULE
 from frictionlab.tui.running import NO_PRESET
-from frictionlab.tui.screens.dialogs import NewPresetScreen, PathScreen
+from frictionlab.tui.screens.dialogs import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen
 
 from ..conftest import merge
 from .conftest import (
-    SWEEP, make_app, open_first_preset, press_settled, run_to_the_end, screen_text, started, status_text, sweep_app, sync,
+    SWEEP, long_run_going, make_app, open_first_preset, press_settled, run_to_the_end, screen_text, started, status_text, sweep_app, sync,
     type_into, wait_until,
 )
 
@@ -141,3 +141,31 @@ async def test_why_a_run_could_not_start_is_taken_back_once_the_preset_is_edited
         after = status_text(app)
     assert refused.startswith("Cannot run: this run would need")
     assert after == "", after
+
+
+@sync
+async def test_ctrl_q_twice_asks_once(folders, registry):
+    """Pressed again while its question was up, Ctrl+Q stacked a second one: n left the same question."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--seed", "8")
+        await press_settled(pilot, "escape", "ctrl+q", "ctrl+q")
+        asked = isinstance(app.screen, ConfirmScreen)
+        await press_settled(pilot, "n")
+        after, running = app.screen, app.is_running
+    assert asked and running and not isinstance(after, ConfirmScreen), after
+
+
+@pytest.mark.long
+@sync
+async def test_ctrl_q_twice_during_a_run_asks_once(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    with long_run_going(folders, registry) as (process, out):
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: app.followed is not None)
+            await press_settled(pilot, "ctrl+q", "ctrl+q")
+            asked = isinstance(app.screen, QuitDuringRunScreen)
+            await press_settled(pilot, "escape")
+            after, running = app.screen, app.is_running
+        alive = process.poll() is None
+    assert asked and running and alive and not isinstance(after, QuitDuringRunScreen), after
