@@ -2,6 +2,8 @@
 or the disk: a refusal read whole, no empty folder left by a refused run, a folder typed
 as a file name refused, a preset name the New dialog checks as the form does."""
 
+from pathlib import Path
+
 import pytest
 import yaml
 from textual.widgets import DataTable
@@ -169,3 +171,17 @@ async def test_ctrl_q_twice_during_a_run_asks_once(folders, registry):
             after, running = app.screen, app.is_running
         alive = process.poll() is None
     assert asked and running and alive and not isinstance(after, QuitDuringRunScreen), after
+
+
+@sync
+async def test_a_presets_description_is_shown_whole_at_80x24(folders, registry):
+    """Cut at three lines ('... 300 realizations, F'), the study's numbers it ends with unread."""
+    shipped = Path(__file__).parents[2] / "presets" / "benad2012-fig5.yaml"
+    (folders / "presets" / "fig5.yaml").write_bytes(shipped.read_bytes())
+    description = yaml.safe_load(shipped.read_text())["description"].split()
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "home")  # fig5 comes before tiny
+        screen = " ".join(screen_text(app).split())
+    assert len(" ".join(description)) > 3 * 80  # more than three lines
+    assert " ".join(description[-8:]) in screen and " ".join(description[:8]) in screen, screen
