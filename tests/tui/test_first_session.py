@@ -162,7 +162,7 @@ async def test_ctrl_q_twice_asks_once(folders, registry):
 @sync
 async def test_ctrl_q_twice_during_a_run_asks_once(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
-    with long_run_going(folders, registry) as (process, out):
+    with long_run_going(folders, registry) as (process, _):
         async with started(app) as pilot:
             await wait_until(pilot, lambda: app.followed is not None)
             await press_settled(pilot, "ctrl+q", "ctrl+q")
