@@ -1,6 +1,7 @@
 """What a new user met in a first session at a terminal over SSH, each read off the screen
-or the disk: a refusal read whole, no empty folder left by a refused run, a folder typed
-as a file name refused, a preset name the New dialog checks as the form does."""
+or the disk: messages and descriptions read whole, no empty folder left by a refused run,
+file and preset names checked in the dialogs, a sweep's table inside its tab, one quit
+question however often Ctrl+Q is pressed."""
 
 from pathlib import Path
 
