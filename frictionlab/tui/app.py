@@ -30,6 +30,7 @@ from ..preset import load_preset_file
 from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
+    copy_name,
     is_builtin,
     new_preset_path,
     preset_folders,
@@ -107,6 +108,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
         self.said_about: Path | None = None  # the row the status line speaks of (taken back on leaving it)
+        self.taken_back_on = ""  # "open": the status line says no preset is open; "edit": why a run could not start
         self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
@@ -256,6 +258,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
         self.said_about = about
+        self.taken_back_on = "open" if text == NO_PRESET else ""
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -292,7 +295,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             self.draft_source = None
         self.draft_path = path
         await self.query_one("#form").load(data, base_dir=path.parent)
-        if self.query_one("#status").has_class("-error"):  # about the preset open before: not this one
+        if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one
             self.say("")
         self.modified = modified
         self._saved = None if modified else copy.deepcopy(self._draft())
@@ -314,6 +317,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
         def done(path: Path | None) -> None:
             if path is not None:
+                data["name"] = copy_name(data["name"], path, default)
                 self._write(path, data, then_open=True, template=entry.path)
 
         self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default, self.save_folder), done)
@@ -363,8 +367,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             else:
                 self.say("The preset is valid: Ctrl+R runs it.")
                 self.said_valid = True
-        elif self.said_valid and event.problems:  # it is no longer: the title counts the problem
-            self.say("")
+        elif (self.said_valid and event.problems) or (self.taken_back_on == "edit" and event.changed):
+            self.say("")  # no longer valid (the title counts the problem), or edited since a run could not start
         self._show_edit_state()
         if (pane := self._mounted("EditPane")) is not None:
             pane.show_problems(event.problems, event.read)

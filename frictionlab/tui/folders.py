@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,6 +22,7 @@ from ..io.inputs import read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import builtin_folder, builtin_presets
 from ..preset.reading import MAX_PRESET_BYTES
+from ..preset.schema import NAME_PATTERN
 from ..io.safe_yaml import load_yaml
 
 # The runs' modules (``detached``, ``runfolder``) and the comment-keeping YAML writer are
@@ -137,6 +139,12 @@ def preset_from_template(template: Path, name: str, new_path: Path, registry=Non
         data = resolve_input_paths(data, Path(template).parent, registry)
     data["name"] = name
     return data
+
+
+def copy_name(name: str, path: Path, default: Path) -> str:
+    """A duplicate's name: ``name`` (``<name>-copy``) saved where offered (``default``), else the
+    file's own name when it can name a preset, as New names the file after the preset."""
+    return path.stem if path != default and re.fullmatch(NAME_PATTERN, path.stem) else name
 
 
 def save_preset(path: Path, data: dict, template: Path | None = None) -> None:

@@ -176,12 +176,15 @@ class RunControl:
                 return
             self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run",
                      about=out_dir if options.resume else None)
+            self.taken_back_on = "" if options.resume else "edit"  # memory, say: an edit may change it
+            self._unclaim(out_dir, options)
             return
         try:
             preset = scene.resolved() if sweep is None else sweep.preset_data
             process = start_detached(preset, out_dir, options, source=sweep.source if sweep is not None else None)
         except OSError as exc:  # no process can be started (out of processes, memory)
             self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
+            self._unclaim(out_dir, options)
             return
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
@@ -195,6 +198,14 @@ class RunControl:
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
         self.say(f"{verb} {name} into {out_dir} as a process of its own "
                  f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
+
+    @staticmethod
+    def _unclaim(out_dir: Path, options: RunOptions) -> None:
+        """A fresh run's folder, made to claim its name, given back when the run is refused
+        before it began: empty, it is removed (each refused Ctrl+R left one in runs/)."""
+        if not options.resume:
+            with suppress(OSError):  # not empty, or gone: left as it is
+                out_dir.rmdir()
 
     def _follower(self, folder: Path, scene, sweep, process=None) -> FollowedRun:
         from .following import FollowedRun, FollowedSweep
@@ -361,11 +372,12 @@ class RunControl:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
         goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
         does not happen)."""
+        if isinstance(self.screen, QuitDuringRunScreen) or getattr(self.screen, "asks_to_quit", False):
+            return  # Ctrl+Q again: the question is up; stacked, one n left the same question there
         if self.modified:
-            self.push_screen(
-                ConfirmScreen("The open preset has unsaved changes. Quit anyway?"),
-                lambda yes: yes and self._quit_leaving_or_cancelling_the_run(),
-            )
+            question = ConfirmScreen("The open preset has unsaved changes. Quit anyway?")
+            question.asks_to_quit = True
+            self.push_screen(question, lambda yes: yes and self._quit_leaving_or_cancelling_the_run())
             return
         self._quit_leaving_or_cancelling_the_run()
 

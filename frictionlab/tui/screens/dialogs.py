@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from textual.app import ComposeResult
@@ -11,6 +12,8 @@ from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
+from ...preset.problems import shown_value
+from ...preset.schema import NAME_PATTERN, NAME_RULE
 from ..folders import new_preset_path
 from ..widgets.keyinput import KeyInput
 
@@ -84,6 +87,8 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
     if not text:
         return None, "path: must not be empty"
     path = Path(text).expanduser()
+    if path.is_dir():  # before .yaml is added: a folder typed was saved as <folder>.yaml beside it
+        return None, f"path: {path} is a folder; give a file name"
     if path.suffix not in (".yaml", ".yml"):
         path = path.with_name(path.name + ".yaml")
     if path.is_dir():
@@ -179,6 +184,9 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         name = self.query_one("#new-name", Input).value.strip()
         if not name:
             show_error(error, "name: must not be empty")
+            return
+        if not re.fullmatch(NAME_PATTERN, name):  # as the form would say at once, and Ctrl+R refuse
+            show_error(error, f"name: {NAME_RULE}, got {shown_value(name)}")
             return
         path, problem = preset_path_problem(self.query_one("#new-path", Input).value, self.folder)
         if path is None:

@@ -63,6 +63,9 @@ def _contact_lines(count) -> list[str]:
     return ["", "points in contact", f"  {count[0]:.2f} at first load", f"  {count[-1]:.2f} at last load"]
 
 
+PLOT_ROWS = 10  # a sweep's plot keeps its whole legend (final fit and contacts): #run-body's min-height
+
+
 class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     BINDINGS = [
         Binding("r", "start", "Run", tooltip="the open preset (again)", show=False),  # the footer has ^r Run
@@ -106,6 +109,24 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _set(self, widget_id: str, text: str | Content) -> None:
         """Show ``text`` as it is: names, values and errors are never read as markup."""
         self.query_one(f"#{widget_id}", Static).update(Content(text) if isinstance(text, str) else text)
+        if widget_id in ("run-stats", "run-error"):  # one line or two: the table's room changes
+            self.call_after_refresh(self._fit_table)
+
+    def on_resize(self) -> None:
+        self.call_after_refresh(self._fit_table)
+
+    def _fit_table(self) -> None:
+        """A sweep's table of points is as tall as its rows, up to 40 % of the tab and no more
+        than the plot's PLOT_ROWS leave: taller, its last rows lay below the tab, out of sight
+        and out of its own scroll's reach (rows 5 to 8 of 8 points at 80x24); it scrolls instead."""
+        table = self.query_one("#sweep-table", DataTable)
+        if not table.display or not self.size.height:
+            return
+        others = sum(child.outer_size.height for child in self.children
+                     if child.display and child is not table and child.id != "run-body")  # fmt: skip
+        height = max(3, min(self.size.height * 2 // 5, self.size.height - others - PLOT_ROWS))
+        if table.styles.max_height is None or table.styles.max_height.value != height:
+            table.styles.max_height = height
 
     def _error(self, text: str) -> None:
         self._set("run-error", Content.styled(shown(text), "red"))  # a run's error may quote a file
