@@ -19,6 +19,8 @@ from .conftest import (
     type_into, wait_until,
 )
 
+pytestmark = pytest.mark.long  # a TUI session each, 2 to 5 s: with the long tests, as the other sessions are
+
 
 async def refuse_for_memory(pilot):
     """The tiny preset's line made 10^12 points long, then Ctrl+R: refused, as it cannot fit."""
@@ -99,7 +101,6 @@ async def test_no_preset_open_is_taken_back_once_one_opens(folders, registry):
     assert after == "", after
 
 
-@pytest.mark.long
 @sync
 async def test_a_sweeps_table_of_eight_points_shows_each_row_at_80x24(folders, registry):
     """Its last rows lay below the tab: 4 of 8 on screen, and the arrows on the table did not reach them."""
@@ -168,7 +169,6 @@ async def test_ctrl_q_twice_asks_once(folders, registry):
     assert asked and running and not isinstance(after, ConfirmScreen), after
 
 
-@pytest.mark.long
 @sync
 async def test_ctrl_q_twice_during_a_run_asks_once(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
