@@ -39,7 +39,7 @@ from .instrument_file import (
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import line_form_warning
+from .scan_shaping import level_line, line_form_warning
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -134,7 +134,7 @@ class ProfileFile(MeasuredFile):
                     )
                 dx = p.spacing
         mode = p.detrend if p.detrend is not None else "tilt" if instrument else "mean"
-        heights = _detrend(z, mode)
+        heights = level_line(z, mode)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
         if not rms > 1e-12 * scale:  # also true for scale == 0
@@ -363,23 +363,3 @@ def _uniform_spacing(where: str, x: np.ndarray) -> float:
             f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
         )
     return float(dx)
-
-
-def remove_mean(z: np.ndarray) -> np.ndarray:
-    """A new array: ``z`` minus its mean (a line or a map)."""
-    return z - z.mean()
-
-
-def _detrend(z: np.ndarray, mode: str) -> np.ndarray:
-    if mode == "none":
-        return z.copy()
-    out = remove_mean(z)
-    if mode in ("tilt", "quadratic"):
-        t = np.arange(z.size, dtype=np.float64)
-        t -= t.mean()
-        out -= (np.dot(t, out) / np.dot(t, t)) * t  # least-squares slope (t and out are centred)
-        if mode == "quadratic" and z.size > 2:  # t^2 less its mean is orthogonal to 1 and t: one more projection
-            s = t * t
-            s -= s.mean()
-            out -= (np.dot(s, out) / np.dot(s, s)) * s
-    return out

@@ -74,6 +74,20 @@ def level(z: np.ndarray, mode: str) -> Levelling:
     return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
 
 
+def level_line(z: np.ndarray, mode: str) -> np.ndarray:
+    """A new array: the line ``z`` less its least-squares ``mode`` (none: a copy; mean; tilt: also
+    t; quadratic: also t^2), one projection per term of the orthogonal basis ``_axis`` (``level``'s
+    along one axis)."""
+    if mode == "none":
+        return z.copy()
+    out = z - z.mean()
+    t, t2 = _axis(z.size)
+    removed = {"tilt": (t,), "quadratic": (t, t2) if z.size > 2 else (t,)}.get(mode, ())
+    for basis in removed:  # each orthogonal to the constant and to the other: one projection each
+        out -= (np.dot(basis, out) / np.dot(basis, basis)) * basis
+    return out
+
+
 def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     """The caveat of a map whose height is mostly a tilt or a curvature left in it."""
     plane, curvature = levelled.plane_share, levelled.curvature_share
