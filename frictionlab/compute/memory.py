@@ -279,7 +279,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
             if most >= 1:
                 advice.append(f"--workers 1 and realizations <= {most:,}")
             else:  # no count of realizations fits (it offered 'realizations <= 0'): only a smaller grid does
-                advice.append(f"fewer points: one realization of {one.points:,} points alone needs "
+                advice.append(f"fewer points: one realization of {points_text(one.points)} points alone needs "
                               f"{gib(one.per_realization)} (a measured scan: crop it or make its pixels coarser)")  # fmt: skip
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
