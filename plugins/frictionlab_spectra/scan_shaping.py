@@ -162,6 +162,7 @@ MAX_SPIKE_FRACTION = 0.05  # despike replaces at most this share of a map's poin
 
 
 SPIKE_K = 6.0  # rms heights above the median around it: what despike's usual value calls a spike
+SPIKE_WINDOW = 5  # pixels a side of the square whose median a point is measured from (despike and its caveat)
 SPIKE_LOOKED_AT = 16  # the highest points looked at for spikes: those that carry the first contact
 
 
@@ -180,8 +181,9 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     spikes = 0
     for index in high:
         row, column = divmod(int(index), nx)
-        rows = [_reflect(r, ny) for r in range(row - 2, row + 3)]
-        columns = [_reflect(c, nx) for c in range(column - 2, column + 3)]
+        half = SPIKE_WINDOW // 2
+        rows = [_reflect(r, ny) for r in range(row - half, row + half + 1)]
+        columns = [_reflect(c, nx) for c in range(column - half, column + half + 1)]
         if z[row, column] - np.median(z[np.ix_(rows, columns)]) > SPIKE_K * rms:
             spikes += 1
     if not spikes:
@@ -205,7 +207,7 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     from scipy import ndimage, sparse
     from scipy.sparse.linalg import spsolve
 
-    local = ndimage.median_filter(z, size=5, mode="reflect")
+    local = ndimage.median_filter(z, size=SPIKE_WINDOW, mode="reflect")
     spike = np.abs(z - local) > k * rms
     count = int(np.count_nonzero(spike))
     if count > MAX_SPIKE_FRACTION * z.size:  # refused before one equation per point is built (a 4096^2 map: hours)
