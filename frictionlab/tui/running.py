@@ -22,7 +22,7 @@ from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
 from .folders import read_run
 from .messages import RunCrashed, RunFinished
-from .screens import ConfirmScreen, QuitDuringRunScreen
+from .screens import QuitDuringRunScreen, QuitUnsavedScreen
 from .text import failure_message
 
 if TYPE_CHECKING:
@@ -372,12 +372,10 @@ class RunControl:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
         goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
         does not happen)."""
-        if isinstance(self.screen, QuitDuringRunScreen) or getattr(self.screen, "asks_to_quit", False):
+        if isinstance(self.screen, (QuitUnsavedScreen, QuitDuringRunScreen)):
             return  # Ctrl+Q again: the question is up; stacked, one n left the same question there
         if self.modified:
-            question = ConfirmScreen("The open preset has unsaved changes. Quit anyway?")
-            question.asks_to_quit = True
-            self.push_screen(question, lambda yes: yes and self._quit_leaving_or_cancelling_the_run())
+            self.push_screen(QuitUnsavedScreen(), lambda yes: yes and self._quit_leaving_or_cancelling_the_run())
             return
         self._quit_leaving_or_cancelling_the_run()
 

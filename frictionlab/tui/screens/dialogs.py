@@ -59,6 +59,13 @@ class ConfirmScreen(Dialog, ModalScreen[bool]):
         self.dismiss(value)
 
 
+class QuitUnsavedScreen(ConfirmScreen):
+    """Quit with unsaved changes? (A screen of its own kind: Ctrl+Q again while it is up asks nothing more.)"""
+
+    def __init__(self):
+        super().__init__("The open preset has unsaved changes. Quit anyway?")
+
+
 class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
     """Quit while a run goes on: leave it running ("leave"), cancel it ("cancel"), or stay (None)."""
 
