@@ -232,9 +232,10 @@ def bootstrap_coefficients(
     per_realization = xi_per_realization @ projector.T if average is None else None  # (M, 2)
     widest = realizations if average is None else max(realizations, projector.shape[1])  # counts, or curves
     rows = max(1, BOOTSTRAP_BLOCK_BYTES // (8 * widest))  # this many resamples at once
+    equal = np.full(realizations, 1.0 / realizations)  # each realization's chance in a draw
     pairs = []
     for start in range(0, bootstrap, rows):  # the draws of one call of size=bootstrap, block by block
-        counts = rng.multinomial(realizations, np.full(realizations, 1.0 / realizations), size=min(rows, bootstrap - start))
+        counts = rng.multinomial(realizations, equal, size=min(rows, bootstrap - start))
         if average is None:
             pairs.append(counts @ per_realization / realizations)
         else:
