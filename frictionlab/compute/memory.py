@@ -10,7 +10,12 @@ the boundary elements of the half-space: about 1.5x the line pipeline):
   97 when the largest load reaches full contact and every point is sorted;
   ``BYTES_PER_POINT`` takes the worst case with a margin;
 * a process with numpy, scipy and frictionlab imported holds about 70 MiB;
-* the main process keeps every finished realization's per-load arrays.
+* the main process keeps every finished realization's per-load arrays;
+* a surface pressed as its MDR-equivalent line is pressed on a line of
+  2 sqrt(A / pi) / dx points, but the main process first makes that line from the
+  whole surface (``SpectrumGenerator.equivalent_line_bytes``), and
+  keeps what the surface derived (its synthesis, its map) for the rest of the run;
+  worker processes are sent the line alone (``Scene.for_workers``).
 """
 
 from __future__ import annotations
@@ -35,19 +40,32 @@ WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per wor
 # its nanny (measured 95 MiB with frictionlab and the plugins imported, after a run).
 DASK_WORKER_PROCESS = 128 * MiB
 KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the file being written
+# Making the MDR-equivalent line of a surface whose spectrum does not say what it takes
+# (``SpectrumGenerator.equivalent_line_bytes``), per point of the surface: the built-in
+# spectra's worst, a non-periodic map read, reflected across its edges and transformed
+# (72 B measured), plus a third.
+EQUIVALENT_LINE_BYTES_PER_POINT = 96
 
 
 @dataclass(frozen=True)
 class MemoryEstimate:
-    points: int  # grid points of one realization
+    points: int  # grid points of one realization (of the line, for an MDR-equivalent line)
     workers: int
     executor: str
     per_realization: int  # bytes one realization needs while it runs
     per_worker: int  # a worker process: its base plus one realization
-    main: int  # the main process: base plus the kept rows
+    main: int  # the main process: base plus the kept rows (and the making of an equivalent line)
     total: int  # the peak of the whole run on this machine
+    grid: int  # points of the spectrum's grid (the surface's, for an MDR-equivalent line)
+    making: int = 0  # bytes the main process takes to make the MDR-equivalent line of the surface
 
     def describe(self) -> str:
+        if self.making:
+            return (
+                f"{gib(self.total)} (making the MDR-equivalent line of a surface of {points_text(self.grid)} points: "
+                f"{gib(self.making)}, then {self.workers} realization(s) at a time of {points_text(self.points)} points: "
+                f"{gib(self.per_realization)} each)"
+            )
         if self.executor == "serial":
             return (
                 f"{gib(self.total)} (one realization of {points_text(self.points)} points: {gib(self.per_realization)}, "
@@ -71,16 +89,35 @@ def points_text(n: int) -> str:
     return f"{n:,}" if n < 10**12 else f"{float(n):.3g}"
 
 
+def maps_to_line(scene: Scene) -> bool:
+    """Whether the run presses the MDR-equivalent line of its surface: made already, or
+    not yet (``line_to_make``)."""
+    return scene.equivalent_line is not None or line_to_make(scene)
+
+
+def line_to_make(scene: Scene) -> bool:
+    """Whether this process has yet to make the MDR-equivalent line of the scene's surface:
+    ``build_scene`` checks the memory before it makes it (once made, the peak of making it
+    is past, and what the surface keeps is in the memory this process already uses)."""
+    return scene.equivalent_line is None and scene.spectrum.dimension not in scene.solver.dimensions
+
+
+def line_points(surface_points: int) -> int:
+    """Points of the MDR-equivalent line of a surface of ``surface_points`` square pixels:
+    ceil(2 sqrt(A / pi) / dx), whatever dx (``equivalent_line.line_grid``; at least 8)."""
+    return max(8, math.ceil(2.0 * math.sqrt(surface_points / math.pi) * (1 - 1e-12)))
+
+
 def grid_points(scene: Scene) -> int:
-    """Points of one realization: from the spectrum's ``grid_shape()``, else by
-    generating realization 0 once (0 if that fails)."""
-    shape = scene.generator.grid_shape()
+    """Points of the spectrum's grid: from its ``grid_shape()``, else by generating
+    realization 0 once (0 if that fails). For an MDR-equivalent line, the surface's."""
+    shape = scene.spectrum.grid_shape()
     if shape is not None:
         return math.prod(shape)
     from ..preset.seeds import realization_rng
 
     try:
-        return scene.generator.generate(realization_rng(scene.preset.seed, 0)).points
+        return scene.spectrum.generate(realization_rng(scene.preset.seed, 0)).points
     except Exception:  # the run itself reports a spectrum that fails, per realization
         return 0
 
@@ -99,19 +136,32 @@ def kept_arrays(scene: Scene) -> int:
     return 5 if scene.forces_vary else 4
 
 
+def _making_line(scene: Scene, points: int) -> int:
+    """Bytes that making the MDR-equivalent line of a surface of ``points`` points takes: what
+    the spectrum declares for its own grid, in proportion for another."""
+    declared, grid = scene.spectrum.equivalent_line_bytes(), grid_points(scene)
+    if declared is None or grid < 1:
+        return points * EQUIVALENT_LINE_BYTES_PER_POINT
+    return declared if points == grid else math.ceil(declared * points / grid)
+
+
 def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = None) -> MemoryEstimate:
-    points = grid_points(scene) if points is None else points
+    """The peak memory of ``scene``'s run; ``points``: of the spectrum's grid (default
+    ``grid_points``), the surface's when its MDR-equivalent line is pressed."""
+    grid = grid_points(scene) if points is None else points
+    points = line_points(grid) if maps_to_line(scene) else grid
+    making = _making_line(scene, grid) if line_to_make(scene) else 0
     steps = int(scene.loads.size)
     kept = scene.preset.realizations * (steps * 8 * kept_arrays(scene) * KEPT_COPIES + 512)
     per_realization = points * bytes_per_point(scene) + steps * BYTES_PER_STEP
-    main = PROCESS_BASE + kept
+    main = PROCESS_BASE + kept + making  # what the surface keeps of its making stays in this process
     if executor == "serial":
         per_worker, total, workers = 0, main + per_realization, 1
     else:
         per_worker = WORKER_BASE.get(executor, WORKER_BASE["dask"]) + per_realization
         # the main process measures one realization before the workers start
         total = main + max(per_realization, workers * per_worker)
-    return MemoryEstimate(points, workers, executor, per_realization, per_worker, main, total)
+    return MemoryEstimate(points, workers, executor, per_realization, per_worker, main, total, grid, making)
 
 
 def available_memory() -> tuple[int, str]:
@@ -213,13 +263,23 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
             continue
         points_param = _points_path(scene)
         fits = _largest_process(estimate(scene, workers=1, executor=executor, points=1)) <= room
-        advice = (f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}" if points_param and fits
-                  else "fewer realizations")  # fmt: skip
+        if points_param and fits:
+            advice = f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}"
+        else:  # only a smaller map helps when its line alone does not fit: no count of realizations does
+            advice = _smaller_map(guess) if guess.making + PROCESS_BASE > room else "fewer realizations"
+        making = (f"making the MDR-equivalent line of a surface of {points_text(guess.grid)} points in the main process: "
+                  f"{gib(guess.making)}, " if guess.making else "")  # fmt: skip
         raise RunError(
-            f"one process of this run would need about {gib(need)} at its peak (a realization of {points_text(guess.points)} points: "
-            f"{gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
+            f"one process of this run would need about {gib(need)} at its peak ({making}a realization of "
+            f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
             f"limit to itself). It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
         )
+
+
+def _smaller_map(guess: MemoryEstimate) -> str:
+    """The advice when making a surface's MDR-equivalent line alone does not fit."""
+    return (f"fewer points: making the MDR-equivalent line of a surface of {points_text(guess.grid)} points alone "
+            f"needs {gib(guess.making)} (a measured map: crop it or make its pixels coarser)")
 
 
 def _points_path(scene: Scene) -> str | None:
@@ -239,7 +299,7 @@ def _in_dask_worker(guess: MemoryEstimate) -> int:
 def _most_points(scene: Scene, executor: str, available: int, need=_total) -> int:
     """The largest points per side (``SpectrumGenerator.points_param``) whose one-worker
     estimate fits: ``need(estimate) <= available`` (by default the run's whole peak)."""
-    dimension = scene.generator.dimension
+    dimension = scene.spectrum.dimension
     low, high = 1, 2
     while need(estimate(scene, workers=1, executor=executor, points=high**dimension)) <= available:
         low, high = high, 2 * high
@@ -265,19 +325,21 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         return guess
     advice = []
     for fewer in range(workers - 1, 0, -1):
-        if estimate(scene, workers=fewer, executor=executor, points=guess.points).total <= available:
+        if estimate(scene, workers=fewer, executor=executor, points=guess.grid).total <= available:
             advice.append(f"--workers {fewer}")
             break
     if not advice:
-        one = estimate(scene, workers=1, executor=executor, points=guess.points)
+        one = estimate(scene, workers=1, executor=executor, points=guess.grid)
         points_param = _points_path(scene)
-        if one.total - one.per_realization + bytes_per_point(scene) < available and points_param:
+        if estimate(scene, workers=1, executor=executor, points=1).total <= available and points_param:
             advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * kept_arrays(scene) * KEPT_COPIES + 512
-            most = math.floor((available - PROCESS_BASE - one.per_realization) / rows)
+            most = math.floor((available - PROCESS_BASE - one.making - one.per_realization) / rows)
             if most >= 1:
                 advice.append(f"--workers 1 and realizations <= {most:,}")
+            elif one.making:  # no count of realizations fits: only a smaller surface does
+                advice.append(_smaller_map(one))
             else:  # no count of realizations fits (it offered 'realizations <= 0'): only a smaller grid does
                 advice.append(f"fewer points: one realization of {points_text(one.points)} points alone needs "
                               f"{gib(one.per_realization)} (a measured scan: crop it or make its pixels coarser)")  # fmt: skip

@@ -40,6 +40,10 @@ class SpectrumGenerator(Plugin):
     - ``equivalent_line()``: for a surface, its MDR-equivalent line (a spectrum of
       lines whose length is ``mdr_length`` of the surface's area), which a solver
       of lines presses instead. Default None (no MDR mapping).
+    - ``equivalent_line_bytes()``: the peak memory ``equivalent_line()`` allocates (reading
+      a measured map included), known without making the line: the memory check runs
+      before it is made. Default None: the framework assumes its own upper bound per point
+      of ``grid_shape()`` (``frictionlab.compute.memory.EQUIVALENT_LINE_BYTES_PER_POINT``).
     - ``c0()``: the prefactor C0 of a power-law PSD. Default NotImplementedError.
     - ``hurst_exponent()``: H of a self-affine spectrum, or None (the default).
     - ``input_summary()``: for a profile or surface read from a file, what was read and
@@ -84,6 +88,9 @@ class SpectrumGenerator(Plugin):
         return None
 
     def equivalent_line(self) -> SpectrumGenerator | None:
+        return None
+
+    def equivalent_line_bytes(self) -> int | None:
         return None
 
     def c0(self) -> float:

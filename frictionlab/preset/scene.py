@@ -107,6 +107,16 @@ class Scene:
         """Whether each realization has forces of its own (indentation control, contact fractions)."""
         return self.control == "indentation" or self.preset.loading.unit == "contact-fraction"
 
+    def for_workers(self) -> Scene:
+        """The scene a worker process is sent: with an MDR-equivalent line, the surface's
+        spectrum without what it derived to make the line (its synthesis, its map, as large as
+        the surface), which a worker pressing the line never uses; the loads worked out here kept."""
+        if self.equivalent_line is None:
+            return self
+        slim = replace(self, spectrum=type(self.spectrum)(self.spectrum.params))
+        slim.__dict__.update({key: value for key, value in self.__dict__.items() if key not in slim.__dict__})
+        return slim
+
     def plugins(self) -> dict:
         """The plugin the preset names for each kind (the spectrum, not its equivalent line)."""
         return {"spectrum": self.spectrum, "solver": self.solver, "slope": self.slope}
@@ -147,9 +157,9 @@ def build_scene(
     """Validate preset data (structure, then each plugin's params) into a Scene.
     ``base_dir``: the folder relative input-file paths in ``data`` are taken
     from (the preset file's; without it, the current folder). ``before_reading(scene)``
-    is called before a measured file is read whole (the memory check, which needs only
-    the spectrum's ``grid_shape()``), unless the map must be read to make its
-    MDR-equivalent line."""
+    is called before a measured file is read whole and before a surface's MDR-equivalent
+    line is made (the memory check, which needs only the spectrum's ``grid_shape()``):
+    then with the scene as it will be, less its line (``equivalent_line`` None)."""
     registry = registry or default_registry()
     if not isinstance(data, dict):
         raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
@@ -190,13 +200,21 @@ def build_scene(
     if measured:  # what the memory check needs (a table without a header is read whole here)
         _read_checked(spectrum.periodic, source)
         _read_checked(spectrum.grid_shape, source)
-    if measured and spectrum.dimension not in plugins["solver"].dimensions:
-        _read_checked(spectrum.rms_height, source)  # its MDR-equivalent line is made from the whole map
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in KINDS:
         getattr(preset, slot).name = plugins[slot].name
-    scene = Scene(preset=preset, **_match_dimensions(plugins, registry, source))
-    if before_reading is not None:
+    checked = []
+
+    def check_then_read(line_of: dict) -> None:
+        """The memory check, then the whole measured file: before a line is made of the surface."""
+        if before_reading is not None:
+            before_reading(Scene(preset=preset, **line_of))
+        checked.append(True)
+        if measured:
+            _read_checked(spectrum.rms_height, source)
+
+    scene = Scene(preset=preset, **_match_dimensions(plugins, registry, source, before_line=check_then_read))
+    if before_reading is not None and not checked:
         before_reading(scene)
     if measured:
         _read_checked(spectrum.rms_height, source)
@@ -211,14 +229,18 @@ def _read_checked(read: Callable[[], object], source: str | None) -> None:
         raise PresetError([f"spectrum.params: {exc}"], source=source) from None
 
 
-def _match_dimensions(plugins: dict, registry: Registry, source: str | None) -> dict:
+def _match_dimensions(plugins: dict, registry: Registry, source: str | None,
+                      before_line: Callable[[dict], None] = lambda plugins: None) -> dict:  # fmt: skip
     """Fit the geometry to what the solver and the slope estimator accept: a surface goes to a
-    solver of lines as its MDR-equivalent line; any other mismatch is a PresetError, and so is
-    a non-periodic profile (a scan) given to a solver or estimator of periodic profiles only."""
+    solver of lines as its MDR-equivalent line (``before_line(plugins)`` is called before it is
+    made); any other mismatch is a PresetError, and so is a non-periodic profile (a scan) given
+    to a solver or estimator of periodic profiles only."""
     spectrum, solver, slope = plugins["spectrum"], plugins["solver"], plugins["slope"]
     made = spectrum.dimension
     shape = {1: "lines", 2: "surfaces"}
     if made not in solver.dimensions:
+        if made == 2 and 1 in solver.dimensions:
+            before_line(plugins)
         try:
             line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
         except ValueError as exc:

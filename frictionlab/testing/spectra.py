@@ -24,7 +24,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
     None, gives 2 N points (per side) over the same length; ``equivalent_line()``
     is None or, for a surface, a spectrum of lines 2 sqrt(A / pi) long with the
-    surface's rms height, itself checked; ``c0()`` is NotImplementedError or
+    surface's rms height, itself checked; ``equivalent_line_bytes()`` is None or, for a
+    spectrum with such a line, a whole number >= 0; ``c0()`` is NotImplementedError or
     finite > 0; ``hurst_exponent()`` is None or finite >= 0; ``input_summary()`` is None or
     a JSON-ready mapping whose ``shape``, ``spacing`` and ``rms_height`` are those of what
     ``generate()`` makes and ``rms_height()``, with ``file`` and ``unit``;
@@ -90,8 +91,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
 
 
 def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
-    """periodic(), points_param, grid_shape(), refined(), equivalent_line(), c0(), hurst_exponent(),
-    input_summary()."""
+    """periodic(), points_param, grid_shape(), refined(), equivalent_line(), equivalent_line_bytes(), c0(),
+    hurst_exponent(), input_summary()."""
     import numpy as np
 
     from frictionlab.plugin import SpectrumGenerator, mdr_length
@@ -126,6 +127,10 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
                        f"{extent:g}. Got shape {made.heights.shape}, spacing {made.spacing!r}.")  # fmt: skip
 
     line = call(cls, "equivalent_line()", gen.equivalent_line)
+    making = call(cls, "equivalent_line_bytes()", gen.equivalent_line_bytes)
+    if making is not None and (line is None or not isinstance(making, int) or isinstance(making, bool) or making < 0):
+        fail(cls, f"equivalent_line_bytes() must be None, or for a spectrum with an equivalent_line() a whole number "
+                  f"of bytes >= 0. Got {making!r} instead.")  # fmt: skip
     if line is not None:
         if cls.dimension != 2 or not isinstance(line, SpectrumGenerator) or line.dimension != 1:
             fail(cls, "equivalent_line() must be None, or (for a surface) a SpectrumGenerator of lines. "

@@ -71,6 +71,9 @@ def test_spectrum_check_fails_for_wrong_declarations():
     cls = spectrum_variant("LineOfALine", equivalent_line=lambda self: GoodSpectrum())
     with pytest.raises(AssertionError, match=r"equivalent_line\(\) must be None"):
         fltesting.check_spectrum(cls)
+    cls = spectrum_variant("MakesNoLineButSaysItsCost", equivalent_line_bytes=lambda self: 1024)  # a line has no line
+    with pytest.raises(AssertionError, match=r"equivalent_line_bytes\(\) must be None"):
+        fltesting.check_spectrum(cls)
     # GoodSpectrum's lines all have rms 1: an own h that follows each line's first height differs between them
     cls = spectrum_variant("OwnHeightPerLine", profile_rms_height=lambda self, profile: 1.0 + abs(float(profile.heights[0])))
     with pytest.raises(AssertionError, match=r"profile_rms_height\(profile\) must be one h for the ensemble"):

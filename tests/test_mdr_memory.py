@@ -1,0 +1,124 @@
+"""The memory of a surface pressed as its MDR-equivalent line: the line is short
+(2 sqrt(A / pi) / dx points), but the main process makes it from the whole surface
+(its synthesis, or its map read and transformed). The check counts that making and runs
+before it, and worker processes are sent the line, not what the surface derived."""
+
+from __future__ import annotations
+
+import pickle
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from frictionlab.compute import engine, memory
+from frictionlab.errors import RunError
+from frictionlab.options import RunOptions
+from frictionlab.preset import Scene, build_scene
+from frictionlab.runs.runner import memory_check_before_reading
+
+from .conftest import SMALL_PRESET, merge
+from .test_executors import same_numbers
+
+MiB = 2**20
+
+
+def mdr_surface(points: int, **changes) -> dict:
+    """A power-law surface with every mode of its grid in the band (short_cutoff 2 pixels:
+    the largest synthesis per point), pressed by MDR."""
+    return merge(SMALL_PRESET, {
+        "realizations": 2, "fit": {"bootstrap": 20},
+        "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": points, "spacing": 1.0,
+                                                         "short_cutoff": 2.0, "rms_height": 1.0}},
+        **changes,
+    })  # fmt: skip
+
+
+def mdr_map(path, **params) -> dict:
+    data = merge(SMALL_PRESET, {"realizations": 1, "fit": {"bootstrap": 20}})
+    data["spectrum"] = {"name": "surface-file", "params": {"path": str(path), "spacing": 1.0, **params}}
+    return data
+
+
+def before_its_line(scene: Scene) -> Scene:
+    """The scene ``build_scene`` checks: the same, its line not made yet."""
+    return Scene(preset=scene.preset, spectrum=scene.spectrum, solver=scene.solver, slope=scene.slope)
+
+
+def traced_peak(make) -> int:
+    """Bytes numpy and Python allocate at the peak of ``make()`` above what was in use before."""
+    tracemalloc.start()
+    try:
+        floor = tracemalloc.get_traced_memory()[0]
+        make()
+        return tracemalloc.get_traced_memory()[1] - floor
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_surface_too_large_for_its_line_to_be_made_is_refused_before_it_is_made(registry, monkeypatch):
+    """The check ran on the line alone (2,312 points here) once the whole surface had been
+    synthesised to make it: a surface too large to synthesise died of MemoryError, a request
+    the check passed. It is refused first, naming the making, with a side that fits."""
+    data = mdr_surface(2048)
+    monkeypatch.setattr(memory, "available_memory", lambda: (256 * MiB, "a test limit"))
+    checked = []
+
+    def check(scene):
+        checked.append(scene)
+        memory_check_before_reading(RunOptions(workers=1))(scene)
+
+    with pytest.raises(RunError) as caught:
+        build_scene(data, registry=registry, before_reading=check)
+    message = str(caught.value)
+    assert "making the MDR-equivalent line of a surface of 4,194,304 points" in message, message
+    assert "but 0.25 GiB is available (a test limit)" in message
+    # refused before anything in proportion to the surface (8 bytes a point is one array of it)
+    peak = traced_peak(lambda: pytest.raises(RunError, build_scene, data, registry=registry, before_reading=check))
+    assert peak < 2048**2
+    side = int(message.split("spectrum.params.points <= ")[1].split(".")[0].replace(",", ""))
+    provisional = checked[0]
+    assert provisional.equivalent_line is None and provisional.spectrum.params.points == 2048
+    fits = memory.estimate(provisional, workers=1, executor="serial", points=side**2).total
+    too_many = memory.estimate(provisional, workers=1, executor="serial", points=(side + 1) ** 2).total
+    assert fits <= 256 * MiB < too_many
+    monkeypatch.setattr(memory, "available_memory", lambda: (fits, "a test limit"))
+    scene = build_scene(mdr_surface(side), registry=registry, before_reading=check)  # the side offered is made
+    assert scene.equivalent_line.grid_shape() == (memory.line_points(side**2),)
+
+
+@pytest.mark.parametrize(
+    "spectrum", ["power-law-2d", "periodic map", "non-periodic map"],
+)
+def test_the_estimate_of_making_the_line_bounds_its_measured_peak(registry, tmp_path, spectrum):
+    """tracemalloc sees numpy's buffers: building the scene (the map read, its FFT, the modes
+    given to the line) peaks under the estimate of making the line, and not far under it."""
+    if spectrum == "power-law-2d":
+        data, points = mdr_surface(1024), 1024**2
+    else:
+        heights = np.random.default_rng(np.random.SeedSequence(11)).normal(size=(512, 768))
+        np.save(tmp_path / "map.npy", heights)
+        data, points = mdr_map(tmp_path / "map.npy", periodic=spectrum == "periodic map"), heights.size
+    built = []
+    peak = traced_peak(lambda: built.append(build_scene(data, registry=registry)))
+    guess = memory.estimate(before_its_line(built[0]), workers=1, executor="serial")
+    assert guess.grid == points and guess.points == built[0].equivalent_line.grid_shape()[0]
+    assert peak <= guess.making
+    assert guess.making < 2.5 * peak
+    # once the line is made, its making is past: the run's estimate is the line's
+    assert memory.estimate(built[0], workers=1, executor="serial").making == 0
+
+
+def test_workers_are_sent_the_line_not_what_the_surface_derived_to_make_it(registry):
+    """Each worker process was sent the whole scene, the surface's synthesis with it (16 bytes
+    a mode, as large as the surface), which no worker pressing the line uses, and which the
+    estimate of a worker does not count. It is sent the line, with the same numbers."""
+    scene = build_scene(mdr_surface(512, realizations=6), registry=registry)
+    assert len(pickle.dumps(scene)) > 8 * 512**2  # the surface's synthesis, here
+    sent = scene.for_workers()
+    assert len(pickle.dumps(sent)) < 512**2 / 8
+    assert sent.equivalent_line is scene.equivalent_line and sent.spectrum.params == scene.spectrum.params
+    serial = engine.run(scene, RunOptions(workers=1, executor="serial"))
+    pooled = engine.run(scene, RunOptions(workers=2, executor="processes"))
+    assert pooled.extra["executor"] == "processes" and pooled.done == 6
+    same_numbers(serial, pooled)
