@@ -87,6 +87,24 @@ def test_a_surface_too_large_for_its_line_to_be_made_is_refused_before_it_is_mad
     assert scene.equivalent_line.grid_shape() == (memory.line_points(side**2),)
 
 
+def test_a_map_too_large_for_its_line_to_be_made_is_refused_before_it_is_read(registry, tmp_path, monkeypatch):
+    """A map pressed by MDR was read whole, then reflected and transformed, before the check,
+    which counted its line alone: it is refused from its .npy header, unread, naming a
+    smaller map (it has no points to offer)."""
+    heights = np.random.default_rng(np.random.SeedSequence(5)).normal(size=(1024, 1024))
+    np.save(tmp_path / "map.npy", heights)
+    data = mdr_map(tmp_path / "map.npy")
+    monkeypatch.setattr(memory, "available_memory", lambda: (192 * MiB, "a test limit"))
+    check = memory_check_before_reading(RunOptions(workers=1))
+    with pytest.raises(RunError) as caught:
+        build_scene(data, registry=registry, before_reading=check)
+    message = str(caught.value)
+    assert "making the MDR-equivalent line of a surface of 1,048,576 points" in message, message
+    assert "It would fit with fewer points: making the MDR-equivalent line" in message
+    peak = traced_peak(lambda: pytest.raises(RunError, build_scene, data, registry=registry, before_reading=check))
+    assert peak < heights.nbytes / 4
+
+
 @pytest.mark.parametrize(
     "spectrum", ["power-law-2d", "periodic map", "non-periodic map"],
 )
