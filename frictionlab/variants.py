@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Callable
 from typing import Any
 
 from .errors import FrictionlabError
@@ -26,22 +27,27 @@ def force_scale(scene: Scene) -> float:
 class SceneFactory:
     """Builds validated variants of one preset's data."""
 
-    def __init__(self, data: dict, registry: Registry, source: str):
+    def __init__(self, data: dict, registry: Registry, source: str,
+                 before_reading: Callable[[Scene], None] | None = None):  # fmt: skip
+        """``before_reading``: the base scene's memory check (``build_scene``), before a
+        measured map is read or an MDR-equivalent line made."""
         self.data = copy.deepcopy(data)
         self.registry = registry
         self.source = source
-        self.base = build_scene(self.data, registry=registry, source=source)
+        self.base = build_scene(self.data, registry=registry, source=source, before_reading=before_reading)
         self._base_scale = force_scale(self.base)
 
-    def make(self, changes: dict[str, Any], *, keep_f_range: bool = True) -> Scene:
+    def make(self, changes: dict[str, Any], *, keep_f_range: bool = True,
+             before_reading: Callable[[Scene], None] | None = None) -> Scene:  # fmt: skip
         """The preset with ``changes`` (dotted path -> value). With ``keep_f_range``
         the force grid is rescaled so the variant sweeps the base scene's f range
-        (a shorter line or another stiffness would otherwise shift it)."""
+        (a shorter line or another stiffness would otherwise shift it).
+        ``before_reading``: as ``build_scene``'s (a memory check)."""
         data = copy.deepcopy(self.data)
         for path, value in changes.items():
             set_path(data, path, value)
         where = f"{self.source} with " + ", ".join(f"{k}={v}" for k, v in changes.items())
-        scene = build_scene(data, registry=self.registry, source=where)
+        scene = build_scene(data, registry=self.registry, source=where, before_reading=before_reading)
         if keep_f_range and scene.preset.loading.unit == "force":  # loads in f keep their f range themselves
             ratio = force_scale(scene) / self._base_scale
             if not math.isclose(ratio, 1.0, rel_tol=1e-12):

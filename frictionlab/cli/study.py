@@ -148,7 +148,7 @@ def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..plugin.registry import default_registry
-    from ..tradeoff.axes import Study
+    from ..tradeoff.axes import PRESET_GRID, Study, refuse_beyond
     from ..tradeoff.outputs import claim_study_folder, recommendation, write_outputs
     from ..tradeoff.scenes import SceneFactory
 
@@ -164,7 +164,8 @@ def run(args) -> ExitCode:
             file=sys.stderr,
         )
         data = {**data, "sweep": None}
-    factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []))
+    factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []),
+                           before_reading=refuse_beyond(*PRESET_GRID))  # before its map is read or its line made
 
     def progress(message: str) -> None:
         if not args.quiet:

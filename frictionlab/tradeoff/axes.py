@@ -167,6 +167,25 @@ def _first_problem(exc: PresetError) -> str:
     return exc.problems[0] if exc.problems else str(exc)
 
 
+PRESET_GRID = ("the preset's grid", "grid (its points)")  # what refuse_beyond names for the preset's own scene
+
+
+def refuse_beyond(what: str, smaller: str) -> Callable[[Scene], None]:
+    """The study's memory check of one scene (a ``build_scene`` ``before_reading``): RunError
+    when one realization of it, run here, would need more than is available."""
+
+    def check(scene: Scene) -> None:
+        guess = estimate(scene, workers=1, executor="serial")
+        available, source = available_memory()
+        if guess.total > available:
+            raise RunError(
+                f"the study would need about {guess.describe()} at its peak for {what}, but "
+                f"{gib(available)} is available ({source}): give a smaller {smaller}"
+            )
+
+    return check
+
+
 class Study:
     """Runs the axes of one preset; ``rows`` collects what is measured."""
 
@@ -263,11 +282,11 @@ class Study:
 
     def check_memory(self) -> None:
         """Refuse (RunError), before anything runs, a study whose largest setting would need more
-        memory than is available: the largest grid factor (and reference grid), else the preset's N."""
-        largest = []  # (what, what to make smaller, scene)
+        memory than is available: the largest grid factor (and reference grid), else the preset's N;
+        each checked before its measured map is read or its MDR-equivalent line made."""
         axes = set(self.options.axes)
         if axes & {"realizations", "steps"}:
-            largest.append(("the preset's grid", "grid (its points)", self.base))
+            refuse_beyond(*PRESET_GRID)(self.base)
         grids = []  # (axis, option, changes, factors), as grid_axis runs them
         if "grid" in axes:
             grids.append(("grid", "--grid-factors", {"realizations": self.grid_m}, self.options.grid_factors))
@@ -281,20 +300,12 @@ class Study:
                 continue
             n = int(round(points * max(factors)))
             refined = generator.refined(n) or {generator.points_param: n}
-            try:
-                scene = self.factory.make({**changes, **{f"spectrum.params.{k}": v for k, v in refined.items()}},
-                                          keep_f_range=False)  # the f range needs a surface generated: not yet
+            check = refuse_beyond(f"the {axis} axis at N = {n:,} ({option} {max(factors):g})", option)
+            try:  # the f range needs a surface generated: not yet
+                self.factory.make({**changes, **{f"spectrum.params.{k}": v for k, v in refined.items()}},
+                                  keep_f_range=False, before_reading=check)  # fmt: skip
             except PresetError:
                 continue  # the axis skips it with a note
-            largest.append((f"the {axis} axis at N = {n:,} ({option} {max(factors):g})", option, scene))
-        available, source = available_memory()
-        for what, smaller, scene in largest:
-            guess = estimate(scene, workers=1, executor="serial")
-            if guess.total > available:
-                raise RunError(
-                    f"the study would need about {guess.describe()} at its peak for {what}, but "
-                    f"{gib(available)} is available ({source}): give a smaller {smaller}"
-                )
 
     # ------------------------------------------------------------ axes
 

@@ -130,3 +130,38 @@ def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path
         err = capsys.readouterr().err
         assert ("the preset's sweep is not studied" in err) is warned
         assert "H = 0.8" in (out / "study.md").read_text()  # the base value, not a point of the sweep
+
+
+MDR_SURFACE = {
+    "name": "mdr-surface", "seed": 3, "realizations": 2, "fit": {"bootstrap": 20},
+    "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 2048, "spacing": 1.0, "short_cutoff": 2.0,
+                                                     "rms_height": 1.0}},
+    "solver": {"name": "mdr"}, "loading": {"start": 0.5, "stop": 20.0, "steps": 8, "spacing": "log"},
+}  # fmt: skip
+
+
+def test_study_refuses_an_mdr_surface_whose_line_cannot_be_made_before_it_is_made(tmp_path, capsys, monkeypatch):
+    """The study made the MDR-equivalent line of the preset's surface (the whole surface's
+    synthesis) before it checked the memory, which counted the line alone: a surface too
+    large to synthesise died of MemoryError ('out of memory: Unable to allocate ...'). It is
+    refused first, naming the making. (The grid axis's surfaces are checked the same way;
+    a refined surface keeps its band, so its making hardly grows.)"""
+    import tracemalloc
+
+    from frictionlab.compute import memory
+
+    monkeypatch.setattr(memory, "available_memory", lambda: (256 * 2**20, "a test limit"))
+    monkeypatch.setattr("frictionlab.tradeoff.axes.available_memory", memory.available_memory)
+    preset, out = write(tmp_path, MDR_SURFACE), tmp_path / "study"
+    tracemalloc.start()
+    try:
+        code = main(["study", str(preset), "--axes", "realizations", "--quiet", "--out", str(out)])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    err = capsys.readouterr().err
+    assert code == ExitCode.RUNTIME_FAILURE, err
+    assert "the study would need about" in err and "making the MDR-equivalent line of a surface of 4,194,304 points" in err
+    assert "for the preset's grid" in err and "Traceback" not in err
+    assert peak < 2048**2 * 8  # not one array of the 2048^2 surface: refused before its synthesis
+    assert not out.exists()
