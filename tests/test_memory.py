@@ -443,3 +443,20 @@ def test_a_grid_too_large_for_one_realization_is_not_offered_no_realizations(tmp
     message = str(caught.value)
     assert "realizations <= 0" not in message
     assert "It would fit with fewer points: one realization of 262,144 points alone needs" in message
+
+
+def test_a_resume_refused_for_memory_says_only_the_worker_count_can_change(registry, monkeypatch):
+    """A resume keeps its stored preset, yet its refusal offered 'spectrum.params.points <= N'
+    as for a new run: it now says that of the advice only --workers applies."""
+    from frictionlab.runs.runner import check_memory
+
+    scene = build_scene(line_of(8_000_000), registry=registry)
+    monkeypatch.setattr(memory, "available_memory", lambda: (GiB // 2, "a test limit"))
+    with pytest.raises(RunError, match=r"spectrum\.params\.points <= [\d,]+\.") as fresh:
+        check_memory(scene, RunOptions(workers=1))
+    assert "A resume" not in str(fresh.value)
+    with pytest.raises(RunError) as resumed:
+        check_memory(scene, RunOptions(workers=1, resume=True))
+    assert str(resumed.value).startswith(str(fresh.value))
+    assert str(resumed.value).endswith("A resume keeps the preset the run was started with: of that advice only "
+                                       "--workers applies; otherwise resume it where more memory is available.")

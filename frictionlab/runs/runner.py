@@ -10,6 +10,7 @@ from pathlib import Path
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..compute.executors import dask_memory_limits
+from ..errors import RunError
 from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
@@ -61,10 +62,17 @@ def check_memory(scene: Scene, options: RunOptions) -> None:
     total = scene.preset.realizations
     workers = options.workers_for(total)
     kind = options.executor_for(workers)
-    check_fits(scene, workers=workers, executor=kind, remote_workers=bool(options.scheduler))
-    if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
-        limits, usable = dask_memory_limits(options.scheduler, workers)
-        check_worker_limits(scene, limits, usable=usable)
+    try:
+        check_fits(scene, workers=workers, executor=kind, remote_workers=bool(options.scheduler))
+        if kind == "dask" and total > 1:  # each Dask worker (the first realization runs here)
+            limits, usable = dask_memory_limits(options.scheduler, workers)
+            check_worker_limits(scene, limits, usable=usable)
+    except RunError as exc:
+        if not options.resume:
+            raise
+        # the advice may name the preset's points or realizations, which a resume cannot change
+        raise RunError(f"{exc} A resume keeps the preset the run was started with: of that advice only "
+                       "--workers applies; otherwise resume it where more memory is available.") from None  # fmt: skip
 
 
 def memory_check_before_reading(options: RunOptions) -> Callable[[Scene], None] | None:
