@@ -138,10 +138,18 @@ def kept_arrays(scene: Scene) -> int:
 
 def _making_line(scene: Scene, points: int) -> int:
     """Bytes that making the MDR-equivalent line of a surface of ``points`` points takes: what
-    the spectrum declares for its own grid, in proportion for another."""
-    declared, grid = scene.spectrum.equivalent_line_bytes(), grid_points(scene)
+    the spectrum declares for its own grid; for another, what it declares with its points
+    parameter set to the side of a square of ``points`` (the advice's grids), else in proportion."""
+    spectrum, grid = scene.spectrum, grid_points(scene)
+    declared = spectrum.equivalent_line_bytes()
     if declared is None or grid < 1:
         return points * EQUIVALENT_LINE_BYTES_PER_POINT
+    side = math.isqrt(points)
+    if points != grid and spectrum.points_param and side * side == points:
+        try:
+            return type(spectrum)(spectrum.params.model_copy(update={spectrum.points_param: side})).equivalent_line_bytes()
+        except ValueError:  # parameters that do not hold at that side: in proportion
+            pass
     return declared if points == grid else math.ceil(declared * points / grid)
 
 
