@@ -6,7 +6,8 @@ Each command runs in a process of its own whose RLIMIT_AS is set before it start
 ``report --figures`` (the paper's presets shrunk), ``validate`` of an instrument file, a
 sweep and a 256 x 256 exact half-space run. Each must end with exit 0 and the numbers of
 the same work done without the limit (in this process); a run that truly needs more is
-refused before it starts, naming the limit. A buffer sized by a cap instead of by the data
+refused before it starts, naming the limit (an MDR run of a surface too large to make its
+line from included, which died of MemoryError once). A buffer sized by a cap instead of by the data
 (16 GiB for a chunk of a few kB) failed every one of them.
 """
 
@@ -178,3 +179,27 @@ def test_a_run_that_needs_more_is_refused_before_it_starts_naming_the_limit(tmp_
     assert done.returncode == 1, done.stderr[-3000:]
     assert "the process limit RLIMIT_AS (ulimit -v)" in done.stderr and "spectrum.params.points <=" in done.stderr
     assert "Traceback" not in done.stderr and not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offered_runs(tmp_path, workers):
+    """An MDR run of a 16384^2 surface with every mode in its band: the check counted the
+    line alone (18,488 points) and passed, then the surface's synthesis died of MemoryError
+    ('out of memory: Unable to allocate 1.00 GiB ...'). It is refused before it is made,
+    naming the making and a side, whose neighbourhood runs under the same limit."""
+    surface = {**SMALL, "realizations": 2, "spectrum": {"name": "power-law-2d", "params": {
+        "hurst": 0.8, "points": 16384, "spacing": 1.0, "short_cutoff": 2.0, "rms_height": 1.0}}}  # fmt: skip
+    done = limited("run", write(tmp_path, "surface", surface), "--out", str(tmp_path / "run"), "--workers", workers,
+                   cwd=tmp_path)  # fmt: skip
+    assert done.returncode == 1, done.stderr[-3000:]
+    assert "making the MDR-equivalent line of a surface of 268,435,456 points" in done.stderr, done.stderr[-3000:]
+    assert "RLIMIT_AS (ulimit -v)" in done.stderr and "out of memory" not in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "run").exists()
+    side = int(done.stderr.split("spectrum.params.points <= ")[1].split(".")[0].replace(",", ""))
+    assert 4000 < side < 16384
+    # the room is the limit less the address space this process holds, which moves by a few MiB
+    # from one process to the next: a side 16 under the offer (9 MiB less to make the line)
+    fits = side - 16
+    offered = {**surface, "spectrum": {**surface["spectrum"], "params": {**surface["spectrum"]["params"], "points": fits}}}
+    ok(limited("run", write(tmp_path, "offered", offered), "--out", str(tmp_path / "fits"), "--workers", workers,
+               "--no-plot", cwd=tmp_path))  # fmt: skip
