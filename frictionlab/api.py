@@ -325,11 +325,12 @@ def run(
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
     scene = build_scene(data, source=source, before_reading=reading)
     if scene.preset.sweep is not None:
+        scene = scene.for_pressing()  # its points are planned anew: of the base, what pressing needs is kept
         from .runs.sweep import plan_sweep, run_sweep
 
         if out is None:
             raise FrictionlabError(f"{source}: a sweep writes a run folder per point: give out=FOLDER")
-        sweep = plan_sweep(data, source=source)
+        sweep = plan_sweep(data, source=source, before_reading=memory_check_before_reading(options))
         run_sweep(sweep, out, options, listeners=[SweepProgress()] if progress else [], plot=plot)
         return load(out)
     return run_scene(scene, out, options, listeners=[ProgressReporter()] if progress else [], plot=plot)

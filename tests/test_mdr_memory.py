@@ -133,10 +133,40 @@ def test_workers_are_sent_the_line_not_what_the_surface_derived_to_make_it(regis
     estimate of a worker does not count. It is sent the line, with the same numbers."""
     scene = build_scene(mdr_surface(512, realizations=6), registry=registry)
     assert len(pickle.dumps(scene)) > 8 * 512**2  # the surface's synthesis, here
-    sent = scene.for_workers()
+    sent = scene.for_pressing()
     assert len(pickle.dumps(sent)) < 512**2 / 8
     assert sent.equivalent_line is scene.equivalent_line and sent.spectrum.params == scene.spectrum.params
     serial = engine.run(scene, RunOptions(workers=1, executor="serial"))
     pooled = engine.run(scene, RunOptions(workers=2, executor="processes"))
     assert pooled.extra["executor"] == "processes" and pooled.done == 6
     same_numbers(serial, pooled)
+
+
+def test_a_sweep_of_mdr_surfaces_checks_each_point_before_its_line_and_keeps_no_surface(registry, monkeypatch):
+    """A sweep planned every point (each surface synthesised to make its line) before any
+    check, and kept every point's synthesis: four 6000^2 surfaces, each of which runs alone
+    under ulimit -v 2 GiB, died of MemoryError while the sweep was planned. Each point is
+    checked before its line is made, and keeps its line, not its surface."""
+    from frictionlab.runs.sweep import plan_sweep
+
+    data = {**mdr_surface(1024), "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.7, 0.8, 0.9]}}}}
+    held = []
+
+    def plan():
+        held.append(plan_sweep(data, registry=registry, before_reading=lambda scene: lines.append(scene.equivalent_line)))
+
+    lines = []  # each point's line when it was checked
+    tracemalloc.start()
+    try:
+        floor = tracemalloc.get_traced_memory()[0]
+        plan()
+        kept = tracemalloc.get_traced_memory()[0] - floor
+    finally:
+        tracemalloc.stop()
+    assert lines == [None] * 4  # each checked before its line was made
+    assert [point.scene.equivalent_line is not None for point in held[0].points] == [True] * 4
+    assert kept < 4 * MiB  # one surface's synthesis is 8 MiB; all four were kept (35 MB)
+    monkeypatch.setattr(memory, "available_memory", lambda: (200 * MiB, "a test limit"))
+    with pytest.raises(RunError, match="making the MDR-equivalent line of a surface of 4,194,304 points"):
+        plan_sweep({**data, "sweep": {"parameters": {"spectrum.params.points": {"values": [256, 2048]}}}},
+                   registry=registry, before_reading=memory_check_before_reading(RunOptions(workers=1)))

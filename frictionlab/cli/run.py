@@ -60,6 +60,8 @@ def run(args) -> ExitCode:
     options = executor_run_options(args, resume=args.resume, force=args.force)
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
     scene = build_scene(data, source=source, before_reading=reading)
+    if scene.preset.sweep is not None:  # its points are planned anew: of the base, what pressing needs is kept
+        scene = scene.for_pressing()
     refuse_empty_path(args.out, "--out", otherwise="leave --out out for runs/<name>-<time>")
     if args.out is not None and (too_long := too_long_path(args.out)):
         raise FrictionlabError(f"--out {too_long}")
@@ -156,10 +158,11 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 
 def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..compute.signals import interrupted_exit_code
+    from ..runs.runner import memory_check_before_reading
     from ..runs.sweep import plan_sweep, run_sweep
     from ..progress import SweepProgress
 
-    sweep = plan_sweep(data, source=str(args.preset))
+    sweep = plan_sweep(data, source=str(args.preset), before_reading=memory_check_before_reading(options))
     try:
         outcome = run_sweep(
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot

@@ -186,7 +186,7 @@ class ProcessExecutor:
                 listener(*payload[1:])
 
         pool = WorkerPool(
-            min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene.for_workers(),),
+            min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene.for_pressing(),),
             retries=self.retries,
         )
         try:
@@ -280,7 +280,7 @@ class DaskExecutor:
         run_id = uuid.uuid4().hex[:8]
         stop_name = f"frictionlab-{run_id}-stop"
         try:
-            scene_arg = _scene_argument(client, scene.for_workers(), len(chunks))
+            scene_arg = _scene_argument(client, scene.for_pressing(), len(chunks))
             keys = [f"frictionlab-{run_id}-{chunk_label(chunk)}" for chunk in chunks]
             chunk_of = dict(zip(keys, chunks))
             # one graph for all the chunks (a submit each is a scheduler round trip each:

@@ -15,7 +15,7 @@ the boundary elements of the half-space: about 1.5x the line pipeline):
   2 sqrt(A / pi) / dx points, but the main process first makes that line from the
   whole surface (``SpectrumGenerator.equivalent_line_bytes``), and
   keeps what the surface derived (its synthesis, its map) for the rest of the run;
-  worker processes are sent the line alone (``Scene.for_workers``).
+  worker processes are sent the line alone (``Scene.for_pressing``).
 """
 
 from __future__ import annotations

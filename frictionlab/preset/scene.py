@@ -107,10 +107,11 @@ class Scene:
         """Whether each realization has forces of its own (indentation control, contact fractions)."""
         return self.control == "indentation" or self.preset.loading.unit == "contact-fraction"
 
-    def for_workers(self) -> Scene:
-        """The scene a worker process is sent: with an MDR-equivalent line, the surface's
-        spectrum without what it derived to make the line (its synthesis, its map, as large as
-        the surface), which a worker pressing the line never uses; the loads worked out here kept."""
+    def for_pressing(self) -> Scene:
+        """The scene with what pressing its profiles needs: with an MDR-equivalent line, the
+        surface's spectrum without what it derived to make the line (its synthesis, its map, as
+        large as the surface), which pressing the line never uses; the loads worked out here
+        kept. What a worker process is sent, and what a sweep keeps of each point."""
         if self.equivalent_line is None:
             return self
         slim = replace(self, spectrum=type(self.spectrum)(self.spectrum.params))

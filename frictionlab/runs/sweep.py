@@ -176,15 +176,15 @@ def _combinations(spec: SweepSettings) -> list[dict[str, Any]]:
     return [dict(zip(paths, row, strict=True)) for row in rows]
 
 
-def plan_sweep(data: dict, registry: Registry | None = None, source: str | None = None) -> Sweep:
-    """Expand preset data with a ``sweep`` section into validated points.
+def plan_sweep(data: dict, registry: Registry | None = None, source: str | None = None, before_reading=None) -> Sweep:
+    """Expand preset data with a ``sweep`` section into validated points, each checked by ``before_reading``.
 
     Every problem of every point is reported at once, each prefixed with
     ``sweep point N (path=value)``; nothing runs unless every point is valid.
     """
     registry = registry or default_registry()
-    base_scene = build_scene(data, registry=registry, source=source)  # the base and the spec itself
-    spec = base_scene.preset.sweep
+    base_preset = build_scene(data, registry=registry, source=source).preset  # the base and the spec itself
+    spec = base_preset.sweep
     if spec is None:
         raise PresetError(["sweep: the preset has no sweep section"], source=source)
     problems = [p for p in (path_problem(path, data, spec, registry) for path in spec.parameters) if p]
@@ -197,16 +197,16 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
     for number, values in enumerate(combos, start=1):
         try:
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
-            scene = build_scene(apply_overrides(base, assignments), registry=registry)
+            scene = build_scene(apply_overrides(base, assignments), registry=registry, before_reading=before_reading)
         except PresetError as exc:
             shown = ", ".join(f"{path}={v!r}" for path, v in values.items())
             problems += [f"sweep point {number} ({shown}): {p}" for p in exc.problems]
             continue
         folder = f"{number:0{width}d}-{_label(values)}"
-        points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene))
+        points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
     if problems:
         raise PresetError(problems, source=source)
-    return Sweep(name=base_scene.preset.name, spec=spec, base=base, points=points, source=source)
+    return Sweep(name=base_preset.name, spec=spec, base=base, points=points, source=source)
 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
