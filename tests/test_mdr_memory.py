@@ -170,3 +170,18 @@ def test_a_sweep_of_mdr_surfaces_checks_each_point_before_its_line_and_keeps_no_
     with pytest.raises(RunError, match="making the MDR-equivalent line of a surface of 4,194,304 points"):
         plan_sweep({**data, "sweep": {"parameters": {"spectrum.params.points": {"values": [256, 2048]}}}},
                    registry=registry, before_reading=memory_check_before_reading(RunOptions(workers=1)))
+
+
+def test_validate_checks_each_point_of_an_mdr_sweep_before_its_line_is_made(registry, tmp_path, monkeypatch, capsys):
+    """``validate`` checked a sweep's base, then made every point's line unchecked: a point
+    too large passed (or died of MemoryError). It is refused, naming the making."""
+    import yaml
+
+    from frictionlab.cli import main
+    from frictionlab.errors import ExitCode
+
+    data = {**mdr_surface(256), "sweep": {"parameters": {"spectrum.params.points": {"values": [256, 2048]}}}}
+    (tmp_path / "sweep.yaml").write_text(yaml.safe_dump(data))
+    monkeypatch.setattr(memory, "available_memory", lambda: (256 * MiB, "a test limit"))
+    assert main(["validate", str(tmp_path / "sweep.yaml")]) == ExitCode.RUNTIME_FAILURE
+    assert "making the MDR-equivalent line of a surface of 4,194,304 points" in capsys.readouterr().err

@@ -38,7 +38,7 @@ def run(args) -> ExitCode:
             source = preset_source(path, args.set or [])
             scene = build_scene(data, source=source, before_reading=check_one_realization)
             if scene.preset.sweep is not None:  # every point too
-                points = len(plan_sweep(data, source=source).points)
+                points = len(plan_sweep(data, source=source, before_reading=check_one_realization).points)
             # its loads in every unit: refused here when the solver cannot take them
             record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
         except FrictionlabError as exc:
