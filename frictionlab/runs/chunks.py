@@ -164,6 +164,21 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
     return np.frombuffer(raw, dtype).astype(np.int64)
 
 
+def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
+    """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
+    complex arrays reached the statistics), xi none infinite or below 0 and the contact counts
+    none below 0 (what a realization can give), and ``failed_error`` is text."""
+    for name in numeric:
+        if arrays[name].dtype.kind not in "iuf":
+            raise ChunkDamage(f"array {name} of type {arrays[name].dtype}, not real numbers")
+    if arrays["failed_error"].dtype.kind != "U":
+        raise ChunkDamage(f"array failed_error of type {arrays['failed_error'].dtype}, not text")
+    if "xi" in numeric and bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
+        raise ChunkDamage("xi infinite or below 0")
+    if "contact_count" in numeric and bool((arrays["contact_count"] < 0).any()):
+        raise ChunkDamage("contact counts below 0")
+
+
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:
     """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
     solver = scene.solver
@@ -207,6 +222,7 @@ def chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Rea
         heights[name] = arrays.get(name, np.full((n, steps), math.nan))
         if heights[name].shape != (n, steps):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
+    _check_values({**arrays, **heights}, (*OK_ARRAYS, *(curves if n else ()), *heights, "failed_seconds"))
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(
