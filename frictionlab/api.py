@@ -420,6 +420,11 @@ def load(folder: str | Path) -> Result | SweepResult:
         raise RunFolderError(
             f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
         )
+    if record.fit is not None and not np.all(np.isfinite(curve["f"]) & (curve["f"] > 0)):
+        raise RunFolderError(  # a run's fit is a law in ln f: it has one only where every f is
+            f"{shown(folder / curve_name)} is damaged: f must be a finite number > 0 at every load step, "
+            "as the fit in summary.json, a law in ln f, needs"
+        )
     if "lines_used" in curve and np.any(curve["lines_used"] > record.realizations.done):
         raise RunFolderError(
             f"{shown(folder / curve_name)} is damaged: lines_used exceeds the {record.realizations.done} "
