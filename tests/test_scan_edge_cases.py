@@ -486,3 +486,43 @@ def test_a_table_whose_lines_end_with_a_separator_is_told_so(tmp_path, text, lin
     (tmp_path / "map.csv").write_text(text)
     with pytest.raises(ValueError, match=rf"line {line} ends with a separator \((comma|semicolon)\), an empty column"):
         SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+
+
+def _npz_as_npy(path, z):
+    np.savez(path.with_suffix(".npz"), z=z)
+    path.with_suffix(".npz").rename(path)
+
+
+def _trailing_bytes(path, z):
+    np.save(path, z)
+    with path.open("ab") as fh:
+        fh.write(np.zeros(3).tobytes())
+
+
+def _cut_short(path, z):
+    np.save(path, z)
+    with path.open("r+b") as fh:
+        fh.truncate(path.stat().st_size - 8)
+
+
+@pytest.mark.parametrize(("write", "said"), [
+    (_npz_as_npy, "an .npz archive (arrays zipped together), not a .npy array; save the heights alone with numpy.save"),
+    (_trailing_bytes, "a damaged .npy file: its header declares an array of shape SHAPE of float64 (BYTES bytes), but the "
+                      "file holds BYTES+24 bytes after it"),
+    (_cut_short, "a damaged .npy file: its header declares an array of shape SHAPE of float64 (BYTES bytes), but the "
+                 "file holds BYTES-8 bytes after it"),
+    (lambda path, z: np.save(path, (z * 1000).astype("timedelta64[s]")),
+     "non-numeric content (array dtype timedelta64[s]); expected real numbers"),
+])  # fmt: skip
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_path, write, said, plugin):
+    """An .npz saved under .npy ended in the catch-all internal error (np.load gives an archive,
+    which has no dtype); bytes after the array, which np.load leaves unread, were taken
+    without a word; a file cut short was 'not a readable .npy array'; durations were heights."""
+    z = rough(12, 10, 18) if plugin is SurfaceFile else rough(1, 40, 18)[0]
+    write(tmp_path / "heights.npy", z)
+    said = said.replace("SHAPE", str(z.shape)).replace("BYTES+24", f"{z.nbytes + 24:,}")
+    said = said.replace("BYTES-8", f"{z.nbytes - 8:,}").replace("BYTES", f"{z.nbytes:,}")
+    with pytest.raises(ValueError) as info:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
+    assert said in str(info.value)
