@@ -21,7 +21,7 @@ def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
     return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
 
 
-def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, more=()):
+def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None, more=()):
     """A Gwyddion file of the map z[y, x] on pixels dx x dy (in unit_xy), and more channels
     (title, map, unit of values) on the same grid."""
     from SurfaceTopography.IO.GWY import _gwy_write_object  # here: its import takes seconds
@@ -30,7 +30,7 @@ def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, more=()):
 
     def field(values, unit):
         return ("o", ("GwyDataField", {
-            "xres": ("i", nx), "yres": ("i", ny), "xreal": ("d", nx * dx if xreal is None else xreal),
+            "xres": ("i", nx if xres is None else xres), "yres": ("i", ny), "xreal": ("d", nx * dx if xreal is None else xreal),
             "yreal": ("d", ny * dy), "xoff": ("d", 0.0), "yoff": ("d", 0.0),
             "si_unit_xy": ("o", ("GwySIUnit", {"unitstr": ("s", unit_xy)})),
             "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", unit)})), "data": ("D", values.astype("<f8").ravel()),
@@ -526,3 +526,13 @@ def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_
     with pytest.raises(ValueError) as info:
         plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
     assert said in str(info.value)
+
+
+@pytest.mark.parametrize("xres", [-10, 0])
+def test_a_header_declaring_a_side_of_fewer_than_one_point_is_damage(tmp_path, xres):
+    """A Gwyddion header of -10 x 12 points over 120 heights was read as 10 x 12 without a word
+    (its reader reshapes to -10, which numpy infers); 0 was 'a damaged Gwyddion file (ValueError)'."""
+    write_gwy(tmp_path / "scan.gwy", rough(12, 10, 19), 1e-7, 1e-7, xres=xres)
+    with pytest.raises(ValueError, match=rf"the file declares {xres} x 12 points \(x by y\), a side of fewer than 1: "
+                                         "a damaged header"):
+        SurfaceFile(path=str(tmp_path / "scan.gwy"), unit="um").rms_height()
