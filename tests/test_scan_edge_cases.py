@@ -536,3 +536,19 @@ def test_a_header_declaring_a_side_of_fewer_than_one_point_is_damage(tmp_path, x
     with pytest.raises(ValueError, match=rf"the file declares {xres} x 12 points \(x by y\), a side of fewer than 1: "
                                          "a damaged header"):
         SurfaceFile(path=str(tmp_path / "scan.gwy"), unit="um").rms_height()
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_table_with_nan_under_undefined_harmonic_is_told_the_filling_is_an_instrument_files(tmp_path, plugin):
+    """undefined: harmonic fills what an instrument file leaves undefined; a table's NaN was refused
+    with the very words said without it, as if the preset had not asked to fill them."""
+    z = rough(12, 10, 20) if plugin is SurfaceFile else rough(1, 40, 20)[0]
+    z.flat[5] = np.nan
+    np.save(tmp_path / "heights.npy", z)
+    with pytest.raises(ValueError) as asked:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1, undefined="harmonic").rms_height()
+    assert "1 value(s) in heights not finite" in str(asked.value)
+    assert "undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN" in str(asked.value)
+    with pytest.raises(ValueError) as not_asked:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
+    assert "harmonic" not in str(not_asked.value)

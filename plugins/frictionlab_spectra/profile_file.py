@@ -118,7 +118,7 @@ class ProfileFile(MeasuredFile):
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
-        check_finite(where, "heights", z)
+        check_finite(where, "heights", z, table_fill_advice(p, instrument))
         check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
@@ -359,9 +359,18 @@ def _separator(delimiter: str | None) -> str:
     return {",": "commas", ";": "semicolons"}.get(delimiter, "spaces")
 
 
-def check_finite(where: str, what: str, values: np.ndarray) -> None:
+def table_fill_advice(p, instrument: bool) -> str:
+    """What ``check_finite`` adds of a table's NaN when the preset asks to fill undefined points
+    (it was refused as if the preset had not asked)."""
+    if instrument or p.undefined != "harmonic":
+        return ""
+    return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
+            "fill them before saving the table, or read the instrument's own file")  # fmt: skip
+
+
+def check_finite(where: str, what: str, values: np.ndarray, advice: str = "") -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
-    magnitude (1e100: squares and sums of them must stay finite), locating the first."""
+    magnitude (1e100: squares and sums of them must stay finite), locating the first; ``advice`` after."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
@@ -369,7 +378,7 @@ def check_finite(where: str, what: str, values: np.ndarray) -> None:
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
-            f"in magnitude, the first at {at}"
+            f"in magnitude, the first at {at}{advice}"
         )
 
 
