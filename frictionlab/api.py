@@ -39,7 +39,6 @@ same files; ``--no-plot`` is ``plot=False``.
 
 from __future__ import annotations
 
-import copy
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -49,7 +48,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .arguments import data_argument, flag_argument, overrides_argument, path_argument
+from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
 from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
 from .compute.fit import LogFit
 from .options import RunOptions
@@ -195,12 +194,13 @@ def read_preset_input(
         raise FrictionlabError("preset given twice: as the first argument and as preset=; give it first, unnamed")
     overrides = overrides_argument(overrides)
     data_argument(keys, "keyword overrides")
+    keys = plain_copy(keys)
     base_dir = None
     if isinstance(preset, Preset):
         data, source = preset.model_dump(mode="json", exclude_none=True), f"<Preset {preset.name}>"
     elif isinstance(preset, Mapping):
-        data_argument(preset, "preset")  # before deepcopy, which recurses
-        data, source = copy.deepcopy(dict(preset)), "<dict>"  # never change the caller's dict
+        data_argument(preset, "preset")  # before the copy, which recurses
+        data, source = plain_copy(preset), "<dict>"  # never change the caller's dict
     elif isinstance(preset, str) and ("\n" in preset or preset.lstrip().startswith("{")):
         try:
             data = load_yaml(preset)
@@ -420,6 +420,11 @@ def load(folder: str | Path) -> Result | SweepResult:
     if isinstance(steps, int) and not isinstance(steps, bool) and rows != steps:
         raise RunFolderError(
             f"{shown(folder / curve_name)} is damaged: {rows} rows, but the run's preset has {steps} load steps"
+        )
+    if record.fit is not None and not np.all(np.isfinite(curve["f"]) & (curve["f"] > 0)):
+        raise RunFolderError(  # a run's fit is a law in ln f: it has one only where every f is
+            f"{shown(folder / curve_name)} is damaged: f must be a finite number > 0 at every load step, "
+            "as the fit in summary.json, a law in ln f, needs"
         )
     if "lines_used" in curve and np.any(curve["lines_used"] > record.realizations.done):
         raise RunFolderError(

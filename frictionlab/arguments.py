@@ -5,6 +5,7 @@ deep inside."""
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -58,10 +59,22 @@ def data_argument(value, name: str) -> None:
                 stack.append((child, depth + 1, f"{where}.{key}"[:200]))
         elif isinstance(item, list | tuple):
             stack.extend((child, depth + 1, f"{where}[{i}]"[:200]) for i, child in enumerate(item))
-        elif not isinstance(item, _SCALARS):
-            raise FrictionlabError(
-                f"{where} must be a str, number, bool, None, list or mapping, got {type(item).__name__}"
-            )
+        elif not isinstance(item, (*_SCALARS, numbers.Real)):  # numpy's numbers are Real: plain_copy makes them Python's
+            kind = f"{type(item).__module__}.{type(item).__name__}".removeprefix("builtins.")  # numpy.bool, not bool
+            raise FrictionlabError(f"{where} must be a str, number, bool, None, list or mapping, got {kind}")
+
+
+def plain_copy(value):
+    """A copy of preset data that ``data_argument`` took, its numbers Python's: a numpy integer
+    (an int64 of an array's size) was refused as no number, and preset.yaml and sweep.json are
+    written from the data, which YAML and JSON cannot hold."""
+    if isinstance(value, Mapping):
+        return {key: plain_copy(child) for key, child in value.items()}
+    if isinstance(value, list | tuple):
+        return [plain_copy(child) for child in value]
+    if isinstance(value, numbers.Real) and type(value) not in (int, float, bool):  # np.float64 too: said as a float
+        return int(value) if isinstance(value, numbers.Integral) else float(value)
+    return value
 
 
 def overrides_argument(value) -> dict:
@@ -77,4 +90,4 @@ def overrides_argument(value) -> dict:
                 f"{type(key).__name__}, not str"
             )
     data_argument(value, "overrides")
-    return dict(value)
+    return plain_copy(value)

@@ -17,7 +17,7 @@ from frictionlab import api
 from frictionlab.errors import FrictionlabError, MissingDependency, PresetError, RunFolderError
 from frictionlab.preset import Preset
 
-from .conftest import PRESETS, SMALL_PRESET
+from .conftest import PRESETS, SMALL_PRESET, merge
 
 FAST = {"workers": 1, "progress": False}
 
@@ -232,6 +232,22 @@ def test_a_wrong_argument_is_a_frictionlab_error_naming_it(call, said):
     with pytest.raises(FrictionlabError) as raised:
         call()
     assert said in str(raised.value)
+
+
+def test_numpy_numbers_in_a_preset_are_its_numbers_and_its_files_hold_plain_ones(tmp_path):
+    """A realizations count or a seed that is a numpy integer (an array's size, a draw) was
+    refused as 'must be a str, number, ... got int64'; a float32 load too. They are read as
+    the numbers they are, in the preset, its overrides and its sweep, and preset.yaml and
+    sweep.json hold plain numbers."""
+    data = merge(SMALL_PRESET, {"realizations": np.int64(4), "loading": {"start": np.float32(0.5)}, "output": {"plot": False},
+                                "sweep": {"parameters": {"seed": {"values": [np.int64(1), np.uint8(2)]}}}})  # fmt: skip
+    swept = frictionlab.run(data, {"fit.bootstrap": np.int32(20)}, out=tmp_path / "sweep", **FAST)
+    assert [row["seed"] for row in swept.rows] == [1, 2] and "np." not in (tmp_path / "sweep" / "sweep.json").read_text()
+    one = frictionlab.run(merge(data, {"sweep": None}), seed=np.int64(3), out=tmp_path / "one", **FAST)
+    stored = yaml.safe_load((tmp_path / "one" / "preset.yaml").read_text())
+    assert (stored["realizations"], stored["seed"], stored["fit"]["bootstrap"]) == (4, 3, 200) and one.realizations == (4, 4)
+    with pytest.raises(FrictionlabError, match="preset.output.plot must be a str, number, bool, None, list or mapping, got numpy.bool"):
+        frictionlab.run(merge(data, {"output": {"plot": np.bool_(False)}}), **FAST)
 
 
 def test_a_result_plot_names_a_wrong_axes(tmp_path):

@@ -63,6 +63,17 @@ def test_runs_prints_a_forged_name_escaped(tmp_path, capsys):
 
 
 @posix
+def test_runs_lists_a_folder_whose_name_holds_a_line_break_on_one_row(tmp_path, capsys):
+    """A line break in a folder's name was kept in its cell (shown keeps a message's lines): the
+    name 'x\\nfake  ...  completed' drew a row of a run that is not there."""
+    with RunDirectory(tmp_path / "x\nfake  small  completed  8 of 8\tz") as run_dir:
+        run_dir.start(build_scene(SMALL_PRESET), resume=False)
+    assert main(["runs", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 2 and "x\\nfake  small  completed  8 of 8\\tz" in lines[1], lines
+
+
+@posix
 def test_resume_prints_its_warning_about_a_folder_escaped(tmp_path, cli):
     folder = tmp_path / f"run{PAYLOAD}"
     frictionlab.run(SMALL_PRESET, out=folder, workers=1, plot=False, progress=False)

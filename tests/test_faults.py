@@ -195,6 +195,22 @@ def misshapen_rows(folder):
     _rewrite(folder, _second(folder), lambda a: a.__setitem__("xi", a["xi"][:, :-1]), True)
 
 
+def text_xi(folder):
+    _rewrite(folder, _second(folder), lambda a: a.__setitem__("xi", a["xi"].astype(str)), True)
+
+
+def negative_count(folder):
+    _rewrite(folder, _second(folder), lambda a: a["contact_count"].__setitem__((0, 0), -1), True)
+
+
+def count_above_points(folder):
+    _rewrite(folder, _second(folder), lambda a: a["contact_count"].__setitem__((0, 0), a["points"][0] + 1), True)
+
+
+def no_points(folder):
+    _rewrite(folder, _second(folder), lambda a: a["points"].__setitem__(0, 0), True)
+
+
 def unlisted_overlapping_copy(folder):
     """A copy of one chunk under a name that overlaps another, not in the manifest."""
     chunks = folder / "chunks"
@@ -221,6 +237,10 @@ DAMAGE = {
     negative_index: "indices outside",
     repeated_index: "or repeated",
     misshapen_rows: "array xi of shape",
+    text_xi: "array xi of type <U32, not real numbers",
+    negative_count: "contact_count below 0 or above the profile's points",
+    count_above_points: "contact_count below 0 or above the profile's points",
+    no_points: "a profile of fewer than 1 point",
     unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",
     listed_twice: None,  # nothing is damaged: no warning
 }

@@ -132,6 +132,28 @@ def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists
     assert listed
 
 
+@pytest.mark.filterwarnings("ignore:resume of .* not in the manifest")  # the folder left in chunks/: said, kept
+@pytest.mark.parametrize("how", ["run --force", "resume of an unfinished compaction"])
+def test_a_folder_named_as_a_listed_chunk_is_kept_and_the_run_goes_on(make_scene, tmp_path, how):
+    """A listed (or retired) chunk that is a folder is no chunk frictionlab wrote: unlinking it
+    failed, and the forced run or the resume ended in 'cannot write results' (exit code 1)."""
+    scene = make_scene({"realizations": 30, **NO_PLOT})
+    cancel = threading.Event()
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(12, cancel)], cancel=cancel)
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    name = "00000029-00000029.npz" if how.startswith("resume") else sorted(manifest["chunks"])[0]
+    if how.startswith("resume"):
+        manifest["retired"] = [name]
+        (tmp_path / "run" / "run.json").write_text(json.dumps(manifest))
+    else:
+        (tmp_path / "run" / "chunks" / name).unlink()
+    (tmp_path / "run" / "chunks" / name).mkdir()
+    (tmp_path / "run" / "chunks" / name / "mine.txt").write_text("user data")
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, force=True, resume=how.startswith("resume")))
+    assert outcome.status == "completed" and outcome.done == 30
+    assert (tmp_path / "run" / "chunks" / name / "mine.txt").read_text() == "user data"
+
+
 def test_the_manifest_lists_every_chunk_with_its_sha256_as_it_is_written(make_scene, tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "UNSAVED_WORK_SECONDS", 0.0)  # each chunk written as it finishes
     scene = make_scene({"realizations": 30, **NO_PLOT})

@@ -21,7 +21,7 @@ def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
     return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
 
 
-def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, more=()):
+def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None, more=()):
     """A Gwyddion file of the map z[y, x] on pixels dx x dy (in unit_xy), and more channels
     (title, map, unit of values) on the same grid."""
     from SurfaceTopography.IO.GWY import _gwy_write_object  # here: its import takes seconds
@@ -30,7 +30,7 @@ def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, more=()):
 
     def field(values, unit):
         return ("o", ("GwyDataField", {
-            "xres": ("i", nx), "yres": ("i", ny), "xreal": ("d", nx * dx if xreal is None else xreal),
+            "xres": ("i", nx if xres is None else xres), "yres": ("i", ny), "xreal": ("d", nx * dx if xreal is None else xreal),
             "yreal": ("d", ny * dy), "xoff": ("d", 0.0), "yoff": ("d", 0.0),
             "si_unit_xy": ("o", ("GwySIUnit", {"unitstr": ("s", unit_xy)})),
             "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", unit)})), "data": ("D", values.astype("<f8").ravel()),
@@ -486,3 +486,69 @@ def test_a_table_whose_lines_end_with_a_separator_is_told_so(tmp_path, text, lin
     (tmp_path / "map.csv").write_text(text)
     with pytest.raises(ValueError, match=rf"line {line} ends with a separator \((comma|semicolon)\), an empty column"):
         SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+
+
+def _npz_as_npy(path, z):
+    np.savez(path.with_suffix(".npz"), z=z)
+    path.with_suffix(".npz").rename(path)
+
+
+def _trailing_bytes(path, z):
+    np.save(path, z)
+    with path.open("ab") as fh:
+        fh.write(np.zeros(3).tobytes())
+
+
+def _cut_short(path, z):
+    np.save(path, z)
+    with path.open("r+b") as fh:
+        fh.truncate(path.stat().st_size - 8)
+
+
+@pytest.mark.parametrize(("write", "said"), [
+    (_npz_as_npy, "an .npz archive (arrays zipped together), not a .npy array; save the heights alone with numpy.save"),
+    (_trailing_bytes, "a damaged .npy file: its header declares an array of shape SHAPE of float64 (BYTES bytes), but the "
+                      "file holds BYTES+24 bytes after it"),
+    (_cut_short, "a damaged .npy file: its header declares an array of shape SHAPE of float64 (BYTES bytes), but the "
+                 "file holds BYTES-8 bytes after it"),
+    (lambda path, z: np.save(path, (z * 1000).astype("timedelta64[s]")),
+     "non-numeric content (array dtype timedelta64[s]); expected real numbers"),
+])  # fmt: skip
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_path, write, said, plugin):
+    """An .npz saved under .npy ended in the catch-all internal error (np.load gives an archive,
+    which has no dtype); bytes after the array, which np.load leaves unread, were taken
+    without a word; a file cut short was 'not a readable .npy array'; durations were heights."""
+    z = rough(12, 10, 18) if plugin is SurfaceFile else rough(1, 40, 18)[0]
+    write(tmp_path / "heights.npy", z)
+    said = said.replace("SHAPE", str(z.shape)).replace("BYTES+24", f"{z.nbytes + 24:,}")
+    said = said.replace("BYTES-8", f"{z.nbytes - 8:,}").replace("BYTES", f"{z.nbytes:,}")
+    with pytest.raises(ValueError) as info:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
+    assert said in str(info.value)
+
+
+@pytest.mark.parametrize("xres", [-10, 0])
+def test_a_header_declaring_a_side_of_fewer_than_one_point_is_damage(tmp_path, xres):
+    """A Gwyddion header of -10 x 12 points over 120 heights was read as 10 x 12 without a word
+    (its reader reshapes to -10, which numpy infers); 0 was 'a damaged Gwyddion file (ValueError)'."""
+    write_gwy(tmp_path / "scan.gwy", rough(12, 10, 19), 1e-7, 1e-7, xres=xres)
+    with pytest.raises(ValueError, match=rf"the file declares {xres} x 12 points \(x by y\), a side of fewer than 1: "
+                                         "a damaged header"):
+        SurfaceFile(path=str(tmp_path / "scan.gwy"), unit="um").rms_height()
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_table_with_nan_under_undefined_harmonic_is_told_the_filling_is_an_instrument_files(tmp_path, plugin):
+    """undefined: harmonic fills what an instrument file leaves undefined; a table's NaN was refused
+    with the very words said without it, as if the preset had not asked to fill them."""
+    z = rough(12, 10, 20) if plugin is SurfaceFile else rough(1, 40, 20)[0]
+    z.flat[5] = np.nan
+    np.save(tmp_path / "heights.npy", z)
+    with pytest.raises(ValueError) as asked:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1, undefined="harmonic").rms_height()
+    assert "1 value(s) in heights not finite" in str(asked.value)
+    assert "undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN" in str(asked.value)
+    with pytest.raises(ValueError) as not_asked:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
+    assert "harmonic" not in str(not_asked.value)

@@ -219,15 +219,17 @@ def test_validate_rejects_a_bad_map_for_mdr_without_a_traceback(tmp_path, capsys
         load_scene(preset)
 
 
-def test_a_npy_whose_header_asks_for_more_than_memory_is_refused_with_its_size(tmp_path):
-    """A header announcing 2^23 x 2^22 doubles (256 TiB, beyond any address space, so the
-    allocation fails whatever the overcommit policy) over a 64-byte body: the message gives
-    the shape and size announced, not a bare MemoryError."""
+def test_a_npy_whose_header_asks_for_more_than_it_holds_is_refused_with_its_size(tmp_path):
+    """A header announcing 2^23 x 2^22 doubles (256 TiB, beyond any address space) over a
+    64-byte body: the message gives the shape and size announced and what the file holds,
+    before anything is allocated, not a bare MemoryError (nor 'does not fit in memory':
+    no memory would hold what the file does not have)."""
     path = tmp_path / "claims.npy"
     with path.open("wb") as fh:
         np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (2**23, 2**22)})
         fh.write(bytes(64))
-    with pytest.raises(ValueError, match=r"shape \(8388608, 4194304\) \(2.62e\+05 GiB\) does not fit in this process's memory"):
+    with pytest.raises(ValueError, match=r"a damaged .npy file: its header declares an array of shape \(8388608, 4194304\) "
+                                         r"of float64 \(281,474,976,710,656 bytes\), but the file holds 64 bytes after it"):
         SurfaceFile(path=str(path), spacing=1.0).rms_height()
 
 

@@ -132,6 +132,9 @@ BAD_SPECS = [
      "give either values or a range (start, stop, num), not both"),
     ({"loading.stop": {"start": 1, "stop": 5}}, "a range needs start, stop and num; missing: num"),
     ({"loading.stop": {}}, "give values: [...] or a range start, stop, num"),
+    # a point twice runs the same ensemble twice, as loads from a value to itself are refused
+    ({"seed": {"values": [1, 2, 1]}}, "sweep: seed: its values give 1 twice (values 1 and 3): each point with it would run twice"),
+    ({"loading.stop": {"start": 5, "stop": 5, "num": 3}}, "loading.stop: its range (start, stop, num) gives 5 twice (values 1 and 2)"),
 ]  # fmt: skip
 
 
@@ -148,6 +151,16 @@ def test_zip_lengths_must_match(registry):
         plan_sweep(sweep_preset(params, mode="zip"), registry=registry)
     assert "mode zip needs the same number of values for every parameter. Got seed: 2, loading.stop: 3" in str(info.value)
     assert len(plan_sweep(sweep_preset(params), registry=registry).points) == 6  # fine as a grid
+
+
+def test_a_zip_point_twice_is_refused_and_a_value_repeated_beside_others_is_not(registry):
+    """Before, [1, 1] with [4, 4] ran one ensemble twice, and a grid with a value listed twice too."""
+    twice = {"seed": {"values": [1, 2, 1]}, "realizations": {"values": [4, 5, 4]}}
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(twice, mode="zip"), registry=registry)
+    assert "mode zip: points 1 and 3 set the same values (seed=1, realizations=4): the same ensemble would run twice" in str(info.value)
+    paired = {"seed": {"values": [1, 2, 1]}, "realizations": {"values": [4, 4, 5]}}
+    assert len(plan_sweep(sweep_preset(paired, mode="zip"), registry=registry).points) == 3
 
 
 def test_a_bad_point_value_names_the_point_and_field(registry):

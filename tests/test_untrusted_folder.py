@@ -155,6 +155,12 @@ HOSTILE = {
     "lines_used above done": lambda f: edit_cell(f, "lines_used", "5"),
     "contact_count negative": lambda f: edit_cell(f, "contact_count", "-1"),
     "contact_fraction above 1": lambda f: edit_cell(f, "contact_fraction", "1.5"),
+    # values no run writes: a force or xi below 0, an f of 0 beside a law in ln f (plot() failed on it)
+    "F negative": lambda f: edit_cell(f, "F", "-0.5"),
+    "xi negative": lambda f: edit_cell(f, "xi", "-0.5"),
+    "xi_sem negative": lambda f: edit_cell(f, "xi_sem", "-1"),
+    "f zero beside a fit": lambda f: edit_cell(f, "f", "0"),
+    "f empty beside a fit": lambda f: edit_cell(f, "f", ""),
     "curve missing": lambda f: (f / "curve.csv").unlink(),
     "curve huge": lambda f: (f / "curve.csv").write_bytes(b"1" * (17 * 1024 * 1024)),
 }

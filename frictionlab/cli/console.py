@@ -30,13 +30,19 @@ def is_terminal(stream=None) -> bool:
         return False
 
 
+def _cell(value) -> str:
+    """``value`` as one line of a table (``shown``, its line breaks and tabs escaped too): a run
+    folder named 'x\\nfake  completed' drew a second row."""
+    from ..errors import shown
+
+    return shown(str(value)).replace("\n", "\\n").replace("\t", "\\t")
+
+
 def print_table(header: Sequence[str], rows: Sequence[Sequence[str]], *, stream=None) -> None:
     """Rows under a header: on a terminal a rich table that fits its width (the last
     column wraps), elsewhere plain columns padded to the widest cell."""
-    from ..errors import shown
-
     stream = stream or sys.stdout
-    header, rows = [shown(str(cell)) for cell in header], [[shown(str(cell)) for cell in row] for row in rows]  # cells from folders
+    header, rows = [_cell(cell) for cell in header], [[_cell(cell) for cell in row] for row in rows]  # cells from folders
     if is_terminal(stream):
         from rich.console import Console
         from rich.table import Table

@@ -98,6 +98,8 @@ def run(args) -> ExitCode:
             return ExitCode.TERMINATED if stopped.signal == signal.SIGTERM else ExitCode.INTERRUPTED
         if follower.finished is not None:
             error = follower.finished.error
+    elif sweep is None:  # ended before: why, as its summary.json says (it was said only to a follower of the run)
+        error = _ended_error(folder)
     if gone:  # what is true: the folder it followed is no more; nothing there to resume
         still = f"; its process (pid {holder}) still runs, writing nowhere you can see" if holder and process_alive(holder) else ""
         message = f"{shown(folder)} was deleted or replaced while its run was going: nothing of that run is left to resume{still}"
@@ -116,6 +118,8 @@ def run(args) -> ExitCode:
     else:
         done = "?" if state.done is None else state.done
         hint = f"; frictionlab resume {folder} continues it" if state.resumable else ""
+        if error and state.done is not None and state.done == state.total:  # every realization done: no resume mends it
+            hint = ""
         if any(row.get("status") == "error" for row in rows):  # a resume fails there again until it is fixed
             hint = f"; do what the points in error say, then frictionlab resume {folder} continues it"
         what = "points" if sweep is not None else "realizations"
@@ -128,6 +132,20 @@ def run(args) -> ExitCode:
         if error:
             print(f"error: {shown(error)}", file=sys.stderr)
     return ExitCode.OK if state.status == "completed" else ExitCode.RUNTIME_FAILURE
+
+
+def _ended_error(folder: Path) -> str | None:
+    """The error of the run that ended in ``folder`` (a fit refused, every realization failed), as
+    its summary.json says; None where it says none or has none (an interrupted run)."""
+    from ..errors import RunFolderError
+    from ..runs.results import read_summary
+
+    try:
+        data, _ = read_summary(folder)
+    except (RunFolderError, OSError):  # none, or one the state already names damaged
+        return None
+    error = data.get("error")
+    return error if isinstance(error, str) and error else None
 
 
 def _state_unless_gone(folder: Path, identity):

@@ -117,6 +117,15 @@ class SweepParameter(_Strict):
         return [int(v) if whole and v.is_integer() else v for v in raw]
 
 
+def _repeated(values: list) -> tuple[int, int] | None:
+    """The first two places ``values`` holds one value (1 and 1.0 are one), or None."""
+    for j, value in enumerate(values):
+        for i in range(j):
+            if values[i] == value and type(values[i]) is not bool and type(value) is not bool:  # true is no 1
+                return i, j
+    return None
+
+
 class SweepSettings(_Strict):
     """A sweep: every point is the preset with the swept paths set (see frictionlab/runs/sweep.py)."""
 
@@ -140,6 +149,24 @@ class SweepSettings(_Strict):
             raise ValueError(
                 f"the sweep has {points:,} points ({self.mode} of {axes}); at most {MAX_SWEEP_POINTS:,} are allowed"
             )
+        return self
+
+    @model_validator(mode="after")
+    def _no_point_twice(self):
+        """Two points that set the same values run the same ensemble twice (a value listed twice, a
+        range from a value to itself): refused, as loads from a value to itself are."""
+        paths = list(self.parameters)
+        columns = [self.parameters[path].points() for path in paths]  # at most MAX_SWEEP_POINTS each: counted above
+        if self.mode == "grid":
+            for path, values in zip(paths, columns, strict=True):
+                if (pair := _repeated(values)) is not None:
+                    how = "values give" if self.parameters[path].values is not None else "range (start, stop, num) gives"
+                    raise ValueError(f"{path}: its {how} {values[pair[1]]!r} twice (values {pair[0] + 1} and "
+                                     f"{pair[1] + 1}): each point with it would run twice; give each value once")  # fmt: skip
+        elif (pair := _repeated(rows := list(zip(*columns, strict=True)))) is not None:
+            shown = ", ".join(f"{path}={value!r}" for path, value in zip(paths, rows[pair[1]], strict=True))
+            raise ValueError(f"mode zip: points {pair[0] + 1} and {pair[1] + 1} set the same values ({shown}): the same "
+                             "ensemble would run twice; give each point once")  # fmt: skip
         return self
 
     def count(self) -> int:

@@ -164,6 +164,29 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
     return np.frombuffer(raw, dtype).astype(np.int64)
 
 
+def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
+    """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
+    complex arrays reached the statistics), ``failed_error`` is text, and the values are what a
+    realization can give: xi none infinite or below 0, each profile of 1 point or more, its
+    contact counts and the points carrying half the load (NaN: not said) from 0 to its points
+    (a chunk that broke these was restored, and its run folder written as its load refuses)."""
+    for name in numeric:
+        if arrays[name].dtype.kind not in "iuf":
+            raise ChunkDamage(f"array {name} of type {arrays[name].dtype}, not real numbers")
+    if arrays["failed_error"].dtype.kind != "U":
+        raise ChunkDamage(f"array failed_error of type {arrays['failed_error'].dtype}, not text")
+    if "xi" not in numeric:  # no finished realization
+        return
+    if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
+        raise ChunkDamage("xi infinite or below 0")
+    points = arrays["points"][:, None]
+    if bool((points < 1).any()):
+        raise ChunkDamage("a profile of fewer than 1 point")
+    for name in ("contact_count", "half_load_points"):
+        if bool(((arrays[name] < 0) | (arrays[name] > points)).any()):  # NaN compares false: allowed
+            raise ChunkDamage(f"{name} below 0 or above the profile's points")
+
+
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:
     """Whether a realization of ``scene`` keeps each of ``OPTIONAL_CURVE_ARRAYS``."""
     solver = scene.solver
@@ -207,6 +230,7 @@ def chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Rea
         heights[name] = arrays.get(name, np.full((n, steps), math.nan))
         if heights[name].shape != (n, steps):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
+    _check_values({**arrays, **heights}, (*OK_ARRAYS, *(curves if n else ()), *heights, "failed_seconds"))
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(

@@ -194,14 +194,15 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
 
 def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
     """Counts are counts: ``lines_used`` a whole number >= 0 at every step, the mean
-    ``contact_count`` >= 0 and ``contact_fraction`` in [0, 1] where given."""
+    ``contact_count`` >= 0 and ``contact_fraction`` in [0, 1] where given; the force, xi
+    and its standard error are >= 0 where given, as every run writes them."""
     problems = []
     if "lines_used" in curve:
         used = curve["lines_used"]
         if not np.all(np.isfinite(used) & (used >= 0) & (used == np.round(used))):
             problems.append("lines_used must be a whole number >= 0 at every load step")
     bounds = [("contact_count", 0.0, np.inf), ("contact_fraction", 0.0, 1.0), (CORRECTED_AREA, 0.0, 1.0)]
-    extra = (*GRADIENT_COLUMNS, SPOTS, "half_load_points")
+    extra = ("F", "F'", "f", "xi", "xi_sem", *GRADIENT_COLUMNS, SPOTS, "half_load_points")
     for column, low, high in bounds + [(name, 0.0, np.inf) for name in extra]:
         if column not in curve:
             continue

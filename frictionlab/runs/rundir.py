@@ -242,9 +242,7 @@ class RunDirectory:
             state = None  # a damaged manifest lists nothing: nothing is deleted
         self._refuse_unless_ours(state, scene, resolved)
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
-        for name in listed:  # chunks of the run that was here: frictionlab wrote them
-            if isinstance(name, str) and CHUNK_NAME.fullmatch(name):
-                (self.chunks / name).unlink(missing_ok=True)
+        self._remove_chunks(listed)  # chunks of the run that was here: frictionlab wrote them
         self.chunks.mkdir(parents=True, exist_ok=True)
         atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
         self._manifest = {
@@ -372,15 +370,21 @@ class RunDirectory:
                           "fingerprint": fingerprint(resolved),
                           "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}}}  # fmt: skip
         self._manifest["chunks"] = dict(state.get("chunks") or {}) if state.get("format") == MANIFEST_FORMAT else {}
-        for name in self._manifest.pop("retired", None) or []:  # a compaction that did not finish
-            if isinstance(name, str) and CHUNK_NAME.fullmatch(name) and name not in self._manifest["chunks"]:
-                (self.chunks / name).unlink(missing_ok=True)
+        self._remove_chunks(self._manifest.pop("retired", None) or [], keep=self._manifest["chunks"])  # an unfinished compaction's
         results = self._verified(scene, warn=True)
         self._kept = {r.index: r for r in results}
         self._write_manifest()
         return results
 
     # ------------------------------------------------------------ chunks
+
+    def _remove_chunks(self, names: list, keep=()) -> None:
+        """Delete the chunks ``names`` a manifest lists (those with a chunk's name, not in ``keep``);
+        a folder so named is the user's (no chunk is one): unlinking it ended the run, exit code 1."""
+        for name in names:
+            path = self.chunks / name if isinstance(name, str) and CHUNK_NAME.fullmatch(name) else None
+            if path is not None and name not in keep and (path.is_symlink() or not path.is_dir()):
+                path.unlink(missing_ok=True)
 
     def _free_name(self, first: int, last: int) -> str:
         """The chunk's file name, or a variant of it when a file the manifest does

@@ -201,7 +201,11 @@ def room_to_read() -> tuple[int, str]:
 
 def check_declared_points(points: tuple[int, ...], where: str) -> None:
     """Refuse, from the header alone, a file that declares more points than this process can
-    read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit."""
+    read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit; or a side of fewer
+    than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound)."""
+    if min(points, default=1) < 1:
+        raise ValueError(f"{where}: the file declares {' x '.join(map(str, points))} points (x by y), a side of fewer "
+                         "than 1: a damaged header; copy it again from the instrument, or export it from there again")
     need = math.prod(points) * 8 * HEIGHT_COPIES
     room, source = room_to_read()
     if need > room:

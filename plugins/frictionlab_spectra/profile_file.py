@@ -24,6 +24,7 @@ profile the solver sees.
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from pathlib import Path
 from typing import ClassVar, Literal
@@ -117,7 +118,7 @@ class ProfileFile(MeasuredFile):
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
-        check_finite(where, "heights", z)
+        check_finite(where, "heights", z, table_fill_advice(p, instrument))
         check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
@@ -200,6 +201,7 @@ def file_suffix(path: Path, where: str) -> str:
 def load_npy(path: Path, where: str) -> np.ndarray:
     """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
     with open_input(path, where) as fh:
+        _check_npy_size(fh, where)
         try:
             data = np.load(fh, allow_pickle=False)
         except MemoryError:  # the header asks for more than this process can allocate
@@ -207,21 +209,25 @@ def load_npy(path: Path, where: str) -> np.ndarray:
                              "crop or resample the map") from None
         except Exception as exc:  # corrupt file, pickled objects, ...: named, never quoted
             raise ValueError(f"{where}: not a readable .npy array ({type(exc).__name__})") from None
-    if not (np.issubdtype(data.dtype, np.integer) or np.issubdtype(data.dtype, np.floating)):
+    if data.dtype.kind not in "iuf":  # numpy counts a timedelta64 as an integer
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
     return data
 
 
 def npy_shape(path: Path, where: str) -> tuple[int, ...] | None:
     """The shape a .npy file's header announces, read without its data (None if the header
-    cannot be read: loading the file then names the problem)."""
+    cannot be read, or the file does not hold what it announces: loading it then names the problem)."""
     with open_input(path, where) as fh:
         header = _npy_header(fh)
-    return None if header is None else header[0]
+        held = os.fstat(fh.fileno()).st_size - header[2] if header else None
+    if header is None or held != _npy_bytes(header):  # a header that lies: loading the file names it
+        return None
+    return header[0]
 
 
-def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype] | None:
-    """The shape and dtype a .npy header announces (a file may announce more than it holds)."""
+def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
+    """The shape and dtype a .npy header announces (a file may announce more than it holds),
+    and where its data starts."""
     fh.seek(0)
     try:
         version = np.lib.format.read_magic(fh)
@@ -229,7 +235,34 @@ def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype] | None:
         shape, _, dtype = read_header[version](fh)
     except Exception:  # noqa: BLE001 - not a header numpy reads
         return None
-    return tuple(int(n) for n in shape), dtype
+    return tuple(int(n) for n in shape), dtype, fh.tell()
+
+
+def _npy_bytes(header: tuple[tuple[int, ...], np.dtype, int]) -> int:
+    """The bytes of data a .npy header (``_npy_header``) announces."""
+    return math.prod(header[0]) * header[1].itemsize
+
+
+def _check_npy_size(fh, where: str) -> None:
+    """ValueError unless the file holds the array its header announces, no more and no less: a
+    file cut short (its header may announce terabytes) or with bytes after its array is
+    damaged, named before anything is allocated; an .npz archive (np.load gives no array of
+    it) is named as such."""
+    head = fh.read(6)
+    fh.seek(0)
+    if head.startswith(b"PK"):
+        raise ValueError(f"{where}: an .npz archive (arrays zipped together), not a .npy array; save the "
+                         "heights alone with numpy.save")  # fmt: skip
+    header = _npy_header(fh)
+    fh.seek(0)
+    if header is None or header[1].hasobject:  # np.load names it
+        return
+    held, declared = os.fstat(fh.fileno()).st_size - header[2], _npy_bytes(header)
+    if held != declared:
+        raise ValueError(
+            f"{where}: a damaged .npy file: its header declares an array of shape {header[0]} of {header[1]} "
+            f"({declared:,} bytes), but the file holds {held:,} bytes after it; save the array again"
+        )
 
 
 def _claimed_array(fh) -> str:
@@ -237,7 +270,7 @@ def _claimed_array(fh) -> str:
     header = _npy_header(fh)
     if header is None:
         return "its array"
-    shape, dtype = header
+    shape, dtype, _ = header
     return f"its array of shape {shape} ({math.prod(shape) * dtype.itemsize / 2**30:.3g} GiB)"
 
 
@@ -326,9 +359,18 @@ def _separator(delimiter: str | None) -> str:
     return {",": "commas", ";": "semicolons"}.get(delimiter, "spaces")
 
 
-def check_finite(where: str, what: str, values: np.ndarray) -> None:
+def table_fill_advice(p, instrument: bool) -> str:
+    """What ``check_finite`` adds of a table's NaN when the preset asks to fill undefined points
+    (it was refused as if the preset had not asked)."""
+    if instrument or p.undefined != "harmonic":
+        return ""
+    return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
+            "fill them before saving the table, or read the instrument's own file")  # fmt: skip
+
+
+def check_finite(where: str, what: str, values: np.ndarray, advice: str = "") -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
-    magnitude (1e100: squares and sums of them must stay finite), locating the first."""
+    magnitude (1e100: squares and sums of them must stay finite), locating the first; ``advice`` after."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
@@ -336,7 +378,7 @@ def check_finite(where: str, what: str, values: np.ndarray) -> None:
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
-            f"in magnitude, the first at {at}"
+            f"in magnitude, the first at {at}{advice}"
         )
 
 

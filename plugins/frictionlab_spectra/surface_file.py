@@ -54,7 +54,9 @@ from .map_pipeline import Downsample, Level, Region, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
-from .profile_file import check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table
+from .profile_file import (
+    check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table, table_fill_advice,
+)
 
 MIN_SIDE = 8
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
@@ -218,7 +220,7 @@ class SurfaceFile(MeasuredFile):
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
         z, pixel, summary = _read_map(path, where, p)
-        check_finite(where, "heights", z)
+        check_finite(where, "heights", z, table_fill_advice(p, is_instrument_file(path, p.format)))
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
         summary.update(shaped)

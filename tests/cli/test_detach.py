@@ -110,6 +110,22 @@ def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path, cli):
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
 
 
+def test_follow_of_a_run_that_ended_failed_says_why_and_advises_no_resume_that_cannot_mend_it(tmp_path, cli):
+    """A run whose every realization finished but whose law could not be fitted (its loads all
+    past full contact): follow, after it ended, said only 'failed, 8/8 realizations ...;
+    frictionlab resume DIR continues it', its error null under --json, though the run's
+    summary.json says why and no resume changes it."""
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"loading": {"start": 1e90, "stop": 1e99}, "output": {"plot": False}}))
+    out = tmp_path / "runs" / "flat"
+    assert cli("run", preset, "--workers", "1", "--quiet", "--out", out).returncode == 1
+    followed = cli("follow", out)
+    assert followed.returncode == 1, followed.stderr
+    assert "small: failed, 8/8 realizations" in followed.stdout and "resume" not in followed.stdout
+    assert "error: no law: the whole profile is in contact at every load" in followed.stderr
+    told = json.loads(cli("follow", out, "--json").stdout)
+    assert told["status"] == "failed" and told["error"].startswith("no law: the whole profile is in contact")
+
+
 @pytest.mark.long
 def test_follow_shows_a_running_sweeps_points_until_it_is_cancelled_and_exits_1(tmp_path, cli):
     data = merge(SMALL_PRESET, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}})

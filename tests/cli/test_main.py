@@ -87,6 +87,24 @@ def test_a_negative_number_in_any_notation_is_an_options_value(capsys):
     assert refused.value.code == ExitCode.USAGE and "unrecognized arguments: -x1" in capsys.readouterr().err
 
 
+def test_a_long_word_after_a_dash_that_is_no_number_is_refused_at_once(tmp_path):
+    """A word of '-' and 100,000 digits ending in a letter took the negative-number pattern
+    (\\d+\\.?\\d*: digits that split many ways) a time quadratic in its length: 20,000 digits a
+    minute, 100,000 half an hour, before argparse could say it expected a value. The numbers
+    it must know are still values."""
+    from frictionlab.cli.main import NEGATIVE_NUMBER
+
+    numbers = ["-1", "-1.", "-.5", "-1.5e-3", "-1E+5", "-inf", "-nan", "-1,2,-3", "-1.5,+2e3,-.5"]
+    assert all(NEGATIVE_NUMBER.match(word) for word in numbers)
+    assert not any(NEGATIVE_NUMBER.match(word) for word in ["-1e", "-1.2.3", "-x1", "-", "-1,", "-,1", "-.", "-e5"])
+    try:
+        done = subprocess.run([sys.executable, "-m", "frictionlab", "run", str(PRESETS / "quickstart.yaml"), "--seed",
+                               "-" + "1" * 100_000 + "x"], capture_output=True, text=True, timeout=60, cwd=tmp_path)  # fmt: skip
+    except subprocess.TimeoutExpired:
+        pytest.fail("a word of 100,000 digits was still being parsed after 60 s")
+    assert done.returncode == ExitCode.USAGE and "argument --seed: expected one argument" in done.stderr
+
+
 @pytest.mark.parametrize(
     "command", [["validate"], ["resume"], ["runs"], ["schema", "--out"], ["run", str(PRESETS / "quickstart.yaml"), "--out"]]
 )
