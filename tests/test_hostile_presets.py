@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -297,6 +298,25 @@ def test_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2_and_quoted_ones_sta
     data = load_yaml("a: 1e-16\nb: 1E5\nc: -2e+3\nd: 1.5e3\ne: .5e1\nf: '1e5'\ng: 1e\nh: e5\ni: 12\nj: 1.5")
     assert data == {"a": 1e-16, "b": 1e5, "c": -2e3, "d": 1.5e3, "e": 5.0, "f": "1e5", "g": "1e", "h": "e5", "i": 12, "j": 1.5}
     assert [type(data[k]) for k in "abcdei"] == [float] * 5 + [int]
+
+
+def test_numbers_are_read_as_python_reads_them_not_as_yaml_1_1_bases():
+    from frictionlab.io.safe_yaml import load_yaml
+
+    data = load_yaml("a: 010\nb: 0o10\nc: 0x1F\nd: 1_000\ne: 1:30\nf: 1:30.5\ng: 1__0\nh: 0b101\ni: -.inf\nj: 2.5_0")
+    assert data == {"a": 10, "b": 8, "c": 31, "d": 1000, "e": "1:30", "f": "1:30.5", "g": "1__0", "h": "0b101",
+                    "i": -math.inf, "j": 2.5}
+    assert [type(data[k]) for k in "abcd"] == [int] * 4
+
+
+@pytest.mark.parametrize(("value", "field"), [("1:30", "seed"), ("2:00", "realizations")])
+def test_a_clock_time_in_a_whole_number_field_is_refused_naming_it(value, field, tmp_path, capsys):
+    # YAML 1.1 reads 1:30 as ninety (base 60); a seed of 90 run without a word is a surprise
+    path = tmp_path / "p.yaml"
+    path.write_text(re.sub(rf"^{field}: .*$", f"{field}: {value}", BASE, flags=re.M))
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert field in err and value in err
 
 
 def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, capsys):

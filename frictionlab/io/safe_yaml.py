@@ -76,11 +76,32 @@ class _BoundedLoader(yaml.SafeLoader):
             self._depth -= 1
 
 
+# Numbers are read as YAML 1.2 and Python read them, not as YAML 1.1: ``1e-6`` is a float
+# (1.1 wants ``1.0e-6``), ``010`` is ten (1.1: octal eight), and ``1:30`` is text (1.1:
+# ninety, base 60), which the field's check then names. Underscores between digits are
+# kept (``1_000``), as Python allows them.
+_INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+_DIGITS = r"[0-9](?:_?[0-9])*"
+_BoundedLoader.yaml_implicit_resolvers = {
+    first: [(tag, regexp) for tag, regexp in resolvers if tag not in (_INT, _FLOAT)]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
 _BoundedLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    _INT, re.compile(rf"^(?:[-+]?{_DIGITS}|0o[0-7]+|0x[0-9a-fA-F]+)$"), list("-+0123456789")
+)
+_BoundedLoader.add_implicit_resolver(
+    _FLOAT,
+    re.compile(
+        rf"^(?:[-+]?(?:{_DIGITS}(?:\.(?:{_DIGITS})?)?|\.{_DIGITS})(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+    ),
     list("-+.0123456789"),
 )
+
+
+def _integer(loader, node):
+    text = loader.construct_scalar(node)
+    return int(text, 0) if text[:2] in ("0o", "0x") else int(text, 10)
 
 
 def past_double_precision(text: str, number: float) -> bool:
@@ -97,7 +118,8 @@ def _finite_or_text(loader, node):
     return node.value if past_double_precision(node.value, number) else number
 
 
-_BoundedLoader.add_constructor("tag:yaml.org,2002:float", _finite_or_text)
+_BoundedLoader.add_constructor(_FLOAT, _finite_or_text)
+_BoundedLoader.add_constructor(_INT, _integer)
 
 def _children(node) -> list:
     if isinstance(node, yaml.SequenceNode):

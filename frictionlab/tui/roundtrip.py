@@ -1,13 +1,13 @@
 """Write an edited preset back into its YAML text, keeping the comments.
 
 The file is read twice: with ruamel.yaml's round-trip loader (the nodes that
-carry comments, quoting and layout) and with PyYAML (the values frictionlab
-sees). A key whose value equals the PyYAML reading is left alone, so its
+carry comments, quoting and layout) and with frictionlab's own reader (the values
+frictionlab sees). A key whose value equals that reading is left alone, so its
 spelling (``1e4``, quotes, a folded description) stays byte for byte; changed
 values are replaced, new keys go after the key that precedes them in the edited
 data, and a removed key hands its comments to the key before it (a comment
 line above the next key is stored with the removed one). New scalars are
-spelled so PyYAML reads them back as the same value (``1.0e-05``, ``'yes'``).
+spelled so frictionlab reads them back as the same value (``1.0e-05``, ``'yes'``).
 """
 
 from __future__ import annotations
@@ -15,18 +15,18 @@ from __future__ import annotations
 import io
 import math
 
-import yaml
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.error import CommentMark
 from ruamel.yaml.representer import RoundTripRepresenter
 from ruamel.yaml.tokens import CommentToken
 
+from ..io.safe_yaml import YamlProblem, load_yaml
 from ..runs.sweep import yaml_scalar
 
 
-class _PyYAMLSafeRepresenter(RoundTripRepresenter):
-    """Plain floats and strings in spellings PyYAML (YAML 1.1) reads back unchanged."""
+class _ReadsBackRepresenter(RoundTripRepresenter):
+    """Plain floats and strings in spellings frictionlab's reader reads back unchanged."""
 
 
 def _represent_float(representer, value: float):
@@ -42,16 +42,16 @@ def _represent_float(representer, value: float):
 def _represent_str(representer, value: str):
     node = RoundTripRepresenter.represent_str(representer, value)
     try:
-        reads_back = yaml.safe_load(value) == value
-    except yaml.YAMLError:
+        reads_back = load_yaml(value) == value
+    except YamlProblem:
         reads_back = False
     if node.style is None and not reads_back and "\n" not in value:
-        node.style = "'"  # e.g. "yes", "1e4", "0o17": plain text PyYAML would read as another type
+        node.style = "'"  # e.g. "yes", "1e4", "0o17": plain text the reader would take for another type
     return node
 
 
-_PyYAMLSafeRepresenter.add_representer(float, _represent_float)
-_PyYAMLSafeRepresenter.add_representer(str, _represent_str)
+_ReadsBackRepresenter.add_representer(float, _represent_float)
+_ReadsBackRepresenter.add_representer(str, _represent_str)
 
 
 def _same(a, b) -> bool:
@@ -256,13 +256,13 @@ def dump_preserving(original: str, data: dict) -> str | None:
     """``data`` as YAML laid out like ``original``, or None when ``original``
     cannot be read as a mapping by both loaders (the caller writes it plainly)."""
     rt = YAML(typ="rt")
-    rt.Representer = _PyYAMLSafeRepresenter
+    rt.Representer = _ReadsBackRepresenter
     rt.preserve_quotes = True
     rt.width = 4096  # never re-wrap a long line the file had on one line
     try:
-        old = yaml.safe_load(original)
+        old = load_yaml(original)
         node = rt.load(original)
-    except Exception:  # ruamel and PyYAML raise several types for text one of them refuses
+    except Exception:  # ruamel and the reader raise several types for text one of them refuses
         return None
     if not isinstance(old, dict) or not isinstance(node, CommentedMap):
         return None

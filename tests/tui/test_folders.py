@@ -3,6 +3,7 @@
 
 import yaml
 
+from frictionlab.io.safe_yaml import load_yaml
 from frictionlab.tui.folders import save_preset
 
 from ..conftest import PRESETS
@@ -72,13 +73,16 @@ def test_save_without_changes_rewrites_every_shipped_preset_byte_for_byte(tmp_pa
         assert (tmp_path / preset.name).read_text() == original, preset.name
 
 
-def test_new_text_values_are_spelled_so_pyyaml_reads_them_back(tmp_path):
+def test_new_text_values_are_spelled_so_presets_read_them_back(tmp_path):
+    # read back as a preset is read (load_yaml), not as PyYAML's YAML 1.1 reads: "1e4" is text
+    # to the one and a number to the other
     source = tmp_path / "source.yaml"
     source.write_text("name: x  # n\nseed: 1\n")
-    data = {"name": "yes", "seed": 1, "description": "1e4", "notes": {"on": "0o17", "nan": float("inf")}}
+    data = {"name": "yes", "seed": 1, "description": "1e4",
+            "notes": {"on": "0o17", "nan": float("inf"), "ten": "010", "small": "1e-6", "clock": "1:30"}}
     save_preset(tmp_path / "out.yaml", data, template=source)
     text = (tmp_path / "out.yaml").read_text()
-    assert yaml.safe_load(text) == data and "# n" in text
+    assert load_yaml(text) == data and "# n" in text
 
 
 def test_the_built_in_presets_are_listed_after_the_users_and_copies_go_to_the_user(tmp_path, monkeypatch):
