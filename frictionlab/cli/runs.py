@@ -4,9 +4,10 @@ damaged (a file of it cannot be read as frictionlab writes it: the reason is sai
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from ..errors import ExitCode, RunFolderError
+from ..errors import ExitCode, RunFolderError, shown
 
 EXAMPLES = """examples:
   frictionlab runs                            the runs under runs/
@@ -46,7 +47,7 @@ def run(args) -> ExitCode:
         emit("runs", {"runs_dir": str(runs_dir), "runs": [s.to_dict() for s in states]})
         return ExitCode.OK
     if not states:
-        print(f"no run folders in {runs_dir}/")
+        print(f"no run folders in {shown(runs_dir)}/{_what_it_is(runs_dir)}")
         return ExitCode.OK
     from .console import print_table
 
@@ -59,9 +60,21 @@ def run(args) -> ExitCode:
         count = "-" if state.status == "damaged" else f"{done}/{total}{unit}"  # the reason follows the table
         rows.append((str(state.folder), state.name, status, count))
     print_table(["FOLDER", "NAME", "STATUS", "DONE"], rows)
-    from ..errors import shown
-
     for state in states:
         if state.reason:
             print(f"{shown(state.folder)} is damaged: {shown(state.reason)}")
     return ExitCode.OK
+
+
+def _what_it_is(folder: Path) -> str:
+    """A hint when DIR is itself a run's or a sweep's folder, not the folder that holds them."""
+    from ..runs.detached import RUN_MARKERS, SWEEP_FILE, STATE_FILE
+
+    marks = [name for name in RUN_MARKERS if os.path.lexists(folder / name)]
+    if not marks:
+        return ""
+    if SWEEP_FILE in marks and STATE_FILE not in marks:
+        return (f": it is a sweep's folder (frictionlab follow {shown(folder)} shows it); "
+                f"its points' run folders: frictionlab runs {shown(folder / 'points')}")
+    return (f": it is a run folder itself (frictionlab follow {shown(folder)} shows it); "
+            f"the runs beside it: frictionlab runs {shown(folder.parent)}")

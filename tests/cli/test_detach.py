@@ -201,3 +201,20 @@ def test_run_detach_quiet_prints_only_the_folder_on_one_line(tmp_path, cli):
     resumed = cli("resume", out, "--detach", "--quiet")  # resume --detach too
     assert resumed.returncode == 0 and resumed.stdout == f"{out}\n" and resumed.stderr == ""
     assert cli("follow", out, "--quiet").returncode == 0
+
+
+@pytest.mark.parametrize(("marker", "hint"), [("run.json", "a run folder itself"), ("sweep.json", "a sweep's folder")])
+def test_runs_given_a_run_or_sweep_folder_says_what_it_is(marker, hint, tmp_path, capsys):
+    from frictionlab.cli import main
+
+    folder = tmp_path / "runs" / "one"
+    folder.mkdir(parents=True)
+    (folder / marker).write_text("{}")
+    assert main(["runs", str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"no run folders in {folder}/: it is {hint}")
+    wanted = folder / "points" if marker == "sweep.json" else folder.parent
+    assert out.rstrip().endswith(f"frictionlab runs {wanted}")
+    capsys.readouterr()
+    assert main(["runs", str(tmp_path)]) == 0  # a folder of run folders' folders: no hint
+    assert capsys.readouterr().out == f"no run folders in {tmp_path}/\n"
