@@ -276,12 +276,15 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             return
         self.run_worker(self._open_after_confirm(entry.path), exclusive=True, group="open")
 
-    async def _open_after_confirm(self, path: Path) -> None:
+    async def _open_after_confirm(self, path: Path, data: dict | None = None, *, modified: bool = False) -> bool:
+        """Open a preset in place of the draft, asking first when the draft has unsaved changes
+        (Enter on the list, New, Duplicate); whether it was opened."""
         if self.modified and not await self.push_screen_wait(
             ConfirmScreen("The open preset has unsaved changes. Discard them?")
         ):
-            return
-        await self.open_preset(path)
+            return False
+        await self.open_preset(path, data, modified=modified)
+        return True
 
     async def open_preset(self, path: Path, data: dict | None = None, *, modified: bool = False) -> None:
         if data is None:
@@ -346,7 +349,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.push_screen(NewPresetScreen(choices, self.save_folder), done)
 
     async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
-        await self.open_preset(path, data, modified=True)
+        if not await self._open_after_confirm(path, data, modified=True):
+            return
         self.draft_source = template  # its comments are kept when the new preset is saved
         self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.")
 
@@ -452,7 +456,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.reload_presets()
         self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:
-            self.run_worker(self.open_preset(path), group="open")
+            self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
         else:
             self.draft_path = self.draft_source = path
             self.modified = False
