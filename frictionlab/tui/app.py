@@ -44,6 +44,7 @@ from .folders import (
 from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
+from .tabs import TabSwitching
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, NewPresetScreen, PathScreen
 from .text import problems_text
@@ -58,7 +59,7 @@ WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started any
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
+class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -233,20 +234,10 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
     # ------------------------------------------------------------ navigation and help
 
-    def action_show_tab(self, tab: str) -> None:
-        self.query_one("#tabs", TabbedContent).active = tab
-        focus = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}[tab]
-        self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
-        self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
-
     def row_highlighted(self, path: Path | None) -> None:
         """A list's cursor is on ``path``'s row: a message about another row is taken back."""
         if self.said_about is not None and self.said_about != path:
             self.say("")
-
-    def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
-        if self.screen_stack:  # not once the app has closed (a late message)
-            self.refresh_bindings()
 
     # ------------------------------------------------------------ the status line
 
