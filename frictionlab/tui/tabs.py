@@ -27,8 +27,10 @@ class TabSwitching:
         if not self.screen_stack:  # not once the app has closed (a late message)
             return
         # a tab clicked with the mouse left the focus in the tab it hid (nowhere, so Enter did nothing
-        # on the list shown): its part takes the keys, as F2..F5 give them
-        focused = self.focused
-        if self.screen is event.pane.screen and (focused is None or event.pane not in focused.ancestors):
-            self._focus_tab(event.pane.id)
+        # on the list shown): its part takes the keys, as F2..F5 give them (not for a tab since left:
+        # the first tab's message comes after a preset given on the command line is open)
+        focused, pane = self.focused, event.pane
+        shown = pane.id == event.tabbed_content.active and self.screen is pane.screen
+        if shown and (focused is None or pane not in focused.ancestors):
+            self._focus_tab(pane.id)
         self.refresh_bindings()
