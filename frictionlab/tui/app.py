@@ -46,7 +46,7 @@ from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
 from .tabs import TabSwitching
 from .running import NO_PRESET, RunControl
-from .screens import ConfirmScreen, NewPresetScreen, PathScreen
+from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
 from .text import problems_text
 from .widgets.presets import NO_PRESETS, PresetsPane
 
@@ -148,6 +148,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
                 return
             if self._early_keys is not None:
                 self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
+                return
+            if isinstance(self.screen, Dialog) and self.screen.hold(event):  # typed as a dialog opens: answered once it is up
                 return
             if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
                 return

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
@@ -20,7 +21,30 @@ from ..widgets.keyinput import KeyInput
 
 class Dialog(ModalScreen):
     """A modal dialog with a footer of its own: the one behind lists the keys of the screen
-    behind (Open, Duplicate, New), none of which acts while the dialog is up."""
+    behind (Open, Duplicate, New), none of which acts while the dialog is up.
+
+    Keys typed before it is mounted (n then a name, read together) wait for it (``hold``): they
+    went to the screen, no field of it focused yet, and were lost. They are answered in the app's
+    queue, in the order typed, once its first field has the focus."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._held: list[events.Key] | None = []  # None once the keys held are answered
+
+    def hold(self, key: events.Key) -> bool:
+        """Keep ``key`` for the dialog until it is mounted; False once it takes keys itself."""
+        if self._held is None:
+            return False
+        self._held.append(key)
+        return True
+
+    def on_mount(self) -> None:
+        self.app.call_later(self._answer_held)  # after the keys the app's queue holds now
+
+    async def _answer_held(self) -> None:
+        held, self._held = self._held, None
+        for key in held or ():
+            await self.app.on_event(key)
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
