@@ -157,6 +157,12 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
         yield Static("", id="path-error", classes="field-error")
         yield Label("Enter: save    Esc: cancel", classes="hint")
 
+    def on_input_changed(self, event: Input.Changed) -> None:
+        """Another file typed: what was said of the one before (it exists, Enter again replaces it) is taken back."""
+        if self.query_one("#path-error", Static).display:
+            self.confirmed = None
+            show_error(self.query_one("#path-error", Static), "")
+
     def on_input_submitted(self, event: Input.Submitted) -> None:
         path, problem = preset_path_problem(event.value, self.folder)
         error = self.query_one("#path-error", Static)
