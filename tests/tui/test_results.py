@@ -10,7 +10,7 @@ from frictionlab.options import RunOptions
 from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
-from .conftest import SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, runs_app, started, sync
+from .conftest import SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, runs_app, screen_text, started, sync
 
 # ------------------------------------------------------------------ results
 
@@ -102,3 +102,18 @@ async def test_esc_leaves_a_sweeps_points_and_a_damaged_row_opened_after_shows_n
     assert opened and drawn and back
     assert not sweep_shown and "seed1: damaged" in info
     assert not plotted
+
+
+@pytest.mark.long  # a sweep run first, then a TUI session
+@sync
+async def test_a_sweeps_points_footer_fits_80_columns_whole(folders, registry):
+    """The points' footer ('esc Back to the runs' among the list's keys) ran past 80 columns
+    with a preset open: Ctrl+S and Ctrl+R were cut from it."""
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter")
+        footer = screen_text(app).splitlines()[-1]
+        assert app.query_one("#results-sweep").display
+    assert "esc Back" in footer and footer.rstrip().endswith("^r Run")

@@ -41,7 +41,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
-        Binding("escape", "back_to_list", "Back to the runs", tooltip="from the open sweep's points"),
+        Binding("escape", "back_to_list", "Back", tooltip="to the runs from the open sweep's points"),  # short: the footer fits 80
         # the same keys on a row where they cannot act (check_action hides those above): the status line says why
         *said_when_hidden(("space", "compare"), ("u", "resume")),
     ]
