@@ -66,3 +66,20 @@ async def test_save_as_takes_back_exists_once_another_file_is_typed_and_asks_aga
     assert "exists" not in retyped
     assert "presets/other.yaml exists: Enter again replaces it" in asked_again
     assert (folders / "presets" / "other.yaml").read_text() == "keep me\n"
+
+
+@sync
+async def test_esc_closes_the_keys_panel_over_a_dialog_and_keeps_what_was_typed(folders, registry):
+    """F1 in the New dialog, then Esc: the dialog closed with the panel, and the name typed into
+    it was gone (Esc closes the keys panel everywhere else)."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n", *"rough", "f1")
+        shown = bool(app.screen.query("HelpPanel"))
+        await press_settled(pilot, "escape")
+        after_one = (type(app.screen).__name__, bool(app.screen.query("HelpPanel")), app.screen.query_one("#new-name", Input).value)
+        await press_settled(pilot, "escape")
+        after_two = type(app.screen).__name__
+    assert shown
+    assert after_one == ("NewPresetScreen", False, "rough")
+    assert after_two != "NewPresetScreen"
