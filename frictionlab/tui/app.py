@@ -149,11 +149,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             if self._early_keys is not None:
                 self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
                 return
-            if isinstance(self.screen, Dialog) and self.screen.hold(event):  # typed as a dialog opens: answered once it is up
-                return
-            if event.key == "escape" and isinstance(self.screen, Dialog) and self.screen.query("HelpPanel"):
-                self.action_hide_help_panel()  # the keys panel first, as elsewhere (the dialog's Esc closed both)
-                return
+            if isinstance(self.screen, Dialog) and (self.screen.hold(event) or self.screen.answers_first(event)):
+                return  # typed as a dialog opens (answered once it is up), or a key the dialog answers itself
             if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
                 return
         await super().on_event(event)

@@ -48,38 +48,3 @@ async def test_duplicate_asks_before_it_opens_the_copy_over_unsaved_edits(folder
     assert kept == ("tiny.yaml", "7", True)
     assert (folders / "presets" / "tiny-copy.yaml").is_file()  # the copy asked for is written either way
 
-
-@sync
-async def test_save_as_takes_back_exists_once_another_file_is_typed_and_asks_again_for_it(folders, registry):
-    """Save as on a file that exists said 'Enter again replaces it', and said it on under any
-    other name typed after; typed back, the first file was then replaced on a single Enter."""
-    (folders / "presets" / "other.yaml").write_text("keep me\n")
-    app = make_app(registry, preset="presets/tiny.yaml")
-    async with started(app) as pilot:
-        await press_settled(pilot, "ctrl+o", "ctrl+u", *"presets/other", "enter")
-        asked = screen_text(app)
-        await press_settled(pilot, "backspace", "backspace")
-        retyped = screen_text(app)
-        await press_settled(pilot, *"er", "enter")
-        asked_again = screen_text(app)
-    assert "presets/other.yaml exists: Enter again replaces it" in asked
-    assert "exists" not in retyped
-    assert "presets/other.yaml exists: Enter again replaces it" in asked_again
-    assert (folders / "presets" / "other.yaml").read_text() == "keep me\n"
-
-
-@sync
-async def test_esc_closes_the_keys_panel_over_a_dialog_and_keeps_what_was_typed(folders, registry):
-    """F1 in the New dialog, then Esc: the dialog closed with the panel, and the name typed into
-    it was gone (Esc closes the keys panel everywhere else)."""
-    app = make_app(registry)
-    async with started(app) as pilot:
-        await press_settled(pilot, "n", *"rough", "f1")
-        shown = bool(app.screen.query("HelpPanel"))
-        await press_settled(pilot, "escape")
-        after_one = (type(app.screen).__name__, bool(app.screen.query("HelpPanel")), app.screen.query_one("#new-name", Input).value)
-        await press_settled(pilot, "escape")
-        after_two = type(app.screen).__name__
-    assert shown
-    assert after_one == ("NewPresetScreen", False, "rough")
-    assert after_two != "NewPresetScreen"

@@ -46,6 +46,18 @@ class Dialog(ModalScreen):
         for key in held or ():
             await self.app.on_event(key)
 
+    def answers_first(self, key: events.Key) -> bool:
+        """Whether the dialog answers ``key`` itself, before any binding: Esc closes the keys panel
+        over it first (its Esc closed both, and what was typed with them); Ctrl+S, Ctrl+O and Ctrl+R
+        wait for it to close, and say so (each opened another dialog over it, or ran the preset)."""
+        if key.key == "escape" and self.query("HelpPanel"):
+            self.app.action_hide_help_panel()
+            return True
+        if key.key in ("ctrl+s", "ctrl+o", "ctrl+r"):
+            self.app.say("A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O and Ctrl+R act.", "warning")
+            return True
+        return False
+
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
             yield from self.body()
