@@ -52,7 +52,7 @@ async def test_save_run_and_save_as_wait_while_a_dialog_is_open_and_say_so(folde
         said = status_text(app)
         dialogs = sum(type(screen).__name__ == "PathScreen" for screen in app.screen_stack)
         await press_settled(pilot, "escape")
-        left = type(app.screen).__name__
-    assert dialogs == 1 and left == "Screen"
+        left = type(app.screen).__name__, status_text(app)
+    assert dialogs == 1 and left == ("Screen", "")  # the message goes with the dialog
     assert said.startswith("A dialog is open: Enter answers it, Esc closes it")
     assert app.followed is None and not (folders / "runs").exists()  # no run started behind the dialog

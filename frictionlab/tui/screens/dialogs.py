@@ -19,6 +19,9 @@ from ..folders import new_preset_path
 from ..widgets.keyinput import KeyInput
 
 
+WAIT_FOR_DIALOG = "A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O and Ctrl+R act."
+
+
 class Dialog(ModalScreen):
     """A modal dialog with a footer of its own: the one behind lists the keys of the screen
     behind (Open, Duplicate, New), none of which acts while the dialog is up.
@@ -54,9 +57,14 @@ class Dialog(ModalScreen):
             self.app.action_hide_help_panel()
             return True
         if key.key in ("ctrl+s", "ctrl+o", "ctrl+r"):
-            self.app.say("A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O and Ctrl+R act.", "warning")
+            self.app.say(WAIT_FOR_DIALOG, "warning")
             return True
         return False
+
+    def on_unmount(self) -> None:
+        status = self.app.query("#status")
+        if status and str(status.first().render()) == WAIT_FOR_DIALOG:
+            self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
