@@ -117,3 +117,27 @@ async def test_a_sweeps_points_footer_fits_80_columns_whole(folders, registry):
         footer = screen_text(app).splitlines()[-1]
         assert app.query_one("#results-sweep").display
     assert "esc Back" in footer and footer.rstrip().endswith("^r Run")
+
+
+@pytest.mark.long  # two runs made first, then one in the TUI
+@sync
+async def test_a_run_made_before_results_is_first_shown_is_the_row_highlighted_there(folders, registry):
+    """Ctrl+R, then F5: the row highlighted was the run listed first before, moved down as the
+    new run was listed above it, so Enter opened the run before the one just made."""
+    from .conftest import run_to_the_end
+
+    make_runs(folders, registry)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await run_to_the_end(pilot)
+        await pilot.pause(0.6)  # the runs folder looked at again (twice a second)
+        await press_settled(pilot, "f5", "enter")
+        pane = app.query_one(ResultsPane)
+        highlighted, opened = pane.highlighted().path, [entry.path for entry in pane.overlay]
+        await press_settled(pilot, "down")
+        moved = pane.highlighted().path
+        app.reload_runs()  # the user's row stays highlighted as the list is read again
+        await pilot.pause()
+        kept = pane.highlighted().path
+    assert highlighted == app.last_out_dir and opened == [app.last_out_dir]
+    assert kept == moved != highlighted
