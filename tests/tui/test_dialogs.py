@@ -1,11 +1,13 @@
 """Dialogs (Save as, New, the questions): what is typed into one is kept, a file is replaced only
 when asked twice, and the keys of the screen behind wait until it is closed."""
 
+import pytest
 from textual.widgets import Input
 
 from .conftest import make_app, press_settled, screen_text, started, status_text, sync
 
 
+@pytest.mark.long  # a TUI session (dialogs' fast case: the last test)
 @sync
 async def test_save_as_takes_back_exists_once_another_file_is_typed_and_asks_again_for_it(folders, registry):
     """Save as on a file that exists said 'Enter again replaces it', and said it on under any
@@ -25,6 +27,7 @@ async def test_save_as_takes_back_exists_once_another_file_is_typed_and_asks_aga
     assert (folders / "presets" / "other.yaml").read_text() == "keep me\n"
 
 
+@pytest.mark.long  # a TUI session (dialogs' fast case: the last test)
 @sync
 async def test_esc_closes_the_keys_panel_over_a_dialog_and_keeps_what_was_typed(folders, registry):
     """F1 in the New dialog, then Esc: the dialog closed with the panel, and the name typed into

@@ -1,6 +1,7 @@
 """Unsaved edits are never dropped without a question: every way of putting another preset
 on the form (Enter on the list, New, Duplicate) asks first, and No keeps the edits."""
 
+import pytest
 from textual.widgets import Input
 
 from .conftest import make_app, press_settled, screen_text, started, sync, type_into, wait_until
@@ -33,6 +34,7 @@ async def test_new_asks_before_it_replaces_unsaved_edits_and_no_keeps_them(folde
     assert not (folders / "presets" / "other.yaml").exists()  # New writes nothing until Ctrl+S
 
 
+@pytest.mark.long  # a TUI session (the question's fast case: New, above)
 @sync
 async def test_duplicate_asks_before_it_opens_the_copy_over_unsaved_edits(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")

@@ -72,6 +72,7 @@ def test_the_terminals_parser_keeps_an_escape_joined_to_a_control_key(typed, key
     ],
     ids=["new", "duplicate"],
 )
+@pytest.mark.long  # a TUI session each (keys in order: the first test)
 @sync
 async def test_keys_typed_as_a_dialog_opens_are_typed_into_it(folders, registry, keys, name, path):
     """n or d then typing at once (keys a terminal or SSH delivers together): the keys came

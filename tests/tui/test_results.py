@@ -10,7 +10,9 @@ from frictionlab.options import RunOptions
 from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
-from .conftest import SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, runs_app, screen_text, started, sync
+from .conftest import (
+    SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, run_to_the_end, runs_app, screen_text, started, sync,
+)
 
 # ------------------------------------------------------------------ results
 
@@ -124,8 +126,6 @@ async def test_a_sweeps_points_footer_fits_80_columns_whole(folders, registry):
 async def test_a_run_made_before_results_is_first_shown_is_the_row_highlighted_there(folders, registry):
     """Ctrl+R, then F5: the row highlighted was the run listed first before, moved down as the
     new run was listed above it, so Enter opened the run before the one just made."""
-    from .conftest import run_to_the_end
-
     make_runs(folders, registry)
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
