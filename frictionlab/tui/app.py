@@ -44,8 +44,9 @@ from .folders import (
 from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
+from .tabs import TabSwitching
 from .running import NO_PRESET, RunControl
-from .screens import ConfirmScreen, NewPresetScreen, PathScreen
+from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
 from .text import problems_text
 from .widgets.presets import NO_PRESETS, PresetsPane
 
@@ -58,7 +59,7 @@ WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started any
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
+class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -148,6 +149,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             if self._early_keys is not None:
                 self._early_keys.append(event)  # typed before the first frame: answered once every pane is there
                 return
+            if isinstance(self.screen, Dialog) and (self.screen.hold(event) or self.screen.answers_first(event)):
+                return  # typed as a dialog opens (answered once it is up), or a key the dialog answers itself
             if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
                 return
         await super().on_event(event)
@@ -233,20 +236,10 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
 
     # ------------------------------------------------------------ navigation and help
 
-    def action_show_tab(self, tab: str) -> None:
-        self.query_one("#tabs", TabbedContent).active = tab
-        focus = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}[tab]
-        self.query_one(focus).focus()  # the form, not a field: a listed key never types into the preset
-        self.call_after_refresh(self.refresh_bindings)  # the footer, for the part now focused
-
     def row_highlighted(self, path: Path | None) -> None:
         """A list's cursor is on ``path``'s row: a message about another row is taken back."""
         if self.said_about is not None and self.said_about != path:
             self.say("")
-
-    def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
-        if self.screen_stack:  # not once the app has closed (a late message)
-            self.refresh_bindings()
 
     # ------------------------------------------------------------ the status line
 
@@ -276,12 +269,15 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
             return
         self.run_worker(self._open_after_confirm(entry.path), exclusive=True, group="open")
 
-    async def _open_after_confirm(self, path: Path) -> None:
+    async def _open_after_confirm(self, path: Path, data: dict | None = None, *, modified: bool = False) -> bool:
+        """Open a preset in place of the draft, asking first when the draft has unsaved changes
+        (Enter on the list, New, Duplicate); whether it was opened."""
         if self.modified and not await self.push_screen_wait(
             ConfirmScreen("The open preset has unsaved changes. Discard them?")
         ):
-            return
-        await self.open_preset(path)
+            return False
+        await self.open_preset(path, data, modified=modified)
+        return True
 
     async def open_preset(self, path: Path, data: dict | None = None, *, modified: bool = False) -> None:
         if data is None:
@@ -346,7 +342,8 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.push_screen(NewPresetScreen(choices, self.save_folder), done)
 
     async def _open_new(self, path: Path, data: dict, template: Path | None) -> None:
-        await self.open_preset(path, data, modified=True)
+        if not await self._open_after_confirm(path, data, modified=True):
+            return
         self.draft_source = template  # its comments are kept when the new preset is saved
         self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.")
 
@@ -452,7 +449,7 @@ class FrictionlabApp(KeysHelp, SaysWhyUnavailable, RunControl, App):
         self.reload_presets()
         self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:
-            self.run_worker(self.open_preset(path), group="open")
+            self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
         else:
             self.draft_path = self.draft_source = path
             self.modified = False

@@ -90,6 +90,9 @@ class PresetEntry:
     error: str = ""
 
 
+NOT_A_MAPPING = "a preset must be a mapping of keys to values (name: ..., spectrum: ...)"
+
+
 def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
     entries = []
     for label, folder in folders:
@@ -101,7 +104,9 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
             except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not YAML, beyond the limits
                 entries.append(PresetEntry(label, path, path.stem, "", f"cannot be read: {_unreadable(exc)}"))
                 continue
-            data = data if isinstance(data, dict) else {}
+            if not isinstance(data, dict):  # a list, a bare value, an empty file: opening it is refused, so it says why
+                entries.append(PresetEntry(label, path, path.stem, "", f"cannot be read: {NOT_A_MAPPING}"))
+                continue
             description = " ".join(str(data.get("description") or "").split())
             entries.append(PresetEntry(label, path, str(data.get("name") or path.stem), description))
     return entries

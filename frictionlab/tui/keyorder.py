@@ -17,9 +17,13 @@ binds no Alt key, so such a key is read as the two keys typed. Esc joined to a c
 from __future__ import annotations
 
 from textual import events
+from textual.widgets import Input
 
-# the actions that only move the focus: run at once, they change nothing else than Textual's own order would
-FOCUS_ACTIONS = frozenset({"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field"})
+# the actions that only move the focus, or open a dialog (which holds the keys after it until its field
+# has the focus): run at once, they change nothing else than Textual's own order would
+FOCUS_ACTIONS = frozenset(
+    {"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field", "new", "duplicate"}
+)
 
 
 def unjoined(key: events.Key) -> list[events.Key]:
@@ -31,8 +35,9 @@ def unjoined(key: events.Key) -> list[events.Key]:
 
 async def answer_focus_key(app, key: events.Key) -> bool:
     """Run ``key``'s binding now if the binding it would reach (the first from the focused
-    widget up) moves the focus; True if it did. A printable key is the focused field's."""
-    if key.is_printable or key.is_forwarded:
+    widget up) moves the focus or opens a dialog; True if it did. A printable key is the
+    focused text field's (n and d open dialogs from the Presets list)."""
+    if key.is_forwarded or (key.is_printable and isinstance(app.focused, Input)):
         return False
     for namespace, bindings in app.screen._modal_binding_chain:
         for binding in bindings.key_to_bindings.get(key.key, ()):

@@ -96,3 +96,18 @@ def test_the_built_in_presets_are_listed_after_the_users_and_copies_go_to_the_us
     assert writable_folder(folders) == tmp_path / "mine"
     (tmp_path / "presets").mkdir()  # a project folder is listed first
     assert [label for label, _ in preset_folders(env=env)] == ["project", "user", "built-in"]
+
+
+def test_a_file_that_is_no_mapping_is_listed_as_unreadable_and_offered_as_no_template(tmp_path):
+    """A YAML list, a bare value or an empty file was listed as a preset '(no description)' and
+    offered as New's template; opening it, or New from it, was refused."""
+    from frictionlab.tui.folders import list_presets, templates
+
+    (tmp_path / "list.yaml").write_text("- 1\n- 2\n")
+    (tmp_path / "empty.yaml").write_text("")
+    (tmp_path / "fine.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    entries = {entry.path.name: entry for entry in list_presets([("project", tmp_path)])}
+    offered = {path.name for _, path in templates(list(entries.values())) if path.parent == tmp_path}
+    assert entries["list.yaml"].error.startswith("cannot be read: a preset must be a mapping")
+    assert entries["empty.yaml"].error.startswith("cannot be read: a preset must be a mapping")
+    assert not entries["fine.yaml"].error and offered == {"fine.yaml"}

@@ -62,3 +62,27 @@ def test_the_terminals_parser_keeps_an_escape_joined_to_a_control_key(typed, key
     parser = XTermParser()
     read = [*parser.feed(typed), *parser.feed("")]
     assert [event.key for event in read if isinstance(event, events.Key)] == keys
+
+
+@pytest.mark.parametrize(
+    ("keys", "name", "path"),
+    [
+        (["n", *"rough", "enter"], "rough", "presets/rough.yaml"),  # the name typed into New as it opens
+        (["d", "ctrl+u", *"presets/mine", "enter"], "mine", "presets/mine.yaml"),  # Duplicate's file (its name)
+    ],
+    ids=["new", "duplicate"],
+)
+@pytest.mark.long  # a TUI session each (keys in order: the first test)
+@sync
+async def test_keys_typed_as_a_dialog_opens_are_typed_into_it(folders, registry, keys, name, path):
+    """n or d then typing at once (keys a terminal or SSH delivers together): the keys came
+    before the dialog's field had the focus, went to the list behind it and were lost; New
+    then made my-scene, the name it offers."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        post_keys(app, keys)
+        await wait_until(pilot, lambda: app.draft_path is not None, timeout=10.0)
+        await pilot.pause()
+        opened = (app.query_one("#field--name", Input).value, str(app.draft_path))
+    assert opened == (name, path)

@@ -10,7 +10,9 @@ from frictionlab.options import RunOptions
 from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
-from .conftest import SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, runs_app, started, sync
+from .conftest import (
+    SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, run_to_the_end, runs_app, screen_text, started, sync,
+)
 
 # ------------------------------------------------------------------ results
 
@@ -102,3 +104,40 @@ async def test_esc_leaves_a_sweeps_points_and_a_damaged_row_opened_after_shows_n
     assert opened and drawn and back
     assert not sweep_shown and "seed1: damaged" in info
     assert not plotted
+
+
+@pytest.mark.long  # a sweep run first, then a TUI session
+@sync
+async def test_a_sweeps_points_footer_fits_80_columns_whole(folders, registry):
+    """The points' footer ('esc Back to the runs' among the list's keys) ran past 80 columns
+    with a preset open: Ctrl+S and Ctrl+R were cut from it."""
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter")
+        footer = screen_text(app).splitlines()[-1]
+        assert app.query_one("#results-sweep").display
+    assert "esc Back" in footer and footer.rstrip().endswith("^r Run")
+
+
+@pytest.mark.long  # two runs made first, then one in the TUI
+@sync
+async def test_a_run_made_before_results_is_first_shown_is_the_row_highlighted_there(folders, registry):
+    """Ctrl+R, then F5: the row highlighted was the run listed first before, moved down as the
+    new run was listed above it, so Enter opened the run before the one just made."""
+    make_runs(folders, registry)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await run_to_the_end(pilot)
+        await pilot.pause(0.6)  # the runs folder looked at again (twice a second)
+        await press_settled(pilot, "f5", "enter")
+        pane = app.query_one(ResultsPane)
+        highlighted, opened = pane.highlighted().path, [entry.path for entry in pane.overlay]
+        await press_settled(pilot, "down")
+        moved = pane.highlighted().path
+        app.reload_runs()  # the user's row stays highlighted as the list is read again
+        await pilot.pause()
+        kept = pane.highlighted().path
+    assert highlighted == app.last_out_dir and opened == [app.last_out_dir]
+    assert kept == moved != highlighted

@@ -1,5 +1,5 @@
 """The TUI's modal screens."""
 
-from .dialogs import ConfirmScreen, NewPresetScreen, PathScreen, QuitDuringRunScreen, QuitUnsavedScreen
+from .dialogs import ConfirmScreen, Dialog, NewPresetScreen, PathScreen, QuitDuringRunScreen, QuitUnsavedScreen
 
-__all__ = ["ConfirmScreen", "NewPresetScreen", "PathScreen", "QuitDuringRunScreen", "QuitUnsavedScreen"]
+__all__ = ["ConfirmScreen", "Dialog", "NewPresetScreen", "PathScreen", "QuitDuringRunScreen", "QuitUnsavedScreen"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
@@ -18,9 +19,52 @@ from ..folders import new_preset_path
 from ..widgets.keyinput import KeyInput
 
 
+WAIT_FOR_DIALOG = "A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O and Ctrl+R act."
+
+
 class Dialog(ModalScreen):
     """A modal dialog with a footer of its own: the one behind lists the keys of the screen
-    behind (Open, Duplicate, New), none of which acts while the dialog is up."""
+    behind (Open, Duplicate, New), none of which acts while the dialog is up.
+
+    Keys typed before it is mounted (n then a name, read together) wait for it (``hold``): they
+    went to the screen, no field of it focused yet, and were lost. They are answered in the app's
+    queue, in the order typed, once its first field has the focus."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._held: list[events.Key] | None = []  # None once the keys held are answered
+
+    def hold(self, key: events.Key) -> bool:
+        """Keep ``key`` for the dialog until it is mounted; False once it takes keys itself."""
+        if self._held is None:
+            return False
+        self._held.append(key)
+        return True
+
+    def on_mount(self) -> None:
+        self.app.call_later(self._answer_held)  # after the keys the app's queue holds now
+
+    async def _answer_held(self) -> None:
+        held, self._held = self._held, None
+        for key in held or ():
+            await self.app.on_event(key)
+
+    def answers_first(self, key: events.Key) -> bool:
+        """Whether the dialog answers ``key`` itself, before any binding: Esc closes the keys panel
+        over it first (its Esc closed both, and what was typed with them); Ctrl+S, Ctrl+O and Ctrl+R
+        wait for it to close, and say so (each opened another dialog over it, or ran the preset)."""
+        if key.key == "escape" and self.query("HelpPanel"):
+            self.app.action_hide_help_panel()
+            return True
+        if key.key in ("ctrl+s", "ctrl+o", "ctrl+r"):
+            self.app.say(WAIT_FOR_DIALOG, "warning")
+            return True
+        return False
+
+    def on_unmount(self) -> None:
+        status = self.app.query("#status")
+        if status and str(status.first().render()) == WAIT_FOR_DIALOG:
+            self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
@@ -132,6 +176,12 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
         yield SubmitInput(str(self.default), "Save", id="path-input")
         yield Static("", id="path-error", classes="field-error")
         yield Label("Enter: save    Esc: cancel", classes="hint")
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        """Another file typed: what was said of the one before (it exists, Enter again replaces it) is taken back."""
+        if self.query_one("#path-error", Static).display:
+            self.confirmed = None
+            show_error(self.query_one("#path-error", Static), "")
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         path, problem = preset_path_problem(event.value, self.folder)

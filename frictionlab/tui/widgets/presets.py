@@ -13,6 +13,7 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ..folders import PresetEntry, list_presets
+from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..text import shorten_middle
 from .pathline import PathLine
 from .tables import ListTable
@@ -20,11 +21,12 @@ from .tables import ListTable
 NO_PRESETS = "No preset to open here: n makes a new one."
 
 
-class PresetsPane(Vertical):
+class PresetsPane(SaysWhyUnavailable, Vertical):
     BINDINGS = [
         Binding("d", "duplicate", "Duplicate", tooltip="the preset (asks for a file name)"),
         Binding("n", "new", "New", tooltip="preset from a listed one (asks its name and file)"),
         Binding("r", "reload", "Reload", tooltip="the list of presets"),
+        *said_when_hidden(("d", "duplicate")),  # on an empty list (check_action hides d): says why
     ]
 
     def __init__(self, **kwargs):
@@ -68,10 +70,14 @@ class PresetsPane(Vertical):
         if self.presets:
             table.move_cursor(row=min(max(row, 0), len(self.presets) - 1), animate=False)
 
+    def check_action(self, action: str, parameters) -> bool:
+        return action != "duplicate" or bool(self.presets)  # listed only with a preset to duplicate
+
     def reload(self, folders: list) -> None:
         """List the presets of ``folders`` (``folders.preset_folders``)."""
         self.presets = list_presets(folders)
         self._fill()
+        self.app.refresh_bindings()  # Open and Duplicate are listed only on a list with a row
         if not self.presets:
             shown = ", ".join(str(f) for _, f in folders)
             self.query_one("#preset-path", PathLine).show("")

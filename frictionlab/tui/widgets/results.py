@@ -41,7 +41,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
         Binding("r", "reload", "Reload", tooltip="the list of runs"),
         Binding("u", "resume", "Resume", tooltip="the highlighted run: only the missing realizations are computed"),
-        Binding("escape", "back_to_list", "Back to the runs", tooltip="from the open sweep's points"),
+        Binding("escape", "back_to_list", "Back", tooltip="to the runs from the open sweep's points"),  # short: the footer fits 80
         # the same keys on a row where they cannot act (check_action hides those above): the status line says why
         *said_when_hidden(("space", "compare"), ("u", "resume")),
     ]
@@ -54,6 +54,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         self._shown: list[Path] = []  # the folders the list shows, in its order
         self._footer_row: tuple | None = None  # the (folder, status) the footer's keys were for
         self._info_about: Path | None = None  # the damaged run whose reason the info box shows
+        self._visited = False  # the list has had the focus: the row highlighted there is the user's
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="results-top"):
@@ -77,6 +78,9 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         width = max(share, min(longest + others + gutter, self.size.width - CHART_MIN))
         table.styles.width = width
         return max(12, width - others - gutter)
+
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        self._visited = True
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
@@ -155,7 +159,9 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         table = self.query_one("#runs-table", DataTable)
         row = table.cursor_row
         was = self._shown[row] if 0 <= row < len(self._shown) else None
-        if was is not None and was in [entry.path for entry in self.runs]:  # the run highlighted stays so
+        # the run highlighted stays so as rows are added above it; until the list is first shown, the
+        # newest stays first (a run made, then F5: Enter opened the run before it, not the one just made)
+        if self._visited and was is not None and was in [entry.path for entry in self.runs]:
             row = [entry.path for entry in self.runs].index(was)
         self._shown = [entry.path for entry in self.runs]
         width = self._name_width()

@@ -1,0 +1,61 @@
+"""Dialogs (Save as, New, the questions): what is typed into one is kept, a file is replaced only
+when asked twice, and the keys of the screen behind wait until it is closed."""
+
+import pytest
+from textual.widgets import Input
+
+from .conftest import make_app, press_settled, screen_text, started, status_text, sync
+
+
+@pytest.mark.long  # a TUI session (dialogs' fast case: the last test)
+@sync
+async def test_save_as_takes_back_exists_once_another_file_is_typed_and_asks_again_for_it(folders, registry):
+    """Save as on a file that exists said 'Enter again replaces it', and said it on under any
+    other name typed after; typed back, the first file was then replaced on a single Enter."""
+    (folders / "presets" / "other.yaml").write_text("keep me\n")
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+o", "ctrl+u", *"presets/other", "enter")
+        asked = screen_text(app)
+        await press_settled(pilot, "backspace", "backspace")
+        retyped = screen_text(app)
+        await press_settled(pilot, *"er", "enter")
+        asked_again = screen_text(app)
+    assert "presets/other.yaml exists: Enter again replaces it" in asked
+    assert "exists" not in retyped
+    assert "presets/other.yaml exists: Enter again replaces it" in asked_again
+    assert (folders / "presets" / "other.yaml").read_text() == "keep me\n"
+
+
+@pytest.mark.long  # a TUI session (dialogs' fast case: the last test)
+@sync
+async def test_esc_closes_the_keys_panel_over_a_dialog_and_keeps_what_was_typed(folders, registry):
+    """F1 in the New dialog, then Esc: the dialog closed with the panel, and the name typed into
+    it was gone (Esc closes the keys panel everywhere else)."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n", *"rough", "f1")
+        shown = bool(app.screen.query("HelpPanel"))
+        await press_settled(pilot, "escape")
+        after_one = (type(app.screen).__name__, bool(app.screen.query("HelpPanel")), app.screen.query_one("#new-name", Input).value)
+        await press_settled(pilot, "escape")
+        after_two = type(app.screen).__name__
+    assert shown
+    assert after_one == ("NewPresetScreen", False, "rough")
+    assert after_two != "NewPresetScreen"
+
+
+@sync
+async def test_save_run_and_save_as_wait_while_a_dialog_is_open_and_say_so(folders, registry):
+    """Ctrl+O in the Save as dialog opened a second one over it (Esc then left one up), and
+    Ctrl+R started the preset behind it."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+o", "ctrl+o", "ctrl+s", "ctrl+r")
+        said = status_text(app)
+        dialogs = sum(type(screen).__name__ == "PathScreen" for screen in app.screen_stack)
+        await press_settled(pilot, "escape")
+        left = type(app.screen).__name__, status_text(app)
+    assert dialogs == 1 and left == ("Screen", "")  # the message goes with the dialog
+    assert said.startswith("A dialog is open: Enter answers it, Esc closes it")
+    assert app.followed is None and not (folders / "runs").exists()  # no run started behind the dialog
