@@ -460,3 +460,17 @@ def test_a_resume_refused_for_memory_says_only_the_worker_count_can_change(regis
     assert str(resumed.value).startswith(str(fresh.value))
     assert str(resumed.value).endswith("A resume keeps the preset the run was started with: of that advice only "
                                        "--workers applies; otherwise resume it where more memory is available.")
+
+
+def test_the_refusals_hint_names_exactly_the_commands_that_take_no_memory_check():
+    # validate and study refuse for memory too, and must not be told of an option they lack
+    import argparse
+    import re
+
+    from frictionlab.cli.main import build_parser
+    from frictionlab.compute.memory import SKIP_HINT
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    taking = {name for name, sub in commands.items() if "--no-memory-check" in sub._option_string_actions}
+    named = set(re.match(r"\((.*) takes? --no-memory-check", SKIP_HINT).group(1).replace(" and ", ", ").split(", "))
+    assert taking == named == {"run", "resume"}

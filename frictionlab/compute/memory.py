@@ -31,6 +31,7 @@ from ..preset import Scene
 
 MiB = 2**20
 GiB = 2**30
+SKIP_HINT = "(run and resume take --no-memory-check to skip this estimate, an upper bound.)"  # validate and study do not
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
@@ -280,7 +281,7 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
         raise RunError(
             f"one process of this run would need about {gib(need)} at its peak ({making}a realization of "
             f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
-            f"limit to itself). It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
+            f"limit to itself). It would fit with {advice}. {SKIP_HINT}"
         )
 
 
@@ -353,7 +354,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
                               f"{gib(one.per_realization)} (a measured scan: crop it or make its pixels coarser)")  # fmt: skip
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
-        f"({source}). It would fit with {advice[0]}. (--no-memory-check skips this estimate, an upper bound.)"
+        f"({source}). It would fit with {advice[0]}. {SKIP_HINT}"
     )
 
 
@@ -381,5 +382,5 @@ def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usabl
         f"one realization of {points_text(guess.points)} points would need about {gib(need)} in a Dask worker "
         f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "
         f"{address} has a memory limit of {gib(limit)} ({smallest}Dask kills a worker at {usable:.0%} of its limit). "
-        f"It would fit with {advice}. (--no-memory-check skips this estimate, an upper bound.)"
+        f"It would fit with {advice}. {SKIP_HINT}"
     )
