@@ -68,12 +68,11 @@ def run(args) -> ExitCode:
 
 def _what_it_is(folder: Path) -> str:
     """A hint when DIR is itself a run's or a sweep's folder, not the folder that holds them."""
-    from ..runs.detached import RUN_MARKERS, SWEEP_FILE, STATE_FILE
+    from ..runs.detached import RUN_MARKERS, is_sweep_folder
 
-    marks = [name for name in RUN_MARKERS if os.path.lexists(folder / name)]
-    if not marks:
+    if not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
         return ""
-    if SWEEP_FILE in marks and STATE_FILE not in marks:
+    if is_sweep_folder(folder):
         return (f": it is a sweep's folder (frictionlab follow {shown(folder)} shows it); "
                 f"its points' run folders: frictionlab runs {shown(folder / 'points')}")
     return (f": it is a run folder itself (frictionlab follow {shown(folder)} shows it); "

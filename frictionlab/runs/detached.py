@@ -255,12 +255,17 @@ def _count(value) -> int | None:
     return value if isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= MAX_COUNT else None
 
 
+def is_sweep_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds a sweep (its sweep.json, and no run.json of its own)."""
+    return os.path.lexists(folder / SWEEP_FILE) and not os.path.lexists(folder / STATE_FILE)
+
+
 def run_state(folder: str | Path) -> RunState:
     """The state of the run (or sweep) in ``folder``; RunFolderError if it holds none (or a damaged one)."""
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
         raise RunFolderError(f"{folder} is not a run folder (not a folder, or a link to one)")
-    if not os.path.lexists(folder / STATE_FILE) and os.path.lexists(folder / SWEEP_FILE):
+    if is_sweep_folder(folder):
         return sweep_state(folder)
     manifest = RunDirectory(folder).state()  # read as untrusted input
     if manifest is None:
@@ -399,7 +404,7 @@ def list_run_states(runs_dir: str | Path) -> list[RunState]:
         try:
             states.append((mtime, run_state(folder)))
         except (OSError, FrictionlabError) as exc:
-            kind = "sweep" if os.path.lexists(folder / SWEEP_FILE) and not os.path.lexists(folder / STATE_FILE) else "run"
+            kind = "sweep" if is_sweep_folder(folder) else "run"
             reason = damage_reason(folder, exc) if isinstance(exc, FrictionlabError) else (exc.strerror or str(exc))
             states.append((mtime, RunState(folder, folder.name, "damaged", None, None, kind=kind, reason=reason)))
     states.sort(key=lambda item: (item[1].status != "running", -item[0], item[1].folder.name))
