@@ -17,11 +17,21 @@ from ..conftest import PRESETS
 
 
 @pytest.fixture(scope="module")
-def quick_study(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exact3d")
-    code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"), "--quiet",
-                 "--workers", "1"])  # fmt: skip
-    assert code == ExitCode.OK
+def quick_study(tmp_path_factory, worker_id):
+    """The quick study, run once per session: the pytest-xdist workers that get some of
+    this module's tests share one copy (built under a file lock) rather than each building
+    its own. Tests read it; a test that writes works on a copy."""
+    from filelock import FileLock
+
+    shared = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        shared = shared.parent  # the base folder all the workers' own are made in
+    out = shared / "exact3d-quick"
+    with FileLock(shared / "exact3d-quick.lock"):
+        if not (out / PAGE).is_file():
+            code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"),
+                         "--quiet", "--workers", "1"])  # fmt: skip
+            assert code == ExitCode.OK
     return out
 
 
@@ -145,7 +155,10 @@ def f_column(folder):
     return np.loadtxt(folder / "curve.csv", delimiter=",", skiprows=1, usecols=1)
 
 
-def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, capsys):
+def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, tmp_path, capsys):
+    import shutil
+
+    quick_study = shutil.copytree(quick_study, tmp_path / "study", symlinks=True)  # the shared one stays as it was
     args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(quick_study), "--runs", str(quick_study / "runs"),
             "--quiet", "--workers", "1"]  # fmt: skip
     before = (quick_study / PAGE).read_text()
