@@ -158,10 +158,22 @@ def test_a_map_too_large_once_on_square_pixels_is_refused_before_it_is_built(tmp
     path = write_gwy(tmp_path / "wide.gwy", rough(24, 32) * 1e-9, 2e-4, 1e-7)
     code, text = validate(tmp_path, capsys, path)
     assert code == ExitCode.USAGE, text
-    assert "pixels of 0.0002 x 1e-07, 2000 times longer along x, make the map on square pixels 62001 x 24" in text
+    assert "pixels of 0.0002 x 1e-07 m, 2000 times longer along x, make the map on square pixels 62001 x 24" in text
     assert "a test limit of 32 MiB" in text and "crop it with region" in text and "give spacing" in text
     code, text = validate(tmp_path, capsys, path, spacing=1e-7)  # the remedy it names
     assert code == ExitCode.OK, text
+
+
+@pytest.mark.parametrize("xreal, said", [(1e300, "pixels of 3.125e+298"), (1e-320, "pixels of 3.1")])
+def test_a_pixel_side_past_what_a_run_takes_is_named_not_an_internal_error(tmp_path, capsys, xreal, said):
+    """A header whose width makes a pixel of 3e298 m, or a subnormal 3e-322 m, beside one of
+    1e-7 m: their ratio overflowed while the shape on square pixels was worked out for the
+    memory estimate (exit code 70, 'OverflowError: int too large to convert to float', or
+    'cannot convert float infinity to integer'). Refused by the read's own check of a side."""
+    path = write_gwy(tmp_path / "wide.gwy", rough(24, 32) * 1e-9, 1e-7, 1e-7, xreal=xreal)
+    code, text = validate(tmp_path, capsys, path)
+    assert code == ExitCode.USAGE, text
+    assert said in text and "a spacing must be between 1e-100 and 1e+100" in text, text
 
 
 # ------------------------------------------------------------ a line stored as a map

@@ -70,6 +70,7 @@ class ScanHeader:
     shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
     periodic: bool
     pixel: tuple[float, ...] | None = None  # (dx, dy) of a map, in the file's unit, when the file says
+    unit: str | None = None  # the file's length unit, when it says
 
 
 def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | None = None) -> ScanHeader | None:
@@ -84,12 +85,13 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
+            unit = chosen.unit if isinstance(chosen.unit, str) else None
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
     if dimension == 1 and len(shape) == 2 and 1 in shape:  # a line stored as a map one pixel wide
         along = 0 if shape[1] == 1 else 1
-        return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1])
-    return ScanHeader(shape[::-1], periodic, pixel) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+        return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1], unit)
+    return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
 
 
 def _by_name(fh):

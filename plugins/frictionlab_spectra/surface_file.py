@@ -149,7 +149,9 @@ class SurfaceFile(MeasuredFile):
         p = self.params
         if header is None or p.region is not None or p.downsample is not None:
             return self._measured().heights.shape
-        return header.shape if p.spacing is not None else square_shape(header.shape, header.pixel)
+        if p.spacing is not None:
+            return header.shape
+        return square_shape(header.shape, header.pixel, f"surface-file {str(p.path)!r}", header.unit)
 
     def radial_psd(self) -> RadialPSD:
         """The detrended map's radially averaged C2D in annuli of the map's own finest dq."""
