@@ -5,6 +5,7 @@ on maps built here with known parts."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -85,6 +86,28 @@ def test_levelling_removes_the_least_squares_plane_and_quadratic_and_says_what_t
     assert bowl.curvature_share / (1 - bowl.plane_share) > 0.5 and "detrend: quadratic" in levelling_warning(bowl, "plane")
     assert levelling_warning(level(rough, "mean"), "mean") is None
 
+
+@pytest.mark.parametrize("rough, bow, seed", [(1e-8, 0.0, 2), (1e-9, 1e-8, 5)])
+def test_the_curvature_left_by_a_plane_is_measured_on_what_the_plane_leaves(rough, bow, seed):
+    """A tilt that carries all but 1e-16 of a map's height variance: the curvature's share of
+    what the plane leaves was curvature / (1 - plane share), and 1 - plane share is rounding
+    there (0: 'a curvature carries inf %', with numpy's 'divide by zero' on stderr; or a
+    share below 0 or above 100 %). It is measured against the levelled heights' own rms,
+    the share brute force gives (a least-squares quadratic fitted to what the plane leaves)."""
+    y, x = np.mgrid[0:64, 0:64].astype(float)
+    left = rough * np.random.default_rng(seed).standard_normal(x.shape) + bow * (x - 31.5) ** 2
+    z = x + 3.0 * y + left
+    design = np.stack([d.ravel() for d in (np.ones_like(x), x, y, x * x, x * y, y * y)], axis=1)
+    after_plane = level(z, "plane").heights.ravel()
+    after_quadratic = after_plane - design @ np.linalg.lstsq(design, after_plane, rcond=None)[0]
+    share = 1.0 - np.var(after_quadratic) / np.var(after_plane)  # brute force
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's divide by zero
+        said = levelling_warning(level(z, "plane"), "plane")
+    if share <= 0.5:
+        assert said is None
+    else:
+        assert said is not None and f"a curvature carries {100 * share:.1f} % " in said, said
 
 def test_despike_replaces_a_spike_and_nothing_else():
     z, _ = band_limited(40, 48, seed=5, top=0.2)

@@ -94,8 +94,11 @@ def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     if mode in ("none", "mean") and plane + curvature > MOST:
         part = "a tilt" if plane >= curvature else "a curvature"
         return _form_kept(part, plane + curvature, "map", mode, "detrend: plane (or quadratic) levels it")
-    if mode == "plane" and curvature > MOST * (1 - plane):
-        return (f"a curvature carries {100 * curvature / (1 - plane):.1f} % of the levelled map's height variance: "
+    # the share of what the plane leaves, from the levelled heights' own rms: 1 - plane loses every digit
+    # when a tilt carries all but 1e-16 of the variance (it gave 'inf %', or a share below zero)
+    left = curvature * (levelled.rms_before / levelled.rms_after) ** 2 if levelled.rms_after > 0 else 0.0
+    if mode == "plane" and left > MOST:
+        return (f"a curvature carries {100 * left:.1f} % of the levelled map's height variance: "
                 "the contact sits where the form puts it; detrend: quadratic removes it, if it is not the "
                 "surface's own shape")  # fmt: skip
     return None
