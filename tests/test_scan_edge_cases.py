@@ -432,6 +432,29 @@ def test_a_bowed_line_is_levelled_by_detrend_quadratic_and_a_curvature_left_in_i
     assert 0.5 < joint < 0.99 and f"carries {100 * joint:.1f} % of the line's height variance (detrend: mean)" in mean_only
 
 
+@pytest.mark.parametrize("bow", [0.0, 1e-9])
+def test_a_steep_line_with_little_roughness_is_read_not_an_internal_error(tmp_path, capsys, bow):
+    """A line whose tilt carries all but 1e-16 of its height variance (3 per point, roughness
+    1e-9): the bow's share of what the tilt leaves was curvature / (1 - tilt share), a
+    division by rounding; 1 - tilt share was 0 and validate ended in the catch-all internal
+    error (exit code 70: ZeroDivisionError). The share is measured on what the tilt leaves:
+    none said of a rough line, the share brute force gives of a bowed one."""
+    t = np.arange(256.0)
+    z = 3.0 * t + 1e-9 * np.random.default_rng(np.random.SeedSequence(0)).standard_normal(t.size) + bow * (t - 100) ** 2
+    np.save(tmp_path / "steep.npy", z)
+    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1.0, "detrend": "tilt"}}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": spec}))
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    text = capsys.readouterr().err
+    assert code == ExitCode.OK, text
+    after_tilt = z - np.polyval(np.polyfit(t, z, 1), t)
+    share = 1.0 - np.var(z - np.polyval(np.polyfit(t, z, 2), t)) / np.var(after_tilt)  # brute force
+    caveats = ProfileFile(**spec["params"]).input_summary().get("caveats", [])
+    assert caveats == ([f"a curvature carries {100 * share:.1f} % of the levelled line's height variance: the contact "
+                        "sits where the form puts it; detrend: quadratic removes it, if it is not the surface's own "
+                        "shape"] if share > 0.5 else []), (share, caveats)  # fmt: skip
+
+
 def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):
     """surface-file sends a map one pixel high to profile-file, which refused a single row of
     heights ('50 columns; expected 1 (z) or 2 (x, z)'): each sent the file away."""

@@ -117,9 +117,11 @@ def line_form_warning(z: np.ndarray, mode: str) -> str | None:
         return None
     tilt = float(np.dot(t, centred)) ** 2 / float(np.dot(t, t)) / variance
     curvature = float(np.dot(t2, centred)) ** 2 / float(np.dot(t2, t2)) / variance if z.size > 2 else 0.0
-    if mode == "tilt":
-        if curvature > MOST * (1 - tilt):
-            return (f"a curvature carries {100 * curvature / (1 - tilt):.1f} % of the levelled line's height "
+    if mode == "tilt":  # the share of what the tilt leaves, summed from it (1 - tilt is rounding on a steep line)
+        rest = centred - (float(np.dot(t, centred)) / float(np.dot(t, t))) * t
+        left = curvature * variance / float(np.dot(rest, rest)) if np.any(rest) else 0.0
+        if left > MOST:
+            return (f"a curvature carries {100 * left:.1f} % of the levelled line's height "
                     "variance: the contact sits where the form puts it; detrend: quadratic removes it, if it is "
                     "not the surface's own shape")  # fmt: skip
         return None
