@@ -455,6 +455,19 @@ def test_a_steep_line_with_little_roughness_is_read_not_an_internal_error(tmp_pa
                         "shape"] if share > 0.5 else []), (share, caveats)  # fmt: skip
 
 
+@pytest.mark.parametrize("text", ["x,y,z\n", "# a scan\n# exported empty\n", "  \n\n\t\n"])
+def test_a_table_of_no_numbers_is_named_as_such_not_as_a_line(tmp_path, text):
+    """A table with a header, comments or blank lines only was 'a map of 1 x 0 pixels (x by
+    y), one pixel wide: a line; use profile-file', sending the user to a plugin that refuses
+    it too ('0 points'); an empty .npy array likewise, by its shape."""
+    (tmp_path / "empty.csv").write_text(text)
+    with pytest.raises(ValueError, match=r"a table of no numbers \(a header, comments or blank lines only\): no heights"):
+        SurfaceFile(path=str(tmp_path / "empty.csv"), spacing=0.1).rms_height()
+    np.save(tmp_path / "empty.npy", np.zeros((1, 0)))
+    with pytest.raises(ValueError, match=r"an array of shape \(1, 0\): no heights; expected a map of at least 8 x 8"):
+        SurfaceFile(path=str(tmp_path / "empty.npy"), spacing=0.1).rms_height()
+
+
 def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):
     """surface-file sends a map one pixel high to profile-file, which refused a single row of
     heights ('50 columns; expected 1 (z) or 2 (x, z)'): each sent the file away."""

@@ -257,6 +257,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                 "is required"
             )
         data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
+        if data.size == 0:  # not 'a map of 1 x 0 pixels, one pixel wide: a line'
+            held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
+                "a table of no numbers (a header, comments or blank lines only)"
+            raise ValueError(f"{where}: {held}: no heights; expected a map of at least {MIN_SIDE} x {MIN_SIDE} points")
         pixel = (p.spacing, p.spacing)
         summary = {
             "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
