@@ -85,6 +85,23 @@ def test_the_channels_of_heights_are_read_beside_ones_that_are_not(tmp_path):
     np.testing.assert_allclose(read, 2e9 * (z - z.mean()), rtol=1e-12, atol=1e-12)
 
 
+
+def test_a_channel_title_of_any_length_is_quoted_cut_in_the_middle(tmp_path, capsys):
+    """A file's channel titles are the file's: a title of 100,000 characters was printed whole
+    by validate (in the line of what was read and in the list of channels) and in a refusal
+    that lists the channels. Each is quoted cut in the middle; the title is still matched whole."""
+    z = rough(16, 20, 2) * 1e-9
+    long = "Height " + "x" * 100_000 + " end"
+    path = write_gwy(tmp_path / "long.gwy", z, 1e-7, 1e-7, more=[(long, 2 * z, "m"), (long, 3 * z, "m")])
+    for channel in (1, long):
+        code, text = validate(tmp_path, capsys, path, channel=channel)
+        assert code == ExitCode.OK, text[:2000]
+        assert "channel 1 'Height xxx" in text and "2 channels are named 'Height xxx" in text, text[:2000]
+        assert max(map(len, text.splitlines())) < 500, [len(line) for line in text.splitlines()]
+    code, text = validate(tmp_path, capsys, path, channel="Phase")
+    assert code == ExitCode.USAGE and "no channel named 'Phase'; the file has 0: 'Height', 1: 'Height xxx" in text
+    assert len(text) < 1000, len(text)
+
 # ------------------------------------------------------------ tables as spreadsheets save them
 
 

@@ -24,7 +24,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator
 
-from ..errors import shown
+from ..errors import short_repr, shown
 
 
 class InputFileProblem(ValueError):
@@ -213,7 +213,7 @@ def describe_input(summary: dict) -> str:
     if "file_unit" in summary and converted is None and unit:  # an instrument file that states no unit
         unit_note = f", the file states no unit: its numbers taken as {unit}"
     channel = summary.get("channel")
-    notes = [f"channel {summary.get('channel_index', '?')} {shown(channel)!r}"] if channel is not None else []
+    notes = [f"channel {summary.get('channel_index', '?')} {short_repr(shown(channel))}"] if channel is not None else []
     if summary.get("region_pixels"):
         (x0, x1), (y0, y1) = summary["region_pixels"]
         notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")
@@ -248,7 +248,7 @@ def describe_channels(summary: dict) -> list[str]:
         points = " x ".join(map(str, channel["points"])) if channel.get("points") else "?"
         units = f"lengths in {shown(channel['unit'] or '?')}, values in {shown(channel['data_unit'] or '?')}"
         taken = " (taken)" if channel["index"] == summary.get("channel_index") else ""
-        lines.append(f"channel {channel['index']}: {shown(channel['name'])!r}, {points} points, {units}{taken}")
+        lines.append(f"channel {channel['index']}: {short_repr(shown(channel['name']))}, {points} points, {units}{taken}")
     if summary.get("channel_note"):
         lines.append(shown(summary["channel_note"]))
     return lines
