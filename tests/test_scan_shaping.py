@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
-from frictionlab_spectra import SurfaceFile
+from frictionlab_spectra import ProfileFile, SurfaceFile
 from frictionlab_spectra.scan_shaping import cosine_resample, despike, level, levelling_warning, spike_warning
 
 
@@ -109,6 +109,7 @@ def test_the_curvature_left_by_a_plane_is_measured_on_what_the_plane_leaves(roug
     else:
         assert said is not None and f"a curvature carries {100 * share:.1f} % " in said, said
 
+
 def test_despike_replaces_a_spike_and_nothing_else():
     z, _ = band_limited(40, 48, seed=5, top=0.2)
     spiky = z.copy()
@@ -151,6 +152,35 @@ def test_a_spike_caveat_comes_with_the_map_unless_despike_is_set(tmp_path):
     assert any("despike: 6 replaces them" in caveat for caveat in said["caveats"])
     cleaned = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, despike=6.0).input_summary()
     assert cleaned["despiked"]["points"] == 1 and "caveats" not in cleaned
+
+
+@pytest.mark.parametrize("where", [slice(300, 302), slice(0, 1), slice(511, 512)])  # inside, the ends
+def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
+    """A profile with a spike 13 rms above it, inside or at an end, was pressed without a word
+    (a map's spikes are said): its law at small loads is the spike's. Counted as a median
+    filter of 5 points (scipy's, ends reflected: independent of the caveat's own windows)
+    counts them; a bump of 4 rms, and the smooth line, say nothing."""
+    from scipy import ndimage
+
+    t = np.arange(512.0)
+    z = np.sin(2 * np.pi * t / 97.0) + 0.5 * np.cos(2 * np.pi * t / 41.0)  # smooth: no point stands out
+    spiky, low = z.copy(), z.copy()
+    spiky[where] += 13 * np.std(z)
+    low[where] += 4 * np.std(z)
+    for name, line in (("smooth", z), ("spiky", spiky), ("low", low)):
+        np.save(tmp_path / f"{name}.npy", line)
+    said = {name: ProfileFile(path=str(tmp_path / f"{name}.npy"), spacing=1.0).input_summary()
+            for name in ("smooth", "spiky", "low")}  # fmt: skip
+    levelled = spiky - spiky.mean()
+    rms = float(np.std(levelled))
+    expected = int(np.count_nonzero(levelled - ndimage.median_filter(levelled, size=5, mode="reflect") > 6 * rms))
+    assert expected == where.stop - where.start
+    assert said["spiky"]["caveats"] == [
+        f"{expected} of the line's 16 highest points stand more than 6 rms heights above the median of the 5 points "
+        "around them: spikes (dust, an instrument's artefact) take the first contact alone, and the law at small "
+        "loads is theirs; remove them from the profile, if they are not the surface's own"
+    ]
+    assert "caveats" not in said["smooth"] and "caveats" not in said["low"]
 
 
 def test_region_and_downsample_in_the_summary(tmp_path):

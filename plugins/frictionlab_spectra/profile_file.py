@@ -40,7 +40,7 @@ from .instrument_file import (
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import level_line, line_form_warning
+from .scan_shaping import level_line, line_form_warning, line_spike_warning
 
 MIN_POINTS = 8
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
@@ -149,8 +149,9 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        if (caveat := line_form_warning(z, mode)) is not None:  # as a map's (map_pipeline.shape_map)
-            summary["caveats"] = [caveat]
+        caveats = [line_form_warning(z, mode), line_spike_warning(heights, rms)]  # as a map's (map_pipeline.shape_map)
+        if any(caveats):
+            summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)
 
 

@@ -179,6 +179,32 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     any map), those above 3 rms: a spike lower than that touches no earlier than the surface."""
     if not rms > 0 or min(z.shape) < 3:
         return None
+    spikes = _spikes(z, rms)
+    if not spikes:
+        return None
+    return (f"{spikes} of the map's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms "
+            "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
+            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
+            "they are not the surface's own")  # fmt: skip
+
+
+def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
+    """The caveat of a line (levelled) with spikes, by ``spike_warning``'s criterion along the
+    line: the median of the SPIKE_WINDOW points around each of its highest points."""
+    if not rms > 0 or z.size < SPIKE_WINDOW:
+        return None
+    spikes = _spikes(z.reshape(1, -1), rms)
+    if not spikes:
+        return None
+    return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms heights above "
+            f"the median of the {SPIKE_WINDOW} points around them: spikes (dust, an instrument's artefact) take the "
+            "first contact alone, and the law at small loads is theirs; remove them from the profile, if they are "
+            "not the surface's own")  # fmt: skip
+
+
+def _spikes(z: np.ndarray, rms: float) -> int:
+    """How many of the SPIKE_LOOKED_AT highest points of ``z`` (above 3 ``rms``) stand more than
+    SPIKE_K ``rms`` above the median of the SPIKE_WINDOW x SPIKE_WINDOW pixels around them."""
     high = np.flatnonzero(z > 3.0 * rms)  # a boolean of the map, the indices of its tallest points
     if high.size > SPIKE_LOOKED_AT:
         high = high[np.argpartition(z.ravel()[high], high.size - SPIKE_LOOKED_AT)[-SPIKE_LOOKED_AT:]]
@@ -187,16 +213,11 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     for index in high:
         row, column = divmod(int(index), nx)
         half = SPIKE_WINDOW // 2
-        rows = [_reflect(r, ny) for r in range(row - half, row + half + 1)]
+        rows = [_reflect(r, ny) for r in range(row - half, row + half + 1)] if ny > 1 else [0]  # a line: its row
         columns = [_reflect(c, nx) for c in range(column - half, column + half + 1)]
         if z[row, column] - np.median(z[np.ix_(rows, columns)]) > SPIKE_K * rms:
             spikes += 1
-    if not spikes:
-        return None
-    return (f"{spikes} of the map's {max(high.size, SPIKE_LOOKED_AT)} highest points stand more than {SPIKE_K:g} rms "
-            "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
-            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
-            "they are not the surface's own")  # fmt: skip
+    return spikes
 
 
 def _reflect(i: int, n: int) -> int:
