@@ -541,6 +541,21 @@ def test_a_text_export_in_latin_1_is_told_to_be_saved_as_utf_8(tmp_path):
         SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
 
 
+def test_a_table_with_a_latin_1_header_is_told_to_be_saved_as_utf_8(tmp_path):
+    """A matrix of heights under a Latin-1 header ('H\\xf6he (\\xb5m)', as a European spreadsheet
+    saves it) was 'not a text file ... read with format: instrument' only; that sends the table
+    to the x, y, z reader, which calls it a damaged file to be copied again from the
+    instrument. The message names the table's own remedy, and the table saved as UTF-8 is read."""
+    z = rough(9, 8, 21)
+    header = "H\xf6he (\xb5m)\n"
+    (tmp_path / "map.csv").write_bytes(header.encode("latin-1") + matrix_text(z).encode())
+    with pytest.raises(ValueError, match=r"not UTF-8 at line 1 .* a table of bare numbers is read as UTF-8: save it so"):
+        SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+    (tmp_path / "map.csv").write_bytes(header.encode("utf-8") + matrix_text(z).encode())
+    read = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1, detrend="none").generate(None).heights
+    np.testing.assert_allclose(read, z, atol=1e-9)
+
+
 @pytest.mark.parametrize(("text", "line"), [
     ("0.1,0.2,0.3,\n0.4,0.5,0.6,\n0.7,0.8,0.1,\n", 1), ("0.1;0.2;0.3;\n0.4;0.5;0.6;\n0.7;0.8;0.1;\n", 1),
     ("0.1,0.2,0.3\n0.4,0.5,0.6,\n0.7,0.8,0.1\n", 2), ("x,y,z\n0.1,0.2,0.3,\n0.4,0.5,0.6,\n", 2),

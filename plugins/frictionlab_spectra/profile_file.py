@@ -292,8 +292,9 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
         lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start + (3 if raw.startswith(b"\xef\xbb\xbf") else 0)) + 1
-        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line}); an instrument's export (a "
-                         "profilometer's .csv) is read with format: instrument") from None
+        raise ValueError(f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ, or "
+                         "no text); an instrument's export (a profilometer's .csv) is read with format: instrument; "
+                         "a table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()
