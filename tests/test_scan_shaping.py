@@ -154,6 +154,19 @@ def test_a_spike_caveat_comes_with_the_map_unless_despike_is_set(tmp_path):
     assert cleaned["despiked"]["points"] == 1 and "caveats" not in cleaned
 
 
+def test_a_map_made_flat_by_despike_says_despike_did_it(tmp_path):
+    """A flat map with two spikes is refused once despike has replaced them, and the refusal
+    said only 'constant (rms height zero after detrend=...)' of a file whose points visibly
+    differ; it names despike and the points it replaced. Without despike the map is read."""
+    z = np.zeros((32, 32))
+    z[5, 5], z[20, 20] = 1.0, -1.0
+    np.save(tmp_path / "map.npy", z)
+    with pytest.raises(ValueError, match=r"constant \(rms height zero after detrend='mean' and despike 6, which "
+                                         r"replaced 2 points\)"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1, despike=6.0).rms_height()
+    assert SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1).rms_height() > 0
+
+
 @pytest.mark.parametrize("where", [slice(300, 302), slice(0, 1), slice(511, 512)])  # inside, the ends
 def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
     """A profile with a spike 13 rms above it, inside or at an end, was pressed without a word

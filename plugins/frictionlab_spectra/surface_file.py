@@ -232,8 +232,10 @@ class SurfaceFile(MeasuredFile):
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
         if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
+            replaced = shaped.get("despiked", {}).get("points")
+            despiked = f" and despike {p.despike:g}, which replaced {replaced} points" if replaced else ""
             raise ValueError(
-                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}); "
+                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}{despiked}); "
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
