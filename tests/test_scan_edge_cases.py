@@ -329,6 +329,20 @@ def test_an_x3p_whose_heights_are_not_the_size_it_declares_is_refused(tmp_path, 
         SurfaceFile(path=str(path)).rms_height()
 
 
+@pytest.mark.parametrize("increment, said", [(b"0", "pixels of 0 x 1e-07 m"), (b"-1e-7", "pixels of -1e-07 x 1e-07 m")])
+def test_a_pixel_side_of_zero_or_below_is_named_with_its_unit(tmp_path, increment, said):
+    """An X3P whose x increment is 0 or negative: refused as 'pixels of 0 x 1e-07; a pixel's
+    size must be > 0', in a unit it did not name (the file's, not the run's: 1e-07 of what?)."""
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+    path = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "zero.x3p",
+                         xml=lambda text: re.sub(rb"(<CX>.*?<Increment>)[^<]*", rb"\g<1>" + increment, text, flags=re.S))
+    with pytest.raises(ValueError, match=re.escape(said) + r" \(x by y, as the file states them\); a pixel's size must be > 0"):
+        SurfaceFile(path=str(path), unit="um").rms_height()
+
+
 def test_an_x3p_whose_heights_are_not_the_bytes_its_checksum_declares_is_refused(tmp_path):
     """One byte changed in the heights (a damaged copy; the heights still finite) was read
     without a word: SurfaceTopography's reader does not check the MD5 checksum main.xml gives.

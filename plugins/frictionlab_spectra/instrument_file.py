@@ -215,9 +215,9 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         periodic = bool(topography.is_periodic)
         listed = channel_list(reader) if len(reader.channels) > 1 else []
         file_format = str(reader.name())
-    shown = " x ".join(f"{p:g}" for p in pixel)
     if not np.all(pixel > 0):  # NaN too
-        raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
+        shown = " x ".join(f"{p:g}" for p in pixel) + (f" {file_unit}" if file_unit else "")
+        raise ValueError(f"{where}: pixels of {shown} (x by y, as the file states them); a pixel's size must be > 0")
     factor = 1.0 if unit is None or file_unit is None else length_factor(file_unit, unit, where, "the file's unit")
     sides = tuple(check_spacing(where, "pixels of", float(p) * factor, unit or file_unit) for p in pixel)
     data = np.ma.getdata(heights)
