@@ -193,6 +193,19 @@ def test_a_pixel_side_past_what_a_run_takes_is_named_not_an_internal_error(tmp_p
     assert said in text and "a spacing must be between 1e-100 and 1e+100" in text, text
 
 
+def test_a_spacing_that_replaces_the_files_own_pixels_says_what_they_were(tmp_path, capsys):
+    """spacing given for an instrument file replaces its pixels and declares them square: a
+    scan of 0.1 x 0.25 um pixels given spacing 0.1 was pressed 2.5 times shorter along y, and
+    validate said only 'of 1e-07 m (from the preset)'. The file's pixels are named beside it;
+    a spacing equal to the file's own square pixel adds nothing."""
+    z = rough(24, 32) * 1e-9
+    code, text = validate(tmp_path, capsys, write_gwy(tmp_path / "rect.gwy", z, 1e-7, 2.5e-7), spacing=1e-7)
+    assert code == ExitCode.OK, text
+    assert "the file's pixels of 1e-07 x 2.5e-07 m replaced by the preset's spacing, square" in text, text
+    code, text = validate(tmp_path, capsys, write_gwy(tmp_path / "square.gwy", z, 1e-7, 1e-7), spacing=1e-7)
+    assert code == ExitCode.OK and "replaced by the preset's spacing" not in text, text
+
+
 # ------------------------------------------------------------ a line stored as a map
 
 

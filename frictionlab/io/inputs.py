@@ -219,6 +219,11 @@ def describe_input(summary: dict) -> str:
         notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")
     if summary.get("pixels"):
         notes.append(f"pixels {summary['pixels']}")
+    stated, given = summary.get("file_spacing"), summary.get("downsampled", {}).get("from_pixel", summary["spacing"])
+    sides = stated if isinstance(stated, list) else [] if stated is None else [stated]
+    if spacing_from == "preset" and any(not math.isclose(side, given, rel_tol=1e-9) for side in sides):
+        notes.append(f"the file's pixels of {' x '.join(f'{side:.6g}' for side in sides)}{length} replaced by the "
+                     "preset's spacing, square")  # fmt: skip
     if summary.get("downsampled"):
         down = summary["downsampled"]
         notes.append(f"downsampled from pixels of {down['from_pixel']:.6g} to {down['to_pixel']:.6g}{length}")
