@@ -26,6 +26,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
     channel_list, check_declared_points, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
+    quoted,
 )
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -86,6 +87,8 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
             unit = chosen.unit if isinstance(chosen.unit, str) else None
+            if unit is not None:
+                length_factor(unit, "m", where, "the file's length unit")  # a message may name it: a length, not any text
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
     if dimension == 1 and len(shape) == 2 and 1 in shape:  # a line stored as a map one pixel wide
@@ -158,7 +161,7 @@ def length_factor(unit: str | None, to: str, where: str, what: str) -> float:
     except Exception:  # noqa: BLE001 - any unit it does not know
         factor = math.nan
     if not (math.isfinite(factor) and factor > 0):
-        raise ValueError(f"{where}: {what} {unit!r} is not a length unit (m, mm, um, nm, pm, ...); "
+        raise ValueError(f"{where}: {what} {quoted(unit)} is not a length unit (m, mm, um, nm, pm, ...); "
                          "choose a channel of heights, or convert the file")  # fmt: skip
     return factor
 
