@@ -222,3 +222,17 @@ def test_a_grid_given_twice_is_run_once_not_taken_as_its_own_reference(builtins,
     assert len(n) == len(set(n)) == len(set(round(256 * f) for f in factors)), n
     assert rows[-1].reference and sum(row.reference for row in rows) == 1
     assert any("gives N = 256 again; each grid is run once" in note for note in study.notes), study.notes
+
+
+def test_a_study_that_measured_nothing_says_why_on_the_terminal(builtins):
+    """Every axis asked skipped (the solver axis of a preset of lines, which no exact solver
+    presses): the recommendation, the one line the terminal shows, said only 'no axis
+    measured enough to recommend anything', the reason left in study.md's notes."""
+    from frictionlab.tradeoff.outputs import recommendation
+
+    study = study_of(TINY, builtins, reference=None, axes=("solver",))
+    study.run()
+    assert study.rows == []
+    said = recommendation(study)
+    assert said.startswith("for 2% error in b at H = 0.8: no axis measured enough to recommend anything; solver, "
+                           "tolerance: skipped: no installed solver solves"), said  # fmt: skip
