@@ -543,6 +543,27 @@ def write_xyz(path, z, pixel, header: bytes) -> None:
     path.write_bytes(header + rows.encode())
 
 
+@pytest.mark.parametrize("plugin", [ProfileFile, SurfaceFile])
+def test_a_line_export_whose_x_is_not_evenly_spaced_is_named_not_an_internal_error(tmp_path, capsys, plugin):
+    """An x, z text export whose x steps unevenly (one point 0.01 um off a step of 0.05 um):
+    SurfaceTopography reads it as a non-uniform line scan, which has no pixel, and validate
+    ended in the catch-all internal error (exit code 70: AttributeError 'pixel_size'). Refused
+    by name, by either plugin; the same line evenly spaced is read by profile-file."""
+    x = np.arange(200) * 0.05
+    z = rough(1, 200, 23)[0] * 0.01
+    uneven = x.copy()
+    uneven[70] += 0.01
+    for name, xs in (("uneven", uneven), ("even", x)):
+        (tmp_path / f"{name}.xyz").write_text("".join(f"{float(a)!r}\t{float(b)!r}\n" for a, b in zip(xs, z)))
+    params = {"path": str(tmp_path / "uneven.xyz"), "unit": "um"}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": {"name": plugin.name, "params": params}}))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "a line scan whose 200 points are not evenly spaced along x; heights are pressed on a uniform grid" in err, err
+    line = ProfileFile(path=str(tmp_path / "even.xyz"), unit="um", detrend="mean").generate(None)
+    assert line.spacing == pytest.approx(0.05, rel=1e-9) and line.heights.size == 200
+
+
 @pytest.mark.parametrize("header", [
     "# x [µm]\ty [µm]\tz [nm]\n".encode(), b"x (um), y (um), z (nm)\n", b"# x/mm y/mm z/um\n",
 ])  # fmt: skip

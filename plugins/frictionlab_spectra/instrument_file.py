@@ -196,6 +196,10 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
             raise describe_failure(type(reader), exc, where) from None
+        if not topography.is_uniform:  # x, z of a text export, x not evenly spaced: it has no pixel
+            raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
+                             "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
+                             "interpolate it onto one")  # fmt: skip
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
             kind = {1: "a line scan", 2: "a 2D map"}
