@@ -564,6 +564,23 @@ def test_a_line_export_whose_x_is_not_evenly_spaced_is_named_not_an_internal_err
     assert line.spacing == pytest.approx(0.05, rel=1e-9) and line.heights.size == 200
 
 
+def test_a_line_export_in_metres_whose_x_is_uneven_is_refused_as_a_tables_is(tmp_path):
+    """SurfaceTopography takes an x, z export's x as even when its steps differ by under 1e-6
+    in the file's unit: in metres, any x. A line of 0.1 um steps with one point 0.03 um off
+    (or x at random) was pressed as if even, without a word; a table's x within 0.1 % of a
+    step is the rule, and it is now the export's too. The even line is read."""
+    x = np.arange(256) * 1e-7
+    z = rough(1, 256, 24)[0] * 1e-8
+    jittered = x.copy()
+    jittered[50] += 3e-8
+    for name, xs in (("jittered", jittered), ("even", x)):
+        (tmp_path / f"{name}.xyz").write_text("x\tz\n" + "".join(f"{float(a)!r}\t{float(b)!r}\n" for a, b in zip(xs, z)))
+    with pytest.raises(ValueError, match=r"x is not uniformly spaced: .* \(0.3 spacings; tolerance 0.001\)"):
+        ProfileFile(path=str(tmp_path / "jittered.xyz"), unit="m").rms_height()
+    line = ProfileFile(path=str(tmp_path / "even.xyz"), unit="m", detrend="mean").generate(None)
+    assert line.spacing == pytest.approx(1e-7, rel=1e-9) and line.heights.size == 256
+
+
 @pytest.mark.parametrize("header", [
     "# x [µm]\ty [µm]\tz [nm]\n".encode(), b"x (um), y (um), z (nm)\n", b"# x/mm y/mm z/um\n",
 ])  # fmt: skip

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import warnings
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
@@ -26,7 +27,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
     channel_list, check_declared_points, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
-    quoted,
+    TEXT_FORMATS, quoted,
 )
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -35,6 +36,7 @@ TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare nu
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
 Unit = Literal["m", "mm", "um", "nm", "pm"]
 Undefined = Literal["refuse", "harmonic"]
+X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 
 
 @dataclass(frozen=True)
@@ -200,6 +202,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
                              "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
                              "interpolate it onto one")  # fmt: skip
+        if topography.dim == 1 and type(reader).format() in TEXT_FORMATS and (x := _text_x(fh, heights.size)) is not None:
+            uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
             kind = {1: "a line scan", 2: "a 2D map"}
@@ -289,3 +293,36 @@ def scan_not_periodic_advice(name: str) -> tuple[str, str]:
     """``SpectrumGenerator.not_periodic_advice`` of a measured line or map."""
     return (f"spectrum {name} is not periodic (periodic: false, a scan whose ends do not meet)",
             "set spectrum.params.periodic: true if its ends meet (after detrend)")  # fmt: skip
+
+
+def uniform_spacing(where: str, x: np.ndarray) -> float:
+    """The step of ``x`` (a table's x column, a text export's), which must increase evenly (within
+    X_TOLERANCE of a step); else a ValueError naming how far it is from even."""
+    n = x.size
+    dx = (x[-1] - x[0]) / (n - 1)
+    if not dx > 0:
+        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
+    deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
+    if deviation > X_TOLERANCE * dx:
+        raise ValueError(
+            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
+            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
+        )
+    return float(dx)
+
+
+def _text_x(fh, points: int) -> np.ndarray | None:
+    """The x column of a text export of a line (its rows of two numbers, x and z), or None when
+    its rows of numbers are not ``points`` such rows (three columns, say)."""
+    fh.seek(0)
+    x = []
+    for line in fh.read().decode("utf-8", errors="replace").splitlines():
+        try:
+            numbers = [float(word) for word in re.split(r"[\s,;]+", line.strip()) if word]
+        except ValueError:  # a header
+            continue
+        if len(numbers) not in (0, 2):
+            return None
+        x += numbers[:1]
+    fh.seek(0)
+    return np.asarray(x) if len(x) == points else None

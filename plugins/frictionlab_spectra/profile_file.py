@@ -36,14 +36,13 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
+    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .scan_shaping import level_line, line_form_warning, line_spike_warning
 
 MIN_POINTS = 8
-X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
 
 
@@ -126,7 +125,7 @@ class ProfileFile(MeasuredFile):
             dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
-            dx = check_spacing(where, "x spaced by", _uniform_spacing(where, x), p.unit)
+            dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), p.unit)
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
                     raise ValueError(
@@ -393,17 +392,3 @@ def check_heights_not_underflowing(where: str, heights: np.ndarray) -> None:
             f"{where}: every value in heights is below {1.0 / MAX_MAGNITUDE:g} in magnitude (the largest "
             f"{largest:.3g}), too small for a run's arithmetic; store them in a unit that makes them larger"
         )
-
-
-def _uniform_spacing(where: str, x: np.ndarray) -> float:
-    n = x.size
-    dx = (x[-1] - x[0]) / (n - 1)
-    if not dx > 0:
-        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
-    deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
-    if deviation > X_TOLERANCE * dx:
-        raise ValueError(
-            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
-            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
-        )
-    return float(dx)
