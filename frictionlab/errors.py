@@ -99,13 +99,18 @@ class RunFolderError(FrictionlabError):
     exit_code = ExitCode.RUN_FOLDER
 
 
-_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F) if chr(c) not in "\n\t"}
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), *range(0x7F, 0xA0)) if chr(c) not in "\n\t"}  # C0, DEL, C1 (CSI)
+# characters that show nothing or turn the text around it (zero-width, bidirectional overrides,
+# a byte-order mark): a name or a key that holds one reads as another on the terminal
+_HIDING = (*range(0x200B, 0x2010), *range(0x202A, 0x202F), *range(0x2066, 0x206A), 0xFEFF)
+_CONTROL.update({c: f"\\u{c:04x}" for c in _HIDING})
 
 
 def shown(text) -> str:
-    """``text`` (or a path) as any terminal takes it: bytes that are not UTF-8 and control
-    characters escaped (an escape sequence typed in a ``--set`` or a file name must not
-    drive the terminal); lines and tabs kept."""
+    """``text`` (or a path) as any terminal takes it: bytes that are not UTF-8, control
+    characters (C0 and C1) and characters that hide or reorder text escaped (an escape
+    sequence typed in a ``--set`` or a file name must not drive the terminal, nor a key read
+    as another); lines and tabs kept."""
     return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
 
 

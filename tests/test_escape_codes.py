@@ -163,3 +163,19 @@ def test_the_tui_status_line_shows_a_message_escaped(registry, tmp_path, monkeyp
 
     shown = asyncio.run(scenario())
     assert shown.count("pwned") == 2 and ESC not in shown and "\x07" not in shown
+
+
+@pytest.mark.parametrize(("typed", "said"), [
+    ("spectrum.params.hurst\u200b=0.5", "spectrum.params.hurst\\u200b: is not a known field; did you mean 'hurst'?"),
+    ("see\u202ed=1", "see\\u202ed: is not a known field"),
+    ("seed\u009b2J=1", "seed\\x9b2J: is not a known field"),
+])  # fmt: skip
+def test_a_key_with_a_character_that_hides_or_reorders_text_is_printed_escaped(tmp_path, capsys, typed, said):
+    """A zero-width space typed into a key read 'spectrum.params.hurst: is not a known field;
+    did you mean 'hurst'?', the difference invisible; a right-to-left override turned the rest
+    of the line around, and a C1 CSI (U+009B) drives a terminal as ESC [ does. Each is escaped."""
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(path), "--set", typed]) == 2
+    err = capsys.readouterr().err
+    assert said in err and not {"\u200b", "\u202e", "\u009b"} & set(err), err

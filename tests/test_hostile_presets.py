@@ -86,8 +86,8 @@ NUMBERS = {
     "inf stop": ("stop: 20.0", "stop: .inf", "loading.stop: must be a finite number, got inf"),
     "nan rms height": ("rms_height: 1.0", "rms_height: .nan", "spectrum.params.rms_height: must be a finite number"),
     "inf c0": ("rms_height: 1.0", "rms_height: null\n    c0: .inf", "spectrum.params.c0: must be a finite number"),
-    "1e308 modulus": ("youngs_modulus: 1.0", "youngs_modulus: 1e308", "solver.params.youngs_modulus: must be 0 or between 1e-100 and 1e+100 in magnitude"),
-    "1e308 height": ("rms_height: 1.0", "rms_height: 1.0e+308", "spectrum.params.rms_height: must be 0 or between"),
+    "1e308 modulus": ("youngs_modulus: 1.0", "youngs_modulus: 1e308", "solver.params.youngs_modulus: must be between 1e-100 and 1e+100, got"),
+    "1e308 height": ("rms_height: 1.0", "rms_height: 1.0e+308", "spectrum.params.rms_height: must be between 1e-100 and 1e+100"),
 }  # fmt: skip
 # names that would take the output folder elsewhere, or are no folder name at all
 FOLDER_ESCAPES = ("/tmp/escape", "../../escape", '"a\\nb"')
@@ -323,8 +323,24 @@ def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, c
     path = tmp_path / "p.yaml"
     path.write_text(yaml.safe_dump(SMALL_PRESET))
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=1e200"]) == ExitCode.USAGE
-    assert "must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+200" in capsys.readouterr().err
+    assert "rms_height: must be between 1e-100 and 1e+100, got 1e+200" in capsys.readouterr().err
     assert main(["validate", str(path), "--set", "spectrum.params.rms_height=2e-3"]) == ExitCode.OK
+
+
+@pytest.mark.parametrize(("assignment", "said"), [
+    ("loading.start=1e-320", "loading.start: must be between 1e-100 and 1e+100, got 1e-320"),  # gt=0
+    ("realizations=1e400", "realizations: must be between 1e-100 and 1e+100, got '1e400'"),  # ge=1
+    ("seed=1e400", "seed: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1e400'"),  # ge=0
+    ("solver.params.poisson_ratio=1e-200", "poisson_ratio: must be 0 or between 1e-100 and 1e+100 in magnitude"),
+])  # fmt: skip
+def test_the_range_a_magnitude_refusal_names_is_the_fields_own(tmp_path, capsys, assignment, said):
+    """A number past the magnitudes a preset takes was told 'must be 0 or between 1e-100 and
+    1e+100' whatever its field: a start of 1e-320, so told, was then given 0 and refused as
+    'must be > 0'. A field whose own bounds refuse 0 is told the range without it."""
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(path), "--set", assignment]) == ExitCode.USAGE
+    assert said in capsys.readouterr().err
 
 
 def test_a_set_into_a_sweep_takes_the_swept_path_as_one_key(tmp_path, capsys):
@@ -373,8 +389,8 @@ def test_a_number_past_double_precision_is_named_as_written(tmp_path, capsys):
     digits = "9" * 5000  # past Python's own limit on the digits of an int read from text
     assert main(["validate", str(path), "--set", "loading.start=1.5e-400", "--set", f"seed={digits}"]) == 2
     err = capsys.readouterr().err
-    assert "loading.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1e400'" in err
-    assert "loading.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1.5e-400'" in err
+    assert "loading.stop: must be between 1e-100 and 1e+100, got '1e400'" in err
+    assert "loading.start: must be between 1e-100 and 1e+100, got '1.5e-400'" in err
     assert "seed: must be 0 or between 1e-100 and 1e+100 in magnitude, got '99999" in err and "got inf" not in err
 
 
@@ -406,9 +422,9 @@ def test_a_whole_number_past_double_precision_in_a_plugins_field_is_named_not_an
     path.write_text(yaml.safe_dump(data))
     assert main(["validate", str(path), "--set", f"{field}={huge}"]) == ExitCode.USAGE
     err = capsys.readouterr().err
-    assert f"{field}: must be 0 or between 1e-100 and 1e+100 in magnitude, got 1000" in err
+    assert f"{field}: must be between 1e-100 and 1e+100, got 1000" in err
     assert "internal error" not in err
     slot, params, name = field.split(".")
     data = merge(data, {slot: {params: {name: huge}}})
-    with pytest.raises(PresetError, match=rf"{field}: must be 0 or between 1e-100 and 1e\+100 in magnitude"):
+    with pytest.raises(PresetError, match=rf"{field}: must be between 1e-100 and 1e\+100, got"):
         frictionlab.validate(data)

@@ -85,6 +85,23 @@ def test_the_channels_of_heights_are_read_beside_ones_that_are_not(tmp_path):
     np.testing.assert_allclose(read, 2e9 * (z - z.mean()), rtol=1e-12, atol=1e-12)
 
 
+
+def test_a_channel_title_of_any_length_is_quoted_cut_in_the_middle(tmp_path, capsys):
+    """A file's channel titles are the file's: a title of 100,000 characters was printed whole
+    by validate (in the line of what was read and in the list of channels) and in a refusal
+    that lists the channels. Each is quoted cut in the middle; the title is still matched whole."""
+    z = rough(16, 20, 2) * 1e-9
+    long = "Height " + "x" * 100_000 + " end"
+    path = write_gwy(tmp_path / "long.gwy", z, 1e-7, 1e-7, more=[(long, 2 * z, "m"), (long, 3 * z, "m")])
+    for channel in (1, long):
+        code, text = validate(tmp_path, capsys, path, channel=channel)
+        assert code == ExitCode.OK, text[:2000]
+        assert "channel 1 'Height xxx" in text and "2 channels are named 'Height xxx" in text, text[:2000]
+        assert max(map(len, text.splitlines())) < 500, [len(line) for line in text.splitlines()]
+    code, text = validate(tmp_path, capsys, path, channel="Phase")
+    assert code == ExitCode.USAGE and "no channel named 'Phase'; the file has 0: 'Height', 1: 'Height xxx" in text
+    assert len(text) < 1000, len(text)
+
 # ------------------------------------------------------------ tables as spreadsheets save them
 
 
@@ -158,10 +175,35 @@ def test_a_map_too_large_once_on_square_pixels_is_refused_before_it_is_built(tmp
     path = write_gwy(tmp_path / "wide.gwy", rough(24, 32) * 1e-9, 2e-4, 1e-7)
     code, text = validate(tmp_path, capsys, path)
     assert code == ExitCode.USAGE, text
-    assert "pixels of 0.0002 x 1e-07, 2000 times longer along x, make the map on square pixels 62001 x 24" in text
+    assert "pixels of 0.0002 x 1e-07 m, 2000 times longer along x, make the map on square pixels 62001 x 24" in text
     assert "a test limit of 32 MiB" in text and "crop it with region" in text and "give spacing" in text
     code, text = validate(tmp_path, capsys, path, spacing=1e-7)  # the remedy it names
     assert code == ExitCode.OK, text
+
+
+@pytest.mark.parametrize("xreal, said", [(1e300, "pixels of 3.125e+298"), (1e-320, "pixels of 3.1")])
+def test_a_pixel_side_past_what_a_run_takes_is_named_not_an_internal_error(tmp_path, capsys, xreal, said):
+    """A header whose width makes a pixel of 3e298 m, or a subnormal 3e-322 m, beside one of
+    1e-7 m: their ratio overflowed while the shape on square pixels was worked out for the
+    memory estimate (exit code 70, 'OverflowError: int too large to convert to float', or
+    'cannot convert float infinity to integer'). Refused by the read's own check of a side."""
+    path = write_gwy(tmp_path / "wide.gwy", rough(24, 32) * 1e-9, 1e-7, 1e-7, xreal=xreal)
+    code, text = validate(tmp_path, capsys, path)
+    assert code == ExitCode.USAGE, text
+    assert said in text and "a spacing must be between 1e-100 and 1e+100" in text, text
+
+
+def test_a_spacing_that_replaces_the_files_own_pixels_says_what_they_were(tmp_path, capsys):
+    """spacing given for an instrument file replaces its pixels and declares them square: a
+    scan of 0.1 x 0.25 um pixels given spacing 0.1 was pressed 2.5 times shorter along y, and
+    validate said only 'of 1e-07 m (from the preset)'. The file's pixels are named beside it;
+    a spacing equal to the file's own square pixel adds nothing."""
+    z = rough(24, 32) * 1e-9
+    code, text = validate(tmp_path, capsys, write_gwy(tmp_path / "rect.gwy", z, 1e-7, 2.5e-7), spacing=1e-7)
+    assert code == ExitCode.OK, text
+    assert "the file's pixels of 1e-07 x 2.5e-07 m replaced by the preset's spacing, square" in text, text
+    code, text = validate(tmp_path, capsys, write_gwy(tmp_path / "square.gwy", z, 1e-7, 1e-7), spacing=1e-7)
+    assert code == ExitCode.OK and "replaced by the preset's spacing" not in text, text
 
 
 # ------------------------------------------------------------ a line stored as a map
@@ -300,6 +342,20 @@ def test_an_x3p_whose_heights_are_not_the_size_it_declares_is_refused(tmp_path, 
         SurfaceFile(path=str(path)).rms_height()
 
 
+@pytest.mark.parametrize("increment, said", [(b"0", "pixels of 0 x 1e-07 m"), (b"-1e-7", "pixels of -1e-07 x 1e-07 m")])
+def test_a_pixel_side_of_zero_or_below_is_named_with_its_unit(tmp_path, increment, said):
+    """An X3P whose x increment is 0 or negative: refused as 'pixels of 0 x 1e-07; a pixel's
+    size must be > 0', in a unit it did not name (the file's, not the run's: 1e-07 of what?)."""
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+    path = rewritten_x3p(tmp_path / "good.x3p", tmp_path / "zero.x3p",
+                         xml=lambda text: re.sub(rb"(<CX>.*?<Increment>)[^<]*", rb"\g<1>" + increment, text, flags=re.S))
+    with pytest.raises(ValueError, match=re.escape(said) + r" \(x by y, as the file states them\); a pixel's size must be > 0"):
+        SurfaceFile(path=str(path), unit="um").rms_height()
+
+
 def test_an_x3p_whose_heights_are_not_the_bytes_its_checksum_declares_is_refused(tmp_path):
     """One byte changed in the heights (a damaged copy; the heights still finite) was read
     without a word: SurfaceTopography's reader does not check the MD5 checksum main.xml gives.
@@ -420,6 +476,42 @@ def test_a_bowed_line_is_levelled_by_detrend_quadratic_and_a_curvature_left_in_i
     assert 0.5 < joint < 0.99 and f"carries {100 * joint:.1f} % of the line's height variance (detrend: mean)" in mean_only
 
 
+@pytest.mark.parametrize("bow", [0.0, 1e-9])
+def test_a_steep_line_with_little_roughness_is_read_not_an_internal_error(tmp_path, capsys, bow):
+    """A line whose tilt carries all but 1e-16 of its height variance (3 per point, roughness
+    1e-9): the bow's share of what the tilt leaves was curvature / (1 - tilt share), a
+    division by rounding; 1 - tilt share was 0 and validate ended in the catch-all internal
+    error (exit code 70: ZeroDivisionError). The share is measured on what the tilt leaves:
+    none said of a rough line, the share brute force gives of a bowed one."""
+    t = np.arange(256.0)
+    z = 3.0 * t + 1e-9 * np.random.default_rng(np.random.SeedSequence(0)).standard_normal(t.size) + bow * (t - 100) ** 2
+    np.save(tmp_path / "steep.npy", z)
+    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1.0, "detrend": "tilt"}}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": spec}))
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    text = capsys.readouterr().err
+    assert code == ExitCode.OK, text
+    after_tilt = z - np.polyval(np.polyfit(t, z, 1), t)
+    share = 1.0 - np.var(z - np.polyval(np.polyfit(t, z, 2), t)) / np.var(after_tilt)  # brute force
+    caveats = ProfileFile(**spec["params"]).input_summary().get("caveats", [])
+    assert caveats == ([f"a curvature carries {100 * share:.1f} % of the levelled line's height variance: the contact "
+                        "sits where the form puts it; detrend: quadratic removes it, if it is not the surface's own "
+                        "shape"] if share > 0.5 else []), (share, caveats)  # fmt: skip
+
+
+@pytest.mark.parametrize("text", ["x,y,z\n", "# a scan\n# exported empty\n", "  \n\n\t\n"])
+def test_a_table_of_no_numbers_is_named_as_such_not_as_a_line(tmp_path, text):
+    """A table with a header, comments or blank lines only was 'a map of 1 x 0 pixels (x by
+    y), one pixel wide: a line; use profile-file', sending the user to a plugin that refuses
+    it too ('0 points'); an empty .npy array likewise, by its shape."""
+    (tmp_path / "empty.csv").write_text(text)
+    with pytest.raises(ValueError, match=r"a table of no numbers \(a header, comments or blank lines only\): no heights"):
+        SurfaceFile(path=str(tmp_path / "empty.csv"), spacing=0.1).rms_height()
+    np.save(tmp_path / "empty.npy", np.zeros((1, 0)))
+    with pytest.raises(ValueError, match=r"an array of shape \(1, 0\): no heights; expected a map of at least 8 x 8"):
+        SurfaceFile(path=str(tmp_path / "empty.npy"), spacing=0.1).rms_height()
+
+
 def test_a_table_of_one_row_is_a_line_for_profile_file(tmp_path):
     """surface-file sends a map one pixel high to profile-file, which refused a single row of
     heights ('50 columns; expected 1 (z) or 2 (x, z)'): each sent the file away."""
@@ -451,6 +543,44 @@ def write_xyz(path, z, pixel, header: bytes) -> None:
     path.write_bytes(header + rows.encode())
 
 
+@pytest.mark.parametrize("plugin", [ProfileFile, SurfaceFile])
+def test_a_line_export_whose_x_is_not_evenly_spaced_is_named_not_an_internal_error(tmp_path, capsys, plugin):
+    """An x, z text export whose x steps unevenly (one point 0.01 um off a step of 0.05 um):
+    SurfaceTopography reads it as a non-uniform line scan, which has no pixel, and validate
+    ended in the catch-all internal error (exit code 70: AttributeError 'pixel_size'). Refused
+    by name, by either plugin; the same line evenly spaced is read by profile-file."""
+    x = np.arange(200) * 0.05
+    z = rough(1, 200, 23)[0] * 0.01
+    uneven = x.copy()
+    uneven[70] += 0.01
+    for name, xs in (("uneven", uneven), ("even", x)):
+        (tmp_path / f"{name}.xyz").write_text("".join(f"{float(a)!r}\t{float(b)!r}\n" for a, b in zip(xs, z)))
+    params = {"path": str(tmp_path / "uneven.xyz"), "unit": "um"}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": {"name": plugin.name, "params": params}}))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "a line scan whose 200 points are not evenly spaced along x; heights are pressed on a uniform grid" in err, err
+    line = ProfileFile(path=str(tmp_path / "even.xyz"), unit="um", detrend="mean").generate(None)
+    assert line.spacing == pytest.approx(0.05, rel=1e-9) and line.heights.size == 200
+
+
+def test_a_line_export_in_metres_whose_x_is_uneven_is_refused_as_a_tables_is(tmp_path):
+    """SurfaceTopography takes an x, z export's x as even when its steps differ by under 1e-6
+    in the file's unit: in metres, any x. A line of 0.1 um steps with one point 0.03 um off
+    (or x at random) was pressed as if even, without a word; a table's x within 0.1 % of a
+    step is the rule, and it is now the export's too. The even line is read."""
+    x = np.arange(256) * 1e-7
+    z = rough(1, 256, 24)[0] * 1e-8
+    jittered = x.copy()
+    jittered[50] += 3e-8
+    for name, xs in (("jittered", jittered), ("even", x)):
+        (tmp_path / f"{name}.xyz").write_text("x\tz\n" + "".join(f"{float(a)!r}\t{float(b)!r}\n" for a, b in zip(xs, z)))
+    with pytest.raises(ValueError, match=r"x is not uniformly spaced: .* \(0.3 spacings; tolerance 0.001\)"):
+        ProfileFile(path=str(tmp_path / "jittered.xyz"), unit="m").rms_height()
+    line = ProfileFile(path=str(tmp_path / "even.xyz"), unit="m", detrend="mean").generate(None)
+    assert line.spacing == pytest.approx(1e-7, rel=1e-9) and line.heights.size == 256
+
+
 @pytest.mark.parametrize("header", [
     "# x [µm]\ty [µm]\tz [nm]\n".encode(), b"x (um), y (um), z (nm)\n", b"# x/mm y/mm z/um\n",
 ])  # fmt: skip
@@ -474,6 +604,21 @@ def test_a_text_export_in_latin_1_is_told_to_be_saved_as_utf_8(tmp_path):
     write_xyz(tmp_path / "scan.xyz", rough(8, 9, 17), 0.5, "# x [\xb5m]\ty [\xb5m]\tz [\xb5m]\n".encode("latin-1"))
     with pytest.raises(ValueError, match="a text export that is not UTF-8 .* save it as UTF-8"):
         SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
+
+
+def test_a_table_with_a_latin_1_header_is_told_to_be_saved_as_utf_8(tmp_path):
+    """A matrix of heights under a Latin-1 header ('H\\xf6he (\\xb5m)', as a European spreadsheet
+    saves it) was 'not a text file ... read with format: instrument' only; that sends the table
+    to the x, y, z reader, which calls it a damaged file to be copied again from the
+    instrument. The message names the table's own remedy, and the table saved as UTF-8 is read."""
+    z = rough(9, 8, 21)
+    header = "H\xf6he (\xb5m)\n"
+    (tmp_path / "map.csv").write_bytes(header.encode("latin-1") + matrix_text(z).encode())
+    with pytest.raises(ValueError, match=r"not UTF-8 at line 1 .* a table of bare numbers is read as UTF-8: save it so"):
+        SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+    (tmp_path / "map.csv").write_bytes(header.encode("utf-8") + matrix_text(z).encode())
+    read = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1, detrend="none").generate(None).heights
+    np.testing.assert_allclose(read, z, atol=1e-9)
 
 
 @pytest.mark.parametrize(("text", "line"), [

@@ -296,6 +296,15 @@ def test_units_that_are_not_lengths_are_refused_and_a_unit_mismatch_is_named(tmp
         SurfaceFile(path=str(tmp_path / "mixed.nc")).generate(None)
 
 
+def test_a_unit_of_any_length_is_quoted_cut_in_the_middle(tmp_path):
+    """A file's unit is the file's text: one of 10,000 characters was quoted whole in the
+    refusal that it is not a length unit."""
+    netcdf(tmp_path / "long.nc", "u" * 10_000, "u" * 10_000)
+    with pytest.raises(ValueError, match="the file's length unit 'u{30}'...'u{30}' is not a length unit") as refused:
+        SurfaceFile(path=str(tmp_path / "long.nc")).generate(None)
+    assert len(str(refused.value)) < 400
+
+
 def test_an_escape_code_in_a_files_unit_or_channel_is_printed_escaped(tmp_path, capsys):
     netcdf(tmp_path / "evil.nc", "\x1b]2;owned\x07\x1b[2J", "\x1b]2;owned\x07\x1b[2J")
     (tmp_path / "p.yaml").write_text(yaml.safe_dump({

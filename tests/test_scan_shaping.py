@@ -5,11 +5,12 @@ on maps built here with known parts."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
-from frictionlab_spectra import SurfaceFile
+from frictionlab_spectra import ProfileFile, SurfaceFile
 from frictionlab_spectra.scan_shaping import cosine_resample, despike, level, levelling_warning, spike_warning
 
 
@@ -86,6 +87,29 @@ def test_levelling_removes_the_least_squares_plane_and_quadratic_and_says_what_t
     assert levelling_warning(level(rough, "mean"), "mean") is None
 
 
+@pytest.mark.parametrize("rough, bow, seed", [(1e-8, 0.0, 2), (1e-9, 1e-8, 5)])
+def test_the_curvature_left_by_a_plane_is_measured_on_what_the_plane_leaves(rough, bow, seed):
+    """A tilt that carries all but 1e-16 of a map's height variance: the curvature's share of
+    what the plane leaves was curvature / (1 - plane share), and 1 - plane share is rounding
+    there (0: 'a curvature carries inf %', with numpy's 'divide by zero' on stderr; or a
+    share below 0 or above 100 %). It is measured against the levelled heights' own rms,
+    the share brute force gives (a least-squares quadratic fitted to what the plane leaves)."""
+    y, x = np.mgrid[0:64, 0:64].astype(float)
+    left = rough * np.random.default_rng(seed).standard_normal(x.shape) + bow * (x - 31.5) ** 2
+    z = x + 3.0 * y + left
+    design = np.stack([d.ravel() for d in (np.ones_like(x), x, y, x * x, x * y, y * y)], axis=1)
+    after_plane = level(z, "plane").heights.ravel()
+    after_quadratic = after_plane - design @ np.linalg.lstsq(design, after_plane, rcond=None)[0]
+    share = 1.0 - np.var(after_quadratic) / np.var(after_plane)  # brute force
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's divide by zero
+        said = levelling_warning(level(z, "plane"), "plane")
+    if share <= 0.5:
+        assert said is None
+    else:
+        assert said is not None and f"a curvature carries {100 * share:.1f} % " in said, said
+
+
 def test_despike_replaces_a_spike_and_nothing_else():
     z, _ = band_limited(40, 48, seed=5, top=0.2)
     spiky = z.copy()
@@ -128,6 +152,48 @@ def test_a_spike_caveat_comes_with_the_map_unless_despike_is_set(tmp_path):
     assert any("despike: 6 replaces them" in caveat for caveat in said["caveats"])
     cleaned = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, despike=6.0).input_summary()
     assert cleaned["despiked"]["points"] == 1 and "caveats" not in cleaned
+
+
+def test_a_map_made_flat_by_despike_says_despike_did_it(tmp_path):
+    """A flat map with two spikes is refused once despike has replaced them, and the refusal
+    said only 'constant (rms height zero after detrend=...)' of a file whose points visibly
+    differ; it names despike and the points it replaced. Without despike the map is read."""
+    z = np.zeros((32, 32))
+    z[5, 5], z[20, 20] = 1.0, -1.0
+    np.save(tmp_path / "map.npy", z)
+    with pytest.raises(ValueError, match=r"constant \(rms height zero after detrend='mean' and despike 6, which "
+                                         r"replaced 2 points\)"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1, despike=6.0).rms_height()
+    assert SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1).rms_height() > 0
+
+
+@pytest.mark.parametrize("where", [slice(300, 302), slice(0, 1), slice(511, 512)])  # inside, the ends
+def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
+    """A profile with a spike 13 rms above it, inside or at an end, was pressed without a word
+    (a map's spikes are said): its law at small loads is the spike's. Counted as a median
+    filter of 5 points (scipy's, ends reflected: independent of the caveat's own windows)
+    counts them; a bump of 4 rms, and the smooth line, say nothing."""
+    from scipy import ndimage
+
+    t = np.arange(512.0)
+    z = np.sin(2 * np.pi * t / 97.0) + 0.5 * np.cos(2 * np.pi * t / 41.0)  # smooth: no point stands out
+    spiky, low = z.copy(), z.copy()
+    spiky[where] += 13 * np.std(z)
+    low[where] += 4 * np.std(z)
+    for name, line in (("smooth", z), ("spiky", spiky), ("low", low)):
+        np.save(tmp_path / f"{name}.npy", line)
+    said = {name: ProfileFile(path=str(tmp_path / f"{name}.npy"), spacing=1.0).input_summary()
+            for name in ("smooth", "spiky", "low")}  # fmt: skip
+    levelled = spiky - spiky.mean()
+    rms = float(np.std(levelled))
+    expected = int(np.count_nonzero(levelled - ndimage.median_filter(levelled, size=5, mode="reflect") > 6 * rms))
+    assert expected == where.stop - where.start
+    assert said["spiky"]["caveats"] == [
+        f"{expected} of the line's 16 highest points stand more than 6 rms heights above the median of the 5 points "
+        "around them: spikes (dust, an instrument's artefact) take the first contact alone, and the law at small "
+        "loads is theirs; remove them from the profile, if they are not the surface's own"
+    ]
+    assert "caveats" not in said["smooth"] and "caveats" not in said["low"]
 
 
 def test_region_and_downsample_in_the_summary(tmp_path):

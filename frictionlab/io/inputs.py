@@ -24,7 +24,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator
 
-from ..errors import shown
+from ..errors import short_repr, shown
 
 
 class InputFileProblem(ValueError):
@@ -213,12 +213,17 @@ def describe_input(summary: dict) -> str:
     if "file_unit" in summary and converted is None and unit:  # an instrument file that states no unit
         unit_note = f", the file states no unit: its numbers taken as {unit}"
     channel = summary.get("channel")
-    notes = [f"channel {summary.get('channel_index', '?')} {shown(channel)!r}"] if channel is not None else []
+    notes = [f"channel {summary.get('channel_index', '?')} {short_repr(shown(channel))}"] if channel is not None else []
     if summary.get("region_pixels"):
         (x0, x1), (y0, y1) = summary["region_pixels"]
         notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")
     if summary.get("pixels"):
         notes.append(f"pixels {summary['pixels']}")
+    stated, given = summary.get("file_spacing"), summary.get("downsampled", {}).get("from_pixel", summary["spacing"])
+    sides = stated if isinstance(stated, list) else [] if stated is None else [stated]
+    if spacing_from == "preset" and any(not math.isclose(side, given, rel_tol=1e-9) for side in sides):
+        notes.append(f"the file's pixels of {' x '.join(f'{side:.6g}' for side in sides)}{length} replaced by the "
+                     "preset's spacing, square")  # fmt: skip
     if summary.get("downsampled"):
         down = summary["downsampled"]
         notes.append(f"downsampled from pixels of {down['from_pixel']:.6g} to {down['to_pixel']:.6g}{length}")
@@ -248,7 +253,7 @@ def describe_channels(summary: dict) -> list[str]:
         points = " x ".join(map(str, channel["points"])) if channel.get("points") else "?"
         units = f"lengths in {shown(channel['unit'] or '?')}, values in {shown(channel['data_unit'] or '?')}"
         taken = " (taken)" if channel["index"] == summary.get("channel_index") else ""
-        lines.append(f"channel {channel['index']}: {shown(channel['name'])!r}, {points} points, {units}{taken}")
+        lines.append(f"channel {channel['index']}: {short_repr(shown(channel['name']))}, {points} points, {units}{taken}")
     if summary.get("channel_note"):
         lines.append(shown(summary["channel_note"]))
     return lines

@@ -165,7 +165,9 @@ def _sequence_kind(kinds: set):
     return next((kind for kind in kinds if typing.get_origin(kind) in (list, tuple)), None)
 
 
-def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number") -> str | None:
+def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number", positive: bool = False) -> str | None:
+    """``positive``: the field's own bounds refuse 0 (gt=0, ge=1), so the range said leaves it out."""
+    allowed = "between 1e-100 and 1e+100" if positive else "0 or between 1e-100 and 1e+100 in magnitude"
     if isinstance(value, bool):
         return f"{path}: must be {what}, not true or false, got {str(value).lower()}"
     if isinstance(value, str):  # YAML reads 1e308 (no dot) as text, which pydantic then takes as a number
@@ -174,13 +176,19 @@ def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number
         except ValueError:
             return None  # not a number at all: pydantic says so
         if past_double_precision(value, number):  # 1e400, 1e-400: not infinity, not zero
-            return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+            return f"{path}: must be {allowed}, got {short_repr(value)}"
         value = number
     if isinstance(value, float) and not math.isfinite(value):
         return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
     if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):
-        return f"{path}: must be 0 or between 1e-100 and 1e+100 in magnitude, got {short_repr(value)}"
+        return f"{path}: must be {allowed}, got {short_repr(value)}"
     return None
+
+
+def _refuses_zero(field) -> bool:
+    """Whether a field's own bounds refuse 0 and every number below it (gt=0, ge=1)."""
+    return any(getattr(m, "gt", None) is not None and m.gt >= 0 or getattr(m, "ge", None) is not None and m.ge > 0
+               for m in field.metadata)  # fmt: skip
 
 
 def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]:
@@ -203,7 +211,8 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
             for key, entry in value.items():
                 problems += number_problems(item, entry, f"{path}.{key}")
         elif kinds & {int, float} and bool not in kinds and not (str in kinds and isinstance(value, str)):
-            problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number")
+            problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number",
+                                      positive=_refuses_zero(field))  # fmt: skip
             problems += [problem] if problem else []
         elif (sequence := _sequence_kind(kinds)) is not None and isinstance(value, list):
             items = set().union(*(_kinds(a) for a in typing.get_args(sequence) if a is not Ellipsis))

@@ -327,9 +327,13 @@ class Study:
                 f"same seed gives the same continuous {'line' if generator.dimension == 1 else 'surface'} sampled "
                 f"more finely; M = {start.preset.realizations}"
             )
-        rows = []
+        rows, grids = [], set()
         for factor in factors:
             n = int(round(points * factor))
+            if n in grids:  # a factor given twice (or 1 and 1.0001): its copy, the reference, had no error
+                self.notes.append(f"{label}: factor {factor:g} gives N = {n} again; each grid is run once")
+                continue
+            grids.add(n)
             refined = generator.refined(n) or {generator.points_param: n}
             try:
                 scene = self.factory.make({**changes, **{f"spectrum.params.{k}": v for k, v in refined.items()}})

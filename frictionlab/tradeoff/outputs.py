@@ -309,8 +309,9 @@ def recommendation(study: Study) -> str:
                 + (f"its indentation by {_pct(row.approach_err_f)} rms" if math.isfinite(row.approach_err_f)
                    else "its indentation not compared (see the notes)")
             )  # fmt: skip
-    if not parts:
-        return f"{head}: no axis measured enough to recommend anything."
+    if not parts:  # why, on the terminal too: the axes asked that could not run on this preset (the notes')
+        skipped = "".join(f"; {note}" for note in study.notes if ": skipped" in note)
+        return f"{head}: no axis measured enough to recommend anything{skipped}."
     return f"{head}: " + "; ".join(parts) + "."
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import warnings
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
     channel_list, check_declared_points, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
+    TEXT_FORMATS, quoted,
 )
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -34,6 +36,7 @@ TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare nu
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
 Unit = Literal["m", "mm", "um", "nm", "pm"]
 Undefined = Literal["refuse", "harmonic"]
+X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 
 
 @dataclass(frozen=True)
@@ -70,6 +73,7 @@ class ScanHeader:
     shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
     periodic: bool
     pixel: tuple[float, ...] | None = None  # (dx, dy) of a map, in the file's unit, when the file says
+    unit: str | None = None  # the file's length unit, when it says
 
 
 def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | None = None) -> ScanHeader | None:
@@ -84,12 +88,15 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
+            unit = chosen.unit if isinstance(chosen.unit, str) else None
+            if unit is not None:
+                length_factor(unit, "m", where, "the file's length unit")  # a message may name it: a length, not any text
         except Exception:  # noqa: BLE001 - the full read names what is wrong with the file
             return None
     if dimension == 1 and len(shape) == 2 and 1 in shape:  # a line stored as a map one pixel wide
         along = 0 if shape[1] == 1 else 1
-        return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1])
-    return ScanHeader(shape[::-1], periodic, pixel) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+        return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1], unit)
+    return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
 
 
 def _by_name(fh):
@@ -156,7 +163,7 @@ def length_factor(unit: str | None, to: str, where: str, what: str) -> float:
     except Exception:  # noqa: BLE001 - any unit it does not know
         factor = math.nan
     if not (math.isfinite(factor) and factor > 0):
-        raise ValueError(f"{where}: {what} {unit!r} is not a length unit (m, mm, um, nm, pm, ...); "
+        raise ValueError(f"{where}: {what} {quoted(unit)} is not a length unit (m, mm, um, nm, pm, ...); "
                          "choose a channel of heights, or convert the file")  # fmt: skip
     return factor
 
@@ -191,6 +198,12 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
             raise describe_failure(type(reader), exc, where) from None
+        if not topography.is_uniform:  # x, z of a text export, x not evenly spaced: it has no pixel
+            raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
+                             "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
+                             "interpolate it onto one")  # fmt: skip
+        if topography.dim == 1 and type(reader).format() in TEXT_FORMATS and (x := _text_x(fh, heights.size)) is not None:
+            uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
             kind = {1: "a line scan", 2: "a 2D map"}
@@ -213,9 +226,9 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         periodic = bool(topography.is_periodic)
         listed = channel_list(reader) if len(reader.channels) > 1 else []
         file_format = str(reader.name())
-    shown = " x ".join(f"{p:g}" for p in pixel)
     if not np.all(pixel > 0):  # NaN too
-        raise ValueError(f"{where}: pixels of {shown}; a pixel's size must be > 0")
+        shown = " x ".join(f"{p:g}" for p in pixel) + (f" {file_unit}" if file_unit else "")
+        raise ValueError(f"{where}: pixels of {shown} (x by y, as the file states them); a pixel's size must be > 0")
     factor = 1.0 if unit is None or file_unit is None else length_factor(file_unit, unit, where, "the file's unit")
     sides = tuple(check_spacing(where, "pixels of", float(p) * factor, unit or file_unit) for p in pixel)
     data = np.ma.getdata(heights)
@@ -280,3 +293,36 @@ def scan_not_periodic_advice(name: str) -> tuple[str, str]:
     """``SpectrumGenerator.not_periodic_advice`` of a measured line or map."""
     return (f"spectrum {name} is not periodic (periodic: false, a scan whose ends do not meet)",
             "set spectrum.params.periodic: true if its ends meet (after detrend)")  # fmt: skip
+
+
+def uniform_spacing(where: str, x: np.ndarray) -> float:
+    """The step of ``x`` (a table's x column, a text export's), which must increase evenly (within
+    X_TOLERANCE of a step); else a ValueError naming how far it is from even."""
+    n = x.size
+    dx = (x[-1] - x[0]) / (n - 1)
+    if not dx > 0:
+        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
+    deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
+    if deviation > X_TOLERANCE * dx:
+        raise ValueError(
+            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
+            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
+        )
+    return float(dx)
+
+
+def _text_x(fh, points: int) -> np.ndarray | None:
+    """The x column of a text export of a line (its rows of two numbers, x and z), or None when
+    its rows of numbers are not ``points`` such rows (three columns, say)."""
+    fh.seek(0)
+    x = []
+    for line in fh.read().decode("utf-8", errors="replace").splitlines():
+        try:
+            numbers = [float(word) for word in re.split(r"[\s,;]+", line.strip()) if word]
+        except ValueError:  # a header
+            continue
+        if len(numbers) not in (0, 2):
+            return None
+        x += numbers[:1]
+    fh.seek(0)
+    return np.asarray(x) if len(x) == points else None

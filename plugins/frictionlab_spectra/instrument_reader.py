@@ -301,10 +301,21 @@ def pick_channel(reader, wanted: str | int | None, where: str):
     same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
     note = None
     if len(same) > 1:
-        note = (f"{len(same)} channels are named {str(channel.name)!r} (indices {', '.join(map(str, same))}); "
+        note = (f"{len(same)} channels are named {quoted(channel.name)} (indices {', '.join(map(str, same))}); "
                 f"index {int(channel.index)} was taken (channel: INDEX chooses another)")  # fmt: skip
     return channel, note
 
 
 def _named(channels) -> str:
-    return ", ".join(f"{int(c.index)}: {str(c.name)!r}" for c in channels)
+    return ", ".join(f"{int(c.index)}: {quoted(c.name)}" for c in channels)
+
+
+NAME_SHOWN = 60  # characters of a file's text (a channel's name, a unit) a message quotes: it may be of any length
+
+
+def quoted(name) -> str:
+    """A channel's name (or any text from a file) as a message quotes it, its middle cut past
+    NAME_SHOWN characters."""
+    text = str(name)
+    half = NAME_SHOWN // 2
+    return repr(text) if len(text) <= NAME_SHOWN else f"{text[:half]!r}...{text[-half:]!r}"

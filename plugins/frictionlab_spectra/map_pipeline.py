@@ -21,6 +21,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from frictionlab.plugin import MAX_MAGNITUDE
+
 from . import instrument_reader
 from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points, spike_warning
 
@@ -63,10 +65,15 @@ class Downsample(BaseModel):
         return self
 
 
-def square_shape(shape: tuple[int, int], pixel: tuple[float, float] | None) -> tuple[int, int]:
-    """The (Ny, Nx) of a map of ``shape`` on pixels (dx, dy) once on square pixels (``shape_map``)."""
-    if pixel is None or not all(0 < p < math.inf for p in pixel) or _nearly_square(*pixel):
+def square_shape(shape: tuple[int, int], pixel: tuple[float, float] | None, where: str,
+                 unit: str | None = None) -> tuple[int, int]:  # fmt: skip
+    """The (Ny, Nx) of a map of ``shape`` on pixels (dx, dy) (in ``unit``) once on square pixels
+    (``shape_map``), from a file's header; refused, naming the pixels, as ``shape_map`` refuses
+    it, when that map would not fit. Sides no run takes (0, NaN, below 1e-100 or above 1e100: a
+    ratio of them may overflow) leave the shape as it is: the read refuses them by name."""
+    if pixel is None or not all(1 / MAX_MAGNITUDE <= p <= MAX_MAGNITUDE for p in pixel) or _nearly_square(*pixel):
         return shape
+    _check_room_to_resample(shape, pixel, where, unit)
     dx, dy = pixel
     ny, nx = shape
     return (resampled_points(ny, dy, dx), nx) if dy > dx else (ny, resampled_points(nx, dx, dy))
@@ -152,7 +159,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
 RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis
 
 
-def _check_room_to_resample(shape: tuple[int, int], pixel: tuple[float, float], where: str) -> None:
+def _check_room_to_resample(shape: tuple[int, int], pixel: tuple[float, float], where: str,
+                            unit: str | None = None) -> None:  # fmt: skip
     """Refuse, before it is built, a map on square pixels larger than this process can hold:
     pixels thousands of times longer one way (a header that lies: Gwyddion reads a zero width
     as 1 m) would make millions of rows of a small scan."""
@@ -165,11 +173,17 @@ def _check_room_to_resample(shape: tuple[int, int], pixel: tuple[float, float], 
     if need > room:
         nx, ny = (other, points) if axis == 0 else (points, other)
         raise ValueError(
-            f"{where}: pixels of {dx:.6g} x {dy:.6g}, {max(dx, dy) / min(dx, dy):.4g} times longer along "
-            f"{'y' if axis == 0 else 'x'}, make the map on square pixels {nx} x {ny} pixels (x by y), about "
+            f"{where}: pixels of {dx:.6g} x {dy:.6g}{f' {unit}' if unit else ''}, {max(dx, dy) / min(dx, dy):.4g} "
+            f"times longer along {'y' if axis == 0 else 'x'}, make the map on square pixels {_count(nx)} x "
+            f"{_count(ny)} pixels (x by y), about "
             f"{need / 2**30:.3g} GiB, more than the {room / 2**30:.3g} GiB this process may use ({source}); crop it "
             "with region, or, if the file's pixel size is wrong, give spacing (square pixels of that side)"
         )
+
+
+def _count(points: int) -> str:
+    """A count of pixels as a person reads it: whole up to 1e12, in three digits beyond."""
+    return str(points) if points < 10**12 else f"{points:.3g}"
 
 
 def _removed(levelled) -> float:

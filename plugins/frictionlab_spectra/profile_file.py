@@ -36,14 +36,13 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
+    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import level_line, line_form_warning
+from .scan_shaping import level_line, line_form_warning, line_spike_warning
 
 MIN_POINTS = 8
-X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
 
 
@@ -126,7 +125,7 @@ class ProfileFile(MeasuredFile):
             dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
-            dx = check_spacing(where, "x spaced by", _uniform_spacing(where, x), p.unit)
+            dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), p.unit)
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
                     raise ValueError(
@@ -149,8 +148,9 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        if (caveat := line_form_warning(z, mode)) is not None:  # as a map's (map_pipeline.shape_map)
-            summary["caveats"] = [caveat]
+        caveats = [line_form_warning(z, mode), line_spike_warning(heights, rms)]  # as a map's (map_pipeline.shape_map)
+        if any(caveats):
+            summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)
 
 
@@ -291,8 +291,9 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
         lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start + (3 if raw.startswith(b"\xef\xbb\xbf") else 0)) + 1
-        raise ValueError(f"{where}: not a text file (not UTF-8 at line {line}); an instrument's export (a "
-                         "profilometer's .csv) is read with format: instrument") from None
+        raise ValueError(f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ, or "
+                         "no text); an instrument's export (a profilometer's .csv) is read with format: instrument; "
+                         "a table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()
@@ -391,17 +392,3 @@ def check_heights_not_underflowing(where: str, heights: np.ndarray) -> None:
             f"{where}: every value in heights is below {1.0 / MAX_MAGNITUDE:g} in magnitude (the largest "
             f"{largest:.3g}), too small for a run's arithmetic; store them in a unit that makes them larger"
         )
-
-
-def _uniform_spacing(where: str, x: np.ndarray) -> float:
-    n = x.size
-    dx = (x[-1] - x[0]) / (n - 1)
-    if not dx > 0:
-        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
-    deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
-    if deviation > X_TOLERANCE * dx:
-        raise ValueError(
-            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
-            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
-        )
-    return float(dx)

@@ -94,8 +94,11 @@ def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     if mode in ("none", "mean") and plane + curvature > MOST:
         part = "a tilt" if plane >= curvature else "a curvature"
         return _form_kept(part, plane + curvature, "map", mode, "detrend: plane (or quadratic) levels it")
-    if mode == "plane" and curvature > MOST * (1 - plane):
-        return (f"a curvature carries {100 * curvature / (1 - plane):.1f} % of the levelled map's height variance: "
+    # the share of what the plane leaves, from the levelled heights' own rms: 1 - plane loses every digit
+    # when a tilt carries all but 1e-16 of the variance (it gave 'inf %', or a share below zero)
+    left = curvature * (levelled.rms_before / levelled.rms_after) ** 2 if levelled.rms_after > 0 else 0.0
+    if mode == "plane" and left > MOST:
+        return (f"a curvature carries {100 * left:.1f} % of the levelled map's height variance: "
                 "the contact sits where the form puts it; detrend: quadratic removes it, if it is not the "
                 "surface's own shape")  # fmt: skip
     return None
@@ -114,9 +117,11 @@ def line_form_warning(z: np.ndarray, mode: str) -> str | None:
         return None
     tilt = float(np.dot(t, centred)) ** 2 / float(np.dot(t, t)) / variance
     curvature = float(np.dot(t2, centred)) ** 2 / float(np.dot(t2, t2)) / variance if z.size > 2 else 0.0
-    if mode == "tilt":
-        if curvature > MOST * (1 - tilt):
-            return (f"a curvature carries {100 * curvature / (1 - tilt):.1f} % of the levelled line's height "
+    if mode == "tilt":  # the share of what the tilt leaves, summed from it (1 - tilt is rounding on a steep line)
+        rest = centred - (float(np.dot(t, centred)) / float(np.dot(t, t))) * t
+        left = curvature * variance / float(np.dot(rest, rest)) if np.any(rest) else 0.0
+        if left > MOST:
+            return (f"a curvature carries {100 * left:.1f} % of the levelled line's height "
                     "variance: the contact sits where the form puts it; detrend: quadratic removes it, if it is "
                     "not the surface's own shape")  # fmt: skip
         return None
@@ -174,6 +179,32 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     any map), those above 3 rms: a spike lower than that touches no earlier than the surface."""
     if not rms > 0 or min(z.shape) < 3:
         return None
+    spikes = _spikes(z, rms)
+    if not spikes:
+        return None
+    return (f"{spikes} of the map's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms "
+            "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
+            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
+            "they are not the surface's own")  # fmt: skip
+
+
+def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
+    """The caveat of a line (levelled) with spikes, by ``spike_warning``'s criterion along the
+    line: the median of the SPIKE_WINDOW points around each of its highest points."""
+    if not rms > 0 or z.size < SPIKE_WINDOW:
+        return None
+    spikes = _spikes(z.reshape(1, -1), rms)
+    if not spikes:
+        return None
+    return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms heights above "
+            f"the median of the {SPIKE_WINDOW} points around them: spikes (dust, an instrument's artefact) take the "
+            "first contact alone, and the law at small loads is theirs; remove them from the profile, if they are "
+            "not the surface's own")  # fmt: skip
+
+
+def _spikes(z: np.ndarray, rms: float) -> int:
+    """How many of the SPIKE_LOOKED_AT highest points of ``z`` (above 3 ``rms``) stand more than
+    SPIKE_K ``rms`` above the median of the SPIKE_WINDOW x SPIKE_WINDOW pixels around them."""
     high = np.flatnonzero(z > 3.0 * rms)  # a boolean of the map, the indices of its tallest points
     if high.size > SPIKE_LOOKED_AT:
         high = high[np.argpartition(z.ravel()[high], high.size - SPIKE_LOOKED_AT)[-SPIKE_LOOKED_AT:]]
@@ -182,16 +213,11 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     for index in high:
         row, column = divmod(int(index), nx)
         half = SPIKE_WINDOW // 2
-        rows = [_reflect(r, ny) for r in range(row - half, row + half + 1)]
+        rows = [_reflect(r, ny) for r in range(row - half, row + half + 1)] if ny > 1 else [0]  # a line: its row
         columns = [_reflect(c, nx) for c in range(column - half, column + half + 1)]
         if z[row, column] - np.median(z[np.ix_(rows, columns)]) > SPIKE_K * rms:
             spikes += 1
-    if not spikes:
-        return None
-    return (f"{spikes} of the map's {max(high.size, SPIKE_LOOKED_AT)} highest points stand more than {SPIKE_K:g} rms "
-            "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
-            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
-            "they are not the surface's own")  # fmt: skip
+    return spikes
 
 
 def _reflect(i: int, n: int) -> int:

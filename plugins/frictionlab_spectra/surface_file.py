@@ -149,7 +149,9 @@ class SurfaceFile(MeasuredFile):
         p = self.params
         if header is None or p.region is not None or p.downsample is not None:
             return self._measured().heights.shape
-        return header.shape if p.spacing is not None else square_shape(header.shape, header.pixel)
+        if p.spacing is not None:
+            return header.shape
+        return square_shape(header.shape, header.pixel, f"surface-file {str(p.path)!r}", header.unit)
 
     def radial_psd(self) -> RadialPSD:
         """The detrended map's radially averaged C2D in annuli of the map's own finest dq."""
@@ -230,8 +232,10 @@ class SurfaceFile(MeasuredFile):
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
         if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
+            replaced = shaped.get("despiked", {}).get("points")
+            despiked = f" and despike {p.despike:g}, which replaced {replaced} points" if replaced else ""
             raise ValueError(
-                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}); "
+                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}{despiked}); "
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
@@ -255,6 +259,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                 "is required"
             )
         data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
+        if data.size == 0:  # not 'a map of 1 x 0 pixels, one pixel wide: a line'
+            held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
+                "a table of no numbers (a header, comments or blank lines only)"
+            raise ValueError(f"{where}: {held}: no heights; expected a map of at least {MIN_SIDE} x {MIN_SIDE} points")
         pixel = (p.spacing, p.spacing)
         summary = {
             "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,

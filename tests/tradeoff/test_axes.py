@@ -207,3 +207,32 @@ def test_a_scan_study_compares_no_indentation_with_the_free_half_space_and_names
     text = recommendation(study)
     assert "at N = 24" in text and "N = 0" not in text and "its indentation not compared" in text
     assert "N = 24 per side" in scene_summary(study)
+
+
+@pytest.mark.parametrize("factors", [(1, 1), (0.5, 1, 1), (1, 1.0001)])
+def test_a_grid_given_twice_is_run_once_not_taken_as_its_own_reference(builtins, factors):
+    """Grid factors that give the same N (a factor listed twice, or two that round to one N)
+    ran the same ensemble twice, and its copy, the reference, said the grid had no error:
+    'frictionlab study quickstart --grid-factors 1,1' recommended 'N = 4096 (against N = 4096)'.
+    Each N is run once, the repeat named in the notes, and the coarsest distinct grid keeps its
+    error against the finest (none is measured where one grid is left)."""
+    study = study_of(TINY, builtins, axes=("grid",), grid_factors=factors)
+    rows = study.run()
+    n = [row.value for row in rows]
+    assert len(n) == len(set(n)) == len(set(round(256 * f) for f in factors)), n
+    assert rows[-1].reference and sum(row.reference for row in rows) == 1
+    assert any("gives N = 256 again; each grid is run once" in note for note in study.notes), study.notes
+
+
+def test_a_study_that_measured_nothing_says_why_on_the_terminal(builtins):
+    """Every axis asked skipped (the solver axis of a preset of lines, which no exact solver
+    presses): the recommendation, the one line the terminal shows, said only 'no axis
+    measured enough to recommend anything', the reason left in study.md's notes."""
+    from frictionlab.tradeoff.outputs import recommendation
+
+    study = study_of(TINY, builtins, reference=None, axes=("solver",))
+    study.run()
+    assert study.rows == []
+    said = recommendation(study)
+    assert said.startswith("for 2% error in b at H = 0.8: no axis measured enough to recommend anything; solver, "
+                           "tolerance: skipped: no installed solver solves"), said  # fmt: skip
