@@ -125,6 +125,14 @@ def test_what_each_scan_says_it_did(tmp_path):
     assert "resampled onto square pixels of 0.128 along y" in rect.input_summary()["pixels"]
 
 
+
+@pytest.mark.parametrize("micro", ["\u00b5m", "\u03bcm"], ids=["micro-sign", "greek-mu"])
+def test_a_preset_may_write_um_with_the_micro_sign_or_the_greek_mu(tmp_path, micro):
+    rectangular_x3p(tmp_path / "r.x3p")
+    written = SurfaceFile(path=str(tmp_path / "r.x3p"), unit=micro)
+    assert written.params.unit == "um"
+    assert written.generate(None).spacing == SurfaceFile(path=str(tmp_path / "r.x3p"), unit="um").generate(None).spacing
+
 def test_channels_are_listed_chosen_by_name_or_index_and_the_shared_name_is_said(tmp_path, capsys):
     four_channel_gwy(tmp_path / "afm.gwy")
     (tmp_path / "p.yaml").write_text(yaml.safe_dump(law_preset(

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
@@ -59,6 +59,12 @@ class MeasuredParams(PluginParams):
         description="whether the heights repeat (a line's last point is followed by its first, a map's opposite "
         "edges meet); default: as an instrument file says, else false (a measured scan does not)",
     )
+
+    @field_validator("unit", mode="before")
+    @classmethod
+    def _micro_sign(cls, unit: object) -> object:
+        # um as an instrument writes it, with the micro sign or the Greek mu
+        return "um" if unit in ("\u00b5m", "\u03bcm") else unit
 
 
 class MeasuredFile(SpectrumGenerator):
