@@ -128,6 +128,17 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
     assert "realizations: must be a number, not true or false" in capsys.readouterr().err
 
 
+
+def test_an_unknown_key_of_any_length_is_named_cut_in_the_middle(tmp_path, capsys):
+    key = "q" + "x" * 10_000 + "z"
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE + f"? {key}\n: 1\n")  # an explicit key: an implicit one is at most 1024 characters
+    for args in (["validate", str(path)], ["validate", "quickstart", "--set", f"spectrum.params.{key}=1"]):
+        assert main(args) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert "is not a known field" in err and "qxxx" in err and "xxxz" in err
+        assert max(map(len, err.splitlines())) < 500
+
 # ------------------------------------------------------------------ cases that hang or eat memory on their own
 
 

@@ -77,6 +77,16 @@ def shown_value(value) -> str:
     return short_repr(value, 240 if isinstance(value, str) else 80)
 
 
+KEY_SHOWN = 60
+
+
+def _shown_key(part) -> str:
+    """A part of a problem's path, its middle cut past KEY_SHOWN characters: a key is the
+    preset's or the command line's own text, of any length."""
+    text = str(part)
+    return text if len(text) <= KEY_SHOWN else f"{text[: KEY_SHOWN // 2]}...{text[-KEY_SHOWN // 2 :]}"
+
+
 def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix: str = "") -> list[str]:
     """One line per pydantic error: ``path: message, got value``. A required field
     missing because it was misspelt is said once, by the misspelling's suggestion."""
@@ -91,7 +101,7 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
     for error in _one_per_union(errors):
         if error["type"] == "missing" and tuple(error["loc"]) in misspelt:
             continue
-        path = ".".join(str(p) for p in (prefix, *error["loc"]) if p != "")
+        path = ".".join(_shown_key(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
         checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
         if error["type"] != "missing" and not checked_together:  # a check of several fields names their values
