@@ -202,6 +202,37 @@ def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     assert summary["undefined_points"] == 2 and summary["filled_by"] == "harmonic"
 
 
+
+def test_a_large_filled_share_is_a_caveat_beside_the_levelling_one(tmp_path, capsys):
+    """Filled points have the interpolation's smooth slopes: from 5 % of the file on, said so;
+    the two filled points above (0.26 %) say nothing."""
+    holes = scan_um() + 0.5 * np.arange(COLUMNS)  # a tilt, left in by detrend: mean
+    holes[2:8, 3:10] = np.nan  # 42 of 768 points: 5.47 %
+    write_x3p(tmp_path / "holes.x3p", holes)
+    surface = SurfaceFile(path=str(tmp_path / "holes.x3p"), unit="um", undefined="harmonic", detrend="mean")
+    caveats = surface.input_summary()["caveats"]
+    assert len(caveats) == 2 and "5.47 % of the file's points were undefined and filled" in caveats[0]
+    assert "crop the map to its measured part (region)" in caveats[0]
+    assert "a tilt carries" in caveats[1]
+    levelled = SurfaceFile(path=str(tmp_path / "holes.x3p"), unit="um", undefined="harmonic")
+    assert [caveat[:4] for caveat in levelled.input_summary()["caveats"]] == ["5.47"]
+    holes[2:8, 3:10] = scan_um()[2:8, 3:10]
+    holes[2, 3] = holes[7, 9] = np.nan
+    write_x3p(tmp_path / "two.x3p", holes)
+    assert "caveats" not in SurfaceFile(path=str(tmp_path / "two.x3p"), unit="um", undefined="harmonic").input_summary()
+
+
+def test_a_line_with_a_large_filled_share_says_so_beside_its_own_caveats(tmp_path):
+    from SurfaceTopography import UniformLineScan
+
+    z = np.cumsum(np.random.default_rng(0).standard_normal(200))
+    z[50:65] = np.nan  # 7.5 %
+    UniformLineScan(z, z.size * PIXEL_UM, unit="um").to_netcdf(str(tmp_path / "line.nc"))
+    caveats = ProfileFile(path=str(tmp_path / "line.nc"), unit="um", undefined="harmonic").input_summary()["caveats"]
+    assert caveats[0].startswith("7.5 % of the file's points were undefined and filled")
+    assert "cut the line in the file to its measured part" in caveats[0]
+    assert any("a curvature carries" in caveat for caveat in caveats[1:])  # the line's own caveat kept beside it
+
 @pytest.mark.parametrize("pixel, writer, unit, said", [
     (1e99, "to_gwy", "pm", "pixels of 1e+102 pm"),  # 1e90 m in the file: in range, beyond it once converted
     (np.inf, "to_netcdf", None, "pixels of inf nm"),

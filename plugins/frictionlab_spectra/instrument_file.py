@@ -254,6 +254,22 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     )
 
 
+FILLED_CAVEAT_SHARE = 0.05  # of a file's points filled by harmonic interpolation: a caveat from here on
+
+
+def filled_caveat(scan: Scan, p) -> str | None:
+    """The caveat of a scan whose undefined points were filled, when they are a share of it
+    that can move ξ: a filled patch is the smooth solution of Laplace's equation, so its
+    slopes are the interpolation's, not the surface's."""
+    share = scan.undefined / scan.heights.size if p.undefined == "harmonic" else 0.0
+    if share < FILLED_CAVEAT_SHARE:
+        return None
+    crop = "crop the map to its measured part (region)" if scan.heights.ndim == 2 else "cut the line in the file to its measured part"
+    return (f"{100 * share:.3g} % of the file's points were undefined and filled by harmonic interpolation: their "
+            "slopes are the interpolation's (smooth), not the surface's, nor is xi where a contact reaches them; "
+            f"{crop} where it is large enough")  # fmt: skip
+
+
 def scan_summary(scan: Scan, p) -> dict:
     """What an input summary says of a scan read from an instrument file, and of where each of
     its settings came from (``p``: the measured plugin's parameters)."""
@@ -267,6 +283,7 @@ def scan_summary(scan: Scan, p) -> dict:
         "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
         "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
         "periodic_from": "file" if p.periodic is None else "preset",
+        **({"caveats": [caveat]} if (caveat := filled_caveat(scan, p)) else {}),
     }  # fmt: skip
 
 

@@ -225,7 +225,8 @@ class SurfaceFile(MeasuredFile):
         check_finite(where, "heights", z, table_fill_advice(p, is_instrument_file(path, p.format)))
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
-        summary.update(shaped)
+        caveats = [*summary.pop("caveats", ()), *shaped.pop("caveats", ())]  # the file's, then the shaping's
+        summary.update(shaped, **({"caveats": caveats} if caveats else {}))
         if min(heights.shape) < MIN_SIDE:
             nx, ny = heights.shape[::-1]
             raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
