@@ -281,6 +281,33 @@ def test_a_damaged_file_of_a_known_format_is_named_as_such(tmp_path):
         SurfaceFile(path=str(tmp_path / "cut.x3p")).generate(None)
 
 
+
+def test_an_xyz_map_off_a_regular_grid_is_named_so_not_as_damage(tmp_path):
+    """SurfaceTopography's reader says why (x jittered: not a regular grid); that was
+    dropped, and the file called damaged, to be copied again from the instrument."""
+    rng = np.random.default_rng(1)
+    rows = [f"{0.1 * i + 0.003 * rng.standard_normal():.6g} {0.1 * j:.6g} {np.sin(i / 3) + np.cos(j / 4):.6g}"
+            for j in range(16) for i in range(16)]  # fmt: skip
+    (tmp_path / "jittered.xyz").write_text("\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=r"not on a regular grid \(XYZ file does not contain a regular grid") as said:
+        SurfaceFile(path=str(tmp_path / "jittered.xyz"), unit="um").generate(None)
+    assert "damaged" not in str(said.value) and "copy it again" not in str(said.value)
+
+
+def test_a_damaged_files_message_carries_its_readers_reason_on_one_short_line():
+    from SurfaceTopography.Exceptions import CorruptFile
+
+    from frictionlab_spectra.instrument_reader import describe_failure
+
+    class Reader:  # what describe_failure asks of a SurfaceTopography reader
+        name = staticmethod(lambda: "Gwyddion")
+        format = staticmethod(lambda: "gwy")
+
+    said = str(describe_failure(Reader(), CorruptFile("Expected 'GwyContainer'\n" + "x" * 5000 + " at byte 12"), "w"))
+    assert said.startswith("w: a damaged Gwyddion file (CorruptFile: Expected 'GwyContainer' xxx")
+    assert "at byte 12); the reader of its format cannot read it" in said
+    assert "\n" not in said and len(said) < 400
+
 def netcdf(path, heights_unit: str, length_unit: str):
     z = rough_um(16)
     with netcdf_file(str(path), "w") as nc:

@@ -242,11 +242,26 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
                           "crop it with the instrument's software")  # fmt: skip
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
+    said = _reason(exc)
+    if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
+        return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
+                          "on the instrument's grid, or its heights as a matrix (a table) with spacing")  # fmt: skip
     kind = "not a valid" if isinstance(exc, FileFormatMismatch) else "a damaged"
     if isinstance(exc, CorruptFile):
         kind = "a damaged"
-    return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}); the reader of its format cannot read it: "
-                      "copy it again from the instrument, or export it from there again")  # fmt: skip
+    return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
+                      "its format cannot read it: copy it again from the instrument, or export it from there again")  # fmt: skip
+
+
+REASON_SHOWN = 160
+
+
+def _reason(exc: BaseException) -> str:
+    """The reader's own words for a failure, on one line, cut in the middle past REASON_SHOWN
+    characters (they may quote the file)."""
+    text = " ".join(str(exc).split())
+    half = REASON_SHOWN // 2
+    return text if len(text) <= REASON_SHOWN else f"{text[:half]}...{text[-half:]}"
 
 
 def _unread_variant(name: str, field: str, value: str, where: str) -> ValueError:
