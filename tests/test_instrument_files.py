@@ -184,6 +184,35 @@ def test_a_line_scan_reads_as_a_profile(tmp_path):
         ProfileFile(path=str(tmp_path / "map.x3p")).generate(None)
 
 
+
+def test_a_periodic_map_is_levelled_by_its_mean_and_refused_where_it_would_stop_tiling(tmp_path):
+    """A plane taken off a map that tiles the plane leaves a step where it repeats: a periodic
+    file is levelled by its mean unless the preset asks otherwise. A crop or a resampling
+    would leave it no longer tiling: refused, naming what."""
+    from SurfaceTopography import Topography
+
+    z = scan_um()
+    topography = Topography(z.T.copy(), (COLUMNS * PIXEL_UM, ROWS * PIXEL_UM), unit="um", periodic=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        topography.to_netcdf(str(tmp_path / "tile.nc"))
+    tile = SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um")
+    assert tile.input_summary()["detrend"] == "mean" and tile.input_summary()["detrend_from"] == "default"
+    np.testing.assert_allclose(tile.generate(None).heights, z - z.mean(), rtol=0, atol=1e-12 * np.abs(z).max())
+    assert SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", periodic=False).input_summary()["detrend"] == "plane"
+    assert SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", detrend="plane").input_summary()["detrend"] == "plane"
+    for changed, said in (({"region": {"x": [0, 16]}}, "once cropped to region"),
+                          ({"downsample": {"factor": 2}}, "once downsampled")):  # fmt: skip
+        with pytest.raises(ValueError, match=f"a periodic map .* no longer tiles the plane {said}; set periodic: false"):
+            SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", **changed).generate(None)
+        SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", periodic=False, **changed).generate(None)  # read
+    rectangular = Topography(z.T.copy(), (COLUMNS * PIXEL_UM, 2 * ROWS * PIXEL_UM), unit="um", periodic=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rectangular.to_netcdf(str(tmp_path / "rect.nc"))
+    with pytest.raises(ValueError, match=r"no longer tiles the plane once resampled from pixels of \S+ x \S+ onto square"):
+        SurfaceFile(path=str(tmp_path / "rect.nc"), unit="um").generate(None)
+
 def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     z = scan_um()
     holes = z.copy()

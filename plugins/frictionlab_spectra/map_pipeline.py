@@ -103,13 +103,31 @@ def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str)
     return z[y0:y1, x0:x1], [[x0, x1], [y0, y1]]
 
 
-def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instrument: bool):
-    """The map to press, its square pixel side, and what was done (the summary's entries)."""
+def check_still_periodic(pixel: tuple[float, float], p, where: str) -> None:
+    """Refuse a periodic map that a step of ``shape_map`` would leave no longer tiling the
+    plane: a crop, or a resampling (onto square pixels, or coarser), whose cosine series
+    ends at the last sample rather than one pixel past it."""
+    dx, dy = pixel
+    steps = [*(["cropped to region"] if p.region is not None else []),
+             *([f"resampled from pixels of {dx:.6g} x {dy:.6g} onto square ones"] if not _nearly_square(dx, dy) else []),
+             *(["downsampled"] if p.downsample is not None else [])]  # fmt: skip
+    if steps:
+        raise ValueError(f"{where}: a periodic map (periodic: true, or as the file says) no longer tiles the plane once "
+                         f"{' and '.join(steps)}; set periodic: false (its slopes are then not taken across its edges), "
+                         "or leave the map whole on its own pixels")  # fmt: skip
+
+
+def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instrument: bool, periodic: bool):
+    """The map to press, its square pixel side, and what was done (the summary's entries).
+    A periodic map is levelled by its mean unless asked otherwise: a plane taken off it
+    would leave a step where it repeats."""
     done: dict[str, Any] = {}
     caveats: list[str] = []
+    if periodic:
+        check_still_periodic(pixel, p, where)
     if p.region is not None:
         z, done["region_pixels"] = _crop(z, pixel, p.region, where)
-    mode = p.detrend if p.detrend is not None else "plane" if instrument else "mean"
+    mode = p.detrend if p.detrend is not None else "plane" if instrument and not periodic else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
         try:

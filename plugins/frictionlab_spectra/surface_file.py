@@ -19,8 +19,10 @@ A measured map is not periodic (``periodic`` unset: as an instrument file says, 
 false): its opposite edges do not meet, so slopes are not taken across them and solvers of
 periodic surfaces refuse it. ``periodic: true`` declares a map that does tile the plane.
 Between the file and the solver the map is cropped, levelled (``detrend``: the least-squares
-plane by default for an instrument file), despiked on request, put on square pixels and
-downsampled on request (``map_pipeline.py``); the input summary records each step.
+plane by default for an instrument file, the mean for a periodic one), despiked on request,
+put on square pixels and downsampled on request (``map_pipeline.py``); the input summary
+records each step. A periodic map is refused with a crop or a resampling, after which it
+would no longer tile the plane.
 
 Solvers of lines (``mdr``, ``mdr-bisection``) get ``equivalent_line()``: the surface's
 ``mdr-equivalent-line`` (``equivalent_line.py``) from the map's own modes (one FFT of the
@@ -122,7 +124,8 @@ class SurfaceFile(MeasuredFile):
         detrend: Level | None = Field(
             None,
             description="remove nothing, the mean, the least-squares plane or quadratic before use; default: plane "
-            "for an instrument file (a scan is rarely level), mean for a table",
+            "for an instrument file (a scan is rarely level), mean for a table or a periodic map (a plane taken off "
+            "it would leave a step where it repeats)",
         )
         region: Region | None = Field(
             None, description="a crop, {x: [start, stop], y: [start, stop], units: pixels | length}: half-open spans "
@@ -224,7 +227,8 @@ class SurfaceFile(MeasuredFile):
         z, pixel, summary = _read_map(path, where, p)
         check_finite(where, "heights", z, table_fill_advice(p, is_instrument_file(path, p.format)))
         check_heights_not_underflowing(where, z)
-        heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
+        heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format),
+                                             periodic=summary["periodic"])
         caveats = [*summary.pop("caveats", ()), *shaped.pop("caveats", ())]  # the file's, then the shaping's
         summary.update(shaped, **({"caveats": caveats} if caveats else {}))
         if min(heights.shape) < MIN_SIDE:
