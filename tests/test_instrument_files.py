@@ -213,6 +213,17 @@ def test_a_periodic_map_is_levelled_by_its_mean_and_refused_where_it_would_stop_
     with pytest.raises(ValueError, match=r"no longer tiles the plane once resampled from pixels of \S+ x \S+ onto square"):
         SurfaceFile(path=str(tmp_path / "rect.nc"), unit="um").generate(None)
 
+
+def test_a_periodic_line_is_levelled_by_its_mean(tmp_path):
+    from SurfaceTopography import UniformLineScan
+
+    z = scan_um()[0] + 0.3 * np.arange(COLUMNS)
+    UniformLineScan(z, z.size * PIXEL_UM, unit="um", periodic=True).to_netcdf(str(tmp_path / "ring.nc"))
+    ring = ProfileFile(path=str(tmp_path / "ring.nc"), unit="um")
+    assert ring.input_summary()["detrend"] == "mean"
+    np.testing.assert_allclose(ring.generate(None).heights, z - z.mean(), rtol=0, atol=1e-12 * np.abs(z).max())
+    assert ProfileFile(path=str(tmp_path / "ring.nc"), unit="um", periodic=False).input_summary()["detrend"] == "tilt"
+
 def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     z = scan_um()
     holes = z.copy()

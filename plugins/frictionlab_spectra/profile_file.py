@@ -67,7 +67,8 @@ class ProfileFile(MeasuredFile):
         )
         detrend: Literal["none", "mean", "tilt", "quadratic"] | None = Field(
             None, description="remove nothing, the mean, the least-squares line (tilt) or parabola (quadratic: a bowed "
-            "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table",
+            "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table or a "
+            "periodic line (a tilt taken off it would leave a step where it repeats)",
         )
 
     # ------------------------------------------------------------ contract
@@ -133,7 +134,7 @@ class ProfileFile(MeasuredFile):
                         f"of the file's x column ({dx!r}); drop the parameter or fix the file"
                     )
                 dx = p.spacing
-        mode = p.detrend if p.detrend is not None else "tilt" if instrument else "mean"
+        mode = p.detrend if p.detrend is not None else "tilt" if instrument and not periodic else "mean"  # as a map's
         heights = level_line(z, mode)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
