@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from ..errors import ExitCode, FrictionlabError
-from .options import add_workers_option, run_options
+from .options import add_workers_option, refuse_empty_path, run_options
 
 
 def add_parser(sub) -> None:
@@ -36,6 +36,12 @@ def run(args) -> ExitCode:
             "run it in a terminal emulator (TERM=xterm-256color, ...), or run presets headless: frictionlab run "
             "PRESET (NO_COLOR=1 draws the TUI without colour)"
         )
+    for option, folder in (("--presets", args.presets), ("--runs", args.runs)):
+        # a file given as a folder: the TUI started and said "No presets in FILE", or listed no runs,
+        # and only a save or a run then failed ("File exists")
+        refuse_empty_path(folder, option)
+        if folder is not None and os.path.lexists(folder) and not os.path.isdir(folder):
+            raise FrictionlabError(f"{option}: {folder} is not a folder: give a folder (one not there yet is made when first written into)")
     if args.preset is not None:
         from ..preset import load_preset_file
         from ..preset.builtin import resolve_preset_path

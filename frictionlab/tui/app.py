@@ -82,6 +82,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
+        Binding("ctrl+z", "suspend_process", "Suspend", tooltip="to the shell, as Ctrl+Z in a shell (fg brings the TUI back)", show=False),
         # the same keys where they cannot act (check_action hides those above): the status line says why
         *said_when_hidden(("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"), priority=True),
     ]
@@ -137,6 +138,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
     def on_mount(self) -> None:
         # F2..F5 switch tabs: the tab bar as a Tab stop would only take focus where nothing shows it
         self.query_one("ContentTabs").can_focus = False
+        # back from Ctrl+Z (fg): Textual re-enters the screen but draws nothing until something changes
+        self.app_resume_signal.subscribe(self, lambda _app: self.refresh(layout=True))
         self.reload_presets()
         self.query_one("#preset-table").focus()
 

@@ -6,7 +6,8 @@ queue at a time; keys typed meanwhile (fast typing, or the keys held while the a
 built) are handed to the widget focused before. Tab then ``abc`` lost the letters on the
 form, and Esc then ``q`` in a field typed the q there, though q quits outside a field.
 Such a key's binding is run here, at once, in the app's queue, so each key after it goes
-where the focus now is.
+where the focus now is. A list's cursor keys are run at once too: n and d (run at once) read the
+highlighted row, and Down Down d typed fast duplicated the row the cursor was on before the arrows.
 
 Esc then a key within the terminal's escape delay (0.1 s: a fast typist, or keystrokes that
 SSH sends joined) reaches the app as one Alt+key, and a field typed its letter: this app
@@ -17,12 +18,17 @@ binds no Alt key, so such a key is read as the two keys typed. Esc joined to a c
 from __future__ import annotations
 
 from textual import events
-from textual.widgets import Input
+from textual.widgets import DataTable, Input
 
 # the actions that only move the focus, or open a dialog (which holds the keys after it until its field
 # has the focus): run at once, they change nothing else than Textual's own order would
 FOCUS_ACTIONS = frozenset(
     {"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field", "new", "duplicate"}
+)
+
+# a list's own cursor moves: nothing else handles these keys on a list, so at once is Textual's order
+LIST_CURSOR_ACTIONS = frozenset(
+    {"cursor_up", "cursor_down", "page_up", "page_down", "scroll_home", "scroll_end", "scroll_top", "scroll_bottom"}
 )
 
 
@@ -35,7 +41,7 @@ def unjoined(key: events.Key) -> list[events.Key]:
 
 async def answer_focus_key(app, key: events.Key) -> bool:
     """Run ``key``'s binding now if the binding it would reach (the first from the focused
-    widget up) moves the focus or opens a dialog; True if it did. A printable key is the
+    widget up) moves the focus, opens a dialog or moves a list's cursor; True if it did. A printable key is the
     focused text field's (n and d open dialogs from the Presets list)."""
     if key.is_forwarded or (key.is_printable and isinstance(app.focused, Input)):
         return False
@@ -43,7 +49,8 @@ async def answer_focus_key(app, key: events.Key) -> bool:
         for binding in bindings.key_to_bindings.get(key.key, ()):
             if binding.priority:
                 continue  # the app ran those before
-            if binding.action not in FOCUS_ACTIONS:
+            moves_cursor = isinstance(namespace, DataTable) and binding.action in LIST_CURSOR_ACTIONS
+            if binding.action not in FOCUS_ACTIONS and not moves_cursor:
                 return False  # another binding comes first: Textual's order
             return await app.run_action(binding.action, namespace)
     return False

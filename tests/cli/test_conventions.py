@@ -220,3 +220,18 @@ def test_tui_takes_a_builtin_name_and_a_mistyped_one_gets_the_closest_before_the
     monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(preset) or 0)
     tui.run(Namespace(preset="quickstart", presets=None, runs=None, workers=1))
     assert len(opened) == 1 and opened[0].endswith("quickstart.yaml")
+
+
+@pytest.mark.parametrize("option", ["--presets", "--runs"])
+def test_tui_refuses_a_file_given_as_its_presets_or_runs_folder_before_the_ui_starts(tmp_path, monkeypatch, cli, option):
+    """A file given as --presets or --runs started the TUI, which said 'No presets in FILE' or
+    listed no runs, and only a save or a run then failed. A folder not there yet is still taken."""
+    import frictionlab.tui
+
+    (tmp_path / "afile").write_text("")
+    opened = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(kwargs) or 0)
+    monkeypatch.chdir(tmp_path)
+    done = cli("tui", option, "afile")
+    assert done.returncode == ExitCode.USAGE and f"{option}: afile is not a folder" in done.stderr
+    assert cli("tui", option, "not-yet").returncode == 0 and len(opened) == 1

@@ -4,6 +4,8 @@ when asked twice, and the keys of the screen behind wait until it is closed."""
 import pytest
 from textual.widgets import Input
 
+from frictionlab.tui.screens.dialogs import QuitDuringRunScreen
+
 from .conftest import make_app, press_settled, screen_text, started, status_text, sync
 
 
@@ -59,3 +61,26 @@ async def test_save_run_and_save_as_wait_while_a_dialog_is_open_and_say_so(folde
     assert dialogs == 1 and left == ("Screen", "")  # the message goes with the dialog
     assert said.startswith("A dialog is open: Enter answers it, Esc closes it")
     assert app.followed is None and not (folders / "runs").exists()  # no run started behind the dialog
+
+
+@sync
+async def test_dialogs_fit_a_60_column_terminal_and_show_their_keys_whole(folders, registry):
+    """At 60x20 the dialogs (72 columns wide) ran past the screen's right edge: the end of a file
+    name typed into New, and its cursor, were out of sight, and the quit question's hint ended
+    before 'Esc: stay'."""
+    app = make_app(registry)
+    async with started(app, size=(60, 20)) as pilot:
+        await press_settled(pilot, "n", "tab", "tab")
+        field = app.screen.query_one("#new-path", Input)
+        field.value = "presets/a-rather-long-file-name-for-my-scene.yam"
+        await press_settled(pilot, "end", "l")
+        dialog = app.screen.query_one(".dialog")
+        inside = dialog.region.right <= 60 and field.region.right <= 60
+        cursor_x = field.cursor_screen_offset.x
+        await press_settled(pilot, "escape")
+        app.push_screen(QuitDuringRunScreen("A run is going in runs/x (pid 1), a process of its own."))
+        await pilot.pause()
+        quit_text = screen_text(app)
+    assert inside
+    assert cursor_x < 60
+    assert "Esc: stay" in quit_text

@@ -119,6 +119,26 @@ async def test_a_sweeps_table_of_eight_points_shows_each_row_at_80x24(folders, r
     assert legend_whole and last_row
 
 
+@pytest.mark.long  # a sweep run in the TUI: seconds (the 80x24 case above stays in the quick suite)
+@sync
+async def test_a_sweeps_table_shows_rows_at_60x20(folders, registry):
+    """At 60x20 the plot kept its 10 rows and pushed the table below the tab: its header alone
+    was on screen, and Tab then the arrows showed no row of it."""
+    app = sweep_app(folders, registry)
+    async with started(app, size=(60, 20)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        table, pane = app.query_one("#sweep-table", DataTable), app.query_one("RunPane")
+        inside, rows = table.region.bottom <= pane.region.bottom, table.size.height
+        table.focus()
+        await press_settled(pilot, *["down"] * (table.row_count - 1))
+        last = str(table.get_row_at(table.row_count - 1)[0])
+        screen = screen_text(app)
+        rows_shown = [line for line in screen.splitlines() if line.split()[:1] == [last]]
+    assert rows >= 3 and inside, rows  # its header and two rows at least
+    assert rows_shown, (last, screen)
+
+
 @sync
 async def test_a_duplicate_saved_under_another_file_name_takes_that_name(folders, registry):
     """It stayed '<name>-copy' whatever file it went to: the list showed 'small-copy' beside rough.yaml."""

@@ -3,8 +3,12 @@ go where the focus went (Textual ran Tab's, Enter's and Esc's bindings only once
 bubbled up, and handed the keys typed meanwhile to the widget focused before)."""
 
 import pytest
+import yaml
 from textual import events
 from textual.widgets import Input
+
+from frictionlab.tui.screens import PathScreen
+from frictionlab.tui.widgets.presets import PresetsPane
 
 from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, sync, wait_until
 
@@ -86,3 +90,20 @@ async def test_keys_typed_as_a_dialog_opens_are_typed_into_it(folders, registry,
         await pilot.pause()
         opened = (app.query_one("#field--name", Input).value, str(app.draft_path))
     assert opened == (name, path)
+
+
+@sync
+async def test_arrows_then_d_typed_fast_duplicate_the_row_the_arrows_went_to(folders, registry):
+    """Down Down d typed together duplicated the first row: d ran at once while the arrows still
+    bubbled up to the list's bindings, so the cursor had not moved yet (and the dialog took them)."""
+    for name in ("b-second", "c-third"):
+        (folders / "presets" / f"{name}.yaml").write_text(yaml.safe_dump({**TINY, "name": name}, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        names = [entry.path.stem for entry in app.query_one(PresetsPane).presets]
+        post_keys(app, ["home", "down", "down", "d"])
+        await wait_until(pilot, lambda: isinstance(app.screen, PathScreen), timeout=10.0)
+        asked = app.screen.title_text
+    assert names[:3] == ["b-second", "c-third", "tiny"]
+    assert asked.startswith("Duplicate tiny.yaml")

@@ -227,3 +227,25 @@ async def test_d_on_a_built_in_preset_offers_a_file_it_can_save_and_saves_it(tmp
         await wait_until(pilot, lambda: app.draft_path is not None, timeout=10.0)
     assert app.draft_path == Path("presets") / f"{first.stem}-copy.yaml"
     assert (tmp_path / "presets" / f"{first.stem}-copy.yaml").is_file()
+
+
+@sync
+async def test_ctrl_z_suspends_to_the_shell_and_fg_draws_the_screen_again(folders, registry, monkeypatch):
+    """Ctrl+Z did nothing and said nothing (a shell user's way to step out); the app now sends
+    itself SIGTSTP as Textual's suspend does, and redraws once back (Textual re-entered the
+    screen and left it blank until a key changed something)."""
+    import signal
+
+    import textual.app
+
+    sent, redrawn = [], []
+    monkeypatch.setattr(textual.app.os, "kill", lambda pid, sig: sent.append(sig))
+    app = make_app(registry)
+    async with started(app) as pilot:
+        monkeypatch.setattr(type(app._driver), "can_suspend", property(lambda driver: True))
+        await press_settled(pilot, "ctrl+z")
+        monkeypatch.setattr(app, "refresh", lambda *args, **kwargs: redrawn.append(kwargs) or app)
+        app.app_resume_signal.publish(app)  # what the driver's SIGCONT posts once the screen is back
+        await pilot.pause()
+    assert sent == [signal.SIGTSTP]
+    assert {"layout": True} in redrawn

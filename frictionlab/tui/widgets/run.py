@@ -118,15 +118,25 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _fit_table(self) -> None:
         """A sweep's table of points is as tall as its rows, up to 40 % of the tab and no more
         than the plot's PLOT_ROWS leave: taller, its last rows lay below the tab, out of sight
-        and out of its own scroll's reach (rows 5 to 8 of 8 points at 80x24); it scrolls instead."""
+        and out of its own scroll's reach (rows 5 to 8 of 8 points at 80x24); it scrolls instead.
+        Where the tab has not that room, the plot gives up rows of its legend."""
         table = self.query_one("#sweep-table", DataTable)
+        body = self.query_one("#run-body")
+        if not table.display:
+            body.styles.min_height = None  # a single run: the stylesheet's (none)
         if not table.display or not self.size.height:
             return
         others = sum(child.outer_size.height for child in self.children
                      if child.display and child is not table and child.id != "run-body")  # fmt: skip
-        height = max(3, min(self.size.height * 2 // 5, self.size.height - others - PLOT_ROWS))
+        room = self.size.height - others
+        height = max(3, min(self.size.height * 2 // 5, room - PLOT_ROWS))
         if table.styles.max_height is None or table.styles.max_height.value != height:
             table.styles.max_height = height
+        # a short terminal (60x20) gives the table its header and two rows before the plot its legend:
+        # the plot's min-height pushed the table's rows below the tab, only its header in sight
+        plot_rows = max(1, min(PLOT_ROWS, room - height))
+        if body.styles.min_height is None or body.styles.min_height.value != plot_rows:
+            body.styles.min_height = plot_rows
 
     def _error(self, text: str) -> None:
         self._set("run-error", Content.styled(shown(text), "red"))  # a run's error may quote a file
