@@ -115,10 +115,11 @@ def line_form_warning(z: np.ndarray, mode: str) -> str | None:
     variance = float(np.dot(centred, centred))
     if not variance > 0:
         return None
-    tilt = float(np.dot(t, centred)) ** 2 / float(np.dot(t, t)) / variance
+    along, norm = float(np.dot(t, centred)), float(np.dot(t, t))
+    tilt = along**2 / norm / variance
     curvature = float(np.dot(t2, centred)) ** 2 / float(np.dot(t2, t2)) / variance if z.size > 2 else 0.0
     if mode == "tilt":  # the share of what the tilt leaves, summed from it (1 - tilt is rounding on a steep line)
-        rest = centred - (float(np.dot(t, centred)) / float(np.dot(t, t))) * t
+        rest = centred - (along / norm) * t
         left = curvature * variance / float(np.dot(rest, rest)) if np.any(rest) else 0.0
         if left > MOST:
             return (f"a curvature carries {100 * left:.1f} % of the levelled line's height "
