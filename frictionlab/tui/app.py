@@ -385,7 +385,9 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             pane = self.query_one(pane_class)
         except NoMatches:
             return None
-        return pane if pane.children else None  # the app is closing: the panes' children go first
+        # closing: exit() asked (is_attached is then False) or the shutdown begun (not running), the
+        # panes' children removed one by one while a watch tick still arrives
+        return pane if pane.children and pane.is_attached and self.is_running else None
 
     def _draft(self) -> dict | None:
         return self.query_one("#form").data

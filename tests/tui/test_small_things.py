@@ -88,6 +88,21 @@ async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_li
     assert quit_by_q
 
 
+
+@sync
+async def test_a_watch_tick_after_exit_is_asked_finds_no_pane_to_fill(folders, registry):
+    """exit() asked, the panes' children are taken away one by one while the runs folder's
+    watch still ticks: it read ResultsPane as there (some children left) and filled a list
+    already gone (NoMatches '#runs-table', a failed session)."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await pilot.pause()
+        before = app._mounted("ResultsPane")
+        app.exit()
+        after = app._mounted("ResultsPane")
+        app._watch_runs()  # a tick now reads nothing
+    assert before is not None and after is None
+
 @sync
 async def test_on_off_switches_say_their_state_in_words(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
