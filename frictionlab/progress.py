@@ -14,6 +14,7 @@ import sys
 import time
 
 from .errors import counted, shown
+from .options import default_workers
 from .plugin.hookspecs import hookimpl
 from .plugin.listeners import SweepListener, progress_text, solve_text
 
@@ -149,9 +150,14 @@ class ProgressReporter:
             + [f"{run.retried} failed ones retried"] * bool(run.retried)
         )
         restored = f" ({restored})" if restored else ""
+        cores = default_workers()
+        crowded = (  # a pool larger than the cores it may use: said, since it is no faster
+            f" on {cores} core(s): they take turns, no faster than {cores}"
+            if run.executor == "processes" and run.workers > cores else ""
+        )  # fmt: skip
         self._write(
             f"{preset.name}: {run.total} realizations of {run.scene.pressed}{restored}, "
-            f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s)"
+            f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s){crowded}"
         )
 
     def _pass_tenths(self, done: int, total: int) -> None:

@@ -7,7 +7,7 @@ from ..errors import FrictionlabError
 from ..options import EXECUTORS
 
 
-def add_workers_option(parser, default_help: str = "all cores; 1: in-process") -> None:
+def add_workers_option(parser, default_help: str = "all cores; 1: in-process; more than the cores are no faster") -> None:
     parser.add_argument("--workers", type=int, metavar="N", help=f"worker processes (default: {default_help})")
 
 

@@ -100,3 +100,18 @@ def test_the_first_line_counts_the_workers_that_run_not_those_asked_for(make_sce
     stream = FakeTerminal()
     engine.run(make_scene({"realizations": 6}), RunOptions(workers=4, executor="serial"), listeners=[ProgressReporter(stream, after=0)])
     assert stream.getvalue().startswith("small: 6 realizations of power-law lines, 16 force steps, 1 worker(s)\n")
+
+
+def test_more_workers_than_cores_are_said_to_take_turns(make_scene, monkeypatch):
+    import frictionlab.progress as progress
+
+    monkeypatch.setattr(progress, "default_workers", lambda: 1)  # a machine of one core
+    stream = FakeTerminal()
+    engine.run(make_scene({"realizations": 4}), RunOptions(workers=2, executor="processes"),
+               listeners=[ProgressReporter(stream, after=0)])  # fmt: skip
+    first = stream.getvalue().splitlines()[0]
+    assert first.endswith(", 2 worker(s) on 1 core(s): they take turns, no faster than 1")
+    stream = FakeTerminal()  # as many as the cores: nothing to say
+    engine.run(make_scene({"realizations": 4}), RunOptions(workers=1, executor="processes"),
+               listeners=[ProgressReporter(stream, after=0)])  # fmt: skip
+    assert stream.getvalue().splitlines()[0].endswith(", 1 worker(s)")
