@@ -36,6 +36,24 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
 
 @pytest.mark.long  # a TUI session
 @sync
+async def test_space_taking_the_only_run_off_the_plot_says_it_is_hidden_not_that_there_is_no_data(folders, registry):
+    """Enter then Space on the same run took it off the overlay, and the plot said "no data yet"
+    beside a run whose curve is there: it says the run is hidden, and Space shows it again."""
+    app = runs_app(folders, registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter", "space")
+        name = app.query_one(ResultsPane).runs[0].path.name
+        hidden_screen = screen_text(app)
+        info = str(app.query_one("#results-info", Static).render())
+        plotted_while_hidden = app.query_one("#results-chart").series
+        await press_settled(pilot, "space")
+        plotted_again = app.query_one("#results-chart").series
+    assert "no data yet" not in hidden_screen and "run hidden" in hidden_screen
+    assert " ".join(info.split()) == f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run."
+    assert not plotted_while_hidden and plotted_again
+
+@pytest.mark.long  # a TUI session
+@sync
 async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
     make_runs(folders, registry)
     (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))

@@ -224,15 +224,23 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 else:
                     self._show_sweep(entry)
                 return
+        hidden = None
         if overlay:
             paths = [e.path for e in self.overlay]
             if entry.path in paths:
                 self.overlay = [e for e in self.overlay if e.path != entry.path]
+                hidden = entry
             else:
                 self.overlay = (self.overlay + [entry])[-len(OVERLAY_STYLES):]
         else:
             self.overlay = [entry]
         self._show_overlay()
+        if hidden is not None and not self.overlay:  # its data is there: "no data yet" said otherwise
+            name = shown(hidden.path.name)
+            self.query_one("#results-chart", Chart).show([], empty="run hidden")
+            self.query_one("#results-info", Static).update(
+                Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
+            )
 
     def _show_sweep(self, entry: SweepEntry) -> None:
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
