@@ -11,7 +11,8 @@ from textual.widgets import Footer
 
 # the actions whose keys go first where the footer is short (in this order): another key does
 # the same (q quits, Tab leaves a sweep's points), or a list that is seldom reloaded or copied;
-# F1 Keys, Save, Run and the focused part's own Open, Compare, Resume, Cancel stay
+# F1 Keys, Save, Run and the focused part's own Open, Compare, Resume, Cancel stay (narrower
+# than these, under some 55 columns, the footer is cut at its edge again)
 LEFT_OUT_FIRST = ("reload", "duplicate", "quit", "back_to_list", "new")
 
 
@@ -40,5 +41,7 @@ class KeysFooter(Footer):
 def drawn_width(keys, compact: bool) -> int:
     """The columns ``keys`` take in a row: a key and its description, with Textual's padding
     (one column each side of the key, one after the description) or, compact, a space between
-    them and one after."""
-    return sum(cell_len(key.key_display) + (cell_len(key.description) + (2 if compact else 3) if key.description else 1) for key in keys)
+    them and one after (a key without a description: the key, and compact, a space after it)."""
+    if compact:
+        return sum(cell_len(key.key_display) + (cell_len(key.description) + 1 if key.description else 0) + 1 for key in keys)
+    return sum(cell_len(key.key_display) + (cell_len(key.description) + 3 if key.description else 0) for key in keys)
