@@ -4,8 +4,9 @@ lazily: headless commands never import Textual."""
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode, FrictionlabError, PresetFileError, did_you_mean
 from .options import add_workers_option, refuse_empty_path, run_options
 
 
@@ -16,7 +17,7 @@ def add_parser(sub) -> None:
         description="The terminal UI: browse and edit presets, run them with live progress, compare results.",
         epilog="examples:\n  frictionlab tui\n  frictionlab tui quickstart",
     )
-    p.add_argument("preset", nargs="?", help="preset YAML file, or a built-in's name, to open (optional)")
+    p.add_argument("preset", nargs="?", help="preset YAML file, or a preset's name (in --presets DIR first, then the built-ins), to open (optional)")
     p.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
     p.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")
     add_workers_option(p)
@@ -44,11 +45,42 @@ def run(args) -> ExitCode:
             raise FrictionlabError(f"{option}: {folder} is not a folder: give a folder (one not there yet is made when first written into)")
     if args.preset is not None:
         from ..preset import load_preset_file
-        from ..preset.builtin import resolve_preset_path
 
-        args.preset = str(resolve_preset_path(args.preset))  # a file, or a built-in's name
+        args.preset = str(find_preset(args.preset, args.presets))
         load_preset_file(args.preset)  # a missing or unreadable file is a usage error, before the UI starts
     options = run_options(workers=args.workers)
     from ..tui import run_app  # Textual is imported here only
 
     return run_app(args.preset, presets_dir=args.presets, runs_dir=args.runs, options=options)
+
+
+def find_preset(argument: str, presets_dir: str | None) -> Path:
+    """The preset file the command line names: with ``--presets DIR`` a name (no folder in it) is
+    looked for in DIR first, as its Presets list shows it (``NAME.yaml``, ``NAME.yml``, or the file
+    named); else, and then, as ``frictionlab run`` reads it (a path as given, or a built-in's name).
+    Found nowhere: a PresetFileError naming the value and each place looked in."""
+    from ..preset.builtin import builtin_presets, resolve_preset_path
+
+    if presets_dir is None or len(Path(argument).parts) != 1:
+        return resolve_preset_path(argument)
+    folder = Path(presets_dir)
+    names = [argument] if Path(argument).suffix in (".yaml", ".yml") else [f"{argument}.yaml", f"{argument}.yml"]
+    looked = [folder / name for name in names]
+    found = next((path for path in looked if os.path.lexists(path) and not path.is_dir()), None)
+    if found is not None:
+        return found  # read (and, if it cannot be, reported) as a preset file
+    try:
+        elsewhere = resolve_preset_path(argument)
+    except PresetFileError:
+        elsewhere = None
+    if elsewhere is not None and os.path.lexists(elsewhere):
+        return elsewhere
+    in_folder = sorted(path.stem for path in folder.glob("*.y*ml")) if folder.is_dir() else []
+    listed = ", ".join(in_folder[:12]) + (f" and {len(in_folder) - 12} more" if len(in_folder) > 12 else "")
+    hint = did_you_mean(Path(argument).stem, in_folder + [p.name for p in builtin_presets()])
+    raise PresetFileError(
+        [f"(file): no preset {argument!r} in --presets {str(folder)!r} (looked for {' and '.join(map(str, looked))}), "
+         f"no file {argument!r} here and no built-in preset of that name{hint or '.'} "
+         f"Presets in {str(folder)!r}: {listed or '(none)'} (`frictionlab presets` lists the built-ins)"],
+        source=argument,
+    )  # fmt: skip

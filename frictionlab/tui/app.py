@@ -22,7 +22,7 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
 from textual.css.query import NoMatches
-from textual.widgets import Footer, Static, TabbedContent, TabPane
+from textual.widgets import Static, TabbedContent, TabPane
 
 from ..errors import PresetError, shown
 from ..options import RunOptions
@@ -48,6 +48,7 @@ from .tabs import TabSwitching
 from .running import NO_PRESET, RunControl
 from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
 from .text import problems_text
+from .widgets.footer import KeysFooter
 from .widgets.presets import NO_PRESETS, PresetsPane
 
 if TYPE_CHECKING:
@@ -133,7 +134,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             yield TabPane("F4 Run", id="run")
             yield TabPane("F5 Results", id="results")
         yield Static("", id="status")
-        yield Footer()
+        yield KeysFooter()
 
     def on_mount(self) -> None:
         # F2..F5 switch tabs: the tab bar as a Tab stop would only take focus where nothing shows it

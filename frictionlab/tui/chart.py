@@ -36,9 +36,13 @@ def _ticks(low: float, high: float) -> str:
     return f"{low:.3g}", f"{high:.3g}"
 
 
-def render_chart(series: list[Series], width: int, height: int) -> list[list[tuple[str, str]]]:
+NO_DATA = "no data yet"
+
+
+def render_chart(series: list[Series], width: int, height: int, empty: str = NO_DATA) -> list[list[tuple[str, str]]]:
     """Rows of (text, style) segments filling ``width`` x ``height`` cells:
-    y labels on the left, the plot, the log-f range on the bottom row."""
+    y labels on the left, the plot, the log-f range on the bottom row; ``empty`` centred
+    when there is no point to plot."""
     label_width = 7
     plot_w, plot_h = max(1, width - label_width), max(1, height - 1)
     points = []
@@ -50,8 +54,7 @@ def render_chart(series: list[Series], width: int, height: int) -> list[list[tup
     ys = np.concatenate([p[1] for p in points]) if points else np.empty(0)
     if xs.size == 0:
         blank = [[(" " * width, "")] for _ in range(height)]
-        message = "no data yet"
-        blank[height // 2] = [(message.center(width)[:width], "dim")]
+        blank[height // 2] = [(empty.center(width)[:width], "dim")]
         return blank
     x_lo, x_hi = float(xs.min()), float(xs.max())
     y_lo, y_hi = float(ys.min()), float(ys.max())

@@ -50,6 +50,32 @@ def test_tui_command_passes_its_folders_and_never_loads_textual_before(tmp_path,
     assert "no such preset file" in result.stderr
 
 
+
+def test_a_preset_name_given_with_presets_dir_is_looked_for_in_that_folder_first(tmp_path, monkeypatch, capsys):
+    """``frictionlab tui --presets DIR NAME`` looked for NAME only here and among the built-ins:
+    DIR's own NAME.yaml was "no file 'NAME' and no built-in preset of that name"."""
+    import frictionlab.tui
+
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    for name in ("own.yaml", "quickstart.yaml", "short.yml"):  # quickstart.yaml: DIR's, not the built-in
+        (folder / name).write_text((ROOT / "presets" / "quickstart.yaml").read_text())
+    monkeypatch.chdir(tmp_path)
+    opened = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(preset) or 0)
+    for name in ("own", "own.yaml", "quickstart", "short"):
+        assert main(["tui", "--presets", "mine", name]) == 0
+    assert opened == [os.path.join("mine", file) for file in ("own.yaml", "own.yaml", "quickstart.yaml", "short.yml")]
+    assert main(["tui", "--presets", "elsewhere", "quickstart"]) == 0  # not in DIR: as frictionlab run reads it
+    assert opened[-1] == str(ROOT / "presets" / "quickstart.yaml")
+    capsys.readouterr()
+
+    assert main(["tui", "--presets", "mine", "onw"]) == 3  # 3: ExitCode.INPUT_FILE, as for a name found nowhere without it
+    said = capsys.readouterr().err
+    where = os.path.join("mine", "onw")
+    assert "'onw'" in said and f"{where}.yaml and {where}.yml" in said and "did you mean 'own'?" in said, said
+    assert "Traceback" not in said and len(opened) == 5
+
 POOL_UNDER_TEXTUAL = """
 import sys, threading
 import frictionlab.tui

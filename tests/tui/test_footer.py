@@ -6,6 +6,8 @@ import json
 
 import pytest
 
+import yaml
+
 from .conftest import (
     SIZE, SWEEP, TINY, make_app, make_runs, press_settled, screen_text, started, status_text, sync, type_into,
     wait_until,
@@ -14,6 +16,26 @@ from .conftest import (
 
 def footer(app) -> str:
     return screen_text(app).splitlines()[-1]
+
+
+def listed_keys(app) -> list[str]:
+    """The descriptions of the keys the footer would list, given the room (the focused part's and the app's)."""
+    return [binding.description for _, binding, enabled, _ in app.screen.active_bindings.values() if binding.show]
+
+
+async def key_panel_words(pilot) -> set[str]:
+    """Every word F1's key panel shows, page after page (F1 again) until F1 hides it."""
+    words = set()
+    await press_settled(pilot, "f1")
+    for _ in range(10):
+        panels = pilot.app.screen.query("HelpPanel")
+        if not panels:
+            break
+        region = panels.first().region
+        rows = screen_text(pilot.app).splitlines()[region.y : region.bottom]
+        words |= {word for row in rows for word in row[region.x : region.right].split()}
+        await press_settled(pilot, "f1")
+    return words
 
 
 def interrupted_copy(folders, name: str) -> None:
@@ -71,6 +93,30 @@ async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
     assert said.startswith("No preset open")
     assert "^s Save" in open_ and "^r Run" in open_
 
+
+@pytest.mark.long  # a sweep made first, then a TUI session at 60x20: seconds
+@sync
+async def test_a_60_column_footer_keeps_save_run_and_keys_and_f1_lists_what_it_leaves_out(folders, registry):
+    """At 60 columns the footer was cut at the right edge: with a preset open the Presets list's
+    `^s Save` and `^r Run`, and a sweep's points' `f1 Keys` too, were past it (they worked, unseen)."""
+    from frictionlab.options import RunOptions
+    from frictionlab.runs.sweep import load_sweep, run_sweep
+
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    seen = {}
+    async with started(app, size=(60, 20)) as pilot:
+        for where, keys in (("presets", ("f2",)), ("points", ("f5", "enter"))):
+            await press_settled(pilot, *keys)
+            seen[where] = (footer(app), listed_keys(app), await key_panel_words(pilot))
+        assert app.query_one("#results-sweep").has_focus  # the points' footer was read
+    for where, (line, listed, panel) in seen.items():
+        assert line.rstrip().endswith("^r Run") and "^s Save" in line and "f1 Keys" in line, (where, line)
+        left_out = [description for description in listed if description not in line]
+        assert len(left_out) < len(listed) / 2, (where, line)  # the focused part's keys are there too
+        assert all(set(description.split()) <= panel for description in left_out), (where, left_out)
+    assert "Open" in seen["presets"][0] and "Compare" in seen["points"][0]
 
 @pytest.mark.long  # a TUI session with a preset open and edited twice: seconds
 @sync

@@ -36,6 +36,68 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
 
 @pytest.mark.long  # a TUI session
 @sync
+async def test_space_taking_the_only_run_off_the_plot_says_it_is_hidden_not_that_there_is_no_data(folders, registry):
+    """Enter then Space on the same run took it off the overlay, and the plot said "no data yet"
+    beside a run whose curve is there: it says the run is hidden, and Space shows it again."""
+    app = runs_app(folders, registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter", "space")
+        name = app.query_one(ResultsPane).runs[0].path.name
+        hidden_screen = screen_text(app)
+        info = str(app.query_one("#results-info", Static).render())
+        plotted_while_hidden = app.query_one("#results-chart").series
+        await press_settled(pilot, "space")
+        plotted_again = app.query_one("#results-chart").series
+    assert "no data yet" not in hidden_screen and "run hidden" in hidden_screen
+    assert " ".join(info.split()) == f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run."
+    assert not plotted_while_hidden and plotted_again
+
+async def wheel_read(pilot, region, turns: int = 12) -> list[str]:
+    """What the screen shows within ``region`` as the mouse wheel turns down over its bottom
+    row, ``turns`` steps, as a terminal sends it (the widget there scrolls, if it can): each
+    step's rows joined, without spaces nor a scrollbar's marks (a line wrapped reads whole)."""
+    from textual import events
+
+    x, y = region.x + 1, region.bottom - 1
+    seen = []
+    for _ in range(turns + 1):
+        rows = [row[region.x : region.right] for row in screen_text(pilot.app).splitlines()[region.y : region.bottom]]
+        seen.append("".join(char for char in "".join(rows) if not char.isspace() and char not in "▁▂▃▄▅▆▇█▍▌▎▏"))
+        pilot.app.post_message(events.MouseScrollDown(None, x, y, 0, 0, 0, False, False, False, screen_x=x, screen_y=y))
+        await pilot.pause()
+    return seen
+
+
+@pytest.mark.long  # a sweep run first, then a TUI session
+@sync
+async def test_the_info_box_under_the_plot_is_read_whole_at_60x20(folders, registry):
+    """At 60x20 the box under the plot lost its last lines: a run's `b=` line (the box held 8
+    rows, the run's lines wrap to 9 there), and beside a sweep's points the box ran 3 rows past
+    the plot's own space, cut at the table. Now it takes up to half the plot's column and
+    scrolls (with the mouse wheel) the rest."""
+    make_runs(folders, registry)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    (folders / "runs" / "seed1").rename(folders / "runs" / "seed1-with-a-longer-name")  # 9 lines at 60x20
+    app = make_app(registry)
+    async with started(app, size=(60, 20)) as pilot:
+        await press_settled(pilot, "f5")
+        names = [entry.path.name for entry in app.query_one(ResultsPane).runs]
+        read = {}
+        for name in ("seed1-with-a-longer-name", "sw"):
+            await press_settled(pilot, "home", *["down"] * names.index(name), "enter")
+            await pilot.pause()
+            body = app.query_one("#results-body").region
+            said = str(app.query_one("#results-info", Static).render()).splitlines()
+            read[name] = (said, await wheel_read(pilot, body))
+    for name, (said, seen) in read.items():  # each word of the box on the screen at one turn of the wheel or another
+        missing = [word for word in " ".join(said).split() if not any(word in step for step in seen)]
+        assert len(said) >= 2 and not missing, (name, missing)
+    assert said[-1].strip().endswith("Esc goes back to the list.")
+    assert read["seed1-with-a-longer-name"][0][-1].strip().startswith("b=0.0150")
+
+@pytest.mark.long  # a TUI session
+@sync
 async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
     make_runs(folders, registry)
     (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))

@@ -5,7 +5,7 @@ from __future__ import annotations
 from rich.text import Text
 from textual.widget import Widget
 
-from ..chart import Series, render_chart
+from ..chart import NO_DATA, Series, render_chart
 
 
 class Chart(Widget):
@@ -16,14 +16,15 @@ class Chart(Widget):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.series: list[Series] = []
+        self.empty = NO_DATA  # what it says with no point to plot
 
-    def show(self, series: list[Series]) -> None:
-        self.series = series
+    def show(self, series: list[Series], empty: str = NO_DATA) -> None:
+        self.series, self.empty = series, empty
         self.refresh()
 
     def render(self) -> Text:
         text = Text(no_wrap=True, overflow="crop")
-        rows = render_chart(self.series, self.size.width, self.size.height)
+        rows = render_chart(self.series, self.size.width, self.size.height, self.empty)
         for i, row in enumerate(rows):
             for chunk, style in row:
                 text.append(chunk, style=style or None)

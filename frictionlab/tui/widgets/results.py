@@ -11,7 +11,7 @@ from rich.text import Text
 from textual import events
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
@@ -61,7 +61,8 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True, empty=NO_RUNS)
             with Vertical(id="results-body"):
                 yield Chart(id="results-chart")
-                yield Static(HINT, id="results-info")
+                with VerticalScroll(id="results-info-box", can_focus=False):  # at 60x20 a run's lines need 9 rows
+                    yield Static(HINT, id="results-info")
         yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
     def _name_width(self) -> int:
@@ -207,7 +208,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 self._close_sweep()
                 self.query_one("#results-chart", Chart).show([])
                 self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
-                self.query_one("#results-info", Static).update(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                self._inform(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
                 self._info_about = entry.path
                 return
             if entry.status == "running" and overlay:  # Space is not listed there: say why, as a hidden key does
@@ -224,15 +225,23 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 else:
                     self._show_sweep(entry)
                 return
+        hidden = None
         if overlay:
             paths = [e.path for e in self.overlay]
             if entry.path in paths:
                 self.overlay = [e for e in self.overlay if e.path != entry.path]
+                hidden = entry
             else:
                 self.overlay = (self.overlay + [entry])[-len(OVERLAY_STYLES):]
         else:
             self.overlay = [entry]
         self._show_overlay()
+        if hidden is not None and not self.overlay:  # its data is there: "no data yet" said otherwise
+            name = shown(hidden.path.name)
+            self.query_one("#results-chart", Chart).show([], empty="run hidden")
+            self._inform(
+                Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
+            )
 
     def _show_sweep(self, entry: SweepEntry) -> None:
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
@@ -243,7 +252,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         for row in entry.points:
             table.add_row(*map(Text, row_cells(entry.paths, row)))
         self.set_class(True, "-sweep")
-        self.query_one("#results-info", Static).update(
+        self._inform(
             Content(
                 f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
                 "Enter on a point opens its run; Space adds it to the overlay; Esc goes back to the list."
@@ -266,7 +275,13 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
             lines += _entry_lines(entry, style)
         self.query_one("#results-chart", Chart).show(series)
-        self.query_one("#results-info", Static).update(Content("\n").join(lines) if lines else HINT)
+        self._inform(Content("\n").join(lines) if lines else HINT)
+
+    def _inform(self, text: Content | str) -> None:
+        """The info box under the plot says ``text``, from its first line (the box scrolls where
+        it is taller than the room the plot leaves)."""
+        self.query_one("#results-info", Static).update(text)
+        self.query_one("#results-info-box").scroll_home(animate=False)
 
 
 def _entry_lines(entry: RunEntry, style: str) -> list[Content]:

@@ -1,0 +1,47 @@
+"""The footer, fitted to the terminal's width: Textual's cuts its keys at the right edge, and at
+60 columns ``^s Save`` and ``^r Run`` were lost there. Keys that would run past the edge are
+drawn closer together, and where they still do not fit the least needed are left out, first
+those in ``LEFT_OUT_FIRST``; F1's key panel lists them all, as it lists every key."""
+
+from __future__ import annotations
+
+from rich.cells import cell_len
+from textual import events
+from textual.widgets import Footer
+
+# the actions whose keys go first where the footer is short (in this order): another key does
+# the same (q quits, Tab leaves a sweep's points), or a list that is seldom reloaded or copied;
+# F1 Keys, Save, Run and the focused part's own Open, Compare, Resume, Cancel stay (narrower
+# than these, under some 55 columns, the footer is cut at its edge again)
+LEFT_OUT_FIRST = ("reload", "duplicate", "quit", "back_to_list", "new")
+
+
+class KeysFooter(Footer):
+    """Textual's footer, its keys fitted to the width it has (``LEFT_OUT_FIRST``)."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._fitted_to = 0  # the width the keys were last fitted to
+
+    def compose(self):
+        keys = list(super().compose())  # FooterKeys: this app's bindings have no groups
+        width = self._fitted_to = self.app.size.width
+        self.compact = drawn_width(keys, compact=False) > width  # no padding around a key, one space after it
+        for action in LEFT_OUT_FIRST:
+            if drawn_width(keys, self.compact) <= width:
+                break
+            keys = [key for key in keys if key.action != action]
+        yield from keys
+
+    def on_resize(self, event: events.Resize) -> None:
+        if event.size.width != self._fitted_to:
+            self.call_after_refresh(self.recompose)
+
+
+def drawn_width(keys, compact: bool) -> int:
+    """The columns ``keys`` take in a row: a key and its description, with Textual's padding
+    (one column each side of the key, one after the description) or, compact, a space between
+    them and one after (a key without a description: the key, and compact, a space after it)."""
+    if compact:
+        return sum(cell_len(key.key_display) + (cell_len(key.description) + 1 if key.description else 0) + 1 for key in keys)
+    return sum(cell_len(key.key_display) + (cell_len(key.description) + 3 if key.description else 0) for key in keys)
