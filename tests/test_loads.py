@@ -126,6 +126,26 @@ def test_a_load_past_the_free_solver_s_arithmetic_is_refused_naming_the_limit(tm
     assert done.returncode != 0 and "f <= 1e+30" in done.stderr and "Traceback" not in done.stderr
 
 
+def test_a_refusal_of_the_loads_names_the_preset_it_is_about(tmp_path, cli):
+    """Loads are checked once the preset is built: their refusal names the file (of several
+    validated at once, the one at fault) and the built-in with its --set options, as a
+    refusal of any other field does."""
+    good = tmp_path / "good.yaml"
+    good.write_text(json.dumps({**SURFACE, "solver": {"name": "bem-halfspace-free"}}), encoding="utf-8")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(json.dumps(with_loading({**SURFACE, "solver": {"name": "bem-halfspace-free"}}, stop=1e39)),
+                   encoding="utf-8")  # fmt: skip
+    done = cli("validate", str(good), str(bad), cwd=tmp_path)
+    assert done.returncode == 2 and f"{bad}: 1 problem in preset" in done.stderr and str(good) not in done.stderr
+    done = cli("run", "quickstart", "--set", "loading.unit=contact-fraction", "--set", "loading.start=0.1",
+               "--set", "loading.stop=0.2", "--out", str(tmp_path / "run"), cwd=tmp_path)  # fmt: skip
+    assert done.returncode == 2 and not (tmp_path / "run").exists()
+    assert "error: built-in preset 'quickstart' --set loading.unit=contact-fraction" in done.stderr
+    with pytest.raises(PresetError, match=r"f <= 1e\+30") as caught:
+        frictionlab.run(bad, out=tmp_path / "api-run", **FAST)
+    assert str(caught.value).startswith(f"{bad}: 1 problem in preset")
+
+
 def test_the_free_solver_itself_refuses_a_load_past_its_arithmetic():
     z = np.random.default_rng(0).standard_normal((8, 8))
     with pytest.raises(ValueError, match=r"f = F / \(E\* h L\) <= 1e\+30"):

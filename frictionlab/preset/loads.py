@@ -114,7 +114,7 @@ def check_loads(scene) -> None:
 
     problems = load_problems(scene)
     if problems:
-        raise PresetError(problems)
+        raise PresetError(problems, source=scene.source)
 
 
 def load_problems(scene) -> list[str]:

@@ -47,6 +47,9 @@ class Scene:
     # When the solver presses lines only and the spectrum makes surfaces: the spectrum's
     # MDR-equivalent line, whose lines are pressed instead (``generator``).
     equivalent_line: SpectrumGenerator | None = None
+    # Where the preset came from (a file, a built-in and its --set options): what names it in the
+    # refusals made after it was built (its loads), as in those of building it.
+    source: str | None = None
 
     @property
     def generator(self) -> SpectrumGenerator:
@@ -209,12 +212,13 @@ def build_scene(
     def check_then_read(line_of: dict) -> None:
         """The memory check, then the whole measured file: before a line is made of the surface."""
         if before_reading is not None:
-            before_reading(Scene(preset=preset, **line_of))
+            before_reading(Scene(preset=preset, source=source, **line_of))
         checked.append(True)
         if measured:
             _read_checked(spectrum.rms_height, source)
 
-    scene = Scene(preset=preset, **_match_dimensions(plugins, registry, source, before_line=check_then_read))
+    matched = _match_dimensions(plugins, registry, source, before_line=check_then_read)
+    scene = Scene(preset=preset, source=source, **matched)
     if before_reading is not None and not checked:
         before_reading(scene)
     if measured:
