@@ -21,6 +21,7 @@ import numpy as np
 from ..compute import engine
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
+from ..preset.builtin import resolve_preset_path
 from .figures import COUNT_TARGETS
 
 
@@ -70,8 +71,9 @@ def calibrated_rms_height(
 
 
 def main(path: str) -> None:
-    """Print the calibrated h of the preset at ``path``, and what each target alone gives."""
-    curve = count_curve(load_preset_file(path))
+    """Print the calibrated h of the preset at ``path`` (a file, or a built-in's name as
+    ``frictionlab run`` takes it), and what each target alone gives."""
+    curve = count_curve(load_preset_file(resolve_preset_path(path)))
     h = curve.fit_rms_height(COUNT_TARGETS)
     print(f"least-squares (in log) h = {h:.4g}")
     for F, n in COUNT_TARGETS.items():
@@ -92,9 +94,11 @@ def cli(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m frictionlab.paper.calibration",
         description="Find the rms height h that gives the paper's mean contact counts (4 at F = 1, 12 at F = 20).",
-        epilog="example: python -m frictionlab.paper.calibration presets/benad2012-fig2.yaml",
+        epilog="example: python -m frictionlab.paper.calibration presets/benad2012-fig2.yaml (benad2012-fig2 anywhere)",
     )
-    parser.add_argument("preset", help="a preset of the Fig. 2 scene (its h is ignored: one ensemble at h = 1)")
+    parser.add_argument(
+        "preset", help="a preset file, or a built-in's name, of the Fig. 2 scene (its h is ignored: one ensemble at h = 1)"
+    )
     args = parser.parse_args(argv)
     try:
         main(args.preset)
