@@ -30,7 +30,8 @@ class FrictionlabError(Exception):
     problems: list[str] | None = None  # one line per problem, where an error lists several (PresetError)
 
 
-EXTRAS = {"dask": "dask", "distributed": "dask", "pandas": "pandas", "ipywidgets": "notebook", "tamaas": "bench"}
+EXTRAS = {"dask": "dask", "distributed": "dask", "bokeh": "dask", "pandas": "pandas", "ipywidgets": "notebook",
+          "tamaas": "bench"}
 """The optional packages by top-level module, and the extra of pyproject.toml that brings each."""
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from .errors import FrictionlabError
+from .errors import FrictionlabError, require
 
 EXECUTORS = ("serial", "processes", "dask")
 
@@ -51,6 +51,8 @@ class RunOptions:
             )
         if isinstance(self.retries, bool) or not isinstance(self.retries, int) or self.retries < 0:
             raise FrictionlabError(f"retries must be a whole number >= 0. Got {self.retries!r} instead.")
+        if self.dashboard:  # before anything starts: without bokeh the dashboard's address serves only 404s
+            require("bokeh", "dashboard")
 
     def workers_for(self, realizations: int) -> int:
         """Workers of a run of ``realizations``: as asked (every core by default), never more than realizations."""

@@ -374,6 +374,7 @@ def test_the_dashboard_is_served_on_loopback_only_when_asked(capsys):
     try:
         http = _http_address(cluster)
         assert http.startswith("http://127.0.0.1:") and _http_status(http, "/health") == 200
+        assert _http_status(http, "/status") == 200  # the dashboard itself (bokeh's pages), not only the server
         assert "Dask dashboard: http://127.0.0.1:" in capsys.readouterr().err
     finally:
         client.close()

@@ -188,8 +188,8 @@ def start_local_cluster(workers: int, dashboard: bool = False):
             host="127.0.0.1",
             protocol="tls://",
             security=security,
-            dashboard_address=None,
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # loopback, any free port
+            dashboard_address=None,  # read as "no dashboard": the scheduler's own flag below says it
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0", "dashboard": dashboard},  # loopback, any free port
             silence_logs=logging.ERROR,
         )
     try:

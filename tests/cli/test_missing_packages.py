@@ -36,6 +36,16 @@ def test_the_dask_executor_without_the_memory_check_says_it_too(tmp_path):
     assert done.returncode == ExitCode.USAGE and 'pip install "frictionlab[dask]"' in done.stderr, done.stderr
 
 
+def test_the_dashboard_without_bokeh_is_refused_before_anything_starts(tmp_path):
+    """Dask serves its dashboard's pages only with bokeh: without it --dashboard printed an address
+    whose every page answered 404. The refusal names the extra that brings it."""
+    done = run_without(["bokeh"], ["run", "quickstart", "--executor", "dask", "--dashboard", "--workers", "1",
+                                   "--out", "o"], tmp_path)  # fmt: skip
+    assert done.returncode == ExitCode.USAGE, done.stderr
+    assert '--dashboard needs bokeh, which is not installed: pip install "frictionlab[dask]"' in done.stderr
+    assert "Traceback" not in done.stderr and "Dask dashboard" not in done.stderr and not (tmp_path / "o").exists()
+
+
 def test_a_missing_package_reached_anywhere_is_said_with_its_pip_command(tmp_path):
     """A command that imports an optional package without ``require`` still gets the message, not exit 70."""
     code = (
@@ -68,6 +78,7 @@ def test_a_missing_module_of_frictionlab_itself_stays_a_bug(monkeypatch, capsys)
 @pytest.mark.parametrize(
     ("module", "command"),
     [("pandas", 'pip install "frictionlab[pandas]"'), ("distributed", 'pip install "frictionlab[dask]"'),
+     ("bokeh", 'pip install "frictionlab[dask]"'),
      ("ipywidgets", 'pip install "frictionlab[notebook]"'), ("scipy", "pip install --force-reinstall frictionlab")],
 )  # fmt: skip
 def test_require_names_the_extra_of_each_optional_package(monkeypatch, module, command):
