@@ -160,6 +160,31 @@ def test_despike_is_opt_in_and_recorded(tmp_path):
     assert summary["despiked"] == {"k": 6.0, "points": 2}  # the script's 2-pixel spike, and no other point
 
 
+def test_a_scan_s_run_reads_back_with_all_its_input_said(tmp_path):
+    """summary.json's input of a file of several channels, despiked, cropped, downsampled and left
+    with its tilt (a caveat) holds mappings and lists of them: load and predict --from refused
+    such a run as damaged. A value nested deeper than the input summary's is still refused."""
+    import frictionlab
+    from frictionlab.errors import RunFolderError
+
+    four_channel_gwy(tmp_path / "afm.gwy")
+    params = {"unit": "um", "undefined": "harmonic", "despike": 6.0, "detrend": "mean",
+              "region": {"x": [0, 80], "y": [0, 32]}, "downsample": {"factor": 2}}  # fmt: skip
+    surface = SurfaceFile(path=str(tmp_path / "afm.gwy"), **params)
+    result = frictionlab.run(law_preset(tmp_path / "afm.gwy", "mdr", surface, **params), out=tmp_path / "run",
+                             workers=1, progress=False, plot=False)  # fmt: skip
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert {"channels", "despiked", "downsampled", "region_pixels", "caveats"} <= set(summary["input"])
+    again = frictionlab.load(tmp_path / "run")
+    assert again.input == summary["input"] and again.fit.a == result.fit.a and again.caveats == result.caveats
+    given = ["--area", "1", "--modulus", "1", "--rms-height", "0.02", "--force", "0.01", "--json"]
+    assert main(["predict", "--from", str(tmp_path / "run"), *given]) == 0
+    summary["input"]["channels"][0]["points"] = [[160, 64]]  # a list in a list in a mapping: no summary writes it
+    (tmp_path / "run" / "summary.json").write_text(json.dumps(summary))
+    with pytest.raises(RunFolderError, match="summary.json is damaged: field 'input.channels"):
+        frictionlab.load(tmp_path / "run")
+
+
 # ------------------------------------------------------------------ files refused from what they declare
 
 

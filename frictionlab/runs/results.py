@@ -246,6 +246,13 @@ class _Normalisation(Record):
     f: str = ""
 
 
+_InputScalar = str | int | Finite | bool | None
+_InputPart = _InputScalar | list[_InputScalar] | dict[str, _InputScalar | list[_InputScalar]]
+# A value of an input summary (``SpectrumGenerator.input_summary``): a number, text, a flag, or a list or mapping
+# of them one level deep (the file's channels, each a mapping; the crop's spans; despike's k and count; caveats).
+InputValue = _InputScalar | list[_InputPart] | dict[str, _InputPart]
+
+
 class SummaryRecord(Record):
     """What load() and predict --from trust of a summary.json: each value checked."""
 
@@ -262,7 +269,7 @@ class SummaryRecord(Record):
     contact_count_at_last_load: Finite | None = None
     files: dict[str, MemberName] = {}
     # what a measured file gave (shape, pixel size, unit, rms height, where each came from)
-    input: dict[str, str | int | Finite | bool | None | list[int | Finite]] | None = None
+    input: dict[str, InputValue] | None = None
 
 
 def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
