@@ -14,7 +14,6 @@ import sys
 import time
 
 from .errors import counted, shown
-from .options import default_workers
 from .plugin.hookspecs import hookimpl
 from .plugin.listeners import SweepListener, progress_text, solve_text
 
@@ -150,10 +149,9 @@ class ProgressReporter:
             + [f"{run.retried} failed ones retried"] * bool(run.retried)
         )
         restored = f" ({restored})" if restored else ""
-        cores = default_workers()
         crowded = (  # a pool larger than the cores it may use: said, since it is no faster
-            f" on {cores} core(s): they take turns, no faster than {cores}"
-            if run.executor == "processes" and run.workers > cores else ""
+            f" on {run.cores} core(s): they take turns, no faster than {run.cores}"
+            if run.executor == "processes" and 0 < run.cores < run.workers else ""
         )  # fmt: skip
         self._write(
             f"{preset.name}: {run.total} realizations of {run.scene.pressed}{restored}, "

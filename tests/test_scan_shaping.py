@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from frictionlab_spectra import ProfileFile, SurfaceFile
-from frictionlab_spectra.scan_shaping import cosine_resample, despike, level, levelling_warning, spike_warning
+from frictionlab_spectra.scan_shaping import cosine_resample, despike, level, levelling_warning, outlier_warning, spike_warning
 
 
 def band_limited(ny: int, nx: int, seed: int = 0, modes: int = 40, top: float = 0.6) -> tuple[np.ndarray, callable]:
@@ -194,6 +194,84 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
         "loads is theirs; remove them from the profile, if they are not the surface's own"
     ]
     assert "caveats" not in said["smooth"] and "caveats" not in said["low"]
+
+
+@pytest.mark.parametrize("hurst", [0.3, 0.7, 1.0])
+def test_self_affine_surfaces_draw_no_caveat_of_points_far_from_the_rest(registry, hurst):
+    """The surfaces a run makes (power-law-2d, rolloff-2d): none draws the caveat."""
+    from frictionlab.preset.seeds import realization_rng
+
+    for name, rolloff in (("power-law-2d", {}), ("rolloff-2d", {"rolloff_wavelength": 32.0})):
+        generator = registry.get("spectrum", name)(hurst=hurst, points=128, short_cutoff=4.0, spacing=1.0, **rolloff)
+        for index in range(3):
+            z = generator.generate(realization_rng(7, index)).heights
+            assert outlier_warning(z - z.mean(), "map") is None
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+@pytest.mark.parametrize("scale", [1e-9, 1.0, 1e200])
+def test_a_value_written_for_a_missing_pixel_is_said_up_or_down_and_at_any_scale(sign, scale):
+    """One pixel of -9999 (or +9999) in a map of Gaussian heights of rms 1: its rms height is
+    that pixel's. Said whatever the unit (no overflow at 1e200), for a pit as for a peak, with
+    the ratio of the rms height to the robust one (1.4826 median absolute deviations)."""
+    z = np.random.default_rng(3).standard_normal((96, 80))
+    assert outlier_warning(scale * z, "map") is None
+    z[40, 33] = sign * 9999.0
+    said = outlier_warning(scale * z, "map")
+    deviation = np.median(np.abs(z - np.median(z)))
+    ratio = np.sqrt(np.mean(np.square(z))) / (1.4826 * deviation)
+    assert said is not None and said.startswith(f"the map's rms height is {ratio:.3g} times what most of its points say")
+    line = np.random.default_rng(4).standard_normal(500)
+    line[[17, 18, 300]] = sign * 1e4  # three pixels: a few, not only one
+    assert outlier_warning(scale * line, "line").startswith("the line's rms height is ")
+
+
+def test_the_caveat_is_said_past_five_times_the_robust_rms_height_and_not_before():
+    """Its criterion, counted plainly: Gaussian heights with 20 of 2000 points lifted to make
+    the rms height 4.5 or 5.5 times the robust one (which those 20 hardly move)."""
+    z = np.random.default_rng(5).standard_normal(2000)
+    for target, said in ((4.5, False), (5.5, True)):
+        lifted = z.copy()
+        robust = 1.4826 * np.median(np.abs(lifted - np.median(lifted)))
+        # 20 points at height c: the mean square (sum of the rest + 20 c^2) / 2000 = (target robust)^2
+        rest = np.sum(np.square(lifted[20:]))
+        lifted[:20] = np.sqrt(((target * robust) ** 2 * 2000 - rest) / 20)
+        robust = 1.4826 * np.median(np.abs(lifted - np.median(lifted)))  # moved a little by the 20
+        ratio = np.sqrt(np.mean(np.square(lifted))) / robust
+        assert (outlier_warning(lifted, "line") is not None) == (ratio > 5) == said, ratio
+
+
+def test_the_caveat_takes_one_copy_of_the_map():
+    import tracemalloc
+
+    z = np.random.default_rng(6).standard_normal((512, 512))
+    tracemalloc.start()
+    try:
+        outlier_warning(z, "map")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1.2 * z.nbytes
+
+
+def test_a_file_with_a_missing_pixels_value_says_its_rms_height_is_that_pixels(tmp_path):
+    z, _ = band_limited(40, 48, seed=6, top=0.2)
+    np.save(tmp_path / "clean.npy", z)
+    z[3, 5] = -9999.0
+    np.save(tmp_path / "sentinel.npy", z)
+    line = np.sin(np.arange(300) / 5.0)
+    np.save(tmp_path / "clean-line.npy", line)
+    line[[30, 31]] = 1e38  # another instrument's sentinel
+    np.save(tmp_path / "sentinel-line.npy", line)
+
+    def caveats(reader, name):
+        return reader(path=str(tmp_path / name), spacing=0.5).input_summary().get("caveats", [])
+
+    for reader, what in ((SurfaceFile, "map"), (ProfileFile, "line")):
+        stem = "" if what == "map" else "-line"
+        assert not any("rms height is" in caveat for caveat in caveats(reader, f"clean{stem}.npy"))
+        assert any(caveat.startswith(f"the {what}'s rms height is ") and "f's unit E* h L, theirs" in caveat
+                   for caveat in caveats(reader, f"sentinel{stem}.npy"))  # fmt: skip
 
 
 def test_region_and_downsample_in_the_summary(tmp_path):

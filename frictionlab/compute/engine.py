@@ -21,7 +21,7 @@ from ..errors import RunError
 from .executors import make_executor, plan_chunks, sized_executor
 from ..plugin.hookspecs import PROJECT_NAME
 from ..plugin.listeners import RunListener
-from ..options import RunOptions
+from ..options import RunOptions, default_workers
 from ..preset import Scene
 from .realization import RealizationResult, SolveListeners, compute_chunk_here
 from .signals import CancelOnSignals
@@ -38,6 +38,7 @@ class RunInfo:
     workers: int
     executor: str = "serial"
     resumed: int = 0  # realizations restored from the run directory, not recomputed
+    cores: int = 0  # the cores this process may use where the run started; 0: not known (a run replayed from its log)
     retried: int = 0  # realizations that had failed before the resume and run again
     # the restored results themselves (by index): a listener's running sums start from them
     restored: tuple[RealizationResult, ...] = field(default=(), repr=False)
@@ -97,6 +98,7 @@ def run(
     todo = [i for i in range(total) if i not in accumulator.results]
     info = RunInfo(
         scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried,
+        cores=default_workers(),
         restored=tuple(accumulator.results[i] for i in sorted(accumulator.results)),
     )  # fmt: skip
     from ..plugin.registry import default_registry

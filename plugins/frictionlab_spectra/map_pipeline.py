@@ -24,7 +24,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from . import instrument_reader
-from .scan_shaping import cosine_resample, despike, level, levelling_warning, resampled_points, spike_warning
+from .scan_shaping import (cosine_resample, despike, level, levelling_warning, outlier_warning, resampled_points,
+                           spike_warning)
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 FileFormat = Literal["auto", "table", "instrument"]
@@ -142,6 +143,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if (warning := levelling_warning(levelled, mode)) is not None:
         caveats.append(warning)
     if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after)) is not None:
+        caveats.append(warning)
+    if (warning := outlier_warning(levelled.heights, "map")) is not None:
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel

@@ -203,6 +203,42 @@ def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
             "not the surface's own")  # fmt: skip
 
 
+OUTLIER_RATIO = 5.0  # rms height over the robust one: Gaussian heights 1, a sine's 0.67, a map with a sentinel 100s
+OUTLIER_MIN_POINTS = 64  # fewer, and the median says too little
+MAD_TO_SIGMA = 1.4826  # the median absolute deviation of Gaussian heights times this is their rms height
+
+
+def outlier_warning(z: np.ndarray, what: str) -> str | None:
+    """The caveat of a levelled map or line (``what``) whose rms height is more than
+    OUTLIER_RATIO times its robust one (MAD_TO_SIGMA times the median distance from the median,
+    which a few points cannot move): a value an instrument writes for a missing pixel (-9999,
+    1e38), spikes down as much as up, scratches. The rms height h, and with it f's unit E* h L,
+    are then theirs. ``spike_warning`` looks only at the points that touch first, and measures
+    them in the rms height these points inflate. Takes one copy of the map."""
+    if z.size < OUTLIER_MIN_POINTS:
+        return None
+    values = np.array(z, dtype=np.float64).ravel()
+    largest = max(float(values.max()), -float(values.min()))  # no temporary |values|
+    if not 0 < largest < math.inf:
+        return None
+    values /= largest  # no overflow from heights of 1e200
+    rms = math.sqrt(float(np.dot(values, values)) / values.size)
+    middle = values.size // 2
+    values.partition(middle)
+    np.subtract(values, values[middle], out=values)
+    np.abs(values, out=values)
+    values.partition(middle)
+    robust = MAD_TO_SIGMA * float(values[middle])
+    if rms <= OUTLIER_RATIO * robust:
+        return None
+    ratio = f"{rms / robust:.3g} times" if robust > 0 else "infinitely"
+    return (f"the {what}'s rms height is {ratio} what most of its points say ({MAD_TO_SIGMA} times their median "
+            "distance from the median, the rms height of Gaussian heights): a few points far from the rest make the "
+            "rms height h, and with it f's unit E* h L, theirs. A value written for a missing pixel, spikes or "
+            "scratches: remove them (despike, region) or mark them undefined in the file, if they are not the "
+            "surface's own")  # fmt: skip
+
+
 def _spikes(z: np.ndarray, rms: float) -> int:
     """How many of the SPIKE_LOOKED_AT highest points of ``z`` (above 3 ``rms``) stand more than
     SPIKE_K ``rms`` above the median of the SPIKE_WINDOW x SPIKE_WINDOW pixels around them."""

@@ -103,9 +103,7 @@ def test_the_first_line_counts_the_workers_that_run_not_those_asked_for(make_sce
 
 
 def test_more_workers_than_cores_are_said_to_take_turns(make_scene, monkeypatch):
-    import frictionlab.progress as progress
-
-    monkeypatch.setattr(progress, "default_workers", lambda: 1)  # a machine of one core
+    monkeypatch.setattr(engine, "default_workers", lambda: 1)  # a machine of one core
     stream = FakeTerminal()
     engine.run(make_scene({"realizations": 4}), RunOptions(workers=2, executor="processes"),
                listeners=[ProgressReporter(stream, after=0)])  # fmt: skip
@@ -115,3 +113,13 @@ def test_more_workers_than_cores_are_said_to_take_turns(make_scene, monkeypatch)
     engine.run(make_scene({"realizations": 4}), RunOptions(workers=1, executor="processes"),
                listeners=[ProgressReporter(stream, after=0)])  # fmt: skip
     assert stream.getvalue().splitlines()[0].endswith(", 1 worker(s)")
+
+
+def test_a_run_replayed_from_its_log_does_not_guess_the_cores_it_ran_on(make_scene):
+    """A run followed from its progress log (``frictionlab follow``, maybe copied from another
+    machine) says its workers, never this machine's cores beside them."""
+    from frictionlab.compute.engine import RunInfo
+
+    stream = FakeTerminal()
+    ProgressReporter(stream, after=0).run_started(RunInfo(scene=make_scene({}), total=4, workers=64, executor="processes"))
+    assert stream.getvalue().splitlines()[0].endswith(", 64 worker(s)")

@@ -52,6 +52,21 @@ async def test_space_taking_the_only_run_off_the_plot_says_it_is_hidden_not_that
     assert " ".join(info.split()) == f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run."
     assert not plotted_while_hidden and plotted_again
 
+@pytest.mark.long  # a TUI session
+@sync
+async def test_the_results_plot_before_any_run_is_opened_says_none_is_open(folders, registry):
+    """The Results tab's plot said "no data yet" beside a list of finished runs: it says
+    no run is open (the hint below says how to open one), until Enter opens one."""
+    app = runs_app(folders, registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5")
+        first = screen_text(app)
+        await press_settled(pilot, "enter")
+        opened = screen_text(app)
+    assert "no data yet" not in first and "no run open" in first and "Enter opens a run" in first
+    assert "no run open" not in opened
+
+
 async def wheel_read(pilot, region, turns: int = 12) -> list[str]:
     """What the screen shows within ``region`` as the mouse wheel turns down over its bottom
     row, ``turns`` steps, as a terminal sends it (the widget there scrolls, if it can): each

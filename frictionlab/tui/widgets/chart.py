@@ -13,10 +13,10 @@ class Chart(Widget):
 
     DEFAULT_CSS = "Chart { height: 1fr; min-height: 6; }"
 
-    def __init__(self, **kwargs):
+    def __init__(self, empty: str = NO_DATA, **kwargs):
         super().__init__(**kwargs)
         self.series: list[Series] = []
-        self.empty = NO_DATA  # what it says with no point to plot
+        self.empty = empty  # what it says with no point to plot
 
     def show(self, series: list[Series], empty: str = NO_DATA) -> None:
         self.series, self.empty = series, empty

@@ -30,6 +30,7 @@ from .tables import ListTable
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
 HINT = "Enter opens a run; Space adds it to the overlay."
+NO_RUN_OPEN = "no run open"
 NO_RUNS = "No runs yet: Ctrl+R runs the open preset (F2 lists the presets)."
 FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of the list's width
 # the list's width: its share of the pane, at least LIST_MIN; the plot keeps CHART_MIN
@@ -60,7 +61,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         with Horizontal(id="results-top"):
             yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True, empty=NO_RUNS)
             with Vertical(id="results-body"):
-                yield Chart(id="results-chart")
+                yield Chart(empty=NO_RUN_OPEN, id="results-chart")  # not "no data yet": the runs have theirs
                 with VerticalScroll(id="results-info-box", can_focus=False):  # at 60x20 a run's lines need 9 rows
                     yield Static(HINT, id="results-info")
         yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
