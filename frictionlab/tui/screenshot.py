@@ -3,7 +3,8 @@
     python -m frictionlab.tui.screenshot docs/tui/main.svg [--preset presets/quickstart.yaml] [--size 80x24]
 
 The app runs headless (Textual's test driver) on the given preset, opens it in
-the Edit tab with the cursor still, and writes what the terminal would show.
+the Edit tab with the cursor still, and writes what the terminal would show. The
+preset is by default a clone's presets/quickstart.yaml, elsewhere the built-in quickstart.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ from __future__ import annotations
 import argparse
 import asyncio
 from pathlib import Path
+
+CLONE_PRESET = Path("presets/quickstart.yaml")  # what the docs' screenshot shows, made in a clone
 
 
 async def take(out: Path, preset: Path, size: tuple[int, int]) -> None:
@@ -28,16 +31,32 @@ async def take(out: Path, preset: Path, size: tuple[int, int]) -> None:
         out.write_text(app.export_screenshot(), encoding="utf-8")
 
 
+def terminal_size(text: str) -> tuple[int, int]:
+    """``COLUMNSxLINES`` as two whole numbers, in what a terminal has."""
+    try:
+        columns, lines = (int(n) for n in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be COLUMNSxLINES, such as 80x24. Got {text!r} instead.") from None
+    if not (20 <= columns <= 1000 and 5 <= lines <= 500):
+        raise argparse.ArgumentTypeError(f"must be 20 to 1000 columns by 5 to 500 lines. Got {text!r} instead.")
+    return columns, lines
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m frictionlab.tui.screenshot", description=__doc__.splitlines()[0])
     parser.add_argument("out", type=Path, help="the SVG file to write")
-    parser.add_argument("--preset", type=Path, default=Path("presets/quickstart.yaml"), help="the preset to open")
-    parser.add_argument("--size", default="80x24", help="terminal columns x lines (default 80x24)")
+    parser.add_argument("--preset", type=Path, help="the preset to open (default: presets/quickstart.yaml, in a clone; "
+                                                    "elsewhere the built-in quickstart)")  # fmt: skip
+    parser.add_argument("--size", type=terminal_size, default=(80, 24), help="terminal columns x lines (default 80x24)")
     args = parser.parse_args(argv)
-    columns, lines = (int(n) for n in args.size.lower().split("x"))
-    if not args.preset.is_file():
-        parser.error(f"--preset: no such file {args.preset}")
-    asyncio.run(take(args.out, args.preset, (columns, lines)))
+    preset = args.preset
+    if preset is None:
+        from ..preset.builtin import find_builtin
+
+        preset = CLONE_PRESET if CLONE_PRESET.is_file() else find_builtin("quickstart").path
+    if not preset.is_file():
+        parser.error(f"--preset: no such file {preset}")
+    asyncio.run(take(args.out, preset, args.size))
     print(f"wrote {args.out}")
     return 0
 

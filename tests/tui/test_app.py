@@ -133,6 +133,25 @@ def test_the_docs_screenshot_is_made_by_its_command(tmp_path, monkeypatch):
     assert (ROOT / "docs" / "tui" / "main.svg").read_text().startswith("<svg")
 
 
+@pytest.mark.parametrize("size", ["80", "80x", "wide", "8x24", "80x2", "80x24x3"])
+def test_a_screenshot_size_that_is_no_terminal_is_refused_by_name(size, capsys):
+    from frictionlab.tui.screenshot import main as screenshot
+
+    with pytest.raises(SystemExit) as exit_:
+        screenshot(["out.svg", "--size", size])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and "--size: " in err and repr(size) in err and "Traceback" not in err
+
+
+@pytest.mark.long  # a TUI session drawn to SVG
+def test_a_screenshot_outside_a_clone_opens_the_built_in_quickstart(tmp_path, monkeypatch):
+    from frictionlab.tui.screenshot import main as screenshot
+
+    monkeypatch.chdir(tmp_path)  # no presets/ here
+    assert screenshot([str(tmp_path / "main.svg"), "--size", "60x20"]) == 0
+    assert "quickstart" in (tmp_path / "main.svg").read_text()
+
+
 def test_the_tui_without_a_terminal_says_so_and_exits_2(tmp_path):
     done = subprocess.run([sys.executable, "-m", "frictionlab", "tui"], stdin=subprocess.DEVNULL, capture_output=True,
                           text=True, cwd=tmp_path, timeout=60)  # fmt: skip
