@@ -229,6 +229,8 @@ def npy_shape(path: Path, where: str) -> tuple[int, ...] | None:
 def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
     """The shape and dtype a .npy header announces (a file may announce more than it holds),
     and where its data starts."""
+    if _header_overrun(fh) is not None:  # numpy would first read the length it declares into one buffer
+        return None
     fh.seek(0)
     try:
         version = np.lib.format.read_magic(fh)
@@ -237,6 +239,29 @@ def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
     except Exception:  # noqa: BLE001 - not a header numpy reads
         return None
     return tuple(int(n) for n in shape), dtype, fh.tell()
+
+
+_LENGTH_FIELD = {1: 2, 2: 4, 3: 4}  # bytes of a .npy header's length field, by the format's major version
+
+
+def _header_overrun(fh) -> str | None:
+    """What is wrong with a .npy file whose header declares itself longer than the file (numpy
+    reads that many bytes into one buffer before it looks at them: up to 4 GiB for a forged file
+    of 20 bytes, refused as memory under ulimit -v), or None. ``fh`` is left at its start."""
+    fh.seek(0)
+    try:
+        major, _ = np.lib.format.read_magic(fh)
+    except Exception:  # noqa: BLE001 - not a .npy file: np.load names it
+        major = None
+    field = fh.read(_LENGTH_FIELD[major]) if major in _LENGTH_FIELD else b""
+    fh.seek(0)
+    if not field or len(field) != _LENGTH_FIELD[major]:  # another version, or a file cut short: np.load names it
+        return None
+    start = 8 + len(field)  # the magic string (6 bytes), the version (2), the length field
+    declared, held = int.from_bytes(field, "little"), os.fstat(fh.fileno()).st_size - start
+    if declared <= held:
+        return None
+    return f"its header declares a length of {declared:,} bytes, but the file holds {max(held, 0):,} bytes after it"
 
 
 def _npy_bytes(header: tuple[tuple[int, ...], np.dtype, int]) -> int:
@@ -254,6 +279,8 @@ def _check_npy_size(fh, where: str) -> None:
     if head.startswith(b"PK"):
         raise ValueError(f"{where}: an .npz archive (arrays zipped together), not a .npy array; save the "
                          "heights alone with numpy.save")  # fmt: skip
+    if (overrun := _header_overrun(fh)) is not None:
+        raise ValueError(f"{where}: a damaged .npy file: {overrun}; save the array again")
     header = _npy_header(fh)
     fh.seek(0)
     if header is None or header[1].hasobject:  # np.load names it
