@@ -439,3 +439,23 @@ def test_a_whole_number_past_double_precision_in_a_plugins_field_is_named_not_an
     data = merge(data, {slot: {params: {name: huge}}})
     with pytest.raises(PresetError, match=rf"{field}: must be between 1e-100 and 1e\+100, got"):
         frictionlab.validate(data)
+
+
+@pytest.mark.parametrize(("assignment", "said"), [
+    ("realizations=1e30", "realizations: must be <= 10000000, got 1e+30"),
+    ("fit.bootstrap=2e19", "fit.bootstrap: must be <= 100000, got 2e+19"),
+    ("sweep.parameters.seed={start: 1, stop: 5, num: 1e19}", "sweep.parameters.seed.num: must be <= 100000, got 1e+19"),
+    ("seed=1e19", "seed: must be a whole number, written in digits (one this large, written with an exponent, "
+                  "is a float), got 1e+19"),
+    ("spectrum.params.points=1e20", "spectrum.params.points: must be a whole number, written in digits"),
+])  # fmt: skip
+def test_a_whole_number_field_given_a_float_past_2_to_the_63_is_told_its_bound(tmp_path, capsys, assignment, said):
+    """A whole float too large for pydantic to make an integer of (1e19 and up) was 'unable to
+    parse input string as an integer, exceeded maximum size': a number called text, and no word
+    of what the field takes. The field's upper bound is said where it has one (a sweep's num
+    too), and where it has none, to write the number in digits."""
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    assert main(["validate", str(path), "--set", assignment]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert said in err and "input string" not in err
