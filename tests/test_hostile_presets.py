@@ -459,3 +459,20 @@ def test_a_whole_number_field_given_a_float_past_2_to_the_63_is_told_its_bound(t
     assert main(["validate", str(path), "--set", assignment]) == ExitCode.USAGE
     err = capsys.readouterr().err
     assert said in err and "input string" not in err
+
+
+def test_a_sweep_range_past_double_precision_is_named_without_numpy_warnings(tmp_path, capsys):
+    """A range from -1e308 to 1e308 (stop - start overflows) printed numpy's 'warning: overflow
+    encountered in subtract' and 'invalid value encountered in multiply' before the problems,
+    as the points were made to look for repeats; the two ends are refused by name, quietly."""
+    import warnings
+
+    path = tmp_path / "p.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"loading.stop": {"start": -1e308, "stop": 1e308, "num": 3}}}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a warning is a failure here, as it is a line on the user's screen
+        assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "warning" not in err
+    assert "sweep.parameters.loading.stop.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got -1e+308" in err
+    assert "sweep.parameters.loading.stop.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+308" in err
