@@ -153,6 +153,25 @@ def test_a_header_over_a_matrix_of_commas_is_skipped(tmp_path):
     np.testing.assert_allclose(read, z, rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("bad", ["x", "", "1.2.3"])
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_first_row_of_heights_with_a_bad_cell_is_refused_not_skipped_as_a_header(tmp_path, bad, plugin):
+    """A first line that was not all numbers was taken for a header and dropped without a word:
+    a map of 12 rows whose first held one cell 'x' (or an empty cell) was read as 11 rows, the
+    first row of heights lost; a profile given as one row of heights was 'a table of no numbers'.
+    A line more numbers than text is a row of data: refused by its line, as any later row with
+    such a cell is. A header (more text than numbers) is skipped still."""
+    z = rough(12, 10, 8) if plugin is SurfaceFile else rough(1, 40, 8)
+    rows = matrix_text(z).splitlines()
+    rows[0] = ",".join([*rows[0].split(",")[:3], bad, *rows[0].split(",")[4:]])
+    (tmp_path / "bad.csv").write_text("\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=r"non-numeric content at line 1 \(expected numbers separated by commas\)"):
+        plugin(path=str(tmp_path / "bad.csv"), spacing=0.1).rms_height()
+    for header in ("x,z\n", "z [nm]\n", "Height 1\n"):
+        (tmp_path / "h.csv").write_text(header + matrix_text(z))
+        assert plugin(path=str(tmp_path / "h.csv"), spacing=0.1).generate(None).heights.size == z.size
+
+
 @pytest.mark.parametrize("separator", [";", "\t"])
 def test_decimal_commas_are_named(tmp_path, separator):
     (tmp_path / "d.csv").write_text(matrix_text(rough(9, 8, 7), separator, decimal=","))

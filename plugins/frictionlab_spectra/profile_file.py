@@ -4,8 +4,8 @@ The file holds heights on a uniform grid, optionally with their x positions:
 
 - ``.csv`` / ``.txt``: one column (heights), one row of heights, or two columns
   (x, z), separated by commas, semicolons or whitespace (a UTF-8 byte-order mark is
-  skipped); lines starting with ``#`` are comments and one non-numeric header line
-  (e.g. ``x,z``) before the data is skipped.
+  skipped); lines starting with ``#`` are comments and one header line before the data
+  (e.g. ``x,z``: more of its cells text than numbers) is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z;
 - any other file: an instrument's line scan (X3P, SUR, NetCDF...) read by the optional
   extra ``topography`` (``instrument_file.py``), with its own spacing and unit, converted
@@ -311,8 +311,8 @@ def _numbers(text: str, delimiter: str | None) -> bool:
 
 
 def read_text_table(path: Path, where: str) -> np.ndarray:
-    """Rows x columns of float64; one non-numeric header line is skipped. A
-    problem names the line, never its content."""
+    """Rows x columns of float64; one header line (more of its cells text than numbers) is
+    skipped. A problem names the line, never its content."""
     with open_input(path, where) as fh:
         raw = fh.read()
     try:
@@ -335,6 +335,8 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
             break
         if _ends_with_separator(text, delimiter):  # numbers and an empty column: no header
             raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
+        if _mostly_numbers(text, delimiter):  # a row of heights with a cell that is not one: named below
+            break
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     try:
         with warnings.catch_warnings():
@@ -367,6 +369,22 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _mostly_numbers(text: str, delimiter: str | None) -> bool:
+    """Whether more of the line's cells are numbers than not: a row of data with a bad cell
+    (``0.1,x,0.3``, ``0.1,,0.3``), which is no header (``x,z``; ``z [nm]``; ``Height 1``)."""
+    cells = text.split(delimiter)
+    numbers = sum(_number(cell) for cell in cells)
+    return numbers > len(cells) - numbers
+
+
+def _number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
 
 
 def _ends_with_separator(text: str, delimiter: str | None) -> bool:
