@@ -677,6 +677,8 @@ def _cut_short(path, z):
                  "file holds BYTES-8 bytes after it"),
     (lambda path, z: np.save(path, (z * 1000).astype("timedelta64[s]")),
      "non-numeric content (array dtype timedelta64[s]); expected real numbers"),
+    (lambda path, z: np.save(path, z.astype(object), allow_pickle=True),  # was 'not a readable .npy array (ValueError)'
+     "an array of Python objects (dtype object), which is never unpickled (that could run code); expected real numbers"),
 ])  # fmt: skip
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
 def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_path, write, said, plugin):

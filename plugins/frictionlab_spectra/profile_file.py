@@ -283,7 +283,10 @@ def _check_npy_size(fh, where: str) -> None:
         raise ValueError(f"{where}: a damaged .npy file: {overrun}; save the array again")
     header = _npy_header(fh)
     fh.seek(0)
-    if header is None or header[1].hasobject:  # np.load names it
+    if header is not None and header[1].hasobject:  # pickled: np.load refuses it without a word of why
+        raise ValueError(f"{where}: an array of Python objects (dtype {header[1]}), which is never unpickled (that "
+                         "could run code); expected real numbers: save the heights as a float array")  # fmt: skip
+    if header is None:  # np.load names it
         return
     held, declared = os.fstat(fh.fileno()).st_size - header[2], _npy_bytes(header)
     if held != declared:
