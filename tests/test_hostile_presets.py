@@ -476,3 +476,16 @@ def test_a_sweep_range_past_double_precision_is_named_without_numpy_warnings(tmp
     assert "warning" not in err
     assert "sweep.parameters.loading.stop.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got -1e+308" in err
     assert "sweep.parameters.loading.stop.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+308" in err
+
+
+@pytest.mark.parametrize(("path", "value"), [("seed", 10**4000), ("name", "a" * 3000)])
+def test_a_sweep_point_refused_names_its_long_value_cut_short(tmp_path, capsys, path, value):
+    """A refused sweep point's label quoted its swept value whole: a seed of 4000 digits (or a
+    name of 3000 letters) made a problem line of over 4000 characters, though the value after
+    'got' was cut short. The label cuts it too; the point's number and path stay."""
+    path_file = tmp_path / "p.yaml"
+    path_file.write_text(preset_text(sweep={"parameters": {path: {"values": [value, 1 if path == "seed" else "b"]}}}))
+    assert main(["validate", str(path_file)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"sweep point 1 ({path}=" in err
+    assert max(map(len, err.splitlines())) < 500
