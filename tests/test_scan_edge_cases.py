@@ -718,3 +718,35 @@ def test_a_table_with_nan_under_undefined_harmonic_is_told_the_filling_is_an_ins
     with pytest.raises(ValueError) as not_asked:
         plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
     assert "harmonic" not in str(not_asked.value)
+
+
+# ------------------------------------------------------------ a table too large to read
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_table_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch, plugin):
+    """A table has no header that gives its size, and was read whole: a 1 TB .csv (sparse) under
+    ulimit -v ended `frictionlab validate` with 'out of memory; ask for fewer points,
+    realizations or workers', the file unnamed and the advice wrong, and without a limit tried
+    to read a terabyte. Now refused by its size before it is read when it cannot fit (at least
+    three times its bytes), and named if it runs out while being read."""
+    import frictionlab_spectra.profile_file as tables
+
+    z = rough(12, 10, 9) if plugin is SurfaceFile else rough(1, 40, 9)
+    (tmp_path / "map.csv").write_text(matrix_text(z))
+    size = (tmp_path / "map.csv").stat().st_size
+    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size - 1, "the room in this test"), raising=False)
+    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it takes at least .* GiB, more than the "
+                                         r".* GiB this process may use \(the room in this test\): save the heights as a "
+                                         r"\.npy array"):
+        plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size, "the room in this test"), raising=False)
+    assert plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height() > 0  # room for three copies: read
+
+    def out_of_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(np, "loadtxt", out_of_memory)
+    (tmp_path / "again.csv").write_text(matrix_text(z))  # another file: the first one's heights are cached
+    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it ran out of memory: save the heights"):
+        plugin(path=str(tmp_path / "again.csv"), spacing=0.1).rms_height()

@@ -38,6 +38,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
+from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .scan_shaping import level_line, line_form_warning, line_spike_warning
@@ -313,11 +314,32 @@ def _numbers(text: str, delimiter: str | None) -> bool:
     return True
 
 
+TABLE_COPIES = 3  # reading a table takes at least 3 times its bytes (its bytes, text, lines and numbers: 3 to 6 measured)
+
+
 def read_text_table(path: Path, where: str) -> np.ndarray:
     """Rows x columns of float64; one header line (more of its cells text than numbers) is
-    skipped. A problem names the line, never its content."""
+    skipped. A problem names the line, never its content. A table has no header that gives its
+    size: one that cannot be read in the memory left is refused by its size, before or while read."""
     with open_input(path, where) as fh:
-        raw = fh.read()
+        size = os.fstat(fh.fileno()).st_size
+        room, source = room_to_read()
+        if size * TABLE_COPIES > room:
+            raise ValueError(_too_large_table(where, size, f"reading it takes at least {size * TABLE_COPIES / 2**30:.3g} "
+                                              f"GiB, more than the {room / 2**30:.3g} GiB this process may use ({source})"))
+        try:
+            return _table(fh.read(), where)
+        except MemoryError:
+            raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
+
+
+def _too_large_table(where: str, size: int, why: str) -> str:
+    return (f"{where}: a table of {size:,} bytes; {why}: save the heights as a .npy array (8 bytes a height, its "
+            "size checked before it is read), or crop the scan before saving it")
+
+
+def _table(raw: bytes, where: str) -> np.ndarray:
+    """The numbers of a table's bytes ``raw`` (``read_text_table``)."""
     try:
         lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
