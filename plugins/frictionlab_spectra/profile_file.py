@@ -243,6 +243,7 @@ def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
 
 
 _LENGTH_FIELD = {1: 2, 2: 4, 3: 4}  # bytes of a .npy header's length field, by the format's major version
+LENGTH_FIELD_BYTES = 4  # the longest of them
 
 
 def _header_overrun(fh) -> str | None:
@@ -254,7 +255,7 @@ def _header_overrun(fh) -> str | None:
         major, _ = np.lib.format.read_magic(fh)
     except Exception:  # noqa: BLE001 - not a .npy file: np.load names it
         major = None
-    field = fh.read(_LENGTH_FIELD[major]) if major in _LENGTH_FIELD else b""
+    field = fh.read(LENGTH_FIELD_BYTES)[: _LENGTH_FIELD[major]] if major in _LENGTH_FIELD else b""
     fh.seek(0)
     if not field or len(field) != _LENGTH_FIELD[major]:  # another version, or a file cut short: np.load names it
         return None
