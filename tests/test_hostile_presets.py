@@ -439,3 +439,53 @@ def test_a_whole_number_past_double_precision_in_a_plugins_field_is_named_not_an
     data = merge(data, {slot: {params: {name: huge}}})
     with pytest.raises(PresetError, match=rf"{field}: must be between 1e-100 and 1e\+100, got"):
         frictionlab.validate(data)
+
+
+@pytest.mark.parametrize(("assignment", "said"), [
+    ("realizations=1e30", "realizations: must be <= 10000000, got 1e+30"),
+    ("fit.bootstrap=2e19", "fit.bootstrap: must be <= 100000, got 2e+19"),
+    ("sweep.parameters.seed={start: 1, stop: 5, num: 1e19}", "sweep.parameters.seed.num: must be <= 100000, got 1e+19"),
+    ("seed=1e19", "seed: must be a whole number, written in digits (one this large, written with an exponent, "
+                  "is a float), got 1e+19"),
+    ("spectrum.params.points=1e20", "spectrum.params.points: must be a whole number, written in digits"),
+])  # fmt: skip
+def test_a_whole_number_field_given_a_float_past_2_to_the_63_is_told_its_bound(tmp_path, capsys, assignment, said):
+    """A whole float too large for pydantic to make an integer of (1e19 and up) was 'unable to
+    parse input string as an integer, exceeded maximum size': a number called text, and no word
+    of what the field takes. The field's upper bound is said where it has one (a sweep's num
+    too), and where it has none, to write the number in digits."""
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE)
+    assert main(["validate", str(path), "--set", assignment]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert said in err and "input string" not in err
+
+
+def test_a_sweep_range_past_double_precision_is_named_without_numpy_warnings(tmp_path, capsys):
+    """A range from -1e308 to 1e308 (stop - start overflows) printed numpy's 'warning: overflow
+    encountered in subtract' and 'invalid value encountered in multiply' before the problems,
+    as the points were made to look for repeats; the two ends are refused by name, quietly."""
+    import warnings
+
+    path = tmp_path / "p.yaml"
+    path.write_text(preset_text(sweep={"parameters": {"loading.stop": {"start": -1e308, "stop": 1e308, "num": 3}}}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a warning is a failure here, as it is a line on the user's screen
+        assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "warning" not in err
+    assert "sweep.parameters.loading.stop.start: must be 0 or between 1e-100 and 1e+100 in magnitude, got -1e+308" in err
+    assert "sweep.parameters.loading.stop.stop: must be 0 or between 1e-100 and 1e+100 in magnitude, got 1e+308" in err
+
+
+@pytest.mark.parametrize(("path", "value"), [("seed", 10**4000), ("name", "a" * 3000)])
+def test_a_sweep_point_refused_names_its_long_value_cut_short(tmp_path, capsys, path, value):
+    """A refused sweep point's label quoted its swept value whole: a seed of 4000 digits (or a
+    name of 3000 letters) made a problem line of over 4000 characters, though the value after
+    'got' was cut short. The label cuts it too; the point's number and path stay."""
+    path_file = tmp_path / "p.yaml"
+    path_file.write_text(preset_text(sweep={"parameters": {path: {"values": [value, 1 if path == "seed" else "b"]}}}))
+    assert main(["validate", str(path_file)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"sweep point 1 ({path}=" in err
+    assert max(map(len, err.splitlines())) < 500

@@ -333,6 +333,8 @@ def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
         (lambda d: {**d, "chunks": ["a"]}, "chunks is not a mapping"),
         (lambda d: {**d, "chunks": {"00000000-00000005.npz": 5}}, "chunks is not a mapping"),
         (lambda d: {**d, "status": 5}, "status is not a word"),
+        (lambda d: {**d, "format": "2"}, "format is not a whole number, but a string"),  # was: every chunk
+        (lambda d: {**d, "format": 2.0}, "format is not a whole number, but a number"),  # ignored and computed again
         (lambda d: {**d, "preset": "x"}, "preset is not a mapping"),
         (lambda d: {**d, "inputs": [1]}, "inputs is not a mapping"),
         (lambda d: "[" * 100_000 + "]" * 100_000, "nested too deep"),

@@ -153,6 +153,25 @@ def test_a_header_over_a_matrix_of_commas_is_skipped(tmp_path):
     np.testing.assert_allclose(read, z, rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("bad", ["x", "", "1.2.3"])
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_first_row_of_heights_with_a_bad_cell_is_refused_not_skipped_as_a_header(tmp_path, bad, plugin):
+    """A first line that was not all numbers was taken for a header and dropped without a word:
+    a map of 12 rows whose first held one cell 'x' (or an empty cell) was read as 11 rows, the
+    first row of heights lost; a profile given as one row of heights was 'a table of no numbers'.
+    A line more numbers than text is a row of data: refused by its line, as any later row with
+    such a cell is. A header (more text than numbers) is skipped still."""
+    z = rough(12, 10, 8) if plugin is SurfaceFile else rough(1, 40, 8)
+    rows = matrix_text(z).splitlines()
+    rows[0] = ",".join([*rows[0].split(",")[:3], bad, *rows[0].split(",")[4:]])
+    (tmp_path / "bad.csv").write_text("\n".join(rows) + "\n")
+    with pytest.raises(ValueError, match=r"non-numeric content at line 1 \(expected numbers separated by commas\)"):
+        plugin(path=str(tmp_path / "bad.csv"), spacing=0.1).rms_height()
+    for header in ("x,z\n", "z [nm]\n", "Height 1\n"):
+        (tmp_path / "h.csv").write_text(header + matrix_text(z))
+        assert plugin(path=str(tmp_path / "h.csv"), spacing=0.1).generate(None).heights.size == z.size
+
+
 @pytest.mark.parametrize("separator", [";", "\t"])
 def test_decimal_commas_are_named(tmp_path, separator):
     (tmp_path / "d.csv").write_text(matrix_text(rough(9, 8, 7), separator, decimal=","))
@@ -658,6 +677,8 @@ def _cut_short(path, z):
                  "file holds BYTES-8 bytes after it"),
     (lambda path, z: np.save(path, (z * 1000).astype("timedelta64[s]")),
      "non-numeric content (array dtype timedelta64[s]); expected real numbers"),
+    (lambda path, z: np.save(path, z.astype(object), allow_pickle=True),  # was 'not a readable .npy array (ValueError)'
+     "an array of Python objects (dtype object), which is never unpickled (that could run code); expected real numbers"),
 ])  # fmt: skip
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
 def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_path, write, said, plugin):
@@ -697,3 +718,35 @@ def test_a_table_with_nan_under_undefined_harmonic_is_told_the_filling_is_an_ins
     with pytest.raises(ValueError) as not_asked:
         plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
     assert "harmonic" not in str(not_asked.value)
+
+
+# ------------------------------------------------------------ a table too large to read
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_table_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch, plugin):
+    """A table has no header that gives its size, and was read whole: a 1 TB .csv (sparse) under
+    ulimit -v ended `frictionlab validate` with 'out of memory; ask for fewer points,
+    realizations or workers', the file unnamed and the advice wrong, and without a limit tried
+    to read a terabyte. Now refused by its size before it is read when it cannot fit (at least
+    three times its bytes), and named if it runs out while being read."""
+    import frictionlab_spectra.profile_file as tables
+
+    z = rough(12, 10, 9) if plugin is SurfaceFile else rough(1, 40, 9)
+    (tmp_path / "map.csv").write_text(matrix_text(z))
+    size = (tmp_path / "map.csv").stat().st_size
+    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size - 1, "the room in this test"), raising=False)
+    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it takes at least .* GiB, more than the "
+                                         r".* GiB this process may use \(the room in this test\): save the heights as a "
+                                         r"\.npy array"):
+        plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size, "the room in this test"), raising=False)
+    assert plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height() > 0  # room for three copies: read
+
+    def out_of_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(np, "loadtxt", out_of_memory)
+    (tmp_path / "again.csv").write_text(matrix_text(z))  # another file: the first one's heights are cached
+    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it ran out of memory: save the heights"):
+        plugin(path=str(tmp_path / "again.csv"), spacing=0.1).rms_height()

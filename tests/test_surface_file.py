@@ -8,6 +8,7 @@ the test's own FFTs, the exponent -2H-2 of a power-law map.
 from __future__ import annotations
 
 import math
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode, PresetError
 from frictionlab.preset import build_scene, load_scene
 from frictionlab.testing import check_plugin
-from frictionlab_spectra import PowerLawSurface, SurfaceFile
+from frictionlab_spectra import PowerLawSurface, ProfileFile, SurfaceFile
 from frictionlab_spectra.equivalent_line import EquivalentLine
 from frictionlab.options import RunOptions
 
@@ -231,6 +232,26 @@ def test_a_npy_whose_header_asks_for_more_than_it_holds_is_refused_with_its_size
     with pytest.raises(ValueError, match=r"a damaged .npy file: its header declares an array of shape \(8388608, 4194304\) "
                                          r"of float64 \(281,474,976,710,656 bytes\), but the file holds 64 bytes after it"):
         SurfaceFile(path=str(path), spacing=1.0).rms_height()
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_npy_whose_header_declares_itself_longer_than_the_file_is_damage_not_memory(tmp_path, plugin):
+    """A 20-byte .npy (format 2.0) whose header length field says 2^31 bytes: numpy reads that
+    many bytes into one buffer before looking at them, so it was 'its array does not fit in this
+    process's memory; crop or resample the map' under ulimit -v, and 'not a readable .npy array
+    (ValueError)' after a 2 GiB allocation without one. It is named as damage, nothing allocated."""
+    path = tmp_path / "forged.npy"
+    path.write_bytes(b"\x93NUMPY\x02\x00" + (2**31).to_bytes(4, "little") + b"{'descr'")
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError) as info:
+            plugin(path=str(path), spacing=1.0).rms_height()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert ("a damaged .npy file: its header declares a length of 2,147,483,648 bytes, but the file holds 8 bytes "
+            "after it; save the array again") in str(info.value)
+    assert peak < 2**26
 
 
 @pytest.mark.parametrize(("region", "said"), [

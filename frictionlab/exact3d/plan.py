@@ -279,8 +279,8 @@ def run_plan(
         # session closed) keeps its time up to its last finished ensemble
         nonlocal counted
         now = time.perf_counter()
-        if Path(runs_dir).is_dir():
-            runs.seconds = _add_time(Path(runs_dir), plan, now - counted if compute else 0.0)
+        if Path(runs_dir).is_dir():  # a --finished-only page reads the time, and writes nothing there
+            runs.seconds = _add_time(Path(runs_dir), plan, now - counted) if compute else _time(Path(runs_dir), plan)
         counted = now
 
     factories: dict[float, SceneFactory] = {}
@@ -367,14 +367,17 @@ def _is_time_file(path: Path) -> bool:
 def _add_time(runs_dir: Path, plan: Plan, seconds: float) -> float:
     """The study's wall time summed over the invocations that ran into ``runs_dir`` (a
     resumed or regenerated study adds its own), kept in ``TIME_FILE``."""
-    path = runs_dir / TIME_FILE
+    total = _time(runs_dir, plan) + seconds
+    atomic_write(runs_dir / TIME_FILE, lambda fh: json.dump({"plan": plan.name, "seconds": total}, fh))
+    return total
+
+
+def _time(runs_dir: Path, plan: Plan) -> float:
+    """The study's wall time so far in ``runs_dir``'s TIME_FILE (0 if it has none of this plan)."""
     try:
         earlier = read_json(runs_dir, TIME_FILE, TIME_FILE_BYTES)
     except RunFolderError:  # none yet, or not one this study wrote: started afresh
         earlier = {}
     seconds_before = earlier.get("seconds")
     usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
-    total = float(seconds_before) if usable and math.isfinite(seconds_before) and earlier.get("plan") == plan.name else 0.0
-    total += seconds
-    atomic_write(path, lambda fh: json.dump({"plan": plan.name, "seconds": total}, fh))
-    return total
+    return float(seconds_before) if usable and math.isfinite(seconds_before) and earlier.get("plan") == plan.name else 0.0

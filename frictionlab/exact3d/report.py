@@ -127,7 +127,7 @@ def write_page(
     command = command or _command(quick, out_dir, runs_dir, finished_only)
     if out_dir:  # refused before a default runs folder is made
         page_paths(Path(out_dir), force=options.force)
-    if runs_dir:
+    if runs_dir and not finished_only:  # --finished-only writes nothing into it: any folder is read
         check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
     presets = find_presets(presets_dir, plan)  # refused before a default runs folder is made
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")

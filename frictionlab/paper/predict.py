@@ -202,6 +202,11 @@ def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.n
         count = ""
         if isinstance(counts, dict):
             count = f" ({short_repr(counts.get('done'), 20)} of {short_repr(counts.get('requested'), 20)} realizations)"
+            if status == "failed" and counts.get("done") == counts.get("requested") and summary.get("error"):
+                said = str(summary["error"])  # no law, with every realization done: resuming it gives none either
+                said = said if len(said) <= 300 else said[:297] + "..."
+                raise RunFolderError(f"{path}: the run failed with all its realizations finished{count}, and holds "
+                                     f"no law: {said}; give a law by hand with --a/--b")  # fmt: skip
         raise RunFolderError(
             f"{path}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
             f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {run_dir}`, "

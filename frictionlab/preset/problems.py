@@ -18,14 +18,43 @@ from .schema import NAME_PATTERN, NAME_RULE
 FIELD_CUTOFF = 0.7  # field names are short and alike (seed, sweep; stop, steps): only a near miss is a guess
 
 
+def _model_at(model: type[BaseModel] | None, loc: tuple) -> type[BaseModel] | None:
+    """The model reached by walking ``loc`` into ``model`` (None where it leads to no model); a
+    key of a mapping of models (a sweep's parameters) leads to the model of its values."""
+    values_of = None  # the model of a mapping's values, where the last part was such a mapping
+    for part in loc:
+        if values_of is not None:
+            model, values_of = values_of, None
+            continue
+        if model is None or not isinstance(part, str) or part not in model.model_fields:
+            return None
+        annotation = model.model_fields[part].annotation
+        if typing.get_origin(annotation) is dict:
+            values_of, model = _nested_model(typing.get_args(annotation)[-1]), None
+            if values_of is None:
+                return None
+            continue
+        model = _nested_model(annotation)
+    return model
+
+
 def _allowed_keys(model: type[BaseModel] | None, loc: tuple) -> list[str]:
     """Field names of the model reached by walking ``loc`` into ``model``."""
-    for part in loc:
-        if model is None or not isinstance(part, str) or part not in model.model_fields:
-            return []
-        annotation = model.model_fields[part].annotation
-        model = annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+    model = _model_at(model, loc)
     return sorted(model.model_fields) if model is not None else []
+
+
+def _too_large_for_an_integer(model: type[BaseModel], loc: tuple) -> str:
+    """What a whole field takes, said of a float past 2**63 (1e30) pydantic cannot make one:
+    its upper bound, where it has one; it said 'unable to parse input string as an integer,
+    exceeded maximum size', a number taken for text and no bound."""
+    parent = _model_at(model, loc[:-1])
+    field = parent.model_fields.get(loc[-1]) if parent is not None and loc and isinstance(loc[-1], str) else None
+    for bound in getattr(field, "metadata", ()):
+        for key, symbol in (("le", "<="), ("lt", "<")):
+            if getattr(bound, key, None) is not None:
+                return f"must be {symbol} {getattr(bound, key)}"
+    return "must be a whole number, written in digits (one this large, written with an exponent, is a float)"
 
 
 def _describe(error: dict, model: type[BaseModel]) -> str:
@@ -49,6 +78,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "is required"
     if kind == "literal_error":
         return f"must be one of {ctx['expected']}"
+    if kind == "int_parsing_size":
+        return _too_large_for_an_integer(model, tuple(error["loc"]))
     if kind in {"int_parsing", "int_type", "int_from_float"}:
         return "must be a whole number"
     if kind in {"float_parsing", "float_type", "finite_number"}:

@@ -112,7 +112,8 @@ class SweepParameter(_Strict):
         if self.values is not None:
             return list(self.values)
         make = np.geomspace if self.spacing == "log" else np.linspace
-        raw = [float(f"{v:.12g}") for v in make(self.start, self.stop, self.num)]
+        with np.errstate(over="ignore", invalid="ignore"):  # ends past 1e100 (stop - start overflows) are refused by name
+            raw = [float(f"{v:.12g}") for v in make(self.start, self.stop, self.num)]
         whole = float(self.start).is_integer() and float(self.stop).is_integer()
         return [int(v) if whole and v.is_integer() else v for v in raw]
 

@@ -103,8 +103,8 @@ def _json_copy(data: dict) -> dict:
     return json.loads(json.dumps(data))
 
 
-_MANIFEST_FIELDS = (  # what a manifest's fields must be, when present
-    ("status", str, "a word"),
+_MANIFEST_FIELDS = (  # what a manifest's fields must be, when present (a format of "2" lost the run its chunks)
+    ("format", int, "a whole number"), ("status", str, "a word"),
     ("fingerprint", str, "a string"),
     ("preset", dict, "a mapping"),
     ("inputs", dict, "a mapping of input files"),
@@ -194,7 +194,7 @@ class RunDirectory:
         check_schema_version(state, path, MANIFEST_FORMAT, key="format")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
-            if value is not None and not isinstance(value, kind):
+            if value is not None and (not isinstance(value, kind) or isinstance(value, bool)):
                 raise RunFolderError(f"{path} is damaged ({key} is not {what}, but {json_kind(value)})")
             if value is not None and not _well_formed(key, value):
                 raise RunFolderError(f"{path} is damaged ({key} is not {what}: an entry is not a string)")

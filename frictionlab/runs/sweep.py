@@ -30,7 +30,7 @@ from pydantic import BaseModel, Field
 
 from .. import __version__
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
 from ..io.files import atomic_write, output_path_problem
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
@@ -199,7 +199,7 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
             scene = build_scene(apply_overrides(base, assignments), registry=registry, before_reading=before_reading)
         except PresetError as exc:
-            shown = ", ".join(f"{path}={v!r}" for path, v in values.items())
+            shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())  # a value may be any length
             problems += [f"sweep point {number} ({shown}): {p}" for p in exc.problems]
             continue
         folder = f"{number:0{width}d}-{_label(values)}"

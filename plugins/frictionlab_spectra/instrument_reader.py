@@ -243,6 +243,11 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
     said = _reason(exc)
+    if reader.format() == "xyz" and isinstance(exc, ValueError) and "no negative elements" in text:
+        return ValueError(  # its grid's step along y (or x) came out zero, binned by numpy.bincount: not damage
+            f"{where}: the points of this {name} file make no grid: two share a position, or all lie on one row or "
+            "one column (a line scan written as x, y, z); export a line as its x and z for profile-file, a map with "
+            "each point once on the instrument's grid")  # fmt: skip
     if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
         return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
                           "on the instrument's grid, or its heights as a matrix (a table) with spacing")  # fmt: skip

@@ -4,8 +4,8 @@ The file holds heights on a uniform grid, optionally with their x positions:
 
 - ``.csv`` / ``.txt``: one column (heights), one row of heights, or two columns
   (x, z), separated by commas, semicolons or whitespace (a UTF-8 byte-order mark is
-  skipped); lines starting with ``#`` are comments and one non-numeric header line
-  (e.g. ``x,z``) before the data is skipped.
+  skipped); lines starting with ``#`` are comments and one header line before the data
+  (e.g. ``x,z``: more of its cells text than numbers) is skipped.
 - ``.npy``: a 1D array of heights, or a 2 x N / N x 2 array of x and z;
 - any other file: an instrument's line scan (X3P, SUR, NetCDF...) read by the optional
   extra ``topography`` (``instrument_file.py``), with its own spacing and unit, converted
@@ -38,6 +38,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
+from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .scan_shaping import level_line, line_form_warning, line_spike_warning, outlier_warning
@@ -230,6 +231,8 @@ def npy_shape(path: Path, where: str) -> tuple[int, ...] | None:
 def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
     """The shape and dtype a .npy header announces (a file may announce more than it holds),
     and where its data starts."""
+    if _header_overrun(fh) is not None:  # numpy would first read the length it declares into one buffer
+        return None
     fh.seek(0)
     try:
         version = np.lib.format.read_magic(fh)
@@ -238,6 +241,30 @@ def _npy_header(fh) -> tuple[tuple[int, ...], np.dtype, int] | None:
     except Exception:  # noqa: BLE001 - not a header numpy reads
         return None
     return tuple(int(n) for n in shape), dtype, fh.tell()
+
+
+_LENGTH_FIELD = {1: 2, 2: 4, 3: 4}  # bytes of a .npy header's length field, by the format's major version
+LENGTH_FIELD_BYTES = 4  # the longest of them
+
+
+def _header_overrun(fh) -> str | None:
+    """What is wrong with a .npy file whose header declares itself longer than the file (numpy
+    reads that many bytes into one buffer before it looks at them: up to 4 GiB for a forged file
+    of 20 bytes, refused as memory under ulimit -v), or None. ``fh`` is left at its start."""
+    fh.seek(0)
+    try:
+        major, _ = np.lib.format.read_magic(fh)
+    except Exception:  # noqa: BLE001 - not a .npy file: np.load names it
+        major = None
+    field = fh.read(LENGTH_FIELD_BYTES)[: _LENGTH_FIELD[major]] if major in _LENGTH_FIELD else b""
+    fh.seek(0)
+    if not field or len(field) != _LENGTH_FIELD[major]:  # another version, or a file cut short: np.load names it
+        return None
+    start = 8 + len(field)  # the magic string (6 bytes), the version (2), the length field
+    declared, held = int.from_bytes(field, "little"), os.fstat(fh.fileno()).st_size - start
+    if declared <= held:
+        return None
+    return f"its header declares a length of {declared:,} bytes, but the file holds {max(held, 0):,} bytes after it"
 
 
 def _npy_bytes(header: tuple[tuple[int, ...], np.dtype, int]) -> int:
@@ -255,9 +282,14 @@ def _check_npy_size(fh, where: str) -> None:
     if head.startswith(b"PK"):
         raise ValueError(f"{where}: an .npz archive (arrays zipped together), not a .npy array; save the "
                          "heights alone with numpy.save")  # fmt: skip
+    if (overrun := _header_overrun(fh)) is not None:
+        raise ValueError(f"{where}: a damaged .npy file: {overrun}; save the array again")
     header = _npy_header(fh)
     fh.seek(0)
-    if header is None or header[1].hasobject:  # np.load names it
+    if header is not None and header[1].hasobject:  # pickled: np.load refuses it without a word of why
+        raise ValueError(f"{where}: an array of Python objects (dtype {header[1]}), which is never unpickled (that "
+                         "could run code); expected real numbers: save the heights as a float array")  # fmt: skip
+    if header is None:  # np.load names it
         return
     held, declared = os.fstat(fh.fileno()).st_size - header[2], _npy_bytes(header)
     if held != declared:
@@ -284,11 +316,32 @@ def _numbers(text: str, delimiter: str | None) -> bool:
     return True
 
 
+TABLE_COPIES = 3  # reading a table takes at least 3 times its bytes (its bytes, text, lines and numbers: 3 to 6 measured)
+
+
 def read_text_table(path: Path, where: str) -> np.ndarray:
-    """Rows x columns of float64; one non-numeric header line is skipped. A
-    problem names the line, never its content."""
+    """Rows x columns of float64; one header line (more of its cells text than numbers) is
+    skipped. A problem names the line, never its content. A table has no header that gives its
+    size: one that cannot be read in the memory left is refused by its size, before or while read."""
     with open_input(path, where) as fh:
-        raw = fh.read()
+        size = os.fstat(fh.fileno()).st_size
+        room, source = room_to_read()
+        if size * TABLE_COPIES > room:
+            raise ValueError(_too_large_table(where, size, f"reading it takes at least {size * TABLE_COPIES / 2**30:.3g} "
+                                              f"GiB, more than the {room / 2**30:.3g} GiB this process may use ({source})"))
+        try:
+            return _table(fh.read(), where)
+        except MemoryError:
+            raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
+
+
+def _too_large_table(where: str, size: int, why: str) -> str:
+    return (f"{where}: a table of {size:,} bytes; {why}: save the heights as a .npy array (8 bytes a height, its "
+            "size checked before it is read), or crop the scan before saving it")
+
+
+def _table(raw: bytes, where: str) -> np.ndarray:
+    """The numbers of a table's bytes ``raw`` (``read_text_table``)."""
     try:
         lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
@@ -309,6 +362,8 @@ def read_text_table(path: Path, where: str) -> np.ndarray:
             break
         if _ends_with_separator(text, delimiter):  # numbers and an empty column: no header
             raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
+        if _mostly_numbers(text, delimiter):  # a row of heights with a cell that is not one: named below
+            break
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     try:
         with warnings.catch_warnings():
@@ -341,6 +396,22 @@ def _first_bad_line(lines: list[str], skip: int, delimiter: str | None) -> str:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _mostly_numbers(text: str, delimiter: str | None) -> bool:
+    """Whether more of the line's cells are numbers than not: a row of data with a bad cell
+    (``0.1,x,0.3``, ``0.1,,0.3``), which is no header (``x,z``; ``z [nm]``; ``Height 1``)."""
+    cells = text.split(delimiter)
+    numbers = sum(_number(cell) for cell in cells)
+    return numbers > len(cells) - numbers
+
+
+def _number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
 
 
 def _ends_with_separator(text: str, delimiter: str | None) -> bool:

@@ -5,8 +5,8 @@ interferometer topography; printed x by y, Nx x Ny, as instruments give it):
 
 - ``.npy``: a 2D array of real numbers;
 - ``.csv`` / ``.txt``: a matrix of numbers, one row of the map per line, separated by
-  commas, semicolons or whitespace; ``#`` starts a comment and one non-numeric header
-  line is skipped;
+  commas, semicolons or whitespace; ``#`` starts a comment and one header line (more
+  of its cells text than numbers) is skipped;
 - any other file: an instrument file (X3P, SUR, DATX, OPD, NetCDF...) read by the optional
   extra ``topography`` (``instrument_file.py``), with its own pixel size and unit.
 

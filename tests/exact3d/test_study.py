@@ -10,7 +10,7 @@ import pytest
 
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
-from frictionlab.exact3d.plan import BROAD_HURSTS, HURSTS, QUICK, preset_name
+from frictionlab.exact3d.plan import BROAD_HURSTS, HURSTS, QUICK, TIME_FILE, preset_name
 from frictionlab.exact3d.report import FIGURES, FIGURES_DIR, PAGE
 
 from ..conftest import PRESETS
@@ -131,11 +131,15 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     for name in ("h0.3-n128-bem-halfspace", "spectral-h1.0-n128-bem-halfspace"):
         shutil.rmtree(runs / name)
     chunks = {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")}
+    (runs / "notes.txt").write_text("mine")  # read only: a user's file beside the runs was refused (exit code 4)
+    timed = (runs / TIME_FILE).read_bytes(), (runs / TIME_FILE).stat().st_mtime_ns  # and the time file was rewritten
     args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / "page"), "--runs", str(runs),
             "--finished-only", "--quiet"]  # fmt: skip
     assert main(args) == ExitCode.OK
     text = (tmp_path / "page" / PAGE).read_text()
     assert {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")} == chunks  # nothing computed
+    assert ((runs / TIME_FILE).read_bytes(), (runs / TIME_FILE).stat().st_mtime_ns) == timed  # nothing written
+    assert (runs / "notes.txt").read_text() == "mine"
     assert not (runs / "h0.3-n128-bem-halfspace").exists()
     assert "2 of the plan's" in text and "H = 0.3, 128² px, exact, 4 surfaces" in text
     assert "H = 1, spectral gradient, 128² px, exact, 2 surfaces" in text

@@ -104,3 +104,18 @@ def test_pairs_from_a_run_whose_lines_lack_xi_at_low_forces(tmp_path):
     low, high = percentile_interval(pairs, outcome.fit.confidence, axis=0)  # the fit's own function, its own tails
     assert (low[0], high[0]) == pytest.approx(outcome.fit.a_ci, rel=1e-12, abs=1e-15)
     assert (low[1], high[1]) == pytest.approx(outcome.fit.b_ci, rel=1e-12, abs=1e-15)
+
+
+def test_from_a_run_that_failed_with_every_realization_done_says_why_not_resume(tmp_path, capsys, make_scene):
+    """A run whose loads all press beyond full contact finishes every realization and fails with
+    'no law'. predict --from said its law 'would come from fewer realizations than it asked for;
+    finish it with frictionlab resume', which gives no law either. It now says the run's own error."""
+    scene = make_scene({"output": {"plot": False}, "loading": {"start": 1e6, "stop": 1e7, "spacing": "log"}})
+    outcome, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1))
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["realizations"]["done"] == summary["realizations"]["requested"]
+    args = ["predict", "--from", str(tmp_path), "--area", "1", "--modulus", "1", "--rms-height", "1", "--force", "1"]
+    assert main(args) == 5
+    err = capsys.readouterr().err
+    assert "the run failed with all its realizations finished" in err and "holds no law: no law: the whole" in err
+    assert "frictionlab resume" not in err and "fewer realizations" not in err
