@@ -17,6 +17,8 @@ def _listed(values) -> str:
 
 
 _D = StudyOptions()
+MAX_GRID_FACTOR = 1e6  # times the preset's N: past any memory (a factor of 1e300 was skipped as a note, exit 0)
+MAX_REPEATS = 100  # timings of one setting: as many as the report's replicates
 DEFAULTS = {  # the flags' defaults, as typed: StudyOptions' own
     "reference": _D.reference,
     "axes": ",".join(_D.axes),
@@ -79,7 +81,8 @@ def add_parser(sub) -> None:
     parser.set_defaults(handler=run)
 
 
-def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: bool = False) -> tuple:
+def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: bool = False,
+             high: float = math.inf) -> tuple:
     try:
         values = tuple(kind(v) for v in text.split(",") if v.strip())
     except ValueError:
@@ -87,9 +90,18 @@ def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: boo
     bad = [v for v in values if not (v > low and math.isfinite(v))]  # inf made a grid of int(inf) points
     if bad:
         raise FrictionlabError(f"{option} values must be finite numbers > {low:g}. Got {bad[0]!r} instead.")
+    beyond = [v for v in values if v > high]
+    if beyond:
+        raise FrictionlabError(f"{option} values must be at most {high:g}. Got {beyond[0]!r} instead.")
     if required and not values:  # an empty list left its axis out without a word
         raise FrictionlabError(f"{option} names no value: give a comma-separated list of numbers. Got {text!r} instead.")
     return values
+
+
+def _between(option: str, value: int, low: int, high: int) -> int:
+    if not low <= value <= high:
+        raise FrictionlabError(f"{option} must be a whole number from {low} to {high}. Got {value} instead.")
+    return value
 
 
 def _at_least(option: str, value: int, low: int) -> int:
@@ -118,10 +130,10 @@ def options_from_args(args) -> StudyOptions:
         compare_realizations=_at_least("--compare-realizations", args.compare_realizations, 2),
         compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
         grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
-        grid_factors=_numbers("--grid-factors", args.grid_factors, required="grid" in axes),
+        grid_factors=_numbers("--grid-factors", args.grid_factors, required="grid" in axes, high=MAX_GRID_FACTOR),
         tolerances=_numbers("--tolerances", args.tolerances) or (min(_D.tolerances),),
-        reference_grid=_numbers("--reference-grid", args.reference_grid),
-        repeats=_at_least("--repeats", args.repeats, 1),
+        reference_grid=_numbers("--reference-grid", args.reference_grid, high=MAX_GRID_FACTOR),
+        repeats=_between("--repeats", args.repeats, 1, MAX_REPEATS),
     )
 
 

@@ -47,6 +47,10 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--reference-grid", "Infinity"], "--reference-grid values must be finite numbers > 0. Got inf instead."),
         (["--grid-factors", ",,"], "--grid-factors names no value"),  # the grid axis was left out without a word
         (["--points", "4"], "--points must be >= 8. Got 4 instead."),
+        (["--grid-factors", "1,1e300"], "--grid-factors values must be at most 1e+06. Got 1e+300 instead."),
+        (["--reference-grid", "2e6"], "--reference-grid values must be at most 1e+06. Got 2000000.0 instead."),
+        (["--repeats", "1000000000"], "--repeats must be a whole number from 1 to 100. Got 1000000000 instead."),
+        (["--repeats", "0"], "--repeats must be a whole number from 1 to 100. Got 0 instead."),
         (["--set", "spectrum.params.hurst=7"], "spectrum.params.hurst: must be <= 1.5"),
     ],
 )
