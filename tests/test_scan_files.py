@@ -425,3 +425,24 @@ def test_a_tilt_left_in_is_a_caveat_of_the_run_and_of_its_summary(tmp_path):
     levelled = frictionlab.run(law_preset(tmp_path / "t.x3p", "mdr", SurfaceFile(path=str(tmp_path / "t.x3p"), unit="um"),
                                           unit="um"), out=tmp_path / "level", workers=1, progress=False, plot=False)  # fmt: skip
     assert not any("tilt" in caveat for caveat in levelled.caveats)
+
+
+def test_realizations_of_one_measured_line_are_said_to_be_one_surface(tmp_path):
+    """Ten realizations of a profile read from a file press the same line ten times: the
+    bootstrap interval over them was a point ([a, a]) beside a std.err of the fit, without a
+    word. The run says the ensemble is one surface; a random spectrum's run says nothing of it."""
+    import frictionlab
+
+    z = np.cumsum(np.random.default_rng(2).standard_normal(2000))
+    np.save(tmp_path / "line.npy", z)
+    preset = {"name": "one", "realizations": 4, "spectrum": {"name": "profile-file",
+              "params": {"path": str(tmp_path / "line.npy"), "spacing": 1.0, "detrend": "tilt"}},
+              "solver": {"name": "mdr"}, "loading": {"start": 0.01, "stop": 0.5, "steps": 8, "spacing": "log", "unit": "f"},
+              "fit": {"bootstrap": 100}}  # fmt: skip
+    result = frictionlab.run(preset, out=tmp_path / "run", workers=1, progress=False, plot=False)
+    said = [caveat for caveat in result.caveats if caveat.startswith("all 4 realizations gave the same curve")]
+    assert len(said) == 1 and result.fit.a_ci[0] == result.fit.a_ci[1]  # the point the caveat explains
+    assert said[0] in json.loads((tmp_path / "run" / "summary.json").read_text())["caveats"]
+    random_lines = frictionlab.run("quickstart", out=tmp_path / "random", workers=1, progress=False, plot=False,
+                                   realizations=4)  # fmt: skip
+    assert not any("same curve" in caveat for caveat in random_lines.caveats)

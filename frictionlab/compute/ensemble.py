@@ -57,6 +57,19 @@ def few_carriers_caveat(half: np.ndarray, f: np.ndarray) -> str | None:
     )
 
 
+def same_curves_caveat(xi: np.ndarray) -> str | None:
+    """The caveat of a run of two or more realizations whose curves are all one (rows of ``xi``,
+    NaN where undefined, equal to the last bit): nothing random varied, a measured profile or
+    surface pressed as it is, so the bootstrap over realizations has no spread to measure."""
+    if xi.shape[0] < 2 or not np.array_equal(xi, np.broadcast_to(xi[0], xi.shape), equal_nan=True):
+        return None
+    return (
+        f"all {xi.shape[0]} realizations gave the same curve (nothing random varies: a measured profile or surface "
+        "pressed as it is): the ensemble is one surface, the bootstrap interval has no spread between surfaces to "
+        "measure (the std.err is the fit's own), and realizations: 1 gives the same numbers"
+    )
+
+
 def spike_caveat(peak: float) -> str:
     """The caveat of a profile whose highest point stands ``peak`` rms heights above its mean."""
     return (
@@ -155,6 +168,8 @@ class RunOutcome:
             caveats.append(caveat)
         if self.peak_rms > SPIKE_RMS:
             caveats.append(spike_caveat(self.peak_rms))
+        if (caveat := same_curves_caveat(self.per_realization["xi"])) is not None:
+            caveats.append(caveat)
         if self.lines_used.size and self.lines_used.min() < self.done:
             caveats.append(
                 f"up to {self.done - int(self.lines_used.min())} of {self.done} lines have no xi at a load (no point "
