@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from ..compute.ensemble import RunOutcome
+from ..compute.ensemble import RunOutcome, same_curves_caveat
 from ..errors import FrictionlabError, PresetError, RunError
 from ..plugin import ContactSolver
 from ..preset import Scene
@@ -200,6 +200,7 @@ class Study:
         self.progress = progress
         self.rows: list[Row] = []
         self.notes: list[str] = []
+        self.one_surface = False  # every realization the same curve (the realizations axis says so)
         self.base = factory.base
         preset = self.base.preset
         self.grid_m = min(preset.realizations, options.grid_realizations)
@@ -254,13 +255,16 @@ class Study:
     # ------------------------------------------------------------ running
 
     def _run(self, axis: str, setting: str, value: float, scene: Scene, note: str = "") -> Row:
+        return self._measured_row(axis, setting, value, scene, note)[0]
+
+    def _measured_row(self, axis: str, setting: str, value: float, scene: Scene, note: str = "") -> tuple[Row, RunOutcome]:
         measured = measure(scene, repeats=self.options.repeats, listeners=self.run_listeners())
         row = make_row(axis, setting, value, scene, measured, note)
         self.progress(
             f"{axis:<12} {setting:<16} {row.solver:<14} {row.seconds:9.3f} s {row.peak_bytes / 2**20:9.1f} MiB"
             f"  b = {row.b:.4f}" + (f"  ({row.note})" if row.note else "")
         )
-        return row
+        return row, measured.outcome
 
     def run(self) -> list[Row]:
         for axis in self.options.axes:
@@ -353,12 +357,21 @@ class Study:
             if m == 1:
                 break
             m //= 2
-        rows = [self._run("realizations", f"M={m}", m, self.factory.make({"realizations": m})) for m in sorted(levels)]
+        measured = [self._measured_row("realizations", f"M={m}", m, self.factory.make({"realizations": m}))
+                    for m in sorted(levels)]  # fmt: skip
         self.notes.append(
             "realizations: the first M lines of the preset (same seed), N and loads as in the preset; "
             "the error is the half-width of the bootstrap interval, no reference"
         )
-        return rows
+        largest = measured[-1][1]
+        if same_curves_caveat(largest.per_realization["xi"]) is not None:
+            self.one_surface = True
+            self.notes.append(
+                f"realizations: all {largest.done} realizations gave the same curve (nothing random varies: a measured "
+                "profile or surface pressed as it is): the ensemble is one surface, its interval has no spread to "
+                "measure, and M = 1 gives the same numbers"
+            )
+        return [row for row, _ in measured]
 
     def steps_axis(self) -> list[Row]:
         densest = self.base.preset.loading.steps

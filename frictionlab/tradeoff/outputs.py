@@ -262,7 +262,10 @@ def recommendation(study: Study) -> str:
     realizations = by_axis.get("realizations", [])
     if realizations:
         within = [r for r in realizations if r.b_ci_rel <= target]
-        if within:
+        if study.one_surface:  # every realization the same curve: one is the ensemble
+            m_needed = 1
+            needs.append("M = 1 (every realization is the same surface)")
+        elif within:
             m_needed = int(within[0].value)
             needs.append(f"M = {m_needed}")
         else:

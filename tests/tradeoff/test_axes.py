@@ -236,3 +236,20 @@ def test_a_study_that_measured_nothing_says_why_on_the_terminal(builtins):
     said = recommendation(study)
     assert said.startswith("for 2% error in b at H = 0.8: no axis measured enough to recommend anything; solver, "
                            "tolerance: skipped: no installed solver solves"), said  # fmt: skip
+
+
+def test_a_study_of_one_measured_line_recommends_one_realization(builtins, tmp_path):
+    """Every realization of a profile read from a file is the same curve: its interval has no
+    spread, and the study recommended the smallest M measured (M = 2 here) as if it had one.
+    It says the ensemble is one surface and recommends M = 1; a random preset's study does not."""
+    from frictionlab.tradeoff.outputs import recommendation
+
+    np.save(tmp_path / "line.npy", np.random.default_rng(3).standard_normal(256).cumsum())
+    scan = {**TINY, "spectrum": {"name": "profile-file", "params": {"path": str(tmp_path / "line.npy"), "spacing": 1.0}}}
+    study = study_of(scan, builtins, axes=("realizations",))
+    study.run()
+    assert any("realizations: all 8 realizations gave the same curve" in note for note in study.notes), study.notes
+    assert "M = 1 (every realization is the same surface)" in recommendation(study)
+    random = study_of(TINY, builtins, axes=("realizations",))
+    random.run()
+    assert not random.one_surface and "same surface" not in recommendation(random)
