@@ -669,7 +669,20 @@ def _cut_short(path, z):
         fh.truncate(path.stat().st_size - 8)
 
 
+def _negative_shape(path, z):
+    np.save(path, z)
+    data = path.read_bytes()
+    declared = str(z.shape).encode()
+    negative = b"(-" + declared[1:]  # the first side made negative, a space dropped: the header's length kept
+    head = data[: 10 + int.from_bytes(data[8:10], "little")]
+    forged = head.replace(declared + b", }", negative + b",}")
+    assert forged != head and len(forged) == len(head)
+    path.write_bytes(forged + data[len(head):])
+
+
 @pytest.mark.parametrize(("write", "said"), [
+    (_negative_shape, "a damaged .npy file: its header declares an array of shape NEGATIVE, a negative number of "
+                      "points; save the array again"),  # was '(-BYTES bytes)'
     (_npz_as_npy, "an .npz archive (arrays zipped together), not a .npy array; save the heights alone with numpy.save"),
     (_trailing_bytes, "a damaged .npy file: its header declares an array of shape SHAPE of float64 (BYTES bytes), but the "
                       "file holds BYTES+24 bytes after it"),
@@ -689,6 +702,7 @@ def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_
     write(tmp_path / "heights.npy", z)
     said = said.replace("SHAPE", str(z.shape)).replace("BYTES+24", f"{z.nbytes + 24:,}")
     said = said.replace("BYTES-8", f"{z.nbytes - 8:,}").replace("BYTES", f"{z.nbytes:,}")
+    said = said.replace("NEGATIVE", str((-z.shape[0], *z.shape[1:])))
     with pytest.raises(ValueError) as info:
         plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
     assert said in str(info.value)

@@ -291,6 +291,9 @@ def _check_npy_size(fh, where: str) -> None:
                          "could run code); expected real numbers: save the heights as a float array")  # fmt: skip
     if header is None:  # np.load names it
         return
+    if any(side < 0 for side in header[0]):
+        raise ValueError(f"{where}: a damaged .npy file: its header declares an array of shape {header[0]}, a "
+                         "negative number of points; save the array again")  # fmt: skip
     held, declared = os.fstat(fh.fileno()).st_size - header[2], _npy_bytes(header)
     if held != declared:
         raise ValueError(
