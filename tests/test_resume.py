@@ -88,6 +88,22 @@ def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
     assert (tmp_path / "run" / "curve.csv").read_text() == before
 
 
+def test_a_fresh_run_into_its_own_completed_folder_says_it_runs_again(make_scene, tmp_path):
+    """A run into the folder of a completed run of the same preset ran it again without a word:
+    it says so, and the numbers are the same."""
+    import warnings
+
+    scene = make_scene({"realizations": 6, **NO_PLOT})
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    before = (tmp_path / "run" / "curve.csv").read_text()
+    with pytest.warns(UserWarning, match="holds a completed run of this preset: it runs again, to the same numbers"):
+        run_to_folder(scene, tmp_path / "run", RunOptions(workers=2))
+    assert (tmp_path / "run" / "curve.csv").read_text() == before
+    with warnings.catch_warnings():  # a new folder, and an unfinished run resumed, say nothing of it
+        warnings.simplefilter("error")
+        run_to_folder(scene, tmp_path / "new", RunOptions(workers=1))
+
+
 def test_a_second_run_into_a_locked_directory_is_refused(make_scene, tmp_path):
     with RunDirectory(tmp_path / "run"):
         with pytest.raises(RunFolderError, match=rf"{tmp_path / 'run'} is in use by another run \(pid {os.getpid()}, started"):

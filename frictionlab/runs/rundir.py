@@ -5,13 +5,11 @@ Layout inside the output folder::
 
     run.lock      held (filelock: flock on POSIX) while a run writes here, removed when it
                   ends; the kernel releases the lock even on kill -9
-    run.json      the manifest: status, the resolved preset and its
-                  fingerprint, every input file with its SHA-256, and every
-                  chunk file with its SHA-256
+    run.json      the manifest: status, the resolved preset and its fingerprint, every
+                  input file and every chunk file with its SHA-256
     preset.yaml   the resolved preset, written before the first realization
-    chunks/00000012-00000023.npz   one file per finished chunk, written to a
-                  temporary name and renamed; the manifest is updated after
-                  the rename. A completed run's chunks are compacted into one.
+    chunks/00000012-00000023.npz   one file per finished chunk, written to a temporary name and
+                  renamed; the manifest is updated after. A completed run's chunks are compacted into one.
 
 A resume trusts nothing it has not verified: every chunk listed in the
 manifest is read and its SHA-256 and arrays checked; a missing or damaged one
@@ -21,9 +19,8 @@ counted twice, and since each has its own seed the resumed result is bitwise
 the one of an uninterrupted run. A resume refuses another preset and an input
 file whose content changed.
 
-A fresh run refuses a folder that holds anything but a run of its own preset
-(another preset's finished run, an unfinished run, files of the user's) unless
-``force``; even then it deletes only chunk files its manifest lists.
+A fresh run refuses a folder that holds anything but a run of its own preset (whose completed
+run it runs again, saying so) unless ``force``; even then it deletes only chunk files its manifest lists.
 """
 
 from __future__ import annotations
@@ -241,6 +238,9 @@ class RunDirectory:
                 raise
             state = None  # a damaged manifest lists nothing: nothing is deleted
         self._refuse_unless_ours(state, scene, resolved)
+        if state is not None and state.get("status") == "completed" and same_preset(state, resolved, scene):
+            warnings.warn(f"{self.path} holds a completed run of this preset: it runs again, to the same numbers",
+                          stacklevel=3)
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
         self._remove_chunks(listed)  # chunks of the run that was here: frictionlab wrote them
         self.chunks.mkdir(parents=True, exist_ok=True)
