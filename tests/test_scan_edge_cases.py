@@ -625,6 +625,17 @@ def test_a_text_export_in_latin_1_is_told_to_be_saved_as_utf_8(tmp_path):
         SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
 
 
+@pytest.mark.parametrize("text", ["# x [um]\ty [um]\tz [um]\n", "# x y z\nx y z\n"])
+def test_an_xyz_export_of_a_header_alone_is_not_told_it_is_latin_1(tmp_path, text):
+    """An x, y, z export of UTF-8 text with no points (a header alone) was told to be 'not UTF-8 (a header
+    in Latin-1: its µ?)', the reader's guess at another encoding taken for the file's: it holds no points."""
+    (tmp_path / "scan.xyz").write_text(text, encoding="utf-8")
+    with pytest.raises(ValueError) as said:
+        SurfaceFile(path=str(tmp_path / "scan.xyz")).rms_height()
+    assert "holds no points its reader can read (it is UTF-8 text" in str(said.value)
+    assert "Latin-1" not in str(said.value)
+
+
 def test_a_table_with_a_latin_1_header_is_told_to_be_saved_as_utf_8(tmp_path):
     """A matrix of heights under a Latin-1 header ('H\\xf6he (\\xb5m)', as a European spreadsheet
     saves it) was 'not a text file ... read with format: instrument' only; that sends the table

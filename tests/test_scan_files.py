@@ -320,17 +320,19 @@ def test_an_xyz_map_off_a_regular_grid_is_named_so_not_as_damage(tmp_path):
 
 
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
-@pytest.mark.parametrize("layout", ["one row", "each point twice"])
+@pytest.mark.parametrize("layout", ["one row", "each point twice", "one point"])
 def test_an_xyz_file_whose_points_make_no_grid_is_named_so_not_as_damage(tmp_path, plugin, layout):
     """A line scan written as x, y, z (y the same on every line) or a map listing each point twice
     gives SurfaceTopography's reader a grid step of zero, and numpy's "'list' argument must have
-    no negative elements": it was 'a damaged ... file', to be copied again from the instrument."""
+    no negative elements": it was 'a damaged ... file', to be copied again from the instrument.
+    One point alone (numpy's "zero-size array to reduction operation") was damage too."""
     rows = [f"{0.1 * i:.6g} {0.1 * j:.6g} {np.sin(i / 3) + np.cos(j / 4):.6g}"
             for j in range(1 if layout == "one row" else 16) for i in range(16)]  # fmt: skip
-    rows = rows if layout == "one row" else rows + rows
+    rows = {"one row": rows, "each point twice": rows + rows, "one point": rows[:1]}[layout]
     (tmp_path / "scan.xyz").write_text("\n".join(rows) + "\n")
-    with pytest.raises(ValueError, match=r"file make no grid: two share a position, or all lie on one row or one "
-                                         r"column \(a line scan written as x, y, z\); export a line as its x and z") as said:
+    with pytest.raises(ValueError, match=r"file make no grid: there is one, two share a position, or all lie on one "
+                                         r"row or one column \(a line scan written as x, y, z\); export a line as its x "
+                                         r"and z") as said:
         plugin(path=str(tmp_path / "scan.xyz"), unit="um").generate(None)
     assert "damaged" not in str(said.value) and "copy it again" not in str(said.value)
 

@@ -117,7 +117,7 @@ def _open_reader(fh, path: Path, where: str):
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
-        raise describe_failure(reader_class, exc, where) from None
+        raise describe_failure(reader_class, exc, where, fh) from None
 
 
 def _require_extra(path: Path, where: str) -> None:
@@ -197,7 +197,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             topography = reader.topography(channel_index=chosen.index, **sizes)
             heights = topography.heights()
         except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
-            raise describe_failure(type(reader), exc, where) from None
+            raise describe_failure(type(reader), exc, where, fh) from None
         if not topography.is_uniform:  # x, z of a text export, x not evenly spaced: it has no pixel
             raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
                              "are pressed on a uniform grid: export the scan on one (as most instruments do), or "

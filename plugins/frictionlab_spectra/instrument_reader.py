@@ -217,9 +217,27 @@ def check_declared_points(points: tuple[int, ...], where: str) -> None:
         )
 
 
-def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
+def _is_utf8(fh) -> bool:
+    """Whether the open file's bytes, all of them, read as UTF-8 (a chunk at a time)."""
+    import codecs
+
+    decoder, position = codecs.getincrementaldecoder("utf-8")(), fh.tell()
+    try:
+        fh.seek(0)
+        while chunk := fh.read(1 << 20):
+            decoder.decode(chunk)
+        decoder.decode(b"", final=True)
+        return True
+    except (UnicodeDecodeError, OSError):
+        return False
+    finally:
+        fh.seek(position)
+
+
+def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueError:
     """What to tell of a file the chosen reader could not read: a damaged file of that
-    format, or its length and height units that differ (named as such)."""
+    format, or its length and height units that differ (named as such). ``fh``, the open
+    file, tells a text export's encoding from its content where the reader blames the one."""
     from SurfaceTopography.Exceptions import CorruptFile, FileFormatMismatch
 
     name = reader.name()
@@ -234,6 +252,9 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
             f"{where}: the {name} file does not state its physical size; give spacing (the pixel side, in the "
             "run's length unit), or export the scan with its pixel size"
         )
+    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS and fh is not None and _is_utf8(fh):
+        return ValueError(f"{where}: this {name} file holds no points its reader can read (it is UTF-8 text: a "
+                          "header alone, or lines that are not numbers); export the scan again")  # fmt: skip
     if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS:
         return ValueError(f"{where}: a text export that is not UTF-8 (a header in Latin-1: its µ?), which "
                           f"SurfaceTopography's {name} reader does not read; save it as UTF-8")  # fmt: skip
@@ -243,10 +264,11 @@ def describe_failure(reader, exc: BaseException, where: str) -> ValueError:
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
     said = _reason(exc)
-    if reader.format() == "xyz" and isinstance(exc, ValueError) and "no negative elements" in text:
+    if reader.format() == "xyz" and isinstance(exc, ValueError) and (
+            "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
         return ValueError(  # its grid's step along y (or x) came out zero, binned by numpy.bincount: not damage
-            f"{where}: the points of this {name} file make no grid: two share a position, or all lie on one row or "
-            "one column (a line scan written as x, y, z); export a line as its x and z for profile-file, a map with "
+            f"{where}: the points of this {name} file make no grid: there is one, two share a position, or all lie on "
+            "one row or one column (a line scan written as x, y, z); export a line as its x and z for profile-file, a map with "
             "each point once on the instrument's grid")  # fmt: skip
     if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
         return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
