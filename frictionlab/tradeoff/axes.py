@@ -363,14 +363,9 @@ class Study:
             "realizations: the first M lines of the preset (same seed), N and loads as in the preset; "
             "the error is the half-width of the bootstrap interval, no reference"
         )
-        largest = measured[-1][1]
-        if same_curves_caveat(largest.per_realization["xi"]) is not None:
+        if (caveat := same_curves_caveat(measured[-1][1].per_realization["xi"])) is not None:
             self.one_surface = True
-            self.notes.append(
-                f"realizations: all {largest.done} realizations gave the same curve (nothing random varies: a measured "
-                "profile or surface pressed as it is): the ensemble is one surface, its interval has no spread to "
-                "measure, and M = 1 gives the same numbers"
-            )
+            self.notes.append(f"realizations: {caveat}")  # the run's own caveat, of the largest M
         return [row for row, _ in measured]
 
     def steps_axis(self) -> list[Row]:
