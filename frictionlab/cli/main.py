@@ -30,6 +30,7 @@ import sys
 import warnings
 
 from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
+from ..compute.heap import keep_freed_memory
 from ..compute.signals import RaiseOnSigterm, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -221,6 +222,7 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
+    keep_freed_memory()  # this process's realizations reuse freed pages, not fault in fresh ones
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))

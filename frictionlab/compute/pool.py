@@ -19,6 +19,8 @@ from collections import Counter, deque
 from collections.abc import Callable, Hashable, Iterator
 from multiprocessing.connection import wait
 
+from .heap import keep_freed_memory
+
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
 STOP_GRACE_SECONDS = 0.5  # after a cancel, a job's time to end by itself before its worker is killed
 ERROR_CHARS = 500  # an error carried back from a worker is cut to this
@@ -65,6 +67,7 @@ def _serve(tasks, results, stop, initializer, initargs, function) -> None:
     _results, _stop = results, stop
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C and SIGTERM are the parent's to handle:
     signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it sets ``stop``, then stops workers
+    keep_freed_memory()  # a fork has its parent's setting; a forkserver's or spawned worker not
     if initializer is not None:
         initializer(*initargs)
     while True:

@@ -35,6 +35,7 @@ from ..io.files import atomic_write, write_npz
 from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
 from ..preset import Scene
+from .import_ahead import PLOT_MODULE, imported
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
@@ -385,10 +386,8 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
     out = Path(out_dir)
     files = {**files, "plot": out / "plot.png"}
 
-    def draw(fh) -> None:
-        from ..plot import plot_curve  # matplotlib is slow to import: only when drawing
-
-        plot_curve(scene, outcome, fh)
+    def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (or ahead, while computing)
+        imported(PLOT_MODULE).plot_curve(scene, outcome, fh)
 
     write_figure(files["plot"], draw)
     _write_summary(out, scene, outcome, files)

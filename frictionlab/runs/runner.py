@@ -15,6 +15,7 @@ from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
+from .import_ahead import PlotImportAhead
 from .results import add_plot, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
@@ -123,6 +124,8 @@ def run_to_folder(
         restored = run_dir.start(scene, resume=options.resume)
         store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
         outcome = None
+        if plot and scene.preset.output.plot:  # matplotlib imported while the workers compute
+            listeners = [*listeners, PlotImportAhead()]
         try:
             outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
         finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)

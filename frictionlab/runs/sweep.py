@@ -38,6 +38,7 @@ from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from ..plugin.registry import Registry, default_registry
+from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
@@ -379,10 +380,8 @@ def run_sweep(
         outcome.files = write_tables(sweep, outcome, out_dir)
         if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
 
-            def draw(fh) -> None:
-                from ..plot import plot_sweep  # matplotlib is slow to import: only when drawing
-
-                plot_sweep(sweep, outcome.rows, fh)
+            def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (its points import it ahead)
+                imported(PLOT_MODULE).plot_sweep(sweep, outcome.rows, fh)
 
             write_figure(out_dir / "sweep.png", draw)
             outcome.files["plot"] = out_dir / "sweep.png"
