@@ -67,5 +67,5 @@ def test_elsewhere_it_says_it_changed_nothing(monkeypatch):
         def __init__(self, name):
             pass
 
-    monkeypatch.setattr("frictionlab.compute.heap.ctypes.CDLL", NoMallopt)
+    monkeypatch.setattr("ctypes.CDLL", NoMallopt)
     assert keep_freed_memory() is False

@@ -222,7 +222,6 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
-    keep_freed_memory()  # this process's realizations reuse freed pages, not fault in fresh ones
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
@@ -334,6 +333,7 @@ def _write_failed(exc: OSError) -> int:
 
 
 def _run_command(args) -> int:
+    keep_freed_memory()  # this process's realizations reuse freed pages, not fault in fresh ones
     try:
         code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit

@@ -15,8 +15,6 @@ the pool's workers (``pool._serve``); a notebook's own process keeps its allocat
 
 from __future__ import annotations
 
-import ctypes
-
 M_TRIM_THRESHOLD = -1  # mallopt's parameters (malloc.h)
 M_MMAP_THRESHOLD = -3
 KEEP_BYTES = 32 * 2**20  # glibc's own ceiling for the thresholds it raises by itself
@@ -25,6 +23,8 @@ KEEP_BYTES = 32 * 2**20  # glibc's own ceiling for the thresholds it raises by i
 def keep_freed_memory() -> bool:
     """Have glibc keep freed blocks up to ``KEEP_BYTES`` for reuse; False where the C
     library is not glibc (musl, macOS, Windows: their allocators decide)."""
+    import ctypes  # here: --help and a usage error need not load it
+
     try:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError, TypeError):

@@ -10,6 +10,8 @@ the boundary elements of the half-space: about 1.5x the line pipeline):
   97 when the largest load reaches full contact and every point is sorted;
   ``BYTES_PER_POINT`` takes the worst case with a margin;
 * a process with numpy, scipy and frictionlab imported holds about 70 MiB;
+* freed arrays of up to 32 MiB are kept for the next realization (``heap``): what is
+  kept was in use a moment before, so the peak does not grow;
 * the main process keeps every finished realization's per-load arrays;
 * a surface pressed as its MDR-equivalent line is pressed on a line of
   2 sqrt(A / pi) / dx points, but the main process first makes that line from the
