@@ -131,7 +131,7 @@ def options_from_args(args) -> StudyOptions:
         compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
         grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
         grid_factors=_numbers("--grid-factors", args.grid_factors, required="grid" in axes, high=MAX_GRID_FACTOR),
-        tolerances=_numbers("--tolerances", args.tolerances) or (min(_D.tolerances),),
+        tolerances=_numbers("--tolerances", args.tolerances, required="tolerance" in axes) or (min(_D.tolerances),),
         reference_grid=_numbers("--reference-grid", args.reference_grid, high=MAX_GRID_FACTOR),
         repeats=_between("--repeats", args.repeats, 1, MAX_REPEATS),
     )

@@ -46,6 +46,7 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--grid-factors", "1,inf"], "--grid-factors values must be finite numbers > 0. Got inf instead."),  # was exit 70
         (["--reference-grid", "Infinity"], "--reference-grid values must be finite numbers > 0. Got inf instead."),
         (["--grid-factors", ",,"], "--grid-factors names no value"),  # the grid axis was left out without a word
+        (["--tolerances", ","], "--tolerances names no value"),  # the tolerance axis ran the default instead
         (["--points", "4"], "--points must be >= 8. Got 4 instead."),
         (["--grid-factors", "1,1e300"], "--grid-factors values must be at most 1e+06. Got 1e+300 instead."),
         (["--reference-grid", "2e6"], "--reference-grid values must be at most 1e+06. Got 2000000.0 instead."),
