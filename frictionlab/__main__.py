@@ -5,7 +5,7 @@ import sys
 
 
 class _TerminatedWhileLoading(KeyboardInterrupt):
-    """SIGTERM before the command's own handling (``signals.RaiseOnSigterm``) is in place."""
+    """SIGTERM before the command's own handling (``signals.RaiseOnSignals``) is in place."""
 
 
 def _terminated(signum, frame):

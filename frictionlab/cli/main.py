@@ -31,7 +31,7 @@ import warnings
 
 from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
 from ..compute.heap import keep_freed_memory
-from ..compute.signals import RaiseOnSigterm, interrupted_exit_code
+from ..compute.signals import RaiseOnSignals, interrupted_exit_code
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
@@ -307,7 +307,7 @@ def main(argv: list[str] | None = None) -> int:
     args.parser = parser  # a command that describes the CLI itself (completion) reads it
     if args.command is None:  # only options, none of which exits (there are none today)
         return _print(short_help())
-    with RaiseOnSigterm():
+    with RaiseOnSignals():
         return _run_command(args)
 
 

@@ -24,7 +24,7 @@ from ..plugin.listeners import RunListener
 from ..options import RunOptions, default_workers
 from ..preset import Scene
 from .realization import RealizationResult, SolveListeners, compute_chunk_here
-from .signals import CancelOnSignals
+from .signals import CancelOnSignals, stop_if_interrupted
 
 __all__ = ["RunInfo", "run"]
 
@@ -84,6 +84,7 @@ def run(
     kept and summarised, and ``outcome.status``
     says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
+    stop_if_interrupted()  # a command of several runs whose Ctrl-C was dropped (in a finalizer) starts no more
     total = scene.preset.realizations
     workers = options.workers_for(total)
     pool = make_executor(options, workers)

@@ -50,22 +50,40 @@ class WorkInterrupted(KeyboardInterrupt):
     interrupted: the finished runs are kept; ``str()`` says where, and how to go on."""
 
 
-class RaiseOnSigterm:
-    """While a command runs: SIGTERM raises Terminated (as Ctrl-C raises
-    KeyboardInterrupt outside a run); earlier signals are forgotten, and the
-    previous handler comes back at the end."""
+_in_command = False  # within RaiseOnSignals: a signal received ends the command, not only its run
+
+
+class RaiseOnSignals:
+    """While a command runs: SIGTERM raises Terminated and Ctrl-C KeyboardInterrupt (as
+    Python's own handler does), each recorded in ``received``; earlier signals are
+    forgotten, and the previous handlers come back at the end. Recorded, because Python
+    drops an exception raised in a finalizer ("Exception ignored in ..."): a signal that
+    lands there is lost, and a command of several runs would go on to its next
+    (``stop_if_interrupted``)."""
 
     def __enter__(self):
+        global _in_command
         received.clear()
-        self.previous = None
+        self.previous = {}
         if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGTERM, lambda signum, frame: _raise_for(signum))
+            self.previous = {signum: signal.signal(signum, lambda signum, frame: _raise_for(signum)) for signum in HANDLED}
+            _in_command = True
         return self
 
     def __exit__(self, *exc):
-        if self.previous is not None:
-            signal.signal(signal.SIGTERM, self.previous)
+        global _in_command
+        for signum, handler in self.previous.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+        _in_command = False if self.previous else _in_command
         return False
+
+
+def stop_if_interrupted() -> None:
+    """Before a run starts: within a command that was interrupted already (its exception
+    dropped, say), raise again instead of starting it. A notebook's own process, outside
+    any command, starts every run it asks for."""
+    if _in_command and received:
+        raise Terminated() if received[-1] == signal.SIGTERM else KeyboardInterrupt()
 
 
 class CancelOnSignals:

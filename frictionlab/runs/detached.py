@@ -140,7 +140,7 @@ def cancel(folder: str | Path) -> int:
 def _child() -> int:
     """The detached process: read the request from stdin, run it, tell the folder how it went."""
     from ..compute.heap import keep_freed_memory
-    from ..compute.signals import RaiseOnSigterm
+    from ..compute.signals import RaiseOnSignals
     from .sweeplog import SweepProgressLog
 
     keep_freed_memory()  # a process of frictionlab's own, as the command's is
@@ -151,7 +151,7 @@ def _child() -> int:
     is_sweep = bool(request["preset"].get("sweep"))
     log = SweepProgressLog(out) if is_sweep else ProgressLog(out)
     try:
-        with RaiseOnSigterm():
+        with RaiseOnSignals():
             options = RunOptions(**request["options"])
             run = _run_sweep if is_sweep else _run_one
             status = run(request, out, options, log)

@@ -44,7 +44,7 @@ def _exit_on_sigterm(app) -> None:
     is given back whole. Raised where the handler lands, it could
     stop the app's own cleanup between two escape codes and leave the terminal on the
     alternate screen. Before the app's loop runs, or once it has closed, it is raised as
-    at any other time (``signals.RaiseOnSigterm``): nothing of the screen is to give back."""
+    at any other time (``signals.RaiseOnSignals``): nothing of the screen is to give back."""
     from ..compute.signals import _raise_for
 
     loop = app._loop  # set while the app's loop runs, its cleanup included
