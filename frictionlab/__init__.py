@@ -66,11 +66,15 @@ class _MovedModules:
         from importlib import import_module
 
         old = spec.name.removeprefix(__name__ + ".")
-        return import_module(f"{__name__}.{_MOVED[old]}.{old}")
+        module = import_module(f"{__name__}.{_MOVED[old]}.{old}")
+        spec.loader_state = module.__spec__  # the import system sets module.__spec__ to this alias's next
+        return module
 
     @staticmethod
     def exec_module(module):
-        pass  # the moved module ran when it was imported under its own name
+        # The moved module ran when it was imported under its own name. Its own spec comes back:
+        # under the alias's, its relative imports warned (ImportWarning: __package__ != __spec__.parent).
+        module.__spec__ = module.__spec__.loader_state
 
 
 def _install_moved_modules() -> None:

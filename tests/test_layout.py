@@ -35,6 +35,7 @@ def test_the_top_of_the_package_holds_few_modules_beside_its_packages():
 def test_a_moved_module_imports_under_its_old_name_as_the_same_module(old):
     moved = importlib.import_module(f"frictionlab.{frictionlab._MOVED[old]}.{old}")
     assert importlib.import_module(f"frictionlab.{old}") is moved
+    assert moved.__spec__.name == moved.__name__  # its own spec kept: its relative imports do not warn
     assert not (ROOT / "frictionlab" / f"{old}.py").exists()  # one copy: the package's
 
 
