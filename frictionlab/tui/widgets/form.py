@@ -241,9 +241,8 @@ class PresetForm(VerticalScroll):
     def on_input_changed(self, event: Input.Changed) -> None:
         spec = self._specs.get(event.input.id or "")
         # only typing is an edit: the Changed that mounting an input posts is not. The field typed
-        # into may have lost the focus since (Esc acts at once, before the keys typed before it)
-        typed = event.input.has_focus or event.input is self._last_field
-        if spec is not None and self.data is not None and typed:
+        # into may have lost the focus since (Tab and Esc act at once, before the keys typed before them)
+        if spec is not None and self.data is not None and getattr(event.input, "typed", False):
             event.stop()
             self._store(spec, parse(spec, event.value))
 
