@@ -400,11 +400,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
             self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
             self.push_screen(
-                PathScreen(
-                    "Save the built-in preset's changes as",
-                    new_preset_path(self.draft_path.stem, self.save_folder),
-                    self.save_folder,
-                ),
+                PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -422,9 +418,15 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             self.say(NO_PRESET, "warning")
             return
         self.push_screen(
-            PathScreen("Save preset as", self.draft_path),
+            PathScreen("Save preset as", self._save_as_default(), self.save_folder),
             lambda path: path is not None and self._save_checked(path),
         )
+
+    def _save_as_default(self) -> Path:
+        """The file Save as offers: the preset's own, or for a built-in one (never written) its copy's."""
+        if is_builtin(self.draft_path):
+            return new_preset_path(self.draft_path.stem, self.save_folder)
+        return self.draft_path
 
     def _save_checked(self, path: Path) -> None:
         data = self._draft()
