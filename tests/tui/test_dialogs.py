@@ -115,3 +115,16 @@ async def test_save_as_on_a_built_in_preset_offers_a_copy_and_never_writes_the_s
     assert f"path: {shipped / 'quickstart.yaml'} is a built-in preset, never written" in refused
     assert (shipped / "quickstart.yaml").read_text() == original
     assert (tmp_path / "presets" / "qs.yaml").is_file()
+
+
+@sync
+async def test_new_takes_back_its_error_once_the_name_is_retyped(folders, registry):
+    """New kept saying "got 'my scene!'" under the name "rough" typed since, until Enter."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n", "ctrl+u", *"my scene!", "enter")
+        said = str(app.screen.query_one("#new-error").render())
+        await press_settled(pilot, "ctrl+u", *"rough")
+        left = app.screen.query_one("#new-error").display
+    assert said.startswith("name: must be 1 to 100 letters") and "got 'my scene!'" in said
+    assert not left

@@ -232,6 +232,7 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
+        show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
         if event.input.id == "new-name" and not self.path_edited:
             name = event.value.strip() or "my-scene"
             self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))
