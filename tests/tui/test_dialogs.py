@@ -89,6 +89,7 @@ async def test_dialogs_fit_a_60_column_terminal_and_show_their_keys_whole(folder
     assert "Esc: stay" in quit_text
 
 
+@pytest.mark.long  # a TUI session: seconds
 @sync
 async def test_save_as_on_a_built_in_preset_offers_a_copy_and_never_writes_the_shipped_file(
     tmp_path, monkeypatch, registry

@@ -4,6 +4,7 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 import numpy as np
+import pytest
 import yaml
 from pydantic import Field
 from textual.widgets import Input, Select, Static, Switch
@@ -239,3 +240,21 @@ async def test_an_edits_message_that_comes_after_the_save_leaves_the_preset_save
         changed_again = app.modified
     assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"] == 12
     assert edited and not after_save and changed_again
+
+
+@pytest.mark.parametrize("size", [(80, 24), (60, 20)])
+@sync
+async def test_the_field_tab_goes_to_stays_in_sight_as_the_help_under_the_form_grows(folders, registry, size):
+    """Tab onto the form's last row in sight: its help, a line longer than the last field's, made
+    the form a row shorter and hid the field focused (height_reference at 80x24)."""
+    app = make_app(registry)
+    async with app.run_test(size=size) as pilot:
+        form = await open_first_preset(pilot)
+        await press_settled(pilot, "enter")
+        hidden = []
+        for _ in range(18):  # the scene's and the spectrum's fields
+            await press_settled(pilot, "tab")
+            field, shown = app.focused, form.content_region
+            if not (shown.y <= field.region.y and field.region.bottom <= shown.bottom):
+                hidden.append(field.id)
+    assert hidden == []

@@ -85,6 +85,7 @@ async def test_a_resume_shows_the_realizations_its_folder_stores_at_once(folders
     assert stats == f"{total}/{total} realizations stored (resuming)"
 
 
+@pytest.mark.long  # a TUI session: seconds
 @sync
 async def test_new_presets_ctrl_s_message_goes_when_another_preset_opens(folders, registry):
     """`New preset rough.yaml: Ctrl+S saves it as presets/rough.yaml` stayed once the new preset was

@@ -374,6 +374,13 @@ class PresetForm(VerticalScroll):
     def on_focus(self, event) -> None:
         self.post_message(self.FieldFocused(None))
 
+    def on_resize(self, event) -> None:
+        """The help and problems under the form grow as a field is focused or typed into: the
+        form, shorter, keeps that field in sight (it hid the last row, the one just focused)."""
+        focused = self.screen.focused
+        if focused is not None and focused is not self and self in focused.ancestors:
+            focused.scroll_visible(animate=False)
+
     def on_descendant_focus(self, event) -> None:
         self._last_field = event.widget
         widget = event.widget
