@@ -3,6 +3,7 @@ Run tab), each read off the screen."""
 
 from pathlib import Path
 
+import pytest
 import yaml
 from textual.widgets import DataTable, Input, Static
 
@@ -264,3 +265,21 @@ async def test_ctrl_z_suspends_to_the_shell_and_fg_draws_the_screen_again(folder
         await pilot.pause()
     assert sent == [signal.SIGTSTP]
     assert {"layout": True} in redrawn
+
+
+NO_LAW = ("point 2: no law: every load from 1 to 20 presses the same points (mean 1.125 in contact), so xi is "
+          "0.245 at every load and a law in ln f is undefined; raise the loads or widen their range")  # fmt: skip
+
+
+@pytest.mark.parametrize("size", [SIZE, (60, 20)])
+@sync
+async def test_a_sweep_points_error_is_shown_whole_on_the_run_tab(folders, registry, size):
+    """At 80x24 the Run tab showed two lines of a failed point's error: it ended at 'raise the',
+    its advice (the loads to change) out of sight, with no way to scroll to it."""
+    app = sweep_app(folders, registry)
+    async with started(app, size=size) as pilot:
+        await press_settled(pilot, "f4")
+        app.query_one("RunPane")._error(NO_LAW)
+        await pilot.pause()
+        shown = " ".join(screen_text(app).split())
+    assert "raise the loads or widen their range" in shown
