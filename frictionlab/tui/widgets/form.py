@@ -74,6 +74,7 @@ class PresetForm(VerticalScroll):
         super().__init__(**kwargs)
         self.registry = registry
         self.data: dict | None = None
+        self._loaded: dict = {}  # the preset as opened: what its file leaves unsaid
         self.base_dir: Path | None = None  # the preset file's folder: relative input files are taken from it
         self.problems: list[str] = []
         self._specs: dict[str, FieldSpec] = {}
@@ -87,6 +88,7 @@ class PresetForm(VerticalScroll):
 
     async def load(self, data: dict, base_dir: Path | None = None) -> None:
         self.data = copy.deepcopy(data)
+        self._loaded = copy.deepcopy(data)
         self.base_dir = base_dir
         self._stash.clear()
         await self.recompose()
@@ -226,11 +228,22 @@ class PresetForm(VerticalScroll):
             set_path(data, (slot, "name"), default_plugin_name(slot), replace_values=True)
 
     def _store(self, spec: FieldSpec, value) -> None:
+        unsaid = get_path(self._loaded, spec.path) is MISSING
+        if spec.kind in ("bool", "choice") and unsaid and value == spec.default:
+            value = MISSING  # back to the default the file left unsaid: no change to save
         if get_path(self.data, spec.path) == value:
             return
         self.ensure_plugin_name(self.data, spec.path)
         set_path(self.data, spec.path, value, replace_values=True)
+        if value is MISSING:
+            self._prune(spec.path[:-1])
         self.revalidate(changed=True)
+
+    def _prune(self, path: tuple[str, ...]) -> None:
+        """Drop the mappings along ``path`` left empty that the file had not (``output: {}``)."""
+        while path and get_path(self.data, path) == {} and get_path(self._loaded, path) is MISSING:
+            set_path(self.data, path, MISSING)
+            path = path[:-1]
 
     def _is_new(self, widget_id: str, value) -> bool:
         if widget_id in self._seen and self._seen[widget_id] == value:
