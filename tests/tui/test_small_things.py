@@ -162,8 +162,9 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
     assert "Save as" not in pages[0] and any("Save as" in page for page in pages)
 
 
+@pytest.mark.parametrize("size", [SIZE, (60, 20)])  # at 60x20 its 45 % of the width cut 'a = 1.1474 [1.0319,'
 @sync
-async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry):
+async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry, size):
     from frictionlab.compute.fit import LogFit
     from frictionlab.tui.widgets import RunPane
     from frictionlab.tui.widgets.run import fit_lines
@@ -171,7 +172,7 @@ async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folde
     fit = LogFit(a=-12.3456, b=-0.0469, a_se=0.1, b_se=0.01, a_ci=(-12.5678, -12.1234), b_ci=(-0.0712, -0.0231),
                  confidence=0.95, bootstrap=1000, r2=0.4006, residual_rms=0.01, points=16)  # fmt: skip
     app = make_app(registry)
-    async with started(app) as pilot:
+    async with started(app, size=size) as pilot:
         app.action_show_tab("run")
         app.query_one(RunPane)._set("run-fit", "\n".join(fit_lines(fit, final=True, f_formula="F / (E* h L)")))
         await pilot.pause()
