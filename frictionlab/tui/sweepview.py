@@ -44,7 +44,8 @@ def shown_value(value: Any) -> str:
     """A swept value as the Run and Results tabs show it: a float to 6 significant digits (a
     linspace's 0.533333333333 widened the table's column, its contacts cut at 80 columns)."""
     if isinstance(value, float) and math.isfinite(value):
-        return f"{value:.6g}"
+        text = f"{value:.6g}"
+        return text if "." in text or "e" in text else text + ".0"  # 1.0, as the preset writes it
     return yaml_scalar(value)
 
 

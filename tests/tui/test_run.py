@@ -220,5 +220,5 @@ async def test_a_linspace_sweeps_table_keeps_its_contacts_on_an_80_column_screen
         table = app.query_one("#sweep-table")
         hurst = [str(table.get_row_at(i)[1]) for i in range(table.row_count)]
         fits = fits_width(table)
-    assert hurst == ["0.3", "0.533333", "0.766667", "1"]
+    assert hurst == ["0.3", "0.533333", "0.766667", "1.0"]
     assert fits, "the sweep table is cut at 80 columns"
