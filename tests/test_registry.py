@@ -99,6 +99,13 @@ def test_unknown_name_suggests_close_matches_and_lists_installed(reg):
     assert excinfo.value.exit_code == ExitCode.USAGE
 
 
+def test_unknown_name_without_a_close_one_is_a_sentence_before_the_installed_list(reg):
+    """`no spectrum plugin named 'nosuch' Installed spectrum plugins: ...` ran the two together."""
+    with pytest.raises(PluginError) as excinfo:
+        reg.get("spectrum", "nosuch")
+    assert str(excinfo.value).startswith("no spectrum plugin named 'nosuch'. Installed spectrum plugins: ")
+
+
 def test_unknown_name_without_close_match_still_lists_installed(reg):
     with pytest.raises(PluginError) as excinfo:
         reg.get("solver", "boundary-element-xyz")

@@ -247,15 +247,16 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
 
     # ------------------------------------------------------------ the status line
 
-    def say(self, text: str, severity: str = "information", title: str = "", about: Path | None = None) -> None:
+    def say(self, text: str, severity: str = "information", title: str = "", about: Path | None = None, until_open=False) -> None:
         """Show ``text`` in the status line above the footer (never over the data); it stays
         until the next message, or (``about``: the run or preset folder or file it speaks of)
-        until another row of a list is highlighted. ``text`` is shown as it is, never as markup."""
+        until another row of a list is highlighted, or (``until_open``: it speaks of the open
+        preset) until another preset opens. ``text`` is shown as it is, never as markup."""
         line = Content.assemble((f"{shown(title)}: ", "bold") if title else "", shown(text))  # no escape code from a folder
         self.blocked_by = None  # a newer message: no longer one to take back when a problem is fixed
         self.said_valid = False
         self.said_about = about
-        self.taken_back_on = "open" if text == NO_PRESET else ""
+        self.taken_back_on = "open" if until_open or text == NO_PRESET else ""
         status = self.query_one("#status", Static)
         status.update(line)
         for name in ("information", "warning", "error"):
@@ -349,7 +350,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
         if not await self._open_after_confirm(path, data, modified=True):
             return
         self.draft_source = template  # its comments are kept when the new preset is saved
-        self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.")
+        self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.", until_open=True)
 
     # ------------------------------------------------------------ editing and saving
 
@@ -398,13 +399,9 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             self.say(NO_PRESET, "warning")
             return
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
-            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning")
+            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning", until_open=True)
             self.push_screen(
-                PathScreen(
-                    "Save the built-in preset's changes as",
-                    new_preset_path(self.draft_path.stem, self.save_folder),
-                    self.save_folder,
-                ),
+                PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -422,9 +419,15 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
             self.say(NO_PRESET, "warning")
             return
         self.push_screen(
-            PathScreen("Save preset as", self.draft_path),
+            PathScreen("Save preset as", self._save_as_default(), self.save_folder),
             lambda path: path is not None and self._save_checked(path),
         )
+
+    def _save_as_default(self) -> Path:
+        """The file Save as offers: the preset's own, or for a built-in one (never written) its copy's."""
+        if is_builtin(self.draft_path):
+            return new_preset_path(self.draft_path.stem, self.save_folder)
+        return self.draft_path
 
     def _save_checked(self, path: Path) -> None:
         data = self._draft()

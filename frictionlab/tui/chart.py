@@ -98,9 +98,17 @@ def render_chart(series: list[Series], width: int, height: int, empty: str = NO_
             bits = int(cells[r, c])
             segments.append((chr(_BRAILLE + bits) if bits else " ", styles[r][c]))
         rows.append(segments)
-    left, right = _ticks(math.exp(x_lo), math.exp(x_hi))
-    middle = "f (log)"
-    gap = max(1, plot_w - len(left) - len(right) - len(middle))
-    axis = left + " " * (gap // 2) + middle + " " * (gap - gap // 2) + right
-    rows.append([(" " * label_width + axis[:plot_w].ljust(plot_w), "dim")])
+    rows.append([(_x_axis(*_ticks(math.exp(x_lo), math.exp(x_hi)), label_width, plot_w), "dim")])
     return rows
+
+
+def _x_axis(left: str, right: str, label_width: int, plot_w: int) -> str:
+    """The bottom row: the f range under the plot, its name between. Narrow (the Results plot
+    at 60 columns), the name goes, then the row takes the labels' columns too: the ends whole."""
+    middle = "f (log)"
+    gap = plot_w - len(left) - len(right) - len(middle)
+    if gap < 2:
+        middle, gap = "", plot_w - len(left) - len(right)
+    if gap < 1:
+        return f"{left} {right}".rjust(label_width + plot_w)[-(label_width + plot_w):]
+    return " " * label_width + left + " " * (gap // 2) + middle + " " * (gap - gap // 2) + right

@@ -39,5 +39,7 @@ class KeysHelp:
     def action_help_quit(self, in_field: bool = False) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
         where = "Ctrl+C copies in a text field. " if in_field else ""
+        if self.running and not self.followed.ended:  # Ctrl+C stops a program in a shell: say what stops this run
+            where += "Ctrl+C does not stop the run: c on the Run tab (F4) cancels it, keeping what finished. "
         self.say(f"{where}Ctrl+Q quits (q too, outside a text field: Esc leaves one); "
                  "a run goes on after you quit unless you cancel it.")  # fmt: skip

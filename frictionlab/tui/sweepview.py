@@ -8,6 +8,7 @@ dict ``sweep.csv`` is written from.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -39,9 +40,18 @@ def short_name(path: str) -> str:
     return path.rsplit(".", 1)[-1]
 
 
+def shown_value(value: Any) -> str:
+    """A swept value as the Run and Results tabs show it: a float to 6 significant digits (a
+    linspace's 0.533333333333 widened the table's column, its contacts cut at 80 columns)."""
+    if isinstance(value, float) and math.isfinite(value):
+        text = f"{value:.6g}"
+        return text if "." in text or "e" in text else text + ".0"  # 1.0, as the preset writes it
+    return yaml_scalar(value)
+
+
 def point_line(sweep: Sweep, point: SweepPoint) -> str:
     """``point 3/8: hurst=0.7``"""
-    values = ", ".join(f"{short_name(p)}={yaml_scalar(v)}" for p, v in point.values.items())
+    values = ", ".join(f"{short_name(p)}={shown_value(v)}" for p, v in point.values.items())
     return f"point {point.number}/{len(sweep.points)}: {values}"
 
 
@@ -72,7 +82,7 @@ def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
     contacts = "-" if first is None else f"{format_count(first)}..{format_count(last)}"
     return [
         str(row["point"]),
-        *(yaml_scalar(row[p]) for p in paths),
+        *(shown_value(row[p]) for p in paths),
         STATUS_MARKS.get(row["status"], "?"),
         _estimate(row, "a"),
         _estimate(row, "b"),

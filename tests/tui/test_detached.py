@@ -382,3 +382,17 @@ async def test_the_run_tabs_footer_offers_only_the_keys_that_apply_now(folders, 
     assert "c Cancel" in running and "u Resume" not in running
     assert app.last_outcome.status == "interrupted"
     assert "u Resume" in cancelled and "c Cancel" not in cancelled
+
+
+@sync
+async def test_ctrl_c_during_a_run_says_which_key_cancels_it(folders, registry):
+    """Ctrl+C, which stops a program in a shell, said only how to quit while a run went on: not
+    that c on the Run tab cancels it."""
+    async with a_long_run_going(folders, registry) as (app, pilot):
+        pid = app.followed.pid
+        await press_settled(pilot, "f2", "ctrl+c")
+        said = status_text(app)
+        await press_settled(pilot, "f4", "c")
+        await wait_until(pilot, lambda: app.followed is None)
+    wait_for(lambda: not process_alive(pid))  # c did as said
+    assert said.startswith("Ctrl+C does not stop the run: c on the Run tab (F4) cancels it, keeping what finished.")

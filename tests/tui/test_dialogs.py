@@ -4,6 +4,9 @@ when asked twice, and the keys of the screen behind wait until it is closed."""
 import pytest
 from textual.widgets import Input
 
+from frictionlab.options import RunOptions
+from frictionlab.preset.builtin import find_builtin
+from frictionlab.tui.app import FrictionlabApp
 from frictionlab.tui.screens.dialogs import QuitDuringRunScreen
 
 from .conftest import make_app, press_settled, screen_text, started, status_text, sync
@@ -84,3 +87,45 @@ async def test_dialogs_fit_a_60_column_terminal_and_show_their_keys_whole(folder
     assert inside
     assert cursor_x < 60
     assert "Esc: stay" in quit_text
+
+
+@pytest.mark.long  # a TUI session: seconds
+@sync
+async def test_save_as_on_a_built_in_preset_offers_a_copy_and_never_writes_the_shipped_file(
+    tmp_path, monkeypatch, registry
+):
+    """Ctrl+O on a built-in preset offered the shipped file itself, and Enter twice replaced it
+    (built-in presets are read and copied, never written)."""
+    import frictionlab.tui.folders
+
+    shipped = tmp_path / "shipped"  # a copy: the test never risks the installed presets
+    shipped.mkdir()
+    original = find_builtin("quickstart").path.read_text()
+    (shipped / "quickstart.yaml").write_text(original)
+    monkeypatch.setattr(frictionlab.tui.folders, "builtin_folder", lambda: shipped)
+    monkeypatch.chdir(tmp_path)
+    app = FrictionlabApp(str(shipped / "quickstart.yaml"), runs_dir="runs", options=RunOptions(workers=1),
+                         registry=registry)  # fmt: skip
+    async with started(app) as pilot:
+        await press_settled(pilot, "ctrl+o")
+        offered = app.screen.query_one(Input).value
+        await press_settled(pilot, "ctrl+u", *str(shipped / "quickstart"), "enter", "enter")
+        refused = str(app.screen.query_one("#path-error").render())
+        await press_settled(pilot, "ctrl+u", *"presets/qs", "enter")
+    assert offered == "presets/quickstart.yaml"
+    assert f"path: {shipped / 'quickstart.yaml'} is a built-in preset, never written" in refused
+    assert (shipped / "quickstart.yaml").read_text() == original
+    assert (tmp_path / "presets" / "qs.yaml").is_file()
+
+
+@sync
+async def test_new_takes_back_its_error_once_the_name_is_retyped(folders, registry):
+    """New kept saying "got 'my scene!'" under the name "rough" typed since, until Enter."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n", "ctrl+u", *"my scene!", "enter")
+        said = str(app.screen.query_one("#new-error").render())
+        await press_settled(pilot, "ctrl+u", *"rough")
+        left = app.screen.query_one("#new-error").display
+    assert said.startswith("name: must be 1 to 100 letters") and "got 'my scene!'" in said
+    assert not left

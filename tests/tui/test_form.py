@@ -4,6 +4,7 @@ from pathlib import Path
 from typing import ClassVar, Literal
 
 import numpy as np
+import pytest
 import yaml
 from pydantic import Field
 from textual.widgets import Input, Select, Static, Switch
@@ -239,3 +240,46 @@ async def test_an_edits_message_that_comes_after_the_save_leaves_the_preset_save
         changed_again = app.modified
     assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"] == 12
     assert edited and not after_save and changed_again
+
+
+@pytest.mark.parametrize("size", [(80, 24), (60, 20)])
+@sync
+async def test_the_field_tab_goes_to_stays_in_sight_as_the_help_under_the_form_grows(folders, registry, size):
+    """Tab onto the form's last row in sight: its help, a line longer than the last field's, made
+    the form a row shorter and hid the field focused (height_reference at 80x24)."""
+    app = make_app(registry)
+    async with app.run_test(size=size) as pilot:
+        form = await open_first_preset(pilot)
+        await press_settled(pilot, "enter")
+        hidden = []
+        for _ in range(18):  # the scene's and the spectrum's fields
+            await press_settled(pilot, "tab")
+            field, shown = app.focused, form.content_region
+            if not (shown.y <= field.region.y and field.region.bottom <= shown.bottom):
+                hidden.append(field.id)
+    assert hidden == []
+
+
+@sync
+async def test_a_switch_or_choice_put_back_to_what_the_file_left_unsaid_is_not_a_change(folders, registry):
+    """tiny.yaml has no output section, nor slope params: output.realizations toggled off and on
+    again, or line_end chosen away and back, left the title `(modified)` (q asked about unsaved
+    changes, Ctrl+S wrote `output: {realizations: true}`) though the preset was as its file."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        switch = app.query_one("#field--output--realizations", Switch)
+        switch.focus()
+        await press_settled(pilot, "space")
+        toggled = app.modified
+        await press_settled(pilot, "space")
+        switched_back = app.modified
+        line_end = app.query_one("#field--slope--params--line_end", Select)
+        first = line_end.value
+        other = next(v for _, v in line_end._options if v not in (first, Select.NULL))
+        await choose(pilot, "field--slope--params--line_end", other)
+        chosen = app.modified
+        await choose(pilot, "field--slope--params--line_end", first)
+        chosen_back, data = app.modified, app._draft()
+    assert (toggled, switched_back, chosen, chosen_back) == (True, False, True, False)
+    assert "output" not in data and "params" not in data["slope"]

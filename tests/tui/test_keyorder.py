@@ -107,3 +107,26 @@ async def test_arrows_then_d_typed_fast_duplicate_the_row_the_arrows_went_to(fol
         asked = app.screen.title_text
     assert names[:3] == ["b-second", "c-third", "tiny"]
     assert asked.startswith("Duplicate tiny.yaml")
+
+
+
+@sync
+async def test_keys_a_field_handles_after_tab_moved_the_focus_are_kept(folders, registry):
+    """Keys typed fast then Tab: the app hands the letters to the field's queue and runs Tab at
+    once, so the field types them once the focus has moved on. Their edit was taken for the
+    Changed that mounting a field posts and dropped: the field showed "big" while the preset
+    held it empty (Ctrl+S saved no name, Ctrl+R refused one the screen showed)."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        name = app.query_one("#field--name", Input)
+        await pilot.press("enter", "tab")  # into the name, then on to the next field
+        await pilot.pause()
+        assert app.focused is not name
+        for key in ["ctrl+u", *"big"]:  # handed to the name before Tab, handled by it after
+            name.post_message(events.Key(key, None if key == "ctrl+u" else key))
+        name.post_message(events.Paste("-2"))  # a paste, the same
+        await wait_until(pilot, lambda: name.value == "big-2", timeout=10.0)
+        await pilot.pause()
+        kept, problems = form.data["name"], form.problems
+    assert (kept, problems) == ("big-2", [])

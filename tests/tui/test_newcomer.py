@@ -369,7 +369,7 @@ def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_
 
     nan = float("nan")
     lines = fit_lines(LogFit(a=0.8, b=0.02, r2=0.99, a_ci=(nan, nan), b_ci=(nan, nan), bootstrap=0), final=True)
-    assert "  no CI (bootstrap off, or < 2 realizations)" in lines
+    assert "  no CI (bootstrap off,\n  or < 2 realizations)" in "\n".join(lines)  # two lines: the panel is as wide as its longest
     assert not any("bootstrap 0 " in line or line.endswith("bootstrap 0") for line in lines)
     assert progress_text(8, 8, 0, 0.5, restored=8) == "8/8 realizations (8 restored), elapsed 0.5 s"  # a point restored whole
     assert progress_text(3, 8, 0, 0.5, restored=3) == "3/8 realizations (3 restored), elapsed 0.5 s"

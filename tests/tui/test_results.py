@@ -218,3 +218,25 @@ async def test_a_run_made_before_results_is_first_shown_is_the_row_highlighted_t
         kept = pane.highlighted().path
     assert highlighted == app.last_out_dir and opened == [app.last_out_dir]
     assert kept == moved != highlighted
+
+
+@sync
+async def test_a_failed_run_opened_says_why_it_failed(folders, registry):
+    """A failed run (a sweep's point with no law) opened in Results said `failed 8/8, contacts
+    1.12..1.12` and nothing of why; its summary.json says why, with what to change."""
+    make_runs(folders, registry)
+    why = "no law: every load from 1 to 20 presses the same points; raise the loads or widen their range"
+    summary_file = folders / "runs" / "seed2" / "summary.json"
+    summary = json.loads(summary_file.read_text())
+    summary.update(status="failed", error=why, fit=None)  # as a run with no law writes it
+    summary_file.write_text(json.dumps(summary))
+    run_file = folders / "runs" / "seed2" / "run.json"
+    run_file.write_text(json.dumps({**json.loads(run_file.read_text()), "status": "failed"}))
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5")
+        names = [entry.path.name for entry in app.query_one(ResultsPane).runs]
+        app.query_one("#runs-table").move_cursor(row=names.index("seed2"))
+        await press_settled(pilot, "enter")
+        info = str(app.query_one("#results-info", Static).render())
+    assert "failed" in info and why in " ".join(info.split())

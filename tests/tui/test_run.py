@@ -207,3 +207,18 @@ async def test_a_finished_sweeps_plot_keeps_its_whole_legend_and_the_room_the_ta
     if size != SIZE:  # room enough: the table takes its rows (and header), the plot the rest
         assert table_rows == points + 1
         assert body_rows >= size[1] - 17
+
+
+@sync
+async def test_a_linspace_sweeps_table_keeps_its_contacts_on_an_80_column_screen(folders, registry):
+    """hurst 0.3 .. 1.0 in 4 points: its column showed 0.533333333333, and the contacts column
+    was cut at 80 columns ('con', '1.1')."""
+    sweep = {**SWEEP, "sweep": {"parameters": {"spectrum.params.hurst": {"start": 0.3, "stop": 1.0, "num": 4}}}}
+    app = sweep_app(folders, registry, sweep)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        table = app.query_one("#sweep-table")
+        hurst = [str(table.get_row_at(i)[1]) for i in range(table.row_count)]
+        fits = fits_width(table)
+    assert hurst == ["0.3", "0.533333", "0.766667", "1.0"]
+    assert fits, "the sweep table is cut at 80 columns"

@@ -3,6 +3,7 @@ Run tab), each read off the screen."""
 
 from pathlib import Path
 
+import pytest
 import yaml
 from textual.widgets import DataTable, Input, Static
 
@@ -161,8 +162,9 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
     assert "Save as" not in pages[0] and any("Save as" in page for page in pages)
 
 
+@pytest.mark.parametrize("size", [SIZE, (60, 20)])  # at 60x20 its 45 % of the width cut 'a = 1.1474 [1.0319,'
 @sync
-async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry):
+async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry, size):
     from frictionlab.compute.fit import LogFit
     from frictionlab.tui.widgets import RunPane
     from frictionlab.tui.widgets.run import fit_lines
@@ -170,7 +172,7 @@ async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folde
     fit = LogFit(a=-12.3456, b=-0.0469, a_se=0.1, b_se=0.01, a_ci=(-12.5678, -12.1234), b_ci=(-0.0712, -0.0231),
                  confidence=0.95, bootstrap=1000, r2=0.4006, residual_rms=0.01, points=16)  # fmt: skip
     app = make_app(registry)
-    async with started(app) as pilot:
+    async with started(app, size=size) as pilot:
         app.action_show_tab("run")
         app.query_one(RunPane)._set("run-fit", "\n".join(fit_lines(fit, final=True, f_formula="F / (E* h L)")))
         await pilot.pause()
@@ -264,3 +266,21 @@ async def test_ctrl_z_suspends_to_the_shell_and_fg_draws_the_screen_again(folder
         await pilot.pause()
     assert sent == [signal.SIGTSTP]
     assert {"layout": True} in redrawn
+
+
+NO_LAW = ("point 2: no law: every load from 1 to 20 presses the same points (mean 1.125 in contact), so xi is "
+          "0.245 at every load and a law in ln f is undefined; raise the loads or widen their range")  # fmt: skip
+
+
+@pytest.mark.parametrize("size", [SIZE, (60, 20)])
+@sync
+async def test_a_sweep_points_error_is_shown_whole_on_the_run_tab(folders, registry, size):
+    """At 80x24 the Run tab showed two lines of a failed point's error: it ended at 'raise the',
+    its advice (the loads to change) out of sight, with no way to scroll to it."""
+    app = sweep_app(folders, registry)
+    async with started(app, size=size) as pilot:
+        await press_settled(pilot, "f4")
+        app.query_one("RunPane")._error(NO_LAW)
+        await pilot.pause()
+        shown = " ".join(screen_text(app).split())
+    assert "raise the loads or widen their range" in shown

@@ -83,3 +83,22 @@ async def test_a_resume_shows_the_realizations_its_folder_stores_at_once(folders
         await wait_until(pilot, lambda: app.followed is None)
     assert shown == (total, total)
     assert stats == f"{total}/{total} realizations stored (resuming)"
+
+
+@pytest.mark.long  # a TUI session: seconds
+@sync
+async def test_new_presets_ctrl_s_message_goes_when_another_preset_opens(folders, registry):
+    """`New preset rough.yaml: Ctrl+S saves it as presets/rough.yaml` stayed once the new preset was
+    discarded and tiny opened: Ctrl+S then saved tiny.yaml, not what the status line said."""
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "n", "ctrl+u", *"rough", "enter")
+        await wait_until(pilot, lambda: app.draft_path is not None)
+        said = status_text(app)
+        await press_settled(pilot, "f2", "home", "enter")
+        await press_settled(pilot, "y")  # discard the new preset's changes
+        await wait_until(pilot, lambda: app.draft_path.name == "tiny.yaml")
+        await pilot.pause()
+        after = status_text(app)
+    assert said == "New preset rough.yaml: Ctrl+S saves it as presets/rough.yaml."
+    assert after == ""

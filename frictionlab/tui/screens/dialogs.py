@@ -15,7 +15,7 @@ from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
-from ..folders import new_preset_path
+from ..folders import is_builtin, new_preset_path
 from ..widgets.keyinput import KeyInput
 
 
@@ -146,6 +146,8 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
         return None, f"path: {path} is a folder; give a file name"
     if not path.parent.is_dir() and not (folder is not None and _same(path.parent, Path(folder))):
         return None, f"path: the folder {path.parent} does not exist"
+    if is_builtin(path):  # shipped with frictionlab: read and copied, never replaced
+        return None, f"path: {path} is a built-in preset, never written; give a file of your own"
     return path, ""
 
 
@@ -230,6 +232,7 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
+        show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
         if event.input.id == "new-name" and not self.path_edited:
             name = event.value.strip() or "my-scene"
             self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))

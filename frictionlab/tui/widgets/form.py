@@ -74,6 +74,7 @@ class PresetForm(VerticalScroll):
         super().__init__(**kwargs)
         self.registry = registry
         self.data: dict | None = None
+        self._loaded: dict = {}  # the preset as opened: what its file leaves unsaid
         self.base_dir: Path | None = None  # the preset file's folder: relative input files are taken from it
         self.problems: list[str] = []
         self._specs: dict[str, FieldSpec] = {}
@@ -87,6 +88,7 @@ class PresetForm(VerticalScroll):
 
     async def load(self, data: dict, base_dir: Path | None = None) -> None:
         self.data = copy.deepcopy(data)
+        self._loaded = copy.deepcopy(data)
         self.base_dir = base_dir
         self._stash.clear()
         await self.recompose()
@@ -226,11 +228,22 @@ class PresetForm(VerticalScroll):
             set_path(data, (slot, "name"), default_plugin_name(slot), replace_values=True)
 
     def _store(self, spec: FieldSpec, value) -> None:
+        unsaid = get_path(self._loaded, spec.path) is MISSING
+        if spec.kind in ("bool", "choice") and unsaid and value == spec.default:
+            value = MISSING  # back to the default the file left unsaid: no change to save
         if get_path(self.data, spec.path) == value:
             return
         self.ensure_plugin_name(self.data, spec.path)
         set_path(self.data, spec.path, value, replace_values=True)
+        if value is MISSING:
+            self._prune(spec.path[:-1])
         self.revalidate(changed=True)
+
+    def _prune(self, path: tuple[str, ...]) -> None:
+        """Drop the mappings along ``path`` left empty that the file had not (``output: {}``)."""
+        while path and get_path(self.data, path) == {} and get_path(self._loaded, path) is MISSING:
+            set_path(self.data, path, MISSING)
+            path = path[:-1]
 
     def _is_new(self, widget_id: str, value) -> bool:
         if widget_id in self._seen and self._seen[widget_id] == value:
@@ -241,9 +254,8 @@ class PresetForm(VerticalScroll):
     def on_input_changed(self, event: Input.Changed) -> None:
         spec = self._specs.get(event.input.id or "")
         # only typing is an edit: the Changed that mounting an input posts is not. The field typed
-        # into may have lost the focus since (Esc acts at once, before the keys typed before it)
-        typed = event.input.has_focus or event.input is self._last_field
-        if spec is not None and self.data is not None and typed:
+        # into may have lost the focus since (Tab and Esc act at once, before the keys typed before them)
+        if spec is not None and self.data is not None and getattr(event.input, "typed", False):
             event.stop()
             self._store(spec, parse(spec, event.value))
 
@@ -374,6 +386,13 @@ class PresetForm(VerticalScroll):
 
     def on_focus(self, event) -> None:
         self.post_message(self.FieldFocused(None))
+
+    def on_resize(self, event) -> None:
+        """The help and problems under the form grow as a field is focused or typed into: the
+        form, shorter, keeps that field in sight (it hid the last row, the one just focused)."""
+        focused = self.screen.focused
+        if focused is not None and focused is not self and self in focused.ancestors:
+            focused.scroll_visible(animate=False)
 
     def on_descendant_focus(self, event) -> None:
         self._last_field = event.widget

@@ -14,9 +14,16 @@ class KeyInput(Input):
     Keys a terminal delivers together (fast typing) then act out of order: ``Ctrl+U``
     followed by ``123`` inserted 123 and then cleared it with the late Ctrl+U, and
     ``Home 7`` put the 7 at the end. Run here, a binding acts before the next key.
+
+    ``typed`` says a key or a paste reached it: its Changed is then the user's edit, even where
+    the focus has moved on meanwhile (Tab typed just after runs first), and never the one
+    mounting it posts.
     """
 
+    typed = False
+
     async def _on_key(self, event: events.Key) -> None:
+        self.typed = True
         bindings = self._bindings.key_to_bindings.get(event.key)
         if bindings and not event.is_printable:
             event.stop()
@@ -24,6 +31,9 @@ class KeyInput(Input):
             await self.run_action(bindings[0].action)
             return
         await super()._on_key(event)
+
+    def _on_paste(self, event: events.Paste) -> None:
+        self.typed = True  # Textual then calls Input's own, which pastes
 
     def action_copy(self) -> None:
         """Ctrl+C copies here, and says (as it does elsewhere) what quits."""

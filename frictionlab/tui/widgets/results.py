@@ -292,6 +292,9 @@ def _entry_lines(entry: RunEntry, style: str) -> list[Content]:
     lines = [Content.assemble((f"■ {entry.path.name}", style), f" f = {formula}" if formula else "")]
     contacts = f", contacts {format_count(counts[0])}..{format_count(counts[1])}" if math.isfinite(counts[0]) else ""
     lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
+    error = entry.summary.get("error")
+    if isinstance(error, str) and error:  # why it failed (no law, say): the advice that comes with it
+        lines.append(Content.assemble("  ", (shown(error), "red")))
     if entry.fit is not None:
         interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731
         lines.append(f"  a={entry.a:.4f} {interval('a_ci')} R^2={entry.r2:.4f}")

@@ -40,8 +40,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
             *what,
             f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
             f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
-            f"  {level} CI, bootstrap {fit.bootstrap}" if fit.bootstrap else
-            "  no CI (bootstrap off, or < 2 realizations)",  # either: the fit cannot tell
+            *([f"  {level} CI, bootstrap {fit.bootstrap}"] if fit.bootstrap else
+              ["  no CI (bootstrap off,", "  or < 2 realizations)"]),  # either; two lines: the panel is as wide as its longest
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
     return lines
