@@ -335,6 +335,9 @@ def _write_failed(exc: OSError) -> int:
 
 def _run_command(args) -> int:
     try:
+        from .options import refuse_empty_paths
+
+        refuse_empty_paths(args.parser, args)
         code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code

@@ -34,9 +34,7 @@ def run(args) -> ExitCode:
     """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
     from ..compute.fit import LogFit, format_number, json_safe
     from ..paper.predict import check_law, predict_xi, prediction_text, read_run_law
-    from .options import refuse_empty_path
 
-    refuse_empty_path(args.from_run, "--from", otherwise="the law by --a and --b")  # not "no --from": Path("") is this folder
     if args.from_run:
         given = [name for name, value in (("--a", args.a), ("--b", args.b), ("--a-ci", args.a_ci), ("--b-ci", args.b_ci),
                                           ("--confidence", args.confidence)) if value is not None]  # fmt: skip

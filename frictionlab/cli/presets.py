@@ -42,9 +42,6 @@ def run(args) -> ExitCode:
     from ..preset.builtin import builtin_presets
 
     if getattr(args, "action", None) == "copy":
-        from .options import refuse_empty_path
-
-        refuse_empty_path(args.dest, "DEST", "file or folder", "leave it out for this folder")
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
             from ..io.files import output_path_problem

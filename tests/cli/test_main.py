@@ -154,6 +154,62 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
 
 
+PATH_METAVARS = ("DIR", "RUN_DIR", "FILE", "DEST")
+
+
+def _path_arguments():
+    """(command words up to the path argument, the argument's name) for every path argument of
+    every command: an option or a positional whose metavar names a file or a folder."""
+    from frictionlab.cli.main import build_parser
+
+    def walk(parser, words):
+        for action in parser._actions:
+            if action.choices and isinstance(action.choices, dict):  # a command's own commands (presets copy)
+                for name, child in action.choices.items():
+                    yield from walk(child, [*words, name])
+            elif action.metavar in PATH_METAVARS:
+                yield words, action
+
+    yield from walk(build_parser(), [])
+
+
+def _filled(words: list[str], path, parser) -> list[str]:
+    """``words`` with every other required argument given a value argparse takes."""
+    argv = list(words)
+    for action in parser._actions:
+        if action is path or not (action.required or (not action.option_strings and action.nargs is None)):
+            continue
+        value = next(iter(action.choices)) if action.choices else "1"
+        argv += [action.option_strings[0], value] if action.option_strings else [value]
+    return argv
+
+
+@pytest.mark.parametrize("words, name", [
+    pytest.param(words, name, id=" ".join([*words, name]))
+    for words, action in _path_arguments() for name in [action.option_strings[-1] if action.option_strings else action.metavar]
+])
+def test_every_path_argument_given_empty_is_refused_before_the_command_runs(words, name, tmp_path, monkeypatch, capsys):
+    """study --out "" and exact3d --out/--runs/--presets "" were taken as not given: a study
+    into a new folder of runs/, hours of exact 3D runs; every path argument is refused alike."""
+    import importlib
+
+    from frictionlab.cli import main
+    from frictionlab.cli.main import build_parser
+
+    module = importlib.import_module(f"frictionlab.cli.{words[0]}")
+    monkeypatch.setattr(module, "run", lambda args: pytest.fail(f"{' '.join(words)} ran with {name} empty"))
+    monkeypatch.chdir(tmp_path)
+    parser = build_parser()
+    for word in words:
+        parser = next(a for a in parser._actions if isinstance(a.choices, dict)).choices[word]
+    path = next(a for a in parser._actions if (a.option_strings[-1] if a.option_strings else a.metavar) == name)
+    argv = _filled(words, path, parser)
+    argv += [name, ""] if path.option_strings else [""]
+    assert main(argv) == ExitCode.USAGE
+    assert f"{name} names no " in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_presets_copy_into_a_missing_folder_or_under_a_file_is_refused_naming_it(tmp_path, capsys):
     """open() of DEST in a folder that does not exist said only "No such file or directory"
     with exit code 1; the folder is named, with exit code 4, and nothing is made."""
