@@ -155,6 +155,18 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     assert "--finished-only" in err and "--runs DIR" in err and not (tmp_path / "p2").exists()
 
 
+@pytest.mark.parametrize("made, said", [(None, "does not exist"), ("file", "is not a folder")])
+def test_finished_only_from_a_runs_folder_that_is_not_one_says_so(made, said, tmp_path, capsys):
+    """It was told 'holds no finished exact ensemble', as of an empty folder of runs."""
+    runs = tmp_path / "runs"
+    if made:
+        runs.write_text("mine")
+    assert main(["exact3d", "--quick", "--finished-only", "--runs", str(runs), "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"--runs {runs} {said}" in err and "holds no" not in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["runs"] if made else [])
+
+
 def f_column(folder):
     return np.loadtxt(folder / "curve.csv", delimiter=",", skiprows=1, usecols=1)
 

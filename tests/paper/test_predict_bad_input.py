@@ -141,6 +141,12 @@ def test_a_missing_folder_is_a_run_folder_error(tmp_path, capsys):
     assert code == ExitCode.RUN_FOLDER and "no readable summary.json there (no such folder)" in err
 
 
+def test_a_file_given_as_the_run_folder_is_named_a_file_not_missing(run_copy, capsys):
+    """--from RUN/summary.json was told 'no such folder' of a file that is there."""
+    code, _, err = predict_from(run_copy / "summary.json", capsys)
+    assert code == ExitCode.RUN_FOLDER and "(not a folder: give the run's folder)" in err and "no such" not in err
+
+
 # ------------------------------------------------------------------ realizations.npz damaged
 
 
