@@ -53,6 +53,9 @@ def run(args) -> ExitCode:
         confidence = 0.95 if args.confidence is None else args.confidence
         law, fitted_f, pairs = LogFit(args.a, args.b, confidence=confidence, **intervals), None, None
         check_law(law, {field: "--" + field.replace("_", "-") for field in ("a", "b", "a_ci", "b_ci", "confidence")})
+        if args.confidence is not None and args.a_ci is None:  # as --tls-cert without a tls:// scheduler
+            raise FrictionlabError(f"--confidence {args.confidence:g} is the level of --a-ci and --b-ci, but there are "
+                                   "none: it would be ignored; give the intervals, or leave --confidence out")  # fmt: skip
     prediction = predict_xi(
         law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
         pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,
