@@ -52,6 +52,11 @@ def executor_run_options(args, **fields):
             "or leave --scheduler out for frictionlab's own local cluster"
         )
     _use_tls_options(args)
+    if args.executor == "serial" and args.workers is not None and args.workers > 1:
+        raise FrictionlabError(
+            f"--workers {args.workers} with --executor serial, which runs every realization in this process, one at "
+            "a time: it would be ignored; give --executor processes (or dask), or leave --workers out"
+        )
     if args.dashboard and (args.executor != "dask" or args.scheduler):
         raise FrictionlabError(
             "--dashboard serves the dashboard of frictionlab's own Dask cluster: it needs --executor dask "

@@ -53,6 +53,18 @@ def test_the_dashboard_without_frictionlabs_own_dask_cluster_is_refused_not_igno
         assert "--dashboard serves the dashboard of frictionlab's own Dask cluster" in capsys.readouterr().err
 
 
+def test_workers_with_the_serial_executor_are_refused_not_ignored(tmp_path, capsys):
+    """--executor serial --workers 4 ran on one worker, the 4 ignored but for '1 worker(s)' in the progress."""
+    from frictionlab.cli import main
+
+    out = tmp_path / "out"
+    assert main(["run", "quickstart", "--out", str(out), "--executor", "serial", "--workers", "4", "--quiet"]) == ExitCode.USAGE
+    assert "--workers 4 with --executor serial" in capsys.readouterr().err and not out.exists()
+    assert main(["run", "quickstart", "--executor", "serial", "--workers", "1", "--out", str(out), "--quiet"]) == ExitCode.OK
+    assert main(["resume", str(out), "--executor", "serial", "--workers", "4", "--quiet"]) == ExitCode.USAGE
+    assert "--workers 4 with --executor serial" in capsys.readouterr().err
+
+
 def test_tls_files_without_a_tls_scheduler_are_refused_not_ignored(tmp_path, capsys):
     """--tls-* only ever reach a tls:// scheduler: given without one, the run went on, unencrypted or on
     frictionlab's own cluster, as if they had been used."""
