@@ -65,6 +65,22 @@ def test_workers_with_the_serial_executor_are_refused_not_ignored(tmp_path, caps
     assert "--workers 4 with --executor serial" in capsys.readouterr().err
 
 
+def test_a_value_argparse_cannot_read_is_said_cut_short_and_a_too_long_number_as_such(capsys):
+    """--seed of 5000 digits was 'invalid int value' (Python reads at most 4300), quoted in full,
+    and a 500-character --workers too."""
+    from frictionlab.cli import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["run", "quickstart", "--seed", "9" * 5000])
+    err = capsys.readouterr().err
+    assert exit_.value.code == ExitCode.USAGE and len(err.splitlines()[-1]) < 300
+    assert "argument --seed: invalid int value: '999" in err and "a whole number of 5000 digits, too long" in err
+    with pytest.raises(SystemExit):
+        main(["run", "quickstart", "--workers", "x" * 500])
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert "argument --workers: invalid int value: 'xxx" in last and "..." in last and len(last) < 300
+
+
 def test_tls_files_without_a_tls_scheduler_are_refused_not_ignored(tmp_path, capsys):
     """--tls-* only ever reach a tls:// scheduler: given without one, the run went on, unencrypted or on
     frictionlab's own cluster, as if they had been used."""
