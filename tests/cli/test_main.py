@@ -1,6 +1,7 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
 import math
+import os
 import subprocess
 import sys
 
@@ -236,6 +237,17 @@ def test_every_path_argument_given_empty_is_refused_before_the_command_runs(word
     assert main(argv) == ExitCode.USAGE
     assert f"{name} names no " in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc, a folder no file can be made in")
+def test_presets_copy_into_a_folder_no_file_can_be_made_in_is_refused_naming_it(capsys):
+    """DEST /proc/self/x was 'No such file or directory: /proc/self/x' with exit code 1; the folder
+    is tried first, as schema --out's is."""
+    from frictionlab.cli import main
+
+    assert main(["presets", "copy", "quickstart", "/proc/self/q.yaml"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert "DEST /proc/self/q.yaml: /proc/self cannot be written in" in err and "a folder you can write to" in err
 
 
 def test_presets_copy_into_a_missing_folder_or_under_a_file_is_refused_naming_it(tmp_path, capsys):
