@@ -62,7 +62,10 @@ class PluginError(FrictionlabError):
 
 class PresetError(FrictionlabError):
     """A preset failed validation. ``problems`` holds one line per problem, each
-    starting with the dotted path of the offending field."""
+    starting with the dotted path of the offending field; the message shows the first
+    ``SHOWN_PROBLEMS`` (a preset of thousands of unknown keys said megabytes of them)."""
+
+    SHOWN_PROBLEMS = 50
 
     def __init__(self, problems: list[str], source: str | None = None):
         self.problems = list(problems)
@@ -70,7 +73,10 @@ class PresetError(FrictionlabError):
         where = f"{source}: " if source else ""
         count = len(self.problems)
         head = f"{where}{count} problem{'s' if count != 1 else ''} in preset"
-        super().__init__("\n".join([head, *("  " + p for p in self.problems)]))
+        shown = ["  " + p for p in self.problems[: self.SHOWN_PROBLEMS]]
+        if count > self.SHOWN_PROBLEMS:
+            shown.append(f"  (and {count - self.SHOWN_PROBLEMS} more; frictionlab validate --json lists every one)")
+        super().__init__("\n".join([head, *shown]))
 
 
 class PresetFileError(PresetError):

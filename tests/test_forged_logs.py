@@ -269,7 +269,7 @@ def test_follow_of_a_sweep_whose_point_folder_was_swapped_says_why_and_advice_th
     assert main(["follow", str(out)]) == 1
     said = capsys.readouterr().out
     line = next(line for line in said.splitlines() if "hurst=0.5" in line)
-    assert "error: cannot resume" in line and "preset differs" in said and f"move {first} aside" in said
+    assert "error: cannot resume" in line and "started with differs from the one given" in said and f"move {first} aside" in said
     assert "do what the points in error say, then frictionlab resume" in said
     shutil.move(first, tmp_path / "aside")  # what it advises
     assert run_sweep(sweep, out, RunOptions(workers=1, resume=True), plot=False).status == "completed"

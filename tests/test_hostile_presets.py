@@ -354,6 +354,36 @@ def test_the_range_a_magnitude_refusal_names_is_the_fields_own(tmp_path, capsys,
     assert said in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("assignment", "said"), [
+    ("spectrum.params={hurst: 0.5, hurst: 0.6}", "duplicate key 'hurst'"),
+    ("sweep.parameters.seed.values=[1, 2", "a [ list opened here is not closed"),
+    pytest.param("description=" + "[" * 100 + "]" * 100, "nested more than", id="deep-list"),
+])  # fmt: skip
+def test_a_set_mapping_or_list_yaml_cannot_read_is_refused_with_its_reason(tmp_path, capsys, assignment, said):
+    """A --set value YAML could not read was taken as text: a mapping with a key twice was then
+    'must be a mapping of keys to values, got '{hurst: 0.5, hurst: 0.6}'', its reason unsaid, and a
+    list left open became a description. One that starts as a mapping or list is refused with why."""
+    path = tmp_path / "p.yaml"
+    path.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["validate", str(path), "--set", assignment]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "a { mapping or [ list YAML cannot read: " in err and said in err and len(err) < 1000
+    assert main(["validate", str(path), "--set", 'description="[draft"']) == ExitCode.OK  # quoted: text
+
+
+def test_thousands_of_problems_are_said_as_the_first_fifty_and_a_count(tmp_path, capsys):
+    """A preset of 5000 unknown keys (60 kB) made 890 kB of stderr, one line each; --json keeps every one."""
+    path = tmp_path / "p.yaml"
+    data = {**SMALL_PRESET, **{f"k{i}": i for i in range(5000)}}
+    path.write_text(yaml.safe_dump(data))
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "5000 problems in preset" in err and err.count(": is not a known field") == 50
+    assert "(and 4950 more; frictionlab validate --json lists every one)" in err and len(err) < 20_000
+    assert main(["validate", str(path), "--json"]) == ExitCode.USAGE
+    assert len(json.loads(capsys.readouterr().out)["presets"][0]["problems"]) == 5000
+
+
 def test_a_set_into_a_sweep_takes_the_swept_path_as_one_key(tmp_path, capsys):
     """`sweep.parameters.spectrum.params.hurst.values=...`: the swept path is one key of
     sweep.parameters; it was split at every dot and refused as unknown fields."""

@@ -100,7 +100,7 @@ def test_a_fresh_run_into_its_own_completed_folder_says_it_runs_again(make_scene
         run_to_folder(scene, tmp_path / "run", RunOptions(workers=2))
     assert (tmp_path / "run" / "curve.csv").read_text() == before
     with warnings.catch_warnings():  # a new folder, and an unfinished run resumed, say nothing of it
-        warnings.simplefilter("error")
+        warnings.simplefilter("error", UserWarning)  # the run's own; not an ImportWarning of a lazy import
         run_to_folder(scene, tmp_path / "new", RunOptions(workers=1))
 
 
@@ -152,9 +152,23 @@ def test_resume_with_another_preset_is_refused_naming_what_differs(make_scene, t
     with pytest.raises(FrictionlabError) as caught:
         run_to_folder(other, tmp_path / "run", RunOptions(workers=1, resume=True))
     message = str(caught.value)
-    assert message.startswith(f"cannot resume {tmp_path / 'run'}: its preset differs from the one given")
+    assert message.startswith(f"cannot resume {tmp_path / 'run'}: the preset its run.json started with differs from the one given")
     assert "realizations: 8 in the run directory, 9 given" in message
     assert "spectrum.params.hurst: 0.8 in the run directory, 0.7 given" in message
+
+
+def test_resume_of_a_folder_whose_preset_yaml_was_edited_names_that_file(make_scene, tmp_path, capsys):
+    """`frictionlab resume DIR` gives no preset, yet was told its preset 'differs from the one
+    given'; the one given is DIR/preset.yaml, edited, and the message names it and run.json."""
+    cancel = threading.Event()
+    cancel.set()
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1), cancel=cancel)
+    stored = tmp_path / "run" / "preset.yaml"
+    stored.write_text(stored.read_text().replace("realizations: 8", "realizations: 9"))
+    assert main(["resume", str(tmp_path / "run"), "--workers", "1", "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"the preset its run.json started with differs from the one given ({stored})" in err
+    assert "realizations: 8 in the run directory, 9 given" in err
 
 
 def _as_written_before(run: Path, fields: list[tuple[str, ...]]) -> None:

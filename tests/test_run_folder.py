@@ -335,6 +335,8 @@ def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
         (lambda d: {**d, "status": 5}, "status is not a word"),
         (lambda d: {**d, "format": "2"}, "format is not a whole number, but a string"),  # was: every chunk
         (lambda d: {**d, "format": 2.0}, "format is not a whole number, but a number"),  # ignored and computed again
+        (lambda d: {**d, "format": 0}, "(format 0: the first is 1)"),  # no frictionlab wrote it: as "2" was
+        (lambda d: {**d, "format": -10**30}, "(format of more than 9 digits: the first is 1)"),
         (lambda d: {**d, "preset": "x"}, "preset is not a mapping"),
         (lambda d: {**d, "inputs": [1]}, "inputs is not a mapping"),
         (lambda d: "[" * 100_000 + "]" * 100_000, "nested too deep"),

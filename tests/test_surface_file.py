@@ -307,6 +307,27 @@ def test_a_bad_channel_is_named_at_its_own_path(tmp_path, registry, channel, sai
     assert said in str(info.value) and "constrained" not in str(info.value)
 
 
+@pytest.mark.parametrize("plugin, name", [("surface-file", "map.npy"), ("surface-file", "map.csv"), ("profile-file", "line.npy"),
+                                          ("profile-file", "line.txt")])
+def test_a_channel_asked_of_a_table_is_refused_naming_it(tmp_path, registry, plugin, name):
+    """A table holds one array of heights: channel: 'Z Sensor' (or 3) was ignored without a
+    word and the run went on with exit 0."""
+    heights = np.random.default_rng(0).standard_normal((16, 16) if plugin == "surface-file" else 64)
+    path = tmp_path / name
+    np.save(path, heights) if name.endswith(".npy") else np.savetxt(path, heights, delimiter=",")
+    data = surface_preset(path, "mdr")
+    data["spectrum"] = {"name": plugin, "params": {"path": str(path), "spacing": 1.0, "channel": "Z Sensor"}}
+    with pytest.raises(PresetError) as info:
+        build_scene(data, registry=registry)
+    said = str(info.value)
+    assert f"channel 'Z Sensor' picks a channel of an instrument file, but {name!r} is read as a table" in said
+    data["spectrum"]["params"]["format"] = "instrument"  # an instrument's export of that suffix may have channels
+    try:
+        build_scene(data, registry=registry)
+    except PresetError as exc:  # its reader's word on the channel, not this refusal
+        assert "picks a channel of an instrument file" not in str(exc)
+
+
 @pytest.mark.parametrize("name", ["map.npy", "map.csv", "map.sur", "map.dat"])
 def test_an_empty_file_is_named_empty_whatever_its_suffix(tmp_path, registry, name):
     """A 0-byte file was 'not a readable .npy array (EOFError)', 'array of shape (0, 1)' or 'a

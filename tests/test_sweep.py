@@ -163,6 +163,19 @@ def test_a_zip_point_twice_is_refused_and_a_value_repeated_beside_others_is_not(
     assert len(plan_sweep(sweep_preset(paired, mode="zip"), registry=registry).points) == 3
 
 
+@pytest.mark.parametrize(("parameters", "mode", "said"), [
+    ({"seed": {"values": [1, "1"]}}, "grid", "sweep points 1 (seed=1) and 2 (seed='1') are one preset"),
+    ({"spectrum.params.hurst": {"values": [0.5, "5e-1"]}}, "grid", "sweep points 1 (spectrum.params.hurst=0.5) and 2"),
+    ({"seed": {"values": [1, "1"]}, "realizations": {"values": [4, 4.0]}}, "zip", "sweep points 1 (seed=1, realizations=4)"),
+])  # fmt: skip
+def test_two_points_that_read_as_one_preset_are_refused(parameters, mode, said, registry):
+    """1 and '1' are two values to the values' own check, but one seed once read: the sweep ran
+    the same ensemble twice, as it does for a value listed twice (refused)."""
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(parameters, mode=mode), registry=registry)
+    assert said in str(info.value) and "the same ensemble would run twice" in str(info.value)
+
+
 def test_a_bad_point_value_names_the_point_and_field(registry):
     params = {"spectrum.params.hurst": {"values": [0.5, 2.0]}, "slope.name": {"values": ["spectral", "slopy"]}}
     with pytest.raises(PresetError) as info:

@@ -192,6 +192,13 @@ def test_a_future_schema_is_refused_naming_its_version(run_copy):
         frictionlab.load(run_copy)
 
 
+def test_a_schema_below_the_first_is_refused_as_damaged(run_copy):
+    """schema_version 0 or -3 was read as the oldest; no frictionlab wrote it."""
+    edit_summary(run_copy, lambda d: set_in(d, "schema_version", 0))
+    with pytest.raises(RunFolderError, match=r"summary.json is damaged \(schema_version 0: the first is 1\)"):
+        frictionlab.load(run_copy)
+
+
 def test_a_link_out_of_the_folder_is_named_as_a_link(run_copy):
     link(run_copy / "curve.csv", run_copy.parent / "elsewhere" / "curve.csv")
     with pytest.raises(RunFolderError, match=r"curve.csv: curve.csv is a symbolic link, which is never followed"):

@@ -13,6 +13,7 @@ import shlex
 from dataclasses import dataclass, field
 
 from ..errors import ExitCode
+from .options import PATH_METAVARS
 
 SHELLS = ("bash", "zsh", "fish")
 
@@ -26,7 +27,8 @@ EXAMPLES = """examples:
 # What a value is, from its argument's metavar or (for a positional) its dest. A value
 # with none of these (a number, an address) is not completed.
 FILES, DIRS, PRESETS, BUILTINS, SETTINGS, WORDS, NOTHING = "files", "dirs", "presets", "builtins", "settings", "words", ""
-KIND_OF_METAVAR = {"FILE": FILES, "DEST": FILES, "DIR": DIRS, "RUN_DIR": DIRS, "NAME": BUILTINS, "PATH=VALUE": SETTINGS}
+KIND_OF_METAVAR = {**{metavar: DIRS if what == "folder" else FILES for metavar, what in PATH_METAVARS.items()},
+                   "NAME": BUILTINS, "PATH=VALUE": SETTINGS}
 KIND_OF_DEST = {"preset": PRESETS, "presets": PRESETS}
 
 

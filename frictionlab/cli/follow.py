@@ -65,9 +65,7 @@ class _StopSignals:
 
 def run(args) -> ExitCode:
     from ..runs.detached import process_alive, run_state
-    from .options import refuse_empty_path
 
-    refuse_empty_path(args.run_dir, "DIR")  # Path("") is this folder
     folder = Path(args.run_dir)
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None

@@ -102,6 +102,7 @@ class _Parser(argparse.ArgumentParser):
             strays = [w for w in self.words if _stray_option(w, options)]
             if strays:
                 message = f"{unrecognized(strays, options)} ({message})"
+        message = re.sub(r"invalid (int|float) value: '(.*)'$", _invalid_value, message)
         message = shown(message)  # the words it quotes as typed: an escape sequence must not drive the terminal
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
         super().error(message)
@@ -117,6 +118,17 @@ class _Parser(argparse.ArgumentParser):
         if extras:
             self.error(unrecognized(extras, self.option_names()))
         return namespace, extras
+
+
+def _invalid_value(match: re.Match) -> str:
+    """argparse's 'invalid int value' with the value cut short (a 5000-digit --seed was said in
+    full, and, past the 4300 digits Python reads as a number, as if it were not a whole number)."""
+    kind, value = match.groups()  # the value as argparse quotes it (its repr, escapes and all)
+    digits = len(value.strip().lstrip("+-"))
+    cut = value if len(value) <= 120 else f"{value[:57]}...{value[-57:]}"
+    if kind == "int" and value.strip().lstrip("+-").isdigit() and digits > sys.get_int_max_str_digits():
+        return f"invalid int value: '{cut}', a whole number of {digits} digits, too long to be one here"
+    return f"invalid {kind} value: '{cut}'"
 
 
 def unrecognized(words: list[str], options: list[str]) -> str:
@@ -335,6 +347,9 @@ def _write_failed(exc: OSError) -> int:
 def _run_command(args) -> int:
     keep_freed_memory()  # this process's realizations reuse freed pages, not fault in fresh ones
     try:
+        from .options import refuse_empty_paths
+
+        refuse_empty_paths(args.parser, args)
         code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code

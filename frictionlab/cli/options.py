@@ -3,6 +3,8 @@ happens here only; what an option means is ``frictionlab.options``."""
 
 from __future__ import annotations
 
+import argparse
+
 from ..errors import FrictionlabError
 from ..options import EXECUTORS
 
@@ -50,6 +52,11 @@ def executor_run_options(args, **fields):
             "or leave --scheduler out for frictionlab's own local cluster"
         )
     _use_tls_options(args)
+    if args.executor == "serial" and args.workers is not None and args.workers > 1:
+        raise FrictionlabError(
+            f"--workers {args.workers} with --executor serial, which runs every realization in this process, one at "
+            "a time: it would be ignored; give --executor processes (or dask), or leave --workers out"
+        )
     if args.dashboard and (args.executor != "dask" or args.scheduler):
         raise FrictionlabError(
             "--dashboard serves the dashboard of frictionlab's own Dask cluster: it needs --executor dask "
@@ -97,10 +104,32 @@ def _tls_flag(name: str) -> str:
     return "--tls-" + ("ca-file" if name == "ca_file" else name)
 
 
-def refuse_empty_path(value: str | None, option: str, what: str = "folder", otherwise: str = "") -> None:
-    """A usage error for a path argument given as the empty string, which Path() would read
-    as this folder (``frictionlab resume ""`` resuming whatever run is here) and an option
-    would take as not given (``report --out ""``: the default folder); ``otherwise``: what
-    the user may give instead (``leave --out out for stdout``)."""
-    if value is not None and not value.strip():
-        raise FrictionlabError(f"{option} names no {what} (it is empty): give a {what}" + (f", or {otherwise}" if otherwise else ""))
+PATH_METAVARS = {"DIR": "folder", "RUN_DIR": "folder", "FILE": "file", "DEST": "file or folder"}
+
+
+def refuse_empty_paths(parser, args) -> None:
+    """A usage error for any path argument of the command (its metavar a ``PATH_METAVARS``)
+    given as the empty string, which Path() reads as this folder (``frictionlab resume ""``
+    resuming whatever run is here) and an option takes as not given (``exact3d --runs ""``:
+    hours of work into a new runs/ folder): checked once here, for every command alike."""
+    for action in _command_actions(parser, args):
+        what = PATH_METAVARS.get(action.metavar)
+        value = getattr(args, action.dest, None)
+        if what is None or not isinstance(value, str) or value.strip():
+            continue
+        name = max(action.option_strings, key=len) if action.option_strings else action.metavar
+        optional = action.option_strings or action.nargs == "?"
+        leave = (f"leave {name} out" if action.option_strings else "leave it out") if optional else ""
+        raise FrictionlabError(f"{name} names no {what} (it is empty): give a {what}" + (f", or {leave}" if leave else ""))
+
+
+def _command_actions(parser, args):
+    """The arguments of the command ``args`` were parsed for (a subcommand's, such as
+    ``presets copy``, included)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            chosen = getattr(args, action.dest, None)
+            if chosen in action.choices:
+                yield from _command_actions(action.choices[chosen], args)
+        else:
+            yield action

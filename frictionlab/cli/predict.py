@@ -34,9 +34,7 @@ def run(args) -> ExitCode:
     """``frictionlab predict``: print the law's xi (and interval) for the given A, E*, h, F."""
     from ..compute.fit import LogFit, format_number, json_safe
     from ..paper.predict import check_law, predict_xi, prediction_text, read_run_law
-    from .options import refuse_empty_path
 
-    refuse_empty_path(args.from_run, "--from", otherwise="the law by --a and --b")  # not "no --from": Path("") is this folder
     if args.from_run:
         given = [name for name, value in (("--a", args.a), ("--b", args.b), ("--a-ci", args.a_ci), ("--b-ci", args.b_ci),
                                           ("--confidence", args.confidence)) if value is not None]  # fmt: skip
@@ -55,6 +53,9 @@ def run(args) -> ExitCode:
         confidence = 0.95 if args.confidence is None else args.confidence
         law, fitted_f, pairs = LogFit(args.a, args.b, confidence=confidence, **intervals), None, None
         check_law(law, {field: "--" + field.replace("_", "-") for field in ("a", "b", "a_ci", "b_ci", "confidence")})
+        if args.confidence is not None and args.a_ci is None:  # as --tls-cert without a tls:// scheduler
+            raise FrictionlabError(f"--confidence {args.confidence:g} is the level of --a-ci and --b-ci, but there are "
+                                   "none: it would be ignored; give the intervals, or leave --confidence out")  # fmt: skip
     prediction = predict_xi(
         law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
         pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,

@@ -42,9 +42,6 @@ def run(args) -> ExitCode:
     from ..preset.builtin import builtin_presets
 
     if getattr(args, "action", None) == "copy":
-        from .options import refuse_empty_path
-
-        refuse_empty_path(args.dest, "DEST", "file or folder", "leave it out for this folder")
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
             from ..io.files import output_path_problem
@@ -76,11 +73,12 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
     target = dest / preset.path.name if dest.is_dir() else dest
-    if not target.parent.is_dir():  # open() would say only "No such file or directory" (exit 1)
-        from ..io.files import output_path_problem
+    from ..io.files import output_path_problem
 
-        problem = output_path_problem(target.parent) or f"the folder {shown(target.parent)} does not exist"
-        raise OutputRefused(f"DEST {shown(target)}: {problem}; make the folder first, or give an existing one")
+    problem, there = output_path_problem(target.parent), target.parent.is_dir()
+    if problem or not there:  # open() would say only "No such file or directory" (/proc/self/x) with exit 1
+        advice = "give a file in a folder you can write to" if there else "make the folder first, or give an existing one"
+        raise OutputRefused(f"DEST {shown(target)}: {problem or f'the folder {shown(target.parent)} does not exist'}; {advice}")
     data = preset.path.read_bytes()
     try:
         if force:  # replaced, never written through a link

@@ -37,11 +37,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..paper.reproduce import write_report
-    from .options import refuse_empty_path
 
-    for option, value in (("--presets", args.presets), ("--out", args.out), ("--figures", args.figures)):
-        refuse_empty_path(value, option)
-    refuse_empty_path(args.markdown, "--markdown", "file")
     if not 1 <= args.replicates <= MAX_REPLICATES:
         raise FrictionlabError(f"--replicates must be a whole number from 1 to {MAX_REPLICATES}. Got {args.replicates} instead.")
     if args.replicates != 1 and not args.readings:

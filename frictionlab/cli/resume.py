@@ -30,9 +30,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..runs.rundir import PRESET_FILE, RunDirectory
-    from .options import refuse_empty_path
 
-    refuse_empty_path(args.run_dir, "DIR")  # Path("") is this folder
     run_dir = Path(args.run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder

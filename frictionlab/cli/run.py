@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, shown, too_long_path
-from .options import add_executor_options, add_workers_option, executor_run_options, refuse_empty_path
+from .options import add_executor_options, add_workers_option, executor_run_options
 
 
 def add_parser(sub) -> None:
@@ -62,7 +62,6 @@ def run(args) -> ExitCode:
     scene = build_scene(data, source=source, before_reading=reading)
     if scene.preset.sweep is not None:  # its points are planned anew: of the base, what pressing needs is kept
         scene = scene.for_pressing()
-    refuse_empty_path(args.out, "--out", otherwise="leave --out out for runs/<name>-<time>")
     if args.out is not None and (too_long := too_long_path(args.out)):
         raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:

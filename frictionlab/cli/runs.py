@@ -33,9 +33,7 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..runs.detached import list_run_states
     from ..runs.rundir import DEFAULT_RUNS_DIR
-    from .options import refuse_empty_path
 
-    refuse_empty_path(args.runs_dir, "DIR")  # Path("") is this folder
     runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
     if args.runs_dir is not None and not runs_dir.is_dir():
         what = "is not a folder" if runs_dir.exists() else "does not exist"

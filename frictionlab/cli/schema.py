@@ -21,10 +21,8 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..preset import preset_json_schema
-    from .options import refuse_empty_path
 
     out = None
-    refuse_empty_path(args.out, "--out", "file", "leave --out out for stdout")
     if args.out:
         from ..io.files import check_output_file
 

@@ -8,7 +8,7 @@ import math
 import shlex
 import sys
 
-from ..errors import ExitCode, FrictionlabError, shown
+from ..errors import ExitCode, FrictionlabError, short_repr, shown
 from ..tradeoff.options import AXES, StudyOptions
 
 
@@ -86,7 +86,7 @@ def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: boo
     try:
         values = tuple(kind(v) for v in text.split(",") if v.strip())
     except ValueError:
-        raise FrictionlabError(f"{option} must be a comma-separated list of numbers. Got {text!r} instead.") from None
+        raise FrictionlabError(f"{option} must be a comma-separated list of numbers. Got {short_repr(text)} instead.") from None
     bad = [v for v in values if not (v > low and math.isfinite(v))]  # inf made a grid of int(inf) points
     if bad:
         raise FrictionlabError(f"{option} values must be finite numbers > {low:g}. Got {bad[0]!r} instead.")
@@ -94,7 +94,7 @@ def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: boo
     if beyond:
         raise FrictionlabError(f"{option} values must be at most {high:g}. Got {beyond[0]!r} instead.")
     if required and not values:  # an empty list left its axis out without a word
-        raise FrictionlabError(f"{option} names no value: give a comma-separated list of numbers. Got {text!r} instead.")
+        raise FrictionlabError(f"{option} names no value: give a comma-separated list of numbers. Got {short_repr(text)} instead.")
     return values
 
 
@@ -115,7 +115,7 @@ def options_from_args(args) -> StudyOptions:
     unknown = [a for a in axes if a not in AXES]
     if unknown or not axes:
         raise FrictionlabError(
-            f"--axes must name some of {', '.join(AXES)}. Got {args.axes!r} instead."
+            f"--axes must name some of {', '.join(AXES)}. Got {short_repr(args.axes)} instead."
         )
     if not 0 < args.target < 1:
         raise FrictionlabError(f"--target must be > 0 and < 1 (a relative error). Got {args.target} instead.")

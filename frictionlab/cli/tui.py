@@ -7,7 +7,7 @@ import os
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, PresetFileError, did_you_mean
-from .options import add_workers_option, refuse_empty_path, run_options
+from .options import add_workers_option, run_options
 
 
 def add_parser(sub) -> None:
@@ -40,7 +40,6 @@ def run(args) -> ExitCode:
     for option, folder in (("--presets", args.presets), ("--runs", args.runs)):
         # a file given as a folder: the TUI started and said "No presets in FILE", or listed no runs,
         # and only a save or a run then failed ("File exists")
-        refuse_empty_path(folder, option)
         if folder is not None and os.path.lexists(folder) and not os.path.isdir(folder):
             raise FrictionlabError(f"{option}: {folder} is not a folder: give a folder (one not there yet is made when first written into)")
     if args.preset is not None:

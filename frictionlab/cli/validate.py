@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ..errors import ExitCode, FrictionlabError, counted, shown
+from ..errors import ExitCode, FrictionlabError, PresetError, counted, shown
 
 
 def add_parser(sub) -> None:
@@ -45,8 +45,8 @@ def run(args) -> ExitCode:
             worst = ExitCode(max(worst, exc.exit_code))
             problems = exc.problems or [str(exc)]
             records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})
-            if not args.json:
-                print(shown(str(exc)), file=sys.stderr)
+            if not args.json:  # a preset's problems start with its name; any other refusal (its memory) is named here
+                print(shown(str(exc) if isinstance(exc, PresetError) else f"{path}: {exc}"), file=sys.stderr)
             continue
         preset = scene.preset
         records.append(record)

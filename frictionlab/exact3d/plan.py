@@ -289,7 +289,14 @@ def run_plan(
             path = Path(presets_dir) / preset_name(job.hurst)
             if not path.is_file():
                 raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
-            factories[job.hurst] = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+            factories[job.hurst] = factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+            said = getattr(factory.base.spectrum.params, "hurst", None)
+            if not isinstance(said, float | int) or not math.isclose(said, job.hurst):  # the page names it by its file
+                raise FrictionlabError(
+                    f"{path}: spectrum.params.hurst is {said!r}, but the study takes this file for H = {job.hurst:g} "
+                    f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
+                    f"{preset_name(job.hurst).removesuffix('.yaml')})"
+                )
     try:
         for job in plan.jobs():
             scene = _scene(factories[job.hurst], job, plan)

@@ -124,6 +124,10 @@ def write_page(
     plan = plan or (QUICK if quick else FULL)
     if finished_only and not runs_dir:
         raise FrictionlabError("--finished-only writes the page from the runs of an earlier study: give its --runs DIR")
+    if finished_only and not Path(runs_dir).is_dir():  # not "holds no finished ensemble": it holds nothing
+        what = "is not a folder" if os.path.lexists(runs_dir) else "does not exist"
+        raise FrictionlabError(f"--runs {runs_dir} {what}: --finished-only writes the page from the runs folder of an "
+                               "earlier study: give that folder")  # fmt: skip
     command = command or _command(quick, out_dir, runs_dir, finished_only)
     if out_dir:  # refused before a default runs folder is made
         page_paths(Path(out_dir), force=options.force)

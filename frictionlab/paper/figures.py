@@ -3,12 +3,13 @@ frictionlab's presets of those figures (``presets/benad2012-fig*.yaml``)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import FrictionlabError
+from ..errors import FrictionlabError, short_repr
 from ..options import RunOptions
-from ..preset import build_scene, read_preset
+from ..preset import build_scene, get_path, read_preset
 from ..runs.runner import run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..runs.sweep import plan_sweep, run_sweep
@@ -25,15 +26,23 @@ class PaperFigure:
     b: float | None
     counts: dict[float, float] = field(default_factory=dict)  # force -> mean points in contact
     note: str = ""
+    setup: dict[str, float] = field(default_factory=dict)  # what the title states: dotted path -> value
+
+
+def _as_paper(hurst: float | None, stop: float) -> dict[str, float]:
+    """A figure's setup as its title states it: H (None: swept) and the forces 1..stop."""
+    return {**({"spectrum.params.hurst": hurst} if hurst is not None else {}), "loading.start": 1.0, "loading.stop": stop}
 
 
 FIGURES = (
-    PaperFigure("fig2", "benad2012-fig2.yaml", "Fig. 2: H = 1, F = 1..20", 1.8847, 0.0805, {1.0: 4.0, 20.0: 12.0}),
-    PaperFigure("fig3", "benad2012-fig3.yaml", "Fig. 3: H = 1, F = 1..500", 1.5289, 0.0614, {500.0: 40.0}),
+    PaperFigure("fig2", "benad2012-fig2.yaml", "Fig. 2: H = 1, F = 1..20", 1.8847, 0.0805, {1.0: 4.0, 20.0: 12.0},
+                setup=_as_paper(1.0, 20.0)),
+    PaperFigure("fig3", "benad2012-fig3.yaml", "Fig. 3: H = 1, F = 1..500", 1.5289, 0.0614, {500.0: 40.0},
+                setup=_as_paper(1.0, 500.0)),
     PaperFigure("fig4", "benad2012-fig4.yaml", "Fig. 4: H = 0.5, F = 1..20", 2.6252, 0.1341, {},
-                "the paper: the log fit is visibly poorer than at H = 1; contact counts not stated"),
+                "the paper: the log fit is visibly poorer than at H = 1; contact counts not stated", _as_paper(0.5, 20.0)),
     PaperFigure("fig5", "benad2012-fig5.yaml", "Fig. 5: a and b against H, each point as Fig. 2", 2.9, 0.14, {},
-                "the paper: a about 2.9 and b about 0.14 near H = 0.7"),
+                "the paper: a about 2.9 and b about 0.14 near H = 0.7", _as_paper(None, 20.0)),
 )  # fmt: skip
 PAPER_H07 = (0.7, 2.9, 0.14)  # H, a, b "about", as the paper states them
 PAPER_POINTS_VS_H = ((1.0, 1.8847, 0.0805, "Fig. 2"), (0.5, 2.6252, 0.1341, "Fig. 4"))
@@ -85,8 +94,23 @@ def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
             run.sweep = plan_sweep(data, source=str(path))
         else:
             run.scene = build_scene(data, source=str(path))
+        _check_setup(fig, path, [point.scene for point in run.sweep.points] if run.sweep else [run.scene])
         runs.append(run)
     return runs
+
+
+def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
+    """FrictionlabError unless every scene is what the figure's title states (``setup``): a
+    preset of H = 0.5 in benad2012-fig2.yaml was reported as 'Fig. 2: H = 1' beside the paper's numbers."""
+    for scene in scenes:
+        for dotted, stated in fig.setup.items():
+            value = get_path(scene.resolved(), dotted, None)
+            if isinstance(value, bool) or not isinstance(value, float | int) or not math.isclose(value, stated):
+                raise FrictionlabError(
+                    f"{path}: {dotted} is {short_repr(value)}, but the report shows this preset as '{fig.title}' beside "
+                    f"the paper's numbers ({dotted} = {stated:g}); give the paper's preset (frictionlab presets copy "
+                    f"{fig.preset.removesuffix('.yaml')}), or run yours with frictionlab run"
+                )
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:

@@ -238,8 +238,9 @@ def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.n
 
 def _read_summary(run_dir: Path) -> dict:
     """summary.json of ``--from``, each value checked (``results.read_summary``)."""
-    if not run_dir.is_dir():
-        raise RunFolderError(f"--from {run_dir}: no readable summary.json there (no such folder)")
+    if not run_dir.is_dir():  # a file (its summary.json, say) is named as one, not as missing
+        what = "not a folder: give the run's folder" if os.path.lexists(run_dir) else "no such folder"
+        raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({what})")
     if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
         raise RunFolderError(  # a law per point: the user names one
             f"--from {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "

@@ -25,7 +25,7 @@ import numpy as np
 import pluggy
 from pydantic import BaseModel
 
-from ..errors import PluginError, did_you_mean
+from ..errors import PluginError, did_you_mean, short_repr
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .base import NAME_PATTERN, Plugin
@@ -308,7 +308,7 @@ class Registry:
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)
-        message = f"no {kind} plugin named {name!r}{did_you_mean(normalize_name(name), installed) or '.'}"
+        message = f"no {kind} plugin named {short_repr(name)}{did_you_mean(normalize_name(name), installed) or '.'}"
         message += f" Installed {kind} plugins: {', '.join(installed) or 'none'}."
         if self.failures:
             broken = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error}" for f in self.failures)

@@ -12,7 +12,7 @@ from typing import Any
 
 import yaml
 
-from ..errors import PresetError
+from ..errors import PresetError, short_repr
 from ..io.safe_yaml import YamlProblem, load_yaml
 
 MISSING = object()
@@ -82,8 +82,12 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
             continue
         try:
             value = load_yaml(raw) if raw.strip() else ""
-        except YamlProblem:
-            value = raw
+        except YamlProblem as exc:
+            if raw.lstrip().startswith(("{", "[")):  # a mapping or list mistyped (a key twice), not text: why is said
+                problems.append(f"--set {short_repr(assignment, 120)}: a {{ mapping or [ list YAML cannot read: {exc}; "
+                                "text that starts with { or [ is given quoted: 'description=\"[draft]\"'")  # fmt: skip
+                continue
+            value = raw  # text YAML does not read (a: b: c) is taken as it is
         try:
             set_path(data, keys, value)
         except ValueError as exc:

@@ -118,7 +118,7 @@ class SweepParameter(_Strict):
         return [int(v) if whole and v.is_integer() else v for v in raw]
 
 
-def _repeated(values: list) -> tuple[int, int] | None:
+def first_repeat(values: list) -> tuple[int, int] | None:
     """The first two places ``values`` holds one value (1 and 1.0 are one), or None."""
     for j, value in enumerate(values):
         for i in range(j):
@@ -160,11 +160,11 @@ class SweepSettings(_Strict):
         columns = [self.parameters[path].points() for path in paths]  # at most MAX_SWEEP_POINTS each: counted above
         if self.mode == "grid":
             for path, values in zip(paths, columns, strict=True):
-                if (pair := _repeated(values)) is not None:
+                if (pair := first_repeat(values)) is not None:
                     how = "values give" if self.parameters[path].values is not None else "range (start, stop, num) gives"
                     raise ValueError(f"{path}: its {how} {values[pair[1]]!r} twice (values {pair[0] + 1} and "
                                      f"{pair[1] + 1}): each point with it would run twice; give each value once")  # fmt: skip
-        elif (pair := _repeated(rows := list(zip(*columns, strict=True)))) is not None:
+        elif (pair := first_repeat(rows := list(zip(*columns, strict=True)))) is not None:
             shown = ", ".join(f"{path}={value!r}" for path, value in zip(paths, rows[pair[1]], strict=True))
             raise ValueError(f"mode zip: points {pair[0] + 1} and {pair[1] + 1} set the same values ({shown}): the same "
                              "ensemble would run twice; give each point once")  # fmt: skip

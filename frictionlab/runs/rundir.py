@@ -352,9 +352,9 @@ class RunDirectory:
                     f"cannot resume {self.path}: the fingerprint in its {STATE_FILE} is not that of the preset it "
                     f"holds (the file damaged or edited); run the preset again into a new folder"
                 )
-            raise RunFolderError(
-                f"cannot resume {self.path}: its preset differs from the one given\n  " + "\n  ".join(changed)
-            )
+            given = f" ({scene.source})" if scene.source else ""  # `resume DIR`: DIR/preset.yaml, edited
+            raise RunFolderError(f"cannot resume {self.path}: the preset its {STATE_FILE} started with differs from the one "
+                                 f"given{given}\n  " + "\n  ".join(changed))
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in inputs.items():
             then = recorded.get(field)

@@ -192,10 +192,16 @@ def read_json(folder: Path, name: str, limit: int = MAX_JSON_BYTES) -> dict:
 
 
 def check_schema_version(data: dict, path: Path, newest: int, key: str = "schema_version") -> None:
-    """RunFolderError, naming the version, when ``data`` was written by a newer frictionlab."""
+    """RunFolderError, naming the version, when ``data`` was written by a newer frictionlab, or
+    holds a version below the first (1), which no frictionlab wrote: read as an older one, a
+    manifest of format 0 had its chunk list ignored and every finished chunk computed again."""
     version = data.get(key, 1)
-    if isinstance(version, int) and not isinstance(version, bool) and version > newest:
-        number = version if version < 10**9 else "of more than 9 digits"
+    if not isinstance(version, int) or isinstance(version, bool):
+        return
+    number = version if abs(version) < 10**9 else "of more than 9 digits"
+    if version < 1:
+        raise RunFolderError(f"{shown(path)} is damaged ({key} {number}: the first is 1)")
+    if version > newest:
         raise RunFolderError(
             f"{shown(path)} was written by a newer frictionlab ({key} {number}; this one reads up to {newest}): "
             "upgrade frictionlab to read it"

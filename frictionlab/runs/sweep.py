@@ -1,16 +1,15 @@
 """Parameter sweeps: one full ensemble per point of a preset's ``sweep`` section.
 
-A point is the preset with the swept dotted paths set (``preset.apply_overrides``,
-then the usual two-phase validation) and the ``sweep`` section removed; the seed
-is the preset's, so a point is reproducible on its own::
+A point is the preset with the swept dotted paths set (``preset.apply_overrides``, then the usual two-phase
+validation) and the ``sweep`` section removed; the seed is the preset's, so a point is reproducible on its own::
 
     frictionlab run PRESET --set sweep=null --set spectrum.params.hurst=0.7
 
 Every point runs through ``runner.run_to_folder`` (the single run path) into ``<out>/points/<NN>-<label>/``.
 ``sweep.csv`` (a row per point, rewritten atomically as points finish), ``sweep.json``, ``sweep.png`` sit in ``<out>``.
 
-Front ends follow a sweep through ``listeners.SweepListener``s; each point's
-run tells the run listeners that ``SweepListener.run_listeners(point)`` gives.
+Front ends follow a sweep through ``listeners.SweepListener``s; each point's run tells the run listeners that
+``SweepListener.run_listeners(point)`` gives.
 """
 
 from __future__ import annotations
@@ -37,6 +36,7 @@ from ..plugin.listeners import SweepListener
 from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
+from ..preset.schema import first_repeat
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
@@ -179,10 +179,8 @@ def _combinations(spec: SweepSettings) -> list[dict[str, Any]]:
 
 def plan_sweep(data: dict, registry: Registry | None = None, source: str | None = None, before_reading=None) -> Sweep:
     """Expand preset data with a ``sweep`` section into validated points, each checked by ``before_reading``.
-
-    Every problem of every point is reported at once, each prefixed with
-    ``sweep point N (path=value)``; nothing runs unless every point is valid.
-    """
+    Every problem of every point is reported at once (``sweep point N (path=value): ...``); nothing runs unless
+    every point is valid, and no two points are one preset."""
     registry = registry or default_registry()
     base_preset = build_scene(data, registry=registry, source=source).preset  # the base and the spec itself
     spec = base_preset.sweep
@@ -193,8 +191,7 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
         raise PresetError(problems, source=source)
     base = {k: v for k, v in data.items() if k != "sweep"}
     combos = _combinations(spec)
-    width = max(2, len(str(len(combos))))
-    points, problems = [], []
+    points, problems, width = [], [], max(2, len(str(len(combos))))
     for number, values in enumerate(combos, start=1):
         try:
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
@@ -205,6 +202,10 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             continue
         folder = f"{number:0{width}d}-{_label(values)}"
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
+    if not problems and (pair := first_repeat([point.scene.resolved() for point in points])) is not None:
+        one, two = (points[i] for i in pair)  # seed 1 and '1': one preset once read, which the values' check cannot see
+        problems = [f"sweep points {one.number} ({one.describe()}) and {two.number} ({two.describe()}) are one preset "
+                    "once their values are read: the same ensemble would run twice; give each value once"]
     if problems:
         raise PresetError(problems, source=source)
     return Sweep(name=base_preset.name, spec=spec, base=base, points=points, source=source)

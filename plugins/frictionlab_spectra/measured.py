@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
@@ -47,7 +47,7 @@ class MeasuredParams(PluginParams):
     detrend: str | None = Field(None, description="levelling")
     channel: str | Annotated[int, Field(ge=0)] | None = Field(
         None, description="an instrument file's channel, by name (the first of that name) or index; default: the "
-        "file's default channel (validate lists them when there are several)",
+        "file's default channel (validate lists them when there are several); a table has none, and is refused one",
     )
     format: FileFormat = Field(
         "auto", description="how to read the file: auto (by suffix: .npy, .csv, .txt are tables), table (bare "
@@ -65,6 +65,17 @@ class MeasuredParams(PluginParams):
     def _micro_sign(cls, unit: object) -> object:
         # um as an instrument writes it, with the micro sign or the Greek mu
         return "um" if unit in ("\u00b5m", "\u03bcm") else unit
+
+    @model_validator(mode="after")
+    def _channel_of_an_instrument_file(self):
+        # a table holds one array of heights: the channel asked of it was ignored without a word
+        if self.channel is not None and not is_instrument_file(Path(self.path), self.format):
+            raise ValueError(
+                f"channel {self.channel!r} picks a channel of an instrument file, but {Path(self.path).name!r} is read "
+                "as a table (one array of heights, by its suffix .npy, .csv or .txt, or format: table): leave channel "
+                "out, or give format: instrument for an instrument's export"
+            )
+        return self
 
 
 class MeasuredFile(SpectrumGenerator):

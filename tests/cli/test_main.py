@@ -1,6 +1,7 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
 import math
+import os
 import subprocess
 import sys
 
@@ -51,6 +52,34 @@ def test_the_dashboard_without_frictionlabs_own_dask_cluster_is_refused_not_igno
     for extra in ([], ["--executor", "processes"], ["--executor", "dask", "--scheduler", "tcp://127.0.0.1:1"]):
         assert main(["run", "quickstart", "--dashboard", "--quiet", *extra]) == ExitCode.USAGE
         assert "--dashboard serves the dashboard of frictionlab's own Dask cluster" in capsys.readouterr().err
+
+
+def test_workers_with_the_serial_executor_are_refused_not_ignored(tmp_path, capsys):
+    """--executor serial --workers 4 ran on one worker, the 4 ignored but for '1 worker(s)' in the progress."""
+    from frictionlab.cli import main
+
+    out = tmp_path / "out"
+    assert main(["run", "quickstart", "--out", str(out), "--executor", "serial", "--workers", "4", "--quiet"]) == ExitCode.USAGE
+    assert "--workers 4 with --executor serial" in capsys.readouterr().err and not out.exists()
+    assert main(["run", "quickstart", "--executor", "serial", "--workers", "1", "--out", str(out), "--quiet"]) == ExitCode.OK
+    assert main(["resume", str(out), "--executor", "serial", "--workers", "4", "--quiet"]) == ExitCode.USAGE
+    assert "--workers 4 with --executor serial" in capsys.readouterr().err
+
+
+def test_a_value_argparse_cannot_read_is_said_cut_short_and_a_too_long_number_as_such(capsys):
+    """--seed of 5000 digits was 'invalid int value' (Python reads at most 4300), quoted in full,
+    and a 500-character --workers too."""
+    from frictionlab.cli import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["run", "quickstart", "--seed", "9" * 5000])
+    err = capsys.readouterr().err
+    assert exit_.value.code == ExitCode.USAGE and len(err.splitlines()[-1]) < 300
+    assert "argument --seed: invalid int value: '999" in err and "a whole number of 5000 digits, too long" in err
+    with pytest.raises(SystemExit):
+        main(["run", "quickstart", "--workers", "x" * 500])
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert "argument --workers: invalid int value: 'xxx" in last and "..." in last and len(last) < 300
 
 
 def test_tls_files_without_a_tls_scheduler_are_refused_not_ignored(tmp_path, capsys):
@@ -152,6 +181,73 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     captured = capsys.readouterr()
     assert said in captured.err and "Traceback" not in captured.err and captured.out == ""
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
+
+
+PATH_METAVARS = ("DIR", "RUN_DIR", "FILE", "DEST")
+
+
+def _path_arguments():
+    """(command words up to the path argument, the argument's name) for every path argument of
+    every command: an option or a positional whose metavar names a file or a folder."""
+    from frictionlab.cli.main import build_parser
+
+    def walk(parser, words):
+        for action in parser._actions:
+            if action.choices and isinstance(action.choices, dict):  # a command's own commands (presets copy)
+                for name, child in action.choices.items():
+                    yield from walk(child, [*words, name])
+            elif action.metavar in PATH_METAVARS:
+                yield words, action
+
+    yield from walk(build_parser(), [])
+
+
+def _filled(words: list[str], path, parser) -> list[str]:
+    """``words`` with every other required argument given a value argparse takes."""
+    argv = list(words)
+    for action in parser._actions:
+        if action is path or not (action.required or (not action.option_strings and action.nargs is None)):
+            continue
+        value = next(iter(action.choices)) if action.choices else "1"
+        argv += [action.option_strings[0], value] if action.option_strings else [value]
+    return argv
+
+
+@pytest.mark.parametrize("words, name", [
+    pytest.param(words, name, id=" ".join([*words, name]))
+    for words, action in _path_arguments() for name in [action.option_strings[-1] if action.option_strings else action.metavar]
+])
+def test_every_path_argument_given_empty_is_refused_before_the_command_runs(words, name, tmp_path, monkeypatch, capsys):
+    """study --out "" and exact3d --out/--runs/--presets "" were taken as not given: a study
+    into a new folder of runs/, hours of exact 3D runs; every path argument is refused alike."""
+    import importlib
+
+    from frictionlab.cli import main
+    from frictionlab.cli.main import build_parser
+
+    module = importlib.import_module(f"frictionlab.cli.{words[0]}")
+    monkeypatch.setattr(module, "run", lambda args: pytest.fail(f"{' '.join(words)} ran with {name} empty"))
+    monkeypatch.chdir(tmp_path)
+    parser = build_parser()
+    for word in words:
+        parser = next(a for a in parser._actions if isinstance(a.choices, dict)).choices[word]
+    path = next(a for a in parser._actions if (a.option_strings[-1] if a.option_strings else a.metavar) == name)
+    argv = _filled(words, path, parser)
+    argv += [name, ""] if path.option_strings else [""]
+    assert main(argv) == ExitCode.USAGE
+    assert f"{name} names no " in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc, a folder no file can be made in")
+def test_presets_copy_into_a_folder_no_file_can_be_made_in_is_refused_naming_it(capsys):
+    """DEST /proc/self/x was 'No such file or directory: /proc/self/x' with exit code 1; the folder
+    is tried first, as schema --out's is."""
+    from frictionlab.cli import main
+
+    assert main(["presets", "copy", "quickstart", "/proc/self/q.yaml"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert "DEST /proc/self/q.yaml: /proc/self cannot be written in" in err and "a folder you can write to" in err
 
 
 def test_presets_copy_into_a_missing_folder_or_under_a_file_is_refused_naming_it(tmp_path, capsys):

@@ -63,6 +63,18 @@ def test_cli_usage_errors_name_the_option(tmp_path, capsys, args, message):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("args, message", [
+    (["--grid-factors", "a," * 5000], "--grid-factors must be a comma-separated list of numbers. Got 'a,a,a"),
+    (["--axes", "a," * 5000], "--axes must name some of grid"),
+    (["--reference", "a" * 5000], "--reference: no solver plugin named 'aaa"),
+])  # fmt: skip
+def test_a_long_value_is_quoted_cut_short(tmp_path, capsys, args, message):
+    """A 10000-character --grid-factors, --axes or --reference was quoted whole in its refusal."""
+    assert main(["study", str(write(tmp_path, TINY)), "--out", str(tmp_path / "o"), *args]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert message in err and "..." in err and len(err) < 500
+
+
 def test_cli_bad_preset_file(tmp_path, capsys):
     (tmp_path / "bad.yaml").write_text("name: [unclosed\n")
     assert main(["study", str(tmp_path / "bad.yaml")]) == ExitCode.USAGE

@@ -83,3 +83,19 @@ def test_a_measured_profile_is_read_and_checked_by_validate_not_first_by_a_worke
     assert "spectrum.params: profile-file" in err and "1 value(s) in heights not finite" in err and "index 1" in err
     (tmp_path / "scan.csv").write_text("\n".join(str(0.01 * (i % 7)) for i in range(64)))
     assert main(["validate", str(preset)]) == ExitCode.OK
+
+
+def test_a_refusal_that_is_not_a_preset_problem_names_its_preset(tmp_path, capsys, monkeypatch):
+    """Of `validate a.yaml b.yaml`, a preset too large for this machine's memory was said as
+    'this run would need about 1043 GiB ...', which of the files not named."""
+    import frictionlab.runs.runner
+    from frictionlab.errors import FrictionlabError
+
+    def too_large(scene):
+        raise FrictionlabError("this run would need about 1043.24 GiB at its peak")
+
+    monkeypatch.setattr(frictionlab.runs.runner, "check_one_realization", too_large)
+    first, second = write_preset(tmp_path, SMALL_PRESET, "a.yaml"), write_preset(tmp_path, SMALL_PRESET, "b.yaml")
+    assert main(["validate", str(first), str(second)]) != ExitCode.OK
+    err = capsys.readouterr().err
+    assert f"{first}: this run would need about 1043.24 GiB" in err and f"{second}: this run would need" in err

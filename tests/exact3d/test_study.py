@@ -155,6 +155,35 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     assert "--finished-only" in err and "--runs DIR" in err and not (tmp_path / "p2").exists()
 
 
+def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_path, capsys):
+    """exact3d-h03.yaml with hurst: 0.9 ran, and the page reported H = 0.9 surfaces as H = 0.3."""
+    import shutil
+
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for hurst in HURSTS:
+        shutil.copy(PRESETS / preset_name(hurst), presets)
+    edited = presets / preset_name(0.3)
+    edited.write_text(edited.read_text().replace("hurst: 0.3", "hurst: 0.9"))
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--presets", str(presets), "--runs", str(runs), "--workers", "1", "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"{edited}: spectrum.params.hurst is 0.9, but the study takes this file for H = 0.3" in err
+    assert not list(runs.glob("*/summary.json"))  # no ensemble ran
+
+
+@pytest.mark.parametrize("made, said", [(None, "does not exist"), ("file", "is not a folder")])
+def test_finished_only_from_a_runs_folder_that_is_not_one_says_so(made, said, tmp_path, capsys):
+    """It was told 'holds no finished exact ensemble', as of an empty folder of runs."""
+    runs = tmp_path / "runs"
+    if made:
+        runs.write_text("mine")
+    assert main(["exact3d", "--quick", "--finished-only", "--runs", str(runs), "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"--runs {runs} {said}" in err and "holds no" not in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["runs"] if made else [])
+
+
 def f_column(folder):
     return np.loadtxt(folder / "curve.csv", delimiter=",", skiprows=1, usecols=1)
 

@@ -141,6 +141,12 @@ def test_a_missing_folder_is_a_run_folder_error(tmp_path, capsys):
     assert code == ExitCode.RUN_FOLDER and "no readable summary.json there (no such folder)" in err
 
 
+def test_a_file_given_as_the_run_folder_is_named_a_file_not_missing(run_copy, capsys):
+    """--from RUN/summary.json was told 'no such folder' of a file that is there."""
+    code, _, err = predict_from(run_copy / "summary.json", capsys)
+    assert code == ExitCode.RUN_FOLDER and "(not a folder: give the run's folder)" in err and "no such" not in err
+
+
 # ------------------------------------------------------------------ realizations.npz damaged
 
 
@@ -337,6 +343,8 @@ def test_an_f_double_precision_holds_is_found_whatever_the_products_do(capsys, a
         ([*LAW, "--rms-slope", "nan"], "--rms-slope must be a finite number > 0. Got nan"),
         ([*LAW, "--rms-height", "0"], "--rms-height must be a finite number > 0. Got 0.0"),  # not rms_height
         ([*LAW, "--from", ""], "--from names no folder (it is empty)"),  # not "give the law"
+        # a level of no interval: it was printed as '50% interval n/a (none)', the option ignored
+        ([*LAW, "--confidence", "0.5"], "--confidence 0.5 is the level of --a-ci and --b-ci, but there are none"),
     ],
 )
 def test_options_out_of_range_are_usage_errors(capsys, options, named):

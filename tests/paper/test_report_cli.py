@@ -95,3 +95,28 @@ def test_a_bad_preset_among_the_figures_is_refused_before_any_figure_runs(tmp_pa
     assert code == ExitCode.USAGE
     assert "benad2012-fig5.yaml" in (err := capsys.readouterr().err) and "seed: must be >= 0, got -4" in err
     assert not (tmp_path / "r" / "fig2").exists()
+
+
+@pytest.mark.parametrize(("key", "assignment", "said"), [
+    ("fig2", "spectrum.params.hurst=0.5", "spectrum.params.hurst is 0.5, but the report shows this preset as 'Fig. 2: H = 1"),
+    ("fig3", "loading.stop=20", "loading.stop is 20.0, but the report shows this preset as 'Fig. 3: H = 1, F = 1..500'"),
+    ("fig5", "loading.start=2", "loading.start is 2.0, but the report shows this preset as 'Fig. 5: a and b against H"),
+])  # fmt: skip
+def test_a_preset_that_is_not_its_figure_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, key, assignment, said):
+    """benad2012-fig2.yaml of H = 0.5 ran and was reported as 'Fig. 2: H = 1' beside the paper's a and b;
+    a preset's other values (its realizations, say) are still its own to choose."""
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for fig in FIGURES:
+        data = load_preset_file(PRESETS / fig.preset)
+        data = apply_overrides(data, [assignment] if fig.key == key else ["realizations=20"])
+        (presets / fig.preset).write_text(yaml.safe_dump(data, sort_keys=False))
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a figure ran before every preset was checked")
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    assert main(["report", "--presets", str(presets), "--out", str(tmp_path / "r"), "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"{presets / f'benad2012-{key}.yaml'}: {said}" in err and "frictionlab presets copy" in err
