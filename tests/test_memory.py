@@ -474,3 +474,14 @@ def test_the_refusals_hint_names_exactly_the_commands_that_take_no_memory_check(
     taking = {name for name, sub in commands.items() if "--no-memory-check" in sub._option_string_actions}
     named = set(re.match(r"\((.*) takes? --no-memory-check", SKIP_HINT).group(1).replace(" and ", ", ").split(", "))
     assert taking == named == {"run", "resume"}
+
+
+def test_a_run_on_one_worker_is_not_advised_one_worker(registry, monkeypatch):
+    """A run already on one worker was told 'It would fit with --workers 1 and
+    spectrum.params.points <= N'; the advice is the points alone, the most that fit."""
+    scene = build_scene(line_of(20_000_000), registry=registry)
+    monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
+    with pytest.raises(RunError, match=r"It would fit with spectrum.params.points <= ([\d,]+)\.") as caught:
+        memory.check_fits(scene, workers=1, executor="processes")
+    assert "--workers" not in caught.value.args[0]
+    assert_offer_is_the_most_that_fits(scene, caught.value.args[0])

@@ -307,3 +307,22 @@ def test_a_despike_that_would_replace_the_scan_itself_is_refused():
     with pytest.raises(ValueError, match=r"despike 0.001 takes \d+ of 1024 points \(9\d\.\d %\) for spikes.*more than 5 %"):
         despike(z, 0.001, float(np.std(z)))
     assert despike(z, 6.0, float(np.std(z)))[1] == 0  # a usual k leaves white noise alone
+
+
+def test_the_levelling_record_survives_despike(tmp_path):
+    """With despike set, the summary gave the rms of the map already levelled as the rms
+    before levelling, and said a tilt carrying most of the height had removed 0 % of it: the
+    despiked map was levelled a second time and that record replaced the first. The record is
+    the levelling of the file's map with its spikes replaced."""
+    z, _ = band_limited(40, 48, seed=6, top=0.2)
+    z[11, 17] += 14 * np.std(z)
+    y, x = np.mgrid[0:40, 0:48].astype(float)
+    tilted = z + 0.2 * np.std(z) * x
+    np.save(tmp_path / "map.npy", tilted)
+    plain = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, detrend="plane").input_summary()
+    cleaned = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, detrend="plane", despike=6.0).input_summary()
+    assert cleaned["despiked"]["points"] == 1
+    assert cleaned["rms_removed_fraction"] > 0.5
+    assert cleaned["rms_removed_fraction"] == pytest.approx(plain["rms_removed_fraction"], abs=0.05)
+    assert cleaned["rms_before_detrend"] == pytest.approx(plain["rms_before_detrend"], rel=0.05)
+    assert cleaned["rms_height"] < plain["rms_height"]

@@ -391,3 +391,17 @@ def test_the_table_after_a_sweep_says_why_a_point_failed_even_with_quiet(tmp_pat
     assert f"seed=1: error: {point} is a symbolic link or not a folder" in printed
     assert "seed=2: a = " in printed
     assert "(sweep.csv, points/)" in printed
+
+
+@pytest.mark.parametrize("detach", [False, True])
+def test_a_refused_sweep_point_is_named_as_the_user_gave_the_preset(tmp_path, capsys, detach):
+    """A built-in sweep run by name with a bad swept value was refused under the installed
+    file's path, and without the --set that made the point bad (validate, and a run of a
+    preset without a sweep, name it as typed)."""
+    bad = "sweep.parameters.spectrum.params.hurst={values: [0.5, 2.0]}"
+    args = ["run", "benad2012-fig5", "--set", bad, "--out", str(tmp_path / "out")] + (["--detach"] if detach else [])
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert f"error: built-in preset 'benad2012-fig5' --set {bad}: 1 problem in preset" in err
+    assert "sweep point 2 (spectrum.params.hurst=2.0): spectrum.params.hurst: must be <= 1.5, got 2.0" in err
+    assert not (tmp_path / "out").exists()

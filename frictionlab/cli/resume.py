@@ -38,7 +38,7 @@ def run(args) -> ExitCode:
         from ..runs.sweep import stored_sweep
         from .options import executor_run_options
 
-        args.preset = str(run_dir / "sweep.json")
+        args.preset = args.source = str(run_dir / "sweep.json")
         data, options = stored_sweep(run_dir), executor_run_options(args, resume=True)
         try:
             if args.detach:

@@ -54,7 +54,7 @@ def run(args) -> ExitCode:
     overrides = list(args.set or [])
     if args.seed is not None:
         overrides.append(f"seed={args.seed}")
-    source = preset_source(args.preset, args.set or [])
+    source = args.source = preset_source(args.preset, args.set or [])  # what messages name, a sweep's too
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
     options = executor_run_options(args, resume=args.resume, force=args.force)
@@ -96,9 +96,9 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
     if data.get("sweep"):
         from ..runs.sweep import plan_sweep
 
-        sweep = plan_sweep(data, source=str(args.preset))
+        sweep = plan_sweep(data, source=args.source)
         check_sweep_startable(sweep, out_dir, options)
-        process = start_detached(data, out_dir, options, plot=not args.no_plot, source=str(args.preset))
+        process = start_detached(data, out_dir, options, plot=not args.no_plot, source=args.source)
         kind, what = "sweep", f"sweep of {counted(len(sweep.points), 'point')}"
     else:
         check_startable(scene, out_dir, options)
@@ -161,7 +161,7 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..runs.sweep import plan_sweep, run_sweep
     from ..progress import SweepProgress
 
-    sweep = plan_sweep(data, source=str(args.preset), before_reading=memory_check_before_reading(options))
+    sweep = plan_sweep(data, source=args.source, before_reading=memory_check_before_reading(options))
     try:
         outcome = run_sweep(
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot

@@ -342,13 +342,14 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
     if not advice:
         one = estimate(scene, workers=1, executor=executor, points=guess.grid)
         points_param = _points_path(scene)
+        one_worker = "--workers 1 and " if workers > 1 else ""  # not advised to a run that has one already
         if estimate(scene, workers=1, executor=executor, points=1).total <= available and points_param:
-            advice.append(f"--workers 1 and {points_param} <= {_most_points(scene, executor, available):,}")
+            advice.append(f"{one_worker}{points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * kept_arrays(scene) * KEPT_COPIES + 512
             most = math.floor((available - PROCESS_BASE - one.making - one.per_realization) / rows)
             if most >= 1:
-                advice.append(f"--workers 1 and realizations <= {most:,}")
+                advice.append(f"{one_worker}realizations <= {most:,}")
             elif one.making:  # no count of realizations fits: only a smaller surface does
                 advice.append(_smaller_map(one))
             else:  # no count of realizations fits (it offered 'realizations <= 0'): only a smaller grid does

@@ -136,8 +136,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         except ValueError as exc:  # k too small: said with the file's name
             raise ValueError(f"{where}: {exc}") from None
         done["despiked"] = {"k": p.despike, "points": count}
-        if count:
-            levelled = level(despiked, mode)
+        if count:  # level the file's map with the spikes replaced: the record says what levelling removed
+            levelled = level(z + (despiked - levelled.heights), mode)
     done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
     if (warning := levelling_warning(levelled, mode)) is not None:
