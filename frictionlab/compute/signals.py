@@ -72,9 +72,10 @@ class RaiseOnSignals:
 
     def __exit__(self, *exc):
         global _in_command
+        if self.previous:  # entered in the main thread
+            _in_command = False
         for signum, handler in self.previous.items():
             signal.signal(signum, signal.SIG_DFL if handler is None else handler)
-        _in_command = False if self.previous else _in_command
         return False
 
 
