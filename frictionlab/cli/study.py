@@ -64,11 +64,11 @@ def add_parser(sub) -> None:
         f"{_D.compare_points} points on a line, {_D.compare_points_surface} per side on a surface)",
     )
     parser.add_argument("--compare-realizations", type=int, default=d["compare_realizations"], metavar="M",
-                        help=f"realizations on the solver and tolerance axes (default {d['compare_realizations']})")
+                        help=f"realizations on the solver and tolerance axes, at most the preset's (default {d['compare_realizations']})")
     parser.add_argument("--compare-steps", type=int, default=d["compare_steps"], metavar="K",
-                        help=f"load steps on the solver and tolerance axes (default {d['compare_steps']})")
+                        help=f"load steps on the solver and tolerance axes, at most the preset's (default {d['compare_steps']})")
     parser.add_argument("--grid-realizations", type=int, default=d["grid_realizations"], metavar="M",
-                        help=f"realizations on the grid and steps axes (default {d['grid_realizations']})")
+                        help=f"realizations on the grid and steps axes, at most the preset's (default {d['grid_realizations']})")
     parser.add_argument("--grid-factors", default=d["grid_factors"], metavar="LIST",
                         help=f"grid sizes as multiples of the preset's N; the largest is the reference (default {d['grid_factors']})")
     parser.add_argument("--tolerances", default=d["tolerances"], metavar="LIST",
