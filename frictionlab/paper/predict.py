@@ -217,7 +217,30 @@ def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.n
     if arrays is None:
         return law, (math.nan, math.nan), None
     xi, f = arrays
-    return law, (float(np.min(f)), float(np.max(f))), _pairs_of(summary, law, xi, f)
+    pairs = _pairs_of(summary, law, xi, f)
+    _check_law_within(pairs, law, path)
+    return law, (float(np.min(f)), float(np.max(f))), pairs
+
+
+CHECKED_RESAMPLES = 100  # from this many, an estimate outside all of its resamples is not chance (2^-100)
+
+
+def _check_law_within(pairs: np.ndarray | None, law: LogFit, path: Path) -> None:
+    """The law of summary.json lies among its bootstrap resamples, redrawn from
+    realizations.npz: each resample refits the realizations' mean, so a or b beyond every
+    one of them says the two files disagree (one edited or damaged), and a prediction
+    from that law would be no run's."""
+    if pairs is None or len(pairs) < CHECKED_RESAMPLES:
+        return
+    for column, name, value in ((0, "a", law.a), (1, "b", law.b)):
+        low, high = float(pairs[:, column].min()), float(pairs[:, column].max())
+        slack = 1e-9 * max(abs(low), abs(high), 1.0)  # a resample may equal the estimate, to rounding
+        if not low - slack <= value <= high + slack:
+            raise RunFolderError(
+                f"{path}: fit.{name} = {value:.6g} lies outside all {len(pairs)} of its bootstrap resamples "
+                f"redrawn from realizations.npz ({low:.6g} to {high:.6g}): the two files disagree (one was "
+                "edited or damaged); run it again, or give the law by hand with --a/--b"
+            )
 
 
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:

@@ -130,6 +130,21 @@ def test_a_fit_field_of_the_wrong_type_or_range(run_copy, capsys, field, value):
     assert "summary.json" in err and f"'{field}" in err, err  # the field, or an item of it ('fit.b_ci.0')
 
 
+@pytest.mark.parametrize("field", ["a", "b"])
+def test_a_law_edited_beyond_its_own_resamples_is_refused(run_copy, capsys, field):
+    """A fit.a (or b) far from what realizations.npz gives, intervals untouched: the
+    prediction would be no run's. Refused naming the field and the span of its resamples;
+    a value within that span (edited or not) is not told from the run's own."""
+    summary = json.loads((run_copy / "summary.json").read_text())
+    low, high = summary["fit"][f"{field}_ci"]
+    edit_summary(run_copy, lambda s: s["fit"].update({field: high + 100 * (high - low) + 1.0}))
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER
+    assert f"fit.{field} = " in err and "outside all 200 of its bootstrap resamples" in err, err
+    edit_summary(run_copy, lambda s: s["fit"].update({field: (low + high) / 2}))
+    assert predict_from(run_copy, capsys)[0] == 0
+
+
 def test_a_summary_without_a_fit(run_copy, capsys):
     edit_summary(run_copy, lambda summary: summary.update(fit=None))
     code, _, err = predict_from(run_copy, capsys)
