@@ -33,9 +33,9 @@ def test_standard_errors_match_numpy_polyfit_covariance():
 
 def test_bootstrap_interval_covers_the_truth_at_about_its_level():
     """Realizations with random offsets and slopes around (a, b): the 90% bootstrap
-    interval of the mean must contain the true a in roughly 90% of ensembles."""
+    intervals of the mean must contain the true a, and the true b, in roughly 90% of ensembles."""
     f = np.geomspace(0.1, 10, 20)
-    a, b, hits, trials = 2.0, 0.1, 0, 200
+    a, b, hits, b_hits, trials = 2.0, 0.1, 0, 0, 200
     rng = np.random.default_rng(11)
     for _ in range(trials):
         m = 40
@@ -44,8 +44,10 @@ def test_bootstrap_interval_covers_the_truth_at_about_its_level():
         xi = a + offsets + (b + slopes) * np.log(f) + rng.normal(0, 0.02, (m, f.size))
         fit = fit_log_law(f, xi, bootstrap=300, confidence=0.9, rng=rng)
         hits += fit.a_ci[0] <= a <= fit.a_ci[1]
+        b_hits += fit.b_ci[0] <= b <= fit.b_ci[1]
     # binomial(200, 0.9) has sd 4.2 hits; percentile bootstrap undercovers a little at m = 40
     assert 0.8 <= hits / trials <= 0.97
+    assert 0.8 <= b_hits / trials <= 0.97
 
 
 def test_bootstrap_is_reproducible_and_brackets_the_estimate():

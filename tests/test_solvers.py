@@ -206,6 +206,24 @@ def test_parabola_force_control():
     np.testing.assert_array_equal(curve.force, forces)
 
 
+def test_mdr_of_a_sphere_is_hertz():
+    """Popov's MDR: a sphere of radius R maps to the line g(x) = x^2 / R; pressed into
+    springs of stiffness E* dx it carries Hertz's F = 4/3 E* sqrt(R) d^(3/2) with the line's
+    contact half-width the sphere's contact radius a = sqrt(R d). E* = E / (1 - nu^2) here,
+    not the solver's own stiffness(). Tolerances: the Euler-Maclaurin bound above."""
+    youngs, nu, radius, dx = 2.0, 0.25, 5.0, 0.01
+    solver = MDRSprings(youngs_modulus=youngs, poisson_ratio=nu)
+    e_star = youngs / (1 - nu**2)
+    half = int(round(6.0 / dx))
+    x = np.arange(-half, half) * dx
+    d = np.linspace(0.05, 1.0, 40)
+    curve = solve(solver, -(x**2) / radius, d, "indentation", dx=dx)
+    a = np.sqrt(radius * d)
+    hertz = 4 / 3 * e_star * np.sqrt(radius) * d**1.5
+    assert np.all(np.abs(curve.force - hertz) <= parabola_bound(e_star, radius / 2, a, dx))
+    assert np.all(np.abs(curve.contact_count * dx - 2 * a) <= dx * (1 + 1e-9))
+
+
 # --------------------------------------------------------- exactness checks
 
 
