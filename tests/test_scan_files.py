@@ -148,6 +148,8 @@ def test_channels_are_listed_chosen_by_name_or_index_and_the_shared_name_is_said
     assert by_name.input_summary()["channel_index"] == 3
     with pytest.raises(ValueError, match="no channel named 'Phase'; the file has 0: 'Height', 1: 'Height'"):
         SurfaceFile(path=str(tmp_path / "afm.gwy"), channel="Phase").generate(None)
+    with pytest.raises(ValueError, match=r"no channel named 'z sensor '; .* did you mean 'Z Sensor'\?"):
+        SurfaceFile(path=str(tmp_path / "afm.gwy"), channel="z sensor ").generate(None)
     with pytest.raises(ValueError, match="channel 7 does not exist; the file has 4"):
         SurfaceFile(path=str(tmp_path / "afm.gwy"), channel=7).generate(None)
 
