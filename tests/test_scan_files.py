@@ -450,3 +450,26 @@ def test_realizations_of_one_measured_line_are_said_to_be_one_surface(tmp_path):
     random_lines = frictionlab.run("quickstart", out=tmp_path / "random", workers=1, progress=False, plot=False,
                                    realizations=4)  # fmt: skip
     assert not any("same curve" in caveat for caveat in random_lines.caveats)
+
+
+def test_a_crop_that_leaves_out_the_undefined_points_is_read(tmp_path):
+    """Undefined points (an X3P's) or NaN (a table's) outside region were refused as if the
+    whole file were pressed, though the tutorial's advice is to crop to the measured part."""
+    z = rough_um(24)
+    holes = z.copy()
+    holes[5, 3] = holes[20, 4] = np.nan
+    np.save(tmp_path / "holes.npy", holes)
+    np.save(tmp_path / "clean.npy", z)
+    x3pio.write(tmp_path / "holes.x3p", holes * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    x3pio.write(tmp_path / "clean.x3p", z * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    region = {"x": [8, 24]}
+    for name, extra in (("x3p", {"unit": "um"}), ("npy", {"spacing": 0.1})):
+        kept = SurfaceFile(path=str(tmp_path / f"holes.{name}"), region=region, **extra)
+        clean = SurfaceFile(path=str(tmp_path / f"clean.{name}"), region=region, **extra)
+        np.testing.assert_allclose(kept.generate(None).heights, clean.generate(None).heights, rtol=1e-12, atol=1e-15)
+    summary = SurfaceFile(path=str(tmp_path / "holes.x3p"), region=region, unit="um").input_summary()
+    assert summary["undefined_points"] == 2 and summary["filled_by"] is None
+    with pytest.raises(ValueError, match=r"1 of 96 points of the region are undefined .* undefined: harmonic"):
+        SurfaceFile(path=str(tmp_path / "holes.x3p"), region={"y": [2, 6]}, unit="um").rms_height()
+    with pytest.raises(ValueError, match=r"1 value\(s\) in the region's heights .* the first at row 3, column 3"):
+        SurfaceFile(path=str(tmp_path / "holes.npy"), region={"y": [2, 6]}, spacing=0.1).rms_height()

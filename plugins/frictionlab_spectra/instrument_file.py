@@ -172,6 +172,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
               channel: str | int | None = None, spacing_given: bool = False) -> Scan:  # fmt: skip
     """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and pixel sides
     converted to ``unit``. ValueError naming ``where`` for anything wrong with the file.
+    ``undefined``: ``refuse``, ``harmonic``, or ``keep`` (left NaN, for a crop to check).
     ``spacing_given``: the preset gives the pixel side, so a file that states no physical
     size is read (its pixel a placeholder of 1, ``Scan.pixel_stated`` false) rather than refused."""
     with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
@@ -214,12 +215,12 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
         if missing:
             if undefined == "refuse":
-                raise ValueError(
-                    f"{where}: {missing} of {heights.size} points are undefined in the file (not measured); "
-                    "set undefined: harmonic to fill them from their neighbours, or fix the scan"
-                )
-            topography = topography.interpolate_undefined_data(method=undefined)
-            heights = topography.heights()
+                raise ValueError(undefined_message(where, missing, heights.size))
+            if undefined == "keep":  # NaN, for a crop to leave out (surface-file's region)
+                heights = np.ma.filled(np.ma.asarray(heights, dtype=np.float64), np.nan)
+            else:
+                topography = topography.interpolate_undefined_data(method=undefined)
+                heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         if along is not None:  # a line stored as a map one pixel wide: its heights along its long side
             heights, pixel = heights.reshape(-1), pixel[along : along + 1]
@@ -252,6 +253,12 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         undefined=missing,
         pixel_stated=stated,
     )
+
+
+def undefined_message(where: str, missing: int, total: int, of: str = "") -> str:
+    """The refusal of a scan with points undefined (``of``: the part of the map they are in)."""
+    return (f"{where}: {missing} of {total} points{of} are undefined in the file (not measured); set undefined: "
+            "harmonic to fill them from their neighbours, or fix the scan")
 
 
 FILLED_CAVEAT_SHARE = 0.05  # of a file's points filled by harmonic interpolation: a caveat from here on

@@ -84,7 +84,7 @@ def _nearly_square(dx: float, dy: float) -> bool:
     return abs(dx - dy) <= PIXEL_TOLERANCE * max(dx, dy)
 
 
-def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
+def crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
     ny, nx = z.shape
     bounds = []
     for span, side, count, name in ((region.x, pixel[0], nx, "x"), (region.y, pixel[1], ny, "y")):
@@ -127,7 +127,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if periodic:
         check_still_periodic(pixel, p, where)
     if p.region is not None:
-        z, done["region_pixels"] = _crop(z, pixel, p.region, where)
+        z, done["region_pixels"] = crop(z, pixel, p.region, where)
     mode = p.detrend if p.detrend is not None else "plane" if instrument and not periodic else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
