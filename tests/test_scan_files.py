@@ -473,3 +473,14 @@ def test_a_crop_that_leaves_out_the_undefined_points_is_read(tmp_path):
         SurfaceFile(path=str(tmp_path / "holes.x3p"), region={"y": [2, 6]}, unit="um").rms_height()
     with pytest.raises(ValueError, match=r"1 value\(s\) in the region's heights .* the first at row 3, column 3"):
         SurfaceFile(path=str(tmp_path / "holes.npy"), region={"y": [2, 6]}, spacing=0.1).rms_height()
+
+
+def test_pixels_equal_but_for_rounding_are_not_said_to_be_taken_as_square(tmp_path):
+    """An x, y, z text file's steps, 0.1 and 0.1 + 2e-17, were said to be 'taken as square
+    (1.39e-14 % apart)': a note about pixels that are square."""
+    z = rough_um(16)[:12]  # 16 x 12 points: x steps of 0.1, y steps of 0.1 + 2e-17 as read
+    rows = [f"{0.1 * i:.6g} {0.1 * j:.6g} {z[j, i]:.9g}" for j in range(12) for i in range(16)]
+    (tmp_path / "scan.xyz").write_text("\n".join(rows) + "\n")
+    surface = SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um")
+    assert "pixels" not in surface.input_summary()
+    assert surface.generate(None).spacing == pytest.approx(0.1, rel=1e-12)

@@ -28,6 +28,7 @@ from .scan_shaping import (cosine_resample, despike, level, levelling_warning, o
                            spike_warning)
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
+SAME_SIDE = 1e-9  # relative difference of two sides that are the same side, rounded
 FileFormat = Literal["auto", "table", "instrument"]
 Level = Literal["none", "mean", "plane", "quadratic"]
 
@@ -148,7 +149,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel
-    if dx != dy:
+    if abs(dx - dy) > SAME_SIDE * max(dx, dy):  # not the rounding of a text file's coordinates (0.1 vs 0.1000...02)
         difference = abs(dx - dy) / max(dx, dy)
         if _nearly_square(dx, dy):
             spacing = 0.5 * (dx + dy)
