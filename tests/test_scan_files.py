@@ -468,7 +468,8 @@ def test_a_crop_that_leaves_out_the_undefined_points_is_read(tmp_path):
         clean = SurfaceFile(path=str(tmp_path / f"clean.{name}"), region=region, **extra)
         np.testing.assert_allclose(kept.generate(None).heights, clean.generate(None).heights, rtol=1e-12, atol=1e-15)
     summary = SurfaceFile(path=str(tmp_path / "holes.x3p"), region=region, unit="um").input_summary()
-    assert summary["undefined_points"] == 2 and summary["filled_by"] is None
+    assert summary["undefined_points"] == 0 and summary["undefined_outside_region"] == 2
+    assert summary["filled_by"] is None
     with pytest.raises(ValueError, match=r"1 of 96 points of the region are undefined .* undefined: harmonic"):
         SurfaceFile(path=str(tmp_path / "holes.x3p"), region={"y": [2, 6]}, unit="um").rms_height()
     with pytest.raises(ValueError, match=r"1 value\(s\) in the region's heights .* the first at row 3, column 3"):
@@ -484,3 +485,20 @@ def test_pixels_equal_but_for_rounding_are_not_said_to_be_taken_as_square(tmp_pa
     surface = SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um")
     assert "pixels" not in surface.input_summary()
     assert surface.generate(None).spacing == pytest.approx(0.1, rel=1e-12)
+
+
+def test_a_filled_hole_is_counted_in_the_region_pressed_not_in_the_file(tmp_path):
+    """With undefined: harmonic and a crop that leaves out a large hole, the summary said the
+    file's 400 points were filled and the caveat asked to crop to the measured part: as done."""
+    z = rough_um(64)
+    z[10:30, 10:30] = np.nan  # 9.8 % of the file
+    x3pio.write(tmp_path / "hole.x3p", z * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    params = {"path": str(tmp_path / "hole.x3p"), "unit": "um", "undefined": "harmonic"}
+    whole = SurfaceFile(**params).input_summary()
+    assert whole["undefined_points"] == 400 and "9.77 % of the file's points" in whole["caveats"][0]
+    measured = SurfaceFile(**params, region={"x": [30, 64]}).input_summary()
+    assert measured["undefined_points"] == 0 and measured["undefined_outside_region"] == 400
+    assert measured["filled_by"] is None and not any("harmonic" in c for c in measured.get("caveats", []))
+    partly = SurfaceFile(**params, region={"x": [20, 64]}).input_summary()
+    assert partly["undefined_points"] == 200 and partly["filled_by"] == "harmonic"
+    assert any(c.startswith("7.1 % of the region's points were undefined") for c in partly["caveats"])

@@ -50,7 +50,7 @@ from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
@@ -259,6 +259,17 @@ def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Par
                  table_fill_advice(p, instrument))
 
 
+def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
+    """What the summary says of a scan's undefined points once cropped: those inside ``region``
+    (filled, or refused by ``_check_defined``) and those it leaves out."""
+    inside = int(np.count_nonzero(crop(scan.undefined_mask, pixel, p.region, where)[0]))
+    size = crop(scan.heights, pixel, p.region, where)[0].size
+    caveat = filled_caveat(inside, size, p, 2, "the region's")
+    return {"undefined_points": inside, "undefined_outside_region": scan.undefined - inside,
+            "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
+            "caveats": [caveat] if caveat else []}  # fmt: skip
+
+
 def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
     way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
@@ -268,8 +279,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
         summary = scan_summary(scan, p)
-        if undefined == "keep":  # none filled: the region leaves them out, or they are refused
-            summary["filled_by"] = None
+        if p.region is not None and scan.undefined:
+            summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         if p.spacing is None:
