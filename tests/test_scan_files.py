@@ -148,6 +148,8 @@ def test_channels_are_listed_chosen_by_name_or_index_and_the_shared_name_is_said
     assert by_name.input_summary()["channel_index"] == 3
     with pytest.raises(ValueError, match="no channel named 'Phase'; the file has 0: 'Height', 1: 'Height'"):
         SurfaceFile(path=str(tmp_path / "afm.gwy"), channel="Phase").generate(None)
+    with pytest.raises(ValueError, match=r"no channel named 'z sensor '; .* did you mean 'Z Sensor'\?"):
+        SurfaceFile(path=str(tmp_path / "afm.gwy"), channel="z sensor ").generate(None)
     with pytest.raises(ValueError, match="channel 7 does not exist; the file has 4"):
         SurfaceFile(path=str(tmp_path / "afm.gwy"), channel=7).generate(None)
 
@@ -448,3 +450,55 @@ def test_realizations_of_one_measured_line_are_said_to_be_one_surface(tmp_path):
     random_lines = frictionlab.run("quickstart", out=tmp_path / "random", workers=1, progress=False, plot=False,
                                    realizations=4)  # fmt: skip
     assert not any("same curve" in caveat for caveat in random_lines.caveats)
+
+
+def test_a_crop_that_leaves_out_the_undefined_points_is_read(tmp_path):
+    """Undefined points (an X3P's) or NaN (a table's) outside region were refused as if the
+    whole file were pressed, though the tutorial's advice is to crop to the measured part."""
+    z = rough_um(24)
+    holes = z.copy()
+    holes[5, 3] = holes[20, 4] = np.nan
+    np.save(tmp_path / "holes.npy", holes)
+    np.save(tmp_path / "clean.npy", z)
+    x3pio.write(tmp_path / "holes.x3p", holes * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    x3pio.write(tmp_path / "clean.x3p", z * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    region = {"x": [8, 24]}
+    for name, extra in (("x3p", {"unit": "um"}), ("npy", {"spacing": 0.1})):
+        kept = SurfaceFile(path=str(tmp_path / f"holes.{name}"), region=region, **extra)
+        clean = SurfaceFile(path=str(tmp_path / f"clean.{name}"), region=region, **extra)
+        np.testing.assert_allclose(kept.generate(None).heights, clean.generate(None).heights, rtol=1e-12, atol=1e-15)
+    summary = SurfaceFile(path=str(tmp_path / "holes.x3p"), region=region, unit="um").input_summary()
+    assert summary["undefined_points"] == 0 and summary["undefined_outside_region"] == 2
+    assert summary["filled_by"] is None
+    with pytest.raises(ValueError, match=r"1 of 96 points of the region are undefined .* undefined: harmonic"):
+        SurfaceFile(path=str(tmp_path / "holes.x3p"), region={"y": [2, 6]}, unit="um").rms_height()
+    with pytest.raises(ValueError, match=r"1 value\(s\) in the region's heights .* the first at row 3, column 3"):
+        SurfaceFile(path=str(tmp_path / "holes.npy"), region={"y": [2, 6]}, spacing=0.1).rms_height()
+
+
+def test_pixels_equal_but_for_rounding_are_not_said_to_be_taken_as_square(tmp_path):
+    """An x, y, z text file's steps, 0.1 and 0.1 + 2e-17, were said to be 'taken as square
+    (1.39e-14 % apart)': a note about pixels that are square."""
+    z = rough_um(16)[:12]  # 16 x 12 points: x steps of 0.1, y steps of 0.1 + 2e-17 as read
+    rows = [f"{0.1 * i:.6g} {0.1 * j:.6g} {z[j, i]:.9g}" for j in range(12) for i in range(16)]
+    (tmp_path / "scan.xyz").write_text("\n".join(rows) + "\n")
+    surface = SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um")
+    assert "pixels" not in surface.input_summary()
+    assert surface.generate(None).spacing == pytest.approx(0.1, rel=1e-12)
+
+
+def test_a_filled_hole_is_counted_in_the_region_pressed_not_in_the_file(tmp_path):
+    """With undefined: harmonic and a crop that leaves out a large hole, the summary said the
+    file's 400 points were filled and the caveat asked to crop to the measured part: as done."""
+    z = rough_um(64)
+    z[10:30, 10:30] = np.nan  # 9.8 % of the file
+    x3pio.write(tmp_path / "hole.x3p", z * 1e-6, x_scale=1e-7, y_scale=1e-7, revision=x3pio.Revision.ISO5436_2000)
+    params = {"path": str(tmp_path / "hole.x3p"), "unit": "um", "undefined": "harmonic"}
+    whole = SurfaceFile(**params).input_summary()
+    assert whole["undefined_points"] == 400 and "9.77 % of the file's points" in whole["caveats"][0]
+    measured = SurfaceFile(**params, region={"x": [30, 64]}).input_summary()
+    assert measured["undefined_points"] == 0 and measured["undefined_outside_region"] == 400
+    assert measured["filled_by"] is None and not any("harmonic" in c for c in measured.get("caveats", []))
+    partly = SurfaceFile(**params, region={"x": [20, 64]}).input_summary()
+    assert partly["undefined_points"] == 200 and partly["filled_by"] == "harmonic"
+    assert any(c.startswith("7.1 % of the region's points were undefined") for c in partly["caveats"])

@@ -241,6 +241,8 @@ def describe_input(summary: dict) -> str:
         + (", periodic" if summary.get("periodic") else ", not periodic")
         + (f", {summary['undefined_points']} undefined points filled ({summary['filled_by']})"
            if summary.get("filled_by") else "")
+        + (f", {summary['undefined_outside_region']} undefined points outside the region"
+           if summary.get("undefined_outside_region") else "")
         + "".join(f"; {note}" for note in notes)
     )  # fmt: skip
 

@@ -56,6 +56,7 @@ class Scan:
     channels: list  # every channel of the file (index, name, points, units) when it has more than one
     undefined: int  # points the file leaves undefined (filled when the preset says how)
     pixel_stated: bool = True  # false: the file states no size, ``pixel`` is 1 per point and the preset's spacing is used
+    undefined_mask: np.ndarray | None = None  # a map's undefined points, (Ny, Nx): which a crop leaves out
 
 
 def is_instrument_file(path: Path, format: str = "auto") -> bool:
@@ -172,6 +173,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
               channel: str | int | None = None, spacing_given: bool = False) -> Scan:  # fmt: skip
     """The scan in ``path`` (``dimension`` 2: a map, 1: a line), heights and pixel sides
     converted to ``unit``. ValueError naming ``where`` for anything wrong with the file.
+    ``undefined``: ``refuse``, ``harmonic``, or ``keep`` (left NaN, for a crop to check).
     ``spacing_given``: the preset gives the pixel side, so a file that states no physical
     size is read (its pixel a placeholder of 1, ``Scan.pixel_stated`` false) rather than refused."""
     with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
@@ -212,14 +214,15 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
         if missing == heights.size:  # harmonic filling would have nothing to fill from
             raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
+        mask = np.ascontiguousarray(np.ma.getmaskarray(heights).T) if missing and dimension == 2 else None
         if missing:
             if undefined == "refuse":
-                raise ValueError(
-                    f"{where}: {missing} of {heights.size} points are undefined in the file (not measured); "
-                    "set undefined: harmonic to fill them from their neighbours, or fix the scan"
-                )
-            topography = topography.interpolate_undefined_data(method=undefined)
-            heights = topography.heights()
+                raise ValueError(undefined_message(where, missing, heights.size))
+            if undefined == "keep":  # NaN, for a crop to leave out (surface-file's region)
+                heights = np.ma.filled(np.ma.asarray(heights, dtype=np.float64), np.nan)
+            else:
+                topography = topography.interpolate_undefined_data(method=undefined)
+                heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         if along is not None:  # a line stored as a map one pixel wide: its heights along its long side
             heights, pixel = heights.reshape(-1), pixel[along : along + 1]
@@ -251,21 +254,28 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         channels=listed,
         undefined=missing,
         pixel_stated=stated,
+        undefined_mask=mask,
     )
+
+
+def undefined_message(where: str, missing: int, total: int, of: str = "") -> str:
+    """The refusal of a scan with points undefined (``of``: the part of the map they are in)."""
+    return (f"{where}: {missing} of {total} points{of} are undefined in the file (not measured); set undefined: "
+            "harmonic to fill them from their neighbours, or fix the scan")
 
 
 FILLED_CAVEAT_SHARE = 0.05  # of a file's points filled by harmonic interpolation: a caveat from here on
 
 
-def filled_caveat(scan: Scan, p) -> str | None:
-    """The caveat of a scan whose undefined points were filled, when they are a share of it
-    that can move ξ: a filled patch is the smooth solution of Laplace's equation, so its
-    slopes are the interpolation's, not the surface's."""
-    share = scan.undefined / scan.heights.size if p.undefined == "harmonic" else 0.0
+def filled_caveat(filled: int, total: int, p, ndim: int, of: str = "the file's") -> str | None:
+    """The caveat of a scan whose undefined points were filled (``filled`` of its ``total``), when
+    they are a share of it that can move ξ: a filled patch is the smooth solution of Laplace's
+    equation, so its slopes are the interpolation's, not the surface's."""
+    share = filled / total if p.undefined == "harmonic" else 0.0
     if share < FILLED_CAVEAT_SHARE:
         return None
-    crop = "crop the map to its measured part (region)" if scan.heights.ndim == 2 else "cut the line in the file to its measured part"
-    return (f"{100 * share:.3g} % of the file's points were undefined and filled by harmonic interpolation: their "
+    crop = "crop the map to its measured part (region)" if ndim == 2 else "cut the line in the file to its measured part"
+    return (f"{100 * share:.3g} % of {of} points were undefined and filled by harmonic interpolation: their "
             "slopes are the interpolation's (smooth), not the surface's, nor is xi where a contact reaches them; "
             f"{crop} where it is large enough")  # fmt: skip
 
@@ -283,7 +293,7 @@ def scan_summary(scan: Scan, p) -> dict:
         "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
         "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
         "periodic_from": "file" if p.periodic is None else "preset",
-        **({"caveats": [caveat]} if (caveat := filled_caveat(scan, p)) else {}),
+        **({"caveats": [caveat]} if (caveat := filled_caveat(scan.undefined, scan.heights.size, p, scan.heights.ndim)) else {}),
     }  # fmt: skip
 
 

@@ -338,7 +338,8 @@ def pick_channel(reader, wanted: str | int | None, where: str):
     else:
         named = [c for c in channels if str(c.name) == wanted]
         if not named:
-            raise ValueError(f"{where}: no channel named {wanted!r}; the file has {_named(channels)}")
+            raise ValueError(f"{where}: no channel named {quoted(wanted)}; the file has {_named(channels)}"
+                             f"{_near_names(channels, wanted)}")  # fmt: skip
         channel = named[0]
     same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
     note = None
@@ -346,6 +347,14 @@ def pick_channel(reader, wanted: str | int | None, where: str):
         note = (f"{len(same)} channels are named {quoted(channel.name)} (indices {', '.join(map(str, same))}); "
                 f"index {int(channel.index)} was taken (channel: INDEX chooses another)")  # fmt: skip
     return channel, note
+
+
+def _near_names(channels, wanted: str) -> str:
+    """A hint when a name differs from one of the file's only in case or surrounding spaces:
+    names are matched exactly, as the file writes them."""
+    key = wanted.strip().casefold()
+    near = [quoted(c.name) for c in channels if str(c.name).strip().casefold() == key]
+    return f" (names are matched exactly: did you mean {near[0]}?)" if near else ""
 
 
 def _named(channels) -> str:

@@ -28,6 +28,7 @@ from .scan_shaping import (cosine_resample, despike, level, levelling_warning, o
                            spike_warning)
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
+SAME_SIDE = 1e-9  # relative difference of two sides that are the same side, rounded
 FileFormat = Literal["auto", "table", "instrument"]
 Level = Literal["none", "mean", "plane", "quadratic"]
 
@@ -84,7 +85,7 @@ def _nearly_square(dx: float, dy: float) -> bool:
     return abs(dx - dy) <= PIXEL_TOLERANCE * max(dx, dy)
 
 
-def _crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
+def crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
     ny, nx = z.shape
     bounds = []
     for span, side, count, name in ((region.x, pixel[0], nx, "x"), (region.y, pixel[1], ny, "y")):
@@ -127,7 +128,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if periodic:
         check_still_periodic(pixel, p, where)
     if p.region is not None:
-        z, done["region_pixels"] = _crop(z, pixel, p.region, where)
+        z, done["region_pixels"] = crop(z, pixel, p.region, where)
     mode = p.detrend if p.detrend is not None else "plane" if instrument and not periodic else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
@@ -148,7 +149,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel
-    if dx != dy:
+    if abs(dx - dy) > SAME_SIDE * max(dx, dy):  # not the rounding of a text file's coordinates (0.1 vs 0.1000...02)
         difference = abs(dx - dy) / max(dx, dy)
         if _nearly_square(dx, dy):
             spacing = 0.5 * (dx + dy)

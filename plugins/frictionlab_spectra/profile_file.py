@@ -433,12 +433,15 @@ def _separator(delimiter: str | None) -> str:
 
 
 def table_fill_advice(p, instrument: bool) -> str:
-    """What ``check_finite`` adds of a table's NaN when the preset asks to fill undefined points
-    (it was refused as if the preset had not asked)."""
-    if instrument or p.undefined != "harmonic":
+    """What ``check_finite`` adds of a table's NaN: what to do (a table cannot mark points as
+    not measured), and, when the preset asks to fill undefined points, why it did not."""
+    if instrument:
         return ""
+    crop = ", leave them out with region" if "region" in type(p).model_fields else ""
+    if p.undefined != "harmonic":
+        return f"; fill them before saving the table{crop}, or read the instrument's own file"
     return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
-            "fill them before saving the table, or read the instrument's own file")  # fmt: skip
+            f"fill them before saving the table{crop}, or read the instrument's own file")  # fmt: skip
 
 
 def check_finite(where: str, what: str, values: np.ndarray, advice: str = "") -> None:

@@ -50,9 +50,9 @@ from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, is_instrument_file, read_scan, scan_header, scan_summary,
+    ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
-from .map_pipeline import Downsample, Level, Region, shape_map, square_shape
+from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
@@ -225,7 +225,7 @@ class SurfaceFile(MeasuredFile):
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
         z, pixel, summary = _read_map(path, where, p)
-        check_finite(where, "heights", z, table_fill_advice(p, is_instrument_file(path, p.format)))
+        _check_defined(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format),
                                              periodic=summary["periodic"])
@@ -236,7 +236,7 @@ class SurfaceFile(MeasuredFile):
             raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
-        if not rms > 1e-12 * float(np.max(np.abs(z))):  # also true for an all-zero map
+        if not rms > 1e-12 * float(np.nanmax(np.abs(z))):  # also true for an all-zero map; NaN only outside region
             replaced = shaped.get("despiked", {}).get("points")
             despiked = f" and despike {p.despike:g}, which replaced {replaced} points" if replaced else ""
             raise ValueError(
@@ -248,14 +248,39 @@ class SurfaceFile(MeasuredFile):
         return Measured(heights, spacing, rms, summary["periodic"], summary)
 
 
+def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, where: str, *,
+                   instrument: bool) -> None:
+    """Refuse undefined points (an instrument's NaN) or NaN/inf inside the part of the map pressed:
+    a crop (``region``) that leaves them out is read."""
+    inside = crop(z, pixel, p.region, where)[0] if p.region is not None else z
+    if instrument and (missing := int(np.count_nonzero(np.isnan(inside)))):
+        raise ValueError(undefined_message(where, missing, inside.size, " of the region"))
+    check_finite(where, "heights" if p.region is None else "the region's heights (rows, columns from its corner)", inside,
+                 table_fill_advice(p, instrument))
+
+
+def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
+    """What the summary says of a scan's undefined points once cropped: those inside ``region``
+    (filled, or refused by ``_check_defined``) and those it leaves out."""
+    inside = int(np.count_nonzero(crop(scan.undefined_mask, pixel, p.region, where)[0]))
+    size = crop(scan.heights, pixel, p.region, where)[0].size
+    caveat = filled_caveat(inside, size, p, 2, "the region's")
+    return {"undefined_points": inside, "undefined_outside_region": scan.undefined - inside,
+            "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
+            "caveats": [caveat] if caveat else []}  # fmt: skip
+
+
 def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
     way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
     if is_instrument_file(path, p.format):
-        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=p.undefined, channel=p.channel,
+        undefined = "keep" if p.region is not None and p.undefined == "refuse" else p.undefined  # outside: cropped
+        scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=undefined, channel=p.channel,
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
         summary = scan_summary(scan, p)
+        if p.region is not None and scan.undefined:
+            summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         if p.spacing is None:
