@@ -15,6 +15,8 @@ import pytest
 
 import frictionlab
 
+from .test_scaling_laws import lengths_scaled
+
 S = 1e9  # m -> nm
 SLOPES = ("forward-difference", "central-difference", "spectral")
 # solver -> (spectrum params in metres, E in Pa, load unit factor m -> nm, forces in N)
@@ -36,7 +38,7 @@ def _preset(solver: str, slope: str, nm: bool) -> dict:
     spectrum, load_factor, (start, stop) = CASES[solver]
     params = dict(spectrum["params"])
     if nm:
-        params = {k: v * S if k in ("spacing", "rms_height", "short_cutoff") else v for k, v in params.items()}
+        params = lengths_scaled(params, S)
     solver_params = {"youngs_modulus": E / S**2 if nm else E, "poisson_ratio": 0.3}
     if solver.startswith("bem"):
         solver_params["tolerance"] = 1e-10

@@ -39,6 +39,12 @@ LAWS = ("heights", "modulus", "length")
 FACTOR = 7.3  # c, m or s: not a power of two, so rounding is exercised
 
 
+def lengths_scaled(params: dict, factor: float) -> dict:
+    """A spectrum's parameters with every length (spacing, heights, cut-off) times ``factor``:
+    the same surface in another unit of length."""
+    return {k: v * factor if k in ("spacing", "rms_height", "short_cutoff") else v for k, v in params.items()}
+
+
 def _preset(solver: str, slope: str, law: str | None) -> dict:
     spectrum, (start, stop), per_depth = SOLVERS[solver]
     params = dict(spectrum["params"])
@@ -54,7 +60,7 @@ def _preset(solver: str, slope: str, law: str | None) -> dict:
         solver_params[modulus_key] *= FACTOR
         load = FACTOR
     elif law == "length":
-        params = {k: v * FACTOR if k in ("spacing", "rms_height", "short_cutoff") else v for k, v in params.items()}
+        params = lengths_scaled(params, FACTOR)
         load = FACTOR if per_depth else FACTOR**2
         if solver == "winkler":  # a foundation modulus on a surface is a stress per unit length
             solver_params[modulus_key] /= FACTOR
