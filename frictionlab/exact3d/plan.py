@@ -30,7 +30,7 @@ from ..compute.ensemble import RunOutcome
 from ..errors import FrictionlabError, OutputRefused, RunFolderError
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
-from ..preset import Scene, read_preset
+from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
 from ..runs.rundir import STATE_FILE, RunDirectory
 from ..runs.runfolder import read_json
@@ -290,10 +290,10 @@ def run_plan(
             if not path.is_file():
                 raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
             factories[job.hurst] = factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
-            said = getattr(factory.base.spectrum.params, "hurst", None)
-            if not isinstance(said, float | int) or not math.isclose(said, job.hurst):  # the page names it by its file
+            # the page names it by its file's H
+            if (unlike := first_unlike(factory.base.resolved(), {"spectrum.params.hurst": job.hurst})) is not None:
                 raise FrictionlabError(
-                    f"{path}: spectrum.params.hurst is {said!r}, but the study takes this file for H = {job.hurst:g} "
+                    f"{path}: spectrum.params.hurst is {unlike[1]!r}, but the study takes this file for H = {job.hurst:g} "
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )

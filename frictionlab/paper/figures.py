@@ -3,13 +3,12 @@ frictionlab's presets of those figures (``presets/benad2012-fig*.yaml``)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import FrictionlabError, short_repr
 from ..options import RunOptions
-from ..preset import build_scene, get_path, read_preset
+from ..preset import build_scene, first_unlike, read_preset
 from ..runs.runner import run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..runs.sweep import plan_sweep, run_sweep
@@ -103,14 +102,13 @@ def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
     """FrictionlabError unless every scene is what the figure's title states (``setup``): a
     preset of H = 0.5 in benad2012-fig2.yaml was reported as 'Fig. 2: H = 1' beside the paper's numbers."""
     for scene in scenes:
-        for dotted, stated in fig.setup.items():
-            value = get_path(scene.resolved(), dotted, None)
-            if isinstance(value, bool) or not isinstance(value, float | int) or not math.isclose(value, stated):
-                raise FrictionlabError(
-                    f"{path}: {dotted} is {short_repr(value)}, but the report shows this preset as '{fig.title}' beside "
-                    f"the paper's numbers ({dotted} = {stated:g}); give the paper's preset (frictionlab presets copy "
-                    f"{fig.preset.removesuffix('.yaml')}), or run yours with frictionlab run"
-                )
+        if (unlike := first_unlike(scene.resolved(), fig.setup)) is not None:
+            dotted, value, stated = unlike
+            raise FrictionlabError(
+                f"{path}: {dotted} is {short_repr(value)}, but the report shows this preset as '{fig.title}' beside "
+                f"the paper's numbers ({dotted} = {stated:g}); give the paper's preset (frictionlab presets copy "
+                f"{fig.preset.removesuffix('.yaml')}), or run yours with frictionlab run"
+            )
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:

@@ -15,7 +15,9 @@ from typing import TYPE_CHECKING
 # Each name is imported from its module on first use: listing or reading a preset file
 # (the TUI's first screen) needs neither the schema's pydantic models nor numpy.
 _LAZY = {
-    **dict.fromkeys(("MISSING", "apply_overrides", "differences", "get_path", "set_path", "yaml_scalar"), "paths"),
+    **dict.fromkeys(
+        ("MISSING", "apply_overrides", "differences", "first_unlike", "get_path", "set_path", "yaml_scalar"), "paths"
+    ),
     **dict.fromkeys(("format_validation_error", "number_problems"), "problems"),
     **dict.fromkeys(("MAX_PRESET_BYTES", "load_preset_file", "read_preset", "resolve_input_paths"), "reading"),
     **dict.fromkeys(("Scene", "build_scene", "load_scene"), "scene"),
@@ -27,7 +29,7 @@ _LAZY = {
 }
 
 if TYPE_CHECKING:
-    from .paths import MISSING, apply_overrides, differences, get_path, set_path, yaml_scalar
+    from .paths import MISSING, apply_overrides, differences, first_unlike, get_path, set_path, yaml_scalar
     from .problems import format_validation_error, number_problems
     from .reading import MAX_PRESET_BYTES, load_preset_file, read_preset, resolve_input_paths
     from .scene import Scene, build_scene, load_scene
@@ -64,6 +66,7 @@ __all__ = [
     "apply_overrides",
     "build_scene",
     "differences",
+    "first_unlike",
     "format_validation_error",
     "get_path",
     "load_preset_file",

@@ -33,6 +33,17 @@ def get_path(data: dict, path: str | Sequence[str], default=MISSING):
     return node
 
 
+def first_unlike(data: dict, stated: dict[str, float]) -> tuple[str, Any, float] | None:
+    """The first dotted path of ``stated`` whose value in ``data`` is not that number (to
+    rounding), as ``(path, its value, the number)``; None when ``data`` holds them all. What
+    a report states of a preset (H = 1, F = 1..20) is checked against the preset so."""
+    for dotted, number in stated.items():
+        value = get_path(data, dotted, None)
+        if isinstance(value, bool) or not isinstance(value, float | int) or not math.isclose(value, number):
+            return dotted, value, number
+    return None
+
+
 def set_path(data: dict, path: str | Sequence[str], value: Any, *, replace_values: bool = False) -> None:
     """Set ``data[a][b][c] = value`` for ``a.b.c`` (or ``("a", "b", "c")``), making mappings
     where keys are missing or None; ``MISSING`` removes the key. A value in the way
