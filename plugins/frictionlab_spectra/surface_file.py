@@ -262,8 +262,8 @@ def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Par
 def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
     """What the summary says of a scan's undefined points once cropped: those inside ``region``
     (filled, or refused by ``_check_defined``) and those it leaves out."""
-    inside = int(np.count_nonzero(crop(scan.undefined_mask, pixel, p.region, where)[0]))
-    size = crop(scan.heights, pixel, p.region, where)[0].size
+    region_mask = crop(scan.undefined_mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
+    inside, size = int(np.count_nonzero(region_mask)), region_mask.size
     caveat = filled_caveat(inside, size, p, 2, "the region's")
     return {"undefined_points": inside, "undefined_outside_region": scan.undefined - inside,
             "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
