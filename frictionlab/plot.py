@@ -91,7 +91,8 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax, ax_count = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.2]})
     fig.subplots_adjust(left=0.12, right=0.97, bottom=0.1, top=0.94, hspace=0.06)
     draw_curve(ax, outcome.f, outcome.xi, outcome.xi_sem, outcome.fit, done=outcome.done, caveats=outcome.caveats)
-    ax.set_title(f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}", fontsize=10)
+    title = f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}"
+    ax.set_title(title, fontsize=10, y=1.0)  # placed, not fitted above the tick labels that the shared x axis hides
     ax_count.plot(outcome.f, outcome.contact_count, "-", color="C2")
     ax_count.set_yscale("log")
     plain_log_labels(ax_count.yaxis)
