@@ -113,7 +113,8 @@ def test_swept_nan_and_infinities_are_refused_by_the_field_not_an_internal_error
 
 
 def test_swept_text_that_looks_like_a_number_stays_text(registry):
-    sweep = plan_sweep(sweep_preset({"description": {"values": ["1e5", "plain"]}}), registry=registry)
+    swept = {"description": {"values": ["1e5", "plain"]}, "seed": {"values": [1, 2]}}  # a description alone: refused
+    sweep = plan_sweep(sweep_preset(swept, mode="zip"), registry=registry)
     assert [p.scene.preset.description for p in sweep.points] == ["1e5", "plain"]
 
 
@@ -167,6 +168,11 @@ def test_a_zip_point_twice_is_refused_and_a_value_repeated_beside_others_is_not(
     ({"seed": {"values": [1, "1"]}}, "grid", "sweep points 1 (seed=1) and 2 (seed='1') are one preset"),
     ({"spectrum.params.hurst": {"values": [0.5, "5e-1"]}}, "grid", "sweep points 1 (spectrum.params.hurst=0.5) and 2"),
     ({"seed": {"values": [1, "1"]}, "realizations": {"values": [4, 4.0]}}, "zip", "sweep points 1 (seed=1, realizations=4)"),
+    # what changes no number: each point ran the same ensemble under another name
+    ({"name": {"values": ["a", "b"]}}, "grid", "sweep points 1 (name=a) and 2 (name=b) are one preset"),
+    ({"description": {"values": ["x", "y"]}}, "grid", "sweep points 1 (description=x) and 2"),
+    ({"output.plot": {"values": [True, False]}}, "grid", "sweep points 1 (output.plot=true) and 2"),
+    ({"output.realizations": {"values": [True, False]}, "seed": {"values": [1, 1]}}, "zip", "sweep points 1"),
 ])  # fmt: skip
 def test_two_points_that_read_as_one_preset_are_refused(parameters, mode, said, registry):
     """1 and '1' are two values to the values' own check, but one seed once read: the sweep ran

@@ -118,6 +118,11 @@ class SweepParameter(_Strict):
         return [int(v) if whole and v.is_integer() else v for v in raw]
 
 
+def ensemble_settings(resolved: dict) -> dict:
+    """What the numbers of a resolved preset depend on: all of it but its name, description and output."""
+    return {key: value for key, value in resolved.items() if key not in ("name", "description", "output")}
+
+
 def first_repeat(values: list) -> tuple[int, int] | None:
     """The first two places ``values`` holds one value (1 and 1.0 are one), or None."""
     for j, value in enumerate(values):

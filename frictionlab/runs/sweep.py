@@ -36,7 +36,7 @@ from ..plugin.listeners import SweepListener
 from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
-from ..preset.schema import first_repeat
+from ..preset.schema import ensemble_settings, first_repeat
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
@@ -202,10 +202,10 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             continue
         folder = f"{number:0{width}d}-{_label(values)}"
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
-    if not problems and (pair := first_repeat([point.scene.resolved() for point in points])) is not None:
+    if not problems and (pair := first_repeat([ensemble_settings(p.scene.resolved()) for p in points])) is not None:
         one, two = (points[i] for i in pair)  # seed 1 and '1': one preset once read, which the values' check cannot see
         problems = [f"sweep points {one.number} ({one.describe()}) and {two.number} ({two.describe()}) are one preset "
-                    "once their values are read: the same ensemble would run twice; give each value once"]
+                    "once read, name, description and output aside: the same ensemble would run twice; give each value once"]
     if problems:
         raise PresetError(problems, source=source)
     return Sweep(name=base_preset.name, spec=spec, base=base, points=points, source=source)
