@@ -417,11 +417,63 @@ def test_blocking_a_broken_plugin_silences_it(two_good):
     assert reg.failures == []
 
 
-def test_misspelled_hook_in_an_entry_point_fails_loudly(two_good):
-    two_good("acme-typo", "typo", "acme_typo_plugin", MISSPELLED_SOURCE)
-    with pytest.raises(pluggy.PluginValidationError, match="register_spectrum"):
-        Registry(env={})
+HOOK_RAISES_SOURCE = '''
+import frictionlab
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    raise RuntimeError("boom: broken in its hook")
+'''
+
+INVALID_CLASS_SOURCE = '''
+import frictionlab
+from tests.testing.fakes import spectrum_class
+
+Loose = spectrum_class("loose-line", __name__, "Loose")
+Loose.Params = dict
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Loose)
+'''
+
+BROKEN_AT_REGISTRATION = {
+    "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
+    "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
+    "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BROKEN_AT_REGISTRATION))
+def test_an_entry_point_broken_at_registration_is_skipped_by_name(two_good, case):
+    """A misspelled hook, a hook that raises or a class breaking the contract is that plugin's
+    failure, named with its distribution: every other plugin (and every command) still works."""
+    source, error = BROKEN_AT_REGISTRATION[case]
+    two_good("acme-typo", "typo", "acme_typo_plugin", source)
+    with pytest.warns(RuntimeWarning, match=r"plugin 'typo' from acme-typo failed to load .*skipped"):
+        reg = Registry(env={})
+    assert [(f.entry_point, f.distribution, f.error) for f in reg.failures] == [("typo", "acme-typo", error)]
+    assert reg.pm.get_plugin("typo") is None
+    assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
+    assert reg.names("solver") == Registry(discover=False).names("solver")
     assert "good-line" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "typo"}).names("spectrum")
+
+
+def test_a_name_two_installed_plugins_claim_is_an_error_only_where_used(two_good):
+    two_good("acme-twin", "twin", "acme_twin_plugin", GOOD_SOURCE.format(cls="Twin", name="good-line"))
+    two_good("acme-fake", "fake", "acme_fake_plugin", GOOD_SOURCE.format(cls="PowerLaw", name="power-law"))
+    with pytest.warns(RuntimeWarning, match="two spectrum plugins are named 'good-line'"):
+        reg = Registry(env={})
+    assert len(reg.clashes) == 2
+    for name, providers in (("good-line", ("acme-good", "acme-twin")), ("power-law", ("frictionlab", "acme-fake"))):
+        assert name not in reg.names("spectrum")
+        with pytest.raises(PluginError, match=f"two spectrum plugins are named '{name}'") as excinfo:
+            reg.get("spectrum", name)
+        assert all(f" from {p}" in str(excinfo.value) for p in providers)
+    assert "other-line" in reg.names("spectrum") and "rolloff" in reg.names("spectrum")
+    assert reg.failures == []
 
 
 def test_default_registry_is_cached():

@@ -196,6 +196,7 @@ class Registry:
         self.pm.add_hookspecs(RunListener)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        self._clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
             self.pm.trace.root.setwriter(sys.stderr.write)
             self.pm.enable_tracing()
@@ -209,6 +210,8 @@ class Registry:
             )
         self.pm.check_pending()
         self._collect()
+        for message in self.clashes:
+            warnings.warn(f"frictionlab plugins: {message}", RuntimeWarning, stacklevel=2)
 
     # ------------------------------------------------------------- loading
 
@@ -224,7 +227,10 @@ class Registry:
             try:
                 plugin = ep.load()
                 self.pm.register(plugin, name=ep.name)
+                self._try_registration(plugin)
             except Exception as exc:  # a broken plugin must not break the tool
+                if self.pm.get_plugin(ep.name) is not None:
+                    self.pm.unregister(name=ep.name)
                 message = f"{type(exc).__name__}: {exc}"
                 self.failures.append(LoadFailure(ep.name, dist, message))
                 warnings.warn(
@@ -232,6 +238,22 @@ class Registry:
                     RuntimeWarning,
                     stacklevel=2,
                 )
+
+    def _try_registration(self, plugin) -> None:
+        """Run ``plugin``'s registration hooks alone, checking every class it registers: a
+        misspelled hook, a hook that raises or a class breaking the contract is then this
+        plugin's failure, not every command's."""
+        hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
+        for caller in self.pm.get_hookcallers(plugin) or ():
+            if caller.name not in hooks:
+                hint = did_you_mean(caller.name, hooks, cutoff=0.85) or f"; the hooks are {', '.join(hooks)}"
+                raise PluginError(f"unknown hook {caller.name!r}{hint}")
+        self.pm.check_pending()  # a hook's arguments; the built-ins passed it: only this plugin can fail it
+        for kind, base in KINDS.items():
+            for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
+                if impl.plugin is plugin:
+                    given = {"register": functools.partial(validate_plugin_class, kind)}
+                    impl.function(**{arg: given[arg] for arg in impl.argnames})
 
     def register_plugin(self, plugin, name: str | None = None) -> None:
         """Register a plugin object (module or class with hookimpls) and re-collect.
@@ -242,10 +264,14 @@ class Registry:
         left as it was.
         """
         was_registered = self.pm.is_registered(plugin)
+        clashes = set(self.clashes)
         try:
             self.pm.register(plugin, name=name)
             self.pm.check_pending()
             self._collect()
+            for message in self.clashes:
+                if message not in clashes:
+                    raise PluginError(message)
         except BaseException:
             if not was_registered and self.pm.is_registered(plugin):
                 self.pm.unregister(plugin)
@@ -257,24 +283,35 @@ class Registry:
         self._collect()
 
     def _collect(self) -> None:
+        """Every registered class by kind and name. A name two classes claim is neither's:
+        asking for it is an error naming both (``_clashes``); every other name works."""
         tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         for kind, base in KINDS.items():
 
             def register(cls, _kind=kind):
                 validate_plugin_class(_kind, cls)
                 key = normalize_name(cls.name)
                 previous = tables[_kind].get(key)
-                if previous is not None and previous.cls is not cls:
-                    raise PluginError(
+                if previous is None or previous.cls is cls:
+                    tables[_kind][key] = PluginInfo(_kind, key, cls)
+                elif key not in clashes[_kind]:
+                    clashes[_kind][key] = (
                         f"two {_kind} plugins are named {key!r}: "
                         f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
                         f"and {cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}; "
                         "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
                     )
-                tables[_kind][key] = PluginInfo(_kind, key, cls)
 
             getattr(self.pm.hook, base.register_hook)(register=register)
-        self._plugins = tables
+            for key in clashes[kind]:
+                del tables[kind][key]
+        self._plugins, self._clashes = tables, clashes
+
+    @property
+    def clashes(self) -> list[str]:
+        """What is wrong with each name that two plugins of one kind claim."""
+        return [message for kind in KINDS for message in self._clashes[kind].values()]
 
     # ------------------------------------------------------------- queries
 
@@ -301,6 +338,8 @@ class Registry:
         if kind not in self._plugins:
             raise PluginError(f"unknown plugin kind {kind!r}; kinds are {', '.join(KINDS)}")
         key = normalize_name(name)
+        if key in self._clashes[kind]:
+            raise PluginError(self._clashes[kind][key])
         try:
             return self._plugins[kind][key]
         except KeyError:
