@@ -75,7 +75,11 @@ def check_solver(cls, **params) -> None:
     too: with every slope NaN, ``slope_rms_contact`` is NaN at every load; with
     slopes 1 but a NaN at the top point, it is 1 wherever it is finite, and finite
     at every load with 2 or more points in contact (the rms over the defined ones).
-    A solver declaring no ``undefined_slopes`` is never given NaN. (Registration itself checks that every declaration is
+    A solver declaring no ``undefined_slopes`` is never given NaN. An iterative solver
+    (``tolerance_param``) calls ``frictionlab.iteration_done(iteration, residual)`` in its loop
+    (a whole number >= 0, a finite residual >= 0), and any solver that calls it lets the
+    ``SolveCancelled`` it raises in a cancelled run propagate, neither swallowed nor wrapped:
+    so a run shows a long load's progress and stops on Ctrl-C. (Registration itself checks that every declaration is
     well formed: ``registry.declaration_problems``.)
     """
     solver = instantiate(cls, params)
@@ -171,6 +175,7 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             if not np.array_equal(np.asarray(getattr(again, name)), arrays[name]):
                 fail(cls, f"{where} is not repeatable: {name} differs between two identical calls")
     _check_solver_declarations(cls, solver, heights, spacing, slopes, cases["force"])
+    _check_cancel(cls, solver, heights, spacing, slopes, cases["force"])
     _check_load_limits(cls, solver, heights, spacing, slopes, unit)
     _check_solver_units(cls, solver, heights, spacing, slopes)
 
@@ -199,6 +204,48 @@ def count_of(curve):
     import numpy as np
 
     return np.asarray(curve.contact_count)
+
+
+def _check_cancel(cls, solver, heights, spacing, slopes, forces) -> None:
+    """An iterative solver (``tolerance_param``) calls ``iteration_done(iteration, residual)`` in
+    its loop, a whole number >= 0 and a finite residual >= 0; any solver that calls it lets the
+    ``SolveCancelled`` it raises on a cancelled run propagate: that is how Ctrl-C stops a long solve."""
+    import math
+
+    import numpy as np
+
+    from frictionlab.plugin import Profile, SolveCancelled, listening_to_iterations
+
+    heard = []
+
+    def cancel(iteration, residual):
+        heard.append((iteration, residual))
+        raise SolveCancelled("the conformance kit cancels the solve")
+
+    where = "solve(..., control='force') in a cancelled run"
+    try:
+        with listening_to_iterations(cancel):
+            solver.solve(Profile(heights.copy(), spacing), forces.copy(), "force", slopes.copy())
+    except SolveCancelled:
+        pass
+    except Exception as exc:
+        fail(cls, f"{where} raised {type(exc).__name__}: {exc}; let the frictionlab.SolveCancelled raised by "
+                  "iteration_done() propagate as it is, so the run stops", exc)  # fmt: skip
+    else:
+        if heard:
+            fail(cls, f"{where} returned: it swallowed the frictionlab.SolveCancelled raised by iteration_done(); "
+                      "let it propagate, so the run stops")  # fmt: skip
+        if cls.tolerance_param is not None:
+            fail(cls, f"tolerance_param is {cls.tolerance_param!r} (an iterative solver), but solve() never called "
+                      "frictionlab.iteration_done(iteration, residual): a run could not show its progress within a "
+                      "load nor stop it on Ctrl-C")  # fmt: skip
+    if heard:
+        iteration, residual = heard[0]
+        whole = isinstance(iteration, (int, np.integer)) and not isinstance(iteration, bool) and iteration >= 0
+        real = isinstance(residual, (int, float, np.floating)) and math.isfinite(residual) and residual >= 0
+        if not (whole and real):
+            fail(cls, "iteration_done(iteration, residual) takes the steps done, a whole number >= 0, and the relative "
+                      f"residual, a finite number >= 0. Got ({iteration!r}, {residual!r}).")  # fmt: skip
 
 
 def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> None:
