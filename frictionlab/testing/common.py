@@ -51,8 +51,8 @@ def check_array(cls, what: str, value, shape=None, floating=True):
         fail(cls, f"{what} must be a numpy array. Got {type(value).__name__} instead.")
     if shape is not None and value.shape != tuple(shape):
         fail(cls, f"{what} must have shape {tuple(shape)}. Got {value.shape} instead.")
-    if floating and not np.issubdtype(value.dtype, np.floating):
-        fail(cls, f"{what} must be floating point. Got dtype {value.dtype} instead.")
+    if floating and value.dtype != np.float64:  # what the framework computes and stores in: float32 loses digits
+        fail(cls, f"{what} must be float64 (double precision). Got dtype {value.dtype} instead.")
     if not np.issubdtype(value.dtype, np.number):
         fail(cls, f"{what} must be numeric. Got dtype {value.dtype} instead.")
     if not np.all(np.isfinite(value)):

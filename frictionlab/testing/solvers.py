@@ -43,7 +43,7 @@ def check_solver(cls, **params) -> None:
     control (forces F = f k h L, L = ``Profile.length``, f from 0.005 to 1, k = ``stiffness()``) and
     under indentation control (2.5 % to 95 % of max z - mean z, the approach at
     which a periodic elastic half-space reaches full contact): it returns a ``ContactCurve``
-    whose arrays all have the shape of ``loads`` and are finite; the controlled
+    whose arrays all have the shape of ``loads`` and are finite, float64 but for the counts; the controlled
     quantity is reported back (``force`` resp. ``indentation`` equal to the
     loads within 1 %); force and indentation do not decrease with load; contact
     counts are whole numbers, do not decrease with load, and lie in 1 .. N;

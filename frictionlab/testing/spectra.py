@@ -9,7 +9,7 @@ from .common import call, check_array, check_positive_number, fail, instantiate,
 
 def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
-    floating-point heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
+    float64 heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
     identical heights; a different seed gives different heights (pass
     ``deterministic=True`` for a generator that ignores randomness by design,
     e.g. one that reads a measured profile); ``rms_height()`` is finite and

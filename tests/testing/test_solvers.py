@@ -46,6 +46,8 @@ SOLVER_BREAKAGES = [
     ("FractionalCount", lambda c, p, l: replace_curve(c, contact_count=c.contact_count + 0.5,
                                                         contact_fraction=(c.contact_count + 0.5) / 64), "whole numbers"),
     ("DimensionlessForce", lambda c, p, l: replace_curve(c, force=c.force / 1000), "must report the loads"),
+    ("SingleSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact.astype(np.float32)),
+     r"slope_rms_contact must be float64 \(double precision\)"),
     ("NaNSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact * np.nan), "must be finite"),
     ("HugeSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact + 100), r"max \|slope\|"),
     ("ShortExtras", lambda c, p, l: replace_curve(c, extras={"iterations": np.ones(2)}), "one entry per load"),
