@@ -34,21 +34,15 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """
     import numpy as np
 
-    from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import profile_problem
 
     gen = instantiate(cls, params)
 
     def generate(seed: int):
         profile = call(cls, f"generate(default_rng({seed}))", gen.generate, np.random.default_rng(seed))
-        if not isinstance(profile, Profile):
-            fail(cls, f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead.")
-        heights = check_array(cls, "Profile.heights", profile.heights)
-        dimension = cls.dimension
-        if heights.ndim != dimension:
-            fail(cls, f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {heights.shape} instead.")
-        if heights.size < 2:
-            fail(cls, f"Profile.heights must have at least 2 points. Got {heights.size}.")
-        check_positive_number(cls, "Profile.spacing", profile.spacing)
+        problem = profile_problem(gen, profile)  # as a run takes it
+        if problem:
+            fail(cls, problem)
         return profile
 
     first = generate(1234)
