@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import PluginError
-from ..plugin.outputs import curve_problem, profile_problem, refuse, slopes_problem
+from ..plugin.outputs import curve_problem, height_of, profile_problem, refuse, slopes_problem
 from ..plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
 from ..preset.seeds import realization_rng
@@ -161,8 +161,8 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
-        own_h = scene.generator.profile_rms_height(profile)
-        unit = force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile)
+        h, own_h = height_of(scene.generator, profile)
+        unit = force_unit(scene.solver, h, profile)
         curve = _solve(scene, profile, slopes, watch, unit)
         refuse(scene.solver, curve_problem(scene.solver, curve, scene.loads.size))
         half = curve.half_load_points

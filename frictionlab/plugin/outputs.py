@@ -92,6 +92,72 @@ def curve_problem(solver: ContactSolver, curve, loads: int, where: str = "solve(
     return None
 
 
+def _positive(what: str, value, none: bool = False) -> str | None:
+    if value is None and none:
+        return None
+    real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    if not (real and math.isfinite(value) and value > 0):
+        return f"{what} must be {'None or a number ' if none else ''}finite and > 0. Got {value!r} instead."
+    return None
+
+
+def _whole(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def answers_problem(plugin) -> str | None:
+    """What is wrong with the answers a run reads of ``plugin`` before it starts: a spectrum's
+    ``periodic()`` and ``grid_shape()`` (``rms_height()``: ``height_problem``, once a measured
+    file is read); a solver's ``stiffness()`` and ``tolerance()``; an estimator's
+    ``undefined_points(periodic)``."""
+    if isinstance(plugin, SpectrumGenerator):
+        periodic, shape, dimension = plugin.periodic(), plugin.grid_shape(), plugin.dimension
+        if not isinstance(periodic, bool):
+            return f"periodic() must be True or False. Got {periodic!r} instead."
+        if shape is not None and not (isinstance(shape, (tuple, list)) and len(shape) == dimension
+                                      and all(_whole(n) and n >= 1 for n in shape)):  # fmt: skip
+            return f"grid_shape() must be None or {dimension} whole number(s) >= 1, the shape generate() makes. Got {shape!r} instead."
+        return None
+    if isinstance(plugin, ContactSolver):
+        return _positive("stiffness()", plugin.stiffness()) or _positive("tolerance()", plugin.tolerance(), none=True)
+    undefined = (plugin.undefined_points(True), plugin.undefined_points(False))
+    if undefined[0] is not False or not isinstance(undefined[1], bool):
+        return ("undefined_points(periodic) must be False for a periodic profile, True or False for another. "
+                f"Got {undefined[0]!r} and {undefined[1]!r}.")  # fmt: skip
+    return None
+
+
+def shape_problem(spectrum: SpectrumGenerator, profile: Profile) -> str | None:
+    """``grid_shape()`` must be None or the shape of what ``generate()`` made, ``profile``."""
+    shape = spectrum.grid_shape()
+    if shape is not None and tuple(shape) != profile.heights.shape:
+        return f"grid_shape() must be None or the shape generate() makes, {profile.heights.shape}. Got {shape!r}."
+    return None
+
+
+def height_problem(spectrum: SpectrumGenerator) -> str | None:
+    """What is wrong with ``rms_height()``, the h of f."""
+    return _positive("rms_height()", spectrum.rms_height())
+
+
+def height_of(spectrum: SpectrumGenerator, profile: Profile) -> tuple[float, float | None]:
+    """The h of f for ``profile`` and the profile's own h (None when it is the nominal one), checked."""
+    own = spectrum.profile_rms_height(profile)
+    if own is None:
+        refuse(spectrum, height_problem(spectrum))
+        return spectrum.rms_height(), None
+    refuse(spectrum, _positive("profile_rms_height(profile)", own))
+    return own, own
+
+
+def full_contact_problem(full) -> str | None:
+    """What is wrong with an answer of ``full_contact_load(profile)``."""
+    if full is None or (isinstance(full, (int, float, np.integer, np.floating)) and not isinstance(full, bool)
+                        and math.isfinite(full) and full >= 0):  # fmt: skip
+        return None
+    return f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}."
+
+
 def refuse(plugin, problem: str | None) -> None:
     """Raise PluginError naming ``plugin`` (kind, name, class, distribution) and ``problem``, if any."""
     if problem:

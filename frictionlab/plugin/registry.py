@@ -16,6 +16,7 @@ import importlib
 import importlib.metadata as md
 import os
 import sys
+import traceback
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -344,6 +345,26 @@ class Registry:
             return self._plugins[kind][key]
         except KeyError:
             raise PluginError(self.not_found_message(kind, name)) from None
+
+    def at_fault(self, exc: BaseException) -> PluginError | None:
+        """``exc`` told as the fault of the installed plugin whose code raised it (the innermost
+        frame of its traceback in a third party's plugin module), or None: the built-ins are
+        frictionlab's own, and a fault anywhere else is not a plugin's."""
+        modules = {info.cls.__module__.partition(".")[0]: info for info in self.infos()}
+        for module in BUILTIN_MODULES:
+            modules.pop(module, None)
+        frames = [(frame, lineno) for frame, lineno in traceback.walk_tb(exc.__traceback__)]
+        for frame, lineno in reversed(frames):
+            info = modules.get(str(frame.f_globals.get("__name__", "")).partition(".")[0])
+            if info is not None:
+                cls = type(frame.f_locals.get("self")) if isinstance(frame.f_locals.get("self"), Plugin) else info.cls
+                where = f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
+                return PluginError(
+                    f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}) raised "
+                    f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
+                    "tell its authors, or choose another plugin"
+                )
+        return None
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)

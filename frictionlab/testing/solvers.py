@@ -83,7 +83,10 @@ def check_solver(cls, **params) -> None:
     well formed: ``registry.declaration_problems``.)
     """
     solver = instantiate(cls, params)
-    check_positive_number(cls, "stiffness()", call(cls, "stiffness()", solver.stiffness))
+    from frictionlab.plugin.outputs import answers_problem
+
+    if problem := call(cls, "stiffness() or tolerance()", answers_problem, solver):  # as a run takes them
+        fail(cls, problem)
     for dimension in cls.dimensions:
         heights, spacing, slopes = _test_line() if dimension == 1 else _test_surface()
         _check_solves(cls, solver, heights, spacing, slopes)
@@ -237,6 +240,7 @@ def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> No
     import numpy as np
 
     from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import full_contact_problem
 
     limit = cls.max_f
     if limit is not None:
@@ -254,8 +258,8 @@ def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> No
     full = call(cls, "full_contact_load(profile)", solver.full_contact_load, Profile(heights.copy(), spacing))
     if full is None:
         return
-    if isinstance(full, bool) or not isinstance(full, (int, float)) or not (np.isfinite(full) and full >= 0):
-        fail(cls, f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}.")
+    if problem := full_contact_problem(full):
+        fail(cls, problem)
     curve = _solve(cls, solver, heights, spacing, slopes, np.array([1.01 * full or unit]))
     if int(count_of(curve)[0]) != heights.size:
         fail(cls, f"full_contact_load(profile) = {full:g}, but 1.01 times it puts {int(count_of(curve)[0])} of "

@@ -41,3 +41,38 @@ def test_a_name_two_plugins_claim_is_named_and_other_presets_still_validate(caps
         assert "spectrum.name: two spectrum plugins are named 'twin-line'" in capsys.readouterr().err
     finally:
         registry_module.default_registry.cache_clear()
+
+
+RAISING_SOURCE = '''
+import frictionlab
+from tests.testing.fakes import GoodSpectrum
+
+
+class Raising(GoodSpectrum):
+    name = "raising-line"
+
+    def rms_height(self):
+        return 1 / 0
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Raising)
+'''
+
+
+def test_a_plugin_that_raises_is_named_with_exit_code_2_not_an_internal_error(capsys, fake_dists):
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-raising", "raising", "acme_raising", RAISING_SOURCE, "1.2")
+    registry_module.default_registry.cache_clear()
+    try:
+        args = ["validate", "quickstart", "--set", "spectrum.name=raising-line", "--set", "spectrum.params={}"]
+        assert main(args) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert err.startswith("error: spectrum 'raising-line' (acme_raising.Raising from acme-raising) raised "
+                              "ZeroDivisionError: division by zero in rms_height() at acme_raising.py:")
+        assert "internal error" not in err
+        assert main(["validate", "quickstart"]) == ExitCode.OK
+    finally:
+        registry_module.default_registry.cache_clear()
