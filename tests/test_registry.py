@@ -14,7 +14,7 @@ import pluggy
 import pytest
 from pydantic import BaseModel, Field
 
-from frictionlab import ContactSolver, PluginParams, hookimpl
+from frictionlab import ContactSolver, PluginParams, SpectrumGenerator, hookimpl
 from frictionlab.plugin import registry as registry_module
 from frictionlab.errors import ExitCode, PluginError
 from frictionlab.plugin.hookspecs import PROJECT_NAME, RegistrationSpecs
@@ -190,6 +190,10 @@ def _broken_variants():
         pytest.param(with_(Params=UndescribedParams), r"Params\.points has no description", id="undescribed"),
         pytest.param(with_(Params=NotAModel), r"Params must be a pydantic model", id="not-pydantic"),
         pytest.param(Solverish, r"must subclass frictionlab\.SpectrumGenerator", id="wrong-kind"),
+        pytest.param(with_(generate=SpectrumGenerator.generate), r"implements no generate\(\): a SpectrumGenerator must",
+                     id="no-generate"),
+        pytest.param(with_(generate=SpectrumGenerator.generate, rms_height=SpectrumGenerator.rms_height),
+                     r"implements no generate\(\) nor rms_height\(\)", id="no-generate-nor-rms-height"),
     ]
 
 

@@ -31,7 +31,7 @@ from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .base import NAME_PATTERN, Plugin
 from .data import Profile
-from .kinds import KINDS, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator
+from .kinds import KINDS, REQUIRED, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator
 from .normalisation import ContactMeasure, ForceNormalisation
 
 ENTRY_POINT_GROUP = PROJECT_NAME
@@ -134,6 +134,10 @@ def declaration_problems(cls) -> list[str]:
             problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
 
     base = next(base for base in KINDS.values() if issubclass(cls, base))
+    missing = [f"{name}()" for name in REQUIRED[base.kind] if getattr(cls, name) is getattr(base, name)]
+    if missing:
+        problems.append(f"implements no {' nor '.join(missing)}: a {base.__name__} must (the base class's only "
+                        "raises NotImplementedError)")  # fmt: skip
     if (cls.kind, cls.register_hook) != (base.kind, base.register_hook):
         problems.append(
             f"kind and register_hook are {base.__name__}'s ({base.kind!r}, {base.register_hook!r}), "

@@ -68,7 +68,7 @@ def _bounded_fields(cls, schema) -> list[tuple[str, str, float, bool]]:
 def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) -> None:
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
     ``"slope"``): ``frictionlab.plugin.registry.validate_plugin_class`` passes (right
-    base class, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
+    base class, its required methods implemented, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
     forbidding unknown keys, every field described, and every declaration well
     formed: ``kind`` and ``register_hook`` are the base class's own; a spectrum's
     ``dimension`` is 1 or 2 and its ``points_param`` names a field; the
