@@ -389,6 +389,7 @@ BROKEN_SOURCES = {
     "raises": ('raise RuntimeError("boom: broken on import")', None, "RuntimeError: boom: broken on import"),
     "missing-dependency": ("import acme_dependency_that_is_not_installed", None, "ModuleNotFoundError"),
     "missing-attribute": ("x = 1", "acme_broken_plugin:nothing_here", "AttributeError"),
+    "syntax-error": ("def broken(:\n    pass", None, "SyntaxError: invalid syntax ("),
 }
 
 
@@ -403,6 +404,8 @@ def test_failing_entry_point_warns_and_is_recorded(two_good, case):
     assert isinstance(failure, LoadFailure)
     assert (failure.entry_point, failure.distribution) == ("broken", "acme-broken")
     assert error in failure.error
+    if case == "syntax-error":  # the file in full: which of the installed copies
+        assert f"{sys.modules['acme_good_plugin'].__file__.rpartition('/')[0]}/acme_broken_plugin.py, line 1)" in failure.error
     # the others still load
     assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
     # only when a plugin is asked for and missing does the failure become an error

@@ -237,6 +237,8 @@ class Registry:
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
                 message = f"{type(exc).__name__}: {exc}"
+                if isinstance(exc, SyntaxError):  # its str names the file without its folder
+                    message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
                 self.failures.append(LoadFailure(ep.name, dist, message))
                 warnings.warn(
                     f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
