@@ -194,6 +194,10 @@ def _broken_variants():
                      id="no-generate"),
         pytest.param(with_(generate=SpectrumGenerator.generate, rms_height=SpectrumGenerator.rms_height),
                      r"implements no generate\(\) nor rms_height\(\)", id="no-generate-nor-rms-height"),
+        pytest.param(with_(generate=lambda self: None), r"generate\(\) must take \(rng\), as frictionlab calls it\. "
+                     r"Got generate\(self\) instead\.", id="generate-without-rng"),
+        pytest.param(with_(profile_rms_height=lambda self, profile, extra: None),
+                     r"profile_rms_height\(\) must take \(profile\)", id="optional-method-with-an-extra-argument"),
     ]
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import importlib
+import inspect
 import importlib.metadata as md
 import os
 import sys
@@ -31,7 +32,7 @@ from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .base import NAME_PATTERN, Plugin
 from .data import Profile
-from .kinds import KINDS, REQUIRED, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator
+from .kinds import KINDS, REQUIRED, ContactSolver, contract, IndentationReference, SlopeEstimator, SpectrumGenerator
 from .normalisation import ContactMeasure, ForceNormalisation
 
 ENTRY_POINT_GROUP = PROJECT_NAME
@@ -138,6 +139,7 @@ def declaration_problems(cls) -> list[str]:
     if missing:
         problems.append(f"implements no {' nor '.join(missing)}: a {base.__name__} must (the base class's only "
                         "raises NotImplementedError)")  # fmt: skip
+    problems += _signature_problems(cls, base)
     if (cls.kind, cls.register_hook) != (base.kind, base.register_hook):
         problems.append(
             f"kind and register_hook are {base.__name__}'s ({base.kind!r}, {base.register_hook!r}), "
@@ -188,6 +190,25 @@ def declaration_problems(cls) -> list[str]:
         declared = cls.bytes_per_point
         if declared is not None and (isinstance(declared, bool) or not isinstance(declared, int) or declared <= 0):
             problems.append(f"bytes_per_point must be None or a whole number > 0. Got {declared!r} instead.")
+    return problems
+
+
+def _signature_problems(cls, base) -> list[str]:
+    """Each method of the contract that ``cls`` overrides must take the arguments the framework
+    passes, as the base class's does (``slopes(heights, spacing, periodic)``)."""
+    problems = []
+    for name in sorted(contract(base.kind)):
+        declared, given = inspect.getattr_static(base, name, None), inspect.getattr_static(cls, name, None)
+        if not inspect.isfunction(declared) or given is declared or not callable(given):
+            continue
+        wanted = list(inspect.signature(declared).parameters)[1:]  # after self
+        try:
+            inspect.signature(getattr(cls, name)).bind(None, *wanted)
+        except TypeError:
+            problems.append(f"{name}() must take ({', '.join(wanted)}), as frictionlab calls it. "
+                            f"Got {name}{inspect.signature(getattr(cls, name))} instead.")  # fmt: skip
+        except ValueError:  # no signature to read (a builtin): nothing to check
+            pass
     return problems
 
 
