@@ -13,6 +13,8 @@ from frictionlab.preset import Scene
 from frictionlab.compute.executors import pool_context
 from frictionlab.options import RunOptions
 
+from .testing.fakes import replace_curve
+
 
 def same_outcome(one, two):
     for key in one.per_realization:
@@ -142,6 +144,52 @@ def test_a_constant_line_fails_with_a_clear_message(make_scene):
     result = compute_realization(scene, 0)
     assert not result.ok
     assert "rms slope of the whole line is 0.0" in result.error
+
+
+def _broken(plugin, kind, method, change):
+    """``plugin`` (its class and parameters) whose ``method`` returns its answer passed through ``change``."""
+    base = type(plugin)
+
+    def broken(self, *args):
+        return change(getattr(base, method)(self, *args))
+
+    return type(f"Broken{kind.title()}", (base,), {"name": f"broken-{kind}", method: broken})(plugin.params)
+
+
+BROKEN_ANSWERS = {
+    "list-heights": ("spectrum", "generate", lambda p: Profile(list(p.heights), p.spacing), "Profile.heights must be a numpy array. Got list"),
+    "text-heights": ("spectrum", "generate", lambda p: Profile(p.heights.astype(str), p.spacing), "Profile.heights must be float64"),
+    "nan-heights": ("spectrum", "generate", lambda p: Profile(p.heights * np.nan, p.spacing), "Profile.heights must be finite"),
+    "column": ("spectrum", "generate", lambda p: Profile(p.heights[:, None], p.spacing), "Profile.heights must be 1-D"),
+    "heights-only": ("spectrum", "generate", lambda p: p.heights, "generate() must return a frictionlab.Profile"),
+    "no-spacing": ("spectrum", "generate", lambda p: Profile(p.heights, 0.0), "Profile.spacing must be finite and > 0"),
+    "short-slopes": ("slope", "slopes", lambda s: s[:-1], "slopes() must have shape (64,). Got (63,)"),
+    "nan-slopes": ("slope", "slopes", lambda s: s * np.nan, "slopes() must be finite"),
+    "short-curve": ("solver", "solve", lambda c: replace_curve(c, slope_rms_contact=c.slope_rms_contact[:-1]),
+                    "solve().slope_rms_contact must have shape (12,). Got (11,)"),
+    "text-counts": ("solver", "solve", lambda c: replace_curve(c, contact_count=c.contact_count.astype(str)),
+                    "solve().contact_count must be real numbers"),
+    "half-counts": ("solver", "solve", lambda c: replace_curve(c, contact_count=c.contact_count + 0.5),
+                    "solve().contact_count must hold whole numbers"),
+    "not-a-curve": ("solver", "solve", lambda c: {"force": c.force}, "solve() must return a frictionlab.ContactCurve"),
+}
+
+
+@pytest.mark.parametrize("case", BROKEN_ANSWERS)
+def test_a_plugin_answer_that_breaks_the_contract_is_refused_by_the_plugin_s_name(make_scene, case):
+    """Taken as it came, such an answer ended the run in an internal error (a curve one load
+    short), a message about something else (NaN heights: 'is the line constant?'), or a run
+    that completed on nonsense (heights or counts as text)."""
+    kind, method, change, problem = BROKEN_ANSWERS[case]
+    scene = make_scene({"realizations": 2, "spectrum": {"params": {"points": 64}}, "loading": {"steps": 12}})
+    slots = {"spectrum": scene.spectrum, "solver": scene.solver, "slope": scene.slope}
+    slots[kind] = _broken(slots[kind], kind, method, change)
+    result = compute_realization(Scene(preset=scene.preset, **slots), 0)
+    assert not result.ok
+    cls = type(slots[kind])
+    assert result.error == (f"PluginError: {kind} 'broken-{kind}' (tests.test_engine.{cls.__qualname__} from "
+                            f"tests.test_engine) broke the plugin contract: {result.error.split('contract: ')[1]}")
+    assert result.error.split("contract: ")[1].startswith(problem)
 
 
 SCALINGS = {

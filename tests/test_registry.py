@@ -14,7 +14,7 @@ import pluggy
 import pytest
 from pydantic import BaseModel, Field
 
-from frictionlab import ContactSolver, PluginParams, hookimpl
+from frictionlab import ContactSolver, PluginParams, SpectrumGenerator, hookimpl
 from frictionlab.plugin import registry as registry_module
 from frictionlab.errors import ExitCode, PluginError
 from frictionlab.plugin.hookspecs import PROJECT_NAME, RegistrationSpecs
@@ -190,6 +190,14 @@ def _broken_variants():
         pytest.param(with_(Params=UndescribedParams), r"Params\.points has no description", id="undescribed"),
         pytest.param(with_(Params=NotAModel), r"Params must be a pydantic model", id="not-pydantic"),
         pytest.param(Solverish, r"must subclass frictionlab\.SpectrumGenerator", id="wrong-kind"),
+        pytest.param(with_(generate=SpectrumGenerator.generate), r"implements no generate\(\): a SpectrumGenerator must",
+                     id="no-generate"),
+        pytest.param(with_(generate=SpectrumGenerator.generate, rms_height=SpectrumGenerator.rms_height),
+                     r"implements no generate\(\) nor rms_height\(\)", id="no-generate-nor-rms-height"),
+        pytest.param(with_(generate=lambda self: None), r"generate\(\) must take \(rng\), as frictionlab calls it\. "
+                     r"Got generate\(self\) instead\.", id="generate-without-rng"),
+        pytest.param(with_(profile_rms_height=lambda self, profile, extra: None),
+                     r"profile_rms_height\(\) must take \(profile\)", id="optional-method-with-an-extra-argument"),
     ]
 
 
@@ -385,6 +393,7 @@ BROKEN_SOURCES = {
     "raises": ('raise RuntimeError("boom: broken on import")', None, "RuntimeError: boom: broken on import"),
     "missing-dependency": ("import acme_dependency_that_is_not_installed", None, "ModuleNotFoundError"),
     "missing-attribute": ("x = 1", "acme_broken_plugin:nothing_here", "AttributeError"),
+    "syntax-error": ("def broken(:\n    pass", None, "SyntaxError: invalid syntax ("),
 }
 
 
@@ -399,6 +408,8 @@ def test_failing_entry_point_warns_and_is_recorded(two_good, case):
     assert isinstance(failure, LoadFailure)
     assert (failure.entry_point, failure.distribution) == ("broken", "acme-broken")
     assert error in failure.error
+    if case == "syntax-error":  # the file in full: which of the installed copies
+        assert f"{sys.modules['acme_good_plugin'].__file__.rpartition('/')[0]}/acme_broken_plugin.py, line 1)" in failure.error
     # the others still load
     assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
     # only when a plugin is asked for and missing does the failure become an error
@@ -417,11 +428,63 @@ def test_blocking_a_broken_plugin_silences_it(two_good):
     assert reg.failures == []
 
 
-def test_misspelled_hook_in_an_entry_point_fails_loudly(two_good):
-    two_good("acme-typo", "typo", "acme_typo_plugin", MISSPELLED_SOURCE)
-    with pytest.raises(pluggy.PluginValidationError, match="register_spectrum"):
-        Registry(env={})
+HOOK_RAISES_SOURCE = '''
+import frictionlab
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    raise RuntimeError("boom: broken in its hook")
+'''
+
+INVALID_CLASS_SOURCE = '''
+import frictionlab
+from tests.testing.fakes import spectrum_class
+
+Loose = spectrum_class("loose-line", __name__, "Loose")
+Loose.Params = dict
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Loose)
+'''
+
+BROKEN_AT_REGISTRATION = {
+    "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
+    "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
+    "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BROKEN_AT_REGISTRATION))
+def test_an_entry_point_broken_at_registration_is_skipped_by_name(two_good, case):
+    """A misspelled hook, a hook that raises or a class breaking the contract is that plugin's
+    failure, named with its distribution: every other plugin (and every command) still works."""
+    source, error = BROKEN_AT_REGISTRATION[case]
+    two_good("acme-typo", "typo", "acme_typo_plugin", source)
+    with pytest.warns(RuntimeWarning, match=r"plugin 'typo' from acme-typo failed to load .*skipped"):
+        reg = Registry(env={})
+    assert [(f.entry_point, f.distribution, f.error) for f in reg.failures] == [("typo", "acme-typo", error)]
+    assert reg.pm.get_plugin("typo") is None
+    assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
+    assert reg.names("solver") == Registry(discover=False).names("solver")
     assert "good-line" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "typo"}).names("spectrum")
+
+
+def test_a_name_two_installed_plugins_claim_is_an_error_only_where_used(two_good):
+    two_good("acme-twin", "twin", "acme_twin_plugin", GOOD_SOURCE.format(cls="Twin", name="good-line"))
+    two_good("acme-fake", "fake", "acme_fake_plugin", GOOD_SOURCE.format(cls="PowerLaw", name="power-law"))
+    with pytest.warns(RuntimeWarning, match="two spectrum plugins are named 'good-line'"):
+        reg = Registry(env={})
+    assert len(reg.clashes) == 2
+    for name, providers in (("good-line", ("acme-good", "acme-twin")), ("power-law", ("frictionlab", "acme-fake"))):
+        assert name not in reg.names("spectrum")
+        with pytest.raises(PluginError, match=f"two spectrum plugins are named '{name}'") as excinfo:
+            reg.get("spectrum", name)
+        assert all(f" from {p}" in str(excinfo.value) for p in providers)
+    assert "other-line" in reg.names("spectrum") and "rolloff" in reg.names("spectrum")
+    assert reg.failures == []
 
 
 def test_default_registry_is_cached():

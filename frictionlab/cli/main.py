@@ -210,6 +210,15 @@ def _missing_package(exc: Exception, purpose: str):
     return MissingDependency(name, purpose)
 
 
+def _plugin_at_fault(exc: Exception):
+    """The PluginError that names the installed plugin whose code raised ``exc``, or None."""
+    if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
+        return None
+    from ..plugin.registry import default_registry
+
+    return default_registry().at_fault(exc)
+
+
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {shown(str(message))}\n"  # a resume's warning names a folder
 
@@ -374,7 +383,7 @@ def _run_command(args) -> int:
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
-        missing = _missing_package(exc, f"frictionlab {args.command}")
+        missing = _missing_package(exc, f"frictionlab {args.command}") or _plugin_at_fault(exc)
         if missing is not None:
             return _refused(args, str(missing), missing.exit_code, f"{error_label()}: ")
         message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"

@@ -31,11 +31,13 @@ def run(args) -> ExitCode:
         failures = [f.__dict__ for f in registry.failures]
         from .jsonout import emit
 
-        emit("plugins", {"plugins": rows, "failed": failures})
+        emit("plugins", {"plugins": rows, "failed": failures, "clashes": registry.clashes})
         return ExitCode.OK
     from .console import print_table
 
     print_table(("KIND", "NAME", "PROVIDER", "VERSION", "SUMMARY"), [(i.kind, i.name, i.provider, i.version, i.summary) for i in infos])
     for failure in registry.failures:
         print(f"failed to load: {failure.entry_point} ({failure.distribution}): {failure.error}", file=sys.stderr)
+    for clash in registry.clashes:
+        print(f"not listed: {clash}", file=sys.stderr)
     return ExitCode.OK

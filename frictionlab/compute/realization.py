@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import PluginError
+from ..plugin.outputs import curve_problem, height_of, profile_problem, refuse, slopes_problem
 from ..plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
 from ..preset.seeds import realization_rng
@@ -143,8 +145,10 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     try:
         rng = realization_rng(scene.preset.seed, index)
         profile = scene.generator.generate(rng)
+        refuse(scene.generator, profile_problem(scene.generator, profile))
         check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
+        refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
         check_cancel()
         scale = slope_scale(slopes)  # xi is a ratio of two rms slopes: an exact scale cancels
         if scale != 1.0:
@@ -157,9 +161,10 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
-        own_h = scene.generator.profile_rms_height(profile)
-        unit = force_unit(scene.solver, scene.generator.rms_height() if own_h is None else own_h, profile)
+        h, own_h = height_of(scene.generator, profile)
+        unit = force_unit(scene.solver, h, profile)
         curve = _solve(scene, profile, slopes, watch, unit)
+        refuse(scene.solver, curve_problem(scene.solver, curve, scene.loads.size))
         half = curve.half_load_points
         heights = np.asarray(profile.heights, dtype=float)
         rms = float(np.std(heights))
@@ -185,7 +190,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         raise
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]
-        error = f"{type(exc).__name__}: {exc} ({os.path.basename(where.filename)}:{where.lineno})"
+        error = f"{type(exc).__name__}: {exc}"
+        if not isinstance(exc, PluginError):  # a broken answer is named with its plugin: no line of ours to show
+            error += f" ({os.path.basename(where.filename)}:{where.lineno})"
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
 
 

@@ -18,7 +18,7 @@ def mdr_length(area: float) -> float:
 
 @dataclass(frozen=True)
 class Profile:
-    """One rough line, shape (N,), or surface, shape (Ny, Nx), with heights on a
+    """One rough line, shape (N,), or surface, shape (Ny, Nx), with float64 heights on a
     uniform grid of ``spacing`` (square pixels on a surface).
 
     ``periodic``: whether the profile repeats (its last point is followed by its
@@ -48,7 +48,8 @@ class Profile:
 class ContactCurve:
     """A solver's answer for one profile over a whole load sweep.
 
-    Every array has one entry per load step, in the order of the loads given.
+    Every array has one entry per load step, in the order of the loads given, float64
+    but for the counts (whole numbers).
     ``force`` holds the total loads (their meaning: the solver's ``LoadMeaning``);
     ``indentation`` the rigid-body approach from the first touch, in the frame the
     solver declares (``ContactSolver.indentation_reference``).

@@ -259,6 +259,12 @@ def contract(kind: str) -> frozenset[str]:
     return frozenset(name for name in {*dir(base), *annotated} if not name.startswith("_"))
 
 
+REQUIRED: dict[str, tuple[str, ...]] = {  # the methods a plugin of each kind must implement itself
+    "spectrum": ("generate", "rms_height"),
+    "solver": ("solve", "stiffness"),
+    "slope": ("slopes",),
+}
+
 KINDS: dict[str, type[Plugin]] = {  # by the name of each kind's section in a preset
     "spectrum": SpectrumGenerator,
     "solver": ContactSolver,

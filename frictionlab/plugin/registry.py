@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import functools
 import importlib
+import inspect
 import importlib.metadata as md
 import os
 import sys
+import traceback
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -30,7 +32,7 @@ from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, RunListener
 from .base import NAME_PATTERN, Plugin
 from .data import Profile
-from .kinds import KINDS, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator
+from .kinds import KINDS, REQUIRED, ContactSolver, contract, IndentationReference, SlopeEstimator, SpectrumGenerator
 from .normalisation import ContactMeasure, ForceNormalisation
 
 ENTRY_POINT_GROUP = PROJECT_NAME
@@ -133,6 +135,11 @@ def declaration_problems(cls) -> list[str]:
             problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
 
     base = next(base for base in KINDS.values() if issubclass(cls, base))
+    missing = [f"{name}()" for name in REQUIRED[base.kind] if getattr(cls, name) is getattr(base, name)]
+    if missing:
+        problems.append(f"implements no {' nor '.join(missing)}: a {base.__name__} must (the base class's only "
+                        "raises NotImplementedError)")  # fmt: skip
+    problems += _signature_problems(cls, base)
     if (cls.kind, cls.register_hook) != (base.kind, base.register_hook):
         problems.append(
             f"kind and register_hook are {base.__name__}'s ({base.kind!r}, {base.register_hook!r}), "
@@ -186,6 +193,25 @@ def declaration_problems(cls) -> list[str]:
     return problems
 
 
+def _signature_problems(cls, base) -> list[str]:
+    """Each method of the contract that ``cls`` overrides must take the arguments the framework
+    passes, as the base class's does (``slopes(heights, spacing, periodic)``)."""
+    problems = []
+    for name in sorted(contract(base.kind)):
+        declared, given = inspect.getattr_static(base, name, None), inspect.getattr_static(cls, name, None)
+        if not inspect.isfunction(declared) or given is declared or not callable(given):
+            continue
+        wanted = list(inspect.signature(declared).parameters)[1:]  # after self
+        try:
+            inspect.signature(getattr(cls, name)).bind(None, *wanted)
+        except TypeError:
+            problems.append(f"{name}() must take ({', '.join(wanted)}), as frictionlab calls it. "
+                            f"Got {name}{inspect.signature(getattr(cls, name))} instead.")  # fmt: skip
+        except ValueError:  # no signature to read (a builtin): nothing to check
+            pass
+    return problems
+
+
 class Registry:
     """Every installed plugin class, by kind and name."""
 
@@ -196,6 +222,7 @@ class Registry:
         self.pm.add_hookspecs(RunListener)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        self._clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
             self.pm.trace.root.setwriter(sys.stderr.write)
             self.pm.enable_tracing()
@@ -209,6 +236,8 @@ class Registry:
             )
         self.pm.check_pending()
         self._collect()
+        for message in self.clashes:
+            warnings.warn(f"frictionlab plugins: {message}", RuntimeWarning, stacklevel=2)
 
     # ------------------------------------------------------------- loading
 
@@ -224,14 +253,35 @@ class Registry:
             try:
                 plugin = ep.load()
                 self.pm.register(plugin, name=ep.name)
+                self._try_registration(plugin)
             except Exception as exc:  # a broken plugin must not break the tool
+                if self.pm.get_plugin(ep.name) is not None:
+                    self.pm.unregister(name=ep.name)
                 message = f"{type(exc).__name__}: {exc}"
+                if isinstance(exc, SyntaxError):  # its str names the file without its folder
+                    message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
                 self.failures.append(LoadFailure(ep.name, dist, message))
                 warnings.warn(
                     f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
                     RuntimeWarning,
                     stacklevel=2,
                 )
+
+    def _try_registration(self, plugin) -> None:
+        """Run ``plugin``'s registration hooks alone, checking every class it registers: a
+        misspelled hook, a hook that raises or a class breaking the contract is then this
+        plugin's failure, not every command's."""
+        hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
+        for caller in self.pm.get_hookcallers(plugin) or ():
+            if caller.name not in hooks:
+                hint = did_you_mean(caller.name, hooks, cutoff=0.85) or f"; the hooks are {', '.join(hooks)}"
+                raise PluginError(f"unknown hook {caller.name!r}{hint}")
+        self.pm.check_pending()  # a hook's arguments; the built-ins passed it: only this plugin can fail it
+        for kind, base in KINDS.items():
+            for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
+                if impl.plugin is plugin:
+                    given = {"register": functools.partial(validate_plugin_class, kind)}
+                    impl.function(**{arg: given[arg] for arg in impl.argnames})
 
     def register_plugin(self, plugin, name: str | None = None) -> None:
         """Register a plugin object (module or class with hookimpls) and re-collect.
@@ -242,10 +292,14 @@ class Registry:
         left as it was.
         """
         was_registered = self.pm.is_registered(plugin)
+        clashes = set(self.clashes)
         try:
             self.pm.register(plugin, name=name)
             self.pm.check_pending()
             self._collect()
+            for message in self.clashes:
+                if message not in clashes:
+                    raise PluginError(message)
         except BaseException:
             if not was_registered and self.pm.is_registered(plugin):
                 self.pm.unregister(plugin)
@@ -257,24 +311,35 @@ class Registry:
         self._collect()
 
     def _collect(self) -> None:
+        """Every registered class by kind and name. A name two classes claim is neither's:
+        asking for it is an error naming both (``_clashes``); every other name works."""
         tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
+        clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         for kind, base in KINDS.items():
 
             def register(cls, _kind=kind):
                 validate_plugin_class(_kind, cls)
                 key = normalize_name(cls.name)
                 previous = tables[_kind].get(key)
-                if previous is not None and previous.cls is not cls:
-                    raise PluginError(
+                if previous is None or previous.cls is cls:
+                    tables[_kind][key] = PluginInfo(_kind, key, cls)
+                elif key not in clashes[_kind]:
+                    clashes[_kind][key] = (
                         f"two {_kind} plugins are named {key!r}: "
                         f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
                         f"and {cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}; "
                         "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
                     )
-                tables[_kind][key] = PluginInfo(_kind, key, cls)
 
             getattr(self.pm.hook, base.register_hook)(register=register)
-        self._plugins = tables
+            for key in clashes[kind]:
+                del tables[kind][key]
+        self._plugins, self._clashes = tables, clashes
+
+    @property
+    def clashes(self) -> list[str]:
+        """What is wrong with each name that two plugins of one kind claim."""
+        return [message for kind in KINDS for message in self._clashes[kind].values()]
 
     # ------------------------------------------------------------- queries
 
@@ -301,10 +366,32 @@ class Registry:
         if kind not in self._plugins:
             raise PluginError(f"unknown plugin kind {kind!r}; kinds are {', '.join(KINDS)}")
         key = normalize_name(name)
+        if key in self._clashes[kind]:
+            raise PluginError(self._clashes[kind][key])
         try:
             return self._plugins[kind][key]
         except KeyError:
             raise PluginError(self.not_found_message(kind, name)) from None
+
+    def at_fault(self, exc: BaseException) -> PluginError | None:
+        """``exc`` told as the fault of the installed plugin whose code raised it (the innermost
+        frame of its traceback in a third party's plugin module), or None: the built-ins are
+        frictionlab's own, and a fault anywhere else is not a plugin's."""
+        modules = {info.cls.__module__.partition(".")[0]: info for info in self.infos()}
+        for module in BUILTIN_MODULES:
+            modules.pop(module, None)
+        frames = [(frame, lineno) for frame, lineno in traceback.walk_tb(exc.__traceback__)]
+        for frame, lineno in reversed(frames):
+            info = modules.get(str(frame.f_globals.get("__name__", "")).partition(".")[0])
+            if info is not None:
+                cls = type(frame.f_locals.get("self")) if isinstance(frame.f_locals.get("self"), Plugin) else info.cls
+                where = f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
+                return PluginError(
+                    f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}) raised "
+                    f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
+                    "tell its authors, or choose another plugin"
+                )
+        return None
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)

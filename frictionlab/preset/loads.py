@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
+from ..plugin.outputs import full_contact_problem, height_of, profile_problem, refuse, shape_problem, slopes_problem
 
 LOAD_UNITS = {
     "force": "the solver's load (a force in E* x length^2, or a force per unit depth)",
@@ -67,19 +68,21 @@ def probe_profile(scene) -> Profile:
     """Realization 0's profile: the grid and h every profile of the scene shares."""
     from .seeds import realization_rng
 
-    return scene.generator.generate(realization_rng(scene.preset.seed, 0))
+    profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
+    refuse(scene.generator, profile_problem(scene.generator, profile) or shape_problem(scene.generator, profile))
+    return profile
 
 
 def load_scales(scene, profile: Profile | None = None) -> LoadScales:
     """The scales of ``scene``'s loads, from ``profile`` (realization 0's when None)."""
     profile = probe_profile(scene) if profile is None else profile
     solver, generator = scene.solver, scene.generator
-    own = generator.profile_rms_height(profile)
-    h = generator.rms_height() if own is None else own
+    h, _ = height_of(generator, profile)
     unit = force_unit(solver, h, profile)
     area = scene.normalisation.nominal_area(profile)
     pressure_unit = None if area is None else float(solver.stiffness()) * area
     full, exact = solver.full_contact_load(profile), True
+    refuse(solver, full_contact_problem(full))
     if full is None and pressure_unit is not None:
         full, exact = estimated_full_contact(scene, profile, pressure_unit), False
     return LoadScales(unit, pressure_unit, full, exact, profile.points)
@@ -90,6 +93,7 @@ def estimated_full_contact(scene, profile: Profile, pressure_unit: float) -> flo
     rms slope (the scene's slope estimator), which presses a surface flat to within a few per cent
     of its area (Persson's theory gives erf(sqrt 2) = 95 % in contact there)."""
     slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
+    refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
     with np.errstate(invalid="ignore", over="ignore"):
         squares = np.square(slopes[np.isfinite(slopes)])
         g = math.sqrt(float(np.mean(squares))) if squares.size else math.nan

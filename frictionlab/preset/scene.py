@@ -15,6 +15,7 @@ from pydantic.errors import PydanticSchemaGenerationError
 from ..errors import PluginError, PresetError
 from ..io.inputs import input_fields, input_file_problem
 from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, SpectrumGenerator
+from ..plugin.outputs import answers_problem, refuse
 from ..plugin.registry import Registry, default_registry
 from .problems import format_validation_error, merge_problems, number_problems, shown_value
 from .reading import read_preset, resolve_input_paths
@@ -204,6 +205,8 @@ def build_scene(
     if measured:  # what the memory check needs (a table without a header is read whole here)
         _read_checked(spectrum.periodic, source)
         _read_checked(spectrum.grid_shape, source)
+    for plugin in plugins.values():  # what the memory check and the geometry read next
+        refuse(plugin, answers_problem(plugin))
     # Store normalised plugin names so the resolved preset is canonical.
     for slot in KINDS:
         getattr(preset, slot).name = plugins[slot].name
@@ -223,6 +226,8 @@ def build_scene(
         before_reading(scene)
     if measured:
         _read_checked(spectrum.rms_height, source)
+    if scene.generator is not spectrum:  # the MDR-equivalent line
+        refuse(scene.generator, answers_problem(scene.generator))
     return scene
 
 

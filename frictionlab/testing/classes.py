@@ -68,7 +68,7 @@ def _bounded_fields(cls, schema) -> list[tuple[str, str, float, bool]]:
 def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) -> None:
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
     ``"slope"``): ``frictionlab.plugin.registry.validate_plugin_class`` passes (right
-    base class, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
+    base class, its required methods implemented, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
     forbidding unknown keys, every field described, and every declaration well
     formed: ``kind`` and ``register_hook`` are the base class's own; a spectrum's
     ``dimension`` is 1 or 2 and its ``points_param`` names a field; the
@@ -80,7 +80,8 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     of strings; ``Params`` has a JSON Schema; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
     field has no default); an unknown key raises ``pydantic.ValidationError``
-    naming it; the parameters survive a JSON round trip (presets are YAML);
+    naming it; the name is not a built-in's of the kind (a preset naming it would be
+    refused as claimed by two plugins); the parameters survive a JSON round trip (presets are YAML);
     and, for every bounded numeric field (bounds read from the JSON Schema, or
     from the field's ``ge``/``gt``/``le``/``lt`` metadata), a value just past
     each bound is rejected, at construction and on assignment, with a message
@@ -93,7 +94,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
 
     from frictionlab.errors import PluginError
     from frictionlab.plugin import KINDS
-    from frictionlab.plugin.registry import normalize_name, validate_plugin_class
+    from frictionlab.plugin.registry import Registry, normalize_name, validate_plugin_class
 
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {', '.join(KINDS)}. Got {kind!r} instead.")
@@ -105,6 +106,11 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
         fail(cls, f"breaks the {kind} plugin contract: {exc}", exc)
     if normalize_name(cls.name) != cls.name:
         fail(cls, f"name must be in normalised kebab-case. Got {cls.name!r} instead.")
+    builtins = Registry(discover=False, env={})
+    builtin = builtins.get(kind, cls.name) if cls.name in builtins.names(kind) else cls
+    if builtin is not cls:
+        fail(cls, f"name {cls.name!r} is taken by the built-in {kind} {builtin.__module__}.{builtin.__qualname__}: "
+                  "a preset naming it would be refused as claimed by two plugins; choose another name")  # fmt: skip
     refs = cls.references
     if not isinstance(refs, (tuple, list)) or not all(isinstance(r, str) and r.strip() for r in refs):
         fail(cls, f"references must be a tuple of strings (DOIs). Got {refs!r} instead.")

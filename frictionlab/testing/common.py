@@ -45,19 +45,12 @@ def instantiate(cls, params: Mapping[str, Any]):
 
 
 def check_array(cls, what: str, value, shape=None, floating=True):
-    import numpy as np
+    """``value`` as the run takes a plugin's array (``frictionlab.plugin.outputs``)."""
+    from frictionlab.plugin.outputs import array_problem
 
-    if not isinstance(value, np.ndarray):
-        fail(cls, f"{what} must be a numpy array. Got {type(value).__name__} instead.")
-    if shape is not None and value.shape != tuple(shape):
-        fail(cls, f"{what} must have shape {tuple(shape)}. Got {value.shape} instead.")
-    if floating and not np.issubdtype(value.dtype, np.floating):
-        fail(cls, f"{what} must be floating point. Got dtype {value.dtype} instead.")
-    if not np.issubdtype(value.dtype, np.number):
-        fail(cls, f"{what} must be numeric. Got dtype {value.dtype} instead.")
-    if not np.all(np.isfinite(value)):
-        bad = int(np.size(value) - np.count_nonzero(np.isfinite(value)))
-        fail(cls, f"{what} must be finite. Got {bad} non-finite value(s).")
+    problem = array_problem(what, value, shape, floating)
+    if problem:
+        fail(cls, problem)
     return value
 
 

@@ -7,7 +7,7 @@ from .common import call, check_array, fail, instantiate, must_refuse
 
 def check_slope_estimator(cls, **params) -> None:
     """``cls(**params).slopes(heights, spacing, periodic)`` on a random periodic line returns
-    a finite floating-point array of the same shape, does not modify its input
+    a finite float64 array of the same shape, does not modify its input
     and is repeatable; a constant line gives zero slopes; on a periodic sine
     (3 periods over 128 points, spacing 0.1) the slopes match the exact
     derivative in order of magnitude and sign (rms within a factor of 2,

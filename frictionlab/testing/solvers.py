@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import call, check_array, check_positive_number, fail, instantiate, must_refuse
+from .common import call, check_positive_number, fail, instantiate, must_refuse
 
 
 def _test_line(points: int = 64, seed: int = 20240613):
@@ -43,7 +43,7 @@ def check_solver(cls, **params) -> None:
     control (forces F = f k h L, L = ``Profile.length``, f from 0.005 to 1, k = ``stiffness()``) and
     under indentation control (2.5 % to 95 % of max z - mean z, the approach at
     which a periodic elastic half-space reaches full contact): it returns a ``ContactCurve``
-    whose arrays all have the shape of ``loads`` and are finite; the controlled
+    whose arrays all have the shape of ``loads`` and are finite, float64 but for the counts; the controlled
     quantity is reported back (``force`` resp. ``indentation`` equal to the
     loads within 1 %); force and indentation do not decrease with load; contact
     counts are whole numbers, do not decrease with load, and lie in 1 .. N;
@@ -75,11 +75,18 @@ def check_solver(cls, **params) -> None:
     too: with every slope NaN, ``slope_rms_contact`` is NaN at every load; with
     slopes 1 but a NaN at the top point, it is 1 wherever it is finite, and finite
     at every load with 2 or more points in contact (the rms over the defined ones).
-    A solver declaring no ``undefined_slopes`` is never given NaN. (Registration itself checks that every declaration is
+    A solver declaring no ``undefined_slopes`` is never given NaN. An iterative solver
+    (``tolerance_param``) calls ``frictionlab.iteration_done(iteration, residual)`` in its loop
+    (a whole number >= 0, a finite residual >= 0), and any solver that calls it lets the
+    ``SolveCancelled`` it raises in a cancelled run propagate, neither swallowed nor wrapped:
+    so a run shows a long load's progress and stops on Ctrl-C. (Registration itself checks that every declaration is
     well formed: ``registry.declaration_problems``.)
     """
     solver = instantiate(cls, params)
-    check_positive_number(cls, "stiffness()", call(cls, "stiffness()", solver.stiffness))
+    from frictionlab.plugin.outputs import answers_problem
+
+    if problem := call(cls, "stiffness() or tolerance()", answers_problem, solver):  # as a run takes them
+        fail(cls, problem)
     for dimension in cls.dimensions:
         heights, spacing, slopes = _test_line() if dimension == 1 else _test_surface()
         _check_solves(cls, solver, heights, spacing, slopes)
@@ -89,7 +96,8 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
     """Everything ``check_solver`` says, on one profile."""
     import numpy as np
 
-    from frictionlab.plugin import ContactCurve, Profile, force_unit
+    from frictionlab.plugin import Profile, force_unit
+    from frictionlab.plugin.outputs import curve_problem
 
     n = heights.size
     shape = "line" if heights.ndim == 1 else "surface"
@@ -118,25 +126,21 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             return curve
 
         curve = run()
-        if not isinstance(curve, ContactCurve):
-            fail(cls, f"{where} must return a frictionlab.ContactCurve. Got {type(curve).__name__} instead.")
-        arrays = {}
-        for name in names:
-            value = getattr(curve, name)
-            floating = name != "contact_count"
-            arrays[name] = check_array(cls, f"{where}.{name}", np.asarray(value), loads.shape, floating)
-        corrected = _declared(cls, where, curve, "real_area_corrected", "corrected_area", loads.shape, True)
+        problem = curve_problem(solver, curve, loads.size, where)  # as a run takes it
+        if problem:
+            fail(cls, problem)
+        arrays = {name: getattr(curve, name) for name in names}
+        if not np.all(np.isfinite(arrays["slope_rms_contact"])):  # every slope defined here: every rms too
+            fail(cls, f"{where}.slope_rms_contact must be finite. Got {arrays['slope_rms_contact']!r}.")
+        corrected = curve.real_area_corrected
         if corrected is not None and (np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12))):
             fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
                       f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
-        gradient = _declared(cls, where, curve, "real_gradient_rms", "real_gradient", loads.shape, True)
+        gradient = curve.real_gradient_rms
         if gradient is not None and np.any(gradient < 0):
             fail(cls, f"{where}.real_gradient_rms is an rms slope and must be >= 0. Got {gradient!r}.")
-        _whole_counts(cls, where, curve, "contact_spots", _declared(cls, where, curve, "contact_spots", "counts_spots",
-                                                                     loads.shape, False))  # fmt: skip
-        if curve.half_load_points is not None:  # optional: a solver may not say
-            half = check_array(cls, f"{where}.half_load_points", np.asarray(curve.half_load_points), loads.shape, False)
-            _whole_counts(cls, where, curve, "half_load_points", half)
+        _whole_counts(cls, where, curve, "contact_spots", curve.contact_spots)
+        _whole_counts(cls, where, curve, "half_load_points", curve.half_load_points)
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")
@@ -148,8 +152,6 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             if np.any(np.diff(arrays[name]) < 0):
                 fail(cls, f"{where}.{name} must not decrease as the load grows. Got {arrays[name]!r}.")
         count = arrays["contact_count"]
-        if not np.array_equal(count, np.round(count)):
-            fail(cls, f"{where}.contact_count must hold whole numbers. Got {count!r}.")
         if np.any(count < 1) or np.any(count > n):
             fail(cls, f"{where}.contact_count must lie in 1 .. {n} (points of the {shape}). Got {count!r}.")
         if not np.allclose(arrays["contact_fraction"], count / n, rtol=1e-12, atol=1e-12):
@@ -171,20 +173,10 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
             if not np.array_equal(np.asarray(getattr(again, name)), arrays[name]):
                 fail(cls, f"{where} is not repeatable: {name} differs between two identical calls")
     _check_solver_declarations(cls, solver, heights, spacing, slopes, cases["force"])
+    _check_cancel(cls, solver, heights, spacing, slopes, cases["force"])
     _check_load_limits(cls, solver, heights, spacing, slopes, unit)
     _check_solver_units(cls, solver, heights, spacing, slopes)
 
-
-
-def _declared(cls, where: str, curve, name: str, flag: str, shape, floating: bool):
-    """``curve``'s array ``name``, checked; None. It must be given exactly when the solver
-    class declares ``flag`` True."""
-    import numpy as np
-
-    value, declared = getattr(curve, name), getattr(cls, flag)  # fields the contract declares, by name
-    if (value is not None) != declared:
-        fail(cls, f"{where}.{name} must be given exactly when {flag} is True (it is {declared!r}). Got {value!r}.")
-    return None if value is None else check_array(cls, f"{where}.{name}", np.asarray(value), shape, floating)
 
 
 def _whole_counts(cls, where: str, curve, name: str, values) -> None:
@@ -201,11 +193,54 @@ def count_of(curve):
     return np.asarray(curve.contact_count)
 
 
+def _check_cancel(cls, solver, heights, spacing, slopes, forces) -> None:
+    """An iterative solver (``tolerance_param``) calls ``iteration_done(iteration, residual)`` in
+    its loop, a whole number >= 0 and a finite residual >= 0; any solver that calls it lets the
+    ``SolveCancelled`` it raises on a cancelled run propagate: that is how Ctrl-C stops a long solve."""
+    import math
+
+    import numpy as np
+
+    from frictionlab.plugin import Profile, SolveCancelled, listening_to_iterations
+
+    heard = []
+
+    def cancel(iteration, residual):
+        heard.append((iteration, residual))
+        raise SolveCancelled("the conformance kit cancels the solve")
+
+    where = "solve(..., control='force') in a cancelled run"
+    try:
+        with listening_to_iterations(cancel):
+            solver.solve(Profile(heights.copy(), spacing), forces.copy(), "force", slopes.copy())
+    except SolveCancelled:
+        pass
+    except Exception as exc:
+        fail(cls, f"{where} raised {type(exc).__name__}: {exc}; let the frictionlab.SolveCancelled raised by "
+                  "iteration_done() propagate as it is, so the run stops", exc)  # fmt: skip
+    else:
+        if heard:
+            fail(cls, f"{where} returned: it swallowed the frictionlab.SolveCancelled raised by iteration_done(); "
+                      "let it propagate, so the run stops")  # fmt: skip
+        if cls.tolerance_param is not None:
+            fail(cls, f"tolerance_param is {cls.tolerance_param!r} (an iterative solver), but solve() never called "
+                      "frictionlab.iteration_done(iteration, residual): a run could not show its progress within a "
+                      "load nor stop it on Ctrl-C")  # fmt: skip
+    if heard:
+        iteration, residual = heard[0]
+        whole = isinstance(iteration, (int, np.integer)) and not isinstance(iteration, bool) and iteration >= 0
+        real = isinstance(residual, (int, float, np.floating)) and math.isfinite(residual) and residual >= 0
+        if not (whole and real):
+            fail(cls, "iteration_done(iteration, residual) takes the steps done, a whole number >= 0, and the relative "
+                      f"residual, a finite number >= 0. Got ({iteration!r}, {residual!r}).")  # fmt: skip
+
+
 def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> None:
     """``max_f`` refused past it; ``full_contact_load`` puts every point in contact."""
     import numpy as np
 
     from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import full_contact_problem
 
     limit = cls.max_f
     if limit is not None:
@@ -223,8 +258,8 @@ def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> No
     full = call(cls, "full_contact_load(profile)", solver.full_contact_load, Profile(heights.copy(), spacing))
     if full is None:
         return
-    if isinstance(full, bool) or not isinstance(full, (int, float)) or not (np.isfinite(full) and full >= 0):
-        fail(cls, f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}.")
+    if problem := full_contact_problem(full):
+        fail(cls, problem)
     curve = _solve(cls, solver, heights, spacing, slopes, np.array([1.01 * full or unit]))
     if int(count_of(curve)[0]) != heights.size:
         fail(cls, f"full_contact_load(profile) = {full:g}, but 1.01 times it puts {int(count_of(curve)[0])} of "

@@ -9,7 +9,7 @@ from .common import call, check_array, check_positive_number, fail, instantiate,
 
 def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
-    floating-point heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
+    float64 heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
     identical heights; a different seed gives different heights (pass
     ``deterministic=True`` for a generator that ignores randomness by design,
     e.g. one that reads a measured profile); ``rms_height()`` is finite and
@@ -34,21 +34,15 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """
     import numpy as np
 
-    from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import height_problem, profile_problem
 
     gen = instantiate(cls, params)
 
     def generate(seed: int):
         profile = call(cls, f"generate(default_rng({seed}))", gen.generate, np.random.default_rng(seed))
-        if not isinstance(profile, Profile):
-            fail(cls, f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead.")
-        heights = check_array(cls, "Profile.heights", profile.heights)
-        dimension = cls.dimension
-        if heights.ndim != dimension:
-            fail(cls, f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {heights.shape} instead.")
-        if heights.size < 2:
-            fail(cls, f"Profile.heights must have at least 2 points. Got {heights.size}.")
-        check_positive_number(cls, "Profile.spacing", profile.spacing)
+        problem = profile_problem(gen, profile)  # as a run takes it
+        if problem:
+            fail(cls, problem)
         return profile
 
     first = generate(1234)
@@ -66,7 +60,9 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
                 "(or pass deterministic=True if the generator is deterministic by design)",
             )
 
-    h = check_positive_number(cls, "rms_height()", call(cls, "rms_height()", gen.rms_height))
+    if problem := call(cls, "rms_height()", height_problem, gen):
+        fail(cls, problem)
+    h = gen.rms_height()
     variances = [np.var(first.heights), np.var(other.heights)]
     variances += [np.var(generate(seed).heights) for seed in range(6)]
     measured = float(np.sqrt(np.mean(variances)))
@@ -96,6 +92,7 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     import numpy as np
 
     from frictionlab.plugin import SpectrumGenerator, mdr_length
+    from frictionlab.plugin.outputs import answers_problem, shape_problem
 
     periodic = call(cls, "periodic()", gen.periodic)
     if not isinstance(periodic, bool) or profile.periodic is not periodic:
@@ -110,9 +107,8 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
         if points != profile.heights.shape[-1]:
             fail(cls, f"points_param names {cls.points_param!r} = {points!r}, but generate() makes "
                       f"{profile.heights.shape[-1]} points (per side)")  # fmt: skip
-    shape = call(cls, "grid_shape()", gen.grid_shape)
-    if shape is not None and tuple(shape) != profile.heights.shape:
-        fail(cls, f"grid_shape() must be None or the shape generate() makes, {profile.heights.shape}. Got {shape!r}.")
+    if problem := call(cls, "grid_shape()", answers_problem, gen) or call(cls, "grid_shape()", shape_problem, gen, profile):
+        fail(cls, problem)
 
     finer_points = 2 * profile.heights.shape[-1]
     changes = call(cls, f"refined({finer_points})", gen.refined, finer_points)

@@ -26,6 +26,7 @@ from pydantic import Field
 
 from frictionlab import (
     ContactCurve, ContactSolver, Control, ForceNormalisation, PluginParams, Profile, defined_rms, half_load_points,
+    iteration_done,
 )  # fmt: skip
 
 from .checks import check_control, check_loads, check_profile
@@ -330,6 +331,7 @@ class BisectionSprings(MDRSprings):
                         hi = mid
                     if abs(value - target) <= tolerance * target:
                         break
+                    iteration_done(step, abs(value - target) / target)  # a long bisection stops on cancel
                 residual[j] = abs(value - target) / target
                 force[j] = load
                 contact = depth <= lo

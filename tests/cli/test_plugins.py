@@ -5,6 +5,8 @@ import json
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 
+from tests.test_registry import fake_dists  # noqa: F401 (a fixture)
+
 
 def test_plugins_lists_kind_name_provider_and_version(capsys):
     assert main(["plugins"]) == ExitCode.OK
@@ -15,3 +17,62 @@ def test_plugins_lists_kind_name_provider_and_version(capsys):
     assert main(["plugins", "--json"]) == ExitCode.OK
     rows = json.loads(capsys.readouterr().out)["plugins"]
     assert {r["name"] for r in rows if r["kind"] == "slope"} >= {"forward-difference", "central-difference", "spectral"}
+
+
+
+def test_a_name_two_plugins_claim_is_named_and_other_presets_still_validate(capsys, fake_dists):
+    from frictionlab.plugin import registry as registry_module
+    from tests.test_registry import GOOD_SOURCE
+
+    for dist in ("acme-one", "acme-two"):
+        module = dist.replace("-", "_")
+        fake_dists(dist, dist, module, GOOD_SOURCE.format(cls="Twin", name="twin-line"))
+    registry_module.default_registry.cache_clear()
+    try:
+        assert main(["plugins"]) == ExitCode.OK
+        captured = capsys.readouterr()
+        assert "twin-line" not in captured.out and "power-law" in captured.out
+        assert "not listed: two spectrum plugins are named 'twin-line': acme_" in captured.err
+        assert main(["plugins", "--json"]) == ExitCode.OK
+        assert "two spectrum plugins are named 'twin-line'" in json.loads(capsys.readouterr().out)["clashes"][0]
+        assert main(["validate", "quickstart"]) == ExitCode.OK
+        twin = ["--set", "spectrum.name=twin-line", "--set", "spectrum.params={}"]
+        assert main(["validate", "quickstart", *twin]) == ExitCode.USAGE
+        assert "spectrum.name: two spectrum plugins are named 'twin-line'" in capsys.readouterr().err
+    finally:
+        registry_module.default_registry.cache_clear()
+
+
+RAISING_SOURCE = '''
+import frictionlab
+from tests.testing.fakes import GoodSpectrum
+
+
+class Raising(GoodSpectrum):
+    name = "raising-line"
+
+    def rms_height(self):
+        return 1 / 0
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Raising)
+'''
+
+
+def test_a_plugin_that_raises_is_named_with_exit_code_2_not_an_internal_error(capsys, fake_dists):
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-raising", "raising", "acme_raising", RAISING_SOURCE, "1.2")
+    registry_module.default_registry.cache_clear()
+    try:
+        args = ["validate", "quickstart", "--set", "spectrum.name=raising-line", "--set", "spectrum.params={}"]
+        assert main(args) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert err.startswith("error: spectrum 'raising-line' (acme_raising.Raising from acme-raising) raised "
+                              "ZeroDivisionError: division by zero in rms_height() at acme_raising.py:")
+        assert "internal error" not in err
+        assert main(["validate", "quickstart"]) == ExitCode.OK
+    finally:
+        registry_module.default_registry.cache_clear()

@@ -58,6 +58,8 @@ CLASS_BREAKAGES = [
     ("NoAssignmentCheck", {"Params": _NoAssignmentParams}, "validate on assignment"),
     ("UnenforcedBound", {"Params": _UnenforcedParams}, r"Params.points = 7 \(past its minimum 8\) was accepted"),
     ("RequiredField", {"Params": _RequiredParams}, r"Params\(\*\*\{\}\) is invalid \(pass the required values"),
+    ("BuiltinsName", {"name": "power-law"}, r"name 'power-law' is taken by the built-in spectrum "
+                                             r"frictionlab_spectra\.power_law\.PowerLaw: .*choose another name"),
 ]
 
 

@@ -46,6 +46,8 @@ SOLVER_BREAKAGES = [
     ("FractionalCount", lambda c, p, l: replace_curve(c, contact_count=c.contact_count + 0.5,
                                                         contact_fraction=(c.contact_count + 0.5) / 64), "whole numbers"),
     ("DimensionlessForce", lambda c, p, l: replace_curve(c, force=c.force / 1000), "must report the loads"),
+    ("SingleSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact.astype(np.float32)),
+     r"slope_rms_contact must be float64 \(double precision\)"),
     ("NaNSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact * np.nan), "must be finite"),
     ("HugeSlope", lambda c, p, l: replace_curve(c, slope_rms_contact=c.slope_rms_contact + 100), r"max \|slope\|"),
     ("ShortExtras", lambda c, p, l: replace_curve(c, extras={"iterations": np.ones(2)}), "one entry per load"),
@@ -163,3 +165,57 @@ def test_solver_declarations_are_checked_at_registration(attributes, match):
     cls = type("Undeclared", (GoodSolver,), {"name": "undeclared", **attributes})
     with pytest.raises(PluginError, match=match):
         registry_module.validate_plugin_class("solver", cls)
+
+
+# ====================================================== progress and cancel
+
+
+def _iterating(qualname, on_step, tolerance_param="modulus"):
+    """GoodSolver reporting one step per load through ``on_step(load_index)``, declared iterative."""
+
+    def solve(self, profile, loads, control, slopes):
+        for index in range(len(loads)):
+            on_step(index)
+        return GoodSolver.solve(self, profile, loads, control, slopes)
+
+    return type(qualname, (GoodSolver,), {"name": "iterating", "solve": solve, "tolerance_param": tolerance_param})
+
+
+def _swallows(index):
+    from frictionlab import SolveCancelled, iteration_done
+
+    try:
+        iteration_done(index, 0.5)
+    except SolveCancelled:
+        pass
+
+
+def _wraps(index):
+    from frictionlab import iteration_done
+
+    try:
+        iteration_done(index, 0.5)
+    except Exception as exc:
+        raise RuntimeError("the solve failed") from exc
+
+
+CANCEL_BREAKAGES = [
+    ("Deaf", lambda index: None, r"tolerance_param is 'modulus' \(an iterative solver\), but solve\(\) never called "
+                                 r"frictionlab\.iteration_done"),
+    ("Swallows", _swallows, "swallowed the frictionlab.SolveCancelled raised by iteration_done"),
+    ("Wraps", _wraps, "raised RuntimeError: the solve failed; let the frictionlab.SolveCancelled"),
+    ("NegativeStep", lambda index: __import__("frictionlab").iteration_done(-1, 0.5), r"Got \(-1, 0\.5\)"),
+    ("NaNResidual", lambda index: __import__("frictionlab").iteration_done(index, float("nan")), r"Got \(0, nan\)"),
+]
+
+
+@pytest.mark.parametrize("qualname,on_step,match", CANCEL_BREAKAGES, ids=[b[0] for b in CANCEL_BREAKAGES])
+def test_solver_check_fails_for_a_solver_that_a_cancel_cannot_stop(qualname, on_step, match):
+    fails_naming(fltesting.check_solver, _iterating(qualname, on_step), match)
+
+
+def test_solver_check_passes_a_solver_that_reports_its_steps_and_stops_on_cancel():
+    from frictionlab import iteration_done
+
+    fltesting.check_solver(_iterating("Reports", lambda index: iteration_done(index, 0.5)))
+    fltesting.check_solver(_iterating("DirectAndQuiet", lambda index: None, tolerance_param=None))

@@ -143,7 +143,7 @@ class SmoothedSlope(SlopeEstimator):
         edge: Literal["wrap", "reflect"] = Field("wrap", description="how the line's ends are treated")
         normalise: bool = Field(False, description="divide by the rms slope")
 
-    def slopes(self, heights, spacing):
+    def slopes(self, heights, spacing, periodic=True):
         return np.gradient(heights, spacing)
 
 

@@ -49,7 +49,7 @@ class BracketSlope(SlopeEstimator):
     class Params(PluginParams):
         ends: Literal["wrap [1]", "[b]cut[/b]"] = Field("[b]cut[/b]", description="ends of the line, as in [2]")
 
-    def slopes(self, heights, spacing):
+    def slopes(self, heights, spacing, periodic=True):
         return np.diff(heights, append=heights[:1]) / spacing
 
 

@@ -1,0 +1,166 @@
+"""What a plugin hands back, checked where the framework takes it: a profile, its slopes,
+a contact curve. The run refuses a broken answer by the plugin's name and distribution,
+before any number is computed from it; the conformance kit (``frictionlab.testing``)
+states the same problems in the same words."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import PluginError
+from .data import ContactCurve, Profile
+from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
+from .registry import _provider_of
+
+CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
+DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
+                   "contact_spots": "counts_spots"}  # fmt: skip
+
+
+def array_problem(what: str, value, shape=None, floating: bool = True, nan: bool = False) -> str | None:
+    """What is wrong with ``value`` as a plugin's array: not a numpy array, another shape,
+    not float64 (``floating``) or not numeric, or not finite (NaN allowed with ``nan``)."""
+    if not isinstance(value, np.ndarray):
+        return f"{what} must be a numpy array. Got {type(value).__name__} instead."
+    if shape is not None and value.shape != tuple(shape):
+        return f"{what} must have shape {tuple(shape)}. Got {value.shape} instead."
+    if floating and value.dtype != np.float64:  # what the framework computes and stores in: float32 loses digits
+        return f"{what} must be float64 (double precision). Got dtype {value.dtype} instead."
+    if not np.issubdtype(value.dtype, np.number) or np.issubdtype(value.dtype, np.complexfloating):
+        return f"{what} must be real numbers. Got dtype {value.dtype} instead."
+    bad = np.isinf(value) if nan else ~np.isfinite(value)
+    if np.any(bad):
+        return f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s)."
+    return None
+
+
+def whole_problem(what: str, values) -> str | None:
+    """``values`` must be whole numbers (counts), of an integer or a float dtype."""
+    if not np.array_equal(values, np.round(values)):
+        return f"{what} must hold whole numbers. Got {values!r}."
+    return None
+
+
+def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
+    """What is wrong with what ``generate()`` returned."""
+    if not isinstance(profile, Profile):
+        return f"generate() must return a frictionlab.Profile. Got {type(profile).__name__} instead."
+    problem = array_problem("Profile.heights", profile.heights)
+    if problem:
+        return problem
+    dimension = generator.dimension
+    if profile.heights.ndim != dimension:
+        return f"Profile.heights must be {dimension}-D (dimension = {dimension}). Got shape {profile.heights.shape} instead."
+    if profile.heights.size < 2:
+        return f"Profile.heights must have at least 2 points. Got {profile.heights.size}."
+    spacing = profile.spacing
+    real = isinstance(spacing, (int, float, np.integer, np.floating)) and not isinstance(spacing, bool)
+    if not (real and math.isfinite(spacing) and spacing > 0):
+        return f"Profile.spacing must be finite and > 0. Got {spacing!r} instead."
+    if not isinstance(profile.periodic, bool):
+        return f"Profile.periodic must be True or False. Got {profile.periodic!r} instead."
+    return None
+
+
+def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile) -> str | None:
+    """What is wrong with what ``slopes(heights, spacing, periodic)`` returned for ``profile``."""
+    undefined = estimator.undefined_points(profile.periodic)
+    return array_problem("slopes()", slopes, profile.heights.shape, nan=undefined is True)
+
+
+def curve_problem(solver: ContactSolver, curve, loads: int, where: str = "solve()") -> str | None:
+    """What is wrong with what ``solve()`` (called as ``where`` says) returned for ``loads`` loads."""
+    if not isinstance(curve, ContactCurve):
+        return f"{where} must return a frictionlab.ContactCurve. Got {type(curve).__name__} instead."
+    for name in CURVE_ARRAYS:
+        nan = name == "slope_rms_contact" and solver.undefined_slopes  # NaN where no point in contact has a slope
+        value, what = getattr(curve, name), f"{where}.{name}"
+        problem = array_problem(what, value, (loads,), floating=name != "contact_count", nan=nan)
+        if problem or (name == "contact_count" and (problem := whole_problem(what, value))):
+            return problem
+    for name, flag in DECLARED_ARRAYS.items():  # contract names: ContactCurve's fields, ContactSolver's flags
+        value, declared, what = getattr(curve, name), getattr(solver, flag), f"{where}.{name}"
+        if (value is not None) != declared:
+            return f"{what} must be given exactly when {flag} is True (it is {declared!r}). Got {value!r}."
+        if value is not None and (problem := array_problem(what, value, (loads,), name != "contact_spots")):
+            return problem
+    half, what = curve.half_load_points, f"{where}.half_load_points"
+    if half is not None:  # optional: a solver may not say
+        return array_problem(what, half, (loads,), floating=False) or whole_problem(what, half)
+    return None
+
+
+def _positive(what: str, value, none: bool = False) -> str | None:
+    if value is None and none:
+        return None
+    real = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    if not (real and math.isfinite(value) and value > 0):
+        return f"{what} must be {'None or a number ' if none else ''}finite and > 0. Got {value!r} instead."
+    return None
+
+
+def _whole(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def answers_problem(plugin) -> str | None:
+    """What is wrong with the answers a run reads of ``plugin`` before it starts: a spectrum's
+    ``periodic()`` and ``grid_shape()`` (``rms_height()``: ``height_problem``, once a measured
+    file is read); a solver's ``stiffness()`` and ``tolerance()``; an estimator's
+    ``undefined_points(periodic)``."""
+    if isinstance(plugin, SpectrumGenerator):
+        periodic, shape, dimension = plugin.periodic(), plugin.grid_shape(), plugin.dimension
+        if not isinstance(periodic, bool):
+            return f"periodic() must be True or False. Got {periodic!r} instead."
+        if shape is not None and not (isinstance(shape, (tuple, list)) and len(shape) == dimension
+                                      and all(_whole(n) and n >= 1 for n in shape)):  # fmt: skip
+            return f"grid_shape() must be None or {dimension} whole number(s) >= 1, the shape generate() makes. Got {shape!r} instead."
+        return None
+    if isinstance(plugin, ContactSolver):
+        return _positive("stiffness()", plugin.stiffness()) or _positive("tolerance()", plugin.tolerance(), none=True)
+    undefined = (plugin.undefined_points(True), plugin.undefined_points(False))
+    if undefined[0] is not False or not isinstance(undefined[1], bool):
+        return ("undefined_points(periodic) must be False for a periodic profile, True or False for another. "
+                f"Got {undefined[0]!r} and {undefined[1]!r}.")  # fmt: skip
+    return None
+
+
+def shape_problem(spectrum: SpectrumGenerator, profile: Profile) -> str | None:
+    """``grid_shape()`` must be None or the shape of what ``generate()`` made, ``profile``."""
+    shape = spectrum.grid_shape()
+    if shape is not None and tuple(shape) != profile.heights.shape:
+        return f"grid_shape() must be None or the shape generate() makes, {profile.heights.shape}. Got {shape!r}."
+    return None
+
+
+def height_problem(spectrum: SpectrumGenerator) -> str | None:
+    """What is wrong with ``rms_height()``, the h of f."""
+    return _positive("rms_height()", spectrum.rms_height())
+
+
+def height_of(spectrum: SpectrumGenerator, profile: Profile) -> tuple[float, float | None]:
+    """The h of f for ``profile`` and the profile's own h (None when it is the nominal one), checked."""
+    own = spectrum.profile_rms_height(profile)
+    if own is None:
+        refuse(spectrum, height_problem(spectrum))
+        return spectrum.rms_height(), None
+    refuse(spectrum, _positive("profile_rms_height(profile)", own))
+    return own, own
+
+
+def full_contact_problem(full) -> str | None:
+    """What is wrong with an answer of ``full_contact_load(profile)``."""
+    if full is None or (isinstance(full, (int, float, np.integer, np.floating)) and not isinstance(full, bool)
+                        and math.isfinite(full) and full >= 0):  # fmt: skip
+        return None
+    return f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}."
+
+
+def refuse(plugin, problem: str | None) -> None:
+    """Raise PluginError naming ``plugin`` (kind, name, class, distribution) and ``problem``, if any."""
+    if problem:
+        cls = type(plugin)
+        raise PluginError(f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from "
+                          f"{_provider_of(cls)[0]}) broke the plugin contract: {problem}")  # fmt: skip

@@ -1,0 +1,83 @@
+"""What a plugin answers before a run starts (its declarations' values, realization 0's
+profile, the load of full contact) is checked where it is taken: a broken answer is refused
+by the plugin's name, and an exception raised in a third party's plugin code is told as
+that plugin's fault, never as frictionlab's internal error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from frictionlab.errors import PluginError
+from frictionlab.preset import build_scene
+from frictionlab.preset.loads import load_scales
+
+from .conftest import SMALL_PRESET
+from .testing.fakes import GoodSolver, GoodSlopes, GoodSpectrum
+
+BROKEN = {
+    "text-rms": (GoodSpectrum, {"rms_height": lambda self: "1.0"}, "rms_height() must be finite and > 0. Got '1.0'"),
+    "no-rms": (GoodSpectrum, {"rms_height": lambda self: -1.0}, "rms_height() must be finite and > 0. Got -1.0"),
+    "text-grid": (GoodSpectrum, {"grid_shape": lambda self: "big"}, "grid_shape() must be None or 1 whole number(s)"),
+    "wrong-grid": (GoodSpectrum, {"grid_shape": lambda self: (7,)},
+                   "grid_shape() must be None or the shape generate() makes, (128,). Got (7,)"),
+    "text-periodic": (GoodSpectrum, {"periodic": lambda self: "yes"}, "periodic() must be True or False. Got 'yes'"),
+    "nan-heights": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
+        np.full(128, np.nan), 1.0)}, "Profile.heights must be finite"),
+    "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
+    "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
+                      "tolerance() must be None or a number finite and > 0. Got nan"),
+    "text-full": (GoodSolver, {"full_contact_load": lambda self, profile: "lots"},
+                  "full_contact_load(profile) must be None or a finite number >= 0. Got 'lots'"),
+    "text-undefined": (GoodSlopes, {"undefined_points": lambda self, periodic: "no"},
+                       "undefined_points(periodic) must be False for a periodic profile"),
+}
+SLOTS = {GoodSpectrum: "spectrum", GoodSolver: "solver", GoodSlopes: "slope"}
+GOOD = {**{k: v for k, v in SMALL_PRESET.items() if k not in SLOTS.values()},
+        "spectrum": {"name": "good-spectrum"}, "solver": {"name": "good-solver"}, "slope": {"name": "good-slopes"}}
+
+
+@pytest.mark.parametrize("case", BROKEN)
+def test_a_broken_answer_is_refused_by_the_plugin_s_name(register_plugin, case):
+    """Taken as it came, each was an internal error (grid_shape as text, full contact as text),
+    a message about the preset's magnitudes (a negative h), or a scene built on it."""
+    base, methods, problem = BROKEN[case]
+    broken = type("Broken", (base,), {"name": f"broken-{SLOTS[base]}", **methods})
+    registry = register_plugin(broken)
+    for cls in {GoodSpectrum, GoodSolver, GoodSlopes} - {base}:
+        register_plugin(cls)
+    data = {**GOOD, SLOTS[base]: {"name": broken.name}}
+    with pytest.raises(PluginError) as excinfo:
+        load_scales(build_scene(data, registry=registry))
+    assert str(excinfo.value) == (f"{SLOTS[base]} 'broken-{SLOTS[base]}' (tests.test_plugin_answers.Broken from "
+                                  f"tests.test_plugin_answers) broke the plugin contract: {problem}"
+                                  + str(excinfo.value).partition(problem)[2])
+
+
+def test_an_exception_in_a_plugin_s_code_is_told_as_its_fault(register_plugin):
+    def rms_height(self):
+        return 1 / 0
+
+    broken = type("Raising", (GoodSpectrum,), {"name": "raising-spectrum", "rms_height": rms_height})
+    registry = register_plugin(broken)
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    with pytest.raises(ZeroDivisionError) as excinfo:
+        load_scales(build_scene({**GOOD, "spectrum": {"name": "raising-spectrum"}}, registry=registry))
+    fault = registry.at_fault(excinfo.value)
+    assert isinstance(fault, PluginError)
+    assert str(fault).startswith("spectrum 'raising-spectrum' (tests.test_plugin_answers.Raising from "
+                                 "tests.test_plugin_answers) raised ZeroDivisionError: division by zero in "
+                                 "rms_height() at test_plugin_answers.py:")
+    assert "the plugin is at fault" in str(fault)
+
+
+def test_an_exception_in_frictionlab_or_a_builtin_is_no_plugin_s_fault(frictionlab_registry):
+    from frictionlab_solvers.checks import check_control
+
+    with pytest.raises(ValueError) as excinfo:
+        check_control("sideways")
+    assert frictionlab_registry.at_fault(excinfo.value) is None
+    with pytest.raises(ZeroDivisionError) as excinfo:
+        1 / 0
+    assert frictionlab_registry.at_fault(excinfo.value) is None
