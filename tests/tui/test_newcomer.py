@@ -347,12 +347,12 @@ async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, regist
 @pytest.mark.long
 @sync
 async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folders, registry, monkeypatch):
-    import frictionlab.tui.app
+    import frictionlab.tui.saving
 
     def refused(path, data, template=None):
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(frictionlab.tui.app, "save_preset", refused)
+    monkeypatch.setattr(frictionlab.tui.saving, "save_preset", refused)
     monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
