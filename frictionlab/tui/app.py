@@ -31,6 +31,7 @@ from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
     copy_name,
+    file_stamp,
     preset_folders,
     preset_from_template,
     runs_signature,
@@ -53,7 +54,7 @@ if TYPE_CHECKING:
     from .widgets import PresetForm
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
-WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
+WATCH_SECONDS = 0.5  # how often the runs folder (and the open preset's file) is looked at: a run started anywhere is listed within this
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
@@ -104,6 +105,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
         self._saved: dict | None = None  # the draft as its file holds it (None: not saved yet)
+        self.disk_stamp: tuple | None = None  # the draft's file as read or written here (folders.file_stamp)
+        self.said_stamp: tuple | None = None  # the file's change the status line said last
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
@@ -170,6 +173,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self._show_edit_state()
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
         self.set_interval(WATCH_SECONDS, self._watch_runs)
+        self.set_interval(WATCH_SECONDS, self._watch_preset_file)
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -283,14 +287,15 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
 
     async def open_preset(self, path: Path, data: dict | None = None, *, modified: bool = False) -> None:
         if data is None:
+            stamp = file_stamp(path)  # before reading it: a write meanwhile is seen as a change, never missed
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
                 self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}", about=path)
                 return
-            self.draft_source = path
+            self.draft_source, self.disk_stamp = path, stamp
         else:
-            self.draft_source = None
+            self.draft_source, self.disk_stamp = None, None
         self.draft_path = path
         await self.query_one("#form").load(data, base_dir=path.parent)
         if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one

@@ -170,6 +170,16 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
     atomic_write(Path(path), lambda fh: fh.write(text))
 
 
+def file_stamp(path: Path) -> tuple[int, int, int] | None:
+    """What changes when a file is written or replaced (its inode, size and time of change), None
+    where it is not there: another program's (an editor's, another TUI's) write is seen by it."""
+    try:
+        stat = os.stat(path)
+    except OSError:
+        return None
+    return stat.st_ino, stat.st_size, stat.st_mtime_ns
+
+
 # ------------------------------------------------------------------ past runs
 
 

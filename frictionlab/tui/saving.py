@@ -1,5 +1,7 @@
 """Saving the open preset (``FrictionlabApp``'s, a mixin): Ctrl+S, Ctrl+O, and the file of a
-duplicate; a built-in preset is saved as a copy, a file that cannot be written is said."""
+duplicate; a built-in preset is saved as a copy, a file that cannot be written is said, and
+one that another program (an editor, another TUI) wrote since it was opened is replaced only
+once the user says so."""
 
 from __future__ import annotations
 
@@ -7,7 +9,7 @@ import copy
 from pathlib import Path
 
 from ..errors import shown
-from .folders import is_builtin, new_preset_path, save_preset, user_presets_dir
+from .folders import file_stamp, is_builtin, new_preset_path, save_preset, user_presets_dir
 from .running import NO_PRESET
 from .screens import ConfirmScreen, PathScreen
 from .widgets.presets import PresetsPane
@@ -34,7 +36,32 @@ class PresetSaving:
                 lambda path: path is not None and self._save_checked(path),
             )
             return
+        if self._changed_on_disk():
+            self.push_screen(ConfirmScreen(changed_question(self.draft_path)),
+                             lambda yes: yes and self._save_checked(self.draft_path))  # fmt: skip
+            return
         self._save_checked(self.draft_path)
+
+    def _changed_on_disk(self) -> bool:
+        """Whether the open preset's file is there and not as it was read or last saved here."""
+        if self.disk_stamp is None or self.draft_source != self.draft_path:
+            return False
+        return file_stamp(self.draft_path) not in (None, self.disk_stamp)
+
+    def _watch_preset_file(self) -> None:
+        """Say once, as it happens, that the open preset's file was changed or removed on disk."""
+        if self.disk_stamp is None or self.draft_source != self.draft_path:
+            return
+        now = file_stamp(self.draft_path)
+        if now in (self.disk_stamp, self.said_stamp):
+            return
+        self.said_stamp = now
+        if now is None:
+            self.say(f"{shown(self.draft_path)} was removed from disk: Ctrl+S writes the form's preset there again.",
+                     "warning", until_open=True)  # fmt: skip
+        else:
+            self.say(f"{shown(self.draft_path)} was changed on disk (by another program or TUI): Ctrl+S asks before "
+                     "replacing it; Enter on it in Presets (F2) opens it as it is now.", "warning", until_open=True)  # fmt: skip
 
     def action_save_as(self) -> None:
         if self.draft_path is None or self._draft() is None:
@@ -83,6 +110,13 @@ class PresetSaving:
             self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
         else:
             self.draft_path = self.draft_source = path
+            self.disk_stamp = file_stamp(path)
             self.modified = False
             self._saved = copy.deepcopy(data)
             self._show_edit_state()
+
+
+def changed_question(path: Path) -> str:
+    return (f"{shown(path)} was changed on disk since it was opened here (by another program or TUI).\n"
+            "Replace it with the form's preset? What the other wrote is lost.\n\n"
+            "n keeps the file: Ctrl+O saves the form elsewhere; Enter on it in Presets opens it as it is now.")  # fmt: skip
