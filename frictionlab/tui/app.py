@@ -54,7 +54,8 @@ if TYPE_CHECKING:
     from .widgets import PresetForm
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
-WATCH_SECONDS = 0.5  # how often the runs folder (and the open preset's file) is looked at: a run started anywhere is listed within this
+WATCH_SECONDS = 0.5  # how often the runs folder and the open preset's file are looked at: a run started anywhere
+#   is listed within this, another program's write to the preset said
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 

@@ -77,6 +77,13 @@ def save_folder(presets_dir: Path | None = None) -> Path:
     return Path(presets_dir) if presets_dir is not None else PROJECT_PRESETS_DIR
 
 
+def made_when_saved(folder: Path, save_to: Path) -> bool:
+    """Whether ``folder`` is a presets folder made when first saved into: ``save_to`` (where new
+    presets go) or the user folder (offered for a preset that cannot be written where it is)."""
+    return any(Path(folder).expanduser().resolve() == Path(made).expanduser().resolve()
+               for made in (save_to, user_presets_dir()))  # fmt: skip
+
+
 def new_preset_path(name: str, folder: Path) -> Path:
     return Path(folder) / f"{name}.yaml"
 

@@ -9,7 +9,7 @@ import copy
 from pathlib import Path
 
 from ..errors import shown
-from .folders import file_stamp, is_builtin, new_preset_path, save_preset, user_presets_dir
+from .folders import file_stamp, is_builtin, made_when_saved, new_preset_path, save_preset, user_presets_dir
 from .running import NO_PRESET
 from .screens import ConfirmScreen, PathScreen
 from .widgets.presets import PresetsPane
@@ -60,8 +60,9 @@ class PresetSaving:
             self.say(f"{shown(self.draft_path)} was removed from disk: Ctrl+S writes the form's preset there again.",
                      "warning", until_open=True)  # fmt: skip
         else:
-            self.say(f"{shown(self.draft_path)} was changed on disk (by another program or TUI): Ctrl+S asks before "
-                     "replacing it; Enter on it in Presets (F2) opens it as it is now.", "warning", until_open=True)  # fmt: skip
+            self.say(f"{shown(self.draft_path)} was changed on disk (by another program or TUI): Ctrl+S asks "
+                     "before replacing it; Enter on it in Presets (F2) opens it as it is now.", "warning",
+                     until_open=True)  # fmt: skip
 
     def action_save_as(self) -> None:
         if self.draft_path is None or self._draft() is None:
@@ -95,13 +96,11 @@ class PresetSaving:
 
     def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
         try:
-            if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
-                path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
+            if not path.parent.exists() and made_when_saved(path.parent, self.save_folder):
+                path.parent.mkdir(parents=True)  # a presets folder, made when first saved into
             save_preset(path, data, template=template)
         except OSError as exc:  # a read-only folder, not the user's, a file in the way
-            elsewhere = user_presets_dir() / path.name
-            self.say(f"{shown(path)} cannot be written ({exc.strerror or exc}): Ctrl+O saves it elsewhere, "
-                     f"e.g. {shown(elsewhere)}", "error", title="Not saved")  # fmt: skip
+            self._ask_elsewhere(path, exc, lambda there: self._write(there, data, then_open, template))
             return
         self.say(f"Saved {path}")
         self.reload_presets()
@@ -114,6 +113,17 @@ class PresetSaving:
             self.modified = False
             self._saved = copy.deepcopy(data)
             self._show_edit_state()
+
+    def _ask_elsewhere(self, path: Path, exc: OSError, write_there) -> None:
+        """Say why ``path`` cannot be written and ask at once for another file, in the user folder
+        by default (made when first saved into); ``write_there`` writes the one given. (Ctrl+O,
+        once advised, saved the open preset, never a duplicate's copy, and offered ``path`` again.)"""
+        reason = exc.strerror or str(exc)
+        elsewhere = user_presets_dir() / path.name
+        self.say(f"{shown(path)} cannot be written ({reason}): give another file, e.g. in your own presets "
+                 f"folder, {shown(elsewhere.parent)}; Esc leaves it unsaved", "error", title="Not saved")  # fmt: skip
+        title = f"{path.name} cannot be written there ({reason}): save it as"
+        self.push_screen(PathScreen(title, elsewhere, self.save_folder), lambda there: there is not None and write_there(there))
 
 
 def changed_question(path: Path) -> str:

@@ -38,3 +38,54 @@ async def test_ctrl_s_asks_before_it_replaces_a_preset_file_another_program_chan
         await press_settled(pilot, "ctrl+s")  # its own write since: saved without a question
         assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"] == 8
         assert status_text(app) == "Saved presets/tiny.yaml"
+
+
+@pytest.fixture
+def read_only_presets(folders, monkeypatch):
+    """presets/ refuses every write, as a read-only folder does (the tests may run as root, whom
+    a mode does not stop); the user folder, mine/, is not there yet."""
+    import frictionlab.tui.saving
+    from frictionlab.tui.folders import save_preset
+
+    def refused(path, data, template=None):
+        if path.resolve().parent == (folders / "presets").resolve():
+            raise OSError(30, "Read-only file system")
+        save_preset(path, data, template)
+
+    monkeypatch.setattr(frictionlab.tui.saving, "save_preset", refused)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    return folders / "mine"
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_cannot_be_saved_where_it_is_is_offered_the_user_folder(read_only_presets, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--realizations", "7")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")
+        assert status_text(app) == (
+            "Not saved: presets/tiny.yaml cannot be written (Read-only file system): give another file, e.g. in "
+            f"your own presets folder, {read_only_presets}; Esc leaves it unsaved"
+        )
+        assert app.screen.title_text == "tiny.yaml cannot be written there (Read-only file system): save it as"
+        await press_settled(pilot, "enter")  # the user folder, made as it is first saved into
+        assert "does not exist" not in screen_text(app)
+        assert yaml.safe_load((read_only_presets / "tiny.yaml").read_text())["realizations"] == 7
+        assert app.draft_path == read_only_presets / "tiny.yaml" and not app.modified
+
+
+@pytest.mark.long
+@sync
+async def test_a_duplicate_that_cannot_be_written_is_asked_another_file_not_sent_to_ctrl_o(read_only_presets, registry):
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "d")
+        await press_settled(pilot, "enter")  # presets/tiny-copy.yaml: refused
+        assert app.screen.title_text.startswith("tiny-copy.yaml cannot be written there")
+        assert "Ctrl+O" not in status_text(app)  # with no preset open, Ctrl+O said only that
+        await press_settled(pilot, "enter")
+        await wait_until(pilot, lambda: app.draft_path == read_only_presets / "tiny-copy.yaml")
+    copied = yaml.safe_load((read_only_presets / "tiny-copy.yaml").read_text())
+    assert copied == merge(TINY, {"name": f"{TINY['name']}-copy"})
