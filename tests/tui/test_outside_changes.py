@@ -1,11 +1,20 @@
 """What happens around the TUI while it is open: its preset's file written by another program (an
 editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
 
+import shutil
+
 import pytest
 import yaml
+from textual.widgets import Static
+
+from frictionlab.options import RunOptions
+from frictionlab.runs.sweep import load_sweep, run_sweep
+from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
-from .conftest import TINY, make_app, press_settled, screen_text, started, status_text, sync, type_into, wait_until
+from .conftest import (
+    SWEEP, TINY, make_app, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+)
 
 
 def _seed_written_by_another(folders, seed=41):
@@ -89,3 +98,43 @@ async def test_a_duplicate_that_cannot_be_written_is_asked_another_file_not_sent
         await wait_until(pilot, lambda: app.draft_path == read_only_presets / "tiny-copy.yaml")
     copied = yaml.safe_load((read_only_presets / "tiny-copy.yaml").read_text())
     assert copied == merge(TINY, {"name": f"{TINY['name']}-copy"})
+
+
+@pytest.mark.long
+@sync
+async def test_a_plotted_run_whose_folder_is_removed_is_taken_off_the_plot_and_said(folders, registry):
+    app = runs_app(folders, registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter", "down", "space")  # both runs plotted
+        pane = app.query_one(ResultsPane)
+        assert len(app.query_one("#results-chart").series) == 4  # each run's curve and fit
+        removed = pane.overlay[0].path
+        shutil.rmtree(removed)
+        await wait_until(pilot, lambda: len(pane.runs) == 1)  # the list follows the folder
+        await pilot.pause()
+        info = " ".join(str(app.query_one("#results-info", Static).render()).split())
+        assert [entry.path for entry in pane.overlay] == [pane.runs[0].path]
+        assert len(app.query_one("#results-chart").series) == 2
+        assert info.startswith(f"Removed from disk since opened: {removed.name}. ■ {pane.runs[0].path.name}")
+        shutil.rmtree(pane.runs[0].path)
+        await wait_until(pilot, lambda: not pane.runs)
+        await pilot.pause()
+        assert not pane.overlay and "run removed" in screen_text(app)
+
+
+@pytest.mark.long
+@sync
+async def test_an_open_sweep_whose_folder_is_removed_leaves_its_table_of_points(folders, registry):
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 2}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter")  # its points listed, the focus on them
+        pane = app.query_one(ResultsPane)
+        assert pane.open_sweep is not None and app.query_one("#results-sweep").has_focus
+        shutil.rmtree(folders / "runs" / "sw")
+        await wait_until(pilot, lambda: not pane.runs)
+        await pilot.pause()
+        assert pane.open_sweep is None and app.query_one("#results-sweep").row_count == 0
+        assert app.query_one("#runs-table").has_focus  # Enter on a point no longer there: nothing left to press
+        assert "Removed from disk since opened: sw." in str(app.query_one("#results-info", Static).render())
