@@ -13,6 +13,7 @@ other panes, a run to follow): a run's modules are imported only once they are u
 from __future__ import annotations
 
 import copy
+import os
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -401,6 +402,9 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
 
     def reload_runs(self) -> None:
         self.query_one("ResultsPane").reload(self.runs_dir)
+        if self.last_resumable and not os.path.lexists(self.last_out_dir):  # removed: u leaves the Run tab's footer
+            self.last_resumable = False
+            self.refresh_bindings()
         self._runs_read_at = time.monotonic()
         self._runs_seen = self._runs_signature()
 

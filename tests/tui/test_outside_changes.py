@@ -13,7 +13,7 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SWEEP, TINY, make_app, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+    SWEEP, TINY, long_run_going, make_app, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
 )
 
 
@@ -138,3 +138,20 @@ async def test_an_open_sweep_whose_folder_is_removed_leaves_its_table_of_points(
         assert pane.open_sweep is None and app.query_one("#results-sweep").row_count == 0
         assert app.query_one("#runs-table").has_focus  # Enter on a point no longer there: nothing left to press
         assert "Removed from disk since opened: sw." in str(app.query_one("#results-info", Static).render())
+
+
+@pytest.mark.long
+@sync
+async def test_u_on_the_run_tab_after_the_runs_folder_was_removed_says_so(folders, registry):
+    app = make_app(registry)
+    with long_run_going(folders, registry) as (process, out):
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: app.followed is not None)  # shown live on the Run tab
+            process.terminate()  # interrupted: u resumes it
+            await wait_until(pilot, lambda: app.followed is None and app.last_resumable)
+            shutil.rmtree(out)
+            await wait_until(pilot, lambda: not app.last_resumable)  # the footer's u goes with the folder
+            await press_settled(pilot, "u")
+            said = status_text(app)
+            assert not out.exists()  # nothing made again in its place
+    assert said == "runs/long was removed from disk: nothing is left to resume; Ctrl+R runs the preset again."
