@@ -13,7 +13,7 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SWEEP, TINY, long_run_going, make_app, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+    SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
 )
 
 
@@ -155,3 +155,24 @@ async def test_u_on_the_run_tab_after_the_runs_folder_was_removed_says_so(folder
             said = status_text(app)
             assert not out.exists()  # nothing made again in its place
     assert said == "runs/long was removed from disk: nothing is left to resume; Ctrl+R runs the preset again."
+
+
+@pytest.mark.long
+@sync
+async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chunks(folders, registry):
+    """Its folder removed by hand while it runs: the run writes on into the progress file it has
+    open and its chunks into the folder made again; the Run tab froze at the count last read."""
+    app = make_app(registry)
+    with long_run_going(folders, registry) as (process, out):
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done > 0)
+            (out / "progress.jsonl").unlink()
+            await wait_until(pilot, lambda: "was removed while the run goes on" in status_text(app))
+            assert "the count comes from the run's chunks" in status_text(app)
+            counts = []
+            for _ in range(2):  # the count moves on, read from the chunks
+                await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+                counts.append(numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0])
+                await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
+            process.terminate()
+            await wait_until(pilot, lambda: app.followed is None)
