@@ -9,9 +9,11 @@ folders, found by their ``sweep.json``.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -166,6 +168,8 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
     from ..io.files import atomic_write
     from .roundtrip import dump_preserving
 
+    if _read_only(path):  # renaming over it would replace it, made writable, as no editor does unasked
+        raise PermissionError(errno.EACCES, "the file is read-only", str(path))
     text = None
     if template is not None:
         try:
@@ -185,6 +189,15 @@ def file_stamp(path: Path) -> tuple[int, int, int] | None:
     except OSError:
         return None
     return stat.st_ino, stat.st_size, stat.st_mtime_ns
+
+
+def _read_only(path: Path) -> bool:
+    """Whether ``path`` is a file no one may write (mode 444: kept from changes on purpose)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return False
+    return stat.S_ISREG(mode) and not mode & 0o222
 
 
 # ------------------------------------------------------------------ past runs

@@ -176,3 +176,21 @@ async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chun
                 await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
             process.terminate()
             await wait_until(pilot, lambda: app.followed is None)
+
+
+@pytest.mark.long
+@sync
+async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, registry, monkeypatch):
+    """Renaming the new text over it replaced a file made read-only (mode 444), made writable."""
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    path = folders / "presets" / "tiny.yaml"
+    before = path.read_text()
+    path.chmod(0o444)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--realizations", "7")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")
+        assert status_text(app).startswith("Not saved: presets/tiny.yaml cannot be written (the file is read-only)")
+        assert app.screen.title_text == "tiny.yaml cannot be written there (the file is read-only): save it as"
+    assert path.read_text() == before and path.stat().st_mode & 0o777 == 0o444
