@@ -178,7 +178,16 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
             text = None
     if text is None:
         text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-    atomic_write(Path(path), lambda fh: fh.write(text))
+    atomic_write(Path(path), lambda fh: fh.write(text), mode=_own_mode(path))
+
+
+def _own_mode(path: Path) -> int | None:
+    """The permissions of the regular file at ``path`` (kept when it is rewritten), None if there is none."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return None
+    return stat.S_IMODE(mode) if stat.S_ISREG(mode) else None
 
 
 def file_stamp(path: Path) -> tuple[int, int, int] | None:
@@ -193,11 +202,8 @@ def file_stamp(path: Path) -> tuple[int, int, int] | None:
 
 def _read_only(path: Path) -> bool:
     """Whether ``path`` is a file no one may write (mode 444: kept from changes on purpose)."""
-    try:
-        mode = os.lstat(path).st_mode
-    except OSError:
-        return False
-    return stat.S_ISREG(mode) and not mode & 0o222
+    mode = _own_mode(path)
+    return mode is not None and not mode & 0o222
 
 
 # ------------------------------------------------------------------ past runs
