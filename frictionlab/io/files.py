@@ -38,9 +38,12 @@ _UMASK = _read_umask()
 FIFO_READER_WAIT_S = 2.0  # how long a FIFO named as an output may go without a reader before it is refused
 
 
-def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = False, *, devices: bool = False) -> None:
+def atomic_write(
+    path: Path, write: Callable[[io.IOBase], None], binary: bool = False, *, devices: bool = False, mode: int | None = None
+) -> None:
     """Write via ``write(file)`` to a temporary sibling, fsync, then rename over ``path``.
-    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600.
+    The file gets the usual permissions (0666 less the umask), not mkstemp's 0600, or ``mode``
+    (a file rewritten keeps its own: one kept private stays so).
 
     Nothing is ever written through a symbolic link: a link at ``path`` is replaced by
     the new file, and the file it pointed at is left as it was (a run folder, or a
@@ -64,7 +67,7 @@ def atomic_write(path: Path, write: Callable[[io.IOBase], None], binary: bool = 
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        os.fchmod(fd, 0o666 & ~_UMASK)
+        os.fchmod(fd, 0o666 & ~_UMASK if mode is None else mode)
         with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
             write(fh)
             fh.flush()

@@ -13,6 +13,7 @@ other panes, a run to follow): a run's modules are imported only once they are u
 from __future__ import annotations
 
 import copy
+import os
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -31,21 +32,19 @@ from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
     copy_name,
-    is_builtin,
-    new_preset_path,
+    file_stamp,
     preset_folders,
     preset_from_template,
     runs_signature,
     save_folder,
-    save_preset,
     templates,
-    user_presets_dir,
 )
 from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
 from .tabs import TabSwitching
 from .running import NO_PRESET, RunControl
+from .saving import PresetSaving
 from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
 from .text import problems_text
 from .widgets.footer import KeysFooter
@@ -56,11 +55,12 @@ if TYPE_CHECKING:
     from .widgets import PresetForm
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
-WATCH_SECONDS = 0.5  # how often the runs folder is looked at: a run started anywhere is listed within this
+WATCH_SECONDS = 0.5  # how often the runs folder and the open preset's file are looked at: a run started anywhere
+#   is listed within this, another program's write to the preset said
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
-class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App):
+class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, PresetSaving, App):
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
@@ -107,6 +107,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
         self.draft_source: Path | None = None  # the file the draft was read from: its comments are kept
         self.modified = False
         self._saved: dict | None = None  # the draft as its file holds it (None: not saved yet)
+        self.disk_stamp: tuple | None = None  # the draft's file as read or written here (folders.file_stamp)
+        self.said_stamp: tuple | None = None  # the file's change the status line said last
         self.problems: list[str] = []
         self.blocked_by: str | None = None  # why the status line says Ctrl+R refused ("" once taken back)
         self.said_valid = False  # the status line says the preset is valid (taken back on a new problem)
@@ -173,6 +175,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
         self._show_edit_state()
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
         self.set_interval(WATCH_SECONDS, self._watch_runs)
+        self.set_interval(WATCH_SECONDS, self._watch_preset_file)
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -286,14 +289,15 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
 
     async def open_preset(self, path: Path, data: dict | None = None, *, modified: bool = False) -> None:
         if data is None:
+            stamp = file_stamp(path)  # before reading it: a write meanwhile is seen as a change, never missed
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
                 self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}", about=path)
                 return
-            self.draft_source = path
+            self.draft_source, self.disk_stamp = path, stamp
         else:
-            self.draft_source = None
+            self.draft_source, self.disk_stamp = None, None
         self.draft_path = path
         await self.query_one("#form").load(data, base_dir=path.parent)
         if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one
@@ -394,81 +398,13 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, App
     def _draft(self) -> dict | None:
         return self.query_one("#form").data
 
-    def action_save(self) -> None:
-        if self.draft_path is None or self._draft() is None:
-            self.say(NO_PRESET, "warning")
-            return
-        if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
-            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning", until_open=True)
-            self.push_screen(
-                PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
-                lambda path: path is not None and self._save_checked(path),
-            )
-            return
-        if self.draft_source != self.draft_path and self.draft_path.exists():
-            # a new preset whose file appeared since the New dialog: replaced only if the user says so
-            self.push_screen(
-                PathScreen(f"{self.draft_path} exists now: save the new preset as", self.draft_path, self.save_folder),
-                lambda path: path is not None and self._save_checked(path),
-            )
-            return
-        self._save_checked(self.draft_path)
-
-    def action_save_as(self) -> None:
-        if self.draft_path is None or self._draft() is None:
-            self.say(NO_PRESET, "warning")
-            return
-        self.push_screen(
-            PathScreen("Save preset as", self._save_as_default(), self.save_folder),
-            lambda path: path is not None and self._save_checked(path),
-        )
-
-    def _save_as_default(self) -> Path:
-        """The file Save as offers: the preset's own, or for a built-in one (never written) its copy's."""
-        if is_builtin(self.draft_path):
-            return new_preset_path(self.draft_path.stem, self.save_folder)
-        return self.draft_path
-
-    def _save_checked(self, path: Path) -> None:
-        data = self._draft()
-        if not self.problems:
-            self._write(path, data, template=self.draft_source)
-            return
-        count = len(self.problems)
-        question = (
-            f"This preset has {count} problem{'s' if count != 1 else ''}; frictionlab run will refuse it:\n"
-            + "\n".join(self.problems[:6])
-            + "\n\nSave it anyway?"
-        )
-        self.push_screen(
-            ConfirmScreen(question), lambda yes: yes and self._write(path, data, template=self.draft_source)
-        )
-
-    def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
-        try:
-            if not path.parent.exists() and path.parent.resolve() == self.save_folder.resolve():
-                path.parent.mkdir(parents=True)  # the presets folder, made when first saved into
-            save_preset(path, data, template=template)
-        except OSError as exc:  # a read-only folder, not the user's, a file in the way
-            elsewhere = user_presets_dir() / path.name
-            self.say(f"{shown(path)} cannot be written ({exc.strerror or exc}): Ctrl+O saves it elsewhere, "
-                     f"e.g. {shown(elsewhere)}", "error", title="Not saved")  # fmt: skip
-            return
-        self.say(f"Saved {path}")
-        self.reload_presets()
-        self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
-        if then_open:
-            self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
-        else:
-            self.draft_path = self.draft_source = path
-            self.modified = False
-            self._saved = copy.deepcopy(data)
-            self._show_edit_state()
-
     # ------------------------------------------------------------ results
 
     def reload_runs(self) -> None:
         self.query_one("ResultsPane").reload(self.runs_dir)
+        if self.last_resumable and not os.path.lexists(self.last_out_dir):  # removed: u leaves the Run tab's footer
+            self.last_resumable = False
+            self.refresh_bindings()
         self._runs_read_at = time.monotonic()
         self._runs_seen = self._runs_signature()
 

@@ -9,9 +9,11 @@ folders, found by their ``sweep.json``.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -75,6 +77,13 @@ def save_folder(presets_dir: Path | None = None) -> Path:
     otherwise: the folder given with ``--presets``, else ``./presets`` (made when
     first saved into). Both are listed, so a saved preset is in the list at once."""
     return Path(presets_dir) if presets_dir is not None else PROJECT_PRESETS_DIR
+
+
+def made_when_saved(folder: Path, save_to: Path) -> bool:
+    """Whether ``folder`` is a presets folder made when first saved into: ``save_to`` (where new
+    presets go) or the user folder (offered for a preset that cannot be written where it is)."""
+    return any(Path(folder).expanduser().resolve() == Path(made).expanduser().resolve()
+               for made in (save_to, user_presets_dir()))  # fmt: skip
 
 
 def new_preset_path(name: str, folder: Path) -> Path:
@@ -159,6 +168,8 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
     from ..io.files import atomic_write
     from .roundtrip import dump_preserving
 
+    if _read_only(path):  # renaming over it would replace it, made writable, as no editor does unasked
+        raise PermissionError(errno.EACCES, "the file is read-only", str(path))
     text = None
     if template is not None:
         try:
@@ -167,7 +178,32 @@ def save_preset(path: Path, data: dict, template: Path | None = None) -> None:
             text = None
     if text is None:
         text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-    atomic_write(Path(path), lambda fh: fh.write(text))
+    atomic_write(Path(path), lambda fh: fh.write(text), mode=_own_mode(path))
+
+
+def _own_mode(path: Path) -> int | None:
+    """The permissions of the regular file at ``path`` (kept when it is rewritten), None if there is none."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return None
+    return stat.S_IMODE(mode) if stat.S_ISREG(mode) else None
+
+
+def file_stamp(path: Path) -> tuple[int, int, int] | None:
+    """What changes when a file is written or replaced (its inode, size and time of change), None
+    where it is not there: another program's (an editor's, another TUI's) write is seen by it."""
+    try:
+        stat = os.stat(path)
+    except OSError:
+        return None
+    return stat.st_ino, stat.st_size, stat.st_mtime_ns
+
+
+def _read_only(path: Path) -> bool:
+    """Whether ``path`` is a file no one may write (mode 444: kept from changes on purpose)."""
+    mode = _own_mode(path)
+    return mode is not None and not mode & 0o222
 
 
 # ------------------------------------------------------------------ past runs

@@ -65,8 +65,8 @@ class FollowedRun:
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:
         the elapsed time moves); True once its process has ended."""
-        if not self.follower.poll() and self.live is not None:
-            self.live.tick()
+        if not self.follower.poll() and self.live is not None and self.progress_problem() is None:
+            self.live.tick()  # the elapsed time moves (not over the count read from the chunks instead)
         if self.process is not None:
             over = self.process.poll() is not None  # also reaps it: no zombie reads as alive
         else:
@@ -76,14 +76,16 @@ class FollowedRun:
         return over
 
     def progress_problem(self) -> str | None:
-        """Why the run cannot write (nor this TUI read) its progress file: it is a link or
-        not a regular file, which is never written or read through; None if it is fine
-        or not there yet."""
+        """Why this TUI cannot read what the run writes to its progress file: it is a link or not
+        a regular file, which is never written or read through, or it was removed once read (its
+        folder removed by hand: the run writes on into the file it has open, its chunks into the
+        folder made again); None if it is fine or not there yet."""
         path = self.folder / PROGRESS_FILE
         try:
             mode = os.lstat(path).st_mode
-        except OSError:
-            return None
+        except OSError:  # the progress froze at what was read, the time left growing, without a word
+            read = self.follower.reader.offset > 0
+            return f"{PROGRESS_FILE} in {shown(self.folder)} was removed while the run goes on" if read else None
         if stat.S_ISREG(mode):
             return None
         what = "a symbolic link" if stat.S_ISLNK(mode) else "not a regular file"
@@ -132,6 +134,9 @@ class FollowedSweep(FollowedRun):
                                       pid=process.pid if process is not None else None)  # fmt: skip
         self.cancelling = False
         self.refusal: str | None = None
+
+    def progress_problem(self) -> str | None:
+        return None  # a sweep's count is its points', never read from chunks: its live tick goes on
 
     def _listeners_of(self, point) -> list[object]:
         self.live = LiveListener(self._post)

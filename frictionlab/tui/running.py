@@ -91,6 +91,12 @@ class RunControl:
         if folder is None:
             self.say("No run to resume: F5 lists the runs (u there resumes the highlighted one).", "warning")
             return
+        if not os.path.lexists(folder):  # removed since it ended (it was said to be 'not a run folder, or a link')
+            self.last_resumable = self.last_resumable and folder != self.last_out_dir
+            self.refresh_bindings()  # u leaves the Run tab's footer
+            self.say(f"{shown(folder)} was removed from disk: nothing is left to resume; Ctrl+R runs the preset "
+                     "again.", "warning", about=folder)  # fmt: skip
+            return
         from ..runs.detached import run_state
 
         try:

@@ -1,6 +1,8 @@
 """Saving presets: comments, key order and spelling kept (``folders.save_preset``)."""
 
 
+import os
+
 import yaml
 
 from frictionlab.io.safe_yaml import load_yaml
@@ -111,3 +113,17 @@ def test_a_file_that_is_no_mapping_is_listed_as_unreadable_and_offered_as_no_tem
     assert entries["list.yaml"].error.startswith("cannot be read: a preset must be a mapping")
     assert entries["empty.yaml"].error.startswith("cannot be read: a preset must be a mapping")
     assert not entries["fine.yaml"].error and offered == {"fine.yaml"}
+
+
+def test_a_preset_saved_again_keeps_its_files_permissions(tmp_path):
+    """A preset kept private (0600) or shared with a group (0640) was made 0644 (0666 less the umask) by a save."""
+    for mode in (0o600, 0o640):
+        path = tmp_path / f"p{mode:o}.yaml"
+        path.write_text(COMMENTED)
+        path.chmod(mode)
+        save_preset(path, {**yaml.safe_load(COMMENTED), "seed": 3}, template=path)
+        assert (path.stat().st_mode & 0o777, yaml.safe_load(path.read_text())["seed"]) == (mode, 3)
+    save_preset(tmp_path / "new.yaml", {"name": "new"})  # a new file: the usual permissions
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (tmp_path / "new.yaml").stat().st_mode & 0o777 == 0o666 & ~umask

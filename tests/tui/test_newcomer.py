@@ -344,24 +344,6 @@ async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, regist
     assert "0.9]}}}" in screen or "0.9]" in screen  # the sweep row's values, whole (they were cut)
 
 
-@pytest.mark.long
-@sync
-async def test_a_preset_that_cannot_be_saved_where_it_is_says_where_it_can(folders, registry, monkeypatch):
-    import frictionlab.tui.app
-
-    def refused(path, data, template=None):
-        raise PermissionError(13, "Permission denied")
-
-    monkeypatch.setattr(frictionlab.tui.app, "save_preset", refused)
-    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
-    app = make_app(registry, preset="presets/tiny.yaml")
-    async with started(app) as pilot:
-        await press_settled(pilot, "ctrl+s")
-        said = status_text(app)
-    assert said == (f"Not saved: presets/tiny.yaml cannot be written (Permission denied): Ctrl+O saves it "
-                    f"elsewhere, e.g. {folders / 'mine' / 'tiny.yaml'}")  # fmt: skip
-
-
 def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_no_rate():
     from frictionlab.compute.fit import LogFit
     from frictionlab.plugin.listeners import progress_text

@@ -15,7 +15,7 @@ from textual.widgets import Button, Footer, Input, Label, Select, Static
 
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
-from ..folders import is_builtin, new_preset_path
+from ..folders import is_builtin, made_when_saved, new_preset_path
 from ..widgets.keyinput import KeyInput
 
 
@@ -133,7 +133,7 @@ class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
 
 def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | None, str]:
     """The path a user typed for a preset (``.yaml`` added), or why it cannot be one;
-    ``folder`` (the presets folder, made when first saved into) need not exist yet."""
+    ``folder`` (the presets folder) and the user folder, made when first saved into, need not exist yet."""
     text = text.strip()
     if not text:
         return None, "path: must not be empty"
@@ -144,7 +144,7 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
         path = path.with_name(path.name + ".yaml")
     if path.is_dir():
         return None, f"path: {path} is a folder; give a file name"
-    if not path.parent.is_dir() and not (folder is not None and _same(path.parent, Path(folder))):
+    if not path.parent.is_dir() and not (folder is not None and made_when_saved(path.parent, folder)):
         return None, f"path: the folder {path.parent} does not exist"
     if is_builtin(path):  # shipped with frictionlab: read and copied, never replaced
         return None, f"path: {path} is a built-in preset, never written; give a file of your own"
@@ -155,10 +155,6 @@ def show_error(line: Static, text: str) -> None:
     """A dialog's error line (hidden, as the form's are, until it has something to say)."""
     line.update(Content(text))
     line.display = bool(text)
-
-
-def _same(a: Path, b: Path) -> bool:
-    return a.expanduser().resolve() == b.expanduser().resolve()
 
 
 class PathScreen(Dialog, ModalScreen[Path | None]):

@@ -4,6 +4,7 @@ an open sweep's table of points below them (Enter on a point opens its run)."""
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ from textual.widgets import DataTable, Static
 from ...errors import FrictionlabError, shown
 from ...compute.fit import format_interval
 from ...runs.detached import RESUMABLE
-from ..chart import Series
+from ..chart import NO_DATA, Series
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
@@ -155,6 +156,23 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
     def reload(self, runs_dir: Path) -> None:
         self.runs = list_runs(runs_dir)
         self._fill()
+        self._drop_removed()
+
+    def _drop_removed(self) -> None:
+        """A plotted run or the open sweep whose folder was removed (by hand, another program) is
+        taken off the plot or the table, and said in the box under the plot: they were drawn on as
+        if still there."""
+        gone = [entry for entry in self.overlay if not os.path.lexists(entry.path)]
+        sweep_gone = self.open_sweep is not None and not os.path.lexists(self.open_sweep.path)
+        if not gone and not sweep_gone:
+            return
+        removed = [entry.path.name for entry in gone] + ([self.open_sweep.path.name] if sweep_gone else [])
+        if sweep_gone:
+            if self.query_one("#results-sweep").has_focus:
+                self.query_one("#runs-table").focus()
+            self._close_sweep()
+        self.overlay = [entry for entry in self.overlay if entry not in gone]
+        self._show_overlay(note=f"Removed from disk since opened: {', '.join(map(shown, removed))}.")
 
     def _fill(self) -> None:
         """The list of runs, each name shortened from the middle to the width the list has."""
@@ -261,9 +279,10 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         )
         table.focus()
 
-    def _show_overlay(self) -> None:
+    def _show_overlay(self, note: str = "") -> None:
+        """The overlay's runs drawn, and their lines in the box under the plot (after ``note``)."""
         self._info_about = None
-        series, lines = [], []
+        series, lines = [], [Content(note)] if note else []
         for style, entry in zip(OVERLAY_STYLES, self.overlay):
             try:
                 curve = read_curve(entry.path)
@@ -275,7 +294,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             if math.isfinite(entry.a):
                 series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
             lines += _entry_lines(entry, style)
-        self.query_one("#results-chart", Chart).show(series)
+        self.query_one("#results-chart", Chart).show(series, empty="run removed" if note else NO_DATA)
         self._inform(Content("\n").join(lines) if lines else HINT)
 
     def _inform(self, text: Content | str) -> None:

@@ -1,0 +1,132 @@
+"""Saving the open preset (``FrictionlabApp``'s, a mixin): Ctrl+S, Ctrl+O, and the file of a
+duplicate; a built-in preset is saved as a copy, a file that cannot be written is said, and
+one that another program (an editor, another TUI) wrote since it was opened is replaced only
+once the user says so."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+from ..errors import shown
+from .folders import file_stamp, is_builtin, made_when_saved, new_preset_path, save_preset, user_presets_dir
+from .running import NO_PRESET
+from .screens import ConfirmScreen, PathScreen
+from .widgets.presets import PresetsPane
+
+
+class PresetSaving:
+    """Ctrl+S and Ctrl+O on the draft, and writing a preset file (``FrictionlabApp``'s)."""
+
+    def action_save(self) -> None:
+        if self.draft_path is None or self._draft() is None:
+            self.say(NO_PRESET, "warning")
+            return
+        if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
+            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning", until_open=True)
+            self.push_screen(
+                PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
+                lambda path: path is not None and self._save_checked(path),
+            )
+            return
+        if self.draft_source != self.draft_path and self.draft_path.exists():
+            # a new preset whose file appeared since the New dialog: replaced only if the user says so
+            self.push_screen(
+                PathScreen(f"{self.draft_path} exists now: save the new preset as", self.draft_path, self.save_folder),
+                lambda path: path is not None and self._save_checked(path),
+            )
+            return
+        if self._changed_on_disk():
+            self.push_screen(ConfirmScreen(changed_question(self.draft_path)),
+                             lambda yes: yes and self._save_checked(self.draft_path))  # fmt: skip
+            return
+        self._save_checked(self.draft_path)
+
+    def _changed_on_disk(self) -> bool:
+        """Whether the open preset's file is there and not as it was read or last saved here."""
+        if self.disk_stamp is None or self.draft_source != self.draft_path:
+            return False
+        return file_stamp(self.draft_path) not in (None, self.disk_stamp)
+
+    def _watch_preset_file(self) -> None:
+        """Say once, as it happens, that the open preset's file was changed or removed on disk."""
+        if self.disk_stamp is None or self.draft_source != self.draft_path:
+            return
+        now = file_stamp(self.draft_path)
+        if now in (self.disk_stamp, self.said_stamp):
+            return
+        self.said_stamp = now
+        if now is None:
+            self.say(f"{shown(self.draft_path)} was removed from disk: Ctrl+S writes the form's preset there again.",
+                     "warning", until_open=True)  # fmt: skip
+        else:
+            self.say(f"{shown(self.draft_path)} was changed on disk (by another program or TUI): Ctrl+S asks "
+                     "before replacing it; Enter on it in Presets (F2) opens it as it is now.", "warning",
+                     until_open=True)  # fmt: skip
+
+    def action_save_as(self) -> None:
+        if self.draft_path is None or self._draft() is None:
+            self.say(NO_PRESET, "warning")
+            return
+        self.push_screen(
+            PathScreen("Save preset as", self._save_as_default(), self.save_folder),
+            lambda path: path is not None and self._save_checked(path),
+        )
+
+    def _save_as_default(self) -> Path:
+        """The file Save as offers: the preset's own, or for a built-in one (never written) its copy's."""
+        if is_builtin(self.draft_path):
+            return new_preset_path(self.draft_path.stem, self.save_folder)
+        return self.draft_path
+
+    def _save_checked(self, path: Path) -> None:
+        data = self._draft()
+        if not self.problems:
+            self._write(path, data, template=self.draft_source)
+            return
+        count = len(self.problems)
+        question = (
+            f"This preset has {count} problem{'s' if count != 1 else ''}; frictionlab run will refuse it:\n"
+            + "\n".join(self.problems[:6])
+            + "\n\nSave it anyway?"
+        )
+        self.push_screen(
+            ConfirmScreen(question), lambda yes: yes and self._write(path, data, template=self.draft_source)
+        )
+
+    def _write(self, path: Path, data: dict, then_open: bool = False, template: Path | None = None) -> None:
+        try:
+            if not path.parent.exists() and made_when_saved(path.parent, self.save_folder):
+                path.parent.mkdir(parents=True)  # a presets folder, made when first saved into
+            save_preset(path, data, template=template)
+        except OSError as exc:  # a read-only folder, not the user's, a file in the way
+            self._ask_elsewhere(path, exc, lambda there: self._write(there, data, then_open, template))
+            return
+        self.say(f"Saved {path}")
+        self.reload_presets()
+        self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
+        if then_open:
+            self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
+        else:
+            self.draft_path = self.draft_source = path
+            self.disk_stamp = file_stamp(path)
+            self.modified = False
+            self._saved = copy.deepcopy(data)
+            self._show_edit_state()
+
+    def _ask_elsewhere(self, path: Path, exc: OSError, write_there) -> None:
+        """Say why ``path`` cannot be written and ask at once for another file, in the user folder
+        by default (made when first saved into); ``write_there`` writes the one given. (Ctrl+O,
+        once advised, saved the open preset, never a duplicate's copy, and offered ``path`` again.)"""
+        reason = exc.strerror or str(exc)
+        elsewhere = user_presets_dir() / path.name
+        self.say(f"{shown(path)} cannot be written ({reason}): give another file, e.g. in your own presets "
+                 f"folder, {shown(elsewhere.parent)}; Esc leaves it unsaved", "error", title="Not saved")  # fmt: skip
+        title = f"{path.name} cannot be written there ({reason}): save it as"
+        self.push_screen(PathScreen(title, elsewhere, self.save_folder), lambda there: there is not None and write_there(there))
+
+
+def changed_question(path: Path) -> str:
+    return (f"{shown(path)} was changed on disk since it was opened here (by another program or TUI).\n"
+            "Replace it with the form's preset? What the other wrote is lost.\n\n"
+            "n keeps the file: Ctrl+O saves the form elsewhere; Enter on it in Presets opens it as it is now.")  # fmt: skip

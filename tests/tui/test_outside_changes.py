@@ -1,0 +1,196 @@
+"""What happens around the TUI while it is open: its preset's file written by another program (an
+editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
+
+import shutil
+
+import pytest
+import yaml
+from textual.widgets import Static
+
+from frictionlab.options import RunOptions
+from frictionlab.runs.sweep import load_sweep, run_sweep
+from frictionlab.tui.widgets import ResultsPane
+
+from ..conftest import merge
+from .conftest import (
+    SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+)
+
+
+def _seed_written_by_another(folders, seed=41):
+    """tiny.yaml as another program leaves it: its seed changed, a comment added."""
+    path = folders / "presets" / "tiny.yaml"
+    path.write_text("# edited elsewhere\n" + yaml.safe_dump(merge(TINY, {"seed": seed}), sort_keys=False))
+
+
+@pytest.mark.long
+@sync
+async def test_ctrl_s_asks_before_it_replaces_a_preset_file_another_program_changed(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        _seed_written_by_another(folders)
+        await wait_until(pilot, lambda: "changed on disk" in status_text(app))  # said as it happens
+        assert "Ctrl+S asks before replacing it" in status_text(app)
+        await type_into(pilot, "field--realizations", "7")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")
+        assert "was changed on disk since it was opened here" in screen_text(app)
+        await press_settled(pilot, "n")  # kept as the other program wrote it
+        assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == 41
+        assert app.modified
+        await press_settled(pilot, "ctrl+s")
+        await press_settled(pilot, "y")  # replaced, as asked
+        saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+        assert (saved["seed"], saved["realizations"]) == (TINY["seed"], 7) and not app.modified
+        await type_into(pilot, "field--realizations", "8")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")  # its own write since: saved without a question
+        assert yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"] == 8
+        assert status_text(app) == "Saved presets/tiny.yaml"
+
+
+@pytest.fixture
+def read_only_presets(folders, monkeypatch):
+    """presets/ refuses every write, as a read-only folder does (the tests may run as root, whom
+    a mode does not stop); the user folder, mine/, is not there yet."""
+    import frictionlab.tui.saving
+    from frictionlab.tui.folders import save_preset
+
+    def refused(path, data, template=None):
+        if path.resolve().parent == (folders / "presets").resolve():
+            raise OSError(30, "Read-only file system")
+        save_preset(path, data, template)
+
+    monkeypatch.setattr(frictionlab.tui.saving, "save_preset", refused)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    return folders / "mine"
+
+
+@pytest.mark.long
+@sync
+async def test_a_preset_that_cannot_be_saved_where_it_is_is_offered_the_user_folder(read_only_presets, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--realizations", "7")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")
+        assert status_text(app) == (
+            "Not saved: presets/tiny.yaml cannot be written (Read-only file system): give another file, e.g. in "
+            f"your own presets folder, {read_only_presets}; Esc leaves it unsaved"
+        )
+        assert app.screen.title_text == "tiny.yaml cannot be written there (Read-only file system): save it as"
+        await press_settled(pilot, "enter")  # the user folder, made as it is first saved into
+        assert "does not exist" not in screen_text(app)
+        assert yaml.safe_load((read_only_presets / "tiny.yaml").read_text())["realizations"] == 7
+        assert app.draft_path == read_only_presets / "tiny.yaml" and not app.modified
+
+
+@pytest.mark.long
+@sync
+async def test_a_duplicate_that_cannot_be_written_is_asked_another_file_not_sent_to_ctrl_o(read_only_presets, registry):
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "d")
+        await press_settled(pilot, "enter")  # presets/tiny-copy.yaml: refused
+        assert app.screen.title_text.startswith("tiny-copy.yaml cannot be written there")
+        assert "Ctrl+O" not in status_text(app)  # with no preset open, Ctrl+O said only that
+        await press_settled(pilot, "enter")
+        await wait_until(pilot, lambda: app.draft_path == read_only_presets / "tiny-copy.yaml")
+    copied = yaml.safe_load((read_only_presets / "tiny-copy.yaml").read_text())
+    assert copied == merge(TINY, {"name": f"{TINY['name']}-copy"})
+
+
+@pytest.mark.long
+@sync
+async def test_a_plotted_run_whose_folder_is_removed_is_taken_off_the_plot_and_said(folders, registry):
+    app = runs_app(folders, registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter", "down", "space")  # both runs plotted
+        pane = app.query_one(ResultsPane)
+        assert len(app.query_one("#results-chart").series) == 4  # each run's curve and fit
+        removed = pane.overlay[0].path
+        shutil.rmtree(removed)
+        await wait_until(pilot, lambda: len(pane.runs) == 1)  # the list follows the folder
+        await pilot.pause()
+        info = " ".join(str(app.query_one("#results-info", Static).render()).split())
+        assert [entry.path for entry in pane.overlay] == [pane.runs[0].path]
+        assert len(app.query_one("#results-chart").series) == 2
+        assert info.startswith(f"Removed from disk since opened: {removed.name}. ■ {pane.runs[0].path.name}")
+        shutil.rmtree(pane.runs[0].path)
+        await wait_until(pilot, lambda: not pane.runs)
+        await pilot.pause()
+        assert not pane.overlay and "run removed" in screen_text(app)
+
+
+@pytest.mark.long
+@sync
+async def test_an_open_sweep_whose_folder_is_removed_leaves_its_table_of_points(folders, registry):
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 2}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter")  # its points listed, the focus on them
+        pane = app.query_one(ResultsPane)
+        assert pane.open_sweep is not None and app.query_one("#results-sweep").has_focus
+        shutil.rmtree(folders / "runs" / "sw")
+        await wait_until(pilot, lambda: not pane.runs)
+        await pilot.pause()
+        assert pane.open_sweep is None and app.query_one("#results-sweep").row_count == 0
+        assert app.query_one("#runs-table").has_focus  # Enter on a point no longer there: nothing left to press
+        assert "Removed from disk since opened: sw." in str(app.query_one("#results-info", Static).render())
+
+
+@pytest.mark.long
+@sync
+async def test_u_on_the_run_tab_after_the_runs_folder_was_removed_says_so(folders, registry):
+    app = make_app(registry)
+    with long_run_going(folders, registry) as (process, out):
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: app.followed is not None)  # shown live on the Run tab
+            process.terminate()  # interrupted: u resumes it
+            await wait_until(pilot, lambda: app.followed is None and app.last_resumable)
+            shutil.rmtree(out)
+            await wait_until(pilot, lambda: not app.last_resumable)  # the footer's u goes with the folder
+            await press_settled(pilot, "u")
+            said = status_text(app)
+            assert not out.exists()  # nothing made again in its place
+    assert said == "runs/long was removed from disk: nothing is left to resume; Ctrl+R runs the preset again."
+
+
+@pytest.mark.long
+@sync
+async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chunks(folders, registry):
+    """Its folder removed by hand while it runs: the run writes on into the progress file it has
+    open and its chunks into the folder made again; the Run tab froze at the count last read."""
+    app = make_app(registry)
+    with long_run_going(folders, registry) as (process, out):
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done > 0)
+            (out / "progress.jsonl").unlink()
+            await wait_until(pilot, lambda: "was removed while the run goes on" in status_text(app))
+            assert "the count comes from the run's chunks" in status_text(app)
+            counts = []
+            for _ in range(2):  # the count moves on, read from the chunks
+                await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+                counts.append(numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0])
+                await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
+            process.terminate()
+            await wait_until(pilot, lambda: app.followed is None)
+
+
+@pytest.mark.long
+@sync
+async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, registry, monkeypatch):
+    """Renaming the new text over it replaced a file made read-only (mode 444), made writable."""
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))
+    path = folders / "presets" / "tiny.yaml"
+    before = path.read_text()
+    path.chmod(0o444)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--realizations", "7")
+        await pilot.press("escape")
+        await press_settled(pilot, "ctrl+s")
+        assert status_text(app).startswith("Not saved: presets/tiny.yaml cannot be written (the file is read-only)")
+        assert app.screen.title_text == "tiny.yaml cannot be written there (the file is read-only): save it as"
+    assert path.read_text() == before and path.stat().st_mode & 0o777 == 0o444
