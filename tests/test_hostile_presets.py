@@ -340,7 +340,11 @@ def test_a_set_value_with_an_exponent_is_checked_as_the_number_it_is(tmp_path, c
 
 @pytest.mark.parametrize(("assignment", "said"), [
     ("loading.start=1e-320", "loading.start: must be between 1e-100 and 1e+100, got 1e-320"),  # gt=0
-    ("realizations=1e400", "realizations: must be between 1e-100 and 1e+100, got '1e400'"),  # ge=1
+    # both bounds of its own (ge=1, le=10_000_000): those, not magnitudes that 1e99 would pass
+    ("realizations=1e400", "realizations: must be >= 1 and <= 10000000, got '1e400'"),
+    ("realizations=1.0e200", "realizations: must be >= 1 and <= 10000000, got 1e+200"),
+    ("spectrum.params.hurst=1e400", "hurst: must be >= 0.0 and <= 1.5, got '1e400'"),
+    ("spectrum.params.hurst=1e-400", "hurst: must be 0 or between 1e-100 and 1e+100 in magnitude"),  # 0 is within
     ("seed=1e400", "seed: must be 0 or between 1e-100 and 1e+100 in magnitude, got '1e400'"),  # ge=0
     ("solver.params.poisson_ratio=1e-200", "poisson_ratio: must be 0 or between 1e-100 and 1e+100 in magnitude"),
 ])  # fmt: skip

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import types
 import typing
+from dataclasses import dataclass
 
 from pydantic import BaseModel, ValidationError
 
@@ -206,8 +207,11 @@ def _sequence_kind(kinds: set):
     return next((kind for kind in kinds if typing.get_origin(kind) in (list, tuple)), None)
 
 
-def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number", positive: bool = False) -> str | None:
-    """``positive``: the field's own bounds refuse 0 (gt=0, ge=1), so the range said leaves it out."""
+def _number_problem(
+    value, path: str, allow_inf_nan: bool, what: str = "a number", positive: bool = False, own: Bounds | None = None
+) -> str | None:
+    """``positive``: the field's own bounds refuse 0 (gt=0, ge=1), so the range said leaves it out; ``own``:
+    its bounds, said instead of the magnitudes any number must keep where the number lies outside them."""
     allowed = "between 1e-100 and 1e+100" if positive else "0 or between 1e-100 and 1e+100 in magnitude"
     if isinstance(value, bool):
         return f"{path}: must be {what}, not true or false, got {str(value).lower()}"
@@ -217,13 +221,39 @@ def _number_problem(value, path: str, allow_inf_nan: bool, what: str = "a number
         except ValueError:
             return None  # not a number at all: pydantic says so
         if past_double_precision(value, number):  # 1e400, 1e-400: not infinity, not zero
-            return f"{path}: must be {allowed}, got {short_repr(value)}"
+            return f"{path}: must be {own.said if own and not own.holds(number) else allowed}, got {short_repr(value)}"
         value = number
     if isinstance(value, float) and not math.isfinite(value):
         return None if allow_inf_nan else f"{path}: must be a finite number, got {value!r}"
     if isinstance(value, int | float) and (abs(value) > MAX_MAGNITUDE or 0 < abs(value) < 1 / MAX_MAGNITUDE):
-        return f"{path}: must be {allowed}, got {short_repr(value)}"
+        return f"{path}: must be {own.said if own and not own.holds(value) else allowed}, got {short_repr(value)}"
     return None
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """A field's lower and upper bounds (pydantic's ge or gt, and le or lt)."""
+
+    low: float
+    low_strict: bool
+    high: float
+    high_strict: bool
+
+    @classmethod
+    def of(cls, field) -> Bounds | None:
+        """The field's bounds, when it has both, else None."""
+        said = {key: getattr(m, key) for m in field.metadata for key in ("ge", "gt", "le", "lt") if getattr(m, key, None) is not None}
+        if not ({"ge", "gt"} & said.keys() and {"le", "lt"} & said.keys()):
+            return None
+        return cls(said.get("ge", said.get("gt")), "ge" not in said, said.get("le", said.get("lt")), "le" not in said)
+
+    @property
+    def said(self) -> str:  # as pydantic's own refusal reads: >= 1 and <= 10000000
+        return f"{'>' if self.low_strict else '>='} {self.low} and {'<' if self.high_strict else '<='} {self.high}"
+
+    def holds(self, number: float) -> bool:
+        above = number > self.low if self.low_strict else number >= self.low
+        return above and (number < self.high if self.high_strict else number <= self.high)
 
 
 def _refuses_zero(field) -> bool:
@@ -253,7 +283,7 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
                 problems += number_problems(item, entry, f"{path}.{key}")
         elif kinds & {int, float} and bool not in kinds and not (str in kinds and isinstance(value, str)):
             problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number",
-                                      positive=_refuses_zero(field))  # fmt: skip
+                                      positive=_refuses_zero(field), own=Bounds.of(field))  # fmt: skip
             problems += [problem] if problem else []
         elif (sequence := _sequence_kind(kinds)) is not None and isinstance(value, list):
             items = set().union(*(_kinds(a) for a in typing.get_args(sequence) if a is not Ellipsis))
