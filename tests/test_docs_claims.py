@@ -123,3 +123,14 @@ def test_a_bare_pytest_leaves_out_exactly_the_long_and_slow_tests(tmp_path, monk
     assert all(marks for marks in collected["deselected"])  # and nothing else left out
     assert sum("long" in marks for marks in collected["deselected"]) >= 50  # the TUI sessions and the 3D study at least
     assert any(marks == ["slow"] for marks in collected["deselected"])
+
+
+def test_the_set_value_the_presets_page_calls_text_is_taken_as_text():
+    """how-to/presets.md's example of a --set value YAML cannot read: kept as the text typed
+    (its first spelling, `a: b`, was a mapping that `description` refused)."""
+    from frictionlab.preset.paths import apply_overrides
+
+    page = " ".join((ROOT / "docs" / "how-to" / "presets.md").read_text(encoding="utf-8").split())
+    assignment = re.search(r"is taken as text \(`--set '([^']+)'`", page).group(1)
+    path, _, text = assignment.partition("=")
+    assert apply_overrides({}, [assignment]) == {path: text}
