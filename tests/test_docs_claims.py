@@ -134,3 +134,17 @@ def test_the_set_value_the_presets_page_calls_text_is_taken_as_text():
     assignment = re.search(r"is taken as text \(`--set '([^']+)'`", page).group(1)
     path, _, text = assignment.partition("=")
     assert apply_overrides({}, [assignment]) == {path: text}
+
+
+def test_the_output_files_page_names_every_key_of_summary_json(tmp_path):
+    """reference/output-files.md's summary.json row names each key a run writes there
+    (python, error, resumed_ and retried_realizations were written but named nowhere)."""
+    import json
+
+    preset = tmp_path / "small.yaml"
+    preset.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--no-plot", "--workers", "1"]) == 0
+    keys = json.loads((tmp_path / "o" / "summary.json").read_text())
+    row = next(line for line in (ROOT / "docs" / "reference" / "output-files.md").read_text(encoding="utf-8").splitlines()
+               if line.startswith("| `summary.json` |"))  # fmt: skip
+    assert [key for key in keys if f"`{key}`" not in row] == []
