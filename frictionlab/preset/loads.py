@@ -138,7 +138,8 @@ def load_problems(scene) -> list[str]:
     if float(f.max()) > solver.max_f:
         problems.append(
             f"loading.stop: {loading.stop:g} is f = {float(f.max()):.4g}, past what {solver.name}'s arithmetic holds: "
-            f"f <= {solver.max_f:g} (F <= {solver.max_f * scales.force_unit:.6g}); full contact comes long before"
+            f"f <= {solver.max_f:g} ({scene.normalisation.load_symbol} <= {solver.max_f * scales.force_unit:.6g} "
+            f"{scene.normalisation.load_unit}); full contact comes long before"
         )
     return problems
 
