@@ -148,3 +148,13 @@ def test_the_output_files_page_names_every_key_of_summary_json(tmp_path):
     row = next(line for line in (ROOT / "docs" / "reference" / "output-files.md").read_text(encoding="utf-8").splitlines()
                if line.startswith("| `summary.json` |"))  # fmt: skip
     assert [key for key in keys if f"`{key}`" not in row] == []
+
+
+def test_the_generated_references_and_the_schema_send_no_reader_to_a_source_file():
+    """The preset reference (its sweep section read "see frictionlab/runs/sweep.py"), the
+    command and JSON references and `frictionlab schema` stand on their own."""
+    from frictionlab.preset.schema import preset_json_schema
+
+    hooks = _hooks()
+    texts = [hooks.preset_reference(), hooks.cli_reference(), hooks.json_reference(), str(preset_json_schema())]
+    assert [re.findall(r"[\w/]+\.py\b", text) for text in texts] == [[], [], [], []]
