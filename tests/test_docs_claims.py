@@ -158,3 +158,12 @@ def test_the_generated_references_and_the_schema_send_no_reader_to_a_source_file
     hooks = _hooks()
     texts = [hooks.preset_reference(), hooks.cli_reference(), hooks.json_reference(), str(preset_json_schema())]
     assert [re.findall(r"[\w/]+\.py\b", text) for text in texts] == [[], [], [], []]
+
+
+def test_the_preset_reference_spells_types_and_references_as_they_are():
+    """A list that may be null reads "list of (a or null) or null", not "... or null or
+    null"; a citation without a DOI (Love 1929) is not written as "doi:Love, ..."."""
+    page = _hooks().preset_reference()
+    assert "or null or null" not in page and "list of (string or boolean" in page
+    assert re.findall(r"doi:(?!10\.)", page) == []
+    assert "Love, Phil. Trans. R. Soc. A 228 (1929) 377; Hockney" in page
