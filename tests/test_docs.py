@@ -279,3 +279,13 @@ def test_the_home_page_and_the_readme_link_every_tutorial_how_to_and_reference_p
     assert [page for page in _nav_pages(section) if f"]({page})" not in home] == []
     if section != "Reference":  # the README names the generated reference pages by what they hold
         assert [page for page in _nav_pages(section) if f"](docs/{page})" not in _text(README)] == []
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/getting-started.md"])
+def test_every_extra_of_the_package_is_named_where_installing_is(page):
+    """pyproject.toml's optional dependencies, each named as `".[extra]"` on the install
+    pages (`bench`, Tamaas for the benchmarks, was named nowhere)."""
+    import tomllib
+
+    extras = tomllib.loads(_text(ROOT / "pyproject.toml"))["project"]["optional-dependencies"]
+    assert [extra for extra in extras if f'".[{extra}]"' not in _text(ROOT / page)] == []
