@@ -183,3 +183,17 @@ def test_a_plugins_joint_checks_run_once_its_own_values_pass_whatever_else_is_wr
         assert main(["validate", str(preset)]) == 2
         err = capsys.readouterr().err
         assert "realizations: must be >= 1" in err and ("must be shorter than long_cutoff" in err) == joint
+
+
+def test_the_help_and_the_dask_tutorial_say_that_a_scheduler_makes_the_executor_dask():
+    """`--scheduler` alone runs on Dask; --executor's help gave only processes and serial
+    as its defaults."""
+    from frictionlab.cli.main import build_parser
+    from frictionlab.options import RunOptions
+
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    helps = {action.dest: " ".join(action.help.split()) for action in run._actions if action.help}
+    assert "default: dask with --scheduler" in helps["executor"] and "then dask" in helps["scheduler"]
+    assert RunOptions(scheduler="tcp://127.0.0.1:8786").executor_for(2) == "dask"
+    tutorial = " ".join((ROOT / "docs" / "tutorials" / "dask-cluster.md").read_text(encoding="utf-8").split())
+    assert "`--scheduler` alone implies `--executor dask`" in tutorial
