@@ -246,7 +246,8 @@ def loads_lines(record: dict, symbol: str) -> list[str]:
                      "is not defined for it)")  # fmt: skip
     else:
         pressure = f", p/E* = {full['pressure']:.4g}" if full["pressure"] is not None else ""
-        lines.append(f"full contact from {symbol} = {full['force']:.4g} (f = {full['f']:.4g}{pressure}): {full['how']}")
+        lines.append(f"full contact from {symbol} = {full['force']:.4g} ({record['force_unit_unit']}), "
+                     f"f = {full['f']:.4g}{pressure}: {full['how']}")  # fmt: skip
         if span is not None and span["force"][1] > full["force"]:
             every = span["force"][0] >= full["force"]  # no load measures roughness: the run finds no law
             lines.append(f"caveat: {'every load is' if every else 'the last loads are'} past full contact"
