@@ -152,7 +152,7 @@ def test_the_process_ends_without_waiting_for_the_step_in_progress(tmp_path, sig
         stderr=subprocess.PIPE,
         text=True,
     )
-    assert "realizations" in proc.stderr.readline()  # the run's first line: its solve is starting
+    assert "1 realization of" in proc.stderr.readline()  # the run's first line: its solve is starting
     time.sleep(1.0)  # inside the first step
     assert proc.poll() is None
     sent = time.monotonic()
