@@ -125,7 +125,7 @@ def main() -> None:
     if tamaas is None and not args.no_tamaas:
         print("Tamaas is not installed (pip install tamaas, or the 'bench' extra): no comparison with it")
     if args.tamaas_surface and tamaas is None:
-        parser.error("--tamaas-surface needs Tamaas (pip install tamaas) and no --no-tamaas")
+        parser.error("--tamaas-surface needs Tamaas (pip install tamaas, or the 'bench' extra) and no --no-tamaas")
     profile, forces = scene(args.side, tamaas if args.tamaas_surface else None)
     slopes = np.ones_like(profile.heights)
     cold = (0, 9, 19)

@@ -87,7 +87,7 @@ def main() -> None:
         parser.error(f"--side must be at least 16. Got {args.side} instead.")
     tamaas = load_tamaas()
     if tamaas is None:
-        raise SystemExit("this benchmark needs Tamaas: pip install tamaas")
+        raise SystemExit("this benchmark needs Tamaas: pip install tamaas, or the 'bench' extra")
     scale = (args.side / 512) ** 2  # the same contact fractions at any side
     with busy_beside(args.busy), tempfile.TemporaryDirectory() as tmp:
         measure(Path(tmp), tamaas, args, 20.0 * scale, 1000.0 * scale)

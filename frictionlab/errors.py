@@ -35,13 +35,42 @@ EXTRAS = {"dask": "dask", "distributed": "dask", "bokeh": "dask", "pandas": "pan
 """The optional packages by top-level module, and the extra of pyproject.toml that brings each."""
 
 
+DISTRIBUTIONS = {"yaml": "pyyaml", "ruamel": "ruamel-yaml"}
+"""The dependencies whose distribution is not named as their top-level module."""
+
+
+def _normalized(name: str) -> str:
+    import re
+
+    return re.sub(r"[-_.]+", "-", name).lower()  # as pip compares distribution names
+
+
+def dependency_command(module: str) -> str:
+    """The pip command that brings back ``module``, a dependency of frictionlab's own: its
+    requirement as frictionlab declares it. frictionlab is installed from a clone, not an
+    index, so "reinstall frictionlab" would find nothing to install: for a module it does
+    not declare, the clone's ``pip install .`` reinstalls it with every dependency."""
+    import re
+    from importlib.metadata import PackageNotFoundError, requires
+
+    try:
+        declared = [req for req in requires("frictionlab") or [] if "extra ==" not in req]
+    except PackageNotFoundError:  # run from a source tree that was never installed
+        declared = []
+    wanted = _normalized(DISTRIBUTIONS.get(module, module))
+    for req in declared:
+        if _normalized(re.match(r"[\w.-]+", req).group(0)) == wanted:  # "scipy>=1.11": scipy
+            return f'pip install "{req.strip()}"'
+    return "pip install . in frictionlab's clone (it installs frictionlab again with every dependency)"
+
+
 class MissingDependency(FrictionlabError):
     """A package a feature needs is not installed; the message says how to install it."""
 
     def __init__(self, module: str, purpose: str):
         self.module = module.partition(".")[0]
         extra = EXTRAS.get(self.module)
-        command = f'pip install "frictionlab[{extra}]"' if extra else "pip install --force-reinstall frictionlab"
+        command = f'pip install "frictionlab[{extra}]"' if extra else dependency_command(self.module)
         super().__init__(f"{purpose} needs {self.module}, which is not installed: {command}")
 
 

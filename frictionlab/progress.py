@@ -154,7 +154,7 @@ class ProgressReporter:
             if run.executor == "processes" and 0 < run.cores < run.workers else ""
         )  # fmt: skip
         self._write(
-            f"{preset.name}: {run.total} realizations of {run.scene.pressed}{restored}, "
+            f"{preset.name}: {run.total} realization{'s' if run.total != 1 else ''} of {run.scene.pressed}{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s){crowded}"
         )
 

@@ -259,3 +259,33 @@ def test_every_test_the_extremes_page_names_exists():
     for file in (ROOT / "tests").rglob("test_*.py"):
         defined |= set(re.findall(r"^(?:async )?def (test_\w+)", _text(file), flags=re.M))
     assert not names - defined, f"docs/explanation/extremes.md names tests that do not exist: {sorted(names - defined)}"
+
+
+def _nav_pages(section: str) -> list[str]:
+    """The pages of one section of mkdocs.yml's nav."""
+    import yaml
+
+    nav = yaml.safe_load((ROOT / "mkdocs.yml").read_text(encoding="utf-8"))["nav"]
+    (entries,) = [item[section] for item in nav if isinstance(item, dict) and section in item]
+    return [page for entry in entries for page in entry.values()]
+
+
+@pytest.mark.parametrize("section", ["Tutorials", "How-to", "Reference"])
+def test_the_home_page_and_the_readme_link_every_tutorial_how_to_and_reference_page(section):
+    """The home page's "Where to go" lists every page of these sections (it had left out
+    the instrument-file tutorial, the loads how-to and the JSON reference); the README
+    every tutorial and how-to."""
+    home = _text(DOCS / "index.md")
+    assert [page for page in _nav_pages(section) if f"]({page})" not in home] == []
+    if section != "Reference":  # the README names the generated reference pages by what they hold
+        assert [page for page in _nav_pages(section) if f"](docs/{page})" not in _text(README)] == []
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/getting-started.md"])
+def test_every_extra_of_the_package_is_named_where_installing_is(page):
+    """pyproject.toml's optional dependencies, each named as `".[extra]"` on the install
+    pages (`bench`, Tamaas for the benchmarks, was named nowhere)."""
+    import tomllib
+
+    extras = tomllib.loads(_text(ROOT / "pyproject.toml"))["project"]["optional-dependencies"]
+    assert [extra for extra in extras if f'".[{extra}]"' not in _text(ROOT / page)] == []

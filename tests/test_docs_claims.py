@@ -123,3 +123,77 @@ def test_a_bare_pytest_leaves_out_exactly_the_long_and_slow_tests(tmp_path, monk
     assert all(marks for marks in collected["deselected"])  # and nothing else left out
     assert sum("long" in marks for marks in collected["deselected"]) >= 50  # the TUI sessions and the 3D study at least
     assert any(marks == ["slow"] for marks in collected["deselected"])
+
+
+def test_the_set_value_the_presets_page_calls_text_is_taken_as_text():
+    """how-to/presets.md's example of a --set value YAML cannot read: kept as the text typed
+    (its first spelling, `a: b`, was a mapping that `description` refused)."""
+    from frictionlab.preset.paths import apply_overrides
+
+    page = " ".join((ROOT / "docs" / "how-to" / "presets.md").read_text(encoding="utf-8").split())
+    assignment = re.search(r"is taken as text \(`--set '([^']+)'`", page).group(1)
+    path, _, text = assignment.partition("=")
+    assert apply_overrides({}, [assignment]) == {path: text}
+
+
+def test_the_output_files_page_names_every_key_of_summary_json(tmp_path):
+    """reference/output-files.md's summary.json row names each key a run writes there
+    (python, error, resumed_ and retried_realizations were written but named nowhere)."""
+    import json
+
+    preset = tmp_path / "small.yaml"
+    preset.write_text(yaml.safe_dump(SMALL_PRESET))
+    assert main(["run", str(preset), "--out", str(tmp_path / "o"), "--quiet", "--no-plot", "--workers", "1"]) == 0
+    keys = json.loads((tmp_path / "o" / "summary.json").read_text())
+    row = next(line for line in (ROOT / "docs" / "reference" / "output-files.md").read_text(encoding="utf-8").splitlines()
+               if line.startswith("| `summary.json` |"))  # fmt: skip
+    assert [key for key in keys if f"`{key}`" not in row] == []
+
+
+def test_the_generated_references_and_the_schema_send_no_reader_to_a_source_file():
+    """The preset reference (its sweep section read "see frictionlab/runs/sweep.py"), the
+    command and JSON references and `frictionlab schema` stand on their own."""
+    from frictionlab.preset.schema import preset_json_schema
+
+    hooks = _hooks()
+    texts = [hooks.preset_reference(), hooks.cli_reference(), hooks.json_reference(), str(preset_json_schema())]
+    assert [re.findall(r"[\w/]+\.py\b", text) for text in texts] == [[], [], [], []]
+
+
+def test_the_preset_reference_spells_types_and_references_as_they_are():
+    """A list that may be null reads "list of (a or null) or null", not "... or null or
+    null"; a citation without a DOI (Love 1929) is not written as "doi:Love, ..."."""
+    page = _hooks().preset_reference()
+    assert "or null or null" not in page and "list of (string or boolean" in page
+    assert re.findall(r"doi:(?!10\.)", page) == []
+    assert "Love, Phil. Trans. R. Soc. A 228 (1929) 377; Hockney" in page
+
+
+def test_a_plugins_joint_checks_run_once_its_own_values_pass_whatever_else_is_wrong(tmp_path, capsys):
+    """how-to/presets.md: the second phase of a plugin waits for its own fields only; a bad
+    value elsewhere is listed beside its problems (the page said it waited for the whole
+    preset)."""
+    page = " ".join((ROOT / "docs" / "how-to" / "presets.md").read_text(encoding="utf-8").split())
+    assert "A plugin's second phase runs once its own values have passed" in page
+    spectrum = {"name": "power-law", "params": {"hurst": 0.8, "points": 10}}  # short cut-off 10 = long cut-off
+    for params, joint in (({}, True), ({"hurst": 2.0}, False)):
+        preset = tmp_path / "p.yaml"
+        preset.write_text(yaml.safe_dump({**SMALL_PRESET, "realizations": 0,
+                                          "spectrum": {**spectrum, "params": {**spectrum["params"], **params}}}))  # fmt: skip
+        assert main(["validate", str(preset)]) == 2
+        err = capsys.readouterr().err
+        assert "realizations: must be >= 1" in err and ("must be shorter than long_cutoff" in err) == joint
+
+
+def test_the_help_and_the_dask_tutorial_say_that_a_scheduler_makes_the_executor_dask():
+    """`--scheduler` alone runs on Dask; --executor's help gave only processes and serial
+    as its defaults."""
+    from frictionlab.cli.main import build_parser
+    from frictionlab.options import RunOptions
+
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    helps = {action.dest: " ".join(action.help.split()) for action in run._actions if action.help}
+    assert "default: dask with --scheduler" in helps["executor"] and "then dask" in helps["scheduler"]
+    assert RunOptions(scheduler="tcp://127.0.0.1:8786").executor_for(2) == "dask"
+    tutorial = " ".join((ROOT / "docs" / "tutorials" / "dask-cluster.md").read_text(encoding="utf-8").split())
+    assert "`--scheduler` alone implies `--executor dask`" in tutorial

@@ -359,14 +359,17 @@ def test_discover_false_never_reads_entry_points(monkeypatch):
 
 
 def test_only_listed_plugins(two_good):
-    reg = Registry(env={"FRICTIONLAB_PLUGINS": " other , nonexistent"})
+    with pytest.warns(RuntimeWarning, match=r"FRICTIONLAB_PLUGINS names 'nonexistent', which is no installed plugin's "
+                                            r"entry point \(installed: good, other;"):  # fmt: skip
+        reg = Registry(env={"FRICTIONLAB_PLUGINS": " other , nonexistent"})
     assert "other-line" in reg.names("spectrum")
     assert "good-line" not in reg.names("spectrum")
     assert "power-law" in reg.names("spectrum")
 
 
-def test_blocked_plugins(two_good):
-    reg = Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "good"})
+def test_blocked_plugins(two_good, recwarn):
+    reg = Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "good,not-installed"})  # blocked all the same: no warning
+    assert not [w for w in recwarn if "FRICTIONLAB" in str(w.message)]
     assert "good-line" not in reg.names("spectrum")
     assert "other-line" in reg.names("spectrum")
     both = Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "good,other"})

@@ -164,6 +164,11 @@ _SECTIONS = {
 }
 
 
+def _reference(ref: str) -> str:
+    """A DOI as doi:10...; a citation without one (Love 1929) as it is written."""
+    return f"doi:{ref}" if ref.startswith("10.") else ref
+
+
 def _schema_type(prop: dict, defs: dict) -> str:
     if "$ref" in prop:
         title = defs.get(prop["$ref"].rsplit("/", 1)[-1], {}).get("title", "object")
@@ -177,7 +182,8 @@ def _schema_type(prop: dict, defs: dict) -> str:
     if "anyOf" in prop:
         return " or ".join(_schema_type(p, defs) for p in prop["anyOf"])
     if prop.get("type") == "array":
-        return "list of " + _schema_type(prop.get("items", {}), defs)
+        item = _schema_type(prop.get("items", {}), defs)
+        return f"list of ({item})" if " or " in item else f"list of {item}"  # not "list of x or null or null"
     return prop.get("type", "any")
 
 
@@ -261,7 +267,7 @@ def preset_reference() -> str:
         for info in registry.infos(kind):
             out += [f"### {kind}: `{info.name}`", "", _cell(info.summary), ""]
             if info.cls.references:
-                out += ["References: " + ", ".join(f"doi:{ref}" for ref in info.cls.references), ""]
+                out += ["References: " + "; ".join(_reference(ref) for ref in info.cls.references), ""]
             table = fields_table(info.cls.Params)
             out += (table if len(table) > 2 else ["No parameters."]) + [""]
     return "\n".join(out)

@@ -17,10 +17,11 @@ def add_executor_options(parser) -> None:
     parser.add_argument(
         "--executor",
         choices=EXECUTORS,
-        help="where realizations run (default: processes, or serial for --workers 1)",
+        help="where realizations run (default: dask with --scheduler, else processes, or serial for --workers 1)",
     )
     parser.add_argument(
-        "--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, tls://HOST:PORT or tcp://HOST:PORT"
+        "--scheduler", metavar="ADDRESS",
+        help="an existing Dask scheduler, tls://HOST:PORT or tcp://HOST:PORT (the executor is then dask)",
     )
     parser.add_argument("--tls-ca-file", metavar="FILE", help="CA certificate of a tls:// Dask scheduler")
     parser.add_argument("--tls-cert", metavar="FILE", help="client certificate for a tls:// Dask scheduler")

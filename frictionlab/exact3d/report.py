@@ -128,13 +128,13 @@ def write_page(
         what = "is not a folder" if os.path.lexists(runs_dir) else "does not exist"
         raise FrictionlabError(f"--runs {runs_dir} {what}: --finished-only writes the page from the runs folder of an "
                                "earlier study: give that folder")  # fmt: skip
-    command = command or _command(quick, out_dir, runs_dir, finished_only)
     if out_dir:  # refused before a default runs folder is made
         page_paths(Path(out_dir), force=options.force)
     if runs_dir and not finished_only:  # --finished-only writes nothing into it: any folder is read
         check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
     presets = find_presets(presets_dir, plan)  # refused before a default runs folder is made
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
+    command = command or _command(quick, out_dir, runs_dir, finished_only)  # names a default runs folder too
     out_dir = Path(out_dir) if out_dir else runs_dir
     page, figures = page_paths(out_dir, force=options.force)
     try:

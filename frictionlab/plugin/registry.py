@@ -212,6 +212,17 @@ def _signature_problems(cls, base) -> list[str]:
     return problems
 
 
+def _warn_of_unknown_names(only: list[str], installed: list[str]) -> None:
+    """A name in FRICTIONLAB_PLUGINS that no installed plugin has (a typo) is said: the plugin
+    meant would otherwise be left out without a word. (A blocked name that is not installed
+    is blocked all the same.)"""
+    for name in (name for name in only if name not in installed):
+        warnings.warn(
+            f"FRICTIONLAB_PLUGINS names {name!r}, which is no installed plugin's entry point (installed: "
+            f"{', '.join(installed) or 'none'}; the built-ins load without being named)", RuntimeWarning, stacklevel=3,
+        )  # fmt: skip
+
+
 class Registry:
     """Every installed plugin class, by kind and name."""
 
@@ -244,7 +255,9 @@ class Registry:
     def _load_entry_points(self, only: list[str], blocked: list[str]) -> None:
         for name in blocked:
             self.pm.set_blocked(name)
-        for ep in md.entry_points(group=ENTRY_POINT_GROUP):
+        found = md.entry_points(group=ENTRY_POINT_GROUP)
+        _warn_of_unknown_names(only, sorted({ep.name for ep in found}))
+        for ep in found:
             if (only and ep.name not in only) or self.pm.is_blocked(ep.name):
                 continue
             if self.pm.get_plugin(ep.name) is not None:

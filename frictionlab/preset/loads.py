@@ -142,7 +142,8 @@ def load_problems(scene) -> list[str]:
     if float(f.max()) > solver.max_f:
         problems.append(
             f"loading.stop: {loading.stop:g} is f = {float(f.max()):.4g}, past what {solver.name}'s arithmetic holds: "
-            f"f <= {solver.max_f:g} (F <= {solver.max_f * scales.force_unit:.6g}); full contact comes long before"
+            f"f <= {solver.max_f:g} ({scene.normalisation.load_symbol} <= {solver.max_f * scales.force_unit:.6g} "
+            f"{scene.normalisation.load_unit}); full contact comes long before"
         )
     return problems
 
@@ -249,7 +250,8 @@ def loads_lines(record: dict, symbol: str) -> list[str]:
                      "is not defined for it)")  # fmt: skip
     else:
         pressure = f", p/E* = {full['pressure']:.4g}" if full["pressure"] is not None else ""
-        lines.append(f"full contact from {symbol} = {full['force']:.4g} (f = {full['f']:.4g}{pressure}): {full['how']}")
+        lines.append(f"full contact from {symbol} = {full['force']:.4g} ({record['force_unit_unit']}), "
+                     f"f = {full['f']:.4g}{pressure}: {full['how']}")  # fmt: skip
         if span is not None and span["force"][1] > full["force"]:
             every = span["force"][0] >= full["force"]  # no load measures roughness: the run finds no law
             lines.append(f"caveat: {'every load is' if every else 'the last loads are'} past full contact"

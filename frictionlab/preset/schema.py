@@ -133,7 +133,7 @@ def first_repeat(values: list) -> tuple[int, int] | None:
 
 
 class SweepSettings(_Strict):
-    """A sweep: every point is the preset with the swept paths set (see frictionlab/runs/sweep.py)."""
+    """A sweep: every point is the preset with the swept paths set, run as an ensemble of its own."""
 
     mode: Literal["grid", "zip"] = Field(
         "grid", description="grid: every combination of the values; zip: the i-th values of every list together."

@@ -79,7 +79,9 @@ def test_a_missing_module_of_frictionlab_itself_stays_a_bug(monkeypatch, capsys)
     ("module", "command"),
     [("pandas", 'pip install "frictionlab[pandas]"'), ("distributed", 'pip install "frictionlab[dask]"'),
      ("bokeh", 'pip install "frictionlab[dask]"'),
-     ("ipywidgets", 'pip install "frictionlab[notebook]"'), ("scipy", "pip install --force-reinstall frictionlab")],
+     ("ipywidgets", 'pip install "frictionlab[notebook]"'), ("scipy", 'pip install "scipy>=1.11"'), ("yaml", 'pip install "pyyaml>=6.0"'),
+     ("ruamel", 'pip install "ruamel.yaml>=0.18"'),
+     ("not_a_dependency", "pip install . in frictionlab's clone (it installs frictionlab again with every dependency)")],
 )  # fmt: skip
 def test_require_names_the_extra_of_each_optional_package(monkeypatch, module, command):
     monkeypatch.setitem(sys.modules, module, None)
@@ -109,3 +111,18 @@ def test_a_missing_matplotlib_keeps_the_numbers_and_says_how_to_mend_the_install
     assert "cannot draw" in done.stderr and "drawing needs matplotlib, which is not installed: pip install" in done.stderr
     assert "internal error" not in done.stderr
     assert (tmp_path / "o" / "summary.json").is_file() and (tmp_path / "o" / "curve.csv").is_file()
+
+
+def test_a_missing_dependency_is_named_with_its_requirement_not_a_reinstall_from_an_index():
+    """frictionlab is installed from its clone, not from an index: "pip install
+    --force-reinstall frictionlab" finds no such distribution. Each dependency it declares is
+    named with the requirement that brings it back."""
+    from importlib.metadata import requires
+
+    from frictionlab.errors import dependency_command
+
+    declared = [req for req in requires("frictionlab") if "extra ==" not in req]
+    modules = {"pyyaml>=6.0": "yaml", "ruamel.yaml>=0.18": "ruamel", "array-api-compat>=1.9": "array_api_compat"}
+    for req in declared:
+        module = modules.get(req, req.split(">=")[0])
+        assert dependency_command(module) == f'pip install "{req}"'

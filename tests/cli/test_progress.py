@@ -123,3 +123,11 @@ def test_a_run_replayed_from_its_log_does_not_guess_the_cores_it_ran_on(make_sce
     stream = FakeTerminal()
     ProgressReporter(stream, after=0).run_started(RunInfo(scene=make_scene({}), total=4, workers=64, executor="processes"))
     assert stream.getvalue().splitlines()[0].endswith(", 64 worker(s)")
+
+
+def test_the_first_line_of_a_run_of_one_realization_says_realization(make_scene):
+    """A measured scan runs one realization: "1 realization of", as validate says it, not
+    "1 realizations of"."""
+    stream = FakeTerminal()
+    engine.run(make_scene({"realizations": 1}), RunOptions(workers=1), listeners=[ProgressReporter(stream, after=0)])
+    assert stream.getvalue().startswith("small: 1 realization of power-law lines, 16 force steps")

@@ -136,3 +136,22 @@ def test_the_pages_wall_time_is_never_less_than_the_compute_its_cores_shared(rec
     text = wall_time_text(recorded, compute=3600.0 + 2400.0, cores=2)
     assert says in text
     assert ("10:00" in text) == (recorded == 600.0)  # the record is named beside the bound
+
+
+def test_the_pages_command_names_the_runs_folder_it_made(tmp_path, monkeypatch):
+    """Without --runs the study makes runs/exact3d-quick-<timestamp>; the command the page
+    gives to regenerate it names that folder, so it reads those runs back instead of
+    computing the study again in yet another new folder."""
+    from types import SimpleNamespace
+
+    from frictionlab.exact3d import report
+
+    monkeypatch.chdir(tmp_path)
+    said = {}
+    monkeypatch.setattr(report, "run_plan", lambda *a, **k: SimpleNamespace(hursts=lambda: [0.8], ensembles=[], seconds=0))
+    monkeypatch.setattr(report, "study_numbers", lambda runs: None)
+    monkeypatch.setattr(report, "PLOTS", [lambda *a, **k: None] * len(report.FIGURES))
+    monkeypatch.setattr(report, "page_text", lambda runs, numbers, command, *a: said.setdefault("command", command))
+    report.write_page(tmp_path / "page", quick=True, presets_dir=PRESETS)
+    (made,) = (tmp_path / "runs").iterdir()
+    assert said["command"] == f"frictionlab exact3d --quick --out {tmp_path / 'page'} --runs runs/{made.name} --force"
