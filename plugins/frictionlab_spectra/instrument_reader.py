@@ -16,6 +16,8 @@ import math
 import re
 import zipfile
 
+from .header_units import HEADER_BYTES, named_units
+
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
@@ -95,12 +97,6 @@ def check_zip_members(fh, reader, where: str) -> None:
 X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int16, int32, float32, float64
 
 
-HEADER_BYTES = 4096  # of a text export read for the units its header names
-_LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "mm": "mm", "cm": "cm", "m": "m"}
-_UNIT_TOKEN = re.compile(r"[\[(/]\s*(pm|nm|um|\u00b5m|\u03bcm|mm|cm|m)\s*(?=[\])\s,;]|$)")
-_NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")
-
-
 def header_units(fh, reader) -> list[str]:
     """The length units the header of a text export names (``x [\u00b5m]``, ``z (nm)``, ``z/nm``),
     in order, from the lines before its first row of numbers; empty for a binary format."""
@@ -109,13 +105,7 @@ def header_units(fh, reader) -> list[str]:
     fh.seek(0)
     head = fh.read(HEADER_BYTES)
     fh.seek(0)
-    text = head.decode("utf-8", errors="replace")  # the reader has read it as UTF-8
-    units = []
-    for line in text.splitlines()[:-1]:  # the last line may be cut short
-        if _NUMBERS.match(line):
-            break
-        units += [_LENGTH_UNIT[token] for token in _UNIT_TOKEN.findall(line)]
-    return units
+    return named_units(head.decode("utf-8", errors="replace"))[0]  # the reader has read it as UTF-8
 
 
 def check_header_units(fh, reader, file_unit: str | None, where: str) -> None:

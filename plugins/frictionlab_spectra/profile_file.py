@@ -38,6 +38,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
+from .header_units import check_table_header
 from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
@@ -111,6 +112,8 @@ class ProfileFile(MeasuredFile):
             periodic = scan.periodic if p.periodic is None else p.periodic
         else:
             x, z = _read_columns(path)
+            if file_suffix(path, where) != ".npy":
+                check_table_header(path, where, p.unit, p.format)
             summary = {
                 "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset", "unit": p.unit,
                 "unit_from": "preset" if p.unit is not None else "none",

@@ -49,6 +49,7 @@ from pydantic import Field
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
+from .header_units import check_table_header
 from .instrument_file import (
     ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
@@ -283,12 +284,15 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
+        table = file_suffix(path, where) != ".npy"
+        if table:  # first: an export whose header states its pixel is told how to read it, not to give spacing
+            check_table_header(path, where, p.unit, p.format)
         if p.spacing is None:
             raise ValueError(
                 f"{where}: a {path.suffix.lower()} map holds bare numbers, so the parameter spacing (the pixel side) "
                 "is required"
             )
-        data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
+        data = read_text_table(path, where) if table else load_npy(path, where)
         if data.size == 0:  # not 'a map of 1 x 0 pixels, one pixel wide: a line'
             held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
                 "a table of no numbers (a header, comments or blank lines only)"

@@ -1,0 +1,64 @@
+"""The length units a text file's header names, before its first row of numbers: in a column's
+label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
+``# Value units: m``). A table's numbers are read bare, so what its header says of their units
+is checked against the preset (``check_table_header``); a text export read by SurfaceTopography
+is checked the same way where its reader skips the header (``instrument_reader``)."""
+
+from __future__ import annotations
+
+import re
+
+HEADER_BYTES = 4096  # of a text file read for the units its header names
+LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
+               "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5"}  # fmt: skip
+_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5"
+_LABEL = re.compile(rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)")  # x [µm], z (nm), z/nm
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_STATED = re.compile(rf"[:=]\s*(?P<size>{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # Width: 25.6 µm; Value units: m
+NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
+
+
+def named_units(text: str) -> tuple[list[str], bool]:
+    """The length units the header of ``text`` (its lines before the first that starts with a
+    number) names, in order, and whether it states a size (a number with its unit: a width)."""
+    units, sized = [], False
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
+        if NUMBERS.match(line):
+            break
+        units += [LENGTH_UNIT[token] for token in _LABEL.findall(line)]
+        if stated := _STATED.search(line.rstrip()):
+            units.append(LENGTH_UNIT[stated["unit"]])
+            sized = sized or stated["size"] is not None
+    return units, sized
+
+
+def check_table_header(path, where: str, unit: str | None, format: str) -> None:
+    """Refuse a table (read as bare numbers) whose header says its numbers are not what the
+    preset takes them for: a header that states the scan's size (an instrument's text export,
+    read with ``format: auto``), columns in different length units, or one unit other than the
+    preset's ``unit``."""
+    from .instrument_file import LENGTH_UNITS, open_input  # here: they import this module
+
+    with open_input(path, where) as fh:
+        units, sized = named_units(fh.read(HEADER_BYTES).decode("utf-8-sig", errors="replace"))
+    named = ", ".join(dict.fromkeys(units))
+    if sized and format == "auto":
+        raise ValueError(
+            f"{where}: its header states the scan's size and units ({named}), as an instrument's text export "
+            "(Gwyddion's, say) does, and a table's numbers are read bare, without them: read it with format: "
+            "instrument, which takes the pixel size and the units from the header (or with format: table, spacing "
+            "and unit, for its bare numbers)"
+        )
+    if sized or not units:  # format: table asked for the bare numbers of an export that states its size
+        return
+    if len(set(units)) > 1:
+        raise ValueError(
+            f"{where}: its header names the length units {named}, and a table's numbers are read bare, all in one "
+            "unit: the slopes would be off by their ratio; convert the columns to one length unit"
+        )
+    if unit is not None and units[0] != unit:
+        to = f"set unit: {units[0]}, or convert" if units[0] in LENGTH_UNITS else "convert"
+        raise ValueError(
+            f"{where}: its header names the length unit {units[0]}, and the preset's unit is {unit}: a table's "
+            f"numbers are taken to be in unit; {to} the numbers to {unit}"
+        )

@@ -1,0 +1,85 @@
+"""A table's numbers are read bare; what its header says of their units is checked against
+the preset: an instrument's text export whose header states its size (Gwyddion's), columns
+in different length units (a profilometer's x in mm, z in um), or a unit other than the
+preset's. Each was read as bare numbers in the preset's unit, without a word, every slope or
+height off by the units' ratio."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab_spectra import ProfileFile, SurfaceFile
+
+
+def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
+    return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
+
+
+def gwyddion_text(path, z_um, pixel_um: float, value_unit: str = "m", scale: float = 1e-6):
+    """A map z[y, x] in um as Gwyddion's plain-text export writes it: its size in µm, values in ``value_unit``."""
+    ny, nx = z_um.shape
+    header = (f"# Channel: Height\n# Width: {nx * pixel_um:.3f} µm\n# Height: {ny * pixel_um:.3f} µm\n"
+              f"# Value units: {value_unit}\n")  # fmt: skip
+    rows = "".join(" ".join(f"{v * scale:.9e}" for v in row) + "\n" for row in z_um)
+    path.write_text(header + rows, encoding="utf-8")
+    return path
+
+
+def test_an_instrument_text_export_read_as_a_table_is_told_to_be_read_as_one(tmp_path, capsys):
+    """Gwyddion's .txt export, read by suffix as a table with spacing 0.1 and unit um, had its
+    heights in metres taken as micrometres: an rms height of 1e-6 um, validated as 'ok'."""
+    z = rough(16, 24)
+    path = gwyddion_text(tmp_path / "scan.txt", z, 0.1)
+    spectrum = {"name": "surface-file", "params": {"path": str(path), "spacing": 0.1, "unit": "um"}}
+    preset = {"name": "gwy", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
+              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    text = "".join(capsys.readouterr())
+    assert code == ExitCode.USAGE, text
+    assert "its header states the scan's size and units (um, m)" in text and "format: instrument" in text
+    assert "Traceback" not in text
+    read = SurfaceFile(path=str(path), unit="um", format="instrument", detrend="none").generate(None)
+    assert read.spacing == pytest.approx(0.1, rel=1e-9)
+    np.testing.assert_allclose(read.heights, z, rtol=1e-8, atol=1e-8)
+    bare = SurfaceFile(path=str(path), spacing=0.1, format="table", detrend="none").generate(None)  # asked for
+    np.testing.assert_allclose(bare.heights, z * 1e-6, rtol=1e-8, atol=1e-14)
+
+
+def test_a_profile_with_x_and_z_in_different_units_is_refused(tmp_path):
+    """A profilometer's export, x in mm and z in um: the pixel was read as 0.0005 'um', every
+    slope a thousand times too steep, and pressures of 20 E* validated as 'ok'."""
+    x = np.arange(64) * 0.5
+    z = rough(1, 64, 2)[0]
+    for name, header, scale in (("mixed.csv", "x [mm],z [um]", 1e-3), ("same.csv", "x [um],z [um]", 1.0)):
+        (tmp_path / name).write_text(header + "\n" + "".join(f"{float(a * scale)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    with pytest.raises(ValueError, match=r"its header names the length units mm, um, .* convert the columns"):
+        ProfileFile(path=str(tmp_path / "mixed.csv"), unit="um").rms_height()
+    line = ProfileFile(path=str(tmp_path / "same.csv"), unit="um").generate(None)
+    assert line.spacing == pytest.approx(0.5, rel=1e-12) and line.heights.size == 64
+
+
+@pytest.mark.parametrize("header", ["z [nm]", "# heights (nm)", "Höhe/nm"])
+def test_a_table_whose_header_names_another_unit_than_the_presets_is_refused(tmp_path, header):
+    z = rough(10, 12, 3)
+    (tmp_path / "m.csv").write_text(header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in z),
+                                    encoding="utf-8")  # fmt: skip
+    with pytest.raises(ValueError, match=r"its header names the length unit nm, and the preset's unit is um: .* set unit: nm"):
+        SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit="um").rms_height()
+    for unit in ("nm", None):
+        assert SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit=unit).generate(None).heights.shape == (10, 12)
+
+
+@pytest.mark.parametrize("label", ["micron", "\u00b5m", "\u03bcm"])
+def test_micrometres_spelled_as_instruments_do_are_micrometres(tmp_path, label):
+    x = np.arange(32) * 0.5
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32)[0]))
+    for name, z_unit in (("nm.csv", "nm"), ("um.csv", "um")):
+        (tmp_path / name).write_text(f"x [{label}],z [{z_unit}]\n" + rows, encoding="utf-8")
+    with pytest.raises(ValueError, match=r"its header names the length units um, nm"):
+        ProfileFile(path=str(tmp_path / "nm.csv"), unit="um").rms_height()
+    assert ProfileFile(path=str(tmp_path / "um.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)
