@@ -326,3 +326,22 @@ def test_the_levelling_record_survives_despike(tmp_path):
     assert cleaned["rms_removed_fraction"] == pytest.approx(plain["rms_removed_fraction"], abs=0.05)
     assert cleaned["rms_before_detrend"] == pytest.approx(plain["rms_before_detrend"], rel=0.05)
     assert cleaned["rms_height"] < plain["rms_height"]
+
+
+@pytest.mark.parametrize("what", ["map", "line"])
+def test_a_form_kept_that_is_mostly_a_curvature_is_told_the_levelling_that_removes_it(tmp_path, what):
+    """A bowed scan levelled by its mean was told 'detrend: plane (or quadratic) levels it' (tilt,
+    for a line): the plane or the tilt keeps the bow, and the run said so in a second caveat. The
+    remedy named is the one that leaves no caveat; a tilt kept is still told plane (or tilt)."""
+    x = np.arange(200) * 0.1
+    bow, tilt = (x - x.mean()) ** 2 / 20.0, 0.3 * x
+    rough_part = np.random.default_rng(3).normal(size=(40, 200)) * 0.01
+    for name, form, remedy in (("bowed", bow, "quadratic"), ("tilted", tilt, "plane (or quadratic)")):
+        z = rough_part + form[None, :] if what == "map" else rough_part[0] + form
+        np.save(tmp_path / f"{name}.npy", z)
+        plugin = SurfaceFile if what == "map" else ProfileFile
+        caveats = plugin(path=str(tmp_path / f"{name}.npy"), spacing=0.1).input_summary()["caveats"]
+        expected = remedy if what == "map" else remedy.replace("plane", "tilt")
+        assert caveats[0].endswith(f"not on the roughness; detrend: {expected} levels it"), caveats
+        levelled = plugin(path=str(tmp_path / f"{name}.npy"), spacing=0.1, detrend=expected.split(" ")[0])
+        assert "caveats" not in levelled.input_summary(), levelled.input_summary()

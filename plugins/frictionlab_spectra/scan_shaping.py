@@ -92,8 +92,7 @@ def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     """The caveat of a map whose height is mostly a tilt or a curvature left in it."""
     plane, curvature = levelled.plane_share, levelled.curvature_share
     if mode in ("none", "mean") and plane + curvature > MOST:
-        part = "a tilt" if plane >= curvature else "a curvature"
-        return _form_kept(part, plane + curvature, "map", mode, "detrend: plane (or quadratic) levels it")
+        return _form_kept(plane, curvature, "map", mode, "plane")
     # the share of what the plane leaves, from the levelled heights' own rms: 1 - plane loses every digit
     # when a tilt carries all but 1e-16 of the variance (it gave 'inf %', or a share below zero)
     left = curvature * (levelled.rms_before / levelled.rms_after) ** 2 if levelled.rms_after > 0 else 0.0
@@ -128,13 +127,16 @@ def line_form_warning(z: np.ndarray, mode: str) -> str | None:
         return None
     if tilt + curvature <= MOST:
         return None
+    return _form_kept(tilt, curvature, "line", mode, "tilt")
+
+
+def _form_kept(tilt: float, curvature: float, what: str, mode: str, levels_tilt: str) -> str:
+    """The caveat of a form kept (shares of the variance), with the levelling that removes it: the
+    tilt's (``levels_tilt``) only if what that leaves is not mostly the curvature, which it keeps."""
     part = "a tilt" if tilt >= curvature else "a curvature"
-    return _form_kept(part, tilt + curvature, "line", mode, "detrend: tilt (or quadratic) levels it")
-
-
-def _form_kept(part: str, share: float, what: str, mode: str, remedy: str) -> str:
-    return (f"{part} carries {100 * share:.1f} % of the {what}'s height variance (detrend: {mode}): the contact sits "
-            f"where the tilt or the form puts it, not on the roughness; {remedy}")  # fmt: skip
+    remedy = "quadratic" if curvature > MOST * (1.0 - tilt) else f"{levels_tilt} (or quadratic)"
+    return (f"{part} carries {100 * (tilt + curvature):.1f} % of the {what}'s height variance (detrend: {mode}): the "
+            f"contact sits where the tilt or the form puts it, not on the roughness; detrend: {remedy} levels it")  # fmt: skip
 
 
 def cosine_resample(z: np.ndarray, axis: int, step: float, new_step: float) -> np.ndarray:
