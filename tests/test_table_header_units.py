@@ -68,7 +68,7 @@ def test_a_table_whose_header_names_another_unit_than_the_presets_is_refused(tmp
     z = rough(10, 12, 3)
     (tmp_path / "m.csv").write_text(header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in z),
                                     encoding="utf-8")  # fmt: skip
-    with pytest.raises(ValueError, match=r"its header names the length unit nm, and the preset's unit is um: .* set unit: nm"):
+    with pytest.raises(ValueError, match=r"its header names the length unit nm, which a table's reader does not read: .* the preset's unit, um; set unit: nm"):
         SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit="um").rms_height()
     for unit in ("nm", None):
         assert SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit=unit).generate(None).heights.shape == (10, 12)
@@ -83,3 +83,39 @@ def test_micrometres_spelled_as_instruments_do_are_micrometres(tmp_path, label):
     with pytest.raises(ValueError, match=r"its header names the length units um, nm"):
         ProfileFile(path=str(tmp_path / "nm.csv"), unit="um").rms_height()
     assert ProfileFile(path=str(tmp_path / "um.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def write_points(path, z, dx: float, dy: float, header: str = "# x [um]\ty [um]\tz [um]\n") -> None:
+    """A map z[y, x] as an export of x, y, z per point, a row of the map after another."""
+    ny, nx = z.shape
+    rows = "".join(f"{i * dx:.6f}\t{j * dy:.6f}\t{float(z[j, i])!r}\n" for j in range(ny) for i in range(nx))
+    path.write_text(header + rows, encoding="utf-8")
+
+
+def test_an_export_of_points_named_txt_is_read_as_points_not_as_a_matrix(tmp_path):
+    """format: instrument promises an export of x, y, z per line under .csv or .txt; under .txt it
+    went to the reader of matrices, which read its three columns as a map 3 pixels wide ('map of 3 x
+    120 pixels; at least 8 x 8'), and a line's x, z as damage ('a damaged Plain text file')."""
+    z = rough(10, 12, 4)
+    write_points(tmp_path / "map.txt", z, 0.1, 0.25)
+    read = SurfaceFile(path=str(tmp_path / "map.txt"), format="instrument", unit="um", spacing=0.1, detrend="none")
+    np.testing.assert_allclose(read.generate(None).heights, z, rtol=0, atol=1e-12)
+    resampled = SurfaceFile(path=str(tmp_path / "map.txt"), format="instrument", unit="um").input_summary()
+    assert "0.1 x 0.25 resampled onto square pixels of 0.1" in resampled["pixels"]
+    x, line = np.arange(40) * 0.5, rough(1, 40, 5)[0]
+    (tmp_path / "line.txt").write_text("x [um]\tz [um]\n" + "".join(f"{a:.3f}\t{float(b)!r}\n" for a, b in zip(x, line)))
+    profile = ProfileFile(path=str(tmp_path / "line.txt"), format="instrument", unit="um", detrend="none").generate(None)
+    assert profile.spacing == pytest.approx(0.5, rel=1e-9)
+    np.testing.assert_allclose(profile.heights, line, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match=r"map of 3 x 120 pixels .* columns of x, y and z per point .* format: instrument"):
+        SurfaceFile(path=str(tmp_path / "map.txt"), spacing=0.1).rms_height()  # a table, by its suffix
+
+
+def test_a_text_export_in_another_unit_than_the_presets_is_refused(tmp_path):
+    """An x, y, z export whose header says um, read with unit: nm, had its numbers taken as nm."""
+    z = rough(9, 10, 6)
+    write_points(tmp_path / "scan.xyz", z, 0.5, 0.5)
+    with pytest.raises(ValueError, match=r"header names the length unit um, which SurfaceTopography's .* reader does not "
+                       r"read: .* the preset's unit, nm; set unit: um"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="nm").rms_height()
+    assert SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").generate(None).spacing == pytest.approx(0.5)

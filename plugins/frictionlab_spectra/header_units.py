@@ -37,28 +37,35 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> None:
     preset takes them for: a header that states the scan's size (an instrument's text export,
     read with ``format: auto``), columns in different length units, or one unit other than the
     preset's ``unit``."""
-    from .instrument_file import LENGTH_UNITS, open_input  # here: they import this module
+    from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
         units, sized = named_units(fh.read(HEADER_BYTES).decode("utf-8-sig", errors="replace"))
-    named = ", ".join(dict.fromkeys(units))
     if sized and format == "auto":
         raise ValueError(
-            f"{where}: its header states the scan's size and units ({named}), as an instrument's text export "
-            "(Gwyddion's, say) does, and a table's numbers are read bare, without them: read it with format: "
-            "instrument, which takes the pixel size and the units from the header (or with format: table, spacing "
-            "and unit, for its bare numbers)"
+            f"{where}: its header states the scan's size and units ({', '.join(dict.fromkeys(units))}), as an "
+            "instrument's text export (Gwyddion's, say) does, and a table's numbers are read bare, without them: "
+            "read it with format: instrument, which takes the pixel size and the units from the header (or with "
+            "format: table, spacing and unit, for its bare numbers)"
         )
-    if sized or not units:  # format: table asked for the bare numbers of an export that states its size
-        return
+    if not sized:  # with format: table, an export that states its size asked for its bare numbers
+        check_units_named(units, unit, where, "which a table's reader does not read")
+
+
+def check_units_named(units: list[str], unit: str | None, where: str, ignored: str) -> None:
+    """Refuse a file whose header names ``units`` (``named_units``) that its reader ignores
+    (``ignored`` says which reader): different length units, or one other than the preset's ``unit``;
+    its numbers would be taken bare, in the preset's unit."""
+    from .instrument_file import LENGTH_UNITS  # here: it imports this module
+
     if len(set(units)) > 1:
         raise ValueError(
-            f"{where}: its header names the length units {named}, and a table's numbers are read bare, all in one "
-            "unit: the slopes would be off by their ratio; convert the columns to one length unit"
+            f"{where}: its header names the length units {', '.join(dict.fromkeys(units))}, {ignored}: its numbers "
+            "are taken bare, all in one unit, the slopes off by their ratio; convert the columns to one length unit"
         )
-    if unit is not None and units[0] != unit:
+    if units and unit is not None and units[0] != unit:
         to = f"set unit: {units[0]}, or convert" if units[0] in LENGTH_UNITS else "convert"
         raise ValueError(
-            f"{where}: its header names the length unit {units[0]}, and the preset's unit is {unit}: a table's "
-            f"numbers are taken to be in unit; {to} the numbers to {unit}"
+            f"{where}: its header names the length unit {units[0]}, {ignored}: its numbers are taken to be in the "
+            f"preset's unit, {unit}; {to} the numbers to {unit}"
         )

@@ -16,7 +16,7 @@ import math
 import re
 import zipfile
 
-from .header_units import HEADER_BYTES, named_units
+from .header_units import HEADER_BYTES, NUMBERS, check_units_named, named_units
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
@@ -50,6 +50,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
             "it the suffix of its format (.x3p, .sur, .datx, .nc, .spm...); a table of bare numbers (a .tsv) is "
             "read with format: table and spacing"
         )
+    if chosen.format() == "asc" and _coordinate_rows(fh):  # x, y, z per line under .txt: not a matrix of heights
+        chosen = next(reader for reader in readers if reader.format() == "xyz")
     if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
@@ -63,6 +65,19 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     if head.startswith(ZIP_MAGIC):
         check_zip_members(fh, chosen, where)
     return chosen
+
+
+def _coordinate_rows(fh) -> bool:
+    """Whether a text file's first row of numbers (whole within ``HEADER_BYTES``) holds two or
+    three: x, z or x, y, z per point, which SurfaceTopography's matrix reader, chosen by the
+    suffix .txt, took for a map two or three pixels wide."""
+    fh.seek(0)
+    head = fh.read(HEADER_BYTES)
+    fh.seek(0)
+    for line in head.decode("utf-8", errors="replace").splitlines()[:-1]:  # the last line may be cut short
+        if NUMBERS.match(line):
+            return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
+    return False
 
 
 def _looks_like_text(head: bytes) -> bool:
@@ -108,19 +123,12 @@ def header_units(fh, reader) -> list[str]:
     return named_units(head.decode("utf-8", errors="replace"))[0]  # the reader has read it as UTF-8
 
 
-def check_header_units(fh, reader, file_unit: str | None, where: str) -> None:
-    """Refuse a text export whose header names different length units (``x [\u00b5m]``, ``z
-    [nm]``) that its reader does not read: the heights and the pixel would be taken as bare
-    numbers in one unit, every slope off by their ratio, without a word."""
-    units = header_units(fh, reader)
-    if file_unit is not None or len(set(units)) < 2:
-        return
-    named = ", ".join(dict.fromkeys(units))
-    raise ValueError(
-        f"{where}: its header names the length units {named}, which SurfaceTopography's {reader.name()} reader "
-        "does not read: the heights and the pixel would be taken as bare numbers in one unit, the slopes off by "
-        "their ratio; convert the columns to one length unit"
-    )
+def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
+    """Refuse a text export whose header names length units (``x [\u00b5m]``, ``z [nm]``) that its
+    reader does not read, when they differ, or differ from the preset's ``unit``: the heights and
+    the pixel would be taken as bare numbers in that unit, the slopes off by their ratio."""
+    if file_unit is None:
+        check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
 
 
 def check_payload(fh, reader, where: str) -> None:

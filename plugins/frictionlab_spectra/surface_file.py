@@ -314,7 +314,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         )
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
-        raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed")
+        points = "; columns of x, y and z per point (an instrument's export) are read with format: instrument" \
+            if nx == 3 and not is_instrument_file(path, p.format) else ""
+        raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic}
     return data.astype(np.float64, copy=False), (float(pixel[0]), float(pixel[1])), summary
 
