@@ -42,7 +42,7 @@ from .header_units import check_table_header
 from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import level_line, line_form_warning, line_spike_warning, outlier_warning
+from .scan_shaping import flat_neighbours_warning, level_line, line_form_warning, line_spike_warning, outlier_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -154,7 +154,7 @@ class ProfileFile(MeasuredFile):
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms),
-                   outlier_warning(heights, "line")]  # as a map's
+                   outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)

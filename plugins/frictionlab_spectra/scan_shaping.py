@@ -233,9 +233,10 @@ def outlier_warning(z: np.ndarray, what: str) -> str | None:
     robust = MAD_TO_SIGMA * float(values[middle])
     if rms <= OUTLIER_RATIO * robust:
         return None
-    ratio = f"{rms / robust:.3g} times" if robust > 0 else "infinitely"
+    ratio = f"{rms / robust:.3g} times" if robust > 0 else f"more than {OUTLIER_RATIO:g} times"
+    zero = "" if robust > 0 else "; here zero: more than half of them have one height"
     return (f"the {what}'s rms height is {ratio} what most of its points say ({MAD_TO_SIGMA} times their median "
-            "distance from the median, the rms height of Gaussian heights): a few points far from the rest make the "
+            f"distance from the median, the rms height of Gaussian heights{zero}): a few points far from the rest make the "
             "rms height h, and with it f's unit E* h L, theirs. A value written for a missing pixel, spikes or "
             "scratches: remove them (despike, region) or mark them undefined in the file, if they are not the "
             "surface's own")  # fmt: skip
@@ -300,3 +301,29 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     out = z.copy()
     out[spike] = spsolve(sparse.csr_matrix((values, (rows, cols)), shape=(count, count)), rhs)
     return out, count
+
+
+FLAT_SHARE = 0.25  # of neighbouring pixels at exactly one height: from here on, the slopes are the steps'
+
+
+def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
+    """The caveat of a map or line as read (``z``, before levelling, which would make its equal
+    heights unequal) whose neighbouring pixels have exactly the same height more often than
+    FLAT_SHARE: heights quantized in steps coarser than the roughness between pixels (an
+    instrument's height resolution), or clipped flat. Their slopes are zero: a smooth scan
+    rounded to steps of a quarter of its rms height pressed to half its b, without a word."""
+    if not rms > 0:
+        return None
+    pairs = equal = 0
+    for axis in range(z.ndim):  # views: one boolean the size of the map at a time
+        whole = [slice(None)] * z.ndim
+        ahead, behind = tuple(whole[:axis] + [slice(1, None)]), tuple(whole[:axis] + [slice(None, -1)])
+        pairs, equal = pairs + z[ahead].size, equal + int(np.count_nonzero(z[ahead] == z[behind]))
+    if not pairs or equal <= FLAT_SHARE * pairs:
+        return None
+    steps = np.abs(np.diff(z, axis=-1))
+    step = float(steps[steps > 0].min()) if np.any(steps > 0) else 0.0
+    return (f"{100 * equal / pairs:.0f} % of the {what}'s neighbouring pixels have exactly the same height: its heights "
+            f"are steps (the smallest {step:.3g}, {step / rms:.2g} rms heights) coarser than the roughness between "
+            "pixels, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
+            "surface's; measure or export the heights at a finer height resolution")  # fmt: skip
