@@ -333,6 +333,7 @@ LINE_JUMP_SHARE = 0.5  # of the height change across lines that whole lines stan
 LINE_JUMP_CORRELATION = -0.4  # successive lines' jumps anticorrelated (a line's own offset in both): not a smooth form
 LINE_HALVES_APART = 0.25  # the two halves of a line offset alike (their offsets' mean square difference, of theirs)
 LINE_BLOCK = 2**20  # points of the map looked at a time
+LINES_LOOKED_AT = 512  # consecutive lines (of a larger map) whose offsets are measured: enough to tell, in a second
 
 
 def line_offset_warning(z: np.ndarray) -> str | None:
@@ -362,9 +363,11 @@ def _line_offsets(z: np.ndarray) -> tuple[float, float, float]:
     of the medians of each row's two halves over that of the medians; a block of rows at a time."""
     ny, nx = z.shape
     rows, half = max(1, LINE_BLOCK // nx), nx // 2
+    first = max(1, (ny - LINES_LOOKED_AT) // 2)  # a band of consecutive lines in the middle: offsets are everywhere
+    last = min(ny - 1, first + LINES_LOOKED_AT)
     medians, apart, total = [], 0.0, 0.0
-    for start in range(1, ny - 1, rows):
-        stop = min(start + rows, ny - 1)
+    for start in range(first, last, rows):
+        stop = min(start + rows, last)
         against = z[start:stop] - 0.5 * (z[start - 1 : stop - 1] + z[start + 1 : stop + 1])
         total += float(np.vdot(against, against))
         medians.append(np.median(against, axis=1))
