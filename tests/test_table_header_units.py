@@ -119,3 +119,19 @@ def test_a_text_export_in_another_unit_than_the_presets_is_refused(tmp_path):
                        r"read: .* the preset's unit, nm; set unit: um"):  # fmt: skip
         SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="nm").rms_height()
     assert SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def test_a_channel_that_is_not_heights_asked_by_name_is_told_why_it_is_not_listed(tmp_path):
+    """Gwyddion's export of Height, Phase (deg) and a retrace: asking for 'Phase' listed the two
+    height channels as if the file had no Phase."""
+    z = rough(12, 16, 7)
+    blocks = []
+    for name, unit, data in (("Height", "m", z * 1e-6), ("Phase", "deg", z * 40), ("Height retrace", "m", z * 1e-6)):
+        rows = "".join(" ".join(f"{v:.9e}" for v in row) + "\n" for row in data)
+        blocks.append(f"# Channel: {name}\n# Width: 1.6 µm\n# Height: 1.2 µm\n# Value units: {unit}\n{rows}")
+    (tmp_path / "three.txt").write_text("".join(blocks), encoding="utf-8")
+    with pytest.raises(ValueError, match=r"no channel named 'Phase'; the file has 0: 'Height', 1: 'Height retrace' "
+                       r"\(channels of heights only: one in degrees, volts or no unit is not read\)"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Phase").rms_height()
+    retrace = SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Height retrace", unit="um")
+    assert retrace.generate(None).spacing == pytest.approx(0.1, rel=1e-9)
