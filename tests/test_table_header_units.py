@@ -135,3 +135,16 @@ def test_a_channel_that_is_not_heights_asked_by_name_is_told_why_it_is_not_liste
         SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Phase").rms_height()
     retrace = SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Height retrace", unit="um")
     assert retrace.generate(None).spacing == pytest.approx(0.1, rel=1e-9)
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_scan_flat_but_for_rounding_is_not_said_to_have_an_rms_height_of_zero(tmp_path, plugin):
+    """5 + 1e-14 noise is refused as flat, as it should be, but was said to have 'rms height zero'."""
+    noise = np.random.default_rng(0).normal(size=(16, 16) if plugin is SurfaceFile else 64)
+    np.save(tmp_path / "flat.npy", 5.0 + 1e-14 * noise)
+    with pytest.raises(ValueError, match=r"is constant \(rms height \d\.\d+e-1[45] after detrend='mean', below 1e-12 of its "
+                       r"largest height 5: the rounding of its numbers\)"):  # fmt: skip
+        plugin(path=str(tmp_path / "flat.npy"), spacing=1.0).rms_height()
+    np.save(tmp_path / "zero.npy", np.zeros_like(noise))
+    with pytest.raises(ValueError, match=r"is constant \(rms height zero after detrend='mean'\)"):
+        plugin(path=str(tmp_path / "zero.npy"), spacing=1.0).rms_height()

@@ -42,7 +42,7 @@ from .header_units import check_table_header
 from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import flat_neighbours_warning, level_line, line_form_warning, line_spike_warning, outlier_warning
+from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -142,9 +142,10 @@ class ProfileFile(MeasuredFile):
         heights = level_line(z, mode)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
-        if not rms > 1e-12 * scale:  # also true for scale == 0
+        if not rms > FLAT * scale:  # also true for scale == 0
+            said = flat_rms(rms, scale)
             raise ValueError(
-                f"{where}: the profile is constant (rms height zero after detrend={mode!r}); "
+                f"{where}: the profile is constant (rms height {said[0]} after detrend={mode!r}{said[1]}); "
                 "a flat line has no roughness"
             )
         heights.flags.writeable = False

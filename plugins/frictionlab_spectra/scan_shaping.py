@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 LEVELS = ("none", "mean", "plane", "quadratic")
+FLAT = 1e-12  # an rms height below this share of the largest height is the rounding of the numbers: flat
 MOST = 0.5  # a tilt or a curvature that carries more than this share of the height variance is warned of
 
 
@@ -378,3 +379,11 @@ def _line_offsets(z: np.ndarray) -> tuple[float, float, float]:
     if not total > 0 or offsets.size < 3 or half < 1 or not power > 0:
         return 0.0, 0.0, math.inf
     return power * nx / total, float(np.dot(offsets[1:], offsets[:-1])) / power, apart / power
+
+
+def flat_rms(rms: float, largest: float) -> tuple[str, str]:
+    """The rms height of a map or line refused as flat (below FLAT of its ``largest`` height), as its
+    message says it, and what it is: zero, or the rounding of its numbers (5 + 1e-14 noise is not 'zero')."""
+    if rms == 0:
+        return "zero", ""
+    return f"{rms:.3g}", f", below {FLAT:g} of its largest height {largest:.3g}: the rounding of its numbers"

@@ -60,6 +60,7 @@ from .power_law import TWO_PI
 from .profile_file import (
     check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table, table_fill_advice,
 )
+from .scan_shaping import FLAT, flat_rms
 
 MIN_SIDE = 8
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
@@ -237,11 +238,14 @@ class SurfaceFile(MeasuredFile):
             raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
-        if not rms > 1e-12 * float(np.nanmax(np.abs(z))):  # also true for an all-zero map; NaN only outside region
+        largest = float(np.nanmax(np.abs(z)))
+        if not rms > FLAT * largest:  # also true for an all-zero map; NaN only outside region
             replaced = shaped.get("despiked", {}).get("points")
             despiked = f" and despike {p.despike:g}, which replaced {replaced} points" if replaced else ""
+            said = flat_rms(rms, largest)
             raise ValueError(
-                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}{despiked}); "
+                f"{where}: the map is constant (rms height {said[0]} after detrend={shaped['detrend']!r}{despiked}"
+                f"{said[1]}); "
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
