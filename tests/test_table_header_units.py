@@ -148,3 +148,20 @@ def test_a_scan_flat_but_for_rounding_is_not_said_to_have_an_rms_height_of_zero(
     np.save(tmp_path / "zero.npy", np.zeros_like(noise))
     with pytest.raises(ValueError, match=r"is constant \(rms height zero after detrend='mean'\)"):
         plugin(path=str(tmp_path / "zero.npy"), spacing=1.0).rms_height()
+
+
+def test_a_text_export_whose_unit_is_spelled_micron_is_not_called_damaged(tmp_path):
+    """'# Width: 1.6 micron' (or values in 'microns') is a unit SurfaceTopography's reader does not
+    know: the file was 'a damaged Plain text file', to be copied again from the instrument."""
+    rows = "".join(" ".join(f"{v:.9e}" for v in row) + "\n" for row in rough(12, 16, 8))
+    for name, width, values in (("lateral.txt", "micron", "µm"), ("values.txt", "µm", "microns")):
+        header = f"# Channel: Height\n# Width: 1.6 {width}\n# Height: 1.2 {width}\n# Value units: {values}\n"
+        (tmp_path / name).write_text(header + rows, encoding="utf-8")
+    with pytest.raises(ValueError) as lateral:
+        SurfaceFile(path=str(tmp_path / "lateral.txt"), format="instrument").rms_height()
+    assert "its header names the lateral unit 'micron', which SurfaceTopography's Plain text reader does not know " \
+        "(not damage); write it as one it knows: m, mm, µm (or um)" in str(lateral.value)  # fmt: skip
+    with pytest.raises(ValueError) as values:
+        SurfaceFile(path=str(tmp_path / "values.txt"), format="instrument").rms_height()
+    assert "holds no channel of heights its reader knows" in str(values.value) and "'micron'" in str(values.value)
+    assert "damaged" not in str(lateral.value) + str(values.value)

@@ -261,6 +261,13 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
                           "crop it with the instrument's software")  # fmt: skip
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
+    if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):
+        return ValueError(f"{where}: its header names the lateral unit {quoted(unknown[1])}, which SurfaceTopography's "
+                          f"{name} reader does not know (not damage); write it as one it knows: {_KNOWN_LENGTHS}")  # fmt: skip
+    if isinstance(exc, CorruptFile) and reader.format() == "asc" and "Could not find any topography data" in text:
+        return ValueError(f"{where}: this {name} file holds no channel of heights its reader knows: no rows of numbers, or "
+                          "none under value units that are a length it reads (degrees, volts, or a spelling such as "
+                          f"'micron'); export the heights with their unit written as one of {_KNOWN_LENGTHS}")  # fmt: skip
     said = _reason(exc)
     if reader.format() == "xyz" and isinstance(exc, ValueError) and (
             "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
@@ -279,6 +286,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
 
 
 REASON_SHOWN = 160
+_KNOWN_LENGTHS = "m, mm, \u00b5m (or um), nm, \u00c5, pm"  # as SurfaceTopography's text readers spell them
 
 
 def _reason(exc: BaseException) -> str:
