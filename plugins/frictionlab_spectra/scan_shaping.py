@@ -327,7 +327,8 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
     return (f"{100 * equal / pairs:.0f} % of the {what}'s neighbouring pixels have exactly the same height: its heights "
             f"are steps (the smallest {step:.3g}, {step / rms:.2g} rms heights) coarser than the roughness between "
             "pixels, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
-            "surface's; measure or export the heights at a finer height resolution")  # fmt: skip
+            "surface's; measure or export the heights at a finer resolution (a float channel in double precision, or "
+            "less their mean: single precision keeps 7 digits of heights far from zero)")  # fmt: skip
 
 
 LINE_JUMP_SHARE = 0.5  # of the height change across lines that whole lines standing apart carry: said from here on
