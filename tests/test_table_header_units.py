@@ -41,7 +41,7 @@ def test_an_instrument_text_export_read_as_a_table_is_told_to_be_read_as_one(tmp
     code = main(["validate", str(tmp_path / "p.yaml")])
     text = "".join(capsys.readouterr())
     assert code == ExitCode.USAGE, text
-    assert "its header states the scan's size and units (um, m)" in text and "format: instrument" in text
+    assert "its header states the scan's units (um, m)" in text and "format: instrument" in text
     assert "Traceback" not in text
     read = SurfaceFile(path=str(path), unit="um", format="instrument", detrend="none").generate(None)
     assert read.spacing == pytest.approx(0.1, rel=1e-9)
@@ -165,3 +165,12 @@ def test_a_text_export_whose_unit_is_spelled_micron_is_not_called_damaged(tmp_pa
         SurfaceFile(path=str(tmp_path / "values.txt"), format="instrument").rms_height()
     assert "holds no channel of heights its reader knows" in str(values.value) and "'micron'" in str(values.value)
     assert "damaged" not in str(lateral.value) + str(values.value)
+
+
+def test_a_header_stating_other_lengths_is_no_instrument_export(tmp_path):
+    """'# Cutoff: 0.8 mm' (a filter's wavelength) or '# Probe radius: 2 um' above a profile in um
+    is no statement of the numbers' units: read as the table it is."""
+    x = np.arange(32) * 0.5
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32, 9)[0]))
+    (tmp_path / "p.csv").write_text("# Cutoff: 0.8 mm\n# Probe radius: 2 um\nx [um],z [um]\n" + rows, encoding="utf-8")
+    assert ProfileFile(path=str(tmp_path / "p.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)

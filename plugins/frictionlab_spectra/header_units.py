@@ -14,41 +14,46 @@ LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "
 _UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5"
 _LABEL = re.compile(rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)")  # x [µm], z (nm), z/nm
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_STATED = re.compile(rf"[:=]\s*(?P<size>{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # Width: 25.6 µm; Value units: m
+_SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
+_UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
+# "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
+_STATED = re.compile(rf"\b(?:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$",
+                     re.IGNORECASE)  # fmt: skip
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
 
 
 def named_units(text: str) -> tuple[list[str], bool]:
     """The length units the header of ``text`` (its lines before the first that starts with a
-    number) names, in order, and whether it states a size (a number with its unit: a width)."""
-    units, sized = [], False
+    number) names, in order, and whether it states one by a key of an instrument's text export
+    (``Width: 25.6 µm``, ``Value units: m``, ``z-unit = nm``): SurfaceTopography's reader reads them."""
+    units, stated_by_key = [], False
     for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             break
         units += [LENGTH_UNIT[token] for token in _LABEL.findall(line)]
         if stated := _STATED.search(line.rstrip()):
             units.append(LENGTH_UNIT[stated["unit"]])
-            sized = sized or stated["size"] is not None
-    return units, sized
+            stated_by_key = True
+    return units, stated_by_key
 
 
 def check_table_header(path, where: str, unit: str | None, format: str) -> None:
     """Refuse a table (read as bare numbers) whose header says its numbers are not what the
-    preset takes them for: a header that states the scan's size (an instrument's text export,
-    read with ``format: auto``), columns in different length units, or one unit other than the
+    preset takes them for: a header of an instrument's text export that states its size or units
+    (read with ``format: auto``), columns in different length units, or one unit other than the
     preset's ``unit``."""
     from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
-        units, sized = named_units(fh.read(HEADER_BYTES).decode("utf-8-sig", errors="replace"))
-    if sized and format == "auto":
+        units, export = named_units(fh.read(HEADER_BYTES).decode("utf-8-sig", errors="replace"))
+    if export and format == "auto":
         raise ValueError(
-            f"{where}: its header states the scan's size and units ({', '.join(dict.fromkeys(units))}), as an "
+            f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "
             "instrument's text export (Gwyddion's, say) does, and a table's numbers are read bare, without them: "
-            "read it with format: instrument, which takes the pixel size and the units from the header (or with "
+            "read it with format: instrument, which takes the units and the pixel size from the header (or with "
             "format: table, spacing and unit, for its bare numbers)"
         )
-    if not sized:  # with format: table, an export that states its size asked for its bare numbers
+    if not export:  # with format: table, an instrument's export asked for its bare numbers
         check_units_named(units, unit, where, "which a table's reader does not read")
 
 
