@@ -174,3 +174,12 @@ def test_a_header_stating_other_lengths_is_no_instrument_export(tmp_path):
     rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32, 9)[0]))
     (tmp_path / "p.csv").write_text("# Cutoff: 0.8 mm\n# Probe radius: 2 um\nx [um],z [um]\n" + rows, encoding="utf-8")
     assert ProfileFile(path=str(tmp_path / "p.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def test_keys_in_any_case_units_as_written(tmp_path):
+    """Keys are matched in any case ('Value Units'); units only as written: 'MM' is no unit (it was
+    looked up as one, a KeyError: an internal error)."""
+    from frictionlab_spectra.header_units import named_units
+
+    assert named_units("# WIDTH: 25.6 MM\n# value units: M\n1 2\n") == ([], False)
+    assert named_units("# Width: 2 µm\n# Value Units: m\n1\n") == (["um", "m"], True)
