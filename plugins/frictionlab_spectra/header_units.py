@@ -21,6 +21,15 @@ _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
 
 
+def head_text(fh, encoding: str = "utf-8") -> str:
+    """The first HEADER_BYTES of the open file ``fh`` as text (bytes that are not ``encoding``
+    replaced), the file left at its start for a reader: its header, and its first rows."""
+    fh.seek(0)
+    head = fh.read(HEADER_BYTES)
+    fh.seek(0)
+    return head.decode(encoding, errors="replace")
+
+
 def named_units(text: str) -> tuple[list[str], bool]:
     """The length units the header of ``text`` (its lines before the first that starts with a
     number) names, in order, and whether it states one by a key of an instrument's text export
@@ -44,7 +53,7 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> None:
     from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
-        units, export = named_units(fh.read(HEADER_BYTES).decode("utf-8-sig", errors="replace"))
+        units, export = named_units(head_text(fh, "utf-8-sig"))
     if export and format == "auto":
         raise ValueError(
             f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "

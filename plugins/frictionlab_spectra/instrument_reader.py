@@ -16,7 +16,7 @@ import math
 import re
 import zipfile
 
-from .header_units import HEADER_BYTES, NUMBERS, check_units_named, named_units
+from .header_units import NUMBERS, check_units_named, head_text, named_units
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
@@ -68,13 +68,10 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
 
 
 def _coordinate_rows(fh) -> bool:
-    """Whether a text file's first row of numbers (whole within ``HEADER_BYTES``) holds two or
+    """Whether a text file's first row of numbers (whole within its ``head_text``) holds two or
     three: x, z or x, y, z per point, which SurfaceTopography's matrix reader, chosen by the
     suffix .txt, took for a map two or three pixels wide."""
-    fh.seek(0)
-    head = fh.read(HEADER_BYTES)
-    fh.seek(0)
-    for line in head.decode("utf-8", errors="replace").splitlines()[:-1]:  # the last line may be cut short
+    for line in head_text(fh).splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
     return False
@@ -117,10 +114,7 @@ def header_units(fh, reader) -> list[str]:
     in order, from the lines before its first row of numbers; empty for a binary format."""
     if reader.format() not in TEXT_FORMATS:
         return []
-    fh.seek(0)
-    head = fh.read(HEADER_BYTES)
-    fh.seek(0)
-    return named_units(head.decode("utf-8", errors="replace"))[0]  # the reader has read it as UTF-8
+    return named_units(head_text(fh))[0]
 
 
 def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
