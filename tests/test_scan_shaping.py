@@ -359,8 +359,9 @@ def test_heights_in_steps_coarser_than_the_roughness_between_pixels_are_said(tmp
     np.save(tmp_path / "steps.npy", np.round(z / step) * step)
     plugin = SurfaceFile if what == "map" else ProfileFile
     said = plugin(path=str(tmp_path / "steps.npy"), spacing=0.1, detrend="mean").input_summary().get("caveats", [])
-    flat = [caveat for caveat in said if "neighbouring pixels have exactly the same height" in caveat]
-    assert len(flat) == 1 and f"the {what}'s neighbouring" in flat[0], said
+    points = "pixels" if what == "map" else "points"
+    flat = [caveat for caveat in said if f"the {what}'s neighbouring {points} have exactly the same height" in caveat]
+    assert len(flat) == 1, said
     assert re.search(rf"steps \(the smallest {step:.3g}, 0\.2\d rms heights\)", flat[0]), flat[0]
     fine = plugin(path=str(tmp_path / "fine.npy"), spacing=0.1, detrend="mean").input_summary().get("caveats", [])
     assert not any("neighbouring pixels" in caveat for caveat in fine), fine

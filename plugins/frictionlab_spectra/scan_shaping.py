@@ -322,11 +322,12 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
         pairs, equal = pairs + z[ahead].size, equal + int(np.count_nonzero(z[ahead] == z[behind]))
     if not pairs or equal <= FLAT_SHARE * pairs:
         return None
-    steps = np.abs(np.diff(z, axis=-1))
-    step = float(steps[steps > 0].min()) if np.any(steps > 0) else 0.0
-    return (f"{100 * equal / pairs:.0f} % of the {what}'s neighbouring pixels have exactly the same height: its heights "
+    steps = np.abs(np.diff(z.ravel()))  # along the rows, and from a row's end to the next's start
+    step = float(steps[steps > 0].min())  # some: the map is not flat (rms > 0)
+    points = "pixels" if what == "map" else "points"
+    return (f"{100 * equal / pairs:.0f} % of the {what}'s neighbouring {points} have exactly the same height: its heights "
             f"are steps (the smallest {step:.3g}, {step / rms:.2g} rms heights) coarser than the roughness between "
-            "pixels, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
+            f"{points}, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
             "surface's; measure or export the heights at a finer resolution (a float channel in double precision, or "
             "less their mean: single precision keeps 7 digits of heights far from zero)")  # fmt: skip
 
