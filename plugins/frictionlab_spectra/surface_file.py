@@ -44,7 +44,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from frictionlab import InputFile
 
@@ -143,6 +143,24 @@ class SurfaceFile(MeasuredFile):
             "pixels around them by the solution of Laplace's equation from their neighbours (off by default; a value that "
             "would replace more than 5 % of the points is refused)",
         )
+        spacing_y: float | None = Field(
+            None, gt=0.0, description="pixel side along y (the map's rows), in the run's length unit, where it differs "
+            "from spacing's along x (a slow scan axis coarser than the fast one): the map is resampled onto square "
+            "pixels of the finer side; needs spacing",
+        )
+
+        @model_validator(mode="after")
+        def _spacing_y_with_spacing(self):
+            if self.spacing_y is not None and self.spacing is None:
+                raise ValueError(f"spacing_y = {self.spacing_y:g} gives the pixel's side along y beside spacing's along "
+                                 "x: give spacing too")  # fmt: skip
+            return self
+
+        def preset_pixel(self) -> tuple[float, float] | None:
+            """The pixel (dx, dy) the preset gives, if it gives one."""
+            if self.spacing is None:
+                return None
+            return (self.spacing, self.spacing if self.spacing_y is None else self.spacing_y)
 
     # ------------------------------------------------------------ contract
 
@@ -154,9 +172,8 @@ class SurfaceFile(MeasuredFile):
         p = self.params
         if header is None or p.region is not None or p.downsample is not None:
             return self._measured().heights.shape
-        if p.spacing is not None:
-            return header.shape
-        return square_shape(header.shape, header.pixel, f"surface-file {str(p.path)!r}", header.unit)
+        pixel = header.pixel if p.spacing is None else p.preset_pixel()
+        return square_shape(header.shape, pixel, f"surface-file {str(p.path)!r}", p.unit or header.unit)
 
     def radial_psd(self) -> RadialPSD:
         """The detrended map's radially averaged C2D in annuli of the map's own finest dq."""
@@ -282,7 +299,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         undefined = "keep" if p.region is not None and p.undefined == "refuse" else p.undefined  # outside: cropped
         scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=undefined, channel=p.channel,
                          spacing_given=p.spacing is not None)  # fmt: skip
-        data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
+        data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
         if p.region is not None and scan.undefined:
             summary.update(_undefined_in_region(scan, pixel, p, where))
@@ -301,7 +318,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
                 "a table of no numbers (a header, comments or blank lines only)"
             raise ValueError(f"{where}: {held}: no heights; expected a map of at least {MIN_SIDE} x {MIN_SIDE} points")
-        pixel = (p.spacing, p.spacing)
+        pixel = p.preset_pixel()
         summary = {
             "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
             "unit_from": "preset" if p.unit is not None else "none",
@@ -321,6 +338,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         points = "; columns of x, y and z per point (an instrument's export) are read with format: instrument" \
             if nx == 3 and not is_instrument_file(path, p.format) else ""
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
-    summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic}
+    summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
+               **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip
     return data.astype(np.float64, copy=False), (float(pixel[0]), float(pixel[1])), summary
 
