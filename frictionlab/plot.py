@@ -97,7 +97,9 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax_count.set_yscale("log")
     plain_log_labels(ax_count.yaxis)
     ax_count.set_ylabel("points in contact")
-    ax_count.set_xlabel(scene.normalisation.definition, fontsize=8)
+    label = wrap_title(scene.normalisation.definition, 6.4 * 0.85, 8)  # a map's definition is wider than the figure
+    ax_count.set_xlabel(label, fontsize=8)
+    fig.subplots_adjust(bottom=0.1 + 0.025 * label.count("\n"))
     ax_count.grid(True, which="both", alpha=0.3)
     fig.savefig(fh, format="png", dpi=110)
 
@@ -109,7 +111,7 @@ def _numeric(values) -> bool:
 def wrap_title(title: str, width_inches: float, fontsize: float) -> str:
     """``title`` broken into lines that fit a figure ``width_inches`` wide (a character
     is about 0.6 of the font size wide), so that none is clipped at the edges."""
-    return textwrap.fill(title, max(20, int(width_inches * 72 / (0.6 * fontsize))))
+    return textwrap.fill(title, max(20, int(width_inches * 72 / (0.6 * fontsize))), break_on_hyphens=False)
 
 
 def plot_sweep(sweep, rows: list[dict[str, Any]], fh, dpi: int = 90) -> None:

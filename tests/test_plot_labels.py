@@ -15,6 +15,8 @@ from frictionlab.compute import engine
 from frictionlab.options import RunOptions
 from frictionlab.plot import PlainLogFormatter, plain_log_labels, plot_curve
 
+from .conftest import SMALL_PRESET
+
 _DIGITS = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹−", "-0123456789-")
 
 
@@ -69,3 +71,31 @@ def test_plot_png_is_drawn_without_mathtext(make_scene, monkeypatch):
     fh = io.BytesIO()
     plot_curve(scene, outcome, fh)
     assert fh.getvalue().startswith(b"\x89PNG") and math.isfinite(outcome.fit.a)
+
+
+def test_the_definition_of_f_under_plot_png_is_inside_the_figure(make_scene, monkeypatch, tmp_path):
+    """A measured map pressed by MDR defines f with the equivalent line's length and the apparent
+    area, 125 characters: on one line it ran past the figure's right edge, cut at 'A the surface's app'."""
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    np.save(tmp_path / "map.npy", np.random.default_rng(1).normal(size=(16, 16)))
+    spectrum = {"name": "surface-file", "params": {"path": str(tmp_path / "map.npy"), "spacing": 0.1}}
+    scene = make_scene({"realizations": 2}, base={**SMALL_PRESET, "spectrum": spectrum})
+    outcome = engine.run(scene, RunOptions(workers=1))
+    drawn = []
+    save = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
+    plot_curve(scene, outcome, io.BytesIO())
+    fig = drawn[0]
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    label = fig.axes[1].xaxis.label
+    assert "A the surface's apparent area" in label.get_text().replace("\n", " ")
+    box, inside = label.get_window_extent(renderer), fig.bbox
+    assert box.x0 >= inside.x0 and box.x1 <= inside.x1 and box.y0 >= inside.y0, (box, inside)
+    ticks = max(t.get_window_extent(renderer).y0 for t in fig.axes[1].get_xticklabels() if t.get_text())
+    assert box.y1 <= ticks  # under the tick labels, not over them

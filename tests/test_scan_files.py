@@ -126,7 +126,7 @@ def test_what_each_scan_says_it_did(tmp_path):
 
 
 
-@pytest.mark.parametrize("micro", ["\u00b5m", "\u03bcm"], ids=["micro-sign", "greek-mu"])
+@pytest.mark.parametrize("micro", ["\u00b5m", "\u03bcm", "micron"], ids=["micro-sign", "greek-mu", "micron"])
 def test_a_preset_may_write_um_with_the_micro_sign_or_the_greek_mu(tmp_path, micro):
     rectangular_x3p(tmp_path / "r.x3p")
     written = SurfaceFile(path=str(tmp_path / "r.x3p"), unit=micro)

@@ -221,9 +221,12 @@ def describe_input(summary: dict) -> str:
         notes.append(f"pixels {summary['pixels']}")
     stated, given = summary.get("file_spacing"), summary.get("downsampled", {}).get("from_pixel", summary["spacing"])
     sides = stated if isinstance(stated, list) else [] if stated is None else [stated]
-    if spacing_from == "preset" and any(not math.isclose(side, given, rel_tol=1e-9) for side in sides):
+    rectangle = summary.get("spacing_given")  # spacing and spacing_y: the preset's pixel, not square
+    if spacing_from == "preset" and any(not math.isclose(side, given, rel_tol=1e-9) for side in sides) and \
+            not (rectangle and len(sides) == 2 and all(map(math.isclose, sides, rectangle))):  # fmt: skip
+        by = f"pixels of {' x '.join(f'{side:.6g}' for side in rectangle)}" if rectangle else "spacing, square"
         notes.append(f"the file's pixels of {' x '.join(f'{side:.6g}' for side in sides)}{length} replaced by the "
-                     "preset's spacing, square")  # fmt: skip
+                     f"preset's {by}")  # fmt: skip
     if summary.get("downsampled"):
         down = summary["downsampled"]
         notes.append(f"downsampled from pixels of {down['from_pixel']:.6g} to {down['to_pixel']:.6g}{length}")

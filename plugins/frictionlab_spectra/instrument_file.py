@@ -184,7 +184,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
         check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
-        check_header_units(fh, type(reader), file_unit, where)
+        check_header_units(fh, type(reader), file_unit, unit, where)
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")
         try:

@@ -16,6 +16,8 @@ import math
 import re
 import zipfile
 
+from .header_units import NUMBERS, check_units_named, head_text, named_units
+
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
@@ -48,6 +50,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
             "it the suffix of its format (.x3p, .sur, .datx, .nc, .spm...); a table of bare numbers (a .tsv) is "
             "read with format: table and spacing"
         )
+    if chosen.format() == "asc" and _coordinate_rows(fh):  # x, y, z per line under .txt: not a matrix of heights
+        chosen = next(reader for reader in readers if reader.format() == "xyz")
     if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
@@ -61,6 +65,16 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     if head.startswith(ZIP_MAGIC):
         check_zip_members(fh, chosen, where)
     return chosen
+
+
+def _coordinate_rows(fh) -> bool:
+    """Whether a text file's first row of numbers (whole within its ``head_text``) holds two or
+    three: x, z or x, y, z per point, which SurfaceTopography's matrix reader, chosen by the
+    suffix .txt, took for a map two or three pixels wide."""
+    for line in head_text(fh).splitlines()[:-1]:  # the last line may be cut short
+        if NUMBERS.match(line):
+            return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
+    return False
 
 
 def _looks_like_text(head: bytes) -> bool:
@@ -95,42 +109,20 @@ def check_zip_members(fh, reader, where: str) -> None:
 X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int16, int32, float32, float64
 
 
-HEADER_BYTES = 4096  # of a text export read for the units its header names
-_LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "mm": "mm", "cm": "cm", "m": "m"}
-_UNIT_TOKEN = re.compile(r"[\[(/]\s*(pm|nm|um|\u00b5m|\u03bcm|mm|cm|m)\s*(?=[\])\s,;]|$)")
-_NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")
-
-
 def header_units(fh, reader) -> list[str]:
     """The length units the header of a text export names (``x [\u00b5m]``, ``z (nm)``, ``z/nm``),
     in order, from the lines before its first row of numbers; empty for a binary format."""
     if reader.format() not in TEXT_FORMATS:
         return []
-    fh.seek(0)
-    head = fh.read(HEADER_BYTES)
-    fh.seek(0)
-    text = head.decode("utf-8", errors="replace")  # the reader has read it as UTF-8
-    units = []
-    for line in text.splitlines()[:-1]:  # the last line may be cut short
-        if _NUMBERS.match(line):
-            break
-        units += [_LENGTH_UNIT[token] for token in _UNIT_TOKEN.findall(line)]
-    return units
+    return named_units(head_text(fh))[0]
 
 
-def check_header_units(fh, reader, file_unit: str | None, where: str) -> None:
-    """Refuse a text export whose header names different length units (``x [\u00b5m]``, ``z
-    [nm]``) that its reader does not read: the heights and the pixel would be taken as bare
-    numbers in one unit, every slope off by their ratio, without a word."""
-    units = header_units(fh, reader)
-    if file_unit is not None or len(set(units)) < 2:
-        return
-    named = ", ".join(dict.fromkeys(units))
-    raise ValueError(
-        f"{where}: its header names the length units {named}, which SurfaceTopography's {reader.name()} reader "
-        "does not read: the heights and the pixel would be taken as bare numbers in one unit, the slopes off by "
-        "their ratio; convert the columns to one length unit"
-    )
+def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
+    """Refuse a text export whose header names length units (``x [\u00b5m]``, ``z [nm]``) that its
+    reader does not read, when they differ, or differ from the preset's ``unit``: the heights and
+    the pixel would be taken as bare numbers in that unit, the slopes off by their ratio."""
+    if file_unit is None:
+        check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
 
 
 def check_payload(fh, reader, where: str) -> None:
@@ -263,6 +255,13 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
                           "crop it with the instrument's software")  # fmt: skip
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
+    if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):
+        return ValueError(f"{where}: its header names the lateral unit {quoted(unknown[1])}, which SurfaceTopography's "
+                          f"{name} reader does not know (not damage); write it as one it knows: {_KNOWN_LENGTHS}")  # fmt: skip
+    if isinstance(exc, CorruptFile) and reader.format() == "asc" and "Could not find any topography data" in text:
+        return ValueError(f"{where}: this {name} file holds no channel of heights its reader knows: no rows of numbers, or "
+                          "none under value units that are a length it reads (degrees, volts, or a spelling such as "
+                          f"'micron'); export the heights with their unit written as one of {_KNOWN_LENGTHS}")  # fmt: skip
     said = _reason(exc)
     if reader.format() == "xyz" and isinstance(exc, ValueError) and (
             "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
@@ -281,6 +280,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
 
 
 REASON_SHOWN = 160
+_KNOWN_LENGTHS = "m, mm, \u00b5m (or um), nm, \u00c5, pm"  # as SurfaceTopography's text readers spell them
 
 
 def _reason(exc: BaseException) -> str:
@@ -339,7 +339,8 @@ def pick_channel(reader, wanted: str | int | None, where: str):
         named = [c for c in channels if str(c.name) == wanted]
         if not named:
             raise ValueError(f"{where}: no channel named {quoted(wanted)}; the file has {_named(channels)}"
-                             f"{_near_names(channels, wanted)}")  # fmt: skip
+                             f"{_near_names(channels, wanted)} (channels of heights only: one in degrees, volts or "
+                             "no unit is not read)")  # fmt: skip
         channel = named[0]
     same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
     note = None

@@ -24,8 +24,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from . import instrument_reader
-from .scan_shaping import (cosine_resample, despike, level, levelling_warning, outlier_warning, resampled_points,
-                           spike_warning)
+from .scan_shaping import (cosine_resample, despike, flat_neighbours_warning, level, levelling_warning, line_offset_warning,
+                           outlier_warning, resampled_points, spike_warning)
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 SAME_SIDE = 1e-9  # relative difference of two sides that are the same side, rounded
@@ -146,6 +146,10 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after)) is not None:
         caveats.append(warning)
     if (warning := outlier_warning(levelled.heights, "map")) is not None:
+        caveats.append(warning)
+    if (warning := flat_neighbours_warning(z, levelled.rms_after, "map")) is not None:
+        caveats.append(warning)
+    if (warning := line_offset_warning(levelled.heights)) is not None:
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel

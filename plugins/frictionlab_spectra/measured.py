@@ -63,8 +63,8 @@ class MeasuredParams(PluginParams):
     @field_validator("unit", mode="before")
     @classmethod
     def _micro_sign(cls, unit: object) -> object:
-        # um as an instrument writes it, with the micro sign or the Greek mu
-        return "um" if unit in ("\u00b5m", "\u03bcm") else unit
+        # um as an instrument writes it: with the micro sign or the Greek mu, or as microns
+        return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else unit
 
     @model_validator(mode="after")
     def _channel_of_an_instrument_file(self):

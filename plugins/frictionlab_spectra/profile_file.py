@@ -38,10 +38,11 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
+from .header_units import check_table_header
 from .instrument_reader import room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
-from .scan_shaping import level_line, line_form_warning, line_spike_warning, outlier_warning
+from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -111,6 +112,8 @@ class ProfileFile(MeasuredFile):
             periodic = scan.periodic if p.periodic is None else p.periodic
         else:
             x, z = _read_columns(path)
+            if file_suffix(path, where) != ".npy":
+                check_table_header(path, where, p.unit, p.format)
             summary = {
                 "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset", "unit": p.unit,
                 "unit_from": "preset" if p.unit is not None else "none",
@@ -139,9 +142,10 @@ class ProfileFile(MeasuredFile):
         heights = level_line(z, mode)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
-        if not rms > 1e-12 * scale:  # also true for scale == 0
+        if not rms > FLAT * scale:  # also true for scale == 0
+            said = flat_rms(rms, scale)
             raise ValueError(
-                f"{where}: the profile is constant (rms height zero after detrend={mode!r}); "
+                f"{where}: the profile is constant (rms height {said[0]} after detrend={mode!r}{said[1]}); "
                 "a flat line has no roughness"
             )
         heights.flags.writeable = False
@@ -151,7 +155,7 @@ class ProfileFile(MeasuredFile):
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms),
-                   outlier_warning(heights, "line")]  # as a map's
+                   outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)

@@ -44,11 +44,12 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
+from .header_units import check_table_header
 from .instrument_file import (
     ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
@@ -59,6 +60,7 @@ from .power_law import TWO_PI
 from .profile_file import (
     check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table, table_fill_advice,
 )
+from .scan_shaping import FLAT, flat_rms
 
 MIN_SIDE = 8
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
@@ -141,6 +143,24 @@ class SurfaceFile(MeasuredFile):
             "pixels around them by the solution of Laplace's equation from their neighbours (off by default; a value that "
             "would replace more than 5 % of the points is refused)",
         )
+        spacing_y: float | None = Field(
+            None, gt=0.0, description="pixel side along y (the map's rows), in the run's length unit, where it differs "
+            "from spacing's along x (a slow scan axis coarser than the fast one): the map is resampled onto square "
+            "pixels of the finer side; needs spacing",
+        )
+
+        @model_validator(mode="after")
+        def _spacing_y_with_spacing(self):
+            if self.spacing_y is not None and self.spacing is None:
+                raise ValueError(f"spacing_y = {self.spacing_y:g} gives the pixel's side along y beside spacing's along "
+                                 "x: give spacing too")  # fmt: skip
+            return self
+
+        def preset_pixel(self) -> tuple[float, float] | None:
+            """The pixel (dx, dy) the preset gives, if it gives one."""
+            if self.spacing is None:
+                return None
+            return (self.spacing, self.spacing if self.spacing_y is None else self.spacing_y)
 
     # ------------------------------------------------------------ contract
 
@@ -152,9 +172,8 @@ class SurfaceFile(MeasuredFile):
         p = self.params
         if header is None or p.region is not None or p.downsample is not None:
             return self._measured().heights.shape
-        if p.spacing is not None:
-            return header.shape
-        return square_shape(header.shape, header.pixel, f"surface-file {str(p.path)!r}", header.unit)
+        pixel = header.pixel if p.spacing is None else p.preset_pixel()
+        return square_shape(header.shape, pixel, f"surface-file {str(p.path)!r}", p.unit or header.unit)
 
     def radial_psd(self) -> RadialPSD:
         """The detrended map's radially averaged C2D in annuli of the map's own finest dq."""
@@ -236,11 +255,14 @@ class SurfaceFile(MeasuredFile):
             raise ValueError(f"{where}: after the crop, resampling and downsampling the map has {nx} x {ny} pixels (x by y); at "
                              f"least {MIN_SIDE} x {MIN_SIDE} are needed")  # fmt: skip
         rms = float(np.std(heights))  # after the size check: a map downsampled to one pixel is small, not flat
-        if not rms > 1e-12 * float(np.nanmax(np.abs(z))):  # also true for an all-zero map; NaN only outside region
+        largest = float(np.nanmax(np.abs(z)))
+        if not rms > FLAT * largest:  # also true for an all-zero map; NaN only outside region
             replaced = shaped.get("despiked", {}).get("points")
             despiked = f" and despike {p.despike:g}, which replaced {replaced} points" if replaced else ""
+            said = flat_rms(rms, largest)
             raise ValueError(
-                f"{where}: the map is constant (rms height zero after detrend={shaped['detrend']!r}{despiked}); "
+                f"{where}: the map is constant (rms height {said[0]} after detrend={shaped['detrend']!r}{despiked}"
+                f"{said[1]}); "
                 "a flat surface has no roughness"
             )
         heights.flags.writeable = False
@@ -277,23 +299,26 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         undefined = "keep" if p.region is not None and p.undefined == "refuse" else p.undefined  # outside: cropped
         scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=undefined, channel=p.channel,
                          spacing_given=p.spacing is not None)  # fmt: skip
-        data, pixel = scan.heights, scan.pixel if p.spacing is None else (p.spacing, p.spacing)
+        data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
         if p.region is not None and scan.undefined:
             summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
+        table = file_suffix(path, where) != ".npy"
+        if table:  # first: an export whose header states its pixel is told how to read it, not to give spacing
+            check_table_header(path, where, p.unit, p.format)
         if p.spacing is None:
             raise ValueError(
                 f"{where}: a {path.suffix.lower()} map holds bare numbers, so the parameter spacing (the pixel side) "
                 "is required"
             )
-        data = load_npy(path, where) if file_suffix(path, where) == ".npy" else read_text_table(path, where)
+        data = read_text_table(path, where) if table else load_npy(path, where)
         if data.size == 0:  # not 'a map of 1 x 0 pixels, one pixel wide: a line'
             held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
                 "a table of no numbers (a header, comments or blank lines only)"
             raise ValueError(f"{where}: {held}: no heights; expected a map of at least {MIN_SIDE} x {MIN_SIDE} points")
-        pixel = (p.spacing, p.spacing)
+        pixel = p.preset_pixel()
         summary = {
             "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
             "unit_from": "preset" if p.unit is not None else "none",
@@ -310,7 +335,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         )
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
-        raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed")
-    summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic}
+        points = "; columns of x, y and z per point (an instrument's export) are read with format: instrument" \
+            if nx == 3 and not is_instrument_file(path, p.format) else ""
+        raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
+    summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
+               **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip
     return data.astype(np.float64, copy=False), (float(pixel[0]), float(pixel[1])), summary
 

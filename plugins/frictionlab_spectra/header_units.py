@@ -1,0 +1,84 @@
+"""The length units a text file's header names, before its first row of numbers: in a column's
+label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
+``# Value units: m``). A table's numbers are read bare, so what its header says of their units
+is checked against the preset (``check_table_header``); a text export read by SurfaceTopography
+is checked the same way where its reader skips the header (``instrument_reader``)."""
+
+from __future__ import annotations
+
+import re
+
+HEADER_BYTES = 4096  # of a text file read for the units its header names
+LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
+               "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5"}  # fmt: skip
+_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5"
+_LABEL = re.compile(rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)")  # x [µm], z (nm), z/nm
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
+_UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
+# "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
+_STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # keys in any case
+NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
+
+
+def head_text(fh, encoding: str = "utf-8") -> str:
+    """The first HEADER_BYTES of the open file ``fh`` as text (bytes that are not ``encoding``
+    replaced), the file left at its start for a reader: its header, and its first rows."""
+    fh.seek(0)
+    head = fh.read(HEADER_BYTES)
+    fh.seek(0)
+    return head.decode(encoding, errors="replace")
+
+
+def named_units(text: str) -> tuple[list[str], bool]:
+    """The length units the header of ``text`` (its lines before the first that starts with a
+    number) names, in order, and whether it states one by a key of an instrument's text export
+    (``Width: 25.6 µm``, ``Value units: m``, ``z-unit = nm``): SurfaceTopography's reader reads them."""
+    units, stated_by_key = [], False
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
+        if NUMBERS.match(line):
+            break
+        units += [LENGTH_UNIT[token] for token in _LABEL.findall(line)]
+        if stated := _STATED.search(line.rstrip()):
+            units.append(LENGTH_UNIT[stated["unit"]])
+            stated_by_key = True
+    return units, stated_by_key
+
+
+def check_table_header(path, where: str, unit: str | None, format: str) -> None:
+    """Refuse a table (read as bare numbers) whose header says its numbers are not what the
+    preset takes them for: a header of an instrument's text export that states its size or units
+    (read with ``format: auto``), columns in different length units, or one unit other than the
+    preset's ``unit``."""
+    from .instrument_file import open_input  # here: it imports this module
+
+    with open_input(path, where) as fh:
+        units, export = named_units(head_text(fh, "utf-8-sig"))
+    if export and format == "auto":
+        raise ValueError(
+            f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "
+            "instrument's text export (Gwyddion's, say) does, and a table's numbers are read bare, without them: "
+            "read it with format: instrument, which takes the units and the pixel size from the header (or with "
+            "format: table, spacing and unit, for its bare numbers)"
+        )
+    if not export:  # with format: table, an instrument's export asked for its bare numbers
+        check_units_named(units, unit, where, "which a table's reader does not read")
+
+
+def check_units_named(units: list[str], unit: str | None, where: str, ignored: str) -> None:
+    """Refuse a file whose header names ``units`` (``named_units``) that its reader ignores
+    (``ignored`` says which reader): different length units, or one other than the preset's ``unit``;
+    its numbers would be taken bare, in the preset's unit."""
+    from .instrument_file import LENGTH_UNITS  # here: it imports this module
+
+    if len(set(units)) > 1:
+        raise ValueError(
+            f"{where}: its header names the length units {', '.join(dict.fromkeys(units))}, {ignored}: its numbers "
+            "are taken bare, all in one unit, the slopes off by their ratio; convert the columns to one length unit"
+        )
+    if units and unit is not None and units[0] != unit:
+        to = f"set unit: {units[0]}, or convert" if units[0] in LENGTH_UNITS else "convert"
+        raise ValueError(
+            f"{where}: its header names the length unit {units[0]}, {ignored}: its numbers are taken to be in the "
+            f"preset's unit, {unit}; {to} the numbers to {unit}"
+        )

@@ -1,0 +1,185 @@
+"""A table's numbers are read bare; what its header says of their units is checked against
+the preset: an instrument's text export whose header states its size (Gwyddion's), columns
+in different length units (a profilometer's x in mm, z in um), or a unit other than the
+preset's. Each was read as bare numbers in the preset's unit, without a word, every slope or
+height off by the units' ratio."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab_spectra import ProfileFile, SurfaceFile
+
+
+def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
+    return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
+
+
+def gwyddion_text(path, z_um, pixel_um: float, value_unit: str = "m", scale: float = 1e-6):
+    """A map z[y, x] in um as Gwyddion's plain-text export writes it: its size in µm, values in ``value_unit``."""
+    ny, nx = z_um.shape
+    header = (f"# Channel: Height\n# Width: {nx * pixel_um:.3f} µm\n# Height: {ny * pixel_um:.3f} µm\n"
+              f"# Value units: {value_unit}\n")  # fmt: skip
+    rows = "".join(" ".join(f"{v * scale:.9e}" for v in row) + "\n" for row in z_um)
+    path.write_text(header + rows, encoding="utf-8")
+    return path
+
+
+def test_an_instrument_text_export_read_as_a_table_is_told_to_be_read_as_one(tmp_path, capsys):
+    """Gwyddion's .txt export, read by suffix as a table with spacing 0.1 and unit um, had its
+    heights in metres taken as micrometres: an rms height of 1e-6 um, validated as 'ok'."""
+    z = rough(16, 24)
+    path = gwyddion_text(tmp_path / "scan.txt", z, 0.1)
+    spectrum = {"name": "surface-file", "params": {"path": str(path), "spacing": 0.1, "unit": "um"}}
+    preset = {"name": "gwy", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
+              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    text = "".join(capsys.readouterr())
+    assert code == ExitCode.USAGE, text
+    assert "its header states the scan's units (um, m)" in text and "format: instrument" in text
+    assert "Traceback" not in text
+    read = SurfaceFile(path=str(path), unit="um", format="instrument", detrend="none").generate(None)
+    assert read.spacing == pytest.approx(0.1, rel=1e-9)
+    np.testing.assert_allclose(read.heights, z, rtol=1e-8, atol=1e-8)
+    bare = SurfaceFile(path=str(path), spacing=0.1, format="table", detrend="none").generate(None)  # asked for
+    np.testing.assert_allclose(bare.heights, z * 1e-6, rtol=1e-8, atol=1e-14)
+
+
+def test_a_profile_with_x_and_z_in_different_units_is_refused(tmp_path):
+    """A profilometer's export, x in mm and z in um: the pixel was read as 0.0005 'um', every
+    slope a thousand times too steep, and pressures of 20 E* validated as 'ok'."""
+    x = np.arange(64) * 0.5
+    z = rough(1, 64, 2)[0]
+    for name, header, scale in (("mixed.csv", "x [mm],z [um]", 1e-3), ("same.csv", "x [um],z [um]", 1.0)):
+        (tmp_path / name).write_text(header + "\n" + "".join(f"{float(a * scale)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    with pytest.raises(ValueError, match=r"its header names the length units mm, um, .* convert the columns"):
+        ProfileFile(path=str(tmp_path / "mixed.csv"), unit="um").rms_height()
+    line = ProfileFile(path=str(tmp_path / "same.csv"), unit="um").generate(None)
+    assert line.spacing == pytest.approx(0.5, rel=1e-12) and line.heights.size == 64
+
+
+@pytest.mark.parametrize("header", ["z [nm]", "# heights (nm)", "Höhe/nm"])
+def test_a_table_whose_header_names_another_unit_than_the_presets_is_refused(tmp_path, header):
+    z = rough(10, 12, 3)
+    (tmp_path / "m.csv").write_text(header + "\n" + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in z),
+                                    encoding="utf-8")  # fmt: skip
+    with pytest.raises(ValueError, match=r"its header names the length unit nm, which a table's reader does not read: .* the preset's unit, um; set unit: nm"):
+        SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit="um").rms_height()
+    for unit in ("nm", None):
+        assert SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit=unit).generate(None).heights.shape == (10, 12)
+
+
+@pytest.mark.parametrize("label", ["micron", "\u00b5m", "\u03bcm"])
+def test_micrometres_spelled_as_instruments_do_are_micrometres(tmp_path, label):
+    x = np.arange(32) * 0.5
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32)[0]))
+    for name, z_unit in (("nm.csv", "nm"), ("um.csv", "um")):
+        (tmp_path / name).write_text(f"x [{label}],z [{z_unit}]\n" + rows, encoding="utf-8")
+    with pytest.raises(ValueError, match=r"its header names the length units um, nm"):
+        ProfileFile(path=str(tmp_path / "nm.csv"), unit="um").rms_height()
+    assert ProfileFile(path=str(tmp_path / "um.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def write_points(path, z, dx: float, dy: float, header: str = "# x [um]\ty [um]\tz [um]\n") -> None:
+    """A map z[y, x] as an export of x, y, z per point, a row of the map after another."""
+    ny, nx = z.shape
+    rows = "".join(f"{i * dx:.6f}\t{j * dy:.6f}\t{float(z[j, i])!r}\n" for j in range(ny) for i in range(nx))
+    path.write_text(header + rows, encoding="utf-8")
+
+
+def test_an_export_of_points_named_txt_is_read_as_points_not_as_a_matrix(tmp_path):
+    """format: instrument promises an export of x, y, z per line under .csv or .txt; under .txt it
+    went to the reader of matrices, which read its three columns as a map 3 pixels wide ('map of 3 x
+    120 pixels; at least 8 x 8'), and a line's x, z as damage ('a damaged Plain text file')."""
+    z = rough(10, 12, 4)
+    write_points(tmp_path / "map.txt", z, 0.1, 0.25)
+    read = SurfaceFile(path=str(tmp_path / "map.txt"), format="instrument", unit="um", spacing=0.1, detrend="none")
+    np.testing.assert_allclose(read.generate(None).heights, z, rtol=0, atol=1e-12)
+    resampled = SurfaceFile(path=str(tmp_path / "map.txt"), format="instrument", unit="um").input_summary()
+    assert "0.1 x 0.25 resampled onto square pixels of 0.1" in resampled["pixels"]
+    x, line = np.arange(40) * 0.5, rough(1, 40, 5)[0]
+    (tmp_path / "line.txt").write_text("x [um]\tz [um]\n" + "".join(f"{a:.3f}\t{float(b)!r}\n" for a, b in zip(x, line)))
+    profile = ProfileFile(path=str(tmp_path / "line.txt"), format="instrument", unit="um", detrend="none").generate(None)
+    assert profile.spacing == pytest.approx(0.5, rel=1e-9)
+    np.testing.assert_allclose(profile.heights, line, rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match=r"map of 3 x 120 pixels .* columns of x, y and z per point .* format: instrument"):
+        SurfaceFile(path=str(tmp_path / "map.txt"), spacing=0.1).rms_height()  # a table, by its suffix
+
+
+def test_a_text_export_in_another_unit_than_the_presets_is_refused(tmp_path):
+    """An x, y, z export whose header says um, read with unit: nm, had its numbers taken as nm."""
+    z = rough(9, 10, 6)
+    write_points(tmp_path / "scan.xyz", z, 0.5, 0.5)
+    with pytest.raises(ValueError, match=r"header names the length unit um, which SurfaceTopography's .* reader does not "
+                       r"read: .* the preset's unit, nm; set unit: um"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="nm").rms_height()
+    assert SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def test_a_channel_that_is_not_heights_asked_by_name_is_told_why_it_is_not_listed(tmp_path):
+    """Gwyddion's export of Height, Phase (deg) and a retrace: asking for 'Phase' listed the two
+    height channels as if the file had no Phase."""
+    z = rough(12, 16, 7)
+    blocks = []
+    for name, unit, data in (("Height", "m", z * 1e-6), ("Phase", "deg", z * 40), ("Height retrace", "m", z * 1e-6)):
+        rows = "".join(" ".join(f"{v:.9e}" for v in row) + "\n" for row in data)
+        blocks.append(f"# Channel: {name}\n# Width: 1.6 µm\n# Height: 1.2 µm\n# Value units: {unit}\n{rows}")
+    (tmp_path / "three.txt").write_text("".join(blocks), encoding="utf-8")
+    with pytest.raises(ValueError, match=r"no channel named 'Phase'; the file has 0: 'Height', 1: 'Height retrace' "
+                       r"\(channels of heights only: one in degrees, volts or no unit is not read\)"):  # fmt: skip
+        SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Phase").rms_height()
+    retrace = SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Height retrace", unit="um")
+    assert retrace.generate(None).spacing == pytest.approx(0.1, rel=1e-9)
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_scan_flat_but_for_rounding_is_not_said_to_have_an_rms_height_of_zero(tmp_path, plugin):
+    """5 + 1e-14 noise is refused as flat, as it should be, but was said to have 'rms height zero'."""
+    noise = np.random.default_rng(0).normal(size=(16, 16) if plugin is SurfaceFile else 64)
+    np.save(tmp_path / "flat.npy", 5.0 + 1e-14 * noise)
+    with pytest.raises(ValueError, match=r"is constant \(rms height \d\.\d+e-1[45] after detrend='mean', below 1e-12 of its "
+                       r"largest height 5: the rounding of its numbers\)"):  # fmt: skip
+        plugin(path=str(tmp_path / "flat.npy"), spacing=1.0).rms_height()
+    np.save(tmp_path / "zero.npy", np.zeros_like(noise))
+    with pytest.raises(ValueError, match=r"is constant \(rms height zero after detrend='mean'\)"):
+        plugin(path=str(tmp_path / "zero.npy"), spacing=1.0).rms_height()
+
+
+def test_a_text_export_whose_unit_is_spelled_micron_is_not_called_damaged(tmp_path):
+    """'# Width: 1.6 micron' (or values in 'microns') is a unit SurfaceTopography's reader does not
+    know: the file was 'a damaged Plain text file', to be copied again from the instrument."""
+    rows = "".join(" ".join(f"{v:.9e}" for v in row) + "\n" for row in rough(12, 16, 8))
+    for name, width, values in (("lateral.txt", "micron", "µm"), ("values.txt", "µm", "microns")):
+        header = f"# Channel: Height\n# Width: 1.6 {width}\n# Height: 1.2 {width}\n# Value units: {values}\n"
+        (tmp_path / name).write_text(header + rows, encoding="utf-8")
+    with pytest.raises(ValueError) as lateral:
+        SurfaceFile(path=str(tmp_path / "lateral.txt"), format="instrument").rms_height()
+    assert "its header names the lateral unit 'micron', which SurfaceTopography's Plain text reader does not know " \
+        "(not damage); write it as one it knows: m, mm, µm (or um)" in str(lateral.value)  # fmt: skip
+    with pytest.raises(ValueError) as values:
+        SurfaceFile(path=str(tmp_path / "values.txt"), format="instrument").rms_height()
+    assert "holds no channel of heights its reader knows" in str(values.value) and "'micron'" in str(values.value)
+    assert "damaged" not in str(lateral.value) + str(values.value)
+
+
+def test_a_header_stating_other_lengths_is_no_instrument_export(tmp_path):
+    """'# Cutoff: 0.8 mm' (a filter's wavelength) or '# Probe radius: 2 um' above a profile in um
+    is no statement of the numbers' units: read as the table it is."""
+    x = np.arange(32) * 0.5
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32, 9)[0]))
+    (tmp_path / "p.csv").write_text("# Cutoff: 0.8 mm\n# Probe radius: 2 um\nx [um],z [um]\n" + rows, encoding="utf-8")
+    assert ProfileFile(path=str(tmp_path / "p.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)
+
+
+def test_keys_in_any_case_units_as_written(tmp_path):
+    """Keys are matched in any case ('Value Units'); units only as written: 'MM' is no unit (it was
+    looked up as one, a KeyError: an internal error)."""
+    from frictionlab_spectra.header_units import named_units
+
+    assert named_units("# WIDTH: 25.6 MM\n# value units: M\n1 2\n") == ([], False)
+    assert named_units("# Width: 2 µm\n# Value Units: m\n1\n") == (["um", "m"], True)
