@@ -263,7 +263,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
                           "crop it with the instrument's software")  # fmt: skip
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
-    said = _reason(exc)
+    said = reason_said(exc)
     if reader.format() == "xyz" and isinstance(exc, ValueError) and (
             "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
         return ValueError(  # its grid's step along y (or x) came out zero, binned by numpy.bincount: not damage
@@ -283,7 +283,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
 REASON_SHOWN = 160
 
 
-def _reason(exc: BaseException) -> str:
+def reason_said(exc: BaseException) -> str:
     """The reader's own words for a failure, on one line, cut in the middle past REASON_SHOWN
     characters (they may quote the file)."""
     text = " ".join(str(exc).split())
