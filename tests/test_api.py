@@ -54,6 +54,22 @@ def test_overrides_may_be_named_as_in_the_signature():
     assert frictionlab.validate("quickstart", overrides={"realizations": 7})["realizations"] == 7
 
 
+
+@pytest.mark.parametrize(("overrides", "keywords", "said"), [
+    ({"spectrum..params": 1}, {}, "'spectrum..params': must be field names joined by dots, e.g. spectrum.params.hurst"),
+    ({"": 1, ".seed": 2}, {}, "'': must be field names joined by dots"),
+    ({}, {"spectrum____params": 1}, "'spectrum____params': must be field names joined by __, e.g. spectrum__params__hurst"),
+    ({}, {"seed__": 1}, "'seed__': must be field names joined by __"),
+])  # fmt: skip
+def test_an_override_path_with_a_name_left_out_is_refused_as_such(overrides, keywords, said):
+    """An override's path with nothing between two dots (or a keyword's between two __) set a key
+    named '' and was refused as another field's problem: spectrum____params=1 was 'spectrum: is
+    not a known field; allowed: name, params', though spectrum is one (--set refuses a..b so)."""
+    with pytest.raises(PresetError) as refused:
+        frictionlab.validate("quickstart", overrides, **keywords)
+    assert said in str(refused.value)
+    assert "is not a known field" not in str(refused.value)
+
 def test_bad_input_is_a_clear_error_naming_the_field():
     with pytest.raises(PresetError, match="spectrum.params.hurst"):
         frictionlab.run(SMALL_PRESET, spectrum__params__hurst=7.0, **FAST)
