@@ -94,6 +94,9 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be a list"
     if kind == "string_too_short":
         return "must not be empty"
+    if kind in {"too_short", "too_long"}:  # pydantic: 'Dictionary should have at least 1 item after validation, not 0'
+        bound = ctx["min_length"] if kind == "too_short" else ctx["max_length"]
+        return f"must hold {'at least' if kind == 'too_short' else 'at most'} {bound} item{'s' * (bound != 1)}"
     if kind == "string_pattern_mismatch" and ctx.get("pattern") == NAME_PATTERN:
         return NAME_RULE
     message = error["msg"]
