@@ -235,6 +235,22 @@ def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
         frictionlab.load(folder)
 
 
+
+def test_a_sweep_json_status_no_sweep_writes_is_refused(tmp_path):
+    """A sweep.json's status and its points' were any text: load() gave a SweepResult of status
+    'done' (or of an escape sequence) and points of status 'ok', as summary.json's status, a
+    choice of four, is not."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    for where, field, first in ((data, "status", "running"), (data["points"][1], "points.1.status", "completed")):
+        saved, where["status"] = where["status"], "done"
+        (folder / "sweep.json").write_text(json.dumps(data))
+        with pytest.raises(RunFolderError, match=rf"sweep.json is damaged: field '{field}': input should be '{first}'"):
+            frictionlab.load(folder)
+        where["status"] = saved
+
 def test_the_tui_list_names_fifos_and_links_damaged_without_blocking(run_copy, tmp_path):
     runs = run_copy.parent
     for name, damage in (("fifo", "summary.json a FIFO"), ("linked", "summary.json a link out")):
