@@ -117,6 +117,9 @@ def options_from_args(args) -> StudyOptions:
         raise FrictionlabError(
             f"--axes must name some of {', '.join(AXES)}. Got {short_repr(args.axes)} instead."
         )
+    if twice := sorted({a for a in axes if axes.count(a) > 1}):  # each ran again: the same rows, the time twice
+        raise FrictionlabError(f"--axes names {', '.join(twice)} more than once; each axis runs once: name it once. "
+                               f"Got {short_repr(args.axes)} instead.")  # fmt: skip
     if not 0 < args.target < 1:
         raise FrictionlabError(f"--target must be > 0 and < 1 (a relative error). Got {args.target} instead.")
     return StudyOptions(

@@ -40,6 +40,8 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
     [
         (["--reference", "bem-nowhere"], "--reference: no solver plugin named 'bem-nowhere'"),
         (["--axes", "grid,speed"], "--axes must name some of grid, realizations, steps, solver, tolerance"),
+        (["--axes", "grid,steps,grid"], "--axes names grid more than once; each axis runs once: name it once. "
+                                         "Got 'grid,steps,grid' instead."),  # the grid axis ran twice, its rows too
         (["--target", "2"], "--target must be > 0 and < 1"),
         (["--tolerances", "1e-3,abc"], "--tolerances must be a comma-separated list of numbers"),
         (["--grid-factors", "1,-2"], "--grid-factors values must be finite numbers > 0. Got -2.0 instead."),
