@@ -124,6 +124,8 @@ class Result:
         if missing or (ax is not None and not hasattr(ax, "transAxes")):
             needs = ", ".join(missing or ["transAxes"])
             raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}, which has no {needs}")
+        if getattr(ax, "name", "rectilinear") != "rectilinear":  # a log x axis and error bars need flat x, y axes
+            raise FrictionlabError(f"ax must be a flat (rectilinear) matplotlib Axes or None, got a {ax.name!r} projection")
         if ax is None:
             import matplotlib.pyplot as plt
 

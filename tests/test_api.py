@@ -270,6 +270,14 @@ def test_a_result_plot_names_a_wrong_axes(tmp_path):
     result = frictionlab.run(SMALL_PRESET, realizations=2, **FAST)
     with pytest.raises(FrictionlabError, match="ax must be a matplotlib Axes or None, got int"):
         result.plot(ax=5)
+    import matplotlib.pyplot as plt
+
+    figure = plt.figure()
+    for projection in ("3d", "polar"):  # a TypeError (3d's fill_between) or a NotImplementedError from inside
+        with pytest.raises(FrictionlabError, match=f"ax must be a flat .rectilinear. matplotlib Axes or None, got a "
+                                                   f"'{projection}' projection"):
+            result.plot(ax=figure.add_subplot(projection=projection))
+    plt.close(figure)
 
 
 def test_api_errors_name_a_built_in_preset_as_the_cli_does(tmp_path, monkeypatch, capsys):
