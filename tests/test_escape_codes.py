@@ -179,3 +179,14 @@ def test_a_key_with_a_character_that_hides_or_reorders_text_is_printed_escaped(t
     assert main(["validate", str(path), "--set", typed]) == 2
     err = capsys.readouterr().err
     assert said in err and not {"\u200b", "\u202e", "\u009b"} & set(err), err
+
+
+@posix
+def test_the_api_names_a_preset_file_escaped(tmp_path):
+    """frictionlab.validate(path) and run raise a PresetError whose first line names the file:
+    printed in a terminal or a notebook, a name holding an escape code drove it (the CLI escapes
+    the whole message; the API's message itself held the code)."""
+    (tmp_path / f"p{PAYLOAD}.yaml").write_text("name: x\n")
+    with pytest.raises(frictionlab.errors.PresetError) as refused:
+        frictionlab.validate(tmp_path / f"p{PAYLOAD}.yaml")
+    assert "pwned" in str(refused.value) and ESC not in str(refused.value)
