@@ -338,7 +338,7 @@ def run(
         from .runs.sweep import plan_sweep, run_sweep
 
         if out is None:
-            raise FrictionlabError(f"{source}: a sweep writes a run folder per point: give out=FOLDER")
+            raise FrictionlabError(f"{shown(source)}: a sweep writes a run folder per point: give out=FOLDER")
         sweep = plan_sweep(data, source=source, before_reading=memory_check_before_reading(options))
         run_sweep(sweep, out, options, listeners=[SweepProgress()] if progress else [], plot=plot)
         return load(out)

@@ -190,3 +190,8 @@ def test_the_api_names_a_preset_file_escaped(tmp_path):
     with pytest.raises(frictionlab.errors.PresetError) as refused:
         frictionlab.validate(tmp_path / f"p{PAYLOAD}.yaml")
     assert "pwned" in str(refused.value) and ESC not in str(refused.value)
+    sweep = merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"values": [1, 2]}}}})
+    (tmp_path / f"s{PAYLOAD}.yaml").write_text(yaml.safe_dump(sweep))
+    with pytest.raises(frictionlab.errors.FrictionlabError, match="a sweep writes a run folder per point") as refused:
+        frictionlab.run(tmp_path / f"s{PAYLOAD}.yaml", progress=False)  # no out=
+    assert "pwned" in str(refused.value) and ESC not in str(refused.value)
