@@ -284,6 +284,10 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
     problem = None
     if counts.done > counts.requested:
         problem = "field 'realizations.done' is more than 'realizations.requested'"
+    elif counts.failed > counts.done:  # done counts the failed ones too
+        problem = "field 'realizations.failed' is more than 'realizations.done' (which counts them)"
+    elif record.status == "completed" and counts.done < counts.requested:  # else cancelled or interrupted
+        problem = "its status is 'completed', but field 'realizations.done' is less than 'realizations.requested'"
     elif record.fit is not None and not counts.done:
         problem = "field 'fit' holds a fit, but no realization was done"
     elif record.fit is None and counts.done and record.status != "failed":
