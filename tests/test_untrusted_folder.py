@@ -126,6 +126,8 @@ HOSTILE = {
     "fit.a a string": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a", "0.5")),
     "fit.b NaN": lambda f: (f / "summary.json").write_text((f / "summary.json").read_text().replace('"b": ', '"b": NaN, "_b": ', 1)),
     "fit.r2 Infinity": lambda f: edit_summary(f, lambda d: set_in(d, "fit.r2", float("inf"))),
+    "fit.b_se negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.b_se", -0.01)),  # a std.err, an rms: never
+    "fit.residual_rms negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.residual_rms", -1)),  # below 0
     "fit a number": lambda f: edit_summary(f, lambda d: set_in(d, "fit", 3)),
     "done a float": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 2.5)),
     "done negative": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", -1)),

@@ -219,17 +219,20 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
 _Interval = Annotated[list[Finite | None], Field(min_length=2, max_length=2)]
 
 
+Spread = Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)]  # a standard error, an rms: never < 0
+
+
 class FitRecord(Record):
     a: Finite
     b: Finite
-    a_se: Finite | None = None
-    b_se: Finite | None = None
+    a_se: Spread | None = None
+    b_se: Spread | None = None
     a_ci: _Interval | None = None
     b_ci: _Interval | None = None
     confidence: Annotated[float, Field(gt=0, lt=1, strict=True)] = 0.95
     bootstrap: Count = 0
     r2: Finite | None = None
-    residual_rms: Finite | None = None
+    residual_rms: Spread | None = None
     points: Count = 0
 
 
