@@ -60,7 +60,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--target", type=float, default=d["target"], help=f"relative error in b to recommend for (default {d['target']:g})")
     parser.add_argument(
         "--points", type=int, default=d["points"], metavar="N",
-        help="grid of the solver and tolerance axes, where the reference runs (default: the preset's N up to "
+        help="grid of the solver and tolerance axes, where the reference runs, at most the preset's N (default: the preset's N up to "
         f"{_D.compare_points} points on a line, {_D.compare_points_surface} per side on a surface)",
     )
     parser.add_argument("--compare-realizations", type=int, default=d["compare_realizations"], metavar="M",
