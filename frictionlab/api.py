@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
-from .errors import FrictionlabError, PresetError, RunFolderError, require, shown
+from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown
 from .compute.fit import LogFit
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, read_curve, read_summary
@@ -124,6 +124,8 @@ class Result:
         if missing or (ax is not None and not hasattr(ax, "transAxes")):
             needs = ", ".join(missing or ["transAxes"])
             raise FrictionlabError(f"ax must be a matplotlib Axes or None, got {type(ax).__name__}, which has no {needs}")
+        if getattr(ax, "name", "rectilinear") != "rectilinear":  # a log x axis and error bars need flat x, y axes
+            raise FrictionlabError(f"ax must be a flat (rectilinear) matplotlib Axes or None, got a {ax.name!r} projection")
         if ax is None:
             import matplotlib.pyplot as plt
 
@@ -182,6 +184,7 @@ def read_preset_input(
     or a ``{...}`` flow mapping); else a path to a file, or a built-in's name.
     ``overrides`` may also come as a keyword (no preset has such a key); ``preset`` may not."""
     from .preset import Preset, load_preset_file, set_path
+    from .preset.paths import is_dotted_path
     from .preset.builtin import find_builtin, preset_source, resolve_preset_path
     from .preset.reading import resolve_input_paths
     from .io.safe_yaml import YamlProblem, load_yaml
@@ -224,9 +227,15 @@ def read_preset_input(
         )
     if base_dir is not None:
         data = resolve_input_paths(data, base_dir)
+    typed = {key.replace("__", "."): key for key in keys}  # a keyword is named as given
     assignments = {**overrides, **{key.replace("__", "."): value for key, value in keys.items()}}
     problems = []
     for path, value in assignments.items():
+        if not is_dotted_path(path):
+            joined = ("__", "spectrum__params__hurst") if path in typed else ("dots", "spectrum.params.hurst")
+            problems.append(f"{short_repr(typed.get(path, path))}: must be field names joined by {joined[0]}, "
+                            f"e.g. {joined[1]}")  # fmt: skip
+            continue
         try:
             set_path(data, str(path), value)
         except ValueError as exc:
@@ -329,7 +338,7 @@ def run(
         from .runs.sweep import plan_sweep, run_sweep
 
         if out is None:
-            raise FrictionlabError(f"{source}: a sweep writes a run folder per point: give out=FOLDER")
+            raise FrictionlabError(f"{shown(source)}: a sweep writes a run folder per point: give out=FOLDER")
         sweep = plan_sweep(data, source=source, before_reading=memory_check_before_reading(options))
         run_sweep(sweep, out, options, listeners=[SweepProgress()] if progress else [], plot=plot)
         return load(out)

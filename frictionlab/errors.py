@@ -99,13 +99,13 @@ class PresetError(FrictionlabError):
     def __init__(self, problems: list[str], source: str | None = None):
         self.problems = list(problems)
         self.source = source
-        where = f"{source}: " if source else ""
+        where = f"{shown(source)}: " if source else ""  # a file name typed with an escape sequence
         count = len(self.problems)
         head = f"{where}{count} problem{'s' if count != 1 else ''} in preset"
-        shown = ["  " + p for p in self.problems[: self.SHOWN_PROBLEMS]]
+        lines = ["  " + p for p in self.problems[: self.SHOWN_PROBLEMS]]
         if count > self.SHOWN_PROBLEMS:
-            shown.append(f"  (and {count - self.SHOWN_PROBLEMS} more; frictionlab validate --json lists every one)")
-        super().__init__("\n".join([head, *shown]))
+            lines.append(f"  (and {count - self.SHOWN_PROBLEMS} more; frictionlab validate --json lists every one)")
+        super().__init__("\n".join([head, *lines]))
 
 
 class PresetFileError(PresetError):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from .errors import FrictionlabError, require
+from .errors import FrictionlabError, require, short_repr
 
 EXECUTORS = ("serial", "processes", "dask")
 
@@ -40,17 +40,17 @@ class RunOptions:
 
     def __post_init__(self):
         if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)):
-            raise FrictionlabError(f"workers must be a whole number >= 1. Got {self.workers!r} instead.")
+            raise FrictionlabError(f"workers must be a whole number >= 1. Got {short_repr(self.workers)} instead.")
         if self.workers is not None and self.workers < 1:
             raise FrictionlabError(f"workers must be >= 1. Got {self.workers} instead.")
         if self.executor is not None and self.executor not in EXECUTORS:
-            raise FrictionlabError(f"executor must be one of {', '.join(EXECUTORS)}. Got {self.executor!r} instead.")
+            raise FrictionlabError(f"executor must be one of {', '.join(EXECUTORS)}. Got {short_repr(self.executor)} instead.")
         if self.scheduler and self.executor not in (None, "dask"):
             raise FrictionlabError(
-                f"scheduler {self.scheduler} needs the dask executor. Got executor {self.executor!r} instead."
+                f"scheduler {short_repr(self.scheduler)} needs the dask executor. Got executor {self.executor!r} instead."
             )
         if isinstance(self.retries, bool) or not isinstance(self.retries, int) or self.retries < 0:
-            raise FrictionlabError(f"retries must be a whole number >= 0. Got {self.retries!r} instead.")
+            raise FrictionlabError(f"retries must be a whole number >= 0. Got {short_repr(self.retries)} instead.")
         if self.dashboard:  # before anything starts: without bokeh the dashboard's address serves only 404s
             require("bokeh", "dashboard")
 

@@ -54,6 +54,22 @@ def test_overrides_may_be_named_as_in_the_signature():
     assert frictionlab.validate("quickstart", overrides={"realizations": 7})["realizations"] == 7
 
 
+
+@pytest.mark.parametrize(("overrides", "keywords", "said"), [
+    ({"spectrum..params": 1}, {}, "'spectrum..params': must be field names joined by dots, e.g. spectrum.params.hurst"),
+    ({"": 1, ".seed": 2}, {}, "'': must be field names joined by dots"),
+    ({}, {"spectrum____params": 1}, "'spectrum____params': must be field names joined by __, e.g. spectrum__params__hurst"),
+    ({}, {"seed__": 1}, "'seed__': must be field names joined by __"),
+])  # fmt: skip
+def test_an_override_path_with_a_name_left_out_is_refused_as_such(overrides, keywords, said):
+    """An override's path with nothing between two dots (or a keyword's between two __) set a key
+    named '' and was refused as another field's problem: spectrum____params=1 was 'spectrum: is
+    not a known field; allowed: name, params', though spectrum is one (--set refuses a..b so)."""
+    with pytest.raises(PresetError) as refused:
+        frictionlab.validate("quickstart", overrides, **keywords)
+    assert said in str(refused.value)
+    assert "is not a known field" not in str(refused.value)
+
 def test_bad_input_is_a_clear_error_naming_the_field():
     with pytest.raises(PresetError, match="spectrum.params.hurst"):
         frictionlab.run(SMALL_PRESET, spectrum__params__hurst=7.0, **FAST)
@@ -254,6 +270,14 @@ def test_a_result_plot_names_a_wrong_axes(tmp_path):
     result = frictionlab.run(SMALL_PRESET, realizations=2, **FAST)
     with pytest.raises(FrictionlabError, match="ax must be a matplotlib Axes or None, got int"):
         result.plot(ax=5)
+    import matplotlib.pyplot as plt
+
+    figure = plt.figure()
+    for projection in ("3d", "polar"):  # a TypeError (3d's fill_between) or a NotImplementedError from inside
+        with pytest.raises(FrictionlabError, match=f"ax must be a flat .rectilinear. matplotlib Axes or None, got a "
+                                                   f"'{projection}' projection"):
+            result.plot(ax=figure.add_subplot(projection=projection))
+    plt.close(figure)
 
 
 def test_api_errors_name_a_built_in_preset_as_the_cli_does(tmp_path, monkeypatch, capsys):

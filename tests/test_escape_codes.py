@@ -179,3 +179,42 @@ def test_a_key_with_a_character_that_hides_or_reorders_text_is_printed_escaped(t
     assert main(["validate", str(path), "--set", typed]) == 2
     err = capsys.readouterr().err
     assert said in err and not {"\u200b", "\u202e", "\u009b"} & set(err), err
+
+
+@posix
+def test_the_api_names_a_preset_file_escaped(tmp_path):
+    """frictionlab.validate(path) and run raise a PresetError whose first line names the file:
+    printed in a terminal or a notebook, a name holding an escape code drove it (the CLI escapes
+    the whole message; the API's message itself held the code)."""
+    (tmp_path / f"p{PAYLOAD}.yaml").write_text("name: x\n")
+    with pytest.raises(frictionlab.errors.PresetError) as refused:
+        frictionlab.validate(tmp_path / f"p{PAYLOAD}.yaml")
+    assert "pwned" in str(refused.value) and ESC not in str(refused.value)
+    sweep = merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"values": [1, 2]}}}})
+    (tmp_path / f"s{PAYLOAD}.yaml").write_text(yaml.safe_dump(sweep))
+    with pytest.raises(frictionlab.errors.FrictionlabError, match="a sweep writes a run folder per point") as refused:
+        frictionlab.run(tmp_path / f"s{PAYLOAD}.yaml", progress=False)  # no out=
+    assert "pwned" in str(refused.value) and ESC not in str(refused.value)
+
+
+@posix
+def test_presets_copy_report_and_exact3d_print_paths_escaped(tmp_path, capsys, monkeypatch):
+    """presets copy echoed its DEST raw ('copied quickstart to ...' on stdout), and report and
+    exact3d printed their progress lines (which name --out, --presets and the files) and the
+    written page's path raw: a folder named with an escape code drove the terminal."""
+    assert main(["presets", "copy", "quickstart", str(tmp_path / f"q{PAYLOAD}.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert "copied quickstart to" in out and "pwned" in out and ESC not in out
+    page = tmp_path / f"page{PAYLOAD}.md"
+
+    def write(*args, log, **kwargs):  # the study itself is not what is checked: its lines and its page are
+        log(f"wrote {page}")
+        page.write_text("# page\n")
+        return page
+
+    monkeypatch.setattr("frictionlab.paper.reproduce.write_report", write)
+    monkeypatch.setattr("frictionlab.exact3d.report.write_page", write)
+    for command in (["report", "--out", str(tmp_path / "r")], ["exact3d", "--quick", "--out", str(tmp_path / "e")]):
+        assert main(command) == 0
+        out, err = capsys.readouterr()
+        assert "pwned" in out and "pwned" in err and ESC not in out + err

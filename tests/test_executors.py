@@ -149,6 +149,18 @@ def test_unknown_executor_and_scheduler_without_dask_are_refused():
         RunOptions(executor="processes", workers=2, scheduler="tcp://127.0.0.1:1")
 
 
+
+@pytest.mark.parametrize("options", [{"workers": "8" * 10000}, {"executor": "x" * 10000},
+                                     {"executor": "serial", "scheduler": "tcp://" + "h" * 10000 + ":1"},
+                                     {"retries": [1] * 10000}])  # fmt: skip
+def test_a_refused_run_option_is_quoted_cut_short(options):
+    """frictionlab.run(workers='888...') (10,000 characters) was refused with the whole value
+    quoted, 10 kB of message; executor, scheduler and retries the same."""
+    with pytest.raises(FrictionlabError) as refused:
+        RunOptions(**options)
+    assert len(str(refused.value)) < 300
+    assert next(iter(options)) in str(refused.value)
+
 def test_missing_dask_names_the_extra_to_install(monkeypatch, scene_24):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     with pytest.raises(FrictionlabError) as caught:

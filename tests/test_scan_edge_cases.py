@@ -719,6 +719,31 @@ def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_
     assert said in str(info.value)
 
 
+
+def _header_of(text: bytes, version: bytes = b"\x01\x00") -> bytes:
+    """A .npy header holding ``text``, padded as numpy pads one (to 64 bytes, a newline last)."""
+    body = text + b" " * (-(10 + len(text) + 1) % 64) + b"\n"
+    return b"\x93NUMPY" + version + len(body).to_bytes(2, "little") + body
+
+
+@pytest.mark.parametrize(("content", "said"), [
+    (b"hello world" * 20, "not a .npy file (it does not start as numpy.save writes one); save the heights with "
+                          "numpy.save, or as a .csv/.txt table of numbers"),
+    (_header_of(b"{'descr': '<f8', 'fortran_order': 'yes', 'shape': (12, 10)}") + bytes(960),
+     "a damaged .npy file: numpy cannot read its header (fortran_order is not a valid bool: 'yes'); save the array again"),
+    (b"\x93NUMPY\x09\x00" + bytes(200), "numpy cannot read its header (we only support format version (1,0), (2,0), "
+                                        "and (3,0), not (9, 0))"),
+], ids=["no-npy", "header", "version"])  # fmt: skip
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_npy_numpy_cannot_read_is_told_why(tmp_path, content, said, plugin):
+    """A file that is no .npy at all, and one whose header numpy refuses, were both 'not a
+    readable .npy array (ValueError)': the exception's name, not what is wrong nor what to do."""
+    (tmp_path / "heights.npy").write_bytes(content)
+    with pytest.raises(ValueError) as info:
+        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
+    assert said in str(info.value)
+
+
 @pytest.mark.parametrize("xres", [-10, 0])
 def test_a_header_declaring_a_side_of_fewer_than_one_point_is_damage(tmp_path, xres):
     """A Gwyddion header of -10 x 12 points over 120 heights was read as 10 x 12 without a word

@@ -258,6 +258,11 @@ def test_a_npy_whose_header_declares_itself_longer_than_the_file_is_damage_not_m
     ({"x": [True, 20]}, "spectrum.params.region.x[0]: must be a number, not true or false, got true"),
     ({"y": [0, False]}, "spectrum.params.region.y[1]: must be a number, not true or false, got false"),
     ({"x": [0, float("nan")], "units": "length"}, "spectrum.params.region.x[1]: must be a finite number, got nan"),
+    # pydantic's own words were 'tuple should have at most 2 items after validation, not 3'
+    ({"x": [0, 4, 8]}, "spectrum.params.region.x: must hold at most 2 items, got [0, 4, 8]"),
+    # each item missing was its own line, 'region.x.1: is required' (and x.0 too for [])
+    ({"x": [4]}, "spectrum.params.region.x: must hold at least 2 items, got [4]"),
+    ({"y": []}, "1 problem in preset\n  spectrum.params.region.y: must hold at least 2 items, got []"),
 ])  # fmt: skip
 def test_a_region_bound_of_true_false_or_nan_is_refused_by_its_place(tmp_path, registry, region, said):
     """A region's bounds are an optional pair (tuple | None): true was taken as pixel 1 before

@@ -136,6 +136,11 @@ BAD_SPECS = [
     # a point twice runs the same ensemble twice, as loads from a value to itself are refused
     ({"seed": {"values": [1, 2, 1]}}, "sweep: seed: its values give 1 twice (values 1 and 3): each point with it would run twice"),
     ({"loading.stop": {"start": 5, "stop": 5, "num": 3}}, "loading.stop: its range (start, stop, num) gives 5 twice (values 1 and 2)"),
+    # a range of one value made its start alone, its stop dropped without a word (linspace of num 1)
+    ({"loading.stop": {"start": 5, "stop": 9, "num": 1}}, "sweep.parameters.loading.stop: a range of num 1 holds its start "
+     "(5) only, never its stop (9): give num >= 2 for both ends, or values: [5] for one value"),
+    # pydantic's own words: 'dictionary should have at least 1 item after validation, not 0'
+    ({}, "sweep.parameters: must hold at least 1 item, got {}"),
 ]  # fmt: skip
 
 

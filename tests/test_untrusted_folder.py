@@ -126,6 +126,8 @@ HOSTILE = {
     "fit.a a string": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a", "0.5")),
     "fit.b NaN": lambda f: (f / "summary.json").write_text((f / "summary.json").read_text().replace('"b": ', '"b": NaN, "_b": ', 1)),
     "fit.r2 Infinity": lambda f: edit_summary(f, lambda d: set_in(d, "fit.r2", float("inf"))),
+    "fit.b_se negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.b_se", -0.01)),  # a std.err, an rms: never
+    "fit.residual_rms negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.residual_rms", -1)),  # below 0
     "fit a number": lambda f: edit_summary(f, lambda d: set_in(d, "fit", 3)),
     "done a float": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 2.5)),
     "done negative": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", -1)),
@@ -140,6 +142,8 @@ HOSTILE = {
     "fit null though done": lambda f: edit_summary(f, lambda d: set_in(d, "fit", None)),
     "fit though none done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 0)),
     "done above requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 99)),
+    "failed above done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.failed", 99)),
+    "completed short of requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.requested", 2**70)),
     "curve short a row": lambda f: (f / "curve.csv").write_text("".join((f / "curve.csv").read_text().splitlines(True)[:-1])),
     # CSV that is not frictionlab's
     "curve binary": lambda f: (f / "curve.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00" + os.urandom(64)),
@@ -234,6 +238,22 @@ def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
     with pytest.raises(RunFolderError, match=r"schema_version 7"):
         frictionlab.load(folder)
 
+
+
+def test_a_sweep_json_status_no_sweep_writes_is_refused(tmp_path):
+    """A sweep.json's status and its points' were any text: load() gave a SweepResult of status
+    'done' (or of an escape sequence) and points of status 'ok', as summary.json's status, a
+    choice of four, is not."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    for where, field, first in ((data, "status", "running"), (data["points"][1], "points.1.status", "completed")):
+        saved, where["status"] = where["status"], "done"
+        (folder / "sweep.json").write_text(json.dumps(data))
+        with pytest.raises(RunFolderError, match=rf"sweep.json is damaged: field '{field}': input should be '{first}'"):
+            frictionlab.load(folder)
+        where["status"] = saved
 
 def test_the_tui_list_names_fifos_and_links_damaged_without_blocking(run_copy, tmp_path):
     runs = run_copy.parent

@@ -11,6 +11,8 @@ import os
 import sys
 from collections.abc import Sequence
 
+from ..errors import shown
+
 
 def use_colour(stream=None) -> bool:
     """Colour (and rich's layout) only on a terminal, and never with NO_COLOR set (no-color.org)."""
@@ -58,3 +60,11 @@ def print_table(header: Sequence[str], rows: Sequence[Sequence[str]], *, stream=
     for row in [header, *rows]:
         cells = [str(cell).ljust(w) for cell, w in zip(row[:-1], widths)]
         print("  ".join([*cells, str(row[-1])]), file=stream)
+
+
+def stderr_log(quiet: bool):
+    """A long command's ``log``: each line on stderr, escaped (it names folders and files as typed,
+    and an escape code in a name must not drive the terminal); nothing under ``--quiet``."""
+    if quiet:
+        return lambda text: None
+    return lambda text: print(shown(text), file=sys.stderr, flush=True)

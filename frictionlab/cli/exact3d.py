@@ -3,9 +3,8 @@ write the page exact-3d-law.md with its figures."""
 
 from __future__ import annotations
 
-import sys
-
-from ..errors import ExitCode
+from ..errors import ExitCode, shown
+from .console import stderr_log
 from .options import add_workers_option, run_options
 
 
@@ -44,7 +43,7 @@ def run(args) -> ExitCode:
     page = write_page(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
         args.out, runs_dir=args.runs, quick=args.quick, finished_only=args.finished_only, presets_dir=args.presets,
         options=run_options(workers=args.workers, force=args.force),
-        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+        log=stderr_log(args.quiet),
     )  # fmt: skip
-    print(page)
+    print(shown(page))
     return ExitCode.OK

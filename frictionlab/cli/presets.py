@@ -88,5 +88,5 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
                 out.write(data)
     except FileExistsError:
         raise OutputRefused(f"{target} exists; give another DEST or --force to replace it") from None
-    print(f"copied {preset.name} to {target}")
+    print(shown(f"copied {preset.name} to {target}"))  # DEST as typed, an escape code in it escaped
     return ExitCode.OK

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import os
 import re
-import sys
 
-from ..errors import ExitCode, FrictionlabError
+from ..errors import ExitCode, FrictionlabError, shown
+from .console import stderr_log
 from .options import add_workers_option, run_options
 
 MAX_REPLICATES = 100  # each is a full run of every reading
@@ -45,7 +45,7 @@ def run(args) -> ExitCode:
     path = write_report(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
         options=run_options(workers=args.workers, force=args.force), readings=args.readings, replicates=args.replicates,
-        log=(lambda text: None) if args.quiet else (lambda text: print(text, file=sys.stderr, flush=True)),
+        log=stderr_log(args.quiet),
         quiet=args.quiet,
     )  # fmt: skip
     if args.json:  # the figures the report shows, as its image links name them
@@ -55,5 +55,5 @@ def run(args) -> ExitCode:
 
         emit("report", {"report": str(path), "figures": figures})
     else:
-        print(path)
+        print(shown(path))
     return ExitCode.OK

@@ -60,7 +60,7 @@ def add_parser(sub) -> None:
     parser.add_argument("--target", type=float, default=d["target"], help=f"relative error in b to recommend for (default {d['target']:g})")
     parser.add_argument(
         "--points", type=int, default=d["points"], metavar="N",
-        help="grid of the solver and tolerance axes, where the reference runs (default: the preset's N up to "
+        help="grid of the solver and tolerance axes, where the reference runs, at most the preset's N (default: the preset's N up to "
         f"{_D.compare_points} points on a line, {_D.compare_points_surface} per side on a surface)",
     )
     parser.add_argument("--compare-realizations", type=int, default=d["compare_realizations"], metavar="M",
@@ -117,6 +117,9 @@ def options_from_args(args) -> StudyOptions:
         raise FrictionlabError(
             f"--axes must name some of {', '.join(AXES)}. Got {short_repr(args.axes)} instead."
         )
+    if twice := sorted({a for a in axes if axes.count(a) > 1}):  # each ran again: the same rows, the time twice
+        raise FrictionlabError(f"--axes names {', '.join(twice)} more than once; each axis runs once: name it once. "
+                               f"Got {short_repr(args.axes)} instead.")  # fmt: skip
     if not 0 < args.target < 1:
         raise FrictionlabError(f"--target must be > 0 and < 1 (a relative error). Got {args.target} instead.")
     return StudyOptions(

@@ -321,6 +321,9 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         bad = np.count_nonzero(np.isinf(xi))
         raise RunFolderError(f"{path}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
                              f"defined at two loads or more ({bad} of {xi.size} are infinite)")  # fmt: skip
+    if negative := np.count_nonzero(xi < 0):  # an rms slope over another: a run writes none below 0
+        raise RunFolderError(f"{path}: array 'xi' must hold numbers >= 0, or NaN where a line has no xi "
+                             f"({negative} of {xi.size} are negative)")  # fmt: skip
     counts = summary.get("realizations")
     done = counts.get("done") if isinstance(counts, dict) else None
     if isinstance(done, int) and not isinstance(done, bool) and done != xi.shape[0]:

@@ -23,6 +23,12 @@ def _keys(path: str | Sequence[str]) -> list[str]:
     return [k.strip() for k in path.split(".")] if isinstance(path, str) else list(path)
 
 
+def is_dotted_path(path: str) -> bool:
+    """Whether ``path`` names a field: a name between every two dots (``a..b``, ``.a``, ``a.``
+    and ``""`` set a key named nothing, which no preset has)."""
+    return all(_keys(path))
+
+
 def get_path(data: dict, path: str | Sequence[str], default=MISSING):
     """``data[a][b][c]`` for ``a.b.c``, or ``default`` where the path does not lead."""
     node = data
@@ -87,8 +93,7 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
     problems = []
     for assignment in assignments:
         path, sep, raw = assignment.partition("=")
-        keys = [k.strip() for k in path.split(".")]
-        if not sep or not all(keys):
+        if not sep or not is_dotted_path(path):
             problems.append(f"--set {assignment!r}: must look like dotted.path=value, e.g. spectrum.params.hurst=0.8")
             continue
         try:
@@ -100,7 +105,7 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
                 continue
             value = raw  # text YAML does not read (a: b: c) is taken as it is
         try:
-            set_path(data, keys, value)
+            set_path(data, path, value)
         except ValueError as exc:
             problems.append(f"--set {assignment!r}: {exc}")
     if problems:

@@ -95,6 +95,9 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be a list"
     if kind == "string_too_short":
         return "must not be empty"
+    if kind in {"too_short", "too_long"}:  # pydantic: 'Dictionary should have at least 1 item after validation, not 0'
+        bound = ctx["min_length"] if kind == "too_short" else ctx["max_length"]
+        return f"must hold {'at least' if kind == 'too_short' else 'at most'} {bound} item{'s' * (bound != 1)}"
     if kind == "string_pattern_mismatch" and ctx.get("pattern") == NAME_PATTERN:
         return NAME_RULE
     message = error["msg"]
@@ -130,7 +133,7 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
         for name in close_names(str(error["loc"][-1]), _allowed_keys(model, tuple(error["loc"][:-1])), FIELD_CUTOFF)[:1]
     }
     lines = []
-    for error in _one_per_union(errors):
+    for error in _one_per_union(_short_tuples(errors)):
         if error["type"] == "missing" and tuple(error["loc"]) in misspelt:
             continue
         path = ".".join(_shown_key(p) for p in (prefix, *error["loc"]) if p != "")
@@ -140,6 +143,18 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
             line += f", got {shown_value(error['input'])}"
         lines.append(line)
     return lines
+
+
+def _short_tuples(errors: list[dict]) -> list[dict]:
+    """pydantic's 'missing' of each item a pair lacks (``region.x.1`` for ``x: [5]``, both items
+    for ``[]``) as one error of the pair itself: it must hold that many items."""
+    def lacking(error):
+        return error["type"] == "missing" and error["loc"] and isinstance(error["loc"][-1], int)
+
+    last = {tuple(error["loc"][:-1]): error for error in errors if lacking(error)}
+    return [{**error, "loc": error["loc"][:-1], "type": "too_short", "ctx": {"min_length": error["loc"][-1] + 1}}
+            if lacking(error) else error for error in errors
+            if not lacking(error) or last[tuple(error["loc"][:-1])] is error]  # fmt: skip
 
 
 UNION_MEMBERS = {"str": "text", "bool": "true or false", "int": "a whole number", "float": "a number", "none": "null",

@@ -99,6 +99,9 @@ class SweepParameter(_Strict):
         if given and len(given) < 3:
             missing = [k for k in ranged if k not in given]
             raise ValueError(f"a range needs start, stop and num; missing: {', '.join(missing)}")
+        if given and self.num == 1 and self.start != self.stop:  # linspace of one value drops stop
+            raise ValueError(f"a range of num 1 holds its start ({self.start:g}) only, never its stop ({self.stop:g}): "
+                             f"give num >= 2 for both ends, or values: [{self.start:g}] for one value")  # fmt: skip
         if given and self.spacing == "log" and (self.start <= 0 or self.stop <= 0):
             raise ValueError(f"a log range needs start > 0 and stop > 0. Got start={self.start!r}, stop={self.stop!r} instead")
         return self

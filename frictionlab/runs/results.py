@@ -219,17 +219,20 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
 _Interval = Annotated[list[Finite | None], Field(min_length=2, max_length=2)]
 
 
+Spread = Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)]  # a standard error, an rms: never < 0
+
+
 class FitRecord(Record):
     a: Finite
     b: Finite
-    a_se: Finite | None = None
-    b_se: Finite | None = None
+    a_se: Spread | None = None
+    b_se: Spread | None = None
     a_ci: _Interval | None = None
     b_ci: _Interval | None = None
     confidence: Annotated[float, Field(gt=0, lt=1, strict=True)] = 0.95
     bootstrap: Count = 0
     r2: Finite | None = None
-    residual_rms: Finite | None = None
+    residual_rms: Spread | None = None
     points: Count = 0
 
 
@@ -284,6 +287,10 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
     problem = None
     if counts.done > counts.requested:
         problem = "field 'realizations.done' is more than 'realizations.requested'"
+    elif counts.failed > counts.done:  # done counts the failed ones too
+        problem = "field 'realizations.failed' is more than 'realizations.done' (which counts them)"
+    elif record.status == "completed" and counts.done < counts.requested:  # else cancelled or interrupted
+        problem = "its status is 'completed', but field 'realizations.done' is less than 'realizations.requested'"
     elif record.fit is not None and not counts.done:
         problem = "field 'fit' holds a fit, but no realization was done"
     elif record.fit is None and counts.done and record.status != "failed":

@@ -23,7 +23,7 @@ import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field
 
@@ -424,7 +424,7 @@ class PointRecord(Record):
     """A point's row of sweep.json (or of a followed sweep's progress log): each value checked."""
 
     folder: MemberName
-    status: str
+    status: Literal["completed", "cancelled", "interrupted", "failed", "error", "pending"]  # PointResult's
     done: Count | None = None
     contact_first: Finite | None = None
     contact_last: Finite | None = None
@@ -448,7 +448,7 @@ class SweepRecord(Record):
     base_preset: dict[str, Any]
     schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
     name: Annotated[str, Field(min_length=1)]
-    status: str
+    status: Literal["running", "completed", "interrupted", "failed"]  # SweepOutcome's
     elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
     points: list[PointRecord]
 

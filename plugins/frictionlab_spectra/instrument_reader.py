@@ -262,7 +262,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
         return ValueError(f"{where}: this {name} file holds no channel of heights its reader knows: no rows of numbers, or "
                           "none under value units that are a length it reads (degrees, volts, or a spelling such as "
                           f"'micron'); export the heights with their unit written as one of {_KNOWN_LENGTHS}")  # fmt: skip
-    said = _reason(exc)
+    said = reason_said(exc)
     if reader.format() == "xyz" and isinstance(exc, ValueError) and (
             "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
         return ValueError(  # its grid's step along y (or x) came out zero, binned by numpy.bincount: not damage
@@ -283,7 +283,7 @@ REASON_SHOWN = 160
 _KNOWN_LENGTHS = "m, mm, \u00b5m (or um), nm, \u00c5, pm"  # as SurfaceTopography's text readers spell them
 
 
-def _reason(exc: BaseException) -> str:
+def reason_said(exc: BaseException) -> str:
     """The reader's own words for a failure, on one line, cut in the middle past REASON_SHOWN
     characters (they may quote the file)."""
     text = " ".join(str(exc).split())

@@ -39,7 +39,7 @@ from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
 from .header_units import check_table_header
-from .instrument_reader import room_to_read
+from .instrument_reader import reason_said, room_to_read
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
@@ -214,8 +214,8 @@ def load_npy(path: Path, where: str) -> np.ndarray:
         except MemoryError:  # the header asks for more than this process can allocate
             raise ValueError(f"{where}: {_claimed_array(fh)} does not fit in this process's memory; "
                              "crop or resample the map") from None
-        except Exception as exc:  # corrupt file, pickled objects, ...: named, never quoted
-            raise ValueError(f"{where}: not a readable .npy array ({type(exc).__name__})") from None
+        except Exception as exc:  # noqa: BLE001 - a header numpy cannot read: why, in its words cut short
+            raise ValueError(f"{where}: {_unreadable_npy(fh, exc)}") from None
     if data.dtype.kind not in "iuf":  # numpy counts a timedelta64 as an integer
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
     return data
@@ -304,6 +304,17 @@ def _check_npy_size(fh, where: str) -> None:
             f"{where}: a damaged .npy file: its header declares an array of shape {header[0]} of {header[1]} "
             f"({declared:,} bytes), but the file holds {held:,} bytes after it; save the array again"
         )
+
+
+def _unreadable_npy(fh, exc: Exception) -> str:
+    """Why np.load could not read a .npy file: not one at all (no magic string), or a header
+    it refuses (a format version it does not know, a key too many), as numpy says."""
+    fh.seek(0)
+    if fh.read(6) != b"\x93NUMPY":
+        return ("not a .npy file (it does not start as numpy.save writes one); save the heights with numpy.save, "
+                "or as a .csv/.txt table of numbers")  # fmt: skip
+    reason = reason_said(exc) or type(exc).__name__
+    return f"a damaged .npy file: numpy cannot read its header ({reason}); save the array again"
 
 
 def _claimed_array(fh) -> str:

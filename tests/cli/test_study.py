@@ -40,6 +40,8 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
     [
         (["--reference", "bem-nowhere"], "--reference: no solver plugin named 'bem-nowhere'"),
         (["--axes", "grid,speed"], "--axes must name some of grid, realizations, steps, solver, tolerance"),
+        (["--axes", "grid,steps,grid"], "--axes names grid more than once; each axis runs once: name it once. "
+                                         "Got 'grid,steps,grid' instead."),  # the grid axis ran twice, its rows too
         (["--target", "2"], "--target must be > 0 and < 1"),
         (["--tolerances", "1e-3,abc"], "--tolerances must be a comma-separated list of numbers"),
         (["--grid-factors", "1,-2"], "--grid-factors values must be finite numbers > 0. Got -2.0 instead."),
@@ -182,3 +184,13 @@ def test_study_refuses_an_mdr_surface_whose_line_cannot_be_made_before_it_is_mad
     assert "for the preset's grid" in err and "Traceback" not in err
     assert peak < 2048**2 * 8  # not one array of the 2048^2 surface: refused before its synthesis
     assert not out.exists()
+
+
+def test_each_comparison_count_says_it_is_at_most_the_presets(capsys):
+    """--points above the preset's N was capped to it without a word in the help, as
+    --compare-realizations, --compare-steps and --grid-realizations once were."""
+    assert main(["study", "--help"]) == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    for option in ("--points N", "--compare-realizations M", "--compare-steps K", "--grid-realizations M"):
+        said = help_text.split(option, 2)[-1].split(" --", 1)[0]  # the option's own help (after the usage line)
+        assert "at most the preset's" in said, (option, said)
