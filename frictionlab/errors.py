@@ -18,6 +18,7 @@ class ExitCode(enum.IntEnum):
     OUTPUT_REFUSED = 4  # the output would replace or delete what frictionlab did not write (see --force)
     RUN_FOLDER = 5  # a run folder that cannot be resumed: damaged, in use, another preset, a changed input file
     INTERNAL = 70  # a bug in frictionlab or a plugin (sysexits' EX_SOFTWARE)
+    HUNG_UP = 129  # SIGHUP, the terminal closed (an SSH session that dropped): as Ctrl-C
     INTERRUPTED = 130  # Ctrl-C (SIGINT): finished work was kept, the run folder is resumable
     BROKEN_PIPE = 141  # stdout was closed by the reader (as a process killed by SIGPIPE)
     TERMINATED = 143  # SIGTERM: as Ctrl-C

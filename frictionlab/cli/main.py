@@ -31,7 +31,7 @@ import warnings
 
 from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
 from ..compute.heap import keep_freed_memory
-from ..compute.signals import RaiseOnSignals, interrupted_exit_code
+from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
@@ -367,10 +367,10 @@ def _run_command(args) -> int:
         detail = f": {exc}" if str(exc) else ""
         message = f"out of memory{detail}; ask for fewer points, realizations or workers"
         return _refused(args, message, ExitCode.RUNTIME_FAILURE)
-    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (signals.Terminated), or a command of several runs
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""
-        return _refused(args, f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", code, "")
+        return _refused(args, f"{interrupted_word()}{said}", code, "")
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
