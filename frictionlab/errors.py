@@ -148,6 +148,20 @@ def escape_unencodable_output() -> None:
             stream.reconfigure(errors="frictionlab-escape")
 
 
+OUT_OF_MEMORY = "MemoryError"  # the kind of a realization's error (``Type: message (file.py:N)``) that ran out of memory
+MEMORY_ADVICE = "fewer workers, fewer points, or where more memory is free"
+
+
+def ran_out_of_memory(error: str) -> bool:
+    """Whether a realization's recorded error is the machine's limit, not a bug or bad input."""
+    return error.startswith(f"{OUT_OF_MEMORY}:") or error == OUT_OF_MEMORY
+
+
+def resume_hint(folder) -> str:
+    """How to go on with a run that stopped before its end: what finished is in ``folder``."""
+    return f"what finished is kept in {folder}/: `frictionlab resume {folder}` computes the rest"
+
+
 def counted(count: int, noun: str) -> str:
     """``1 point``, ``2 points``: a count and its noun in the number it takes."""
     return f"{count} {noun}{'' if count == 1 else 's'}"

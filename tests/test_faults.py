@@ -103,6 +103,7 @@ def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(regist
     process, out, err, run_dir = _signalled_mid_run(tmp_path, signum)
     assert process.returncode == code, err
     assert "status interrupted" in out and "Traceback" not in err
+    assert f"what finished is kept in {run_dir}/: `frictionlab resume {run_dir}`" in err
     state = json.loads((run_dir / "run.json").read_text())
     assert state["status"] == "interrupted"
     kept = len(state["chunks"])

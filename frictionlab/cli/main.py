@@ -366,6 +366,11 @@ def _run_command(args) -> int:
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
         message = f"out of memory{detail}; ask for fewer points, realizations or workers"
+        folder = getattr(args, "out_dir", None)  # a run's folder, once made: what it holds is not lost
+        if folder is not None:
+            from .run import resumable
+
+            message += f"; {resumable(folder)}"
         return _refused(args, message, ExitCode.RUNTIME_FAILURE)
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
