@@ -14,6 +14,7 @@ line from included, which died of MemoryError once). A buffer sized by a cap ins
 from __future__ import annotations
 
 import json
+import re
 import resource
 import subprocess
 import sys
@@ -195,7 +196,7 @@ def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offere
     assert "making the MDR-equivalent line of a surface of 268,435,456 points" in done.stderr, done.stderr[-3000:]
     assert "RLIMIT_AS (ulimit -v)" in done.stderr and "out of memory" not in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "run").exists()
-    side = int(done.stderr.split("spectrum.params.points <= ")[1].split(".")[0].replace(",", ""))
+    side = int(re.search(r"spectrum\.params\.points <= ([\d,]+)", done.stderr).group(1).replace(",", ""))
     assert 4000 < side < 16384
     # the room is the limit less the address space this process holds, which moves by a few MiB
     # from one process to the next: a side 16 under the offer (9 MiB less to make the line)
