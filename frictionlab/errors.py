@@ -5,6 +5,7 @@ from __future__ import annotations
 import codecs
 import enum
 import os
+import re
 import sys
 
 
@@ -155,6 +156,32 @@ MEMORY_ADVICE = "fewer workers, fewer points, or where more memory is free"
 def ran_out_of_memory(error: str) -> bool:
     """Whether a realization's recorded error is the machine's limit, not a bug or bad input."""
     return error.startswith(f"{OUT_OF_MEMORY}:") or error == OUT_OF_MEMORY
+
+
+def process_limit() -> tuple[int, str] | None:
+    """The smallest process limit on memory set here (``ulimit -v``, ``ulimit -d``) in
+    bytes, with the ulimit option that sets it; None without one (or on Windows)."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    limits = [(resource.getrlimit(getattr(resource, name))[0], flag)
+              for name, flag in (("RLIMIT_AS", "-v"), ("RLIMIT_DATA", "-d"))]  # fmt: skip
+    set_ = [(soft, flag) for soft, flag in limits if soft != resource.RLIM_INFINITY]
+    return min(set_) if set_ else None
+
+
+def out_of_memory_loading(exc: BaseException) -> str | None:
+    """The library a process limit left no room to load (``ImportError``: 'failed to map
+    segment from shared object', numpy's own message quoting it), else None."""
+    match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
+    return match.group(1) if isinstance(exc, ImportError) and match else None
+
+
+def limit_advice() -> str:
+    """What a command out of memory adds under a process limit: the limit, to raise."""
+    limit = process_limit()
+    return f", or raise the process limit (ulimit {limit[1]} is {limit[0] // 1024} here)" if limit else ""
 
 
 def resume_hint(folder) -> str:

@@ -14,6 +14,7 @@ line from included, which died of MemoryError once). A buffer sized by a cap ins
 from __future__ import annotations
 
 import json
+import os
 import re
 import resource
 import subprocess
@@ -204,3 +205,39 @@ def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offere
     offered = {**surface, "spectrum": {**surface["spectrum"], "params": {**surface["spectrum"]["params"], "points": fits}}}
     ok(limited("run", write(tmp_path, "offered", offered), "--out", str(tmp_path / "fits"), "--workers", workers,
                "--no-plot", cwd=tmp_path))  # fmt: skip
+
+
+@pytest.mark.parametrize("limit_mib", [60, 100, 250])
+@pytest.mark.parametrize("command", [["run", "quickstart", "--out", "run"], ["exact3d", "--quick", "--runs", "runs", "--workers", "1"]])
+def test_a_limit_too_small_to_load_or_run_is_said_and_never_hangs(tmp_path, command, limit_mib):
+    """Under ulimit -v 250000 OpenBLAS's import reserved a buffer per core, found no room and spun
+    for ever inside the import, deaf to SIGTERM (exact3d); or exited with 'OpenBLAS error: Memory
+    allocation still failed' (run); under 60000 a library that could not be mapped was an
+    'internal error ... (this is a bug)'. Each ends at once, saying the limit."""
+    def tight():
+        resource.setrlimit(resource.RLIMIT_AS, (limit_mib * 2**20,) * 2)
+
+    env = {name: value for name, value in os.environ.items() if not name.endswith("_NUM_THREADS")}
+    done = subprocess.run([sys.executable, "-m", "frictionlab", *command, "--quiet"], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120, preexec_fn=tight, env=env)  # fmt: skip
+    assert done.returncode == 1, (done.returncode, done.stderr[-3000:])
+    assert done.stderr.startswith("error: ") and "ulimit -v" in done.stderr, done.stderr[-3000:]
+    assert not any(word in done.stderr for word in ("OpenBLAS", "internal error", "Traceback"))
+
+
+def test_openblas_starts_no_threads_under_a_process_limit_unless_told(monkeypatch):
+    from frictionlab.compute import heap
+
+    for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"):
+        monkeypatch.setenv(name, "")  # set, then removed: each is given back as it was after the test
+        monkeypatch.delenv(name)
+    monkeypatch.setattr(heap, "process_limit", lambda: None)
+    heap.few_blas_threads_under_a_limit()
+    assert "OPENBLAS_NUM_THREADS" not in os.environ  # no limit: OpenBLAS's own choice
+    monkeypatch.setattr(heap, "process_limit", lambda: (2**30, "-v"))
+    monkeypatch.setenv("OMP_NUM_THREADS", "4")
+    heap.few_blas_threads_under_a_limit()
+    assert "OPENBLAS_NUM_THREADS" not in os.environ  # the user's count stands
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    heap.few_blas_threads_under_a_limit()
+    assert os.environ["OPENBLAS_NUM_THREADS"] == "1"

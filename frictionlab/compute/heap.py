@@ -1,4 +1,5 @@
-"""Freed memory kept for the next realization instead of handed back to the system at once.
+"""Freed memory kept for the next realization instead of handed back to the system at once;
+and, under a process limit on memory, OpenBLAS held to one thread (``few_blas_threads_under_a_limit``).
 
 glibc hands a freed block of more than 128 kB straight back to the system (and trims the
 heap's top past a threshold it sets from the blocks seen), and the next realization's
@@ -14,6 +15,10 @@ the pool's workers (``pool._serve``); a notebook's own process keeps its allocat
 """
 
 from __future__ import annotations
+
+import os
+
+from ..errors import process_limit
 
 M_TRIM_THRESHOLD = -1  # mallopt's parameters (malloc.h)
 M_MMAP_THRESHOLD = -3
@@ -32,3 +37,16 @@ def keep_freed_memory() -> bool:
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
     # both or neither: a fixed mmap threshold with glibc's default trim (128 kB) would trim the same pages
     return mallopt(M_TRIM_THRESHOLD, KEEP_BYTES) == 1 and mallopt(M_MMAP_THRESHOLD, KEEP_BYTES) == 1
+
+
+def few_blas_threads_under_a_limit() -> None:
+    """Under a process limit on memory, OpenBLAS is told to start no threads of its own
+    (``OPENBLAS_NUM_THREADS=1``, unless the user chose a count): at import it reserves a
+    buffer of 32 to 64 MiB of address space per thread, one per core, and when that does
+    not fit it spins for ever inside the import, deaf to SIGTERM, or exits printing
+    'OpenBLAS error: Memory allocation still failed'. frictionlab's own BLAS work runs on
+    one thread anyway (the fit; the solvers use FFTs). Before numpy is imported; worker
+    processes inherit it."""
+    chosen = ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")  # what OpenBLAS reads, in order
+    if process_limit() is not None and not any(os.environ.get(name) for name in chosen):
+        os.environ["OPENBLAS_NUM_THREADS"] = "1"
