@@ -225,19 +225,36 @@ def test_a_limit_too_small_to_load_or_run_is_said_and_never_hangs(tmp_path, comm
     assert not any(word in done.stderr for word in ("OpenBLAS", "internal error", "Traceback"))
 
 
-def test_openblas_starts_no_threads_under_a_process_limit_unless_told(monkeypatch):
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_sweep_on_dask_runs_without_tracebacks_or_a_hang(tmp_path, workers):
+    """Under ulimit -v 700000 the Dask cluster's threads (glibc's 64 MiB malloc arena each) took
+    the main process's address space: 'RuntimeError: can't start new thread' tracebacks from
+    tornado, then a hang. Each point now ends with its numbers, or refused before it starts."""
+    def tight():
+        resource.setrlimit(resource.RLIMIT_AS, (700_000 * 1024,) * 2)
+
+    env = {name: value for name, value in os.environ.items() if not name.startswith("MALLOC_")}
+    command = [sys.executable, "-m", "frictionlab", "run", write(tmp_path, "sweep", SWEEP), "--out", "out",
+               "--executor", "dask", "--workers", workers, "--quiet"]  # fmt: skip
+    done = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path, timeout=120, preexec_fn=tight, env=env)
+    assert done.returncode in (0, 1) and not any(word in done.stderr for word in ("Traceback", "OpenBLAS")), done.stderr[-3000:]
+    rows = json.loads((tmp_path / "out" / "sweep.json").read_text())["points"]
+    assert all(row["status"] == "completed" or "would need about" in row["error"] for row in rows), rows
+
+
+def test_openblas_and_malloc_spare_address_space_under_a_process_limit_unless_told(monkeypatch):
     from frictionlab.compute import heap
 
-    for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"):
+    for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS", "MALLOC_ARENA_MAX"):
         monkeypatch.setenv(name, "")  # set, then removed: each is given back as it was after the test
         monkeypatch.delenv(name)
     monkeypatch.setattr(heap, "process_limit", lambda: None)
-    heap.few_blas_threads_under_a_limit()
-    assert "OPENBLAS_NUM_THREADS" not in os.environ  # no limit: OpenBLAS's own choice
+    heap.spare_address_space_under_a_limit()
+    assert "OPENBLAS_NUM_THREADS" not in os.environ and "MALLOC_ARENA_MAX" not in os.environ  # no limit
     monkeypatch.setattr(heap, "process_limit", lambda: (2**30, "-v"))
     monkeypatch.setenv("OMP_NUM_THREADS", "4")
-    heap.few_blas_threads_under_a_limit()
+    heap.spare_address_space_under_a_limit()
     assert "OPENBLAS_NUM_THREADS" not in os.environ  # the user's count stands
     monkeypatch.delenv("OMP_NUM_THREADS")
-    heap.few_blas_threads_under_a_limit()
-    assert os.environ["OPENBLAS_NUM_THREADS"] == "1"
+    heap.spare_address_space_under_a_limit()
+    assert (os.environ["OPENBLAS_NUM_THREADS"], os.environ["MALLOC_ARENA_MAX"]) == ("1", "2")

@@ -31,7 +31,7 @@ import warnings
 
 from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
                       short_repr, shown, too_long_path)  # fmt: skip
-from ..compute.heap import few_blas_threads_under_a_limit, keep_freed_memory
+from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -235,7 +235,7 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
-    few_blas_threads_under_a_limit()  # before numpy is imported
+    spare_address_space_under_a_limit()  # before numpy is imported
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
