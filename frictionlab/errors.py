@@ -5,6 +5,7 @@ from __future__ import annotations
 import codecs
 import enum
 import os
+import re
 import sys
 
 
@@ -18,6 +19,7 @@ class ExitCode(enum.IntEnum):
     OUTPUT_REFUSED = 4  # the output would replace or delete what frictionlab did not write (see --force)
     RUN_FOLDER = 5  # a run folder that cannot be resumed: damaged, in use, another preset, a changed input file
     INTERNAL = 70  # a bug in frictionlab or a plugin (sysexits' EX_SOFTWARE)
+    HUNG_UP = 129  # SIGHUP, the terminal closed (an SSH session that dropped): as Ctrl-C
     INTERRUPTED = 130  # Ctrl-C (SIGINT): finished work was kept, the run folder is resumable
     BROKEN_PIPE = 141  # stdout was closed by the reader (as a process killed by SIGPIPE)
     TERMINATED = 143  # SIGTERM: as Ctrl-C
@@ -174,6 +176,46 @@ def escape_unencodable_output() -> None:
     for stream in (sys.stdout, sys.stderr):
         if hasattr(stream, "reconfigure") and getattr(stream, "errors", None) in ("strict", "surrogateescape"):
             stream.reconfigure(errors="frictionlab-escape")
+
+
+OUT_OF_MEMORY = "MemoryError"  # the kind of a realization's error (``Type: message (file.py:N)``) that ran out of memory
+MEMORY_ADVICE = "fewer workers, fewer points, or where more memory is free"
+
+
+def ran_out_of_memory(error: str) -> bool:
+    """Whether a realization's recorded error is the machine's limit, not a bug or bad input."""
+    return error.startswith(f"{OUT_OF_MEMORY}:") or error == OUT_OF_MEMORY
+
+
+def process_limit() -> tuple[int, str] | None:
+    """The smallest process limit on memory set here (``ulimit -v``, ``ulimit -d``) in
+    bytes, with the ulimit option that sets it; None without one (or on Windows)."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    limits = [(resource.getrlimit(getattr(resource, name))[0], flag)
+              for name, flag in (("RLIMIT_AS", "-v"), ("RLIMIT_DATA", "-d"))]  # fmt: skip
+    set_ = [(soft, flag) for soft, flag in limits if soft != resource.RLIM_INFINITY]
+    return min(set_) if set_ else None
+
+
+def out_of_memory_loading(exc: BaseException) -> str | None:
+    """The library a process limit left no room to load (``ImportError``: 'failed to map
+    segment from shared object', numpy's own message quoting it), else None."""
+    match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
+    return match.group(1) if isinstance(exc, ImportError) and match else None
+
+
+def limit_advice() -> str:
+    """What a command out of memory adds under a process limit: the limit, to raise."""
+    limit = process_limit()
+    return f", or raise the process limit (ulimit {limit[1]} is {limit[0] // 1024} here)" if limit else ""
+
+
+def resume_hint(folder) -> str:
+    """How to go on with a run that stopped before its end: what finished is in ``folder``."""
+    return f"what finished is kept in {folder}/: `frictionlab resume {folder}` computes the rest"
 
 
 def counted(count: int, noun: str) -> str:

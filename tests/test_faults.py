@@ -1,4 +1,4 @@
-"""Fault injection: a pool worker killed while it sends its result, SIGTERM in
+"""Fault injection: a pool worker killed while it sends its result, SIGTERM or SIGHUP in
 the middle of a run, and chunk files damaged in every way we could think of.
 Each time the run ends (or resumes) to exactly the numbers of an
 uninterrupted run, bit for bit, and never counts a realization twice."""
@@ -80,22 +80,30 @@ def _listed_chunks(run_dir: Path) -> int:
         return 0
 
 
-@pytest.mark.long
-def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry, tmp_path):
+def _signalled_mid_run(tmp_path, signum, preexec_fn=None) -> tuple[subprocess.Popen, str, str, Path]:
+    """``frictionlab run`` of KILL_PRESET sent ``signum`` once two chunks are written."""
     preset = tmp_path / "long.yaml"
     preset.write_text(yaml.safe_dump(KILL_PRESET))
     run_dir = tmp_path / "run"
     command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(run_dir), "--workers", "2"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=preexec_fn)
     deadline = time.monotonic() + 60
     while _listed_chunks(run_dir) < 2:
         assert process.poll() is None, process.communicate()
         assert time.monotonic() < deadline, "no chunk written in 60 s"
         time.sleep(0.01)
-    process.send_signal(signal.SIGTERM)
-    out, err = process.communicate(timeout=60)
-    assert process.returncode == 143, err
+    process.send_signal(signum)
+    out, err = process.communicate(timeout=120)
+    return process, out, err, run_dir
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)])  # SIGHUP: the terminal closed
+def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(registry, tmp_path, signum, code):
+    process, out, err, run_dir = _signalled_mid_run(tmp_path, signum)
+    assert process.returncode == code, err
     assert "status interrupted" in out and "Traceback" not in err
+    assert f"what finished is kept in {run_dir}/: `frictionlab resume {run_dir}`" in err
     state = json.loads((run_dir / "run.json").read_text())
     assert state["status"] == "interrupted"
     kept = len(state["chunks"])
@@ -109,6 +117,13 @@ def test_sigterm_mid_run_ends_interrupted_with_143_and_resumes_bitwise(registry,
     assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < KILL_PRESET["realizations"]
     run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")
+
+
+@pytest.mark.long
+def test_a_hangup_ignored_as_nohup_ignores_it_leaves_the_run_going(tmp_path):
+    process, out, err, run_dir = _signalled_mid_run(tmp_path, signal.SIGHUP, lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    assert process.returncode == 0, err
+    assert json.loads((run_dir / "run.json").read_text())["status"] == "completed"
 
 
 # ------------------------------------------------------------------ damaged chunks

@@ -437,7 +437,8 @@ def test_a_grid_too_large_for_one_realization_is_not_offered_no_realizations(tmp
         "solver": {"name": "bem-halfspace-free"}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3},
     })  # fmt: skip
     one = memory.estimate(scene, workers=1, executor="serial")
-    monkeypatch.setattr(memory, "available_memory", lambda: (one.per_realization // 2, "a test limit"))
+    room = memory.PROCESS_BASE + one.per_realization // 2  # frictionlab itself fits, the realization does not
+    monkeypatch.setattr(memory, "available_memory", lambda: (room, "a test limit"))
     with pytest.raises(RunError) as caught:
         memory.check_fits(scene, workers=1, executor="serial")
     message = str(caught.value)

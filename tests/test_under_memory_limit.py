@@ -14,6 +14,8 @@ line from included, which died of MemoryError once). A buffer sized by a cap ins
 from __future__ import annotations
 
 import json
+import os
+import re
 import resource
 import subprocess
 import sys
@@ -195,7 +197,7 @@ def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offere
     assert "making the MDR-equivalent line of a surface of 268,435,456 points" in done.stderr, done.stderr[-3000:]
     assert "RLIMIT_AS (ulimit -v)" in done.stderr and "out of memory" not in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "run").exists()
-    side = int(done.stderr.split("spectrum.params.points <= ")[1].split(".")[0].replace(",", ""))
+    side = int(re.search(r"spectrum\.params\.points <= ([\d,]+)", done.stderr).group(1).replace(",", ""))
     assert 4000 < side < 16384
     # the room is the limit less the address space this process holds, which moves by a few MiB
     # from one process to the next: a side 16 under the offer (9 MiB less to make the line)
@@ -203,3 +205,56 @@ def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offere
     offered = {**surface, "spectrum": {**surface["spectrum"], "params": {**surface["spectrum"]["params"], "points": fits}}}
     ok(limited("run", write(tmp_path, "offered", offered), "--out", str(tmp_path / "fits"), "--workers", workers,
                "--no-plot", cwd=tmp_path))  # fmt: skip
+
+
+@pytest.mark.parametrize("limit_mib", [60, 100, 250])
+@pytest.mark.parametrize("command", [["run", "quickstart", "--out", "run"], ["exact3d", "--quick", "--runs", "runs", "--workers", "1"]])
+def test_a_limit_too_small_to_load_or_run_is_said_and_never_hangs(tmp_path, command, limit_mib):
+    """Under ulimit -v 250000 OpenBLAS's import reserved a buffer per core, found no room and spun
+    for ever inside the import, deaf to SIGTERM (exact3d); or exited with 'OpenBLAS error: Memory
+    allocation still failed' (run); under 60000 a library that could not be mapped was an
+    'internal error ... (this is a bug)'. Each ends at once, saying the limit."""
+    def tight():
+        resource.setrlimit(resource.RLIMIT_AS, (limit_mib * 2**20,) * 2)
+
+    env = {name: value for name, value in os.environ.items() if not name.endswith("_NUM_THREADS")}
+    done = subprocess.run([sys.executable, "-m", "frictionlab", *command, "--quiet"], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120, preexec_fn=tight, env=env)  # fmt: skip
+    assert done.returncode == 1, (done.returncode, done.stderr[-3000:])
+    assert done.stderr.startswith("error: ") and "ulimit -v" in done.stderr, done.stderr[-3000:]
+    assert not any(word in done.stderr for word in ("OpenBLAS", "internal error", "Traceback"))
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_sweep_on_dask_runs_without_tracebacks_or_a_hang(tmp_path, workers):
+    """Under ulimit -v 700000 the Dask cluster's threads (glibc's 64 MiB malloc arena each) took
+    the main process's address space: 'RuntimeError: can't start new thread' tracebacks from
+    tornado, then a hang. Each point now ends with its numbers, or refused before it starts."""
+    def tight():
+        resource.setrlimit(resource.RLIMIT_AS, (700_000 * 1024,) * 2)
+
+    env = {name: value for name, value in os.environ.items() if not name.startswith("MALLOC_")}
+    command = [sys.executable, "-m", "frictionlab", "run", write(tmp_path, "sweep", SWEEP), "--out", "out",
+               "--executor", "dask", "--workers", workers, "--quiet"]  # fmt: skip
+    done = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path, timeout=120, preexec_fn=tight, env=env)
+    assert done.returncode in (0, 1) and not any(word in done.stderr for word in ("Traceback", "OpenBLAS")), done.stderr[-3000:]
+    rows = json.loads((tmp_path / "out" / "sweep.json").read_text())["points"]
+    assert all(row["status"] == "completed" or "would need about" in row["error"] for row in rows), rows
+
+
+def test_openblas_and_malloc_spare_address_space_under_a_process_limit_unless_told(monkeypatch):
+    from frictionlab.compute import heap
+
+    for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS", "MALLOC_ARENA_MAX"):
+        monkeypatch.setenv(name, "")  # set, then removed: each is given back as it was after the test
+        monkeypatch.delenv(name)
+    monkeypatch.setattr(heap, "process_limit", lambda: None)
+    heap.spare_address_space_under_a_limit()
+    assert "OPENBLAS_NUM_THREADS" not in os.environ and "MALLOC_ARENA_MAX" not in os.environ  # no limit
+    monkeypatch.setattr(heap, "process_limit", lambda: (2**30, "-v"))
+    monkeypatch.setenv("OMP_NUM_THREADS", "4")
+    heap.spare_address_space_under_a_limit()
+    assert "OPENBLAS_NUM_THREADS" not in os.environ  # the user's count stands
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    heap.spare_address_space_under_a_limit()
+    assert (os.environ["OPENBLAS_NUM_THREADS"], os.environ["MALLOC_ARENA_MAX"]) == ("1", "2")

@@ -10,6 +10,7 @@ import threading
 from pathlib import Path
 
 from ..errors import ExitCode, shown
+from ..compute.signals import ENDINGS, install
 
 POLL_SECONDS = 0.2
 EXAMPLES = """examples:
@@ -27,7 +28,7 @@ def add_parser(sub) -> None:
         "until it ends, then its state on stdout. For a sweep's folder: each point as it starts, its "
         "realizations, and its fit once it ends. Ctrl-C stops following; the run goes on. The exit code is 0 "
         "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it) or its folder was "
-        "deleted while it ran, 130 if following was stopped with Ctrl-C (143: SIGTERM).",
+        "deleted while it ran, 130 if following was stopped with Ctrl-C (143: SIGTERM, 129: SIGHUP).",
         epilog=EXAMPLES,
     )
     p.add_argument("run_dir", metavar="DIR", help="a run folder, or a sweep's folder")
@@ -37,7 +38,7 @@ def add_parser(sub) -> None:
 
 
 class _StopSignals:
-    """Within the block, Ctrl-C and SIGTERM are noted (``signal``) instead of raised: raised
+    """Within the block, Ctrl-C, SIGTERM and SIGHUP are noted (``signal``) instead of raised: raised
     at any line they could stop a progress bar while it holds its lock, and closing the bar
     then waits for ever on the thread that draws it."""
 
@@ -54,8 +55,7 @@ class _StopSignals:
         self._noted.wait(seconds)
 
     def __enter__(self):
-        for signum in (signal.SIGINT, signal.SIGTERM):
-            self._previous[signum] = signal.signal(signum, self._note)
+        self._previous = install(self._note)
         return self
 
     def __exit__(self, *exc) -> None:
@@ -93,7 +93,7 @@ def run(args) -> ExitCode:
                 raise KeyboardInterrupt
         except KeyboardInterrupt:
             print(f"stopped following; the run goes on{f' (pid {state.pid})' if state.pid else ''}", file=sys.stderr)
-            return ExitCode.TERMINATED if stopped.signal == signal.SIGTERM else ExitCode.INTERRUPTED
+            return ENDINGS[stopped.signal][0]
         if follower.finished is not None:
             error = follower.finished.error
     elif sweep is None:  # ended before: why, as its summary.json says (it was said only to a follower of the run)

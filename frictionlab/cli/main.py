@@ -29,9 +29,10 @@ import re
 import sys
 import warnings
 
-from ..errors import ExitCode, FrictionlabError, escape_unencodable_output, short_repr, shown, too_long_path
-from ..compute.heap import keep_freed_memory
-from ..compute.signals import RaiseOnSignals, interrupted_exit_code
+from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
+                      short_repr, shown, too_long_path)  # fmt: skip
+from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
+from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
@@ -243,6 +244,7 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
+    spare_address_space_under_a_limit()  # before numpy is imported
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
@@ -374,15 +376,24 @@ def _run_command(args) -> int:
         return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
-        message = f"out of memory{detail}; ask for fewer points, realizations or workers"
+        message = f"out of memory{detail}; ask for fewer points, realizations or workers{limit_advice()}"
+        folder = getattr(args, "out_dir", None)  # a run's folder, once made: what it holds is not lost
+        if folder is not None:
+            from .run import resumable
+
+            message += f"; {resumable(folder)}"
         return _refused(args, message, ExitCode.RUNTIME_FAILURE)
-    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (signals.Terminated), or a command of several runs
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""
-        return _refused(args, f"{'terminated' if code == ExitCode.TERMINATED else 'interrupted'}{said}", code, "")
+        return _refused(args, f"{interrupted_word()}{said}", code, "")
     except Exception as exc:  # an internal error (a bug): say so plainly, traceback on request
         if os.environ.get("FRICTIONLAB_DEBUG"):
             raise
+        library = out_of_memory_loading(exc)
+        if library is not None:  # a process limit too small to load numpy or scipy: not a bug either
+            return _refused(args, f"out of memory loading {library}{limit_advice().replace(', or raise', '; raise')}",
+                            ExitCode.RUNTIME_FAILURE)  # fmt: skip
         missing = _missing_package(exc, f"frictionlab {args.command}") or _plugin_at_fault(exc)
         if missing is not None:
             return _refused(args, str(missing), missing.exit_code, f"{error_label()}: ")

@@ -7,7 +7,8 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, RunFolderError, counted, shown, too_long_path
+from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, counted, ran_out_of_memory,
+                      resume_hint, shown, too_long_path)  # fmt: skip
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -68,7 +69,7 @@ def run(args) -> ExitCode:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     if args.resume and not Path(args.out).is_dir():
         raise RunFolderError(f"{args.out} is not a run folder to resume (it does not exist, or is not a folder)")
-    out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)
+    out_dir = args.out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)  # named if memory runs out
     try:
         if args.detach:
             return detach(args, data, scene, out_dir, options)
@@ -137,7 +138,8 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     try:
         result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
     except OSError as exc:
-        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}"), file=sys.stderr)
+        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}; {resumable(out_dir)}"),
+              file=sys.stderr)  # fmt: skip
         return ExitCode.RUNTIME_FAILURE
     if closed:
         raise closed[0]
@@ -147,12 +149,26 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 
         emit("run", summary_dict(scene, outcome, {k: str(p) for k, p in result.files.items()}))
     if outcome.status in ("interrupted", "cancelled"):
+        print(shown(f"  {resumable(out_dir)}"), file=sys.stderr)
         return interrupted_exit_code()
     if outcome.failures or outcome.status == "failed":
         if outcome.error:
             print(f"error: {shown(outcome.error)}", file=sys.stderr)
+        short = sum(ran_out_of_memory(error) for _, error in outcome.failures)
+        if short:  # the machine's limit, not the preset's: the same run goes on where more fits
+            print(shown(f"{short} realization(s) ran out of memory; {resumable(out_dir)} (with {MEMORY_ADVICE})"),
+                  file=sys.stderr)  # fmt: skip
         return ExitCode.RUNTIME_FAILURE
     return ExitCode.OK
+
+
+def resumable(out_dir: Path) -> str:
+    """``resume_hint`` for a folder a run (run.json) or a sweep (sweep.json) has recorded itself in,
+    else that nothing was kept."""
+    from ..runs.rundir import STATE_FILE
+
+    recorded = any((out_dir / name).is_file() for name in (STATE_FILE, "sweep.json"))
+    return resume_hint(out_dir) if recorded else "nothing was kept"
 
 
 def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
@@ -167,7 +183,8 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
         )
     except OSError as exc:
-        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}"), file=sys.stderr)
+        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}; {resumable(out_dir)}"),
+              file=sys.stderr)  # fmt: skip
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         from .jsonout import emit
@@ -177,6 +194,7 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
         rows = [{**result.row(), "error": result.error} for result in outcome.results]  # why a point failed
         print(shown(sweep_table(sweep, outcome.status, outcome.elapsed, rows, out_dir, "plot" in outcome.files)))
     if outcome.status == "interrupted":
+        print(shown(f"  {resumable(out_dir)}"), file=sys.stderr)
         return interrupted_exit_code()
     return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK
 

@@ -220,8 +220,10 @@ def run(args) -> ExitCode:
         print(text)
         print(f"  {', '.join(p.name for p in files.values())} in {shown(out_dir)}/")
     if interrupted:
-        print("interrupted: the files hold the axes finished before the interrupt", file=sys.stderr)
-        return ExitCode.INTERRUPTED
+        from ..compute.signals import interrupted_exit_code, interrupted_word
+
+        print(f"{interrupted_word()}: the files hold the axes finished before the interrupt", file=sys.stderr)
+        return interrupted_exit_code()
     failed = [r for r in study.rows if r.outcome is not None and r.outcome.failures]
     if failed:
         print(f"error: realizations failed in {len(failed)} setting(s); see the notes in study.md", file=sys.stderr)

@@ -1,4 +1,6 @@
-"""Freed memory kept for the next realization instead of handed back to the system at once.
+"""Freed memory kept for the next realization instead of handed back to the system at once;
+and, under a process limit on memory, address space reserved and never used held back
+(``spare_address_space_under_a_limit``).
 
 glibc hands a freed block of more than 128 kB straight back to the system (and trims the
 heap's top past a threshold it sets from the blocks seen), and the next realization's
@@ -15,14 +17,26 @@ the pool's workers (``pool._serve``); a notebook's own process keeps its allocat
 
 from __future__ import annotations
 
+import os
+
+from ..errors import process_limit
+
 M_TRIM_THRESHOLD = -1  # mallopt's parameters (malloc.h)
 M_MMAP_THRESHOLD = -3
+M_ARENA_MAX = -8
+ARENAS = 2  # malloc arenas under a process limit (``spare_address_space_under_a_limit``)
 KEEP_BYTES = 32 * 2**20  # glibc's own ceiling for the thresholds it raises by itself
 
 
 def keep_freed_memory() -> bool:
     """Have glibc keep freed blocks up to ``KEEP_BYTES`` for reuse; False where the C
     library is not glibc (musl, macOS, Windows: their allocators decide)."""
+    # both or neither: a fixed mmap threshold with glibc's default trim (128 kB) would trim the same pages
+    return _mallopt(M_TRIM_THRESHOLD, KEEP_BYTES) and _mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)
+
+
+def _mallopt(parameter: int, value: int) -> bool:
+    """glibc's ``mallopt``; False where the C library is not glibc."""
     import ctypes  # here: --help and a usage error need not load it
 
     try:
@@ -30,5 +44,27 @@ def keep_freed_memory() -> bool:
     except (OSError, AttributeError, TypeError):
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
-    # both or neither: a fixed mmap threshold with glibc's default trim (128 kB) would trim the same pages
-    return mallopt(M_TRIM_THRESHOLD, KEEP_BYTES) == 1 and mallopt(M_MMAP_THRESHOLD, KEEP_BYTES) == 1
+    return mallopt(parameter, value) == 1
+
+
+def spare_address_space_under_a_limit() -> None:
+    """Under a process limit on memory (``ulimit -v``, ``ulimit -d``), what reserves address
+    space it never uses is held back, unless the user chose otherwise in the environment:
+
+    * OpenBLAS starts no threads of its own (``OPENBLAS_NUM_THREADS=1``): at import it reserves
+      a buffer of 32 to 64 MiB per thread, one per core, and when that does not fit it spins for
+      ever inside the import, deaf to SIGTERM, or exits printing 'OpenBLAS error: Memory
+      allocation still failed'. frictionlab's own BLAS work runs on one thread anyway (the fit;
+      the solvers use FFTs);
+    * glibc keeps ``ARENAS`` malloc arenas, not 8 per core of 64 MiB each: a Dask cluster's
+      threads took 1 GiB of address space in the main process (0.4 GiB with 2 arenas), and a
+      sweep on Dask ran out of it under ulimit -v 700000 ("can't start new thread"), then hung.
+
+    Before numpy is imported; the process's children inherit the environment."""
+    if process_limit() is None:
+        return
+    if not any(os.environ.get(name) for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")):
+        os.environ["OPENBLAS_NUM_THREADS"] = "1"  # the variables OpenBLAS reads, in order
+    if not os.environ.get("MALLOC_ARENA_MAX"):
+        os.environ["MALLOC_ARENA_MAX"] = str(ARENAS)  # children: glibc reads it as they start
+        _mallopt(M_ARENA_MAX, ARENAS)  # this process, started already

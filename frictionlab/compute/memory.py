@@ -274,8 +274,10 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
             continue
         points_param = _points_path(scene)
         fits = _largest_process(estimate(scene, workers=1, executor=executor, points=1)) <= room
-        if points_param and fits:
-            advice = f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}"
+        if not fits:  # frictionlab itself does not fit: no setting of the preset helps
+            advice = _higher_limit(source, room, need)
+        elif points_param:
+            advice = f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}, or with {_higher_limit(source, room, need)}"
         else:  # only a smaller map helps when its line alone does not fit: no count of realizations does
             advice = _smaller_map(guess) if guess.making + PROCESS_BASE > room else "fewer realizations"
         making = (f"making the MDR-equivalent line of a surface of {points_text(guess.grid)} points in the main process: "
@@ -285,6 +287,17 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
             f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
             f"limit to itself). It would fit with {advice}. {SKIP_HINT}"
         )
+
+
+def _higher_limit(source: str, room: int, need: int) -> str:
+    """The process limit (``source``, which leaves ``room``) under which ``need`` fits, as
+    the ``ulimit`` command that sets it: whole MiB in KiB (as ulimit counts), 2 % above, since
+    what a process holds once loaded differs from one start to the next by some kB."""
+    import resource
+
+    name, flag = ("RLIMIT_AS", "-v") if "RLIMIT_AS" in source else ("RLIMIT_DATA", "-d")
+    soft, _ = resource.getrlimit(getattr(resource, name))
+    return f"a higher limit: ulimit {flag} {math.ceil((soft - room + need) * 1.02 / MiB) * 1024} or more"
 
 
 def _smaller_map(guess: MemoryEstimate) -> str:
@@ -339,11 +352,15 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         if estimate(scene, workers=fewer, executor=executor, points=guess.grid).total <= available:
             advice.append(f"--workers {fewer}")
             break
+    least = estimate(scene, workers=1, executor=executor, points=1).total  # frictionlab itself, with the smallest grid
+    if not advice and least > available:  # no setting of the preset helps
+        advice.append(_higher_limit(source, available, guess.total) if source.startswith("the process limit") else
+                      f"more memory free: frictionlab itself (Python, numpy, scipy) needs about {gib(least)}")  # fmt: skip
     if not advice:
         one = estimate(scene, workers=1, executor=executor, points=guess.grid)
         points_param = _points_path(scene)
         one_worker = "--workers 1 and " if workers > 1 else ""  # not advised to a run that has one already
-        if estimate(scene, workers=1, executor=executor, points=1).total <= available and points_param:
+        if points_param:
             advice.append(f"{one_worker}{points_param} <= {_most_points(scene, executor, available):,}")
         else:
             rows = scene.loads.size * 8 * kept_arrays(scene) * KEPT_COPIES + 512
@@ -355,6 +372,8 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
             else:  # no count of realizations fits (it offered 'realizations <= 0'): only a smaller grid does
                 advice.append(f"fewer points: one realization of {points_text(one.points)} points alone needs "
                               f"{gib(one.per_realization)} (a measured scan: crop it or make its pixels coarser)")  # fmt: skip
+    if source.startswith("the process limit") and not advice[0].startswith("a higher limit"):
+        advice[0] += f", or with {_higher_limit(source, available, guess.total)}"
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
         f"({source}). It would fit with {advice[0]}. {SKIP_HINT}"

@@ -67,6 +67,8 @@ def _serve(tasks, results, stop, initializer, initargs, function) -> None:
     _results, _stop = results, stop
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C and SIGTERM are the parent's to handle:
     signal.signal(signal.SIGTERM, signal.SIG_IGN)  # it sets ``stop``, then stops workers
+    if hasattr(signal, "SIGHUP"):  # a closed terminal hangs up the whole job: the parent's to handle too
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)
     keep_freed_memory()  # a fork has its parent's setting; a forkserver's or spawned worker not
     if initializer is not None:
         initializer(*initargs)

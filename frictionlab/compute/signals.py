@@ -1,8 +1,10 @@
-"""Ctrl-C (SIGINT) and SIGTERM end a run the same way: the first one sets the run's
+"""Ctrl-C (SIGINT), SIGTERM and SIGHUP (the terminal closed: an SSH session that
+dropped) end a run the same way: the first one sets the run's
 cancel, which the solves running see at their next iteration (they are abandoned,
 what finished is kept), the run ends "interrupted" and its folder can be resumed;
 a second one interrupts at once. The exit code says which
-signal it was (130 or 143).
+signal it was (130, 143 or 129). A SIGHUP ignored when the command started
+(``nohup``, a detached run) stays ignored.
 
 Signal handlers live in the main thread only; the TUI, which runs the engine
 in a worker thread, cancels through its own event instead.
@@ -15,23 +17,44 @@ import threading
 
 from ..errors import ExitCode
 
-HANDLED = (signal.SIGINT, signal.SIGTERM)
+HANDLED = (signal.SIGINT, signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else []))  # no SIGHUP on Windows
+ENDINGS = {signal.SIGINT: (ExitCode.INTERRUPTED, "interrupted"), signal.SIGTERM: (ExitCode.TERMINATED, "terminated")}
+if hasattr(signal, "SIGHUP"):
+    ENDINGS[signal.SIGHUP] = (ExitCode.HUNG_UP, "hung up (the terminal closed)")
 received: list[int] = []  # the signals that ended work in this process, in order
 
 
 class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where Ctrl-C raises KeyboardInterrupt (so every path that
+    """SIGTERM or SIGHUP, raised where Ctrl-C raises KeyboardInterrupt (so every path that
     keeps finished work on Ctrl-C keeps it on SIGTERM too)."""
 
 
 def _raise_for(signum: int):
     received.append(signum)
-    raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+    raise KeyboardInterrupt() if signum == signal.SIGINT else Terminated()
+
+
+def _ending() -> tuple[ExitCode, str]:
+    """The exit code and word of the signal that ended the work: the first other than
+    Ctrl-C (a SIGTERM or hangup after a Ctrl-C is what ended it), else Ctrl-C's."""
+    others = [signum for signum in received if signum != signal.SIGINT]
+    return ENDINGS[others[0]] if others else ENDINGS[signal.SIGINT]
 
 
 def interrupted_exit_code() -> ExitCode:
-    """TERMINATED if a SIGTERM ended the work, else INTERRUPTED."""
-    return ExitCode.TERMINATED if signal.SIGTERM in received else ExitCode.INTERRUPTED
+    """TERMINATED if a SIGTERM ended the work, HUNG_UP for a SIGHUP, else INTERRUPTED."""
+    return _ending()[0]
+
+
+def interrupted_word() -> str:
+    """What ended the work, as the command's last line says it: "interrupted", "terminated"..."""
+    return _ending()[1]
+
+
+def install(handler) -> dict:
+    """``handler`` for each signal of HANDLED but one ignored (``nohup``'s SIGHUP); the previous handlers."""
+    return {signum: signal.signal(signum, handler) for signum in HANDLED
+            if not (signum != signal.SIGINT and signal.getsignal(signum) == signal.SIG_IGN)}  # fmt: skip
 
 
 def mark() -> int:
@@ -66,7 +89,7 @@ class RaiseOnSignals:
         received.clear()
         self.previous = {}
         if threading.current_thread() is threading.main_thread():
-            self.previous = {signum: signal.signal(signum, lambda signum, frame: _raise_for(signum)) for signum in HANDLED}
+            self.previous = install(lambda signum, frame: _raise_for(signum))
             _in_command = True
         return self
 
@@ -84,11 +107,11 @@ def stop_if_interrupted() -> None:
     dropped, say), raise again instead of starting it. A notebook's own process, outside
     any command, starts every run it asks for."""
     if _in_command and received:
-        raise Terminated() if received[-1] == signal.SIGTERM else KeyboardInterrupt()
+        raise KeyboardInterrupt() if received[-1] == signal.SIGINT else Terminated()
 
 
 class CancelOnSignals:
-    """While a run goes on: the first SIGINT or SIGTERM sets ``cancel`` (running
+    """While a run goes on: the first SIGINT, SIGTERM or SIGHUP sets ``cancel`` (running
     solves stop at their next iteration; what finished is kept); a second one raises KeyboardInterrupt or
     Terminated. Only in the main thread, where signals land."""
 
@@ -110,7 +133,7 @@ class CancelOnSignals:
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            self.previous = {signum: signal.signal(signum, self._handle) for signum in HANDLED}
+            self.previous = install(self._handle)
         return self
 
     def __exit__(self, *exc):

@@ -31,26 +31,31 @@ def run_app(
     keep_escape_before_control_keys()
     start_process_helpers()
     app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, options=options)
-    previous = signal.signal(signal.SIGTERM, lambda signum, frame: _exit_on_sigterm(app))
+    from ..compute.signals import HANDLED
+
+    ends = [signum for signum in HANDLED  # Ctrl-C is a key of the app's; a hangup nohup ignores stays ignored
+            if signum != signal.SIGINT and signal.getsignal(signum) != signal.SIG_IGN]  # fmt: skip
+    previous = {signum: signal.signal(signum, lambda signum, frame: _exit_on_sigterm(app, signum)) for signum in ends}
     try:
         app.run()
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     return app.return_code or 0
 
 
-def _exit_on_sigterm(app) -> None:
-    """SIGTERM while the app runs: it quits (``FrictionlabApp.terminate``), so its terminal
-    is given back whole. Raised where the handler lands, it could
-    stop the app's own cleanup between two escape codes and leave the terminal on the
-    alternate screen. Before the app's loop runs, or once it has closed, it is raised as
-    at any other time (``signals.RaiseOnSignals``): nothing of the screen is to give back."""
-    from ..compute.signals import _raise_for
+def _exit_on_sigterm(app, signum: int = signal.SIGTERM) -> None:
+    """SIGTERM (or SIGHUP: its terminal closed) while the app runs: it quits
+    (``FrictionlabApp.terminate``), so its terminal is given back whole. Raised where the
+    handler lands, it could stop the app's own cleanup between two escape codes and leave the
+    terminal on the alternate screen. Before the app's loop runs, or once it has closed, it is
+    raised as at any other time (``signals.RaiseOnSignals``): nothing of the screen is to give back."""
+    from ..compute.signals import ENDINGS, _raise_for
 
     loop = app._loop  # set while the app's loop runs, its cleanup included
     if loop is None:
-        _raise_for(signal.SIGTERM)
-    loop.call_soon_threadsafe(app.terminate)
+        _raise_for(signum)
+    loop.call_soon_threadsafe(app.terminate, int(ENDINGS[signum][0]))
 
 
 def start_process_helpers() -> None:

@@ -123,7 +123,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
         self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
-        self._terminated = False  # a SIGTERM came before it was built: it quits once it is
+        self._terminated = 0  # the exit code of a SIGTERM (SIGHUP) that came before it was built: it quits once it is
 
     # ------------------------------------------------------------ layout
 
@@ -198,15 +198,15 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
                 key = events.Key("enter", "\r")
             await self.on_event(key)
 
-    def terminate(self) -> None:
-        """SIGTERM: quit without a question (a run goes on: it is a process of its own), exit
-        code 143; while the panes are being mounted, once they are (an exit then fails their mount)."""
+    def terminate(self, code: int | None = None) -> None:
+        """SIGTERM (or SIGHUP: ``code`` 129): quit without a question (a run goes on: it is a
+        process of its own), exit code 143; while the panes are being mounted, once they are
+        (an exit then fails their mount)."""
         from ..errors import ExitCode
 
+        self._terminated = code or self._terminated or int(ExitCode.TERMINATED)
         if self.built:
-            self.exit(return_code=int(ExitCode.TERMINATED))
-        else:
-            self._terminated = True
+            self.exit(return_code=self._terminated)
 
     @property
     def built(self) -> bool:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import math
 import re
 
+from ..errors import MEMORY_ADVICE, ran_out_of_memory
+
 ELLIPSIS = "…"
 
 
@@ -63,9 +65,12 @@ _INPUT_ERRORS = ("ValueError", "InputFileProblem", "FileNotFoundError", "Permiss
 def failure_message(error: str) -> str:
     """A realization's error as the engine records it (``Type: message (file.py:N)``)
     told to the user: an input problem (a file that cannot be read, a value the
-    plugin refuses) as its message alone; anything else as an internal error, with
+    plugin refuses) as its message alone; running out of memory with what helps; anything else as an internal error, with
     its type and place, to report."""
     kind, _, message = error.partition(": ")
+    if ran_out_of_memory(error):  # the machine's limit, not a bug to report
+        detail = _WHERE.sub("", message).strip()
+        return f"out of memory{f' ({detail})' if detail else ''}: run it again with {MEMORY_ADVICE}"
     if kind in _INPUT_ERRORS and message:
         return _WHERE.sub("", message)
     return f"internal error ({error}); please report it"

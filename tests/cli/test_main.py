@@ -1,5 +1,6 @@
 """The headless CLI as a user meets it: real files, real subprocesses, exit codes."""
 
+import json
 import math
 import os
 import subprocess
@@ -7,7 +8,7 @@ import sys
 
 import pytest
 
-from frictionlab.errors import ExitCode
+from frictionlab.errors import MEMORY_ADVICE, ExitCode
 
 from ..conftest import PRESETS
 
@@ -283,3 +284,57 @@ def test_ctrl_c_while_the_command_loads_ends_with_130_and_a_line_not_a_traceback
                           capture_output=True, text=True, timeout=60)  # fmt: skip
     assert done.returncode == 130, done.stderr
     assert done.stderr == "interrupted\n"
+
+
+def test_realizations_out_of_memory_say_how_to_resume_and_the_resume_finishes(tmp_path, monkeypatch, capsys):
+    """A realization that ran out of memory was told as any failure ('1 realization(s) failed; first:
+    #1: MemoryError...'), with nothing on what was kept nor how to go on; the TUI called it an internal error."""
+    from frictionlab.cli import main
+    from frictionlab.tui.text import failure_message
+    from frictionlab_spectra.power_law import PowerLaw
+
+    made, original = [], PowerLaw.generate
+
+    def second_one_short(self, rng):
+        made.append(1)
+        if len(made) == 2:
+            raise MemoryError("Unable to allocate 16.0 MiB for an array with shape (2097152,) and data type float64")
+        return original(self, rng)
+
+    monkeypatch.setattr(PowerLaw, "generate", second_one_short)
+    out = tmp_path / "run"
+    args = ["--out", str(out), "--workers", "1", "--quiet", "--no-plot", "--set", "realizations=4"]
+    assert main(["run", "quickstart", *args]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert f"1 realization(s) ran out of memory; what finished is kept in {out}/: `frictionlab resume {out}`" in err
+    assert "internal error" not in err
+    reason = "MemoryError: Unable to allocate 16.0 MiB (springs.py:174)"
+    assert failure_message(reason) == f"out of memory (Unable to allocate 16.0 MiB): run it again with {MEMORY_ADVICE}"
+    monkeypatch.setattr(PowerLaw, "generate", original)
+    assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.OK
+    summary = json.loads((out / "summary.json").read_text())
+    assert (summary["status"], summary["resumed_realizations"], summary["retried_realizations"]) == ("completed", 3, 1)
+
+
+@pytest.mark.parametrize("said", ["No space left on device", "out of memory: Unable to allocate 2.0 GiB"])
+def test_a_full_disk_or_memory_at_the_end_says_what_is_kept_and_how_to_resume(tmp_path, monkeypatch, capsys, said):
+    """'error: cannot write results to DIR: No space left on device' (or 'error: out of memory;
+    ask for fewer points...') said nothing of the chunks kept there."""
+    import errno
+
+    from frictionlab.cli import main
+    from frictionlab.runs import runner
+
+    def full(out_dir, *args):
+        if said.startswith("out of memory"):
+            raise MemoryError(said.removeprefix("out of memory: "))
+        raise OSError(errno.ENOSPC, said, str(out_dir / "summary.json"))
+
+    monkeypatch.setattr(runner, "write_results", full)
+    out = tmp_path / "run"
+    assert main(["run", "quickstart", "--out", str(out), "--workers", "1", "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert f"{said}" in err and f"; what finished is kept in {out}/: `frictionlab resume {out}`" in err
+    assert "internal error" not in err
+    monkeypatch.undo()
+    assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.OK

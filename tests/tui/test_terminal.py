@@ -112,8 +112,12 @@ def _wait_reading(process, keyboard, until, timeout=60.0) -> bytes:
 
 
 # the drawn screen's case is long (a process that imports and draws the whole app: seconds)
-@pytest.mark.parametrize("when", ["while it loads", pytest.param("as its screen is drawn", marks=pytest.mark.long)])
-def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when):
+@pytest.mark.parametrize("when, signum, code", [
+    ("while it loads", "SIGTERM", 143),
+    pytest.param("as its screen is drawn", "SIGTERM", 143, marks=pytest.mark.long),
+    pytest.param("as its screen is drawn", "SIGHUP", 129, marks=pytest.mark.long),  # a hangup was raised mid-draw
+])  # fmt: skip
+def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when, signum, code):
     """A SIGTERM while it loads (after it took the terminal out of line mode, before its commands
     handle signals) killed it there, its terminal left without echo nor line mode; once the app
     draws, one raised in the app's mount ended it with a traceback. It ends with 143 and the
@@ -126,7 +130,7 @@ def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when):
             written = _wait_reading(process, keyboard, lambda _: not termios.tcgetattr(program)[3] & termios.ECHO)
         else:
             written = _wait_reading(process, keyboard, lambda written: b"\x1b[?1049h" in written)  # alternate screen
-        process.send_signal(signal.SIGTERM)
+        process.send_signal(getattr(signal, signum))
         written += _wait_reading(process, keyboard, lambda _: process.poll() is not None)
         written += _wait_reading(process, keyboard, lambda _: not select.select([keyboard], [], [], 0.2)[0])
         after = termios.tcgetattr(program)
@@ -136,7 +140,7 @@ def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when):
         process.wait()
         os.close(keyboard)
         os.close(program)
-    assert process.returncode == 143
+    assert process.returncode == code
     assert after == before
     assert b"Traceback" not in written and b"Error" not in written
     assert written.count(b"\x1b[?1049h") == written.count(b"\x1b[?1049l")  # back on the main screen
