@@ -139,7 +139,9 @@ def test_the_spikes_among_the_highest_points_are_said_as_despike_would_replace_t
     spiky[where] += 13 * rms
     expected = int(np.count_nonzero(spiky - ndimage.median_filter(spiky, size=5, mode="reflect") > 6 * rms))
     assert expected == despike(spiky, 6.0, rms)[1] >= 1
-    assert spike_warning(spiky, rms).startswith(f"{expected} of the map's 16 highest points stand more than 6 rms heights")
+    said = spike_warning(spiky, rms)
+    stand, it = ("stands", "replaces it, if it is not") if expected == 1 else ("stand", "replaces them, if they are not")
+    assert said.startswith(f"{expected} of the map's 16 highest points {stand} more than 6 rms heights") and it in said
     low = z.copy()
     low[where] += 4 * rms
     assert spike_warning(low, rms) is None
@@ -150,7 +152,7 @@ def test_a_spike_caveat_comes_with_the_map_unless_despike_is_set(tmp_path):
     z[11, 17] += 14 * np.std(z)
     np.save(tmp_path / "map.npy", z)
     said = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5).input_summary()
-    assert any("despike: 6 replaces them" in caveat for caveat in said["caveats"])
+    assert any("1 of the map's 16 highest points stands" in c and "despike: 6 replaces it, if it is not" in c for c in said["caveats"])
     cleaned = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.5, despike=6.0).input_summary()
     assert cleaned["despiked"]["points"] == 1 and "caveats" not in cleaned
 
@@ -190,9 +192,10 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
     expected = int(np.count_nonzero(levelled - ndimage.median_filter(levelled, size=5, mode="reflect") > 6 * rms))
     assert expected == where.stop - where.start
     assert said["spiky"]["caveats"] == [
-        f"{expected} of the line's 16 highest points stand more than 6 rms heights above the median of the 5 points "
-        "around them: spikes (dust, an instrument's artefact) take the first contact alone, and the law at small "
-        "loads is theirs; remove them from the profile, if they are not the surface's own"
+        f"{expected} of the line's 16 highest points {'stands' if expected == 1 else 'stand'} more than 6 rms heights "
+        "above the median of the 5 points around them: spikes (dust, an instrument's artefact) take the first contact "
+        f"alone, and the law at small loads is theirs; remove {'it' if expected == 1 else 'them'} from the profile, "
+        f"if {'it is' if expected == 1 else 'they are'} not the surface's own"
     ]
     assert "caveats" not in said["smooth"] and "caveats" not in said["low"]
 

@@ -186,10 +186,16 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     spikes = _spikes(z, rms)
     if not spikes:
         return None
-    return (f"{spikes} of the map's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms "
+    stand, them, they = _agreeing(spikes)
+    return (f"{spikes} of the map's {SPIKE_LOOKED_AT} highest points {stand} more than {SPIKE_K:g} rms "
             "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
-            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces them, if "
-            "they are not the surface's own")  # fmt: skip
+            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces {them}, if "
+            f"{they} not the surface's own")  # fmt: skip
+
+
+def _agreeing(spikes: int) -> tuple[str, str, str]:
+    """The verb and pronouns that agree with a count of spikes: one stands, two stand."""
+    return ("stands", "it", "it is") if spikes == 1 else ("stand", "them", "they are")
 
 
 def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
@@ -200,9 +206,10 @@ def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
     spikes = _spikes(z.reshape(1, -1), rms)
     if not spikes:
         return None
-    return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points stand more than {SPIKE_K:g} rms heights above "
+    stand, them, they = _agreeing(spikes)
+    return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points {stand} more than {SPIKE_K:g} rms heights above "
             f"the median of the {SPIKE_WINDOW} points around them: spikes (dust, an instrument's artefact) take the "
-            "first contact alone, and the law at small loads is theirs; remove them from the profile, if they are "
+            f"first contact alone, and the law at small loads is theirs; remove {them} from the profile, if {they} "
             "not the surface's own")  # fmt: skip
 
 
