@@ -91,8 +91,9 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax, ax_count = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.2]})
     fig.subplots_adjust(left=0.12, right=0.97, bottom=0.1, top=0.94, hspace=0.06)
     draw_curve(ax, outcome.f, outcome.xi, outcome.xi_sem, outcome.fit, done=outcome.done, caveats=outcome.caveats)
-    title = f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}"
+    title = wrap_title(f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}", 6.4, 10)
     ax.set_title(title, fontsize=10, y=1.0)  # placed, not fitted above the tick labels that the shared x axis hides
+    fig.subplots_adjust(top=0.94 - 0.03 * title.count("\n"))  # a long name: the title's lines inside the figure
     ax_count.plot(outcome.f, outcome.contact_count, "-", color="C2")
     ax_count.set_yscale("log")
     plain_log_labels(ax_count.yaxis)

@@ -99,3 +99,24 @@ def test_the_definition_of_f_under_plot_png_is_inside_the_figure(make_scene, mon
     assert box.x0 >= inside.x0 and box.x1 <= inside.x1 and box.y0 >= inside.y0, (box, inside)
     ticks = max(t.get_window_extent(renderer).y0 for t in fig.axes[1].get_xticklabels() if t.get_text())
     assert box.y1 <= ticks  # under the tick labels, not over them
+
+
+def test_a_long_title_of_plot_png_is_inside_the_figure(make_scene, monkeypatch):
+    """The title names the preset, what is pressed, the solver and the slope estimator: with a
+    name of 60 characters it ran past both edges of the figure on one line."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    name = "a-long-preset-name-as-a-study-gives-it-h08-n1024-seed2026-run"
+    scene = make_scene({"realizations": 2, "name": name})
+    outcome = engine.run(scene, RunOptions(workers=1))
+    drawn = []
+    save = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
+    plot_curve(scene, outcome, io.BytesIO())
+    canvas = FigureCanvasAgg(drawn[0])
+    canvas.draw()
+    title, inside = drawn[0].axes[0].title, drawn[0].bbox
+    assert name in title.get_text().replace("\n", " ")
+    box = title.get_window_extent(canvas.get_renderer())
+    assert box.x0 >= inside.x0 and box.x1 <= inside.x1 and box.y1 <= inside.y1, (box, inside)
