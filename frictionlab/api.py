@@ -457,7 +457,7 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 
 def _load_sweep(folder: Path) -> SweepResult:
-    from .runs.sweep import read_sweep_record
+    from .runs.sweeprecord import read_sweep_record
 
     summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]

@@ -216,6 +216,25 @@ def test_an_intact_copy_loads_the_same_numbers(run_copy, finished):
 # ------------------------------------------------------------------ sweeps and the TUI's list
 
 
+def test_a_sweep_json_without_a_row_for_every_point_is_damaged(tmp_path):
+    """Its points cut short (or one row too many) loaded as a smaller sweep without a word."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    for points, said in ((data["points"][:1], "1 rows for a sweep of 2 points"),
+                         (data["points"] * 2, "4 rows for a sweep of 2 points")):  # fmt: skip
+        (folder / "sweep.json").write_text(json.dumps({**data, "points": points}))
+        with pytest.raises(RunFolderError, match=f"sweep.json is damaged \\(points: {said}\\)"):
+            frictionlab.load(folder)
+    bad_section = {**data["sweep"], "mode": "diagonal"}
+    (folder / "sweep.json").write_text(json.dumps({**data, "sweep": bad_section}))
+    with pytest.raises(RunFolderError, match=r"sweep.json is damaged \(sweep: not a sweep section"):
+        frictionlab.load(folder)
+    (folder / "sweep.json").write_text(json.dumps(data))
+    assert len(frictionlab.load(folder).points) == 2
+
+
 def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
     folder = tmp_path / "sweep"
     preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})

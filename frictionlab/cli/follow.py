@@ -178,7 +178,7 @@ def _stored_sweep(folder: Path):
 
 def _rows(folder: Path) -> list[dict]:
     """Each point's row of the sweep's sweep.json, its values checked."""
-    from ..runs.sweep import read_sweep_record
+    from ..runs.sweeprecord import read_sweep_record
 
     _, record = read_sweep_record(folder)
     return [point.model_dump() for point in record.points]

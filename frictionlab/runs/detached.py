@@ -344,7 +344,8 @@ def _chunk_count(folder: Path, chunks, total: int | None) -> int | None:
 
 def sweep_state(folder: str | Path) -> RunState:
     """The state of the sweep in ``folder`` (its sweep.json, checked); RunFolderError if it holds none."""
-    from .sweep import UNFINISHED, read_sweep_record
+    from .sweep import UNFINISHED
+    from .sweeprecord import read_sweep_record
 
     folder = Path(folder)
     _, record = read_sweep_record(folder)

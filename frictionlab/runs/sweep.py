@@ -23,9 +23,9 @@ import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel
 
 from .. import __version__
 from ..compute.dask_session import one_dask_cluster
@@ -41,11 +41,10 @@ from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
-from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, make_subfolder, read_json
+from .runfolder import make_subfolder, read_json
+from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
 from .runner import run_to_folder
 
-SWEEP_SCHEMA_VERSION = 1
-MAX_SWEEP_RECORD_BYTES = 64 * 1024 * 1024  # a sweep.json holds a row per point: at most 1000 of them
 RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
     "contact_first", "contact_last", "elapsed_s", "folder",
@@ -418,48 +417,6 @@ def stored_sweep(out_dir: Path) -> dict:
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
     data, _ = read_sweep_record(out_dir)
     return {**data["base_preset"], "sweep": data["sweep"]}  # as Sweep.preset_data
-
-
-class PointRecord(Record):
-    """A point's row of sweep.json (or of a followed sweep's progress log): each value checked."""
-
-    folder: MemberName
-    status: Literal["completed", "cancelled", "interrupted", "failed", "error", "pending"]  # PointResult's
-    done: Count | None = None
-    contact_first: Finite | None = None
-    contact_last: Finite | None = None
-    a: Finite | None = None
-    a_lo: Finite | None = None
-    a_hi: Finite | None = None
-    b: Finite | None = None
-    b_lo: Finite | None = None
-    b_hi: Finite | None = None
-    r2: Finite | None = None
-
-
-class _SweepSpecRecord(Record):
-    parameters: dict[str, Any]
-
-
-class SweepRecord(Record):
-    """What load(), resume and the TUI trust of a sweep.json: each value checked."""
-
-    sweep: _SweepSpecRecord  # first: what a resume needs, named first when missing
-    base_preset: dict[str, Any]
-    schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
-    name: Annotated[str, Field(min_length=1)]
-    status: Literal["running", "completed", "interrupted", "failed"]  # SweepOutcome's
-    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
-    points: list[PointRecord]
-
-
-def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
-    """A sweep folder's sweep.json (read as any run folder's file is: ``runfolder``): the
-    JSON object and its checked record; RunFolderError naming the file and the field."""
-    path = Path(out_dir) / "sweep.json"
-    data = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
-    check_schema_version(data, path, SWEEP_SCHEMA_VERSION)
-    return data, checked(SweepRecord, data, path)
 
 
 def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:

@@ -20,7 +20,8 @@ from ..errors import RunFolderError
 from ..plugin.listeners import SweepListener
 from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf, _number, _whole
 from .runfolder import checked
-from .sweep import UNFINISHED, PointRecord, PointResult, Sweep, SweepPoint, point_folder
+from .sweep import UNFINISHED, PointResult, Sweep, SweepPoint, point_folder
+from .sweeprecord import PointRecord
 
 
 class SweepProgressLog(SweepListener):

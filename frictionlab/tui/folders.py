@@ -304,8 +304,8 @@ class SweepEntry:
 
 
 def read_sweep(folder: Path) -> SweepEntry:
-    """A sweep folder's sweep.json, checked (``sweep.read_sweep_record``); RunFolderError if unreadable."""
-    from ..runs.sweep import read_sweep_record
+    """A sweep folder's sweep.json, checked (``sweeprecord.read_sweep_record``); RunFolderError if unreadable."""
+    from ..runs.sweeprecord import read_sweep_record
 
     folder = Path(folder)
     summary, record = read_sweep_record(folder)

@@ -1,0 +1,65 @@
+"""A sweep folder's sweep.json read back as untrusted input: every value checked
+(``runfolder``), and a row for every point its sweep section counts."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import Field, ValidationError
+
+from ..errors import RunFolderError
+from ..preset.schema import SweepSettings
+from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
+
+SWEEP_SCHEMA_VERSION = 1
+MAX_SWEEP_RECORD_BYTES = 64 * 1024 * 1024  # a sweep.json holds a row per point: at most 1000 of them
+
+
+class PointRecord(Record):
+    """A point's row of sweep.json (or of a followed sweep's progress log): each value checked."""
+
+    folder: MemberName
+    status: Literal["completed", "cancelled", "interrupted", "failed", "error", "pending"]  # PointResult's
+    done: Count | None = None
+    contact_first: Finite | None = None
+    contact_last: Finite | None = None
+    a: Finite | None = None
+    a_lo: Finite | None = None
+    a_hi: Finite | None = None
+    b: Finite | None = None
+    b_lo: Finite | None = None
+    b_hi: Finite | None = None
+    r2: Finite | None = None
+
+
+class _SweepSpecRecord(Record):
+    parameters: dict[str, Any]
+
+
+class SweepRecord(Record):
+    """What load(), resume and the TUI trust of a sweep.json: each value checked."""
+
+    sweep: _SweepSpecRecord  # first: what a resume needs, named first when missing
+    base_preset: dict[str, Any]
+    schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
+    name: Annotated[str, Field(min_length=1)]
+    status: Literal["running", "completed", "interrupted", "failed"]  # SweepOutcome's
+    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
+    points: list[PointRecord]
+
+
+def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
+    """A sweep folder's sweep.json (read as any run folder's file is: ``runfolder``): the
+    JSON object and its checked record; RunFolderError naming the file and the field."""
+    path = Path(out_dir) / "sweep.json"
+    data = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+    check_schema_version(data, path, SWEEP_SCHEMA_VERSION)
+    record = checked(SweepRecord, data, path)
+    try:  # a row per point: a list cut short would be read as a smaller sweep
+        points = SweepSettings.model_validate(data["sweep"]).count()
+    except ValidationError:
+        raise RunFolderError(f"{path} is damaged (sweep: not a sweep section a preset can hold)") from None
+    if len(record.points) != points:
+        raise RunFolderError(f"{path} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
+    return data, record
