@@ -205,3 +205,26 @@ def test_a_chunk_with_a_forged_central_directory_is_not_parsed(tmp_path, registr
         assert "unreadable" in str(exc)
     else:
         raise AssertionError("a forged central directory was read as a chunk")
+
+
+def test_a_run_that_ends_between_the_two_looks_is_its_ending_not_interrupted(tmp_path, registry, monkeypatch):
+    """A follower read run.json ("running"), then found the lock free: the run had ended in
+    between (it writes its ending, then lets the lock go), and was called interrupted (a
+    `follow` right after a short resume exited 1 once in CI). The manifest is read again."""
+    import frictionlab.runs.detached as detached
+
+    folder = tmp_path / "run"
+    _run(folder, registry)
+    manifest = folder / "run.json"
+    ended = manifest.read_text()
+    manifest.write_text(json.dumps({**json.loads(ended), "status": "running"}))
+
+    def ends_now(path) -> bool:  # the run writes its ending and lets the lock go as it is looked at
+        manifest.write_text(ended)
+        return False
+
+    monkeypatch.setattr(detached, "lock_held", ends_now)
+    assert run_state(folder).status == "completed"
+    manifest.write_text(json.dumps({**json.loads(ended), "status": "running"}))
+    monkeypatch.setattr(detached, "lock_held", lambda path: False)  # gone, still saying running
+    assert run_state(folder).status == "interrupted"

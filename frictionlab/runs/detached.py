@@ -284,8 +284,10 @@ def run_state(folder: str | Path) -> RunState:
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
-        else:
-            status = "interrupted"  # the process that wrote "running" is gone
+        else:  # gone, or it ended between the two looks: its manifest, read again, says which
+            manifest = RunDirectory(folder).state() or manifest
+            status = str(manifest.get("status") or "?")
+            status = "interrupted" if status == "running" else status  # the process that wrote "running" is gone
     if status == "running":  # its log's last count (none to read, a link never followed: what it stored)
         done = _last_count(folder)
         return RunState(folder, name, status, stored() if done is None else done, total, pid)
@@ -353,8 +355,9 @@ def sweep_state(folder: str | Path) -> RunState:
     if status == "running":
         if lock_held(folder):
             pid = lock_holder(folder)  # None where it cannot be verified: never a pid a file names
-        else:
-            status = "interrupted"  # the process that wrote "running" is gone
+        else:  # gone, or it ended between the two looks: its sweep.json, read again, says which
+            _, record = read_sweep_record(folder)
+            status = "interrupted" if record.status == "running" else record.status
     done = sum(point.status not in UNFINISHED for point in record.points)
     return RunState(folder, record.name, status, done, len(record.points), pid, kind="sweep")
 
