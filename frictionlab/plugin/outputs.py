@@ -143,9 +143,10 @@ def height_problem(spectrum: SpectrumGenerator) -> str | None:
 def height_of(spectrum: SpectrumGenerator, profile: Profile) -> tuple[float, float | None]:
     """The h of f for ``profile`` and the profile's own h (None when it is the nominal one), checked."""
     own = spectrum.profile_rms_height(profile)
-    if own is None:
-        refuse(spectrum, height_problem(spectrum))
-        return spectrum.rms_height(), None
+    if own is None:  # asked once: a measured spectrum may compute it
+        nominal = spectrum.rms_height()
+        refuse(spectrum, _positive("rms_height()", nominal))
+        return nominal, None
     refuse(spectrum, _positive("profile_rms_height(profile)", own))
     return own, own
 

@@ -257,7 +257,7 @@ class Bounds:
     @classmethod
     def of(cls, field) -> Bounds | None:
         """The field's bounds, when it has both, else None."""
-        said = {key: getattr(m, key) for m in field.metadata for key in ("ge", "gt", "le", "lt") if getattr(m, key, None) is not None}
+        said = _limits(field)
         if not ({"ge", "gt"} & said.keys() and {"le", "lt"} & said.keys()):
             return None
         return cls(said.get("ge", said.get("gt")), "ge" not in said, said.get("le", said.get("lt")), "le" not in said)
@@ -271,10 +271,15 @@ class Bounds:
         return above and (number < self.high if self.high_strict else number <= self.high)
 
 
+def _limits(field) -> dict[str, float]:
+    """A field's own bounds, by pydantic's names (ge, gt, le, lt)."""
+    return {key: getattr(m, key) for m in field.metadata for key in ("ge", "gt", "le", "lt") if getattr(m, key, None) is not None}
+
+
 def _refuses_zero(field) -> bool:
     """Whether a field's own bounds refuse 0 and every number below it (gt=0, ge=1)."""
-    return any(getattr(m, "gt", None) is not None and m.gt >= 0 or getattr(m, "ge", None) is not None and m.ge > 0
-               for m in field.metadata)  # fmt: skip
+    limits = _limits(field)
+    return ("gt" in limits and limits["gt"] >= 0) or ("ge" in limits and limits["ge"] > 0)
 
 
 def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]:
