@@ -94,7 +94,9 @@ class Prediction:
 
     @property
     def beyond_full_contact(self) -> bool:
-        return self.xi > 1.0  # xi = 1 at full contact: the log law no longer holds
+        # xi = 1 at full contact and the law has no reason to pass it there; a mean xi can
+        # exceed 1 a little before full contact (a very rough line), so this says "may"
+        return self.xi > 1.0
 
 
 def check_law(
@@ -348,7 +350,8 @@ def prediction_text(p: Prediction) -> str:
     if p.extrapolated:
         lines.append(f"warning: f is outside the run's fitted range [{p.fitted_f[0]:.3g}, {p.fitted_f[1]:.3g}]: extrapolated")
     if p.beyond_full_contact:
-        lines.append("warning: xi > 1, beyond full contact (xi = 1 there): the log law does not hold")
+        lines.append("warning: xi > 1, more than the whole surface's rms slope: at full contact xi = 1, so this force "
+                     "may be past where the log law holds (see the run's contact fraction)")
     if p.xi <= 0:
         lines.append("warning: xi <= 0: below the law's range (too few points in contact)")
     return "\n".join(lines)

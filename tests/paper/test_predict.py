@@ -14,6 +14,7 @@ from frictionlab.paper.predict import (
     bootstrap_pairs,
     dimensionless_force_3d,
     predict_xi,
+    prediction_text,
     read_run_law,
 )
 from frictionlab.runs.runner import run_to_folder
@@ -40,6 +41,18 @@ def test_the_specs_worked_law():
     low, high = predict_xi(LogFit(2.9, 0.14), force=force, **kw), predict_xi(LogFit(2.9, 0.14), force=500 * force, **kw)
     assert high.xi - low.xi == pytest.approx(0.14 * math.log(500), rel=1e-12)
     assert 3 <= high.xi / low.xi <= 4
+
+
+def test_xi_above_one_warns_that_the_force_may_be_past_the_law():
+    """xi = 1 at full contact: a law read past 1 says the force may be past where it holds,
+    not that the contact is full (a mean xi can pass 1 before full contact)."""
+    kw = dict(modulus=1.0, rms_height=1e4, area=math.pi * 0.25e10)  # f = F * 1e-9
+    past = predict_xi(LogFit(2.9, 0.14), force=1e4, **kw)  # xi = 2.9 + 0.14 ln 1e-5 = 1.29
+    below = predict_xi(LogFit(2.9, 0.14), force=7.0, **kw)
+    assert past.xi > 1 > below.xi and past.beyond_full_contact and not below.beyond_full_contact
+    warning = "warning: xi > 1, more than the whole surface's rms slope"
+    assert warning in prediction_text(past) and "may be past where the log law holds" in prediction_text(past)
+    assert "warning" not in prediction_text(below)
 
 
 def test_bootstrap_pairs_keep_the_correlation_the_rectangle_loses():
