@@ -127,9 +127,12 @@ def height_moments(heights: np.ndarray) -> tuple[float, float]:
 
 def nayak_parameter(heights: np.ndarray, spacing: float) -> float:
     """alpha = m0 m4 / m2^2 of the profiles of a periodic surface along x (its rows),
-    with m0 = <z^2>, m2 = <(dz/dx)^2>, m4 = <(d2z/dx2)^2> from the spectrum (exact
-    derivatives; the mean and the Nyquist column dropped). For an isotropic surface
-    it is the same in every direction."""
+    each about its own mean, as a profile trace is: m0 = <(z - row mean)^2>, m2 =
+    <(dz/dx)^2>, m4 = <(d2z/dx2)^2> from the spectrum (exact derivatives; the column
+    q_x = 0, the rows' means, and the Nyquist column dropped). m0 is therefore below
+    the surface's <z^2> by the variance of its waves along y alone (about 6 % with a
+    long cut-off of a quarter of the side, a fifth to a third with the side). For an
+    isotropic surface it is the same in every direction."""
     z = np.asarray(heights, float)
     points = z.shape[-1]
     spectrum = np.fft.rfft(z - z.mean(), axis=-1)

@@ -317,7 +317,10 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         "holds 16 cells of its longest wave and its heights are close to Gaussian one by one. The comparison "
         "family, the same spectrum with the long cut-off at the side, is dominated by its few longest waves. "
         "Skewness and kurtosis are those of each surface's heights (0 and 3 for a Gaussian); the Nayak parameter "
-        "α = m0 m4 / m2² of its profiles (m_n the spectral moments; 1 for a single wave, growing with the band).",
+        "α = m0 m4 / m2² of its rows, each taken about its own mean as a profile trace is (m_n the spectral "
+        "moments; 1 for a single wave, growing with the band). Counted about the surface's mean, the rows' own "
+        "means add to m0 the variance of the waves along y alone, and α is larger: most where a few long waves "
+        "carry much of the height, as in the comparison family.",
         "",
         *surfaces_table(runs, numbers),
         "",
