@@ -67,14 +67,11 @@ def in_use(out_dir: str | Path, holder: int | None = None) -> RunFolderError:
 
 def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
     """``check_startable`` for a sweep (``sweep.Sweep``): its folder, and each point's memory."""
-    from .runner import check_memory
-    from .sweep import check_sweep_folder
+    from .sweep import check_sweep_folder, check_sweep_memory
 
     _check_not_in_use(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)
-    if options.memory_check:
-        for point in sweep.points:
-            check_memory(point.scene, options)
+    check_sweep_memory(sweep, options)
 
 
 def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions(), *,
