@@ -276,7 +276,8 @@ def check_memory_ahead(factories: dict[float, SceneFactory], runs_dir: Path, pla
             raise RunError(
                 f"the exact 3D study starts nothing: its ensemble {job.describe()} does not fit: {exc} The study's "
                 "grids are its plan's, whatever its presets say: of that advice a preset's setting does not apply; "
-                "--workers and a higher limit do, or more memory free, or --quick (grids of 64² to 192² px, not converged)."
+                "--workers and a higher limit do, or more memory free, or --quick (grids of 64² to 192² px, "
+                "not converged)."
             ) from None
 
 

@@ -311,8 +311,8 @@ def run_state(folder: str | Path) -> RunState:
 def _uncounted(manifest: dict, preset: dict, done: int | None, total: int | None) -> str | None:
     """Why an ended run's count of realizations cannot be told (None where it can): said, never shown as ``?``."""
     if total is None:
-        return (f"{STATE_FILE} does not say how many realizations the run has (its realizations is "
-                f"{short_repr(manifest.get('realizations'))}, its preset's {short_repr(preset.get('realizations'))})")  # fmt: skip
+        told = (short_repr(manifest.get("realizations")), short_repr(preset.get("realizations")))
+        return f"{STATE_FILE} does not say how many realizations the run has (its realizations is {told[0]}, its preset's {told[1]})"
     if done is None:
         return f"{STATE_FILE} does not list its chunks: what finished cannot be counted"
     if done > total:

@@ -26,7 +26,8 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_points, check_text_room, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
+    channel_list, check_declared_points, check_header_units, check_payload, check_text_room, choose_reader,
+    describe_failure, pick_channel,
     TEXT_FORMATS, quoted,
 )
 
