@@ -17,14 +17,15 @@ def program() -> None:
     command's own handling, ends as one at any other time does: a line and exit code 130
     (SIGTERM: 143)."""
     held = None
-    if sys.argv[1:2] == ["tui"]:  # first thing: keys typed while it loads wait for the app as typed
-        from .tui.terminal import hold_keys
-
-        # before the terminal is held: a SIGTERM while it loads (its default ends the process
-        # at once) raises here, so the finally below gives the terminal back its echo and line mode
-        signal.signal(signal.SIGTERM, _terminated)
-        held = hold_keys()
     try:
+        if sys.argv[1:2] == ["tui"]:  # first thing: keys typed while it loads wait for the app as typed
+            from .tui.terminal import hold_keys
+
+            # before the terminal is held: a SIGTERM while it loads (its default ends the process
+            # at once) raises here, so the finally below gives the terminal back its echo and line mode;
+            # inside the try: a background job (`timeout 5 frictionlab tui`) stops at the hold until signalled
+            signal.signal(signal.SIGTERM, _terminated)
+            held = hold_keys()
         from .cli import program as run_program
 
         run_program()

@@ -228,3 +228,33 @@ def test_a_run_that_ends_between_the_two_looks_is_its_ending_not_interrupted(tmp
     manifest.write_text(json.dumps({**json.loads(ended), "status": "running"}))
     monkeypatch.setattr(detached, "lock_held", lambda path: False)  # gone, still saying running
     assert run_state(folder).status == "interrupted"
+
+
+def _edit_manifest(folder, edit):
+    manifest = json.loads((folder / "run.json").read_text())
+    edit(manifest)
+    (folder / "run.json").write_text(json.dumps(manifest))
+
+
+def test_a_run_whose_count_cannot_be_told_is_damaged_with_the_reason_never_a_question_mark(tmp_path, registry, capsys):
+    """A run.json whose realizations was not a count was listed '4/?', one without its chunks'
+    list (and no summary) '?/4': each is now damaged, saying why; a count its preset still
+    tells is used."""
+    runs = tmp_path / "runs"
+    for name in ("no-total", "preset-total", "no-chunks"):
+        _run(runs / name, registry)
+    _edit_manifest(runs / "no-total", lambda m: m.update(realizations="x", preset={**m["preset"], "realizations": None}))
+    _edit_manifest(runs / "preset-total", lambda m: m.update(realizations="x"))
+    _edit_manifest(runs / "no-chunks", lambda m: m.pop("chunks"))
+    (runs / "no-chunks" / "summary.json").unlink()
+    states = {s.folder.name: s for s in list_run_states(runs)}
+    assert (states["preset-total"].status, states["preset-total"].done, states["preset-total"].total) == ("completed", 4, 4)
+    assert states["no-total"].status == states["no-chunks"].status == "damaged"
+    assert states["no-total"].reason == ("run.json does not say how many realizations the run has "
+                                         "(its realizations is 'x', its preset's None)")  # fmt: skip
+    assert states["no-chunks"].reason == "run.json does not list its chunks: what finished cannot be counted"
+    assert main(["runs", str(runs)]) == 0
+    out = capsys.readouterr().out
+    assert "?" not in out and f"{runs / 'no-total'} is damaged: run.json does not say" in out
+    assert main(["follow", str(runs / "no-chunks")]) == 1
+    assert capsys.readouterr().out == f"small: damaged, in {runs / 'no-chunks'}/: {states['no-chunks'].reason}\n"

@@ -780,20 +780,22 @@ def test_a_table_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch,
     """A table has no header that gives its size, and was read whole: a 1 TB .csv (sparse) under
     ulimit -v ended `frictionlab validate` with 'out of memory; ask for fewer points,
     realizations or workers', the file unnamed and the advice wrong, and without a limit tried
-    to read a terabyte. Now refused by its size before it is read when it cannot fit (at least
-    three times its bytes), and named if it runs out while being read."""
-    import frictionlab_spectra.profile_file as tables
+    to read a terabyte. Now refused before it is read when its numbers (counted per byte in its
+    first bytes, 8 bytes each, three copies) cannot fit, and named if it runs out while being read."""
+    import frictionlab_spectra.text_table as tables
+    from frictionlab_spectra.instrument_reader import HEIGHT_COPIES
 
     z = rough(12, 10, 9) if plugin is SurfaceFile else rough(1, 40, 9)
     (tmp_path / "map.csv").write_text(matrix_text(z))
-    size = (tmp_path / "map.csv").stat().st_size
-    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size - 1, "the room in this test"), raising=False)
-    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it takes at least .* GiB, more than the "
-                                         r".* GiB this process may use \(the room in this test\): save the heights as a "
-                                         r"\.npy array"):
+    copies = HEIGHT_COPIES if plugin is SurfaceFile else tables.TABLE_COPIES  # a map's levelling holds more
+    size, need = (tmp_path / "map.csv").stat().st_size, z.size * 8 * copies
+    monkeypatch.setattr(tables, "room_to_read", lambda: (need - 1, "the room in this test"))
+    with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading its numbers takes about .* GiB, more than "
+                                         r"the .* GiB this process may use \(the room in this test\): save the heights as "
+                                         r"a \.npy array"):
         plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
-    monkeypatch.setattr(tables, "room_to_read", lambda: (3 * size, "the room in this test"), raising=False)
-    assert plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height() > 0  # room for three copies: read
+    monkeypatch.setattr(tables, "room_to_read", lambda: (need, "the room in this test"))
+    assert plugin(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height() > 0  # room for its copies: read
 
     def out_of_memory(*args, **kwargs):
         raise MemoryError
@@ -802,3 +804,25 @@ def test_a_table_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch,
     (tmp_path / "again.csv").write_text(matrix_text(z))  # another file: the first one's heights are cached
     with pytest.raises(ValueError, match=rf"a table of {size:,} bytes; reading it ran out of memory: save the heights"):
         plugin(path=str(tmp_path / "again.csv"), spacing=0.1).rms_height()
+
+
+@pytest.mark.parametrize("columns", [1, 400])
+def test_a_table_is_read_in_memory_of_its_numbers_not_of_its_text(tmp_path, columns):
+    """A text table was read whole, decoded and split into lines: 3 times its bytes for a matrix
+    and 5.5 for a column, 17 times its numbers (a 280 MB column of heights ran out of memory under
+    ulimit -v 1048576 for 88 MB of numbers). It is read a line at a time: its numbers' bytes, and
+    numpy's spare room while it grows them."""
+    import tracemalloc
+
+    from frictionlab_spectra.text_table import read_text_table
+
+    z = np.random.default_rng(3).normal(size=(200_000 // columns, columns))
+    np.savetxt(tmp_path / "z.txt", z)
+    tracemalloc.start()
+    try:
+        read = read_text_table(tmp_path / "z.txt", "z.txt")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    np.testing.assert_array_equal(read, z)  # savetxt's 18 digits: the same numbers
+    assert peak < 2 * z.nbytes < (tmp_path / "z.txt").stat().st_size, (peak, z.nbytes)

@@ -502,3 +502,22 @@ def test_a_filled_hole_is_counted_in_the_region_pressed_not_in_the_file(tmp_path
     partly = SurfaceFile(**params, region={"x": [20, 64]}).input_summary()
     assert partly["undefined_points"] == 200 and partly["filled_by"] == "harmonic"
     assert any(c.startswith("7.1 % of the region's points were undefined") for c in partly["caveats"])
+
+
+def test_a_text_export_too_large_for_the_memory_left_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    """SurfaceTopography's text readers parse the whole file as it is opened (1.2 to 1.9 times its
+    bytes): a large .xyz under a memory limit ended as 'the Plain text file declares more points
+    than this process can hold', or read past the room. It is refused by its size, unparsed."""
+    import frictionlab_spectra.instrument_reader as readers
+
+    z = rough_um(16)
+    rows = [f"{0.1 * i:.6g} {0.1 * j:.6g} {z[j, i]:.9g}" for j in range(16) for i in range(16)]
+    (tmp_path / "scan.xyz").write_text("\n".join(rows) + "\n")
+    size = (tmp_path / "scan.xyz").stat().st_size
+    monkeypatch.setattr(readers, "room_to_read", lambda: (2 * size - 1, "the room in this test"))
+    with pytest.raises(ValueError, match=rf"scan.xyz': a text export \(.*\) of {size:,} bytes; SurfaceTopography's "
+                                         r"reader takes about .* GiB to read it, more than the .* GiB this process may "
+                                         r"use \(the room in this test\); crop the scan"):
+        SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height()
+    monkeypatch.setattr(readers, "room_to_read", lambda: (2 * size, "the room in this test"))
+    assert SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height() > 0

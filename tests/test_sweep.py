@@ -416,3 +416,29 @@ def test_a_refused_sweep_point_is_named_as_the_user_gave_the_preset(tmp_path, ca
     assert f"error: built-in preset 'benad2012-fig5' --set {bad}: 1 problem in preset" in err
     assert "sweep point 2 (spectrum.params.hurst=2.0): spectrum.params.hurst: must be <= 1.5, got 2.0" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_whose_largest_point_does_not_fit_is_refused_before_its_first_point_runs(tmp_path, monkeypatch, registry):
+    """Each point's memory was checked as the point started: a sweep planned without the check
+    (the library's, a detached sweep's child) ran its first points, then failed at the large
+    one. The largest point is checked before any runs, and the refusal names it."""
+    from frictionlab.compute import memory
+    from frictionlab.errors import RunError
+
+    data = sweep_preset({"spectrum.params.points": {"values": [512, 30_000_000, 1024]}})
+    sweep = plan_sweep(data, registry=registry)  # no memory check while planned
+    monkeypatch.setattr(memory, "available_memory", lambda: (memory.GiB, "the memory of a test"))
+    with pytest.raises(RunError, match=r"^sweep point 2 \(spectrum\.params\.points=30000000\): this run would need"):
+        run_sweep(sweep, tmp_path / "out", RunOptions(workers=1))
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_clis_memory_refusal_of_a_sweep_names_the_point(tmp_path, monkeypatch, capsys):
+    from frictionlab.compute import memory
+
+    monkeypatch.setattr(memory, "available_memory", lambda: (memory.GiB, "the memory of a test"))
+    path = write(tmp_path, sweep_preset({"spectrum.params.points": {"values": [512, 30_000_000]}}))
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--workers", "1"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: sweep point 2 (spectrum.params.points=30000000): this run would need about")
+    assert "the memory of a test" in err and not (tmp_path / "out").exists()

@@ -183,6 +183,20 @@ def test_a_run_that_needs_more_is_refused_before_it_starts_naming_the_limit(tmp_
     assert "Traceback" not in done.stderr and not (tmp_path / "run").exists()
 
 
+def test_the_exact_3d_study_whose_finest_grid_does_not_fit_starts_nothing(tmp_path):
+    """Under ulimit -v 1048576 the full study ran its 256² to 1024² grids for hours, then its
+    2048² grid was refused. Every ensemble left to run is checked first: it ends at once."""
+    def one_gib():
+        resource.setrlimit(resource.RLIMIT_AS, (2**30, 2**30))
+
+    command = [sys.executable, "-m", "frictionlab", "exact3d", "--runs", "runs", "--out", "page", "--workers", "1", "--quiet"]
+    done = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path, timeout=300, preexec_fn=one_gib)
+    assert done.returncode == 1, done.stderr[-3000:]
+    assert done.stderr.startswith("error: the exact 3D study starts nothing: its ensemble H = 0.8, 2048² px, exact")
+    assert "RLIMIT_AS (ulimit -v)" in done.stderr and "--quick" in done.stderr and "Traceback" not in done.stderr
+    assert not (tmp_path / "runs").exists() and not (tmp_path / "page").exists()
+
+
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offered_runs(tmp_path, workers):
     """An MDR run of a 16384^2 surface with every mode in its band: the check counted the

@@ -114,7 +114,10 @@ def run(args) -> ExitCode:
         extra = {"points": rows} if sweep is not None else {}
         emit("follow", {**state.to_dict(), "error": error, **extra})
     else:
-        done = "?" if state.done is None else state.done
+        if state.reason is not None:  # damaged: what is known, not a count with a question mark
+            print(shown(f"{state.name}: damaged, in {folder}/: {state.reason}"))
+            return ExitCode.RUNTIME_FAILURE
+        done = state.done
         hint = f"; frictionlab resume {folder} continues it" if state.resumable else ""
         if error and state.done is not None and state.done == state.total:  # every realization done: no resume mends it
             hint = ""

@@ -51,8 +51,8 @@ def run(args) -> ExitCode:
 
     rows = []
     for state in states:
-        done = "?" if state.done is None else str(state.done)
-        total = "?" if state.total is None else str(state.total)
+        done = "not yet known" if state.done is None else str(state.done)  # a running run before its first count
+        total = "unknown" if state.total is None else str(state.total)
         status = f"running (pid {state.pid})" if state.pid else state.status
         unit = " points" if state.kind == "sweep" else ""
         count = "-" if state.status == "damaged" else f"{done}/{total}{unit}"  # the reason follows the table

@@ -27,14 +27,14 @@ from pathlib import Path
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
-from ..errors import FrictionlabError, OutputRefused, RunFolderError
+from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
 from ..runs.rundir import STATE_FILE, RunDirectory
 from ..runs.runfolder import read_json
-from ..runs.runner import run_to_folder
+from ..runs.runner import check_memory, run_to_folder
 from ..preset.seeds import realization_rng
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..variants import SceneFactory
@@ -228,8 +228,9 @@ def _cutoffs(scene: Scene) -> tuple[float, float, float]:
     return profile.spacing, float(short), float(params.get("long_cutoff") or side)
 
 
-def _scene(factory: SceneFactory, job: Job, plan: Plan) -> Scene:
-    """The scene of ``job``: the preset refined to the job's grid, with its family's changes."""
+def _scene(factory: SceneFactory, job: Job, plan: Plan, before_reading: Callable[[Scene], None] | None = None) -> Scene:
+    """The scene of ``job``: the preset refined to the job's grid, with its family's changes
+    (``before_reading``: as ``build_scene``'s, a memory check)."""
     base = factory.base
     changes = {f"spectrum.params.{k}": v for k, v in base.spectrum.refined(job.points).items()}
     if job.family == SIDE:
@@ -244,7 +245,40 @@ def _scene(factory: SceneFactory, job: Job, plan: Plan) -> Scene:
         changes.update({"loading.start": first, "loading.stop": last, "loading.steps": steps, "loading.spacing": "log"})
     if not job.exact:  # the equivalent line depends on the surface only through its spectrum
         changes.update({"solver": factory.solver_choice(APPROXIMATION), "realizations": job.surfaces * plan.mdr_lines})
-    return factory.make(changes)
+    return factory.make(changes, before_reading=before_reading)
+
+
+class _Fits(Exception):
+    """Raised once an ensemble's memory check passed: its MDR-equivalent line need not be made."""
+
+
+def check_memory_ahead(factories: dict[float, SceneFactory], runs_dir: Path, plan: Plan, options: RunOptions) -> None:
+    """Refuse (RunError), before any ensemble runs, a study one of whose ensembles left to run
+    does not fit in memory (each run's own check, ``runner.check_memory``): not hours in, at
+    its finest grid. The check is arithmetic: no surface is made for it."""
+    if not options.memory_check:
+        return
+
+    def check(scene: Scene) -> None:
+        check_memory(scene, replace(options, resume=False))
+        raise _Fits
+
+    for job in plan.jobs():
+        factory = factories[job.hurst]
+        solver = factory.base.solver.name if job.exact else factory.solver_choice(APPROXIMATION)["name"]
+        if finished(Path(runs_dir) / job.folder(solver)):
+            continue
+        try:
+            _scene(factory, job, plan, before_reading=check)
+        except _Fits:
+            continue
+        except RunError as exc:
+            raise RunError(
+                f"the exact 3D study starts nothing: its ensemble {job.describe()} does not fit: {exc} The study's "
+                "grids are its plan's, whatever its presets say: of that advice a preset's setting does not apply; "
+                "--workers and a higher limit do, or more memory free, or --quick (grids of 64² to 192² px, "
+                "not converged)."
+            ) from None
 
 
 def finished(folder: Path) -> bool:
@@ -297,6 +331,8 @@ def run_plan(
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )
+    if compute:
+        check_memory_ahead(factories, runs_dir, plan, options)
     try:
         for job in plan.jobs():
             scene = _scene(factories[job.hurst], job, plan)

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused
+from ..errors import FrictionlabError, OutputRefused, RunError
 from ..io.files import atomic_write, output_path_problem
 from ..plugin.listeners import format_duration
 from ..options import RunOptions
@@ -133,6 +133,7 @@ def write_page(
     if runs_dir and not finished_only:  # --finished-only writes nothing into it: any folder is read
         check_runs_folder(Path(runs_dir), force=options.force, own=(PAGE, FIGURES_DIR))
     presets = find_presets(presets_dir, plan)  # refused before a default runs folder is made
+    made = not runs_dir
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     command = command or _command(quick, out_dir, runs_dir, finished_only)  # names a default runs folder too
     out_dir = Path(out_dir) if out_dir else runs_dir
@@ -142,6 +143,10 @@ def write_page(
             runs = run_plan(presets, runs_dir, plan, options, compute=not finished_only, log=log)
     except WorkInterrupted as exc:
         raise WorkInterrupted(f"{exc}; no page written") from None
+    except RunError:  # refused before it began (the memory check): the runs folder made for it goes
+        if made and not any(runs_dir.iterdir()):
+            runs_dir.rmdir()
+        raise
     if not runs.hursts():
         raise FrictionlabError(
             f"{runs_dir} holds no finished exact ensemble with MDR beside it: nothing to write a page from; "

@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, shown
+from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
@@ -67,14 +67,11 @@ def in_use(out_dir: str | Path, holder: int | None = None) -> RunFolderError:
 
 def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
     """``check_startable`` for a sweep (``sweep.Sweep``): its folder, and each point's memory."""
-    from .runner import check_memory
-    from .sweep import check_sweep_folder
+    from .sweep import check_sweep_folder, check_sweep_memory
 
     _check_not_in_use(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)
-    if options.memory_check:
-        for point in sweep.points:
-            check_memory(point.scene, options)
+    check_sweep_memory(sweep, options)
 
 
 def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = RunOptions(), *,
@@ -276,6 +273,8 @@ def run_state(folder: str | Path) -> RunState:
     name = str(preset.get("name") or folder.name)
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
+    if total is None:  # the count the run was started with is its preset's too
+        total = _count(preset.get("realizations"))
     pid = None
 
     def stored() -> int | None:  # what a resume restores; it opens every chunk, so only where asked
@@ -304,9 +303,21 @@ def run_state(folder: str | Path) -> RunState:
     done = _count(counts.get("done"))
     if done is None:  # no summary, or none that counts: the chunks say
         done = ended_count()
-    if done is not None and total is not None and done > total:  # not a count of this run
-        done = None
+    if (reason := _uncounted(manifest, preset, done, total)) is not None:
+        return RunState(folder, name, "damaged", None if reason.startswith("its chunks") else done, total, reason=reason)
     return RunState(folder, name, status, done, total, pid)
+
+
+def _uncounted(manifest: dict, preset: dict, done: int | None, total: int | None) -> str | None:
+    """Why an ended run's count of realizations cannot be told (None where it can): said, never shown as ``?``."""
+    if total is None:
+        told = (short_repr(manifest.get("realizations")), short_repr(preset.get("realizations")))
+        return f"{STATE_FILE} does not say how many realizations the run has (its realizations is {told[0]}, its preset's {told[1]})"
+    if done is None:
+        return f"{STATE_FILE} does not list its chunks: what finished cannot be counted"
+    if done > total:
+        return f"its chunks hold {done} realizations, more than the {total} of its {STATE_FILE}: not this run's"
+    return None
 
 
 def damage_reason(folder: Path, error: Exception) -> str:

@@ -29,7 +29,7 @@ from pydantic import BaseModel
 
 from .. import __version__
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, short_repr
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr
 from ..io.files import atomic_write, output_path_problem
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
@@ -43,7 +43,8 @@ from .results import holds_results, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder, read_json
 from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
-from .runner import run_to_folder
+from ..compute.memory import estimate
+from .runner import check_memory, run_to_folder
 
 RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
@@ -199,6 +200,9 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())  # a value may be any length
             problems += [f"sweep point {number} ({shown}): {p}" for p in exc.problems]
             continue
+        except RunError as exc:  # the memory check: the point named, before any point runs
+            shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())
+            raise RunError(f"sweep point {number} ({shown}): {exc}") from None
         folder = f"{number:0{width}d}-{_label(values)}"
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
     if not problems and (pair := first_repeat([ensemble_settings(p.scene.resolved()) for p in points])) is not None:
@@ -208,6 +212,19 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
     if problems:
         raise PresetError(problems, source=source)
     return Sweep(name=base_preset.name, spec=spec, base=base, points=points, source=source)
+
+
+def check_sweep_memory(sweep: Sweep, options: RunOptions) -> None:
+    """Refuse (RunError), before the first point runs, a sweep one of whose points does not fit
+    in memory (each point's run checks it again as it starts): not halfway, its first points
+    run. The largest point is checked first, so the advice of a refusal fits every point."""
+    if not options.memory_check:
+        return
+    for point in sorted(sweep.points, key=lambda p: -estimate(p.scene, workers=1, executor="serial").total):
+        try:
+            check_memory(point.scene, options)
+        except RunError as exc:
+            raise RunError(f"sweep point {point.number} ({point.describe()}): {exc}") from None
 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
@@ -343,6 +360,7 @@ def run_sweep(
     "running" until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
     out_dir = Path(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
+    check_sweep_memory(sweep, options)
     listeners = list(listeners)
     cancel = threading.Event() if cancel is None else cancel
     started = time.perf_counter()

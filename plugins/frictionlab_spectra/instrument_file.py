@@ -26,7 +26,8 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_points, check_header_units, check_payload, choose_reader, describe_failure, pick_channel,
+    channel_list, check_declared_points, check_header_units, check_payload, check_text_room, choose_reader,
+    describe_failure, pick_channel,
     TEXT_FORMATS, quoted,
 )
 
@@ -115,6 +116,8 @@ def _open_reader(fh, path: Path, where: str):
     from SurfaceTopography.IO import open_topography
 
     reader_class = choose_reader(fh, path.suffix.lower().lstrip("."), where)
+    if reader_class.format() in TEXT_FORMATS:  # parsed whole as it is opened
+        check_text_room(fh, reader_class, where)
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted

@@ -13,6 +13,7 @@ above ``XML_LIMIT`` is refused (a 0.4 MiB file can inflate to gigabytes of blank
 from __future__ import annotations
 
 import math
+import os
 import re
 import zipfile
 
@@ -209,6 +210,22 @@ def check_declared_points(points: tuple[int, ...], where: str) -> None:
         )
 
 
+TEXT_READER_COPIES = 2  # SurfaceTopography's text readers hold 1.2 (x, y, z rows) to 1.9 (a matrix) times the file's bytes
+
+
+def check_text_room(fh, reader, where: str) -> None:
+    """Refuse, before SurfaceTopography's reader parses it whole, a text export whose reading
+    cannot fit in the memory left (it has no header that gives its points), naming the limit."""
+    size = os.fstat(fh.fileno()).st_size
+    need, (room, source) = size * TEXT_READER_COPIES, room_to_read()
+    if need > room:
+        raise ValueError(
+            f"{where}: a text export ({reader.name()}) of {size:,} bytes; SurfaceTopography's reader takes about "
+            f"{need / 2**30:.3g} GiB to read it, more than the {room / 2**30:.3g} GiB this process may use ({source}); "
+            "crop the scan with the instrument's software, or save its heights as a .npy array"
+        )
+
+
 def _is_utf8(fh) -> bool:
     """Whether the open file's bytes, all of them, read as UTF-8 (a chunk at a time)."""
     import codecs
@@ -251,8 +268,9 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
         return ValueError(f"{where}: a text export that is not UTF-8 (a header in Latin-1: its µ?), which "
                           f"SurfaceTopography's {name} reader does not read; save it as UTF-8")  # fmt: skip
     if isinstance(exc, MemoryError):
-        return ValueError(f"{where}: the {name} file declares more points than this process can hold; "
-                          "crop it with the instrument's software")  # fmt: skip
+        what = "ran out of memory reading this text export" if reader.format() in TEXT_FORMATS else \
+            "the file declares more points than this process can hold"
+        return ValueError(f"{where}: {what} ({name}); crop it with the instrument's software")
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
     if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):

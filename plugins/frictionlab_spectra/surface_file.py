@@ -53,6 +53,7 @@ from .header_units import check_table_header
 from .instrument_file import (
     ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
+from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
@@ -313,7 +314,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                 f"{where}: a {path.suffix.lower()} map holds bare numbers, so the parameter spacing (the pixel side) "
                 "is required"
             )
-        data = read_text_table(path, where) if table else load_npy(path, where)
+        data = read_text_table(path, where, HEIGHT_COPIES) if table else load_npy(path, where)
         if data.size == 0:  # not 'a map of 1 x 0 pixels, one pixel wide: a line'
             held = f"an array of shape {data.shape}" if data.ndim != 2 or path.suffix.lower() == ".npy" else \
                 "a table of no numbers (a header, comments or blank lines only)"

@@ -155,3 +155,21 @@ def test_the_pages_command_names_the_runs_folder_it_made(tmp_path, monkeypatch):
     report.write_page(tmp_path / "page", quick=True, presets_dir=PRESETS)
     (made,) = (tmp_path / "runs").iterdir()
     assert said["command"] == f"frictionlab exact3d --quick --out {tmp_path / 'page'} --runs runs/{made.name} --force"
+
+
+def test_an_ensemble_beyond_the_memory_refuses_the_study_before_any_runs(tmp_path, capsys, monkeypatch):
+    """The study checked each ensemble's memory as it started it: the full plan ran for hours
+    before its 2048² grid was refused. Every ensemble left to run is checked first: here the
+    quick plan's 192² grid does not fit, and nothing runs, nothing is made."""
+    from frictionlab.compute import memory
+    from frictionlab.exact3d import plan
+
+    fits_128 = memory.PROCESS_BASE + 6 * memory.MiB  # 128² px fits; 192² px (the quick plan's finest) does not
+    monkeypatch.setattr(memory, "available_memory", lambda: (fits_128, "the memory of a test"))
+    monkeypatch.setattr(plan, "run_to_folder", lambda *args, **kwargs: pytest.fail("an ensemble ran"))
+    monkeypatch.chdir(tmp_path)
+    assert exact3d("--workers", "1") == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith("error: the exact 3D study starts nothing: its ensemble H = 0.8, 192² px, exact, 2 surfaces")
+    assert "is available (the memory of a test)" in err and "--quick" in err and "Traceback" not in err
+    assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir())

@@ -81,6 +81,30 @@ def test_frictionlab_tui_holds_the_keys_first_and_drops_the_unread_ones_as_it_en
     assert calls == ["hold", ("release", "held")]
 
 
+def test_a_sigterm_while_the_keys_are_held_ends_as_terminated_not_a_traceback(monkeypatch, capsys):
+    """`timeout 5 frictionlab tui` runs it as a background job: taking the terminal stops it
+    (SIGTTOU) until timeout's SIGTERM, which raised inside ``hold_keys``, outside the handling
+    that says 'terminated': a traceback."""
+    import signal
+    import sys
+
+    import frictionlab.__main__ as entry
+    from frictionlab.tui import terminal
+
+    def stopped_until_terminated():
+        signal.getsignal(signal.SIGTERM)(signal.SIGTERM, None)
+
+    monkeypatch.setattr(terminal, "hold_keys", stopped_until_terminated)
+    monkeypatch.setattr(sys, "argv", ["frictionlab", "tui"])
+    previous = signal.getsignal(signal.SIGTERM)
+    try:
+        with pytest.raises(SystemExit) as ended:
+            entry.program()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert ended.value.code == 143 and capsys.readouterr().err == "terminated\n"
+
+
 def _spawned_tui(tmp_path):
     """``frictionlab tui`` in a pseudo-terminal in line mode with echo, as a login shell leaves it:
     (process, keyboard end, program end, the program end's attributes before it started)."""

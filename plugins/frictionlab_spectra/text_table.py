@@ -1,0 +1,172 @@
+"""Tables of bare numbers in text (.csv, .txt): one header line at most, numbers separated by
+commas, semicolons or whitespace, read a line at a time into float64 (``read_text_table``)."""
+
+from __future__ import annotations
+
+import codecs
+import io
+import math
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .instrument_file import open_input
+from .instrument_reader import room_to_read
+
+
+def _numbers(text: str, delimiter: str | None) -> bool:
+    return all(_number(token) for token in text.split(delimiter))
+
+
+SAMPLE_BYTES = 65536  # the file's first bytes, whose numbers per byte size the whole table's
+TABLE_COPIES = 3  # float64 arrays of the numbers: numpy's growing one (1.1 to 1.3 times them, measured), a column copied
+
+
+def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.ndarray:
+    """Rows x columns of float64; one header line (more of its cells text than numbers) is
+    skipped. A problem names the line, never its content. The text is read a line at a time,
+    never whole: what it takes is its numbers (8 bytes each), not its bytes. A table has no
+    header that gives its size: one whose numbers, counted in its first bytes, cannot fit in
+    the memory left is refused before it is read, and one that runs out while read so named.
+    ``copies``: the arrays of its numbers its reader holds at once (a map's levelling, more)."""
+    with open_input(path, where) as fh:
+        size = os.fstat(fh.fileno()).st_size
+        need = _numbers_in(fh, size) * 8 * copies
+        room, source = room_to_read()
+        if need > room:
+            raise ValueError(_too_large_table(where, size, f"reading its numbers takes about {need / 2**30:.3g} GiB, "
+                                              f"more than the {room / 2**30:.3g} GiB this process may use ({source})"))
+        text = io.TextIOWrapper(fh, encoding="utf-8-sig")  # without the byte-order mark a spreadsheet writes first
+        try:
+            return _table(text, where)
+        except MemoryError:
+            raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
+        except UnicodeDecodeError:
+            raise ValueError(f"{where}: not UTF-8 at line {_undecodable_line(fh)} (text in another encoding, as a "
+                             "Latin-1 header's µ, or no text); an instrument's export (a profilometer's .csv) is read "
+                             "with format: instrument; a table of bare numbers is read as UTF-8: save it so (a "
+                             "spreadsheet's 'CSV UTF-8')") from None
+        finally:
+            text.detach()  # the file is open_input's to close
+
+
+def _numbers_in(fh, size: int) -> int:
+    """The numbers a table of ``size`` bytes holds, as many per byte as in its first bytes (a
+    number cut at their end not counted; at least one per 64 bytes: a first line of text is no
+    measure). ``fh`` is left at its start."""
+    sample = fh.read(SAMPLE_BYTES)
+    fh.seek(0)
+    cells = sum(len(line.split(b"#", 1)[0].replace(b",", b" ").replace(b";", b" ").split()) for line in sample.splitlines())
+    cells -= len(sample) == SAMPLE_BYTES and not sample[-1:].isspace()  # the last, cut
+    return math.ceil(size * max(cells / max(len(sample), 1), 1 / 64))
+
+
+def _too_large_table(where: str, size: int, why: str) -> str:
+    return (f"{where}: a table of {size:,} bytes; {why}: save the heights as a .npy array (8 bytes a height, its "
+            "size checked before it is read), or crop the scan before saving it")
+
+
+def _undecodable_line(fh) -> int:
+    """The line of the first bytes of the open file that are not UTF-8, found a chunk at a time."""
+    decoder, line = codecs.getincrementaldecoder("utf-8")(), 1
+    fh.seek(0)
+    while chunk := fh.read(1 << 20):
+        try:
+            decoder.decode(chunk)
+        except UnicodeDecodeError as exc:
+            return line + chunk.count(b"\n", 0, exc.start)
+        line += chunk.count(b"\n")
+    return line
+
+
+def _table(text, where: str) -> np.ndarray:
+    """The numbers of the open text file ``text`` (``read_text_table``): its first lines say
+    whether a header is to be skipped and how numbers are separated; numpy reads the rest."""
+    skip, delimiter = 0, None
+    for lineno, line in enumerate(text, start=1):
+        cells = line.split("#", 1)[0].strip()
+        if not cells:
+            continue
+        if skip:  # the first line after a header says how its numbers are separated
+            delimiter = _delimiter(cells)
+            break
+        delimiter = _delimiter(cells)
+        if _numbers(cells, delimiter):
+            break
+        if _ends_with_separator(cells, delimiter):  # numbers and an empty column: no header
+            raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
+        if _mostly_numbers(cells, delimiter):  # a row of heights with a cell that is not one: named below
+            break
+        skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
+    text.seek(0)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
+            data = np.loadtxt(text, dtype=np.float64, delimiter=delimiter, comments="#", ndmin=2, skiprows=skip)
+    except ValueError:
+        text.seek(0)
+        raise ValueError(f"{where}: {_first_bad_line(text, skip, delimiter)}") from None
+    if data.size == 0:
+        data = np.zeros((0, 1))
+    return data
+
+
+def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
+    """Where a table stops being one: the first line after ``skip`` that is not numbers, or
+    whose column count differs from the first data line's."""
+    columns = None
+    for lineno, line in enumerate(lines, start=1):
+        text = line.split("#", 1)[0].strip()
+        if lineno <= skip or not text:
+            continue
+        if not _numbers(text, delimiter):
+            if _ends_with_separator(text, delimiter):
+                return _trailing_text(lineno, delimiter)
+            if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
+                return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
+                        "export the table with decimal points")  # fmt: skip
+            return f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
+        count = len(text.split(delimiter))
+        if columns is not None and count != columns:
+            return f"line {lineno} has {count} columns, the lines before it {columns}"
+        columns = count
+    return "not a table of numbers"
+
+
+def _mostly_numbers(text: str, delimiter: str | None) -> bool:
+    """Whether more of the line's cells are numbers than not: a row of data with a bad cell
+    (``0.1,x,0.3``, ``0.1,,0.3``), which is no header (``x,z``; ``z [nm]``; ``Height 1``)."""
+    cells = text.split(delimiter)
+    numbers = sum(_number(cell) for cell in cells)
+    return numbers > len(cells) - numbers
+
+
+def _number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _ends_with_separator(text: str, delimiter: str | None) -> bool:
+    """Numbers followed by a separator and nothing (``1.5,2.5,``): an empty last column."""
+    return delimiter is not None and text.endswith(delimiter) and _numbers(text[: -len(delimiter)].rstrip(), delimiter)
+
+
+def _trailing_text(lineno: int, delimiter: str | None) -> str:
+    return (f"line {lineno} ends with a separator ({_separator(delimiter)[:-1]}), an empty column after its last "
+            "number; export the table without a separator at the end of its lines")
+
+
+def _delimiter(text: str) -> str | None:
+    """Semicolons (a spreadsheet's export where the comma is the decimal mark), else commas, else whitespace."""
+    return ";" if ";" in text else "," if "," in text else None
+
+
+def _separator(delimiter: str | None) -> str:
+    return {",": "commas", ";": "semicolons"}.get(delimiter, "spaces")
+
+
