@@ -23,7 +23,7 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
 from textual.css.query import NoMatches
-from textual.widgets import Static, TabbedContent, TabPane
+from textual.widgets import Static, TabPane
 
 from ..errors import PresetError, shown
 from ..options import RunOptions
@@ -42,7 +42,7 @@ from .folders import (
 from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
-from .tabs import TabSwitching
+from .tabs import Tabs, TabSwitching
 from .running import NO_PRESET, RunControl
 from .saving import PresetSaving
 from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
@@ -129,7 +129,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
 
     def compose(self) -> ComposeResult:
         # the first screen is the Presets tab: the other panes are mounted just after it is drawn
-        with TabbedContent(initial="presets", id="tabs"):
+        with Tabs(initial="presets", id="tabs"):
             with TabPane("F2 Presets", id="presets"):
                 yield PresetsPane(id="presets-pane")
             yield TabPane("F3 Edit", id="edit")

@@ -5,7 +5,7 @@ bubbled up, and handed the keys typed meanwhile to the widget focused before).""
 import pytest
 import yaml
 from textual import events
-from textual.widgets import Input
+from textual.widgets import Input, TabbedContent
 
 from frictionlab.tui.screens import PathScreen
 from frictionlab.tui.widgets.presets import PresetsPane
@@ -41,6 +41,22 @@ async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, regist
             post_keys(app, ["escape", "q"])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
         assert not app.modified  # the q was never typed into the name
+
+
+@sync
+async def test_esc_in_a_field_then_ctrl_r_shows_the_run_tab(folders, registry):
+    """Esc focused the form, Ctrl+R showed the Run tab, and the form's late focus message took
+    the screen back to the Edit tab: the run went on unseen, and c (cancel) did nothing there."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        await pilot.press("tab")  # into the name field
+        post_keys(app, ["escape", "ctrl+r"])
+        await wait_until(pilot, lambda: app.running or app.last_outcome is not None)
+        for _ in range(5):  # the late messages, if any, arrive
+            await pilot.pause(0.05)
+        assert app.query_one("#tabs", TabbedContent).active == "run"
+        assert app.focused is app.query_one("#run-pane")
 
 
 @pytest.mark.parametrize(
