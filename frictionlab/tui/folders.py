@@ -121,6 +121,21 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
     return entries
 
 
+def presets_signature(folders: list[tuple[str, Path]]) -> tuple:
+    """What changes when a preset file is added to ``folders``, removed, renamed or written (by
+    an editor, a shell, another TUI): each folder's preset files' names, times and sizes (nothing read)."""
+
+    def stamp(path: Path):
+        try:
+            found = path.stat()
+        except OSError:  # a link to nothing, gone meanwhile: listed as it is
+            return None
+        return found.st_mtime_ns, found.st_size
+
+    return tuple((str(folder), tuple((p.name, stamp(p)) for p in sorted(folder.glob("*.y*ml"))) if folder.is_dir() else None)
+                 for _, folder in folders)  # fmt: skip
+
+
 def _unreadable(exc: Exception) -> str:
     """Why a preset file cannot be read, in words (never a line of it)."""
     if isinstance(exc, UnicodeDecodeError):

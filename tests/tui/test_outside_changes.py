@@ -194,3 +194,23 @@ async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, r
         assert status_text(app).startswith("Not saved: presets/tiny.yaml cannot be written (the file is read-only)")
         assert app.screen.title_text == "tiny.yaml cannot be written there (the file is read-only): save it as"
     assert path.read_text() == before and path.stat().st_mode & 0o777 == 0o444
+
+
+@sync
+async def test_the_presets_list_follows_its_folder(folders, registry):
+    """A preset file added, rewritten or removed by another program is listed as it is now, without
+    r; the highlighted preset stays highlighted as a file is listed above it."""
+    from frictionlab.tui.widgets.presets import PresetsPane
+
+    app = make_app(registry)
+    async with started(app) as pilot:
+        pane = app.query_one(PresetsPane)
+        assert [e.path.name for e in pane.presets] == ["tiny.yaml"]
+        (folders / "presets" / "added.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "added"}), sort_keys=False))
+        await wait_until(pilot, lambda: [e.path.name for e in pane.presets] == ["added.yaml", "tiny.yaml"], timeout=10.0)
+        assert pane.selected().path.name == "tiny.yaml"  # where the cursor was
+        (folders / "presets" / "added.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "renamed"}), sort_keys=False))
+        await wait_until(pilot, lambda: pane.presets[0].name == "renamed", timeout=10.0)
+        (folders / "presets" / "tiny.yaml").unlink()
+        await wait_until(pilot, lambda: [e.path.name for e in pane.presets] == ["added.yaml"], timeout=10.0)
+        assert "added.yaml" in screen_text(app)
