@@ -59,6 +59,25 @@ async def test_esc_in_a_field_then_ctrl_r_shows_the_run_tab(folders, registry):
         assert app.focused is app.query_one("#run-pane")
 
 
+@sync
+async def test_down_typed_fast_on_the_form_scrolls_a_line_each(folders, registry):
+    """Textual's scroll waits for a refresh and starts from where the form was: 20 Downs typed
+    fast (a key held down) scrolled the form one line."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        form = app.query_one("#form")
+        await wait_until(pilot, lambda: app.focused is form)
+        assert form.max_scroll_y > 12
+        post_keys(app, ["down"] * 12)
+        await wait_until(pilot, lambda: form.scroll_y == 12, timeout=10.0)
+        post_keys(app, ["down"] * (form.max_scroll_y + 5))  # past the end: Up then scrolls from the end
+        await wait_until(pilot, lambda: form.scroll_y == form.max_scroll_y, timeout=10.0)
+        await pilot.press("up")
+        await wait_until(pilot, lambda: form.scroll_y == form.max_scroll_y - 1, timeout=10.0)
+        post_keys(app, ["pageup"] * 3)
+        await wait_until(pilot, lambda: form.scroll_y == 0, timeout=10.0)
+
+
 @pytest.mark.parametrize(
     ("typed", "keys"),
     [
