@@ -278,8 +278,14 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     def _watch_presets(self) -> None:
         """The Presets list follows its folders: a preset file added, removed or rewritten
         there (an editor, a shell, another TUI) is listed as it is now, without r."""
-        if presets_signature(self.folders) != self._presets_seen:
-            self.reload_presets()
+        if presets_signature(self.folders) == self._presets_seen:
+            return
+        pane = self.query_one(PresetsPane)
+        before = {entry.path: entry for entry in pane.presets}
+        self.reload_presets()
+        about = self.said_about
+        if about in before and before[about] not in pane.presets:  # why it could not be opened: out of date
+            self.say("")
 
     def open_selected_preset(self) -> None:
         entry = self.query_one(PresetsPane).selected()

@@ -2,6 +2,7 @@
 editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
 
 import shutil
+from pathlib import Path
 
 import pytest
 import yaml
@@ -214,3 +215,20 @@ async def test_the_presets_list_follows_its_folder(folders, registry):
         (folders / "presets" / "tiny.yaml").unlink()
         await wait_until(pilot, lambda: [e.path.name for e in pane.presets] == ["added.yaml"], timeout=10.0)
         assert "added.yaml" in screen_text(app)
+
+
+@sync
+async def test_why_a_preset_could_not_be_opened_is_taken_back_once_its_file_is_repaired(folders, registry):
+    path = folders / "presets" / "tiny.yaml"
+    path.write_text("name: [broken\n")
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "enter")
+        assert "Cannot open tiny.yaml: not valid YAML" in status_text(app)
+        (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
+        await wait_until(pilot, lambda: len(app.query_one("PresetsPane").presets) == 2, timeout=10.0)
+        assert "Cannot open tiny.yaml" in status_text(app)  # another file: still so
+        path.write_text(yaml.safe_dump(TINY, sort_keys=False))  # repaired by another program
+        await wait_until(pilot, lambda: status_text(app) == "", timeout=10.0)
+        await press_settled(pilot, "enter")  # the cursor stayed on it: it opens now
+        assert app.draft_path == Path("presets/tiny.yaml") and not status_text(app)
