@@ -278,9 +278,9 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     def _watch_presets(self) -> None:
         """The Presets list follows its folders: a preset file added, removed or rewritten
         there (an editor, a shell, another TUI) is listed as it is now, without r."""
-        if presets_signature(self.folders) == self._presets_seen:
+        pane = self._mounted("PresetsPane")
+        if pane is None or presets_signature(self.folders) == self._presets_seen:  # or the app is closing
             return
-        pane = self.query_one(PresetsPane)
         before = {entry.path: entry for entry in pane.presets}
         self.reload_presets()
         about = self.said_about
