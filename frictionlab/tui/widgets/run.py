@@ -91,8 +91,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         """The footer offers only what applies now: cancel while a run goes, run and resume
         when none does (resume only a run that ended before it completed)."""
         app = self.app
-        if action == "cancel":  # not once its last event came: its process is only closing
-            return app.running and not app.followed.ended
+        if action == "cancel":  # not once its last event came (its process is only closing), nor twice
+            return app.running and not app.followed.ended and not app.followed.cancelling
         if action == "resume":
             return not app.running and app.last_resumable
         return not app.running if action == "start" else True
