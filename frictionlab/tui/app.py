@@ -23,7 +23,7 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.content import Content
 from textual.css.query import NoMatches
-from textual.widgets import Static, TabbedContent, TabPane
+from textual.widgets import Static, TabPane
 
 from ..errors import PresetError, shown
 from ..options import RunOptions
@@ -35,6 +35,7 @@ from .folders import (
     file_stamp,
     preset_folders,
     preset_from_template,
+    presets_signature,
     runs_signature,
     save_folder,
     templates,
@@ -42,7 +43,7 @@ from .folders import (
 from .hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from .keyorder import answer_focus_key, unjoined
 from .keyshelp import KeysHelp
-from .tabs import TabSwitching
+from .tabs import Tabs, TabSwitching
 from .running import NO_PRESET, RunControl
 from .saving import PresetSaving
 from .screens import ConfirmScreen, Dialog, NewPresetScreen, PathScreen
@@ -55,8 +56,8 @@ if TYPE_CHECKING:
     from .widgets import PresetForm
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
-WATCH_SECONDS = 0.5  # how often the runs folder and the open preset's file are looked at: a run started anywhere
-#   is listed within this, another program's write to the preset said
+WATCH_SECONDS = 0.5  # how often the runs and presets folders and the open preset's file are looked at: a run or
+#   preset file made anywhere is listed within this, another program's write to the preset said
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
 
 
@@ -121,6 +122,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.last_out_dir: Path | None = None
         self.last_resumable = False  # the last run shown ended before it completed, and can go on (u)
         self._runs_seen: tuple = ()  # the runs folder as last listed (runs_signature)
+        self._presets_seen: tuple = ()  # the presets folders as last listed (presets_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
         self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
         self._terminated = 0  # the exit code of a SIGTERM (SIGHUP) that came before it was built: it quits once it is
@@ -129,7 +131,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
 
     def compose(self) -> ComposeResult:
         # the first screen is the Presets tab: the other panes are mounted just after it is drawn
-        with TabbedContent(initial="presets", id="tabs"):
+        with Tabs(initial="presets", id="tabs"):
             with TabPane("F2 Presets", id="presets"):
                 yield PresetsPane(id="presets-pane")
             yield TabPane("F3 Edit", id="edit")
@@ -176,6 +178,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.set_interval(FOLLOW_SECONDS, self._follow_tick)
         self.set_interval(WATCH_SECONDS, self._watch_runs)
         self.set_interval(WATCH_SECONDS, self._watch_preset_file)
+        self.set_interval(WATCH_SECONDS, self._watch_presets)
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -268,7 +271,21 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     # ------------------------------------------------------------ presets
 
     def reload_presets(self) -> None:
-        self.query_one(PresetsPane).reload(self.folders)
+        folders = self.folders
+        self._presets_seen = presets_signature(folders)
+        self.query_one(PresetsPane).reload(folders)
+
+    def _watch_presets(self) -> None:
+        """The Presets list follows its folders: a preset file added, removed or rewritten
+        there (an editor, a shell, another TUI) is listed as it is now, without r."""
+        pane = self._mounted("PresetsPane")
+        if pane is None or presets_signature(self.folders) == self._presets_seen:  # or the app is closing
+            return
+        before = {entry.path: entry for entry in pane.presets}
+        self.reload_presets()
+        about = self.said_about
+        if about in before and before[about] not in pane.presets:  # why it could not be opened: out of date
+            self.say("")
 
     def open_selected_preset(self) -> None:
         entry = self.query_one(PresetsPane).selected()

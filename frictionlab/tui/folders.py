@@ -121,6 +121,27 @@ def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
     return entries
 
 
+def presets_signature(folders: list[tuple[str, Path]]) -> tuple:
+    """What changes when a preset file is added to ``folders``, removed, renamed or written (by
+    an editor, a shell, another TUI): each folder's preset files' names, times and sizes (nothing read)."""
+    return tuple((str(folder), _files_stamp(folder)) for _, folder in folders)
+
+
+def _files_stamp(folder: Path) -> tuple | None:
+    try:
+        return tuple((p.name, _stamp(p)) for p in sorted(folder.glob("*.y*ml"))) if folder.is_dir() else None
+    except OSError:  # not to be looked into: looked at again next time
+        return None
+
+
+def _stamp(path: Path) -> tuple[int, int] | None:
+    try:
+        found = path.stat()
+    except OSError:  # a link to nothing, a file gone meanwhile: listed as it is
+        return None
+    return found.st_mtime_ns, found.st_size
+
+
 def _unreadable(exc: Exception) -> str:
     """Why a preset file cannot be read, in words (never a line of it)."""
     if isinstance(exc, UnicodeDecodeError):

@@ -102,8 +102,11 @@ class FollowedRun:
         """SIGTERM: the run keeps what finished and ends interrupted. False if it is gone, or
         (``refusal`` says why) no process could be verified as the one that holds its folder.
         Signalled: the process started here (not yet reaped: its pid is its own), else only
-        the folder's lock holder (``detached.cancel``)."""
+        the folder's lock holder (``detached.cancel``). Signalled once: a second SIGTERM stops the
+        run's process at once, before it has written what finished (c pressed again, c on quitting)."""
         self.refusal = None
+        if self.cancelling:
+            return True
         if self.process is not None:
             if self.process.poll() is None:
                 self.process.terminate()

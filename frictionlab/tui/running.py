@@ -345,9 +345,14 @@ class RunControl:
         if self.followed.ended:
             self.say("The run has ended: its files are being written; nothing is left to cancel.", "warning")
             return
+        if self.followed.cancelling:  # signalled again, it would stop before writing what finished
+            self.say("Cancelling already: what finished is being written (u resumes the run once it has ended).",
+                     "warning")  # fmt: skip
+            return
         if not self.followed.cancel():  # its process is gone (the next tick shows how it ended), or not verified
             return self.followed.refusal and self.say(self.followed.refusal, "error", title="Not cancelled")
         self.query_one("RunPane").show_cancelling()
+        self.refresh_bindings()  # c leaves the footer: pressed again it would stop the writing of what finished
         self.say("Cancelling: the solves running stop; what finished is kept (u resumes it).")  # in place of what was said
 
     def on_run_finished(self, message: RunFinished) -> None:

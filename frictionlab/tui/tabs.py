@@ -5,9 +5,20 @@ from __future__ import annotations
 import contextlib
 
 from textual.css.query import NoMatches
-from textual.widgets import TabbedContent
+from textual.widgets import TabbedContent, TabPane
 
 FOCUS = {"presets": "#preset-table", "edit": "#form", "run": "#run-pane", "results": "#runs-table"}
+
+
+class Tabs(TabbedContent):
+    """Textual's tabs, where a widget focused in a pane shows that pane only while it still has
+    the focus: Esc in a field then Ctrl+R typed fast focused the form, then showed the Run tab,
+    and the form's late message took the screen back to the Edit tab."""
+
+    def _on_tab_pane_focused(self, event: TabPane.Focused) -> None:
+        focused = self.screen.focused
+        if focused is not None and event.tab_pane not in focused.ancestors_with_self:
+            event.prevent_default()  # the focus has moved on since: Textual's handler leaves the tab shown since
 
 
 class TabSwitching:
@@ -21,7 +32,8 @@ class TabSwitching:
 
     def _focus_tab(self, tab: str) -> None:
         with contextlib.suppress(NoMatches):  # a pane not mounted yet (a tab clicked as the app starts)
-            self.query_one(FOCUS[tab]).focus()
+            widget = self.query_one(FOCUS[tab])
+            widget.screen.set_focus(widget)  # now: the Focused message of the tab left is then out of date
 
     def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if not self.screen_stack:  # not once the app has closed (a late message)

@@ -129,3 +129,19 @@ async def test_new_takes_back_its_error_once_the_name_is_retyped(folders, regist
         left = app.screen.query_one("#new-error").display
     assert said.startswith("name: must be 1 to 100 letters") and "got 'my scene!'" in said
     assert not left
+
+
+@pytest.mark.parametrize(("key", "field", "error"), [("ctrl+o", "#path-input", "#path-error"), ("n", "#new-path", "#new-error")])
+@sync
+async def test_a_file_name_too_long_for_the_system_is_refused_in_the_dialog(folders, registry, key, field, error):
+    """Save as (or New) with a name past the file system's limit (255 bytes) crashed the TUI with a
+    traceback (File name too long, from the check that the path is not a folder)."""
+    app = make_app(registry, preset="presets/tiny.yaml" if key == "ctrl+o" else None)
+    async with started(app) as pilot:
+        await press_settled(pilot, key)
+        app.screen.query_one(field, Input).value = "presets/" + "y" * 300
+        await press_settled(pilot, "enter")
+        assert app.is_running
+        said = str(app.screen.query_one(error).render())
+        assert said.startswith("path: 'presets/yyy") and said.endswith("cannot be a file here (File name too long); give another")
+        assert sorted(p.name for p in (folders / "presets").iterdir()) == ["tiny.yaml"]

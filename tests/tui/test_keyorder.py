@@ -5,7 +5,7 @@ bubbled up, and handed the keys typed meanwhile to the widget focused before).""
 import pytest
 import yaml
 from textual import events
-from textual.widgets import Input
+from textual.widgets import Input, TabbedContent
 
 from frictionlab.tui.screens import PathScreen
 from frictionlab.tui.widgets.presets import PresetsPane
@@ -41,6 +41,41 @@ async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, regist
             post_keys(app, ["escape", "q"])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
         assert not app.modified  # the q was never typed into the name
+
+
+@sync
+async def test_esc_in_a_field_then_ctrl_r_shows_the_run_tab(folders, registry):
+    """Esc focused the form, Ctrl+R showed the Run tab, and the form's late focus message took
+    the screen back to the Edit tab: the run went on unseen, and c (cancel) did nothing there."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        await pilot.press("tab")  # into the name field
+        post_keys(app, ["escape", "ctrl+r"])
+        await wait_until(pilot, lambda: app.running or app.last_outcome is not None)
+        for _ in range(5):  # the late messages, if any, arrive
+            await pilot.pause(0.05)
+        assert app.query_one("#tabs", TabbedContent).active == "run"
+        assert app.focused is app.query_one("#run-pane")
+
+
+@sync
+async def test_down_typed_fast_on_the_form_scrolls_a_line_each(folders, registry):
+    """Textual's scroll waits for a refresh and starts from where the form was: 20 Downs typed
+    fast (a key held down) scrolled the form one line."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        form = app.query_one("#form")
+        await wait_until(pilot, lambda: app.focused is form)
+        assert form.max_scroll_y > 12
+        post_keys(app, ["down"] * 12)
+        await wait_until(pilot, lambda: form.scroll_y == 12, timeout=10.0)
+        post_keys(app, ["down"] * (form.max_scroll_y + 5))  # past the end: Up then scrolls from the end
+        await wait_until(pilot, lambda: form.scroll_y == form.max_scroll_y, timeout=10.0)
+        await pilot.press("up")
+        await wait_until(pilot, lambda: form.scroll_y == form.max_scroll_y - 1, timeout=10.0)
+        post_keys(app, ["pageup"] * 3)
+        await wait_until(pilot, lambda: form.scroll_y == 0, timeout=10.0)
 
 
 @pytest.mark.parametrize(

@@ -2,6 +2,7 @@
 editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
 
 import shutil
+from pathlib import Path
 
 import pytest
 import yaml
@@ -194,3 +195,40 @@ async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, r
         assert status_text(app).startswith("Not saved: presets/tiny.yaml cannot be written (the file is read-only)")
         assert app.screen.title_text == "tiny.yaml cannot be written there (the file is read-only): save it as"
     assert path.read_text() == before and path.stat().st_mode & 0o777 == 0o444
+
+
+@sync
+async def test_the_presets_list_follows_its_folder(folders, registry):
+    """A preset file added, rewritten or removed by another program is listed as it is now, without
+    r; the highlighted preset stays highlighted as a file is listed above it."""
+    from frictionlab.tui.widgets.presets import PresetsPane
+
+    app = make_app(registry)
+    async with started(app) as pilot:
+        pane = app.query_one(PresetsPane)
+        assert [e.path.name for e in pane.presets] == ["tiny.yaml"]
+        (folders / "presets" / "added.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "added"}), sort_keys=False))
+        await wait_until(pilot, lambda: [e.path.name for e in pane.presets] == ["added.yaml", "tiny.yaml"], timeout=10.0)
+        assert pane.selected().path.name == "tiny.yaml"  # where the cursor was
+        (folders / "presets" / "added.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "renamed"}), sort_keys=False))
+        await wait_until(pilot, lambda: pane.presets[0].name == "renamed", timeout=10.0)
+        (folders / "presets" / "tiny.yaml").unlink()
+        await wait_until(pilot, lambda: [e.path.name for e in pane.presets] == ["added.yaml"], timeout=10.0)
+        assert "added.yaml" in screen_text(app)
+
+
+@sync
+async def test_why_a_preset_could_not_be_opened_is_taken_back_once_its_file_is_repaired(folders, registry):
+    path = folders / "presets" / "tiny.yaml"
+    path.write_text("name: [broken\n")
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "enter")
+        assert "Cannot open tiny.yaml: not valid YAML" in status_text(app)
+        (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
+        await wait_until(pilot, lambda: len(app.query_one("PresetsPane").presets) == 2, timeout=10.0)
+        assert "Cannot open tiny.yaml" in status_text(app)  # another file: still so
+        path.write_text(yaml.safe_dump(TINY, sort_keys=False))  # repaired by another program
+        await wait_until(pilot, lambda: status_text(app) == "", timeout=10.0)
+        await press_settled(pilot, "enter")  # the cursor stayed on it: it opens now
+        assert app.draft_path == Path("presets/tiny.yaml") and not status_text(app)

@@ -18,8 +18,8 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE, SWEEP, TINY, fits_width, make_app, numbers_in, press_run, press_settled, run_to_the_end, screen_text,
-    started, status_text, sweep_app, sync, wait_until,
+    SIZE, SWEEP, TINY, fits_width, make_app, numbers_in, post_keys, press_run, press_settled, run_to_the_end,
+    screen_text, started, status_text, sweep_app, sync, wait_until,
 )
 
 # ------------------------------------------------------------------ running
@@ -95,6 +95,29 @@ async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_
         kept = arrays["index"].tolist()
     # the realization being solved is abandoned, not waited for: never kept, never failed
     assert outcome.status == "interrupted" and index not in kept and outcome.failures == []
+
+
+@sync
+async def test_c_pressed_again_while_cancelling_signals_the_run_once(folders, registry):
+    """c stayed in the footer while the run wrote what finished, and pressed again sent a second
+    SIGTERM, which stops the run's process at once: its summary, curve and realizations unwritten."""
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "long", "realizations": 100_000})))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        process, signals = app.followed.process, []
+        terminate = process.terminate
+        process.terminate = lambda: (signals.append("SIGTERM"), terminate())[1]
+        post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
+        await pilot.pause()
+        said = status_text(app)
+        listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+        out_dir = app.last_out_dir
+    assert signals == ["SIGTERM"] and "Cancel" not in listed
+    assert said.startswith("Cancelling already: what finished is being written")
+    assert json.loads((out_dir / "summary.json").read_text())["status"] == "interrupted"
 
 
 @sync

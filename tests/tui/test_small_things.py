@@ -118,6 +118,18 @@ async def test_on_off_switches_say_their_state_in_words(folders, registry):
 
 
 @sync
+async def test_the_run_tab_shows_no_progress_bar_until_a_run_is_shown(folders, registry):
+    """With no run yet the bar had no total and pulsed (`--%`), as if something ran."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await press_settled(pilot, "f4")
+        assert "No run yet" in screen_text(app)
+        assert not app.query_one("#run-bar").display and "--%" not in screen_text(app)
+        await run_to_the_end(pilot)
+        assert app.query_one("#run-bar").display and "100%" in screen_text(app)
+
+
+@sync
 async def test_a_new_run_shows_no_fit_of_the_run_before(folders, registry):
     (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "long", "realizations": 100_000})))
     app = make_app(registry, preset="presets/tiny.yaml")

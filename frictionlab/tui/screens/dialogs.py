@@ -137,7 +137,14 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
     text = text.strip()
     if not text:
         return None, "path: must not be empty"
-    path = Path(text).expanduser()
+    try:
+        return _checked_path(Path(text).expanduser(), folder)
+    except (OSError, ValueError) as exc:  # a name past the system's limits, a folder not to be read: no traceback
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        return None, f"path: {shown_value(text)} cannot be a file here ({reason}); give another"
+
+
+def _checked_path(path: Path, folder: Path | None) -> tuple[Path | None, str]:
     if path.is_dir():  # before .yaml is added: a folder typed was saved as <folder>.yaml beside it
         return None, f"path: {path} is a folder; give a file name"
     if path.suffix not in (".yaml", ".yml"):

@@ -11,6 +11,7 @@ import copy
 from pathlib import Path
 
 import yaml
+from textual.actions import SkipAction
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
@@ -383,6 +384,26 @@ class PresetForm(VerticalScroll):
 
     def action_leave_field(self) -> None:
         self.screen.set_focus(self, scroll_visible=False)  # the next key (q) is the app's, never the field's
+
+    # Up, Down, PageUp, PageDown: scrolled now, each from where the one before went. Textual's
+    # scroll waits for a screen refresh and starts from where the form was: 20 Downs typed fast (a
+    # key held down) scrolled it one line.
+    def action_scroll_down(self) -> None:
+        self._scroll_by(1)
+
+    def action_scroll_up(self) -> None:
+        self._scroll_by(-1)
+
+    def action_page_down(self) -> None:
+        self._scroll_by(self.scrollable_content_region.height)
+
+    def action_page_up(self) -> None:
+        self._scroll_by(-self.scrollable_content_region.height)
+
+    def _scroll_by(self, lines: int) -> None:
+        if not self.allow_vertical_scroll:
+            raise SkipAction()  # the form fits: the key goes on to the app
+        self.scroll_to(y=self.scroll_target_y + lines, animate=False, immediate=True)
 
     def on_focus(self, event) -> None:
         self.post_message(self.FieldFocused(None))

@@ -74,16 +74,20 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
         return action != "duplicate" or bool(self.presets)  # listed only with a preset to duplicate
 
     def reload(self, folders: list) -> None:
-        """List the presets of ``folders`` (``folders.preset_folders``)."""
+        """List the presets of ``folders`` (``folders.preset_folders``); the highlighted preset
+        stays highlighted where it is still listed (a file added above it moved the cursor off it)."""
+        chosen = self.selected()
         self.presets = list_presets(folders)
         self._fill()
+        if chosen is not None:
+            self.highlight(chosen.path)
         self.app.refresh_bindings()  # Open and Duplicate are listed only on a list with a row
         if not self.presets:
             shown = ", ".join(str(f) for _, f in folders)
             self.query_one("#preset-path", PathLine).show("")
             self.query_one("#preset-info", Static).update(Content(f"No presets in {shown}. n makes a new one."))
         else:
-            self._show_info(0)
+            self._show_info(self.query_one("#preset-table", DataTable).cursor_row)
 
     def highlight(self, path: Path) -> None:
         """Move the list's cursor to the preset in ``path``, if it is listed."""

@@ -91,8 +91,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         """The footer offers only what applies now: cancel while a run goes, run and resume
         when none does (resume only a run that ended before it completed)."""
         app = self.app
-        if action == "cancel":  # not once its last event came: its process is only closing
-            return app.running and not app.followed.ended
+        if action == "cancel":  # not once its last event came (its process is only closing), nor twice
+            return app.running and not app.followed.ended and not app.followed.cancelling
         if action == "resume":
             return not app.running and app.last_resumable
         return not app.running if action == "start" else True
@@ -105,6 +105,12 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
 
     def action_resume(self) -> None:
         self.app.resume_run(self.app.last_out_dir)
+
+    def _show_bar(self, total: int, done: int) -> None:
+        """The progress bar, there once a run is shown: before, with no total, it pulsed as if one ran."""
+        bar = self.query_one("#run-bar", ProgressBar)
+        bar.update(total=total, progress=done)
+        bar.display = True
 
     def _set(self, widget_id: str, text: str | Content) -> None:
         """Show ``text`` as it is: names, values and errors are never read as markup."""
@@ -160,7 +166,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             table.clear(columns=True)
             table.add_columns(*table_columns(sweep.paths))
         self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
-        self.query_one("#run-bar", ProgressBar).update(total=preset.realizations, progress=0)
+        self._show_bar(preset.realizations, 0)
         self._set("run-error", "")
         self._set("run-stats", "starting")
         self._clear_fit()
@@ -178,7 +184,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     # ------------------------------------------------------------ while it runs
 
     def show_progress(self, snap: Snapshot, cancelling: bool) -> None:
-        self.query_one("#run-bar", ProgressBar).update(total=snap.total, progress=snap.done)
+        self._show_bar(snap.total, snap.done)
         if not cancelling:
             stats = progress_text(snap.done, snap.total, snap.failed, snap.elapsed, restored=snap.restored)
             self._set("run-stats", f"{stats}\n{snap.solving}" if snap.solving else stats)
@@ -195,7 +201,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def show_stored_count(self, done: int, total: int, resuming: bool = False) -> None:
         """The count the run folder's chunks hold (when there is no progress file to read, or
         as a resume begins, before its process says what it restored)."""
-        self.query_one("#run-bar", ProgressBar).update(total=total, progress=done)
+        self._show_bar(total, done)
         what = "resuming" if resuming else "read from the run's chunks"
         self._set("run-stats", f"{done}/{total} realizations stored ({what})")
 
@@ -217,7 +223,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         key = str(point.number)  # one row a point: a resume tells again of the points it had
         if kind == "started":
             self._set("sweep-point", point_line(sweep, point))
-            self.query_one("#run-bar", ProgressBar).update(total=point.scene.preset.realizations, progress=0)
+            self._show_bar(point.scene.preset.realizations, 0)
             if key in table.rows:  # an interrupted point, running again: its status mark (after #, the values)
                 status = list(table.columns)[1 + len(sweep.paths)]
                 table.update_cell(key, status, Text(STATUS_MARKS["running"]))
@@ -237,7 +243,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         """Show a finished run (``FinishedRun``, read back from its folder); return the line the app notifies."""
         result = run.result
         done, requested = result.realizations
-        self.query_one("#run-bar", ProgressBar).update(total=requested, progress=done)
+        self._show_bar(requested, done)
         self._set("run-stats", f"{result.status}: {done}/{requested} realizations in "
                                f"{format_duration(result.elapsed)}, {run.workers} worker"
                                f"{'s' if run.workers != 1 else ''}")  # fmt: skip
