@@ -245,3 +245,18 @@ async def test_a_linspace_sweeps_table_keeps_its_contacts_on_an_80_column_screen
         fits = fits_width(table)
     assert hurst == ["0.3", "0.533333", "0.766667", "1.0"]
     assert fits, "the sweep table is cut at 80 columns"
+
+
+@sync
+async def test_r_on_the_run_tab_starts_no_run_and_says_what_does(folders, registry):
+    """r reloads a list on the Presets and Results tabs: on the Run tab it started a run (an
+    hour-long one, for whoever expected a reload); it now says which keys do what."""
+    app = make_app(registry, preset="presets/tiny.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_settled(pilot, "f4")
+        await press_settled(pilot, "r")
+        await pilot.pause(0.2)
+        running, said, out_dir = app.running, status_text(app), app.last_out_dir
+    assert not running and out_dir is None
+    assert not list((folders / "runs").glob("*"))  # no run folder made
+    assert "Ctrl+R runs the open preset" in said

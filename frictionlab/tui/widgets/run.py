@@ -63,16 +63,18 @@ def _contact_lines(count) -> list[str]:
     return ["", "points in contact", f"  {count[0]:.2f} at first load", f"  {count[-1]:.2f} at last load"]
 
 
+R_ON_RUN_TAB = "r reloads the lists on the Presets and Results tabs; Ctrl+R runs the open preset."
 PLOT_ROWS = 10  # a sweep's plot keeps its whole legend (final fit and contacts): #run-body's min-height
 
 
 class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     BINDINGS = [
-        Binding("r", "start", "Run", tooltip="the open preset (again)", show=False),  # the footer has ^r Run
+        # r reloads a list on the Presets and Results tabs: here it says so, and starts no run (Ctrl+R does)
+        Binding("r", "not_run", show=False, system=True),
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
-        *said_when_hidden(("r", "start"), ("c", "cancel"), ("u", "resume")),
+        *said_when_hidden(("c", "cancel"), ("u", "resume")),
     ]
 
     def compose(self) -> ComposeResult:
@@ -88,17 +90,17 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         yield Static("", id="run-error")
 
     def check_action(self, action: str, parameters) -> bool:
-        """The footer offers only what applies now: cancel while a run goes, run and resume
-        when none does (resume only a run that ended before it completed)."""
+        """The footer offers only what applies now: cancel while a run goes, resume when none
+        does (only a run that ended before it completed)."""
         app = self.app
         if action == "cancel":  # not once its last event came (its process is only closing), nor twice
             return app.running and not app.followed.ended and not app.followed.cancelling
         if action == "resume":
             return not app.running and app.last_resumable
-        return not app.running if action == "start" else True
+        return True
 
-    def action_start(self) -> None:
-        self.app.action_start_run()
+    def action_not_run(self) -> None:
+        self.app.say(R_ON_RUN_TAB)
 
     def action_cancel(self) -> None:
         self.app.action_cancel_run()
