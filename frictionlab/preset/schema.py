@@ -62,9 +62,12 @@ class Loading(_Strict):
         return np.linspace(self.start, self.stop, self.steps)
 
 
+MAX_BOOTSTRAP = 100_000  # resamples: a summary.json read back is held to it too
+
+
 class FitSettings(_Strict):
     bootstrap: int = Field(
-        1000, ge=0, le=100_000, description="Bootstrap resamples over realizations for the intervals (0: none)."
+        1000, ge=0, le=MAX_BOOTSTRAP, description="Bootstrap resamples over realizations for the intervals (0: none)."
     )
     confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level of the intervals.")
 
