@@ -228,3 +228,19 @@ def test_a_run_that_ends_between_the_two_looks_is_its_ending_not_interrupted(tmp
     manifest.write_text(json.dumps({**json.loads(ended), "status": "running"}))
     monkeypatch.setattr(detached, "lock_held", lambda path: False)  # gone, still saying running
     assert run_state(folder).status == "interrupted"
+
+
+def test_a_resume_writes_the_count_of_realizations_its_preset_asks(tmp_path, registry, capsys):
+    """A manifest whose realizations was damaged ("4" as text) kept it through a resume: the run
+    completed, and was listed with 4/? done for ever after."""
+    folder = tmp_path / "run"
+    _run(folder, registry)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest.update(status="interrupted", realizations="4")
+    (folder / "run.json").write_text(json.dumps(manifest))
+    for name in ("summary.json", "curve.csv", "realizations.npz"):
+        (folder / name).unlink()
+    assert (run_state(folder).status, run_state(folder).total) == ("interrupted", None)  # shown as ?
+    assert main(["resume", str(folder), "--quiet", "--no-plot", "--workers", "1"]) == 0
+    assert json.loads((folder / "run.json").read_text())["realizations"] == 4
+    assert (run_state(folder).status, run_state(folder).total) == ("completed", 4)
