@@ -13,6 +13,7 @@ from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
+from ...io.inputs import expand_user
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
 from ..folders import is_builtin, made_when_saved, new_preset_path
@@ -137,7 +138,10 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
     text = text.strip()
     if not text:
         return None, "path: must not be empty"
-    path = Path(text).expanduser()
+    try:
+        path = Path(expand_user(text))
+    except ValueError as exc:
+        return None, f"path: {exc}"
     if path.is_dir():  # before .yaml is added: a folder typed was saved as <folder>.yaml beside it
         return None, f"path: {path} is a folder; give a file name"
     if path.suffix not in (".yaml", ".yml"):
