@@ -72,3 +72,18 @@ def test_fig2_lines_solved_exactly_agree_with_the_naive_bisection(registry, real
         np.testing.assert_array_equal(one.contact_count, two.contact_count)
         np.testing.assert_allclose(one.xi, two.xi, rtol=1e-12)
         np.testing.assert_allclose(one.indentation, two.indentation, rtol=1e-8)
+
+
+@pytest.mark.parametrize("text, got", [("", "got an empty file (or comments only)"),
+                                       ("# a comment\n", "got an empty file (or comments only)"),
+                                       ("- a\n- b\n", "got ['a', 'b']"), ("5\n", "got 5")])  # fmt: skip
+def test_a_preset_file_that_is_no_mapping_says_what_it_holds(tmp_path, capsys, text, got):
+    """An empty preset was refused as 'Got NoneType instead', a list as 'Got list': Python's
+    names for what the file held, not the file's own words."""
+    from frictionlab.cli import main
+
+    (tmp_path / "p.yaml").write_text(text)
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 2
+    err = "".join(capsys.readouterr())
+    assert f"(file): a preset must be a mapping of keys to values (name: ..., spectrum: ...), {got}" in err
+    assert "NoneType" not in err

@@ -23,7 +23,7 @@ from ..errors import FrictionlabError, RunFolderError
 from ..io.inputs import expand_user, read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import builtin_folder, builtin_presets
-from ..preset.reading import MAX_PRESET_BYTES
+from ..preset.reading import MAX_PRESET_BYTES, NOT_A_MAPPING
 from ..preset.schema import NAME_PATTERN
 from ..io.safe_yaml import load_yaml
 
@@ -103,9 +103,6 @@ class PresetEntry:
     name: str  # the preset's own name, or the file stem if unreadable
     description: str
     error: str = ""
-
-
-NOT_A_MAPPING = "a preset must be a mapping of keys to values (name: ..., spectrum: ...)"
 
 
 def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:
