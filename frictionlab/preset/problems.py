@@ -256,11 +256,14 @@ class Bounds:
 
     @classmethod
     def of(cls, field) -> Bounds | None:
-        """The field's bounds, when it has both, else None."""
+        """The field's bounds when it has both, or a lower one above the least magnitude, its top
+        then that of every number (points: >= 8 and <= 1e+100, not 'between 1e-100 and 1e+100',
+        which 2 is); else None (the magnitudes are said)."""
         said = _limits(field)
-        if not ({"ge", "gt"} & said.keys() and {"le", "lt"} & said.keys()):
+        low = said.get("ge", said.get("gt"))
+        if not {"le", "lt"} & said.keys() and (low is None or low <= 1 / MAX_MAGNITUDE):
             return None
-        return cls(said.get("ge", said.get("gt")), "ge" not in said, said.get("le", said.get("lt")), "le" not in said)
+        return cls(low, "ge" not in said, said.get("le", said.get("lt", MAX_MAGNITUDE)), "lt" in said)
 
     @property
     def said(self) -> str:  # as pydantic's own refusal reads: >= 1 and <= 10000000
