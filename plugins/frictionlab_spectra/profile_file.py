@@ -357,12 +357,15 @@ def _too_large_table(where: str, size: int, why: str) -> str:
 def _table(raw: bytes, where: str) -> np.ndarray:
     """The numbers of a table's bytes ``raw`` (``read_text_table``)."""
     try:
+        if (nul := raw.find(b"\x00")) >= 0:  # valid UTF-8, but no text's: UTF-16 without its mark, or binary
+            raise UnicodeDecodeError("utf-8", raw, nul, nul + 1, "a NUL byte")
         lines = raw.decode("utf-8-sig").splitlines()  # without the byte-order mark a spreadsheet writes first
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start + (3 if raw.startswith(b"\xef\xbb\xbf") else 0)) + 1
-        raise ValueError(f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ, or "
-                         "no text); an instrument's export (a profilometer's .csv) is read with format: instrument; "
-                         "a table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')") from None
+        raise ValueError(f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or "
+                         "UTF-16's NUL bytes, or no text); an instrument's export (a profilometer's .csv) is read with "
+                         "format: instrument; a table of bare numbers is read as UTF-8: save it so (a spreadsheet's "
+                         "'CSV UTF-8')") from None
     skip, delimiter = 0, None
     for lineno, line in enumerate(lines, start=1):
         text = line.split("#", 1)[0].strip()
