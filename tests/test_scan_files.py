@@ -253,6 +253,10 @@ def test_an_x3p_declaring_more_points_than_fit_is_refused_from_its_header(tmp_pa
     assert code == ExitCode.USAGE, err
     assert "a damaged XML 3D surface profile (X3P) file: its binary heights take 32768 bytes, and its description " \
            "declares 484000000 points" in err and "Traceback" not in err  # fmt: skip
+    monkeypatch.setattr(instrument_reader, "room_to_read", lambda: (2**16, "a test limit of 64 KiB"))
+    (tmp_path / "small.yaml").write_text((tmp_path / "p.yaml").read_text().replace("huge.x3p", "small.x3p"))
+    assert main(["validate", str(tmp_path / "small.yaml")]) == ExitCode.USAGE  # a sound file, too large for the room
+    assert "declares 64 x 64 points (x by y); reading them takes about" in capsys.readouterr().err
 
 
 def forged_netcdf(path, n: int):
