@@ -782,7 +782,7 @@ def test_a_table_too_large_to_read_is_refused_by_its_size(tmp_path, monkeypatch,
     realizations or workers', the file unnamed and the advice wrong, and without a limit tried
     to read a terabyte. Now refused by its size before it is read when it cannot fit (at least
     three times its bytes), and named if it runs out while being read."""
-    import frictionlab_spectra.profile_file as tables
+    import frictionlab_spectra.text_table as tables
 
     z = rough(12, 10, 9) if plugin is SurfaceFile else rough(1, 40, 9)
     (tmp_path / "map.csv").write_text(matrix_text(z))
