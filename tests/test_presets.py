@@ -87,3 +87,20 @@ def test_a_preset_file_that_is_no_mapping_says_what_it_holds(tmp_path, capsys, t
     err = "".join(capsys.readouterr())
     assert f"(file): a preset must be a mapping of keys to values (name: ..., spectrum: ...), {got}" in err
     assert "NoneType" not in err
+
+
+def test_a_run_folder_given_as_a_preset_points_to_its_preset(tmp_path, capsys):
+    """`frictionlab run runs/x` (the folder, not its preset.yaml) was refused as 'preset file is
+    a folder, not a regular file', the preset beside it unsaid."""
+    from frictionlab.cli import main
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "preset.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    for command in ("validate", "run"):
+        assert main([command, str(folder)]) == 3
+        err = "".join(capsys.readouterr())
+        assert f"a folder, not a preset; it holds a run, whose preset is {folder / 'preset.yaml'}" in err
+    (tmp_path / "empty").mkdir()
+    assert main(["validate", str(tmp_path / "empty")]) == 3
+    assert "preset file is a folder, not a regular file" in "".join(capsys.readouterr())
