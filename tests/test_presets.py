@@ -101,6 +101,10 @@ def test_a_run_folder_given_as_a_preset_points_to_its_preset(tmp_path, capsys):
         assert main([command, str(folder)]) == 3
         err = "".join(capsys.readouterr())
         assert f"a folder, not a preset; it holds a run, whose preset is {folder / 'preset.yaml'}" in err
+    (tmp_path / "sweep").mkdir()
+    (tmp_path / "sweep" / "sweep.json").write_text("{}")
+    assert main(["validate", str(tmp_path / "sweep")]) == 3
+    assert "a folder, not a preset; it holds a sweep (frictionlab resume" in "".join(capsys.readouterr())
     (tmp_path / "empty").mkdir()
     assert main(["validate", str(tmp_path / "empty")]) == 3
     assert "preset file is a folder, not a regular file" in "".join(capsys.readouterr())
