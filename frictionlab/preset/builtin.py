@@ -86,7 +86,8 @@ def resolve_preset_path(argument: str | Path) -> Path:
         )  # fmt: skip
     if path.is_dir() and (path / "sweep.json").is_file():
         raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {path} continues "
-                               f"it), each point's preset in {path / 'points'}/<NN-label>/preset.yaml"], source=str(argument))  # fmt: skip
+                               f"it), each point's preset in {path / 'points'}/<NN-label>/preset.yaml"],
+                              source=str(argument))  # fmt: skip
     if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one
     found = find_builtin(str(argument))

@@ -53,7 +53,9 @@ class Loading(_Strict):
         if self.unit != "force" and self.control != "force":
             raise ValueError(f"unit {self.unit!r} gives loads, not indentations: it needs control 'force'")
         if self.unit == "contact-fraction" and self.stop >= 1:
-            raise ValueError(f"stop must be < 1 under unit contact-fraction (a fraction of the area). Got {self.stop} instead.")
+            raise ValueError(
+                f"stop must be < 1 under unit contact-fraction (a fraction of the area). Got {self.stop} instead."
+            )
         return self
 
     def values(self) -> np.ndarray:

@@ -78,9 +78,9 @@ def check_units_named(units: list[str], unit: str | None, where: str, ignored: s
     if imperial := [u for u in units if re.fullmatch(IMPERIAL, u)]:
         taken = f"in the preset's unit, {unit}" if unit else "bare"
         raise ValueError(
-            f"{where}: its header names the length unit {imperial[0]!r}, {ignored} and frictionlab does not convert: its numbers would be "
-            f"taken {taken}, the slopes or heights off by the units' ratio; convert the columns to one of "
-            f"{', '.join(LENGTH_UNITS)}"
+            f"{where}: its header names the length unit {imperial[0]!r}, {ignored} and frictionlab does not "
+            f"convert: its numbers would be taken {taken}, the slopes or heights off by the units' ratio; convert "
+            f"the columns to one of {', '.join(LENGTH_UNITS)}"
         )
     if len(set(units)) > 1:
         raise ValueError(
