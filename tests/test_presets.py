@@ -108,3 +108,14 @@ def test_a_run_folder_given_as_a_preset_points_to_its_preset(tmp_path, capsys):
     (tmp_path / "empty").mkdir()
     assert main(["validate", str(tmp_path / "empty")]) == 3
     assert "preset file is a folder, not a regular file" in "".join(capsys.readouterr())
+
+
+def test_a_preset_file_of_two_documents_says_so():
+    """Two YAML documents in one file (a --- line between them) were refused as 'not valid YAML
+    at line 6, column 1: but found another document', the parser's half sentence."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=r"^a second YAML document \(a --- line\) starts at line 3: a preset is one "
+                                          r"document; put the other in a file of its own$"):  # fmt: skip
+        load_yaml("name: a\nseed: 1\n---\nname: b\n")
+    assert load_yaml("---\nname: a\n...\n") == {"name": "a"}  # one document, marked so

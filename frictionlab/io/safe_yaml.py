@@ -205,6 +205,9 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_OPENED[what]} "
                 f"opened here is not closed (at line {mark.line + 1}: {(exc.problem or 'syntax error')[:60]})")
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+    if (exc.context or "").startswith("expected a single document") and mark:  # "but found another document"
+        return (f"a second YAML document (a --- line) starts at line {mark.line + 1}: a preset is one document; put "
+                "the other in a file of its own")
     return f"not valid YAML{where}: {(exc.problem or exc.context or 'syntax error')[:80]}"
 
 
