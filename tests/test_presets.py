@@ -119,3 +119,15 @@ def test_a_preset_file_of_two_documents_says_so():
                                           r"document; put the other in a file of its own$"):  # fmt: skip
         load_yaml("name: a\nseed: 1\n---\nname: b\n")
     assert load_yaml("---\nname: a\n...\n") == {"name": "a"}  # one document, marked so
+
+
+
+def test_a_tab_in_a_preset_file_is_named_as_one():
+    """A tab indenting a line (an editor's) was refused in PyYAML's words: 'found character
+    '\\t' that cannot start any token'."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=r"^not valid YAML at line 3, column 1: a tab, where YAML takes spaces only "
+                                          r"\(to indent, say\); replace it with spaces$"):  # fmt: skip
+        load_yaml("name: a\nspectrum:\n\tname: power-law\n")
+    assert load_yaml('name: "a\tb"\n') == {"name": "a\tb"}  # in a quoted string, a tab is text

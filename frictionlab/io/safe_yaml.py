@@ -205,6 +205,8 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_OPENED[what]} "
                 f"opened here is not closed (at line {mark.line + 1}: {(exc.problem or 'syntax error')[:60]})")
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+    if "'\\t'" in (exc.problem or "") and mark:  # "found character '\t' that cannot start any token"
+        return f"not valid YAML{where}: a tab, where YAML takes spaces only (to indent, say); replace it with spaces"
     if (exc.context or "").startswith("expected a single document") and mark:  # "but found another document"
         return (f"a second YAML document (a --- line) starts at line {mark.line + 1}: a preset is one document; put "
                 "the other in a file of its own")
