@@ -122,7 +122,7 @@ def test_a_preset_file_of_two_documents_says_so():
 
 
 
-def test_a_tab_in_a_preset_file_is_named_as_one():
+def test_a_tab_or_a_stray_colon_in_a_preset_file_is_named():
     """A tab indenting a line (an editor's) was refused in PyYAML's words: 'found character
     '\\t' that cannot start any token'."""
     from frictionlab.io.safe_yaml import YamlProblem, load_yaml
@@ -131,3 +131,7 @@ def test_a_tab_in_a_preset_file_is_named_as_one():
                                           r"\(to indent, say\); replace it with spaces$"):  # fmt: skip
         load_yaml("name: a\nspectrum:\n\tname: power-law\n")
     assert load_yaml('name: "a\tb"\n') == {"name": "a\tb"}  # in a quoted string, a tab is text
+    for text, line in (("name: a\n  seed: 1\n", 2), ("description: a: b\n", 1)):  # 'mapping values are not allowed here'
+        with pytest.raises(YamlProblem, match=rf"^not valid YAML at line {line}, column \d+: a ': ' where YAML takes none: "
+                                              r"a key indented under a value, or a value holding ': ' \(quote it\)$"):  # fmt: skip
+            load_yaml(text)

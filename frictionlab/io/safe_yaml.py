@@ -207,6 +207,9 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
     if "'\\t'" in (exc.problem or "") and mark:  # "found character '\t' that cannot start any token"
         return f"not valid YAML{where}: a tab, where YAML takes spaces only (to indent, say); replace it with spaces"
+    if exc.problem == "mapping values are not allowed here":
+        return (f"not valid YAML{where}: a ': ' where YAML takes none: a key indented under a value, or a value "
+                "holding ': ' (quote it)")
     if (exc.context or "").startswith("expected a single document") and mark:  # "but found another document"
         return (f"a second YAML document (a --- line) starts at line {mark.line + 1}: a preset is one document; put "
                 "the other in a file of its own")
