@@ -1,6 +1,7 @@
 """Every shipped preset validates, and the study's Fig. 2 scene reproduces its contact counts."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -135,3 +136,18 @@ def test_a_tab_or_a_stray_colon_in_a_preset_file_is_named():
         with pytest.raises(YamlProblem, match=rf"^not valid YAML at line {line}, column \d+: a ': ' where YAML takes none: "
                                               r"a key indented under a value, or a value holding ': ' \(quote it\)$"):  # fmt: skip
             load_yaml(text)
+    for text, line in (("name: a\nseed 1\nrealizations: 3\n", 2), ("name: a\nseed 1\n", 2)):  # at the next line, or the end
+        with pytest.raises(YamlProblem, match=rf"^not valid YAML at line {line}, column 1: a line that is neither 'key: "
+                                              r"value' nor part of a value \(a key without its ':', as 'seed 1'"):  # fmt: skip
+            load_yaml(text)
+
+
+@pytest.mark.parametrize("text, tag", [("name: !!python/object:os.system x\n", "'tag:yaml.org,2002:python/object:os.system'"),
+                                       ("name: !Custom x\n", "'!Custom'")])  # fmt: skip
+def test_a_tag_a_preset_does_not_take_is_named_with_the_remedy(text, tag):
+    """'could not determine a constructor for the tag ...': PyYAML's internals, no remedy."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=re.escape(f"at line 1: its tag {tag} is none a preset takes; write the value "
+                                                    "without it")):  # fmt: skip
+        load_yaml(text)
