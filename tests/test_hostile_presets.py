@@ -93,7 +93,7 @@ NUMBERS = {
 FOLDER_ESCAPES = ("/tmp/escape", "../../escape", '"a\\nb"')
 IN_PROCESS.update({case: (replace(old, new), ExitCode.USAGE, message) for case, (old, new, message) in NUMBERS.items()})
 IN_PROCESS.update({f"name {name}": (replace("name: small", f"name: {name}"), ExitCode.USAGE,
-                                    "name: must be 1 to 100 letters") for name in FOLDER_ESCAPES})  # fmt: skip
+                                    "name: must be 1 to 100 of a-z, A-Z, 0-9") for name in FOLDER_ESCAPES})  # fmt: skip
 
 
 @pytest.mark.parametrize("case", list(IN_PROCESS))

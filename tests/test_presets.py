@@ -151,3 +151,14 @@ def test_a_tag_a_preset_does_not_take_is_named_with_the_remedy(text, tag):
     with pytest.raises(YamlProblem, match=re.escape(f"at line 1: its tag {tag} is none a preset takes; write the value "
                                                     "without it")):  # fmt: skip
         load_yaml(text)
+
+
+def test_a_name_with_an_accent_is_told_which_letters_a_name_takes():
+    """'héllo' was refused as 'must be 1 to 100 letters, digits, ...': é is a letter."""
+    from frictionlab.errors import PresetError
+    from frictionlab.preset import build_scene
+
+    from .conftest import SMALL_PRESET, merge
+
+    with pytest.raises(PresetError, match=r"name: must be 1 to 100 of a-z, A-Z, 0-9, .* got 'héllo'"):
+        build_scene(merge(SMALL_PRESET, {"name": "héllo"}))

@@ -15,7 +15,7 @@ from ..plugin.registry import Registry, default_registry
 MAX_SWEEP_POINTS = 1000  # counted from the axes, before any point is built
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._+-]{0,99}$"
 NAME_RULE = (
-    "must be 1 to 100 letters, digits, '.', '_', '+' or '-', starting with a letter or digit "
+    "must be 1 to 100 of a-z, A-Z, 0-9, '.', '_', '+' or '-', starting with a letter or digit "
     "(it names the output folder)"
 )
 
