@@ -4,6 +4,7 @@ pydantic's errors worded for people, and the numbers pydantic would let through.
 from __future__ import annotations
 
 import math
+import re
 import types
 import typing
 from dataclasses import dataclass
@@ -316,6 +317,11 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
 
 
 def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
-    """Both lists, without a pydantic line for a field the number check already named."""
-    named = {line.split(": ", 1)[0] for line in numbers}
-    return numbers + [line for line in pydantic_lines if line.split(": ", 1)[0] not in named]
+    """Both lists, without a pydantic line for a field the number check already named (its
+    items as ``x[0]``, pydantic's as ``x.0``)."""
+
+    def field(line: str) -> str:
+        return re.sub(r"\[(\d+)\]", r".\1", line.split(": ", 1)[0])
+
+    named = {field(line) for line in numbers}
+    return numbers + [line for line in pydantic_lines if field(line) not in named]
