@@ -8,6 +8,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import shutil
 import signal
 import subprocess
@@ -226,6 +227,14 @@ def no_points(folder):
     _rewrite(folder, _second(folder), lambda a: a["points"].__setitem__(0, 0), True)
 
 
+def nan_force_unit(folder):  # the run failed as 'the preset's magnitudes leave double precision'
+    _rewrite(folder, _second(folder), lambda a: a["force_unit"].__setitem__(0, math.nan), True)
+
+
+def zero_slope(folder):
+    _rewrite(folder, _second(folder), lambda a: a["slope_rms_line"].__setitem__(0, 0.0), True)
+
+
 def unlisted_overlapping_copy(folder):
     """A copy of one chunk under a name that overlaps another, not in the manifest."""
     chunks = folder / "chunks"
@@ -256,6 +265,8 @@ DAMAGE = {
     negative_count: "contact_count below 0 or above the profile's points",
     count_above_points: "contact_count below 0 or above the profile's points",
     no_points: "a profile of fewer than 1 point",
+    nan_force_unit: "a force unit k h X not > 0",
+    zero_slope: "a line's rms slope not a finite number > 0",
     unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",
     listed_twice: None,  # nothing is damaged: no warning
 }

@@ -84,7 +84,7 @@ def test_a_unit_the_solver_cannot_take_is_refused_before_the_run(tmp_path, chang
 
 @pytest.mark.parametrize("loading, words", [
     ({"unit": "f", "control": "indentation", "start": 0.1, "stop": 1.0, "steps": 3}, "needs control 'force'"),
-    ({"unit": "contact-fraction", "start": 0.1, "stop": 1.0, "steps": 3}, "a contact fraction is below 1"),
+    ({"unit": "contact-fraction", "start": 0.1, "stop": 1.0, "steps": 3}, "stop must be < 1 under unit contact-fraction .* Got 1.0 instead"),
     ({"unit": "newton", "start": 0.1, "stop": 1.0, "steps": 3}, "loading.unit"),
 ])  # fmt: skip
 def test_bad_units_are_named(loading, words):

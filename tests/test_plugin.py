@@ -1,5 +1,7 @@
 """The plugin base contract: constructors only store validated parameters."""
 
+import re
+
 import pytest
 from pydantic import ValidationError
 
@@ -121,3 +123,22 @@ def test_the_framework_uses_nothing_of_a_plugin_beyond_the_contract(tmp_path, re
     rows = study.run()
     assert {row.axis for row in rows} == {"grid", "solver", "tolerance"}
     assert all(math.isfinite(row.b) for row in rows)
+
+
+@pytest.mark.parametrize("value", ["maybe", "2", "ture", "\x1b[2J"])
+def test_a_yes_no_variable_set_to_another_value_is_said(value):
+    """FRICTIONLAB_DISABLE_DISCOVERY=maybe (or a typo of true) was read as off without a word:
+    the entry points it was meant to keep out loaded all the same."""
+    from frictionlab.plugin.registry import Registry
+
+    for key in ("FRICTIONLAB_DISABLE_DISCOVERY", "FRICTIONLAB_TRACE_HOOKS"):
+        with pytest.warns(RuntimeWarning, match=re.escape(f"{key}={value!r}") + r" is not one of 1, true, yes, on \(on\) or 0, .* read as off"):
+            Registry(env={key: value})
+
+
+def test_a_yes_no_variable_of_a_known_spelling_is_read_without_a_word(recwarn):
+    from frictionlab.plugin.registry import Registry
+
+    for value in ("", "0", "off", "No", " TRUE "):
+        Registry(discover=False, env={"FRICTIONLAB_TRACE_HOOKS": value.replace("TRUE", "false")})
+    assert not [w for w in recwarn if "FRICTIONLAB" in str(w.message)]

@@ -1,6 +1,7 @@
 """Every shipped preset validates, and the study's Fig. 2 scene reproduces its contact counts."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -72,3 +73,92 @@ def test_fig2_lines_solved_exactly_agree_with_the_naive_bisection(registry, real
         np.testing.assert_array_equal(one.contact_count, two.contact_count)
         np.testing.assert_allclose(one.xi, two.xi, rtol=1e-12)
         np.testing.assert_allclose(one.indentation, two.indentation, rtol=1e-8)
+
+
+@pytest.mark.parametrize("text, got", [("", "got an empty file (or comments only)"),
+                                       ("# a comment\n", "got an empty file (or comments only)"),
+                                       ("- a\n- b\n", "got ['a', 'b']"), ("5\n", "got 5")])  # fmt: skip
+def test_a_preset_file_that_is_no_mapping_says_what_it_holds(tmp_path, capsys, text, got):
+    """An empty preset was refused as 'Got NoneType instead', a list as 'Got list': Python's
+    names for what the file held, not the file's own words."""
+    from frictionlab.cli import main
+
+    (tmp_path / "p.yaml").write_text(text)
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 2
+    err = "".join(capsys.readouterr())
+    assert f"(file): a preset must be a mapping of keys to values (name: ..., spectrum: ...), {got}" in err
+    assert "NoneType" not in err
+
+
+def test_a_run_folder_given_as_a_preset_points_to_its_preset(tmp_path, capsys):
+    """`frictionlab run runs/x` (the folder, not its preset.yaml) was refused as 'preset file is
+    a folder, not a regular file', the preset beside it unsaid."""
+    from frictionlab.cli import main
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "preset.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    for command in ("validate", "run"):
+        assert main([command, str(folder)]) == 3
+        err = "".join(capsys.readouterr())
+        assert f"a folder, not a preset; it holds a run, whose preset is {folder / 'preset.yaml'}" in err
+    (tmp_path / "sweep").mkdir()
+    (tmp_path / "sweep" / "sweep.json").write_text("{}")
+    assert main(["validate", str(tmp_path / "sweep")]) == 3
+    assert "a folder, not a preset; it holds a sweep (frictionlab resume" in "".join(capsys.readouterr())
+    (tmp_path / "empty").mkdir()
+    assert main(["validate", str(tmp_path / "empty")]) == 3
+    assert "preset file is a folder, not a regular file" in "".join(capsys.readouterr())
+
+
+def test_a_preset_file_of_two_documents_says_so():
+    """Two YAML documents in one file (a --- line between them) were refused as 'not valid YAML
+    at line 6, column 1: but found another document', the parser's half sentence."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=r"^a second YAML document \(a --- line\) starts at line 3: a preset is one "
+                                          r"document; put the other in a file of its own$"):  # fmt: skip
+        load_yaml("name: a\nseed: 1\n---\nname: b\n")
+    assert load_yaml("---\nname: a\n...\n") == {"name": "a"}  # one document, marked so
+
+
+
+def test_a_tab_or_a_stray_colon_in_a_preset_file_is_named():
+    """A tab indenting a line (an editor's) was refused in PyYAML's words: 'found character
+    '\\t' that cannot start any token'."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=r"^not valid YAML at line 3, column 1: a tab, where YAML takes spaces only "
+                                          r"\(to indent, say\); replace it with spaces$"):  # fmt: skip
+        load_yaml("name: a\nspectrum:\n\tname: power-law\n")
+    assert load_yaml('name: "a\tb"\n') == {"name": "a\tb"}  # in a quoted string, a tab is text
+    for text, line in (("name: a\n  seed: 1\n", 2), ("description: a: b\n", 1)):  # 'mapping values are not allowed here'
+        with pytest.raises(YamlProblem, match=rf"^not valid YAML at line {line}, column \d+: a ': ' where YAML takes none: "
+                                              r"a key indented under a value, or a value holding ': ' \(quote it\)$"):  # fmt: skip
+            load_yaml(text)
+    for text, line in (("name: a\nseed 1\nrealizations: 3\n", 2), ("name: a\nseed 1\n", 2)):  # at the next line, or the end
+        with pytest.raises(YamlProblem, match=rf"^not valid YAML at line {line}, column 1: a line that is neither 'key: "
+                                              r"value' nor part of a value \(a key without its ':', as 'seed 1'"):  # fmt: skip
+            load_yaml(text)
+
+
+@pytest.mark.parametrize("text, tag", [("name: !!python/object:os.system x\n", "'tag:yaml.org,2002:python/object:os.system'"),
+                                       ("name: !Custom x\n", "'!Custom'")])  # fmt: skip
+def test_a_tag_a_preset_does_not_take_is_named_with_the_remedy(text, tag):
+    """'could not determine a constructor for the tag ...': PyYAML's internals, no remedy."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=re.escape(f"at line 1: its tag {tag} is none a preset takes; write the value "
+                                                    "without it")):  # fmt: skip
+        load_yaml(text)
+
+
+def test_a_name_with_an_accent_is_told_which_letters_a_name_takes():
+    """'héllo' was refused as 'must be 1 to 100 letters, digits, ...': é is a letter."""
+    from frictionlab.errors import PresetError
+    from frictionlab.preset import build_scene
+
+    from .conftest import SMALL_PRESET, merge
+
+    with pytest.raises(PresetError, match=r"name: must be 1 to 100 of a-z, A-Z, 0-9, .* got 'héllo'"):
+        build_scene(merge(SMALL_PRESET, {"name": "héllo"}))

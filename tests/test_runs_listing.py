@@ -258,3 +258,20 @@ def test_a_run_whose_count_cannot_be_told_is_damaged_with_the_reason_never_a_que
     assert "?" not in out and f"{runs / 'no-total'} is damaged: run.json does not say" in out
     assert main(["follow", str(runs / "no-chunks")]) == 1
     assert capsys.readouterr().out == f"small: damaged, in {runs / 'no-chunks'}/: {states['no-chunks'].reason}\n"
+
+
+def test_a_resume_writes_the_count_of_realizations_its_preset_asks(tmp_path, registry, capsys):
+    """A manifest whose realizations was damaged ("4" as text) kept it through a resume: the run
+    completed, and was listed with 4/? done for ever after (now listed by its preset's count, but
+    its run.json stays mended)."""
+    folder = tmp_path / "run"
+    _run(folder, registry)
+    manifest = json.loads((folder / "run.json").read_text())
+    manifest.update(status="interrupted", realizations="4")
+    (folder / "run.json").write_text(json.dumps(manifest))
+    for name in ("summary.json", "curve.csv", "realizations.npz"):
+        (folder / name).unlink()
+    assert (run_state(folder).status, run_state(folder).total) == ("interrupted", 4)  # listed by its preset's count
+    assert main(["resume", str(folder), "--quiet", "--no-plot", "--workers", "1"]) == 0
+    assert json.loads((folder / "run.json").read_text())["realizations"] == 4
+    assert (run_state(folder).status, run_state(folder).total) == ("completed", 4)

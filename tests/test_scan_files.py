@@ -228,7 +228,9 @@ def test_an_xml_member_that_inflates_beyond_the_cap_is_refused_unread(tmp_path):
 
 def test_an_x3p_declaring_more_points_than_fit_is_refused_from_its_header(tmp_path, monkeypatch, capsys):
     """Its data member is deflated zeros in the forged case; here, as small as the original:
-    the refusal comes from the declared size, before the reader looks at the data."""
+    the refusal comes from the header and the zip's directory, before the reader looks at the
+    data: a payload smaller than the points declared is a damaged file (a payload of the size
+    declared, a map too large to read: ``check_declared_points``)."""
     from frictionlab_spectra import instrument_reader
 
     tilted_x3p(tmp_path / "small.x3p")
@@ -249,8 +251,12 @@ def test_an_x3p_declaring_more_points_than_fit_is_refused_from_its_header(tmp_pa
     code = main(["validate", str(tmp_path / "p.yaml")])
     err = capsys.readouterr().err
     assert code == ExitCode.USAGE, err
-    assert "declares 22000 x 22000 points (x by y); reading them takes about 14.4 GiB, more than the 2 GiB" in err
-    assert "a test limit of 2 GiB" in err and "Traceback" not in err
+    assert "a damaged XML 3D surface profile (X3P) file: its binary heights take 32768 bytes, and its description " \
+           "declares 484000000 points" in err and "Traceback" not in err  # fmt: skip
+    monkeypatch.setattr(instrument_reader, "room_to_read", lambda: (2**16, "a test limit of 64 KiB"))
+    (tmp_path / "small.yaml").write_text((tmp_path / "p.yaml").read_text().replace("huge.x3p", "small.x3p"))
+    assert main(["validate", str(tmp_path / "small.yaml")]) == ExitCode.USAGE  # a sound file, too large for the room
+    assert "declares 64 x 64 points (x by y); reading them takes about" in capsys.readouterr().err
 
 
 def forged_netcdf(path, n: int):

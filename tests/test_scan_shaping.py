@@ -429,3 +429,20 @@ def test_a_scan_in_single_precision_far_from_zero_is_said_to_be_in_steps(tmp_pat
     assert "caveats" not in double.input_summary()
     np.testing.assert_allclose(double.generate(None).heights, 5e-4 * (smooth - smooth.mean()) / np.std(smooth),
                                rtol=0, atol=1e-10)  # fmt: skip
+
+
+@pytest.mark.parametrize("span, said", [("[.nan, 10]", "region.x[0]: must be a finite number, got nan"),
+                                        ("[0, .inf]", "region.x[1]: must be a finite number, got inf")])  # fmt: skip
+def test_a_region_bound_not_finite_is_one_problem(tmp_path, capsys, span, said):
+    """A NaN in region.x was told twice: as not finite, and as 'region.x = [nan, 10]: needs
+    0 <= start < stop', the order check run on it."""
+    from frictionlab.cli import main
+
+    np.save(tmp_path / "map.npy", np.random.default_rng(1).normal(size=(16, 16)))
+    (tmp_path / "p.yaml").write_text(
+        "name: r\nrealizations: 1\nsolver: {name: mdr}\nloading: {start: 0.001, stop: 1, steps: 3}\n"
+        f"spectrum: {{name: surface-file, params: {{path: map.npy, spacing: 1.0, region: {{x: {span}}}}}}}\n"
+    )
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 2
+    out = "".join(capsys.readouterr())
+    assert "1 problem in preset" in out and f"spectrum.params.{said}" in out, out

@@ -183,3 +183,20 @@ def test_keys_in_any_case_units_as_written(tmp_path):
 
     assert named_units("# WIDTH: 25.6 MM\n# value units: M\n1 2\n") == ([], False)
     assert named_units("# Width: 2 µm\n# Value Units: m\n1\n") == (["um", "m"], True)
+
+
+@pytest.mark.parametrize("header, named", [("x [in],z [uin]", "in"), ("x [mm],z [\u00b5in]", "\u00b5in"),
+                                           ("x (inch), z (mil)", "inch"), ("z/in", "in")])  # fmt: skip
+def test_a_header_in_inches_is_refused_not_read_bare(tmp_path, header, named):
+    """A US profilometer's export in inches and microinches: the units were not known, so not
+    counted, and the numbers were read bare in the preset's unit ('x [mm],z [µin]' with unit: mm
+    took every height in µin for mm) without a word."""
+    columns = 1 if "," not in header else 2
+    rows = "".join(",".join([f"{i * 0.5!r}", repr(float(v))][-columns:]) + "\n" for i, v in enumerate(rough(1, 32)[0]))
+    (tmp_path / "in.csv").write_text(header + "\n" + rows, encoding="utf-8")
+    for unit in ("mm", None):
+        with pytest.raises(ValueError, match=rf"its header names the length unit '{named}', .* convert the columns to one of m, mm"):
+            ProfileFile(path=str(tmp_path / "in.csv"), unit=unit, spacing=0.5).rms_height()
+    heights = "".join(f"{float(v)!r}\n" for v in rough(1, 32)[0])
+    (tmp_path / "word.csv").write_text("z (in um)\n" + heights)  # "in" as a word, not a unit
+    assert ProfileFile(path=str(tmp_path / "word.csv"), unit="um", spacing=0.5).generate(None).heights.size == 32

@@ -83,16 +83,17 @@ def add_parser(sub) -> None:
 
 def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: bool = False,
              high: float = math.inf) -> tuple:
+    written = [v.strip() for v in text.split(",") if v.strip()]
     try:
-        values = tuple(kind(v) for v in text.split(",") if v.strip())
+        values = tuple(kind(v) for v in written)
     except ValueError:
         raise FrictionlabError(f"{option} must be a comma-separated list of numbers. Got {short_repr(text)} instead.") from None
-    bad = [v for v in values if not (v > low and math.isfinite(v))]  # inf made a grid of int(inf) points
-    if bad:
-        raise FrictionlabError(f"{option} values must be finite numbers > {low:g}. Got {bad[0]!r} instead.")
-    beyond = [v for v in values if v > high]
+    bad = [w for w, v in zip(written, values) if not (v > low and math.isfinite(v))]  # inf made a grid of int(inf) points
+    if bad:  # as written: 1e-400 is read as 0.0
+        raise FrictionlabError(f"{option} values must be finite numbers > {low:g}. Got {short_repr(bad[0])} instead.")
+    beyond = [w for w, v in zip(written, values) if v > high]
     if beyond:
-        raise FrictionlabError(f"{option} values must be at most {high:g}. Got {beyond[0]!r} instead.")
+        raise FrictionlabError(f"{option} values must be at most {high:g}. Got {short_repr(beyond[0])} instead.")
     if required and not values:  # an empty list left its axis out without a word
         raise FrictionlabError(f"{option} names no value: give a comma-separated list of numbers. Got {short_repr(text)} instead.")
     return values

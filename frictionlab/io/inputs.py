@@ -174,10 +174,20 @@ class _InputFileMarker:
 INPUT_FILE_MARKER = _InputFileMarker()
 
 
+def expand_user(value: str) -> str:
+    """``value`` with a leading ``~`` or ``~user`` expanded; ValueError naming it for a user
+    this system does not know (pathlib raises RuntimeError there, os.path leaves it as a folder name)."""
+    expanded = os.path.expanduser(value)
+    if expanded.startswith("~"):
+        user = value.split("/", 1)[0]
+        raise ValueError(f"{user} names no user of this system with a home folder; give the path in full")
+    return expanded
+
+
 def _absolute_path(value: str) -> str:
     if any(ord(c) < 32 or ord(c) == 127 for c in value):
         raise ValueError("must not contain control characters (NUL, newline, tab, ...)")
-    return os.path.abspath(os.path.expanduser(value))
+    return os.path.abspath(expand_user(value))
 
 
 InputFile = Annotated[str, INPUT_FILE_MARKER, AfterValidator(_absolute_path)]
@@ -192,7 +202,8 @@ def input_fields(params_model) -> list[str]:
 
 
 def is_relative(value) -> bool:
-    return isinstance(value, str) and bool(value) and not os.path.isabs(os.path.expanduser(value))
+    """Whether a path is taken from the preset's folder: not absolute, nor from a home folder (``~``)."""
+    return isinstance(value, str) and bool(value) and not value.startswith("~") and not os.path.isabs(value)
 
 
 # ------------------------------------------------------------------ what a plugin read

@@ -191,12 +191,20 @@ def check_nodes(root) -> None:
 _OPENED = {"a flow sequence": "a [ list", "a flow mapping": "a { mapping", "a quoted scalar": "a quoted string"}
 
 
+# PyYAML's words for the commonest slips, said in a preset's terms (at the fault, not where it was found)
+_NO_COLON = "a line that is neither 'key: value' nor part of a value (a key without its ':', as 'seed 1' for 'seed: 1')"
+_STRAY_COLON = "a ': ' where YAML takes none: a key indented under a value, or a value holding ': ' (quote it)"
+_TAB = "a tab, where YAML takes spaces only (to indent, say); replace it with spaces"
+
+
 def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     """The parser's complaint, at the line where the fault is: a bracket or a quote left
     open is found only at the end of the file, so it is told where it was opened."""
     mark, context = exc.problem_mark or exc.context_mark, exc.context_mark
     at_end = mark is not None and not text[mark.index:].strip()
     what = (exc.context or "").removeprefix("while parsing ").removeprefix("while scanning ")[:60]
+    if exc.problem == "could not find expected ':'" and context is not None:  # found at the next line, or the end
+        return f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_NO_COLON}"
     if at_end and context is not None and exc.context:  # "while parsing a flow sequence" ...
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: "
                 f"{_OPENED.get(what, what)} opened here is not closed before the end of the file")  # fmt: skip
@@ -204,8 +212,13 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
         # found lines later (the next key): the fault is the bracket or quote left open
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_OPENED[what]} "
                 f"opened here is not closed (at line {mark.line + 1}: {(exc.problem or 'syntax error')[:60]})")
+    if (exc.context or "").startswith("expected a single document") and mark:  # "but found another document"
+        return (f"a second YAML document (a --- line) starts at line {mark.line + 1}: a preset is one document; put "
+                "the other in a file of its own")
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-    return f"not valid YAML{where}: {(exc.problem or exc.context or 'syntax error')[:80]}"
+    problem = exc.problem or exc.context or "syntax error"
+    said = _TAB if "'\\t'" in problem else _STRAY_COLON if problem == "mapping values are not allowed here" else problem[:80]
+    return f"not valid YAML{where}: {said}"
 
 
 def load_yaml(text: str) -> Any:
@@ -231,7 +244,10 @@ def load_yaml(text: str) -> Any:
         except yaml.MarkedYAMLError as exc:
             mark = exc.problem_mark or exc.context_mark
             where = f" at line {mark.line + 1}" if mark else ""
-            raise YamlProblem(f"a value YAML cannot read{where}: {exc.problem or 'bad value'}") from None
+            said = exc.problem or "bad value"
+            if said.startswith("could not determine a constructor for the tag"):  # !!python/object:..., !Foo
+                said = f"its tag {said.rsplit(' ', 1)[-1][:80]} is none a preset takes; write the value without it"
+            raise YamlProblem(f"a value YAML cannot read{where}: {said}") from None
         except _Unconvertible as exc:  # the reason names limits and ranges, never the text
             reason = str(exc.cause).split(";")[0][:100]
             raise YamlProblem(f"the value at line {exc.line} cannot be converted ({type(exc.cause).__name__}: {reason})") from None

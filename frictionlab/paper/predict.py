@@ -34,7 +34,7 @@ from ..errors import FrictionlabError, RunFolderError, short_repr
 from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
-from ..runs.results import read_summary
+from ..runs.results import read_curve, read_summary
 from ..runs.runfolder import read_member
 from ..preset.seeds import bootstrap_rng
 
@@ -191,9 +191,9 @@ def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
 MAX_REALIZATIONS_BYTES = 16 * 1024**3  # realizations.npz: curves of every realization
 
 
-def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
-    """The law a run fitted (its summary.json), the range of f it was fitted over, and its
-    bootstrap pairs (None without realizations.npz). RunFolderError, naming the file and
+def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float] | None, np.ndarray | None]:
+    """The law a run fitted (its summary.json), the range of f it was fitted over (None when
+    unknown), and its bootstrap pairs (None without realizations.npz). RunFolderError, naming the file and
     the field, for a run that did not complete or whose files are damaged."""
     run_dir = Path(run_dir)
     summary = _read_summary(run_dir)
@@ -216,12 +216,21 @@ def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.n
         )
     law = _fit_of(summary, path)
     arrays = _read_realizations(run_dir / "realizations.npz", summary)
-    if arrays is None:
-        return law, (math.nan, math.nan), None
+    if arrays is None:  # output.realizations: false; curve.csv has the same loads
+        return law, _curve_range(run_dir), None
     xi, f = arrays
     pairs = _pairs_of(summary, law, xi, f)
     _check_law_within(pairs, law, path)
     return law, (float(np.min(f)), float(np.max(f))), pairs
+
+
+def _curve_range(run_dir: Path) -> tuple[float, float] | None:
+    """The range of f of curve.csv (checked as ``read_curve`` reads it); None without one."""
+    if not os.path.lexists(run_dir / "curve.csv"):
+        return None
+    f = read_curve(run_dir)["f"]
+    f = f[np.isfinite(f) & (f > 0)]
+    return (float(f.min()), float(f.max())) if f.size else None
 
 
 CHECKED_RESAMPLES = 100  # from this many, an estimate outside all of its resamples is not chance (2^-100)

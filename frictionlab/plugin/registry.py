@@ -48,8 +48,16 @@ def _env_list(env, key: str) -> list[str]:
     return [item.strip() for item in env.get(key, "").split(",") if item.strip()]
 
 
+_ON, _OFF = ("1", "true", "yes", "on"), ("", "0", "false", "no", "off")
+
+
 def _env_flag(env, key: str) -> bool:
-    return env.get(key, "").strip().lower() in {"1", "true", "yes", "on"}
+    """A yes/no variable; another value (a typo: ``ture``, ``2``) is said, and read as no."""
+    value = env.get(key, "").strip().lower()
+    if value not in _ON + _OFF:
+        warnings.warn(f"{key}={env[key]!r} is not one of {', '.join(_ON)} (on) or {', '.join(_OFF[1:])} (off); "
+                      "read as off", RuntimeWarning, stacklevel=3)  # fmt: skip
+    return value in _ON
 
 
 @dataclass(frozen=True)

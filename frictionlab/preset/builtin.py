@@ -78,6 +78,16 @@ def resolve_preset_path(argument: str | Path) -> Path:
     # a folder is never a preset: the run folder of `frictionlab run quickstart --out quickstart`, say
     if named and path.is_dir() and (shadowed := find_builtin(str(argument))) is not None:
         return shadowed.path
+    if path.is_dir() and (path / "preset.yaml").is_file():  # a run folder given for its preset
+        raise PresetFileError(
+            [f"(file): a folder, not a preset; it holds a run, whose preset is {path / 'preset.yaml'} (frictionlab "
+             f"resume {path} continues the run; frictionlab run {path / 'preset.yaml'} --out NEW runs it again)"],
+            source=str(argument),
+        )  # fmt: skip
+    if path.is_dir() and (path / "sweep.json").is_file():
+        raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {path} continues "
+                               f"it), each point's preset in {path / 'points'}/<NN-label>/preset.yaml"],
+                              source=str(argument))  # fmt: skip
     if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one
     found = find_builtin(str(argument))

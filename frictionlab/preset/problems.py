@@ -4,6 +4,7 @@ pydantic's errors worded for people, and the numbers pydantic would let through.
 from __future__ import annotations
 
 import math
+import re
 import types
 import typing
 from dataclasses import dataclass
@@ -256,11 +257,14 @@ class Bounds:
 
     @classmethod
     def of(cls, field) -> Bounds | None:
-        """The field's bounds, when it has both, else None."""
+        """The field's bounds when it has both, or a lower one above the least magnitude, its top
+        then that of every number (points: >= 8 and <= 1e+100, not 'between 1e-100 and 1e+100',
+        which 2 is); else None (the magnitudes are said)."""
         said = _limits(field)
-        if not ({"ge", "gt"} & said.keys() and {"le", "lt"} & said.keys()):
+        low = said.get("ge", said.get("gt"))
+        if not {"le", "lt"} & said.keys() and (low is None or low <= 1 / MAX_MAGNITUDE):
             return None
-        return cls(said.get("ge", said.get("gt")), "ge" not in said, said.get("le", said.get("lt")), "le" not in said)
+        return cls(low, "ge" not in said, said.get("le", said.get("lt", MAX_MAGNITUDE)), "lt" in said)
 
     @property
     def said(self) -> str:  # as pydantic's own refusal reads: >= 1 and <= 10000000
@@ -313,6 +317,11 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
 
 
 def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
-    """Both lists, without a pydantic line for a field the number check already named."""
-    named = {line.split(": ", 1)[0] for line in numbers}
-    return numbers + [line for line in pydantic_lines if line.split(": ", 1)[0] not in named]
+    """Both lists, without a pydantic line for a field the number check already named (its
+    items as ``x[0]``, pydantic's as ``x.0``)."""
+
+    def field(line: str) -> str:
+        return re.sub(r"\[(\d+)\]", r".\1", line.split(": ", 1)[0])
+
+    named = {field(line) for line in numbers}
+    return numbers + [line for line in pydantic_lines if field(line) not in named]

@@ -7,10 +7,12 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..errors import FrictionlabError, PresetError, PresetFileError
+from ..errors import FrictionlabError, PresetError, PresetFileError, short_repr
 from ..io.inputs import InputFileProblem, input_fields, is_relative, read_regular_file
 from ..io.safe_yaml import YamlLimit, YamlProblem, load_yaml
 from .paths import apply_overrides
+
+NOT_A_MAPPING = "a preset must be a mapping of keys to values (name: ..., spectrum: ...)"
 
 if TYPE_CHECKING:
     from ..plugin.registry import Registry
@@ -42,10 +44,8 @@ def load_preset_file(path: str | Path, *, follow_links: bool = True) -> dict:
     except YamlProblem as exc:
         raise PresetError([f"(file): {exc}"], source=str(path)) from None
     if not isinstance(data, dict):
-        raise PresetError(
-            [f"(file): a preset must be a mapping of keys to values. Got {type(data).__name__} instead."],
-            source=str(path),
-        )
+        got = "an empty file (or comments only)" if data is None else short_repr(data, 80)
+        raise PresetError([f"(file): {NOT_A_MAPPING}, got {got}"], source=str(path))
     return data
 
 

@@ -18,7 +18,7 @@ from ..plugin import KINDS, ContactSolver, ForceNormalisation, SlopeEstimator, S
 from ..plugin.outputs import answers_problem, refuse
 from ..plugin.registry import Registry, default_registry
 from .problems import format_validation_error, merge_problems, number_problems, shown_value
-from .reading import read_preset, resolve_input_paths
+from .reading import NOT_A_MAPPING, read_preset, resolve_input_paths
 from .schema import PluginChoice, Preset
 
 
@@ -167,7 +167,7 @@ def build_scene(
     then with the scene as it will be, less its line (``equivalent_line`` None)."""
     registry = registry or default_registry()
     if not isinstance(data, dict):
-        raise PresetError([f"(preset): must be a mapping of keys to values. Got {type(data).__name__} instead."], source)
+        raise PresetError([f"(preset): {NOT_A_MAPPING}, got {shown_value(data)}"], source)
     if base_dir is not None:
         data = resolve_input_paths(data, base_dir, registry)
     numbers = number_problems(Preset, data)

@@ -15,7 +15,7 @@ from ..plugin.registry import Registry, default_registry
 MAX_SWEEP_POINTS = 1000  # counted from the axes, before any point is built
 NAME_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._+-]{0,99}$"
 NAME_RULE = (
-    "must be 1 to 100 letters, digits, '.', '_', '+' or '-', starting with a letter or digit "
+    "must be 1 to 100 of a-z, A-Z, 0-9, '.', '_', '+' or '-', starting with a letter or digit "
     "(it names the output folder)"
 )
 
@@ -53,7 +53,9 @@ class Loading(_Strict):
         if self.unit != "force" and self.control != "force":
             raise ValueError(f"unit {self.unit!r} gives loads, not indentations: it needs control 'force'")
         if self.unit == "contact-fraction" and self.stop >= 1:
-            raise ValueError(f"a contact fraction is below 1 (stop). Got {self.stop} instead")
+            raise ValueError(
+                f"stop must be < 1 under unit contact-fraction (a fraction of the area). Got {self.stop} instead."
+            )
         return self
 
     def values(self) -> np.ndarray:
@@ -62,9 +64,12 @@ class Loading(_Strict):
         return np.linspace(self.start, self.stop, self.steps)
 
 
+MAX_BOOTSTRAP = 100_000  # resamples: a summary.json read back is held to it too
+
+
 class FitSettings(_Strict):
     bootstrap: int = Field(
-        1000, ge=0, le=100_000, description="Bootstrap resamples over realizations for the intervals (0: none)."
+        1000, ge=0, le=MAX_BOOTSTRAP, description="Bootstrap resamples over realizations for the intervals (0: none)."
     )
     confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level of the intervals.")
 

@@ -167,7 +167,8 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
 def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
     complex arrays reached the statistics), ``failed_error`` is text, and the values are what a
-    realization can give: xi none infinite or below 0, each profile of 1 point or more, its
+    realization can give: xi none infinite or below 0, each profile of 1 point or more, its rms
+    slope finite and > 0 and its force unit > 0 (NaN there failed the run as a preset's magnitudes), its
     contact counts and the points carrying half the load (NaN: not said) from 0 to its points
     (a chunk that broke these was restored, and its run folder written as its load refuses)."""
     for name in numeric:
@@ -182,6 +183,10 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     points = arrays["points"][:, None]
     if bool((points < 1).any()):
         raise ChunkDamage("a profile of fewer than 1 point")
+    if not bool((arrays["slope_rms_line"] > 0).all() and np.isfinite(arrays["slope_rms_line"]).all()):
+        raise ChunkDamage("a line's rms slope not a finite number > 0")  # a realization with one is a failure
+    if not bool((arrays["force_unit"] > 0).all()):  # NaN compares false: refused (inf: the run's own check says it)
+        raise ChunkDamage("a force unit k h X not > 0")
     for name in ("contact_count", "half_load_points"):
         if bool(((arrays[name] < 0) | (arrays[name] > points)).any()):  # NaN compares false: allowed
             raise ChunkDamage(f"{name} below 0 or above the profile's points")

@@ -35,6 +35,7 @@ from ..io.files import atomic_write, write_npz
 from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
 from ..preset import Scene
+from ..preset.schema import MAX_BOOTSTRAP
 from .import_ahead import PLOT_MODULE, imported
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
 
@@ -230,7 +231,7 @@ class FitRecord(Record):
     a_ci: _Interval | None = None
     b_ci: _Interval | None = None
     confidence: Annotated[float, Field(gt=0, lt=1, strict=True)] = 0.95
-    bootstrap: Count = 0
+    bootstrap: Annotated[int, Field(ge=0, le=MAX_BOOTSTRAP, strict=True)] = 0  # predict --from redraws them
     r2: Finite | None = None
     residual_rms: Spread | None = None
     points: Count = 0

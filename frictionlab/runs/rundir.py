@@ -367,7 +367,7 @@ class RunDirectory:
         if state.get("fingerprint") != fingerprint(resolved):  # started before fields now at their defaults
             atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
         self._manifest = {**state, "format": MANIFEST_FORMAT, "status": "running", "preset": resolved,
-                          "fingerprint": fingerprint(resolved),
+                          "fingerprint": fingerprint(resolved), "realizations": resolved.get("realizations"),
                           "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}}}  # fmt: skip
         self._manifest["chunks"] = dict(state.get("chunks") or {}) if state.get("format") == MANIFEST_FORMAT else {}
         self._remove_chunks(self._manifest.pop("retired", None) or [], keep=self._manifest["chunks"])  # an unfinished compaction's

@@ -20,6 +20,9 @@ def run_app(
     options=None,
 ) -> int:
     """Run the app until it quits; ``options`` (``RunOptions``): how its runs are carried out."""
+    from .folders import user_presets_dir  # no Textual there
+
+    user_presets_dir()  # FRICTIONLAB_PRESETS_DIR=~nouser: said now, not as a traceback in the app
     if not (sys.stdin.isatty() and sys.stdout.isatty()):  # keys come from, and the screen goes to, a terminal
         raise FrictionlabError(
             "frictionlab tui needs a terminal for its keys and its screen (stdin and stdout are not one here); "

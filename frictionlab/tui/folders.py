@@ -20,10 +20,10 @@ from pathlib import Path
 import yaml
 
 from ..errors import FrictionlabError, RunFolderError
-from ..io.inputs import read_regular_file
+from ..io.inputs import expand_user, read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import builtin_folder, builtin_presets
-from ..preset.reading import MAX_PRESET_BYTES
+from ..preset.reading import MAX_PRESET_BYTES, NOT_A_MAPPING
 from ..preset.schema import NAME_PATTERN
 from ..io.safe_yaml import load_yaml
 
@@ -34,11 +34,14 @@ PROJECT_PRESETS_DIR = Path("presets")
 
 
 def user_presets_dir(env=None) -> Path:
+    """FrictionlabError naming the variable for a ``~user`` this system does not know."""
     env = os.environ if env is None else env
-    if env.get("FRICTIONLAB_PRESETS_DIR"):
-        return Path(env["FRICTIONLAB_PRESETS_DIR"]).expanduser()
-    if env.get("XDG_CONFIG_HOME"):
-        return Path(env["XDG_CONFIG_HOME"]).expanduser() / "frictionlab" / "presets"
+    for key, below in (("FRICTIONLAB_PRESETS_DIR", ()), ("XDG_CONFIG_HOME", ("frictionlab", "presets"))):
+        if env.get(key):
+            try:
+                return Path(expand_user(env[key]), *below)
+            except ValueError as exc:
+                raise FrictionlabError(f"{key}={env[key]!r}: {exc}") from None
     from platformdirs import user_config_path  # ~/.config on Linux, the platform's own folder elsewhere
 
     return user_config_path("frictionlab") / "presets"
@@ -82,8 +85,11 @@ def save_folder(presets_dir: Path | None = None) -> Path:
 def made_when_saved(folder: Path, save_to: Path) -> bool:
     """Whether ``folder`` is a presets folder made when first saved into: ``save_to`` (where new
     presets go) or the user folder (offered for a preset that cannot be written where it is)."""
-    return any(Path(folder).expanduser().resolve() == Path(made).expanduser().resolve()
-               for made in (save_to, user_presets_dir()))  # fmt: skip
+    try:
+        return any(Path(expand_user(str(folder))).resolve() == Path(expand_user(str(made))).resolve()
+                   for made in (save_to, user_presets_dir()))  # fmt: skip
+    except ValueError:  # ~user of no user: no folder of ours
+        return False
 
 
 def new_preset_path(name: str, folder: Path) -> Path:
@@ -97,9 +103,6 @@ class PresetEntry:
     name: str  # the preset's own name, or the file stem if unreadable
     description: str
     error: str = ""
-
-
-NOT_A_MAPPING = "a preset must be a mapping of keys to values (name: ..., spectrum: ...)"
 
 
 def list_presets(folders: list[tuple[str, Path]]) -> list[PresetEntry]:

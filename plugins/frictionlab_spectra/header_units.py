@@ -11,8 +11,12 @@ import re
 HEADER_BYTES = 4096  # of a text file read for the units its header names
 LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
                "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5"}  # fmt: skip
+# inch-based lengths, as US profilometers export them: named by a header, never converted, so refused
+IMPERIAL = r"inch(?:es)?|in|mils?|thou|[u\u00b5\u03bc]in|micro-?inch(?:es)?"
 _UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5"
-_LABEL = re.compile(rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)")  # x [µm], z (nm), z/nm
+_LABEL = re.compile(  # x [µm], z (nm), z/nm; an inch only in brackets or after a slash ("z (in nm)" names nm)
+    rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)|[\[(]\s*({IMPERIAL})\s*[\])]|/\s*({IMPERIAL})\s*(?=[,;\t]|$)"
+)
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
@@ -38,7 +42,7 @@ def named_units(text: str) -> tuple[list[str], bool]:
     for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             break
-        units += [LENGTH_UNIT[token] for token in _LABEL.findall(line)]
+        units += [LENGTH_UNIT.get(unit, unit) for found in _LABEL.findall(line) for unit in found if unit]
         if stated := _STATED.search(line.rstrip()):
             units.append(LENGTH_UNIT[stated["unit"]])
             stated_by_key = True
@@ -71,6 +75,13 @@ def check_units_named(units: list[str], unit: str | None, where: str, ignored: s
     its numbers would be taken bare, in the preset's unit."""
     from .instrument_file import LENGTH_UNITS  # here: it imports this module
 
+    if imperial := [u for u in units if re.fullmatch(IMPERIAL, u)]:
+        taken = f"in the preset's unit, {unit}" if unit else "bare"
+        raise ValueError(
+            f"{where}: its header names the length unit {imperial[0]!r}, {ignored} and frictionlab does not "
+            f"convert: its numbers would be taken {taken}, the slopes or heights off by the units' ratio; convert "
+            f"the columns to one of {', '.join(LENGTH_UNITS)}"
+        )
     if len(set(units)) > 1:
         raise ValueError(
             f"{where}: its header names the length units {', '.join(dict.fromkeys(units))}, {ignored}: its numbers "

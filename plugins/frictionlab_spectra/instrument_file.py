@@ -86,6 +86,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
         warnings.simplefilter("ignore")
         try:
             reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
+            check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
             sizes = chosen.physical_sizes
@@ -183,6 +184,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
+        check_payload(fh, type(reader), where, checksum=False)
         if chosen.nb_grid_pts is not None:
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
         check_payload(fh, type(reader), where)

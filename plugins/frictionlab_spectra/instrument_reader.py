@@ -126,14 +126,15 @@ def check_header_units(fh, reader, file_unit: str | None, unit: str | None, wher
         check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
 
 
-def check_payload(fh, reader, where: str) -> None:
+def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
     """Refuse an X3P whose binary heights are not the size its main.xml declares (points times
     the bytes of its data type), or not the bytes its MD5 checksum declares: SurfaceTopography's
     reader checks neither, so a payload longer than declared, of another type (doubles declared
     as floats: heights of 1e37), or damaged in copying, was read without a word. Other formats,
     an X3P with its heights in the XML, or one whose description this cannot follow, are left to
-    the reader. After ``check_declared_points``: a map declared too large is refused as such,
-    whatever its payload."""
+    the reader. The size first, with ``checksum`` false (cheap: a forged header's 10^9 points are
+    damage, not a map too large to read); the checksum after ``check_declared_points``, so a map
+    declared too large, and so stored, is refused as such before its heights are hashed."""
     import hashlib
     import xml.etree.ElementTree as ElementTree
 
@@ -147,9 +148,9 @@ def check_payload(fh, reader, where: str) -> None:
             points = math.prod(int(root.findtext(f"Record3/MatrixDimension/Size{axis}", "")) for axis in "XYZ")
             link = root.findtext("Record3/DataLink/PointDataLink", "").strip()
             stored = archive.getinfo(link).file_size
-            checksum = root.findtext("Record3/DataLink/MD5ChecksumPointData", "").strip().lower()
+            declared_sum = root.findtext("Record3/DataLink/MD5ChecksumPointData", "").strip().lower()
             sized = kind not in X3P_ITEM_BYTES or stored == points * X3P_ITEM_BYTES[kind]
-            if sized and re.fullmatch(r"[0-9a-f]{32}", checksum):
+            if sized and checksum and re.fullmatch(r"[0-9a-f]{32}", declared_sum):
                 digest = hashlib.md5(usedforsecurity=False)
                 with archive.open(link) as member:  # in blocks: no second copy of the heights
                     for block in iter(lambda: member.read(1 << 20), b""):
@@ -166,10 +167,10 @@ def check_payload(fh, reader, where: str) -> None:
             f"declares {points} points of data type {kind} ({X3P_ITEM_BYTES[kind]} bytes each: {declared} bytes); "
             "copy it again from the instrument, or export it from there again"
         )
-    if found is not None and found != checksum:
+    if found is not None and found != declared_sum:
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights' MD5 checksum is {found}, and its "
-            f"description declares {checksum}; copy it again from the instrument, or export it from there again"
+            f"description declares {declared_sum}; copy it again from the instrument, or export it from there again"
         )
 
 

@@ -16,7 +16,7 @@ the spring of one MDR point) stay the ones checked against closed forms.
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -33,14 +33,17 @@ FileFormat = Literal["auto", "table", "instrument"]
 Level = Literal["none", "mean", "plane", "quadratic"]
 
 
+_Finite = Annotated[float, Field(allow_inf_nan=False)]  # NaN refused as the field's own, not again as an order
+
+
 class Region(BaseModel):
     """A crop: ``x`` and ``y`` as [start, stop) along the map's columns and rows, in pixels of
     the file or in the run's length unit from the map's first pixel (``units``); either
     unset keeps the whole of that side."""
 
     model_config = ConfigDict(extra="forbid")
-    x: tuple[float, float] | None = Field(None, description="[start, stop) along x (the map's columns)")
-    y: tuple[float, float] | None = Field(None, description="[start, stop) along y (the map's rows)")
+    x: tuple[_Finite, _Finite] | None = Field(None, description="[start, stop) along x (the map's columns)")
+    y: tuple[_Finite, _Finite] | None = Field(None, description="[start, stop) along y (the map's rows)")
     units: Literal["pixels", "length"] = Field("pixels", description="pixels of the file, or the run's length unit")
 
     @model_validator(mode="after")

@@ -59,8 +59,9 @@ from .measured import Measured, MeasuredFile, MeasuredParams
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
-    check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, read_text_table, table_fill_advice,
+    check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
 )
+from .text_table import read_text_table
 from .scan_shaping import FLAT, flat_rms
 
 MIN_SIDE = 8

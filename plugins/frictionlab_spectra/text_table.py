@@ -7,6 +7,7 @@ import codecs
 import io
 import math
 import os
+import re
 import warnings
 from pathlib import Path
 
@@ -33,7 +34,11 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
     ``copies``: the arrays of its numbers its reader holds at once (a map's levelling, more)."""
     with open_input(path, where) as fh:
         size = os.fstat(fh.fileno()).st_size
-        need = _numbers_in(fh, size) * 8 * copies
+        sample = fh.read(SAMPLE_BYTES)
+        fh.seek(0)
+        if (nul := sample.find(b"\x00")) >= 0:  # valid UTF-8, but no text's: UTF-16 without its mark, or binary
+            raise ValueError(_not_utf8(where, sample.count(b"\n", 0, nul) + 1))
+        need = _numbers_in(sample, size) * 8 * copies
         room, source = room_to_read()
         if need > room:
             raise ValueError(_too_large_table(where, size, f"reading its numbers takes about {need / 2**30:.3g} GiB, "
@@ -44,20 +49,21 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
         except MemoryError:
             raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
         except UnicodeDecodeError:
-            raise ValueError(f"{where}: not UTF-8 at line {_undecodable_line(fh)} (text in another encoding, as a "
-                             "Latin-1 header's µ, or no text); an instrument's export (a profilometer's .csv) is read "
-                             "with format: instrument; a table of bare numbers is read as UTF-8: save it so (a "
-                             "spreadsheet's 'CSV UTF-8')") from None
+            raise ValueError(_not_utf8(where, _undecodable_line(fh))) from None
         finally:
             text.detach()  # the file is open_input's to close
 
 
-def _numbers_in(fh, size: int) -> int:
-    """The numbers a table of ``size`` bytes holds, as many per byte as in its first bytes (a
-    number cut at their end not counted; at least one per 64 bytes: a first line of text is no
-    measure). ``fh`` is left at its start."""
-    sample = fh.read(SAMPLE_BYTES)
-    fh.seek(0)
+def _not_utf8(where: str, line: int) -> str:
+    return (f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or UTF-16's NUL "
+            "bytes, or no text); an instrument's export (a profilometer's .csv) is read with format: instrument; a "
+            "table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')")
+
+
+def _numbers_in(sample: bytes, size: int) -> int:
+    """The numbers a table of ``size`` bytes holds, as many per byte as in its first bytes
+    ``sample`` (a number cut at their end not counted; at least one per 64 bytes: a first line
+    of text is no measure)."""
     cells = sum(len(line.split(b"#", 1)[0].replace(b",", b" ").replace(b";", b" ").split()) for line in sample.splitlines())
     cells -= len(sample) == SAMPLE_BYTES and not sample[-1:].isspace()  # the last, cut
     return math.ceil(size * max(cells / max(len(sample), 1), 1 / 64))
@@ -101,6 +107,10 @@ def _table(text, where: str) -> np.ndarray:
             break
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     text.seek(0)
+    if delimiter == "," and COMMA_DECIMAL.fullmatch(cells):  # two whole numbers: x, z, or one decimal-comma height?
+        if (lineno := _comma_decimal_line(text, skip)) is not None:
+            raise ValueError(f"{where}: {_decimal_commas(lineno)}")
+        text.seek(0)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
@@ -125,14 +135,38 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
             if _ends_with_separator(text, delimiter):
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
-                return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
-                        "export the table with decimal points")  # fmt: skip
+                return _decimal_commas(lineno)
             return f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _decimal_commas(lineno: int) -> str:
+    return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
+            "export the table with decimal points")
+
+
+COMMA_DECIMAL = re.compile(r"[-+]?\d+,\d+(?:[eE][-+]?\d+)?")  # 0,0677: decimal commas, or x, z in whole numbers
+LEADING_ZERO = re.compile(r"[-+]?\d+,0\d")  # 0,0677: a fraction; no program writes a whole number 0677
+
+
+def _comma_decimal_line(lines, skip: int) -> int | None:
+    """The first line of a column of numbers with decimal commas (0,0677 read as x = 0, z = 677,
+    refused as a grid that is not uniform), if every line is two whole numbers and a second starts
+    with 0 and a digit; None otherwise. ``lines`` is read through once, a line at a time."""
+    first = None
+    for lineno, line in enumerate(lines, start=1):
+        text = line.split("#", 1)[0].strip()
+        if lineno <= skip or not text:
+            continue
+        if not COMMA_DECIMAL.fullmatch(text):
+            return None
+        if first is None and LEADING_ZERO.match(text):
+            first = lineno
+    return first
 
 
 def _mostly_numbers(text: str, delimiter: str | None) -> bool:

@@ -132,3 +132,18 @@ def test_from_a_run_that_failed_with_every_realization_done_says_why_not_resume(
     err = capsys.readouterr().err
     assert "the run failed with all its realizations finished" in err and "holds no law: no law: the whole" in err
     assert "frictionlab resume" not in err and "fewer realizations" not in err
+
+
+def test_a_run_without_realizations_npz_keeps_its_fitted_range(tmp_path, capsys, make_scene):
+    """output.realizations: false leaves no realizations.npz: the range of f came back
+    [nan, nan], and every prediction, inside the loads or not, was called extrapolated."""
+    scene = make_scene({"output": {"plot": False, "realizations": False}})
+    outcome, _ = run_to_folder(scene, tmp_path, RunOptions(workers=1))
+    assert not (tmp_path / "realizations.npz").exists()
+    _, fitted_f, pairs = read_run_law(tmp_path)
+    assert pairs is None and fitted_f == pytest.approx((outcome.f.min(), outcome.f.max()), rel=1e-12)
+    (tmp_path / "curve.csv").unlink()
+    assert read_run_law(tmp_path)[1] is None  # not known: no warning either way
+    assert main(["predict", "--from", str(tmp_path), "--area", "1", "--modulus", "1", "--rms-height", "1",
+                 "--force", "1", "--json"]) == 0  # fmt: skip
+    assert json.loads(capsys.readouterr().out)["extrapolated"] is False

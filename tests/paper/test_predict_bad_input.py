@@ -105,6 +105,7 @@ def test_a_summary_that_is_a_folder(run_copy, capsys):
         ("fit.bootstrap", "x"),
         ("fit.bootstrap", -1),
         ("fit.bootstrap", 2.5),
+        pytest.param("fit.bootstrap", 100_001, id="fit.bootstrap-beyond-a-preset-s"),  # redrawn: 10**12 ran for hours
         ("fit.points", "x"),
         ("fit.a_ci", "x"),
         ("fit.a_ci", [1, 2, 3]),

@@ -127,7 +127,7 @@ async def test_new_takes_back_its_error_once_the_name_is_retyped(folders, regist
         said = str(app.screen.query_one("#new-error").render())
         await press_settled(pilot, "ctrl+u", *"rough")
         left = app.screen.query_one("#new-error").display
-    assert said.startswith("name: must be 1 to 100 letters") and "got 'my scene!'" in said
+    assert said.startswith("name: must be 1 to 100 of a-z, A-Z, 0-9") and "got 'my scene!'" in said
     assert not left
 
 

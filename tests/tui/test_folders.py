@@ -127,3 +127,34 @@ def test_a_preset_saved_again_keeps_its_files_permissions(tmp_path):
     umask = os.umask(0)
     os.umask(umask)
     assert (tmp_path / "new.yaml").stat().st_mode & 0o777 == 0o666 & ~umask
+
+
+NO_USER = "~frictionlab-no-such-user"
+
+
+def test_a_home_folder_of_no_user_is_said_not_raised(monkeypatch, capsys):
+    """~user of a user this system does not know: pathlib raised RuntimeError, and the TUI
+    ended in a traceback (its locals, the whole environment, on the screen) at start, from
+    FRICTIONLAB_PRESETS_DIR, or when such a path was typed in the save dialog; a preset's
+    input path was taken as a folder named so beside the preset ('no such file')."""
+    import pytest
+    from pydantic import ValidationError
+
+    from frictionlab.cli import main
+    from frictionlab.errors import FrictionlabError
+    from frictionlab.tui.folders import user_presets_dir
+    from frictionlab.tui.screens.dialogs import preset_path_problem
+    from frictionlab_spectra import ProfileFile
+
+    assert preset_path_problem(f"{NO_USER}/mine") == (None, f"path: {NO_USER} names no user of this system with a "
+                                                              "home folder; give the path in full")  # fmt: skip
+    for key in ("FRICTIONLAB_PRESETS_DIR", "XDG_CONFIG_HOME"):
+        with pytest.raises(FrictionlabError, match=f"{key}='{NO_USER}/p': {NO_USER} names no user"):
+            user_presets_dir(env={key: f"{NO_USER}/p"})
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", f"{NO_USER}/p")
+    assert main(["tui"]) == 2
+    err = capsys.readouterr().err
+    assert f"FRICTIONLAB_PRESETS_DIR='{NO_USER}/p'" in err and "Traceback" not in err
+    with pytest.raises(ValidationError, match=f"{NO_USER} names no user"):
+        ProfileFile(path=f"{NO_USER}/scan.npy", spacing=1.0)
+    assert user_presets_dir(env={"FRICTIONLAB_PRESETS_DIR": "~/p"}) == __import__("pathlib").Path.home() / "p"

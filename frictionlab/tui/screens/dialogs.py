@@ -13,6 +13,7 @@ from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
+from ...io.inputs import expand_user
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
 from ..folders import is_builtin, made_when_saved, new_preset_path
@@ -138,7 +139,11 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
     if not text:
         return None, "path: must not be empty"
     try:
-        return _checked_path(Path(text).expanduser(), folder)
+        path = Path(expand_user(text))
+    except ValueError as exc:  # ~user of no user here
+        return None, f"path: {exc}"
+    try:
+        return _checked_path(path, folder)
     except (OSError, ValueError) as exc:  # a name past the system's limits, a folder not to be read: no traceback
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         return None, f"path: {shown_value(text)} cannot be a file here ({reason}); give another"
