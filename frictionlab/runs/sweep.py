@@ -197,12 +197,10 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
             scene = build_scene(apply_overrides(base, assignments), registry=registry, before_reading=before_reading)
         except PresetError as exc:
-            shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())  # a value may be any length
-            problems += [f"sweep point {number} ({shown}): {p}" for p in exc.problems]
+            problems += [f"{_point_named(number, values)}: {p}" for p in exc.problems]
             continue
         except RunError as exc:  # the memory check: the point named, before any point runs
-            shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())
-            raise RunError(f"sweep point {number} ({shown}): {exc}") from None
+            raise RunError(f"{_point_named(number, values)}: {exc}") from None
         folder = f"{number:0{width}d}-{_label(values)}"
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
     if not problems and (pair := first_repeat([ensemble_settings(p.scene.resolved()) for p in points])) is not None:
@@ -212,6 +210,11 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
     if problems:
         raise PresetError(problems, source=source)
     return Sweep(name=base_preset.name, spec=spec, base=base, points=points, source=source)
+
+
+def _point_named(number: int, values: dict[str, Any]) -> str:
+    shown = ", ".join(f"{path}={short_repr(v)}" for path, v in values.items())  # a value may be any length
+    return f"sweep point {number} ({shown})"
 
 
 def check_sweep_memory(sweep: Sweep, options: RunOptions) -> None:
@@ -224,7 +227,7 @@ def check_sweep_memory(sweep: Sweep, options: RunOptions) -> None:
         try:
             check_memory(point.scene, options)
         except RunError as exc:
-            raise RunError(f"sweep point {point.number} ({point.describe()}): {exc}") from None
+            raise RunError(f"{_point_named(point.number, point.values)}: {exc}") from None
 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
