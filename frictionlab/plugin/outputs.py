@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import PluginError
 from .data import ContactCurve, Profile
 from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
-from .registry import _provider_of
+from .registry import provider_of
 
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
@@ -164,4 +164,4 @@ def refuse(plugin, problem: str | None) -> None:
     if problem:
         cls = type(plugin)
         raise PluginError(f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from "
-                          f"{_provider_of(cls)[0]}) broke the plugin contract: {problem}")  # fmt: skip
+                          f"{provider_of(cls)[0]}) broke the plugin contract: {problem}")  # fmt: skip

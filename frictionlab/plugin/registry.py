@@ -74,11 +74,11 @@ class PluginInfo:
     def provider(self) -> str:
         """The distribution that ships the plugin (looked up when asked: the lookup
         reads every installed distribution's metadata, too slow for each start)."""
-        return _provider_of(self.cls)[0]
+        return provider_of(self.cls)[0]
 
     @property
     def version(self) -> str:
-        return _provider_of(self.cls)[1]
+        return provider_of(self.cls)[1]
 
 
 @dataclass(frozen=True)
@@ -94,7 +94,7 @@ def _module_distributions() -> dict[str, list[str]]:
 
 
 @functools.cache
-def _provider_of(cls: type) -> tuple[str, str]:
+def provider_of(cls: type) -> tuple[str, str]:
     """The distribution (and version) that ships ``cls``, from its module."""
     top = cls.__module__.split(".")[0]
     dists = _module_distributions().get(top)
@@ -348,7 +348,7 @@ class Registry:
                     clashes[_kind][key] = (
                         f"two {_kind} plugins are named {key!r}: "
                         f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
-                        f"and {cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}; "
+                        f"and {cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}; "
                         "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
                     )
 
@@ -408,7 +408,7 @@ class Registry:
                 cls = type(frame.f_locals.get("self")) if isinstance(frame.f_locals.get("self"), Plugin) else info.cls
                 where = f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
                 return PluginError(
-                    f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {_provider_of(cls)[0]}) raised "
+                    f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}) raised "
                     f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
                     "tell its authors, or choose another plugin"
                 )
