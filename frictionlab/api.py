@@ -51,6 +51,7 @@ import numpy as np
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
 from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown
 from .compute.fit import LogFit
+from .compute.signals import RunInterrupted
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, read_curve, read_summary
 from .runs.runfolder import subfolder
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
     from .compute.ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
+__all__ = ["Result", "RunInterrupted", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
@@ -316,7 +317,22 @@ def run(
     preset, the overrides) is held to a preset file's limits: 64 levels of nesting,
     20,000 values. A built-in preset is named as the command line names it
     (``built-in preset 'quickstart'``).
+
+    Ctrl-C (in Jupyter, interrupting the kernel) stops the run within about a second,
+    keeps what finished (in ``out``, resumable) and raises ``RunInterrupted``, a
+    ``KeyboardInterrupt`` whose ``result`` is the run as it ended: a cell or a loop of
+    runs stops there too.
     """
+    from .compute.signals import interrupted_since, mark
+
+    seen = mark()
+    result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
+    if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
+        raise RunInterrupted(result)
+    return result
+
+
+def _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys):
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
     from .runs.runner import memory_check_before_reading
