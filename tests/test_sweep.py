@@ -442,3 +442,12 @@ def test_the_clis_memory_refusal_of_a_sweep_names_the_point(tmp_path, monkeypatc
     err = capsys.readouterr().err
     assert err.startswith("error: sweep point 2 (spectrum.params.points=30000000): this run would need about")
     assert "the memory of a test" in err and not (tmp_path / "out").exists()
+
+
+def test_a_bare_list_of_values_says_how_to_give_one():
+    with pytest.raises(PresetError) as caught:
+        plan_sweep(sweep_preset({"spectrum.params.hurst": [0.5, 0.8]}))
+    assert caught.value.problems == [
+        "sweep.parameters.spectrum.params.hurst: must be a mapping: {values: [...]} for a list, "
+        "or {start: ..., stop: ..., num: ...} for a range, got [0.5, 0.8]"
+    ]
