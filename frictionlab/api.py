@@ -172,6 +172,11 @@ class SweepResult:
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
         return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
 
+    def _repr_html_(self) -> str:  # a notebook's view: a row per point with its fit
+        from .reprs import sweep_html
+
+        return sweep_html(self)
+
     def __repr__(self) -> str:
         return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"
 
