@@ -83,7 +83,10 @@ class Result:
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
-    where each came from), else None."""
+    where each came from), else None. ``realizations``: (done, requested);
+    ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
+    in the preset's units (lengths as its spacing, F in modulus x length², per unit
+    depth on a half-plane): curve.csv's header names each column's."""
 
     name: str
     status: str  # completed | cancelled | interrupted | failed
