@@ -167,7 +167,8 @@ class SweepResult:
 
     @property
     def points(self) -> list[Result]:
-        """Each finished point's ``Result``, read from its folder."""
+        """The ``Result`` of each point with a fit, read from its folder: an interrupted
+        point's too (its ``status`` says so); a pending or failed one has none."""
         return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
@@ -303,8 +304,8 @@ def run(
     progress: bool = True,
     memory_check: bool = True,
     **keys: Any,
-) -> Result:
-    """Run a preset and return its ``Result``.
+) -> Result | SweepResult:
+    """Run a preset and return its ``Result`` (a sweep's: its ``SweepResult``).
 
     ``preset``: a path, a built-in's name (``"quickstart"``), YAML text, a dict or a
     ``frictionlab.preset.Preset``. ``overrides`` (second, or ``overrides=``): ``{"spectrum.params.hurst": 0.8}``;
@@ -316,7 +317,7 @@ def run(
     memory. ``plot``: draw plot.png into ``out``. ``workers``, ``executor``,
     ``scheduler``: where realizations run (every core by default; the numbers are the
     same whatever they are). ``progress``: a bar on stderr (on a terminal, or in
-    Jupyter), plain lines elsewhere.
+    Jupyter with ipywidgets: the ``notebook`` extra), plain lines elsewhere.
 
     A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
     point) and returns a ``SweepResult``. Bad input raises a
