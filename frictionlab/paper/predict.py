@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import path_argument
 from ..errors import FrictionlabError, RunFolderError, short_repr
 from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
@@ -223,12 +224,15 @@ def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
 MAX_REALIZATIONS_BYTES = 16 * 1024**3  # realizations.npz: curves of every realization
 
 
-def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
+def read_run_law(
+    run_dir: str | Path, name: str = "run folder"
+) -> tuple[LogFit, tuple[float, float], np.ndarray | None]:
     """The law a run fitted (its summary.json), the range of f it was fitted over, and its
     bootstrap pairs (None without realizations.npz). RunFolderError, naming the file and
-    the field, for a run that did not complete or whose files are damaged."""
-    run_dir = Path(run_dir)
-    summary = _read_summary(run_dir)
+    the field, for a run that did not complete or whose files are damaged; ``name`` says
+    how a message names the folder (the command line: ``--from``)."""
+    run_dir = path_argument(run_dir, "run_dir", "a run folder")
+    summary = _read_summary(run_dir, name)
     path = run_dir / "summary.json"
     status = summary.get("status", "completed")
     if status != "completed":
@@ -280,7 +284,7 @@ def _check_law_within(pairs: np.ndarray | None, law: LogFit, path: Path) -> None
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
     """The run's bootstrap (a, b) pairs, redrawn from realizations.npz with the run's
     seed and resample count: the very pairs behind summary.json's intervals."""
-    run_dir = Path(run_dir)
+    run_dir = path_argument(run_dir, "run_dir", "a run folder")
     summary = _read_summary(run_dir)
     law = _fit_of(summary, run_dir / "summary.json")
     arrays = _read_realizations(run_dir / "realizations.npz", summary)
@@ -293,14 +297,15 @@ def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.n
     return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
 
 
-def _read_summary(run_dir: Path) -> dict:
-    """summary.json of ``--from``, each value checked (``results.read_summary``)."""
+def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
+    """summary.json of the run folder, each value checked (``results.read_summary``); ``name``
+    says how the caller names it (the command line: ``--from``)."""
     if not run_dir.is_dir():  # a file (its summary.json, say) is named as one, not as missing
         what = "not a folder: give the run's folder" if os.path.lexists(run_dir) else "no such folder"
-        raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({what})")
+        raise RunFolderError(f"{name} {run_dir}: no readable summary.json there ({what})")
     if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
         raise RunFolderError(  # a law per point: the user names one
-            f"--from {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
+            f"{name} {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
             f"{run_dir / 'points'}/<NN-label> (frictionlab runs {run_dir / 'points'} lists them)"
         )
     return read_summary(run_dir)[0]

@@ -51,3 +51,12 @@ def test_pairs_of_the_wrong_shape_are_named(pairs, said):
 def test_rms_slope_of_a_wrong_type_is_named():
     with pytest.raises(FrictionlabError, match=r"rms_slope must be a finite number > 0\. Got '0\.1' instead"):
         predict_xi(LAW, force=7.0, rms_slope="0.1", **KW)
+
+
+def test_a_run_folder_from_python_is_named_as_python_names_it(tmp_path):
+    from frictionlab.paper.predict import bootstrap_pairs, read_run_law
+
+    with pytest.raises(FrictionlabError, match=r"^run folder .*nothere: no readable summary\.json there \(no such folder\)$"):
+        bootstrap_pairs(tmp_path / "nothere")  # not '--from', an option of the command line
+    with pytest.raises(FrictionlabError, match=r"^run_dir must be a path to a run folder .*got int$"):
+        read_run_law(3)
