@@ -51,3 +51,20 @@ def test_an_interrupted_run_in_memory_keeps_its_result_on_the_exception(pressed_
     with pytest.raises(frictionlab.RunInterrupted, match="kept in memory only") as caught:
         frictionlab.run(merge(SMALL_PRESET, {"realizations": 40}), workers=1)
     assert caught.value.result.folder is None and caught.value.result.realizations[0] >= 2
+
+
+def test_a_run_pressed_during_its_fit_is_complete_and_still_stops_the_caller(tmp_path, monkeypatch):
+    import frictionlab.compute.ensemble as ensemble
+
+    fit = ensemble.fit_log_law
+
+    def fit_while_pressed(*args, **kwargs):  # every realization done; Ctrl-C as the fit starts
+        os.kill(os.getpid(), signal.SIGINT)
+        return fit(*args, **kwargs)
+
+    monkeypatch.setattr(ensemble, "fit_log_law", fit_while_pressed)
+    with pytest.raises(frictionlab.RunInterrupted) as caught:
+        frictionlab.run(SMALL_PRESET, workers=1, progress=False, out=tmp_path / "run")
+    assert caught.value.result.status == "completed" and caught.value.result.fit is not None
+    assert str(caught.value) == (f"run completed: 8 of 8 realizations finished, kept in {tmp_path / 'run'}; "
+                                 "the exception's .result holds it")  # fmt: skip

@@ -89,7 +89,8 @@ class RunInterrupted(KeyboardInterrupt):
             done = f"{sum(row.get('status') == 'completed' for row in r.rows)} of {len(r.rows)} points"
         else:
             done = f"{r.realizations[0]} of {r.realizations[1]} realizations"
-        kept = f"kept in {shown(r.folder)} (resume=True continues it)" if r.folder else "kept in memory only"
+        kept = f"kept in {shown(r.folder)}" if r.folder else "kept in memory only"
+        kept += " (resume=True continues it)" if r.folder and r.status != "completed" else ""
         return f"run {r.status}: {done} finished, {kept}; the exception's .result holds it"
 
 
