@@ -53,14 +53,15 @@ from .errors import FrictionlabError, PresetError, RunFolderError, require, shor
 from .compute.fit import LogFit
 from .compute.signals import RunInterrupted
 from .options import RunOptions
-from .runs.results import CORRECTED_AREA, read_curve, read_summary
+from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
 from .runs.runfolder import subfolder
 
 if TYPE_CHECKING:
     from .compute.ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "RunInterrupted", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
+__all__ = ["Result", "RunInterrupted", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record",
+           "validate"]  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
@@ -86,7 +87,8 @@ class Result:
     where each came from), else None. ``realizations``: (done, requested);
     ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
     in the preset's units (lengths as its spacing, F in modulus x length², per unit
-    depth on a half-plane): curve.csv's header names each column's."""
+    depth on a half-plane): ``units`` says each column's, as curve.csv's header does
+    (``to_pandas()`` keeps it in ``attrs["units"]``)."""
 
     name: str
     status: str  # completed | cancelled | interrupted | failed
@@ -101,6 +103,7 @@ class Result:
     outcome: RunOutcome | None = field(default=None, repr=False, compare=False)  # in-process runs only
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
     input: dict | None = None
+    units: dict[str, str] = field(default_factory=dict, repr=False, compare=False)  # by column, curve.csv's brackets
 
     @property
     def a(self) -> float:
@@ -117,7 +120,9 @@ class Result:
     def to_pandas(self):
         """The table as a pandas DataFrame, one row per load step (pandas: the ``pandas``
         extra; without it, a ``MissingDependency`` naming it; ``table`` is the same as numpy arrays)."""
-        return require("pandas", "Result.to_pandas()").DataFrame(self.table)
+        frame = require("pandas", "Result.to_pandas()").DataFrame(self.table)
+        frame.attrs["units"] = dict(self.units)
+        return frame
 
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
@@ -429,6 +434,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
         outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
+        units=column_units(curve_headers(scene)),
     )  # fmt: skip
 
 
@@ -447,7 +453,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
     summary, record = read_summary(folder)
     curve_name = record.files.get("curve", "curve.csv")
-    curve = read_curve(folder, curve_name)
+    header, curve = read_curve_table(folder, curve_name)
     loading = summary["preset"].get("loading")
     steps = loading.get("steps") if isinstance(loading, dict) else None
     rows = len(next(iter(curve.values())))
@@ -478,6 +484,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         folder=folder,
         files={key: folder / name for key, name in record.files.items()},
         input=record.input,
+        units=column_units(header),
     )
 
 
