@@ -109,6 +109,15 @@ class Prediction:
         # exceed 1 a little before full contact (a very rough line), so this says "may"
         return self.xi > 1.0
 
+    def __repr__(self) -> str:  # rounded, as a notebook shows it; the fields keep every digit
+        slope = "" if self.slope_contact is None else f", rms slope in contact = {self.slope_contact:.4g}"
+        flags = ", extrapolated" * self.extrapolated + ", xi > 1: may be past full contact" * self.beyond_full_contact
+        return (f"Prediction(f = {self.f:.6g}, xi = {format_number(self.xi)} {format_interval(self.xi_ci)} "
+                f"({100 * self.confidence:g}% CI, {self.interval}){slope}{flags})")  # fmt: skip
+
+    def __str__(self) -> str:  # print(): as ``frictionlab predict`` says it, with its warnings
+        return prediction_text(self)
+
 
 def check_law(
     law: LogFit, names: dict[str, str] | None = None, error: type[FrictionlabError] = FrictionlabError

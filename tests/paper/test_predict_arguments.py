@@ -60,3 +60,13 @@ def test_a_run_folder_from_python_is_named_as_python_names_it(tmp_path):
         bootstrap_pairs(tmp_path / "nothere")  # not '--from', an option of the command line
     with pytest.raises(FrictionlabError, match=r"^run_dir must be a path to a run folder .*got int$"):
         read_run_law(3)
+
+
+def test_a_prediction_shows_rounded_with_its_flags_and_prints_as_the_command_does():
+    from frictionlab.paper.predict import prediction_text
+
+    p = predict_xi(LAW, force=7.0, fitted_f=(1e-3, 1e-1), rms_slope=0.5, **KW)
+    assert repr(p) == (f"Prediction(f = 7e-09, xi = {p.xi:.4f} [{p.xi_ci[0]:.4f}, {p.xi_ci[1]:.4f}] "
+                       f"(95% CI, rectangle of a_ci x b_ci), rms slope in contact = {p.slope_contact:.4g}, extrapolated)")  # fmt: skip
+    assert str(p) == prediction_text(p) and "extrapolated" in str(p)
+    assert p.xi == pytest.approx(2.9 + 0.14 * math.log(p.f), rel=1e-12)  # the field keeps every digit
