@@ -200,7 +200,7 @@ def read_preset_input(
     ``overrides`` may also come as a keyword (no preset has such a key); ``preset`` may not."""
     from .preset import Preset, load_preset_file, set_path
     from .preset.paths import is_dotted_path
-    from .preset.builtin import find_builtin, preset_source, resolve_preset_path
+    from .preset.builtin import locate_preset
     from .preset.reading import resolve_input_paths
     from .io.safe_yaml import YamlProblem, load_yaml
 
@@ -228,9 +228,8 @@ def read_preset_input(
             raise PresetError([f"(text): a preset must be a mapping. Got {type(data).__name__} instead."], "<YAML text>")
         source = "<YAML text>"
     elif isinstance(preset, str | os.PathLike):
-        path = resolve_preset_path(path_argument(preset, "preset", "a preset file, or a built-in's name"))
         # a built-in is named as the CLI names it, not by the installed file the user never touched
-        source = preset_source(preset) if find_builtin(str(preset)) is not None and path != Path(preset) else str(path)
+        path, source = locate_preset(path_argument(preset, "preset", "a preset file, or a built-in's name"))
         try:
             data = load_preset_file(path)
         except PresetError as exc:

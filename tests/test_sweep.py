@@ -451,3 +451,10 @@ def test_a_bare_list_of_values_says_how_to_give_one():
         "sweep.parameters.spectrum.params.hurst: must be a mapping: {values: [...]} for a list, "
         "or {start: ..., stop: ..., num: ...} for a range, got [0.5, 0.8]"
     ]
+
+
+def test_load_sweep_takes_a_built_ins_name_and_names_it_so():
+    sweep = load_sweep("benad2012-fig5", ["realizations=2"])
+    assert len(sweep.points) == 8
+    with pytest.raises(PresetError, match=r"^built-in preset 'benad2012-fig5': 1 problem"):
+        load_sweep("benad2012-fig5", ["realizations=0"])

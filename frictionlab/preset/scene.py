@@ -316,8 +316,7 @@ def load_scene(
 ) -> Scene:
     """A preset file, or a built-in's name (``"quickstart"``), with ``--set`` overrides
     (``["spectrum.params.hurst=0.5"]``) applied -> validated Scene."""
-    from .builtin import preset_source, resolve_preset_path
+    from .builtin import locate_preset
 
-    resolved = resolve_preset_path(path)
-    source = preset_source(path) if resolved != Path(path) else str(path)
+    resolved, source = locate_preset(path)
     return build_scene(read_preset(resolved, overrides, registry), registry=registry, source=source)

@@ -228,8 +228,12 @@ def check_sweep_memory(sweep: Sweep, options: RunOptions) -> None:
 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
-    """File -> overrides -> planned Sweep (the preset must have a sweep section)."""
-    return plan_sweep(read_preset(path, list(overrides), registry), registry=registry, source=str(path))
+    """A preset file, or a built-in's name (``"benad2012-fig5"``), with ``--set`` overrides
+    applied -> planned Sweep (the preset must have a sweep section)."""
+    from ..preset.builtin import locate_preset
+
+    resolved, source = locate_preset(path)
+    return plan_sweep(read_preset(resolved, list(overrides), registry), registry=registry, source=source)
 
 
 # ------------------------------------------------------------------ running
