@@ -458,3 +458,19 @@ def test_load_sweep_takes_a_built_ins_name_and_names_it_so():
     assert len(sweep.points) == 8
     with pytest.raises(PresetError, match=r"^built-in preset 'benad2012-fig5': 1 problem"):
         load_sweep("benad2012-fig5", ["realizations=0"])
+
+
+def test_a_point_and_its_result_read_as_a_notebook_needs(tmp_path):
+    finished = []
+
+    class Listener(SweepListener):
+        def point_finished(self, sweep, point, result):
+            finished.append((repr(point), result.fit, result.outcome.fit))
+
+    sweep = plan_sweep(sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.8]}}))
+    run_sweep(sweep, tmp_path / "sweep", RunOptions(workers=1), listeners=[Listener()], plot=False)
+    assert [shown for shown, _, _ in finished] == [
+        "<SweepPoint 1: spectrum.params.hurst=0.5, folder '01-hurst-0.5'>",
+        "<SweepPoint 2: spectrum.params.hurst=0.8, folder '02-hurst-0.8'>",
+    ]
+    assert all(fit is not None and fit == own for _, fit, own in finished)

@@ -73,6 +73,9 @@ class SweepPoint:
     def describe(self) -> str:
         return ", ".join(self.assignments)
 
+    def __repr__(self) -> str:  # its scene, every default filled in, is too long to read
+        return f"<SweepPoint {self.number}: {self.describe()}, folder {self.folder_name!r}>"
+
 
 @dataclass(frozen=True)
 class Sweep:
@@ -249,6 +252,11 @@ class PointResult:
     outcome: Any = None  # ensemble.RunOutcome
     error: str | None = None
     recorded: dict[str, Any] | None = None  # a row read back (a followed sweep's): stands for ``outcome``
+
+    @property
+    def fit(self) -> LogFit | None:
+        """The point's fit of xi = a + b ln f; None where it has none (or only a row read back)."""
+        return None if self.outcome is None else self.outcome.fit
 
     def row(self) -> dict[str, Any]:
         if self.recorded is not None:
