@@ -30,7 +30,7 @@ _LAZY = {
         ),
         "plugin",
     ),  # fmt: skip
-    **dict.fromkeys(("run", "load", "validate", "Result", "SweepResult"), "api"),
+    **dict.fromkeys(("run", "load", "validate", "Result", "RunInterrupted", "SweepResult"), "api"),
 }
 
 
@@ -124,6 +124,7 @@ __all__ = [
     "PluginParams",
     "Profile",
     "Result",
+    "RunInterrupted",
     "RunListener",
     "RunOptions",
     "SlopeEstimator",

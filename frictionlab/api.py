@@ -51,15 +51,17 @@ import numpy as np
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
 from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown
 from .compute.fit import LogFit
+from .compute.signals import RunInterrupted
 from .options import RunOptions
-from .runs.results import CORRECTED_AREA, read_curve, read_summary
+from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
 from .runs.runfolder import subfolder
 
 if TYPE_CHECKING:
     from .compute.ensemble import RunOutcome
     from .preset import Preset, Scene
 
-__all__ = ["Result", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record", "validate"]
+__all__ = ["Result", "RunInterrupted", "SweepResult", "load", "read_preset_input", "run", "run_scene", "scene_record",
+           "validate"]  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its arrays have no single truth value
@@ -82,7 +84,11 @@ class Result:
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
-    where each came from), else None."""
+    where each came from), else None. ``realizations``: (done, requested);
+    ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
+    in the preset's units (lengths as its spacing, F in modulus x length², per unit
+    depth on a half-plane): ``units`` says each column's, as curve.csv's header does
+    (``to_pandas()`` keeps it in ``attrs["units"]``)."""
 
     name: str
     status: str  # completed | cancelled | interrupted | failed
@@ -97,6 +103,7 @@ class Result:
     outcome: RunOutcome | None = field(default=None, repr=False, compare=False)  # in-process runs only
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
     input: dict | None = None
+    units: dict[str, str] = field(default_factory=dict, repr=False, compare=False)  # by column, curve.csv's brackets
 
     @property
     def a(self) -> float:
@@ -113,7 +120,9 @@ class Result:
     def to_pandas(self):
         """The table as a pandas DataFrame, one row per load step (pandas: the ``pandas``
         extra; without it, a ``MissingDependency`` naming it; ``table`` is the same as numpy arrays)."""
-        return require("pandas", "Result.to_pandas()").DataFrame(self.table)
+        frame = require("pandas", "Result.to_pandas()").DataFrame(self.table)
+        frame.attrs["units"] = dict(self.units)
+        return frame
 
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
@@ -163,13 +172,19 @@ class SweepResult:
 
     @property
     def points(self) -> list[Result]:
-        """Each finished point's ``Result``, read from its folder."""
+        """The ``Result`` of each point with a fit, read from its folder: an interrupted
+        point's too (its ``status`` says so); a pending or failed one has none."""
         return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
 
     def to_pandas(self):
         """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
         return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
+
+    def _repr_html_(self) -> str:  # a notebook's view: a row per point with its fit
+        from .reprs import sweep_html
+
+        return sweep_html(self)
 
     def __repr__(self) -> str:
         return f"<SweepResult {self.name!r}: {self.status}, {len(self.rows)} points over {', '.join(self.parameters)}>"
@@ -185,7 +200,7 @@ def read_preset_input(
     ``overrides`` may also come as a keyword (no preset has such a key); ``preset`` may not."""
     from .preset import Preset, load_preset_file, set_path
     from .preset.paths import is_dotted_path
-    from .preset.builtin import find_builtin, preset_source, resolve_preset_path
+    from .preset.builtin import locate_preset
     from .preset.reading import resolve_input_paths
     from .io.safe_yaml import YamlProblem, load_yaml
 
@@ -213,9 +228,8 @@ def read_preset_input(
             raise PresetError([f"(text): a preset must be a mapping. Got {type(data).__name__} instead."], "<YAML text>")
         source = "<YAML text>"
     elif isinstance(preset, str | os.PathLike):
-        path = resolve_preset_path(path_argument(preset, "preset", "a preset file, or a built-in's name"))
         # a built-in is named as the CLI names it, not by the installed file the user never touched
-        source = preset_source(preset) if find_builtin(str(preset)) is not None and path != Path(preset) else str(path)
+        path, source = locate_preset(path_argument(preset, "preset", "a preset file, or a built-in's name"))
         try:
             data = load_preset_file(path)
         except PresetError as exc:
@@ -294,8 +308,8 @@ def run(
     progress: bool = True,
     memory_check: bool = True,
     **keys: Any,
-) -> Result:
-    """Run a preset and return its ``Result``.
+) -> Result | SweepResult:
+    """Run a preset and return its ``Result`` (a sweep's: its ``SweepResult``).
 
     ``preset``: a path, a built-in's name (``"quickstart"``), YAML text, a dict or a
     ``frictionlab.preset.Preset``. ``overrides`` (second, or ``overrides=``): ``{"spectrum.params.hurst": 0.8}``;
@@ -307,7 +321,7 @@ def run(
     memory. ``plot``: draw plot.png into ``out``. ``workers``, ``executor``,
     ``scheduler``: where realizations run (every core by default; the numbers are the
     same whatever they are). ``progress``: a bar on stderr (on a terminal, or in
-    Jupyter), plain lines elsewhere.
+    Jupyter with ipywidgets: the ``notebook`` extra), plain lines elsewhere.
 
     A preset with a ``sweep`` runs every point into ``out`` (required: a folder per
     point) and returns a ``SweepResult``. Bad input raises a
@@ -316,7 +330,22 @@ def run(
     preset, the overrides) is held to a preset file's limits: 64 levels of nesting,
     20,000 values. A built-in preset is named as the command line names it
     (``built-in preset 'quickstart'``).
+
+    Ctrl-C (in Jupyter, interrupting the kernel) stops the run within about a second,
+    keeps what finished (in ``out``, resumable) and raises ``RunInterrupted``, a
+    ``KeyboardInterrupt`` whose ``result`` is the run as it ended: a cell or a loop of
+    runs stops there too.
     """
+    from .compute.signals import interrupted_since, mark
+
+    seen = mark()
+    result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
+    if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
+        raise RunInterrupted(result)
+    return result
+
+
+def _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys):
     from .preset import build_scene
     from .progress import ProgressReporter, SweepProgress
     from .runs.runner import memory_check_before_reading
@@ -404,6 +433,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
         outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
+        units=column_units(curve_headers(scene)),
     )  # fmt: skip
 
 
@@ -422,7 +452,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         raise RunFolderError(f"{shown(folder)}: no summary.json (nor sweep.json){where}: not a finished run")
     summary, record = read_summary(folder)
     curve_name = record.files.get("curve", "curve.csv")
-    curve = read_curve(folder, curve_name)
+    header, curve = read_curve_table(folder, curve_name)
     loading = summary["preset"].get("loading")
     steps = loading.get("steps") if isinstance(loading, dict) else None
     rows = len(next(iter(curve.values())))
@@ -453,6 +483,7 @@ def load(folder: str | Path) -> Result | SweepResult:
         folder=folder,
         files={key: folder / name for key, name in record.files.items()},
         input=record.input,
+        units=column_units(header),
     )
 
 

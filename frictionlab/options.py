@@ -9,6 +9,7 @@ results whatever the workers, the executor or a resume.
 
 from __future__ import annotations
 
+import numbers
 import os
 from dataclasses import dataclass
 
@@ -39,6 +40,10 @@ class RunOptions:
     force: bool = False  # write into a folder that is not a run of this preset
 
     def __post_init__(self):
+        for name in ("workers", "retries"):  # numpy's integers (np.int64 of an arange) are whole numbers too
+            value = getattr(self, name)
+            if isinstance(value, numbers.Integral) and not isinstance(value, bool | int):
+                object.__setattr__(self, name, int(value))
         if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)):
             raise FrictionlabError(f"workers must be a whole number >= 1. Got {short_repr(self.workers)} instead.")
         if self.workers is not None and self.workers < 1:

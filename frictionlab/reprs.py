@@ -1,5 +1,6 @@
 """How a run's result shows in a notebook (``Result._repr_html_``): the fit as a table
-with its intervals, rounded as the CLI prints it, and the curve as an inline image.
+with its intervals, rounded as the CLI prints it, and the curve as an inline image; a
+sweep's (``SweepResult._repr_html_``): a row per point, its values and its fit.
 Every text is escaped: a preset's name or a caveat is data, not markup."""
 
 from __future__ import annotations
@@ -45,8 +46,34 @@ def result_html(result) -> str:
     return "<div>" + "".join(parts) + "</div>"
 
 
-def _number(value: float) -> str:
-    return format_number(value) if math.isfinite(value) else "n/a"
+def sweep_html(sweep) -> str:
+    """A ``frictionlab.SweepResult`` as HTML: status, and a row per point with a and b in their intervals."""
+    head = "".join(f"<th>{html.escape(name)}</th>" for name in ("point", *sweep.parameters, "status", "a", "b", "R²"))
+    rows = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
+            row.get("point"), *(row.get(name) for name in sweep.parameters), row.get("status"),
+            _estimate(row, "a"), _estimate(row, "b"), _number(row.get("r2")),
+        )) + "</tr>"
+        for row in sweep.rows
+    )  # fmt: skip
+    return (
+        f"<div><p><strong>{html.escape(sweep.name)}</strong>: sweep {html.escape(sweep.status)}, "
+        f"{len(sweep.rows)} points in {sweep.elapsed:.2f} s; xi = a + b ln f at each</p>"
+        f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>"
+        f"<p>results in <code>{html.escape(str(sweep.folder))}</code> (points/: a run folder each)</p></div>"
+    )
+
+
+def _estimate(row: dict, name: str) -> str:
+    """A point's a or b with its interval, as sweep.csv holds them (None where unknown)."""
+    value = row.get(name)
+    if value is None:
+        return "n/a"
+    return f"{format_number(value)} {format_interval((row.get(name + '_lo'), row.get(name + '_hi')))}"
+
+
+def _number(value: float | None) -> str:
+    return format_number(value) if value is not None and math.isfinite(value) else "n/a"
 
 
 def _curve_png(result) -> str:

@@ -310,3 +310,13 @@ def test_load_reads_a_folder_written_before_the_lines_used_column(tmp_path):
     curve.write_text("\n".join(",".join([r[1], r[0], *r[2:]]) for r in rows) + "\n")
     with pytest.raises(RunFolderError, match="is damaged"):
         frictionlab.load(folder)
+
+
+def test_the_units_of_the_columns_are_curve_csvs_in_memory_on_disk_and_in_pandas(tmp_path):
+    result = frictionlab.run(SMALL_PRESET, out=tmp_path / "run", plot=False, **FAST)
+    header = (tmp_path / "run" / "curve.csv").read_text().splitlines()[0]
+    assert f"F [{result.units['F']}]" in header and f"indentation [{result.units['indentation']}]" in header
+    assert result.units["F"] == "force: modulus x length^2" and result.units["indentation"].startswith("length")
+    assert frictionlab.load(tmp_path / "run").units == result.units
+    assert frictionlab.run(SMALL_PRESET, **FAST).units == result.units  # kept in memory: the same
+    assert result.to_pandas().attrs["units"] == result.units

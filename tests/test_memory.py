@@ -486,3 +486,12 @@ def test_a_run_on_one_worker_is_not_advised_one_worker(registry, monkeypatch):
         memory.check_fits(scene, workers=1, executor="processes")
     assert "--workers" not in caught.value.args[0]
     assert_offer_is_the_most_that_fits(scene, caught.value.args[0])
+
+
+def test_a_refusal_in_python_names_the_keyword_that_skips_it():
+    import frictionlab
+
+    with pytest.raises(RunError) as caught:
+        frictionlab.run(SMALL_PRESET, spectrum__params__points=2**40, workers=1, progress=False)
+    assert "frictionlab.run memory_check=False, to skip this estimate" in str(caught.value)
+    assert frictionlab.run(SMALL_PRESET, workers=1, progress=False, memory_check=False).status == "completed"

@@ -83,3 +83,21 @@ def test_a_fit_shows_rounded_and_keeps_its_exact_numbers():
     assert not re.search(r"\d{6}", text)  # no 16-digit floats
     assert fit.a == 1.127512345678  # the field itself is exact
     assert "n/a" in repr(LogFit(2.0, 0.1)) and math.isnan(LogFit(2.0, 0.1).r2)
+
+
+def test_a_law_given_by_hand_shows_no_fitted_r2_or_points():
+    text = repr(LogFit(1.1, 0.03, a_ci=(1.0, 1.2), b_ci=(0.02, 0.04)))
+    assert text == "LogFit(a = 1.1000 [1.0000, 1.2000], b = 0.0300 [0.0200, 0.0400] (95% CI))"
+
+
+def test_a_sweeps_html_is_a_row_per_point_with_its_values_and_fit(tmp_path):
+    preset = {**SMALL_PRESET, "sweep": {"mode": "grid", "parameters": {"spectrum.params.hurst": {"values": [0.5, 0.8]}}}}
+    sweep = frictionlab.run(preset, out=tmp_path / "sweep", plot=False, **FAST)
+    cells = parsed(sweep._repr_html_()).cells
+    assert cells[:6] == ["point", "spectrum.params.hurst", "status", "a", "b", "R²"]
+    for row, shown in zip(sweep.rows, (cells[6:12], cells[12:18]), strict=True):
+        a = f"{row['a']:.4f} [{row['a_lo']:.4f}, {row['a_hi']:.4f}]"
+        assert shown == [str(row["point"]), str(row["spectrum.params.hurst"]), "completed", a,
+                         f"{row['b']:.4f} [{row['b_lo']:.4f}, {row['b_hi']:.4f}]", f"{row['r2']:.4f}"]  # fmt: skip
+    pending = dataclasses.replace(sweep, rows=[{**sweep.rows[0], "status": "pending", "a": None, "r2": None}])
+    assert parsed(pending._repr_html_()).cells[6:] == ["1", "0.5", "pending", "n/a", cells[10], "n/a"]

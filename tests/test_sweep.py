@@ -442,3 +442,35 @@ def test_the_clis_memory_refusal_of_a_sweep_names_the_point(tmp_path, monkeypatc
     err = capsys.readouterr().err
     assert err.startswith("error: sweep point 2 (spectrum.params.points=30000000): this run would need about")
     assert "the memory of a test" in err and not (tmp_path / "out").exists()
+
+
+def test_a_bare_list_of_values_says_how_to_give_one():
+    with pytest.raises(PresetError) as caught:
+        plan_sweep(sweep_preset({"spectrum.params.hurst": [0.5, 0.8]}))
+    assert caught.value.problems == [
+        "sweep.parameters.spectrum.params.hurst: must be a mapping: {values: [...]} for a list, "
+        "or {start: ..., stop: ..., num: ...} for a range, got [0.5, 0.8]"
+    ]
+
+
+def test_load_sweep_takes_a_built_ins_name_and_names_it_so():
+    sweep = load_sweep("benad2012-fig5", ["realizations=2"])
+    assert len(sweep.points) == 8
+    with pytest.raises(PresetError, match=r"^built-in preset 'benad2012-fig5': 1 problem"):
+        load_sweep("benad2012-fig5", ["realizations=0"])
+
+
+def test_a_point_and_its_result_read_as_a_notebook_needs(tmp_path):
+    finished = []
+
+    class Listener(SweepListener):
+        def point_finished(self, sweep, point, result):
+            finished.append((repr(point), result.fit, result.outcome.fit))
+
+    sweep = plan_sweep(sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.8]}}))
+    run_sweep(sweep, tmp_path / "sweep", RunOptions(workers=1), listeners=[Listener()], plot=False)
+    assert [shown for shown, _, _ in finished] == [
+        "<SweepPoint 1: spectrum.params.hurst=0.5, folder '01-hurst-0.5'>",
+        "<SweepPoint 2: spectrum.params.hurst=0.8, folder '02-hurst-0.8'>",
+    ]
+    assert all(fit is not None and fit == own for _, fit, own in finished)

@@ -43,7 +43,7 @@ def run(args) -> ExitCode:
                 f"give either --from RUN_DIR or the law by hand, not both: {', '.join(given)} with --from "
                 "(the run's summary.json holds its law, intervals and confidence)"
             )
-        law, fitted_f, pairs = read_run_law(args.from_run)
+        law, fitted_f, pairs = read_run_law(args.from_run, "--from")
     else:
         if args.a is None or args.b is None:
             raise FrictionlabError("give the law: --a A --b B (with --a-ci/--b-ci for an interval), or --from RUN_DIR")

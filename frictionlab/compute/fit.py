@@ -84,10 +84,8 @@ class LogFit:
 
     def __repr__(self) -> str:  # rounded as the CLI prints a fit; the exact numbers are the fields
         level = f"{100 * self.confidence:g}% CI" + (f", bootstrap {self.bootstrap}" if self.bootstrap else "")
-        return (
-            f"LogFit(a = {format_estimate(self.a, self.a_ci)}, b = {format_estimate(self.b, self.b_ci)} ({level}); "
-            f"R² = {format_number(self.r2)}, {self.points} points)"
-        )
+        fitted = f"; R² = {format_number(self.r2)}, {self.points} points" if self.points else ""  # else a law given by hand
+        return f"LogFit(a = {format_estimate(self.a, self.a_ci)}, b = {format_estimate(self.b, self.b_ci)} ({level}){fitted})"
 
 
 def json_safe(value):

@@ -33,7 +33,9 @@ from ..preset import Scene
 
 MiB = 2**20
 GiB = 2**30
-SKIP_HINT = "(run and resume take --no-memory-check to skip this estimate, an upper bound.)"  # validate and study do not
+SKIP_HINT = (  # validate and study do not
+    "(run and resume take --no-memory-check, frictionlab.run memory_check=False, to skip this estimate, an upper bound.)"
+)
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays

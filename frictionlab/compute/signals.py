@@ -15,7 +15,7 @@ from __future__ import annotations
 import signal
 import threading
 
-from ..errors import ExitCode
+from ..errors import ExitCode, shown
 
 HANDLED = (signal.SIGINT, signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else []))  # no SIGHUP on Windows
 ENDINGS = {signal.SIGINT: (ExitCode.INTERRUPTED, "interrupted"), signal.SIGTERM: (ExitCode.TERMINATED, "terminated")}
@@ -71,6 +71,27 @@ def interrupted_since(seen: int) -> bool:
 class WorkInterrupted(KeyboardInterrupt):
     """A command of several runs (report, exact3d) stops after a run that ended
     interrupted: the finished runs are kept; ``str()`` says where, and how to go on."""
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """``frictionlab.run`` stopped by Ctrl-C, a notebook's interrupt or SIGTERM: raised once
+    what finished is written, so that a cell or a loop of runs stops there too. ``result``
+    holds the ``Result`` (or ``SweepResult``) as it ended (in a notebook, after the cell:
+    ``sys.last_value.result``); ``resume=True`` into its folder continues it."""
+
+    def __init__(self, result):
+        super().__init__(result)
+        self.result = result
+
+    def __str__(self) -> str:
+        r = self.result
+        if hasattr(r, "rows"):  # a sweep's
+            done = f"{sum(row.get('status') == 'completed' for row in r.rows)} of {len(r.rows)} points"
+        else:
+            done = f"{r.realizations[0]} of {r.realizations[1]} realizations"
+        kept = f"kept in {shown(r.folder)}" if r.folder else "kept in memory only"
+        kept += " (resume=True continues it)" if r.folder and r.status != "completed" else ""
+        return f"run {r.status}: {done} finished, {kept}; the exception's .result holds it"
 
 
 _in_command = False  # within RaiseOnSignals: a signal received ends the command, not only its run

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import io
 import math
+import numbers
 import os
 import sys
 import zipfile
@@ -30,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import path_argument
 from ..errors import FrictionlabError, RunFolderError, short_repr
 from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
@@ -52,8 +54,7 @@ def dimensionless_force_3d(
     (beyond about 1e-308 .. 1e308) is a FrictionlabError naming the four inputs (as ``names``
     spells them: ``{"rms_height": "--rms-height"}``)."""
     for name, value in (("force", force), ("modulus", modulus), ("rms_height", rms_height), ("area", area)):
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-            raise FrictionlabError(f"{(names or {}).get(name, name)} must be a finite number > 0. Got {value!r} instead.")
+        _check_positive(value, (names or {}).get(name, name))
     force, modulus, rms_height, area = (float(v) for v in (force, modulus, rms_height, area))
     unit = MDR_OF_A_SURFACE.force_unit(modulus, rms_height, mdr_length(area))
     f = force / unit if unit > 0 else math.inf
@@ -69,6 +70,16 @@ def dimensionless_force_3d(
             "give them in one consistent system of units"
         )
     return f
+
+
+def _is_number(value) -> bool:
+    """A real number, numpy's scalars too (a value read from a table is np.float64 or np.int64), not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+
+
+def _check_positive(value, name: str) -> None:
+    if not (_is_number(value) and math.isfinite(value) and value > 0):
+        raise FrictionlabError(f"{name} must be a finite number > 0. Got {short_repr(value)} instead.")
 
 
 def _normal(value: float) -> bool:
@@ -98,6 +109,15 @@ class Prediction:
         # exceed 1 a little before full contact (a very rough line), so this says "may"
         return self.xi > 1.0
 
+    def __repr__(self) -> str:  # rounded, as a notebook shows it; the fields keep every digit
+        slope = "" if self.slope_contact is None else f", rms slope in contact = {self.slope_contact:.4g}"
+        flags = ", extrapolated" * self.extrapolated + ", xi > 1: may be past full contact" * self.beyond_full_contact
+        return (f"Prediction(f = {self.f:.6g}, xi = {format_number(self.xi)} {format_interval(self.xi_ci)} "
+                f"({100 * self.confidence:g}% CI, {self.interval}){slope}{flags})")  # fmt: skip
+
+    def __str__(self) -> str:  # print(): as ``frictionlab predict`` says it, with its warnings
+        return prediction_text(self)
+
 
 def check_law(
     law: LogFit, names: dict[str, str] | None = None, error: type[FrictionlabError] = FrictionlabError
@@ -111,20 +131,26 @@ def check_law(
     def name(field: str) -> str:
         return names.get(field, field)
 
+    if not isinstance(law, LogFit):  # a run's r.fit is None when no realization finished
+        why = " (a run's fit is None when no realization finished)" if law is None else ""
+        raise error(f"law must be a frictionlab.compute.fit.LogFit, e.g. LogFit(a, b, a_ci=(lo, hi), "
+                    f"b_ci=(lo, hi)). Got {type(law).__name__}{why} instead.")  # fmt: skip
     for field in ("a", "b"):
         value = getattr(law, field)
-        if not math.isfinite(value):
+        if not (_is_number(value) and math.isfinite(value)):
             raise error(f"{name(field)} must be a finite number. Got {value!r} instead.")
-    if not (0 < law.confidence < 1):
+    if not (_is_number(law.confidence) and 0 < law.confidence < 1):
         raise error(
             f"{name('confidence')} must be a number between 0 and 1 (exclusive). Got {law.confidence!r} instead."
         )
     for field in ("a_ci", "b_ci"):
-        low, high = getattr(law, field)
-        if math.isnan(low) and math.isnan(high):
+        value = getattr(law, field)
+        pair = isinstance(value, tuple | list) and len(value) == 2 and all(map(_is_number, value))
+        if pair and math.isnan(value[0]) and math.isnan(value[1]):
             continue
-        if not (math.isfinite(low) and math.isfinite(high) and low <= high):
-            raise error(f"{name(field)} must be two finite numbers LO <= HI. Got {low!r}, {high!r} instead.")
+        if not (pair and math.isfinite(value[0]) and math.isfinite(value[1]) and value[0] <= value[1]):
+            got = f"{value[0]!r}, {value[1]!r}" if pair else short_repr(value)
+            raise error(f"{name(field)} must be two finite numbers LO <= HI. Got {got} instead.")
 
 
 def predict_xi(
@@ -145,16 +171,14 @@ def predict_xi(
     refuses, and for numbers that leave double precision (every number returned is finite
     but an unknown interval, NaN)."""
     check_law(law)
-    if rms_slope is not None and not (math.isfinite(rms_slope) and rms_slope > 0):
-        raise FrictionlabError(
-            f"{(names or {}).get('rms_slope', 'rms_slope')} must be a finite number > 0. Got {rms_slope!r} instead."
-        )
+    if rms_slope is not None:
+        _check_positive(rms_slope, (names or {}).get("rms_slope", "rms_slope"))
     f = dimensionless_force_3d(force, modulus, rms_height, area, names)
+    pairs = None if pairs is None else _pairs_argument(pairs)
     ln_f = math.log(f)
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, by name
         xi = law.a + law.b * ln_f
         if pairs is not None and len(pairs):
-            pairs = np.asarray(pairs, float)
             low, high = percentile_interval(pairs[:, 0] + pairs[:, 1] * ln_f, law.confidence)
             ci, how = (float(low), float(high)), "bootstrap pairs"
         elif all(math.isfinite(v) for v in (*law.a_ci, *law.b_ci)):
@@ -176,6 +200,24 @@ def predict_xi(
     return Prediction(f, xi, ci, how, law.confidence, fitted_f, rms_slope, slope, slope_ci)
 
 
+def _pairs_argument(pairs) -> np.ndarray:
+    """The bootstrap (a, b) pairs as an (n, 2) array of finite numbers (``bootstrap_pairs`` gives them)."""
+    try:
+        array = np.asarray(pairs, dtype=float)
+    except (TypeError, ValueError):
+        array = None
+    if array is None:
+        got = type(pairs).__name__
+    elif array.ndim != 2 or array.shape[1] != 2:
+        got = f"shape {array.shape}"
+    elif not np.isfinite(array).all():
+        got = f"{np.count_nonzero(~np.isfinite(array))} values that are not finite"
+    else:
+        return array
+    raise FrictionlabError(f"pairs must be bootstrap (a, b) pairs: an array of shape (n, 2) of finite numbers, "
+                           f"as bootstrap_pairs(run folder) gives. Got {got} instead.")  # fmt: skip
+
+
 def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
     if not math.isfinite(value):
         raise FrictionlabError(
@@ -191,12 +233,15 @@ def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
 MAX_REALIZATIONS_BYTES = 16 * 1024**3  # realizations.npz: curves of every realization
 
 
-def read_run_law(run_dir: str | Path) -> tuple[LogFit, tuple[float, float] | None, np.ndarray | None]:
+def read_run_law(
+    run_dir: str | Path, name: str = "run folder"
+) -> tuple[LogFit, tuple[float, float] | None, np.ndarray | None]:
     """The law a run fitted (its summary.json), the range of f it was fitted over (None when
-    unknown), and its bootstrap pairs (None without realizations.npz). RunFolderError, naming the file and
-    the field, for a run that did not complete or whose files are damaged."""
-    run_dir = Path(run_dir)
-    summary = _read_summary(run_dir)
+    unknown), and its bootstrap pairs (None without realizations.npz). RunFolderError, naming
+    the file and the field, for a run that did not complete or whose files are damaged;
+    ``name`` says how a message names the folder (the command line: ``--from``)."""
+    run_dir = path_argument(run_dir, "run_dir", "a run folder")
+    summary = _read_summary(run_dir, name)
     path = run_dir / "summary.json"
     status = summary.get("status", "completed")
     if status != "completed":
@@ -257,7 +302,7 @@ def _check_law_within(pairs: np.ndarray | None, law: LogFit, path: Path) -> None
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
     """The run's bootstrap (a, b) pairs, redrawn from realizations.npz with the run's
     seed and resample count: the very pairs behind summary.json's intervals."""
-    run_dir = Path(run_dir)
+    run_dir = path_argument(run_dir, "run_dir", "a run folder")
     summary = _read_summary(run_dir)
     law = _fit_of(summary, run_dir / "summary.json")
     arrays = _read_realizations(run_dir / "realizations.npz", summary)
@@ -270,14 +315,15 @@ def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.n
     return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
 
 
-def _read_summary(run_dir: Path) -> dict:
-    """summary.json of ``--from``, each value checked (``results.read_summary``)."""
+def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
+    """summary.json of the run folder, each value checked (``results.read_summary``); ``name``
+    says how the caller names it (the command line: ``--from``)."""
     if not run_dir.is_dir():  # a file (its summary.json, say) is named as one, not as missing
         what = "not a folder: give the run's folder" if os.path.lexists(run_dir) else "no such folder"
-        raise RunFolderError(f"--from {run_dir}: no readable summary.json there ({what})")
+        raise RunFolderError(f"{name} {run_dir}: no readable summary.json there ({what})")
     if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
         raise RunFolderError(  # a law per point: the user names one
-            f"--from {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
+            f"{name} {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
             f"{run_dir / 'points'}/<NN-label> (frictionlab runs {run_dir / 'points'} lists them)"
         )
     return read_summary(run_dir)[0]

@@ -128,6 +128,13 @@ def _one_line(description: str) -> str:
     return line
 
 
+def locate_preset(argument: str | Path) -> tuple[Path, str]:
+    """The preset file ``argument`` means (``resolve_preset_path``) and how a message names
+    it: as given, a built-in by its name (``preset_source``)."""
+    path = resolve_preset_path(argument)
+    return path, preset_source(argument) if path != Path(argument) else str(argument)
+
+
 def preset_source(argument: str | Path, overrides=()) -> str:
     """How a message names a preset: as the user gave it (a path, or a built-in's name,
     never the installed file they did not touch), with the ``--set`` overrides they

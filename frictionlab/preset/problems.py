@@ -14,7 +14,7 @@ from pydantic import BaseModel, ValidationError
 from ..errors import close_names, did_you_mean, short_repr
 from ..plugin import MAX_MAGNITUDE
 from ..io.safe_yaml import past_double_precision
-from .schema import NAME_PATTERN, NAME_RULE
+from .schema import NAME_PATTERN, NAME_RULE, SweepParameter
 
 
 FIELD_CUTOFF = 0.7  # field names are short and alike (seed, sweep; stop, steps): only a near miss is a guess
@@ -91,6 +91,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
     if kind in {"string_type"}:
         return "must be text"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:
+        if _model_at(model, tuple(error["loc"])) is SweepParameter:  # a bare list is the likely slip
+            return "must be a mapping: {values: [...]} for a list, or {start: ..., stop: ..., num: ...} for a range"
         return "must be a mapping of keys to values"
     if kind in {"list_type", "tuple_type"}:
         return "must be a list"

@@ -314,5 +314,9 @@ def _plugin_problems(registry: Registry, slot: str, choice: PluginChoice):
 def load_scene(
     path: str | Path, overrides: list[str] = (), registry: Registry | None = None
 ) -> Scene:
-    """File -> overrides -> validated Scene."""
-    return build_scene(read_preset(path, overrides, registry), registry=registry, source=str(path))
+    """A preset file, or a built-in's name (``"quickstart"``), with ``--set`` overrides
+    (``["spectrum.params.hurst=0.5"]``) applied -> validated Scene."""
+    from .builtin import locate_preset
+
+    resolved, source = locate_preset(path)
+    return build_scene(read_preset(resolved, overrides, registry), registry=registry, source=source)

@@ -177,6 +177,11 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     """A run folder's curve.csv read back (``runfolder``: inside the folder, never
     through a link): each column by its short name (``column_name``), empty cells as
     NaN. RunFolderError naming the file for anything but the table frictionlab writes."""
+    return read_curve_table(folder, name)[1]
+
+
+def read_curve_table(folder: Path, name: str = "curve.csv") -> tuple[list[str], dict[str, np.ndarray]]:
+    """``read_curve``, with the header row as written."""
     header, rows = read_number_table(folder, name)
     names = [column_name(h) for h in header]
     stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
@@ -191,7 +196,7 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
     table = np.array(rows, dtype=float).reshape(len(rows), len(names))
     curve = {n: table[:, i].copy() for i, n in enumerate(names)}
     _check_counts(curve, Path(folder) / name)
-    return curve
+    return header, curve
 
 
 def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
@@ -301,12 +306,23 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
     return data, record
 
 
-def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
-    writer = csv.writer(fh, lineterminator="\n")
+def curve_headers(scene: Scene) -> list[str]:
+    """curve.csv's whole header row: ``curve_header``, then the columns the solver adds."""
     corrected = [CORRECTED_AREA_HEADER] if scene.solver.corrected_area else []
     gradient = list(GRADIENT_COLUMNS.values()) if scene.solver.real_gradient else []
     spots = [SPOTS_HEADER] if scene.solver.counts_spots else []
-    writer.writerow(curve_header(scene) + corrected + gradient + spots)
+    return curve_header(scene) + corrected + gradient + spots
+
+
+def column_units(headers: list[str]) -> dict[str, str]:
+    """What each column is, in its unit, by short name (``F`` of ``F' [...]`` too):
+    the brackets of curve.csv's header, for the columns that have them."""
+    return {column_name(h).rstrip("'"): h.split(" [", 1)[1].removesuffix("]") for h in headers if " [" in h}
+
+
+def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
+    writer = csv.writer(fh, lineterminator="\n")
+    writer.writerow(curve_headers(scene))
     columns = (
         outcome.force,
         outcome.f,
@@ -318,11 +334,11 @@ def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
         outcome.indentation,
         outcome.half_load_points if outcome.half_load_points is not None else np.full(outcome.f.size, np.nan),
     )
-    if corrected:
+    if scene.solver.corrected_area:
         columns = (*columns, outcome.real_area_corrected)
-    if gradient:
+    if scene.solver.real_gradient:
         columns = (*columns, outcome.real_gradient_rms, outcome.kappa, outcome.kappa_r)
-    if spots:
+    if scene.solver.counts_spots:
         columns = (*columns, outcome.contact_spots)
 
     plain = [np.asarray(column, dtype=float).tolist() for column in columns]  # Python floats: no numpy scalar per cell

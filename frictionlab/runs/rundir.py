@@ -30,13 +30,12 @@ import json
 import os
 import re
 import time
-import warnings
 from pathlib import Path
 
 import yaml
 
 from .. import __version__
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown, warn_user
 from ..io.files import atomic_write, output_path_problem, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
 from ..preset import Scene, differences, load_preset_file
@@ -239,8 +238,7 @@ class RunDirectory:
             state = None  # a damaged manifest lists nothing: nothing is deleted
         self._refuse_unless_ours(state, scene, resolved)
         if state is not None and state.get("status") == "completed" and same_preset(state, resolved, scene):
-            warnings.warn(f"{self.path} holds a completed run of this preset: it runs again, to the same numbers",
-                          stacklevel=3)
+            warn_user(f"{self.path} holds a completed run of this preset: it runs again, to the same numbers")
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
         self._remove_chunks(listed)  # chunks of the run that was here: frictionlab wrote them
         self.chunks.mkdir(parents=True, exist_ok=True)
@@ -453,7 +451,7 @@ class RunDirectory:
     def _warn_damage(self, damaged: dict[str, str], results: dict, total: int) -> None:
         report = damage_report(self.chunks, set(self._manifest["chunks"]), damaged, set(results), total)
         if report:
-            warnings.warn(f"resume of {self.path}: {report}", stacklevel=3)
+            warn_user(f"resume of {self.path}: {report}")
 
     def compact(self, pending: list[RealizationResult] | tuple = ()) -> bool:
         """Merge the chunks of a completed run, with ``pending`` (its last results, not yet

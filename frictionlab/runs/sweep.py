@@ -73,6 +73,9 @@ class SweepPoint:
     def describe(self) -> str:
         return ", ".join(self.assignments)
 
+    def __repr__(self) -> str:  # its scene, every default filled in, is too long to read
+        return f"<SweepPoint {self.number}: {self.describe()}, folder {self.folder_name!r}>"
+
 
 @dataclass(frozen=True)
 class Sweep:
@@ -231,8 +234,12 @@ def check_sweep_memory(sweep: Sweep, options: RunOptions) -> None:
 
 
 def load_sweep(path: str | Path, overrides: Iterable[str] = (), registry: Registry | None = None) -> Sweep:
-    """File -> overrides -> planned Sweep (the preset must have a sweep section)."""
-    return plan_sweep(read_preset(path, list(overrides), registry), registry=registry, source=str(path))
+    """A preset file, or a built-in's name (``"benad2012-fig5"``), with ``--set`` overrides
+    applied -> planned Sweep (the preset must have a sweep section)."""
+    from ..preset.builtin import locate_preset
+
+    resolved, source = locate_preset(path)
+    return plan_sweep(read_preset(resolved, list(overrides), registry), registry=registry, source=source)
 
 
 # ------------------------------------------------------------------ running
@@ -248,6 +255,11 @@ class PointResult:
     outcome: Any = None  # ensemble.RunOutcome
     error: str | None = None
     recorded: dict[str, Any] | None = None  # a row read back (a followed sweep's): stands for ``outcome``
+
+    @property
+    def fit(self) -> LogFit | None:
+        """The point's fit of xi = a + b ln f; None where it has none (or only a row read back)."""
+        return None if self.outcome is None else self.outcome.fit
 
     def row(self) -> dict[str, Any]:
         if self.recorded is not None:
