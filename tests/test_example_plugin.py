@@ -97,7 +97,7 @@ def example_here(installed_example, monkeypatch):
     monkeypatch.syspath_prepend(str(installed_example))
     for name in [name for name in os.environ if name.startswith("FRICTIONLAB_")]:
         monkeypatch.delenv(name)
-    caches = (registry._module_distributions, registry._provider_of, registry.default_registry)
+    caches = (registry._module_distributions, registry.provider_of, registry.default_registry)
     for cache in caches:
         cache.cache_clear()
     yield installed_example
