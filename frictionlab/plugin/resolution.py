@@ -9,7 +9,7 @@ ever finer grids (docs/explanation/physics.md, "Pixels on the short cut-off").
 from __future__ import annotations
 
 # the fewest pixels on the short cut-off that no caveat flags, by the profile's dimension: xi is
-# within about 5 % of its 32-pixel value from 8 on for lines (MDR; 2 % at f >= 1e-3) and only from
+# within about 5 % of its 32-pixel value from 8 on for lines (MDR; 3 % at f >= 1e-3) and only from
 # 16 on for surfaces (exact half-space; 8 pixels: 30 % above it at f = 0.01)
 MIN_SHORT_CUTOFF_PIXELS = {1: 8, 2: 16}
 
