@@ -26,7 +26,7 @@ _LAZY = {
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
             "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
-            "half_load_points", "load_finished", "mdr_length",
+            "half_load_points", "load_finished", "mdr_length", "short_cutoff_caveat",
         ),
         "plugin",
     ),  # fmt: skip
@@ -143,5 +143,6 @@ __all__ = [
     "mdr_length",
     "open_regular_file",
     "run",
+    "short_cutoff_caveat",
     "validate",
 ]

@@ -263,7 +263,9 @@ def scene_record(scene: Scene) -> dict:
     """What a validated preset would run: its plugins, realizations, load steps, what
     its spectrum read from a file (``input``: shape, pixel size, unit, rms height), or None,
     and its loads (``loads``: the force unit, the range in every unit, where full contact
-    starts: ``frictionlab.preset.loads.describe_loads``). Loads the solver cannot take are refused."""
+    starts: ``frictionlab.preset.loads.describe_loads``) and what a reader of its run should know
+    from its spectrum's parameters alone (``caveats``: ``SpectrumGenerator.caveats()``). Loads the
+    solver cannot take are refused."""
     from .preset.loads import check_loads, describe_loads
 
     check_loads(scene)
@@ -272,7 +274,7 @@ def scene_record(scene: Scene) -> dict:
         "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
         "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
         "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
-        "loads": describe_loads(scene),
+        "loads": describe_loads(scene), "caveats": list(scene.spectrum.caveats()),
     }  # fmt: skip
 
 

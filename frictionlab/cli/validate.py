@@ -62,6 +62,8 @@ def run(args) -> ExitCode:
                     print(shown(f"    {line}"))
                 for caveat in record["input"].get("caveats", ()):
                     print(f"  caveat: {shown(caveat)}")
+            for caveat in record["caveats"]:  # of the spectrum's parameters (few pixels on the short cut-off)
+                print(f"  caveat: {shown(caveat)}")
             for line in loads_lines(record["loads"], scene.normalisation.load_symbol):
                 print(shown(f"  {line}"))
     if args.json:

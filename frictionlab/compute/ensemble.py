@@ -138,7 +138,8 @@ class RunOutcome:
     kappa_r: np.ndarray | None = None
     contact_spots: np.ndarray | None = None  # mean over realizations; None unless the solver counts spots
     extra: dict = field(default_factory=dict)
-    input_caveats: tuple[str, ...] = ()  # what the spectrum's input_summary says of the file it read (a tilt left in)
+    # the spectrum's caveats: of the file it read (input_summary: a tilt left in), of its parameters (caveats())
+    spectrum_caveats: tuple[str, ...] = ()
     half_load_points: np.ndarray | None = None  # ensemble mean of the points carrying half the force (NaN: not said)
     peak_rms: float = math.nan  # the largest (max z - mean z) / rms height over the profiles
     no_law: str | None = None  # why no law was fitted though realizations finished (xi the same at every load)
@@ -154,10 +155,10 @@ class RunOutcome:
         profile in contact from some load on (xi is 1 there by definition), or lines
         without xi at some load (averaged over fewer lines there)."""
         if self.no_law:  # and why, where a spike makes it
-            return [self.no_law, *self.input_caveats] + ([spike_caveat(self.peak_rms)] if self.peak_rms > SPIKE_RMS else [])
+            return [self.no_law, *self.spectrum_caveats] + ([spike_caveat(self.peak_rms)] if self.peak_rms > SPIKE_RMS else [])
         if self.fit is None or not self.contact_count.size:
             return []
-        caveats = list(self.input_caveats)
+        caveats = list(self.spectrum_caveats)
         if self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
             caveats.append(few_contacts_caveat(float(self.contact_count[0])))
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
@@ -348,7 +349,7 @@ class Accumulator:
             elapsed=elapsed,
             workers=workers,
             error=error,
-            input_caveats=tuple((scene.spectrum.input_summary() or {}).get("caveats", ())),
+            spectrum_caveats=(*(scene.spectrum.input_summary() or {}).get("caveats", ()), *scene.spectrum.caveats()),
             compute_seconds=float(sum(self.results[i].seconds for i in indices)),
             real_area_corrected=(per["real_area_corrected"].mean(axis=0) if n else nan_row)
             if scene.solver.corrected_area else None,

@@ -32,6 +32,7 @@ from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
+from ..plugin.resolution import MIN_SHORT_CUTOFF_PIXELS
 from ..runs.rundir import STATE_FILE, RunDirectory
 from ..runs.runfolder import read_json
 from ..runs.runner import check_memory, run_to_folder
@@ -44,7 +45,7 @@ FIRST_HURST = 0.8  # the H whose ensembles run first, and the one with the fines
 APPROXIMATION = "mdr"  # the solver whose prediction is set beside the exact one
 MAIN, SIDE, SPECTRAL, BROAD = "main", "side", "spectral", "broad"  # the families of surfaces and gradients
 BROAD_HURSTS = (0.5, 0.8, 1.0)  # the H of the broad-band family
-MIN_PIXELS_QUOTED = 16  # pixels on the short cut-off of a grid whose numbers are quoted
+MIN_PIXELS_QUOTED = MIN_SHORT_CUTOFF_PIXELS[2]  # pixels on the short cut-off of a grid whose numbers are quoted
 
 
 def preset_name(hurst: float) -> str:

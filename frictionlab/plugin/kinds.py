@@ -51,6 +51,10 @@ class SpectrumGenerator(Plugin):
       numbers carry none) and ``rms_height``, and where each came from (the file or the
       preset). ``frictionlab validate``, the API, the TUI and summary.json show it.
       Default None (nothing read).
+    - ``caveats()``: what a reader of any run of this spectrum should know, from its
+      parameters alone (a short cut-off on too few pixels:
+      ``frictionlab.short_cutoff_caveat``), as sentences; the run lists them with its
+      own caveats and ``frictionlab validate`` prints them. Default ``()``.
     - ``profile_rms_height(profile)``: the h of f for one generated profile, when it is
       the profile's own (its measured rms height); None (the default) when it is the
       nominal ``rms_height()``. The lines of one ensemble must then share one h (to a
@@ -101,6 +105,9 @@ class SpectrumGenerator(Plugin):
 
     def input_summary(self) -> dict[str, Any] | None:
         return None
+
+    def caveats(self) -> tuple[str, ...]:
+        return ()
 
     def profile_rms_height(self, profile: Profile) -> float | None:
         return None

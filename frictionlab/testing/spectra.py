@@ -30,7 +30,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     a JSON-ready mapping whose ``shape``, ``spacing`` and ``rms_height`` are those of what
     ``generate()`` makes and ``rms_height()``, with ``file`` and ``unit``;
     ``profile_rms_height(profile)`` is None or finite > 0 for the generated
-    profiles, and the same for two of them within a relative 1e-9 (f needs one h).
+    profiles, and the same for two of them within a relative 1e-9 (f needs one h);
+    ``caveats()`` is a tuple of non-empty sentences (strings).
     """
     import numpy as np
 
@@ -88,7 +89,7 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
 
 def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
     """periodic(), points_param, grid_shape(), refined(), equivalent_line(), equivalent_line_bytes(), c0(),
-    hurst_exponent(), input_summary()."""
+    hurst_exponent(), input_summary(), caveats()."""
     import numpy as np
 
     from frictionlab.plugin import SpectrumGenerator, mdr_length
@@ -156,6 +157,9 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
         fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")
     _check_input_summary(cls, gen, profile)
+    caveats = call(cls, "caveats()", gen.caveats)
+    if not isinstance(caveats, tuple) or not all(isinstance(c, str) and c.strip() for c in caveats):
+        fail(cls, f"caveats() must be a tuple of non-empty strings. Got {caveats!r}.")
 
 
 def _check_input_summary(cls, gen, profile) -> None:

@@ -180,9 +180,9 @@ def default_spectrum(registry) -> str:
 def validation_of(data: dict, registry, base_dir: Path | None = None) -> tuple[list[str], str]:
     """The headless validator's problems for ``data`` (empty when it is valid; relative
     input files taken from ``base_dir``, the preset file's folder, as ``frictionlab
-    validate`` takes them) and, for a valid preset whose spectrum reads a file, the line
-    ``frictionlab validate`` prints on what it read (shape, pixel size, unit, rms height);
-    else ""."""
+    validate`` takes them) and, for a valid preset, the lines ``frictionlab validate`` prints
+    on what its spectrum read from a file (shape, pixel size, unit, rms height) and on the
+    caveats of its spectrum's parameters (few pixels on the short cut-off); else ""."""
     try:
         if base_dir is not None:
             data = resolve_input_paths(data, base_dir, registry)
@@ -190,7 +190,8 @@ def validation_of(data: dict, registry, base_dir: Path | None = None) -> tuple[l
     except PresetError as exc:
         return list(exc.problems), ""
     summary = scene.spectrum.input_summary()
-    return [], "" if summary is None else f"read {describe_input(summary)}"
+    read = [] if summary is None else [f"read {describe_input(summary)}"]
+    return [], "\n".join(read + [f"caveat: {caveat}" for caveat in scene.spectrum.caveats()])
 
 
 def problem_path(problem: str) -> str:

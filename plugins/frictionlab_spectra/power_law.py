@@ -41,7 +41,7 @@ import numpy as np
 
 from pydantic import Field, model_validator
 
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from frictionlab import PluginParams, Profile, SpectrumGenerator, short_cutoff_caveat
 
 from .params_cache import cached_on_params
 
@@ -54,6 +54,12 @@ JACOBS_JUNGE_PASTEWKA_2017 = "10.1088/2051-672X/aa51f8"
 
 
 # ------------------------------------------------------------------ geometry
+
+
+def band_caveats(band: Band, dimension: int) -> tuple[str, ...]:
+    """A generator's ``caveats()``: the short cut-off on too few pixels, or nothing."""
+    caveat = short_cutoff_caveat(band.short_cutoff / band.spacing, dimension)
+    return () if caveat is None else (caveat,)
 
 
 @dataclass(frozen=True)
@@ -371,6 +377,9 @@ class BandLimitedSpectrum(SpectrumGenerator):
 
     def grid_shape(self) -> tuple[int, ...]:
         return (self.params.points,)
+
+    def caveats(self) -> tuple[str, ...]:
+        return band_caveats(self.params.resolve_band(), self.dimension)
 
     def refined(self, points: int) -> dict:
         """The same continuous line on ``points`` points: length and cut-off wavelengths kept."""

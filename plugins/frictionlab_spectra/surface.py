@@ -45,6 +45,7 @@ from .power_law import (
     TWO_PI,
     Band,
     BandParams,
+    band_caveats,
     band_integral,
     relative_psd,
     resolve_band,
@@ -193,6 +194,9 @@ class BandLimitedSurface(SpectrumGenerator):
 
     def hurst_exponent(self) -> float:
         return float(self.params.hurst)
+
+    def caveats(self) -> tuple[str, ...]:
+        return band_caveats(_surface_band(self.params)[0], self.dimension)  # no synthesis: validate asks too
 
     def refined(self, points: int) -> dict:
         """The same continuous surface on ``points`` pixels per side (``points_y`` in proportion):

@@ -44,6 +44,8 @@ SPECTRUM_BREAKAGES = [
     ("NoAdviceWhenNotPeriodic",
      {"generate": lambda self, rng: Profile(rng.standard_normal(64), 1.0, periodic=False), "periodic": lambda self: False,
       "not_periodic_advice": lambda self: ("not periodic", "")}, r"not_periodic_advice\(\) must be a \(why, how\)"),
+    ("CaveatsAsOneString", {"caveats": lambda self: "coarse"}, r"caveats\(\) must be a tuple of non-empty strings"),
+    ("EmptyCaveat", {"caveats": lambda self: ("",)}, r"caveats\(\) must be a tuple of non-empty strings"),
 ]
 
 

@@ -260,3 +260,14 @@ async def test_r_on_the_run_tab_starts_no_run_and_says_what_does(folders, regist
     assert not running and out_dir is None
     assert not list((folders / "runs").glob("*"))  # no run folder made
     assert "Ctrl+R runs the open preset" in said
+
+
+@sync
+async def test_a_finished_run_shows_its_caveats_as_the_cli_prints_them(folders, registry):
+    coarse = merge(TINY, {"name": "coarse", "spectrum": {"params": {"short_cutoff": 4.0}}})  # 4 pixels on it
+    (folders / "presets" / "coarse.yaml").write_text(yaml.safe_dump(coarse, sort_keys=False))
+    app = make_app(registry, preset="presets/coarse.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        shown = " ".join(str(app.query_one("#run-fit", Static).render()).split())
+    assert "caveat: the short cut-off spans 4 pixels" in shown

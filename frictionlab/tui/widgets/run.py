@@ -254,7 +254,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             series = [Series(f, xi, "cyan"), fit_series(f, result.fit.a, result.fit.b, "yellow")]
             self.query_one("#run-chart", Chart).show(series)
         lines = fit_lines(result.fit, final=True, f_formula=run.f_formula)
-        self._set("run-fit", "\n".join(lines + _contact_lines(result.table["contact_count"])))
+        caveats = [f"caveat: {caveat}" for caveat in result.caveats]  # as frictionlab run prints them
+        self._set("run-fit", "\n".join(lines + _contact_lines(result.table["contact_count"]) + caveats))
         if run.failures or run.error:
             # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
             index, reason = run.failures[0] if run.failures else (None, None)
