@@ -201,7 +201,7 @@ def read_preset_input(
     from .preset import Preset, load_preset_file, set_path
     from .preset.paths import is_dotted_path
     from .preset.builtin import locate_preset
-    from .preset.reading import resolve_input_paths
+    from .preset.reading import not_a_mapping, resolve_input_paths
     from .io.safe_yaml import YamlProblem, load_yaml
 
     if "overrides" in keys:  # run(preset, overrides={...}): the positional argument, named
@@ -225,7 +225,7 @@ def read_preset_input(
         except YamlProblem as exc:
             raise PresetError([f"(text): {exc}"], source="<YAML text>") from None
         if not isinstance(data, dict):
-            raise PresetError([f"(text): a preset must be a mapping. Got {type(data).__name__} instead."], "<YAML text>")
+            raise PresetError([f"(text): {not_a_mapping(data, 'empty text (or comments only)')}"], "<YAML text>")
         source = "<YAML text>"
     elif isinstance(preset, str | os.PathLike):
         # a built-in is named as the CLI names it, not by the installed file the user never touched

@@ -162,3 +162,15 @@ def test_a_name_with_an_accent_is_told_which_letters_a_name_takes():
 
     with pytest.raises(PresetError, match=r"name: must be 1 to 100 of a-z, A-Z, 0-9, .* got 'héllo'"):
         build_scene(merge(SMALL_PRESET, {"name": "héllo"}))
+
+
+@pytest.mark.parametrize("text, got", [("# a comment\n", "got empty text (or comments only)"),
+                                       ("- a\n- b\n", "got ['a', 'b']")])  # fmt: skip
+def test_preset_text_that_is_no_mapping_says_what_it_holds(text, got):
+    """YAML text given to the API is told what it holds as a file is ('Got list' before)."""
+    import frictionlab
+    from frictionlab.errors import PresetError
+
+    with pytest.raises(PresetError) as refused:
+        frictionlab.validate(text)
+    assert f"(text): a preset must be a mapping of keys to values (name: ..., spectrum: ...), {got}" in str(refused.value)

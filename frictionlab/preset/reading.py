@@ -14,6 +14,12 @@ from .paths import apply_overrides
 
 NOT_A_MAPPING = "a preset must be a mapping of keys to values (name: ..., spectrum: ...)"
 
+
+def not_a_mapping(data, empty: str) -> str:
+    """Why YAML that read as ``data`` (no dict) is no preset; ``empty`` says what None came from."""
+    return f"{NOT_A_MAPPING}, got {empty if data is None else short_repr(data, 80)}"
+
+
 if TYPE_CHECKING:
     from ..plugin.registry import Registry
 
@@ -44,8 +50,7 @@ def load_preset_file(path: str | Path, *, follow_links: bool = True) -> dict:
     except YamlProblem as exc:
         raise PresetError([f"(file): {exc}"], source=str(path)) from None
     if not isinstance(data, dict):
-        got = "an empty file (or comments only)" if data is None else short_repr(data, 80)
-        raise PresetError([f"(file): {NOT_A_MAPPING}, got {got}"], source=str(path))
+        raise PresetError([f"(file): {not_a_mapping(data, 'an empty file (or comments only)')}"], source=str(path))
     return data
 
 
