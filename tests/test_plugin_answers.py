@@ -81,3 +81,42 @@ def test_an_exception_in_frictionlab_or_a_builtin_is_no_plugin_s_fault(frictionl
     with pytest.raises(ZeroDivisionError) as excinfo:
         1 / 0
     assert frictionlab_registry.at_fault(excinfo.value) is None
+
+
+def _filled(seed: int, dtype) -> np.ndarray:
+    """A small array of ``dtype`` with, for floats, NaN and ±inf strewn at random (or none)."""
+    rng = np.random.default_rng(seed)
+    size = int(rng.integers(1, 9))
+    if not np.issubdtype(dtype, np.floating):
+        return rng.integers(-(2**62), 2**62, size=size, dtype=dtype)
+    values = rng.normal(size=size) * 10.0 ** rng.integers(-300, 300)
+    for special in (np.nan, np.inf, -np.inf):
+        values[rng.random(size) < rng.choice([0.0, 0.3, 1.0])] = special
+    return values
+
+
+@pytest.mark.parametrize("nan", [False, True])
+@pytest.mark.parametrize("dtype", [np.float64, np.int64])
+def test_an_array_is_refused_as_not_finite_exactly_where_an_entry_is(nan, dtype):
+    """array_problem's test of finiteness (by the array's extremes) agrees, entry by entry
+    brute force, with a mask of every entry, for arrays all NaN, all inf, mixed or clean."""
+    from frictionlab.plugin.outputs import array_problem
+
+    for seed in range(300):
+        value = _filled(seed, dtype)
+        bad = np.isinf(value) if nan else ~np.isfinite(value)
+        problem = array_problem("a", value, floating=False, nan=nan)
+        assert (problem is not None) == bool(bad.any()), (seed, value)
+
+
+def test_the_slope_scale_is_found_past_nan_slopes():
+    """slope_scale brings the largest slope in magnitude (NaN ones passed by) near 1 by a power
+    of two, and leaves slopes that square safely as they are."""
+    from frictionlab.compute.realization import slope_scale
+
+    for largest in (1e300, -1e300, 1e-300, -1e-300, 3.0):
+        slopes = np.array([np.nan, 0.5 * largest, largest, np.nan, 0.0])
+        scale = slope_scale(slopes)
+        expected = 1.0 if abs(largest) == 3.0 else 2.0 ** -np.frexp(abs(largest))[1]
+        assert scale == expected, largest
+    assert slope_scale(np.full(4, np.nan)) == 1.0 and slope_scale(np.array([1.0, np.inf])) == 1.0

@@ -117,8 +117,8 @@ def slope_scale(slopes: np.ndarray) -> float:
     """1, or the power of two that brings the largest magnitude among ``slopes`` to about 1
     when their squares would overflow or underflow (heights over spacing past 1e154, say: both
     numbers a preset allows); a power of two scales every slope exactly."""
-    with np.errstate(invalid="ignore"):
-        largest = float(np.nanmax(np.abs(slopes))) if slopes.size else 0.0
+    # the extremes, passing NaN by (an undefined slope), rather than a temporary of |slopes|
+    largest = float(np.fmax(np.fmax.reduce(slopes, axis=None), -np.fmin.reduce(slopes, axis=None))) if slopes.size else 0.0
     if not math.isfinite(largest) or largest == 0.0 or 1 / SAFE_SLOPE <= largest <= SAFE_SLOPE:
         return 1.0
     return math.ldexp(1.0, -math.frexp(largest)[1])
@@ -167,7 +167,8 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         refuse(scene.solver, curve_problem(scene.solver, curve, scene.loads.size))
         half = curve.half_load_points
         heights = np.asarray(profile.heights, dtype=float)
-        rms = float(np.std(heights))
+        mean = float(heights.mean())
+        rms = float(np.sqrt(np.mean(np.square(heights - mean))))  # np.std, its mean kept for the peak
         return RealizationResult(
             index=index,
             seconds=time.perf_counter() - start,
@@ -184,7 +185,7 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             measured_rms_height=rms,
             own_rms_height=math.nan if own_h is None else float(own_h),
             half_load_points=np.full(scene.loads.size, math.nan) if half is None else np.asarray(half, float),
-            peak_rms=(float(heights.max()) - float(heights.mean())) / rms if rms > 0 else math.nan,
+            peak_rms=(float(heights.max()) - mean) / rms if rms > 0 else math.nan,
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise

@@ -30,10 +30,19 @@ def array_problem(what: str, value, shape=None, floating: bool = True, nan: bool
         return f"{what} must be float64 (double precision). Got dtype {value.dtype} instead."
     if not np.issubdtype(value.dtype, np.number) or np.issubdtype(value.dtype, np.complexfloating):
         return f"{what} must be real numbers. Got dtype {value.dtype} instead."
-    bad = np.isinf(value) if nan else ~np.isfinite(value)
-    if np.any(bad):
+    if value.size and not _all_finite(value, nan):
+        bad = np.isinf(value) if nan else ~np.isfinite(value)
         return f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s)."
     return None
+
+
+def _all_finite(value: np.ndarray, nan: bool) -> bool:
+    """Whether every entry of a non-empty numeric ``value`` is finite (or NaN, with ``nan``):
+    its extremes say it without a mask the size of the array."""
+    if not nan:  # max and min carry a NaN through
+        return bool(np.isfinite(value.max()) and np.isfinite(value.min()))
+    extremes = np.fmax.reduce(value, axis=None), np.fmin.reduce(value, axis=None)  # these pass a NaN by
+    return bool(np.isfinite(extremes).all()) or not np.isinf(value).any()  # NaN extremes: every entry is NaN
 
 
 def whole_problem(what: str, values) -> str | None:
