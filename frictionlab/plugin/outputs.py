@@ -73,10 +73,13 @@ def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
     return None
 
 
-def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile) -> str | None:
+def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile, what: str = "slopes()") -> str | None:
     """What is wrong with what ``slopes(heights, spacing, periodic)`` returned for ``profile``."""
-    undefined = estimator.undefined_points(profile.periodic)
-    return array_problem("slopes()", slopes, profile.heights.shape, nan=undefined is True)
+    undefined = estimator.undefined_points(profile.periodic) is True
+    problem = array_problem(what, slopes, profile.heights.shape, nan=undefined)
+    if problem and not undefined and array_problem(what, slopes, profile.heights.shape, nan=True) is None:  # NaN alone
+        problem += f" A NaN (a point without a slope) needs undefined_points({profile.periodic}) to return True."
+    return problem
 
 
 def curve_problem(solver: ContactSolver, curve, loads: int, where: str = "solve()") -> str | None:

@@ -18,11 +18,15 @@ def check_slope_estimator(cls, **params) -> None:
     on a tilted plane gives the tilt at every point (no difference across the
     ends), or, for a ``periodic_only`` estimator, raises ValueError; there
     ``undefined_points(False)`` says whether some points may have no slope (NaN):
-    if True, NaN appears only on the profile's edge (first or last point along an
-    axis) and every other slope is the tilt; if False, none is NaN. On a periodic
+    if True, NaN appears only in bands at the profile's ends (a wide stencil leaves
+    several points without a slope; at most a quarter of each axis at either end)
+    and every other slope is the tilt; if False, none is NaN. On a periodic
     profile every slope is finite, and ``undefined_points(True)`` is False.
     """
     import numpy as np
+
+    from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import slopes_problem
 
     estimator = instantiate(cls, params)
     spacing = 0.1
@@ -41,12 +45,15 @@ def check_slope_estimator(cls, **params) -> None:
         if not np.array_equal(heights, original):
             fail(cls, f"slopes({what}) modified its input")
         if not periodic and undefined_ends and isinstance(slopes, np.ndarray) and slopes.shape == heights.shape:
-            inner = tuple(slice(1, -1) for _ in heights.shape)
-            if np.isnan(slopes[inner]).any():
-                fail(cls, f"slopes({what}): NaN (no slope) is allowed on the edge of the profile only")
-            check_array(cls, f"slopes({what}) inside the edge", slopes[inner])
+            core = _defined_core(slopes)
+            if core is None:
+                fail(cls, f"slopes({what}): NaN (no slope) is allowed only in bands at the profile's ends, at most "
+                          "a quarter of each axis at either end, around a block where every point has a slope")  # fmt: skip
+            check_array(cls, f"slopes({what}) inside the edge", slopes[core])
             return slopes
-        check_array(cls, f"slopes({what})", slopes, heights.shape)
+        problem = slopes_problem(estimator, slopes, Profile(heights, spacing, periodic), f"slopes({what})")
+        if problem:
+            fail(cls, problem)
         return slopes
 
     rng = np.random.default_rng(7)
@@ -100,3 +107,19 @@ def check_slope_estimator(cls, **params) -> None:
                 f"on a non-periodic {kind} tilted by {grade.tolist()} every slope must be {exact:.6g}; "
                 f"point {tuple(int(i) for i in worst)} has {tilted[worst]:.6g} (a difference across the ends?)",
             )
+
+
+def _defined_core(slopes):
+    """The block of points with a slope, as slices, when the NaN (points without one) only
+    fill bands at the profile's ends, each at most a quarter of its axis; else None."""
+    import numpy as np
+
+    defined = ~np.isnan(slopes)
+    core = []
+    for axis, size in enumerate(slopes.shape):
+        found = np.flatnonzero(defined.any(axis=tuple(a for a in range(slopes.ndim) if a != axis)))
+        if found.size == 0 or found[0] > size // 4 or size - 1 - found[-1] > size // 4:
+            return None
+        core.append(slice(int(found[0]), int(found[-1]) + 1))
+    core = tuple(core)
+    return core if defined[core].all() and np.count_nonzero(defined) == defined[core].size else None

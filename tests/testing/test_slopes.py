@@ -62,8 +62,10 @@ def _nan_at(index):
 @pytest.mark.parametrize(
     "qualname,slopes,undefined,match",
     [
-        ("UndeclaredEnd", _nan_at(-1), lambda self, periodic: False, "must be finite"),
-        ("InnerNaN", _nan_at(5), lambda self, periodic: not periodic, "on the edge of the profile only"),
+        ("UndeclaredEnd", _nan_at(-1), lambda self, periodic: False,
+         r"must be finite\. Got 1 non-finite value\(s\)\. A NaN \(a point without a slope\) needs undefined_points\(False\) to return True"),
+        ("InnerNaN", _nan_at(5), lambda self, periodic: not periodic, "only in bands at the profile's ends"),
+        ("WideBand", _nan_at(slice(0, 40)), lambda self, periodic: not periodic, "at most a quarter of each axis"),
         ("UndefinedWhenPeriodic", _nan_at(-1), lambda self, periodic: True, r"undefined_points\(True\) must be False"),
     ],
 )
@@ -73,3 +75,20 @@ def test_slope_check_holds_undefined_points_to_the_edge_of_a_scan(qualname, slop
     ends = type("UndefinedEnd", (slopes_variant("UndefinedEnd", _nan_at(-1)),),
                 {"undefined_points": lambda self, periodic: not periodic})  # fmt: skip
     fltesting.check_slope_estimator(ends)
+
+
+def test_a_wide_stencil_may_leave_several_points_at_each_end_without_a_slope():
+    """Fourth-order central differences leave two points at each end of a scan without a
+    slope (NaN, declared): the check accepts them, the tilt exact at every other point, on
+    lines and on surfaces (NaN bands two points deep along both axes)."""
+
+    def fourth_order(self, z, dx, periodic=True):
+        ahead = [np.roll(z, -k, axis=0) - np.roll(z, k, axis=0) for k in (1, 2)]
+        out = (8 * ahead[0] - ahead[1]) / (12 * dx)
+        if not periodic:
+            out[:2], out[-2:] = np.nan, np.nan
+        return out
+
+    line = type("FourthOrder", (slopes_variant("FourthOrder", fourth_order),),
+                {"undefined_points": lambda self, periodic: not periodic})  # fmt: skip
+    fltesting.check_slope_estimator(line)
