@@ -17,7 +17,7 @@ import os
 import re
 import zipfile
 
-from .header_units import NUMBERS, check_units_named, head_text, named_units
+from .header_units import NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
@@ -118,12 +118,38 @@ def header_units(fh, reader) -> list[str]:
     return named_units(head_text(fh))[0]
 
 
+def check_text_heights(fh, reader, where: str) -> None:
+    """Refuse a text export whose header labels a column in a unit that is no length
+    (``header_units.check_heights_are_lengths``): its reader skips the header."""
+    if reader.format() in TEXT_FORMATS:
+        check_heights_are_lengths(head_text(fh), where)
+
+
 def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
     """Refuse a text export whose header names length units (``x [\u00b5m]``, ``z [nm]``) that its
     reader does not read, when they differ, or differ from the preset's ``unit``: the heights and
     the pixel would be taken as bare numbers in that unit, the slopes off by their ratio."""
     if file_unit is None:
         check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
+
+
+def check_not_amperes(reader, channel, where: str) -> None:
+    """Refuse a Gwyddion channel whose values are in A: Gwyddion's unit strings are SI, A the
+    ampere (an STM's current), but SurfaceTopography's reader takes A for the angstrom and read
+    a current channel as heights without a word (Gwyddion stores an angstrom as m)."""
+    if reader.format() != "gwy":
+        return
+    try:
+        field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
+        unit = field["si_unit_z"]["GwySIUnit"]["unitstr"]
+    except (AttributeError, KeyError, TypeError):  # a file this does not follow: its reader's reading stands
+        return
+    if unit == "A":
+        raise ValueError(
+            f"{where}: channel {channel.index} ({quoted(channel.name)}) holds values in A, Gwyddion's symbol of the "
+            "ampere (a current, not heights; Gwyddion stores an angstrom as m): choose the channel of heights with "
+            "channel, or export the height channel"
+        )
 
 
 def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:

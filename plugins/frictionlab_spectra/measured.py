@@ -28,6 +28,9 @@ class Measured:
     summary: dict[str, Any]  # what was read, and where each value came from
 
 
+ANGSTROM = {"\u212b": "\u00c5", "angstrom": "\u00c5", "angstroms": "\u00c5"}  # the angstrom sign, and in words
+
+
 class MeasuredParams(PluginParams):
     """The parameters a measured line and a measured map share, in the order of their forms:
     each file kind words ``path``, ``spacing`` and ``detrend`` for itself."""
@@ -36,7 +39,7 @@ class MeasuredParams(PluginParams):
     spacing: float | None = Field(None, description="grid spacing", gt=0.0)
     unit: Unit | None = Field(
         None,
-        description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
+        description="length unit of the heights and the spacing in this run (m, mm, um, nm, \u00c5, pm): an instrument "
         "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
     )
     undefined: Undefined = Field(
@@ -64,7 +67,9 @@ class MeasuredParams(PluginParams):
     @classmethod
     def _micro_sign(cls, unit: object) -> object:
         # um as an instrument writes it: with the micro sign or the Greek mu, or as microns
-        return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else unit
+        if unit == "A":  # the ampere's symbol, or an angstrom in ASCII: never guessed
+            raise ValueError("must be a length unit (m, mm, um, nm, \u00c5, pm): A is the ampere; an angstrom (1e-10 m) is written \u00c5")
+        return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else ANGSTROM.get(unit, unit)
 
     @model_validator(mode="after")
     def _channel_of_an_instrument_file(self):

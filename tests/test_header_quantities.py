@@ -1,0 +1,100 @@
+"""What a scan's header says its numbers are. The angstrom (Å, 1e-10 m, as AFM files state it)
+is a length unit of files and of a preset's ``unit``; a bare "A" is the ampere, never guessed.
+A column labelled in a unit that is no length (``z [V]``, ``height (nA)``, ``phase [deg]``) holds
+no heights: its numbers were read as heights in the preset's unit without a word."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from frictionlab.cli import main
+from frictionlab.errors import ExitCode
+from frictionlab_spectra import ProfileFile, SurfaceFile
+
+from .test_scan_edge_cases import rough, write_gwy
+
+
+def write_line(path, header: str, x, z):
+    path.write_text(header + "\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)), encoding="utf-8")
+    return path
+
+
+def validate(tmp_path, capsys, kind: str, params: dict) -> tuple[int, str]:
+    preset = {"name": "h", "realizations": 1, "spectrum": {"name": kind, "params": params}, "solver": {"name": "mdr"},
+              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset, allow_unicode=True), encoding="utf-8")
+    code = main(["validate", str(tmp_path / "p.yaml")])
+    return code, "".join(capsys.readouterr())
+
+
+@pytest.mark.parametrize("spelled", ["\u00c5", "\u212b", "angstrom"])
+def test_a_table_in_angstroms_is_read_with_unit_angstrom(tmp_path, spelled):
+    """A table labelled x [Å], z [Å] could not be read at all: its advice 'set unit: Å' was refused."""
+    x, z = np.arange(64) * 5.0, rough(1, 64)[0]
+    path = write_line(tmp_path / "afm.csv", f"x [{spelled}],z [{spelled}]", x, z)
+    line = ProfileFile(path=str(path), unit=spelled, detrend="none").generate(None)
+    assert line.spacing == pytest.approx(5.0, rel=1e-12)
+    np.testing.assert_allclose(line.heights, z, rtol=1e-12)
+    with pytest.raises(ValueError, match=r"names the length unit \u00c5, .* set unit: \u00c5, or convert"):
+        ProfileFile(path=str(path), unit="nm").rms_height()
+
+
+def test_an_instrument_file_in_angstroms_converts_to_unit_angstrom(tmp_path):
+    z = rough(16, 16, 2)
+    path = write_gwy(tmp_path / "afm.gwy", z * 1e-10, 2e-10, 2e-10)  # Gwyddion stores metres
+    scan = SurfaceFile(path=str(path), unit="\u00c5", detrend="none").generate(None)
+    assert scan.spacing == pytest.approx(2.0, rel=1e-9)
+    np.testing.assert_allclose(scan.heights, z, rtol=1e-9)
+
+
+def test_unit_a_is_refused_as_the_amperes(tmp_path, capsys):
+    x, z = np.arange(64) * 5.0, rough(1, 64)[0]
+    write_line(tmp_path / "afm.csv", "x,z", x, z)
+    code, text = validate(tmp_path, capsys, "profile-file", {"path": str(tmp_path / "afm.csv"), "unit": "A"})
+    assert code == ExitCode.USAGE, text
+    assert "spectrum.params.unit: must be a length unit (m, mm, um, nm, \u00c5, pm): A is the ampere" in text
+    assert "Traceback" not in text
+
+
+@pytest.mark.parametrize(("header", "label", "unit"), [
+    ("x [um],z [V]", "z [V]", "V"), ("x [um],height (nA)", "height (nA)", "nA"),
+    ("x [um],phase [deg]", "phase [deg]", "deg"), ("x/um,f/kHz", "f/kHz", "kHz"), ("x [um],z [A]", "z [A]", "A"),
+])  # fmt: skip
+def test_a_table_column_in_a_unit_that_is_no_length_is_refused(tmp_path, capsys, header, label, unit):
+    """Each was validated 'ok', its volts (or degrees) taken for micrometres of height."""
+    x, z = np.arange(64) * 0.5, rough(1, 64)[0]
+    write_line(tmp_path / "scan.csv", header, x, z)
+    code, text = validate(tmp_path, capsys, "profile-file", {"path": str(tmp_path / "scan.csv"), "unit": "um"})
+    assert code == ExitCode.USAGE, text
+    assert f"'/{tmp_path.name}/scan.csv'" in text or "scan.csv" in text
+    assert f"its header labels a column {label!r}, in {unit}" in text
+    assert "which is not a length unit (allowed: m, mm, um, nm, \u00c5, pm): its numbers are not heights" in text
+    assert ("A is the ampere" in text) == (unit == "A") and "Traceback" not in text
+
+
+def test_a_map_or_an_xyz_export_in_volts_is_refused_and_labels_that_are_no_unit_are_left(tmp_path):
+    z = rough(16, 16, 3)
+    rows = "".join(",".join(repr(float(v)) for v in row) + "\n" for row in z)
+    (tmp_path / "map.csv").write_text("z [V]\n" + rows, encoding="utf-8")
+    with pytest.raises(ValueError, match=r"labels a column 'z \[V\]', in V, which is not a length unit"):
+        SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1, unit="um").rms_height()
+    xyz = "".join(f"{0.1 * i:.4f} {0.1 * j:.4f} {z[j, i]:.9g}\n" for j in range(16) for i in range(16))
+    (tmp_path / "scan.xyz").write_text("# x [um] y [um] z [mV]\n" + xyz)
+    with pytest.raises(ValueError, match=r"labels a column 'z \[mV\]', in mV"):
+        SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height()
+    for header in ("height(s) of sample (A2), S/N ratio 3", "z [nm]"):  # no unit's label; a length
+        (tmp_path / "ok.csv").write_text(header + "\n" + rows, encoding="utf-8")
+        assert SurfaceFile(path=str(tmp_path / "ok.csv"), spacing=0.1, unit="nm").generate(None).heights.shape == (16, 16)
+
+
+def test_a_gwyddion_channel_in_amperes_is_no_heights_and_another_channel_is_picked(tmp_path):
+    """SurfaceTopography's reader took Gwyddion's A (the ampere) for the angstrom: a current
+    channel was read as heights of 1e-10 m per ampere."""
+    z = rough(16, 16, 4)
+    path = write_gwy(tmp_path / "stm.gwy", z * 1e-12, 1e-9, 1e-9, unit_z="A", more=[("Height", z * 1e-9, "m")])
+    with pytest.raises(ValueError, match=r"channel 0 \('Height'\) holds values in A, Gwyddion's symbol of the ampere"):
+        SurfaceFile(path=str(path), unit="nm").rms_height()
+    scan = SurfaceFile(path=str(path), unit="nm", channel=1, detrend="none").generate(None)
+    np.testing.assert_allclose(scan.heights, z, rtol=1e-9)
