@@ -90,6 +90,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
+            check_declared_points(shape, where, fh)  # more points than its bytes hold: the full read names the damage
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
             unit = chosen.unit if isinstance(chosen.unit, str) else None
@@ -188,7 +189,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         check_not_amperes(type(reader), chosen, where)
         check_payload(fh, type(reader), where, checksum=False)
         if chosen.nb_grid_pts is not None:
-            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
+            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where, fh, type(reader))
         check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
         check_text_heights(fh, type(reader), where)

@@ -219,13 +219,26 @@ def room_to_read() -> tuple[int, str]:
     return min(found)
 
 
-def check_declared_points(points: tuple[int, ...], where: str) -> None:
+AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
+MOST_POINTS_A_BYTE = 1032  # deflate's greatest ratio: a point of one byte, compressed, takes at least 1/1032 byte
+
+
+def check_declared_points(points: tuple[int, ...], where: str, fh=None, reader=None) -> None:
     """Refuse, from the header alone, a file that declares more points than this process can
     read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit; or a side of fewer
-    than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound)."""
+    than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound); or,
+    first, more points than the open file ``fh``'s bytes could hold even compressed (a forged
+    or truncated header: damage, not a map too large to read), named as of ``reader``'s format."""
+    shape = " x ".join(map(str, points))
     if min(points, default=1) < 1:
-        raise ValueError(f"{where}: the file declares {' x '.join(map(str, points))} points (x by y), a side of fewer "
-                         "than 1: a damaged header; copy it again from the instrument, or export it from there again")
+        raise ValueError(f"{where}: the file declares {shape} points (x by y), a side of fewer than 1: a damaged "
+                         f"header; {AGAIN}")  # fmt: skip
+    size = None if fh is None else os.fstat(fh.fileno()).st_size
+    if size is not None and math.prod(points) > size * MOST_POINTS_A_BYTE:
+        raise ValueError(
+            f"{where}: a damaged or truncated {'' if reader is None else reader.name() + ' '}file: its header declares {shape} points (x by y), and the file has "
+            f"{size:,} bytes, too few to hold them even compressed (at most {MOST_POINTS_A_BYTE} points a byte); {AGAIN}"
+        )
     need = math.prod(points) * 8 * HEIGHT_COPIES
     room, source = room_to_read()
     if need > room:
