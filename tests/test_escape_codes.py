@@ -218,3 +218,24 @@ def test_presets_copy_report_and_exact3d_print_paths_escaped(tmp_path, capsys, m
         assert main(command) == 0
         out, err = capsys.readouterr()
         assert "pwned" in out and "pwned" in err and ESC not in out + err
+
+
+@posix
+def test_an_out_folder_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    """``--out 'run\\ncompleted'`` printed 'results in .../run' and a line 'completed/': a
+    message's lines are kept by ``shown``, and a path in it was put in as text."""
+    from pathlib import Path
+
+    from frictionlab.errors import shown, shown_name
+
+    assert shown(Path("a\nb\tc")) == shown_name("a\nb\tc") == "a\\nb\\tc" and shown("a\nb") == "a\nb"
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(merge(SMALL_PRESET, {"realizations": 1, "fit": {"bootstrap": 0}})))
+    folder = tmp_path / "run\ncompleted"
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(folder), "--workers", "1", "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert f"  results in {tmp_path}/run\\ncompleted/" in out and "\ncompleted/" not in out, out
+    (tmp_path / "file\nx").write_text("")
+    for args in (["--out", str(tmp_path / "file\nx")], ["--resume", "--out", str(tmp_path / "none\nx")]):
+        assert main(["run", str(tmp_path / "p.yaml"), *args]) != 0
+        err = capsys.readouterr().err
+        assert "\\nx" in err and "\nx" not in err, err

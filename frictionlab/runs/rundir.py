@@ -144,7 +144,7 @@ class RunDirectory:
         lock = self.path / LOCK_FILE
         if lock.is_symlink() or (os.path.lexists(lock) and not lock.is_file()):  # a link would be truncated through
             raise RunFolderError(
-                f"{lock} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
+                f"{shown(lock)} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
                 "(remove it, or give another folder)"
             )
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
@@ -161,7 +161,7 @@ class RunDirectory:
                 text = ""
             holder = (shown(text) if text.startswith(f"pid {pid},") else f"pid {pid}") if pid else "a process that cannot be verified"
             raise RunFolderError(
-                f"{self.path} is in use by another run ({holder}): wait for it to end, "
+                f"{shown(self.path)} is in use by another run ({holder}): wait for it to end, "
                 "or give another output folder"
             ) from None
         return self
