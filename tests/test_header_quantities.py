@@ -98,3 +98,11 @@ def test_a_gwyddion_channel_in_amperes_is_no_heights_and_another_channel_is_pick
         SurfaceFile(path=str(path), unit="nm").rms_height()
     scan = SurfaceFile(path=str(path), unit="nm", channel=1, detrend="none").generate(None)
     np.testing.assert_allclose(scan.heights, z, rtol=1e-9)
+
+
+def test_a_npy_map_three_wide_is_not_told_to_be_read_as_an_xyz_export(tmp_path):
+    """A 3 x 3 .npy was told 'columns of x, y and z per point are read with format: instrument',
+    which no .npy is (SurfaceTopography does not read one)."""
+    np.save(tmp_path / "tiny.npy", rough(3, 3))
+    with pytest.raises(ValueError, match=r"map of 3 x 3 pixels \(x by y\); at least 8 x 8 are needed$"):
+        SurfaceFile(path=str(tmp_path / "tiny.npy"), spacing=1.0).rms_height()
