@@ -96,8 +96,10 @@ def test_a_gwyddion_channel_in_amperes_is_no_heights_and_another_channel_is_pick
     path = write_gwy(tmp_path / "stm.gwy", z * 1e-12, 1e-9, 1e-9, unit_z="A", more=[("Height", z * 1e-9, "m")])
     with pytest.raises(ValueError, match=r"channel 0 \('Height'\) holds values in A, Gwyddion's symbol of the ampere"):
         SurfaceFile(path=str(path), unit="nm").rms_height()
-    scan = SurfaceFile(path=str(path), unit="nm", channel=1, detrend="none").generate(None)
-    np.testing.assert_allclose(scan.heights, z, rtol=1e-9)
+    chosen = SurfaceFile(path=str(path), unit="nm", channel=1, detrend="none")
+    np.testing.assert_allclose(chosen.generate(None).heights, z, rtol=1e-9)
+    listed = chosen.input_summary()["channels"]  # the current's unit as the file says it, not the reader's m
+    assert [c["data_unit"] for c in listed] == ["A", "m"]
 
 
 def test_a_npy_map_three_wide_is_not_told_to_be_read_as_an_xyz_export(tmp_path):

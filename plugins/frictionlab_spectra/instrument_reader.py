@@ -137,19 +137,23 @@ def check_not_amperes(reader, channel, where: str) -> None:
     """Refuse a Gwyddion channel whose values are in A: Gwyddion's unit strings are SI, A the
     ampere (an STM's current), but SurfaceTopography's reader takes A for the angstrom and read
     a current channel as heights without a word (Gwyddion stores an angstrom as m)."""
-    if reader.format() != "gwy":
-        return
-    try:
-        field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
-        unit = field["si_unit_z"]["GwySIUnit"]["unitstr"]
-    except (AttributeError, KeyError, TypeError):  # a file this does not follow: its reader's reading stands
-        return
-    if unit == "A":
+    if _gwyddion_amperes(reader, channel):
         raise ValueError(
             f"{where}: channel {channel.index} ({quoted(channel.name)}) holds values in A, Gwyddion's symbol of the "
             "ampere (a current, not heights; Gwyddion stores an angstrom as m): choose the channel of heights with "
             "channel, or export the height channel"
         )
+
+
+def _gwyddion_amperes(reader, channel) -> bool:
+    """Whether ``channel`` of a Gwyddion file holds values in A (``check_not_amperes``)."""
+    if reader.format() != "gwy":
+        return False
+    try:
+        field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
+        return field["si_unit_z"]["GwySIUnit"]["unitstr"] == "A"
+    except (AttributeError, KeyError, TypeError):  # a file this does not follow: its reader's reading stands
+        return False
 
 
 def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
@@ -369,6 +373,7 @@ def channel_list(reader) -> list[dict]:
             data_unit = channel.data_unit
         except Exception:  # noqa: BLE001 - a reader that cannot say: nothing to list
             data_unit = None
+        data_unit = "A" if _gwyddion_amperes(type(reader), channel) else data_unit  # not m, as its reader says
         listed.append({
             "index": int(channel.index), "name": str(channel.name),
             "points": [int(n) for n in channel.nb_grid_pts] if channel.nb_grid_pts is not None else None,
