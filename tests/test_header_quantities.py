@@ -69,8 +69,8 @@ def test_a_table_column_in_a_unit_that_is_no_length_is_refused(tmp_path, capsys,
     code, text = validate(tmp_path, capsys, "profile-file", {"path": str(tmp_path / "scan.csv"), "unit": "um"})
     assert code == ExitCode.USAGE, text
     assert f"'/{tmp_path.name}/scan.csv'" in text or "scan.csv" in text
-    assert f"its header labels a column {label!r}, in {unit}" in text
-    assert "which is not a length unit (allowed: m, mm, um, nm, \u00c5, pm): its numbers are not heights" in text
+    assert f"its header's {label!r} says numbers in {unit}" in text
+    assert "which is not a length unit (allowed: m, mm, um, nm, \u00c5, pm): they are not heights" in text
     assert ("A is the ampere" in text) == (unit == "A") and "Traceback" not in text
 
 
@@ -78,12 +78,17 @@ def test_a_map_or_an_xyz_export_in_volts_is_refused_and_labels_that_are_no_unit_
     z = rough(16, 16, 3)
     rows = "".join(",".join(repr(float(v)) for v in row) + "\n" for row in z)
     (tmp_path / "map.csv").write_text("z [V]\n" + rows, encoding="utf-8")
-    with pytest.raises(ValueError, match=r"labels a column 'z \[V\]', in V, which is not a length unit"):
+    with pytest.raises(ValueError, match=r"header's 'z \[V\]' says numbers in V, which is not a length unit"):
         SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1, unit="um").rms_height()
     xyz = "".join(f"{0.1 * i:.4f} {0.1 * j:.4f} {z[j, i]:.9g}\n" for j in range(16) for i in range(16))
     (tmp_path / "scan.xyz").write_text("# x [um] y [um] z [mV]\n" + xyz)
-    with pytest.raises(ValueError, match=r"labels a column 'z \[mV\]', in mV"):
+    with pytest.raises(ValueError, match=r"header's 'z \[mV\]' says numbers in mV"):
         SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height()
+    gwyddion = "# Channel: Amplitude\n# Width: 1.6 \u00b5m\n# Height: 1.6 \u00b5m\n# Value units: V\n"
+    (tmp_path / "amplitude.txt").write_text(gwyddion + xyz.replace(" ", "  "), encoding="utf-8")
+    for format in ("auto", "table"):  # format: table read its volts as heights
+        with pytest.raises(ValueError, match=r"header's 'Value units: V' says numbers in V"):
+            SurfaceFile(path=str(tmp_path / "amplitude.txt"), spacing=0.1, unit="um", format=format).rms_height()
     for header in ("height(s) of sample (A2), S/N ratio 3", "z [nm]"):  # no unit's label; a length
         (tmp_path / "ok.csv").write_text(header + "\n" + rows, encoding="utf-8")
         assert SurfaceFile(path=str(tmp_path / "ok.csv"), spacing=0.1, unit="nm").generate(None).heights.shape == (16, 16)

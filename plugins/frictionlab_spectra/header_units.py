@@ -29,6 +29,8 @@ _SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
 # "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
 _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # keys in any case
+# "# Value units: V": a unit key of an instrument's text export (Gwyddion's) stating one that is no length
+_STATED_NOT_LENGTH = re.compile(rf"\b(?i:{_UNIT_KEYS})\s*[:=]\s*(?P<unit>{NOT_LENGTH})\s*$")
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
 
 
@@ -58,10 +60,12 @@ def named_units(text: str) -> tuple[list[str], bool]:
 
 def not_length_label(text: str) -> tuple[str, str] | None:
     """The first column label of the header of ``text`` whose unit is no length (``z [V]``,
-    ``height (nA)``, ``phase/deg``), and that unit; None when there is none."""
+    ``height (nA)``, ``phase/deg``; ``Value units: V`` too), and that unit; None when there is none."""
     for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             break
+        if stated := _STATED_NOT_LENGTH.search(line.rstrip()):
+            return line[stated.start() :].strip(), stated["unit"]
         if found := _NOT_LENGTH_LABEL.search(line):
             start = max(line.rfind(mark, 0, found.start()) for mark in ",;\t#])") + 1  # the label's cell
             unit = found.group().strip("[]()/ \t")
@@ -81,8 +85,8 @@ def check_heights_are_lengths(text: str, where: str) -> None:
     label, unit = found
     ampere = " (A is the ampere; an angstrom is written \u00c5)" if unit == "A" else ""
     raise ValueError(
-        f"{where}: its header labels a column {quoted(label)}, in {unit}{ampere}, which is not a length unit "
-        f"(allowed: {', '.join(LENGTH_UNITS)}): its numbers are not heights; export the height channel alone, with "
+        f"{where}: its header's {quoted(label)} says numbers in {unit}{ampere}, which is not a length unit "
+        f"(allowed: {', '.join(LENGTH_UNITS)}): they are not heights; export the height channel alone, with "
         "its length unit (an instrument file's other channels are picked with channel)"
     )
 
