@@ -113,3 +113,18 @@ def test_a_npy_map_three_wide_is_not_told_to_be_read_as_an_xyz_export(tmp_path):
     np.save(tmp_path / "tiny.npy", rough(3, 3))
     with pytest.raises(ValueError, match=r"map of 3 x 3 pixels \(x by y\); at least 8 x 8 are needed$"):
         SurfaceFile(path=str(tmp_path / "tiny.npy"), spacing=1.0).rms_height()
+
+
+def test_a_first_row_of_decimal_commas_is_named_not_taken_for_a_header(tmp_path):
+    """'-0,12;1,5' on line 1 was skipped as a header, and line 2 named as the first of decimal commas."""
+    z = rough(16, 16, 5)
+    (tmp_path / "semi.csv").write_text("".join(";".join(f"{v:.5f}".replace(".", ",") for v in row) + "\n" for row in z))
+    with pytest.raises(ValueError, match=r"decimal commas at line 1 \(as 1,5\)"):
+        SurfaceFile(path=str(tmp_path / "semi.csv"), spacing=1.0).rms_height()
+
+
+def test_two_columns_read_as_a_map_are_told_to_be_a_line(tmp_path):
+    x, z = np.arange(64) * 0.5, rough(1, 64)[0]
+    write_line(tmp_path / "line.csv", "x,z", x, z)
+    with pytest.raises(ValueError, match=r"map of 2 x 64 pixels .*; columns of x and z \(a line\) are read by profile-file"):
+        SurfaceFile(path=str(tmp_path / "line.csv"), spacing=1.0).rms_height()
