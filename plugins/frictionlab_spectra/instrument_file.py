@@ -26,8 +26,8 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_points, check_header_units, check_not_amperes, check_payload, check_text_heights,
-    check_text_room, choose_reader, describe_failure, pick_channel,
+    channel_list, check_declared_bytes, check_declared_points, check_header_units, check_not_amperes, check_payload,
+    check_text_heights, check_text_room, choose_reader, describe_failure, pick_channel,
     TEXT_FORMATS, quoted,
 )
 
@@ -90,7 +90,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
-            check_declared_points(shape, where, fh)  # more points than its bytes hold: the full read names the damage
+            check_declared_bytes(shape, where, fh)  # more points than its bytes hold: the full read names the damage
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
             unit = chosen.unit if isinstance(chosen.unit, str) else None

@@ -204,6 +204,20 @@ def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
         )
 
 
+def check_declared_bytes(points: tuple[int, ...], where: str, fh, reader=None) -> None:
+    """Refuse a header that declares more points than the open file ``fh``'s bytes could hold
+    even compressed (a forged or truncated file: damage, not a map too large to read, which the
+    memory estimate said), named as of ``reader``'s format when known."""
+    size = os.fstat(fh.fileno()).st_size
+    if math.prod(points) > size * MOST_POINTS_A_BYTE:
+        shape = " x ".join(map(str, points))
+        raise ValueError(
+            f"{where}: a damaged or truncated {'' if reader is None else reader.name() + ' '}file: its header declares "
+            f"{shape} points (x by y), and the file has {size:,} bytes, too few to hold them even compressed (at most "
+            f"{MOST_POINTS_A_BYTE} points a byte); {AGAIN}"
+        )
+
+
 HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: the reader's, ours, levelled, resampled
 
 
@@ -231,22 +245,16 @@ def check_declared_points(points: tuple[int, ...], where: str, fh=None, reader=N
     """Refuse, from the header alone, a file that declares more points than this process can
     read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit; or a side of fewer
     than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound); or,
-    first, more points than the open file ``fh``'s bytes could hold even compressed (a forged
-    or truncated header: damage, not a map too large to read), named as of ``reader``'s format."""
+    first, more points than the open file ``fh``'s bytes hold (``check_declared_bytes``)."""
     shape = " x ".join(map(str, points))
     if min(points, default=1) < 1:
         raise ValueError(f"{where}: the file declares {shape} points (x by y), a side of fewer than 1: a damaged "
                          f"header; {AGAIN}")  # fmt: skip
-    size = None if fh is None else os.fstat(fh.fileno()).st_size
-    if size is not None and math.prod(points) > size * MOST_POINTS_A_BYTE:
-        raise ValueError(
-            f"{where}: a damaged or truncated {'' if reader is None else reader.name() + ' '}file: its header declares {shape} points (x by y), and the file has "
-            f"{size:,} bytes, too few to hold them even compressed (at most {MOST_POINTS_A_BYTE} points a byte); {AGAIN}"
-        )
+    if fh is not None:
+        check_declared_bytes(points, where, fh, reader)
     need = math.prod(points) * 8 * HEIGHT_COPIES
     room, source = room_to_read()
     if need > room:
-        shape = " x ".join(str(n) for n in points)
         raise ValueError(
             f"{where}: the file declares {shape} points (x by y); reading them takes about {need / 2**30:.3g} GiB, "
             f"more than the {room / 2**30:.3g} GiB this process may use ({source}); crop the scan with the "
