@@ -24,6 +24,7 @@ XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
+AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
 
 
 def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None):
@@ -195,12 +196,12 @@ def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights take {stored} bytes, and its description "
             f"declares {points} points of data type {kind} ({X3P_ITEM_BYTES[kind]} bytes each: {declared} bytes); "
-            "copy it again from the instrument, or export it from there again"
+            + AGAIN
         )
     if found is not None and found != declared_sum:
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights' MD5 checksum is {found}, and its "
-            f"description declares {declared_sum}; copy it again from the instrument, or export it from there again"
+            f"description declares {declared_sum}; {AGAIN}"
         )
 
 
@@ -237,7 +238,6 @@ def room_to_read() -> tuple[int, str]:
     return min(found)
 
 
-AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
 MOST_POINTS_A_BYTE = 1032  # deflate's greatest ratio: a point of one byte, compressed, takes at least 1/1032 byte
 
 
@@ -346,7 +346,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
     if isinstance(exc, CorruptFile):
         kind = "a damaged"
     return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
-                      "its format cannot read it: copy it again from the instrument, or export it from there again")  # fmt: skip
+                      f"its format cannot read it: {AGAIN}")  # fmt: skip
 
 
 REASON_SHOWN = 160
