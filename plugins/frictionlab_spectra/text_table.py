@@ -105,7 +105,7 @@ def _table(text, where: str) -> np.ndarray:
             raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
         if _mostly_numbers(cells, delimiter):  # a row of heights with a cell that is not one: named below
             break
-        if delimiter != "," and _numbers(cells.replace(",", "."), delimiter):  # 1,5;2,25: numbers, not a header
+        if _numbers(cells.replace(",", "."), ";" if ";" in cells else None):  # 1,5;2,25: numbers, not a header
             raise ValueError(f"{where}: {_decimal_commas(lineno)}")
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     text.seek(0)
