@@ -101,7 +101,7 @@ class PresetError(FrictionlabError):
     def __init__(self, problems: list[str], source: str | None = None):
         self.problems = list(problems)
         self.source = source
-        where = f"{shown(source)}: " if source else ""  # a file name typed with an escape sequence
+        where = f"{shown_name(source)}: " if source else ""  # a file name typed with an escape sequence, a line break
         count = len(self.problems)
         head = f"{where}{count} problem{'s' if count != 1 else ''} in preset"
         lines = ["  " + p for p in self.problems[: self.SHOWN_PROBLEMS]]

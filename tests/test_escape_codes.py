@@ -239,3 +239,20 @@ def test_an_out_folder_whose_name_holds_a_line_break_is_said_on_one_line(tmp_pat
         assert main(["run", str(tmp_path / "p.yaml"), *args]) != 0
         err = capsys.readouterr().err
         assert "\\nx" in err and "\nx" not in err, err
+
+
+@posix
+def test_a_preset_or_run_folder_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    """'p\\nq.yaml: 1 problem in preset', 'in .../r\\nz/' and '.../no\\nx does not exist' each
+    printed a name across two lines."""
+    preset = merge(SMALL_PRESET, {"realizations": 1, "fit": {"bootstrap": 0}})
+    (tmp_path / "p\nq.yaml").write_text(yaml.safe_dump(merge(preset, {"realizations": 0})))
+    assert main(["validate", str(tmp_path / "p\nq.yaml")]) != 0
+    assert "p\\nq.yaml: 1 problem in preset" in capsys.readouterr().err
+    assert main(["resume", str(tmp_path / "no\nx")]) != 0
+    assert "no\\nx does not exist" in capsys.readouterr().err
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "r\nz"), "--workers", "1", "--no-plot"]) == 0
+    capsys.readouterr()
+    assert main(["follow", str(tmp_path / "r\nz")]) == 0
+    assert "completed, 1/1 realizations, in " in (out := capsys.readouterr().out) and "r\\nz/" in out, out

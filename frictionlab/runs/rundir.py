@@ -205,7 +205,7 @@ class RunDirectory:
         path = self.path / PRESET_FILE
         if not self.path.is_dir():
             what = "is not a folder" if os.path.lexists(self.path) else "does not exist"
-            raise RunFolderError(f"{self.path} {what}: there is no run to resume there")
+            raise RunFolderError(f"{shown(self.path)} {what}: there is no run to resume there")
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:
