@@ -256,3 +256,11 @@ def test_a_preset_or_run_folder_whose_name_holds_a_line_break_is_said_on_one_lin
     capsys.readouterr()
     assert main(["follow", str(tmp_path / "r\nz")]) == 0
     assert "completed, 1/1 realizations, in " in (out := capsys.readouterr().out) and "r\\nz/" in out, out
+
+
+@posix
+def test_an_output_file_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    (tmp_path / "j\nk.json").write_text("{}")
+    assert main(["schema", "--out", str(tmp_path / "j\nk.json")]) != 0
+    err = capsys.readouterr().err
+    assert "j\\nk.json exists: give another file" in err, err
