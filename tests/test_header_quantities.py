@@ -89,7 +89,7 @@ def test_a_map_or_an_xyz_export_in_volts_is_refused_and_labels_that_are_no_unit_
     for format in ("auto", "table"):  # format: table read its volts as heights
         with pytest.raises(ValueError, match=r"header's 'Value units: V' says numbers in V"):
             SurfaceFile(path=str(tmp_path / "amplitude.txt"), spacing=0.1, unit="um", format=format).rms_height()
-    for header in ("height(s) of sample (A2), S/N ratio 3", "z [nm]"):  # no unit's label; a length
+    for header in ("height(s) of sample (A2), S/N ratio 3", "z [nm]", "# Setpoint (%): 50\n# Drive [mV]: 3\nz [nm]"):  # no unit's label; a length
         (tmp_path / "ok.csv").write_text(header + "\n" + rows, encoding="utf-8")
         assert SurfaceFile(path=str(tmp_path / "ok.csv"), spacing=0.1, unit="nm").generate(None).heights.shape == (16, 16)
 

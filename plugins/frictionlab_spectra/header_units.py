@@ -59,17 +59,19 @@ def named_units(text: str) -> tuple[list[str], bool]:
 
 
 def not_length_label(text: str) -> tuple[str, str] | None:
-    """The first column label of the header of ``text`` whose unit is no length (``z [V]``,
-    ``height (nA)``, ``phase/deg``; ``Value units: V`` too), and that unit; None when there is none."""
+    """The column label of the header of ``text`` whose unit is no length (``z [V]``,
+    ``height (nA)``, ``phase/deg``: on its last line, over the numbers, not in metadata such as
+    ``# Setpoint (%): 50``; ``Value units: V`` on any), and that unit; None when there is none."""
+    labels = ""
     for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             break
         if stated := _STATED_NOT_LENGTH.search(line.rstrip()):
             return line[stated.start() :].strip(), stated["unit"]
-        if found := _NOT_LENGTH_LABEL.search(line):
-            start = max(line.rfind(mark, 0, found.start()) for mark in ",;\t#])") + 1  # the label's cell
-            unit = found.group().strip("[]()/ \t")
-            return line[start : found.end()].strip(), unit
+        labels = line if line.strip() else labels
+    if found := _NOT_LENGTH_LABEL.search(labels):
+        start = max(labels.rfind(mark, 0, found.start()) for mark in ",;\t#])") + 1  # the label's cell
+        return labels[start : found.end()].strip(), found.group().strip("[]()/ \t")
     return None
 
 
