@@ -2,7 +2,9 @@
 label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
 ``# Value units: m``). A table's numbers are read bare, so what its header says of their units
 is checked against the preset (``check_table_header``); a text export read by SurfaceTopography
-is checked the same way where its reader skips the header (``instrument_reader``)."""
+is checked the same way where its reader skips the header (``instrument_reader``). A column
+labelled in a unit that is no length (``z [V]``, ``phase [deg]``; a bare ``A`` is the ampere)
+holds no heights, and is refused (``check_heights_are_lengths``)."""
 
 from __future__ import annotations
 

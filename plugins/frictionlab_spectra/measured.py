@@ -13,7 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
-from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
+from .instrument_file import LENGTH_UNITS, ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
 from .map_pipeline import FileFormat
 
 
@@ -68,7 +68,7 @@ class MeasuredParams(PluginParams):
     def _micro_sign(cls, unit: object) -> object:
         # um as an instrument writes it: with the micro sign or the Greek mu, or as microns; the angstrom too
         if unit == "A":  # the ampere's symbol, or an angstrom in ASCII: never guessed
-            raise ValueError("must be a length unit (m, mm, um, nm, \u00c5, pm): A is the ampere; an angstrom "
+            raise ValueError(f"must be a length unit ({', '.join(LENGTH_UNITS)}): A is the ampere; an angstrom "
                              "(1e-10 m) is written \u00c5")  # fmt: skip
         if isinstance(unit, str) and (unit in ANGSTROM or unit.lower() in ANGSTROM):
             return "\u00c5"
