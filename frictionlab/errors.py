@@ -101,7 +101,7 @@ class PresetError(FrictionlabError):
     def __init__(self, problems: list[str], source: str | None = None):
         self.problems = list(problems)
         self.source = source
-        where = f"{shown(source)}: " if source else ""  # a file name typed with an escape sequence
+        where = f"{shown_name(source)}: " if source else ""  # a file name typed with an escape sequence, a line break
         count = len(self.problems)
         head = f"{where}{count} problem{'s' if count != 1 else ''} in preset"
         lines = ["  " + p for p in self.problems[: self.SHOWN_PROBLEMS]]
@@ -144,12 +144,22 @@ _HIDING = (*range(0x200B, 0x2010), *range(0x202A, 0x202F), *range(0x2066, 0x206A
 _CONTROL.update({c: f"\\u{c:04x}" for c in _HIDING})
 
 
+_LINES = {ord("\n"): "\\n", ord("\t"): "\\t"}
+
+
 def shown(text) -> str:
     """``text`` (or a path) as any terminal takes it: bytes that are not UTF-8, control
     characters (C0 and C1) and characters that hide or reorder text escaped (an escape
     sequence typed in a ``--set`` or a file name must not drive the terminal, nor a key read
-    as another); lines and tabs kept."""
-    return os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
+    as another); a message's lines and tabs kept, a path's escaped (``shown_name``)."""
+    said = os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
+    return said.translate(_LINES) if isinstance(text, os.PathLike) else said
+
+
+def shown_name(text) -> str:
+    """A name (a path, a folder typed as ``--out``) as ``shown`` says it, on one line: its line
+    breaks and tabs escaped too (a folder 'x\\nrun completed' read as two lines of a message)."""
+    return shown(text).translate(_LINES)
 
 
 def _escape_unencodable(exc: UnicodeError):
@@ -215,7 +225,7 @@ def limit_advice() -> str:
 
 def resume_hint(folder) -> str:
     """How to go on with a run that stopped before its end: what finished is in ``folder``."""
-    return f"what finished is kept in {folder}/: `frictionlab resume {folder}` computes the rest"
+    return f"what finished is kept in {shown_name(folder)}/: `frictionlab resume {shown_name(folder)}` computes the rest"
 
 
 def counted(count: int, noun: str) -> str:

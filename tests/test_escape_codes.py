@@ -218,3 +218,49 @@ def test_presets_copy_report_and_exact3d_print_paths_escaped(tmp_path, capsys, m
         assert main(command) == 0
         out, err = capsys.readouterr()
         assert "pwned" in out and "pwned" in err and ESC not in out + err
+
+
+@posix
+def test_an_out_folder_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    """``--out 'run\\ncompleted'`` printed 'results in .../run' and a line 'completed/': a
+    message's lines are kept by ``shown``, and a path in it was put in as text."""
+    from pathlib import Path
+
+    from frictionlab.errors import shown, shown_name
+
+    assert shown(Path("a\nb\tc")) == shown_name("a\nb\tc") == "a\\nb\\tc" and shown("a\nb") == "a\nb"
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(merge(SMALL_PRESET, {"realizations": 1, "fit": {"bootstrap": 0}})))
+    folder = tmp_path / "run\ncompleted"
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(folder), "--workers", "1", "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert f"  results in {tmp_path}/run\\ncompleted/" in out and "\ncompleted/" not in out, out
+    (tmp_path / "file\nx").write_text("")
+    for args in (["--out", str(tmp_path / "file\nx")], ["--resume", "--out", str(tmp_path / "none\nx")]):
+        assert main(["run", str(tmp_path / "p.yaml"), *args]) != 0
+        err = capsys.readouterr().err
+        assert "\\nx" in err and "\nx" not in err, err
+
+
+@posix
+def test_a_preset_or_run_folder_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    """'p\\nq.yaml: 1 problem in preset', 'in .../r\\nz/' and '.../no\\nx does not exist' each
+    printed a name across two lines."""
+    preset = merge(SMALL_PRESET, {"realizations": 1, "fit": {"bootstrap": 0}})
+    (tmp_path / "p\nq.yaml").write_text(yaml.safe_dump(merge(preset, {"realizations": 0})))
+    assert main(["validate", str(tmp_path / "p\nq.yaml")]) != 0
+    assert "p\\nq.yaml: 1 problem in preset" in capsys.readouterr().err
+    assert main(["resume", str(tmp_path / "no\nx")]) != 0
+    assert "no\\nx does not exist" in capsys.readouterr().err
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "r\nz"), "--workers", "1", "--no-plot"]) == 0
+    capsys.readouterr()
+    assert main(["follow", str(tmp_path / "r\nz")]) == 0
+    assert "completed, 1/1 realizations, in " in (out := capsys.readouterr().out) and "r\\nz/" in out, out
+
+
+@posix
+def test_an_output_file_whose_name_holds_a_line_break_is_said_on_one_line(tmp_path, capsys):
+    (tmp_path / "j\nk.json").write_text("{}")
+    assert main(["schema", "--out", str(tmp_path / "j\nk.json")]) != 0
+    err = capsys.readouterr().err
+    assert "j\\nk.json exists: give another file" in err, err

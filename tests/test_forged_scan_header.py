@@ -33,3 +33,24 @@ def test_an_x3p_declaring_far_more_points_than_it_holds_is_named_damaged(tmp_pat
     assert "a damaged XML 3D surface profile (X3P) file: its binary heights take" in err
     assert "declares 16000000000 points" in err and "would need about" not in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(("kind", "command"), [("surface-file", "validate"), ("surface-file", "run"),
+                                               ("profile-file", "validate")])  # fmt: skip
+def test_a_gwyddion_file_declaring_far_more_points_than_its_bytes_is_named_damaged(tmp_path, capsys, kind, command):
+    """A Gwyddion file of 2 KiB whose header declares 10^8 x 16 points: the memory estimate
+    refused it ('this run would need about 143 GiB', exit 1), or the reader's check ('reading
+    them takes about 47.7 GiB'), never saying the file was damaged."""
+    from .test_scan_edge_cases import write_gwy
+
+    write_gwy(tmp_path / "forged.gwy", rough(16, 16) * 1e-9, 1e-9, 1e-9, xres=10**8, xreal=0.1)
+    size = (tmp_path / "forged.gwy").stat().st_size
+    preset = {"name": "forged", "realizations": 1, "spectrum": {"name": kind, "params": {"path": "forged.gwy"}},
+              "solver": {"name": "mdr"}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    code = main([command, str(tmp_path / "p.yaml"), *(["--out", str(tmp_path / "out")] if command == "run" else [])])
+    err = capsys.readouterr().err
+    assert code == ExitCode.USAGE, err
+    assert (f"a damaged or truncated Gwyddion file: its header declares 100000000 x 16 points (x by y), and the file "
+            f"has {size:,} bytes, too few to hold them even compressed") in err  # fmt: skip
+    assert "GiB" not in err and "Traceback" not in err and not (tmp_path / "out").exists()

@@ -174,8 +174,9 @@ def test_a_first_row_of_heights_with_a_bad_cell_is_refused_not_skipped_as_a_head
 
 @pytest.mark.parametrize("separator", [";", "\t"])
 def test_decimal_commas_are_named(tmp_path, separator):
+    """At their first line: the first was skipped as a header, and line 2 named."""
     (tmp_path / "d.csv").write_text(matrix_text(rough(9, 8, 7), separator, decimal=","))
-    with pytest.raises(ValueError, match=r"decimal commas at line 2 \(as 1,5\); .* export the table with decimal points"):
+    with pytest.raises(ValueError, match=r"decimal commas at line 1 \(as 1,5\); .* export the table with decimal points"):
         SurfaceFile(path=str(tmp_path / "d.csv"), spacing=0.1).rms_height()
 
 

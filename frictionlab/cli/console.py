@@ -35,9 +35,9 @@ def is_terminal(stream=None) -> bool:
 def _cell(value) -> str:
     """``value`` as one line of a table (``shown``, its line breaks and tabs escaped too): a run
     folder named 'x\\nfake  completed' drew a second row."""
-    from ..errors import shown
+    from ..errors import shown_name
 
-    return shown(str(value)).replace("\n", "\\n").replace("\t", "\\t")
+    return shown_name(str(value))
 
 
 def print_table(header: Sequence[str], rows: Sequence[Sequence[str]], *, stream=None) -> None:

@@ -9,7 +9,7 @@ import sys
 import threading
 from pathlib import Path
 
-from ..errors import ExitCode, shown
+from ..errors import ExitCode, shown, shown_name
 from ..compute.signals import ENDINGS, install
 
 POLL_SECONDS = 0.2
@@ -115,16 +115,16 @@ def run(args) -> ExitCode:
         emit("follow", {**state.to_dict(), "error": error, **extra})
     else:
         if state.reason is not None:  # damaged: what is known, not a count with a question mark
-            print(shown(f"{state.name}: damaged, in {folder}/: {state.reason}"))
+            print(shown(f"{state.name}: damaged, in {shown_name(folder)}/: {state.reason}"))
             return ExitCode.RUNTIME_FAILURE
         done = state.done
-        hint = f"; frictionlab resume {folder} continues it" if state.resumable else ""
+        hint = f"; frictionlab resume {shown_name(folder)} continues it" if state.resumable else ""
         if error and state.done is not None and state.done == state.total:  # every realization done: no resume mends it
             hint = ""
         if any(row.get("status") == "error" for row in rows):  # a resume fails there again until it is fixed
-            hint = f"; do what the points in error say, then frictionlab resume {folder} continues it"
+            hint = f"; do what the points in error say, then frictionlab resume {shown_name(folder)} continues it"
         what = "points" if sweep is not None else "realizations"
-        print(shown(f"{state.name}: {state.status}, {done}/{state.total} {what}, in {folder}/{hint}"))
+        print(shown(f"{state.name}: {state.status}, {done}/{state.total} {what}, in {shown_name(folder)}/{hint}"))
         if sweep is not None:
             from ..progress import point_result_line
 

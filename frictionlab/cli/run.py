@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, counted, ran_out_of_memory,
-                      resume_hint, shown, too_long_path)  # fmt: skip
+                      resume_hint, shown, shown_name, too_long_path)  # fmt: skip
 from .options import add_executor_options, add_workers_option, executor_run_options
 
 
@@ -68,7 +68,7 @@ def run(args) -> ExitCode:
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
     if args.resume and not Path(args.out).is_dir():
-        raise RunFolderError(f"{args.out} is not a run folder to resume (it does not exist, or is not a folder)")
+        raise RunFolderError(f"{shown_name(args.out)} is not a run folder to resume (it does not exist, or is not a folder)")
     out_dir = args.out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)  # named if memory runs out
     try:
         if args.detach:
@@ -229,7 +229,7 @@ def result_table(scene, outcome, out_dir: Path) -> str:
     if outcome.failures:
         index, error = outcome.failures[0]
         lines.append(f"  {len(outcome.failures)} realization(s) failed; first: #{index}: {error}")
-    lines.append(f"  results in {out_dir}/")
+    lines.append(f"  results in {shown_name(out_dir)}/")
     return "\n".join(lines)
 
 
@@ -240,5 +240,5 @@ def sweep_table(sweep, status: str, elapsed: float, rows: list[dict], out_dir: P
     from ..progress import point_result_line
 
     lines += [point_result_line(sweep, point, row) for point, row in zip(sweep.points, rows)]
-    lines.append(f"  results in {out_dir}/ (sweep.csv, {'sweep.png, ' if drawn else ''}points/)")
+    lines.append(f"  results in {shown_name(out_dir)}/ (sweep.csv, {'sweep.png, ' if drawn else ''}points/)")
     return "\n".join(lines)

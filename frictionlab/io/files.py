@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import OutputRefused, shown
+from ..errors import OutputRefused, shown, shown_name
 
 _SAMPLE_BYTES = 65536  # of an array, deflated to decide whether the whole of it is worth deflating
 _WORTH_IT = 0.75  # deflate an array whose sample shrinks below this fraction of its size
@@ -147,21 +147,21 @@ def check_output_file(path: str | Path, option: str, *, force: bool) -> Path:
     path = Path(path)
     kind = _kind(path)
     if kind == "folder" or text.endswith(os.sep):
-        raise OutputRefused(f"{option} {text} is a folder: give a file name (e.g. {path / 'name'})")
+        raise OutputRefused(f"{option} {shown_name(text)} is a folder: give a file name (e.g. {shown(path / 'name')})")
     if _is_open_stream(path):  # /dev/stdout: written into, wherever it is redirected
         return path
     problem = output_path_problem(path.parent)
     if problem:
-        raise OutputRefused(f"{option} {path}: {problem}")
+        raise OutputRefused(f"{option} {shown(path)}: {problem}")
     if kind in ("socket", "block device", "special file"):
-        raise OutputRefused(f"{option} {path} is a {kind}, not a file: give a file to write to")
+        raise OutputRefused(f"{option} {shown(path)} is a {kind}, not a file: give a file to write to")
     if path.is_symlink() and kind not in ("character device", "FIFO") and not force:
         raise OutputRefused(
-            f"{option} {path} is a symbolic link: give another file, or --force to replace the link "
+            f"{option} {shown(path)} is a symbolic link: give another file, or --force to replace the link "
             "(the file it points at is never written)"
         )
     if kind == "file" and not force:
-        raise OutputRefused(f"{option} {path} exists: give another file, or --force to replace it")
+        raise OutputRefused(f"{option} {shown(path)} exists: give another file, or --force to replace it")
     return path
 
 

@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown, shown_name
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
@@ -263,12 +263,12 @@ def run_state(folder: str | Path) -> RunState:
     """The state of the run (or sweep) in ``folder``; RunFolderError if it holds none (or a damaged one)."""
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
-        raise RunFolderError(f"{folder} is not a run folder (not a folder, or a link to one)")
+        raise RunFolderError(f"{shown_name(folder)} is not a run folder (not a folder, or a link to one)")
     if is_sweep_folder(folder):
         return sweep_state(folder)
     manifest = RunDirectory(folder).state()  # read as untrusted input
     if manifest is None:
-        raise RunFolderError(f"{folder} holds no run (no {STATE_FILE})")
+        raise RunFolderError(f"{shown_name(folder)} holds no run (no {STATE_FILE})")
     preset = manifest.get("preset") if isinstance(manifest.get("preset"), dict) else {}
     name = str(preset.get("name") or folder.name)
     status = str(manifest.get("status") or "?")

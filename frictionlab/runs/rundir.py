@@ -144,7 +144,7 @@ class RunDirectory:
         lock = self.path / LOCK_FILE
         if lock.is_symlink() or (os.path.lexists(lock) and not lock.is_file()):  # a link would be truncated through
             raise RunFolderError(
-                f"{lock} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
+                f"{shown(lock)} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
                 "(remove it, or give another folder)"
             )
         # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
@@ -161,7 +161,7 @@ class RunDirectory:
                 text = ""
             holder = (shown(text) if text.startswith(f"pid {pid},") else f"pid {pid}") if pid else "a process that cannot be verified"
             raise RunFolderError(
-                f"{self.path} is in use by another run ({holder}): wait for it to end, "
+                f"{shown(self.path)} is in use by another run ({holder}): wait for it to end, "
                 "or give another output folder"
             ) from None
         return self
@@ -205,7 +205,7 @@ class RunDirectory:
         path = self.path / PRESET_FILE
         if not self.path.is_dir():
             what = "is not a folder" if os.path.lexists(self.path) else "does not exist"
-            raise RunFolderError(f"{self.path} {what}: there is no run to resume there")
+            raise RunFolderError(f"{shown(self.path)} {what}: there is no run to resume there")
         if not os.path.lexists(path):
             raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
         try:

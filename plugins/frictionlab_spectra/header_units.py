@@ -2,7 +2,9 @@
 label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
 ``# Value units: m``). A table's numbers are read bare, so what its header says of their units
 is checked against the preset (``check_table_header``); a text export read by SurfaceTopography
-is checked the same way where its reader skips the header (``instrument_reader``)."""
+is checked the same way where its reader skips the header (``instrument_reader``). A column
+labelled in a unit that is no length (``z [V]``, ``phase [deg]``; a bare ``A`` is the ampere)
+holds no heights, and is refused (``check_heights_are_lengths``)."""
 
 from __future__ import annotations
 
@@ -10,10 +12,17 @@ import re
 
 HEADER_BYTES = 4096  # of a text file read for the units its header names
 LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
-               "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5"}  # fmt: skip
+               "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5", "\u212b": "\u00c5", "angstrom": "\u00c5",
+               "angstroms": "\u00c5"}  # fmt: skip
 # inch-based lengths, as US profilometers export them: named by a header, never converted, so refused
 IMPERIAL = r"inch(?:es)?|in|mils?|thou|[u\u00b5\u03bc]in|micro-?inch(?:es)?"
-_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5"
+_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5|\u212b|angstroms?"
+# units of what is no length, as instruments label a channel's column: volts, amperes (a bare "A" is
+# an ampere here, as in SI: an angstrom is written \u00c5), angles, frequencies, forces, pressures, counts
+NOT_LENGTH = (r"[fpn\u00b5\u03bcumkM]?V|[fpn\u00b5\u03bcum]?A|deg|\u00b0|m?rad|[kMG]?Hz|[pn\u00b5\u03bcum]?N|[kMG]?Pa|"
+              r"a\.\s?u\.?|arb\.?(?:\s?units?)?|counts?|cps|%|dB")  # no second: "height(s)"
+# "z [V]", "height (nA)", "phase/deg": in brackets, or after a slash at a cell's end (not "S/N ratio")
+_NOT_LENGTH_LABEL = re.compile(rf"[\[(]\s*(?:{NOT_LENGTH})\s*[\])]|/\s*(?:{NOT_LENGTH})\s*(?=[,;\t]|$)")
 _LABEL = re.compile(  # x [µm], z (nm), z/nm; an inch only in brackets or after a slash ("z (in nm)" names nm)
     rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)|[\[(]\s*({IMPERIAL})\s*[\])]|/\s*({IMPERIAL})\s*(?=[,;\t]|$)"
 )
@@ -22,6 +31,8 @@ _SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
 # "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
 _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # keys in any case
+# "# Value units: V": a unit key of an instrument's text export (Gwyddion's) stating one that is no length
+_STATED_NOT_LENGTH = re.compile(rf"\b(?i:{_UNIT_KEYS})\s*[:=]\s*(?P<unit>{NOT_LENGTH})\s*$")
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
 
 
@@ -49,6 +60,41 @@ def named_units(text: str) -> tuple[list[str], bool]:
     return units, stated_by_key
 
 
+def not_length_label(text: str) -> tuple[str, str] | None:
+    """The column label of the header of ``text`` whose unit is no length (``z [V]``,
+    ``height (nA)``, ``phase/deg``: on its last line, over the numbers, not in metadata such as
+    ``# Setpoint (%): 50``; ``Value units: V`` on any), and that unit; None when there is none."""
+    labels = ""
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
+        if NUMBERS.match(line):
+            break
+        if stated := _STATED_NOT_LENGTH.search(line.rstrip()):
+            return line[stated.start() :].strip(), stated["unit"]
+        labels = line if line.strip() else labels
+    if found := _NOT_LENGTH_LABEL.search(labels):
+        start = max(labels.rfind(mark, 0, found.start()) for mark in ",;\t#])") + 1  # the label's cell
+        return labels[start : found.end()].strip(), found.group().strip("[]()/ \t")
+    return None
+
+
+def check_heights_are_lengths(text: str, where: str) -> None:
+    """Refuse a file whose header labels a column in a unit that is no length (an AFM's channel
+    in volts, amperes, degrees, hertz): its numbers are not heights, and were read as heights in
+    the preset's unit without a word."""
+    from .instrument_file import LENGTH_UNITS  # here: it imports this module
+    from .instrument_reader import quoted
+
+    if (found := not_length_label(text)) is None:
+        return
+    label, unit = found
+    ampere = " (A is the ampere; an angstrom is written \u00c5)" if unit == "A" else ""
+    raise ValueError(
+        f"{where}: its header's {quoted(label)} says numbers in {unit}{ampere}, which is not a length unit "
+        f"(allowed: {', '.join(LENGTH_UNITS)}): they are not heights; export the height channel alone, with "
+        "its length unit (an instrument file's other channels are picked with channel)"
+    )
+
+
 def check_table_header(path, where: str, unit: str | None, format: str) -> None:
     """Refuse a table (read as bare numbers) whose header says its numbers are not what the
     preset takes them for: a header of an instrument's text export that states its size or units
@@ -57,7 +103,9 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> None:
     from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
-        units, export = named_units(head_text(fh, "utf-8-sig"))
+        head = head_text(fh, "utf-8-sig")
+    check_heights_are_lengths(head, where)
+    units, export = named_units(head)
     if export and format == "auto":
         raise ValueError(
             f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "

@@ -26,16 +26,17 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_points, check_header_units, check_payload, check_text_room, choose_reader,
-    describe_failure, pick_channel,
+    channel_list, check_declared_bytes, check_declared_points, check_header_units, check_not_amperes, check_payload,
+    check_text_heights, check_text_room, choose_reader, describe_failure, pick_channel,
     TEXT_FORMATS, quoted,
 )
 
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
 # the units a preset may ask for, in metres
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "pm": 1e-12}
-Unit = Literal["m", "mm", "um", "nm", "pm"]
+# (the angstrom, 1e-10 m, as AFM files state it, spelled \u00c5: a bare "A" is the ampere)
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "\u00c5": 1e-10, "pm": 1e-12}
+Unit = Literal["m", "mm", "um", "nm", "\u00c5", "pm"]
 Undefined = Literal["refuse", "harmonic"]
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 
@@ -89,6 +90,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
             chosen, _ = pick_channel(reader, channel, where)
             shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
+            check_declared_bytes(shape, where, fh)  # more points than its bytes hold: the full read names the damage
             sizes = chosen.physical_sizes
             pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
             unit = chosen.unit if isinstance(chosen.unit, str) else None
@@ -168,7 +170,7 @@ def length_factor(unit: str | None, to: str, where: str, what: str) -> float:
     except Exception:  # noqa: BLE001 - any unit it does not know
         factor = math.nan
     if not (math.isfinite(factor) and factor > 0):
-        raise ValueError(f"{where}: {what} {quoted(unit)} is not a length unit (m, mm, um, nm, pm, ...); "
+        raise ValueError(f"{where}: {what} {quoted(unit)} is not a length unit ({', '.join(LENGTH_UNITS)}, ...); "
                          "choose a channel of heights, or convert the file")  # fmt: skip
     return factor
 
@@ -184,11 +186,13 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
+        check_not_amperes(type(reader), chosen, where)
         check_payload(fh, type(reader), where, checksum=False)
         if chosen.nb_grid_pts is not None:
-            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where)
+            check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where, fh, type(reader))
         check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
+        check_text_heights(fh, type(reader), where)
         check_header_units(fh, type(reader), file_unit, unit, where)
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")

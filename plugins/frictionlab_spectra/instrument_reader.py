@@ -17,13 +17,14 @@ import os
 import re
 import zipfile
 
-from .header_units import NUMBERS, check_units_named, head_text, named_units
+from .header_units import NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
+AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
 
 
 def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None):
@@ -118,12 +119,42 @@ def header_units(fh, reader) -> list[str]:
     return named_units(head_text(fh))[0]
 
 
+def check_text_heights(fh, reader, where: str) -> None:
+    """Refuse a text export whose header labels a column in a unit that is no length
+    (``header_units.check_heights_are_lengths``): its reader skips the header."""
+    if reader.format() in TEXT_FORMATS:
+        check_heights_are_lengths(head_text(fh), where)
+
+
 def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
     """Refuse a text export whose header names length units (``x [\u00b5m]``, ``z [nm]``) that its
     reader does not read, when they differ, or differ from the preset's ``unit``: the heights and
     the pixel would be taken as bare numbers in that unit, the slopes off by their ratio."""
     if file_unit is None:
         check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
+
+
+def check_not_amperes(reader, channel, where: str) -> None:
+    """Refuse a Gwyddion channel whose values are in A: Gwyddion's unit strings are SI, A the
+    ampere (an STM's current), but SurfaceTopography's reader takes A for the angstrom and read
+    a current channel as heights without a word (Gwyddion stores an angstrom as m)."""
+    if _gwyddion_amperes(reader, channel):
+        raise ValueError(
+            f"{where}: channel {channel.index} ({quoted(channel.name)}) holds values in A, Gwyddion's symbol of the "
+            "ampere (a current, not heights; Gwyddion stores an angstrom as m): choose the channel of heights with "
+            "channel, or export the height channel"
+        )
+
+
+def _gwyddion_amperes(reader, channel) -> bool:
+    """Whether ``channel`` of a Gwyddion file holds values in A (``check_not_amperes``)."""
+    if reader.format() != "gwy":
+        return False
+    try:
+        field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
+        return field["si_unit_z"]["GwySIUnit"]["unitstr"] == "A"
+    except (AttributeError, KeyError, TypeError):  # a file this does not follow: its reader's reading stands
+        return False
 
 
 def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
@@ -165,12 +196,26 @@ def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights take {stored} bytes, and its description "
             f"declares {points} points of data type {kind} ({X3P_ITEM_BYTES[kind]} bytes each: {declared} bytes); "
-            "copy it again from the instrument, or export it from there again"
+            + AGAIN
         )
     if found is not None and found != declared_sum:
         raise ValueError(
             f"{where}: a damaged {reader.name()} file: its binary heights' MD5 checksum is {found}, and its "
-            f"description declares {declared_sum}; copy it again from the instrument, or export it from there again"
+            f"description declares {declared_sum}; {AGAIN}"
+        )
+
+
+def check_declared_bytes(points: tuple[int, ...], where: str, fh, reader=None) -> None:
+    """Refuse a header that declares more points than the open file ``fh``'s bytes could hold
+    even compressed (a forged or truncated file: damage, not a map too large to read, which the
+    memory estimate said), named as of ``reader``'s format when known."""
+    size = os.fstat(fh.fileno()).st_size
+    if math.prod(points) > size * MOST_POINTS_A_BYTE:
+        shape = " x ".join(map(str, points))
+        raise ValueError(
+            f"{where}: a damaged or truncated {'' if reader is None else reader.name() + ' '}file: its header declares "
+            f"{shape} points (x by y), and the file has {size:,} bytes, too few to hold them even compressed (at most "
+            f"{MOST_POINTS_A_BYTE} points a byte); {AGAIN}"
         )
 
 
@@ -193,17 +238,23 @@ def room_to_read() -> tuple[int, str]:
     return min(found)
 
 
-def check_declared_points(points: tuple[int, ...], where: str) -> None:
+MOST_POINTS_A_BYTE = 1032  # deflate's greatest ratio: a point of one byte, compressed, takes at least 1/1032 byte
+
+
+def check_declared_points(points: tuple[int, ...], where: str, fh=None, reader=None) -> None:
     """Refuse, from the header alone, a file that declares more points than this process can
     read (a forged NetCDF of 100000^2, an X3P of 22000^2), naming the limit; or a side of fewer
-    than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound)."""
+    than 1 point (a Gwyddion reader took -40 for 40 and read the map as if it were sound); or,
+    first, more points than the open file ``fh``'s bytes hold (``check_declared_bytes``)."""
+    shape = " x ".join(map(str, points))
     if min(points, default=1) < 1:
-        raise ValueError(f"{where}: the file declares {' x '.join(map(str, points))} points (x by y), a side of fewer "
-                         "than 1: a damaged header; copy it again from the instrument, or export it from there again")
+        raise ValueError(f"{where}: the file declares {shape} points (x by y), a side of fewer than 1: a damaged "
+                         f"header; {AGAIN}")  # fmt: skip
+    if fh is not None:
+        check_declared_bytes(points, where, fh, reader)
     need = math.prod(points) * 8 * HEIGHT_COPIES
     room, source = room_to_read()
     if need > room:
-        shape = " x ".join(str(n) for n in points)
         raise ValueError(
             f"{where}: the file declares {shape} points (x by y); reading them takes about {need / 2**30:.3g} GiB, "
             f"more than the {room / 2**30:.3g} GiB this process may use ({source}); crop the scan with the "
@@ -295,7 +346,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
     if isinstance(exc, CorruptFile):
         kind = "a damaged"
     return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
-                      "its format cannot read it: copy it again from the instrument, or export it from there again")  # fmt: skip
+                      f"its format cannot read it: {AGAIN}")  # fmt: skip
 
 
 REASON_SHOWN = 160
@@ -330,6 +381,7 @@ def channel_list(reader) -> list[dict]:
             data_unit = channel.data_unit
         except Exception:  # noqa: BLE001 - a reader that cannot say: nothing to list
             data_unit = None
+        data_unit = "A" if _gwyddion_amperes(type(reader), channel) else data_unit  # not m, as its reader says
         listed.append({
             "index": int(channel.index), "name": str(channel.name),
             "points": [int(n) for n in channel.nb_grid_pts] if channel.nb_grid_pts is not None else None,

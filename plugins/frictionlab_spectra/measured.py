@@ -13,7 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
-from .instrument_file import ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
+from .instrument_file import LENGTH_UNITS, ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
 from .map_pipeline import FileFormat
 
 
@@ -28,6 +28,9 @@ class Measured:
     summary: dict[str, Any]  # what was read, and where each value came from
 
 
+ANGSTROM = ("\u212b", "angstrom", "angstroms")  # the angstrom sign, and in words (any case)
+
+
 class MeasuredParams(PluginParams):
     """The parameters a measured line and a measured map share, in the order of their forms:
     each file kind words ``path``, ``spacing`` and ``detrend`` for itself."""
@@ -36,7 +39,7 @@ class MeasuredParams(PluginParams):
     spacing: float | None = Field(None, description="grid spacing", gt=0.0)
     unit: Unit | None = Field(
         None,
-        description="length unit of the heights and the spacing in this run (m, mm, um, nm, pm): an instrument "
+        description="length unit of the heights and the spacing in this run (m, mm, um, nm, \u00c5, pm): an instrument "
         "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
     )
     undefined: Undefined = Field(
@@ -63,7 +66,12 @@ class MeasuredParams(PluginParams):
     @field_validator("unit", mode="before")
     @classmethod
     def _micro_sign(cls, unit: object) -> object:
-        # um as an instrument writes it: with the micro sign or the Greek mu, or as microns
+        # um as an instrument writes it: with the micro sign or the Greek mu, or as microns; the angstrom too
+        if unit == "A":  # the ampere's symbol, or an angstrom in ASCII: never guessed
+            raise ValueError(f"must be a length unit ({', '.join(LENGTH_UNITS)}): A is the ampere; an angstrom "
+                             "(1e-10 m) is written \u00c5")  # fmt: skip
+        if isinstance(unit, str) and (unit in ANGSTROM or unit.lower() in ANGSTROM):
+            return "\u00c5"
         return "um" if unit in ("\u00b5m", "\u03bcm", "micron", "microns") else unit
 
     @model_validator(mode="after")

@@ -105,6 +105,8 @@ def _table(text, where: str) -> np.ndarray:
             raise ValueError(f"{where}: {_trailing_text(lineno, delimiter)}")
         if _mostly_numbers(cells, delimiter):  # a row of heights with a cell that is not one: named below
             break
+        if _numbers(cells.replace(",", "."), ";" if ";" in cells else None):  # 1,5;2,25: numbers, not a header
+            raise ValueError(f"{where}: {_decimal_commas(lineno)}")
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     text.seek(0)
     if delimiter == "," and COMMA_DECIMAL.fullmatch(cells):  # two whole numbers: x, z, or one decimal-comma height?
