@@ -19,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..compute import engine
+from ..compute.signals import WorkInterrupted, interrupted_exit_code, interrupted_word
+from ..errors import RunError
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
 from ..preset.builtin import resolve_preset_path
@@ -59,6 +61,11 @@ def count_curve(data: dict, options: RunOptions = RunOptions(), listeners=()) ->
         "loading.steps=2000", "loading.spacing=log", "fit.bootstrap=0", "sweep=null",
     ]  # fmt: skip
     outcome = engine.run(build_scene(apply_overrides(data, wide)), options, listeners=listeners)
+    done = f"after {len(outcome.indices)} of {outcome.requested} realizations"
+    if outcome.status in ("interrupted", "cancelled"):  # a part of the ensemble gives another h: never print it
+        raise WorkInterrupted(f"the calibration's ensemble ended {outcome.status} {done}; no h from a part of it")
+    if outcome.status != "completed":
+        raise RunError(f"the calibration's ensemble {outcome.status} {done}: {outcome.error}")
     return CountCurve(np.log(outcome.loads), np.log(outcome.contact_count))
 
 
@@ -105,6 +112,10 @@ def cli(argv: list[str] | None = None) -> int:
     except FrictionlabError as exc:
         print(f"frictionlab: {exc}", file=sys.stderr)
         return int(exc.exit_code)
+    except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: said in a line, with the signal's exit code
+        said = f": {exc}" if str(exc) else ""
+        print(f"frictionlab: {interrupted_word()}{said}", file=sys.stderr)
+        return int(interrupted_exit_code())
     return 0
 
 

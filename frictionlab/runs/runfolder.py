@@ -33,7 +33,7 @@ from ..errors import RunFolderError, shown
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
-MAX_CSV_BYTES = 16 * 1024 * 1024  # curve.csv: a row of 7 numbers per load step
+MAX_CSV_BYTES = 16 * 1024 * 1024  # curve.csv: a row of 9 to 14 numbers per load step
 
 
 def _member(name: str) -> str:

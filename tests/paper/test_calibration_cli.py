@@ -1,11 +1,19 @@
 """`python -m frictionlab.paper.calibration`: usage and input errors in a line, no traceback."""
 
+import os
+import signal
 import subprocess
 import sys
 
 import pytest
 
+from frictionlab import hookimpl
+from frictionlab.compute import signals
+from frictionlab.compute.signals import WorkInterrupted
+from frictionlab.options import RunOptions
 from frictionlab.paper import calibration
+from frictionlab.preset import load_preset_file
+from frictionlab.preset.builtin import resolve_preset_path
 
 
 def calibrate(*args: str, cwd=None) -> subprocess.CompletedProcess:
@@ -53,3 +61,37 @@ def test_the_clone_s_path_outside_the_clone_names_the_built_in(tmp_path):
     done = calibrate("presets/benad2012-fig2.yaml", cwd=tmp_path)
     assert done.returncode == 3 and "Traceback" not in done.stderr
     assert "the built-in preset of that name is 'benad2012-fig2'" in done.stderr
+
+
+class InterruptAtFirstRealization:
+    """Ctrl-C as the first line finishes: the run's own handler cancels the rest."""
+
+    @hookimpl
+    def realization_done(self, done):
+        if done == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+
+def test_an_interrupted_calibration_gives_no_h_from_part_of_its_ensemble():
+    """Ctrl-C ended the calibration's ensemble early, and the h of the lines that had finished
+    was printed as the answer, with exit code 0."""
+    data = load_preset_file(resolve_preset_path("quickstart"))
+    data["realizations"] = 6
+    with pytest.raises(WorkInterrupted, match=r"ended interrupted after 1 of 6 realizations; no h from a part of it"):
+        calibration.count_curve(data, RunOptions(workers=1, executor="serial"), [InterruptAtFirstRealization()])
+
+
+def test_an_interrupted_calibration_is_said_in_a_line_with_the_signal_s_exit_code(monkeypatch, capsys):
+    def interrupted(*args, **kwargs):
+        signals.received.append(signal.SIGINT)
+        raise WorkInterrupted("the calibration's ensemble ended interrupted after 1 of 6 realizations")
+
+    monkeypatch.setattr(signals, "received", [])
+    monkeypatch.setattr(calibration, "count_curve", interrupted)
+    try:
+        code = calibration.cli(["quickstart"])
+    except KeyboardInterrupt:
+        pytest.fail("the interrupt escaped as a traceback")
+    assert code == 130
+    out, err = capsys.readouterr()
+    assert out == "" and err == "frictionlab: interrupted: the calibration's ensemble ended interrupted after 1 of 6 realizations\n"
