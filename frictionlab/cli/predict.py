@@ -12,8 +12,8 @@ def add_parser(sub) -> None:
         help="rms slope in contact of a 3D contact from a fitted law",
         description="The rms slope in contact of a contact of area A, modulus E*, rms height h under force F, "
         "from a law xi = a + b ln f (given, or a run folder's), with its interval.",
-        epilog="examples:\n  frictionlab predict --a 1.88 --b 0.08 --area 1e-4 --modulus 1e9 --rms-height 1e-6 --force 10\n"
-        "  frictionlab predict --from runs/fig2 --area 1e-4 --modulus 1e9 --rms-height 1e-6 --force 10 --json",
+        epilog="examples:\n  frictionlab predict --a 1.88 --b 0.08 --area 1e-4 --modulus 1e9 --rms-height 1e-6 --force 1e-5\n"
+        "  frictionlab predict --from runs/fig2 --area 1e-4 --modulus 1e9 --rms-height 1e-6 --force 1e-5 --json",
     )
     p.add_argument("--a", type=float, help="the law's a")
     p.add_argument("--b", type=float, help="the law's b")
