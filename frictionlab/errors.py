@@ -295,3 +295,24 @@ def warn_user(message: str) -> None:
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, stacklevel=level + 1 if frame is not None else 2)
+
+
+def _quiet_stdout() -> None:
+    """After a BrokenPipeError: point stdout at /dev/null so the interpreter's
+    final flush does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # stdout without a descriptor (a test's capture)
+        pass
+
+
+def output_failed(exc: OSError) -> int:
+    """stdout could not be written: a closed pipe ends quietly (its reader has enough),
+    anything else (a full disk) is said on stderr."""
+    _quiet_stdout()  # the interpreter's last flush must not fail again
+    if isinstance(exc, BrokenPipeError):
+        return int(ExitCode.BROKEN_PIPE)
+    print(f"error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
+    return int(ExitCode.RUNTIME_FAILURE)

@@ -30,7 +30,7 @@ import sys
 import warnings
 
 from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
-                      short_repr, shown, too_long_path)  # fmt: skip
+                      output_failed, short_repr, shown, too_long_path)  # fmt: skip
 from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
@@ -224,17 +224,6 @@ def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {shown(str(message))}\n"  # a resume's warning names a folder
 
 
-def _quiet_stdout() -> None:
-    """After a BrokenPipeError: point stdout at /dev/null so the interpreter's
-    final flush does not fail again."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError):  # stdout without a descriptor (a test's capture)
-        pass
-
-
 def program() -> None:
     """The ``frictionlab`` command (and ``python -m frictionlab``): ``main``, then exit."""
     # Start-up makes some 10^5 objects that live as long as the process (modules, classes,
@@ -326,7 +315,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         return _print(None)  # a closed pipe under --help shows in this flush, as under any command
     except OSError as exc:  # the help could not be written: `| head -1` (a closed pipe), `> /dev/full`
-        return _write_failed(exc)
+        return output_failed(exc)
     args.parser = parser  # a command that describes the CLI itself (completion) reads it
     if args.command is None:  # only options, none of which exits (there are none today)
         return _print(short_help())
@@ -341,18 +330,8 @@ def _print(text: str | None) -> int:
             print(text)
         sys.stdout.flush()
     except OSError as exc:
-        return _write_failed(exc)
+        return output_failed(exc)
     return int(ExitCode.OK)
-
-
-def _write_failed(exc: OSError) -> int:
-    """stdout could not be written: a closed pipe ends quietly (its reader has enough),
-    anything else (a full disk) is said on stderr."""
-    _quiet_stdout()  # the interpreter's last flush must not fail again
-    if isinstance(exc, BrokenPipeError):
-        return int(ExitCode.BROKEN_PIPE)
-    print(f"error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
-    return int(ExitCode.RUNTIME_FAILURE)
 
 
 def _run_command(args) -> int:
@@ -365,12 +344,12 @@ def _run_command(args) -> int:
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough
-        return _write_failed(exc)
+        return output_failed(exc)
     except FrictionlabError as exc:
         return _refused(args, shown(str(exc)), exc.exit_code, f"{error_label()}: ", exc.problems)
     except OSError as exc:  # the machine said no (disk full, permission denied): not a bug
         if not exc.filename:  # stdout itself (`> /dev/full`)
-            return _write_failed(exc)
+            return output_failed(exc)
         if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
             return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
         return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
@@ -413,7 +392,7 @@ def _refused(args, message: str, code: int, label: str = "error: ", problems=Non
             jsonout.emit_error(_command_path(args), message, int(code), problems)
             sys.stdout.flush()
         except OSError as exc:
-            _write_failed(exc)
+            output_failed(exc)
     return int(code)
 
 

@@ -96,7 +96,7 @@ def cli(argv: list[str] | None = None) -> int:
     """``python -m frictionlab.paper.calibration PRESET``: usage and input errors said in a line."""
     import argparse
 
-    from ..errors import FrictionlabError
+    from ..errors import FrictionlabError, output_failed
 
     parser = argparse.ArgumentParser(
         prog="python -m frictionlab.paper.calibration",
@@ -109,6 +109,9 @@ def cli(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         main(args.preset)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's last flush
+    except BrokenPipeError as exc:  # `... | head -1`: the reader has enough
+        return output_failed(exc)
     except FrictionlabError as exc:
         print(f"frictionlab: {exc}", file=sys.stderr)
         return int(exc.exit_code)

@@ -95,3 +95,21 @@ def test_an_interrupted_calibration_is_said_in_a_line_with_the_signal_s_exit_cod
     assert code == 130
     out, err = capsys.readouterr()
     assert out == "" and err == "frictionlab: interrupted: the calibration's ensemble ended interrupted after 1 of 6 realizations\n"
+
+
+def test_a_closed_pipe_ends_the_calibration_quietly(tmp_path):
+    """`python -m frictionlab.paper.calibration PRESET | head -0`: no traceback, the closed
+    pipe's exit code, as every frictionlab command ends on one."""
+    from frictionlab.errors import ExitCode
+
+    preset = tmp_path / "small.yaml"
+    preset.write_text(resolve_preset_path("benad2012-fig2").read_text().replace("realizations: 300", "realizations: 4")
+                      .replace("points: 100000", "points: 2000").replace("length: 100000.0", "length: 2000.0"))  # fmt: skip
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run([sys.executable, "-m", "frictionlab.paper.calibration", str(preset)], stdout=write_end,
+                              stderr=subprocess.PIPE, timeout=120)  # fmt: skip
+    finally:
+        os.close(write_end)
+    assert done.stderr == b"" and done.returncode == ExitCode.BROKEN_PIPE
