@@ -1,10 +1,14 @@
 """A run's fit, its points in contact and its caveats on the Run and Results tabs at 60x20,
 80x24 and 120x40: whole, never cut at the panel's edge or below it."""
 
+from pathlib import Path
+from types import SimpleNamespace
+
 import pytest
 import yaml
 
 from frictionlab.tui.text import format_count
+from frictionlab.tui.widgets.results import _entry_lines
 
 from ..conftest import merge
 from .conftest import TINY, make_app, press_settled, run_to_the_end, screen_text, sweep_app, sync
@@ -69,8 +73,20 @@ async def test_the_results_box_at_60x20_breaks_its_lines_between_numbers(folders
         await press_settled(pilot, "enter")
         await pilot.pause()
         lines = [line.strip() for line in screen_text(app).splitlines()]
+        info = app.query_one("#results-info")
+        rows, said = info.size.height, str(info.render()).splitlines()
     count, _, fit = ended(app)
     shown = " ".join(line.split("  ")[-1].strip() for line in lines)
     assert f"{format_count(count[0])}..{format_count(count[-1])}" in shown, "\n".join(lines)
     assert f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]" in shown, "\n".join(lines)
     assert f"R^2={fit.r2:.4f}" in shown, "\n".join(lines)
+    assert rows == len(said), said  # each line within the box's columns: none wrapped again by the box
+
+
+def test_a_status_line_breaks_between_its_parts_in_a_narrow_box():
+    """`interrupted 3613/30000,` was one part, wider than the 18 columns of the box at 60x20."""
+    entry = SimpleNamespace(contact_counts=(26.5, 326.63), formula="F / (E* h L)", path=Path("quickstart-20261130-014711"),
+                            status="interrupted", done=3613, requested=30000, summary={}, fit=None)
+    lines = [str(line) for line in _entry_lines(entry, "cyan", 18)]
+    assert all(len(line) <= 18 for line in lines), lines
+    assert " ".join(" ".join(lines).split()).endswith("interrupted 3613/30000, contacts 26.5..327")

@@ -321,9 +321,9 @@ def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
         lines = [Content.assemble((shorten_run_name(name, width), style), f" {formula}" if formula else "")]
     else:
         lines = [Content.styled(shorten_run_name(name, width), style), *packed([formula], width)]
-    status = [f"{entry.status} {entry.done}/{entry.requested}"]
+    status = [entry.status, f"{entry.done}/{entry.requested}"]
     if math.isfinite(counts[0]):
-        status = [f"{status[0]},", "contacts", f"{format_count(counts[0])}..{format_count(counts[1])}"]
+        status = [status[0], f"{status[1]},", "contacts", f"{format_count(counts[0])}..{format_count(counts[1])}"]
     lines += packed(status, width)
     error = entry.summary.get("error")
     if isinstance(error, str) and error:  # why it failed (no law, say): the advice that comes with it
