@@ -67,7 +67,18 @@ class _Bar:
         self.progress.console.print(text, markup=False)
 
     def stop(self) -> None:
-        self.progress.stop()
+        console = self.progress.console
+        if not console.is_jupyter:
+            self.progress.stop()
+            return
+        # in a notebook rich's stop draws no last state (the bar stayed at its last refresh) and
+        # shows the console's empty buffer: a blank output under each bar. Drawn, then stopped quietly.
+        self.progress.refresh()
+        console.quiet = True
+        try:
+            self.progress.stop()
+        finally:
+            console.quiet = False
 
 
 SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond its first line

@@ -102,7 +102,7 @@ class PresetSaving:
         except OSError as exc:  # a read-only folder, not the user's, a file in the way
             self._ask_elsewhere(path, exc, lambda there: self._write(there, data, then_open, template))
             return
-        self.say(f"Saved {path}")
+        self.say(f"Saved {path}", until_open=not then_open)  # of the open preset: not of the next one opened
         self.reload_presets()
         self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:

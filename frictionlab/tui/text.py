@@ -47,6 +47,18 @@ def shorten_run_name(name: str, width: int) -> str:
     return shorten_middle(name, width)
 
 
+def packed(pieces: list[str], width: int, indent: str = "  ") -> list[str]:
+    """``pieces`` after ``indent``, as many a line as ``width`` holds: a narrow box (60x20)
+    breaks between them, never within a number or an interval."""
+    lines: list[str] = []
+    for piece in pieces:
+        if lines and len(lines[-1]) + 1 + len(piece) <= width:
+            lines[-1] += " " + piece
+        else:
+            lines.append(indent + piece)
+    return lines
+
+
 def format_count(value: float) -> str:
     """A mean count (points in contact) to 3 significant digits, in plain digits below
     1e5 (``0.750``, ``30.6``, ``621``, ``1350``): one column reads alike from row to row."""

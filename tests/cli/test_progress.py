@@ -131,3 +131,36 @@ def test_the_first_line_of_a_run_of_one_realization_says_realization(make_scene)
     stream = FakeTerminal()
     engine.run(make_scene({"realizations": 1}), RunOptions(workers=1), listeners=[ProgressReporter(stream, after=0)])
     assert stream.getvalue().startswith("small: 1 realization of power-law lines, 16 force steps")
+
+
+def test_a_notebook_bar_leaves_no_empty_output_under_it(monkeypatch, make_scene):
+    """rich, stopping its bar in a notebook, showed its console's empty buffer: an empty output
+    (a blank line) under every bar, one a point in a sweep."""
+    import builtins
+    import sys
+    import types
+
+    ipython = in_a_notebook(monkeypatch, widgets=True)
+    monkeypatch.setattr(builtins, "get_ipython", ipython.get_ipython, raising=False)  # as IPython's kernel sets it
+    shown = []
+    display = types.ModuleType("IPython.display")
+    display.display = lambda *objects, **_: shown.extend(objects)
+    monkeypatch.setitem(sys.modules, "IPython.display", display)
+
+    class Output:  # ipywidgets' output area: what is displayed within it goes to the bar's own place
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def clear_output(self, wait=False):
+            pass
+
+    sys.modules["ipywidgets"].Output = Output
+    reporter = ProgressReporter(io.StringIO(), after=0)
+    assert reporter.interactive
+    engine.run(make_scene({"realizations": 10}), RunOptions(workers=1), listeners=[reporter])
+    texts = [getattr(item, "text", None) for item in shown if not isinstance(item, Output)]
+    assert texts and "10/10" in texts[-1]  # the bar drawn full at its end
+    assert all(text.strip() for text in texts), texts

@@ -17,8 +17,8 @@ from frictionlab.tui.widgets import PresetForm
 
 from ..conftest import PRESETS, merge
 from .conftest import (
-    SIZE, TINY, choose, error_text, headless_problems, make_app, new_preset, open_first_preset, press_settled, sync,
-    type_into,
+    SIZE, TINY, choose, error_text, headless_problems, make_app, new_preset, open_first_preset, post_keys, press_settled,
+    sync, type_into,
 )
 
 # ------------------------------------------------------------------ edit and save
@@ -283,3 +283,24 @@ async def test_a_switch_or_choice_put_back_to_what_the_file_left_unsaid_is_not_a
         chosen_back, data = app.modified, app._draft()
     assert (toggled, switched_back, chosen, chosen_back) == (True, False, True, False)
     assert "output" not in data and "params" not in data["slope"]
+
+
+@sync
+async def test_fields_left_fast_leave_the_help_and_enter_on_the_field_focused(folders, registry):
+    """Shift+Tab typed fast (held) from points to seed: the help went on telling of hurst, and
+    Esc then Enter went back into hurst, so what was typed next changed another field."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("f3")
+        await pilot.pause()
+        app.query_one("#field--spectrum--params--points").focus()
+        await pilot.pause()
+        post_keys(app, ["shift+tab"] * 4)  # hurst, the spectrum's plugin, realizations, seed
+        await pilot.pause()
+        await pilot.pause(0.2)
+        focused = app.focused.id
+        help_line = str(app.query_one("#field-help", Static).render())
+        await pilot.press("escape", "enter")
+        assert focused == "field--seed"
+        assert help_line.startswith("seed:"), help_line
+        assert app.focused.id == "field--seed"

@@ -269,5 +269,5 @@ async def test_a_finished_run_shows_its_caveats_as_the_cli_prints_them(folders, 
     app = make_app(registry, preset="presets/coarse.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
         await run_to_the_end(pilot)
-        shown = " ".join(str(app.query_one("#run-fit", Static).render()).split())
+        shown = " ".join(str(app.query_one("#run-caveats", Static).render()).split())  # under the plot, wrapped
     assert "caveat: the short cut-off spans 4 pixels" in shown

@@ -68,6 +68,22 @@ async def test_opening_another_preset_clears_the_error_about_the_first(folders, 
 
 
 @sync
+async def test_opening_another_preset_takes_back_saved_about_the_first(folders, registry):
+    """`Saved presets/tiny.yaml` stayed under the next preset opened, as if that one were saved there."""
+    (folders / "presets" / "other.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "other"})))
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await type_into(pilot, "field--realizations", "3")
+        await press_settled(pilot, "ctrl+s")
+        before = status_text(app)
+        await press_settled(pilot, "f2")
+        await app.open_preset(folders / "presets" / "other.yaml")
+        await pilot.pause()
+        after = status_text(app)
+    assert before == "Saved presets/tiny.yaml" and after == ""
+
+
+@sync
 async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_line(folders, registry):
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:

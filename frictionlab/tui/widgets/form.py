@@ -416,8 +416,11 @@ class PresetForm(VerticalScroll):
             focused.scroll_visible(animate=False)
 
     def on_descendant_focus(self, event) -> None:
-        self._last_field = event.widget
-        widget = event.widget
+        # keys typed fast (Shift+Tab held) move the focus on before each field's message comes, in
+        # no set order: the field focused now is the one (the help spoke of hurst, seed focused)
+        focused = self.screen.focused
+        widget = focused if focused is not None and self in focused.ancestors else event.widget
+        self._last_field = widget
         spec = self._specs.get(widget.id or "")
         if spec is None and (widget.id or "").startswith("plugin--"):
             slot = widget.id.removeprefix("plugin--")

@@ -24,7 +24,7 @@ from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..sweepview import STATUS_MARKS, row_cells, table_columns
-from ..text import format_count, shorten_run_name
+from ..text import format_count, packed, shorten_run_name
 from .chart import Chart
 from .run import fit_series
 from .tables import ListTable
@@ -87,6 +87,8 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
+        if self.overlay and self._info_about is None and self.open_sweep is None:
+            self.call_after_refresh(self._show_overlay)  # its lines broken to the box's new width
 
     def highlighted(self) -> RunEntry | SweepEntry | None:
         row = self.query_one("#runs-table", DataTable).cursor_row
@@ -293,9 +295,14 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             series.append(Series(f, xi, style))
             if math.isfinite(entry.a):
                 series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
-            lines += _entry_lines(entry, style)
+            lines += _entry_lines(entry, style, self._info_width())
         self.query_one("#results-chart", Chart).show(series, empty="run removed" if note else NO_DATA)
         self._inform(Content("\n").join(lines) if lines else HINT)
+
+    def _info_width(self) -> int:
+        """The columns of the box under the plot, less its scroll bar's (unknown before it is laid out: as if wide)."""
+        box = self.query_one("#results-info-box")
+        return box.size.width - box.styles.scrollbar_size_vertical if box.size.width else 200
 
     def _inform(self, text: Content | str) -> None:
         """The info box under the plot says ``text``, from its first line (the box scrolls where
@@ -304,18 +311,25 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         self.query_one("#results-info-box").scroll_home(animate=False)
 
 
-def _entry_lines(entry: RunEntry, style: str) -> list[Content]:
-    """What the overlay says of one run: f, its status and contacts, its fit."""
+def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
+    """What the overlay says of one run: f, its status and contacts, its fit; in ``width``
+    columns, broken between its parts (at 60x20 the box has 20)."""
     counts = entry.contact_counts
-    formula = entry.formula
-    lines = [Content.assemble((f"■ {entry.path.name}", style), f" f = {formula}" if formula else "")]
-    contacts = f", contacts {format_count(counts[0])}..{format_count(counts[1])}" if math.isfinite(counts[0]) else ""
-    lines.append(f"  {entry.status} {entry.done}/{entry.requested}{contacts}")
+    formula = f"f = {entry.formula}" if entry.formula else ""
+    name = f"■ {entry.path.name}"
+    if len(name) + 1 + len(formula) <= width or not formula:
+        lines = [Content.assemble((shorten_run_name(name, width), style), f" {formula}" if formula else "")]
+    else:
+        lines = [Content.styled(shorten_run_name(name, width), style), *packed([formula], width)]
+    status = [entry.status, f"{entry.done}/{entry.requested}"]
+    if math.isfinite(counts[0]):
+        status = [status[0], f"{status[1]},", "contacts", f"{format_count(counts[0])}..{format_count(counts[1])}"]
+    lines += packed(status, width)
     error = entry.summary.get("error")
     if isinstance(error, str) and error:  # why it failed (no law, say): the advice that comes with it
         lines.append(Content.assemble("  ", (shown(error), "red")))
     if entry.fit is not None:
         interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731
-        lines.append(f"  a={entry.a:.4f} {interval('a_ci')} R^2={entry.r2:.4f}")
-        lines.append(f"  b={entry.b:.4f} {interval('b_ci')}")
+        lines += packed([f"a={entry.a:.4f}", interval("a_ci"), f"R^2={entry.r2:.4f}"], width)
+        lines += packed([f"b={entry.b:.4f}", interval("b_ci")], width)
     return [Content(line) if isinstance(line, str) else line for line in lines]

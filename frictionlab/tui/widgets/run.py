@@ -10,7 +10,7 @@ import numpy as np
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, ProgressBar, Static
 
@@ -21,7 +21,7 @@ from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
 from ..sweepview import STATUS_MARKS, point_line, row_cells, table_cells, table_columns
-from ..text import failure_message, shorten_middle
+from ..text import failure_message, format_count, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
 
@@ -57,10 +57,38 @@ def fit_series(f: np.ndarray, a: float, b: float, style: str) -> Series:
     return Series(ends, a + b * np.log(ends), style, line=True)
 
 
-def _contact_lines(count) -> list[str]:
+def contact_lines(count, room: int | None = None) -> list[str]:
+    """The mean points in contact at the first and the last load in the ``room`` rows left
+    under the fit (None: all it takes): four, two or one line, never cut."""
     if count is None or not np.size(count):
         return []
-    return ["", "points in contact", f"  {count[0]:.2f} at first load", f"  {count[-1]:.2f} at last load"]
+    first, last = float(count[0]), float(count[-1])
+    forms = (
+        ["", "points in contact", f"  {first:.2f} at first load", f"  {last:.2f} at last load"],
+        ["points in contact", f"  {first:.2f} first .. {last:.2f} last"],
+        [f"contacts {format_count(first)}..{format_count(last)}"],  # as the sweep table's column
+    )
+    return next((form for form in forms if room is None or len(form) <= room), forms[-1])
+
+
+class FitPanel(Static):
+    """The fit beside the plot, then the points in contact in the rows it leaves: a sweep's
+    plot at 60x20 has 7, and the last lines were cut below the panel."""
+
+    def show(self, lines: list[str], count=None) -> None:
+        self._lines, self._count = lines, count
+        self._fill()
+
+    def on_resize(self) -> None:
+        if hasattr(self, "_lines"):
+            self._fill()
+
+    def _fill(self) -> None:
+        room = self.size.height - len(self._lines) if self.size.height else None
+        text = "\n".join(self._lines + contact_lines(self._count, room))
+        if text != getattr(self, "_text", None):
+            self._text = text
+            self.update(Content(text))
 
 
 R_ON_RUN_TAB = "r reloads the lists on the Presets and Results tabs; Ctrl+R runs the open preset."
@@ -85,7 +113,9 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         yield Static("", id="run-stats")
         with Horizontal(id="run-body"):
             yield Chart(id="run-chart")
-            yield Static("", id="run-fit")
+            yield FitPanel("", id="run-fit")
+        with VerticalScroll(id="run-caveats-box", can_focus=False):  # wrapped, whole; scrolls at 60x20
+            yield Static("", id="run-caveats")
         yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
         yield Static("", id="run-error")
 
@@ -117,7 +147,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _set(self, widget_id: str, text: str | Content) -> None:
         """Show ``text`` as it is: names, values and errors are never read as markup."""
         self.query_one(f"#{widget_id}", Static).update(Content(text) if isinstance(text, str) else text)
-        if widget_id in ("run-stats", "run-error"):  # one line or two: the table's room changes
+        if widget_id in ("run-stats", "run-error", "run-caveats"):  # one line or two: the table's room changes
             self.call_after_refresh(self._fit_table)
 
     def on_resize(self) -> None:
@@ -145,6 +175,12 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         plot_rows = max(1, min(PLOT_ROWS, room - height))
         if body.styles.min_height is None or body.styles.min_height.value != plot_rows:
             body.styles.min_height = plot_rows
+
+    def _caveats(self, caveats: list[str]) -> None:
+        """Under the plot, the width of the tab: beside the fit, a caveat's line set the panel's
+        width, the plot gone and the caveat cut at the edge."""
+        self.query_one("#run-caveats-box").display = bool(caveats)
+        self._set("run-caveats", "\n".join(caveats))
 
     def _error(self, text: str) -> None:
         self._set("run-error", Content.styled(shown(text), "red"))  # a run's error may quote a file
@@ -181,7 +217,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _clear_fit(self) -> None:
         """No curve nor fit of an earlier run under this one's count."""
         self.query_one("#run-chart", Chart).show([])
-        self._set("run-fit", "\n".join(fit_lines(None, final=False)))
+        self.query_one("#run-fit", FitPanel).show(fit_lines(None, final=False))
+        self._caveats([])
 
     # ------------------------------------------------------------ while it runs
 
@@ -195,8 +232,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             if snap.fit is not None:
                 series.append(fit_series(snap.f, snap.fit.a, snap.fit.b, "yellow"))
             self.query_one("#run-chart", Chart).show(series)
-            lines = fit_lines(snap.fit, final=False, f_formula=snap.f_formula) + _contact_lines(snap.contact_count)
-            self._set("run-fit", "\n".join(lines))
+            lines = fit_lines(snap.fit, final=False, f_formula=snap.f_formula)
+            self.query_one("#run-fit", FitPanel).show(lines, snap.contact_count)
         if snap.first_error:
             self._error(snap.first_error)
 
@@ -254,8 +291,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             series = [Series(f, xi, "cyan"), fit_series(f, result.fit.a, result.fit.b, "yellow")]
             self.query_one("#run-chart", Chart).show(series)
         lines = fit_lines(result.fit, final=True, f_formula=run.f_formula)
-        caveats = [f"caveat: {caveat}" for caveat in result.caveats]  # as frictionlab run prints them
-        self._set("run-fit", "\n".join(lines + _contact_lines(result.table["contact_count"]) + caveats))
+        self.query_one("#run-fit", FitPanel).show(lines, result.table["contact_count"])
+        self._caveats([f"caveat: {caveat}" for caveat in result.caveats])  # as frictionlab run prints them
         if run.failures or run.error:
             # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
             index, reason = run.failures[0] if run.failures else (None, None)

@@ -1,0 +1,92 @@
+"""A run's fit, its points in contact and its caveats on the Run and Results tabs at 60x20,
+80x24 and 120x40: whole, never cut at the panel's edge or below it."""
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+import yaml
+
+from frictionlab.tui.text import format_count
+from frictionlab.tui.widgets.results import _entry_lines
+
+from ..conftest import merge
+from .conftest import TINY, make_app, press_settled, run_to_the_end, screen_text, sweep_app, sync
+
+FEW = merge(TINY, {"name": "few", "loading": {"start": 0.0005, "stop": 5.0}})  # caveats: few points in contact
+
+
+def ended(app):
+    """The run the Run tab shows at the end (a sweep's: its last point's): its counts, caveats and fit."""
+    run = getattr(app.last_outcome, "last", None) or app.last_outcome
+    return run.result.table["contact_count"], run.result.caveats, run.result.fit
+
+
+def words(text: str) -> str:
+    return " ".join(text.split())
+
+
+@pytest.mark.parametrize("size", [(60, 20), (80, 24), (120, 40)])
+@sync
+async def test_a_runs_contacts_and_caveats_are_whole_beside_a_plot_that_keeps_its_width(folders, registry, size):
+    """The caveats, set beside the fit, made its panel as wide as they were: the plot gone and
+    each caveat cut at the tab's edge."""
+    (folders / "presets" / "few.yaml").write_text(yaml.safe_dump(FEW))
+    app = make_app(registry, preset="presets/few.yaml", workers=1)
+    async with app.run_test(size=size) as pilot:
+        await run_to_the_end(pilot)
+        await pilot.pause()
+        screen = screen_text(app)
+        chart = app.query_one("#run-chart").size.width
+    count, caveats, _ = ended(app)
+    assert len(caveats) >= 1
+    assert chart >= size[0] // 3, screen
+    first, last = format_count(count[0]), format_count(count[-1])
+    assert f"contacts {first}..{last}" in screen or f"{count[-1]:.2f} at last load" in screen, screen
+    if size != (60, 20):  # there the box shows its first lines and scrolls
+        for caveat in caveats:
+            assert words(f"caveat: {caveat}") in words(screen), screen
+    else:
+        assert words(f"caveat: {caveats[0]}")[:100] in words(screen), screen
+
+
+@sync
+async def test_a_sweeps_contacts_show_in_the_rows_its_plot_has_at_60x20(folders, registry):
+    """A sweep's plot at 60x20 has 7 rows: the fit took them all, its points in contact below, out of sight."""
+    app = sweep_app(folders, registry)
+    async with app.run_test(size=(60, 20)) as pilot:
+        await run_to_the_end(pilot)
+        await pilot.pause()
+        screen = screen_text(app)
+    count, _, _ = ended(app)
+    assert f"contacts {format_count(count[0])}..{format_count(count[-1])}" in screen, screen
+
+
+@sync
+async def test_the_results_box_at_60x20_breaks_its_lines_between_numbers(folders, registry):
+    """Its 20 columns wrapped `completed 8/8, contacts 1.38..38.6` within the run's name and numbers."""
+    (folders / "presets" / "few.yaml").write_text(yaml.safe_dump(FEW))
+    app = make_app(registry, preset="presets/few.yaml", workers=1)
+    async with app.run_test(size=(60, 20)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f5")
+        await press_settled(pilot, "enter")
+        await pilot.pause()
+        lines = [line.strip() for line in screen_text(app).splitlines()]
+        info = app.query_one("#results-info")
+        rows, said = info.size.height, str(info.render()).splitlines()
+    count, _, fit = ended(app)
+    shown = " ".join(line.split("  ")[-1].strip() for line in lines)
+    assert f"{format_count(count[0])}..{format_count(count[-1])}" in shown, "\n".join(lines)
+    assert f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]" in shown, "\n".join(lines)
+    assert f"R^2={fit.r2:.4f}" in shown, "\n".join(lines)
+    assert rows == len(said), said  # each line within the box's columns: none wrapped again by the box
+
+
+def test_a_status_line_breaks_between_its_parts_in_a_narrow_box():
+    """`interrupted 3613/30000,` was one part, wider than the 18 columns of the box at 60x20."""
+    entry = SimpleNamespace(contact_counts=(26.5, 326.63), formula="F / (E* h L)", path=Path("quickstart-20261130-014711"),
+                            status="interrupted", done=3613, requested=30000, summary={}, fit=None)
+    lines = [str(line) for line in _entry_lines(entry, "cyan", 18)]
+    assert all(len(line) <= 18 for line in lines), lines
+    assert " ".join(" ".join(lines).split()).endswith("interrupted 3613/30000, contacts 26.5..327")
