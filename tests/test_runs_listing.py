@@ -5,6 +5,8 @@ cannot be read is counted from its chunks."""
 import json
 import os
 
+import pytest
+
 from frictionlab.cli import main
 from frictionlab.runs.detached import list_run_states, run_state
 from frictionlab.options import RunOptions
@@ -275,3 +277,26 @@ def test_a_resume_writes_the_count_of_realizations_its_preset_asks(tmp_path, reg
     assert main(["resume", str(folder), "--quiet", "--no-plot", "--workers", "1"]) == 0
     assert json.loads((folder / "run.json").read_text())["realizations"] == 4
     assert (run_state(folder).status, run_state(folder).total) == ("completed", 4)
+
+
+def test_a_summary_whose_values_its_schema_refuses_is_damaged_as_load_says_not_completed(tmp_path, registry, capsys):
+    """A summary.json that parses but holds a value its schema refuses (a fit's a that is NaN,
+    a count below 0) was listed as completed, and `follow` ended with 0, while
+    frictionlab.load and predict --from refused the folder: all now say damaged, and why."""
+    from frictionlab import load
+    from frictionlab.errors import RunFolderError
+
+    runs = tmp_path / "runs"
+    edits = {"nan-a": ('"a": ', '"a": NaN, "was": '), "negative": ('"done": ', '"done": -1, "was": ')}
+    for name, (old, new) in edits.items():
+        _run(runs / name, registry)
+        path = runs / name / "summary.json"
+        path.write_text(path.read_text().replace(old, new, 1))
+    states = {s.folder.name: s for s in list_run_states(runs)}
+    for name, field in (("nan-a", "'fit.a'"), ("negative", "'realizations.done'")):
+        with pytest.raises(RunFolderError) as refused:
+            load(runs / name)
+        assert states[name].status == "damaged" and field in states[name].reason, states[name]
+        assert states[name].reason in str(refused.value)
+        assert main(["follow", "--quiet", str(runs / name)]) == 1
+        assert capsys.readouterr().out.startswith(f"{TINY['name']}: damaged, in {runs / name}/: summary.json")

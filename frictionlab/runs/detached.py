@@ -27,6 +27,7 @@ from . import runfolder
 from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
+from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json
 
@@ -374,11 +375,12 @@ def sweep_state(folder: str | Path) -> RunState:
 
 
 def _summary(folder: Path) -> dict | None:
-    """summary.json, None if there is none; RunFolderError if it is damaged (a link, not JSON, ...)."""
+    """summary.json, None if there is none; RunFolderError if it is damaged (a link, not JSON,
+    a value its schema refuses: what ``frictionlab.load`` refuses is never listed as completed)."""
     if not os.path.lexists(folder / "summary.json"):
         return None
     try:
-        return read_json(folder, "summary.json")
+        return read_summary(folder)[0]
     except OSError as exc:
         raise RunFolderError(f"{shown(folder / 'summary.json')} cannot be read ({exc.strerror or exc})") from None
 
