@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import doctest
 import json
+import shutil
 import subprocess
 import sys
 
@@ -91,6 +92,24 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
         assert point.fit == alone.fit and row["a"] == alone.fit.a and row["b_hi"] == alone.fit.b_ci[1]
     assert frictionlab.load(tmp_path / "sweep").rows == result.rows
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
+
+
+def test_a_sweep_point_whose_folder_holds_another_run_is_refused_not_read_as_the_point(tmp_path):
+    """SweepResult.points read whatever run sat in a point's folder: another sweep's point, or
+    another preset's run, moved there came back as the point, its numbers not the row's."""
+    sweep = {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    frictionlab.run(SMALL_PRESET, out=tmp_path / "sweep", sweep=sweep, plot=False, **FAST)
+    points = tmp_path / "sweep" / "points"
+    first, second = sorted(points.iterdir())
+    shutil.rmtree(first)
+    shutil.copytree(second, first)  # the H = 0.9 point in the H = 0.5 point's place
+    with pytest.raises(RunFolderError, match=r"holds another run than point 1 of sweep 'small' \(its "
+                       r"spectrum.params.hurst is 0.9, the point's 0.5\): move it aside"):
+        frictionlab.load(tmp_path / "sweep").points
+    shutil.rmtree(first)
+    frictionlab.run(merge(SMALL_PRESET, {"name": "other"}), out=first, plot=False, **FAST)
+    with pytest.raises(RunFolderError, match=r"\(its name is 'other', the point's 'small'\)"):
+        frictionlab.load(tmp_path / "sweep").points
 
 
 def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path, cli):
