@@ -273,7 +273,8 @@ def _folder(path):
         (_pickled, "pickled Python objects, which are never loaded"),
         (_array_larger_than_memory, "larger than this machine's memory"),
         (_without_xi, "no array 'xi'"),
-        (_all_nan, "'xi' must hold finite numbers"),
+        (_all_nan, "'xi' must hold finite numbers, or NaN where a line has no xi, with xi defined at two loads or "
+                   "more (no line has xi at "),  # said as it is: it once said "(0 of ... are infinite)"
         (_one_xi_negative, "'xi' must hold numbers >= 0, or NaN where a line has no xi (1 of "),
         (_f_not_positive, "'f' must hold finite numbers > 0"),
         (_xi_of_other_shape, "one per load step"),
