@@ -14,6 +14,7 @@ from ..errors import OutputRefused
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
+from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
 from .figures import find_presets, run_figures
 from .markdown import markdown
@@ -42,7 +43,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
     markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
-    figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
+    figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, "figures", "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
     return out_dir, markdown_path, figures_dir
 

@@ -29,7 +29,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from ..errors import RunFolderError, shown
+from ..errors import OutputRefused, RunFolderError, shown
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
@@ -103,6 +103,20 @@ def make_subfolder(root: str | Path, name: str) -> Path:
     finally:
         os.close(fd)
     return Path(root) / name
+
+
+def output_subfolder(root: str | Path, name: str, then: str, *, make: bool = True) -> Path:
+    """``root / name``, a folder frictionlab writes into below one the user named (a report's
+    ``fig2``, a study's ensemble): made one level at a time (``make_subfolder``), or, with
+    ``make`` False, only checked where it exists. A link or a file there is refused as output
+    (exit code 4), never written or read through: it could point anywhere."""
+    try:
+        if make:
+            Path(root).mkdir(parents=True, exist_ok=True)  # the folder named: it may be a link, it is the user's
+            return make_subfolder(root, name)
+        return subfolder(root, name) if os.path.lexists(Path(root) / name) else Path(root) / name
+    except RunFolderError as exc:
+        raise OutputRefused(f"{exc}: move it aside, then {then}") from None
 
 
 def read_member(folder: str | Path, name: str, limit: int, what: str | None = None) -> bytes:
