@@ -54,7 +54,7 @@ from .compute.fit import LogFit
 from .compute.signals import RunInterrupted
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
-from .runs.runfolder import subfolder
+from .runs.runfolder import check_searchable, subfolder
 from .runs.sweeprecord import own_point, read_sweep_record
 
 if TYPE_CHECKING:
@@ -448,7 +448,7 @@ def load(folder: str | Path) -> Result | SweepResult:
     read as untrusted input (``frictionlab.runs.runfolder``: only regular files inside it,
     never through a link, every value checked): any problem, a folder with neither
     file too, is a ``RunFolderError`` naming the file and what is wrong."""
-    folder = path_argument(folder, "folder", "a run folder")
+    check_searchable(folder := path_argument(folder, "folder", "a run folder"))
     if not os.path.lexists(folder / "summary.json") and os.path.lexists(folder / "sweep.json"):
         return _load_sweep(folder)
     if not os.path.lexists(folder / "summary.json"):

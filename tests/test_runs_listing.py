@@ -300,3 +300,35 @@ def test_a_summary_whose_values_its_schema_refuses_is_damaged_as_load_says_not_c
         assert states[name].reason in str(refused.value)
         assert main(["follow", "--quiet", str(runs / name)]) == 1
         assert capsys.readouterr().out.startswith(f"{TINY['name']}: damaged, in {runs / name}/: summary.json")
+
+
+def test_a_run_folder_that_cannot_be_looked_into_is_said_so_not_taken_for_no_run(tmp_path, registry):
+    """A run folder the user may not search (mode 000, or 0666: no x): load said 'no summary.json',
+    follow 'holds no run', runs left it out, and resume ended with 'error: Permission denied:
+    .../sweep.json' (exit code 1). Each now names the folder and the permission, as a run
+    folder that cannot be read (exit code 5; listed as damaged). Run as a process without the
+    privilege to read past permissions, which root has."""
+    import subprocess
+    import sys
+
+    runs = tmp_path / "runs"
+    _run(runs / "locked", registry)
+    held = sorted(p.relative_to(runs) for p in runs.rglob("*"))
+    drop = ["setpriv", "--bounding-set=-dac_override,-dac_read_search"] if os.geteuid() == 0 else []
+    said = f"{runs / 'locked'} cannot be read (permission denied): its files cannot be looked at"
+    for mode in (0o000, 0o666):
+        (runs / "locked").chmod(mode)
+        try:
+            for args, code in ((["resume", "--quiet"], 5), (["follow", "--quiet"], 5), (["runs"], 0)):
+                folder = runs if args == ["runs"] else runs / "locked"
+                done = subprocess.run([*drop, sys.executable, "-m", "frictionlab", *args, str(folder)],
+                                      capture_output=True, text=True, timeout=120)  # fmt: skip
+                assert done.returncode == code, done.stderr
+                shown = done.stdout if args == ["runs"] else done.stderr
+                assert (f"{runs / 'locked'} is damaged: " + said.split(" ", 1)[1] if args == ["runs"] else said) in shown
+            load = f"import frictionlab\ntry:\n frictionlab.load({str(runs / 'locked')!r})\nexcept Exception as e: print(e)"
+            done = subprocess.run([*drop, sys.executable, "-c", load], capture_output=True, text=True, timeout=120)
+            assert done.stdout.strip() == said, done.stdout + done.stderr
+        finally:
+            (runs / "locked").chmod(0o755)
+    assert sorted(p.relative_to(runs) for p in runs.rglob("*")) == held

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import ExitCode, OutputRefused, PresetError, RunFolderError
+from ..runs.runfolder import check_searchable
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -32,6 +33,7 @@ def run(args) -> ExitCode:
     from ..runs.rundir import PRESET_FILE, RunDirectory
 
     run_dir = Path(args.run_dir)
+    check_searchable(run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
         from ..preset import build_scene

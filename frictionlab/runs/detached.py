@@ -265,6 +265,7 @@ def run_state(folder: str | Path) -> RunState:
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
         raise RunFolderError(f"{folder} is not a run folder (not a folder, or a link to one)")
+    runfolder.check_searchable(folder)
     if is_sweep_folder(folder):
         return sweep_state(folder)
     manifest = RunDirectory(folder).state()  # read as untrusted input
@@ -414,13 +415,16 @@ def list_run_states(runs_dir: str | Path) -> list[RunState]:
         return []
     states = []
     for folder in runs_dir.iterdir():
-        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
-            continue
         try:
             mtime = folder.lstat().st_mtime
         except OSError:
             continue  # gone since it was listed
+        if folder.is_symlink():
+            continue
         try:
+            runfolder.check_searchable(folder)  # one that cannot be looked into is listed, never left out
+            if not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
+                continue
             states.append((mtime, run_state(folder)))
         except (OSError, FrictionlabError) as exc:
             kind = "sweep" if is_sweep_folder(folder) else "run"

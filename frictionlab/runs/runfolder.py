@@ -57,6 +57,17 @@ class Record(BaseModel):
     model_config = ConfigDict(extra="allow", strict=True, defer_build=True)  # built when a folder is read
 
 
+def check_searchable(folder: str | Path) -> None:
+    """RunFolderError when the files in ``folder`` cannot be looked at (no permission to search
+    it): said so, not taken for a folder that holds no run, nor an OSError of the first look."""
+    try:
+        os.lstat(Path(folder) / "run.json")
+    except PermissionError:
+        raise RunFolderError(f"{shown(folder)} cannot be read (permission denied): its files cannot be looked at") from None
+    except OSError:
+        pass  # absent, or not a folder: said where it is read
+
+
 def subfolder(root: Path, name: str) -> Path:
     """``root / name`` once every component of ``name`` (a relative path) is known to be
     a folder and not a symbolic link: a sweep's point folders stay inside the sweep's.
