@@ -29,7 +29,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from ..errors import OutputRefused, RunFolderError, shown
+from ..errors import OutputRefused, RunFolderError, short_repr, shown
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
@@ -179,7 +179,9 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     """``raw`` (the bytes of the run folder's file ``path``) as a JSON object;
     RunFolderError naming the file otherwise."""
     try:
-        data = json.loads(raw)
+        data = json.loads(raw, object_pairs_hook=_unique_keys)
+    except _RepeatedKey as exc:  # frictionlab writes each key once: the file was edited, or pieced together
+        raise RunFolderError(f"{shown(path)} is damaged (key {short_repr(exc.args[0])} given twice in one object)") from None
     except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
         where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
         raise RunFolderError(f"{shown(path)} is damaged (not valid JSON{where})") from None
@@ -188,6 +190,20 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     if not isinstance(data, dict):
         raise RunFolderError(f"{shown(path)} is damaged (a JSON {type(data).__name__}, not an object)")
     return data
+
+
+class _RepeatedKey(Exception):
+    pass
+
+
+def _unique_keys(pairs: list) -> dict:
+    """A JSON object whose keys are all different: JSON itself keeps the last of two silently."""
+    seen = set()
+    for key, _ in pairs:
+        if key in seen:
+            raise _RepeatedKey(key)
+        seen.add(key)
+    return dict(pairs)
 
 
 _JSON_KINDS = {dict: "an object", list: "an array", str: "a string", int: "a number", float: "a number", bool: "true or false"}

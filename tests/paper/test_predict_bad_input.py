@@ -70,6 +70,7 @@ def test_the_undamaged_copy_predicts(run_copy, capsys):
         pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", id="deep-list"),
         pytest.param('{"a": ' * 100_000 + "1" + "}" * 100_000, "nested too deeply", id="deep-object"),
         pytest.param("\udcff", "not valid JSON", id="not-utf8"),  # a lone byte 0xff once written
+        pytest.param('{"fit": {"a": 1, "a": 2}}', "(key 'a' given twice in one object)", id="repeated-key"),  # was the last
     ],
 )
 def test_a_summary_that_is_not_a_json_object(run_copy, capsys, text, reason):
