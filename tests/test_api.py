@@ -141,6 +141,22 @@ def test_load_refuses_a_curve_it_did_not_write_naming_the_file(tmp_path):
         frictionlab.load(folder)
 
 
+def test_load_refuses_a_cell_python_reads_as_a_number_but_frictionlab_never_writes(tmp_path):
+    """float() takes '1_0' as 10, ' 2' with its space, and Arabic-Indic digits: a curve.csv edited
+    so was read as numbers it never held. A cell is a plain decimal number, or empty."""
+    folder = tmp_path / "run"
+    frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
+    curve = folder / "curve.csv"
+    text = curve.read_text()
+    first = text.splitlines()[1].split(",")
+    for cell in ("1_0", " 2", "\u0661\u0662", "0x10"):
+        curve.write_text(text.replace(",".join(first), ",".join([first[0], first[1], cell, *first[3:]]), 1))
+        with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(line 2, column 3: not a finite number\)"):
+            frictionlab.load(folder)
+    curve.write_text(text.replace(",".join(first), ",".join([first[0], first[1], "1E-05", *first[3:]]), 1))
+    assert frictionlab.load(folder).table["xi"][0] == 1e-05  # as a float is written, exponent and all
+
+
 def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path):
     r = frictionlab.run(SMALL_PRESET, out=tmp_path / "a", plot=False, **FAST)
     assert {p.name for p in (tmp_path / "a").iterdir()} >= {"summary.json", "curve.csv", "preset.yaml"}

@@ -23,6 +23,7 @@ import io
 import json
 import math
 import os
+import re
 import stat
 from pathlib import Path, PurePosixPath
 from typing import Annotated
@@ -302,16 +303,15 @@ def read_number_table(folder: Path, name: str, limit: int = MAX_CSV_BYTES) -> tu
     return header, table
 
 
+_NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)  # as Python writes a float
+
+
 def _cell(cell: str, path: Path, line: int, column: int) -> float:
     if not cell:
         return math.nan
-    try:
-        value = float(cell)
-    except ValueError:
-        value = math.nan
-    else:
-        if math.isfinite(value):
-            return value
+    value = float(cell) if _NUMBER.fullmatch(cell) else math.nan  # float() also takes '1_0', ' 1', Arabic digits
+    if math.isfinite(value):
+        return value
     raise RunFolderError(f"{shown(path)} is damaged (line {line}, column {column}: not a finite number)")
 
 
