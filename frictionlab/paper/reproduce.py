@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
 from ..errors import OutputRefused
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
 from ..runs.runfolder import output_subfolder
@@ -51,6 +51,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
 def _refuse_overwriting(markdown_path: Path | None, figures_dir: Path | None, force: bool) -> None:
     figures = [figures_dir / name for name in FIGURE_FILES] if figures_dir else []
     taken = [p for p in ([markdown_path] if markdown_path else []) + figures if os.path.lexists(p)]
+    refuse_unreplaceable(taken, "report", "give other --out/--markdown/--figures")
     if taken and not force:
         shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
         raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")

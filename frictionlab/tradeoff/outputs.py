@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputRefused, shown
-from ..io.files import atomic_write, output_path_problem, replace_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from .axes import COLUMNS, Row, Study, grid_side
 from .metrics import pareto_front
 
@@ -341,11 +341,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     problem = output_path_problem(out)
     if problem:
         raise OutputRefused(f"--out: {shown(problem)}; give a folder")
-    if blocked := [(name, why) for name in FILES if (why := replace_problem(out / name))]:  # --force too: not after the work
-        name, why = blocked[0]
-        raise OutputRefused(
-            f"--out: {shown(out / name)} {why}: the study writes its {name} there; move it aside, or give another folder"
-        )
+    refuse_unreplaceable([out / name for name in FILES], "study", "give another --out")  # --force too
     if force or not out.is_dir():
         return out
     held = sorted(p.name for p in out.iterdir())

@@ -121,7 +121,7 @@ def test_a_study_file_that_is_a_folder_is_refused_before_the_work_not_after(tmp_
     code = main(["study", "quickstart", *QUICK, "--out", str(out), *(["--force"] if force else [])])
     err = capsys.readouterr().err
     assert code == ExitCode.OUTPUT_REFUSED, err
-    assert f"--out: {out / 'study.csv'} is a folder, not a file: the study writes its study.csv there; move it aside" in err
+    assert f"{out / 'study.csv'} is a folder, not a file: the study writes its study.csv there; move it aside" in err
     assert sorted(p.name for p in out.rglob("*")) == ["mine.txt", "study.csv", "study.md"]
 
 

@@ -333,3 +333,15 @@ def test_a_link_at_an_ensembles_folder_is_never_read_or_written_through(quick_st
     assert main([*base, "--finished-only", "--out", str(tmp_path / "out")]) == ExitCode.OUTPUT_REFUSED
     assert f"{tmp_path / 'out' / FIGURES_DIR} is a symbolic link" in capsys.readouterr().err
     assert not any(elsewhere.iterdir())
+
+
+def test_a_page_that_is_a_folder_is_refused_before_the_study_even_with_force(quick_study, tmp_path, capsys):
+    """--force over an --out whose exact-3d-law.md is a folder read (or ran) every ensemble, then
+    ended with 'error: is a folder, not a file: ...' (exit code 1). Refused before any."""
+    (tmp_path / "out" / PAGE).mkdir(parents=True)
+    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--runs", str(quick_study / "runs"), "--out",
+            str(tmp_path / "out"), "--finished-only", "--force", "--quiet"]  # fmt: skip
+    assert main(args) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'out' / PAGE} is a folder, not a file: the exact 3D study writes its {PAGE} there" in err
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [PAGE]
