@@ -332,3 +332,16 @@ def test_a_run_folder_that_cannot_be_looked_into_is_said_so_not_taken_for_no_run
         finally:
             (runs / "locked").chmod(0o755)
     assert sorted(p.relative_to(runs) for p in runs.rglob("*")) == held
+
+
+def test_follow_of_a_link_the_user_named_follows_the_folder_as_resume_does(tmp_path, registry, capsys):
+    """`follow LINK` of a link to a run folder was refused ('not a run folder (not a folder, or a
+    link to one)') while resume, predict --from and load take the folder named, link or not."""
+    _run(tmp_path / "run", registry)
+    (tmp_path / "link").symlink_to(tmp_path / "run")
+    capsys.readouterr()
+    assert main(["follow", "--quiet", str(tmp_path / "link")]) == 0
+    assert capsys.readouterr().out == f"{TINY['name']}: completed, 4/4 realizations, in {tmp_path / 'run'}/\n"
+    (tmp_path / "file-link").symlink_to(tmp_path / "run" / "summary.json")  # a link to a file is still no run folder
+    assert main(["follow", "--quiet", str(tmp_path / "file-link")]) == 5
+    assert "is not a run folder" in capsys.readouterr().err
