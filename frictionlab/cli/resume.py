@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import ExitCode, PresetError, RunFolderError
-from ..runs.runfolder import check_searchable
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -31,6 +30,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..runs.rundir import PRESET_FILE, RunDirectory
+    from ..runs.runfolder import check_searchable
 
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
