@@ -54,7 +54,8 @@ from .compute.fit import LogFit
 from .compute.signals import RunInterrupted
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
-from .runs.runfolder import subfolder
+from .runs.runfolder import check_searchable, subfolder
+from .runs.sweeprecord import own_point, read_sweep_record
 
 if TYPE_CHECKING:
     from .compute.ensemble import RunOutcome
@@ -174,7 +175,8 @@ class SweepResult:
     def points(self) -> list[Result]:
         """The ``Result`` of each point with a fit, read from its folder: an interrupted
         point's too (its ``status`` says so); a pending or failed one has none."""
-        return [load(subfolder(self.folder, row["folder"])) for row in self.rows if row.get("a") is not None]
+        return [own_point(load(subfolder(self.folder, row["folder"])), self.name, row, self.parameters)
+                for row in self.rows if row.get("a") is not None]  # never another run moved into its folder
 
     def to_pandas(self):
         """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
@@ -446,7 +448,7 @@ def load(folder: str | Path) -> Result | SweepResult:
     read as untrusted input (``frictionlab.runs.runfolder``: only regular files inside it,
     never through a link, every value checked): any problem, a folder with neither
     file too, is a ``RunFolderError`` naming the file and what is wrong."""
-    folder = path_argument(folder, "folder", "a run folder")
+    check_searchable(folder := path_argument(folder, "folder", "a run folder"))
     if not os.path.lexists(folder / "summary.json") and os.path.lexists(folder / "sweep.json"):
         return _load_sweep(folder)
     if not os.path.lexists(folder / "summary.json"):
@@ -490,8 +492,6 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 
 def _load_sweep(folder: Path) -> SweepResult:
-    from .runs.sweeprecord import read_sweep_record
-
     summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
     return SweepResult(

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import doctest
 import json
+import shutil
 import subprocess
 import sys
 
@@ -93,6 +94,24 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
 
 
+def test_a_sweep_point_whose_folder_holds_another_run_is_refused_not_read_as_the_point(tmp_path):
+    """SweepResult.points read whatever run sat in a point's folder: another sweep's point, or
+    another preset's run, moved there came back as the point, its numbers not the row's."""
+    sweep = {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    frictionlab.run(SMALL_PRESET, out=tmp_path / "sweep", sweep=sweep, plot=False, **FAST)
+    points = tmp_path / "sweep" / "points"
+    first, second = sorted(points.iterdir())
+    shutil.rmtree(first)
+    shutil.copytree(second, first)  # the H = 0.9 point in the H = 0.5 point's place
+    with pytest.raises(RunFolderError, match=r"holds another run than point 1 of sweep 'small' \(its "
+                       r"spectrum.params.hurst is 0.9, the point's 0.5\): move it aside"):
+        frictionlab.load(tmp_path / "sweep").points
+    shutil.rmtree(first)
+    frictionlab.run(merge(SMALL_PRESET, {"name": "other"}), out=first, plot=False, **FAST)
+    with pytest.raises(RunFolderError, match=r"\(its name is 'other', the point's 'small'\)"):
+        frictionlab.load(tmp_path / "sweep").points
+
+
 def test_load_reads_a_cli_run_back_with_the_same_numbers(tmp_path, cli):
     folder = tmp_path / "cli-run"
     result = cli("run", "quickstart", "--out", folder, "--quiet", "--workers", "2", "--set", "realizations=12")
@@ -120,6 +139,22 @@ def test_load_refuses_a_curve_it_did_not_write_naming_the_file(tmp_path):
     curve.write_text("")  # emptied
     with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(empty: no header\)"):
         frictionlab.load(folder)
+
+
+def test_load_refuses_a_cell_python_reads_as_a_number_but_frictionlab_never_writes(tmp_path):
+    """float() takes '1_0' as 10, ' 2' with its space, and Arabic-Indic digits: a curve.csv edited
+    so was read as numbers it never held. A cell is a plain decimal number, or empty."""
+    folder = tmp_path / "run"
+    frictionlab.run(SMALL_PRESET, out=folder, plot=False, **FAST)
+    curve = folder / "curve.csv"
+    text = curve.read_text()
+    first = text.splitlines()[1].split(",")
+    for cell in ("1_0", " 2", "\u0661\u0662", "0x10"):
+        curve.write_text(text.replace(",".join(first), ",".join([first[0], first[1], cell, *first[3:]]), 1))
+        with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(line 2, column 3: not a finite number\)"):
+            frictionlab.load(folder)
+    curve.write_text(text.replace(",".join(first), ",".join([first[0], first[1], "1E-05", *first[3:]]), 1))
+    assert frictionlab.load(folder).table["xi"][0] == 1e-05  # as a float is written, exponent and all
 
 
 def test_out_writes_the_cli_files_and_plot_false_leaves_out_the_figure(tmp_path):

@@ -5,6 +5,8 @@ cannot be read is counted from its chunks."""
 import json
 import os
 
+import pytest
+
 from frictionlab.cli import main
 from frictionlab.runs.detached import list_run_states, run_state
 from frictionlab.options import RunOptions
@@ -275,3 +277,71 @@ def test_a_resume_writes_the_count_of_realizations_its_preset_asks(tmp_path, reg
     assert main(["resume", str(folder), "--quiet", "--no-plot", "--workers", "1"]) == 0
     assert json.loads((folder / "run.json").read_text())["realizations"] == 4
     assert (run_state(folder).status, run_state(folder).total) == ("completed", 4)
+
+
+def test_a_summary_whose_values_its_schema_refuses_is_damaged_as_load_says_not_completed(tmp_path, registry, capsys):
+    """A summary.json that parses but holds a value its schema refuses (a fit's a that is NaN,
+    a count below 0) was listed as completed, and `follow` ended with 0, while
+    frictionlab.load and predict --from refused the folder: all now say damaged, and why."""
+    from frictionlab import load
+    from frictionlab.errors import RunFolderError
+
+    runs = tmp_path / "runs"
+    edits = {"nan-a": ('"a": ', '"a": NaN, "was": '), "negative": ('"done": ', '"done": -1, "was": ')}
+    for name, (old, new) in edits.items():
+        _run(runs / name, registry)
+        path = runs / name / "summary.json"
+        path.write_text(path.read_text().replace(old, new, 1))
+    states = {s.folder.name: s for s in list_run_states(runs)}
+    for name, field in (("nan-a", "'fit.a'"), ("negative", "'realizations.done'")):
+        with pytest.raises(RunFolderError) as refused:
+            load(runs / name)
+        assert states[name].status == "damaged" and field in states[name].reason, states[name]
+        assert states[name].reason in str(refused.value)
+        assert main(["follow", "--quiet", str(runs / name)]) == 1
+        assert capsys.readouterr().out.startswith(f"{TINY['name']}: damaged, in {runs / name}/: summary.json")
+
+
+def test_a_run_folder_that_cannot_be_looked_into_is_said_so_not_taken_for_no_run(tmp_path, registry):
+    """A run folder the user may not search (mode 000, or 0666: no x): load said 'no summary.json',
+    follow 'holds no run', runs left it out, and resume ended with 'error: Permission denied:
+    .../sweep.json' (exit code 1). Each now names the folder and the permission, as a run
+    folder that cannot be read (exit code 5; listed as damaged). Run as a process without the
+    privilege to read past permissions, which root has."""
+    import subprocess
+    import sys
+
+    runs = tmp_path / "runs"
+    _run(runs / "locked", registry)
+    held = sorted(p.relative_to(runs) for p in runs.rglob("*"))
+    drop = ["setpriv", "--bounding-set=-dac_override,-dac_read_search"] if os.geteuid() == 0 else []
+    said = f"{runs / 'locked'} cannot be read (permission denied): its files cannot be looked at"
+    for mode in (0o000, 0o666):
+        (runs / "locked").chmod(mode)
+        try:
+            for args, code in ((["resume", "--quiet"], 5), (["follow", "--quiet"], 5), (["runs"], 0)):
+                folder = runs if args == ["runs"] else runs / "locked"
+                done = subprocess.run([*drop, sys.executable, "-m", "frictionlab", *args, str(folder)],
+                                      capture_output=True, text=True, timeout=120)  # fmt: skip
+                assert done.returncode == code, done.stderr
+                shown = done.stdout if args == ["runs"] else done.stderr
+                assert (f"{runs / 'locked'} is damaged: " + said.split(" ", 1)[1] if args == ["runs"] else said) in shown
+            load = f"import frictionlab\ntry:\n frictionlab.load({str(runs / 'locked')!r})\nexcept Exception as e: print(e)"
+            done = subprocess.run([*drop, sys.executable, "-c", load], capture_output=True, text=True, timeout=120)
+            assert done.stdout.strip() == said, done.stdout + done.stderr
+        finally:
+            (runs / "locked").chmod(0o755)
+    assert sorted(p.relative_to(runs) for p in runs.rglob("*")) == held
+
+
+def test_follow_of_a_link_the_user_named_follows_the_folder_as_resume_does(tmp_path, registry, capsys):
+    """`follow LINK` of a link to a run folder was refused ('not a run folder (not a folder, or a
+    link to one)') while resume, predict --from and load take the folder named, link or not."""
+    _run(tmp_path / "run", registry)
+    (tmp_path / "link").symlink_to(tmp_path / "run")
+    capsys.readouterr()
+    assert main(["follow", "--quiet", str(tmp_path / "link")]) == 0
+    assert capsys.readouterr().out == f"{TINY['name']}: completed, 4/4 realizations, in {tmp_path / 'run'}/\n"
+    (tmp_path / "file-link").symlink_to(tmp_path / "run" / "summary.json")  # a link to a file is still no run folder
+    assert main(["follow", "--quiet", str(tmp_path / "file-link")]) == 5
+    assert "is not a run folder" in capsys.readouterr().err

@@ -474,3 +474,37 @@ def test_a_point_and_its_result_read_as_a_notebook_needs(tmp_path):
         "<SweepPoint 2: spectrum.params.hurst=0.8, folder '02-hurst-0.8'>",
     ]
     assert all(fit is not None and fit == own for _, fit, own in finished)
+
+
+def test_a_sweep_table_that_is_a_folder_or_a_folder_not_writable_is_said_so_at_once(tmp_path, capsys):
+    """sweep.png a folder: the points ran, then the figure failed (exit code 1). A sweep folder
+    that cannot be written in: `resume` said its sweep.json was edited. Each is now said as it
+    is before any point runs (exit code 4), the folder left as it was."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    preset = {**SMALL_PRESET, "realizations": 2, "fit": {"bootstrap": 20},
+              "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}  # fmt: skip
+    path, out = tmp_path / "s.yaml", tmp_path / "out"
+    path.write_text(yaml.safe_dump(preset))
+    assert main(["run", str(path), "--out", str(out), "--quiet", "--workers", "1"]) == 0
+    shutil.rmtree(next((out / "points").iterdir()))  # a point to compute again
+    (out / "sweep.png").unlink()
+    (out / "sweep.png").mkdir()
+    capsys.readouterr()
+    for args in (["run", str(path), "--out", str(out), "--resume"], ["resume", str(out)]):
+        assert main([*args, "--quiet", "--workers", "1"]) == 4
+        assert f"{out / 'sweep.png'} is a folder, not a file: the sweep writes its sweep.png there" in capsys.readouterr().err
+        assert len(list((out / "points").iterdir())) == 1
+    (out / "sweep.png").rmdir()
+    drop = ["setpriv", "--bounding-set=-dac_override,-dac_read_search"] if os.geteuid() == 0 else []
+    out.chmod(0o555)
+    try:
+        done = subprocess.run([*drop, sys.executable, "-m", "frictionlab", "resume", str(out), "--quiet", "--workers", "1"],
+                              capture_output=True, text=True, timeout=120)  # fmt: skip
+    finally:
+        out.chmod(0o755)
+    assert done.returncode == 4 and f"{out} cannot be written in: Permission denied" in done.stderr, done.stderr
+    assert "damaged" not in done.stderr and len(list((out / "points").iterdir())) == 1

@@ -67,6 +67,8 @@ def run(args) -> ExitCode:
     from ..runs.detached import process_alive, run_state
 
     folder = Path(args.run_dir)
+    if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
+        folder = folder.resolve()
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None
     error, gone, identity, holder = None, False, _identity(folder), state.pid

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode, OutputRefused, PresetError, RunFolderError
+from ..errors import ExitCode, PresetError, RunFolderError
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -30,12 +30,14 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..runs.rundir import PRESET_FILE, RunDirectory
+    from ..runs.runfolder import check_searchable
 
     run_dir = Path(args.run_dir)
+    check_searchable(run_dir)
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
         from ..preset import build_scene
-        from ..runs.sweep import stored_sweep
+        from ..runs.sweep import OtherSweep, stored_sweep
         from .options import executor_run_options
 
         args.preset = args.source = str(run_dir / "sweep.json")
@@ -44,7 +46,7 @@ def run(args) -> ExitCode:
             if args.detach:
                 return stored_run(run_dir, lambda: run_command.detach(args, data, build_scene(data), run_dir, options))
             return stored_run(run_dir, lambda: run_command.run_sweep_into(args, data, run_dir, options))
-        except OutputRefused:  # the folder checked against the sweep its own sweep.json gives: they differ
+        except OtherSweep:  # the folder checked against the sweep its own sweep.json gives: they differ
             raise RunFolderError(
                 f"{args.preset} is damaged: its name, sweep and base preset are not those of one sweep "
                 "(a field edited): it cannot be resumed"

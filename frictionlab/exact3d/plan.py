@@ -34,7 +34,7 @@ from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
 from ..plugin.resolution import MIN_SHORT_CUTOFF_PIXELS
 from ..runs.rundir import STATE_FILE, RunDirectory
-from ..runs.runfolder import read_json
+from ..runs.runfolder import output_subfolder, read_json
 from ..runs.runner import check_memory, run_to_folder
 from ..preset.seeds import realization_rng
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -266,8 +266,7 @@ def check_memory_ahead(factories: dict[float, SceneFactory], runs_dir: Path, pla
 
     for job in plan.jobs():
         factory = factories[job.hurst]
-        solver = factory.base.solver.name if job.exact else factory.solver_choice(APPROXIMATION)["name"]
-        if finished(Path(runs_dir) / job.folder(solver)):
+        if finished(Path(runs_dir) / job.folder(_solver_name(factory, job))):
             continue
         try:
             _scene(factory, job, plan, before_reading=check)
@@ -280,6 +279,11 @@ def check_memory_ahead(factories: dict[float, SceneFactory], runs_dir: Path, pla
                 "--workers and a higher limit do, or more memory free, or --quick (grids of 64² to 192² px, "
                 "not converged)."
             ) from None
+
+
+def _solver_name(factory: SceneFactory, job) -> str:
+    """The solver ``job``'s ensemble runs, as its folder is named, without making its scene."""
+    return factory.base.solver.name if job.exact else factory.solver_choice(APPROXIMATION)["name"]
 
 
 def finished(folder: Path) -> bool:
@@ -332,12 +336,14 @@ def run_plan(
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )
+    for job in plan.jobs():  # a link at an ensemble's folder refused before any ensemble runs, not hours in
+        output_subfolder(runs_dir, job.folder(_solver_name(factories[job.hurst], job)), "run the command again", make=False)
     if compute:
         check_memory_ahead(factories, runs_dir, plan, options)
     try:
         for job in plan.jobs():
             scene = _scene(factories[job.hurst], job, plan)
-            folder = Path(runs_dir) / job.folder(scene.solver.name)
+            folder = output_subfolder(runs_dir, job.folder(scene.solver.name), "run the command again", make=compute)
             if not compute and not finished(folder):
                 runs.missing.append(job)
                 continue

@@ -12,10 +12,11 @@ import numpy as np
 
 from ..compute.dask_session import one_dask_cluster
 from ..errors import FrictionlabError, OutputRefused, RunError
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..plugin.listeners import format_duration
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
+from ..runs.runfolder import output_subfolder
 from ..preset.seeds import realization_rng
 from ..compute.signals import WorkInterrupted
 from .evidence import MANY_SPOTS
@@ -72,8 +73,9 @@ def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
     problem = output_path_problem(out_dir)
     if problem:
         raise OutputRefused(f"--out: {problem}; give a folder for the page")
-    page, figures = out_dir / PAGE, out_dir / FIGURES_DIR
+    page, figures = out_dir / PAGE, output_subfolder(out_dir, FIGURES_DIR, "write the page again", make=False)
     taken = [p for p in (page, *(figures / name for name in FIGURES)) if os.path.lexists(p)]
+    refuse_unreplaceable(taken, "exact 3D study", "give another --out")
     if taken and not force:
         raise OutputRefused(f"the page would overwrite {', '.join(map(str, taken[:3]))}: give another --out, or --force")
     return page, figures

@@ -127,6 +127,16 @@ def replace_problem(path: Path) -> str | None:
     return f"is a {kind}, not a file" if kind in ("folder", "socket", "block device") else None
 
 
+def refuse_unreplaceable(paths, what: str, instead: str) -> None:
+    """OutputRefused naming the first of ``paths`` that ``atomic_write`` cannot replace (a
+    folder, ...): said before the ``what`` (a study, a report) does its work, --force or not,
+    never when it writes after the work; ``instead`` says what else to do."""
+    for path in paths:
+        if problem := replace_problem(Path(path)):
+            raise OutputRefused(f"{shown(str(path))} {problem}: the {what} writes its {shown(Path(path).name)} there; "
+                                f"move it aside, or {instead}")
+
+
 def _kind(path: Path, follow_links: bool = True) -> str | None:
     """What is at ``path`` (links followed unless ``follow_links`` is False: then a
     link is "symbolic link"): "file", "folder", "FIFO"..., None if nothing."""

@@ -9,6 +9,7 @@ from pathlib import Path
 from ..errors import FrictionlabError, short_repr
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
+from ..runs.runfolder import output_subfolder
 from ..runs.runner import run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..runs.sweep import plan_sweep, run_sweep
@@ -117,8 +118,11 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
     from ..progress import ProgressReporter, SweepProgress
 
     runs = plan_figures(presets, out_dir)
+    for run in runs:  # a link at a figure's folder refused before any figure runs
+        output_subfolder(out_dir, run.figure.key, "run the report again", make=False)
     for run in runs:
         fig, path = run.figure, run.preset_path
+        output_subfolder(out_dir, fig.key, "run the report again")
         seen = mark()
         if run.sweep is not None:
             listeners = [SweepProgress()] if progress else []

@@ -374,10 +374,11 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         raise RunFolderError(f"{path}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
     if not np.all(np.isfinite(f) & (f > 0)):
         raise RunFolderError(f"{path}: array 'f' must hold finite numbers > 0 (some are not)")
-    if np.isinf(xi).any() or np.isnan(xi).all(axis=0).sum() > f.size - 2:  # NaN: a line with no xi at that load
-        bad = np.count_nonzero(np.isinf(xi))
+    defined = f.size - np.isnan(xi).all(axis=0).sum()  # NaN: a line with no xi at that load
+    if (bad := np.count_nonzero(np.isinf(xi))) or defined < 2:  # said as it is: infinite, or too few loads
+        why = f"{bad} of {xi.size} are infinite" if bad else f"no line has xi at {f.size - defined} of its {f.size} loads"
         raise RunFolderError(f"{path}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
-                             f"defined at two loads or more ({bad} of {xi.size} are infinite)")  # fmt: skip
+                             f"defined at two loads or more ({why})")  # fmt: skip
     if negative := np.count_nonzero(xi < 0):  # an rms slope over another: a run writes none below 0
         raise RunFolderError(f"{path}: array 'xi' must hold numbers >= 0, or NaN where a line has no xi "
                              f"({negative} of {xi.size} are negative)")  # fmt: skip

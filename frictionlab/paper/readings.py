@@ -18,6 +18,7 @@ from ..errors import FrictionlabError
 from ..compute.fit import LogFit, fit_log_law
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
+from ..runs.runfolder import output_subfolder
 from ..runs.runner import run_to_folder
 from ..compute.signals import interrupted_since, mark
 from ..preset.seeds import bootstrap_rng, replicate_seeds
@@ -187,6 +188,7 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
         if key not in ensembles:
             seeded = overrides + ([] if seed is None else [f"seed={seed}"])
             scene = build_scene(apply_overrides(data, [*seeded, "output.plot=false"]), source=str(base.preset_path))
+            output_subfolder(out_dir, str(folder.relative_to(out_dir)), "run the report again")
             seen = mark()
             outcome, _ = run_to_folder(scene, folder, options, listeners=listeners())
             if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):

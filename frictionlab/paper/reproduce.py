@@ -11,9 +11,10 @@ from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
 from ..errors import OutputRefused
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
+from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
 from .figures import find_presets, run_figures
 from .markdown import markdown
@@ -42,7 +43,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
         _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
     markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
-    figures_dir = Path(figures_dir) if figures_dir else out_dir / "figures"
+    figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, "figures", "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
     return out_dir, markdown_path, figures_dir
 
@@ -50,6 +51,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
 def _refuse_overwriting(markdown_path: Path | None, figures_dir: Path | None, force: bool) -> None:
     figures = [figures_dir / name for name in FIGURE_FILES] if figures_dir else []
     taken = [p for p in ([markdown_path] if markdown_path else []) + figures if os.path.lexists(p)]
+    refuse_unreplaceable(taken, "report", "give other --out/--markdown/--figures")
     if taken and not force:
         shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
         raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")

@@ -27,6 +27,7 @@ from . import runfolder
 from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown, shown_name
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
+from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 from .runfolder import read_json
 
@@ -264,6 +265,7 @@ def run_state(folder: str | Path) -> RunState:
     folder = Path(folder)
     if folder.is_symlink() or not folder.is_dir():
         raise RunFolderError(f"{shown_name(folder)} is not a run folder (not a folder, or a link to one)")
+    runfolder.check_searchable(folder)
     if is_sweep_folder(folder):
         return sweep_state(folder)
     manifest = RunDirectory(folder).state()  # read as untrusted input
@@ -374,11 +376,12 @@ def sweep_state(folder: str | Path) -> RunState:
 
 
 def _summary(folder: Path) -> dict | None:
-    """summary.json, None if there is none; RunFolderError if it is damaged (a link, not JSON, ...)."""
+    """summary.json, None if there is none; RunFolderError if it is damaged (a link, not JSON,
+    a value its schema refuses: what ``frictionlab.load`` refuses is never listed as completed)."""
     if not os.path.lexists(folder / "summary.json"):
         return None
     try:
-        return read_json(folder, "summary.json")
+        return read_summary(folder)[0]
     except OSError as exc:
         raise RunFolderError(f"{shown(folder / 'summary.json')} cannot be read ({exc.strerror or exc})") from None
 
@@ -412,13 +415,16 @@ def list_run_states(runs_dir: str | Path) -> list[RunState]:
         return []
     states = []
     for folder in runs_dir.iterdir():
-        if folder.is_symlink() or not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
-            continue
         try:
             mtime = folder.lstat().st_mtime
         except OSError:
             continue  # gone since it was listed
+        if folder.is_symlink():
+            continue
         try:
+            runfolder.check_searchable(folder)  # one that cannot be looked into is listed, never left out
+            if not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
+                continue
             states.append((mtime, run_state(folder)))
         except (OSError, FrictionlabError) as exc:
             kind = "sweep" if is_sweep_folder(folder) else "run"

@@ -23,13 +23,14 @@ import io
 import json
 import math
 import os
+import re
 import stat
 from pathlib import Path, PurePosixPath
 from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from ..errors import RunFolderError, shown
+from ..errors import OutputRefused, RunFolderError, short_repr, shown
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
@@ -55,6 +56,17 @@ class Record(BaseModel):
     number), a field a later frictionlab adds kept unchecked."""
 
     model_config = ConfigDict(extra="allow", strict=True, defer_build=True)  # built when a folder is read
+
+
+def check_searchable(folder: str | Path) -> None:
+    """RunFolderError when the files in ``folder`` cannot be looked at (no permission to search
+    it): said so, not taken for a folder that holds no run, nor an OSError of the first look."""
+    try:
+        os.lstat(Path(folder) / "run.json")
+    except PermissionError:
+        raise RunFolderError(f"{shown(folder)} cannot be read (permission denied): its files cannot be looked at") from None
+    except OSError:
+        pass  # absent, or not a folder: said where it is read
 
 
 def subfolder(root: Path, name: str) -> Path:
@@ -103,6 +115,20 @@ def make_subfolder(root: str | Path, name: str) -> Path:
     finally:
         os.close(fd)
     return Path(root) / name
+
+
+def output_subfolder(root: str | Path, name: str, then: str, *, make: bool = True) -> Path:
+    """``root / name``, a folder frictionlab writes into below one the user named (a report's
+    ``fig2``, a study's ensemble): made one level at a time (``make_subfolder``), or, with
+    ``make`` False, only checked where it exists. A link or a file there is refused as output
+    (exit code 4), never written or read through: it could point anywhere."""
+    try:
+        if make:
+            Path(root).mkdir(parents=True, exist_ok=True)  # the folder named: it may be a link, it is the user's
+            return make_subfolder(root, name)
+        return subfolder(root, name) if os.path.lexists(Path(root) / name) else Path(root) / name
+    except RunFolderError as exc:
+        raise OutputRefused(f"{exc}: move it aside, then {then}") from None
 
 
 def read_member(folder: str | Path, name: str, limit: int, what: str | None = None) -> bytes:
@@ -154,7 +180,9 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     """``raw`` (the bytes of the run folder's file ``path``) as a JSON object;
     RunFolderError naming the file otherwise."""
     try:
-        data = json.loads(raw)
+        data = json.loads(raw, object_pairs_hook=_unique_keys)
+    except _RepeatedKey as exc:  # frictionlab writes each key once: the file was edited, or pieced together
+        raise RunFolderError(f"{shown(path)} is damaged (key {short_repr(exc.args[0])} given twice in one object)") from None
     except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
         where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
         raise RunFolderError(f"{shown(path)} is damaged (not valid JSON{where})") from None
@@ -163,6 +191,20 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
     if not isinstance(data, dict):
         raise RunFolderError(f"{shown(path)} is damaged (a JSON {type(data).__name__}, not an object)")
     return data
+
+
+class _RepeatedKey(Exception):
+    pass
+
+
+def _unique_keys(pairs: list) -> dict:
+    """A JSON object whose keys are all different: JSON itself keeps the last of two silently."""
+    seen = set()
+    for key, _ in pairs:
+        if key in seen:
+            raise _RepeatedKey(key)
+        seen.add(key)
+    return dict(pairs)
 
 
 _JSON_KINDS = {dict: "an object", list: "an array", str: "a string", int: "a number", float: "a number", bool: "true or false"}
@@ -261,16 +303,15 @@ def read_number_table(folder: Path, name: str, limit: int = MAX_CSV_BYTES) -> tu
     return header, table
 
 
+_NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)  # as Python writes a float
+
+
 def _cell(cell: str, path: Path, line: int, column: int) -> float:
     if not cell:
         return math.nan
-    try:
-        value = float(cell)
-    except ValueError:
-        value = math.nan
-    else:
-        if math.isfinite(value):
-            return value
+    value = float(cell) if _NUMBER.fullmatch(cell) else math.nan  # float() also takes '1_0', ' 1', Arabic digits
+    if math.isfinite(value):
+        return value
     raise RunFolderError(f"{shown(path)} is damaged (line {line}, column {column}: not a finite number)")
 
 

@@ -30,7 +30,7 @@ from pydantic import BaseModel
 from .. import __version__
 from ..compute.dask_session import one_dask_cluster
 from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
 from ..options import RunOptions
@@ -424,25 +424,33 @@ def run_sweep(
     return outcome
 
 
+class OtherSweep(OutputRefused):
+    """The folder holds something else than this sweep (a resume reads it as its sweep.json edited)."""
+
+
+SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")  # what a sweep writes in its folder, beside points/
+
+
 def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
     """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
     (its sweep.json names the same sweep and base preset), or ``force``."""
     problem = output_path_problem(out_dir)
     if problem:
         raise OutputRefused(f"{problem}; give a folder for the output")
+    refuse_unreplaceable([out_dir / name for name in SWEEP_FILES], "sweep", "give another output folder")  # --force too
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
         return
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
         old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
     except RunFolderError:
-        raise OutputRefused(
+        raise OtherSweep(
             f"{out_dir} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
         ) from None
     mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
-        raise OutputRefused(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
+        raise OtherSweep(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
 
 
 def stored_sweep(out_dir: Path) -> dict:

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputRefused, shown
-from ..io.files import atomic_write, output_path_problem
+from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from .axes import COLUMNS, Row, Study, grid_side
 from .metrics import pareto_front
 
@@ -341,6 +341,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     problem = output_path_problem(out)
     if problem:
         raise OutputRefused(f"--out: {shown(problem)}; give a folder")
+    refuse_unreplaceable([out / name for name in FILES], "study", "give another --out")  # --force too
     if force or not out.is_dir():
         return out
     held = sorted(p.name for p in out.iterdir())

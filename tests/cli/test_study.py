@@ -109,6 +109,22 @@ def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_fo
     assert code == ExitCode.OUTPUT_REFUSED and "not a study of tiny" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("force", [False, True])
+def test_a_study_file_that_is_a_folder_is_refused_before_the_work_not_after(tmp_path, capsys, force):
+    """A study folder whose study.csv is a folder (its study.md headed as the study's) was taken
+    as the study's own: the study ran, then failed to write ('[Errno 21] ...', exit code 1),
+    its work lost; with --force, a study.md folder too. Refused at once, naming the file."""
+    out = tmp_path / "out"
+    (out / "study.csv").mkdir(parents=True)
+    (out / "study.csv" / "mine.txt").write_text("keep me")
+    (out / "study.md").write_text("# Trade-off study: quickstart\n")
+    code = main(["study", "quickstart", *QUICK, "--out", str(out), *(["--force"] if force else [])])
+    err = capsys.readouterr().err
+    assert code == ExitCode.OUTPUT_REFUSED, err
+    assert f"{out / 'study.csv'} is a folder, not a file: the study writes its study.csv there; move it aside" in err
+    assert sorted(p.name for p in out.rglob("*")) == ["mine.txt", "study.csv", "study.md"]
+
+
 @pytest.mark.long
 def test_two_studies_started_together_get_two_default_folders(tmp_path):
     import subprocess

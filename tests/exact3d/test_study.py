@@ -307,3 +307,41 @@ def test_the_full_plan_pairs_three_grids_with_16_surfaces_and_a_broad_band_of_32
     first, last, _ = FULL.loads
     assert math.log10(last / first) >= 3.5
     assert set(FULL.broad_hursts) == {0.5, 0.8, 1.0}
+
+
+def test_a_link_at_an_ensembles_folder_is_never_read_or_written_through(quick_study, tmp_path, capsys):
+    """--runs with a link at an ensemble's folder: --finished-only read the run it pointed at into
+    the page, and --force wrote the ensemble where it pointed, outside --runs. Both are refused
+    before anything runs, naming the link; nothing is written where it points, nor the page."""
+    import shutil
+
+    runs, elsewhere = tmp_path / "runs", tmp_path / "elsewhere"
+    shutil.copytree(quick_study / "runs", runs)
+    shutil.move(runs / "h0.5-n64-mdr", elsewhere)
+    (runs / "h0.5-n64-mdr").symlink_to(elsewhere)
+    held = {p: p.stat().st_mtime_ns for p in elsewhere.rglob("*")}
+    base = ["exact3d", "--quick", "--presets", str(PRESETS), "--runs", str(runs), "--workers", "1", "--quiet"]
+    for extra in (["--finished-only", "--out", str(tmp_path / "page")], ["--force", "--out", str(tmp_path / "page")]):
+        assert main([*base, *extra]) == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert f"{runs / 'h0.5-n64-mdr'} is a symbolic link or not a folder, which is never followed: move it aside" in err
+        assert {p: p.stat().st_mtime_ns for p in elsewhere.rglob("*")} == held and not (tmp_path / "page" / PAGE).exists()
+    shutil.rmtree(elsewhere)
+    elsewhere.mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / FIGURES_DIR).symlink_to(elsewhere)  # the page's figures folder, a link
+    assert main([*base, "--finished-only", "--out", str(tmp_path / "out")]) == ExitCode.OUTPUT_REFUSED
+    assert f"{tmp_path / 'out' / FIGURES_DIR} is a symbolic link" in capsys.readouterr().err
+    assert not any(elsewhere.iterdir())
+
+
+def test_a_page_that_is_a_folder_is_refused_before_the_study_even_with_force(quick_study, tmp_path, capsys):
+    """--force over an --out whose exact-3d-law.md is a folder read (or ran) every ensemble, then
+    ended with 'error: is a folder, not a file: ...' (exit code 1). Refused before any."""
+    (tmp_path / "out" / PAGE).mkdir(parents=True)
+    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--runs", str(quick_study / "runs"), "--out",
+            str(tmp_path / "out"), "--finished-only", "--force", "--quiet"]  # fmt: skip
+    assert main(args) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'out' / PAGE} is a folder, not a file: the exact 3D study writes its {PAGE} there" in err
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [PAGE]

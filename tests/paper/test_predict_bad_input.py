@@ -70,6 +70,7 @@ def test_the_undamaged_copy_predicts(run_copy, capsys):
         pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", id="deep-list"),
         pytest.param('{"a": ' * 100_000 + "1" + "}" * 100_000, "nested too deeply", id="deep-object"),
         pytest.param("\udcff", "not valid JSON", id="not-utf8"),  # a lone byte 0xff once written
+        pytest.param('{"fit": {"a": 1, "a": 2}}', "(key 'a' given twice in one object)", id="repeated-key"),  # was the last
     ],
 )
 def test_a_summary_that_is_not_a_json_object(run_copy, capsys, text, reason):
@@ -273,7 +274,8 @@ def _folder(path):
         (_pickled, "pickled Python objects, which are never loaded"),
         (_array_larger_than_memory, "larger than this machine's memory"),
         (_without_xi, "no array 'xi'"),
-        (_all_nan, "'xi' must hold finite numbers"),
+        (_all_nan, "'xi' must hold finite numbers, or NaN where a line has no xi, with xi defined at two loads or "
+                   "more (no line has xi at "),  # said as it is: it once said "(0 of ... are infinite)"
         (_one_xi_negative, "'xi' must hold numbers >= 0, or NaN where a line has no xi (1 of "),
         (_f_not_positive, "'f' must hold finite numbers > 0"),
         (_xi_of_other_shape, "one per load step"),

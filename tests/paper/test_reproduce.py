@@ -161,6 +161,32 @@ def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(
     assert not (tmp_path / "runs").exists()  # refused before its default folder was made
 
 
+@pytest.mark.parametrize("linked", ["fig5", "figures"])
+def test_a_link_at_a_figures_or_a_runs_folder_is_refused_before_anything_runs(tiny_presets, tmp_path, capsys, linked):
+    """--out holding a link at fig5 (a figure's run folder) or figures/: the report wrote the run,
+    or the PNGs, where the link pointed, outside --out. Refused before any figure runs."""
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / linked).symlink_to(elsewhere)
+    assert main(["report", "--presets", str(tiny_presets), "--out", str(out), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"{out / linked} is a symbolic link or not a folder, which is never followed: move it aside" in err
+    assert not any(elsewhere.iterdir()) and sorted(p.name for p in out.iterdir()) == [linked]  # fig2 did not run
+
+
+@pytest.mark.parametrize("blocked", ["REPRODUCTION.md", "figures/fig3.png"])
+def test_a_report_file_that_is_a_folder_is_refused_before_the_runs_even_with_force(tiny_presets, tmp_path, capsys, blocked):
+    """--force over an --out whose REPRODUCTION.md (or a figure) is a folder ran every figure,
+    then ended with 'error: is a folder, not a file: ...' (exit code 1). Refused before any run."""
+    out = tmp_path / "out"
+    (out / blocked).mkdir(parents=True)
+    assert main(["report", "--presets", str(tiny_presets), "--out", str(out), "--force", "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"{out / blocked} is a folder, not a file: the report writes its {Path(blocked).name} there; move it aside" in err
+    assert not (out / "fig2").exists()
+
+
 @pytest.fixture(scope="module")
 def tiny_runs(tmp_path_factory, tiny_presets):
     return run_figures(tiny_presets, tmp_path_factory.mktemp("runs"), RunOptions(workers=1))
