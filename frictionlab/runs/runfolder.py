@@ -30,7 +30,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from ..errors import OutputRefused, RunFolderError, short_repr, shown
+from ..errors import OutputRefused, RunFolderError, short_repr, shown, shown_name
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
@@ -64,7 +64,7 @@ def check_searchable(folder: str | Path) -> None:
     try:
         os.lstat(Path(folder) / "run.json")
     except PermissionError:
-        raise RunFolderError(f"{shown(folder)} cannot be read (permission denied): its files cannot be looked at") from None
+        raise RunFolderError(f"{shown_name(folder)} cannot be read (permission denied): its files cannot be looked at") from None
     except OSError:
         pass  # absent, or not a folder: said where it is read
 
