@@ -16,6 +16,10 @@ progress they share.
 
 from __future__ import annotations
 
+import functools
+import os
+import traceback
+import warnings
 from typing import TYPE_CHECKING, Protocol
 
 from .hookspecs import hookspec
@@ -68,6 +72,44 @@ class RunListener(Protocol):
 LIFECYCLE_HOOKS = (
     "run_started", "realization_done", "realization_failed", "load_done", "iteration_done", "run_finished",
 )  # fmt: skip
+
+
+def fault_site(exc: BaseException, package: str):
+    """The innermost frame of ``exc``'s traceback in ``package`` (a plugin's top-level
+    module) and where it is, ``solve() at module.py:12``; (None, "") if none is."""
+    for frame, lineno in reversed(list(traceback.walk_tb(exc.__traceback__))):
+        if str(frame.f_globals.get("__name__", "")).partition(".")[0] == package:
+            return frame, f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
+    return None, ""
+
+
+class GuardedListener:
+    """An installed plugin's lifecycle hooks (``hookimpls``), called so that one that raises
+    is told once, naming the plugin (``label``) and how to be rid of it (``advice``), and
+    heard no more in this run, which goes on: a logger's fault never costs the results."""
+
+    def __init__(self, hookimpls, label: str, advice: str):
+        self._label, self._advice, self._failed = label, advice, False
+        for name, impl in hookimpls:  # (hook name, pluggy HookImpl)
+            setattr(self, name, self._guard(name, impl.function))
+
+    def _guard(self, name, function):
+        @functools.wraps(function)  # keeps the hookimpl mark and the argument names pluggy reads
+        def guarded(*args, **kwargs):
+            if self._failed:
+                return None
+            try:
+                return function(*args, **kwargs)
+            except Exception as exc:  # the plugin's fault: told, not the run's end
+                self._failed = True
+                _, where = fault_site(exc, function.__module__.partition(".")[0])
+                warnings.warn(
+                    f"{self._label} raised {type(exc).__name__}: {exc} in {where or name + '()'}; it hears no more "
+                    f"of this run, which goes on: {self._advice}", RuntimeWarning, stacklevel=2,
+                )  # fmt: skip
+                return None
+
+        return guarded
 
 
 class SweepListener:

@@ -29,7 +29,7 @@ from pydantic import BaseModel
 
 from ..errors import PluginError, did_you_mean, short_repr
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
-from .listeners import LIFECYCLE_HOOKS, RunListener
+from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener
 from .base import NAME_PATTERN, Plugin
 from .data import Profile
 from .kinds import KINDS, REQUIRED, ContactSolver, contract, IndentationReference, SlopeEstimator, SpectrumGenerator
@@ -96,7 +96,11 @@ def _module_distributions() -> dict[str, list[str]]:
 @functools.cache
 def provider_of(cls: type) -> tuple[str, str]:
     """The distribution (and version) that ships ``cls``, from its module."""
-    top = cls.__module__.split(".")[0]
+    return _provider(cls.__module__)
+
+
+def _provider(module: str) -> tuple[str, str]:
+    top = module.split(".")[0]
     dists = _module_distributions().get(top)
     if dists:
         dist = dists[0]
@@ -104,7 +108,7 @@ def provider_of(cls: type) -> tuple[str, str]:
             return dist, md.version(dist)
         except md.PackageNotFoundError:  # pragma: no cover - broken metadata
             return dist, "unknown"
-    return cls.__module__, "unversioned"
+    return module, "unversioned"
 
 
 def validate_plugin_class(kind: str, cls) -> None:
@@ -240,6 +244,7 @@ class Registry:
         self.pm.add_hookspecs(RegistrationSpecs)
         self.pm.add_hookspecs(RunListener)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
+        self._distributions: dict[str, str] = {}  # entry point -> its distribution, of those loaded
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         self._clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
@@ -275,6 +280,7 @@ class Registry:
                 plugin = ep.load()
                 self.pm.register(plugin, name=ep.name)
                 self._try_registration(plugin)
+                self._distributions[ep.name] = dist
             except Exception as exc:  # a broken plugin must not break the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
@@ -367,11 +373,22 @@ class Registry:
     def run_listeners(self) -> list[object]:
         """The registered plugins that implement a lifecycle hook: ``engine.run`` tells them
         of every run, besides the listeners it is given."""
-        found: dict[int, object] = {}
+        found: dict[int, list] = {}
         for name in LIFECYCLE_HOOKS:
             for impl in getattr(self.pm.hook, name).get_hookimpls():
-                found.setdefault(id(impl.plugin), impl.plugin)
-        return list(found.values())
+                found.setdefault(id(impl.plugin), []).append((name, impl))
+        return [self._guarded(impls) for impls in found.values()]
+
+    def _guarded(self, impls) -> GuardedListener:
+        """A listening plugin whose hook raises is told by its entry point and distribution."""
+        name = self.pm.get_name(impls[0][1].plugin)
+        if name in self._distributions:
+            label = f"frictionlab plugin {name!r} from {self._distributions[name]}"
+            advice = f"tell its authors, or block it (FRICTIONLAB_BLOCK_PLUGINS={name})"
+        else:
+            module = impls[0][1].function.__module__
+            label, advice = f"run listener {module} from {_provider(module)[0]}", "tell its authors"
+        return GuardedListener(impls, label, advice)
 
     def names(self, kind: str) -> list[str]:
         return sorted(self._plugins[kind])

@@ -1,0 +1,43 @@
+"""Mistakes of an installed plugin, as its author makes them: each is told naming the plugin
+and its distribution, and none costs a run."""
+
+from __future__ import annotations
+
+import pytest
+
+from frictionlab.compute import engine
+from frictionlab.options import RunOptions
+from frictionlab.plugin.registry import Registry
+from frictionlab.preset import build_scene
+
+from .test_registry import fake_dists  # noqa: F401 - the fixture
+
+RAISING_LOGGER = '''
+import frictionlab
+
+heard = []
+
+@frictionlab.hookimpl
+def run_started(run):
+    raise RuntimeError("log server unreachable")
+
+@frictionlab.hookimpl
+def realization_done(run, result, done, total):
+    heard.append(done)
+'''
+
+
+def test_a_listener_that_raises_is_told_and_the_run_goes_on(fake_dists, small_preset):  # noqa: F811
+    fake_dists("acme-logs", "acme-logger", "acme_logger_plugin", RAISING_LOGGER, "0.2")
+    registry = Registry(env={})
+    small_preset["realizations"] = 3
+    with pytest.warns(RuntimeWarning) as warned:
+        outcome = engine.run(build_scene(small_preset, registry=registry), RunOptions(workers=1), registry=registry)
+    assert (outcome.status, outcome.done) == ("completed", 3)
+    [message] = [str(w.message) for w in warned if "raised" in str(w.message)]  # told once, not per event
+    assert "'acme-logger' from acme-logs raised RuntimeError: log server unreachable" in message
+    assert "run_started() at acme_logger_plugin.py:8" in message
+    assert "FRICTIONLAB_BLOCK_PLUGINS=acme-logger" in message
+    import acme_logger_plugin
+
+    assert acme_logger_plugin.heard == []  # heard no more of the run once it failed
