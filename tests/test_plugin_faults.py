@@ -41,3 +41,36 @@ def test_a_listener_that_raises_is_told_and_the_run_goes_on(fake_dists, small_pr
     import acme_logger_plugin
 
     assert acme_logger_plugin.heard == []  # heard no more of the run once it failed
+
+
+RAISING_SOLVER = '''
+import frictionlab
+from frictionlab import ContactSolver, ForceNormalisation
+
+class Raising(ContactSolver):
+    name = "acme-raising"
+    summary = "a solver with a bug"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
+
+    def stiffness(self):
+        return 1.0
+
+    def solve(self, profile, loads, control, slopes):
+        return {}["missing-key"]
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(Raising)
+'''
+
+
+def test_an_exception_in_a_plugins_solve_names_the_plugin_in_the_realizations_error(fake_dists, small_preset):  # noqa: F811
+    fake_dists("acme-solvers", "acme-raising", "acme_raising_plugin", RAISING_SOLVER, "0.3")
+    registry = Registry(env={})
+    small_preset.update(realizations=2, solver={"name": "acme-raising"})
+    outcome = engine.run(build_scene(small_preset, registry=registry), RunOptions(workers=1), registry=registry)
+    assert outcome.done == 0
+    [(_, error), _] = outcome.failures
+    assert "solver 'acme-raising' (acme_raising_plugin.Raising from acme-solvers) raised KeyError" in error
+    assert "in solve() at acme_raising_plugin.py:15" in error

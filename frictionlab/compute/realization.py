@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import PluginError
+from ..plugin.registry import plugin_fault
 from ..plugin.outputs import curve_problem, height_of, profile_problem, refuse, slopes_problem
 from ..plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -192,7 +193,10 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     except Exception as exc:  # carried, not raised: one bad line must not end the run
         where = traceback.extract_tb(exc.__traceback__)[-1]
         error = f"{type(exc).__name__}: {exc}"
-        if not isinstance(exc, PluginError):  # a broken answer is named with its plugin: no line of ours to show
+        fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
+        if fault is not None:  # raised in a third party's plugin: named, with its distribution and line
+            error = f"PluginError: {fault}"
+        elif not isinstance(exc, PluginError):  # a broken answer is named with its plugin: no line of ours to show
             error += f" ({os.path.basename(where.filename)}:{where.lineno})"
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
 

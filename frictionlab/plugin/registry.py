@@ -17,7 +17,6 @@ import inspect
 import importlib.metadata as md
 import os
 import sys
-import traceback
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -29,7 +28,7 @@ from pydantic import BaseModel
 
 from ..errors import PluginError, did_you_mean, short_repr
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
-from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener
+from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener, fault_site
 from .base import NAME_PATTERN, Plugin
 from .data import Profile
 from .kinds import KINDS, REQUIRED, ContactSolver, contract, IndentationReference, SlopeEstimator, SpectrumGenerator
@@ -412,24 +411,8 @@ class Registry:
             raise PluginError(self.not_found_message(kind, name)) from None
 
     def at_fault(self, exc: BaseException) -> PluginError | None:
-        """``exc`` told as the fault of the installed plugin whose code raised it (the innermost
-        frame of its traceback in a third party's plugin module), or None: the built-ins are
-        frictionlab's own, and a fault anywhere else is not a plugin's."""
-        modules = {info.cls.__module__.partition(".")[0]: info for info in self.infos()}
-        for module in BUILTIN_MODULES:
-            modules.pop(module, None)
-        frames = [(frame, lineno) for frame, lineno in traceback.walk_tb(exc.__traceback__)]
-        for frame, lineno in reversed(frames):
-            info = modules.get(str(frame.f_globals.get("__name__", "")).partition(".")[0])
-            if info is not None:
-                cls = type(frame.f_locals.get("self")) if isinstance(frame.f_locals.get("self"), Plugin) else info.cls
-                where = f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
-                return PluginError(
-                    f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}) raised "
-                    f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
-                    "tell its authors, or choose another plugin"
-                )
-        return None
+        """``exc`` told as the fault of the installed plugin whose code raised it, or None."""
+        return plugin_fault(exc, [info.cls for info in self.infos()])
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)
@@ -439,6 +422,27 @@ class Registry:
             broken = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error}" for f in self.failures)
             message += f" Plugins that failed to load: {broken}."
         return message
+
+
+def plugin_fault(exc: BaseException, classes) -> PluginError | None:
+    """``exc`` told as the fault of the plugin among ``classes`` whose code raised it (the innermost
+    frame of its traceback in a third party's plugin package), or None: the built-ins are
+    frictionlab's own, and a fault anywhere else is not a plugin's."""
+    packages: dict[str, type] = {}
+    for cls in classes:
+        if (top := cls.__module__.partition(".")[0]) not in BUILTIN_MODULES:
+            packages.setdefault(top, cls)
+    for package, cls in packages.items():
+        frame, where = fault_site(exc, package)
+        if frame is not None:
+            own = frame.f_locals.get("self")
+            cls = type(own) if isinstance(own, Plugin) else cls
+            return PluginError(
+                f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}) raised "
+                f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
+                "tell its authors, or choose another plugin"
+            )
+    return None
 
 
 @functools.cache
