@@ -4,10 +4,13 @@ and its distribution, and none costs a run."""
 from __future__ import annotations
 
 import pytest
+from pydantic import Field
 
+from frictionlab import PluginParams, Profile, SpectrumGenerator
 from frictionlab.compute import engine
+from frictionlab.errors import PluginError
 from frictionlab.options import RunOptions
-from frictionlab.plugin.registry import Registry
+from frictionlab.plugin.registry import Registry, validate_plugin_class
 from frictionlab.preset import build_scene
 
 from .test_registry import fake_dists  # noqa: F401 - the fixture
@@ -74,3 +77,52 @@ def test_an_exception_in_a_plugins_solve_names_the_plugin_in_the_realizations_er
     [(_, error), _] = outcome.failures
     assert "solver 'acme-raising' (acme_raising_plugin.Raising from acme-solvers) raised KeyError" in error
     assert "in solve() at acme_raising_plugin.py:15" in error
+
+
+MISSING_METHOD = '''
+import frictionlab
+from frictionlab import Profile, SpectrumGenerator
+
+class Missing(SpectrumGenerator):
+    name = "acme-line"
+    summary = "forgot rms_height"
+
+    def generate(self, rng):
+        return Profile(heights=rng.standard_normal(64), spacing=1.0)
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Missing)
+'''
+
+
+def test_a_preset_naming_a_plugin_that_failed_to_load_is_told_why_not_a_guess(fake_dists):  # noqa: F811
+    fake_dists("acme-lines", "acme", "acme_line_plugin", MISSING_METHOD)  # entry point named otherwise
+    with pytest.warns(RuntimeWarning, match="'acme' from acme-lines failed to load"):
+        registry = Registry(env={})
+    with pytest.raises(PluginError) as refused:
+        registry.get("spectrum", "acme-line")
+    message = str(refused.value)
+    assert message.startswith("spectrum plugin 'acme-line' is installed but failed to load: acme (acme-lines): ")
+    assert "implements no rms_height()" in message
+    assert "did you mean" not in message
+    assert "installed spectrum plugins: " in message and "power-law" in message
+
+
+class Undescribed(SpectrumGenerator):
+    name = "acme-blank"
+    summary = "a field described by blanks"
+
+    class Params(PluginParams):
+        points: int = Field(64, description="  ")
+
+    def generate(self, rng):
+        return Profile(rng.standard_normal(self.params.points), 1.0)
+
+    def rms_height(self):
+        return 1.0
+
+
+def test_a_field_described_by_blanks_is_refused_with_how_to_describe_it():
+    with pytest.raises(PluginError, match=r"Params.points has no description; give it one, points: \.\.\. = Field\("):
+        validate_plugin_class("spectrum", Undescribed)

@@ -85,6 +85,7 @@ class LoadFailure:
     entry_point: str
     distribution: str
     error: str
+    claims: tuple[tuple[str, str], ...] = ()  # (kind, name) of the classes it registered before failing
 
 
 @functools.cache
@@ -129,8 +130,12 @@ def validate_plugin_class(kind: str, cls) -> None:
     if params.model_config.get("extra") != "forbid":
         raise PluginError(f"{label}: Params must forbid unknown keys (model_config extra='forbid')")
     for field_name, info in params.model_fields.items():
-        if not info.description:
-            raise PluginError(f"{label}: Params.{field_name} has no description")
+        if not (info.description or "").strip():
+            raise PluginError(
+                f"{label}: Params.{field_name} has no description; give it one, {field_name}: ... = "
+                f"Field(default, description=\"what it is (its unit)\"): presets, frictionlab schema and the "
+                "edit form show it"
+            )
     for problem in declaration_problems(cls):
         raise PluginError(f"{label}: {problem}")
 
@@ -275,10 +280,11 @@ class Registry:
             if self.pm.get_plugin(ep.name) is not None:
                 continue
             dist = ep.dist.name if ep.dist else "unknown distribution"
+            claims: list[tuple[str, str]] = []
             try:
                 plugin = ep.load()
                 self.pm.register(plugin, name=ep.name)
-                self._try_registration(plugin)
+                self._try_registration(plugin, claims)
                 self._distributions[ep.name] = dist
             except Exception as exc:  # a broken plugin must not break the tool
                 if self.pm.get_plugin(ep.name) is not None:
@@ -286,14 +292,14 @@ class Registry:
                 message = f"{type(exc).__name__}: {exc}"
                 if isinstance(exc, SyntaxError):  # its str names the file without its folder
                     message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
-                self.failures.append(LoadFailure(ep.name, dist, message))
+                self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warnings.warn(
                     f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
                     RuntimeWarning,
                     stacklevel=2,
                 )
 
-    def _try_registration(self, plugin) -> None:
+    def _try_registration(self, plugin, claims: list[tuple[str, str]]) -> None:
         """Run ``plugin``'s registration hooks alone, checking every class it registers: a
         misspelled hook, a hook that raises or a class breaking the contract is then this
         plugin's failure, not every command's."""
@@ -306,8 +312,11 @@ class Registry:
         for kind, base in KINDS.items():
             for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
                 if impl.plugin is plugin:
-                    given = {"register": functools.partial(validate_plugin_class, kind)}
-                    impl.function(**{arg: given[arg] for arg in impl.argnames})
+                    def register(cls, _kind=kind):  # a preset naming a refused class is told why
+                        claims.append((_kind, normalize_name(str(getattr(cls, "name", "")))))
+                        validate_plugin_class(_kind, cls)
+
+                    impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
 
     def register_plugin(self, plugin, name: str | None = None) -> None:
         """Register a plugin object (module or class with hookimpls) and re-collect.
@@ -416,6 +425,13 @@ class Registry:
 
     def not_found_message(self, kind: str, name: str) -> str:
         installed = self.names(kind)
+        key = normalize_name(name)
+        failed = [f for f in self.failures if (kind, key) in f.claims or (not f.claims and f.entry_point == key)]
+        if failed:  # installed, but refused: why, not a guess at another name
+            why = "; ".join(f"{f.entry_point} ({f.distribution}): {f.error.rstrip('.')}" for f in failed)
+            return (f"{kind} plugin {short_repr(name)} is installed but failed to load: {why}. Fix the plugin "
+                    f"(frictionlab plugins then lists it), or choose another: installed {kind} plugins: "
+                    f"{', '.join(installed) or 'none'}.")  # fmt: skip
         message = f"no {kind} plugin named {short_repr(name)}{did_you_mean(normalize_name(name), installed) or '.'}"
         message += f" Installed {kind} plugins: {', '.join(installed) or 'none'}."
         if self.failures:
