@@ -126,3 +126,18 @@ class Undescribed(SpectrumGenerator):
 def test_a_field_described_by_blanks_is_refused_with_how_to_describe_it():
     with pytest.raises(PluginError, match=r"Params.points has no description; give it one, points: \.\.\. = Field\("):
         validate_plugin_class("spectrum", Undescribed)
+
+
+def test_the_contract_says_what_the_run_and_the_kit_do():
+    """The docstrings an author reads: the rate iteration_done is heard at, the sign of slopes."""
+    from pathlib import Path
+
+    from frictionlab import RunListener, SlopeEstimator
+    from frictionlab.compute.realization import ITERATION_EVENT_SECONDS
+
+    page = (Path(__file__).parents[1] / "docs" / "reference" / "plugin-contract.md").read_text(encoding="utf-8")
+    assert 1 / ITERATION_EVENT_SECONDS == 4
+    for text in (page, RunListener.iteration_done.__doc__):
+        assert "at most four times a" in " ".join(text.split())
+    assert "dz/dx with its sign on a line" in " ".join(SlopeEstimator.__doc__.split())
+    assert "the run goes on: a logger's fault never costs results" in " ".join(page.split())

@@ -117,7 +117,9 @@ class SlopeEstimator(Plugin):
     """Turns a profile into pointwise slopes.
 
     ``slopes(heights, spacing, periodic)`` returns an array of the same shape as
-    ``heights``: the slope attributed to each point. The rms slope of the whole
+    ``heights``: the slope attributed to each point, dz/dx with its sign on a line and the
+    gradient's magnitude |grad z| >= 0 on a surface (a tilted plane's every slope is its
+    tilt; ``frictionlab.testing`` checks both). The rms slope of the whole
     line and the rms slope over the points in contact are both formed from it,
     so the two always use the same estimator. With ``periodic=False`` (a scan
     whose ends do not meet) no difference may reach across the ends.

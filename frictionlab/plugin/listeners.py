@@ -60,7 +60,7 @@ class RunListener(Protocol):
     def iteration_done(self, run: RunInfo, index: int, load: int, iteration: int, residual: float) -> None:
         """Realization ``index`` is solving its ``load``-th load (counted from 1): ``iteration``
         steps are done and the relative residual is ``residual``. An iterative solver reports
-        each iteration (``frictionlab.iteration_done``); listeners hear it at most twice a
+        each iteration (``frictionlab.iteration_done``); listeners hear it at most four times a
         second per realization, so a long load shows movement. Heard as ``load_done`` is."""
 
     @hookspec
