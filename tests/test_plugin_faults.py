@@ -141,3 +141,17 @@ def test_the_contract_says_what_the_run_and_the_kit_do():
         assert "at most four times a" in " ".join(text.split())
     assert "dz/dx with its sign on a line" in " ".join(SlopeEstimator.__doc__.split())
     assert "the run goes on: a logger's fault never costs results" in " ".join(page.split())
+
+
+def test_the_kits_register_plugin_says_the_hook_meant_as_discovery_does(register_plugin):
+    import pluggy
+
+    from frictionlab import hookimpl
+
+    class Misspelled:
+        @hookimpl
+        def run_finish(self, run, outcome):
+            pass
+
+    with pytest.raises(pluggy.PluginValidationError, match=r"unknown hook 'run_finish'; did you mean 'run_finished'\?"):
+        register_plugin(Misspelled())

@@ -303,11 +303,8 @@ class Registry:
         """Run ``plugin``'s registration hooks alone, checking every class it registers: a
         misspelled hook, a hook that raises or a class breaking the contract is then this
         plugin's failure, not every command's."""
-        hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
-        for caller in self.pm.get_hookcallers(plugin) or ():
-            if caller.name not in hooks:
-                hint = did_you_mean(caller.name, hooks, cutoff=0.85) or f"; the hooks are {', '.join(hooks)}"
-                raise PluginError(f"unknown hook {caller.name!r}{hint}")
+        if problem := self._unknown_hook(plugin):
+            raise PluginError(problem)
         self.pm.check_pending()  # a hook's arguments; the built-ins passed it: only this plugin can fail it
         for kind, base in KINDS.items():
             for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
@@ -317,6 +314,16 @@ class Registry:
                         validate_plugin_class(_kind, cls)
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
+
+    def _unknown_hook(self, plugin) -> str:
+        """A hook ``plugin`` implements that frictionlab has none of (a misspelling), said with
+        the hook meant; "" if none."""
+        hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
+        for caller in self.pm.get_hookcallers(plugin) or ():
+            if caller.name not in hooks:
+                hint = did_you_mean(caller.name, hooks, cutoff=0.85) or f"; the hooks are {', '.join(hooks)}"
+                return f"unknown hook {caller.name!r}{hint}"
+        return ""
 
     def register_plugin(self, plugin, name: str | None = None) -> None:
         """Register a plugin object (module or class with hookimpls) and re-collect.
@@ -330,6 +337,8 @@ class Registry:
         clashes = set(self.clashes)
         try:
             self.pm.register(plugin, name=name)
+            if problem := self._unknown_hook(plugin):  # as a run's discovery says it: with the hook meant
+                raise pluggy.PluginValidationError(plugin, f"{problem} (in {plugin!r})")
             self.pm.check_pending()
             self._collect()
             for message in self.clashes:
