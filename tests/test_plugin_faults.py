@@ -155,3 +155,22 @@ def test_the_kits_register_plugin_says_the_hook_meant_as_discovery_does(register
 
     with pytest.raises(pluggy.PluginValidationError, match=r"unknown hook 'run_finish'; did you mean 'run_finished'\?"):
         register_plugin(Misspelled())
+
+
+WRONG_ARGUMENT = '''
+import frictionlab
+
+@frictionlab.hookimpl
+def realization_done(run, res, done, total):
+    pass
+'''
+
+
+def test_a_hook_taking_an_argument_not_passed_is_told_on_one_line_with_those_passed(fake_dists):  # noqa: F811
+    fake_dists("acme-args", "acme-args", "acme_args_plugin", WRONG_ARGUMENT)
+    with pytest.warns(RuntimeWarning):
+        registry = Registry(env={})
+    [failure] = registry.failures
+    assert "\n" not in failure.error
+    assert "{'res'}" in failure.error
+    assert failure.error.endswith("realization_done passes (run, result, done, total): take any of them, by these names")

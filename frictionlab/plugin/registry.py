@@ -16,6 +16,7 @@ import importlib
 import inspect
 import importlib.metadata as md
 import os
+import re
 import sys
 import warnings
 from collections.abc import Mapping
@@ -292,6 +293,8 @@ class Registry:
                 message = f"{type(exc).__name__}: {exc}"
                 if isinstance(exc, SyntaxError):  # its str names the file without its folder
                     message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
+                elif isinstance(exc, pluggy.PluginValidationError):
+                    message = self._hook_arguments_message(exc)
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warnings.warn(
                     f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
@@ -314,6 +317,16 @@ class Registry:
                         validate_plugin_class(_kind, cls)
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
+
+    def _hook_arguments_message(self, exc: pluggy.PluginValidationError) -> str:
+        """pluggy's refusal of a hook's arguments, on one line, with the arguments the hook passes."""
+        message = f"PluginValidationError: {' '.join(str(exc).split())}"
+        hook = re.search(r"for hook '(\w+)'", str(exc))
+        caller = getattr(self.pm.hook, hook.group(1), None) if hook else None
+        if caller is not None and caller.spec is not None:
+            message += (f"; {hook.group(1)} passes ({', '.join(caller.spec.argnames)}): take any of them, "
+                        "by these names")  # fmt: skip
+        return message
 
     def _unknown_hook(self, plugin) -> str:
         """A hook ``plugin`` implements that frictionlab has none of (a misspelling), said with
