@@ -174,3 +174,32 @@ def test_a_hook_taking_an_argument_not_passed_is_told_on_one_line_with_those_pas
     assert "\n" not in failure.error
     assert "{'res'}" in failure.error
     assert failure.error.endswith("realization_done passes (run, result, done, total): take any of them, by these names")
+
+
+class OneCaveat(SpectrumGenerator):
+    name = "acme-one-caveat"
+    summary = "a caveat given as a bare string"
+
+    class Params(PluginParams):
+        points: int = Field(64, ge=8, le=4096, description="Grid points.")
+
+    def generate(self, rng):
+        return Profile(rng.standard_normal(self.params.points), 1.0)
+
+    def rms_height(self):
+        return 1.0
+
+    def caveats(self):
+        return "for testing only"
+
+
+def test_caveats_given_as_a_bare_string_are_refused_before_the_run_as_by_the_kit(small_preset, register_plugin):
+    from frictionlab.testing import check_spectrum
+
+    registry = register_plugin(OneCaveat)
+    small_preset["spectrum"] = {"name": "acme-one-caveat"}
+    expected = r"caveats\(\) must be a tuple of non-empty strings \(one sentence: \(sentence,\)\)\. Got 'for testing only'"
+    with pytest.raises(PluginError, match=expected):
+        build_scene(small_preset, registry=registry)
+    with pytest.raises(AssertionError, match=expected):
+        check_spectrum(OneCaveat)

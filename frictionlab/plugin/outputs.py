@@ -119,7 +119,7 @@ def _whole(value) -> bool:
 
 def answers_problem(plugin) -> str | None:
     """What is wrong with the answers a run reads of ``plugin`` before it starts: a spectrum's
-    ``periodic()`` and ``grid_shape()`` (``rms_height()``: ``height_problem``, once a measured
+    ``periodic()``, ``grid_shape()`` and ``caveats()`` (``rms_height()``: ``height_problem``, once a measured
     file is read); a solver's ``stiffness()`` and ``tolerance()``; an estimator's
     ``undefined_points(periodic)``."""
     if isinstance(plugin, SpectrumGenerator):
@@ -129,7 +129,7 @@ def answers_problem(plugin) -> str | None:
         if shape is not None and not (isinstance(shape, (tuple, list)) and len(shape) == dimension
                                       and all(_whole(n) and n >= 1 for n in shape)):  # fmt: skip
             return f"grid_shape() must be None or {dimension} whole number(s) >= 1, the shape generate() makes. Got {shape!r} instead."
-        return None
+        return caveats_problem(plugin.caveats())
     if isinstance(plugin, ContactSolver):
         return _positive("stiffness()", plugin.stiffness()) or _positive("tolerance()", plugin.tolerance(), none=True)
     undefined = (plugin.undefined_points(True), plugin.undefined_points(False))
@@ -137,6 +137,13 @@ def answers_problem(plugin) -> str | None:
         return ("undefined_points(periodic) must be False for a periodic profile, True or False for another. "
                 f"Got {undefined[0]!r} and {undefined[1]!r}.")  # fmt: skip
     return None
+
+
+def caveats_problem(caveats) -> str | None:
+    """A spectrum's ``caveats()`` must be a tuple of sentences: a bare string would be told letter by letter."""
+    if isinstance(caveats, tuple) and all(isinstance(c, str) and c.strip() for c in caveats):
+        return None
+    return f"caveats() must be a tuple of non-empty strings (one sentence: (sentence,)). Got {caveats!r} instead."
 
 
 def shape_problem(spectrum: SpectrumGenerator, profile: Profile) -> str | None:

@@ -108,7 +108,8 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
         if points != profile.heights.shape[-1]:
             fail(cls, f"points_param names {cls.points_param!r} = {points!r}, but generate() makes "
                       f"{profile.heights.shape[-1]} points (per side)")  # fmt: skip
-    if problem := call(cls, "grid_shape()", answers_problem, gen) or call(cls, "grid_shape()", shape_problem, gen, profile):
+    answers = call(cls, "periodic(), grid_shape() or caveats()", answers_problem, gen)
+    if problem := answers or call(cls, "grid_shape()", shape_problem, gen, profile):
         fail(cls, problem)
 
     finer_points = 2 * profile.heights.shape[-1]
@@ -157,9 +158,6 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
     if hurst is not None and not (isinstance(hurst, float | int) and math.isfinite(hurst) and hurst >= 0):
         fail(cls, f"hurst_exponent() must be None or a finite number >= 0. Got {hurst!r}.")
     _check_input_summary(cls, gen, profile)
-    caveats = call(cls, "caveats()", gen.caveats)
-    if not isinstance(caveats, tuple) or not all(isinstance(c, str) and c.strip() for c in caveats):
-        fail(cls, f"caveats() must be a tuple of non-empty strings. Got {caveats!r}.")
 
 
 def _check_input_summary(cls, gen, profile) -> None:
