@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from pydantic import Field
 
-from frictionlab import PluginParams, Profile, SpectrumGenerator
+from frictionlab import ContactSolver, ForceNormalisation, PluginParams, Profile, SpectrumGenerator
 from frictionlab.compute import engine
 from frictionlab.errors import PluginError
 from frictionlab.options import RunOptions
@@ -203,3 +203,32 @@ def test_caveats_given_as_a_bare_string_are_refused_before_the_run_as_by_the_kit
         build_scene(small_preset, registry=registry)
     with pytest.raises(AssertionError, match=expected):
         check_spectrum(OneCaveat)
+
+
+def _helper_that_fails():
+    return {}["missing-key"]
+
+
+class HelpedSolver(ContactSolver):
+    name = "acme-helped"
+    summary = "a solver whose module-level helper raises"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
+
+    def stiffness(self):
+        return 1.0
+
+    def solve(self, profile, loads, control, slopes):
+        return _helper_that_fails()
+
+
+def test_a_fault_in_a_helper_is_told_as_the_plugin_whose_method_called_it():
+    """The spectrum and the solver share a package: the one whose method was on the stack is at fault."""
+    from frictionlab.plugin.registry import plugin_fault
+
+    try:
+        HelpedSolver().solve(None, None, "force", None)
+    except KeyError as exc:
+        fault = plugin_fault(exc, [OneCaveat, HelpedSolver])
+    assert str(fault).startswith("solver 'acme-helped' (tests.test_plugin_faults.HelpedSolver from ")
+    assert "in _helper_that_fails() at test_plugin_faults.py:" in str(fault)

@@ -22,6 +22,7 @@ import traceback
 import warnings
 from typing import TYPE_CHECKING, Protocol
 
+from .base import Plugin
 from .hookspecs import hookspec
 
 if TYPE_CHECKING:  # annotations only: the engine imports this module
@@ -75,12 +76,16 @@ LIFECYCLE_HOOKS = (
 
 
 def fault_site(exc: BaseException, package: str):
-    """The innermost frame of ``exc``'s traceback in ``package`` (a plugin's top-level
-    module) and where it is, ``solve() at module.py:12``; (None, "") if none is."""
-    for frame, lineno in reversed(list(traceback.walk_tb(exc.__traceback__))):
-        if str(frame.f_globals.get("__name__", "")).partition(".")[0] == package:
-            return frame, f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}"
-    return None, ""
+    """Where ``exc`` was raised in ``package`` (a plugin's top-level module): its innermost frame
+    there, ``solve() at module.py:12``, and the plugin instance whose method is nearest to it on
+    the stack (a helper function has none of its own); (None, "", None) if no frame is there."""
+    frames = [(frame, lineno) for frame, lineno in traceback.walk_tb(exc.__traceback__)
+              if str(frame.f_globals.get("__name__", "")).partition(".")[0] == package][::-1]  # fmt: skip
+    if not frames:
+        return None, "", None
+    frame, lineno = frames[0]
+    owner = next((f.f_locals["self"] for f, _ in frames if isinstance(f.f_locals.get("self"), Plugin)), None)
+    return frame, f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}", owner
 
 
 class GuardedListener:
@@ -102,7 +107,7 @@ class GuardedListener:
                 return function(*args, **kwargs)
             except Exception as exc:  # the plugin's fault: told, not the run's end
                 self._failed = True
-                _, where = fault_site(exc, function.__module__.partition(".")[0])
+                _, where, _ = fault_site(exc, function.__module__.partition(".")[0])
                 warnings.warn(
                     f"{self._label} raised {type(exc).__name__}: {exc} in {where or name + '()'}; it hears no more "
                     f"of this run, which goes on: {self._advice}", RuntimeWarning, stacklevel=2,

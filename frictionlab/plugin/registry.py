@@ -471,10 +471,9 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
         if (top := cls.__module__.partition(".")[0]) not in BUILTIN_MODULES:
             packages.setdefault(top, cls)
     for package, cls in packages.items():
-        frame, where = fault_site(exc, package)
+        frame, where, owner = fault_site(exc, package)
         if frame is not None:
-            own = frame.f_locals.get("self")
-            cls = type(own) if isinstance(own, Plugin) else cls
+            cls = cls if owner is None else type(owner)
             return PluginError(
                 f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}) raised "
                 f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
