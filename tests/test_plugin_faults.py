@@ -141,6 +141,7 @@ def test_the_contract_says_what_the_run_and_the_kit_do():
         assert "at most four times a" in " ".join(text.split())
     assert "dz/dx with its sign on a line" in " ".join(SlopeEstimator.__doc__.split())
     assert "the run goes on: a logger's fault never costs results" in " ".join(page.split())
+    assert "a `Params` field without a description" in " ".join(page.split())  # refused by the registry
 
 
 def test_the_kits_register_plugin_says_the_hook_meant_as_discovery_does(register_plugin):
