@@ -233,3 +233,17 @@ def test_a_fault_in_a_helper_is_told_as_the_plugin_whose_method_called_it():
         fault = plugin_fault(exc, [OneCaveat, HelpedSolver])
     assert str(fault).startswith("solver 'acme-helped' (tests.test_plugin_faults.HelpedSolver from ")
     assert "in _helper_that_fails() at test_plugin_faults.py:" in str(fault)
+
+
+def test_a_plugin_claiming_a_built_ins_name_is_told_with_the_entry_point_to_block(fake_dists):  # noqa: F811
+    from tests.test_registry import GOOD_SOURCE
+
+    fake_dists("acme-twin", "acme-twin-ep", "acme_twin", GOOD_SOURCE.format(cls="Twin", name="power-law"))
+    with pytest.warns(RuntimeWarning, match="two spectrum plugins are named 'power-law'"):
+        registry = Registry(env={})
+    with pytest.raises(PluginError) as refused:
+        registry.get("spectrum", "power-law")
+    assert str(refused.value).endswith(
+        "block one with FRICTIONLAB_BLOCK_PLUGINS=acme-twin-ep, or uninstall its distribution"
+    )
+    assert "power-law" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "acme-twin-ep"}).names("spectrum")

@@ -250,6 +250,7 @@ class Registry:
         self.pm.add_hookspecs(RunListener)  # an installed plugin may listen to every run
         self.failures: list[LoadFailure] = []
         self._distributions: dict[str, str] = {}  # entry point -> its distribution, of those loaded
+        self._claims: dict[tuple[str, str], list[str]] = {}  # (kind, name) -> the entry points registering it
         self._plugins: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         self._clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
@@ -287,6 +288,8 @@ class Registry:
                 self.pm.register(plugin, name=ep.name)
                 self._try_registration(plugin, claims)
                 self._distributions[ep.name] = dist
+                for claim in claims:
+                    self._claims.setdefault(claim, []).append(ep.name)
             except Exception as exc:  # a broken plugin must not break the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
@@ -385,13 +388,19 @@ class Registry:
                         f"two {_kind} plugins are named {key!r}: "
                         f"{previous.cls.__module__}.{previous.cls.__qualname__} from {previous.provider} "
                         f"and {cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}; "
-                        "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
+                        + self._clash_advice(_kind, key)
                     )
 
             getattr(self.pm.hook, base.register_hook)(register=register)
             for key in clashes[kind]:
                 del tables[kind][key]
         self._plugins, self._clashes = tables, clashes
+
+    def _clash_advice(self, kind: str, key: str) -> str:
+        """How to be rid of a claim to a taken name: the entry points to block (never a built-in's)."""
+        if claims := self._claims.get((kind, key)):
+            return f"block one with FRICTIONLAB_BLOCK_PLUGINS={' or '.join(claims)}, or uninstall its distribution"
+        return "uninstall or block one of them (FRICTIONLAB_BLOCK_PLUGINS)"
 
     @property
     def clashes(self) -> list[str]:
