@@ -247,3 +247,22 @@ def test_a_plugin_claiming_a_built_ins_name_is_told_with_the_entry_point_to_bloc
         "block one with FRICTIONLAB_BLOCK_PLUGINS=acme-twin-ep, or uninstall its distribution"
     )
     assert "power-law" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "acme-twin-ep"}).names("spectrum")
+
+
+def test_the_kit_names_a_solvers_float32_field_as_an_attribute_of_what_solve_returned():
+    import dataclasses
+
+    import numpy as np
+
+    from frictionlab.testing import check_solver
+    from frictionlab_solvers.springs import WinklerSprings
+
+    class Single(WinklerSprings):
+        name = "acme-single"
+
+        def solve(self, profile, loads, control, slopes):
+            curve = super().solve(profile, loads, control, slopes)
+            return dataclasses.replace(curve, force=curve.force.astype(np.float32))
+
+    with pytest.raises(AssertionError, match=r"on a line, solve\(\.\.\., control='force'\)\.force must be float64"):
+        check_solver(Single)

@@ -111,7 +111,7 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
     names = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 
     for control, loads in cases.items():
-        where = f"solve(..., control={control!r}) on a {shape}"
+        where = f"on a {shape}, solve(..., control={control!r})"  # its fields read as solve(...).force
 
         def run():
             profile = Profile(heights=heights.copy(), spacing=spacing)
