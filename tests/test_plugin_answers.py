@@ -1,5 +1,5 @@
 """What a plugin answers before a run starts (its declarations' values, realization 0's
-profile, the load of full contact) is checked where it is taken: a broken answer is refused
+profile and its slopes, the load of full contact) is checked where it is taken: a broken answer is refused
 by the plugin's name, and an exception raised in a third party's plugin code is told as
 that plugin's fault, never as frictionlab's internal error."""
 
@@ -29,6 +29,8 @@ BROKEN = {
                       "tolerance() must be None or a number finite and > 0. Got nan"),
     "text-full": (GoodSolver, {"full_contact_load": lambda self, profile: "lots"},
                   "full_contact_load(profile) must be None or a finite number >= 0. Got 'lots'"),
+    "single-slopes": (GoodSlopes, {"slopes": lambda self, heights, spacing, periodic=True: GoodSlopes.slopes(
+        self, heights, spacing, periodic).astype(np.float32)}, "slopes() must be float64 (double precision)"),
     "text-undefined": (GoodSlopes, {"undefined_points": lambda self, periodic: "no"},
                        "undefined_points(periodic) must be False for a periodic profile"),
 }

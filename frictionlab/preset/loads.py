@@ -83,17 +83,18 @@ def load_scales(scene, profile: Profile | None = None) -> LoadScales:
     pressure_unit = None if area is None else float(solver.stiffness()) * area
     full, exact = solver.full_contact_load(profile), True
     refuse(solver, full_contact_problem(full))
+    # the estimator's answer too, as every realization takes it: a broken one is refused before the run
+    slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
+    refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
     if full is None and pressure_unit is not None:
-        full, exact = estimated_full_contact(scene, profile, pressure_unit), False
+        full, exact = estimated_full_contact(slopes, pressure_unit), False
     return LoadScales(unit, pressure_unit, full, exact, profile.points)
 
 
-def estimated_full_contact(scene, profile: Profile, pressure_unit: float) -> float | None:
+def estimated_full_contact(slopes: np.ndarray, pressure_unit: float) -> float | None:
     """An estimate of the force of full contact: the nominal pressure p = E* g, g the profile's
-    rms slope (the scene's slope estimator), which presses a surface flat to within a few per cent
-    of its area (Persson's theory gives erf(sqrt 2) = 95 % in contact there)."""
-    slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-    refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
+    rms slope (``slopes``, of the scene's slope estimator), which presses a surface flat to within a
+    few per cent of its area (Persson's theory gives erf(sqrt 2) = 95 % in contact there)."""
     with np.errstate(invalid="ignore", over="ignore"):
         squares = np.square(slopes[np.isfinite(slopes)])
         g = math.sqrt(float(np.mean(squares))) if squares.size else math.nan
