@@ -285,16 +285,16 @@ def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
 
 
-def warn_user(message: str) -> None:
-    """A UserWarning attributed to the first caller outside frictionlab (a script's or a
-    notebook cell's line): a notebook shows that line, not one of ours, and a warning
-    shown once per place is shown again for each place of the user's that causes it."""
+def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
+    """A warning (a UserWarning by default) attributed to the first caller outside frictionlab
+    (a script's or a notebook cell's line): a notebook shows that line, not one of ours, and a
+    warning shown once per place is shown again for each place of the user's that causes it."""
     import warnings
 
     package, frame, level = os.path.dirname(__file__) + os.sep, sys._getframe(1), 1
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1
-    warnings.warn(message, stacklevel=level + 1 if frame is not None else 2)
+    warnings.warn(message, category, stacklevel=level + 1 if frame is not None else 2)
 
 
 def _quiet_stdout() -> None:

@@ -18,3 +18,22 @@ def test_running_twice_into_a_folder_warns_at_the_callers_line(tmp_path):
         frictionlab.run(SMALL_PRESET, out=tmp_path / "run", **FAST)
     [warning] = [w for w in caught if "holds a completed run of this preset" in str(w.message)]
     assert warning.filename == __file__ and warning.category is UserWarning
+
+
+def test_warnings_of_the_plugin_registry_built_on_first_use_name_the_callers_line(monkeypatch):
+    """The registry is built by a notebook's first run: its warnings (a typo in a
+    FRICTIONLAB_* variable) named a line of frictionlab's registry.py, not the cell's."""
+    from frictionlab.plugin.registry import default_registry
+
+    monkeypatch.setenv("FRICTIONLAB_TRACE_HOOKS", "ture")
+    monkeypatch.setenv("FRICTIONLAB_PLUGINS", "gausian")
+    default_registry.cache_clear()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            frictionlab.validate(SMALL_PRESET)
+    finally:
+        default_registry.cache_clear()  # the next test's registry reads its own environment
+    said = [w for w in caught if "FRICTIONLAB_" in str(w.message)]
+    assert len(said) == 2, [str(w.message) for w in caught]
+    assert all(w.filename == __file__ and w.category is RuntimeWarning for w in said), [w.filename for w in said]
