@@ -41,6 +41,9 @@ def _has_widgets() -> bool:
     return importlib.util.find_spec("ipywidgets") is not None
 
 
+NOTEBOOK_REDRAWS_PER_SECOND = 1
+
+
 class _Bar:
     """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
 
@@ -50,9 +53,12 @@ class _Bar:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
         console = Console(file=stream, highlight=False)
+        # in a notebook each redraw is a new output (cleared, displayed again), sent whether or not
+        # anything changed: once a second, as often as the elapsed time it shows moves
+        rate = NOTEBOOK_REDRAWS_PER_SECOND if console.is_jupyter else 10
         self.progress = Progress(
             TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
-            TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=10,
+            TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=rate,
             get_time=clock,
         )  # fmt: skip
         self.task = self.progress.add_task(description, total=total, completed=completed, note="")
