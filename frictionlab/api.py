@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
-from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown
+from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown, warn_user
 from .compute.fit import LogFit
 from .compute.signals import RunInterrupted
 from .options import RunOptions
@@ -85,7 +85,8 @@ class Result:
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
-    where each came from), else None. ``realizations``: (done, requested);
+    where each came from), else None. ``error``: why a failed run has no fit (xi the same at
+    every load, ...), else None. ``realizations``: (done, requested);
     ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
     in the preset's units (lengths as its spacing, F in modulus x length², per unit
     depth on a half-plane): ``units`` says each column's, as curve.csv's header does
@@ -105,6 +106,7 @@ class Result:
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
     input: dict | None = None
     units: dict[str, str] = field(default_factory=dict, repr=False, compare=False)  # by column, curve.csv's brackets
+    error: str | None = None  # why the run failed
 
     @property
     def a(self) -> float:
@@ -346,6 +348,8 @@ def run(
     result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
     if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
         raise RunInterrupted(result)
+    if result.status == "failed" and isinstance(result, Result):  # said where the run was asked for, as the CLI's error
+        warn_user(f"{result.name}: run failed: {result.error or 'no fit'}")
     return result
 
 
@@ -437,7 +441,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
         outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
-        units=column_units(curve_headers(scene)),
+        units=column_units(curve_headers(scene)), error=outcome.error,
     )  # fmt: skip
 
 
@@ -475,20 +479,13 @@ def load(folder: str | Path) -> Result | SweepResult:
             "realizations done"
         )
     return Result(
-        name=record.preset.name,
-        status=record.status,
-        fit=LogFit.from_dict(summary["fit"]) if record.fit is not None else None,
+        name=record.preset.name, status=record.status, fit=None if record.fit is None else LogFit.from_dict(summary["fit"]),
         table={name.rstrip("'"): values for name, values in curve.items()},  # F' on the half-plane
-        realizations=(record.realizations.done, record.realizations.requested),
-        normalisation=record.normalisation.f,
-        preset=summary["preset"],
-        elapsed=record.elapsed_seconds,
-        caveats=list(record.caveats),
-        folder=folder,
-        files={key: folder / name for key, name in record.files.items()},
-        input=record.input,
-        units=column_units(header),
-    )
+        realizations=(record.realizations.done, record.realizations.requested), normalisation=record.normalisation.f,
+        preset=summary["preset"], elapsed=record.elapsed_seconds, caveats=list(record.caveats), folder=folder,
+        files={key: folder / name for key, name in record.files.items()}, input=record.input,
+        units=column_units(header), error=record.error,
+    )  # fmt: skip
 
 
 def _load_sweep(folder: Path) -> SweepResult:

@@ -37,3 +37,23 @@ def test_warnings_of_the_plugin_registry_built_on_first_use_name_the_callers_lin
     said = [w for w in caught if "FRICTIONLAB_" in str(w.message)]
     assert len(said) == 2, [str(w.message) for w in caught]
     assert all(w.filename == __file__ and w.category is RuntimeWarning for w in said), [w.filename for w in said]
+
+
+def test_a_failed_run_says_why_at_the_callers_line_and_its_result_keeps_the_reason(tmp_path):
+    """A run whose loads all press the same points fits no law: in a notebook the cell showed
+    "run failed: 8 of 8 realizations finished" and, for the result, "no fit: no realization
+    finished"; why was nowhere to be seen (the CLI says it as its error)."""
+    from .conftest import merge
+
+    preset = merge(SMALL_PRESET, {"loading": {"start": 1e-30, "stop": 1e-25, "steps": 6}})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = frictionlab.run(preset, out=tmp_path / "run", **FAST)
+    assert result.status == "failed" and result.error.startswith("no law: every load")
+    [warning] = [w for w in caught if "run failed" in str(w.message)]
+    assert str(warning.message) == f"small: run failed: {result.error}"
+    assert warning.filename == __file__ and warning.category is UserWarning
+    html = result._repr_html_()
+    assert "no fit: no law: every load" in html and "no realization finished" not in html
+    assert html.count("no law: every load") == 1  # the caveat that says the same is not said twice
+    assert frictionlab.load(tmp_path / "run").error == result.error
