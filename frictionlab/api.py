@@ -49,9 +49,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
-from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown, warn_user
+from .errors import FrictionlabError, PresetError, RunFolderError, raised_here, require, short_repr, shown, warn_user
 from .compute.fit import LogFit
-from .compute.signals import RunInterrupted
+from .compute.signals import RunInterrupted, interrupted_since, mark
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
 from .runs.runfolder import check_searchable, subfolder
@@ -282,6 +282,7 @@ def scene_record(scene: Scene) -> dict:
     }  # fmt: skip
 
 
+@raised_here
 def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
              **keys: Any) -> dict:  # fmt: skip
     """Check a preset (any form ``run`` takes, overrides as there) without running it, and
@@ -299,6 +300,7 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
     return scene_record(build_scene(data, source=source, before_reading=check_one_realization))
 
 
+@raised_here
 def run(
     preset: str | Path | Mapping[str, Any] | Preset,
     overrides: Mapping[str, Any] | None = None,
@@ -342,8 +344,6 @@ def run(
     ``KeyboardInterrupt`` whose ``result`` is the run as it ended: a cell or a loop of
     runs stops there too.
     """
-    from .compute.signals import interrupted_since, mark
-
     seen = mark()
     result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
     if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
@@ -445,6 +445,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
     )  # fmt: skip
 
 
+@raised_here
 def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers

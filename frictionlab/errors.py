@@ -297,6 +297,23 @@ def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
     warnings.warn(message, category, stacklevel=level + 1 if frame is not None else 2)
 
 
+def raised_here(entry):
+    """For the Python API's entry points (``frictionlab.run``, ``load``, ``validate``): a
+    FrictionlabError (bad input, a refusal) comes out of the entry point with its traceback
+    cut there: a notebook shows the caller's line, the call and the message, not a screen of
+    frictionlab's own frames that say nothing about what to change."""
+    import functools
+
+    @functools.wraps(entry)
+    def called(*args, **keys):
+        try:
+            return entry(*args, **keys)
+        except FrictionlabError as exc:
+            raise exc.with_traceback(None)  # its message says what is wrong: frictionlab's frames are left out
+
+    return called
+
+
 def _quiet_stdout() -> None:
     """After a BrokenPipeError: point stdout at /dev/null so the interpreter's
     final flush does not fail again."""

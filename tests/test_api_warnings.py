@@ -57,3 +57,25 @@ def test_a_failed_run_says_why_at_the_callers_line_and_its_result_keeps_the_reas
     assert "no fit: no law: every load" in html and "no realization finished" not in html
     assert html.count("no law: every load") == 1  # the caveat that says the same is not said twice
     assert frictionlab.load(tmp_path / "run").error == result.error
+
+
+def test_a_bad_preset_comes_out_of_the_call_with_a_short_traceback():
+    """A notebook showed every frame between the call and the check that refused (run,
+    _run, build_scene, ...: six for the memory check): only the call's frame is left."""
+    import traceback
+
+    import pytest
+
+    from frictionlab.errors import PresetError, RunFolderError
+
+    calls = [
+        (lambda: frictionlab.run(SMALL_PRESET, {"spectrum.params.hurst": 2.0}, **FAST), PresetError),
+        (lambda: frictionlab.validate(SMALL_PRESET, {"realizations": 0}), PresetError),
+        (lambda: frictionlab.load("no-such-folder"), RunFolderError),
+    ]
+    for call, kind in calls:
+        with pytest.raises(kind) as raised:
+            call()
+        frames = traceback.extract_tb(raised.value.__traceback__)
+        assert [frame.name for frame in frames] == ["test_a_bad_preset_comes_out_of_the_call_with_a_short_traceback", "<lambda>", "called"]
+        assert raised.value.__context__ is None or raised.value.__suppress_context__
