@@ -91,6 +91,18 @@ SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond it
 LOAD_LINE_SECONDS = 1.5  # in a log: a long solve's load or iteration at most this often (movement every 2 s)
 
 
+def _flush_stdout(stream) -> None:
+    """What the caller printed before (a notebook cell's ``print`` above a run) goes out
+    before progress on stderr: stdout is buffered (a kernel sends it every 0.2 s, a pipe
+    when full), stderr is flushed at once, so a line printed first showed after."""
+    out = sys.stdout
+    if out is not None and out is not stream:
+        try:
+            out.flush()
+        except (OSError, ValueError):  # closed, or its reader gone: it says so where it is written
+            pass
+
+
 class BestEffort:
     """A stream whose failed writes are dropped from then on: progress is never worth a
     run (stderr closed under it, or full: ``2>/dev/full``)."""
@@ -100,6 +112,7 @@ class BestEffort:
 
     def write(self, text: str) -> int:
         if not self.broken:
+            _flush_stdout(self.stream)
             try:
                 return self.stream.write(text)
             except (OSError, ValueError):  # ValueError: written after it was closed

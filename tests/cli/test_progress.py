@@ -185,3 +185,28 @@ def test_a_notebook_bar_is_redrawn_once_a_second_not_ten_times(monkeypatch):
     bar = _Bar(io.StringIO(), "realizations", 10)
     bar.stop()
     assert bar.progress.console.is_jupyter and bar.progress.live.refresh_per_second == 1
+
+
+def test_what_was_printed_before_a_run_goes_out_before_its_progress(monkeypatch, make_scene):
+    """In a notebook, ``print("start"); frictionlab.run(...)`` showed the run's first progress
+    line above "start": stdout waits in a buffer, stderr is flushed at once."""
+    import sys
+
+    sent = []
+
+    class Buffered(io.StringIO):  # stdout as a kernel's or a pipe's: sent when flushed
+        def flush(self):
+            if self.getvalue():
+                sent.append(("stdout", self.getvalue()))
+                self.seek(0)
+                self.truncate()
+
+    class Progress(io.StringIO):
+        def write(self, text):
+            sent.append(("stderr", text))
+            return len(text)
+
+    monkeypatch.setattr(sys, "stdout", Buffered())
+    print("start")
+    engine.run(make_scene({"realizations": 2}), RunOptions(workers=1), listeners=[ProgressReporter(Progress(), after=0)])
+    assert sent[0] == ("stdout", "start\n") and sent[1][0] == "stderr", sent
