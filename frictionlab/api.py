@@ -162,9 +162,9 @@ class Result:
 
 @dataclass(frozen=True, eq=False)
 class SweepResult:
-    """A finished sweep: one row per point (``rows``: the swept values by dotted path,
-    ``a``, ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``,
-    ``contact_last``, ``status``, ``folder``), each point's run in ``folder``/points/."""
+    """A finished sweep: one row per point (``rows``: the swept values by dotted path, ``a``,
+    ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``, ``contact_last``,
+    ``status``, ``error`` (why a failed point failed), ``folder``), each point's run in ``folder``/points/."""
 
     name: str
     status: str  # completed | interrupted | failed
@@ -491,7 +491,7 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 def _load_sweep(folder: Path) -> SweepResult:
     summary, record = read_sweep_record(folder)
-    rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
+    rows = [{k: v for k, v in point.items() if k != "set"} for point in summary["points"]]
     return SweepResult(
         name=record.name, status=record.status, parameters=list(record.sweep.parameters), rows=rows,
         folder=folder, elapsed=record.elapsed_seconds,

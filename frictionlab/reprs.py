@@ -51,7 +51,7 @@ def sweep_html(sweep) -> str:
     head = "".join(f"<th>{html.escape(name)}</th>" for name in ("point", *sweep.parameters, "status", "a", "b", "R²"))
     rows = "".join(
         "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
-            row.get("point"), *(row.get(name) for name in sweep.parameters), row.get("status"),
+            row.get("point"), *(row.get(name) for name in sweep.parameters), _status(row),
             _estimate(row, "a"), _estimate(row, "b"), _number(row.get("r2")),
         )) + "</tr>"
         for row in sweep.rows
@@ -62,6 +62,11 @@ def sweep_html(sweep) -> str:
         f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>"
         f"<p>results in <code>{html.escape(str(sweep.folder))}</code> (points/: a run folder each)</p></div>"
     )
+
+
+def _status(row: dict) -> str:
+    """A point's status, and why where it failed (as ``frictionlab run`` lists it)."""
+    return f"{row.get('status')}: {row['error']}" if row.get("error") else str(row.get("status"))
 
 
 def _estimate(row: dict, name: str) -> str:
