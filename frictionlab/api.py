@@ -49,9 +49,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
-from .errors import FrictionlabError, PresetError, RunFolderError, require, short_repr, shown
+from .errors import FrictionlabError, PresetError, RunFolderError, raised_here, require, short_repr, shown, warn_user
 from .compute.fit import LogFit
-from .compute.signals import RunInterrupted
+from .compute.signals import RunInterrupted, interrupted_since, mark
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
 from .runs.runfolder import check_searchable, subfolder
@@ -85,7 +85,8 @@ class Result:
     must know (fewer than 3 points in contact at the first load). ``folder``: the
     run folder, None for a run kept in memory. ``input``: for a measured profile or
     surface, what was read from its file (shape, pixel size, unit, rms height and
-    where each came from), else None. ``realizations``: (done, requested);
+    where each came from), else None. ``error``: why a failed run has no fit (xi the same at
+    every load, ...), else None. ``realizations``: (done, requested);
     ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
     in the preset's units (lengths as its spacing, F in modulus x length², per unit
     depth on a half-plane): ``units`` says each column's, as curve.csv's header does
@@ -105,6 +106,7 @@ class Result:
     files: dict[str, Path] = field(default_factory=dict, repr=False, compare=False)
     input: dict | None = None
     units: dict[str, str] = field(default_factory=dict, repr=False, compare=False)  # by column, curve.csv's brackets
+    error: str | None = None  # why the run failed
 
     @property
     def a(self) -> float:
@@ -160,9 +162,9 @@ class Result:
 
 @dataclass(frozen=True, eq=False)
 class SweepResult:
-    """A finished sweep: one row per point (``rows``: the swept values by dotted path,
-    ``a``, ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``,
-    ``contact_last``, ``status``, ``folder``), each point's run in ``folder``/points/."""
+    """A finished sweep: one row per point (``rows``: the swept values by dotted path, ``a``,
+    ``a_lo``, ``a_hi``, ``b``, ``b_lo``, ``b_hi``, ``r2``, ``contact_first``, ``contact_last``,
+    ``status``, ``error`` (why a failed point failed), ``folder``), each point's run in ``folder``/points/."""
 
     name: str
     status: str  # completed | interrupted | failed
@@ -280,6 +282,7 @@ def scene_record(scene: Scene) -> dict:
     }  # fmt: skip
 
 
+@raised_here
 def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
              **keys: Any) -> dict:  # fmt: skip
     """Check a preset (any form ``run`` takes, overrides as there) without running it, and
@@ -297,6 +300,7 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
     return scene_record(build_scene(data, source=source, before_reading=check_one_realization))
 
 
+@raised_here
 def run(
     preset: str | Path | Mapping[str, Any] | Preset,
     overrides: Mapping[str, Any] | None = None,
@@ -340,12 +344,12 @@ def run(
     ``KeyboardInterrupt`` whose ``result`` is the run as it ended: a cell or a loop of
     runs stops there too.
     """
-    from .compute.signals import interrupted_since, mark
-
     seen = mark()
     result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
     if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
         raise RunInterrupted(result)
+    if result.status == "failed" and isinstance(result, Result):  # said where the run was asked for, as the CLI's error
+        warn_user(f"{result.name}: run failed: {result.error or 'no fit'}")
     return result
 
 
@@ -437,10 +441,11 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
         preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
         outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
-        units=column_units(curve_headers(scene)),
+        units=column_units(curve_headers(scene)), error=outcome.error,
     )  # fmt: skip
 
 
+@raised_here
 def load(folder: str | Path) -> Result | SweepResult:
     """A finished run read back from its folder (written by ``frictionlab run`` or
     ``frictionlab.run(..., out=...)``): summary.json and curve.csv, the same numbers
@@ -475,25 +480,18 @@ def load(folder: str | Path) -> Result | SweepResult:
             "realizations done"
         )
     return Result(
-        name=record.preset.name,
-        status=record.status,
-        fit=LogFit.from_dict(summary["fit"]) if record.fit is not None else None,
+        name=record.preset.name, status=record.status, fit=None if record.fit is None else LogFit.from_dict(summary["fit"]),
         table={name.rstrip("'"): values for name, values in curve.items()},  # F' on the half-plane
-        realizations=(record.realizations.done, record.realizations.requested),
-        normalisation=record.normalisation.f,
-        preset=summary["preset"],
-        elapsed=record.elapsed_seconds,
-        caveats=list(record.caveats),
-        folder=folder,
-        files={key: folder / name for key, name in record.files.items()},
-        input=record.input,
-        units=column_units(header),
-    )
+        realizations=(record.realizations.done, record.realizations.requested), normalisation=record.normalisation.f,
+        preset=summary["preset"], elapsed=record.elapsed_seconds, caveats=list(record.caveats), folder=folder,
+        files={key: folder / name for key, name in record.files.items()}, input=record.input,
+        units=column_units(header), error=record.error,
+    )  # fmt: skip
 
 
 def _load_sweep(folder: Path) -> SweepResult:
     summary, record = read_sweep_record(folder)
-    rows = [{k: v for k, v in point.items() if k not in ("set", "error")} for point in summary["points"]]
+    rows = [{k: v for k, v in point.items() if k != "set"} for point in summary["points"]]
     return SweepResult(
         name=record.name, status=record.status, parameters=list(record.sweep.parameters), rows=rows,
         folder=folder, elapsed=record.elapsed_seconds,

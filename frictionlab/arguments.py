@@ -35,7 +35,7 @@ def path_argument(value, name: str, what: str) -> Path:
 
 def flag_argument(value, name: str) -> bool:
     if not isinstance(value, bool):
-        raise FrictionlabError(f"{name} must be True or False, got {type(value).__name__}")
+        raise FrictionlabError(f"{name} must be True or False, got {short_repr(value)} ({type(value).__name__})")
     return value
 
 

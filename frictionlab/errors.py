@@ -285,16 +285,33 @@ def did_you_mean(word: str, names, cutoff: float = 0.5) -> str:
     return f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
 
 
-def warn_user(message: str) -> None:
-    """A UserWarning attributed to the first caller outside frictionlab (a script's or a
-    notebook cell's line): a notebook shows that line, not one of ours, and a warning
-    shown once per place is shown again for each place of the user's that causes it."""
+def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
+    """A warning (a UserWarning by default) attributed to the first caller outside frictionlab
+    (a script's or a notebook cell's line): a notebook shows that line, not one of ours, and a
+    warning shown once per place is shown again for each place of the user's that causes it."""
     import warnings
 
     package, frame, level = os.path.dirname(__file__) + os.sep, sys._getframe(1), 1
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1
-    warnings.warn(message, stacklevel=level + 1 if frame is not None else 2)
+    warnings.warn(message, category, stacklevel=level + 1 if frame is not None else 2)
+
+
+def raised_here(entry):
+    """For the Python API's entry points (``frictionlab.run``, ``load``, ``validate``): a
+    FrictionlabError (bad input, a refusal) comes out of the entry point with its traceback
+    cut there: a notebook shows the caller's line, the call and the message, not a screen of
+    frictionlab's own frames that say nothing about what to change."""
+    import functools
+
+    @functools.wraps(entry)
+    def called(*args, **keys):
+        try:
+            return entry(*args, **keys)
+        except FrictionlabError as exc:
+            raise exc.with_traceback(None)  # its message says what is wrong: frictionlab's frames are left out
+
+    return called
 
 
 def _quiet_stdout() -> None:

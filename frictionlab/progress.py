@@ -41,6 +41,9 @@ def _has_widgets() -> bool:
     return importlib.util.find_spec("ipywidgets") is not None
 
 
+NOTEBOOK_REDRAWS_PER_SECOND = 1
+
+
 class _Bar:
     """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
 
@@ -50,9 +53,12 @@ class _Bar:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
         console = Console(file=stream, highlight=False)
+        # in a notebook each redraw is a new output (cleared, displayed again), sent whether or not
+        # anything changed: once a second, as often as the elapsed time it shows moves
+        rate = NOTEBOOK_REDRAWS_PER_SECOND if console.is_jupyter else 10
         self.progress = Progress(
             TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
-            TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=10,
+            TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=rate,
             get_time=clock,
         )  # fmt: skip
         self.task = self.progress.add_task(description, total=total, completed=completed, note="")
@@ -85,6 +91,18 @@ SHOW_AFTER = 2.0  # seconds: a run shorter than this shows no progress beyond it
 LOAD_LINE_SECONDS = 1.5  # in a log: a long solve's load or iteration at most this often (movement every 2 s)
 
 
+def _flush_stdout(stream) -> None:
+    """What the caller printed before (a notebook cell's ``print`` above a run) goes out
+    before progress on stderr: stdout is buffered (a kernel sends it every 0.2 s, a pipe
+    when full), stderr is flushed at once, so a line printed first showed after."""
+    out = sys.stdout
+    if out is not None and out is not stream:
+        try:
+            out.flush()
+        except (OSError, ValueError):  # closed, or its reader gone: it says so where it is written
+            pass
+
+
 class BestEffort:
     """A stream whose failed writes are dropped from then on: progress is never worth a
     run (stderr closed under it, or full: ``2>/dev/full``)."""
@@ -94,6 +112,7 @@ class BestEffort:
 
     def write(self, text: str) -> int:
         if not self.broken:
+            _flush_stdout(self.stream)
             try:
                 return self.stream.write(text)
             except (OSError, ValueError):  # ValueError: written after it was closed

@@ -21,8 +21,8 @@ def result_html(result) -> str:
         f"{done}/{requested} realizations in {result.elapsed:.2f} s</p>"
     ]
     fit = result.fit
-    if fit is None:
-        parts.append("<p>no fit: no realization finished</p>")
+    if fit is None:  # why: a failed run says; an interrupted one may have finished none
+        parts.append(f"<p>no fit: {html.escape(result.error or 'no realization finished')}</p>")
     else:
         level = f"{100 * fit.confidence:g}% CI" + (f" (bootstrap {fit.bootstrap})" if fit.bootstrap else "")
         rows = "".join(
@@ -40,7 +40,7 @@ def result_html(result) -> str:
         )
     if len(result.table.get("f", ())):
         parts.append(f'<img alt="xi against f" src="data:image/png;base64,{_curve_png(result)}">')
-    parts += [f"<p>caveat: {html.escape(caveat)}</p>" for caveat in result.caveats]
+    parts += [f"<p>caveat: {html.escape(caveat)}</p>" for caveat in result.caveats if caveat != result.error]
     if result.folder is not None:
         parts.append(f"<p>results in <code>{html.escape(str(result.folder))}</code></p>")
     return "<div>" + "".join(parts) + "</div>"
@@ -51,7 +51,7 @@ def sweep_html(sweep) -> str:
     head = "".join(f"<th>{html.escape(name)}</th>" for name in ("point", *sweep.parameters, "status", "a", "b", "R²"))
     rows = "".join(
         "<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in (
-            row.get("point"), *(row.get(name) for name in sweep.parameters), row.get("status"),
+            row.get("point"), *(row.get(name) for name in sweep.parameters), _status(row),
             _estimate(row, "a"), _estimate(row, "b"), _number(row.get("r2")),
         )) + "</tr>"
         for row in sweep.rows
@@ -62,6 +62,11 @@ def sweep_html(sweep) -> str:
         f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>"
         f"<p>results in <code>{html.escape(str(sweep.folder))}</code> (points/: a run folder each)</p></div>"
     )
+
+
+def _status(row: dict) -> str:
+    """A point's status, and why where it failed (as ``frictionlab run`` lists it)."""
+    return f"{row.get('status')}: {row['error']}" if row.get("error") else str(row.get("status"))
 
 
 def _estimate(row: dict, name: str) -> str:

@@ -101,3 +101,17 @@ def test_a_sweeps_html_is_a_row_per_point_with_its_values_and_fit(tmp_path):
                          f"{row['b']:.4f} [{row['b_lo']:.4f}, {row['b_hi']:.4f}]", f"{row['r2']:.4f}"]  # fmt: skip
     pending = dataclasses.replace(sweep, rows=[{**sweep.rows[0], "status": "pending", "a": None, "r2": None}])
     assert parsed(pending._repr_html_()).cells[6:] == ["1", "0.5", "pending", "n/a", cells[10], "n/a"]
+
+
+def test_a_failed_point_of_a_sweep_says_why_in_its_row(tmp_path):
+    """A point whose loads all press the same points fits no law: the notebook's table said
+    "failed" and n/a, and the rows had lost the reason sweep.json keeps (the CLI lists it)."""
+    preset = {**SMALL_PRESET, "loading": {**SMALL_PRESET["loading"], "start": 1e-30},
+              "sweep": {"parameters": {"loading.stop": {"values": [1e-25, 20.0]}}}}  # fmt: skip
+    sweep = frictionlab.run(preset, out=tmp_path / "sweep", plot=False, **FAST)
+    failed, completed = sweep.rows
+    assert failed["status"] == "failed" and failed["error"].startswith("no law: every load")
+    assert completed["status"] == "completed" and completed["error"] is None
+    cells = parsed(sweep._repr_html_()).cells
+    assert cells[8] == f"failed: {failed['error']}" and cells[14] == "completed"
+    assert frictionlab.load(tmp_path / "sweep").rows == sweep.rows

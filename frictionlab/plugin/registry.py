@@ -18,7 +18,6 @@ import importlib.metadata as md
 import os
 import re
 import sys
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import get_args
@@ -27,7 +26,7 @@ import numpy as np
 import pluggy
 from pydantic import BaseModel
 
-from ..errors import PluginError, did_you_mean, short_repr
+from ..errors import PluginError, did_you_mean, short_repr, warn_user
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener, fault_site
 from .base import NAME_PATTERN, Plugin
@@ -55,8 +54,8 @@ def _env_flag(env, key: str) -> bool:
     """A yes/no variable; another value (a typo: ``ture``, ``2``) is said, and read as no."""
     value = env.get(key, "").strip().lower()
     if value not in _ON + _OFF:
-        warnings.warn(f"{key}={env[key]!r} is not one of {', '.join(_ON)} (on) or {', '.join(_OFF[1:])} (off); "
-                      "read as off", RuntimeWarning, stacklevel=3)  # fmt: skip
+        warn_user(f"{key}={env[key]!r} is not one of {', '.join(_ON)} (on) or {', '.join(_OFF[1:])} (off); "
+                  "read as off", RuntimeWarning)  # fmt: skip
     return value in _ON
 
 
@@ -234,9 +233,9 @@ def _warn_of_unknown_names(only: list[str], installed: list[str]) -> None:
     meant would otherwise be left out without a word. (A blocked name that is not installed
     is blocked all the same.)"""
     for name in (name for name in only if name not in installed):
-        warnings.warn(
+        warn_user(
             f"FRICTIONLAB_PLUGINS names {name!r}, which is no installed plugin's entry point (installed: "
-            f"{', '.join(installed) or 'none'}; the built-ins load without being named)", RuntimeWarning, stacklevel=3,
+            f"{', '.join(installed) or 'none'}; the built-ins load without being named)", RuntimeWarning,
         )  # fmt: skip
 
 
@@ -267,7 +266,7 @@ class Registry:
         self.pm.check_pending()
         self._collect()
         for message in self.clashes:
-            warnings.warn(f"frictionlab plugins: {message}", RuntimeWarning, stacklevel=2)
+            warn_user(f"frictionlab plugins: {message}", RuntimeWarning)
 
     # ------------------------------------------------------------- loading
 
@@ -299,11 +298,7 @@ class Registry:
                 elif isinstance(exc, pluggy.PluginValidationError):
                     message = self._hook_arguments_message(exc)
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
-                warnings.warn(
-                    f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped",
-                    RuntimeWarning,
-                    stacklevel=2,
-                )
+                warn_user(f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped", RuntimeWarning)
 
     def _try_registration(self, plugin, claims: list[tuple[str, str]]) -> None:
         """Run ``plugin``'s registration hooks alone, checking every class it registers: a

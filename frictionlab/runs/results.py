@@ -269,6 +269,7 @@ class SummaryRecord(Record):
     schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
     preset: _PresetName
     status: Literal["completed", "cancelled", "interrupted", "failed"]
+    error: str | None = None  # why a failed run failed
     seed: Count | None = None
     fit: FitRecord | None = None
     realizations: _Counts

@@ -31,6 +31,7 @@ class PointRecord(Record):
     b_lo: Finite | None = None
     b_hi: Finite | None = None
     r2: Finite | None = None
+    error: str | None = None  # why a failed point failed
 
 
 class _SweepSpecRecord(Record):

@@ -133,9 +133,8 @@ def test_the_first_line_of_a_run_of_one_realization_says_realization(make_scene)
     assert stream.getvalue().startswith("small: 1 realization of power-law lines, 16 force steps")
 
 
-def test_a_notebook_bar_leaves_no_empty_output_under_it(monkeypatch, make_scene):
-    """rich, stopping its bar in a notebook, showed its console's empty buffer: an empty output
-    (a blank line) under every bar, one a point in a sweep."""
+def notebook_display(monkeypatch):
+    """As in a Jupyter kernel with ipywidgets: what rich displays is collected in the list returned."""
     import builtins
     import sys
     import types
@@ -158,9 +157,56 @@ def test_a_notebook_bar_leaves_no_empty_output_under_it(monkeypatch, make_scene)
             pass
 
     sys.modules["ipywidgets"].Output = Output
+    return shown
+
+
+def test_a_notebook_bar_leaves_no_empty_output_under_it(monkeypatch, make_scene):
+    """rich, stopping its bar in a notebook, showed its console's empty buffer: an empty output
+    (a blank line) under every bar, one a point in a sweep."""
+    shown = notebook_display(monkeypatch)
     reporter = ProgressReporter(io.StringIO(), after=0)
     assert reporter.interactive
     engine.run(make_scene({"realizations": 10}), RunOptions(workers=1), listeners=[reporter])
-    texts = [getattr(item, "text", None) for item in shown if not isinstance(item, Output)]
+    texts = [getattr(item, "text", None) for item in shown if type(item).__name__ != "Output"]
     assert texts and "10/10" in texts[-1]  # the bar drawn full at its end
     assert all(text.strip() for text in texts), texts
+
+
+def test_a_notebook_bar_is_redrawn_once_a_second_not_ten_times(monkeypatch):
+    """In a notebook each redraw of rich's bar is an output cleared and sent again, changed or
+    not: ten a second flooded the kernel's channel (817 outputs over a solve of two minutes,
+    all alike but the second)."""
+    from frictionlab.progress import _Bar
+
+    terminal = _Bar(FakeTerminal(), "realizations", 10)
+    terminal.stop()
+    assert terminal.progress.live.refresh_per_second == 10
+    notebook_display(monkeypatch)
+    bar = _Bar(io.StringIO(), "realizations", 10)
+    bar.stop()
+    assert bar.progress.console.is_jupyter and bar.progress.live.refresh_per_second == 1
+
+
+def test_what_was_printed_before_a_run_goes_out_before_its_progress(monkeypatch, make_scene):
+    """In a notebook, ``print("start"); frictionlab.run(...)`` showed the run's first progress
+    line above "start": stdout waits in a buffer, stderr is flushed at once."""
+    import sys
+
+    sent = []
+
+    class Buffered(io.StringIO):  # stdout as a kernel's or a pipe's: sent when flushed
+        def flush(self):
+            if self.getvalue():
+                sent.append(("stdout", self.getvalue()))
+                self.seek(0)
+                self.truncate()
+
+    class Progress(io.StringIO):
+        def write(self, text):
+            sent.append(("stderr", text))
+            return len(text)
+
+    monkeypatch.setattr(sys, "stdout", Buffered())
+    print("start")
+    engine.run(make_scene({"realizations": 2}), RunOptions(workers=1), listeners=[ProgressReporter(Progress(), after=0)])
+    assert sent[0] == ("stdout", "start\n") and sent[1][0] == "stderr", sent
