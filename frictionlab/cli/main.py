@@ -30,7 +30,7 @@ import sys
 import warnings
 
 from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
-                      output_failed, short_repr, shown, too_long_path)  # fmt: skip
+                      output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
@@ -352,7 +352,7 @@ def _run_command(args) -> int:
             return output_failed(exc)
         if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
             return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
-        return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
+        return _refused(args, f"{exc.strerror or exc}: {shown_name(exc.filename)}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
         message = f"out of memory{detail}; ask for fewer points, realizations or workers{limit_advice()}"

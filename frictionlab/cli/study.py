@@ -8,7 +8,7 @@ import math
 import shlex
 import sys
 
-from ..errors import ExitCode, FrictionlabError, short_repr, shown
+from ..errors import ExitCode, FrictionlabError, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 
 
@@ -203,7 +203,7 @@ def run(args) -> ExitCode:
     try:
         files = write_outputs(study, out_dir, text, command_line(args))
     except OSError as exc:
-        print(f"error: cannot write the study to {shown(out_dir)}: {exc}", file=sys.stderr)
+        print(f"error: cannot write the study to {shown_name(out_dir)}: {exc}", file=sys.stderr)
         return ExitCode.RUNTIME_FAILURE
     if args.json:
         from ..compute.fit import json_safe
@@ -219,7 +219,7 @@ def run(args) -> ExitCode:
                        "interrupted": interrupted})  # fmt: skip
     else:
         print(text)
-        print(f"  {', '.join(p.name for p in files.values())} in {shown(out_dir)}/")
+        print(f"  {', '.join(p.name for p in files.values())} in {shown_name(out_dir)}/")
     if interrupted:
         from ..compute.signals import interrupted_exit_code, interrupted_word
 

@@ -16,7 +16,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
-from ...errors import FrictionlabError, shown
+from ...errors import FrictionlabError, shown, shown_name
 from ...compute.fit import format_interval
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
@@ -241,7 +241,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 return
             if isinstance(entry, SweepEntry):
                 if overlay:
-                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.",
+                    self.app.say(f"{shown_name(entry.path.name)} is a sweep: Enter lists its points, Space on a point overlays it.",
                                  "warning", about=entry.path)
                 else:
                     self._show_sweep(entry)
