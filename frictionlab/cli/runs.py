@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, RunFolderError, shown, shown_name
+from ..errors import ExitCode, RunFolderError, command_word, shown, shown_name
 
 EXAMPLES = """examples:
   frictionlab runs                            the runs under runs/
@@ -71,7 +71,7 @@ def _what_it_is(folder: Path) -> str:
     if not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
         return ""
     if is_sweep_folder(folder):
-        return (f": it is a sweep's folder (frictionlab follow {shown(folder)} shows it); "
-                f"its points' run folders: frictionlab runs {shown(folder / 'points')}")
-    return (f": it is a run folder itself (frictionlab follow {shown(folder)} shows it); "
-            f"the runs beside it: frictionlab runs {shown(folder.parent)}")
+        return (f": it is a sweep's folder (frictionlab follow {command_word(folder)} shows it); "
+                f"its points' run folders: frictionlab runs {command_word(folder / 'points')}")
+    return (f": it is a run folder itself (frictionlab follow {command_word(folder)} shows it); "
+            f"the runs beside it: frictionlab runs {command_word(folder.parent)}")

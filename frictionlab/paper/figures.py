@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import FrictionlabError, short_repr, shown_name
+from ..errors import FrictionlabError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
 from ..runs.runfolder import output_subfolder
@@ -132,8 +132,8 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
             run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
-            how = (f"frictionlab run {shown_name(path)} --out {shown_name(run.folder)} --resume" if run.sweep is not None
-                   else f"frictionlab resume {shown_name(run.folder)}")  # fmt: skip
+            how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None
+                   else f"frictionlab resume {command_word(run.folder)}")  # fmt: skip
             raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (continue it with `{how}`)")
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
             raise WorkInterrupted(f"{fig.key} completed in {shown_name(run.folder)}")

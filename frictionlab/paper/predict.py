@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..arguments import path_argument
-from ..errors import FrictionlabError, RunFolderError, short_repr, shown_name
+from ..errors import FrictionlabError, RunFolderError, command_word, short_repr, shown_name
 from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
@@ -256,7 +256,7 @@ def read_run_law(
                                      f"no law: {said}; give a law by hand with --a/--b")  # fmt: skip
         raise RunFolderError(
             f"{shown_name(path)}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
-            f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {shown_name(run_dir)}`, "
+            f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {command_word(run_dir)}`, "
             "or give its law by hand with --a/--b"
         )
     law = _fit_of(summary, path)
@@ -324,7 +324,7 @@ def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
     if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
         raise RunFolderError(  # a law per point: the user names one
             f"{name} {shown_name(run_dir)} is a sweep's folder, which holds a law per point: give one point's run folder, "
-            f"{shown_name(run_dir / 'points')}/<NN-label> (frictionlab runs {shown_name(run_dir / 'points')} lists them)"
+            f"{shown_name(run_dir / 'points')}/<NN-label> (frictionlab runs {command_word(run_dir / 'points')} lists them)"
         )
     return read_summary(run_dir)[0]
 

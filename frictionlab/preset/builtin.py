@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from ..errors import PresetFileError, did_you_mean, short_repr, shown_name
+from ..errors import PresetFileError, command_word, did_you_mean, short_repr, shown_name
 
 _LONGEST = 100  # characters of a one-line description
 _PACKAGE = Path(__file__).resolve().parent.parent
@@ -81,11 +81,11 @@ def resolve_preset_path(argument: str | Path) -> Path:
     if path.is_dir() and (path / "preset.yaml").is_file():  # a run folder given for its preset
         raise PresetFileError(
             [f"(file): a folder, not a preset; it holds a run, whose preset is {shown_name(path / 'preset.yaml')} (frictionlab "
-             f"resume {shown_name(path)} continues the run; frictionlab run {shown_name(path / 'preset.yaml')} --out NEW runs it again)"],
+             f"resume {command_word(path)} continues the run; frictionlab run {command_word(path / 'preset.yaml')} --out NEW runs it again)"],
             source=str(argument),
         )  # fmt: skip
     if path.is_dir() and (path / "sweep.json").is_file():
-        raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {shown_name(path)} continues "
+        raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {command_word(path)} continues "
                                f"it), each point's preset in {shown_name(path / 'points')}/<NN-label>/preset.yaml"],
                               source=str(argument))  # fmt: skip
     if path.exists() or not named:

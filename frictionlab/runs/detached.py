@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .results import read_summary
@@ -118,7 +118,7 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
             raise FrictionlabError(f"the run into {shown_name(out_dir)} ended at once (exit code {process.returncode}) without a word")
         time.sleep(0.05)
     raise FrictionlabError(f"the run into {shown_name(out_dir)} has not started after {timeout:g} s (pid {process.pid}); "
-                           f"`frictionlab follow {shown_name(out_dir)}` shows it if it does")  # fmt: skip
+                           f"`frictionlab follow {command_word(out_dir)}` shows it if it does")  # fmt: skip
 
 
 def _raise_run_error(event: dict) -> None:

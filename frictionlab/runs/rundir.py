@@ -35,7 +35,7 @@ from pathlib import Path
 import yaml
 
 from .. import __version__
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown, shown_name, warn_user
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
 from ..io.files import atomic_write, output_path_problem, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
 from ..preset import Scene, differences, load_preset_file
@@ -324,7 +324,7 @@ class RunDirectory:
         if status != "completed" and self._listed(state):
             raise OutputRefused(
                 f"{shown_name(self.path)} holds an unfinished run ({len(self._listed(state))} chunk file(s) in {CHUNK_DIR}/, "
-                f"status {status}): continue it with --resume (resume=True in Python, or `frictionlab resume {shown_name(self.path)}`), "
+                f"status {status}): continue it with --resume (resume=True in Python, or `frictionlab resume {command_word(self.path)}`), "
                 "or give another output folder, or force it (--force; force=True) to start it again"
             )
 
