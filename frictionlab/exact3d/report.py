@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, RunError, shown_name
+from ..errors import FrictionlabError, OutputRefused, RunError, command_word, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..plugin.listeners import format_duration
 from ..options import RunOptions
@@ -166,8 +166,8 @@ def write_page(
 def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | None, finished_only: bool) -> str:
     """The command that regenerates the page: with the runs folder it was given, so
     that rerunning it reads those runs back instead of computing them again."""
-    return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {out_dir}" if out_dir else "")
-            + (f" --runs {runs_dir}" if runs_dir else "") + (" --finished-only" if finished_only else "")
+    return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {command_word(out_dir)}" if out_dir else "")
+            + (f" --runs {command_word(runs_dir)}" if runs_dir else "") + (" --finished-only" if finished_only else "")
             + " --force")  # fmt: skip
 
 

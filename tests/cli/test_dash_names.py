@@ -50,3 +50,19 @@ def test_suggested_commands_name_a_folder_as_a_word_to_paste(dashed, tmp_path, c
     capsys.readouterr()
     assert main(["run", "--", "-r"]) == ExitCode.INPUT_FILE  # a run folder given as a preset
     assert "frictionlab resume ./-r continues the run" in capsys.readouterr().err
+
+
+def test_the_commands_written_into_a_study_or_exact3d_page_take_their_folders_back():
+    """study.md and the exact3d page write the command that made them: `--out -r2` and a
+    preset -x.yaml were written as typed, a command argparse refuses; a line break split it."""
+    import shlex
+
+    from frictionlab.cli.main import build_parser
+    from frictionlab.cli.study import command_line
+    from frictionlab.exact3d.report import _command
+
+    args = build_parser().parse_args(["study", "--out=-r2", "--", "-x.yaml"])
+    assert shlex.split(command_line(args))[2:] == ["./-x.yaml", "--out", "./-r2"]
+    args = build_parser().parse_args(["study", "q.yaml", "--out", "a\nb c"])
+    assert command_line(args).endswith("--out 'a\\nb c'")
+    assert shlex.split(_command(True, "-p", "my runs", False))[3:7] == ["--out", "./-p", "--runs", "my runs"]
