@@ -225,7 +225,16 @@ def limit_advice() -> str:
 
 def resume_hint(folder) -> str:
     """How to go on with a run that stopped before its end: what finished is in ``folder``."""
-    return f"what finished is kept in {shown_name(folder)}/: `frictionlab resume {shown_name(folder)}` computes the rest"
+    return f"what finished is kept in {shown_name(folder)}/: `frictionlab resume {command_word(folder)}` computes the rest"
+
+
+def command_word(path) -> str:
+    """``path`` as a word of a command to copy (``shown_name``): after ./ where it starts with '-'
+    (`frictionlab resume -r2` takes it for an option), quoted where a shell splits it (a space)."""
+    import shlex
+
+    said = shown_name(path)
+    return shlex.quote(f"./{said}" if said.startswith("-") else said)
 
 
 def counted(count: int, noun: str) -> str:

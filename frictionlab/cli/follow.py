@@ -9,7 +9,7 @@ import sys
 import threading
 from pathlib import Path
 
-from ..errors import ExitCode, shown, shown_name
+from ..errors import ExitCode, command_word, shown, shown_name
 from ..compute.signals import ENDINGS, install
 
 POLL_SECONDS = 0.2
@@ -120,11 +120,11 @@ def run(args) -> ExitCode:
             print(shown(f"{state.name}: damaged, in {shown_name(folder)}/: {state.reason}"))
             return ExitCode.RUNTIME_FAILURE
         done = state.done
-        hint = f"; frictionlab resume {shown_name(folder)} continues it" if state.resumable else ""
+        hint = f"; frictionlab resume {command_word(folder)} continues it" if state.resumable else ""
         if error and state.done is not None and state.done == state.total:  # every realization done: no resume mends it
             hint = ""
         if any(row.get("status") == "error" for row in rows):  # a resume fails there again until it is fixed
-            hint = f"; do what the points in error say, then frictionlab resume {shown_name(folder)} continues it"
+            hint = f"; do what the points in error say, then frictionlab resume {command_word(folder)} continues it"
         what = "points" if sweep is not None else "realizations"
         print(shown(f"{state.name}: {state.status}, {done}/{state.total} {what}, in {shown_name(folder)}/{hint}"))
         if sweep is not None:

@@ -30,7 +30,7 @@ import sys
 import warnings
 
 from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
-                      output_failed, short_repr, shown, too_long_path)  # fmt: skip
+                      output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
@@ -103,6 +103,7 @@ class _Parser(argparse.ArgumentParser):
             strays = [w for w in self.words if _stray_option(w, options)]
             if strays:
                 message = f"{unrecognized(strays, options)} ({message})"
+        message += _dash_value_hint(message, self.words)
         message = re.sub(r"invalid (int|float) value: '(.*)'$", _invalid_value, message)
         message = shown(message)  # the words it quotes as typed: an escape sequence must not drive the terminal
         _Parser.refusal = (self.prog, message)  # for the JSON error object of a usage error under --json
@@ -121,6 +122,18 @@ class _Parser(argparse.ArgumentParser):
         return namespace, extras
 
 
+def _dash_value_hint(message: str, words: list[str]) -> str:
+    """How to give an option a value that starts with '-' (`--out -r2`: argparse takes -r2
+    for an option and says only 'expected one argument')."""
+    option = re.match(r"argument (?:\S+/)?(--\S+): expected one argument$", message)
+    if option is None or option.group(1) not in words[:-1]:
+        return ""
+    value = words[words.index(option.group(1)) + 1]
+    if not value.startswith("-") or value == "--":
+        return ""
+    return f"; a value that starts with '-' is given as {option.group(1)}={value}"
+
+
 def _invalid_value(match: re.Match) -> str:
     """argparse's 'invalid int value' with the value cut short (a 5000-digit --seed was said in
     full, and, past the 4300 digits Python reads as a number, as if it were not a whole number)."""
@@ -136,6 +149,13 @@ def unrecognized(words: list[str], options: list[str]) -> str:
     """argparse's message for words it did not take, with the options closest to each."""
     from ..errors import close_names
 
+    named = [word for word in words if word.startswith("-") and os.path.lexists(word)]
+    if named:  # a file or folder whose name starts with '-' (`run -x.yaml`) is not an option
+        return (f"unrecognized arguments: {' '.join(words)}; {named[0]} is a file here: a name that starts with "
+                f"'-' is given as ./{named[0]}")  # fmt: skip
+    if any(word.partition("=")[0] in options for word in words):  # `run -- -x.yaml --out DIR`: --out is a name
+        return (f"unrecognized arguments: {' '.join(words)}; every word after -- is a name, never an option: "
+                "give the options before --")  # fmt: skip
     close = [name for word in words if word.startswith("-") for name in close_names(word.partition("=")[0], options, 0.7)]
     hint = f"; did you mean {' or '.join(repr(name) for name in dict.fromkeys(close))}?" if close else ""
     return f"unrecognized arguments: {' '.join(words)}{hint}"
@@ -352,7 +372,7 @@ def _run_command(args) -> int:
             return output_failed(exc)
         if exc.errno == errno.ENAMETOOLONG:  # a path argument no file can have: the command line is wrong
             return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
-        return _refused(args, f"{exc.strerror or exc}: {exc.filename}", ExitCode.RUNTIME_FAILURE)
+        return _refused(args, f"{exc.strerror or exc}: {shown_name(exc.filename)}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
         detail = f": {exc}" if str(exc) else ""
         message = f"out of memory{detail}; ask for fewer points, realizations or workers{limit_advice()}"

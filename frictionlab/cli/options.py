@@ -121,7 +121,8 @@ def refuse_empty_paths(parser, args) -> None:
         name = max(action.option_strings, key=len) if action.option_strings else action.metavar
         optional = action.option_strings or action.nargs == "?"
         leave = (f"leave {name} out" if action.option_strings else "leave it out") if optional else ""
-        raise FrictionlabError(f"{name} names no {what} (it is empty): give a {what}" + (f", or {leave}" if leave else ""))
+        empty = "it is empty" if not value else "it is only spaces"  # a folder named ' ' is refused as a mistyped one
+        raise FrictionlabError(f"{name} names no {what} ({empty}): give a {what}" + (f", or {leave}" if leave else ""))
 
 
 def _command_actions(parser, args):

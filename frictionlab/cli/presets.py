@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean, shown
+from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean, shown, shown_name
 
 EXAMPLES = """examples:
   frictionlab presets                         list the built-in presets
@@ -87,6 +87,6 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
             with open(target, "xb") as out:  # "x": never over a file (or a link) that appeared meanwhile
                 out.write(data)
     except FileExistsError:
-        raise OutputRefused(f"{target} exists; give another DEST or --force to replace it") from None
+        raise OutputRefused(f"{shown_name(target)} exists; give another DEST or --force to replace it") from None
     print(shown(f"copied {preset.name} to {target}"))  # DEST as typed, an escape code in it escaped
     return ExitCode.OK

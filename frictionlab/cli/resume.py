@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode, PresetError, RunFolderError
+from ..errors import ExitCode, PresetError, RunFolderError, shown_name
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -48,7 +48,7 @@ def run(args) -> ExitCode:
             return stored_run(run_dir, lambda: run_command.run_sweep_into(args, data, run_dir, options))
         except OtherSweep:  # the folder checked against the sweep its own sweep.json gives: they differ
             raise RunFolderError(
-                f"{args.preset} is damaged: its name, sweep and base preset are not those of one sweep "
+                f"{shown_name(args.preset)} is damaged: its name, sweep and base preset are not those of one sweep "
                 "(a field edited): it cannot be resumed"
             ) from None
     RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
@@ -63,6 +63,6 @@ def stored_run(run_dir: Path, start, doing: str = "resumed"):
     try:
         return start()
     except PresetError as exc:
-        refused = RunFolderError(f"{exc}\n{run_dir} cannot be {doing}: the preset stored there is not valid here")
+        refused = RunFolderError(f"{exc}\n{shown_name(run_dir)} cannot be {doing}: the preset stored there is not valid here")
         refused.problems = exc.problems
         raise refused from None

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, counted, ran_out_of_memory,
+from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, command_word, counted, ran_out_of_memory,
                       resume_hint, shown, shown_name, too_long_path)  # fmt: skip
 from .options import add_executor_options, add_workers_option, executor_run_options
 
@@ -114,7 +114,7 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
         print(out_dir)
     else:
         print(shown(f"{scene.preset.name}: {what} detached in {out_dir}/ (pid {process.pid})\n"
-                    f"  frictionlab follow {out_dir}    shows its progress\n"
+                    f"  frictionlab follow {command_word(out_dir)}    shows its progress\n"
                     f"  kill -TERM {process.pid}    cancels it (what finished is kept; frictionlab resume continues it)"))  # fmt: skip
     return ExitCode.OK
 

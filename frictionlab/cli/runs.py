@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, RunFolderError, shown
+from ..errors import ExitCode, RunFolderError, command_word, shown, shown_name
 
 EXAMPLES = """examples:
   frictionlab runs                            the runs under runs/
@@ -37,7 +37,7 @@ def run(args) -> ExitCode:
     runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
     if args.runs_dir is not None and not runs_dir.is_dir():
         what = "is not a folder" if runs_dir.exists() else "does not exist"
-        raise RunFolderError(f"DIR: {runs_dir} {what}: give the folder that holds run folders")
+        raise RunFolderError(f"DIR: {shown_name(runs_dir)} {what}: give the folder that holds run folders")
     states = list_run_states(runs_dir)
     if args.json:
         from .jsonout import emit
@@ -71,7 +71,7 @@ def _what_it_is(folder: Path) -> str:
     if not any(os.path.lexists(folder / name) for name in RUN_MARKERS):
         return ""
     if is_sweep_folder(folder):
-        return (f": it is a sweep's folder (frictionlab follow {shown(folder)} shows it); "
-                f"its points' run folders: frictionlab runs {shown(folder / 'points')}")
-    return (f": it is a run folder itself (frictionlab follow {shown(folder)} shows it); "
-            f"the runs beside it: frictionlab runs {shown(folder.parent)}")
+        return (f": it is a sweep's folder (frictionlab follow {command_word(folder)} shows it); "
+                f"its points' run folders: frictionlab runs {command_word(folder / 'points')}")
+    return (f": it is a run folder itself (frictionlab follow {command_word(folder)} shows it); "
+            f"the runs beside it: frictionlab runs {command_word(folder.parent)}")

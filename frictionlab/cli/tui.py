@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, FrictionlabError, PresetFileError, did_you_mean
+from ..errors import ExitCode, FrictionlabError, PresetFileError, did_you_mean, shown_name
 from .options import add_workers_option, run_options
 
 
@@ -41,7 +41,7 @@ def run(args) -> ExitCode:
         # a file given as a folder: the TUI started and said "No presets in FILE", or listed no runs,
         # and only a save or a run then failed ("File exists")
         if folder is not None and os.path.lexists(folder) and not os.path.isdir(folder):
-            raise FrictionlabError(f"{option}: {folder} is not a folder: give a folder (one not there yet is made when first written into)")
+            raise FrictionlabError(f"{option}: {shown_name(folder)} is not a folder: give a folder (one not there yet is made when first written into)")
     if args.preset is not None:
         from ..preset import load_preset_file
 

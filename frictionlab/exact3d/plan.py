@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
-from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError
+from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError, shown_name
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
@@ -61,7 +61,7 @@ def find_presets(presets_dir: str | Path | None, plan: Plan) -> Path:
         if all((folder / preset_name(h)).is_file() for h in plan.hursts):
             return folder
     wanted = ", ".join(preset_name(h) for h in plan.hursts)
-    raise FrictionlabError(f"--presets: no folder with {wanted}; looked in {', '.join(map(str, candidates))}")
+    raise FrictionlabError(f"--presets: no folder with {wanted}; looked in {', '.join(map(shown_name, candidates))}")
 
 
 @dataclass(frozen=True)
@@ -327,12 +327,12 @@ def run_plan(
         if job.hurst not in factories:
             path = Path(presets_dir) / preset_name(job.hurst)
             if not path.is_file():
-                raise FrictionlabError(f"the exact 3D study needs the preset {path}: it is missing")
+                raise FrictionlabError(f"the exact 3D study needs the preset {shown_name(path)}: it is missing")
             factories[job.hurst] = factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
             # the page names it by its file's H
             if (unlike := first_unlike(factory.base.resolved(), {"spectrum.params.hurst": job.hurst})) is not None:
                 raise FrictionlabError(
-                    f"{path}: spectrum.params.hurst is {unlike[1]!r}, but the study takes this file for H = {job.hurst:g} "
+                    f"{shown_name(path)}: spectrum.params.hurst is {unlike[1]!r}, but the study takes this file for H = {job.hurst:g} "
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )
@@ -362,7 +362,7 @@ def run_plan(
                 raise KeyboardInterrupt
             if outcome.status != "completed":
                 raise FrictionlabError(
-                    f"the run in {folder} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
+                    f"the run in {shown_name(folder)} ended {outcome.status}" + (f": {outcome.error}" if outcome.error else "")
                     + "; run the command again with the same --runs to resume it"
                 )  # fmt: skip
             spacing, short, long = _cutoffs(scene)
@@ -371,7 +371,7 @@ def run_plan(
                 count_time()
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
         raise WorkInterrupted(
-            f"the ensembles that finished are kept in {runs_dir}; run the command again with --runs {runs_dir} to resume"
+            f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with --runs {shown_name(runs_dir)} to resume"
         ) from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
         count_time()

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, RunError
+from ..errors import FrictionlabError, OutputRefused, RunError, command_word, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..plugin.listeners import format_duration
 from ..options import RunOptions
@@ -128,7 +128,7 @@ def write_page(
         raise FrictionlabError("--finished-only writes the page from the runs of an earlier study: give its --runs DIR")
     if finished_only and not Path(runs_dir).is_dir():  # not "holds no finished ensemble": it holds nothing
         what = "is not a folder" if os.path.lexists(runs_dir) else "does not exist"
-        raise FrictionlabError(f"--runs {runs_dir} {what}: --finished-only writes the page from the runs folder of an "
+        raise FrictionlabError(f"--runs {shown_name(runs_dir)} {what}: --finished-only writes the page from the runs folder of an "
                                "earlier study: give that folder")  # fmt: skip
     if out_dir:  # refused before a default runs folder is made
         page_paths(Path(out_dir), force=options.force)
@@ -151,8 +151,8 @@ def write_page(
         raise
     if not runs.hursts():
         raise FrictionlabError(
-            f"{runs_dir} holds no finished exact ensemble with MDR beside it: nothing to write a page from; "
-            f"run the study (without --finished-only) with --runs {runs_dir}"
+            f"{shown_name(runs_dir)} holds no finished exact ensemble with MDR beside it: nothing to write a page from; "
+            f"run the study (without --finished-only) with --runs {shown_name(runs_dir)}"
         )
     numbers = study_numbers(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")
@@ -166,8 +166,8 @@ def write_page(
 def _command(quick: bool, out_dir: str | Path | None, runs_dir: str | Path | None, finished_only: bool) -> str:
     """The command that regenerates the page: with the runs folder it was given, so
     that rerunning it reads those runs back instead of computing them again."""
-    return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {out_dir}" if out_dir else "")
-            + (f" --runs {runs_dir}" if runs_dir else "") + (" --finished-only" if finished_only else "")
+    return (f"frictionlab exact3d{' --quick' if quick else ''}" + (f" --out {command_word(out_dir)}" if out_dir else "")
+            + (f" --runs {command_word(runs_dir)}" if runs_dir else "") + (" --finished-only" if finished_only else "")
             + " --force")  # fmt: skip
 
 

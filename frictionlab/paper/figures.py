@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import FrictionlabError, short_repr
+from ..errors import FrictionlabError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
 from ..runs.runfolder import output_subfolder
@@ -78,7 +78,7 @@ def find_presets(presets_dir: str | Path | None) -> Path:
     which = "; ".join(f"{name}: {problem}" for name, problem in problems.items() if problem)  # a FIFO, say
     which = f" (in {given}, {which})" if which else ""
     raise FrictionlabError(
-        f"--presets: no folder with the paper's presets ({wanted}); looked in {', '.join(map(str, candidates))}{which}"
+        f"--presets: no folder with the paper's presets ({wanted}); looked in {', '.join(map(shown_name, candidates))}{which}"
     )
 
 
@@ -106,7 +106,7 @@ def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
         if (unlike := first_unlike(scene.resolved(), fig.setup)) is not None:
             dotted, value, stated = unlike
             raise FrictionlabError(
-                f"{path}: {dotted} is {short_repr(value)}, but the report shows this preset as '{fig.title}' beside "
+                f"{shown_name(path)}: {dotted} is {short_repr(value)}, but the report shows this preset as '{fig.title}' beside "
                 f"the paper's numbers ({dotted} = {stated:g}); give the paper's preset (frictionlab presets copy "
                 f"{fig.preset.removesuffix('.yaml')}), or run yours with frictionlab run"
             )
@@ -132,9 +132,9 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
             run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
-            how = (f"frictionlab run {path} --out {run.folder} --resume" if run.sweep is not None
-                   else f"frictionlab resume {run.folder}")  # fmt: skip
-            raise WorkInterrupted(f"{fig.key} ended interrupted in {run.folder} (continue it with `{how}`)")
+            how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None
+                   else f"frictionlab resume {command_word(run.folder)}")  # fmt: skip
+            raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (continue it with `{how}`)")
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
-            raise WorkInterrupted(f"{fig.key} completed in {run.folder}")
+            raise WorkInterrupted(f"{fig.key} completed in {shown_name(run.folder)}")
     return runs

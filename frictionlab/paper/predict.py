@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..arguments import path_argument
-from ..errors import FrictionlabError, RunFolderError, short_repr
+from ..errors import FrictionlabError, RunFolderError, command_word, short_repr, shown_name
 from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
@@ -252,11 +252,11 @@ def read_run_law(
             if status == "failed" and counts.get("done") == counts.get("requested") and summary.get("error"):
                 said = str(summary["error"])  # no law, with every realization done: resuming it gives none either
                 said = said if len(said) <= 300 else said[:297] + "..."
-                raise RunFolderError(f"{path}: the run failed with all its realizations finished{count}, and holds "
+                raise RunFolderError(f"{shown_name(path)}: the run failed with all its realizations finished{count}, and holds "
                                      f"no law: {said}; give a law by hand with --a/--b")  # fmt: skip
         raise RunFolderError(
-            f"{path}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
-            f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {run_dir}`, "
+            f"{shown_name(path)}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
+            f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {command_word(run_dir)}`, "
             "or give its law by hand with --a/--b"
         )
     law = _fit_of(summary, path)
@@ -293,7 +293,7 @@ def _check_law_within(pairs: np.ndarray | None, law: LogFit, path: Path) -> None
         slack = 1e-9 * max(abs(low), abs(high), 1.0)  # a resample may equal the estimate, to rounding
         if not low - slack <= value <= high + slack:
             raise RunFolderError(
-                f"{path}: fit.{name} = {value:.6g} lies outside all {len(pairs)} of its bootstrap resamples "
+                f"{shown_name(path)}: fit.{name} = {value:.6g} lies outside all {len(pairs)} of its bootstrap resamples "
                 f"redrawn from realizations.npz ({low:.6g} to {high:.6g}): the two files disagree (one was "
                 "edited or damaged); run it again, or give the law by hand with --a/--b"
             )
@@ -320,11 +320,11 @@ def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
     says how the caller names it (the command line: ``--from``)."""
     if not run_dir.is_dir():  # a file (its summary.json, say) is named as one, not as missing
         what = "not a folder: give the run's folder" if os.path.lexists(run_dir) else "no such folder"
-        raise RunFolderError(f"{name} {run_dir}: no readable summary.json there ({what})")
+        raise RunFolderError(f"{name} {shown_name(run_dir)}: no readable summary.json there ({what})")
     if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "sweep.json"):
         raise RunFolderError(  # a law per point: the user names one
-            f"{name} {run_dir} is a sweep's folder, which holds a law per point: give one point's run folder, "
-            f"{run_dir / 'points'}/<NN-label> (frictionlab runs {run_dir / 'points'} lists them)"
+            f"{name} {shown_name(run_dir)} is a sweep's folder, which holds a law per point: give one point's run folder, "
+            f"{shown_name(run_dir / 'points')}/<NN-label> (frictionlab runs {command_word(run_dir / 'points')} lists them)"
         )
     return read_summary(run_dir)[0]
 
@@ -332,12 +332,12 @@ def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
 def _fit_of(summary: dict, path: Path) -> LogFit:
     """summary.json's ``fit`` (its types checked by the schema) checked as a law (``check_law``)."""
     if summary.get("fit") is None:
-        raise RunFolderError(f"{path}: the run has no fit (status {summary.get('status')})")
+        raise RunFolderError(f"{shown_name(path)}: the run has no fit (status {summary.get('status')})")
     law = LogFit.from_dict(summary["fit"])
-    names = {field: f"{path}: field 'fit.{field}'" for field in ("a", "b", "a_ci", "b_ci", "confidence")}
+    names = {field: f"{shown_name(path)}: field 'fit.{field}'" for field in ("a", "b", "a_ci", "b_ci", "confidence")}
     check_law(law, names, RunFolderError)
     if law.bootstrap and summary.get("seed") is None:
-        raise RunFolderError(f"{path}: field 'seed' must be a whole number >= 0 (the bootstrap's), not null")
+        raise RunFolderError(f"{shown_name(path)}: field 'seed' must be a whole number >= 0 (the bootstrap's), not null")
     return law
 
 
@@ -348,45 +348,45 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
     try:
         raw = read_member(path.parent, path.name, MAX_REALIZATIONS_BYTES, "realizations.npz")
         if raw[:2] != b"PK":  # every zip, so every .npz, starts so
-            raise RunFolderError(f"{path} is damaged (not an .npz archive: it does not start as a zip file does)")
+            raise RunFolderError(f"{shown_name(path)} is damaged (not an .npz archive: it does not start as a zip file does)")
         with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             missing = [name for name in ("xi", "f") if name not in data.files]
             if missing:
-                raise RunFolderError(f"{path} is damaged (no array {missing[0]!r} in it)")
+                raise RunFolderError(f"{shown_name(path)} is damaged (no array {missing[0]!r} in it)")
             xi, f = data["xi"], data["f"]
     except InputFileProblem as exc:
-        raise RunFolderError(f"{path}: {exc}") from None
+        raise RunFolderError(f"{shown_name(path)}: {exc}") from None
     except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:  # cut short, pickled, bad header
         reason = str(exc) or type(exc).__name__
         if "allow_pickle" in reason:
             reason = "it holds pickled Python objects, which are never loaded"
         reason = short_repr(reason, 120)[1:-1]
-        raise RunFolderError(f"{path} is damaged (not an .npz archive of number arrays: {reason})") from None
+        raise RunFolderError(f"{shown_name(path)} is damaged (not an .npz archive of number arrays: {reason})") from None
     except MemoryError as exc:  # an array's header may claim any shape
-        raise RunFolderError(f"{path}: an array in it is larger than this machine's memory ({exc})") from None
+        raise RunFolderError(f"{shown_name(path)}: an array in it is larger than this machine's memory ({exc})") from None
     for name, array, ndim in (("xi", xi, 2), ("f", f, 1)):
         if array.dtype.kind not in "fiu" or array.ndim != ndim or not array.size:
             raise RunFolderError(
-                f"{path}: array {name!r} must be {ndim}-D numbers, not empty. "
+                f"{shown_name(path)}: array {name!r} must be {ndim}-D numbers, not empty. "
                 f"Got shape {array.shape} of {array.dtype} instead."
             )
     if xi.shape[1] != f.size:
-        raise RunFolderError(f"{path}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
+        raise RunFolderError(f"{shown_name(path)}: array 'xi' has {xi.shape[1]} columns, one per load step, but 'f' has {f.size}")
     if not np.all(np.isfinite(f) & (f > 0)):
-        raise RunFolderError(f"{path}: array 'f' must hold finite numbers > 0 (some are not)")
+        raise RunFolderError(f"{shown_name(path)}: array 'f' must hold finite numbers > 0 (some are not)")
     defined = f.size - np.isnan(xi).all(axis=0).sum()  # NaN: a line with no xi at that load
     if (bad := np.count_nonzero(np.isinf(xi))) or defined < 2:  # said as it is: infinite, or too few loads
         why = f"{bad} of {xi.size} are infinite" if bad else f"no line has xi at {f.size - defined} of its {f.size} loads"
-        raise RunFolderError(f"{path}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
+        raise RunFolderError(f"{shown_name(path)}: array 'xi' must hold finite numbers, or NaN where a line has no xi, with xi "
                              f"defined at two loads or more ({why})")  # fmt: skip
     if negative := np.count_nonzero(xi < 0):  # an rms slope over another: a run writes none below 0
-        raise RunFolderError(f"{path}: array 'xi' must hold numbers >= 0, or NaN where a line has no xi "
+        raise RunFolderError(f"{shown_name(path)}: array 'xi' must hold numbers >= 0, or NaN where a line has no xi "
                              f"({negative} of {xi.size} are negative)")  # fmt: skip
     counts = summary.get("realizations")
     done = counts.get("done") if isinstance(counts, dict) else None
     if isinstance(done, int) and not isinstance(done, bool) and done != xi.shape[0]:
         raise RunFolderError(
-            f"{path}: array 'xi' has {xi.shape[0]} realizations but summary.json says {done} were done: "
+            f"{shown_name(path)}: array 'xi' has {xi.shape[0]} realizations but summary.json says {done} were done: "
             "the two files are not of one run"
         )
     return xi.astype(float), f.astype(float)

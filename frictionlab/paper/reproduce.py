@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import OutputRefused
+from ..errors import OutputRefused, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
@@ -38,7 +38,7 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     if problem:
         raise OutputRefused(f"--markdown: {problem}; give a file in a folder you can write to")
     if markdown_path and Path(markdown_path).is_dir():
-        raise OutputRefused(f"--markdown {markdown_path} is a folder: give a file name (e.g. {Path(markdown_path) / 'REPRODUCTION.md'})")
+        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is a folder: give a file name (e.g. {shown_name(Path(markdown_path) / 'REPRODUCTION.md')})")
     if not out_dir:  # what a fresh folder would hold is new: only a --markdown or --figures given can be taken
         _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
@@ -72,7 +72,7 @@ def write_report(
     try:
         with one_dask_cluster(options):  # on Dask, every run uses one client and cluster
             started = time.perf_counter()
-            log(f"report: running Figs. 2 to 5 from {presets}/ into {out_dir}/")
+            log(f"report: running Figs. 2 to 5 from {shown_name(presets)}/ into {shown_name(out_dir)}/")
             runs = run_figures(presets, out_dir, options, progress=not quiet)
             log(f"report: Figs. 2 to 5 ran in {time.perf_counter() - started:.1f} s; drawing")
             images = {}
@@ -99,11 +99,11 @@ def write_report(
                 images["fig5-calibrated"] = os.path.relpath(figures_dir / name, markdown_path.parent or Path("."))
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
-        raise WorkInterrupted(f"{said}the runs that finished are kept in {out_dir}; no {markdown_path} written") from None
+        raise WorkInterrupted(f"{said}the runs that finished are kept in {shown_name(out_dir)}; no {shown_name(markdown_path)} written") from None
     command = "frictionlab report" + (" --readings" if readings else "") + (f" --replicates {replicates}" if replicates > 1 else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
     atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
-    log(f"report: wrote {markdown_path} and {len(images)} figures in {figures_dir}/ ({elapsed:.1f} s for Figs. 2 to 5)")
+    log(f"report: wrote {shown_name(markdown_path)} and {len(images)} figures in {shown_name(figures_dir)}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from ..errors import PresetFileError, did_you_mean, short_repr
+from ..errors import PresetFileError, command_word, did_you_mean, short_repr, shown_name
 
 _LONGEST = 100  # characters of a one-line description
 _PACKAGE = Path(__file__).resolve().parent.parent
@@ -80,13 +80,13 @@ def resolve_preset_path(argument: str | Path) -> Path:
         return shadowed.path
     if path.is_dir() and (path / "preset.yaml").is_file():  # a run folder given for its preset
         raise PresetFileError(
-            [f"(file): a folder, not a preset; it holds a run, whose preset is {path / 'preset.yaml'} (frictionlab "
-             f"resume {path} continues the run; frictionlab run {path / 'preset.yaml'} --out NEW runs it again)"],
+            [f"(file): a folder, not a preset; it holds a run, whose preset is {shown_name(path / 'preset.yaml')} (frictionlab "
+             f"resume {command_word(path)} continues the run; frictionlab run {command_word(path / 'preset.yaml')} --out NEW runs it again)"],
             source=str(argument),
         )  # fmt: skip
     if path.is_dir() and (path / "sweep.json").is_file():
-        raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {path} continues "
-                               f"it), each point's preset in {path / 'points'}/<NN-label>/preset.yaml"],
+        raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {command_word(path)} continues "
+                               f"it), each point's preset in {shown_name(path / 'points')}/<NN-label>/preset.yaml"],
                               source=str(argument))  # fmt: skip
     if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one

@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name
 from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .results import read_summary
@@ -115,10 +115,10 @@ def wait_started(process: subprocess.Popen, out_dir: str | Path, timeout: float 
             holder = lock_holder(out_dir)
             if holder is not None and holder != process.pid:  # it lost the folder to another (its word may be lost)
                 raise in_use(out_dir, holder)
-            raise FrictionlabError(f"the run into {out_dir} ended at once (exit code {process.returncode}) without a word")
+            raise FrictionlabError(f"the run into {shown_name(out_dir)} ended at once (exit code {process.returncode}) without a word")
         time.sleep(0.05)
-    raise FrictionlabError(f"the run into {out_dir} has not started after {timeout:g} s (pid {process.pid}); "
-                           f"`frictionlab follow {out_dir}` shows it if it does")  # fmt: skip
+    raise FrictionlabError(f"the run into {shown_name(out_dir)} has not started after {timeout:g} s (pid {process.pid}); "
+                           f"`frictionlab follow {command_word(out_dir)}` shows it if it does")  # fmt: skip
 
 
 def _raise_run_error(event: dict) -> None:
@@ -160,7 +160,7 @@ def _child() -> int:
         log.error("the run was stopped (SIGTERM) before it could write its results", ExitCode.TERMINATED)
         return ExitCode.TERMINATED
     except OSError as exc:
-        log.error(f"cannot write results to {exc.filename or out}: {exc.strerror or exc}", ExitCode.RUNTIME_FAILURE)
+        log.error(f"cannot write results to {shown_name(exc.filename or out)}: {exc.strerror or exc}", ExitCode.RUNTIME_FAILURE)
         return ExitCode.RUNTIME_FAILURE
     except Exception as exc:  # a bug: said where a follower looks, since stderr is nobody's
         log.error(f"internal error ({type(exc).__name__}: {exc}); please report it", ExitCode.INTERNAL)

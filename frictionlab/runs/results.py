@@ -30,7 +30,7 @@ from pydantic import Field
 
 from .. import __version__
 from ..compute.ensemble import RunOutcome
-from ..errors import MissingDependency, RunError, RunFolderError, shown
+from ..errors import MissingDependency, RunError, RunFolderError, shown, shown_name
 from ..io.files import atomic_write, write_npz
 from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
@@ -426,12 +426,12 @@ def write_figure(path: Path, draw) -> None:
     try:
         atomic_write(path, draw, binary=True)
     except OSError as exc:
-        raise RunError(f"cannot write {path}: {exc.strerror or exc}; the numbers are written") from None
+        raise RunError(f"cannot write {shown_name(path)}: {exc.strerror or exc}; the numbers are written") from None
     except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
-        raise RunError(f"cannot draw {path}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
+        raise RunError(f"cannot draw {shown_name(path)}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
                        "the numbers are written") from None  # fmt: skip
     except Exception as exc:
-        raise RunError(f"cannot draw {path}: {type(exc).__name__}: {exc}; the numbers are written") from None
+        raise RunError(f"cannot draw {shown_name(path)}: {type(exc).__name__}: {exc}; the numbers are written") from None
 
 
 def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:

@@ -35,7 +35,7 @@ from pathlib import Path
 import yaml
 
 from .. import __version__
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, shown, warn_user
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
 from ..io.files import atomic_write, output_path_problem, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
 from ..preset import Scene, differences, load_preset_file
@@ -186,14 +186,14 @@ class RunDirectory:
         try:
             state = read_json_object(path, MAX_MANIFEST_BYTES, "manifest")
         except InputFileProblem as exc:
-            raise RunFolderError(f"{path}: {exc}") from None
+            raise RunFolderError(f"{shown_name(path)}: {exc}") from None
         check_schema_version(state, path, MANIFEST_FORMAT, key="format")
         for key, kind, what in _MANIFEST_FIELDS:
             value = state.get(key)
             if value is not None and (not isinstance(value, kind) or isinstance(value, bool)):
-                raise RunFolderError(f"{path} is damaged ({key} is not {what}, but {json_kind(value)})")
+                raise RunFolderError(f"{shown_name(path)} is damaged ({key} is not {what}, but {json_kind(value)})")
             if value is not None and not _well_formed(key, value):
-                raise RunFolderError(f"{path} is damaged ({key} is not {what}: an entry is not a string)")
+                raise RunFolderError(f"{shown_name(path)} is damaged ({key} is not {what}: an entry is not a string)")
         return state
 
     def _write_manifest(self) -> None:
@@ -207,12 +207,12 @@ class RunDirectory:
             what = "is not a folder" if os.path.lexists(self.path) else "does not exist"
             raise RunFolderError(f"{shown(self.path)} {what}: there is no run to resume there")
         if not os.path.lexists(path):
-            raise RunFolderError(f"{self.path} holds no run to resume (no {PRESET_FILE})")
+            raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {PRESET_FILE})")
         try:
             return load_preset_file(path, follow_links=False)
         except PresetError as exc:
             raise RunFolderError(
-                f"{path} is damaged ({exc.problems[0].removeprefix('(file): ')}): this run cannot be resumed"
+                f"{shown_name(path)} is damaged ({exc.problems[0].removeprefix('(file): ')}): this run cannot be resumed"
             ) from None
 
     # ------------------------------------------------------------ start, finish
@@ -238,7 +238,7 @@ class RunDirectory:
             state = None  # a damaged manifest lists nothing: nothing is deleted
         self._refuse_unless_ours(state, scene, resolved)
         if state is not None and state.get("status") == "completed" and same_preset(state, resolved, scene):
-            warn_user(f"{self.path} holds a completed run of this preset: it runs again, to the same numbers")
+            warn_user(f"{shown_name(self.path)} holds a completed run of this preset: it runs again, to the same numbers")
         listed = [*self._listed(state), *((state or {}).get("retired") or [])]
         self._remove_chunks(listed)  # chunks of the run that was here: frictionlab wrote them
         self.chunks.mkdir(parents=True, exist_ok=True)
@@ -308,7 +308,7 @@ class RunDirectory:
             if others:
                 listed = ", ".join(repr(name) for name in others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputRefused(
-                    f"{self.path} is not empty and is not a frictionlab run folder (it holds {listed}): "
+                    f"{shown_name(self.path)} is not empty and is not a frictionlab run folder (it holds {listed}): "
                     f"{hint} (frictionlab then replaces only the files it writes and deletes none)"
                 )
             return
@@ -318,13 +318,13 @@ class RunDirectory:
             changed = differences(old, resolved) if isinstance(old, dict) else []
             fields = ", ".join(d.split(":", 1)[0] for d in changed[:5]) or "its fingerprint"
             raise OutputRefused(
-                f"{self.path} holds a finished run of another preset (it differs in {fields}): "
+                f"{shown_name(self.path)} holds a finished run of another preset (it differs in {fields}): "
                 f"{hint} (its results are then replaced)"
             )
         if status != "completed" and self._listed(state):
             raise OutputRefused(
-                f"{self.path} holds an unfinished run ({len(self._listed(state))} chunk file(s) in {CHUNK_DIR}/, "
-                f"status {status}): continue it with --resume (resume=True in Python, or `frictionlab resume {self.path}`), "
+                f"{shown_name(self.path)} holds an unfinished run ({len(self._listed(state))} chunk file(s) in {CHUNK_DIR}/, "
+                f"status {status}): continue it with --resume (resume=True in Python, or `frictionlab resume {command_word(self.path)}`), "
                 "or give another output folder, or force it (--force; force=True) to start it again"
             )
 
@@ -335,30 +335,30 @@ class RunDirectory:
                 hashes[field] = {"path": path, "sha256": sha256_of(path)}
             except (InputFileProblem, OSError) as exc:
                 reason = exc if isinstance(exc, InputFileProblem) else exc.strerror
-                raise FrictionlabError(f"{field}: cannot read {path}: {reason}") from None
+                raise FrictionlabError(f"{field}: cannot read {shown_name(path)}: {reason}") from None
         return hashes
 
     def _resume(self, scene: Scene, resolved: dict, inputs: dict) -> list[RealizationResult]:
         state = self.state()
         if state is None:
-            raise RunFolderError(f"{self.path} holds no run to resume (no {STATE_FILE})")
+            raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {STATE_FILE})")
         if not same_preset(state, resolved, scene):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
             changed = differences(stored, resolved)
             if not changed:  # the same preset, and a fingerprint that is not its own
                 raise RunFolderError(
-                    f"cannot resume {self.path}: the fingerprint in its {STATE_FILE} is not that of the preset it "
+                    f"cannot resume {shown_name(self.path)}: the fingerprint in its {STATE_FILE} is not that of the preset it "
                     f"holds (the file damaged or edited); run the preset again into a new folder"
                 )
             given = f" ({scene.source})" if scene.source else ""  # `resume DIR`: DIR/preset.yaml, edited
-            raise RunFolderError(f"cannot resume {self.path}: the preset its {STATE_FILE} started with differs from the one "
+            raise RunFolderError(f"cannot resume {shown_name(self.path)}: the preset its {STATE_FILE} started with differs from the one "
                                  f"given{given}\n  " + "\n  ".join(changed))
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in inputs.items():
             then = recorded.get(field)
             if isinstance(then, dict) and then.get("sha256") != now["sha256"]:
                 raise RunFolderError(
-                    f"cannot resume {self.path}: the input file {field} ({now['path']}) changed since the run "
+                    f"cannot resume {shown_name(self.path)}: the input file {field} ({now['path']}) changed since the run "
                     f"started (SHA-256 {str(then.get('sha256'))[:12]}... then, {now['sha256'][:12]}... now); "
                     "restore it, or start a new run in another folder"
                 )
@@ -451,7 +451,7 @@ class RunDirectory:
     def _warn_damage(self, damaged: dict[str, str], results: dict, total: int) -> None:
         report = damage_report(self.chunks, set(self._manifest["chunks"]), damaged, set(results), total)
         if report:
-            warn_user(f"resume of {self.path}: {report}")
+            warn_user(f"resume of {shown_name(self.path)}: {report}")
 
     def compact(self, pending: list[RealizationResult] | tuple = ()) -> bool:
         """Merge the chunks of a completed run, with ``pending`` (its last results, not yet

@@ -29,7 +29,7 @@ from pydantic import BaseModel
 
 from .. import __version__
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr
+from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
@@ -336,7 +336,7 @@ def _run_points(
                 point.scene, folder, point_options, listeners=run_listeners, cancel=cancel, plot=plot
             )
         except FrictionlabError as exc:  # a folder not this point's run's: a resume meets it again unless moved
-            hint = f"; move {folder} aside, then resume the sweep to compute the point afresh" if isinstance(
+            hint = f"; move {shown_name(folder)} aside, then resume the sweep to compute the point afresh" if isinstance(
                 exc, (RunFolderError, OutputRefused)) else ""  # fmt: skip
             yield PointResult(point, "error", folder, error=f"{exc}{hint}")
             continue
@@ -445,12 +445,12 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
         old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
     except RunFolderError:
         raise OtherSweep(
-            f"{out_dir} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
+            f"{shown_name(out_dir)} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
         ) from None
     mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
-        raise OtherSweep(f"{out_dir} holds another sweep: {hint} (its tables are then replaced)")
+        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)")
 
 
 def stored_sweep(out_dir: Path) -> dict:

@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError
 
-from ..errors import RunFolderError, shown
+from ..errors import RunFolderError, shown, shown_name
 from ..preset.schema import SweepSettings
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
 
@@ -60,9 +60,9 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
     try:  # a row per point: a list cut short would be read as a smaller sweep
         points = SweepSettings.model_validate(data["sweep"]).count()
     except ValidationError:
-        raise RunFolderError(f"{path} is damaged (sweep: not a sweep section a preset can hold)") from None
+        raise RunFolderError(f"{shown_name(path)} is damaged (sweep: not a sweep section a preset can hold)") from None
     if len(record.points) != points:
-        raise RunFolderError(f"{path} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
+        raise RunFolderError(f"{shown_name(path)} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
     return data, record
 
 

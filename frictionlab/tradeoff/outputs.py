@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import OutputRefused, shown
+from ..errors import OutputRefused, shown, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from .axes import COLUMNS, Row, Study, grid_side
 from .metrics import pareto_front
@@ -349,7 +349,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
         return out
     listed = ", ".join(repr(shown(n)) for n in held[:3])
     raise OutputRefused(
-        f"--out {shown(out)} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
+        f"--out {shown_name(out)} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
         "give another folder, or --force to write study.csv, study.md and study.png into it (nothing else is touched)"
     )
 

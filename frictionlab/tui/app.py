@@ -25,7 +25,7 @@ from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Static, TabPane
 
-from ..errors import PresetError, shown
+from ..errors import PresetError, shown, shown_name
 from ..options import RunOptions
 from ..preset import load_preset_file
 from ..plugin.registry import default_registry
@@ -310,7 +310,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
             try:
                 data = load_preset_file(path)
             except PresetError as exc:
-                self.say(problems_text(exc.problems), "error", title=f"Cannot open {path.name}", about=path)
+                self.say(problems_text(exc.problems), "error", title=f"Cannot open {shown_name(path.name)}", about=path)
                 return
             self.draft_source, self.disk_stamp = path, stamp
         else:
@@ -342,7 +342,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
                 data["name"] = copy_name(data["name"], path, default)
                 self._write(path, data, then_open=True, template=entry.path)
 
-        self.push_screen(PathScreen(f"Duplicate {entry.path.name} as", default, self.save_folder), done)
+        self.push_screen(PathScreen(f"Duplicate {shown_name(entry.path.name)} as", default, self.save_folder), done)
 
     def new_preset(self) -> None:
         """A new preset from a template that runs (a listed preset; a plugin's
@@ -371,7 +371,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         if not await self._open_after_confirm(path, data, modified=True):
             return
         self.draft_source = template  # its comments are kept when the new preset is saved
-        self.say(f"New preset {path.name}: Ctrl+S saves it as {path}.", until_open=True)
+        self.say(f"New preset {shown_name(path.name)}: Ctrl+S saves it as {shown_name(path)}.", until_open=True)
 
     # ------------------------------------------------------------ editing and saving
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
-from ..errors import FrictionlabError, PresetError, RunFolderError, shown
+from ..errors import FrictionlabError, PresetError, RunFolderError, shown, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
 from .folders import read_run
@@ -79,7 +79,7 @@ class RunControl:
         self._start(scene, sweep, out_dir, self.run_options)
 
     def _refuse_damaged(self, folder: Path, reason: str) -> None:
-        self.say(f"{folder.name} is damaged: {reason}. Nothing of it was changed; move it aside "
+        self.say(f"{shown_name(folder.name)} is damaged: {reason}. Nothing of it was changed; move it aside "
                  "or repair that file to go on.", "error", title="Cannot resume", about=folder)  # fmt: skip
 
     def resume_run(self, folder: Path | None) -> None:
@@ -108,7 +108,7 @@ class RunControl:
                     self.show_running(folder)
                 return
             if state.kind == "sweep" and state.status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning", about=folder)
+                self.say(f"{shown_name(folder.name)} is complete: nothing to resume.", "warning", about=folder)
                 return
             if state.status == "damaged":  # a resume would rewrite the damaged file: the user did not ask that
                 self._refuse_damaged(folder, state.reason)
@@ -123,7 +123,7 @@ class RunControl:
             # not a run folder (yet): said below
         try:
             if read_run(folder).status == "completed":
-                self.say(f"{folder.name} is complete: nothing to resume.", "warning", about=folder)
+                self.say(f"{shown_name(folder.name)} is complete: nothing to resume.", "warning", about=folder)
                 return
         except (OSError, RunFolderError):
             pass  # no summary yet (a run killed early): the stored preset says whether it can go on
@@ -162,7 +162,7 @@ class RunControl:
         except RunFolderError as exc:
             self.say(str(exc), "error", title=f"Cannot {verb}", about=folder)
         except PresetError as exc:
-            self.say(exc.problems[0], "error", title=f"Cannot {verb} {folder.name}", about=folder)
+            self.say(exc.problems[0], "error", title=f"Cannot {verb} {shown_name(folder.name)}", about=folder)
         return None
 
     def _start(self, scene, sweep, out_dir: Path, options: RunOptions) -> None:
@@ -202,7 +202,7 @@ class RunControl:
         self.action_show_tab("run")
         verb = "Resuming" if options.resume else "Running"
         name = scene.preset.name if sweep is None else f"the sweep {sweep.name}"
-        self.say(f"{verb} {name} into {out_dir} as a process of its own "
+        self.say(f"{verb} {name} into {shown_name(out_dir)} as a process of its own "
                  f"(pid {self.followed.pid}): it goes on if you quit")  # fmt: skip
 
     @staticmethod
@@ -243,7 +243,7 @@ class RunControl:
         self.followed = self._follower(folder, scene, sweep)
         self.refresh_bindings()
         name = scene.preset.name if sweep is None else f"The sweep {sweep.name}"
-        self.say(f"{name} is running in {folder} (a process of its own): F4 shows it, c cancels it")
+        self.say(f"{name} is running in {shown_name(folder)} (a process of its own): F4 shows it, c cancels it")
         self._follow_tick()
 
     def _show_point(self, sweep, kind: str, point, result) -> None:
@@ -288,7 +288,7 @@ class RunControl:
             finished = read(followed.folder)
         except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
             resume = "u resumes it" if self.last_resumable else "it cannot be resumed"
-            error = f"the run's process ended without writing its results ({resume}: {followed.folder})"
+            error = f"the run's process ended without writing its results ({resume}: {shown_name(followed.folder)})"
             if self.last_resumable:  # killed (kill -9, a reboot): interrupted, as Results and runs say
                 self._show_stored(followed.folder, resuming=False)
             self.on_run_crashed(RunCrashed(error, interrupted=self.last_resumable))
@@ -405,7 +405,7 @@ class RunControl:
             self.exit()
 
         what = "sweep" if isinstance(followed, FollowedSweep) else "run"
-        question = (f"A {what} is going in {followed.folder} (pid {followed.pid}), a process of its own.\n"
+        question = (f"A {what} is going in {shown_name(followed.folder)} (pid {followed.pid}), a process of its own.\n"
                     "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
                     "(what finished is kept)?")  # fmt: skip
         self.push_screen(QuitDuringRunScreen(question), answered)

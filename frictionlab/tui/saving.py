@@ -8,7 +8,7 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-from ..errors import shown
+from ..errors import shown, shown_name
 from .folders import file_stamp, is_builtin, made_when_saved, new_preset_path, save_preset, user_presets_dir
 from .running import NO_PRESET
 from .screens import ConfirmScreen, PathScreen
@@ -23,7 +23,7 @@ class PresetSaving:
             self.say(NO_PRESET, "warning")
             return
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
-            self.say(f"{self.draft_path.name} is a built-in preset: save your version as a new file.", "warning", until_open=True)
+            self.say(f"{shown_name(self.draft_path.name)} is a built-in preset: save your version as a new file.", "warning", until_open=True)
             self.push_screen(
                 PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
@@ -32,7 +32,7 @@ class PresetSaving:
         if self.draft_source != self.draft_path and self.draft_path.exists():
             # a new preset whose file appeared since the New dialog: replaced only if the user says so
             self.push_screen(
-                PathScreen(f"{self.draft_path} exists now: save the new preset as", self.draft_path, self.save_folder),
+                PathScreen(f"{shown_name(self.draft_path)} exists now: save the new preset as", self.draft_path, self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -102,7 +102,7 @@ class PresetSaving:
         except OSError as exc:  # a read-only folder, not the user's, a file in the way
             self._ask_elsewhere(path, exc, lambda there: self._write(there, data, then_open, template))
             return
-        self.say(f"Saved {path}", until_open=not then_open)  # of the open preset: not of the next one opened
+        self.say(f"Saved {shown_name(path)}", until_open=not then_open)  # of the open preset: not of the next one opened
         self.reload_presets()
         self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
         if then_open:
@@ -122,7 +122,7 @@ class PresetSaving:
         elsewhere = user_presets_dir() / path.name
         self.say(f"{shown(path)} cannot be written ({reason}): give another file, e.g. in your own presets "
                  f"folder, {shown(elsewhere.parent)}; Esc leaves it unsaved", "error", title="Not saved")  # fmt: skip
-        title = f"{path.name} cannot be written there ({reason}): save it as"
+        title = f"{shown_name(path.name)} cannot be written there ({reason}): save it as"
         self.push_screen(PathScreen(title, elsewhere, self.save_folder), lambda there: there is not None and write_there(there))
 
 

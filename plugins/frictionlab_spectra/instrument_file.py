@@ -26,7 +26,7 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_reader import (
-    channel_list, check_declared_bytes, check_declared_points, check_header_units, check_not_amperes, check_payload,
+    channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
     check_text_heights, check_text_room, choose_reader, describe_failure, pick_channel,
     TEXT_FORMATS, quoted,
 )
@@ -186,7 +186,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
-        check_not_amperes(type(reader), chosen, where)
+        check_channel_of_heights(reader, chosen, where)
         check_payload(fh, type(reader), where, checksum=False)
         if chosen.nb_grid_pts is not None:
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where, fh, type(reader))
@@ -201,7 +201,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         except Exception:  # noqa: BLE001 - a reader that cannot say
             data_unit = None
         if isinstance(data_unit, str) and data_unit != file_unit:
-            length_factor(data_unit, "m", where, f"channel {chosen.index}'s values are in")
+            length_factor(data_unit, "m", where, f"the unit of channel {chosen.index}'s values")
         stated = chosen.physical_sizes is not None or not spacing_given or chosen.nb_grid_pts is None
         sizes = {} if stated else {"physical_sizes": tuple(float(n) for n in chosen.nb_grid_pts)}
         try:

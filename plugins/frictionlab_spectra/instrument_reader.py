@@ -134,20 +134,55 @@ def check_header_units(fh, reader, file_unit: str | None, unit: str | None, wher
         check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
 
 
-def check_not_amperes(reader, channel, where: str) -> None:
-    """Refuse a Gwyddion channel whose values are in A: Gwyddion's unit strings are SI, A the
-    ampere (an STM's current), but SurfaceTopography's reader takes A for the angstrom and read
-    a current channel as heights without a word (Gwyddion stores an angstrom as m)."""
-    if _gwyddion_amperes(reader, channel):
-        raise ValueError(
-            f"{where}: channel {channel.index} ({quoted(channel.name)}) holds values in A, Gwyddion's symbol of the "
-            "ampere (a current, not heights; Gwyddion stores an angstrom as m): choose the channel of heights with "
-            "channel, or export the height channel"
-        )
+def check_channel_of_heights(reader, channel, where: str) -> None:
+    """Refuse a channel whose values are no lengths, in any reader: one that lists the channels
+    of currents, voltages and phases beside the heights (IBW, MI) gives each a kind, and a
+    channel's values in A, V or deg were read as heights of 1 m per unit when it was picked
+    (``channel:``) or was the file's default. A Gwyddion channel in A is the ampere
+    (``_gwyddion_amperes``), which its reader takes for the angstrom."""
+    found = _not_heights(reader, channel)
+    if found is None:
+        return
+    kind, data_unit = found
+    if data_unit == "A" and _gwyddion_amperes(reader, channel):
+        what = "values in A, Gwyddion's symbol of the ampere (a current, not heights; Gwyddion stores an angstrom as m)"
+    else:
+        said = f"values in {quoted(data_unit)}" if data_unit else "values without a unit"
+        what = f"{'' if kind in ('height', 'other') else kind + ' '}{said}, not heights"
+    heights = [f"{int(c.index)}: {quoted(c.name)}" for c in reader.channels if _not_heights(reader, c) is None]
+    choose = f"choose a channel of heights with channel ({', '.join(heights)})" if heights else "the file holds no channel of heights"
+    raise ValueError(f"{where}: channel {channel.index} ({quoted(channel.name)}) holds {what}: {choose}, or export "
+                     "the height channel alone")  # fmt: skip
+
+
+def _not_heights(reader, channel) -> tuple[str, str | None] | None:
+    """The kind and unit of ``channel``'s values where they are no heights, else None."""
+    kind = getattr(getattr(channel, "data_kind", None), "value", "height")  # a reader older than data_kind: heights
+    amperes = _gwyddion_amperes(reader, channel)
+    data_unit = "A" if amperes else _said_unit(channel)
+    if kind == "height" and not amperes and (data_unit in (None, channel.unit) or _is_length(data_unit)):
+        return None  # the lateral unit, checked where the sizes are converted (length_factor)
+    return kind, data_unit
+
+
+def _said_unit(channel) -> str | None:
+    """The unit of a channel's values as its reader says it (None where it cannot say)."""
+    try:
+        unit = channel.data_unit
+    except Exception:  # noqa: BLE001 - a reader that cannot say: its reading stands
+        return None
+    return unit if isinstance(unit, str) and unit else None
+
+
+def _is_length(unit: str) -> bool:
+    """Whether SurfaceTopography reads ``unit`` as a length (its spellings: 'MicroMeters', 'um')."""
+    from SurfaceTopography.Support.UnitConversion import is_length_unit, mangle_length_unit_utf8  # the extra's
+
+    return is_length_unit(mangle_length_unit_utf8(unit))
 
 
 def _gwyddion_amperes(reader, channel) -> bool:
-    """Whether ``channel`` of a Gwyddion file holds values in A (``check_not_amperes``)."""
+    """Whether ``channel`` of a Gwyddion file holds values in A (``check_channel_of_heights``)."""
     if reader.format() != "gwy":
         return False
     try:

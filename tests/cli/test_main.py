@@ -172,6 +172,7 @@ def test_a_refusal_names_the_first_overrides_only(capsys):
         (["report", "--presets", ""], ExitCode.USAGE, "--presets names no folder (it is empty)"),
         (["report", "--figures", ""], ExitCode.USAGE, "--figures names no folder (it is empty)"),
         (["report", "--markdown", ""], ExitCode.USAGE, "--markdown names no file (it is empty)"),
+        (["run", "quickstart", "--out", "  "], ExitCode.USAGE, "--out names no folder (it is only spaces)"),
     ],
 )
 def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, code, said, tmp_path, monkeypatch, capsys):

@@ -13,6 +13,7 @@ from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Footer, Input, Label, Select, Static
 
+from ...errors import shown_name
 from ...io.inputs import expand_user
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
@@ -151,15 +152,15 @@ def preset_path_problem(text: str, folder: Path | None = None) -> tuple[Path | N
 
 def _checked_path(path: Path, folder: Path | None) -> tuple[Path | None, str]:
     if path.is_dir():  # before .yaml is added: a folder typed was saved as <folder>.yaml beside it
-        return None, f"path: {path} is a folder; give a file name"
+        return None, f"path: {shown_name(path)} is a folder; give a file name"
     if path.suffix not in (".yaml", ".yml"):
         path = path.with_name(path.name + ".yaml")
     if path.is_dir():
-        return None, f"path: {path} is a folder; give a file name"
+        return None, f"path: {shown_name(path)} is a folder; give a file name"
     if not path.parent.is_dir() and not (folder is not None and made_when_saved(path.parent, folder)):
-        return None, f"path: the folder {path.parent} does not exist"
+        return None, f"path: the folder {shown_name(path.parent)} does not exist"
     if is_builtin(path):  # shipped with frictionlab: read and copied, never replaced
-        return None, f"path: {path} is a built-in preset, never written; give a file of your own"
+        return None, f"path: {shown_name(path)} is a built-in preset, never written; give a file of your own"
     return path, ""
 
 
@@ -201,7 +202,7 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
             return
         if path.exists() and path != self.confirmed:
             self.confirmed = path
-            show_error(error, f"{path} exists: Enter again replaces it, Esc keeps it")
+            show_error(error, f"{shown_name(path)} exists: Enter again replaces it, Esc keeps it")
             return
         self.dismiss(path)
 
@@ -261,7 +262,7 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
             show_error(error, problem)
             return
         if path.exists():
-            show_error(error, f"{path} exists: give another file (a new preset never replaces one)")
+            show_error(error, f"{shown_name(path)} exists: give another file (a new preset never replaces one)")
             return
         template = self.query_one("#new-template", Select).value if self.templates else None
         self.dismiss((name, template, path))

@@ -12,6 +12,7 @@ from textual.containers import Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
+from ...errors import shown_name
 from ..folders import PresetEntry, list_presets
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..text import shorten_middle
@@ -45,9 +46,9 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
     def _widths(self, table: DataTable) -> tuple[int, int, int]:
         """The name, folder and file columns' widths: all three on screen, a long name or file
         name cut in its middle, the name given at least half of what the folder leaves."""
-        names = max((len(e.name) for e in self.presets), default=4)
+        names = max((len(shown_name(e.name)) for e in self.presets), default=4)
         labels = max((len(e.label) for e in self.presets), default=6)
-        files = max((len(e.path.name) for e in self.presets), default=4)
+        files = max((len(shown_name(e.path.name)) for e in self.presets), default=4)
         if self.size.width == 0:  # not laid out yet: filled again once it is (on_resize)
             return names, labels, files
         room = self.size.width - 6 * table.cell_padding - table.styles.scrollbar_size_vertical
@@ -65,7 +66,7 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
         table.add_column("folder", width=folder)
         table.add_column("file", width=file)
         for entry in self.presets:  # Text: never markup
-            table.add_row(*(Text(shorten_middle(text, width)) for text, width in
+            table.add_row(*(Text(shorten_middle(shown_name(text), width)) for text, width in
                             ((entry.name, name), (entry.label, folder), (entry.path.name, file))))  # fmt: skip
         if self.presets:
             table.move_cursor(row=min(max(row, 0), len(self.presets) - 1), animate=False)

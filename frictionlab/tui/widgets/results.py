@@ -16,7 +16,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
-from ...errors import FrictionlabError, shown
+from ...errors import FrictionlabError, shown, shown_name
 from ...compute.fit import format_interval
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
@@ -76,7 +76,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             return 12
         overflows = len(self.runs) + 1 > table.size.height  # the header row, then the runs
         gutter = table.styles.scrollbar_size_vertical if overflows else 0
-        longest = max((len(entry.path.name) for entry in self.runs), default=0)
+        longest = max((len(shown_name(entry.path.name)) for entry in self.runs), default=0)
         share = max(LIST_MIN, int(self.size.width * LIST_SHARE))
         width = max(share, min(longest + others + gutter, self.size.width - CHART_MIN))
         table.styles.width = width
@@ -174,7 +174,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 self.query_one("#runs-table").focus()
             self._close_sweep()
         self.overlay = [entry for entry in self.overlay if entry not in gone]
-        self._show_overlay(note=f"Removed from disk since opened: {', '.join(map(shown, removed))}.")
+        self._show_overlay(note=f"Removed from disk since opened: {', '.join(map(shown_name, removed))}.")
 
     def _fill(self) -> None:
         """The list of runs, each name shortened from the middle to the width the list has."""
@@ -200,7 +200,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             else:
                 a = f"{entry.a:.4f}" if math.isfinite(entry.a) else "-"
                 b = f"{entry.b:.4f}" if math.isfinite(entry.b) else "-"
-            name = Text(shorten_run_name(entry.path.name, width))  # Text: never markup
+            name = Text(shorten_run_name(shown_name(entry.path.name), width))  # Text: never markup
             table.add_row(STATUS_MARKS.get(entry.status, "?"), name, a, b)
         if self.runs:
             table.move_cursor(row=min(max(row, 0), len(self.runs) - 1), animate=False)
@@ -228,12 +228,12 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             if entry.status == "damaged":  # nothing to show but why: no sweep's points or curves beside it
                 self._close_sweep()
                 self.query_one("#results-chart", Chart).show([])
-                self.app.say(f"{shown(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
-                self._inform(Content(f"{shown(entry.path.name)}: damaged\n{entry.reason}"))
+                self.app.say(f"{shown_name(entry.path.name)} is damaged: {entry.reason}", "warning", about=entry.path)
+                self._inform(Content(f"{shown_name(entry.path.name)}: damaged\n{entry.reason}"))
                 self._info_about = entry.path
                 return
             if entry.status == "running" and overlay:  # Space is not listed there: say why, as a hidden key does
-                self.app.say(f"{shown(entry.path.name)} is running: it has no curve to compare until it ends; "
+                self.app.say(f"{shown_name(entry.path.name)} is running: it has no curve to compare until it ends; "
                              "Enter shows it live on the Run tab", "warning", about=entry.path)  # fmt: skip
                 return
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
@@ -241,7 +241,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 return
             if isinstance(entry, SweepEntry):
                 if overlay:
-                    self.app.say(f"{entry.path.name} is a sweep: Enter lists its points, Space on a point overlays it.",
+                    self.app.say(f"{shown_name(entry.path.name)} is a sweep: Enter lists its points, Space on a point overlays it.",
                                  "warning", about=entry.path)
                 else:
                     self._show_sweep(entry)
@@ -258,7 +258,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             self.overlay = [entry]
         self._show_overlay()
         if hidden is not None and not self.overlay:  # its data is there: "no data yet" said otherwise
-            name = shown(hidden.path.name)
+            name = shown_name(hidden.path.name)
             self.query_one("#results-chart", Chart).show([], empty="run hidden")
             self._inform(
                 Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
@@ -289,7 +289,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             try:
                 curve = read_curve(entry.path)
             except (OSError, FrictionlabError) as exc:
-                lines.append(Content.assemble((entry.path.name, style), f": no curve ({exc})"))
+                lines.append(Content.assemble((shown_name(entry.path.name), style), f": no curve ({shown(str(exc))})"))
                 continue
             f, xi = np.array(curve.get("f", []), float), np.array(curve.get("xi", []), float)
             series.append(Series(f, xi, style))
@@ -316,7 +316,7 @@ def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
     columns, broken between its parts (at 60x20 the box has 20)."""
     counts = entry.contact_counts
     formula = f"f = {entry.formula}" if entry.formula else ""
-    name = f"■ {entry.path.name}"
+    name = f"■ {shown_name(entry.path.name)}"
     if len(name) + 1 + len(formula) <= width or not formula:
         lines = [Content.assemble((shorten_run_name(name, width), style), f" {formula}" if formula else "")]
     else:

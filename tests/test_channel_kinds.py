@@ -1,0 +1,78 @@
+"""A channel of an instrument file whose values are no heights is refused in any reader, by
+name: SurfaceTopography's IBW and MI readers list an AFM's current, voltage and phase channels
+beside its heights (each with a kind), and such a channel, picked with ``channel:`` or the
+file's default, was read as heights of 1 m per ampere or volt. (Gwyddion's A, the ampere its
+reader takes for the angstrom, was refused alone.)"""
+
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("SurfaceTopography")
+
+from SurfaceTopography.IO.Reader import ChannelInfo, DataKind, data_kind_from_unit  # noqa: E402
+
+from frictionlab_spectra import SurfaceFile  # noqa: E402
+from frictionlab_spectra.instrument_reader import check_channel_of_heights  # noqa: E402
+
+from .test_scan_edge_cases import rough, write_gwy  # noqa: E402
+
+
+class Listing:
+    """A reader (IBW's, an Asylum file) that lists heights, a current in A, a bias in V and a
+    phase in deg, each with the kind SurfaceTopography gives it."""
+
+    def __init__(self, real=None, units=(("Height", "m"), ("Current", "A"), ("Bias", "V"), ("Phase", "deg"))):
+        self.real = real
+        self.channels = [
+            ChannelInfo(self, i, name=name, dim=2, nb_grid_pts=(16, 16), unit="m", data_unit=unit,
+                        data_kind=data_kind_from_unit(unit, name, ascii_angstrom=False))
+            for i, (name, unit) in enumerate(units)
+        ]  # fmt: skip
+        self.default_channel = self.channels[0]
+
+    @classmethod
+    def format(cls):
+        return "ibw"
+
+    @classmethod
+    def name(cls):
+        return "Igor binary wave (IBW)"
+
+    def close(self):
+        if self.real is not None:
+            self.real.close()
+
+
+@pytest.mark.parametrize(("index", "said"), [
+    (1, "channel 1 ('Current') holds current values in 'A', not heights"),
+    (2, "channel 2 ('Bias') holds voltage values in 'V', not heights"),
+    (3, "channel 3 ('Phase') holds phase values in 'deg', not heights"),
+])  # fmt: skip
+def test_a_channel_of_another_kind_is_refused_naming_the_channels_of_heights(index, said):
+    reader = Listing()
+    assert [c.data_kind for c in reader.channels][1] == DataKind.CURRENT  # IBW's A is the ampere
+    with pytest.raises(ValueError, match="^scan: " + said.replace("(", r"\(").replace(")", r"\)")) as refused:
+        check_channel_of_heights(reader, reader.channels[index], "scan")
+    assert "choose a channel of heights with channel (0: 'Height')" in str(refused.value)
+    check_channel_of_heights(reader, reader.channels[0], "scan")  # heights pass
+
+
+def test_a_reader_without_kinds_is_judged_by_the_unit_of_its_values():
+    """A reader that gives no kind (or an older SurfaceTopography): a unit that is no length refuses."""
+    reader = Listing(units=(("Z", "V"),))
+    for channel in reader.channels:
+        channel._data_kind = None
+    with pytest.raises(ValueError, match=r"channel 0 \('Z'\) holds values in 'V', not heights: the file holds no "):
+        check_channel_of_heights(reader, reader.channels[0], "scan")
+    for unit in ("nm", "um", "\u00b5m", "\u00c5", None):
+        check_channel_of_heights(Listing(units=(("Z", unit),)), Listing(units=(("Z", unit),)).channels[0], "scan")
+
+
+@pytest.mark.parametrize("channel", [1, "Bias"])
+def test_a_surface_file_refuses_a_current_or_voltage_channel_its_reader_lists(tmp_path, monkeypatch, channel):
+    """The refusal reaches the spectrum's message, by index or by name."""
+    path = write_gwy(tmp_path / "afm.gwy", rough(16, 16, 4) * 1e-9, 1e-9, 1e-9)
+    monkeypatch.setattr("frictionlab_spectra.instrument_file._open_reader", lambda fh, path, where: Listing())
+    with pytest.raises(ValueError, match=r"afm.gwy': channel \d \('(Current|Bias)'\) holds (current|voltage) values"):
+        SurfaceFile(path=str(path), unit="nm", channel=channel).rms_height()
