@@ -110,7 +110,8 @@ def test_a_finished_run_of_another_preset_is_refused_and_the_same_preset_reruns(
     err = capsys.readouterr().err
     assert "holds a finished run of another preset (it differs in seed, spectrum.params.hurst)" in err
     assert tree(out) == before
-    assert main(["run", str(first), "--out", str(out), "--quiet"]) == ExitCode.OK  # the same preset: rerun
+    with pytest.warns(UserWarning, match="holds a completed run of this preset: it runs again"):
+        assert main(["run", str(first), "--out", str(out), "--quiet"]) == ExitCode.OK  # the same preset: rerun
     assert main(["run", str(other), "--out", str(out), "--quiet", "--force"]) == ExitCode.OK
     assert json.loads((out / "summary.json").read_text())["seed"] == 8
 
@@ -295,7 +296,8 @@ def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
     assert "is not empty and is not the folder of a frictionlab sweep" in capsys.readouterr().err
     assert [p.name for p in folder.iterdir()] == ["notes.txt"]
     assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OK
-    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet", "--no-plot"]) == ExitCode.OK  # its own: rerun
+    with pytest.warns(UserWarning, match="holds a completed run of this preset: it runs again"):  # each point of its own
+        assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--quiet", "--no-plot"]) == ExitCode.OK  # its own: rerun
     other = write(tmp_path / "t.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
         "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
     assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
@@ -314,7 +316,8 @@ def test_a_figure_that_cannot_be_written_fails_the_command_but_the_run_is_finish
     err = capsys.readouterr().err
     assert "cannot write" in err and "plot.png" in err and "the numbers are written" in err
     assert _status(out) == "completed" and json.loads((out / "summary.json").read_text())["status"] == "completed"
-    assert main(["run", str(preset), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK  # not "unfinished"
+    with pytest.warns(UserWarning, match="holds a completed run of this preset: it runs again"):
+        assert main(["run", str(preset), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK  # not "unfinished"
 
 
 def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):

@@ -377,7 +377,8 @@ def test_a_summary_that_is_a_link_to_a_user_file_is_replaced_not_written_through
     for name in ("summary.json", "curve.csv", "preset.yaml"):
         (folder / name).unlink()
         (folder / name).symlink_to(user)
-    frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)  # the same preset: rerun in place
+    with pytest.warns(UserWarning, match="holds a completed run of this preset: it runs again"):
+        frictionlab.run(QUICK, out=folder, workers=1, progress=False, plot=False)  # the same preset: rerun in place
     assert user.read_text() == SECRET
     assert not any((folder / name).is_symlink() for name in ("summary.json", "curve.csv", "preset.yaml"))
     assert frictionlab.load(folder).status == "completed"

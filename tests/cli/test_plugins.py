@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 
@@ -29,7 +31,8 @@ def test_a_name_two_plugins_claim_is_named_and_other_presets_still_validate(caps
         fake_dists(dist, dist, module, GOOD_SOURCE.format(cls="Twin", name="twin-line"))
     registry_module.default_registry.cache_clear()
     try:
-        assert main(["plugins"]) == ExitCode.OK
+        with pytest.warns(RuntimeWarning, match="two spectrum plugins are named 'twin-line'"):
+            assert main(["plugins"]) == ExitCode.OK
         captured = capsys.readouterr()
         assert "twin-line" not in captured.out and "power-law" in captured.out
         assert "not listed: two spectrum plugins are named 'twin-line': acme_" in captured.err
