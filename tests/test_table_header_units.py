@@ -131,7 +131,7 @@ def test_a_channel_that_is_not_heights_asked_by_name_is_told_why_it_is_not_liste
         blocks.append(f"# Channel: {name}\n# Width: 1.6 µm\n# Height: 1.2 µm\n# Value units: {unit}\n{rows}")
     (tmp_path / "three.txt").write_text("".join(blocks), encoding="utf-8")
     with pytest.raises(ValueError, match=r"no channel named 'Phase'; the file has 0: 'Height', 1: 'Height retrace' "
-                       r"\(channels of heights only: one in degrees, volts or no unit is not read\)"):  # fmt: skip
+                       r"\(most readers list channels of heights only: one in degrees, volts or no unit may be left out\)"):  # fmt: skip
         SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Phase").rms_height()
     retrace = SurfaceFile(path=str(tmp_path / "three.txt"), format="instrument", channel="Height retrace", unit="um")
     assert retrace.generate(None).spacing == pytest.approx(0.1, rel=1e-9)

@@ -445,8 +445,8 @@ def pick_channel(reader, wanted: str | int | None, where: str):
         named = [c for c in channels if str(c.name) == wanted]
         if not named:
             raise ValueError(f"{where}: no channel named {quoted(wanted)}; the file has {_named(channels)}"
-                             f"{_near_names(channels, wanted)} (channels of heights only: one in degrees, volts or "
-                             "no unit is not read)")  # fmt: skip
+                             f"{_near_names(channels, wanted)} (most readers list channels of heights only: one in "
+                             "degrees, volts or no unit may be left out)")  # fmt: skip
         channel = named[0]
     same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
     note = None
