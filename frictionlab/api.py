@@ -55,7 +55,6 @@ from .compute.signals import RunInterrupted, interrupted_since, mark
 from .options import RunOptions
 from .runs.results import CORRECTED_AREA, column_units, curve_headers, read_curve_table, read_summary
 from .runs.runfolder import check_searchable, subfolder
-from .runs.sweeprecord import own_point, read_sweep_record
 
 if TYPE_CHECKING:
     from .compute.ensemble import RunOutcome
@@ -177,6 +176,8 @@ class SweepResult:
     def points(self) -> list[Result]:
         """The ``Result`` of each point with a fit, read from its folder: an interrupted
         point's too (its ``status`` says so); a pending or failed one has none."""
+        from .runs.sweeprecord import own_point  # a sweep's record: only where a sweep is read
+
         return [own_point(load(subfolder(self.folder, row["folder"])), self.name, row, self.parameters)
                 for row in self.rows if row.get("a") is not None]  # never another run moved into its folder
 
@@ -490,6 +491,8 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 
 def _load_sweep(folder: Path) -> SweepResult:
+    from .runs.sweeprecord import read_sweep_record
+
     summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k != "set"} for point in summary["points"]]
     return SweepResult(

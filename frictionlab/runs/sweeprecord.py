@@ -9,6 +9,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, ValidationError
 
 from ..errors import RunFolderError, shown, shown_name
+from ..preset.paths import MISSING, get_path
 from ..preset.schema import SweepSettings
 from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
 
@@ -70,22 +71,16 @@ def own_point(point, name: str, row: dict, parameters: list[str]):
     """``point`` (a run read back from a point's folder: its ``folder``, its resolved ``preset``) if it
     is that ``row``'s point of sweep ``name``, else RunFolderError: another run moved into its place
     would be read as it."""
-    folder, preset = point.folder, point.preset
-    told = [("name", preset.get("name"), name)]
+    preset = point.preset
+    wrong = [] if preset.get("name") == name else [("name", preset.get("name"), name)]
     for path in parameters:  # a swept value as the row holds it; a mapping or list is filled in by the reader
-        value, node = row.get(path), preset
-        for key in path.split("."):
-            node = node.get(key, _MISSING) if isinstance(node, dict) else _MISSING
-        if node is not _MISSING and isinstance(value, (str, int, float, bool)) and value != node:
-            told.append((path, node, value))
-    wrong = [(field, held, wanted) for field, held, wanted in told if held != wanted]
+        value, held = row.get(path), get_path(preset, path)
+        if held is not MISSING and isinstance(value, (str, int, float, bool)) and value != held:
+            wrong.append((path, held, value))
     if wrong:
         field, held, wanted = wrong[0]
         raise RunFolderError(
-            f"{shown(folder)} holds another run than point {row.get('point')} of sweep {name!r} (its {field} is "
+            f"{shown(point.folder)} holds another run than point {row.get('point')} of sweep {name!r} (its {field} is "
             f"{held!r}, the point's {wanted!r}): move it aside, then resume the sweep to compute the point afresh"
         )
     return point
-
-
-_MISSING = object()
