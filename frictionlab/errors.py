@@ -229,12 +229,17 @@ def resume_hint(folder) -> str:
 
 
 def command_word(path) -> str:
-    """``path`` as a word of a command to copy (``shown_name``): after ./ where it starts with '-'
-    (`frictionlab resume -r2` takes it for an option), quoted where a shell splits it (a space)."""
+    """``path`` as a word of a command to copy (``shown_name``, ``not_an_option``), quoted where a
+    shell splits it (a space)."""
     import shlex
 
-    said = shown_name(path)
-    return shlex.quote(f"./{said}" if said.startswith("-") else said)
+    return shlex.quote(not_an_option(shown_name(path)))
+
+
+def not_an_option(name: str) -> str:
+    """A name as a word a command takes back as a name: ./-r2, not -r2 (`frictionlab resume -r2`
+    takes it for an option)."""
+    return f"./{name}" if name.startswith("-") else name
 
 
 def counted(count: int, noun: str) -> str:

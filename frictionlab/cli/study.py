@@ -8,7 +8,7 @@ import math
 import shlex
 import sys
 
-from ..errors import ExitCode, FrictionlabError, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, not_an_option, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 
 
@@ -143,7 +143,7 @@ def options_from_args(args) -> StudyOptions:
 
 def command_line(args) -> str:
     """The command as a user would type it: the preset and every option that differs from its default."""
-    words = ["frictionlab", "study", _not_an_option(args.preset)]
+    words = ["frictionlab", "study", not_an_option(args.preset)]
     for assignment in args.set or []:
         words += ["--set", assignment]
     if args.seed is not None:
@@ -153,16 +153,11 @@ def command_line(args) -> str:
         if value != default:
             words += [f"--{dest.replace('_', '-')}", str(value)]
     if args.out:
-        words += ["--out", _not_an_option(args.out)]
+        words += ["--out", not_an_option(args.out)]
     if args.force:
         words.append("--force")
     # a folder name that is not UTF-8 is shown with its bytes escaped (the page is UTF-8 text), on one line
     return shlex.join(shown_name(w) for w in words)
-
-
-def _not_an_option(path: str) -> str:
-    """A path as a word the command takes back: ./-r2, not -r2 (an option)."""
-    return f"./{path}" if path.startswith("-") else path
 
 
 def run(args) -> ExitCode:
