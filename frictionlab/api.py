@@ -177,7 +177,6 @@ class SweepResult:
         """The ``Result`` of each point with a fit, read from its folder: an interrupted
         point's too (its ``status`` says so); a pending or failed one has none."""
         from .runs.sweeprecord import own_point  # a sweep's record: only where a sweep is read
-
         return [own_point(load(subfolder(self.folder, row["folder"])), self.name, row, self.parameters)
                 for row in self.rows if row.get("a") is not None]  # never another run moved into its folder
 
@@ -492,7 +491,6 @@ def load(folder: str | Path) -> Result | SweepResult:
 
 def _load_sweep(folder: Path) -> SweepResult:
     from .runs.sweeprecord import read_sweep_record
-
     summary, record = read_sweep_record(folder)
     rows = [{k: v for k, v in point.items() if k != "set"} for point in summary["points"]]
     return SweepResult(
