@@ -256,19 +256,48 @@ def test_a_sweep_on_dask_runs_without_tracebacks_or_a_hang(tmp_path, workers):
     assert all(row["status"] == "completed" or "would need about" in row["error"] for row in rows), rows
 
 
-def test_openblas_and_malloc_spare_address_space_under_a_process_limit_unless_told(monkeypatch):
+def test_malloc_arenas_are_held_back_under_a_process_limit_unless_told(monkeypatch):
     from frictionlab.compute import heap
 
-    for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS", "MALLOC_ARENA_MAX"):
-        monkeypatch.setenv(name, "")  # set, then removed: each is given back as it was after the test
-        monkeypatch.delenv(name)
+    monkeypatch.setenv("MALLOC_ARENA_MAX", "")  # set, then removed: given back as it was after the test
+    monkeypatch.delenv("MALLOC_ARENA_MAX")
     monkeypatch.setattr(heap, "process_limit", lambda: None)
     heap.spare_address_space_under_a_limit()
-    assert "OPENBLAS_NUM_THREADS" not in os.environ and "MALLOC_ARENA_MAX" not in os.environ  # no limit
+    assert "MALLOC_ARENA_MAX" not in os.environ  # no limit
     monkeypatch.setattr(heap, "process_limit", lambda: (2**30, "-v"))
-    monkeypatch.setenv("OMP_NUM_THREADS", "4")
+    monkeypatch.setenv("MALLOC_ARENA_MAX", "8")
     heap.spare_address_space_under_a_limit()
-    assert "OPENBLAS_NUM_THREADS" not in os.environ  # the user's count stands
-    monkeypatch.delenv("OMP_NUM_THREADS")
+    assert os.environ["MALLOC_ARENA_MAX"] == "8"  # the user's count stands
+    monkeypatch.delenv("MALLOC_ARENA_MAX")
     heap.spare_address_space_under_a_limit()
-    assert (os.environ["OPENBLAS_NUM_THREADS"], os.environ["MALLOC_ARENA_MAX"]) == ("1", "2")
+    assert os.environ["MALLOC_ARENA_MAX"] == "2"
+
+
+@pytest.mark.parametrize("chosen", [None, "OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"])
+def test_the_command_runs_openblas_on_one_thread_unless_the_user_chose_a_count(chosen):
+    """Set before numpy is imported (OpenBLAS reads it as it loads), in the command's process
+    whatever its memory limit: what the command's own code then finds, and what numpy's
+    OpenBLAS runs with."""
+    script = (
+        "import importlib, json, sys\n"
+        "command = importlib.import_module('frictionlab.cli.main')  # the package names its function main too\n"
+        "def main(argv=None):\n"
+        "    before = 'numpy' in sys.modules\n"
+        "    import os, numpy, threadpoolctl\n"
+        "    blas = [lib['num_threads'] for lib in threadpoolctl.threadpool_info() if lib['internal_api'] == 'openblas']\n"
+        "    print(json.dumps([before, os.environ.get('OPENBLAS_NUM_THREADS'), blas]))\n"
+        "    return 0\n"
+        "command.main = main\n"
+        "sys.argv = ['frictionlab', 'validate', 'quickstart']\n"
+        "command.program()\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")}
+    if chosen:
+        env[chosen] = "2"
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    numpy_before, told, blas = json.loads(done.stdout.strip().splitlines()[-1])
+    assert not numpy_before and blas
+    if chosen is None:
+        assert told == "1" and blas == [1] * len(blas)
+    else:
+        assert told == (None if chosen != "OPENBLAS_NUM_THREADS" else "2")  # left as the user set it

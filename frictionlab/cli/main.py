@@ -31,7 +31,7 @@ import warnings
 
 from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
                       output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
-from ..compute.heap import spare_address_space_under_a_limit, keep_freed_memory
+from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -253,7 +253,8 @@ def program() -> None:
     # Python's defaults: it lives long, and wants many short pauses rather than a few long.
     if sys.argv[1:2] != ["tui"]:
         gc.set_threshold(100_000, 20, 20)
-    spare_address_space_under_a_limit()  # before numpy is imported
+    one_blas_thread_unless_chosen()  # before numpy is imported
+    spare_address_space_under_a_limit()
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))

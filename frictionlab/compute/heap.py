@@ -1,6 +1,6 @@
 """Freed memory kept for the next realization instead of handed back to the system at once;
-and, under a process limit on memory, address space reserved and never used held back
-(``spare_address_space_under_a_limit``).
+OpenBLAS on one thread (``one_blas_thread_unless_chosen``); and, under a process limit on
+memory, address space reserved and never used held back (``spare_address_space_under_a_limit``).
 
 glibc hands a freed block of more than 128 kB straight back to the system (and trims the
 heap's top past a threshold it sets from the blocks seen), and the next realization's
@@ -47,24 +47,32 @@ def _mallopt(parameter: int, value: int) -> bool:
     return mallopt(parameter, value) == 1
 
 
-def spare_address_space_under_a_limit() -> None:
-    """Under a process limit on memory (``ulimit -v``, ``ulimit -d``), what reserves address
-    space it never uses is held back, unless the user chose otherwise in the environment:
-
-    * OpenBLAS starts no threads of its own (``OPENBLAS_NUM_THREADS=1``): at import it reserves
-      a buffer of 32 to 64 MiB per thread, one per core, and when that does not fit it spins for
-      ever inside the import, deaf to SIGTERM, or exits printing 'OpenBLAS error: Memory
-      allocation still failed'. frictionlab's own BLAS work runs on one thread anyway (the fit;
-      the solvers use FFTs);
-    * glibc keeps ``ARENAS`` malloc arenas, not 8 per core of 64 MiB each: a Dask cluster's
-      threads took 1 GiB of address space in the main process (0.4 GiB with 2 arenas), and a
-      sweep on Dask ran out of it under ulimit -v 700000 ("can't start new thread"), then hung.
+def one_blas_thread_unless_chosen() -> None:
+    """OpenBLAS starts no threads of its own (``OPENBLAS_NUM_THREADS=1``) unless the user set
+    its thread count in the environment. Its threads, started as numpy is imported (in the
+    command's process and again in each worker it forks), spin for a while after each wake:
+    a Fig. 2 run took 1.03 s of CPU with them and 0.87 s without, time taken from the workers
+    on a machine with as many cores as workers. frictionlab's own BLAS work runs on one thread
+    anyway (the fit; the solvers use FFTs, the pool's workers one core each). Under a process
+    limit on memory it matters more: at import OpenBLAS reserves a buffer of 32 to 64 MiB per
+    thread, one per core, and when that does not fit it spins for ever inside the import, deaf
+    to SIGTERM, or exits printing 'OpenBLAS error: Memory allocation still failed'.
 
     Before numpy is imported; the process's children inherit the environment."""
-    if process_limit() is None:
-        return
     if not any(os.environ.get(name) for name in ("OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS")):
         os.environ["OPENBLAS_NUM_THREADS"] = "1"  # the variables OpenBLAS reads, in order
+
+
+def spare_address_space_under_a_limit() -> None:
+    """Under a process limit on memory (``ulimit -v``, ``ulimit -d``), glibc keeps ``ARENAS``
+    malloc arenas, not 8 per core of 64 MiB each, unless the user chose otherwise in the
+    environment: a Dask cluster's threads took 1 GiB of address space in the main process
+    (0.4 GiB with 2 arenas), and a sweep on Dask ran out of it under ulimit -v 700000
+    ("can't start new thread"), then hung.
+
+    Before threads start; the process's children inherit the environment."""
+    if process_limit() is None:
+        return
     if not os.environ.get("MALLOC_ARENA_MAX"):
         os.environ["MALLOC_ARENA_MAX"] = str(ARENAS)  # children: glibc reads it as they start
         _mallopt(M_ARENA_MAX, ARENAS)  # this process, started already
