@@ -51,7 +51,7 @@ def test_study(odd, capsys):
 def test_run_and_resume(odd, tmp_path, capsys):
     said_on_one_line(capsys, ["run", "quickstart", "--out", str(odd)], 4)
     said_on_one_line(capsys, ["resume", str(odd)], 5)
-    said_on_one_line(capsys, ["runs", str(odd / "other")], 5)
+    said_on_one_line(capsys, ["runs", str(odd / "other")], 2)
     said_on_one_line(capsys, ["presets", "copy", "quickstart", str(odd / "other")], 4)
 
 
