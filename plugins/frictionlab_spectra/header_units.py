@@ -125,7 +125,7 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> str |
             f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "
             "instrument's text export (Gwyddion's, say) does, and a table's numbers are read bare, without them: "
             "read it with format: instrument, which takes the units and the pixel size from the header (or with "
-            "format: table, spacing and unit, for its bare numbers)"
+            "format: table and spacing, for its bare numbers in the unit it states for its values)"
         )
     if export:  # with format: table, an instrument's export asked for its bare numbers: its values' unit is theirs
         units = values_units(head)
