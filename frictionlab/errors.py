@@ -229,11 +229,35 @@ def resume_hint(folder) -> str:
 
 
 def command_word(path) -> str:
-    """``path`` as a word of a command to copy (``shown_name``, ``not_an_option``), quoted where a
-    shell splits it (a space)."""
+    """``path`` as a word of a command to copy (``not_an_option``, ``shell_word``)."""
+    return shell_word(not_an_option(os.fsdecode(path)))
+
+
+def shell_word(word: str) -> str:
+    """``word`` as bash takes it back, pasted into a command: quoted where a shell splits it (a
+    space), and, where it holds what ``shown_name`` escapes (bytes that are not UTF-8, control
+    characters, a line break), in bash's $'...' with those escaped: ``shown_name``'s ``\\xff``
+    inside plain quotes named another folder, one with a backslash in its name."""
     import shlex
 
-    return shlex.quote(not_an_option(shown_name(path)))
+    if shown_name(word) == word:  # printable UTF-8
+        return shlex.quote(word)
+    return "$'" + "".join(map(_ansi_c, word)) + "'"
+
+
+def _ansi_c(char: str) -> str:
+    """One character of a word in bash's $'...': a byte that is not UTF-8 (a lone surrogate, as
+    Python decodes it) as \\xHH, a character ``shown_name`` escapes as its code, quote and backslash escaped."""
+    code = ord(char)
+    if 0xDC80 <= code <= 0xDCFF:
+        return f"\\x{code - 0xDC00:02x}"
+    if char in "\\'":
+        return "\\" + char
+    if code in _LINES:
+        return _LINES[code]
+    if code in _CONTROL:  # $'\x85' would be the byte, not the character U+0085
+        return f"\\x{code:02x}" if code < 0x80 else f"\\u{code:04x}"
+    return char
 
 
 def not_an_option(name: str) -> str:

@@ -345,3 +345,12 @@ def test_follow_of_a_link_the_user_named_follows_the_folder_as_resume_does(tmp_p
     (tmp_path / "file-link").symlink_to(tmp_path / "run" / "summary.json")  # a link to a file is still no run folder
     assert main(["follow", "--quiet", str(tmp_path / "file-link")]) == 5
     assert "is not a run folder" in capsys.readouterr().err
+
+
+def test_runs_of_a_folder_that_does_not_exist_is_a_usage_error(tmp_path, capsys):
+    """`frictionlab runs /missing/dir` exited 5, the code of a run folder that cannot be used: a
+    folder named on the command line that does not exist is a bad argument (2), as exact3d's --runs."""
+    (tmp_path / "file").write_text("")
+    for name, what in (("missing", "does not exist"), ("file", "is not a folder")):
+        assert main(["runs", str(tmp_path / name)]) == 2
+        assert capsys.readouterr().err == f"error: DIR: {tmp_path / name} {what}: give the folder that holds run folders\n"

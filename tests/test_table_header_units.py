@@ -200,3 +200,49 @@ def test_a_header_in_inches_is_refused_not_read_bare(tmp_path, header, named):
     heights = "".join(f"{float(v)!r}\n" for v in rough(1, 32)[0])
     (tmp_path / "word.csv").write_text("z (in um)\n" + heights)  # "in" as a word, not a unit
     assert ProfileFile(path=str(tmp_path / "word.csv"), unit="um", spacing=0.5).generate(None).heights.size == 32
+
+
+def test_a_table_takes_the_length_unit_its_header_names_when_the_preset_gives_none(tmp_path, capsys):
+    """'x [um],z [um]' or 'z [nm]' over a table with no unit in the preset: the numbers were
+    taken as bare numbers ('no unit') without a word; the header's unit is theirs, and said so."""
+    x, z = np.arange(32) * 0.5, rough(1, 32, 10)[0]
+    (tmp_path / "line.csv").write_text("x [um],z [um]\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    (tmp_path / "map.csv").write_text("z [nm]\n" + "".join(",".join(map(repr, row.tolist())) + "\n" for row in rough(9, 10)))
+    (tmp_path / "bare.csv").write_text("x,z\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, z)))
+    line = ProfileFile(path=str(tmp_path / "line.csv")).input_summary()
+    assert (line["unit"], line["unit_from"], line["spacing"]) == ("um", "header", pytest.approx(0.5))
+    surface = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).input_summary()
+    assert (surface["unit"], surface["unit_from"]) == ("nm", "header")
+    bare = ProfileFile(path=str(tmp_path / "bare.csv")).input_summary()  # no unit named: as before
+    assert (bare["unit"], bare["unit_from"]) == (None, "none")
+    given = ProfileFile(path=str(tmp_path / "line.csv"), unit="\u00b5m").input_summary()
+    assert (given["unit"], given["unit_from"]) == ("um", "preset")
+    spectrum = {"name": "profile-file", "params": {"path": str(tmp_path / "line.csv")}}
+    preset = {"name": "line", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
+              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+    assert "32 points of 0.5 um (from the file), rms height" in (out := capsys.readouterr().out)
+    assert "unit um from the file's header" in out and "no unit" not in out
+
+
+def test_an_export_read_as_a_table_takes_the_unit_its_header_states_for_its_values(tmp_path):
+    """Gwyddion's export read with format: table: its values in nm were bare numbers without a
+    word, and with unit: um taken as micrometres; its sizes' unit (Width: µm) is no height's."""
+    path = gwyddion_text(tmp_path / "scan.txt", rough(12, 16, 11), 0.1, value_unit="nm", scale=1e3)
+    read = SurfaceFile(path=str(path), spacing=100.0, format="table").input_summary()
+    assert (read["unit"], read["unit_from"]) == ("nm", "header")
+    with pytest.raises(ValueError, match=r"its header names the length unit nm, .* the preset's unit, um; set unit: nm"):
+        SurfaceFile(path=str(path), spacing=0.1, unit="um", format="table").rms_height()
+    assert SurfaceFile(path=str(path), spacing=100.0, unit="nm", format="table").input_summary()["unit_from"] == "preset"
+
+
+def test_a_text_export_takes_the_unit_its_header_names_when_its_reader_gives_none(tmp_path):
+    """An x, y, z export under '# x [um] y [um] z [um]' read with no unit: SurfaceTopography's
+    reader skips the header, and the scan was 'no unit (bare numbers)'."""
+    z = rough(9, 10, 12)
+    write_points(tmp_path / "scan.xyz", z, 0.5, 0.5)
+    read = SurfaceFile(path=str(tmp_path / "scan.xyz"), detrend="none")
+    summary = read.input_summary()
+    assert (summary["unit"], summary["unit_from"]) == ("um", "header")
+    np.testing.assert_allclose(read.generate(None).heights, z, rtol=0, atol=1e-12)  # as read: not converted

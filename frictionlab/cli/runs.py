@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExitCode, RunFolderError, command_word, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, command_word, shown, shown_name
 
 EXAMPLES = """examples:
   frictionlab runs                            the runs under runs/
@@ -37,7 +37,8 @@ def run(args) -> ExitCode:
     runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
     if args.runs_dir is not None and not runs_dir.is_dir():
         what = "is not a folder" if runs_dir.exists() else "does not exist"
-        raise RunFolderError(f"DIR: {shown_name(runs_dir)} {what}: give the folder that holds run folders")
+        # a bad argument (exit 2, as exact3d's --runs), not a run folder that cannot be used (5)
+        raise FrictionlabError(f"DIR: {shown_name(runs_dir)} {what}: give the folder that holds run folders")
     states = list_run_states(runs_dir)
     if args.json:
         from .jsonout import emit

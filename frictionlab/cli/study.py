@@ -5,10 +5,9 @@ command line: its options, checked, and the run. Heavy modules are imported insi
 from __future__ import annotations
 
 import math
-import shlex
 import sys
 
-from ..errors import ExitCode, FrictionlabError, not_an_option, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, not_an_option, shell_word, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 
 
@@ -156,8 +155,8 @@ def command_line(args) -> str:
         words += ["--out", not_an_option(args.out)]
     if args.force:
         words.append("--force")
-    # a folder name that is not UTF-8 is shown with its bytes escaped (the page is UTF-8 text), on one line
-    return shlex.join(shown_name(w) for w in words)
+    # a folder name that is not UTF-8 in bash's $'...', its bytes escaped (the page is UTF-8 text), on one line
+    return " ".join(map(shell_word, words))
 
 
 def run(args) -> ExitCode:

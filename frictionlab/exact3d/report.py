@@ -152,7 +152,7 @@ def write_page(
     if not runs.hursts():
         raise FrictionlabError(
             f"{shown_name(runs_dir)} holds no finished exact ensemble with MDR beside it: nothing to write a page from; "
-            f"run the study (without --finished-only) with --runs {shown_name(runs_dir)}"
+            f"run the study (without --finished-only) with --runs {command_word(runs_dir)}"
         )
     numbers = study_numbers(runs)
     log(f"exact3d: {len(runs.ensembles)} ensembles in {format_duration(runs.seconds)}; drawing")

@@ -223,6 +223,8 @@ def describe_input(summary: dict) -> str:
     unit_note = f", converted from the file's {shown(converted)}" if converted and unit and converted != unit else ""
     if "file_unit" in summary and converted is None and unit:  # an instrument file that states no unit
         unit_note = f", the file states no unit: its numbers taken as {unit}"
+    if summary.get("unit_from") == "header":  # a table's bare numbers, in the unit its header names
+        unit_note = f", unit {unit} from the file's header"
     channel = summary.get("channel")
     notes = [f"channel {summary.get('channel_index', '?')} {short_repr(shown(channel))}"] if channel is not None else []
     if summary.get("region_pixels"):

@@ -1,7 +1,8 @@
 """The length units a text file's header names, before its first row of numbers: in a column's
 label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
 ``# Value units: m``). A table's numbers are read bare, so what its header says of their units
-is checked against the preset (``check_table_header``); a text export read by SurfaceTopography
+is checked against the preset, and is their unit where the preset gives none
+(``check_table_header``); a text export read by SurfaceTopography
 is checked the same way where its reader skips the header (``instrument_reader``). A column
 labelled in a unit that is no length (``z [V]``, ``phase [deg]``; a bare ``A`` is the ampere)
 holds no heights, and is refused (``check_heights_are_lengths``)."""
@@ -31,6 +32,8 @@ _SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
 # "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
 _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # keys in any case
+# "# Value units: nm", "z-unit = nm": the unit a text export states for its values, the heights
+_STATED_VALUES = re.compile(rf"\b(?i:value\s+units|z-unit|unit\s+data)\s*[:=]\s*(?P<unit>{_UNITS})\s*$")
 # "# Value units: V": a unit key of an instrument's text export (Gwyddion's) stating one that is no length
 _STATED_NOT_LENGTH = re.compile(rf"\b(?i:{_UNIT_KEYS})\s*[:=]\s*(?P<unit>{NOT_LENGTH})\s*$")
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
@@ -45,14 +48,26 @@ def head_text(fh, encoding: str = "utf-8") -> str:
     return head.decode(encoding, errors="replace")
 
 
+def header_lines(text: str) -> list[str]:
+    """The lines of the header of ``text``: those before the first that starts with a number
+    (the last line of ``text`` left out: it may be cut short)."""
+    lines = text.splitlines()[:-1]
+    return lines[: next((i for i, line in enumerate(lines) if NUMBERS.match(line)), len(lines))]
+
+
+def values_units(text: str) -> list[str]:
+    """The length units the header of ``text`` states for its values (``Value units: nm``,
+    ``z-unit = nm``), not its sizes (``Width: 25.6 µm``): a text export's heights."""
+    stated = (_STATED_VALUES.search(line.rstrip()) for line in header_lines(text))
+    return [LENGTH_UNIT[found["unit"]] for found in stated if found]
+
+
 def named_units(text: str) -> tuple[list[str], bool]:
     """The length units the header of ``text`` (its lines before the first that starts with a
     number) names, in order, and whether it states one by a key of an instrument's text export
     (``Width: 25.6 µm``, ``Value units: m``, ``z-unit = nm``): SurfaceTopography's reader reads them."""
     units, stated_by_key = [], False
-    for line in text.splitlines()[:-1]:  # the last line may be cut short
-        if NUMBERS.match(line):
-            break
+    for line in header_lines(text):
         units += [LENGTH_UNIT.get(unit, unit) for found in _LABEL.findall(line) for unit in found if unit]
         if stated := _STATED.search(line.rstrip()):
             units.append(LENGTH_UNIT[stated["unit"]])
@@ -65,9 +80,7 @@ def not_length_label(text: str) -> tuple[str, str] | None:
     ``height (nA)``, ``phase/deg``: on its last line, over the numbers, not in metadata such as
     ``# Setpoint (%): 50``; ``Value units: V`` on any), and that unit; None when there is none."""
     labels = ""
-    for line in text.splitlines()[:-1]:  # the last line may be cut short
-        if NUMBERS.match(line):
-            break
+    for line in header_lines(text):
         if stated := _STATED_NOT_LENGTH.search(line.rstrip()):
             return line[stated.start() :].strip(), stated["unit"]
         labels = line if line.strip() else labels
@@ -95,11 +108,12 @@ def check_heights_are_lengths(text: str, where: str) -> None:
     )
 
 
-def check_table_header(path, where: str, unit: str | None, format: str) -> None:
-    """Refuse a table (read as bare numbers) whose header says its numbers are not what the
-    preset takes them for: a header of an instrument's text export that states its size or units
-    (read with ``format: auto``), columns in different length units, or one unit other than the
-    preset's ``unit``."""
+def check_table_header(path, where: str, unit: str | None, format: str) -> str | None:
+    """The length unit the header of a table (read as bare numbers) names for them, None if it
+    names none: the table's unit where the preset gives none. Refuse a header that says its
+    numbers are not what the preset takes them for: a header of an instrument's text export that
+    states its size or units (read with ``format: auto``), columns in different length units, or
+    one unit other than the preset's ``unit``."""
     from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
@@ -111,10 +125,12 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> None:
             f"{where}: its header states the scan's units ({', '.join(dict.fromkeys(units))}), as an "
             "instrument's text export (Gwyddion's, say) does, and a table's numbers are read bare, without them: "
             "read it with format: instrument, which takes the units and the pixel size from the header (or with "
-            "format: table, spacing and unit, for its bare numbers)"
+            "format: table and spacing, for its bare numbers in the unit it states for its values)"
         )
-    if not export:  # with format: table, an instrument's export asked for its bare numbers
-        check_units_named(units, unit, where, "which a table's reader does not read")
+    if export:  # with format: table, an instrument's export asked for its bare numbers: its values' unit is theirs
+        units = values_units(head)
+    check_units_named(units, unit, where, "which a table's reader does not read")
+    return units[0] if units else None
 
 
 def check_units_named(units: list[str], unit: str | None, where: str, ignored: str) -> None:

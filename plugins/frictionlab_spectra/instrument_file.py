@@ -193,7 +193,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         check_payload(fh, type(reader), where)
         file_unit = chosen.unit if isinstance(chosen.unit, str) else None
         check_text_heights(fh, type(reader), where)
-        check_header_units(fh, type(reader), file_unit, unit, where)
+        header_unit = check_header_units(fh, type(reader), file_unit, unit, where)
         if file_unit is not None:
             length_factor(file_unit, "m", where, "the file's length unit")
         try:
@@ -253,7 +253,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     return Scan(
         heights=z,
         pixel=sides,
-        unit=unit if unit is not None else file_unit,
+        unit=unit if unit is not None else file_unit or header_unit,  # the header's: never converted, so as read
         file_unit=file_unit,
         periodic=periodic,
         format=file_format,
@@ -299,7 +299,7 @@ def scan_summary(scan: Scan, p) -> dict:
         **({"channels": scan.channels} if scan.channels else {}),
         "file_spacing": None if not scan.pixel_stated else scan.pixel[0] if same else list(scan.pixel),
         "spacing_from": "file" if p.spacing is None else "preset", "file_unit": scan.file_unit,
-        "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.unit else "none",
+        "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.file_unit else "header" if scan.unit else "none",
         "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
         "periodic_from": "file" if p.periodic is None else "preset",
         **({"caveats": [caveat]} if (caveat := filled_caveat(scan.undefined, scan.heights.size, p, scan.heights.ndim)) else {}),

@@ -126,12 +126,16 @@ def check_text_heights(fh, reader, where: str) -> None:
         check_heights_are_lengths(head_text(fh), where)
 
 
-def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> None:
-    """Refuse a text export whose header names length units (``x [\u00b5m]``, ``z [nm]``) that its
-    reader does not read, when they differ, or differ from the preset's ``unit``: the heights and
-    the pixel would be taken as bare numbers in that unit, the slopes off by their ratio."""
-    if file_unit is None:
-        check_units_named(header_units(fh, reader), unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
+def check_header_units(fh, reader, file_unit: str | None, unit: str | None, where: str) -> str | None:
+    """The length unit the header of a text export names (``x [\u00b5m]``, ``z [nm]``) where its
+    reader gives none: the scan's unit where the preset gives none. Refuse units that differ, or
+    differ from the preset's ``unit``: the heights and the pixel would be taken as bare numbers
+    in that unit, the slopes off by their ratio."""
+    if file_unit is not None:
+        return None
+    units = header_units(fh, reader)
+    check_units_named(units, unit, where, f"which SurfaceTopography's {reader.name()} reader does not read")
+    return units[0] if units else None
 
 
 def check_channel_of_heights(reader, channel, where: str) -> None:

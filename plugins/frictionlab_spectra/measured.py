@@ -13,6 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
+from .header_units import check_table_header
 from .instrument_file import LENGTH_UNITS, ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
 from .map_pipeline import FileFormat
 
@@ -40,7 +41,8 @@ class MeasuredParams(PluginParams):
     unit: Unit | None = Field(
         None,
         description="length unit of the heights and the spacing in this run (m, mm, um, nm, \u00c5, pm): an instrument "
-        "file's are converted to it (default: the file's own); a table's numbers are taken to be in it",
+        "file's are converted to it (default: the file's own); a table's numbers are taken to be in it (default: the "
+        "unit its header names, if any)",
     )
     undefined: Undefined = Field(
         "refuse",
@@ -84,6 +86,14 @@ class MeasuredParams(PluginParams):
                 "out, or give format: instrument for an instrument's export"
             )
         return self
+
+
+def table_unit(path: Path, where: str, p: MeasuredParams, text: bool) -> dict[str, str | None]:
+    """A table's unit and where it came from, for its input summary: the preset's ``unit``, else
+    the one the header of a ``text`` table names (``check_table_header``, which refuses another
+    than the preset's), else none: bare numbers."""
+    named = check_table_header(path, where, p.unit, p.format) if text else None
+    return {"unit": p.unit or named, "unit_from": "preset" if p.unit is not None else "header" if named else "none"}
 
 
 class MeasuredFile(SpectrumGenerator):

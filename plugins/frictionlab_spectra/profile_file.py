@@ -37,9 +37,8 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
-from .header_units import check_table_header
 from .instrument_reader import reason_said
-from .measured import Measured, MeasuredFile, MeasuredParams
+from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .text_table import read_text_table
 from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
@@ -112,11 +111,9 @@ class ProfileFile(MeasuredFile):
             periodic = scan.periodic if p.periodic is None else p.periodic
         else:
             x, z = _read_columns(path)
-            if file_suffix(path, where) != ".npy":
-                check_table_header(path, where, p.unit, p.format)
             summary = {
-                "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset", "unit": p.unit,
-                "unit_from": "preset" if p.unit is not None else "none",
+                "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset",
+                **table_unit(path, where, p, file_suffix(path, where) != ".npy"),
                 "periodic_from": "preset" if p.periodic is not None else "default",
             }  # fmt: skip
             periodic = bool(p.periodic)
@@ -130,7 +127,7 @@ class ProfileFile(MeasuredFile):
             dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
             check_finite(where, "x", x)
-            dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), p.unit)
+            dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), summary["unit"])
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
                     raise ValueError(

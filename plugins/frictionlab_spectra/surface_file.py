@@ -49,13 +49,12 @@ from pydantic import Field, model_validator
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
-from .header_units import check_table_header
 from .instrument_file import (
     ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
-from .measured import Measured, MeasuredFile, MeasuredParams
+from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
@@ -308,8 +307,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         table = file_suffix(path, where) != ".npy"
-        if table:  # first: an export whose header states its pixel is told how to read it, not to give spacing
-            check_table_header(path, where, p.unit, p.format)
+        unit = table_unit(path, where, p, table)  # first: an export stating its pixel is told how to read it, not to give spacing
         if p.spacing is None:
             raise ValueError(
                 f"{where}: a {path.suffix.lower()} map holds bare numbers, so the parameter spacing (the pixel side) "
@@ -322,8 +320,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             raise ValueError(f"{where}: {held}: no heights; expected a map of at least {MIN_SIDE} x {MIN_SIDE} points")
         pixel = p.preset_pixel()
         summary = {
-            "format": path.suffix.lower(), "spacing_from": "preset", "unit": p.unit,
-            "unit_from": "preset" if p.unit is not None else "none",
+            "format": path.suffix.lower(), "spacing_from": "preset", **unit,
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
         periodic = bool(p.periodic)

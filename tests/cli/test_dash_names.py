@@ -4,6 +4,9 @@ are names, and an option among them was answered 'did you mean --out?' to `--out
 commands frictionlab suggests (`frictionlab resume -r2`, `frictionlab follow my runs/a`) could
 not be pasted back."""
 
+import os
+import subprocess
+
 import pytest
 
 from frictionlab.cli import main
@@ -64,5 +67,18 @@ def test_the_commands_written_into_a_study_or_exact3d_page_take_their_folders_ba
     args = build_parser().parse_args(["study", "--out=-r2", "--", "-x.yaml"])
     assert shlex.split(command_line(args))[2:] == ["./-x.yaml", "--out", "./-r2"]
     args = build_parser().parse_args(["study", "q.yaml", "--out", "a\nb c"])
-    assert command_line(args).endswith("--out 'a\\nb c'")
+    assert command_line(args).endswith("--out $'a\\nb c'")  # bash's quoting: its \\n is the line break
     assert shlex.split(_command(True, "-p", "my runs", False))[3:7] == ["--out", "./-p", "--runs", "my runs"]
+
+
+@pytest.mark.parametrize("name", [b"r\xff", b"it's \xfe\\xff", b"a\nb\tc", b"esc\x1b[31m", "z\u200bw \u0085".encode(), "caf\u00e9 ok".encode()])
+def test_a_suggested_command_names_a_folder_of_any_bytes_as_bash_takes_it_back(name):
+    """'resume with: frictionlab resume 'r\\xff'': a name that is not UTF-8 was written with
+    Python's escapes inside plain quotes, which bash takes as a backslash, an x and two letters:
+    another folder. Bash's $'...' says each byte; printable UTF-8 is quoted as before."""
+    word = command_word(os.fsdecode(b"/runs/" + name))
+    env = {**os.environ, "LC_ALL": "C.UTF-8"}  # bash writes $'\\u200b' in the locale's encoding
+    said = subprocess.run(["bash", "-c", f"printf %s {word}"], capture_output=True, env=env, check=True, timeout=60)
+    assert said.stdout == b"/runs/" + name, word
+    assert word.isascii() or name == "caf\u00e9 ok".encode()  # the terminal shows every byte of it
+    assert (word == "'/runs/caf\u00e9 ok'") == (name == "caf\u00e9 ok".encode())

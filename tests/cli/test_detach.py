@@ -104,7 +104,7 @@ def test_runs_and_follow_on_a_sweep_folder_whose_sweep_json_is_a_link_say_so_wit
 
 def test_runs_and_follow_name_a_folder_that_is_not_a_run(tmp_path, cli):
     missing = cli("runs", tmp_path / "nowhere")
-    assert missing.returncode == 5 and "DIR:" in missing.stderr and "does not exist" in missing.stderr
+    assert missing.returncode == 2 and "DIR:" in missing.stderr and "does not exist" in missing.stderr  # a bad argument
     (tmp_path / "plain").mkdir()
     followed = cli("follow", tmp_path / "plain")
     assert followed.returncode == 5 and "holds no run" in followed.stderr and "Traceback" not in followed.stderr
