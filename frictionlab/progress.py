@@ -140,9 +140,12 @@ class ProgressReporter:
     """A ``listeners.RunListener``: one run's progress on ``stream`` (stderr): a bar
     when ``interactive`` (default: a terminal or a notebook), else a plain line per tenth;
     either only once the run has gone on ``after`` seconds (a short run shows its first
-    line and, in a log, its last)."""
+    line and, in a log, its last). A spectrum read from a file says what was read under
+    the first line (``io.inputs.input_lines``), once for the reporters sharing ``inputs_said``
+    (a sweep's points, a study's runs: the same file read alike is said once)."""
 
-    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER, clock=time.perf_counter):
+    def __init__(self, stream=None, interactive: bool | None = None, after: float = SHOW_AFTER, clock=time.perf_counter,
+                 inputs_said: set[str] | None = None):  # fmt: skip
         self.stream = BestEffort(stream or sys.stderr)
         self.interactive = wants_bar(self.stream) if interactive is None else interactive
         self.after = after
@@ -156,6 +159,7 @@ class ProgressReporter:
         self.done = 0
         self.loads = 0  # load steps of each realization
         self.last_load_line = 0.0
+        self.inputs_said = set() if inputs_said is None else inputs_said
 
     def _line(self, done: int, total: int) -> str:
         return progress_text(done, total, self.failed, self.clock() - self.started, restored=self.resumed)
@@ -187,6 +191,16 @@ class ProgressReporter:
             f"{preset.name}: {run.total} realization{'s' if run.total != 1 else ''} of {run.scene.pressed}{restored}, "
             f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s){crowded}"
         )
+        self._say_input(run.scene.spectrum.input_summary())
+
+    def _say_input(self, summary: dict | None) -> None:
+        """What a measured file gave (its channel, unit, levelling), once: a run headless shows it too."""
+        from .io.inputs import input_lines
+
+        said = "\n".join(f"  {shown(line)}" for line in input_lines(summary)) if summary is not None else ""
+        if said and said not in self.inputs_said:
+            self.inputs_said.add(said)
+            self._write(said)
 
     def _pass_tenths(self, done: int, total: int) -> None:
         """Count the tenths of ``total`` that ``done`` passed as said (computed, not looped:
@@ -267,6 +281,7 @@ class SweepProgress(SweepListener):
         self.after = after
         self.clock = clock  # a followed sweep's (sweeplog.SweepFollower.now): its times are the run's
         self.reporter: ProgressReporter | None = None  # the point's running now
+        self.inputs_said: set[str] = set()  # a file every point reads alike is said once
 
     def _write(self, text: str) -> None:
         if self.reporter is not None:  # above its bar, if one shows
@@ -289,7 +304,8 @@ class SweepProgress(SweepListener):
 
     def run_listeners(self, point):
         self.close()
-        self.reporter = ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock)
+        self.reporter = ProgressReporter(self.stream, self.interactive, self.after, clock=self.clock,
+                                         inputs_said=self.inputs_said)  # fmt: skip
         return [self.reporter]
 
     def point_finished(self, sweep, point, result):

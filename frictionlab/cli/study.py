@@ -188,7 +188,9 @@ def run(args) -> ExitCode:
 
     from ..progress import ProgressReporter
 
-    study = Study(factory, options, progress, run_listeners=list if args.quiet else (lambda: [ProgressReporter()]))
+    said: set[str] = set()  # its runs read one file alike: what was read is said once
+    study = Study(factory, options, progress,
+                  run_listeners=list if args.quiet else (lambda: [ProgressReporter(inputs_said=said)]))  # fmt: skip
     study.check_memory()  # before a folder is made
     out_dir = claim_study_folder(args.out, factory.base.preset.name, force=args.force)
     reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"

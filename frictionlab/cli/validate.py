@@ -22,7 +22,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..api import scene_record
-    from ..io.inputs import describe_channels, describe_input
+    from ..io.inputs import input_lines
     from ..preset.loads import loads_lines
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
@@ -57,9 +57,8 @@ def run(args) -> ExitCode:
                 + (f", sweep of {counted(points, 'point')})" if points is not None else ")")
             ))
             if record["input"] is not None:  # its unit, as the instrument file wrote it
-                print(shown(f"  read {describe_input(record['input'])}"))
-                for line in describe_channels(record["input"]):
-                    print(shown(f"    {line}"))
+                for line in input_lines(record["input"]):
+                    print(shown(f"  {line}"))
                 for caveat in record["input"].get("caveats", ()):
                     print(f"  caveat: {shown(caveat)}")
             for caveat in record["caveats"]:  # of the spectrum's parameters (few pixels on the short cut-off)

@@ -263,6 +263,12 @@ def describe_input(summary: dict) -> str:
     )  # fmt: skip
 
 
+def input_lines(summary: dict) -> list[str]:
+    """What was read, as ``validate`` and a run's progress say it: ``read`` and
+    ``describe_input``'s line, then ``describe_channels``' lines, indented under it."""
+    return [f"read {describe_input(summary)}", *(f"  {line}" for line in describe_channels(summary))]
+
+
 def describe_channels(summary: dict) -> list[str]:
     """One line per channel of a file with several (index, name, points x by y, units), and
     which one was taken when several share its name; escaped (``errors.shown``)."""
