@@ -169,16 +169,26 @@ def test_refusal_names_estimate_limit_and_fewer_workers(registry, monkeypatch):
     needed = memory.estimate(scene, workers=2, executor="processes").total
     assert needed > GiB
     assert message.startswith(f"this run would need about {needed / GiB:.2f} GiB (2 worker(s) x ")
-    assert "but 1.00 GiB is available (a test limit). It would fit with --workers 1." in message
+    assert "but 1.00 GiB is available (a test limit). It would fit with --workers 1 (workers=1 in Python)." in message
     memory.check_fits(scene, workers=1, executor="processes")  # the advice is right
 
 
 def test_refusal_offers_fewer_points_when_one_worker_is_too_many(registry, monkeypatch):
     scene = build_scene(line_of(20_000_000), registry=registry)
     monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
-    with pytest.raises(RunError, match=r"It would fit with --workers 1 and spectrum.params.points <= ([\d,]+)\.") as caught:
+    with pytest.raises(RunError, match=r"It would fit with --workers 1 \(workers=1 in Python\) and spectrum.params.points <= ([\d,]+)\.") as caught:
         memory.check_fits(scene, workers=2, executor="processes")
     assert_offer_is_the_most_that_fits(scene, caught.value.args[0])
+
+
+def test_a_notebooks_refusal_names_the_argument_of_frictionlab_run(registry, monkeypatch, tmp_path):
+    """The advice reaches frictionlab.run too, where workers=1 is what to type (--workers 1 is not)."""
+    import frictionlab
+
+    monkeypatch.setattr(memory, "available_memory", lambda: (1 * GiB, "a test limit"))
+    with pytest.raises(RunError, match=r"It would fit with --workers 1 \(workers=1 in Python\)\.") as caught:
+        frictionlab.run(line_of(4_000_000), workers=2, progress=False, out=tmp_path / "out")
+    assert "frictionlab.run memory_check=False" in str(caught.value) and not (tmp_path / "out").exists()
 
 
 def test_cli_refuses_before_writing_anything(tmp_path, monkeypatch, capsys):
@@ -388,7 +398,7 @@ def test_workers_under_ulimit_v_each_have_the_limit_to_themselves(registry, monk
     _under_a_process_limit(monkeypatch, 1 * GiB)
     assert memory.check_fits(scene, workers=16, executor="processes") == guess
     _under_a_process_limit(monkeypatch, 1 * GiB, machine=2 * GiB)  # the machine still bounds the sum
-    with pytest.raises(RunError, match=r"but 2\.00 GiB is available \(a test machine\)\. It would fit with --workers \d+\."):
+    with pytest.raises(RunError, match=r"but 2\.00 GiB is available \(a test machine\)\. It would fit with --workers (\d+) \(workers=\1 in Python\)\."):
         memory.check_fits(scene, workers=16, executor="processes")
 
 
@@ -459,8 +469,9 @@ def test_a_resume_refused_for_memory_says_only_the_worker_count_can_change(regis
     with pytest.raises(RunError) as resumed:
         check_memory(scene, RunOptions(workers=1, resume=True))
     assert str(resumed.value).startswith(str(fresh.value))
-    assert str(resumed.value).endswith("A resume keeps the preset the run was started with: of that advice only "
-                                       "--workers applies; otherwise resume it where more memory is available.")
+    assert str(resumed.value).endswith("A resume keeps the preset the run was started with: of that advice only the worker "
+                                       "count applies (--workers; workers= in Python); otherwise resume it where more "
+                                       "memory is available.")  # fmt: skip
 
 
 def test_the_refusals_hint_names_exactly_the_commands_that_take_no_memory_check():

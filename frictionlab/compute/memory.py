@@ -36,6 +36,12 @@ GiB = 2**30
 SKIP_HINT = (  # validate and study do not
     "(run and resume take --no-memory-check, frictionlab.run memory_check=False, to skip this estimate, an upper bound.)"
 )
+
+
+def workers_advice(workers: int) -> str:
+    """A worker count to run with, as the command line and as ``frictionlab.run`` take it
+    (the refusal reaches both, as ``SKIP_HINT`` does)."""
+    return f"--workers {workers} (workers={workers} in Python)"
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
@@ -352,7 +358,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
     advice = []
     for fewer in range(workers - 1, 0, -1):
         if estimate(scene, workers=fewer, executor=executor, points=guess.grid).total <= available:
-            advice.append(f"--workers {fewer}")
+            advice.append(workers_advice(fewer))
             break
     least = estimate(scene, workers=1, executor=executor, points=1).total  # frictionlab itself, with the smallest grid
     if not advice and least > available:  # no setting of the preset helps
@@ -361,7 +367,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
     if not advice:
         one = estimate(scene, workers=1, executor=executor, points=guess.grid)
         points_param = _points_path(scene)
-        one_worker = "--workers 1 and " if workers > 1 else ""  # not advised to a run that has one already
+        one_worker = f"{workers_advice(1)} and " if workers > 1 else ""  # not advised to a run that has one already
         if points_param:
             advice.append(f"{one_worker}{points_param} <= {_most_points(scene, executor, available):,}")
         else:

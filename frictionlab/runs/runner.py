@@ -72,8 +72,9 @@ def check_memory(scene: Scene, options: RunOptions) -> None:
         if not options.resume:
             raise
         # the advice may name the preset's points or realizations, which a resume cannot change
-        raise RunError(f"{exc} A resume keeps the preset the run was started with: of that advice only "
-                       "--workers applies; otherwise resume it where more memory is available.") from None  # fmt: skip
+        raise RunError(f"{exc} A resume keeps the preset the run was started with: of that advice only the worker "
+                       "count applies (--workers; workers= in Python); otherwise resume it where more memory is "
+                       "available.") from None  # fmt: skip
 
 
 def memory_check_before_reading(options: RunOptions) -> Callable[[Scene], None] | None:
