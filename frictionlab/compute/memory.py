@@ -36,12 +36,6 @@ GiB = 2**30
 SKIP_HINT = (  # validate and study do not
     "(run and resume take --no-memory-check, frictionlab.run memory_check=False, to skip this estimate, an upper bound.)"
 )
-
-
-def workers_advice(workers: int) -> str:
-    """A worker count to run with, as the command line and as ``frictionlab.run`` take it
-    (the refusal reaches both, as ``SKIP_HINT`` does)."""
-    return f"--workers {workers} (workers={workers} in Python)"
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
@@ -56,6 +50,12 @@ KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the fi
 # spectra's worst, a non-periodic map read, reflected across its edges and transformed
 # (72 B measured), plus a third.
 EQUIVALENT_LINE_BYTES_PER_POINT = 96
+
+
+def workers_advice(workers: int) -> str:
+    """A worker count to run with, as the command line and as ``frictionlab.run`` take it
+    (the refusal reaches both, as ``SKIP_HINT`` does)."""
+    return f"--workers {workers} (workers={workers} in Python)"
 
 
 @dataclass(frozen=True)
