@@ -27,6 +27,7 @@ class PaperFigure:
     counts: dict[float, float] = field(default_factory=dict)  # force -> mean points in contact
     note: str = ""
     setup: dict[str, float] = field(default_factory=dict)  # what the title states: dotted path -> value
+    swept: tuple[str, ...] = ()  # the paths its preset sweeps (none: a single run)
 
 
 def _as_paper(hurst: float | None, stop: float) -> dict[str, float]:
@@ -42,7 +43,7 @@ FIGURES = (
     PaperFigure("fig4", "benad2012-fig4.yaml", "Fig. 4: H = 0.5, F = 1..20", 2.6252, 0.1341, {},
                 "the paper: the log fit is visibly poorer than at H = 1; contact counts not stated", _as_paper(0.5, 20.0)),
     PaperFigure("fig5", "benad2012-fig5.yaml", "Fig. 5: a and b against H, each point as Fig. 2", 2.9, 0.14, {},
-                "the paper: a about 2.9 and b about 0.14 near H = 0.7", _as_paper(None, 20.0)),
+                "the paper: a about 2.9 and b about 0.14 near H = 0.7", _as_paper(None, 20.0), ("spectrum.params.hurst",)),
 )  # fmt: skip
 PAPER_H07 = (0.7, 2.9, 0.14)  # H, a, b "about", as the paper states them
 PAPER_POINTS_VS_H = ((1.0, 1.8847, 0.0805, "Fig. 2"), (0.5, 2.6252, 0.1341, "Fig. 4"))
@@ -94,9 +95,23 @@ def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
             run.sweep = plan_sweep(data, source=str(path))
         else:
             run.scene = build_scene(data, source=str(path))
+        _check_swept(fig, path, tuple(run.sweep.paths) if run.sweep else ())
         _check_setup(fig, path, [point.scene for point in run.sweep.points] if run.sweep else [run.scene])
         runs.append(run)
     return runs
+
+
+def _check_swept(fig: PaperFigure, path: Path, swept: tuple[str, ...]) -> None:
+    """FrictionlabError unless the preset sweeps what the figure does: Fig. 2 swept over seeds was
+    reported as 'Fig. 5 at H = 1', its seeds as H; Fig. 5 without its sweep as 'a and b against H'."""
+    if swept != fig.swept:
+        said = f"sweeps {', '.join(swept)}" if swept else "has no sweep (a single run)"
+        wanted = f"a sweep of {', '.join(fig.swept)} alone" if fig.swept else "a single run (no sweep)"
+        raise FrictionlabError(
+            f"{shown_name(path)}: sweep: the preset {said}, but the report shows it as '{fig.title}', {wanted}; give "
+            f"the paper's preset (frictionlab presets copy {fig.preset.removesuffix('.yaml')}), or run yours with "
+            "frictionlab run"
+        )
 
 
 def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
