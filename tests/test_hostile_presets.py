@@ -128,6 +128,20 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
     assert "realizations: must be a number, not true or false" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("assignments, said", [
+    (["loading.start=true", "loading.stop=0.5"], "loading.start: must be a number, not true or false"),
+    (["spectrum.params.length=true"], "spectrum.params.length: must be a number, not true or false"),
+    (["spectrum.params.short_cutoff=true"], "spectrum.params.short_cutoff: must be a number, not true or false"),
+])  # fmt: skip
+def test_a_bool_refused_is_not_also_checked_against_other_fields_as_one(capsys, assignments, said):
+    """true passes pydantic as 1: a check across the section's fields then said 'stop must be > start
+    (1.0)' or 'length=1.0 disagree', of a value no one wrote."""
+    args = ["validate", "quickstart"] + [word for a in assignments for word in ("--set", a)]
+    assert main(args) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "1 problem in preset" in err and said in err and "1.0" not in err, err
+
+
 
 def test_an_unknown_key_of_any_length_is_named_cut_in_the_middle(tmp_path, capsys):
     key = "q" + "x" * 10_000 + "z"
