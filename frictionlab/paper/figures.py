@@ -3,12 +3,15 @@ frictionlab's presets of those figures (``presets/benad2012-fig*.yaml``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+import os
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import FrictionlabError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
+from ..runs.rundir import RunDirectory, same_preset
 from ..runs.runfolder import output_subfolder
 from ..runs.runner import run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -127,6 +130,19 @@ def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
             )
 
 
+def _left_here(run: FigureRun) -> bool:
+    """Whether the figure's folder holds its run (its sweep), stopped or completed, left by a report
+    run before into this --out: continued, not run again from its start (the work of a report
+    stopped by Ctrl-C, or of a `frictionlab resume` of its figure as the message said, was thrown away)."""
+    if run.sweep is not None:
+        return os.path.lexists(run.folder / "sweep.json")  # a sweep's resume reads back its own points only
+    try:
+        state = RunDirectory(run.folder).state()
+    except FrictionlabError:
+        return False  # damaged: the fresh run says how
+    return state is not None and same_preset(state, json.loads(json.dumps(run.scene.resolved())), run.scene)
+
+
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
     """Run each figure's preset into ``out_dir``, every preset checked first; with
     ``progress``, each run's progress on stderr."""
@@ -139,17 +155,20 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
         fig, path = run.figure, run.preset_path
         output_subfolder(out_dir, fig.key, "run the report again")
         seen = mark()
+        resume = not options.force and _left_here(run)
         if run.sweep is not None:
             listeners = [SweepProgress()] if progress else []
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False, listeners=listeners)
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, replace(options, resume=resume), plot=False,
+                                          listeners=listeners)  # fmt: skip
         else:
             listeners = [ProgressReporter()] if progress else []
-            run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, replace(options, resume=resume), listeners=listeners)
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
             how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None
                    else f"frictionlab resume {command_word(run.folder)}")  # fmt: skip
-            raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (continue it with `{how}`)")
+            raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (the report run again with the "
+                                  f"same --out continues it, or `{how}` alone)")  # fmt: skip
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
             raise WorkInterrupted(f"{fig.key} completed in {shown_name(run.folder)}")
     return runs
