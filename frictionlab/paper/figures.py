@@ -130,17 +130,21 @@ def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
             )
 
 
-def _left_here(run: FigureRun) -> bool:
-    """Whether the figure's folder holds its run (its sweep), stopped or completed, left by a report
-    run before into this --out: continued, not run again from its start (the work of a report
-    stopped by Ctrl-C, or of a `frictionlab resume` of its figure as the message said, was thrown away)."""
-    if run.sweep is not None:
-        return os.path.lexists(run.folder / "sweep.json")  # a sweep's resume reads back its own points only
+def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
+    """``options`` resuming what a report run before into this --out left in ``folder`` (a run of
+    ``scene``'s preset, stopped or finished; a sweep's folder when ``scene`` is None), unless
+    --force: it was run again from its start, the work of a report stopped by Ctrl-C (or of a
+    `frictionlab resume` of its figure, as the message said) thrown away."""
+    if options.force:
+        return options
+    if scene is None:
+        return replace(options, resume=os.path.lexists(folder / "sweep.json"))  # it reads back its own points only
     try:
-        state = RunDirectory(run.folder).state()
+        state = RunDirectory(folder).state()
     except FrictionlabError:
-        return False  # damaged: the fresh run says how
-    return state is not None and same_preset(state, json.loads(json.dumps(run.scene.resolved())), run.scene)
+        return options  # damaged: the fresh run says how
+    ours = state is not None and same_preset(state, json.loads(json.dumps(scene.resolved())), scene)
+    return replace(options, resume=ours)
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
@@ -155,14 +159,14 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
         fig, path = run.figure, run.preset_path
         output_subfolder(out_dir, fig.key, "run the report again")
         seen = mark()
-        resume = not options.force and _left_here(run)
         if run.sweep is not None:
             listeners = [SweepProgress()] if progress else []
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, replace(options, resume=resume), plot=False,
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
                                           listeners=listeners)  # fmt: skip
         else:
             listeners = [ProgressReporter()] if progress else []
-            run.outcome, _ = run_to_folder(run.scene, run.folder, replace(options, resume=resume), listeners=listeners)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
+                                           listeners=listeners)  # fmt: skip
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
             how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None

@@ -209,6 +209,9 @@ def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     assert rows[2].fit.a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
     text = "\n".join(readings_markdown(rows))
     assert "`slope.name=spectral`" in text and f"{rows[1].fit.a:.4f}" in text
+    again = run_readings(runs, tmp_path, RunOptions(workers=1), readings=readings)  # the report run again: read back
+    assert json.loads((tmp_path / "readings" / "02-fig2" / "summary.json").read_text())["resumed_realizations"] == 6
+    assert [(r.fit.a, r.fit.b) for r in again] == pytest.approx([(r.fit.a, r.fit.b) for r in rows], rel=1e-12)
 
 
 def test_presets_folder_errors(tmp_path, capsys):
