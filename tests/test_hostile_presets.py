@@ -128,6 +128,15 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
     assert "realizations: must be a number, not true or false" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("assignment", ["name=\udcff\udcfe", "\udcff=1", "spectrum.params.hurst=0.5\udcff"])
+def test_a_set_in_bytes_that_are_not_utf8_is_refused_as_such(capsys, assignment):
+    """A --set typed in Latin-1 (Python reads its bytes as lone surrogates) was told pydantic's 'unable
+    to parse raw data as a unicode string', of '\\udcff', or of the field '(preset)' for a key."""
+    assert main(["validate", "quickstart", "--set", assignment]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "not UTF-8 text" in err and "\\xff" in err and "udcff" not in err and "raw data" not in err, err
+
+
 @pytest.mark.parametrize("assignments, said", [
     (["loading.start=true", "loading.stop=0.5"], "loading.start: must be a number, not true or false"),
     (["spectrum.params.length=true"], "spectrum.params.length: must be a number, not true or false"),
