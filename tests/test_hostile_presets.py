@@ -128,6 +128,14 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
     assert "realizations: must be a number, not true or false" in capsys.readouterr().err
 
 
+def test_binary_text_that_is_not_utf8_is_said_so(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE + "description: !!binary /w==\n")  # the byte 0xff
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "description: must be UTF-8 text, got b'\\xff'" in err and "raw data" not in err, err
+
+
 @pytest.mark.parametrize("assignment", ["name=\udcff\udcfe", "\udcff=1", "spectrum.params.hurst=0.5\udcff"])
 def test_a_set_in_bytes_that_are_not_utf8_is_refused_as_such(capsys, assignment):
     """A --set typed in Latin-1 (Python reads its bytes as lone surrogates) was told pydantic's 'unable

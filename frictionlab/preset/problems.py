@@ -90,6 +90,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be true or false"
     if kind in {"string_type"}:
         return "must be text"
+    if kind == "string_unicode":  # !!binary bytes that are not UTF-8: 'unable to parse raw data as a unicode string'
+        return "must be UTF-8 text"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:
         if _model_at(model, tuple(error["loc"])) is SweepParameter:  # a bare list is the likely slip
             return "must be a mapping: {values: [...]} for a list, or {start: ..., stop: ..., num: ...} for a range"
