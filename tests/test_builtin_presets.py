@@ -77,6 +77,19 @@ def test_presets_copy_to_a_name_ending_in_a_slash_makes_that_folder(tmp_path, cl
     assert (tmp_path / "afile").read_text() == "mine"
 
 
+def test_presets_copy_over_a_folder_of_its_name_is_refused_with_or_without_force(tmp_path, capsys):
+    """A folder named as the copy: refused as 'exists, or --force', and --force then failed with exit 1."""
+    from frictionlab.cli import main
+
+    (tmp_path / "quickstart.yaml").mkdir()
+    (tmp_path / "quickstart.yaml" / "mine.txt").write_text("mine")
+    for force in ([], ["--force"]):
+        assert main(["presets", "copy", "quickstart", str(tmp_path), *force]) == ExitCode.OUTPUT_REFUSED
+        text = capsys.readouterr().err
+        assert "quickstart.yaml is a folder, not a file" in text and "give another DEST" in text, text
+    assert (tmp_path / "quickstart.yaml" / "mine.txt").read_text() == "mine"
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory) -> Path:
     """frictionlab installed as a user would (a built wheel, not editable), offline,

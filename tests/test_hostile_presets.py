@@ -128,6 +128,37 @@ def test_a_bool_given_with_set_is_refused(tmp_path, capsys):
     assert "realizations: must be a number, not true or false" in capsys.readouterr().err
 
 
+def test_binary_text_that_is_not_utf8_is_said_so(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text(BASE + "description: !!binary /w==\n")  # the byte 0xff
+    assert main(["validate", str(path)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "description: must be UTF-8 text, got b'\\xff'" in err and "raw data" not in err, err
+
+
+@pytest.mark.parametrize("assignment", ["name=\udcff\udcfe", "\udcff=1", "spectrum.params.hurst=0.5\udcff"])
+def test_a_set_in_bytes_that_are_not_utf8_is_refused_as_such(capsys, assignment):
+    """A --set typed in Latin-1 (Python reads its bytes as lone surrogates) was told pydantic's 'unable
+    to parse raw data as a unicode string', of '\\udcff', or of the field '(preset)' for a key."""
+    assert main(["validate", "quickstart", "--set", assignment]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "not UTF-8 text" in err and "\\xff" in err and "udcff" not in err and "raw data" not in err, err
+
+
+@pytest.mark.parametrize("assignments, said", [
+    (["loading.start=true", "loading.stop=0.5"], "loading.start: must be a number, not true or false"),
+    (["spectrum.params.length=true"], "spectrum.params.length: must be a number, not true or false"),
+    (["spectrum.params.short_cutoff=true"], "spectrum.params.short_cutoff: must be a number, not true or false"),
+])  # fmt: skip
+def test_a_bool_refused_is_not_also_checked_against_other_fields_as_one(capsys, assignments, said):
+    """true passes pydantic as 1: a check across the section's fields then said 'stop must be > start
+    (1.0)' or 'length=1.0 disagree', of a value no one wrote."""
+    args = ["validate", "quickstart"] + [word for a in assignments for word in ("--set", a)]
+    assert main(args) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "1 problem in preset" in err and said in err and "1.0" not in err, err
+
+
 
 def test_an_unknown_key_of_any_length_is_named_cut_in_the_middle(tmp_path, capsys):
     key = "q" + "x" * 10_000 + "z"

@@ -55,10 +55,14 @@ def test_a_profile_with_x_and_z_in_different_units_is_refused(tmp_path):
     slope a thousand times too steep, and pressures of 20 E* validated as 'ok'."""
     x = np.arange(64) * 0.5
     z = rough(1, 64, 2)[0]
-    for name, header, scale in (("mixed.csv", "x [mm],z [um]", 1e-3), ("same.csv", "x [um],z [um]", 1.0)):
+    for name, header, scale in (("mixed.csv", "x [mm],z [um]", 1e-3), ("same.csv", "x [um],z [um]", 1.0),
+                                ("road.csv", "x [km],z [mm]", 1e-6)):  # fmt: skip
         (tmp_path / name).write_text(header + "\n" + "".join(f"{float(a * scale)!r},{float(b)!r}\n" for a, b in zip(x, z)))
     with pytest.raises(ValueError, match=r"its header names the length units mm, um, .* convert the columns"):
         ProfileFile(path=str(tmp_path / "mixed.csv"), unit="um").rms_height()
+    # a road profile's x in km beside z in mm: km was no unit it knew, so the mm alone read as the table's one unit
+    with pytest.raises(ValueError, match=r"its header names the length units km, mm, .* convert the columns"):
+        ProfileFile(path=str(tmp_path / "road.csv")).rms_height()
     line = ProfileFile(path=str(tmp_path / "same.csv"), unit="um").generate(None)
     assert line.spacing == pytest.approx(0.5, rel=1e-12) and line.heights.size == 64
 
@@ -186,7 +190,8 @@ def test_keys_in_any_case_units_as_written(tmp_path):
 
 
 @pytest.mark.parametrize("header, named", [("x [in],z [uin]", "in"), ("x [mm],z [\u00b5in]", "\u00b5in"),
-                                           ("x (inch), z (mil)", "inch"), ("z/in", "in")])  # fmt: skip
+                                           ("x (inch), z (mil)", "inch"), ("z/in", "in"),
+                                           ("x [ft],z [um]", "ft"), ("x (feet), z (mm)", "feet")])  # fmt: skip
 def test_a_header_in_inches_is_refused_not_read_bare(tmp_path, header, named):
     """A US profilometer's export in inches and microinches: the units were not known, so not
     counted, and the numbers were read bare in the preset's unit ('x [mm],z [µin]' with unit: mm

@@ -73,12 +73,13 @@ def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
     target = dest / preset.path.name if dest.is_dir() else dest
-    from ..io.files import output_path_problem
+    from ..io.files import output_path_problem, refuse_unreplaceable
 
     problem, there = output_path_problem(target.parent), target.parent.is_dir()
     if problem or not there:  # open() would say only "No such file or directory" (/proc/self/x) with exit 1
         advice = "give a file in a folder you can write to" if there else "make the folder first, or give an existing one"
         raise OutputRefused(f"DEST {shown(target)}: {problem or f'the folder {shown(target.parent)} does not exist'}; {advice}")
+    refuse_unreplaceable([target], "copy", "give another DEST")  # a folder: "exists, --force" then failed with exit 1
     data = preset.path.read_bytes()
     try:
         if force:  # replaced, never written through a link

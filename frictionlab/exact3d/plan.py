@@ -328,7 +328,13 @@ def run_plan(
             path = Path(presets_dir) / preset_name(job.hurst)
             if not path.is_file():
                 raise FrictionlabError(f"the exact 3D study needs the preset {shown_name(path)}: it is missing")
-            factories[job.hurst] = factory = SceneFactory(read_preset(path, registry=registry), registry, source=str(path))
+            data = read_preset(path, registry=registry)
+            if data.get("sweep") is not None:  # it was dropped without a word: the study makes its own ensembles
+                raise FrictionlabError(
+                    f"{shown_name(path)}: sweep: the preset sweeps {', '.join(data['sweep'].get('parameters') or {})}, "
+                    "but the study runs its own ensembles of it (grids, families), none of them swept; remove the sweep"
+                )
+            factories[job.hurst] = factory = SceneFactory(data, registry, source=str(path))
             # the page names it by its file's H
             if (unlike := first_unlike(factory.base.resolved(), {"spectrum.params.hurst": job.hurst})) is not None:
                 raise FrictionlabError(

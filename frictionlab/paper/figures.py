@@ -3,12 +3,15 @@ frictionlab's presets of those figures (``presets/benad2012-fig*.yaml``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import json
+import os
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import FrictionlabError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
+from ..runs.rundir import RunDirectory, same_preset
 from ..runs.runfolder import output_subfolder
 from ..runs.runner import run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -27,6 +30,7 @@ class PaperFigure:
     counts: dict[float, float] = field(default_factory=dict)  # force -> mean points in contact
     note: str = ""
     setup: dict[str, float] = field(default_factory=dict)  # what the title states: dotted path -> value
+    swept: tuple[str, ...] = ()  # the paths its preset sweeps (none: a single run)
 
 
 def _as_paper(hurst: float | None, stop: float) -> dict[str, float]:
@@ -42,7 +46,7 @@ FIGURES = (
     PaperFigure("fig4", "benad2012-fig4.yaml", "Fig. 4: H = 0.5, F = 1..20", 2.6252, 0.1341, {},
                 "the paper: the log fit is visibly poorer than at H = 1; contact counts not stated", _as_paper(0.5, 20.0)),
     PaperFigure("fig5", "benad2012-fig5.yaml", "Fig. 5: a and b against H, each point as Fig. 2", 2.9, 0.14, {},
-                "the paper: a about 2.9 and b about 0.14 near H = 0.7", _as_paper(None, 20.0)),
+                "the paper: a about 2.9 and b about 0.14 near H = 0.7", _as_paper(None, 20.0), ("spectrum.params.hurst",)),
 )  # fmt: skip
 PAPER_H07 = (0.7, 2.9, 0.14)  # H, a, b "about", as the paper states them
 PAPER_POINTS_VS_H = ((1.0, 1.8847, 0.0805, "Fig. 2"), (0.5, 2.6252, 0.1341, "Fig. 4"))
@@ -94,9 +98,23 @@ def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
             run.sweep = plan_sweep(data, source=str(path))
         else:
             run.scene = build_scene(data, source=str(path))
+        _check_swept(fig, path, tuple(run.sweep.paths) if run.sweep else ())
         _check_setup(fig, path, [point.scene for point in run.sweep.points] if run.sweep else [run.scene])
         runs.append(run)
     return runs
+
+
+def _check_swept(fig: PaperFigure, path: Path, swept: tuple[str, ...]) -> None:
+    """FrictionlabError unless the preset sweeps what the figure does: Fig. 2 swept over seeds was
+    reported as 'Fig. 5 at H = 1', its seeds as H; Fig. 5 without its sweep as 'a and b against H'."""
+    if swept != fig.swept:
+        said = f"sweeps {', '.join(swept)}" if swept else "has no sweep (a single run)"
+        wanted = f"a sweep of {', '.join(fig.swept)} alone" if fig.swept else "a single run (no sweep)"
+        raise FrictionlabError(
+            f"{shown_name(path)}: sweep: the preset {said}, but the report shows it as '{fig.title}', {wanted}; give "
+            f"the paper's preset (frictionlab presets copy {fig.preset.removesuffix('.yaml')}), or run yours with "
+            "frictionlab run"
+        )
 
 
 def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
@@ -110,6 +128,23 @@ def _check_setup(fig: PaperFigure, path: Path, scenes: list) -> None:
                 f"the paper's numbers ({dotted} = {stated:g}); give the paper's preset (frictionlab presets copy "
                 f"{fig.preset.removesuffix('.yaml')}), or run yours with frictionlab run"
             )
+
+
+def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
+    """``options`` resuming what a report run before into this --out left in ``folder`` (a run of
+    ``scene``'s preset, stopped or finished; a sweep's folder when ``scene`` is None), unless
+    --force: it was run again from its start, the work of a report stopped by Ctrl-C (or of a
+    `frictionlab resume` of its figure, as the message said) thrown away."""
+    if options.force:
+        return options
+    if scene is None:
+        return replace(options, resume=os.path.lexists(folder / "sweep.json"))  # it reads back its own points only
+    try:
+        state = RunDirectory(folder).state()
+    except FrictionlabError:
+        return options  # damaged: the fresh run says how
+    ours = state is not None and same_preset(state, json.loads(json.dumps(scene.resolved())), scene)
+    return replace(options, resume=ours)
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
@@ -126,15 +161,18 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
         seen = mark()
         if run.sweep is not None:
             listeners = [SweepProgress()] if progress else []
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, options, plot=False, listeners=listeners)
+            run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
+                                          listeners=listeners)  # fmt: skip
         else:
             listeners = [ProgressReporter()] if progress else []
-            run.outcome, _ = run_to_folder(run.scene, run.folder, options, listeners=listeners)
+            run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
+                                           listeners=listeners)  # fmt: skip
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
             how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None
                    else f"frictionlab resume {command_word(run.folder)}")  # fmt: skip
-            raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (continue it with `{how}`)")
+            raise WorkInterrupted(f"{fig.key} ended interrupted in {shown_name(run.folder)} (the report run again with the "
+                                  f"same --out continues it, or `{how}` alone)")  # fmt: skip
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
             raise WorkInterrupted(f"{fig.key} completed in {shown_name(run.folder)}")
     return runs

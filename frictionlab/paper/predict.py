@@ -326,6 +326,12 @@ def _read_summary(run_dir: Path, name: str = "run folder") -> dict:
             f"{name} {shown_name(run_dir)} is a sweep's folder, which holds a law per point: give one point's run folder, "
             f"{shown_name(run_dir / 'points')}/<NN-label> (frictionlab runs {command_word(run_dir / 'points')} lists them)"
         )
+    if not os.path.lexists(run_dir / "summary.json") and os.path.lexists(run_dir / "run.json"):
+        raise RunFolderError(  # killed before its end (kill -9, a crash): "no such summary.json" said not why
+            f"{name} {shown_name(run_dir)} holds a run that wrote no summary.json: it is still running (`frictionlab "
+            f"follow {command_word(run_dir)}` shows it), or it stopped before its end (`frictionlab resume "
+            f"{command_word(run_dir)}` finishes it); or give the law by hand with --a/--b"
+        )
     return read_summary(run_dir)[0]
 
 

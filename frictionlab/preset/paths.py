@@ -12,7 +12,7 @@ from typing import Any
 
 import yaml
 
-from ..errors import PresetError, short_repr
+from ..errors import PresetError, short_repr, shown_name
 from ..io.safe_yaml import YamlProblem, load_yaml
 
 MISSING = object()
@@ -92,6 +92,12 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
     data = copy.deepcopy(data)
     problems = []
     for assignment in assignments:
+        try:
+            assignment.encode("utf-8")
+        except UnicodeEncodeError:  # bytes of another encoding on the command line: pydantic's 'unable to parse raw data'
+            problems.append(f"--set '{shown_name(assignment)}': not UTF-8 text (a byte of another encoding, shown as "
+                            "\\xNN); a preset is UTF-8: type the value in UTF-8")  # fmt: skip
+            continue
         path, sep, raw = assignment.partition("=")
         if not sep or not is_dotted_path(path):
             problems.append(f"--set {assignment!r}: must look like dotted.path=value, e.g. spectrum.params.hurst=0.8")

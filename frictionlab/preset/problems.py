@@ -90,6 +90,8 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
         return "must be true or false"
     if kind in {"string_type"}:
         return "must be text"
+    if kind == "string_unicode":  # !!binary bytes that are not UTF-8: 'unable to parse raw data as a unicode string'
+        return "must be UTF-8 text"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:
         if _model_at(model, tuple(error["loc"])) is SweepParameter:  # a bare list is the likely slip
             return "must be a mapping: {values: [...]} for a list, or {start: ..., stop: ..., num: ...} for a range"
@@ -320,10 +322,13 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
 
 def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
     """Both lists, without a pydantic line for a field the number check already named (its
-    items as ``x[0]``, pydantic's as ``x.0``)."""
+    items as ``x[0]``, pydantic's as ``x.0``), nor for a section holding one: a check across
+    its fields read the refused value as another (true as 1: 'stop must be > start (1.0)'),
+    and pydantic runs none of them when a field of the section fails."""
 
     def field(line: str) -> str:
         return re.sub(r"\[(\d+)\]", r".\1", line.split(": ", 1)[0])
 
     named = {field(line) for line in numbers}
-    return numbers + [line for line in pydantic_lines if field(line) not in named]
+    return numbers + [line for line in pydantic_lines if field(line) not in named
+                      and not any(name.startswith(field(line) + ".") for name in named)]  # fmt: skip

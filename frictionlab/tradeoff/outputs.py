@@ -231,10 +231,22 @@ def _smallest_within(rows: list[Row], target: float) -> Row | None:
     return chosen
 
 
-def _needed_realizations(measured: int, ci_rel: float, target: float) -> tuple[int, bool]:
-    """(M, extrapolated?) for a half-width of ``target``, from a half-width ``ci_rel`` at ``measured`` lines (~ 1/sqrt(M))."""
+def _unknown_m(measured: int) -> str:
+    return (f"an unknown M (no interval of b at M = {measured} to extrapolate from: fit.bootstrap is 0, or there is a "
+            "single realization)")  # fmt: skip
+
+
+def _interval_of_b(row, what: str) -> str:
+    if math.isfinite(row.b_ci_rel):
+        return f"b's 95% interval from {row.realizations} {what}: +-{_pct(row.b_ci_rel)}"
+    return f"no interval of b from {row.realizations} {what}"  # it read '+-–'
+
+
+def _needed_realizations(measured: int, ci_rel: float, target: float) -> tuple[int, bool] | None:
+    """(M, extrapolated?) for a half-width of ``target``, from a half-width ``ci_rel`` at ``measured`` lines (~ 1/sqrt(M));
+    None without a half-width (``_unknown_m``): 'M = 50, extrapolated from M = 50' was said of no error at all."""
     if not math.isfinite(ci_rel):
-        return measured, False
+        return None
     return max(2, math.ceil(measured * (ci_rel / target) ** 2)), ci_rel > target
 
 
@@ -268,10 +280,11 @@ def recommendation(study: Study) -> str:
         elif within:
             m_needed = int(within[0].value)
             needs.append(f"M = {m_needed}")
-        else:
-            largest = realizations[-1]
-            m_needed, _ = _needed_realizations(largest.realizations, largest.b_ci_rel, target)
+        elif (needed := _needed_realizations((largest := realizations[-1]).realizations, largest.b_ci_rel, target)):
+            m_needed = needed[0]
             needs.append(f"M = {m_needed} (extrapolated as 1/sqrt(M) from M = {largest.realizations})")
+        else:
+            needs.append(_unknown_m(largest.realizations))
         if seconds_per_line is None:
             seconds_per_line = realizations[-1].seconds / max(1, realizations[-1].realizations)
     steps = by_axis.get("steps", [])
@@ -294,13 +307,13 @@ def recommendation(study: Study) -> str:
         if tolerance:
             loosest = next((r for r in tolerance if error_in_b(r) <= target), tolerance[-1])
             chosen, tol_text = loosest, f"tolerance {loosest.tolerance:g}, "
-        m_ref, extrapolated = _needed_realizations(reference.realizations, reference.b_ci_rel, target)
-        how = f" (extrapolated from M = {reference.realizations})" if extrapolated else ""
         per_line = chosen.seconds / max(1, chosen.realizations)
-        parts.append(
-            f"{reference.solver} needs {tol_text}M = {m_ref}{how} at N = {reference.points}, "
-            f"about {per_line * m_ref:.2g} s serial"
-        )
+        if (needed := _needed_realizations(reference.realizations, reference.b_ci_rel, target)) is None:
+            m_text = f"{_unknown_m(reference.realizations)} at N = {reference.points}"
+        else:
+            how = f" (extrapolated from M = {reference.realizations})" if needed[1] else ""
+            m_text = f"M = {needed[0]}{how} at N = {reference.points}, about {per_line * needed[0]:.2g} s serial"
+        parts.append(f"{reference.solver} needs {tol_text}{m_text}")
         what = "surfaces" if study.base.spectrum.dimension == 2 else "lines"
         for row in solver_rows:
             if row.reference:
@@ -308,7 +321,7 @@ def recommendation(study: Study) -> str:
             parts.append(
                 f"against {reference.solver} on the same {row.realizations} {what} at N = {row.points} and equal f, "
                 f"{row.solver}'s xi(f) is off by {_pct(row.xi_err_f)} rms (mean {_signed_pct(row.xi_bias_f)}), its b by "
-                f"{_pct(row.b_err)} (b's 95% interval from {reference.realizations} {what}: +-{_pct(reference.b_ci_rel)}), "
+                f"{_pct(row.b_err)} ({_interval_of_b(reference, what)}), "
                 + (f"its indentation by {_pct(row.approach_err_f)} rms" if math.isfinite(row.approach_err_f)
                    else "its indentation not compared (see the notes)")
             )  # fmt: skip

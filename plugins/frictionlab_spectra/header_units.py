@@ -13,11 +13,11 @@ import re
 
 HEADER_BYTES = 4096  # of a text file read for the units its header names
 LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
-               "mm": "mm", "cm": "cm", "m": "m", "\u00c5": "\u00c5", "\u212b": "\u00c5", "angstrom": "\u00c5",
-               "angstroms": "\u00c5"}  # fmt: skip
-# inch-based lengths, as US profilometers export them: named by a header, never converted, so refused
-IMPERIAL = r"inch(?:es)?|in|mils?|thou|[u\u00b5\u03bc]in|micro-?inch(?:es)?"
-_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|m|\u00c5|\u212b|angstroms?"
+               "mm": "mm", "cm": "cm", "dm": "dm", "km": "km", "m": "m", "\u00c5": "\u00c5", "\u212b": "\u00c5",
+               "angstrom": "\u00c5", "angstroms": "\u00c5"}  # fmt: skip
+# inch- and foot-based lengths, as US instruments export them: named by a header, never converted, so refused
+IMPERIAL = r"inch(?:es)?|in|mils?|thou|[u\u00b5\u03bc]in|micro-?inch(?:es)?|ft|feet|foot|yd|yards?"
+_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|dm|km|m|\u00c5|\u212b|angstroms?"
 # units of what is no length, as instruments label a channel's column: volts, amperes (a bare "A" is
 # an ampere here, as in SI: an angstrom is written \u00c5), angles, frequencies, forces, pressures, counts
 NOT_LENGTH = (r"[fpn\u00b5\u03bcumkM]?V|[fpn\u00b5\u03bcum]?A|deg|\u00b0|m?rad|[kMG]?Hz|[pn\u00b5\u03bcum]?N|[kMG]?Pa|"

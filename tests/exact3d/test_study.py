@@ -172,6 +172,23 @@ def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_p
     assert not list(runs.glob("*/summary.json"))  # no ensemble ran
 
 
+def test_a_preset_with_a_sweep_is_refused_before_anything_runs(tmp_path, capsys):
+    """exact3d-h03.yaml with a sweep of seeds ran its ensembles as if it had none, the sweep dropped without a word."""
+    import shutil
+
+    presets = tmp_path / "presets"
+    presets.mkdir()
+    for hurst in HURSTS:
+        shutil.copy(PRESETS / preset_name(hurst), presets)
+    edited = presets / preset_name(0.3)
+    edited.write_text(edited.read_text() + "sweep:\n  parameters:\n    seed: {values: [1, 2]}\n")
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--presets", str(presets), "--runs", str(runs), "--workers", "1", "--quiet"]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"{edited}: sweep: the preset sweeps seed, but the study runs its own ensembles" in err
+    assert not list(runs.glob("*/summary.json"))  # no ensemble ran
+
+
 @pytest.mark.parametrize("made, said", [(None, "does not exist"), ("file", "is not a folder")])
 def test_finished_only_from_a_runs_folder_that_is_not_one_says_so(made, said, tmp_path, capsys):
     """It was told 'holds no finished exact ensemble', as of an empty folder of runs."""

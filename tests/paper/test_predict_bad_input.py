@@ -153,6 +153,15 @@ def test_a_summary_without_a_fit(run_copy, capsys):
     assert code == ExitCode.RUN_FOLDER and "summary.json" in err and "field 'fit' is null, but realizations were done" in err
 
 
+def test_a_run_stopped_before_its_summary_says_how_to_finish_it(run_copy, capsys):
+    """A run killed (kill -9) before its end leaves run.json and chunks, no summary.json: it was told
+    only 'no such summary.json'."""
+    (run_copy / "summary.json").unlink()
+    code, _, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER and "holds a run that wrote no summary.json" in err
+    assert f"frictionlab resume {run_copy}" in err and f"frictionlab follow {run_copy}" in err
+
+
 def test_a_missing_folder_is_a_run_folder_error(tmp_path, capsys):
     code, _, err = predict_from(tmp_path / "nothing", capsys)
     assert code == ExitCode.RUN_FOLDER and "no readable summary.json there (no such folder)" in err

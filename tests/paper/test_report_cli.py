@@ -101,6 +101,11 @@ def test_a_bad_preset_among_the_figures_is_refused_before_any_figure_runs(tmp_pa
     ("fig2", "spectrum.params.hurst=0.5", "spectrum.params.hurst is 0.5, but the report shows this preset as 'Fig. 2: H = 1"),
     ("fig3", "loading.stop=20", "loading.stop is 20.0, but the report shows this preset as 'Fig. 3: H = 1, F = 1..500'"),
     ("fig5", "loading.start=2", "loading.start is 2.0, but the report shows this preset as 'Fig. 5: a and b against H"),
+    ("fig2", "sweep={parameters: {seed: {values: [1, 2]}}}", "sweep: the preset sweeps seed, but the report shows it as "
+     "'Fig. 2: H = 1, F = 1..20', a single run (no sweep)"),  # reported as 'Fig. 5 at H = 1', its seeds as H
+    ("fig5", "sweep=null", "sweep: the preset has no sweep (a single run), but the report shows it as 'Fig. 5: a and b "
+     "against H, each point as Fig. 2', a sweep of spectrum.params.hurst alone"),
+    ("fig5", "sweep.parameters={seed: {values: [1, 2]}}", "sweep: the preset sweeps seed, but"),
 ])  # fmt: skip
 def test_a_preset_that_is_not_its_figure_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, key, assignment, said):
     """benad2012-fig2.yaml of H = 0.5 ran and was reported as 'Fig. 2: H = 1' beside the paper's a and b;

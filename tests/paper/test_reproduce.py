@@ -209,6 +209,9 @@ def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     assert rows[2].fit.a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
     text = "\n".join(readings_markdown(rows))
     assert "`slope.name=spectral`" in text and f"{rows[1].fit.a:.4f}" in text
+    again = run_readings(runs, tmp_path, RunOptions(workers=1), readings=readings)  # the report run again: read back
+    assert json.loads((tmp_path / "readings" / "02-fig2" / "summary.json").read_text())["resumed_realizations"] == 6
+    assert [(r.fit.a, r.fit.b) for r in again] == pytest.approx([(r.fit.a, r.fit.b) for r in rows], rel=1e-12)
 
 
 def test_presets_folder_errors(tmp_path, capsys):
@@ -304,3 +307,24 @@ def test_replicates_need_readings(capsys):
     assert "--replicates 3 needs --readings" in capsys.readouterr().err
     assert main(["report", "--readings", "--replicates", "0", "--quiet"]) == 2
     assert "--replicates must be a whole number from 1 to 100. Got 0 instead." in capsys.readouterr().err
+
+
+def test_a_report_run_again_continues_its_stopped_and_finished_runs(tiny_presets, tmp_path, recwarn):
+    """A report stopped part way (Ctrl-C in Fig. 2), run again into its --out, refused Fig. 2 ('an
+    unfinished run: continue it with --resume', an option report lacks), and ran every finished
+    figure again from its start; after `frictionlab resume` of Fig. 2, as its message said, too."""
+    out = tmp_path / "out"
+    run_figures(tiny_presets, out, RunOptions(workers=1))
+    state = json.loads((out / "fig2" / "run.json").read_text())
+    (out / "fig2" / "run.json").write_text(json.dumps({**state, "status": "interrupted"}))
+    point = out / "fig5" / "points" / "01-hurst-0.6" / "summary.json"
+    before = point.read_bytes()
+    recwarn.clear()
+    runs = run_figures(tiny_presets, out, RunOptions(workers=1))
+    assert all((run.sweep_outcome or run.outcome).status == "completed" for run in runs)
+    for key in ("fig2", "fig3", "fig4"):
+        assert json.loads((out / key / "summary.json").read_text())["resumed_realizations"] == 6, key
+    assert point.read_bytes() == before  # a finished point is read back, not run again
+    assert not [w for w in recwarn if "runs again" in str(w.message)]
+    run_figures(tiny_presets, out, RunOptions(workers=1, force=True))  # --force: every run afresh
+    assert json.loads((out / "fig2" / "summary.json").read_text())["resumed_realizations"] == 0

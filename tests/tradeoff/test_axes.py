@@ -253,3 +253,17 @@ def test_a_study_of_one_measured_line_recommends_one_realization(builtins, tmp_p
     random = study_of(TINY, builtins, axes=("realizations",))
     random.run()
     assert not random.one_surface and "same surface" not in recommendation(random)
+
+
+@pytest.mark.parametrize("changes", [{"fit": {"bootstrap": 0}}, {"realizations": 1}])
+def test_a_study_with_no_interval_of_b_recommends_no_realizations(builtins, changes):
+    """fit.bootstrap 0 (or one realization) measures no interval of b: the study said 'M = 8
+    (extrapolated as 1/sqrt(M) from M = 8)' and 'mdr-bisection needs M = 4', of no error at all."""
+    from frictionlab.tradeoff.outputs import recommendation
+
+    study = study_of({**TINY, **changes}, builtins, axes=("realizations", "solver"))
+    study.run()
+    said = recommendation(study)
+    assert "extrapolated" not in said and "needs M =" not in said and "+-" not in said, said
+    assert said.count("an unknown M (no interval of b at M = ") == 2, said
+    assert "fit.bootstrap is 0, or there is a single realization" in said and "no interval of b from" in said, said
