@@ -135,3 +135,16 @@ def _command_actions(parser, args):
                 yield from _command_actions(action.choices[chosen], args)
         else:
             yield action
+
+
+def preset_overrides(args) -> list[str]:
+    """The ``--set`` assignments, then ``--seed S`` as ``seed=S``. A ``--set seed=`` of
+    another value beside ``--seed`` is refused: which one the run took would be a guess."""
+    overrides = list(args.set or [])
+    if args.seed is None:
+        return overrides
+    for assignment in overrides:
+        path, sep, value = assignment.partition("=")
+        if sep and path.strip() == "seed" and value.strip() != str(args.seed):
+            raise FrictionlabError(f"--seed {args.seed} and --set {assignment!r} both give the root seed: give it once")
+    return [*overrides, f"seed={args.seed}"]

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, command_word, counted, ran_out_of_memory,
                       resume_hint, shown, shown_name, too_long_path)  # fmt: skip
-from .options import add_executor_options, add_workers_option, executor_run_options
+from .options import add_executor_options, add_workers_option, executor_run_options, preset_overrides
 
 
 def add_parser(sub) -> None:
@@ -52,9 +52,7 @@ def run(args) -> ExitCode:
     from ..runs.rundir import new_run_folder
     from ..runs.runner import memory_check_before_reading
 
-    overrides = list(args.set or [])
-    if args.seed is not None:
-        overrides.append(f"seed={args.seed}")
+    overrides = preset_overrides(args)
     source = args.source = preset_source(args.preset, args.set or [])  # what messages name, a sweep's too
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data

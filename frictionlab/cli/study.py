@@ -9,6 +9,7 @@ import sys
 
 from ..errors import ExitCode, FrictionlabError, not_an_option, shell_word, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
+from .options import preset_overrides
 
 
 def _listed(values) -> str:
@@ -168,9 +169,7 @@ def run(args) -> ExitCode:
     from ..tradeoff.scenes import SceneFactory
 
     options = options_from_args(args)
-    overrides = list(args.set or [])
-    if args.seed is not None:
-        overrides.append(f"seed={args.seed}")
+    overrides = preset_overrides(args)
     data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
     if data.get("sweep") is not None:
         print(

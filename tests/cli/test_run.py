@@ -93,6 +93,21 @@ def test_json_summary_on_stdout_and_set_and_seed_overrides(tmp_path, cli):
     assert result.stderr == ""  # --quiet
 
 
+@pytest.mark.parametrize("command", ["run", "study"])
+def test_a_seed_given_twice_with_two_values_is_refused_before_any_work(tmp_path, cli, command):
+    """--seed 99 with --set seed=5 (either order) named a seed the run did not take: --seed won, without a word."""
+    preset = write_preset(tmp_path, SMALL_PRESET)
+    for order in (("--seed", "99", "--set", "seed=5"), ("--set", "seed=5", "--seed", "99")):
+        result = cli(command, preset, "--out", tmp_path / "o", "--quiet", *order)
+        assert result.returncode == ExitCode.USAGE, result.stderr
+        assert "--seed 99 and --set 'seed=5' both give the root seed: give it once" in result.stderr
+        assert "Traceback" not in result.stderr and not (tmp_path / "o").exists()
+    same = cli("run", preset, "--out", tmp_path / "o", "--json", "--quiet", "--workers", "1", "--no-plot",
+               "--set", "seed=99", "--seed", "99")  # fmt: skip
+    assert same.returncode == 0, same.stderr
+    assert json.loads(same.stdout)["seed"] == 99
+
+
 def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
     result = cli("run", preset, "--out", tmp_path / "o", "--workers", "2", "--no-plot")
