@@ -16,7 +16,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument("presets", nargs="+", metavar="PRESET", help="preset YAML files or built-in names")
     p.add_argument("--set", action="append", metavar="PATH=VALUE", help="override before validating")
-    p.add_argument("--json", action="store_true", help="one record per preset on stdout: ok, problems, what would run")
+    p.add_argument("--json", action="store_true", help="one JSON object on stdout: ok, and under presets one record per preset (ok, problems, what would run)")
     p.set_defaults(handler=run)
 
 
