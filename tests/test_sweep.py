@@ -169,6 +169,25 @@ def test_a_zip_point_twice_is_refused_and_a_value_repeated_beside_others_is_not(
     assert len(plan_sweep(sweep_preset(paired, mode="zip"), registry=registry).points) == 3
 
 
+def test_one_problem_of_many_points_is_said_for_three_then_once_for_the_rest(registry):
+    """A log range over a whole-number field (40 values, 39 of them fractions) printed a line for
+    each point, differing only in its numbers; each problem is now said for three points, then
+    once for the rest, and another problem (a realization count of 0) apart."""
+    parameters = {"spectrum.params.points": {"start": 100, "stop": 4000, "num": 40, "spacing": "log"},
+                  "realizations": {"values": [2, 0]}}  # fmt: skip
+    with pytest.raises(PresetError) as info:
+        plan_sweep(sweep_preset(parameters), registry=registry)
+    problems = info.value.problems
+    assert problems[0] == "sweep point 2 (spectrum.params.points=100, realizations=0): realizations: must be >= 1, got 0"
+    assert sum("must be a whole number, got" in p for p in problems) == 3
+    assert sum("must be >= 1, got 0" in p for p in problems) == 3
+    assert problems[-2:] == [
+        "sweep points 6 to 78 (73 more): spectrum.params.points: the same problem, with their own values",
+        "sweep points 8, 10, 12, ..., 80 (37 more): realizations: the same problem, with their own values",
+    ]
+    assert len(problems) == 8
+
+
 @pytest.mark.parametrize(("parameters", "mode", "said"), [
     ({"seed": {"values": [1, "1"]}}, "grid", "sweep points 1 (seed=1) and 2 (seed='1') are one preset"),
     ({"spectrum.params.hurst": {"values": [0.5, "5e-1"]}}, "grid", "sweep points 1 (spectrum.params.hurst=0.5) and 2"),

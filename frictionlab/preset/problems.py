@@ -332,3 +332,25 @@ def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
     named = {field(line) for line in numbers}
     return numbers + [line for line in pydantic_lines if field(line) not in named
                       and not any(name.startswith(field(line) + ".") for name in named)]  # fmt: skip
+
+
+def fold_point_problems(problems: list[tuple[int, str, str]], shown: int = 3) -> list[str]:
+    """A sweep's ``(point number, label, problem)`` lines, as ``label: problem``, in their
+    order, at most ``shown`` of one problem told apart only by its numbers (a value, a
+    bound); then one line naming the other points with it: a log range over a whole-number
+    field otherwise repeats one refusal for each of 40 sweep points."""
+    lines, seen, folded = [], {}, {}
+    for number, label, problem in problems:
+        kind = re.sub(r"\d[\d.e+-]*", "#", problem)
+        seen[kind] = seen.get(kind, 0) + 1
+        if seen[kind] <= shown:
+            lines.append(f"{label}: {problem}")
+        else:
+            folded.setdefault(kind, (problem.split(": ", 1)[0], []))[1].append(number)
+    for field, numbers in folded.values():
+        if numbers == list(range(numbers[0], numbers[-1] + 1)):
+            listed = f"{numbers[0]} to {numbers[-1]}"
+        else:  # the first few and the last: every point of a grid's other axis would fill the screen
+            listed = ", ".join(map(str, numbers)) if len(numbers) <= 6 else f"{', '.join(map(str, numbers[:3]))}, ..., {numbers[-1]}"
+        lines.append(f"sweep points {listed} ({len(numbers)} more): {field}: the same problem, with their own values")
+    return lines

@@ -37,6 +37,7 @@ from ..options import RunOptions
 from ..plugin import KINDS
 from ..preset import Preset, Scene, SweepSettings, apply_overrides, build_scene, read_preset, yaml_scalar
 from ..preset.schema import ensemble_settings, first_repeat
+from ..preset.problems import fold_point_problems
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
@@ -200,12 +201,13 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
             scene = build_scene(apply_overrides(base, assignments), registry=registry, before_reading=before_reading)
         except PresetError as exc:
-            problems += [f"{_point_named(number, values)}: {p}" for p in exc.problems]
+            problems += [(number, _point_named(number, values), p) for p in exc.problems]
             continue
         except RunError as exc:  # the memory check: the point named, before any point runs
             raise RunError(f"{_point_named(number, values)}: {exc}") from None
         folder = f"{number:0{width}d}-{_label(values)}"
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
+    problems = fold_point_problems(problems)
     if not problems and (pair := first_repeat([ensemble_settings(p.scene.resolved()) for p in points])) is not None:
         one, two = (points[i] for i in pair)  # seed 1 and '1': one preset once read, which the values' check cannot see
         problems = [f"sweep points {one.number} ({one.describe()}) and {two.number} ({two.describe()}) are one preset "
