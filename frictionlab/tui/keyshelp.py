@@ -23,6 +23,13 @@ class KeysHelp:
         else:
             self.action_hide_help_panel()
 
+    def action_show_help_panel(self) -> None:
+        """Textual's panel, with a line on top that says how to close it."""
+        from .widgets import KeysPanel
+
+        if not self.screen.query("HelpPanel"):
+            self.screen.mount(KeysPanel())
+
     def action_toggle_keys(self) -> None:
         """? shows the key panel, or hides it (F1 pages through it)."""
         if self.screen.query("HelpPanel"):

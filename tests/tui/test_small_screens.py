@@ -123,3 +123,36 @@ def test_a_status_line_breaks_between_its_parts_in_a_narrow_box():
     lines = [str(line) for line in _entry_lines(entry, "cyan", 18)]
     assert all(len(line) <= 18 for line in lines), lines
     assert " ".join(" ".join(lines).split()).endswith("interrupted 3613/30000, contacts 26.5..327")
+
+
+def keys_panel_first_line(app) -> str:
+    lines = [line.strip(" ▏") for line in screen_text(app).splitlines()]
+    return next((line for line in lines if line), "")
+
+
+@sync
+async def test_the_keys_panel_at_30x8_fits_the_screen_says_how_to_close_it_and_closes(folders, registry):
+    """At 30x8 it covered the screen, footer included, 46 columns wide: its keys cut off at the
+    left, and nothing in sight said that Esc, F1 or ? closes it."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "f1")
+        panel = app.screen.query_one("HelpPanel")
+        inside, first = panel.region.x >= 0 and panel.region.right <= 30, keys_panel_first_line(app)
+        keys_shown = "Scroll Up" in screen_text(app) and "↑" in screen_text(app)
+        await press_settled(pilot, "escape")
+        closed_by_esc = not app.screen.query("HelpPanel")
+        await press_settled(pilot, "f1")
+        last = ""
+        for _ in range(40):  # F1 pages on, then closes it after the last page
+            last = keys_panel_first_line(app)
+            await press_settled(pilot, "f1")
+            if not app.screen.query("HelpPanel"):
+                break
+        closed_by_f1 = not app.screen.query("HelpPanel")
+        await press_settled(pilot, "question_mark")
+        await press_settled(pilot, "question_mark")
+        closed_by_question_mark = not app.screen.query("HelpPanel")
+    assert inside and keys_shown, panel.region
+    assert first == "Esc closes; F1: next page" and last == "Esc or F1 closes"
+    assert closed_by_esc and closed_by_f1 and closed_by_question_mark
