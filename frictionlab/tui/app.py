@@ -162,6 +162,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
                 return  # typed as a dialog opens (answered once it is up), or a key the dialog answers itself
             if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
                 return
+            if self.esc_closed_keys(event):  # before a list's Esc (Back): the panel says Esc closes it
+                return
         await super().on_event(event)
 
     async def on_ready(self) -> None:
