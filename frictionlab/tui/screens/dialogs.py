@@ -109,6 +109,11 @@ class QuitUnsavedScreen(ConfirmScreen):
         super().__init__("The open preset has unsaved changes. Quit anyway?")
 
 
+class QuitRunEndedScreen(ConfirmScreen):
+    """Quit? asked again when the run ended while ``QuitDuringRunScreen`` was up: its question
+    still said the run was going, l and c to leave running or cancel what had ended."""
+
+
 class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
     """Quit while a run goes on: leave it running ("leave"), cancel it ("cancel"), or stay (None)."""
 
