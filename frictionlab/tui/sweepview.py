@@ -91,4 +91,3 @@ def row_cells(paths: list[str], row: dict[str, Any], intervals: bool = True) -> 
         "-" if row["r2"] is None else f"{row['r2']:.3f}",
         contacts,
     ]
-

@@ -118,7 +118,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         """The open sweep's points are no longer listed (another row was opened)."""
         self.open_sweep = None
         self.set_class(False, "-sweep")
-        self.query_one("#results-sweep", DataTable).clear(columns=True)
+        self.query_one("#results-sweep", SweepList).clear_points()
 
     def _refresh_footer(self) -> None:
         """The footer again when what the highlighted row allows may differ (another row, a status

@@ -16,14 +16,21 @@ class SweepRows:
     intervals would push R^2 and the contacts out of sight (60 columns), they are left out
     (sweep.csv, the plot's fit and each point's run have them)."""
 
-    _paths: list[str] = []
-    _points: dict[str, dict] = {}
-    _intervals: bool | None = None
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._paths: list[str] = []
+        self._points: dict[str, dict] = {}  # sweep.json's points (PointResult.row()), by point number
+        self._intervals: bool | None = None  # the form shown; None: no sweep's columns
 
     def show_points(self, paths: list[str], rows=()) -> None:
         """The columns of a sweep over ``paths`` and its ``rows`` (sweep.json's points), keyed by point number."""
         self._paths, self._points, self._intervals = list(paths), {str(row["point"]): row for row in rows}, None
         self._refill()
+
+    def clear_points(self) -> None:
+        """No sweep's points (its sweep closed): none come back on a resize."""
+        self._paths, self._points, self._intervals = [], {}, None
+        self.clear(columns=True)
 
     def put_point(self, row: dict) -> None:
         """A point's row (``PointResult.row()``) added, or updated in place (a resumed point)."""
@@ -43,7 +50,7 @@ class SweepRows:
             self.put_point({**self._points[key], "status": "running"})
 
     def on_resize(self) -> None:
-        if self._fits_intervals() != self._intervals:
+        if self._intervals is not None and self._fits_intervals() != self._intervals:
             self._refill()
 
     def _fits_intervals(self) -> bool:
