@@ -65,6 +65,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
+    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (60, "-roomy")]  # narrow: the keys panel takes the width (app.tcss)
     BINDINGS = [
         Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
         Binding("question_mark", "toggle_keys", "Keys", tooltip="(show or hide), outside a text field", show=False),
@@ -160,6 +161,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
             if isinstance(self.screen, Dialog) and (self.screen.hold(event) or self.screen.answers_first(event)):
                 return  # typed as a dialog opens (answered once it is up), or a key the dialog answers itself
             if await answer_focus_key(self, event):  # Tab, the form's Enter and Esc: before the next key
+                return
+            if self.esc_closed_keys(event):  # before a list's Esc (Back): the panel says Esc closes it
                 return
         await super().on_event(event)
 

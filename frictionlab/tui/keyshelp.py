@@ -23,12 +23,28 @@ class KeysHelp:
         else:
             self.action_hide_help_panel()
 
+    def action_show_help_panel(self) -> None:
+        """Textual's panel, with a line on top that says how to close it."""
+        from .widgets import KeysPanel
+
+        if not self.screen.query("HelpPanel"):
+            self.screen.mount(KeysPanel())
+
     def action_toggle_keys(self) -> None:
         """? shows the key panel, or hides it (F1 pages through it)."""
         if self.screen.query("HelpPanel"):
             self.action_hide_help_panel()
         else:
             self.action_show_help_panel()
+
+    def esc_closed_keys(self, key) -> bool:
+        """Esc with the panel up closes it, before the focused part's own Esc (a sweep's points went
+        back to the runs, the panel left up; a dialog's Esc closed both); a field's Esc, run
+        before, leaves the field first."""
+        if key.key != "escape" or not self.screen.query("HelpPanel"):
+            return False
+        self.action_hide_help_panel()
+        return True
 
     def action_hide_keys(self) -> None:
         if self.screen.query("HelpPanel"):

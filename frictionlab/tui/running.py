@@ -22,7 +22,7 @@ from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
 from .folders import read_run
 from .messages import RunCrashed, RunFinished
-from .screens import QuitDuringRunScreen, QuitUnsavedScreen
+from .screens import QuitDuringRunScreen, QuitRunEndedScreen, QuitUnsavedScreen
 from .text import failure_message
 
 if TYPE_CHECKING:
@@ -279,6 +279,8 @@ class RunControl:
         if followed.process is not None and lock_held(followed.folder):  # ours ended, the folder is another's:
             self._follow_the_winner(followed.folder)  # its resume won the race (its word may be lost: the winner
             return  # rewrote the progress file), never the old summary read as how ours ended
+        if isinstance(self.screen, QuitDuringRunScreen):
+            self._ask_quit_again(followed)
         if followed.error:
             self.on_run_crashed(RunCrashed(followed.error))
             self.reload_runs()
@@ -295,6 +297,17 @@ class RunControl:
             self.reload_runs()
             return
         self.on_run_finished(RunFinished(finished, followed.folder))
+
+    def _ask_quit_again(self, followed) -> None:
+        """The run ended while the quit question was up: that question, which said it was going,
+        is asked again as things are now (y quits, n or Esc stays)."""
+        from .following import FollowedSweep
+
+        what = "sweep" if isinstance(followed, FollowedSweep) else "run"
+        self.screen.dismiss(None)
+        question = (f"The {what} in {shown_name(followed.folder)} has ended meanwhile: nothing is left to leave "
+                    "running or to cancel. Quit now?")  # fmt: skip
+        self.push_screen(QuitRunEndedScreen(question), lambda yes: yes and self.exit())
 
     def _show_stored(self, folder: Path, resuming: bool = True) -> None:
         from ..runs.detached import stored_count
@@ -383,7 +396,7 @@ class RunControl:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
         goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
         does not happen)."""
-        if isinstance(self.screen, (QuitUnsavedScreen, QuitDuringRunScreen)):
+        if isinstance(self.screen, (QuitUnsavedScreen, QuitDuringRunScreen, QuitRunEndedScreen)):
             return  # Ctrl+Q again: the question is up; stacked, one n left the same question there
         if self.modified:
             self.push_screen(QuitUnsavedScreen(), lambda yes: yes and self._quit_leaving_or_cancelling_the_run())

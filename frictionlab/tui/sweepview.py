@@ -61,36 +61,33 @@ STATUS_MARKS = {
 }  # fmt: skip
 
 
-def table_columns(paths: list[str]) -> list[str]:
-    """The sweep table's headers: short, so a one-parameter sweep fits 80 columns."""
-    return ["#", *(short_name(p) for p in paths), "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+def table_columns(paths: list[str], intervals: bool = True) -> list[str]:
+    """The sweep table's headers: short, so a one-parameter sweep fits 80 columns (60 without
+    the ``intervals``)."""
+    a, b = ("a [95% CI]", "b [95% CI]") if intervals else ("a", "b")
+    return ["#", *(short_name(p) for p in paths), "", a, b, "R^2", "contacts"]
 
 
-def _estimate(row: dict[str, Any], name: str) -> str:
+def _estimate(row: dict[str, Any], name: str, intervals: bool) -> str:
     value, ci = row[name], (row[f"{name}_lo"], row[f"{name}_hi"])
     if value is None:
         return "-"
-    interval = format_interval(ci, digits=3, missing="", sep=",")  # 80 columns
+    interval = format_interval(ci, digits=3, missing="", sep=",") if intervals else ""  # 80 columns
     return f"{value:.4f}" + (f" {interval}" if interval else "")
 
 
-def row_cells(paths: list[str], row: dict[str, Any]) -> list[str]:
+def row_cells(paths: list[str], row: dict[str, Any], intervals: bool = True) -> list[str]:
     """One row of the table from a row of sweep.csv (``PointResult.row()`` or a
     point of sweep.json): the point number, the swept values, a status mark,
-    a and b with their intervals, R^2, points in contact at the first .. last load."""
+    a and b (with their ``intervals``), R^2, points in contact at the first .. last load."""
     first, last = row["contact_first"], row["contact_last"]
     contacts = "-" if first is None else f"{format_count(first)}..{format_count(last)}"
     return [
         str(row["point"]),
         *(shown_value(row[p]) for p in paths),
         STATUS_MARKS.get(row["status"], "?"),
-        _estimate(row, "a"),
-        _estimate(row, "b"),
+        _estimate(row, "a", intervals),
+        _estimate(row, "b", intervals),
         "-" if row["r2"] is None else f"{row['r2']:.3f}",
         contacts,
     ]
-
-
-def table_cells(sweep: Sweep, result: PointResult) -> list[str]:
-    """The row of a point that just finished."""
-    return row_cells(sweep.paths, result.row())

@@ -94,6 +94,28 @@ async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_wai
 
 
 @sync
+async def test_a_run_that_ends_while_the_quit_question_is_up_is_asked_about_again(folders, registry):
+    """In tmux: q while a run went on, and the run completed under the question, which kept
+    saying that it was going (pid N), l to leave it running and c to cancel it."""
+    from frictionlab.tui.screens import QuitDuringRunScreen, QuitRunEndedScreen
+
+    async with a_long_run_going(folders, registry) as (app, pilot):
+        pid = app.followed.pid
+        await press_settled(pilot, "q")
+        asked = isinstance(app.screen, QuitDuringRunScreen)
+        end(pid)  # it ends (killed here: the question is the same for a run that completed)
+        await wait_until(pilot, lambda: isinstance(app.screen, QuitRunEndedScreen), timeout=10.0)
+        await pilot.pause()
+        again = " ".join(screen_text(app).replace("│", " ").split())
+        await press_settled(pilot, "n")  # stay
+        stayed = app.is_running and not app.screen.query(".dialog")
+        await press_settled(pilot, "q")  # nothing goes on: no question
+        quit_at_once = not app.is_running
+    assert asked and "has ended meanwhile: nothing is left to leave running or to cancel. Quit now?" in again
+    assert stayed and quit_at_once
+
+
+@sync
 async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(folders, registry):
     async with a_long_run_going(folders, registry) as (app, pilot):
         pid, out = app.followed.pid, app.followed.folder

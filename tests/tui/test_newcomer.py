@@ -92,6 +92,23 @@ async def test_q_after_a_refused_run_quits_and_never_types_into_the_field_at_fau
     assert quit_by_q and yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["seed"] == -5
 
 
+@sync
+async def test_ctrl_r_refused_in_a_field_leaves_the_keys_typed_next_in_the_field(folders, registry):
+    """In tmux at 80x24: realizations typed as -5, Ctrl+R refused, then Ctrl+U and 20 typed to
+    fix it: the focus had gone to the form, Ctrl+U did nothing and 2 switched to the Presets tab."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        app.query_one("#field--realizations").focus()
+        await press_settled(pilot, "ctrl+u", "minus", "5")
+        await press_settled(pilot, "ctrl+r")
+        said = status_text(app)
+        await press_settled(pilot, "ctrl+u", "2", "0")
+        tab, focused = app.query_one("#tabs").active, app.focused.id
+        value = app.query_one("#field--realizations").value
+    assert said.startswith("Cannot run: 1 problem: realizations: must be >= 1, got -5"), said
+    assert (tab, focused, value) == ("edit", "field--realizations", "20")
+
+
 @pytest.mark.long
 @sync
 async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):

@@ -186,6 +186,24 @@ async def test_esc_leaves_a_sweeps_points_and_a_damaged_row_opened_after_shows_n
 
 @pytest.mark.long  # a sweep run first, then a TUI session
 @sync
+async def test_esc_over_a_sweeps_points_closes_the_keys_panel_before_it_goes_back(folders, registry):
+    """In tmux at 80x24: the keys panel says Esc closes it, but over a sweep's points Esc went
+    back to the runs and left the panel up."""
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5", "enter", "f1")
+        shown = bool(app.screen.query("HelpPanel"))
+        await press_settled(pilot, "escape")
+        closed, on_points = not app.screen.query("HelpPanel"), app.query_one("#results-sweep").has_focus
+        await press_settled(pilot, "escape")
+        back = app.query_one("#runs-table").has_focus
+    assert shown and closed and on_points and back
+
+
+@pytest.mark.long  # a sweep run first, then a TUI session
+@sync
 async def test_a_sweeps_points_footer_fits_80_columns_whole(folders, registry):
     """The points' footer ('esc Back to the runs' among the list's keys) ran past 80 columns
     with a preset open: Ctrl+S and Ctrl+R were cut from it."""

@@ -25,15 +25,19 @@ async def refuse_a_stop_below_the_start(pilot):
 
 @sync
 async def test_ctrl_r_with_stop_not_above_start_focuses_the_stop_field(folders, registry):
+    """Pressed in the stop field: the focus stays there (the keys typed next fix it); Esc leaves
+    it, and Enter goes back in."""
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
         await refuse_a_stop_below_the_start(pilot)
         pointed = app.focused.id
         said = status_text(app)
+        await press_settled(pilot, "escape")
+        left = app.focused.id
         await pilot.press("enter")
         focused = app.focused.id
     assert said.startswith("Cannot run: 1 problem: loading: stop must be > start")
-    assert pointed == "form" and focused == "field--loading--stop"
+    assert pointed == "field--loading--stop" and left == "form" and focused == "field--loading--stop"
 
 
 @sync

@@ -52,12 +52,9 @@ class Dialog(ModalScreen):
             await self.app.on_event(key)
 
     def answers_first(self, key: events.Key) -> bool:
-        """Whether the dialog answers ``key`` itself, before any binding: Esc closes the keys panel
-        over it first (its Esc closed both, and what was typed with them); Ctrl+S, Ctrl+O and Ctrl+R
-        wait for it to close, and say so (each opened another dialog over it, or ran the preset)."""
-        if key.key == "escape" and self.query("HelpPanel"):
-            self.app.action_hide_help_panel()
-            return True
+        """Whether the dialog answers ``key`` itself, before any binding: Ctrl+S, Ctrl+O and Ctrl+R
+        wait for it to close, and say so (each opened another dialog over it, or ran the preset).
+        (Esc closes the keys panel over it first: ``KeysHelp.esc_closed_keys``.)"""
         if key.key in ("ctrl+s", "ctrl+o", "ctrl+r"):
             self.app.say(WAIT_FOR_DIALOG, "warning")
             return True
@@ -110,6 +107,11 @@ class QuitUnsavedScreen(ConfirmScreen):
 
     def __init__(self):
         super().__init__("The open preset has unsaved changes. Quit anyway?")
+
+
+class QuitRunEndedScreen(ConfirmScreen):
+    """Quit? asked again when the run ended while ``QuitDuringRunScreen`` was up: its question
+    still said the run was going, l and c to leave running or cancel what had ended."""
 
 
 class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):

@@ -9,6 +9,7 @@ from importlib import import_module
 
 _MODULES = {
     "EditPane": "editor",
+    "KeysPanel": "keyspanel",
     "ListTable": "tables",
     "PresetForm": "form",
     "PresetsPane": "presets",

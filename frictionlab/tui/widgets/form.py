@@ -347,7 +347,9 @@ class PresetForm(VerticalScroll):
     def focus_problem(self, problems: list[str]) -> None:
         """Point at the field of the first problem that has one (else the first field): scrolled
         into view and the one Enter goes into, while the focus stays on the form, so that a
-        key the footer lists (q, ?) acts and never types into the field."""
+        key the footer lists (q, ?) acts and never types into the field. Pressed in a field,
+        the focus goes into that one: the keys typed next were meant for a field (a value's
+        digit 2 switched to the Presets tab)."""
         for problem in problems:
             dotted = problem_path(problem)
             slot, _, rest = dotted.partition(".")
@@ -365,7 +367,11 @@ class PresetForm(VerticalScroll):
 
     def _point_at(self, field) -> None:
         self._last_field = field
-        self.focus(scroll_visible=False)
+        focused = self.screen.focused
+        if focused is not None and focused is not self and self in focused.ancestors:
+            field.focus(scroll_visible=False)
+        else:
+            self.focus(scroll_visible=False)
         field.scroll_visible()
 
     def check_action(self, action: str, parameters) -> bool:

@@ -23,10 +23,11 @@ from ..chart import NO_DATA, Series
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
-from ..sweepview import STATUS_MARKS, row_cells, table_columns
+from ..sweepview import STATUS_MARKS
 from ..text import format_count, packed, shorten_run_name
 from .chart import Chart
 from .run import fit_series
+from .sweeptable import SweepList
 from .tables import ListTable
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
@@ -65,7 +66,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 yield Chart(empty=NO_RUN_OPEN, id="results-chart")  # not "no data yet": the runs have theirs
                 with VerticalScroll(id="results-info-box", can_focus=False):  # at 60x20 a run's lines need 9 rows
                     yield Static(HINT, id="results-info")
-        yield ListTable(id="results-sweep", cursor_type="row", zebra_stripes=True)
+        yield SweepList(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
     def _name_width(self) -> int:
         """Size the list to the width the pane has: its share, more when a name needs
@@ -117,7 +118,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         """The open sweep's points are no longer listed (another row was opened)."""
         self.open_sweep = None
         self.set_class(False, "-sweep")
-        self.query_one("#results-sweep", DataTable).clear(columns=True)
+        self.query_one("#results-sweep", SweepList).clear_points()
 
     def _refresh_footer(self) -> None:
         """The footer again when what the highlighted row allows may differ (another row, a status
@@ -267,11 +268,8 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
     def _show_sweep(self, entry: SweepEntry) -> None:
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
         self.open_sweep = entry
-        table = self.query_one("#results-sweep", DataTable)
-        table.clear(columns=True)
-        table.add_columns(*table_columns(entry.paths))
-        for row in entry.points:
-            table.add_row(*map(Text, row_cells(entry.paths, row)))
+        table = self.query_one("#results-sweep", SweepList)
+        table.show_points(entry.paths, entry.points)
         self.set_class(True, "-sweep")
         self._inform(
             Content(

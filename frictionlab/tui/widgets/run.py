@@ -7,12 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.content import Content
-from textual.widgets import DataTable, ProgressBar, Static
+from textual.widgets import ProgressBar, Static
 
 from ...errors import shown
 from ...compute.fit import format_estimate
@@ -20,28 +19,33 @@ from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
-from ..sweepview import STATUS_MARKS, point_line, row_cells, table_cells, table_columns
+from ..sweepview import point_line
 from ..text import failure_message, format_count, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
+from .sweeptable import SweepTable
 
 
-def fit_lines(fit, *, final: bool, f_formula: str = "") -> list[str]:
-    """The coefficients as the Run tab and Results tab show them, with what f is."""
+def fit_lines(fit, *, final: bool, f_formula: str = "", short: bool = False) -> list[str]:
+    """The coefficients as the Run tab and Results tab show them, with what f is; ``short``:
+    the interval's level on the first line, without the bootstrap's count (a plot of 6 rows)."""
     what = [f"  f = {f_formula}"] if f_formula else []
     if fit is None:
         return ["xi = a + b ln f", *what, "  (no realization yet)"]
     head = "xi = a + b ln f" + ("" if final else "  (interim)")
     lines = [head, *what, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
     if final:
-        level = f"{100 * fit.confidence:g}%"
+        level = f"{100 * fit.confidence:g}% CI"
+        about = [f"  {level}, bootstrap {fit.bootstrap}"] if fit.bootstrap else [
+            "  no CI (bootstrap off,", "  or < 2 realizations)"]  # either; two lines: the panel is as wide as its longest
+        if short:
+            head, about = head + (f", {level}" if fit.bootstrap else ""), []
         lines = [
             head,
             *what,
             f"  a = {format_estimate(fit.a, fit.a_ci, missing='')}",
             f"  b = {format_estimate(fit.b, fit.b_ci, missing='')}",
-            *([f"  {level} CI, bootstrap {fit.bootstrap}"] if fit.bootstrap else
-              ["  no CI (bootstrap off,", "  or < 2 realizations)"]),  # either; two lines: the panel is as wide as its longest
+            *about,
         ]
     lines.append(f"  R^2 = {fit.r2:.4f}")
     return lines
@@ -73,10 +77,11 @@ def contact_lines(count, room: int | None = None) -> list[str]:
 
 class FitPanel(Static):
     """The fit beside the plot, then the points in contact in the rows it leaves: a sweep's
-    plot at 60x20 has 7, and the last lines were cut below the panel."""
+    plot at 60x20 has 6, and the last lines were cut below the panel."""
 
-    def show(self, lines: list[str], count=None) -> None:
-        self._lines, self._count = lines, count
+    def show(self, lines: list[str], count=None, short: list[str] | None = None) -> None:
+        """``lines``, or the ``short`` ones where the panel has no room for them and the contacts."""
+        self._lines, self._count, self._short = lines, count, short
         self._fill()
 
     def on_resize(self) -> None:
@@ -84,8 +89,11 @@ class FitPanel(Static):
             self._fill()
 
     def _fill(self) -> None:
-        room = self.size.height - len(self._lines) if self.size.height else None
-        text = "\n".join(self._lines + contact_lines(self._count, room))
+        lines = self._lines
+        if self._short and self.size.height and len(lines) + bool(contact_lines(self._count)) > self.size.height:
+            lines = self._short
+        room = self.size.height - len(lines) if self.size.height else None
+        text = "\n".join(lines + contact_lines(self._count, room))
         if text != getattr(self, "_text", None):
             self._text = text
             self.update(Content(text))
@@ -93,6 +101,8 @@ class FitPanel(Static):
 
 R_ON_RUN_TAB = "r reloads the lists on the Presets and Results tabs; Ctrl+R runs the open preset."
 PLOT_ROWS = 10  # a sweep's plot keeps its whole legend (final fit and contacts): #run-body's min-height
+PLOT_FLOOR = 6  # where the tab is short: the fit's short lines and its contacts (FitPanel)
+TABLE_ROWS = 5  # a sweep's table keeps its header and four points before the plot its PLOT_ROWS
 
 
 class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
@@ -116,7 +126,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             yield FitPanel("", id="run-fit")
         with VerticalScroll(id="run-caveats-box", can_focus=False):  # wrapped, whole; scrolls at 60x20
             yield Static("", id="run-caveats")
-        yield DataTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
+        yield SweepTable(id="sweep-table", zebra_stripes=True, cursor_type="row")
         yield Static("", id="run-error")
 
     def check_action(self, action: str, parameters) -> bool:
@@ -146,7 +156,10 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
 
     def _set(self, widget_id: str, text: str | Content) -> None:
         """Show ``text`` as it is: names, values and errors are never read as markup."""
-        self.query_one(f"#{widget_id}", Static).update(Content(text) if isinstance(text, str) else text)
+        line = self.query_one(f"#{widget_id}", Static)
+        line.update(Content(text) if isinstance(text, str) else text)
+        if widget_id == "run-error":  # no error: no blank row the sweep's table could use
+            line.display = bool(str(text))
         if widget_id in ("run-stats", "run-error", "run-caveats"):  # one line or two: the table's room changes
             self.call_after_refresh(self._fit_table)
 
@@ -157,8 +170,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         """A sweep's table of points is as tall as its rows, up to 40 % of the tab and no more
         than the plot's PLOT_ROWS leave: taller, its last rows lay below the tab, out of sight
         and out of its own scroll's reach (rows 5 to 8 of 8 points at 80x24); it scrolls instead.
-        Where the tab has not that room, the plot gives up rows of its legend."""
-        table = self.query_one("#sweep-table", DataTable)
+        Where the tab has not that room (60x20), the table keeps TABLE_ROWS, the plot PLOT_FLOOR."""
+        table = self.query_one("#sweep-table", SweepTable)
         body = self.query_one("#run-body")
         if not table.display:
             body.styles.min_height = None  # a single run: the stylesheet's (none)
@@ -167,11 +180,10 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         others = sum(child.outer_size.height for child in self.children
                      if child.display and child is not table and child.id != "run-body")  # fmt: skip
         room = self.size.height - others
-        height = max(3, min(self.size.height * 2 // 5, room - PLOT_ROWS))
+        height = max(3, min(room - PLOT_FLOOR, max(TABLE_ROWS, min(self.size.height * 2 // 5, room - PLOT_ROWS))))
         if table.styles.max_height is None or table.styles.max_height.value != height:
             table.styles.max_height = height
-        # a short terminal (60x20) gives the table its header and two rows before the plot its legend:
-        # the plot's min-height pushed the table's rows below the tab, only its header in sight
+        # the plot's min-height pushed the table's rows below the tab, only its header in sight (60x20)
         plot_rows = max(1, min(PLOT_ROWS, room - height))
         if body.styles.min_height is None or body.styles.min_height.value != plot_rows:
             body.styles.min_height = plot_rows
@@ -200,9 +212,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             self._set("run-title", Content.assemble((self._fitted(sweep.name, what), "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
-            table = self.query_one("#sweep-table", DataTable)
-            table.clear(columns=True)
-            table.add_columns(*table_columns(sweep.paths))
+            self.query_one("#sweep-table", SweepTable).show_points(sweep.paths)
         self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
         self._show_bar(preset.realizations, 0)
         self._set("run-error", "")
@@ -247,9 +257,9 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def show_stored_sweep(self, sweep, rows: list[dict], point, done: int, total: int) -> None:
         """A sweep's resume as it begins: the rows of its points that are done (sweep.json's),
         and ``point``, which it goes on with, at the count its chunks hold."""
-        table = self.query_one("#sweep-table", DataTable)
+        table = self.query_one("#sweep-table", SweepTable)
         for row in rows:
-            table.add_row(*map(Text, row_cells(sweep.paths, row)), key=str(row["point"]))
+            table.put_point(row)
         self._set("sweep-point", point_line(sweep, point))
         self.show_stored_count(done, total, resuming=True)
 
@@ -258,21 +268,13 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
 
     def show_point(self, sweep, kind: str, point, result) -> None:
         """A sweep point started (``result`` None) or finished."""
-        table = self.query_one("#sweep-table", DataTable)
-        key = str(point.number)  # one row a point: a resume tells again of the points it had
+        table = self.query_one("#sweep-table", SweepTable)
         if kind == "started":
             self._set("sweep-point", point_line(sweep, point))
             self._show_bar(point.scene.preset.realizations, 0)
-            if key in table.rows:  # an interrupted point, running again: its status mark (after #, the values)
-                status = list(table.columns)[1 + len(sweep.paths)]
-                table.update_cell(key, status, Text(STATUS_MARKS["running"]))
+            table.mark_running(str(point.number))  # an interrupted point, running again
             return
-        cells = list(map(Text, table_cells(sweep, result)))
-        if key in table.rows:
-            for column, cell in zip(table.columns, cells):
-                table.update_cell(key, column, cell)
-        else:
-            table.add_row(*cells, key=key)
+        table.put_point(result.row())  # one row a point: a resume tells again of the points it had
         if result.error:
             self._error(f"point {result.point.number}: {result.error}")
 
@@ -290,8 +292,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         if result.fit is not None:
             series = [Series(f, xi, "cyan"), fit_series(f, result.fit.a, result.fit.b, "yellow")]
             self.query_one("#run-chart", Chart).show(series)
-        lines = fit_lines(result.fit, final=True, f_formula=run.f_formula)
-        self.query_one("#run-fit", FitPanel).show(lines, result.table["contact_count"])
+        lines, short = (fit_lines(result.fit, final=True, f_formula=run.f_formula, short=s) for s in (False, True))
+        self.query_one("#run-fit", FitPanel).show(lines, result.table["contact_count"], short)
         self._caveats([f"caveat: {caveat}" for caveat in result.caveats])  # as frictionlab run prints them
         if run.failures or run.error:
             # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
