@@ -5,11 +5,15 @@ Importing this package is cheap; Textual loads when the app is built.
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
+import threading
 from pathlib import Path
 
 from ..errors import FrictionlabError
+
+HANGUP_GRACE_SECONDS = 3.0  # after a hangup, the app's own exit has this long; then the process ends regardless
 
 
 def run_app(
@@ -58,7 +62,20 @@ def _exit_on_sigterm(app, signum: int = signal.SIGTERM) -> None:
     loop = app._loop  # set while the app's loop runs, its cleanup included
     if loop is None:
         _raise_for(signum)
-    loop.call_soon_threadsafe(app.terminate, int(ENDINGS[signum][0]))
+    code = int(ENDINGS[signum][0])
+    loop.call_soon_threadsafe(app.terminate, code)
+    if signum == getattr(signal, "SIGHUP", None):
+        _end_after(HANGUP_GRACE_SECONDS, code)
+
+
+def _end_after(seconds: float, code: int) -> None:
+    """End the process ``seconds`` from now if it has not ended by then. After a hangup its
+    terminal is gone, with nothing of it to give back, and the app's exit once waited for ever
+    on Textual's writer thread, whose writes to the closed terminal never ended: the process
+    stayed behind, an orphan of the SSH session. Its runs are processes of their own."""
+    timer = threading.Timer(seconds, os._exit, args=(code,))
+    timer.daemon = True
+    timer.start()
 
 
 def start_process_helpers() -> None:

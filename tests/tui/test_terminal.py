@@ -168,3 +168,44 @@ def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when, sign
     assert after == before
     assert b"Traceback" not in written and b"Error" not in written
     assert written.count(b"\x1b[?1049h") == written.count(b"\x1b[?1049l")  # back on the main screen
+
+
+@pytest.mark.long
+def test_a_hangup_ends_the_tui_even_when_its_exit_would_wait_for_ever(tmp_path):
+    """Once seen after an SSH session closed: the app's exit waited on Textual's writer thread,
+    whose writes to the closed terminal never ended, and the process stayed behind. The app's
+    exit is made to hang here; the hangup ends the process all the same, with 129, within
+    HANGUP_GRACE_SECONDS."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from frictionlab.tui import HANGUP_GRACE_SECONDS
+
+    script = (
+        "import sys\n"
+        "from frictionlab.tui.app import FrictionlabApp\n"
+        "FrictionlabApp.terminate = lambda self, code=None: None  # an exit that never comes\n"
+        "sys.argv = ['frictionlab', 'tui']\n"
+        "from frictionlab.__main__ import program\n"
+        "program()\n"
+    )
+    keyboard, program = pty.openpty()
+    os.set_blocking(keyboard, False)
+    process = subprocess.Popen([sys.executable, "-c", script], stdin=program, stdout=program, stderr=program,
+                               cwd=tmp_path, env={**os.environ, "TERM": "xterm-256color"}, start_new_session=True)  # fmt: skip
+    try:
+        _wait_reading(process, keyboard, lambda written: b"\x1b[?1049h" in written)  # the app has drawn
+        sent = time.monotonic()
+        process.send_signal(signal.SIGHUP)
+        _wait_reading(process, keyboard, lambda _: process.poll() is not None, timeout=HANGUP_GRACE_SECONDS + 20)
+        took = time.monotonic() - sent
+    finally:
+        if process.poll() is None:
+            process.kill()
+        process.wait()
+        os.close(keyboard)
+        os.close(program)
+    assert process.returncode == 129
+    assert took >= HANGUP_GRACE_SECONDS * 0.9  # its own exit was given its time first
