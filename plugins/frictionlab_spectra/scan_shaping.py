@@ -175,12 +175,13 @@ SPIKE_WINDOW = 5  # pixels a side of the square whose median a point is measured
 SPIKE_LOOKED_AT = 16  # the highest points looked at for spikes: those that carry the first contact
 
 
-def spike_warning(z: np.ndarray, rms: float) -> str | None:
-    """The caveat of a map (levelled, not despiked) among whose SPIKE_LOOKED_AT highest points
-    some stand more than SPIKE_K ``rms`` above the median of the 5 x 5 pixels around them
-    (edges reflected, as ``despike`` reads them): spikes take the first contact alone, and
-    ``despike: 6`` would replace exactly them. Only the highest points are looked at (cheap on
-    any map), those above 3 rms: a spike lower than that touches no earlier than the surface."""
+def spike_warning(z: np.ndarray, rms: float, pixel: tuple[float, float] = (1.0, 1.0)) -> str | None:
+    """The caveat of a map (levelled, not despiked; pixels of ``pixel`` = (dx, dy)) among whose
+    SPIKE_LOOKED_AT highest points some stand more than SPIKE_K ``rms`` above the median of the
+    5 x 5 pixels around them (edges reflected, as ``despike`` reads them): spikes take the first
+    contact alone, and ``despike: 6`` would replace exactly them. Only the highest points are
+    looked at (cheap on any map), those above 3 rms: a spike lower than that touches no earlier
+    than the surface. ``_spike_slope_note`` adds what they do to the rms slope."""
     if not rms > 0 or min(z.shape) < 3:
         return None
     spikes = _spikes(z, rms)
@@ -189,8 +190,35 @@ def spike_warning(z: np.ndarray, rms: float) -> str | None:
     stand, them, they = _agreeing(spikes)
     return (f"{spikes} of the map's {SPIKE_LOOKED_AT} highest points {stand} more than {SPIKE_K:g} rms "
             "heights above the median of the 5 x 5 pixels around them: spikes (dust, an instrument's artefact) take "
-            f"the first contact alone, and the law at small loads is theirs; despike: {SPIKE_K:g} replaces {them}, if "
-            f"{they} not the surface's own")  # fmt: skip
+            f"the first contact alone, and the law at small loads is theirs{_spike_slope_note(z, rms, pixel, 'map')}; "
+            f"despike: {SPIKE_K:g} replaces {them}, if {they} not the surface's own")  # fmt: skip
+
+
+SPIKE_SLOPE_SHARE = 0.5  # of the mean squared slope: spikes carrying more make the rms slope theirs
+
+
+def _spike_slope_note(z: np.ndarray, rms: float, pixel: tuple[float, float], what: str) -> str:
+    """A clause for the spike caveat when the points ``despike: 6`` replaces carry more than
+    SPIKE_SLOPE_SHARE of ``z``'s mean squared slope: the rms slope xi is measured against,
+    and the full-contact estimate E* g, are then theirs (one spike 20 rms high on a map of
+    128 x 128 pixels triples it). Empty otherwise."""
+    try:
+        cleaned, _ = despike(z, SPIKE_K, rms)
+    except ValueError:  # too many points for spikes: the spike caveat's count is the story
+        return ""
+    spiky, smooth = _mean_square_slope(z, pixel), _mean_square_slope(cleaned, pixel)
+    if not spiky > 0 or smooth >= (1.0 - SPIKE_SLOPE_SHARE) * spiky:
+        return ""
+    times = f", {math.sqrt(spiky / smooth):.3g} times what it is without them" if smooth > 0 else ""
+    return (f"; they carry {100 * (1 - smooth / spiky):.0f} % of the {what}'s mean squared slope (its rms slope is "
+            f"{math.sqrt(spiky):.3g}{times}), so the rms slope xi divides by, and the full-contact estimate p = E* g, "
+            "are theirs too")  # fmt: skip
+
+
+def _mean_square_slope(z: np.ndarray, pixel: tuple[float, float]) -> float:
+    """The mean squared gradient of map ``z`` (a line: one row) by forward differences on pixels of (dx, dy)."""
+    return sum(float(np.mean(np.square(np.diff(z, axis=axis) / step)))
+               for axis, step in ((1, pixel[0]), (0, pixel[1])) if z.shape[axis] > 1)  # fmt: skip
 
 
 def _agreeing(spikes: int) -> tuple[str, str, str]:
@@ -198,18 +226,20 @@ def _agreeing(spikes: int) -> tuple[str, str, str]:
     return ("stands", "it", "it is") if spikes == 1 else ("stand", "them", "they are")
 
 
-def line_spike_warning(z: np.ndarray, rms: float) -> str | None:
-    """The caveat of a line (levelled) with spikes, by ``spike_warning``'s criterion along the
-    line: the median of the SPIKE_WINDOW points around each of its highest points."""
+def line_spike_warning(z: np.ndarray, rms: float, spacing: float = 1.0) -> str | None:
+    """The caveat of a line (levelled, points ``spacing`` apart) with spikes, by ``spike_warning``'s
+    criterion along the line: the median of the SPIKE_WINDOW points around each of its highest points."""
     if not rms > 0 or z.size < SPIKE_WINDOW:
         return None
-    spikes = _spikes(z.reshape(1, -1), rms)
+    line = z.reshape(1, -1)
+    spikes = _spikes(line, rms)
     if not spikes:
         return None
     stand, them, they = _agreeing(spikes)
     return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points {stand} more than {SPIKE_K:g} rms heights above "
             f"the median of the {SPIKE_WINDOW} points around them: spikes (dust, an instrument's artefact) take the "
-            f"first contact alone, and the law at small loads is theirs; remove {them} from the profile, if {they} "
+            f"first contact alone, and the law at small loads is theirs{_spike_slope_note(line, rms, (spacing, spacing), 'line')}; "
+            f"remove {them} from the profile, if {they} "
             "not the surface's own")  # fmt: skip
 
 
