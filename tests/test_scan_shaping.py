@@ -495,3 +495,39 @@ def test_a_spike_that_makes_a_lines_rms_slope_says_so_in_the_lines_length_unit(t
     levelled = (z - z.mean()).reshape(1, -1)
     smooth = despike(levelled, 6.0, float(np.std(levelled)))[0]
     assert _clause(levelled, smooth, 0.2, 0.2, "line") in caveat
+
+
+@pytest.mark.parametrize("depth", [-20.0, -100.0])  # a pit; a dropout written as a height
+def test_a_pit_that_makes_the_rms_slope_says_so_and_despike_is_named(tmp_path, depth):
+    """A pixel far below a smooth map (a dropout the instrument wrote as a height, not NaN) is no
+    spike up, and nothing was said, though it made the map's rms slope, xi's denominator and the
+    full-contact estimate E* g. The caveat counts it, gives the rms slope on the file's pixels with
+    and without it, and names despike; a line's names removing it from the profile."""
+    z, _ = band_limited(40, 48, seed=5, top=0.2)
+    z[20, 30] += depth * np.std(z)
+    np.save(tmp_path / "map.npy", z)
+    said = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.05, spacing_y=0.125).input_summary()["caveats"]
+    (caveat,) = [c for c in said if "of the map's points" in c]  # at 100 rms, the outlier caveat too
+    levelled = z - z.mean()
+    smooth = despike(levelled, 6.0, float(np.std(levelled)))[0]
+    assert caveat.startswith("1 of the map's points stands more than 6 rms heights from the median of the 5 x 5 pixels")
+    assert _clause(levelled, smooth, 0.05, 0.125, "map") in caveat and caveat.endswith("; despike: 6 replaces it, if it is not the surface's own")
+    t = np.arange(512.0)
+    line = np.sin(2 * np.pi * t / 97.0) + 0.5 * np.cos(2 * np.pi * t / 41.0)
+    line[200:202] += depth * np.std(line)
+    np.save(tmp_path / "line.npy", line)
+    said = ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.2).input_summary()["caveats"]
+    (caveat,) = [c for c in said if "of the line's points" in c]
+    assert caveat.startswith("2 of the line's points stand more than 6 rms heights from the median of the 5 points")
+    assert caveat.endswith("; remove them from the profile, if they are not the surface's own")
+
+
+@pytest.mark.parametrize("hurst", [0.3, 0.8])
+def test_self_affine_surfaces_draw_no_spike_or_pit_caveat(registry, hurst):
+    """The surfaces a run makes, rough down to two pixels: their largest slopes are their own."""
+    from frictionlab.preset.seeds import realization_rng
+
+    generator = registry.get("spectrum", "power-law-2d")(hurst=hurst, points=128, short_cutoff=2.0, spacing=1.0)
+    for index in range(3):
+        z = generator.generate(realization_rng(3, index)).heights
+        assert spike_warning(z - z.mean(), float(np.std(z))) is None
