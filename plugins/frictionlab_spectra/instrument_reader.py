@@ -430,6 +430,9 @@ def channel_list(reader) -> list[dict]:
     return listed
 
 
+LEFT_OUT = " (most readers list channels of heights only: one in degrees, volts or no unit may be left out)"
+
+
 def pick_channel(reader, wanted: str | int | None, where: str):
     """The channel ``wanted`` (an index, or a name: the first of that name), or the reader's
     default; and a note when other channels share its name (None otherwise)."""
@@ -443,14 +446,14 @@ def pick_channel(reader, wanted: str | int | None, where: str):
     elif isinstance(wanted, int):
         if not 0 <= wanted < len(channels):
             raise ValueError(f"{where}: channel {wanted} does not exist; the file has {len(channels)} "
-                             f"(0 to {len(channels) - 1}): {_named(channels)}")  # fmt: skip
+                             f"(0 to {len(channels) - 1}): {_named(channels)}{LEFT_OUT}; indices count the channels "
+                             "listed here, not the instrument's own numbering: name the channel to be sure")  # fmt: skip
         channel = channels[wanted]
     else:
         named = [c for c in channels if str(c.name) == wanted]
         if not named:
             raise ValueError(f"{where}: no channel named {quoted(wanted)}; the file has {_named(channels)}"
-                             f"{_near_names(channels, wanted)} (most readers list channels of heights only: one in "
-                             "degrees, volts or no unit may be left out)")  # fmt: skip
+                             f"{_near_names(channels, wanted)}{LEFT_OUT}")  # fmt: skip
         channel = named[0]
     same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
     note = None
