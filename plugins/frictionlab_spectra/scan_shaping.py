@@ -223,10 +223,14 @@ def _pits_warning(z: np.ndarray, rms: float, pixel: tuple[float, float], what: s
     replaces (pits, a dropout written as a height) carry most of its mean squared slope: they
     touch no earlier than the surface, but the rms slope is theirs. The median filter runs only
     when the largest FEW_DIFFERENCES of the squared differences carry that share (1.5 s on 2048^2)."""
-    squares = np.concatenate([square.ravel() for square in _squared_slopes(z, pixel)])
-    top = min(squares.size, max(4, int(FEW_DIFFERENCES * squares.size)))
-    total = float(squares.sum())
-    if not total > 0 or float(np.partition(squares, squares.size - top)[-top:].sum()) <= SPIKE_SLOPE_SHARE * total:
+    total = largest = 0.0
+    for square in _squared_slopes(z, pixel):  # one axis at a time: one copy of the map
+        top = min(square.size, max(2, int(FEW_DIFFERENCES * square.size)))
+        total += float(square.sum())
+        square = square.ravel()
+        square.partition(square.size - top)
+        largest += float(square[-top:].sum())
+    if not total > 0 or largest <= SPIKE_SLOPE_SHARE * total:
         return None
     note, count = _spike_slope_note(z, rms, pixel, what)
     if not note:
@@ -243,9 +247,13 @@ def _mean_square_slope(z: np.ndarray, pixel: tuple[float, float]) -> float:
     return sum(float(np.mean(square)) for square in _squared_slopes(z, pixel))
 
 
-def _squared_slopes(z: np.ndarray, pixel: tuple[float, float]) -> list[np.ndarray]:
-    """The squared forward differences of ``z`` over (dx, dy), along x and (a map) along y."""
-    return [np.square(np.diff(z, axis=axis) / step) for axis, step in ((1, pixel[0]), (0, pixel[1])) if z.shape[axis] > 1]
+def _squared_slopes(z: np.ndarray, pixel: tuple[float, float]):
+    """The squared forward differences of ``z`` over (dx, dy), along x and (a map) along y, one at a time."""
+    for axis, step in ((1, pixel[0]), (0, pixel[1])):
+        if z.shape[axis] > 1:
+            square = np.diff(z, axis=axis)
+            square /= step
+            yield np.square(square, out=square)
 
 
 def _agreeing(spikes: int) -> tuple[str, str, str]:
