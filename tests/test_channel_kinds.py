@@ -6,6 +6,7 @@ reader takes for the angstrom, was refused alone.)"""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 pytest.importorskip("SurfaceTopography")
@@ -76,3 +77,39 @@ def test_a_surface_file_refuses_a_current_or_voltage_channel_its_reader_lists(tm
     monkeypatch.setattr("frictionlab_spectra.instrument_file._open_reader", lambda fh, path, where: Listing())
     with pytest.raises(ValueError, match=r"afm.gwy': channel \d \('(Current|Bias)'\) holds (current|voltage) values"):
         SurfaceFile(path=str(path), unit="nm", channel=channel).rms_height()
+
+
+def test_an_index_past_the_channels_listed_says_they_are_not_the_instruments_numbering(tmp_path, capsys):
+    """Gwyddion numbers a file's channels 0 to 3 (Height, Amplitude in V, Phase in deg, Z Sensor);
+    its reader lists the two of heights, 0 and 1. 'channel: 3', Gwyddion's Z Sensor, was refused
+    as 'does not exist' with the two listed and no word of why the numbers differ."""
+    from .test_scan_edge_cases import validate
+
+    z = rough(16, 16) * 1e-9
+    path = write_gwy(tmp_path / "afm.gwy", z, 1e-7, 1e-7,
+                     more=[("Amplitude", rough(16, 16), "V"), ("Phase", rough(16, 16), "deg"), ("Z Sensor", z, "m")])  # fmt: skip
+    code, text = validate(tmp_path, capsys, path, channel=3)
+    assert code == 2 and "Traceback" not in text
+    assert ("channel 3 does not exist; the file has 2 (0 to 1): 0: 'Height', 1: 'Z Sensor' (most readers list "
+            "channels of heights only: one in degrees, volts or no unit may be left out); indices count the channels "
+            "listed here, not the instrument's own numbering: name the channel to be sure") in text
+
+
+@pytest.mark.parametrize("signal", ["Amplitude", "Deflection Error", "Phase"])
+def test_a_signal_in_metres_first_in_the_file_is_passed_over_for_the_height_channel(tmp_path, capsys, signal):
+    """An AFM file whose first channel is an amplitude or a deflection error, in metres as its
+    heights are, had it read as the heights by default: an rms height 100 times too small and
+    slopes of the error signal, with only its name in the listing. The channel named Height is
+    taken, and the listing says why and how to take the other; asked for by index, the signal is read."""
+    from .test_scan_edge_cases import validate
+
+    z = rough(16, 16) * 1e-9
+    path = write_gwy(tmp_path / "afm.gwy", z * 0.01, 1e-7, 1e-7, more=[("Height", z, "m")], title=signal)
+    summary = SurfaceFile(path=str(path), unit="nm", detrend="mean").input_summary()
+    assert summary["channel"] == "Height" and summary["channel_index"] == 1
+    assert abs(summary["rms_height"] - float(np.std(z * 1e9))) < 1e-9 * summary["rms_height"]
+    code, text = validate(tmp_path, capsys, path, unit="nm")
+    assert code == 0 and (f"the file's default channel, 0 '{signal}', names a signal, not heights: channel 1 'Height' "
+                          "was taken (channel: 0 takes the other)") in text
+    asked = SurfaceFile(path=str(path), unit="nm", detrend="mean", channel=0).input_summary()
+    assert asked["channel"] == signal and "channel_note" not in asked

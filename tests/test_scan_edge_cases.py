@@ -21,8 +21,8 @@ def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
     return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
 
 
-def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None, more=()):
-    """A Gwyddion file of the map z[y, x] on pixels dx x dy (in unit_xy), and more channels
+def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None, more=(), title="Height"):
+    """A Gwyddion file of the map z[y, x] (channel 0, ``title``) on pixels dx x dy (in unit_xy), and more channels
     (title, map, unit of values) on the same grid."""
     from SurfaceTopography.IO.GWY import _gwy_write_object  # here: its import takes seconds
 
@@ -36,7 +36,7 @@ def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None
             "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", unit)})), "data": ("D", values.astype("<f8").ravel()),
         }))  # fmt: skip
 
-    container = {"/0/data/title": ("s", "Height"), "/0/data": field(z, unit_z)}
+    container = {"/0/data/title": ("s", title), "/0/data": field(z, unit_z)}
     for index, (title, values, unit) in enumerate(more, start=1):
         container[f"/{index}/data/title"] = ("s", title)
         container[f"/{index}/data"] = field(values, unit)

@@ -191,12 +191,15 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
     rms = float(np.std(levelled))
     expected = int(np.count_nonzero(levelled - ndimage.median_filter(levelled, size=5, mode="reflect") > 6 * rms))
     assert expected == where.stop - where.start
-    assert said["spiky"]["caveats"] == [
+    (caveat,) = said["spiky"]["caveats"]
+    assert caveat.startswith(
         f"{expected} of the line's 16 highest points {'stands' if expected == 1 else 'stand'} more than 6 rms heights "
         "above the median of the 5 points around them: spikes (dust, an instrument's artefact) take the first contact "
-        f"alone, and the law at small loads is theirs; remove {'it' if expected == 1 else 'them'} from the profile, "
-        f"if {'it is' if expected == 1 else 'they are'} not the surface's own"
-    ]
+        "alone, and the law at small loads is theirs; they carry "  # and the rms slope: checked below
+    ) and caveat.endswith(
+        f"; remove {'it' if expected == 1 else 'them'} from the profile, if {'it is' if expected == 1 else 'they are'} "
+        "not the surface's own"
+    )
     assert "caveats" not in said["smooth"] and "caveats" not in said["low"]
 
 
@@ -446,3 +449,85 @@ def test_a_region_bound_not_finite_is_one_problem(tmp_path, capsys, span, said):
     assert main(["validate", str(tmp_path / "p.yaml")]) == 2
     out = "".join(capsys.readouterr())
     assert "1 problem in preset" in out and f"spectrum.params.{said}" in out, out
+
+
+def _clause(spiky: np.ndarray, smooth: np.ndarray, dx: float, dy: float, what: str) -> str:
+    """The spike caveat's slope clause, by hand: forward differences over the pixel's sides."""
+    def square(z):
+        return sum(np.mean((np.diff(z, axis=a) / d) ** 2) for a, d in ((1, dx), (0, dy)) if z.shape[a] > 1)
+
+    with_, without = square(spiky), square(smooth)
+    return (f"they carry {100 * (1 - without / with_):.0f} % of the {what}'s mean squared slope (its rms slope is "
+            f"{np.sqrt(with_):.3g}, {np.sqrt(with_ / without):.3g} times what it is without them), so the rms slope xi "
+            "divides by, and the full-contact estimate p = E* g, are theirs too")
+
+
+def test_a_spike_that_makes_the_rms_slope_says_so_with_the_slope_on_the_files_pixels(tmp_path):
+    """One spike 20 rms high on a smooth map of 0.05 x 0.125 pixels (x by y) carries most of the
+    mean squared slope: the rms slope that xi divides by and the full-contact estimate E* g were the
+    spike's, and the caveat said only that the law at small loads was. The rms slope is the
+    file's, on its own pixels (with the spike, and without it as despike: 6 replaces it); a spike
+    of 7 rms on a rough map, which carries little of the slope, adds no such clause."""
+    z, _ = band_limited(40, 48, seed=5, top=0.2)
+    z -= z.mean()
+    spiky = z.copy()
+    spiky[20, 30] += 20 * np.std(z)
+    np.save(tmp_path / "map.npy", spiky)
+    said = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.05, spacing_y=0.125).input_summary()["caveats"]
+    levelled = spiky - spiky.mean()
+    smooth = despike(levelled, 6.0, float(np.std(levelled)))[0]
+    assert any(_clause(levelled, smooth, 0.05, 0.125, "map") in c and "despike: 6 replaces it" in c for c in said)
+    rough, _ = band_limited(64, 64, seed=5, top=0.9, modes=200)
+    rough -= rough.mean()
+    rough[np.unravel_index(np.argmax(rough), rough.shape)] += 7 * np.std(rough)
+    caveat = spike_warning(rough, float(np.std(rough)))
+    assert caveat.startswith("1 of the map's 16 highest points stands") and "slope" not in caveat
+
+
+def test_a_spike_that_makes_a_lines_rms_slope_says_so_in_the_lines_length_unit(tmp_path):
+    """A profile's spike 13 rms high on a smooth line of points 0.2 apart: the clause gives the rms
+    slope over 0.2, not over one point."""
+    t = np.arange(512.0)
+    z = np.sin(2 * np.pi * t / 97.0) + 0.5 * np.cos(2 * np.pi * t / 41.0)
+    z[300] += 13 * np.std(z)
+    np.save(tmp_path / "line.npy", z)
+    (caveat,) = ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.2).input_summary()["caveats"]
+    levelled = (z - z.mean()).reshape(1, -1)
+    smooth = despike(levelled, 6.0, float(np.std(levelled)))[0]
+    assert _clause(levelled, smooth, 0.2, 0.2, "line") in caveat
+
+
+@pytest.mark.parametrize("depth", [-20.0, -100.0])  # a pit; a dropout written as a height
+def test_a_pit_that_makes_the_rms_slope_says_so_and_despike_is_named(tmp_path, depth):
+    """A pixel far below a smooth map (a dropout the instrument wrote as a height, not NaN) is no
+    spike up, and nothing was said, though it made the map's rms slope, xi's denominator and the
+    full-contact estimate E* g. The caveat counts it, gives the rms slope on the file's pixels with
+    and without it, and names despike; a line's names removing it from the profile."""
+    z, _ = band_limited(40, 48, seed=5, top=0.2)
+    z[20, 30] += depth * np.std(z)
+    np.save(tmp_path / "map.npy", z)
+    said = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.05, spacing_y=0.125).input_summary()["caveats"]
+    (caveat,) = [c for c in said if "of the map's points" in c]  # at 100 rms, the outlier caveat too
+    levelled = z - z.mean()
+    smooth = despike(levelled, 6.0, float(np.std(levelled)))[0]
+    assert caveat.startswith("1 of the map's points stands more than 6 rms heights from the median of the 5 x 5 pixels")
+    assert _clause(levelled, smooth, 0.05, 0.125, "map") in caveat and caveat.endswith("; despike: 6 replaces it, if it is not the surface's own")
+    t = np.arange(512.0)
+    line = np.sin(2 * np.pi * t / 97.0) + 0.5 * np.cos(2 * np.pi * t / 41.0)
+    line[200:202] += depth * np.std(line)
+    np.save(tmp_path / "line.npy", line)
+    said = ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.2).input_summary()["caveats"]
+    (caveat,) = [c for c in said if "of the line's points" in c]
+    assert caveat.startswith("2 of the line's points stand more than 6 rms heights from the median of the 5 points")
+    assert caveat.endswith("; remove them from the profile, if they are not the surface's own")
+
+
+@pytest.mark.parametrize("hurst", [0.3, 0.8])
+def test_self_affine_surfaces_draw_no_spike_or_pit_caveat(registry, hurst):
+    """The surfaces a run makes, rough down to two pixels: their largest slopes are their own."""
+    from frictionlab.preset.seeds import realization_rng
+
+    generator = registry.get("spectrum", "power-law-2d")(hurst=hurst, points=128, short_cutoff=2.0, spacing=1.0)
+    for index in range(3):
+        z = generator.generate(realization_rng(3, index)).heights
+        assert spike_warning(z - z.mean(), float(np.std(z))) is None

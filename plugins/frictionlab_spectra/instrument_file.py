@@ -25,9 +25,10 @@ import numpy as np
 from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
+from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, choose_reader, describe_failure, pick_channel,
+    check_text_heights, check_text_room, choose_reader, describe_failure,
     TEXT_FORMATS, quoted,
 )
 

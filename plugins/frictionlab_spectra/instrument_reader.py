@@ -430,48 +430,6 @@ def channel_list(reader) -> list[dict]:
     return listed
 
 
-def pick_channel(reader, wanted: str | int | None, where: str):
-    """The channel ``wanted`` (an index, or a name: the first of that name), or the reader's
-    default; and a note when other channels share its name (None otherwise)."""
-    channels = list(reader.channels)
-    if not channels:  # a reader keeps only channels of heights (a length over lengths): here, none
-        raise ValueError(f"{where}: the {reader.name()} file holds no channel of heights that SurfaceTopography reads "
-                         "(heights are lengths: m, um, nm...; a channel in degrees, volts, newtons or no unit is "
-                         "not read as heights); export the height channel with its length unit")  # fmt: skip
-    if wanted is None:
-        channel = reader.default_channel
-    elif isinstance(wanted, int):
-        if not 0 <= wanted < len(channels):
-            raise ValueError(f"{where}: channel {wanted} does not exist; the file has {len(channels)} "
-                             f"(0 to {len(channels) - 1}): {_named(channels)}")  # fmt: skip
-        channel = channels[wanted]
-    else:
-        named = [c for c in channels if str(c.name) == wanted]
-        if not named:
-            raise ValueError(f"{where}: no channel named {quoted(wanted)}; the file has {_named(channels)}"
-                             f"{_near_names(channels, wanted)} (most readers list channels of heights only: one in "
-                             "degrees, volts or no unit may be left out)")  # fmt: skip
-        channel = named[0]
-    same = [int(c.index) for c in channels if str(c.name) == str(channel.name)]
-    note = None
-    if len(same) > 1:
-        note = (f"{len(same)} channels are named {quoted(channel.name)} (indices {', '.join(map(str, same))}); "
-                f"index {int(channel.index)} was taken (channel: INDEX chooses another)")  # fmt: skip
-    return channel, note
-
-
-def _near_names(channels, wanted: str) -> str:
-    """A hint when a name differs from one of the file's only in case or surrounding spaces:
-    names are matched exactly, as the file writes them."""
-    key = wanted.strip().casefold()
-    near = [quoted(c.name) for c in channels if str(c.name).strip().casefold() == key]
-    return f" (names are matched exactly: did you mean {near[0]}?)" if near else ""
-
-
-def _named(channels) -> str:
-    return ", ".join(f"{int(c.index)}: {quoted(c.name)}" for c in channels)
-
-
 NAME_SHOWN = 60  # characters of a file's text (a channel's name, a unit) a message quotes: it may be of any length
 
 

@@ -146,7 +146,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
     if (warning := levelling_warning(levelled, mode)) is not None:
         caveats.append(warning)
-    if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after)) is not None:
+    if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after, pixel)) is not None:
         caveats.append(warning)
     if (warning := outlier_warning(levelled.heights, "map")) is not None:
         caveats.append(warning)

@@ -151,7 +151,7 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms),
+        caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
