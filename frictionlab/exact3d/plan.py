@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
-from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, shown_name
+from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, shown_name, write_failed
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
@@ -379,6 +379,9 @@ def run_plan(
         raise WorkInterrupted(
             f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with --runs {command_word(runs_dir)} to resume"
         ) from None
+    except OSError as exc:  # a full disk: what finished stays, as after an interrupt
+        raise write_failed(exc, f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
+                                f"--runs {command_word(runs_dir)} to resume") from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
         count_time()
     return runs

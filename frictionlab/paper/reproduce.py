@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import OutputRefused, shown_name
+from ..errors import OutputRefused, shown_name, write_failed
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
@@ -100,6 +100,9 @@ def write_report(
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
         raise WorkInterrupted(f"{said}the runs that finished are kept in {shown_name(out_dir)}; no {shown_name(markdown_path)} written") from None
+    except OSError as exc:  # a full disk: what finished stays, as after an interrupt
+        raise write_failed(exc, f"the runs that finished are kept in {shown_name(out_dir)}: the report run again with the same "
+                                f"--out continues them; no {shown_name(markdown_path)} written") from None
     command = "frictionlab report" + (" --readings" if readings else "") + (f" --replicates {replicates}" if replicates > 1 else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,

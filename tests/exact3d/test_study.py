@@ -362,3 +362,22 @@ def test_a_page_that_is_a_folder_is_refused_before_the_study_even_with_force(qui
     err = capsys.readouterr().err
     assert f"{tmp_path / 'out' / PAGE} is a folder, not a file: the exact 3D study writes its {PAGE} there" in err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [PAGE]
+
+
+def test_a_full_disk_says_which_file_and_that_the_ensembles_that_finished_are_kept(tmp_path, capsys, monkeypatch):
+    """A full disk in an ensemble's run said 'No space left on device: FILE', nothing of the
+    ensembles kept nor of how to resume them."""
+    import errno
+
+    from frictionlab.exact3d import plan
+
+    def full(scene, folder, options, *args, **keys):
+        raise OSError(errno.ENOSPC, "No space left on device", str(folder / "summary.json"))
+
+    monkeypatch.setattr(plan, "run_to_folder", full)
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--runs", str(runs), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: cannot write {runs}/") and err.count("\n") == 1
+    assert err.endswith(f"/summary.json: No space left on device; the ensembles that finished are kept in {runs}; "
+                        f"run the command again with --runs {runs} to resume\n")  # fmt: skip

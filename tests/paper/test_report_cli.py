@@ -125,3 +125,26 @@ def test_a_preset_that_is_not_its_figure_is_refused_before_any_figure_runs(tmp_p
     assert main(["report", "--presets", str(presets), "--out", str(tmp_path / "r"), "--quiet"]) == ExitCode.USAGE
     err = capsys.readouterr().err
     assert f"{presets / f'benad2012-{key}.yaml'}: {said}" in err and "frictionlab presets copy" in err
+
+
+def test_a_full_disk_says_which_file_and_that_the_runs_that_finished_are_kept(tmp_path, capsys, monkeypatch):
+    """A full disk in a figure's run said 'No space left on device: FILE' and nothing of the runs
+    that finished nor of how to go on (they are kept: the report run again continues them)."""
+    import errno
+
+    from frictionlab.io.files import atomic_write
+    from frictionlab.paper import reproduce
+
+    def chunk_that_does_not_fit(presets, out_dir, options, **how):
+        def full(fh):
+            raise OSError(errno.ENOSPC, "No space left on device")  # as a write says it: no file named
+
+        atomic_write(out_dir / "fig3" / "chunks" / "00000000-00000009.npz", full, binary=True)
+
+    monkeypatch.setattr(reproduce, "run_figures", chunk_that_does_not_fit)
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err == (f"error: cannot write {out}/fig3/chunks/00000000-00000009.npz: No space left on device; the runs that "
+                   f"finished are kept in {out}: the report run again with the same --out continues them; "
+                   f"no {out}/REPRODUCTION.md written\n")  # fmt: skip
