@@ -346,6 +346,8 @@ def run_plan(
         output_subfolder(runs_dir, job.folder(_solver_name(factories[job.hurst], job)), "run the command again", make=False)
     if compute:
         check_memory_ahead(factories, runs_dir, plan, options)
+    kept = (f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
+            f"--runs {command_word(runs_dir)} to resume")  # fmt: skip
     try:
         for job in plan.jobs():
             scene = _scene(factories[job.hurst], job, plan)
@@ -376,12 +378,9 @@ def run_plan(
             if done is None:
                 count_time()
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
-        raise WorkInterrupted(
-            f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with --runs {command_word(runs_dir)} to resume"
-        ) from None
-    except OSError as exc:  # a full disk: what finished stays, as after an interrupt
-        raise write_failed(exc, f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
-                                f"--runs {command_word(runs_dir)} to resume") from None
+        raise WorkInterrupted(kept) from None
+    except (OSError, RunError) as exc:  # a full disk (at a run's plot.png: a RunError): what finished stays
+        raise (write_failed(exc, kept) if isinstance(exc, OSError) else RunError(f"{exc}; {kept}")) from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
         count_time()
     return runs

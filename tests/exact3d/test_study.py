@@ -381,3 +381,19 @@ def test_a_full_disk_says_which_file_and_that_the_ensembles_that_finished_are_ke
     assert err.startswith(f"error: cannot write {runs}/") and err.count("\n") == 1
     assert err.endswith(f"/summary.json: No space left on device; the ensembles that finished are kept in {runs}; "
                         f"run the command again with --runs {runs} to resume\n")  # fmt: skip
+
+
+def test_a_full_disk_at_a_runs_figure_says_how_to_resume_too(tmp_path, capsys, monkeypatch):
+    """A run's plot.png on a full disk said only '...; the numbers are written'."""
+    from frictionlab.errors import RunError
+    from frictionlab.exact3d import plan
+
+    def full(scene, folder, options, *args, **keys):
+        raise RunError(f"cannot write {folder}/plot.png: No space left on device; the numbers are written")
+
+    monkeypatch.setattr(plan, "run_to_folder", full)
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--runs", str(runs), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.endswith(f"/plot.png: No space left on device; the numbers are written; the ensembles that finished are "
+                        f"kept in {runs}; run the command again with --runs {runs} to resume\n")  # fmt: skip
