@@ -16,7 +16,7 @@ from ..options import RunOptions
 from ..runs.rundir import new_run_folder
 from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
-from .figures import find_presets, run_figures
+from .figures import find_presets, kept_in, run_figures
 from .markdown import markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
 from .readings import READINGS, fig5_calibrated_readings, run_readings
@@ -101,8 +101,7 @@ def write_report(
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
         raise WorkInterrupted(f"{said}the runs that finished are kept in {shown_name(out_dir)}; no {shown_name(markdown_path)} written") from None
     except OSError as exc:  # a full disk: what finished stays, as after an interrupt
-        raise write_failed(exc, f"the runs that finished are kept in {shown_name(out_dir)}: the report run again with the same "
-                                f"--out continues them; no {shown_name(markdown_path)} written") from None
+        raise write_failed(exc, f"{kept_in(out_dir)}; no {shown_name(markdown_path)} written") from None
     command = "frictionlab report" + (" --readings" if readings else "") + (f" --replicates {replicates}" if replicates > 1 else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
