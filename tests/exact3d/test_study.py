@@ -397,3 +397,20 @@ def test_a_full_disk_at_a_runs_figure_says_how_to_resume_too(tmp_path, capsys, m
     err = capsys.readouterr().err
     assert err.endswith(f"/plot.png: No space left on device; the numbers are written; the ensembles that finished are "
                         f"kept in {runs}; run the command again with --runs {runs} to resume\n")  # fmt: skip
+
+
+def test_out_of_memory_making_a_presets_surface_gives_advice_that_fits_the_study(tmp_path, capsys, monkeypatch):
+    """Under `ulimit -v`, the surface that scales a preset's loads (made before the memory check)
+    ran out of memory, and the study was told to ask for fewer points or realizations: its
+    grids and ensembles are its plan's, not a setting of the command."""
+    from frictionlab.exact3d import plan
+
+    def short(*args, **keys):
+        raise MemoryError("Unable to allocate 8.00 MiB for an array with shape (1024, 1024) and data type float64")
+
+    monkeypatch.setattr(plan, "SceneFactory", short)
+    assert main(["exact3d", "--quick", "--runs", str(tmp_path / "runs"), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith("error: the exact 3D study starts nothing: out of memory making a surface of ")
+    assert "(Unable to allocate 8.00 MiB" in err and "; run it where more memory is free" in err
+    assert "fewer points" not in err and "internal error" not in err
