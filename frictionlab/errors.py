@@ -229,8 +229,8 @@ def resume_hint(folder) -> str:
 
 
 def write_failed(exc: OSError, kept: str) -> RunError:
-    """A write of a command of several runs that failed (a full disk) as a RunError (exit code 1):
-    the file and the system's reason, then ``kept``, what finished and how to go on."""
+    """A write that failed (a full disk) as a RunError (exit code 1; under --json, the error
+    object): the file and the system's reason, then ``kept``, what finished and how to go on."""
     where = f" {shown_name(exc.filename)}" if exc.filename else ""
     return RunError(f"cannot write{where}: {exc.strerror or exc}; {kept}")
 

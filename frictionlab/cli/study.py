@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ..errors import ExitCode, FrictionlabError, not_an_option, shell_word, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 from .options import preset_overrides
 
@@ -214,8 +214,7 @@ def run(args) -> ExitCode:
         files = write_outputs(study, out_dir, text, command_line(args))
     except OSError as exc:  # a full disk: the study's files are written whole, or not at all
         again = _again(out_dir, factory.base.preset.name, args.force)
-        print(f"error: cannot write the study to {shown_name(out_dir)}: {exc.strerror or exc}; {again}", file=sys.stderr)
-        return ExitCode.RUNTIME_FAILURE
+        raise RunError(f"cannot write the study to {shown_name(out_dir)}: {exc.strerror or exc}; {again}") from None
     if args.json:
         from ..compute.fit import json_safe
         from ..tradeoff.axes import COLUMNS

@@ -1,5 +1,7 @@
 """``frictionlab study``: the command line of the trade-off study."""
 
+import json
+
 
 
 import pytest
@@ -231,10 +233,12 @@ def test_a_full_disk_says_so_plainly_and_how_to_write_the_study_once_there_is_ro
     out = tmp_path / "o"
     args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--compare-steps", "5",
             "--quiet"]  # fmt: skip
-    assert main(args) == ExitCode.RUNTIME_FAILURE
-    err = capsys.readouterr().err
-    assert err == (f"error: cannot write the study to {out}: No space left on device; free some space and run the study "
-                   "again with --force (it replaces only study.csv, study.md and study.png)\n")  # fmt: skip
+    assert main([*args, "--json"]) == ExitCode.RUNTIME_FAILURE
+    captured = capsys.readouterr()
+    said = (f"cannot write the study to {out}: No space left on device; free some space and run the study again with "
+            "--force (it replaces only study.csv, study.md and study.png)")  # fmt: skip
+    assert captured.err == f"error: {said}\n"
+    assert json.loads(captured.out)["error"] == said  # the error object, as for every failure under --json
     monkeypatch.undo()
     assert main(args) == ExitCode.OUTPUT_REFUSED  # as said: without --force, the folder is not a study's
     assert main([*args, "--force"]) == ExitCode.OK
