@@ -106,6 +106,9 @@ def write_report(
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
-    atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
+    try:  # a path the user named: /dev/stdout is written into
+        atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)
+    except OSError as exc:  # a full disk, /dev/full: every run finished
+        raise write_failed(exc, f"{kept_in(out_dir)} (reading them back)") from None
     log(f"report: wrote {shown_name(markdown_path)} and {len(images)} figures in {shown_name(figures_dir)}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

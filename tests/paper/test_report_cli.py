@@ -185,3 +185,24 @@ def test_a_figure_refused_as_it_starts_says_that_the_runs_before_it_are_kept(tmp
     assert capsys.readouterr().err == (
         "error: one process of this run would need about 0.18 GiB at its peak, but 101 MiB is available; the runs that "
         f"finished are kept in {out}: the report run again with the same --out continues them\n")  # fmt: skip
+
+
+def test_a_report_that_cannot_be_written_says_that_the_runs_are_kept(tmp_path, capsys, monkeypatch):
+    """`--markdown /dev/full` (or a disk full at the last file) said only 'No space left on
+    device: /dev/full', nothing of the runs, all finished, which the report run again reads back."""
+    import errno
+
+    from frictionlab.paper import reproduce
+
+    monkeypatch.setattr(reproduce, "run_figures", lambda *args, **keys: [])
+    monkeypatch.setattr(reproduce, "markdown", lambda *args, **keys: "# report\n")
+
+    def full(path, write, *args, **keys):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(reproduce, "atomic_write", full)
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    assert capsys.readouterr().err == (
+        f"error: cannot write {out}/REPRODUCTION.md: No space left on device; the runs that finished are kept in "
+        f"{out}: the report run again with the same --out continues them (reading them back)\n")  # fmt: skip
