@@ -228,6 +228,13 @@ def resume_hint(folder) -> str:
     return f"what finished is kept in {shown_name(folder)}/: `frictionlab resume {command_word(folder)}` computes the rest"
 
 
+def write_failed(exc: OSError, kept: str) -> RunError:
+    """A write that failed (a full disk) as a RunError (exit code 1; under --json, the error
+    object): the file and the system's reason, then ``kept``, what finished and how to go on."""
+    where = f" {shown_name(exc.filename)}" if exc.filename else ""
+    return RunError(f"cannot write{where}: {exc.strerror or exc}; {kept}")
+
+
 def command_word(path) -> str:
     """``path`` as a word of a command to copy (``not_an_option``, ``shell_word``)."""
     return shell_word(not_an_option(os.fsdecode(path)))

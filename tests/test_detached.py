@@ -239,3 +239,46 @@ def test_wait_started_waits_for_its_own_process_not_the_run_a_resume_continues(t
     silent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.3)"])  # never writes a start
     with pytest.raises(FrictionlabError, match="ended at once"):
         wait_started(silent, tmp_path, timeout=30)
+
+
+def test_a_log_line_cut_by_a_full_disk_is_taken_back_so_the_error_after_it_is_read(tmp_path, monkeypatch):
+    """A full disk cut a line of progress.jsonl: the run's error event was appended to the cut
+    line, which no reader parses, so `follow` never heard why the run stopped."""
+    import errno
+
+    log = ProgressLog(tmp_path)
+    log.begin({"event": "started", "pid": os.getpid(), "name": "x", "total": 3})
+    real_write = os.write
+
+    calls = []
+
+    def half_then_full(fd, data):  # as write(2) does at the disk's last block, then on a full disk
+        calls.append(data)
+        if len(calls) == 1:
+            return real_write(fd, data[: len(data) // 2])
+        if b'"error"' not in data:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(fd, data)  # the error: room enough again (the cut line's blocks, or a file deleted)
+
+    monkeypatch.setattr(os, "write", half_then_full)
+    log.write({"event": "load", "index": 0, "done": 1, "total": 3})
+    log.write({"event": "load", "index": 0, "done": 2, "total": 3})  # not written: the log stopped at the cut
+    log.error("cannot write results to x: No space left on device", 1)
+    events = ProgressReader(tmp_path).new_events()
+    assert [event["event"] for event in events] == ["started", "error"]
+    assert events[-1]["message"] == "cannot write results to x: No space left on device"
+
+
+def test_follow_of_a_run_that_ended_on_a_full_disk_says_why(tmp_path, capsys):
+    """A detached run stopped by a full disk logs its error; `follow` afterwards said only
+    'interrupted' (it read the error of summary.json alone, which a full disk did not let be written)."""
+    from frictionlab.cli import main
+
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 12}))
+    cancel = __import__("threading").Event()
+    cancel.set()  # stopped as it began: an interrupted folder, as the disk left it
+    run_to_folder(scene, tmp_path, RunOptions(workers=1), listeners=[ProgressLog(tmp_path)], cancel=cancel)
+    said = f"cannot write results to {tmp_path}/chunks/00000000-00000011.npz: No space left on device"
+    ProgressLog(tmp_path).error(said, 1)  # as the detached process says it
+    assert main(["follow", str(tmp_path)]) == 1
+    assert capsys.readouterr().err == f"error: {said}\n"

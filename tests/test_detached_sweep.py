@@ -133,3 +133,22 @@ def test_a_sweep_that_says_running_with_no_live_process_reads_as_interrupted(tmp
     (out / "run.lock").write_text("pid 999999999, started 2025-01-01 00:00:00\n")
     state = run_state(out)
     assert (state.status, state.pid, state.resumable) == ("interrupted", None, True)
+
+
+def test_follow_of_a_sweep_that_ended_on_a_full_disk_says_why(tmp_path, capsys):
+    """A detached sweep stopped by a full disk logs its error; `follow` afterwards listed its
+    points and said nothing of why it stopped."""
+    from frictionlab.cli import main
+    from frictionlab.runs.progresslog import ProgressLog
+
+    out = tmp_path / "sweep"
+    assert main(["run", "benad2012-fig5", "--set", "realizations=2", "--set", "loading.steps=5", "--set", "fit.bootstrap=20",
+                 "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 0  # fmt: skip
+    data = json.loads((out / "sweep.json").read_text())
+    data["status"] = "interrupted"  # as a sweep stopped by the disk leaves it
+    (out / "sweep.json").write_text(json.dumps(data))
+    said = f"cannot write results to {out}/points/02-hurst-0.4/curve.csv: No space left on device"
+    ProgressLog(out).error(said, 1)  # as the detached process says it
+    capsys.readouterr()
+    assert main(["follow", str(out)]) == 1
+    assert capsys.readouterr().err == f"error: {said}\n"

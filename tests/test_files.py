@@ -1,5 +1,6 @@
 """Files are written whole or not at all, with the usual permissions."""
 
+import errno
 import io
 import os
 import zipfile
@@ -175,3 +176,32 @@ def test_a_fifo_the_user_named_that_nothing_reads_is_refused_not_waited_on(tmp_p
     assert codes == [ExitCode.OUTPUT_REFUSED]
     assert "is a FIFO (named pipe) that nothing reads: start its reader first" in capsys.readouterr().err
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+
+
+def _full_disk(*args):
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))  # as a write or fsync says it: no file named
+
+
+def test_a_full_disk_names_the_file_it_was_writing_and_leaves_no_part_of_it(tmp_path, monkeypatch):
+    """A write's ENOSPC named no file: `report` and `exact3d` said 'cannot write the output',
+    naming neither the file nor its folder."""
+    target = tmp_path / "summary.json"
+    monkeypatch.setattr(os, "fsync", _full_disk)
+    with pytest.raises(OSError) as raised:
+        atomic_write(target, lambda fh: fh.write("{}"))
+    assert (raised.value.errno, raised.value.filename) == (errno.ENOSPC, str(target))
+    assert list(tmp_path.iterdir()) == []  # nothing that looks whole, no temporary
+
+
+def test_a_full_device_the_user_named_is_named_too(tmp_path):
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full on this system")
+    with pytest.raises(OSError) as raised:
+        atomic_write(Path("/dev/full"), lambda fh: fh.write("x" * 65536), devices=True)
+    assert (raised.value.errno, raised.value.filename) == (errno.ENOSPC, "/dev/full")
+
+
+def test_an_output_folder_under_a_device_says_what_the_device_is(tmp_path):
+    from frictionlab.io.files import output_path_problem
+
+    assert output_path_problem(Path(os.devnull) / "run") == f"{os.devnull}/run cannot be made a folder: {os.devnull} is a character device"

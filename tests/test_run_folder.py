@@ -426,3 +426,19 @@ def test_results_keep_the_preset_the_start_wrote_and_restore_one_changed_or_link
     results.write_results(out, scene, outcome)
     assert not (out / "preset.yaml").is_symlink() and (out / "preset.yaml").read_text() == expected
     assert mine.read_text() == expected and written.count("preset.yaml") == 2
+
+
+def test_a_disk_too_full_to_say_who_holds_the_lock_does_not_stop_the_run_nor_leave_the_lock(tmp_path, monkeypatch):
+    """A full disk as run.lock was given its holder's pid ended the run at once ('nothing was
+    kept') and left run.lock behind, never removed, though the lock itself holds."""
+    import errno
+
+    from frictionlab.cli import main
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(os, "pwrite", full)
+    out = tmp_path / "run"
+    assert main(["run", "quickstart", "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    assert (out / "summary.json").is_file() and not (out / "run.lock").exists()

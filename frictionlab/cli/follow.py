@@ -64,7 +64,7 @@ class _StopSignals:
 
 
 def run(args) -> ExitCode:
-    from ..runs.detached import process_alive, run_state
+    from ..runs.detached import logged_error, process_alive, run_state
 
     folder = Path(args.run_dir)
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
@@ -98,8 +98,10 @@ def run(args) -> ExitCode:
             return ENDINGS[stopped.signal][0]
         if follower.finished is not None:
             error = follower.finished.error
-    elif sweep is None:  # ended before: why, as its summary.json says (it was said only to a follower of the run)
-        error = _ended_error(folder)
+    else:  # ended before: why, as a run's summary.json says (it was said only to a follower), or its log (a full disk)
+        error = _ended_error(folder) if sweep is None else None
+        if error is None and state.status != "completed":
+            error = logged_error(folder)
     if gone:  # what is true: the folder it followed is no more; nothing there to resume
         still = f"; its process (pid {holder}) still runs, writing nowhere you can see" if holder and process_alive(holder) else ""
         message = f"{shown(folder)} was deleted or replaced while its run was going: nothing of that run is left to resume{still}"

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, command_word, counted, ran_out_of_memory,
-                      resume_hint, shown, shown_name, too_long_path)  # fmt: skip
+                      resume_hint, shown, shown_name, too_long_path, write_failed)  # fmt: skip
 from .options import add_executor_options, add_workers_option, executor_run_options, preset_overrides
 
 
@@ -135,10 +135,8 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
         result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
-    except OSError as exc:
-        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}; {resumable(out_dir)}"),
-              file=sys.stderr)  # fmt: skip
-        return ExitCode.RUNTIME_FAILURE
+    except OSError as exc:  # a full disk: said as every refusal is, as the error object under --json too
+        raise write_failed(exc, resumable(out_dir)) from None
     if closed:
         raise closed[0]
     outcome = result.outcome
@@ -180,10 +178,8 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
         outcome = run_sweep(
             sweep, out_dir, options, listeners=[] if args.quiet else [SweepProgress()], plot=not args.no_plot
         )
-    except OSError as exc:
-        print(shown(f"error: cannot write results to {exc.filename or out_dir}: {exc.strerror or exc}; {resumable(out_dir)}"),
-              file=sys.stderr)  # fmt: skip
-        return ExitCode.RUNTIME_FAILURE
+    except OSError as exc:  # a full disk: said as every refusal is, as the error object under --json too
+        raise write_failed(exc, resumable(out_dir)) from None
     if args.json:
         from .jsonout import emit
 

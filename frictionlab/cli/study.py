@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ..errors import ExitCode, FrictionlabError, not_an_option, shell_word, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 from .options import preset_overrides
 
@@ -160,6 +160,16 @@ def command_line(args) -> str:
     return " ".join(map(shell_word, words))
 
 
+def _again(out_dir, name: str, force: bool) -> str:
+    """How to write the study once there is room: the same command, with --force where the files
+    written before the disk filled (study.csv without its study.md) would make its folder refused."""
+    from ..tradeoff.outputs import is_study_of
+
+    if force or not out_dir.is_dir() or not any(out_dir.iterdir()) or is_study_of(out_dir / "study.md", name):
+        return "free some space and run the study again"
+    return "free some space and run the study again with --force (it replaces only study.csv, study.md and study.png)"
+
+
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
@@ -202,9 +212,9 @@ def run(args) -> ExitCode:
     text = recommendation(study)
     try:
         files = write_outputs(study, out_dir, text, command_line(args))
-    except OSError as exc:
-        print(f"error: cannot write the study to {shown_name(out_dir)}: {exc}", file=sys.stderr)
-        return ExitCode.RUNTIME_FAILURE
+    except OSError as exc:  # a full disk: the study's files are written whole, or not at all
+        again = _again(out_dir, factory.base.preset.name, args.force)
+        raise RunError(f"cannot write the study to {shown_name(out_dir)}: {exc.strerror or exc}; {again}") from None
     if args.json:
         from ..compute.fit import json_safe
         from ..tradeoff.axes import COLUMNS

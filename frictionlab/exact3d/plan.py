@@ -27,7 +27,8 @@ from pathlib import Path
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
-from ..errors import FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, shown_name
+from ..errors import (FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, limit_advice, shown_name,
+                      write_failed)
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
@@ -334,7 +335,11 @@ def run_plan(
                     f"{shown_name(path)}: sweep: the preset sweeps {', '.join(data['sweep'].get('parameters') or {})}, "
                     "but the study runs its own ensembles of it (grids, families), none of them swept; remove the sweep"
                 )
-            factories[job.hurst] = factory = SceneFactory(data, registry, source=str(path))
+            try:  # its loads are scaled on a surface of the preset's grid, made before any memory check
+                factories[job.hurst] = factory = SceneFactory(data, registry, source=str(path))
+            except MemoryError as exc:  # the plan's grids are fixed: fewer points is no advice here
+                raise RunError(f"the exact 3D study starts nothing: out of memory making a surface of {shown_name(path)} "
+                               f"({exc}); run it where more memory is free{limit_advice()}") from None  # fmt: skip
             # the page names it by its file's H
             if (unlike := first_unlike(factory.base.resolved(), {"spectrum.params.hurst": job.hurst})) is not None:
                 raise FrictionlabError(
@@ -346,6 +351,8 @@ def run_plan(
         output_subfolder(runs_dir, job.folder(_solver_name(factories[job.hurst], job)), "run the command again", make=False)
     if compute:
         check_memory_ahead(factories, runs_dir, plan, options)
+    kept = (f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
+            f"--runs {command_word(runs_dir)} to resume")  # fmt: skip
     try:
         for job in plan.jobs():
             scene = _scene(factories[job.hurst], job, plan)
@@ -376,9 +383,9 @@ def run_plan(
             if done is None:
                 count_time()
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
-        raise WorkInterrupted(
-            f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with --runs {command_word(runs_dir)} to resume"
-        ) from None
+        raise WorkInterrupted(kept) from None
+    except (OSError, RunError) as exc:  # a full disk (at a run's plot.png: a RunError): what finished stays
+        raise (write_failed(exc, kept) if isinstance(exc, OSError) else RunError(f"{exc}; {kept}")) from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
         count_time()
     return runs

@@ -8,6 +8,7 @@ socket or block device is refused; ``output_path_problem`` says why a path canno
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import io
 import os
@@ -57,7 +58,7 @@ def atomic_write(
     file")."""
     path = Path(path)
     if devices and (_kind(path) in ("character device", "FIFO") or _is_open_stream(path)):
-        with _open_node(path, binary) as fh:
+        with _naming(path), _open_node(path, binary) as fh:
             write(fh)
         return
     problem = replace_problem(path)
@@ -66,15 +67,28 @@ def atomic_write(
         raise error(errno.EISDIR if "folder" in problem else errno.EINVAL, problem, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    with _naming(path):
+        try:
+            os.fchmod(fd, 0o666 & ~_UMASK if mode is None else mode)
+            with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
+                write(fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)  # renames over a link itself, never its target
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+
+@contextlib.contextmanager
+def _naming(path: Path):
+    """A write or fsync that fails (a full disk: ENOSPC) raises an OSError naming no file:
+    it is given ``path``, so that its message says which file, in which folder, was not written."""
     try:
-        os.fchmod(fd, 0o666 & ~_UMASK if mode is None else mode)
-        with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)  # renames over a link itself, never its target
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = str(path)
         raise
 
 
@@ -186,7 +200,7 @@ def output_path_problem(path: Path) -> str | None:
                 return _unwritable(candidate, path)
             if candidate == path:
                 return f"{shown(path)} is {_not_a_folder(path)}, not a folder"
-            return f"{shown(path)} cannot be made a folder: {shown(candidate)} is a file"
+            return f"{shown(path)} cannot be made a folder: {shown(candidate)} is {_not_a_folder(candidate)}"
     return None
 
 

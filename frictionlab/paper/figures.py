@@ -8,12 +8,12 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..errors import FrictionlabError, command_word, short_repr, shown_name
+from ..errors import FrictionlabError, RunError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
 from ..runs.rundir import RunDirectory, same_preset
 from ..runs.runfolder import output_subfolder
-from ..runs.runner import run_to_folder
+from ..runs.runner import check_memory, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..runs.sweep import plan_sweep, run_sweep
 
@@ -147,26 +147,55 @@ def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
     return replace(options, resume=ours)
 
 
+def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:
+    """Refuse (RunError), before any figure runs, a report one of whose runs does not fit in
+    memory (each run's own check, ``runner.check_memory``): not once the figures before it ran."""
+    if not options.memory_check:
+        return
+    for run in runs:
+        for scene in [point.scene for point in run.sweep.points] if run.sweep else [run.scene]:
+            try:
+                check_memory(scene, replace(options, resume=False))
+            except RunError as exc:
+                raise RunError(f"the report starts nothing: {run.figure.key} does not fit: {exc} Of that advice, a "
+                               "preset's setting applies to a copy of the presets (--presets DIR); --workers and a "
+                               "higher limit do, or more memory free.") from None  # fmt: skip
+
+
+def kept_in(out_dir: Path) -> str:
+    """What a report that stopped keeps, and how to go on."""
+    return f"the runs that finished are kept in {shown_name(out_dir)}: the report run again with the same --out continues them"
+
+
+def _run(run: FigureRun, options: RunOptions, progress: bool) -> None:
+    """Run (or continue) one figure's run; with ``progress``, its progress on stderr."""
+    from ..progress import ProgressReporter, SweepProgress
+
+    if run.sweep is not None:
+        listeners = [SweepProgress()] if progress else []
+        run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
+                                      listeners=listeners)  # fmt: skip
+    else:
+        listeners = [ProgressReporter()] if progress else []
+        run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
+                                       listeners=listeners)  # fmt: skip
+
+
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
     """Run each figure's preset into ``out_dir``, every preset checked first; with
     ``progress``, each run's progress on stderr."""
-    from ..progress import ProgressReporter, SweepProgress
-
     runs = plan_figures(presets, out_dir)
     for run in runs:  # a link at a figure's folder refused before any figure runs
         output_subfolder(out_dir, run.figure.key, "run the report again", make=False)
+    _check_memory_ahead(runs, options)
     for run in runs:
         fig, path = run.figure, run.preset_path
         output_subfolder(out_dir, fig.key, "run the report again")
         seen = mark()
-        if run.sweep is not None:
-            listeners = [SweepProgress()] if progress else []
-            run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
-                                          listeners=listeners)  # fmt: skip
-        else:
-            listeners = [ProgressReporter()] if progress else []
-            run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
-                                           listeners=listeners)  # fmt: skip
+        try:
+            _run(run, options, progress)
+        except RunError as exc:  # its own memory check (this process grew), a figure not written: the others stay
+            raise RunError(f"{str(exc).rstrip('.')}; {kept_in(out_dir)}") from None
         status = (run.sweep_outcome or run.outcome).status
         if status in ("interrupted", "cancelled"):
             how = (f"frictionlab run {command_word(path)} --out {command_word(run.folder)} --resume" if run.sweep is not None

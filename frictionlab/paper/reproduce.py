@@ -10,13 +10,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import OutputRefused, shown_name
+from ..errors import OutputRefused, shown_name, write_failed
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
 from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
-from .figures import find_presets, run_figures
+from .figures import find_presets, kept_in, run_figures
 from .markdown import markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
 from .readings import READINGS, fig5_calibrated_readings, run_readings
@@ -100,10 +100,15 @@ def write_report(
     except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: a run ended interrupted, or it came between two
         said = f"{exc}; " if isinstance(exc, WorkInterrupted) and str(exc) else ""
         raise WorkInterrupted(f"{said}the runs that finished are kept in {shown_name(out_dir)}; no {shown_name(markdown_path)} written") from None
+    except OSError as exc:  # a full disk: what finished stays, as after an interrupt
+        raise write_failed(exc, f"{kept_in(out_dir)}; no {shown_name(markdown_path)} written") from None
     command = "frictionlab report" + (" --readings" if readings else "") + (f" --replicates {replicates}" if replicates > 1 else "")
     text = markdown(runs, images, elapsed=elapsed, readings=reading_rows, readings_elapsed=readings_elapsed,
                     fig5_calibrated=fig5_rows, fig5_calibrated_elapsed=fig5_elapsed, workers=options.workers,
                     command=command)  # fmt: skip
-    atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)  # a path the user named: /dev/stdout is written into
+    try:  # a path the user named: /dev/stdout is written into
+        atomic_write(markdown_path, lambda fh: fh.write(text), devices=True)
+    except OSError as exc:  # a full disk, /dev/full: every run finished
+        raise write_failed(exc, f"{kept_in(out_dir)} (reading them back)") from None
     log(f"report: wrote {shown_name(markdown_path)} and {len(images)} figures in {shown_name(figures_dir)}/ ({elapsed:.1f} s for Figs. 2 to 5)")
     return markdown_path

@@ -405,6 +405,20 @@ def _last_count(folder: Path) -> int | None:
                 done = _count(event.get("done"))
 
 
+def logged_error(folder: Path) -> str | None:
+    """The error the run in ``folder`` logged as its last word (a full disk), read from the
+    progress log's tail; None if its last event is another."""
+    reader = ProgressReader(folder)
+    try:
+        reader.offset = max(0, os.lstat(reader.path).st_size - TAIL_BYTES)  # a cut first line is skipped
+    except OSError:
+        return None
+    last = None
+    while events := reader.new_events():
+        last = events[-1]
+    return str(last.get("message")) if last is not None and last["event"] == "error" else None
+
+
 def list_run_states(runs_dir: str | Path) -> list[RunState]:
     """The state of every run folder directly under ``runs_dir`` (one holding a
     ``run.json``, a ``summary.json``, or a sweep's ``sweep.json``), running ones first,

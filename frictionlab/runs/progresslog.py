@@ -84,8 +84,12 @@ class ProgressLog:
         ``MAX_LINE_BYTES`` (``fitted_line``), written at once."""
         if self._fd is None:
             return
+        line = fitted_line({**event, "time": self.clock()})
         try:
-            os.write(self._fd, fitted_line({**event, "time": self.clock()}))
+            written = os.write(self._fd, line)
+            if written < len(line):  # a full disk: the part written goes, so that no later line (the error) is glued to it
+                os.ftruncate(self._fd, os.lseek(self._fd, 0, os.SEEK_CUR) - written)
+                self.close()
         except OSError:
             self.close()
 

@@ -25,6 +25,7 @@ run it runs again, saying so) unless ``force``; even then it deletes only chunk 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -57,7 +58,8 @@ START_LEFTOVER = re.compile(rf"\.(?:{re.escape(PRESET_FILE)}|{re.escape(STATE_FI
 def _write_holder(fd: int) -> None:
     """Who holds run.lock, for the message of a run refused because of it."""
     os.ftruncate(fd, 0)
-    os.pwrite(fd, f"pid {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n".encode(), 0)
+    with contextlib.suppress(OSError):  # a courtesy a full disk goes without: raised, it left run.lock behind
+        os.pwrite(fd, f"pid {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n".encode(), 0)
 
 
 def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:

@@ -358,7 +358,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     if force or not out.is_dir():
         return out
     held = sorted(p.name for p in out.iterdir())
-    if not held or (set(held) <= set(FILES) and _is_study_of(out / "study.md", name)):
+    if not held or (set(held) <= set(FILES) and is_study_of(out / "study.md", name)):
         return out
     listed = ", ".join(repr(shown(n)) for n in held[:3])
     raise OutputRefused(
@@ -367,7 +367,7 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     )
 
 
-def _is_study_of(page: Path, name: str) -> bool:
+def is_study_of(page: Path, name: str) -> bool:
     try:
         if not page.is_file() or page.is_symlink():
             return False

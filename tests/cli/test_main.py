@@ -339,3 +339,25 @@ def test_a_full_disk_or_memory_at_the_end_says_what_is_kept_and_how_to_resume(tm
     assert "internal error" not in err
     monkeypatch.undo()
     assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.OK
+
+
+def test_a_full_disk_under_json_prints_the_error_object(tmp_path, monkeypatch, capsys):
+    """`run --json` stopped by a full disk printed nothing on stdout: a script found no JSON
+    where every other refusal or failure gives the error object."""
+    import errno
+
+    from frictionlab.cli import main
+    from frictionlab.runs import runner
+
+    def full(out_dir, *args):
+        raise OSError(errno.ENOSPC, "No space left on device", str(out_dir / "summary.json"))
+
+    monkeypatch.setattr(runner, "write_results", full)
+    out = tmp_path / "run"
+    assert main(["run", "quickstart", "--out", str(out), "--workers", "1", "--quiet", "--json"]) == ExitCode.RUNTIME_FAILURE
+    captured = capsys.readouterr()
+    said = (f"cannot write {out}/summary.json: No space left on device; what finished is kept in {out}/: "
+            f"`frictionlab resume {out}` computes the rest")  # fmt: skip
+    assert captured.err == f"error: {said}\n"
+    error = json.loads(captured.out)
+    assert (error["schema"], error["command"], error["error"], error["exit_code"]) == ("frictionlab/error/1", "run", said, 1)

@@ -1,5 +1,7 @@
 """``frictionlab study``: the command line of the trade-off study."""
 
+import json
+
 
 
 import pytest
@@ -211,3 +213,33 @@ def test_each_comparison_count_says_it_is_at_most_the_presets(capsys):
     for option in ("--points N", "--compare-realizations M", "--compare-steps K", "--grid-realizations M"):
         said = help_text.split(option, 2)[-1].split(" --", 1)[0]  # the option's own help (after the usage line)
         assert "at most the preset's" in said, (option, said)
+
+
+def test_a_full_disk_says_so_plainly_and_how_to_write_the_study_once_there_is_room(tmp_path, capsys, monkeypatch):
+    """A full disk after study.csv said '[Errno 28] No space left on device' and nothing more;
+    the same command then refused the folder (its study.csv with no study.md) without --force."""
+    import errno
+
+    from frictionlab.tradeoff import outputs
+
+    write_file = outputs.atomic_write
+
+    def md_does_not_fit(path, write, *args, **keys):
+        if path.name == "study.md":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        write_file(path, write, *args, **keys)
+
+    monkeypatch.setattr(outputs, "atomic_write", md_does_not_fit)
+    out = tmp_path / "o"
+    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--compare-steps", "5",
+            "--quiet"]  # fmt: skip
+    assert main([*args, "--json"]) == ExitCode.RUNTIME_FAILURE
+    captured = capsys.readouterr()
+    said = (f"cannot write the study to {out}: No space left on device; free some space and run the study again with "
+            "--force (it replaces only study.csv, study.md and study.png)")  # fmt: skip
+    assert captured.err == f"error: {said}\n"
+    assert json.loads(captured.out)["error"] == said  # the error object, as for every failure under --json
+    monkeypatch.undo()
+    assert main(args) == ExitCode.OUTPUT_REFUSED  # as said: without --force, the folder is not a study's
+    assert main([*args, "--force"]) == ExitCode.OK
+    assert {p.name for p in out.iterdir()} == {"study.csv", "study.md", "study.png"}

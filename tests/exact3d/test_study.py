@@ -362,3 +362,55 @@ def test_a_page_that_is_a_folder_is_refused_before_the_study_even_with_force(qui
     err = capsys.readouterr().err
     assert f"{tmp_path / 'out' / PAGE} is a folder, not a file: the exact 3D study writes its {PAGE} there" in err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [PAGE]
+
+
+def test_a_full_disk_says_which_file_and_that_the_ensembles_that_finished_are_kept(tmp_path, capsys, monkeypatch):
+    """A full disk in an ensemble's run said 'No space left on device: FILE', nothing of the
+    ensembles kept nor of how to resume them."""
+    import errno
+
+    from frictionlab.exact3d import plan
+
+    def full(scene, folder, options, *args, **keys):
+        raise OSError(errno.ENOSPC, "No space left on device", str(folder / "summary.json"))
+
+    monkeypatch.setattr(plan, "run_to_folder", full)
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--runs", str(runs), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: cannot write {runs}/") and err.count("\n") == 1
+    assert err.endswith(f"/summary.json: No space left on device; the ensembles that finished are kept in {runs}; "
+                        f"run the command again with --runs {runs} to resume\n")  # fmt: skip
+
+
+def test_a_full_disk_at_a_runs_figure_says_how_to_resume_too(tmp_path, capsys, monkeypatch):
+    """A run's plot.png on a full disk said only '...; the numbers are written'."""
+    from frictionlab.errors import RunError
+    from frictionlab.exact3d import plan
+
+    def full(scene, folder, options, *args, **keys):
+        raise RunError(f"cannot write {folder}/plot.png: No space left on device; the numbers are written")
+
+    monkeypatch.setattr(plan, "run_to_folder", full)
+    runs = tmp_path / "runs"
+    assert main(["exact3d", "--quick", "--runs", str(runs), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.endswith(f"/plot.png: No space left on device; the numbers are written; the ensembles that finished are "
+                        f"kept in {runs}; run the command again with --runs {runs} to resume\n")  # fmt: skip
+
+
+def test_out_of_memory_making_a_presets_surface_gives_advice_that_fits_the_study(tmp_path, capsys, monkeypatch):
+    """Under `ulimit -v`, the surface that scales a preset's loads (made before the memory check)
+    ran out of memory, and the study was told to ask for fewer points or realizations: its
+    grids and ensembles are its plan's, not a setting of the command."""
+    from frictionlab.exact3d import plan
+
+    def short(*args, **keys):
+        raise MemoryError("Unable to allocate 8.00 MiB for an array with shape (1024, 1024) and data type float64")
+
+    monkeypatch.setattr(plan, "SceneFactory", short)
+    assert main(["exact3d", "--quick", "--runs", str(tmp_path / "runs"), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith("error: the exact 3D study starts nothing: out of memory making a surface of ")
+    assert "(Unable to allocate 8.00 MiB" in err and "; run it where more memory is free" in err
+    assert "fewer points" not in err and "internal error" not in err

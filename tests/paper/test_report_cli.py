@@ -125,3 +125,84 @@ def test_a_preset_that_is_not_its_figure_is_refused_before_any_figure_runs(tmp_p
     assert main(["report", "--presets", str(presets), "--out", str(tmp_path / "r"), "--quiet"]) == ExitCode.USAGE
     err = capsys.readouterr().err
     assert f"{presets / f'benad2012-{key}.yaml'}: {said}" in err and "frictionlab presets copy" in err
+
+
+def test_a_full_disk_says_which_file_and_that_the_runs_that_finished_are_kept(tmp_path, capsys, monkeypatch):
+    """A full disk in a figure's run said 'No space left on device: FILE' and nothing of the runs
+    that finished nor of how to go on (they are kept: the report run again continues them)."""
+    import errno
+
+    from frictionlab.io.files import atomic_write
+    from frictionlab.paper import reproduce
+
+    def chunk_that_does_not_fit(presets, out_dir, options, **how):
+        def full(fh):
+            raise OSError(errno.ENOSPC, "No space left on device")  # as a write says it: no file named
+
+        atomic_write(out_dir / "fig3" / "chunks" / "00000000-00000009.npz", full, binary=True)
+
+    monkeypatch.setattr(reproduce, "run_figures", chunk_that_does_not_fit)
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err == (f"error: cannot write {out}/fig3/chunks/00000000-00000009.npz: No space left on device; the runs that "
+                   f"finished are kept in {out}: the report run again with the same --out continues them; "
+                   f"no {out}/REPRODUCTION.md written\n")  # fmt: skip
+
+
+def test_a_figure_that_does_not_fit_in_memory_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch):
+    """Under `ulimit -v`, Fig. 4 too large was refused only once Figs. 2 and 3 had run."""
+    from frictionlab.errors import RunError
+    from frictionlab.paper import figures
+    from frictionlab.runs import runner
+
+    def refuse_fig4(scene, options):
+        if scene.preset.name == "benad2012-fig4":
+            raise RunError("this run would need about 9 GiB at its peak, but 1 GiB is available.")
+
+    monkeypatch.setattr(runner, "check_memory", refuse_fig4)
+    monkeypatch.setattr(figures, "check_memory", refuse_fig4, raising=False)
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert err.startswith("error: the report starts nothing: fig4 does not fit: this run would need about 9 GiB")
+    assert "--workers and a higher limit do" in err and err.count("\n") == 1
+    assert not (out / "fig2").exists()
+
+
+def test_a_figure_refused_as_it_starts_says_that_the_runs_before_it_are_kept(tmp_path, capsys, monkeypatch):
+    """Refused by its own memory check (this process grew meanwhile), a figure said nothing of
+    the runs before it, kept and continued by the report run again."""
+    from frictionlab.errors import RunError
+    from frictionlab.runs import runner
+
+    def refuse(scene, options):
+        raise RunError("one process of this run would need about 0.18 GiB at its peak, but 101 MiB is available.")
+
+    monkeypatch.setattr(runner, "check_memory", refuse)  # the run's own check, not the report's ahead of it
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    assert capsys.readouterr().err == (
+        "error: one process of this run would need about 0.18 GiB at its peak, but 101 MiB is available; the runs that "
+        f"finished are kept in {out}: the report run again with the same --out continues them\n")  # fmt: skip
+
+
+def test_a_report_that_cannot_be_written_says_that_the_runs_are_kept(tmp_path, capsys, monkeypatch):
+    """`--markdown /dev/full` (or a disk full at the last file) said only 'No space left on
+    device: /dev/full', nothing of the runs, all finished, which the report run again reads back."""
+    import errno
+
+    from frictionlab.paper import reproduce
+
+    monkeypatch.setattr(reproduce, "run_figures", lambda *args, **keys: [])
+    monkeypatch.setattr(reproduce, "markdown", lambda *args, **keys: "# report\n")
+
+    def full(path, write, *args, **keys):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(reproduce, "atomic_write", full)
+    out = tmp_path / "report"
+    assert main(["report", "--out", str(out), "--quiet"]) == ExitCode.RUNTIME_FAILURE
+    assert capsys.readouterr().err == (
+        f"error: cannot write {out}/REPRODUCTION.md: No space left on device; the runs that finished are kept in "
+        f"{out}: the report run again with the same --out continues them (reading them back)\n")  # fmt: skip
