@@ -81,15 +81,10 @@ def _listed_chunks(run_dir: Path) -> int:
         return 0
 
 
-# KILL_PRESET's 480 realizations took about as long as two chunks' half seconds: on a loaded
-# machine the run could end before the signal reached it (exit 0)
-SIGNAL_PRESET = merge(KILL_PRESET, {"realizations": 2000})  # about 5 s on 2 workers here, 2 chunks by 1 s
-
-
 def _signalled_mid_run(tmp_path, signum, preexec_fn=None) -> tuple[subprocess.Popen, str, str, Path]:
-    """``frictionlab run`` of SIGNAL_PRESET sent ``signum`` once two chunks are written."""
+    """``frictionlab run`` of KILL_PRESET sent ``signum`` once two chunks are written."""
     preset = tmp_path / "long.yaml"
-    preset.write_text(yaml.safe_dump(SIGNAL_PRESET))
+    preset.write_text(yaml.safe_dump(KILL_PRESET))
     run_dir = tmp_path / "run"
     command = [sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(run_dir), "--workers", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=preexec_fn)
@@ -120,8 +115,8 @@ def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(regist
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert resumed.returncode == 0, resumed.stderr
-    assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < SIGNAL_PRESET["realizations"]
-    run_to_folder(build_scene(SIGNAL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
+    assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < KILL_PRESET["realizations"]
+    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")
 
 

@@ -32,7 +32,9 @@ NO_PLOT = {"output": {"plot": False}}  # matplotlib costs a second per folder an
 # A run killed once two chunks are on disk must still have most of its work ahead: chunks are
 # written every UNSAVED_WORK_SECONDS of computing, so the run is sized at ~20x that per worker
 # (80 realizations finished between the second chunk and the signal on a fast machine).
-KILL_PRESET = merge(SMALL_PRESET, {"realizations": 480, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
+# about 5 s on 2 workers here, the two chunks a test waits for by 1 s: with 480 realizations the run
+# took about as long as those chunks, and on a loaded machine ended before its signal or kill
+KILL_PRESET = merge(SMALL_PRESET, {"realizations": 2000, "spectrum": {"params": {"points": 65536}}, **NO_PLOT})
 # exact half-space contact of a surface with a rolloff, ~0.1 s per realization
 KILL_SURFACE = merge(
     yaml.safe_load((Path(__file__).parents[1] / "presets" / "exact3d-h08-rolloff.yaml").read_text()),
