@@ -386,36 +386,35 @@ def _summary(folder: Path) -> dict | None:
         raise RunFolderError(f"{shown(folder / 'summary.json')} cannot be read ({exc.strerror or exc})") from None
 
 
-def _last_count(folder: Path) -> int | None:
-    """Realizations finished as the progress log's last counting event says (read from its tail)."""
+def _tail_events(folder: Path):
+    """The events of the progress log's last ``TAIL_BYTES`` (a cut first line is skipped);
+    none if the log cannot be read."""
     reader = ProgressReader(folder)
     try:
-        reader.offset = max(0, os.lstat(reader.path).st_size - TAIL_BYTES)  # a cut first line is skipped
+        reader.offset = max(0, os.lstat(reader.path).st_size - TAIL_BYTES)
     except OSError:
-        return None
+        return
+    while events := reader.new_events():
+        yield from events
+
+
+def _last_count(folder: Path) -> int | None:
+    """Realizations finished as the progress log's last counting event says (read from its tail)."""
     done = None
-    while True:
-        events = reader.new_events()
-        if not events:
-            return done
-        for event in events:
-            if event["event"] == "started":  # none finished yet but those restored
-                done = _count(event.get("resumed")) or 0
-            elif event["event"] in ("realization", "finished"):
-                done = _count(event.get("done"))
+    for event in _tail_events(folder):
+        if event["event"] == "started":  # none finished yet but those restored
+            done = _count(event.get("resumed")) or 0
+        elif event["event"] in ("realization", "finished"):
+            done = _count(event.get("done"))
+    return done
 
 
 def logged_error(folder: Path) -> str | None:
     """The error the run in ``folder`` logged as its last word (a full disk), read from the
     progress log's tail; None if its last event is another."""
-    reader = ProgressReader(folder)
-    try:
-        reader.offset = max(0, os.lstat(reader.path).st_size - TAIL_BYTES)  # a cut first line is skipped
-    except OSError:
-        return None
     last = None
-    while events := reader.new_events():
-        last = events[-1]
+    for last in _tail_events(folder):  # noqa: B007 - the last one is what is said
+        pass
     return str(last.get("message")) if last is not None and last["event"] == "error" else None
 
 
