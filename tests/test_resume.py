@@ -21,7 +21,7 @@ from frictionlab import hookimpl
 from frictionlab.cli import main
 from frictionlab.errors import ExitCode, FrictionlabError, RunFolderError
 from frictionlab.preset import build_scene
-from frictionlab.runs.rundir import RunDirectory, _json_copy, fingerprint
+from frictionlab.runs.rundir import RunDirectory, json_copy, fingerprint
 from frictionlab.runs.runner import run_to_folder
 from frictionlab.options import RunOptions
 
@@ -201,7 +201,7 @@ def test_a_run_started_before_a_field_existed_resumes_with_the_field_at_its_defa
     assert resumed.status == "completed" and resumed.extra["resumed"] == first.done
     state = json.loads((tmp_path / "run" / "run.json").read_text())
     assert state["preset"]["loading"]["unit"] == "force"  # the folder now states the field, at its default
-    assert state["fingerprint"] == fingerprint(_json_copy(scene.resolved()))
+    assert state["fingerprint"] == fingerprint(json_copy(scene.resolved()))
     run_to_folder(scene, tmp_path / "whole", RunOptions(workers=1))
     same_files(tmp_path / "run", tmp_path / "whole")
 

@@ -3,7 +3,6 @@ frictionlab's presets of those figures (``presets/benad2012-fig*.yaml``)."""
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -11,7 +10,7 @@ from pathlib import Path
 from ..errors import FrictionlabError, RunError, command_word, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
-from ..runs.rundir import RunDirectory, same_preset
+from ..runs.rundir import RunDirectory, json_copy, same_preset
 from ..runs.runfolder import output_subfolder
 from ..runs.runner import check_memory, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -63,6 +62,11 @@ class FigureRun:
     sweep: object = None  # sweep.Sweep (Fig. 5)
     sweep_outcome: object = None
 
+    @property
+    def scenes(self) -> list:
+        """What it runs: the sweep's points' scenes, or its one scene."""
+        return [point.scene for point in self.sweep.points] if self.sweep else [self.scene]
+
     def preset_rms_height(self) -> str:
         """The rms height h of a sweep's preset, as the text shows it."""
         return f"{self.sweep.base['spectrum']['params'].get('rms_height'):g}"
@@ -99,7 +103,7 @@ def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
         else:
             run.scene = build_scene(data, source=str(path))
         _check_swept(fig, path, tuple(run.sweep.paths) if run.sweep else ())
-        _check_setup(fig, path, [point.scene for point in run.sweep.points] if run.sweep else [run.scene])
+        _check_setup(fig, path, run.scenes)
         runs.append(run)
     return runs
 
@@ -143,7 +147,7 @@ def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
         state = RunDirectory(folder).state()
     except FrictionlabError:
         return options  # damaged: the fresh run says how
-    ours = state is not None and same_preset(state, json.loads(json.dumps(scene.resolved())), scene)
+    ours = state is not None and same_preset(state, json_copy(scene.resolved()), scene)
     return replace(options, resume=ours)
 
 
@@ -153,7 +157,7 @@ def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:
     if not options.memory_check:
         return
     for run in runs:
-        for scene in [point.scene for point in run.sweep.points] if run.sweep else [run.scene]:
+        for scene in run.scenes:
             try:
                 check_memory(scene, replace(options, resume=False))
             except RunError as exc:

@@ -94,10 +94,10 @@ def same_preset(state: dict, resolved: dict, scene: Scene) -> bool:
     stored = state.get("preset")
     if not isinstance(stored, dict) or fingerprint(stored) != state.get("fingerprint"):
         return False
-    return with_new_defaults(stored, resolved, _json_copy(scene.defaults())) == resolved
+    return with_new_defaults(stored, resolved, json_copy(scene.defaults())) == resolved
 
 
-def _json_copy(data: dict) -> dict:
+def json_copy(data: dict) -> dict:
     return json.loads(json.dumps(data))
 
 
@@ -228,7 +228,7 @@ class RunDirectory:
                 "(remove it, or give another folder)"
             )
         self._check_replaceable(scene, resume)
-        resolved = _json_copy(scene.resolved())
+        resolved = json_copy(scene.resolved())
         inputs = self._input_hashes(scene)
         if resume:
             return self._resume(scene, resolved, inputs)
@@ -292,7 +292,7 @@ class RunDirectory:
             if not self.force:
                 raise
             state = None
-        self._refuse_unless_ours(state, scene, _json_copy(scene.resolved()))
+        self._refuse_unless_ours(state, scene, json_copy(scene.resolved()))
 
     @staticmethod
     def _listed(state: dict | None) -> list[str]:
@@ -422,7 +422,7 @@ class RunDirectory:
             return None
         if not state or state.get("status") != "completed" or state.get("format") != MANIFEST_FORMAT:
             return None
-        if not same_preset(state, _json_copy(scene.resolved()), scene):
+        if not same_preset(state, json_copy(scene.resolved()), scene):
             return None
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         for field, now in self._input_hashes(scene).items():
