@@ -155,8 +155,8 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     assert "--finished-only" in err and "--runs DIR" in err and not (tmp_path / "p2").exists()
 
 
-def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_path, capsys):
-    """exact3d-h03.yaml with hurst: 0.9 ran, and the page reported H = 0.9 surfaces as H = 0.3."""
+def _presets_with_h03_edited(tmp_path, edit) -> tuple:
+    """(the presets folder, its exact3d-h03.yaml): the study's presets copied, that one's text through ``edit``."""
     import shutil
 
     presets = tmp_path / "presets"
@@ -164,7 +164,13 @@ def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_p
     for hurst in HURSTS:
         shutil.copy(PRESETS / preset_name(hurst), presets)
     edited = presets / preset_name(0.3)
-    edited.write_text(edited.read_text().replace("hurst: 0.3", "hurst: 0.9"))
+    edited.write_text(edit(edited.read_text()))
+    return presets, edited
+
+
+def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_path, capsys):
+    """exact3d-h03.yaml with hurst: 0.9 ran, and the page reported H = 0.9 surfaces as H = 0.3."""
+    presets, edited = _presets_with_h03_edited(tmp_path, lambda text: text.replace("hurst: 0.3", "hurst: 0.9"))
     runs = tmp_path / "runs"
     assert main(["exact3d", "--quick", "--presets", str(presets), "--runs", str(runs), "--workers", "1", "--quiet"]) == ExitCode.USAGE
     err = capsys.readouterr().err
@@ -174,14 +180,7 @@ def test_a_preset_whose_h_is_not_its_files_is_refused_before_anything_runs(tmp_p
 
 def test_a_preset_with_a_sweep_is_refused_before_anything_runs(tmp_path, capsys):
     """exact3d-h03.yaml with a sweep of seeds ran its ensembles as if it had none, the sweep dropped without a word."""
-    import shutil
-
-    presets = tmp_path / "presets"
-    presets.mkdir()
-    for hurst in HURSTS:
-        shutil.copy(PRESETS / preset_name(hurst), presets)
-    edited = presets / preset_name(0.3)
-    edited.write_text(edited.read_text() + "sweep:\n  parameters:\n    seed: {values: [1, 2]}\n")
+    presets, edited = _presets_with_h03_edited(tmp_path, lambda text: text + "sweep:\n  parameters:\n    seed: {values: [1, 2]}\n")
     runs = tmp_path / "runs"
     assert main(["exact3d", "--quick", "--presets", str(presets), "--runs", str(runs), "--workers", "1", "--quiet"]) == ExitCode.USAGE
     err = capsys.readouterr().err
