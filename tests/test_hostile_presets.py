@@ -88,6 +88,11 @@ NUMBERS = {
     "inf c0": ("rms_height: 1.0", "rms_height: null\n    c0: .inf", "spectrum.params.c0: must be a finite number"),
     "1e308 modulus": ("youngs_modulus: 1.0", "youngs_modulus: 1e308", "solver.params.youngs_modulus: must be between 1e-100 and 1e+100, got"),
     "1e308 height": ("rms_height: 1.0", "rms_height: 1.0e+308", "spectrum.params.rms_height: must be between 1e-100 and 1e+100"),
+    # and the mirror: pydantic alone takes 0, 1 and the text 'yes' or 'off' as true or false
+    "0 plot": ("plot: false", "plot: 0", "output.plot: must be true or false, got 0"),
+    "text plot": ("plot: false", "plot: 'yes'", "output.plot: must be true or false, got 'yes'"),
+    "1.0 realizations file": ("plot: false", "plot: false\n  realizations: 1.0",
+                              "output.realizations: must be true or false, got 1.0"),
 }  # fmt: skip
 # names that would take the output folder elsewhere, or are no folder name at all
 FOLDER_ESCAPES = ("/tmp/escape", "../../escape", '"a\\nb"')

@@ -292,7 +292,9 @@ def _refuses_zero(field) -> bool:
 
 def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]:
     """Numeric fields of ``model`` given true/false, infinity or NaN (unless the
-    field allows them), or a magnitude beyond MAX_MAGNITUDE, in ``data``."""
+    field allows them), or a magnitude beyond MAX_MAGNITUDE, in ``data``; and true/false
+    fields given anything else (pydantic takes 0, 1 and the text 'yes' or 'off' as a
+    bool, where a numeric field takes no bool)."""
     if not isinstance(data, dict):
         return []
     problems = []
@@ -309,6 +311,8 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
         elif isinstance(item, type) and issubclass(item, BaseModel) and isinstance(value, dict):
             for key, entry in value.items():
                 problems += number_problems(item, entry, f"{path}.{key}")
+        elif kinds - {type(None)} == {bool} and value is not None and not isinstance(value, bool):
+            problems.append(f"{path}: must be true or false, got {shown_value(value)}")
         elif kinds & {int, float} and bool not in kinds and not (str in kinds and isinstance(value, str)):
             problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number",
                                       positive=_refuses_zero(field), own=Bounds.of(field))  # fmt: skip
