@@ -293,3 +293,17 @@ def test_clear_errors():
         solve(BEMHalfPlane(), np.where(np.arange(64) == 3, np.nan, line), [1.0])
     with pytest.raises(ValueError, match="tolerance"):
         BEMHalfPlane(tolerance=0.0)
+
+
+@pytest.mark.parametrize("cls, z", [(BEMHalfPlane, rough_line(64, 3)), (BEMHalfSpace, rough_surface(32, 5))])
+def test_the_indentation_no_load_reaches_is_the_approach_at_full_contact(cls, z):
+    """``full_contact_indentation``, which validate checks the loads against, is where a solve
+    under force control stops approaching, and what a solve under indentation control cannot pass."""
+    solver = cls(tolerance=1e-11, stop="tolerance")
+    full = solver.full_contact_indentation(Profile(z, 1.0))
+    assert full == pytest.approx(float(solve(solver, z, [1e4 * z.size]).indentation[0]), rel=1e-12)
+    nearly = solve(solver, z, [0.999 * full], control="indentation")
+    assert 0.9 * z.size < nearly.contact_count[0] < z.size
+    with pytest.raises(ValueError, match="at or past the full-contact approach"):
+        solve(solver, z, [full], control="indentation")
+    assert solver.full_contact_indentation(Profile(z, 1.0, periodic=False)) is None

@@ -127,6 +127,22 @@ def test_a_load_past_the_free_solver_s_arithmetic_is_refused_naming_the_limit(tm
     assert done.returncode != 0 and "f <= 1e+30" in done.stderr and "Traceback" not in done.stderr
 
 
+def test_an_indentation_no_force_reaches_is_refused_before_the_run(tmp_path, cli):
+    """Under indentation control a periodic half-space saturates at max z - mean z (full contact):
+    the preset passed validate, and every realization failed at run time."""
+    preset = with_loading(SURFACE, control="indentation", start=0.1, stop=50.0)
+    with pytest.raises(PresetError, match=r"loading.stop: indentation 50 is at or past [0-9.]+, the full-contact "
+                                          r"approach max z - mean z of realization 0") as caught:
+        frictionlab.run(preset, out=tmp_path / "run", **FAST)
+    assert not (tmp_path / "run").exists() and "loading.control 'force'" in str(caught.value)
+    full = float(str(caught.value).split("at or past ")[1].split(",")[0])
+    below = frictionlab.run(with_loading(preset, stop=0.9 * full), out=None, **FAST)
+    assert below.status == "completed" and below.realizations == (1, 1)
+    done = cli("validate", "mdr-vs-halfspace", "--set", "solver.name=bem-halfspace", "--set", "loading.control=indentation",
+               "--set", "loading.stop=50", "--set", "loading.start=0.1")  # fmt: skip
+    assert done.returncode == 2 and "loading.stop: indentation 50 is at or past" in done.stderr, done.stderr
+
+
 def test_a_refusal_of_the_loads_names_the_preset_it_is_about(tmp_path, cli):
     """Loads are checked once the preset is built: their refusal names the file (of several
     validated at once, the one at fault) and the built-in with its --set options, as a

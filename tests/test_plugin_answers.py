@@ -29,6 +29,8 @@ BROKEN = {
                       "tolerance() must be None or a number finite and > 0. Got nan"),
     "text-full": (GoodSolver, {"full_contact_load": lambda self, profile: "lots"},
                   "full_contact_load(profile) must be None or a finite number >= 0. Got 'lots'"),
+    "nan-indentation": (GoodSolver, {"full_contact_indentation": lambda self, profile: float("nan")},
+                        "full_contact_indentation(profile) must be None or a finite number >= 0. Got nan"),
     "single-slopes": (GoodSlopes, {"slopes": lambda self, heights, spacing, periodic=True: GoodSlopes.slopes(
         self, heights, spacing, periodic).astype(np.float32)}, "slopes() must be float64 (double precision)"),
     "text-undefined": (GoodSlopes, {"undefined_points": lambda self, periodic: "no"},

@@ -202,6 +202,10 @@ class ContactSolver(Plugin):
     - ``full_contact_load(profile)`` (None): the load at which every point of ``profile``
       is in contact, exactly, where the solver knows it without a solve (springs, from
       the heights); ``frictionlab validate`` shows it. None: not known short of solving.
+    - ``full_contact_indentation(profile)`` (None): the indentation that no finite load
+      reaches, where there is one (a periodic half-space: the approach to the mean surface
+      saturates at max z - mean z, at full contact); an indentation at or past it is
+      refused before the run. None: every indentation has a finite load.
     - ``undefined_slopes`` (False): True when ``solve`` takes slopes with NaN at
       points that have no slope, and forms ``slope_rms_contact`` over the contact
       points whose slope is defined (``defined_rms``), NaN at a load where none is.
@@ -249,6 +253,10 @@ class ContactSolver(Plugin):
 
     def full_contact_load(self, profile: Profile) -> float | None:
         """The load at which every point of ``profile`` is in contact; None when only a solve would say."""
+        return None
+
+    def full_contact_indentation(self, profile: Profile) -> float | None:
+        """The indentation of ``profile`` no finite load reaches; None when there is none."""
         return None
 
     def tolerance(self) -> float | None:

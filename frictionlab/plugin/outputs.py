@@ -170,12 +170,12 @@ def height_of(spectrum: SpectrumGenerator, profile: Profile) -> tuple[float, flo
     return own, own
 
 
-def full_contact_problem(full) -> str | None:
-    """What is wrong with an answer of ``full_contact_load(profile)``."""
+def full_contact_problem(full, method: str = "full_contact_load") -> str | None:
+    """What is wrong with an answer of ``full_contact_load(profile)`` (or of ``method``)."""
     if full is None or (isinstance(full, (int, float, np.integer, np.floating)) and not isinstance(full, bool)
                         and math.isfinite(full) and full >= 0):  # fmt: skip
         return None
-    return f"full_contact_load(profile) must be None or a finite number >= 0. Got {full!r}."
+    return f"{method}(profile) must be None or a finite number >= 0. Got {full!r}."
 
 
 def refuse(plugin, problem: str | None) -> None:

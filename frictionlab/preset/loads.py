@@ -42,6 +42,7 @@ class LoadScales:
     full_contact: float | None
     full_contact_exact: bool
     points: int
+    full_indentation: float | None = None  # the indentation no finite load reaches (the solver's), if any
 
     def to_forces(self, values: np.ndarray, unit: str) -> np.ndarray:
         """``values`` in ``unit`` (force, f or pressure) as the solver's loads."""
@@ -83,12 +84,14 @@ def load_scales(scene, profile: Profile | None = None) -> LoadScales:
     pressure_unit = None if area is None else float(solver.stiffness()) * area
     full, exact = solver.full_contact_load(profile), True
     refuse(solver, full_contact_problem(full))
+    full_indentation = solver.full_contact_indentation(profile)
+    refuse(solver, full_contact_problem(full_indentation, "full_contact_indentation"))
     # the estimator's answer too, as every realization takes it: a broken one is refused before the run
     slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
     refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
     if full is None and pressure_unit is not None:
         full, exact = estimated_full_contact(slopes, pressure_unit), False
-    return LoadScales(unit, pressure_unit, full, exact, profile.points)
+    return LoadScales(unit, pressure_unit, full, exact, profile.points, full_indentation)
 
 
 def estimated_full_contact(slopes: np.ndarray, pressure_unit: float) -> float | None:
@@ -136,6 +139,8 @@ def load_problems(scene) -> list[str]:
             f"loading.unit: 'contact-fraction' is a real-contact fraction, but {solver.name} counts "
             f"{solver.contact_measure}, not the real contact: give the loads as 'force', 'f' or 'pressure'"
         )
+    if loading.control == "indentation" and not problems:
+        problems += _indentation_problems(scene)
     if problems or loading.unit == "contact-fraction" or solver.max_f is None or loading.control != "force":
         return problems
     scales = scene.load_scales
@@ -203,6 +208,18 @@ def _next_force(low: tuple[float, int], high: tuple[float, int] | None, target: 
     lo, hi = math.log(low[0]), math.log(high[0])
     inside = lo + 0.05 * (hi - lo) < math.log(guess) < hi - 0.05 * (hi - lo) if guess > 0 else False
     return guess if inside else math.exp(0.5 * (lo + hi))
+
+
+def _indentation_problems(scene) -> list[str]:
+    """An indentation at or past the one no finite load reaches (realization 0's surface)."""
+    full = scene.load_scales.full_indentation
+    deepest = float(np.max(scene.preset.loading.values()))
+    if full is None or deepest < full:
+        return []
+    return [f"loading.stop: indentation {deepest:g} is at or past {full:.6g}, the full-contact approach max z - "
+            f"mean z of realization 0's surface (in its length unit): on a periodic elastic body no finite force "
+            f"reaches it, and {scene.solver.name} would fail there. Use loading.control 'force', or indentations "
+            f"below {full:.4g}"]  # fmt: skip
 
 
 def describe_loads(scene) -> dict:

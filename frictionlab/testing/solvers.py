@@ -71,7 +71,8 @@ def check_solver(cls, **params) -> None:
     other solves it. ``max_f`` is None or a number > 0, and a force of 10 ``max_f`` k h X
     raises ValueError naming the limit (before any overflow); ``full_contact_load(profile)``
     is None or a finite number >= 0, and the load 1 % above it puts every point in
-    contact. A solver declaring ``undefined_slopes`` is given NaN slopes
+    contact; ``full_contact_indentation(profile)`` is None or a finite number >= 0, and an
+    indentation 1 % past it raises ValueError. A solver declaring ``undefined_slopes`` is given NaN slopes
     too: with every slope NaN, ``slope_rms_contact`` is NaN at every load; with
     slopes 1 but a NaN at the top point, it is 1 wherever it is finite, and finite
     at every load with 2 or more points in contact (the rms over the defined ones).
@@ -236,7 +237,8 @@ def _check_cancel(cls, solver, heights, spacing, slopes, forces) -> None:
 
 
 def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> None:
-    """``max_f`` refused past it; ``full_contact_load`` puts every point in contact."""
+    """``max_f`` refused past it; ``full_contact_load`` puts every point in contact; an indentation
+    past ``full_contact_indentation`` is refused."""
     import numpy as np
 
     from frictionlab.plugin import Profile
@@ -255,6 +257,21 @@ def _check_load_limits(cls, solver, heights, spacing, slopes, unit: float) -> No
             fail(cls, f"a force at f = 10 max_f must raise ValueError. Got {type(exc).__name__}: {exc}", exc)
         else:
             fail(cls, f"max_f is {limit:g}, but a force at f = 10 max_f was accepted; it must raise ValueError")
+    deepest = call(cls, "full_contact_indentation(profile)", solver.full_contact_indentation,
+                   Profile(heights.copy(), spacing))  # fmt: skip
+    if problem := full_contact_problem(deepest, "full_contact_indentation"):
+        fail(cls, problem)
+    if deepest:
+        try:
+            solver.solve(Profile(heights.copy(), spacing), np.array([1.01 * deepest]), "indentation", slopes.copy())
+        except ValueError:
+            pass
+        except Exception as exc:
+            fail(cls, f"an indentation past full_contact_indentation(profile) must raise ValueError. Got "
+                      f"{type(exc).__name__}: {exc}", exc)  # fmt: skip
+        else:
+            fail(cls, f"full_contact_indentation(profile) = {deepest:g}, but an indentation 1 % past it was solved; "
+                      "no load reaches it, so it must raise ValueError")  # fmt: skip
     full = call(cls, "full_contact_load(profile)", solver.full_contact_load, Profile(heights.copy(), spacing))
     if full is None:
         return

@@ -26,6 +26,7 @@ reached at full contact, and no finite force pushes past it.
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -144,7 +145,7 @@ class PeriodicBEM(ContactSolver):
         depth /= scale
         operator = PeriodicHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
         cg = self.contact_cg(operator, depth)
-        full_approach = float(depth.mean())  # scaled max z - mean z
+        full_approach = self.full_contact_indentation(profile) / scale
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
         certified = self.params.stop == "certified"  # under force control only (solve_load)
         if control == "indentation":
@@ -196,6 +197,13 @@ class PeriodicBEM(ContactSolver):
             return 0.0  # flat: every point touches at once
         force_unit = self.stiffness() * scale * profile.spacing ** (heights.ndim - 1) * heights.size
         return -float(PeriodicHalfSpace(depth.shape).pressure_of(-depth / scale).min()) * force_unit
+
+    def full_contact_indentation(self, profile: Profile) -> float | None:
+        """max z - mean z: on a periodic body the approach to the mean surface saturates there,
+        at full contact, which no finite force reaches."""
+        heights = np.asarray(profile.heights, dtype=float)
+        approach = float(heights.max() - heights.mean())
+        return approach if profile.periodic and math.isfinite(approach) and approach > 0 else None
 
 
 class BEMHalfPlane(PeriodicBEM):

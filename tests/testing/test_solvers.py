@@ -219,3 +219,14 @@ def test_solver_check_passes_a_solver_that_reports_its_steps_and_stops_on_cancel
 
     fltesting.check_solver(_iterating("Reports", lambda index: iteration_done(index, 0.5)))
     fltesting.check_solver(_iterating("DirectAndQuiet", lambda index: None, tolerance_param=None))
+
+
+@pytest.mark.parametrize("deepest, match", [
+    (lambda self, profile: "deep", r"full_contact_indentation\(profile\) must be None or a finite number >= 0"),
+    (lambda self, profile: 1e-3, r"full_contact_indentation\(profile\) = 0.001, but an indentation 1 % past it was solved"),
+])  # fmt: skip
+def test_solver_check_fails_for_a_wrong_full_contact_indentation(deepest, match):
+    """GoodSolver's springs take any indentation: one claimed unreachable must be refused by solve."""
+    cls = type("Shallow", (GoodSolver,), {"name": "shallow", "full_contact_indentation": deepest})
+    with pytest.raises(AssertionError, match=match):
+        fltesting.check_solver(cls)
