@@ -1,5 +1,5 @@
-"""How a run's result shows in a notebook (``Result._repr_html_``): the fit as a table
-with its intervals, rounded as the CLI prints it, and the curve as an inline image; a
+"""How a run's result shows in a notebook (``Result._repr_html_``): what a measured
+input's file gave (as the CLI says it), the fit as a table with its intervals, rounded as the CLI prints it, and the curve as an inline image; a
 sweep's (``SweepResult._repr_html_``): a row per point, its values and its fit.
 Every text is escaped: a preset's name or a caveat is data, not markup."""
 
@@ -14,12 +14,17 @@ from .compute.fit import format_interval, format_number
 
 
 def result_html(result) -> str:
-    """A ``frictionlab.Result`` as HTML: status, the fit's table, the curve, caveats."""
+    """A ``frictionlab.Result`` as HTML: status, what was read (a measured input), the fit's
+    table, the curve, caveats."""
     done, requested = result.realizations
     parts = [
         f"<p><strong>{html.escape(result.name)}</strong>: {html.escape(result.status)}, "
         f"{done}/{requested} realizations in {result.elapsed:.2f} s</p>"
     ]
+    if result.input:  # the channel, unit and levelling read: as the CLI says them under its progress
+        from .io.inputs import input_lines
+
+        parts.append("<p>" + "<br>".join(html.escape(line) for line in input_lines(result.input)) + "</p>")
     fit = result.fit
     if fit is None:  # why: a failed run says; an interrupted one may have finished none
         parts.append(f"<p>no fit: {html.escape(result.error or 'no realization finished')}</p>")

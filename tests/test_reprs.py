@@ -115,3 +115,22 @@ def test_a_failed_point_of_a_sweep_says_why_in_its_row(tmp_path):
     cells = parsed(sweep._repr_html_()).cells
     assert cells[8] == f"failed: {failed['error']}" and cells[14] == "completed"
     assert frictionlab.load(tmp_path / "sweep").rows == sweep.rows
+
+
+def test_a_measured_inputs_html_says_what_was_read_as_the_cli_does(tmp_path):
+    """The CLI says the channel, unit and levelling read under its progress; the notebook's view
+    said nothing of them. The file's name is data: escaped."""
+    from html import escape
+
+    from frictionlab.io.inputs import input_lines
+
+    rng = np.random.default_rng(4)
+    scan = tmp_path / "a<b>&c.csv"
+    scan.write_text("\n".join(f"{z:.6f}" for z in np.cumsum(rng.standard_normal(256))) + "\n")
+    preset = {**SMALL_PRESET, "spectrum": {"name": "profile-file", "params": {"path": str(scan), "spacing": 1.0}}}
+    result = frictionlab.run(preset, **FAST, plot=False)
+    html = result._repr_html_()
+    lines = input_lines(result.input)
+    assert lines and "a<b>&c.csv" in lines[0] and "a&lt;b&gt;&amp;c.csv" in html and "<b>" not in html
+    assert all(escape(line) in html for line in lines)
+    parsed(html)
