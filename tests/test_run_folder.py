@@ -442,3 +442,28 @@ def test_a_disk_too_full_to_say_who_holds_the_lock_does_not_stop_the_run_nor_lea
     out = tmp_path / "run"
     assert main(["run", "quickstart", "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 0
     assert (out / "summary.json").is_file() and not (out / "run.lock").exists()
+
+
+def test_resume_refuses_a_file_now_read_otherwise_and_resumes_an_older_folder(tmp_path, monkeypatch, capsys):
+    """The same bytes read otherwise by another version (another channel, another levelling) would
+    mix realizations of two surfaces: the manifest records what was read (in a run folder of an
+    older version it is absent, and the resume goes on)."""
+    preset = write(tmp_path / "scan.yaml", merge(PROFILE, {"realizations": 6}))
+    _scan(tmp_path / "scan.csv")
+    out = tmp_path / "run"
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OK
+    manifest = json.loads((out / "run.json").read_text())
+    read = manifest["read"]
+    assert read["shape"] == [len((tmp_path / "scan.csv").read_text().split())] and "caveats" not in read
+    manifest["read"] = {**read, "rms_height": read["rms_height"] * 1.5, "detrend": "quadratic"}
+    (out / "run.json").write_text(json.dumps(manifest))
+    capsys.readouterr()
+    assert main(["resume", str(out), "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert "is read otherwise than when the run started" in err and "detrend: 'quadratic' then, 'mean' now" in err
+    assert "rms_height:" in err and "SHA-256" not in err
+    del manifest["read"]
+    (out / "run.json").write_text(json.dumps(manifest))
+    assert main(["resume", str(out), "--quiet"]) == ExitCode.OK
+    assert json.loads((out / "run.json").read_text())["read"] == read  # recorded from now on

@@ -6,7 +6,8 @@ Layout inside the output folder::
     run.lock      held (filelock: flock on POSIX) while a run writes here, removed when it
                   ends; the kernel releases the lock even on kill -9
     run.json      the manifest: status, the resolved preset and its fingerprint, every
-                  input file and every chunk file with its SHA-256
+                  input file with its SHA-256 and what was read from it (``inputrecord``),
+                  every chunk file with its SHA-256
     preset.yaml   the resolved preset, written before the first realization
     chunks/00000012-00000023.npz   one file per finished chunk, written to a temporary name and
                   renamed; the manifest is updated after. A completed run's chunks are compacted into one.
@@ -16,8 +17,8 @@ manifest is read and its SHA-256 and arrays checked; a missing or damaged one
 is recomputed (with a warning that says how many), a file in ``chunks/`` the
 manifest does not list is ignored. Realizations are keyed by index, so none is
 counted twice, and since each has its own seed the resumed result is bitwise
-the one of an uninterrupted run. A resume refuses another preset and an input
-file whose content changed.
+the one of an uninterrupted run. A resume refuses another preset, an input
+file whose content changed, and one now read otherwise (another version's reading).
 
 A fresh run refuses a folder that holds anything but a run of its own preset (whose completed
 run it runs again, saying so) unless ``force``; even then it deletes only chunk files its manifest lists.
@@ -36,12 +37,13 @@ from pathlib import Path
 import yaml
 
 from .. import __version__
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
+from ..errors import OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
 from ..io.files import atomic_write, output_path_problem, replace_problem
-from ..io.inputs import InputFileProblem, holds_exactly, sha256_of
+from ..io.inputs import InputFileProblem, holds_exactly
 from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import with_new_defaults
 from ..compute.realization import RealizationResult
+from .inputrecord import file_hashes, input_changes, refuse_changed_inputs, what_was_read
 from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, chunk_bytes, damage_report, read_chunk
 from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
 
@@ -106,6 +108,7 @@ _MANIFEST_FIELDS = (  # what a manifest's fields must be, when present (a format
     ("fingerprint", str, "a string"),
     ("preset", dict, "a mapping"),
     ("inputs", dict, "a mapping of input files"),
+    ("read", dict, "a mapping of what was read from the input file"),
     ("chunks", dict, "a mapping of chunk file names to SHA-256 digests"),
     ("retired", list, "a list of chunk file names"),
 )
@@ -229,9 +232,9 @@ class RunDirectory:
             )
         self._check_replaceable(scene, resume)
         resolved = json_copy(scene.resolved())
-        inputs = self._input_hashes(scene)
+        inputs, read = file_hashes(scene), what_was_read(scene)
         if resume:
-            return self._resume(scene, resolved, inputs)
+            return self._resume(scene, resolved, inputs, read)
         try:
             state = self.state()
         except RunFolderError:
@@ -253,6 +256,7 @@ class RunDirectory:
             "realizations": resolved.get("realizations"),
             "preset": resolved,
             "inputs": inputs,
+            **({"read": read} if read is not None else {}),
             "chunks": {},
         }
         self._write_manifest()
@@ -330,17 +334,7 @@ class RunDirectory:
                 "or give another output folder, or force it (--force; force=True) to start it again"
             )
 
-    def _input_hashes(self, scene: Scene) -> dict:
-        hashes = {}
-        for field, path in scene.input_files().items():
-            try:
-                hashes[field] = {"path": path, "sha256": sha256_of(path)}
-            except (InputFileProblem, OSError) as exc:
-                reason = exc if isinstance(exc, InputFileProblem) else exc.strerror
-                raise FrictionlabError(f"{field}: cannot read {shown_name(path)}: {reason}") from None
-        return hashes
-
-    def _resume(self, scene: Scene, resolved: dict, inputs: dict) -> list[RealizationResult]:
+    def _resume(self, scene: Scene, resolved: dict, inputs: dict, read: dict | None) -> list[RealizationResult]:
         state = self.state()
         if state is None:
             raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {STATE_FILE})")
@@ -355,20 +349,14 @@ class RunDirectory:
             given = f" ({scene.source})" if scene.source else ""  # `resume DIR`: DIR/preset.yaml, edited
             raise RunFolderError(f"cannot resume {shown_name(self.path)}: the preset its {STATE_FILE} started with differs from the one "
                                  f"given{given}\n  " + "\n  ".join(changed))
+        refuse_changed_inputs(self.path, state, inputs, read)
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
-        for field, now in inputs.items():
-            then = recorded.get(field)
-            if isinstance(then, dict) and then.get("sha256") != now["sha256"]:
-                raise RunFolderError(
-                    f"cannot resume {shown_name(self.path)}: the input file {field} ({now['path']}) changed since the run "
-                    f"started (SHA-256 {str(then.get('sha256'))[:12]}... then, {now['sha256'][:12]}... now); "
-                    "restore it, or start a new run in another folder"
-                )
         if state.get("fingerprint") != fingerprint(resolved):  # started before fields now at their defaults
             atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
         self._manifest = {**state, "format": MANIFEST_FORMAT, "status": "running", "preset": resolved,
                           "fingerprint": fingerprint(resolved), "realizations": resolved.get("realizations"),
-                          "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}}}  # fmt: skip
+                          "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}},
+                          **({"read": read} if read is not None else {})}  # fmt: skip
         self._manifest["chunks"] = dict(state.get("chunks") or {}) if state.get("format") == MANIFEST_FORMAT else {}
         self._remove_chunks(self._manifest.pop("retired", None) or [], keep=self._manifest["chunks"])  # an unfinished compaction's
         results = self._verified(scene, warn=True)
@@ -424,10 +412,10 @@ class RunDirectory:
             return None
         if not same_preset(state, json_copy(scene.resolved()), scene):
             return None
+        hashes = file_hashes(scene)
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
-        for field, now in self._input_hashes(scene).items():
-            if not isinstance(recorded.get(field), dict) or recorded[field].get("sha256") != now["sha256"]:
-                return None
+        if any(not isinstance(recorded.get(field), dict) for field in hashes) or input_changes(state, hashes, what_was_read(scene)):
+            return None
         results = self._verified(scene, dict(state.get("chunks") or {}), warn=False)
         return results if len(results) == scene.preset.realizations else None
 

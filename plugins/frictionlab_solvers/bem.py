@@ -145,7 +145,7 @@ class PeriodicBEM(ContactSolver):
         depth /= scale
         operator = PeriodicHalfSpace(depth.shape, namespace(self.params.device), self.params.fft_workers)
         cg = self.contact_cg(operator, depth)
-        full_approach = self.full_contact_indentation(profile) / scale
+        full_approach = float(depth.mean())  # scaled max z - mean z (full_contact_indentation)
         tolerance, max_iterations = self.params.tolerance, self.params.max_iterations
         certified = self.params.stop == "certified"  # under force control only (solve_load)
         if control == "indentation":

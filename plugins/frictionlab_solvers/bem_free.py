@@ -193,3 +193,7 @@ class BEMHalfSpaceFree(PeriodicBEM):
     def full_contact_load(self, profile: Profile) -> float | None:
         """Not known short of a solve: the border of a free scan carries the most pressure."""
         return None
+
+    def full_contact_indentation(self, profile: Profile) -> float | None:
+        """None: a free body takes any indentation, the force growing without bound."""
+        return None
