@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,6 +41,9 @@ BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margi
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
 PROCESS_BASE = 160 * MiB  # main process: interpreter, numpy, scipy, pydantic, matplotlib for the plot
+# Of PROCESS_BASE, what matplotlib takes once imported, and once a figure was drawn as PNG (its
+# backend imported): a little below the address space each took, measured (34 and 71 MiB).
+PLOT_SHARES = {"matplotlib": 32 * MiB, "matplotlib.backends.backend_agg": 64 * MiB}
 WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process (Dask: with its nanny)
 # What a Dask worker's ``memory_limit`` watches: the worker process alone, without
 # its nanny (measured 95 MiB with frictionlab and the plugins imported, after a run).
@@ -193,12 +197,19 @@ def available_memory() -> tuple[int, str]:
     return min(found)
 
 
+def _counted_twice() -> int:
+    """What the room left to this process is credited once it has imported matplotlib or drawn
+    a figure (a report's later figures): that share of ``PROCESS_BASE``, which the estimate
+    counts, is then also in the memory this process uses, which the room is measured after."""
+    return max((share for name, share in PLOT_SHARES.items() if name in sys.modules), default=0)
+
+
 def _machine_rooms() -> list[tuple[int, str]]:
     """The room the machine leaves to all the run's processes together: MemAvailable, and
     what a cgroup limit leaves."""
     found: list[tuple[int, str]] = []
     try:
-        found.append((_system_available(), "the memory the system says is available: MemAvailable on Linux"))
+        found.append((_system_available() + _counted_twice(), "the memory the system says is available: MemAvailable on Linux"))
     except (OSError, RuntimeError):
         pass
     for limit_file, usage_file in (
@@ -211,7 +222,7 @@ def _machine_rooms() -> list[tuple[int, str]]:
         except (OSError, ValueError):
             continue
         if limit.isdigit() and int(limit) < 2**60:
-            found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
+            found.append((int(limit) - usage + _counted_twice(), f"the cgroup limit {limit_file} less current usage"))
     return found
 
 
@@ -262,7 +273,7 @@ def _process_limits() -> list[tuple[int, str]]:
     for name, current in (("RLIMIT_AS", vms), ("RLIMIT_DATA", data)):
         soft, _ = resource.getrlimit(getattr(resource, name))
         if soft != resource.RLIM_INFINITY:
-            found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
+            found.append((soft - current + _counted_twice(), f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
     return found
 
 
