@@ -87,3 +87,45 @@ def test_a_report_whose_sweep_point_was_refused_says_so_and_run_again_continues(
     assert not (out / "REPRODUCTION.md").exists()
     monkeypatch.setattr(sweep, "run_to_folder", real)
     assert main(command) == ExitCode.OK and (out / "REPRODUCTION.md").is_file()
+
+
+def _options_of(command: str) -> set[str]:
+    import argparse
+
+    from frictionlab.cli.main import build_parser
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    return set(commands[command]._option_string_actions)
+
+
+@pytest.mark.parametrize("command, args", [
+    ("run", ["quickstart", "--workers", "2"]), ("resume", []), ("validate", ["quickstart"]),
+    ("report", ["--workers", "2"]), ("exact3d", ["--quick", "--workers", "2"]),
+])  # fmt: skip
+def test_a_memory_refusal_names_only_options_of_the_command_in_use(command, args, tmp_path, monkeypatch, capsys):
+    """report and exact3d were told that --no-memory-check skips the estimate, an option they
+    lack (and every command of frictionlab.run's keywords): each names only its own."""
+    import re
+
+    from frictionlab.cli import main
+    from frictionlab.errors import ExitCode
+
+    from .conftest import SMALL_PRESET
+
+    if command == "resume":  # a run that stopped, met again with less memory
+        import frictionlab
+
+        frictionlab.run(SMALL_PRESET, out=tmp_path / "stopped", workers=1, progress=False)
+        args = [str(tmp_path / "stopped"), "--workers", "2"]
+    elif command in ("report", "exact3d"):
+        args = [*args, "--out", str(tmp_path / "out")]
+    monkeypatch.setattr(memory, "available_memory", lambda: (64 * MiB, "a test limit"))
+    monkeypatch.setattr(memory, "_machine_rooms", lambda: [(64 * MiB, "a test limit")])
+    assert main([command, *args, "--quiet"] if command != "validate" else [command, *args]) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    assert "0.06 GiB is available (a test limit)" in err or "64 MiB is available (a test limit)" in err, err
+    named = set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", err))
+    assert named <= _options_of(command), err
+    assert "memory_check=False" not in err and "in Python" not in err
+    skips = "--no-memory-check" in _options_of(command)
+    assert ("(--no-memory-check skips this estimate, an upper bound.)" in err) == skips

@@ -29,14 +29,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import RunError
+from ..errors import RunError, skip_hint, workers_advice
 from ..preset import Scene
 
 MiB = 2**20
 GiB = 2**30
-SKIP_HINT = (  # validate and study do not
-    "(run and resume take --no-memory-check, frictionlab.run memory_check=False, to skip this estimate, an upper bound.)"
-)
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
@@ -54,12 +51,6 @@ KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the fi
 # spectra's worst, a non-periodic map read, reflected across its edges and transformed
 # (72 B measured), plus a third.
 EQUIVALENT_LINE_BYTES_PER_POINT = 96
-
-
-def workers_advice(workers: int) -> str:
-    """A worker count to run with, as the command line and as ``frictionlab.run`` take it
-    (the refusal reaches both, as ``SKIP_HINT`` does)."""
-    return f"--workers {workers} (workers={workers} in Python)"
 
 
 @dataclass(frozen=True)
@@ -304,7 +295,7 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
         raise RunError(
             f"one process of this run would need about {gib(need)} at its peak ({making}a realization of "
             f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
-            f"limit to itself). It would fit with {advice}. {SKIP_HINT}"
+            f"limit to itself). It would fit with {advice}.{skip_hint()}"
         )
 
 
@@ -395,7 +386,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         advice[0] += f", or with {_higher_limit(source, available, guess.total)}"
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
-        f"({source}). It would fit with {advice[0]}. {SKIP_HINT}"
+        f"({source}). It would fit with {advice[0]}.{skip_hint()}"
     )
 
 
@@ -423,5 +414,5 @@ def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usabl
         f"one realization of {points_text(guess.points)} points would need about {gib(need)} in a Dask worker "
         f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "
         f"{address} has a memory limit of {gib(limit)} ({smallest}Dask kills a worker at {usable:.0%} of its limit). "
-        f"It would fit with {advice}. {SKIP_HINT}"
+        f"It would fit with {advice}.{skip_hint()}"
     )
