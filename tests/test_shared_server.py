@@ -129,3 +129,25 @@ def test_a_memory_refusal_names_only_options_of_the_command_in_use(command, args
     assert "memory_check=False" not in err and "in Python" not in err
     skips = "--no-memory-check" in _options_of(command)
     assert ("(--no-memory-check skips this estimate, an upper bound.)" in err) == skips
+
+
+def test_a_resume_of_a_folder_it_cannot_write_says_to_resume_a_copy_not_to_give_another_folder(tmp_path):
+    """``resume DIR`` takes no other folder, yet a folder it could not write (another user's run)
+    was met with 'give a folder for the output'."""
+    import os
+    import subprocess
+
+    import frictionlab
+
+    out = tmp_path / "theirs"
+    frictionlab.run(SMALL_PRESET, out=out, workers=1, progress=False)
+    drop = ["setpriv", "--bounding-set=-dac_override,-dac_read_search"] if os.geteuid() == 0 else []
+    out.chmod(0o555)
+    try:
+        done = subprocess.run([*drop, sys.executable, "-m", "frictionlab", "resume", str(out), "--quiet"],
+                              capture_output=True, text=True, timeout=120)  # fmt: skip
+    finally:
+        out.chmod(0o755)
+    assert done.returncode == 4 and f"{out} cannot be written in: Permission denied" in done.stderr, done.stderr
+    assert f"copy it where you can write (cp -r {out} NEW_FOLDER) and resume the copy" in done.stderr
+    assert "give a folder for the output" not in done.stderr
