@@ -1,6 +1,8 @@
 """A run's progress.jsonl is sized to what a follower needs: counts, outcomes and the mean
 curve, never each realization's curve (about 10 KB a realization at 400 load steps, before)."""
 
+import json
+
 import numpy as np
 
 from frictionlab.compute.engine import RunInfo
@@ -90,3 +92,9 @@ def test_a_slow_run_writes_each_realization_as_it_finishes(tmp_path):
     follower.poll()
     assert [done for _, done in heard.results] == [1, 2, 3, 4, 5] and [done for _, done in heard.failed] == [6]
     assert len((tmp_path / PROGRESS_FILE).read_bytes().splitlines()) == 1 + 6  # started, then each at once
+
+
+def test_a_run_of_days_writes_its_realizations_at_least_every_minute(tmp_path):
+    scene, _ = log_run(tmp_path, 3000, seconds_each=20.0)  # 60000 s: 1% of it would be 10 minutes
+    times = [json.loads(line)["time"] for line in (tmp_path / PROGRESS_FILE).read_bytes().splitlines()[1:]]
+    assert max(np.diff(times)) <= 60.0 + 20.0  # a minute, and the realization that found it due

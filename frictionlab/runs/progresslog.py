@@ -35,16 +35,17 @@ PROGRESS_FILE = "progress.jsonl"
 MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # far above what a run writes (tens of bytes a realization): beyond that it is not ours
 READ_BLOCK = 4 * 1024 * 1024  # read at most this much at a time: a follower stays responsive
 FLUSH_SECONDS = 1.0  # realizations finished together are written as one line at most this often,
-FLUSH_SHARE = 0.01  # or this share of the run's time so far if longer: a long run's log grows as the log of its time
+FLUSH_SHARE = 0.01  # or this share of the run's time so far if longer (a long run's log grows slower than its time),
+MAX_FLUSH_SECONDS = 60.0  # but at least this often while realizations finish: a follower is never a minute behind
 SOLVE_SECONDS = 0.5  # a solve's load events, at most this often (a fast solver reports every load)
 
 
 class ProgressLog:
     """A ``listeners.RunListener`` that writes the run's events to ``folder/progress.jsonl``.
     Realizations are written together (``progresslines.Batch``): the first at once, then at
-    most every ``FLUSH_SECONDS`` (``FLUSH_SHARE`` of the run's time so far, if longer), the
-    last with it, and what is pending before any other event. Progress is never worth a
-    run: a write that fails stops the log, not the run."""
+    most every ``FLUSH_SECONDS`` (``FLUSH_SHARE`` of the run's time so far, if longer, up to
+    ``MAX_FLUSH_SECONDS``), the last with it, and what is pending before any other event.
+    Progress is never worth a run: a write that fails stops the log, not the run."""
 
     def __init__(self, folder: str | Path, clock=time.time):
         self.path = Path(folder) / PROGRESS_FILE
@@ -93,7 +94,7 @@ class ProgressLog:
     def _due(self) -> bool:
         now = self.clock()
         elapsed = now - self._started if math.isfinite(self._started) else 0.0
-        return now - self._flushed >= max(FLUSH_SECONDS, FLUSH_SHARE * elapsed)
+        return now - self._flushed >= max(FLUSH_SECONDS, min(FLUSH_SHARE * elapsed, MAX_FLUSH_SECONDS))
 
     def error(self, message: str, exit_code: int) -> None:
         """The run could not start, or stopped with an error: what a follower shows."""
