@@ -253,11 +253,13 @@ def workers_advice(workers: int) -> str:
 
 
 def skip_hint() -> str:
-    """How the front end in use skips the estimate, as the refusal's last sentence ("" where it cannot)."""
+    """The refusal's last sentence: how the front end in use skips the estimate, where it can."""
     front = _front_end.get()
     if front.python:
         return " (memory_check=False skips this estimate, an upper bound.)"
-    return " (--no-memory-check skips this estimate, an upper bound.)" if "--no-memory-check" in front.options else ""
+    if "--no-memory-check" in front.options:
+        return " (--no-memory-check skips this estimate, an upper bound.)"
+    return " (The estimate is an upper bound.)"
 
 
 def limit_advice() -> str:

@@ -35,7 +35,7 @@ def run(args) -> ExitCode:
 
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
-    if (problem := output_path_problem(run_dir)) is not None:  # said for a resume, which takes no other folder
+    if run_dir.is_dir() and (problem := output_path_problem(run_dir)) is not None:  # said as a resume can act on it
         raise OutputRefused(f"{problem}; a resume writes into the folder it continues: copy it where you can write "
                             f"(cp -r {command_word(run_dir)} NEW_FOLDER) and resume the copy")
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
