@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .arguments import data_argument, flag_argument, overrides_argument, path_argument, plain_copy
-from .errors import FrictionlabError, PresetError, RunFolderError, raised_here, require, short_repr, shown, warn_user
+from .errors import FrictionlabError, FrontEnd, PresetError, advising, RunFolderError, raised_here, require, short_repr, shown, warn_user
 from .compute.fit import LogFit
 from .compute.signals import RunInterrupted, interrupted_since, mark
 from .options import RunOptions
@@ -345,7 +345,8 @@ def run(
     runs stops there too.
     """
     seen = mark()
-    result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
+    with advising(FrontEnd(options=frozenset(), python=True)):  # a refusal's advice in this function's keywords
+        result = _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys)
     if interrupted_since(seen) or result.status == "interrupted":  # what finished is kept: the caller stops too
         raise RunInterrupted(result)
     if result.status == "failed" and isinstance(result, Result):  # said where the run was asked for, as the CLI's error

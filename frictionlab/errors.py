@@ -7,6 +7,10 @@ import enum
 import os
 import re
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 
 
 class ExitCode(enum.IntEnum):
@@ -215,6 +219,47 @@ def out_of_memory_loading(exc: BaseException) -> str | None:
     segment from shared object', numpy's own message quoting it), else None."""
     match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
     return match.group(1) if isinstance(exc, ImportError) and match else None
+
+
+@dataclass(frozen=True)
+class FrontEnd:
+    """What the user in front of a refusal can type: the options of the command in use
+    (``options``), or ``frictionlab.run``'s keywords (``python``). A refusal's advice names
+    only those."""
+
+    options: frozenset[str] = frozenset({"--workers"})
+    python: bool = False
+
+
+_front_end: ContextVar[FrontEnd] = ContextVar("front_end", default=FrontEnd())
+
+
+@contextmanager
+def advising(front_end: FrontEnd) -> Iterator[None]:
+    """Within the block, refusals advise as ``front_end`` takes it."""
+    token = _front_end.set(front_end)
+    try:
+        yield
+    finally:
+        _front_end.reset(token)
+
+
+def workers_advice(workers: int) -> str:
+    """A worker count to run with, as the front end in use takes it."""
+    front = _front_end.get()
+    if front.python:
+        return f"workers={workers}"
+    return f"--workers {workers}" if "--workers" in front.options else f"{workers} worker(s)"
+
+
+def skip_hint() -> str:
+    """The refusal's last sentence: how the front end in use skips the estimate, where it can."""
+    front = _front_end.get()
+    if front.python:
+        return " (memory_check=False skips this estimate, an upper bound.)"
+    if "--no-memory-check" in front.options:
+        return " (--no-memory-check skips this estimate, an upper bound.)"
+    return " (The estimate is an upper bound.)"
 
 
 def limit_advice() -> str:

@@ -29,8 +29,8 @@ import re
 import sys
 import warnings
 
-from ..errors import (ExitCode, FrictionlabError, escape_unencodable_output, limit_advice, out_of_memory_loading,
-                      output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
+from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
+                      out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
@@ -358,10 +358,11 @@ def _print(text: str | None) -> int:
 def _run_command(args) -> int:
     keep_freed_memory()  # this process's realizations reuse freed pages, not fault in fresh ones
     try:
-        from .options import refuse_empty_paths
+        from .options import command_options, refuse_empty_paths
 
         refuse_empty_paths(args.parser, args)
-        code = int(args.handler(args))
+        with advising(FrontEnd(options=command_options(args.parser, args))):  # a refusal advises this command's options
+            code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code
     except BrokenPipeError as exc:  # `frictionlab plugins --json | head -c 10`: the reader has enough

@@ -137,6 +137,11 @@ def _command_actions(parser, args):
             yield action
 
 
+def command_options(parser, args) -> frozenset[str]:
+    """The option strings of the command ``args`` were parsed for: what its messages may advise."""
+    return frozenset(name for action in _command_actions(parser, args) for name in action.option_strings)
+
+
 def preset_overrides(args) -> list[str]:
     """The ``--set`` assignments, then ``--seed S`` as ``seed=S``. A ``--set seed=`` of
     another value beside ``--seed`` is refused: which one the run took would be a guess."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ExitCode, PresetError, RunFolderError, shown_name
+from ..errors import ExitCode, OutputRefused, PresetError, RunFolderError, command_word, shown_name
 from . import run as run_command
 from .options import add_executor_options, add_workers_option
 from .run import add_detach_option
@@ -29,11 +29,15 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
+    from ..io.files import output_path_problem
     from ..runs.rundir import PRESET_FILE, RunDirectory
     from ..runs.runfolder import check_searchable
 
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
+    if run_dir.is_dir() and (problem := output_path_problem(run_dir)) is not None:  # said as a resume can act on it
+        raise OutputRefused(f"{problem}; a resume writes into the folder it continues: copy it where you can write "
+                            f"(cp -r {command_word(run_dir)} NEW_FOLDER) and resume the copy")
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
         from ..preset import build_scene

@@ -170,6 +170,37 @@ def _again(out_dir, name: str, force: bool) -> str:
     return "free some space and run the study again with --force (it replaces only study.csv, study.md and study.png)"
 
 
+def _kept_elsewhere(study, out_dir, text: str, args, exc: OSError) -> None:
+    """The study's files could not be written to ``out_dir``: write them to a new temporary
+    folder (``TMPDIR``, often another disk) and say how to move them there; where that fails
+    too, print its rows (study.csv) and recommendation on stderr. Raises the RunError that says so."""
+    import io
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    from ..errors import command_word
+    from ..tradeoff.outputs import write_csv, write_outputs
+
+    refused = f"cannot write the study to {shown_name(out_dir)}: {exc.strerror or exc}"
+    spare = None
+    try:
+        spare = Path(tempfile.mkdtemp(prefix=f"{study.factory.base.preset.name}-study-"))
+        files = write_outputs(study, spare, text, command_line(args))
+    except OSError as again:
+        if spare is not None:
+            shutil.rmtree(spare, ignore_errors=True)  # the folder made here, for nothing
+        table = io.StringIO()
+        write_csv(table, study.rows)
+        print(f"{text}\n\nstudy.csv:\n{table.getvalue()}", file=sys.stderr, end="")
+        raise RunError(f"{refused}, nor to a temporary folder ({again.strerror or again}): its rows (study.csv) and "
+                       f"recommendation are printed above; {_again(out_dir, study.factory.base.preset.name, args.force)}") from None
+    names = ", ".join(path.name for path in files.values())
+    out = command_word(out_dir)
+    raise RunError(f"{refused}; it was written to {shown_name(spare)}/ instead ({names}): once {shown_name(out_dir)} "
+                   f"can be written, mkdir -p {out} && mv {command_word(spare)}/study.* {out}/") from None
+
+
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
@@ -212,9 +243,8 @@ def run(args) -> ExitCode:
     text = recommendation(study)
     try:
         files = write_outputs(study, out_dir, text, command_line(args))
-    except OSError as exc:  # a full disk: the study's files are written whole, or not at all
-        again = _again(out_dir, factory.base.preset.name, args.force)
-        raise RunError(f"cannot write the study to {shown_name(out_dir)}: {exc.strerror or exc}; {again}") from None
+    except OSError as exc:  # a full disk: what was measured is kept elsewhere, never measured again
+        _kept_elsewhere(study, out_dir, text, args, exc)
     if args.json:
         from ..compute.fit import json_safe
         from ..tradeoff.axes import COLUMNS

@@ -24,22 +24,23 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import RunError
+from ..errors import RunError, skip_hint, workers_advice
 from ..preset import Scene
 
 MiB = 2**20
 GiB = 2**30
-SKIP_HINT = (  # validate and study do not
-    "(run and resume take --no-memory-check, frictionlab.run memory_check=False, to skip this estimate, an upper bound.)"
-)
 BYTES_PER_POINT = 112  # measured worst case 97 B (full contact), plus 15% margin
 PROFILE_BYTES_PER_POINT = 24  # the heights and slopes a solver is given (16 B), plus 50 %
 BYTES_PER_STEP = 96  # per load step in a worker: the sweep's per-load arrays
 PROCESS_BASE = 160 * MiB  # main process: interpreter, numpy, scipy, pydantic, matplotlib for the plot
+# Of PROCESS_BASE, what matplotlib takes once imported, and once a figure was drawn as PNG (its
+# backend imported): a little below the address space each took, measured (34 and 71 MiB).
+PLOT_SHARES = {"matplotlib": 32 * MiB, "matplotlib.backends.backend_agg": 64 * MiB}
 WORKER_BASE = {"serial": 0, "processes": 96 * MiB, "dask": 256 * MiB}  # per worker process (Dask: with its nanny)
 # What a Dask worker's ``memory_limit`` watches: the worker process alone, without
 # its nanny (measured 95 MiB with frictionlab and the plugins imported, after a run).
@@ -50,12 +51,6 @@ KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the fi
 # spectra's worst, a non-periodic map read, reflected across its edges and transformed
 # (72 B measured), plus a third.
 EQUIVALENT_LINE_BYTES_PER_POINT = 96
-
-
-def workers_advice(workers: int) -> str:
-    """A worker count to run with, as the command line and as ``frictionlab.run`` take it
-    (the refusal reaches both, as ``SKIP_HINT`` does)."""
-    return f"--workers {workers} (workers={workers} in Python)"
 
 
 @dataclass(frozen=True)
@@ -193,12 +188,19 @@ def available_memory() -> tuple[int, str]:
     return min(found)
 
 
+def _counted_twice() -> int:
+    """What the room left to this process is credited once it has imported matplotlib or drawn
+    a figure (a report's later figures): that share of ``PROCESS_BASE``, which the estimate
+    counts, is then also in the memory this process uses, which the room is measured after."""
+    return max((share for name, share in PLOT_SHARES.items() if name in sys.modules), default=0)
+
+
 def _machine_rooms() -> list[tuple[int, str]]:
     """The room the machine leaves to all the run's processes together: MemAvailable, and
     what a cgroup limit leaves."""
     found: list[tuple[int, str]] = []
     try:
-        found.append((_system_available(), "the memory the system says is available: MemAvailable on Linux"))
+        found.append((_system_available() + _counted_twice(), "the memory the system says is available: MemAvailable on Linux"))
     except (OSError, RuntimeError):
         pass
     for limit_file, usage_file in (
@@ -211,7 +213,7 @@ def _machine_rooms() -> list[tuple[int, str]]:
         except (OSError, ValueError):
             continue
         if limit.isdigit() and int(limit) < 2**60:
-            found.append((int(limit) - usage, f"the cgroup limit {limit_file} less current usage"))
+            found.append((int(limit) - usage + _counted_twice(), f"the cgroup limit {limit_file} less current usage"))
     return found
 
 
@@ -262,7 +264,7 @@ def _process_limits() -> list[tuple[int, str]]:
     for name, current in (("RLIMIT_AS", vms), ("RLIMIT_DATA", data)):
         soft, _ = resource.getrlimit(getattr(resource, name))
         if soft != resource.RLIM_INFINITY:
-            found.append((soft - current, f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
+            found.append((soft - current + _counted_twice(), f"the process limit {name} (ulimit -{'v' if name == 'RLIMIT_AS' else 'd'}) less what this process uses"))
     return found
 
 
@@ -293,7 +295,7 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
         raise RunError(
             f"one process of this run would need about {gib(need)} at its peak ({making}a realization of "
             f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
-            f"limit to itself). It would fit with {advice}. {SKIP_HINT}"
+            f"limit to itself). It would fit with {advice}.{skip_hint()}"
         )
 
 
@@ -384,7 +386,7 @@ def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: boo
         advice[0] += f", or with {_higher_limit(source, available, guess.total)}"
     raise RunError(
         f"this run would need about {guess.describe()} at its peak, but {gib(available)} is available "
-        f"({source}). It would fit with {advice[0]}. {SKIP_HINT}"
+        f"({source}). It would fit with {advice[0]}.{skip_hint()}"
     )
 
 
@@ -412,5 +414,5 @@ def check_worker_limits(scene: Scene, limits: Mapping[str, int | None], *, usabl
         f"one realization of {points_text(guess.points)} points would need about {gib(need)} in a Dask worker "
         f"({gib(guess.per_realization)} plus {gib(DASK_WORKER_PROCESS)} for the worker process), but Dask worker "
         f"{address} has a memory limit of {gib(limit)} ({smallest}Dask kills a worker at {usable:.0%} of its limit). "
-        f"It would fit with {advice}. {SKIP_HINT}"
+        f"It would fit with {advice}.{skip_hint()}"
     )

@@ -208,4 +208,16 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
                                   f"same --out continues it, or `{how}` alone)")  # fmt: skip
         if interrupted_since(seen):  # the signal came as its last realizations ran: it completed
             raise WorkInterrupted(f"{fig.key} completed in {shown_name(run.folder)}")
+        if (unfit := _without_fit(run)) is not None:  # nothing to draw or tell for it: said, never a traceback
+            raise RunError(f"{fig.key} has no fit ({unfit}); {kept_in(out_dir)}")
     return runs
+
+
+def _without_fit(run: FigureRun) -> str | None:
+    """Why a figure's run (one of its sweep's points) has no fit, None if it has every one."""
+    if run.sweep_outcome is None:
+        return None if run.outcome.fit is not None else str(run.outcome.error or run.outcome.status)
+    for point in run.sweep_outcome.results:
+        if point.fit is None:
+            return f"sweep point {point.point.number} ({point.point.describe()}): {point.error or point.status}"
+    return None

@@ -404,7 +404,7 @@ def _last_count(folder: Path) -> int | None:
     for event in _tail_events(folder):
         if event["event"] == "started":  # none finished yet but those restored
             done = _count(event.get("resumed")) or 0
-        elif event["event"] in ("realization", "finished"):
+        elif event["event"] in ("realization", "realizations", "finished"):
             done = _count(event.get("done"))
     return done
 

@@ -1,8 +1,9 @@
 """A run's progress as a file in its folder, so that whoever comes later can follow it.
 
 A run writes ``progress.jsonl``: one JSON object a line, appended as things happen
-(``started``, one ``realization`` per finished realization with its curve, ``load``
-and ``iteration`` within a long solve, ``finished``; ``error`` when the run could not start). A TUI
+(``started``; ``realizations`` for the realizations finished since the last such line,
+with the sums of their curves (``progresslines``); ``load`` and ``iteration`` within a long
+solve; ``finished``; ``error`` when the run could not start). A TUI
 opened later, ``frictionlab follow`` or ``tail -f`` read it; ``Follower`` replays
 it to ``listeners.RunListener``s, the same ones that hear a run in this process.
 
@@ -23,46 +24,35 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 from pydantic import Field, ValidationError, model_validator
 
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
+from .progresslines import MAX_BATCH, MAX_LINE_BYTES, Batch, _number, _whole, batch_results, fitted_line, result_of
 from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"
-MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # ~100k realizations of 100 load steps: beyond that it is not ours
+MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # far above what a run writes (tens of bytes a realization): beyond that it is not ours
 READ_BLOCK = 4 * 1024 * 1024  # read at most this much at a time: a follower stays responsive
-MAX_LINE_BYTES = 1024 * 1024  # an event's line, at most (a realization's curves thinned to fit): within READ_BLOCK
-MAX_TEXT = 4000  # characters of a message, in a line that would pass MAX_LINE_BYTES otherwise
-CURVES = ("xi", "contact_count", "force")  # what a follower's mean curve needs (force: under indentation control)
-
-
-def _floats(values) -> list | None:
-    return None if values is None else np.asarray(values, float).tolist()
-
-
-def _event_of(result: RealizationResult, done: int, total: int, restored: bool = False) -> dict:
-    event = {"event": "realization", "index": result.index, "done": done, "total": total,
-             "seconds": result.seconds, "ok": result.ok}  # fmt: skip
-    if restored:
-        event["restored"] = True
-    if result.ok:
-        event.update({name: _floats(getattr(result, name)) for name in CURVES})
-        event.update(force_unit=result.force_unit, slope_rms_line=result.slope_rms_line, points=result.points)
-    else:
-        event["error"] = result.error
-    return event
+FLUSH_SECONDS = 1.0  # realizations finished together are written as one line at most this often,
+FLUSH_SHARE = 0.01  # or this share of the run's time so far if longer (a long run's log grows slower than its time),
+MAX_FLUSH_SECONDS = 60.0  # but at least this often while realizations finish: a follower is never a minute behind
+SOLVE_SECONDS = 0.5  # a solve's load events, at most this often (a fast solver reports every load)
 
 
 class ProgressLog:
     """A ``listeners.RunListener`` that writes the run's events to ``folder/progress.jsonl``.
+    Realizations are written together (``progresslines.Batch``): the first at once, then at
+    most every ``FLUSH_SECONDS`` (``FLUSH_SHARE`` of the run's time so far, if longer, up to
+    ``MAX_FLUSH_SECONDS``), the last with it, and what is pending before any other event.
     Progress is never worth a run: a write that fails stops the log, not the run."""
 
     def __init__(self, folder: str | Path, clock=time.time):
         self.path = Path(folder) / PROGRESS_FILE
         self.clock = clock
         self._fd: int | None = None
+        self._batch = Batch()
+        self._started = self._flushed = self._solve_said = -math.inf
 
     def _open(self, truncate: bool) -> None:
         self.close()
@@ -75,6 +65,7 @@ class ProgressLog:
             self._fd = None
 
     def close(self) -> None:
+        self.flush()
         if self._fd is not None:
             os.close(self._fd)
             self._fd = None
@@ -93,10 +84,24 @@ class ProgressLog:
         except OSError:
             self.close()
 
+    def flush(self) -> None:
+        """Write the realizations not yet written, if any."""
+        batch, self._batch = self._batch, Batch()
+        if len(batch):
+            self._flushed = self.clock()
+            self.write(batch.event())
+
+    def _due(self) -> bool:
+        now = self.clock()
+        elapsed = now - self._started if math.isfinite(self._started) else 0.0
+        return now - self._flushed >= max(FLUSH_SECONDS, min(FLUSH_SHARE * elapsed, MAX_FLUSH_SECONDS))
+
     def error(self, message: str, exit_code: int) -> None:
         """The run could not start, or stopped with an error: what a follower shows."""
         if self._fd is None:
+            self._batch = Batch()  # none of its realizations are told after another run's events
             self._open(truncate=False)  # appended: the log may be another live run's (a folder in use)
+        self.flush()
         self.write({"event": "error", "pid": os.getpid(), "message": message, "exit_code": int(exit_code)})
 
     def begin(self, event: dict) -> None:
@@ -108,66 +113,54 @@ class ProgressLog:
     def run_started(self, run):
         self.begin({"event": "started", "pid": os.getpid(), "name": run.scene.preset.name, "total": run.total,
                     "workers": run.workers, "executor": run.executor, "resumed": run.resumed, "retried": run.retried})  # fmt: skip
+        self._batch = Batch(restored=True)
         for done, result in enumerate(run.restored, start=1):
-            self.write(_event_of(result, done, run.total, restored=True))
+            self._batch.add(result, done, run.total)
+            if len(self._batch) >= MAX_BATCH:
+                self.flush()
+                self._batch = Batch(restored=True)
+        self.flush()
+        self._started, self._flushed, self._solve_said = self.clock(), -math.inf, -math.inf  # the first is written at once
 
     @hookimpl
     def realization_done(self, result, done, total):
-        self.write(_event_of(result, done, total))
+        self._batch.add(result, done, total)
+        if done >= total or len(self._batch) >= MAX_BATCH or self._due():
+            self.flush()
 
     @hookimpl
     def realization_failed(self, result, done, total):
-        self.write(_event_of(result, done, total))
+        self.realization_done(result, done, total)
+
+    def _solve_note(self, event: dict) -> None:
+        """A long solve's event (the realizations due first): an iteration's always (the run
+        sends them at most every ``ITERATION_EVENT_SECONDS``), a load's if none was for ``SOLVE_SECONDS``."""
+        if self._due():
+            self.flush()
+        if event["event"] == "iteration" or self.clock() - self._solve_said >= SOLVE_SECONDS:
+            self._solve_said = self.clock()
+            self.write(event)
 
     @hookimpl
     def load_done(self, index, done, total):
-        self.write({"event": "load", "index": index, "done": done, "total": total})
+        self._solve_note({"event": "load", "index": index, "done": done, "total": total})
 
     @hookimpl
     def iteration_done(self, index, load, iteration, residual):
-        self.write({"event": "iteration", "index": index, "load": load, "iteration": iteration, "residual": residual})
+        self._solve_note({"event": "iteration", "index": index, "load": load, "iteration": iteration, "residual": residual})
 
     @hookimpl
     def run_finished(self, outcome):
+        self.flush()
         self.write({"event": "finished", "status": outcome.status, "done": outcome.done,
                     "failed": len(outcome.failures), "requested": outcome.requested, "error": outcome.error})  # fmt: skip
         self.close()  # a sweep's child writes one log per point: none stays open
 
 
-def _line(event: dict) -> bytes:
-    return (json.dumps(event, separators=(",", ":")) + "\n").encode()
-
-
-def _cut(value):
-    """``value`` with every string in it cut to ``MAX_TEXT`` characters."""
-    if isinstance(value, str):
-        return value if len(value) <= MAX_TEXT else value[:MAX_TEXT] + "..."
-    if isinstance(value, dict):
-        return {key: _cut(item) for key, item in value.items()}
-    return [_cut(item) for item in value] if isinstance(value, list) else value
-
-
-def fitted_line(event: dict) -> bytes:
-    """``event`` as one line of at most ``MAX_LINE_BYTES``, which a reader takes whole: a
-    realization's curves thinned to every ``stride``-th load step (``stride`` in the event;
-    a run of ~40000 load steps or more), a longer message cut, else only the event's kind."""
-    line = _line(event)
-    if len(line) <= MAX_LINE_BYTES:
-        return line
-    if event.get("event") == "realization" and any(isinstance(event.get(name), list) for name in CURVES):
-        stride = -(-len(line) // (MAX_LINE_BYTES * 9 // 10))  # the curves are nearly all of it
-        while len(line) > MAX_LINE_BYTES and stride < 2 * MAX_LINE_BYTES:  # each pass halves the curves
-            curves = {name: event[name][::stride] for name in CURVES if isinstance(event.get(name), list)}
-            line, stride = _line({**event, **curves, "stride": stride}), 2 * stride
-        if len(line) <= MAX_LINE_BYTES:
-            return line
-    line = _line(_cut(event))
-    return line if len(line) <= MAX_LINE_BYTES else _line({"event": str(event.get("event"))[:MAX_TEXT], "cut": True})
-
-
 # ------------------------------------------------------------------ reading
 
 
+REALIZATIONS = ("realization", "realizations")  # one realization's event (as written before), several's
 HEAD_BYTES = 4096  # of the first line, kept to tell a rewritten file (its ``started`` names a new pid and time)
 
 
@@ -271,6 +264,22 @@ class _Realization(_Load):
     error: str | None = None
 
 
+class _Batch(_Event):
+    done: Whole = 0
+    total: Whole = 0
+    index: Annotated[list[Whole], Field(max_length=MAX_COUNT)] = []
+    seconds: list[Finite | None] = []
+    ok: Whole = 0
+    errors: dict[str, str] = {}
+    stride: Annotated[int, Field(ge=1, le=MAX_COUNT, strict=True)] = 1
+
+    @model_validator(mode="after")
+    def _as_many_as_done(self):
+        if len(self.index) > self.done:
+            raise ValueError("more realizations than done")
+        return self
+
+
 class _Iteration(_Event):
     index: Whole = 0
     load: Whole = 0
@@ -308,8 +317,8 @@ class _SweepFinished(_Event):
     total: Whole = 0
 
 
-EVENT_RECORDS = {"started": _Started, "realization": _Realization, "load": _Load, "iteration": _Iteration,
-                 "finished": _Finished, "error": _Error, "sweep_started": _SweepStarted,
+EVENT_RECORDS = {"started": _Started, "realization": _Realization, "realizations": _Batch, "load": _Load,
+                 "iteration": _Iteration, "finished": _Finished, "error": _Error, "sweep_started": _SweepStarted,
                  "point_started": _PointStarted, "point_finished": _PointStarted, "sweep_finished": _SweepFinished}  # fmt: skip
 
 
@@ -324,45 +333,6 @@ def checked_event(event: dict) -> dict | None:
     except ValidationError:
         return None
     return event
-
-
-def _whole(value, default: int = 0) -> int:
-    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else default
-
-
-def _number(value) -> float:
-    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
-
-
-def _curve(value, steps: int, stride: int = 1) -> np.ndarray | None:
-    """A curve of ``steps`` load steps, written at every ``stride``-th (NaN at the others)."""
-    if not isinstance(value, list) or len(value) != -(-steps // stride):
-        return None
-    try:
-        written = np.array([math.nan if x is None else x for x in value], dtype=float)
-    except (TypeError, ValueError):
-        return None
-    if stride == 1:
-        return written
-    curve = np.full(steps, math.nan)
-    curve[::stride] = written
-    return curve
-
-
-def result_of(event: dict, steps: int) -> RealizationResult | None:
-    """The RealizationResult a ``realization`` event tells, None if it does not hold one
-    (a curve of another length than the run's load steps, a field of the wrong kind)."""
-    index = _whole(event.get("index"), -1)
-    if index < 0:
-        return None
-    seconds = _number(event.get("seconds"))
-    if event.get("ok") is not True:
-        return RealizationResult(index=index, seconds=seconds, error=str(event.get("error") or "failed"))
-    curves = {name: _curve(event.get(name), steps, event.get("stride", 1)) for name in CURVES}
-    if curves["xi"] is None or curves["contact_count"] is None:
-        return None
-    return RealizationResult(index=index, seconds=seconds, **curves, force_unit=_number(event.get("force_unit")),
-                             slope_rms_line=_number(event.get("slope_rms_line")), points=_whole(event.get("points")))  # fmt: skip
 
 
 @dataclass
@@ -420,6 +390,7 @@ class Follower:
         self.finished: Finished | None = None
         self.done = self.total = 0
         self._event_time: float | None = None
+        self._told_at: float | None = None  # the time of the event before the one replayed
         self._hooks = None
         self._resuming = None  # a resume's RunInfo, told once the realizations it restored are read
         self._restored: list[RealizationResult] = []
@@ -439,6 +410,26 @@ class Follower:
         self.done = info.resumed
         self._tell("run_started", run=info)
 
+    def _results(self, event: dict) -> list[RealizationResult] | None:
+        """The realizations a ``realization`` or ``realizations`` event tells, None if it holds none."""
+        if event["event"] == "realizations":
+            return batch_results(event, self.scene.loads.size)
+        result = result_of(event, self.scene.loads.size)
+        return None if result is None else [result]
+
+    def _realizations(self, event: dict) -> None:
+        """Tell each realization of ``event``, counted up to its ``done``; none of another run's."""
+        results, done = self._results(event), _whole(event.get("done"), self.done)
+        if not results or done > self.total or done < len(results):  # not realizations of this run
+            return
+        end = self._event_time
+        start = self._told_at if end is not None and self._told_at is not None and self._told_at < end else end
+        for k, result in enumerate(results, start=1):  # each at its share of the time since the last event: a rate as the run's
+            self.done = done - len(results) + k
+            self._event_time = None if end is None else start + (end - start) * k / len(results)
+            hook = "realization_done" if result.ok else "realization_failed"
+            self._tell(hook, run=self.info, result=result, done=self.done, total=self.total)
+
     def poll(self) -> int:
         """Replay the events written since the last call; return how many."""
         from ..compute.engine import RunInfo
@@ -448,12 +439,12 @@ class Follower:
             self.info, self.finished, self._resuming = None, None, None
         for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
-            self._event_time = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
+            at = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
+            self._event_time = at
             try:
-                if self._resuming is not None and kind == "realization" and event.get("restored") is True:
-                    result = result_of(event, self.scene.loads.size)  # as the run's own listeners have them:
-                    if result is not None and result.ok:  # in RunInfo.restored, not as realizations done now
-                        self._restored.append(result)
+                if self._resuming is not None and kind in REALIZATIONS and event.get("restored") is True:
+                    results = self._results(event) or []  # as the run's own listeners have them:
+                    self._restored += [result for result in results if result.ok]  # in RunInfo.restored, not done now
                     if len(self._restored) >= self._resuming.resumed:
                         self._start(replace(self._resuming, restored=tuple(self._restored)))
                     continue
@@ -469,13 +460,8 @@ class Follower:
                         self._resuming, self._restored = info, []
                     else:
                         self._start(info)
-                elif kind == "realization" and self.info is not None:
-                    result = result_of(event, self.scene.loads.size)
-                    if result is None or _whole(event.get("done"), self.done) > self.total:  # not a realization of this run
-                        continue
-                    self.done = _whole(event.get("done"), self.done)
-                    hook = "realization_done" if result.ok else "realization_failed"
-                    self._tell(hook, run=self.info, result=result, done=self.done, total=self.total)
+                elif kind in REALIZATIONS and self.info is not None:
+                    self._realizations(event)
                 elif kind == "load" and self.info is not None:
                     self._tell("load_done", run=self.info, index=_whole(event.get("index")),
                                done=_whole(event.get("done")), total=_whole(event.get("total")))  # fmt: skip
@@ -492,5 +478,5 @@ class Follower:
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              _whole(event.get("exit_code"), 1))  # fmt: skip
             finally:
-                self._event_time = None
+                self._event_time, self._told_at = None, self._told_at if at is None else at
         return len(events)

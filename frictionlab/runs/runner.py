@@ -73,8 +73,7 @@ def check_memory(scene: Scene, options: RunOptions) -> None:
             raise
         # the advice may name the preset's points or realizations, which a resume cannot change
         raise RunError(f"{exc} A resume keeps the preset the run was started with: of that advice only the worker "
-                       "count applies (--workers; workers= in Python); otherwise resume it where more memory is "
-                       "available.") from None  # fmt: skip
+                       "count applies; otherwise resume it where more memory is available.") from None  # fmt: skip
 
 
 def memory_check_before_reading(options: RunOptions) -> Callable[[Scene], None] | None:

@@ -235,11 +235,50 @@ def test_a_full_disk_says_so_plainly_and_how_to_write_the_study_once_there_is_ro
             "--quiet"]  # fmt: skip
     assert main([*args, "--json"]) == ExitCode.RUNTIME_FAILURE
     captured = capsys.readouterr()
-    said = (f"cannot write the study to {out}: No space left on device; free some space and run the study again with "
-            "--force (it replaces only study.csv, study.md and study.png)")  # fmt: skip
-    assert captured.err == f"error: {said}\n"
+    said = (f"cannot write the study to {out}: No space left on device, nor to a temporary folder (No space left on "
+            "device): its rows (study.csv) and recommendation are printed above; free some space and run the study "
+            "again with --force (it replaces only study.csv, study.md and study.png)")  # fmt: skip
+    assert captured.err.endswith(f"error: {said}\n")
+    assert "\nstudy.csv:\naxis," in captured.err  # what was measured, kept where a person sees it
     assert json.loads(captured.out)["error"] == said  # the error object, as for every failure under --json
     monkeypatch.undo()
     assert main(args) == ExitCode.OUTPUT_REFUSED  # as said: without --force, the folder is not a study's
     assert main([*args, "--force"]) == ExitCode.OK
     assert {p.name for p in out.iterdir()} == {"study.csv", "study.md", "study.png"}
+
+
+def test_a_study_whose_folder_cannot_be_written_keeps_its_files_elsewhere_and_says_how_to_move_them(tmp_path, capsys,
+                                                                                                  monkeypatch):
+    """A full disk (or a folder that refuses writes) lost every number measured: the study had to
+    run again. Its files go to a temporary folder (TMPDIR, often another disk), and the message
+    says the command that moves them, nothing measured again."""
+    import errno
+    import subprocess
+    import tempfile
+
+    from frictionlab.tradeoff import outputs
+
+    out, spare_disk = tmp_path / "o", tmp_path / "spare-disk"
+    spare_disk.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(spare_disk))
+    write_file = outputs.atomic_write
+
+    def out_is_full(path, write, *args, **keys):
+        if path.parent == out:
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        write_file(path, write, *args, **keys)
+
+    monkeypatch.setattr(outputs, "atomic_write", out_is_full)
+    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--compare-steps", "5", "--quiet"]
+    assert main(args) == ExitCode.RUNTIME_FAILURE
+    err = capsys.readouterr().err
+    [spare] = spare_disk.iterdir()
+    assert {p.name for p in spare.iterdir()} == {"study.csv", "study.md", "study.png"}
+    assert f"cannot write the study to {out}: No space left on device; it was written to {spare}/ instead" in err
+    move = err.split("can be written, ", 1)[1].strip()
+    assert move == f"mkdir -p {out} && mv {spare}/study.* {out}/"
+    kept = (spare / "study.csv").read_text()
+    subprocess.run(["bash", "-c", move], check=True)
+    assert (out / "study.csv").read_text() == kept and {p.name for p in out.iterdir()} == {"study.csv", "study.md", "study.png"}
+    monkeypatch.undo()
+    assert main(args) == ExitCode.OK  # the folder moved into is a study of the preset: written again without --force
