@@ -343,12 +343,16 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
     Laplace's equation from its neighbours; and how many were replaced. ValueError when more than
     MAX_SPIKE_FRACTION of the points would be (``k`` too small: the scan itself, not its spikes)."""
-    from scipy import ndimage, sparse
+    from scipy import ndimage
     from scipy.sparse.linalg import spsolve
 
     local = ndimage.median_filter(z, size=SPIKE_WINDOW, mode="reflect")
-    spike = np.abs(z - local) > k * rms
-    count = int(np.count_nonzero(spike))
+    np.subtract(z, local, out=local)  # in place: the filter's copy of the map is the only one made
+    spike = np.abs(local, out=local) > k * rms
+    del local
+    flat = np.flatnonzero(spike)  # sorted: a neighbour is a spike where searchsorted finds it
+    del spike
+    count = int(flat.size)
     if count > MAX_SPIKE_FRACTION * z.size:  # refused before one equation per point is built (a 4096^2 map: hours)
         raise ValueError(
             f"despike {k:g} takes {count} of {z.size} points ({100 * count / z.size:.1f} %) for spikes: a spike is a "
@@ -357,23 +361,36 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
         )
     if not count:  # (every point a spike was refused above)
         return z, 0
-    ny, nx = z.shape
-    index = np.full(z.shape, -1, dtype=np.int64)
-    index[spike] = np.arange(count)
-    rows, cols, values = [], [], []
-    rhs = np.zeros(count)
-    where = np.argwhere(spike)
-    for (i, j), row in zip(where, range(count)):  # a handful of points: each an equation
-        neighbours = [(a, b) for a, b in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)) if 0 <= a < ny and 0 <= b < nx]
-        rows.append(row), cols.append(row), values.append(float(len(neighbours)))
-        for a, b in neighbours:
-            if spike[a, b]:
-                rows.append(row), cols.append(int(index[a, b])), values.append(-1.0)
-            else:
-                rhs[row] += z[a, b]
+    matrix, rhs = _laplace_system(z, flat)
     out = z.copy()
-    out[spike] = spsolve(sparse.csr_matrix((values, (rows, cols)), shape=(count, count)), rhs)
+    out.ravel()[flat] = spsolve(matrix, rhs)  # out is contiguous: ravel is a view
     return out, count
+
+
+def _laplace_system(z: np.ndarray, flat: np.ndarray):
+    """Laplace's equation on the points of ``z`` at the sorted flat indices ``flat``, from their
+    4 neighbours inside the map: a neighbour among them is an unknown, another a known height.
+    Arrays of the spikes' size only (an index of the whole map was two more copies of it)."""
+    from scipy import sparse
+
+    ny, nx = z.shape
+    count = flat.size
+    own = np.arange(count)
+    i, j = np.divmod(flat, nx)
+    degree, rhs = np.zeros(count), np.zeros(count)
+    rows, cols = [own], [own]
+    for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        a, b = i + di, j + dj
+        inside = (a >= 0) & (a < ny) & (b >= 0) & (b < nx)
+        a, b = np.clip(a, 0, ny - 1), np.clip(b, 0, nx - 1)
+        at = np.minimum(np.searchsorted(flat, a * nx + b), count - 1)
+        unknown = inside & (flat[at] == a * nx + b)
+        degree += inside
+        rhs += np.where(inside & ~unknown, z[a, b], 0.0)
+        rows.append(own[unknown]), cols.append(at[unknown])
+    values = np.concatenate([degree, -np.ones(sum(r.size for r in rows[1:]))])
+    matrix = sparse.csr_matrix((values, (np.concatenate(rows), np.concatenate(cols))), shape=(count, count))
+    return matrix, rhs
 
 
 FLAT_SHARE = 0.25  # of neighbouring pixels at exactly one height: from here on, the slopes are the steps'
