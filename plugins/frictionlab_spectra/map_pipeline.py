@@ -156,6 +156,7 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel
+    scan = (z.shape[1] * dx, z.shape[0] * dy)  # the extent the scan's pixels cover, x by y
     if abs(dx - dy) > SAME_SIDE * max(dx, dy):  # not the rounding of a text file's coordinates (0.1 vs 0.1000...02)
         difference = abs(dx - dy) / max(dx, dy)
         if _nearly_square(dx, dy):
@@ -180,6 +181,9 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         done["downsampled"] = {"from_pixel": spacing, "to_pixel": new}
         spacing = new
     z = z - np.mean(z) if mode != "none" else z
+    pressed = (z.shape[1] * spacing, z.shape[0] * spacing)
+    if abs(pressed[0] * pressed[1] / (scan[0] * scan[1]) - 1) > PIXEL_TOLERANCE:  # resampled points end at the last sample
+        done["extent"] = {"scan": list(scan), "pressed": list(pressed)}
     if caveats:
         done["caveats"] = caveats
     return np.ascontiguousarray(z), float(spacing), done
