@@ -410,7 +410,7 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
         ahead, behind = tuple(whole[:axis] + [slice(1, None)]), tuple(whole[:axis] + [slice(None, -1)])
         pairs, equal = pairs + z[ahead].size, equal + int(np.count_nonzero(z[ahead] == z[behind]))
     if not pairs or equal <= FLAT_SHARE * pairs:
-        return None
+        return _clipped_warning(z, what)
     steps = np.abs(np.diff(z.ravel()))  # along the rows, and from a row's end to the next's start
     step = float(steps[steps > 0].min())  # some: the map is not flat (rms > 0)
     points = "pixels" if what == "map" else "points"
@@ -419,6 +419,25 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
             f"{points}, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
             "surface's; measure or export the heights at a finer resolution (a float channel in double precision, or "
             "less their mean: single precision keeps 7 digits of heights far from zero)")  # fmt: skip
+
+
+CLIPPED_SHARE = 0.01  # of the points at exactly the highest (lowest) height: a range exceeded, not a surface's peaks
+CLIPPED_POINTS = 8  # and at least this many: a few points alike at the top are a short line's rounding
+
+
+def _clipped_warning(z: np.ndarray, what: str) -> str | None:
+    """The caveat of a map or line as read with more than CLIPPED_SHARE of its points at its highest (lowest)
+    height: an instrument out of its range (an AFM's z saturated), too few neighbours alike for the steps'."""
+    for side, edge in (("highest", z.max()), ("lowest", z.min())):
+        count = int(np.count_nonzero(z == edge))
+        if count >= CLIPPED_POINTS and count > CLIPPED_SHARE * z.size:
+            share = count / z.size
+            return (f"{100 * share:.3g} % of the {what}'s points sit at exactly its {side} height, {float(edge):.6g}: "
+                    "clipped (an instrument's height range exceeded), or a value written for missing points; "
+                    f"{'the first contact lands on that plateau, and ' if side == 'highest' else ''}its slopes are "
+                    "zero; measure with a larger height range, or leave the clipped part out (region), if it is not "
+                    "the surface's own")  # fmt: skip
+    return None
 
 
 LINE_JUMP_SHARE = 0.5  # of the height change across lines that whole lines standing apart carry: said from here on
