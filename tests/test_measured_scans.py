@@ -32,3 +32,22 @@ def test_a_short_lines_few_equal_tops_are_not_called_clipped(tmp_path):
     np.savetxt(tmp_path / "line.csv", line)
     said = ProfileFile(path=str(tmp_path / "line.csv"), spacing=0.1).input_summary().get("caveats", ())
     assert not any("clipped (" in c for c in said), said
+
+
+def test_a_table_exported_with_its_axes_is_said_to_hold_positions(tmp_path):
+    """A matrix with x positions over its columns and y beside its rows (or a spreadsheet's row
+    numbers) was read whole as heights: a ramp along two edges, the rms height and the spikes theirs."""
+    z, _ = band_limited(32, 32, seed=6, top=0.3)
+    x = np.round(np.arange(32) * 0.0390625, 6)  # as an export prints them: 6 digits
+    with_axes = np.block([[np.zeros((1, 1)), x[None, :]], [x[:, None], z]])
+    np.savetxt(tmp_path / "axes.csv", with_axes, delimiter=",", fmt="%.6g")
+    np.savetxt(tmp_path / "numbered.csv", np.c_[np.arange(32), z], delimiter=",")
+    np.savetxt(tmp_path / "plain.csv", z, delimiter=",")
+    said = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=0.1).input_summary()["caveats"][0]
+    assert "the table's first row (0 to 1.21094) and first column (0 to 1.21094) are evenly spaced" in said, said
+    assert "region: {x: [1, 33], y: [1, 33]}" in said
+    said = SurfaceFile(path=str(tmp_path / "numbered.csv"), spacing=0.1).input_summary()["caveats"][0]
+    assert "the table's first column (0 to 31) is evenly spaced" in said and "region: {x: [1, 33]}" in said, said
+    assert "caveats" not in SurfaceFile(path=str(tmp_path / "plain.csv"), spacing=0.1).input_summary()
+    cropped = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=0.1, region={"x": [1, 33], "y": [1, 33]})
+    assert "caveats" not in cropped.input_summary()
