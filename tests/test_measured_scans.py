@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -51,3 +53,14 @@ def test_a_table_exported_with_its_axes_is_said_to_hold_positions(tmp_path):
     assert "caveats" not in SurfaceFile(path=str(tmp_path / "plain.csv"), spacing=0.1).input_summary()
     cropped = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=0.1, region={"x": [1, 33], "y": [1, 33]})
     assert "caveats" not in cropped.input_summary()
+
+
+@pytest.mark.parametrize("region, kept", [({"y": [0, 1]}, "64 x 1"), ({"x": [0.04, 0.06], "units": "length"}, "1 x 64")])
+def test_a_region_one_pixel_wide_is_refused_without_numpys_warnings(tmp_path, region, kept):
+    """Its levelling divided by zero first: 'warning: invalid value encountered in scalar divide' and
+    'Mean of empty slice' were printed above the refusal."""
+    np.save(tmp_path / "map.npy", band_limited(64, 64, seed=2, top=0.3)[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=f"region keeps {kept} pixels \\(x by y\\) of the map, one pixel wide: a line"):
+            SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1, region=region).rms_height()

@@ -132,6 +132,9 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         check_still_periodic(pixel, p, where)
     if p.region is not None:
         z, done["region_pixels"] = crop(z, pixel, p.region, where)
+        if min(z.shape) < 2:  # a line, which no resampling makes a map: refused before its levelling divides by zero
+            raise ValueError(f"{where}: region keeps {z.shape[1]} x {z.shape[0]} pixels (x by y) of the map, one pixel "
+                             "wide: a line; give a larger region, or read a line with profile-file")  # fmt: skip
     mode = p.detrend if p.detrend is not None else "plane" if instrument and not periodic else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
