@@ -64,3 +64,14 @@ def test_a_region_one_pixel_wide_is_refused_without_numpys_warnings(tmp_path, re
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match=f"region keeps {kept} pixels \\(x by y\\) of the map, one pixel wide: a line"):
             SurfaceFile(path=str(tmp_path / "map.npy"), spacing=0.1, region=region).rms_height()
+
+
+def test_pixels_many_times_longer_one_way_say_the_map_pressed_is_mostly_interpolated(tmp_path):
+    """Rows 5 times apart the columns': 60 of the 76 rows pressed are the cosine series between the
+    16 measured, smooth along y, and that was said only as '64 x 16 -> 64 x 76 pixels'."""
+    np.save(tmp_path / "rows.npy", np.random.default_rng(8).normal(size=(16, 64)))
+    said = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=0.1, spacing_y=0.5).input_summary()["caveats"]
+    assert any("the file's pixels are 5 times longer along y: 16 of the 76 rows pressed were measured" in c
+               and "shorter than two measured rows (1)" in c for c in said), said  # fmt: skip
+    said = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=0.1, spacing_y=0.25).input_summary().get("caveats", ())
+    assert not any("times longer" in c for c in said), said

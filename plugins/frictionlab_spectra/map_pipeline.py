@@ -175,6 +175,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             done["pixels"] = (f"{dx:.6g} x {dy:.6g} resampled onto square pixels of {spacing:.6g} along "
                               f"{'y' if axis == 0 else 'x'} (band-limited cosine series): {before[1]} x {before[0]} "
                               f"-> {z.shape[1]} x {z.shape[0]} pixels")  # fmt: skip
+            if max(dx, dy) > LONG_PIXELS * spacing:
+                caveats.append(_long_pixels_caveat((dx, dy), before[axis], z.shape[axis]))
     if p.downsample is not None:
         new = spacing * p.downsample.factor if p.downsample.factor is not None else p.downsample.pixel
         if not new > spacing * (1 + 1e-12):
@@ -190,6 +192,22 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if caveats:
         done["caveats"] = caveats
     return np.ascontiguousarray(z), float(spacing), done
+
+
+LONG_PIXELS = 4.0  # times longer one way than the other: from here on, most of the map pressed is interpolated
+
+
+def _long_pixels_caveat(pixel: tuple[float, float], measured: int, pressed: int) -> str:
+    """The caveat of a map on pixels more than LONG_PIXELS times longer one way: the lines pressed
+    between the measured ones are their cosine series, with none of the roughness shorter than
+    two measured lines (a self-affine surface's slopes are mostly there)."""
+    dx, dy = pixel
+    along, ratio, long = ("y", dy / dx, dy) if dy > dx else ("x", dx / dy, dx)
+    lines = "rows" if along == "y" else "columns"
+    return (f"the file's pixels are {ratio:.4g} times longer along {along}: {measured} of the {pressed} {lines} pressed "
+            f"were measured, the rest are their cosine series, with no roughness along {along} shorter than two "
+            f"measured {lines} ({2 * long:.3g}); the slopes along {along}, and the rms slope xi divides by, miss it. "
+            f"Measure on square pixels, or press one measured line with profile-file")  # fmt: skip
 
 
 RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis
