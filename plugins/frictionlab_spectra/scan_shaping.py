@@ -435,8 +435,8 @@ def _clipped_warning(z: np.ndarray, what: str) -> str | None:
             return (f"{100 * share:.3g} % of the {what}'s points sit at exactly its {side} height, {float(edge):.6g}: "
                     "clipped (an instrument's height range exceeded), or a value written for missing points; "
                     f"{'the first contact lands on that plateau, and ' if side == 'highest' else ''}its slopes are "
-                    "zero; measure with a larger height range, or leave the clipped part out (region), if it is not "
-                    "the surface's own")  # fmt: skip
+                    f"zero; measure with a larger height range, or leave the clipped part out "
+                    f"({'region' if what == 'map' else 'of the profile'}), if it is not the surface's own")  # fmt: skip
     return None
 
 
