@@ -56,3 +56,27 @@ def test_despike_holds_little_more_than_the_median_filters_copy_of_the_map():
         tracemalloc.stop()
     assert count == 49
     assert peak < 2 * z.nbytes, peak / z.nbytes  # the filter's copy, then the copy returned (it held 3.1)
+
+
+@pytest.mark.parametrize("detrend", ["plane", "quadratic", "none"])
+def test_a_map_levelled_and_despiked_holds_at_most_three_copies_of_it(monkeypatch, detrend):
+    """HEIGHT_COPIES counts four copies of a map while it is read (the reader's, ours, levelled,
+    resampled): levelling held three (a basis xy of the map's size, and its square), and the
+    despiked map levelled again five at once."""
+    from types import SimpleNamespace
+
+    from frictionlab_spectra import map_pipeline, scan_shaping
+
+    monkeypatch.setattr(scan_shaping, "LINE_BLOCK", 4096)  # blocks of rows a map of millions of points has
+    z = np.random.default_rng(9).normal(size=(256, 256))
+    z[::37, ::41] += 40.0
+    p = SimpleNamespace(region=None, detrend=detrend, despike=6.0, downsample=None)
+    map_pipeline.shape_map(z, (1.0, 1.0), p, "w", instrument=True, periodic=False)  # imports before the count
+    tracemalloc.start()
+    try:
+        heights, _, done = map_pipeline.shape_map(z, (1.0, 1.0), p, "w", instrument=True, periodic=False)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert done["despiked"]["points"] == 49
+    assert peak < 3 * z.nbytes, peak / z.nbytes  # beyond the map read (it held 6)

@@ -144,7 +144,10 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             raise ValueError(f"{where}: {exc}") from None
         done["despiked"] = {"k": p.despike, "points": count}
         if count:  # level the file's map with the spikes replaced: the record says what levelling removed
-            levelled = level(z + (despiked - levelled.heights), mode)
+            np.subtract(despiked, levelled.heights, out=despiked)  # what despike changed, in place
+            del levelled  # let go before the new levelling: a copy of the map at a time
+            levelled = level(np.add(despiked, z, out=despiked), mode)
+            del despiked
     done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
     if (warning := levelling_warning(levelled, mode)) is not None:

@@ -47,30 +47,34 @@ def _axis(n: int) -> tuple[np.ndarray, np.ndarray]:
 def level(z: np.ndarray, mode: str) -> Levelling:
     """``z`` less its least-squares ``mode`` (none, mean, plane: a + bx + cy, quadratic: also
     x^2, xy, y^2). On a grid the basis 1, x, y, x^2 - <x^2>, xy, y^2 - <y^2> is orthogonal, so
-    each term is one projection (no design matrix of six copies of the map)."""
+    each term is one projection (no design matrix of six copies of the map), a factor along y times
+    one along x removed a block of rows at a time: one copy of the map (a basis xy was two more)."""
     mean = float(np.mean(z))
     out = z - mean
     ny, nx = z.shape
     x, x2 = _axis(nx)
     y, y2 = _axis(ny)
+    along_x, along_y = np.ones(ny), np.ones(nx)  # the other factor of a term along one axis
     rows, columns = out.sum(axis=1), out.sum(axis=0)  # projections of separable terms need only these
-    plane = [(columns @ x / (ny * (x @ x)), x[None, :]), (rows @ y / (nx * (y @ y)), y[:, None])]
-    curved = [(y @ (out @ x) / ((x @ x) * (y @ y)), y[:, None] * x[None, :])]
+    plane = [(columns @ x / (ny * (x @ x)), along_x, x), (rows @ y / (nx * (y @ y)), y, along_y)]
+    curved = [(y @ (out @ x) / ((x @ x) * (y @ y)), y, x)]
     if nx > 2:
-        curved.append((columns @ x2 / (ny * (x2 @ x2)), x2[None, :]))
+        curved.append((columns @ x2 / (ny * (x2 @ x2)), along_x, x2))
     if ny > 2:
-        curved.append((rows @ y2 / (nx * (y2 @ y2)), y2[:, None]))
+        curved.append((rows @ y2 / (nx * (y2 @ y2)), y2, along_y))
     size = float(z.size)
     variance = float(np.vdot(out, out)) / size  # no temporary the size of the map
-    share = [sum(c * c * float(np.sum(b * b)) * size / b.size for c, b in terms) / size for terms in (plane, curved)]
+    share = [sum(c * c * (a @ a) * (b @ b) for c, a, b in terms) / size for terms in (plane, curved)]
     removed = plane if mode == "plane" else plane + curved if mode == "quadratic" else []
-    for coefficient, basis in removed:
-        out -= coefficient * basis
+    block = max(1, LINE_BLOCK // nx)
+    for coefficient, a, b in removed:
+        for start in range(0, ny, block):
+            term = a[start : start + block, None] * b[None, :]
+            out[start : start + block] -= np.multiply(term, coefficient, out=term)
+    rms_after = math.sqrt(float(np.vdot(out, out)) / size)  # every term removed is orthogonal to the constant
     if mode == "none":
-        out = z.copy()  # bit for bit what the file holds
-        rms_after = float(np.std(out))
-    else:  # every term removed is orthogonal to the constant: the mean stays zero
-        rms_after = math.sqrt(float(np.vdot(out, out)) / size)
+        out = None  # let go before the copy, bit for bit what the file holds
+        out = z.copy()
     scale = variance if variance > 0 else math.inf
     return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
 
@@ -168,8 +172,6 @@ def resampled_points(n: int, step: float, new_step: float) -> int:
 
 
 MAX_SPIKE_FRACTION = 0.05  # despike replaces at most this share of a map's points
-
-
 SPIKE_K = 6.0  # rms heights above the median around it: what despike's usual value calls a spike
 SPIKE_WINDOW = 5  # pixels a side of the square whose median a point is measured from (despike and its caveat)
 SPIKE_LOOKED_AT = 16  # the highest points looked at for spikes: those that carry the first contact
@@ -368,9 +370,8 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
 
 
 def _laplace_system(z: np.ndarray, flat: np.ndarray):
-    """Laplace's equation on the points of ``z`` at the sorted flat indices ``flat``, from their
-    4 neighbours inside the map: a neighbour among them is an unknown, another a known height.
-    Arrays of the spikes' size only (an index of the whole map was two more copies of it)."""
+    """Laplace's equation on the points of ``z`` at the sorted flat indices ``flat`` from their 4 neighbours
+    inside the map (one among them an unknown): arrays of their size (a map's index was two copies)."""
     from scipy import sparse
 
     ny, nx = z.shape
@@ -429,10 +430,8 @@ def _clipped_warning(z: np.ndarray, what: str) -> str | None:
     """The caveat of a map or line as read with more than CLIPPED_SHARE of its points at its highest (lowest)
     height: an instrument out of its range (an AFM's z saturated), too few neighbours alike for the steps'."""
     for side, edge in (("highest", z.max()), ("lowest", z.min())):
-        count = int(np.count_nonzero(z == edge))
-        if count >= CLIPPED_POINTS and count > CLIPPED_SHARE * z.size:
-            share = count / z.size
-            return (f"{100 * share:.3g} % of the {what}'s points sit at exactly its {side} height, {float(edge):.6g}: "
+        if (count := int(np.count_nonzero(z == edge))) >= CLIPPED_POINTS and count > CLIPPED_SHARE * z.size:
+            return (f"{100 * count / z.size:.3g} % of the {what}'s points sit at exactly its {side} height, {float(edge):.6g}: "
                     "clipped (an instrument's height range exceeded), or a value written for missing points; "
                     f"{'the first contact lands on that plateau, and ' if side == 'highest' else ''}its slopes are "
                     f"zero; measure with a larger height range, or leave the clipped part out "
