@@ -77,3 +77,19 @@ def test_pixels_many_times_longer_one_way_say_the_map_pressed_is_mostly_interpol
                and "shorter than two measured rows (1)" in c for c in said), said  # fmt: skip
     said = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=0.1, spacing_y=0.25).input_summary().get("caveats", ())
     assert not any("times longer" in c for c in said), said
+
+
+def test_a_map_of_two_lines_is_not_sent_from_one_plugin_to_the_other(tmp_path):
+    """profile-file said 'the file holds a 2D map; use surface-file', and surface-file 'at least 8 x 8
+    are needed': each sent the user to the other."""
+    from SurfaceTopography import Topography
+
+    Topography(np.random.default_rng(5).normal(size=(256, 2)), (25.6, 0.2), unit="µm").to_x3p(str(tmp_path / "two.x3p"))
+    with pytest.raises(ValueError, match=r"a 2D map of 256 x 2 pixels \(x by y\): too narrow for surface-file \(at least "
+                       r"8 x 8\), and profile-file reads a line \(a map one pixel wide\); export one of its lines"):  # fmt: skip
+        ProfileFile(path=str(tmp_path / "two.x3p"), unit="um").rms_height()
+    with pytest.raises(ValueError, match=r"map of 256 x 2 pixels \(x by y\); at least 8 x 8 are needed"):
+        SurfaceFile(path=str(tmp_path / "two.x3p"), unit="um").rms_height()
+    Topography(np.random.default_rng(5).normal(size=(16, 16)), (1.6, 1.6), unit="µm").to_x3p(str(tmp_path / "map.x3p"))
+    with pytest.raises(ValueError, match="the file holds a 2D map; use surface-file"):
+        ProfileFile(path=str(tmp_path / "map.x3p"), unit="um").rms_height()

@@ -50,7 +50,7 @@ from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
@@ -63,7 +63,6 @@ from .profile_file import (
 from .text_table import axes_warning, read_text_table
 from .scan_shaping import FLAT, flat_rms
 
-MIN_SIDE = 8
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
 # The peak of ``equivalent_line``, measured with tracemalloc (ru_maxrss agrees), plus a third:
 # per point of the map, the read or the FFT (36 bytes for a periodic map, 72 for one
