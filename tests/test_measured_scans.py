@@ -93,3 +93,16 @@ def test_a_map_of_two_lines_is_not_sent_from_one_plugin_to_the_other(tmp_path):
     Topography(np.random.default_rng(5).normal(size=(16, 16)), (1.6, 1.6), unit="µm").to_x3p(str(tmp_path / "map.x3p"))
     with pytest.raises(ValueError, match="the file holds a 2D map; use surface-file"):
         ProfileFile(path=str(tmp_path / "map.x3p"), unit="um").rms_height()
+
+
+def test_a_text_export_cut_short_is_refused_not_stretched(tmp_path):
+    """Gwyddion's text export cut two thirds of the way (a copy stopped): its reader dropped the cut
+    row, the 42 rows left were stretched over the 6.4 um its header states, pixels of 0.1 x 0.152 um
+    resampled onto 63 rows, and the map read without a word."""
+    from .test_table_header_units import gwyddion_text
+
+    whole = gwyddion_text(tmp_path / "scan.txt", band_limited(64, 64, seed=4, top=0.3)[0], 0.1).read_text(encoding="utf-8")
+    assert SurfaceFile(path=str(tmp_path / "scan.txt"), format="instrument", unit="um").grid_shape() == (64, 64)
+    (tmp_path / "cut.txt").write_text(whole[: 2 * len(whole) // 3], encoding="utf-8")
+    with pytest.raises(ValueError, match=r"its last line holds \d+ numbers and the line before it 64: a .* file cut short"):
+        SurfaceFile(path=str(tmp_path / "cut.txt"), format="instrument", unit="um").rms_height()
