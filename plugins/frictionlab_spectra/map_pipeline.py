@@ -160,6 +160,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     if (warning := line_offset_warning(levelled.heights)) is not None:
         caveats.append(warning)
+    if (warning := _noise_warning(levelled.heights)) is not None:
+        caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel
     scan = (z.shape[1] * dx, z.shape[0] * dy)  # the extent the scan's pixels cover, x by y
@@ -211,6 +213,27 @@ def _long_pixels_caveat(pixel: tuple[float, float], measured: int, pressed: int)
             f"were measured, the rest are their cosine series, with no roughness along {along} shorter than two "
             f"measured {lines} ({2 * long:.3g}); the slopes along {along}, and the rms slope xi divides by, miss it. "
             f"Measure on square pixels, or press one measured line with profile-file")  # fmt: skip
+
+
+WHITE = 0.2  # correlation of neighbouring heights below which a scan is noise: a measured surface's is near 1
+
+
+def _noise_warning(z: np.ndarray) -> str | None:
+    """The caveat of a levelled map whose neighbouring heights are uncorrelated along x and y: white
+    noise, which no surface is. Bytes read in the wrong order (an int16 byte-swapped) gave a map of
+    it, pressed without a word; an instrument's noise on a surface smoother than it resolves gives
+    one too. The slopes, and xi, are then the noise's."""
+    power = float(np.einsum("ij,ij->", z, z))  # no temporary of the map's size
+    if not power > 0:
+        return None
+    said = {axis: float(np.einsum("ij,ij->", a, b)) / power for axis, a, b in (("x", z[:, 1:], z[:, :-1]),
+                                                                             ("y", z[1:], z[:-1]))}  # fmt: skip
+    if max(said.values()) >= WHITE:
+        return None
+    along = ", ".join(f"{c:.2f} along {axis}" for axis, c in said.items())
+    return (f"the map's neighbouring heights are uncorrelated ({along}; a measured surface's are near 1): white "
+            "noise, as bytes read in the wrong order or as the wrong type give, or an instrument's noise on a surface "
+            "smoother than it resolves; the slopes, and xi, are the noise's, not the surface's")  # fmt: skip
 
 
 RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis
