@@ -119,3 +119,20 @@ def test_a_map_of_white_noise_is_said_to_be_noise(tmp_path):
     assert any(c.startswith("the map's neighbouring heights are uncorrelated (") and "bytes read in the wrong order" in c
                for c in said), said  # fmt: skip
     assert "caveats" not in SurfaceFile(path=str(tmp_path / "right.npy"), spacing=0.1).input_summary()
+
+
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_heights_that_are_no_numbers_in_double_precision_are_refused_without_numpys_warnings(tmp_path, plugin):
+    """A float32 map with its bytes swapped holds signalling NaNs, and a float128 one heights past
+    double precision: numpy's 'invalid value encountered in cast' (and, in the check of the table's
+    first row, 'in scalar subtract') was printed above the refusal that names them."""
+    shape = (16, 16) if plugin is SurfaceFile else (64,)
+    signalling = np.random.default_rng(1).normal(size=shape).astype(np.float32)
+    signalling.reshape(-1)[5] = np.array([0x7F800001], dtype=np.uint32).view(np.float32)[0]
+    np.save(tmp_path / "snan.npy", signalling)
+    np.save(tmp_path / "huge.npy", np.random.default_rng(2).normal(size=shape).astype(np.longdouble) * np.longdouble("1e400"))
+    for name in ("snan.npy", "huge.npy"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(ValueError, match=r"value\(s\) in heights not finite"):
+                plugin(path=str(tmp_path / name), spacing=0.1).rms_height()

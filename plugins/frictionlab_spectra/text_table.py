@@ -232,8 +232,8 @@ def axes_warning(data: np.ndarray, kept: tuple[bool, bool] = (True, True)) -> st
 
 def _evenly_spaced(line: np.ndarray) -> bool:
     """Whether ``line`` (more than 2 numbers) rises or falls by one step, to EVEN of its range."""
-    span = float(line[-1] - line[0])
-    if line.size < 3 or not span:
+    if line.size < 3 or not np.all(np.abs(line) < 1e300):  # NaN, inf, the huge: refused by name once read
         return False
+    span = float(line[-1] - line[0])
     even = line[0] + span * np.arange(line.size) / (line.size - 1)
-    return float(np.max(np.abs(line - even))) <= EVEN * abs(span)
+    return bool(span) and float(np.max(np.abs(line - even))) <= EVEN * abs(span)
