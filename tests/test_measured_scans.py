@@ -116,9 +116,14 @@ def test_a_map_of_white_noise_is_said_to_be_noise(tmp_path):
     np.save(tmp_path / "swapped.npy", heights.byteswap().view("<i2"))
     np.save(tmp_path / "right.npy", heights)
     said = SurfaceFile(path=str(tmp_path / "swapped.npy"), spacing=0.1).input_summary()["caveats"]
-    assert any(c.startswith("the map's neighbouring heights are uncorrelated (") and "bytes read in the wrong order" in c
+    assert any(c.startswith("the signs of the map's neighbouring heights are uncorrelated (") and "wrong order" in c
                for c in said), said  # fmt: skip
     assert "caveats" not in SurfaceFile(path=str(tmp_path / "right.npy"), spacing=0.1).input_summary()
+    dropouts = z.copy()
+    dropouts[[5, 20, 33, 47, 60], [7, 50, 21, 40, 3]] = -9999.0  # their power is most of the map's: not noise
+    np.save(tmp_path / "dropouts.npy", dropouts)
+    said = SurfaceFile(path=str(tmp_path / "dropouts.npy"), spacing=0.1).input_summary()["caveats"]
+    assert len(said) == 2 and not any("uncorrelated" in c for c in said), said  # the dropouts' caveats
 
 
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])

@@ -215,25 +215,23 @@ def _long_pixels_caveat(pixel: tuple[float, float], measured: int, pressed: int)
             f"Measure on square pixels, or press one measured line with profile-file")  # fmt: skip
 
 
-WHITE = 0.2  # correlation of neighbouring heights below which a scan is noise: a measured surface's is near 1
+WHITE = 0.1  # correlation of neighbouring heights' signs below which a scan is noise: a measured surface's is near 1
 
 
 def _noise_warning(z: np.ndarray) -> str | None:
-    """The caveat of a levelled map whose neighbouring heights are uncorrelated along x and y: white
-    noise, which no surface is. Bytes read in the wrong order (an int16 byte-swapped) gave a map of
-    it, pressed without a word; an instrument's noise on a surface smoother than it resolves gives
-    one too. The slopes, and xi, are then the noise's."""
-    power = float(np.einsum("ij,ij->", z, z))  # no temporary of the map's size
-    if not power > 0:
-        return None
-    said = {axis: float(np.einsum("ij,ij->", a, b)) / power for axis, a, b in (("x", z[:, 1:], z[:, :-1]),
-                                                                             ("y", z[1:], z[:-1]))}  # fmt: skip
-    if max(said.values()) >= WHITE:
+    """The caveat of a levelled map whose neighbouring heights' signs (above or below the mean: a few
+    points far from the rest cannot move them) are uncorrelated along x and y: white noise, which no
+    surface is. Bytes read in the wrong order (an int16 byte-swapped) gave a map of it, pressed without
+    a word; an instrument's noise on a surface smoother than it resolves gives one too."""
+    below = np.signbit(z)  # a byte a point
+    said = {axis: 2.0 * np.count_nonzero(a == b) / a.size - 1.0 for axis, a, b in (("x", below[:, 1:], below[:, :-1]),
+                                                                                 ("y", below[1:], below[:-1]))}  # fmt: skip
+    if max(said.values()) >= WHITE or not np.any(z):
         return None
     along = ", ".join(f"{c:.2f} along {axis}" for axis, c in said.items())
-    return (f"the map's neighbouring heights are uncorrelated ({along}; a measured surface's are near 1): white "
-            "noise, as bytes read in the wrong order or as the wrong type give, or an instrument's noise on a surface "
-            "smoother than it resolves; the slopes, and xi, are the noise's, not the surface's")  # fmt: skip
+    return (f"the signs of the map's neighbouring heights are uncorrelated ({along}; a measured surface's are near 1): "
+            "white noise, as bytes read in the wrong order or as the wrong type give, or an instrument's noise on a "
+            "surface smoother than it resolves; the slopes, and xi, are the noise's, not the surface's")  # fmt: skip
 
 
 RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis
