@@ -49,3 +49,21 @@ def test_spacing_y_needs_spacing_and_is_said_where_it_replaces_the_files(tmp_pat
     out = capsys.readouterr().out
     assert "the file's pixels of 0.1 x 0.2 um replaced by the preset's pixels of 0.1 x 0.25" in out, out
     assert "24 x 16 -> 24 x 38 pixels" in out, out
+
+
+def test_a_resampling_that_changes_the_maps_area_says_so_in_the_line_and_the_record(tmp_path, capsys):
+    # 64 rows of 125 nm onto 50 nm: 158 rows, 7900 of the scan's 8000 nm (its points end at the last row)
+    np.save(tmp_path / "rows.npy", np.random.default_rng(3).normal(size=(64, 160)))
+    read = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=50.0, spacing_y=125.0, unit="nm")
+    assert read.generate(None).heights.shape == (158, 160)
+    extent = read.input_summary()["extent"]
+    assert extent["scan"] == pytest.approx([8000.0, 8000.0]) and extent["pressed"] == pytest.approx([8000.0, 7900.0])
+    spectrum = {"name": "surface-file", "params": {"path": "rows.npy", "unit": "nm", "spacing": 50.0, "spacing_y": 125.0}}
+    preset = {"name": "area", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
+              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
+    out = capsys.readouterr().out
+    assert "the map pressed covers 8000 x 7900 nm of the scan's 8000 x 8000 nm (x by y), 1.25 % less area" in out, out
+    square = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=50.0, unit="nm")  # nothing resampled: nothing said
+    assert "extent" not in square.input_summary()

@@ -341,7 +341,10 @@ def test_a_form_kept_that_is_mostly_a_curvature_is_told_the_levelling_that_remov
     remedy named is the one that leaves no caveat; a tilt kept is still told plane (or tilt)."""
     x = np.arange(200) * 0.1
     bow, tilt = (x - x.mean()) ** 2 / 20.0, 0.3 * x
-    rough_part = np.random.default_rng(3).normal(size=(40, 200)) * 0.01
+    from scipy.ndimage import uniform_filter
+
+    # roughness whose neighbours are correlated, as a measured map's are (white noise is said to be noise)
+    rough_part = uniform_filter(np.random.default_rng(3).normal(size=(40, 200)), 3) * 0.03
     for name, form, remedy in (("bowed", bow, "quadratic"), ("tilted", tilt, "plane (or quadratic)")):
         z = rough_part + form[None, :] if what == "map" else rough_part[0] + form
         np.save(tmp_path / f"{name}.npy", z)

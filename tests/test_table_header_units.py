@@ -251,3 +251,27 @@ def test_a_text_export_takes_the_unit_its_header_names_when_its_reader_gives_non
     summary = read.input_summary()
     assert (summary["unit"], summary["unit_from"]) == ("um", "header")
     np.testing.assert_allclose(read.generate(None).heights, z, rtol=0, atol=1e-12)  # as read: not converted
+
+
+@pytest.mark.parametrize("last, said", [("# Value units: nm", "its header states the scan's units \\(nm\\)"),
+                                        ("z [nm]", "its header names the length unit nm")])  # fmt: skip
+def test_a_unit_named_past_the_first_4_kb_of_a_long_header_is_still_read(tmp_path, last, said):
+    """100 comment lines (6.5 kB) before the line naming the unit: only the first 4 kB were looked
+    at, and the numbers, in nm, were taken in the preset's um without a word."""
+    comments = "".join(f"# instrument setting {i}: {'x' * 50}\n" for i in range(100))
+    rows = "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rough(10, 12, 4))
+    (tmp_path / "m.csv").write_text(comments + last + "\n" + rows, encoding="utf-8")
+    with pytest.raises(ValueError, match=said):
+        SurfaceFile(path=str(tmp_path / "m.csv"), spacing=0.1, unit="um").rms_height()
+
+
+@pytest.mark.parametrize("label, named", [("z [Nanometers]", "nm"), ("height (micrometre)", "um"),
+                                          ("Height [Microns]", "um"), ("z/Millimeter", "mm")])  # fmt: skip
+def test_a_unit_spelled_out_in_any_case_is_that_unit(tmp_path, label, named):
+    """'z [nanometer]' was no unit: the numbers, in nm, were taken in the preset's um without a word."""
+    rows = "".join(f"{0.5 * i!r},{float(v)!r}\n" for i, v in enumerate(rough(1, 32, 5)[0]))
+    (tmp_path / "line.csv").write_text(f"x,{label}\n" + rows, encoding="utf-8")
+    other = "pm" if named != "pm" else "nm"
+    with pytest.raises(ValueError, match=rf"its header names the length unit {named}, .* the preset's unit, {other}"):
+        ProfileFile(path=str(tmp_path / "line.csv"), unit=other).rms_height()
+    assert ProfileFile(path=str(tmp_path / "line.csv")).input_summary()["unit"] == named

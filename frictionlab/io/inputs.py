@@ -243,6 +243,8 @@ def describe_input(summary: dict) -> str:
     if summary.get("downsampled"):
         down = summary["downsampled"]
         notes.append(f"downsampled from pixels of {down['from_pixel']:.6g} to {down['to_pixel']:.6g}{length}")
+    if summary.get("extent"):
+        notes.append(_extent_note(summary["extent"], length))
     if summary.get("despiked"):
         notes.append(f"despike {summary['despiked']['k']:g} rms: {summary['despiked']['points']} points replaced")
     if "detrend" in summary:
@@ -261,6 +263,16 @@ def describe_input(summary: dict) -> str:
            if summary.get("undefined_outside_region") else "")
         + "".join(f"; {note}" for note in notes)
     )  # fmt: skip
+
+
+def _extent_note(extent: dict, length: str) -> str:
+    """The area the pressed map covers against the scan's, when resampling changed it: its points
+    run from the first sample to the last, so up to a new pixel of each side is not covered."""
+    scan, pressed = extent["scan"], extent["pressed"]
+    change = pressed[0] * pressed[1] / (scan[0] * scan[1]) - 1
+    return (f"the map pressed covers {pressed[0]:.6g} x {pressed[1]:.6g}{length} of the scan's {scan[0]:.6g} x "
+            f"{scan[1]:.6g}{length} (x by y), {100 * abs(change):.3g} % {'less' if change < 0 else 'more'} area: "
+            "resampled points run from the first sample to the last")
 
 
 def input_lines(summary: dict) -> list[str]:

@@ -12,12 +12,16 @@ from __future__ import annotations
 import re
 
 HEADER_BYTES = 4096  # of a text file read for the units its header names
+HEADER_MOST = 1 << 20  # read while its header has not ended: a header longer than this is not a table's
 LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
                "mm": "mm", "cm": "cm", "dm": "dm", "km": "km", "m": "m", "\u00c5": "\u00c5", "\u212b": "\u00c5",
                "angstrom": "\u00c5", "angstroms": "\u00c5"}  # fmt: skip
 # inch- and foot-based lengths, as US instruments export them: named by a header, never converted, so refused
 IMPERIAL = r"inch(?:es)?|in|mils?|thou|[u\u00b5\u03bc]in|micro-?inch(?:es)?|ft|feet|foot|yd|yards?"
-_UNITS = r"pm|nm|um|\u00b5m|\u03bcm|microns?|mm|cm|dm|km|m|\u00c5|\u212b|angstroms?"
+# spelled out, in any case ("Micrometer", "nanometres", "Microns"): unambiguous, as an abbreviation in capitals is not
+_WORDS = {"pico": "pm", "nano": "nm", "micro": "um", "milli": "mm", "centi": "cm", "deci": "dm", "kilo": "km", "": "m"}
+_WORD = r"(?i:(?:pico|nano|micro|milli|centi|deci|kilo)?met(?:er|re)s?|microns?|angstroms?)"
+_UNITS = rf"pm|nm|um|\u00b5m|\u03bcm|mm|cm|dm|km|m|\u00c5|\u212b|{_WORD}"
 # units of what is no length, as instruments label a channel's column: volts, amperes (a bare "A" is
 # an ampere here, as in SI: an angstrom is written \u00c5), angles, frequencies, forces, pressures, counts
 NOT_LENGTH = (r"[fpn\u00b5\u03bcumkM]?V|[fpn\u00b5\u03bcum]?A|deg|\u00b0|m?rad|[kMG]?Hz|[pn\u00b5\u03bcum]?N|[kMG]?Pa|"
@@ -36,14 +40,32 @@ _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?
 _STATED_VALUES = re.compile(rf"\b(?i:value\s+units|z-unit|unit\s+data)\s*[:=]\s*(?P<unit>{_UNITS})\s*$")
 # "# Value units: V": a unit key of an instrument's text export (Gwyddion's) stating one that is no length
 _STATED_NOT_LENGTH = re.compile(rf"\b(?i:{_UNIT_KEYS})\s*[:=]\s*(?P<unit>{NOT_LENGTH})\s*$")
+
+
+def length_unit(name: str) -> str:
+    """The unit a header's ``name`` of a length unit (``_UNITS``) is, as LENGTH_UNIT spells it."""
+    if name in LENGTH_UNIT or not re.fullmatch(_WORD, name):
+        return LENGTH_UNIT.get(name, name)
+    word = name.lower()
+    return LENGTH_UNIT[word] if word.startswith(("micron", "angstrom")) else _WORDS[word.removesuffix("s")[:-5]]
+
+
 NUMBERS = re.compile(r"[\s,;]*[-+]?(\d|\.\d)")  # a line that starts with a number: the header has ended
 
 
 def head_text(fh, encoding: str = "utf-8") -> str:
-    """The first HEADER_BYTES of the open file ``fh`` as text (bytes that are not ``encoding``
-    replaced), the file left at its start for a reader: its header, and its first rows."""
+    """The start of the open file ``fh`` as text (bytes that are not ``encoding`` replaced), the
+    file left at its start for a reader: its header, and its first rows. HEADER_BYTES, or more
+    while no whole line of numbers has ended the header (a header of 100 comment lines hid its
+    ``Value units: nm`` past 4 kB, and the numbers were taken in the preset's unit), up to HEADER_MOST."""
     fh.seek(0)
     head = fh.read(HEADER_BYTES)
+    while len(head) < HEADER_MOST and len(header_lines(text := head.decode(encoding, errors="replace"))) == \
+            len(text.splitlines()[:-1]):  # fmt: skip
+        more = fh.read(len(head))  # twice as much each time
+        if not more:
+            break
+        head += more
     fh.seek(0)
     return head.decode(encoding, errors="replace")
 
@@ -59,7 +81,7 @@ def values_units(text: str) -> list[str]:
     """The length units the header of ``text`` states for its values (``Value units: nm``,
     ``z-unit = nm``), not its sizes (``Width: 25.6 µm``): a text export's heights."""
     stated = (_STATED_VALUES.search(line.rstrip()) for line in header_lines(text))
-    return [LENGTH_UNIT[found["unit"]] for found in stated if found]
+    return [length_unit(found["unit"]) for found in stated if found]
 
 
 def named_units(text: str) -> tuple[list[str], bool]:
@@ -68,9 +90,9 @@ def named_units(text: str) -> tuple[list[str], bool]:
     (``Width: 25.6 µm``, ``Value units: m``, ``z-unit = nm``): SurfaceTopography's reader reads them."""
     units, stated_by_key = [], False
     for line in header_lines(text):
-        units += [LENGTH_UNIT.get(unit, unit) for found in _LABEL.findall(line) for unit in found if unit]
+        units += [length_unit(unit) for found in _LABEL.findall(line) for unit in found if unit]
         if stated := _STATED.search(line.rstrip()):
-            units.append(LENGTH_UNIT[stated["unit"]])
+            units.append(length_unit(stated["unit"]))
             stated_by_key = True
     return units, stated_by_key
 

@@ -28,10 +28,11 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, choose_reader, describe_failure,
+    check_text_heights, check_text_room, check_text_whole, choose_reader, describe_failure,
     TEXT_FORMATS, quoted,
 )
 
+MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
 TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
 # the units a preset may ask for, in metres
@@ -122,6 +123,7 @@ def _open_reader(fh, path: Path, where: str):
     reader_class = choose_reader(fh, path.suffix.lower().lstrip("."), where)
     if reader_class.format() in TEXT_FORMATS:  # parsed whole as it is opened
         check_text_room(fh, reader_class, where)
+        check_text_whole(fh, reader_class, where)
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
@@ -218,9 +220,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
-            kind = {1: "a line scan", 2: "a 2D map"}
-            advice = "use surface-file" if topography.dim == 2 else "use profile-file"
-            raise ValueError(f"{where}: the file holds {kind.get(topography.dim, topography.dim)}; {advice}")
+            raise ValueError(_other_kind(where, topography.dim, topography.nb_grid_pts))
         missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
         if missing == heights.size:  # harmonic filling would have nothing to fill from
             raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
@@ -324,6 +324,17 @@ def check_spacing(where: str, what: str, spacing: float, unit: str | None) -> fl
         raise ValueError(f"{where}: {what} {spacing:g}{in_unit}; a spacing must be between "
                          f"{1 / MAX_MAGNITUDE:g} and {MAX_MAGNITUDE:g} in the run's length unit")
     return spacing
+
+
+def _other_kind(where: str, dim: int, points: tuple[int, ...]) -> str:
+    """Why a file of ``dim`` dimensions is not what its plugin reads, and which plugin does: a map
+    too narrow for surface-file is not sent there (it sent it back to profile-file)."""
+    if dim == 2 and min(points) < MIN_SIDE:
+        return (f"{where}: the file holds a 2D map of {points[0]} x {points[1]} pixels (x by y): too narrow for "
+                f"surface-file (at least {MIN_SIDE} x {MIN_SIDE}), and profile-file reads a line (a map one pixel "
+                "wide); export one of its lines from the instrument's software")  # fmt: skip
+    kind = {1: "a line scan", 2: "a 2D map"}
+    return f"{where}: the file holds {kind.get(dim, dim)}; use {'surface-file' if dim == 2 else 'profile-file'}"
 
 
 def scan_not_periodic_advice(name: str) -> tuple[str, str]:

@@ -132,6 +132,9 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         check_still_periodic(pixel, p, where)
     if p.region is not None:
         z, done["region_pixels"] = crop(z, pixel, p.region, where)
+        if min(z.shape) < 2:  # a line, which no resampling makes a map: refused before its levelling divides by zero
+            raise ValueError(f"{where}: region keeps {z.shape[1]} x {z.shape[0]} pixels (x by y) of the map, one pixel "
+                             "wide: a line; give a larger region, or read a line with profile-file")  # fmt: skip
     mode = p.detrend if p.detrend is not None else "plane" if instrument and not periodic else "mean"
     levelled = level(z, mode)
     if p.despike is not None:
@@ -141,7 +144,10 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             raise ValueError(f"{where}: {exc}") from None
         done["despiked"] = {"k": p.despike, "points": count}
         if count:  # level the file's map with the spikes replaced: the record says what levelling removed
-            levelled = level(z + (despiked - levelled.heights), mode)
+            np.subtract(despiked, levelled.heights, out=despiked)  # what despike changed, in place
+            del levelled  # let go before the new levelling: a copy of the map at a time
+            levelled = level(np.add(despiked, z, out=despiked), mode)
+            del despiked
     done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
     if (warning := levelling_warning(levelled, mode)) is not None:
@@ -154,8 +160,11 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     if (warning := line_offset_warning(levelled.heights)) is not None:
         caveats.append(warning)
+    if (warning := _noise_warning(levelled.heights)) is not None:
+        caveats.append(warning)
     z, spacing = levelled.heights, pixel[0]
     dx, dy = pixel
+    scan = (z.shape[1] * dx, z.shape[0] * dy)  # the extent the scan's pixels cover, x by y
     if abs(dx - dy) > SAME_SIDE * max(dx, dy):  # not the rounding of a text file's coordinates (0.1 vs 0.1000...02)
         difference = abs(dx - dy) / max(dx, dy)
         if _nearly_square(dx, dy):
@@ -171,6 +180,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             done["pixels"] = (f"{dx:.6g} x {dy:.6g} resampled onto square pixels of {spacing:.6g} along "
                               f"{'y' if axis == 0 else 'x'} (band-limited cosine series): {before[1]} x {before[0]} "
                               f"-> {z.shape[1]} x {z.shape[0]} pixels")  # fmt: skip
+            if max(dx, dy) > LONG_PIXELS * spacing:
+                caveats.append(_long_pixels_caveat((dx, dy), before[axis], z.shape[axis]))
     if p.downsample is not None:
         new = spacing * p.downsample.factor if p.downsample.factor is not None else p.downsample.pixel
         if not new > spacing * (1 + 1e-12):
@@ -180,9 +191,47 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         done["downsampled"] = {"from_pixel": spacing, "to_pixel": new}
         spacing = new
     z = z - np.mean(z) if mode != "none" else z
+    pressed = (z.shape[1] * spacing, z.shape[0] * spacing)
+    if abs(pressed[0] * pressed[1] / (scan[0] * scan[1]) - 1) > PIXEL_TOLERANCE:  # resampled points end at the last sample
+        done["extent"] = {"scan": list(scan), "pressed": list(pressed)}
     if caveats:
         done["caveats"] = caveats
     return np.ascontiguousarray(z), float(spacing), done
+
+
+LONG_PIXELS = 4.0  # times longer one way than the other: from here on, most of the map pressed is interpolated
+
+
+def _long_pixels_caveat(pixel: tuple[float, float], measured: int, pressed: int) -> str:
+    """The caveat of a map on pixels more than LONG_PIXELS times longer one way: the lines pressed
+    between the measured ones are their cosine series, with none of the roughness shorter than
+    two measured lines (a self-affine surface's slopes are mostly there)."""
+    dx, dy = pixel
+    along, ratio, long = ("y", dy / dx, dy) if dy > dx else ("x", dx / dy, dx)
+    lines = "rows" if along == "y" else "columns"
+    return (f"the file's pixels are {ratio:.4g} times longer along {along}: {measured} of the {pressed} {lines} pressed "
+            f"were measured, the rest are their cosine series, with no roughness along {along} shorter than two "
+            f"measured {lines} ({2 * long:.3g}); the slopes along {along}, and the rms slope xi divides by, miss it. "
+            f"Measure on square pixels, or press one measured line with profile-file")  # fmt: skip
+
+
+WHITE = 0.1  # correlation of neighbouring heights' signs below which a scan is noise: a measured surface's is near 1
+
+
+def _noise_warning(z: np.ndarray) -> str | None:
+    """The caveat of a levelled map whose neighbouring heights' signs (above or below the mean: a few
+    points far from the rest cannot move them) are uncorrelated along x and y: white noise, which no
+    surface is. Bytes read in the wrong order (an int16 byte-swapped) gave a map of it, pressed without
+    a word; an instrument's noise on a surface smoother than it resolves gives one too."""
+    below = np.signbit(z)  # a byte a point
+    said = {axis: 2.0 * np.count_nonzero(a == b) / a.size - 1.0 for axis, a, b in (("x", below[:, 1:], below[:, :-1]),
+                                                                                 ("y", below[1:], below[:-1]))}  # fmt: skip
+    if max(said.values()) >= WHITE or not np.any(z):
+        return None
+    along = ", ".join(f"{c:.2f} along {axis}" for axis, c in said.items())
+    return (f"the signs of the map's neighbouring heights are uncorrelated ({along}; a measured surface's are near 1): "
+            "white noise, as bytes read in the wrong order or as the wrong type give, or an instrument's noise on a "
+            "surface smoother than it resolves; the slopes, and xi, are the noise's, not the surface's")  # fmt: skip
 
 
 RESAMPLE_COPIES = 3  # (new points x kept modes) arrays alive at once while cosine_resample builds its basis

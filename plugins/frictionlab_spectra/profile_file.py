@@ -203,7 +203,9 @@ def file_suffix(path: Path, where: str) -> str:
 
 
 def load_npy(path: Path, where: str) -> np.ndarray:
-    """The array of a .npy file of real numbers (integer or floating dtype), as stored."""
+    """The array of a .npy file of real numbers (integer or floating dtype), as stored; floats in
+    double precision, their NaN (a byte-swapped float32 holds signalling ones, numpy's cast warned of
+    them above the refusal) and overflow (float128) left for ``check_finite`` to name."""
     with open_input(path, where) as fh:
         _check_npy_size(fh, where)
         try:
@@ -215,6 +217,9 @@ def load_npy(path: Path, where: str) -> np.ndarray:
             raise ValueError(f"{where}: {_unreadable_npy(fh, exc)}") from None
     if data.dtype.kind not in "iuf":  # numpy counts a timedelta64 as an integer
         raise ValueError(f"{where}: non-numeric content (array dtype {data.dtype}); expected real numbers")
+    if data.dtype.kind == "f":
+        with np.errstate(invalid="ignore", over="ignore"):
+            return data.astype(np.float64, copy=False)
     return data
 
 

@@ -47,30 +47,34 @@ def _axis(n: int) -> tuple[np.ndarray, np.ndarray]:
 def level(z: np.ndarray, mode: str) -> Levelling:
     """``z`` less its least-squares ``mode`` (none, mean, plane: a + bx + cy, quadratic: also
     x^2, xy, y^2). On a grid the basis 1, x, y, x^2 - <x^2>, xy, y^2 - <y^2> is orthogonal, so
-    each term is one projection (no design matrix of six copies of the map)."""
+    each term is one projection (no design matrix of six copies of the map), a factor along y times
+    one along x removed a block of rows at a time: one copy of the map (a basis xy was two more)."""
     mean = float(np.mean(z))
     out = z - mean
     ny, nx = z.shape
     x, x2 = _axis(nx)
     y, y2 = _axis(ny)
+    along_x, along_y = np.ones(ny), np.ones(nx)  # the other factor of a term along one axis
     rows, columns = out.sum(axis=1), out.sum(axis=0)  # projections of separable terms need only these
-    plane = [(columns @ x / (ny * (x @ x)), x[None, :]), (rows @ y / (nx * (y @ y)), y[:, None])]
-    curved = [(y @ (out @ x) / ((x @ x) * (y @ y)), y[:, None] * x[None, :])]
+    plane = [(columns @ x / (ny * (x @ x)), along_x, x), (rows @ y / (nx * (y @ y)), y, along_y)]
+    curved = [(y @ (out @ x) / ((x @ x) * (y @ y)), y, x)]
     if nx > 2:
-        curved.append((columns @ x2 / (ny * (x2 @ x2)), x2[None, :]))
+        curved.append((columns @ x2 / (ny * (x2 @ x2)), along_x, x2))
     if ny > 2:
-        curved.append((rows @ y2 / (nx * (y2 @ y2)), y2[:, None]))
+        curved.append((rows @ y2 / (nx * (y2 @ y2)), y2, along_y))
     size = float(z.size)
     variance = float(np.vdot(out, out)) / size  # no temporary the size of the map
-    share = [sum(c * c * float(np.sum(b * b)) * size / b.size for c, b in terms) / size for terms in (plane, curved)]
+    share = [sum(c * c * (a @ a) * (b @ b) for c, a, b in terms) / size for terms in (plane, curved)]
     removed = plane if mode == "plane" else plane + curved if mode == "quadratic" else []
-    for coefficient, basis in removed:
-        out -= coefficient * basis
+    block = max(1, LINE_BLOCK // nx)
+    for coefficient, a, b in removed:
+        for start in range(0, ny, block):
+            term = a[start : start + block, None] * b[None, :]
+            out[start : start + block] -= np.multiply(term, coefficient, out=term)
+    rms_after = math.sqrt(float(np.vdot(out, out)) / size)  # every term removed is orthogonal to the constant
     if mode == "none":
-        out = z.copy()  # bit for bit what the file holds
-        rms_after = float(np.std(out))
-    else:  # every term removed is orthogonal to the constant: the mean stays zero
-        rms_after = math.sqrt(float(np.vdot(out, out)) / size)
+        out = None  # let go before the copy, bit for bit what the file holds
+        out = z.copy()
     scale = variance if variance > 0 else math.inf
     return Levelling(out, math.sqrt(variance), rms_after, share[0] / scale, share[1] / scale)
 
@@ -168,8 +172,6 @@ def resampled_points(n: int, step: float, new_step: float) -> int:
 
 
 MAX_SPIKE_FRACTION = 0.05  # despike replaces at most this share of a map's points
-
-
 SPIKE_K = 6.0  # rms heights above the median around it: what despike's usual value calls a spike
 SPIKE_WINDOW = 5  # pixels a side of the square whose median a point is measured from (despike and its caveat)
 SPIKE_LOOKED_AT = 16  # the highest points looked at for spikes: those that carry the first contact
@@ -343,12 +345,16 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
     Laplace's equation from its neighbours; and how many were replaced. ValueError when more than
     MAX_SPIKE_FRACTION of the points would be (``k`` too small: the scan itself, not its spikes)."""
-    from scipy import ndimage, sparse
+    from scipy import ndimage
     from scipy.sparse.linalg import spsolve
 
     local = ndimage.median_filter(z, size=SPIKE_WINDOW, mode="reflect")
-    spike = np.abs(z - local) > k * rms
-    count = int(np.count_nonzero(spike))
+    np.subtract(z, local, out=local)  # in place: the filter's copy of the map is the only one made
+    spike = np.abs(local, out=local) > k * rms
+    del local
+    flat = np.flatnonzero(spike)  # sorted: a neighbour is a spike where searchsorted finds it
+    del spike
+    count = int(flat.size)
     if count > MAX_SPIKE_FRACTION * z.size:  # refused before one equation per point is built (a 4096^2 map: hours)
         raise ValueError(
             f"despike {k:g} takes {count} of {z.size} points ({100 * count / z.size:.1f} %) for spikes: a spike is a "
@@ -357,23 +363,35 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
         )
     if not count:  # (every point a spike was refused above)
         return z, 0
-    ny, nx = z.shape
-    index = np.full(z.shape, -1, dtype=np.int64)
-    index[spike] = np.arange(count)
-    rows, cols, values = [], [], []
-    rhs = np.zeros(count)
-    where = np.argwhere(spike)
-    for (i, j), row in zip(where, range(count)):  # a handful of points: each an equation
-        neighbours = [(a, b) for a, b in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)) if 0 <= a < ny and 0 <= b < nx]
-        rows.append(row), cols.append(row), values.append(float(len(neighbours)))
-        for a, b in neighbours:
-            if spike[a, b]:
-                rows.append(row), cols.append(int(index[a, b])), values.append(-1.0)
-            else:
-                rhs[row] += z[a, b]
+    matrix, rhs = _laplace_system(z, flat)
     out = z.copy()
-    out[spike] = spsolve(sparse.csr_matrix((values, (rows, cols)), shape=(count, count)), rhs)
+    out.ravel()[flat] = spsolve(matrix, rhs)  # out is contiguous: ravel is a view
     return out, count
+
+
+def _laplace_system(z: np.ndarray, flat: np.ndarray):
+    """Laplace's equation on the points of ``z`` at the sorted flat indices ``flat`` from their 4 neighbours
+    inside the map (one among them an unknown): arrays of their size (a map's index was two copies)."""
+    from scipy import sparse
+
+    ny, nx = z.shape
+    count = flat.size
+    own = np.arange(count)
+    i, j = np.divmod(flat, nx)
+    degree, rhs = np.zeros(count), np.zeros(count)
+    rows, cols = [own], [own]
+    for di, dj in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        a, b = i + di, j + dj
+        inside = (a >= 0) & (a < ny) & (b >= 0) & (b < nx)
+        a, b = np.clip(a, 0, ny - 1), np.clip(b, 0, nx - 1)
+        at = np.minimum(np.searchsorted(flat, a * nx + b), count - 1)
+        unknown = inside & (flat[at] == a * nx + b)
+        degree += inside
+        rhs += np.where(inside & ~unknown, z[a, b], 0.0)
+        rows.append(own[unknown]), cols.append(at[unknown])
+    values = np.concatenate([degree, -np.ones(sum(r.size for r in rows[1:]))])
+    matrix = sparse.csr_matrix((values, (np.concatenate(rows), np.concatenate(cols))), shape=(count, count))
+    return matrix, rhs
 
 
 FLAT_SHARE = 0.25  # of neighbouring pixels at exactly one height: from here on, the slopes are the steps'
@@ -393,7 +411,7 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
         ahead, behind = tuple(whole[:axis] + [slice(1, None)]), tuple(whole[:axis] + [slice(None, -1)])
         pairs, equal = pairs + z[ahead].size, equal + int(np.count_nonzero(z[ahead] == z[behind]))
     if not pairs or equal <= FLAT_SHARE * pairs:
-        return None
+        return _clipped_warning(z, what)
     steps = np.abs(np.diff(z.ravel()))  # along the rows, and from a row's end to the next's start
     step = float(steps[steps > 0].min())  # some: the map is not flat (rms > 0)
     points = "pixels" if what == "map" else "points"
@@ -402,6 +420,23 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
             f"{points}, or clipped flat; their slopes are zero, so the rms slope and xi are the steps', not the "
             "surface's; measure or export the heights at a finer resolution (a float channel in double precision, or "
             "less their mean: single precision keeps 7 digits of heights far from zero)")  # fmt: skip
+
+
+CLIPPED_SHARE = 0.01  # of the points at exactly the highest (lowest) height: a range exceeded, not a surface's peaks
+CLIPPED_POINTS = 8  # and at least this many: a few points alike at the top are a short line's rounding
+
+
+def _clipped_warning(z: np.ndarray, what: str) -> str | None:
+    """The caveat of a map or line as read with more than CLIPPED_SHARE of its points at its highest (lowest)
+    height: an instrument out of its range (an AFM's z saturated), too few neighbours alike for the steps'."""
+    for side, edge in (("highest", z.max()), ("lowest", z.min())):
+        if (count := int(np.count_nonzero(z == edge))) >= CLIPPED_POINTS and count > CLIPPED_SHARE * z.size:
+            return (f"{100 * count / z.size:.3g} % of the {what}'s points sit at exactly its {side} height, {float(edge):.6g}: "
+                    "clipped (an instrument's height range exceeded), or a value written for missing points; "
+                    f"{'the first contact lands on that plateau, and ' if side == 'highest' else ''}its slopes are "
+                    f"zero; measure with a larger height range, or leave the clipped part out "
+                    f"({'region' if what == 'map' else 'of the profile'}), if it is not the surface's own")  # fmt: skip
+    return None
 
 
 LINE_JUMP_SHARE = 0.5  # of the height change across lines that whole lines standing apart carry: said from here on

@@ -50,7 +50,7 @@ from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
 from .instrument_file import (
-    ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
@@ -60,10 +60,9 @@ from .power_law import TWO_PI
 from .profile_file import (
     check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
 )
-from .text_table import read_text_table
+from .text_table import axes_warning, read_text_table
 from .scan_shaping import FLAT, flat_rms
 
-MIN_SIDE = 8
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
 # The peak of ``equivalent_line``, measured with tracemalloc (ru_maxrss agrees), plus a third:
 # per point of the map, the read or the FFT (36 bytes for a periodic map, 72 for one
@@ -293,6 +292,12 @@ def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params
             "caveats": [caveat] if caveat else []}  # fmt: skip
 
 
+def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
+    """``axes_warning`` of a table map, of the first row and column that ``region`` keeps."""
+    (x0, _), (y0, _) = crop(data, pixel, p.region, where)[1] if p.region is not None else ((0, 0), (0, 0))
+    return axes_warning(data, (y0 == 0, x0 == 0))
+
+
 def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
     way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
@@ -323,6 +328,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "format": path.suffix.lower(), "spacing_from": "preset", **unit,
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
+        if data.ndim == 2 and min(data.shape) >= MIN_SIDE and (caveat := _axes_in_region(data, pixel, p, where)):
+            summary["caveats"] = [caveat]
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape

@@ -206,3 +206,34 @@ def _separator(delimiter: str | None) -> str:
     return {",": "commas", ";": "semicolons"}.get(delimiter, "spaces")
 
 
+
+
+EVEN = 1e-5  # of its range: a line of numbers this close to evenly spaced is positions (printed to 6 digits), not heights
+
+
+def axes_warning(data: np.ndarray, kept: tuple[bool, bool] = (True, True)) -> str | None:
+    """The caveat of a table map whose first row (past its corner) or first column holds evenly
+    spaced numbers: an export's axes, x over the columns and y beside the rows (a matrix with its
+    positions, a spreadsheet's row numbers), read as heights; no measured row is a line to 1e-5.
+    ``kept``: whether a crop keeps the first row, and the first column."""
+    ny, nx = data.shape
+    lines = (("row", data[0, 1:], f"y: [1, {ny}]"), ("column", data[1:, 0], f"x: [1, {nx}]"))
+    found = [(name, line, crop) for (name, line, crop), keep in zip(lines, kept) if keep and _evenly_spaced(line)]
+    if not found:
+        return None
+    corner = data[0, 0]
+    said = " and ".join(f"first {name} ({corner if _evenly_spaced(np.r_[corner, line]) else line[0]:.6g} to {line[-1]:.6g})"
+                        for name, line, _ in found)  # fmt: skip
+    return (f"the table's {said} {'are' if len(found) > 1 else 'is'} evenly spaced: an export's positions (x over the "
+            "columns, y beside the rows) or row numbers, read here as heights, a ramp along the map's edge; leave "
+            f"{'them' if len(found) > 1 else 'it'} out with region: {{{', '.join(crop for *_, crop in found[::-1])}}}, "
+            "if they are not heights")  # fmt: skip
+
+
+def _evenly_spaced(line: np.ndarray) -> bool:
+    """Whether ``line`` (more than 2 numbers) rises or falls by one step, to EVEN of its range."""
+    if line.size < 3 or not np.all(np.abs(line) < 1e300):  # NaN, inf, the huge: refused by name once read
+        return False
+    span = float(line[-1] - line[0])
+    even = line[0] + span * np.arange(line.size) / (line.size - 1)
+    return bool(span) and float(np.max(np.abs(line - even))) <= EVEN * abs(span)
