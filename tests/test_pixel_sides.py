@@ -16,6 +16,15 @@ from frictionlab_spectra import SurfaceFile
 from .test_scan_shaping import band_limited, rms_gradient
 
 
+
+def validated_surface(folder, capsys, params: dict) -> str:
+    """What ``frictionlab validate`` prints of a one-realization preset reading ``params``' map."""
+    preset = {"name": "sides", "realizations": 1, "spectrum": {"name": "surface-file", "params": params},
+              "solver": {"name": "mdr"}, "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
+    (folder / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(folder / "p.yaml")]) == ExitCode.OK
+    return capsys.readouterr().out
+
 def test_a_table_on_rectangular_pixels_keeps_its_surfaces_gradient(tmp_path):
     _, surface = band_limited(40, 48, seed=11, top=0.3)  # every wave held by the coarse rows too
     y, x = np.mgrid[0:40, 0:48].astype(float)
@@ -41,12 +50,7 @@ def test_spacing_y_needs_spacing_and_is_said_where_it_replaces_the_files(tmp_pat
     from SurfaceTopography import Topography
 
     Topography(np.random.default_rng(1).normal(size=(24, 16)), (2.4, 3.2), unit="µm").to_x3p(str(tmp_path / "s.x3p"))
-    spectrum = {"name": "surface-file", "params": {"path": "s.x3p", "unit": "um", "spacing": 0.1, "spacing_y": 0.25}}
-    preset = {"name": "sides", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
-              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
-    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
-    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
-    out = capsys.readouterr().out
+    out = validated_surface(tmp_path, capsys, {"path": "s.x3p", "unit": "um", "spacing": 0.1, "spacing_y": 0.25})
     assert "the file's pixels of 0.1 x 0.2 um replaced by the preset's pixels of 0.1 x 0.25" in out, out
     assert "24 x 16 -> 24 x 38 pixels" in out, out
 
@@ -58,12 +62,7 @@ def test_a_resampling_that_changes_the_maps_area_says_so_in_the_line_and_the_rec
     assert read.generate(None).heights.shape == (158, 160)
     extent = read.input_summary()["extent"]
     assert extent["scan"] == pytest.approx([8000.0, 8000.0]) and extent["pressed"] == pytest.approx([8000.0, 7900.0])
-    spectrum = {"name": "surface-file", "params": {"path": "rows.npy", "unit": "nm", "spacing": 50.0, "spacing_y": 125.0}}
-    preset = {"name": "area", "realizations": 1, "spectrum": spectrum, "solver": {"name": "mdr"},
-              "loading": {"start": 0.01, "stop": 0.1, "steps": 3, "unit": "f"}}  # fmt: skip
-    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
-    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
-    out = capsys.readouterr().out
+    out = validated_surface(tmp_path, capsys, {"path": "rows.npy", "unit": "nm", "spacing": 50.0, "spacing_y": 125.0})
     assert "the map pressed covers 8000 x 7900 nm of the scan's 8000 x 8000 nm (x by y), 1.25 % less area" in out, out
     square = SurfaceFile(path=str(tmp_path / "rows.npy"), spacing=50.0, unit="nm")  # nothing resampled: nothing said
     assert "extent" not in square.input_summary()
