@@ -16,7 +16,6 @@ from frictionlab_spectra import SurfaceFile
 from .test_scan_shaping import band_limited, rms_gradient
 
 
-
 def validated_surface(folder, capsys, params: dict) -> str:
     """What ``frictionlab validate`` prints of a one-realization preset reading ``params``' map."""
     preset = {"name": "sides", "realizations": 1, "spectrum": {"name": "surface-file", "params": params},
@@ -24,6 +23,7 @@ def validated_surface(folder, capsys, params: dict) -> str:
     (folder / "p.yaml").write_text(yaml.safe_dump(preset))
     assert main(["validate", str(folder / "p.yaml")]) == ExitCode.OK
     return capsys.readouterr().out
+
 
 def test_a_table_on_rectangular_pixels_keeps_its_surfaces_gradient(tmp_path):
     _, surface = band_limited(40, 48, seed=11, top=0.3)  # every wave held by the coarse rows too
