@@ -173,6 +173,22 @@ def test_resume_of_a_folder_whose_preset_yaml_was_edited_names_that_file(make_sc
     assert "realizations: 8 in the run directory, 9 given" in err
 
 
+def test_resume_of_a_run_whose_preset_yaml_was_given_a_sweep_names_that_file(make_scene, tmp_path, capsys):
+    """A sweep section added to a run's preset.yaml made resume run the sweep into the run's folder,
+    refused as 'not the folder of a frictionlab sweep ... (--force ...)', an option resume lacks (exit 4)."""
+    cancel = threading.Event()
+    cancel.set()
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1), cancel=cancel)
+    stored = tmp_path / "run" / "preset.yaml"
+    stored.write_text(stored.read_text() + "sweep:\n  parameters:\n    seed: {values: [1, 2]}\n")
+    before = sorted(p.name for p in (tmp_path / "run").rglob("*"))
+    assert main(["resume", str(tmp_path / "run"), "--workers", "1", "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"cannot resume {tmp_path / 'run'}: its preset.yaml has a sweep section, but the run there is one ensemble" in err
+    assert "--force" not in err
+    assert sorted(p.name for p in (tmp_path / "run").rglob("*")) == before
+
+
 def _as_written_before(run: Path, fields: list[tuple[str, ...]]) -> None:
     """Make ``run`` look started by a frictionlab that did not yet have ``fields``: each
     dropped from the stored preset, and the manifest's fingerprint that of what is left."""
