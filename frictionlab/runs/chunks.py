@@ -196,8 +196,8 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
         raise ChunkDamage("xi infinite or below 0")
     points = arrays["points"][:, None]
-    if bool((points < 1).any()):
-        raise ChunkDamage("a profile of fewer than 1 point")
+    if not bool((np.isfinite(points) & (points >= 1) & (points == np.floor(points))).all()):  # NaN failed int()
+        raise ChunkDamage("a profile's points not a whole number >= 1")
     if not bool((arrays["slope_rms_line"] > 0).all() and np.isfinite(arrays["slope_rms_line"]).all()):
         raise ChunkDamage("a line's rms slope not a finite number > 0")  # a realization with one is a failure
     if not bool((arrays["force_unit"] > 0).all()):  # NaN compares false: refused (inf: the run's own check says it)
