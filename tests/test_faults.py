@@ -227,6 +227,14 @@ def no_points(folder):
     _rewrite(folder, _second(folder), lambda a: a["points"].__setitem__(0, 0), True)
 
 
+def nan_points(folder):  # int(NaN) failed the resume as an internal error
+    _rewrite(folder, _second(folder), lambda a: a.update(points=np.where(a["points"] == a["points"][0], np.nan, 1.0)), True)
+
+
+def fractional_points(folder):
+    _rewrite(folder, _second(folder), lambda a: a.update(points=a["points"] + 0.5), True)
+
+
 def nan_force_unit(folder):  # the run failed as 'the preset's magnitudes leave double precision'
     _rewrite(folder, _second(folder), lambda a: a["force_unit"].__setitem__(0, math.nan), True)
 
@@ -264,7 +272,9 @@ DAMAGE = {
     text_xi: "array xi of type <U32, not real numbers",
     negative_count: "contact_count below 0 or above the profile's points",
     count_above_points: "contact_count below 0 or above the profile's points",
-    no_points: "a profile of fewer than 1 point",
+    no_points: "a profile's points not a whole number >= 1",
+    nan_points: "a profile's points not a whole number >= 1",
+    fractional_points: "a profile's points not a whole number >= 1",
     nan_force_unit: "a force unit k h X not > 0",
     zero_slope: "a line's rms slope not a finite number > 0",
     unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",

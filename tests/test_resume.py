@@ -173,6 +173,22 @@ def test_resume_of_a_folder_whose_preset_yaml_was_edited_names_that_file(make_sc
     assert "realizations: 8 in the run directory, 9 given" in err
 
 
+def test_resume_of_a_run_whose_preset_yaml_was_given_a_sweep_names_that_file(make_scene, tmp_path, capsys):
+    """A sweep section added to a run's preset.yaml made resume run the sweep into the run's folder,
+    refused as 'not the folder of a frictionlab sweep ... (--force ...)', an option resume lacks (exit 4)."""
+    cancel = threading.Event()
+    cancel.set()
+    run_to_folder(make_scene(NO_PLOT), tmp_path / "run", RunOptions(workers=1), cancel=cancel)
+    stored = tmp_path / "run" / "preset.yaml"
+    stored.write_text(stored.read_text() + "sweep:\n  parameters:\n    seed: {values: [1, 2]}\n")
+    before = sorted(p.name for p in (tmp_path / "run").rglob("*"))
+    assert main(["resume", str(tmp_path / "run"), "--workers", "1", "--quiet"]) == ExitCode.RUN_FOLDER
+    err = capsys.readouterr().err
+    assert f"cannot resume {tmp_path / 'run'}: its preset.yaml has a sweep section, but the run there is one ensemble" in err
+    assert "--force" not in err
+    assert sorted(p.name for p in (tmp_path / "run").rglob("*")) == before
+
+
 def _as_written_before(run: Path, fields: list[tuple[str, ...]]) -> None:
     """Make ``run`` look started by a frictionlab that did not yet have ``fields``: each
     dropped from the stored preset, and the manifest's fingerprint that of what is left."""
@@ -278,3 +294,33 @@ def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tm
 
     run_to_folder(build_scene(data, registry=registry), tmp_path / "whole", RunOptions(workers=2))
     same_files(run_dir, tmp_path / "whole")
+
+
+def test_a_chunks_folder_no_file_can_be_written_in_is_refused_before_any_realization(make_scene, tmp_path, monkeypatch, capsys):
+    """A resume whose chunks/ cannot be written in (read-only) computed a chunk, failed to write it
+    (exit 1) and said `frictionlab resume` computes the rest, which failed the same way: refused at
+    once (exit 4), naming the folder, with the chunks kept and nothing computed."""
+    import tempfile
+
+    scene = make_scene({"realizations": 20, **NO_PLOT})
+    cancel = threading.Event()
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel)
+    chunks = tmp_path / "run" / "chunks"
+    kept = {p.name: p.read_bytes() for p in chunks.iterdir()}
+    chunks.chmod(0o555)  # refuses any user but root; for root, as the kernel would say it:
+    refuse = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir) == chunks:
+            raise PermissionError(13, "Permission denied")
+        return refuse(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    try:
+        code = main(["resume", str(tmp_path / "run"), "--workers", "1", "--quiet"])
+    finally:
+        chunks.chmod(0o755)
+    err = capsys.readouterr().err
+    assert code == ExitCode.OUTPUT_REFUSED, err
+    assert f"{chunks} cannot be written in: Permission denied: the run keeps its realizations there" in err
+    assert {p.name: p.read_bytes() for p in chunks.iterdir()} == kept

@@ -91,6 +91,23 @@ def test_ranges_linear_and_log(registry):
     assert hursts == [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]
 
 
+def test_a_range_of_long_whole_numbers_keeps_every_digit(registry):
+    """Range values were rounded to 12 significant digits: seeds 1700000000000 .. 1700000000002 gave
+    1700000000000 three times (refused as a value given twice), 1700000000001 .. 1700000012345 ran
+    seeds other than those written; ends past 2**53 were floats first."""
+    params = {"seed": {"start": 1700000000000, "stop": 1700000000002, "num": 3}}
+    sweep = plan_sweep(sweep_preset(params), registry=registry)
+    assert [p.values["seed"] for p in sweep.points] == [1700000000000, 1700000000001, 1700000000002]
+    params = {"seed": {"start": 1700000000001, "stop": 1700000012345, "num": 2},
+              "spectrum.params.hurst": {"values": [0.5]}}  # fmt: skip
+    assert [p.values["seed"] for p in plan_sweep(sweep_preset(params), registry=registry).points] == [
+        1700000000001, 1700000012345]
+    big = 2**64 + 1
+    params = {"seed": {"start": big, "stop": big + 4, "num": 3, "spacing": "log"}}
+    seeds = [p.values["seed"] for p in plan_sweep(sweep_preset(params), registry=registry).points]
+    assert seeds[0] == big and seeds[-1] == big + 4 and all(isinstance(s, int) for s in seeds)
+
+
 @pytest.mark.parametrize("value", [0.3, 1e-05, 2.5e-07, 1e20, 10000.0, 3, True, None, "spectral", "0.5", -0.0])
 def test_yaml_scalar_reads_back_as_the_same_value(value):
     text = yaml_scalar(value)
@@ -128,7 +145,7 @@ BAD_SPECS = [
     ({"seed": {"values": []}}, "sweep.parameters.seed: values must not be empty"),
     ({"loading.stop": {"start": 1, "stop": 5, "num": 0}}, "sweep.parameters.loading.stop.num: must be >= 1, got 0"),
     ({"loading.stop": {"start": 0, "stop": 5, "num": 3, "spacing": "log"}},
-     "a log range needs start > 0 and stop > 0. Got start=0.0, stop=5.0 instead"),
+     "a log range needs start > 0 and stop > 0. Got start=0, stop=5 instead"),  # as written
     ({"loading.stop": {"values": [5], "start": 1, "stop": 5, "num": 2}},
      "give either values or a range (start, stop, num), not both"),
     ({"loading.stop": {"start": 1, "stop": 5}}, "a range needs start, stop and num; missing: num"),

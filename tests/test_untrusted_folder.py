@@ -235,6 +235,28 @@ def test_a_sweep_json_without_a_row_for_every_point_is_damaged(tmp_path):
     assert len(frictionlab.load(folder).points) == 2
 
 
+def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp_path, capsys):
+    """A row's elapsed_s, point number or swept value of NaN or infinity (json reads them) made
+    follow --json fail as an internal error (exit 70), and a row without its contact_last follow
+    itself: each refused naming the field (exit 5), the row without the count shown without it."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    for key, value in (("elapsed_s", float("inf")), ("point", float("nan")), ("spectrum.params.hurst", float("nan")),
+                       ("set", [float("nan")])):  # fmt: skip
+        (folder / "sweep.json").write_text(json.dumps({**data, "points": [{**data["points"][0], key: value}, data["points"][1]]}))
+        code = main(["follow", str(folder), "--json"])
+        out, err = capsys.readouterr()
+        assert code == ExitCode.RUN_FOLDER, err
+        assert "sweep.json is damaged: field 'points.0" in err and key in err and "internal error" not in err
+    row = {k: v for k, v in data["points"][0].items() if k != "contact_last"}
+    (folder / "sweep.json").write_text(json.dumps({**data, "points": [row, data["points"][1]]}))
+    assert main(["follow", str(folder), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "hurst=0.6: a = " in out and "contacts" in out.splitlines()[-1] and "internal error" not in out
+
+
 def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
     folder = tmp_path / "sweep"
     preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})

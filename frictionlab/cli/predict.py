@@ -56,6 +56,11 @@ def run(args) -> ExitCode:
         if args.confidence is not None and args.a_ci is None:  # as --tls-cert without a tls:// scheduler
             raise FrictionlabError(f"--confidence {args.confidence:g} is the level of --a-ci and --b-ci, but there are "
                                    "none: it would be ignored; give the intervals, or leave --confidence out")  # fmt: skip
+        for field in intervals:  # a typo (a and b swapped): xi printed beside an interval that excluded it
+            value, (low, high) = getattr(law, field[0]), intervals[field]
+            if not low <= value <= high:
+                raise FrictionlabError(f"--{field[0]} {value!r} lies outside its interval --{field.replace('_', '-')} "
+                                       f"{low!r} {high!r}: an interval of the law's {field[0]} holds it; check the values")  # fmt: skip
     prediction = predict_xi(
         law, force=args.force, modulus=args.modulus, rms_height=args.rms_height, area=args.area,
         pairs=pairs, fitted_f=fitted_f, rms_slope=args.rms_slope,

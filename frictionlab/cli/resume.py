@@ -55,7 +55,13 @@ def run(args) -> ExitCode:
                 f"{shown_name(args.preset)} is damaged: its name, sweep and base preset are not those of one sweep "
                 "(a field edited): it cannot be resumed"
             ) from None
-    RunDirectory(run_dir).stored_preset()  # a clear error when there is nothing to resume, or it is damaged
+    # a clear error when there is nothing to resume, or it is damaged; a sweep added to a run's preset.yaml
+    # was refused as no sweep's folder, to be forced with --force, which resume lacks
+    if RunDirectory(run_dir).stored_preset().get("sweep") is not None:
+        raise RunFolderError(
+            f"cannot resume {shown_name(run_dir)}: its {PRESET_FILE} has a sweep section, but the run there is one "
+            "ensemble, not a sweep (the file was edited): remove that section to resume it, or run the sweep into another folder"
+        )
     args.preset = str(run_dir / PRESET_FILE)
     return stored_run(run_dir, lambda: run_command.run(args))
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import sys
 
-from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown_name
 from ..tradeoff.options import AXES, StudyOptions
 from .options import preset_overrides
 
@@ -201,6 +201,16 @@ def _kept_elsewhere(study, out_dir, text: str, args, exc: OSError) -> None:
                    f"can be written, mkdir -p {out} && mv {command_word(spare)}/study.* {out}/") from None
 
 
+def _refuse_nothing_to_run(study, axes: tuple[str, ...]) -> None:
+    """Refuse axes that all need a reference solver where there is none: the study ran nothing,
+    wrote a study.md of notes, and said 'no axis measured enough' with exit code 0."""
+    if study.reference_choice is not None or not set(axes) <= {"solver", "tolerance"}:
+        return
+    why = next((n.split(": skipped: ", 1)[1] for n in study.notes if ": skipped: " in n), "there is no reference solver")
+    raise FrictionlabError(f"--axes {','.join(axes)}: nothing would run: {'it needs' if len(axes) == 1 else 'they need'} "
+                           f"a reference solver, and {why}; give other --axes (grid, realizations, steps)")  # fmt: skip
+
+
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
@@ -232,6 +242,7 @@ def run(args) -> ExitCode:
     study = Study(factory, options, progress,
                   run_listeners=list if args.quiet else (lambda: [ProgressReporter(inputs_said=said)]))  # fmt: skip
     study.check_memory()  # before a folder is made
+    _refuse_nothing_to_run(study, options.axes)
     out_dir = claim_study_folder(args.out, factory.base.preset.name, force=args.force)
     reference = study.reference_choice["name"] if study.reference_choice else "none (solver and tolerance axes skipped)"
     progress(f"{factory.base.preset.name}: axes {', '.join(options.axes)}; reference {reference}")

@@ -393,6 +393,7 @@ def run_plan(
 
 TIME_FILE = "exact3d-time.json"
 TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
+MAX_STUDY_SECONDS = 1e9  # some 30 years: a wall time past it is no study's
 ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL}|{BROAD})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
 
 
@@ -443,4 +444,6 @@ def _time(runs_dir: Path, plan: Plan) -> float:
         earlier = {}
     seconds_before = earlier.get("seconds")
     usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
-    return float(seconds_before) if usable and math.isfinite(seconds_before) and earlier.get("plan") == plan.name else 0.0
+    # an edited file's -5 or 1e308 was printed on the page as the study's wall time (1e308: 300 digits)
+    usable = usable and 0 <= seconds_before <= MAX_STUDY_SECONDS and earlier.get("plan") == plan.name
+    return float(seconds_before) if usable else 0.0

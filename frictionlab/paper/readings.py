@@ -168,8 +168,12 @@ class ReadingRow:
         return float(yaml.safe_load(next(o for o in self.overrides if o.startswith(prefix))[len(prefix):]))
 
 
+READINGS_FOLDER = "readings"  # the readings' run folders, in the report's --out
+CALIBRATED_FOLDER = "fig5-calibrated"  # the runs of Fig. 5 with h calibrated at each H
+
+
 def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = RunOptions(), *, readings=READINGS,
-                 folder_name="readings", progress: bool = False, replicates: int = 1) -> list[ReadingRow]:  # fmt: skip
+                 folder_name=READINGS_FOLDER, progress: bool = False, replicates: int = 1) -> list[ReadingRow]:  # fmt: skip
     """Run each reading (calibrating h first where it says so) on ``replicates`` independent
     ensembles: the preset's seed, then seeds from one ``SeedSequence`` (``seeds.replicate_seeds``).
     h is calibrated once per reading, on the preset's seed, and kept for every ensemble."""

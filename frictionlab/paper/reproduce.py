@@ -16,10 +16,10 @@ from ..options import RunOptions
 from ..runs.rundir import new_run_folder
 from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
-from .figures import find_presets, kept_in, run_figures
+from .figures import FIGURES, find_presets, kept_in, run_figures
 from .markdown import markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
-from .readings import READINGS, fig5_calibrated_readings, run_readings
+from .readings import CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, fig5_calibrated_readings, run_readings
 
 
 FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
@@ -45,7 +45,21 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
     figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, "figures", "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
+    _refuse_inside_runs(out_dir, markdown_path, figures_dir)
     return out_dir, markdown_path, figures_dir
+
+
+def _refuse_inside_runs(out_dir: Path, markdown_path: Path, figures_dir: Path) -> None:
+    """Refuse a markdown or figures folder in a folder of the report's runs: --markdown OUT/fig2/summary.json
+    wrote the report over the run's summary, which was then damaged (a file or a folder the run writes)."""
+    names = (*(fig.key for fig in FIGURES), READINGS_FOLDER, CALIBRATED_FOLDER)
+    runs = [os.path.realpath(out_dir / name) for name in names]
+    for option, path in (("--markdown", markdown_path), ("--figures", figures_dir)):
+        where = os.path.realpath(path)
+        inside = next((run for run in runs if where == run or where.startswith(run + os.sep)), None)
+        if inside is not None:
+            raise OutputRefused(f"{option} {shown_name(path)} is in {shown_name(inside)}, where the report keeps "
+                                "its runs: give a path outside it")  # fmt: skip
 
 
 def _refuse_overwriting(markdown_path: Path | None, figures_dir: Path | None, force: bool) -> None:
@@ -92,7 +106,7 @@ def write_report(
                 log(f"report: Fig. 5 with h calibrated at each of {len(fig5.sweep.points)} H")
                 t0 = time.perf_counter()
                 fig5_rows = run_readings(runs, out_dir, options, readings=fig5_calibrated_readings(fig5.sweep),
-                                         folder_name="fig5-calibrated", progress=not quiet)  # fmt: skip
+                                         folder_name=CALIBRATED_FOLDER, progress=not quiet)  # fmt: skip
                 fig5_elapsed = time.perf_counter() - t0
                 name = "fig5-calibrated.png"
                 atomic_write(figures_dir / name, lambda fh: plot_fig5_calibrated(fig5, fig5_rows, fh, dpi=dpi), binary=True)

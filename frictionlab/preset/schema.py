@@ -4,6 +4,7 @@ validation), and the JSON Schema of a preset with the installed plugins' params.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from typing import Any, Literal
 
 import numpy as np
@@ -86,8 +87,9 @@ class SweepParameter(_Strict):
     """The values one swept parameter takes: a list, or a range start..stop with num values."""
 
     values: list[SweepScalar] | None = Field(None, description="Explicit values (YAML scalars); or give a range.")
-    start: float | None = Field(None, allow_inf_nan=False, description="First value of a range.")
-    stop: float | None = Field(None, allow_inf_nan=False, description="Last value of a range (included).")
+    # int kept as int: a seed of 20 digits is no float's
+    start: int | float | None = Field(None, allow_inf_nan=False, description="First value of a range.")
+    stop: int | float | None = Field(None, allow_inf_nan=False, description="Last value of a range (included).")
     num: int | None = Field(None, ge=1, le=100_000, description="Number of values of a range, >= 1.")
     spacing: Literal["linear", "log"] = Field("linear", description="Range values evenly spaced in value or in log.")
 
@@ -116,14 +118,28 @@ class SweepParameter(_Strict):
         return len(self.values) if self.values is not None else int(self.num)
 
     def points(self) -> list:
-        """The values, in order (ranges rounded to 12 significant digits so labels and --set stay clean)."""
+        """The values, in order (ranges rounded to 12 significant digits so labels and --set stay clean;
+        whole values between whole ends exact, and the ends as given: a seed of 13 digits was rounded)."""
         if self.values is not None:
             return list(self.values)
+        whole = float(self.start).is_integer() and float(self.stop).is_integer()
+        if whole and self.spacing == "linear":
+            return _whole_range(int(self.start), int(self.stop), self.num)
         make = np.geomspace if self.spacing == "log" else np.linspace
         with np.errstate(over="ignore", invalid="ignore"):  # ends past 1e100 (stop - start overflows) are refused by name
-            raw = [float(f"{v:.12g}") for v in make(self.start, self.stop, self.num)]
-        whole = float(self.start).is_integer() and float(self.stop).is_integer()
-        return [int(v) if whole and v.is_integer() else v for v in raw]
+            raw = [float(f"{v:.12g}") for v in make(float(self.start), float(self.stop), self.num)]
+        if whole:
+            raw[0], raw[-1] = int(self.start), int(self.stop)
+        return [int(v) if whole and float(v).is_integer() else v for v in raw]
+
+
+def _whole_range(start: int, stop: int, num: int) -> list:
+    """``num`` values from ``start`` to ``stop``, evenly spaced: those that are whole exactly, as ints,
+    the others rounded to 12 significant digits."""
+    if num == 1:
+        return [start]
+    steps = [start + Fraction(stop - start, num - 1) * i for i in range(num)]
+    return [int(v) if v.denominator == 1 else float(f"{float(v):.12g}") for v in steps]
 
 
 def ensemble_settings(resolved: dict) -> dict:

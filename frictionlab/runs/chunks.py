@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..compute.realization import RealizationResult
+from ..errors import OutputRefused, RunFolderError, shown
+from ..io.files import output_path_problem
 from ..io.inputs import InputFileProblem
 from ..preset import Scene
 from .runfolder import open_member, read_member
@@ -34,6 +36,19 @@ ADDED_CURVE_ARRAYS = ("half_load_points",)  # kept by every run, absent from the
 
 class ChunkDamage(ValueError):
     """A chunk file whose content is not what a chunk of this run can hold."""
+
+
+def check_chunk_folder(folder: Path) -> None:
+    """Refuse, before any realization runs, a chunks/ the run cannot keep its realizations in: a
+    link or no folder (never written or read through), or a folder no file can be created in (a
+    resume computed a chunk, lost it when it could not be written, and said to resume again)."""
+    if os.path.islink(folder) or (os.path.lexists(folder) and not folder.is_dir()):
+        raise RunFolderError(
+            f"{shown(folder)} is not a folder (a link, a file, ...): chunks are never written or read through it "
+            "(remove it, or give another folder)"
+        )
+    if folder.is_dir() and (problem := output_path_problem(folder)):
+        raise OutputRefused(f"{problem}: the run keeps its realizations there; make it writable, then run again")
 
 
 def chunk_bytes(results: list[RealizationResult]) -> bytes:
@@ -181,8 +196,8 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
         raise ChunkDamage("xi infinite or below 0")
     points = arrays["points"][:, None]
-    if bool((points < 1).any()):
-        raise ChunkDamage("a profile of fewer than 1 point")
+    if not bool((np.isfinite(points) & (points >= 1) & (points == np.floor(points))).all()):  # NaN failed int()
+        raise ChunkDamage("a profile's points not a whole number >= 1")
     if not bool((arrays["slope_rms_line"] > 0).all() and np.isfinite(arrays["slope_rms_line"]).all()):
         raise ChunkDamage("a line's rms slope not a finite number > 0")  # a realization with one is a failure
     if not bool((arrays["force_unit"] > 0).all()):  # NaN compares false: refused (inf: the run's own check says it)

@@ -44,7 +44,7 @@ from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import with_new_defaults
 from ..compute.realization import RealizationResult
 from .inputrecord import file_hashes, input_changes, refuse_changed_inputs, what_was_read
-from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, chunk_bytes, damage_report, read_chunk
+from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, check_chunk_folder, chunk_bytes, damage_report, read_chunk
 from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
@@ -225,11 +225,7 @@ class RunDirectory:
     def start(self, scene: Scene, *, resume: bool) -> list[RealizationResult]:
         """Prepare the directory for ``scene``; return the results already stored
         and verified (resume) or none (a fresh run)."""
-        if os.path.islink(self.chunks) or (os.path.lexists(self.chunks) and not self.chunks.is_dir()):
-            raise RunFolderError(
-                f"{self.chunks} is not a folder (a link, a file, ...): chunks are never written or read through it "
-                "(remove it, or give another folder)"
-            )
+        check_chunk_folder(self.chunks)
         self._check_replaceable(scene, resume)
         resolved = json_copy(scene.resolved())
         inputs, read = file_hashes(scene), what_was_read(scene)

@@ -3,10 +3,11 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, ValidationError
+from pydantic import Field, ValidationError, model_validator
 
 from ..errors import RunFolderError, shown, shown_name
 from ..preset.paths import MISSING, get_path
@@ -22,7 +23,11 @@ class PointRecord(Record):
 
     folder: MemberName
     status: Literal["completed", "cancelled", "interrupted", "failed", "error", "pending"]  # PointResult's
+    point: Annotated[int, Field(ge=1, strict=True)] | None = None
+    label: str | None = None
+    set: list[str] | None = None  # the point's --set options
     done: Count | None = None
+    elapsed_s: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] | None = None
     contact_first: Finite | None = None
     contact_last: Finite | None = None
     a: Finite | None = None
@@ -33,6 +38,14 @@ class PointRecord(Record):
     b_hi: Finite | None = None
     r2: Finite | None = None
     error: str | None = None  # why a failed point failed
+
+    @model_validator(mode="after")
+    def _finite_values(self):
+        """A swept value of NaN or infinity (its row's own keys): follow --json failed on it, an internal error."""
+        for key, value in (self.model_extra or {}).items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise ValueError(f"{key} must be a finite number, or text, got {value!r}")
+        return self
 
 
 class _SweepSpecRecord(Record):

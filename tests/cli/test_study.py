@@ -151,6 +151,18 @@ def test_study_refuses_a_grid_beyond_the_memory_before_starting(tmp_path, capsys
     assert not out.exists()
 
 
+@pytest.mark.parametrize("axes", ["solver", "tolerance", "solver,tolerance"])
+def test_axes_that_all_need_a_reference_where_there_is_none_are_refused(tmp_path, capsys, axes):
+    """A line preset of mdr has no exact solver to compare with: --axes solver ran nothing, wrote a
+    study.md of notes and said 'no axis measured enough to recommend anything' with exit code 0."""
+    out = tmp_path / "study"
+    code = main(["study", "quickstart", "--axes", axes, "--quiet", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == ExitCode.USAGE, err
+    assert f"--axes {axes}: nothing would run" in err and "no installed solver solves the elastic half-space" in err
+    assert not out.exists()
+
+
 def test_study_out_may_be_a_folder_name_that_is_not_utf8(tmp_path, capsys, figure_stubbed):
     import os
 

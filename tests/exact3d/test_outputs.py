@@ -173,3 +173,19 @@ def test_an_ensemble_beyond_the_memory_refuses_the_study_before_any_runs(tmp_pat
     assert err.startswith("error: the exact 3D study starts nothing: its ensemble H = 0.8, 192² px, exact, 2 surfaces")
     assert "is available (the memory of a test)" in err and "--quick" in err and "Traceback" not in err
     assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir())
+
+
+@pytest.mark.parametrize("text, seconds", [
+    ('{"plan": "quick", "seconds": 12.5}', 12.5),
+    ('{"plan": "quick", "seconds": -5}', 0.0),  # was printed as the study's wall time, -5.0 s
+    ('{"plan": "quick", "seconds": 1e308}', 0.0),  # printed as a number of 300 digits
+    ('{"plan": "quick", "seconds": Infinity}', 0.0),
+    ('{"plan": "quick", "seconds": NaN}', 0.0),
+    ('{"plan": "quick", "seconds": "12"}', 0.0),
+    ('{"plan": "full", "seconds": 12.5}', 0.0),
+])  # fmt: skip
+def test_an_edited_time_file_counts_only_a_wall_time_a_study_can_have_taken(tmp_path, text, seconds):
+    from frictionlab.exact3d import plan as study
+
+    (tmp_path / study.TIME_FILE).write_text(text)
+    assert study._time(tmp_path, study.QUICK) == seconds

@@ -381,6 +381,11 @@ def test_an_f_double_precision_holds_is_found_whatever_the_products_do(capsys, a
         ([*LAW, "--from", ""], "--from names no folder (it is empty)"),  # not "give the law"
         # a level of no interval: it was printed as '50% interval n/a (none)', the option ignored
         ([*LAW, "--confidence", "0.5"], "--confidence 0.5 is the level of --a-ci and --b-ci, but there are none"),
+        # a typo (a and b swapped, a digit lost): xi was printed beside an interval that left it out
+        (["--a", "1.88", "--b", "0.08", "--a-ci", "0.07", "0.09", "--b-ci", "1.8", "1.9"],
+         "--a 1.88 lies outside its interval --a-ci 0.07 0.09"),
+        (["--a", "1.88", "--b", "0.08", "--a-ci", "1.8", "1.9", "--b-ci", "0.8", "0.9"],
+         "--b 0.08 lies outside its interval --b-ci 0.8 0.9"),
     ],
 )
 def test_options_out_of_range_are_usage_errors(capsys, options, named):

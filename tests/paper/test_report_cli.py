@@ -75,6 +75,20 @@ def test_figures_or_out_that_is_a_file_and_markdown_that_is_a_folder_are_refused
     assert afile.read_text() == "mine" and sorted(p.name for p in tmp_path.iterdir()) == ["folder", "my.md"]
 
 
+@pytest.mark.parametrize("option, inside", [("--markdown", "fig2/summary.json"), ("--markdown", "fig5/sweep.json"),
+                                            ("--figures", "fig3"), ("--figures", "readings/figures"),
+                                            ("--markdown", "fig5-calibrated/REPRODUCTION.md")])  # fmt: skip
+def test_a_markdown_or_figures_in_a_folder_of_the_reports_runs_is_refused(tmp_path, capsys, option, inside):
+    """--markdown OUT/fig2/summary.json wrote the report over Fig. 2's summary, its run then damaged
+    (`frictionlab runs` said so): refused before any run (exit 4), and nothing made."""
+    out = tmp_path / "r"
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), option, str(out / inside), "--quiet"])
+    assert code == ExitCode.OUTPUT_REFUSED
+    folder = out / inside.split("/")[0]
+    assert f"{option} {out / inside} is in {folder}, where the report keeps its runs" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_a_bad_preset_among_the_figures_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch):
     """Fig. 5's preset is the last to run: its mistake is named (exit 2) before Figs. 2 to 4
     spend their minutes, and no run folder is made."""
