@@ -25,7 +25,8 @@ from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.progress import ProgressReporter
-from frictionlab.runs.progresslog import MAX_LINE_BYTES, PROGRESS_FILE, READ_BLOCK, Follower, ProgressLog, ProgressReader
+from frictionlab.runs.progresslines import MAX_LINE_BYTES
+from frictionlab.runs.progresslog import PROGRESS_FILE, READ_BLOCK, Follower, ProgressLog, ProgressReader
 from frictionlab.compute.realization import RealizationResult
 from frictionlab.runs.rundir import LOCK_FILE, RunDirectory
 from frictionlab.runs.runfolder import _not_to_signal

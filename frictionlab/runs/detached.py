@@ -29,7 +29,6 @@ from ..options import RunOptions
 from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
 from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
-from .runfolder import read_json
 
 SWEEP_FILE = "sweep.json"  # what marks a sweep's folder (it has no run.json)
 RUN_MARKERS = (STATE_FILE, "summary.json", SWEEP_FILE)  # a folder holding one is a run's (or was meant to be)

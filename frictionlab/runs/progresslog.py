@@ -28,7 +28,7 @@ from pydantic import Field, ValidationError, model_validator
 
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
-from .progresslines import MAX_BATCH, MAX_LINE_BYTES, Batch, _number, _whole, batch_results, fitted_line, result_of
+from .progresslines import MAX_BATCH, Batch, _number, _whole, batch_results, fitted_line, result_of
 from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"
