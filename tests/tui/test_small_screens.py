@@ -156,3 +156,18 @@ async def test_the_keys_panel_at_30x8_fits_the_screen_says_how_to_close_it_and_c
     assert inside and keys_shown, panel.region
     assert first == "Esc closes; F1: next page" and last == "Esc or F1 closes"
     assert closed_by_esc and closed_by_f1 and closed_by_question_mark
+
+
+@pytest.mark.parametrize("size", [(30, 8), (59, 20)])
+@sync
+async def test_the_keys_panel_under_60_columns_covers_every_row_and_gives_the_footer_back(folders, registry, size):
+    """Under 60 columns the panel split the screen at its whole width: the footer kept one column,
+    its ⏎ drawn in the panel's last row in place of the panel's border."""
+    app = make_app(registry)
+    async with app.run_test(size=size) as pilot:
+        await press_settled(pilot, "f1")
+        shown = screen_text(app).splitlines()
+        await press_settled(pilot, "escape")
+        footer = screen_text(app).splitlines()[-1]
+    assert all(line.startswith("▏") for line in shown), shown
+    assert footer.strip().startswith("⏎ Open"), footer
