@@ -32,6 +32,7 @@ from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
     copy_name,
+    copy_target,
     file_stamp,
     preset_folders,
     preset_from_template,
@@ -80,7 +81,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         Binding("4", "show_tab('run')", "Run tab", tooltip="(as F4), outside a text field", show=False),
         Binding("5", "show_tab('results')", "Results tab", tooltip="(as F5), outside a text field", show=False),
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
-        Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
+        Binding("ctrl+o", "save_as", "Save a copy", tooltip="in another file, under a name of its own", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
@@ -337,12 +338,12 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         except PresetError as exc:
             self.say(problems_text(exc.problems), "error", title="Cannot duplicate", about=entry.path)
             return
-        data["name"] = f"{data.get('name') or entry.path.stem}-copy"
-        default = self.save_folder / f"{entry.path.stem}-copy.yaml"  # where n and Ctrl+S save too
+        # in the folder where n and Ctrl+S save too
+        name, default = copy_target(str(data.get("name") or entry.path.stem), entry.path.stem, self.save_folder, self.names_listed())
 
         def done(path: Path | None) -> None:
             if path is not None:
-                data["name"] = copy_name(data["name"], path, default)
+                data["name"] = copy_name(name, path, default, self.names_listed(replaced=path))
                 self._write(path, data, then_open=True, template=entry.path)
 
         self.push_screen(PathScreen(f"Duplicate {shown_name(entry.path.name)} as", default, self.save_folder), done)

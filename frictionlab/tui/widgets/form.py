@@ -228,6 +228,12 @@ class PresetForm(VerticalScroll):
         if slot in KINDS and len(path) > 2 and get_path(data, (slot, "name")) is MISSING:
             set_path(data, (slot, "name"), default_plugin_name(slot), replace_values=True)
 
+    def rename(self, name: str) -> None:
+        """The draft named ``name`` (a copy saved under it), its field showing it."""
+        spec = next(spec for spec in self._specs.values() if spec.path == ("name",))
+        self.query_one(f"#{spec.widget_id}", Input).value = name  # not typed: Changed stores nothing
+        self._store(spec, name)
+
     def _store(self, spec: FieldSpec, value) -> None:
         unsaid = get_path(self._loaded, spec.path) is MISSING
         if spec.kind in ("bool", "choice") and unsaid and value == spec.default:
