@@ -171,3 +171,19 @@ async def test_the_keys_panel_under_60_columns_covers_every_row_and_gives_the_fo
         footer = screen_text(app).splitlines()[-1]
     assert all(line.startswith("▏") for line in shown), shown
     assert footer.strip().startswith("⏎ Open"), footer
+
+
+@sync
+async def test_a_dialog_taller_than_a_30x8_screen_stays_on_it_and_the_arrows_bring_its_answers(folders, registry):
+    """At 30x8 a question (save with problems?) ran past the screen's bottom edge, its answers
+    (y, n, Esc) out of reach below it, and no key scrolled it."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "enter", "ctrl+u", *"bad name", "escape", "ctrl+s")
+        dialog = app.screen.query_one(".dialog")
+        inside = dialog.region.y >= 0 and dialog.region.bottom <= 7  # the footer takes the last row
+        before = screen_text(app)
+        await press_settled(pilot, *["down"] * 30)
+        after = screen_text(app)
+    assert inside, dialog.region
+    assert "n / Esc: no" not in before and "n / Esc: no" in after
