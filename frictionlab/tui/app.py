@@ -87,6 +87,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
+        Binding("c", "cancel_where", show=False, system=True),  # outside the Run tab: says where c cancels a run
         Binding("ctrl+z", "suspend_process", "Suspend", tooltip="to the shell, as Ctrl+Z in a shell (fg brings the TUI back)", show=False),
         # the same keys where they cannot act (check_action hides those above): the status line says why
         *said_when_hidden(("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"), priority=True),
