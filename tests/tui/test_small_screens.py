@@ -187,3 +187,13 @@ async def test_a_dialog_taller_than_a_30x8_screen_stays_on_it_and_the_arrows_bri
         after = screen_text(app)
     assert inside, dialog.region
     assert "n / Esc: no" not in before and "n / Esc: no" in after
+
+
+@sync
+async def test_the_new_dialog_at_30x8_shows_its_values_not_only_its_labels(folders, registry):
+    """At 30x8 its labels kept 20 of the dialog's 26 columns: the name read 'scene', the file 'prese'."""
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "n")
+        text = screen_text(app)
+    assert "my-scene" in text and "quickstart" in text, text
