@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
+from textual.containers import VerticalScroll
 from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Static, TabPane
@@ -141,7 +142,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
             yield TabPane("F3 Edit", id="edit")
             yield TabPane("F4 Run", id="run")
             yield TabPane("F5 Results", id="results")
-        yield Static("", id="status")
+        with VerticalScroll(id="status-box", can_focus=False):
+            yield Static("", id="status")
         yield KeysFooter()
 
     def on_mount(self) -> None:
@@ -271,6 +273,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.taken_back_on = "open" if until_open or text == NO_PRESET else ""
         status = self.query_one("#status", Static)
         status.update(line)
+        self.query_one("#status-box").scroll_home(animate=False)  # a message read from its start
         for name in ("information", "warning", "error"):
             status.set_class(name == severity, f"-{name}")
 
