@@ -68,7 +68,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (60, "-roomy")]  # narrow: the keys panel takes the width (app.tcss)
-    VERTICAL_BREAKPOINTS = [(0, "-short"), (22, "-tall")]  # short: a dialog as tall as the screen at most (app.tcss)
+    # short: a dialog as tall as the screen at most; tiny (30x8): the Edit tab's form keeps rows (app.tcss)
+    VERTICAL_BREAKPOINTS = [(0, "-tiny"), (12, "-short"), (22, "-tall")]
     BINDINGS = [
         Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
         Binding("question_mark", "toggle_keys", "Keys", tooltip="(show or hide), outside a text field", show=False),

@@ -197,3 +197,14 @@ async def test_the_new_dialog_at_30x8_shows_its_values_not_only_its_labels(folde
         await press_settled(pilot, "n")
         text = screen_text(app)
     assert "my-scene" in text and "quickstart" in text, text
+
+
+@sync
+async def test_the_form_at_30x8_keeps_rows_beside_the_help_and_problems(folders, registry):
+    """At 30x8 the field's help and the problems took every row: the form showed none of its
+    fields, Enter went into a name that could not be seen."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "enter")
+        rows, text = app.query_one("#form").region.height, screen_text(app)
+    assert rows >= 2 and any(line.startswith("name") for line in text.splitlines()), text
