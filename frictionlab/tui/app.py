@@ -307,7 +307,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     async def _open_after_confirm(self, path: Path, data: dict | None = None, *, modified: bool = False) -> bool:
         """Open a preset in place of the draft, asking first when the draft has unsaved changes
         (Enter on the list, New, Duplicate); whether it was opened."""
-        if self.modified and not await self.push_screen_wait(
+        if await self.unsaved() and not await self.push_screen_wait(
             ConfirmScreen("The open preset has unsaved changes. Discard them?")
         ):
             return False

@@ -5,6 +5,7 @@ once the user says so."""
 
 from __future__ import annotations
 
+import asyncio
 import copy
 from pathlib import Path
 
@@ -51,6 +52,20 @@ class PresetSaving:
                              lambda yes: yes and self._save_checked(self.draft_path))  # fmt: skip
             return
         self._save_checked(self.draft_path)
+
+    async def unsaved(self) -> bool:
+        """Whether the draft has unsaved changes, counting an edit still on its way: keys typed
+        together (z, Esc, q: SSH sends them joined) are in the form's fields' queues when q is
+        answered, and the app heard of the change only after it had quit without asking."""
+        if self.modified or self._saved is None or self._mounted("EditPane") is None:
+            return self.modified
+        form = self.query_one("#form")
+        pumps = [form, *form.query("*")]
+        for _ in range(1000):  # each turn lets the fields' and the form's queues move on
+            if not any(pump.message_queue_size for pump in pumps):
+                break
+            await asyncio.sleep(0)
+        return form.data is not None and form.data != self._saved
 
     def _changed_on_disk(self) -> bool:
         """Whether the open preset's file is there and not as it was read or last saved here."""

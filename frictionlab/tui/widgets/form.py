@@ -381,11 +381,14 @@ class PresetForm(VerticalScroll):
         field.scroll_visible()
 
     def check_action(self, action: str, parameters) -> bool:
-        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies)."""
+        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies).
+        The screen's focus, not ``has_focus``: that follows once the Focus message is handled, and Enter,
+        Esc, q typed fast found the form still focused on Esc, which then came late, after the q typed."""
+        focused = self.screen.focused is self
         if action == "edit_field":
-            return self.has_focus and self.data is not None
+            return focused and self.data is not None
         if action == "leave_field":
-            return not self.has_focus
+            return not focused
         return True
 
     def action_edit_field(self) -> None:
