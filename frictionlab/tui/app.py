@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 from textual import events
 from textual.app import App, ComposeResult
 from textual.binding import Binding
+from textual.containers import VerticalScroll
 from textual.content import Content
 from textual.css.query import NoMatches
 from textual.widgets import Static, TabPane
@@ -32,6 +33,7 @@ from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
     copy_name,
+    copy_target,
     file_stamp,
     preset_folders,
     preset_from_template,
@@ -66,6 +68,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
     HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (60, "-roomy")]  # narrow: the keys panel takes the width (app.tcss)
+    # short: a dialog as tall as the screen at most; tiny (30x8): the Edit tab's form keeps rows (app.tcss)
+    VERTICAL_BREAKPOINTS = [(0, "-tiny"), (12, "-short"), (22, "-tall")]
     BINDINGS = [
         Binding("f1", "help", "Keys", tooltip="(show, next page, hide): those of the focused part and the app's", priority=True),
         Binding("question_mark", "toggle_keys", "Keys", tooltip="(show or hide), outside a text field", show=False),
@@ -80,11 +84,12 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         Binding("4", "show_tab('run')", "Run tab", tooltip="(as F4), outside a text field", show=False),
         Binding("5", "show_tab('results')", "Results tab", tooltip="(as F5), outside a text field", show=False),
         Binding("ctrl+s", "save", "Save", tooltip="the preset (asks first if it has problems)", priority=True),
-        Binding("ctrl+o", "save_as", "Save as", tooltip="another file", show=False, priority=True),
+        Binding("ctrl+o", "save_as", "Save a copy", tooltip="in another file, under a name of its own", show=False, priority=True),
         Binding("ctrl+r", "start_run", "Run", tooltip="the open preset", priority=True),
         Binding("ctrl+q", "quit", "Quit", tooltip="(asks if the preset has unsaved changes, or a run goes on)", priority=True),
         Binding("q", "quit", "Quit", tooltip="outside a text field, as Ctrl+Q", show=False),
         Binding("ctrl+c", "help_quit", show=False, system=True),  # in the status line, not a pop-up over it
+        Binding("c", "cancel_where", show=False, system=True),  # outside the Run tab: says where c cancels a run
         Binding("ctrl+z", "suspend_process", "Suspend", tooltip="to the shell, as Ctrl+Z in a shell (fg brings the TUI back)", show=False),
         # the same keys where they cannot act (check_action hides those above): the status line says why
         *said_when_hidden(("ctrl+s", "save"), ("ctrl+o", "save_as"), ("ctrl+r", "start_run"), priority=True),
@@ -138,7 +143,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
             yield TabPane("F3 Edit", id="edit")
             yield TabPane("F4 Run", id="run")
             yield TabPane("F5 Results", id="results")
-        yield Static("", id="status")
+        with VerticalScroll(id="status-box", can_focus=False):
+            yield Static("", id="status")
         yield KeysFooter()
 
     def on_mount(self) -> None:
@@ -268,6 +274,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.taken_back_on = "open" if until_open or text == NO_PRESET else ""
         status = self.query_one("#status", Static)
         status.update(line)
+        self.query_one("#status-box").scroll_home(animate=False)  # a message read from its start
         for name in ("information", "warning", "error"):
             status.set_class(name == severity, f"-{name}")
 
@@ -300,7 +307,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     async def _open_after_confirm(self, path: Path, data: dict | None = None, *, modified: bool = False) -> bool:
         """Open a preset in place of the draft, asking first when the draft has unsaved changes
         (Enter on the list, New, Duplicate); whether it was opened."""
-        if self.modified and not await self.push_screen_wait(
+        if await self.unsaved() and not await self.push_screen_wait(
             ConfirmScreen("The open preset has unsaved changes. Discard them?")
         ):
             return False
@@ -337,12 +344,12 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         except PresetError as exc:
             self.say(problems_text(exc.problems), "error", title="Cannot duplicate", about=entry.path)
             return
-        data["name"] = f"{data.get('name') or entry.path.stem}-copy"
-        default = self.save_folder / f"{entry.path.stem}-copy.yaml"  # where n and Ctrl+S save too
+        # in the folder where n and Ctrl+S save too
+        name, default = copy_target(str(data.get("name") or entry.path.stem), entry.path.stem, self.save_folder, self.names_listed())
 
         def done(path: Path | None) -> None:
             if path is not None:
-                data["name"] = copy_name(data["name"], path, default)
+                data["name"] = copy_name(name, path, default, self.names_listed(replaced=path))
                 self._write(path, data, then_open=True, template=entry.path)
 
         self.push_screen(PathScreen(f"Duplicate {shown_name(entry.path.name)} as", default, self.save_folder), done)

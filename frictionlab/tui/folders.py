@@ -10,6 +10,7 @@ folders, found by their ``sweep.json``.
 from __future__ import annotations
 
 import errno
+import itertools
 import math
 import os
 import re
@@ -179,10 +180,37 @@ def preset_from_template(template: Path, name: str, new_path: Path, registry=Non
     return data
 
 
-def copy_name(name: str, path: Path, default: Path) -> str:
-    """A duplicate's name: ``name`` (``<name>-copy``) saved where offered (``default``), else the
-    file's own name when it can name a preset, as New names the file after the preset."""
-    return path.stem if path != default and re.fullmatch(NAME_PATTERN, path.stem) else name
+def copy_target(name: str, stem: str, folder: Path, taken: set[str]) -> tuple[str, Path]:
+    """A copy's name and the file offered for it: ``<name>-copy`` in ``<stem>-copy.yaml``, numbered
+    (``-copy-2``) until the name is no listed preset's and the file is not there (never replaced)."""
+    for number in itertools.count(1):
+        suffix = "-copy" if number == 1 else f"-copy-{number}"
+        path = Path(folder) / f"{stem}{suffix}.yaml"
+        copied = name[: 100 - len(suffix)] + suffix  # a name is at most 100 characters
+        if copied not in taken and not os.path.lexists(path):
+            return copied, path
+    raise AssertionError("unreachable")
+
+
+def copy_name(name: str, path: Path, default: Path, taken: set[str]) -> str:
+    """A copy's name: ``name`` (``copy_target``'s) saved where offered (``default``), else the
+    file's own name when it can name a preset and no listed preset has it, as New names the
+    file after the preset."""
+    own = path != default and re.fullmatch(NAME_PATTERN, path.stem) and path.stem not in taken
+    return path.stem if own else name
+
+
+def names_taken(entries: list[PresetEntry], replaced: Path | None = None) -> set[str]:
+    """The names of the listed presets ``entries``, but that of the file a copy replaces."""
+    gone = _resolved(replaced) if replaced is not None else None
+    return {entry.name for entry in entries if gone is None or _resolved(entry.path) != gone}
+
+
+def _resolved(path: Path) -> Path:
+    try:
+        return Path(path).resolve()
+    except (OSError, RuntimeError):  # a link loop
+        return Path(path)
 
 
 def save_preset(path: Path, data: dict, template: Path | None = None) -> None:

@@ -52,6 +52,12 @@ class KeysHelp:
         else:
             raise SkipAction()  # Esc means nothing here: another part may take it
 
+    def action_cancel_where(self) -> None:
+        """c outside the Run tab (whose own c cancels) and a text field: while a run goes, say where
+        it cancels (pressed on the Edit tab, say, it did nothing, unsaid)."""
+        if self.running and not self.followed.ended:
+            self.say("c cancels the run on the Run tab (F4), where it shows; here it does nothing.", "warning")
+
     def action_help_quit(self, in_field: bool = False) -> None:
         """Ctrl+C (copy, in a text field) does not quit: where the status line says what does."""
         where = "Ctrl+C copies in a text field. " if in_field else ""

@@ -392,13 +392,13 @@ class RunControl:
         self.say(message.error, "warning" if message.interrupted else "error",
                  title="Run interrupted" if message.interrupted else "Run failed")  # fmt: skip
 
-    def action_quit(self) -> None:
+    async def action_quit(self) -> None:
         """Quit at once; with unsaved changes, ask first whether to drop them; then, while a run
         goes on, whether to leave it running or cancel it (nothing is cancelled by a quit that
         does not happen)."""
         if isinstance(self.screen, (QuitUnsavedScreen, QuitDuringRunScreen, QuitRunEndedScreen)):
             return  # Ctrl+Q again: the question is up; stacked, one n left the same question there
-        if self.modified:
+        if await self.unsaved():
             self.push_screen(QuitUnsavedScreen(), lambda yes: yes and self._quit_leaving_or_cancelling_the_run())
             return
         self._quit_leaving_or_cancelling_the_run()

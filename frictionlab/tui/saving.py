@@ -5,11 +5,22 @@ once the user says so."""
 
 from __future__ import annotations
 
+import asyncio
 import copy
 from pathlib import Path
 
 from ..errors import shown, shown_name
-from .folders import file_stamp, is_builtin, made_when_saved, new_preset_path, save_preset, user_presets_dir
+from .folders import (
+    copy_name,
+    copy_target,
+    file_stamp,
+    is_builtin,
+    made_when_saved,
+    names_taken,
+    new_preset_path,
+    save_preset,
+    user_presets_dir,
+)
 from .running import NO_PRESET
 from .screens import ConfirmScreen, PathScreen
 from .widgets.presets import PresetsPane
@@ -25,7 +36,7 @@ class PresetSaving:
         if is_builtin(self.draft_path):  # shipped with frictionlab: saved as a copy, where the user says
             self.say(f"{shown_name(self.draft_path.name)} is a built-in preset: save your version as a new file.", "warning", until_open=True)
             self.push_screen(
-                PathScreen("Save the built-in preset's changes as", self._save_as_default(), self.save_folder),
+                PathScreen("Save the built-in preset's changes as", new_preset_path(self.draft_path.stem, self.save_folder), self.save_folder),
                 lambda path: path is not None and self._save_checked(path),
             )
             return
@@ -41,6 +52,20 @@ class PresetSaving:
                              lambda yes: yes and self._save_checked(self.draft_path))  # fmt: skip
             return
         self._save_checked(self.draft_path)
+
+    async def unsaved(self) -> bool:
+        """Whether the draft has unsaved changes, counting an edit still on its way: keys typed
+        together (z, Esc, q: SSH sends them joined) are in the form's fields' queues when q is
+        answered, and the app heard of the change only after it had quit without asking."""
+        if self.modified or self._saved is None or self._mounted("EditPane") is None:
+            return self.modified
+        form = self.query_one("#form")
+        pumps = [form, *form.query("*")]
+        for _ in range(1000):  # each turn lets the fields' and the form's queues move on
+            if not any(pump.message_queue_size for pump in pumps):
+                break
+            await asyncio.sleep(0)
+        return form.data is not None and form.data != self._saved
 
     def _changed_on_disk(self) -> bool:
         """Whether the open preset's file is there and not as it was read or last saved here."""
@@ -65,22 +90,34 @@ class PresetSaving:
                      until_open=True)  # fmt: skip
 
     def action_save_as(self) -> None:
+        """A copy of the draft in another file (by default ``<file>-copy.yaml`` beside it), under a
+        name no listed preset has; the form goes on with the copy, the preset's own file is kept."""
         if self.draft_path is None or self._draft() is None:
             self.say(NO_PRESET, "warning")
             return
+        folder = self.save_folder if is_builtin(self.draft_path) else self.draft_path.parent
+        name = str(self._draft().get("name") or self.draft_path.stem)
+        copied, default = copy_target(name, self.draft_path.stem, folder, self.names_listed())
         self.push_screen(
-            PathScreen("Save preset as", self._save_as_default(), self.save_folder),
-            lambda path: path is not None and self._save_checked(path),
+            PathScreen("Save a copy of the preset as", default, self.save_folder),
+            lambda path: path is not None and self._save_copy(path, copied, default),
         )
 
-    def _save_as_default(self) -> Path:
-        """The file Save as offers: the preset's own, or for a built-in one (never written) its copy's."""
-        if is_builtin(self.draft_path):
-            return new_preset_path(self.draft_path.stem, self.save_folder)
-        return self.draft_path
+    def _save_copy(self, path: Path, copied: str, default: Path) -> None:
+        """Ctrl+O's file chosen: the draft saved there, renamed unless it is the preset's own
+        file or its name is no other listed preset's (two rows of the list shared one)."""
+        data, name = self._draft(), self._draft().get("name")
+        if path != self.draft_path and (not isinstance(name, str) or name in self.names_listed(replaced=path)):
+            data = {**data, "name": copy_name(copied, path, default, self.names_listed(replaced=path))}
+        self._save_checked(path, data)
 
-    def _save_checked(self, path: Path) -> None:
-        data = self._draft()
+    def names_listed(self, replaced: Path | None = None) -> set[str]:
+        """The names the presets list shows, but that of the file a copy replaces (``replaced``)."""
+        return names_taken(self.query_one(PresetsPane).presets, replaced)
+
+    def _save_checked(self, path: Path, data: dict | None = None) -> None:
+        """Write the draft (or ``data``, Ctrl+O's renamed copy of it) to ``path``, asking first when it has problems."""
+        data = self._draft() if data is None else data
         if not self.problems:
             self._write(path, data, template=self.draft_source)
             return
@@ -108,6 +145,8 @@ class PresetSaving:
         if then_open:
             self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
         else:
+            if data.get("name") != self._draft().get("name"):  # Ctrl+O's copy: the form shows its name
+                self.query_one("#form").rename(data["name"])
             self.draft_path = self.draft_source = path
             self.disk_stamp = file_stamp(path)
             self.modified = False

@@ -112,7 +112,7 @@ async def test_save_as_on_a_built_in_preset_offers_a_copy_and_never_writes_the_s
         await press_settled(pilot, "ctrl+u", *str(shipped / "quickstart"), "enter", "enter")
         refused = str(app.screen.query_one("#path-error").render())
         await press_settled(pilot, "ctrl+u", *"presets/qs", "enter")
-    assert offered == "presets/quickstart.yaml"
+    assert offered == "presets/quickstart-copy.yaml"
     assert f"path: {shipped / 'quickstart.yaml'} is a built-in preset, never written" in refused
     assert (shipped / "quickstart.yaml").read_text() == original
     assert (tmp_path / "presets" / "qs.yaml").is_file()

@@ -10,7 +10,7 @@ from textual.widgets import Input, TabbedContent
 from frictionlab.tui.screens import PathScreen
 from frictionlab.tui.widgets.presets import PresetsPane
 
-from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, sync, wait_until
+from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, press_settled, sync, wait_until
 
 
 @sync
@@ -41,6 +41,35 @@ async def test_esc_then_q_in_a_field_quits_and_never_types_the_q(folders, regist
             post_keys(app, ["escape", "q"])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
         assert not app.modified  # the q was never typed into the name
+
+
+@sync
+async def test_enter_esc_q_typed_fast_on_the_form_quits_and_never_types_the_q(folders, registry):
+    """In tmux: Enter, Esc, q typed together typed the q into the name: Esc found the form still
+    focused (its Focus message not yet handled), so it waited behind the q."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        post_keys(app, ["enter", "escape", "q"])
+        await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
+        assert app.query_one("#form").data["name"] == TINY["name"] and not app.modified
+
+
+@sync
+async def test_a_letter_esc_q_typed_fast_asks_before_the_edit_is_lost(folders, registry):
+    """In tmux: Enter, z, Esc, q typed together quit at once: the z was still on its way through
+    the form when q asked whether there were unsaved changes, and the edit was lost unasked."""
+    from frictionlab.tui.screens.dialogs import QuitUnsavedScreen
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        post_keys(app, ["enter", "z", "escape", "q"])
+        await wait_until(pilot, lambda: isinstance(app.screen, QuitUnsavedScreen) or not app.is_running, timeout=10.0)
+        asked = isinstance(app.screen, QuitUnsavedScreen)
+        await press_settled(pilot, "n")
+        kept = app.query_one("#form").data["name"]
+    assert asked and kept == TINY["name"] + "z"
 
 
 @sync

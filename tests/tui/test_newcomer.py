@@ -120,7 +120,7 @@ async def test_esc_leaves_a_field_so_that_q_quits(folders, registry):
         footer_in_field = screen_text(app).splitlines()[-1]
         await press_settled(pilot, "escape")
         left = app.focused.id
-        app.modified = False
+        await press_settled(pilot, "ctrl+s")  # saved: q quits without a question
         await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert typed == "smallx" and "Leave field" in footer_in_field

@@ -184,6 +184,29 @@ async def test_esc_leaves_a_sweeps_points_and_a_damaged_row_opened_after_shows_n
     assert not plotted
 
 
+@pytest.mark.long  # a TUI session over a sweep run first
+@sync
+async def test_a_run_opened_after_esc_leaves_a_sweeps_points_is_shown_without_them(folders, registry):
+    """In tmux at 80x24: Enter on a sweep, Esc, Enter on a plain run: the plot showed the run,
+    and under it the sweep's table of points stayed, as if they were the run's."""
+    (folders / "sweep.yaml").write_text(yaml.safe_dump({**SWEEP, "realizations": 3}, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    make_runs(folders, registry)
+    app = make_app(registry)
+    async with started(app) as pilot:
+        await press_settled(pilot, "f5")
+        names = [e.path.name for e in app.query_one(ResultsPane).runs]
+        await press_settled(pilot, *["down"] * names.index("sw"), "enter")
+        opened = app.query_one("#results-sweep").display
+        await press_settled(pilot, "escape", "home", *["down"] * names.index("seed1"), "space")
+        beside = app.query_one("#results-sweep").display  # Space adds a run beside the points
+        await press_settled(pilot, "enter")
+        shown, pane, text = app.query_one("#results-sweep").display, app.query_one(ResultsPane), screen_text(app)
+    assert opened and beside
+    assert not shown and pane.open_sweep is None and "hurst" not in text
+    assert [entry.path.name for entry in pane.overlay] == ["seed1"]
+
+
 @pytest.mark.long  # a sweep run first, then a TUI session
 @sync
 async def test_esc_over_a_sweeps_points_closes_the_keys_panel_before_it_goes_back(folders, registry):

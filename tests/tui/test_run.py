@@ -71,6 +71,26 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
 
 
 @sync
+async def test_c_on_another_tab_while_a_run_goes_says_where_it_cancels_and_cancels_nothing(folders, registry):
+    """In tmux: Ctrl+R, F3, c: nothing happened and nothing said so (c cancels on the Run tab)."""
+    big = merge(TINY, {"name": "long", "realizations": 100_000})
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.last_snapshot is not None)
+        said = {}
+        for tab in ("f3", "f2", "f5"):
+            await press_settled(pilot, tab, "c")
+            said[tab] = status_text(app)
+        going = not app.followed.cancelling
+        await press_settled(pilot, "f4", "c")  # the run's own c: cancels it
+        await wait_until(pilot, lambda: app.last_outcome is not None)
+    assert all(text.startswith("c cancels the run on the Run tab (F4)") for text in said.values()), said
+    assert going and app.last_outcome.status == "interrupted"
+
+
+@sync
 async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_realization(folders, registry):
     from ..test_load_progress import LONG_LOADS
 

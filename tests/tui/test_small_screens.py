@@ -156,3 +156,55 @@ async def test_the_keys_panel_at_30x8_fits_the_screen_says_how_to_close_it_and_c
     assert inside and keys_shown, panel.region
     assert first == "Esc closes; F1: next page" and last == "Esc or F1 closes"
     assert closed_by_esc and closed_by_f1 and closed_by_question_mark
+
+
+@pytest.mark.parametrize("size", [(30, 8), (59, 20)])
+@sync
+async def test_the_keys_panel_under_60_columns_covers_every_row_and_gives_the_footer_back(folders, registry, size):
+    """Under 60 columns the panel split the screen at its whole width: the footer kept one column,
+    its ⏎ drawn in the panel's last row in place of the panel's border."""
+    app = make_app(registry)
+    async with app.run_test(size=size) as pilot:
+        await press_settled(pilot, "f1")
+        shown = screen_text(app).splitlines()
+        await press_settled(pilot, "escape")
+        footer = screen_text(app).splitlines()[-1]
+    assert all(line.startswith("▏") for line in shown), shown
+    assert footer.strip().startswith("⏎ Open"), footer
+
+
+@sync
+async def test_a_dialog_taller_than_a_30x8_screen_stays_on_it_and_the_arrows_bring_its_answers(folders, registry):
+    """At 30x8 a question (save with problems?) ran past the screen's bottom edge, its answers
+    (y, n, Esc) out of reach below it, and no key scrolled it."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "enter", "ctrl+u", *"bad name", "escape", "ctrl+s")
+        dialog = app.screen.query_one(".dialog")
+        inside = dialog.region.y >= 0 and dialog.region.bottom <= 7  # the footer takes the last row
+        before = screen_text(app)
+        await press_settled(pilot, *["down"] * 30)
+        after = screen_text(app)
+    assert inside, dialog.region
+    assert "n / Esc: no" not in before and "n / Esc: no" in after
+
+
+@sync
+async def test_the_new_dialog_at_30x8_shows_its_values_not_only_its_labels(folders, registry):
+    """At 30x8 its labels kept 20 of the dialog's 26 columns: the name read 'scene', the file 'prese'."""
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "n")
+        text = screen_text(app)
+    assert "my-scene" in text and "quickstart" in text, text
+
+
+@sync
+async def test_the_form_at_30x8_keeps_rows_beside_the_help_and_problems(folders, registry):
+    """At 30x8 the field's help and the problems took every row: the form showed none of its
+    fields, Enter went into a name that could not be seen."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "enter")
+        rows, text = app.query_one("#form").region.height, screen_text(app)
+    assert rows >= 2 and any(line.startswith("name") for line in text.splitlines()), text

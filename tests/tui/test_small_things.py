@@ -100,7 +100,7 @@ async def test_q_quits_outside_a_text_field_and_ctrl_c_says_how_in_the_status_li
         said_in_field = status_text(app)
         await press_settled(pilot, "f2", "ctrl+c")
         said, toasts = status_text(app), len(app.query("Toast"))
-        app.modified = False
+        await press_settled(pilot, "ctrl+s")  # saved: q quits without a question
         await press_settled(pilot, "q")
         quit_by_q = not app.is_running
     assert typed == "smallq"  # and typed at the end of the name: the cursor starts there
@@ -191,7 +191,7 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
             pages.append(screen_text(app))
         hidden = not app.screen.query("HelpPanel")
     assert len(pages) >= 2 and hidden  # more than one page at 80x24, then hidden
-    assert "Save as" not in pages[0] and any("Save as" in page for page in pages)
+    assert "Save a copy" not in pages[0] and any("Save a copy" in page for page in pages)
 
 
 @pytest.mark.parametrize("size", [SIZE, (60, 20)])  # at 60x20 its 45 % of the width cut 'a = 1.1474 [1.0319,'

@@ -11,13 +11,14 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.content import Content
 from textual.screen import ModalScreen
-from textual.widgets import Button, Footer, Input, Label, Select, Static
+from textual.widgets import Button, Input, Label, Select, Static
 
 from ...errors import shown_name
 from ...io.inputs import expand_user
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
 from ..folders import is_builtin, made_when_saved, new_preset_path
+from ..widgets.footer import KeysFooter
 from ..widgets.keyinput import KeyInput
 
 
@@ -30,7 +31,17 @@ class Dialog(ModalScreen):
 
     Keys typed before it is mounted (n then a name, read together) wait for it (``hold``): they
     went to the screen, no field of it focused yet, and were lost. They are answered in the app's
-    queue, in the order typed, once its first field has the focus."""
+    queue, in the order typed, once its first field has the focus.
+
+    Taller than the screen (30x8), it scrolls with the arrows: nothing in it takes them, and its
+    answers (the hint, last) were out of reach below the screen's edge."""
+
+    BINDINGS = [
+        Binding("down", "scroll_dialog(1)", show=False),
+        Binding("up", "scroll_dialog(-1)", show=False),
+        Binding("pagedown", "scroll_dialog(5)", show=False),
+        Binding("pageup", "scroll_dialog(-5)", show=False),
+    ]
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -65,10 +76,13 @@ class Dialog(ModalScreen):
         if status and str(status.first().render()) == WAIT_FOR_DIALOG:
             self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
 
+    def action_scroll_dialog(self, lines: int) -> None:
+        self.query_one(".dialog").scroll_relative(y=lines, animate=False)
+
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog"):
             yield from self.body()
-        yield Footer()
+        yield KeysFooter()  # its keys drawn closer together where the width is short
 
     def body(self) -> ComposeResult:
         raise NotImplementedError

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from textual.app import ComposeResult
-from textual.containers import Vertical
+from textual.containers import Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import Static
 
@@ -27,7 +27,8 @@ class EditPane(Vertical):
         yield PathLine(id="edit-title")
         yield PresetForm(self.registry, id="form")
         yield Static("", id="field-help")
-        yield Static("", id="problems")
+        with VerticalScroll(id="problems-box", can_focus=False):
+            yield Static("", id="problems")
 
     def show_title(self, path: Path | None, modified: bool, problems: list[str]) -> None:
         title = self.query_one("#edit-title", PathLine)

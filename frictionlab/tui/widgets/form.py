@@ -228,6 +228,12 @@ class PresetForm(VerticalScroll):
         if slot in KINDS and len(path) > 2 and get_path(data, (slot, "name")) is MISSING:
             set_path(data, (slot, "name"), default_plugin_name(slot), replace_values=True)
 
+    def rename(self, name: str) -> None:
+        """The draft named ``name`` (a copy saved under it), its field showing it."""
+        spec = next(spec for spec in self._specs.values() if spec.path == ("name",))
+        self.query_one(f"#{spec.widget_id}", Input).value = name  # not typed: Changed stores nothing
+        self._store(spec, name)
+
     def _store(self, spec: FieldSpec, value) -> None:
         unsaid = get_path(self._loaded, spec.path) is MISSING
         if spec.kind in ("bool", "choice") and unsaid and value == spec.default:
@@ -375,11 +381,14 @@ class PresetForm(VerticalScroll):
         field.scroll_visible()
 
     def check_action(self, action: str, parameters) -> bool:
-        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies)."""
+        """Enter goes into a field from the form; Esc leaves one (the footer shows the one that applies).
+        The screen's focus, not ``has_focus``: that follows once the Focus message is handled, and Enter,
+        Esc, q typed fast found the form still focused on Esc, which then came late, after the q typed."""
+        focused = self.screen.focused is self
         if action == "edit_field":
-            return self.has_focus and self.data is not None
+            return focused and self.data is not None
         if action == "leave_field":
-            return not self.has_focus
+            return not focused
         return True
 
     def action_edit_field(self) -> None:

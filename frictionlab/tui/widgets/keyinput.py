@@ -34,6 +34,15 @@ class KeyInput(Input):
 
     def _on_paste(self, event: events.Paste) -> None:
         self.typed = True  # Textual then calls Input's own, which pastes
+        lines = event.text.splitlines()
+        if len(lines) > 1:  # Input's own keeps the first line, the rest dropped unsaid: a paragraph, joined
+            event.prevent_default()
+            event.stop()
+            text = " ".join(line.strip() for line in lines if line.strip())
+            if self.selection.is_empty:
+                self.insert_text_at_cursor(text)
+            else:
+                self.replace(text, *self.selection)
 
     def action_copy(self) -> None:
         """Ctrl+C copies here, and says (as it does elsewhere) what quits."""

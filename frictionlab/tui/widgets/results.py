@@ -247,6 +247,8 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 else:
                     self._show_sweep(entry)
                 return
+            if not overlay:  # Enter: this run alone (Space adds it beside the sweep's points)
+                self._close_sweep()
         hidden = None
         if overlay:
             paths = [e.path for e in self.overlay]

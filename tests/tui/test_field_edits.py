@@ -1,0 +1,48 @@
+"""What a form field does with what is typed or pasted into it, as a user in a terminal does it."""
+
+from textual import events
+from textual.widgets import Input
+
+from .conftest import SIZE, make_app, open_first_preset, sync, wait_until
+
+
+@sync
+async def test_a_paste_of_several_lines_is_kept_whole_on_the_fields_one_line(folders, registry):
+    """Textual's Input kept a paste's first line only: a description pasted as a paragraph lost
+    the rest of it, and nothing said so."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        field = app.query_one("#field--description", Input)
+        field.focus()
+        await pilot.pause()
+        field.post_message(events.Paste("Rough line,\n  pressed flat\r\n\nin a second."))
+        await wait_until(pilot, lambda: form.data.get("description") is not None, timeout=10.0)
+        await pilot.pause()
+        shown, kept = field.value, form.data["description"]
+    assert shown == kept == "Rough line, pressed flat in a second."
+
+
+@sync
+async def test_problems_past_the_panels_six_rows_are_reached_with_the_wheel(folders, registry):
+    """A preset with six problems showed five under the form and cut the sixth, with no scroll
+    bar nor wheel to reach it."""
+    import yaml
+    from textual.geometry import Region
+
+    from .conftest import screen_text
+    from .test_results import wheel_read
+
+    bad = {"name": 5, "seed": -1, "realizations": "many", "spectrum": 3, "solver": {"name": "nosuch"},
+           "loading": {"start": 1, "stop": 0.5, "steps": 1e9}}  # fmt: skip
+    (folders / "presets" / "bad.yaml").write_text(yaml.safe_dump(bad))
+    app = make_app(registry, preset="presets/bad.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        rows = screen_text(app).splitlines()
+        top = next(i for i, row in enumerate(rows) if "problems (as frictionlab validate says)" in row)
+        last = "".join(app.problems[-1].split())
+        shown_first = last in "".join(screen_text(app).split())
+        seen = await wheel_read(pilot, Region(0, top, SIZE[0], SIZE[1] - 2 - top))  # above the status line and footer
+    assert len(app.problems) >= 6 and not shown_first
+    assert any(last in rows for rows in seen), (last, seen[-1])
