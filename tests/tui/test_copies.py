@@ -18,6 +18,15 @@ def name_in(path) -> str:
     return yaml.safe_load(path.read_text())["name"]
 
 
+async def save_a_copy(pilot, app, file_name: str) -> str:
+    """Ctrl+O, Enter on the file offered, until the form edits ``file_name``: the file offered."""
+    await press_settled(pilot, "ctrl+o")
+    offered = app.screen.query_one(Input).value
+    await press_settled(pilot, "enter")
+    await wait_until(pilot, lambda: app.draft_path.name == file_name)
+    return offered
+
+
 @sync
 async def test_ctrl_o_saves_a_copy_under_a_name_of_its_own_and_keeps_the_preset(folders, registry):
     """Ctrl+O offered the preset's own file and kept its name: saved elsewhere, two rows of the
@@ -25,10 +34,7 @@ async def test_ctrl_o_saves_a_copy_under_a_name_of_its_own_and_keeps_the_preset(
     before = (folders / "presets" / "tiny.yaml").read_text()
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
-        await press_settled(pilot, "ctrl+o")
-        offered = app.screen.query_one(Input).value
-        await press_settled(pilot, "enter")
-        await wait_until(pilot, lambda: app.draft_path.name == "tiny-copy.yaml")
+        offered = await save_a_copy(pilot, app, "tiny-copy.yaml")
         await pilot.pause()
         shown, modified, names = app.query_one("#form").data["name"], app.modified, listed_names(app)
         field = app.query_one("#form").query_one("#field--name", Input).value
@@ -44,10 +50,7 @@ async def test_ctrl_o_offers_no_file_that_exists_and_no_name_that_is_listed(fold
     (folders / "presets" / "x.yaml").write_text(yaml.safe_dump(merge(TINY, {"name": "small-copy-2"})))
     app = make_app(registry, preset="presets/tiny.yaml")
     async with started(app) as pilot:
-        await press_settled(pilot, "ctrl+o")
-        offered = app.screen.query_one(Input).value
-        await press_settled(pilot, "enter")
-        await wait_until(pilot, lambda: app.draft_path.name == "tiny-copy-3.yaml")
+        offered = await save_a_copy(pilot, app, "tiny-copy-3.yaml")
     assert offered == "presets/tiny-copy-3.yaml"
     assert name_in(folders / "presets" / "tiny-copy-3.yaml") == "small-copy-3"
     assert name_in(folders / "presets" / "tiny-copy.yaml") == "other"

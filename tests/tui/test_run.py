@@ -46,11 +46,16 @@ async def test_a_run_shows_the_headless_coefficients(folders, registry):
     assert runs_listed == [out_dir.name]
 
 
-@sync
-async def test_cancel_keeps_and_writes_what_finished(folders, registry):
+def long_run_app(folders, registry):
+    """The app on a preset of 100000 realizations: a run that goes on until cancelled."""
     big = merge(TINY, {"name": "long", "realizations": 100_000})
     (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
-    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    return make_app(registry, preset="presets/long.yaml", workers=1)
+
+
+@sync
+async def test_cancel_keeps_and_writes_what_finished(folders, registry):
+    app = long_run_app(folders, registry)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
@@ -73,9 +78,7 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
 @sync
 async def test_c_on_another_tab_while_a_run_goes_says_where_it_cancels_and_cancels_nothing(folders, registry):
     """In tmux: Ctrl+R, F3, c: nothing happened and nothing said so (c cancels on the Run tab)."""
-    big = merge(TINY, {"name": "long", "realizations": 100_000})
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(big))
-    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    app = long_run_app(folders, registry)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None)
