@@ -123,6 +123,7 @@ def options_from_args(args) -> StudyOptions:
                                f"Got {short_repr(args.axes)} instead.")  # fmt: skip
     if not 0 < args.target < 1:
         raise FrictionlabError(f"--target must be > 0 and < 1 (a relative error). Got {args.target} instead.")
+    _refuse_unused_options(args, axes)
     return StudyOptions(
         reference=args.reference,
         axes=axes,
@@ -139,6 +140,28 @@ def options_from_args(args) -> StudyOptions:
         reference_grid=_numbers("--reference-grid", args.reference_grid, high=MAX_GRID_FACTOR),
         repeats=_between("--repeats", args.repeats, 1, MAX_REPEATS),
     )
+
+
+COMPARED = ("solver", "tolerance")  # the axes (and --reference-grid) that run the reference solver
+AXIS_OPTIONS = {  # an option given, and the axes it changes: none of them run, it did nothing, unsaid
+    "grid_factors": ("grid",),
+    "grid_realizations": ("grid", "steps"),
+    **dict.fromkeys(("points", "compare_realizations", "compare_steps", "tolerances", "reference"), COMPARED),
+}
+
+
+def _refuse_unused_options(args, axes: tuple[str, ...]) -> None:
+    """Refuse an option set away from its default whose axes ``axes`` leave out: the study ran
+    without it and said nothing (``--axes grid --tolerances 1e-4``)."""
+    for name, used_by in AXIS_OPTIONS.items():
+        if getattr(args, name) == DEFAULTS[name] or set(used_by) & set(axes):
+            continue
+        if used_by == COMPARED and args.reference_grid:  # the reference's own grid runs with them
+            continue
+        option = "--" + name.replace("_", "-")
+        which = f"the {' and '.join(used_by)} {'axes' if len(used_by) > 1 else 'axis'}"
+        raise FrictionlabError(f"{option} changes {which}, which --axes {','.join(axes)} leaves out: add "
+                               f"{' or '.join(used_by)} to --axes, or drop {option}")  # fmt: skip
 
 
 def command_line(args) -> str:

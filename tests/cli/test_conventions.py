@@ -185,7 +185,7 @@ def test_colour_on_a_terminal_only_and_never_with_no_color(cli):
 
 
 def test_study_json_holds_the_recommendation_and_one_row_per_setting(tmp_path, cli, figure_stubbed):
-    done = cli("study", "quickstart", "--axes", "realizations", "--grid-realizations", "4", "--repeats", "1",
+    done = cli("study", "quickstart", "--axes", "realizations", "--repeats", "1",
                    "--json", "--quiet", "--out", tmp_path / "study")  # fmt: skip
     assert done.returncode == 0, done.stderr
     out = json.loads(done.stdout)

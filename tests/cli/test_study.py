@@ -58,6 +58,14 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--repeats", "1000000000"], "--repeats must be a whole number from 1 to 100. Got 1000000000 instead."),
         (["--repeats", "0"], "--repeats must be a whole number from 1 to 100. Got 0 instead."),
         (["--set", "spectrum.params.hurst=7"], "spectrum.params.hurst: must be <= 1.5"),
+        # an option whose axes are left out did nothing, unsaid
+        (["--axes", "grid", "--tolerances", "1e-4"], "--tolerances changes the solver and tolerance axes, which --axes "
+                                                     "grid leaves out: add solver or tolerance to --axes, or drop --tolerances"),
+        (["--axes", "realizations", "--grid-factors", "1,2"], "--grid-factors changes the grid axis, which --axes "
+                                                               "realizations leaves out: add grid to --axes"),
+        (["--axes", "realizations", "--grid-realizations", "5"], "--grid-realizations changes the grid and steps axes"),
+        (["--axes", "steps", "--points", "64"], "--points changes the solver and tolerance axes"),
+        (["--axes", "grid", "--compare-realizations", "3"], "--compare-realizations changes the solver and tolerance"),
     ],
 )
 def test_cli_usage_errors_name_the_option(tmp_path, capsys, args, message):
@@ -90,7 +98,7 @@ def test_cli_bad_preset_file(tmp_path, capsys):
 
 # ------------------------------------------------------------------ where the study writes
 
-QUICK = ["--axes", "realizations", "--grid-realizations", "3", "--quiet"]
+QUICK = ["--axes", "realizations", "--quiet"]
 
 
 def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_folders, figure_stubbed):
@@ -176,7 +184,7 @@ def test_a_sweep_preset_is_studied_at_its_base_values_and_the_user_told(tmp_path
     swept = {**TINY, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}}
     for data, warned in ((swept, True), ({**swept, "sweep": None}, False)):
         preset, out = write(tmp_path, data), tmp_path / f"study-{warned}"
-        assert main(["study", str(preset), "--axes", "realizations", "--grid-realizations", "3", "--out", str(out)]) == 0
+        assert main(["study", str(preset), "--axes", "realizations", "--out", str(out)]) == 0
         err = capsys.readouterr().err
         assert ("the preset's sweep is not studied" in err) is warned
         assert "H = 0.8" in (out / "study.md").read_text()  # the base value, not a point of the sweep
@@ -243,7 +251,7 @@ def test_a_full_disk_says_so_plainly_and_how_to_write_the_study_once_there_is_ro
 
     monkeypatch.setattr(outputs, "atomic_write", md_does_not_fit)
     out = tmp_path / "o"
-    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--compare-steps", "5",
+    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps",
             "--quiet"]  # fmt: skip
     assert main([*args, "--json"]) == ExitCode.RUNTIME_FAILURE
     captured = capsys.readouterr()
@@ -281,7 +289,7 @@ def test_a_study_whose_folder_cannot_be_written_keeps_its_files_elsewhere_and_sa
         write_file(path, write, *args, **keys)
 
     monkeypatch.setattr(outputs, "atomic_write", out_is_full)
-    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--compare-steps", "5", "--quiet"]
+    args = ["study", str(write(tmp_path, TINY)), "--out", str(out), "--axes", "steps", "--quiet"]
     assert main(args) == ExitCode.RUNTIME_FAILURE
     err = capsys.readouterr().err
     [spare] = spare_disk.iterdir()
