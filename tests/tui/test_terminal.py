@@ -105,9 +105,10 @@ def test_a_sigterm_while_the_keys_are_held_ends_as_terminated_not_a_traceback(mo
     assert ended.value.code == 143 and capsys.readouterr().err == "terminated\n"
 
 
-def _spawned_tui(tmp_path):
-    """``frictionlab tui`` in a pseudo-terminal in line mode with echo, as a login shell leaves it:
-    (process, keyboard end, program end, the program end's attributes before it started)."""
+def _spawned_tui(tmp_path, python_args=("-m", "frictionlab", "tui")):
+    """``frictionlab tui`` (or Python with ``python_args``) in a pseudo-terminal in line mode with
+    echo, as a login shell leaves it: (process, keyboard end, program end, the program end's
+    attributes before it started)."""
     import subprocess
     import sys
 
@@ -115,9 +116,18 @@ def _spawned_tui(tmp_path):
     os.set_blocking(keyboard, False)
     before = termios.tcgetattr(program)
     env = {**os.environ, "TERM": "xterm-256color"}
-    process = subprocess.Popen([sys.executable, "-m", "frictionlab", "tui"], stdin=program, stdout=program,
+    process = subprocess.Popen([sys.executable, *python_args], stdin=program, stdout=program,
                                stderr=program, cwd=tmp_path, env=env, start_new_session=True)  # fmt: skip
     return process, keyboard, program, before
+
+
+def _ended(process, keyboard, program) -> None:
+    """The spawned process ended (killed if it still runs) and its pseudo-terminal closed."""
+    if process.poll() is None:
+        process.kill()
+    process.wait()
+    os.close(keyboard)
+    os.close(program)
 
 
 def _wait_reading(process, keyboard, until, timeout=60.0) -> bytes:
@@ -159,11 +169,7 @@ def test_sigterm_to_frictionlab_tui_gives_the_terminal_back(tmp_path, when, sign
         written += _wait_reading(process, keyboard, lambda _: not select.select([keyboard], [], [], 0.2)[0])
         after = termios.tcgetattr(program)
     finally:
-        if process.poll() is None:
-            process.kill()
-        process.wait()
-        os.close(keyboard)
-        os.close(program)
+        _ended(process, keyboard, program)
     assert process.returncode == code
     assert after == before
     assert b"Traceback" not in written and b"Error" not in written
@@ -177,8 +183,6 @@ def test_a_hangup_ends_the_tui_even_when_its_exit_would_wait_for_ever(tmp_path):
     exit is made to hang here; the hangup ends the process all the same, with 129, within
     HANGUP_GRACE_SECONDS."""
     import signal
-    import subprocess
-    import sys
     import time
 
     from frictionlab.tui import HANGUP_GRACE_SECONDS
@@ -191,10 +195,7 @@ def test_a_hangup_ends_the_tui_even_when_its_exit_would_wait_for_ever(tmp_path):
         "from frictionlab.__main__ import program\n"
         "program()\n"
     )
-    keyboard, program = pty.openpty()
-    os.set_blocking(keyboard, False)
-    process = subprocess.Popen([sys.executable, "-c", script], stdin=program, stdout=program, stderr=program,
-                               cwd=tmp_path, env={**os.environ, "TERM": "xterm-256color"}, start_new_session=True)  # fmt: skip
+    process, keyboard, program, _ = _spawned_tui(tmp_path, ("-c", script))
     try:
         _wait_reading(process, keyboard, lambda written: b"\x1b[?1049h" in written)  # the app has drawn
         sent = time.monotonic()
@@ -202,10 +203,6 @@ def test_a_hangup_ends_the_tui_even_when_its_exit_would_wait_for_ever(tmp_path):
         _wait_reading(process, keyboard, lambda _: process.poll() is not None, timeout=HANGUP_GRACE_SECONDS + 20)
         took = time.monotonic() - sent
     finally:
-        if process.poll() is None:
-            process.kill()
-        process.wait()
-        os.close(keyboard)
-        os.close(program)
+        _ended(process, keyboard, program)
     assert process.returncode == 129
     assert took >= HANGUP_GRACE_SECONDS * 0.9  # its own exit was given its time first
