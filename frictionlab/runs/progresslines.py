@@ -27,11 +27,13 @@ def _floats(values) -> list | None:
     return None if values is None else np.asarray(values, float).tolist()
 
 
-def _whole(value, default: int = 0) -> int:
+def whole_or(value, default: int = 0) -> int:
+    """``value`` if it is a whole number >= 0 (as a log read back holds it), else ``default``."""
     return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else default
 
 
-def _number(value) -> float:
+def number_or_nan(value) -> float:
+    """``value`` as a float if it is a number (not true or false), else NaN."""
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
 
 
@@ -96,17 +98,17 @@ def _outcome(event: dict, steps: int, count: int) -> dict | None:
     if curves["xi"] is None or curves["contact_count"] is None:
         return None
     curves = {name: None if curve is None else curve / count for name, curve in curves.items()}
-    return dict(**curves, force_unit=_number(event.get("force_unit")),
-                slope_rms_line=_number(event.get("slope_rms_line")), points=_whole(event.get("points")))  # fmt: skip
+    return dict(**curves, force_unit=number_or_nan(event.get("force_unit")),
+                slope_rms_line=number_or_nan(event.get("slope_rms_line")), points=whole_or(event.get("points")))  # fmt: skip
 
 
 def result_of(event: dict, steps: int) -> RealizationResult | None:
     """The RealizationResult a ``realization`` event tells, None if it does not hold one
     (a curve of another length than the run's load steps, a field of the wrong kind)."""
-    index = _whole(event.get("index"), -1)
+    index = whole_or(event.get("index"), -1)
     if index < 0:
         return None
-    seconds = _number(event.get("seconds"))
+    seconds = number_or_nan(event.get("seconds"))
     if event.get("ok") is not True:
         return RealizationResult(index=index, seconds=seconds, error=str(event.get("error") or "failed"))
     outcome = _outcome(event, steps, 1)
@@ -122,10 +124,10 @@ def batch_results(event: dict, steps: int) -> list[RealizationResult] | None:
         return None
     ok = sum(str(i) not in errors for i in index)
     outcome = _outcome(event, steps, ok) if ok else {}
-    if outcome is None or (ok and _whole(event.get("ok")) != ok):
+    if outcome is None or (ok and whole_or(event.get("ok")) != ok):
         return None
-    return [RealizationResult(index=i, seconds=_number(s), error=str(errors[str(i)])) if str(i) in errors
-            else RealizationResult(index=i, seconds=_number(s), **outcome) for i, s in zip(index, seconds)]  # fmt: skip
+    return [RealizationResult(index=i, seconds=number_or_nan(s), error=str(errors[str(i)])) if str(i) in errors
+            else RealizationResult(index=i, seconds=number_or_nan(s), **outcome) for i, s in zip(index, seconds)]  # fmt: skip
 
 
 # ------------------------------------------------------------------ the size of a line

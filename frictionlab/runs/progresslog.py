@@ -28,7 +28,7 @@ from pydantic import Field, ValidationError, model_validator
 
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
-from .progresslines import MAX_BATCH, Batch, _number, _whole, batch_results, fitted_line, result_of
+from .progresslines import MAX_BATCH, Batch, batch_results, fitted_line, number_or_nan, result_of, whole_or
 from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"
@@ -419,7 +419,7 @@ class Follower:
 
     def _realizations(self, event: dict) -> None:
         """Tell each realization of ``event``, counted up to its ``done``; none of another run's."""
-        results, done = self._results(event), _whole(event.get("done"), self.done)
+        results, done = self._results(event), whole_or(event.get("done"), self.done)
         if not results or done > self.total or done < len(results):  # not realizations of this run
             return
         end = self._event_time
@@ -439,7 +439,7 @@ class Follower:
             self.info, self.finished, self._resuming = None, None, None
         for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
-            at = _number(event.get("time")) if math.isfinite(_number(event.get("time"))) else None
+            at = number_or_nan(event.get("time")) if math.isfinite(number_or_nan(event.get("time"))) else None
             self._event_time = at
             try:
                 if self._resuming is not None and kind in REALIZATIONS and event.get("restored") is True:
@@ -451,11 +451,11 @@ class Follower:
                 if self._resuming is not None:  # the restored ones are over (some were not readable)
                     self._start(replace(self._resuming, restored=tuple(self._restored)))
                 if kind == "started":
-                    self.pid = _whole(event.get("pid")) or None
-                    self.total = _whole(event.get("total"))
+                    self.pid = whole_or(event.get("pid")) or None
+                    self.total = whole_or(event.get("total"))
                     self.done, self.finished, self.info = 0, None, None
-                    info = RunInfo(scene=self.scene, total=self.total, workers=_whole(event.get("workers"), 1),
-                                   executor=str(event.get("executor")), resumed=_whole(event.get("resumed")))  # fmt: skip
+                    info = RunInfo(scene=self.scene, total=self.total, workers=whole_or(event.get("workers"), 1),
+                                   executor=str(event.get("executor")), resumed=whole_or(event.get("resumed")))  # fmt: skip
                     if info.resumed:
                         self._resuming, self._restored = info, []
                     else:
@@ -463,20 +463,20 @@ class Follower:
                 elif kind in REALIZATIONS and self.info is not None:
                     self._realizations(event)
                 elif kind == "load" and self.info is not None:
-                    self._tell("load_done", run=self.info, index=_whole(event.get("index")),
-                               done=_whole(event.get("done")), total=_whole(event.get("total")))  # fmt: skip
+                    self._tell("load_done", run=self.info, index=whole_or(event.get("index")),
+                               done=whole_or(event.get("done")), total=whole_or(event.get("total")))  # fmt: skip
                 elif kind == "iteration" and self.info is not None:
-                    self._tell("iteration_done", run=self.info, index=_whole(event.get("index")), load=_whole(event.get("load")),
-                               iteration=_whole(event.get("iteration")), residual=_number(event.get("residual")))  # fmt: skip
+                    self._tell("iteration_done", run=self.info, index=whole_or(event.get("index")), load=whole_or(event.get("load")),
+                               iteration=whole_or(event.get("iteration")), residual=number_or_nan(event.get("residual")))  # fmt: skip
                 elif kind == "finished":
                     error = event.get("error")
-                    self.finished = Finished(str(event.get("status")), _whole(event.get("done")),
-                                             _whole(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
+                    self.finished = Finished(str(event.get("status")), whole_or(event.get("done")),
+                                             whole_or(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
                     if self.info is not None:  # as the run told its own: a bar ends, a last snapshot goes out
                         self._tell("run_finished", run=self.info, outcome=self.finished)
                 elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
-                                             _whole(event.get("exit_code"), 1))  # fmt: skip
+                                             whole_or(event.get("exit_code"), 1))  # fmt: skip
             finally:
                 self._event_time, self._told_at = None, self._told_at if at is None else at
         return len(events)

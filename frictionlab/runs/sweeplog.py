@@ -18,7 +18,8 @@ from pathlib import Path
 
 from ..errors import RunFolderError
 from ..plugin.listeners import SweepListener
-from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf, _number, _whole
+from .progresslines import number_or_nan, whole_or
+from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf
 from .runfolder import checked
 from .sweep import UNFINISHED, PointResult, Sweep, SweepPoint, point_folder
 from .sweeprecord import PointRecord
@@ -97,11 +98,11 @@ class SweepFollower:
         for event in self.awaited.after(events, self.reader.restarted):
             kind = event["event"]
             if kind == "sweep_started":
-                self.pid = _whole(event.get("pid")) or None
+                self.pid = whole_or(event.get("pid")) or None
                 self.finished, self.point, self.run, self.done = None, None, None, 0
                 self._tell("sweep_started", self.sweep)
             elif kind == "point_started":
-                point = self._points.get(_whole(event.get("number"), -1))
+                point = self._points.get(whole_or(event.get("number"), -1))
                 if point is not None:
                     self.point, self.run = point, None
                     self._tell("point_started", self.sweep, point)
@@ -109,12 +110,12 @@ class SweepFollower:
                 self._point_finished(event)
             elif kind == "sweep_finished":
                 self._finish_point_run()
-                self.finished = Finished(str(event.get("status")), _whole(event.get("done")), _whole(event.get("total")))
+                self.finished = Finished(str(event.get("status")), whole_or(event.get("done")), whole_or(event.get("total")))
                 self.point = None
             elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                 self._finish_point_run()
                 self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
-                                         _whole(event.get("exit_code"), 1))  # fmt: skip
+                                         whole_or(event.get("exit_code"), 1))  # fmt: skip
         if self.point is not None and self.finished is None:
             if self.run is None:  # made for the point running now only: earlier points are not replayed
                 listeners = [each for listener in self.listeners for each in listener.run_listeners(self.point)]
@@ -128,7 +129,7 @@ class SweepFollower:
             self.run = None
 
     def _point_finished(self, event: dict) -> None:
-        point = self._points.get(_whole(event.get("number"), -1))
+        point = self._points.get(whole_or(event.get("number"), -1))
         row = event.get("row")
         if point is None or not isinstance(row, dict):
             return
@@ -141,7 +142,7 @@ class SweepFollower:
             self.point = None
         values = record.model_dump(include=set(PointRecord.model_fields))
         error = row.get("error") if isinstance(row.get("error"), str) else None
-        elapsed = _number(row.get("elapsed_s"))
+        elapsed = number_or_nan(row.get("elapsed_s"))
         values.update(elapsed_s=elapsed if math.isfinite(elapsed) else None)
         result = PointResult(point, record.status, point_folder(self.folder, point), error=error, recorded=values)
         self.done += 1
