@@ -60,14 +60,18 @@ def head_text(fh, encoding: str = "utf-8") -> str:
     ``Value units: nm`` past 4 kB, and the numbers were taken in the preset's unit), up to HEADER_MOST."""
     fh.seek(0)
     head = fh.read(HEADER_BYTES)
-    while len(head) < HEADER_MOST and len(header_lines(text := head.decode(encoding, errors="replace"))) == \
-            len(text.splitlines()[:-1]):  # fmt: skip
+    while len(head) < HEADER_MOST and not _numbers_begun(head.decode(encoding, errors="replace")):
         more = fh.read(len(head))  # twice as much each time
         if not more:
             break
         head += more
     fh.seek(0)
     return head.decode(encoding, errors="replace")
+
+
+def _numbers_begun(text: str) -> bool:
+    """Whether a whole line of ``text`` starts with a number: its header has ended."""
+    return any(NUMBERS.match(line) for line in text.splitlines()[:-1])
 
 
 def header_lines(text: str) -> list[str]:
