@@ -227,7 +227,7 @@ def _kept_elsewhere(study, out_dir, text: str, args, exc: OSError) -> None:
 def _refuse_nothing_to_run(study, axes: tuple[str, ...]) -> None:
     """Refuse axes that all need a reference solver where there is none: the study ran nothing,
     wrote a study.md of notes, and said 'no axis measured enough' with exit code 0."""
-    if study.reference_choice is not None or not set(axes) <= {"solver", "tolerance"}:
+    if study.reference_choice is not None or not set(axes) <= set(COMPARED):
         return
     why = next((n.split(": skipped: ", 1)[1] for n in study.notes if ": skipped: " in n), "there is no reference solver")
     raise FrictionlabError(f"--axes {','.join(axes)}: nothing would run: {'it needs' if len(axes) == 1 else 'they need'} "
