@@ -21,6 +21,8 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
+from ..io.values import number_or_nan
+
 NAN2 = (math.nan, math.nan)
 
 BOOTSTRAP_BLOCK_BYTES = 64 * 2**20
@@ -58,23 +60,20 @@ class LogFit:
     def from_dict(cls, data: dict) -> LogFit:
         """The fit of a summary.json (null read as NaN); KeyError without a or b."""
 
-        def number(value) -> float:
-            return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
-
         def interval(value) -> tuple[float, float]:
-            return (number(value[0]), number(value[1])) if isinstance(value, list | tuple) and len(value) == 2 else NAN2
+            return (number_or_nan(value[0]), number_or_nan(value[1])) if isinstance(value, list | tuple) and len(value) == 2 else NAN2
 
         return cls(
-            a=number(data["a"]),
-            b=number(data["b"]),
-            a_se=number(data.get("a_se")),
-            b_se=number(data.get("b_se")),
+            a=number_or_nan(data["a"]),
+            b=number_or_nan(data["b"]),
+            a_se=number_or_nan(data.get("a_se")),
+            b_se=number_or_nan(data.get("b_se")),
             a_ci=interval(data.get("a_ci")),
             b_ci=interval(data.get("b_ci")),
-            confidence=number(data.get("confidence", 0.95)),
+            confidence=number_or_nan(data.get("confidence", 0.95)),
             bootstrap=int(data.get("bootstrap") or 0),
-            r2=number(data.get("r2")),
-            residual_rms=number(data.get("residual_rms")),
+            r2=number_or_nan(data.get("r2")),
+            residual_rms=number_or_nan(data.get("residual_rms")),
             points=int(data.get("points") or 0),
         )
 

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ..compute.realization import RealizationResult
+from ..io.values import number_or_nan, whole_or
 
 MAX_LINE_BYTES = 1024 * 1024  # an event's line, at most (a realization's curves thinned to fit): within READ_BLOCK
 MAX_TEXT = 4000  # characters of a message, in a line that would pass MAX_LINE_BYTES otherwise
@@ -25,16 +26,6 @@ MAX_BATCH = 1000  # realizations in one line: its indices and seconds stay far b
 
 def _floats(values) -> list | None:
     return None if values is None else np.asarray(values, float).tolist()
-
-
-def whole_or(value, default: int = 0) -> int:
-    """``value`` if it is a whole number >= 0 (as a log read back holds it), else ``default``."""
-    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else default
-
-
-def number_or_nan(value) -> float:
-    """``value`` as a float if it is a number (not true or false), else NaN."""
-    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
 
 
 class Batch:

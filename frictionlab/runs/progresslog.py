@@ -28,7 +28,8 @@ from pydantic import Field, ValidationError, model_validator
 
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
-from .progresslines import MAX_BATCH, Batch, batch_results, fitted_line, number_or_nan, result_of, whole_or
+from ..io.values import number_or_nan, whole_or
+from .progresslines import MAX_BATCH, Batch, batch_results, fitted_line, result_of
 from .runfolder import Finite, Record
 
 PROGRESS_FILE = "progress.jsonl"

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from ..errors import RunFolderError
 from ..plugin.listeners import SweepListener
-from .progresslines import number_or_nan, whole_or
+from ..io.values import number_or_nan, whole_or
 from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf
 from .runfolder import checked
 from .sweep import UNFINISHED, PointResult, Sweep, SweepPoint, point_folder

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import errno
 import itertools
-import math
 import os
 import re
 import stat
@@ -27,6 +26,7 @@ from ..preset.builtin import builtin_folder, builtin_presets
 from ..preset.reading import MAX_PRESET_BYTES, NOT_A_MAPPING
 from ..preset.schema import NAME_PATTERN
 from ..io.safe_yaml import load_yaml
+from ..io.values import number_or_nan, whole_or
 
 # The runs' modules (``detached``, ``runfolder``) and the comment-keeping YAML writer are
 # imported where runs are read or a preset written: the first screen lists presets only.
@@ -261,16 +261,8 @@ def _read_only(path: Path) -> bool:
 # ------------------------------------------------------------------ past runs
 
 
-def _number(value) -> float:
-    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
-
-
 def _mapping(value) -> dict:
     return value if isinstance(value, dict) else {}
-
-
-def _count(value) -> int:
-    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else 0
 
 
 @dataclass
@@ -288,25 +280,25 @@ class RunEntry:
 
     @property
     def a(self) -> float:
-        return _number((self.fit or {}).get("a"))
+        return number_or_nan((self.fit or {}).get("a"))
 
     @property
     def b(self) -> float:
-        return _number((self.fit or {}).get("b"))
+        return number_or_nan((self.fit or {}).get("b"))
 
     @property
     def r2(self) -> float:
-        return _number((self.fit or {}).get("r2"))
+        return number_or_nan((self.fit or {}).get("r2"))
 
     def interval(self, key: str) -> tuple[float, float] | None:
         """The fit's ``a_ci`` or ``b_ci`` as two numbers, None if it has none (or a damaged one)."""
         pair = (self.fit or {}).get(key)
-        return (_number(pair[0]), _number(pair[1])) if isinstance(pair, list) and len(pair) == 2 else None
+        return (number_or_nan(pair[0]), number_or_nan(pair[1])) if isinstance(pair, list) and len(pair) == 2 else None
 
     @property
     def contact_counts(self) -> tuple[float, float]:
         """The mean points in contact at the first and the last load (NaN where unknown)."""
-        return _number(self.summary.get("contact_count_at_first_load")), _number(self.summary.get("contact_count_at_last_load"))
+        return number_or_nan(self.summary.get("contact_count_at_first_load")), number_or_nan(self.summary.get("contact_count_at_last_load"))
 
     @property
     def formula(self) -> str:
@@ -328,8 +320,8 @@ def read_run(folder: Path) -> RunEntry:
         path=folder,
         name=str(preset.get("name") or folder.name),
         status=str(summary.get("status", "?")),
-        done=_count(realizations.get("done")),
-        requested=_count(realizations.get("requested")),
+        done=whole_or(realizations.get("done")),
+        requested=whole_or(realizations.get("requested")),
         fit=summary.get("fit") if isinstance(summary.get("fit"), dict) else None,
         summary=summary,
         mtime=os.lstat(summary_path).st_mtime,
