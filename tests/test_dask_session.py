@@ -52,7 +52,7 @@ def test_a_sweep_on_dask_starts_one_cluster_for_all_its_points(tmp_path, registr
     assert clusters_started[0].status.name == "closed"  # closed when the sweep ended
     for result in outcome.results:
         serial = engine.run(result.point.scene, RunOptions(workers=1))
-        assert np.array_equal(result.outcome.per_realization["xi"], serial.per_realization["xi"])
+        assert np.array_equal(np.load(result.folder / "realizations.npz")["xi"], serial.per_realization["xi"])
 
 
 @pytest.mark.long

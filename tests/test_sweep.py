@@ -15,7 +15,8 @@ from frictionlab.preset import load_scene
 from frictionlab.runs.runner import run_to_folder
 from frictionlab.plugin.listeners import SweepListener
 from frictionlab.preset import apply_overrides, yaml_scalar
-from frictionlab.runs.sweep import load_sweep, plan_sweep, read_table, run_sweep
+from frictionlab.runs.sweep import load_sweep, plan_sweep, run_sweep
+from frictionlab.runs.sweepfiles import read_table
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET
@@ -39,13 +40,14 @@ def test_points_equal_separate_runs_with_the_same_seed(tmp_path, registry):
     data = sweep_preset({"spectrum.params.hurst": {"values": [0.5, 0.9]}, "loading.stop": {"values": [5.0, 50.0]}})
     path = write(tmp_path, data)
     sweep = load_sweep(path, registry=registry)
-    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1), plot=False)
+    heard = Heard()
+    outcome = run_sweep(sweep, tmp_path / "out", RunOptions(workers=1), listeners=[heard], plot=False)
     assert outcome.status == "completed" and len(outcome.results) == 4
     for result in outcome.results:
         # the documented way to rerun one point: the preset, sweep off, the point's --set options
         alone = load_scene(path, ["sweep=null", *result.point.assignments], registry=registry)
         single, _ = run_to_folder(alone, tmp_path / f"alone-{result.point.number}", RunOptions(workers=2))
-        assert np.array_equal(result.outcome.per_realization["xi"], single.per_realization["xi"])
+        assert np.array_equal(heard.curves[result.point.number], single.per_realization["xi"])
         assert (result.outcome.fit.a, result.outcome.fit.b) == (single.fit.a, single.fit.b)
         assert result.outcome.fit.a_ci == single.fit.a_ci
         stored = np.load(result.folder / "realizations.npz")
@@ -53,6 +55,31 @@ def test_points_equal_separate_runs_with_the_same_seed(tmp_path, registry):
     # the swept values really reached the scenes
     assert [r.point.scene.spectrum.params.hurst for r in outcome.results] == [0.5, 0.5, 0.9, 0.9]
     assert [r.point.scene.loads[-1] for r in outcome.results] == [5.0, 50.0, 5.0, 50.0]
+
+
+class Heard(SweepListener):
+    """Each point's per-realization xi, as its listeners hear the point finish."""
+
+    def __init__(self):
+        self.curves = {}
+
+    def point_finished(self, sweep, point, result):
+        self.curves[point.number] = result.outcome.per_realization["xi"]
+
+
+def test_a_sweep_holds_its_points_without_their_realizations_curves(tmp_path, registry):
+    """Held to its end, each realization's curves would grow a sweep's memory at every point
+    (realizations x load steps x curves: megabytes a point); they are in each point's folder."""
+    data = sweep_preset({"spectrum.params.hurst": {"values": [0.6, 0.8]}}, realizations=5)
+    heard = Heard()
+    outcome = run_sweep(plan_sweep(data, registry=registry), tmp_path / "out", RunOptions(workers=1), listeners=[heard])
+    steps = data["loading"]["steps"]
+    for result in outcome.results:
+        assert heard.curves[result.point.number].shape == (5, steps)  # the listeners heard the point whole
+        assert result.outcome.per_realization == {}
+        assert np.load(result.folder / "realizations.npz")["xi"].shape == (5, steps)
+        assert result.outcome.xi.shape == (steps,) and result.fit is not None
+        assert isinstance(result.outcome.caveats, list)  # read without the curves
 
 
 def test_table_and_json_hold_each_points_fit(tmp_path, registry):

@@ -177,7 +177,8 @@ def _identity(folder: Path) -> tuple[int, int] | None:
 
 
 def _stored_sweep(folder: Path):
-    from ..runs.sweep import plan_sweep, stored_sweep
+    from ..runs.sweep import plan_sweep
+    from ..runs.sweepfiles import stored_sweep
     from .resume import stored_run
 
     return stored_run(folder, lambda: plan_sweep(stored_sweep(folder), source=str(folder / "sweep.json")), "followed")

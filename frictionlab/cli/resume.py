@@ -41,7 +41,7 @@ def run(args) -> ExitCode:
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
     if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
         from ..preset import build_scene
-        from ..runs.sweep import OtherSweep, stored_sweep
+        from ..runs.sweepfiles import OtherSweep, stored_sweep
         from .options import executor_run_options
 
         args.preset = args.source = str(run_dir / "sweep.json")

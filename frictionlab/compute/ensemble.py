@@ -169,7 +169,8 @@ class RunOutcome:
             caveats.append(caveat)
         if self.peak_rms > SPIKE_RMS:
             caveats.append(spike_caveat(self.peak_rms))
-        if (caveat := same_curves_caveat(self.per_realization["xi"])) is not None:
+        xi = self.per_realization.get("xi")  # None in a sweep's held copy (PointResult.held)
+        if xi is not None and (caveat := same_curves_caveat(xi)) is not None:
             caveats.append(caveat)
         if self.lines_used.size and self.lines_used.min() < self.done:
             caveats.append(

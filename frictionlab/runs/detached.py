@@ -67,7 +67,8 @@ def in_use(out_dir: str | Path, holder: int | None = None) -> RunFolderError:
 
 def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> None:
     """``check_startable`` for a sweep (``sweep.Sweep``): its folder, and each point's memory."""
-    from .sweep import check_sweep_folder, check_sweep_memory
+    from .sweep import check_sweep_memory
+    from .sweepfiles import check_sweep_folder
 
     _check_not_in_use(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)

@@ -14,9 +14,7 @@ Front ends follow a sweep through ``listeners.SweepListener``s; each point's run
 
 from __future__ import annotations
 
-import csv
 import itertools
-import json
 import re
 import threading
 import time
@@ -27,10 +25,8 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from .. import __version__
 from ..compute.dask_session import one_dask_cluster
 from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr, shown_name
-from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
 from ..options import RunOptions
@@ -42,15 +38,11 @@ from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .results import holds_results, results_on_disk, write_figure
 from .rundir import STATE_FILE, RunDirectory
-from .runfolder import make_subfolder, read_json
-from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
+from .runfolder import make_subfolder
+from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, write_tables
 from ..compute.memory import estimate
 from .runner import check_memory, run_to_folder
 
-RESULT_COLUMNS = (
-    "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
-    "contact_first", "contact_last", "elapsed_s", "folder",
-)  # fmt: skip
 UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that do not count it as done
 
 
@@ -263,6 +255,11 @@ class PointResult:
         """The point's fit of xi = a + b ln f; None where it has none (or only a row read back)."""
         return None if self.outcome is None else self.outcome.fit
 
+    def held(self) -> PointResult:
+        """This result as a sweep holds it till its end: without each realization's curves (they are
+        in the point's realizations.npz), else a sweep's memory grows by them at every point."""
+        return self if self.outcome is None else replace(self, outcome=replace(self.outcome, per_realization={}))
+
     def row(self) -> dict[str, Any]:
         if self.recorded is not None:
             return {**self.recorded, "point": self.point.number, "label": self.point.folder_name, **self.point.values}
@@ -396,7 +393,7 @@ def run_sweep(
         try:
             with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
                 for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
-                    results[result.point.number] = result
+                    results[result.point.number] = result.held()  # the listeners hear it whole
                     outcome.results = list(results.values())
                     outcome.elapsed = time.perf_counter() - started
                     write_tables(sweep, outcome, out_dir)
@@ -424,76 +421,3 @@ def run_sweep(
         for listener in listeners:  # before the lock goes: a follower that sees it gone has heard this
             listener.sweep_finished(sweep, outcome)
     return outcome
-
-
-class OtherSweep(OutputRefused):
-    """The folder holds something else than this sweep (a resume reads it as its sweep.json edited)."""
-
-
-SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")  # what a sweep writes in its folder, beside points/
-
-
-def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
-    """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
-    (its sweep.json names the same sweep and base preset), or ``force``."""
-    problem = output_path_problem(out_dir)
-    if problem:
-        raise OutputRefused(f"{problem}; give a folder for the output")
-    refuse_unreplaceable([out_dir / name for name in SWEEP_FILES], "sweep", "give another output folder")  # --force too
-    if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
-        return
-    hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
-    try:
-        old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
-    except RunFolderError:
-        raise OtherSweep(
-            f"{shown_name(out_dir)} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
-        ) from None
-    mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
-    mine = json.loads(json.dumps(mine, default=str))
-    if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
-        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)")
-
-
-def stored_sweep(out_dir: Path) -> dict:
-    """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
-    and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
-    data, _ = read_sweep_record(out_dir)
-    return {**data["base_preset"], "sweep": data["sweep"]}  # as Sweep.preset_data
-
-
-def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:
-    """Write sweep.csv and sweep.json atomically (called after every point)."""
-    rows = outcome.rows
-    columns = ["point", "label", *sweep.paths, *RESULT_COLUMNS]
-    files = {"table": out_dir / "sweep.csv", "summary": out_dir / "sweep.json"}
-
-    def write_csv(fh):
-        writer = csv.writer(fh, lineterminator="\n")
-        writer.writerow(columns)
-        for row in rows:
-            writer.writerow(["" if row[c] is None else repr(row[c]) if isinstance(row[c], float) else row[c] for c in columns])
-
-    atomic_write(files["table"], write_csv)
-    summary = {
-        "schema_version": SWEEP_SCHEMA_VERSION,
-        "frictionlab_version": __version__,
-        "name": sweep.name,
-        "source": sweep.source,
-        "status": outcome.status,
-        "elapsed_seconds": round(outcome.elapsed, 3),
-        "sweep": sweep.spec.model_dump(mode="json", exclude_none=True),
-        "base_preset": sweep.base,
-        "points": [
-            {**row, "set": r.point.assignments, "error": r.error} for row, r in zip(rows, outcome.results, strict=True)
-        ],
-        "files": {"table": "sweep.csv", **({"plot": "sweep.png"} if "plot" in outcome.files else {})},
-    }
-    atomic_write(files["summary"], lambda fh: json.dump(summary, fh, indent=2, allow_nan=False, default=str))
-    return {**outcome.files, **files}
-
-
-def read_table(path: str | Path) -> list[dict[str, str]]:
-    """sweep.csv as a list of rows (strings), for scripts and tests."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        return list(csv.DictReader(fh))

@@ -148,7 +148,8 @@ class RunControl:
         its first point's); RunFolderError or PresetError if it holds none that can run."""
         from ..runs.detached import run_state
         from ..runs.rundir import RunDirectory
-        from ..runs.sweep import plan_sweep, stored_sweep
+        from ..runs.sweep import plan_sweep
+        from ..runs.sweepfiles import stored_sweep
 
         if run_state(folder).kind == "sweep":
             sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))

@@ -7,7 +7,8 @@ import yaml
 from textual.widgets import Static
 
 from frictionlab.options import RunOptions
-from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
+from frictionlab.runs.sweep import load_sweep, run_sweep
+from frictionlab.runs.sweepfiles import read_table
 from frictionlab.tui.widgets import ResultsPane
 
 from .conftest import (

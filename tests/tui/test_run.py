@@ -13,7 +13,8 @@ from frictionlab.plugin.hookspecs import hookimpl
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 from frictionlab.runs.runner import run_to_folder
-from frictionlab.runs.sweep import load_sweep, read_table, run_sweep
+from frictionlab.runs.sweep import load_sweep, run_sweep
+from frictionlab.runs.sweepfiles import read_table
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
