@@ -403,6 +403,28 @@ def test_workers_under_ulimit_v_each_have_the_limit_to_themselves(registry, monk
         memory.check_fits(scene, workers=16, executor="processes")
 
 
+def _bytes(text: str) -> float:
+    number, unit = text.split()
+    return float(number) * (GiB if unit == "GiB" else 2**20)
+
+
+@pytest.mark.parametrize("points, executor", [(1000, "processes"), (5_000_000, "processes")])
+def test_a_refusal_by_the_process_limit_names_every_part_of_the_need(registry, monkeypatch, points, executor):
+    """A small run refused under a small limit once read 'would need 0.16 GiB (a realization: 0 MiB)':
+    the process's own share, Python and its libraries, was left unsaid. The parts now add up to the need."""
+    scene = build_scene(line_of(points), registry=registry)
+    _under_a_process_limit(monkeypatch, 20 * 2**20)
+    with pytest.raises(RunError) as caught:
+        memory.check_fits(scene, workers=2, executor=executor)
+    amount = r"(\d+(?:\.\d+)? (?:GiB|MiB))"
+    found = re.search(rf"would need about {amount} at its peak \(a realization of [\d,]+ points: {amount}, the process "
+                      rf"itself with Python, its libraries and what it keeps: {amount}\)", str(caught.value))
+    assert found, str(caught.value)
+    need, realization, own = (_bytes(found.group(i)) for i in (1, 2, 3))
+    assert own >= 64 * 2**20  # at least what the base of a worker process is
+    assert realization + own == pytest.approx(need, abs=0.011 * GiB)  # each shown to 0.01 GiB or 1 MiB
+
+
 def test_a_realization_past_the_process_limit_is_refused_naming_it_and_a_grid_that_fits(registry, monkeypatch):
     scene = build_scene(line_of(20_000_000), registry=registry)  # 2.1 GiB a realization
     _under_a_process_limit(monkeypatch, 1 * GiB)

@@ -290,11 +290,14 @@ def _check_each_process(scene: Scene, guess: MemoryEstimate, executor: str) -> N
             advice = f"{points_param} <= {_most_points(scene, executor, room, _largest_process):,}, or with {_higher_limit(source, room, need)}"
         else:  # only a smaller map helps when its line alone does not fit: no count of realizations does
             advice = _smaller_map(guess) if guess.making + PROCESS_BASE > room else "fewer realizations"
+        main_largest = need == guess.main + guess.per_realization
         making = (f"making the MDR-equivalent line of a surface of {points_text(guess.grid)} points in the main process: "
-                  f"{gib(guess.making)}, " if guess.making else "")  # fmt: skip
+                  f"{gib(guess.making)}, " if guess.making and main_largest else "")  # fmt: skip
+        own = need - guess.per_realization - (guess.making if main_largest else 0)  # what a 0 MiB realization leaves
         raise RunError(
             f"one process of this run would need about {gib(need)} at its peak ({making}a realization of "
-            f"{points_text(guess.points)} points: {gib(guess.per_realization)}), but {gib(room)} is available ({source}; each worker process has the "
+            f"{points_text(guess.points)} points: {gib(guess.per_realization)}, the process itself with Python, its "
+            f"libraries and what it keeps: {gib(own)}), but {gib(room)} is available ({source}; each worker process has the "
             f"limit to itself). It would fit with {advice}.{skip_hint()}"
         )
 
