@@ -20,6 +20,7 @@ from __future__ import annotations
 import ipaddress
 import logging
 import warnings
+from contextlib import contextmanager
 from urllib.parse import urlsplit
 
 from ..errors import FrictionlabError, MissingDependency, RunError, require, short_repr
@@ -164,6 +165,18 @@ WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": N
 PROFILE_OFF = {"distributed.worker.profile.enabled": False}
 
 
+@contextmanager
+def _said_if_not_started():
+    """A local cluster whose processes did not start (``Nanny failed to start``: a system without
+    the semaphores worker processes need, a full disk) is refused, naming its cause."""
+    try:
+        yield
+    except (RuntimeError, OSError) as exc:
+        cause = exc.__cause__ or exc.__context__
+        why = f"{exc}" + (f" ({type(cause).__name__}: {cause})" if cause is not None else "")
+        raise RunError(f"the local Dask cluster did not start: {why}") from None
+
+
 def start_local_cluster(workers: int, dashboard: bool = False):
     """This user's own ``LocalCluster`` of ``workers`` single-thread processes on
     127.0.0.1 over TLS with credentials made now, and a client of it. Returns
@@ -180,7 +193,7 @@ def start_local_cluster(workers: int, dashboard: bool = False):
         ) from None
     routes = {"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}
     quiet = {} if dashboard else {**routes, **PROFILE_OFF}
-    with dask.config.set({**quiet, **WORKER_CONFIG}):
+    with dask.config.set({**quiet, **WORKER_CONFIG}), _said_if_not_started():
         cluster = distributed.LocalCluster(
             n_workers=workers,
             threads_per_worker=1,

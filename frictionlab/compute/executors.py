@@ -33,7 +33,7 @@ from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .dask_session import current_session
-from ..errors import RunError
+from ..errors import RunError, warn_user
 from ..options import RunOptions
 from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
 from ..preset import Scene
@@ -160,6 +160,16 @@ def pool_context():
     if "fork" in methods and threading.active_count() == 1:
         return multiprocessing.get_context("fork")
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def pool_refused() -> str | None:
+    """Why this system starts no process pool, or None. The pool's stop event is a POSIX
+    semaphore, which a system without a usable /dev/shm (some containers and batch nodes) refuses."""
+    try:
+        pool_context().Event()
+    except OSError as exc:
+        return f"worker processes need a POSIX semaphore, which this system refuses: {exc.strerror or exc}; is /dev/shm missing or read-only?"
+    return None
 
 
 class ProcessExecutor:
@@ -415,8 +425,15 @@ def make_executor(options: RunOptions, workers: int):
     if name == "serial":
         return SerialExecutor()
     if name == "processes":
-        return ProcessExecutor(workers, retries=options.retries)
+        if (refused := pool_refused()) is None:
+            return ProcessExecutor(workers, retries=options.retries)
+        if options.executor is not None:  # asked for by name: said, not replaced
+            raise RunError(f"executor 'processes' cannot start here: {refused}; the serial executor runs in this process")
+        warn_user(f"{workers} worker processes cannot start here ({refused}): the run goes on in this process")
+        return SerialExecutor()
     import_distributed()  # fail before anything starts
+    if not options.scheduler and (refused := pool_refused()) is not None:  # its own local cluster's processes
+        raise RunError(f"executor 'dask' cannot start its local cluster here: {refused}")
     return DaskExecutor(
         workers,
         scheduler=options.scheduler,
