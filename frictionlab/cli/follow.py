@@ -79,7 +79,9 @@ def run(args) -> ExitCode:
             try:
                 with stopped:
                     while state.status == "running" and stopped.signal is None:  # until its process ends
-                        if not follower.poll():
+                        polled = follower.poll()
+                        _say_warnings(follower)
+                        if not polled:
                             stopped.wait(POLL_SECONDS)
                             now = _state_unless_gone(folder, identity)
                             if now is None:  # deleted (or replaced) under the run
@@ -88,6 +90,7 @@ def run(args) -> ExitCode:
                             state = now
                     if stopped.signal is None:
                         follower.poll()  # the last events, written as it ended
+                        _say_warnings(follower)
             finally:  # a bar still showing ends on its own line, before anything else is printed
                 for listener in follower.listeners:
                     listener.close()
@@ -174,6 +177,13 @@ def _identity(folder: Path) -> tuple[int, int] | None:
     except OSError:
         return None
     return info.st_dev, info.st_ino
+
+
+def _say_warnings(follower) -> None:
+    """The warnings the run's process wrote to its log (its stderr is no one's), as a run in
+    the foreground shows them."""
+    for message in follower.warnings.take():
+        print(f"warning: {shown(message)}", file=sys.stderr, flush=True)
 
 
 def _stored_sweep(folder: Path):

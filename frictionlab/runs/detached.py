@@ -20,13 +20,17 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
 from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name
 from ..options import RunOptions
-from .progresslog import MAX_COUNT, ProgressLog, ProgressReader, StartOf
+from .progressevents import MAX_COUNT
+from .progresslog import ProgressLog, ProgressReader, StartOf
 from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 
@@ -149,7 +153,7 @@ def _child() -> int:
     is_sweep = bool(request["preset"].get("sweep"))
     log = SweepProgressLog(out) if is_sweep else ProgressLog(out)
     try:
-        with RaiseOnSignals():
+        with RaiseOnSignals(), _warnings_to(log):
             options = RunOptions(**request["options"])
             run = _run_sweep if is_sweep else _run_one
             status = run(request, out, options, log)
@@ -170,6 +174,15 @@ def _child() -> int:
     if status in ("interrupted", "cancelled"):
         return ExitCode.TERMINATED
     return ExitCode.OK if status == "completed" else ExitCode.RUNTIME_FAILURE
+
+
+@contextmanager
+def _warnings_to(log) -> Iterator[None]:
+    """Warnings go to the run's progress log, where a follower (the TUI, ``follow``) shows
+    them: this process's stderr is no one's."""
+    with warnings.catch_warnings():
+        warnings.showwarning = lambda message, category, *where, **keys: log.warning(str(message))
+        yield
 
 
 def _run_one(request: dict, out: Path, options: RunOptions, log: ProgressLog) -> str:

@@ -22,15 +22,12 @@ import stat
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Annotated
-
-from pydantic import Field, ValidationError, model_validator
 
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
 from ..io.values import number_or_nan, whole_or
 from .progresslines import MAX_BATCH, Batch, batch_results, fitted_line, result_of
-from .runfolder import Finite, Record
+from .progressevents import checked_event
 
 PROGRESS_FILE = "progress.jsonl"
 MAX_PROGRESS_BYTES = 256 * 1024 * 1024  # far above what a run writes (tens of bytes a realization): beyond that it is not ours
@@ -54,6 +51,7 @@ class ProgressLog:
         self._fd: int | None = None
         self._batch = Batch()
         self._started = self._flushed = self._solve_said = -math.inf
+        self._held: list[dict] = []  # warnings given before the file was begun: written once it is
 
     def _open(self, truncate: bool) -> None:
         self.close()
@@ -102,13 +100,25 @@ class ProgressLog:
         if self._fd is None:
             self._batch = Batch()  # none of its realizations are told after another run's events
             self._open(truncate=False)  # appended: the log may be another live run's (a folder in use)
+            self._write_held()
         self.flush()
         self.write({"event": "error", "pid": os.getpid(), "message": message, "exit_code": int(exit_code)})
+
+    def warning(self, message: str) -> None:
+        """A warning of the run's process (a detached one's stderr is no one's): what a follower shows."""
+        event = {"event": "warning", "pid": os.getpid(), "message": message}
+        self._held.append(event) if self._fd is None else self.write(event)
+
+    def _write_held(self) -> None:
+        held, self._held = self._held, []
+        for event in held:
+            self.write(event)
 
     def begin(self, event: dict) -> None:
         """Start the file afresh (a new run, or its resume) with ``event``."""
         self._open(truncate=True)
         self.write(event)
+        self._write_held()
 
     @hookimpl
     def run_started(self, run):
@@ -220,120 +230,19 @@ def _parse(line: bytes) -> dict | None:
     return checked_event(event) if isinstance(event, dict) and isinstance(event.get("event"), str) else None
 
 
-# What an event's numbers must be, as summary.json's (``results.SummaryRecord``): a count is a
-# whole number from 0 to MAX_COUNT (a preset's realizations and load steps are far below it),
-# a part never more than its whole. An event that is not so is skipped, as a line that is not JSON.
-MAX_COUNT = 10**9
-MAX_PID = 2**22  # Linux's largest
-Whole = Annotated[int, Field(ge=0, le=MAX_COUNT, strict=True)]
-Pid = Annotated[int, Field(ge=1, le=MAX_PID, strict=True)]
+class HeardWarnings:
+    """The warnings a followed process wrote (``warning`` events), each handed out once (``take``)."""
 
+    def __init__(self):
+        self._new: list[str] = []
 
-class _Event(Record):
-    time: Annotated[float, Field(allow_inf_nan=False, strict=True)] | None = None
+    def hear(self, event: dict, pid: int | None) -> None:
+        if pid is None or event.get("pid") == pid:  # not a refused second run's
+            self._new.append(str(event.get("message")))
 
-    @model_validator(mode="after")
-    def _parts_within_wholes(self):
-        for part, whole in (("done", "total"), ("resumed", "total"), ("done", "requested"), ("number", "total")):
-            if {part, whole} <= self.model_fields_set:  # both written
-                if getattr(self, whole) is not None and getattr(self, part) > getattr(self, whole):
-                    raise ValueError(f"{part} is more than {whole}")
-        return self
-
-
-class _Started(_Event):
-    pid: Pid | None = None
-    total: Whole = 0
-    workers: Whole = 1
-    resumed: Whole = 0
-    retried: Whole = 0
-
-
-class _Load(_Event):
-    """Realization ``index``'s loads solved, ``done`` of ``total``. A realization's event counts
-    the run's realizations instead, and adds its outcome."""
-
-    index: Whole = 0
-    done: Whole = 0
-    total: Whole = 0
-
-
-class _Realization(_Load):
-    ok: bool = False
-    seconds: Finite | None = None
-    stride: Annotated[int, Field(ge=1, le=MAX_COUNT, strict=True)] = 1
-    error: str | None = None
-
-
-class _Batch(_Event):
-    done: Whole = 0
-    total: Whole = 0
-    index: Annotated[list[Whole], Field(max_length=MAX_COUNT)] = []
-    seconds: list[Finite | None] = []
-    ok: Whole = 0
-    errors: dict[str, str] = {}
-    stride: Annotated[int, Field(ge=1, le=MAX_COUNT, strict=True)] = 1
-
-    @model_validator(mode="after")
-    def _as_many_as_done(self):
-        if len(self.index) > self.done:
-            raise ValueError("more realizations than done")
-        return self
-
-
-class _Iteration(_Event):
-    index: Whole = 0
-    load: Whole = 0
-    iteration: Whole = 0
-    residual: float | None = None
-
-
-class _Finished(_Event):
-    status: str = "?"
-    done: Whole = 0
-    requested: Whole = 0
-    failed: Whole = 0
-    error: str | None = None
-
-
-class _Error(_Event):
-    pid: Pid | None = None
-    message: str = "failed"
-    exit_code: Annotated[int, Field(ge=0, le=255, strict=True)] = 1
-
-
-class _SweepStarted(_Event):
-    pid: Pid | None = None
-    total: Whole = 0
-
-
-class _PointStarted(_Event):
-    number: Whole = 0
-    total: Whole | None = None
-
-
-class _SweepFinished(_Event):
-    status: str = "?"
-    done: Whole = 0
-    total: Whole = 0
-
-
-EVENT_RECORDS = {"started": _Started, "realization": _Realization, "realizations": _Batch, "load": _Load,
-                 "iteration": _Iteration, "finished": _Finished, "error": _Error, "sweep_started": _SweepStarted,
-                 "point_started": _PointStarted, "point_finished": _PointStarted, "sweep_finished": _SweepFinished}  # fmt: skip
-
-
-def checked_event(event: dict) -> dict | None:
-    """``event`` (a parsed line) once its fields are what its kind's record says, None if
-    not. Only those fields are validated (a realization's curves are checked by ``result_of``)."""
-    record = EVENT_RECORDS.get(event["event"])
-    if record is None:
-        return event  # a kind a later frictionlab writes: its followers skip it
-    try:
-        record.model_validate({name: event[name] for name in record.model_fields if name in event})
-    except ValidationError:
-        return None
-    return event
+    def take(self) -> list[str]:
+        new, self._new = self._new, []
+        return new
 
 
 @dataclass
@@ -395,6 +304,7 @@ class Follower:
         self._hooks = None
         self._resuming = None  # a resume's RunInfo, told once the realizations it restored are read
         self._restored: list[RealizationResult] = []
+        self.warnings = HeardWarnings()
 
     def now(self) -> float:
         return time.time() if self._event_time is None else self._event_time
@@ -478,6 +388,8 @@ class Follower:
                 elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              whole_or(event.get("exit_code"), 1))  # fmt: skip
+                elif kind == "warning":
+                    self.warnings.hear(event, self.pid)
             finally:
                 self._event_time, self._told_at = None, self._told_at if at is None else at
         return len(events)

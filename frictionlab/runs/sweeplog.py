@@ -19,7 +19,7 @@ from pathlib import Path
 from ..errors import RunFolderError
 from ..plugin.listeners import SweepListener
 from ..io.values import number_or_nan, whole_or
-from .progresslog import Finished, Follower, ProgressLog, ProgressReader, StartOf
+from .progresslog import Finished, Follower, HeardWarnings, ProgressLog, ProgressReader, StartOf
 from .runfolder import checked
 from .sweep import UNFINISHED, PointResult, Sweep, SweepPoint, point_folder
 from .sweeprecord import PointRecord
@@ -42,6 +42,9 @@ class SweepProgressLog(SweepListener):
 
     def run_listeners(self, point: SweepPoint) -> list[object]:
         return [ProgressLog(point_folder(self.out_dir, point))]
+
+    def warning(self, message: str) -> None:
+        self.log.warning(message)
 
     def point_finished(self, sweep: Sweep, point: SweepPoint, result: PointResult) -> None:
         self.log.write({"event": "point_finished", "number": point.number, "row": {**result.row(), "error": result.error}})
@@ -80,6 +83,7 @@ class SweepFollower:
         self.run: Follower | None = None  # its run's follower, once made
         self.done = 0  # points finished
         self._points = {point.number: point for point in sweep.points}
+        self.warnings = HeardWarnings()
 
     @property
     def total(self) -> int:
@@ -112,6 +116,8 @@ class SweepFollower:
                 self._finish_point_run()
                 self.finished = Finished(str(event.get("status")), whole_or(event.get("done")), whole_or(event.get("total")))
                 self.point = None
+            elif kind == "warning":
+                self.warnings.hear(event, self.pid)
             elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
                 self._finish_point_run()
                 self.finished = Finished("failed", self.done, self.total, str(event.get("message")),

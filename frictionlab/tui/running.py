@@ -269,6 +269,8 @@ class RunControl:
             self._count_from_chunks(followed)
         ended = followed.ended
         over = followed.poll()
+        for message in followed.follower.warnings.take():  # its process's: its stderr is no one's
+            self.say(message, "warning", about=followed.folder)
         if followed.ended != ended:  # its last event: c leaves the footer now, not once its process has closed
             self.refresh_bindings()
         if not over:
