@@ -13,6 +13,7 @@ other panes, a run to follow): a run's modules are imported only once they are u
 from __future__ import annotations
 
 import copy
+import functools
 import os
 import time
 from pathlib import Path
@@ -184,10 +185,10 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         await self.query_one("#results", TabPane).mount(ResultsPane(id="results-pane"))
         self.reload_runs()
         self._show_edit_state()
-        self.set_interval(FOLLOW_SECONDS, self._follow_tick)
-        self.set_interval(WATCH_SECONDS, self._watch_runs)
-        self.set_interval(WATCH_SECONDS, self._watch_preset_file)
-        self.set_interval(WATCH_SECONDS, self._watch_presets)
+        for seconds, tick in ((FOLLOW_SECONDS, self._follow_tick), (WATCH_SECONDS, self._watch_runs),
+                              (WATCH_SECONDS, self._watch_preset_file), (WATCH_SECONDS, self._watch_presets)):
+            # a tick as the app shuts down (a run ending as it quits) would find its widgets gone
+            self.set_interval(seconds, functools.partial(self._unless_closing, tick))
         going = [state for state in list_run_states(self.runs_dir) if state.status == "running"]
         if going:  # started earlier (by a TUI that went away, or frictionlab run --detach): shown live
             self.follow_run(going[0].folder)
@@ -261,6 +262,10 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
             self.say("")
 
     # ------------------------------------------------------------ the status line
+
+    def _unless_closing(self, tick) -> None:
+        if self.is_running:
+            tick()
 
     def say(self, text: str, severity: str = "information", title: str = "", about: Path | None = None, until_open=False) -> None:
         """Show ``text`` in the status line above the footer (never over the data); it stays

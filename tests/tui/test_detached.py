@@ -418,3 +418,49 @@ async def test_ctrl_c_during_a_run_says_which_key_cancels_it(folders, registry):
         await wait_until(pilot, lambda: app.followed is None)
     wait_for(lambda: not process_alive(pid))  # c did as said
     assert said.startswith("Ctrl+C does not stop the run: c on the Run tab (F4) cancels it, keeping what finished.")
+
+
+@sync
+async def test_a_warning_of_the_run_s_process_shows_in_the_status_line(folders, registry, monkeypatch):
+    """The run's process has no terminal: a warning it gives (here: worker processes cannot
+    start, so it goes on in its own process) reaches the TUI through its progress log."""
+    from ..test_no_semaphores import REFUSING
+
+    (folders / "site").mkdir()
+    (folders / "site" / "sitecustomize.py").write_text(REFUSING)
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(folders / "site"), *__import__("sys").path]))
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=2)
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        pid = app.followed.pid
+        try:
+            await wait_until(pilot, lambda: "worker processes cannot start here" in status_text(app), timeout=30.0)
+        finally:
+            end(pid)
+
+
+@sync
+async def test_a_run_that_ends_as_the_tui_quits_does_not_reach_its_gone_widgets(folders, registry):
+    """The app's timers go on while it shuts down: a run that ended then (here: killed) was
+    shown on widgets already removed, a traceback on the way out (NoMatches: '#run-stats')."""
+    import asyncio
+
+    from frictionlab.tui.app import FOLLOW_SECONDS
+
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml", workers=1)
+    close_all = app._close_all
+
+    async def closing_slowly():  # the widgets go first, then ticks come before the app's own end
+        await close_all()
+        await asyncio.sleep(4 * FOLLOW_SECONDS)
+
+    app._close_all = closing_slowly
+    async with app.run_test(size=SIZE) as pilot:
+        await press_run(pilot)
+        await wait_until(pilot, lambda: app.followed is not None and app.followed.pid is not None)
+        pid = app.followed.pid
+        end(pid)
+        wait_for(lambda: not process_alive(pid))
+    assert app.return_code in (0, None)
