@@ -11,6 +11,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from frictionlab.compute import engine
@@ -92,3 +93,78 @@ def test_the_command_finishes_in_its_own_process_on_such_a_system(tmp_path):
     assert "warning: 2 worker processes cannot start here" in done.stderr and "Traceback" not in done.stderr
     assert "40/40 realizations in" in done.stdout and "(1 worker)" in done.stdout
     assert (tmp_path / "out" / "summary.json").is_file()
+
+
+# ------------------------------------------------------------------ out of descriptors or processes
+
+
+def _failing_starts(monkeypatch, after: int):
+    """Worker starts fail, as under ``ulimit -n`` (EMFILE), once ``after`` have started."""
+    from frictionlab.compute import executors, pool
+
+    monkeypatch.setattr(executors, "POOL_START_SECONDS", 0.0)  # a short run would skip the pool anyway
+    real, started = pool.WorkerPool._start, []
+
+    def start(self, stop):
+        if len(started) >= after:
+            raise OSError(errno.EMFILE, "Too many open files")
+        started.append(real(self, stop))
+        return started[-1]
+
+    monkeypatch.setattr(pool.WorkerPool, "_start", start)
+    return started
+
+
+def test_a_pool_of_which_no_worker_starts_runs_here_saying_why(scene, monkeypatch):
+    alone = engine.run(scene, RunOptions(workers=1))
+    _failing_starts(monkeypatch, after=0)
+    with pytest.warns(UserWarning, match=r"^worker processes could not start \(Too many open files; ulimit -n is \d+ "
+                                         r"here\): the run goes on in this process$"):
+        outcome = engine.run(scene, RunOptions(workers=2))
+    assert (outcome.status, outcome.done, outcome.extra["executor"], outcome.workers) == ("completed", 6, "serial", 1)
+    assert outcome.fit == alone.fit
+
+
+def test_a_pool_short_of_workers_goes_on_with_those_that_started(scene, monkeypatch):
+    alone = engine.run(scene, RunOptions(workers=1))
+    started = _failing_starts(monkeypatch, after=1)
+    with pytest.warns(UserWarning, match=r"^1 of 3 worker processes started \(Too many open files.*\): the run goes on with 1$"):
+        outcome = engine.run(scene, RunOptions(workers=3))
+    assert (outcome.status, outcome.done, outcome.extra["executor"], outcome.workers) == ("completed", 6, "processes", 1)
+    assert len(started) == 1 and outcome.fit == alone.fit
+
+
+@pytest.mark.skipif(not hasattr(__import__("resource"), "RLIMIT_NOFILE") or sys.platform == "win32", reason="POSIX limits")
+def test_the_command_under_a_low_ulimit_n_finishes_saying_so(tmp_path):
+    import resource
+
+    def low_limit():
+        resource.setrlimit(resource.RLIMIT_NOFILE, (16, 16))
+
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "run", "quickstart", "--workers", "8",
+                           "--set", "realizations=400", "--out", str(tmp_path / "out"), "--no-plot"],
+                          capture_output=True, text=True, cwd=tmp_path, preexec_fn=low_limit)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr and "cannot write" not in done.stderr
+    assert "ulimit -n is 16 here" in done.stderr and "400/400 realizations in" in done.stdout
+
+
+@pytest.mark.parametrize("workers, starts", [(1, 1), (2, 2)])
+def test_a_worker_that_dies_and_cannot_be_replaced_leaves_its_chunks_to_the_others_or_to_this_process(
+    make_scene, tmp_path, monkeypatch, workers, starts
+):
+    """A worker dies (its chunk runs again); no new one can start: with one worker the chunks not
+    yet done run here, with two the one left takes them. Every realization once, the same numbers."""
+    from .faults import CrashingPowerLaw, with_spectrum
+
+    scene = make_scene({"realizations": 24})
+    alone = engine.run(scene, RunOptions(workers=1))
+    flag = tmp_path / "crashed"
+    crashing = with_spectrum(scene, CrashingPowerLaw, flag=str(flag), parent=os.getpid())
+    _failing_starts(monkeypatch, after=starts)
+    with pytest.warns(UserWarning, match="worker processes"):
+        outcome = engine.run(crashing, RunOptions(workers=workers, executor="processes"))
+    assert flag.exists(), "no worker died: the test did not test anything"
+    assert (outcome.status, outcome.done, outcome.failures) == ("completed", 24, [])
+    np.testing.assert_array_equal(outcome.per_realization["xi"], alone.per_realization["xi"])
+    assert outcome.fit == alone.fit

@@ -35,7 +35,7 @@ from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, 
 from .dask_session import current_session
 from ..errors import RunError, warn_user
 from ..options import RunOptions
-from .pool import JobFailed, WorkerLost, WorkerPool, send_progress, stop_event
+from .pool import JobFailed, PoolNotStarted, WorkerLost, WorkerPool, send_progress, stop_event
 from ..preset import Scene
 from .realization import UNHEARD, RealizationResult, SolveListeners, compute_chunk, compute_chunk_here
 
@@ -199,10 +199,19 @@ class ProcessExecutor:
             min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene.for_pressing(),),
             retries=self.retries,
         )
+        ended = set()
         try:
             for key, results in pool.run(jobs, cancel, on_progress):
+                ended.add(key)
                 if results:  # none: cancelled within its first realization
                     yield jobs[key][: len(results)], results
+            if pool.short:
+                self.workers = pool.size  # what the outcome tells of the run
+        except PoolNotStarted as refused:  # not one worker runs (at the start, or none came back after deaths)
+            warn_user(f"worker processes could not start ({refused.reason}): the run goes on in this process")
+            self.name, self.workers = SerialExecutor.name, 1  # what the outcome tells of the run
+            rest = [chunk for key, chunk in jobs.items() if key not in ended]
+            yield from SerialExecutor().map_chunks(scene, rest, cancel, listeners)
         except WorkerLost as lost:
             raise RunError(
                 f"a worker process died {lost.deaths} times while running realizations "

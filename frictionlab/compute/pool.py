@@ -19,6 +19,7 @@ from collections import Counter, deque
 from collections.abc import Callable, Hashable, Iterator
 from multiprocessing.connection import wait
 
+from ..errors import warn_user
 from .heap import keep_freed_memory
 
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
@@ -40,6 +41,26 @@ class JobFailed(Exception):
     def __init__(self, key: Hashable, error: str):
         super().__init__(error)
         self.key, self.error = key, error
+
+
+class PoolNotStarted(Exception):
+    """Not one worker process could start (out of file descriptors or processes: ``ulimit -n``, ``-u``)."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.reason = reason
+
+
+def start_failure(exc: OSError) -> str:
+    """Why a worker process did not start, with the process limit that ran out where one did."""
+    import errno
+    import resource
+
+    limits = {errno.EMFILE: ("RLIMIT_NOFILE", "-n"), errno.EAGAIN: ("RLIMIT_NPROC", "-u")}
+    name, flag = limits.get(exc.errno, (None, None))
+    soft = resource.getrlimit(getattr(resource, name))[0] if name and hasattr(resource, name) else None
+    limit = f"; ulimit {flag} is {soft} here" if soft is not None and soft != resource.RLIM_INFINITY else ""
+    return f"{exc.strerror or exc}{limit}"
 
 
 _results = None  # in a worker: the pipe of its results, for ``send_progress``
@@ -140,6 +161,7 @@ class WorkerPool:
     def __init__(self, size: int, context, function: Callable, initializer=None, initargs=(), retries: int = 2):
         self.size, self.context, self.function = max(1, size), context, function
         self.initializer, self.initargs, self.retries = initializer, initargs, retries
+        self.short = False  # fewer workers started than asked for (``ulimit -n`` or ``-u`` reached)
 
     def _start(self, stop) -> _Worker:
         return _Worker(self.context, stop, self.initializer, self.initargs, self.function)
@@ -149,7 +171,15 @@ class WorkerPool:
         while pending and (len(workers) < self.size or any(w.job is None for w in workers)):
             worker = next((w for w in workers if w.job is None), None)
             if worker is None:
-                worker = self._start(stop)
+                try:
+                    worker = self._start(stop)
+                except OSError as exc:  # ulimit -n or -u reached: the workers started go on alone
+                    if not workers:
+                        raise PoolNotStarted(start_failure(exc)) from None
+                    warn_user(f"{len(workers)} of {self.size} worker processes started ({start_failure(exc)}): "
+                              f"the run goes on with {len(workers)}")  # fmt: skip
+                    self.size, self.short = len(workers), True
+                    continue
                 workers.append(worker)
             key = pending.popleft()
             if not worker.give(key, jobs[key]):  # it died idle: no charge to the job
