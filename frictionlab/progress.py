@@ -10,7 +10,9 @@ imported only when a bar is drawn. ``NO_COLOR`` is honoured by rich itself.
 
 from __future__ import annotations
 
+import math
 import sys
+import threading
 import time
 
 from .errors import counted, shown
@@ -44,6 +46,18 @@ def _has_widgets() -> bool:
 NOTEBOOK_REDRAWS_PER_SECOND = 1
 
 
+def _thread_starts() -> bool:
+    """Whether a thread can start here (a container's pids limit may refuse one): rich redraws a
+    bar from a thread of its own, else the bar is redrawn as it moves."""
+    try:
+        thread = threading.Thread(target=lambda: None, daemon=True)
+        thread.start()
+    except RuntimeError:
+        return False
+    thread.join()
+    return True
+
+
 class _Bar:
     """A rich progress bar of one task on ``stream`` (imported when first drawn)."""
 
@@ -56,10 +70,12 @@ class _Bar:
         # in a notebook each redraw is a new output (cleared, displayed again), sent whether or not
         # anything changed: once a second, as often as the elapsed time it shows moves
         rate = NOTEBOOK_REDRAWS_PER_SECOND if console.is_jupyter else 10
+        self.every = 1.0 / rate
+        self.redrawn = None if _thread_starts() else -math.inf  # None: rich's own thread redraws
         self.progress = Progress(
             TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[note]}"),
             TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(), console=console, refresh_per_second=rate,
-            get_time=clock,
+            get_time=clock, auto_refresh=self.redrawn is None,
         )  # fmt: skip
         self.task = self.progress.add_task(description, total=total, completed=completed, note="")
         if started is not None:  # drawn late (a run shows its bar after 2 s): the clock is the run's
@@ -67,7 +83,10 @@ class _Bar:
         self.progress.start()
 
     def update(self, completed: int, note: str = "") -> None:
-        self.progress.update(self.task, completed=completed, note=note)
+        due = self.redrawn is not None and time.perf_counter() - self.redrawn >= self.every  # drawn here, without a thread
+        self.progress.update(self.task, completed=completed, note=note, refresh=due)
+        if due:
+            self.redrawn = time.perf_counter()
 
     def print(self, text: str) -> None:
         self.progress.console.print(text, markup=False)

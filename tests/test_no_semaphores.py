@@ -8,6 +8,7 @@ from __future__ import annotations
 import _multiprocessing
 import errno
 import os
+import re
 import subprocess
 import sys
 
@@ -168,3 +169,39 @@ def test_a_worker_that_dies_and_cannot_be_replaced_leaves_its_chunks_to_the_othe
     assert (outcome.status, outcome.done, outcome.failures) == ("completed", 24, [])
     np.testing.assert_array_equal(outcome.per_realization["xi"], alone.per_realization["xi"])
     assert outcome.fit == alone.fit
+
+
+def test_a_run_where_no_thread_can_start_is_solved_in_the_main_thread(tmp_path, monkeypatch, cli):
+    """A container's pids limit refuses new threads ("can't start new thread"): the serial
+    solve and the plotting import ahead run without one, to the same numbers and files."""
+    import threading
+
+    here = cli("run", "quickstart", "--workers", "1", "--out", tmp_path / "with-threads")
+
+    def refused(self):
+        raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(threading.Thread, "start", refused)
+    done = cli("run", "quickstart", "--workers", "1", "--out", tmp_path / "no-threads")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "no-threads" / "plot.png").is_file()
+    timeless = lambda out: re.sub(r"in [\d.]+ s", "", out.replace("no-threads", "with-threads"))  # noqa: E731
+    assert timeless(done.stdout) == timeless(here.stdout) and "xi = a + b ln f" in done.stdout
+
+
+def test_a_progress_bar_is_drawn_where_no_thread_can_start(monkeypatch):
+    """rich redraws its bar from a thread of its own; without one the bar is redrawn as it moves."""
+    import io
+    import threading
+
+    from frictionlab.progress import _Bar
+
+    def refused(self):
+        raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(threading.Thread, "start", refused)
+    stream = io.StringIO()
+    bar = _Bar(stream, "realizations", 10)
+    bar.update(7)
+    bar.stop()
+    assert "7/10" in stream.getvalue()

@@ -249,7 +249,10 @@ def compute_chunk_here(
             errors.append(exc)
 
     solver = threading.Thread(target=work, name="frictionlab-solve", daemon=True)
-    solver.start()
+    try:
+        solver.start()
+    except RuntimeError:  # no thread to be had (a container's pids limit): solved here, a cancel heard between realizations
+        work()
     while solver.is_alive():
         solver.join(CANCEL_POLL_SECONDS)
         if cancel is not None and cancel.is_set():

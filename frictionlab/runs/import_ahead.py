@@ -51,9 +51,13 @@ def import_ahead(name: str) -> threading.Thread | None:
         return None
     if _importing is None and hasattr(os, "register_at_fork"):
         os.register_at_fork(before=_wait_for_the_import)
-    _importing = threading.Thread(target=_import_quietly, args=(name,), name=f"import {name}", daemon=True)
-    _importing.start()
-    return _importing
+    thread = threading.Thread(target=_import_quietly, args=(name,), name=f"import {name}", daemon=True)
+    try:
+        thread.start()
+    except RuntimeError:  # no thread to be had (a container's pids limit): imported when it is needed
+        return None
+    _importing = thread
+    return thread
 
 
 class PlotImportAhead:
