@@ -205,3 +205,21 @@ def test_a_progress_bar_is_drawn_where_no_thread_can_start(monkeypatch):
     bar.update(7)
     bar.stop()
     assert "7/10" in stream.getvalue()
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="flock is POSIX")
+@pytest.mark.parametrize("code", [errno.ENOLCK, errno.ENOSYS])
+def test_a_folder_on_a_file_system_without_locks_is_refused_naming_it(tmp_path, monkeypatch, cli, code):
+    """Some network file systems keep no locks: a run without its folder's lock could share the
+    folder with another and mix their chunks. It ended 'error: cannot write: No locks available'."""
+    import fcntl
+
+    def no_locks(fd, operation):
+        raise OSError(code, os.strerror(code))
+
+    monkeypatch.setattr(fcntl, "flock", no_locks)
+    done = cli("run", "quickstart", "--out", tmp_path / "out")
+    assert done.returncode not in (0, 70) and "Traceback" not in done.stderr
+    assert f"run.lock cannot be locked ({os.strerror(code)})" in done.stderr
+    assert "does not keep locks" in done.stderr and "give an output folder on a local disk" in done.stderr
+    assert not (tmp_path / "out" / "summary.json").exists()

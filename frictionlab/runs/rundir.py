@@ -29,6 +29,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
+import errno
 import os
 import re
 import time
@@ -168,6 +169,13 @@ class RunDirectory:
             raise RunFolderError(
                 f"{shown(self.path)} is in use by another run ({holder}): wait for it to end, "
                 "or give another output folder"
+            ) from None
+        except OSError as exc:
+            if exc.errno not in (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP):
+                raise
+            raise RunFolderError(  # two runs into one folder would mix their chunks: none without the lock
+                f"{shown(lock)} cannot be locked ({exc.strerror}): the file system of {shown(self.path)} does not "
+                "keep locks (some network file systems do not); give an output folder on a local disk"
             ) from None
         return self
 
