@@ -41,7 +41,9 @@ from .instrument_reader import reason_said
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .text_table import read_text_table
-from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
+from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning
+from .scan_shaping.levelling import level_line, line_form_warning
+from .scan_shaping.spikes import line_spike_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
