@@ -506,7 +506,7 @@ def test_a_steep_line_with_little_roughness_is_read_not_an_internal_error(tmp_pa
     t = np.arange(256.0)
     z = 3.0 * t + 1e-9 * np.random.default_rng(np.random.SeedSequence(0)).standard_normal(t.size) + bow * (t - 100) ** 2
     np.save(tmp_path / "steep.npy", z)
-    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1.0, "detrend": "tilt"}}
+    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1e-4, "detrend": "tilt"}}
     (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": spec}))
     code = main(["validate", str(tmp_path / "p.yaml")])
     text = capsys.readouterr().err

@@ -1,12 +1,14 @@
 """Caveats of heights that are not a surface's: a few points far from the rest (outliers, a value
-written for a missing pixel), heights in steps or clipped at a range, and a map too flat to tell
-from the rounding of its numbers (``FLAT``)."""
+written for a missing pixel), heights in steps or clipped at a range, a map too flat to tell
+from the rounding of its numbers (``FLAT``), and heights in another unit than the pixels'."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+
+from .spikes import mean_square_slope
 
 FLAT = 1e-12  # an rms height below this share of the largest height is the rounding of the numbers: flat
 OUTLIER_RATIO = 5.0  # rms height over the robust one: Gaussian heights 1, a sine's 0.67, a map with a sentinel 100s
@@ -95,3 +97,32 @@ def flat_rms(rms: float, largest: float) -> tuple[str, str]:
     if rms == 0:
         return "zero", ""
     return f"{rms:.3g}", f", below {FLAT:g} of its largest height {largest:.3g}: the rounding of its numbers"
+
+
+SLOPES = (1e-6, 10.0)  # rms slopes of measured surfaces lie inside, by far: outside, heights and pixels disagree in unit
+
+
+def units_warning(z: np.ndarray, spacing: float, summary: dict, what: str) -> str | None:
+    """The caveat of a levelled map or line (``what``, on square pixels of ``spacing``) whose rms
+    slope is outside SLOPES: its heights and its pixel side are most likely in different units
+    (heights in m beside pixels in um: slopes 1e-6 times a surface's). xi against f does not
+    change with the ratio, but the force unit E* h L and E* g do, so F and p/E* are off by it.
+    ``summary`` (the input summary) says which unit each was taken in and from where."""
+    slope = math.sqrt(mean_square_slope(z if z.ndim == 2 else z.reshape(1, -1), (spacing, spacing)))
+    if SLOPES[0] <= slope <= SLOPES[1] or not math.isfinite(slope):
+        return None
+    unit = summary.get("unit")
+    heights = f"heights in {unit}" if unit else "heights in no stated unit"
+    if summary.get("file_unit") and summary["file_unit"] != unit:
+        heights += f" (converted from the file's {summary['file_unit']})"
+    else:
+        heights += {"preset": " (the preset's unit)", "file": " (the file's)", "header": " (the header's)"}.get(
+            summary.get("unit_from"), "")
+    pixels = f"{'pixels' if what == 'map' else 'points'} {spacing:.3g}{f' {unit}' if unit else ''} apart " \
+             f"({'the preset' if summary.get('spacing_from') == 'preset' else 'the file'}'s spacing)"
+    side = "above" if slope > SLOPES[1] else "below"
+    return (f"the {what}'s rms slope is {slope:.3g}, with its {heights} and its {pixels}: {side} any measured "
+            f"surface's ({SLOPES[0]:g} to {SLOPES[1]:g}), as heights and pixel sides in different units make it "
+            "(heights in m beside pixels in um: a millionth of the slope). xi against f does not change, but the force "
+            "unit E* h L and the full-contact pressure E* g are off by the ratio of the units, and with them every "
+            "F and p/E*: give the heights in the unit of the pixel side (unit, spacing), or convert the file")  # fmt: skip

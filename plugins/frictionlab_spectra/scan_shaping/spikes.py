@@ -46,7 +46,7 @@ def _spike_slope_note(z: np.ndarray, rms: float, pixel: tuple[float, float], wha
         cleaned, count = despike(z, SPIKE_K, rms)
     except ValueError:  # too many points for spikes: the spike caveat's count is the story
         return "", 0
-    spiky, smooth = _mean_square_slope(z, pixel), _mean_square_slope(cleaned, pixel)
+    spiky, smooth = mean_square_slope(z, pixel), mean_square_slope(cleaned, pixel)
     if not spiky > 0 or smooth >= (1.0 - SPIKE_SLOPE_SHARE) * spiky:
         return "", count
     times = f", {math.sqrt(spiky / smooth):.3g} times what it is without them" if smooth > 0 else ""
@@ -82,7 +82,7 @@ def _pits_warning(z: np.ndarray, rms: float, pixel: tuple[float, float], what: s
             f"rather than leaving them undefined{note}; {fix.format(them=them)}, if {they} not the surface's own")  # fmt: skip
 
 
-def _mean_square_slope(z: np.ndarray, pixel: tuple[float, float]) -> float:
+def mean_square_slope(z: np.ndarray, pixel: tuple[float, float]) -> float:
     """The mean squared gradient of map ``z`` (a line: one row) by forward differences on pixels of (dx, dy)."""
     return sum(float(np.mean(square)) for square in _squared_slopes(z, pixel))
 
