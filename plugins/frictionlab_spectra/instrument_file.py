@@ -29,7 +29,7 @@ from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
     check_text_heights, check_text_room, check_text_whole, choose_reader, describe_failure,
-    TEXT_FORMATS, quoted,
+    parses_text, quoted,
 )
 
 MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
@@ -121,7 +121,7 @@ def _open_reader(fh, path: Path, where: str):
     from SurfaceTopography.IO import open_topography
 
     reader_class = choose_reader(fh, path.suffix.lower().lstrip("."), where)
-    if reader_class.format() in TEXT_FORMATS:  # parsed whole as it is opened
+    if parses_text(reader_class, fh):  # parsed whole as it is opened
         check_text_room(fh, reader_class, where)
         check_text_whole(fh, reader_class, where)
     try:
@@ -216,7 +216,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
                              "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
                              "interpolate it onto one")  # fmt: skip
-        if topography.dim == 1 and type(reader).format() in TEXT_FORMATS and (x := _text_x(fh, heights.size)) is not None:
+        if topography.dim == 1 and parses_text(type(reader), fh) and (x := _text_x(fh, heights.size)) is not None:
             uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:

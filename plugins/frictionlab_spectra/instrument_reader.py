@@ -22,6 +22,7 @@ from .header_units import NUMBERS, check_heights_are_lengths, check_units_named,
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
+BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary variant, which its reader reads too
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
 AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
@@ -54,12 +55,12 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         )
     if chosen.format() == "asc" and _coordinate_rows(fh):  # x, y, z per line under .txt: not a matrix of heights
         chosen = next(reader for reader in readers if reader.format() == "xyz")
-    if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
+    if parses_text(chosen, head) and not _looks_like_text(head):
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
             f"{chosen.name()} file; give a binary format its own suffix"
         )
-    if chosen.format() in TEXT_FORMATS and head.startswith(UTF8_BOM):  # its readers fail on it, as on damage
+    if parses_text(chosen, head) and head.startswith(UTF8_BOM):  # its readers fail on it, as on damage
         raise ValueError(
             f"{where}: a text export that starts with a UTF-8 byte-order mark (as a spreadsheet saves 'CSV UTF-8'), "
             f"which SurfaceTopography's {chosen.name()} reader does not read; save it without one (plain CSV or text)"
@@ -67,6 +68,21 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     if head.startswith(ZIP_MAGIC):
         check_zip_members(fh, chosen, where)
     return chosen
+
+
+def parses_text(reader, file) -> bool:
+    """Whether ``reader`` parses ``file`` (the open file, its first bytes, or None: unknown) as
+    text: a text format, unless the file starts with the magic of its binary variant (an SDF's)."""
+    magic = BINARY_VARIANTS.get(reader.format())
+    if reader.format() not in TEXT_FORMATS or magic is None or file is None:
+        return reader.format() in TEXT_FORMATS
+    if isinstance(file, bytes):
+        return not file.startswith(magic)
+    position = file.tell()
+    file.seek(0)
+    head = file.read(len(magic))
+    file.seek(position)
+    return head != magic
 
 
 def _coordinate_rows(fh) -> bool:
@@ -114,7 +130,7 @@ X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int1
 def header_units(fh, reader) -> list[str]:
     """The length units the header of a text export names (``x [\u00b5m]``, ``z (nm)``, ``z/nm``),
     in order, from the lines before its first row of numbers; empty for a binary format."""
-    if reader.format() not in TEXT_FORMATS:
+    if not parses_text(reader, fh):
         return []
     return named_units(head_text(fh))[0]
 
@@ -122,7 +138,7 @@ def header_units(fh, reader) -> list[str]:
 def check_text_heights(fh, reader, where: str) -> None:
     """Refuse a text export whose header labels a column in a unit that is no length
     (``header_units.check_heights_are_lengths``): its reader skips the header."""
-    if reader.format() in TEXT_FORMATS:
+    if parses_text(reader, fh):
         check_heights_are_lengths(head_text(fh), where)
 
 
@@ -373,14 +389,14 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
             f"{where}: the {name} file does not state its physical size; give spacing (the pixel side, in the "
             "run's length unit), or export the scan with its pixel size"
         )
-    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS and fh is not None and _is_utf8(fh):
+    if isinstance(exc, UnicodeError) and parses_text(reader, fh) and fh is not None and _is_utf8(fh):
         return ValueError(f"{where}: this {name} file holds no points its reader can read (it is UTF-8 text: a "
                           "header alone, or lines that are not numbers); export the scan again")  # fmt: skip
-    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS:
+    if isinstance(exc, UnicodeError) and parses_text(reader, fh):
         return ValueError(f"{where}: a text export that is not UTF-8 (a header in Latin-1: its µ?), which "
                           f"SurfaceTopography's {name} reader does not read; save it as UTF-8")  # fmt: skip
     if isinstance(exc, MemoryError):
-        what = "ran out of memory reading this text export" if reader.format() in TEXT_FORMATS else \
+        what = "ran out of memory reading this text export" if parses_text(reader, fh) else \
             "the file declares more points than this process can hold"
         return ValueError(f"{where}: {what} ({name}); crop it with the instrument's software")
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
