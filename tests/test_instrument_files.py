@@ -409,3 +409,19 @@ def test_validate_says_a_table_has_no_unit_unless_the_preset_gives_one(tmp_path,
         (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.npy", unit, spacing=PIXEL_UM)))
         assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
         assert f"read scan.npy (.npy): 32 x 24 pixels (x by y) {expected}" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("declared", ["NumProfiles = 20", "NumPoints = 31"])
+def test_an_sdf_whose_data_holds_more_numbers_than_its_header_declares_is_named_damaged(tmp_path, capsys, declared):
+    """SurfaceTopography's SDF reader reads lines until it has NumPoints x NumProfiles numbers:
+    a header declaring 20 profiles of a map of 24 was read as a map of 20 rows, the last 4
+    dropped without a word (a header of 31 points a profile, as the reader's own damage)."""
+    write_sdf(tmp_path / "scan.sdf", scan_um(), binary=False)
+    key = declared.split()[0]
+    text = (tmp_path / "scan.sdf").read_text().splitlines()
+    (tmp_path / "forged.sdf").write_text("\n".join(declared if line.startswith(key) else line for line in text) + "\n")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "forged.sdf", "um")))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    points = 20 * COLUMNS if key == "NumProfiles" else 31 * ROWS
+    assert f"its data holds {ROWS * COLUMNS} numbers, {ROWS * COLUMNS - points} more" in err and "Traceback" not in err, err

@@ -28,9 +28,10 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, check_text_whole, choose_reader, describe_failure,
+    check_text_heights, check_text_room, choose_reader, describe_failure,
     parses_text, quoted,
 )
+from .text_exports import check_declared_values, check_text_whole
 
 MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -124,6 +125,7 @@ def _open_reader(fh, path: Path, where: str):
     if parses_text(reader_class, fh):  # parsed whole as it is opened
         check_text_room(fh, reader_class, where)
         check_text_whole(fh, reader_class, where)
+        check_declared_values(fh, reader_class, where)
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted

@@ -333,27 +333,6 @@ def check_text_room(fh, reader, where: str) -> None:
         )
 
 
-TAIL_BYTES = 65536  # of a text export read for its last line
-
-
-def check_text_whole(fh, reader, where: str) -> None:
-    """Refuse a text export whose last line of numbers holds fewer than the line before it: a file
-    cut short (a copy or a transfer stopped). Its reader dropped the cut row, and a matrix export whose
-    header states its size stretched the rows left over it: pixels 1.5 times too long along y, resampled."""
-    size = os.fstat(fh.fileno()).st_size
-    fh.seek(max(0, size - TAIL_BYTES))
-    lines = [line for line in fh.read().decode("utf-8", errors="replace").splitlines()[1:] if line.strip()][-2:]
-    fh.seek(0)
-    if len(lines) < 2 or not all(NUMBERS.match(line) for line in lines):  # a footer, or one line: nothing to compare
-        return
-    before, last = (len(re.split(r"[\s,;]+", line.strip())) for line in lines)
-    if last < before:
-        raise ValueError(
-            f"{where}: its last line holds {last} numbers and the line before it {before}: a {reader.name()} file "
-            f"cut short (a copy or a transfer stopped); {AGAIN}"
-        )
-
-
 def _is_utf8(fh) -> bool:
     """Whether the open file's bytes, all of them, read as UTF-8 (a chunk at a time)."""
     import codecs
