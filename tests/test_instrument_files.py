@@ -425,3 +425,13 @@ def test_an_sdf_whose_data_holds_more_numbers_than_its_header_declares_is_named_
     err = capsys.readouterr().err
     points = 20 * COLUMNS if key == "NumProfiles" else 31 * ROWS
     assert f"its data holds {ROWS * COLUMNS} numbers, {ROWS * COLUMNS - points} more" in err and "Traceback" not in err, err
+
+
+def test_an_sdf_with_a_byte_order_mark_is_named_as_such_not_as_another_format(tmp_path):
+    """A text SDF saved by an editor with a byte-order mark before its magic 'aISO-1.0' was told
+    'its first bytes are not that format's: a damaged file, or another format under that suffix'."""
+    write_sdf(tmp_path / "plain.sdf", scan_um(), binary=False)
+    (tmp_path / "marked.sdf").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.sdf").read_bytes())
+    with pytest.raises(ValueError, match="starts with a UTF-8 byte-order mark .* save it without one") as refused:
+        SurfaceFile(path=str(tmp_path / "marked.sdf")).rms_height()
+    assert "damaged" not in str(refused.value) and "another format" not in str(refused.value)

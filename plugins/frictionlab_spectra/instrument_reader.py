@@ -42,6 +42,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     chosen = next((r for r in matches if r in by_suffix), matches[0] if matches else None)
     if chosen is None:
         chosen = next((r for r in by_suffix if r.can_read(head) != MagicMatch.NO), None)
+    if chosen is None and head.startswith(UTF8_BOM):  # a text format's magic behind a byte-order mark
+        chosen = next((r for r in by_suffix if r.can_read(head[len(UTF8_BOM) :]) == MagicMatch.YES), None)
     if chosen is None and by_suffix:
         names = " or ".join(dict.fromkeys(reader.name() for reader in by_suffix))
         raise ValueError(f"{where}: its suffix .{path_suffix} names {names}, but its first bytes are not that "
