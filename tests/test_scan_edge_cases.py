@@ -180,6 +180,44 @@ def test_decimal_commas_are_named(tmp_path, separator):
         SurfaceFile(path=str(tmp_path / "d.csv"), spacing=0.1).rms_height()
 
 
+
+@pytest.mark.parametrize("kind", ["xyz", "matrix", "gwyddion"])
+@pytest.mark.parametrize("separator", [";", "\t"])
+def test_decimal_commas_of_an_instrument_export_are_named(tmp_path, kind, separator):
+    """An export in a European locale (x, y, z points, a matrix, Gwyddion's text export with its
+    header) writes 1,5e-07: SurfaceTopography's readers took the commas for separators, and the
+    scan was 'a damaged file (6 columns)' or held 'no channel of heights ... a spelling such as
+    micron'. The same scan with decimal points is read, with its heights."""
+    z = rough(9, 8, 7) * 1e-7
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    header = "# Channel: Height\n# Width: 0.8 µm\n# Height: 0.9 µm\n# Value units: m\n" if kind == "gwyddion" else ""
+    rows = zip(x.ravel(), y.ravel(), z.ravel()) if kind == "xyz" else z
+    text = header + "".join(separator.join(f"{v:.9e}" for v in row) + "\n" for row in rows)
+    (tmp_path / "comma.txt").write_text(text.replace(".", ",").replace("0,8 µm", "0.8 µm").replace("0,9 µm", "0.9 µm"))
+    (tmp_path / "point.txt").write_text(text if kind == "xyz" else text.replace(separator, "\t"))  # a matrix: whitespace
+    spacing = {"spacing": 0.1} if kind == "matrix" else {}
+    line = 5 if kind == "gwyddion" else 1
+    with pytest.raises(ValueError, match=rf"decimal commas at line {line} \(as 1,5\); .* export the scan with decimal points"):
+        SurfaceFile(path=str(tmp_path / "comma.txt"), format="instrument", **spacing).rms_height()
+    read = SurfaceFile(path=str(tmp_path / "point.txt"), format="instrument", detrend="mean", **spacing).generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-6 * np.abs(z).max())
+
+
+@pytest.mark.parametrize("suffix, separator, name", [(".csv", ",", "commas"), (".txt", ";", "semicolons"),
+                                                     (".txt", ",", "commas")])
+def test_a_matrix_export_separated_by_commas_is_named_as_such(tmp_path, suffix, separator, name):
+    """SurfaceTopography reads a matrix (format: instrument, a Gwyddion text export) between tabs
+    or spaces only: a .csv matrix went to its reader of x, y, z points ('a damaged file: 8
+    columns'), a .txt one was 'no channel of heights ... a spelling such as micron'. Read as a
+    table, its heights are the file's."""
+    z = rough(9, 8, 7)
+    path = tmp_path / f"m{suffix}"
+    path.write_text("".join(separator.join(f"{v:.9e}" for v in row) + "\n" for row in z))
+    with pytest.raises(ValueError, match=f"line 1 holds 8 numbers separated by {name}: a matrix .* format: table and spacing"):
+        SurfaceFile(path=str(path), format="instrument", spacing=0.1).rms_height()
+    read = SurfaceFile(path=str(path), format="table", spacing=0.1, detrend="mean").generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-8, atol=1e-8)
+
 # ------------------------------------------------------------ pixels far from square
 
 

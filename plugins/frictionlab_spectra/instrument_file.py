@@ -31,7 +31,7 @@ from .instrument_reader import (
     check_text_heights, check_text_room, choose_reader, describe_failure,
     parses_text, quoted,
 )
-from .text_exports import check_declared_values, check_text_whole
+from .text_exports import check_declared_values, check_numbers_written, check_text_whole
 
 MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -126,6 +126,7 @@ def _open_reader(fh, path: Path, where: str):
         check_text_room(fh, reader_class, where)
         check_text_whole(fh, reader_class, where)
         check_declared_values(fh, reader_class, where)
+        check_numbers_written(fh, reader_class, where)
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted

@@ -1,14 +1,17 @@
 """A text export's numbers against what the file says of them, before its reader parses it:
-a last line shorter than the one before (a file cut short), or an SDF's data holding more
-numbers than its header declares (its reader stops at the count declared)."""
+a last line shorter than the one before (a file cut short), an SDF's data holding more
+numbers than its header declares (its reader stops at the count declared), or numbers
+written with decimal commas (its reader takes them for separators)."""
 
 from __future__ import annotations
 
 import os
 import re
 
-from .header_units import NUMBERS
+from .header_units import NUMBERS, head_text
 from .instrument_reader import AGAIN
+
+COMMA_BETWEEN_DIGITS = re.compile(r"\d,\d")
 
 TAIL_BYTES = 65536  # of a text export read for its last line
 
@@ -62,3 +65,36 @@ def check_declared_values(fh, reader, where: str) -> None:
             f"its data holds {count} numbers, {count - points * profiles} more, which its reader would drop without a "
             f"word (a header that states too few points or profiles); {AGAIN}"
         )
+
+
+def check_numbers_written(fh, reader, where: str) -> None:
+    """Refuse a text export whose first row of numbers its reader would misread: decimal commas
+    between its separators (tabs, spaces, semicolons: 1,5e-07;2,5e-07, as an export in a European
+    locale writes them), which its reader took for separators (an x, y, z export was 'damaged, 6
+    columns'); or a matrix separated by commas or semicolons, which no reader of SurfaceTopography
+    reads (its matrix reader: tabs and spaces only; a .csv goes to its reader of points). Each was
+    'damaged' or held 'no channel of heights ... a spelling such as micron'."""
+    from .text_table import decimal_commas, is_number  # here: text_table reads files through instrument_file
+
+    for lineno, line in enumerate(head_text(fh).splitlines()[:-1], start=1):  # the last line may be cut short
+        if not NUMBERS.match(line):
+            continue
+        cells = re.split(r"[\s;]+", line.strip())
+        if len(cells) > 1 and any(COMMA_BETWEEN_DIGITS.search(cell) for cell in cells) and all(
+                is_number(cell.replace(",", ".")) for cell in cells):
+            raise ValueError(f"{where}: {decimal_commas(lineno, 'scan')}")
+        numbers = re.split(r"[\s,;]+", line.strip())
+        matrix = reader.format() == "xyz" and len(numbers) > 3  # a .csv goes to the reader of points
+        if matrix or reader.format() == "asc" and re.search(r"[,;]", line):
+            raise ValueError(
+                f"{where}: line {lineno} holds {len(numbers)} numbers separated by {_separators(line)}: a matrix of "
+                f"heights, which SurfaceTopography's {reader.name()} reader does not read (it reads x, y, z points, or "
+                "a matrix between tabs or spaces in a .txt); read its bare numbers with format: table and spacing"
+            )
+        return
+
+
+def _separators(line: str) -> str:
+    """What separates the numbers of ``line``, in words."""
+    found = [name for mark, name in ((",", "commas"), (";", "semicolons"), ("\t", "tabs")) if mark in line]
+    return " and ".join(found) or "spaces"
