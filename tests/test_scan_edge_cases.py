@@ -381,6 +381,22 @@ def rewritten_x3p(source, path, *, xml=lambda text: text, data=lambda payload: p
     return path
 
 
+@pytest.mark.parametrize("axis", ["X", "Y"])
+def test_an_x3p_with_positions_given_point_by_point_is_named_not_damaged(tmp_path, axis):
+    """An X3P whose x (or y) axis is absolute (AxisType A: a position stored for every point) is
+    a valid file SurfaceTopography does not read; it was 'a damaged ... file: copy it again'."""
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+    absolute = rb"\1A"
+    rewritten_x3p(tmp_path / "good.x3p", tmp_path / "absolute.x3p",
+                  xml=lambda text: re.sub(rb"(<C" + axis.encode() + rb">\s*<AxisType>)I", absolute, text))
+    with pytest.raises(ValueError, match=rf"gives its {axis.lower()} positions point by point .* \(not damage\)") as refused:
+        SurfaceFile(path=str(tmp_path / "absolute.x3p")).rms_height()
+    assert "damaged" not in str(refused.value) and "copy it again" not in str(refused.value)
+
+
 @pytest.mark.parametrize("lie, said", [
     ({"data": lambda payload: payload + payload[:80]}, "take 2640 bytes, and its description declares 320 points "
                                                        "of data type D (8 bytes each: 2560 bytes)"),

@@ -382,6 +382,10 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
         return ValueError(f"{where}: {what} ({name}); crop it with the instrument's software")
     if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
         return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
+    if isinstance(exc, CorruptFile) and (axis := re.match(r"C([XY]) AxisType is not 'I'", text)):  # its own words
+        return ValueError(f"{where}: this {name} file gives its {axis[1].lower()} positions point by point (AxisType A), "
+                          "not on a regular grid (AxisType I), which is all SurfaceTopography reads (not damage): export "
+                          "the scan on the instrument's grid, or its heights as a table with spacing")  # fmt: skip
     if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):
         return ValueError(f"{where}: its header names the lateral unit {quoted(unknown[1])}, which SurfaceTopography's "
                           f"{name} reader does not know (not damage); write it as one it knows: {_KNOWN_LENGTHS}")  # fmt: skip
