@@ -382,6 +382,23 @@ def test_units_that_are_not_lengths_are_refused_and_a_unit_mismatch_is_named(tmp
         SurfaceFile(path=str(tmp_path / "mixed.nc")).generate(None)
 
 
+def test_sizes_along_x_and_y_in_different_units_are_named_as_such_not_as_the_heights(tmp_path):
+    """A NetCDF whose x is in um and y in nm (heights in um) was told its heights and its lateral
+    sizes were in different units, and to convert its heights."""
+    z = np.random.default_rng(3).normal(size=(12, 10))
+    with netcdf_file(str(tmp_path / "xy.nc"), "w") as nc:
+        for name, size, length, unit in (("x", 12, 6.0, "um"), ("y", 10, 5000.0, "nm")):
+            nc.createDimension(name, size)
+            var = nc.createVariable(name, "d", (name,))
+            var.length, var.unit = length, unit
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = z
+        heights.unit = "um"
+    with pytest.raises(ValueError, match="sizes along x and along y are in different length units") as refused:
+        SurfaceFile(path=str(tmp_path / "xy.nc")).generate(None)
+    assert "convert its heights" not in str(refused.value)
+
+
 def test_a_unit_of_any_length_is_quoted_cut_in_the_middle(tmp_path):
     """A file's unit is the file's text: one of 10,000 characters was quoted whole in the
     refusal that it is not a length unit."""

@@ -360,10 +360,14 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
 
     name = reader.name()
     text = str(exc)
-    if isinstance(exc, ValueError) and "Units for" in text and "differ" in text:  # SurfaceTopography's own words
+    if isinstance(exc, ValueError) and "Units for x- and y-coordinate" in text:  # SurfaceTopography's own words
+        return ValueError(f"{where}: the file's sizes along x and along y are in different length units, and "
+                          f"SurfaceTopography reads a {name} file with one unit for both; convert them to one")  # fmt: skip
+    if isinstance(exc, ValueError) and "Units for" in text and "differ" in text:
         return ValueError(
             f"{where}: the file's heights and its lateral sizes are in different units, and SurfaceTopography "
-            f"reads a {name} file with one unit for both; convert its heights to the unit of its sizes"
+            f"reads a {name} file with one unit for both; convert its heights to the unit of its sizes (values in a "
+            "unit that is no length, volts or degrees, are no heights: export the height channel)"
         )
     if isinstance(exc, ValueError) and "physical_sizes" in text:  # SurfaceTopography's own words: not damage
         return ValueError(
