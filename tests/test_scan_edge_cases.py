@@ -213,10 +213,20 @@ def test_a_matrix_export_separated_by_commas_is_named_as_such(tmp_path, suffix, 
     z = rough(9, 8, 7)
     path = tmp_path / f"m{suffix}"
     path.write_text("".join(separator.join(f"{v:.9e}" for v in row) + "\n" for row in z))
-    with pytest.raises(ValueError, match=f"line 1 holds 8 numbers separated by {name}: a matrix .* format: table and spacing"):
+    with pytest.raises(ValueError, match=f"line 1 holds 8 numbers separated by {name}, .* format: table and spacing"):
         SurfaceFile(path=str(path), format="instrument", spacing=0.1).rms_height()
     read = SurfaceFile(path=str(path), format="table", spacing=0.1, detrend="mean").generate(None)
     np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-8, atol=1e-8)
+
+
+def test_an_xyz_export_with_a_fourth_column_is_told_to_keep_x_y_and_the_heights(tmp_path):
+    """x, y, z and an intensity per point was 'a damaged Plain text file (4 columns): copy it again'."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    rows = zip(x.ravel(), y.ravel(), z.ravel(), np.ones(z.size))
+    (tmp_path / "xyzi.csv").write_text("".join(",".join(f"{v:.9e}" for v in row) + "\n" for row in rows))
+    with pytest.raises(ValueError, match="line 1 holds 4 numbers separated by commas, .* export x, y and the heights alone"):
+        SurfaceFile(path=str(tmp_path / "xyzi.csv"), format="instrument").rms_height()
 
 # ------------------------------------------------------------ pixels far from square
 

@@ -84,12 +84,12 @@ def check_numbers_written(fh, reader, where: str) -> None:
                 is_number(cell.replace(",", ".")) for cell in cells):
             raise ValueError(f"{where}: {decimal_commas(lineno, 'scan')}")
         numbers = re.split(r"[\s,;]+", line.strip())
-        matrix = reader.format() == "xyz" and len(numbers) > 3  # a .csv goes to the reader of points
-        if matrix or reader.format() == "asc" and re.search(r"[,;]", line):
-            raise ValueError(
-                f"{where}: line {lineno} holds {len(numbers)} numbers separated by {_separators(line)}: a matrix of "
-                f"heights, which SurfaceTopography's {reader.name()} reader does not read (it reads x, y, z points, or "
-                "a matrix between tabs or spaces in a .txt); read its bare numbers with format: table and spacing"
+        if reader.format() == "xyz" and len(numbers) > 3 or reader.format() == "asc" and re.search(r"[,;]", line):
+            raise ValueError(  # a .csv goes to the reader of points; a .txt of numbers between commas to the matrix one
+                f"{where}: line {lineno} holds {len(numbers)} numbers separated by {_separators(line)}, which "
+                "SurfaceTopography does not read: its readers take x, y, z points (three a line, or x, z) or a matrix "
+                "of heights between tabs or spaces (in a .txt); export x, y and the heights alone, or read a matrix's "
+                "bare numbers with format: table and spacing"
             )
         return
 
