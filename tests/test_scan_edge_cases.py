@@ -219,6 +219,23 @@ def test_a_matrix_export_separated_by_commas_is_named_as_such(tmp_path, suffix, 
     np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-8, atol=1e-8)
 
 
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_a_text_export_in_utf16_is_told_to_be_saved_as_utf8(tmp_path, encoding):
+    """A Windows program's 'Unicode text' (UTF-16, with or without its byte-order mark) sent to
+    SurfaceTopography was 'a .txt file that is not text (binary bytes at its start): give a binary
+    format its own suffix'. The same export in UTF-8 is read, its heights the file's."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    text = "".join(f"{a:.9e}\t{b:.9e}\t{c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel()))
+    (tmp_path / "wide.txt").write_bytes(text.encode(encoding))
+    with pytest.raises(ValueError, match="a text export in UTF-16 .* save it as UTF-8") as refused:
+        SurfaceFile(path=str(tmp_path / "wide.txt"), format="instrument").rms_height()
+    assert "not text" not in str(refused.value)
+    (tmp_path / "plain.txt").write_text(text)
+    read = SurfaceFile(path=str(tmp_path / "plain.txt"), format="instrument", detrend="mean").generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-15)
+
 def test_an_xyz_export_with_a_fourth_column_is_told_to_keep_x_y_and_the_heights(tmp_path):
     """x, y, z and an intensity per point was 'a damaged Plain text file (4 columns): copy it again'."""
     y, x = np.mgrid[0:9, 0:8] * 1e-7

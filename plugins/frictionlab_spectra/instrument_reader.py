@@ -57,6 +57,11 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         )
     if chosen.format() == "asc" and _coordinate_rows(fh):  # x, y, z per line under .txt: not a matrix of heights
         chosen = next(reader for reader in readers if reader.format() == "xyz")
+    if parses_text(chosen, head) and _utf16(head):
+        raise ValueError(
+            f"{where}: a text export in UTF-16 (as a Windows program saves 'Unicode text'), which SurfaceTopography's "
+            f"{chosen.name()} reader does not read: save it as UTF-8 (or plain ASCII)"
+        )
     if parses_text(chosen, head) and not _looks_like_text(head):
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
@@ -95,6 +100,18 @@ def _coordinate_rows(fh) -> bool:
         if NUMBERS.match(line):
             return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
     return False
+
+
+UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # UTF-16's byte-order marks, little and big endian
+
+
+def _utf16(head: bytes) -> bool:
+    """Text in UTF-16: its byte-order mark, or printable ASCII with a NUL beside every character."""
+    sample = head[: len(head) // 2 * 2][:256]
+    printable = set(range(32, 127)) | set(b"\t\n\r")
+    ascii_pairs = any(sample[odd::2].count(0) == len(sample) // 2 and set(sample[1 - odd :: 2]) <= printable
+                      for odd in (0, 1))  # fmt: skip
+    return head.startswith(UTF16_MARKS) or len(sample) >= 8 and ascii_pairs
 
 
 def _looks_like_text(head: bytes) -> bool:
