@@ -28,9 +28,9 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, choose_reader, describe_failure,
-    parses_text, quoted,
+    check_text_heights, check_text_room, choose_reader, parses_text, quoted,
 )
+from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
 
 MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
