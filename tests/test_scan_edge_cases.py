@@ -236,6 +236,27 @@ def test_a_text_export_in_utf16_is_told_to_be_saved_as_utf8(tmp_path, encoding):
     read = SurfaceFile(path=str(tmp_path / "plain.txt"), format="instrument", detrend="mean").generate(None)
     np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-15)
 
+
+@pytest.mark.parametrize("left_out, said", [([5, 40, 41], "3 of its points missing"), ([], "1 listed twice")])
+def test_an_xyz_export_with_points_left_out_is_told_which_grid_they_lie_on(tmp_path, left_out, said):
+    """An optical profilometer's x, y, z export leaves out the points it did not measure: 'not on
+    a regular grid: export the map on the instrument's grid', which it was. The grid and the
+    points missing (or listed twice) are named, and the same export with those points written
+    with a NaN height is read, filled by undefined: harmonic, the other heights the file's."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    rows = [f"{a:.9e} {b:.9e} {c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel())]
+    kept = [row for i, row in enumerate(rows) if i not in left_out] + ([] if left_out else rows[10:11])
+    (tmp_path / "gaps.txt").write_text("".join(kept))
+    with pytest.raises(ValueError, match=f"lie on a grid of 8 x 9 points \\(x by y\\), {said}; write each point"):
+        SurfaceFile(path=str(tmp_path / "gaps.txt"), format="instrument").rms_height()
+    nan = [row.rsplit(" ", 1)[0] + " nan\n" if i in left_out else row for i, row in enumerate(rows)]
+    (tmp_path / "nan.txt").write_text("".join(nan))
+    read = SurfaceFile(path=str(tmp_path / "nan.txt"), format="instrument", undefined="harmonic", detrend="none")
+    measured = np.ones(z.size, bool)
+    measured[left_out] = False
+    np.testing.assert_allclose(read.generate(None).heights.ravel()[measured], z.ravel()[measured], rtol=1e-6)
+
 def test_an_xyz_export_with_a_fourth_column_is_told_to_keep_x_y_and_the_heights(tmp_path):
     """x, y, z and an intensity per point was 'a damaged Plain text file (4 columns): copy it again'."""
     y, x = np.mgrid[0:9, 0:8] * 1e-7

@@ -5,7 +5,10 @@ in another encoding. The reader's own words are shown on one line, cut short."""
 
 from __future__ import annotations
 
+import os
 import re
+
+import numpy as np
 
 from .instrument_reader import AGAIN, parses_text, quoted
 
@@ -83,6 +86,10 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
             f"{where}: the points of this {name} file make no grid: there is one, two share a position, or all lie on "
             "one row or one column (a line scan written as x, y, z); export a line as its x and z for profile-file, a map with "
             "each point once on the instrument's grid")  # fmt: skip
+    if isinstance(exc, CorruptFile) and "regular grid" in text and fh is not None and (gaps := _grid_gaps(fh)):
+        return ValueError(f"{where}: this {name} file's points lie on a grid of {gaps}; write each point of the grid once, "
+                          "one not measured with the height NaN (undefined: harmonic fills it), or export the map as a "
+                          "matrix")  # fmt: skip
     if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
         return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
                           "on the instrument's grid, or its heights as a matrix (a table) with spacing")  # fmt: skip
@@ -91,6 +98,41 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
         kind = "a damaged"
     return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
                       f"its format cannot read it: {AGAIN}")  # fmt: skip
+
+
+ON_GRID = 1e-3  # of a step: a position this far from the grid's is on it (a text export's rounding)
+GAPS_BYTES = 2**26  # an export read again, point by point, for its gaps: larger ones get the reader's words alone
+
+
+def _grid_gaps(fh) -> str | None:
+    """What keeps an x, y, z export's points from a full grid when they lie on one (their x and
+    y each a whole number of steps from the first): points left out (an export that drops those
+    it did not measure) or listed twice, in words; None when they lie on no grid (or the file is large)."""
+    if os.fstat(fh.fileno()).st_size > GAPS_BYTES:
+        return None
+    points = []
+    fh.seek(0)
+    for raw in fh:  # a line at a time; a header's words are no numbers
+        try:
+            points.append([float(word) for word in re.split(r"[\s,;]+", raw.decode("utf-8", "replace").strip())][:2])
+        except ValueError:
+            continue
+    fh.seek(0)
+    xy = np.array([point for point in points if len(point) == 2])
+    if xy.shape[0] < 4:
+        return None
+    index = []
+    for axis in xy.T:
+        steps = np.diff(np.unique(axis))
+        step = float(np.median(steps)) if steps.size else 0.0
+        if not step > 0 or np.any(np.abs((axis - axis.min()) / step - np.round((axis - axis.min()) / step)) > ON_GRID):
+            return None
+        index.append(np.round((axis - axis.min()) / step).astype(np.int64))
+    nx, ny = int(index[0].max()) + 1, int(index[1].max()) + 1
+    distinct = np.unique(index[1] * nx + index[0]).size
+    missing, twice = nx * ny - distinct, xy.shape[0] - distinct
+    said = [f"{missing} of its points missing" if missing else "", f"{twice} listed twice" if twice else ""]
+    return f"{nx} x {ny} points (x by y), {' and '.join(part for part in said if part)}" if missing or twice else None
 
 
 REASON_SHOWN = 160
