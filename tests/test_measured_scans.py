@@ -178,3 +178,26 @@ def test_heights_in_another_unit_than_the_pixels_are_said_with_the_slope_they_ma
                          .input_summary()["caveats"])  # fmt: skip
     assert said is not None and said.startswith("the line's rms slope is") and "points 0.5 um apart" in said, said
     assert _said_slope(said) == pytest.approx(factor * line_slope, rel=2e-3)
+
+
+def test_the_tui_says_what_validate_says_of_the_file_read(tmp_path, capsys):
+    """The TUI's edit panel showed the line on what was read, but not the caveats of the file
+    (heights in another unit than the pixels, a tilt, spikes) that validate prints under it."""
+    import yaml
+
+    from frictionlab.cli import main
+    from frictionlab.registry import default_registry
+    from frictionlab.tui.fields import validation_of
+
+    z, _ = band_limited(64, 64, seed=11, top=0.3)
+    np.save(tmp_path / "mixed.npy", z * 0.05 / z.std() * 1e-6)  # um written in m, pixels in um
+    preset = {"name": "mixed", "realizations": 1, "solver": {"name": "mdr"},
+              "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "mixed.npy"), "spacing": 0.5,
+                                                              "unit": "um"}},
+              "loading": {"start": 1e-4, "stop": 1e-3, "steps": 3}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 0
+    printed = [line.strip() for line in capsys.readouterr().out.splitlines() if "caveat: the map's rms slope" in line]
+    problems, shown = validation_of(preset, default_registry())
+    assert problems == [] and len(printed) == 1, printed
+    assert printed[0] in shown.splitlines(), shown
