@@ -1,7 +1,8 @@
 """A text export's numbers against what the file says of them, before its reader parses it:
 a last line shorter than the one before (a file cut short), an SDF's data holding more
-numbers than its header declares (its reader stops at the count declared), or numbers
-written with decimal commas (its reader takes them for separators)."""
+numbers than its header declares (its reader stops at the count declared), numbers written
+with decimal commas (its reader takes them for separators), or rows it does not read (a
+matrix between commas, points with more columns than x, y, z)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,8 @@ import re
 from .header_units import NUMBERS, head_text
 from .instrument_reader import AGAIN
 
-COMMA_BETWEEN_DIGITS = re.compile(r"\d,\d")
-
 TAIL_BYTES = 65536  # of a text export read for its last line
+COMMA_BETWEEN_DIGITS = re.compile(r"\d,\d")  # 1,5: a decimal comma, where a cell holds one
 
 
 def check_text_whole(fh, reader, where: str) -> None:
