@@ -203,6 +203,22 @@ def test_decimal_commas_of_an_instrument_export_are_named(tmp_path, kind, separa
     np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-6 * np.abs(z).max())
 
 
+
+def test_a_gwyddion_export_whose_header_sizes_have_decimal_commas_is_named(tmp_path):
+    """Gwyddion's text export in a European locale writes '# Width: 0,800 µm': the reader took
+    ',800 µm' for an unknown lateral unit ('write it as one it knows: m, mm, µm'). With points,
+    the same export is read on pixels of 0.1 um, its heights the file's."""
+    z = rough(9, 8, 7) * 1e-7
+    matrix = "".join("\t".join(f"{v:.9e}" for v in row) + "\n" for row in z)
+    header = "# Channel: Height\n# Width: 0.800 µm\n# Height: 0.900 µm\n# Value units: m\n"
+    (tmp_path / "comma.txt").write_text(header.replace("0.", "0,") + matrix)
+    with pytest.raises(ValueError, match=r"its header writes a size with a decimal comma .* export it with decimal points"):
+        SurfaceFile(path=str(tmp_path / "comma.txt"), format="instrument").rms_height()
+    (tmp_path / "point.txt").write_text(header + matrix)
+    read = SurfaceFile(path=str(tmp_path / "point.txt"), format="instrument", unit="um", detrend="none").generate(None)
+    assert read.spacing == pytest.approx(0.1, rel=1e-9)
+    np.testing.assert_allclose(read.heights, z * 1e6, rtol=1e-8)
+
 @pytest.mark.parametrize("suffix, separator, name", [(".csv", ",", "commas"), (".txt", ";", "semicolons"),
                                                      (".txt", ",", "commas")])
 def test_a_matrix_export_separated_by_commas_is_named_as_such(tmp_path, suffix, separator, name):

@@ -72,6 +72,10 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
         return ValueError(f"{where}: this {name} file gives its {axis[1].lower()} positions point by point (AxisType A), "
                           "not on a regular grid (AxisType I), which is all SurfaceTopography reads (not damage): export "
                           "the scan on the instrument's grid, or its heights as a table with spacing")  # fmt: skip
+    if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)) and \
+            re.match(r",\d", unknown[1]):  # 16,000 µm: the reader split the size at its decimal comma
+        return ValueError(f"{where}: its header writes a size with a decimal comma (as 16,000 µm: its reader took "
+                          f"{quoted(unknown[1])} for the unit); export it with decimal points")  # fmt: skip
     if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):
         return ValueError(f"{where}: its header names the lateral unit {quoted(unknown[1])}, which SurfaceTopography's "
                           f"{name} reader does not know (not damage); write it as one it knows: {_KNOWN_LENGTHS}")  # fmt: skip
