@@ -65,9 +65,11 @@ def test_a_map_levelled_and_despiked_holds_at_most_three_copies_of_it(monkeypatc
     despiked map levelled again five at once."""
     from types import SimpleNamespace
 
-    from frictionlab_spectra import map_pipeline, scan_shaping
+    from frictionlab_spectra import map_pipeline
+    from frictionlab_spectra.scan_shaping import levelling, line_offsets
 
-    monkeypatch.setattr(scan_shaping, "LINE_BLOCK", 4096)  # blocks of rows a map of millions of points has
+    for module in (levelling, line_offsets):  # blocks of rows a map of millions of points has
+        monkeypatch.setattr(module, "LINE_BLOCK", 4096)
     z = np.random.default_rng(9).normal(size=(256, 256))
     z[::37, ::41] += 40.0
     p = SimpleNamespace(region=None, detrend=detrend, despike=6.0, downsample=None)

@@ -2,7 +2,7 @@
 
 The files are written here by the writers that exist, with known heights and pixel
 sizes: X3P by x3pio (ISO 5436-2000 revision, heights and sizes in metres), NetCDF
-and Gwyddion by SurfaceTopography. What is checked:
+and Gwyddion by SurfaceTopography, ISO 25178-71 SDF (text and binary) by hand. What is checked:
 
 * the numbers read are the numbers written, in the unit the preset asks for;
 * f and xi do not depend on the unit: the same scan in um and in nm, pressed with
@@ -16,6 +16,7 @@ and Gwyddion by SurfaceTopography. What is checked:
 from __future__ import annotations
 
 import json
+import struct
 import sys
 import warnings
 
@@ -56,10 +57,27 @@ def write_topography(path, z, pixel, unit, writer):
         getattr(topography, writer)(str(path))
 
 
+def write_sdf(path, z_um, binary: bool, pixel_um=PIXEL_UM):
+    """ISO 25178-71 SDF, by hand: metres, one profile (row) after another, as text or as binary
+    (its header packed little endian; DataType 7: float64)."""
+    ny, nx = z_um.shape
+    if binary:
+        header = struct.pack("<8s10s12s12sHHddddBBB", b"bISO-1.0", b"frictionlb", b"010120261200", b"010120261200", nx, ny,
+                             pixel_um * 1e-6, pixel_um * 1e-6, 1e-6, -1.0, 0, 7, 0)  # fmt: skip
+        path.write_bytes(header + z_um.astype("<f8").tobytes())
+        return
+    head = ["aISO-1.0", "ManufacID = frictionlab", f"NumPoints = {nx}", f"NumProfiles = {ny}", f"Xscale = {pixel_um * 1e-6!r}",
+            f"Yscale = {pixel_um * 1e-6!r}", "Zscale = 1e-06", "Zresolution = -1", "Compression = 0", "DataType = 7",
+            "CheckType = 0", "*"]  # fmt: skip
+    path.write_text("\n".join(head + [" ".join(map(repr, row)) for row in z_um.tolist()] + ["*"]) + "\n")
+
+
 WRITERS = {
     "x3p": lambda path, z: write_x3p(path, z),
     "nc": lambda path, z: write_topography(path, z, PIXEL_UM, "um", "to_netcdf"),
     "gwy": lambda path, z: write_topography(path, z * 1e3, PIXEL_UM * 1e3, "nm", "to_gwy"),
+    "sdf": lambda path, z: write_sdf(path, z, binary=False),
+    "binary.sdf": lambda path, z: write_sdf(path, z, binary=True),  # was refused as 'not text'
 }
 
 
@@ -73,7 +91,7 @@ def test_the_numbers_read_are_the_numbers_written_in_the_unit_asked(tmp_path, su
     made = surface.generate(None)
     summary = surface.input_summary()
     if unit is None:  # the file's own unit
-        factor = {"x3p": 1e-6, "nc": 1.0, "gwy": 1e-6}[suffix]  # X3P and Gwyddion store metres
+        factor = {"x3p": 1e-6, "nc": 1.0, "gwy": 1e-6}.get(suffix, 1.0)  # X3P and Gwyddion store metres; SDF is read in um
         assert summary["unit_from"] == "file"
     else:
         assert summary["unit"] == unit and summary["unit_from"] == "preset"
@@ -391,3 +409,29 @@ def test_validate_says_a_table_has_no_unit_unless_the_preset_gives_one(tmp_path,
         (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "scan.npy", unit, spacing=PIXEL_UM)))
         assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.OK
         assert f"read scan.npy (.npy): 32 x 24 pixels (x by y) {expected}" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("declared", ["NumProfiles = 20", "NumPoints = 31"])
+def test_an_sdf_whose_data_holds_more_numbers_than_its_header_declares_is_named_damaged(tmp_path, capsys, declared):
+    """SurfaceTopography's SDF reader reads lines until it has NumPoints x NumProfiles numbers:
+    a header declaring 20 profiles of a map of 24 was read as a map of 20 rows, the last 4
+    dropped without a word (a header of 31 points a profile, as the reader's own damage)."""
+    write_sdf(tmp_path / "scan.sdf", scan_um(), binary=False)
+    key = declared.split()[0]
+    text = (tmp_path / "scan.sdf").read_text().splitlines()
+    (tmp_path / "forged.sdf").write_text("\n".join(declared if line.startswith(key) else line for line in text) + "\n")
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "forged.sdf", "um")))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    points = 20 * COLUMNS if key == "NumProfiles" else 31 * ROWS
+    assert f"its data holds {ROWS * COLUMNS} numbers, {ROWS * COLUMNS - points} more" in err and "Traceback" not in err, err
+
+
+def test_an_sdf_with_a_byte_order_mark_is_named_as_such_not_as_another_format(tmp_path):
+    """A text SDF saved by an editor with a byte-order mark before its magic 'aISO-1.0' was told
+    'its first bytes are not that format's: a damaged file, or another format under that suffix'."""
+    write_sdf(tmp_path / "plain.sdf", scan_um(), binary=False)
+    (tmp_path / "marked.sdf").write_bytes(b"\xef\xbb\xbf" + (tmp_path / "plain.sdf").read_bytes())
+    with pytest.raises(ValueError, match="starts with a UTF-8 byte-order mark .* save it without one") as refused:
+        SurfaceFile(path=str(tmp_path / "marked.sdf")).rms_height()
+    assert "damaged" not in str(refused.value) and "another format" not in str(refused.value)

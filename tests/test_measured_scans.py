@@ -21,12 +21,12 @@ def test_a_scan_clipped_at_its_instruments_range_is_said(tmp_path, side):
     clipped = np.minimum(z, limit) if side == "highest" else np.maximum(z, limit)
     np.save(tmp_path / "clipped.npy", clipped)
     np.save(tmp_path / "whole.npy", z)
-    caveats = SurfaceFile(path=str(tmp_path / "clipped.npy"), spacing=0.1).input_summary()["caveats"]
+    caveats = SurfaceFile(path=str(tmp_path / "clipped.npy"), spacing=1.0).input_summary()["caveats"]
     assert any(f"% of the map's points sit at exactly its {side} height" in c and "part out (region)" in c
                for c in caveats), caveats  # fmt: skip
-    assert "caveats" not in SurfaceFile(path=str(tmp_path / "whole.npy"), spacing=0.1).input_summary()
+    assert "caveats" not in SurfaceFile(path=str(tmp_path / "whole.npy"), spacing=1.0).input_summary()
     np.savetxt(tmp_path / "line.csv", clipped[:8].ravel())
-    line = ProfileFile(path=str(tmp_path / "line.csv"), spacing=0.1).input_summary()
+    line = ProfileFile(path=str(tmp_path / "line.csv"), spacing=1.0).input_summary()
     assert any(f"of the line's points sit at exactly its {side} height" in c and "part out (of the profile)" in c
                for c in line["caveats"]), line  # a line has no region  # fmt: skip
 
@@ -47,13 +47,13 @@ def test_a_table_exported_with_its_axes_is_said_to_hold_positions(tmp_path):
     np.savetxt(tmp_path / "axes.csv", with_axes, delimiter=",", fmt="%.6g")
     np.savetxt(tmp_path / "numbered.csv", np.c_[np.arange(32), z], delimiter=",")
     np.savetxt(tmp_path / "plain.csv", z, delimiter=",")
-    said = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=0.1).input_summary()["caveats"][0]
+    said = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=1.0).input_summary()["caveats"][0]
     assert "the table's first row (0 to 1.21094) and first column (0 to 1.21094) are evenly spaced" in said, said
     assert "region: {x: [1, 33], y: [1, 33]}" in said
-    said = SurfaceFile(path=str(tmp_path / "numbered.csv"), spacing=0.1).input_summary()["caveats"][0]
+    said = SurfaceFile(path=str(tmp_path / "numbered.csv"), spacing=1.0).input_summary()["caveats"][0]
     assert "the table's first column (0 to 31) is evenly spaced" in said and "region: {x: [1, 33]}" in said, said
-    assert "caveats" not in SurfaceFile(path=str(tmp_path / "plain.csv"), spacing=0.1).input_summary()
-    cropped = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=0.1, region={"x": [1, 33], "y": [1, 33]})
+    assert "caveats" not in SurfaceFile(path=str(tmp_path / "plain.csv"), spacing=1.0).input_summary()
+    cropped = SurfaceFile(path=str(tmp_path / "axes.csv"), spacing=1.0, region={"x": [1, 33], "y": [1, 33]})
     assert "caveats" not in cropped.input_summary()
 
 
@@ -115,14 +115,14 @@ def test_a_map_of_white_noise_is_said_to_be_noise(tmp_path):
     heights = np.round(1000 * z / z.std()).astype("<i2")
     np.save(tmp_path / "swapped.npy", heights.byteswap().view("<i2"))
     np.save(tmp_path / "right.npy", heights)
-    said = SurfaceFile(path=str(tmp_path / "swapped.npy"), spacing=0.1).input_summary()["caveats"]
+    said = SurfaceFile(path=str(tmp_path / "swapped.npy"), spacing=1000.0).input_summary()["caveats"]
     assert any(c.startswith("the signs of the map's neighbouring heights are uncorrelated (") and "wrong order" in c
                for c in said), said  # fmt: skip
-    assert "caveats" not in SurfaceFile(path=str(tmp_path / "right.npy"), spacing=0.1).input_summary()
+    assert "caveats" not in SurfaceFile(path=str(tmp_path / "right.npy"), spacing=1000.0).input_summary()
     dropouts = z.copy()
     dropouts[[5, 20, 33, 47, 60], [7, 50, 21, 40, 3]] = -9999.0  # their power is most of the map's: not noise
     np.save(tmp_path / "dropouts.npy", dropouts)
-    said = SurfaceFile(path=str(tmp_path / "dropouts.npy"), spacing=0.1).input_summary()["caveats"]
+    said = SurfaceFile(path=str(tmp_path / "dropouts.npy"), spacing=1000.0).input_summary()["caveats"]
     assert len(said) == 2 and not any("uncorrelated" in c for c in said), said  # the dropouts' caveats
 
 
@@ -141,3 +141,63 @@ def test_heights_that_are_no_numbers_in_double_precision_are_refused_without_num
             warnings.simplefilter("error")
             with pytest.raises(ValueError, match=r"value\(s\) in heights not finite"):
                 plugin(path=str(tmp_path / name), spacing=0.1).rms_height()
+
+
+def _units_caveat(caveats) -> str | None:
+    said = [c for c in caveats if "rms slope is" in c and "different units" in c]
+    assert len(said) <= 1, said
+    return said[0] if said else None
+
+
+def _said_slope(caveat: str) -> float:
+    return float(caveat.split("rms slope is ", 1)[1].split(",", 1)[0])
+
+
+@pytest.mark.parametrize("factor, side", [(1e-6, "below"), (1e3, "above")])
+def test_heights_in_another_unit_than_the_pixels_are_said_with_the_slope_they_make(tmp_path, factor, side):
+    """A map in um saved in m (or in nm) beside pixels in um, and a line alike: its rms slope is
+    the surface's times 1e-6 (1e3), which no measured surface has; xi against f does not see it,
+    but F and p/E* are off by that ratio, and it was pressed without a word. The slope said is
+    the forward differences' of the map in its own units, times the factor."""
+    z, _ = band_limited(64, 64, seed=11, top=0.3)
+    z *= 0.05 / z.std()  # rms height 0.05 um on pixels of 0.5 um
+    slope = np.sqrt(np.mean((np.diff(z, axis=1) / 0.5) ** 2) + np.mean((np.diff(z, axis=0) / 0.5) ** 2))
+    assert 1e-3 < slope < 1  # a surface's: no caveat in the right unit
+    np.savetxt(tmp_path / "um.csv", z, delimiter=",")
+    np.savetxt(tmp_path / "mixed.csv", z * factor, delimiter=",")
+    assert _units_caveat(SurfaceFile(path=str(tmp_path / "um.csv"), spacing=0.5, unit="um").input_summary().get(
+        "caveats", ())) is None  # fmt: skip
+    said = _units_caveat(SurfaceFile(path=str(tmp_path / "mixed.csv"), spacing=0.5, unit="um").input_summary()["caveats"])
+    assert said is not None and f"{side} any measured surface's" in said, said
+    assert "heights in um (the preset's unit)" in said and "pixels 0.5 um apart (the preset's spacing)" in said, said
+    assert _said_slope(said) == pytest.approx(factor * slope, rel=2e-3)  # printed to 3 digits
+    line = z[:8].ravel()  # consecutive rows: one profile, its jumps between rows a surface's too
+    line_slope = np.sqrt(np.mean((np.diff(line) / 0.5) ** 2))
+    np.save(tmp_path / "line.npy", line * factor)
+    said = _units_caveat(ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.5, unit="um", detrend="none")
+                         .input_summary()["caveats"])  # fmt: skip
+    assert said is not None and said.startswith("the line's rms slope is") and "points 0.5 um apart" in said, said
+    assert _said_slope(said) == pytest.approx(factor * line_slope, rel=2e-3)
+
+
+def test_the_tui_says_what_validate_says_of_the_file_read(tmp_path, capsys):
+    """The TUI's edit panel showed the line on what was read, but not the caveats of the file
+    (heights in another unit than the pixels, a tilt, spikes) that validate prints under it."""
+    import yaml
+
+    from frictionlab.cli import main
+    from frictionlab.registry import default_registry
+    from frictionlab.tui.fields import validation_of
+
+    z, _ = band_limited(64, 64, seed=11, top=0.3)
+    np.save(tmp_path / "mixed.npy", z * 0.05 / z.std() * 1e-6)  # um written in m, pixels in um
+    preset = {"name": "mixed", "realizations": 1, "solver": {"name": "mdr"},
+              "spectrum": {"name": "surface-file", "params": {"path": str(tmp_path / "mixed.npy"), "spacing": 0.5,
+                                                              "unit": "um"}},
+              "loading": {"start": 1e-4, "stop": 1e-3, "steps": 3}}  # fmt: skip
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 0
+    printed = [line.strip() for line in capsys.readouterr().out.splitlines() if "caveat: the map's rms slope" in line]
+    problems, shown = validation_of(preset, default_registry())
+    assert problems == [] and len(printed) == 1, printed
+    assert printed[0] in shown.splitlines(), shown

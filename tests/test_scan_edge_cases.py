@@ -180,6 +180,108 @@ def test_decimal_commas_are_named(tmp_path, separator):
         SurfaceFile(path=str(tmp_path / "d.csv"), spacing=0.1).rms_height()
 
 
+
+@pytest.mark.parametrize("kind", ["xyz", "matrix", "gwyddion"])
+@pytest.mark.parametrize("separator", [";", "\t"])
+def test_decimal_commas_of_an_instrument_export_are_named(tmp_path, kind, separator):
+    """An export in a European locale (x, y, z points, a matrix, Gwyddion's text export with its
+    header) writes 1,5e-07: SurfaceTopography's readers took the commas for separators, and the
+    scan was 'a damaged file (6 columns)' or held 'no channel of heights ... a spelling such as
+    micron'. The same scan with decimal points is read, with its heights."""
+    z = rough(9, 8, 7) * 1e-7
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    header = "# Channel: Height\n# Width: 0.8 µm\n# Height: 0.9 µm\n# Value units: m\n" if kind == "gwyddion" else ""
+    rows = zip(x.ravel(), y.ravel(), z.ravel()) if kind == "xyz" else z
+    text = header + "".join(separator.join(f"{v:.9e}" for v in row) + "\n" for row in rows)
+    (tmp_path / "comma.txt").write_text(text.replace(".", ",").replace("0,8 µm", "0.8 µm").replace("0,9 µm", "0.9 µm"))
+    (tmp_path / "point.txt").write_text(text if kind == "xyz" else text.replace(separator, "\t"))  # a matrix: whitespace
+    spacing = {"spacing": 0.1} if kind == "matrix" else {}
+    line = 5 if kind == "gwyddion" else 1
+    with pytest.raises(ValueError, match=rf"decimal commas at line {line} \(as 1,5\); .* export the scan with decimal points"):
+        SurfaceFile(path=str(tmp_path / "comma.txt"), format="instrument", **spacing).rms_height()
+    read = SurfaceFile(path=str(tmp_path / "point.txt"), format="instrument", detrend="mean", **spacing).generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-6 * np.abs(z).max())
+
+
+
+def test_a_gwyddion_export_whose_header_sizes_have_decimal_commas_is_named(tmp_path):
+    """Gwyddion's text export in a European locale writes '# Width: 0,800 µm': the reader took
+    ',800 µm' for an unknown lateral unit ('write it as one it knows: m, mm, µm'). With points,
+    the same export is read on pixels of 0.1 um, its heights the file's."""
+    z = rough(9, 8, 7) * 1e-7
+    matrix = "".join("\t".join(f"{v:.9e}" for v in row) + "\n" for row in z)
+    header = "# Channel: Height\n# Width: 0.800 µm\n# Height: 0.900 µm\n# Value units: m\n"
+    (tmp_path / "comma.txt").write_text(header.replace("0.", "0,") + matrix)
+    with pytest.raises(ValueError, match=r"its header writes a size with a decimal comma .* export it with decimal points"):
+        SurfaceFile(path=str(tmp_path / "comma.txt"), format="instrument").rms_height()
+    (tmp_path / "point.txt").write_text(header + matrix)
+    read = SurfaceFile(path=str(tmp_path / "point.txt"), format="instrument", unit="um", detrend="none").generate(None)
+    assert read.spacing == pytest.approx(0.1, rel=1e-9)
+    np.testing.assert_allclose(read.heights, z * 1e6, rtol=1e-8)
+
+@pytest.mark.parametrize("suffix, separator, name", [(".csv", ",", "commas"), (".txt", ";", "semicolons"),
+                                                     (".txt", ",", "commas")])
+def test_a_matrix_export_separated_by_commas_is_named_as_such(tmp_path, suffix, separator, name):
+    """SurfaceTopography reads a matrix (format: instrument, a Gwyddion text export) between tabs
+    or spaces only: a .csv matrix went to its reader of x, y, z points ('a damaged file: 8
+    columns'), a .txt one was 'no channel of heights ... a spelling such as micron'. Read as a
+    table, its heights are the file's."""
+    z = rough(9, 8, 7)
+    path = tmp_path / f"m{suffix}"
+    path.write_text("".join(separator.join(f"{v:.9e}" for v in row) + "\n" for row in z))
+    with pytest.raises(ValueError, match=f"line 1 holds 8 numbers separated by {name}, .* format: table and spacing"):
+        SurfaceFile(path=str(path), format="instrument", spacing=0.1).rms_height()
+    read = SurfaceFile(path=str(path), format="table", spacing=0.1, detrend="mean").generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-8, atol=1e-8)
+
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_a_text_export_in_utf16_is_told_to_be_saved_as_utf8(tmp_path, encoding):
+    """A Windows program's 'Unicode text' (UTF-16, with or without its byte-order mark) sent to
+    SurfaceTopography was 'a .txt file that is not text (binary bytes at its start): give a binary
+    format its own suffix'. The same export in UTF-8 is read, its heights the file's."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    text = "".join(f"{a:.9e}\t{b:.9e}\t{c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel()))
+    (tmp_path / "wide.txt").write_bytes(text.encode(encoding))
+    with pytest.raises(ValueError, match="a text export in UTF-16 .* save it as UTF-8") as refused:
+        SurfaceFile(path=str(tmp_path / "wide.txt"), format="instrument").rms_height()
+    assert "not text" not in str(refused.value)
+    (tmp_path / "plain.txt").write_text(text)
+    read = SurfaceFile(path=str(tmp_path / "plain.txt"), format="instrument", detrend="mean").generate(None)
+    np.testing.assert_allclose(read.heights, z - z.mean(), rtol=1e-6, atol=1e-15)
+
+
+@pytest.mark.parametrize("left_out, said", [([5, 40, 41], "3 of its points missing"), ([], "1 listed twice")])
+def test_an_xyz_export_with_points_left_out_is_told_which_grid_they_lie_on(tmp_path, left_out, said):
+    """An optical profilometer's x, y, z export leaves out the points it did not measure: 'not on
+    a regular grid: export the map on the instrument's grid', which it was. The grid and the
+    points missing (or listed twice) are named, and the same export with those points written
+    with a NaN height is read, filled by undefined: harmonic, the other heights the file's."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    rows = [f"{a:.9e} {b:.9e} {c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel())]
+    kept = [row for i, row in enumerate(rows) if i not in left_out] + ([] if left_out else rows[10:11])
+    (tmp_path / "gaps.txt").write_text("".join(kept))
+    with pytest.raises(ValueError, match=f"lie on a grid of 8 x 9 points \\(x by y\\), {said}; write each point"):
+        SurfaceFile(path=str(tmp_path / "gaps.txt"), format="instrument").rms_height()
+    nan = [row.rsplit(" ", 1)[0] + " nan\n" if i in left_out else row for i, row in enumerate(rows)]
+    (tmp_path / "nan.txt").write_text("".join(nan))
+    read = SurfaceFile(path=str(tmp_path / "nan.txt"), format="instrument", undefined="harmonic", detrend="none")
+    measured = np.ones(z.size, bool)
+    measured[left_out] = False
+    np.testing.assert_allclose(read.generate(None).heights.ravel()[measured], z.ravel()[measured], rtol=1e-6)
+
+def test_an_xyz_export_with_a_fourth_column_is_told_to_keep_x_y_and_the_heights(tmp_path):
+    """x, y, z and an intensity per point was 'a damaged Plain text file (4 columns): copy it again'."""
+    y, x = np.mgrid[0:9, 0:8] * 1e-7
+    z = rough(9, 8, 7) * 1e-8
+    rows = zip(x.ravel(), y.ravel(), z.ravel(), np.ones(z.size))
+    (tmp_path / "xyzi.csv").write_text("".join(",".join(f"{v:.9e}" for v in row) + "\n" for row in rows))
+    with pytest.raises(ValueError, match="line 1 holds 4 numbers separated by commas, .* export x, y and the heights alone"):
+        SurfaceFile(path=str(tmp_path / "xyzi.csv"), format="instrument").rms_height()
+
 # ------------------------------------------------------------ pixels far from square
 
 
@@ -341,6 +443,22 @@ def rewritten_x3p(source, path, *, xml=lambda text: text, data=lambda payload: p
             content = xml(content) if item.filename == "main.xml" else content
             new.writestr(item.filename, data(content) if item.filename == "bindata/data.bin" else content)
     return path
+
+
+@pytest.mark.parametrize("axis", ["X", "Y"])
+def test_an_x3p_with_positions_given_point_by_point_is_named_not_damaged(tmp_path, axis):
+    """An X3P whose x (or y) axis is absolute (AxisType A: a position stored for every point) is
+    a valid file SurfaceTopography does not read; it was 'a damaged ... file: copy it again'."""
+    import x3pio
+
+    x3pio.write(tmp_path / "good.x3p", rough(16, 20) * 1e-6, x_scale=1e-7, y_scale=1e-7,
+                revision=x3pio.Revision.ISO5436_2000)  # fmt: skip
+    absolute = rb"\1A"
+    rewritten_x3p(tmp_path / "good.x3p", tmp_path / "absolute.x3p",
+                  xml=lambda text: re.sub(rb"(<C" + axis.encode() + rb">\s*<AxisType>)I", absolute, text))
+    with pytest.raises(ValueError, match=rf"gives its {axis.lower()} positions point by point .* \(not damage\)") as refused:
+        SurfaceFile(path=str(tmp_path / "absolute.x3p")).rms_height()
+    assert "damaged" not in str(refused.value) and "copy it again" not in str(refused.value)
 
 
 @pytest.mark.parametrize("lie, said", [
@@ -506,7 +624,7 @@ def test_a_steep_line_with_little_roughness_is_read_not_an_internal_error(tmp_pa
     t = np.arange(256.0)
     z = 3.0 * t + 1e-9 * np.random.default_rng(np.random.SeedSequence(0)).standard_normal(t.size) + bow * (t - 100) ** 2
     np.save(tmp_path / "steep.npy", z)
-    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1.0, "detrend": "tilt"}}
+    spec = {"name": "profile-file", "params": {"path": str(tmp_path / "steep.npy"), "spacing": 1e-4, "detrend": "tilt"}}
     (tmp_path / "p.yaml").write_text(yaml.safe_dump({**preset(tmp_path), "spectrum": spec}))
     code = main(["validate", str(tmp_path / "p.yaml")])
     text = capsys.readouterr().err

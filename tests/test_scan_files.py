@@ -348,7 +348,7 @@ def test_an_xyz_file_whose_points_make_no_grid_is_named_so_not_as_damage(tmp_pat
 def test_a_damaged_files_message_carries_its_readers_reason_on_one_short_line():
     from SurfaceTopography.Exceptions import CorruptFile
 
-    from frictionlab_spectra.instrument_reader import describe_failure
+    from frictionlab_spectra.reader_failures import describe_failure
 
     class Reader:  # what describe_failure asks of a SurfaceTopography reader
         name = staticmethod(lambda: "Gwyddion")
@@ -381,6 +381,47 @@ def test_units_that_are_not_lengths_are_refused_and_a_unit_mismatch_is_named(tmp
     with pytest.raises(ValueError, match="heights and its lateral sizes are in different units"):
         SurfaceFile(path=str(tmp_path / "mixed.nc")).generate(None)
 
+
+def test_sizes_along_x_and_y_in_different_units_are_named_as_such_not_as_the_heights(tmp_path):
+    """A NetCDF whose x is in um and y in nm (heights in um) was told its heights and its lateral
+    sizes were in different units, and to convert its heights."""
+    z = np.random.default_rng(3).normal(size=(12, 10))
+    with netcdf_file(str(tmp_path / "xy.nc"), "w") as nc:
+        for name, size, length, unit in (("x", 12, 6.0, "um"), ("y", 10, 5000.0, "nm")):
+            nc.createDimension(name, size)
+            var = nc.createVariable(name, "d", (name,))
+            var.length, var.unit = length, unit
+        heights = nc.createVariable("heights", "d", ("x", "y"))
+        heights[:] = z
+        heights.unit = "um"
+    with pytest.raises(ValueError, match="sizes along x and along y are in different length units") as refused:
+        SurfaceFile(path=str(tmp_path / "xy.nc")).generate(None)
+    assert "convert its heights" not in str(refused.value)
+
+
+
+def write_bcr(path, counts: np.ndarray, *, xunit="nm", yunit="nm", zunit="nm", bit2nm=0.1):
+    """A BCR-STM file by hand: a 2048-byte text header, then int16 heights (little endian), rows along x."""
+    ny, nx = counts.shape
+    header = (f"fileformat = bcrstm\nheadersize = 2048\nxpixels = {nx}\nypixels = {ny}\nxlength = {nx * 100}\n"
+              f"ylength = {ny * 100}\nxunit = {xunit}\nyunit = {yunit}\nzunit = {zunit}\nbit2nm = {bit2nm}\n")
+    path.write_bytes(header.encode("latin-1").ljust(2048, b"\0") + counts.astype("<i2").tobytes())
+
+
+@pytest.mark.parametrize("units, said", [
+    ({"yunit": "um"}, "sizes along x and along y are in different length units"),  # was 'a damaged BCR-STM file'
+    ({"zunit": "V"}, "the file's heights are in 'V', a voltage, not a length: it holds no heights"),
+])  # fmt: skip
+def test_a_bcr_file_of_units_its_reader_refuses_is_named_not_damaged(tmp_path, units, said):
+    counts = np.round(rough_um(16) * 1e4)  # heights of 0.1 nm steps
+    write_bcr(tmp_path / "sound.bcr", counts)
+    read = SurfaceFile(path=str(tmp_path / "sound.bcr"), unit="nm", detrend="none").generate(None)
+    np.testing.assert_allclose(read.heights, 0.1 * counts, rtol=1e-12)  # bit2nm: 0.1 nm a count
+    assert read.spacing == pytest.approx(100.0)
+    write_bcr(tmp_path / "units.bcr", counts, **units)
+    with pytest.raises(ValueError, match=said) as refused:
+        SurfaceFile(path=str(tmp_path / "units.bcr")).generate(None)
+    assert "damaged" not in str(refused.value)
 
 def test_a_unit_of_any_length_is_quoted_cut_in_the_middle(tmp_path):
     """A file's unit is the file's text: one of 10,000 characters was quoted whole in the

@@ -181,17 +181,19 @@ def validation_of(data: dict, registry, base_dir: Path | None = None) -> tuple[l
     """The headless validator's problems for ``data`` (empty when it is valid; relative
     input files taken from ``base_dir``, the preset file's folder, as ``frictionlab
     validate`` takes them) and, for a valid preset, the lines ``frictionlab validate`` prints
-    on what its spectrum read from a file (shape, pixel size, unit, rms height) and on the
-    caveats of its spectrum's parameters (few pixels on the short cut-off); else ""."""
+    on what its spectrum read from a file (shape, pixel size, unit, rms height), the caveats of
+    what it read (a tilt left in, spikes, heights in another unit than the pixels) and those of
+    its spectrum's parameters (few pixels on the short cut-off); else ""."""
     try:
         if base_dir is not None:
             data = resolve_input_paths(data, base_dir, registry)
         scene = build_scene(data, registry=registry)
     except PresetError as exc:
         return list(exc.problems), ""
-    summary = scene.spectrum.input_summary()
-    read = [] if summary is None else [f"read {describe_input(summary)}"]
-    return [], "\n".join(read + [f"caveat: {caveat}" for caveat in scene.spectrum.caveats()])
+    summary = scene.spectrum.input_summary() or {}
+    read = [f"read {describe_input(summary)}"] if summary else []
+    caveats = [*summary.get("caveats", ()), *scene.spectrum.caveats()]  # the file's (a tilt, spikes), then the parameters'
+    return [], "\n".join(read + [f"caveat: {caveat}" for caveat in caveats])
 
 
 def problem_path(problem: str) -> str:

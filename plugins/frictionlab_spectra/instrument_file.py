@@ -28,9 +28,10 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .channel_choice import pick_channel
 from .instrument_reader import (
     channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, check_text_whole, choose_reader, describe_failure,
-    TEXT_FORMATS, quoted,
+    check_text_heights, check_text_room, choose_reader, parses_text, quoted,
 )
+from .reader_failures import describe_failure
+from .text_exports import check_declared_values, check_numbers_written, check_text_whole
 
 MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
@@ -121,9 +122,11 @@ def _open_reader(fh, path: Path, where: str):
     from SurfaceTopography.IO import open_topography
 
     reader_class = choose_reader(fh, path.suffix.lower().lstrip("."), where)
-    if reader_class.format() in TEXT_FORMATS:  # parsed whole as it is opened
+    if parses_text(reader_class, fh):  # parsed whole as it is opened
         check_text_room(fh, reader_class, where)
         check_text_whole(fh, reader_class, where)
+        check_declared_values(fh, reader_class, where)
+        check_numbers_written(fh, reader_class, where)
     try:
         return open_topography(_by_name(fh), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
@@ -216,7 +219,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
                              "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
                              "interpolate it onto one")  # fmt: skip
-        if topography.dim == 1 and type(reader).format() in TEXT_FORMATS and (x := _text_x(fh, heights.size)) is not None:
+        if topography.dim == 1 and parses_text(type(reader), fh) and (x := _text_x(fh, heights.size)) is not None:
             uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:

@@ -22,6 +22,7 @@ from .header_units import NUMBERS, check_heights_are_lengths, check_units_named,
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
+BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary variant, which its reader reads too
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
 AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
@@ -41,6 +42,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     chosen = next((r for r in matches if r in by_suffix), matches[0] if matches else None)
     if chosen is None:
         chosen = next((r for r in by_suffix if r.can_read(head) != MagicMatch.NO), None)
+    if chosen is None and head.startswith(UTF8_BOM):  # a text format's magic behind a byte-order mark
+        chosen = next((r for r in by_suffix if r.can_read(head[len(UTF8_BOM) :]) == MagicMatch.YES), None)
     if chosen is None and by_suffix:
         names = " or ".join(dict.fromkeys(reader.name() for reader in by_suffix))
         raise ValueError(f"{where}: its suffix .{path_suffix} names {names}, but its first bytes are not that "
@@ -54,12 +57,17 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         )
     if chosen.format() == "asc" and _coordinate_rows(fh):  # x, y, z per line under .txt: not a matrix of heights
         chosen = next(reader for reader in readers if reader.format() == "xyz")
-    if chosen.format() in TEXT_FORMATS and not _looks_like_text(head):
+    if parses_text(chosen, head) and _utf16(head):
+        raise ValueError(
+            f"{where}: a text export in UTF-16 (as a Windows program saves 'Unicode text'), which SurfaceTopography's "
+            f"{chosen.name()} reader does not read: save it as UTF-8 (or plain ASCII)"
+        )
+    if parses_text(chosen, head) and not _looks_like_text(head):
         raise ValueError(
             f"{where}: a .{path_suffix} file that is not text (binary bytes at its start): not a "
             f"{chosen.name()} file; give a binary format its own suffix"
         )
-    if chosen.format() in TEXT_FORMATS and head.startswith(UTF8_BOM):  # its readers fail on it, as on damage
+    if parses_text(chosen, head) and head.startswith(UTF8_BOM):  # its readers fail on it, as on damage
         raise ValueError(
             f"{where}: a text export that starts with a UTF-8 byte-order mark (as a spreadsheet saves 'CSV UTF-8'), "
             f"which SurfaceTopography's {chosen.name()} reader does not read; save it without one (plain CSV or text)"
@@ -67,6 +75,21 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     if head.startswith(ZIP_MAGIC):
         check_zip_members(fh, chosen, where)
     return chosen
+
+
+def parses_text(reader, file) -> bool:
+    """Whether ``reader`` parses ``file`` (the open file, its first bytes, or None: unknown) as
+    text: a text format, unless the file starts with the magic of its binary variant (an SDF's)."""
+    magic = BINARY_VARIANTS.get(reader.format())
+    if reader.format() not in TEXT_FORMATS or magic is None or file is None:
+        return reader.format() in TEXT_FORMATS
+    if isinstance(file, bytes):
+        return not file.startswith(magic)
+    position = file.tell()
+    file.seek(0)
+    head = file.read(len(magic))
+    file.seek(position)
+    return head != magic
 
 
 def _coordinate_rows(fh) -> bool:
@@ -77,6 +100,18 @@ def _coordinate_rows(fh) -> bool:
         if NUMBERS.match(line):
             return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
     return False
+
+
+UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")  # UTF-16's byte-order marks, little and big endian
+
+
+def _utf16(head: bytes) -> bool:
+    """Text in UTF-16: its byte-order mark, or printable ASCII with a NUL beside every character."""
+    sample = head[: len(head) // 2 * 2][:256]
+    printable = set(range(32, 127)) | set(b"\t\n\r")
+    ascii_pairs = any(sample[odd::2].count(0) == len(sample) // 2 and set(sample[1 - odd :: 2]) <= printable
+                      for odd in (0, 1))  # fmt: skip
+    return head.startswith(UTF16_MARKS) or len(sample) >= 8 and ascii_pairs
 
 
 def _looks_like_text(head: bytes) -> bool:
@@ -114,7 +149,7 @@ X3P_ITEM_BYTES = {"I": 2, "L": 4, "F": 4, "D": 8}  # ISO 5436-2 data types: int1
 def header_units(fh, reader) -> list[str]:
     """The length units the header of a text export names (``x [\u00b5m]``, ``z (nm)``, ``z/nm``),
     in order, from the lines before its first row of numbers; empty for a binary format."""
-    if reader.format() not in TEXT_FORMATS:
+    if not parses_text(reader, fh):
         return []
     return named_units(head_text(fh))[0]
 
@@ -122,7 +157,7 @@ def header_units(fh, reader) -> list[str]:
 def check_text_heights(fh, reader, where: str) -> None:
     """Refuse a text export whose header labels a column in a unit that is no length
     (``header_units.check_heights_are_lengths``): its reader skips the header."""
-    if reader.format() in TEXT_FORMATS:
+    if parses_text(reader, fh):
         check_heights_are_lengths(head_text(fh), where)
 
 
@@ -315,122 +350,6 @@ def check_text_room(fh, reader, where: str) -> None:
             f"{need / 2**30:.3g} GiB to read it, more than the {room / 2**30:.3g} GiB this process may use ({source}); "
             "crop the scan with the instrument's software, or save its heights as a .npy array"
         )
-
-
-TAIL_BYTES = 65536  # of a text export read for its last line
-
-
-def check_text_whole(fh, reader, where: str) -> None:
-    """Refuse a text export whose last line of numbers holds fewer than the line before it: a file
-    cut short (a copy or a transfer stopped). Its reader dropped the cut row, and a matrix export whose
-    header states its size stretched the rows left over it: pixels 1.5 times too long along y, resampled."""
-    size = os.fstat(fh.fileno()).st_size
-    fh.seek(max(0, size - TAIL_BYTES))
-    lines = [line for line in fh.read().decode("utf-8", errors="replace").splitlines()[1:] if line.strip()][-2:]
-    fh.seek(0)
-    if len(lines) < 2 or not all(NUMBERS.match(line) for line in lines):  # a footer, or one line: nothing to compare
-        return
-    before, last = (len(re.split(r"[\s,;]+", line.strip())) for line in lines)
-    if last < before:
-        raise ValueError(
-            f"{where}: its last line holds {last} numbers and the line before it {before}: a {reader.name()} file "
-            f"cut short (a copy or a transfer stopped); {AGAIN}"
-        )
-
-
-def _is_utf8(fh) -> bool:
-    """Whether the open file's bytes, all of them, read as UTF-8 (a chunk at a time)."""
-    import codecs
-
-    decoder, position = codecs.getincrementaldecoder("utf-8")(), fh.tell()
-    try:
-        fh.seek(0)
-        while chunk := fh.read(1 << 20):
-            decoder.decode(chunk)
-        decoder.decode(b"", final=True)
-        return True
-    except (UnicodeDecodeError, OSError):
-        return False
-    finally:
-        fh.seek(position)
-
-
-def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueError:
-    """What to tell of a file the chosen reader could not read: a damaged file of that
-    format, or its length and height units that differ (named as such). ``fh``, the open
-    file, tells a text export's encoding from its content where the reader blames the one."""
-    from SurfaceTopography.Exceptions import CorruptFile, FileFormatMismatch
-
-    name = reader.name()
-    text = str(exc)
-    if isinstance(exc, ValueError) and "Units for" in text and "differ" in text:  # SurfaceTopography's own words
-        return ValueError(
-            f"{where}: the file's heights and its lateral sizes are in different units, and SurfaceTopography "
-            f"reads a {name} file with one unit for both; convert its heights to the unit of its sizes"
-        )
-    if isinstance(exc, ValueError) and "physical_sizes" in text:  # SurfaceTopography's own words: not damage
-        return ValueError(
-            f"{where}: the {name} file does not state its physical size; give spacing (the pixel side, in the "
-            "run's length unit), or export the scan with its pixel size"
-        )
-    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS and fh is not None and _is_utf8(fh):
-        return ValueError(f"{where}: this {name} file holds no points its reader can read (it is UTF-8 text: a "
-                          "header alone, or lines that are not numbers); export the scan again")  # fmt: skip
-    if isinstance(exc, UnicodeError) and reader.format() in TEXT_FORMATS:
-        return ValueError(f"{where}: a text export that is not UTF-8 (a header in Latin-1: its µ?), which "
-                          f"SurfaceTopography's {name} reader does not read; save it as UTF-8")  # fmt: skip
-    if isinstance(exc, MemoryError):
-        what = "ran out of memory reading this text export" if reader.format() in TEXT_FORMATS else \
-            "the file declares more points than this process can hold"
-        return ValueError(f"{where}: {what} ({name}); crop it with the instrument's software")
-    if isinstance(exc, CorruptFile) and (variant := re.fullmatch(r"(Revision|FeatureType) should be '([^']*)'\.", text)):
-        return _unread_variant(name, *variant.groups(), where)  # SurfaceTopography's own words: a valid file
-    if isinstance(exc, CorruptFile) and (unknown := re.fullmatch(r"Unknown lateral unit '(.*)'\.", text)):
-        return ValueError(f"{where}: its header names the lateral unit {quoted(unknown[1])}, which SurfaceTopography's "
-                          f"{name} reader does not know (not damage); write it as one it knows: {_KNOWN_LENGTHS}")  # fmt: skip
-    if isinstance(exc, CorruptFile) and reader.format() == "asc" and "Could not find any topography data" in text:
-        return ValueError(f"{where}: this {name} file holds no channel of heights its reader knows: no rows of numbers, or "
-                          "none under value units that are a length it reads (degrees, volts, or a spelling such as "
-                          f"'micron'); export the heights with their unit written as one of {_KNOWN_LENGTHS}")  # fmt: skip
-    said = reason_said(exc)
-    if reader.format() == "xyz" and isinstance(exc, ValueError) and (
-            "no negative elements" in text or "zero-size array" in text):  # one point: no step either way
-        return ValueError(  # its grid's step along y (or x) came out zero, binned by numpy.bincount: not damage
-            f"{where}: the points of this {name} file make no grid: there is one, two share a position, or all lie on "
-            "one row or one column (a line scan written as x, y, z); export a line as its x and z for profile-file, a map with "
-            "each point once on the instrument's grid")  # fmt: skip
-    if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
-        return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
-                          "on the instrument's grid, or its heights as a matrix (a table) with spacing")  # fmt: skip
-    kind = "not a valid" if isinstance(exc, FileFormatMismatch) else "a damaged"
-    if isinstance(exc, CorruptFile):
-        kind = "a damaged"
-    return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
-                      f"its format cannot read it: {AGAIN}")  # fmt: skip
-
-
-REASON_SHOWN = 160
-_KNOWN_LENGTHS = "m, mm, \u00b5m (or um), nm, \u00c5, pm"  # as SurfaceTopography's text readers spell them
-
-
-def reason_said(exc: BaseException) -> str:
-    """The reader's own words for a failure, on one line, cut in the middle past REASON_SHOWN
-    characters (they may quote the file)."""
-    text = " ".join(str(exc).split())
-    half = REASON_SHOWN // 2
-    return text if len(text) <= REASON_SHOWN else f"{text[:half]}...{text[-half:]}"
-
-
-def _unread_variant(name: str, field: str, value: str, where: str) -> ValueError:
-    """A file of a revision or a kind of its format that SurfaceTopography's reader does not
-    read (an X3P of ISO 25178-72, an X3P profile): named as such, not as damage."""
-    if field == "Revision":
-        return ValueError(f"{where}: this {name} file is of a revision SurfaceTopography does not read (it reads revision "
-                          f"{value!r} only, not ISO 25178-72); export the scan as an ISO 5436-2 (2000) X3P, or in "
-                          "another format")  # fmt: skip
-    return ValueError(f"{where}: this {name} file is not an areal map (SurfaceTopography reads feature type "
-                      f"{value!r} only: no profile or point cloud); export a profile as a .csv of x, z for "
-                      "profile-file, or the map as an areal X3P")  # fmt: skip
 
 
 def channel_list(reader) -> list[dict]:

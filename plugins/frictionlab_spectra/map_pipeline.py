@@ -7,7 +7,7 @@ Square pixels. Pixels whose sides differ by at most ``PIXEL_TOLERANCE`` (a fast 
 scan axis calibrated apart, 0.06 % on an NT-MDT map) are taken as square, of their mean
 side. Truly rectangular pixels (an X3P of 0.128 x 0.315 um) are resampled onto square ones
 of the finer side, along the coarser axis, by the map's band-limited cosine series
-(``scan_shaping.cosine_resample``): it passes through every measured point and adds no
+(``scan_shaping.resampling.cosine_resample``): it passes through every measured point and adds no
 wavelength the scan did not have, so the rms height and the rms gradient are kept. Every
 solver then presses square pixels: their kernels (the half-space's response to one pixel,
 the spring of one MDR point) stay the ones checked against closed forms.
@@ -24,8 +24,11 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from . import instrument_reader
-from .scan_shaping import (cosine_resample, despike, flat_neighbours_warning, level, levelling_warning, line_offset_warning,
-                           outlier_warning, resampled_points, spike_warning)
+from .scan_shaping.height_caveats import flat_neighbours_warning, outlier_warning
+from .scan_shaping.levelling import level, levelling_warning
+from .scan_shaping.line_offsets import line_offset_warning
+from .scan_shaping.resampling import cosine_resample, resampled_points
+from .scan_shaping.spikes import despike, spike_warning
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 SAME_SIDE = 1e-9  # relative difference of two sides that are the same side, rounded

@@ -37,11 +37,13 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .instrument_file import (
     ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
-from .instrument_reader import reason_said
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
+from .reader_failures import reason_said
 from .text_table import read_text_table
-from .scan_shaping import FLAT, flat_neighbours_warning, flat_rms, level_line, line_form_warning, line_spike_warning, outlier_warning
+from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
+from .scan_shaping.levelling import level_line, line_form_warning
+from .scan_shaping.spikes import line_spike_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -152,7 +154,8 @@ class ProfileFile(MeasuredFile):
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
-                   outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line")]  # as a map's
+                   outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
+                   units_warning(heights, float(dx), summary, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)

@@ -61,7 +61,7 @@ from .profile_file import (
     check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
 )
 from .text_table import axes_warning, read_text_table
-from .scan_shaping import FLAT, flat_rms
+from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
 
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
 # The peak of ``equivalent_line``, measured with tracemalloc (ru_maxrss agrees), plus a third:
@@ -267,6 +267,8 @@ class SurfaceFile(MeasuredFile):
             )
         heights.flags.writeable = False
         summary.update(shape=list(heights.shape), spacing=float(spacing), rms_height=rms)
+        if caveat := units_warning(heights, spacing, summary, "map"):
+            summary["caveats"] = [*summary.get("caveats", ()), caveat]
         return Measured(heights, spacing, rms, summary["periodic"], summary)
 
 

@@ -18,7 +18,7 @@ from .instrument_reader import room_to_read
 
 
 def _numbers(text: str, delimiter: str | None) -> bool:
-    return all(_number(token) for token in text.split(delimiter))
+    return all(is_number(token) for token in text.split(delimiter))
 
 
 SAMPLE_BYTES = 65536  # the file's first bytes, whose numbers per byte size the whole table's
@@ -106,12 +106,12 @@ def _table(text, where: str) -> np.ndarray:
         if _mostly_numbers(cells, delimiter):  # a row of heights with a cell that is not one: named below
             break
         if _numbers(cells.replace(",", "."), ";" if ";" in cells else None):  # 1,5;2,25: numbers, not a header
-            raise ValueError(f"{where}: {_decimal_commas(lineno)}")
+            raise ValueError(f"{where}: {decimal_commas(lineno)}")
         skip = lineno  # a header such as "x,z", or "z" over a matrix of commas
     text.seek(0)
     if delimiter == "," and COMMA_DECIMAL.fullmatch(cells):  # two whole numbers: x, z, or one decimal-comma height?
         if (lineno := _comma_decimal_line(text, skip)) is not None:
-            raise ValueError(f"{where}: {_decimal_commas(lineno)}")
+            raise ValueError(f"{where}: {decimal_commas(lineno)}")
         text.seek(0)
     try:
         with warnings.catch_warnings():
@@ -137,7 +137,7 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
             if _ends_with_separator(text, delimiter):
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
-                return _decimal_commas(lineno)
+                return decimal_commas(lineno)
             return f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
@@ -146,9 +146,9 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
     return "not a table of numbers"
 
 
-def _decimal_commas(lineno: int) -> str:
+def decimal_commas(lineno: int, what: str = "table") -> str:
     return (f"decimal commas at line {lineno} (as 1,5); numbers are read with a decimal point (1.5): "
-            "export the table with decimal points")
+            f"export the {what} with decimal points")
 
 
 COMMA_DECIMAL = re.compile(r"[-+]?\d+,\d+(?:[eE][-+]?\d+)?")  # 0,0677: decimal commas, or x, z in whole numbers
@@ -175,11 +175,11 @@ def _mostly_numbers(text: str, delimiter: str | None) -> bool:
     """Whether more of the line's cells are numbers than not: a row of data with a bad cell
     (``0.1,x,0.3``, ``0.1,,0.3``), which is no header (``x,z``; ``z [nm]``; ``Height 1``)."""
     cells = text.split(delimiter)
-    numbers = sum(_number(cell) for cell in cells)
+    numbers = sum(is_number(cell) for cell in cells)
     return numbers > len(cells) - numbers
 
 
-def _number(cell: str) -> bool:
+def is_number(cell: str) -> bool:
     try:
         float(cell)
     except ValueError:
