@@ -273,6 +273,7 @@ class Registry:
     def _load_entry_points(self, only: list[str], blocked: list[str]) -> None:
         for name in blocked:
             self.pm.set_blocked(name)
+        self._collect()  # the built-ins' names, which no installed plugin may take
         found = md.entry_points(group=ENTRY_POINT_GROUP)
         _warn_of_unknown_names(only, sorted({ep.name for ep in found}))
         for ep in found:
@@ -311,8 +312,12 @@ class Registry:
             for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
                 if impl.plugin is plugin:
                     def register(cls, _kind=kind):  # a preset naming a refused class is told why
-                        claims.append((_kind, normalize_name(str(getattr(cls, "name", "")))))
+                        claims.append((_kind, key := normalize_name(str(getattr(cls, "name", "")))))
                         validate_plugin_class(_kind, cls)
+                        if (taken := self._plugins[_kind].get(key)) and taken.cls is not cls:  # a built-in's
+                            raise PluginError(f"{cls.__qualname__}: name {key!r} is taken by the built-in {_kind} "
+                                              f"{taken.cls.__module__}.{taken.cls.__qualname__}, which keeps it; "
+                                              "choose another name")  # fmt: skip
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
 
@@ -366,7 +371,8 @@ class Registry:
         self._collect()
 
     def _collect(self) -> None:
-        """Every registered class by kind and name. A name two classes claim is neither's:
+        """Every registered class by kind and name. A name two classes claim is neither's (an installed
+        plugin claiming a built-in's fails to load instead: ``_try_registration``):
         asking for it is an error naming both (``_clashes``); every other name works."""
         tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}

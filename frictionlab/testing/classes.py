@@ -80,8 +80,8 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     of strings; ``Params`` has a JSON Schema; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
     field has no default); an unknown key raises ``pydantic.ValidationError``
-    naming it; the name is not a built-in's of the kind (a preset naming it would be
-    refused as claimed by two plugins); the parameters survive a JSON round trip (presets are YAML);
+    naming it; the name is not a built-in's of the kind (the built-in keeps it: the plugin would
+    fail to load); the parameters survive a JSON round trip (presets are YAML);
     and, for every bounded numeric field (bounds read from the JSON Schema, or
     from the field's ``ge``/``gt``/``le``/``lt`` metadata), a value just past
     each bound is rejected, at construction and on assignment, with a message
@@ -110,7 +110,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     builtin = builtins.get(kind, cls.name) if cls.name in builtins.names(kind) else cls
     if builtin is not cls:
         fail(cls, f"name {cls.name!r} is taken by the built-in {kind} {builtin.__module__}.{builtin.__qualname__}: "
-                  "a preset naming it would be refused as claimed by two plugins; choose another name")  # fmt: skip
+                  "installed, the plugin would fail to load (the built-in keeps its name); choose another name")  # fmt: skip
     refs = cls.references
     if not isinstance(refs, (tuple, list)) or not all(isinstance(r, str) and r.strip() for r in refs):
         fail(cls, f"references must be a tuple of strings (DOIs). Got {refs!r} instead.")
