@@ -24,6 +24,9 @@ BROKEN = {
     "text-periodic": (GoodSpectrum, {"periodic": lambda self: "yes"}, "periodic() must be True or False. Got 'yes'"),
     "nan-heights": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
         np.full(128, np.nan), 1.0)}, "Profile.heights must be finite"),
+    "flag-periodic": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
+        np.sin(np.arange(128.0)), 1.0, periodic=False)},
+        "Profile.periodic must be what periodic() declares, True. Got False instead."),
     "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
     "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
                       "tolerance() must be None or a number finite and > 0. Got nan"),

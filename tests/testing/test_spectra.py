@@ -67,7 +67,7 @@ def test_deterministic_flag_allows_seed_independence():
 
 def test_spectrum_check_fails_for_wrong_declarations():
     cls = spectrum_variant("SaysPeriodic", periodic=lambda self: False)
-    with pytest.raises(AssertionError, match=r"periodic\(\) must be True or False and equal Profile.periodic"):
+    with pytest.raises(AssertionError, match=r"Profile.periodic must be what periodic\(\) declares, False. Got True instead."):
         fltesting.check_spectrum(cls)
     cls = spectrum_variant("WrongShape", grid_shape=lambda self: (3,))
     with pytest.raises(AssertionError, match=r"grid_shape\(\) must be None or the shape"):
