@@ -44,6 +44,13 @@ SPECTRUM_BREAKAGES = [
     ("NoAdviceWhenNotPeriodic",
      {"generate": lambda self, rng: Profile(rng.standard_normal(64), 1.0, periodic=False), "periodic": lambda self: False,
       "not_periodic_advice": lambda self: ("not periodic", "")}, r"not_periodic_advice\(\) must be a \(why, how\)"),
+    ("Trended", {"generate": lambda self, rng: Profile(GoodSpectrum.generate(self, rng).heights + np.linspace(0, 3, 128), 1.0)},
+     r"periodic\(\) is True, but the profile does not wrap: the step from its last point back to its first is 2\.9"),
+    ("EndPointRepeated", {"generate": lambda self, rng: Profile(np.cos(2 * np.pi * np.linspace(0, 1, 128) + rng.uniform(0, 6)), 1.0)},
+     r"the last point repeats the first in every one of 8 seeds: a period of N points is sampled on \[0, L\)"),
+    ("TrendedSurface", {"dimension": 2, "generate": lambda self, rng: Profile(
+        GoodSpectrum.generate(self, rng).heights[:, None] + np.linspace(0, 3, 64) + np.sin(np.arange(64) / 3), 1.0)},
+     r"the profile does not wrap along axis 1"),
     ("CaveatsAsOneString", {"caveats": lambda self: "coarse"}, r"caveats\(\) must be a tuple of non-empty strings"),
     ("EmptyCaveat", {"caveats": lambda self: ("",)}, r"caveats\(\) must be a tuple of non-empty strings"),
 ]
