@@ -127,3 +127,15 @@ def test_the_slope_scale_is_found_past_nan_slopes():
         expected = 1.0 if abs(largest) == 3.0 else 2.0 ** -np.frexp(abs(largest))[1]
         assert scale == expected, largest
     assert slope_scale(np.full(4, np.nan)) == 1.0 and slope_scale(np.array([1.0, np.inf])) == 1.0
+
+
+def test_negative_slopes_on_a_surface_are_refused_where_a_run_takes_them():
+    """A surface's slopes are |grad z|; a line's keep their sign. A run took negative ones on."""
+    from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import slopes_problem
+
+    z = np.linspace(-1.0, 1.0, 64).reshape(8, 8)
+    assert slopes_problem(GoodSlopes(), z, Profile(z, 1.0)) == (
+        "slopes() on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of -1.")
+    assert slopes_problem(GoodSlopes(), np.abs(z), Profile(z, 1.0)) is None
+    assert slopes_problem(GoodSlopes(), z[0], Profile(z[0], 1.0)) is None

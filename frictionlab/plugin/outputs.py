@@ -81,6 +81,8 @@ def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile, what: st
     problem = array_problem(what, slopes, profile.heights.shape, nan=undefined)
     if problem and not undefined and array_problem(what, slopes, profile.heights.shape, nan=True) is None:  # NaN alone
         problem += f" A NaN (a point without a slope) needs undefined_points({profile.periodic}) to return True."
+    if not problem and slopes.ndim == 2 and slopes.size and (least := float(np.fmin.reduce(slopes, axis=None))) < 0:
+        problem = f"{what} on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of {least:.6g}."
     return problem
 
 
