@@ -122,11 +122,15 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
         fail(cls, f"Params.model_json_schema() raised {type(exc).__name__}: {exc}", exc)
 
     # defaults (or the given params) construct
+    required = [info.alias or name for name, info in Params.model_fields.items() if info.is_required()]
+    if missing := [name for name in required if name not in params]:
+        fail(cls, f"Params.{', Params.'.join(missing)} has no default: pass the check a value (check_plugin("
+                  f"{kind!r}, cls, {', '.join(name + '=...' for name in missing)})), or give the field a default "
+                  "(Field(default, description=...)) so that a preset may leave it out")  # fmt: skip
     try:
         model = Params(**params)
     except ValidationError as exc:
-        hint = "" if params else " (pass the required values: check_plugin_class(kind, cls, params={...}))"
-        fail(cls, f"Params(**{params!r}) is invalid{hint}: {exc}", exc)
+        fail(cls, f"Params(**{params!r}) is invalid: {exc}", exc)
     instance = instantiate(cls, params)
     if instance.__dict__.get("params") != model:
         fail(cls, "the constructor must store its validated Params as self.params")

@@ -57,7 +57,8 @@ CLASS_BREAKAGES = [
     ("StringReferences", {"references": "10.1000/xyz"}, "references must be a tuple of strings"),
     ("NoAssignmentCheck", {"Params": _NoAssignmentParams}, "validate on assignment"),
     ("UnenforcedBound", {"Params": _UnenforcedParams}, r"Params.points = 7 \(past its minimum 8\) was accepted"),
-    ("RequiredField", {"Params": _RequiredParams}, r"Params\(\*\*\{\}\) is invalid \(pass the required values"),
+    ("RequiredField", {"Params": _RequiredParams},
+     r"Params.points has no default: pass the check a value \(check_plugin\(.spectrum., cls, points=...\)\), or give "),
     ("BuiltinsName", {"name": "power-law"}, r"name 'power-law' is taken by the built-in spectrum "
                                              r"frictionlab_spectra\.power_law\.PowerLaw: .*choose another name"),
 ]
