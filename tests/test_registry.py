@@ -453,10 +453,39 @@ def register_spectra(register):
     register(Loose)
 '''
 
+PARAMS_SOURCE = '''
+import numpy as np
+from pydantic import ConfigDict, Field
+import frictionlab
+from tests.testing.fakes import spectrum_class
+
+Loose = spectrum_class("loose-line", __name__, "Loose")
+
+
+class Params(frictionlab.PluginParams):
+    model_config = ConfigDict(extra="forbid", arbitrary_types_allowed=True)
+    {field}
+
+
+Loose.Params = Params
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Loose)
+'''
+
 BROKEN_AT_REGISTRATION = {
     "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
     "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
     "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
+    "no-schema": (PARAMS_SOURCE.replace("{field}", 'window: np.ndarray = Field(None, description="a window")'),
+                  "PluginError: Loose: Params has no JSON Schema (PydanticInvalidForJsonSchema: Cannot generate a "
+                  "JsonSchema for core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)): give every field a type "
+                  "pydantic can describe (numbers, strings, lists of them)"),
+    "default-out-of-bounds": (PARAMS_SOURCE.replace("{field}", 'points: int = Field(4, ge=8, description="points")'),
+                              "PluginError: Loose: Params.points defaults to 4, which its own bounds refuse (Input "
+                              "should be greater than or equal to 8): a preset leaving it out would run with it"),
 }
 
 

@@ -77,7 +77,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     dimension, ``problem`` names the physical problem, ``approximation`` is a bool,
     ``contact_measure`` and ``indentation_reference`` take allowed values,
     ``body_params`` and ``tolerance_param`` name fields); ``references`` is a tuple
-    of strings; ``Params`` has a JSON Schema; ``Params(**params)`` and
+    of strings; ``Params`` has a JSON Schema and every default passes its own bounds; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
     field has no default); an unknown key raises ``pydantic.ValidationError``
     naming it; the name is not a built-in's of the kind (the built-in keeps it: the plugin would
@@ -94,6 +94,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
 
     from frictionlab.errors import PluginError
     from frictionlab.plugin import KINDS
+    from frictionlab.plugin.classcheck import params_problem
     from frictionlab.plugin.registry import Registry, normalize_name, validate_plugin_class
 
     if kind not in KINDS:
@@ -116,10 +117,9 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
         fail(cls, f"references must be a tuple of strings (DOIs). Got {refs!r} instead.")
 
     Params = cls.Params
-    try:
-        schema = Params.model_json_schema()
-    except Exception as exc:  # editors and the CLI need it
-        fail(cls, f"Params.model_json_schema() raised {type(exc).__name__}: {exc}", exc)
+    if problem := params_problem(cls):  # as an installed plugin's registration says it
+        fail(cls, problem)
+    schema = Params.model_json_schema()
 
     # defaults (or the given params) construct
     required = [info.alias or name for name, info in Params.model_fields.items() if info.is_required()]

@@ -41,6 +41,10 @@ class _RequiredParams(PluginParams):
     spacing: float = Field(1.0, gt=0, description="grid spacing")
 
 
+class _BadDefaultParams(PluginParams):
+    points: int = Field(4, ge=8, description="number of grid points")
+
+
 class _NotStoring(GoodSpectrum):
     name = "not-storing"
 
@@ -59,6 +63,8 @@ CLASS_BREAKAGES = [
     ("UnenforcedBound", {"Params": _UnenforcedParams}, r"Params.points = 7 \(past its minimum 8\) was accepted"),
     ("RequiredField", {"Params": _RequiredParams},
      r"Params.points has no default: pass the check a value \(check_plugin\(.spectrum., cls, points=...\)\), or give "),
+    ("DefaultOutOfBounds", {"Params": _BadDefaultParams},
+     r"Params.points defaults to 4, which its own bounds refuse \(Input should be greater than or equal to 8\)"),
     ("BuiltinsName", {"name": "power-law"}, r"name 'power-law' is taken by the built-in spectrum "
                                              r"frictionlab_spectra\.power_law\.PowerLaw: .*choose another name"),
 ]
