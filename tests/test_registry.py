@@ -479,6 +479,8 @@ BROKEN_AT_REGISTRATION = {
     "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
     "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
     "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
+    "exits-at-import": ("import argparse\nargparse.ArgumentParser(prog='acme').parse_args(['--no-such-option'])\n",
+                        "SystemExit(2): it exits as it loads (parsing arguments at import?)"),
     "no-schema": (PARAMS_SOURCE.replace("{field}", 'window: np.ndarray = Field(None, description="a window")'),
                   "PluginError: Loose: Params has no JSON Schema (PydanticInvalidForJsonSchema: Cannot generate a "
                   "JsonSchema for core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)): give every field a type "
@@ -502,6 +504,15 @@ def test_an_entry_point_broken_at_registration_is_skipped_by_name(two_good, case
     assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
     assert reg.names("solver") == Registry(discover=False).names("solver")
     assert "good-line" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "typo"}).names("spectrum")
+
+
+def test_what_a_plugin_prints_as_it_loads_goes_to_stderr(two_good, capsys):
+    """stdout may be JSON (frictionlab schema, --json): a plugin's debug print corrupted it."""
+    two_good("acme-chatty", "chatty", "acme_chatty_plugin",
+             "print('loading chatty')\n" + GOOD_SOURCE.format(cls="Chatty", name="chatty-line"))
+    assert "chatty-line" in Registry(env={}).names("spectrum")
+    out, err = capsys.readouterr()
+    assert (out, err) == ("", "loading chatty\n")
 
 
 def test_a_name_two_installed_plugins_claim_is_an_error_only_where_used(two_good):

@@ -11,6 +11,7 @@ Environment switches (read when a registry is built):
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib
 import importlib.metadata as md
@@ -160,18 +161,21 @@ class Registry:
                 continue
             dist = ep.dist.name if ep.dist else "unknown distribution"
             claims: list[tuple[str, str]] = []
-            try:
-                plugin = ep.load()
-                self.pm.register(plugin, name=ep.name)
-                self._try_registration(plugin, claims)
+            try:  # what it prints goes to stderr: stdout may be JSON (--json, frictionlab schema)
+                with contextlib.redirect_stdout(sys.stderr):
+                    plugin = ep.load()
+                    self.pm.register(plugin, name=ep.name)
+                    self._try_registration(plugin, claims)
                 self._distributions[ep.name] = dist
                 for claim in claims:
                     self._claims.setdefault(claim, []).append(ep.name)
-            except Exception as exc:  # a broken plugin must not break the tool
+            except (Exception, SystemExit) as exc:  # a broken plugin must not break (nor end) the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
                 message = f"{type(exc).__name__}: {exc}"
-                if isinstance(exc, SyntaxError):  # its str names the file without its folder
+                if isinstance(exc, SystemExit):  # argparse or sys.exit() at import, reading frictionlab's arguments
+                    message = f"SystemExit({exc.code!r}): it exits as it loads (parsing arguments at import?)"
+                elif isinstance(exc, SyntaxError):  # its str names the file without its folder
                     message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
                 elif isinstance(exc, pluggy.PluginValidationError):
                     message = self._hook_arguments_message(exc)
