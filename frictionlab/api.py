@@ -147,7 +147,28 @@ def scene_record(scene: Scene) -> dict:
     }  # fmt: skip
 
 
+def _plugin_told(entry):
+    """An exception raised in an installed plugin's code comes out of ``entry`` as the
+    ``PluginError`` naming that plugin, its distribution and the line, as the CLI tells it
+    (the original, frictionlab's frames and all, is its ``__context__``)."""
+    import functools
+
+    @functools.wraps(entry)
+    def called(*args, **keys):
+        try:
+            return entry(*args, **keys)
+        except Exception as exc:
+            from .plugin.registry import installed_plugin_fault
+
+            if (fault := installed_plugin_fault(exc)) is None:
+                raise
+            raise fault from None
+
+    return called
+
+
 @raised_here
+@_plugin_told
 def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
              **keys: Any) -> dict:  # fmt: skip
     """Check a preset (any form ``run`` takes, overrides as there) without running it, and
@@ -166,6 +187,7 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
 
 
 @raised_here
+@_plugin_told
 def run(
     preset: str | Path | Mapping[str, Any] | Preset,
     overrides: Mapping[str, Any] | None = None,

@@ -19,6 +19,7 @@ from frictionlab.errors import FrictionlabError, MissingDependency, PresetError,
 from frictionlab.preset import Preset
 
 from .conftest import PRESETS, SMALL_PRESET, merge
+from .test_registry import fake_dists  # noqa: F401 (a fixture)
 
 FAST = {"workers": 1, "progress": False}
 
@@ -355,3 +356,42 @@ def test_the_units_of_the_columns_are_curve_csvs_in_memory_on_disk_and_in_pandas
     assert frictionlab.load(tmp_path / "run").units == result.units
     assert frictionlab.run(SMALL_PRESET, **FAST).units == result.units  # kept in memory: the same
     assert result.to_pandas().attrs["units"] == result.units
+
+
+STIFFNESS_RAISES = '''
+import frictionlab
+from tests.testing.fakes import GoodSolver
+
+
+class Raising(GoodSolver):
+    name = "raising-solver"
+
+    def stiffness(self):
+        return 1 / 0
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(Raising)
+'''
+
+
+def test_an_exception_in_an_installed_plugin_is_told_as_its_fault_not_raised_raw(fake_dists):  # noqa: F811
+    """frictionlab.run and validate raised the plugin's ZeroDivisionError out of frictionlab's
+    frames, where the CLI named the plugin. Now both do."""
+    from frictionlab.errors import PluginError
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-raising", "raising", "acme_raising", STIFFNESS_RAISES, "1.2")
+    registry_module.default_registry.cache_clear()
+    try:
+        raising = {"solver.name": "raising-solver", "solver.params": {}}
+        for call in (lambda: frictionlab.validate("quickstart", raising),
+                     lambda: frictionlab.run("quickstart", raising, workers=1, progress=False, plot=False)):
+            with pytest.raises(PluginError) as excinfo:
+                call()
+            assert str(excinfo.value).startswith("solver 'raising-solver' (acme_raising.Raising from acme-raising) "
+                                                 "raised ZeroDivisionError: division by zero in stiffness() at ")
+            assert excinfo.value.__suppress_context__ and isinstance(excinfo.value.__context__, ZeroDivisionError)
+    finally:
+        registry_module.default_registry.cache_clear()

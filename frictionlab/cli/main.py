@@ -236,9 +236,9 @@ def _plugin_at_fault(exc: Exception):
     """The PluginError that names the installed plugin whose code raised ``exc``, or None."""
     if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
         return None
-    from ..plugin.registry import default_registry
+    from ..plugin.registry import installed_plugin_fault
 
-    return default_registry().at_fault(exc)
+    return installed_plugin_fault(exc)
 
 
 def _plain_warning(message, category, filename, lineno, file=None, line=None):

@@ -375,6 +375,14 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
     return None
 
 
+def installed_plugin_fault(exc: BaseException) -> PluginError | None:
+    """``exc`` told as the fault of the installed plugin whose code raised it, or None (also when
+    no plugin was loaded in this process: none ran)."""
+    if default_registry.cache_info().currsize == 0:
+        return None
+    return default_registry().at_fault(exc)
+
+
 @functools.cache
 def default_registry() -> Registry:
     """The process-wide registry, built on first use."""
