@@ -133,9 +133,13 @@ class Registry:
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
             self.pm.trace.root.setwriter(sys.stderr.write)
             self.pm.enable_tracing()
+        self._builtins: dict[str, dict[str, type]] = {kind: {} for kind in KINDS}  # the names no installed plugin may take
         if builtins:
             for module_name in BUILTIN_MODULES:
-                self.pm.register(importlib.import_module(module_name), name=module_name)
+                self.pm.register(module := importlib.import_module(module_name), name=module_name)
+                for kind, base in KINDS.items():
+                    if hook := getattr(module, base.register_hook, None):
+                        hook(register=lambda cls, _kind=kind: self._builtins[_kind].setdefault(normalize_name(cls.name), cls))
         if discover and not _env_flag(env, "FRICTIONLAB_DISABLE_DISCOVERY"):
             self._load_entry_points(
                 only=_env_list(env, "FRICTIONLAB_PLUGINS"),
@@ -151,7 +155,6 @@ class Registry:
     def _load_entry_points(self, only: list[str], blocked: list[str]) -> None:
         for name in blocked:
             self.pm.set_blocked(name)
-        self._collect()  # the built-ins' names, which no installed plugin may take
         found = md.entry_points(group=ENTRY_POINT_GROUP)
         _warn_of_unknown_names(only, sorted({ep.name for ep in found}))
         for ep in found:
@@ -197,9 +200,9 @@ class Registry:
                         validate_plugin_class(_kind, cls)
                         if problem := params_problem(cls):
                             raise PluginError(f"{cls.__qualname__}: {problem}")
-                        if (taken := self._plugins[_kind].get(key)) and taken.cls is not cls:  # a built-in's
+                        if (taken := self._builtins[_kind].get(key)) and taken is not cls:
                             raise PluginError(f"{cls.__qualname__}: name {key!r} is taken by the built-in {_kind} "
-                                              f"{taken.cls.__module__}.{taken.cls.__qualname__}, which keeps it; "
+                                              f"{taken.__module__}.{taken.__qualname__}, which keeps it; "
                                               "choose another name")  # fmt: skip
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
