@@ -116,6 +116,20 @@ def test_an_array_is_refused_as_not_finite_exactly_where_an_entry_is(nan, dtype)
         assert (problem is not None) == bool(bad.any()), (seed, value)
 
 
+def test_a_non_finite_array_is_told_with_its_first_bad_entry_and_where():
+    """'Got 1 non-finite value(s)' left the plugin's author to search the array."""
+    from frictionlab.plugin.outputs import array_problem
+
+    line = np.arange(6.0)
+    line[[2, 4]] = np.nan, np.inf
+    assert array_problem("Profile.heights", line) == (
+        "Profile.heights must be finite. Got 2 non-finite value(s), the first nan at index 2.")
+    surface = np.zeros((3, 4))
+    surface[1, 2] = -np.inf
+    assert array_problem("slopes()", surface, nan=True) == (
+        "slopes() must be finite. Got 1 non-finite value(s), the first -inf at index (1, 2).")
+
+
 def test_the_slope_scale_is_found_past_nan_slopes():
     """slope_scale brings the largest slope in magnitude (NaN ones passed by) near 1 by a power
     of two, and leaves slopes that square safely as they are."""

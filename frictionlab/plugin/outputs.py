@@ -32,7 +32,10 @@ def array_problem(what: str, value, shape=None, floating: bool = True, nan: bool
         return f"{what} must be real numbers. Got dtype {value.dtype} instead."
     if value.size and not _all_finite(value, nan):
         bad = np.isinf(value) if nan else ~np.isfinite(value)
-        return f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s)."
+        first = np.unravel_index(int(np.argmax(bad)), value.shape)  # where to look, in the plugin's own terms
+        where = first[0] if value.ndim == 1 else tuple(int(i) for i in first)
+        return (f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s), the first "
+                f"{float(value[first])} at index {where}.")  # fmt: skip
     return None
 
 

@@ -63,7 +63,7 @@ def _nan_at(index):
     "qualname,slopes,undefined,match",
     [
         ("UndeclaredEnd", _nan_at(-1), lambda self, periodic: False,
-         r"must be finite\. Got 1 non-finite value\(s\)\. A NaN \(a point without a slope\) needs undefined_points\(False\) to return True"),
+         r"must be finite\. Got 1 non-finite value\(s\), the first nan at index 127\. A NaN \(a point without a slope\) needs undefined_points\(False\) to return True"),
         ("InnerNaN", _nan_at(5), lambda self, periodic: not periodic, "only in bands at the profile's ends"),
         ("WideBand", _nan_at(slice(0, 40)), lambda self, periodic: not periodic, "at most a quarter of each axis"),
         ("UndefinedWhenPeriodic", _nan_at(-1), lambda self, periodic: True, r"undefined_points\(True\) must be False"),
