@@ -231,9 +231,9 @@ class Registry:
         """Register a plugin object (module or class with hookimpls) and re-collect.
 
         If the plugin is rejected (a misspelled hook: ``pluggy.PluginValidationError``;
-        a class breaking the contract or clashing with another: ``PluginError``),
-        it is unregistered again before the error propagates, so the registry is
-        left as it was.
+        a class breaking the contract, taking a built-in's name or clashing with another:
+        ``PluginError``, in the words an installed plugin's failure to load says it), it is
+        unregistered again before the error propagates, so the registry is left as it was.
         """
         was_registered = self.pm.is_registered(plugin)
         clashes = set(self.clashes)
@@ -241,7 +241,7 @@ class Registry:
             self.pm.register(plugin, name=name)
             if problem := self._unknown_hook(plugin):  # as a run's discovery says it: with the hook meant
                 raise pluggy.PluginValidationError(plugin, f"{problem} (in {plugin!r})")
-            self.pm.check_pending()
+            self._try_registration(plugin, [])
             self._collect()
             for message in self.clashes:
                 if message not in clashes:

@@ -35,7 +35,8 @@ Fixtures
 
     Registration runs pluggy's ``check_pending()``, so a misspelled hook name
     fails here with ``pluggy.PluginValidationError``; a class that breaks the
-    contract fails with ``frictionlab.errors.PluginError``.
+    contract or takes a built-in's name fails with ``frictionlab.errors.PluginError``,
+    in the words an installed plugin's failure to load says it.
 
 Conformance checks
 ==================
