@@ -479,7 +479,11 @@ def register_spectra(register):
 
 BROKEN_AT_REGISTRATION = {
     "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
-    "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
+    "hook-raises": (HOOK_RAISES_SOURCE,
+                    "RuntimeError: boom: broken in its hook (in register_solvers() at acme_typo_plugin.py:7)"),
+    "import-fails": ("import json\nimport no_such_module_for_acme\n",
+                     "ModuleNotFoundError: No module named 'no_such_module_for_acme' (as it imports, "
+                     "acme_typo_plugin.py:2)"),
     "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
     "exits-at-import": ("import argparse\nargparse.ArgumentParser(prog='acme').parse_args(['--no-such-option'])\n",
                         "SystemExit(2): it exits as it loads (parsing arguments at import?)"),

@@ -175,15 +175,24 @@ class Registry:
             except (Exception, SystemExit) as exc:  # a broken plugin must not break (nor end) the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
-                message = f"{type(exc).__name__}: {exc}"
-                if isinstance(exc, SystemExit):  # argparse or sys.exit() at import, reading frictionlab's arguments
-                    message = f"SystemExit({exc.code!r}): it exits as it loads (parsing arguments at import?)"
-                elif isinstance(exc, SyntaxError):  # its str names the file without its folder
-                    message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
-                elif isinstance(exc, pluggy.PluginValidationError):
-                    message = self._hook_arguments_message(exc)
+                message = self._failure_message(exc, ep.module.partition(".")[0])
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warn_user(f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped", RuntimeWarning)
+
+    def _failure_message(self, exc: BaseException, package: str) -> str:
+        """Why an entry point failed to load, on one line, with where in its ``package`` it raised."""
+        if isinstance(exc, SystemExit):  # argparse or sys.exit() at import, reading frictionlab's arguments
+            return f"SystemExit({exc.code!r}): it exits as it loads (parsing arguments at import?)"
+        if isinstance(exc, SyntaxError):  # its str names the file without its folder
+            return f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
+        if isinstance(exc, pluggy.PluginValidationError):
+            return self._hook_arguments_message(exc)
+        message = f"{type(exc).__name__}: {exc}"
+        frame, where, _ = fault_site(exc, package)
+        if frame is None or isinstance(exc, PluginError):  # a broken contract is said by what, not where
+            return message
+        function, _, line = where.partition(" at ")
+        return f"{message} ({'as it imports, ' + line if function == '<module>()' else 'in ' + where})"
 
     def _try_registration(self, plugin, claims: list[tuple[str, str]]) -> None:
         """Run ``plugin``'s registration hooks alone, checking every class it registers: a
