@@ -487,6 +487,8 @@ BROKEN_AT_REGISTRATION = {
     "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
     "exits-at-import": ("import argparse\nargparse.ArgumentParser(prog='acme').parse_args(['--no-such-option'])\n",
                         "SystemExit(2): it exits as it loads (parsing arguments at import?)"),
+    "no-mark": ("def register_spectra(register):\n    pass\n",
+                "PluginError: it implements no hook: register_spectra lacks the @frictionlab.hookimpl mark"),
     "no-schema": (PARAMS_SOURCE.replace("{field}", 'window: np.ndarray = Field(None, description="a window")'),
                   "PluginError: Loose: Params has no JSON Schema (PydanticInvalidForJsonSchema: Cannot generate a "
                   "JsonSchema for core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)): give every field a type "
@@ -510,6 +512,17 @@ def test_an_entry_point_broken_at_registration_is_skipped_by_name(two_good, case
     assert {"good-line", "other-line", "power-law"} <= set(reg.names("spectrum"))
     assert reg.names("solver") == Registry(discover=False).names("solver")
     assert "good-line" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "typo"}).names("spectrum")
+
+
+def test_an_entry_point_naming_the_class_not_the_module_is_told_so(two_good):
+    """It registered nothing without a word: the plugin was looked for in vain."""
+    two_good("acme-named", "named", "acme_named_plugin", GOOD_SOURCE.format(cls="Named", name="named-line"),
+             target="acme_named_plugin:Named")
+    with pytest.warns(RuntimeWarning, match="plugin 'named' from acme-named failed to load"):
+        reg = Registry(env={})
+    assert [f.error for f in reg.failures] == [
+        "PluginError: it implements no hook: the entry point's value must be the module holding its "
+        "@frictionlab.hookimpl functions (acme_named_plugin), not the class Named"]
 
 
 def test_what_a_plugin_prints_as_it_loads_goes_to_stderr(two_good, capsys):

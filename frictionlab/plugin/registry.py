@@ -106,6 +106,18 @@ def _provider(module: str) -> tuple[str, str]:
     return module, "unversioned"
 
 
+def _registers_nothing(plugin) -> str:
+    """Why an entry point that implements no hook is refused (skipped without a word, its plugins
+    were looked for in vain): a hook without its mark, or the class named instead of the module."""
+    hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
+    if unmarked := [name for name in hooks if callable(getattr(plugin, name, None))]:
+        return f"it implements no hook: {', '.join(unmarked)} lacks the @frictionlab.hookimpl mark"
+    said = "it implements no hook: the entry point's value must be the module holding its @frictionlab.hookimpl functions"
+    if isinstance(plugin, type):  # the class itself, as the kit's register_plugin takes it
+        said += f" ({plugin.__module__}), not the class {plugin.__qualname__}"
+    return said
+
+
 def _warn_of_unknown_names(only: list[str], installed: list[str]) -> None:
     """A name in FRICTIONLAB_PLUGINS that no installed plugin has (a typo) is said: the plugin
     meant would otherwise be left out without a word. (A blocked name that is not installed
@@ -169,6 +181,8 @@ class Registry:
                     plugin = ep.load()
                     self.pm.register(plugin, name=ep.name)
                     self._try_registration(plugin, claims)
+                    if not claims and not self.pm.get_hookcallers(plugin):
+                        raise PluginError(_registers_nothing(plugin))
                 self._distributions[ep.name] = dist
                 for claim in claims:
                     self._claims.setdefault(claim, []).append(ep.name)
