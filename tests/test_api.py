@@ -395,3 +395,11 @@ def test_an_exception_in_an_installed_plugin_is_told_as_its_fault_not_raised_raw
             assert excinfo.value.__suppress_context__ and isinstance(excinfo.value.__context__, ZeroDivisionError)
     finally:
         registry_module.default_registry.cache_clear()
+
+
+def test_a_refused_scheduler_is_named_as_the_keyword_given_not_the_command_line_option():
+    """frictionlab.run(scheduler=...) was told '--scheduler must be ...', an option it has not."""
+    with pytest.raises(FrictionlabError) as excinfo:
+        frictionlab.run("quickstart", scheduler="nonsense", progress=False, plot=False)
+    assert str(excinfo.value) == ("scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. "
+                                  "Got 'nonsense' instead.")
