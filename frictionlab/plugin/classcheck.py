@@ -8,6 +8,7 @@ the conformance kit, not for the built-ins at every start."""
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Mapping
 from typing import get_args
 
@@ -141,7 +142,8 @@ def _signature_problems(cls, base) -> list[str]:
 def params_problem(cls) -> str | None:
     """What is wrong with ``cls.Params`` beyond its declaration: no JSON Schema (``frictionlab
     schema`` and the terminal UI's form read it), or a default its own bounds refuse (pydantic
-    does not check defaults: a preset leaving the field out would pass the plugin that value)."""
+    does not check defaults: a preset leaving the field out would pass the plugin that value), or
+    infinity or NaN allowed or given as a default (the run's summary.json could not hold it)."""
     params = cls.Params
     try:
         params.model_json_schema()
@@ -151,6 +153,13 @@ def params_problem(cls) -> str | None:
                 "field a type pydantic can describe (numbers, strings, lists of them)")  # fmt: skip
     defaults = {info.alias or name: info.get_default(call_default_factory=True)
                 for name, info in params.model_fields.items() if not info.is_required()}  # fmt: skip
+    finite = "a parameter must be a finite number (results are JSON, which has no infinity or NaN)"
+    for field, info in params.model_fields.items():  # summary.json holds every parameter
+        if any(getattr(m, "allow_inf_nan", False) for m in info.metadata):
+            return f"Params.{field} allows infinity and NaN (allow_inf_nan=True): {finite}; use None for none"
+    for field, value in defaults.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            return f"Params.{field} defaults to {value!r}: {finite}; give a finite default, or None for none"
     try:
         params.model_validate(defaults)
     except ValidationError as exc:
