@@ -135,14 +135,16 @@ def scene_record(scene: Scene) -> dict:
     starts: ``frictionlab.preset.loads.describe_loads``) and what a reader of its run should know
     from its spectrum's parameters alone (``caveats``: ``SpectrumGenerator.caveats()``). Loads the
     solver cannot take are refused."""
+    from .plugin.outputs import input_summary_problem, refuse
     from .preset.loads import check_loads, describe_loads
 
     check_loads(scene)
-    preset = scene.preset
+    preset, read = scene.preset, scene.spectrum.input_summary()
+    refuse(scene.spectrum, input_summary_problem(read))  # printed, and JSON under --json
     return {
         "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
         "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
-        "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+        "steps": preset.loading.steps, "control": preset.loading.control, "input": read,
         "loads": describe_loads(scene), "caveats": list(scene.spectrum.caveats()),
     }  # fmt: skip
 

@@ -153,3 +153,27 @@ def test_negative_slopes_on_a_surface_are_refused_where_a_run_takes_them():
         "slopes() on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of -1.")
     assert slopes_problem(GoodSlopes(), np.abs(z), Profile(z, 1.0)) is None
     assert slopes_problem(GoodSlopes(), z[0], Profile(z[0], 1.0)) is None
+
+
+@pytest.mark.parametrize("summary, said", [
+    ({"file": "a.csv", "shape": [128], "spacing": 1.0, "unit": None, "rms_height": float("nan")},
+     "Out of range float values are not JSON compliant"),
+    ({"file": "a.csv", "shape": [128], "spacing": 1.0, "unit": None, "rms_height": 1.0, "when": object()},
+     "Object of type object is not JSON serializable"),
+    ({"file": "a.csv"}, "input_summary() must give at least file, shape, spacing, unit and rms_height"),
+])
+def test_an_input_summary_no_json_holds_is_refused_as_the_run_starts_and_by_validate(register_plugin, summary, said):
+    """Taken as it came, the run computed every realization, then ended in an internal error
+    writing summary.json (and validate --json in one writing its answer)."""
+    from frictionlab.api import scene_record
+    from frictionlab.runs.inputrecord import what_was_read
+
+    broken = type("Summarised", (GoodSpectrum,), {"name": "broken-spectrum", "input_summary": lambda self: summary})
+    registry = register_plugin(broken)
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "spectrum": {"name": "broken-spectrum"}}, registry=registry)
+    for read in (what_was_read, scene_record):
+        with pytest.raises(PluginError, match="broke the plugin contract: input_summary()") as excinfo:
+            read(scene)
+        assert said in str(excinfo.value)

@@ -5,11 +5,12 @@ states the same problems in the same words."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 
-from ..errors import PluginError
+from ..errors import PluginError, short_repr
 from .data import ContactCurve, Profile
 from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
 from .registry import provider_of
@@ -151,6 +152,20 @@ def caveats_problem(caveats) -> str | None:
     if isinstance(caveats, tuple) and all(isinstance(c, str) and c.strip() for c in caveats):
         return None
     return f"caveats() must be a tuple of non-empty strings (one sentence: (sentence,)). Got {caveats!r} instead."
+
+
+def input_summary_problem(summary) -> str | None:
+    """``input_summary()`` must be None or a JSON-ready mapping (summary.json holds it) giving at
+    least file, shape, spacing, unit and rms_height (the progress and validate say them)."""
+    if summary is None:
+        return None
+    try:
+        json.dumps(summary, allow_nan=False)
+    except (TypeError, ValueError) as exc:  # an object json cannot write, infinity, NaN
+        return f"input_summary() must be None or a JSON-ready mapping. Got {short_repr(repr(summary), 300)[1:-1]} ({exc})."
+    if not isinstance(summary, dict) or not {"file", "shape", "spacing", "unit", "rms_height"} <= set(summary):
+        return f"input_summary() must give at least file, shape, spacing, unit and rms_height. Got {summary!r}."
+    return None
 
 
 def shape_problem(spectrum: SpectrumGenerator, profile: Profile) -> str | None:

@@ -192,17 +192,13 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
 
 
 def _check_input_summary(cls, gen, profile) -> None:
-    import json
+    from frictionlab.plugin.outputs import input_summary_problem
 
     summary = call(cls, "input_summary()", gen.input_summary)
     if summary is None:
         return
-    try:
-        json.dumps(summary, allow_nan=False)
-    except (TypeError, ValueError) as exc:
-        fail(cls, f"input_summary() must be None or a JSON-ready mapping. Got {summary!r} ({exc}).")
-    if not isinstance(summary, dict) or not {"file", "shape", "spacing", "unit", "rms_height"} <= set(summary):
-        fail(cls, f"input_summary() must give at least file, shape, spacing, unit and rms_height. Got {summary!r}.")
+    if problem := input_summary_problem(summary):  # as a run takes it
+        fail(cls, problem)
     if (tuple(summary["shape"]) != profile.heights.shape or summary["spacing"] != profile.spacing
             or summary["rms_height"] != gen.rms_height()):
         fail(cls, f"input_summary() must give the shape {profile.heights.shape}, spacing {profile.spacing!r} and "
