@@ -43,7 +43,8 @@ Conformance checks
 
 Each check raises ``AssertionError`` with a readable message naming the class
 and what is wrong (an exception raised by your plugin's code is turned into an
-``AssertionError`` too, chained to the original). Parametrise them over your own
+``AssertionError`` too, chained to the original, whose traceback starts in your code);
+pytest shows the test that called the check and the message, not the kit's own frames. Parametrise them over your own
 classes::
 
     import pytest
@@ -64,6 +65,7 @@ from __future__ import annotations
 import pytest
 
 from .classes import check_plugin_class
+from .common import reported
 from .slopes import check_slope_estimator
 from .solvers import check_solver
 from .spectra import check_spectrum
@@ -123,6 +125,7 @@ def _as_hook_plugin(obj):
     return obj
 
 
+@reported
 def check_plugin(kind: str, cls, *, deterministic: bool = False, **params) -> None:
     """``check_plugin_class(kind, cls, params)`` followed by the check of ``kind``
     (``deterministic`` is passed on to ``check_spectrum`` only)."""

@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from .common import fail, instantiate
+from .common import fail, instantiate, reported
 
 
 def _schema_bounds(prop: Mapping[str, Any]) -> list[tuple[str, float, bool]]:
@@ -65,6 +65,7 @@ def _bounded_fields(cls, schema) -> list[tuple[str, str, float, bool]]:
     return found
 
 
+@reported
 def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) -> None:
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
     ``"slope"``): ``frictionlab.plugin.registry.validate_plugin_class`` passes (right

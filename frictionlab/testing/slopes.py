@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from .common import call, check_array, fail, instantiate, must_refuse
+from .common import call, check_array, fail, instantiate, must_refuse, reported
 
 
+@reported
 def check_slope_estimator(cls, **params) -> None:
     """``cls(**params).slopes(heights, spacing, periodic)`` on a random periodic line returns
     a finite float64 array of the same shape, does not modify its input

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import math
 
-from .common import call, check_array, check_positive_number, fail, instantiate, is_not_implemented
+from .common import call, check_array, check_positive_number, fail, instantiate, is_not_implemented, reported
 
 
+@reported
 def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
     float64 heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives

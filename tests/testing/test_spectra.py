@@ -121,3 +121,22 @@ def test_a_non_periodic_spectrum_with_its_own_advice_passes_and_the_default_advi
     fltesting.check_spectrum(spectrum_variant("PlainScan", **line))
     own = ("spectrum scan is not periodic (closed: false)", "set spectrum.params.closed: true")
     fltesting.check_spectrum(spectrum_variant("OwnScan", **line, not_periodic_advice=lambda self: own))
+
+
+def test_a_failed_check_shows_the_test_and_the_plugin_not_the_kits_frames():
+    """pytest printed every frame of the kit (check_plugin, check_spectrum, fail...) above the
+    message; a frame it shows must be the caller's or the plugin's."""
+    import os
+    import traceback
+
+    def blows_up(self, rng):
+        raise RuntimeError("my generator broke")
+
+    for generate, cause in ((lambda self, rng: Profile(np.full(8, np.nan), 1.0), None), (blows_up, "blows_up")):
+        with pytest.raises(AssertionError) as excinfo:
+            fltesting.check_plugin("spectrum", spectrum_variant("Broken", generate=generate))
+        kit = [frame for frame, _ in traceback.walk_tb(excinfo.value.__traceback__)
+               if f"frictionlab{os.sep}testing" in frame.f_code.co_filename]
+        assert kit and all(frame.f_locals.get("__tracebackhide__") for frame in kit)
+        if cause:
+            assert excinfo.value.__cause__.__traceback__.tb_frame.f_code.co_name == cause
