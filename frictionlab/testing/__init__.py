@@ -43,9 +43,9 @@ Conformance checks
 
 Each check raises ``AssertionError`` with a readable message naming the class
 and what is wrong (an exception raised by your plugin's code is turned into an
-``AssertionError`` too, chained to the original, whose traceback starts in your code);
-pytest shows the test that called the check and the message, not the kit's own frames. Parametrise them over your own
-classes::
+``AssertionError`` too, chained to the original, whose traceback starts in your
+code); pytest shows the test that called the check and the message, not the
+kit's own frames. Parametrise them over your own classes::
 
     import pytest
     from frictionlab.testing import check_plugin
