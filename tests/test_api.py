@@ -403,3 +403,29 @@ def test_a_refused_scheduler_is_named_as_the_keyword_given_not_the_command_line_
         frictionlab.run("quickstart", scheduler="nonsense", progress=False, plot=False)
     assert str(excinfo.value) == ("scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. "
                                   "Got 'nonsense' instead.")
+
+
+class _SometimesBroken:
+    """A spectrum whose generate() raises for about half the realizations (by its rng)."""
+
+    def generate(self, rng):
+        if rng.random() < 0.5:
+            raise RuntimeError("this one broke")
+        return super().generate(rng)
+
+
+@pytest.mark.parametrize("realizations", [6, 1])
+def test_a_run_with_failed_realizations_is_read_back_not_called_damaged(make_scene, tmp_path, realizations):
+    """summary.json counts done (finished) and failed apart; read_summary took done to count the
+    failed too, and called any run with a failed realization damaged: load() refused it."""
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import Scene
+    from frictionlab.runs.runner import run_to_folder
+
+    scene = make_scene({"realizations": realizations, "seed": 3})
+    broken = type("Sometimes", (_SometimesBroken, type(scene.spectrum)), {})(scene.spectrum.params)
+    scene = Scene(preset=scene.preset, spectrum=broken, solver=scene.solver, slope=scene.slope)
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, executor="serial"))
+    assert outcome.failures and (outcome.done or realizations == 1)
+    read = frictionlab.load(tmp_path / "run")
+    assert read.realizations == (outcome.done, realizations) and read.status == outcome.status
