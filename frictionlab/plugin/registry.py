@@ -149,9 +149,7 @@ class Registry:
         if builtins:
             for module_name in BUILTIN_MODULES:
                 self.pm.register(module := importlib.import_module(module_name), name=module_name)
-                for kind, base in KINDS.items():
-                    if hook := getattr(module, base.register_hook, None):
-                        hook(register=lambda cls, _kind=kind: self._builtins[_kind].setdefault(normalize_name(cls.name), cls))
+                self._note_builtins(module)
         if discover and not _env_flag(env, "FRICTIONLAB_DISABLE_DISCOVERY"):
             self._load_entry_points(
                 only=_env_list(env, "FRICTIONLAB_PLUGINS"),
@@ -193,6 +191,12 @@ class Registry:
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warn_user(f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped", RuntimeWarning)
 
+    def _note_builtins(self, module) -> None:
+        """The classes a built-in module registers, by kind and name: names no installed plugin may take."""
+        for kind, base in KINDS.items():
+            if hook := getattr(module, base.register_hook, None):
+                hook(register=lambda cls, kind=kind: self._builtins[kind].setdefault(normalize_name(cls.name), cls))
+
     def _failure_message(self, exc: BaseException, package: str) -> str:
         """Why an entry point failed to load, on one line, with where in its ``package`` it raised."""
         if isinstance(exc, SystemExit):  # argparse or sys.exit() at import, reading frictionlab's arguments
@@ -219,16 +223,19 @@ class Registry:
             for impl in getattr(self.pm.hook, base.register_hook).get_hookimpls():
                 if impl.plugin is plugin:
                     def register(cls, _kind=kind):  # a preset naming a refused class is told why
-                        claims.append((_kind, key := normalize_name(str(getattr(cls, "name", "")))))
+                        claims.append((_kind, normalize_name(str(getattr(cls, "name", "")))))
                         validate_plugin_class(_kind, cls)
-                        if problem := params_problem(cls):
+                        if problem := params_problem(cls) or self._builtin_name_problem(_kind, cls):
                             raise PluginError(f"{cls.__qualname__}: {problem}")
-                        if (taken := self._builtins[_kind].get(key)) and taken is not cls:
-                            raise PluginError(f"{cls.__qualname__}: name {key!r} is taken by the built-in {_kind} "
-                                              f"{taken.__module__}.{taken.__qualname__}, which keeps it; "
-                                              "choose another name")  # fmt: skip
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
+
+    def _builtin_name_problem(self, kind: str, cls) -> str | None:
+        """A class of an installed plugin may not take a built-in's name: the built-in keeps it."""
+        key = normalize_name(cls.name)
+        if (taken := self._builtins[kind].get(key)) is None or taken is cls:
+            return None
+        return f"name {key!r} is taken by the built-in {kind} {taken.__module__}.{taken.__qualname__}, which keeps it; choose another name"
 
     def _hook_arguments_message(self, exc: pluggy.PluginValidationError) -> str:
         """pluggy's refusal of a hook's arguments, on one line, with the arguments the hook passes."""
