@@ -235,7 +235,8 @@ class Registry:
         key = normalize_name(cls.name)
         if (taken := self._builtins[kind].get(key)) is None or taken is cls:
             return None
-        return f"name {key!r} is taken by the built-in {kind} {taken.__module__}.{taken.__qualname__}, which keeps it; choose another name"
+        return (f"name {key!r} is taken by the built-in {kind} {taken.__module__}.{taken.__qualname__}, which keeps "
+                "it; choose another name")  # fmt: skip
 
     def _hook_arguments_message(self, exc: pluggy.PluginValidationError) -> str:
         """pluggy's refusal of a hook's arguments, on one line, with the arguments the hook passes."""
