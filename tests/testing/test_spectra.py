@@ -140,3 +140,11 @@ def test_a_failed_check_shows_the_test_and_the_plugin_not_the_kits_frames():
         assert kit and all(frame.f_locals.get("__tracebackhide__") for frame in kit)
         if cause:
             assert excinfo.value.__cause__.__traceback__.tb_frame.f_code.co_name == cause
+
+
+def test_a_measured_profile_declared_periodic_is_not_held_to_wrapping():
+    """deterministic: a file's profile is periodic as its data and its preset say (a plane levelled
+    away leaves a step at the wrap); the kit checks the plugin, not the data."""
+    scan = np.sin(np.arange(128) / 5) + np.linspace(0, 3, 128)
+    fltesting.check_spectrum(spectrum_variant("Scan", generate=lambda self, rng: Profile(scan.copy(), 1.0)),
+                             deterministic=True)
