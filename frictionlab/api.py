@@ -135,19 +135,42 @@ def scene_record(scene: Scene) -> dict:
     starts: ``frictionlab.preset.loads.describe_loads``) and what a reader of its run should know
     from its spectrum's parameters alone (``caveats``: ``SpectrumGenerator.caveats()``). Loads the
     solver cannot take are refused."""
+    from .plugin.outputs import input_summary_problem, refuse
     from .preset.loads import check_loads, describe_loads
 
     check_loads(scene)
-    preset = scene.preset
+    preset, read = scene.preset, scene.spectrum.input_summary()
+    refuse(scene.spectrum, input_summary_problem(read))  # printed, and JSON under --json
     return {
         "name": preset.name, "realizations": preset.realizations, "spectrum": scene.spectrum.name,
         "pressed": scene.pressed, "solver": scene.solver.name, "slope": scene.slope.name,
-        "steps": preset.loading.steps, "control": preset.loading.control, "input": scene.spectrum.input_summary(),
+        "steps": preset.loading.steps, "control": preset.loading.control, "input": read,
         "loads": describe_loads(scene), "caveats": list(scene.spectrum.caveats()),
     }  # fmt: skip
 
 
+def _plugin_told(entry):
+    """An exception raised in an installed plugin's code comes out of ``entry`` as the
+    ``PluginError`` naming that plugin, its distribution and the line, as the CLI tells it
+    (the original, frictionlab's frames and all, is its ``__context__``)."""
+    import functools
+
+    @functools.wraps(entry)
+    def called(*args, **keys):
+        try:
+            return entry(*args, **keys)
+        except Exception as exc:
+            from .plugin.registry import installed_plugin_fault
+
+            if (fault := installed_plugin_fault(exc)) is None:
+                raise
+            raise fault from None
+
+    return called
+
+
 @raised_here
+@_plugin_told
 def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping[str, Any] | None = None, /,
              **keys: Any) -> dict:  # fmt: skip
     """Check a preset (any form ``run`` takes, overrides as there) without running it, and
@@ -166,6 +189,7 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
 
 
 @raised_here
+@_plugin_told
 def run(
     preset: str | Path | Mapping[str, Any] | Preset,
     overrides: Mapping[str, Any] | None = None,

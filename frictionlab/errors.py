@@ -252,6 +252,20 @@ def workers_advice(workers: int) -> str:
     return f"--workers {workers}" if "--workers" in front.options else f"{workers} worker(s)"
 
 
+def for_python() -> bool:
+    """Whether a refusal is read by a caller of ``frictionlab.run`` (keywords), not a command's user."""
+    return _front_end.get().python
+
+
+def option_given(option: str, value: str | None = None) -> str:
+    """An option of the command line (``--scheduler``), with the ``value`` given it, as the front end
+    in use spells it: ``--scheduler tcp://...``, or ``scheduler='tcp://...'`` for ``frictionlab.run``."""
+    if for_python():
+        name = option.removeprefix("--").replace("-", "_")
+        return name if value is None else f"{name}={value!r}"
+    return option if value is None else f"{option} {value}"
+
+
 def skip_hint() -> str:
     """The refusal's last sentence: how the front end in use skips the estimate, where it can."""
     front = _front_end.get()

@@ -19,6 +19,7 @@ from frictionlab.errors import FrictionlabError, MissingDependency, PresetError,
 from frictionlab.preset import Preset
 
 from .conftest import PRESETS, SMALL_PRESET, merge
+from .test_registry import fake_dists  # noqa: F401 (a fixture)
 
 FAST = {"workers": 1, "progress": False}
 
@@ -355,3 +356,76 @@ def test_the_units_of_the_columns_are_curve_csvs_in_memory_on_disk_and_in_pandas
     assert frictionlab.load(tmp_path / "run").units == result.units
     assert frictionlab.run(SMALL_PRESET, **FAST).units == result.units  # kept in memory: the same
     assert result.to_pandas().attrs["units"] == result.units
+
+
+STIFFNESS_RAISES = '''
+import frictionlab
+from tests.testing.fakes import GoodSolver
+
+
+class Raising(GoodSolver):
+    name = "raising-solver"
+
+    def stiffness(self):
+        return 1 / 0
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(Raising)
+'''
+
+
+def test_an_exception_in_an_installed_plugin_is_told_as_its_fault_not_raised_raw(fake_dists):  # noqa: F811
+    """frictionlab.run and validate raised the plugin's ZeroDivisionError out of frictionlab's
+    frames, where the CLI named the plugin. Now both do."""
+    from frictionlab.errors import PluginError
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-raising", "raising", "acme_raising", STIFFNESS_RAISES, "1.2")
+    registry_module.default_registry.cache_clear()
+    try:
+        raising = {"solver.name": "raising-solver", "solver.params": {}}
+        for call in (lambda: frictionlab.validate("quickstart", raising),
+                     lambda: frictionlab.run("quickstart", raising, workers=1, progress=False, plot=False)):
+            with pytest.raises(PluginError) as excinfo:
+                call()
+            assert str(excinfo.value).startswith("solver 'raising-solver' (acme_raising.Raising from acme-raising) "
+                                                 "raised ZeroDivisionError: division by zero in stiffness() at ")
+            assert excinfo.value.__suppress_context__ and isinstance(excinfo.value.__context__, ZeroDivisionError)
+    finally:
+        registry_module.default_registry.cache_clear()
+
+
+def test_a_refused_scheduler_is_named_as_the_keyword_given_not_the_command_line_option():
+    """frictionlab.run(scheduler=...) was told '--scheduler must be ...', an option it has not."""
+    with pytest.raises(FrictionlabError) as excinfo:
+        frictionlab.run("quickstart", scheduler="nonsense", progress=False, plot=False)
+    assert str(excinfo.value) == ("scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. "
+                                  "Got 'nonsense' instead.")
+
+
+class _SometimesBroken:
+    """A spectrum whose generate() raises for about half the realizations (by its rng)."""
+
+    def generate(self, rng):
+        if rng.random() < 0.5:
+            raise RuntimeError("this one broke")
+        return super().generate(rng)
+
+
+@pytest.mark.parametrize("realizations", [6, 1])
+def test_a_run_with_failed_realizations_is_read_back_not_called_damaged(make_scene, tmp_path, realizations):
+    """summary.json counts done (finished) and failed apart; read_summary took done to count the
+    failed too, and called any run with a failed realization damaged: load() refused it."""
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import Scene
+    from frictionlab.runs.runner import run_to_folder
+
+    scene = make_scene({"realizations": realizations, "seed": 3})
+    broken = type("Sometimes", (_SometimesBroken, type(scene.spectrum)), {})(scene.spectrum.params)
+    scene = Scene(preset=scene.preset, spectrum=broken, solver=scene.solver, slope=scene.slope)
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, executor="serial"))
+    assert outcome.failures and (outcome.done or realizations == 1)
+    read = frictionlab.load(tmp_path / "run")
+    assert read.realizations == (outcome.done, realizations) and read.status == outcome.status

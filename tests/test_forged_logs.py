@@ -142,7 +142,7 @@ def test_runs_shows_the_verified_holder_and_only_checked_counts(tmp_path, capsys
     finally:
         release(holder)
     # summary.json's done beyond its run's: not shown; the folder damaged, as frictionlab.load finds it, and why
-    assert f"{done} is damaged: summary.json is damaged: field 'realizations.done' is more than" in out
+    assert f"{done} is damaged: summary.json is damaged: fields 'realizations.done' and 'realizations.failed' add up to more than" in out
     assert "10000000000" not in out and not re.search(r"completed +\d", out)
     assert f"running (pid {holder.pid})" in out and "pid 1)" not in out
     assert "10000000000" not in out and "interrupted" in out and " 0/12" in out  # the started event's count: none done

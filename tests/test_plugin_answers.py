@@ -24,6 +24,9 @@ BROKEN = {
     "text-periodic": (GoodSpectrum, {"periodic": lambda self: "yes"}, "periodic() must be True or False. Got 'yes'"),
     "nan-heights": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
         np.full(128, np.nan), 1.0)}, "Profile.heights must be finite"),
+    "flag-periodic": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
+        np.sin(np.arange(128.0)), 1.0, periodic=False)},
+        "Profile.periodic must be what periodic() declares, True. Got False instead."),
     "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
     "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
                       "tolerance() must be None or a number finite and > 0. Got nan"),
@@ -113,6 +116,20 @@ def test_an_array_is_refused_as_not_finite_exactly_where_an_entry_is(nan, dtype)
         assert (problem is not None) == bool(bad.any()), (seed, value)
 
 
+def test_a_non_finite_array_is_told_with_its_first_bad_entry_and_where():
+    """'Got 1 non-finite value(s)' left the plugin's author to search the array."""
+    from frictionlab.plugin.outputs import array_problem
+
+    line = np.arange(6.0)
+    line[[2, 4]] = np.nan, np.inf
+    assert array_problem("Profile.heights", line) == (
+        "Profile.heights must be finite. Got 2 non-finite value(s), the first nan at index 2.")
+    surface = np.zeros((3, 4))
+    surface[1, 2] = -np.inf
+    assert array_problem("slopes()", surface, nan=True) == (
+        "slopes() must be finite. Got 1 non-finite value(s), the first -inf at index (1, 2).")
+
+
 def test_the_slope_scale_is_found_past_nan_slopes():
     """slope_scale brings the largest slope in magnitude (NaN ones passed by) near 1 by a power
     of two, and leaves slopes that square safely as they are."""
@@ -124,3 +141,39 @@ def test_the_slope_scale_is_found_past_nan_slopes():
         expected = 1.0 if abs(largest) == 3.0 else 2.0 ** -np.frexp(abs(largest))[1]
         assert scale == expected, largest
     assert slope_scale(np.full(4, np.nan)) == 1.0 and slope_scale(np.array([1.0, np.inf])) == 1.0
+
+
+def test_negative_slopes_on_a_surface_are_refused_where_a_run_takes_them():
+    """A surface's slopes are |grad z|; a line's keep their sign. A run took negative ones on."""
+    from frictionlab.plugin import Profile
+    from frictionlab.plugin.outputs import slopes_problem
+
+    z = np.linspace(-1.0, 1.0, 64).reshape(8, 8)
+    assert slopes_problem(GoodSlopes(), z, Profile(z, 1.0)) == (
+        "slopes() on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of -1.")
+    assert slopes_problem(GoodSlopes(), np.abs(z), Profile(z, 1.0)) is None
+    assert slopes_problem(GoodSlopes(), z[0], Profile(z[0], 1.0)) is None
+
+
+@pytest.mark.parametrize("summary, said", [
+    ({"file": "a.csv", "shape": [128], "spacing": 1.0, "unit": None, "rms_height": float("nan")},
+     "Out of range float values are not JSON compliant"),
+    ({"file": "a.csv", "shape": [128], "spacing": 1.0, "unit": None, "rms_height": 1.0, "when": object()},
+     "Object of type object is not JSON serializable"),
+    ({"file": "a.csv"}, "input_summary() must give at least file, shape, spacing, unit and rms_height"),
+])
+def test_an_input_summary_no_json_holds_is_refused_as_the_run_starts_and_by_validate(register_plugin, summary, said):
+    """Taken as it came, the run computed every realization, then ended in an internal error
+    writing summary.json (and validate --json in one writing its answer)."""
+    from frictionlab.api import scene_record
+    from frictionlab.runs.inputrecord import what_was_read
+
+    broken = type("Summarised", (GoodSpectrum,), {"name": "broken-spectrum", "input_summary": lambda self: summary})
+    registry = register_plugin(broken)
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "spectrum": {"name": "broken-spectrum"}}, registry=registry)
+    for read in (what_was_read, scene_record):
+        with pytest.raises(PluginError, match="broke the plugin contract: input_summary()") as excinfo:
+            read(scene)
+        assert said in str(excinfo.value)

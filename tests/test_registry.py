@@ -139,14 +139,16 @@ def test_two_plugins_with_one_name_name_both_providers(reg):
     assert reg.get("spectrum", "twin-line") is first
 
 
-def test_clash_with_a_builtin_names_frictionlab(reg):
+def test_a_builtins_name_is_refused_as_an_installed_plugin_is_told(reg):
+    """The kit's register_plugin said 'two spectrum plugins are named', where an installed
+    plugin fails to load and the built-in keeps its name."""
     impostor = spectrum_class("power-law", "acme_three.lines", "Impostor")
     with pytest.raises(PluginError) as excinfo:
         reg.register_plugin(provider(impostor))
-    message = str(excinfo.value)
-    assert "frictionlab_spectra.power_law.PowerLaw from frictionlab" in message
-    assert "acme_three.lines.Impostor from acme_three.lines" in message
+    assert str(excinfo.value) == ("Impostor: name 'power-law' is taken by the built-in spectrum "
+                                  "frictionlab_spectra.power_law.PowerLaw, which keeps it; choose another name")
     assert reg.get("spectrum", "power-law").__module__ == "frictionlab_spectra.power_law"
+    assert reg.clashes == []
 
 
 def test_one_class_registered_twice_is_not_a_clash(reg):
@@ -453,10 +455,47 @@ def register_spectra(register):
     register(Loose)
 '''
 
+PARAMS_SOURCE = '''
+import numpy as np
+from pydantic import ConfigDict, Field
+import frictionlab
+from tests.testing.fakes import spectrum_class
+
+Loose = spectrum_class("loose-line", __name__, "Loose")
+
+
+class Params(frictionlab.PluginParams):
+    model_config = ConfigDict(extra="forbid", arbitrary_types_allowed=True)
+    {field}
+
+
+Loose.Params = Params
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Loose)
+'''
+
 BROKEN_AT_REGISTRATION = {
     "misspelled-hook": (MISSPELLED_SOURCE, "PluginError: unknown hook 'register_spectrum'; did you mean 'register_spectra'?"),
-    "hook-raises": (HOOK_RAISES_SOURCE, "RuntimeError: boom: broken in its hook"),
+    "hook-raises": (HOOK_RAISES_SOURCE,
+                    "RuntimeError: boom: broken in its hook (in register_solvers() at acme_typo_plugin.py:7)"),
+    "import-fails": ("import json\nimport no_such_module_for_acme\n",
+                     "ModuleNotFoundError: No module named 'no_such_module_for_acme' (as it imports, "
+                     "acme_typo_plugin.py:2)"),
     "invalid-class": (INVALID_CLASS_SOURCE, "PluginError: Loose: Params must be a pydantic model"),
+    "exits-at-import": ("import argparse\nargparse.ArgumentParser(prog='acme').parse_args(['--no-such-option'])\n",
+                        "SystemExit(2): it exits as it loads (parsing arguments at import?)"),
+    "no-mark": ("def register_spectra(register):\n    pass\n",
+                "PluginError: it implements no hook: register_spectra lacks the @frictionlab.hookimpl mark"),
+    "no-schema": (PARAMS_SOURCE.replace("{field}", 'window: np.ndarray = Field(None, description="a window")'),
+                  "PluginError: Loose: Params has no JSON Schema (PydanticInvalidForJsonSchema: Cannot generate a "
+                  "JsonSchema for core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)): give every field a type "
+                  "pydantic can describe (numbers, strings, lists of them)"),
+    "default-out-of-bounds": (PARAMS_SOURCE.replace("{field}", 'points: int = Field(4, ge=8, description="points")'),
+                              "PluginError: Loose: Params.points defaults to 4, which its own bounds refuse (Input "
+                              "should be greater than or equal to 8): a preset leaving it out would run with it"),
 }
 
 
@@ -475,22 +514,43 @@ def test_an_entry_point_broken_at_registration_is_skipped_by_name(two_good, case
     assert "good-line" in Registry(env={"FRICTIONLAB_BLOCK_PLUGINS": "typo"}).names("spectrum")
 
 
+def test_an_entry_point_naming_the_class_not_the_module_is_told_so(two_good):
+    """It registered nothing without a word: the plugin was looked for in vain."""
+    two_good("acme-named", "named", "acme_named_plugin", GOOD_SOURCE.format(cls="Named", name="named-line"),
+             target="acme_named_plugin:Named")
+    with pytest.warns(RuntimeWarning, match="plugin 'named' from acme-named failed to load"):
+        reg = Registry(env={})
+    assert [f.error for f in reg.failures] == [
+        "PluginError: it implements no hook: the entry point's value must be the module holding its "
+        "@frictionlab.hookimpl functions (acme_named_plugin), not the class Named"]
+
+
+def test_what_a_plugin_prints_as_it_loads_goes_to_stderr(two_good, capsys):
+    """stdout may be JSON (frictionlab schema, --json): a plugin's debug print corrupted it."""
+    two_good("acme-chatty", "chatty", "acme_chatty_plugin",
+             "print('loading chatty')\n" + GOOD_SOURCE.format(cls="Chatty", name="chatty-line"))
+    assert "chatty-line" in Registry(env={}).names("spectrum")
+    out, err = capsys.readouterr()
+    assert (out, err) == ("", "loading chatty\n")
+
+
 def test_a_name_two_installed_plugins_claim_is_an_error_only_where_used(two_good):
+    """Two installed plugins: neither's. An installed plugin claiming a built-in's name fails to
+    load instead, and the built-in keeps it (test_plugin_faults)."""
     two_good("acme-twin", "twin", "acme_twin_plugin", GOOD_SOURCE.format(cls="Twin", name="good-line"))
     two_good("acme-fake", "fake", "acme_fake_plugin", GOOD_SOURCE.format(cls="PowerLaw", name="power-law"))
     with pytest.warns(RuntimeWarning) as warned:
         reg = Registry(env={})
     said = [str(w.message) for w in warned]
     assert any("two spectrum plugins are named 'good-line'" in m for m in said), said
-    assert any("two spectrum plugins are named 'power-law'" in m for m in said), said
-    assert len(reg.clashes) == 2
-    for name, providers in (("good-line", ("acme-good", "acme-twin")), ("power-law", ("frictionlab", "acme-fake"))):
-        assert name not in reg.names("spectrum")
-        with pytest.raises(PluginError, match=f"two spectrum plugins are named '{name}'") as excinfo:
-            reg.get("spectrum", name)
-        assert all(f" from {p}" in str(excinfo.value) for p in providers)
+    assert len(reg.clashes) == 1
+    assert "good-line" not in reg.names("spectrum")
+    with pytest.raises(PluginError, match="two spectrum plugins are named 'good-line'") as excinfo:
+        reg.get("spectrum", "good-line")
+    assert all(f" from {p}" in str(excinfo.value) for p in ("acme-good", "acme-twin"))
     assert "other-line" in reg.names("spectrum") and "rolloff" in reg.names("spectrum")
-    assert reg.failures == []
+    assert reg.get("spectrum", "power-law").__module__ == "frictionlab_spectra.power_law"
+    assert [f.entry_point for f in reg.failures] == ["fake"]
 
 
 def test_default_registry_is_cached():

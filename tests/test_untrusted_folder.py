@@ -142,7 +142,7 @@ HOSTILE = {
     "fit null though done": lambda f: edit_summary(f, lambda d: set_in(d, "fit", None)),
     "fit though none done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 0)),
     "done above requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 99)),
-    "failed above done": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.failed", 99)),
+    "failed above requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.failed", 99)),
     "completed short of requested": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.requested", 2**70)),
     "curve short a row": lambda f: (f / "curve.csv").write_text("".join((f / "curve.csv").read_text().splitlines(True)[:-1])),
     # CSV that is not frictionlab's

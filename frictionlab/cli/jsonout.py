@@ -4,14 +4,17 @@ Every object names its shape first, ``"schema": "frictionlab/<shape>/<version>"`
 version goes up when a key is removed or changes meaning (keys may be added within a
 version). ``SHAPES`` says what each holds; the reference page of the site is made from
 it. A command refused or failed under ``--json`` prints the ``error`` shape (and says
-the same on stderr, for a person watching). ``frictionlab schema`` prints a JSON Schema
+the same on stderr, for a person watching). While such a command works, whatever else prints
+(a plugin's debug line) goes to stderr: ``json_only``. ``frictionlab schema`` prints a JSON Schema
 document, for editors, not one of these.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
+import sys
 
 VERSION = 1
 
@@ -59,8 +62,29 @@ def dumps(name: str, payload: dict) -> str:
     return json.dumps({"schema": shape(name), **payload}, indent=2, allow_nan=False)
 
 
+_real_stdout = None  # while a --json command works (``json_only``): where its JSON goes
+
+
+@contextlib.contextmanager
+def json_only():
+    """While a ``--json`` command works, ``sys.stdout`` is stderr: whatever else prints (a plugin's
+    debug line, here or in a forked worker) cannot break the one JSON object, which ``emit`` writes
+    to the real stdout."""
+    global _real_stdout
+    real = _real_stdout = sys.stdout
+    sys.stdout = sys.stderr
+    try:
+        yield
+    finally:
+        sys.stdout, _real_stdout = real, None
+
+
+def _stdout():
+    return _real_stdout or sys.stdout
+
+
 def emit(name: str, payload: dict) -> None:
-    print(dumps(name, payload))
+    print(dumps(name, payload), file=_stdout())
 
 
 def error_object(command: str | None, message: str, exit_code: int, problems: list[str] | None = None) -> dict:
@@ -75,4 +99,4 @@ def error_object(command: str | None, message: str, exit_code: int, problems: li
 
 
 def emit_error(command: str | None, message: str, exit_code: int, problems: list[str] | None = None) -> None:
-    print(json.dumps(error_object(command, message, exit_code, problems), indent=2))
+    print(json.dumps(error_object(command, message, exit_code, problems), indent=2), file=_stdout())

@@ -22,6 +22,7 @@ Conventions every command keeps (tested in tests/cli/test_conventions.py):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import errno
 import gc
 import os
@@ -235,9 +236,9 @@ def _plugin_at_fault(exc: Exception):
     """The PluginError that names the installed plugin whose code raised ``exc``, or None."""
     if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
         return None
-    from ..plugin.registry import default_registry
+    from ..plugin.registry import installed_plugin_fault
 
-    return default_registry().at_fault(exc)
+    return installed_plugin_fault(exc)
 
 
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
@@ -361,7 +362,10 @@ def _run_command(args) -> int:
         from .options import command_options, refuse_empty_paths
 
         refuse_empty_paths(args.parser, args)
-        with advising(FrontEnd(options=command_options(args.parser, args))):  # a refusal advises this command's options
+        from .jsonout import json_only
+
+        stdout = json_only() if getattr(args, "json", False) else contextlib.nullcontext()
+        with advising(FrontEnd(options=command_options(args.parser, args))), stdout:  # a refusal advises this command's options
             code = int(args.handler(args))
         sys.stdout.flush()  # a closed pipe or a full disk shows here, not at exit
         return code

@@ -23,7 +23,7 @@ import warnings
 from contextlib import contextmanager
 from urllib.parse import urlsplit
 
-from ..errors import FrictionlabError, MissingDependency, RunError, require, short_repr
+from ..errors import FrictionlabError, MissingDependency, RunError, for_python, option_given, require, short_repr
 
 DASK_PURPOSE = "the dask executor"
 DASK_MISSING = str(MissingDependency("distributed", DASK_PURPOSE))
@@ -61,7 +61,8 @@ def check_address(address: str) -> str:
         host = port = None
     if scheme not in SCHEMES or not host or not port:
         raise FrictionlabError(
-            f"--scheduler must be an address like tcp://HOST:PORT or tls://HOST:PORT. Got {short_repr(address)} instead."
+            f"{option_given('--scheduler')} must be an address like tcp://HOST:PORT or tls://HOST:PORT. "
+            f"Got {short_repr(address)} instead."
         )
     if scheme not in ENCRYPTED and not _loopback(host) and address not in _WARNED_PLAIN:
         _WARNED_PLAIN.add(address)  # checked by the command line and again on connecting: said once
@@ -104,8 +105,9 @@ def connect_scheduler(address: str):
         reason = f"{type(exc).__name__}: {exc}"
         if address.startswith("tls://") and "ssl_context" in reason:  # what was given, not the network
             raise FrictionlabError(
-                f"--scheduler {address}: a tls:// scheduler needs TLS certificates: give --tls-ca-file, --tls-cert "
-                "and --tls-key (or Dask's distributed.comm.tls configuration)"
+                f"{option_given('--scheduler', address)}: a tls:// scheduler needs TLS certificates: "
+                + ("configure them in Dask's distributed.comm.tls before the run" if for_python() else
+                   "give --tls-ca-file, --tls-cert and --tls-key (or Dask's distributed.comm.tls configuration)")
             ) from None
         raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}") from None
 
@@ -150,7 +152,7 @@ def _check_answers_as_scheduler(address: str, security, seconds: float = CONNECT
         reason = f"{type(reply).__name__}: {reply}"
         raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}")
     raise RunError(
-        f"--scheduler {address} did not answer as a Dask scheduler within {seconds:g} s (is it another "
+        f"{option_given('--scheduler', address)} did not answer as a Dask scheduler within {seconds:g} s (is it another "
         "service, such as the dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)"
     )
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import pickle
 import signal
+import sys
 import time
 from collections import Counter, deque
 from collections.abc import Callable, Hashable, Iterator
@@ -91,6 +92,7 @@ def _serve(tasks, results, stop, initializer, initargs, function) -> None:
     if hasattr(signal, "SIGHUP"):  # a closed terminal hangs up the whole job: the parent's to handle too
         signal.signal(signal.SIGHUP, signal.SIG_IGN)
     keep_freed_memory()  # a fork has its parent's setting; a forkserver's or spawned worker not
+    sys.stdout = sys.stderr  # a plugin's print is no part of a command's output (--json: one JSON object)
     if initializer is not None:
         initializer(*initargs)
     while True:

@@ -5,11 +5,12 @@ states the same problems in the same words."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 
-from ..errors import PluginError
+from ..errors import PluginError, short_repr
 from .data import ContactCurve, Profile
 from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
 from .registry import provider_of
@@ -32,7 +33,10 @@ def array_problem(what: str, value, shape=None, floating: bool = True, nan: bool
         return f"{what} must be real numbers. Got dtype {value.dtype} instead."
     if value.size and not _all_finite(value, nan):
         bad = np.isinf(value) if nan else ~np.isfinite(value)
-        return f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s)."
+        first = np.unravel_index(int(np.argmax(bad)), value.shape)  # where to look, in the plugin's own terms
+        where = first[0] if value.ndim == 1 else tuple(int(i) for i in first)
+        return (f"{what} must be finite. Got {int(np.count_nonzero(bad))} non-finite value(s), the first "
+                f"{float(value[first])} at index {where}.")  # fmt: skip
     return None
 
 
@@ -70,6 +74,8 @@ def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
         return f"Profile.spacing must be finite and > 0. Got {spacing!r} instead."
     if not isinstance(profile.periodic, bool):
         return f"Profile.periodic must be True or False. Got {profile.periodic!r} instead."
+    if profile.periodic is not (declared := generator.periodic()):  # the preset's solver and estimator were checked by it
+        return f"Profile.periodic must be what periodic() declares, {declared!r}. Got {profile.periodic!r} instead."
     return None
 
 
@@ -79,6 +85,8 @@ def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile, what: st
     problem = array_problem(what, slopes, profile.heights.shape, nan=undefined)
     if problem and not undefined and array_problem(what, slopes, profile.heights.shape, nan=True) is None:  # NaN alone
         problem += f" A NaN (a point without a slope) needs undefined_points({profile.periodic}) to return True."
+    if not problem and slopes.ndim == 2 and slopes.size and (least := float(np.fmin.reduce(slopes, axis=None))) < 0:
+        problem = f"{what} on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of {least:.6g}."
     return problem
 
 
@@ -144,6 +152,20 @@ def caveats_problem(caveats) -> str | None:
     if isinstance(caveats, tuple) and all(isinstance(c, str) and c.strip() for c in caveats):
         return None
     return f"caveats() must be a tuple of non-empty strings (one sentence: (sentence,)). Got {caveats!r} instead."
+
+
+def input_summary_problem(summary) -> str | None:
+    """``input_summary()`` must be None or a JSON-ready mapping (summary.json holds it) giving at
+    least file, shape, spacing, unit and rms_height (the progress and validate say them)."""
+    if summary is None:
+        return None
+    try:
+        json.dumps(summary, allow_nan=False)
+    except (TypeError, ValueError) as exc:  # an object json cannot write, infinity, NaN
+        return f"input_summary() must be None or a JSON-ready mapping. Got {short_repr(repr(summary), 300)[1:-1]} ({exc})."
+    if not isinstance(summary, dict) or not {"file", "shape", "spacing", "unit", "rms_height"} <= set(summary):
+        return f"input_summary() must give at least file, shape, spacing, unit and rms_height. Got {summary!r}."
+    return None
 
 
 def shape_problem(spectrum: SpectrumGenerator, profile: Profile) -> str | None:

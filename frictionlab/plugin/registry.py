@@ -11,28 +11,23 @@ Environment switches (read when a registry is built):
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib
-import inspect
 import importlib.metadata as md
 import os
 import re
 import sys
-from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import get_args
 
-import numpy as np
 import pluggy
-from pydantic import BaseModel
 
 from ..errors import PluginError, did_you_mean, short_repr, warn_user
+from .base import Plugin
+from .classcheck import declaration_problems, params_problem, validate_plugin_class  # noqa: F401 - read here by the kit
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
+from .kinds import KINDS
 from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener, fault_site
-from .base import NAME_PATTERN, Plugin
-from .data import Profile
-from .kinds import KINDS, REQUIRED, ContactSolver, contract, IndentationReference, SlopeEstimator, SpectrumGenerator
-from .normalisation import ContactMeasure, ForceNormalisation
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
@@ -111,121 +106,16 @@ def _provider(module: str) -> tuple[str, str]:
     return module, "unversioned"
 
 
-def validate_plugin_class(kind: str, cls) -> None:
-    """Raise PluginError if ``cls`` does not fulfil the plugin contract of ``kind``."""
-    base = KINDS[kind]
-    label = getattr(cls, "__qualname__", repr(cls))
-    if not (isinstance(cls, type) and issubclass(cls, base)):
-        raise PluginError(f"{label}: a {kind} plugin must subclass frictionlab.{base.__name__}")
-    if not isinstance(cls.name, str) or not NAME_PATTERN.match(cls.name):
-        raise PluginError(
-            f"{label}: name must be kebab-case (lowercase words joined by '-'). "
-            f"Got {cls.name!r} instead."
-        )
-    if not isinstance(cls.summary, str) or not cls.summary.strip() or "\n" in cls.summary.strip():
-        raise PluginError(f"{label}: summary must be one non-empty line. Got {cls.summary!r} instead.")
-    params = cls.Params
-    if not (isinstance(params, type) and issubclass(params, BaseModel)):
-        raise PluginError(f"{label}: Params must be a pydantic model")
-    if params.model_config.get("extra") != "forbid":
-        raise PluginError(f"{label}: Params must forbid unknown keys (model_config extra='forbid')")
-    for field_name, info in params.model_fields.items():
-        if not (info.description or "").strip():
-            raise PluginError(
-                f"{label}: Params.{field_name} has no description; give it one, {field_name}: ... = "
-                f"Field(default, description=\"what it is (its unit)\"): presets, frictionlab schema and the "
-                "edit form show it"
-            )
-    for problem in declaration_problems(cls):
-        raise PluginError(f"{label}: {problem}")
-
-
-def declaration_problems(cls) -> list[str]:
-    """What is wrong with the contract declarations of a plugin class (see ``plugin.py``)."""
-    fields = set(cls.Params.model_fields)
-    problems = []
-
-    def named_fields(what: str, names) -> None:
-        unknown = [n for n in names if n not in fields]
-        if unknown:
-            problems.append(f"{what} names {', '.join(map(repr, unknown))}, not fields of Params ({', '.join(sorted(fields)) or 'none'})")
-
-    base = next(base for base in KINDS.values() if issubclass(cls, base))
-    missing = [f"{name}()" for name in REQUIRED[base.kind] if getattr(cls, name) is getattr(base, name)]
-    if missing:
-        problems.append(f"implements no {' nor '.join(missing)}: a {base.__name__} must (the base class's only "
-                        "raises NotImplementedError)")  # fmt: skip
-    problems += _signature_problems(cls, base)
-    if (cls.kind, cls.register_hook) != (base.kind, base.register_hook):
-        problems.append(
-            f"kind and register_hook are {base.__name__}'s ({base.kind!r}, {base.register_hook!r}), "
-            "not a plugin's to change"
-        )
-    if issubclass(cls, SpectrumGenerator):
-        if cls.dimension not in (1, 2):
-            problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
-        if cls.points_param is not None:
-            named_fields("points_param", [cls.points_param])
-    if issubclass(cls, (ContactSolver, SlopeEstimator)):
-        dims = cls.dimensions
-        if not (isinstance(dims, tuple) and dims and set(dims) <= {1, 2}):
-            problems.append(f"dimensions must be a non-empty tuple of 1 and/or 2. Got {dims!r} instead.")
-        if not isinstance(cls.periodic_only, bool):
-            problems.append(f"periodic_only must be True or False. Got {cls.periodic_only!r} instead.")
-    if issubclass(cls, ContactSolver):
-        declared = cls.normalisations
-        if not isinstance(declared, Mapping) or set(declared) != set(cls.dimensions) or not all(
-            isinstance(n, ForceNormalisation) for n in declared.values()
-        ):
-            problems.append(
-                "normalisations must map each of its dimensions "
-                f"{cls.dimensions!r} to a ForceNormalisation (what its load means and how f is formed). "
-                f"Got {declared!r} instead."
-            )
-        else:
-            for dimension, normalisation in declared.items():
-                try:
-                    normalisation.extent_of(Profile(np.zeros((2,) * dimension), 1.0))
-                except ValueError as exc:
-                    problems.append(f"normalisations[{dimension}]: {exc}")
-        for attr in ("approximation", "undefined_slopes", "mean_displacement_known", "corrected_area", "real_gradient",
-                     "counts_spots"):
-            if not isinstance(getattr(cls, attr), bool):
-                problems.append(f"{attr} must be True or False. Got {getattr(cls, attr)!r} instead.")
-        if not (isinstance(cls.problem, str) and cls.problem.strip()):
-            problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
-        for attr, value, allowed in (
-            ("contact_measure", cls.contact_measure, ContactMeasure),
-            ("indentation_reference", cls.indentation_reference, IndentationReference),
-        ):
-            if value not in get_args(allowed):
-                problems.append(f"{attr} must be one of {', '.join(map(repr, get_args(allowed)))}. Got {value!r} instead.")
-        named_fields("body_params", cls.body_params)
-        if cls.tolerance_param is not None:
-            named_fields("tolerance_param", [cls.tolerance_param])
-        declared = cls.bytes_per_point
-        if declared is not None and (isinstance(declared, bool) or not isinstance(declared, int) or declared <= 0):
-            problems.append(f"bytes_per_point must be None or a whole number > 0. Got {declared!r} instead.")
-    return problems
-
-
-def _signature_problems(cls, base) -> list[str]:
-    """Each method of the contract that ``cls`` overrides must take the arguments the framework
-    passes, as the base class's does (``slopes(heights, spacing, periodic)``)."""
-    problems = []
-    for name in sorted(contract(base.kind)):
-        declared, given = inspect.getattr_static(base, name, None), inspect.getattr_static(cls, name, None)
-        if not inspect.isfunction(declared) or given is declared or not callable(given):
-            continue
-        wanted = list(inspect.signature(declared).parameters)[1:]  # after self
-        try:
-            inspect.signature(getattr(cls, name)).bind(None, *wanted)
-        except TypeError:
-            problems.append(f"{name}() must take ({', '.join(wanted)}), as frictionlab calls it. "
-                            f"Got {name}{inspect.signature(getattr(cls, name))} instead.")  # fmt: skip
-        except ValueError:  # no signature to read (a builtin): nothing to check
-            pass
-    return problems
+def _registers_nothing(plugin) -> str:
+    """Why an entry point that implements no hook is refused (skipped without a word, its plugins
+    were looked for in vain): a hook without its mark, or the class named instead of the module."""
+    hooks = [base.register_hook for base in KINDS.values()] + list(LIFECYCLE_HOOKS)
+    if unmarked := [name for name in hooks if callable(getattr(plugin, name, None))]:
+        return f"it implements no hook: {', '.join(unmarked)} lacks the @frictionlab.hookimpl mark"
+    said = "it implements no hook: the entry point's value must be the module holding its @frictionlab.hookimpl functions"
+    if isinstance(plugin, type):  # the class itself, as the kit's register_plugin takes it
+        said += f" ({plugin.__module__}), not the class {plugin.__qualname__}"
+    return said
 
 
 def _warn_of_unknown_names(only: list[str], installed: list[str]) -> None:
@@ -255,9 +145,11 @@ class Registry:
         if _env_flag(env, "FRICTIONLAB_TRACE_HOOKS"):
             self.pm.trace.root.setwriter(sys.stderr.write)
             self.pm.enable_tracing()
+        self._builtins: dict[str, dict[str, type]] = {kind: {} for kind in KINDS}  # the names no installed plugin may take
         if builtins:
             for module_name in BUILTIN_MODULES:
-                self.pm.register(importlib.import_module(module_name), name=module_name)
+                self.pm.register(module := importlib.import_module(module_name), name=module_name)
+                self._note_builtins(module)
         if discover and not _env_flag(env, "FRICTIONLAB_DISABLE_DISCOVERY"):
             self._load_entry_points(
                 only=_env_list(env, "FRICTIONLAB_PLUGINS"),
@@ -282,23 +174,43 @@ class Registry:
                 continue
             dist = ep.dist.name if ep.dist else "unknown distribution"
             claims: list[tuple[str, str]] = []
-            try:
-                plugin = ep.load()
-                self.pm.register(plugin, name=ep.name)
-                self._try_registration(plugin, claims)
+            try:  # what it prints goes to stderr: stdout may be JSON (--json, frictionlab schema)
+                with contextlib.redirect_stdout(sys.stderr):
+                    plugin = ep.load()
+                    self.pm.register(plugin, name=ep.name)
+                    self._try_registration(plugin, claims)
+                    if not claims and not self.pm.get_hookcallers(plugin):
+                        raise PluginError(_registers_nothing(plugin))
                 self._distributions[ep.name] = dist
                 for claim in claims:
                     self._claims.setdefault(claim, []).append(ep.name)
-            except Exception as exc:  # a broken plugin must not break the tool
+            except (Exception, SystemExit) as exc:  # a broken plugin must not break (nor end) the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
-                message = f"{type(exc).__name__}: {exc}"
-                if isinstance(exc, SyntaxError):  # its str names the file without its folder
-                    message = f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
-                elif isinstance(exc, pluggy.PluginValidationError):
-                    message = self._hook_arguments_message(exc)
+                message = self._failure_message(exc, ep.module.partition(".")[0])
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warn_user(f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped", RuntimeWarning)
+
+    def _note_builtins(self, module) -> None:
+        """The classes a built-in module registers, by kind and name: names no installed plugin may take."""
+        for kind, base in KINDS.items():
+            if hook := getattr(module, base.register_hook, None):
+                hook(register=lambda cls, kind=kind: self._builtins[kind].setdefault(normalize_name(cls.name), cls))
+
+    def _failure_message(self, exc: BaseException, package: str) -> str:
+        """Why an entry point failed to load, on one line, with where in its ``package`` it raised."""
+        if isinstance(exc, SystemExit):  # argparse or sys.exit() at import, reading frictionlab's arguments
+            return f"SystemExit({exc.code!r}): it exits as it loads (parsing arguments at import?)"
+        if isinstance(exc, SyntaxError):  # its str names the file without its folder
+            return f"SyntaxError: {exc.msg} ({exc.filename}, line {exc.lineno})"
+        if isinstance(exc, pluggy.PluginValidationError):
+            return self._hook_arguments_message(exc)
+        message = f"{type(exc).__name__}: {exc}"
+        frame, where, _ = fault_site(exc, package)
+        if frame is None or isinstance(exc, PluginError):  # a broken contract is said by what, not where
+            return message
+        function, _, line = where.partition(" at ")
+        return f"{message} ({'as it imports, ' + line if function == '<module>()' else 'in ' + where})"
 
     def _try_registration(self, plugin, claims: list[tuple[str, str]]) -> None:
         """Run ``plugin``'s registration hooks alone, checking every class it registers: a
@@ -313,8 +225,18 @@ class Registry:
                     def register(cls, _kind=kind):  # a preset naming a refused class is told why
                         claims.append((_kind, normalize_name(str(getattr(cls, "name", "")))))
                         validate_plugin_class(_kind, cls)
+                        if problem := params_problem(cls) or self._builtin_name_problem(_kind, cls):
+                            raise PluginError(f"{cls.__qualname__}: {problem}")
 
                     impl.function(**{arg: {"register": register}[arg] for arg in impl.argnames})
+
+    def _builtin_name_problem(self, kind: str, cls) -> str | None:
+        """A class of an installed plugin may not take a built-in's name: the built-in keeps it."""
+        key = normalize_name(cls.name)
+        if (taken := self._builtins[kind].get(key)) is None or taken is cls:
+            return None
+        return (f"name {key!r} is taken by the built-in {kind} {taken.__module__}.{taken.__qualname__}, which keeps "
+                "it; choose another name")  # fmt: skip
 
     def _hook_arguments_message(self, exc: pluggy.PluginValidationError) -> str:
         """pluggy's refusal of a hook's arguments, on one line, with the arguments the hook passes."""
@@ -340,9 +262,9 @@ class Registry:
         """Register a plugin object (module or class with hookimpls) and re-collect.
 
         If the plugin is rejected (a misspelled hook: ``pluggy.PluginValidationError``;
-        a class breaking the contract or clashing with another: ``PluginError``),
-        it is unregistered again before the error propagates, so the registry is
-        left as it was.
+        a class breaking the contract, taking a built-in's name or clashing with another:
+        ``PluginError``, in the words an installed plugin's failure to load says it), it is
+        unregistered again before the error propagates, so the registry is left as it was.
         """
         was_registered = self.pm.is_registered(plugin)
         clashes = set(self.clashes)
@@ -350,7 +272,7 @@ class Registry:
             self.pm.register(plugin, name=name)
             if problem := self._unknown_hook(plugin):  # as a run's discovery says it: with the hook meant
                 raise pluggy.PluginValidationError(plugin, f"{problem} (in {plugin!r})")
-            self.pm.check_pending()
+            self._try_registration(plugin, [])
             self._collect()
             for message in self.clashes:
                 if message not in clashes:
@@ -366,7 +288,8 @@ class Registry:
         self._collect()
 
     def _collect(self) -> None:
-        """Every registered class by kind and name. A name two classes claim is neither's:
+        """Every registered class by kind and name. A name two classes claim is neither's (an installed
+        plugin claiming a built-in's fails to load instead: ``_try_registration``):
         asking for it is an error naming both (``_clashes``); every other name works."""
         tables: dict[str, dict[str, PluginInfo]] = {kind: {} for kind in KINDS}
         clashes: dict[str, dict[str, str]] = {kind: {} for kind in KINDS}
@@ -484,6 +407,14 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
                 "tell its authors, or choose another plugin"
             )
     return None
+
+
+def installed_plugin_fault(exc: BaseException) -> PluginError | None:
+    """``exc`` told as the fault of the installed plugin whose code raised it, or None (also when
+    no plugin was loaded in this process: none ran)."""
+    if default_registry.cache_info().currsize == 0:
+        return None
+    return default_registry().at_fault(exc)
 
 
 @functools.cache

@@ -10,6 +10,7 @@ import math
 
 from ..errors import FrictionlabError, RunFolderError, short_repr, shown, shown_name
 from ..io.inputs import InputFileProblem, sha256_of
+from ..plugin.outputs import input_summary_problem, refuse
 from ..preset import Scene
 
 PROSE = frozenset({"caveats", "channel_note", "file"})  # how it is said, and where it lay: not what was read
@@ -28,8 +29,10 @@ def file_hashes(scene: Scene) -> dict:
 
 
 def what_was_read(scene: Scene) -> dict | None:
-    """The spectrum's ``input_summary`` less its prose; None for a spectrum that reads no file."""
+    """The spectrum's ``input_summary`` less its prose; None for a spectrum that reads no file. Read
+    as the run starts: one summary.json could not hold is refused by the plugin's name then."""
     summary = scene.spectrum.input_summary()
+    refuse(scene.spectrum, input_summary_problem(summary))
     return None if summary is None else {key: value for key, value in summary.items() if key not in PROSE}
 
 

@@ -292,12 +292,12 @@ def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
     record = checked(SummaryRecord, data, path)
     counts = record.realizations
     problem = None
-    if counts.done > counts.requested:
-        problem = "field 'realizations.done' is more than 'realizations.requested'"
-    elif counts.failed > counts.done:  # done counts the failed ones too
-        problem = "field 'realizations.failed' is more than 'realizations.done' (which counts them)"
-    elif record.status == "completed" and counts.done < counts.requested:  # else cancelled or interrupted
-        problem = "its status is 'completed', but field 'realizations.done' is less than 'realizations.requested'"
+    ran = counts.done + counts.failed  # done: finished with a curve; failed: raised (a run goes on past them)
+    if ran > counts.requested:
+        problem = "fields 'realizations.done' and 'realizations.failed' add up to more than 'realizations.requested'"
+    elif record.status == "completed" and ran < counts.requested:  # else cancelled or interrupted
+        problem = ("its status is 'completed', but fields 'realizations.done' and 'realizations.failed' add up "
+                   "to less than 'realizations.requested'")  # fmt: skip
     elif record.fit is not None and not counts.done:
         problem = "field 'fit' holds a fit, but no realization was done"
     elif record.fit is None and counts.done and record.status != "failed":

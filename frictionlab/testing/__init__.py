@@ -35,15 +35,17 @@ Fixtures
 
     Registration runs pluggy's ``check_pending()``, so a misspelled hook name
     fails here with ``pluggy.PluginValidationError``; a class that breaks the
-    contract fails with ``frictionlab.errors.PluginError``.
+    contract or takes a built-in's name fails with ``frictionlab.errors.PluginError``,
+    in the words an installed plugin's failure to load says it.
 
 Conformance checks
 ==================
 
 Each check raises ``AssertionError`` with a readable message naming the class
 and what is wrong (an exception raised by your plugin's code is turned into an
-``AssertionError`` too, chained to the original). Parametrise them over your own
-classes::
+``AssertionError`` too, chained to the original, whose traceback starts in your
+code); pytest shows the test that called the check and the message, not the
+kit's own frames. Parametrise them over your own classes::
 
     import pytest
     from frictionlab.testing import check_plugin
@@ -63,6 +65,7 @@ from __future__ import annotations
 import pytest
 
 from .classes import check_plugin_class
+from .common import reported
 from .slopes import check_slope_estimator
 from .solvers import check_solver
 from .spectra import check_spectrum
@@ -122,6 +125,7 @@ def _as_hook_plugin(obj):
     return obj
 
 
+@reported
 def check_plugin(kind: str, cls, *, deterministic: bool = False, **params) -> None:
     """``check_plugin_class(kind, cls, params)`` followed by the check of ``kind``
     (``deterministic`` is passed on to ``check_spectrum`` only)."""

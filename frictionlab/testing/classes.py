@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from .common import fail, instantiate
+from .common import fail, instantiate, reported
 
 
 def _schema_bounds(prop: Mapping[str, Any]) -> list[tuple[str, float, bool]]:
@@ -65,6 +65,7 @@ def _bounded_fields(cls, schema) -> list[tuple[str, str, float, bool]]:
     return found
 
 
+@reported
 def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) -> None:
     """The contract every kind shares (``kind`` is ``"spectrum"``, ``"solver"`` or
     ``"slope"``): ``frictionlab.plugin.registry.validate_plugin_class`` passes (right
@@ -77,11 +78,11 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     dimension, ``problem`` names the physical problem, ``approximation`` is a bool,
     ``contact_measure`` and ``indentation_reference`` take allowed values,
     ``body_params`` and ``tolerance_param`` name fields); ``references`` is a tuple
-    of strings; ``Params`` has a JSON Schema; ``Params(**params)`` and
+    of strings; ``Params`` has a JSON Schema and every default passes its own bounds; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
     field has no default); an unknown key raises ``pydantic.ValidationError``
-    naming it; the name is not a built-in's of the kind (a preset naming it would be
-    refused as claimed by two plugins); the parameters survive a JSON round trip (presets are YAML);
+    naming it; the name is not a built-in's of the kind (the built-in keeps it: the plugin would
+    fail to load); the parameters survive a JSON round trip (presets are YAML);
     and, for every bounded numeric field (bounds read from the JSON Schema, or
     from the field's ``ge``/``gt``/``le``/``lt`` metadata), a value just past
     each bound is rejected, at construction and on assignment, with a message
@@ -94,6 +95,7 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
 
     from frictionlab.errors import PluginError
     from frictionlab.plugin import KINDS
+    from frictionlab.plugin.classcheck import params_problem
     from frictionlab.plugin.registry import Registry, normalize_name, validate_plugin_class
 
     if kind not in KINDS:
@@ -110,23 +112,26 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     builtin = builtins.get(kind, cls.name) if cls.name in builtins.names(kind) else cls
     if builtin is not cls:
         fail(cls, f"name {cls.name!r} is taken by the built-in {kind} {builtin.__module__}.{builtin.__qualname__}: "
-                  "a preset naming it would be refused as claimed by two plugins; choose another name")  # fmt: skip
+                  "installed, the plugin would fail to load (the built-in keeps its name); choose another name")  # fmt: skip
     refs = cls.references
     if not isinstance(refs, (tuple, list)) or not all(isinstance(r, str) and r.strip() for r in refs):
         fail(cls, f"references must be a tuple of strings (DOIs). Got {refs!r} instead.")
 
     Params = cls.Params
-    try:
-        schema = Params.model_json_schema()
-    except Exception as exc:  # editors and the CLI need it
-        fail(cls, f"Params.model_json_schema() raised {type(exc).__name__}: {exc}", exc)
+    if problem := params_problem(cls):  # as an installed plugin's registration says it
+        fail(cls, problem)
+    schema = Params.model_json_schema()
 
     # defaults (or the given params) construct
+    required = [info.alias or name for name, info in Params.model_fields.items() if info.is_required()]
+    if missing := [name for name in required if name not in params]:
+        fail(cls, f"Params.{', Params.'.join(missing)} has no default: pass the check a value (check_plugin("
+                  f"{kind!r}, cls, {', '.join(name + '=...' for name in missing)})), or give the field a default "
+                  "(Field(default, description=...)) so that a preset may leave it out")  # fmt: skip
     try:
         model = Params(**params)
     except ValidationError as exc:
-        hint = "" if params else " (pass the required values: check_plugin_class(kind, cls, params={...}))"
-        fail(cls, f"Params(**{params!r}) is invalid{hint}: {exc}", exc)
+        fail(cls, f"Params(**{params!r}) is invalid: {exc}", exc)
     instance = instantiate(cls, params)
     if instance.__dict__.get("params") != model:
         fail(cls, "the constructor must store its validated Params as self.params")

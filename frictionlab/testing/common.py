@@ -4,6 +4,7 @@ arrays and numbers. numpy is imported only when a check runs."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -16,6 +17,22 @@ def label(cls) -> str:
         return repr(cls)
     name = cls.name if issubclass(cls, Plugin) else None
     return f"{cls.__module__}.{cls.__qualname__}" + (f" ({name!r})" if name else "")
+
+
+def reported(check: Callable) -> Callable:
+    """A public check whose failure shows, under pytest, the test that called it and the message:
+    not the kit's own frames (this one pytest hides; the rest are cut). The plugin's own
+    exception, where one was raised, stays chained with its traceback."""
+
+    @functools.wraps(check)
+    def checked(*args, **kwargs):
+        __tracebackhide__ = True
+        try:
+            return check(*args, **kwargs)
+        except AssertionError as exc:
+            raise exc.with_traceback(None)
+
+    return checked
 
 
 def fail(cls, message: str, cause: BaseException | None = None):
@@ -32,7 +49,12 @@ def call(cls, what: str, fn: Callable[..., Any], *args, **kwargs):
     except AssertionError:
         raise
     except Exception as exc:
-        fail(cls, f"{what} raised {type(exc).__name__}: {exc}", exc)
+        fail(cls, f"{what} raised {type(exc).__name__}: {exc}", _from_the_call(exc))
+
+
+def _from_the_call(exc: BaseException) -> BaseException:
+    """``exc`` with its traceback from the frame ``call`` called on: the plugin's code first."""
+    return exc.with_traceback(exc.__traceback__.tb_next) if exc.__traceback__ is not None else exc
 
 
 def instantiate(cls, params: Mapping[str, Any]):

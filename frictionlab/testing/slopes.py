@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from .common import call, check_array, fail, instantiate, must_refuse
+from .common import call, check_array, fail, instantiate, must_refuse, reported
 
 
+@reported
 def check_slope_estimator(cls, **params) -> None:
     """``cls(**params).slopes(heights, spacing, periodic)`` on a random periodic line returns
     a finite float64 array of the same shape, does not modify its input
@@ -76,9 +77,7 @@ def check_slope_estimator(cls, **params) -> None:
         sine = amplitude * np.sin(phase)
         exact = amplitude * np.cos(phase) * (q[0] if kind == "line" else np.hypot(*q))
         estimate = run("sine" if kind == "line" else "plane wave", sine)
-        if kind == "surface":
-            if np.any(estimate < 0):
-                fail(cls, "on a surface the slopes must be gradient magnitudes |grad z| >= 0")
+        if kind == "surface":  # slopes_problem refused a negative one
             exact = np.abs(exact)
         rms_exact = float(np.sqrt(np.mean(exact**2)))
         rms_estimate = float(np.sqrt(np.mean(estimate**2)))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import call, check_positive_number, fail, instantiate, must_refuse
+from .common import call, check_positive_number, fail, instantiate, must_refuse, reported
 
 
 def _test_line(points: int = 64, seed: int = 20240613):
@@ -35,6 +35,7 @@ def _test_surface(points: int = 16, seed: int = 20240613):
     return heights, spacing, slopes
 
 
+@reported
 def check_solver(cls, **params) -> None:
     """``cls(**params).solve(profile, loads, control, slopes)``, for each of the
     solver's ``dimensions``, on a small smooth random periodic line (64 points)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import math
 
-from .common import call, check_array, check_positive_number, fail, instantiate, is_not_implemented
+from .common import call, check_array, check_positive_number, fail, instantiate, is_not_implemented, reported
 
 
+@reported
 def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
     float64 heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
@@ -18,7 +19,11 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     vectorised (array in, array of the same shape out), finite and >= 0; if
     ``rms_slope`` is implemented it is finite and > 0. The declarations:
     ``periodic()`` is a bool equal to ``Profile.periodic`` of what it makes, and when
-    it is False ``not_periodic_advice()`` gives two sentences (why, how to change it);
+    it is False ``not_periodic_advice()`` gives two sentences (why, how to change it); when it is
+    True, and randomness makes the profiles (not ``deterministic``), they wrap: along each axis,
+    the step from the last point back to the first is neither more than twice the largest step
+    between neighbours (a trend) nor zero (a period sampled with its end point) in every one of
+    the 8 seeds;
     ``points_param``, if not None, names the field whose value is the points (per
     side) that ``generate()`` makes;
     ``grid_shape()`` is None or the generated shape; ``refined(2 N)``, if not
@@ -64,8 +69,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     if problem := call(cls, "rms_height()", height_problem, gen):
         fail(cls, problem)
     h = gen.rms_height()
-    variances = [np.var(first.heights), np.var(other.heights)]
-    variances += [np.var(generate(seed).heights) for seed in range(6)]
+    profiles = [first, other, *(generate(seed) for seed in range(6))]
+    variances = [np.var(profile.heights) for profile in profiles]
     measured = float(np.sqrt(np.mean(variances)))
     if not (h / 3 <= measured <= 3 * h):
         fail(
@@ -85,6 +90,34 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     if not missing:
         check_positive_number(cls, "rms_slope()", slope)
     _check_spectrum_declarations(cls, gen, first, params, deterministic)
+    if first.periodic and not deterministic:  # a measured profile is periodic as its data and its preset say
+        _check_wraps(cls, profiles)
+
+
+def _check_wraps(cls, profiles) -> None:
+    """A periodic profile's last point leads back to its first as any point leads to the next, along
+    each axis: in every one of ``profiles``, a step back more than twice the largest step between
+    neighbours is a trend or a window across the profile; none at all, a period sampled with its
+    end point ([0, L] rather than [0, L)). Steps are rms over the other axis of a surface."""
+    import numpy as np
+
+    for axis in range(profiles[0].heights.ndim):
+        along = "" if profiles[0].heights.ndim == 1 else f" along axis {axis}"
+        wraps, largest, typical = [], [], []
+        for profile in profiles:
+            z = profile.heights
+            steps = np.diff(z, axis=axis, append=np.take(z, [0], axis=axis))  # the last: back to the first
+            rms = np.sqrt(np.mean(np.square(np.moveaxis(steps, axis, 0)).reshape(z.shape[axis], -1), axis=1))
+            wraps.append(rms[-1]), largest.append(rms[:-1].max()), typical.append(np.median(rms[:-1]))
+        if all(w > 2 * m for w, m in zip(wraps, largest)):
+            fail(cls, f"periodic() is True, but the profile does not wrap{along}: the step from its last point back "
+                      f"to its first is {wraps[0]:.4g}, more than twice the largest step between neighbours "
+                      f"({largest[0]:.4g}), in every one of {len(profiles)} seeds (a trend across it?); make it "
+                      "periodic, or declare periodic() False")  # fmt: skip
+        if all(w <= 1e-9 * t for w, t in zip(wraps, typical)) and min(typical) > 0:
+            fail(cls, f"periodic() is True, but the last point repeats the first{along} in every one of "
+                      f"{len(profiles)} seeds: a period of N points is sampled on [0, L) (x = arange(N) * dx), "
+                      "not on [0, L] (linspace(0, L, N))")  # fmt: skip
 
 
 def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool) -> None:
@@ -161,17 +194,13 @@ def _check_spectrum_declarations(cls, gen, profile, params, deterministic: bool)
 
 
 def _check_input_summary(cls, gen, profile) -> None:
-    import json
+    from frictionlab.plugin.outputs import input_summary_problem
 
     summary = call(cls, "input_summary()", gen.input_summary)
     if summary is None:
         return
-    try:
-        json.dumps(summary, allow_nan=False)
-    except (TypeError, ValueError) as exc:
-        fail(cls, f"input_summary() must be None or a JSON-ready mapping. Got {summary!r} ({exc}).")
-    if not isinstance(summary, dict) or not {"file", "shape", "spacing", "unit", "rms_height"} <= set(summary):
-        fail(cls, f"input_summary() must give at least file, shape, spacing, unit and rms_height. Got {summary!r}.")
+    if problem := input_summary_problem(summary):  # as a run takes it
+        fail(cls, problem)
     if (tuple(summary["shape"]) != profile.heights.shape or summary["spacing"] != profile.spacing
             or summary["rms_height"] != gen.rms_height()):
         fail(cls, f"input_summary() must give the shape {profile.heights.shape}, spacing {profile.spacing!r} and "

@@ -79,3 +79,41 @@ def test_a_plugin_that_raises_is_named_with_exit_code_2_not_an_internal_error(ca
         assert main(["validate", "quickstart"]) == ExitCode.OK
     finally:
         registry_module.default_registry.cache_clear()
+
+
+CHATTY_SOURCE = '''
+import frictionlab
+from tests.testing.fakes import GoodSpectrum
+
+
+class Chatty(GoodSpectrum):
+    name = "chatty-line"
+
+    def generate(self, rng):
+        print("generating, debug")
+        return super().generate(rng)
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Chatty)
+'''
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_plugin_printing_as_it_runs_leaves_json_alone_on_stdout(capsys, fake_dists, tmp_path, workers):
+    """A researcher's debug print in generate() went to stdout, before the one JSON object."""
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-chatty", "chatty", "acme_chatty", CHATTY_SOURCE)
+    registry_module.default_registry.cache_clear()
+    try:
+        args = ["run", "quickstart", "--set", "spectrum.name=chatty-line", "--set", "spectrum.params={}",
+                "--set", "realizations=3", "--set", "fit.bootstrap=0", "--out", str(tmp_path / "run"),
+                "--no-plot", "--workers", workers, "--json"]
+        assert main(args) == ExitCode.OK
+        captured = capsys.readouterr()
+        assert json.loads(captured.out)["status"] == "completed"
+        assert "generating, debug" in captured.err
+    finally:
+        registry_module.default_registry.cache_clear()

@@ -41,6 +41,18 @@ class _RequiredParams(PluginParams):
     spacing: float = Field(1.0, gt=0, description="grid spacing")
 
 
+class _BadDefaultParams(PluginParams):
+    points: int = Field(4, ge=8, description="number of grid points")
+
+
+class _InfiniteDefaultParams(PluginParams):
+    depth: float = Field(float("inf"), gt=0, description="deepest indentation")
+
+
+class _InfiniteAllowedParams(PluginParams):
+    depth: float = Field(1.0, gt=0, allow_inf_nan=True, description="deepest indentation")
+
+
 class _NotStoring(GoodSpectrum):
     name = "not-storing"
 
@@ -57,7 +69,14 @@ CLASS_BREAKAGES = [
     ("StringReferences", {"references": "10.1000/xyz"}, "references must be a tuple of strings"),
     ("NoAssignmentCheck", {"Params": _NoAssignmentParams}, "validate on assignment"),
     ("UnenforcedBound", {"Params": _UnenforcedParams}, r"Params.points = 7 \(past its minimum 8\) was accepted"),
-    ("RequiredField", {"Params": _RequiredParams}, r"Params\(\*\*\{\}\) is invalid \(pass the required values"),
+    ("RequiredField", {"Params": _RequiredParams},
+     r"Params.points has no default: pass the check a value \(check_plugin\(.spectrum., cls, points=...\)\), or give "),
+    ("DefaultOutOfBounds", {"Params": _BadDefaultParams},
+     r"Params.points defaults to 4, which its own bounds refuse \(Input should be greater than or equal to 8\)"),
+    ("InfiniteDefault", {"Params": _InfiniteDefaultParams},
+     r"Params.depth defaults to inf: a parameter must be a finite number \(results are JSON"),
+    ("InfiniteAllowed", {"Params": _InfiniteAllowedParams},
+     r"Params.depth allows infinity and NaN \(allow_inf_nan=True\): a parameter must be a finite number"),
     ("BuiltinsName", {"name": "power-law"}, r"name 'power-law' is taken by the built-in spectrum "
                                              r"frictionlab_spectra\.power_law\.PowerLaw: .*choose another name"),
 ]

@@ -63,7 +63,7 @@ def _nan_at(index):
     "qualname,slopes,undefined,match",
     [
         ("UndeclaredEnd", _nan_at(-1), lambda self, periodic: False,
-         r"must be finite\. Got 1 non-finite value\(s\)\. A NaN \(a point without a slope\) needs undefined_points\(False\) to return True"),
+         r"must be finite\. Got 1 non-finite value\(s\), the first nan at index 127\. A NaN \(a point without a slope\) needs undefined_points\(False\) to return True"),
         ("InnerNaN", _nan_at(5), lambda self, periodic: not periodic, "only in bands at the profile's ends"),
         ("WideBand", _nan_at(slice(0, 40)), lambda self, periodic: not periodic, "at most a quarter of each axis"),
         ("UndefinedWhenPeriodic", _nan_at(-1), lambda self, periodic: True, r"undefined_points\(True\) must be False"),
@@ -92,3 +92,12 @@ def test_a_wide_stencil_may_leave_several_points_at_each_end_without_a_slope():
     line = type("FourthOrder", (slopes_variant("FourthOrder", fourth_order),),
                 {"undefined_points": lambda self, periodic: not periodic})  # fmt: skip
     fltesting.check_slope_estimator(line)
+
+
+def test_negative_slopes_on_a_surface_fail_in_the_words_of_a_run():
+    def slopes(self, z, dx, periodic=True):
+        return forward_differences(z, dx, periodic) if z.ndim == 1 else -np.hypot(*np.gradient(z, dx))
+
+    cls = type("NegativeGradient", (slopes_variant("NegativeGradient", slopes),), {"dimensions": (1, 2)})
+    fails_naming(fltesting.check_slope_estimator, cls,
+                 r"slopes\(random surface\) on a surface must be gradient magnitudes \|grad z\| >= 0. Got a minimum of -")

@@ -44,6 +44,13 @@ SPECTRUM_BREAKAGES = [
     ("NoAdviceWhenNotPeriodic",
      {"generate": lambda self, rng: Profile(rng.standard_normal(64), 1.0, periodic=False), "periodic": lambda self: False,
       "not_periodic_advice": lambda self: ("not periodic", "")}, r"not_periodic_advice\(\) must be a \(why, how\)"),
+    ("Trended", {"generate": lambda self, rng: Profile(GoodSpectrum.generate(self, rng).heights + np.linspace(0, 3, 128), 1.0)},
+     r"periodic\(\) is True, but the profile does not wrap: the step from its last point back to its first is 2\.9"),
+    ("EndPointRepeated", {"generate": lambda self, rng: Profile(np.cos(2 * np.pi * np.linspace(0, 1, 128) + rng.uniform(0, 6)), 1.0)},
+     r"the last point repeats the first in every one of 8 seeds: a period of N points is sampled on \[0, L\)"),
+    ("TrendedSurface", {"dimension": 2, "generate": lambda self, rng: Profile(
+        GoodSpectrum.generate(self, rng).heights[:, None] + np.linspace(0, 3, 64) + np.sin(np.arange(64) / 3), 1.0)},
+     r"the profile does not wrap along axis 1"),
     ("CaveatsAsOneString", {"caveats": lambda self: "coarse"}, r"caveats\(\) must be a tuple of non-empty strings"),
     ("EmptyCaveat", {"caveats": lambda self: ("",)}, r"caveats\(\) must be a tuple of non-empty strings"),
 ]
@@ -67,7 +74,7 @@ def test_deterministic_flag_allows_seed_independence():
 
 def test_spectrum_check_fails_for_wrong_declarations():
     cls = spectrum_variant("SaysPeriodic", periodic=lambda self: False)
-    with pytest.raises(AssertionError, match=r"periodic\(\) must be True or False and equal Profile.periodic"):
+    with pytest.raises(AssertionError, match=r"Profile.periodic must be what periodic\(\) declares, False. Got True instead."):
         fltesting.check_spectrum(cls)
     cls = spectrum_variant("WrongShape", grid_shape=lambda self: (3,))
     with pytest.raises(AssertionError, match=r"grid_shape\(\) must be None or the shape"):
@@ -114,3 +121,30 @@ def test_a_non_periodic_spectrum_with_its_own_advice_passes_and_the_default_advi
     fltesting.check_spectrum(spectrum_variant("PlainScan", **line))
     own = ("spectrum scan is not periodic (closed: false)", "set spectrum.params.closed: true")
     fltesting.check_spectrum(spectrum_variant("OwnScan", **line, not_periodic_advice=lambda self: own))
+
+
+def test_a_failed_check_shows_the_test_and_the_plugin_not_the_kits_frames():
+    """pytest printed every frame of the kit (check_plugin, check_spectrum, fail...) above the
+    message; a frame it shows must be the caller's or the plugin's."""
+    import os
+    import traceback
+
+    def blows_up(self, rng):
+        raise RuntimeError("my generator broke")
+
+    for generate, cause in ((lambda self, rng: Profile(np.full(8, np.nan), 1.0), None), (blows_up, "blows_up")):
+        with pytest.raises(AssertionError) as excinfo:
+            fltesting.check_plugin("spectrum", spectrum_variant("Broken", generate=generate))
+        kit = [frame for frame, _ in traceback.walk_tb(excinfo.value.__traceback__)
+               if f"frictionlab{os.sep}testing" in frame.f_code.co_filename]
+        assert kit and all(frame.f_locals.get("__tracebackhide__") for frame in kit)
+        if cause:
+            assert excinfo.value.__cause__.__traceback__.tb_frame.f_code.co_name == cause
+
+
+def test_a_measured_profile_declared_periodic_is_not_held_to_wrapping():
+    """deterministic: a file's profile is periodic as its data and its preset say (a plane levelled
+    away leaves a step at the wrap); the kit checks the plugin, not the data."""
+    scan = np.sin(np.arange(128) / 5) + np.linspace(0, 3, 128)
+    fltesting.check_spectrum(spectrum_variant("Scan", generate=lambda self, rng: Profile(scan.copy(), 1.0)),
+                             deterministic=True)
