@@ -12,8 +12,9 @@ import pytest
 import yaml
 
 from frictionlab.cli import main
-from frictionlab.errors import ExitCode
+from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.paper.figures import FIGURES
+from frictionlab.paper.reproduce import report_paths
 from frictionlab.preset import apply_overrides, load_preset_file
 
 from ..conftest import PRESETS
@@ -220,3 +221,32 @@ def test_a_report_that_cannot_be_written_says_that_the_runs_are_kept(tmp_path, c
     assert capsys.readouterr().err == (
         f"error: cannot write {out}/REPRODUCTION.md: No space left on device; the runs that finished are kept in "
         f"{out}: the report run again with the same --out continues them (reading them back)\n")  # fmt: skip
+
+
+def test_an_out_that_holds_other_files_is_refused_before_anything_runs(tmp_path, capsys):
+    """--out naming a folder of the user's (not empty, not a report's) was filled with the report's runs,
+    figures and REPRODUCTION.md: refused (exit 4) naming what it holds, and nothing is written there."""
+    out = tmp_path / "mine"
+    (out / "data").mkdir(parents=True)
+    (out / "notes.txt").write_text("mine")
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
+    assert code == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"--out {out} is not empty and is not the folder of an earlier report (it holds 'data', 'notes.txt')" in err
+    assert "--force" in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == ["data", "notes.txt"] and not any((out / "data").iterdir())
+
+
+def test_an_out_of_an_earlier_report_is_taken(tmp_path):
+    """What an earlier report left in its --out (its runs, figures/, REPRODUCTION.md, a temporary
+    file of it), and the figures folder asked for in it, are not the user's files."""
+    out = tmp_path / "out"
+    for name in ("fig2", "fig5", "readings", "fig5-calibrated", "figures", "pngs"):
+        (out / name).mkdir(parents=True)
+    for name in ("REPRODUCTION.md", ".REPRODUCTION.md.x1y2.tmp"):
+        (out / name).write_text("")
+    assert report_paths(out, tmp_path / "other.md", out / "pngs")[0] == out
+    (out / "mine.md").write_text("")
+    with pytest.raises(OutputRefused, match="it holds 'mine.md', 'pngs'"):
+        report_paths(out, tmp_path / "other.md", tmp_path / "figs")
+    assert report_paths(out, out / "new.md", tmp_path / "figs", force=True)[0] == out  # --force writes into it
