@@ -12,7 +12,7 @@ from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
 from ..runs.rundir import RunDirectory, json_copy, same_preset
 from ..runs.runfolder import output_subfolder
-from ..runs.runner import check_memory, run_to_folder
+from ..runs.runner import check_memory, read_back, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
 from ..runs.sweep import plan_sweep, run_sweep
 
@@ -180,9 +180,19 @@ def _run(run: FigureRun, options: RunOptions, progress: bool) -> None:
         run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
                                       listeners=listeners)  # fmt: skip
     else:
-        listeners = [ProgressReporter()] if progress else []
-        run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
-                                       listeners=listeners)  # fmt: skip
+        run.outcome = run_or_read_back(run.scene, run.folder, options, [ProgressReporter()] if progress else [])
+
+
+def run_or_read_back(scene, folder: Path, options: RunOptions, listeners: list):
+    """The outcome of ``scene`` run into ``folder``, continuing what an earlier report left there
+    (``continuing``); a run it completed is read back as it is, its files (its recorded wall time) kept."""
+    options = continuing(options, folder, scene)
+    if options.resume:
+        with RunDirectory(folder):  # not while another process runs it
+            outcome = read_back(scene, folder, listeners)
+        if outcome is not None:
+            return outcome
+    return run_to_folder(scene, folder, options, listeners=listeners)[0]
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:

@@ -40,12 +40,12 @@ from ..preset.schema import ensemble_settings, first_repeat
 from ..preset.problems import fold_point_problems
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
-from .results import holds_results, results_on_disk, write_figure
+from .results import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder, read_json
 from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
 from ..compute.memory import estimate
-from .runner import check_memory, run_to_folder
+from .runner import check_memory, read_back, run_to_folder
 
 RESULT_COLUMNS = (
     "status", "done", "a", "a_lo", "a_hi", "b", "b_lo", "b_hi", "r2",
@@ -328,7 +328,7 @@ def _run_points(
             continue
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
-        finished = _read_back(point.scene, folder, run_listeners, plot) if started and options.resume else None
+        finished = read_back(point.scene, folder, run_listeners, plot) if started and options.resume else None
         if finished is not None:
             yield PointResult(point, finished.status, folder, outcome=finished, error=finished.error)
             continue
@@ -345,20 +345,6 @@ def _run_points(
         yield PointResult(point, outcome.status, folder, outcome=outcome, error=outcome.error)
         if outcome.status in ("cancelled", "interrupted"):
             return
-
-
-def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
-    """The outcome of a point a resumed sweep finds completed with its files, read back (its
-    listeners hear it restored) without writing anything: None where it must run again, which
-    writes them again (``results_on_disk``; a curve.csv or realizations.npz not of its results)."""
-    from ..compute import engine
-
-    if not results_on_disk(folder, scene, plot):
-        return None
-    done = RunDirectory(folder).completed_results(scene)
-    if done is None or not holds_results(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
-        return None  # its listeners hear it run again, not restored first
-    return engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
 
 
 def run_sweep(
