@@ -347,6 +347,8 @@ RESUME_REFUSALS = {  # damage -> what the message says
     "future manifest": (lambda f, u: _edit_manifest(f, format=9), "format 9; this one reads up to 2"),
     "status NaN": (lambda f, u: (f / "run.json").write_text('{"status": NaN}'), "status is not a word, but a number"),
     "status the secret": (lambda f, u: _edit_manifest(f, status=[SECRET]), "status is not a word, but an array"),
+    "status no run writes": (lambda f, u: _edit_manifest(f, status="done"),
+                             "status is 'done', not one of running, completed, interrupted, cancelled, failed"),
     "chunks a list": (lambda f, u: _edit_manifest(f, chunks=[SECRET]), "chunks is not a mapping"),
 }
 
