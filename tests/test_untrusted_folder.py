@@ -257,6 +257,21 @@ def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp
     assert "hurst=0.6: a = " in out and "contacts" in out.splitlines()[-1] and "internal error" not in out
 
 
+def test_resume_of_a_sweep_whose_sweep_json_is_a_folder_or_a_fifo_says_so(tmp_path, capsys):
+    """resume of a sweep's folder whose sweep.json is not a regular file said 'holds no run to resume
+    (no preset.yaml)', as if it were no sweep: the file is named, and what it is (exit 5)."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    (folder / "sweep.json").unlink()
+    for make, what in ((os.mkdir, "a folder"), (os.mkfifo, "a FIFO (named pipe)")):
+        make(folder / "sweep.json")
+        codes = []
+        assert with_timeout(lambda: codes.append(main(["resume", str(folder), "--quiet"]))) is None
+        assert codes == [ExitCode.RUN_FOLDER] and f"sweep.json is {what}, not a regular file" in capsys.readouterr().err
+        (os.rmdir if what == "a folder" else os.unlink)(folder / "sweep.json")
+
+
 def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
     folder = tmp_path / "sweep"
     preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
