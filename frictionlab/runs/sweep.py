@@ -72,7 +72,9 @@ class SweepPoint:
         return [f"{path}={yaml_scalar(v)}" for path, v in self.values.items()]
 
     def describe(self) -> str:
-        return ", ".join(self.assignments)
+        """Its assignments as messages and tables show them, each cut past 80 characters (a swept
+        description of pages said them whole, in each message naming the point)."""
+        return ", ".join(a if len(a) <= 80 else a[:77] + "..." for a in self.assignments)
 
     def __repr__(self) -> str:  # its scene, every default filled in, is too long to read
         return f"<SweepPoint {self.number}: {self.describe()}, folder {self.folder_name!r}>"
