@@ -55,14 +55,10 @@ def preset_name(hurst: float) -> str:
 
 def find_presets(presets_dir: str | Path | None, plan: Plan) -> Path:
     """``presets_dir``, or else ./presets if it holds the family, else the built-in presets."""
-    from ..preset.builtin import builtin_folder
+    from ..preset.builtin import preset_folder
 
-    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
-    for folder in candidates:
-        if all((folder / preset_name(h)).is_file() for h in plan.hursts):
-            return folder
-    wanted = ", ".join(preset_name(h) for h in plan.hursts)
-    raise FrictionlabError(f"--presets: no folder with {wanted}; looked in {', '.join(map(shown_name, candidates))}")
+    names = [preset_name(h) for h in plan.hursts]
+    return preset_folder(presets_dir, names, ", ".join(names))
 
 
 @dataclass(frozen=True)

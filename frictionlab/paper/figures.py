@@ -73,21 +73,10 @@ class FigureRun:
 
 
 def find_presets(presets_dir: str | Path | None) -> Path:
-    from ..io.inputs import regular_file_problem
-    from ..preset.builtin import builtin_folder
+    from ..preset.builtin import preset_folder
 
-    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
-    for folder in candidates:
-        if all((folder / fig.preset).is_file() for fig in FIGURES):
-            return folder
-    wanted = ", ".join(fig.preset for fig in FIGURES)
-    given = Path(presets_dir) if presets_dir and Path(presets_dir).is_dir() else None
-    problems = {fig.preset: regular_file_problem(given / fig.preset) for fig in FIGURES} if given else {}
-    which = "; ".join(f"{name}: {problem}" for name, problem in problems.items() if problem)  # a FIFO, say
-    which = f" (in {given}, {which})" if which else ""
-    raise FrictionlabError(
-        f"--presets: no folder with the paper's presets ({wanted}); looked in {', '.join(map(shown_name, candidates))}{which}"
-    )
+    names = [fig.preset for fig in FIGURES]
+    return preset_folder(presets_dir, names, f"the paper's presets ({', '.join(names)})")
 
 
 def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
