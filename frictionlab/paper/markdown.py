@@ -35,13 +35,13 @@ def _row_for_h(run: FigureRun, value: float):
     return min(run.sweep_outcome.rows, key=lambda r: abs(r[path] - value))
 
 
-READ_BACK_NOTE = (" Runs that an earlier report into this folder completed were read back, not run again: these"
+READ_BACK_NOTE = (" Runs completed earlier in this folder were read back, not run again: these"
                   " wall times count only what this report ran; each figure below shows the time recorded when it was"
                   " computed.")
 
 
 def _read_back(run) -> bool:
-    """Whether a figure's run (one of its sweep's points) was read back from an earlier report."""
+    """Whether a figure's run (one of its sweep's points) was read back, completed earlier."""
     outcomes = [point.outcome for point in run.sweep_outcome.results] if run.sweep_outcome else [run.outcome]
     return any(o is not None and o.extra.get("read_back") for o in outcomes)
 
@@ -49,22 +49,21 @@ def _read_back(run) -> bool:
 def _timed(o) -> str:
     """How long a run's realizations took: when computed, for a run read back."""
     if o.extra.get("read_back"):
-        return f"in {o.elapsed:.2f} s when an earlier report computed them (read back)"
+        return f"in {o.elapsed:.2f} s when computed (read back)"
     resumed = o.extra.get("resumed", 0)
-    return f"in {o.elapsed:.2f} s" + (f" ({resumed} of them computed by an earlier report and read back)" if resumed else "")
+    return f"in {o.elapsed:.2f} s" + (f" ({resumed} of them computed earlier and read back)" if resumed else "")
 
 
 def _sweep_timed(outcome) -> str:
-    """How long a sweep took: its points' recorded times where an earlier report computed them."""
+    """How long a sweep took: its points' recorded times where they were computed earlier."""
     points = [r.outcome for r in outcome.results if r.outcome is not None]
     back = [o for o in points if o.extra.get("read_back")]
     if not back:
         return f"{outcome.elapsed:.1f} s"
     recorded = sum(o.elapsed for o in back)
     if len(back) == len(outcome.results):
-        return f"{recorded:.2f} s when an earlier report computed them (read back)"
-    return (f"{outcome.elapsed:.1f} s, and {recorded:.2f} s when an earlier report computed "
-            f"{len(back)} of them (read back)")
+        return f"{recorded:.2f} s when computed (read back)"
+    return f"{outcome.elapsed:.1f} s, and {recorded:.2f} s when computed for the {len(back)} read back"
 
 
 def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, readings_elapsed=None,
