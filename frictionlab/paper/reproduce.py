@@ -47,6 +47,10 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, DEFAULT_FIGURES, "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
     _refuse_inside_runs(out_dir, markdown_path, figures_dir)
+    figures = {os.path.realpath(figures_dir / name) for name in FIGURE_FILES}
+    if os.path.realpath(markdown_path) in figures:  # the report was written over the figure, linking to itself
+        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is a figure the report draws in {shown_name(figures_dir)}: "
+                            "give another file name")  # fmt: skip
     if not force:
         _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
     return out_dir, markdown_path, figures_dir

@@ -250,3 +250,16 @@ def test_an_out_of_an_earlier_report_is_taken(tmp_path):
     with pytest.raises(OutputRefused, match="it holds 'mine.md', 'pngs'"):
         report_paths(out, tmp_path / "other.md", tmp_path / "figs")
     assert report_paths(out, out / "new.md", tmp_path / "figs", force=True)[0] == out  # --force writes into it
+
+
+@pytest.mark.parametrize("markdown", ["out/figures/fig2.png", "figs/fig5-calibrated.png"])
+def test_a_markdown_that_is_one_of_the_reports_figures_is_refused(tmp_path, capsys, markdown):
+    """--markdown OUT/figures/fig2.png: Fig. 2 was drawn, then the report written over it, linking to
+    itself as the figure. Refused before any run (exit 4)."""
+    out = tmp_path / "out"
+    figures = ["--figures", str(tmp_path / "figs")] if markdown.startswith("figs/") else []
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), *figures, "--markdown", str(tmp_path / markdown),
+                 "--quiet"])  # fmt: skip
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert f"--markdown {tmp_path / markdown} is a figure the report draws in" in capsys.readouterr().err
+    assert not out.exists()
