@@ -14,7 +14,7 @@ from ..runs.rundir import RunDirectory, json_copy, same_preset
 from ..runs.runfolder import output_subfolder
 from ..runs.runner import check_memory, read_back, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
-from ..runs.sweep import plan_sweep, run_sweep
+from ..runs.sweep import check_sweep_folder, plan_sweep, run_sweep
 
 
 @dataclass(frozen=True)
@@ -140,6 +140,15 @@ def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
     return replace(options, resume=ours)
 
 
+def _check_folder(run: FigureRun, options: RunOptions) -> None:
+    """Refuse what a figure's run refuses in its folder (a folder of the user's files, another
+    preset's run): Figs. 2 and 3 ran for minutes before Fig. 4's folder was refused."""
+    if run.sweep is not None:
+        check_sweep_folder(run.sweep, run.folder, options.force)
+    elif not continuing(options, run.folder, run.scene).resume:
+        RunDirectory(run.folder, force=options.force).check_fresh(run.scene)
+
+
 def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:
     """Refuse (RunError), before any figure runs, a report one of whose runs does not fit in
     memory (each run's own check, ``runner.check_memory``): not once the figures before it ran."""
@@ -188,8 +197,9 @@ def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions()
     """Run each figure's preset into ``out_dir``, every preset checked first; with
     ``progress``, each run's progress on stderr."""
     runs = plan_figures(presets, out_dir)
-    for run in runs:  # a link at a figure's folder refused before any figure runs
+    for run in runs:  # a link at a figure's folder, or one its run refuses, refused before any figure runs
         output_subfolder(out_dir, run.figure.key, "run the report again", make=False)
+        _check_folder(run, options)
     _check_memory_ahead(runs, options)
     for run in runs:
         fig, path = run.figure, run.preset_path

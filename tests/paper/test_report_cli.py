@@ -263,3 +263,22 @@ def test_a_markdown_that_is_one_of_the_reports_figures_is_refused(tmp_path, caps
     assert code == ExitCode.OUTPUT_REFUSED
     assert f"--markdown {tmp_path / markdown} is a figure the report draws in" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("key", ["fig4", "fig5"])
+def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, key):
+    """--out of an earlier report whose fig4 (or fig5) holds files of the user's: Figs. 2 and 3 ran
+    for minutes, then Fig. 4's run refused its folder. Refused before any figure runs (exit 4)."""
+    out = tmp_path / "r"
+    (out / key).mkdir(parents=True)
+    (out / key / "notes.txt").write_text("mine")
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a figure ran before every figure's folder was checked")
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert f"{out / key} is not empty and is not" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == [key] and (out / key / "notes.txt").read_text() == "mine"
