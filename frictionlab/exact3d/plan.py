@@ -343,8 +343,11 @@ def run_plan(
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )
-    for job in plan.jobs():  # a link at an ensemble's folder refused before any ensemble runs, not hours in
-        output_subfolder(runs_dir, job.folder(_solver_name(factories[job.hurst], job)), "run the command again", make=False)
+    for job in plan.jobs():  # a link at an ensemble's folder, or files of the user's there: refused before any runs
+        name = job.folder(_solver_name(factories[job.hurst], job))
+        folder = output_subfolder(runs_dir, name, "run the command again", make=False)
+        if compute and folder.is_dir() and not (folder / STATE_FILE).exists():  # what its run refuses, not hours in
+            RunDirectory(folder, force=options.force).check_fresh(_scene(factories[job.hurst], job, plan))
     if compute:
         check_memory_ahead(factories, runs_dir, plan, options)
     kept = (f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
