@@ -135,6 +135,7 @@ HOSTILE = {
     "status unknown": lambda f: edit_summary(f, lambda d: set_in(d, "status", SECRET)),
     "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
     "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
+    "elapsed past 30 years": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", 1e300)),  # 300 digits shown
     "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
     "input rms NaN": lambda f: edit_summary(f, lambda d: set_in(d, "input", {"file": "scan.x3p", "rms_height": float("nan")})),
     "input a list": lambda f: edit_summary(f, lambda d: set_in(d, "input", [1, 2])),
@@ -243,7 +244,7 @@ def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp
     preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
     frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
     data = json.loads((folder / "sweep.json").read_text())
-    for key, value in (("elapsed_s", float("inf")), ("point", float("nan")), ("spectrum.params.hurst", float("nan")),
+    for key, value in (("elapsed_s", float("inf")), ("elapsed_s", 1e300), ("point", float("nan")), ("spectrum.params.hurst", float("nan")),
                        ("set", [float("nan")])):  # fmt: skip
         (folder / "sweep.json").write_text(json.dumps({**data, "points": [{**data["points"][0], key: value}, data["points"][1]]}))
         code = main(["follow", str(folder), "--json"])

@@ -35,7 +35,7 @@ from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
 from ..plugin.resolution import MIN_SHORT_CUTOFF_PIXELS
 from ..runs.rundir import STATE_FILE, RunDirectory
-from ..runs.runfolder import output_subfolder, read_json
+from ..runs.runfolder import MAX_WALL_SECONDS, output_subfolder, read_json
 from ..runs.runner import check_memory, run_to_folder
 from ..preset.seeds import realization_rng
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -392,7 +392,6 @@ def run_plan(
 
 TIME_FILE = "exact3d-time.json"
 TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
-MAX_STUDY_SECONDS = 1e9  # some 30 years: a wall time past it is no study's
 ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL}|{BROAD})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
 
 
@@ -444,5 +443,5 @@ def _time(runs_dir: Path, plan: Plan) -> float:
     seconds_before = earlier.get("seconds")
     usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
     # an edited file's -5 or 1e308 was printed on the page as the study's wall time (1e308: 300 digits)
-    usable = usable and 0 <= seconds_before <= MAX_STUDY_SECONDS and earlier.get("plan") == plan.name
+    usable = usable and 0 <= seconds_before <= MAX_WALL_SECONDS and earlier.get("plan") == plan.name
     return float(seconds_before) if usable else 0.0
