@@ -59,7 +59,7 @@ def test_runs_prints_a_forged_name_escaped(tmp_path, capsys):
     (folder / "run.json").write_text(json.dumps(manifest))
     assert main(["runs", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert out.count("pwned") == 3 and ESC not in out
+    assert out.count("pwned") == 4 and ESC not in out  # the folder's name twice, as the run's name, the status refused
 
 
 @posix

@@ -241,6 +241,8 @@ def test_one_problem_of_many_points_is_said_for_three_then_once_for_the_rest(reg
     ({"description": {"values": ["x", "y"]}}, "grid", "sweep points 1 (description=x) and 2"),
     ({"output.plot": {"values": [True, False]}}, "grid", "sweep points 1 (output.plot=true) and 2"),
     ({"output.realizations": {"values": [True, False]}, "seed": {"values": [1, 1]}}, "zip", "sweep points 1"),
+    # a description of pages was said whole: each value is cut
+    ({"description": {"values": ["x" * 3000, "y"]}}, "grid", f"sweep points 1 (description={'x' * 65}...) and 2"),
 ])  # fmt: skip
 def test_two_points_that_read_as_one_preset_are_refused(parameters, mode, said, registry):
     """1 and '1' are two values to the values' own check, but one seed once read: the sweep ran

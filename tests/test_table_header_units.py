@@ -6,6 +6,8 @@ height off by the units' ratio."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import yaml
@@ -275,3 +277,22 @@ def test_a_unit_spelled_out_in_any_case_is_that_unit(tmp_path, label, named):
     with pytest.raises(ValueError, match=rf"its header names the length unit {named}, .* the preset's unit, {other}"):
         ProfileFile(path=str(tmp_path / "line.csv"), unit=other).rms_height()
     assert ProfileFile(path=str(tmp_path / "line.csv")).input_summary()["unit"] == named
+
+
+@pytest.mark.parametrize("header, label, unit", [("x [furlong],z [um]", "x [furlong]", "furlong"),
+                                                 ("t [s],z [nm]", "t [s]", "s"), ("z [NM]", "z [NM]", "NM")])  # fmt: skip
+def test_a_column_labelled_in_a_unit_frictionlab_does_not_know_is_refused(tmp_path, header, label, unit):
+    """'x [furlong],z [um]' was read as x in um (the one unit known), every slope off by the units'
+    ratio, validated as 'ok': a bracketed unit that is no known unit is refused, naming the label."""
+    columns = header.count(",") + 1
+    rows = "".join(",".join([f"{i * 0.5!r}", repr(float(v))][-columns:]) + "\n" for i, v in enumerate(rough(1, 32)[0]))
+    (tmp_path / "odd.csv").write_text(header + "\n" + rows, encoding="utf-8")
+    for given in ("um", None):
+        with pytest.raises(ValueError, match=rf"its header's '{re.escape(label)}' names the unit '{unit}', which is no unit"):
+            ProfileFile(path=str(tmp_path / "odd.csv"), unit=given, spacing=0.5).rms_height()
+
+
+def test_brackets_that_hold_no_unit_above_the_labels_are_no_unit(tmp_path):
+    rows = "".join(f"{i * 0.5!r},{float(v)!r}\n" for i, v in enumerate(rough(1, 32)[0]))
+    (tmp_path / "dated.csv").write_text("# scanned [2024-01-01]\nx [um],z [um]\n" + rows)
+    assert ProfileFile(path=str(tmp_path / "dated.csv"), spacing=0.5).generate(None).heights.size == 32

@@ -135,6 +135,7 @@ HOSTILE = {
     "status unknown": lambda f: edit_summary(f, lambda d: set_in(d, "status", SECRET)),
     "caveats a string": lambda f: edit_summary(f, lambda d: set_in(d, "caveats", SECRET)),
     "elapsed a string": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", "1")),
+    "elapsed past 30 years": lambda f: edit_summary(f, lambda d: set_in(d, "elapsed_seconds", 1e300)),  # 300 digits shown
     "future schema": lambda f: edit_summary(f, lambda d: set_in(d, "schema_version", 99)),
     "input rms NaN": lambda f: edit_summary(f, lambda d: set_in(d, "input", {"file": "scan.x3p", "rms_height": float("nan")})),
     "input a list": lambda f: edit_summary(f, lambda d: set_in(d, "input", [1, 2])),
@@ -243,7 +244,7 @@ def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp
     preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
     frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
     data = json.loads((folder / "sweep.json").read_text())
-    for key, value in (("elapsed_s", float("inf")), ("point", float("nan")), ("spectrum.params.hurst", float("nan")),
+    for key, value in (("elapsed_s", float("inf")), ("elapsed_s", 1e300), ("point", float("nan")), ("spectrum.params.hurst", float("nan")),
                        ("set", [float("nan")])):  # fmt: skip
         (folder / "sweep.json").write_text(json.dumps({**data, "points": [{**data["points"][0], key: value}, data["points"][1]]}))
         code = main(["follow", str(folder), "--json"])
@@ -255,6 +256,21 @@ def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp
     assert main(["follow", str(folder), "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "hurst=0.6: a = " in out and "contacts" in out.splitlines()[-1] and "internal error" not in out
+
+
+def test_resume_of_a_sweep_whose_sweep_json_is_a_folder_or_a_fifo_says_so(tmp_path, capsys):
+    """resume of a sweep's folder whose sweep.json is not a regular file said 'holds no run to resume
+    (no preset.yaml)', as if it were no sweep: the file is named, and what it is (exit 5)."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    (folder / "sweep.json").unlink()
+    for make, what in ((os.mkdir, "a folder"), (os.mkfifo, "a FIFO (named pipe)")):
+        make(folder / "sweep.json")
+        codes = []
+        assert with_timeout(lambda: codes.append(main(["resume", str(folder), "--quiet"]))) is None
+        assert codes == [ExitCode.RUN_FOLDER] and f"sweep.json is {what}, not a regular file" in capsys.readouterr().err
+        (os.rmdir if what == "a folder" else os.unlink)(folder / "sweep.json")
 
 
 def test_a_sweep_json_naming_a_folder_outside_is_refused(tmp_path):
@@ -347,6 +363,8 @@ RESUME_REFUSALS = {  # damage -> what the message says
     "future manifest": (lambda f, u: _edit_manifest(f, format=9), "format 9; this one reads up to 2"),
     "status NaN": (lambda f, u: (f / "run.json").write_text('{"status": NaN}'), "status is not a word, but a number"),
     "status the secret": (lambda f, u: _edit_manifest(f, status=[SECRET]), "status is not a word, but an array"),
+    "status no run writes": (lambda f, u: _edit_manifest(f, status="done"),
+                             "status is 'done', not one of running, completed, interrupted, cancelled, failed"),
     "chunks a list": (lambda f, u: _edit_manifest(f, chunks=[SECRET]), "chunks is not a mapping"),
 }
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from ..errors import ExitCode, OutputRefused, PresetError, RunFolderError, command_word, shown_name
@@ -39,7 +40,8 @@ def run(args) -> ExitCode:
         raise OutputRefused(f"{problem}; a resume writes into the folder it continues: copy it where you can write "
                             f"(cp -r {command_word(run_dir)} NEW_FOLDER) and resume the copy")
     args.out, args.resume, args.set, args.seed, args.force = str(run_dir), True, None, None, False
-    if (run_dir / "sweep.json").is_file() and not (run_dir / PRESET_FILE).exists():  # a sweep's folder
+    # a sweep's folder, its sweep.json a folder or a link too: read as one, it says what is wrong with it
+    if os.path.lexists(run_dir / "sweep.json") and not os.path.lexists(run_dir / PRESET_FILE):
         from ..preset import build_scene
         from ..runs.sweepfiles import OtherSweep, stored_sweep
         from .options import executor_run_options

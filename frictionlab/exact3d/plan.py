@@ -35,7 +35,7 @@ from ..preset import Scene, first_unlike, read_preset
 from ..plugin.registry import Registry, default_registry
 from ..plugin.resolution import MIN_SHORT_CUTOFF_PIXELS
 from ..runs.rundir import STATE_FILE, RunDirectory
-from ..runs.runfolder import output_subfolder, read_json
+from ..runs.runfolder import MAX_WALL_SECONDS, output_subfolder, read_json
 from ..runs.runner import check_memory, run_to_folder
 from ..preset.seeds import realization_rng
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -55,14 +55,10 @@ def preset_name(hurst: float) -> str:
 
 def find_presets(presets_dir: str | Path | None, plan: Plan) -> Path:
     """``presets_dir``, or else ./presets if it holds the family, else the built-in presets."""
-    from ..preset.builtin import builtin_folder
+    from ..preset.builtin import preset_folder
 
-    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
-    for folder in candidates:
-        if all((folder / preset_name(h)).is_file() for h in plan.hursts):
-            return folder
-    wanted = ", ".join(preset_name(h) for h in plan.hursts)
-    raise FrictionlabError(f"--presets: no folder with {wanted}; looked in {', '.join(map(shown_name, candidates))}")
+    names = [preset_name(h) for h in plan.hursts]
+    return preset_folder(presets_dir, names, ", ".join(names))
 
 
 @dataclass(frozen=True)
@@ -347,8 +343,11 @@ def run_plan(
                     f"and reports its ensembles so; give a preset of H = {job.hurst:g} (frictionlab presets copy "
                     f"{preset_name(job.hurst).removesuffix('.yaml')})"
                 )
-    for job in plan.jobs():  # a link at an ensemble's folder refused before any ensemble runs, not hours in
-        output_subfolder(runs_dir, job.folder(_solver_name(factories[job.hurst], job)), "run the command again", make=False)
+    for job in plan.jobs():  # a link at an ensemble's folder, or files of the user's there: refused before any runs
+        name = job.folder(_solver_name(factories[job.hurst], job))
+        folder = output_subfolder(runs_dir, name, "run the command again", make=False)
+        if compute and folder.is_dir() and not (folder / STATE_FILE).exists():  # what its run refuses, not hours in
+            RunDirectory(folder, force=options.force).check_fresh(_scene(factories[job.hurst], job, plan))
     if compute:
         check_memory_ahead(factories, runs_dir, plan, options)
     kept = (f"the ensembles that finished are kept in {shown_name(runs_dir)}; run the command again with "
@@ -393,7 +392,6 @@ def run_plan(
 
 TIME_FILE = "exact3d-time.json"
 TIME_FILE_BYTES = 4096  # {"plan": ..., "seconds": ...}
-MAX_STUDY_SECONDS = 1e9  # some 30 years: a wall time past it is no study's
 ENSEMBLE_FOLDER = re.compile(rf"(?:(?:{SIDE}|{SPECTRAL}|{BROAD})-)?h\d\.\d-n\d+-[A-Za-z0-9_.-]+")  # one ensemble's, as Job.folder names it
 
 
@@ -445,5 +443,5 @@ def _time(runs_dir: Path, plan: Plan) -> float:
     seconds_before = earlier.get("seconds")
     usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
     # an edited file's -5 or 1e308 was printed on the page as the study's wall time (1e308: 300 digits)
-    usable = usable and 0 <= seconds_before <= MAX_STUDY_SECONDS and earlier.get("plan") == plan.name
+    usable = usable and 0 <= seconds_before <= MAX_WALL_SECONDS and earlier.get("plan") == plan.name
     return float(seconds_before) if usable else 0.0

@@ -12,9 +12,9 @@ from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
 from ..runs.rundir import RunDirectory, json_copy, same_preset
 from ..runs.runfolder import output_subfolder
-from ..runs.runner import check_memory, run_to_folder
+from ..runs.runner import check_memory, read_back, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
-from ..runs.sweep import plan_sweep, run_sweep
+from ..runs.sweep import check_sweep_folder, plan_sweep, run_sweep
 
 
 @dataclass(frozen=True)
@@ -73,21 +73,10 @@ class FigureRun:
 
 
 def find_presets(presets_dir: str | Path | None) -> Path:
-    from ..io.inputs import regular_file_problem
-    from ..preset.builtin import builtin_folder
+    from ..preset.builtin import preset_folder
 
-    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
-    for folder in candidates:
-        if all((folder / fig.preset).is_file() for fig in FIGURES):
-            return folder
-    wanted = ", ".join(fig.preset for fig in FIGURES)
-    given = Path(presets_dir) if presets_dir and Path(presets_dir).is_dir() else None
-    problems = {fig.preset: regular_file_problem(given / fig.preset) for fig in FIGURES} if given else {}
-    which = "; ".join(f"{name}: {problem}" for name, problem in problems.items() if problem)  # a FIFO, say
-    which = f" (in {given}, {which})" if which else ""
-    raise FrictionlabError(
-        f"--presets: no folder with the paper's presets ({wanted}); looked in {', '.join(map(shown_name, candidates))}{which}"
-    )
+    names = [fig.preset for fig in FIGURES]
+    return preset_folder(presets_dir, names, f"the paper's presets ({', '.join(names)})")
 
 
 def plan_figures(presets: Path, out_dir: Path) -> list[FigureRun]:
@@ -151,6 +140,15 @@ def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
     return replace(options, resume=ours)
 
 
+def _check_folder(run: FigureRun, options: RunOptions) -> None:
+    """Refuse what a figure's run refuses in its folder (a folder of the user's files, another
+    preset's run): Figs. 2 and 3 ran for minutes before Fig. 4's folder was refused."""
+    if run.sweep is not None:
+        check_sweep_folder(run.sweep, run.folder, options.force)
+    elif not continuing(options, run.folder, run.scene).resume:
+        RunDirectory(run.folder, force=options.force).check_fresh(run.scene)
+
+
 def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:
     """Refuse (RunError), before any figure runs, a report one of whose runs does not fit in
     memory (each run's own check, ``runner.check_memory``): not once the figures before it ran."""
@@ -180,17 +178,28 @@ def _run(run: FigureRun, options: RunOptions, progress: bool) -> None:
         run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
                                       listeners=listeners)  # fmt: skip
     else:
-        listeners = [ProgressReporter()] if progress else []
-        run.outcome, _ = run_to_folder(run.scene, run.folder, continuing(options, run.folder, run.scene),
-                                       listeners=listeners)  # fmt: skip
+        run.outcome = run_or_read_back(run.scene, run.folder, options, [ProgressReporter()] if progress else [])
+
+
+def run_or_read_back(scene, folder: Path, options: RunOptions, listeners: list):
+    """The outcome of ``scene`` run into ``folder``, continuing what an earlier report left there
+    (``continuing``); a run it completed is read back as it is, its files (its recorded wall time) kept."""
+    options = continuing(options, folder, scene)
+    if options.resume:
+        with RunDirectory(folder):  # not while another process runs it
+            outcome = read_back(scene, folder, listeners)
+        if outcome is not None:
+            return outcome
+    return run_to_folder(scene, folder, options, listeners=listeners)[0]
 
 
 def run_figures(presets: Path, out_dir: Path, options: RunOptions = RunOptions(), *, progress: bool = False) -> list[FigureRun]:
     """Run each figure's preset into ``out_dir``, every preset checked first; with
     ``progress``, each run's progress on stderr."""
     runs = plan_figures(presets, out_dir)
-    for run in runs:  # a link at a figure's folder refused before any figure runs
+    for run in runs:  # a link at a figure's folder, or one its run refuses, refused before any figure runs
         output_subfolder(out_dir, run.figure.key, "run the report again", make=False)
+        _check_folder(run, options)
     _check_memory_ahead(runs, options)
     for run in runs:
         fig, path = run.figure, run.preset_path

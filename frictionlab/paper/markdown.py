@@ -35,6 +35,37 @@ def _row_for_h(run: FigureRun, value: float):
     return min(run.sweep_outcome.rows, key=lambda r: abs(r[path] - value))
 
 
+READ_BACK_NOTE = (" Runs completed earlier in this folder were read back, not run again: these"
+                  " wall times count only what this report ran; each figure below shows the time recorded when it was"
+                  " computed.")
+
+
+def _read_back(run) -> bool:
+    """Whether a figure's run (one of its sweep's points) was read back, completed earlier."""
+    outcomes = [point.outcome for point in run.sweep_outcome.results] if run.sweep_outcome else [run.outcome]
+    return any(o is not None and o.extra.get("read_back") for o in outcomes)
+
+
+def _timed(o) -> str:
+    """How long a run's realizations took: when computed, for a run read back."""
+    if o.extra.get("read_back"):
+        return f"in {o.elapsed:.2f} s when computed (read back)"
+    resumed = o.extra.get("resumed", 0)
+    return f"in {o.elapsed:.2f} s" + (f" ({resumed} of them computed earlier and read back)" if resumed else "")
+
+
+def _sweep_timed(outcome) -> str:
+    """How long a sweep took: its points' recorded times where they were computed earlier."""
+    points = [r.outcome for r in outcome.results if r.outcome is not None]
+    back = [o for o in points if o.extra.get("read_back")]
+    if not back:
+        return f"{outcome.elapsed:.1f} s"
+    recorded = sum(o.elapsed for o in back)
+    if len(back) == len(outcome.results):
+        return f"{recorded:.2f} s when computed (read back)"
+    return f"{outcome.elapsed:.1f} s, and {recorded:.2f} s when computed for the {len(back)} read back"
+
+
 def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, readings_elapsed=None,
              fig5_calibrated=None, fig5_calibrated_elapsed=None, workers: int | None = None,
              command="frictionlab report") -> str:  # fmt: skip
@@ -48,6 +79,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
         + (f"; the readings below took another {readings_elapsed:.1f} s" if readings_elapsed is not None else "")
         + (f", Fig. 5 with h calibrated at each H {fig5_calibrated_elapsed:.1f} s" if fig5_calibrated_elapsed else "")
         + "."
+        + (READ_BACK_NOTE if any(_read_back(run) for run in runs) else "")
         + " The paper's numbers are those its Figs. 2 to 5 state; the presets are in `presets/` (their comments say"
         " how h = 1e4 was calibrated). Intervals are 95% percentile bootstrap over realizations;"
         " † marks a paper value outside frictionlab's interval.",
@@ -80,7 +112,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
             f_lo, f_hi = float(o.f[0]), float(o.f[-1])
             law = lambda a, b, f: a + b * math.log(f)  # noqa: E731
             lines.append(
-                f"Preset `{run.preset_path.name}`: {o.done} realizations in {o.elapsed:.2f} s. "
+                f"Preset `{run.preset_path.name}`: {o.done} realizations {_timed(o)}. "
                 f"Over f = {f_lo:.3g} .. {f_hi:.3g} the paper's law gives "
                 f"xi = {law(s.a, s.b, f_lo):.3f} .. {law(s.a, s.b, f_hi):.3f}; frictionlab measures "
                 f"{o.xi[0]:.3f} .. {o.xi[-1]:.3f} (fit {law(o.fit.a, o.fit.b, f_lo):.3f} .. "
@@ -97,7 +129,7 @@ def markdown(runs, images: dict[str, str], *, elapsed: float, readings=None, rea
             path = run.sweep.paths[0]
             lines += [
                 f"Preset `{run.preset_path.name}`: {len(run.sweep.points)} points ({path}), "
-                f"{run.sweep_outcome.elapsed:.1f} s. Note: {s.note}; the paper's Figs. 2 (H = 1) and 4 (H = 0.5) "
+                f"{_sweep_timed(run.sweep_outcome)}. Note: {s.note}; the paper's Figs. 2 (H = 1) and 4 (H = 0.5) "
                 "are marked too.",
                 "",
                 "| H | a (95% CI) | b (95% CI) | R² | points in contact at F = 1 / 20 |",

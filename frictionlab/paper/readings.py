@@ -19,11 +19,10 @@ from ..compute.fit import LogFit, fit_log_law
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
 from ..runs.runfolder import output_subfolder
-from ..runs.runner import run_to_folder
 from ..compute.signals import interrupted_since, mark
 from ..preset.seeds import bootstrap_rng, replicate_seeds
 from .calibration import calibrated_rms_height
-from .figures import FigureRun, continuing
+from .figures import FigureRun, run_or_read_back
 
 
 AVERAGES = {
@@ -194,7 +193,7 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
             scene = build_scene(apply_overrides(data, [*seeded, "output.plot=false"]), source=str(base.preset_path))
             output_subfolder(out_dir, str(folder.relative_to(out_dir)), "run the report again")
             seen = mark()
-            outcome, _ = run_to_folder(scene, folder, continuing(options, folder, scene), listeners=listeners())
+            outcome = run_or_read_back(scene, folder, options, listeners())
             if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
                 raise KeyboardInterrupt  # the report stops: what finished is kept
             ensembles[key] = scene, outcome

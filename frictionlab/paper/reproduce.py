@@ -23,6 +23,7 @@ from .readings import CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, fig5_calibra
 
 
 FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
+DEFAULT_MARKDOWN, DEFAULT_FIGURES = "REPRODUCTION.md", "figures"  # in --out
 
 
 def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: bool = False) -> tuple[Path, Path, Path]:
@@ -42,11 +43,46 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     if not out_dir:  # what a fresh folder would hold is new: only a --markdown or --figures given can be taken
         _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
-    markdown_path = Path(markdown_path) if markdown_path else out_dir / "REPRODUCTION.md"
-    figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, "figures", "run the report again", make=False)
+    markdown_path = Path(markdown_path) if markdown_path else out_dir / DEFAULT_MARKDOWN
+    figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, DEFAULT_FIGURES, "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
     _refuse_inside_runs(out_dir, markdown_path, figures_dir)
+    figures = {os.path.realpath(figures_dir / name) for name in FIGURE_FILES}
+    if os.path.realpath(markdown_path) in figures:  # the report was written over the figure, linking to itself
+        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is a figure the report draws in {shown_name(figures_dir)}: "
+                            "give another file name")  # fmt: skip
+    if not force:
+        _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
     return out_dir, markdown_path, figures_dir
+
+
+def _refuse_foreign_folder(out_dir: Path, markdown_path: Path, figures_dir: Path) -> None:
+    """Refuse an --out that holds anything but what a report writes there (its runs' folders, its
+    figures folder, its markdown): the report filled a folder of the user's with runs and figures."""
+    files = {DEFAULT_MARKDOWN}
+    if os.path.realpath(markdown_path.parent) == os.path.realpath(out_dir):
+        files.add(markdown_path.name)
+    names = {*(fig.key for fig in FIGURES), READINGS_FOLDER, CALIBRATED_FOLDER, DEFAULT_FIGURES, *files}
+    if os.path.realpath(figures_dir.parent) == os.path.realpath(out_dir):
+        names.add(figures_dir.name)
+    try:
+        held = sorted(p.name for p in out_dir.iterdir() if not _written_by_a_report(p.name, names, files))
+    except FileNotFoundError:
+        return
+    except OSError as exc:  # output_path_problem made a file there: only listing it failed
+        raise OutputRefused(f"--out {shown_name(out_dir)} cannot be listed ({exc.strerror or exc}): give another folder") from None
+    if held:
+        listed = ", ".join(repr(shown_name(name)) for name in held[:3]) + (", ..." if len(held) > 3 else "")
+        raise OutputRefused(
+            f"--out {shown_name(out_dir)} is not empty and is not the folder of an earlier report (it holds {listed}): "
+            "give a new or empty folder, or --force to write the report into it (only the files it writes are replaced)"
+        )
+
+
+def _written_by_a_report(name: str, names: set[str], files: set[str]) -> bool:
+    """Whether ``name`` is one a report writes in its --out (a temporary file of its markdown too):
+    one that is a link or of the wrong kind is refused as each is checked (``output_subfolder``...)."""
+    return name in names or any(name.startswith(f".{file}.") and name.endswith(".tmp") for file in files)
 
 
 def _refuse_inside_runs(out_dir: Path, markdown_path: Path, figures_dir: Path) -> None:

@@ -45,6 +45,24 @@ def builtin_folder() -> Path | None:
     return None
 
 
+def preset_folder(presets_dir: str | Path | None, names: list[str], what: str) -> Path:
+    """``presets_dir`` (else ./presets, else the built-in presets' folder) if it holds every file of
+    ``names``; else FrictionlabError naming the folders looked in and, in ``presets_dir``, why each
+    that is not a regular file is not (a FIFO, say). ``what`` says which presets they are."""
+    from ..errors import FrictionlabError
+    from ..io.inputs import regular_file_problem
+
+    candidates = [Path(presets_dir)] if presets_dir else [Path("presets"), *filter(None, [builtin_folder()])]
+    for folder in candidates:
+        if all((folder / name).is_file() for name in names):
+            return folder
+    given = Path(presets_dir) if presets_dir and Path(presets_dir).is_dir() else None
+    problems = {name: regular_file_problem(given / name) for name in names} if given else {}
+    which = "; ".join(f"{name}: {problem}" for name, problem in problems.items() if problem)
+    which = f" (in {shown_name(given)}, {which})" if which else ""
+    raise FrictionlabError(f"--presets: no folder with {what}; looked in {', '.join(map(shown_name, candidates))}{which}")
+
+
 def builtin_presets() -> list[BuiltinPreset]:
     """Every built-in preset, by name; the description is the first line of the
     preset's own ``description`` (or of its leading comment if it has none)."""

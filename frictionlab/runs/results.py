@@ -37,7 +37,7 @@ from ..compute.fit import json_safe
 from ..preset import Scene
 from ..preset.schema import MAX_BOOTSTRAP
 from .import_ahead import PLOT_MODULE, imported
-from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json, read_number_table
+from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json, read_number_table
 
 SUMMARY_SCHEMA_VERSION = 2  # 2: "normalisation" says what the load means and defines f per solver
 CURVE_COLUMNS = (
@@ -275,7 +275,7 @@ class SummaryRecord(Record):
     realizations: _Counts
     normalisation: _Normalisation = _Normalisation()
     caveats: list[str] = []
-    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
+    elapsed_seconds: Seconds = 0.0
     contact_count_at_first_load: Finite | None = None
     contact_count_at_last_load: Finite | None = None
     files: dict[str, MemberName] = {}

@@ -53,6 +53,7 @@ LOCK_FILE = "run.lock"
 STATE_FILE = "run.json"
 PRESET_FILE = "preset.yaml"
 MANIFEST_FORMAT = 2
+MANIFEST_STATUSES = ("running", "completed", "interrupted", "cancelled", "failed")  # what start and finish write
 MAX_MANIFEST_BYTES = 64 * 1024 * 1024  # ~4096 chunks of ~100 bytes each, with ample room
 # what a run killed while it started leaves (atomic_write's temporary files of its own names)
 START_LEFTOVER = re.compile(rf"\.(?:{re.escape(PRESET_FILE)}|{re.escape(STATE_FILE)})\.\w+\.tmp")
@@ -207,6 +208,9 @@ class RunDirectory:
                 raise RunFolderError(f"{shown_name(path)} is damaged ({key} is not {what}, but {json_kind(value)})")
             if value is not None and not _well_formed(key, value):
                 raise RunFolderError(f"{shown_name(path)} is damaged ({key} is not {what}: an entry is not a string)")
+        if state.get("status") is not None and state["status"] not in MANIFEST_STATUSES:  # listed as it was, unexplained
+            raise RunFolderError(f"{shown_name(path)} is damaged (status is {shown(repr(state['status'][:80]))}, not one "
+                                 f"of {', '.join(MANIFEST_STATUSES)})")  # fmt: skip
         return state
 
     def _write_manifest(self) -> None:

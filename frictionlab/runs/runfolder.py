@@ -49,6 +49,9 @@ MemberName = Annotated[str, AfterValidator(_member)]
 """A schema field that names a file (or folder) of the run folder."""
 Finite = Annotated[float, Field(allow_inf_nan=False, strict=True)]
 Count = Annotated[int, Field(ge=0, strict=True)]
+MAX_WALL_SECONDS = 1e9  # some 30 years: a wall time past it is no run's (1e300 s was shown in 300 digits)
+Seconds = Annotated[float, Field(ge=0, le=MAX_WALL_SECONDS, allow_inf_nan=False, strict=True)]
+"""A wall time a run folder's file records."""
 
 
 class Record(BaseModel):

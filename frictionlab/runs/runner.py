@@ -10,13 +10,13 @@ from pathlib import Path
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..compute.executors import dask_memory_limits
-from ..errors import RunError
+from ..errors import RunError, RunFolderError
 from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
 from .import_ahead import PlotImportAhead
-from .results import add_plot, write_results
+from .results import add_plot, holds_results, read_summary, results_on_disk, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
 
@@ -139,3 +139,24 @@ def run_to_folder(
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
             run_dir.finish(scene, outcome.status)
     return outcome, files
+
+
+def read_back(scene: Scene, folder: Path, listeners: Iterable[object] = (), plot: bool = True) -> RunOutcome | None:
+    """The outcome of a completed run of ``scene`` found with its files in ``folder``, read back
+    (its listeners hear it restored) without writing anything, its ``elapsed`` the wall time its
+    summary.json recorded when it was computed and ``extra["read_back"]`` set: None where it must
+    run again, which writes them again (``results_on_disk``; a curve.csv or realizations.npz not of
+    its results, a damaged summary.json)."""
+    if not results_on_disk(folder, scene, plot):
+        return None
+    done = RunDirectory(folder).completed_results(scene)
+    if done is None or not holds_results(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
+        return None  # its listeners hear it run again, not restored first
+    try:
+        recorded = read_summary(folder)[1].elapsed_seconds
+    except RunFolderError:
+        return None
+    outcome = engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
+    outcome.elapsed = recorded
+    outcome.extra["read_back"] = True
+    return outcome

@@ -36,12 +36,12 @@ from ..preset.schema import ensemble_settings, first_repeat
 from ..preset.problems import fold_point_problems
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
-from .results import holds_results, results_on_disk, write_figure
+from .results import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder
 from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, write_tables
 from ..compute.memory import estimate
-from .runner import check_memory, run_to_folder
+from .runner import check_memory, read_back, run_to_folder
 
 UNFINISHED = ("pending", "interrupted", "cancelled")  # a point's statuses that do not count it as done
 
@@ -64,7 +64,9 @@ class SweepPoint:
         return [f"{path}={yaml_scalar(v)}" for path, v in self.values.items()]
 
     def describe(self) -> str:
-        return ", ".join(self.assignments)
+        """Its assignments as messages and tables show them, each cut past 80 characters (a swept
+        description of pages said them whole, in each message naming the point)."""
+        return ", ".join(a if len(a) <= 80 else a[:77] + "..." for a in self.assignments)
 
     def __repr__(self) -> str:  # its scene, every default filled in, is too long to read
         return f"<SweepPoint {self.number}: {self.describe()}, folder {self.folder_name!r}>"
@@ -325,7 +327,7 @@ def _run_points(
             continue
         run_listeners = [each for listener in listeners for each in listener.run_listeners(point)]
         started = (folder / STATE_FILE).exists()  # a resumed sweep starts afresh the points it never reached
-        finished = _read_back(point.scene, folder, run_listeners, plot) if started and options.resume else None
+        finished = read_back(point.scene, folder, run_listeners, plot) if started and options.resume else None
         if finished is not None:
             yield PointResult(point, finished.status, folder, outcome=finished, error=finished.error)
             continue
@@ -342,20 +344,6 @@ def _run_points(
         yield PointResult(point, outcome.status, folder, outcome=outcome, error=outcome.error)
         if outcome.status in ("cancelled", "interrupted"):
             return
-
-
-def _read_back(scene: Scene, folder: Path, listeners: list, plot: bool):
-    """The outcome of a point a resumed sweep finds completed with its files, read back (its
-    listeners hear it restored) without writing anything: None where it must run again, which
-    writes them again (``results_on_disk``; a curve.csv or realizations.npz not of its results)."""
-    from ..compute import engine
-
-    if not results_on_disk(folder, scene, plot):
-        return None
-    done = RunDirectory(folder).completed_results(scene)
-    if done is None or not holds_results(folder, scene, engine.run(scene, RunOptions(workers=1), restored=done)):
-        return None  # its listeners hear it run again, not restored first
-    return engine.run(scene, RunOptions(workers=1), listeners=listeners, restored=done)
 
 
 def run_sweep(

@@ -12,7 +12,7 @@ from pydantic import Field, ValidationError, model_validator
 from ..errors import RunFolderError, shown, shown_name
 from ..preset.paths import MISSING, get_path
 from ..preset.schema import SweepSettings
-from .runfolder import Count, Finite, MemberName, Record, check_schema_version, checked, read_json
+from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json
 
 SWEEP_SCHEMA_VERSION = 1
 MAX_SWEEP_RECORD_BYTES = 64 * 1024 * 1024  # a sweep.json holds a row per point: at most 1000 of them
@@ -27,7 +27,7 @@ class PointRecord(Record):
     label: str | None = None
     set: list[str] | None = None  # the point's --set options
     done: Count | None = None
-    elapsed_s: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] | None = None
+    elapsed_s: Seconds | None = None
     contact_first: Finite | None = None
     contact_last: Finite | None = None
     a: Finite | None = None
@@ -60,7 +60,7 @@ class SweepRecord(Record):
     schema_version: Annotated[int, Field(ge=1, strict=True)] = 1
     name: Annotated[str, Field(min_length=1)]
     status: Literal["running", "completed", "interrupted", "failed"]  # SweepOutcome's
-    elapsed_seconds: Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)] = 0.0
+    elapsed_seconds: Seconds = 0.0
     points: list[PointRecord]
 
 

@@ -116,6 +116,22 @@ def not_length_label(text: str) -> tuple[str, str] | None:
     return None
 
 
+_BRACKETED = re.compile(r"\[\s*([^\[\]\s,;]*[^\W\d_][^\[\]\s,;]*)\s*\]")  # "x [furlong]": a word in brackets
+
+
+def unknown_unit_label(text: str) -> tuple[str, str] | None:
+    """The column label over the numbers of ``text`` (its header's last line) that names in square
+    brackets a unit that is neither a length unit nor one of what is no length (``x [furlong]``,
+    ``t [s]``), and that unit; None when there is none."""
+    labels = next((line for line in reversed(header_lines(text)) if line.strip()), "")
+    known = re.compile(rf"{_UNITS}|{IMPERIAL}|{NOT_LENGTH}")
+    for found in _BRACKETED.finditer(labels):
+        if not known.fullmatch(found[1]):
+            start = max(labels.rfind(mark, 0, found.start()) for mark in ",;\t#])") + 1  # the label's cell
+            return labels[start : found.end()].strip(), found[1]
+    return None
+
+
 def check_heights_are_lengths(text: str, where: str) -> None:
     """Refuse a file whose header labels a column in a unit that is no length (an AFM's channel
     in volts, amperes, degrees, hertz): its numbers are not heights, and were read as heights in
@@ -145,6 +161,15 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> str |
     with open_input(path, where) as fh:
         head = head_text(fh, "utf-8-sig")
     check_heights_are_lengths(head, where)
+    if (unknown := unknown_unit_label(head)) is not None:  # read bare, in the preset's unit, without a word
+        from .instrument_file import LENGTH_UNITS  # here: it imports this module
+        from .instrument_reader import quoted
+
+        raise ValueError(
+            f"{where}: its header's {quoted(unknown[0])} names the unit {quoted(unknown[1])}, which is no unit "
+            f"frictionlab knows (length units: {', '.join(LENGTH_UNITS)}): its numbers would be taken bare, the "
+            "slopes off by an unknown ratio; convert the column to a length unit and label it so"
+        )
     units, export = named_units(head)
     if export and format == "auto":
         raise ValueError(

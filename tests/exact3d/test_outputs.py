@@ -189,3 +189,17 @@ def test_an_edited_time_file_counts_only_a_wall_time_a_study_can_have_taken(tmp_
 
     (tmp_path / study.TIME_FILE).write_text(text)
     assert study._time(tmp_path, study.QUICK) == seconds
+
+
+def test_an_ensembles_folder_its_run_refuses_is_refused_before_any_runs(tmp_path, capsys, monkeypatch):
+    """--runs of an earlier study whose last ensemble's folder holds files of the user's: every
+    ensemble before it ran (hours, on the full plan), then its run refused the folder. Refused first."""
+    from frictionlab.exact3d import plan
+
+    folder = tmp_path / "runs" / "h0.8-n192-bem-halfspace"
+    folder.mkdir(parents=True)
+    (folder / "notes.txt").write_text("mine")
+    monkeypatch.setattr(plan, "run_to_folder", lambda *args, **kwargs: pytest.fail("an ensemble ran"))
+    assert exact3d("--workers", "1", "--runs", tmp_path / "runs", "--out", tmp_path / "page") == ExitCode.OUTPUT_REFUSED
+    assert f"{folder} is not empty and is not a frictionlab run folder (it holds 'notes.txt')" in capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "runs").iterdir()) == [folder.name]

@@ -4,6 +4,8 @@ and figures, the refusal to overwrite, a second invocation that resumes every en
 
 import json
 import math
+import os
+import shutil
 
 import numpy as np
 import pytest
@@ -396,6 +398,19 @@ def test_a_full_disk_at_a_runs_figure_says_how_to_resume_too(tmp_path, capsys, m
     err = capsys.readouterr().err
     assert err.endswith(f"/plot.png: No space left on device; the numbers are written; the ensembles that finished are "
                         f"kept in {runs}; run the command again with --runs {runs} to resume\n")  # fmt: skip
+
+
+def test_a_presets_folder_names_the_file_that_is_not_a_regular_one(tmp_path, capsys, monkeypatch):
+    """A family with exact3d-h07.yaml a FIFO was refused as 'no folder with exact3d-h03.yaml, ...' without
+    a word of which file, or why: named as the report names its presets."""
+    monkeypatch.chdir(tmp_path)
+    folder = tmp_path / "presets"
+    shutil.copytree(PRESETS, folder)
+    (folder / "exact3d-h07.yaml").unlink()
+    os.mkfifo(folder / "exact3d-h07.yaml")
+    code = main(["exact3d", "--quick", "--presets", str(folder), "--out", str(tmp_path / "out"), "--quiet"])
+    assert code == ExitCode.USAGE
+    assert "exact3d-h07.yaml: is a FIFO (named pipe), not a regular file" in capsys.readouterr().err
 
 
 def test_out_of_memory_making_a_presets_surface_gives_advice_that_fits_the_study(tmp_path, capsys, monkeypatch):

@@ -12,8 +12,9 @@ import pytest
 import yaml
 
 from frictionlab.cli import main
-from frictionlab.errors import ExitCode
+from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.paper.figures import FIGURES
+from frictionlab.paper.reproduce import report_paths
 from frictionlab.preset import apply_overrides, load_preset_file
 
 from ..conftest import PRESETS
@@ -220,3 +221,64 @@ def test_a_report_that_cannot_be_written_says_that_the_runs_are_kept(tmp_path, c
     assert capsys.readouterr().err == (
         f"error: cannot write {out}/REPRODUCTION.md: No space left on device; the runs that finished are kept in "
         f"{out}: the report run again with the same --out continues them (reading them back)\n")  # fmt: skip
+
+
+def test_an_out_that_holds_other_files_is_refused_before_anything_runs(tmp_path, capsys):
+    """--out naming a folder of the user's (not empty, not a report's) was filled with the report's runs,
+    figures and REPRODUCTION.md: refused (exit 4) naming what it holds, and nothing is written there."""
+    out = tmp_path / "mine"
+    (out / "data").mkdir(parents=True)
+    (out / "notes.txt").write_text("mine")
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
+    assert code == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert f"--out {out} is not empty and is not the folder of an earlier report (it holds 'data', 'notes.txt')" in err
+    assert "--force" in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == ["data", "notes.txt"] and not any((out / "data").iterdir())
+
+
+def test_an_out_of_an_earlier_report_is_taken(tmp_path):
+    """What an earlier report left in its --out (its runs, figures/, REPRODUCTION.md, a temporary
+    file of it), and the figures folder asked for in it, are not the user's files."""
+    out = tmp_path / "out"
+    for name in ("fig2", "fig5", "readings", "fig5-calibrated", "figures", "pngs"):
+        (out / name).mkdir(parents=True)
+    for name in ("REPRODUCTION.md", ".REPRODUCTION.md.x1y2.tmp"):
+        (out / name).write_text("")
+    assert report_paths(out, tmp_path / "other.md", out / "pngs")[0] == out
+    (out / "mine.md").write_text("")
+    with pytest.raises(OutputRefused, match="it holds 'mine.md', 'pngs'"):
+        report_paths(out, tmp_path / "other.md", tmp_path / "figs")
+    assert report_paths(out, out / "new.md", tmp_path / "figs", force=True)[0] == out  # --force writes into it
+
+
+@pytest.mark.parametrize("markdown", ["out/figures/fig2.png", "figs/fig5-calibrated.png"])
+def test_a_markdown_that_is_one_of_the_reports_figures_is_refused(tmp_path, capsys, markdown):
+    """--markdown OUT/figures/fig2.png: Fig. 2 was drawn, then the report written over it, linking to
+    itself as the figure. Refused before any run (exit 4)."""
+    out = tmp_path / "out"
+    figures = ["--figures", str(tmp_path / "figs")] if markdown.startswith("figs/") else []
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), *figures, "--markdown", str(tmp_path / markdown),
+                 "--quiet"])  # fmt: skip
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert f"--markdown {tmp_path / markdown} is a figure the report draws in" in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("key", ["fig4", "fig5"])
+def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, key):
+    """--out of an earlier report whose fig4 (or fig5) holds files of the user's: Figs. 2 and 3 ran
+    for minutes, then Fig. 4's run refused its folder. Refused before any figure runs (exit 4)."""
+    out = tmp_path / "r"
+    (out / key).mkdir(parents=True)
+    (out / key / "notes.txt").write_text("mine")
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a figure ran before every figure's folder was checked")
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert f"{out / key} is not empty and is not" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == [key] and (out / key / "notes.txt").read_text() == "mine"

@@ -7,6 +7,7 @@ import json
 import math
 import os
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -161,6 +162,26 @@ def test_report_writes_into_a_fresh_folder_and_overwrites_nothing_without_force(
     assert not (tmp_path / "runs").exists()  # refused before its default folder was made
 
 
+def test_a_report_run_again_into_its_out_shows_the_wall_time_recorded_when_each_run_was_computed(tiny_report, tiny_presets, tmp_path):
+    """Run again into the same --out, the runs read back were shown as '6 realizations in 0.00 s' (the
+    time of reading them back), their summary.json rewritten with it: the recorded time is shown, kept."""
+    folder, done = tiny_report
+    out = tmp_path / "out"
+    shutil.copytree(folder / Path(json.loads(done.stdout)["report"]).parent, out)
+    summaries = {key: (out / key / "summary.json").read_bytes() for key in ("fig2", "fig3", "fig4")}
+    again = run_cli("report", "--presets", tiny_presets, "--out", out, "--markdown", tmp_path / "again.md",
+                    "--figures", tmp_path / "figures", "--quiet", "--workers", "1")  # fmt: skip
+    assert again.returncode == ExitCode.OK, again.stderr
+    text = (tmp_path / "again.md").read_text()
+    for key, summary in summaries.items():
+        assert (out / key / "summary.json").read_bytes() == summary  # read back, not rewritten
+        took = json.loads(summary)["elapsed_seconds"]
+        assert f"realizations in {took:.2f} s when computed (read back)" in text
+    points = json.loads((out / "fig5" / "sweep.json").read_text())["points"]
+    assert all(point["elapsed_s"] > 0 for point in points)  # each point's own time, kept (was 0.0)
+    assert "were read back, not run again" in text
+
+
 @pytest.mark.parametrize("linked", ["fig5", "figures"])
 def test_a_link_at_a_figures_or_a_runs_folder_is_refused_before_anything_runs(tiny_presets, tmp_path, capsys, linked):
     """--out holding a link at fig5 (a figure's run folder) or figures/: the report wrote the run,
@@ -209,8 +230,9 @@ def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     assert rows[2].fit.a == pytest.approx(np.polyfit(np.log(runs[0].outcome.f), pooled, 1)[1], rel=1e-9)
     text = "\n".join(readings_markdown(rows))
     assert "`slope.name=spectral`" in text and f"{rows[1].fit.a:.4f}" in text
+    summary = (tmp_path / "readings" / "02-fig2" / "summary.json").read_bytes()
     again = run_readings(runs, tmp_path, RunOptions(workers=1), readings=readings)  # the report run again: read back
-    assert json.loads((tmp_path / "readings" / "02-fig2" / "summary.json").read_text())["resumed_realizations"] == 6
+    assert (tmp_path / "readings" / "02-fig2" / "summary.json").read_bytes() == summary  # not rewritten
     assert [(r.fit.a, r.fit.b) for r in again] == pytest.approx([(r.fit.a, r.fit.b) for r in rows], rel=1e-12)
 
 
@@ -318,13 +340,13 @@ def test_a_report_run_again_continues_its_stopped_and_finished_runs(tiny_presets
     state = json.loads((out / "fig2" / "run.json").read_text())
     (out / "fig2" / "run.json").write_text(json.dumps({**state, "status": "interrupted"}))
     point = out / "fig5" / "points" / "01-hurst-0.6" / "summary.json"
-    before = point.read_bytes()
+    before = {path: path.read_bytes() for path in (point, out / "fig3" / "summary.json", out / "fig4" / "summary.json")}
     recwarn.clear()
     runs = run_figures(tiny_presets, out, RunOptions(workers=1))
     assert all((run.sweep_outcome or run.outcome).status == "completed" for run in runs)
-    for key in ("fig2", "fig3", "fig4"):
-        assert json.loads((out / key / "summary.json").read_text())["resumed_realizations"] == 6, key
-    assert point.read_bytes() == before  # a finished point is read back, not run again
+    assert json.loads((out / "fig2" / "summary.json").read_text())["resumed_realizations"] == 6
+    assert [bool(run.outcome.extra.get("read_back")) for run in runs[:3]] == [False, True, True]
+    assert all(path.read_bytes() == held for path, held in before.items())  # finished runs read back, not run again
     assert not [w for w in recwarn if "runs again" in str(w.message)]
     run_figures(tiny_presets, out, RunOptions(workers=1, force=True))  # --force: every run afresh
     assert json.loads((out / "fig2" / "summary.json").read_text())["resumed_realizations"] == 0
