@@ -244,7 +244,7 @@ def test_spots_reach_curve_csv_and_grow_from_a_few(tmp_path):
 
 @pytest.mark.parametrize("attr", ["real_gradient", "counts_spots"])
 def test_a_declaration_that_is_not_a_bool_is_refused_naming_it(attr):
-    from frictionlab.plugin.registry import declaration_problems
+    from frictionlab.plugin.classcheck import declaration_problems
 
     broken = type("Broken", (BEMHalfSpace,), {attr: "yes", "name": "broken-bem"})
     assert any(attr in p and "True or False" in p for p in declaration_problems(broken))

@@ -24,7 +24,7 @@ import pluggy
 
 from ..errors import PluginError, did_you_mean, short_repr, warn_user
 from .base import Plugin
-from .classcheck import declaration_problems, params_problem, validate_plugin_class  # noqa: F401 - read here by the kit
+from .classcheck import params_problem, validate_plugin_class
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .kinds import KINDS
 from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener, fault_site

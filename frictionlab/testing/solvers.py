@@ -82,7 +82,7 @@ def check_solver(cls, **params) -> None:
     (a whole number >= 0, a finite residual >= 0), and any solver that calls it lets the
     ``SolveCancelled`` it raises in a cancelled run propagate, neither swallowed nor wrapped:
     so a run shows a long load's progress and stops on Ctrl-C. (Registration itself checks that every declaration is
-    well formed: ``registry.declaration_problems``.)
+    well formed: ``classcheck.declaration_problems``.)
     """
     solver = instantiate(cls, params)
     from frictionlab.plugin.outputs import answers_problem
