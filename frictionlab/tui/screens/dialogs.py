@@ -200,7 +200,7 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
 
     def body(self) -> ComposeResult:
         yield Label(Content(self.title_text), classes="heading")
-        yield SubmitInput(str(self.default), "Save", id="path-input")
+        yield SubmitInput(str(self.default), "Save", name="path", id="path-input")
         yield Static("", id="path-error", classes="field-error")
         yield Label("Enter: save    Esc: cancel", classes="hint")
 
@@ -239,7 +239,7 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         yield Label("New preset", classes="heading")
         with Horizontal(classes="row"):
             yield Label("name", classes="field-label")
-            yield SubmitInput("my-scene", "Create", id="new-name", compact=True)
+            yield SubmitInput("my-scene", "Create", name="name", id="new-name", compact=True)
         with Horizontal(classes="row"):
             yield Label("start from", classes="field-label")
             if self.templates:
@@ -251,7 +251,8 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
                 yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
         with Horizontal(classes="row"):
             yield Label("save as", classes="field-label")
-            yield SubmitInput(str(new_preset_path("my-scene", self.folder)), "Create", id="new-path", compact=True)
+            default = str(new_preset_path("my-scene", self.folder))
+            yield SubmitInput(default, "Create", name="path", id="new-path", compact=True)
         yield Static("", id="new-error", classes="field-error")
         yield Button("Create", id="new-create", compact=True)
         yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
