@@ -208,3 +208,35 @@ async def test_the_form_at_30x8_keeps_rows_beside_the_help_and_problems(folders,
         await press_settled(pilot, "enter")
         rows, text = app.query_one("#form").region.height, screen_text(app)
     assert rows >= 2 and any(line.startswith("name") for line in text.splitlines()), text
+
+
+async def screens_while(pilot, *keys) -> list[str]:
+    """The screen, then again after each key of ``keys``."""
+    seen = [screen_text(pilot.app)]
+    for key in keys:
+        await press_settled(pilot, key)
+        seen.append(screen_text(pilot.app))
+    return seen
+
+
+@sync
+async def test_a_runs_fit_at_30x8_is_reached_on_the_run_and_results_tabs(folders, registry):
+    """At 30x8 the Run tab's fit was below the progress, out of sight, and no key scrolled to it;
+    the Results tab kept its list 40 columns wide and the plot and its box beside it, off the screen.
+    The Run tab scrolls with the arrows; the Results list takes the width, its box under it,
+    which Tab goes to and the arrows scroll."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        run_screens = await screens_while(pilot, *["down"] * 20)
+        await press_settled(pilot, "f5", "enter")
+        listed = screen_text(app)
+        results_screens = await screens_while(pilot, "tab", *["down"] * 20)
+    _, _, fit = ended(app)
+    interval = f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]"
+    assert any(interval in screen and "a = " in screen for screen in run_screens), run_screens[-1]
+    assert any(f"R^2 = {fit.r2:.4f}" in screen for screen in run_screens), run_screens[-1]
+    assert "✓" in listed and next((folders / "runs").iterdir()).name[-6:] in listed, listed
+    assert any(interval in screen for screen in results_screens), "\n=====\n".join(results_screens[:3])
+    assert any(f"R^2={fit.r2:.4f}" in screen for screen in results_screens), results_screens[-1]

@@ -111,6 +111,9 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         Binding("r", "not_run", show=False, system=True),
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
+        # under 12 rows (30x8) the fit is below the progress, out of sight: the tab scrolls (app.tcss)
+        Binding("up", "scroll_up", "Scroll up", tooltip="the tab, where it is taller than the screen (30x8)", show=False),
+        Binding("down", "scroll_down", "Scroll down", tooltip="the tab, where it is taller than the screen (30x8)", show=False),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
         *said_when_hidden(("c", "cancel"), ("u", "resume")),
     ]
