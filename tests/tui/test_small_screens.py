@@ -245,13 +245,17 @@ async def test_a_runs_fit_at_30x8_is_reached_on_the_run_and_results_tabs(folders
 @sync
 async def test_an_open_sweeps_points_at_30x8_are_each_reached_with_the_arrows(folders, registry):
     """At 30x8 an open sweep's points took the rows the list's own row needed, and its sideways
-    scroll bar the row of a point: the arrows moved among points none of which was on the screen."""
+    scroll bar the row of a point: the arrows moved among points none of which was on the screen.
+    On the Run tab the sweep's line was cut at 30 columns."""
     app = sweep_app(folders, registry)
     async with app.run_test(size=(30, 8)) as pilot:
         await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        run_screens = await screens_while(pilot, *["down"] * 6)
         await press_settled(pilot, "f5", "enter")
         screens = await screens_while(pilot, "down", "down")
     sweep = next((folders / "runs").iterdir()).name
+    assert any("sweep.png)" in screen for screen in run_screens), run_screens  # its line wrapped, not cut at 30
     assert all(sweep[-6:] in screen for screen in screens), screens[0]
     for number, screen in zip((1, 2, 3), screens, strict=True):
         assert any(line.split()[:1] == [str(number)] and "✓" in line for line in screen.splitlines()), screen
