@@ -259,3 +259,16 @@ async def test_an_open_sweeps_points_at_30x8_are_each_reached_with_the_arrows(fo
     assert all(sweep[-6:] in screen for screen in screens), screens[0]
     for number, screen in zip((1, 2, 3), screens, strict=True):
         assert any(line.split()[:1] == [str(number)] and "✓" in line for line in screen.splitlines()), screen
+
+
+@sync
+async def test_the_presets_list_at_30x8_shows_a_presets_whole_name(folders, registry):
+    """At 30x8 the list kept its three columns and gave the name 8 (``ben…fig2``): under 60 columns
+    the file column is left out (the line under the list names the file) and the name gets the room."""
+    for name in ("benad2012-fig2", "exact3d-h08-rolloff"):
+        (folders / "presets" / f"{name}.yaml").write_text(yaml.safe_dump({**TINY, "name": name}))
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        screens = await screens_while(pilot, *["down"] * 3)
+    for name in ("benad2012-fig2", "exact3d-h08-rolloff"):
+        assert any(name in screen for screen in screens), "\n".join(screens)
