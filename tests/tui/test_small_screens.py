@@ -272,3 +272,21 @@ async def test_the_presets_list_at_30x8_shows_a_presets_whole_name(folders, regi
         screens = await screens_while(pilot, *["down"] * 3)
     for name in ("benad2012-fig2", "exact3d-h08-rolloff"):
         assert any(name in screen for screen in screens), "\n".join(screens)
+
+
+@sync
+async def test_a_run_at_30x8_shows_its_progress_first(folders, registry):
+    """At 30x8 the run's title (two lines) and folder took the rows the status line left: its
+    progress bar and counts were below them, out of sight while it ran. The tab starts at the
+    progress; Up shows the title."""
+    import re
+
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        shown = screen_text(app)
+        above = await screens_while(pilot, *["up"] * 4)
+    assert any(re.fullmatch(r"━{25,}\W?", line.rstrip()) for line in shown.splitlines()), shown  # the bar, 100 %
+    assert "completed: 8/8 realizations" in shown.replace(" Run completed", ""), shown
+    assert any("small: 8 realizations" in screen for screen in above), above[-1]
