@@ -72,3 +72,22 @@ async def test_control_characters_pasted_are_left_out_and_said(folders, registry
     saved = load_yaml((folders / "presets" / "tiny.yaml").read_text(encoding="utf-8"))
     assert saved["description"] == field.value == "Rough[31m line, flat"
     assert "description" in said and "\\x1b" in said and "\\x07" in said, said
+
+
+@sync
+async def test_control_characters_pasted_into_a_dialogs_field_are_said_in_the_dialog(folders, registry):
+    """The status line, where the form's field says what a paste left out, is under a dialog
+    that fills a 30x8 screen: the dialog says it in its own error line."""
+    from .conftest import press_settled
+
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "n")
+        field = app.screen.query_one("#new-name", Input)
+        field.post_message(events.Paste("\x1b[1mrough"))
+        await pilot.pause()
+        await pilot.pause()
+        line = app.screen.query_one("#new-error")
+        said = " ".join(str(line.render()).split()) if line.display else ""
+    assert field.value.endswith("[1mrough"), field.value
+    assert "name: the paste's control characters \\x1b" in said, said

@@ -76,6 +76,11 @@ class Dialog(ModalScreen):
         if status and str(status.first().render()) == WAIT_FOR_DIALOG:
             self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
 
+    def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
+        """What a paste left out, in the dialog's error line: the status line may be under it (30x8)."""
+        event.stop()  # it comes after the Changed the paste posted, which clears that line
+        show_error(self.query_one(".field-error", Static), event.text)
+
     def action_scroll_dialog(self, lines: int) -> None:
         self.query_one(".dialog").scroll_relative(y=lines, animate=False)
 
@@ -258,7 +263,8 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
-        show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
+        if event.input.id == "new-name" or event.input.has_focus:  # not the file following the name
+            show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
         if event.input.id == "new-name" and not self.path_edited:
             name = event.value.strip() or "my-scene"
             self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))

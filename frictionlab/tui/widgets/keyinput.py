@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 from textual import events
+from textual.message import Message
 from textual.widgets import Input
 
 from ...errors import shown
@@ -40,6 +41,14 @@ class KeyInput(Input):
 
     typed = False
 
+    class LeftOut(Message):
+        """A paste's control characters were left out; ``text`` says which, naming the field (the
+        app says it in the status line, a dialog, which may cover that line at 30x8, in its own)."""
+
+        def __init__(self, text: str):
+            super().__init__()
+            self.text = text
+
     async def _on_key(self, event: events.Key) -> None:
         self.typed = True
         bindings = self._bindings.key_to_bindings.get(event.key)
@@ -62,11 +71,9 @@ class KeyInput(Input):
                 self.insert_text_at_cursor(text)
             else:
                 self.replace(text, *self.selection)
-        say = getattr(self.app, "say", None)
-        if dropped and say is not None:
-            field = self.name or self.id or "field"
-            say(f"{field}: the paste's control characters {', '.join(dropped)} were left out "
-                "(a field holds text only)", severity="warning")  # fmt: skip
+        if dropped:  # after the Changed the insertion posted: a dialog clears its error line on that
+            self.post_message(self.LeftOut(f"{self.name or self.id or 'field'}: the paste's control characters "
+                                           f"{', '.join(dropped)} were left out (a field holds text only)"))  # fmt: skip
 
     def action_copy(self) -> None:
         """Ctrl+C copies here, and says (as it does elsewhere) what quits."""
