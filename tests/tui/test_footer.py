@@ -197,6 +197,7 @@ async def test_cancel_leaves_the_footer_once_the_runs_last_event_came_while_its_
     assert said == "The run has ended: its files are being written; nothing is left to cancel."
 
 
+@pytest.mark.long  # two finished runs made first, then a TUI session through the four tabs: seconds
 @sync
 async def test_a_30_column_footer_shows_whole_keys_and_keeps_f1(folders, registry):
     """At 30 columns the footer ran past the edge and Textual cut its last key to a stray `^`
