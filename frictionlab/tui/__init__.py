@@ -33,9 +33,10 @@ def run_app(
             "without one, run presets headless: frictionlab run PRESET"
         )
     from .app import FrictionlabApp
-    from .keyorder import keep_escape_before_control_keys
+    from .keyorder import keep_escape_before_control_keys, paste_keeps_escapes
 
     keep_escape_before_control_keys()
+    paste_keeps_escapes()
     start_process_helpers()
     app = FrictionlabApp(preset, presets_dir=presets_dir, runs_dir=runs_dir, options=options)
     from ..compute.signals import HANDLED

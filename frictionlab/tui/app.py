@@ -57,6 +57,7 @@ from .widgets.presets import NO_PRESETS, PresetsPane
 if TYPE_CHECKING:
     from .following import FollowedRun
     from .widgets import PresetForm
+    from .widgets.keyinput import KeyInput
 
 FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress moves at least this often
 WATCH_SECONDS = 0.5  # how often the runs and presets folders and the open preset's file are looked at: a run or
@@ -282,6 +283,9 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.query_one("#status-box").scroll_home(animate=False)  # a message read from its start
         for name in ("information", "warning", "error"):
             status.set_class(name == severity, f"-{name}")
+
+    def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
+        self.say(event.text, "warning")
 
     # ------------------------------------------------------------ presets
 

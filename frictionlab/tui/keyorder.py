@@ -12,7 +12,8 @@ highlighted row, and Down Down d typed fast duplicated the row the cursor was on
 Esc then a key within the terminal's escape delay (0.1 s: a fast typist, or keystrokes that
 SSH sends joined) reaches the app as one Alt+key, and a field typed its letter: this app
 binds no Alt key, so such a key is read as the two keys typed. Esc joined to a control key
-(Ctrl+S, Ctrl+R, Enter) lost the Esc in Textual's parser itself: ``keep_escape_before_control_keys``.
+(Ctrl+S, Ctrl+R, Enter) lost the Esc in Textual's parser itself: ``keep_escape_before_control_keys``;
+an ESC inside a paste made the rest of it keys: ``paste_keeps_escapes``.
 """
 
 from __future__ import annotations
@@ -77,3 +78,62 @@ def keep_escape_before_control_keys() -> None:
 
     sequence_to_key_events.keeps_escape = True
     XTermParser._sequence_to_key_events = sequence_to_key_events
+
+
+PASTE_START, PASTE_END = "\x1b[200~", "\x1b[201~"
+PASTED_ESC = "\ufdd0"  # a noncharacter: stands for an ESC inside a paste until the paste is whole
+
+
+def paste_keeps_escapes() -> None:
+    """An ESC inside a paste (text copied with its colour codes) ended the paste there for
+    Textual's parser: the paste stopped at it and the rest arrived as keys before it, typed
+    (``^[31m``), or acting where no field has the focus (q quits, c cancels a run). The
+    parser is handed such an ESC as a stand-in character, given back in the paste's text
+    (where the field leaves it out, saying so)."""
+    from textual._xterm_parser import XTermParser
+
+    feed = XTermParser.feed
+    if getattr(feed, "keeps_pasted_escapes", False):
+        return
+
+    def feed_pastes_whole(self, data: str):
+        text = _escapes_in_pastes_replaced(self, data)
+        chunks = [text] if text else []  # never "" for a read all held: "" is the input's end
+        if not data:
+            chunks.append("")  # the end, after what was held
+        for chunk in chunks:
+            for token in feed(self, chunk):
+                if isinstance(token, events.Paste):
+                    token.text = token.text.replace(PASTED_ESC, "\x1b")
+                yield token
+
+    feed_pastes_whole.keeps_pasted_escapes = True
+    XTermParser.feed = feed_pastes_whole
+
+
+def _escapes_in_pastes_replaced(parser, data: str) -> str:
+    """``data`` with each ESC inside a paste but the one of its end marker as ``PASTED_ESC``;
+    what may begin the end marker at the end of ``data`` is held for the next read (``""``: the end)."""
+    text = getattr(parser, "_held_in_paste", "") + data
+    pasting, recent = getattr(parser, "_pasting", False), getattr(parser, "_recent", "")
+    out: list[str] = []
+    at = 0
+    while at < len(text):
+        rest = text[at : at + len(PASTE_END)]
+        if pasting and text[at] == "\x1b" and rest != PASTE_END:
+            if data and PASTE_END.startswith(rest) and at + len(rest) == len(text):
+                break  # the marker may go on in the next read
+            out.append(PASTED_ESC)
+            at += 1
+            continue
+        if pasting and rest == PASTE_END:
+            out.append(rest)
+            at += len(rest)
+            pasting, recent = False, ""
+            continue
+        out.append(text[at])
+        recent = (recent + text[at])[-len(PASTE_START) :]
+        pasting = pasting or recent == PASTE_START
+        at += 1
+    parser._held_in_paste, parser._pasting, parser._recent = text[at:], pasting, recent
+    return "".join(out)

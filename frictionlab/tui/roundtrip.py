@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import io
 import math
+import re
 
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.error import CommentMark
 from ruamel.yaml.representer import RoundTripRepresenter
+from ruamel.yaml.scalarstring import DoubleQuotedScalarString
 from ruamel.yaml.tokens import CommentToken
 
 from ..io.safe_yaml import YamlProblem, load_yaml
@@ -137,8 +139,17 @@ def _append_after(node: CommentedMap, key, text: str) -> None:
 # ------------------------------------------------------------------ merging
 
 
+# what only a double-quoted scalar carries, escaped: YAML's non-printable characters, and line
+# breaks but \n (a folded or quoted value reads them back as \n)
+_ESCAPED_ONLY = re.compile("[^\t\n\x20-\x7e\xa0-\u2027\u202a-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
 def _to_node(value):
-    """Plain dicts and lists as ruamel containers, so comments can be hung on them."""
+    """Plain dicts and lists as ruamel containers, so comments can be hung on them; text
+    that needs escapes double-quoted (ruamel keeps a key's folded or quoted style for its new value,
+    and wrote the characters raw: a file no reader takes)."""
+    if isinstance(value, str) and _ESCAPED_ONLY.search(value):
+        return DoubleQuotedScalarString(value)
     if isinstance(value, dict) and not isinstance(value, CommentedMap):
         return CommentedMap((k, _to_node(v)) for k, v in value.items())
     if isinstance(value, list) and not isinstance(value, CommentedSeq):

@@ -46,3 +46,48 @@ async def test_problems_past_the_panels_six_rows_are_reached_with_the_wheel(fold
         seen = await wheel_read(pilot, Region(0, top, SIZE[0], SIZE[1] - 2 - top))  # above the status line and footer
     assert len(app.problems) >= 6 and not shown_first
     assert any(last in rows for rows in seen), (last, seen[-1])
+
+
+@sync
+async def test_control_characters_pasted_are_left_out_and_said(folders, registry):
+    """A paste's ESC, BEL or colour code went into the field raw and was saved so into the preset:
+    a file frictionlab could no longer read (``character #x0007 is not allowed``), or (a BEL in a
+    folded description) a character lost. They are left out, a tab becomes a space, and the status
+    line names the field and what was left out."""
+    from frictionlab.io.safe_yaml import load_yaml
+
+    from .conftest import press_settled, status_text
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        field = app.query_one("#field--description", Input)
+        field.focus()
+        await pilot.pause()
+        field.post_message(events.Paste("Rough\x1b[31m line\x07,\tflat\x7f\x9b"))
+        await wait_until(pilot, lambda: form.data.get("description") is not None, timeout=10.0)
+        await pilot.pause()
+        said = status_text(app)
+        await press_settled(pilot, "escape", "ctrl+s")
+    saved = load_yaml((folders / "presets" / "tiny.yaml").read_text(encoding="utf-8"))
+    assert saved["description"] == field.value == "Rough[31m line, flat"
+    assert "description" in said and "\\x1b" in said and "\\x07" in said, said
+
+
+@sync
+async def test_control_characters_pasted_into_a_dialogs_field_are_said_in_the_dialog(folders, registry):
+    """The status line, where the form's field says what a paste left out, is under a dialog
+    that fills a 30x8 screen: the dialog says it in its own error line."""
+    from .conftest import press_settled
+
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        await press_settled(pilot, "n")
+        field = app.screen.query_one("#new-name", Input)
+        field.post_message(events.Paste("\x1b[1mrough"))
+        await pilot.pause()
+        await pilot.pause()
+        line = app.screen.query_one("#new-error")
+        said = " ".join(str(line.render()).split()) if line.display else ""
+    assert field.value.endswith("[1mrough"), field.value
+    assert "name: the paste's control characters \\x1b" in said, said

@@ -87,6 +87,18 @@ def test_new_text_values_are_spelled_so_presets_read_them_back(tmp_path):
     assert load_yaml(text) == data and "# n" in text
 
 
+def test_text_a_folded_or_quoted_value_cannot_hold_raw_is_written_escaped(tmp_path):
+    """ruamel.yaml keeps a key's folded (``>-``) or quoted style for its new value: one holding a
+    control character was written raw, a file no reader takes (``#x0001 is not allowed``), and a
+    BEL, ruamel's own fold mark, broke the line and lost the character after it."""
+    source = tmp_path / "source.yaml"
+    source.write_text("name: x  # n\ndescription: >-\n  Folded\n  text.\nnotes: 'quoted'\n")
+    data = {"name": "x", "description": "a\x07bc\x01d\re\x1bf", "notes": "q\x9bz\x85"}
+    save_preset(tmp_path / "out.yaml", data, template=source)
+    text = (tmp_path / "out.yaml").read_text()
+    assert load_yaml(text) == data and "# n" in text
+
+
 def test_the_built_in_presets_are_listed_after_the_users_and_copies_go_to_the_user(tmp_path, monkeypatch):
     from frictionlab.preset.builtin import builtin_folder
     from frictionlab.tui.folders import preset_folders, writable_folder

@@ -195,3 +195,20 @@ async def test_cancel_leaves_the_footer_once_the_runs_last_event_came_while_its_
             still_following = app.followed is not None
     assert still_following  # its outcome is read once its process is gone
     assert said == "The run has ended: its files are being written; nothing is left to cancel."
+
+
+@pytest.mark.long  # two finished runs made first, then a TUI session through the four tabs: seconds
+@sync
+async def test_a_30_column_footer_shows_whole_keys_and_keeps_f1(folders, registry):
+    """At 30 columns the footer ran past the edge and Textual cut its last key to a stray `^`
+    (`⏎ Open space Compare f1 Keys ^`): the keys past the edge are left out whole, F1's kept."""
+    make_runs(folders, registry)
+    app = make_app(registry, preset="presets/tiny.yaml")
+    lines = []
+    async with started(app, size=(30, 8)) as pilot:
+        for keys in (("f2",), ("f3",), ("f4",), ("f5",)):
+            await press_settled(pilot, *keys)
+            lines.append(footer(app).rstrip())
+    for line in lines:
+        assert "f1 Keys" in line, lines
+        assert line.endswith(("Keys", "Open", "Compare", "Save", "Run", "Edit", "Resume", "Cancel", "New")), lines

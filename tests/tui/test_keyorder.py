@@ -133,6 +133,31 @@ def test_the_terminals_parser_keeps_an_escape_joined_to_a_control_key(typed, key
 
 
 @pytest.mark.parametrize(
+    "reads",
+    [
+        ["\x1b[200~red: \x1b[31mx\x1b[0m, q\x1b[201~", "c"],
+        list("\x1b[200~red: \x1b[31mx\x1b[0m, q\x1b[201~c"),  # a read a character (a slow link)
+        ["\x1b[200~red: \x1b[31mx\x1b", "[0m, q\x1b[20", "1~c"],  # the end marker split between reads
+    ],
+    ids=["one-read", "by-character", "split"],
+)
+def test_an_escape_inside_a_paste_stays_in_the_paste(reads):
+    """Text pasted with its colour codes: Textual's parser ended the paste at its first ESC and
+    made the rest keys, sent before the paste (``^[31mx^[0m, q`` typed into a field, or, where
+    no field has the focus, q quitting). The paste is whole; the keys after it are keys."""
+    from textual._xterm_parser import XTermParser
+
+    from frictionlab.tui.keyorder import keep_escape_before_control_keys, paste_keeps_escapes
+
+    keep_escape_before_control_keys()
+    paste_keeps_escapes()
+    parser = XTermParser()
+    read = [event for data in [*reads, ""] for event in parser.feed(data)]
+    assert [(type(e).__name__, getattr(e, "text", getattr(e, "key", None))) for e in read] == [
+        ("Paste", "red: \x1b[31mx\x1b[0m, q"), ("Key", "c")]
+
+
+@pytest.mark.parametrize(
     ("keys", "name", "path"),
     [
         (["n", *"rough", "enter"], "rough", "presets/rough.yaml"),  # the name typed into New as it opens

@@ -208,3 +208,85 @@ async def test_the_form_at_30x8_keeps_rows_beside_the_help_and_problems(folders,
         await press_settled(pilot, "enter")
         rows, text = app.query_one("#form").region.height, screen_text(app)
     assert rows >= 2 and any(line.startswith("name") for line in text.splitlines()), text
+
+
+async def screens_while(pilot, *keys) -> list[str]:
+    """The screen, then again after each key of ``keys``."""
+    seen = [screen_text(pilot.app)]
+    for key in keys:
+        await press_settled(pilot, key)
+        seen.append(screen_text(pilot.app))
+    return seen
+
+
+@sync
+async def test_a_runs_fit_at_30x8_is_reached_on_the_run_and_results_tabs(folders, registry):
+    """At 30x8 the Run tab's fit was below the progress, out of sight, and no key scrolled to it;
+    the Results tab kept its list 40 columns wide and the plot and its box beside it, off the screen.
+    The Run tab scrolls with the arrows; the Results list takes the width, its box under it,
+    which Tab goes to and the arrows scroll."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        run_screens = await screens_while(pilot, *["down"] * 20)
+        await press_settled(pilot, "f5", "enter")
+        listed = screen_text(app)
+        results_screens = await screens_while(pilot, "tab", *["down"] * 20)
+    _, _, fit = ended(app)
+    interval = f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]"
+    assert any(interval in screen and "a = " in screen for screen in run_screens), run_screens[-1]
+    assert any(f"R^2 = {fit.r2:.4f}" in screen for screen in run_screens), run_screens[-1]
+    assert "✓" in listed and next((folders / "runs").iterdir()).name[-6:] in listed, listed
+    assert any(interval in screen for screen in results_screens), "\n=====\n".join(results_screens[:3])
+    assert any(f"R^2={fit.r2:.4f}" in screen for screen in results_screens), results_screens[-1]
+
+
+@sync
+async def test_an_open_sweeps_points_at_30x8_are_each_reached_with_the_arrows(folders, registry):
+    """At 30x8 an open sweep's points took the rows the list's own row needed, and its sideways
+    scroll bar the row of a point: the arrows moved among points none of which was on the screen.
+    On the Run tab the sweep's line was cut at 30 columns."""
+    app = sweep_app(folders, registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        run_screens = await screens_while(pilot, *["down"] * 6)
+        await press_settled(pilot, "f5", "enter")
+        screens = await screens_while(pilot, "down", "down")
+    sweep = next((folders / "runs").iterdir()).name
+    assert any("sweep.png)" in screen for screen in run_screens), run_screens  # its line wrapped, not cut at 30
+    assert all(sweep[-6:] in screen for screen in screens), screens[0]
+    for number, screen in zip((1, 2, 3), screens, strict=True):
+        assert any(line.split()[:1] == [str(number)] and "✓" in line for line in screen.splitlines()), screen
+
+
+@sync
+async def test_the_presets_list_at_30x8_shows_a_presets_whole_name(folders, registry):
+    """At 30x8 the list kept its three columns and gave the name 8 (``ben…fig2``): under 60 columns
+    the file column is left out (the line under the list names the file) and the name gets the room."""
+    for name in ("benad2012-fig2", "exact3d-h08-rolloff"):
+        (folders / "presets" / f"{name}.yaml").write_text(yaml.safe_dump({**TINY, "name": name}))
+    app = make_app(registry)
+    async with app.run_test(size=(30, 8)) as pilot:
+        screens = await screens_while(pilot, *["down"] * 3)
+    for name in ("benad2012-fig2", "exact3d-h08-rolloff"):
+        assert any(name in screen for screen in screens), "\n".join(screens)
+
+
+@sync
+async def test_a_run_at_30x8_shows_its_progress_first(folders, registry):
+    """At 30x8 the run's title (two lines) and folder took the rows the status line left: its
+    progress bar and counts were below them, out of sight while it ran. The tab starts at the
+    progress; Up shows the title."""
+    import re
+
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(30, 8)) as pilot:
+        await run_to_the_end(pilot)
+        await press_settled(pilot, "f4")
+        shown = screen_text(app)
+        above = await screens_while(pilot, *["up"] * 4)
+    assert any(re.fullmatch(r"━{25,}\W?", line.rstrip()) for line in shown.splitlines()), shown  # the bar, 100 %
+    assert "completed: 8/8 realizations" in shown.replace(" Run completed", ""), shown
+    assert any("small: 8 realizations" in screen for screen in above), above[-1]

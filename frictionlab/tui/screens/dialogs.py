@@ -76,6 +76,11 @@ class Dialog(ModalScreen):
         if status and str(status.first().render()) == WAIT_FOR_DIALOG:
             self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
 
+    def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
+        """What a paste left out, in the dialog's error line: the status line may be under it (30x8)."""
+        event.stop()  # it comes after the Changed the paste posted, which clears that line
+        show_error(self.query_one(".field-error", Static), event.text)
+
     def action_scroll_dialog(self, lines: int) -> None:
         self.query_one(".dialog").scroll_relative(y=lines, animate=False)
 
@@ -200,7 +205,7 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
 
     def body(self) -> ComposeResult:
         yield Label(Content(self.title_text), classes="heading")
-        yield SubmitInput(str(self.default), "Save", id="path-input")
+        yield SubmitInput(str(self.default), "Save", name="path", id="path-input")
         yield Static("", id="path-error", classes="field-error")
         yield Label("Enter: save    Esc: cancel", classes="hint")
 
@@ -239,7 +244,7 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
         yield Label("New preset", classes="heading")
         with Horizontal(classes="row"):
             yield Label("name", classes="field-label")
-            yield SubmitInput("my-scene", "Create", id="new-name", compact=True)
+            yield SubmitInput("my-scene", "Create", name="name", id="new-name", compact=True)
         with Horizontal(classes="row"):
             yield Label("start from", classes="field-label")
             if self.templates:
@@ -251,13 +256,15 @@ class NewPresetScreen(Dialog, ModalScreen[tuple[str, Path | None, Path] | None])
                 yield Static("a plugin's defaults (no preset listed to start from)", id="new-template")
         with Horizontal(classes="row"):
             yield Label("save as", classes="field-label")
-            yield SubmitInput(str(new_preset_path("my-scene", self.folder)), "Create", id="new-path", compact=True)
+            default = str(new_preset_path("my-scene", self.folder))
+            yield SubmitInput(default, "Create", name="path", id="new-path", compact=True)
         yield Static("", id="new-error", classes="field-error")
         yield Button("Create", id="new-create", compact=True)
         yield Label("Tab: next field    Enter: create    Esc: cancel", classes="hint")
 
     def on_input_changed(self, event: Input.Changed) -> None:
-        show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
+        if event.input.id == "new-name" or event.input.has_focus:  # not the file following the name
+            show_error(self.query_one("#new-error", Static), "")  # it quoted what was typed before
         if event.input.id == "new-name" and not self.path_edited:
             name = event.value.strip() or "my-scene"
             self.query_one("#new-path", Input).value = str(new_preset_path(name, self.folder))

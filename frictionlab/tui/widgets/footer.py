@@ -11,8 +11,8 @@ from textual.widgets import Footer
 
 # the actions whose keys go first where the footer is short (in this order): another key does
 # the same (q quits, Tab leaves a sweep's points), or a list that is seldom reloaded or copied;
-# F1 Keys, Save, Run and the focused part's own Open, Compare, Resume, Cancel stay (narrower
-# than these, under some 55 columns, the footer is cut at its edge again)
+# F1 Keys, Save, Run and the focused part's own Open, Compare, Resume, Cancel stay; narrower
+# than these (30 columns) the last keys go, whole, but F1's: Textual cut one at the edge to a stray ^
 LEFT_OUT_FIRST = ("reload", "duplicate", "quit", "back_to_list", "new")
 
 
@@ -31,6 +31,9 @@ class KeysFooter(Footer):
             if drawn_width(keys, self.compact) <= width:
                 break
             keys = [key for key in keys if key.action != action]
+        while drawn_width(keys, self.compact) > width and any(key.action != "help" for key in keys):
+            last = max(i for i, key in enumerate(keys) if key.action != "help")
+            keys = keys[:last] + keys[last + 1 :]
         yield from keys
 
     def on_resize(self, event: events.Resize) -> None:

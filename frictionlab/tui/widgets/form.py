@@ -154,6 +154,7 @@ class PresetForm(VerticalScroll):
                 validate_on=[],  # the form marks it, from the headless validator's problems (revalidate)
                 # a text (a description) is read from its start: selecting it on focus would show its end
                 select_on_focus=spec.kind != "text",
+                name=spec.dotted,  # as messages name the field
                 id=spec.widget_id,
             )
             widget.cursor_position = len(widget.value) if spec.kind == "text" else 0  # typing adds to a name

@@ -2,8 +2,27 @@
 
 from __future__ import annotations
 
+import re
+
 from textual import events
+from textual.message import Message
 from textual.widgets import Input
+
+from ...errors import shown
+
+# what a paste may bring that a field must not hold: C0 controls, DEL and C1 (an ESC, a BEL, a
+# terminal's colour codes copied along) are no text, and a YAML file cannot hold them raw
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+
+
+def pasted_text(text: str) -> tuple[str, list[str]]:
+    """A paste as a one-line field takes it: its lines and tabs joined by spaces, its other
+    control characters left out; and those left out, as ``shown`` writes them (``\\x1b``)."""
+    lines = [line.strip() for line in text.splitlines()]
+    joined = " ".join(line for line in lines if line) if len(lines) > 1 else text
+    joined = joined.replace("\t", " ")
+    dropped = sorted({shown(c) for c in _CONTROL.findall(joined)})
+    return _CONTROL.sub("", joined), dropped
 
 
 class KeyInput(Input):
@@ -22,6 +41,14 @@ class KeyInput(Input):
 
     typed = False
 
+    class LeftOut(Message):
+        """A paste's control characters were left out; ``text`` says which, naming the field (the
+        app says it in the status line, a dialog, which may cover that line at 30x8, in its own)."""
+
+        def __init__(self, text: str):
+            super().__init__()
+            self.text = text
+
     async def _on_key(self, event: events.Key) -> None:
         self.typed = True
         bindings = self._bindings.key_to_bindings.get(event.key)
@@ -33,16 +60,20 @@ class KeyInput(Input):
         await super()._on_key(event)
 
     def _on_paste(self, event: events.Paste) -> None:
-        self.typed = True  # Textual then calls Input's own, which pastes
-        lines = event.text.splitlines()
-        if len(lines) > 1:  # Input's own keeps the first line, the rest dropped unsaid: a paragraph, joined
-            event.prevent_default()
-            event.stop()
-            text = " ".join(line.strip() for line in lines if line.strip())
+        """Input's own kept a paste's first line only (the rest dropped unsaid) and its control
+        characters raw, saved so into the preset: a paragraph is joined, the controls left out, said."""
+        self.typed = True
+        event.prevent_default()
+        event.stop()
+        text, dropped = pasted_text(event.text)
+        if text:
             if self.selection.is_empty:
                 self.insert_text_at_cursor(text)
             else:
                 self.replace(text, *self.selection)
+        if dropped:  # after the Changed the insertion posted: a dialog clears its error line on that
+            self.post_message(self.LeftOut(f"{self.name or self.id or 'field'}: the paste's control characters "
+                                           f"{', '.join(dropped)} were left out (a field holds text only)"))  # fmt: skip
 
     def action_copy(self) -> None:
         """Ctrl+C copies here, and says (as it does elsewhere) what quits."""

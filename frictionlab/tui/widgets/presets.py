@@ -45,13 +45,20 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
 
     def _widths(self, table: DataTable) -> tuple[int, int, int]:
         """The name, folder and file columns' widths: all three on screen, a long name or file
-        name cut in its middle, the name given at least half of what the folder leaves."""
+        name cut in its middle, the name given at least half of what the folder leaves. Under
+        60 columns no file column (0), and no folder column where the name needs its room: the
+        line under the list names the file; at 30 columns the name kept 8 (``ben…fig2``)."""
         names = max((len(shown_name(e.name)) for e in self.presets), default=4)
         labels = max((len(e.label) for e in self.presets), default=6)
         files = max((len(shown_name(e.path.name)) for e in self.presets), default=4)
         if self.size.width == 0:  # not laid out yet: filled again once it is (on_resize)
             return names, labels, files
-        room = self.size.width - 6 * table.cell_padding - table.styles.scrollbar_size_vertical
+        padding = 2 * table.cell_padding  # a column's
+        room = self.size.width - table.styles.scrollbar_size_vertical
+        if self.screen.has_class("-narrow"):  # the name first; the folder where it fits whole beside it
+            folder = labels if names + labels + 2 * padding <= room else 0
+            return max(4, room - padding - (folder + padding if folder else 0)), folder, 0
+        room -= 3 * padding
         folder = min(labels, max(6, room // 5))
         room -= folder
         name = min(names, max(room // 2, room - files))
@@ -62,12 +69,13 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
         row = table.cursor_row
         name, folder, file = self._widths(table)
         table.clear(columns=True)
-        table.add_column("name", width=name)
-        table.add_column("folder", width=folder)
-        table.add_column("file", width=file)
+        columns = [("name", name), ("folder", folder), ("file", file)]
+        for label, width in columns:
+            if width:  # under 60 columns the file's, and the folder's, may be left out (_widths)
+                table.add_column(label, width=width)
         for entry in self.presets:  # Text: never markup
-            table.add_row(*(Text(shorten_middle(shown_name(text), width)) for text, width in
-                            ((entry.name, name), (entry.label, folder), (entry.path.name, file))))  # fmt: skip
+            cells = zip((entry.name, entry.label, entry.path.name), (width for _, width in columns), strict=True)
+            table.add_row(*(Text(shorten_middle(shown_name(text), width)) for text, width in cells if width))
         if self.presets:
             table.move_cursor(row=min(max(row, 0), len(self.presets) - 1), animate=False)
 

@@ -39,6 +39,15 @@ FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of t
 LIST_SHARE, LIST_MIN, CHART_MIN = 0.45, 40, 40
 
 
+class InfoBox(VerticalScroll):
+    """The box under the plot; under 60 columns, under the list (app.tcss), where it may have the
+    tab's rows alone (30x8): Tab goes to it there and the arrows scroll it. Wider, beside the list,
+    the list keeps the keys."""
+
+    def allow_focus(self) -> bool:
+        return self.screen.has_class("-narrow")
+
+
 class ResultsPane(SaysWhyUnavailable, Vertical):
     BINDINGS = [
         Binding("space", "compare", "Compare", tooltip="(add the run to the overlay, or remove it)"),
@@ -64,7 +73,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             yield ListTable(id="runs-table", cursor_type="row", zebra_stripes=True, empty=NO_RUNS)
             with Vertical(id="results-body"):
                 yield Chart(empty=NO_RUN_OPEN, id="results-chart")  # not "no data yet": the runs have theirs
-                with VerticalScroll(id="results-info-box", can_focus=False):  # at 60x20 a run's lines need 9 rows
+                with InfoBox(id="results-info-box"):  # at 60x20 a run's lines need 9 rows
                     yield Static(HINT, id="results-info")
         yield SweepList(id="results-sweep", cursor_type="row", zebra_stripes=True)
 
@@ -80,11 +89,17 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         longest = max((len(shown_name(entry.path.name)) for entry in self.runs), default=0)
         share = max(LIST_MIN, int(self.size.width * LIST_SHARE))
         width = max(share, min(longest + others + gutter, self.size.width - CHART_MIN))
-        table.styles.width = width
+        if self._narrow():  # the plot goes under the list: the list takes the width (app.tcss)
+            width, table.styles.width = self.size.width, None
+        else:
+            table.styles.width = width
         return max(12, width - others - gutter)
 
     def on_descendant_focus(self, event: events.DescendantFocus) -> None:
         self._visited = True
+
+    def _narrow(self) -> bool:
+        return self.screen.has_class("-narrow")
 
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out

@@ -111,6 +111,9 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         Binding("r", "not_run", show=False, system=True),
         Binding("c", "cancel", "Cancel", tooltip="the run: what finished is kept and saved"),
         Binding("u", "resume", "Resume", tooltip="the last run: only the missing realizations are computed"),
+        # under 12 rows (30x8) the fit is below the progress, out of sight: the tab scrolls (app.tcss)
+        Binding("up", "scroll_up", "Scroll up", tooltip="the tab, where it is taller than the screen (30x8)", show=False),
+        Binding("down", "scroll_down", "Scroll down", tooltip="the tab, where it is taller than the screen (30x8)", show=False),
         # the same keys where they cannot act now (check_action hides those above): the status line says why
         *said_when_hidden(("c", "cancel"), ("u", "resume")),
     ]
@@ -218,6 +221,14 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         self._set("run-error", "")
         self._set("run-stats", "starting")
         self._clear_fit()
+        self.call_after_refresh(self._progress_in_sight)
+
+    def _progress_in_sight(self) -> None:
+        """Under 12 rows (30x8) the title and the folder took the rows the status line left, the
+        progress below them: the tab starts at the progress (a sweep's at its point), Up shows them."""
+        if self.screen.has_class("-tiny"):
+            first = self.query_one("#sweep-point" if self.has_class("-sweep") else "#run-bar")
+            self.scroll_to_widget(first, top=True, animate=False)
 
     def _fitted(self, name: str, rest: str) -> str:
         """``name`` cut in its middle so that the line with ``rest`` fits the tab's width."""
