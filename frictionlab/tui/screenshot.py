@@ -26,6 +26,7 @@ async def take(out: Path, preset: Path, size: tuple[int, int]) -> None:
         await pilot.pause()
         for field in app.screen.query(Input):
             field.cursor_blink = False
+        await pilot.wait_for_scheduled_animations()  # the tabs' underline slides in: caught at its end, every time
         await pilot.pause()
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(app.export_screenshot(), encoding="utf-8")
