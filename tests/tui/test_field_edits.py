@@ -6,19 +6,25 @@ from textual.widgets import Input
 from .conftest import SIZE, make_app, open_first_preset, sync, wait_until
 
 
+async def pasted_into_description(app, pilot, text: str):
+    """The first preset opened, ``text`` pasted into its description field: (form, field) once taken."""
+    form = await open_first_preset(pilot)
+    field = app.query_one("#field--description", Input)
+    field.focus()
+    await pilot.pause()
+    field.post_message(events.Paste(text))
+    await wait_until(pilot, lambda: form.data.get("description") is not None, timeout=10.0)
+    await pilot.pause()
+    return form, field
+
+
 @sync
 async def test_a_paste_of_several_lines_is_kept_whole_on_the_fields_one_line(folders, registry):
     """Textual's Input kept a paste's first line only: a description pasted as a paragraph lost
     the rest of it, and nothing said so."""
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        form = await open_first_preset(pilot)
-        field = app.query_one("#field--description", Input)
-        field.focus()
-        await pilot.pause()
-        field.post_message(events.Paste("Rough line,\n  pressed flat\r\n\nin a second."))
-        await wait_until(pilot, lambda: form.data.get("description") is not None, timeout=10.0)
-        await pilot.pause()
+        form, field = await pasted_into_description(app, pilot, "Rough line,\n  pressed flat\r\n\nin a second.")
         shown, kept = field.value, form.data["description"]
     assert shown == kept == "Rough line, pressed flat in a second."
 
@@ -60,13 +66,7 @@ async def test_control_characters_pasted_are_left_out_and_said(folders, registry
 
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        form = await open_first_preset(pilot)
-        field = app.query_one("#field--description", Input)
-        field.focus()
-        await pilot.pause()
-        field.post_message(events.Paste("Rough\x1b[31m line\x07,\tflat\x7f\x9b"))
-        await wait_until(pilot, lambda: form.data.get("description") is not None, timeout=10.0)
-        await pilot.pause()
+        form, field = await pasted_into_description(app, pilot, "Rough\x1b[31m line\x07,\tflat\x7f\x9b")
         said = status_text(app)
         await press_settled(pilot, "escape", "ctrl+s")
     saved = load_yaml((folders / "presets" / "tiny.yaml").read_text(encoding="utf-8"))
