@@ -57,6 +57,16 @@ async def answer_focus_key(app, key: events.Key) -> bool:
     return False
 
 
+def _xterm_parser():
+    """Textual's terminal parser, or None: a private part of Textual, which a later Textual may
+    not have (its keys and pastes are then read as that Textual reads them)."""
+    try:
+        from textual._xterm_parser import XTermParser
+    except ImportError:
+        return None
+    return XTermParser
+
+
 def keep_escape_before_control_keys() -> None:
     """Esc then a control key, joined by the terminal (as above; on a busy machine keys typed
     0.15 s apart are read together), reached the app as the control key alone: Textual's
@@ -64,10 +74,9 @@ def keep_escape_before_control_keys() -> None:
     (ESC Ctrl+S is Ctrl+S), so Esc then Ctrl+S in a field saved and stayed in it. The parser
     hands the Esc on first instead. The sequences Textual maps whole (ESC Tab: Shift+Tab,
     ESC Backspace: Ctrl+W) are not this path and stay as they are."""
-    from textual._xterm_parser import XTermParser
-
-    parse = XTermParser._sequence_to_key_events
-    if getattr(parse, "keeps_escape", False):
+    XTermParser = _xterm_parser()
+    parse = getattr(XTermParser, "_sequence_to_key_events", None)
+    if parse is None or getattr(parse, "keeps_escape", False):
         return
 
     def sequence_to_key_events(self, sequence: str, alt: bool = False):
@@ -90,10 +99,9 @@ def paste_keeps_escapes() -> None:
     (``^[31m``), or acting where no field has the focus (q quits, c cancels a run). The
     parser is handed such an ESC as a stand-in character, given back in the paste's text
     (where the field leaves it out, saying so)."""
-    from textual._xterm_parser import XTermParser
-
-    feed = XTermParser.feed
-    if getattr(feed, "keeps_pasted_escapes", False):
+    XTermParser = _xterm_parser()
+    feed = getattr(XTermParser, "feed", None)
+    if feed is None or getattr(feed, "keeps_pasted_escapes", False):
         return
 
     def feed_pastes_whole(self, data: str):
