@@ -107,7 +107,10 @@ class ProgressLog:
     def warning(self, message: str) -> None:
         """A warning of the run's process (a detached one's stderr is no one's): what a follower shows."""
         event = {"event": "warning", "pid": os.getpid(), "message": message}
-        self._held.append(event) if self._fd is None else self.write(event)
+        if self._fd is None:
+            self._held.append(event)
+        else:
+            self.write(event)
 
     def _write_held(self) -> None:
         held, self._held = self._held, []
@@ -230,6 +233,12 @@ def _parse(line: bytes) -> dict | None:
     return checked_event(event) if isinstance(event, dict) and isinstance(event.get("event"), str) else None
 
 
+def told_by(event: dict, pid: int | None) -> bool:
+    """Whether ``event`` (an ``error`` or ``warning``) is of the followed process ``pid`` (any,
+    while it is not known): not of a second run that was refused the folder."""
+    return pid is None or event.get("pid") == pid
+
+
 class HeardWarnings:
     """The warnings a followed process wrote (``warning`` events), each handed out once (``take``)."""
 
@@ -237,7 +246,7 @@ class HeardWarnings:
         self._new: list[str] = []
 
     def hear(self, event: dict, pid: int | None) -> None:
-        if pid is None or event.get("pid") == pid:  # not a refused second run's
+        if told_by(event, pid):
             self._new.append(str(event.get("message")))
 
     def take(self) -> list[str]:
@@ -385,7 +394,7 @@ class Follower:
                                              whole_or(event.get("requested")), error if isinstance(error, str) else None)  # fmt: skip
                     if self.info is not None:  # as the run told its own: a bar ends, a last snapshot goes out
                         self._tell("run_finished", run=self.info, outcome=self.finished)
-                elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
+                elif kind == "error" and told_by(event, self.pid):
                     self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                              whole_or(event.get("exit_code"), 1))  # fmt: skip
                 elif kind == "warning":

@@ -19,7 +19,7 @@ from pathlib import Path
 from ..errors import RunFolderError
 from ..plugin.listeners import SweepListener
 from ..io.values import number_or_nan, whole_or
-from .progresslog import Finished, Follower, HeardWarnings, ProgressLog, ProgressReader, StartOf
+from .progresslog import Finished, Follower, HeardWarnings, ProgressLog, ProgressReader, StartOf, told_by
 from .runfolder import checked
 from .sweep import UNFINISHED, PointResult, Sweep, SweepPoint, point_folder
 from .sweeprecord import PointRecord
@@ -118,7 +118,7 @@ class SweepFollower:
                 self.point = None
             elif kind == "warning":
                 self.warnings.hear(event, self.pid)
-            elif kind == "error" and (self.pid is None or event.get("pid") == self.pid):  # not a refused second run's
+            elif kind == "error" and told_by(event, self.pid):
                 self._finish_point_run()
                 self.finished = Finished("failed", self.done, self.total, str(event.get("message")),
                                          whole_or(event.get("exit_code"), 1))  # fmt: skip
