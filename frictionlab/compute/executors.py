@@ -170,7 +170,8 @@ def pool_refused() -> str | None:
     try:
         pool_context().Event()
     except OSError as exc:
-        return f"worker processes need a POSIX semaphore, which this system refuses: {exc.strerror or exc}; is /dev/shm missing or read-only?"
+        return (f"worker processes need a POSIX semaphore, which this system refuses: {exc.strerror or exc}; "
+                "is /dev/shm missing or read-only?")
     return None
 
 

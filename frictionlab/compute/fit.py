@@ -61,7 +61,9 @@ class LogFit:
         """The fit of a summary.json (null read as NaN); KeyError without a or b."""
 
         def interval(value) -> tuple[float, float]:
-            return (number_or_nan(value[0]), number_or_nan(value[1])) if isinstance(value, list | tuple) and len(value) == 2 else NAN2
+            if isinstance(value, list | tuple) and len(value) == 2:
+                return number_or_nan(value[0]), number_or_nan(value[1])
+            return NAN2
 
         return cls(
             a=number_or_nan(data["a"]),

@@ -27,9 +27,9 @@ run it runs again, saying so) unless ``force``; even then it deletes only chunk 
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
-import errno
 import os
 import re
 import time
