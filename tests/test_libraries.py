@@ -1,5 +1,5 @@
-"""What well-kept libraries now do for frictionlab, checked where it shows: run.lock
-(filelock) between real processes, available memory (psutil), the user's config
+"""What the system and well-kept libraries do for frictionlab, checked where it shows:
+run.lock (an flock) between real processes, available memory (psutil), the user's config
 folder (platformdirs)."""
 
 from __future__ import annotations

@@ -3,7 +3,7 @@ lost, no damaged data is used, and no file frictionlab did not write is touched.
 
 Layout inside the output folder::
 
-    run.lock      held (filelock: flock on POSIX) while a run writes here, removed when it
+    run.lock      held (an flock on POSIX: ``runlock``) while a run writes here, removed when it
                   ends; the kernel releases the lock even on kill -9
     run.json      the manifest: status, the resolved preset and its fingerprint, every
                   input file with its SHA-256 and what was read from it (``inputrecord``),
@@ -47,6 +47,7 @@ from ..compute.realization import RealizationResult
 from .inputrecord import file_hashes, input_changes, refuse_changed_inputs, what_was_read
 from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, check_chunk_folder, chunk_bytes, damage_report, read_chunk
 from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
+from .runlock import LockHeld, RunLock
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
 LOCK_FILE = "run.lock"
@@ -131,7 +132,7 @@ class RunDirectory:
     def __init__(self, path: str | Path, *, force: bool = False):
         self.path = Path(path)
         self.force = force
-        self._lock = None  # a filelock.FileLock while held
+        self._lock: RunLock | None = None  # while held
         self._manifest: dict | None = None
         self._kept: dict[int, RealizationResult] = {}  # every result stored or verified here, by index
 
@@ -142,8 +143,6 @@ class RunDirectory:
     # ------------------------------------------------------------ lock
 
     def __enter__(self) -> RunDirectory:
-        from filelock import FileLock, Timeout
-
         problem = output_path_problem(self.path)
         if problem:
             raise OutputRefused(f"{problem}; give a folder for the output")
@@ -154,13 +153,13 @@ class RunDirectory:
                 f"{shown(lock)} is not a regular file (a link, a folder, ...): it cannot hold the run's lock "
                 "(remove it, or give another folder)"
             )
-        # filelock: flock on POSIX, LockFileEx on Windows; a forked worker does not keep the
-        # lock, a holder that died (kill -9) holds it no more, and a waiter that opened a
-        # file the holder then removed takes the lock on the new file.
-        self._lock = FileLock(lock, timeout=0, mode=0o644, thread_local=False, on_acquired=_write_holder)
+        # a forked worker does not keep the lock, a holder that died (kill -9) holds it no
+        # more, and a waiter that opened a file the holder then removed takes the lock on the new file.
+        self._lock = RunLock(lock, on_acquired=_write_holder)
         try:
             self._lock.acquire()
-        except Timeout:
+        except LockHeld:
+            self._lock = None
             pid = lock_holder(lock)  # as the kernel says: the lock file's text is anyone's
             try:  # what _write_holder wrote, believed only where it names that process
                 text = read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]
@@ -172,6 +171,7 @@ class RunDirectory:
                 "or give another output folder"
             ) from None
         except OSError as exc:
+            self._lock = None
             if exc.errno not in (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP):
                 raise
             raise RunFolderError(  # two runs into one folder would mix their chunks: none without the lock
