@@ -14,7 +14,9 @@ would run (``frictionlab.api``). They are imported on first use,
 so ``import frictionlab`` stays cheap.
 """
 
-# Every public name is imported on first use (PEP 562), so that ``import frictionlab``
+from ._version import __version__  # a constant: the build reads it from there too
+
+# Every other public name is imported on first use (PEP 562), so that ``import frictionlab``
 # (and ``frictionlab --help``) costs almost nothing: numpy and pydantic come with the
 # first name that needs them.
 _LAZY = {
@@ -87,19 +89,8 @@ def _install_moved_modules() -> None:
 _install_moved_modules()
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("frictionlab")
-    except PackageNotFoundError:  # running from a source tree without install
-        return "0.0.0+unknown"
-
-
 def __getattr__(name: str):
-    if name == "__version__":
-        value = _version()
-    elif name in _LAZY:
+    if name in _LAZY:
         from importlib import import_module
 
         value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
@@ -110,7 +101,7 @@ def __getattr__(name: str):
 
 
 def __dir__():
-    return sorted([*globals(), *_LAZY, "__version__"])
+    return sorted([*globals(), *_LAZY])
 
 
 __all__ = [

@@ -30,6 +30,7 @@ import re
 import sys
 import warnings
 
+from .. import __version__
 from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
                       out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
@@ -39,19 +40,6 @@ from .console import error_label
 
 COMMANDS = (run, resume, runs, follow, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
-
-
-class _Version(argparse.Action):
-    """``--version``, its number read only when asked (importlib.metadata is slow to import)."""
-
-    def __init__(self, option_strings, dest, **kwargs):
-        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        from .. import __version__
-
-        print(f"frictionlab {__version__}")  # on stdout, where a script reads it
-        parser.exit()
 
 
 DESCRIPTION = "rms slope in contact against normal force, over ensembles of random rough lines and surfaces."
@@ -175,7 +163,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     own words needs: its help, usage and errors are the same; building all fourteen was
     a tenth of a short run's start)."""
     parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EXAMPLES)
-    parser.add_argument("-V", "--version", action=_Version, help="print the version and exit")
+    parser.add_argument(
+        "-V", "--version", action="version", version=f"frictionlab {__version__}", help="print the version and exit"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for command in COMMANDS:
         if only is None or _name(command) == only:

@@ -37,6 +37,13 @@ def test_version_short_and_long(cli):
         assert done.returncode == 0 and re.fullmatch(r"frictionlab \d+\.\d+\S*\n", done.stdout), done.stdout
 
 
+def test_the_version_printed_is_the_installed_distributions(cli):
+    """Read from frictionlab/_version.py (cheap at start-up); the build's metadata must agree."""
+    from importlib.metadata import version
+
+    assert cli("--version").stdout == f"frictionlab {version('frictionlab')}\n"
+
+
 def test_bare_command_shows_a_short_help_with_every_command_and_examples(cli):
     done = cli()
     assert done.returncode == 0 and done.stderr == ""
