@@ -68,3 +68,31 @@ def test_a_detached_run_s_warning_reaches_its_follower(tmp_path, monkeypatch):
     assert follower.finished.status == "completed"
     [warning] = follower.warnings.take()
     assert warning.startswith("2 worker processes cannot start here (") and "POSIX semaphore" in warning
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="a detached run is a POSIX session")
+def test_follow_of_a_run_that_ended_says_its_warnings_and_not_another_process_s(tmp_path, capsys):
+    """The run ended before anyone followed it: its warnings are in its log alone."""
+    from frictionlab.cli.main import main
+
+    data = merge(SMALL_PRESET, {"realizations": 4})
+    out = tmp_path / "run"
+    assert main(["run", str(write_preset(tmp_path, data)), "--out", str(out), "--quiet", "--no-plot"]) == 0
+    process = start_detached(build_scene(data).resolved(), out, RunOptions(workers=1), plot=False)  # runs again
+    wait_for(lambda: process.poll() is not None)
+    with open(out / PROGRESS_FILE, "a") as log:  # a second run, refused the folder, logged this
+        log.write(json.dumps({"event": "warning", "pid": process.pid + 1, "message": "another run's"}) + "\n")
+    capsys.readouterr()
+    assert main(["follow", str(out)]) == 0
+    said = capsys.readouterr()
+    assert "completed, 4/4 realizations" in said.out
+    warnings = [line for line in said.err.splitlines() if line.startswith("warning: ")]
+    assert len(warnings) == 1 and "holds a completed run of this preset: it runs again" in warnings[0]
+
+
+def write_preset(folder, data):
+    import yaml
+
+    path = folder / "preset.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path

@@ -64,7 +64,7 @@ class _StopSignals:
 
 
 def run(args) -> ExitCode:
-    from ..runs.detached import logged_error, process_alive, run_state
+    from ..runs.detached import logged_error, logged_warnings, process_alive, run_state
 
     folder = Path(args.run_dir)
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
@@ -80,7 +80,7 @@ def run(args) -> ExitCode:
                 with stopped:
                     while state.status == "running" and stopped.signal is None:  # until its process ends
                         polled = follower.poll()
-                        _say_warnings(follower)
+                        _say_warnings(follower.warnings.take())
                         if not polled:
                             stopped.wait(POLL_SECONDS)
                             now = _state_unless_gone(folder, identity)
@@ -90,7 +90,7 @@ def run(args) -> ExitCode:
                             state = now
                     if stopped.signal is None:
                         follower.poll()  # the last events, written as it ended
-                        _say_warnings(follower)
+                        _say_warnings(follower.warnings.take())
             finally:  # a bar still showing ends on its own line, before anything else is printed
                 for listener in follower.listeners:
                     listener.close()
@@ -102,6 +102,7 @@ def run(args) -> ExitCode:
         if follower.finished is not None:
             error = follower.finished.error
     else:  # ended before: why, as a run's summary.json says (it was said only to a follower), or its log (a full disk)
+        _say_warnings(logged_warnings(folder))  # said only to a follower too: its stderr was no one's
         error = _ended_error(folder) if sweep is None else None
         if error is None and state.status != "completed":
             error = logged_error(folder)
@@ -179,10 +180,10 @@ def _identity(folder: Path) -> tuple[int, int] | None:
     return info.st_dev, info.st_ino
 
 
-def _say_warnings(follower) -> None:
+def _say_warnings(messages: list[str]) -> None:
     """The warnings the run's process wrote to its log (its stderr is no one's), as a run in
     the foreground shows them."""
-    for message in follower.warnings.take():
+    for message in messages:
         print(f"warning: {shown(message)}", file=sys.stderr, flush=True)
 
 

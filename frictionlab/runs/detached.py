@@ -30,7 +30,7 @@ from . import runfolder
 from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name
 from ..options import RunOptions
 from .progressevents import MAX_COUNT
-from .progresslog import ProgressLog, ProgressReader, StartOf
+from .progresslog import ProgressLog, ProgressReader, StartOf, told_by
 from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 
@@ -429,6 +429,18 @@ def logged_error(folder: Path) -> str | None:
     for last in _tail_events(folder):  # noqa: B007 - the last one is what is said
         pass
     return str(last.get("message")) if last is not None and last["event"] == "error" else None
+
+
+def logged_warnings(folder: Path) -> list[str]:
+    """The warnings the last run in ``folder`` wrote to its progress log (read from its tail):
+    those of the process whose ``started`` event is the last, not of a second run refused the folder."""
+    warnings, pid = [], None
+    for event in _tail_events(folder):
+        if event["event"] == "started":
+            warnings, pid = [], event.get("pid")
+        elif event["event"] == "warning" and told_by(event, pid):
+            warnings.append(str(event.get("message")))
+    return warnings
 
 
 def list_run_states(runs_dir: str | Path) -> list[RunState]:
