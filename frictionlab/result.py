@@ -14,7 +14,7 @@ import numpy as np
 
 from .arguments import path_argument
 from .errors import FrictionlabError, RunFolderError, raised_here, require, shown
-from .compute.fit import LogFit
+from .compute.fit import LogFit, format_number
 from .runs.results import read_curve_table, read_summary, column_units
 from .runs.runfolder import check_searchable, subfolder
 
@@ -112,7 +112,7 @@ class Result:
         return result_html(self)
 
     def __repr__(self) -> str:
-        fit = "no fit" if self.fit is None else f"a = {self.fit.a:.4f}, b = {self.fit.b:.4f}, R² = {self.fit.r2:.3f}"
+        fit = "no fit" if self.fit is None else f"a = {format_number(self.fit.a)}, b = {format_number(self.fit.b)}, R² = {format_number(self.fit.r2, 3)}"
         where = f", folder {str(self.folder)!r}" if self.folder else ""
         done, requested = self.realizations
         return f"<Result {self.name!r}: {self.status}, {done}/{requested} realizations, {fit}{where}>"

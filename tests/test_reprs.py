@@ -134,3 +134,12 @@ def test_a_measured_inputs_html_says_what_was_read_as_the_cli_does(tmp_path):
     assert lines and "a<b>&c.csv" in lines[0] and "a&lt;b&gt;&amp;c.csv" in html and "<b>" not in html
     assert all(escape(line) in html for line in lines)
     parsed(html)
+
+
+def test_a_results_one_line_repr_stays_short_whatever_its_fit():
+    """A forged (or absurd) summary.json read back: 1e300 is not 300 digits."""
+    result = frictionlab.run(SMALL_PRESET, **FAST)
+    huge = dataclasses.replace(result, fit=dataclasses.replace(result.fit, a=1e300, b=-2.5e7))
+    text = repr(huge)
+    assert "a = 1e+300, b = -2.5e+07" in text and len(text) < 200
+    assert f"a = {result.fit.a:.4f}, b = {result.fit.b:.4f}" in repr(result)
