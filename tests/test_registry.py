@@ -399,6 +399,9 @@ BROKEN_SOURCES = {
     "missing-dependency": ("import acme_dependency_that_is_not_installed", None, "ModuleNotFoundError"),
     "missing-attribute": ("x = 1", "acme_broken_plugin:nothing_here", "AttributeError"),
     "syntax-error": ("def broken(:\n    pass", None, "SyntaxError: invalid syntax ("),
+    "no-module-name": ("x = 1", "acme-broken-plugin:plugin", "PluginError: the entry point's value "
+                       "'acme-broken-plugin:plugin' names no module: it must be module or module:attribute, of "
+                       "letters, digits, _ and dots"),
 }
 
 

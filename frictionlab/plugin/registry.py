@@ -173,9 +173,13 @@ class Registry:
             if self.pm.get_plugin(ep.name) is not None:
                 continue
             dist = ep.dist.name if ep.dist else "unknown distribution"
+            value = ep.pattern.match(ep.value)  # None: ep.load() and ep.module would raise AttributeError
             claims: list[tuple[str, str]] = []
             try:  # what it prints goes to stderr: stdout may be JSON (--json, frictionlab schema)
                 with contextlib.redirect_stdout(sys.stderr):
+                    if value is None:
+                        raise PluginError(f"the entry point's value {ep.value!r} names no module: it must be module "
+                                          "or module:attribute, of letters, digits, _ and dots")  # fmt: skip
                     plugin = ep.load()
                     self.pm.register(plugin, name=ep.name)
                     self._try_registration(plugin, claims)
@@ -187,7 +191,7 @@ class Registry:
             except (Exception, SystemExit) as exc:  # a broken plugin must not break (nor end) the tool
                 if self.pm.get_plugin(ep.name) is not None:
                     self.pm.unregister(name=ep.name)
-                message = self._failure_message(exc, ep.module.partition(".")[0])
+                message = self._failure_message(exc, value.group("module").partition(".")[0] if value else "")
                 self.failures.append(LoadFailure(ep.name, dist, message, tuple(claims)))
                 warn_user(f"frictionlab plugin {ep.name!r} from {dist} failed to load ({message}); skipped", RuntimeWarning)
 
