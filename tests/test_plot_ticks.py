@@ -1,0 +1,58 @@
+"""plot.png makes its ticks only where they show (matplotlib made a tick for each
+location its locators gave, up to a decade beyond a log axis's ends, and drew 36 of 83),
+and is the same picture for it; its PNG is compressed at zlib's fastest level."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from frictionlab import plot
+from frictionlab.compute import engine
+from frictionlab.options import RunOptions
+from frictionlab.preset import build_scene
+
+from .conftest import SMALL_PRESET, merge
+
+
+@pytest.fixture(scope="module")
+def small_run(registry):
+    scene = build_scene(merge(SMALL_PRESET, {"realizations": 3}), registry=registry)
+    return scene, engine.run(scene, RunOptions(workers=1))
+
+
+def drawn_figure(small_run, monkeypatch) -> tuple[Figure, bytes]:
+    drawn = []
+    save = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
+    fh = io.BytesIO()
+    plot.plot_curve(*small_run, fh)
+    return drawn[0], fh.getvalue()
+
+
+def in_view(axis, locs) -> int:
+    scale = axis.get_transform()
+    low, high = np.sort(scale.transform(np.array(axis.get_view_interval())))
+    at = scale.transform(np.asarray(locs, dtype=float)) if len(locs) else np.array([])
+    return int(np.count_nonzero((at >= low - 1e-9 * (high - low)) & (at <= high + 1e-9 * (high - low))))
+
+
+def test_no_more_ticks_are_made_than_show(small_run, monkeypatch):
+    """As many ticks as show on each axis (one at least: matplotlib makes one as it builds an axis)."""
+    fig, _ = drawn_figure(small_run, monkeypatch)
+    shown = 0
+    for axis in (a for ax in fig.axes for a in (ax.xaxis, ax.yaxis)):
+        for made, locs in ((axis.majorTicks, axis.get_majorticklocs()), (axis.minorTicks, axis.get_minorticklocs())):
+            assert len(made) <= max(1, in_view(axis, locs)), (axis.axis_name, len(made), in_view(axis, locs))
+            shown += in_view(axis, locs)
+    assert shown >= 8  # both panels ticked
+
+
+def test_the_ticks_in_view_draw_the_same_picture(small_run, monkeypatch):
+    _, ours = drawn_figure(small_run, monkeypatch)
+    monkeypatch.setattr(plot, "ticks_in_view", lambda ax: None)
+    _, everything = drawn_figure(small_run, monkeypatch)
+    assert ours == everything
