@@ -21,6 +21,7 @@ from .compute.fit import LogFit
 from .preset import Scene
 
 XI_LABEL = "xi = rms slope in contact / rms slope"
+FAST_PNG = {"compress_level": 1}  # zlib's fastest: a third of the encoding's time for a file 7% larger
 
 
 AXES_NEEDS = ("errorbar", "fill_between", "grid", "legend", "plot", "set_title", "set_xlabel", "set_xscale",
@@ -104,7 +105,7 @@ def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
     ax_count.grid(True, which="both", alpha=0.3)
     for each in (ax, ax_count):
         ticks_in_view(each)
-    fig.savefig(fh, format="png", dpi=110)
+    fig.savefig(fh, format="png", dpi=110, pil_kwargs=FAST_PNG)
 
 
 def ticks_in_view(ax) -> None:

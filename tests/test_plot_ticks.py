@@ -5,6 +5,8 @@ and is the same picture for it; its PNG is compressed at zlib's fastest level.""
 from __future__ import annotations
 
 import io
+import struct
+import zlib
 
 import numpy as np
 import pytest
@@ -56,3 +58,19 @@ def test_the_ticks_in_view_draw_the_same_picture(small_run, monkeypatch):
     monkeypatch.setattr(plot, "ticks_in_view", lambda ax: None)
     _, everything = drawn_figure(small_run, monkeypatch)
     assert ours == everything
+
+
+def png_chunks(data: bytes):
+    at = 8
+    while at < len(data):
+        (length,) = struct.unpack(">I", data[at : at + 4])
+        yield data[at + 4 : at + 8], data[at + 8 : at + 8 + length]
+        at += 12 + length
+
+
+def test_plot_png_is_compressed_at_zlibs_fastest_level(small_run, monkeypatch):
+    _, png = drawn_figure(small_run, monkeypatch)
+    idat = b"".join(body for kind, body in png_chunks(png) if kind == b"IDAT")
+    assert idat[1] >> 6 == 0, "the zlib header's FLEVEL: 0 is the fastest level"  # 2 is zlib's default (6)
+    width, height = struct.unpack(">II", next(body for kind, body in png_chunks(png) if kind == b"IHDR")[:8])
+    assert len(zlib.decompress(idat)) == height * (1 + 4 * width)  # RGBA rows, each with its filter byte
