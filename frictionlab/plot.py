@@ -12,15 +12,18 @@ import math
 import textwrap
 from typing import Any
 
+import matplotlib.backends.backend_agg  # noqa: F401 (savefig's PNG canvas: imported with this module, ahead of drawing)
 import numpy as np
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, LogFormatter
+from PIL import Image
 
 from .compute.ensemble import RunOutcome
 from .compute.fit import LogFit
 from .preset import Scene
 
+Image.preinit()  # PIL's format drivers, which the first figure saved would import
 XI_LABEL = "xi = rms slope in contact / rms slope"
 FAST_PNG = {"compress_level": 1}  # zlib's fastest: a third of the encoding's time for a file 7% larger
 UNHINTED = {"text.hinting": "no_hinting"}  # FreeType's hinting, run for each glyph, was 15% of drawing plot.png
