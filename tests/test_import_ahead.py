@@ -11,6 +11,8 @@ import pytest
 from frictionlab.runs import import_ahead
 from frictionlab.runs.runner import run_to_folder
 
+from .conftest import PRESETS
+
 
 def _in_a_fresh_process(code: str, tmp_path) -> str:
     return subprocess.run(
@@ -109,3 +111,25 @@ def test_a_module_asked_for_while_its_import_ahead_fails_raises_that_failure(tmp
         tmp_path,
     )
     assert out.strip() == "raised: broken on purpose"
+
+
+def test_drawing_plot_png_imports_nothing_the_plot_module_did_not(tmp_path):
+    """The PNG canvas and PIL's format drivers come with the plotting module (imported
+    ahead), not with the first figure saved, after the fit is printed."""
+    out = _in_a_fresh_process(
+        f"""
+        import io, sys
+        from frictionlab.compute import engine
+        from frictionlab.options import RunOptions
+        from frictionlab.preset import load_scene
+        scene = load_scene({str(PRESETS / "benad2012-fig2.yaml")!r}, ["realizations=2", "spectrum.params.points=1024",
+                           "spectrum.params.length=1024", "loading.steps=8", "fit.bootstrap=10"])
+        outcome = engine.run(scene, RunOptions(workers=1))
+        import frictionlab.plot
+        before = set(sys.modules)
+        frictionlab.plot.plot_curve(scene, outcome, io.BytesIO())
+        print(sorted(set(sys.modules) - before))
+        """,
+        tmp_path,
+    )
+    assert out.strip() == "[]"
