@@ -133,3 +133,54 @@ def test_drawing_plot_png_imports_nothing_the_plot_module_did_not(tmp_path):
         tmp_path,
     )
     assert out.strip() == "[]"
+
+
+def test_plot_png_is_drawn_in_a_thread_while_the_numbers_are_written_and_is_the_same_figure(
+    make_scene, tmp_path, monkeypatch
+):
+    """Begun once the ensemble is done, before its chunks and result files are written; the
+    file holds the bytes the figure drawn in place has."""
+    import io
+    import threading
+
+    from frictionlab import plot
+
+    seen, drawing = {}, plot.plot_curve
+
+    def plot_curve(scene, outcome, fh):
+        seen["drawn in"] = threading.current_thread().name
+        drawing(scene, outcome, fh)
+
+    monkeypatch.setattr(plot, "plot_curve", plot_curve)
+    scene = make_scene({"realizations": 4})
+    outcome, files = run_to_folder(scene, tmp_path / "run")
+    assert seen["drawn in"] == "draw the figure" != threading.main_thread().name
+    in_place = io.BytesIO()
+    drawing(scene, outcome, in_place)
+    assert files["plot"].read_bytes() == in_place.getvalue()
+
+
+def test_a_figure_that_fails_as_it_is_drawn_ahead_fails_where_its_file_is_written():
+    def draw(fh):
+        fh.write(b"half")
+        raise ValueError("no such font")
+
+    drawn = import_ahead.DrawnAhead(draw)
+    with pytest.raises(ValueError, match="no such font"):
+        drawn.write(None)
+
+
+def test_without_a_thread_the_figure_is_drawn_as_its_file_is_written(monkeypatch):
+    import io
+    import threading
+
+    def no_thread(self):
+        raise RuntimeError("can't start new thread")
+
+    monkeypatch.setattr(threading.Thread, "start", no_thread)
+    drawn_in = []
+    drawn = import_ahead.DrawnAhead(lambda fh: (drawn_in.append(fh), fh.write(b"png")))
+    assert drawn_in == []
+    out = io.BytesIO()
+    drawn.write(out)
+    assert drawn_in == [out] and out.getvalue() == b"png"
