@@ -188,7 +188,8 @@ XI_BOUND = 2.0
 def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
     complex arrays reached the statistics), ``failed_error`` is text, and the values are what a
-    realization can give: xi none infinite, below 0 or above ``XI_BOUND`` sqrt(points), each
+    realization can give: times and heights none infinite or below 0, indentations none
+    infinite, xi none infinite, below 0 or above ``XI_BOUND`` sqrt(points), each
     profile of 1 point or more, its rms slope finite and > 0 and its force unit > 0 (NaN there
     failed the run as a preset's magnitudes), its contact counts and the points carrying half the
     load (NaN: not said) from 0 to its points (a chunk that broke these was restored, and its run
@@ -198,8 +199,13 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
             raise ChunkDamage(f"array {name} of type {arrays[name].dtype}, not real numbers")
     if arrays["failed_error"].dtype.kind != "U":
         raise ChunkDamage(f"array failed_error of type {arrays['failed_error'].dtype}, not text")
+    for name in ("seconds", "failed_seconds", "measured_rms_height", "own_rms_height", "peak_rms"):
+        if name in numeric and bool((np.isinf(arrays[name]) | (arrays[name] < 0)).any()):  # NaN: an older chunk's
+            raise ChunkDamage(f"{name} infinite or below 0")  # a forged peak of inf was a caveat of the run
     if "xi" not in numeric:  # no finished realization
         return
+    if bool(np.isinf(arrays["indentation"]).any()):
+        raise ChunkDamage("indentation infinite")
     if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
         raise ChunkDamage("xi infinite or below 0")
     points = arrays["points"][:, None]
