@@ -155,6 +155,24 @@ def preset_overrides(args) -> list[str]:
     return [*overrides, f"seed={args.seed}"]
 
 
+def refuse_swept_overrides(args, data: dict) -> None:
+    """Refuse a ``--set`` (or ``--seed``) of a path the preset's sweep sets at each of its points:
+    ``--seed 9`` beside a sweep over seed ran seeds 1 and 2, the option ignored without a word."""
+    sweep = data.get("sweep")
+    swept = sweep.get("parameters") if isinstance(sweep, dict) else None
+    if not isinstance(swept, dict):
+        return
+    given = [(f"--set {assignment!r}", assignment.partition("=")[0].strip()) for assignment in args.set or []]
+    if getattr(args, "seed", None) is not None:
+        given.append((f"--seed {args.seed}", "seed"))
+    for option, path in given:
+        if path in swept:
+            raise FrictionlabError(
+                f"{option}: {path} is swept by the preset's sweep, which sets it at each point: it would be ignored; "
+                f"sweep other values (--set 'sweep.parameters.{path}={{values: [...]}}'), or run the preset once (--set sweep=null)"
+            )
+
+
 def refuse_unusable_matplotlib() -> None:
     """Import matplotlib before a command whose figures are its output does any work:
     a bad MPLBACKEND makes matplotlib's import itself raise, which the study found only
