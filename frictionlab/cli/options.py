@@ -156,21 +156,17 @@ def preset_overrides(args) -> list[str]:
 
 
 def refuse_swept_overrides(args, data: dict) -> None:
-    """Refuse a ``--set`` (or ``--seed``) of a path the preset's sweep sets at each of its points:
-    ``--seed 9`` beside a sweep over seed ran seeds 1 and 2, the option ignored without a word."""
-    sweep = data.get("sweep")
-    swept = sweep.get("parameters") if isinstance(sweep, dict) else None
-    if not isinstance(swept, dict):
-        return
-    given = [(f"--set {assignment!r}", assignment.partition("=")[0].strip()) for assignment in args.set or []]
+    """Refuse a ``--set`` (or ``--seed``) of a path the preset's sweep sets at each point
+    (``preset.paths.swept_paths``)."""
+    from ..preset.paths import SWEPT, swept_paths
+
+    given = {assignment.partition("=")[0].strip(): f"--set {assignment!r}" for assignment in args.set or []}
     if getattr(args, "seed", None) is not None:
-        given.append((f"--seed {args.seed}", "seed"))
-    for option, path in given:
-        if path in swept:
-            raise FrictionlabError(
-                f"{option}: {path} is swept by the preset's sweep, which sets it at each point: it would be ignored; "
-                f"sweep other values (--set 'sweep.parameters.{path}={{values: [...]}}'), or run the preset once (--set sweep=null)"
-            )
+        given["seed"] = f"--seed {args.seed}"
+    if swept := swept_paths(data, list(given)):
+        path = swept[0]
+        raise FrictionlabError(f"{given[path]}: {path} {SWEPT}; sweep other values (--set "
+                               f"'sweep.parameters.{path}={{values: [...]}}'), or run the preset once (--set sweep=null)")
 
 
 def refuse_unusable_matplotlib() -> None:
