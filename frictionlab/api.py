@@ -68,7 +68,7 @@ def read_preset_input(
     or a ``{...}`` flow mapping); else a path to a file, or a built-in's name.
     ``overrides`` may also come as a keyword (no preset has such a key); ``preset`` may not."""
     from .preset import Preset, load_preset_file, set_path
-    from .preset.paths import is_dotted_path
+    from .preset.paths import SWEPT, is_dotted_path, swept_paths
     from .preset.builtin import locate_preset
     from .preset.reading import not_a_mapping, resolve_input_paths
     from .io.safe_yaml import YamlProblem, load_yaml
@@ -123,6 +123,8 @@ def read_preset_input(
             set_path(data, str(path), value)
         except ValueError as exc:
             problems.append(f"{path}: {exc}")
+    problems += [f"{typed.get(path, path)}: {SWEPT}; sweep other values, or run the preset once (sweep=None)"
+                 for path in swept_paths(data, list(assignments))]  # fmt: skip
     if problems:
         raise PresetError(problems, source="overrides")
     return data, source, base_dir

@@ -56,6 +56,9 @@ class RunOptions:
             )
         if isinstance(self.retries, bool) or not isinstance(self.retries, int) or self.retries < 0:
             raise FrictionlabError(f"retries must be a whole number >= 0. Got {short_repr(self.retries)} instead.")
+        for name in ("dashboard", "resume", "memory_check", "force"):  # force="no" is a truthy str: it forced
+            if not isinstance(value := getattr(self, name), bool):
+                raise FrictionlabError(f"{name} must be True or False. Got {short_repr(value)} ({type(value).__name__}) instead.")
         if self.dashboard:  # before anything starts: without bokeh the dashboard's address serves only 404s
             require("bokeh", "dashboard")
 

@@ -429,3 +429,12 @@ def test_a_run_with_failed_realizations_is_read_back_not_called_damaged(make_sce
     assert outcome.failures and (outcome.done or realizations == 1)
     read = frictionlab.load(tmp_path / "run")
     assert read.realizations == (outcome.done, realizations) and read.status == outcome.status
+
+
+@pytest.mark.parametrize("given", [{"seed": 9}, {"overrides": {"seed": 9}}])
+def test_an_override_of_a_swept_path_is_refused(given):
+    """run(sweep_over_seed, seed=9) ran seeds 1 and 2, the keyword ignored without a word."""
+    preset = merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"values": [1, 2]}}}})
+    with pytest.raises(PresetError, match="seed: is swept by the preset's sweep, which sets it at each point"):
+        frictionlab.validate(preset, **given)
+    assert frictionlab.validate(preset, sweep=None, seed=9)["name"] == SMALL_PRESET["name"]  # the preset once

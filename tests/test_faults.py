@@ -223,6 +223,18 @@ def count_above_points(folder):
     _rewrite(folder, _second(folder), lambda a: a["contact_count"].__setitem__((0, 0), a["points"][0] + 1), True)
 
 
+def huge_xi(folder):  # finite and >= 0: the fit overflowed, a printed in 300 digits
+    _rewrite(folder, _second(folder), lambda a: a["xi"].__setitem__((0, 0), 1e308), True)
+
+
+def infinite_peak(folder):  # the run's caveat said its highest point stood inf rms heights above the mean
+    _rewrite(folder, _second(folder), lambda a: a["peak_rms"].__setitem__(0, math.inf), True)
+
+
+def negative_seconds(folder):
+    _rewrite(folder, _second(folder), lambda a: a["seconds"].__setitem__(0, -1e308), True)
+
+
 def no_points(folder):
     _rewrite(folder, _second(folder), lambda a: a["points"].__setitem__(0, 0), True)
 
@@ -272,6 +284,9 @@ DAMAGE = {
     text_xi: "array xi of type <U32, not real numbers",
     negative_count: "contact_count below 0 or above the profile's points",
     count_above_points: "contact_count below 0 or above the profile's points",
+    huge_xi: "xi above what an rms over some of a profile's slopes can be",
+    infinite_peak: "peak_rms infinite or below 0",
+    negative_seconds: "seconds infinite or below 0",
     no_points: "a profile's points not a whole number >= 1",
     nan_points: "a profile's points not a whole number >= 1",
     fractional_points: "a profile's points not a whole number >= 1",

@@ -205,3 +205,23 @@ def test_an_output_folder_under_a_device_says_what_the_device_is(tmp_path):
     from frictionlab.io.files import output_path_problem
 
     assert output_path_problem(Path(os.devnull) / "run") == f"{os.devnull}/run cannot be made a folder: {os.devnull} is a character device"
+
+
+def test_a_socket_given_as_an_input_file_is_named_a_socket(tmp_path, cli):
+    """Opening a socket fails with ENXIO, which read "cannot be read: no such device or address"
+    (a preset file; a run folder's run.json in frictionlab runs): it is said as what it is."""
+    import socket
+
+    from frictionlab.io.inputs import InputFileProblem, open_regular_file
+    from frictionlab.runs.runfolder import open_member
+
+    (tmp_path / "run").mkdir()
+    with socket.socket(socket.AF_UNIX) as sock, socket.socket(socket.AF_UNIX) as inner:
+        sock.bind(str(tmp_path / "p.yaml"))
+        inner.bind(str(tmp_path / "run" / "run.json"))
+        with pytest.raises(InputFileProblem, match="^preset file is a socket, not a regular file$"):
+            open_regular_file(tmp_path / "p.yaml", "preset file")
+        with pytest.raises(InputFileProblem, match="^run.json is a socket, not a regular file$"):
+            open_member(tmp_path / "run", "run.json")
+        done = cli("validate", str(tmp_path / "p.yaml"))
+    assert done.returncode == 3 and "preset file is a socket, not a regular file" in done.stdout + done.stderr

@@ -69,9 +69,9 @@ IN_PROCESS = {
     "NUL name": (replace("name: small", 'name: "a\\0b"'), ExitCode.USAGE, "got 'a\\x00b'"),
     "NUL byte in the file": (BASE + "description: a\x00b\n", ExitCode.USAGE, "character #x0000 is not allowed"),
     "int past the digit limit": (replace("seed: 7", "seed: " + "1" * 5000), ExitCode.USAGE,
-                                 "cannot be converted (ValueError: Exceeds the limit (4300 digits)"),
+                                 "seed: the value at line 2 cannot be converted (ValueError: Exceeds the limit (4300 digits)"),
     "impossible date": (replace("name: small", "name: 2020-13-45"), ExitCode.USAGE,
-                        "cannot be converted (ValueError: month must be in 1..12)"),
+                        "name: the value at line 1 cannot be converted (ValueError: month must be in 1..12)"),
     "control char in a file path": (replace("name: power-law", "name: profile-file").replace(
         "hurst: 0.8\n    points: 1024\n    rms_height: 1.0", 'path: "scan\\n.csv"\n    spacing: 1.0'),
         ExitCode.USAGE, "spectrum.params.path: must not contain control characters"),

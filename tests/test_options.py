@@ -21,3 +21,11 @@ def test_numpy_integers_are_whole_numbers():
 def test_other_types_are_refused_by_name(workers):
     with pytest.raises(FrictionlabError, match=r"^workers must be a whole number >= 1\. Got .* instead\.$"):
         RunOptions(workers=workers)
+
+
+@pytest.mark.parametrize("name", ["force", "resume", "memory_check", "dashboard"])
+@pytest.mark.parametrize("value", ["no", 1, None])
+def test_a_flag_that_is_not_a_bool_is_refused_by_name(name, value):
+    """RunOptions(force="no"): a truthy string forced the write into a folder of the user's."""
+    with pytest.raises(FrictionlabError, match=rf"^{name} must be True or False\. Got .* instead\.$"):
+        RunOptions(**{name: value})

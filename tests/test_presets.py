@@ -111,6 +111,21 @@ def test_a_run_folder_given_as_a_preset_points_to_its_preset(tmp_path, capsys):
     assert "preset file is a folder, not a regular file" in "".join(capsys.readouterr())
 
 
+@pytest.mark.parametrize("record", ["summary.json", "run.json"])
+def test_a_runs_record_given_as_a_preset_points_to_its_preset(tmp_path, capsys, record):
+    """`frictionlab run runs/x/summary.json` listed the summary's fields as 37 problems of a preset."""
+    from frictionlab.cli import main
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "preset.yaml").write_text((PRESETS / "quickstart.yaml").read_text())
+    (folder / record).write_text('{"schema_version": 2, "preset": {}}')
+    assert main(["validate", str(folder / record)]) == 3
+    err = "".join(capsys.readouterr())
+    assert f"(file): the {record} of a run, not a preset; the run's preset is {folder / 'preset.yaml'}" in err
+    assert "problems in preset" not in err
+
+
 def test_a_preset_file_of_two_documents_says_so():
     """Two YAML documents in one file (a --- line between them) were refused as 'not valid YAML
     at line 6, column 1: but found another document', the parser's half sentence."""

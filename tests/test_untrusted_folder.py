@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import threading
 from pathlib import Path
@@ -234,6 +235,23 @@ def test_a_sweep_json_without_a_row_for_every_point_is_damaged(tmp_path):
         frictionlab.load(folder)
     (folder / "sweep.json").write_text(json.dumps(data))
     assert len(frictionlab.load(folder).points) == 2
+
+
+def test_a_sweep_json_row_without_its_swept_value_is_damaged(tmp_path):
+    """A row without the value its point gave the swept parameter, or a mapping there, was shown
+    (and compared with its point's run) as that value."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    for value, said in ((None, "missing"), ({"x": 1}, "a dict, not text, a number, true, false or null")):
+        row = {k: v for k, v in data["points"][1].items() if k != "spectrum.params.hurst"}
+        if value is not None:
+            row["spectrum.params.hurst"] = value
+        (folder / "sweep.json").write_text(json.dumps({**data, "points": [data["points"][0], row]}))
+        with pytest.raises(RunFolderError, match=r"sweep.json is damaged: field 'points.1.spectrum.params.hurst' "
+                                                 rf"\(the swept value of point 2\) is {re.escape(said)}$"):
+            frictionlab.load(folder)
 
 
 def test_a_sweep_json_row_edited_is_refused_or_shown_never_an_internal_error(tmp_path, capsys):

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..errors import ExitCode, shown
 from .console import stderr_log
-from .options import add_workers_option, run_options
+from .options import add_workers_option, refuse_unusable_matplotlib, run_options
 
 
 def add_parser(sub) -> None:
@@ -38,6 +38,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
+    refuse_unusable_matplotlib()  # before exact3d.report's import of its figures' module
     from ..exact3d.report import write_page
 
     page = write_page(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code

@@ -42,6 +42,8 @@ def run(args) -> ExitCode:
     from ..preset.builtin import builtin_presets
 
     if getattr(args, "action", None) == "copy":
+        if args.json:  # taken by `presets`, not by copy: a script waiting for JSON got a line of text
+            raise FrictionlabError("--json lists the built-in presets as JSON; presets copy prints none: leave --json out")
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
             from ..io.files import output_path_problem

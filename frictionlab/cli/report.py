@@ -7,7 +7,7 @@ import re
 
 from ..errors import ExitCode, FrictionlabError, shown
 from .console import stderr_log
-from .options import add_workers_option, run_options
+from .options import add_workers_option, refuse_unusable_matplotlib, run_options
 
 MAX_REPLICATES = 100  # each is a full run of every reading
 
@@ -37,12 +37,13 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
-    from ..paper.reproduce import write_report
-
     if not 1 <= args.replicates <= MAX_REPLICATES:
         raise FrictionlabError(f"--replicates must be a whole number from 1 to {MAX_REPLICATES}. Got {args.replicates} instead.")
     if args.replicates != 1 and not args.readings:
         raise FrictionlabError(f"--replicates {args.replicates} needs --readings: only the readings run on several ensembles")
+    refuse_unusable_matplotlib()  # before paper.reproduce's import of its figures' module
+    from ..paper.reproduce import write_report
+
     path = write_report(  # interrupted: signals.WorkInterrupted, said by cli.main with its exit code
         presets_dir=args.presets, out_dir=args.out, markdown_path=args.markdown, figures_dir=args.figures,
         options=run_options(workers=args.workers, force=args.force), readings=args.readings, replicates=args.replicates,

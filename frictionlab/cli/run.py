@@ -9,7 +9,13 @@ from pathlib import Path
 
 from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, command_word, counted, ran_out_of_memory,
                       resume_hint, shown, shown_name, too_long_path, write_failed)  # fmt: skip
-from .options import add_executor_options, add_workers_option, executor_run_options, preset_overrides
+from .options import (
+    add_executor_options,
+    add_workers_option,
+    executor_run_options,
+    preset_overrides,
+    refuse_swept_overrides,
+)
 
 
 def add_parser(sub) -> None:
@@ -56,6 +62,7 @@ def run(args) -> ExitCode:
     source = args.source = preset_source(args.preset, args.set or [])  # what messages name, a sweep's too
     args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
+    refuse_swept_overrides(args, data)
     options = executor_run_options(args, resume=args.resume, force=args.force)
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
     scene = build_scene(data, source=source, before_reading=reading)

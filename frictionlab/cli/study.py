@@ -9,7 +9,7 @@ import sys
 
 from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown_name
 from ..tradeoff.options import AXES, StudyOptions
-from .options import preset_overrides
+from .options import preset_overrides, refuse_unusable_matplotlib
 
 
 def _listed(values) -> str:
@@ -243,6 +243,7 @@ def run(args) -> ExitCode:
     from ..tradeoff.scenes import SceneFactory
 
     options = options_from_args(args)
+    refuse_unusable_matplotlib()  # study.png is drawn once every axis has run
     overrides = preset_overrides(args)
     data = read_preset(resolve_preset_path(args.preset), overrides)  # relative input files taken from the preset's folder
     if data.get("sweep") is not None:

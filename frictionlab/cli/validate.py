@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import ExitCode, FrictionlabError, PresetError, counted, shown
+from .options import refuse_swept_overrides
 
 
 def add_parser(sub) -> None:
@@ -35,6 +36,7 @@ def run(args) -> ExitCode:
         points = None
         try:
             data = read_preset(resolve_preset_path(path), args.set or [])
+            refuse_swept_overrides(args, data)
             source = preset_source(path, args.set or [])
             scene = build_scene(data, source=source, before_reading=check_one_realization)
             if scene.preset.sweep is not None:  # every point too

@@ -84,6 +84,8 @@ def open_regular_file(path: str | Path, what: str = "file", *, dir_fd: int | Non
     except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
         if getattr(exc, "errno", None) == errno.ELOOP and not follow_links:
             raise InputFileProblem(f"{what} is a symbolic link, which is never followed here") from None
+        if kind := _not_regular(path, dir_fd, follow_links):  # a socket cannot be opened: ENXIO said "no such device"
+            raise InputFileProblem(f"{what} is {kind}, not a regular file") from None
         reason = getattr(exc, "strerror", None) or "cannot be opened"
         raise InputFileProblem(f"{what} cannot be read: {reason[:1].lower() + reason[1:]}") from None
     mode = os.fstat(fd).st_mode
@@ -95,6 +97,15 @@ def open_regular_file(path: str | Path, what: str = "file", *, dir_fd: int | Non
         raise InputFileProblem(f"{what} is in the kernel's /proc or /sys (a read may block), not a data file")
     os.set_blocking(fd, True)
     return os.fdopen(fd, "rb")
+
+
+def _not_regular(path, dir_fd: int | None, follow_links: bool) -> str | None:
+    """What ``path`` is when it is there and no regular file, in words (``file_kind``); else None."""
+    try:
+        mode = os.stat(path, dir_fd=dir_fd, follow_symlinks=follow_links).st_mode
+    except (OSError, ValueError):
+        return None
+    return None if stat.S_ISREG(mode) else file_kind(mode)
 
 
 def _of_the_kernel(fd: int) -> bool:

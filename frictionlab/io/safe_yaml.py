@@ -38,9 +38,9 @@ def _line(node_or_mark) -> int:
 class _Unconvertible(ValueError):
     """A scalar YAML parsed but Python cannot hold, with the line it is on."""
 
-    def __init__(self, line: int, cause: Exception):
+    def __init__(self, node, cause: Exception):
         super().__init__(str(cause))
-        self.line, self.cause = line, cause
+        self.node, self.line, self.cause = node, _line(node), cause
 
 
 class _BoundedLoader(yaml.SafeLoader):
@@ -59,7 +59,7 @@ class _BoundedLoader(yaml.SafeLoader):
         except (ValueError, OverflowError) as exc:  # a date like 2020-13-45, an int past Python's digit limit
             if isinstance(exc, _Unconvertible):
                 raise
-            raise _Unconvertible(_line(node), exc) from None
+            raise _Unconvertible(node, exc) from None
 
     def compose_node(self, parent, index):
         self._depth += 1
@@ -143,10 +143,11 @@ def _duplicate_key(node: yaml.MappingNode, path: str) -> str | None:
     return None
 
 
-def check_nodes(root) -> None:
+def check_nodes(root) -> dict[int, str]:
     """Refuse recursive aliases, more than MAX_VALUES values once aliases are
     expanded, and duplicate keys. Each node is visited once (iterative
-    depth-first walk: aliases can chain deeper than the stack)."""
+    depth-first walk: aliases can chain deeper than the stack). Returns the dotted
+    path of each mapping's value, by its node's id."""
     size: dict[int, int] = {}  # expanded size of each finished node
     open_nodes: set[int] = set()  # the nodes on the current path
     paths: dict[int, str] = {id(root): ""}
@@ -186,6 +187,7 @@ def check_nodes(root) -> None:
                 )
             if id(child) not in size:
                 stack.append((child, False))
+    return paths
 
 
 _OPENED = {"a flow sequence": "a [ list", "a flow mapping": "a { mapping", "a quoted scalar": "a quoted string"}
@@ -238,7 +240,7 @@ def load_yaml(text: str) -> Any:
             raise YamlProblem("not valid YAML") from None
         if root is None:
             return None
-        check_nodes(root)
+        paths = check_nodes(root)
         try:
             return loader.construct_document(root)
         except yaml.MarkedYAMLError as exc:
@@ -250,7 +252,9 @@ def load_yaml(text: str) -> Any:
             raise YamlProblem(f"a value YAML cannot read{where}: {said}") from None
         except _Unconvertible as exc:  # the reason names limits and ranges, never the text
             reason = str(exc.cause).split(";")[0][:100]
-            raise YamlProblem(f"the value at line {exc.line} cannot be converted ({type(exc.cause).__name__}: {reason})") from None
+            field = f"{paths[id(exc.node)]}: " if paths.get(id(exc.node)) else ""  # a list's item has no key of its own
+            raise YamlProblem(f"{field}the value at line {exc.line} cannot be converted ({type(exc.cause).__name__}: "
+                              f"{reason})") from None
         except (ValueError, OverflowError) as exc:
             raise YamlProblem(f"a value YAML cannot convert ({type(exc).__name__})") from None
     finally:

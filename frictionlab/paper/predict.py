@@ -266,6 +266,7 @@ def read_run_law(
     xi, f = arrays
     pairs = _pairs_of(summary, law, xi, f)
     _check_law_within(pairs, law, path)
+    _check_intervals_redrawn(pairs, law, path)
     return law, (float(np.min(f)), float(np.max(f))), pairs
 
 
@@ -299,6 +300,23 @@ def _check_law_within(pairs: np.ndarray | None, law: LogFit, path: Path) -> None
             )
 
 
+def _check_intervals_redrawn(pairs: np.ndarray | None, law: LogFit, path: Path) -> None:
+    """summary.json's intervals are the percentiles of the very pairs redrawn here: a
+    realizations.npz that gives others (one xi forged to 1e308 gave an interval of xi up
+    to 1e306, a and b still among the resamples) is not the run's."""
+    if pairs is None or not len(pairs):
+        return
+    low, high = percentile_interval(pairs, law.confidence, axis=0)
+    for column, name, stored in ((0, "a", law.a_ci), (1, "b", law.b_ci)):
+        redrawn = (float(low[column]), float(high[column]))
+        if not np.allclose(stored, redrawn, rtol=1e-6, atol=1e-12):
+            raise RunFolderError(
+                f"{shown_name(path)}: fit.{name}_ci = [{stored[0]:.6g}, {stored[1]:.6g}] is not the interval of its "
+                f"{len(pairs)} bootstrap resamples redrawn from realizations.npz ([{redrawn[0]:.6g}, {redrawn[1]:.6g}]): "
+                "the two files disagree (one was edited or damaged); run it again, or give the law by hand with --a/--b"
+            )
+
+
 def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
     """The run's bootstrap (a, b) pairs, redrawn from realizations.npz with the run's
     seed and resample count: the very pairs behind summary.json's intervals."""
@@ -312,7 +330,8 @@ def bootstrap_pairs(run_dir: str | Path) -> np.ndarray | None:
 def _pairs_of(summary: dict, law: LogFit, xi: np.ndarray, f: np.ndarray) -> np.ndarray | None:
     if not law.bootstrap or xi.shape[0] < 2:
         return None
-    return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
+    with np.errstate(over="ignore", invalid="ignore"):  # a forged xi of 1e308: refused by name once redrawn
+        return resample_pairs(f, xi, law.bootstrap, bootstrap_rng(summary["seed"]))
 
 
 def _read_summary(run_dir: Path, name: str = "run folder") -> dict:

@@ -47,13 +47,22 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, DEFAULT_FIGURES, "run the report again", make=False)
     _refuse_overwriting(markdown_path, figures_dir, force)
     _refuse_inside_runs(out_dir, markdown_path, figures_dir)
-    figures = {os.path.realpath(figures_dir / name) for name in FIGURE_FILES}
-    if os.path.realpath(markdown_path) in figures:  # the report was written over the figure, linking to itself
-        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is a figure the report draws in {shown_name(figures_dir)}: "
-                            "give another file name")  # fmt: skip
+    _refuse_markdown_among_figures(markdown_path, figures_dir)
     if not force:
         _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
     return out_dir, markdown_path, figures_dir
+
+
+def _refuse_markdown_among_figures(markdown_path: Path, figures_dir: Path) -> None:
+    """Refuse a markdown that is a figure (written over Fig. 2, linking to itself) or the figures'
+    folder, or a folder above it (every figure ran, then the markdown was a folder: exit 1)."""
+    markdown, folder = os.path.realpath(markdown_path), os.path.realpath(figures_dir)
+    if markdown in {os.path.realpath(figures_dir / name) for name in FIGURE_FILES}:
+        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is a figure the report draws in {shown_name(figures_dir)}: "
+                            "give another file name")  # fmt: skip
+    if folder == markdown or folder.startswith(markdown + os.sep):
+        raise OutputRefused(f"--markdown {shown_name(markdown_path)} is the figures' folder {shown_name(figures_dir)}, "
+                            "or a folder above it: give another file name, or other --figures")  # fmt: skip
 
 
 def _refuse_foreign_folder(out_dir: Path, markdown_path: Path, figures_dir: Path) -> None:

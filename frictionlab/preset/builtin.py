@@ -106,6 +106,13 @@ def resolve_preset_path(argument: str | Path) -> Path:
         raise PresetFileError([f"(file): a folder, not a preset; it holds a sweep (frictionlab resume {command_word(path)} continues "
                                f"it), each point's preset in {shown_name(path / 'points')}/<NN-label>/preset.yaml"],
                               source=str(argument))  # fmt: skip
+    # a run's record given for its preset: its fields were listed as 37 problems of a preset
+    if path.name in ("summary.json", "run.json") and (path.parent / "preset.yaml").is_file():
+        raise PresetFileError(
+            [f"(file): the {path.name} of a run, not a preset; the run's preset is {shown_name(path.parent / 'preset.yaml')} "
+             f"(frictionlab run {command_word(path.parent / 'preset.yaml')} --out NEW runs it again)"],
+            source=str(argument),
+        )  # fmt: skip
     if path.exists() or not named:
         return path  # a path: read (and, if missing, reported) as one
     found = find_builtin(str(argument))

@@ -87,6 +87,17 @@ def _swept_path_as_one_key(keys: list[str], value: Any) -> list[str]:
     return [*keys[:2], ".".join(keys[2:])]
 
 
+SWEPT = "is swept by the preset's sweep, which sets it at each point: it would be ignored"
+
+
+def swept_paths(data: dict, paths: Sequence[str]) -> list[str]:
+    """Those of ``paths`` that the preset's sweep sets at each of its points: an override of one
+    (``--seed 9`` beside a sweep over seed) was ignored without a word."""
+    sweep = data.get("sweep")
+    swept = sweep.get("parameters") if isinstance(sweep, dict) else None
+    return [path for path in paths if isinstance(swept, dict) and path in swept]
+
+
 def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
     """A copy of ``data`` with ``dotted.path=value`` assignments applied (values read as YAML scalars)."""
     data = copy.deepcopy(data)

@@ -179,25 +179,40 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
     return np.frombuffer(raw, dtype).astype(np.int64)
 
 
+# An rms over some of n values is at most sqrt(n) times their rms (its largest square is at most
+# their sum): xi, the rms slope in contact over the profile's, is at most sqrt(points); twice
+# that leaves room for a plugin's own weighting. A forged xi of 1e308 overflowed the fit.
+XI_BOUND = 2.0
+
+
 def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
     complex arrays reached the statistics), ``failed_error`` is text, and the values are what a
-    realization can give: xi none infinite or below 0, each profile of 1 point or more, its rms
-    slope finite and > 0 and its force unit > 0 (NaN there failed the run as a preset's magnitudes), its
-    contact counts and the points carrying half the load (NaN: not said) from 0 to its points
-    (a chunk that broke these was restored, and its run folder written as its load refuses)."""
+    realization can give: times and heights none infinite or below 0, indentations none
+    infinite, xi none infinite, below 0 or above ``XI_BOUND`` sqrt(points), each
+    profile of 1 point or more, its rms slope finite and > 0 and its force unit > 0 (NaN there
+    failed the run as a preset's magnitudes), its contact counts and the points carrying half the
+    load (NaN: not said) from 0 to its points (a chunk that broke these was restored, and its run
+    folder written as its load refuses)."""
     for name in numeric:
         if arrays[name].dtype.kind not in "iuf":
             raise ChunkDamage(f"array {name} of type {arrays[name].dtype}, not real numbers")
     if arrays["failed_error"].dtype.kind != "U":
         raise ChunkDamage(f"array failed_error of type {arrays['failed_error'].dtype}, not text")
+    for name in ("seconds", "failed_seconds", "measured_rms_height", "own_rms_height", "peak_rms"):
+        if name in numeric and bool((np.isinf(arrays[name]) | (arrays[name] < 0)).any()):  # NaN: an older chunk's
+            raise ChunkDamage(f"{name} infinite or below 0")  # a forged peak of inf was a caveat of the run
     if "xi" not in numeric:  # no finished realization
         return
+    if bool(np.isinf(arrays["indentation"]).any()):
+        raise ChunkDamage("indentation infinite")
     if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
         raise ChunkDamage("xi infinite or below 0")
     points = arrays["points"][:, None]
     if not bool((np.isfinite(points) & (points >= 1) & (points == np.floor(points))).all()):  # NaN failed int()
         raise ChunkDamage("a profile's points not a whole number >= 1")
+    if bool((arrays["xi"] > XI_BOUND * np.sqrt(points)).any()):  # NaN compares false: allowed
+        raise ChunkDamage("xi above what an rms over some of a profile's slopes can be")
     if not bool((arrays["slope_rms_line"] > 0).all() and np.isfinite(arrays["slope_rms_line"]).all()):
         raise ChunkDamage("a line's rms slope not a finite number > 0")  # a realization with one is a failure
     if not bool((arrays["force_unit"] > 0).all()):  # NaN compares false: refused (inf: the run's own check says it)

@@ -77,7 +77,20 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
         raise RunFolderError(f"{shown_name(path)} is damaged (sweep: not a sweep section a preset can hold)") from None
     if len(record.points) != points:
         raise RunFolderError(f"{shown_name(path)} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
+    _check_swept_values(data["points"], list(record.sweep.parameters), path)
     return data, record
+
+
+def _check_swept_values(rows: list[dict], parameters: list[str], path: Path) -> None:
+    """Each row holds the value its point gave each swept parameter, a scalar as a sweep's values
+    are: a row without it, or with a mapping there, was shown and compared as the point's value."""
+    for number, row in enumerate(rows):
+        for parameter in parameters:
+            value = row.get(parameter, MISSING)
+            if value is MISSING or not (value is None or isinstance(value, (str, int, float, bool))):
+                said = "missing" if value is MISSING else f"a {type(value).__name__}, not text, a number, true, false or null"
+                raise RunFolderError(f"{shown_name(path)} is damaged: field 'points.{number}.{parameter}' (the swept value "
+                                     f"of point {number + 1}) is {said}")  # fmt: skip
 
 
 def own_point(point, name: str, row: dict, parameters: list[str]):

@@ -139,3 +139,11 @@ def test_a_mistyped_command_under_json_is_an_error_object_too(capsys):
     data = one_object(capsys.readouterr().out)
     assert data["schema"] == "frictionlab/error/1" and "did you mean 'validate'?" in data["error"]
     assert data["command"] is None and data["exit_code"] == ExitCode.USAGE
+
+
+def test_presets_json_before_copy_is_refused_not_ignored(tmp_path, cli):
+    """`presets --json copy NAME` printed a line of text to a script waiting for JSON."""
+    done = cli("presets", "--json", "copy", "quickstart", str(tmp_path / "q.yaml"))
+    assert done.returncode == ExitCode.USAGE and not (tmp_path / "q.yaml").exists()
+    data = one_object(done.stdout)
+    assert data["schema"] == "frictionlab/error/1" and "presets copy prints none: leave --json out" in data["error"]

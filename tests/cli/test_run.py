@@ -108,6 +108,20 @@ def test_a_seed_given_twice_with_two_values_is_refused_before_any_work(tmp_path,
     assert json.loads(same.stdout)["seed"] == 99
 
 
+@pytest.mark.parametrize("command, option", [("run", ["--seed", "9"]), ("run", ["--set", "seed=9"]),
+                                             ("validate", ["--set", "seed=9"])])  # fmt: skip
+def test_a_swept_path_given_on_the_command_line_is_refused(tmp_path, cli, command, option):
+    """--seed 9 beside a sweep over seed ran seeds 1 and 2, the option ignored without a word."""
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"values": [1, 2]}}}}))
+    out = ["--out", tmp_path / "o", "--quiet"] if command == "run" else []
+    result = cli(command, preset, *out, *option)
+    assert result.returncode == ExitCode.USAGE, result.stderr
+    said = "--seed 9" if option[0] == "--seed" else "--set 'seed=9'"
+    assert f"{said}: seed is swept by the preset's sweep, which sets it at each point: it would be ignored" in result.stderr
+    assert not (tmp_path / "o").exists()
+    assert cli("validate", preset, "--set", "sweep=null", "--set", "seed=9").returncode == 0  # the preset once
+
+
 def test_progress_lines_on_stderr_when_not_a_terminal(tmp_path, cli):
     preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 40}))
     result = cli("run", preset, "--out", tmp_path / "o", "--workers", "2", "--no-plot")

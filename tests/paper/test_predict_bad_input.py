@@ -220,6 +220,14 @@ def _one_xi_negative(path):  # an rms slope over another is never below 0: a fil
         np.savez(fh, **arrays)
 
 
+def _one_xi_huge(path):  # finite and >= 0, a and b still among the resamples: the interval of xi went to 1e306
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["xi"][0, 0] = 1e308
+    with path.open("wb") as fh:
+        np.savez(fh, **arrays)
+
+
 def _f_not_positive(path):
     with np.load(path) as data:
         arrays = dict(data)
@@ -286,6 +294,7 @@ def _folder(path):
         (_all_nan, "'xi' must hold finite numbers, or NaN where a line has no xi, with xi defined at two loads or "
                    "more (no line has xi at "),  # said as it is: it once said "(0 of ... are infinite)"
         (_one_xi_negative, "'xi' must hold numbers >= 0, or NaN where a line has no xi (1 of "),
+        (_one_xi_huge, "is not the interval of its 200 bootstrap resamples redrawn from realizations.npz"),
         (_f_not_positive, "'f' must hold finite numbers > 0"),
         (_xi_of_other_shape, "one per load step"),
         (_xi_as_text, "'xi' must be 2-D numbers"),

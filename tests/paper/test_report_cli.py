@@ -282,3 +282,16 @@ def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_
     assert code == ExitCode.OUTPUT_REFUSED
     assert f"{out / key} is not empty and is not" in capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == [key] and (out / key / "notes.txt").read_text() == "mine"
+
+
+@pytest.mark.parametrize("markdown, figures", [("out/figures", None), ("R.md", "R.md"), ("R.md", "R.md/figs")])
+def test_a_markdown_that_is_the_figures_folder_is_refused(tmp_path, capsys, markdown, figures):
+    """--markdown OUT/figures (the figures' folder): every figure ran, then the markdown could not be
+    written, a folder (exit 1). Refused before any run (exit 4)."""
+    out = tmp_path / "out"
+    given = ["--figures", str(tmp_path / figures)] if figures else []
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), *given, "--markdown", str(tmp_path / markdown),
+                 "--quiet"])  # fmt: skip
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert f"--markdown {tmp_path / markdown} is the figures' folder" in capsys.readouterr().err
+    assert not out.exists() and not (tmp_path / markdown).exists()
