@@ -237,3 +237,34 @@ def test_the_bootstrap_forms_its_counts_a_block_at_a_time_with_the_draws_of_one_
     projector = np.linalg.pinv(np.column_stack([np.ones(f.size), np.log(f)]))
     whole = (defined_mean(xi, counts) if averaged else counts @ xi / realizations) @ projector.T
     np.testing.assert_allclose(pairs, whole, rtol=1e-10, atol=1e-13)
+
+
+@pytest.mark.parametrize("resamples, confidence, said", [(1, 0.95, True), (39, 0.95, True), (40, 0.95, False),
+                                                         (19, 0.9, True), (20, 0.9, False), (0, 0.95, False)])
+def test_intervals_from_too_few_resamples_for_both_tails_carry_a_caveat(resamples, confidence, said):
+    """A percentile interval at confidence c leaves (1 - c) / 2 of the resamples in each tail: under
+    2 / (1 - c) of them a tail holds none; with 1 the interval is that resample, which may not hold
+    the estimate (0: no intervals, nothing to say)."""
+    from frictionlab.compute.ensemble import few_resamples_caveat
+
+    rng = np.random.default_rng(3)
+    f = np.geomspace(1, 20, 12)
+    xi = 1.0 + 0.05 * np.log(f) + 0.02 * rng.standard_normal((30, f.size))
+    fit = fit_log_law(f, xi, bootstrap=resamples, confidence=confidence, rng=np.random.default_rng(1))
+    caveat = few_resamples_caveat(fit)
+    assert (caveat is not None) == said
+    if said:
+        assert f"rest on {resamples} bootstrap" in caveat and f"fewer than {round(2 / (1 - confidence))}" in caveat
+    if resamples == 1:  # what the caveat warns of: one resample's interval is a point
+        assert fit.a_ci[0] == fit.a_ci[1]
+
+
+def test_a_run_with_too_few_resamples_says_so_in_its_caveats():
+    import frictionlab
+
+    from .conftest import SMALL_PRESET, merge
+
+    few = frictionlab.run(merge(SMALL_PRESET, {"fit": {"bootstrap": 5}}), workers=1, progress=False)
+    enough = frictionlab.run(merge(SMALL_PRESET, {"fit": {"bootstrap": 40}}), workers=1, progress=False)
+    assert any("rest on 5 bootstrap" in c for c in few.caveats)
+    assert not any("bootstrap resample" in c for c in enough.caveats)

@@ -72,6 +72,19 @@ def same_curves_caveat(xi: np.ndarray) -> str | None:
     )
 
 
+def few_resamples_caveat(fit: LogFit) -> str | None:
+    """The caveat of intervals drawn from too few bootstrap resamples: fewer than 2 / (1 -
+    confidence) leave a tail of the percentile interval without a single resample (with 1, the
+    interval is that resample's, which need not hold the estimate)."""
+    need = math.ceil(2 / (1 - fit.confidence) - 1e-9)
+    if not 0 < fit.bootstrap < need:
+        return None
+    return (
+        f"the {100 * fit.confidence:g}% intervals rest on {fit.bootstrap} bootstrap resample(s): fewer than {need} "
+        "leave a tail without one, so the interval is too narrow (or misses the estimate); raise fit.bootstrap"
+    )
+
+
 def spike_caveat(peak: float) -> str:
     """The caveat of a profile whose highest point stands ``peak`` rms heights above its mean."""
     return (
@@ -161,6 +174,8 @@ class RunOutcome:
         if self.fit is None or not self.contact_count.size:
             return []
         caveats = list(self.spectrum_caveats)
+        if caveat := few_resamples_caveat(self.fit):
+            caveats.append(caveat)
         if self.contact_count[0] < MIN_CONTACTS_FIRST_LOAD:
             caveats.append(few_contacts_caveat(float(self.contact_count[0])))
         full = np.flatnonzero(self.contact_fraction >= FULL_CONTACT)
