@@ -49,6 +49,8 @@ def run_app(
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+    if app.farewell:
+        print(app.farewell, file=sys.stderr)
     return app.return_code or 0
 
 
