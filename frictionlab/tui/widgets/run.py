@@ -168,6 +168,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
 
     def on_resize(self) -> None:
         self.call_after_refresh(self._fit_table)
+        self.call_after_refresh(self._progress_in_sight)
 
     def _fit_table(self) -> None:
         """A sweep's table of points is as tall as its rows, up to 40 % of the tab and no more
@@ -226,7 +227,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _progress_in_sight(self) -> None:
         """Under 12 rows (30x8) the title and the folder took the rows the status line left, the
         progress below them: the tab starts at the progress (a sweep's at its point), Up shows them."""
-        if self.screen.has_class("-tiny"):
+        if self.screen.has_class("-tiny") or self.max_scroll_y > 0:
             first = self.query_one("#sweep-point" if self.has_class("-sweep") else "#run-bar")
             self.scroll_to_widget(first, top=True, animate=False)
 
