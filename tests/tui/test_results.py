@@ -283,3 +283,22 @@ async def test_a_failed_run_opened_says_why_it_failed(folders, registry):
         await press_settled(pilot, "enter")
         info = str(app.query_one("#results-info", Static).render())
     assert "failed" in info and why in " ".join(info.split())
+
+
+@sync
+async def test_the_runs_list_at_40x12_keeps_its_rows_in_sight_beside_an_open_sweep(folders, registry):
+    """In tmux at 40x12: Enter on a sweep left the list's header over blank rows, its own row
+    gone from sight, and so it stayed after Esc went back to the list."""
+    make_runs(folders, registry)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry)
+    async with app.run_test(size=(40, 12)) as pilot:
+        await press_settled(pilot, "f5")
+        index = [e.path.name for e in app.query_one(ResultsPane).runs].index("sw")
+        await press_settled(pilot, *["down"] * index, "enter")
+        opened = screen_text(app)
+        await press_settled(pilot, "escape")
+        back = screen_text(app)
+    for screen in (opened, back):
+        assert any(line.split()[:2] == ["✓", "sw"] for line in screen.splitlines()), screen

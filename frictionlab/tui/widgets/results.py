@@ -101,8 +101,19 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
     def _narrow(self) -> bool:
         return self.screen.has_class("-narrow")
 
+    def _keep_list_rows(self) -> None:
+        """Under 60 columns the list has half the rows above the plot (app.tcss), and at least
+        its header and the row highlighted: at 40x12 an open sweep's points left the list three,
+        its header alone in sight. Under 12 rows (30x8) the stylesheet's two stand."""
+        table = self.query_one("#runs-table", DataTable)
+        top = self.query_one("#results-top").size.height
+        rows = max(2, top // 2) if top and self._narrow() and not self.screen.has_class("-tiny") else None
+        if rows != (table.styles.max_height and table.styles.max_height.value):
+            table.styles.max_height = rows
+
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
+        self.call_after_refresh(self._keep_list_rows)
         if self.overlay and self._info_about is None and self.open_sweep is None:
             self.call_after_refresh(self._show_overlay)  # its lines broken to the box's new width
 
@@ -134,6 +145,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         self.open_sweep = None
         self.set_class(False, "-sweep")
         self.query_one("#results-sweep", SweepList).clear_points()
+        self.call_after_refresh(self._keep_list_rows)
 
     def _refresh_footer(self) -> None:
         """The footer again when what the highlighted row allows may differ (another row, a status
@@ -288,6 +300,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         table = self.query_one("#results-sweep", SweepList)
         table.show_points(entry.paths, entry.points)
         self.set_class(True, "-sweep")
+        self.call_after_refresh(self._keep_list_rows)
         self._inform(
             Content(
                 f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"
