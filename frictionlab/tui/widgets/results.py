@@ -123,7 +123,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
 
     def check_action(self, action: str, parameters) -> bool:
         """The footer offers what the highlighted row allows: Resume on a run or sweep that ended
-        before it completed, Compare on a run with a curve (or on a sweep's point)."""
+        before it completed, Compare on a run with a curve (one with its results written; or on a sweep's point)."""
         if action == "back_to_list":
             return self.open_sweep is not None and self.query_one("#results-sweep").has_focus
         if action not in ("resume", "compare"):
@@ -135,7 +135,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             return False
         if action == "resume":
             return entry.status in RESUMABLE
-        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running")
+        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running") and bool(entry.summary)
 
     def action_back_to_list(self) -> None:
         self.query_one("#runs-table").focus()
@@ -267,6 +267,9 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return
+            if not isinstance(entry, SweepEntry) and not entry.summary:  # ended before its results (killed): no curve
+                self._say_no_results(entry, shown_alone=not overlay)
+                return
             if isinstance(entry, SweepEntry):
                 if overlay:
                     self.app.say(f"{shown_name(entry.path.name)} is a sweep: Enter lists its points, Space on a point overlays it.",
@@ -293,6 +296,19 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             self._inform(
                 Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
             )
+
+    def _say_no_results(self, entry: RunEntry, shown_alone: bool) -> None:
+        """A run that ended before it wrote its results (its process killed) has no curve: Enter and
+        Space said "no curve (... no such curve.csv)", as of a damaged folder, not how it ended."""
+        why = (f"{shown_name(entry.path.name)}: {entry.status} before its results were written, "
+               f"{entry.done}/{entry.requested} realizations stored" + ("; u resumes it" if entry.status in RESUMABLE else ""))  # fmt: skip
+        self.app.say(why, "warning", about=entry.path)
+        if shown_alone:  # Enter: the plot and the box speak of it alone
+            self._close_sweep()
+            self.overlay = []
+            self.query_one("#results-chart", Chart).show([], empty="no curve yet")
+            self._inform(Content(why))
+            self._info_about = entry.path
 
     def _show_sweep(self, entry: SweepEntry) -> None:
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
