@@ -61,11 +61,11 @@ def find_preset(argument: str, presets_dir: str | None) -> Path:
     the file named; else, and then, as ``frictionlab run`` reads it (a path as given, or a
     built-in's name). Found nowhere: a PresetFileError naming the value and each place looked in."""
     from ..preset.builtin import builtin_presets, resolve_preset_path
-    from ..tui.folders import BUILTIN, preset_folders  # no Textual there
+    from ..tui import listed_preset_folders  # no Textual there
 
     if len(Path(argument).parts) != 1 or (presets_dir is None and os.path.lexists(argument)):
         return resolve_preset_path(argument)  # a path, or a file here: the one meant
-    folders = [folder for label, folder in preset_folders(Path(presets_dir) if presets_dir else None) if label != BUILTIN]
+    folders = listed_preset_folders(presets_dir)
     names = [argument] if Path(argument).suffix in (".yaml", ".yml") else [f"{argument}.yaml", f"{argument}.yml"]
     looked = [folder / name for folder in folders for name in names]
     found = next((path for path in looked if os.path.lexists(path) and not path.is_dir()), None)
