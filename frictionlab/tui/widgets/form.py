@@ -64,8 +64,8 @@ class PresetForm(VerticalScroll):
         Binding("enter", "edit_field", "Edit", tooltip="the fields: Enter or Tab goes in, Esc comes back out"),
         Binding("escape", "leave_field", "Leave field", tooltip="(back to the form: q, ? and the app's keys act again)"),
         # in a field Down scrolled the form a line under the cursor, which stayed where it was
-        Binding("down", "arrow(1)", "Scroll down", tooltip="(the form; in a field: the field below, as Tab)", show=False),
-        Binding("up", "arrow(-1)", "Scroll up", tooltip="(the form; in a field: the field above, as Shift+Tab)", show=False),
+        Binding("down", "arrow(1)", "Scroll Down", tooltip="(the form; in a field: the field below, as Tab)", show=False),
+        Binding("up", "arrow(-1)", "Scroll Up", tooltip="(the form; in a field: the field above, as Shift+Tab)", show=False),
     ]
 
     class Edited(Message):
