@@ -79,7 +79,7 @@ def find_preset(argument: str, presets_dir: str | None) -> Path:
         return elsewhere
     in_folders = sorted({path.stem for folder in folders if folder.is_dir() for path in folder.glob("*.y*ml")})
     listed = ", ".join(in_folders[:12]) + (f" and {len(in_folders) - 12} more" if len(in_folders) > 12 else "")
-    hint = did_you_mean(Path(argument).stem, in_folders + [p.name for p in builtin_presets()])
+    hint = did_you_mean(Path(argument).stem, list(dict.fromkeys(in_folders + [p.name for p in builtin_presets()])))  # once each
     where = f"--presets {str(folders[0])!r}" if presets_dir else " or ".join(repr(str(folder)) for folder in folders)
     raise PresetFileError(
         [f"(file): no preset {argument!r} in {where} (looked for {' and '.join(map(str, looked))}), "
