@@ -17,7 +17,8 @@ def add_parser(sub) -> None:
         description="The terminal UI: browse and edit presets, run them with live progress, compare results.",
         epilog="examples:\n  frictionlab tui\n  frictionlab tui quickstart",
     )
-    p.add_argument("preset", nargs="?", help="preset YAML file, or a preset's name (in --presets DIR first, then the built-ins), to open (optional)")
+    p.add_argument("preset", nargs="?", help="preset YAML file, or a preset's name (looked for in the folders the Presets list shows, "
+                   "--presets DIR or ./presets and the user folder, then among the built-ins), to open (optional)")
     p.add_argument("--presets", metavar="DIR", help="presets folder to browse (default: ./presets and the user folder)")
     p.add_argument("--runs", metavar="DIR", help="where runs are written and listed (default: runs)")
     add_workers_option(p)
@@ -54,17 +55,19 @@ def run(args) -> ExitCode:
 
 
 def find_preset(argument: str, presets_dir: str | None) -> Path:
-    """The preset file the command line names: with ``--presets DIR`` a name (no folder in it) is
-    looked for in DIR first, as its Presets list shows it (``NAME.yaml``, ``NAME.yml``, or the file
-    named); else, and then, as ``frictionlab run`` reads it (a path as given, or a built-in's name).
-    Found nowhere: a PresetFileError naming the value and each place looked in."""
+    """The preset file the command line names: a name (no folder in it, no file of that name here
+    unless ``--presets DIR`` is given) is looked for first in the folders the Presets list shows,
+    in its order (DIR; else ``./presets``, then the user folder): ``NAME.yaml``, ``NAME.yml``, or
+    the file named; else, and then, as ``frictionlab run`` reads it (a path as given, or a
+    built-in's name). Found nowhere: a PresetFileError naming the value and each place looked in."""
     from ..preset.builtin import builtin_presets, resolve_preset_path
+    from ..tui import listed_preset_folders  # no Textual there
 
-    if presets_dir is None or len(Path(argument).parts) != 1:
-        return resolve_preset_path(argument)
-    folder = Path(presets_dir)
+    if len(Path(argument).parts) != 1 or (presets_dir is None and os.path.lexists(argument)):
+        return resolve_preset_path(argument)  # a path, or a file here: the one meant
+    folders = listed_preset_folders(presets_dir)
     names = [argument] if Path(argument).suffix in (".yaml", ".yml") else [f"{argument}.yaml", f"{argument}.yml"]
-    looked = [folder / name for name in names]
+    looked = [folder / name for folder in folders for name in names]
     found = next((path for path in looked if os.path.lexists(path) and not path.is_dir()), None)
     if found is not None:
         return found  # read (and, if it cannot be, reported) as a preset file
@@ -74,12 +77,13 @@ def find_preset(argument: str, presets_dir: str | None) -> Path:
         elsewhere = None
     if elsewhere is not None and os.path.lexists(elsewhere):
         return elsewhere
-    in_folder = sorted(path.stem for path in folder.glob("*.y*ml")) if folder.is_dir() else []
-    listed = ", ".join(in_folder[:12]) + (f" and {len(in_folder) - 12} more" if len(in_folder) > 12 else "")
-    hint = did_you_mean(Path(argument).stem, in_folder + [p.name for p in builtin_presets()])
+    in_folders = sorted({path.stem for folder in folders if folder.is_dir() for path in folder.glob("*.y*ml")})
+    listed = ", ".join(in_folders[:12]) + (f" and {len(in_folders) - 12} more" if len(in_folders) > 12 else "")
+    hint = did_you_mean(Path(argument).stem, list(dict.fromkeys(in_folders + [p.name for p in builtin_presets()])))  # once each
+    where = f"--presets {str(folders[0])!r}" if presets_dir else " or ".join(repr(str(folder)) for folder in folders)
     raise PresetFileError(
-        [f"(file): no preset {argument!r} in --presets {str(folder)!r} (looked for {' and '.join(map(str, looked))}), "
+        [f"(file): no preset {argument!r} in {where} (looked for {' and '.join(map(str, looked))}), "
          f"no file {argument!r} here and no built-in preset of that name{hint or '.'} "
-         f"Presets in {str(folder)!r}: {listed or '(none)'} (`frictionlab presets` lists the built-ins)"],
+         f"Presets there: {listed or '(none)'} (`frictionlab presets` lists the built-ins)"],
         source=argument,
     )  # fmt: skip

@@ -49,7 +49,17 @@ def run_app(
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+    if app.farewell:
+        print(app.farewell, file=sys.stderr)
     return app.return_code or 0
+
+
+def listed_preset_folders(presets_dir: str | Path | None) -> list[Path]:
+    """The folders of presets the Presets list shows, in its order, less the built-ins': where
+    ``frictionlab tui NAME`` looks for NAME first (``cli.tui.find_preset``)."""
+    from .folders import BUILTIN, preset_folders  # no Textual there
+
+    return [folder for label, folder in preset_folders(Path(presets_dir) if presets_dir else None) if label != BUILTIN]
 
 
 def _exit_on_sigterm(app, signum: int = signal.SIGTERM) -> None:

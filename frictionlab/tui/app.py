@@ -124,6 +124,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.said_about: Path | None = None  # the row the status line speaks of (taken back on leaving it)
         self.taken_back_on = ""  # "open": the status line says no preset is open; "edit": why a run could not start
         self.followed: FollowedRun | None = None  # the run (FollowedSweep: sweep) in its own process shown on the Run tab
+        self.farewell: str | None = None  # said on the shell once the app has quit (a run left going)
         # what the Run tab shows: the last snapshot, and the last finished run's (or sweep's) outcome and folder
         self.last_snapshot = None
         self.last_outcome = None

@@ -24,7 +24,8 @@ from textual.widgets import DataTable, Input
 # the actions that only move the focus, or open a dialog (which holds the keys after it until its field
 # has the focus): run at once, they change nothing else than Textual's own order would
 FOCUS_ACTIONS = frozenset(
-    {"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field", "new", "duplicate"}
+    {"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field", "new", "duplicate",
+     "arrow(1)", "arrow(-1)"}  # the form's Up and Down: a field's neighbour (a line of scroll on the form itself)
 )
 
 # a list's own cursor moves: nothing else handles these keys on a list, so at once is Textual's order
@@ -50,6 +51,8 @@ async def answer_focus_key(app, key: events.Key) -> bool:
         for binding in bindings.key_to_bindings.get(key.key, ()):
             if binding.priority:
                 continue  # the app ran those before
+            if isinstance(namespace, Input) and binding.action in ("scroll_up", "scroll_down"):
+                continue  # a field of one line scrolls nothing: the key is the form's (or a dialog's)
             moves_cursor = isinstance(namespace, DataTable) and binding.action in LIST_CURSOR_ACTIONS
             if binding.action not in FOCUS_ACTIONS and not moves_cursor:
                 return False  # another binding comes first: Textual's order

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
-from ..errors import FrictionlabError, PresetError, RunFolderError, shown, shown_name
+from ..errors import FrictionlabError, PresetError, RunFolderError, command_word, shown, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
 from .folders import read_run
@@ -413,18 +413,31 @@ class RunControl:
             return
         from .following import FollowedSweep
 
+        what = "sweep" if isinstance(followed, FollowedSweep) else "run"
+
         def answered(choice: str | None) -> None:
             if choice is None:
                 return
             if choice == "cancel":
                 followed.cancel()  # SIGTERM: it keeps what finished; no need to wait for it
+            self.farewell = quit_farewell(what, followed.folder, followed.pid, cancelled=choice == "cancel")
             self.exit()
 
-        what = "sweep" if isinstance(followed, FollowedSweep) else "run"
         question = (f"A {what} is going in {shown_name(followed.folder)} (pid {followed.pid}), a process of its own.\n"
                     "Leave it running (a TUI opened later shows it, u resumes it if it stops), or cancel it "
                     "(what finished is kept)?")  # fmt: skip
         self.push_screen(QuitDuringRunScreen(question), answered)
+
+
+def quit_farewell(what: str, folder: Path, pid: int | None, cancelled: bool) -> str:
+    """The line the shell shows once the TUI has quit during a run: the screen that said where
+    the run went is gone, and the prompt alone said nothing of a process still going."""
+    word = command_word(folder)
+    if cancelled:
+        return (f"The {what} in {shown_name(folder)} (pid {pid}) was told to stop: it keeps what finished "
+                f"(`frictionlab resume {word}` goes on with it).")  # fmt: skip
+    return (f"The {what} in {shown_name(folder)} (pid {pid}) goes on: `frictionlab follow {word}` shows it, "
+            "`frictionlab runs` lists it.")  # fmt: skip
 
 
 def _resumable(folder: Path) -> bool:

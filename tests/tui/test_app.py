@@ -76,6 +76,32 @@ def test_a_preset_name_given_with_presets_dir_is_looked_for_in_that_folder_first
     assert "'onw'" in said and f"{where}.yaml and {where}.yml" in said and "did you mean 'own'?" in said, said
     assert "Traceback" not in said and len(opened) == 5
 
+
+def test_a_preset_name_is_looked_for_in_the_folders_the_presets_list_shows(tmp_path, monkeypatch, capsys):
+    """In tmux: ``frictionlab tui sw`` beside presets/sw.yaml, listed first on the Presets tab,
+    was "no file 'sw' and no built-in preset of that name"; ``quickstart`` opened the built-in
+    under the project's own quickstart.yaml the list shows first."""
+    import frictionlab.tui
+
+    text = (ROOT / "presets" / "quickstart.yaml").read_text()
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "user").mkdir()
+    for path in ("presets/sw.yaml", "presets/quickstart.yaml", "user/mine.yml", "sw.yaml"):
+        (tmp_path / path).write_text(text)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "user"))
+    opened = []
+    monkeypatch.setattr(frictionlab.tui, "run_app", lambda preset, **kwargs: opened.append(preset) or 0)
+    for name in ("sw", "quickstart", "mine", "sw.yaml"):  # sw.yaml: the file here, as given
+        assert main(["tui", name]) == 0
+    assert opened == [os.path.join("presets", "sw.yaml"), os.path.join("presets", "quickstart.yaml"),
+                      str(tmp_path / "user" / "mine.yml"), "sw.yaml"]  # fmt: skip
+    capsys.readouterr()
+    assert main(["tui", "sx"]) == 3
+    said = capsys.readouterr().err
+    assert "'presets'" in said and "did you mean 'sw'?" in said and "Presets there: mine, quickstart, sw" in said, said
+
+
 POOL_UNDER_TEXTUAL = """
 import sys, threading
 import frictionlab.tui

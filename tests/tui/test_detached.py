@@ -89,6 +89,8 @@ async def test_quit_during_a_run_asks_and_leaving_it_running_returns_without_wai
         assert "Leave it running" in asked and "cancel it" in asked and f"pid {pid}" in asked
         assert stayed and quit_at_once
         assert run_state(out).status == "running"  # the TUI is gone, the run is not
+        # the shell is told where it went on and how to see it (the screen that said so is gone)
+        assert f"pid {pid}" in app.farewell and f"frictionlab follow {out}" in app.farewell
     finally:
         end(pid)
 
@@ -125,6 +127,7 @@ async def test_quit_and_cancel_ends_the_run_interrupted_keeping_what_finished(fo
         wait_for(lambda: not process_alive(pid))
         state = run_state(out)
         assert quit_at_once and state.status == "interrupted" and 2 <= state.done < 100_000
+        assert "told to stop" in app.farewell and f"frictionlab resume {out}" in app.farewell
     finally:
         end(pid)
 

@@ -304,3 +304,30 @@ async def test_fields_left_fast_leave_the_help_and_enter_on_the_field_focused(fo
         assert focused == "field--seed"
         assert help_line.startswith("seed:"), help_line
         assert app.focused.id == "field--seed"
+
+
+@sync
+async def test_down_and_up_in_a_field_go_to_the_field_below_and_above(folders, registry):
+    """In tmux: Down in a field scrolled the form a line, the cursor left in the field it was in;
+    a form's arrows go from field to field, as Tab and Shift+Tab do, however fast typed."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        seed, realizations = app.query_one("#field--seed", Input), app.query_one("#field--realizations", Input)
+        seed.focus()
+        await pilot.pause()
+        post_keys(app, ["down", "end", "ctrl+u", *"12"])  # typed at once: the digits go where Down went
+        await pilot.pause(0.5)
+        below = app.focused
+        await press_settled(pilot, "up")
+        above = app.focused
+        choice = app.query_one("#plugin--spectrum", Select)
+        choice.focus()
+        await pilot.pause()
+        await press_settled(pilot, "down")  # a choice too: Textual's opened its list there
+        past_choice, opened = app.focused, choice.expanded
+        await press_settled(pilot, "escape", "down")  # on the form itself: a line of scroll, no field
+        on_form = app.focused
+    assert below is realizations and realizations.value == "12" and above is seed
+    assert past_choice is not choice and isinstance(past_choice, Input) and not opened
+    assert isinstance(on_form, PresetForm)

@@ -283,3 +283,54 @@ async def test_a_failed_run_opened_says_why_it_failed(folders, registry):
         await press_settled(pilot, "enter")
         info = str(app.query_one("#results-info", Static).render())
     assert "failed" in info and why in " ".join(info.split())
+
+
+@sync
+async def test_the_runs_list_at_40x12_keeps_its_rows_in_sight_beside_an_open_sweep(folders, registry):
+    """In tmux at 40x12: Enter on a sweep left the list's header over blank rows, its own row
+    gone from sight, and so it stayed after Esc went back to the list."""
+    make_runs(folders, registry)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
+    app = make_app(registry)
+    async with app.run_test(size=(40, 12)) as pilot:
+        await press_settled(pilot, "f5")
+        index = [e.path.name for e in app.query_one(ResultsPane).runs].index("sw")
+        await press_settled(pilot, *["down"] * index, "enter")
+        opened = screen_text(app)
+        await press_settled(pilot, "escape")
+        back = screen_text(app)
+    for screen in (opened, back):
+        assert any(line.split()[:2] == ["✓", "sw"] for line in screen.splitlines()), screen
+
+
+@sync
+async def test_a_killed_run_opened_says_how_it_ended_not_that_its_curve_file_is_missing(folders, registry):
+    """In tmux: Enter on a run whose process was killed (kill -9: no summary, no curve) said
+    "no curve (runs/.../curve.csv: no such curve.csv)", as of a damaged folder, and the footer
+    offered Space, which said the same; nothing said it can be resumed."""
+    import time
+
+    from frictionlab.runs.detached import run_state
+    from frictionlab.tui.widgets.results import ResultsPane as Pane
+
+    from .conftest import start_long_run, status_text
+
+    process, out = start_long_run(folders, registry)
+    deadline = time.monotonic() + 60.0
+    while (run_state(out).done or 0) < 2:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    process.kill()
+    process.wait()
+    app = make_app(registry)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await press_settled(pilot, "f5")
+        pane = app.query_one(Pane)
+        compare_offered = pane.check_action("compare", ())
+        await press_settled(pilot, "enter")
+        info = " ".join(str(app.query_one("#results-info", Static).render()).split())
+        said = status_text(app)
+    assert not compare_offered
+    assert "no such" not in info and "interrupted before its results were written" in info, info
+    assert "realizations stored; u resumes it" in info and "u resumes it" in said, said

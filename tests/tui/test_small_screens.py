@@ -1,6 +1,7 @@
 """A run's fit, its points in contact and its caveats on the Run and Results tabs at 60x20,
 80x24 and 120x40: whole, never cut at the panel's edge or below it."""
 
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -290,3 +291,25 @@ async def test_a_run_at_30x8_shows_its_progress_first(folders, registry):
     assert any(re.fullmatch(r"━{25,}\W?", line.rstrip()) for line in shown.splitlines()), shown  # the bar, 100 %
     assert "completed: 8/8 realizations" in shown.replace(" Run completed", ""), shown
     assert any("small: 8 realizations" in screen for screen in above), above[-1]
+
+
+@pytest.mark.parametrize("size", [(40, 12), (30, 12)])
+@sync
+async def test_a_run_at_40x12_shows_its_elapsed_time_and_time_left(folders, registry, size):
+    """In tmux at 40x12 the status line's four rows (the run, its pid, that it goes on) left the
+    tab five: the title (two), the folder and the bar took four, and the progress line's second
+    row, its elapsed time and time left, was cut off below them while the run went on."""
+    from .conftest import LONG, wait_until
+
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    app = make_app(registry, preset="presets/long.yaml")
+    async with app.run_test(size=size) as pilot:
+        await press_settled(pilot, "ctrl+r")
+        try:
+            await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 4)
+            await pilot.pause(1.2)  # a tick: the line as it is redrawn each second
+            screen = screen_text(app)
+        finally:
+            app.followed.process.kill()
+    # at 30 columns the line takes three rows: the third, the time left, was cut off (two at most)
+    assert re.search(r"elapsed [\d.]+ \w+, left [\d.?]", words(screen)), screen

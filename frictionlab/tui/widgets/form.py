@@ -43,6 +43,16 @@ def _section_id(path: tuple[str, ...]) -> str:
     return "section--" + "--".join(path)
 
 
+class FieldSelect(Select):
+    """A choice of the form: Enter or Space opens its list; Up and Down go to the field above or
+    below, as in a text field (Textual's opened the list: Down through the form stopped there)."""
+
+    BINDINGS = [
+        Binding("down", "app.focus_next", "Field below", show=False),
+        Binding("up", "app.focus_previous", "Field above", show=False),
+    ]
+
+
 class PresetForm(VerticalScroll):
     """Edits ``data`` (the preset as a plain mapping, unknown sections kept).
 
@@ -53,6 +63,9 @@ class PresetForm(VerticalScroll):
     BINDINGS = [
         Binding("enter", "edit_field", "Edit", tooltip="the fields: Enter or Tab goes in, Esc comes back out"),
         Binding("escape", "leave_field", "Leave field", tooltip="(back to the form: q, ? and the app's keys act again)"),
+        # in a field Down scrolled the form a line under the cursor, which stayed where it was
+        Binding("down", "arrow(1)", "Scroll Down", tooltip="(the form; in a field: the field below, as Tab)", show=False),
+        Binding("up", "arrow(-1)", "Scroll Up", tooltip="(the form; in a field: the field above, as Shift+Tab)", show=False),
     ]
 
     class Edited(Message):
@@ -138,7 +151,7 @@ class PresetForm(VerticalScroll):
         elif spec.kind == "choice":
             options = [(Content(str(c)), c) for c in spec.choices]  # text, never markup
             known = current in spec.choices
-            widget = Select(
+            widget = FieldSelect(
                 options,
                 value=current if known else Select.NULL,
                 allow_blank=spec.optional or not known,
@@ -185,7 +198,7 @@ class PresetForm(VerticalScroll):
         name = get_path(self.data, (slot, "name"), default_plugin_name(slot))
         names = self.registry.names(slot)
         known = self._known_name(slot, name)
-        select = Select(
+        select = FieldSelect(
             [(Content(n), n) for n in names],
             value=known if known else Select.NULL,
             allow_blank=known is None,
@@ -404,6 +417,16 @@ class PresetForm(VerticalScroll):
     # Up, Down, PageUp, PageDown: scrolled now, each from where the one before went. Textual's
     # scroll waits for a screen refresh and starts from where the form was: 20 Downs typed fast (a
     # key held down) scrolled it one line.
+    def action_arrow(self, step: int) -> None:
+        """Up or Down: in a field, the field above or below, as Shift+Tab and Tab go (a choice's
+        own: ``FieldSelect``); on the form itself, a line of scroll."""
+        if self.screen.focused is self or self.screen.focused is None:
+            self._scroll_by(step)
+        elif step > 0:
+            self.screen.focus_next()
+        else:
+            self.screen.focus_previous()
+
     def action_scroll_down(self) -> None:
         self._scroll_by(1)
 

@@ -25,6 +25,9 @@ def pasted_text(text: str) -> tuple[str, list[str]]:
     return _CONTROL.sub("", joined), dropped
 
 
+LINES_KEYS = ("up", "down")  # Input's own bindings scroll it by lines, and it has one
+
+
 class KeyInput(Input):
     """An ``Input`` that runs its own key bindings (Ctrl+U, Home, Ctrl+W, ...) at once.
 
@@ -52,6 +55,8 @@ class KeyInput(Input):
     async def _on_key(self, event: events.Key) -> None:
         self.typed = True
         bindings = self._bindings.key_to_bindings.get(event.key)
+        if event.key in LINES_KEYS:  # a field of one line scrolls no lines: the form's or the dialog's Up/Down act
+            bindings = None
         if bindings and not event.is_printable:
             event.stop()
             event.prevent_default()

@@ -101,8 +101,19 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
     def _narrow(self) -> bool:
         return self.screen.has_class("-narrow")
 
+    def _keep_list_rows(self) -> None:
+        """Under 60 columns the list has half the rows above the plot (app.tcss), and at least
+        its header and the row highlighted: at 40x12 an open sweep's points left the list three,
+        its header alone in sight. Under 12 rows (30x8) the stylesheet's two stand."""
+        table = self.query_one("#runs-table", DataTable)
+        top = self.query_one("#results-top").size.height
+        rows = max(2, top // 2) if top and self._narrow() and not self.screen.has_class("-tiny") else None
+        if rows != (table.styles.max_height and table.styles.max_height.value):
+            table.styles.max_height = rows
+
     def on_resize(self, event: events.Resize) -> None:
         self.call_after_refresh(self._fill)  # the list's width is known once laid out
+        self.call_after_refresh(self._keep_list_rows)
         if self.overlay and self._info_about is None and self.open_sweep is None:
             self.call_after_refresh(self._show_overlay)  # its lines broken to the box's new width
 
@@ -112,7 +123,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
 
     def check_action(self, action: str, parameters) -> bool:
         """The footer offers what the highlighted row allows: Resume on a run or sweep that ended
-        before it completed, Compare on a run with a curve (or on a sweep's point)."""
+        before it completed, Compare on a run with a curve (one with its results written; or on a sweep's point)."""
         if action == "back_to_list":
             return self.open_sweep is not None and self.query_one("#results-sweep").has_focus
         if action not in ("resume", "compare"):
@@ -124,7 +135,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             return False
         if action == "resume":
             return entry.status in RESUMABLE
-        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running")
+        return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running") and bool(entry.summary)
 
     def action_back_to_list(self) -> None:
         self.query_one("#runs-table").focus()
@@ -134,6 +145,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         self.open_sweep = None
         self.set_class(False, "-sweep")
         self.query_one("#results-sweep", SweepList).clear_points()
+        self.call_after_refresh(self._keep_list_rows)
 
     def _refresh_footer(self) -> None:
         """The footer again when what the highlighted row allows may differ (another row, a status
@@ -255,6 +267,9 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             if entry.status == "running":  # its process goes on: shown live (a sweep too)
                 self.app.show_running(entry.path)
                 return
+            if not isinstance(entry, SweepEntry) and not entry.summary:  # ended before its results (killed): no curve
+                self._say_no_results(entry, shown_alone=not overlay)
+                return
             if isinstance(entry, SweepEntry):
                 if overlay:
                     self.app.say(f"{shown_name(entry.path.name)} is a sweep: Enter lists its points, Space on a point overlays it.",
@@ -282,12 +297,26 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
                 Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
             )
 
+    def _say_no_results(self, entry: RunEntry, shown_alone: bool) -> None:
+        """A run that ended before it wrote its results (its process killed) has no curve: Enter and
+        Space said "no curve (... no such curve.csv)", as of a damaged folder, not how it ended."""
+        why = (f"{shown_name(entry.path.name)}: {entry.status} before its results were written, "
+               f"{entry.done}/{entry.requested} realizations stored" + ("; u resumes it" if entry.status in RESUMABLE else ""))  # fmt: skip
+        self.app.say(why, "warning", about=entry.path)
+        if shown_alone:  # Enter: the plot and the box speak of it alone
+            self._close_sweep()
+            self.overlay = []
+            self.query_one("#results-chart", Chart).show([], empty="no curve yet")
+            self._inform(Content(why))
+            self._info_about = entry.path
+
     def _show_sweep(self, entry: SweepEntry) -> None:
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
         self.open_sweep = entry
         table = self.query_one("#results-sweep", SweepList)
         table.show_points(entry.paths, entry.points)
         self.set_class(True, "-sweep")
+        self.call_after_refresh(self._keep_list_rows)
         self._inform(
             Content(
                 f"sweep {entry.name}: {entry.status}, {len(entry.points)} points.\n"

@@ -165,9 +165,22 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             line.display = bool(str(text))
         if widget_id in ("run-stats", "run-error", "run-caveats"):  # one line or two: the table's room changes
             self.call_after_refresh(self._fit_table)
+        if widget_id == "run-stats":
+            self.call_after_refresh(self._stats_in_sight)
+
+    _stats_rows = 0  # the rows the progress line took when last laid out
+
+    def _stats_in_sight(self) -> None:
+        """The progress line grew (``starting``, then its counts on three rows at 30x12): the tab
+        scrolled to it as it started shows it whole, as long as the tab scrolls (``_progress_in_sight``)."""
+        rows = self.query_one("#run-stats").outer_size.height
+        if rows != self._stats_rows:
+            self._stats_rows = rows
+            self._progress_in_sight()
 
     def on_resize(self) -> None:
         self.call_after_refresh(self._fit_table)
+        self.call_after_refresh(self._progress_in_sight)
 
     def _fit_table(self) -> None:
         """A sweep's table of points is as tall as its rows, up to 40 % of the tab and no more
@@ -226,7 +239,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def _progress_in_sight(self) -> None:
         """Under 12 rows (30x8) the title and the folder took the rows the status line left, the
         progress below them: the tab starts at the progress (a sweep's at its point), Up shows them."""
-        if self.screen.has_class("-tiny"):
+        if self.screen.has_class("-tiny") or self.max_scroll_y > 0:
             first = self.query_one("#sweep-point" if self.has_class("-sweep") else "#run-bar")
             self.scroll_to_widget(first, top=True, animate=False)
 
