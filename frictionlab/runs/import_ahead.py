@@ -7,9 +7,6 @@ half-done import (the child would inherit module locks held by a thread it does 
 have), so the import starts only once the workers are running, and any later fork (a
 worker replaced after a death) first waits for it to end (``os.register_at_fork``). The
 figure takes the module through ``imported``, which waits for it too.
-
-Once the ensemble is done, the figure is drawn in a thread (``DrawnAhead``) while the
-numbers are written, and its bytes written after them.
 """
 
 from __future__ import annotations
@@ -77,37 +74,3 @@ class PlotImportAhead:
         self.heard += 1
         if self.heard == 2:
             import_ahead(PLOT_MODULE)
-
-
-class DrawnAhead:
-    """plot.png of ``outcome`` drawn into memory in a thread, while this one writes the
-    numbers (their fsyncs, compression and hashing let go of the interpreter): ``write(fh)``
-    waits for the drawing and writes its bytes, or raises what the drawing raised. No
-    thread to be had: it draws as it is asked to write."""
-
-    def __init__(self, draw):
-        self._draw, self._png, self._error = draw, None, None
-        self._thread = threading.Thread(target=self._draw_ahead, name="draw the figure", daemon=True)
-        try:
-            self._thread.start()
-        except RuntimeError:  # a container's pids limit
-            self._thread = None
-
-    def _draw_ahead(self) -> None:
-        import io
-
-        png = io.BytesIO()
-        try:
-            self._draw(png)
-        except BaseException as exc:  # noqa: BLE001 (raised again where the file is written)
-            self._error = exc
-        self._png = png.getvalue()
-
-    def write(self, fh) -> None:
-        if self._thread is None:
-            self._draw(fh)
-            return
-        self._thread.join()
-        if self._error is not None:
-            raise self._error
-        fh.write(self._png)

@@ -403,26 +403,18 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     return files
 
 
-def figure_wanted(scene: Scene, outcome: RunOutcome) -> bool:
-    """Whether plot.png is drawn: the preset asks for it and anything finished."""
-    return bool(scene.preset.output.plot and outcome.done)
-
-
-def draw_figure(scene: Scene, outcome: RunOutcome):
-    """plot.png's drawing, ``draw(file)``: matplotlib is slow to import, so only when drawing (or
-    ahead, while computing)."""
-    return lambda fh: imported(PLOT_MODULE).plot_curve(scene, outcome, fh)
-
-
-def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path], drawn=None) -> dict[str, Path]:
-    """Draw plot.png (``figure_wanted``) after the other files, and list it in summary.json
-    (rewritten); ``files`` with the plot's path. ``drawn``: its drawing begun ahead
-    (``import_ahead.DrawnAhead``), written here."""
-    if not figure_wanted(scene, outcome):
+def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> dict[str, Path]:
+    """Draw plot.png (if the preset asks for it and anything finished) after the other
+    files, and list it in summary.json (rewritten); ``files`` with the plot's path."""
+    if not (scene.preset.output.plot and outcome.done):
         return files
     out = Path(out_dir)
     files = {**files, "plot": out / "plot.png"}
-    write_figure(files["plot"], draw_figure(scene, outcome) if drawn is None else drawn.write)
+
+    def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (or ahead, while computing)
+        imported(PLOT_MODULE).plot_curve(scene, outcome, fh)
+
+    write_figure(files["plot"], draw)
     _write_summary(out, scene, outcome, files)
     return files
 

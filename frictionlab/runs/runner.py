@@ -15,8 +15,8 @@ from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
-from .import_ahead import DrawnAhead, PlotImportAhead
-from .results import add_plot, draw_figure, figure_wanted, holds_results, read_summary, results_on_disk, write_results
+from .import_ahead import PlotImportAhead
+from .results import add_plot, holds_results, read_summary, results_on_disk, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
 
@@ -123,13 +123,11 @@ def run_to_folder(
     with RunDirectory(out_dir, force=options.force) as run_dir:
         restored = run_dir.start(scene, resume=options.resume)
         store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
-        outcome = drawn = None
+        outcome = None
         if plot and scene.preset.output.plot:  # matplotlib imported while the workers compute
             listeners = [*listeners, PlotImportAhead()]
         try:
             outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
-            if plot and figure_wanted(scene, outcome):  # drawn while the numbers are written
-                drawn = DrawnAhead(draw_figure(scene, outcome))
         finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)
             store.flush(merge=outcome is not None and outcome.status == "completed")
         files = write_results(out_dir, scene, outcome)
@@ -137,7 +135,7 @@ def run_to_folder(
             if on_results is not None:
                 on_results(outcome, files)
             if plot:
-                files = add_plot(out_dir, scene, outcome, files, drawn)
+                files = add_plot(out_dir, scene, outcome, files)
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
             run_dir.finish(scene, outcome.status)
     return outcome, files
