@@ -91,6 +91,29 @@ def require(module: str, purpose: str):
         raise MissingDependency(module, purpose) from None
 
 
+def refuse_unusable_matplotlib() -> None:
+    """Import matplotlib before a command whose figures are its output does any work, and
+    before the API draws: a bad MPLBACKEND makes matplotlib's import itself raise (the study
+    found it only after it had computed; the report, exact3d and ``Result.plot`` as
+    matplotlib's own ValueError). A FrictionlabError naming it and what is allowed."""
+    import os
+    import re
+
+    try:
+        import matplotlib  # noqa: F401  (its import reads MPLBACKEND)
+    except ModuleNotFoundError:
+        return  # said where a figure is drawn, with the pip command that installs it
+    except ValueError as exc:
+        backend = os.environ.get("MPLBACKEND")
+        if backend is None:
+            raise
+        allowed = ", ".join(re.findall(r"'([^']+)'", str(exc).partition("supported values are ")[2])) or "agg, pdf, svg"
+        raise FrictionlabError(
+            f"MPLBACKEND={backend!r} is no matplotlib backend; allowed: {allowed}. Unset it, or set "
+            "MPLBACKEND=agg: frictionlab draws its figures into PNG files and needs no display"
+        ) from None
+
+
 class PluginError(FrictionlabError):
     """A plugin is missing, broken, or clashes with another."""
 

@@ -11,6 +11,7 @@ import io
 import math
 
 from .compute.fit import format_interval, format_number
+from .errors import FrictionlabError, refuse_unusable_matplotlib
 
 
 def result_html(result) -> str:
@@ -44,7 +45,10 @@ def result_html(result) -> str:
             f"{html.escape(result.normalisation)}</p>"
         )
     if len(result.table.get("f", ())):
-        parts.append(f'<img alt="xi against f" src="data:image/png;base64,{_curve_png(result)}">')
+        try:
+            parts.append(f'<img alt="xi against f" src="data:image/png;base64,{_curve_png(result)}">')
+        except FrictionlabError as exc:  # a bad MPLBACKEND, matplotlib missing: the numbers are still shown
+            parts.append(f"<p>the curve is not drawn: {html.escape(str(exc))}</p>")
     parts += [f"<p>caveat: {html.escape(caveat)}</p>" for caveat in result.caveats if caveat != result.error]
     if result.folder is not None:
         parts.append(f"<p>results in <code>{html.escape(str(result.folder))}</code></p>")
@@ -88,6 +92,7 @@ def _number(value: float | None) -> str:
 
 def _curve_png(result) -> str:
     """``result.plot()`` on a bare figure (no pyplot: a notebook's backend is left alone), as base64 PNG."""
+    refuse_unusable_matplotlib()
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(6.4, 4.2), layout="constrained")

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .arguments import path_argument
-from .errors import FrictionlabError, RunFolderError, raised_here, require, shown
+from .errors import FrictionlabError, RunFolderError, raised_here, refuse_unusable_matplotlib, require, shown
 from .compute.fit import LogFit, format_number
 from .runs.results import read_curve_table, read_summary, column_units
 from .runs.runfolder import check_searchable, subfolder
@@ -88,6 +88,7 @@ class Result:
     def plot(self, ax=None):
         """xi against f with the fit and its caveats, on ``ax`` (a new figure's when
         None, through pyplot, so a notebook shows it); returns the Axes."""
+        refuse_unusable_matplotlib()  # a bad MPLBACKEND: named, not matplotlib's ValueError from its import
         from .plot import AXES_NEEDS, draw_curve
 
         missing = [name for name in AXES_NEEDS if not callable(getattr(ax, name, None))] if ax is not None else []

@@ -143,3 +143,23 @@ def test_a_results_one_line_repr_stays_short_whatever_its_fit():
     text = repr(huge)
     assert "a = 1e+300, b = -2.5e+07" in text and len(text) < 200
     assert f"a = {result.fit.a:.4f}, b = {result.fit.b:.4f}" in repr(result)
+
+
+def test_a_bad_mplbackend_is_named_by_plot_and_leaves_the_html_its_numbers(tmp_path):
+    """matplotlib's import raises on it (a ValueError from deep inside): read in a fresh process."""
+    import os
+    import subprocess
+    import sys
+
+    frictionlab.run(SMALL_PRESET, out=tmp_path / "run", **FAST)
+    code = (
+        "import frictionlab\n"
+        f"r = frictionlab.load({str(tmp_path / 'run')!r})\n"
+        "try:\n    r.plot()\nexcept frictionlab.errors.FrictionlabError as exc:\n    print('plot:', exc)\n"
+        "h = r._repr_html_()\nprint('html:', 'the curve is not drawn: MPLBACKEND' in h, f'{r.fit.a:.4f}' in h)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env={**os.environ, "MPLBACKEND": "no-such-backend"})  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "plot: MPLBACKEND='no-such-backend' is no matplotlib backend; allowed:" in done.stdout
+    assert "html: True True" in done.stdout

@@ -3,9 +3,9 @@ write the page exact-3d-law.md with its figures."""
 
 from __future__ import annotations
 
-from ..errors import ExitCode, shown
+from ..errors import ExitCode, refuse_unusable_matplotlib, shown
 from .console import stderr_log
-from .options import add_workers_option, refuse_unusable_matplotlib, run_options
+from .options import add_workers_option, run_options
 
 
 def add_parser(sub) -> None:

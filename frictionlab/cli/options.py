@@ -168,24 +168,3 @@ def refuse_swept_overrides(args, data: dict) -> None:
         raise FrictionlabError(f"{given[path]}: {path} {SWEPT}; sweep other values (--set "
                                f"'sweep.parameters.{path}={{values: [...]}}'), or run the preset once (--set sweep=null)")
 
-
-def refuse_unusable_matplotlib() -> None:
-    """Import matplotlib before a command whose figures are its output does any work:
-    a bad MPLBACKEND makes matplotlib's import itself raise, which the study found only
-    after it had computed, the report and exact3d at their start, as an internal error."""
-    import os
-    import re
-
-    try:
-        import matplotlib  # noqa: F401  (its import reads MPLBACKEND)
-    except ModuleNotFoundError:
-        return  # said where a figure is drawn, with the pip command that installs it
-    except ValueError as exc:
-        backend = os.environ.get("MPLBACKEND")
-        if backend is None:
-            raise
-        allowed = ", ".join(re.findall(r"'([^']+)'", str(exc).partition("supported values are ")[2])) or "agg, pdf, svg"
-        raise FrictionlabError(
-            f"MPLBACKEND={backend!r} is no matplotlib backend; allowed: {allowed}. Unset it, or set "
-            "MPLBACKEND=agg: frictionlab draws its figures into PNG files and needs no display"
-        ) from None

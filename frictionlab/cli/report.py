@@ -5,9 +5,9 @@ from __future__ import annotations
 import os
 import re
 
-from ..errors import ExitCode, FrictionlabError, shown
+from ..errors import ExitCode, FrictionlabError, refuse_unusable_matplotlib, shown
 from .console import stderr_log
-from .options import add_workers_option, refuse_unusable_matplotlib, run_options
+from .options import add_workers_option, run_options
 
 MAX_REPLICATES = 100  # each is a full run of every reading
 

@@ -7,9 +7,10 @@ from __future__ import annotations
 import math
 import sys
 
-from ..errors import ExitCode, FrictionlabError, RunError, not_an_option, shell_word, short_repr, shown_name
+from ..errors import (ExitCode, FrictionlabError, RunError, not_an_option, refuse_unusable_matplotlib, shell_word, short_repr,
+                      shown_name)
 from ..tradeoff.options import AXES, StudyOptions
-from .options import preset_overrides, refuse_unusable_matplotlib
+from .options import preset_overrides
 
 
 def _listed(values) -> str:
