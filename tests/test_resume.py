@@ -245,6 +245,16 @@ def test_resume_of_a_folder_without_a_run_says_so(tmp_path, capsys):
     assert f"{tmp_path} holds no run to resume (no preset.yaml)" in capsys.readouterr().err
 
 
+def test_a_run_resumed_into_a_sweeps_folder_is_told_what_continues_the_sweep(make_scene, tmp_path):
+    """run --resume --out SWEEPDIR said only "no run.json": a sweep keeps one per point."""
+    (tmp_path / "sweep.json").write_text("{}")
+    with pytest.raises(FrictionlabError, match=rf"no run.json\): it is a sweep's folder, which `frictionlab resume {tmp_path}` continues"):
+        run_to_folder(make_scene(NO_PLOT), tmp_path, RunOptions(workers=1, resume=True))
+    (tmp_path / "sweep.json").unlink()
+    with pytest.raises(FrictionlabError, match=r"holds no run to resume \(no run.json\)$"):
+        run_to_folder(make_scene(NO_PLOT), tmp_path, RunOptions(workers=1, resume=True))
+
+
 def _children(pid: int) -> set[int]:
     found = set()
     for task in Path(f"/proc/{pid}/task").glob("*"):

@@ -345,7 +345,9 @@ class RunDirectory:
     def _resume(self, scene: Scene, resolved: dict, inputs: dict, read: dict | None) -> list[RealizationResult]:
         state = self.state()
         if state is None:
-            raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {STATE_FILE})")
+            sweep = os.path.lexists(self.path / "sweep.json")  # its points are runs of their own
+            raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {STATE_FILE})" + (
+                f": it is a sweep's folder, which `frictionlab resume {command_word(self.path)}` continues" if sweep else ""))
         if not same_preset(state, resolved, scene):
             stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
             changed = differences(stored, resolved)
