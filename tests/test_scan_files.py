@@ -210,6 +210,17 @@ def test_a_binary_file_never_reaches_a_text_reader(tmp_path, monkeypatch):
         SurfaceFile(path=str(tmp_path / "noise.bin")).generate(None)
 
 
+def test_a_gwyddion_simple_field_file_is_named_with_what_to_do(tmp_path):
+    """A .gsf (Gwyddion's simple export) has no reader: it was told to take a format's suffix, or
+    under .dat that it was no text, as if renaming or damage were the matter."""
+    header = b"Gwyddion Simple Field 1.0\nXRes = 16\nYRes = 16\nXReal = 1e-06\nYReal = 1e-06\nZUnits = m\n"
+    data = header + b"\0" * (4 - len(header) % 4) + np.ones(256, "<f4").tobytes()
+    for name in ("map.gsf", "map.dat"):
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(ValueError, match=r"a Gwyddion Simple Field \(\.gsf\) file.*save it as \.gwy"):
+            SurfaceFile(path=str(tmp_path / name)).generate(None)
+
+
 def test_an_xml_member_that_inflates_beyond_the_cap_is_refused_unread(tmp_path):
     from frictionlab_spectra.instrument_reader import XML_LIMIT
 
