@@ -359,8 +359,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
         table = not is_instrument_file(path, p.format) and path.suffix.lower() != ".npy"
-        points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument",
-                  2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "") if table else ""  # fmt: skip
+        points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument"
+                  if table else "", 2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "")  # fmt: skip
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
                **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip
