@@ -303,8 +303,8 @@ def _square_over_oblong(scan, p: SurfaceFile.Params) -> str | None:
         return None
     return (f"spacing {p.spacing:g} replaces the file's pixel of {dx:.6g} x {dy:.6g} (x by y), which is not square, by "
             f"a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
-            f"slopes along y {dy / dx:.4g} times as steep); give spacing_y too ({p.spacing * dy / dx:.6g} keeps the file's shape), or "
-            "leave spacing out to use the file's pixel")  # fmt: skip
+            f"slopes along y {dy / dx:.4g} times as steep); give spacing_y too ({p.spacing * dy / dx:.6g} keeps the "
+            "file's shape), or leave spacing out to use the file's pixel")  # fmt: skip
 
 
 def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
