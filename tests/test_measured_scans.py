@@ -201,3 +201,36 @@ def test_the_tui_says_what_validate_says_of_the_file_read(tmp_path, capsys):
     problems, shown = validation_of(preset, default_registry())
     assert problems == [] and len(printed) == 1, printed
     assert printed[0] in shown.splitlines(), shown
+
+
+def test_a_square_spacing_over_a_file_of_oblong_pixels_is_said(tmp_path):
+    """spacing alone replaced a Gwyddion scan's 0.1 x 0.2 um pixels by squares of 0.1 without a
+    word: the map squashed to half its length along y, its slopes along y doubled."""
+    from .test_scan_edge_cases import rough, write_gwy
+
+    z = rough(32, 48, 5) * 1e-8
+    write_gwy(tmp_path / "oblong.gwy", z, 1e-7, 2e-7)
+    caveats = SurfaceFile(path=str(tmp_path / "oblong.gwy"), unit="um", spacing=0.1).input_summary()["caveats"]
+    assert any("replaces the file's pixel of 0.1 x 0.2 (x by y), which is not square" in c and "spacing_y too (0.2 "
+               in c for c in caveats)  # fmt: skip
+    for kept in ({}, {"spacing": 0.1, "spacing_y": 0.2}):  # the file's pixel, or both sides given: nothing to say
+        summary = SurfaceFile(path=str(tmp_path / "oblong.gwy"), unit="um", **kept).input_summary()
+        assert not any("not square" in c for c in summary.get("caveats", ()))
+    write_gwy(tmp_path / "square.gwy", z, 1e-7, 1e-7)
+    summary = SurfaceFile(path=str(tmp_path / "square.gwy"), unit="um", spacing=0.05).input_summary()
+    assert not any("not square" in c for c in summary.get("caveats", ()))
+
+
+def test_a_map_given_to_profile_file_and_a_line_to_surface_file_are_sent_to_the_other(tmp_path):
+    """A map given to profile-file was 'array of shape (64, 96); expected (N,), (N, 2) or (2, N)'
+    (or '96 columns'), and an x, z line saved as .npy given to surface-file 'a map of 2 x 500
+    pixels': neither said which plugin reads the file (a .csv line did)."""
+    rng = np.random.default_rng(4)
+    np.save(tmp_path / "map.npy", rng.normal(size=(16, 24)))
+    np.savetxt(tmp_path / "map.csv", rng.normal(size=(16, 24)), delimiter=",")
+    for name in ("map.npy", "map.csv"):
+        with pytest.raises(ValueError, match=r"expected .*; a height map \(rows of heights.*\) is read by surface-file"):
+            ProfileFile(path=str(tmp_path / name), spacing=0.1).rms_height()
+    np.save(tmp_path / "line.npy", np.c_[0.1 * np.arange(50), rng.normal(size=50)])
+    with pytest.raises(ValueError, match=r"map of 2 x 50 pixels .*; columns of x and z \(a line\) are read by profile-file"):
+        SurfaceFile(path=str(tmp_path / "line.npy"), spacing=0.1).rms_height()

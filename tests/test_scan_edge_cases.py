@@ -172,6 +172,21 @@ def test_a_first_row_of_heights_with_a_bad_cell_is_refused_not_skipped_as_a_head
         assert plugin(path=str(tmp_path / "h.csv"), spacing=0.1).generate(None).heights.size == z.size
 
 
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_bad_cell_past_the_first_line_is_named_by_its_column_and_an_empty_one_as_missing(tmp_path, plugin):
+    """An export's empty cell (a point it left out, '0.1,,0.3') was 'non-numeric content at line
+    4', naming neither the cell nor what it is; a cell of text was not found in a line of 200."""
+    z = rough(12, 10, 8) if plugin is SurfaceFile else rough(1, 40, 8)
+    rows = matrix_text(z).splitlines()
+    if plugin is ProfileFile:
+        rows = [f"{0.1 * i:.1f},{row}" for i, row in enumerate(rows[0].split(","))]  # x, z rows
+    for bad, said in (("", r"column 1 is empty, a point the export left out; write NaN"), ("n/a", r"column 1 is not a number")):
+        edited = [*rows[:3], ",".join([bad, *rows[3].split(",")[1:]]), *rows[4:]]
+        (tmp_path / "bad.csv").write_text("\n".join(edited) + "\n")
+        with pytest.raises(ValueError, match=r"non-numeric content at line 4 \(expected numbers separated by commas\): " + said):
+            plugin(path=str(tmp_path / "bad.csv"), spacing=0.1).rms_height()
+
+
 @pytest.mark.parametrize("separator", [";", "\t"])
 def test_decimal_commas_are_named(tmp_path, separator):
     """At their first line: the first was skipped as a header, and line 2 named."""

@@ -210,6 +210,17 @@ def test_a_binary_file_never_reaches_a_text_reader(tmp_path, monkeypatch):
         SurfaceFile(path=str(tmp_path / "noise.bin")).generate(None)
 
 
+def test_a_gwyddion_simple_field_file_is_named_with_what_to_do(tmp_path):
+    """A .gsf (Gwyddion's simple export) has no reader: it was told to take a format's suffix, or
+    under .dat that it was no text, as if renaming or damage were the matter."""
+    header = b"Gwyddion Simple Field 1.0\nXRes = 16\nYRes = 16\nXReal = 1e-06\nYReal = 1e-06\nZUnits = m\n"
+    data = header + b"\0" * (4 - len(header) % 4) + np.ones(256, "<f4").tobytes()
+    for name in ("map.gsf", "map.dat"):
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(ValueError, match=r"a Gwyddion Simple Field \(\.gsf\) file.*save it as \.gwy"):
+            SurfaceFile(path=str(tmp_path / name)).generate(None)
+
+
 def test_an_xml_member_that_inflates_beyond_the_cap_is_refused_unread(tmp_path):
     from frictionlab_spectra.instrument_reader import XML_LIMIT
 
@@ -568,3 +579,29 @@ def test_a_text_export_too_large_for_the_memory_left_is_refused_before_it_is_par
         SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height()
     monkeypatch.setattr(readers, "room_to_read", lambda: (2 * size, "the room in this test"))
     assert SurfaceFile(path=str(tmp_path / "scan.xyz"), unit="um").rms_height() > 0
+
+
+def test_undefined_points_under_a_gwyddion_mask_are_said_to_be_its_mask(tmp_path):
+    """SurfaceTopography reads a Gwyddion mask as points not measured, and the refusal said only
+    that: a mask that selects grains over measured heights was then filled (undefined: harmonic)
+    as its message advised, those heights replaced."""
+    from SurfaceTopography.IO.GWY import _gwy_write_object
+
+    from .test_scan_edge_cases import rough
+
+    z = rough(16, 24, 3) * 1e-8  # on pixels of 0.1 um, a mask over its first 3 rows
+    field = {"xres": ("i", 24), "yres": ("i", 16), "xreal": ("d", 2.4e-6), "yreal": ("d", 1.6e-6),
+             "si_unit_xy": ("o", ("GwySIUnit", {"unitstr": ("s", "m")})),
+             "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", "")}))}  # fmt: skip
+    mask = np.zeros_like(z)
+    mask[:3] = 1.0
+    container = {"/0/data/title": ("s", "Height"),
+                 "/0/data": ("o", ("GwyDataField", {**field, "si_unit_z": ("o", ("GwySIUnit", {"unitstr": ("s", "m")})),
+                                                    "data": ("D", z.ravel())})),
+                 "/0/mask": ("o", ("GwyDataField", {**field, "data": ("D", mask.ravel())}))}  # fmt: skip
+    with open(tmp_path / "masked.gwy", "wb") as fh:
+        fh.write(b"GWYP")
+        _gwy_write_object(fh, "GwyContainer", container)
+    with pytest.raises(ValueError, match=r"72 of 384 points are undefined in the file: under its Gwyddion mask.*a "
+                       r"selection \(grains, a marked area\) over measured heights would have them replaced"):
+        SurfaceFile(path=str(tmp_path / "masked.gwy"), unit="um").generate(None)

@@ -230,7 +230,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         mask = np.ascontiguousarray(np.ma.getmaskarray(heights).T) if missing and dimension == 2 else None
         if missing:
             if undefined == "refuse":
-                raise ValueError(undefined_message(where, missing, heights.size))
+                raise ValueError(undefined_message(where, missing, heights.size, gwyddion=reader.format() == "gwy"))
             if undefined == "keep":  # NaN, for a crop to leave out (surface-file's region)
                 heights = np.ma.filled(np.ma.asarray(heights, dtype=np.float64), np.nan)
             else:
@@ -271,10 +271,17 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     )
 
 
-def undefined_message(where: str, missing: int, total: int, of: str = "") -> str:
-    """The refusal of a scan with points undefined (``of``: the part of the map they are in)."""
-    return (f"{where}: {missing} of {total} points{of} are undefined in the file (not measured); set undefined: "
-            "harmonic to fill them from their neighbours, or fix the scan")
+def undefined_message(where: str, missing: int, total: int, of: str = "", *, gwyddion: bool = False) -> str:
+    """The refusal of a scan with points undefined (``of``: the part of the map they are in).
+    A Gwyddion file's undefined points are those under its mask, which may instead be a
+    selection (grains, a marked area) over measured heights: filling them would replace those."""
+    if not gwyddion:
+        return (f"{where}: {missing} of {total} points{of} are undefined in the file (not measured); set undefined: "
+                "harmonic to fill them from their neighbours, or fix the scan")
+    return (f"{where}: {missing} of {total} points{of} are undefined in the file: under its Gwyddion mask, read as "
+            "points not measured; set undefined: harmonic to fill them from their neighbours, or fix the scan; a mask "
+            "that is a selection (grains, a marked area) over measured heights would have them replaced: remove it in "
+            "Gwyddion and save the file again")
 
 
 FILLED_CAVEAT_SHARE = 0.05  # of a file's points filled by harmonic interpolation: a caveat from here on

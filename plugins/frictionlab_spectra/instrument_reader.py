@@ -25,6 +25,7 @@ TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a b
 BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary variant, which its reader reads too
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
+GSF_MAGIC = b"Gwyddion Simple Field"  # a Gwyddion export no reader of the extra reads
 AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
 
 
@@ -38,6 +39,11 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     head = fh.read(MAGIC_BYTES)
     fh.seek(0)
     matches = [reader for reader in readers if reader.can_read(head) == MagicMatch.YES]
+    if not matches and (head.startswith(GSF_MAGIC) or path_suffix == "gsf"):  # under any suffix: not text, no reader
+        raise ValueError(
+            f"{where}: a Gwyddion Simple Field (.gsf) file, a format SurfaceTopography does not read (renaming it would "
+            "not help): open it in Gwyddion and save it as .gwy, which is read with its units and pixel sizes"
+        )
     by_suffix = [reader for reader in readers if path_suffix in getattr(reader, "_file_extensions", ())]
     chosen = next((r for r in matches if r in by_suffix), matches[0] if matches else None)
     if chosen is None:

@@ -186,7 +186,8 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
             return data[:, 0].astype(np.float64), data[:, 1].astype(np.float64)
         if data.ndim == 2 and data.shape[0] == 2:
             return data[0].astype(np.float64), data[1].astype(np.float64)
-        raise ValueError(f"{where}: array of shape {data.shape}; expected (N,), (N, 2) or (2, N)")
+        raise ValueError(f"{where}: array of shape {data.shape}; expected (N,), (N, 2) or (2, N)"
+                         + (MAP_ADVICE if data.ndim == 2 else ""))
     data = read_text_table(path, where)
     if data.shape[1] == 1:
         return None, data[:, 0].copy()
@@ -194,7 +195,10 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
         return None, data[0].copy()
     if data.shape[1] == 2:
         return data[:, 0].copy(), data[:, 1].copy()
-    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights")
+    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights{MAP_ADVICE}")
+
+
+MAP_ADVICE = "; a height map (rows of heights, each a line across it) is read by surface-file"
 
 
 def file_suffix(path: Path, where: str) -> str:

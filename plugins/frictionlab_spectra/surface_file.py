@@ -39,6 +39,7 @@ reproduce).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -294,6 +295,18 @@ def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params
             "caveats": [caveat] if caveat else []}  # fmt: skip
 
 
+def _square_over_oblong(scan, p: SurfaceFile.Params) -> str | None:
+    """The caveat of ``spacing`` alone replacing a file's pixel that is not square: the preset's
+    square pixel stretches the map along one axis against the other, its slopes with it."""
+    dx, dy = scan.pixel
+    if p.spacing is None or p.spacing_y is not None or not scan.pixel_stated or math.isclose(dx, dy, rel_tol=1e-6):
+        return None
+    return (f"spacing {p.spacing:g} replaces the file's pixel of {dx:.6g} x {dy:.6g} (x by y), which is not square, by "
+            f"a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
+            f"slopes along y {dy / dx:.4g} times as steep); give spacing_y too ({p.spacing * dy / dx:.6g} keeps the "
+            "file's shape), or leave spacing out to use the file's pixel")  # fmt: skip
+
+
 def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
     """``axes_warning`` of a table map, of the first row and column that ``region`` keeps."""
     (x0, _), (y0, _) = crop(data, pixel, p.region, where)[1] if p.region is not None else ((0, 0), (0, 0))
@@ -309,6 +322,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
+        if caveat := _square_over_oblong(scan, p):
+            summary["caveats"] = [*summary.get("caveats", ()), caveat]
         if p.region is not None and scan.undefined:
             summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
@@ -344,8 +359,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
     if min(data.shape) < MIN_SIDE:
         ny, nx = data.shape
         table = not is_instrument_file(path, p.format) and path.suffix.lower() != ".npy"
-        points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument",
-                  2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "") if table else ""  # fmt: skip
+        points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument"
+                  if table else "", 2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "")  # fmt: skip
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
                **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip

@@ -138,12 +138,23 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
-            return f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
+            return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
+                    + _bad_cell(text, delimiter))
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _bad_cell(text: str, delimiter: str | None) -> str:
+    """Which cell of a line is no number, by its column (never its content); an empty cell is a
+    point an export left out, which NaN stands for (then refused, or cropped out, by name)."""
+    cells = text.split(delimiter)
+    column = next(i for i, cell in enumerate(cells, start=1) if not is_number(cell))
+    if cells[column - 1].strip():
+        return f": column {column} is not a number"
+    return f": column {column} is empty, a point the export left out; write NaN there to mark it missing"
 
 
 def decimal_commas(lineno: int, what: str = "table") -> str:
