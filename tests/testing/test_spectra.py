@@ -51,6 +51,8 @@ SPECTRUM_BREAKAGES = [
     ("TrendedSurface", {"dimension": 2, "generate": lambda self, rng: Profile(
         GoodSpectrum.generate(self, rng).heights[:, None] + np.linspace(0, 3, 64) + np.sin(np.arange(64) / 3), 1.0)},
      r"the profile does not wrap along axis 1"),
+    ("PeriodicNotABool", {"periodic": lambda self: "yes"},  # named as a run names it, not as a mismatch with the profile
+     r"periodic\(\) must be True or False\. Got 'yes' instead\."),
     ("CaveatsAsOneString", {"caveats": lambda self: "coarse"}, r"caveats\(\) must be a tuple of non-empty strings"),
     ("EmptyCaveat", {"caveats": lambda self: ("",)}, r"caveats\(\) must be a tuple of non-empty strings"),
 ]
