@@ -284,6 +284,8 @@ def _containing_itself() -> dict:
         (lambda: frictionlab.run("quickstart", {"seed": 3}, overrides={"seed": 4}, **FAST), "overrides given twice"),
         (lambda: frictionlab.run("quickstart", preset="quickstart", **FAST), "preset given twice"),
         (lambda: frictionlab.validate("quickstart", overrides=5), "overrides must be a mapping of dotted keys to values, got int"),
+        # run's options copied into validate: named as run's, not as unknown preset fields
+        (lambda: frictionlab.validate("quickstart", workers=1, progress=False), "validate takes no workers=, progress=: that is"),
         (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
         (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
         (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),
