@@ -186,6 +186,9 @@ def validate(preset: str | Path | Mapping[str, Any] | Preset, overrides: Mapping
     from .preset import build_scene
     from .runs.runner import check_one_realization
 
+    if given := [key for key in keys if key in _run_keywords()]:  # run's own, not a preset field: said as such
+        raise FrictionlabError(f"validate takes no {', '.join(f'{key}=' for key in given)}: "
+                               "that is how frictionlab.run runs a preset; validate checks the preset alone")
     data, source, _ = read_preset_input(preset, overrides, **keys)
     return scene_record(build_scene(data, source=source, before_reading=check_one_realization))
 
@@ -243,6 +246,13 @@ def run(
     if result.status == "failed" and isinstance(result, Result):  # said where the run was asked for, as the CLI's error
         warn_user(f"{result.name}: run failed: {result.error or 'no fit'}")
     return result
+
+
+def _run_keywords() -> set[str]:
+    """``run``'s keyword-only arguments (``out``, ``workers``...): options, not preset fields."""
+    import inspect
+
+    return {p.name for p in inspect.signature(run).parameters.values() if p.kind is p.KEYWORD_ONLY}
 
 
 def _run(preset, overrides, out, workers, executor, scheduler, resume, force, plot, progress, memory_check, keys):

@@ -148,13 +148,14 @@ def plot_sweep(sweep, rows: list[dict[str, Any]], fh, dpi: int = 90) -> None:
     sweep_figure(sweep, rows).savefig(fh, format="png", dpi=dpi)
 
 
-def sweep_figure(sweep, rows: list[dict[str, Any]]) -> Figure:
+def sweep_figure(sweep, rows: list[dict[str, Any]], make=Figure) -> Figure:
     """a and b (rows of panels) against each swept parameter (columns), each axis
     named by what it is (``sweep.axis_label``), with their bootstrap intervals; in a
-    grid the other parameters' values make the series."""
+    grid the other parameters' values make the series. ``make``: pyplot.figure for a
+    figure a notebook shows."""
     paths = sweep.paths
     width = 4.2 * len(paths)
-    fig = Figure(figsize=(width, 5.6), layout="constrained")
+    fig = make(figsize=(width, 5.6), layout="constrained")
     axes = fig.subplots(2, len(paths), squeeze=False)
     done = [r for r in rows if r["a"] is not None]
     for col, path in enumerate(paths):

@@ -145,6 +145,20 @@ class SweepResult:
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
         return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
 
+    def plot(self):
+        """a and b against each swept parameter with their 95 % intervals, as sweep.png
+        draws them, in a new figure through pyplot (so a notebook shows it); returns the Figure."""
+        import matplotlib.pyplot as plt
+
+        from .plot import sweep_figure
+        from .preset import SweepSettings
+        from .runs.sweep import Sweep
+        from .runs.sweeprecord import read_sweep_record
+
+        summary, _ = read_sweep_record(self.folder)  # its spec and base preset: the axes' scales and names
+        sweep = Sweep(self.name, SweepSettings.model_validate(summary["sweep"]), summary["base_preset"], points=[])
+        return sweep_figure(sweep, self.rows, make=plt.figure)
+
     def _repr_html_(self) -> str:  # a notebook's view: a row per point with its fit
         from .reprs import sweep_html
 

@@ -95,6 +95,20 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
 
 
+def test_a_sweep_plots_as_its_sweep_png_does(tmp_path):
+    """SweepResult had no plot(): a notebook drew a sweep only by hand. Read back, its figure
+    names the axes by their fields, as sweep.png does."""
+    import matplotlib.pyplot as plt
+
+    sweep = {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.9]}}}
+    frictionlab.run(SMALL_PRESET, out=tmp_path / "sweep", sweep=sweep, plot=False, **FAST)
+    figure = frictionlab.load(tmp_path / "sweep").plot()
+    assert figure.number in plt.get_fignums()  # through pyplot: a notebook shows it
+    assert [ax.get_ylabel() for ax in figure.axes] == ["a", "b"]
+    assert [ax.get_xlabel() for ax in figure.axes if ax.get_xlabel()] == ["Hurst exponent H"]
+    plt.close(figure)
+
+
 def test_a_sweep_point_whose_folder_holds_another_run_is_refused_not_read_as_the_point(tmp_path):
     """SweepResult.points read whatever run sat in a point's folder: another sweep's point, or
     another preset's run, moved there came back as the point, its numbers not the row's."""
@@ -270,6 +284,8 @@ def _containing_itself() -> dict:
         (lambda: frictionlab.run("quickstart", {"seed": 3}, overrides={"seed": 4}, **FAST), "overrides given twice"),
         (lambda: frictionlab.run("quickstart", preset="quickstart", **FAST), "preset given twice"),
         (lambda: frictionlab.validate("quickstart", overrides=5), "overrides must be a mapping of dotted keys to values, got int"),
+        # run's options copied into validate: named as run's, not as unknown preset fields
+        (lambda: frictionlab.validate("quickstart", workers=1, progress=False), "validate takes no workers=, progress=: that is"),
         (lambda: frictionlab.load(None), "folder must be a path to a run folder (a str or pathlib.Path), got NoneType"),
         (lambda: frictionlab.load(""), "folder must be a path to a run folder, got an empty string"),
         (lambda: frictionlab.load("a\0b"), "folder must be a path to a run folder, got a string with a NUL character"),

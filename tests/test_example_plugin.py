@@ -190,3 +190,20 @@ def test_the_tutorials_step_4_validates_as_shown_and_a_name_switched_alone_is_re
         assert done.returncode == 0 and ": ok (" in done.stdout, (argv, done.stderr)
     alone = cli("validate", "quickstart", "--set", "spectrum.name=gaussian", cwd=tmp_path)
     assert alone.returncode == 2 and "spectrum.params.hurst: is not a known field" in alone.stderr
+
+
+def test_the_tutorials_step_3_tests_run_as_shown(example_here, register_plugin):
+    """docs/tutorials/write-a-plugin.md, step 3: its conformance tests, run on the example
+    (the page's ``Gaussian``), pass as written, each parametrised case and the hook's."""
+    import re
+
+    page = (ROOT / "docs" / "tutorials" / "write-a-plugin.md").read_text(encoding="utf-8")
+    block = re.search(r"```python\n(.*?)```", page.split("## 3.", 1)[1], re.S).group(1)
+    from frictionlab_gaussian import Gaussian
+
+    space = {"Gaussian": Gaussian}
+    exec(compile(block, "write-a-plugin.md", "exec"), space)
+    (marker,) = space["test_conformance"].pytestmark
+    for params in marker.args[1]:
+        space["test_conformance"](params)
+    space["test_registered_through_the_hook"](register_plugin)

@@ -74,7 +74,9 @@ def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
         return f"Profile.spacing must be finite and > 0. Got {spacing!r} instead."
     if not isinstance(profile.periodic, bool):
         return f"Profile.periodic must be True or False. Got {profile.periodic!r} instead."
-    if profile.periodic is not (declared := generator.periodic()):  # the preset's solver and estimator were checked by it
+    if not isinstance(declared := generator.periodic(), bool):  # as answers_problem says it, not as a mismatch
+        return f"periodic() must be True or False. Got {declared!r} instead."
+    if profile.periodic is not declared:  # the preset's solver and estimator were checked by it
         return f"Profile.periodic must be what periodic() declares, {declared!r}. Got {profile.periodic!r} instead."
     return None
 

@@ -96,9 +96,9 @@ class Sweep:
         (``spectrum.params.hurst``: "Hurst exponent H"), else its last key."""
         keys = path.split(".")
         field = None
-        if len(keys) == 3 and keys[1] == "params" and self.points:
-            plugin = self.points[0].scene.plugins().get(keys[0])
-            field = type(plugin.params).model_fields.get(keys[2]) if plugin is not None else None
+        if len(keys) == 3 and keys[1] == "params":
+            params = self._params_model(keys[0])
+            field = params.model_fields.get(keys[2]) if params is not None else None
         else:
             model = Preset
             for key in keys:
@@ -106,6 +106,19 @@ class Sweep:
                 model = _model_of(field.annotation) if field is not None else None
         head = re.split(r"[:;(,]", (field.description or "") if field is not None else "")[0].strip()
         return head if 0 < len(head) <= 40 else keys[-1].replace("_", " ")
+
+
+    def _params_model(self, section: str) -> type[BaseModel] | None:
+        """The Params of the plugin in ``section``: a point's, else (a sweep read back
+        from its folder, without points) the installed plugin the base preset names."""
+        if self.points:
+            plugin = self.points[0].scene.plugins().get(section)
+            return type(plugin.params) if plugin is not None else None
+        name = (self.base.get(section) or {}).get("name")
+        try:
+            return default_registry().get(section, name).Params if isinstance(name, str) else None
+        except FrictionlabError:  # not installed (any more): the figure names the field by its key
+            return None
 
 
 def _label(values: dict[str, Any]) -> str:

@@ -54,7 +54,8 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     first = generate(1234)
     second = generate(1234)
     if first.heights.shape != second.heights.shape or not np.array_equal(first.heights, second.heights):
-        fail(cls, "the same seed gave different heights; draw all randomness from the rng argument")
+        fail(cls, "the same seed gave different heights; draw all randomness from the rng argument and keep no "
+                  "state between calls (realizations run in any order, in other processes)")
     if first.spacing != second.spacing:
         fail(cls, "the same seed gave different spacings")
     other = generate(4321)

@@ -28,6 +28,9 @@ SPECTRUM_BREAKAGES = [
      "same seed gave different heights"),
     ("IgnoresSeed", {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0))},
      "different seeds gave identical heights"),
+    ("Stateful", {"generate": lambda self, rng: Profile(  # its rng used, yet each call differs: told to keep no state
+        GoodSpectrum.generate(self, rng).heights + 0.01 * next(self.__dict__.setdefault("calls", iter(range(99)))), 1.0)},
+     "same seed gave different heights; draw all randomness from the rng argument and keep no state between calls"),
     ("NaNHeights", {"generate": lambda self, rng: Profile(np.full(8, np.nan), 1.0)}, "must be finite"),
     ("TwoDimensional", {"generate": lambda self, rng: Profile(rng.random((4, 4)), 1.0)}, "must be 1-D"),
     ("IntegerHeights", {"generate": lambda self, rng: Profile(rng.integers(0, 9, 16), 1.0)}, "must be float64"),
@@ -51,6 +54,8 @@ SPECTRUM_BREAKAGES = [
     ("TrendedSurface", {"dimension": 2, "generate": lambda self, rng: Profile(
         GoodSpectrum.generate(self, rng).heights[:, None] + np.linspace(0, 3, 64) + np.sin(np.arange(64) / 3), 1.0)},
      r"the profile does not wrap along axis 1"),
+    ("PeriodicNotABool", {"periodic": lambda self: "yes"},  # named as a run names it, not as a mismatch with the profile
+     r"periodic\(\) must be True or False\. Got 'yes' instead\."),
     ("CaveatsAsOneString", {"caveats": lambda self: "coarse"}, r"caveats\(\) must be a tuple of non-empty strings"),
     ("EmptyCaveat", {"caveats": lambda self: ("",)}, r"caveats\(\) must be a tuple of non-empty strings"),
 ]
