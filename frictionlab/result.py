@@ -148,6 +148,7 @@ class SweepResult:
     def plot(self):
         """a and b against each swept parameter with their 95 % intervals, as sweep.png
         draws them, in a new figure through pyplot (so a notebook shows it); returns the Figure."""
+        refuse_unusable_matplotlib()
         import matplotlib.pyplot as plt
 
         from .plot import sweep_figure
