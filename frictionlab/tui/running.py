@@ -355,8 +355,10 @@ class RunControl:
             pane.show_stored_count(done or 0, total)
 
     def action_cancel_run(self) -> None:
-        if not self.running:
-            self.say("No run is going: Ctrl+R starts one.", "warning")
+        if not self.running:  # Ctrl+R answers "no preset open" where none is: say what starts a run here
+            self.say("No run is going: Ctrl+R starts one." if self._draft() is not None else
+                     "No run is going, and no preset is open: F2 lists them (Enter opens one), then Ctrl+R runs it.",
+                     "warning")  # fmt: skip
             return
         if self.followed.ended:
             self.say("The run has ended: its files are being written; nothing is left to cancel.", "warning")

@@ -205,7 +205,7 @@ CANNOT_ACT = [  # pressed one after the other, in an app with no preset and no r
     (["ctrl+o"], "No preset open"),
     (["enter"], "No preset to open here"),
     (["d"], "No preset to duplicate here"),
-    (["f4", "c"], "No run is going"),
+    (["f4", "c"], "No run is going, and no preset is open: F2 lists them"),
     (["f5", "space"], "No runs yet"),
     (["enter"], "No runs yet"),
 ]
@@ -224,6 +224,14 @@ async def test_every_key_that_cannot_act_says_why(tmp_path, monkeypatch, registr
             said.append(status_text(app))
     for (keys, expected), status in zip(CANNOT_ACT, said, strict=True):
         assert status.startswith(expected), (keys, status)
+
+
+@sync
+async def test_c_with_a_preset_open_and_no_run_says_ctrl_r_starts_one(folders, registry):
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await pilot.press("f4", "c")
+        assert status_text(app).startswith("No run is going: Ctrl+R starts one.")
 
 
 @sync
