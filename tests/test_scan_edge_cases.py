@@ -21,6 +21,15 @@ def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
     return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
 
 
+def xyz_lines(ny: int, nx: int, seed: int, sep: str = " ", intensity: bool = False) -> tuple[list[str], np.ndarray]:
+    """An instrument's x, y, z export of a rough ny x nx map on 0.1 um pixels (in m): its lines,
+    a point each (with an intensity column of ones), and the heights z[y, x]."""
+    y, x = np.mgrid[0:ny, 0:nx] * 1e-7
+    z = rough(ny, nx, seed) * 1e-8
+    columns = (x.ravel(), y.ravel(), z.ravel()) + ((np.ones(z.size),) if intensity else ())
+    return [sep.join(f"{v:.9e}" for v in row) + "\n" for row in zip(*columns)], z
+
+
 def write_gwy(path, z, dx, dy, *, unit_xy="m", unit_z="m", xreal=None, xres=None, more=(), title="Height"):
     """A Gwyddion file of the map z[y, x] (channel 0, ``title``) on pixels dx x dy (in unit_xy), and more channels
     (title, map, unit of values) on the same grid."""
@@ -256,9 +265,8 @@ def test_a_text_export_in_utf16_is_told_to_be_saved_as_utf8(tmp_path, encoding):
     """A Windows program's 'Unicode text' (UTF-16, with or without its byte-order mark) sent to
     SurfaceTopography was 'a .txt file that is not text (binary bytes at its start): give a binary
     format its own suffix'. The same export in UTF-8 is read, its heights the file's."""
-    y, x = np.mgrid[0:9, 0:8] * 1e-7
-    z = rough(9, 8, 7) * 1e-8
-    text = "".join(f"{a:.9e}\t{b:.9e}\t{c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel()))
+    lines, z = xyz_lines(9, 8, 7, sep="\t")
+    text = "".join(lines)
     (tmp_path / "wide.txt").write_bytes(text.encode(encoding))
     with pytest.raises(ValueError, match="a text export in UTF-16 .* save it as UTF-8") as refused:
         SurfaceFile(path=str(tmp_path / "wide.txt"), format="instrument").rms_height()
@@ -274,9 +282,7 @@ def test_an_xyz_export_with_points_left_out_is_told_which_grid_they_lie_on(tmp_p
     a regular grid: export the map on the instrument's grid', which it was. The grid and the
     points missing (or listed twice) are named, and the same export with those points written
     with a NaN height is read, filled by undefined: harmonic, the other heights the file's."""
-    y, x = np.mgrid[0:9, 0:8] * 1e-7
-    z = rough(9, 8, 7) * 1e-8
-    rows = [f"{a:.9e} {b:.9e} {c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel())]
+    rows, z = xyz_lines(9, 8, 7)
     kept = [row for i, row in enumerate(rows) if i not in left_out] + ([] if left_out else rows[10:11])
     (tmp_path / "gaps.txt").write_text("".join(kept))
     with pytest.raises(ValueError, match=f"lie on a grid of 8 x 9 points \\(x by y\\), {said}; write each point"):
@@ -290,10 +296,8 @@ def test_an_xyz_export_with_points_left_out_is_told_which_grid_they_lie_on(tmp_p
 
 def test_an_xyz_export_with_a_fourth_column_is_told_to_keep_x_y_and_the_heights(tmp_path):
     """x, y, z and an intensity per point was 'a damaged Plain text file (4 columns): copy it again'."""
-    y, x = np.mgrid[0:9, 0:8] * 1e-7
-    z = rough(9, 8, 7) * 1e-8
-    rows = zip(x.ravel(), y.ravel(), z.ravel(), np.ones(z.size))
-    (tmp_path / "xyzi.csv").write_text("".join(",".join(f"{v:.9e}" for v in row) + "\n" for row in rows))
+    lines, _ = xyz_lines(9, 8, 7, sep=",", intensity=True)
+    (tmp_path / "xyzi.csv").write_text("".join(lines))
     with pytest.raises(ValueError, match="line 1 holds 4 numbers separated by commas, .* export x, y and the heights alone"):
         SurfaceFile(path=str(tmp_path / "xyzi.csv"), format="instrument").rms_height()
 
@@ -383,9 +387,8 @@ def test_an_x3p_of_another_revision_or_a_profile_is_named_not_called_damaged(tmp
 def test_a_text_export_with_a_byte_order_mark_is_named(tmp_path):
     """SurfaceTopography's XYZ reader fails on a leading byte-order mark as on damage ('a damaged
     Plain text file ... copy it again'); the mark is named, and the same file without it is read."""
-    y, x = np.mgrid[0:10, 0:12] * 1e-7
-    z = rough(10, 12, 9) * 1e-8
-    text = "".join(f"{a:.9e},{b:.9e},{c:.9e}\n" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel()))
+    lines, z = xyz_lines(10, 12, 9, sep=",")
+    text = "".join(lines)
     (tmp_path / "marked.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
     with pytest.raises(ValueError, match="starts with a UTF-8 byte-order mark .* save it without one") as refused:
         SurfaceFile(path=str(tmp_path / "marked.csv"), format="instrument").rms_height()
