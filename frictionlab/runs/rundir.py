@@ -155,11 +155,10 @@ class RunDirectory:
             )
         # a forked worker does not keep the lock, a holder that died (kill -9) holds it no
         # more, and a waiter that opened a file the holder then removed takes the lock on the new file.
-        self._lock = RunLock(lock, on_acquired=_write_holder)
+        held = RunLock(lock, on_acquired=_write_holder)
         try:
-            self._lock.acquire()
+            held.acquire()
         except LockHeld:
-            self._lock = None
             pid = lock_holder(lock)  # as the kernel says: the lock file's text is anyone's
             try:  # what _write_holder wrote, believed only where it names that process
                 text = read_member(self.path, LOCK_FILE, 4096).decode("utf-8", "replace").strip()[:200]
@@ -171,13 +170,13 @@ class RunDirectory:
                 "or give another output folder"
             ) from None
         except OSError as exc:
-            self._lock = None
             if exc.errno not in (errno.ENOLCK, errno.ENOSYS, errno.EOPNOTSUPP):
                 raise
             raise RunFolderError(  # two runs into one folder would mix their chunks: none without the lock
                 f"{shown(lock)} cannot be locked ({exc.strerror}): the file system of {shown(self.path)} does not "
                 "keep locks (some network file systems do not); give an output folder on a local disk"
             ) from None
+        self._lock = held
         return self
 
     def __exit__(self, *exc) -> bool:
