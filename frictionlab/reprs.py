@@ -47,7 +47,7 @@ def result_html(result) -> str:
     if len(result.table.get("f", ())):
         try:
             parts.append(f'<img alt="xi against f" src="data:image/png;base64,{_curve_png(result)}">')
-        except FrictionlabError as exc:  # a bad MPLBACKEND, matplotlib missing: the numbers are still shown
+        except FrictionlabError as exc:  # a bad MPLBACKEND (refuse_unusable_matplotlib): the numbers are still shown
             parts.append(f"<p>the curve is not drawn: {html.escape(str(exc))}</p>")
     parts += [f"<p>caveat: {html.escape(caveat)}</p>" for caveat in result.caveats if caveat != result.error]
     if result.folder is not None:
