@@ -33,6 +33,7 @@ DRAW = """
 import io, json, pickle, sys, time
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from frictionlab import plot
+from frictionlab.runs.figures import CurveFigure
 scene, outcome = pickle.load(open(sys.argv[1], "rb"))
 if sys.argv[2] == "baseline":
     plot.ticks_in_view, plot.UNHINTED, plot.FAST_PNG = (lambda ax: None), {}, {}
@@ -45,7 +46,7 @@ def timed_draw(canvas):
 FigureCanvasAgg.draw = timed_draw
 fh = io.BytesIO()
 start = time.perf_counter()
-plot.plot_curve(scene, outcome, fh)
+plot.plot_curve(CurveFigure.of(scene, outcome), fh)
 end = time.perf_counter()
 print(json.dumps({"whole": end - start, "built": marks["built"] - start, "drawn": marks["drawn"] - marks["built"],
                   "png": end - marks["drawn"], "bytes": len(fh.getvalue())}))

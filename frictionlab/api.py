@@ -293,10 +293,12 @@ def run_scene(
     plot: bool = True,
     on_results=None,
     cancel=None,
+    drawer=None,
 ) -> Result:
     """Run a validated ``Scene`` into the folder ``out`` (``runner.run_to_folder``) or,
     when None, in memory (``engine.run``); the one path of ``frictionlab.run`` and of
-    ``frictionlab run``. ``on_results(result)`` is called before the figure is drawn."""
+    ``frictionlab run``. ``on_results(result)`` is called before the figure is drawn
+    (by ``drawer``, a ``runs.figures.DrawingProcess``, where one is given)."""
     if out is None:
         from .compute import engine
         from .preset.loads import check_loads
@@ -319,7 +321,7 @@ def run_scene(
             on_results(_result(scene, outcome, Path(out), files))
 
     outcome, files = run_to_folder(
-        scene, out, options, listeners=listeners, cancel=cancel, plot=plot, on_results=tell
+        scene, out, options, listeners=listeners, cancel=cancel, plot=plot, on_results=tell, drawer=drawer
     )
     return _result(scene, outcome, Path(out), files)
 

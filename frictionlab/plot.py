@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import textwrap
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.backends.backend_agg  # noqa: F401 (savefig's PNG canvas: imported with this module, ahead of drawing)
 import numpy as np
@@ -19,9 +19,9 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, LogFormatter
 from PIL import Image
 
-from .compute.ensemble import RunOutcome
-from .compute.fit import LogFit
-from .preset import Scene
+if TYPE_CHECKING:  # only these: the process that draws plot.png imports no more than matplotlib and numpy
+    from .compute.fit import LogFit
+    from .runs.figures import CurveFigure
 
 Image.preinit()  # PIL's format drivers, which the first figure saved would import
 XI_LABEL = "xi = rms slope in contact / rms slope"
@@ -92,19 +92,20 @@ def draw_interval(ax, x, estimate, low, high, fmt: str, *, color, capsize: float
     ax.plot(x, estimate, fmt, color=color, label=label, **line)
 
 
-def plot_curve(scene: Scene, outcome: RunOutcome, fh) -> None:
+def plot_curve(figure: CurveFigure, fh) -> None:
+    """plot.png: ``figure``'s curve and fit above, the points in contact below, on a shared f axis."""
     fig = Figure(figsize=(6.4, 5.6))  # fixed margins: a constrained layout would take 60% of the drawing time
     ax, ax_count = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.2]})
     fig.subplots_adjust(left=0.12, right=0.97, bottom=0.1, top=0.94, hspace=0.06)
-    draw_curve(ax, outcome.f, outcome.xi, outcome.xi_sem, outcome.fit, done=outcome.done, caveats=outcome.caveats)
-    title = wrap_title(f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}", 6.4, 10)
+    draw_curve(ax, figure.f, figure.xi, figure.xi_sem, figure.fit, done=figure.done, caveats=figure.caveats)
+    title = wrap_title(figure.title, 6.4, 10)
     ax.set_title(title, fontsize=10, y=1.0)  # placed, not fitted above the tick labels that the shared x axis hides
     fig.subplots_adjust(top=0.94 - 0.03 * title.count("\n"))  # a long name: the title's lines inside the figure
-    ax_count.plot(outcome.f, outcome.contact_count, "-", color="C2")
+    ax_count.plot(figure.f, figure.contact_count, "-", color="C2")
     ax_count.set_yscale("log")
     plain_log_labels(ax_count.yaxis)
     ax_count.set_ylabel("points in contact")
-    label = wrap_title(scene.normalisation.definition, 6.4 * 0.85, 8)  # a map's definition is wider than the figure
+    label = wrap_title(figure.f_label, 6.4 * 0.85, 8)  # a map's definition is wider than the figure
     ax_count.set_xlabel(label, fontsize=8)
     fig.subplots_adjust(bottom=0.1 + 0.025 * label.count("\n"))
     ax_count.grid(True, which="both", alpha=0.3)

@@ -126,8 +126,9 @@ def test_drawing_plot_png_imports_nothing_the_plot_module_did_not(tmp_path):
                            "spectrum.params.length=1024", "loading.steps=8", "fit.bootstrap=10"])
         outcome = engine.run(scene, RunOptions(workers=1))
         import frictionlab.plot
+        from frictionlab.runs.figures import CurveFigure
         before = set(sys.modules)
-        frictionlab.plot.plot_curve(scene, outcome, io.BytesIO())
+        frictionlab.plot.plot_curve(CurveFigure.of(scene, outcome), io.BytesIO())
         print(sorted(set(sys.modules) - before))
         """,
         tmp_path,

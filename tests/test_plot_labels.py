@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import LogFormatterSciNotation
 
 from frictionlab.compute import engine
+from frictionlab.runs.figures import CurveFigure
 from frictionlab.options import RunOptions
 from frictionlab.plot import PlainLogFormatter, plain_log_labels, plot_curve
 
@@ -69,7 +70,7 @@ def test_plot_png_is_drawn_without_mathtext(make_scene, monkeypatch):
     scene = make_scene({"realizations": 3})
     outcome = engine.run(scene, RunOptions(workers=1))
     fh = io.BytesIO()
-    plot_curve(scene, outcome, fh)
+    plot_curve(CurveFigure.of(scene, outcome), fh)
     assert fh.getvalue().startswith(b"\x89PNG") and math.isfinite(outcome.fit.a)
 
 
@@ -86,7 +87,7 @@ def test_the_definition_of_f_under_plot_png_is_inside_the_figure(make_scene, mon
     drawn = []
     save = Figure.savefig
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
-    plot_curve(scene, outcome, io.BytesIO())
+    plot_curve(CurveFigure.of(scene, outcome), io.BytesIO())
     fig = drawn[0]
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -113,7 +114,7 @@ def test_a_long_title_of_plot_png_is_inside_the_figure(make_scene, monkeypatch):
     drawn = []
     save = Figure.savefig
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
-    plot_curve(scene, outcome, io.BytesIO())
+    plot_curve(CurveFigure.of(scene, outcome), io.BytesIO())
     canvas = FigureCanvasAgg(drawn[0])
     canvas.draw()
     title, inside = drawn[0].axes[0].title, drawn[0].bbox

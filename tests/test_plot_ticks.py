@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 
 from frictionlab import plot
 from frictionlab.compute import engine
+from frictionlab.runs.figures import CurveFigure
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
 
@@ -32,7 +33,7 @@ def drawn_figure(small_run, monkeypatch) -> tuple[Figure, bytes]:
     save = Figure.savefig
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
     fh = io.BytesIO()
-    plot.plot_curve(*small_run, fh)
+    plot.plot_curve(CurveFigure.of(*small_run), fh)
     return drawn[0], fh.getvalue()
 
 
@@ -90,6 +91,6 @@ def test_plot_png_text_is_drawn_unhinted_and_the_settings_are_left_as_they_were(
 
     monkeypatch.setattr(FigureCanvasAgg, "draw", noted)
     with matplotlib.rc_context({"text.hinting": "force_autohint"}):
-        plot.plot_curve(*small_run, io.BytesIO())
+        plot.plot_curve(CurveFigure.of(*small_run), io.BytesIO())
         assert matplotlib.rcParams["text.hinting"] == "force_autohint"
     assert seen == ["no_hinting"]

@@ -53,6 +53,18 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> ExitCode:
+    from ..runs.figures import DrawingProcess
+
+    # forked before anything heavy is imported: it imports matplotlib on the core this start leaves idle
+    drawer = None if args.no_plot or args.detach else DrawingProcess.start()
+    try:
+        return _run(args, drawer)
+    finally:
+        if drawer is not None:
+            drawer.close()
+
+
+def _run(args, drawer) -> ExitCode:
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
     from ..runs.rundir import new_run_folder
@@ -68,6 +80,8 @@ def run(args) -> ExitCode:
     scene = build_scene(data, source=source, before_reading=reading)
     if scene.preset.sweep is not None:  # its points are planned anew: of the base, what pressing needs is kept
         scene = scene.for_pressing()
+    if drawer is not None and (scene.preset.sweep is not None or not scene.preset.output.plot):
+        drawer.close()  # no plot.png to draw: its import takes a core no longer
     if args.out is not None and (too_long := too_long_path(args.out)):
         raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:
@@ -80,7 +94,7 @@ def run(args) -> ExitCode:
             return detach(args, data, scene, out_dir, options)
         if scene.preset.sweep is not None:  # one ensemble per point
             return run_sweep_into(args, data, out_dir, options)
-        return _run_scene(args, scene, out_dir, options)
+        return _run_scene(args, scene, out_dir, options, drawer)
     except FrictionlabError:  # refused before it began (the memory check): the folder made for it goes
         if not args.out and not any(out_dir.iterdir()):
             out_dir.rmdir()
@@ -124,7 +138,7 @@ def detach(args, data: dict, scene, out_dir: Path, options) -> ExitCode:
     return ExitCode.OK
 
 
-def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
+def _run_scene(args, scene, out_dir: Path, options, drawer=None) -> ExitCode:
     from ..api import run_scene
     from ..progress import ProgressReporter
     from ..runs.results import summary_dict
@@ -141,7 +155,9 @@ def _run_scene(args, scene, out_dir: Path, options) -> ExitCode:
 
     listeners = [] if args.quiet else [ProgressReporter()]
     try:
-        result = run_scene(scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table)
+        result = run_scene(
+            scene, out_dir, options, listeners=listeners, plot=not args.no_plot, on_results=print_table, drawer=drawer
+        )
     except OSError as exc:  # a full disk: said as every refusal is, as the error object under --json too
         raise write_failed(exc, resumable(out_dir)) from None
     if closed:

@@ -16,9 +16,8 @@ import os
 import sys
 import threading
 
+from .figures import PLOT_MODULE
 from ..plugin.hookspecs import hookimpl
-
-PLOT_MODULE = "frictionlab.plot"
 
 _importing: threading.Thread | None = None
 

@@ -30,12 +30,13 @@ from pydantic import Field
 
 from .. import __version__
 from ..compute.ensemble import RunOutcome
-from ..errors import MissingDependency, RunError, RunFolderError, shown, shown_name
+from ..errors import RunFolderError, shown
 from ..io.files import atomic_write, write_npz
 from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
 from ..preset import Scene
 from ..preset.schema import MAX_BOOTSTRAP
+from .figures import CurveFigure, DrawingProcess, plot_wanted, write_figure
 from .import_ahead import PLOT_MODULE, imported
 from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json, read_number_table
 
@@ -403,35 +404,28 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     return files
 
 
-def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> dict[str, Path]:
+def plot_path(out_dir: str | Path) -> Path:
+    return Path(out_dir) / "plot.png"
+
+
+def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path],
+             drawing: DrawingProcess | None = None) -> dict[str, Path]:  # fmt: skip
     """Draw plot.png (if the preset asks for it and anything finished) after the other
-    files, and list it in summary.json (rewritten); ``files`` with the plot's path."""
-    if not (scene.preset.output.plot and outcome.done):
+    files, and list it in summary.json (rewritten); ``files`` with the plot's path.
+    ``drawing``: a ``DrawingProcess`` sent it already, waited for (drawn here if it died)."""
+    if not plot_wanted(scene, outcome):
         return files
     out = Path(out_dir)
-    files = {**files, "plot": out / "plot.png"}
-
-    def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (or ahead, while computing)
-        imported(PLOT_MODULE).plot_curve(scene, outcome, fh)
-
-    write_figure(files["plot"], draw)
+    files = {**files, "plot": plot_path(out)}
+    if drawing is None or not drawing.wait():
+        write_curve_figure(files["plot"], CurveFigure.of(scene, outcome))
     _write_summary(out, scene, outcome, files)
     return files
 
 
-def write_figure(path: Path, draw) -> None:
-    """Write a figure file with ``draw(file)``, which imports matplotlib itself. A
-    failure is a RunError naming the file: a folder that said no, or matplotlib
-    refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then."""
-    try:
-        atomic_write(path, draw, binary=True)
-    except OSError as exc:
-        raise RunError(f"cannot write {shown_name(path)}: {exc.strerror or exc}; the numbers are written") from None
-    except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
-        raise RunError(f"cannot draw {shown_name(path)}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
-                       "the numbers are written") from None  # fmt: skip
-    except Exception as exc:
-        raise RunError(f"cannot draw {shown_name(path)}: {type(exc).__name__}: {exc}; the numbers are written") from None
+def write_curve_figure(path: Path, figure: CurveFigure) -> None:
+    """plot.png of ``figure``, drawn in this process."""
+    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_curve(figure, fh))
 
 
 def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:

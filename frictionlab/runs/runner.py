@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
@@ -16,9 +17,12 @@ from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
 from .import_ahead import PlotImportAhead
-from .results import add_plot, holds_results, read_summary, results_on_disk, write_results
+from .results import add_plot, holds_results, plot_path, read_summary, results_on_disk, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
+
+if TYPE_CHECKING:
+    from .figures import DrawingProcess
 
 UNSAVED_WORK_SECONDS = 0.5  # of the run's time: finished chunks are written once this much is not on disk yet
 
@@ -97,6 +101,7 @@ def run_to_folder(
     cancel=None,
     plot: bool = True,
     on_results: Callable[[RunOutcome, dict[str, Path]], None] | None = None,
+    drawer: DrawingProcess | None = None,
 ) -> tuple[RunOutcome, dict[str, Path]]:
     """Run ``scene`` as ``options`` say and write its result files into ``out_dir``.
 
@@ -115,7 +120,9 @@ def run_to_folder(
     The figure comes last: ``on_results(outcome, files)`` is called once the
     numbers are written (a front end prints the fit there, so nobody waits for
     matplotlib), then plot.png is drawn unless ``plot`` is False or the preset
-    says ``output.plot: false``. Returns the outcome and the paths of the files written.
+    says ``output.plot: false``: here, matplotlib imported while the workers compute, or by
+    ``drawer`` (``figures.DrawingProcess``) where one is given, sent the figure as soon as the
+    fit exists. Returns the outcome and the paths of the files written.
     """
     if options.memory_check:
         check_memory(scene, options)
@@ -124,10 +131,13 @@ def run_to_folder(
         restored = run_dir.start(scene, resume=options.resume)
         store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
         outcome = None
-        if plot and scene.preset.output.plot:  # matplotlib imported while the workers compute
+        if plot and scene.preset.output.plot and drawer is None:  # matplotlib imported while the workers compute
             listeners = [*listeners, PlotImportAhead()]
+        drawing = None
         try:
             outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
+            if plot and drawer is not None and drawer.send(plot_path(out_dir), scene, outcome):
+                drawing = drawer  # drawn there while the numbers are written here
         finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)
             store.flush(merge=outcome is not None and outcome.status == "completed")
         files = write_results(out_dir, scene, outcome)
@@ -135,7 +145,7 @@ def run_to_folder(
             if on_results is not None:
                 on_results(outcome, files)
             if plot:
-                files = add_plot(out_dir, scene, outcome, files)
+                files = add_plot(out_dir, scene, outcome, files, drawing)
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
             run_dir.finish(scene, outcome.status)
     return outcome, files

@@ -36,7 +36,7 @@ from ..preset.schema import ensemble_settings, first_repeat
 from ..preset.problems import fold_point_problems
 from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
-from .results import write_figure
+from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder
 from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, write_tables
