@@ -127,6 +127,21 @@ def test_a_resume_keeps_the_time_an_older_frictionlab_recorded(make_scene, tmp_p
     assert recorded_seconds(tmp_path / "run") == pytest.approx(1234.5 + again.elapsed, abs=2e-6)
 
 
+@pytest.mark.parametrize("forged, kept", [(1e9, 1e9), (1e300, 0.0), ("1", 0.0), (-1.0, 0.0)])
+def test_a_forged_recorded_time_is_no_time_or_kept_within_what_a_summary_holds(make_scene, tmp_path, forged, kept):
+    """A manifest's elapsed_seconds is read only as a time a summary.json may hold (at most 1e9 s):
+    the sum past it was written, and the folder then refused by load() as damaged."""
+    import frictionlab
+
+    scene = make_scene({"realizations": 4, **NO_PLOT})
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    manifest["elapsed_seconds"] = forged
+    (tmp_path / "run" / "run.json").write_text(json.dumps(manifest))
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    assert frictionlab.load(tmp_path / "run").elapsed == pytest.approx(min(kept + again.elapsed, 1e9), abs=2e-6)
+
+
 def test_a_fresh_run_into_its_own_completed_folder_says_it_runs_again(make_scene, tmp_path):
     """A run into the folder of a completed run of the same preset ran it again without a word:
     it says so, and the numbers are the same."""

@@ -132,7 +132,8 @@ def run_to_folder(
             outcome = engine.run(scene, options, listeners=listeners, cancel=cancel, store=store, restored=restored)
         finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)
             store.flush(merge=outcome is not None and outcome.status == "completed")
-        outcome.extra["earlier_seconds"] = earlier  # summary.json records the sessions' time summed
+        # the sessions' time summed, as summary.json and the manifest record it (within what either holds)
+        outcome.extra["recorded_seconds"] = recorded = min(earlier + outcome.elapsed, MAX_WALL_SECONDS)
         files = write_results(out_dir, scene, outcome)
         try:
             if on_results is not None:
@@ -140,7 +141,7 @@ def run_to_folder(
             if plot:
                 files = add_plot(out_dir, scene, outcome, files)
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
-            run_dir.finish(scene, outcome.status, seconds=earlier + outcome.elapsed)
+            run_dir.finish(scene, outcome.status, seconds=recorded)
     return outcome, files
 
 
