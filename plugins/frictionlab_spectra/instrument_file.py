@@ -5,9 +5,10 @@ and the length unit the file carries, converted to the unit a preset asks for.
 SurfaceTopography is imported here only when such a file is read (its import takes
 seconds). It lays a map out as heights[x, y]; a map here is z[row, column] = z[y, x],
 so its array is transposed, except a bare array's (.npz, .mat, .h5: no axes), which is
-z[y, x] already, as numpy saves a map and as a .npy map is read. Undefined points (an optical scan's dropouts) are refused,
-or filled by the solution of Laplace's equation from their defined neighbours (SurfaceTopography's
-harmonic interpolation) when the preset chooses ``undefined: harmonic``.
+z[y, x] already, as numpy saves a map and as a .npy map is read. Undefined points (an
+optical scan's dropouts) are refused, or filled by the solution of Laplace's equation from
+their defined neighbours (SurfaceTopography's harmonic interpolation) when the preset
+chooses ``undefined: harmonic``.
 """
 
 from __future__ import annotations
@@ -228,7 +229,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
         if missing == heights.size:  # harmonic filling would have nothing to fill from
             raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
-        transpose = dimension == 2 and reader.format() not in BARE_ARRAY_FORMATS  # heights[x, y]: z[y, x] is its transpose
+        transpose = dimension == 2 and reader.format() not in BARE_ARRAY_FORMATS  # heights[x, y]: z[y, x] its transpose
         mask = np.ma.getmaskarray(heights) if missing and dimension == 2 else None
         mask = None if mask is None else np.ascontiguousarray(mask.T if transpose else mask)
         if missing:
