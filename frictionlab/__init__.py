@@ -27,7 +27,7 @@ _LAZY = {
     **dict.fromkeys(
         (
             "ContactCurve", "ContactSolver", "Control", "ForceNormalisation", "Plugin", "PluginParams", "Profile",
-            "SlopeEstimator", "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
+            "SlopeEstimator", "SolveCancelled", "SolveFailed", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "iteration_done",
             "half_load_points", "load_finished", "mdr_length", "short_cutoff_caveat",
         ),
         "plugin",
@@ -120,6 +120,7 @@ __all__ = [
     "RunOptions",
     "SlopeEstimator",
     "SolveCancelled",
+    "SolveFailed",
     "SpectrumGenerator",
     "SweepListener",
     "SweepResult",

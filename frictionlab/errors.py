@@ -189,6 +189,11 @@ def shown_name(text) -> str:
     return shown(text).translate(_LINES)
 
 
+def first_names(names: list[str], count: int = 3) -> str:
+    """The first ``count`` of ``names`` as a message lists what a folder holds: ``'a', 'b', ...``."""
+    return ", ".join(repr(shown_name(name)) for name in names[:count]) + (", ..." if len(names) > count else "")
+
+
 def _escape_unencodable(exc: UnicodeError):
     """Codec error handler: a byte of a path that was not UTF-8 (a lone surrogate, as
     Python decodes it) written as ``\xff``, as ``shown`` does; any other character the

@@ -282,3 +282,24 @@ def test_ctrl_c_during_the_fit_lets_the_fit_finish_and_the_run_is_summarised(mak
     outcome = engine.run(scene, RunOptions(workers=1))  # before, a KeyboardInterrupt left no outcome
     assert outcome.status == "completed" and outcome.extra["signal"] == "SIGINT"
     assert outcome.fit == expected.fit
+
+
+def test_a_failure_a_plugin_explains_is_its_message_alone(make_scene):
+    """A SolveFailed is the plugin's own word to the user: before, a built-in's ended in the
+    source line that raised it ('... loosen the tolerance. (contact_cg.py:436)'), and a
+    third party's was told as that plugin's fault ('tell its authors')."""
+    from frictionlab import SolveFailed
+
+    scene = make_scene({"spectrum": {"params": {"points": 64}},
+                        "solver": {"name": "bem-halfplane", "params": {"max_iterations": 1, "tolerance": 1e-12}}})
+    error = compute_realization(scene, 0).error
+    assert error.startswith("SolveFailed: bem-halfplane did not converge at load 0")
+    assert error.endswith("Raise max_iterations or loosen the tolerance.")
+    base = type(scene.solver)
+
+    def solve(self, *args):
+        raise SolveFailed("gave up: raise max_iterations")
+
+    diverging = type("Diverging", (base,), {"name": "diverging", "solve": solve})(scene.solver.params)
+    result = compute_realization(Scene(preset=scene.preset, spectrum=scene.spectrum, solver=diverging, slope=scene.slope), 0)
+    assert result.error == "SolveFailed: gave up: raise max_iterations"

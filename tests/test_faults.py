@@ -235,6 +235,26 @@ def negative_seconds(folder):
     _rewrite(folder, _second(folder), lambda a: a["seconds"].__setitem__(0, -1e308), True)
 
 
+def huge_seconds(folder):  # summed into the run's compute time: inf
+    _rewrite(folder, _second(folder), lambda a: a["seconds"].__setitem__(0, 1e300), True)
+
+
+def huge_indentation(folder):  # finite: its mean over the realizations overflowed (a warning, an empty cell)
+    _rewrite(folder, _second(folder), lambda a: a["indentation"].__setitem__((0, 3), 1e308), True)
+
+
+def nan_indentation(folder):  # no solver's: its curve must be finite
+    _rewrite(folder, _second(folder), lambda a: a["indentation"].__setitem__((0, 3), math.nan), True)
+
+
+def huge_rms_height(folder):
+    _rewrite(folder, _second(folder), lambda a: a["measured_rms_height"].__setitem__(0, 1e308), True)
+
+
+def huge_slope(folder):
+    _rewrite(folder, _second(folder), lambda a: a["slope_rms_line"].__setitem__(0, 1e308), True)
+
+
 def no_points(folder):
     _rewrite(folder, _second(folder), lambda a: a["points"].__setitem__(0, 0), True)
 
@@ -271,12 +291,12 @@ def listed_twice(folder):
 
 
 DAMAGE = {
-    truncated: "1 checksum mismatch",
-    emptied: "1 checksum mismatch",
-    deleted: "1 missing",
-    edited_value: "1 checksum mismatch",
-    nan_row: "1 checksum mismatch",
-    missing_array: "1 no array xi",
+    truncated: "'00000001-00000010.npz': checksum mismatch",
+    emptied: "checksum mismatch",
+    deleted: "'00000001-00000010.npz': missing",
+    edited_value: "checksum mismatch",
+    nan_row: "checksum mismatch",
+    missing_array: "no array xi",
     index_out_of_range: "indices outside",
     negative_index: "indices outside",
     repeated_index: "or repeated",
@@ -285,8 +305,13 @@ DAMAGE = {
     negative_count: "contact_count below 0 or above the profile's points",
     count_above_points: "contact_count below 0 or above the profile's points",
     huge_xi: "xi above what an rms over some of a profile's slopes can be",
-    infinite_peak: "peak_rms infinite or below 0",
-    negative_seconds: "seconds infinite or below 0",
+    infinite_peak: "peak_rms inf, not from 0 to 1e+300 (or NaN)",
+    negative_seconds: "seconds -1e+308, not from 0 to 1e+09 (or NaN)",
+    huge_seconds: "seconds 1e+300, not from 0 to 1e+09 (or NaN)",
+    huge_indentation: "'00000001-00000010.npz': indentation 1e+308, not from -1e+300 to 1e+300",
+    nan_indentation: "indentation nan, not from -1e+300 to 1e+300",
+    huge_rms_height: "measured_rms_height 1e+308, not from 0 to 1e+300 (or NaN)",
+    huge_slope: "slope_rms_line 1e+308, not from 0 to 1e+300",
     no_points: "a profile's points not a whole number >= 1",
     nan_points: "a profile's points not a whole number >= 1",
     fractional_points: "a profile's points not a whole number >= 1",

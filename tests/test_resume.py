@@ -90,6 +90,58 @@ def test_resuming_a_completed_run_computes_nothing(make_scene, tmp_path):
     assert (tmp_path / "run" / "curve.csv").read_text() == before
 
 
+def recorded_seconds(folder: Path) -> float:
+    return json.loads((folder / "summary.json").read_text())["elapsed_seconds"]
+
+
+def test_a_resume_adds_its_time_to_what_the_run_recorded(make_scene, tmp_path):
+    """A resume of a completed run replaced the elapsed_seconds its summary.json recorded with the
+    near-zero time of computing nothing (and a resume of a cancelled run with its own share alone)."""
+    scene = make_scene({"realizations": 12, **NO_PLOT})
+    cancel = threading.Event()
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel)
+    assert first.status == "cancelled"
+    assert recorded_seconds(tmp_path / "run") == pytest.approx(first.elapsed, abs=1e-6)
+    second, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    assert second.status == "completed"
+    total = recorded_seconds(tmp_path / "run")
+    assert total == pytest.approx(first.elapsed + second.elapsed, abs=2e-6)
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))  # computes nothing
+    assert recorded_seconds(tmp_path / "run") == pytest.approx(total + again.elapsed, abs=2e-6)
+    with pytest.warns(UserWarning, match="runs again"):
+        fresh, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    assert recorded_seconds(tmp_path / "run") == pytest.approx(fresh.elapsed, abs=1e-6)  # its own time alone
+
+
+def test_a_resume_keeps_the_time_an_older_frictionlab_recorded(make_scene, tmp_path):
+    """A completed folder whose manifest records no time (written before it did): the summary's is kept."""
+    scene = make_scene({"realizations": 4, **NO_PLOT})
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    del manifest["elapsed_seconds"]
+    (tmp_path / "run" / "run.json").write_text(json.dumps(manifest))
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    summary["elapsed_seconds"] = 1234.5
+    (tmp_path / "run" / "summary.json").write_text(json.dumps(summary))
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    assert recorded_seconds(tmp_path / "run") == pytest.approx(1234.5 + again.elapsed, abs=2e-6)
+
+
+@pytest.mark.parametrize("forged, kept", [(1e9, 1e9), (1e300, 0.0), ("1", 0.0), (-1.0, 0.0)])
+def test_a_forged_recorded_time_is_no_time_or_kept_within_what_a_summary_holds(make_scene, tmp_path, forged, kept):
+    """A manifest's elapsed_seconds is read only as a time a summary.json may hold (at most 1e9 s):
+    the sum past it was written, and the folder then refused by load() as damaged."""
+    import frictionlab
+
+    scene = make_scene({"realizations": 4, **NO_PLOT})
+    run_to_folder(scene, tmp_path / "run", RunOptions(workers=1))
+    manifest = json.loads((tmp_path / "run" / "run.json").read_text())
+    manifest["elapsed_seconds"] = forged
+    (tmp_path / "run" / "run.json").write_text(json.dumps(manifest))
+    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    assert frictionlab.load(tmp_path / "run").elapsed == pytest.approx(min(kept + again.elapsed, 1e9), abs=2e-6)
+
+
 def test_a_fresh_run_into_its_own_completed_folder_says_it_runs_again(make_scene, tmp_path):
     """A run into the folder of a completed run of the same preset ran it again without a word:
     it says so, and the numbers are the same."""

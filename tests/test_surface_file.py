@@ -20,6 +20,7 @@ from frictionlab.preset import build_scene, load_scene
 from frictionlab.testing import check_plugin
 from frictionlab_spectra import PowerLawSurface, ProfileFile, SurfaceFile
 from frictionlab_spectra.equivalent_line import EquivalentLine
+from frictionlab_spectra.instrument_file import scan_header
 from frictionlab.options import RunOptions
 
 from .conftest import SMALL_PRESET, merge
@@ -341,3 +342,37 @@ def test_an_empty_file_is_named_empty_whatever_its_suffix(tmp_path, registry, na
     with pytest.raises(PresetError) as info:
         build_scene(surface_preset(str(tmp_path / name), "mdr"), registry=registry)
     assert f"spectrum.params.path: is empty (0 bytes), it holds no heights, got '{tmp_path / name}'" in str(info.value)
+
+
+def save_bare(path, z):
+    """``z`` saved as numpy, MATLAB or HDF5 save a map: a bare array, no axes."""
+    if path.suffix == ".npz":
+        np.savez(path, z)
+    elif path.suffix == ".mat":
+        import scipy.io
+
+        scipy.io.savemat(path, {"z": z})
+    else:
+        import h5py
+
+        with h5py.File(path, "w") as fh:
+            fh["z"] = z
+    return path
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".mat", ".h5"])
+def test_a_bare_array_is_a_map_of_rows_along_y_as_a_npy_is(tmp_path, suffix):
+    """A map saved from numpy into .npz, .mat or .h5 was read transposed to the same map saved as
+    .npy (its first index taken as x): its rows are y, its columns x, whatever the format."""
+    z = np.random.default_rng(3).normal(size=(16, 24))  # 24 x 16 pixels (x by y)
+    np.save(tmp_path / "map.npy", z)
+    bare = save_bare(tmp_path / f"map{suffix}", z)
+    made = {}
+    for path in (tmp_path / "map.npy", bare):
+        surface = SurfaceFile(path=str(path), spacing=0.5, spacing_y=1.0, detrend="mean")  # dy = 2 dx
+        made[path.suffix] = (surface.generate(None).heights, surface.input_summary())
+    (npy, npy_summary), (read, summary) = made[".npy"], made[suffix]
+    assert read.shape == npy.shape and npy.shape[1] == 24 and npy.shape[0] > 16  # y resampled onto square pixels
+    np.testing.assert_allclose(read, npy, rtol=1e-12, atol=1e-12)
+    assert summary["shape"] == npy_summary["shape"]
+    assert scan_header(bare, "map", dimension=2).shape == z.shape  # what the memory estimate reads ahead: (Ny, Nx)

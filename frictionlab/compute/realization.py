@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import curve_problem, height_of, profile_problem, refuse, slopes_problem
-from ..plugin import SolveCancelled, defined_rms, force_unit, listening_to_iterations, listening_to_loads
+from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
 from ..preset.seeds import realization_rng
 
@@ -191,14 +191,23 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise
     except Exception as exc:  # carried, not raised: one bad line must not end the run
-        where = traceback.extract_tb(exc.__traceback__)[-1]
-        error = f"{type(exc).__name__}: {exc}"
-        fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
-        if fault is not None:  # raised in a third party's plugin: named, with its distribution and line
-            error = f"PluginError: {fault}"
-        elif not isinstance(exc, PluginError):  # a broken answer is named with its plugin: no line of ours to show
-            error += f" ({os.path.basename(where.filename)}:{where.lineno})"
-        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=error)
+        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
+
+
+def _failure(scene: Scene, exc: Exception) -> str:
+    """A realization's error as recorded, ``Type: message``: a failure the plugin explains
+    (``SolveFailed``) as its message; one raised in a third party's plugin as that plugin's
+    fault; a broken answer named with its plugin; anything else with the line that raised it."""
+    if isinstance(exc, SolveFailed):  # deliberate and told for the user: no source line, no blame
+        return f"SolveFailed: {exc}"
+    fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
+    if fault is not None:
+        return f"PluginError: {fault}"
+    error = f"{type(exc).__name__}: {exc}"
+    if isinstance(exc, PluginError):  # no line of ours to show
+        return error
+    where = traceback.extract_tb(exc.__traceback__)[-1]
+    return error + f" ({os.path.basename(where.filename)}:{where.lineno})"
 
 
 def compute_chunk(

@@ -7,10 +7,10 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..errors import FrictionlabError, RunError, command_word, short_repr, shown_name
+from ..errors import FrictionlabError, OutputRefused, RunError, command_word, first_names, short_repr, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, first_unlike, read_preset
-from ..runs.rundir import RunDirectory, json_copy, same_preset
+from ..runs.rundir import STATE_FILE, RunDirectory, json_copy, same_preset
 from ..runs.runfolder import output_subfolder
 from ..runs.runner import check_memory, read_back, run_to_folder
 from ..compute.signals import WorkInterrupted, interrupted_since, mark
@@ -140,13 +140,33 @@ def continuing(options: RunOptions, folder: Path, scene=None) -> RunOptions:
     return replace(options, resume=ours)
 
 
+def own_force(options: RunOptions, folder: Path) -> RunOptions:
+    """``options`` for a run of the report into ``folder``: --force replaces what frictionlab
+    wrote there (a run's or a sweep's, run afresh), never a folder of other files, which is
+    refused as without it (--force wrote a figure's run over the user's summary.json)."""
+    return options if not options.force or _holds_a_run(folder) else replace(options, force=False)
+
+
+def _holds_a_run(folder: Path) -> bool:
+    return any(os.path.lexists(folder / name) for name in (STATE_FILE, "sweep.json"))
+
+
 def _check_folder(run: FigureRun, options: RunOptions) -> None:
     """Refuse what a figure's run refuses in its folder (a folder of the user's files, another
     preset's run): Figs. 2 and 3 ran for minutes before Fig. 4's folder was refused."""
-    if run.sweep is not None:
-        check_sweep_folder(run.sweep, run.folder, options.force)
-    elif not continuing(options, run.folder, run.scene).resume:
-        RunDirectory(run.folder, force=options.force).check_fresh(run.scene)
+    own = own_force(options, run.folder)
+    try:
+        if run.sweep is not None:
+            check_sweep_folder(run.sweep, run.folder, own.force)
+        elif not continuing(own, run.folder, run.scene).resume:
+            RunDirectory(run.folder, force=own.force).check_fresh(run.scene)
+    except OutputRefused:
+        if _holds_a_run(run.folder):  # another preset's run: its message says what --force does
+            raise
+        held = first_names(sorted(p.name for p in run.folder.iterdir()))
+        raise OutputRefused(f"{shown_name(run.folder)} holds files that no frictionlab run wrote ({held}): the report writes "
+                            "its runs only into new or empty folders or its own, --force or not; move them aside, "
+                            "or give another --out") from None  # fmt: skip
 
 
 def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:
@@ -175,8 +195,8 @@ def _run(run: FigureRun, options: RunOptions, progress: bool) -> None:
 
     if run.sweep is not None:
         listeners = [SweepProgress()] if progress else []
-        run.sweep_outcome = run_sweep(run.sweep, run.folder, continuing(options, run.folder), plot=False,
-                                      listeners=listeners)  # fmt: skip
+        own = continuing(own_force(options, run.folder), run.folder)
+        run.sweep_outcome = run_sweep(run.sweep, run.folder, own, plot=False, listeners=listeners)
     else:
         run.outcome = run_or_read_back(run.scene, run.folder, options, [ProgressReporter()] if progress else [])
 
@@ -184,7 +204,7 @@ def _run(run: FigureRun, options: RunOptions, progress: bool) -> None:
 def run_or_read_back(scene, folder: Path, options: RunOptions, listeners: list):
     """The outcome of ``scene`` run into ``folder``, continuing what an earlier report left there
     (``continuing``); a run it completed is read back as it is, its files (its recorded wall time) kept."""
-    options = continuing(options, folder, scene)
+    options = continuing(own_force(options, folder), folder, scene)
     if options.resume:
         with RunDirectory(folder):  # not while another process runs it
             outcome = read_back(scene, folder, listeners)

@@ -10,14 +10,15 @@ from collections.abc import Callable
 from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import OutputRefused, shown_name, write_failed
+from ..errors import OutputRefused, first_names, shown_name, write_failed
+from ..io.inputs import InputFileProblem, open_regular_file
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
 from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
 from .figures import FIGURES, find_presets, kept_in, run_figures
-from .markdown import markdown
+from .markdown import HEADING, markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
 from .readings import CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, fig5_calibrated_readings, run_readings
 
@@ -30,7 +31,9 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     """The run folders, the markdown and the figures folder of a report: by
     default all in a fresh folder ``runs/report-<timestamp>/`` (``REPRODUCTION.md``,
     ``figures/``). An existing markdown or figure is refused unless ``force``, and so is a
-    folder given for the markdown or a file for a folder."""
+    folder given for the markdown or a file for a folder. An --out that is not a report's, or
+    a REPRODUCTION.md in it that no report wrote, is refused even with ``force``: it replaces
+    only what a report wrote."""
     for option, folder in (("--out", out_dir), ("--figures", figures_dir)):
         problem = output_path_problem(Path(folder)) if folder else None
         if problem:
@@ -43,14 +46,32 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     if not out_dir:  # what a fresh folder would hold is new: only a --markdown or --figures given can be taken
         _refuse_overwriting(Path(markdown_path) if markdown_path else None, Path(figures_dir) if figures_dir else None, force)
     out_dir = Path(out_dir) if out_dir else new_run_folder("report")
+    named = bool(markdown_path)
     markdown_path = Path(markdown_path) if markdown_path else out_dir / DEFAULT_MARKDOWN
     figures_dir = Path(figures_dir) if figures_dir else output_subfolder(out_dir, DEFAULT_FIGURES, "run the report again", make=False)
+    _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
+    if not named:  # one there is replaced only if a report wrote it
+        _refuse_foreign_markdown(markdown_path)
     _refuse_overwriting(markdown_path, figures_dir, force)
     _refuse_inside_runs(out_dir, markdown_path, figures_dir)
     _refuse_markdown_among_figures(markdown_path, figures_dir)
-    if not force:
-        _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
     return out_dir, markdown_path, figures_dir
+
+
+def _refuse_foreign_markdown(path: Path) -> None:
+    """Refuse a REPRODUCTION.md in --out that does not begin as a report does (a link, a file of
+    the user's that merely has its name): --force wrote the report over it."""
+    if not os.path.lexists(path) or (path.is_dir() and not path.is_symlink()):
+        return  # a folder is refused as one (refuse_unreplaceable), --force or not
+    heading = (HEADING + "\n").encode()
+    try:
+        with open_regular_file(path, follow_links=False) as fh:
+            ours = fh.read(len(heading)) == heading
+    except (InputFileProblem, OSError):
+        ours = False
+    if not ours:
+        raise OutputRefused(f"{shown_name(path)} was not written by frictionlab report: the report never replaces it, "
+                            "--force or not; move it aside, or give --markdown another file")  # fmt: skip
 
 
 def _refuse_markdown_among_figures(markdown_path: Path, figures_dir: Path) -> None:
@@ -81,10 +102,10 @@ def _refuse_foreign_folder(out_dir: Path, markdown_path: Path, figures_dir: Path
     except OSError as exc:  # output_path_problem made a file there: only listing it failed
         raise OutputRefused(f"--out {shown_name(out_dir)} cannot be listed ({exc.strerror or exc}): give another folder") from None
     if held:
-        listed = ", ".join(repr(shown_name(name)) for name in held[:3]) + (", ..." if len(held) > 3 else "")
+        listed = first_names(held)
         raise OutputRefused(
             f"--out {shown_name(out_dir)} is not empty and is not the folder of an earlier report (it holds {listed}): "
-            "give a new or empty folder, or --force to write the report into it (only the files it writes are replaced)"
+            "give a new or empty folder (the report writes into no other, --force or not)"
         )
 
 

@@ -26,13 +26,13 @@ from .data import ContactCurve, Profile, half_load_points, mdr_length
 from .kinds import KINDS, ContactSolver, IndentationReference, SlopeEstimator, SpectrumGenerator, contract
 from .resolution import MIN_SHORT_CUTOFF_PIXELS, short_cutoff_caveat
 from .normalisation import ContactMeasure, Extent, ForceNormalisation, LoadMeaning, PressureArea, defined_rms, force_unit
-from .solve_progress import SolveCancelled, iteration_done, listening_to_iterations, listening_to_loads, load_finished
+from .solve_progress import SolveCancelled, SolveFailed, iteration_done, listening_to_iterations, listening_to_loads, load_finished
 
 __all__ = [
     "KINDS", "MAX_MAGNITUDE", "MIN_SHORT_CUTOFF_PIXELS", "NAME_PATTERN",
     "ContactCurve", "ContactSolver", "Control", "Extent",
     "ContactMeasure", "ForceNormalisation", "IndentationReference", "LoadMeaning", "PressureArea", "Plugin", "PluginParams", "Profile", "SlopeEstimator",
-    "SolveCancelled", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "half_load_points",
+    "SolveCancelled", "SolveFailed", "SpectrumGenerator", "contract", "defined_rms", "force_unit", "half_load_points",
     "iteration_done", "listening_to_iterations", "listening_to_loads", "load_finished", "mdr_length",
     "short_cutoff_caveat",
 ]  # fmt: skip

@@ -1,5 +1,5 @@
 """A solve's progress, told from inside a solver's loop: loads finished, iterations
-done, and the cancel that stops a long solve."""
+done, the cancel that stops a long solve, and the failure a plugin explains itself."""
 
 from __future__ import annotations
 
@@ -25,6 +25,13 @@ class SolveCancelled(Exception):
     """Raised by ``iteration_done`` inside a solver's loop when the run it belongs to
     is cancelled (the TUI's cancel, Ctrl-C, SIGTERM). A solver lets it propagate: the
     realization is then neither stored nor counted as failed, and runs again on resume."""
+
+
+class SolveFailed(ValueError):
+    """Raised by a plugin for a failure it explains itself (a solver that did not converge,
+    a profile it cannot press): the message says what happened and what to change. The
+    realization fails with that message alone, told neither as a bug (no source line) nor
+    as the plugin's fault. A ValueError, so code that catches a plugin's refusals catches it."""
 
 
 def iteration_done(iteration: int, residual: float) -> None:

@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 
 from ..compute.realization import RealizationResult
-from ..errors import OutputRefused, RunFolderError, shown
+from ..errors import OutputRefused, RunFolderError, first_names, shown
 from ..io.files import output_path_problem
 from ..io.inputs import InputFileProblem
 from ..preset import Scene
-from .runfolder import open_member, read_member
+from .runfolder import MAX_WALL_SECONDS, open_member, read_member
 
 CHUNK_DIR = "chunks"
 MAX_CHUNK_DIRECTORY_BYTES = 256 * 1024  # a chunk's ~30 arrays list in under 8 kB of its zip's central directory
@@ -93,12 +93,12 @@ def damage_report(chunk_dir: Path, listed: set[str], damaged: dict[str, str], ke
         if match:
             lost.update(range(int(match[1]), min(int(match[2]), total - 1) + 1))
     lost -= kept
-    reasons: dict[str, int] = {}
-    for why in damaged.values():
-        reasons[why] = reasons.get(why, 0) + 1
+    reasons: dict[str, list[str]] = {}
+    for name, why in damaged.items():
+        reasons.setdefault(why, []).append(name)
     parts = []
-    if damaged:
-        detail = ", ".join(f"{n} {why}" for why, n in reasons.items())
+    if damaged:  # each reason with the files it was found in
+        detail = "; ".join(f"{first_names(names)}: {why}" for why, names in reasons.items())
         parts.append(f"{len(damaged)} chunk file(s) failed verification ({detail})")
     if unlisted:
         parts.append(f"{len(unlisted)} file(s) in {CHUNK_DIR}/ are not in the manifest and are ignored")
@@ -183,13 +183,29 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
 # their sum): xi, the rms slope in contact over the profile's, is at most sqrt(points); twice
 # that leaves room for a plugin's own weighting. A forged xi of 1e308 overflowed the fit.
 XI_BOUND = 2.0
+# A per-realization value past this is no run's: the ensemble means add up to 10^7 of them (a
+# preset's most realizations) and stay finite (a forged indentation of 1e308 overflowed its mean).
+VALUE_BOUND = 1e300
+# what a realization can give in each column besides xi and the counts: (least, most, NaN allowed)
+VALUE_RANGES = {
+    "indentation": (-VALUE_BOUND, VALUE_BOUND, False),  # finite, as a solver's curve must be
+    "force": (-VALUE_BOUND, VALUE_BOUND, False),
+    "real_area_corrected": (0.0, VALUE_BOUND, False),
+    "real_gradient_rms": (0.0, VALUE_BOUND, True),  # NaN: a chunk of a version before it, as below
+    "slope_rms_line": (0.0, VALUE_BOUND, False),
+    "measured_rms_height": (0.0, VALUE_BOUND, True),
+    "own_rms_height": (0.0, VALUE_BOUND, True),
+    "peak_rms": (0.0, VALUE_BOUND, True),  # a forged peak of inf was a caveat of the run
+    "seconds": (0.0, MAX_WALL_SECONDS, True),
+    "failed_seconds": (0.0, MAX_WALL_SECONDS, True),
+}
 
 
 def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
     """ChunkDamage unless each of ``numeric`` holds real numbers (a forged chunk's text or
     complex arrays reached the statistics), ``failed_error`` is text, and the values are what a
-    realization can give: times and heights none infinite or below 0, indentations none
-    infinite, xi none infinite, below 0 or above ``XI_BOUND`` sqrt(points), each
+    realization can give: each column within its ``VALUE_RANGES`` (the message names the
+    column, the value and the range), xi none infinite, below 0 or above ``XI_BOUND`` sqrt(points), each
     profile of 1 point or more, its rms slope finite and > 0 and its force unit > 0 (NaN there
     failed the run as a preset's magnitudes), its contact counts and the points carrying half the
     load (NaN: not said) from 0 to its points (a chunk that broke these was restored, and its run
@@ -199,13 +215,10 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
             raise ChunkDamage(f"array {name} of type {arrays[name].dtype}, not real numbers")
     if arrays["failed_error"].dtype.kind != "U":
         raise ChunkDamage(f"array failed_error of type {arrays['failed_error'].dtype}, not text")
-    for name in ("seconds", "failed_seconds", "measured_rms_height", "own_rms_height", "peak_rms"):
-        if name in numeric and bool((np.isinf(arrays[name]) | (arrays[name] < 0)).any()):  # NaN: an older chunk's
-            raise ChunkDamage(f"{name} infinite or below 0")  # a forged peak of inf was a caveat of the run
+    for name in (name for name in VALUE_RANGES if name in numeric):
+        _check_range(name, arrays[name], *VALUE_RANGES[name])
     if "xi" not in numeric:  # no finished realization
         return
-    if bool(np.isinf(arrays["indentation"]).any()):
-        raise ChunkDamage("indentation infinite")
     if bool((np.isinf(arrays["xi"]) | (arrays["xi"] < 0)).any()):
         raise ChunkDamage("xi infinite or below 0")
     points = arrays["points"][:, None]
@@ -213,13 +226,22 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
         raise ChunkDamage("a profile's points not a whole number >= 1")
     if bool((arrays["xi"] > XI_BOUND * np.sqrt(points)).any()):  # NaN compares false: allowed
         raise ChunkDamage("xi above what an rms over some of a profile's slopes can be")
-    if not bool((arrays["slope_rms_line"] > 0).all() and np.isfinite(arrays["slope_rms_line"]).all()):
+    if not bool((arrays["slope_rms_line"] > 0).all()):
         raise ChunkDamage("a line's rms slope not a finite number > 0")  # a realization with one is a failure
     if not bool((arrays["force_unit"] > 0).all()):  # NaN compares false: refused (inf: the run's own check says it)
         raise ChunkDamage("a force unit k h X not > 0")
-    for name in ("contact_count", "half_load_points"):
+    for name in (name for name in ("contact_count", "half_load_points", "contact_spots") if name in numeric):
         if bool(((arrays[name] < 0) | (arrays[name] > points)).any()):  # NaN compares false: allowed
             raise ChunkDamage(f"{name} below 0 or above the profile's points")
+
+
+def _check_range(name: str, values: np.ndarray, least: float, most: float, nan: bool) -> None:
+    bad = ~((values >= least) & (values <= most))  # NaN too
+    if nan:
+        bad &= ~np.isnan(values)
+    if bool(bad.any()):
+        value = float(values.flat[int(np.argmax(bad))])
+        raise ChunkDamage(f"{name} {value:g}, not from {least:g} to {most:g}{' (or NaN)' if nan else ''}")
 
 
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:

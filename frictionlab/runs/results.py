@@ -105,7 +105,8 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         **_half_load_ends(outcome),
         "peak_height_rms": json_safe(float(outcome.peak_rms)),
         "caveats": outcome.caveats,
-        "elapsed_seconds": round(outcome.elapsed, 6),
+        # the run's sessions summed (run_to_folder): a resume's own time added to what the folder recorded
+        "elapsed_seconds": round(outcome.extra.get("recorded_seconds", outcome.elapsed), 6),
         "workers": outcome.workers,
         "executor": outcome.extra.get("executor"),
         "resumed_realizations": outcome.extra.get("resumed", 0),

@@ -279,11 +279,12 @@ class RunDirectory:
                 refused, then = (RunFolderError, "resume") if resume else (OutputRefused, "run again")
                 raise refused(f"{shown(self.path / name)} {problem}: the run writes its {name} there; move it aside, then {then}")
 
-    def finish(self, scene: Scene, status: str) -> None:
-        """Record the final status; a completed run's chunks are compacted into one file."""
+    def finish(self, scene: Scene, status: str, seconds: float | None = None) -> None:
+        """Record the final status (and the ``seconds`` the run's sessions took); a completed
+        run's chunks are compacted into one file."""
         if self._manifest is None:
             return
-        self._manifest["status"] = status
+        self._manifest.update(status=status, **({} if seconds is None else {"elapsed_seconds": round(seconds, 6)}))
         self._manifest["frictionlab_version"] = __version__
         if status == "completed":
             self.compact()

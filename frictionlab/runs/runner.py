@@ -17,6 +17,7 @@ from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
 from .import_ahead import PlotImportAhead
+from .runfolder import MAX_WALL_SECONDS
 from .results import add_plot, holds_results, plot_path, read_summary, results_on_disk, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
@@ -128,6 +129,7 @@ def run_to_folder(
         check_memory(scene, options)
     check_loads(scene)  # a unit the solver cannot take, a load past its arithmetic: before the folder is touched
     with RunDirectory(out_dir, force=options.force) as run_dir:
+        earlier = recorded_seconds(run_dir) if options.resume else 0.0  # read before start() takes the manifest over
         restored = run_dir.start(scene, resume=options.resume)
         store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
         outcome = None
@@ -140,6 +142,8 @@ def run_to_folder(
                 drawing = drawer  # drawn there while the numbers are written here
         finally:  # whatever ended the run, what finished is written (a completed run's chunks as one)
             store.flush(merge=outcome is not None and outcome.status == "completed")
+        # the sessions' time summed, as summary.json and the manifest record it (within what either holds)
+        outcome.extra["recorded_seconds"] = recorded = min(earlier + outcome.elapsed, MAX_WALL_SECONDS)
         files = write_results(out_dir, scene, outcome)
         try:
             if on_results is not None:
@@ -147,8 +151,24 @@ def run_to_folder(
             if plot:
                 files = add_plot(out_dir, scene, outcome, files, drawing)
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
-            run_dir.finish(scene, outcome.status)
+            run_dir.finish(scene, outcome.status, seconds=recorded)
     return outcome, files
+
+
+def recorded_seconds(run_dir: RunDirectory) -> float:
+    """The wall time the run's earlier sessions took, as its manifest recorded it when the last
+    of them ended (a resume adds its own, so a resume that computes nothing keeps it); before
+    the manifest recorded it, the summary.json that session wrote. 0 when neither says (a
+    first session killed before it ended) or the value is no time."""
+    try:
+        state = run_dir.state() or {}
+        seconds = state.get("elapsed_seconds")
+        if seconds is None and state.get("status") not in (None, "running"):  # a run of an older frictionlab
+            seconds = read_summary(run_dir.path)[1].elapsed_seconds
+    except RunFolderError:  # start() says what is wrong with the manifest; a damaged summary.json is rewritten
+        return 0.0
+    number = isinstance(seconds, (int, float)) and not isinstance(seconds, bool)
+    return float(seconds) if number and 0 <= seconds <= MAX_WALL_SECONDS else 0.0
 
 
 def read_back(scene: Scene, folder: Path, listeners: Iterable[object] = (), plot: bool = True) -> RunOutcome | None:

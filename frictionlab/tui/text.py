@@ -71,7 +71,7 @@ def format_count(value: float) -> str:
 
 
 _WHERE = re.compile(r"\s\([\w.-]+\.py:\d+\)$")  # the source location the engine appends
-_INPUT_ERRORS = ("ValueError", "InputFileProblem", "FileNotFoundError", "PermissionError", "OSError")
+_INPUT_ERRORS = ("SolveFailed", "ValueError", "InputFileProblem", "FileNotFoundError", "PermissionError", "OSError")
 
 
 def failure_message(error: str) -> str:

@@ -32,7 +32,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import Field, field_validator
 
-from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, load_finished
+from frictionlab import ContactCurve, ContactSolver, Control, ForceNormalisation, Profile, SolveFailed, load_finished
 
 from .arrays import namespace
 from .checks import check_control, check_loads, check_profile
@@ -113,7 +113,7 @@ class PeriodicBEM(ContactSolver):
         loads = check_loads(loads, control)
         heights, slopes, spacing = check_profile(self, profile, slopes)
         if not profile.periodic:
-            raise ValueError(
+            raise SolveFailed(
                 f"{self.name} presses periodic profiles only, and this one is not (a scan whose ends do not "
                 "meet). Make it periodic (remove its tilt, check that its ends meet, then set the spectrum's "
                 "periodic: true) or press it with a solver of independent springs (mdr, winkler)."
@@ -133,7 +133,7 @@ class PeriodicBEM(ContactSolver):
 
         if scale == 0.0:  # a flat profile: every load presses every point evenly
             if control == "indentation":
-                raise ValueError(
+                raise SolveFailed(
                     "the profile is flat: it touches everywhere at once, so any indentation past "
                     "the first touch needs an infinite force. Use control 'force'."
                 )
@@ -152,7 +152,7 @@ class PeriodicBEM(ContactSolver):
             too_deep = np.flatnonzero(loads / scale >= full_approach)
             if too_deep.size:
                 j = int(too_deep[0])
-                raise ValueError(
+                raise SolveFailed(
                     f"indentation {float(loads[j])!r} (load {j}) is at or past the full-contact approach "
                     f"max(z) - mean(z) = {full_approach * scale:.6g}: on a periodic elastic body the "
                     "approach to the mean surface saturates at full contact, and no finite force "

@@ -21,7 +21,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, load_finished, mdr_length
+from frictionlab import ContactCurve, Control, ForceNormalisation, Profile, SolveFailed, load_finished, mdr_length
 
 from .arrays import host, namespace, on_device
 from .bem import PeriodicBEM
@@ -157,16 +157,16 @@ class BEMHalfSpaceFree(PeriodicBEM):
         record = ContactRecord(steps, points, line_rms, corrected=True, real_gradient=True, spots=True, periodic=False)
         shift = np.zeros(steps)
         if scale == 0.0:
-            raise ValueError("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
+            raise SolveFailed("the profile is flat: a flat punch has no contact to resolve; give a rough surface")
         if control == "force":  # f of this surface: its own rms height h, L = 2 sqrt(A / pi)
             limit = self.max_f * self.stiffness() * float(np.std(heights)) * mdr_length(profile.area)
             if float(loads.max()) > limit:
-                raise ValueError(
+                raise SolveFailed(
                     f"load {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
                     f"f = F / (E* h L) <= {self.max_f:g}, F <= {limit:.6g} on this surface"
                 )
         elif float(loads.max()) > self.max_f * scale:  # the pressures of an approach of d grow as E* d / dx
-            raise ValueError(
+            raise SolveFailed(
                 f"indentation {float(loads.max()):g} is past what {self.name}'s single-precision steps hold: "
                 f"at most {self.max_f:g} times the height range, {self.max_f * scale:.6g} on this surface"
             )

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frictionlab import ContactSolver, Profile
+from frictionlab import ContactSolver, Profile, SolveFailed
 
 
 def check_control(control: str) -> None:
@@ -38,7 +38,7 @@ def check_profile(solver: ContactSolver, profile: Profile, slopes) -> tuple[np.n
     if heights.ndim not in solver.dimensions or heights.size == 0:
         shapes = " or ".join({1: "(N,)", 2: "(Ny, Nx)"}[d] for d in solver.dimensions)
         what = " or ".join({1: "a line", 2: "a surface"}[d] for d in solver.dimensions)
-        raise ValueError(
+        raise SolveFailed(
             f"{solver.name} presses {what}: heights must have shape {shapes} with at least one point. "
             f"Got shape {heights.shape} instead."
         )

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frictionlab import iteration_done
+from frictionlab import SolveFailed, iteration_done
 
 from .arrays import host, is_cupy, is_numpy, namespace_of, on_device
 from .elastic import ElasticOperator
@@ -419,7 +419,7 @@ def next_pressure(pressure: np.ndarray | None, previous: float, target: float, c
 def solve_load(cg: ProjectedCG, solver: str, j: int, load: float, pressure: np.ndarray, target: float,
                control: str, tolerance: float, max_iterations: int, certified: bool):  # fmt: skip
     """Load ``j`` of a sweep solved from ``pressure``: ``(pressure, approach, iterations,
-    residual)``; a ValueError naming ``solver``, the load and what to change if it does not converge."""
+    residual)``; a SolveFailed naming ``solver``, the load and what to change if it does not converge."""
     try:
         pressure, approach, iterations, residual = cg.solve(
             on_device(getattr(cg, "xp", None), pressure),  # the baseline CG has no namespace
@@ -433,7 +433,7 @@ def solve_load(cg: ProjectedCG, solver: str, j: int, load: float, pressure: np.n
         return host(pressure), approach, iterations, residual  # on the GPU: back to the host
     except NotConverged as failure:
         what = "force" if control == "force" else "indentation"
-        raise ValueError(
+        raise SolveFailed(
             f"{solver} did not converge at load {j} ({what} {float(load):g}): residual "
             f"{failure.residual:.3g} > tolerance {tolerance:g} after {failure.iterations} "
             "iterations. Raise max_iterations or loosen the tolerance."

@@ -4,9 +4,11 @@ and the length unit the file carries, converted to the unit a preset asks for.
 
 SurfaceTopography is imported here only when such a file is read (its import takes
 seconds). It lays a map out as heights[x, y]; a map here is z[row, column] = z[y, x],
-so its array is transposed. Undefined points (an optical scan's dropouts) are refused,
-or filled by the solution of Laplace's equation from their defined neighbours (SurfaceTopography's
-harmonic interpolation) when the preset chooses ``undefined: harmonic``.
+so its array is transposed, except a bare array's (.npz, .mat, .h5: no axes), which is
+z[y, x] already, as numpy saves a map and as a .npy map is read. Undefined points (an
+optical scan's dropouts) are refused, or filled by the solution of Laplace's equation from
+their defined neighbours (SurfaceTopography's harmonic interpolation) when the preset
+chooses ``undefined: harmonic``.
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ from frictionlab.plugin import MAX_MAGNITUDE
 
 from .channel_choice import pick_channel
 from .instrument_reader import (
-    channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points, check_header_units, check_payload,
-    check_text_heights, check_text_room, choose_reader, parses_text, quoted,
+    BARE_ARRAY_FORMATS, channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points,
+    check_header_units, check_payload, check_text_heights, check_text_room, choose_reader, parses_text, quoted, xy_order,
 )
 from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
@@ -92,10 +94,10 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
             reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
             check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
             chosen, _ = pick_channel(reader, channel, where)
-            shape, periodic = tuple(int(n) for n in chosen.nb_grid_pts), bool(chosen.is_periodic)
+            shape, periodic = xy_order(reader, (int(n) for n in chosen.nb_grid_pts)), bool(chosen.is_periodic)
             check_declared_bytes(shape, where, fh)  # more points than its bytes hold: the full read names the damage
             sizes = chosen.physical_sizes
-            pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(sizes, shape))
+            pixel = None if sizes is None else tuple(float(s) / n for s, n in zip(xy_order(reader, sizes), shape))
             unit = chosen.unit if isinstance(chosen.unit, str) else None
             if unit is not None:
                 length_factor(unit, "m", where, "the file's length unit")  # a message may name it: a length, not any text
@@ -104,7 +106,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
     if dimension == 1 and len(shape) == 2 and 1 in shape:  # a line stored as a map one pixel wide
         along = 0 if shape[1] == 1 else 1
         return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1], unit)
-    return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # heights[x, y] is z[y, x]
+    return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # (Nx, Ny): z is (Ny, Nx)
 
 
 def _by_name(fh):
@@ -223,11 +225,13 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
-            raise ValueError(_other_kind(where, topography.dim, topography.nb_grid_pts))
+            raise ValueError(_other_kind(where, topography.dim, xy_order(reader, topography.nb_grid_pts)))
         missing = int(np.ma.count_masked(heights)) if np.ma.isMaskedArray(heights) else 0
         if missing == heights.size:  # harmonic filling would have nothing to fill from
             raise ValueError(f"{where}: all {missing} points are undefined in the file (not measured): nothing to press")
-        mask = np.ascontiguousarray(np.ma.getmaskarray(heights).T) if missing and dimension == 2 else None
+        transpose = dimension == 2 and reader.format() not in BARE_ARRAY_FORMATS  # heights[x, y]: z[y, x] its transpose
+        mask = np.ma.getmaskarray(heights) if missing and dimension == 2 else None
+        mask = None if mask is None else np.ascontiguousarray(mask.T if transpose else mask)
         if missing:
             if undefined == "refuse":
                 raise ValueError(undefined_message(where, missing, heights.size, gwyddion=reader.format() == "gwy"))
@@ -239,6 +243,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
         if along is not None:  # a line stored as a map one pixel wide: its heights along its long side
             heights, pixel = heights.reshape(-1), pixel[along : along + 1]
+        pixel = np.asarray(xy_order(reader, pixel))
         periodic = bool(topography.is_periodic)
         listed = channel_list(reader) if len(reader.channels) > 1 else []
         file_format = str(reader.name())
@@ -249,7 +254,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     sides = tuple(check_spacing(where, "pixels of", float(p) * factor, unit or file_unit) for p in pixel)
     data = np.ma.getdata(heights)
     # one copy, in C order as a .npy map (the same sums), scaled in place
-    z = np.ascontiguousarray(data.T if dimension == 2 else data, dtype=np.float64)
+    z = np.ascontiguousarray(data.T if transpose else data, dtype=np.float64)
     if z is data or (dimension == 2 and np.shares_memory(z, data)):
         z = z.copy()
     if factor != 1.0:

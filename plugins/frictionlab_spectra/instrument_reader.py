@@ -26,6 +26,9 @@ BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary va
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
 GSF_MAGIC = b"Gwyddion Simple Field"  # a Gwyddion export no reader of the extra reads
+# numpy, MATLAB and HDF5 files hold bare arrays, without axes: a map there is z[row, column] =
+# z[y, x], as a .npy map and as numpy saves it (SurfaceTopography takes their first index as x)
+BARE_ARRAY_FORMATS = ("npz", "mat", "h5")
 AGAIN = "copy it again from the instrument, or export it from there again"  # the advice for a damaged file
 
 
@@ -358,6 +361,13 @@ def check_text_room(fh, reader, where: str) -> None:
         )
 
 
+def xy_order(reader, values: tuple) -> tuple:
+    """``values`` given per axis in SurfaceTopography's order (points, pixel sides) in x, y order:
+    reversed for a bare array (``BARE_ARRAY_FORMATS``), whose first index is y."""
+    values = tuple(values)
+    return values[::-1] if len(values) == 2 and reader.format() in BARE_ARRAY_FORMATS else values
+
+
 def channel_list(reader) -> list[dict]:
     """Every channel of an open reader: index, name, dimension, points (x, y), units; JSON-ready."""
     listed = []
@@ -369,7 +379,7 @@ def channel_list(reader) -> list[dict]:
         data_unit = "A" if _gwyddion_amperes(type(reader), channel) else data_unit  # not m, as its reader says
         listed.append({
             "index": int(channel.index), "name": str(channel.name),
-            "points": [int(n) for n in channel.nb_grid_pts] if channel.nb_grid_pts is not None else None,
+            "points": [int(n) for n in xy_order(reader, channel.nb_grid_pts)] if channel.nb_grid_pts is not None else None,
             "unit": channel.unit if isinstance(channel.unit, str) else None,
             "data_unit": data_unit if isinstance(data_unit, str) else None,
         })  # fmt: skip

@@ -3,7 +3,8 @@
 The file holds a height map z[row, column] of shape (Ny, Nx) (an AFM, profilometer or
 interferometer topography; printed x by y, Nx x Ny, as instruments give it):
 
-- ``.npy``: a 2D array of real numbers;
+- ``.npy``: a 2D array of real numbers; a bare array in ``.npz``, ``.mat`` or ``.h5`` (no
+  axes) is read the same way, its rows along y;
 - ``.csv`` / ``.txt``: a matrix of numbers, one row of the map per line, separated by
   commas, semicolons or whitespace; ``#`` starts a comment and one header line (more
   of its cells text than numbers) is skipped;

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 import yaml
@@ -233,8 +234,26 @@ def test_an_out_that_holds_other_files_is_refused_before_anything_runs(tmp_path,
     assert code == ExitCode.OUTPUT_REFUSED
     err = capsys.readouterr().err
     assert f"--out {out} is not empty and is not the folder of an earlier report (it holds 'data', 'notes.txt')" in err
-    assert "--force" in err and "Traceback" not in err
+    assert "--force or not" in err and "Traceback" not in err
     assert sorted(p.name for p in out.iterdir()) == ["data", "notes.txt"] and not any((out / "data").iterdir())
+
+
+@pytest.mark.parametrize("mine", ["notes.txt", "REPRODUCTION.md", "fig2/summary.json"])
+def test_force_never_writes_over_files_the_report_did_not_write(tmp_path, capsys, mine):
+    """--force wrote the report into a folder of the user's: over a REPRODUCTION.md of theirs, and a figure's run
+    over the summary.json and curve.csv in a fig2/ of theirs. Refused before any run (exit 4), --force or not."""
+    out = tmp_path / "mine"
+    (out / mine).parent.mkdir(parents=True)
+    (out / mine).write_text("mine")
+    said = {"notes.txt": f"--out {out} is not empty and is not the folder of an earlier report (it holds 'notes.txt')",
+            "REPRODUCTION.md": f"{out}/REPRODUCTION.md was not written by frictionlab report: the report never replaces it",
+            "fig2/summary.json": f"{out}/fig2 holds files that no frictionlab run wrote"}[mine]  # fmt: skip
+    for force in ([], ["--force"]):
+        assert main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet", *force]) == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert said in err and "--force or not" in err and "Traceback" not in err
+        assert [p.relative_to(out) for p in out.rglob("*") if p.is_file()] == [Path(mine)]
+        assert (out / mine).read_text() == "mine"
 
 
 def test_an_out_of_an_earlier_report_is_taken(tmp_path):
@@ -249,7 +268,8 @@ def test_an_out_of_an_earlier_report_is_taken(tmp_path):
     (out / "mine.md").write_text("")
     with pytest.raises(OutputRefused, match="it holds 'mine.md', 'pngs'"):
         report_paths(out, tmp_path / "other.md", tmp_path / "figs")
-    assert report_paths(out, out / "new.md", tmp_path / "figs", force=True)[0] == out  # --force writes into it
+    with pytest.raises(OutputRefused, match="it holds 'mine.md'"):  # --force wrote into it
+        report_paths(out, out / "new.md", tmp_path / "figs", force=True)
 
 
 @pytest.mark.parametrize("markdown", ["out/figures/fig2.png", "figs/fig5-calibrated.png"])
@@ -280,7 +300,7 @@ def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_
     monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
     code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
     assert code == ExitCode.OUTPUT_REFUSED
-    assert f"{out / key} is not empty and is not" in capsys.readouterr().err
+    assert f"{out / key} holds files that no frictionlab run wrote ('notes.txt'): " in capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == [key] and (out / key / "notes.txt").read_text() == "mine"
 
 
