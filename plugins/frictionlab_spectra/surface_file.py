@@ -50,8 +50,9 @@ from pydantic import Field, model_validator
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
+from .header_units import stated_pixel
 from .instrument_file import (
-    MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    LENGTH_UNITS, MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
@@ -70,6 +71,7 @@ MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at 
 # reflected across its edges), and per mode of a block given to the line, its temporaries (58).
 LINE_BYTES_PER_POINT = {True: 48, False: 96}  # by periodic()
 LINE_BYTES_PER_MODE = 80
+SQUARE_PIXEL = 1e-3  # relative: a pixel whose sides differ by less is square (a header prints its sizes rounded)
 
 
 @dataclass(frozen=True)
@@ -295,16 +297,35 @@ def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params
             "caveats": [caveat] if caveat else []}  # fmt: skip
 
 
-def _square_over_oblong(scan, p: SurfaceFile.Params) -> str | None:
-    """The caveat of ``spacing`` alone replacing a file's pixel that is not square: the preset's
-    square pixel stretches the map along one axis against the other, its slopes with it."""
-    dx, dy = scan.pixel
-    if p.spacing is None or p.spacing_y is not None or not scan.pixel_stated or math.isclose(dx, dy, rel_tol=1e-6):
+def _square_over_oblong(pixel: tuple[float, float] | None, p: SurfaceFile.Params, unit: str | None,
+                        whose: str = "the file's", use: str = "leave spacing out") -> str | None:
+    """The caveat of ``spacing`` alone replacing a file's ``pixel`` (dx, dy in ``unit``; None where
+    it states none) that is not square: the preset's square pixel stretches the map along one axis
+    against the other, its slopes with it. Square within SQUARE_PIXEL: a header's sizes are rounded."""
+    if pixel is None or p.spacing is None or p.spacing_y is not None or math.isclose(*pixel, rel_tol=SQUARE_PIXEL):
         return None
-    return (f"spacing {p.spacing:g} replaces the file's pixel of {dx:.6g} x {dy:.6g} (x by y), which is not square, by "
-            f"a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
+    (dx, dy), said = pixel, f" {unit}" if unit else ""
+    return (f"spacing {p.spacing:g} replaces {whose} pixel of {dx:.6g} x {dy:.6g}{said} (x by y), which is not square, "
+            f"by a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
             f"slopes along y {dy / dx:.4g} times as steep); give spacing_y too ({p.spacing * dy / dx:.6g} keeps the "
-            "file's shape), or leave spacing out to use the file's pixel")  # fmt: skip
+            f"file's shape), or {use} to use the file's pixel")  # fmt: skip
+
+
+def _table_caveats(path: Path, where: str, data: np.ndarray, p: SurfaceFile.Params, unit: dict) -> list[str]:
+    """The caveats of a table map (of at least MIN_SIDE points each way): an export's axes read as
+    heights, and the square pixel ``spacing`` declares where the header states an oblong one
+    (Gwyddion's text export, read with format: table), in the run's ``unit`` (``table_unit``)."""
+    said = unit["unit"] if unit["unit"] in LENGTH_UNITS else "m"
+    stated = _header_pixel(path, where, data.shape, said) if file_suffix(path, where) != ".npy" else None
+    oblong = _square_over_oblong(stated, p, said, "its header's", "read it with format: instrument")
+    return [caveat for caveat in (_axes_in_region(data, p.preset_pixel(), p, where), oblong) if caveat]
+
+
+def _header_pixel(path: Path, where: str, shape: tuple[int, int], unit: str) -> tuple[float, float] | None:
+    """The pixel (dx, dy) a table's header states (``stated_pixel``), in ``unit``."""
+    if (pixel := stated_pixel(path, where, shape)) is None:
+        return None
+    return pixel[0] / LENGTH_UNITS[unit], pixel[1] / LENGTH_UNITS[unit]
 
 
 def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
@@ -322,7 +343,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
-        if caveat := _square_over_oblong(scan, p):
+        if caveat := _square_over_oblong(scan.pixel if scan.pixel_stated else None, p, summary.get("unit")):
             summary["caveats"] = [*summary.get("caveats", ()), caveat]
         if p.region is not None and scan.undefined:
             summary.update(_undefined_in_region(scan, pixel, p, where))
@@ -345,8 +366,8 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "format": path.suffix.lower(), "spacing_from": "preset", **unit,
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
-        if data.ndim == 2 and min(data.shape) >= MIN_SIDE and (caveat := _axes_in_region(data, pixel, p, where)):
-            summary["caveats"] = [caveat]
+        if data.ndim == 2 and min(data.shape) >= MIN_SIDE and (caveats := _table_caveats(path, where, data, p, unit)):
+            summary["caveats"] = caveats
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
