@@ -36,3 +36,71 @@ def test_a_table_whose_header_states_an_oblong_pixel_is_not_squared_without_a_wo
     square = gwyddion_matrix(tmp_path / "square.txt", rough(16, 32), (0.5, 0.5))
     said = SurfaceFile(path=str(square), format="table", spacing=0.5).input_summary().get("caveats", ())
     assert not any("not square" in caveat for caveat in said)
+
+
+def xz_table(path, x: np.ndarray, z: np.ndarray, header: str = "x [um],z [um]"):
+    path.write_text(header + "\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(x.tolist(), z.tolist())), encoding="utf-8")
+    return path
+
+
+def test_a_profile_scanned_right_to_left_is_read_mirrored(tmp_path):
+    """A profile exported right to left (x decreasing) was refused ('x must increase'); its line
+    read as written is the scan mirrored, which changes no statistic and no contact."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 4)[0]
+    backwards = ProfileFile(path=str(xz_table(tmp_path / "back.csv", x[::-1], z)))
+    forwards = ProfileFile(path=str(xz_table(tmp_path / "fore.csv", x, z)))
+    assert backwards.generate(None).spacing == pytest.approx(0.5, rel=1e-12)
+    np.testing.assert_allclose(backwards.generate(None).heights, forwards.generate(None).heights, rtol=0, atol=0)
+    assert backwards.input_summary()["x_decreasing"] is True and "x_decreasing" not in forwards.input_summary()
+    from frictionlab.io.inputs import describe_input
+
+    assert "x decreasing (a scan written right to left)" in describe_input(backwards.input_summary())
+    still = xz_table(tmp_path / "still.csv", np.r_[x[:32], x[:32][::-1]], z)
+    with pytest.raises(ValueError, match=r"still.csv.*x does not advance from its first row to its last \(x\[0\] = 0, "
+                                         r"x\[63\] = 0\); the x column must increase or decrease by one step a row"):
+        ProfileFile(path=str(still)).rms_height()
+
+
+def test_a_text_export_of_a_line_scanned_right_to_left_is_read_with_a_positive_pixel(tmp_path):
+    """format: instrument: SurfaceTopography reads x decreasing as a pixel of -0.5; refused
+    before ('x must increase'), it is read as the same line mirrored, its pixel 0.5."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 5)[0]
+    path = tmp_path / "back.txt"
+    path.write_text("".join(f"{a!r}\t{b!r}\n" for a, b in zip(x[::-1].tolist(), z.tolist())), encoding="utf-8")
+    line = ProfileFile(path=str(path), format="instrument", unit="um", detrend="mean")
+    assert line.generate(None).spacing == pytest.approx(0.5, rel=1e-9)
+    np.testing.assert_allclose(line.generate(None).heights, z - z.mean(), rtol=1e-9, atol=1e-12)
+    assert line.input_summary()["x_decreasing"] is True
+
+
+def test_a_tables_nan_is_named_by_its_line_and_column_in_the_file(tmp_path):
+    """A NaN (a point an optical profilometer dropped) was named 'at index 50' (its row among the
+    heights, from 0) or 'row 3, column 4' (from 0): neither the line nor the column an editor shows."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 6)[0]
+    z[50], x[60] = np.nan, np.nan  # the heights' NaN on the file's line 52 (a header, then rows from 0), x's on 62
+    path = xz_table(tmp_path / "dropped.csv", x, z)
+    with pytest.raises(ValueError, match=r"dropped.csv'?: 1 value\(s\) in heights not finite .* the first at line 52, "
+                                         r"column 2 of the file; fill them before saving the table"):
+        ProfileFile(path=str(path)).rms_height()
+    z[50] = 0.0
+    with pytest.raises(ValueError, match=r"1 value\(s\) in x not finite .* the first at line 62, column 1 of the file"):
+        ProfileFile(path=str(xz_table(tmp_path / "x.csv", x, z))).rms_height()
+    m = rough(12, 10, 7)
+    m[3, 4] = np.nan
+    (tmp_path / "map.csv").write_text("# exported\n" + "".join(",".join(map(repr, row.tolist())) + "\n" for row in m))
+    with pytest.raises(ValueError, match=r"the first at line 5, column 5 of the file; fill them before saving the table, "
+                                         "leave them out with region"):
+        SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
+
+
+def test_a_text_tables_nan_is_told_how_to_have_it_filled(tmp_path):
+    """A .csv's NaN was told to 'read the instrument's own file'; SurfaceTopography's reader of the
+    same export (format: instrument) takes it for a point not measured, which undefined: harmonic fills."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 8)[0]
+    z[20] = np.nan
+    path = xz_table(tmp_path / "dropped.csv", x, z)
+    with pytest.raises(ValueError, match=r"read the file with format: instrument and undefined: harmonic, which fills "
+                                         "them from their neighbours"):
+        ProfileFile(path=str(path)).rms_height()
+    filled = ProfileFile(path=str(path), format="instrument", undefined="harmonic", detrend="none").generate(None)
+    assert filled.heights[20] == pytest.approx((z[19] + z[21]) / 2, rel=1e-9)

@@ -40,7 +40,7 @@ from .instrument_file import (
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .reader_failures import reason_said
-from .text_table import read_text_table
+from .text_table import first_not_finite, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
 from .scan_shaping.levelling import level_line, line_form_warning
 from .scan_shaping.spikes import line_spike_warning
@@ -117,18 +117,21 @@ class ProfileFile(MeasuredFile):
                 "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset",
                 **table_unit(path, where, p, file_suffix(path, where) != ".npy"),
                 "periodic_from": "preset" if p.periodic is not None else "default",
+                **({"x_decreasing": True} if x is not None and x[-1] < x[0] else {}),  # read mirrored: uniform_spacing
             }  # fmt: skip
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
-        check_finite(where, "heights", z, table_fill_advice(p, instrument))
+        text = None if instrument or file_suffix(path, where) == ".npy" else path
+        advice = table_fill_advice(p, instrument, text is not None)
+        check_finite(where, "heights", z, advice, text, None if x is None else 2)
         check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
             dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
-            check_finite(where, "x", x)
+            check_finite(where, "x", x, table=text, column=1)
             dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), summary["unit"])
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
@@ -335,26 +338,34 @@ def _claimed_array(fh) -> str:
     return f"its array of shape {shape} ({math.prod(shape) * dtype.itemsize / 2**30:.3g} GiB)"
 
 
-def table_fill_advice(p, instrument: bool) -> str:
-    """What ``check_finite`` adds of a table's NaN: what to do (a table cannot mark points as
-    not measured), and, when the preset asks to fill undefined points, why it did not."""
+def table_fill_advice(p, instrument: bool, text: bool = False) -> str:
+    """What ``check_finite`` adds of a table's NaN: what to do (a table cannot mark points as not
+    measured; SurfaceTopography's reader of a ``text`` table can, and fills them when asked), and,
+    when the preset asks to fill undefined points, why it did not."""
     if instrument:
         return ""
     crop = ", leave them out with region" if "region" in type(p).model_fields else ""
+    matrix = " (a map's numbers between tabs or spaces)" if crop else ""
+    read = (f", or read the file with format: instrument{matrix} and undefined: harmonic, which fills them from their "
+            "neighbours" if text else ", or read the instrument's own file")  # fmt: skip
     if p.undefined != "harmonic":
-        return f"; fill them before saving the table{crop}, or read the instrument's own file"
+        return f"; fill them before saving the table{crop}{read}"
     return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
-            f"fill them before saving the table{crop}, or read the instrument's own file")  # fmt: skip
+            f"fill them before saving the table{crop}{read}")
 
 
-def check_finite(where: str, what: str, values: np.ndarray, advice: str = "") -> None:
+def check_finite(where: str, what: str, values: np.ndarray, advice: str = "", table: Path | None = None,
+                 column: int | None = None) -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
-    magnitude (1e100: squares and sums of them must stay finite), locating the first; ``advice`` after."""
+    magnitude (1e100: squares and sums of them must stay finite), locating the first (by its line
+    and column in the text file ``table`` the values are its ``column`` of, if given); ``advice`` after."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
         first = np.unravel_index(int(np.argmax(bad)), bad.shape)
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
+        if table is not None and (cell := first_not_finite(table, where, column)) is not None:
+            at = f"line {cell[0]}, column {cell[1]} of the file"
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
             f"in magnitude, the first at {at}{advice}"

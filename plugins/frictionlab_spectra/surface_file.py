@@ -247,7 +247,7 @@ class SurfaceFile(MeasuredFile):
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
         z, pixel, summary = _read_map(path, where, p)
-        _check_defined(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
+        _check_defined(z, pixel, p, path, where)
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format),
                                              periodic=summary["periodic"])
@@ -275,15 +275,16 @@ class SurfaceFile(MeasuredFile):
         return Measured(heights, spacing, rms, summary["periodic"], summary)
 
 
-def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, where: str, *,
-                   instrument: bool) -> None:
+def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, path: Path, where: str) -> None:
     """Refuse undefined points (an instrument's NaN) or NaN/inf inside the part of the map pressed:
-    a crop (``region``) that leaves them out is read."""
+    a crop (``region``) that leaves them out is read. A text table's first is named by its line."""
+    instrument = is_instrument_file(path, p.format)
     inside = crop(z, pixel, p.region, where)[0] if p.region is not None else z
     if instrument and (missing := int(np.count_nonzero(np.isnan(inside)))):
         raise ValueError(undefined_message(where, missing, inside.size, " of the region"))
+    text = not instrument and file_suffix(path, where) != ".npy"
     check_finite(where, "heights" if p.region is None else "the region's heights (rows, columns from its corner)", inside,
-                 table_fill_advice(p, instrument))
+                 table_fill_advice(p, instrument, text), path if text and p.region is None else None)
 
 
 def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:

@@ -54,6 +54,25 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
             text.detach()  # the file is open_input's to close
 
 
+def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple[int, int] | None:
+    """The line and column (from 1, as an editor shows them) of the first number of a text table
+    (in its ``column``, if given) that is not finite or is beyond MAX_MAGNITUDE (a NaN a
+    profilometer writes for a point it did not measure), read a line at a time; None if there is
+    none (a header's cells are no numbers)."""
+    from frictionlab.plugin import MAX_MAGNITUDE  # here: only a table refused for such a number needs it
+
+    with open_input(path, where) as fh:
+        for lineno, raw in enumerate(io.TextIOWrapper(fh, encoding="utf-8-sig", errors="replace"), start=1):
+            text = raw.split("#", 1)[0].strip()
+            delimiter = _delimiter(text)
+            if not text or not _numbers(text, delimiter):
+                continue
+            for at, cell in enumerate(text.split(delimiter), start=1):
+                if column in (None, at) and not abs(float(cell)) <= MAX_MAGNITUDE:  # NaN too
+                    return lineno, at
+    return None
+
+
 def _not_utf8(where: str, line: int) -> str:
     return (f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or UTF-16's NUL "
             "bytes, or no text); an instrument's export (a profilometer's .csv) is read with format: instrument; a "
