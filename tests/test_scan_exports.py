@@ -104,3 +104,14 @@ def test_a_text_tables_nan_is_told_how_to_have_it_filled(tmp_path):
         ProfileFile(path=str(path)).rms_height()
     filled = ProfileFile(path=str(path), format="instrument", undefined="harmonic", detrend="none").generate(None)
     assert filled.heights[20] == pytest.approx((z[19] + z[21]) / 2, rel=1e-9)
+
+
+def test_a_map_whose_header_is_latin1_is_told_to_be_saved_as_utf8(tmp_path):
+    """A map's 'z [µm]' saved in Latin-1 was refused as naming 'the unit '\ufffdm', which is no unit
+    frictionlab knows': its header's µ undecoded, and the advice to relabel a column it had right."""
+    m = rough(10, 10, 9)
+    path = tmp_path / "latin1.csv"
+    path.write_bytes("# scan\nz [µm]\n".encode("latin-1") + "".join(",".join(map(repr, r.tolist())) + "\n" for r in m).encode())
+    with pytest.raises(ValueError, match=r"latin1.csv'?: not UTF-8 at line 2 .* save it so") as refused:
+        SurfaceFile(path=str(path), spacing=0.1).rms_height()
+    assert "no unit frictionlab knows" not in str(refused.value)

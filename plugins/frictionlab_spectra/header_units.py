@@ -180,6 +180,10 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> str |
 
     with open_input(path, where) as fh:
         head = head_text(fh, "utf-8-sig")
+    if (undecoded := next((i for i, line in enumerate(header_lines(head), 1) if "\ufffd" in line), None)) is not None:
+        from .text_table import not_utf8  # here: it reads files through instrument_file, which imports this module
+
+        raise ValueError(not_utf8(where, undecoded))  # a Latin-1 'z [µm]' was 'no unit frictionlab knows'
     check_heights_are_lengths(head, where)
     if (unknown := unknown_unit_label(head)) is not None:  # read bare, in the preset's unit, without a word
         from .instrument_file import LENGTH_UNITS  # here: it imports this module

@@ -37,7 +37,7 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
         sample = fh.read(SAMPLE_BYTES)
         fh.seek(0)
         if (nul := sample.find(b"\x00")) >= 0:  # valid UTF-8, but no text's: UTF-16 without its mark, or binary
-            raise ValueError(_not_utf8(where, sample.count(b"\n", 0, nul) + 1))
+            raise ValueError(not_utf8(where, sample.count(b"\n", 0, nul) + 1))
         need = _numbers_in(sample, size) * 8 * copies
         room, source = room_to_read()
         if need > room:
@@ -49,7 +49,7 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
         except MemoryError:
             raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
         except UnicodeDecodeError:
-            raise ValueError(_not_utf8(where, _undecodable_line(fh))) from None
+            raise ValueError(not_utf8(where, _undecodable_line(fh))) from None
         finally:
             text.detach()  # the file is open_input's to close
 
@@ -73,7 +73,7 @@ def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple
     return None
 
 
-def _not_utf8(where: str, line: int) -> str:
+def not_utf8(where: str, line: int) -> str:
     return (f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or UTF-16's NUL "
             "bytes, or no text); an instrument's export (a profilometer's .csv) is read with format: instrument; a "
             "table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')")
