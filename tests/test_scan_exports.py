@@ -115,3 +115,19 @@ def test_a_map_whose_header_is_latin1_is_told_to_be_saved_as_utf8(tmp_path):
     with pytest.raises(ValueError, match=r"latin1.csv'?: not UTF-8 at line 2 .* save it so") as refused:
         SurfaceFile(path=str(path), spacing=0.1).rms_height()
     assert "no unit frictionlab knows" not in str(refused.value)
+
+
+@pytest.mark.parametrize("footer", ["End of data", "Total points: 64"])
+def test_a_footer_after_a_tables_numbers_is_named_so(tmp_path, footer):
+    """An export's summary line after its numbers was 'non-numeric content at line 66: column 1 is
+    not a number', as a bad cell among the numbers is; it is a footer, which is deleted or commented out."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 10)[0]
+    path = xz_table(tmp_path / "footer.csv", x, z)
+    path.write_text(path.read_text() + footer + "\n\n")
+    with pytest.raises(ValueError, match=r"non-numeric content at line 66 .* a footer after the table .* delete it, or "
+                                         "start its lines with #"):
+        ProfileFile(path=str(path)).rms_height()
+    bad_row = xz_table(tmp_path / "bad.csv", x, z)
+    bad_row.write_text(bad_row.read_text() + "32.0,x\n")  # a row of numbers with a bad cell: no footer
+    with pytest.raises(ValueError, match=r"line 66 .*column 2 is not a number$"):
+        ProfileFile(path=str(bad_row)).rms_height()

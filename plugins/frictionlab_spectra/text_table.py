@@ -158,12 +158,21 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
             return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
-                    + _bad_cell(text, delimiter))
+                    + _bad_cell(text, delimiter) + (_footer(lines, delimiter) if columns is not None and not is_number(text.split(delimiter)[0]) else ""))
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+def _footer(rest, delimiter: str | None) -> str:
+    """What a table's first line of text after its numbers is when no line of ``rest`` (the lines
+    after it) holds numbers: a footer, which an export writes after its data ('End of data')."""
+    if any(_numbers(text, delimiter) for line in rest if (text := line.split("#", 1)[0].strip())):
+        return ""
+    return ("; no line after it holds numbers: a footer after the table (an export's summary, 'End of data'), "
+            "which a table of numbers does not have: delete it, or start its lines with #")
 
 
 def _bad_cell(text: str, delimiter: str | None) -> str:
