@@ -131,3 +131,21 @@ def test_a_footer_after_a_tables_numbers_is_named_so(tmp_path, footer):
     bad_row.write_text(bad_row.read_text() + "32.0,x\n")  # a row of numbers with a bad cell: no footer
     with pytest.raises(ValueError, match=r"line 66 .*column 2 is not a number$"):
         ProfileFile(path=str(bad_row)).rms_height()
+
+
+def test_a_file_with_a_second_channel_per_point_is_told_to_export_the_heights_alone(tmp_path):
+    """x, z and an intensity per row was told 'a height map is read by surface-file'; x, y, z and an
+    intensity per point was 'a map of 4 x 144 pixels; at least 8 x 8': both are channels per column."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 11)[0]
+    line = tmp_path / "line.csv"
+    line.write_text("x [um],z [um],intensity\n" + "".join(f"{a!r},{b!r},{abs(b)!r}\n" for a, b in zip(x.tolist(), z.tolist())))
+    with pytest.raises(ValueError, match=r"3 columns; .* a channel per column \(x, z and an intensity, a second "
+                                         r"height\): export x and the heights alone") as refused:
+        ProfileFile(path=str(line)).rms_height()
+    assert "a height map" not in str(refused.value)
+    m = rough(12, 12, 12)
+    points = tmp_path / "points.txt"
+    points.write_text("".join(f"{i} {j} {float(m[j, i])!r} {abs(float(m[j, i]))!r}\n" for j in range(12) for i in range(12)))
+    with pytest.raises(ValueError, match=r"map of 4 x 144 pixels .*; columns of x, y, z and another channel per point "
+                                         r"\(an intensity\): export x, y and the heights alone"):
+        SurfaceFile(path=str(points), spacing=0.1).rms_height()

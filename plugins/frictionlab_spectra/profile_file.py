@@ -198,10 +198,15 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
         return None, data[0].copy()
     if data.shape[1] == 2:
         return data[:, 0].copy(), data[:, 1].copy()
-    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights{MAP_ADVICE}")
+    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights"
+                     + (CHANNELS_ADVICE if data.shape[1] <= MAX_POINT_COLUMNS < data.shape[0] else MAP_ADVICE))
 
 
 MAP_ADVICE = "; a height map (rows of heights, each a line across it) is read by surface-file"
+MAX_POINT_COLUMNS = 4  # a point's x, z (or x, y, z) and another channel, as instruments export them
+CHANNELS_ADVICE = ("; a few columns over many rows are a channel per column (x, z and an intensity, a second height): "
+                   "export x and the heights alone (x, y and z per point, a map's, are read by surface-file with "
+                   "format: instrument)")  # fmt: skip
 
 
 def file_suffix(path: Path, where: str) -> str:

@@ -382,7 +382,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         ny, nx = data.shape
         table = not is_instrument_file(path, p.format) and path.suffix.lower() != ".npy"
         points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument"
-                  if table else "", 2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "")  # fmt: skip
+                  if table else "", 2: "; columns of x and z (a line) are read by profile-file",
+                  4: "; columns of x, y, z and another channel per point (an intensity): export x, y and the heights "
+                  "alone, read with format: instrument"}.get(nx if ny > nx else 0, "")  # fmt: skip
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
                **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip
