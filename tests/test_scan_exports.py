@@ -149,3 +149,12 @@ def test_a_file_with_a_second_channel_per_point_is_told_to_export_the_heights_al
     with pytest.raises(ValueError, match=r"map of 4 x 144 pixels .*; columns of x, y, z and another channel per point "
                                          r"\(an intensity\): export x, y and the heights alone"):
         SurfaceFile(path=str(points), spacing=0.1).rms_height()
+
+
+@pytest.mark.parametrize("text", ["0.1,0.2\n", "0.1\n0.2\n"])
+def test_a_map_of_two_points_is_not_sent_to_profile_file(tmp_path, text):
+    """A table of 2 heights was 'one pixel wide: a line; use profile-file', which refuses it as 2 points."""
+    (tmp_path / "two.csv").write_text(text)
+    with pytest.raises(ValueError, match=r"a map of \d x \d pixels \(x by y\): 2 heights, too few for a map \(at least "
+                                         r"8 x 8\) or a line \(profile-file: at least 8 points\)"):
+        SurfaceFile(path=str(tmp_path / "two.csv"), spacing=0.1).rms_height()

@@ -60,7 +60,7 @@ from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
-    check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
+    MIN_POINTS, check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
 )
 from .text_table import axes_warning, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
@@ -372,6 +372,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
+        if nx * ny < MIN_POINTS:  # profile-file would refuse it too
+            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {nx * ny} height{'s' * (nx * ny > 1)}, too few for a map (at "
+                             f"least {MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least {MIN_POINTS} points)")
         raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y), one pixel wide: a line; use profile-file")
     if data.ndim != 2:
         raise ValueError(
