@@ -31,7 +31,12 @@ def test_a_table_whose_header_states_an_oblong_pixel_is_not_squared_without_a_wo
     (caveat,) = [said for said in summary["caveats"] if "not square" in said]
     assert "its header's pixel of 1 x 0.5 um (x by y), which is not square" in caveat
     assert "give spacing_y too (0.5 keeps the file's shape), or read it with format: instrument" in caveat
+    assert summary["file_spacing"] == pytest.approx([1.0, 0.5], rel=1e-9)
+    from frictionlab.io.inputs import describe_input
+
+    assert "the file's pixels of 1 x 0.5 um replaced by the preset's spacing, square" in describe_input(summary)
     kept = SurfaceFile(path=str(path), format="table", spacing=1.0, spacing_y=0.5).input_summary()
+    assert "replaced" not in describe_input(kept)
     assert not any("not square" in said for said in kept.get("caveats", ()))
     square = gwyddion_matrix(tmp_path / "square.txt", rough(16, 32), (0.5, 0.5))
     said = SurfaceFile(path=str(square), format="table", spacing=0.5).input_summary().get("caveats", ())

@@ -312,14 +312,18 @@ def _square_over_oblong(pixel: tuple[float, float] | None, p: SurfaceFile.Params
             f"file's shape), or {use} to use the file's pixel")  # fmt: skip
 
 
-def _table_caveats(path: Path, where: str, data: np.ndarray, p: SurfaceFile.Params, unit: dict) -> list[str]:
-    """The caveats of a table map (of at least MIN_SIDE points each way): an export's axes read as
-    heights, and the square pixel ``spacing`` declares where the header states an oblong one
-    (Gwyddion's text export, read with format: table), in the run's ``unit`` (``table_unit``)."""
-    said = unit["unit"] if unit["unit"] in LENGTH_UNITS else "m"
-    stated = _header_pixel(path, where, data.shape, said) if file_suffix(path, where) != ".npy" else None
+def _table_checks(path: Path, where: str, data: np.ndarray, p: SurfaceFile.Params, unit: dict) -> dict[str, Any]:
+    """What the summary says of a table map (of at least MIN_SIDE points each way): the pixel its
+    header states (Gwyddion's text export, read with format: table), in the run's ``unit``
+    (``table_unit``), which ``validate`` names where the preset's differs; and the caveats of an
+    export's axes read as heights, and of a square ``spacing`` over the header's oblong pixel."""
+    said = unit["unit"] if unit["unit"] in LENGTH_UNITS else None
+    text = file_suffix(path, where) != ".npy"
+    stated = _header_pixel(path, where, data.shape, said) if text and said else None
     oblong = _square_over_oblong(stated, p, said, "its header's", "read it with format: instrument")
-    return [caveat for caveat in (_axes_in_region(data, p.preset_pixel(), p, where), oblong) if caveat]
+    caveats = [caveat for caveat in (_axes_in_region(data, p.preset_pixel(), p, where), oblong) if caveat]
+    spacing = {} if stated is None else {"file_spacing": stated[0] if stated[0] == stated[1] else list(stated)}
+    return {**spacing, **({"caveats": caveats} if caveats else {})}
 
 
 def _header_pixel(path: Path, where: str, shape: tuple[int, int], unit: str) -> tuple[float, float] | None:
@@ -367,14 +371,15 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "format": path.suffix.lower(), "spacing_from": "preset", **unit,
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
-        if data.ndim == 2 and min(data.shape) >= MIN_SIDE and (caveats := _table_caveats(path, where, data, p, unit)):
-            summary["caveats"] = caveats
+        if data.ndim == 2 and min(data.shape) >= MIN_SIDE:
+            summary.update(_table_checks(path, where, data, p, unit))
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
         if nx * ny < MIN_POINTS:  # profile-file would refuse it too
-            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {nx * ny} height{'s' * (nx * ny > 1)}, too few for a map (at "
-                             f"least {MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least {MIN_POINTS} points)")
+            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {nx * ny} height{'s' * (nx * ny > 1)}, too "
+                             f"few for a map (at least {MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least "
+                             f"{MIN_POINTS} points)")
         raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y), one pixel wide: a line; use profile-file")
     if data.ndim != 2:
         raise ValueError(
