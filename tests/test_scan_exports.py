@@ -163,3 +163,17 @@ def test_a_map_of_two_points_is_not_sent_to_profile_file(tmp_path, text):
     with pytest.raises(ValueError, match=r"a map of \d x \d pixels \(x by y\): 2 heights, too few for a map \(at least "
                                          r"8 x 8\) or a line \(profile-file: at least 8 points\)"):
         SurfaceFile(path=str(tmp_path / "two.csv"), spacing=0.1).rms_height()
+
+
+@pytest.mark.parametrize("cell", ["", " "])
+def test_a_tables_empty_last_cell_is_a_point_left_out_not_a_separator_too_many(tmp_path, cell):
+    """'0.5,' among rows of x, z (a profilometer's dropout: its z left empty) was 'ends with a separator, an
+    empty column after its last number: export the table without a separator at the end of its lines'."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 13)[0]
+    path = xz_table(tmp_path / "dropout.csv", x, z)
+    lines = path.read_text().splitlines()
+    lines[51] = lines[51].split(",")[0] + "," + cell
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"line 52 \(expected numbers separated by commas\): column 2 is empty, a point "
+                                         "the export left out; write NaN there to mark it missing"):
+        ProfileFile(path=str(path)).rms_height()
