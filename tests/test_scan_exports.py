@@ -177,3 +177,13 @@ def test_a_tables_empty_last_cell_is_a_point_left_out_not_a_separator_too_many(t
     with pytest.raises(ValueError, match=r"line 52 \(expected numbers separated by commas\): column 2 is empty, a point "
                                          "the export left out; write NaN there to mark it missing"):
         ProfileFile(path=str(path)).rms_height()
+
+
+@pytest.mark.parametrize("height", [1e-3, 0.3, 7.7])
+def test_a_map_of_equal_heights_is_refused_as_flat_not_as_an_internal_error(tmp_path, height):
+    """A map whose every height is 0.001 (its mean's rounding leaves an rms of 4e-19, not 0) was refused
+    as 'zero-size array to reduction operation minimum which has no identity', numpy's words."""
+    np.save(tmp_path / "flat.npy", np.full((16, 32), height))
+    with pytest.raises(ValueError, match=r"flat.npy'?: the map is constant \(rms height zero after detrend='mean'\); "
+                                         "a flat surface has no roughness"):
+        SurfaceFile(path=str(tmp_path / "flat.npy"), spacing=0.1).rms_height()
