@@ -134,8 +134,9 @@ def test_a_footer_after_a_tables_numbers_is_named_so(tmp_path, footer):
         ProfileFile(path=str(path)).rms_height()
     bad_row = xz_table(tmp_path / "bad.csv", x, z)
     bad_row.write_text(bad_row.read_text() + "32.0,x\n")  # a row of numbers with a bad cell: no footer
-    with pytest.raises(ValueError, match=r"line 66 .*column 2 is not a number$"):
+    with pytest.raises(ValueError, match=r"line 66 .*column 2 is not a number") as refused:
         ProfileFile(path=str(bad_row)).rms_height()
+    assert "a footer after the table" not in str(refused.value)
 
 
 def test_a_file_with_a_second_channel_per_point_is_told_to_export_the_heights_alone(tmp_path):
@@ -187,3 +188,19 @@ def test_a_map_of_equal_heights_is_refused_as_flat_not_as_an_internal_error(tmp_
     with pytest.raises(ValueError, match=r"flat.npy'?: the map is constant \(rms height zero after detrend='mean'\); "
                                          "a flat surface has no roughness"):
         SurfaceFile(path=str(tmp_path / "flat.npy"), spacing=0.1).rms_height()
+
+
+def test_a_cell_that_marks_a_point_not_measured_is_told_to_be_nan(tmp_path):
+    """'***' (or N/A, --) where a profilometer did not measure was 'column 2 is not a number', as a typo is."""
+    x, z = np.arange(64) * 0.5, rough(1, 64, 14)[0]
+    path = xz_table(tmp_path / "stars.csv", x, z)
+    lines = path.read_text().splitlines()
+    lines[51], lines[53] = lines[51].split(",")[0] + ",***", lines[53].split(",")[0] + ",1.2.3"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"line 52 .*: column 2 is not a number, and holds no digit: if it marks a point "
+                                         r"not measured \(as \*\*\*, N/A or -- do\), write NaN there$"):
+        ProfileFile(path=str(path)).rms_height()
+    lines[51] = lines[51].split(",")[0] + ",0.5"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"line 54 .*: column 2 is not a number$"):  # a typo: no such guess
+        ProfileFile(path=str(path)).rms_height()

@@ -157,8 +157,9 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
+            footer = columns is not None and not is_number(text.split(delimiter)[0]) and _footer(lines, delimiter)
             return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
-                    + _bad_cell(text, delimiter) + (_footer(lines, delimiter) if columns is not None and not is_number(text.split(delimiter)[0]) else ""))
+                    + (footer or _bad_cell(text, delimiter)))
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
@@ -171,8 +172,8 @@ def _footer(rest, delimiter: str | None) -> str:
     after it) holds numbers: a footer, which an export writes after its data ('End of data')."""
     if any(_numbers(text, delimiter) for line in rest if (text := line.split("#", 1)[0].strip())):
         return ""
-    return ("; no line after it holds numbers: a footer after the table (an export's summary, 'End of data'), "
-            "which a table of numbers does not have: delete it, or start its lines with #")
+    return (": text, and no line after it holds numbers: a footer after the table (an export's summary, 'End of "
+            "data'), which a table of numbers does not have; delete it, or start its lines with #")
 
 
 def _bad_cell(text: str, delimiter: str | None) -> str:
@@ -180,8 +181,11 @@ def _bad_cell(text: str, delimiter: str | None) -> str:
     point an export left out, which NaN stands for (then refused, or cropped out, by name)."""
     cells = text.split(delimiter)
     column = next(i for i, cell in enumerate(cells, start=1) if not is_number(cell))
-    if cells[column - 1].strip():
+    if any(char.isdigit() for char in cells[column - 1]):
         return f": column {column} is not a number"
+    if cells[column - 1].strip():  # ***, N/A, --: how exports mark a point not measured
+        return (f": column {column} is not a number, and holds no digit: if it marks a point not measured (as ***, N/A "
+                "or -- do), write NaN there")
     return f": column {column} is empty, a point the export left out; write NaN there to mark it missing"
 
 
