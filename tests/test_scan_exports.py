@@ -85,7 +85,7 @@ def test_a_tables_nan_is_named_by_its_line_and_column_in_the_file(tmp_path):
     z[50], x[60] = np.nan, np.nan  # the heights' NaN on the file's line 52 (a header, then rows from 0), x's on 62
     path = xz_table(tmp_path / "dropped.csv", x, z)
     with pytest.raises(ValueError, match=r"dropped.csv'?: 1 value\(s\) in heights not finite .* the first at line 52, "
-                                         r"column 2 of the file; fill them before saving the table"):
+                                         r"column 2 of the file; set undefined: harmonic to fill NaN"):
         ProfileFile(path=str(path)).rms_height()
     z[50] = 0.0
     with pytest.raises(ValueError, match=r"1 value\(s\) in x not finite .* the first at line 62, column 1 of the file"):
@@ -93,22 +93,48 @@ def test_a_tables_nan_is_named_by_its_line_and_column_in_the_file(tmp_path):
     m = rough(12, 10, 7)
     m[3, 4] = np.nan
     (tmp_path / "map.csv").write_text("# exported\n" + "".join(",".join(map(repr, row.tolist())) + "\n" for row in m))
-    with pytest.raises(ValueError, match=r"the first at line 5, column 5 of the file; fill them before saving the table, "
-                                         "leave them out with region"):
+    with pytest.raises(ValueError, match=r"the first at line 5, column 5 of the file; set undefined: harmonic to fill NaN "
+                                         r"\(points not measured\) from their neighbours, or fix them before saving the "
+                                         "table, or leave them out with region"):
         SurfaceFile(path=str(tmp_path / "map.csv"), spacing=0.1).rms_height()
 
 
-def test_a_text_tables_nan_is_told_how_to_have_it_filled(tmp_path):
-    """A .csv's NaN was told to 'read the instrument's own file'; SurfaceTopography's reader of the
-    same export (format: instrument) takes it for a point not measured, which undefined: harmonic fills."""
+@pytest.mark.parametrize("columns", ["z", "x, z"])
+def test_a_tables_nan_is_filled_as_an_instrument_files_undefined_points(tmp_path, columns):
+    """A NaN in a .csv (an optical profilometer's dropout) was refused, told to fill it before saving
+    or to 'read the instrument's own file'; undefined: harmonic fills it as SurfaceTopography fills an
+    instrument file's undefined points: on a line, straight between its neighbours."""
     x, z = np.arange(64) * 0.5, rough(1, 64, 8)[0]
-    z[20] = np.nan
-    path = xz_table(tmp_path / "dropped.csv", x, z)
-    with pytest.raises(ValueError, match=r"read the file with format: instrument and undefined: harmonic, which fills "
-                                         "them from their neighbours"):
-        ProfileFile(path=str(path)).rms_height()
-    filled = ProfileFile(path=str(path), format="instrument", undefined="harmonic", detrend="none").generate(None)
-    assert filled.heights[20] == pytest.approx((z[19] + z[21]) / 2, rel=1e-9)
+    z[20], z[30:33], z[0] = np.nan, np.nan, np.nan
+    path = xz_table(tmp_path / "dropped.csv", x, z) if columns == "x, z" else tmp_path / "dropped.csv"
+    if columns == "z":
+        path.write_text("".join(f"{v!r}\n" for v in z.tolist()))
+    line = ProfileFile(path=str(path), spacing=0.5, undefined="harmonic", detrend="none")
+    filled = line.generate(None).heights
+    assert filled[20] == pytest.approx((z[19] + z[21]) / 2, rel=1e-9)
+    np.testing.assert_allclose(filled[30:33], z[29] + (z[33] - z[29]) * np.arange(1, 4) / 4, rtol=1e-9)
+    assert filled[0] == pytest.approx(z[1], rel=1e-12)  # level past the first defined point
+    summary = line.input_summary()
+    assert summary["undefined_points"] == 5 and summary["filled_by"] == "harmonic"
+    assert any("were undefined and filled by harmonic interpolation" in c for c in summary["caveats"])  # 7.8 %
+
+
+def test_a_table_maps_nan_are_filled_as_surfacetopography_fills_them(tmp_path):
+    """A map's NaN filled with undefined: harmonic: the solution of Laplace's equation over the holes,
+    the same heights as SurfaceTopography's harmonic filling of an instrument file's undefined points."""
+    from scipy.ndimage import gaussian_filter
+    from SurfaceTopography import Topography
+
+    z = gaussian_filter(rough(20, 30, 15), 2)
+    z[3:6, 4:9], z[0, 0], z[19, 10:14], z[10, 29] = np.nan, np.nan, np.nan, np.nan
+    (tmp_path / "map.csv").write_text("".join(",".join(map(repr, row.tolist())) + "\n" for row in z))
+    read = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=1.0, undefined="harmonic", detrend="none")
+    expected = Topography(np.ma.masked_invalid(z.T), (30.0, 20.0)).interpolate_undefined_data("harmonic").heights().T
+    np.testing.assert_allclose(read.generate(None).heights, expected, rtol=0, atol=1e-12)
+    assert read.input_summary()["undefined_points"] == 21
+    np.save(tmp_path / "none.npy", np.full((10, 10), np.nan))
+    with pytest.raises(ValueError, match=r"none.npy'?: all 100 heights are NaN \(not measured\): nothing to press"):
+        SurfaceFile(path=str(tmp_path / "none.npy"), spacing=1.0, undefined="harmonic").rms_height()
 
 
 def test_a_map_whose_header_is_latin1_is_told_to_be_saved_as_utf8(tmp_path):

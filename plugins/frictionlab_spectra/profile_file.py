@@ -35,12 +35,13 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
+    ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .reader_failures import reason_said
 from .text_table import first_not_finite, read_text_table
+from .scan_shaping.filling import fill_harmonic
 from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
 from .scan_shaping.levelling import level_line, line_form_warning
 from .scan_shaping.spikes import line_spike_warning
@@ -119,12 +120,12 @@ class ProfileFile(MeasuredFile):
                 "periodic_from": "preset" if p.periodic is not None else "default",
                 **({"x_decreasing": True} if x is not None and x[-1] < x[0] else {}),  # read mirrored: uniform_spacing
             }  # fmt: skip
+            summary.update(fill_table(where, z, p))
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         text = None if instrument or file_suffix(path, where) == ".npy" else path
-        advice = table_fill_advice(p, instrument, text is not None)
-        check_finite(where, "heights", z, advice, text, None if x is None else 2)
+        check_finite(where, "heights", z, table_fill_advice(p, instrument), text, None if x is None else 2)
         check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
@@ -343,20 +344,33 @@ def _claimed_array(fh) -> str:
     return f"its array of shape {shape} ({math.prod(shape) * dtype.itemsize / 2**30:.3g} GiB)"
 
 
-def table_fill_advice(p, instrument: bool, text: bool = False) -> str:
-    """What ``check_finite`` adds of a table's NaN: what to do (a table cannot mark points as not
-    measured; SurfaceTopography's reader of a ``text`` table can, and fills them when asked), and,
-    when the preset asks to fill undefined points, why it did not."""
+def table_fill_advice(p, instrument: bool) -> str:
+    """What ``check_finite`` adds of a table's values that are not finite: what to do (its NaN are
+    filled with ``undefined: harmonic``: ``fill_table``), and, when the preset asks to fill
+    undefined points, why these were not."""
     if instrument:
         return ""
-    crop = ", leave them out with region" if "region" in type(p).model_fields else ""
-    matrix = " (a map's numbers between tabs or spaces)" if crop else ""
-    read = (f", or read the file with format: instrument{matrix} and undefined: harmonic, which fills them from their "
-            "neighbours" if text else ", or read the instrument's own file")  # fmt: skip
+    fix = "fix them before saving the table" + (", or leave them out with region" if "region" in type(p).model_fields
+                                                else "")  # fmt: skip
     if p.undefined != "harmonic":
-        return f"; fill them before saving the table{crop}{read}"
-    return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
-            f"fill them before saving the table{crop}{read}")
+        return f"; set undefined: harmonic to fill NaN (points not measured) from their neighbours, or {fix}"
+    return (f"; undefined: harmonic fills a table's NaN (points not measured), not an inf or a number beyond "
+            f"{MAX_MAGNITUDE:g}: write NaN there, or {fix}")
+
+
+def fill_table(where: str, z: np.ndarray, p) -> dict:
+    """Fill a table's NaN (points not measured) in place when the preset says ``undefined:
+    harmonic``, as an instrument file's undefined points are; what its summary says of them."""
+    if p.undefined != "harmonic" or not (missing := int(np.count_nonzero(np.isnan(z)))):
+        return {}
+    with np.errstate(invalid="ignore"):
+        if np.any(np.abs(z) > MAX_MAGNITUDE):  # inf too: refused with the NaN by check_finite, nothing filled from it
+            return {}
+    if missing == z.size:  # nothing to fill from
+        raise ValueError(f"{where}: all {missing} heights are NaN (not measured): nothing to press")
+    fill_harmonic(z)
+    caveat = filled_caveat(missing, z.size, p, z.ndim)
+    return {"undefined_points": missing, "filled_by": p.undefined, **({"caveats": [caveat]} if caveat else {})}
 
 
 def check_finite(where: str, what: str, values: np.ndarray, advice: str = "", table: Path | None = None,

@@ -60,7 +60,7 @@ from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
-    MIN_POINTS, check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
+    MIN_POINTS, check_finite, fill_table, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
 )
 from .text_table import axes_warning, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
@@ -284,7 +284,7 @@ def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Par
         raise ValueError(undefined_message(where, missing, inside.size, " of the region"))
     text = not instrument and file_suffix(path, where) != ".npy"
     check_finite(where, "heights" if p.region is None else "the region's heights (rows, columns from its corner)", inside,
-                 table_fill_advice(p, instrument, text), path if text and p.region is None else None)
+                 table_fill_advice(p, instrument), path if text and p.region is None else None)
 
 
 def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
@@ -372,7 +372,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
         if data.ndim == 2 and min(data.shape) >= MIN_SIDE:
-            summary.update(_table_checks(path, where, data, p, unit))
+            checked, filled = _table_checks(path, where, data, p, unit), fill_table(where, data, p)
+            caveats = [*checked.pop("caveats", ()), *filled.pop("caveats", ())]
+            summary.update(checked, **filled, **({"caveats": caveats} if caveats else {}))
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
