@@ -224,7 +224,7 @@ def test_a_cell_that_marks_a_point_not_measured_is_told_to_be_nan(tmp_path):
     lines[51], lines[53] = lines[51].split(",")[0] + ",***", lines[53].split(",")[0] + ",1.2.3"
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(ValueError, match=r"line 52 .*: column 2 is not a number, and holds no digit: if it marks a point "
-                                         r"not measured \(as \*\*\*, N/A or -- do\), write NaN there$"):
+                                         r"not measured \(as \*\*\*, N/A or -- do\), write NaN there, which undefined: harmonic fills$"):
         ProfileFile(path=str(path)).rms_height()
     lines[51] = lines[51].split(",")[0] + ",0.5"
     path.write_text("\n".join(lines) + "\n")

@@ -185,8 +185,9 @@ def _bad_cell(text: str, delimiter: str | None) -> str:
         return f": column {column} is not a number"
     if cells[column - 1].strip():  # ***, N/A, --: how exports mark a point not measured
         return (f": column {column} is not a number, and holds no digit: if it marks a point not measured (as ***, N/A "
-                "or -- do), write NaN there")
-    return f": column {column} is empty, a point the export left out; write NaN there to mark it missing"
+                "or -- do), write NaN there, which undefined: harmonic fills")
+    return (f": column {column} is empty, a point the export left out; write NaN there to mark it missing, which "
+            "undefined: harmonic fills")
 
 
 def decimal_commas(lineno: int, what: str = "table") -> str:
