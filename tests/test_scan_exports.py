@@ -230,3 +230,18 @@ def test_a_cell_that_marks_a_point_not_measured_is_told_to_be_nan(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(ValueError, match=r"line 54 .*: column 2 is not a number$"):  # a typo: no such guess
         ProfileFile(path=str(path)).rms_height()
+
+
+def test_an_x_column_printed_too_coarsely_is_told_so(tmp_path):
+    """A profilometer's x in mm to 3 decimals, its step 0.0025 mm: the rounding alone put points 0.4
+    steps off a uniform grid, refused with the deviation and nothing to do."""
+    x, z = np.arange(100) * 0.0025, rough(1, 100, 16)[0]
+    path = tmp_path / "coarse.csv"
+    path.write_text("".join(f"{a:.3f},{b!r}\n" for a, b in zip(x.tolist(), z.tolist())))
+    with pytest.raises(ValueError, match=r"x is not uniformly spaced: .*; x is written to 3 decimals \(0.001\), too coarse "
+                                         r"for its step of about 0.0025: export x with more digits, or the heights alone"):
+        ProfileFile(path=str(path)).rms_height()
+    x[50:] += 0.1  # a jump: no rounding's
+    path.write_text("".join(f"{a:.4f},{b!r}\n" for a, b in zip(x.tolist(), z.tolist())))
+    with pytest.raises(ValueError, match=r"x is not uniformly spaced: .*: export the scan on a uniform grid"):
+        ProfileFile(path=str(path)).rms_height()

@@ -371,11 +371,28 @@ def uniform_spacing(where: str, x: np.ndarray) -> float:
     deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
     dx = abs(dx)
     if deviation > X_TOLERANCE * dx:
-        raise ValueError(
-            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
-            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
-        )
+        said = (f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
+                f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})")
+        raise ValueError(said + _x_advice(x))
     return float(dx)
+
+
+def _x_advice(x: np.ndarray) -> str:
+    """What to do of an x column off a uniform grid: export it with more digits, where it is one
+    printed too coarsely for its step (a profilometer's x in mm to 3 decimals, its step 0.0025 mm:
+    its rounding alone moves points 0.4 steps); else export the scan on a uniform grid."""
+    step, offset = np.polyfit(np.arange(x.size, dtype=np.float64), x, 1)
+    rest = float(np.max(np.abs(x - offset - step * np.arange(x.size))))
+    for decimals in range(13):  # the fewest decimals that write every x: the resolution it was printed to
+        scaled = x * 10.0**decimals
+        if np.all(np.abs(scaled - np.round(scaled)) <= 1e-9 * np.maximum(1.0, np.abs(scaled))):  # float64's error
+            printed = 10.0**-decimals
+            if rest <= printed:  # the print's rounding, not the scan, puts it off the grid
+                return (f"; x is written to {decimals} decimals ({printed:g}), too coarse for its step of about "
+                        f"{abs(step):.4g}: export x with more digits, or the heights alone (one column) with spacing "
+                        "(the scan's step)")
+            break
+    return ": export the scan on a uniform grid (as most instruments do), or interpolate it onto one"
 
 
 def _text_x(fh, points: int) -> np.ndarray | None:
