@@ -245,3 +245,27 @@ def test_an_x_column_printed_too_coarsely_is_told_so(tmp_path):
     path.write_text("".join(f"{a:.4f},{b!r}\n" for a, b in zip(x.tolist(), z.tolist())))
     with pytest.raises(ValueError, match=r"x is not uniformly spaced: .*: export the scan on a uniform grid"):
         ProfileFile(path=str(path)).rms_height()
+
+
+def test_undefined_points_cropped_out_keep_the_caveat_of_a_square_spacing(tmp_path):
+    """An instrument file's undefined points left out by region replaced its summary's caveats by the
+    region's: the caveat of spacing squaring its oblong pixel was dropped without a word."""
+    z = rough(16, 32, 17)
+    z[2, 3] = np.nan  # outside the region
+    path = gwyddion_matrix(tmp_path / "scan.txt", z, (1.0, 0.5))
+    summary = SurfaceFile(path=str(path), format="instrument", unit="um", spacing=1.0,
+                          region={"x": [8, 32], "y": [8, 16]}).input_summary()  # fmt: skip
+    assert summary["undefined_outside_region"] == 1
+    assert any("which is not square" in caveat for caveat in summary["caveats"])
+
+
+def test_a_tables_nan_outside_the_region_is_counted_there_when_filled(tmp_path):
+    """A table's NaN outside region, under undefined: harmonic, was counted as filled in the map pressed."""
+    z = rough(16, 16, 18)
+    z[2, 3] = np.nan
+    np.save(tmp_path / "map.npy", z)
+    for x, inside in (([8, 16], 0), ([2, 16], 1)):
+        summary = SurfaceFile(path=str(tmp_path / "map.npy"), spacing=1.0, undefined="harmonic",
+                              region={"x": x, "y": [1, 16]}).input_summary()  # fmt: skip
+        assert (summary["undefined_points"], summary["undefined_outside_region"]) == (inside, 1 - inside)
+        assert summary["filled_by"] == ("harmonic" if inside else None)

@@ -287,13 +287,14 @@ def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Par
                  table_fill_advice(p, instrument), path if text and p.region is None else None)
 
 
-def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
-    """What the summary says of a scan's undefined points once cropped: those inside ``region``
-    (filled, or refused by ``_check_defined``) and those it leaves out."""
-    region_mask = crop(scan.undefined_mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
+def _undefined_in_region(mask: np.ndarray, undefined: int, pixel: tuple[float, float], p: SurfaceFile.Params,
+                         where: str) -> dict[str, Any]:
+    """What the summary says of a map's ``undefined`` points (``mask``) once cropped: those inside
+    ``region`` (filled, or refused by ``_check_defined``) and those it leaves out."""
+    region_mask = crop(mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
     inside, size = int(np.count_nonzero(region_mask)), region_mask.size
     caveat = filled_caveat(inside, size, p, 2, "the region's")
-    return {"undefined_points": inside, "undefined_outside_region": scan.undefined - inside,
+    return {"undefined_points": inside, "undefined_outside_region": undefined - inside,
             "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
             "caveats": [caveat] if caveat else []}  # fmt: skip
 
@@ -348,10 +349,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
+        if p.region is not None and scan.undefined:  # its caveat replaces the whole file's
+            summary.update(_undefined_in_region(scan.undefined_mask, scan.undefined, pixel, p, where))
         if caveat := _square_over_oblong(scan.pixel if scan.pixel_stated else None, p, summary.get("unit")):
             summary["caveats"] = [*summary.get("caveats", ()), caveat]
-        if p.region is not None and scan.undefined:
-            summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         table = file_suffix(path, where) != ".npy"
@@ -372,7 +373,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
         if data.ndim == 2 and min(data.shape) >= MIN_SIDE:
+            holes = np.isnan(data) if p.region is not None and p.undefined == "harmonic" else None
             checked, filled = _table_checks(path, where, data, p, unit), fill_table(where, data, p)
+            if filled and holes is not None:  # counted inside the region, as an instrument file's
+                filled = _undefined_in_region(holes, filled["undefined_points"], pixel, p, where)
             caveats = [*checked.pop("caveats", ()), *filled.pop("caveats", ())]
             summary.update(checked, **filled, **({"caveats": caveats} if caveats else {}))
         periodic = bool(p.periodic)
