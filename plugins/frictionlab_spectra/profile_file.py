@@ -35,7 +35,8 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
+    ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
+    uniform_spacing,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params

@@ -52,7 +52,8 @@ from frictionlab import InputFile
 from .equivalent_line import EquivalentLine
 from .header_units import stated_pixel
 from .instrument_file import (
-    LENGTH_UNITS, MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    LENGTH_UNITS, MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary,
+    undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
@@ -60,7 +61,8 @@ from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
-    MIN_POINTS, check_finite, fill_table, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
+    MIN_POINTS, check_finite, check_heights_not_underflowing, file_suffix, fill_table, load_npy, npy_shape,
+    table_fill_advice,
 )
 from .text_table import axes_warning, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
@@ -383,9 +385,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
         if nx * ny < MIN_POINTS:  # profile-file would refuse it too
-            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {nx * ny} height{'s' * (nx * ny > 1)}, too "
-                             f"few for a map (at least {MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least "
-                             f"{MIN_POINTS} points)")
+            heights = f"{nx * ny} height{'s' * (nx * ny > 1)}"
+            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {heights}, too few for a map (at least "
+                             f"{MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least {MIN_POINTS} points)")
         raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y), one pixel wide: a line; use profile-file")
     if data.ndim != 2:
         raise ValueError(

@@ -153,7 +153,7 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
         if lineno <= skip or not text:
             continue
         if not _numbers(text, delimiter):
-            if _ends_with_separator(text, delimiter) and len(text.split(delimiter)) != columns:  # else its last cell is empty
+            if _ends_with_separator(text, delimiter) and len(text.split(delimiter)) != columns:  # else: an empty cell
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)

@@ -66,7 +66,7 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
     if not pairs or equal <= FLAT_SHARE * pairs:
         return _clipped_warning(z, what)
     steps = np.abs(np.diff(z.ravel()))  # along the rows, and from a row's end to the next's start
-    if not (steps > 0).any():  # every height equal, its rms not 0 but rounding's (0.001 less their mean): refused as flat
+    if not (steps > 0).any():  # all equal, their rms not 0 but rounding's (0.001 less their mean): refused as flat
         return None
     step = float(steps[steps > 0].min())
     points = "pixels" if what == "map" else "points"
