@@ -269,3 +269,16 @@ def test_a_tables_nan_outside_the_region_is_counted_there_when_filled(tmp_path):
                               region={"x": x, "y": [1, 16]}).input_summary()  # fmt: skip
         assert (summary["undefined_points"], summary["undefined_outside_region"]) == (inside, 1 - inside)
         assert summary["filled_by"] == ("harmonic" if inside else None)
+
+
+def test_a_lines_outlier_caveat_names_what_a_line_has(tmp_path):
+    """A profile's dropout written as -999999 was told to 'remove them (despike, region)': a line has
+    neither; it is removed from the file, or written NaN, which undefined: harmonic fills."""
+    x, z = np.arange(128) * 0.5, rough(1, 128, 19)[0]
+    z[40] = -999999.0
+    caveats = ProfileFile(path=str(xz_table(tmp_path / "sentinel.csv", x, z))).input_summary()["caveats"]
+    (said,) = [caveat for caveat in caveats if "rms height is" in caveat]
+    assert "despike" not in said and "region" not in said
+    assert "remove them from the file, or write NaN in their place, which undefined: harmonic fills" in said
+    filled = ProfileFile(path=str(xz_table(tmp_path / "nan.csv", x, np.where(z < -1e5, np.nan, z))), undefined="harmonic")
+    assert not any("rms height is" in caveat for caveat in filled.input_summary().get("caveats", ()))
