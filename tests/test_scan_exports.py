@@ -1,12 +1,14 @@
 """Instrument exports as users bring them, read as tables: a Gwyddion text export whose header
-states an oblong pixel, a profile scanned right to left, a line with points the instrument
-dropped (NaN)."""
+states an oblong pixel, a profile scanned right to left, points an instrument dropped (NaN, an
+empty cell, ***), a footer, a second channel, an x column printed too coarsely, a map of equal
+heights or of two points. Each was refused with a misleading message, or read without a word."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from frictionlab.io.inputs import describe_input
 from frictionlab_spectra import ProfileFile, SurfaceFile
 
 
@@ -32,8 +34,6 @@ def test_a_table_whose_header_states_an_oblong_pixel_is_not_squared_without_a_wo
     assert "its header's pixel of 1 x 0.5 um (x by y), which is not square" in caveat
     assert "give spacing_y too (0.5 keeps the file's shape), or read it with format: instrument" in caveat
     assert summary["file_spacing"] == pytest.approx([1.0, 0.5], rel=1e-9)
-    from frictionlab.io.inputs import describe_input
-
     assert "the file's pixels of 1 x 0.5 um replaced by the preset's spacing, square" in describe_input(summary)
     kept = SurfaceFile(path=str(path), format="table", spacing=1.0, spacing_y=0.5).input_summary()
     assert "replaced" not in describe_input(kept)
@@ -57,8 +57,6 @@ def test_a_profile_scanned_right_to_left_is_read_mirrored(tmp_path):
     assert backwards.generate(None).spacing == pytest.approx(0.5, rel=1e-12)
     np.testing.assert_allclose(backwards.generate(None).heights, forwards.generate(None).heights, rtol=0, atol=0)
     assert backwards.input_summary()["x_decreasing"] is True and "x_decreasing" not in forwards.input_summary()
-    from frictionlab.io.inputs import describe_input
-
     assert "x decreasing (a scan written right to left)" in describe_input(backwards.input_summary())
     still = xz_table(tmp_path / "still.csv", np.r_[x[:32], x[:32][::-1]], z)
     with pytest.raises(ValueError, match=r"still.csv.*x does not advance from its first row to its last \(x\[0\] = 0, "
