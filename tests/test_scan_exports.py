@@ -117,17 +117,21 @@ def test_a_tables_nan_is_filled_as_an_instrument_files_undefined_points(tmp_path
     assert any("were undefined and filled by harmonic interpolation" in c for c in summary["caveats"])  # 7.8 %
 
 
-def test_a_table_maps_nan_are_filled_as_surfacetopography_fills_them(tmp_path):
+@pytest.mark.parametrize("periodic", [False, True])
+def test_a_table_maps_nan_are_filled_as_surfacetopography_fills_them(tmp_path, periodic):
     """A map's NaN filled with undefined: harmonic: the solution of Laplace's equation over the holes,
-    the same heights as SurfaceTopography's harmonic filling of an instrument file's undefined points."""
+    the same heights as SurfaceTopography's harmonic filling of an instrument file's undefined points
+    (a periodic map's holes at an edge filled from the opposite edge too)."""
     from scipy.ndimage import gaussian_filter
     from SurfaceTopography import Topography
 
-    z = gaussian_filter(rough(20, 30, 15), 2)
+    z = gaussian_filter(rough(20, 30, 15), 2, mode="wrap")
     z[3:6, 4:9], z[0, 0], z[19, 10:14], z[10, 29] = np.nan, np.nan, np.nan, np.nan
     (tmp_path / "map.csv").write_text("".join(",".join(map(repr, row.tolist())) + "\n" for row in z))
-    read = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=1.0, undefined="harmonic", detrend="none")
-    expected = Topography(np.ma.masked_invalid(z.T), (30.0, 20.0)).interpolate_undefined_data("harmonic").heights().T
+    read = SurfaceFile(path=str(tmp_path / "map.csv"), spacing=1.0, undefined="harmonic", detrend="none",
+                       periodic=periodic)  # fmt: skip
+    expected = Topography(np.ma.masked_invalid(z.T), (30.0, 20.0), periodic=periodic).interpolate_undefined_data(
+        "harmonic").heights().T  # fmt: skip
     np.testing.assert_allclose(read.generate(None).heights, expected, rtol=0, atol=1e-12)
     assert read.input_summary()["undefined_points"] == 21
     np.save(tmp_path / "none.npy", np.full((10, 10), np.nan))

@@ -369,7 +369,7 @@ def fill_table(where: str, z: np.ndarray, p) -> dict:
             return {}
     if missing == z.size:  # nothing to fill from
         raise ValueError(f"{where}: all {missing} heights are NaN (not measured): nothing to press")
-    fill_harmonic(z)
+    fill_harmonic(z, bool(p.periodic))
     caveat = filled_caveat(missing, z.size, p, z.ndim)
     return {"undefined_points": missing, "filled_by": p.undefined, **({"caveats": [caveat]} if caveat else {})}
 
