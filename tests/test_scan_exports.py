@@ -284,3 +284,17 @@ def test_a_lines_outlier_caveat_names_what_a_line_has(tmp_path):
     assert "remove them from the file, or write NaN in their place, which undefined: harmonic fills" in said
     filled = ProfileFile(path=str(xz_table(tmp_path / "nan.csv", x, np.where(z < -1e5, np.nan, z))), undefined="harmonic")
     assert not any("rms height is" in caveat for caveat in filled.input_summary().get("caveats", ()))
+
+
+@pytest.mark.parametrize("plugin", [ProfileFile, SurfaceFile])
+def test_a_header_of_several_lines_is_told_to_be_commented_out(tmp_path, plugin):
+    """An export's header of settings (Instrument, Date, then the labels) was 'non-numeric content at
+    line 2: column 1 is not a number', as a bad cell is; a table has one header line at most."""
+    z = rough(16, 16, 20) if plugin is SurfaceFile else rough(1, 64, 20)[0][:, None]
+    rows = "".join(",".join(map(repr, row.tolist())) + "\n" for row in z)
+    (tmp_path / "export.csv").write_text("Instrument,VK-X\nDate,2024/01/01\nz\n" + rows)
+    with pytest.raises(ValueError, match=r"line 2 .*: a second line of text before the numbers; a table has one header "
+                                         "line at most: start the others with #, or read an instrument's export"):
+        plugin(path=str(tmp_path / "export.csv"), spacing=0.1).rms_height()
+    (tmp_path / "export.csv").write_text("# Instrument,VK-X\n# Date,2024/01/01\nz\n" + rows)
+    assert plugin(path=str(tmp_path / "export.csv"), spacing=0.1).rms_height() > 0

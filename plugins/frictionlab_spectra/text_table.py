@@ -157,14 +157,19 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
-            footer = columns is not None and not is_number(text.split(delimiter)[0]) and _footer(lines, delimiter)
+            words = not is_number(text.split(delimiter)[0]) and not _mostly_numbers(text, delimiter)  # no row of data
+            footer = columns is not None and words and _footer(lines, delimiter)
             return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
-                    + (footer or _bad_cell(text, delimiter)))
+                    + (footer or (_MORE_HEADER if columns is None and words else _bad_cell(text, delimiter))))
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
         columns = count
     return "not a table of numbers"
+
+
+_MORE_HEADER = (": a second line of text before the numbers; a table has one header line at most: start the others "
+                "with #, or read an instrument's export (its header of settings and units) with format: instrument")
 
 
 def _footer(rest, delimiter: str | None) -> str:
