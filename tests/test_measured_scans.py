@@ -211,7 +211,7 @@ def test_a_square_spacing_over_a_file_of_oblong_pixels_is_said(tmp_path):
     z = rough(32, 48, 5) * 1e-8
     write_gwy(tmp_path / "oblong.gwy", z, 1e-7, 2e-7)
     caveats = SurfaceFile(path=str(tmp_path / "oblong.gwy"), unit="um", spacing=0.1).input_summary()["caveats"]
-    assert any("replaces the file's pixel of 0.1 x 0.2 (x by y), which is not square" in c and "spacing_y too (0.2 "
+    assert any("replaces the file's pixel of 0.1 x 0.2 um (x by y), which is not square" in c and "spacing_y too (0.2 "
                in c for c in caveats)  # fmt: skip
     for kept in ({}, {"spacing": 0.1, "spacing_y": 0.2}):  # the file's pixel, or both sides given: nothing to say
         summary = SurfaceFile(path=str(tmp_path / "oblong.gwy"), unit="um", **kept).input_summary()

@@ -892,21 +892,20 @@ def test_a_header_declaring_a_side_of_fewer_than_one_point_is_damage(tmp_path, x
 
 
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
-def test_a_table_with_nan_under_undefined_harmonic_is_told_the_filling_is_an_instrument_files(tmp_path, plugin):
-    """undefined: harmonic fills what an instrument file leaves undefined; a table's NaN was refused
-    with the very words said without it, as if the preset had not asked to fill them."""
+def test_a_tables_nan_is_filled_under_undefined_harmonic(tmp_path, plugin):
+    """undefined: harmonic filled only what an instrument file leaves undefined; a table's NaN was
+    refused with the very words said without it, as if the preset had not asked to fill them."""
     z = rough(12, 10, 20) if plugin is SurfaceFile else rough(1, 40, 20)[0]
     z.flat[5] = np.nan
     np.save(tmp_path / "heights.npy", z)
-    with pytest.raises(ValueError) as asked:
-        plugin(path=str(tmp_path / "heights.npy"), spacing=0.1, undefined="harmonic").rms_height()
-    assert "1 value(s) in heights not finite" in str(asked.value)
-    assert "undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN" in str(asked.value)
+    asked = plugin(path=str(tmp_path / "heights.npy"), spacing=0.1, undefined="harmonic", detrend="none")
+    assert np.isfinite(asked.generate(None).heights).all()
+    assert asked.input_summary()["undefined_points"] == 1 and asked.input_summary()["filled_by"] == "harmonic"
     with pytest.raises(ValueError) as not_asked:
         plugin(path=str(tmp_path / "heights.npy"), spacing=0.1).rms_height()
-    assert "harmonic" not in str(not_asked.value)
-    assert "fill them before saving the table" in str(not_asked.value)  # was: the count, and nothing to do
-    assert (", leave them out with region" in str(not_asked.value)) == (plugin is SurfaceFile)
+    assert "1 value(s) in heights not finite" in str(not_asked.value)
+    assert "set undefined: harmonic to fill NaN (points not measured)" in str(not_asked.value)
+    assert ("or leave them out with region" in str(not_asked.value)) == (plugin is SurfaceFile)
 
 
 # ------------------------------------------------------------ a table too large to read

@@ -692,11 +692,11 @@ def test_profile_file_errors(tmp_path):
     bad = _bumpy(16).astype(str)
     bad[3], bad[7], bad[9] = "nan", "inf", "NaN"
     message = _profile_error(path=_write(tmp_path, "nan.csv", "\n".join(bad)), spacing=1.0)
-    assert "3 value(s) in heights not finite" in message and "index 3" in message
+    assert "3 value(s) in heights not finite" in message and "line 4, column 1 of the file" in message
     huge = _bumpy(16).astype(str)
     huge[2], huge[5] = "1e308", "-1e200"  # finite, but their squares are not: refused before any arithmetic
     message = _profile_error(path=_write(tmp_path, "huge.csv", "\n".join(huge)), spacing=1.0)
-    assert "2 value(s) in heights not finite (NaN or inf) or beyond 1e+100 in magnitude, the first at index 2" in message
+    assert "2 value(s) in heights not finite (NaN or inf) or beyond 1e+100 in magnitude, the first at line 3, column 1 of the file" in message
 
     x = np.arange(16.0)
     x[5] += 0.3

@@ -238,6 +238,9 @@ def describe_input(summary: dict) -> str:
         unit_note = f", unit {unit} from the file's header"
     channel = summary.get("channel")
     notes = [f"channel {summary.get('channel_index', '?')} {short_repr(shown(channel))}"] if channel is not None else []
+    if summary.get("x_decreasing"):
+        notes.append("x decreasing (a scan written right to left): the line read as written, mirrored, which changes "
+                     "no statistic and no contact")
     if summary.get("region_pixels"):
         (x0, x1), (y0, y1) = summary["region_pixels"]
         notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")

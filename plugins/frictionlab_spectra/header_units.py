@@ -101,6 +101,26 @@ def named_units(text: str) -> tuple[list[str], bool]:
     return units, stated_by_key
 
 
+_EXTENT = re.compile(rf"\b(?i:(?P<key>width|height))\s*[:=]\s*(?P<value>{_NUMBER})\s*(?P<unit>{_UNITS})\s*$")
+
+
+def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float] | None:
+    """The pixel (dx, dy) in metres of a map of ``shape`` (Ny, Nx) whose header states the scan's
+    width and height (Gwyddion's text export: ``# Width: 32.000 µm``, ``# Height: 8.000 µm``), or
+    None unless it states both in length units: a table's reader takes its pixel from the preset."""
+    from .instrument_file import LENGTH_UNITS, open_input  # here: it imports this module
+
+    with open_input(path, where) as fh:
+        head = head_text(fh, "utf-8-sig")
+    extent = {}
+    for line in header_lines(head):
+        if (found := _EXTENT.search(line.rstrip())) and length_unit(found["unit"]) in LENGTH_UNITS:
+            extent.setdefault(found["key"].lower(), float(found["value"]) * LENGTH_UNITS[length_unit(found["unit"])])
+    if len(extent) < 2 or not all(side > 0 for side in extent.values()):
+        return None
+    return extent["width"] / shape[1], extent["height"] / shape[0]
+
+
 def not_length_label(text: str) -> tuple[str, str] | None:
     """The column label of the header of ``text`` whose unit is no length (``z [V]``,
     ``height (nA)``, ``phase/deg``: on its last line, over the numbers, not in metadata such as
@@ -160,6 +180,10 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> str |
 
     with open_input(path, where) as fh:
         head = head_text(fh, "utf-8-sig")
+    if (undecoded := next((i for i, line in enumerate(header_lines(head), 1) if "\ufffd" in line), None)) is not None:
+        from .text_table import not_utf8  # here: it reads files through instrument_file, which imports this module
+
+        raise ValueError(not_utf8(where, undecoded))  # a Latin-1 'z [µm]' was 'no unit frictionlab knows'
     check_heights_are_lengths(head, where)
     if (unknown := unknown_unit_label(head)) is not None:  # read bare, in the preset's unit, without a word
         from .instrument_file import LENGTH_UNITS  # here: it imports this module

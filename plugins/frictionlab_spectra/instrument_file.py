@@ -64,6 +64,7 @@ class Scan:
     undefined: int  # points the file leaves undefined (filled when the preset says how)
     pixel_stated: bool = True  # false: the file states no size, ``pixel`` is 1 per point and the preset's spacing is used
     undefined_mask: np.ndarray | None = None  # a map's undefined points, (Ny, Nx): which a crop leaves out
+    x_decreasing: bool = False  # a line's x column runs backwards (scanned right to left): read mirrored
 
 
 def is_instrument_file(path: Path, format: str = "auto") -> bool:
@@ -221,8 +222,10 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             raise ValueError(f"{where}: a line scan whose {heights.size} points are not evenly spaced along x; heights "
                              "are pressed on a uniform grid: export the scan on one (as most instruments do), or "
                              "interpolate it onto one")  # fmt: skip
+        backwards = False
         if topography.dim == 1 and parses_text(type(reader), fh) and (x := _text_x(fh, heights.size)) is not None:
             uniform_spacing(where, x)  # the reader takes x as even within 1e-6 in the file's unit: any x, in metres
+            backwards = bool(x[-1] < x[0])  # its reader's pixel is then negative; the heights are in the file's order
         along = _line_axis(topography, dimension)
         if topography.dim != dimension and along is None:
             raise ValueError(_other_kind(where, topography.dim, xy_order(reader, topography.nb_grid_pts)))
@@ -240,7 +243,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             else:
                 topography = topography.interpolate_undefined_data(method=undefined)
                 heights = topography.heights()
-        pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64))
+        pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64)) * (-1.0 if backwards else 1.0)
         if along is not None:  # a line stored as a map one pixel wide: its heights along its long side
             heights, pixel = heights.reshape(-1), pixel[along : along + 1]
         pixel = np.asarray(xy_order(reader, pixel))
@@ -273,6 +276,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         undefined=missing,
         pixel_stated=stated,
         undefined_mask=mask,
+        x_decreasing=backwards,
     )
 
 
@@ -318,6 +322,7 @@ def scan_summary(scan: Scan, p) -> dict:
         "unit": scan.unit, "unit_from": "preset" if p.unit is not None else "file" if scan.file_unit else "header" if scan.unit else "none",
         "undefined_points": scan.undefined, "filled_by": p.undefined if scan.undefined else None,
         "periodic_from": "file" if p.periodic is None else "preset",
+        **({"x_decreasing": True} if scan.x_decreasing else {}),
         **({"caveats": [caveat]} if (caveat := filled_caveat(scan.undefined, scan.heights.size, p, scan.heights.ndim)) else {}),
     }  # fmt: skip
 
@@ -359,19 +364,40 @@ def scan_not_periodic_advice(name: str) -> tuple[str, str]:
 
 
 def uniform_spacing(where: str, x: np.ndarray) -> float:
-    """The step of ``x`` (a table's x column, a text export's), which must increase evenly (within
-    X_TOLERANCE of a step); else a ValueError naming how far it is from even."""
+    """The step of ``x`` (a table's x column, a text export's), which must increase or decrease
+    evenly (within X_TOLERANCE of a step), as its size; else a ValueError naming how far it is
+    from even. A line scanned right to left (x decreasing) is read as written: mirrored, which
+    changes none of its statistics, nor its contact."""
     n = x.size
     dx = (x[-1] - x[0]) / (n - 1)
-    if not dx > 0:
-        raise ValueError(f"{where}: x must increase (x[0] = {float(x[0]):g}, x[-1] = {float(x[-1]):g})")
+    if not abs(dx) > 0:
+        raise ValueError(f"{where}: x does not advance from its first row to its last (x[0] = {float(x[0]):g}, "
+                         f"x[{n - 1}] = {float(x[-1]):g}); the x column must increase or decrease by one step a row")
     deviation = float(np.max(np.abs(x - (x[0] + dx * np.arange(n)))))
+    dx = abs(dx)
     if deviation > X_TOLERANCE * dx:
-        raise ValueError(
-            f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
-            f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})"
-        )
+        said = (f"{where}: x is not uniformly spaced: max deviation from a uniform grid of spacing {float(dx)!r} "
+                f"is {deviation!r} ({deviation / dx:.3g} spacings; tolerance {X_TOLERANCE:g})")
+        raise ValueError(said + _x_advice(x))
     return float(dx)
+
+
+def _x_advice(x: np.ndarray) -> str:
+    """What to do of an x column off a uniform grid: export it with more digits, where it is one
+    printed too coarsely for its step (a profilometer's x in mm to 3 decimals, its step 0.0025 mm:
+    its rounding alone moves points 0.4 steps); else export the scan on a uniform grid."""
+    step, offset = np.polyfit(np.arange(x.size, dtype=np.float64), x, 1)
+    rest = float(np.max(np.abs(x - offset - step * np.arange(x.size))))
+    for decimals in range(13):  # the fewest decimals that write every x: the resolution it was printed to
+        scaled = x * 10.0**decimals
+        if np.all(np.abs(scaled - np.round(scaled)) <= 1e-9 * np.maximum(1.0, np.abs(scaled))):  # float64's error
+            printed = 10.0**-decimals
+            if rest <= printed:  # the print's rounding, not the scan, puts it off the grid
+                return (f"; x is written to {decimals} decimals ({printed:g}), too coarse for its step of about "
+                        f"{abs(step):.4g}: export x with more digits, or the heights alone (one column) with spacing "
+                        "(the scan's step)")
+            break
+    return ": export the scan on a uniform grid (as most instruments do), or interpolate it onto one"
 
 
 def _text_x(fh, points: int) -> np.ndarray | None:

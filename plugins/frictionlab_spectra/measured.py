@@ -46,8 +46,8 @@ class MeasuredParams(PluginParams):
     )
     undefined: Undefined = Field(
         "refuse",
-        description="what to do with points an instrument file leaves undefined: refuse the file, or fill them "
-        "from their neighbours (harmonic: the solution of Laplace's equation)",
+        description="what to do with points a file leaves undefined (an instrument file's, a table's NaN): refuse "
+        "the file, or fill them from their neighbours (harmonic: the solution of Laplace's equation)",
     )
     detrend: str | None = Field(None, description="levelling")
     channel: str | Annotated[int, Field(ge=0)] | None = Field(

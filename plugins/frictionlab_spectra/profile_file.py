@@ -35,12 +35,14 @@ from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .instrument_file import (
-    ScanHeader, check_spacing, is_instrument_file, open_input, read_scan, scan_header, scan_summary, uniform_spacing,
+    ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
+    uniform_spacing,
 )
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .reader_failures import reason_said
-from .text_table import read_text_table
+from .text_table import first_not_finite, read_text_table
+from .scan_shaping.filling import fill_harmonic
 from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
 from .scan_shaping.levelling import level_line, line_form_warning
 from .scan_shaping.spikes import line_spike_warning
@@ -117,18 +119,21 @@ class ProfileFile(MeasuredFile):
                 "format": path.suffix.lower(), "spacing_from": "file" if x is not None else "preset",
                 **table_unit(path, where, p, file_suffix(path, where) != ".npy"),
                 "periodic_from": "preset" if p.periodic is not None else "default",
+                **({"x_decreasing": True} if x is not None and x[-1] < x[0] else {}),  # read mirrored: uniform_spacing
             }  # fmt: skip
+            summary.update(fill_table(where, z, p))
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
-        check_finite(where, "heights", z, table_fill_advice(p, instrument))
+        text = None if instrument or file_suffix(path, where) == ".npy" else path
+        check_finite(where, "heights", z, table_fill_advice(p, instrument), text, None if x is None else 2)
         check_heights_not_underflowing(where, z)
         if x is None:
             if p.spacing is None and not instrument:
                 raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
             dx = scan.pixel[0] if p.spacing is None else p.spacing
         else:
-            check_finite(where, "x", x)
+            check_finite(where, "x", x, table=text, column=1)
             dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), summary["unit"])
             if p.spacing is not None:
                 if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
@@ -195,10 +200,15 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
         return None, data[0].copy()
     if data.shape[1] == 2:
         return data[:, 0].copy(), data[:, 1].copy()
-    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights{MAP_ADVICE}")
+    raise ValueError(f"{where}: {data.shape[1]} columns; expected 1 (z), 2 (x, z) or a single row of heights"
+                     + (CHANNELS_ADVICE if data.shape[1] <= MAX_POINT_COLUMNS < data.shape[0] else MAP_ADVICE))
 
 
 MAP_ADVICE = "; a height map (rows of heights, each a line across it) is read by surface-file"
+MAX_POINT_COLUMNS = 4  # a point's x, z (or x, y, z) and another channel, as instruments export them
+CHANNELS_ADVICE = ("; a few columns over many rows are a channel per column (x, z and an intensity, a second height): "
+                   "export x and the heights alone (x, y and z per point, a map's, are read by surface-file with "
+                   "format: instrument)")  # fmt: skip
 
 
 def file_suffix(path: Path, where: str) -> str:
@@ -336,25 +346,46 @@ def _claimed_array(fh) -> str:
 
 
 def table_fill_advice(p, instrument: bool) -> str:
-    """What ``check_finite`` adds of a table's NaN: what to do (a table cannot mark points as
-    not measured), and, when the preset asks to fill undefined points, why it did not."""
+    """What ``check_finite`` adds of a table's values that are not finite: what to do (its NaN are
+    filled with ``undefined: harmonic``: ``fill_table``), and, when the preset asks to fill
+    undefined points, why these were not."""
     if instrument:
         return ""
-    crop = ", leave them out with region" if "region" in type(p).model_fields else ""
+    fix = "fix them before saving the table" + (", or leave them out with region" if "region" in type(p).model_fields
+                                                else "")  # fmt: skip
     if p.undefined != "harmonic":
-        return f"; fill them before saving the table{crop}, or read the instrument's own file"
-    return ("; undefined: harmonic fills the points an instrument file leaves undefined, not a table's NaN or inf: "
-            f"fill them before saving the table{crop}, or read the instrument's own file")  # fmt: skip
+        return f"; set undefined: harmonic to fill NaN (points not measured) from their neighbours, or {fix}"
+    return (f"; undefined: harmonic fills a table's NaN (points not measured), not an inf or a number beyond "
+            f"{MAX_MAGNITUDE:g}: write NaN there, or {fix}")
 
 
-def check_finite(where: str, what: str, values: np.ndarray, advice: str = "") -> None:
+def fill_table(where: str, z: np.ndarray, p) -> dict:
+    """Fill a table's NaN (points not measured) in place when the preset says ``undefined:
+    harmonic``, as an instrument file's undefined points are; what its summary says of them."""
+    if p.undefined != "harmonic" or not (missing := int(np.count_nonzero(np.isnan(z)))):
+        return {}
+    with np.errstate(invalid="ignore"):
+        if np.any(np.abs(z) > MAX_MAGNITUDE):  # inf too: refused with the NaN by check_finite, nothing filled from it
+            return {}
+    if missing == z.size:  # nothing to fill from
+        raise ValueError(f"{where}: all {missing} heights are NaN (not measured): nothing to press")
+    fill_harmonic(z, bool(p.periodic))
+    caveat = filled_caveat(missing, z.size, p, z.ndim)
+    return {"undefined_points": missing, "filled_by": p.undefined, **({"caveats": [caveat]} if caveat else {})}
+
+
+def check_finite(where: str, what: str, values: np.ndarray, advice: str = "", table: Path | None = None,
+                 column: int | None = None) -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
-    magnitude (1e100: squares and sums of them must stay finite), locating the first; ``advice`` after."""
+    magnitude (1e100: squares and sums of them must stay finite), locating the first (by its line
+    and column in the text file ``table`` the values are its ``column`` of, if given); ``advice`` after."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
         first = np.unravel_index(int(np.argmax(bad)), bad.shape)
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
+        if table is not None and (cell := first_not_finite(table, where, column)) is not None:
+            at = f"line {cell[0]}, column {cell[1]} of the file"
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "
             f"in magnitude, the first at {at}{advice}"

@@ -51,8 +51,10 @@ from pydantic import Field, model_validator
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
+from .header_units import stated_pixel
 from .instrument_file import (
-    MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary, undefined_message,
+    LENGTH_UNITS, MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary,
+    undefined_message,
 )
 from .instrument_reader import HEIGHT_COPIES
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
@@ -60,7 +62,8 @@ from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
 from .profile_file import (
-    check_finite, check_heights_not_underflowing, file_suffix, load_npy, npy_shape, table_fill_advice,
+    MIN_POINTS, check_finite, check_heights_not_underflowing, file_suffix, fill_table, load_npy, npy_shape,
+    table_fill_advice,
 )
 from .text_table import axes_warning, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
@@ -71,6 +74,7 @@ MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at 
 # reflected across its edges), and per mode of a block given to the line, its temporaries (58).
 LINE_BYTES_PER_POINT = {True: 48, False: 96}  # by periodic()
 LINE_BYTES_PER_MODE = 80
+SQUARE_PIXEL = 1e-3  # relative: a pixel whose sides differ by less is square (a header prints its sizes rounded)
 
 
 @dataclass(frozen=True)
@@ -246,7 +250,7 @@ class SurfaceFile(MeasuredFile):
         path = Path(p.path)
         where = f"surface-file {str(path)!r}"
         z, pixel, summary = _read_map(path, where, p)
-        _check_defined(z, pixel, p, where, instrument=is_instrument_file(path, p.format))
+        _check_defined(z, pixel, p, path, where)
         check_heights_not_underflowing(where, z)
         heights, spacing, shaped = shape_map(z, pixel, p, where, instrument=is_instrument_file(path, p.format),
                                              periodic=summary["periodic"])
@@ -274,38 +278,63 @@ class SurfaceFile(MeasuredFile):
         return Measured(heights, spacing, rms, summary["periodic"], summary)
 
 
-def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, where: str, *,
-                   instrument: bool) -> None:
+def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, path: Path, where: str) -> None:
     """Refuse undefined points (an instrument's NaN) or NaN/inf inside the part of the map pressed:
-    a crop (``region``) that leaves them out is read."""
+    a crop (``region``) that leaves them out is read. A text table's first is named by its line."""
+    instrument = is_instrument_file(path, p.format)
     inside = crop(z, pixel, p.region, where)[0] if p.region is not None else z
     if instrument and (missing := int(np.count_nonzero(np.isnan(inside)))):
         raise ValueError(undefined_message(where, missing, inside.size, " of the region"))
+    text = not instrument and file_suffix(path, where) != ".npy"
     check_finite(where, "heights" if p.region is None else "the region's heights (rows, columns from its corner)", inside,
-                 table_fill_advice(p, instrument))
+                 table_fill_advice(p, instrument), path if text and p.region is None else None)
 
 
-def _undefined_in_region(scan, pixel: tuple[float, float], p: SurfaceFile.Params, where: str) -> dict[str, Any]:
-    """What the summary says of a scan's undefined points once cropped: those inside ``region``
-    (filled, or refused by ``_check_defined``) and those it leaves out."""
-    region_mask = crop(scan.undefined_mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
+def _undefined_in_region(mask: np.ndarray, undefined: int, pixel: tuple[float, float], p: SurfaceFile.Params,
+                         where: str) -> dict[str, Any]:
+    """What the summary says of a map's ``undefined`` points (``mask``) once cropped: those inside
+    ``region`` (filled, or refused by ``_check_defined``) and those it leaves out."""
+    region_mask = crop(mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
     inside, size = int(np.count_nonzero(region_mask)), region_mask.size
     caveat = filled_caveat(inside, size, p, 2, "the region's")
-    return {"undefined_points": inside, "undefined_outside_region": scan.undefined - inside,
+    return {"undefined_points": inside, "undefined_outside_region": undefined - inside,
             "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
             "caveats": [caveat] if caveat else []}  # fmt: skip
 
 
-def _square_over_oblong(scan, p: SurfaceFile.Params) -> str | None:
-    """The caveat of ``spacing`` alone replacing a file's pixel that is not square: the preset's
-    square pixel stretches the map along one axis against the other, its slopes with it."""
-    dx, dy = scan.pixel
-    if p.spacing is None or p.spacing_y is not None or not scan.pixel_stated or math.isclose(dx, dy, rel_tol=1e-6):
+def _square_over_oblong(pixel: tuple[float, float] | None, p: SurfaceFile.Params, unit: str | None,
+                        whose: str = "the file's", use: str = "leave spacing out") -> str | None:
+    """The caveat of ``spacing`` alone replacing a file's ``pixel`` (dx, dy in ``unit``; None where
+    it states none) that is not square: the preset's square pixel stretches the map along one axis
+    against the other, its slopes with it. Square within SQUARE_PIXEL: a header's sizes are rounded."""
+    if pixel is None or p.spacing is None or p.spacing_y is not None or math.isclose(*pixel, rel_tol=SQUARE_PIXEL):
         return None
-    return (f"spacing {p.spacing:g} replaces the file's pixel of {dx:.6g} x {dy:.6g} (x by y), which is not square, by "
-            f"a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
+    (dx, dy), said = pixel, f" {unit}" if unit else ""
+    return (f"spacing {p.spacing:g} replaces {whose} pixel of {dx:.6g} x {dy:.6g}{said} (x by y), which is not square, "
+            f"by a square one: against its x side, the map's y side becomes {dx / dy:.4g} times what the file says (its "
             f"slopes along y {dy / dx:.4g} times as steep); give spacing_y too ({p.spacing * dy / dx:.6g} keeps the "
-            "file's shape), or leave spacing out to use the file's pixel")  # fmt: skip
+            f"file's shape), or {use} to use the file's pixel")  # fmt: skip
+
+
+def _table_checks(path: Path, where: str, data: np.ndarray, p: SurfaceFile.Params, unit: dict) -> dict[str, Any]:
+    """What the summary says of a table map (of at least MIN_SIDE points each way): the pixel its
+    header states (Gwyddion's text export, read with format: table), in the run's ``unit``
+    (``table_unit``), which ``validate`` names where the preset's differs; and the caveats of an
+    export's axes read as heights, and of a square ``spacing`` over the header's oblong pixel."""
+    said = unit["unit"] if unit["unit"] in LENGTH_UNITS else None
+    text = file_suffix(path, where) != ".npy"
+    stated = _header_pixel(path, where, data.shape, said) if text and said else None
+    oblong = _square_over_oblong(stated, p, said, "its header's", "read it with format: instrument")
+    caveats = [caveat for caveat in (_axes_in_region(data, p.preset_pixel(), p, where), oblong) if caveat]
+    spacing = {} if stated is None else {"file_spacing": stated[0] if stated[0] == stated[1] else list(stated)}
+    return {**spacing, **({"caveats": caveats} if caveats else {})}
+
+
+def _header_pixel(path: Path, where: str, shape: tuple[int, int], unit: str) -> tuple[float, float] | None:
+    """The pixel (dx, dy) a table's header states (``stated_pixel``), in ``unit``."""
+    if (pixel := stated_pixel(path, where, shape)) is None:
+        return None
+    return pixel[0] / LENGTH_UNITS[unit], pixel[1] / LENGTH_UNITS[unit]
 
 
 def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
@@ -323,10 +352,10 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
                          spacing_given=p.spacing is not None)  # fmt: skip
         data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
-        if caveat := _square_over_oblong(scan, p):
+        if p.region is not None and scan.undefined:  # its caveat replaces the whole file's
+            summary.update(_undefined_in_region(scan.undefined_mask, scan.undefined, pixel, p, where))
+        if caveat := _square_over_oblong(scan.pixel if scan.pixel_stated else None, p, summary.get("unit")):
             summary["caveats"] = [*summary.get("caveats", ()), caveat]
-        if p.region is not None and scan.undefined:
-            summary.update(_undefined_in_region(scan, pixel, p, where))
         periodic = scan.periodic if p.periodic is None else p.periodic
     else:
         table = file_suffix(path, where) != ".npy"
@@ -346,11 +375,20 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             "format": path.suffix.lower(), "spacing_from": "preset", **unit,
             "periodic_from": "preset" if p.periodic is not None else "default",
         }  # fmt: skip
-        if data.ndim == 2 and min(data.shape) >= MIN_SIDE and (caveat := _axes_in_region(data, pixel, p, where)):
-            summary["caveats"] = [caveat]
+        if data.ndim == 2 and min(data.shape) >= MIN_SIDE:
+            holes = np.isnan(data) if p.region is not None and p.undefined == "harmonic" else None
+            checked, filled = _table_checks(path, where, data, p, unit), fill_table(where, data, p)
+            if filled and holes is not None:  # counted inside the region, as an instrument file's
+                filled = _undefined_in_region(holes, filled["undefined_points"], pixel, p, where)
+            caveats = [*checked.pop("caveats", ()), *filled.pop("caveats", ())]
+            summary.update(checked, **filled, **({"caveats": caveats} if caveats else {}))
         periodic = bool(p.periodic)
     if data.ndim == 2 and 1 in data.shape:
         ny, nx = data.shape
+        if nx * ny < MIN_POINTS:  # profile-file would refuse it too
+            heights = f"{nx * ny} height{'s' * (nx * ny > 1)}"
+            raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y): {heights}, too few for a map (at least "
+                             f"{MIN_SIDE} x {MIN_SIDE}) or a line (profile-file: at least {MIN_POINTS} points)")
         raise ValueError(f"{where}: a map of {nx} x {ny} pixels (x by y), one pixel wide: a line; use profile-file")
     if data.ndim != 2:
         raise ValueError(
@@ -361,7 +399,9 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         ny, nx = data.shape
         table = not is_instrument_file(path, p.format) and path.suffix.lower() != ".npy"
         points = {3: "; columns of x, y and z per point (an instrument's export) are read with format: instrument"
-                  if table else "", 2: "; columns of x and z (a line) are read by profile-file"}.get(nx, "")  # fmt: skip
+                  if table else "", 2: "; columns of x and z (a line) are read by profile-file",
+                  4: "; columns of x, y, z and another channel per point (an intensity): export x, y and the heights "
+                  "alone, read with format: instrument"}.get(nx if ny > nx else 0, "")  # fmt: skip
         raise ValueError(f"{where}: map of {nx} x {ny} pixels (x by y); at least {MIN_SIDE} x {MIN_SIDE} are needed{points}")
     summary = {"file": str(path), **summary, "file_shape": list(data.shape), "periodic": periodic,
                **({"spacing_given": list(pixel)} if p.spacing_y is not None else {})}  # fmt: skip

@@ -37,7 +37,7 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
         sample = fh.read(SAMPLE_BYTES)
         fh.seek(0)
         if (nul := sample.find(b"\x00")) >= 0:  # valid UTF-8, but no text's: UTF-16 without its mark, or binary
-            raise ValueError(_not_utf8(where, sample.count(b"\n", 0, nul) + 1))
+            raise ValueError(not_utf8(where, sample.count(b"\n", 0, nul) + 1))
         need = _numbers_in(sample, size) * 8 * copies
         room, source = room_to_read()
         if need > room:
@@ -49,12 +49,31 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
         except MemoryError:
             raise ValueError(_too_large_table(where, size, "reading it ran out of memory")) from None
         except UnicodeDecodeError:
-            raise ValueError(_not_utf8(where, _undecodable_line(fh))) from None
+            raise ValueError(not_utf8(where, _undecodable_line(fh))) from None
         finally:
             text.detach()  # the file is open_input's to close
 
 
-def _not_utf8(where: str, line: int) -> str:
+def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple[int, int] | None:
+    """The line and column (from 1, as an editor shows them) of the first number of a text table
+    (in its ``column``, if given) that is not finite or is beyond MAX_MAGNITUDE (a NaN a
+    profilometer writes for a point it did not measure), read a line at a time; None if there is
+    none (a header's cells are no numbers)."""
+    from frictionlab.plugin import MAX_MAGNITUDE  # here: only a table refused for such a number needs it
+
+    with open_input(path, where) as fh:
+        for lineno, raw in enumerate(io.TextIOWrapper(fh, encoding="utf-8-sig", errors="replace"), start=1):
+            text = raw.split("#", 1)[0].strip()
+            delimiter = _delimiter(text)
+            if not text or not _numbers(text, delimiter):
+                continue
+            for at, cell in enumerate(text.split(delimiter), start=1):
+                if column in (None, at) and not abs(float(cell)) <= MAX_MAGNITUDE:  # NaN too
+                    return lineno, at
+    return None
+
+
+def not_utf8(where: str, line: int) -> str:
     return (f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or UTF-16's NUL "
             "bytes, or no text); an instrument's export (a profilometer's .csv) is read with format: instrument; a "
             "table of bare numbers is read as UTF-8: save it so (a spreadsheet's 'CSV UTF-8')")
@@ -134,12 +153,14 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
         if lineno <= skip or not text:
             continue
         if not _numbers(text, delimiter):
-            if _ends_with_separator(text, delimiter):
+            if _ends_with_separator(text, delimiter) and len(text.split(delimiter)) != columns:  # else: an empty cell
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
+            words = not is_number(text.split(delimiter)[0]) and not _mostly_numbers(text, delimiter)  # no row of data
+            footer = columns is not None and words and _footer(lines, delimiter)
             return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
-                    + _bad_cell(text, delimiter))
+                    + (footer or (_MORE_HEADER if columns is None and words else _bad_cell(text, delimiter))))
         count = len(text.split(delimiter))
         if columns is not None and count != columns:
             return f"line {lineno} has {count} columns, the lines before it {columns}"
@@ -147,14 +168,31 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
     return "not a table of numbers"
 
 
+_MORE_HEADER = (": a second line of text before the numbers; a table has one header line at most: start the others "
+                "with #, or read an instrument's export (its header of settings and units) with format: instrument")
+
+
+def _footer(rest, delimiter: str | None) -> str:
+    """What a table's first line of text after its numbers is when no line of ``rest`` (the lines
+    after it) holds numbers: a footer, which an export writes after its data ('End of data')."""
+    if any(_numbers(text, delimiter) for line in rest if (text := line.split("#", 1)[0].strip())):
+        return ""
+    return (": text, and no line after it holds numbers: a footer after the table (an export's summary, 'End of "
+            "data'), which a table of numbers does not have; delete it, or start its lines with #")
+
+
 def _bad_cell(text: str, delimiter: str | None) -> str:
     """Which cell of a line is no number, by its column (never its content); an empty cell is a
     point an export left out, which NaN stands for (then refused, or cropped out, by name)."""
     cells = text.split(delimiter)
     column = next(i for i, cell in enumerate(cells, start=1) if not is_number(cell))
-    if cells[column - 1].strip():
+    if any(char.isdigit() for char in cells[column - 1]):
         return f": column {column} is not a number"
-    return f": column {column} is empty, a point the export left out; write NaN there to mark it missing"
+    if cells[column - 1].strip():  # ***, N/A, --: how exports mark a point not measured
+        return (f": column {column} is not a number, and holds no digit: if it marks a point not measured (as ***, N/A "
+                "or -- do), write NaN there, which undefined: harmonic fills")
+    return (f": column {column} is empty, a point the export left out; write NaN there to mark it missing, which "
+            "undefined: harmonic fills")
 
 
 def decimal_commas(lineno: int, what: str = "table") -> str:

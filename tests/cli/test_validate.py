@@ -80,7 +80,7 @@ def test_a_measured_profile_is_read_and_checked_by_validate_not_first_by_a_worke
     preset = write_preset(tmp_path, data)
     assert main(["validate", str(preset)]) == ExitCode.USAGE
     err = capsys.readouterr().err
-    assert "spectrum.params: profile-file" in err and "1 value(s) in heights not finite" in err and "index 1" in err
+    assert "spectrum.params: profile-file" in err and "1 value(s) in heights not finite" in err and "line 2, column 1 of the file" in err
     (tmp_path / "scan.csv").write_text("\n".join(str(0.01 * (i % 7)) for i in range(64)))
     assert main(["validate", str(preset)]) == ExitCode.OK
 

@@ -41,11 +41,12 @@ def outlier_warning(z: np.ndarray, what: str) -> str | None:
         return None
     ratio = f"{rms / robust:.3g} times" if robust > 0 else f"more than {OUTLIER_RATIO:g} times"
     zero = "" if robust > 0 else "; here zero: more than half of them have one height"
+    fix = "remove them (despike, region), or mark them undefined in the file (a table's NaN)" if what == "map" else \
+        "remove them from the file, or write NaN in their place"  # a line has no despike, nor region
     return (f"the {what}'s rms height is {ratio} what most of its points say ({MAD_TO_SIGMA} times their median "
             f"distance from the median, the rms height of Gaussian heights{zero}): a few points far from the rest make the "
-            "rms height h, and with it f's unit E* h L, theirs. A value written for a missing pixel, spikes or "
-            "scratches: remove them (despike, region) or mark them undefined in the file, if they are not the "
-            "surface's own")  # fmt: skip
+            f"rms height h, and with it f's unit E* h L, theirs. A value written for a missing pixel, spikes or "
+            f"scratches: {fix}, which undefined: harmonic fills, if they are not the surface's own")  # fmt: skip
 
 FLAT_SHARE = 0.25  # of neighbouring pixels at exactly one height: from here on, the slopes are the steps'
 
@@ -66,7 +67,9 @@ def flat_neighbours_warning(z: np.ndarray, rms: float, what: str) -> str | None:
     if not pairs or equal <= FLAT_SHARE * pairs:
         return _clipped_warning(z, what)
     steps = np.abs(np.diff(z.ravel()))  # along the rows, and from a row's end to the next's start
-    step = float(steps[steps > 0].min())  # some: the map is not flat (rms > 0)
+    if not (steps > 0).any():  # all equal, their rms not 0 but rounding's (0.001 less their mean): refused as flat
+        return None
+    step = float(steps[steps > 0].min())
     points = "pixels" if what == "map" else "points"
     return (f"{100 * equal / pairs:.0f} % of the {what}'s neighbouring {points} have exactly the same height: its heights "
             f"are steps (the smallest {step:.3g}, {step / rms:.2g} rms heights) coarser than the roughness between "
