@@ -85,7 +85,7 @@ def test_available_memory_is_psutils_or_less_under_a_cgroup_limit():
 def test_the_user_presets_folder_is_the_platforms_config_folder(monkeypatch):
     from platformdirs import user_config_path
 
-    from frictionlab.tui.folders import user_presets_dir
+    from frictionlab.preset.builtin import user_presets_dir
 
     assert user_presets_dir(env={}) == user_config_path("frictionlab") / "presets"
     assert user_presets_dir(env={"XDG_CONFIG_HOME": "/x"}) == __import__("pathlib").Path("/x/frictionlab/presets")

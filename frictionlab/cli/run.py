@@ -66,13 +66,16 @@ def run(args) -> ExitCode:
 
 def _run(args, drawer) -> ExitCode:
     from ..preset import build_scene, read_preset
-    from ..preset.builtin import preset_source, resolve_preset_path
+    from ..preset.builtin import preset_source, resolve_preset_path, same_name_note
     from ..runs.rundir import new_run_folder
     from ..runs.runner import memory_check_before_reading
 
     overrides = preset_overrides(args)
     source = args.source = preset_source(args.preset, args.set or [])  # what messages name, a sweep's too
-    args.preset = str(resolve_preset_path(args.preset))  # a path, or a built-in's name
+    resolved = resolve_preset_path(args.preset)  # a path, or a built-in's name
+    if note := same_name_note(args.preset, resolved):
+        print(shown(note), file=sys.stderr)
+    args.preset = str(resolved)
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
     refuse_swept_overrides(args, data)
     options = executor_run_options(args, resume=args.resume, force=args.force)

@@ -60,8 +60,7 @@ def find_preset(argument: str, presets_dir: str | None) -> Path:
     in its order (DIR; else ``./presets``, then the user folder): ``NAME.yaml``, ``NAME.yml``, or
     the file named; else, and then, as ``frictionlab run`` reads it (a path as given, or a
     built-in's name). Found nowhere: a PresetFileError naming the value and each place looked in."""
-    from ..preset.builtin import builtin_presets, resolve_preset_path
-    from ..tui import listed_preset_folders  # no Textual there
+    from ..preset.builtin import builtin_presets, listed_preset_folders, resolve_preset_path
 
     if len(Path(argument).parts) != 1 or (presets_dir is None and os.path.lexists(argument)):
         return resolve_preset_path(argument)  # a path, or a file here: the one meant

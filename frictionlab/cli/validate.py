@@ -26,7 +26,7 @@ def run(args) -> ExitCode:
     from ..io.inputs import input_lines
     from ..preset.loads import loads_lines
     from ..preset import build_scene, read_preset
-    from ..preset.builtin import preset_source, resolve_preset_path
+    from ..preset.builtin import preset_source, resolve_preset_path, same_name_note
     from ..runs.runner import check_one_realization
     from ..runs.sweep import plan_sweep
 
@@ -35,7 +35,10 @@ def run(args) -> ExitCode:
     for path in args.presets:
         points = None
         try:
-            data = read_preset(resolve_preset_path(path), args.set or [])
+            resolved = resolve_preset_path(path)
+            if (note := same_name_note(path, resolved)) and not args.json:
+                print(shown(note), file=sys.stderr)
+            data = read_preset(resolved, args.set or [])
             refuse_swept_overrides(args, data)
             source = preset_source(path, args.set or [])
             scene = build_scene(data, source=source, before_reading=check_one_realization)

@@ -9,12 +9,13 @@ A preset argument that is not a path to a file but a built-in's name
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
-from ..errors import PresetFileError, command_word, did_you_mean, short_repr, shown_name
+from ..errors import FrictionlabError, PresetFileError, command_word, did_you_mean, short_repr, shown_name
 
 _LONGEST = 100  # characters of a one-line description
 _PACKAGE = Path(__file__).resolve().parent.parent
@@ -43,6 +44,81 @@ def builtin_folder() -> Path | None:
         if folder.is_dir() and any(folder.glob("*.yaml")):
             return folder
     return None
+
+
+PROJECT_PRESETS_DIR = Path("presets")
+
+
+def user_presets_dir(env=None) -> Path:
+    """The user's own presets folder (the TUI lists it): ``$FRICTIONLAB_PRESETS_DIR``, else
+    ``$XDG_CONFIG_HOME/frictionlab/presets``, else the platform's config folder. A FrictionlabError
+    names the variable for a ``~user`` this system does not know."""
+    from ..io.inputs import expand_user
+
+    env = os.environ if env is None else env
+    for key, below in (("FRICTIONLAB_PRESETS_DIR", ()), ("XDG_CONFIG_HOME", ("frictionlab", "presets"))):
+        if env.get(key):
+            try:
+                return Path(expand_user(env[key]), *below)
+            except ValueError as exc:
+                raise FrictionlabError(f"{key}={env[key]!r}: {exc}") from None
+    from platformdirs import user_config_path  # ~/.config on Linux, the platform's own folder elsewhere
+
+    return user_config_path("frictionlab") / "presets"
+
+
+BUILTIN = "built-in"  # the label of the presets shipped with frictionlab: read, copied, never written
+
+
+def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str, Path]]:
+    """(label, folder) pairs to browse: the given folder, or ./presets, the user
+    folder and the built-in presets (unless ./presets is that folder: a checkout)."""
+    if presets_dir is not None:
+        return [("presets", Path(presets_dir))]
+    folders = [("project", PROJECT_PRESETS_DIR)] if PROJECT_PRESETS_DIR.is_dir() else []
+    folders.append(("user", user_presets_dir(env)))
+    shipped = builtin_folder()
+    if shipped is not None and not any(folder.resolve() == shipped.resolve() for _, folder in folders):
+        folders.append((BUILTIN, shipped))
+    return folders
+
+
+def listed_preset_folders(presets_dir: str | Path | None = None) -> list[Path]:
+    """The folders of presets the TUI's Presets list shows, in its order, less the built-ins':
+    where ``frictionlab tui NAME`` looks for NAME first (``cli.tui.find_preset``)."""
+    return [folder for label, folder in preset_folders(Path(presets_dir) if presets_dir else None) if label != BUILTIN]
+
+
+def same_named_presets(argument: str | Path, resolved: Path) -> list[Path]:
+    """Where ``argument`` is a built-in's name (``resolved`` its file), the files of that name in
+    the folders ``frictionlab tui`` lists first (./presets, the user folder) that are not the
+    built-in: ``tui NAME`` opens the first of them, ``run NAME`` the built-in. Unreadable
+    folders and files are passed over (this only informs)."""
+    argument, builtin = str(argument), find_builtin(str(argument))
+    if len(Path(argument).parts) != 1 or builtin is None or Path(resolved) != builtin.path:
+        return []
+    try:
+        folders, own = listed_preset_folders(), builtin.path.read_bytes()
+    except (FrictionlabError, OSError):
+        return []
+    found = []
+    for path in (folder / f"{builtin.name}{suffix}" for folder in folders for suffix in (".yaml", ".yml")):
+        try:
+            if path.is_file() and path.resolve() != builtin.path.resolve() and path.read_bytes() != own:
+                found.append(path)
+        except OSError:
+            pass
+    return found
+
+
+def same_name_note(argument: str | Path, resolved: Path) -> str | None:
+    """What ``run NAME`` and ``validate NAME`` say where NAME is a built-in's and a listed folder
+    holds another preset of that name (``same_named_presets``), or None."""
+    others = same_named_presets(argument, resolved)
+    if not others:
+        return None
+    return (f"note: {str(argument)!r} is the built-in preset; {shown_name(others[0])} is another of that name (the one "
+            f"`frictionlab tui {argument}` opens); to use it, give its path: frictionlab run {command_word(others[0])}")
 
 
 def preset_folder(presets_dir: str | Path | None, names: list[str], what: str) -> Path:

@@ -24,7 +24,7 @@ def run_app(
     options=None,
 ) -> int:
     """Run the app until it quits; ``options`` (``RunOptions``): how its runs are carried out."""
-    from .folders import user_presets_dir  # no Textual there
+    from ..preset.builtin import user_presets_dir
 
     user_presets_dir()  # FRICTIONLAB_PRESETS_DIR=~nouser: said now, not as a traceback in the app
     if not (sys.stdin.isatty() and sys.stdout.isatty()):  # keys come from, and the screen goes to, a terminal
@@ -52,14 +52,6 @@ def run_app(
     if app.farewell:
         print(app.farewell, file=sys.stderr)
     return app.return_code or 0
-
-
-def listed_preset_folders(presets_dir: str | Path | None) -> list[Path]:
-    """The folders of presets the Presets list shows, in its order, less the built-ins': where
-    ``frictionlab tui NAME`` looks for NAME first (``cli.tui.find_preset``)."""
-    from .folders import BUILTIN, preset_folders  # no Textual there
-
-    return [folder for label, folder in preset_folders(Path(presets_dir) if presets_dir else None) if label != BUILTIN]
 
 
 def _exit_on_sigterm(app, signum: int = signal.SIGTERM) -> None:

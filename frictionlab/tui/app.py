@@ -30,13 +30,13 @@ from textual.widgets import Static, TabPane
 from ..errors import PresetError, shown, shown_name
 from ..options import RunOptions
 from ..preset import load_preset_file
+from ..preset.builtin import preset_folders
 from ..plugin.registry import default_registry
 from ..runs.rundir import DEFAULT_RUNS_DIR
 from .folders import (
     copy_name,
     copy_target,
     file_stamp,
-    preset_folders,
     preset_from_template,
     presets_signature,
     runs_signature,

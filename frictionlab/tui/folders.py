@@ -22,7 +22,7 @@ import yaml
 from ..errors import FrictionlabError, RunFolderError
 from ..io.inputs import expand_user, read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
-from ..preset.builtin import builtin_folder, builtin_presets
+from ..preset.builtin import BUILTIN, PROJECT_PRESETS_DIR, builtin_folder, builtin_presets, user_presets_dir
 from ..preset.reading import MAX_PRESET_BYTES, NOT_A_MAPPING
 from ..preset.schema import NAME_PATTERN
 from ..io.safe_yaml import load_yaml
@@ -30,39 +30,6 @@ from ..io.values import number_or_nan, whole_or
 
 # The runs' modules (``detached``, ``runfolder``) and the comment-keeping YAML writer are
 # imported where runs are read or a preset written: the first screen lists presets only.
-
-PROJECT_PRESETS_DIR = Path("presets")
-
-
-def user_presets_dir(env=None) -> Path:
-    """FrictionlabError naming the variable for a ``~user`` this system does not know."""
-    env = os.environ if env is None else env
-    for key, below in (("FRICTIONLAB_PRESETS_DIR", ()), ("XDG_CONFIG_HOME", ("frictionlab", "presets"))):
-        if env.get(key):
-            try:
-                return Path(expand_user(env[key]), *below)
-            except ValueError as exc:
-                raise FrictionlabError(f"{key}={env[key]!r}: {exc}") from None
-    from platformdirs import user_config_path  # ~/.config on Linux, the platform's own folder elsewhere
-
-    return user_config_path("frictionlab") / "presets"
-
-
-BUILTIN = "built-in"  # the label of the presets shipped with frictionlab: read, copied, never written
-
-
-def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str, Path]]:
-    """(label, folder) pairs to browse: the given folder, or ./presets, the user
-    folder and the built-in presets (unless ./presets is that folder: a checkout)."""
-    if presets_dir is not None:
-        return [("presets", Path(presets_dir))]
-    folders = [("project", PROJECT_PRESETS_DIR)] if PROJECT_PRESETS_DIR.is_dir() else []
-    folders.append(("user", user_presets_dir(env)))
-    shipped = builtin_folder()
-    if shipped is not None and not any(folder.resolve() == shipped.resolve() for _, folder in folders):
-        folders.append((BUILTIN, shipped))
-    return folders
-
 
 def writable_folder(folders: list[tuple[str, Path]]) -> Path:
     """Where copies go by default: the user folder (or the only one given)."""

@@ -10,6 +10,7 @@ import copy
 from pathlib import Path
 
 from ..errors import shown, shown_name
+from ..preset.builtin import user_presets_dir
 from .folders import (
     copy_name,
     copy_target,
@@ -19,7 +20,6 @@ from .folders import (
     names_taken,
     new_preset_path,
     save_preset,
-    user_presets_dir,
 )
 from .running import NO_PRESET
 from .screens import ConfirmScreen, PathScreen

@@ -99,3 +99,35 @@ def test_a_refusal_that_is_not_a_preset_problem_names_its_preset(tmp_path, capsy
     assert main(["validate", str(first), str(second)]) != ExitCode.OK
     err = capsys.readouterr().err
     assert f"{first}: this run would need about 1043.24 GiB" in err and f"{second}: this run would need" in err
+
+
+def _builtin_text(name: str) -> str:
+    from frictionlab.preset.builtin import find_builtin
+
+    return find_builtin(name).path.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("where", ["project", "user"])
+def test_a_builtin_name_beside_a_preset_of_that_name_says_which_is_used(tmp_path, monkeypatch, capsys, where):
+    """`tui quickstart` opens ./presets/quickstart.yaml (or the user folder's) where there is one;
+    `validate quickstart` and `run quickstart` read the built-in, and now say so, naming the other."""
+    folder = tmp_path / ("presets" if where == "project" else "mine")
+    folder.mkdir()
+    (folder / "quickstart.yaml").write_text(_builtin_text("quickstart").replace("realizations: 50", "realizations: 7"))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    assert main(["validate", "quickstart"]) == ExitCode.OK
+    out, err = capsys.readouterr()
+    assert "(50 realizations" in out  # the built-in, as before
+    shown_path = "presets/quickstart.yaml" if where == "project" else str(folder / "quickstart.yaml")
+    assert f"note: 'quickstart' is the built-in preset; {shown_path} is another of that name" in err
+    assert f"frictionlab run {shown_path}" in err
+
+
+def test_no_note_for_a_path_or_a_same_named_copy_of_the_builtin(tmp_path, monkeypatch, capsys):
+    (tmp_path / "presets").mkdir()
+    (tmp_path / "presets" / "quickstart.yaml").write_text(_builtin_text("quickstart"))  # a plain copy: nothing differs
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(tmp_path / "mine"))
+    assert main(["validate", "quickstart", "presets/quickstart.yaml"]) == ExitCode.OK
+    assert "note:" not in capsys.readouterr().err

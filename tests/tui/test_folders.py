@@ -101,7 +101,8 @@ def test_text_a_folded_or_quoted_value_cannot_hold_raw_is_written_escaped(tmp_pa
 
 def test_the_built_in_presets_are_listed_after_the_users_and_copies_go_to_the_user(tmp_path, monkeypatch):
     from frictionlab.preset.builtin import builtin_folder
-    from frictionlab.tui.folders import preset_folders, writable_folder
+    from frictionlab.preset.builtin import preset_folders
+    from frictionlab.tui.folders import writable_folder
 
     monkeypatch.chdir(tmp_path)  # no ./presets
     env = {"FRICTIONLAB_PRESETS_DIR": str(tmp_path / "mine")}
@@ -154,7 +155,7 @@ def test_a_home_folder_of_no_user_is_said_not_raised(monkeypatch, capsys):
 
     from frictionlab.cli import main
     from frictionlab.errors import FrictionlabError
-    from frictionlab.tui.folders import user_presets_dir
+    from frictionlab.preset.builtin import user_presets_dir
     from frictionlab.tui.screens.dialogs import preset_path_problem
     from frictionlab_spectra import ProfileFile
 
