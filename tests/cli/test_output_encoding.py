@@ -42,3 +42,18 @@ def test_the_streams_a_process_is_started_with_escape_it_too(tmp_path):
                           timeout=300)  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert_escaped(done, tmp_path, argv, made)
+
+
+def test_a_folder_named_in_utf8_under_the_c_locale_is_printed_escaped_not_an_internal_error(tmp_path):
+    """Under LC_ALL=C without Python's UTF-8 mode (the file system's encoding ASCII), `run
+    --out ü` wrote its files, then ended in 'internal error: UnicodeEncodeError' (exit 70): the
+    table's 'results in ü/' was made printable once, and os.fsencode refused its 'ü' the second time."""
+    env = {**os.environ, "LC_ALL": "C", "LANG": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
+    env.pop("PYTHONIOENCODING", None)
+    argv = ["run", "quickstart", "--set", "realizations=4", "--workers", "1", "--no-plot", "--out", "ü".encode()]
+    done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, cwd=tmp_path, env=env,
+                          timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert b"internal error" not in done.stderr
+    assert b"results in \\xfc/" in done.stdout, done.stdout  # the ASCII stream's escape of the character
+    assert (tmp_path / "ü" / "summary.json").is_file()
