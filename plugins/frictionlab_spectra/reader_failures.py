@@ -110,7 +110,7 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
 
 
 NPZ_SHOWN = 3  # arrays of an archive named in a message, the rest counted
-NPY_HEADER_BYTES = 1 << 16  # what is read of an array in an archive: its header, never its data
+NPY_HEADER_BYTES = 65536  # what is read of an array in an archive: its header, never its data
 
 
 def _npy_shape(start: bytes) -> str:
