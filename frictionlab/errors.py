@@ -179,8 +179,22 @@ def shown(text) -> str:
     characters (C0 and C1) and characters that hide or reorder text escaped (an escape
     sequence typed in a ``--set`` or a file name must not drive the terminal, nor a key read
     as another); a message's lines and tabs kept, a path's escaped (``shown_name``)."""
-    said = os.fsencode(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
+    said = _bytes_of(text).decode("utf-8", "backslashreplace").translate(_CONTROL)
     return said.translate(_LINES) if isinstance(text, os.PathLike) else said
+
+
+def _bytes_of(text) -> bytes:
+    """The bytes ``text`` stands for: a name's own bytes where they are not UTF-8 (Python
+    decodes them as lone surrogates), every other character in UTF-8, whatever the locale:
+    os.fsencode under LC_ALL=C (ASCII) raised on the 'ü' of a folder's name shown once
+    already, as the table that names it was shown, after the run."""
+    text = os.fspath(text)
+    if isinstance(text, bytes):
+        return text
+    try:
+        return text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a surrogate no byte gave (a forged JSON's \ud800): escaped below
+        return text.encode("utf-8", "surrogatepass")
 
 
 def shown_name(text) -> str:

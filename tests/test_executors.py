@@ -484,3 +484,24 @@ def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_co
     finally:
         (listener.shutdown if server == "http" else listener.close)()
     assert time.monotonic() - started < 3 * CONNECT_SECONDS  # a bound against a hang (it was minutes), not a speed test
+
+
+@needs_dask
+def test_a_scheduler_address_where_nothing_listens_is_said_so():
+    """A port where nothing listens (the connection refused) was said, after Dask's connect had
+    retried it for the whole timeout, to 'not answer as a Dask scheduler (is it another service,
+    such as the dashboard's HTTP port?)': a question about a service that is not there."""
+    import socket
+
+    import distributed
+
+    from frictionlab.compute.dask_security import _check_answers_as_scheduler
+    from frictionlab.errors import RunError
+
+    with socket.socket() as taken:  # a port of this machine, free once closed
+        taken.bind(("127.0.0.1", 0))
+        port = taken.getsockname()[1]
+    with pytest.raises(RunError) as refused:
+        _check_answers_as_scheduler(f"tcp://127.0.0.1:{port}", distributed.Security(), seconds=1)
+    assert str(refused.value) == (f"--scheduler tcp://127.0.0.1:{port}: nothing listens there (the connection was "
+                                  "refused): start the scheduler first (dask scheduler), or give the address it listens on")  # fmt: skip

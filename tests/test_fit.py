@@ -70,6 +70,22 @@ def test_no_bootstrap_with_one_realization_or_zero_resamples():
     assert none.to_dict()["b_ci"] == [None, None]  # JSON has no NaN
 
 
+def test_one_bootstrap_resample_is_refused_as_no_interval(capsys):
+    """fit.bootstrap: 1 printed a '95% CI [1.0868, 1.0868]' of no width beside a = 1.1275: one
+    resample's numbers called an interval. 0 (none) and 2 or more are taken."""
+    import frictionlab
+    from frictionlab.cli import main
+    from frictionlab.errors import ExitCode, PresetError
+
+    assert main(["validate", "quickstart", "--set", "fit.bootstrap=1"]) == ExitCode.USAGE
+    assert "fit.bootstrap: must be 0 (no intervals) or at least 2: one resample gives an interval of one point, not " \
+           "a spread, got 1" in capsys.readouterr().err
+    with pytest.raises(PresetError, match="fit.bootstrap: must be 0"):
+        frictionlab.validate("quickstart", {"fit.bootstrap": 1})
+    for bootstrap in (0, 2):
+        assert main(["validate", "quickstart", "--set", f"fit.bootstrap={bootstrap}"]) == ExitCode.OK
+
+
 @pytest.mark.parametrize(
     "f, message",
     [(np.array([0.0, 1.0, 2.0]), "f must be finite and > 0"), (np.array([1.0, 1.0, 1.0]), "two distinct forces")],

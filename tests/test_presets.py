@@ -157,6 +157,18 @@ def test_a_tab_or_a_stray_colon_in_a_preset_file_is_named():
             load_yaml(text)
 
 
+@pytest.mark.parametrize("text", ['description: "a scene"\n  of lines\nseed: 1\n', "seed: [1]\n  - 2\n"])
+def test_a_line_indented_under_a_whole_value_is_named(text):
+    """Words after a closing quote, or a list item under 'key: [..]', indented as part of the
+    value: refused in PyYAML's words, "expected <block end>, but found '<scalar>'"."""
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    with pytest.raises(YamlProblem, match=r"^not valid YAML at line 2, column 3: a line indented under a value that is "
+                                          r"already whole \(words after a closing quote, say, or a list item under 'key: "
+                                          r"value'\); indent it as the keys beside it, or make it part of that value$"):  # fmt: skip
+        load_yaml(text)
+
+
 @pytest.mark.parametrize("text, tag", [("name: !!python/object:os.system x\n", "'tag:yaml.org,2002:python/object:os.system'"),
                                        ("name: !Custom x\n", "'!Custom'")])  # fmt: skip
 def test_a_tag_a_preset_does_not_take_is_named_with_the_remedy(text, tag):

@@ -354,3 +354,17 @@ def test_runs_of_a_folder_that_does_not_exist_is_a_usage_error(tmp_path, capsys)
     for name, what in (("missing", "does not exist"), ("file", "is not a folder")):
         assert main(["runs", str(tmp_path / name)]) == 2
         assert capsys.readouterr().err == f"error: DIR: {tmp_path / name} {what}: give the folder that holds run folders\n"
+
+
+@pytest.mark.parametrize("command", ["follow", "resume"])
+@pytest.mark.parametrize("inside", ["summary.json", "chunks"])
+def test_a_file_or_folder_inside_a_run_folder_names_the_folder_to_give(tmp_path, registry, capsys, command, inside):
+    """`resume run/summary.json` (`follow run/chunks`) was 'is not a folder: there is no run to
+    resume there' ('holds no run (no run.json)'), without the folder the user meant."""
+    _run(tmp_path / "run", registry)
+    capsys.readouterr()
+    before = sorted(p.name for p in (tmp_path / "run").iterdir())
+    assert main([command, "--quiet", str(tmp_path / "run" / inside)]) == 5
+    assert capsys.readouterr().err == (f"error: {tmp_path / 'run' / inside} is inside the run folder {tmp_path / 'run'}, not "
+                                       f"one itself: give that folder (frictionlab {command} {tmp_path / 'run'})\n")  # fmt: skip
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == before

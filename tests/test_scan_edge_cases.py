@@ -857,6 +857,25 @@ def test_a_npy_that_is_not_one_array_of_numbers_as_its_header_says_is_named(tmp_
 
 
 
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_an_npz_of_no_two_dimensional_array_is_named_as_such_not_as_damage(tmp_path, plugin):
+    """A line saved with numpy.savez (a valid archive, of a 1-D array) was 'not a valid NumPy
+    array archive (NPZ) file ...: copy it again from the instrument', as if damaged; an array's
+    header too long to read (forged) is named as of unknown shape, its bytes never read whole."""
+    import zipfile
+
+    np.savez(tmp_path / "line.npz", z=rough(1, 40, 18)[0], cube=np.zeros((2, 3, 4)))
+    with zipfile.ZipFile(tmp_path / "line.npz", "a") as archive:
+        archive.writestr("forged.npy", b"\x93NUMPY\x02\x00" + (2**31).to_bytes(4, "little") + bytes(100))
+    with pytest.raises(ValueError) as info:
+        plugin(path=str(tmp_path / "line.npz"), spacing=0.1).rms_height()
+    said = str(info.value)
+    assert "file holds no two-dimensional array, the only kind SurfaceTopography reads from one (its arrays: 'z' of " \
+           "shape (40,), 'cube' of shape (2, 3, 4), 'forged' of shape unknown; not damage): save a map as a 2D array, a " \
+           "line as .npy (np.save) or a column of text for profile-file" in said, said
+    assert "copy it again" not in said
+
+
 def _header_of(text: bytes, version: bytes = b"\x01\x00") -> bytes:
     """A .npy header holding ``text``, padded as numpy pads one (to 64 bytes, a newline last)."""
     body = text + b" " * (-(10 + len(text) + 1) % 64) + b"\n"

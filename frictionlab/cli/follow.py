@@ -65,10 +65,12 @@ class _StopSignals:
 
 def run(args) -> ExitCode:
     from ..runs.detached import logged_error, logged_warnings, process_alive, run_state
+    from .resume import refuse_a_part_of_a_run
 
     folder = Path(args.run_dir)
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
         folder = folder.resolve()
+    refuse_a_part_of_a_run(folder, "follow")
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None
     error, gone, identity, holder = None, False, _identity(folder), state.pid

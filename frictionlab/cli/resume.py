@@ -29,6 +29,23 @@ def add_parser(sub) -> None:
     p.set_defaults(handler=run)
 
 
+def refuse_a_part_of_a_run(path: Path, verb: str) -> None:
+    """RunFolderError naming the folder to give where ``path`` is a file or folder inside a run's
+    or a sweep's folder (its summary.json, chunks/ or points/), not one itself: it was refused
+    as 'not a folder' or 'holds no run', without the folder the user meant."""
+    from ..runs.detached import SWEEP_FILE
+    from ..runs.rundir import PRESET_FILE, STATE_FILE
+
+    holds = lambda folder, *names: any(os.path.lexists(folder / name) for name in names)  # noqa: E731
+    if path.name in ("", ".", "..") or (path.is_dir() and holds(path, PRESET_FILE, STATE_FILE, SWEEP_FILE)):
+        return
+    parent = path.parent
+    kind = "run" if holds(parent, PRESET_FILE, STATE_FILE) else "sweep" if holds(parent, SWEEP_FILE) else None
+    if kind is not None:
+        raise RunFolderError(f"{shown_name(path)} is inside the {kind} folder {shown_name(parent)}, not one itself: give "
+                             f"that folder (frictionlab {verb} {command_word(parent)})")  # fmt: skip
+
+
 def run(args) -> ExitCode:
     from ..io.files import output_path_problem
     from ..runs.rundir import PRESET_FILE, RunDirectory
@@ -36,6 +53,7 @@ def run(args) -> ExitCode:
 
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
+    refuse_a_part_of_a_run(run_dir, "resume")
     if run_dir.is_dir() and (problem := output_path_problem(run_dir)) is not None:  # said as a resume can act on it
         raise OutputRefused(f"{problem}; a resume writes into the folder it continues: copy it where you can write "
                             f"(cp -r {command_word(run_dir)} NEW_FOLDER) and resume the copy")

@@ -100,6 +100,18 @@ def _numbers(option: str, text: str, kind=float, low: float = 0.0, required: boo
     return values
 
 
+def _compared(option: str, text: str, axis_runs: bool, reference: str, high: float = math.inf) -> tuple:
+    """The values of an axis measured against its largest (or tightest) one: where that axis
+    runs, two at least; one alone was the reference, compared with nothing, and the grid
+    axis then said 'N > 4096 (not reached)' of a grid it never measured."""
+    values = _numbers(option, text, required=axis_runs, high=high)
+    if axis_runs and len(set(values)) < 2:
+        raise FrictionlabError(f"{option} must give two different values at least (the axis measures the others "
+                               f"against the {reference}). "
+                               f"Got {short_repr(text)} instead.")  # fmt: skip
+    return values
+
+
 def _between(option: str, value: int, low: int, high: int) -> int:
     if not low <= value <= high:
         raise FrictionlabError(f"{option} must be a whole number from {low} to {high}. Got {value} instead.")
@@ -136,8 +148,8 @@ def options_from_args(args) -> StudyOptions:
         compare_realizations=_at_least("--compare-realizations", args.compare_realizations, 2),
         compare_steps=_at_least("--compare-steps", args.compare_steps, 2),
         grid_realizations=_at_least("--grid-realizations", args.grid_realizations, 2),
-        grid_factors=_numbers("--grid-factors", args.grid_factors, required="grid" in axes, high=MAX_GRID_FACTOR),
-        tolerances=_numbers("--tolerances", args.tolerances, required="tolerance" in axes) or (min(_D.tolerances),),
+        grid_factors=_compared("--grid-factors", args.grid_factors, "grid" in axes, "largest", MAX_GRID_FACTOR),
+        tolerances=_compared("--tolerances", args.tolerances, "tolerance" in axes, "tightest") or (min(_D.tolerances),),
         reference_grid=_numbers("--reference-grid", args.reference_grid, high=MAX_GRID_FACTOR),
         repeats=_between("--repeats", args.repeats, 1, MAX_REPEATS),
     )

@@ -146,15 +146,35 @@ def _check_answers_as_scheduler(address: str, security, seconds: float = CONNECT
     reply = answer[0] if answer else TimeoutError()
     if isinstance(reply, dict) and reply.get("type") == "Scheduler":
         return
+    if address.startswith("tls://") and "ssl_context" in str(reply):
+        return  # the missing certificates: said by the Client below, as before
+    _refuse_nothing_listening(address, seconds)
     if isinstance(reply, BaseException) and not isinstance(reply, TimeoutError | asyncio.TimeoutError):
-        if address.startswith("tls://") and "ssl_context" in str(reply):
-            return  # the missing certificates: said by the Client below, as before
         reason = f"{type(reply).__name__}: {reply}"
         raise RunError(f"cannot reach the Dask scheduler at {address}: {short_repr(reason, 300)[1:-1]}")
     raise RunError(
         f"{option_given('--scheduler', address)} did not answer as a Dask scheduler within {seconds:g} s (is it another "
         "service, such as the dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)"
     )
+
+
+def _refuse_nothing_listening(address: str, seconds: float) -> None:
+    """RunError where nothing listens at ``address`` (the connection refused) or its host has no
+    address: Dask retried those until its timeout, then asked whether the port was another service."""
+    import socket
+
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    given = option_given("--scheduler", address)
+    try:
+        socket.create_connection((parts.hostname, parts.port), timeout=seconds).close()
+    except ConnectionRefusedError:
+        raise RunError(f"{given}: nothing listens there (the connection was refused): start the scheduler first "
+                       "(dask scheduler), or give the address it listens on") from None  # fmt: skip
+    except socket.gaierror as exc:
+        raise RunError(f"{given}: no host named {short_repr(parts.hostname)} is known ({exc.strerror}): check "
+                       "the address") from None  # fmt: skip
+    except OSError:  # a timeout, a network that cannot be reached: said as before
+        pass
 
 
 # Dask's nanny gives its workers MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back at

@@ -19,6 +19,7 @@ import hashlib
 import math
 import os
 import stat
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -56,6 +57,9 @@ def regular_file_problem(path: str | Path) -> str | None:
         return "no such file (a parent of it is a file)"
     except PermissionError:
         return "permission denied"
+    except UnicodeEncodeError:  # 'ü.npy' under LC_ALL=C: was 'cannot be read (UnicodeEncodeError)'
+        return (f"cannot be named in this system's encoding of file names ({sys.getfilesystemencoding()}, from the "
+                "locale): run under a UTF-8 locale (LC_ALL=C.UTF-8) or with PYTHONUTF8=1")
     except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
         return f"cannot be read ({getattr(exc, 'strerror', None) or type(exc).__name__})"
     return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, not a regular file"
@@ -199,6 +203,15 @@ def _absolute_path(value: str) -> str:
     if any(ord(c) < 32 or ord(c) == 127 for c in value):
         raise ValueError("must not contain control characters (NUL, newline, tab, ...)")
     return os.path.abspath(expand_user(value))
+
+
+def as_typed(word: str) -> str:
+    """A command-line word as it was typed: under LC_ALL=C Python decodes the UTF-8 bytes of
+    an 'ü' as two bytes it cannot read (lone surrogates); they are UTF-8 once taken back."""
+    try:
+        return os.fsencode(word).decode("utf-8")
+    except UnicodeError:  # bytes of another encoding, or a character the file system cannot name
+        return word
 
 
 InputFile = Annotated[str, INPUT_FILE_MARKER, AfterValidator(_absolute_path)]

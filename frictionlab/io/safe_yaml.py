@@ -197,6 +197,8 @@ _OPENED = {"a flow sequence": "a [ list", "a flow mapping": "a { mapping", "a qu
 _NO_COLON = "a line that is neither 'key: value' nor part of a value (a key without its ':', as 'seed 1' for 'seed: 1')"
 _STRAY_COLON = "a ': ' where YAML takes none: a key indented under a value, or a value holding ': ' (quote it)"
 _TAB = "a tab, where YAML takes spaces only (to indent, say); replace it with spaces"
+_INDENTED = ("a line indented under a value that is already whole (words after a closing quote, say, or a list item "
+             "under 'key: value'); indent it as the keys beside it, or make it part of that value")
 
 
 def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
@@ -220,6 +222,8 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
     problem = exc.problem or exc.context or "syntax error"
     said = _TAB if "'\\t'" in problem else _STRAY_COLON if problem == "mapping values are not allowed here" else problem[:80]
+    if problem.startswith("expected <block end>, but found") and exc.context == "while parsing a block mapping":
+        said = _INDENTED
     return f"not valid YAML{where}: {said}"
 
 

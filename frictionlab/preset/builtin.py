@@ -162,6 +162,9 @@ def resolve_preset_path(argument: str | Path) -> Path:
         raise PresetFileError(["(file): the preset is named by an empty string: give a preset file or a built-in's name"],
                               source=repr(str(argument)))  # fmt: skip
     path = Path(argument)
+    if not path.exists() and re.match(r"[A-Za-z][A-Za-z0-9+.-]*://", str(argument)):  # Path() would show it as http:/host
+        raise PresetFileError([f"(file): {shown_name(argument)} is an address; a preset is read from a file here, never "
+                               "fetched: download it (curl -O ADDRESS), then give the file"], source=str(argument))  # fmt: skip
     if not path.exists() and path.suffix in (".yaml", ".yml") and find_builtin(path.stem):  # presets/quickstart.yaml
         raise PresetFileError(  # outside the clone: the file is not there, but the package has it
             [f"(file): no file {str(argument)!r} here; the built-in preset of that name is {path.stem!r} "

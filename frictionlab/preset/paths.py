@@ -13,6 +13,7 @@ from typing import Any
 import yaml
 
 from ..errors import PresetError, short_repr, shown_name
+from ..io.inputs import as_typed
 from ..io.safe_yaml import YamlProblem, load_yaml
 
 MISSING = object()
@@ -102,7 +103,7 @@ def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
     """A copy of ``data`` with ``dotted.path=value`` assignments applied (values read as YAML scalars)."""
     data = copy.deepcopy(data)
     problems = []
-    for assignment in assignments:
+    for assignment in map(as_typed, assignments):
         try:
             assignment.encode("utf-8")
         except UnicodeEncodeError:  # bytes of another encoding on the command line: pydantic's 'unable to parse raw data'

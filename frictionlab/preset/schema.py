@@ -8,7 +8,7 @@ from fractions import Fraction
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from ..plugin import KINDS
 from ..plugin.registry import Registry, default_registry
@@ -70,9 +70,17 @@ MAX_BOOTSTRAP = 100_000  # resamples: a summary.json read back is held to it too
 
 class FitSettings(_Strict):
     bootstrap: int = Field(
-        1000, ge=0, le=MAX_BOOTSTRAP, description="Bootstrap resamples over realizations for the intervals (0: none)."
+        1000, ge=0, le=MAX_BOOTSTRAP, description="Bootstrap resamples over realizations for the intervals (0: none, else at least 2)."
     )
     confidence: float = Field(0.95, gt=0, lt=1, description="Confidence level of the intervals.")
+
+    @field_validator("bootstrap")
+    @classmethod
+    def _an_interval(cls, value: int) -> int:
+        if value == 1:  # its '95% interval' was that resample's numbers: of no width, and off the estimate
+            raise ValueError("must be 0 (no intervals) or at least 2: one resample gives an interval of one point, "
+                             "not a spread")  # the value is said after it
+        return value
 
 
 class OutputSettings(_Strict):

@@ -266,7 +266,8 @@ def recommendation(study: Study) -> str:
         row = _smallest_within(grid[:-1], target) if len(grid) > 1 else None
         if row is None:
             grid_reached = False
-            needs.append(f"N > {int(grid[-2].value) if len(grid) > 1 else int(grid[-1].value)} (not reached on the grid axis)")
+            needs.append(f"N > {int(grid[-2].value)} (not reached on the grid axis)" if len(grid) > 1 else
+                         f"an N the grid axis did not measure (it ran only its reference, N = {int(grid[-1].value)}: see the notes)")
         else:
             needs.append(f"N = {int(row.value)} (against N = {int(grid[-1].value)})")
             seconds_per_line = row.seconds / max(1, row.realizations)

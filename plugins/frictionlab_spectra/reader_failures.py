@@ -97,11 +97,54 @@ def describe_failure(reader, exc: BaseException, where: str, fh=None) -> ValueEr
     if isinstance(exc, CorruptFile) and "regular grid" in text:  # SurfaceTopography's own words: a valid export
         return ValueError(f"{where}: the points of this {name} file are not on a regular grid ({said}); export the map "
                           "on the instrument's grid, or its heights as a matrix (a table) with spacing")  # fmt: skip
+    if isinstance(exc, FileFormatMismatch) and reader.format() == "npz" and fh is not None and \
+            (arrays := _npz_arrays(fh)) is not None:  # a valid archive of other arrays (a line saved with np.savez)
+        return ValueError(f"{where}: this {name} file holds no two-dimensional array, the only kind SurfaceTopography "
+                          f"reads from one ({arrays}; not damage): save a map as a 2D array, a line as .npy (np.save) "
+                          "or a column of text for profile-file")  # fmt: skip
     kind = "not a valid" if isinstance(exc, FileFormatMismatch) else "a damaged"
     if isinstance(exc, CorruptFile):
         kind = "a damaged"
     return ValueError(f"{where}: {kind} {name} file ({type(exc).__name__}{': ' + said if said else ''}); the reader of "
                       f"its format cannot read it: {AGAIN}")  # fmt: skip
+
+
+NPZ_SHOWN = 3  # arrays of an archive named in a message, the rest counted
+NPY_HEADER_BYTES = 65536  # what is read of an array in an archive: its header, never its data
+
+
+def _npy_shape(start: bytes) -> str:
+    """The shape a .npy header at ``start`` declares, or 'unknown' where it does not read as one."""
+    import io
+
+    head = io.BytesIO(start)
+    try:
+        version = np.lib.format.read_magic(head)
+        read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+        return str(read_header(head)[0])
+    except Exception:  # noqa: BLE001 - a header longer than NPY_HEADER_BYTES, or none
+        return "unknown"
+
+
+def _npz_arrays(fh) -> str | None:
+    """The arrays of an NPZ archive with their shapes, from their headers alone (a member
+    that inflates to gigabytes is never read whole), in words; None where it reads as no archive."""
+    import zipfile
+
+    try:
+        fh.seek(0)
+        with zipfile.ZipFile(fh) as archive:
+            shapes = []
+            for member in [n for n in archive.namelist() if n.endswith(".npy")]:
+                with archive.open(member) as array:
+                    shapes.append((member[:-4], _npy_shape(array.read(NPY_HEADER_BYTES))))
+    except Exception:  # noqa: BLE001 - a damaged archive: the reader's words say it
+        return None
+    finally:
+        fh.seek(0)
+    said = [f"{quoted(name)} of shape {shape}" for name, shape in shapes[:NPZ_SHOWN]]
+    more = f" and {len(shapes) - NPZ_SHOWN} more" if len(shapes) > NPZ_SHOWN else ""
+    return f"its arrays: {', '.join(said)}{more}" if said else "no array at all"
 
 
 ON_GRID = 1e-3  # of a step: a position this far from the grid's is on it (a text export's rounding)

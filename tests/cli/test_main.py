@@ -185,6 +185,21 @@ def test_an_empty_path_is_refused_naming_it_never_read_as_this_folder(command, c
     assert list(tmp_path.iterdir()) == []  # nothing written in this folder
 
 
+@pytest.mark.parametrize("command", [["validate"], ["run"], ["study"]])
+def test_a_preset_given_as_an_address_is_named_as_one_as_typed(command, tmp_path, monkeypatch, capsys):
+    """A preset named by its address was 'http:/example.com/p.yaml: no such preset file': not
+    the value typed (its // made one /), nor what is wrong with it."""
+    from frictionlab.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main([*command, "https://example.com/p.yaml"]) == ExitCode.INPUT_FILE
+    err = capsys.readouterr().err
+    assert "https://example.com/p.yaml: 1 problem in preset" in err, err
+    assert "(file): https://example.com/p.yaml is an address; a preset is read from a file here, never fetched: " \
+           "download it (curl -O ADDRESS), then give the file" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
 PATH_METAVARS = ("DIR", "RUN_DIR", "FILE", "DEST")
 
 

@@ -53,6 +53,12 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--grid-factors", ",,"], "--grid-factors names no value"),  # the grid axis was left out without a word
         (["--tolerances", ","], "--tolerances names no value"),  # the tolerance axis ran the default instead
         (["--points", "4"], "--points must be >= 8. Got 4 instead."),
+        # one value is the axis's reference alone, measured against nothing
+        (["--grid-factors", "2"], "--grid-factors must give two different values at least (the axis measures the "
+                                  "others against the largest). Got '2' instead."),
+        (["--grid-factors", "1,1"], "--grid-factors must give two different values at least"),
+        (["--tolerances", "1e-6", "--axes", "tolerance"], "--tolerances must give two different values at least "
+                                                          "(the axis measures the others against the tightest)"),
         (["--grid-factors", "1,1e300"], "--grid-factors values must be at most 1e+06. Got '1e300' instead."),
         (["--reference-grid", "2e6"], "--reference-grid values must be at most 1e+06. Got '2e6' instead."),
         (["--repeats", "1000000000"], "--repeats must be a whole number from 1 to 100. Got 1000000000 instead."),

@@ -224,6 +224,20 @@ def test_a_grid_given_twice_is_run_once_not_taken_as_its_own_reference(builtins,
     assert any("gives N = 256 again; each grid is run once" in note for note in study.notes), study.notes
 
 
+@pytest.mark.parametrize("factors", [(1, 1), (0.01, 1)])
+def test_a_grid_axis_of_its_reference_alone_does_not_say_a_finer_grid_is_needed(builtins, factors):
+    """The grid axis left with its reference only (a factor repeated, or the other one's N below
+    the spectrum's least) compared nothing, yet the recommendation said 'N > 256 (not reached on
+    the grid axis)', as if 256 had been measured and found too coarse."""
+    from frictionlab.tradeoff.outputs import recommendation
+
+    study = study_of(TINY, builtins, axes=("grid",), grid_factors=factors)
+    assert len(study.run()) == 1
+    said = recommendation(study)
+    assert "not reached" not in said, said
+    assert "an N the grid axis did not measure (it ran only its reference, N = 256: see the notes)" in said, said
+
+
 def test_a_study_that_measured_nothing_says_why_on_the_terminal(builtins):
     """Every axis asked skipped (the solver axis of a preset of lines, which no exact solver
     presses): the recommendation, the one line the terminal shows, said only 'no axis
