@@ -343,7 +343,7 @@ def _result(scene: Scene, outcome: RunOutcome, folder: Path | None, files: dict[
     return Result(
         name=scene.preset.name, status=outcome.status, fit=outcome.fit, table=table,
         realizations=(outcome.done, outcome.requested), normalisation=outcome.normalisation.definition,
-        preset=scene.resolved(), elapsed=outcome.elapsed, caveats=outcome.caveats, folder=folder,
+        preset=scene.resolved(), elapsed=outcome.sessions_elapsed, caveats=outcome.caveats, folder=folder,
         outcome=outcome, files=dict(files), input=scene.spectrum.input_summary(),
         units=column_units(curve_headers(scene)), error=outcome.error,
     )  # fmt: skip

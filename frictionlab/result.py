@@ -45,7 +45,8 @@ class Result:
     surface, what was read from its file (shape, pixel size, unit, rms height and
     where each came from), else None. ``error``: why a failed run has no fit (xi the same at
     every load, ...), else None. ``realizations``: (done, requested);
-    ``elapsed``: seconds. f and xi are dimensionless; ``F`` and ``indentation`` are
+    ``elapsed``: wall seconds of computing, a resumed run's sessions summed (summary.json's
+    ``elapsed_seconds``). f and xi are dimensionless; ``F`` and ``indentation`` are
     in the preset's units (lengths as its spacing, F in modulus x length², per unit
     depth on a half-plane): ``units`` says each column's, as curve.csv's header does
     (``to_pandas()`` keeps it in ``attrs["units"]``)."""

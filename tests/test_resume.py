@@ -113,6 +113,20 @@ def test_a_resume_adds_its_time_to_what_the_run_recorded(make_scene, tmp_path):
     assert recorded_seconds(tmp_path / "run") == pytest.approx(fresh.elapsed, abs=1e-6)  # its own time alone
 
 
+def test_the_api_gives_a_resumed_run_the_time_its_summary_records(make_scene, tmp_path):
+    """frictionlab.run(resume=True).elapsed was the resume's own time while load() of the same
+    folder (summary.json) gave the sessions summed: the one run said two times."""
+    import frictionlab
+
+    scene = make_scene({"realizations": 12, **NO_PLOT})
+    cancel = threading.Event()
+    first, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel)
+    resumed = frictionlab.run(scene.resolved(), out=tmp_path / "run", workers=1, resume=True, progress=False, plot=False)
+    assert resumed.realizations == (12, 12)
+    assert resumed.elapsed > first.elapsed  # the first session's time is in it
+    assert resumed.elapsed == pytest.approx(frictionlab.load(tmp_path / "run").elapsed, abs=1e-6)
+
+
 def test_a_resume_keeps_the_time_an_older_frictionlab_recorded(make_scene, tmp_path):
     """A completed folder whose manifest records no time (written before it did): the summary's is kept."""
     scene = make_scene({"realizations": 4, **NO_PLOT})

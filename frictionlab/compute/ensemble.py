@@ -164,6 +164,12 @@ class RunOutcome:
         return int(self.indices.size)
 
     @property
+    def sessions_elapsed(self) -> float:
+        """Wall seconds of the run's sessions summed, as summary.json records them: a resume's
+        own and what its folder recorded before (``extra["recorded_seconds"]``)."""
+        return float(self.extra.get("recorded_seconds", self.elapsed))
+
+    @property
     def caveats(self) -> list[str]:
         """What a reader of the fit must know: too few points in contact at the first load
         (the rms slope in contact of one or two points is mostly noise), the whole

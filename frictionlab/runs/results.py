@@ -106,7 +106,7 @@ def summary_dict(scene: Scene, outcome: RunOutcome, files: dict[str, str]) -> di
         "peak_height_rms": json_safe(float(outcome.peak_rms)),
         "caveats": outcome.caveats,
         # the run's sessions summed (run_to_folder): a resume's own time added to what the folder recorded
-        "elapsed_seconds": round(outcome.extra.get("recorded_seconds", outcome.elapsed), 6),
+        "elapsed_seconds": round(outcome.sessions_elapsed, 6),
         "workers": outcome.workers,
         "executor": outcome.extra.get("executor"),
         "resumed_realizations": outcome.extra.get("resumed", 0),
