@@ -194,6 +194,22 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
     assert "Save a copy" not in pages[0] and any("Save a copy" in page for page in pages)
 
 
+@sync
+async def test_the_key_panel_lists_no_sideways_scroll_on_a_form_that_fits_the_width(folders, registry):
+    """Found in tmux: F1 on the Edit tab listed Left, Right, Ctrl+PgUp and Ctrl+PgDn as Scroll
+    Left/Right and Page Left/Right: the form is as wide as the screen, and they did nothing."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app, size=(120, 60)) as pilot:
+        await press_settled(pilot, "f1")
+        shown = screen_text(app)
+        form = app.query_one("#form")
+        await press_settled(pilot, "right")
+        moved = form.scroll_x
+    assert "Scroll Up" in shown and "Page Down" in shown
+    assert not any(word in shown for word in ("Scroll Left", "Scroll Right", "Page Left", "Page Right"))
+    assert moved == 0
+
+
 @pytest.mark.parametrize("size", [SIZE, (60, 20)])  # at 60x20 its 45 % of the width cut 'a = 1.1474 [1.0319,'
 @sync
 async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry, size):

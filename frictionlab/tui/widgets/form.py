@@ -403,6 +403,8 @@ class PresetForm(VerticalScroll):
             return focused and self.data is not None
         if action == "leave_field":
             return not focused
+        if action in ("scroll_left", "scroll_right", "page_left", "page_right"):
+            return self.max_scroll_x > 0  # the form fits the width: F1 listed them, and they did nothing
         return True
 
     def action_edit_field(self) -> None:
