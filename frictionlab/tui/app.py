@@ -134,6 +134,7 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self._presets_seen: tuple = ()  # the presets folders as last listed (presets_signature)
         self._runs_read_at = 0.0  # when it was (time.monotonic)
         self._early_keys: list[events.Key] | None = []  # keys typed before the app is built (None: it is)
+        self.quitting = False  # set once it exits: the keys still on their way are dropped, as at the shell
         self._terminated = 0  # the exit code of a SIGTERM (SIGHUP) that came before it was built: it quits once it is
 
     # ------------------------------------------------------------ layout
@@ -158,7 +159,13 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         self.reload_presets()
         self.query_one("#preset-table").focus()
 
+    def exit(self, *args, **kwargs) -> None:
+        self.quitting = True
+        super().exit(*args, **kwargs)
+
     async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, events.Key) and self.quitting:
+            return  # typed after the quit (q then ?): a panel or dialog mounted on screens going away failed
         if isinstance(event, events.Key):
             if len(keys := unjoined(event)) > 1:  # Esc and a key the terminal joined as Alt+key
                 for key in keys:

@@ -159,6 +159,8 @@ def parse(spec: FieldSpec, text: str):
         value = load_yaml(text)
     except ValueError:  # not YAML, or beyond its limits: kept as typed, and refused by the validator
         return text
+    if spec.kind == "int" and isinstance(value, float) and value.is_integer() and abs(value) < 2**53:
+        return int(value)  # 1e3 or 50.0 in a whole-number field: saved as 1000, not 1000.0 (1e30 is said as typed)
     return value if isinstance(value, str | int | float | bool) else text
 
 

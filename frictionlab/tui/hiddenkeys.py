@@ -12,6 +12,15 @@ def said_when_hidden(*pairs: tuple[str, str], priority: bool = False) -> list[Bi
     return [Binding(key, f"unavailable('{action}')", show=False, system=True, priority=priority) for key, action in pairs]
 
 
+SIDEWAYS = frozenset({"scroll_left", "scroll_right", "page_left", "page_right", "cursor_left", "cursor_right"})
+
+
+def idle_sideways(widget, action: str) -> bool:
+    """Whether ``action`` would move ``widget`` sideways where it fits its width: F1 listed Left,
+    Right, Ctrl+PgUp and Ctrl+PgDn there, and they did nothing (narrow, a list scrolls to its a, b)."""
+    return action in SIDEWAYS and widget.max_scroll_x == 0
+
+
 class SaysWhyUnavailable:
     """``action_unavailable`` for an app or widget with ``said_when_hidden`` bindings."""
 

@@ -25,7 +25,9 @@ from textual.widgets import DataTable, Input
 # has the focus): run at once, they change nothing else than Textual's own order would
 FOCUS_ACTIONS = frozenset(
     {"app.focus_next", "app.focus_previous", "focus_next", "focus_previous", "edit_field", "leave_field", "new", "duplicate",
-     "arrow(1)", "arrow(-1)"}  # the form's Up and Down: a field's neighbour (a line of scroll on the form itself)
+     "arrow(1)", "arrow(-1)",  # the form's Up and Down: a field's neighbour (a line of scroll on the form itself)
+     # q, and the digits that switch tabs (as F2..F5 do, at once): q then n on the Presets list opened New, not quit
+     "quit", "show_tab('presets')", "show_tab('edit')", "show_tab('run')", "show_tab('results')"}
 )
 
 # a list's own cursor moves: nothing else handles these keys on a list, so at once is Textual's order

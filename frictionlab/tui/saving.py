@@ -162,7 +162,14 @@ class PresetSaving:
         self.say(f"{shown(path)} cannot be written ({reason}): give another file, e.g. in your own presets "
                  f"folder, {shown(elsewhere.parent)}; Esc leaves it unsaved", "error", title="Not saved")  # fmt: skip
         title = f"{shown_name(path.name)} cannot be written there ({reason}): save it as"
-        self.push_screen(PathScreen(title, elsewhere, self.save_folder), lambda there: there is not None and write_there(there))
+
+        def answered(there: Path | None) -> None:
+            if there is None:  # Esc: the advice to give another file no longer applies, and nothing was written
+                self.say(f"{shown(path)} cannot be written ({reason}); nothing was written", "warning", title="Not saved")
+                return
+            write_there(there)
+
+        self.push_screen(PathScreen(title, elsewhere, self.save_folder), answered)
 
 
 def changed_question(path: Path) -> str:

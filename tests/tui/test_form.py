@@ -25,6 +25,24 @@ from .conftest import (
 
 
 @sync
+async def test_a_whole_number_typed_as_1e3_is_saved_as_a_whole_number(folders, registry):
+    """Found in tmux: 1e3 typed into realizations was saved as 'realizations: 1000.0', and 1e9
+    was refused as 'must be <= 10000000, got 1000000000.0'."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await type_into(pilot, "field--realizations", "1e9")
+        too_many = error_text(app, "field--realizations")
+        await type_into(pilot, "field--realizations", "1e3")
+        await type_into(pilot, "field--loading--steps", "12.0")
+        await press_settled(pilot, "ctrl+s")
+        assert not app.modified and form.problems == []
+    assert too_many == "realizations: must be <= 10000000, got 1000000000"
+    text = (folders / "presets" / "tiny.yaml").read_text()
+    assert "realizations: 1000\n" in text and "steps: 12\n" in text
+
+
+@sync
 async def test_invalid_value_shows_the_headless_message_then_save_round_trips(folders, registry):
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:

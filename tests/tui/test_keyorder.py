@@ -219,3 +219,17 @@ async def test_keys_a_field_handles_after_tab_moved_the_focus_are_kept(folders, 
         await pilot.pause()
         kept, problems = form.data["name"], form.problems
     assert (kept, problems) == ("big-2", [])
+
+
+@pytest.mark.parametrize("after", [["question_mark"], ["f1"], ["n"], ["d"], ["2", "question_mark"]])
+@sync
+async def test_keys_typed_after_q_are_dropped_not_answered_on_a_closing_screen(folders, registry, after):
+    """In tmux: q then ? typed together quit with a traceback and exit code 1 (MountError: the
+    keys panel mounted on the screen being removed); the keys after the quit are never read."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        await press_settled(pilot, "f2")
+        post_keys(app, ["q", *after])
+        await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
+    assert app.return_code == 0

@@ -194,6 +194,10 @@ async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, r
         await press_settled(pilot, "ctrl+s")
         assert status_text(app).startswith("Not saved: presets/tiny.yaml cannot be written (the file is read-only)")
         assert app.screen.title_text == "tiny.yaml cannot be written there (the file is read-only): save it as"
+        await press_settled(pilot, "escape")
+        # the dialog gone, the status line no longer says to give another file (found in tmux)
+        left = status_text(app)
+    assert left == "Not saved: presets/tiny.yaml cannot be written (the file is read-only); nothing was written"
     assert path.read_text() == before and path.stat().st_mode & 0o777 == 0o444
 
 

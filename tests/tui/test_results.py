@@ -281,8 +281,12 @@ async def test_a_failed_run_opened_says_why_it_failed(folders, registry):
         names = [entry.path.name for entry in app.query_one(ResultsPane).runs]
         app.query_one("#runs-table").move_cursor(row=names.index("seed2"))
         await press_settled(pilot, "enter")
-        info = str(app.query_one("#results-info", Static).render())
+        box = app.query_one("#results-info", Static)
+        info, width = str(box.render()), box.content_size.width
     assert "failed" in info and why in " ".join(info.split())
+    # why, broken between words and indented as the box's other lines: wrapped, it went on at the box's edge
+    lines = info.splitlines()
+    assert all(line.startswith("  ") and len(line) <= width for line in lines[1:]), lines
 
 
 @sync

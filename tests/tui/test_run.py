@@ -47,6 +47,28 @@ async def test_a_run_shows_the_headless_coefficients(folders, registry):
     assert runs_listed == [out_dir.name]
 
 
+NO_LAW = merge(TINY, {"name": "nolaw", "spectrum": {"params": {"rms_height": 1.0e6}}, "loading": {"start": 1.0, "stop": 2.0}})
+
+
+@sync
+async def test_a_run_with_no_law_says_so_once_not_no_realization_yet(folders, registry):
+    """Found in tmux: a run that ended with no law (every load pressing the same points) showed
+    '(no realization yet)' beside its 8 realizations, the last interim line over its points, and
+    under the caveat the same reason again as '0 realization(s) failed; no law: ...'."""
+    (folders / "presets" / "nolaw.yaml").write_text(yaml.safe_dump(NO_LAW))
+    app = make_app(registry, preset="presets/nolaw.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        fit = str(app.query_one("#run-fit", Static).render())
+        error = str(app.query_one("#run-error", Static).render())
+        caveats = str(app.query_one("#run-caveats", Static).render())
+        series = app.query_one("#run-chart").series
+    assert app.last_outcome.fit is None and "no law" in caveats
+    assert "(no fit)" in fit and "no realization yet" not in fit
+    assert "realization(s) failed" not in error and "no law" not in error  # said once, as the caveat
+    assert len(series) == 1  # the mean curve alone, no fitted line
+
+
 def long_run_app(folders, registry):
     """The app on a preset of 100000 realizations: a run that goes on until cancelled."""
     big = merge(TINY, {"name": "long", "realizations": 100_000})

@@ -194,6 +194,26 @@ async def test_f1_pages_through_the_key_panel_at_80x24_to_save_as_then_hides_it(
     assert "Save a copy" not in pages[0] and any("Save a copy" in page for page in pages)
 
 
+@sync
+async def test_the_key_panel_lists_no_sideways_scroll_on_a_form_that_fits_the_width(folders, registry):
+    """Found in tmux: F1 on the Edit tab listed Left, Right, Ctrl+PgUp and Ctrl+PgDn as Scroll
+    Left/Right and Page Left/Right (Cursor left/right on the Presets list): the form and the list
+    fit the screen's width, and they did nothing."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app, size=(120, 60)) as pilot:
+        await press_settled(pilot, "f1")
+        shown = screen_text(app)
+        form = app.query_one("#form")
+        await press_settled(pilot, "right")
+        moved = form.scroll_x
+        await press_settled(pilot, "f2")  # the Presets list, as wide as its columns: the same
+        listed = screen_text(app)
+    assert "Scroll Up" in shown and "Page Down" in shown and "Cursor down" in listed
+    sideways = ("Scroll Left", "Scroll Right", "Page Left", "Page Right", "Cursor left", "Cursor right")
+    assert not any(word in text for word in sideways for text in (shown, listed))
+    assert moved == 0
+
+
 @pytest.mark.parametrize("size", [SIZE, (60, 20)])  # at 60x20 its 45 % of the width cut 'a = 1.1474 [1.0319,'
 @sync
 async def test_the_fit_panel_keeps_each_interval_on_one_line_at_80_columns(folders, registry, size):

@@ -31,6 +31,7 @@ from ..fields import (
     problems_for,
     validation_of,
 )
+from ..hiddenkeys import idle_sideways
 from .keyinput import KeyInput
 
 
@@ -403,7 +404,7 @@ class PresetForm(VerticalScroll):
             return focused and self.data is not None
         if action == "leave_field":
             return not focused
-        return True
+        return not idle_sideways(self, action)
 
     def action_edit_field(self) -> None:
         fields = [w for w in self.query("Input, Select, Switch") if w.focusable]

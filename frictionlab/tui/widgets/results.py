@@ -371,7 +371,8 @@ def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
     lines += packed(status, width)
     error = entry.summary.get("error")
     if isinstance(error, str) and error:  # why it failed (no law, say): the advice that comes with it
-        lines.append(Content.assemble("  ", (shown(error), "red")))
+        # broken between words as the rest of the box is, each line indented (wrapped, it went on at the edge)
+        lines += [Content.assemble(line[:2], (line[2:], "red")) for line in packed(shown(error).split(), width)]
     if entry.fit is not None:
         interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731
         lines += packed([f"a={entry.a:.4f}", interval("a_ci"), f"R^2={entry.r2:.4f}"], width)

@@ -30,8 +30,8 @@ def fit_lines(fit, *, final: bool, f_formula: str = "", short: bool = False) -> 
     """The coefficients as the Run tab and Results tab show them, with what f is; ``short``:
     the interval's level on the first line, without the bootstrap's count (a plot of 6 rows)."""
     what = [f"  f = {f_formula}"] if f_formula else []
-    if fit is None:
-        return ["xi = a + b ln f", *what, "  (no realization yet)"]
+    if fit is None:  # at the end, no law could be fitted (the reason is under the plot)
+        return ["xi = a + b ln f", *what, "  (no fit)" if final else "  (no realization yet)"]
     head = "xi = a + b ln f" + ("" if final else "  (interim)")
     lines = [head, *what, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
     if final:
@@ -313,17 +313,18 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
                                f"{format_duration(result.elapsed)}, {run.workers} worker"
                                f"{'s' if run.workers != 1 else ''}")  # fmt: skip
         f, xi = result.table["f"], result.table["xi"]
+        series = [Series(f, xi, "cyan")]  # without a fit, the curve alone: not the last interim line
         if result.fit is not None:
-            series = [Series(f, xi, "cyan"), fit_series(f, result.fit.a, result.fit.b, "yellow")]
-            self.query_one("#run-chart", Chart).show(series)
+            series.append(fit_series(f, result.fit.a, result.fit.b, "yellow"))
+        self.query_one("#run-chart", Chart).show(series)
         lines, short = (fit_lines(result.fit, final=True, f_formula=run.f_formula, short=s) for s in (False, True))
         self.query_one("#run-fit", FitPanel).show(lines, result.table["contact_count"], short)
         self._caveats([f"caveat: {caveat}" for caveat in result.caveats])  # as frictionlab run prints them
-        if run.failures or run.error:
-            # a realization's own error, told as the user can act on it (the engine's summary quotes it raw)
-            index, reason = run.failures[0] if run.failures else (None, None)
-            first = f"#{index}: {failure_message(reason)}" if run.failures else run.error
-            self._error(f"{run.failed} realization(s) failed; {first}")
+        if run.failures:  # a realization's own error, told as the user can act on it (the summary quotes it raw)
+            index, reason = run.failures[0]
+            self._error(f"{run.failed} realization(s) failed; #{index}: {failure_message(reason)}")
+        elif run.error and run.error not in result.caveats:  # a run's own error (no law) is a caveat above already
+            self._error(f"error: {run.error}")
         return f"Run {result.status}: {done}/{requested} realizations"
 
     def show_sweep_outcome(self, sweep) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from textual.binding import Binding
 from textual.widgets import DataTable
 
-from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
+from ..hiddenkeys import SaysWhyUnavailable, idle_sideways, said_when_hidden
 
 
 class ListTable(SaysWhyUnavailable, DataTable):
@@ -25,6 +25,8 @@ class ListTable(SaysWhyUnavailable, DataTable):
         self.empty = empty
 
     def check_action(self, action: str, parameters) -> bool:
+        if idle_sideways(self, action):
+            return False
         return action != "select_cursor" or self.row_count > 0  # an empty list: nothing to open
 
     def action_select_cursor(self) -> None:
