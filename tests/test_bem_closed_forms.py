@@ -173,3 +173,42 @@ def test_hertz_cylinder_on_periodic_half_plane(half_width_pixels, control):
         # d grows like F (ln(1 / F) + const): F is within the relative order of d, (dx / a)^2
         assert curve.force[0] == pytest.approx(force, rel=2 * (dx / a) ** 2)
     assert abs(curve.contact_count[0] / 2 - half_width_pixels) <= 1.0
+
+
+def converged_pressure(solver, z, force, dx):
+    """The pressure field of the solver's own CG at ``force``, in the units of E*."""
+    from frictionlab_solvers.contact_cg import ProjectedCG
+    from frictionlab_solvers.elastic import PeriodicHalfSpace
+
+    depth = z.max() - z
+    scale = depth.max()
+    unit = solver.stiffness() * scale / dx  # the CG's pressure unit (bem.py)
+    mean = force / (z.size * dx**z.ndim) / unit
+    cg = ProjectedCG(PeriodicHalfSpace(z.shape), depth / scale)
+    p, *_ = cg.solve(np.full(z.shape, mean), mean_pressure=mean, tolerance=1e-11, max_iterations=10_000)
+    return p * unit
+
+
+@pytest.mark.parametrize("sphere, contact_pixels", [(True, 8.0), (True, 12.0), (False, 10.0), (False, 40.0)])
+def test_hertz_pressure_is_the_half_ellipse_of_peak_p0(sphere, contact_pixels):
+    """p = p0 sqrt(1 - (r / a)^2), p0 = 3 F / (2 pi a^2) (sphere) or 2 F' / (pi a) (cylinder),
+    inside 0.8 a (the square-root edge spreads over a pixel). Errors: the sampling, of the
+    relative order (dx / a)^2, and the periodic images, whose smooth displacement adds a
+    curvature of relative order (a / L)^2 (pi^2 / 6 for the cylinder, less in 3D)."""
+    if sphere:
+        points, dx, radius = 128, 0.25, 40.0
+        solver = BEMHalfSpace(youngs_modulus=1.5, poisson_ratio=0.25)
+        y, x = (np.mgrid[0:points, 0:points] - points / 2) * dx
+        r = np.hypot(x, y)
+    else:
+        points, dx, radius = 1024, 2.0, 5000.0
+        solver = BEMHalfPlane(youngs_modulus=0.7)
+        r = np.abs((np.arange(points) - points / 2) * dx)
+    e_star, a = solver.stiffness(), contact_pixels * dx
+    force = 4 * e_star * a**3 / (3 * radius) if sphere else np.pi * e_star * a**2 / (4 * radius)
+    peak = 3 * force / (2 * np.pi * a**2) if sphere else 2 * force / (np.pi * a)
+    p = converged_pressure(solver, -(r**2) / (2 * radius), force, dx)
+    inner = r < 0.8 * a
+    error = np.max(np.abs(p[inner] - peak * np.sqrt(1 - (r[inner] / a) ** 2))) / peak
+    assert error <= 3 * (dx / a) ** 2 + 2 * (a / (points * dx)) ** 2
+    assert np.all(p[r > 1.1 * a] == 0.0)  # no pressure a pixel past the edge
