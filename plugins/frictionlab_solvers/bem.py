@@ -68,7 +68,8 @@ class PeriodicBEM(ContactSolver):
             ge=1e-14,
             le=0.1,
             allow_inf_nan=False,
-            description="relative residual: largest gap error on contact points or penetration elsewhere, over the rms height",
+            description="relative residual: largest gap error on contact points or penetration elsewhere, over the rms height; "
+            "with stop: certified a load may end before it (its indentation within 1e-4): set stop: tolerance to hold it",
         )
         max_iterations: int = Field(
             10_000, ge=1, le=10_000_000, description="conjugate-gradient steps allowed per load before giving up"
