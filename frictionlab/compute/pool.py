@@ -59,9 +59,35 @@ def start_failure(exc: OSError) -> str:
 
     limits = {errno.EMFILE: ("RLIMIT_NOFILE", "-n"), errno.EAGAIN: ("RLIMIT_NPROC", "-u")}
     name, flag = limits.get(exc.errno, (None, None))
+    pids = cgroup_pids_limit() if exc.errno == errno.EAGAIN else None
+    if pids is not None:  # a container's or a job scheduler's limit, not the user's ulimit -u
+        return f"{exc.strerror or exc}; the control group's process limit (pids.max) is {pids} here"
     soft = resource.getrlimit(getattr(resource, name))[0] if name and hasattr(resource, name) else None
     limit = f"; ulimit {flag} is {soft} here" if soft is not None and soft != resource.RLIM_INFINITY else ""
     return f"{exc.strerror or exc}{limit}"
+
+
+def cgroup_pids_limit(root: str = "/sys/fs/cgroup", own: str = "/proc/self/cgroup") -> int | None:
+    """The pids.max of this process's control group where it is reached (a fork refused
+    by it, not by ``ulimit -u``), else None: cgroup v1's pids hierarchy, or v2's."""
+    try:
+        with open(own) as fh:
+            lines = fh.read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        _, controllers, path = line.split(":", 2)
+        if controllers not in ("pids", ""):
+            continue
+        for folder in (f"{root}/pids{path}", f"{root}{path}", f"{root}/unified{path}"):
+            try:
+                with open(f"{folder}/pids.max") as fh, open(f"{folder}/pids.current") as now:
+                    limit, current = fh.read().strip(), int(now.read())
+            except (OSError, ValueError):
+                continue
+            if limit.isdigit() and current >= int(limit):
+                return int(limit)
+    return None
 
 
 _results = None  # in a worker: the pipe of its results, for ``send_progress``
