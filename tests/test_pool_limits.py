@@ -40,3 +40,32 @@ def test_a_fork_refused_by_a_pids_limit_names_it_not_ulimit_u(monkeypatch):
     monkeypatch.setattr(pool, "cgroup_pids_limit", lambda: 4, raising=False)
     reason = pool.start_failure(OSError(errno.EAGAIN, "Resource temporarily unavailable"))
     assert reason == "Resource temporarily unavailable; the control group's process limit (pids.max) is 4 here"
+
+
+def test_a_second_interrupt_during_the_pools_stop_leaves_no_worker_waiting(monkeypatch):
+    """A second Ctrl-C lands while the pool waits for its first idle worker to stop: every
+    worker was told to stop before that wait, so none waits on for a job (workers ignore
+    SIGTERM; the command's exit would wait for them forever)."""
+    import multiprocessing
+    import threading
+
+    import pytest
+
+    from frictionlab.compute.executors import pool_context
+
+    def interrupted_wait(self, timeout=2.0):
+        raise KeyboardInterrupt  # the second Ctrl-C, at the first wait
+
+    monkeypatch.setattr(pool._Worker, "stop", interrupted_wait)
+    workers = pool.WorkerPool(2, pool_context(), abs)
+    with pytest.raises(KeyboardInterrupt) as caught:  # holds the pool's frame, as an exiting command does
+        for _ in workers.run({key: -key for key in range(8)}, threading.Event()):
+            pass
+    children = multiprocessing.active_children()
+    for child in children:
+        child.join(10)
+    waiting = [child for child in children if child.is_alive()]
+    for child in waiting:  # the old way's leftovers: killed, or pytest's own exit waits for them
+        child.kill()
+        child.join()
+    assert caught.value is not None and not waiting

@@ -26,6 +26,7 @@ from .heap import keep_freed_memory
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
 STOP_GRACE_SECONDS = 0.5  # after a cancel, a job's time to end by itself before its worker is killed
 ERROR_CHARS = 500  # an error carried back from a worker is cut to this
+HELD_SIGNALS = {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)}
 
 
 class WorkerLost(Exception):
@@ -167,12 +168,16 @@ class _Worker:
         self.job = key
         return True
 
-    def stop(self, timeout: float = 2.0) -> None:
-        """Ask it to stop, and kill it if it has not within ``timeout`` (at once for 0)."""
+    def ask_stop(self) -> None:
+        """Tell it to stop (it ends after its job), without waiting."""
         try:
             self.tasks.send(None)
         except OSError:
             pass
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Ask it to stop, and kill it if it has not within ``timeout`` (at once for 0)."""
+        self.ask_stop()
         if timeout:
             self.process.join(timeout)
         if self.process.is_alive():
@@ -270,6 +275,23 @@ class WorkerPool:
                             if not cancel.is_set():
                                 pending.appendleft(worker.job)
         finally:  # idle workers stop; busy ones (an error or an interrupt got here) are killed
-            for worker in workers:
-                worker.stop(0 if worker.job is not None else 2.0)
+            _stop_all(workers)
+
+
+def _stop_all(workers: list[_Worker]) -> None:
+    """Every worker told to stop (a busy one killed) before any wait, with signals held
+    meanwhile: a second Ctrl-C that interrupts the waits leaves no worker waiting for a
+    job. It ignores SIGTERM, so the command's exit would wait for it forever."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS) if hasattr(signal, "pthread_sigmask") else None
+    try:
+        for worker in workers:
+            if worker.job is not None:
+                worker.process.kill()
+            else:
+                worker.ask_stop()
+    finally:
+        if held is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
+    for worker in workers:
+        worker.stop(0 if worker.job is not None else 2.0)
 
