@@ -50,6 +50,15 @@ EXAMPLES = """examples:
   frictionlab tui                             edit, run and compare in the terminal
   frictionlab COMMAND --help                  what a command does, with examples
 """
+EXIT_CODES = {  # each of ExitCode, for a script to tell the endings apart (the full table: docs/data-safety.md)
+    ExitCode.OK: "done", ExitCode.RUNTIME_FAILURE: "a run failed or would not fit in memory (what finished is kept)",
+    ExitCode.USAGE: "bad command line or preset value", ExitCode.INPUT_FILE: "the preset file cannot be used",
+    ExitCode.OUTPUT_REFUSED: "output refused (see --force)", ExitCode.RUN_FOLDER: "run folder cannot be resumed or is in use",
+    ExitCode.INTERNAL: "internal error (a bug)", ExitCode.HUNG_UP: "hung up (SIGHUP), resumable",
+    ExitCode.INTERRUPTED: "Ctrl-C, resumable", ExitCode.BROKEN_PIPE: "stdout closed by its reader",
+    ExitCode.TERMINATED: "SIGTERM, resumable",
+}  # fmt: skip
+EPILOG = EXAMPLES + "\nexit codes:\n" + "".join(f"  {int(code):<4}{meaning}\n" for code, meaning in EXIT_CODES.items())
 
 
 # \d+(?:\.\d*)? and not \d+\.?\d*: a run of digits splits one way only, so a word of 20,000 digits
@@ -162,7 +171,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The parser of every command, or with ``only`` of that one command (what parsing its
     own words needs: its help, usage and errors are the same; building all fourteen was
     a tenth of a short run's start)."""
-    parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EXAMPLES)
+    parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EPILOG)
     parser.add_argument(
         "-V", "--version", action="version", version=f"frictionlab {__version__}", help="print the version and exit"
     )
