@@ -178,3 +178,20 @@ def test_frictionlab_run_draws_plot_png_in_its_drawing_process(tmp_path):
     assert done.returncode == 0, done.stderr
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["files"]["plot"] == "plot.png"
     assert (tmp_path / "run" / "plot.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_drawing_process_killed_while_it_writes_leaves_no_temporary_file(tmp_path):
+    """The run ended by an error (a disk full as its chunks merged) while plot.png was
+    being written there: the process is killed, and its half-written file removed."""
+    out = _run(
+        """
+        drawer = DrawingProcess.start()
+        drawer.send(Path("plot.png"), scene, outcome)
+        Path(".plot.png.k1ll3d_x.tmp").write_bytes(b"half a png")  # where the kill caught atomic_write
+        Path(".other.png.k1ll3d_x.tmp").write_bytes(b"not the figure's")
+        drawer.close()
+        print(sorted(path.name for path in Path(".").glob("*.tmp")))
+        """,
+        tmp_path,
+    )
+    assert out == ["['.other.png.k1ll3d_x.tmp']"]

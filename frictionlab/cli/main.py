@@ -33,13 +33,15 @@ import warnings
 from .. import __version__
 from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
                       out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
-from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
+from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, reserve_blas_buffer,
+                            spare_address_space_under_a_limit)
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
 COMMANDS = (run, resume, runs, follow, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
+COMPUTING = {"run", "resume", "report", "study", "exact3d", "tui"}  # the commands whose fits call BLAS
 
 
 DESCRIPTION = "rms slope in contact against normal force, over ensembles of random rough lines and surfaces."
@@ -50,6 +52,15 @@ EXAMPLES = """examples:
   frictionlab tui                             edit, run and compare in the terminal
   frictionlab COMMAND --help                  what a command does, with examples
 """
+EXIT_CODES = {  # each of ExitCode, for a script to tell the endings apart (the full table: docs/data-safety.md)
+    ExitCode.OK: "done", ExitCode.RUNTIME_FAILURE: "a run failed or would not fit in memory (what finished is kept)",
+    ExitCode.USAGE: "bad command line or preset value", ExitCode.INPUT_FILE: "the preset file cannot be used",
+    ExitCode.OUTPUT_REFUSED: "output refused (see --force)", ExitCode.RUN_FOLDER: "run folder cannot be resumed or is in use",
+    ExitCode.INTERNAL: "internal error (a bug)", ExitCode.HUNG_UP: "hung up (SIGHUP), resumable",
+    ExitCode.INTERRUPTED: "Ctrl-C, resumable", ExitCode.BROKEN_PIPE: "stdout closed by its reader",
+    ExitCode.TERMINATED: "SIGTERM, resumable",
+}  # fmt: skip
+EPILOG = EXAMPLES + "\nexit codes:\n" + "".join(f"  {int(code):<4}{meaning}\n" for code, meaning in EXIT_CODES.items())
 
 
 # \d+(?:\.\d*)? and not \d+\.?\d*: a run of digits splits one way only, so a word of 20,000 digits
@@ -162,7 +173,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The parser of every command, or with ``only`` of that one command (what parsing its
     own words needs: its help, usage and errors are the same; building all fourteen was
     a tenth of a short run's start)."""
-    parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EXAMPLES)
+    parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EPILOG)
     parser.add_argument(
         "-V", "--version", action="version", version=f"frictionlab {__version__}", help="print the version and exit"
     )
@@ -352,6 +363,8 @@ def _run_command(args) -> int:
         from .options import command_options, refuse_empty_paths
 
         refuse_empty_paths(args.parser, args)
+        if args.command in COMPUTING:
+            reserve_blas_buffer()  # under ulimit -v: a lack of room is said now, not an exit after the work
         from .jsonout import json_only
 
         stdout = json_only() if getattr(args, "json", False) else contextlib.nullcontext()

@@ -26,6 +26,7 @@ from .heap import keep_freed_memory
 WAIT_SECONDS = 0.2  # how often a cancel is looked at while every worker computes
 STOP_GRACE_SECONDS = 0.5  # after a cancel, a job's time to end by itself before its worker is killed
 ERROR_CHARS = 500  # an error carried back from a worker is cut to this
+HELD_SIGNALS = {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)}
 
 
 class WorkerLost(Exception):
@@ -59,9 +60,35 @@ def start_failure(exc: OSError) -> str:
 
     limits = {errno.EMFILE: ("RLIMIT_NOFILE", "-n"), errno.EAGAIN: ("RLIMIT_NPROC", "-u")}
     name, flag = limits.get(exc.errno, (None, None))
+    pids = cgroup_pids_limit() if exc.errno == errno.EAGAIN else None
+    if pids is not None:  # a container's or a job scheduler's limit, not the user's ulimit -u
+        return f"{exc.strerror or exc}; the control group's process limit (pids.max) is {pids} here"
     soft = resource.getrlimit(getattr(resource, name))[0] if name and hasattr(resource, name) else None
     limit = f"; ulimit {flag} is {soft} here" if soft is not None and soft != resource.RLIM_INFINITY else ""
     return f"{exc.strerror or exc}{limit}"
+
+
+def cgroup_pids_limit(root: str = "/sys/fs/cgroup", own: str = "/proc/self/cgroup") -> int | None:
+    """The pids.max of this process's control group where it is reached (a fork refused
+    by it, not by ``ulimit -u``), else None: cgroup v1's pids hierarchy, or v2's."""
+    try:
+        with open(own) as fh:
+            lines = fh.read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        _, controllers, path = line.split(":", 2)
+        if controllers not in ("pids", ""):
+            continue
+        for folder in (f"{root}/pids{path}", f"{root}{path}", f"{root}/unified{path}"):
+            try:
+                with open(f"{folder}/pids.max") as fh, open(f"{folder}/pids.current") as now:
+                    limit, current = fh.read().strip(), int(now.read())
+            except (OSError, ValueError):
+                continue
+            if limit.isdigit() and current >= int(limit):
+                return int(limit)
+    return None
 
 
 _results = None  # in a worker: the pipe of its results, for ``send_progress``
@@ -141,12 +168,16 @@ class _Worker:
         self.job = key
         return True
 
-    def stop(self, timeout: float = 2.0) -> None:
-        """Ask it to stop, and kill it if it has not within ``timeout`` (at once for 0)."""
+    def ask_stop(self) -> None:
+        """Tell it to stop (it ends after its job), without waiting."""
         try:
             self.tasks.send(None)
         except OSError:
             pass
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Ask it to stop, and kill it if it has not within ``timeout`` (at once for 0)."""
+        self.ask_stop()
         if timeout:
             self.process.join(timeout)
         if self.process.is_alive():
@@ -244,6 +275,23 @@ class WorkerPool:
                             if not cancel.is_set():
                                 pending.appendleft(worker.job)
         finally:  # idle workers stop; busy ones (an error or an interrupt got here) are killed
-            for worker in workers:
-                worker.stop(0 if worker.job is not None else 2.0)
+            _stop_all(workers)
+
+
+def _stop_all(workers: list[_Worker]) -> None:
+    """Every worker told to stop (a busy one killed) before any wait, with signals held
+    meanwhile: a second Ctrl-C that interrupts the waits leaves no worker waiting for a
+    job. It ignores SIGTERM, so the command's exit would wait for it forever."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS) if hasattr(signal, "pthread_sigmask") else None
+    try:
+        for worker in workers:
+            if worker.job is not None:
+                worker.process.kill()
+            else:
+                worker.ask_stop()
+    finally:
+        if held is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
+    for worker in workers:
+        worker.stop(0 if worker.job is not None else 2.0)
 

@@ -93,6 +93,7 @@ class DrawingProcess:
     def __init__(self, pid: int, connection: Connection) -> None:
         self.pid: int | None = pid
         self._connection = connection
+        self._path: Path | None = None  # the figure it was sent: its temporary file is removed if it is killed
 
     @classmethod
     def start(cls) -> DrawingProcess | None:
@@ -132,6 +133,7 @@ class DrawingProcess:
         finished (``results.plot_wanted``): False if not, or if the process is gone (``wait``)."""
         if self.pid is None or not plot_wanted(scene, outcome):
             return False
+        self._path = Path(path)
         try:
             self._connection.send((str(path), CurveFigure.of(scene, outcome)))
         except OSError:  # it died: killed, out of memory
@@ -169,6 +171,23 @@ class DrawingProcess:
         try:
             os.waitpid(pid, 0)
         except ChildProcessError:
+            pass
+        if self._path is not None:  # killed while it wrote (the run ended by an error, a disk full)
+            _remove_partial(self._path)
+
+
+def _remove_partial(path: Path) -> None:
+    """The temporary sibling ``io.files.atomic_write`` left of ``path`` in a process killed
+    while writing it: the figure is then drawn again, or not at all, never half."""
+    try:
+        leftovers = [entry for entry in path.parent.iterdir()
+                     if entry.name.startswith(f".{path.name}.") and entry.name.endswith(".tmp")]  # fmt: skip
+    except OSError:
+        return
+    for entry in leftovers:
+        try:
+            entry.unlink()
+        except OSError:
             pass
 
 
