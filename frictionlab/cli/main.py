@@ -33,15 +33,13 @@ import warnings
 from .. import __version__
 from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
                       out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
-from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, reserve_blas_buffer,
-                            spare_address_space_under_a_limit)
+from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
 COMMANDS = (run, resume, runs, follow, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
-COMPUTING = {"run", "resume", "report", "study", "exact3d", "tui"}  # the commands whose fits call BLAS
 
 
 DESCRIPTION = "rms slope in contact against normal force, over ensembles of random rough lines and surfaces."
@@ -363,8 +361,6 @@ def _run_command(args) -> int:
         from .options import command_options, refuse_empty_paths
 
         refuse_empty_paths(args.parser, args)
-        if args.command in COMPUTING:
-            reserve_blas_buffer()  # under ulimit -v: a lack of room is said now, not an exit after the work
         from .jsonout import json_only
 
         stdout = json_only() if getattr(args, "json", False) else contextlib.nullcontext()

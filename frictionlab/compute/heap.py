@@ -76,16 +76,3 @@ def spare_address_space_under_a_limit() -> None:
     if not os.environ.get("MALLOC_ARENA_MAX"):
         os.environ["MALLOC_ARENA_MAX"] = str(ARENAS)  # children: glibc reads it as they start
         _mallopt(M_ARENA_MAX, ARENAS)  # this process, started already
-
-
-def reserve_blas_buffer() -> None:
-    """Under a process limit on memory, have OpenBLAS map its work buffer now, before any
-    work: it maps it at its first call, and where the limit leaves no room it exits the
-    process ('OpenBLAS error: Memory allocation still failed'), past Python's reach. A run's
-    fit made that call after its realizations, so the run ended unsaved; now a lack of
-    memory there is a MemoryError, said and survived like any other. Imports numpy."""
-    if process_limit() is None:
-        return
-    import numpy as np
-
-    np.linalg.lstsq(np.ones((4, 2)), np.ones(4), rcond=None)

@@ -141,12 +141,11 @@ def cancel(folder: str | Path) -> int:
 
 def _child() -> int:
     """The detached process: read the request from stdin, run it, tell the folder how it went."""
-    from ..compute.heap import keep_freed_memory, reserve_blas_buffer
+    from ..compute.heap import keep_freed_memory
     from ..compute.signals import RaiseOnSignals
     from .sweeplog import SweepProgressLog
 
     keep_freed_memory()  # a process of frictionlab's own, as the command's is
-    reserve_blas_buffer()
     if hasattr(signal, "SIGHUP"):
         signal.signal(signal.SIGHUP, signal.SIG_IGN)  # no terminal of its own; a stray hangup is not a cancel
     request = json.loads(sys.stdin.read())
