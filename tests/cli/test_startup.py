@@ -40,8 +40,14 @@ def test_validate_imports_only_what_validating_needs():
 
 
 @pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
-def test_the_figure_imports_matplotlib_only_when_drawn(tmp_path):
+@pytest.mark.parametrize("drawing_process", [True, False])
+def test_the_figure_imports_matplotlib_only_when_drawn(tmp_path, drawing_process):
+    """``frictionlab run`` draws plot.png in a process forked as it starts (matplotlib never
+    comes into the command's own); where none can be had, it imports matplotlib to draw it."""
     quickstart = PRESETS / "quickstart.yaml"
-    code = f"from frictionlab.cli import main\nmain(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet'])"
-    assert "matplotlib" in imported_after(code)
+    refuse = "" if drawing_process else (
+        "import frictionlab.runs.figures as figures\nfigures.DrawingProcess.start = classmethod(lambda cls: None)\n")
+    code = (f"{refuse}from frictionlab.cli import main\n"
+            f"main(['run', {str(quickstart)!r}, '--out', {str(tmp_path / 'o')!r}, '--quiet'])")
+    assert ("matplotlib" in imported_after(code)) is not drawing_process
     assert (tmp_path / "o" / "plot.png").is_file()
