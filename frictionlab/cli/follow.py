@@ -71,6 +71,10 @@ def run(args) -> ExitCode:
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
         folder = folder.resolve()
     refuse_a_part_of_a_run(folder, "follow")
+    if folder.is_dir():  # else run_state says what it is
+        from ..runs.sweepfiles import refuse_a_sweep_without_record
+
+        refuse_a_sweep_without_record(folder, "follow")
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None
     error, gone, identity, holder = None, False, _identity(folder), state.pid

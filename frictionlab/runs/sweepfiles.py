@@ -51,6 +51,23 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
         raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)")
 
 
+def refuse_a_sweep_without_record(folder: Path, command: str) -> None:
+    """RunFolderError where ``folder`` is a sweep's (its sweep.csv or points/, no run of its own) whose
+    sweep.json is gone: it was refused as 'no preset.yaml' (or 'no run.json'), files no sweep has."""
+    from .rundir import PRESET_FILE, STATE_FILE
+
+    if any((folder / name).exists() or (folder / name).is_symlink() for name in ("sweep.json", PRESET_FILE, STATE_FILE)):
+        return
+    left = [shown for name, shown in (("sweep.csv", "sweep.csv"), ("points", "points/")) if (folder / name).exists()]
+    if left:
+        raise RunFolderError(
+            f"{shown_name(folder)} is a sweep's folder (it holds {' and '.join(left)}) but its sweep.json, which says "
+            f"what the sweep is, is missing: frictionlab {command} cannot read the sweep without it. Each point in "
+            f"{shown_name(folder / 'points')}/ is a run of its own (frictionlab {command} POINT_FOLDER); or run the "
+            "sweep's preset into another folder"
+        )
+
+
 def stored_sweep(out_dir: Path) -> dict:
     """The preset data of the sweep stored in ``out_dir`` (its sweep.json: the base preset
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
