@@ -72,6 +72,12 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--axes", "realizations", "--grid-realizations", "5"], "--grid-realizations changes the grid and steps axes"),
         (["--axes", "steps", "--points", "64"], "--points changes the solver and tolerance axes"),
         (["--axes", "grid", "--compare-realizations", "3"], "--compare-realizations changes the solver and tolerance"),
+        # above the preset's own it ran with the preset's, unsaid
+        (["--compare-realizations", "1000"], "--compare-realizations 1000 is more than the preset's 8 realizations: the "
+                                             "study takes at most the preset's; give --compare-realizations 8 or less"),
+        (["--grid-realizations", "9"], "--grid-realizations 9 is more than the preset's 8 realizations"),
+        (["--compare-steps", "41"], "--compare-steps 41 is more than the preset's 12 load steps"),
+        (["--points", "99999999"], "--points 99999999 is more than the preset's 256 points: the study takes at most"),
     ],
 )
 def test_cli_usage_errors_name_the_option(tmp_path, capsys, args, message):
