@@ -48,7 +48,22 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
-        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)")
+        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)"
+                         + _changes(old, mine))
+
+
+def _changes(old, mine: dict, shown: int = 8) -> str:
+    """Where the sweep stored (``old``, its sweep.json) and the one given differ, a line each, the
+    first ``shown`` of them: 'holds another sweep' alone named no field to look at."""
+    from ..preset.paths import differences
+
+    def flat(record: dict) -> dict:  # as the preset reads: its fields, and its sweep section
+        base = record.get("base_preset")
+        return {**(base if isinstance(base, dict) else {"base_preset": base}), "sweep": record.get("sweep")}
+
+    changed = differences(flat(old), flat(mine)) if isinstance(old, dict) else []
+    more = f"\n  ... and {len(changed) - shown} more" if len(changed) > shown else ""
+    return "".join(f"\n  {line}" for line in changed[:shown]) + more
 
 
 def refuse_a_sweep_without_record(folder: Path, command: str) -> None:
