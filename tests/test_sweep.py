@@ -185,6 +185,9 @@ BAD_SPECS = [
      "(5) only, never its stop (9): give num >= 2 for both ends, or values: [5] for one value"),
     # pydantic's own words: 'dictionary should have at least 1 item after validation, not 0'
     ({}, "sweep.parameters: must hold at least 1 item, got {}"),
+    # spacing: log beside values was ignored without a word: the values ran as listed
+    ({"loading.stop": {"values": [1, 5], "spacing": "log"}}, "sweep.parameters.loading.stop: spacing: log spaces a range "
+     "(start, stop, num); values are taken as listed: drop spacing, or give a range instead of values"),
 ]  # fmt: skip
 
 
