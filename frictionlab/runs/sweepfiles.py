@@ -12,7 +12,7 @@ from .. import __version__
 from ..errors import OutputRefused, RunFolderError, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from .runfolder import read_json
-from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
+from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, as_it_ran, read_sweep_record
 
 if TYPE_CHECKING:
     from .sweep import Sweep, SweepOutcome
@@ -40,7 +40,7 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
         return
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
-        old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+        old = as_it_ran(read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES))
     except RunFolderError:
         raise OtherSweep(
             f"{shown_name(out_dir)} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
