@@ -131,6 +131,20 @@ def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_fo
     assert code == ExitCode.OUTPUT_REFUSED and "not a study of tiny" in capsys.readouterr().err
 
 
+def test_a_study_folder_with_other_files_beside_it_is_said_to_be_that_study(tmp_path, capsys):
+    """A study of the same preset with the user's notes beside it was refused as 'holds
+    'notes.txt', 'study.md', ..., not a study of quickstart': it is one; the notes are the matter."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "study.md").write_text("# Trade-off study: quickstart\n")
+    (out / "notes.txt").write_text("keep me")
+    assert main(["study", "quickstart", *QUICK, "--out", str(out)]) == ExitCode.OUTPUT_REFUSED
+    assert capsys.readouterr().err == (f"error: --out {out} holds a study of quickstart and also 'notes.txt': give another "
+                                       "folder, or --force to write study.csv, study.md and study.png into it (nothing "
+                                       "else is touched)\n")  # fmt: skip
+    assert (out / "notes.txt").read_text() == "keep me" and sorted(p.name for p in out.iterdir()) == ["notes.txt", "study.md"]
+
+
 @pytest.mark.parametrize("force", [False, True])
 def test_a_study_file_that_is_a_folder_is_refused_before_the_work_not_after(tmp_path, capsys, force):
     """A study folder whose study.csv is a folder (its study.md headed as the study's) was taken
