@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -71,9 +72,10 @@ def refuse_a_sweep_without_record(folder: Path, command: str) -> None:
     sweep.json is gone: it was refused as 'no preset.yaml' (or 'no run.json'), files no sweep has."""
     from .rundir import PRESET_FILE, STATE_FILE
 
-    if any((folder / name).exists() or (folder / name).is_symlink() for name in ("sweep.json", PRESET_FILE, STATE_FILE)):
+    # lexists: a folder that cannot be searched is said so by the reads that follow, not raised here
+    if any(os.path.lexists(folder / name) for name in ("sweep.json", PRESET_FILE, STATE_FILE)):
         return
-    left = [shown for name, shown in (("sweep.csv", "sweep.csv"), ("points", "points/")) if (folder / name).exists()]
+    left = [shown for name, shown in (("sweep.csv", "sweep.csv"), ("points", "points/")) if os.path.lexists(folder / name)]
     if left:
         raise RunFolderError(
             f"{shown_name(folder)} is a sweep's folder (it holds {' and '.join(left)}) but its sweep.json, which says "
