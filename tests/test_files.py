@@ -193,6 +193,22 @@ def test_a_full_disk_names_the_file_it_was_writing_and_leaves_no_part_of_it(tmp_
     assert list(tmp_path.iterdir()) == []  # nothing that looks whole, no temporary
 
 
+def test_a_rename_refused_names_the_file_not_its_temporary(tmp_path, monkeypatch):
+    """A rename over a file that cannot be replaced (chattr +i: EPERM) said 'Operation not
+    permitted: .../.exist.json.3rpqgi_w.tmp', a temporary the user never heard of."""
+    target = tmp_path / "exist.json"
+    target.write_text("keep")
+
+    def refused(src, dst):  # as os.replace says it: both names
+        raise PermissionError(errno.EPERM, os.strerror(errno.EPERM), str(src), str(dst))
+
+    monkeypatch.setattr(os, "replace", refused)
+    with pytest.raises(OSError) as raised:
+        atomic_write(target, lambda fh: fh.write("{}"))
+    assert (raised.value.errno, raised.value.filename, raised.value.filename2) == (errno.EPERM, str(target), None)
+    assert [p.name for p in tmp_path.iterdir()] == ["exist.json"] and target.read_text() == "keep"
+
+
 def test_a_full_device_the_user_named_is_named_too(tmp_path):
     if not os.path.exists("/dev/full"):
         pytest.skip("no /dev/full on this system")

@@ -252,6 +252,8 @@ def test_follow_of_a_run_whose_folder_is_deleted_says_it_is_gone_and_advises_no_
         run.kill()
         run.wait()
     assert follow.returncode == 1 and "was deleted or replaced while its run was going" in err
+    # it said the process wrote 'nowhere you can see': its next chunk made the folder anew
+    assert f"still runs and may write a new {out}/ as it goes on (kill -TERM {run.pid} stops it)" in err
     assert "resume" not in (out_text + err).replace("nothing of that run is left to resume", "")
 
 

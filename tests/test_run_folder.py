@@ -302,7 +302,13 @@ def test_a_sweep_into_a_folder_that_is_not_its_own_is_refused(tmp_path, capsys):
     other = write(tmp_path / "t.yaml", merge(QUICK, {"realizations": 2, "sweep": {"parameters": {
         "spectrum.params.hurst": {"values": [0.5]}}}}))  # fmt: skip
     assert main(["run", str(other), "--out", str(tmp_path / "sweep"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
-    assert "holds another sweep" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "holds another sweep" in err
+    # it named no field: which values differ, stored and given
+    assert "\n  sweep.parameters.spectrum.params.hurst.values: [0.6, 0.9] in the run directory, [0.5] given" in err
+    assert main(["run", str(preset), "--out", str(tmp_path / "sweep"), "--resume", "--quiet",
+                 "--set", "realizations=3"]) == ExitCode.OUTPUT_REFUSED  # fmt: skip
+    assert capsys.readouterr().err.endswith("\n  realizations: 2 in the run directory, 3 given\n")
 
 
 def _status(folder: Path) -> str:

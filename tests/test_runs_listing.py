@@ -368,3 +368,18 @@ def test_a_file_or_folder_inside_a_run_folder_names_the_folder_to_give(tmp_path,
     assert capsys.readouterr().err == (f"error: {tmp_path / 'run' / inside} is inside the run folder {tmp_path / 'run'}, not "
                                        f"one itself: give that folder (frictionlab {command} {tmp_path / 'run'})\n")  # fmt: skip
     assert sorted(p.name for p in (tmp_path / "run").iterdir()) == before
+
+
+@pytest.mark.parametrize("command", ["follow", "resume"])
+def test_a_sweep_folder_whose_sweep_json_is_gone_is_said_so_not_a_missing_preset_yaml(tmp_path, capsys, command):
+    """`resume SWEEP` with sweep.json deleted said 'holds no run to resume (no preset.yaml)' (`follow`:
+    'no run.json'), files no sweep has: it names the missing sweep.json and how to reach the points."""
+    sweep = tmp_path / "sweep"
+    (sweep / "points" / "01-seed-1").mkdir(parents=True)
+    (sweep / "sweep.csv").write_text("point,label\n1,01-seed-1\n")
+    before = sorted(p.name for p in sweep.rglob("*"))
+    assert main([command, "--quiet", str(sweep)]) == 5
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {sweep} is a sweep's folder (it holds sweep.csv and points/) but its sweep.json")
+    assert f"frictionlab {command} POINT_FOLDER" in err and "Traceback" not in err
+    assert sorted(p.name for p in sweep.rglob("*")) == before  # nothing written or deleted

@@ -185,6 +185,9 @@ BAD_SPECS = [
      "(5) only, never its stop (9): give num >= 2 for both ends, or values: [5] for one value"),
     # pydantic's own words: 'dictionary should have at least 1 item after validation, not 0'
     ({}, "sweep.parameters: must hold at least 1 item, got {}"),
+    # spacing: log beside values was ignored without a word: the values ran as listed
+    ({"loading.stop": {"values": [1, 5], "spacing": "log"}}, "sweep.parameters.loading.stop: spacing: log spaces a range "
+     "(start, stop, num); values are taken as listed: drop spacing, or give a range instead of values"),
 ]  # fmt: skip
 
 
@@ -573,3 +576,23 @@ def test_a_sweep_table_that_is_a_folder_or_a_folder_not_writable_is_said_so_at_o
         out.chmod(0o755)
     assert done.returncode == 4 and f"{out} cannot be written in: Permission denied" in done.stderr, done.stderr
     assert "damaged" not in done.stderr and len(list((out / "points").iterdir())) == 1
+
+
+def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, registry, capsys):
+    """spacing: log beside values, now refused, was once accepted (and ignored): an interrupted
+    sweep that holds it in its sweep.json resumed as 'damaged', its finished point out of reach."""
+    cancel = threading.Event()
+
+    class StopAfterFirst(SweepListener):
+        def point_finished(self, sweep, point, result):
+            cancel.set()
+
+    sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2]}}), registry=registry)
+    run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    record = json.loads((tmp_path / "sweep.json").read_text())
+    record["sweep"]["parameters"]["seed"]["spacing"] = "log"  # as such a sweep wrote it
+    (tmp_path / "sweep.json").write_text(json.dumps(record))
+    first = (tmp_path / "points" / sweep.points[0].folder_name / "summary.json").read_bytes()
+    assert main(["resume", str(tmp_path), "--workers", "1", "--quiet", "--no-plot"]) == 0, capsys.readouterr().err
+    assert [r["status"] for r in read_table(tmp_path / "sweep.csv")] == ["completed", "completed"]
+    assert (tmp_path / "points" / sweep.points[0].folder_name / "summary.json").read_bytes() == first  # kept, not rerun

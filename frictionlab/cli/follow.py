@@ -71,6 +71,10 @@ def run(args) -> ExitCode:
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
         folder = folder.resolve()
     refuse_a_part_of_a_run(folder, "follow")
+    if folder.is_dir():  # else run_state says what it is
+        from ..runs.sweepfiles import refuse_a_sweep_without_record
+
+        refuse_a_sweep_without_record(folder, "follow")
     state = run_state(folder)  # RunFolderError: not a run folder
     sweep = _stored_sweep(folder) if state.kind == "sweep" else None
     error, gone, identity, holder = None, False, _identity(folder), state.pid
@@ -109,8 +113,10 @@ def run(args) -> ExitCode:
         if error is None and state.status != "completed":
             error = logged_error(folder)
     if gone:  # what is true: the folder it followed is no more; nothing there to resume
-        still = f"; its process (pid {holder}) still runs, writing nowhere you can see" if holder and process_alive(holder) else ""
-        message = f"{shown(folder)} was deleted or replaced while its run was going: nothing of that run is left to resume{still}"
+        message = f"{shown(folder)} was deleted or replaced while its run was going: nothing of that run is left to resume"
+        if holder and process_alive(holder):  # it goes on, and its next write makes the folder anew
+            message += (f"; its process (pid {holder}) still runs and may write a new {shown_name(folder)}/ as it goes "
+                        f"on (kill -TERM {holder} stops it)")  # fmt: skip
         if args.json:
             from .jsonout import emit
 

@@ -50,6 +50,7 @@ def run(args) -> ExitCode:
     from ..io.files import output_path_problem
     from ..runs.rundir import PRESET_FILE, RunDirectory
     from ..runs.runfolder import check_searchable
+    from ..runs.sweepfiles import refuse_a_sweep_without_record
 
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
@@ -75,6 +76,7 @@ def run(args) -> ExitCode:
                 f"{shown_name(args.preset)} is damaged: its name, sweep and base preset are not those of one sweep "
                 "(a field edited): it cannot be resumed"
             ) from None
+    refuse_a_sweep_without_record(run_dir, "resume")
     # a clear error when there is nothing to resume, or it is damaged; a sweep added to a run's preset.yaml
     # was refused as no sweep's folder, to be forced with --force, which resume lacks
     if RunDirectory(run_dir).stored_preset().get("sweep") is not None:

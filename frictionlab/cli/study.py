@@ -247,6 +247,25 @@ def _refuse_nothing_to_run(study, axes: tuple[str, ...]) -> None:
                            f"a reference solver, and {why}; give other --axes (grid, realizations, steps)")  # fmt: skip
 
 
+def _refuse_beyond_the_preset(args, base) -> None:
+    """Refuse a size given above the preset's own: the study takes at most the preset's, so
+    ``--compare-realizations 1000`` on a preset of 4 ran with 4 and said nothing."""
+    from ..tradeoff.axes import preset_points
+
+    preset = base.preset
+    limits = {"points": (preset_points(base), "points per side" if base.spectrum.dimension == 2 else "points"),
+              "compare_realizations": (preset.realizations, "realizations"),
+              "grid_realizations": (preset.realizations, "realizations"),
+              "compare_steps": (preset.loading.steps, "load steps")}  # fmt: skip
+    for name, (limit, what) in limits.items():
+        value = getattr(args, name)
+        if value == DEFAULTS[name] or limit is None or value <= limit:  # a default above it is the preset's, as documented
+            continue
+        option = "--" + name.replace("_", "-")
+        raise FrictionlabError(f"{option} {value} is more than the preset's {limit} {what}: the study takes at most the "
+                               f"preset's; give {option} {limit} or less, or raise the preset's with --set")  # fmt: skip
+
+
 def run(args) -> ExitCode:
     from ..preset import read_preset
     from ..preset.builtin import preset_source, resolve_preset_path
@@ -268,6 +287,7 @@ def run(args) -> ExitCode:
         data = {**data, "sweep": None}
     factory = SceneFactory(data, default_registry(), source=preset_source(args.preset, args.set or []),
                            before_reading=refuse_beyond(*PRESET_GRID))  # before its map is read or its line made
+    _refuse_beyond_the_preset(args, factory.base)
 
     def progress(message: str) -> None:
         if not args.quiet:

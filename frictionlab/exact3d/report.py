@@ -81,6 +81,16 @@ def page_paths(out_dir: Path, *, force: bool) -> tuple[Path, Path]:
     return page, figures
 
 
+def _refuse_out_inside_runs(out_dir: Path, runs_dir: Path) -> None:
+    """Refuse an --out below --runs: --out RUNS/h0.3-n64-mdr wrote the page and its figures into
+    an ensemble's run folder (--force or not), and any other would be a stranger there, for which
+    the next --runs RUNS is refused."""
+    out, runs = os.path.realpath(out_dir), os.path.realpath(runs_dir)
+    if out.startswith(runs + os.sep):
+        raise OutputRefused(f"--out {shown_name(out_dir)} is inside the runs folder {shown_name(runs_dir)}, which holds "
+                            "only the ensembles' runs: give the runs folder itself (the default) or one outside it")  # fmt: skip
+
+
 def same_surfaces(runs: StudyRuns) -> bool:
     """Whether the coarsest and the finest finished grid of the first H hold the same surface
     (realization 0) at the coarse grid's points."""
@@ -139,6 +149,7 @@ def write_page(
     runs_dir = Path(runs_dir) if runs_dir else new_run_folder(f"exact3d-{plan.name}")
     command = command or _command(quick, out_dir, runs_dir, finished_only)  # names a default runs folder too
     out_dir = Path(out_dir) if out_dir else runs_dir
+    _refuse_out_inside_runs(out_dir, runs_dir)
     page, figures = page_paths(out_dir, force=options.force)
     try:
         with one_dask_cluster(options):  # on Dask, every ensemble's run uses one client and cluster

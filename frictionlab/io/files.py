@@ -66,8 +66,8 @@ def atomic_write(
         error = IsADirectoryError if "folder" in problem else OSError
         raise error(errno.EISDIR if "folder" in problem else errno.EINVAL, problem, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     with _naming(path):
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         try:
             os.fchmod(fd, 0o666 & ~_UMASK if mode is None else mode)
             with os.fdopen(fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
@@ -83,12 +83,14 @@ def atomic_write(
 @contextlib.contextmanager
 def _naming(path: Path):
     """A write or fsync that fails (a full disk: ENOSPC) raises an OSError naming no file:
-    it is given ``path``, so that its message says which file, in which folder, was not written."""
+    it is given ``path``, so that its message says which file, in which folder, was not written;
+    as is one naming the temporary sibling (a rename over an immutable file), a name never heard of."""
     try:
         yield
     except OSError as exc:
-        if exc.filename is None:
-            exc.filename = str(path)
+        temporary = exc.filename is not None and Path(exc.filename).name.startswith(f".{path.name}.")
+        if exc.filename is None or temporary:
+            exc.filename, exc.filename2 = str(path), None
         raise
 
 

@@ -52,9 +52,9 @@ def report_paths(out_dir=None, markdown_path=None, figures_dir=None, *, force: b
     _refuse_foreign_folder(out_dir, markdown_path, figures_dir)
     if not named:  # one there is replaced only if a report wrote it
         _refuse_foreign_markdown(markdown_path)
-    _refuse_overwriting(markdown_path, figures_dir, force)
-    _refuse_inside_runs(out_dir, markdown_path, figures_dir)
+    _refuse_inside_runs(out_dir, markdown_path, figures_dir)  # first: 'or --force' would not lift them
     _refuse_markdown_among_figures(markdown_path, figures_dir)
+    _refuse_overwriting(markdown_path, figures_dir, force)
     return out_dir, markdown_path, figures_dir
 
 

@@ -111,6 +111,9 @@ class SweepParameter(_Strict):
             raise ValueError("give values: [...] or a range start, stop, num")
         if self.values is not None and not self.values:
             raise ValueError("values must not be empty")
+        if self.values is not None and self.spacing == "log":  # it was ignored: the values ran as listed
+            raise ValueError("spacing: log spaces a range (start, stop, num); values are taken as listed: drop "
+                             "spacing, or give a range instead of values")  # fmt: skip
         if given and len(given) < 3:
             missing = [k for k in ranged if k not in given]
             raise ValueError(f"a range needs start, stop and num; missing: {', '.join(missing)}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,7 +13,7 @@ from .. import __version__
 from ..errors import OutputRefused, RunFolderError, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from .runfolder import read_json
-from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, read_sweep_record
+from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, as_it_ran, read_sweep_record
 
 if TYPE_CHECKING:
     from .sweep import Sweep, SweepOutcome
@@ -40,7 +41,7 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
         return
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
-        old = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+        old = as_it_ran(read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES))
     except RunFolderError:
         raise OtherSweep(
             f"{shown_name(out_dir)} is not empty and is not the folder of a frictionlab sweep (no readable sweep.json): {hint}"
@@ -48,7 +49,40 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     mine = {"name": sweep.name, "sweep": sweep.spec.model_dump(mode="json", exclude_none=True), "base_preset": sweep.base}
     mine = json.loads(json.dumps(mine, default=str))
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
-        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)")
+        raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)"
+                         + _changes(old, mine))
+
+
+def _changes(old, mine: dict, shown: int = 8) -> str:
+    """Where the sweep stored (``old``, its sweep.json) and the one given differ, a line each, the
+    first ``shown`` of them: 'holds another sweep' alone named no field to look at."""
+    from ..preset.paths import differences
+
+    def flat(record: dict) -> dict:  # as the preset reads: its fields, and its sweep section
+        base = record.get("base_preset")
+        return {**(base if isinstance(base, dict) else {"base_preset": base}), "sweep": record.get("sweep")}
+
+    changed = differences(flat(old), flat(mine)) if isinstance(old, dict) else []
+    more = f"\n  ... and {len(changed) - shown} more" if len(changed) > shown else ""
+    return "".join(f"\n  {line}" for line in changed[:shown]) + more
+
+
+def refuse_a_sweep_without_record(folder: Path, command: str) -> None:
+    """RunFolderError where ``folder`` is a sweep's (its sweep.csv or points/, no run of its own) whose
+    sweep.json is gone: it was refused as 'no preset.yaml' (or 'no run.json'), files no sweep has."""
+    from .rundir import PRESET_FILE, STATE_FILE
+
+    # lexists: a folder that cannot be searched is said so by the reads that follow, not raised here
+    if any(os.path.lexists(folder / name) for name in ("sweep.json", PRESET_FILE, STATE_FILE)):
+        return
+    left = [shown for name, shown in (("sweep.csv", "sweep.csv"), ("points", "points/")) if os.path.lexists(folder / name)]
+    if left:
+        raise RunFolderError(
+            f"{shown_name(folder)} is a sweep's folder (it holds {' and '.join(left)}) but its sweep.json, which says "
+            f"what the sweep is, is missing: frictionlab {command} cannot read the sweep without it. Each point in "
+            f"{shown_name(folder / 'points')}/ is a run of its own (frictionlab {command} POINT_FOLDER); or run the "
+            "sweep's preset into another folder"
+        )
 
 
 def stored_sweep(out_dir: Path) -> dict:

@@ -68,7 +68,7 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
     """A sweep folder's sweep.json (read as any run folder's file is: ``runfolder``): the
     JSON object and its checked record; RunFolderError naming the file and the field."""
     path = Path(out_dir) / "sweep.json"
-    data = read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES)
+    data = as_it_ran(read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES))
     check_schema_version(data, path, SWEEP_SCHEMA_VERSION)
     record = checked(SweepRecord, data, path)
     try:  # a row per point: a list cut short would be read as a smaller sweep
@@ -79,6 +79,18 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
         raise RunFolderError(f"{shown_name(path)} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
     _check_swept_values(data["points"], list(record.sweep.parameters), path)
     return data, record
+
+
+def as_it_ran(data):
+    """A sweep.json's object with each parameter's ``spacing: log`` beside ``values`` read as
+    ``linear``: a sweep started before that pair was refused ran its values as listed, and stays
+    one that resume, follow and load read (and a run into its folder takes as the same sweep)."""
+    sweep = data.get("sweep") if isinstance(data, dict) else None
+    if not isinstance(sweep, dict) or not isinstance(sweep.get("parameters"), dict):
+        return data
+    listed = lambda p: isinstance(p, dict) and p.get("values") is not None and p.get("spacing") == "log"  # noqa: E731
+    parameters = {path: {**p, "spacing": "linear"} if listed(p) else p for path, p in sweep["parameters"].items()}
+    return {**data, "sweep": {**sweep, "parameters": parameters}}
 
 
 def _check_swept_values(rows: list[dict], parameters: list[str], path: Path) -> None:

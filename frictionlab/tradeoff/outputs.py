@@ -361,11 +361,13 @@ def claim_study_folder(out_dir: str | Path | None, name: str, *, force: bool = F
     held = sorted(p.name for p in out.iterdir())
     if not held or (set(held) <= set(FILES) and is_study_of(out / "study.md", name)):
         return out
-    listed = ", ".join(repr(shown(n)) for n in held[:3])
-    raise OutputRefused(
-        f"--out {shown_name(out)} holds {listed}{', ...' if len(held) > 3 else ''}, not a study of {name}: "
-        "give another folder, or --force to write study.csv, study.md and study.png into it (nothing else is touched)"
-    )
+    others = [n for n in held if n not in FILES]
+    study = bool(others) and is_study_of(out / "study.md", name)  # it said 'not a study of NAME' of one beside notes
+    listed = ", ".join(repr(shown(n)) for n in (others if study else held)[:3])
+    more = ", ..." if len(others if study else held) > 3 else ""
+    what = f"a study of {name} and also {listed}{more}" if study else f"{listed}{more}, not a study of {name}"
+    raise OutputRefused(f"--out {shown_name(out)} holds {what}: give another folder, or --force to write study.csv, "
+                        "study.md and study.png into it (nothing else is touched)")  # fmt: skip
 
 
 def is_study_of(page: Path, name: str) -> bool:

@@ -72,6 +72,12 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
         (["--axes", "realizations", "--grid-realizations", "5"], "--grid-realizations changes the grid and steps axes"),
         (["--axes", "steps", "--points", "64"], "--points changes the solver and tolerance axes"),
         (["--axes", "grid", "--compare-realizations", "3"], "--compare-realizations changes the solver and tolerance"),
+        # above the preset's own it ran with the preset's, unsaid
+        (["--compare-realizations", "1000"], "--compare-realizations 1000 is more than the preset's 8 realizations: the "
+                                             "study takes at most the preset's; give --compare-realizations 8 or less"),
+        (["--grid-realizations", "9"], "--grid-realizations 9 is more than the preset's 8 realizations"),
+        (["--compare-steps", "41"], "--compare-steps 41 is more than the preset's 12 load steps"),
+        (["--points", "99999999"], "--points 99999999 is more than the preset's 256 points: the study takes at most"),
     ],
 )
 def test_cli_usage_errors_name_the_option(tmp_path, capsys, args, message):
@@ -123,6 +129,20 @@ def test_study_out_keeps_the_users_files_unless_force(tmp_path, capsys, users_fo
     # another preset's study folder is not its own
     code = main(["study", str(write(tmp_path, TINY)), *QUICK, "--out", str(other)])
     assert code == ExitCode.OUTPUT_REFUSED and "not a study of tiny" in capsys.readouterr().err
+
+
+def test_a_study_folder_with_other_files_beside_it_is_said_to_be_that_study(tmp_path, capsys):
+    """A study of the same preset with the user's notes beside it was refused as 'holds
+    'notes.txt', 'study.md', ..., not a study of quickstart': it is one; the notes are the matter."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "study.md").write_text("# Trade-off study: quickstart\n")
+    (out / "notes.txt").write_text("keep me")
+    assert main(["study", "quickstart", *QUICK, "--out", str(out)]) == ExitCode.OUTPUT_REFUSED
+    assert capsys.readouterr().err == (f"error: --out {out} holds a study of quickstart and also 'notes.txt': give another "
+                                       "folder, or --force to write study.csv, study.md and study.png into it (nothing "
+                                       "else is touched)\n")  # fmt: skip
+    assert (out / "notes.txt").read_text() == "keep me" and sorted(p.name for p in out.iterdir()) == ["notes.txt", "study.md"]
 
 
 @pytest.mark.parametrize("force", [False, True])

@@ -203,3 +203,16 @@ def test_an_ensembles_folder_its_run_refuses_is_refused_before_any_runs(tmp_path
     assert exact3d("--workers", "1", "--runs", tmp_path / "runs", "--out", tmp_path / "page") == ExitCode.OUTPUT_REFUSED
     assert f"{folder} is not empty and is not a frictionlab run folder (it holds 'notes.txt')" in capsys.readouterr().err
     assert sorted(p.name for p in (tmp_path / "runs").iterdir()) == [folder.name]
+
+
+@pytest.mark.parametrize("inside", ["h0.3-n64-mdr", "page"])
+@pytest.mark.parametrize("finished_only", [True, False])
+def test_an_out_inside_the_runs_folder_is_refused_before_anything_runs(tmp_path, capsys, inside, finished_only):
+    """--out RUNS/h0.3-n64-mdr wrote the page and its figures into an ensemble's run folder (exit 0)."""
+    runs = tmp_path / "runs"
+    (runs / "h0.3-n64-mdr").mkdir(parents=True)
+    code = exact3d("--runs", runs, "--out", runs / inside, *(["--finished-only"] if finished_only else []))
+    assert code == ExitCode.OUTPUT_REFUSED
+    assert capsys.readouterr().err == (f"error: --out {runs / inside} is inside the runs folder {runs}, which holds only "
+                                       "the ensembles' runs: give the runs folder itself (the default) or one outside it\n")  # fmt: skip
+    assert [p.name for p in runs.rglob("*")] == ["h0.3-n64-mdr"]

@@ -91,6 +91,20 @@ def test_a_markdown_or_figures_in_a_folder_of_the_reports_runs_is_refused(tmp_pa
     assert not out.exists()
 
 
+@pytest.mark.parametrize("inside", ["fig2/summary.json", "fig5/sweep.csv"])
+def test_a_markdown_over_a_file_of_an_earlier_reports_run_is_refused_without_advising_force(tmp_path, capsys, inside):
+    """Over a run's file that exists, it said 'the report would overwrite it: ... or --force';
+    --force then met the refusal that no --force lifts."""
+    out = tmp_path / "r"
+    (out / inside).parent.mkdir(parents=True)
+    (out / inside).write_text("the run's")
+    code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--markdown", str(out / inside), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == ExitCode.OUTPUT_REFUSED and "--force" not in err
+    assert f"--markdown {out / inside} is in {out / inside.split('/')[0]}, where the report keeps its runs" in err
+    assert (out / inside).read_text() == "the run's"
+
+
 def test_a_bad_preset_among_the_figures_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch):
     """Fig. 5's preset is the last to run: its mistake is named (exit 2) before Figs. 2 to 4
     spend their minutes, and no run folder is made."""
