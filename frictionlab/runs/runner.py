@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..compute.executors import dask_memory_limits
-from ..errors import RunError, RunFolderError
+from ..errors import RunError, RunFolderError, process_limit
 from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
@@ -34,18 +34,24 @@ class BatchedStore:
     run's ``workers``), and at the end (``flush``). A run of under half a second writes one
     chunk and no compaction, whatever its worker count; a long one a chunk about every half
     second, what a kill -9 may lose besides the realizations running. A cancel, Ctrl-C or
-    SIGTERM loses nothing: the run ends through ``flush``."""
+    SIGTERM loses nothing: the run ends through ``flush``. ``awaited``: how many results the
+    run computes; given, the batch holding the last of them is written as it comes, before
+    the fit (under a limit on memory, OpenBLAS may end the process at the fit's first call,
+    past Python's reach: the run's work is on disk by then)."""
 
-    def __init__(self, run_dir: RunDirectory, unsaved: float | None = None, workers: int = 1):
+    def __init__(self, run_dir: RunDirectory, unsaved: float | None = None, workers: int = 1, awaited: int | None = None):
         self.run_dir = run_dir
         self.unsaved = (UNSAVED_WORK_SECONDS if unsaved is None else unsaved) * max(1, workers)
         self.pending: list[RealizationResult] = []
         self.work = 0.0
+        self.awaited = awaited
 
     def save_chunk(self, results: list[RealizationResult]) -> None:
         self.pending.extend(results)
         self.work += sum(r.seconds for r in results)
-        if self.work >= self.unsaved:
+        if self.awaited is not None:
+            self.awaited -= len(results)
+        if self.work >= self.unsaved or (self.awaited is not None and self.awaited <= 0):
             self.flush()
 
     def flush(self, merge: bool = False) -> None:
@@ -131,7 +137,8 @@ def run_to_folder(
     with RunDirectory(out_dir, force=options.force) as run_dir:
         earlier = recorded_seconds(run_dir) if options.resume else 0.0  # read before start() takes the manifest over
         restored = run_dir.start(scene, resume=options.resume)
-        store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations))
+        awaited = scene.preset.realizations - sum(r.ok for r in restored) if process_limit() else None
+        store = BatchedStore(run_dir, workers=options.workers_for(scene.preset.realizations), awaited=awaited)
         outcome = None
         if plot and scene.preset.output.plot and drawer is None:  # matplotlib imported while the workers compute
             listeners = [*listeners, PlotImportAhead()]
