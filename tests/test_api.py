@@ -454,3 +454,11 @@ def test_an_override_of_a_swept_path_is_refused(given):
     with pytest.raises(PresetError, match="seed: is swept by the preset's sweep, which sets it at each point"):
         frictionlab.validate(preset, **given)
     assert frictionlab.validate(preset, sweep=None, seed=9)["name"] == SMALL_PRESET["name"]  # the preset once
+
+
+def test_numpy_bools_are_taken_as_flags(tmp_path):
+    """A flag computed in a notebook (``array.any()``) is numpy's bool: taken, not refused."""
+    result = frictionlab.run("quickstart", realizations=2, workers=1, progress=np.False_, plot=np.bool_(False),
+                             out=tmp_path / "run")  # fmt: skip
+    assert result.status == "completed"
+    assert not (tmp_path / "run" / "plot.png").exists()
