@@ -201,7 +201,7 @@ def _solved(method, values):
 
 RUN_BROKEN = {
     "global-random": (GoodSpectrum, {"generate": _noisy_generate}, "generate() used numpy's global random state"),
-    "in-place": (GoodSlopes, {"slopes": _in_place_slopes}, "(a plugin must leave the arrays it is given as they are"),
+    "in-place": (GoodSlopes, {"slopes": _in_place_slopes}, "(a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones)"),
     "negative-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c - c.max())},
                        "solve().contact_count must lie in 0 .. 128 (points of the profile). Got array([-"),
     "reversed-force": (GoodSolver, {"solve": _solved("force", lambda f: f[::-1].copy())},

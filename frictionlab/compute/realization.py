@@ -19,8 +19,8 @@ import numpy as np
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import (
-    curve_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, reported_problem,
-    slopes_problem,
+    LEAVE_INPUTS, curve_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse,
+    reported_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -205,8 +205,6 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
-READ_ONLY_HINT = (" (a plugin must leave the arrays it is given as they are: heights, slopes, loads; "
-                  "compute into new ones)")
 
 
 def _failure(scene: Scene, exc: Exception) -> str:
@@ -217,7 +215,7 @@ def _failure(scene: Scene, exc: Exception) -> str:
         return f"SolveFailed: {exc}"
     fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
     if fault is not None:
-        return f"PluginError: {fault}" + (READ_ONLY_HINT if "read-only" in str(exc) else "")
+        return f"PluginError: {fault}" + (f" ({LEAVE_INPUTS})" if "read-only" in str(exc) else "")
     error = f"{type(exc).__name__}: {exc}"
     if isinstance(exc, PluginError):  # no line of ours to show
         return error

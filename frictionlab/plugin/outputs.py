@@ -13,8 +13,9 @@ import numpy as np
 from ..errors import PluginError, short_repr
 from .data import ContactCurve, Profile
 from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
-from .registry import provider_of
+from .registry import plugin_label
 
+LEAVE_INPUTS = "a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones"
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
                    "contact_spots": "counts_spots"}  # fmt: skip
@@ -243,6 +244,4 @@ def full_contact_problem(full, method: str = "full_contact_load") -> str | None:
 def refuse(plugin, problem: str | None) -> None:
     """Raise PluginError naming ``plugin`` (kind, name, class, distribution) and ``problem``, if any."""
     if problem:
-        cls = type(plugin)
-        raise PluginError(f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from "
-                          f"{provider_of(cls)[0]}) broke the plugin contract: {problem}")  # fmt: skip
+        raise PluginError(f"{plugin_label(type(plugin))} broke the plugin contract: {problem}")
