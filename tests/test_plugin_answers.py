@@ -29,6 +29,10 @@ BROKEN = {
     "flag-periodic": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
         np.sin(np.arange(128.0)), 1.0, periodic=False)},
         "Profile.periodic must be what periodic() declares, True. Got False instead."),
+    "fresh-entropy": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())},
+                      "the same seed gave different heights; draw all randomness from the rng argument"),
+    "global-random": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(
+        self, np.random.default_rng(np.random.randint(2**31)))}, "generate() used numpy's global random state"),
     "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
     "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
                       "tolerance() must be None or a number finite and > 0. Got nan"),
@@ -224,3 +228,16 @@ def test_a_plugin_breaking_the_contract_within_a_realization_fails_it_naming_the
     error = compute_realization(scene, 0).error
     assert error is not None and problem in error
     assert f"{SLOTS[base]} 'broken-{SLOTS[base]}' (broken_plugin.Broken from " in error
+
+
+def test_a_run_refuses_a_generator_its_seed_does_not_fix_before_any_realization(register_plugin):
+    """A run made realization 0 before it started only for some loads: a generator drawing fresh
+    entropy ran to numbers no rerun gives. ``check_loads``, run before every run, refuses it."""
+    from frictionlab.preset.loads import check_loads
+
+    broken = type("Broken", (GoodSpectrum,), {"name": "broken-spectrum", **BROKEN["fresh-entropy"][1]})
+    registry = register_plugin(broken)
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    with pytest.raises(PluginError, match="the same seed gave different heights"):
+        check_loads(build_scene({**GOOD, "spectrum": {"name": broken.name}}, registry=registry))

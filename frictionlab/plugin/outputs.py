@@ -16,6 +16,8 @@ from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
 from .registry import plugin_label
 
 LEAVE_INPUTS = "a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones"
+SAME_SEED = ("the same seed gave different heights; draw all randomness from the rng argument and keep no "
+             "state between calls (realizations run in any order, in other processes)")
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
                    "contact_spots": "counts_spots"}  # fmt: skip

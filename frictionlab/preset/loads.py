@@ -20,7 +20,7 @@ import numpy as np
 
 from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
 from ..plugin.outputs import (
-    full_contact_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, shape_problem,
+    SAME_SEED, full_contact_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, shape_problem,
     slopes_problem,
 )  # fmt: skip
 
@@ -69,14 +69,31 @@ class LoadScales:
 
 
 def probe_profile(scene) -> Profile:
-    """Realization 0's profile: the grid and h every profile of the scene shares."""
+    """Realization 0's profile: the grid and h every profile of the scene shares. Generated twice,
+    one at a time: a generator whose seed does not fix its heights (fresh entropy, a clock, state
+    kept between calls) is refused before the run, not found out by a rerun that differs."""
+    digest = _heights_digest(_generated(scene))
+    profile = _generated(scene)
+    if _heights_digest(profile) != digest:
+        refuse(scene.generator, SAME_SEED)
+    return replace(profile, heights=read_only(profile.heights))  # lent as every realization's is
+
+
+def _generated(scene) -> Profile:
     from .seeds import realization_rng
 
     before = random_state()
     profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
     refuse(scene.generator, global_random_problem("generate()", before) or profile_problem(scene.generator, profile)
            or shape_problem(scene.generator, profile))  # fmt: skip
-    return replace(profile, heights=read_only(profile.heights))  # lent as every realization's is
+    return profile
+
+
+def _heights_digest(profile: Profile) -> tuple:
+    import hashlib
+
+    heights = np.ascontiguousarray(profile.heights)
+    return heights.shape, profile.spacing, hashlib.blake2b(memoryview(heights).cast("B")).digest()
 
 
 def load_scales(scene, profile: Profile | None = None) -> LoadScales:
@@ -126,6 +143,7 @@ def check_loads(scene) -> None:
     """Refuse, before a run, loads ``scene``'s solver cannot take (``load_problems``): a PresetError."""
     from ..errors import PresetError
 
+    scene.load_scales  # realization 0 made and checked, as validate does: a broken generator is refused before the run
     problems = load_problems(scene)
     if problems:
         raise PresetError(problems, source=scene.source)
