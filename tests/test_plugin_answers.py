@@ -229,15 +229,3 @@ def test_a_plugin_breaking_the_contract_within_a_realization_fails_it_naming_the
     assert error is not None and problem in error
     assert f"{SLOTS[base]} 'broken-{SLOTS[base]}' (broken_plugin.Broken from " in error
 
-
-def test_a_run_refuses_a_generator_its_seed_does_not_fix_before_any_realization(register_plugin):
-    """A run made realization 0 before it started only for some loads: a generator drawing fresh
-    entropy ran to numbers no rerun gives. ``check_loads``, run before every run, refuses it."""
-    from frictionlab.preset.loads import check_loads
-
-    broken = type("Broken", (GoodSpectrum,), {"name": "broken-spectrum", **BROKEN["fresh-entropy"][1]})
-    registry = register_plugin(broken)
-    for cls in (GoodSolver, GoodSlopes):
-        register_plugin(cls)
-    with pytest.raises(PluginError, match="the same seed gave different heights"):
-        check_loads(build_scene({**GOOD, "spectrum": {"name": broken.name}}, registry=registry))

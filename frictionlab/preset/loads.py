@@ -143,7 +143,6 @@ def check_loads(scene) -> None:
     """Refuse, before a run, loads ``scene``'s solver cannot take (``load_problems``): a PresetError."""
     from ..errors import PresetError
 
-    scene.load_scales  # realization 0 made and checked, as validate does: a broken generator is refused before the run
     problems = load_problems(scene)
     if problems:
         raise PresetError(problems, source=scene.source)
