@@ -374,6 +374,9 @@ def test_the_units_of_the_columns_are_curve_csvs_in_memory_on_disk_and_in_pandas
     assert frictionlab.load(tmp_path / "run").units == result.units
     assert frictionlab.run(SMALL_PRESET, **FAST).units == result.units  # kept in memory: the same
     assert result.to_pandas().attrs["units"] == result.units
+    # every column is labelled, those curve.csv gives no brackets too (xi had no entry: a KeyError)
+    assert set(result.units) == set(result.table)
+    assert result.units["xi"].startswith("dimensionless") and result.units["lines_used"].startswith("count")
 
 
 STIFFNESS_RAISES = '''
