@@ -93,6 +93,10 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
         assert point.fit == alone.fit and row["a"] == alone.fit.a and row["b_hi"] == alone.fit.b_ci[1]
     assert frictionlab.load(tmp_path / "sweep").rows == result.rows
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
+    # every numeric column is labelled, as a Result's are (the frame had no units at all)
+    numeric = {key for key, value in result.rows[0].items() if isinstance(value, float | int) and key != "point"}
+    assert numeric - set(result.parameters) == set(result.units)
+    assert result.to_pandas().attrs["units"] == result.units and result.units["contact_first"].startswith("count")
 
 
 def test_a_sweep_plots_as_its_sweep_png_does(tmp_path):
