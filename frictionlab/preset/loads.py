@@ -20,7 +20,7 @@ import numpy as np
 
 from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
 from ..plugin.outputs import (
-    SAME_SEED, full_contact_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, shape_problem,
+    full_contact_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, shape_problem,
     slopes_problem,
 )  # fmt: skip
 
@@ -69,13 +69,8 @@ class LoadScales:
 
 
 def probe_profile(scene) -> Profile:
-    """Realization 0's profile: the grid and h every profile of the scene shares. Generated twice,
-    one at a time: a generator whose seed does not fix its heights (fresh entropy, a clock, state
-    kept between calls) is refused before the run, not found out by a rerun that differs."""
-    digest = _heights_digest(_generated(scene))
+    """Realization 0's profile: the grid and h every profile of the scene shares."""
     profile = _generated(scene)
-    if _heights_digest(profile) != digest:
-        refuse(scene.generator, SAME_SEED)
     return replace(profile, heights=read_only(profile.heights))  # lent as every realization's is
 
 
@@ -87,13 +82,6 @@ def _generated(scene) -> Profile:
     refuse(scene.generator, global_random_problem("generate()", before) or profile_problem(scene.generator, profile)
            or shape_problem(scene.generator, profile))  # fmt: skip
     return profile
-
-
-def _heights_digest(profile: Profile) -> tuple:
-    import hashlib
-
-    heights = np.ascontiguousarray(profile.heights)
-    return heights.shape, profile.spacing, hashlib.blake2b(memoryview(heights).cast("B")).digest()
 
 
 def load_scales(scene, profile: Profile | None = None) -> LoadScales:
