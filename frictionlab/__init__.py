@@ -126,6 +126,7 @@ __all__ = [
     "SweepResult",
     "__version__",
     "contract",
+    "defined_rms",
     "force_unit",
     "half_load_points",
     "hookimpl",

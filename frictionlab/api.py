@@ -263,9 +263,10 @@ def _run(preset, overrides, out, workers, executor, scheduler, resume, force, pl
     out = None if out is None else path_argument(out, "out", "a folder to write the run into")
     if scheduler is not None and not isinstance(scheduler, str):
         raise FrictionlabError(f"scheduler must be a Dask scheduler's address (a str), got {type(scheduler).__name__}")
-    for name, value in (("resume", resume), ("force", force), ("plot", plot), ("progress", progress),
-                        ("memory_check", memory_check)):  # fmt: skip
-        flag_argument(value, name)
+    resume, force, plot, progress, memory_check = (
+        flag_argument(value, name) for name, value in (("resume", resume), ("force", force), ("plot", plot),
+                                                       ("progress", progress), ("memory_check", memory_check))
+    )  # fmt: skip
     data, source, _ = read_preset_input(preset, overrides, **keys)
     options = RunOptions(
         workers=workers, executor=executor, scheduler=scheduler, resume=resume, force=force, memory_check=memory_check

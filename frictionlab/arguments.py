@@ -34,9 +34,12 @@ def path_argument(value, name: str, what: str) -> Path:
 
 
 def flag_argument(value, name: str) -> bool:
-    if not isinstance(value, bool):
+    """``value`` as a bool: True or False, or numpy's (``array.any()`` gives one)."""
+    import numpy as np
+
+    if not isinstance(value, bool | np.bool_):
         raise FrictionlabError(f"{name} must be True or False, got {short_repr(value)} ({type(value).__name__})")
-    return value
+    return bool(value)
 
 
 def data_argument(value, name: str) -> None:

@@ -120,6 +120,17 @@ class Result:
         return f"<Result {self.name!r}: {self.status}, {done}/{requested} realizations, {fit}{where}>"
 
 
+SWEEP_UNITS = {  # a sweep's columns (sweep.csv's), by name
+    "done": "count: realizations finished",
+    **dict.fromkeys(("a", "a_lo", "a_hi"), "dimensionless: a of xi = a + b ln f (_lo, _hi: its interval)"),
+    **dict.fromkeys(("b", "b_lo", "b_hi"), "dimensionless: b of xi = a + b ln f (_lo, _hi: its interval)"),
+    "r2": "dimensionless: R² of the fit",
+    "contact_first": "count: points in contact at the first load; ensemble mean",
+    "contact_last": "count: points in contact at the last load; ensemble mean",
+    "elapsed_s": "seconds: the point's wall time",
+}
+
+
 @dataclass(frozen=True, eq=False)
 class SweepResult:
     """A finished sweep: one row per point (``rows``: the swept values by dotted path, ``a``,
@@ -141,10 +152,20 @@ class SweepResult:
         return [own_point(load(subfolder(self.folder, row["folder"])), self.name, row, self.parameters)
                 for row in self.rows if row.get("a") is not None]  # never another run moved into its folder
 
+    @property
+    def units(self) -> dict[str, str]:
+        """What each numeric column of ``rows`` is, in its unit (as ``Result.units``); the swept
+        values are in the preset's units of their field."""
+        columns = self.rows[0] if self.rows else {}
+        return {name: unit for name, unit in SWEEP_UNITS.items() if name in columns}
+
     def to_pandas(self):
-        """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts)."""
+        """The rows as a pandas DataFrame (the ``pandas`` extra; ``rows`` holds them as dicts),
+        ``units`` in its ``attrs["units"]``."""
         columns = {key: [row.get(key) for row in self.rows] for key in self.rows[0]} if self.rows else {}
-        return require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
+        frame = require("pandas", "SweepResult.to_pandas()").DataFrame(columns)
+        frame.attrs["units"] = self.units
+        return frame
 
     def plot(self):
         """a and b against each swept parameter with their 95 % intervals, as sweep.png

@@ -93,6 +93,10 @@ def test_a_sweep_runs_into_its_folder_and_each_point_is_the_run_alone(tmp_path):
         assert point.fit == alone.fit and row["a"] == alone.fit.a and row["b_hi"] == alone.fit.b_ci[1]
     assert frictionlab.load(tmp_path / "sweep").rows == result.rows
     assert list(result.to_pandas()["b"]) == [r["b"] for r in result.rows]
+    # every numeric column is labelled, as a Result's are (the frame had no units at all)
+    numeric = {key for key, value in result.rows[0].items() if isinstance(value, float | int) and key != "point"}
+    assert numeric - set(result.parameters) == set(result.units)
+    assert result.to_pandas().attrs["units"] == result.units and result.units["contact_first"].startswith("count")
 
 
 def test_a_sweep_plots_as_its_sweep_png_does(tmp_path):
@@ -231,6 +235,8 @@ def test_every_public_name_resolves_lazily():
     code = "import frictionlab; [getattr(frictionlab, n) for n in frictionlab.__all__]; from frictionlab import *; print('ok')"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.stdout.strip() == "ok", done.stderr
+    # every lazily imported name is public (defined_rms, which the contract tells a solver to use, was left out)
+    assert set(frictionlab._LAZY) <= set(frictionlab.__all__)
 
 
 def test_loads_that_press_the_whole_line_flat_carry_a_caveat_from_where_it_starts(tmp_path):
@@ -372,6 +378,9 @@ def test_the_units_of_the_columns_are_curve_csvs_in_memory_on_disk_and_in_pandas
     assert frictionlab.load(tmp_path / "run").units == result.units
     assert frictionlab.run(SMALL_PRESET, **FAST).units == result.units  # kept in memory: the same
     assert result.to_pandas().attrs["units"] == result.units
+    # every column is labelled, those curve.csv gives no brackets too (xi had no entry: a KeyError)
+    assert set(result.units) == set(result.table)
+    assert result.units["xi"].startswith("dimensionless") and result.units["lines_used"].startswith("count")
 
 
 STIFFNESS_RAISES = '''
@@ -454,3 +463,11 @@ def test_an_override_of_a_swept_path_is_refused(given):
     with pytest.raises(PresetError, match="seed: is swept by the preset's sweep, which sets it at each point"):
         frictionlab.validate(preset, **given)
     assert frictionlab.validate(preset, sweep=None, seed=9)["name"] == SMALL_PRESET["name"]  # the preset once
+
+
+def test_numpy_bools_are_taken_as_flags(tmp_path):
+    """A flag computed in a notebook (``array.any()``) is numpy's bool: taken, not refused."""
+    result = frictionlab.run("quickstart", realizations=2, workers=1, progress=np.False_, plot=np.bool_(False),
+                             out=tmp_path / "run")  # fmt: skip
+    assert result.status == "completed"
+    assert not (tmp_path / "run" / "plot.png").exists()

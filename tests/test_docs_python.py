@@ -31,3 +31,28 @@ def test_the_readmes_python_example_runs_from_a_clone(tmp_path, monkeypatch):
     space: dict = {}
     exec(compile(block, "README.md", "exec"), space)
     assert space["again"].fit == space["r"].fit and len(space["xi"]) == len(space["r"].table["f"])
+
+
+def test_the_plugin_tutorials_solver_and_estimator_pass_the_kit_and_run(register_plugin):
+    """docs/tutorials/write-a-plugin.md showed a spectrum generator only: a solver's author had
+    to read frictionlab's source for how a ForceNormalisation is made. Its solver and slope
+    estimator, as written, pass the conformance kit and run a realization."""
+    from frictionlab.compute.realization import compute_realization
+    from frictionlab.preset import build_scene
+    from frictionlab.testing import check_plugin
+
+    from .conftest import SMALL_PRESET
+    from .testing.fakes import GoodSpectrum
+
+    page = (ROOT / "docs" / "tutorials" / "write-a-plugin.md").read_text(encoding="utf-8")
+    (block,) = [b for b in re.findall(r"```python\n(.*?)```", page, re.S) if "class Springs" in b]
+    space: dict = {"__name__": "tutorial_plugin"}
+    exec(compile(block, "write-a-plugin.md", "exec"), space)
+    check_plugin("solver", space["Springs"])
+    check_plugin("slope", space["Central"])
+    for cls in (GoodSpectrum, space["Springs"], space["Central"]):
+        registry = register_plugin(cls)
+    data = {**SMALL_PRESET, "spectrum": {"name": GoodSpectrum.name}, "solver": {"name": "my-springs"},
+            "slope": {"name": "my-central"}}  # fmt: skip
+    result = compute_realization(build_scene(data, registry=registry), 0)
+    assert result.error is None and result.xi.shape == (SMALL_PRESET["loading"]["steps"],)

@@ -5,6 +5,8 @@ that plugin's fault, never as frictionlab's internal error."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -27,6 +29,8 @@ BROKEN = {
     "flag-periodic": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, rng).__class__(
         np.sin(np.arange(128.0)), 1.0, periodic=False)},
         "Profile.periodic must be what periodic() declares, True. Got False instead."),
+    "global-random": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(
+        self, np.random.default_rng(np.random.randint(2**31)))}, "generate() used numpy's global random state"),
     "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
     "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
                       "tolerance() must be None or a number finite and > 0. Got nan"),
@@ -177,3 +181,49 @@ def test_an_input_summary_no_json_holds_is_refused_as_the_run_starts_and_by_vali
         with pytest.raises(PluginError, match="broke the plugin contract: input_summary()") as excinfo:
             read(scene)
         assert said in str(excinfo.value)
+
+
+def _noisy_generate(self, rng):
+    np.random.standard_normal()  # numpy's global state: another number for each worker count
+    return GoodSpectrum.generate(self, rng)
+
+
+def _in_place_slopes(self, heights, spacing, periodic=True):
+    heights -= heights.mean()  # the profile the solver is given next changes
+    return GoodSlopes.slopes(self, heights, spacing, periodic)
+
+
+def _solved(method, values):
+    def solve(self, profile, loads, control, slopes):
+        curve = GoodSolver.solve(self, profile, loads, control, slopes)
+        return replace(curve, **{method: values(getattr(curve, method))})
+
+    return solve
+
+
+RUN_BROKEN = {
+    "global-random": (GoodSpectrum, {"generate": _noisy_generate}, "generate() used numpy's global random state"),
+    "in-place": (GoodSlopes, {"slopes": _in_place_slopes}, "(a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones)"),
+    "negative-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c - c.max())},
+                       "solve().contact_count must lie in 0 .. 128 (points of the profile). Got array([-"),
+    "reversed-force": (GoodSolver, {"solve": _solved("force", lambda f: f[::-1].copy())},
+                       "solve(..., control='force').force must report the loads asked for"),
+}
+
+
+@pytest.mark.parametrize("case", RUN_BROKEN)
+def test_a_plugin_breaking_the_contract_within_a_realization_fails_it_naming_the_plugin(register_plugin, case):
+    """Each of these ran to a result: numbers that changed with the worker count (global random
+    state), with the loads (a profile changed in place), or counts no profile has."""
+    from frictionlab.compute.realization import compute_realization
+
+    base, methods, problem = RUN_BROKEN[case]
+    broken = type("Broken", (base,), {"name": f"broken-{SLOTS[base]}", "__module__": "broken_plugin", **methods})
+    registry = register_plugin(broken)
+    for cls in {GoodSpectrum, GoodSolver, GoodSlopes} - {base}:
+        register_plugin(cls)
+    scene = build_scene({**GOOD, SLOTS[base]: {"name": broken.name}}, registry=registry)
+    error = compute_realization(scene, 0).error
+    assert error is not None and problem in error
+    assert f"{SLOTS[base]} 'broken-{SLOTS[base]}' (broken_plugin.Broken from " in error
+

@@ -12,13 +12,16 @@ import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
-from ..plugin.outputs import curve_problem, height_of, profile_problem, refuse, slopes_problem
+from ..plugin.outputs import (
+    LEAVE_INPUTS, curve_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse,
+    reported_problem, slopes_problem,
+)  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
 from ..preset.seeds import realization_rng
@@ -130,14 +133,21 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
     profile's forces by solving (``loads.forces_for_fractions``, from f = the fraction: ``unit``
     is the profile's k h X)."""
     if scene.solver_loads is not None:
-        return scene.solver.solve(profile, scene.solver_loads, scene.control, slopes)
-    from ..preset.loads import forces_for_fractions
+        loads, control = scene.solver_loads, scene.control
+    else:
+        from ..preset.loads import forces_for_fractions
 
-    def seeking(j: int) -> None:  # iterations of the search are said as the load's
-        watch.load = j + 1
+        def seeking(j: int) -> None:  # iterations of the search are said as the load's
+            watch.load = j + 1
 
-    forces = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
-    return scene.solver.solve(profile, forces, "force", slopes)
+        loads = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
+        control = "force"
+    before = random_state()
+    curve = scene.solver.solve(profile, read_only(loads), control, slopes)
+    refuse(scene.solver, global_random_problem("solve()", before)
+           or curve_problem(scene.solver, curve, loads.size)
+           or reported_problem(curve, loads, control, profile.points))  # fmt: skip
+    return curve
 
 
 def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
@@ -145,15 +155,17 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
+        before = random_state()
         profile = scene.generator.generate(rng)
-        refuse(scene.generator, profile_problem(scene.generator, profile))
+        refuse(scene.generator, global_random_problem("generate()", before) or profile_problem(scene.generator, profile))
+        profile = replace(profile, heights=read_only(profile.heights))  # what the estimator and solver are lent
         check_cancel()  # a large surface takes a second to generate
+        before = random_state()
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-        refuse(scene.slope, slopes_problem(scene.slope, slopes, profile))
+        refuse(scene.slope, global_random_problem("slopes()", before) or slopes_problem(scene.slope, slopes, profile))
         check_cancel()
         scale = slope_scale(slopes)  # xi is a ratio of two rms slopes: an exact scale cancels
-        if scale != 1.0:
-            slopes = slopes * scale
+        slopes = read_only(slopes * scale if scale != 1.0 else slopes)
         if scene.slope.undefined_points(profile.periodic):
             slope_rms_line = defined_rms(slopes)  # over the points that have a slope
         else:  # every slope defined: a NaN makes the rms NaN, refused below
@@ -165,7 +177,6 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         h, own_h = height_of(scene.generator, profile)
         unit = force_unit(scene.solver, h, profile)
         curve = _solve(scene, profile, slopes, watch, unit)
-        refuse(scene.solver, curve_problem(scene.solver, curve, scene.loads.size))
         half = curve.half_load_points
         heights = np.asarray(profile.heights, dtype=float)
         mean = float(heights.mean())
@@ -194,6 +205,8 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
+
+
 def _failure(scene: Scene, exc: Exception) -> str:
     """A realization's error as recorded, ``Type: message``: a failure the plugin explains
     (``SolveFailed``) as its message; one raised in a third party's plugin as that plugin's
@@ -202,7 +215,7 @@ def _failure(scene: Scene, exc: Exception) -> str:
         return f"SolveFailed: {exc}"
     fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
     if fault is not None:
-        return f"PluginError: {fault}"
+        return f"PluginError: {fault}" + (f" ({LEAVE_INPUTS})" if "read-only" in str(exc) else "")
     error = f"{type(exc).__name__}: {exc}"
     if isinstance(exc, PluginError):  # no line of ours to show
         return error

@@ -13,8 +13,11 @@ import numpy as np
 from ..errors import PluginError, short_repr
 from .data import ContactCurve, Profile
 from .kinds import ContactSolver, SlopeEstimator, SpectrumGenerator
-from .registry import provider_of
+from .registry import plugin_label
 
+LEAVE_INPUTS = "a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones"
+SAME_SEED = ("the same seed gave different heights; draw all randomness from the rng argument and keep no "
+             "state between calls (realizations run in any order, in other processes)")
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
                    "contact_spots": "counts_spots"}  # fmt: skip
@@ -114,6 +117,44 @@ def curve_problem(solver: ContactSolver, curve, loads: int, where: str = "solve(
     return None
 
 
+def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, points: int) -> str | None:
+    """What is wrong with the numbers of a well-formed ``curve`` solved for ``loads`` under ``control``
+    on a profile of ``points`` points: the loads not reported as asked (within 1%, as the
+    conformance kit asks), a count or fraction out of its range."""
+    reported, what = getattr(curve, control), f"solve(..., control={control!r}).{control}"
+    if not np.allclose(reported, loads, rtol=1e-2, atol=0):
+        return f"{what} must report the loads asked for: {short_repr(loads, 300)}. Got {short_repr(reported, 300)} instead."
+    count, fraction = curve.contact_count, curve.contact_fraction
+    if count.size and (count.min() < 0 or count.max() > points):
+        return f"solve().contact_count must lie in 0 .. {points} (points of the profile). Got {short_repr(count, 300)}."
+    if fraction.size and (fraction.min() < 0 or fraction.max() > 1):
+        return f"solve().contact_fraction must lie in [0, 1]. Got {short_repr(fraction, 300)}."
+    return None
+
+
+def random_state() -> tuple:
+    """numpy's global random state (what ``np.random.*`` functions draw from), to compare."""
+    _, keys, position, has_gauss, gauss = np.random.get_state()
+    return keys.tobytes(), position, has_gauss, gauss
+
+
+def global_random_problem(what: str, before: tuple) -> str | None:
+    """A plugin call that drew from (or seeded) numpy's global random state since ``before``: its
+    numbers would depend on which realizations ran before it in the process, so on the worker count."""
+    if random_state() == before:
+        return None
+    return (f"{what} used numpy's global random state (np.random.* functions): draw all randomness from "
+            "the rng argument generate() is given, so that a seed gives the same numbers for any worker count")
+
+
+def read_only(array: np.ndarray) -> np.ndarray:
+    """A view of ``array`` that cannot be written: what a plugin is lent, so that changing it in place
+    raises in the plugin's own line rather than changing what the run computes next."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
+
+
 def _positive(what: str, value, none: bool = False) -> str | None:
     if value is None and none:
         return None
@@ -205,6 +246,4 @@ def full_contact_problem(full, method: str = "full_contact_load") -> str | None:
 def refuse(plugin, problem: str | None) -> None:
     """Raise PluginError naming ``plugin`` (kind, name, class, distribution) and ``problem``, if any."""
     if problem:
-        cls = type(plugin)
-        raise PluginError(f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from "
-                          f"{provider_of(cls)[0]}) broke the plugin contract: {problem}")  # fmt: skip
+        raise PluginError(f"{plugin_label(type(plugin))} broke the plugin contract: {problem}")

@@ -88,6 +88,11 @@ def _module_distributions() -> dict[str, list[str]]:
     return md.packages_distributions()
 
 
+def plugin_label(cls: type) -> str:
+    """``solver 'mdr' (module.Class from distribution)``: a plugin class as every message names it."""
+    return f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]})"
+
+
 @functools.cache
 def provider_of(cls: type) -> tuple[str, str]:
     """The distribution (and version) that ships ``cls``, from its module."""
@@ -406,7 +411,7 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
         if frame is not None:
             cls = cls if owner is None else type(owner)
             return PluginError(
-                f"{cls.kind} {cls.name!r} ({cls.__module__}.{cls.__qualname__} from {provider_of(cls)[0]}) raised "
+                f"{plugin_label(cls)} raised "
                 f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
                 "tell its authors, or choose another plugin"
             )

@@ -317,10 +317,19 @@ def curve_headers(scene: Scene) -> list[str]:
     return curve_header(scene) + corrected + gradient + spots
 
 
+PLAIN_COLUMNS = {  # the columns whose header has no brackets: numbers without a unit, said as such
+    "xi": "dimensionless: rms slope in contact / rms slope of the line; ensemble mean",
+    "xi_sem": "dimensionless: standard error of the mean of xi",
+    "lines_used": "count: realizations whose xi is defined at this load",
+    "contact_count": "count: points in contact; ensemble mean",
+}
+
+
 def column_units(headers: list[str]) -> dict[str, str]:
-    """What each column is, in its unit, by short name (``F`` of ``F' [...]`` too):
-    the brackets of curve.csv's header, for the columns that have them."""
-    return {column_name(h).rstrip("'"): h.split(" [", 1)[1].removesuffix("]") for h in headers if " [" in h}
+    """What each column is, in its unit, by short name (``F`` of ``F' [...]`` too): the
+    brackets of curve.csv's header, or for a column without them what kind of number it is."""
+    units = {column_name(h).rstrip("'"): h.split(" [", 1)[1].removesuffix("]") for h in headers if " [" in h}
+    return {**{name: PLAIN_COLUMNS[name] for name in headers if name in PLAIN_COLUMNS}, **units}
 
 
 def _write_curve(scene: Scene, outcome: RunOutcome, fh) -> None:

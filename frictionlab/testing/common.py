@@ -11,12 +11,15 @@ from typing import Any
 
 
 def label(cls) -> str:
+    """A plugin class named as a run names it: its kind, name, class and distribution."""
     from frictionlab.plugin import Plugin
+    from frictionlab.plugin.registry import plugin_label
 
     if not isinstance(cls, type):
         return repr(cls)
-    name = cls.name if issubclass(cls, Plugin) else None
-    return f"{cls.__module__}.{cls.__qualname__}" + (f" ({name!r})" if name else "")
+    if issubclass(cls, Plugin) and getattr(cls, "kind", None) and isinstance(cls.name, str) and cls.name:
+        return plugin_label(cls)
+    return f"{cls.__module__}.{cls.__qualname__}"
 
 
 def reported(check: Callable) -> Callable:

@@ -27,7 +27,7 @@ def check_slope_estimator(cls, **params) -> None:
     import numpy as np
 
     from frictionlab.plugin import Profile
-    from frictionlab.plugin.outputs import slopes_problem
+    from frictionlab.plugin.outputs import LEAVE_INPUTS, slopes_problem
 
     estimator = instantiate(cls, params)
     spacing = 0.1
@@ -44,7 +44,7 @@ def check_slope_estimator(cls, **params) -> None:
         where = f"slopes({what}, spacing={spacing}, periodic={periodic})"
         slopes = call(cls, where, estimator.slopes, heights, spacing, periodic)
         if not np.array_equal(heights, original):
-            fail(cls, f"slopes({what}) modified its input")
+            fail(cls, f"slopes({what}) modified its input: {LEAVE_INPUTS}")
         if not periodic and undefined_ends and isinstance(slopes, np.ndarray) and slopes.shape == heights.shape:
             core = _defined_core(slopes)
             if core is None:

@@ -99,7 +99,7 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
     import numpy as np
 
     from frictionlab.plugin import Profile, force_unit
-    from frictionlab.plugin.outputs import curve_problem
+    from frictionlab.plugin.outputs import LEAVE_INPUTS, curve_problem
 
     n = heights.size
     shape = "line" if heights.ndim == 1 else "surface"
@@ -124,7 +124,7 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
                 and np.array_equal(args[1], loads)
                 and np.array_equal(args[3], slopes)
             ):
-                fail(cls, f"{where} modified its inputs")
+                fail(cls, f"{where} modified its inputs: {LEAVE_INPUTS}")
             return curve
 
         curve = run()

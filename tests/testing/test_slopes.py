@@ -35,7 +35,7 @@ SLOPE_BREAKAGES = [
     ("Integer", lambda self, z, dx, periodic=True: np.round(forward_differences(z, dx)).astype(int), "must be float64"),
     ("Single", lambda self, z, dx, periodic=True: forward_differences(z, dx).astype(np.float32),
      r"must be float64 \(double precision\). Got dtype float32"),
-    ("MutatesInput", _demean_in_place, "modified its input"),
+    ("MutatesInput", _demean_in_place, r"modified its input: a plugin must leave the arrays it is given as they are"),
     ("Random", lambda self, z, dx, periodic=True: forward_differences(z, dx) + 1e-12 * np.random.default_rng().random(z.size),
      "not repeatable"),
     ("WrapsAScan", lambda self, z, dx, periodic=True: forward_differences(z, dx), "a difference across the ends"),
@@ -101,3 +101,12 @@ def test_negative_slopes_on_a_surface_fail_in_the_words_of_a_run():
     cls = type("NegativeGradient", (slopes_variant("NegativeGradient", slopes),), {"dimensions": (1, 2)})
     fails_naming(fltesting.check_slope_estimator, cls,
                  r"slopes\(random surface\) on a surface must be gradient magnitudes \|grad z\| >= 0. Got a minimum of -")
+
+
+def test_the_kit_names_a_plugin_as_a_run_does_with_its_distribution():
+    """The kit named the class alone (``module.MutatesInput ('broken-slopes')``); a run names the
+    kind, the name, the class and the distribution: the kit now says it in the same words."""
+    cls = slopes_variant("MutatesInput", _demean_in_place)
+    with pytest.raises(AssertionError) as excinfo:
+        fltesting.check_slope_estimator(cls)
+    assert str(excinfo.value).startswith(f"slope 'broken-slopes' ({cls.__module__}.MutatesInput from {cls.__module__}): ")

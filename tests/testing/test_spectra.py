@@ -31,6 +31,9 @@ SPECTRUM_BREAKAGES = [
     ("Stateful", {"generate": lambda self, rng: Profile(  # its rng used, yet each call differs: told to keep no state
         GoodSpectrum.generate(self, rng).heights + 0.01 * next(self.__dict__.setdefault("calls", iter(range(99)))), 1.0)},
      "same seed gave different heights; draw all randomness from the rng argument and keep no state between calls"),
+    # seeded from numpy's global state: told as the run tells it, not as a seed that varies
+    ("GlobalState", {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(np.random.randint(99)))},
+     r"generate\(\) used numpy's global random state \(np.random.\* functions\)"),
     ("NaNHeights", {"generate": lambda self, rng: Profile(np.full(8, np.nan), 1.0)}, "must be finite"),
     ("TwoDimensional", {"generate": lambda self, rng: Profile(rng.random((4, 4)), 1.0)}, "must be 1-D"),
     ("IntegerHeights", {"generate": lambda self, rng: Profile(rng.integers(0, 9, 16), 1.0)}, "must be float64"),
