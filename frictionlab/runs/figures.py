@@ -130,7 +130,7 @@ class DrawingProcess:
 
     def send(self, path: Path, scene: Scene, outcome: RunOutcome) -> bool:
         """Have it draw ``path``, plot.png of ``outcome``, if the preset asks for it and anything
-        finished (``results.plot_wanted``): False if not, or if the process is gone (``wait``)."""
+        finished (``plot_wanted``): False if not, or if the process is gone (``wait``)."""
         if self.pid is None or not plot_wanted(scene, outcome):
             return False
         self._path = Path(path)
@@ -152,6 +152,7 @@ class DrawingProcess:
         except BaseException:  # Ctrl-C while it draws: it is ended with this process
             self.close()
             raise
+        self._path = None  # it answered: written, or its temporary file removed by atomic_write
         self.close()
         if failure is not None:
             raise RunError(failure)
