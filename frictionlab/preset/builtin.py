@@ -104,7 +104,9 @@ def same_named_presets(argument: str | Path, resolved: Path) -> list[Path]:
     found = []
     for path in (folder / f"{builtin.name}{suffix}" for folder in folders for suffix in (".yaml", ".yml")):
         try:
-            if path.is_file() and path.resolve() != builtin.path.resolve() and path.read_bytes() != own:
+            # read only a file the built-in's size: another size differs, however large it is
+            if path.is_file() and path.resolve() != builtin.path.resolve() and (
+                    path.stat().st_size != len(own) or path.read_bytes() != own):
                 found.append(path)
         except OSError:
             pass
