@@ -249,6 +249,14 @@ def screen_text(app) -> str:
     return "\n".join(strip.text for strip in app.screen._compositor.render_strips())
 
 
+def record_said(app) -> list[str]:
+    """Every message the app says from now on, in order: a run's own end may replace a message
+    before the key that said it has returned."""
+    said, say = [], app.say
+    app.say = lambda text, *args, **kwargs: (said.append(text), say(text, *args, **kwargs))[1]
+    return said
+
+
 def status_text(app) -> str:
     """The status line's message ("" if the app has none)."""
     lines = app.query("#status")

@@ -19,7 +19,7 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SIZE, SWEEP, TINY, fits_width, make_app, numbers_in, post_keys, press_run, press_settled, run_to_the_end,
+    SIZE, SWEEP, TINY, fits_width, make_app, numbers_in, post_keys, press_run, press_settled, record_said, run_to_the_end,
     screen_text, started, status_text, sweep_app, sync, wait_until,
 )
 
@@ -82,9 +82,10 @@ async def test_cancel_keeps_and_writes_what_finished(folders, registry):
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
         await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 3)
+        said_since = record_said(app)
         await pilot.press("c")  # the Run tab has focus
-        said = status_text(app)  # at once, before the run has ended
         await wait_until(pilot, lambda: app.last_outcome is not None)
+        said = said_since[0] if said_since else ""  # the first thing c said, before the run had ended
         outcome, out_dir = app.last_outcome, app.last_out_dir
         stats = str(app.query_one("#run-stats", Static).render())
     # c is SIGTERM to the run's process, as a kill from a shell: it ends interrupted, resumable
@@ -155,13 +156,14 @@ async def test_c_pressed_again_while_cancelling_signals_the_run_once(folders, re
         process, signals = app.followed.process, []
         terminate = process.terminate
         process.terminate = lambda: (signals.append("SIGTERM"), terminate())[1]
+        said_since = record_said(app)
         post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
         await pilot.pause()
-        said = status_text(app)
         listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
         await wait_until(pilot, lambda: app.last_outcome is not None)
         out_dir = app.last_out_dir
     assert signals == ["SIGTERM"] and "Cancel" not in listed
+    said = said_since[1] if len(said_since) > 1 else ""  # what the second c said
     assert said.startswith("Cancelling already: what finished is being written")
     assert json.loads((out_dir / "summary.json").read_text())["status"] == "interrupted"
 
