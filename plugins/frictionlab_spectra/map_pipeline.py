@@ -44,7 +44,7 @@ class Region(BaseModel):
     the file or in the run's length unit from the map's first pixel (``units``); either
     unset keeps the whole of that side."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", defer_build=True)  # built when a preset reads a file
     x: tuple[_Finite, _Finite] | None = Field(None, description="[start, stop) along x (the map's columns)")
     y: tuple[_Finite, _Finite] | None = Field(None, description="[start, stop) along y (the map's rows)")
     units: Literal["pixels", "length"] = Field("pixels", description="pixels of the file, or the run's length unit")
@@ -62,7 +62,7 @@ class Region(BaseModel):
 class Downsample(BaseModel):
     """Coarser pixels: ``factor`` times the pixel side, or a ``pixel`` side in the run's unit."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", defer_build=True)  # built when a preset reads a file
     factor: int | None = Field(None, ge=2, description="the new pixel side in pixels (an integer >= 2)")
     pixel: float | None = Field(None, gt=0.0, description="the new pixel side in the run's length unit")
 
