@@ -257,10 +257,33 @@ def process_limit() -> tuple[int, str] | None:
 
 
 def out_of_memory_loading(exc: BaseException) -> str | None:
-    """The library a process limit left no room to load (``ImportError``: 'failed to map
-    segment from shared object', numpy's own message quoting it), else None."""
+    """The library a process limit left no room to load, else None: an ``ImportError``
+    ('failed to map segment from shared object', numpy's own message quoting it), or under a
+    process limit a ``SystemError`` raised as a module was imported (a compiled module whose
+    start could not allocate and set no exception: 'error return without exception set',
+    seen from pydantic's under ``ulimit -v 102400``), named by the package whose import failed."""
     match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
-    return match.group(1) if isinstance(exc, ImportError) and match else None
+    if isinstance(exc, ImportError) and match:
+        return match.group(1)
+    if isinstance(exc, SystemError) and process_limit() is not None:
+        return _package_being_imported(exc)
+    return None
+
+
+def _package_being_imported(exc: BaseException) -> str | None:
+    """The installed package whose import raised ``exc`` ('a library' where the import began
+    outside one), or None where ``exc`` was not raised by an import."""
+    import traceback
+    from pathlib import Path
+
+    frames = traceback.extract_tb(exc.__traceback__)
+    if not any(frame.filename.startswith("<frozen importlib") for frame in frames):
+        return None
+    files = [Path(frame.filename).parts for frame in frames if not frame.filename.startswith("<")]
+    importing = files[-1] if files else ()
+    if "site-packages" not in importing[:-1]:
+        return "a library"
+    return importing[importing.index("site-packages") + 1].split(".")[0]  # pydantic/..., six.py
 
 
 @dataclass(frozen=True)

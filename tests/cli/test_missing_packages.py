@@ -126,3 +126,28 @@ def test_a_missing_dependency_is_named_with_its_requirement_not_a_reinstall_from
     for req in declared:
         module = modules.get(req, req.split(">=")[0])
         assert dependency_command(module) == f'pip install "{req}"'
+
+
+@pytest.mark.parametrize("limited", [True, False])
+def test_a_library_that_cannot_start_under_a_memory_limit_is_said_as_the_limit(tmp_path, limited):
+    """Under ulimit -v 102400 pydantic's compiled core sometimes failed to start without saying
+    why ('SystemError: error return without exception set' from the import): an internal error
+    (exit 70). Under a process limit it is the limit, named with the package; without one it
+    stays a bug."""
+    package = tmp_path / "lib" / "site-packages" / "pydantic"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text('raise SystemError("error return without exception set")\n')
+    limit = "import resource; resource.setrlimit(resource.RLIMIT_AS, (1 << 45, resource.RLIM_INFINITY))\n"
+    code = (
+        f"{limit if limited else ''}import sys; sys.path.insert(0, {str(package.parent)!r})\n"
+        "from frictionlab.cli.main import main\n"
+        "sys.exit(main(['run', 'quickstart', '--no-plot', '--out', 'o']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    if limited:
+        assert done.returncode == ExitCode.RUNTIME_FAILURE, done.stderr
+        assert done.stderr.startswith("error: out of memory loading pydantic; raise the process limit (ulimit -v is ")
+        assert "internal error" not in done.stderr and "Traceback" not in done.stderr
+    else:
+        assert done.returncode == ExitCode.INTERNAL, done.stderr
+        assert "internal error: SystemError: error return without exception set" in done.stderr
