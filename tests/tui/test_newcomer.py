@@ -351,6 +351,8 @@ async def test_a_swept_field_says_so_and_field_help_is_never_cut(folders, regist
     app = make_app(registry, preset="presets/sw.yaml")
     async with started(app) as pilot:
         app.query_one("#field--spectrum--params--hurst").focus()
+        help_shown = lambda: str(app.query_one("#field-help").render()).startswith("spectrum.params.hurst is swept")  # noqa: E731
+        await wait_until(pilot, lambda: help_shown() and "hurst" in screen_text(app), 30)  # a busy machine paints late
         await pilot.pause()
         screen = screen_text(app)
         help_text = str(app.query_one("#field-help").render())
