@@ -272,18 +272,18 @@ def out_of_memory_loading(exc: BaseException) -> str | None:
 
 def _package_being_imported(exc: BaseException) -> str | None:
     """The installed package whose import raised ``exc`` ('a library' where the import began
-    outside one), or None where ``exc`` was not raised by an import."""
-    import traceback
-    from pathlib import Path
-
-    frames = traceback.extract_tb(exc.__traceback__)
-    if not any(frame.filename.startswith("<frozen importlib") for frame in frames):
+    outside one), or None where ``exc`` was not raised by an import. It imports nothing: the
+    memory that failed the import may fail another."""
+    files, tb = [], exc.__traceback__
+    while tb is not None:
+        files.append(tb.tb_frame.f_code.co_filename)
+        tb = tb.tb_next
+    if not any(name.startswith("<frozen importlib") for name in files):
         return None
-    files = [Path(frame.filename).parts for frame in frames if not frame.filename.startswith("<")]
-    importing = files[-1] if files else ()
-    if "site-packages" not in importing[:-1]:
+    parts = next((name for name in reversed(files) if not name.startswith("<")), "").split(os.sep)
+    if "site-packages" not in parts[:-1]:
         return "a library"
-    return importing[importing.index("site-packages") + 1].split(".")[0]  # pydantic/..., six.py
+    return parts[parts.index("site-packages") + 1].split(".")[0]  # pydantic/..., six.py
 
 
 @dataclass(frozen=True)
