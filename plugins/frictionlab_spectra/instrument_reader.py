@@ -321,6 +321,21 @@ def room_to_read() -> tuple[int, str]:
     return min(found)
 
 
+def check_fill_room(where: str, shape: tuple[int, ...], holes: int) -> None:
+    """Refuse, before it starts, a harmonic fill (``undefined: harmonic``) of ``holes`` points not
+    measured in a scan of ``shape`` that cannot fit in the memory left: its sparse solve took the
+    memory mid-read, and ended in MemoryError, or the process killed."""
+    from .scan_shaping.filling import harmonic_fill_bytes
+
+    need, (room, source) = harmonic_fill_bytes(shape, holes), room_to_read()
+    if need > room:
+        raise ValueError(
+            f"{where}: filling its {holes:,} points not measured (undefined: harmonic) takes about {need / 2**30:.3g} "
+            f"GiB, more than the {room / 2**30:.3g} GiB this process may use ({source}); leave them out with region "
+            "(the measured part of the scan), or fill fewer: fix the scan, or export it with its holes filled"
+        )
+
+
 MOST_POINTS_A_BYTE = 1032  # deflate's greatest ratio: a point of one byte, compressed, takes at least 1/1032 byte
 
 
