@@ -162,9 +162,9 @@ def _plugin_told(entry):
         try:
             return entry(*args, **keys)
         except Exception as exc:
-            from .plugin.registry import installed_plugin_fault
+            from .plugin.registry import installed_plugin_fault, solve_failed
 
-            if (fault := installed_plugin_fault(exc)) is None:
+            if (fault := solve_failed(exc) or installed_plugin_fault(exc)) is None:
                 raise
             raise fault from None
 

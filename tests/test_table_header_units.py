@@ -296,3 +296,23 @@ def test_brackets_that_hold_no_unit_above_the_labels_are_no_unit(tmp_path):
     rows = "".join(f"{i * 0.5!r},{float(v)!r}\n" for i, v in enumerate(rough(1, 32)[0]))
     (tmp_path / "dated.csv").write_text("# scanned [2024-01-01]\nx [um],z [um]\n" + rows)
     assert ProfileFile(path=str(tmp_path / "dated.csv"), spacing=0.5).generate(None).heights.size == 32
+
+
+def test_a_headers_size_with_a_decimal_comma_gives_its_pixel_under_format_table(tmp_path):
+    """'# Width: 2,400 µm' (Gwyddion's export in a locale whose decimal mark is a comma), read with
+    format: table, stated no pixel: its pixel was not named beside the preset's, nor its oblong
+    shape; with format: auto such a header was not even taken for an export's. Read as 2.400 µm."""
+    z = rough(16, 24)
+    point = gwyddion_text(tmp_path / "point.txt", z, 0.1, value_unit="um", scale=1.0)
+    comma = tmp_path / "comma.txt"
+    comma.write_text(point.read_text(encoding="utf-8").replace("2.400 µm", "2,400 µm").replace("1.600 µm", "1,600 µm"),
+                     encoding="utf-8")  # fmt: skip
+    assert "# Width: 2,400 µm\n# Height: 1,600 µm" in comma.read_text(encoding="utf-8")
+    for path in (point, comma):
+        summary = SurfaceFile(path=str(path), spacing=0.2, unit="um", format="table").input_summary()
+        assert summary["file_spacing"] == pytest.approx(0.1, rel=1e-9), path.name
+        with pytest.raises(ValueError, match="its header states the scan's units"):  # an export's: format: instrument
+            SurfaceFile(path=str(path), spacing=0.2, unit="um").rms_height()
+    comma.write_text(comma.read_text(encoding="utf-8").replace("1,600 µm", "3,200 µm"), encoding="utf-8")
+    caveats = SurfaceFile(path=str(comma), spacing=0.2, unit="um", format="table").input_summary()["caveats"]
+    assert any("which is not square" in caveat and "0.1 x 0.2 um" in caveat for caveat in caveats)

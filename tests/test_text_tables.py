@@ -33,3 +33,32 @@ def test_a_column_of_decimal_commas_is_named(tmp_path):
     (tmp_path / "xz.csv").write_text("".join(f"{i},{v}\n" for i, v in enumerate([0, 5, 7, 1, 0, 3, 2, 9, 4, 6])))
     line = ProfileFile(path=str(tmp_path / "xz.csv")).generate(None)
     assert line.spacing == 1.0 and line.heights.size == 10
+
+
+def test_fortran_exponents_are_read_as_the_numbers_they_are(tmp_path):
+    """1.0D-06 and 2.5d+03, as a Fortran program writes a double, made 'a second line of text before
+    the numbers' (numpy reads no D): read as 1.0e-06 and 2.5e+03, in a line's column (x and z too)
+    and in a map of whitespace, commas or semicolons; a NaN among them is still named by its line
+    and column, and a cell that is no number still refused by its line."""
+    rng = np.random.default_rng(4)
+    z = np.cumsum(rng.normal(size=64)) * 1e-6
+    (tmp_path / "z.txt").write_text("z [m]\n" + "".join(f"{v:.6E}\n".replace("E", "D") for v in z))
+    (tmp_path / "xz.csv").write_text("".join(f"{i * 0.5:.3e},{v:.6e}\n".replace("e", "d") for i, v in enumerate(z)))
+    for name in ("z.txt", "xz.csv"):
+        line = ProfileFile(path=str(tmp_path / name), **({} if name == "xz.csv" else {"spacing": 0.5})).generate(None)
+        np.testing.assert_allclose(line.heights + z.mean(), z, rtol=1e-6, atol=1e-12)  # detrend mean by default
+        assert line.spacing == pytest.approx(0.5, rel=1e-12)
+    m = rng.normal(size=(16, 16)) * 1e3
+    for separator in (" ", ",", ";"):
+        (tmp_path / "m.txt").write_text("".join(separator.join(f"{v:.8E}".replace("E", "d") for v in row) + "\n" for row in m))
+        read = SurfaceFile(path=str(tmp_path / "m.txt"), spacing=1.0, detrend="none")._measured().heights
+        np.testing.assert_allclose(read, m, rtol=1e-8)
+    holed = [f"{v:.6E}".replace("E", "D") for v in z]
+    holed[9] = "NaN"
+    (tmp_path / "nan.txt").write_text("\n".join(holed) + "\n")
+    with pytest.raises(ValueError, match=r"at line 10, column 1"):
+        ProfileFile(path=str(tmp_path / "nan.txt"), spacing=1.0).rms_height()
+    holed[9] = "1.0Q-06"  # no exponent Fortran writes: still no number
+    (tmp_path / "bad.txt").write_text("\n".join(holed) + "\n")
+    with pytest.raises(ValueError, match=r"non-numeric content at line 10 .*: column 1 is not a number"):
+        ProfileFile(path=str(tmp_path / "bad.txt"), spacing=1.0).rms_height()

@@ -232,12 +232,13 @@ def _missing_package(exc: Exception, purpose: str):
 
 
 def _plugin_at_fault(exc: Exception):
-    """The PluginError that names the installed plugin whose code raised ``exc``, or None."""
+    """The PluginError that names the installed plugin whose code raised ``exc``, or None; a
+    ``SolveFailed`` (a failure the plugin explains) as its message, naming it without blame."""
     if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
         return None
-    from ..plugin.registry import installed_plugin_fault
+    from ..plugin.registry import installed_plugin_fault, solve_failed
 
-    return installed_plugin_fault(exc)
+    return solve_failed(exc) or installed_plugin_fault(exc)
 
 
 def _plain_warning(message, category, filename, lineno, file=None, line=None):

@@ -110,19 +110,33 @@ PATH_METAVARS = {"DIR": "folder", "RUN_DIR": "folder", "FILE": "file", "DEST": "
 
 def refuse_empty_paths(parser, args) -> None:
     """A usage error for any path argument of the command (its metavar a ``PATH_METAVARS``)
-    given as the empty string, which Path() reads as this folder (``frictionlab resume ""``
+    given as '-' where it does not mean stdout (a file or folder named '-' was made), or as the empty string, which Path() reads as this folder (``frictionlab resume ""``
     resuming whatever run is here) and an option takes as not given (``exact3d --runs ""``:
     hours of work into a new runs/ folder): checked once here, for every command alike."""
     for action in _command_actions(parser, args):
         what = PATH_METAVARS.get(action.metavar)
         value = getattr(args, action.dest, None)
-        if what is None or not isinstance(value, str) or value.strip():
+        if what is None or not isinstance(value, str) or (value.strip() and value != "-") or _dash_is_stdout(action, value):
             continue
         name = max(action.option_strings, key=len) if action.option_strings else action.metavar
+        if value == "-":  # a file named '-' (or a folder): made silently where the user meant stdout
+            raise FrictionlabError(f"{name} -: '-' stands for standard output or input, which {name} cannot be: it "
+                                   f"names a {what}; give a {what} (./- for one named '-')")  # fmt: skip
         optional = action.option_strings or action.nargs == "?"
         leave = (f"leave {name} out" if action.option_strings else "leave it out") if optional else ""
         empty = "it is empty" if not value else "it is only spaces"  # a folder named ' ' is refused as a mistyped one
         raise FrictionlabError(f"{name} names no {what} ({empty}): give a {what}" + (f", or {leave}" if leave else ""))
+
+
+def dash_is_stdout(action: argparse.Action) -> argparse.Action:
+    """Mark ``action`` (a FILE or DEST) as one whose '-' means stdout, as by CLI convention; any
+    other path argument refuses '-' (``refuse_empty_paths``)."""
+    action.dash_is_stdout = True
+    return action
+
+
+def _dash_is_stdout(action: argparse.Action, value: str) -> bool:
+    return value == "-" and getattr(action, "dash_is_stdout", False)
 
 
 def _command_actions(parser, args):

@@ -4,9 +4,11 @@ to take one out to edit (never over an existing file without ``--force``)."""
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 from ..errors import ExitCode, FrictionlabError, OutputRefused, did_you_mean, shown, shown_name
+from .options import dash_is_stdout
 
 EXAMPLES = """examples:
   frictionlab presets                         list the built-in presets
@@ -32,8 +34,9 @@ def add_parser(sub) -> None:
         epilog="example:\n  frictionlab presets copy benad2012-fig2 my-fig2.yaml",
     )
     c.add_argument("name", metavar="NAME", help="a built-in preset (frictionlab presets lists them)")
-    c.add_argument("dest", nargs="?", default=".", metavar="DEST",
-                   help="file or folder (default: .); a name ending in / is a folder, made if missing")
+    dash_is_stdout(c.add_argument("dest", nargs="?", default=".", metavar="DEST",
+                                  help="file or folder (default: .); a name ending in / is a folder, made if missing; "
+                                  "- prints the preset on stdout"))
     c.add_argument("--force", action="store_true", help="replace DEST if it exists")
     p.set_defaults(handler=run)
 
@@ -44,6 +47,8 @@ def run(args) -> ExitCode:
     if getattr(args, "action", None) == "copy":
         if args.json:  # taken by `presets`, not by copy: a script waiting for JSON got a line of text
             raise FrictionlabError("--json lists the built-in presets as JSON; presets copy prints none: leave --json out")
+        if args.dest == "-":  # stdout, by CLI convention
+            return print_preset(args.name)
         dest = Path(args.dest)
         if args.dest.endswith(("/", os.sep)) and not dest.is_dir():  # "newdir/": a folder, not a file named newdir
             from ..io.files import output_path_problem
@@ -66,14 +71,28 @@ def run(args) -> ExitCode:
     return ExitCode.OK
 
 
-def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
-    from ..io.files import atomic_write
+def _builtin(name: str):
     from ..preset.builtin import builtin_presets, find_builtin
 
     preset = find_builtin(name)
     if preset is None:
         names = [p.name for p in builtin_presets()]
         raise FrictionlabError(f"no built-in preset {name!r}{did_you_mean(name, names) or '.'} Built-ins: {', '.join(names)}.")
+    return preset
+
+
+def print_preset(name: str) -> ExitCode:
+    """``presets copy NAME -``: the built-in preset's file as it is, on stdout."""
+    data = _builtin(name).path.read_bytes()
+    sys.stdout.flush()
+    sys.stdout.buffer.write(data)
+    return ExitCode.OK
+
+
+def copy_preset(name: str, dest: Path, *, force: bool = False) -> ExitCode:
+    from ..io.files import atomic_write
+
+    preset = _builtin(name)
     target = dest / preset.path.name if dest.is_dir() else dest
     from ..io.files import output_path_problem, refuse_unreplaceable
 

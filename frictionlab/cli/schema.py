@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 from ..errors import ExitCode
+from .options import dash_is_stdout
 
 
 def add_parser(sub) -> None:
@@ -14,7 +15,8 @@ def add_parser(sub) -> None:
         description="Print the JSON Schema of a preset, with the parameters of every installed plugin (for editors).",
         epilog="example:\n  frictionlab schema --out preset.schema.json",
     )
-    p.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout (an existing FILE is kept unless --force)")
+    dash_is_stdout(p.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout (an existing FILE is kept "
+                                  "unless --force; - is stdout)"))
     p.add_argument("--force", action="store_true", help="replace FILE if it exists")
     p.set_defaults(handler=run)
 
@@ -23,7 +25,7 @@ def run(args) -> ExitCode:
     from ..preset import preset_json_schema
 
     out = None
-    if args.out:
+    if args.out and args.out != "-":  # '-': stdout
         from ..io.files import check_output_file
 
         out = check_output_file(args.out, "--out", force=args.force)  # before the work: refused at once

@@ -29,6 +29,8 @@ def run(args) -> ExitCode:
     from ..preset.builtin import preset_source, resolve_preset_path, same_name_note
     from ..runs.runner import check_one_realization
     from ..runs.sweep import plan_sweep
+    from ..plugin import SolveFailed
+    from ..plugin.registry import solve_failed
 
     worst = ExitCode.OK
     records = []
@@ -46,7 +48,8 @@ def run(args) -> ExitCode:
                 points = len(plan_sweep(data, source=source, before_reading=check_one_realization).points)
             # its loads in every unit: refused here when the solver cannot take them
             record = {"preset": str(path), "ok": True, "problems": [], **scene_record(scene), "sweep_points": points}
-        except FrictionlabError as exc:
+        except (FrictionlabError, SolveFailed) as raised:  # a SolveFailed: the plugin's word, as run tells it
+            exc = solve_failed(raised) or raised
             worst = ExitCode(max(worst, exc.exit_code))
             problems = exc.problems or [str(exc)]
             records.append({"preset": str(path), "ok": False, "problems": problems, "exit_code": int(exc.exit_code)})

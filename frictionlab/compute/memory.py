@@ -18,6 +18,10 @@ the boundary elements of the half-space: about 1.5x the line pipeline):
   whole surface (``SpectrumGenerator.equivalent_line_bytes``), and
   keeps what the surface derived (its synthesis, its map) for the rest of the run;
   worker processes are sent the line alone (``Scene.for_pressing``).
+
+Not counted here: filling a measured map's points not measured (``undefined: harmonic``), whose
+cost (kilobytes per point filled) depends on how many there are, known only once the file is
+read; the reader estimates it then, before the fill, and refuses one that does not fit.
 """
 
 from __future__ import annotations

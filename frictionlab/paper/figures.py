@@ -161,12 +161,19 @@ def _check_folder(run: FigureRun, options: RunOptions) -> None:
         elif not continuing(own, run.folder, run.scene).resume:
             RunDirectory(run.folder, force=own.force).check_fresh(run.scene)
     except OutputRefused:
-        if _holds_a_run(run.folder):  # another preset's run: its message says what --force does
-            raise
-        held = first_names(sorted(p.name for p in run.folder.iterdir()))
-        raise OutputRefused(f"{shown_name(run.folder)} holds files that no frictionlab run wrote ({held}): the report writes "
-                            "its runs only into new or empty folders or its own, --force or not; move them aside, "
-                            "or give another --out") from None  # fmt: skip
+        refuse_foreign_files(run.folder)
+        raise  # another preset's run: its message says what --force does
+
+
+def refuse_foreign_files(folder: Path) -> None:
+    """OutputRefused for a folder the report runs into (a figure's, a reading's) that holds files
+    no frictionlab run wrote: --force never writes there (``own_force``), so the run's own advice,
+    --force, would not help; nothing when it holds a run, or nothing at all."""
+    if _holds_a_run(folder) or not folder.is_dir() or not (names := sorted(p.name for p in folder.iterdir())):
+        return
+    raise OutputRefused(f"{shown_name(folder)} holds files that no frictionlab run wrote ({first_names(names)}): the report "
+                        "writes its runs only into new or empty folders or its own, --force or not; move them aside, "
+                        "or give another --out") from None  # fmt: skip
 
 
 def _check_memory_ahead(runs: list[FigureRun], options: RunOptions) -> None:

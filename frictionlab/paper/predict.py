@@ -168,8 +168,8 @@ def predict_xi(
     """xi = a + b ln f of ``law`` at f = sqrt(pi) F / (2 E* h sqrt(A)), with an interval
     (see the module doc): from the bootstrap ``pairs`` if given, else from the corners of
     the law's ``a_ci`` x ``b_ci`` if known. FrictionlabError for a law ``check_law``
-    refuses, and for numbers that leave double precision (every number returned is finite
-    but an unknown interval, NaN)."""
+    refuses, for numbers that leave double precision (every number returned is finite
+    but an unknown interval, NaN), and for an xi <= 0, which no rms slope is."""
     check_law(law)
     if rms_slope is not None:
         _check_positive(rms_slope, (names or {}).get("rms_slope", "rms_slope"))
@@ -187,6 +187,7 @@ def predict_xi(
         else:
             ci, how = (math.nan, math.nan), "none"
     _refuse_overflow("xi = a + b ln f", xi, law, ln_f)
+    _refuse_not_positive(xi, law, f, fitted_f, names)
     if how != "none":
         _refuse_overflow(f"the interval of xi ({how})", max(abs(ci[0]), abs(ci[1])), law, ln_f)
     slope = slope_ci = None
@@ -224,6 +225,21 @@ def _refuse_overflow(what: str, value: float, law: LogFit, ln_f: float) -> None:
             f"{what} is beyond double precision (about 1e308) with a = {law.a!r}, b = {law.b!r}, ln f = {ln_f:.6g}: "
             "the law's coefficients (or their intervals) are too large"
         )
+
+
+def _refuse_not_positive(xi: float, law: LogFit, f: float, fitted_f, names: dict[str, str] | None) -> None:
+    """An xi <= 0 is an rms slope at or below zero: no contact has one, so no prediction is
+    printed. It comes of an f far outside the law's range, most often of inputs in mixed units."""
+    if xi > 0:
+        return
+    named = ", ".join((names or {}).get(field, field) for field in ("force", "modulus", "rms_height", "area"))
+    fitted = "" if fitted_f is None else f" (the run was fitted over f = {fitted_f[0]:.3g} .. {fitted_f[1]:.3g})"
+    raise FrictionlabError(
+        f"xi = a + b ln f = {law.a:.6g} + {law.b:.6g} x {math.log(f):.4g} = {xi:.4g} at f = {f:.6g}{fitted}: an rms "
+        f"slope in contact must be > 0, so this f lies far outside where the law holds. Check {named}: they must "
+        "be in one consistent system of units (F in N with E* in Pa, h and sqrt(A) in m, say); else the force is "
+        "too far from the law's range (too few points in contact) for a prediction"
+    )
 
 
 # ------------------------------------------------------------------ a run folder's law
@@ -433,6 +449,4 @@ def prediction_text(p: Prediction) -> str:
     if p.beyond_full_contact:
         lines.append("warning: xi > 1, more than the whole surface's rms slope: at full contact xi = 1, so this force "
                      "may be past where the log law holds (see the run's contact fraction)")
-    if p.xi <= 0:
-        lines.append("warning: xi <= 0: below the law's range (too few points in contact)")
     return "\n".join(lines)

@@ -7,6 +7,7 @@ except the averaging readings, which re-average the default run's
 
 from __future__ import annotations
 
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..errors import FrictionlabError
+from ..errors import FrictionlabError, OutputRefused
 from ..compute.fit import LogFit, fit_log_law
 from ..options import RunOptions
 from ..preset import apply_overrides, build_scene, load_preset_file
@@ -22,7 +23,7 @@ from ..runs.runfolder import output_subfolder
 from ..compute.signals import interrupted_since, mark
 from ..preset.seeds import bootstrap_rng, replicate_seeds
 from .calibration import calibrated_rms_height
-from .figures import FigureRun, run_or_read_back
+from .figures import FigureRun, refuse_foreign_files, run_or_read_back
 
 
 AVERAGES = {
@@ -171,6 +172,16 @@ READINGS_FOLDER = "readings"  # the readings' run folders, in the report's --out
 CALIBRATED_FOLDER = "fig5-calibrated"  # the runs of Fig. 5 with h calibrated at each H
 
 
+def check_reading_folders(out_dir: Path) -> None:
+    """Refuse, before any figure runs, a folder of the readings' (``readings/NN-figK``,
+    ``fig5-calibrated/...``) that holds files no frictionlab run wrote (``refuse_foreign_files``)."""
+    for name in (READINGS_FOLDER, CALIBRATED_FOLDER):
+        if (out_dir / name).is_dir() and not (out_dir / name).is_symlink():  # a link: refused as the readings start
+            for folder in sorted(out_dir / name / child for child in os.listdir(out_dir / name)):
+                if folder.is_dir() and not folder.is_symlink():
+                    refuse_foreign_files(folder)
+
+
 def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = RunOptions(), *, readings=READINGS,
                  folder_name=READINGS_FOLDER, progress: bool = False, replicates: int = 1) -> list[ReadingRow]:  # fmt: skip
     """Run each reading (calibrating h first where it says so) on ``replicates`` independent
@@ -193,7 +204,11 @@ def run_readings(runs: list[FigureRun], out_dir: Path, options: RunOptions = Run
             scene = build_scene(apply_overrides(data, [*seeded, "output.plot=false"]), source=str(base.preset_path))
             output_subfolder(out_dir, str(folder.relative_to(out_dir)), "run the report again")
             seen = mark()
-            outcome = run_or_read_back(scene, folder, options, listeners())
+            try:
+                outcome = run_or_read_back(scene, folder, options, listeners())
+            except OutputRefused:
+                refuse_foreign_files(folder)  # its run's advice, --force, does not lift it
+                raise
             if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
                 raise KeyboardInterrupt  # the report stops: what finished is kept
             ensembles[key] = scene, outcome

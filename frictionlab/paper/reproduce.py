@@ -20,7 +20,8 @@ from ..compute.signals import WorkInterrupted
 from .figures import FIGURES, find_presets, kept_in, run_figures
 from .markdown import HEADING, markdown
 from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
-from .readings import CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, fig5_calibrated_readings, run_readings
+from .readings import (CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, check_reading_folders, fig5_calibrated_readings,
+                       run_readings)
 
 
 FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
@@ -149,6 +150,8 @@ def write_report(
     every run shows its progress on stderr (``frictionlab.progress``)."""
     presets = find_presets(presets_dir)
     out_dir, markdown_path, figures_dir = report_paths(out_dir, markdown_path, figures_dir, force=options.force)
+    if readings:  # before Figs. 2 to 5 run, not after
+        check_reading_folders(out_dir)
     try:
         with one_dask_cluster(options):  # on Dask, every run uses one client and cluster
             started = time.perf_counter()

@@ -18,16 +18,18 @@ import importlib.metadata as md
 import os
 import re
 import sys
+import traceback
 from dataclasses import dataclass
 
 import pluggy
 
-from ..errors import PluginError, did_you_mean, short_repr, warn_user
+from ..errors import FrictionlabError, PluginError, did_you_mean, short_repr, warn_user
 from .base import Plugin
 from .classcheck import params_problem, validate_plugin_class
 from .hookspecs import PROJECT_NAME, RegistrationSpecs
 from .kinds import KINDS
 from .listeners import LIFECYCLE_HOOKS, GuardedListener, RunListener, fault_site
+from .solve_progress import SolveFailed
 
 ENTRY_POINT_GROUP = PROJECT_NAME
 BUILTIN_MODULES = ("frictionlab_spectra", "frictionlab_solvers", "frictionlab_slopes")
@@ -416,6 +418,18 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
                 "tell its authors, or choose another plugin"
             )
     return None
+
+
+def solve_failed(exc: BaseException) -> FrictionlabError | None:
+    """A ``SolveFailed`` raised outside a realization (the load of full contact, taken while a
+    preset is validated or before a run) told as a realization's failure tells it: the plugin's
+    own word, naming the plugin whose method raised it, never as its fault nor as a bug; None
+    for any other exception."""
+    if not isinstance(exc, SolveFailed):
+        return None
+    frames = [frame for frame, _ in traceback.walk_tb(exc.__traceback__)][::-1]  # innermost first
+    owner = next((frame.f_locals["self"] for frame in frames if isinstance(frame.f_locals.get("self"), Plugin)), None)
+    return FrictionlabError((f"{plugin_label(type(owner))} raised " if owner is not None else "") + f"SolveFailed: {exc}")
 
 
 def installed_plugin_fault(exc: BaseException) -> PluginError | None:

@@ -228,6 +228,13 @@ class Study:
         if self.options.reference is not None:
             choice = self.factory.solver_choice(self.options.reference, tolerance=tolerance)
             reference = self.factory.registry.get("solver", choice["name"])
+            if reference.name == base.name and "solver" in self.options.axes:
+                raise FrictionlabError(
+                    f"--reference {self.options.reference}: {base.name} is the preset's own solver, and the solver axis "
+                    f"would compare it with itself (every error 0); give another solver of the {base.problem} "
+                    "(frictionlab plugins lists them), or leave --reference out for the exact one, or leave solver out "
+                    "of --axes (the tolerance axis measures a solver against its own tightest tolerance)"
+                )
             if reference.problem != base.problem:
                 raise FrictionlabError(
                     f"--reference: {reference.name} solves the {reference.problem}, but the preset's solver "

@@ -31,7 +31,8 @@ _NOT_LENGTH_LABEL = re.compile(rf"[\[(]\s*(?:{NOT_LENGTH})\s*[\])]|/\s*(?:{NOT_L
 _LABEL = re.compile(  # x [µm], z (nm), z/nm; an inch only in brackets or after a slash ("z (in nm)" names nm)
     rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)|[\[(]\s*({IMPERIAL})\s*[\])]|/\s*({IMPERIAL})\s*(?=[,;\t]|$)"
 )
-_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+# a number a header states, its decimal mark a point or a comma (Gwyddion's export in a European locale: 25,6 µm)
+_NUMBER = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
 _SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
 # "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
@@ -106,7 +107,8 @@ _EXTENT = re.compile(rf"\b(?i:(?P<key>width|height))\s*[:=]\s*(?P<value>{_NUMBER
 
 def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float] | None:
     """The pixel (dx, dy) in metres of a map of ``shape`` (Ny, Nx) whose header states the scan's
-    width and height (Gwyddion's text export: ``# Width: 32.000 µm``, ``# Height: 8.000 µm``), or
+    width and height (Gwyddion's text export: ``# Width: 32.000 µm``, ``# Height: 8.000 µm``; ``32,000 µm``
+    in a locale whose decimal mark is a comma), or
     None unless it states both in length units: a table's reader takes its pixel from the preset."""
     from .instrument_file import LENGTH_UNITS, open_input  # here: it imports this module
 
@@ -115,7 +117,8 @@ def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float
     extent = {}
     for line in header_lines(head):
         if (found := _EXTENT.search(line.rstrip())) and length_unit(found["unit"]) in LENGTH_UNITS:
-            extent.setdefault(found["key"].lower(), float(found["value"]) * LENGTH_UNITS[length_unit(found["unit"])])
+            value = float(found["value"].replace(",", "."))  # 25,6: a decimal comma (no export groups thousands)
+            extent.setdefault(found["key"].lower(), value * LENGTH_UNITS[length_unit(found["unit"])])
     if len(extent) < 2 or not all(side > 0 for side in extent.values()):
         return None
     return extent["width"] / shape[1], extent["height"] / shape[0]

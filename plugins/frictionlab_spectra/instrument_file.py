@@ -30,7 +30,8 @@ from frictionlab.plugin import MAX_MAGNITUDE
 from .channel_choice import pick_channel
 from .instrument_reader import (
     BARE_ARRAY_FORMATS, channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points,
-    check_header_units, check_payload, check_text_heights, check_text_room, choose_reader, parses_text, quoted, xy_order,
+    check_fill_room, check_header_units, check_payload, check_text_heights, check_text_room, choose_reader, parses_text,
+    quoted, xy_order,
 )
 from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
@@ -241,6 +242,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
             if undefined == "keep":  # NaN, for a crop to leave out (surface-file's region)
                 heights = np.ma.filled(np.ma.asarray(heights, dtype=np.float64), np.nan)
             else:
+                check_fill_room(where, tuple(topography.nb_grid_pts), missing)
                 topography = topography.interpolate_undefined_data(method=undefined)
                 heights = topography.heights()
         pixel = np.atleast_1d(np.asarray(topography.pixel_size, dtype=np.float64)) * (-1.0 if backwards else 1.0)

@@ -308,17 +308,40 @@ HEIGHT_COPIES = 4  # float64 arrays of the map alive at once while it is read: t
 def room_to_read() -> tuple[int, str]:
     """Bytes this process may still allocate, and what sets that: the memory the system has
     available, or the room left under the process's address-space limit (``ulimit -v``)."""
+    return min((room, source) for room, source, _ in memory_rooms())
+
+
+def memory_rooms() -> list[tuple[int, str, bool]]:
+    """Each limit on what this process may still allocate: (bytes, what sets it, whether it
+    limits the address space, ``ulimit -v``, rather than the memory in use)."""
     import psutil
 
-    found = [(int(psutil.virtual_memory().available), "the memory the system has available")]
+    found = [(int(psutil.virtual_memory().available), "the memory the system has available", False)]
     try:
         import resource
     except ImportError:  # not on Windows
-        return min(found)
+        return found
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
-        found.append((soft - psutil.Process().memory_info().vms, "the room left under this process's limit ulimit -v"))
-    return min(found)
+        found.append((soft - psutil.Process().memory_info().vms, "the room left under this process's limit ulimit -v", True))
+    return found
+
+
+def check_fill_room(where: str, shape: tuple[int, ...], holes: int) -> None:
+    """Refuse, before it starts, a harmonic fill (``undefined: harmonic``) of ``holes`` points not
+    measured in a scan of ``shape`` that cannot fit in the memory left: its sparse solve took the
+    memory mid-read, and ended in MemoryError, or the process killed."""
+    from .scan_shaping.filling import harmonic_fill_bytes
+
+    for room, source, address_space in memory_rooms():  # what it keeps resident, or the address space it reserves
+        need = harmonic_fill_bytes(shape, holes, reserved=address_space)
+        if need <= room:
+            continue
+        raise ValueError(
+            f"{where}: filling its {holes:,} points not measured (undefined: harmonic) takes about {need / 2**30:.3g} "
+            f"GiB, more than the {room / 2**30:.3g} GiB this process may use ({source}); leave them out with region "
+            "(the measured part of the scan), or fill fewer: fix the scan, or export it with its holes filled"
+        )
 
 
 MOST_POINTS_A_BYTE = 1032  # deflate's greatest ratio: a point of one byte, compressed, takes at least 1/1032 byte

@@ -38,6 +38,7 @@ from .instrument_file import (
     ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
     uniform_spacing,
 )
+from .instrument_reader import check_fill_room
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .reader_failures import reason_said
@@ -369,6 +370,7 @@ def fill_table(where: str, z: np.ndarray, p) -> dict:
             return {}
     if missing == z.size:  # nothing to fill from
         raise ValueError(f"{where}: all {missing} heights are NaN (not measured): nothing to press")
+    check_fill_room(where, z.shape, missing)  # before the solve, which took the memory mid-read
     fill_harmonic(z, bool(p.periodic))
     caveat = filled_caveat(missing, z.size, p, z.ndim)
     return {"undefined_points": missing, "filled_by": p.undefined, **({"caveats": [caveat]} if caveat else {})}

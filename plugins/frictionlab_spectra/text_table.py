@@ -68,7 +68,7 @@ def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple
             if not text or not _numbers(text, delimiter):
                 continue
             for at, cell in enumerate(text.split(delimiter), start=1):
-                if column in (None, at) and not abs(float(cell)) <= MAX_MAGNITUDE:  # NaN too
+                if column in (None, at) and not abs(float(e_exponents(cell))) <= MAX_MAGNITUDE:  # NaN too
                     return lineno, at
     return None
 
@@ -133,15 +133,33 @@ def _table(text, where: str) -> np.ndarray:
             raise ValueError(f"{where}: {decimal_commas(lineno)}")
         text.seek(0)
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
-            data = np.loadtxt(text, dtype=np.float64, delimiter=delimiter, comments="#", ndmin=2, skiprows=skip)
+        data = _loadtxt(text, delimiter, skip)
     except ValueError:
         text.seek(0)
-        raise ValueError(f"{where}: {_first_bad_line(text, skip, delimiter)}") from None
+        try:  # numpy reads no Fortran exponent (1.0D-06): read again with e, only where one failed it
+            data = _loadtxt((e_exponents(line) for line in text), delimiter, skip)
+        except ValueError:
+            text.seek(0)
+            raise ValueError(f"{where}: {_first_bad_line(text, skip, delimiter)}") from None
     if data.size == 0:
         data = np.zeros((0, 1))
     return data
+
+
+def _loadtxt(lines, delimiter: str | None, skip: int) -> np.ndarray:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # numpy warns on empty input; the point count reports it
+        return np.loadtxt(lines, dtype=np.float64, delimiter=delimiter, comments="#", ndmin=2, skiprows=skip)
+
+
+# 1.0D-06, -2.5d+03: a number as Fortran writes it (D for a double's exponent), a whole cell
+FORTRAN_NUMBER = re.compile(r"(?<![\w.+-])([-+]?(?:\d+\.?\d*|\.\d+))[dD]([-+]?\d+)(?![\w.])")
+
+
+def e_exponents(text: str) -> str:
+    """``text`` with each number written with Fortran's exponent (``1.0D-06``) written with
+    numpy's (``1.0e-06``): the same number; any other text left as it is."""
+    return FORTRAN_NUMBER.sub(r"\1e\2", text) if "d" in text or "D" in text else text
 
 
 def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
@@ -229,8 +247,9 @@ def _mostly_numbers(text: str, delimiter: str | None) -> bool:
 
 
 def is_number(cell: str) -> bool:
+    """Whether ``cell`` is a number, written as Python or as Fortran (``1.0D-06``) writes one."""
     try:
-        float(cell)
+        float(e_exponents(cell))
     except ValueError:
         return False
     return True

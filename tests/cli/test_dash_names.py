@@ -82,3 +82,26 @@ def test_a_suggested_command_names_a_folder_of_any_bytes_as_bash_takes_it_back(n
     assert said.stdout == b"/runs/" + name, word
     assert word.isascii() or name == "caf\u00e9 ok".encode()  # the terminal shows every byte of it
     assert (word == "'/runs/caf\u00e9 ok'") == (name == "caf\u00e9 ok".encode())
+
+
+def test_a_lone_dash_is_stdout_where_a_command_prints_and_refused_elsewhere(tmp_path, monkeypatch, capsys):
+    """`schema --out -` wrote a file named '-', and `run --out -` a folder named so: '-' is stdout by
+    CLI convention. schema and presets copy print there; an option naming a folder (or a file no
+    stdout can stand for, as report's --markdown) refuses it by name (exit 2), making nothing."""
+    import json
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["schema", "--out", "-"]) == ExitCode.OK
+    assert "FitSettings" in json.loads(capsys.readouterr().out)["$defs"]
+    assert main(["presets", "copy", "quickstart", "-"]) == ExitCode.OK
+    assert "name: quickstart" in capsys.readouterr().out
+    for words, option, what in ((["run", "quickstart", "--out", "-"], "--out", "folder"),
+                                (["report", "--markdown", "-"], "--markdown", "file"),
+                                (["predict", "--from", "-", "--area", "1", "--modulus", "1", "--rms-height", "1",
+                                  "--force", "1"], "--from", "folder"),
+                                (["runs", "-"], "DIR", "folder")):  # fmt: skip
+        assert main(words) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert f"{option} -: '-' stands for standard output or input, which {option} cannot be: it names a {what}" in err
+        assert "./- for one named '-'" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []

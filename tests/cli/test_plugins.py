@@ -81,6 +81,49 @@ def test_a_plugin_that_raises_is_named_with_exit_code_2_not_an_internal_error(ca
         registry_module.default_registry.cache_clear()
 
 
+EXPLAINING_SOURCE = '''
+import frictionlab
+from frictionlab import SolveFailed
+from frictionlab_solvers.springs import MDRSprings
+
+
+class Picky(MDRSprings):
+    name = "acme-picky"
+
+    def full_contact_load(self, profile):
+        raise SolveFailed("no full contact on a line this rough; use mdr")
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(Picky)
+'''
+
+
+def test_a_solve_failed_before_any_realization_is_the_plugins_word_not_its_fault(tmp_path, capsys, fake_dists):
+    """A SolveFailed (a failure the plugin explains) raised as validate takes the load of full
+    contact was told "the plugin is at fault: tell its authors", where a realization's tells its
+    message alone: said as run says it, naming the plugin, exit 2; validate goes on to the next preset."""
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-picky", "picky", "acme_picky", EXPLAINING_SOURCE, "1.0")
+    registry_module.default_registry.cache_clear()
+    try:
+        said = ("solver 'acme-picky' (acme_picky.Picky from acme-picky) raised SolveFailed: no full contact on a "
+                "line this rough; use mdr")
+        picky = ["--set", "solver.name=acme-picky"]
+        assert main(["validate", "quickstart", "quickstart", *picky]) == ExitCode.USAGE
+        err = capsys.readouterr().err
+        assert err.count(f"quickstart: {said}") == 2 and "at fault" not in err and "internal error" not in err
+        f_loads = ["--set", "loading.unit=f", "--set", "loading.start=0.01", "--set", "loading.stop=1"]
+        run = ["run", "quickstart", *picky, *f_loads, "--out", str(tmp_path / "r"), "--quiet"]
+        assert main(run) == ExitCode.USAGE  # its loads in f need the load of full contact
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: {said}") and "at fault" not in err
+    finally:
+        registry_module.default_registry.cache_clear()
+
+
 CHATTY_SOURCE = '''
 import frictionlab
 from tests.testing.fakes import GoodSpectrum

@@ -41,6 +41,9 @@ def test_cli_runs_a_study_and_prints_the_recommendation(tmp_path, capsys):
     "args, message",
     [
         (["--reference", "bem-nowhere"], "--reference: no solver plugin named 'bem-nowhere'"),
+        # the preset's own solver compared with itself: every error 0, said as a result
+        (["--reference", "MDR"], "--reference MDR: mdr is the preset's own solver, and the solver axis would compare "
+                                 "it with itself (every error 0); give another solver of the elastic half-space"),
         (["--axes", "grid,speed"], "--axes must name some of grid, realizations, steps, solver, tolerance"),
         (["--axes", "grid,steps,grid"], "--axes names grid more than once; each axis runs once: name it once. "
                                          "Got 'grid,steps,grid' instead."),  # the grid axis ran twice, its rows too

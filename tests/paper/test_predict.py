@@ -9,6 +9,7 @@ import pytest
 from frictionlab import mdr_length
 from frictionlab.cli import main
 from frictionlab.compute.fit import LogFit, percentile_interval
+from frictionlab.errors import FrictionlabError
 from frictionlab.options import RunOptions
 from frictionlab.paper.predict import (
     bootstrap_pairs,
@@ -89,7 +90,9 @@ def test_cli(tmp_path, capsys, make_scene):
     out = json.loads(capsys.readouterr().out)
     assert out["xi"] == pytest.approx(2.9 + 0.14 * math.log(out["f"]), rel=1e-12)
     run_to_folder(make_scene({"output": {"plot": False}}), tmp_path, RunOptions(workers=1))
-    assert main([*args, "--from", str(tmp_path)]) == 0
+    fitted = read_run_law(tmp_path)[1]  # a force inside the run's range of f: xi > 0 there
+    inside = math.sqrt(fitted[0] * fitted[1]) / dimensionless_force_3d(1.0, 1.0, 1e4, 1e10)
+    assert main([*args[:-1], repr(inside), "--from", str(tmp_path)]) == 0
     assert "(bootstrap pairs)" in capsys.readouterr().out
     assert main([*args]) == 2
     assert "--a A --b B" in capsys.readouterr().err
@@ -147,3 +150,18 @@ def test_a_run_without_realizations_npz_keeps_its_fitted_range(tmp_path, capsys,
     assert main(["predict", "--from", str(tmp_path), "--area", "1", "--modulus", "1", "--rms-height", "1",
                  "--force", "1", "--json"]) == 0  # fmt: skip
     assert json.loads(capsys.readouterr().out)["extrapolated"] is False
+
+
+
+def test_an_xi_at_or_below_zero_is_refused_naming_the_inputs(capsys):
+    """An rms slope in contact of xi <= 0 (h in m beside A and F of another system) was printed
+    with a warning and exit 0: no contact has one; it is refused (exit 2) naming the inputs."""
+    args = ["predict", "--a", "1.88", "--b", "0.08", "--area", "1e-4", "--modulus", "1e9", "--rms-height", "1", "--force", "1e-5"]
+    assert main(args) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "Traceback" not in captured.err
+    assert "an rms slope in contact must be > 0" in captured.err and "= -0.3401 at f = 8.86227e-13" in captured.err
+    assert "Check --force, --modulus, --rms-height, --area" in captured.err and "consistent system of units" in captured.err
+    with pytest.raises(FrictionlabError, match="must be > 0"):
+        predict_xi(LogFit(1.88, 0.08), force=1e-5, modulus=1e9, rms_height=1.0, area=1e-4)
+    assert predict_xi(LogFit(1.88, 0.08), force=1e-5, modulus=1e9, rms_height=1e-6, area=1e-4).xi > 0

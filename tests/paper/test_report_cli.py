@@ -329,3 +329,26 @@ def test_a_markdown_that_is_the_figures_folder_is_refused(tmp_path, capsys, mark
     assert code == ExitCode.OUTPUT_REFUSED
     assert f"--markdown {tmp_path / markdown} is the figures' folder" in capsys.readouterr().err
     assert not out.exists() and not (tmp_path / markdown).exists()
+
+
+@pytest.mark.parametrize("folder", ["readings/02-fig2", "fig5-calibrated/01-fig5"])
+def test_a_readings_folder_of_other_files_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, folder):
+    """--out of an earlier report whose readings/02-fig2 holds files of the user's: Figs. 2 to 5 ran,
+    then the reading's run refused its folder advising --force, which the report never applies
+    there. Refused before any figure runs (exit 4), saying what helps."""
+    out = tmp_path / "r"
+    (out / folder).mkdir(parents=True)
+    (out / folder / "notes.txt").write_text("mine")
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a figure ran before the readings' folders were checked")
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    for force in ([], ["--force"]):
+        code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--readings", "--quiet", *force])
+        assert code == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert f"{out / folder} holds files that no frictionlab run wrote ('notes.txt'): " in err
+        assert "--force or not; move them aside, or give another --out" in err and "force it (--force" not in err
+    assert (out / folder / "notes.txt").read_text() == "mine" and [p.name for p in out.iterdir()] == [folder.split("/")[0]]

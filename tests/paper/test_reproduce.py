@@ -236,6 +236,23 @@ def test_readings_rerun_as_documented(tmp_path, tiny_presets, tiny_runs):
     assert [(r.fit.a, r.fit.b) for r in again] == pytest.approx([(r.fit.a, r.fit.b) for r in rows], rel=1e-12)
 
 
+def test_a_readings_folder_of_other_files_is_refused_saying_what_helps(tmp_path, tiny_runs):
+    """A reading's folder holding files of the user's: its run's refusal advised --force, which the
+    report never applies there (it replaces only what a run wrote); said as the report says it."""
+    from frictionlab.errors import OutputRefused
+
+    (tmp_path / "readings" / "01-fig2").mkdir(parents=True)
+    (tmp_path / "readings" / "01-fig2" / "notes.txt").write_text("mine")
+    for force in (False, True):
+        with pytest.raises(OutputRefused) as refused:
+            run_readings(tiny_runs, tmp_path, RunOptions(workers=1, force=force),
+                         readings=(Reading("fig2", "spectral", ("slope.name=spectral",)),))  # fmt: skip
+        said = str(refused.value)
+        assert said.startswith(f"{tmp_path / 'readings' / '01-fig2'} holds files that no frictionlab run wrote ('notes.txt')")
+        assert "--force or not; move them aside, or give another --out" in said and "force it (--force" not in said
+    assert (tmp_path / "readings" / "01-fig2" / "notes.txt").read_text() == "mine"
+
+
 def test_presets_folder_errors(tmp_path, capsys):
     with pytest.raises(Exception, match="no folder with the paper's presets"):
         find_presets(tmp_path)
