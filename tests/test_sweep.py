@@ -596,3 +596,33 @@ def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, 
     assert main(["resume", str(tmp_path), "--workers", "1", "--quiet", "--no-plot"]) == 0, capsys.readouterr().err
     assert [r["status"] for r in read_table(tmp_path / "sweep.csv")] == ["completed", "completed"]
     assert (tmp_path / "points" / sweep.points[0].folder_name / "summary.json").read_bytes() == first  # kept, not rerun
+
+
+def test_a_sweep_started_with_fit_bootstrap_1_resumes_without_intervals(tmp_path, registry, recwarn):
+    """fit.bootstrap: 1, now refused, was once taken: a sweep whose sweep.json and points hold it was
+    refused by resume as a preset not valid here. Every point resumes with no intervals, and says so."""
+    from frictionlab.runs.rundir import fingerprint
+
+    cancel = threading.Event()
+
+    class StopAfterFirst(SweepListener):
+        def point_finished(self, sweep, point, result):
+            cancel.set()
+
+    sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2]}}), registry=registry)
+    run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    record = json.loads((tmp_path / "sweep.json").read_text())
+    record["base_preset"]["fit"]["bootstrap"] = 1  # as such a sweep wrote it, in its point's folder too
+    (tmp_path / "sweep.json").write_text(json.dumps(record))
+    point = tmp_path / "points" / sweep.points[0].folder_name
+    state = json.loads((point / "run.json").read_text())
+    state["preset"]["fit"]["bootstrap"] = 1
+    state["fingerprint"] = fingerprint(state["preset"])
+    (point / "run.json").write_text(json.dumps(state))
+    (point / "preset.yaml").write_text(yaml.safe_dump(state["preset"]))
+    assert main(["resume", str(tmp_path), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    rows = read_table(tmp_path / "sweep.csv")
+    assert [(r["status"], r["a_lo"]) for r in rows] == [("completed", ""), ("completed", "")]
+    said = [str(w.message) for w in recwarn if "fit.bootstrap is 1" in str(w.message)]
+    assert len(said) == 1 and f"resume of {point}: " in said[0], said
+    assert json.loads((point / "summary.json").read_text())["fit"]["bootstrap"] == 0  # its record as it now reads

@@ -77,6 +77,10 @@ def _run(args, drawer) -> ExitCode:
         print(shown(note), file=sys.stderr)
     args.preset = str(resolved)
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
+    if getattr(args, "stored", False):  # a run folder's own preset.yaml (resume DIR): read as this version reads it
+        from ..preset.paths import as_now
+
+        data = as_now(data)[0]  # the resume says what it changed
     refuse_swept_overrides(args, data)
     options = executor_run_options(args, resume=args.resume, force=args.force)
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
