@@ -46,7 +46,7 @@ from ..preset.paths import as_now, with_new_defaults
 from ..compute.realization import RealizationResult
 from .inputrecord import file_hashes, input_changes, refuse_changed_inputs, what_was_read
 from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, check_chunk_folder, chunk_bytes, damage_report, read_chunk
-from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
+from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member, refuse_other_kind
 from .runlock import LockHeld, RunLock
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
@@ -181,10 +181,8 @@ class RunDirectory:
 
     def __exit__(self, *exc) -> bool:
         if self._lock is not None:
-            try:
-                (self.path / LOCK_FILE).unlink()  # while still held: a waiter that opened it retries on the new one
-            except OSError:
-                pass
+            with contextlib.suppress(OSError):  # while still held: a waiter that opened it retries on the new one
+                (self.path / LOCK_FILE).unlink()
             self._lock.release()
             self._lock = None
         return False
@@ -313,7 +311,8 @@ class RunDirectory:
 
     def _refuse_unless_ours(self, state: dict | None, scene: Scene, resolved: dict) -> None:
         """OutputRefused when a fresh run here would replace what is not a
-        finished run of the same preset (unless ``force``)."""
+        finished run of the same preset (unless ``force``), or is a sweep's (``force`` too)."""
+        refuse_other_kind(self.path, "run")
         if self.force:
             return
         hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
