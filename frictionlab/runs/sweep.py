@@ -41,7 +41,7 @@ from .import_ahead import PLOT_MODULE, imported
 from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder
-from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, write_tables
+from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, stored_sweep, write_tables
 from .sweeprecord import read_sweep_record
 from ..compute.memory import estimate
 from .runner import check_memory, read_back, run_to_folder
@@ -436,7 +436,7 @@ def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, inte
 def sweep_of_point(folder: str | Path) -> Path | None:
     """The folder of the sweep whose point ``folder`` is (``SWEEP/points/NN``: its sweep.json
     beside points/), else None."""
-    folder = Path(folder)
+    folder = Path(folder) if Path(folder).name not in ("", ".", "..") else Path(os.path.abspath(folder))  # no link followed
     if folder.parent.name == "points" and os.path.lexists(folder.parent.parent / "sweep.json"):
         return folder.parent.parent
     return None
@@ -452,11 +452,11 @@ def refresh_point_tables(folder: str | Path, plot: bool = True) -> tuple[bool, s
         return None
     resume = f"`frictionlab resume {command_word(out_dir)}` writes them (and runs what is unfinished)"
     try:
-        data, record = read_sweep_record(out_dir)
-        sweep = plan_sweep({**data["base_preset"], "sweep": data["sweep"]}, source=data.get("source"))
-        if Path(folder).name not in [p.folder_name for p in sweep.points]:
-            return None
         with RunDirectory(out_dir):  # the sweep's lock: not while the sweep itself runs
+            data, record = read_sweep_record(out_dir)
+            sweep = plan_sweep(stored_sweep(out_dir), source=str(out_dir / "sweep.json"))  # as `resume SWEEP` plans it
+            if Path(os.path.abspath(folder)).name not in [p.folder_name for p in sweep.points]:  # a folder of its own
+                return None
             results = [_as_it_is(point, out_dir, row) for point, row in zip(sweep.points, data["points"], strict=True)]
             outcome = SweepOutcome(status="running", results=results, elapsed=record.elapsed_seconds)
             _finish(sweep, outcome, out_dir, plot)
