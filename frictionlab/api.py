@@ -282,7 +282,13 @@ def _run(preset, overrides, out, workers, executor, scheduler, resume, force, pl
         sweep = plan_sweep(data, source=source, before_reading=memory_check_before_reading(options))
         run_sweep(sweep, out, options, listeners=[SweepProgress()] if progress else [], plot=plot)
         return load(out)
-    return run_scene(scene, out, options, listeners=[ProgressReporter()] if progress else [], plot=plot)
+    result = run_scene(scene, out, options, listeners=[ProgressReporter()] if progress else [], plot=plot)
+    if resume:  # a sweep's point resumed alone: its sweep's tables take it, or say why not
+        from .runs.sweep import refresh_point_tables
+
+        if (refreshed := refresh_point_tables(out, plot)) is not None and not refreshed[0]:
+            warn_user(refreshed[1])
+    return result
 
 
 def run_scene(

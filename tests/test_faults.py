@@ -21,7 +21,9 @@ import numpy as np
 import pytest
 import yaml
 
+from frictionlab.cli import main
 from frictionlab.compute import engine
+from frictionlab.errors import ExitCode
 from frictionlab.runs import runner
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
@@ -271,6 +273,10 @@ def nan_force_unit(folder):  # the run failed as 'the preset's magnitudes leave 
     _rewrite(folder, _second(folder), lambda a: a["force_unit"].__setitem__(0, math.nan), True)
 
 
+def other_force_unit(folder):  # a unit not the run's moved f, and so the fitted law
+    _rewrite(folder, _second(folder), lambda a: a["force_unit"].__setitem__(0, a["force_unit"][0] * 2), True)
+
+
 def zero_slope(folder):
     _rewrite(folder, _second(folder), lambda a: a["slope_rms_line"].__setitem__(0, 0.0), True)
 
@@ -316,10 +322,26 @@ DAMAGE = {
     nan_points: "a profile's points not a whole number >= 1",
     fractional_points: "a profile's points not a whole number >= 1",
     nan_force_unit: "a force unit k h X not > 0",
+    other_force_unit: "force_unit 2048, not from 1023.99999898 to 1024.00000102",
     zero_slope: "a line's rms slope not a finite number > 0",
     unlisted_overlapping_copy: "1 file(s) in chunks/ are not in the manifest and are ignored",
     listed_twice: None,  # nothing is damaged: no warning
 }
+
+
+def test_a_forged_force_unit_of_realization_0_does_not_move_the_law(partial_and_whole, tmp_path, recwarn):
+    """The ensemble forms f with realization 0's force unit: a chunk forged with another one (its
+    checksum listed) changed a on resume, with no word; it is recomputed as any forged chunk is."""
+    _, partial, whole = partial_and_whole
+    folder = tmp_path / "run"
+    shutil.copytree(partial, folder)
+    first = list(_manifest(folder)["chunks"])[0]
+    _rewrite(folder, first, lambda a: a["force_unit"].__setitem__(0, a["force_unit"][0] * 3), True)
+    assert main(["resume", str(folder), "--workers", "1", "--quiet", "--no-plot"]) == ExitCode.OK
+    err = "\n".join(str(w.message) for w in recwarn)
+    assert f"'{first}': force_unit 3072, not from 1023.99999898 to 1024.00000102" in err, err
+    assert "1 realization(s) they held are recomputed" in err
+    same_files(folder, whole)
 
 
 @pytest.mark.parametrize("damage", list(DAMAGE), ids=[f.__name__ for f in DAMAGE])

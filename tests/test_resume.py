@@ -288,6 +288,44 @@ def test_a_run_started_before_a_field_existed_resumes_with_the_field_at_its_defa
     same_files(tmp_path / "run", tmp_path / "whole")
 
 
+def _as_written_with(run: Path, section: str, key: str, value) -> None:
+    """Make ``run`` look started by a frictionlab that took ``section.key: value``, now refused: the
+    stored preset holds it, and the manifest's fingerprint is that preset's."""
+    state = json.loads((run / "run.json").read_text())
+    state["preset"][section][key] = value
+    state["fingerprint"] = fingerprint(state["preset"])
+    (run / "run.json").write_text(json.dumps(state))
+    (run / "preset.yaml").write_text(yaml.safe_dump(state["preset"]))
+
+
+def test_a_run_started_with_fit_bootstrap_1_resumes_without_intervals_and_says_so(make_scene, tmp_path, recwarn):
+    """fit.bootstrap: 1 was once taken; now refused, a folder holding it was refused by `resume DIR`
+    as a preset not valid here: what finished could never be completed. It resumes, fitted with
+    no intervals (bootstrap 0), its finished realizations kept, and says so."""
+    scene, cancel = make_scene({"realizations": 20, **NO_PLOT}), threading.Event()
+    for folder in ("cli", "api"):
+        first, _ = run_to_folder(scene, tmp_path / folder, RunOptions(workers=1), listeners=[CancelAfter(4, cancel)], cancel=cancel)
+        assert first.status == "cancelled" and first.done < 20
+        _as_written_with(tmp_path / folder, "fit", "bootstrap", 1)
+        cancel.clear()
+    now = make_scene({"realizations": 20, "fit": {"bootstrap": 0}, **NO_PLOT})
+    run_to_folder(now, tmp_path / "whole", RunOptions(workers=1))
+
+    assert main(["resume", str(tmp_path / "cli"), "--workers", "1", "--quiet"]) == ExitCode.OK
+    said = [str(w.message) for w in recwarn if "fit.bootstrap" in str(w.message)]
+    assert len(said) == 1 and f"resume of {tmp_path / 'cli'}: its fit.bootstrap is 1" in said[0], said
+    assert "taken as 0, a fit without intervals" in said[0] and "fit.bootstrap 2 or more" in said[0]
+    summary = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert summary["fit"]["bootstrap"] == 0 and summary["fit"]["a_ci"] == [None, None]
+    assert summary["resumed_realizations"] == first.done  # what finished was kept, not computed again
+    assert yaml.safe_load((tmp_path / "cli" / "preset.yaml").read_text())["fit"]["bootstrap"] == 0
+    same_files(tmp_path / "cli", tmp_path / "whole")
+    # the preset given as it now reads (bootstrap 0) resumes the folder too
+    resumed, _ = run_to_folder(now, tmp_path / "api", RunOptions(workers=1, resume=True))
+    assert resumed.status == "completed" and resumed.extra["resumed"] == first.done
+    same_files(tmp_path / "api", tmp_path / "whole")
+
+
 def test_a_field_added_later_but_given_another_value_than_its_default_is_refused(make_scene, tmp_path):
     cancel = threading.Event()
     cancel.set()

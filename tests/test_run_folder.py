@@ -116,6 +116,28 @@ def test_a_finished_run_of_another_preset_is_refused_and_the_same_preset_reruns(
     assert json.loads((out / "summary.json").read_text())["seed"] == 8
 
 
+@pytest.mark.parametrize("first, then", [("run", "sweep"), ("sweep", "run")])
+@pytest.mark.parametrize("detach", [False, True])
+def test_a_sweep_forced_into_a_runs_folder_or_a_run_into_a_sweeps_is_refused(tmp_path, capsys, first, then, detach):
+    """--force wrote a sweep beside a run (or a run beside a sweep): both manifests stayed, and the
+    folder was read as the run (runs, load, resume), the sweep out of sight. Refused, forced or
+    not, before anything is written, saying what the folder holds and what to do."""
+    presets = {"run": write(tmp_path / "run.yaml", QUICK),
+               "sweep": write(tmp_path / "sweep.yaml", {**QUICK, "sweep": {"parameters": {"seed": {"values": [1, 2]}}}})}
+    out = tmp_path / "out"
+    assert main(["run", str(presets[first]), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK
+    before, held = tree(out), "run.json" if first == "run" else "sweep.json"
+    capsys.readouterr()
+    for force in ([], ["--force"]):
+        command = ["run", str(presets[then]), "--out", str(out), "--quiet", "--no-plot", *force, *(["--detach"] * detach)]
+        assert main(command) == ExitCode.OUTPUT_REFUSED
+        err = capsys.readouterr().err
+        assert f"error: {out} holds a frictionlab {first} ({held}), not a {then}: a {then} is not written into a {first}'s " \
+               "folder, even forced (--force; force=True in Python)" in err, err
+        assert f"move the {first} aside (mv {out} NEW_NAME)" in err and "Traceback" not in err
+        assert tree(out) == before
+
+
 def test_force_over_an_unfinished_run_deletes_only_the_chunks_its_manifest_lists(make_scene, tmp_path):
     scene = make_scene({"realizations": 30, **NO_PLOT})
     cancel = threading.Event()

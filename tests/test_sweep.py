@@ -596,3 +596,90 @@ def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, 
     assert main(["resume", str(tmp_path), "--workers", "1", "--quiet", "--no-plot"]) == 0, capsys.readouterr().err
     assert [r["status"] for r in read_table(tmp_path / "sweep.csv")] == ["completed", "completed"]
     assert (tmp_path / "points" / sweep.points[0].folder_name / "summary.json").read_bytes() == first  # kept, not rerun
+
+
+def test_a_sweep_started_with_fit_bootstrap_1_resumes_without_intervals(tmp_path, registry, recwarn):
+    """fit.bootstrap: 1, now refused, was once taken: a sweep whose sweep.json and points hold it was
+    refused by resume as a preset not valid here. Every point resumes with no intervals, and says so."""
+    from frictionlab.runs.rundir import fingerprint
+
+    cancel = threading.Event()
+
+    class StopAfterFirst(SweepListener):
+        def point_finished(self, sweep, point, result):
+            cancel.set()
+
+    sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2]}}), registry=registry)
+    run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    record = json.loads((tmp_path / "sweep.json").read_text())
+    record["base_preset"]["fit"]["bootstrap"] = 1  # as such a sweep wrote it, in its point's folder too
+    (tmp_path / "sweep.json").write_text(json.dumps(record))
+    point = tmp_path / "points" / sweep.points[0].folder_name
+    state = json.loads((point / "run.json").read_text())
+    state["preset"]["fit"]["bootstrap"] = 1
+    state["fingerprint"] = fingerprint(state["preset"])
+    (point / "run.json").write_text(json.dumps(state))
+    (point / "preset.yaml").write_text(yaml.safe_dump(state["preset"]))
+    assert main(["resume", str(tmp_path), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    rows = read_table(tmp_path / "sweep.csv")
+    assert [(r["status"], r["a_lo"]) for r in rows] == [("completed", ""), ("completed", "")]
+    said = [str(w.message) for w in recwarn if "fit.bootstrap is 1" in str(w.message)]
+    assert len(said) == 1 and f"resume of {point}: " in said[0], said
+    assert json.loads((point / "summary.json").read_text())["fit"]["bootstrap"] == 0  # its record as it now reads
+
+
+def _cancelled_in_point_2(data, out, registry):
+    """``data``'s sweep run into ``out`` and cancelled within its second point (some of its
+    realizations finished, in its folder); the points after it never reached."""
+    cancel = threading.Event()
+
+    class StopInSecond(SweepListener):
+        def run_listeners(self, point):
+            class Counting:
+                @hookimpl
+                def realization_done(self, done):
+                    if point.number == 2 and done >= 2:
+                        cancel.set()
+
+            return [Counting()]
+
+    sweep = plan_sweep(data, registry=registry)
+    run_sweep(sweep, out, RunOptions(workers=1), listeners=[StopInSecond()], cancel=cancel, plot=False)
+    return sweep
+
+
+def test_resuming_one_point_of_a_sweep_writes_the_sweeps_tables(tmp_path, registry, capsys):
+    """`frictionlab resume SWEEP/points/NN` completed the point, and left sweep.csv and sweep.json
+    saying it was cancelled (and the sweep interrupted) until the whole sweep was resumed."""
+    data = sweep_preset({"seed": {"values": [1, 2, 3]}}, realizations=12)
+    whole = run_sweep(plan_sweep(data, registry=registry), tmp_path / "whole", RunOptions(workers=1), plot=False)
+    sweep = _cancelled_in_point_2(data, tmp_path / "out", registry)
+    rows = read_table(tmp_path / "out" / "sweep.csv")
+    assert [r["status"] for r in rows] == ["completed", "cancelled", "pending"]
+    point = tmp_path / "out" / "points" / sweep.points[1].folder_name
+    capsys.readouterr()
+    assert main(["resume", str(point), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    err = capsys.readouterr().err
+    assert f"sweep.csv and sweep.json of the sweep in {tmp_path / 'out'}/ updated with this point (sweep interrupted)" in err
+    rows = read_table(tmp_path / "out" / "sweep.csv")
+    assert [r["status"] for r in rows] == ["completed", "completed", "pending"]
+    assert float(rows[1]["a"]) == pytest.approx(whole.results[1].fit.a, rel=1e-12)
+    record = json.loads((tmp_path / "out" / "sweep.json").read_text())
+    assert record["status"] == "interrupted" and record["points"][1]["done"] == 12
+    assert main(["resume", str(tmp_path / "out"), "--workers", "1", "--quiet", "--no-plot"]) == 0
+    assert [(r["status"], r["a"]) for r in read_table(tmp_path / "out" / "sweep.csv")] == [
+        (r["status"], r["a"]) for r in read_table(tmp_path / "whole" / "sweep.csv")]  # fmt: skip
+
+
+def test_a_point_resumed_while_its_sweep_is_held_says_how_to_update_the_tables(tmp_path, registry, capsys):
+    from frictionlab.runs.rundir import RunDirectory
+
+    data = sweep_preset({"seed": {"values": [1, 2]}}, realizations=12)
+    sweep = _cancelled_in_point_2(data, tmp_path, registry)
+    before = (tmp_path / "sweep.csv").read_bytes()
+    with RunDirectory(tmp_path):  # the sweep's lock, as a sweep running there holds it
+        assert main(["resume", str(tmp_path / "points" / sweep.points[1].folder_name), "--workers", "1", "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert f"the tables of the sweep in {tmp_path}/ are not updated with this point ({tmp_path} is in use by another run" in err
+    assert f"`frictionlab resume {tmp_path}` writes them (and runs what is unfinished)" in err
+    assert (tmp_path / "sweep.csv").read_bytes() == before

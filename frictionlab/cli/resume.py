@@ -84,7 +84,7 @@ def run(args) -> ExitCode:
             f"cannot resume {shown_name(run_dir)}: its {PRESET_FILE} has a sweep section, but the run there is one "
             "ensemble, not a sweep (the file was edited): remove that section to resume it, or run the sweep into another folder"
         )
-    args.preset = str(run_dir / PRESET_FILE)
+    args.preset, args.stored = str(run_dir / PRESET_FILE), True
     return stored_run(run_dir, lambda: run_command.run(args))
 
 

@@ -77,6 +77,10 @@ def _run(args, drawer) -> ExitCode:
         print(shown(note), file=sys.stderr)
     args.preset = str(resolved)
     data = read_preset(args.preset, overrides)  # read once: a sweep plans its points from the same data
+    if getattr(args, "stored", False):  # a run folder's own preset.yaml (resume DIR): read as this version reads it
+        from ..preset.paths import as_now
+
+        data = as_now(data)[0]  # the resume says what it changed
     refuse_swept_overrides(args, data)
     options = executor_run_options(args, resume=args.resume, force=args.force)
     reading = None if data.get("sweep") else memory_check_before_reading(options)  # a sweep checks each point
@@ -145,6 +149,7 @@ def _run_scene(args, scene, out_dir: Path, options, drawer=None) -> ExitCode:
     from ..api import run_scene
     from ..progress import ProgressReporter
     from ..runs.results import summary_dict
+    from ..runs.sweep import refresh_point_tables
     from ..compute.signals import interrupted_exit_code
 
     closed = []  # stdout closed or full: raised again once the run folder is finished
@@ -166,6 +171,8 @@ def _run_scene(args, scene, out_dir: Path, options, drawer=None) -> ExitCode:
     if closed:
         raise closed[0]
     outcome = result.outcome
+    if args.resume and (refreshed := refresh_point_tables(out_dir, plot=not args.no_plot)) is not None:
+        print(shown(f"  {refreshed[1]}"), file=sys.stderr)  # a sweep's point resumed alone: its sweep's tables
     if args.json:
         from .jsonout import emit
 

@@ -193,3 +193,26 @@ def with_new_defaults(stored: dict, resolved: dict, defaults: dict) -> dict:
         elif isinstance(stored[key], dict) and isinstance(value, dict):
             out[key] = with_new_defaults(stored[key], value, default if isinstance(default, dict) else {})
     return out
+
+
+# A value an older frictionlab took and this one refuses: (path, that value, what it now reads as, what that means).
+RETIRED_VALUES = (
+    ("fit.bootstrap", 1, 0, "a fit without intervals: one resample gives an interval of one point, not a spread; "
+                            "run the preset again with fit.bootstrap 2 or more for intervals"),
+)
+
+
+def as_now(stored) -> tuple[Any, list[str]]:
+    """``stored`` (a run folder's preset, or a sweep's base preset) with each of ``RETIRED_VALUES`` it
+    holds read as what it now means, and a note for each saying so: a run started with one resumes
+    (its realizations do not depend on it) rather than being refused as a preset no longer valid."""
+    if not isinstance(stored, dict):
+        return stored, []
+    out, notes = copy.deepcopy(stored), []
+    for path, old, new, means in RETIRED_VALUES:
+        value = get_path(out, path, None)
+        if value == old and type(value) is type(old):
+            set_path(out, path, new)
+            notes.append(f"its {path} is {old!r}, which an older frictionlab accepted and this one refuses: it is "
+                         f"taken as {new!r}, {means}")  # fmt: skip
+    return out, notes

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compute.ensemble import OWN_H_TOLERANCE
 from ..compute.realization import RealizationResult
 from ..errors import OutputRefused, RunFolderError, first_names, shown
 from ..io.files import output_path_problem
@@ -235,13 +236,21 @@ def _check_values(arrays: dict, numeric: tuple[str, ...]) -> None:
             raise ChunkDamage(f"{name} below 0 or above the profile's points")
 
 
-def _check_range(name: str, values: np.ndarray, least: float, most: float, nan: bool) -> None:
+def _check_range(name: str, values: np.ndarray, least: float, most: float, nan: bool, digits: int = 6) -> None:
     bad = ~((values >= least) & (values <= most))  # NaN too
     if nan:
         bad &= ~np.isnan(values)
     if bool(bad.any()):
         value = float(values.flat[int(np.argmax(bad))])
-        raise ChunkDamage(f"{name} {value:g}, not from {least:g} to {most:g}{' (or NaN)' if nan else ''}")
+        raise ChunkDamage(f"{name} {value:.{digits}g}, not from {least:.{digits}g} to {most:.{digits}g}{' (or NaN)' if nan else ''}")
+
+
+def _check_force_unit(values: np.ndarray, scene: Scene) -> None:
+    """ChunkDamage unless each realization's force unit k h X is the run's (realization 0's profile
+    gives it, and every profile shares it: the ensemble forms f with the first one's). A forged
+    chunk's other unit moved f, and so the fitted law."""
+    unit, spread = scene.load_scales.force_unit, OWN_H_TOLERANCE  # the spread the profiles' own h may have
+    _check_range("force_unit", values, unit * (1 - spread), unit * (1 + spread), False, digits=12)
 
 
 def _optional_kept(scene: Scene) -> tuple[bool, ...]:
@@ -288,6 +297,8 @@ def chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Rea
         if heights[name].shape != (n, steps):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n, steps)}")
     _check_values({**arrays, **heights}, (*OK_ARRAYS, *(curves if n else ()), *heights, "failed_seconds"))
+    if n:
+        _check_force_unit(arrays["force_unit"], scene)
     out = []
     for row, index in enumerate(arrays["index"].tolist()):
         out.append(RealizationResult(

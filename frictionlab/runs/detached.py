@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name
+from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name, warn_user
 from ..options import RunOptions
 from .progressevents import MAX_COUNT
 from .progresslog import ProgressLog, ProgressReader, StartOf, told_by
@@ -189,9 +189,12 @@ def _run_one(request: dict, out: Path, options: RunOptions, log: ProgressLog) ->
     """One ensemble; its status ("failed" when some realization failed)."""
     from ..preset import build_scene
     from .runner import run_to_folder
+    from .sweep import refresh_point_tables
 
     scene = build_scene(request["preset"])
     outcome, _ = run_to_folder(scene, out, options, listeners=[log], plot=bool(request.get("plot", True)))
+    if options.resume and (refreshed := refresh_point_tables(out, bool(request.get("plot", True)))) and not refreshed[0]:
+        warn_user(refreshed[1])  # a sweep's point resumed alone: its sweep's tables not updated, and why
     return "failed" if outcome.status == "completed" and outcome.failures else outcome.status
 
 

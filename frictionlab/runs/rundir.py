@@ -42,11 +42,11 @@ from ..errors import OutputRefused, PresetError, RunFolderError, command_word, s
 from ..io.files import atomic_write, output_path_problem, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly
 from ..preset import Scene, differences, load_preset_file
-from ..preset.paths import with_new_defaults
+from ..preset.paths import as_now, with_new_defaults
 from ..compute.realization import RealizationResult
 from .inputrecord import file_hashes, input_changes, refuse_changed_inputs, what_was_read
 from .chunks import CHUNK_DIR, CHUNK_NAME, ChunkDamage, check_chunk_folder, chunk_bytes, damage_report, read_chunk
-from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member
+from .runfolder import check_schema_version, json_kind, lock_holder, read_json_object, read_member, refuse_other_kind
 from .runlock import LockHeld, RunLock
 
 DEFAULT_RUNS_DIR = Path("runs")  # where front ends put a run that names no folder
@@ -93,13 +93,13 @@ def fingerprint(resolved: dict) -> str:
 def same_preset(state: dict, resolved: dict, scene: Scene) -> bool:
     """Whether a manifest's run is of ``scene``'s preset (``resolved``, its JSON form): the same
     fingerprint, or the same once each field added to frictionlab since the run started is
-    taken at its default."""
+    taken at its default, and each value since retired as what it now reads as (``as_now``)."""
     if state.get("fingerprint") == fingerprint(resolved):
         return True
     stored = state.get("preset")
     if not isinstance(stored, dict) or fingerprint(stored) != state.get("fingerprint"):
         return False
-    return with_new_defaults(stored, resolved, json_copy(scene.defaults())) == resolved
+    return with_new_defaults(as_now(stored)[0], resolved, json_copy(scene.defaults())) == resolved
 
 
 def json_copy(data: dict) -> dict:
@@ -181,10 +181,8 @@ class RunDirectory:
 
     def __exit__(self, *exc) -> bool:
         if self._lock is not None:
-            try:
-                (self.path / LOCK_FILE).unlink()  # while still held: a waiter that opened it retries on the new one
-            except OSError:
-                pass
+            with contextlib.suppress(OSError):  # while still held: a waiter that opened it retries on the new one
+                (self.path / LOCK_FILE).unlink()
             self._lock.release()
             self._lock = None
         return False
@@ -313,7 +311,8 @@ class RunDirectory:
 
     def _refuse_unless_ours(self, state: dict | None, scene: Scene, resolved: dict) -> None:
         """OutputRefused when a fresh run here would replace what is not a
-        finished run of the same preset (unless ``force``)."""
+        finished run of the same preset (unless ``force``), or is a sweep's (``force`` too)."""
+        refuse_other_kind(self.path, "run")
         if self.force:
             return
         hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
@@ -361,8 +360,10 @@ class RunDirectory:
                                  f"given{given}\n  " + "\n  ".join(changed))
         refuse_changed_inputs(self.path, state, inputs, read)
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
-        if state.get("fingerprint") != fingerprint(resolved):  # started before fields now at their defaults
+        if state.get("fingerprint") != fingerprint(resolved):  # started before fields now at their defaults, or retired values
             atomic_write(self.path / PRESET_FILE, lambda fh: yaml.safe_dump(resolved, fh, sort_keys=False))
+            for note in as_now(state.get("preset"))[1]:
+                warn_user(f"resume of {shown_name(self.path)}: {note}")
         self._manifest = {**state, "format": MANIFEST_FORMAT, "status": "running", "preset": resolved,
                           "fingerprint": fingerprint(resolved), "realizations": resolved.get("realizations"),
                           "inputs": {**inputs, **{k: v for k, v in recorded.items() if k not in inputs}},
@@ -420,8 +421,8 @@ class RunDirectory:
             return None
         if not state or state.get("status") != "completed" or state.get("format") != MANIFEST_FORMAT:
             return None
-        if not same_preset(state, json_copy(scene.resolved()), scene):
-            return None
+        if not same_preset(state, json_copy(scene.resolved()), scene) or as_now(state.get("preset"))[1]:  # its retired
+            return None  # values are rewritten, and said, by a resume
         hashes = file_hashes(scene)
         recorded = state.get("inputs") if isinstance(state.get("inputs"), dict) else {}
         if any(not isinstance(recorded.get(field), dict) for field in hashes) or input_changes(state, hashes, what_was_read(scene)):

@@ -30,7 +30,7 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
-from ..errors import OutputRefused, RunFolderError, short_repr, shown, shown_name
+from ..errors import OutputRefused, RunFolderError, command_word, short_repr, shown, shown_name
 from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 
 MAX_JSON_BYTES = 64 * 1024 * 1024  # summary.json is a few kB, run.json ~100 bytes a chunk (4096 at most)
@@ -132,6 +132,24 @@ def output_subfolder(root: str | Path, name: str, then: str, *, make: bool = Tru
         return subfolder(root, name) if os.path.lexists(Path(root) / name) else Path(root) / name
     except RunFolderError as exc:
         raise OutputRefused(f"{exc}: move it aside, then {then}") from None
+
+
+# the files that make a folder a run's, or a sweep's (a run killed as it started leaves its preset.yaml alone)
+KIND_FILES = {"run": ("run.json", "preset.yaml"), "sweep": ("sweep.json",)}
+
+
+def refuse_other_kind(folder: Path, kind: str) -> None:
+    """OutputRefused, --force or not, where a ``kind`` ("run" or "sweep") is to be written into
+    ``folder`` and it holds the other kind: written beside it, both manifests stayed there, and
+    the folder read as either (``runs``, ``load`` and ``resume`` took the run, the sweep unseen)."""
+    other = "sweep" if kind == "run" else "run"
+    held = [name for name in KIND_FILES[other] if os.path.lexists(folder / name)]
+    if held:
+        raise OutputRefused(
+            f"{shown_name(folder)} holds a frictionlab {other} ({held[0]}), not a {kind}: a {kind} is not written into "
+            f"a {other}'s folder, even forced (--force; force=True in Python): both would stay there, the folder read as either; give "
+            f"another output folder, or move the {other} aside (mv {command_word(folder)} NEW_NAME) and run again"
+        )
 
 
 def read_member(folder: str | Path, name: str, limit: int, what: str | None = None) -> bytes:

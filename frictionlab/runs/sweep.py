@@ -15,6 +15,7 @@ Front ends follow a sweep through ``listeners.SweepListener``s; each point's run
 from __future__ import annotations
 
 import itertools
+import os
 import re
 import threading
 import time
@@ -26,7 +27,8 @@ from typing import Any
 from pydantic import BaseModel
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, short_repr, shown_name
+from ..errors import (FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, command_word, short_repr,
+                      shown_name)  # fmt: skip
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
 from ..options import RunOptions
@@ -39,7 +41,8 @@ from .import_ahead import PLOT_MODULE, imported
 from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder
-from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, write_tables
+from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, stored_sweep, write_tables
+from .sweeprecord import read_sweep_record
 from ..compute.memory import estimate
 from .runner import check_memory, read_back, run_to_folder
 
@@ -402,23 +405,70 @@ def run_sweep(
                         listener.point_finished(sweep, result.point, result)
         except KeyboardInterrupt:  # Ctrl-C between two points
             interrupted = True
-        statuses = {r.status for r in outcome.results}
-        if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
-            outcome.status = "interrupted"
-        elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
-            outcome.status = "failed"
-        else:
-            outcome.status = "completed"
         outcome.elapsed = time.perf_counter() - started
-        outcome.files = write_tables(sweep, outcome, out_dir)
-        if plot and any(r.outcome is not None and r.outcome.fit is not None for r in outcome.results):
-
-            def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (its points import it ahead)
-                imported(PLOT_MODULE).plot_sweep(sweep, outcome.rows, fh)
-
-            write_figure(out_dir / "sweep.png", draw)
-            outcome.files["plot"] = out_dir / "sweep.png"
-            write_tables(sweep, outcome, out_dir)
+        _finish(sweep, outcome, out_dir, plot, interrupted)
         for listener in listeners:  # before the lock goes: a follower that sees it gone has heard this
             listener.sweep_finished(sweep, outcome)
     return outcome
+
+
+def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, interrupted: bool = False) -> None:
+    """The sweep's status from its points' (``interrupted``: stopped between two points), its tables
+    written, and sweep.png drawn where ``plot`` and some point has a fit."""
+    statuses = {r.status for r in outcome.results}
+    if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
+        outcome.status = "interrupted"
+    elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
+        outcome.status = "failed"
+    else:
+        outcome.status = "completed"
+    outcome.files = write_tables(sweep, outcome, out_dir)
+    if plot and any(r.fit is not None or (r.recorded or {}).get("a") is not None for r in outcome.results):
+
+        def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (its points import it ahead)
+            imported(PLOT_MODULE).plot_sweep(sweep, outcome.rows, fh)
+
+        write_figure(out_dir / "sweep.png", draw)
+        outcome.files["plot"] = out_dir / "sweep.png"
+        write_tables(sweep, outcome, out_dir)
+
+
+def sweep_of_point(folder: str | Path) -> Path | None:
+    """The folder of the sweep whose point ``folder`` is (``SWEEP/points/NN``: its sweep.json
+    beside points/), else None."""
+    folder = Path(folder) if Path(folder).name not in ("", ".", "..") else Path(os.path.abspath(folder))  # no link followed
+    if folder.parent.name == "points" and os.path.lexists(folder.parent.parent / "sweep.json"):
+        return folder.parent.parent
+    return None
+
+
+def refresh_point_tables(folder: str | Path, plot: bool = True) -> tuple[bool, str] | None:
+    """After one point of a sweep (``folder``) ran on its own (``frictionlab resume SWEEP/points/NN``),
+    the sweep's sweep.csv and sweep.json (and sweep.png, with ``plot``) written again: each completed
+    point read back, the others' rows as they were; nothing is computed. None where ``folder`` is no
+    sweep's point; else whether they were written, and what to tell the user."""
+    out_dir = sweep_of_point(folder)
+    if out_dir is None:
+        return None
+    resume = f"`frictionlab resume {command_word(out_dir)}` writes them (and runs what is unfinished)"
+    try:
+        with RunDirectory(out_dir):  # the sweep's lock: not while the sweep itself runs
+            data, record = read_sweep_record(out_dir)
+            sweep = plan_sweep(stored_sweep(out_dir), source=str(out_dir / "sweep.json"))  # as `resume SWEEP` plans it
+            if Path(os.path.abspath(folder)).name not in [p.folder_name for p in sweep.points]:  # a folder of its own
+                return None
+            results = [_as_it_is(point, out_dir, row) for point, row in zip(sweep.points, data["points"], strict=True)]
+            outcome = SweepOutcome(status="running", results=results, elapsed=record.elapsed_seconds)
+            _finish(sweep, outcome, out_dir, plot)
+    except (FrictionlabError, OSError) as exc:
+        return False, f"the tables of the sweep in {shown_name(out_dir)}/ are not updated with this point ({exc}): {resume}"
+    return True, f"sweep.csv and sweep.json of the sweep in {shown_name(out_dir)}/ updated with this point (sweep {outcome.status})"
+
+
+def _as_it_is(point: SweepPoint, out_dir: Path, row: dict) -> PointResult:
+    """``point``'s result read back from its folder where it completed, else its ``row`` of sweep.json."""
+    folder = point_folder(out_dir, point)
+    done = read_back(point.scene, folder, (), plot=False) if (folder / STATE_FILE).exists() else None
+    if done is not None:
+        return PointResult(point, done.status, folder, outcome=done, error=done.error).held()
+    return PointResult(point, row["status"], folder, error=row.get("error"), recorded=row)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from .. import __version__
 from ..errors import OutputRefused, RunFolderError, shown_name
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
-from .runfolder import read_json
+from .runfolder import read_json, refuse_other_kind
 from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, as_it_ran, read_sweep_record
 
 if TYPE_CHECKING:
@@ -37,6 +37,7 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     if problem:
         raise OutputRefused(f"{problem}; give a folder for the output")
     refuse_unreplaceable([out_dir / name for name in SWEEP_FILES], "sweep", "give another output folder")  # --force too
+    refuse_other_kind(out_dir, "sweep")  # --force too
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
         return
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"

@@ -10,7 +10,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field, ValidationError, model_validator
 
 from ..errors import RunFolderError, shown, shown_name
-from ..preset.paths import MISSING, get_path
+from ..preset.paths import MISSING, as_now, get_path
 from ..preset.schema import SweepSettings
 from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json
 
@@ -83,8 +83,11 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
 
 def as_it_ran(data):
     """A sweep.json's object with each parameter's ``spacing: log`` beside ``values`` read as
-    ``linear``: a sweep started before that pair was refused ran its values as listed, and stays
-    one that resume, follow and load read (and a run into its folder takes as the same sweep)."""
+    ``linear``, and its base preset's retired values as they now read (``as_now``): a sweep
+    started before that pair was refused ran its values as listed, and stays one that resume,
+    follow and load read (and a run into its folder takes as the same sweep)."""
+    if isinstance(data, dict) and isinstance(data.get("base_preset"), dict):
+        data = {**data, "base_preset": as_now(data["base_preset"])[0]}
     sweep = data.get("sweep") if isinstance(data, dict) else None
     if not isinstance(sweep, dict) or not isinstance(sweep.get("parameters"), dict):
         return data

@@ -146,6 +146,7 @@ class RunControl:
     def _stored(self, folder: Path):
         """(scene, sweep) of the run stored in ``folder`` (sweep None), or of the sweep (scene
         its first point's); RunFolderError or PresetError if it holds none that can run."""
+        from ..preset.paths import as_now
         from ..runs.detached import run_state
         from ..runs.rundir import RunDirectory
         from ..runs.sweep import plan_sweep
@@ -154,7 +155,8 @@ class RunControl:
         if run_state(folder).kind == "sweep":
             sweep = plan_sweep(stored_sweep(folder), registry=self.registry, source=str(folder / "sweep.json"))
             return sweep.points[0].scene, sweep
-        return build_scene(RunDirectory(folder).stored_preset(), registry=self.registry), None
+        stored = as_now(RunDirectory(folder).stored_preset())[0]  # a value since retired: the resume says so
+        return build_scene(stored, registry=self.registry), None
 
     def _stored_or_say(self, folder: Path, verb: str):
         """``_stored(folder)``, or None once the status line has said why it cannot ``verb`` it."""

@@ -102,3 +102,28 @@ async def test_new_presets_ctrl_s_message_goes_when_another_preset_opens(folders
         after = status_text(app)
     assert said == "New preset rough.yaml: Ctrl+S saves it as presets/rough.yaml."
     assert after == ""
+
+
+def test_a_folder_whose_preset_holds_fit_bootstrap_1_is_one_the_tui_can_resume(folders, registry):
+    """fit.bootstrap: 1, taken by older versions and now refused, made the TUI refuse the folder's
+    stored preset as not valid: it is read as 0 (no intervals), which the resume then says."""
+    import json
+
+    import yaml
+
+    from frictionlab.options import RunOptions
+    from frictionlab.preset import build_scene
+    from frictionlab.runs.rundir import fingerprint
+    from frictionlab.runs.runner import run_to_folder
+
+    from .conftest import TINY, merge
+
+    folder = folders / "runs" / "old"
+    run_to_folder(build_scene(merge(TINY, {"name": "old"}), registry=registry), folder, RunOptions(workers=1))
+    state = json.loads((folder / "run.json").read_text())
+    state["preset"]["fit"]["bootstrap"] = 1  # as such a version wrote it
+    state["fingerprint"] = fingerprint(state["preset"])
+    (folder / "run.json").write_text(json.dumps(state))
+    (folder / "preset.yaml").write_text(yaml.safe_dump(state["preset"]))
+    scene, sweep = make_app(registry)._stored(folder)
+    assert sweep is None and scene.preset.fit.bootstrap == 0
