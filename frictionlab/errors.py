@@ -257,11 +257,9 @@ def process_limit() -> tuple[int, str] | None:
 
 
 def out_of_memory_loading(exc: BaseException) -> str | None:
-    """The library a process limit left no room to load, else None: an ``ImportError``
-    ('failed to map segment from shared object', numpy's own message quoting it), or under a
-    process limit a ``SystemError`` raised as a module was imported (a compiled module whose
-    start could not allocate and set no exception: 'error return without exception set',
-    seen from pydantic's under ``ulimit -v 102400``), named by the package whose import failed."""
+    """The library a process limit left no room to load, else None: an ``ImportError`` ('failed
+    to map segment', numpy's message quoting it), or under a limit a ``SystemError`` from an
+    import (a compiled module that could not allocate: 'error return without exception set')."""
     match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
     if isinstance(exc, ImportError) and match:
         return match.group(1)
@@ -271,9 +269,8 @@ def out_of_memory_loading(exc: BaseException) -> str | None:
 
 
 def _package_being_imported(exc: BaseException) -> str | None:
-    """The installed package whose import raised ``exc`` ('a library' where the import began
-    outside one), or None where ``exc`` was not raised by an import. It imports nothing: the
-    memory that failed the import may fail another."""
+    """The installed package whose import raised ``exc`` ('a library' if none), None if no
+    import raised it; importing nothing, as the memory that failed one may fail another."""
     files, tb = [], exc.__traceback__
     while tb is not None:
         files.append(tb.tb_frame.f_code.co_filename)
@@ -281,9 +278,7 @@ def _package_being_imported(exc: BaseException) -> str | None:
     if not any(name.startswith("<frozen importlib") for name in files):
         return None
     parts = next((name for name in reversed(files) if not name.startswith("<")), "").split(os.sep)
-    if "site-packages" not in parts[:-1]:
-        return "a library"
-    return parts[parts.index("site-packages") + 1].split(".")[0]  # pydantic/..., six.py
+    return parts[parts.index("site-packages") + 1].split(".")[0] if "site-packages" in parts[:-1] else "a library"
 
 
 @dataclass(frozen=True)
