@@ -110,9 +110,10 @@ PATH_METAVARS = {"DIR": "folder", "RUN_DIR": "folder", "FILE": "file", "DEST": "
 
 def refuse_empty_paths(parser, args) -> None:
     """A usage error for any path argument of the command (its metavar a ``PATH_METAVARS``)
-    given as '-' where it does not mean stdout (a file or folder named '-' was made), or as the empty string, which Path() reads as this folder (``frictionlab resume ""``
-    resuming whatever run is here) and an option takes as not given (``exact3d --runs ""``:
-    hours of work into a new runs/ folder): checked once here, for every command alike."""
+    given as '-' where it does not mean stdout (a file or folder named '-' was made), or as the
+    empty string, which Path() reads as this folder (``frictionlab resume ""`` resuming
+    whatever run is here) and an option takes as not given (``exact3d --runs ""``: hours of
+    work into a new runs/ folder): checked once here, for every command alike."""
     for action in _command_actions(parser, args):
         what = PATH_METAVARS.get(action.metavar)
         value = getattr(args, action.dest, None)
