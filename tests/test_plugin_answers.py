@@ -201,8 +201,23 @@ def _solved(method, values):
     return solve
 
 
+def _one_draw(method):
+    """``method`` of a good plugin, drawing one number of numpy's global state first."""
+    def drawing(self, *args, **kwargs):
+        np.random.randint(2)  # one 32-bit word of the key
+        return method(self, *args, **kwargs)
+
+    return drawing
+
+
 RUN_BROKEN = {
     "global-random": (GoodSpectrum, {"generate": _noisy_generate}, "generate() used numpy's global random state"),
+    "one-draw-generate": (GoodSpectrum, {"generate": _one_draw(GoodSpectrum.generate)},
+                          "generate() used numpy's global random state"),
+    "one-draw-slopes": (GoodSlopes, {"slopes": _one_draw(GoodSlopes.slopes)}, "slopes() used numpy's global random state"),
+    "one-draw-solve": (GoodSolver, {"solve": _one_draw(GoodSolver.solve)}, "solve() used numpy's global random state"),
+    "one-draw-own-height": (GoodSpectrum, {"profile_rms_height": _one_draw(lambda self, profile: 1.0)},
+                            "profile_rms_height() used numpy's global random state"),
     "in-place": (GoodSlopes, {"slopes": _in_place_slopes}, "(a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones)"),
     "negative-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c - c.max())},
                        "solve().contact_count must lie in 0 .. 128 (points of the profile). Got array([-"),
@@ -227,3 +242,34 @@ def test_a_plugin_breaking_the_contract_within_a_realization_fails_it_naming_the
     assert error is not None and problem in error
     assert f"{SLOTS[base]} 'broken-{SLOTS[base]}' (broken_plugin.Broken from " in error
 
+
+
+@pytest.mark.parametrize("first", ["nothing", "a Gaussian", "the rest of the key"])
+def test_one_draw_is_caught_whatever_numpy_s_global_state_holds(register_plugin, first):
+    """A realization looks at numpy's global state between its plugin calls by its key and
+    position alone, read in full once: one Gaussian drawn of a pair cached before the realization
+    moves neither, and a draw that ends the key renews it (the position as it was)."""
+    from frictionlab.compute.realization import compute_realization
+
+    def solve(self, profile, loads, control, slopes):
+        if first == "a Gaussian":
+            np.random.standard_normal()  # the cached second of the pair: key and position unchanged
+        else:
+            np.random.randint(2**32, size=624 if first == "the rest of the key" else 1, dtype=np.uint64)
+        return GoodSolver.solve(self, profile, loads, control, slopes)
+
+    broken = type("Broken", (GoodSolver,), {"name": "broken-solver", "__module__": "broken_plugin", "solve": solve})
+    registry = register_plugin(broken)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "solver": {"name": "broken-solver"}}, registry=registry)
+    state = np.random.get_state()
+    try:
+        np.random.seed(5)
+        if first == "a Gaussian":
+            np.random.standard_normal()  # one of a pair: the other is cached
+            assert np.random.get_state()[3] == 1
+        error = compute_realization(scene, 0).error
+    finally:
+        np.random.set_state(state)
+    assert error is not None and "solve() used numpy's global random state" in error

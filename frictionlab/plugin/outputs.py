@@ -5,8 +5,11 @@ states the same problems in the same words."""
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import json
 import math
+import sys
 
 import numpy as np
 
@@ -132,19 +135,54 @@ def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, point
     return None
 
 
+_KEY_BYTES = 624 * 4  # MT19937's key; its position (a C int) follows it in the state struct
+
+
+@functools.cache
+def _legacy_state_address() -> int | None:
+    """Where the legacy MT19937 state that ``np.random.*`` functions draw from lies in memory (its
+    key, then its position), when it reads there as ``np.random.get_state()`` says; None otherwise
+    (another numpy's layout: the whole state is then compared)."""
+    try:
+        address = np.random.mtrand._rand._bit_generator.ctypes.state_address
+        _, keys, position, _, _ = np.random.get_state()
+        raw = ctypes.string_at(address, _KEY_BYTES + 4)
+        same = raw[:_KEY_BYTES] == keys.tobytes() and int.from_bytes(raw[_KEY_BYTES:], sys.byteorder, signed=True) == position
+    except (AttributeError, TypeError, ValueError):
+        return None
+    return address if same else None
+
+
 def random_state() -> tuple:
     """numpy's global random state (what ``np.random.*`` functions draw from), to compare."""
     _, keys, position, has_gauss, gauss = np.random.get_state()
     return keys.tobytes(), position, has_gauss, gauss
 
 
-def global_random_problem(what: str, before: tuple) -> str | None:
-    """A plugin call that drew from (or seeded) numpy's global random state since ``before``: its
-    numbers would depend on which realizations ran before it in the process, so on the worker count."""
-    if random_state() == before:
-        return None
-    return (f"{what} used numpy's global random state (np.random.* functions): draw all randomness from "
-            "the rng argument generate() is given, so that a seed gives the same numbers for any worker count")
+class RandomWatch:
+    """numpy's global random state looked at between consecutive plugin calls: ``problem(what)``
+    says whether the call since the last look (``what``) drew from it (or seeded it), whose numbers
+    would then depend on which realizations ran before it in the process, so on the worker count.
+
+    A look copies the MT19937 key and position (about a microsecond; ``np.random.get_state()``
+    takes tens), read once in full here: every draw moves the position or, past the key's end,
+    renews the whole key. Only a cached second Gaussian is drawn without either, so where one
+    is cached now every look reads the whole state."""
+
+    def __init__(self):
+        address = _legacy_state_address()
+        self.address = address if address is not None and not np.random.get_state()[3] else None
+        self.last = self._look()
+
+    def _look(self):
+        return random_state() if self.address is None else ctypes.string_at(self.address, _KEY_BYTES + 4)
+
+    def problem(self, what: str) -> str | None:
+        before, self.last = self.last, self._look()
+        if self.last == before:
+            return None
+        return (f"{what} used numpy's global random state (np.random.* functions): draw all randomness from "
+                "the rng argument generate() is given, so that a seed gives the same numbers for any worker count")
 
 
 def read_only(array: np.ndarray) -> np.ndarray:

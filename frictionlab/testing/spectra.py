@@ -40,14 +40,14 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """
     import numpy as np
 
-    from frictionlab.plugin.outputs import SAME_SEED, global_random_problem, height_problem, profile_problem, random_state
+    from frictionlab.plugin.outputs import SAME_SEED, RandomWatch, height_problem, profile_problem
 
     gen = instantiate(cls, params)
 
     def generate(seed: int):
-        before = random_state()
+        watch = RandomWatch()
         profile = call(cls, f"generate(default_rng({seed}))", gen.generate, np.random.default_rng(seed))
-        problem = global_random_problem("generate()", before) or profile_problem(gen, profile)  # as a run takes it
+        problem = watch.problem("generate()") or profile_problem(gen, profile)  # as a run takes it
         if problem:
             fail(cls, problem)
         return profile
