@@ -189,6 +189,11 @@ class ContactSolver(Plugin):
       depends on each surface, not on f and h alone, so ``mean_displacement`` cannot
       give it (a free-boundary half-space): a study then compares no indentations.
     - ``periodic_only`` (False): True for a solver of periodic profiles only.
+    - ``mdr_lines`` (False): True for a solver of lines alone (``dimensions`` ``(1,)``) whose line
+      models a surface by the method of dimensionality reduction (MDR): a surface is then pressed
+      as its spectrum's MDR-equivalent line (``SpectrumGenerator.equivalent_line()``). False: a
+      preset giving it a surface is refused; a solver of lines does not press a surface's line
+      unless it says that line stands for the surface.
     - ``body_params`` (()): the ``Params`` fields describing the elastic body (not
       the numerics); a study carries them from one solver to another that has them.
     - ``tolerance_param`` (None): the ``Params`` field of the relative tolerance of
@@ -224,6 +229,7 @@ class ContactSolver(Plugin):
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False
+    mdr_lines: ClassVar[bool] = False
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None
     bytes_per_point: ClassVar[int | None] = None

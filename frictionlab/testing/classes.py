@@ -76,7 +76,8 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     ``dimensions`` of a solver or an estimator are 1 and/or 2 and ``periodic_only``
     is a bool; a solver's ``normalisations`` give one ``normalisation`` per
     dimension, ``problem`` names the physical problem, ``approximation`` is a bool,
-    ``contact_measure`` and ``indentation_reference`` take allowed values,
+    ``contact_measure`` and ``indentation_reference`` take allowed values, ``mdr_lines`` is a bool,
+    True only for a solver of lines alone,
     ``body_params`` and ``tolerance_param`` name fields); ``references`` is a tuple
     of strings; ``Params`` has a JSON Schema and every default passes its own bounds; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a
