@@ -9,6 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from pydantic import Field
 
 from frictionlab.errors import PluginError
 from frictionlab.preset import build_scene
@@ -223,6 +224,10 @@ RUN_BROKEN = {
                        "solve().contact_count must lie in 0 .. 128 (points of the profile). Got array([-"),
     "reversed-force": (GoodSolver, {"solve": _solved("force", lambda f: f[::-1].copy())},
                        "solve(..., control='force').force must report the loads asked for"),
+    "reversed-indentation": (GoodSolver, {"solve": _solved("indentation", lambda d: d[::-1].copy())},
+                             "solve(..., control='force').indentation must not decrease as the load grows. Got "),
+    "reversed-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c[::-1].copy())},
+                       "solve(..., control='force').contact_count must not decrease as the load grows. Got "),
 }
 
 
@@ -273,3 +278,47 @@ def test_one_draw_is_caught_whatever_numpy_s_global_state_holds(register_plugin,
     finally:
         np.random.set_state(state)
     assert error is not None and "solve() used numpy's global random state" in error
+
+
+def test_loads_out_of_order_fail_the_realization_before_the_solver_sees_them(register_plugin):
+    """Taken as they came, loads that decrease were solved, and the curve kept in their order."""
+    from frictionlab.compute.realization import compute_realization
+
+    registry = register_plugin(GoodSolver)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene(GOOD, registry=registry)
+    scene.__dict__["solver_loads"] = scene.solver_loads[::-1].copy()  # as a caller's own scene might hold them
+    error = compute_realization(scene, 0).error
+    assert error is not None and error.startswith("ValueError: the loads handed to the solver must not decrease. Got ")
+
+
+@pytest.mark.parametrize("drop, refused", [(1e-5, False), (1e-2, True)])
+def test_under_indentation_control_a_force_that_falls_is_refused_past_an_iterative_solver_s_stop(
+        register_plugin, drop, refused):
+    """Taken as it came, forces out of order under indentation control were kept (the count of
+    each load then paired with another's force); an iterative solver's stop may leave a drop of
+    a relative 1e-3."""
+    from frictionlab.compute.realization import compute_realization
+
+    def solve(self, profile, loads, control, slopes):
+        curve = GoodSolver.solve(self, profile, loads, control, slopes)
+        force = curve.force.copy()
+        force[-1] = force[-2] - drop * force.max()
+        return replace(curve, force=force)
+
+    class Params(GoodSolver.Params):
+        tolerance: float = Field(1e-6, gt=0, description="relative tolerance")
+
+    broken = type("Iterative", (GoodSolver,), {"name": "iterative-solver", "__module__": "broken_plugin",
+                                               "solve": solve, "Params": Params, "tolerance_param": "tolerance"})
+    registry = register_plugin(broken)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    loading = {**GOOD["loading"], "control": "indentation", "start": 0.1, "stop": 1.0}
+    scene = build_scene({**GOOD, "solver": {"name": "iterative-solver"}, "loading": loading}, registry=registry)
+    error = compute_realization(scene, 0).error
+    if refused:
+        assert error is not None and "solve(..., control='indentation').force must not decrease" in error
+    else:
+        assert error is None

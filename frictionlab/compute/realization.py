@@ -19,8 +19,8 @@ import numpy as np
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import (
-    LEAVE_INPUTS, RandomWatch, curve_problem, height_of, profile_problem, read_only, refuse,
-    reported_problem, slopes_problem,
+    LEAVE_INPUTS, RandomWatch, curve_problem, height_of, order_problem, profile_problem, read_only, refuse,
+    reported_problem, schedule_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -142,10 +142,13 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
 
         loads = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
         control = "force"
+    if problem := schedule_problem(loads):  # contact fractions: forces found by solving, in order
+        raise ValueError(problem)
     curve = scene.solver.solve(profile, read_only(loads), control, slopes)
     refuse(scene.solver, randomness.problem("solve()")
            or curve_problem(scene.solver, curve, loads.size)
-           or reported_problem(curve, loads, control, profile.points))  # fmt: skip
+           or reported_problem(curve, loads, control, profile.points)
+           or order_problem(scene.solver, curve, control))  # fmt: skip
     return curve
 
 

@@ -153,6 +153,34 @@ def _legacy_state_address() -> int | None:
     return address if same else None
 
 
+ORDER_RTOL = 1e-3  # a drop an iterative solver's stop may leave (bem's certified indentation: within 1e-4)
+
+
+def schedule_problem(loads: np.ndarray) -> str | None:
+    """Loads handed to a solver must not decrease: every solver sweeps them in order (warm starts)."""
+    if loads.size > 1 and np.any(loads[1:] < loads[:-1]):
+        return f"the loads handed to the solver must not decrease. Got {short_repr(loads, 300)}."
+    return None
+
+
+def order_problem(solver: ContactSolver, curve: ContactCurve, control: str) -> str | None:
+    """What a well-formed ``curve`` solved for non-decreasing loads reports out of order: a force,
+    indentation or contact count below one at a smaller load (by more than a relative ``ORDER_RTOL``
+    of the largest for an iterative solver, whose stop leaves that much; by nothing for a direct one)."""
+    rtol = ORDER_RTOL if solver.tolerance_param is not None else 1e-12
+    for name in ("force", "indentation", "contact_count"):
+        values = np.asarray(getattr(curve, name), dtype=float)
+        if values.size < 2:
+            continue
+        drops = np.maximum.accumulate(values) - values  # below the largest at a smaller load
+        j = int(np.argmax(drops))
+        if drops[j] > rtol * float(np.abs(values).max()):
+            first = int(np.argmax(values[:j] > values[j]))
+            return (f"solve(..., control={control!r}).{name} must not decrease as the load grows. Got {values[j]:.6g} "
+                    f"at index {j}, after {values[first]:.6g} at index {first}: {short_repr(values, 300)}.")  # fmt: skip
+    return None
+
+
 def random_state() -> tuple:
     """numpy's global random state (what ``np.random.*`` functions draw from), to compare."""
     _, keys, position, has_gauss, gauss = np.random.get_state()
