@@ -213,6 +213,10 @@ def _one_draw(method):
 
 RUN_BROKEN = {
     "global-random": (GoodSpectrum, {"generate": _noisy_generate}, "generate() used numpy's global random state"),
+    "own-seed": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0))},
+                 "different seeds gave identical heights; draw all randomness from the rng argument"),
+    "unseeded": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())},
+                 "the same seed gave different heights; draw all randomness from the rng argument"),
     "one-draw-generate": (GoodSpectrum, {"generate": _one_draw(GoodSpectrum.generate)},
                           "generate() used numpy's global random state"),
     "one-draw-slopes": (GoodSlopes, {"slopes": _one_draw(GoodSlopes.slopes)}, "slopes() used numpy's global random state"),
@@ -322,3 +326,46 @@ def test_under_indentation_control_a_force_that_falls_is_refused_past_an_iterati
         assert error is not None and "solve(..., control='indentation').force must not decrease" in error
     else:
         assert error is None
+
+
+@pytest.mark.parametrize("declared", [False, True])
+def test_a_spectrum_ignoring_its_rng_fails_realization_0_alone_unless_declared_deterministic(register_plugin, declared):
+    """Once a run: realization 0 is made again, and realization 1's profile once, to be compared;
+    the other realizations are not checked again. A spectrum declaring ``deterministic`` may give
+    every seed one profile."""
+    from frictionlab.compute.realization import compute_realization
+
+    def fixed(self, rng):
+        return GoodSpectrum.generate(self, np.random.default_rng(0))
+
+    cls = type("Fixed", (GoodSpectrum,), {"name": "fixed-spectrum", "__module__": "fixed_plugin",
+                                          "generate": fixed, "deterministic": declared})
+    registry = register_plugin(cls)
+    for other in (GoodSolver, GoodSlopes):
+        register_plugin(other)
+    scene = build_scene({**GOOD, "spectrum": {"name": cls.name}}, registry=registry)
+    errors = [compute_realization(scene, i).error for i in range(3)]
+    if declared:
+        assert errors == [None, None, None]
+    else:
+        assert errors[0].startswith("PluginError: spectrum 'fixed-spectrum' (fixed_plugin.Fixed from fixed_plugin) "
+                                    "broke the plugin contract: different seeds gave identical heights")
+        assert errors[1:] == [None, None]
+
+
+def test_realization_1_s_own_failure_is_not_realization_0_s(register_plugin):
+    """Realization 0's check makes realization 1's profile: where that raises, realization 1 says so itself."""
+    from frictionlab.compute.realization import compute_realization
+    from frictionlab.preset.seeds import realization_rng
+
+    def generate(self, rng):
+        if rng.bit_generator.state == realization_rng(GOOD["seed"], 1).bit_generator.state:
+            raise RuntimeError("realization 1's own failure")
+        return GoodSpectrum.generate(self, rng)
+
+    registry = register_plugin(type("Second", (GoodSpectrum,), {"name": "second-fails", "generate": generate}))
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "spectrum": {"name": "second-fails"}}, registry=registry)
+    assert compute_realization(scene, 0).error is None
+    assert "realization 1's own failure" in compute_realization(scene, 1).error

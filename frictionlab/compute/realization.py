@@ -6,6 +6,7 @@ workers) imports only this and the scene, nothing of the run's bookkeeping.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import threading
@@ -20,7 +21,7 @@ from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import (
     LEAVE_INPUTS, RandomWatch, curve_problem, height_of, order_problem, profile_problem, read_only, refuse,
-    reported_problem, schedule_problem, slopes_problem,
+    reported_problem, schedule_problem, seed_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -152,6 +153,11 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
     return curve
 
 
+def _generated(generator, seed: int, index: int):
+    """Realization ``index``'s profile from a fresh generator of its seed."""
+    return generator.generate(realization_rng(seed, index))
+
+
 def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     check_cancel = watch.check
     start = time.perf_counter()
@@ -160,6 +166,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         randomness = RandomWatch()  # looked at between plugin calls: one look per call
         profile = scene.generator.generate(rng)
         refuse(scene.generator, randomness.problem("generate()") or profile_problem(scene.generator, profile))
+        if index == 0:  # once a run (two more profiles made): what a generator ignoring its rng makes of every realization
+            again, others = functools.partial(_generated, scene.generator, scene.preset.seed), scene.preset.realizations > 1
+            refuse(scene.generator, seed_problem(scene.generator, profile, again, others) or randomness.problem("generate()"))
         profile = replace(profile, heights=read_only(profile.heights))  # what the estimator and solver are lent
         check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)

@@ -77,6 +77,8 @@ def declaration_problems(cls) -> list[str]:
             problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
         if cls.points_param is not None:
             named_fields("points_param", [cls.points_param])
+        if not isinstance(cls.deterministic, bool):
+            problems.append(f"deterministic must be True or False. Got {cls.deterministic!r} instead.")
     if issubclass(cls, (ContactSolver, SlopeEstimator)):
         dims = cls.dimensions
         if not (isinstance(dims, tuple) and dims and set(dims) <= {1, 2}):

@@ -30,6 +30,11 @@ class SpectrumGenerator(Plugin):
     - ``not_periodic_advice()``: when ``periodic()`` is False, why (with the parameter
       at cause) and how to make the profile periodic, as ``(why, how)``: a refusal by a
       periodic-only solver or estimator says both. Default: general advice.
+    - ``deterministic`` (False): True for a generator that ignores its rng by design (one that
+      reads a measured profile): every realization is then the same profile. A run asks of
+      realization 0, once, that a fresh generator of its seed give the same heights again and,
+      unless ``deterministic``, that another seed give other heights; the conformance kit asks
+      the same.
     - ``grid_shape()``: the shape of a generated profile, known without generating
       (memory estimates). Default None: the framework generates one profile.
     - ``points_param``: the ``Params`` field that sets the points (per side); the
@@ -65,6 +70,7 @@ class SpectrumGenerator(Plugin):
     register_hook: ClassVar[str] = "register_spectra"
     dimension: ClassVar[int] = 1  # 1: makes lines (N,); 2: makes surfaces (Ny, Nx)
     points_param: ClassVar[str | None] = None
+    deterministic: ClassVar[bool] = False
 
     def generate(self, rng: np.random.Generator) -> Profile:  # pragma: no cover - interface
         raise NotImplementedError

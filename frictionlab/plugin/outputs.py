@@ -10,6 +10,7 @@ import functools
 import json
 import math
 import sys
+from collections.abc import Callable
 
 import numpy as np
 
@@ -21,6 +22,9 @@ from .registry import plugin_label
 LEAVE_INPUTS = "a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones"
 SAME_SEED = ("the same seed gave different heights; draw all randomness from the rng argument and keep no "
              "state between calls (realizations run in any order, in other processes)")
+OTHER_SEED = ("different seeds gave identical heights; draw all randomness from the rng argument (or declare "
+              "deterministic = True, for a generator that ignores randomness by design, e.g. one that reads a measured profile)")
+SAMPLE_POINTS = 1024  # heights compared of two profiles of one seed: spread over the whole profile
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
                    "contact_spots": "counts_spots"}  # fmt: skip
@@ -84,6 +88,39 @@ def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
         return f"periodic() must be True or False. Got {declared!r} instead."
     if profile.periodic is not declared:  # the preset's solver and estimator were checked by it
         return f"Profile.periodic must be what periodic() declares, {declared!r}. Got {profile.periodic!r} instead."
+    return None
+
+
+def heights_sample(profile: Profile) -> tuple:
+    """Up to ``SAMPLE_POINTS`` heights of ``profile`` spread evenly over it, with its shape and spacing:
+    what compares two profiles without keeping both."""
+    heights = profile.heights
+    spread = np.linspace(0, heights.size - 1, min(heights.size, SAMPLE_POINTS)).astype(np.intp)
+    return heights.shape, profile.spacing, heights.flat[spread].tobytes()
+
+
+def seed_problem(generator: SpectrumGenerator, profile: Profile, generated: Callable[[int], object],
+                 others: bool = True) -> str | None:  # fmt: skip
+    """What is wrong with a generator whose realization 0 is ``profile``, as ``generated(index)``
+    makes realization ``index`` again from a fresh generator of its seed: realization 0 must come
+    out the same, and realization 1 other where there are ``others`` (unless ``deterministic``); an
+    exception making realization 1 is left to it. Each is sampled and let go before the next is
+    made: at most one more profile is held."""
+    expected = heights_sample(profile)
+    for index, problem in ((0, SAME_SEED), (1, OTHER_SEED)):
+        if index and (generator.deterministic or not others):
+            break
+        try:
+            made = generated(index)
+        except Exception:  # noqa: BLE001 - realization 1's own failure: it tells it when it runs
+            if index:
+                break
+            raise
+        if wrong := profile_problem(generator, made):
+            return wrong
+        if (heights_sample(made) == expected) != (index == 0):
+            return problem
+        del made
     return None
 
 
