@@ -6,7 +6,6 @@ workers) imports only this and the scene, nothing of the run's bookkeeping.
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 import threading
@@ -153,11 +152,6 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
     return curve
 
 
-def _generated(generator, seed: int, index: int):
-    """Realization ``index``'s profile from a fresh generator of its seed."""
-    return generator.generate(realization_rng(seed, index))
-
-
 def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     check_cancel = watch.check
     start = time.perf_counter()
@@ -167,7 +161,10 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         profile = scene.generator.generate(rng)
         refuse(scene.generator, randomness.problem("generate()") or profile_problem(scene.generator, profile))
         if index == 0:  # once a run (two more profiles made): what a generator ignoring its rng makes of every realization
-            again, others = functools.partial(_generated, scene.generator, scene.preset.seed), scene.preset.realizations > 1
+            def again(i: int):  # realization i's profile, from a fresh generator of its seed
+                return scene.generator.generate(realization_rng(scene.preset.seed, i))
+
+            others = scene.preset.realizations > 1
             refuse(scene.generator, seed_problem(scene.generator, profile, again, others) or randomness.problem("generate()"))
         profile = replace(profile, heights=read_only(profile.heights))  # what the estimator and solver are lent
         check_cancel()  # a large surface takes a second to generate

@@ -172,24 +172,6 @@ def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, point
     return None
 
 
-_KEY_BYTES = 624 * 4  # MT19937's key; its position (a C int) follows it in the state struct
-
-
-@functools.cache
-def _legacy_state_address() -> int | None:
-    """Where the legacy MT19937 state that ``np.random.*`` functions draw from lies in memory (its
-    key, then its position), when it reads there as ``np.random.get_state()`` says; None otherwise
-    (another numpy's layout: the whole state is then compared)."""
-    try:
-        address = np.random.mtrand._rand._bit_generator.ctypes.state_address
-        _, keys, position, _, _ = np.random.get_state()
-        raw = ctypes.string_at(address, _KEY_BYTES + 4)
-        same = raw[:_KEY_BYTES] == keys.tobytes() and int.from_bytes(raw[_KEY_BYTES:], sys.byteorder, signed=True) == position
-    except (AttributeError, TypeError, ValueError):
-        return None
-    return address if same else None
-
-
 ORDER_RTOL = 1e-3  # a drop an iterative solver's stop may leave (bem's certified indentation: within 1e-4)
 
 
@@ -216,6 +198,24 @@ def order_problem(solver: ContactSolver, curve: ContactCurve, control: str) -> s
             return (f"solve(..., control={control!r}).{name} must not decrease as the load grows. Got {values[j]:.6g} "
                     f"at index {j}, after {values[first]:.6g} at index {first}: {short_repr(values, 300)}.")  # fmt: skip
     return None
+
+
+_KEY_BYTES = 624 * 4  # MT19937's key; its position (a C int) follows it in the state struct
+
+
+@functools.cache
+def _legacy_state_address() -> int | None:
+    """Where the legacy MT19937 state that ``np.random.*`` functions draw from lies in memory (its
+    key, then its position), when it reads there as ``np.random.get_state()`` says; None otherwise
+    (another numpy's layout: the whole state is then compared)."""
+    try:
+        address = np.random.mtrand._rand._bit_generator.ctypes.state_address
+        _, keys, position, _, _ = np.random.get_state()
+        raw = ctypes.string_at(address, _KEY_BYTES + 4)
+        same = raw[:_KEY_BYTES] == keys.tobytes() and int.from_bytes(raw[_KEY_BYTES:], sys.byteorder, signed=True) == position
+    except (AttributeError, TypeError, ValueError):
+        return None
+    return address if same else None
 
 
 def random_state() -> tuple:
