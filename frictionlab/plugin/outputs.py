@@ -230,14 +230,21 @@ class RandomWatch:
     would then depend on which realizations ran before it in the process, so on the worker count.
 
     A look copies the MT19937 key and position (about a microsecond; ``np.random.get_state()``
-    takes tens), read once in full here: every draw moves the position or, past the key's end,
-    renews the whole key. Only a cached second Gaussian is drawn without either, so where one
-    is cached now every look reads the whole state."""
+    takes tens): every draw moves the position or, past the key's end, renews the whole key. Only
+    a cached second Gaussian is drawn without either; so the whole state is read as a watch starts,
+    unless the key and position are those a watch started at with none cached (nothing drawn
+    since: none cached now), and where one is cached every look reads the whole state."""
+
+    clear: bytes | None = None  # the key and position at the last start known to have no Gaussian cached
 
     def __init__(self):
         address = _legacy_state_address()
-        self.address = address if address is not None and not np.random.get_state()[3] else None
+        if address is not None and ctypes.string_at(address, _KEY_BYTES + 4) != RandomWatch.clear:
+            address = None if np.random.get_state()[3] else address
+        self.address = address
         self.last = self._look()
+        if address is not None:
+            RandomWatch.clear = self.last
 
     def _look(self):
         return random_state() if self.address is None else ctypes.string_at(self.address, _KEY_BYTES + 4)
