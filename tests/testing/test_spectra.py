@@ -160,3 +160,11 @@ def test_a_measured_profile_declared_periodic_is_not_held_to_wrapping():
     scan = np.sin(np.arange(128) / 5) + np.linspace(0, 3, 128)
     fltesting.check_spectrum(spectrum_variant("Scan", generate=lambda self, rng: Profile(scan.copy(), 1.0),
                                               deterministic=True))
+
+
+def test_deterministic_is_declared_true_or_false():
+    from frictionlab.errors import PluginError
+    from frictionlab.plugin.registry import validate_plugin_class
+
+    with pytest.raises(PluginError, match=r"deterministic must be True or False\. Got 'yes' instead\."):
+        validate_plugin_class("spectrum", spectrum_variant("Vague", deterministic="yes"))
