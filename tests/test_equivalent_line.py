@@ -202,3 +202,22 @@ def test_f_of_an_mdr_equivalent_line_is_said_for_the_surface_and_its_length_is_2
     assert n.extent == "length" and "L = 2 sqrt(A / pi) the MDR-equivalent line's length" in n.definition
     profile = scene.generator.generate(np.random.default_rng(0))
     assert n.extent_of(profile) == pytest.approx(mdr_length(64.0**2), rel=1e-12)
+
+
+def test_a_solver_of_lines_not_declaring_mdr_lines_is_refused_a_surface(register_plugin):
+    """Taken as it came, a third party's solver of lines pressed the surface's MDR-equivalent
+    line, which only MDR's springs take for the surface (a half-plane's line is not the surface)."""
+    from frictionlab.errors import PresetError
+
+    from .testing.fakes import GoodSolver
+
+    registry = register_plugin(GoodSolver)
+    data = {**SMALL_PRESET, "spectrum": {"name": "power-law-2d", "params": {"hurst": 0.8, "points": 32}},
+            "solver": {"name": "good-solver"}}
+    with pytest.raises(PresetError, match=r"solver.name: good-solver presses lines only, but spectrum power-law-2d "
+                                          r"makes surfaces: use solver .*\bmdr\b"):  # fmt: skip
+        build_scene(data, registry=registry)
+    declared = type("MDRLike", (GoodSolver,), {"name": "mdr-like", "mdr_lines": True})
+    registry = register_plugin(declared)
+    scene = build_scene({**data, "solver": {"name": "mdr-like"}}, registry=registry)
+    assert scene.geometry == "mdr-equivalent line of a surface"

@@ -9,8 +9,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from pydantic import Field
 
 from frictionlab.errors import PluginError
+from frictionlab.plugin.outputs import RandomWatch
 from frictionlab.preset import build_scene
 from frictionlab.preset.loads import load_scales
 
@@ -201,13 +203,36 @@ def _solved(method, values):
     return solve
 
 
+def _one_draw(method):
+    """``method`` of a good plugin, drawing one number of numpy's global state first."""
+    def drawing(self, *args, **kwargs):
+        np.random.randint(2)  # one 32-bit word of the key
+        return method(self, *args, **kwargs)
+
+    return drawing
+
+
 RUN_BROKEN = {
     "global-random": (GoodSpectrum, {"generate": _noisy_generate}, "generate() used numpy's global random state"),
+    "own-seed": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0))},
+                 "different seeds gave identical heights; draw all randomness from the rng argument"),
+    "unseeded": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())},
+                 "the same seed gave different heights; draw all randomness from the rng argument"),
+    "one-draw-generate": (GoodSpectrum, {"generate": _one_draw(GoodSpectrum.generate)},
+                          "generate() used numpy's global random state"),
+    "one-draw-slopes": (GoodSlopes, {"slopes": _one_draw(GoodSlopes.slopes)}, "slopes() used numpy's global random state"),
+    "one-draw-solve": (GoodSolver, {"solve": _one_draw(GoodSolver.solve)}, "solve() used numpy's global random state"),
+    "one-draw-own-height": (GoodSpectrum, {"profile_rms_height": _one_draw(lambda self, profile: 1.0)},
+                            "profile_rms_height() used numpy's global random state"),
     "in-place": (GoodSlopes, {"slopes": _in_place_slopes}, "(a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones)"),
     "negative-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c - c.max())},
                        "solve().contact_count must lie in 0 .. 128 (points of the profile). Got array([-"),
     "reversed-force": (GoodSolver, {"solve": _solved("force", lambda f: f[::-1].copy())},
                        "solve(..., control='force').force must report the loads asked for"),
+    "reversed-indentation": (GoodSolver, {"solve": _solved("indentation", lambda d: d[::-1].copy())},
+                             "solve(..., control='force').indentation must not decrease as the load grows. Got "),
+    "reversed-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c[::-1].copy())},
+                       "solve(..., control='force').contact_count must not decrease as the load grows. Got "),
 }
 
 
@@ -227,3 +252,122 @@ def test_a_plugin_breaking_the_contract_within_a_realization_fails_it_naming_the
     assert error is not None and problem in error
     assert f"{SLOTS[base]} 'broken-{SLOTS[base]}' (broken_plugin.Broken from " in error
 
+
+
+@pytest.mark.parametrize("first", ["nothing", "a Gaussian", "the rest of the key"])
+def test_one_draw_is_caught_whatever_numpy_s_global_state_holds(register_plugin, first):
+    """A realization looks at numpy's global state between its plugin calls by its key and
+    position alone, read in full once: one Gaussian drawn of a pair cached before the realization
+    moves neither, and a draw that ends the key renews it (the position as it was)."""
+    from frictionlab.compute.realization import compute_realization
+
+    def solve(self, profile, loads, control, slopes):
+        if first == "a Gaussian":
+            np.random.standard_normal()  # the cached second of the pair: key and position unchanged
+        else:
+            np.random.randint(2**32, size=624 if first == "the rest of the key" else 1, dtype=np.uint64)
+        return GoodSolver.solve(self, profile, loads, control, slopes)
+
+    broken = type("Broken", (GoodSolver,), {"name": "broken-solver", "__module__": "broken_plugin", "solve": solve})
+    registry = register_plugin(broken)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "solver": {"name": "broken-solver"}}, registry=registry)
+    state = np.random.get_state()
+    try:
+        np.random.seed(5)
+        RandomWatch()  # as a realization before this one starts: it finds no Gaussian cached
+        if first == "a Gaussian":
+            np.random.standard_normal()  # one of a pair: the other is cached
+            assert np.random.get_state()[3] == 1
+        error = compute_realization(scene, 0).error
+    finally:
+        np.random.set_state(state)
+    assert error is not None and "solve() used numpy's global random state" in error
+
+
+def test_loads_out_of_order_fail_the_realization_before_the_solver_sees_them(register_plugin):
+    """Taken as they came, loads that decrease were solved, and the curve kept in their order."""
+    from frictionlab.compute.realization import compute_realization
+
+    registry = register_plugin(GoodSolver)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene(GOOD, registry=registry)
+    scene.__dict__["solver_loads"] = scene.solver_loads[::-1].copy()  # as a caller's own scene might hold them
+    error = compute_realization(scene, 0).error
+    assert error is not None and error.startswith("ValueError: the loads handed to the solver must not decrease. Got ")
+
+
+@pytest.mark.parametrize("drop, refused", [(1e-5, False), (1e-2, True)])
+def test_under_indentation_control_a_force_that_falls_is_refused_past_an_iterative_solver_s_stop(
+        register_plugin, drop, refused):
+    """Taken as it came, forces out of order under indentation control were kept (the count of
+    each load then paired with another's force); an iterative solver's stop may leave a drop of
+    a relative 1e-3."""
+    from frictionlab.compute.realization import compute_realization
+
+    def solve(self, profile, loads, control, slopes):
+        curve = GoodSolver.solve(self, profile, loads, control, slopes)
+        force = curve.force.copy()
+        force[-1] = force[-2] - drop * force.max()
+        return replace(curve, force=force)
+
+    class Params(GoodSolver.Params):
+        tolerance: float = Field(1e-6, gt=0, description="relative tolerance")
+
+    broken = type("Iterative", (GoodSolver,), {"name": "iterative-solver", "__module__": "broken_plugin",
+                                               "solve": solve, "Params": Params, "tolerance_param": "tolerance"})
+    registry = register_plugin(broken)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    loading = {**GOOD["loading"], "control": "indentation", "start": 0.1, "stop": 1.0}
+    scene = build_scene({**GOOD, "solver": {"name": "iterative-solver"}, "loading": loading}, registry=registry)
+    error = compute_realization(scene, 0).error
+    if refused:
+        assert error is not None and "solve(..., control='indentation').force must not decrease" in error
+    else:
+        assert error is None
+
+
+@pytest.mark.parametrize("declared", [False, True])
+def test_a_spectrum_ignoring_its_rng_fails_realization_0_alone_unless_declared_deterministic(register_plugin, declared):
+    """Once a run: realization 0 is made again, and realization 1's profile once, to be compared;
+    the other realizations are not checked again. A spectrum declaring ``deterministic`` may give
+    every seed one profile."""
+    from frictionlab.compute.realization import compute_realization
+
+    def fixed(self, rng):
+        return GoodSpectrum.generate(self, np.random.default_rng(0))
+
+    cls = type("Fixed", (GoodSpectrum,), {"name": "fixed-spectrum", "__module__": "fixed_plugin",
+                                          "generate": fixed, "deterministic": declared})
+    registry = register_plugin(cls)
+    for other in (GoodSolver, GoodSlopes):
+        register_plugin(other)
+    scene = build_scene({**GOOD, "spectrum": {"name": cls.name}}, registry=registry)
+    errors = [compute_realization(scene, i).error for i in range(3)]
+    if declared:
+        assert errors == [None, None, None]
+    else:
+        assert errors[0].startswith("PluginError: spectrum 'fixed-spectrum' (fixed_plugin.Fixed from fixed_plugin) "
+                                    "broke the plugin contract: different seeds gave identical heights")
+        assert errors[1:] == [None, None]
+
+
+def test_realization_1_s_own_failure_is_not_realization_0_s(register_plugin):
+    """Realization 0's check makes realization 1's profile: where that raises, realization 1 says so itself."""
+    from frictionlab.compute.realization import compute_realization
+    from frictionlab.preset.seeds import realization_rng
+
+    def generate(self, rng):
+        if rng.bit_generator.state == realization_rng(GOOD["seed"], 1).bit_generator.state:
+            raise RuntimeError("realization 1's own failure")
+        return GoodSpectrum.generate(self, rng)
+
+    registry = register_plugin(type("Second", (GoodSpectrum,), {"name": "second-fails", "generate": generate}))
+    for cls in (GoodSolver, GoodSlopes):
+        register_plugin(cls)
+    scene = build_scene({**GOOD, "spectrum": {"name": "second-fails"}}, registry=registry)
+    assert compute_realization(scene, 0).error is None
+    assert "realization 1's own failure" in compute_realization(scene, 1).error

@@ -109,7 +109,7 @@ def line_to_make(scene: Scene) -> bool:
     """Whether this process has yet to make the MDR-equivalent line of the scene's surface:
     ``build_scene`` checks the memory before it makes it (once made, the peak of making it
     is past, and what the surface keeps is in the memory this process already uses)."""
-    return scene.equivalent_line is None and scene.spectrum.dimension not in scene.solver.dimensions
+    return scene.equivalent_line is None and scene.spectrum.dimension == 2 and scene.solver.mdr_lines
 
 
 def line_points(surface_points: int) -> int:

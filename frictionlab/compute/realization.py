@@ -19,8 +19,8 @@ import numpy as np
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import (
-    LEAVE_INPUTS, curve_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse,
-    reported_problem, slopes_problem,
+    LEAVE_INPUTS, RandomWatch, curve_problem, height_of, order_problem, profile_problem, read_only, refuse,
+    reported_problem, schedule_problem, seed_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -128,10 +128,10 @@ def slope_scale(slopes: np.ndarray) -> float:
     return math.ldexp(1.0, -math.frexp(largest)[1])
 
 
-def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: float):
+def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: float, randomness: RandomWatch):
     """The solver's curve over the scene's loads; contact fractions first turned into this
     profile's forces by solving (``loads.forces_for_fractions``, from f = the fraction: ``unit``
-    is the profile's k h X)."""
+    is the profile's k h X). ``randomness``: numpy's global random state, looked at last before the solver."""
     if scene.solver_loads is not None:
         loads, control = scene.solver_loads, scene.control
     else:
@@ -142,11 +142,13 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
 
         loads = forces_for_fractions(scene.solver, profile, scene.loads, slopes, first_guess=unit, on_load=seeking)
         control = "force"
-    before = random_state()
+    if problem := schedule_problem(loads):  # contact fractions: forces found by solving, in order
+        raise ValueError(problem)
     curve = scene.solver.solve(profile, read_only(loads), control, slopes)
-    refuse(scene.solver, global_random_problem("solve()", before)
+    refuse(scene.solver, randomness.problem("solve()")
            or curve_problem(scene.solver, curve, loads.size)
-           or reported_problem(curve, loads, control, profile.points))  # fmt: skip
+           or reported_problem(curve, loads, control, profile.points)
+           or order_problem(scene.solver, curve, control))  # fmt: skip
     return curve
 
 
@@ -155,14 +157,19 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     start = time.perf_counter()
     try:
         rng = realization_rng(scene.preset.seed, index)
-        before = random_state()
+        randomness = RandomWatch()  # looked at between plugin calls: one look per call
         profile = scene.generator.generate(rng)
-        refuse(scene.generator, global_random_problem("generate()", before) or profile_problem(scene.generator, profile))
+        refuse(scene.generator, randomness.problem("generate()") or profile_problem(scene.generator, profile))
+        if index == 0:  # once a run (two more profiles made): what a generator ignoring its rng makes of every realization
+            def again(i: int):  # realization i's profile, from a fresh generator of its seed
+                return scene.generator.generate(realization_rng(scene.preset.seed, i))
+
+            others = scene.preset.realizations > 1
+            refuse(scene.generator, seed_problem(scene.generator, profile, again, others) or randomness.problem("generate()"))
         profile = replace(profile, heights=read_only(profile.heights))  # what the estimator and solver are lent
         check_cancel()  # a large surface takes a second to generate
-        before = random_state()
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-        refuse(scene.slope, global_random_problem("slopes()", before) or slopes_problem(scene.slope, slopes, profile))
+        refuse(scene.slope, randomness.problem("slopes()") or slopes_problem(scene.slope, slopes, profile))
         check_cancel()
         scale = slope_scale(slopes)  # xi is a ratio of two rms slopes: an exact scale cancels
         slopes = read_only(slopes * scale if scale != 1.0 else slopes)
@@ -175,8 +182,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
             )
         h, own_h = height_of(scene.generator, profile)
+        refuse(scene.generator, randomness.problem("profile_rms_height()"))
         unit = force_unit(scene.solver, h, profile)
-        curve = _solve(scene, profile, slopes, watch, unit)
+        curve = _solve(scene, profile, slopes, watch, unit, randomness)
         half = curve.half_load_points
         heights = np.asarray(profile.heights, dtype=float)
         mean = float(heights.mean())

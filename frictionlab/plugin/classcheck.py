@@ -77,6 +77,8 @@ def declaration_problems(cls) -> list[str]:
             problems.append(f"dimension must be 1 (lines) or 2 (surfaces). Got {cls.dimension!r} instead.")
         if cls.points_param is not None:
             named_fields("points_param", [cls.points_param])
+        if not isinstance(cls.deterministic, bool):
+            problems.append(f"deterministic must be True or False. Got {cls.deterministic!r} instead.")
     if issubclass(cls, (ContactSolver, SlopeEstimator)):
         dims = cls.dimensions
         if not (isinstance(dims, tuple) and dims and set(dims) <= {1, 2}):
@@ -100,9 +102,12 @@ def declaration_problems(cls) -> list[str]:
                 except ValueError as exc:
                     problems.append(f"normalisations[{dimension}]: {exc}")
         for attr in ("approximation", "undefined_slopes", "mean_displacement_known", "corrected_area", "real_gradient",
-                     "counts_spots"):
+                     "counts_spots", "mdr_lines"):
             if not isinstance(getattr(cls, attr), bool):
                 problems.append(f"{attr} must be True or False. Got {getattr(cls, attr)!r} instead.")
+        if cls.mdr_lines is True and tuple(cls.dimensions) != (1,):
+            problems.append(f"mdr_lines is for a solver of lines alone (dimensions (1,)): one of surfaces presses them "
+                            f"itself. Got mdr_lines True with dimensions {cls.dimensions!r}.")  # fmt: skip
         if not (isinstance(cls.problem, str) and cls.problem.strip()):
             problems.append(f"problem must name the physical problem solved (e.g. 'elastic half-space'). Got {cls.problem!r} instead.")
         for attr, value, allowed in (

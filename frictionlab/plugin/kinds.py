@@ -30,6 +30,11 @@ class SpectrumGenerator(Plugin):
     - ``not_periodic_advice()``: when ``periodic()`` is False, why (with the parameter
       at cause) and how to make the profile periodic, as ``(why, how)``: a refusal by a
       periodic-only solver or estimator says both. Default: general advice.
+    - ``deterministic`` (False): True for a generator that ignores its rng by design (one that
+      reads a measured profile): every realization is then the same profile. A run asks of
+      realization 0, once, that a fresh generator of its seed give the same heights again and,
+      unless ``deterministic``, that another seed give other heights; the conformance kit asks
+      the same.
     - ``grid_shape()``: the shape of a generated profile, known without generating
       (memory estimates). Default None: the framework generates one profile.
     - ``points_param``: the ``Params`` field that sets the points (per side); the
@@ -65,6 +70,7 @@ class SpectrumGenerator(Plugin):
     register_hook: ClassVar[str] = "register_spectra"
     dimension: ClassVar[int] = 1  # 1: makes lines (N,); 2: makes surfaces (Ny, Nx)
     points_param: ClassVar[str | None] = None
+    deterministic: ClassVar[bool] = False
 
     def generate(self, rng: np.random.Generator) -> Profile:  # pragma: no cover - interface
         raise NotImplementedError
@@ -189,6 +195,11 @@ class ContactSolver(Plugin):
       depends on each surface, not on f and h alone, so ``mean_displacement`` cannot
       give it (a free-boundary half-space): a study then compares no indentations.
     - ``periodic_only`` (False): True for a solver of periodic profiles only.
+    - ``mdr_lines`` (False): True for a solver of lines alone (``dimensions`` ``(1,)``) whose line
+      models a surface by the method of dimensionality reduction (MDR): a surface is then pressed
+      as its spectrum's MDR-equivalent line (``SpectrumGenerator.equivalent_line()``). False: a
+      preset giving it a surface is refused; a solver of lines does not press a surface's line
+      unless it says that line stands for the surface.
     - ``body_params`` (()): the ``Params`` fields describing the elastic body (not
       the numerics); a study carries them from one solver to another that has them.
     - ``tolerance_param`` (None): the ``Params`` field of the relative tolerance of
@@ -224,6 +235,7 @@ class ContactSolver(Plugin):
     indentation_reference: ClassVar[IndentationReference] = "undeformed body"
     mean_displacement_known: ClassVar[bool] = True
     periodic_only: ClassVar[bool] = False
+    mdr_lines: ClassVar[bool] = False
     body_params: ClassVar[tuple[str, ...]] = ()
     tolerance_param: ClassVar[str | None] = None
     bytes_per_point: ClassVar[int | None] = None

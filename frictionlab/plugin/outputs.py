@@ -5,8 +5,12 @@ states the same problems in the same words."""
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import json
 import math
+import sys
+from collections.abc import Callable
 
 import numpy as np
 
@@ -18,6 +22,9 @@ from .registry import plugin_label
 LEAVE_INPUTS = "a plugin must leave the arrays it is given as they are (heights, slopes, loads): compute into new ones"
 SAME_SEED = ("the same seed gave different heights; draw all randomness from the rng argument and keep no "
              "state between calls (realizations run in any order, in other processes)")
+OTHER_SEED = ("different seeds gave identical heights; draw all randomness from the rng argument (or declare "
+              "deterministic = True, for a generator that ignores randomness by design, e.g. one that reads a measured profile)")
+SAMPLE_POINTS = 1024  # heights compared of two profiles of one seed: spread over the whole profile
 CURVE_ARRAYS = ("force", "indentation", "contact_count", "contact_fraction", "slope_rms_contact")
 DECLARED_ARRAYS = {"real_area_corrected": "corrected_area", "real_gradient_rms": "real_gradient",
                    "contact_spots": "counts_spots"}  # fmt: skip
@@ -84,6 +91,39 @@ def profile_problem(generator: SpectrumGenerator, profile) -> str | None:
     return None
 
 
+def heights_sample(profile: Profile) -> tuple:
+    """Up to ``SAMPLE_POINTS`` heights of ``profile`` spread evenly over it, with its shape and spacing:
+    what compares two profiles without keeping both."""
+    heights = profile.heights
+    spread = np.linspace(0, heights.size - 1, min(heights.size, SAMPLE_POINTS)).astype(np.intp)
+    return heights.shape, profile.spacing, heights.flat[spread].tobytes()
+
+
+def seed_problem(generator: SpectrumGenerator, profile: Profile, generated: Callable[[int], object],
+                 others: bool = True) -> str | None:  # fmt: skip
+    """What is wrong with a generator whose realization 0 is ``profile``, as ``generated(index)``
+    makes realization ``index`` again from a fresh generator of its seed: realization 0 must come
+    out the same, and realization 1 other where there are ``others`` (unless ``deterministic``); an
+    exception making realization 1 is left to it. Each is sampled and let go before the next is
+    made: at most one more profile is held."""
+    expected = heights_sample(profile)
+    for index, problem in ((0, SAME_SEED), (1, OTHER_SEED)):
+        if index and (generator.deterministic or not others):
+            break
+        try:
+            made = generated(index)
+        except Exception:  # noqa: BLE001 - realization 1's own failure: it tells it when it runs
+            if index:
+                break
+            raise
+        if wrong := profile_problem(generator, made):
+            return wrong
+        if (heights_sample(made) == expected) != (index == 0):
+            return problem
+        del made
+    return None
+
+
 def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile, what: str = "slopes()") -> str | None:
     """What is wrong with what ``slopes(heights, spacing, periodic)`` returned for ``profile``."""
     undefined = estimator.undefined_points(profile.periodic) is True
@@ -132,19 +172,89 @@ def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, point
     return None
 
 
+ORDER_RTOL = 1e-3  # a drop an iterative solver's stop may leave (bem's certified indentation: within 1e-4)
+
+
+def schedule_problem(loads: np.ndarray) -> str | None:
+    """Loads handed to a solver must not decrease: every solver sweeps them in order (warm starts)."""
+    if loads.size > 1 and np.any(loads[1:] < loads[:-1]):
+        return f"the loads handed to the solver must not decrease. Got {short_repr(loads, 300)}."
+    return None
+
+
+def order_problem(solver: ContactSolver, curve: ContactCurve, control: str) -> str | None:
+    """What a well-formed ``curve`` solved for non-decreasing loads reports out of order: a force,
+    indentation or contact count below one at a smaller load (by more than a relative ``ORDER_RTOL``
+    of the largest for an iterative solver, whose stop leaves that much; by nothing for a direct one)."""
+    rtol = ORDER_RTOL if solver.tolerance_param is not None else 1e-12
+    for name in ("force", "indentation", "contact_count"):
+        values = np.asarray(getattr(curve, name), dtype=float)
+        if values.size < 2:
+            continue
+        drops = np.maximum.accumulate(values) - values  # below the largest at a smaller load
+        j = int(np.argmax(drops))
+        if drops[j] > rtol * float(np.abs(values).max()):
+            first = int(np.argmax(values[:j] > values[j]))
+            return (f"solve(..., control={control!r}).{name} must not decrease as the load grows. Got {values[j]:.6g} "
+                    f"at index {j}, after {values[first]:.6g} at index {first}: {short_repr(values, 300)}.")  # fmt: skip
+    return None
+
+
+_KEY_BYTES = 624 * 4  # MT19937's key; its position (a C int) follows it in the state struct
+
+
+@functools.cache
+def _legacy_state_address() -> int | None:
+    """Where the legacy MT19937 state that ``np.random.*`` functions draw from lies in memory (its
+    key, then its position), when it reads there as ``np.random.get_state()`` says; None otherwise
+    (another numpy's layout: the whole state is then compared)."""
+    try:
+        address = np.random.mtrand._rand._bit_generator.ctypes.state_address
+        _, keys, position, _, _ = np.random.get_state()
+        raw = ctypes.string_at(address, _KEY_BYTES + 4)
+        same = raw[:_KEY_BYTES] == keys.tobytes() and int.from_bytes(raw[_KEY_BYTES:], sys.byteorder, signed=True) == position
+    except (AttributeError, TypeError, ValueError):
+        return None
+    return address if same else None
+
+
 def random_state() -> tuple:
     """numpy's global random state (what ``np.random.*`` functions draw from), to compare."""
     _, keys, position, has_gauss, gauss = np.random.get_state()
     return keys.tobytes(), position, has_gauss, gauss
 
 
-def global_random_problem(what: str, before: tuple) -> str | None:
-    """A plugin call that drew from (or seeded) numpy's global random state since ``before``: its
-    numbers would depend on which realizations ran before it in the process, so on the worker count."""
-    if random_state() == before:
-        return None
-    return (f"{what} used numpy's global random state (np.random.* functions): draw all randomness from "
-            "the rng argument generate() is given, so that a seed gives the same numbers for any worker count")
+class RandomWatch:
+    """numpy's global random state looked at between consecutive plugin calls: ``problem(what)``
+    says whether the call since the last look (``what``) drew from it (or seeded it), whose numbers
+    would then depend on which realizations ran before it in the process, so on the worker count.
+
+    A look copies the MT19937 key and position (about a microsecond; ``np.random.get_state()``
+    takes tens): every draw moves the position or, past the key's end, renews the whole key. Only
+    a cached second Gaussian is drawn without either; so the whole state is read as a watch starts,
+    unless the key and position are those a watch started at with none cached (nothing drawn
+    since: none cached now), and where one is cached every look reads the whole state."""
+
+    clear: bytes | None = None  # the key and position at the last start known to have no Gaussian cached
+
+    def __init__(self):
+        address = _legacy_state_address()
+        if address is not None and ctypes.string_at(address, _KEY_BYTES + 4) != RandomWatch.clear:
+            address = None if np.random.get_state()[3] else address
+        self.address = address
+        self.last = self._look()
+        if address is not None:
+            RandomWatch.clear = self.last
+
+    def _look(self):
+        return random_state() if self.address is None else ctypes.string_at(self.address, _KEY_BYTES + 4)
+
+    def problem(self, what: str) -> str | None:
+        before, self.last = self.last, self._look()
+        if self.last == before:
+            return None
+        return (f"{what} used numpy's global random state (np.random.* functions): draw all randomness from "
+                "the rng argument generate() is given, so that a seed gives the same numbers for any worker count")
 
 
 def read_only(array: np.ndarray) -> np.ndarray:

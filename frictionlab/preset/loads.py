@@ -20,8 +20,7 @@ import numpy as np
 
 from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
 from ..plugin.outputs import (
-    full_contact_problem, global_random_problem, height_of, profile_problem, random_state, read_only, refuse, shape_problem,
-    slopes_problem,
+    RandomWatch, full_contact_problem, height_of, profile_problem, read_only, refuse, shape_problem, slopes_problem,
 )  # fmt: skip
 
 LOAD_UNITS = {
@@ -77,9 +76,9 @@ def probe_profile(scene) -> Profile:
 def _generated(scene) -> Profile:
     from .seeds import realization_rng
 
-    before = random_state()
+    watch = RandomWatch()
     profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
-    refuse(scene.generator, global_random_problem("generate()", before) or profile_problem(scene.generator, profile)
+    refuse(scene.generator, watch.problem("generate()") or profile_problem(scene.generator, profile)
            or shape_problem(scene.generator, profile))  # fmt: skip
     return profile
 
@@ -97,9 +96,9 @@ def load_scales(scene, profile: Profile | None = None) -> LoadScales:
     full_indentation = solver.full_contact_indentation(profile)
     refuse(solver, full_contact_problem(full_indentation, "full_contact_indentation"))
     # the estimator's answer too, as every realization takes it: a broken one is refused before the run
-    before = random_state()
+    watch = RandomWatch()
     slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)
-    refuse(scene.slope, global_random_problem("slopes()", before) or slopes_problem(scene.slope, slopes, profile))
+    refuse(scene.slope, watch.problem("slopes()") or slopes_problem(scene.slope, slopes, profile))
     if full is None and pressure_unit is not None:
         full, exact = estimated_full_contact(slopes, pressure_unit), False
     return LoadScales(unit, pressure_unit, full, exact, profile.points, full_indentation)

@@ -249,17 +249,20 @@ def _match_dimensions(plugins: dict, registry: Registry, source: str | None,
     made = spectrum.dimension
     shape = {1: "lines", 2: "surfaces"}
     if made not in solver.dimensions:
-        if made == 2 and 1 in solver.dimensions:
+        mdr = made == 2 and solver.mdr_lines  # a line standing for the surface, as the solver declares
+        if mdr:
             before_line(plugins)
         try:
-            line = spectrum.equivalent_line() if made == 2 and 1 in solver.dimensions else None
+            line = spectrum.equivalent_line() if mdr else None
         except ValueError as exc:
             raise PresetError([f"spectrum: its MDR-equivalent line is invalid: {exc}"], source=source) from None
         if line is None:
+            able = [i.name for i in registry.infos("solver") if made in i.cls.dimensions or (made == 2 and i.cls.mdr_lines)]
             raise PresetError(
                 [f"solver.name: {solver.name} presses {' and '.join(shape[d] for d in solver.dimensions)} "
                  f"only, but spectrum {spectrum.name} makes {shape[made]}"
-                 + (" and has no MDR-equivalent line" if made == 2 and 1 in solver.dimensions else "")],
+                 + (" and has no MDR-equivalent line" if mdr else "")
+                 + (f": use solver {' or '.join(able)}" if able and not mdr else "")],
                 source=source,
             )
         plugins = {**plugins, "equivalent_line": line}

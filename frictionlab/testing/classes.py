@@ -72,11 +72,12 @@ def check_plugin_class(kind: str, cls, params: Mapping[str, Any] | None = None) 
     base class, its required methods implemented, kebab-case ``name``, one-line ``summary``, pydantic ``Params``
     forbidding unknown keys, every field described, and every declaration well
     formed: ``kind`` and ``register_hook`` are the base class's own; a spectrum's
-    ``dimension`` is 1 or 2 and its ``points_param`` names a field; the
+    ``dimension`` is 1 or 2, its ``deterministic`` a bool and its ``points_param`` names a field; the
     ``dimensions`` of a solver or an estimator are 1 and/or 2 and ``periodic_only``
     is a bool; a solver's ``normalisations`` give one ``normalisation`` per
     dimension, ``problem`` names the physical problem, ``approximation`` is a bool,
-    ``contact_measure`` and ``indentation_reference`` take allowed values,
+    ``contact_measure`` and ``indentation_reference`` take allowed values, ``mdr_lines`` is a bool,
+    True only for a solver of lines alone,
     ``body_params`` and ``tolerance_param`` name fields); ``references`` is a tuple
     of strings; ``Params`` has a JSON Schema and every default passes its own bounds; ``Params(**params)`` and
     ``cls(**params)`` construct (``params`` defaults to ``{}``: give it when a

@@ -11,9 +11,10 @@ from .common import call, check_array, check_positive_number, fail, instantiate,
 def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """``cls(**params).generate(rng)`` returns a ``Profile`` with finite,
     float64 heights of ``cls.dimension`` dimensions (1: a line, 2: a surface) and a finite ``spacing > 0``; the same seed gives
-    identical heights; a different seed gives different heights (pass
-    ``deterministic=True`` for a generator that ignores randomness by design,
-    e.g. one that reads a measured profile); ``rms_height()`` is finite and
+    identical heights; a different seed gives different heights (unless the class declares
+    ``deterministic = True``, a generator that ignores randomness by design, e.g. one that
+    reads a measured profile: a run reads the declaration, so ``deterministic=True`` given
+    here alone fails); ``rms_height()`` is finite and
     > 0 and agrees within a factor of 3 with the rms (about the mean) of the
     generated lines, pooled over 8 seeds. If ``psd`` is implemented it is
     vectorised (array in, array of the same shape out), finite and >= 0; if
@@ -40,14 +41,18 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     """
     import numpy as np
 
-    from frictionlab.plugin.outputs import SAME_SEED, global_random_problem, height_problem, profile_problem, random_state
+    from frictionlab.plugin.outputs import OTHER_SEED, SAME_SEED, RandomWatch, height_problem, profile_problem
 
+    if deterministic and cls.deterministic is not True:
+        fail(cls, "deterministic=True was given to the check, but the class does not declare deterministic = True: "
+                  "a run reads the declaration, and refuses a generator whose seeds all give one profile")  # fmt: skip
+    deterministic = cls.deterministic is True
     gen = instantiate(cls, params)
 
     def generate(seed: int):
-        before = random_state()
+        watch = RandomWatch()
         profile = call(cls, f"generate(default_rng({seed}))", gen.generate, np.random.default_rng(seed))
-        problem = global_random_problem("generate()", before) or profile_problem(gen, profile)  # as a run takes it
+        problem = watch.problem("generate()") or profile_problem(gen, profile)  # as a run takes it
         if problem:
             fail(cls, problem)
         return profile
@@ -61,11 +66,7 @@ def check_spectrum(cls, *, deterministic: bool = False, **params) -> None:
     other = generate(4321)
     if not deterministic and other.heights.shape == first.heights.shape:
         if np.array_equal(other.heights, first.heights):
-            fail(
-                cls,
-                "different seeds gave identical heights; use the rng argument "
-                "(or pass deterministic=True if the generator is deterministic by design)",
-            )
+            fail(cls, OTHER_SEED)
 
     if problem := call(cls, "rms_height()", height_problem, gen):
         fail(cls, problem)

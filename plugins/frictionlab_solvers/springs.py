@@ -214,6 +214,7 @@ class MDRSprings(SpringRow):
     # MDR is defined on a line: a surface runs as its MDR-equivalent line (preset.build_scene),
     # whose length is 2 sqrt(A / pi): F / (E* h L) is then the surface's own 3D f
     dimensions: ClassVar[tuple[int, ...]] = (1,)
+    mdr_lines: ClassVar[bool] = True
     normalisations = {1: ForceNormalisation(load="force", modulus="E*", extent="length", pressure_area="mdr disc")}
     problem: ClassVar[str] = "elastic half-space"
     approximation: ClassVar[bool] = True  # the 3D contact of an isotropic surface, reduced to a line

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, ClassVar
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -99,6 +99,8 @@ def table_unit(path: Path, where: str, p: MeasuredParams, text: bool) -> dict[st
 class MeasuredFile(SpectrumGenerator):
     """The contract's methods that read nothing but what ``_measured`` and ``_header`` give;
     every ``generate`` returns the same heights."""
+
+    deterministic: ClassVar[bool] = True  # the rng is not used: every realization is the measured profile
 
     def _measured(self) -> Measured:
         raise NotImplementedError

@@ -156,6 +156,11 @@ def test_solver_check_fails_when_undefined_slopes_are_not_left_out():
         ({"corrected_area": "yes"}, "corrected_area must be True or False. Got 'yes'"),
         ({"body_params": ("youngs_modulus",)}, "body_params names 'youngs_modulus', not fields of Params"),
         ({"tolerance_param": "tol"}, "tolerance_param names 'tol'"),
+        ({"mdr_lines": 1}, "mdr_lines must be True or False. Got 1"),
+        ({"mdr_lines": True, "dimensions": (1, 2), "normalisations": {
+            1: ForceNormalisation(load="force", modulus="k", extent="length"),
+            2: ForceNormalisation(load="force", modulus="k", extent="area")}},
+         r"mdr_lines is for a solver of lines alone \(dimensions \(1,\)\)"),
         ({"bytes_per_point": 0}, "bytes_per_point must be None or a whole number > 0. Got 0"),
         ({"bytes_per_point": 12.5}, "bytes_per_point must be None or a whole number > 0. Got 12.5"),
         ({"normalisations": {1: ForceNormalisation(load="force", modulus="k", extent="area")}}, "not defined for a 1D"),

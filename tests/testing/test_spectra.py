@@ -70,14 +70,18 @@ def test_spectrum_check_fails_for_broken_generators(qualname, methods, match):
     fails_naming(fltesting.check_spectrum, cls, match)
 
 
-def test_deterministic_flag_allows_seed_independence():
-    cls = spectrum_variant("FixedLine", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0)))
-    fltesting.check_spectrum(cls, deterministic=True)
-    with pytest.raises(AssertionError):  # but not a different answer for the same seed
-        fltesting.check_spectrum(
-            spectrum_variant("Drifting", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng())),
-            deterministic=True,
-        )
+def test_a_generator_declared_deterministic_may_ignore_its_seed():
+    """The kit reads ``deterministic`` where a run does, on the class: given to the check alone it
+    passed a generator every run of more than one realization would refuse."""
+    def fixed(self, rng):
+        return GoodSpectrum.generate(self, np.random.default_rng(0))
+
+    fltesting.check_spectrum(spectrum_variant("FixedLine", generate=fixed, deterministic=True))
+    with pytest.raises(AssertionError, match="deterministic=True was given to the check, but the class does not declare"):
+        fltesting.check_spectrum(spectrum_variant("Undeclared", generate=fixed), deterministic=True)
+    with pytest.raises(AssertionError, match="the same seed gave different heights"):  # but not a drifting answer
+        fltesting.check_spectrum(spectrum_variant(
+            "Drifting", generate=lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng()), deterministic=True))
 
 
 def test_spectrum_check_fails_for_wrong_declarations():
@@ -154,5 +158,13 @@ def test_a_measured_profile_declared_periodic_is_not_held_to_wrapping():
     """deterministic: a file's profile is periodic as its data and its preset say (a plane levelled
     away leaves a step at the wrap); the kit checks the plugin, not the data."""
     scan = np.sin(np.arange(128) / 5) + np.linspace(0, 3, 128)
-    fltesting.check_spectrum(spectrum_variant("Scan", generate=lambda self, rng: Profile(scan.copy(), 1.0)),
-                             deterministic=True)
+    fltesting.check_spectrum(spectrum_variant("Scan", generate=lambda self, rng: Profile(scan.copy(), 1.0),
+                                              deterministic=True))
+
+
+def test_deterministic_is_declared_true_or_false():
+    from frictionlab.errors import PluginError
+    from frictionlab.plugin.registry import validate_plugin_class
+
+    with pytest.raises(PluginError, match=r"deterministic must be True or False\. Got 'yes' instead\."):
+        validate_plugin_class("spectrum", spectrum_variant("Vague", deterministic="yes"))
