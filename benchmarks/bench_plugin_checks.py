@@ -12,25 +12,16 @@
 from __future__ import annotations
 
 import argparse
-import time
 import timeit
 from pathlib import Path
 
 import frictionlab.compute.realization as realization
 from frictionlab.plugin.outputs import RandomWatch, random_state
 from frictionlab.preset import load_scene
+from bench_fig2 import best_of  # this folder's
 
 PRESET = Path(__file__).resolve().parents[1] / "presets" / "benad2012-fig2.yaml"
 LOOKS = 2000  # of each kind, per repeat
-
-
-def best_of(repeat: int, work) -> float:
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def watched() -> None:  # a realization's looks now

@@ -578,9 +578,8 @@ def test_a_sweep_table_that_is_a_folder_or_a_folder_not_writable_is_said_so_at_o
     assert "damaged" not in done.stderr and len(list((out / "points").iterdir())) == 1
 
 
-def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, registry, capsys):
-    """spacing: log beside values, now refused, was once accepted (and ignored): an interrupted
-    sweep that holds it in its sweep.json resumed as 'damaged', its finished point out of reach."""
+def sweep_stopped_after_its_first_point(folder, registry):
+    """A sweep of two seeds into ``folder``, cancelled once its first point has finished."""
     cancel = threading.Event()
 
     class StopAfterFirst(SweepListener):
@@ -588,7 +587,14 @@ def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, 
             cancel.set()
 
     sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2]}}), registry=registry)
-    run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    run_sweep(sweep, folder, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    return sweep
+
+
+def test_a_sweep_started_with_spacing_log_beside_values_still_resumes(tmp_path, registry, capsys):
+    """spacing: log beside values, now refused, was once accepted (and ignored): an interrupted
+    sweep that holds it in its sweep.json resumed as 'damaged', its finished point out of reach."""
+    sweep = sweep_stopped_after_its_first_point(tmp_path, registry)
     record = json.loads((tmp_path / "sweep.json").read_text())
     record["sweep"]["parameters"]["seed"]["spacing"] = "log"  # as such a sweep wrote it
     (tmp_path / "sweep.json").write_text(json.dumps(record))
@@ -603,14 +609,7 @@ def test_a_sweep_started_with_fit_bootstrap_1_resumes_without_intervals(tmp_path
     refused by resume as a preset not valid here. Every point resumes with no intervals, and says so."""
     from frictionlab.runs.rundir import fingerprint
 
-    cancel = threading.Event()
-
-    class StopAfterFirst(SweepListener):
-        def point_finished(self, sweep, point, result):
-            cancel.set()
-
-    sweep = plan_sweep(sweep_preset({"seed": {"values": [1, 2]}}), registry=registry)
-    run_sweep(sweep, tmp_path, RunOptions(workers=1), listeners=[StopAfterFirst()], cancel=cancel, plot=False)
+    sweep = sweep_stopped_after_its_first_point(tmp_path, registry)
     record = json.loads((tmp_path / "sweep.json").read_text())
     record["base_preset"]["fit"]["bootstrap"] = 1  # as such a sweep wrote it, in its point's folder too
     (tmp_path / "sweep.json").write_text(json.dumps(record))

@@ -299,6 +299,15 @@ def test_a_markdown_that_is_one_of_the_reports_figures_is_refused(tmp_path, caps
     assert not out.exists()
 
 
+def no_figure_may_run(monkeypatch, why: str) -> None:
+    """Any figure's run fails the test, saying ``why``."""
+    def must_not_run(*args, **kwargs):
+        raise AssertionError(why)
+
+    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
+    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+
+
 @pytest.mark.parametrize("key", ["fig4", "fig5"])
 def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_path, capsys, monkeypatch, key):
     """--out of an earlier report whose fig4 (or fig5) holds files of the user's: Figs. 2 and 3 ran
@@ -307,11 +316,7 @@ def test_a_figures_folder_its_run_refuses_is_refused_before_any_figure_runs(tmp_
     (out / key).mkdir(parents=True)
     (out / key / "notes.txt").write_text("mine")
 
-    def must_not_run(*args, **kwargs):
-        raise AssertionError("a figure ran before every figure's folder was checked")
-
-    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
-    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    no_figure_may_run(monkeypatch, "a figure ran before every figure's folder was checked")
     code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--quiet"])
     assert code == ExitCode.OUTPUT_REFUSED
     assert f"{out / key} holds files that no frictionlab run wrote ('notes.txt'): " in capsys.readouterr().err
@@ -340,11 +345,7 @@ def test_a_readings_folder_of_other_files_is_refused_before_any_figure_runs(tmp_
     (out / folder).mkdir(parents=True)
     (out / folder / "notes.txt").write_text("mine")
 
-    def must_not_run(*args, **kwargs):
-        raise AssertionError("a figure ran before the readings' folders were checked")
-
-    monkeypatch.setattr("frictionlab.paper.figures.run_to_folder", must_not_run)
-    monkeypatch.setattr("frictionlab.paper.figures.run_sweep", must_not_run)
+    no_figure_may_run(monkeypatch, "a figure ran before the readings' folders were checked")
     for force in ([], ["--force"]):
         code = main(["report", "--presets", str(PRESETS), "--out", str(out), "--readings", "--quiet", *force])
         assert code == ExitCode.OUTPUT_REFUSED
