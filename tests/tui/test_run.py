@@ -69,6 +69,31 @@ async def test_a_run_with_no_law_says_so_once_not_no_realization_yet(folders, re
     assert len(series) == 1  # the mean curve alone, no fitted line
 
 
+@sync
+async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_nothing(folders, registry):
+    """In tmux: u on a run that failed with no law (its 8 of 8 realizations finished) resumed it,
+    computed nothing and failed again the same way; the footer offered it on the Run and Results tabs."""
+    (folders / "presets" / "nolaw.yaml").write_text(yaml.safe_dump(NO_LAW))
+    app = make_app(registry, preset="presets/nolaw.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        out_dir = app.last_out_dir
+        before = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
+        footers, said = [], {}
+        for tab in ("f4", "f5"):
+            await press_settled(pilot, tab)
+            footers.append(screen_text(app).splitlines()[-1])
+            await press_settled(pilot, "u")
+            said[tab] = (status_text(app), app.running)
+        after = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
+    assert all("Resume" not in footer for footer in footers), footers
+    for text, running in said.values():
+        assert not running and text.startswith(f"Cannot resume: {out_dir.name} failed with all its 8 realizations "
+                                               "finished: no law: every load"), text  # fmt: skip
+        assert "A resume computes nothing new and fails the same way" in text and "raise the loads" in text
+    assert after == before  # nothing started, nothing rewritten
+
+
 def long_run_app(folders, registry):
     """The app on a preset of 100000 realizations: a run that goes on until cancelled."""
     big = merge(TINY, {"name": "long", "realizations": 100_000})
