@@ -2,6 +2,7 @@
 
 import json
 import re
+import signal
 import threading
 
 import numpy as np
@@ -142,6 +143,29 @@ async def test_c_on_another_tab_while_a_run_goes_says_where_it_cancels_and_cance
     assert going and app.last_outcome.status == "interrupted"
 
 
+SOLVING_EARLY = r"realization [1-9]\d*: load [1-4]/8, iteration"  # a later realization, half its loads to go
+
+
+async def stopped_in_a_solve(pilot, process) -> None:
+    """The run's process stopped (SIGSTOP) where the screen, having read all it wrote, shows a
+    realization early in its solve: c then lands there. Unstopped, a loaded machine ran the
+    realization to its end between the screen's read (every 0.25 s) and c's signal."""
+    app = pilot.app
+    log = app.followed.folder / "progress.jsonl"
+    for _ in range(20):
+        await wait_until(pilot, lambda: app.last_snapshot is not None and re.match(SOLVING_EARLY, app.last_snapshot.solving or ""))
+        process.send_signal(signal.SIGSTOP)
+        await wait_until(pilot, lambda: app.followed.follower.reader.offset == log.stat().st_size)
+        read = app.last_snapshot
+        await wait_until(pilot, lambda: app.last_snapshot is not read)  # a tick after: the last event read is shown
+        # its last event an iteration at load 4 or before: another comes every 0.25 s of solving, the
+        # realization's last 4 loads take 0.5 s and more, so it is still being solved
+        if re.match(SOLVING_EARLY, app.last_snapshot.solving):
+            return
+        process.send_signal(signal.SIGCONT)
+    raise AssertionError("the run was never stopped early in a solve")
+
+
 @sync
 async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_realization(folders, registry):
     from ..test_load_progress import LONG_LOADS
@@ -152,13 +176,14 @@ async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_
     app = make_app(registry, preset="presets/long.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
-        # a later realization early in its solve (half its loads to go): the screen, read every
-        # 0.25 s, lags the run, and a realization met at its last load may be stored before c lands
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 1
-                         and re.match(r"realization \d+: load [1-4]/8, iteration", app.last_snapshot.solving or ""))  # fmt: skip
-        solving = app.last_snapshot.solving
-        stats = str(app.query_one("#run-stats", Static).render())
-        await pilot.press("c")  # SIGTERM to the run's process
+        process = app.followed.process
+        try:
+            await stopped_in_a_solve(pilot, process)
+            solving = app.last_snapshot.solving
+            stats = str(app.query_one("#run-stats", Static).render())
+            await pilot.press("c")  # SIGTERM to the run's process, answered as it goes on
+        finally:
+            process.send_signal(signal.SIGCONT)
         await wait_until(pilot, lambda: app.last_outcome is not None)
         outcome, out_dir = app.last_outcome, app.last_out_dir
     assert solving in stats.splitlines()[1] and re.match(r"realization [1-9]\d*: load ", solving)
