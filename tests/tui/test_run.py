@@ -207,9 +207,16 @@ async def test_c_pressed_again_while_cancelling_signals_the_run_once(folders, re
         terminate = process.terminate
         process.terminate = lambda: (signals.append("SIGTERM"), terminate())[1]
         said_since = record_said(app)
-        post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
-        await pilot.pause()
-        listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
+        # the run's process stopped until both are answered: under load it wrote what finished and ended
+        # between the two (a tick of the app's own comes between them), and the second said it had ended
+        process.send_signal(signal.SIGSTOP)
+        try:
+            post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
+            await wait_until(pilot, lambda: len(said_since) >= 2)
+            await pilot.pause()
+            listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
+        finally:
+            process.send_signal(signal.SIGCONT)
         await wait_until(pilot, lambda: app.last_outcome is not None)
         out_dir = app.last_out_dir
     assert signals == ["SIGTERM"] and "Cancel" not in listed
