@@ -69,7 +69,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
     CSS_PATH = "app.tcss"
     TITLE = "frictionlab"
     ENABLE_COMMAND_PALETTE = False  # every action has a key; the footer needs the room
-    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (60, "-roomy")]  # narrow: the keys panel takes the width (app.tcss)
+    # narrow: the keys panel takes the width; roomy: half of it; wide: 60 % (app.tcss)
+    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (60, "-roomy"), (80, "-wide")]
     # short: a dialog as tall as the screen at most; tiny (30x8): the Edit tab's form keeps rows (app.tcss)
     VERTICAL_BREAKPOINTS = [(0, "-tiny"), (12, "-short"), (22, "-tall")]
     BINDINGS = [

@@ -273,6 +273,15 @@ class RunEntry:
         formula = _mapping(self.summary.get("normalisation")).get("formula")
         return formula if isinstance(formula, str) else ""
 
+    @property
+    def failed_for_good(self) -> str:
+        """Why the run failed with every realization finished (no law: each load pressed the same
+        points), "" otherwise: a resume computes nothing and fails the same way."""
+        error = self.summary.get("error")
+        if self.status != "failed" or not 0 < self.done == self.requested or not isinstance(error, str):
+            return ""
+        return error
+
 
 def read_run(folder: Path) -> RunEntry:
     """A run folder's summary (read as untrusted input: ``runfolder``); RunFolderError

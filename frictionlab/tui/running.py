@@ -122,11 +122,17 @@ class RunControl:
                 return
             # not a run folder (yet): said below
         try:
-            if read_run(folder).status == "completed":
-                self.say(f"{shown_name(folder.name)} is complete: nothing to resume.", "warning", about=folder)
-                return
+            entry = read_run(folder)
         except (OSError, RunFolderError):
-            pass  # no summary yet (a run killed early): the stored preset says whether it can go on
+            entry = None  # no summary yet (a run killed early): the stored preset says whether it can go on
+        if entry is not None and entry.status == "completed":
+            self.say(f"{shown_name(folder.name)} is complete: nothing to resume.", "warning", about=folder)
+            return
+        if entry is not None and entry.failed_for_good:  # no process started: it would compute nothing
+            self.say(f"{shown_name(folder.name)} failed with all its {entry.done} realizations finished: "
+                     f"{entry.failed_for_good}. A resume computes nothing new and fails the same way: change the "
+                     "preset as that says, then run it again (Ctrl+R).", "error", title="Cannot resume", about=folder)  # fmt: skip
+            return
         stored = self._stored_or_say(folder, "resume")
         if stored is not None:
             self._start(*stored, folder, replace(self.run_options, resume=True))
@@ -445,10 +451,16 @@ def quit_farewell(what: str, folder: Path, pid: int | None, cancelled: bool) -> 
 
 
 def _resumable(folder: Path) -> bool:
-    """Whether the run (or sweep) in ``folder`` ended before it completed and can go on."""
+    """Whether the run (or sweep) in ``folder`` ended before it completed and can go on (a run that
+    failed with every realization finished cannot: ``RunEntry.failed_for_good``)."""
     from ..runs.detached import run_state
 
     try:
-        return run_state(folder).resumable
+        if not run_state(folder).resumable:
+            return False
     except (OSError, FrictionlabError):
         return False
+    try:
+        return not read_run(folder).failed_for_good  # a resume would fail the same way
+    except (OSError, FrictionlabError):
+        return True  # no summary yet (killed early): it goes on from its chunks

@@ -7,7 +7,7 @@ from textual.widgets import Input
 from frictionlab.options import RunOptions
 from frictionlab.preset.builtin import find_builtin
 from frictionlab.tui.app import FrictionlabApp
-from frictionlab.tui.screens.dialogs import QuitDuringRunScreen
+from frictionlab.tui.screens.dialogs import ConfirmScreen, QuitDuringRunScreen
 
 from .conftest import make_app, press_settled, screen_text, started, status_text, sync
 
@@ -64,6 +64,32 @@ async def test_save_run_and_save_as_wait_while_a_dialog_is_open_and_say_so(folde
     assert dialogs == 1 and left == ("Screen", "")  # the message goes with the dialog
     assert said.startswith("A dialog is open: Enter answers it, Esc closes it")
     assert app.followed is None and not (folders / "runs").exists()  # no run started behind the dialog
+
+
+@pytest.mark.parametrize("opened_by", ["n", "ctrl+o", "question"])
+@sync
+async def test_f2_to_f5_wait_while_a_dialog_is_open_and_say_so(folders, registry, opened_by):
+    """In tmux: n (New), then F5: the Results tab came up behind the dialog, which stayed open over it;
+    so in Save a copy and in a question."""
+    app = make_app(registry, preset=None if opened_by == "n" else "presets/tiny.yaml")
+    async with started(app) as pilot:
+        if opened_by == "question":
+            app.push_screen(ConfirmScreen("The open preset has unsaved changes. Discard them?"))
+        else:
+            await pilot.press(opened_by)
+        await pilot.pause()
+        dialog, tab = app.screen, app.query_one("#tabs").active
+        tabs = []
+        for key in ("f2", "f3", "f4", "f5"):
+            await press_settled(pilot, key)
+            tabs.append((app.query_one("#tabs").active, app.screen is dialog))
+        said = status_text(app)
+        await press_settled(pilot, "escape", "f5")  # closed: F5 switches again
+        after = app.query_one("#tabs").active
+    assert tab == ("presets" if opened_by == "n" else "edit")
+    assert tabs == [(tab, True)] * 4
+    assert said.startswith("A dialog is open: Enter answers it, Esc closes it; then") and "F2 to F5 act" in said
+    assert after == "results"
 
 
 @sync

@@ -18,7 +18,7 @@ from frictionlab.tui.widgets import PresetForm
 from ..conftest import PRESETS, merge
 from .conftest import (
     SIZE, TINY, choose, error_text, headless_problems, make_app, new_preset, open_first_preset, post_keys, press_settled,
-    sync, type_into,
+    sync, type_into, wait_until,
 )
 
 # ------------------------------------------------------------------ edit and save
@@ -230,7 +230,8 @@ async def test_keys_typed_just_before_esc_reach_the_draft(folders, registry):
         await pilot.pause()
         post_keys(app, ["end", "ctrl+u", *"12", "escape"])
         await wait_until(pilot, lambda: field.value == "12" and app.focused is not field)
-        await pilot.pause(0.3)
+        # the edit's message comes after the focus has left: waited for, not a fixed 0.3 s (a loaded machine is slower)
+        await wait_until(pilot, lambda: app._draft()["realizations"] == 12 and app.modified)
         draft, modified = app._draft()["realizations"], app.modified
     assert draft == 12 and modified
 
@@ -314,8 +315,9 @@ async def test_fields_left_fast_leave_the_help_and_enter_on_the_field_focused(fo
         app.query_one("#field--spectrum--params--points").focus()
         await pilot.pause()
         post_keys(app, ["shift+tab"] * 4)  # hurst, the spectrum's plugin, realizations, seed
-        await pilot.pause()
-        await pilot.pause(0.2)
+        help_of = lambda: str(app.query_one("#field-help", Static).render())  # noqa: E731
+        # every key answered and the help line redrawn: waited for, not a fixed 0.2 s (a loaded machine is slower)
+        await wait_until(pilot, lambda: app.focused.id == "field--seed" and help_of().startswith("seed:"))
         focused = app.focused.id
         help_line = str(app.query_one("#field-help", Static).render())
         await pilot.press("escape", "enter")
@@ -335,7 +337,7 @@ async def test_down_and_up_in_a_field_go_to_the_field_below_and_above(folders, r
         seed.focus()
         await pilot.pause()
         post_keys(app, ["down", "end", "ctrl+u", *"12"])  # typed at once: the digits go where Down went
-        await pilot.pause(0.5)
+        await wait_until(pilot, lambda: "12" in (seed.value, realizations.value))  # all five answered
         below = app.focused
         await press_settled(pilot, "up")
         above = app.focused

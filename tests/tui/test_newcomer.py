@@ -2,10 +2,10 @@
 what the footer says, every run listed as it starts, damaged folders named, resume
 offered wherever a run can be resumed."""
 
-import asyncio
 import subprocess
 import shutil
 import sys
+import time
 
 import pytest
 import yaml
@@ -19,7 +19,7 @@ from frictionlab.tui.widgets import ResultsPane
 from ..conftest import merge
 from .conftest import (
     LONG, SIZE, TINY, interrupted_long_run, long_run_going, make_app, make_runs, numbers_in, press_settled,
-    runs_app, screen_text, started, status_text, sync, wait_until,
+    record_said, runs_app, screen_text, started, status_text, sync, wait_until,
 )
 
 
@@ -173,10 +173,11 @@ async def test_after_a_run_killed_mid_way_the_run_tab_offers_u_and_u_resumes_it(
         await wait_until(pilot, lambda: app.followed is None)
         await pilot.pause()
         footer, said = _footer(app), status_text(app)
+        said_since = record_said(app)  # the resumed process's own warning (chunks it recomputes) may follow at once
         await press_settled(pilot, "u")
         resumed = app.followed is not None and app.followed.folder == folder
         pid = app.followed.pid if resumed else None
-        said_after = status_text(app)
+        said_after = said_since[0] if said_since else ""
         if resumed:
             app.followed.cancel()
             await wait_until(pilot, lambda: app.followed is None)
@@ -379,21 +380,24 @@ def test_a_one_realization_fit_says_why_it_has_no_interval_and_a_finished_count_
 
 @pytest.mark.long
 @sync
-async def test_a_run_whose_folder_came_before_its_manifest_is_listed_within_a_second(folders, registry):
+async def test_a_run_whose_folder_came_before_its_manifest_is_listed_at_the_next_look(folders, registry):
     """A run started elsewhere makes its folder first and its run.json a moment later: the
-    list is read again at once for a folder not yet listed, not after the coalescing delay."""
+    list is read again at once for a folder not yet listed, not after the coalescing delay.
+    (The watch is called here, between two of its ticks: a loaded machine made a time limit on
+    its timer fail.)"""
     make_runs(folders, registry)
     runs = folders / "runs"
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("f5")
+        await press_settled(pilot, "f5")
         pane = app.query_one(ResultsPane)
         (runs / "later").mkdir()  # as a run starting elsewhere makes it
-        await pilot.pause(0.7)  # looked at: nothing to list there yet
-        assert "later" not in {e.path.name for e in pane.runs}
+        app._watch_runs()  # looked at: nothing to list there yet
+        seen_empty = "later" in {name for name, _ in app._runs_seen[1]} and "later" not in {e.path.name for e in pane.runs}
         for item in (runs / "seed1").iterdir():  # its files written (a finished run's, as a run's would be)
             if item.is_file():
                 shutil.copy2(item, runs / "later" / item.name)
-        written = asyncio.get_running_loop().time()
-        await wait_until(pilot, lambda: "later" in {e.path.name for e in pane.runs}, timeout=10.0)
-        assert asyncio.get_running_loop().time() - written < 1.2  # the watch's interval and a read, not 2 s more
+        app._runs_read_at = time.monotonic()  # the list was just read: a listed run's change would wait REREAD_SECONDS
+        app._watch_runs()
+        listed = "later" in {e.path.name for e in pane.runs}
+    assert seen_empty and listed

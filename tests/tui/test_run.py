@@ -2,6 +2,7 @@
 
 import json
 import re
+import signal
 import threading
 
 import numpy as np
@@ -69,6 +70,31 @@ async def test_a_run_with_no_law_says_so_once_not_no_realization_yet(folders, re
     assert len(series) == 1  # the mean curve alone, no fitted line
 
 
+@sync
+async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_nothing(folders, registry):
+    """In tmux: u on a run that failed with no law (its 8 of 8 realizations finished) resumed it,
+    computed nothing and failed again the same way; the footer offered it on the Run and Results tabs."""
+    (folders / "presets" / "nolaw.yaml").write_text(yaml.safe_dump(NO_LAW))
+    app = make_app(registry, preset="presets/nolaw.yaml", workers=1)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        out_dir = app.last_out_dir
+        before = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
+        footers, said = [], {}
+        for tab in ("f4", "f5"):
+            await press_settled(pilot, tab)
+            footers.append(screen_text(app).splitlines()[-1])
+            await press_settled(pilot, "u")
+            said[tab] = (status_text(app), app.running)
+        after = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
+    assert all("Resume" not in footer for footer in footers), footers
+    for text, running in said.values():
+        assert not running and text.startswith(f"Cannot resume: {out_dir.name} failed with all its 8 realizations "
+                                               "finished: no law: every load"), text  # fmt: skip
+        assert "A resume computes nothing new and fails the same way" in text and "raise the loads" in text
+    assert after == before  # nothing started, nothing rewritten
+
+
 def long_run_app(folders, registry):
     """The app on a preset of 100000 realizations: a run that goes on until cancelled."""
     big = merge(TINY, {"name": "long", "realizations": 100_000})
@@ -117,6 +143,29 @@ async def test_c_on_another_tab_while_a_run_goes_says_where_it_cancels_and_cance
     assert going and app.last_outcome.status == "interrupted"
 
 
+SOLVING_EARLY = r"realization [1-9]\d*: load [1-4]/8, iteration"  # a later realization, half its loads to go
+
+
+async def stopped_in_a_solve(pilot, process) -> None:
+    """The run's process stopped (SIGSTOP) where the screen, having read all it wrote, shows a
+    realization early in its solve: c then lands there. Unstopped, a loaded machine ran the
+    realization to its end between the screen's read (every 0.25 s) and c's signal."""
+    app = pilot.app
+    log = app.followed.folder / "progress.jsonl"
+    for _ in range(20):
+        await wait_until(pilot, lambda: app.last_snapshot is not None and re.match(SOLVING_EARLY, app.last_snapshot.solving or ""))
+        process.send_signal(signal.SIGSTOP)
+        await wait_until(pilot, lambda: app.followed.follower.reader.offset == log.stat().st_size)
+        read = app.last_snapshot
+        await wait_until(pilot, lambda: app.last_snapshot is not read)  # a tick after: the last event read is shown
+        # its last event an iteration at load 4 or before: another comes every 0.25 s of solving, the
+        # realization's last 4 loads take 0.5 s and more, so it is still being solved
+        if re.match(SOLVING_EARLY, app.last_snapshot.solving):
+            return
+        process.send_signal(signal.SIGCONT)
+    raise AssertionError("the run was never stopped early in a solve")
+
+
 @sync
 async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_realization(folders, registry):
     from ..test_load_progress import LONG_LOADS
@@ -127,13 +176,14 @@ async def test_a_long_solve_shows_its_iterations_and_cancel_stops_it_within_the_
     app = make_app(registry, preset="presets/long.yaml", workers=1)
     async with app.run_test(size=SIZE) as pilot:
         await press_run(pilot)
-        # a later realization early in its solve (half its loads to go): the screen, read every
-        # 0.25 s, lags the run, and a realization met at its last load may be stored before c lands
-        await wait_until(pilot, lambda: app.last_snapshot is not None and app.last_snapshot.done >= 1
-                         and re.match(r"realization \d+: load [1-4]/8, iteration", app.last_snapshot.solving or ""))  # fmt: skip
-        solving = app.last_snapshot.solving
-        stats = str(app.query_one("#run-stats", Static).render())
-        await pilot.press("c")  # SIGTERM to the run's process
+        process = app.followed.process
+        try:
+            await stopped_in_a_solve(pilot, process)
+            solving = app.last_snapshot.solving
+            stats = str(app.query_one("#run-stats", Static).render())
+            await pilot.press("c")  # SIGTERM to the run's process, answered as it goes on
+        finally:
+            process.send_signal(signal.SIGCONT)
         await wait_until(pilot, lambda: app.last_outcome is not None)
         outcome, out_dir = app.last_outcome, app.last_out_dir
     assert solving in stats.splitlines()[1] and re.match(r"realization [1-9]\d*: load ", solving)
@@ -157,9 +207,16 @@ async def test_c_pressed_again_while_cancelling_signals_the_run_once(folders, re
         terminate = process.terminate
         process.terminate = lambda: (signals.append("SIGTERM"), terminate())[1]
         said_since = record_said(app)
-        post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
-        await pilot.pause()
-        listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
+        # the run's process stopped until both are answered: under load it wrote what finished and ended
+        # between the two (a tick of the app's own comes between them), and the second said it had ended
+        process.send_signal(signal.SIGSTOP)
+        try:
+            post_keys(app, ["c", "c"])  # the second at once, while the run is still writing what finished
+            await wait_until(pilot, lambda: len(said_since) >= 2)
+            await pilot.pause()
+            listed = [binding.description for _, binding, _, _ in app.screen.active_bindings.values() if binding.show]
+        finally:
+            process.send_signal(signal.SIGCONT)
         await wait_until(pilot, lambda: app.last_outcome is not None)
         out_dir = app.last_out_dir
     assert signals == ["SIGTERM"] and "Cancel" not in listed

@@ -641,7 +641,7 @@ async def test_every_fields_help_is_shown_whole_at_80x24(folders, registry):
         cut = []
         for widget in app.query_one("#form").query("Input, Select, Switch"):
             widget.focus()
-            for _ in range(20):  # a loaded machine lays the grown help out a refresh or more later
+            for _ in range(250):  # a loaded machine lays the grown help out a refresh or more later (not a fixed 0.4 s in all)
                 await pilot.pause(0.02)
                 lines = help_line.content_size.height  # what it shows
                 needed = len(help_line.render().wrap(help_line.content_size.width)) if lines else 0

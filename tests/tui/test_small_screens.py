@@ -174,6 +174,22 @@ async def test_the_keys_panel_under_60_columns_covers_every_row_and_gives_the_fo
     assert footer.strip().startswith("⏎ Open"), footer
 
 
+@pytest.mark.parametrize(("width", "app_keeps", "panel_keeps"), [(60, 30, 30), (70, 35, 35), (80, 32, 46)])
+@sync
+async def test_the_keys_panel_from_60_columns_leaves_the_app_room_beside_it(folders, registry, width, app_keeps, panel_keeps):
+    """In tmux at 60x30: F1 on the Edit tab left the form 14 columns beside the panel (24 at 70),
+    its values cut to a letter or two; from 80 columns the panel keeps its 46 so that a key and its
+    line sit side by side."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=(width, 24)) as pilot:
+        await press_settled(pilot, "f1")
+        panel, form = app.screen.query_one("HelpPanel").region, app.query_one("#form").region
+        shown = screen_text(app)
+    assert form.right <= panel.x and panel.right == width  # side by side, not over the form
+    assert form.width >= app_keeps and panel.width >= panel_keeps, (form, panel)
+    assert "Scroll Up" in shown and "realizations" in shown
+
+
 @sync
 async def test_a_dialog_taller_than_a_30x8_screen_stays_on_it_and_the_arrows_bring_its_answers(folders, registry):
     """At 30x8 a question (save with problems?) ran past the screen's bottom edge, its answers

@@ -22,7 +22,8 @@ from ..widgets.footer import KeysFooter
 from ..widgets.keyinput import KeyInput
 
 
-WAIT_FOR_DIALOG = "A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O and Ctrl+R act."
+WAIT_FOR_DIALOG = "A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O, Ctrl+R and F2 to F5 act."
+WAITING_KEYS = frozenset({"ctrl+s", "ctrl+o", "ctrl+r", "f2", "f3", "f4", "f5"})  # the app's keys that pass a dialog
 
 
 class Dialog(ModalScreen):
@@ -63,10 +64,11 @@ class Dialog(ModalScreen):
             await self.app.on_event(key)
 
     def answers_first(self, key: events.Key) -> bool:
-        """Whether the dialog answers ``key`` itself, before any binding: Ctrl+S, Ctrl+O and Ctrl+R
-        wait for it to close, and say so (each opened another dialog over it, or ran the preset).
+        """Whether the dialog answers ``key`` itself, before any binding: Ctrl+S, Ctrl+O, Ctrl+R and
+        F2 to F5 wait for it to close, and say so (each opened another dialog over it, ran the
+        preset, or switched the tab behind it, the dialog left up over another tab).
         (Esc closes the keys panel over it first: ``KeysHelp.esc_closed_keys``.)"""
-        if key.key in ("ctrl+s", "ctrl+o", "ctrl+r"):
+        if key.key in WAITING_KEYS:
             self.app.say(WAIT_FOR_DIALOG, "warning")
             return True
         return False
@@ -74,7 +76,7 @@ class Dialog(ModalScreen):
     def on_unmount(self) -> None:
         status = self.app.query("#status")
         if status and str(status.first().render()) == WAIT_FOR_DIALOG:
-            self.app.say("")  # the dialog is closed: Ctrl+S, Ctrl+O and Ctrl+R act again
+            self.app.say("")  # the dialog is closed: those keys act again
 
     def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
         """What a paste left out, in the dialog's error line: the status line may be under it (30x8)."""
