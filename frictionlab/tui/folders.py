@@ -275,10 +275,12 @@ class RunEntry:
 
     @property
     def failed_for_good(self) -> str:
-        """Why the run failed with every realization finished (no law: each load pressed the same
-        points), "" otherwise: a resume computes nothing and fails the same way."""
+        """Why the run failed with every realization finished and none failed (no law: each load
+        pressed the same points), "" otherwise: a resume computes nothing and fails the same way.
+        A failed realization is computed again by a resume (one out of memory may then fit)."""
         error = self.summary.get("error")
-        if self.status != "failed" or not 0 < self.done == self.requested or not isinstance(error, str):
+        failed = _mapping(self.summary.get("realizations")).get("failed")
+        if self.status != "failed" or not 0 < self.done == self.requested or not isinstance(error, str) or failed != 0:
             return ""
         return error
 

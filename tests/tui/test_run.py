@@ -95,6 +95,19 @@ async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_n
     assert after == before  # nothing started, nothing rewritten
 
 
+@pytest.mark.parametrize("failed", [0, 8])
+def test_a_run_whose_realizations_failed_stays_resumable(tmp_path, failed):
+    """A run whose every realization failed (out of memory, say) has 8 of 8 done and an error too,
+    but a resume computes the failed ones again: only a run of no failed realization, failed at
+    its fit (no law), is one a resume cannot help."""
+    from frictionlab.tui.folders import read_run
+
+    error = "no realization finished: 8 failed; the first, #0: MemoryError" if failed else "no law: every load ..."
+    summary = {"status": "failed", "error": error, "realizations": {"done": 8, "requested": 8, "failed": failed}}
+    (tmp_path / "summary.json").write_text(json.dumps(summary))
+    assert read_run(tmp_path).failed_for_good == ("" if failed else error)
+
+
 def long_run_app(folders, registry):
     """The app on a preset of 100000 realizations: a run that goes on until cancelled."""
     big = merge(TINY, {"name": "long", "realizations": 100_000})
