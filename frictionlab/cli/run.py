@@ -149,7 +149,6 @@ def _run_scene(args, scene, out_dir: Path, options, drawer=None) -> ExitCode:
     from ..api import run_scene
     from ..progress import ProgressReporter
     from ..runs.results import summary_dict
-    from ..runs.sweep import refresh_point_tables
     from ..compute.signals import interrupted_exit_code
 
     closed = []  # stdout closed or full: raised again once the run folder is finished
@@ -171,8 +170,11 @@ def _run_scene(args, scene, out_dir: Path, options, drawer=None) -> ExitCode:
     if closed:
         raise closed[0]
     outcome = result.outcome
-    if args.resume and (refreshed := refresh_point_tables(out_dir, plot=not args.no_plot)) is not None:
-        print(shown(f"  {refreshed[1]}"), file=sys.stderr)  # a sweep's point resumed alone: its sweep's tables
+    if args.resume:  # a sweep's point resumed alone: its sweep's tables (the sweep module only then)
+        from ..runs.sweep import refresh_point_tables
+
+        if (refreshed := refresh_point_tables(out_dir, plot=not args.no_plot)) is not None:
+            print(shown(f"  {refreshed[1]}"), file=sys.stderr)
     if args.json:
         from .jsonout import emit
 

@@ -213,8 +213,6 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
-
-
 def _failure(scene: Scene, exc: Exception) -> str:
     """A realization's error as recorded, ``Type: message``: a failure the plugin explains
     (``SolveFailed``) as its message; one raised in a third party's plugin as that plugin's
