@@ -68,7 +68,6 @@ def test_a_fill_that_does_not_fit_is_refused_before_it_starts(tmp_path, monkeypa
         raise AssertionError("the fill started")
 
     monkeypatch.setattr(filling, "fill_harmonic", must_not_fill)
-    monkeypatch.setattr("frictionlab_spectra.profile_file.fill_harmonic", must_not_fill)
     for address_space in (False, True):  # the memory in use, or ulimit -v: what the fill keeps, or reserves
         need = harmonic_fill_bytes(z.shape, 256, reserved=address_space)
         monkeypatch.setattr(instrument_reader, "memory_rooms", lambda: [(need - 1, "a test limit", address_space)])

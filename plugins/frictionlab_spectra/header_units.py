@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import re
 
+from .file_kinds import LENGTH_UNITS
+
 HEADER_BYTES = 4096  # of a text file read for the units its header names
 HEADER_MOST = 1 << 20  # read while its header has not ended: a header longer than this is not a table's
 LENGTH_UNIT = {"pm": "pm", "nm": "nm", "um": "um", "\u00b5m": "um", "\u03bcm": "um", "micron": "um", "microns": "um",
@@ -110,7 +112,7 @@ def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float
     width and height (Gwyddion's text export: ``# Width: 32.000 µm``, ``# Height: 8.000 µm``; ``32,000 µm``
     in a locale whose decimal mark is a comma), or
     None unless it states both in length units: a table's reader takes its pixel from the preset."""
-    from .instrument_file import LENGTH_UNITS, open_input  # here: it imports this module
+    from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
         head = head_text(fh, "utf-8-sig")
@@ -159,7 +161,6 @@ def check_heights_are_lengths(text: str, where: str) -> None:
     """Refuse a file whose header labels a column in a unit that is no length (an AFM's channel
     in volts, amperes, degrees, hertz): its numbers are not heights, and were read as heights in
     the preset's unit without a word."""
-    from .instrument_file import LENGTH_UNITS  # here: it imports this module
     from .instrument_reader import quoted
 
     if (found := not_length_label(text)) is None:
@@ -189,7 +190,6 @@ def check_table_header(path, where: str, unit: str | None, format: str) -> str |
         raise ValueError(not_utf8(where, undecoded))  # a Latin-1 'z [µm]' was 'no unit frictionlab knows'
     check_heights_are_lengths(head, where)
     if (unknown := unknown_unit_label(head)) is not None:  # read bare, in the preset's unit, without a word
-        from .instrument_file import LENGTH_UNITS  # here: it imports this module
         from .instrument_reader import quoted
 
         raise ValueError(
@@ -215,7 +215,6 @@ def check_units_named(units: list[str], unit: str | None, where: str, ignored: s
     """Refuse a file whose header names ``units`` (``named_units``) that its reader ignores
     (``ignored`` says which reader): different length units, or one other than the preset's ``unit``;
     its numbers would be taken bare, in the preset's unit."""
-    from .instrument_file import LENGTH_UNITS  # here: it imports this module
 
     if imperial := [u for u in units if re.fullmatch(IMPERIAL, u)]:
         taken = f"in the preset's unit, {unit}" if unit else "bare"

@@ -20,7 +20,6 @@ import warnings
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from frictionlab import InputFileProblem, open_regular_file
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .channel_choice import pick_channel
+from .file_kinds import LENGTH_UNITS, MIN_SIDE, ScanHeader
 from .instrument_reader import (
     BARE_ARRAY_FORMATS, channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points,
     check_fill_room, check_header_units, check_payload, check_text_heights, check_text_room, choose_reader, parses_text,
@@ -36,14 +36,7 @@ from .instrument_reader import (
 from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
 
-MIN_SIDE = 8  # pixels a side of the smallest map surface-file presses
 TOPOGRAPHY_EXTRA = 'pip install "frictionlab[topography]"'
-TABLE_SUFFIXES = (".npy", ".csv", ".txt")  # read by frictionlab itself: bare numbers, no unit
-# the units a preset may ask for, in metres
-# (the angstrom, 1e-10 m, as AFM files state it, spelled \u00c5: a bare "A" is the ampere)
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "\u00c5": 1e-10, "pm": 1e-12}
-Unit = Literal["m", "mm", "um", "nm", "\u00c5", "pm"]
-Undefined = Literal["refuse", "harmonic"]
 X_TOLERANCE = 1e-3  # allowed deviation of x from a uniform grid, as a fraction of the spacing
 
 
@@ -66,24 +59,6 @@ class Scan:
     pixel_stated: bool = True  # false: the file states no size, ``pixel`` is 1 per point and the preset's spacing is used
     undefined_mask: np.ndarray | None = None  # a map's undefined points, (Ny, Nx): which a crop leaves out
     x_decreasing: bool = False  # a line's x column runs backwards (scanned right to left): read mirrored
-
-
-def is_instrument_file(path: Path, format: str = "auto") -> bool:
-    """Whether ``path`` goes to SurfaceTopography: ``format`` instrument, or auto and not one
-    of frictionlab's own tables (.npy, .csv, .txt)."""
-    if format != "auto":
-        return format == "instrument"
-    return path.suffix.lower() not in TABLE_SUFFIXES
-
-
-@dataclass(frozen=True)
-class ScanHeader:
-    """What an instrument file's metadata says without its heights being read."""
-
-    shape: tuple[int, ...]  # as ``read_scan`` gives it: (Ny, Nx) for a map, (N,) for a line
-    periodic: bool
-    pixel: tuple[float, ...] | None = None  # (dx, dy) of a map, in the file's unit, when the file says
-    unit: str | None = None  # the file's length unit, when it says
 
 
 def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | None = None) -> ScanHeader | None:
@@ -357,12 +332,6 @@ def _other_kind(where: str, dim: int, points: tuple[int, ...]) -> str:
                 "wide); export one of its lines from the instrument's software")  # fmt: skip
     kind = {1: "a line scan", 2: "a 2D map"}
     return f"{where}: the file holds {kind.get(dim, dim)}; use {'surface-file' if dim == 2 else 'profile-file'}"
-
-
-def scan_not_periodic_advice(name: str) -> tuple[str, str]:
-    """``SpectrumGenerator.not_periodic_advice`` of a measured line or map."""
-    return (f"spectrum {name} is not periodic (periodic: false, a scan whose ends do not meet)",
-            "set spectrum.params.periodic: true if its ends meet (after detrend)")  # fmt: skip
 
 
 def uniform_spacing(where: str, x: np.ndarray) -> float:

@@ -23,7 +23,6 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from . import instrument_reader
 from .scan_shaping.height_caveats import flat_neighbours_warning, outlier_warning
 from .scan_shaping.levelling import level, levelling_warning
 from .scan_shaping.line_offsets import line_offset_warning
@@ -32,7 +31,6 @@ from .scan_shaping.spikes import despike, spike_warning
 
 PIXEL_TOLERANCE = 1e-3  # relative difference of a pixel's two sides still taken as square
 SAME_SIDE = 1e-9  # relative difference of two sides that are the same side, rounded
-FileFormat = Literal["auto", "table", "instrument"]
 Level = Literal["none", "mean", "plane", "quadratic"]
 
 
@@ -245,6 +243,8 @@ def _check_room_to_resample(shape: tuple[int, int], pixel: tuple[float, float], 
     """Refuse, before it is built, a map on square pixels larger than this process can hold:
     pixels thousands of times longer one way (a header that lies: Gwyddion reads a zero width
     as 1 m) would make millions of rows of a small scan."""
+    from . import instrument_reader  # the readers, only when a map is resampled
+
     dx, dy = pixel
     axis = 0 if dy > dx else 1  # rows are along y
     points = resampled_points(shape[axis], max(dx, dy), min(dx, dy))

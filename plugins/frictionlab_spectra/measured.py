@@ -13,9 +13,9 @@ from pydantic import Field, field_validator, model_validator
 
 from frictionlab import InputFile, PluginParams, Profile, SpectrumGenerator
 
-from .header_units import check_table_header
-from .instrument_file import LENGTH_UNITS, ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice
-from .map_pipeline import FileFormat
+from .file_kinds import (
+    LENGTH_UNITS, FileFormat, ScanHeader, Undefined, Unit, is_instrument_file, scan_not_periodic_advice,
+)
 
 
 @dataclass(frozen=True)
@@ -92,6 +92,8 @@ def table_unit(path: Path, where: str, p: MeasuredParams, text: bool) -> dict[st
     """A table's unit and where it came from, for its input summary: the preset's ``unit``, else
     the one the header of a ``text`` table names (``check_table_header``, which refuses another
     than the preset's), else none: bare numbers."""
+    from .header_units import check_table_header  # the readers, only when a file is read
+
     named = check_table_header(path, where, p.unit, p.format) if text else None
     return {"unit": p.unit or named, "unit_from": "preset" if p.unit is not None else "header" if named else "none"}
 

@@ -34,19 +34,11 @@ from pydantic import Field
 from frictionlab import InputFile
 from frictionlab.plugin import MAX_MAGNITUDE
 
-from .instrument_file import (
-    ScanHeader, check_spacing, filled_caveat, is_instrument_file, open_input, read_scan, scan_header, scan_summary,
-    uniform_spacing,
-)
-from .instrument_reader import check_fill_room
+# The readers (instrument_file, text_table, scan_shaping) are imported where a file is read:
+# a run of a generated surface, and every command, registers this class without them.
+from .file_kinds import ScanHeader, is_instrument_file
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
-from .reader_failures import reason_said
-from .text_table import first_not_finite, read_text_table
-from .scan_shaping.filling import fill_harmonic
-from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
-from .scan_shaping.levelling import level_line, line_form_warning
-from .scan_shaping.spikes import line_spike_warning
 
 MIN_POINTS = 8
 SPACING_TOLERANCE = 1e-6  # allowed relative disagreement of the spacing param with the file's x
@@ -91,6 +83,8 @@ class ProfileFile(MeasuredFile):
     def _header(self) -> ScanHeader | None:
         """The line's points (and an instrument file's periodicity) without reading its heights;
         None for a text table, or a header that does not describe a valid line."""
+        from .instrument_file import scan_header
+
         path = Path(self.params.path)
         where = f"profile-file {str(path)!r}"
         if is_instrument_file(path, self.params.format):
@@ -104,6 +98,11 @@ class ProfileFile(MeasuredFile):
 
     @cached_on_params
     def _measured(self) -> Measured:
+        from .instrument_file import check_spacing, read_scan, scan_summary, uniform_spacing
+        from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
+        from .scan_shaping.levelling import level_line, line_form_warning
+        from .scan_shaping.spikes import line_spike_warning
+
         p = self.params
         path = Path(p.path)
         where = f"profile-file {str(path)!r}"
@@ -180,6 +179,8 @@ def _npy_line_points(shape: tuple[int, ...]) -> int | None:
 
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     """(x or None, z) as float64 arrays, from a .npy or a text file."""
+    from .text_table import read_text_table
+
     where = f"profile-file {str(path)!r}"
     suffix = file_suffix(path, where)
     if suffix == ".npy":
@@ -224,6 +225,8 @@ def load_npy(path: Path, where: str) -> np.ndarray:
     """The array of a .npy file of real numbers (integer or floating dtype), as stored; floats in
     double precision, their NaN (a byte-swapped float32 holds signalling ones, numpy's cast warned of
     them above the refusal) and overflow (float128) left for ``check_finite`` to name."""
+    from .instrument_file import open_input
+
     with open_input(path, where) as fh:
         _check_npy_size(fh, where)
         try:
@@ -244,6 +247,8 @@ def load_npy(path: Path, where: str) -> np.ndarray:
 def npy_shape(path: Path, where: str) -> tuple[int, ...] | None:
     """The shape a .npy file's header announces, read without its data (None if the header
     cannot be read, or the file does not hold what it announces: loading it then names the problem)."""
+    from .instrument_file import open_input
+
     with open_input(path, where) as fh:
         header = _npy_header(fh)
         held = os.fstat(fh.fileno()).st_size - header[2] if header else None
@@ -329,6 +334,8 @@ def _check_npy_size(fh, where: str) -> None:
 def _unreadable_npy(fh, exc: Exception) -> str:
     """Why np.load could not read a .npy file: not one at all (no magic string), or a header
     it refuses (a format version it does not know, a key too many), as numpy says."""
+    from .reader_failures import reason_said
+
     fh.seek(0)
     if fh.read(6) != b"\x93NUMPY":
         return ("not a .npy file (it does not start as numpy.save writes one); save the heights with numpy.save, "
@@ -363,6 +370,10 @@ def table_fill_advice(p, instrument: bool) -> str:
 def fill_table(where: str, z: np.ndarray, p) -> dict:
     """Fill a table's NaN (points not measured) in place when the preset says ``undefined:
     harmonic``, as an instrument file's undefined points are; what its summary says of them."""
+    from .instrument_file import filled_caveat
+    from .instrument_reader import check_fill_room
+    from .scan_shaping.filling import fill_harmonic
+
     if p.undefined != "harmonic" or not (missing := int(np.count_nonzero(np.isnan(z)))):
         return {}
     with np.errstate(invalid="ignore"):
@@ -384,6 +395,8 @@ def check_finite(where: str, what: str, values: np.ndarray, advice: str = "", ta
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
+        from .text_table import first_not_finite
+
         first = np.unravel_index(int(np.argmax(bad)), bad.shape)
         at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
         if table is not None and (cell := first_not_finite(table, where, column)) is not None:

@@ -51,12 +51,9 @@ from pydantic import Field, model_validator
 from frictionlab import InputFile
 
 from .equivalent_line import EquivalentLine
-from .header_units import stated_pixel
-from .instrument_file import (
-    LENGTH_UNITS, MIN_SIDE, ScanHeader, filled_caveat, is_instrument_file, read_scan, scan_header, scan_summary,
-    undefined_message,
-)
-from .instrument_reader import HEIGHT_COPIES
+# The readers (instrument_file, text_table, header_units) are imported where a file is read:
+# a run of a generated surface, and every command, registers this class without them.
+from .file_kinds import LENGTH_UNITS, MIN_SIDE, ScanHeader, is_instrument_file
 from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
@@ -65,7 +62,6 @@ from .profile_file import (
     MIN_POINTS, check_finite, check_heights_not_underflowing, file_suffix, fill_table, load_npy, npy_shape,
     table_fill_advice,
 )
-from .text_table import axes_warning, read_text_table
 from .scan_shaping.height_caveats import FLAT, flat_rms, units_warning
 
 MODES_PER_BLOCK = 2**20  # modes of the map's spectrum given to its MDR line at a time
@@ -233,6 +229,8 @@ class SurfaceFile(MeasuredFile):
     def _header(self) -> ScanHeader | None:
         """The map's shape (and an instrument file's periodicity) without reading its heights;
         None for a text table, or a header that does not describe a valid map."""
+        from .instrument_file import scan_header
+
         path = Path(self.params.path)
         where = f"surface-file {str(path)!r}"
         if is_instrument_file(path, self.params.format):
@@ -281,6 +279,8 @@ class SurfaceFile(MeasuredFile):
 def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Params, path: Path, where: str) -> None:
     """Refuse undefined points (an instrument's NaN) or NaN/inf inside the part of the map pressed:
     a crop (``region``) that leaves them out is read. A text table's first is named by its line."""
+    from .instrument_file import undefined_message
+
     instrument = is_instrument_file(path, p.format)
     inside = crop(z, pixel, p.region, where)[0] if p.region is not None else z
     if instrument and (missing := int(np.count_nonzero(np.isnan(inside)))):
@@ -294,6 +294,8 @@ def _undefined_in_region(mask: np.ndarray, undefined: int, pixel: tuple[float, f
                          where: str) -> dict[str, Any]:
     """What the summary says of a map's ``undefined`` points (``mask``) once cropped: those inside
     ``region`` (filled, or refused by ``_check_defined``) and those it leaves out."""
+    from .instrument_file import filled_caveat
+
     region_mask = crop(mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
     inside, size = int(np.count_nonzero(region_mask)), region_mask.size
     caveat = filled_caveat(inside, size, p, 2, "the region's")
@@ -332,6 +334,8 @@ def _table_checks(path: Path, where: str, data: np.ndarray, p: SurfaceFile.Param
 
 def _header_pixel(path: Path, where: str, shape: tuple[int, int], unit: str) -> tuple[float, float] | None:
     """The pixel (dx, dy) a table's header states (``stated_pixel``), in ``unit``."""
+    from .header_units import stated_pixel
+
     if (pixel := stated_pixel(path, where, shape)) is None:
         return None
     return pixel[0] / LENGTH_UNITS[unit], pixel[1] / LENGTH_UNITS[unit]
@@ -339,6 +343,8 @@ def _header_pixel(path: Path, where: str, shape: tuple[int, int], unit: str) -> 
 
 def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) -> str | None:
     """``axes_warning`` of a table map, of the first row and column that ``region`` keeps."""
+    from .text_table import axes_warning
+
     (x0, _), (y0, _) = crop(data, pixel, p.region, where)[1] if p.region is not None else ((0, 0), (0, 0))
     return axes_warning(data, (y0 == 0, x0 == 0))
 
@@ -346,6 +352,10 @@ def _axes_in_region(data: np.ndarray, pixel, p: SurfaceFile.Params, where: str) 
 def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray, tuple[float, float], dict[str, Any]]:
     """The (Ny, Nx) float64 map of a table or an instrument file (at least MIN_SIDE points each
     way), its pixel sides (dx, dy) in the run's unit, and what was read and used (``input_summary``)."""
+    from .instrument_file import read_scan, scan_summary
+    from .instrument_reader import HEIGHT_COPIES
+    from .text_table import read_text_table
+
     if is_instrument_file(path, p.format):
         undefined = "keep" if p.region is not None and p.undefined == "refuse" else p.undefined  # outside: cropped
         scan = read_scan(path, where, dimension=2, unit=p.unit, undefined=undefined, channel=p.channel,
