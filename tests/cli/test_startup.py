@@ -8,10 +8,13 @@ import pytest
 
 from ..conftest import PRESETS
 
+# a measured file's readers: imported where a file is read, never by a preset of a generated surface
+READERS = tuple(f"frictionlab_spectra.{m}" for m in ("instrument_file", "instrument_reader", "header_units", "text_table"))
 HEAVY = ("numpy", "numpy.ma", "pydantic", "scipy", "matplotlib", "rich", "textual", "importlib.metadata", "dask",
-         "distributed", "pandas", "SurfaceTopography")
+         "distributed", "pandas", "SurfaceTopography", *READERS)
 # what no command of a line preset needs before its figure: none is on the path of validate or run --no-plot
-NOT_FOR_A_LINE = {"scipy", "matplotlib", "numpy.ma", "rich", "textual", "dask", "distributed", "pandas", "SurfaceTopography"}
+NOT_FOR_A_LINE = {"scipy", "matplotlib", "numpy.ma", "rich", "textual", "dask", "distributed", "pandas",
+                  "SurfaceTopography", *READERS}
 
 
 def imported_after(code: str) -> set[str]:
