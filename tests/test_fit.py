@@ -6,7 +6,14 @@ import os
 import numpy as np
 import pytest
 
-from frictionlab.compute.fit import defined_mean, fit_log_law, least_squares, percentile_interval
+from frictionlab.compute.fit import defined_mean, fit_log_law, least_squares, percentile_interval, resample_counts
+
+
+def drawn_counts(seed: int, realizations: int, resamples: int) -> np.ndarray:
+    """The bootstrap's draws, by hand: each resample picks ``realizations`` of them uniformly,
+    with replacement, and counts how often it picked each."""
+    picks = np.random.default_rng(seed).integers(0, realizations, size=(resamples, realizations))
+    return np.array([np.bincount(row, minlength=realizations) for row in picks])
 
 
 def test_exact_log_law_is_recovered_exactly():
@@ -101,8 +108,7 @@ def test_bootstrap_equals_refitting_every_resampled_mean_curve():
     f = np.geomspace(0.5, 20, 25)
     xi = 1.2 + 0.05 * np.log(f) + rng.normal(0, 0.1, (12, f.size))
     fit = fit_log_law(f, xi, bootstrap=200, confidence=0.8, rng=np.random.default_rng(4))
-    draw = np.random.default_rng(4)
-    counts = draw.multinomial(12, np.full(12, 1 / 12), size=200)
+    counts = drawn_counts(4, 12, 200)
     refits = np.array([least_squares(f, c @ xi / 12)[0] for c in counts])
     low, high = np.percentile(refits, [10, 90], axis=0)
     assert fit.a_ci == pytest.approx((low[0], high[0]), rel=1e-12)
@@ -134,7 +140,7 @@ def test_undefined_xi_is_left_out_of_the_mean_the_fit_and_every_resample():
     assert used[0] == 8 and used[-1] == 11
     fit = fit_log_law(f, xi, bootstrap=200, confidence=0.8, rng=np.random.default_rng(4))
     assert (fit.a, fit.b) == pytest.approx(tuple(least_squares(f, mean)[0]), rel=1e-12)
-    counts = np.random.default_rng(4).multinomial(12, np.full(12, 1 / 12), size=200)
+    counts = drawn_counts(4, 12, 200)
     refits = []
     for c in counts:
         curve = [sum(c[i] * xi[i, j] for i in range(12) if not math.isnan(xi[i, j]))
@@ -249,7 +255,7 @@ def test_the_bootstrap_forms_its_counts_a_block_at_a_time_with_the_draws_of_one_
     finally:
         tracemalloc.stop()
     assert peak < 6 * 2**20, peak
-    counts = np.random.default_rng(3).multinomial(realizations, np.full(realizations, 1 / realizations), size=resamples)
+    counts = drawn_counts(3, realizations, resamples)
     projector = np.linalg.pinv(np.column_stack([np.ones(f.size), np.log(f)]))
     whole = (defined_mean(xi, counts) if averaged else counts @ xi / realizations) @ projector.T
     np.testing.assert_allclose(pairs, whole, rtol=1e-10, atol=1e-13)
@@ -284,3 +290,19 @@ def test_a_run_with_too_few_resamples_says_so_in_its_caveats():
     enough = frictionlab.run(merge(SMALL_PRESET, {"fit": {"bootstrap": 40}}), workers=1, progress=False)
     assert any("rest on 5 bootstrap" in c for c in few.caveats)
     assert not any("bootstrap resample" in c for c in enough.caveats)
+
+
+def test_resample_counts_are_multinomial_with_equal_chances():
+    """Each resample draws M realizations with replacement: its counts sum to M, and over many
+    resamples each count has the multinomial's mean 1 and variance 1 - 1/M, and two realizations'
+    counts the covariance -1/M."""
+    realizations, resamples = 10, 40_000
+    counts = resample_counts(np.random.default_rng(11), realizations, resamples)
+    assert counts.shape == (resamples, realizations) and counts.min() >= 0
+    assert (counts.sum(axis=1) == realizations).all()
+    sigma = math.sqrt((1 - 1 / realizations) / resamples)  # of a mean count
+    assert np.abs(counts.mean(axis=0) - 1).max() < 5 * sigma
+    covariance = np.cov(counts, rowvar=False)
+    assert np.diag(covariance) == pytest.approx(np.full(realizations, 1 - 1 / realizations), abs=0.05)
+    off = covariance[~np.eye(realizations, dtype=bool)]
+    assert off == pytest.approx(np.full(off.size, -1 / realizations), abs=0.03)
