@@ -21,7 +21,7 @@ class ExitCode(enum.IntEnum):
     USAGE = 2  # bad command line, invalid preset (a field's value), unknown or broken plugin
     INPUT_FILE = 3  # a preset file that cannot be used as one: missing, not a regular file, too large, not UTF-8
     OUTPUT_REFUSED = 4  # the output would replace or delete what frictionlab did not write (see --force)
-    RUN_FOLDER = 5  # a run folder that cannot be resumed: damaged, in use, another preset, a changed input file
+    RUN_FOLDER = 5  # a run folder that cannot be resumed: damaged, in use, another preset, a changed input file, a fit failed with all done
     INTERNAL = 70  # a bug in frictionlab or a plugin (sysexits' EX_SOFTWARE)
     HUNG_UP = 129  # SIGHUP, the terminal closed (an SSH session that dropped): as Ctrl-C
     INTERRUPTED = 130  # Ctrl-C (SIGINT): finished work was kept, the run folder is resumable

@@ -134,9 +134,10 @@ def run(args) -> ExitCode:
             print(shown(f"{state.name}: damaged, in {shown_name(folder)}/: {state.reason}"))
             return ExitCode.RUNTIME_FAILURE
         done = state.done
-        hint = f"; frictionlab resume {command_word(folder)} continues it" if state.resumable else ""
-        if error and state.done is not None and state.done == state.total:  # every realization done: no resume mends it
-            hint = ""
+        from ..runs.settled import why_no_resume_helps
+
+        mendable = state.resumable and not why_no_resume_helps(folder)[0]  # not a fit failed with every realization done
+        hint = f"; frictionlab resume {command_word(folder)} continues it" if mendable else ""
         if any(row.get("status") == "error" for row in rows):  # a resume fails there again until it is fixed
             hint = f"; do what the points in error say, then frictionlab resume {command_word(folder)} continues it"
         what = "points" if sweep is not None else "realizations"

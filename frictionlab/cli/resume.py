@@ -55,6 +55,7 @@ def run(args) -> ExitCode:
     run_dir = Path(args.run_dir)
     check_searchable(run_dir)
     refuse_a_part_of_a_run(run_dir, "resume")
+    run_command.refuse_what_no_resume_helps(run_dir)
     if run_dir.is_dir() and (problem := output_path_problem(run_dir)) is not None:  # said as a resume can act on it
         raise OutputRefused(f"{problem}; a resume writes into the folder it continues: copy it where you can write "
                             f"(cp -r {command_word(run_dir)} NEW_FOLDER) and resume the copy")

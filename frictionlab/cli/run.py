@@ -55,6 +55,9 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..runs.figures import DrawingProcess
 
+    if args.resume and args.out and not getattr(args, "stored", False):  # `resume DIR` said it already
+        refuse_what_no_resume_helps(Path(args.out))
+
     # forked before anything heavy is imported: it imports matplotlib on the core this start leaves idle
     drawer = None if args.no_plot or args.detach else DrawingProcess.start()
     try:
@@ -62,6 +65,35 @@ def run(args) -> ExitCode:
     finally:
         if drawer is not None:
             drawer.close()
+
+
+SHOWN_POINTS = 10  # of a sweep's points whose fit failed, said one a line
+
+
+def refuse_what_no_resume_helps(run_dir: Path) -> None:
+    """RunFolderError, before anything is read or written, for a run whose fit failed with every
+    realization finished (no law), or a sweep whose points all ended so, or completed: a resume
+    would restore them, compute nothing and fail the same way (``runs.settled``)."""
+    from ..runs.rundir import PRESET_FILE
+    from ..runs.settled import why_no_resume_helps
+
+    kind, reasons = why_no_resume_helps(run_dir)
+    if not kind:
+        return
+    if kind == "run":
+        head = f"cannot resume {shown_name(run_dir)}: all its realizations finished, and its fit failed: {reasons[0]}"
+        again = f"the preset it ran is {command_word(run_dir / PRESET_FILE)}"
+    else:
+        lines = [f"  {reason}" for reason in reasons[:SHOWN_POINTS]]
+        lines += [f"  (and {len(reasons) - SHOWN_POINTS} more)"] if len(reasons) > SHOWN_POINTS else []
+        head = (f"cannot resume {shown_name(run_dir)}: every point of the sweep ended, and at "
+                f"{counted(len(reasons), 'point')} all the realizations finished but the fit failed:\n" + "\n".join(lines))  # fmt: skip
+        again = f"each point's preset is its {PRESET_FILE} in {command_word(run_dir / 'points')}/"
+    raise RunFolderError(
+        f"{head}\nA resume restores every realization, computes nothing new and fails the same way (nothing in "
+        f"{shown_name(run_dir)} was changed). Change the preset as that says (other loads, a wider range, more "
+        f"realizations) and run it into a new folder ({again})"
+    )
 
 
 def _run(args, drawer) -> ExitCode:

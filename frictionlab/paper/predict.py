@@ -38,6 +38,7 @@ from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
 from ..runs.results import read_curve, read_summary
 from ..runs.runfolder import read_member
+from ..runs.settled import fit_failed
 from ..preset.seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
@@ -265,11 +266,9 @@ def read_run_law(
         count = ""
         if isinstance(counts, dict):
             count = f" ({short_repr(counts.get('done'), 20)} of {short_repr(counts.get('requested'), 20)} realizations)"
-            if status == "failed" and counts.get("done") == counts.get("requested") and summary.get("error"):
-                said = str(summary["error"])  # no law, with every realization done: resuming it gives none either
-                said = said if len(said) <= 300 else said[:297] + "..."
-                raise RunFolderError(f"{shown_name(path)}: the run failed with all its realizations finished{count}, and holds "
-                                     f"no law: {said}; give a law by hand with --a/--b")  # fmt: skip
+        if said := fit_failed(summary):  # no law, with every realization done: resuming it gives none either
+            raise RunFolderError(f"{shown_name(path)}: the run failed with all its realizations finished{count}, and holds "
+                                 f"no law: {said}; give a law by hand with --a/--b")  # fmt: skip
         raise RunFolderError(
             f"{shown_name(path)}: the run's status is {short_repr(status)}{count}, not 'completed': its law and interval "
             f"would come from fewer realizations than it asked for; finish it with `frictionlab resume {command_word(run_dir)}`, "

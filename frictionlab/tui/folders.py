@@ -15,6 +15,7 @@ import os
 import re
 import stat
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import yaml
@@ -276,13 +277,11 @@ class RunEntry:
     @property
     def failed_for_good(self) -> str:
         """Why the run failed with every realization finished and none failed (no law: each load
-        pressed the same points), "" otherwise: a resume computes nothing and fails the same way.
-        A failed realization is computed again by a resume (one out of memory may then fit)."""
-        error = self.summary.get("error")
-        failed = _mapping(self.summary.get("realizations")).get("failed")
-        if self.status != "failed" or not 0 < self.done == self.requested or not isinstance(error, str) or failed != 0:
-            return ""
-        return error
+        pressed the same points), "" otherwise: a resume computes nothing and fails the same way
+        (``runs.settled``; a failed realization is computed again by a resume)."""
+        from ..runs.settled import fit_failed
+
+        return fit_failed(self.summary) if self.status == "failed" else ""  # not a resume going on
 
 
 def read_run(folder: Path) -> RunEntry:
@@ -317,6 +316,14 @@ class SweepEntry:
     points: list[dict]  # sweep.json's rows: the swept values and the columns of sweep.csv
     mtime: float
     elapsed: float = 0.0  # seconds, as sweep.json says
+
+    @cached_property
+    def failed_for_good(self) -> str:
+        """Each point's error, one a line, where every point ended and those failed with every
+        realization finished (the others completed), "" otherwise: a resume cannot help them."""
+        from ..runs.settled import points_fit_failed
+
+        return "\n".join(points_fit_failed(self.path, self.points)) if self.status == "failed" else ""
 
     def point_folder(self, row: dict) -> Path:
         """The folder of a point (RunFolderError if sweep.json names one outside the sweep's, or a link)."""

@@ -17,16 +17,19 @@ from typing import TYPE_CHECKING
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
-from ..errors import FrictionlabError, PresetError, RunFolderError, command_word, shown, shown_name
+from ..errors import FrictionlabError, PresetError, RunFolderError, command_word, counted, shown, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
-from .folders import read_run
+from .folders import read_run, read_sweep
 from .messages import RunCrashed, RunFinished
 from .screens import QuitDuringRunScreen, QuitRunEndedScreen, QuitUnsavedScreen
 from .text import failure_message
 
 if TYPE_CHECKING:
     from .following import FollowedRun
+
+NO_RESUME_HELPS = ("A resume computes nothing new and fails the same way: change the preset as that says, then run it "
+                   "again (Ctrl+R).")  # fmt: skip
 
 # A run's modules (its process, its folder, its log, the Run tab) are imported where a run is
 # started or followed: the first screen needs none of them, and it is drawn before they load.
@@ -110,6 +113,11 @@ class RunControl:
             if state.kind == "sweep" and state.status == "completed":
                 self.say(f"{shown_name(folder.name)} is complete: nothing to resume.", "warning", about=folder)
                 return
+            if state.kind == "sweep" and state.status == "failed" and (points := read_sweep(folder).failed_for_good.splitlines()):
+                self.say(f"{shown_name(folder.name)}: every point ended, and at {counted(len(points), 'point')} all the "
+                         f"realizations finished but the fit failed: {'; '.join(points)}. {NO_RESUME_HELPS}",
+                         "error", title="Cannot resume", about=folder)  # fmt: skip
+                return
             if state.status == "damaged":  # a resume would rewrite the damaged file: the user did not ask that
                 self._refuse_damaged(folder, state.reason)
                 return
@@ -130,8 +138,7 @@ class RunControl:
             return
         if entry is not None and entry.failed_for_good:  # no process started: it would compute nothing
             self.say(f"{shown_name(folder.name)} failed with all its {entry.done} realizations finished: "
-                     f"{entry.failed_for_good}. A resume computes nothing new and fails the same way: change the "
-                     "preset as that says, then run it again (Ctrl+R).", "error", title="Cannot resume", about=folder)  # fmt: skip
+                     f"{entry.failed_for_good}. {NO_RESUME_HELPS}", "error", title="Cannot resume", about=folder)  # fmt: skip
             return
         stored = self._stored_or_say(folder, "resume")
         if stored is not None:
@@ -452,15 +459,13 @@ def quit_farewell(what: str, folder: Path, pid: int | None, cancelled: bool) -> 
 
 def _resumable(folder: Path) -> bool:
     """Whether the run (or sweep) in ``folder`` ended before it completed and can go on (a run that
-    failed with every realization finished cannot: ``RunEntry.failed_for_good``)."""
+    failed with every realization finished cannot, nor a sweep of such points: ``runs.settled``)."""
     from ..runs.detached import run_state
+    from ..runs.settled import why_no_resume_helps
 
     try:
         if not run_state(folder).resumable:
             return False
     except (OSError, FrictionlabError):
         return False
-    try:
-        return not read_run(folder).failed_for_good  # a resume would fail the same way
-    except (OSError, FrictionlabError):
-        return True  # no summary yet (killed early): it goes on from its chunks
+    return not why_no_resume_helps(folder)[0]  # a resume would fail the same way

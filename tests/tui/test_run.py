@@ -95,6 +95,60 @@ async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_n
     assert after == before  # nothing started, nothing rewritten
 
 
+NO_LAW_SWEEP = merge(NO_LAW, {"name": "nolawsweep", "spectrum": {"params": {"rms_height": 1.0}},
+                              "sweep": {"parameters": {"spectrum.params.rms_height": {"values": [1.0, 1.0e6]}}}})  # fmt: skip
+
+
+@sync
+async def test_u_on_a_sweep_whose_only_failures_are_no_law_fits_says_why_and_starts_nothing(folders, registry):
+    """A sweep whose points all ended, the second with no law (8 of 8 realizations finished):
+    u resumed it from the Run and Results tabs, computed nothing and failed again the same way."""
+    app = sweep_app(folders, registry, NO_LAW_SWEEP)
+    async with app.run_test(size=SIZE) as pilot:
+        await run_to_the_end(pilot)
+        out_dir = app.last_out_dir
+        before = {path: path.stat().st_mtime_ns for path in out_dir.rglob("*")}
+        footers, said = [], {}
+        for tab in ("f4", "f5"):
+            await press_settled(pilot, tab)
+            footers.append(screen_text(app).splitlines()[-1])
+            await press_settled(pilot, "u")
+            said[tab] = (status_text(app), app.running)
+        after = {path: path.stat().st_mtime_ns for path in out_dir.rglob("*")}
+    assert json.loads((out_dir / "sweep.json").read_text())["status"] == "failed"
+    assert all("Resume" not in footer for footer in footers), footers
+    for text, running in said.values():
+        assert not running and text.startswith(f"Cannot resume: {out_dir.name}: every point ended, and at 1 point all the "
+                                               "realizations finished but the fit failed: point 2: no law: every load"), text  # fmt: skip
+        assert "A resume computes nothing new and fails the same way" in text
+    assert after == before  # nothing started, nothing rewritten
+
+
+def test_a_sweep_with_a_point_that_can_go_on_stays_resumable(tmp_path, registry):
+    """Beside a point with no law, a point interrupted, in error or with a failed realization is
+    one a resume computes again: the sweep stays resumable (u offered, its points not refused)."""
+    from frictionlab.tui.folders import read_sweep
+
+    run_sweep(load_sweep(_written(tmp_path, NO_LAW_SWEEP), registry=registry), tmp_path / "sw", RunOptions(workers=1), plot=False)
+    entry = read_sweep(tmp_path / "sw")
+    assert entry.failed_for_good.startswith("point 2: no law: every load")
+    for status in ("interrupted", "error"):
+        entry = read_sweep(tmp_path / "sw")
+        entry.points[0]["status"] = status
+        assert entry.failed_for_good == "", status
+    summary_path = tmp_path / "sw" / entry.points[1]["folder"] / "summary.json"
+    summary = json.loads(summary_path.read_text())
+    summary["realizations"]["failed"] = 1
+    summary_path.write_text(json.dumps(summary))
+    assert read_sweep(tmp_path / "sw").failed_for_good == ""
+
+
+def _written(folder, data):
+    path = folder / "preset.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
 @pytest.mark.parametrize("failed", [0, 8])
 def test_a_run_whose_realizations_failed_stays_resumable(tmp_path, failed):
     """A run whose every realization failed (out of memory, say) has 8 of 8 done and an error too,

@@ -133,8 +133,8 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             return True
         if entry is None:
             return False
-        if action == "resume":  # not a run failed with every realization finished: it would fail so again
-            return entry.status in RESUMABLE and not (isinstance(entry, RunEntry) and entry.failed_for_good)
+        if action == "resume":  # not a run (nor a sweep's points) failed with every realization finished: it would fail so again
+            return entry.status in RESUMABLE and not entry.failed_for_good
         return not isinstance(entry, SweepEntry) and entry.status not in ("damaged", "running") and bool(entry.summary)
 
     def action_back_to_list(self) -> None:
