@@ -257,15 +257,16 @@ def process_limit() -> tuple[int, str] | None:
 
 
 def out_of_memory_loading(exc: BaseException) -> str | None:
-    """The library a process limit left no room to load, else None: an ``ImportError`` ('failed
-    to map segment', numpy's message quoting it), or under a limit a ``SystemError`` from an
-    import (a compiled module that could not allocate: 'error return without exception set')."""
+    """The library a process limit left no room to load, else None: an ``ImportError`` ('failed to map
+    segment'; numpy's message, scipy's 'install seems to be broken', quoting or raised from it), or
+    under a limit a ``SystemError`` ('error return without exception set') or ``MemoryError`` of an import."""
     match = re.search(r"([^\s/:]+\.so[\w.]*): failed to map segment", str(exc))
     if isinstance(exc, ImportError) and match:
         return match.group(1)
-    if isinstance(exc, SystemError) and process_limit() is not None:
+    if isinstance(exc, (SystemError, MemoryError)) and process_limit() is not None:
         return _package_being_imported(exc)
-    return None
+    cause = exc.__cause__ or exc.__context__
+    return out_of_memory_loading(cause) if isinstance(exc, ImportError) and cause is not None else None
 
 
 def _package_being_imported(exc: BaseException) -> str | None:

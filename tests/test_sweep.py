@@ -466,10 +466,14 @@ def test_the_table_after_a_sweep_says_why_a_point_failed_even_with_quiet(tmp_pat
     point.rename(elsewhere)
     point.symlink_to(elsewhere)
     assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 1
-    printed = capsys.readouterr().out
+    printed, said = capsys.readouterr()
     assert f"seed=1: error: {point} is a symbolic link or not a folder" in printed
     assert "seed=2: a = " in printed
     assert "(sweep.csv, points/)" in printed
+    # on stderr too, as a run's failure is: under --quiet it said nothing there, exit 1 (a sweep
+    # under ulimit -v whose second point was refused, in a script reading stderr)
+    assert said.startswith(f"error: 1 of 2 points failed; first: point 1: {point} is a symbolic link or not a folder")
+    assert f"`frictionlab resume {out}` computes the rest" in said
 
 
 @pytest.mark.parametrize("detach", [False, True])

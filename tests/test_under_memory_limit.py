@@ -221,22 +221,46 @@ def test_an_mdr_surface_whose_line_cannot_be_made_is_refused_and_the_side_offere
                "--no-plot", cwd=tmp_path))  # fmt: skip
 
 
-@pytest.mark.parametrize("limit_mib", [60, 100, 250])
+@pytest.mark.parametrize("limit_mib", [60, 80, 100, 250])
 @pytest.mark.parametrize("command", [["run", "quickstart", "--out", "run"], ["exact3d", "--quick", "--runs", "runs", "--workers", "1"]])
 def test_a_limit_too_small_to_load_or_run_is_said_and_never_hangs(tmp_path, command, limit_mib):
     """Under ulimit -v 250000 OpenBLAS's import reserved a buffer per core, found no room and spun
     for ever inside the import, deaf to SIGTERM (exact3d); or exited with 'OpenBLAS error: Memory
-    allocation still failed' (run); under 60000 a library that could not be mapped was an
-    'internal error ... (this is a bug)'. Each ends at once, saying the limit."""
+    allocation still failed' (run; under 80 MiB on one thread, its one buffer); under 60000 a
+    library that could not be mapped was an 'internal error ... (this is a bug)'. Each ends at
+    once, saying the limit."""
+    tight_run(command, limit_mib, tmp_path)
+
+
+def tight_run(command, limit_mib, cwd) -> subprocess.CompletedProcess:
+    """``frictionlab COMMAND --quiet`` under ``ulimit -v`` of ``limit_mib``: it must end at once,
+    exit 1, saying the limit, in no words of a library's or a traceback."""
     def tight():
         resource.setrlimit(resource.RLIMIT_AS, (limit_mib * 2**20,) * 2)
 
     env = {name: value for name, value in os.environ.items() if not name.endswith("_NUM_THREADS")}
     done = subprocess.run([sys.executable, "-m", "frictionlab", *command, "--quiet"], capture_output=True, text=True,
-                          cwd=tmp_path, timeout=120, preexec_fn=tight, env=env)  # fmt: skip
+                          cwd=cwd, timeout=60, preexec_fn=tight, env=env)  # fmt: skip
     assert done.returncode == 1, (done.returncode, done.stderr[-3000:])
     assert done.stderr.startswith("error: ") and "ulimit -v" in done.stderr, done.stderr[-3000:]
-    assert not any(word in done.stderr for word in ("OpenBLAS", "internal error", "Traceback"))
+    assert not any(word in done.stderr for word in ("OpenBLAS", "internal error", "Traceback", "not installed"))
+    return done
+
+
+@pytest.mark.parametrize("limit_mib", [130, 160])
+def test_an_instrument_file_whose_reader_cannot_load_is_said_as_the_limit_not_a_hang(tmp_path, limit_mib):
+    """Reading a NetCDF scan loads SurfaceTopography and with it scipy's OpenBLAS, whose work
+    buffer (32 MiB) is reserved as it loads. Under ulimit -v 163840 it found no room and spun
+    for ever inside the import; under 133120 a library of it that could not be mapped (scipy
+    raises it again as 'the install seems to be broken') was said 'instrument files are read by
+    the optional extra topography: pip install', exit 2, with the extra installed."""
+    from SurfaceTopography import Topography
+
+    z = np.random.default_rng(4).standard_normal((64, 64))
+    Topography(z, (16.0, 16.0), unit="um").to_netcdf(str(tmp_path / "scan.nc"))
+    preset = write(tmp_path, "scan", {**SMALL, "spectrum": {"name": "surface-file", "params": {"path": "scan.nc", "unit": "um"}}})
+    done = tight_run(["run", preset, "--no-plot", "--out", "run", "--workers", "1"], limit_mib, tmp_path)
+    assert "out of memory loading " in done.stderr and not (tmp_path / "run").exists()
 
 
 @pytest.mark.parametrize("workers", ["1", "2"])

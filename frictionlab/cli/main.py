@@ -33,7 +33,8 @@ import warnings
 from .. import __version__
 from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
                       out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
-from ..compute.heap import keep_freed_memory, one_blas_thread_unless_chosen, spare_address_space_under_a_limit
+from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, refuse_blas_without_room,
+                            spare_address_space_under_a_limit)  # fmt: skip
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
@@ -256,6 +257,7 @@ def program() -> None:
         gc.set_threshold(100_000, 20, 20)
     one_blas_thread_unless_chosen()  # before numpy is imported
     spare_address_space_under_a_limit()
+    refuse_blas_without_room()  # before numpy is imported
     for name in ("stdout", "stderr"):  # started with it closed (`>&-`): it writes nowhere, as to /dev/null
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
@@ -380,6 +382,9 @@ def _run_command(args) -> int:
             return _refused(args, too_long_path(exc.filename, known=True), ExitCode.USAGE)
         return _refused(args, f"{exc.strerror or exc}: {shown_name(exc.filename)}", ExitCode.RUNTIME_FAILURE)
     except MemoryError as exc:  # numpy could not allocate: the machine's limit, not a bug
+        library = out_of_memory_loading(exc)
+        if library is not None:  # the program itself does not fit: fewer points would not help
+            return _out_of_memory_loading(args, library)
         detail = f": {exc}" if str(exc) else ""
         message = f"out of memory{detail}; ask for fewer points, realizations or workers{limit_advice()}"
         folder = getattr(args, "out_dir", None)  # a run's folder, once made: what it holds is not lost
@@ -397,14 +402,18 @@ def _run_command(args) -> int:
             raise
         library = out_of_memory_loading(exc)
         if library is not None:  # a process limit too small to load numpy or scipy: not a bug either
-            return _refused(args, f"out of memory loading {library}{limit_advice().replace(', or raise', '; raise')}",
-                            ExitCode.RUNTIME_FAILURE)  # fmt: skip
+            return _out_of_memory_loading(args, library)
         missing = _missing_package(exc, f"frictionlab {args.command}") or _plugin_at_fault(exc)
         if missing is not None:
             return _refused(args, str(missing), missing.exit_code, f"{error_label()}: ")
         message = f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]}"
         return _refused(args, message, ExitCode.INTERNAL, "internal error: ",
                         suffix="\n(this is a bug; set FRICTIONLAB_DEBUG=1 for the traceback)")  # fmt: skip
+
+
+def _out_of_memory_loading(args, library: str) -> int:
+    return _refused(args, f"out of memory loading {library}{limit_advice().replace(', or raise', '; raise')}",
+                    ExitCode.RUNTIME_FAILURE)  # fmt: skip
 
 
 def _refused(args, message: str, code: int, label: str = "error: ", problems=None, suffix: str = "") -> int:

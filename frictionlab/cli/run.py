@@ -257,7 +257,13 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     if outcome.status == "interrupted":
         print(shown(f"  {resumable(out_dir)}"), file=sys.stderr)
         return interrupted_exit_code()
-    return ExitCode.RUNTIME_FAILURE if outcome.status == "failed" else ExitCode.OK
+    if outcome.status == "failed":  # said on stderr as a run's failure is, under --quiet and --json too
+        failed = [(point, result) for point, result in zip(sweep.points, outcome.results) if result.error]
+        first = f"; first: point {failed[0][0].number}: {failed[0][1].error}" if failed else ""
+        print(shown(f"error: {len(failed)} of {counted(len(sweep.points), 'point')} failed{first}; {resumable(out_dir)}"),
+              file=sys.stderr)  # fmt: skip
+        return ExitCode.RUNTIME_FAILURE
+    return ExitCode.OK
 
 
 def result_table(scene, outcome, out_dir: Path) -> str:

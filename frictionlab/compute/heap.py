@@ -76,3 +76,86 @@ def spare_address_space_under_a_limit() -> None:
     if not os.environ.get("MALLOC_ARENA_MAX"):
         os.environ["MALLOC_ARENA_MAX"] = str(ARENAS)  # children: glibc reads it as they start
         _mallopt(M_ARENA_MAX, ARENAS)  # this process, started already
+
+
+BLAS_BUFFER = 32 * 2**20  # the work buffer OpenBLAS allocates as it loads (33,558,528 bytes asked, seen under gdb)
+BLAS_SLACK = 8 * 2**20  # what else the load maps (a thread's stack, the loader's own tables)
+
+
+def refuse_blas_without_room() -> None:
+    """Under ``ulimit -v``, numpy's and scipy's OpenBLAS each load only where the address space
+    left holds it, its libraries and its work buffer; else the import raises ``BlasNoRoom``.
+    Where the buffer does not fit, OpenBLAS does not fail as an import does: scipy's spun for
+    ever inside the import (`run` of an instrument file under ulimit -v 163840 hung), numpy's
+    exited printing only 'OpenBLAS error: Memory allocation still failed'. Not on a system
+    without /proc (the room is read from /proc/self/statm)."""
+    limit = process_limit()
+    if limit is None or limit[1] != "-v" or not os.path.exists("/proc/self/statm"):
+        return
+    import sys
+
+    if not any(isinstance(finder, _BlasRoom) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _BlasRoom(limit[0]))
+
+
+class BlasNoRoom(ImportError):
+    """numpy's or scipy's OpenBLAS has no room to load under the process limit.
+    An ImportError, as a library that cannot be mapped is ('failed to map segment'); the CLI
+    says it as ``errors.out_of_memory_loading`` does, naming the library."""
+
+    def __init__(self, library: str, need: int, room: int):
+        self.library = library
+        super().__init__(f"{library}: failed to map segment from shared object (it needs about {need >> 20} MiB of "
+                         f"address space with its work buffer; {max(room, 0) >> 20} MiB is left)")  # fmt: skip
+
+
+class _BlasRoom:
+    """A finder on ``sys.meta_path`` that finds nothing itself: before each compiled module of
+    numpy or scipy loads, until that package's OpenBLAS is mapped, it checks the room."""
+
+    def __init__(self, limit: int):
+        self.limit = limit
+        self.waiting = {"numpy", "scipy"}  # packages whose OpenBLAS is not mapped yet
+
+    def find_spec(self, name, path=None, target=None):
+        package = name.partition(".")[0]
+        if package not in self.waiting or name == package:  # a package's __init__ is no compiled module
+            return None
+        from importlib.machinery import EXTENSION_SUFFIXES, PathFinder
+
+        spec = PathFinder.find_spec(name, path, target)
+        if spec is None or not spec.origin or not spec.origin.endswith(tuple(EXTENSION_SUFFIXES)):
+            return None  # left to the other finders
+        libs = _blas_libraries(spec.origin, package)
+        if not libs or _mapped(libs[0]):
+            self.waiting.discard(package)  # loaded (or none of its own): no more checks
+            return None
+        need = sum(os.path.getsize(lib) for lib in libs) + os.path.getsize(spec.origin) + BLAS_BUFFER + BLAS_SLACK
+        room = self.limit - _address_space()
+        if room < need:
+            raise BlasNoRoom(os.path.basename(libs[0]), need, room)
+        return None
+
+
+def _blas_libraries(origin: str, package: str) -> list[str]:
+    """The OpenBLAS a wheel of ``package`` brings (``numpy.libs/libscipy_openblas64_*.so``) first,
+    then the other libraries beside it; [] where it brings none (a system's BLAS)."""
+    origin = os.path.realpath(origin)  # as /proc/self/maps names what is mapped
+    at = origin.rfind(os.sep + package + os.sep)
+    folder = os.path.join(origin[:at], f"{package}.libs")
+    try:
+        names = sorted(os.listdir(folder), key=lambda name: "openblas" not in name) if at >= 0 else []
+    except OSError:  # no wheel's libraries beside it
+        return []
+    return [os.path.join(folder, name) for name in names] if names and "openblas" in names[0] else []
+
+
+def _mapped(library: str) -> bool:
+    with open("/proc/self/maps") as fh:
+        return any(line.endswith(library + "\n") for line in fh)
+
+
+def _address_space() -> int:
+    """This process's address space in bytes (what ``ulimit -v`` limits)."""
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")

@@ -151,3 +151,27 @@ def test_a_library_that_cannot_start_under_a_memory_limit_is_said_as_the_limit(t
     else:
         assert done.returncode == ExitCode.INTERNAL, done.stderr
         assert "internal error: SystemError: error return without exception set" in done.stderr
+
+
+@pytest.mark.parametrize("failure", ["MemoryError()", "ImportError('the install seems to be broken') from "
+                                     "ImportError('libfoo.so: failed to map segment from shared object')"],
+                         ids=["memory-error", "import-error-raised-from-a-library-not-mapped"])  # fmt: skip
+def test_a_library_that_runs_out_of_memory_as_it_loads_is_said_as_the_limit(tmp_path, failure):
+    """Under ulimit -v 102400 an import that ran out of memory was said 'out of memory; ask for
+    fewer points, realizations or workers' (of `validate`, `predict`: the program itself did
+    not fit); scipy's 'install seems to be broken', raised from a library that could not be
+    mapped, was an internal error (exit 70), or, reading an instrument file, 'not installed'."""
+    package = tmp_path / "lib" / "site-packages" / "pydantic"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text(f"raise {failure}\n")
+    code = (
+        "import resource; resource.setrlimit(resource.RLIMIT_AS, (1 << 45, resource.RLIM_INFINITY))\n"
+        f"import sys; sys.path.insert(0, {str(package.parent)!r})\n"
+        "from frictionlab.cli.main import main\n"
+        "sys.exit(main(['run', 'quickstart', '--no-plot', '--out', 'o']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert done.returncode == ExitCode.RUNTIME_FAILURE, done.stderr
+    library = "pydantic" if failure == "MemoryError()" else "libfoo.so"
+    assert done.stderr.startswith(f"error: out of memory loading {library}; raise the process limit (ulimit -v is "), done.stderr
+    assert "fewer points" not in done.stderr and "internal error" not in done.stderr and "Traceback" not in done.stderr
