@@ -42,7 +42,7 @@ from .instrument_reader import check_fill_room
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .reader_failures import reason_said
-from .text_table import first_not_finite, read_text_table
+from .text_table import blank_line_among_numbers, first_not_finite, read_text_table
 from .scan_shaping.filling import fill_harmonic
 from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
 from .scan_shaping.levelling import level_line, line_form_warning
@@ -196,6 +196,11 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
                          + (MAP_ADVICE if data.ndim == 2 else ""))
     data = read_text_table(path, where)
     if data.shape[1] == 1:
+        if data.shape[0] > 1 and (blank := blank_line_among_numbers(path, where)) is not None:
+            raise ValueError(f"{where}: line {blank} is empty, between heights: in a column of heights that is a "
+                             "point the export left out, and read past it every height after it would move one point "
+                             "along; write NaN there to mark it missing (undefined: harmonic fills it), or delete the "
+                             "line if no point is missing")  # fmt: skip
         return None, data[:, 0].copy()
     if data.shape[0] == 1 and data.shape[1] > 2:  # one row of heights (a map one pixel high, as surface-file says)
         return None, data[0].copy()
