@@ -78,6 +78,9 @@ def blank_line_among_numbers(path: Path, where: str) -> int | None:
     in a column of heights, a spreadsheet writes the cell it left empty (a point not measured)
     as such a line, which numpy skips, moving every height after it one point along."""
     with open_input(path, where) as fh:
+        if not _has_blank_line(fh):  # the common case, a pass over bytes: the lines are read only where one is
+            return None
+        fh.seek(0)
         blank, numbers_before = None, False
         for lineno, raw in enumerate(io.TextIOWrapper(fh, encoding="utf-8-sig", errors="replace"), start=1):
             if not raw.strip():
@@ -89,6 +92,21 @@ def blank_line_among_numbers(path: Path, where: str) -> int | None:
                     return blank
                 numbers_before = True
     return None
+
+
+_BLANK_LINE = re.compile(rb"\n[ \t]*\r?\n|\r[ \t]*\r")  # after LF or CRLF, or in a file of CR line ends
+
+
+def _has_blank_line(fh) -> bool:
+    """Whether the open binary file holds an empty (or whitespace) line, read a chunk at a time."""
+    tail = b""
+    while chunk := fh.read(1 << 20):
+        text = tail + chunk
+        if _BLANK_LINE.search(text):
+            return True
+        end = max(text.rfind(b"\n"), text.rfind(b"\r"))
+        tail = text[end:] if end >= 0 and not text[end + 1 :].strip() else b""  # a blank line cut by the chunk's end
+    return False
 
 
 def not_utf8(where: str, line: int) -> str:
