@@ -196,6 +196,22 @@ def test_a_bad_cell_past_the_first_line_is_named_by_its_column_and_an_empty_one_
             plugin(path=str(tmp_path / "bad.csv"), spacing=0.1).rms_height()
 
 
+def test_an_empty_line_among_a_columns_heights_is_a_point_left_out_not_skipped(tmp_path):
+    """A column of heights with an empty line among them (a spreadsheet's empty cell: a point not
+    measured) was read without that line: 39 points, each after it one point along. Empty lines
+    before or after the heights, and the same column written with NaN, are read as they were."""
+    z = rough(1, 40, 8)[0]
+    rows = [repr(float(v)) for v in z]
+    path = tmp_path / "gap.csv"
+    path.write_text("\n".join([*rows[:11], "", *rows[12:]]) + "\n")
+    with pytest.raises(ValueError, match=r"line 12 is empty, between heights: .* write NaN there to mark it missing"):
+        ProfileFile(path=str(path), spacing=0.1).rms_height()
+    path.write_text("z\n\n" + "\n".join(rows) + "\n\n\n")
+    assert ProfileFile(path=str(path), spacing=0.1).generate(None).heights.size == 40
+    path.write_text("\n".join([*rows[:11], "nan", *rows[12:]]) + "\n")
+    assert ProfileFile(path=str(path), spacing=0.1, undefined="harmonic").generate(None).heights.size == 40
+
+
 @pytest.mark.parametrize("separator", [";", "\t"])
 def test_decimal_commas_are_named(tmp_path, separator):
     """At their first line: the first was skipped as a header, and line 2 named."""

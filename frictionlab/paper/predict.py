@@ -33,7 +33,7 @@ import numpy as np
 
 from ..arguments import path_argument
 from ..errors import FrictionlabError, RunFolderError, command_word, short_repr, shown_name
-from ..compute.fit import LogFit, format_interval, format_number, percentile_interval, resample_pairs
+from ..compute.fit import LogFit, fit_log_law, format_interval, format_number, percentile_interval, resample_pairs
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
 from ..runs.results import read_curve, read_summary
@@ -282,6 +282,7 @@ def read_run_law(
     pairs = _pairs_of(summary, law, xi, f)
     _check_law_within(pairs, law, path)
     _check_intervals_redrawn(pairs, law, path)
+    _check_law_refitted(xi, f, law, path)
     return law, (float(np.min(f)), float(np.max(f))), pairs
 
 
@@ -329,6 +330,22 @@ def _check_intervals_redrawn(pairs: np.ndarray | None, law: LogFit, path: Path) 
                 f"{shown_name(path)}: fit.{name}_ci = [{stored[0]:.6g}, {stored[1]:.6g}] is not the interval of its "
                 f"{len(pairs)} bootstrap resamples redrawn from realizations.npz ([{redrawn[0]:.6g}, {redrawn[1]:.6g}]): "
                 "the two files disagree (one was edited or damaged); run it again, or give the law by hand with --a/--b"
+            )
+
+
+def _check_law_refitted(xi: np.ndarray, f: np.ndarray, law: LogFit, path: Path) -> None:
+    """summary.json's a and b are the fit of realizations.npz's mean curve, refitted here to
+    rounding: with fewer than CHECKED_RESAMPLES resamples (or none) an edited a or b was
+    taken as the run's (a = 1e30 predicted xi = 1e30 with the run's interval beside it)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        refit = fit_log_law(f, xi, bootstrap=0)
+    scale = max(abs(refit.a), abs(refit.b))
+    for name, stored, value in (("a", law.a, refit.a), ("b", law.b, refit.b)):
+        if not math.isclose(stored, value, rel_tol=1e-6, abs_tol=1e-9 * scale):
+            raise RunFolderError(
+                f"{shown_name(path)}: fit.{name} = {stored:.6g} is not the fit of realizations.npz's mean curve "
+                f"({name} = {value:.6g}): the two files disagree (one was edited or damaged); run it again, or give "
+                "the law by hand with --a/--b"
             )
 
 

@@ -179,7 +179,7 @@ def _npy_line_points(shape: tuple[int, ...]) -> int | None:
 
 def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
     """(x or None, z) as float64 arrays, from a .npy or a text file."""
-    from .text_table import read_text_table
+    from .text_table import blank_line_among_numbers, read_text_table
 
     where = f"profile-file {str(path)!r}"
     suffix = file_suffix(path, where)
@@ -197,6 +197,11 @@ def _read_columns(path: Path) -> tuple[np.ndarray | None, np.ndarray]:
                          + (MAP_ADVICE if data.ndim == 2 else ""))
     data = read_text_table(path, where)
     if data.shape[1] == 1:
+        if data.shape[0] > 1 and (blank := blank_line_among_numbers(path, where)) is not None:
+            raise ValueError(f"{where}: line {blank} is empty, between heights: in a column of heights that is a "
+                             "point the export left out, and read past it every height after it would move one point "
+                             "along; write NaN there to mark it missing (undefined: harmonic fills it), or delete the "
+                             "line if no point is missing")  # fmt: skip
         return None, data[:, 0].copy()
     if data.shape[0] == 1 and data.shape[1] > 2:  # one row of heights (a map one pixel high, as surface-file says)
         return None, data[0].copy()

@@ -73,6 +73,42 @@ def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple
     return None
 
 
+def blank_line_among_numbers(path: Path, where: str) -> int | None:
+    """The first blank line (from 1) between two lines of numbers of a text table, else None:
+    in a column of heights, a spreadsheet writes the cell it left empty (a point not measured)
+    as such a line, which numpy skips, moving every height after it one point along."""
+    with open_input(path, where) as fh:
+        if not _has_blank_line(fh):  # the common case, a pass over bytes: the lines are read only where one is
+            return None
+        fh.seek(0)
+        blank, numbers_before = None, False
+        for lineno, raw in enumerate(io.TextIOWrapper(fh, encoding="utf-8-sig", errors="replace"), start=1):
+            if not raw.strip():
+                blank = blank or (lineno if numbers_before else None)
+                continue
+            text = raw.split("#", 1)[0].strip()
+            if text and _numbers(text, _delimiter(text)):
+                if blank is not None:
+                    return blank
+                numbers_before = True
+    return None
+
+
+_BLANK_LINE = re.compile(rb"\n[ \t]*\r?\n|\r[ \t]*\r")  # after LF or CRLF, or in a file of CR line ends
+
+
+def _has_blank_line(fh) -> bool:
+    """Whether the open binary file holds an empty (or whitespace) line, read a chunk at a time."""
+    tail = b""
+    while chunk := fh.read(1 << 20):
+        text = tail + chunk
+        if _BLANK_LINE.search(text):
+            return True
+        end = max(text.rfind(b"\n"), text.rfind(b"\r"))
+        tail = text[end:] if end >= 0 and not text[end + 1 :].strip() else b""  # a blank line cut by the chunk's end
+    return False
+
+
 def not_utf8(where: str, line: int) -> str:
     return (f"{where}: not UTF-8 at line {line} (text in another encoding, as a Latin-1 header's µ or UTF-16's NUL "
             "bytes, or no text); an instrument's export (a profilometer's .csv) is read with format: instrument; a "

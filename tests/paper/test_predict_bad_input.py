@@ -13,9 +13,11 @@ import numpy as np
 import pytest
 
 from frictionlab.cli import main
+from frictionlab.compute.fit import percentile_interval, resample_pairs
 from frictionlab.errors import ExitCode
 from frictionlab.options import RunOptions
 from frictionlab.preset import build_scene
+from frictionlab.preset.seeds import bootstrap_rng
 from frictionlab.runs.runner import run_to_folder
 
 from ..conftest import SMALL_PRESET, merge
@@ -135,16 +137,34 @@ def test_a_fit_field_of_the_wrong_type_or_range(run_copy, capsys, field, value):
 @pytest.mark.parametrize("field", ["a", "b"])
 def test_a_law_edited_beyond_its_own_resamples_is_refused(run_copy, capsys, field):
     """A fit.a (or b) far from what realizations.npz gives, intervals untouched: the
-    prediction would be no run's. Refused naming the field and the span of its resamples;
-    a value within that span (edited or not) is not told from the run's own."""
+    prediction would be no run's. Refused naming the field and the span of its resamples."""
     summary = json.loads((run_copy / "summary.json").read_text())
     low, high = summary["fit"][f"{field}_ci"]
     edit_summary(run_copy, lambda s: s["fit"].update({field: high + 100 * (high - low) + 1.0}))
     code, _, err = predict_from(run_copy, capsys)
     assert code == ExitCode.RUN_FOLDER
     assert f"fit.{field} = " in err and "outside all 200 of its bootstrap resamples" in err, err
-    edit_summary(run_copy, lambda s: s["fit"].update({field: (low + high) / 2}))
-    assert predict_from(run_copy, capsys)[0] == 0
+
+
+@pytest.mark.parametrize("field", ["a", "b"])
+@pytest.mark.parametrize("where", ["among its resamples", "with few resamples"])
+def test_a_law_edited_is_refused_as_not_the_fit_of_its_realizations(run_copy, capsys, field, where):
+    """A fit.a (or b) edited to a value among its resamples, or in a run of fewer than 100
+    resamples (whose span says nothing: a = 1e30 gave xi = 1e30 beside the run's interval),
+    was taken as the run's law: it is refitted from realizations.npz, to rounding."""
+    summary = json.loads((run_copy / "summary.json").read_text())
+    low, high = summary["fit"][f"{field}_ci"]
+    if where == "among its resamples":
+        edit_summary(run_copy, lambda s: s["fit"].update({field: (low + high) / 2}))
+    else:  # the run's 20 resamples, the interval they give, and a forged a or b
+        pairs = resample_pairs(np.load(run_copy / "realizations.npz")["f"], np.load(run_copy / "realizations.npz")["xi"],
+                               20, bootstrap_rng(summary["seed"]))  # fmt: skip
+        ci = percentile_interval(pairs, summary["fit"]["confidence"], axis=0)
+        edit_summary(run_copy, lambda s: s["fit"].update({"bootstrap": 20, field: 1e30, "a_ci": [ci[0][0], ci[1][0]],
+                                                          "b_ci": [ci[0][1], ci[1][1]]}))  # fmt: skip
+    code, out, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER and not out
+    assert f"fit.{field} = " in err and "is not the fit of realizations.npz's mean curve" in err, err
 
 
 def test_a_summary_without_a_fit(run_copy, capsys):
