@@ -70,6 +70,18 @@ async def test_a_run_with_no_law_says_so_once_not_no_realization_yet(folders, re
     assert len(series) == 1  # the mean curve alone, no fitted line
 
 
+async def u_on_the_run_and_results_tabs(pilot, app) -> tuple[list[str], list[tuple[str, bool]]]:
+    """The footer of the Run (F4) and Results (F5) tabs, and what ``u`` said on each (the status
+    line, and whether a run started)."""
+    footers, said = [], []
+    for tab in ("f4", "f5"):
+        await press_settled(pilot, tab)
+        footers.append(screen_text(app).splitlines()[-1])
+        await press_settled(pilot, "u")
+        said.append((status_text(app), app.running))
+    return footers, said
+
+
 @sync
 async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_nothing(folders, registry):
     """In tmux: u on a run that failed with no law (its 8 of 8 realizations finished) resumed it,
@@ -80,15 +92,10 @@ async def test_u_on_a_run_with_no_law_says_why_a_resume_cannot_help_and_starts_n
         await run_to_the_end(pilot)
         out_dir = app.last_out_dir
         before = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
-        footers, said = [], {}
-        for tab in ("f4", "f5"):
-            await press_settled(pilot, tab)
-            footers.append(screen_text(app).splitlines()[-1])
-            await press_settled(pilot, "u")
-            said[tab] = (status_text(app), app.running)
+        footers, said = await u_on_the_run_and_results_tabs(pilot, app)
         after = {path.name: path.stat().st_mtime_ns for path in out_dir.iterdir()}
     assert all("Resume" not in footer for footer in footers), footers
-    for text, running in said.values():
+    for text, running in said:
         assert not running and text.startswith(f"Cannot resume: {out_dir.name} failed with all its 8 realizations "
                                                "finished: no law: every load"), text  # fmt: skip
         assert "A resume computes nothing new and fails the same way" in text and "raise the loads" in text
@@ -108,16 +115,11 @@ async def test_u_on_a_sweep_whose_only_failures_are_no_law_fits_says_why_and_sta
         await run_to_the_end(pilot)
         out_dir = app.last_out_dir
         before = {path: path.stat().st_mtime_ns for path in out_dir.rglob("*")}
-        footers, said = [], {}
-        for tab in ("f4", "f5"):
-            await press_settled(pilot, tab)
-            footers.append(screen_text(app).splitlines()[-1])
-            await press_settled(pilot, "u")
-            said[tab] = (status_text(app), app.running)
+        footers, said = await u_on_the_run_and_results_tabs(pilot, app)
         after = {path: path.stat().st_mtime_ns for path in out_dir.rglob("*")}
     assert json.loads((out_dir / "sweep.json").read_text())["status"] == "failed"
     assert all("Resume" not in footer for footer in footers), footers
-    for text, running in said.values():
+    for text, running in said:
         assert not running and text.startswith(f"Cannot resume: {out_dir.name}: every point ended, and at 1 point all the "
                                                "realizations finished but the fit failed: point 2: no law: every load"), text  # fmt: skip
         assert "A resume computes nothing new and fails the same way" in text
