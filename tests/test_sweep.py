@@ -686,3 +686,25 @@ def test_a_point_resumed_while_its_sweep_is_held_says_how_to_update_the_tables(t
     assert f"the tables of the sweep in {tmp_path}/ are not updated with this point ({tmp_path} is in use by another run" in err
     assert f"`frictionlab resume {tmp_path}` writes them (and runs what is unfinished)" in err
     assert (tmp_path / "sweep.csv").read_bytes() == before
+
+
+def test_a_sweep_failed_by_a_points_failed_realizations_says_which_on_stderr(tmp_path, capsys, monkeypatch):
+    """A point that completed with some realizations failed (out of memory, say) makes its sweep
+    failed: stderr said '0 of 2 points failed', counting only the points with an error."""
+    import frictionlab.runs.sweep as sweep_module
+
+    real = sweep_module.run_sweep
+
+    def with_a_failed_realization(sweep, out_dir, *args, **kwargs):
+        outcome = real(sweep, out_dir, *args, **kwargs)
+        outcome.results[1].outcome.failures = [(3, "MemoryError: a test's")]
+        sweep_module._finish(sweep, outcome, out_dir, plot=False)
+        return outcome
+
+    monkeypatch.setattr(sweep_module, "run_sweep", with_a_failed_realization)
+    preset = write(tmp_path, sweep_preset({"seed": {"values": [1, 2]}}))
+    out = tmp_path / "out"
+    assert main(["run", str(preset), "--out", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 1
+    said = capsys.readouterr().err
+    assert said.startswith("error: 1 of 2 points failed; first: point 2: 1 realization failed, the first: "
+                           "MemoryError: a test's"), said

@@ -258,8 +258,8 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
         print(shown(f"  {resumable(out_dir)}"), file=sys.stderr)
         return interrupted_exit_code()
     if outcome.status == "failed":  # said on stderr as a run's failure is, under --quiet and --json too
-        failed = [(point, result) for point, result in zip(sweep.points, outcome.results) if result.error]
-        first = f"; first: point {failed[0][0].number}: {failed[0][1].error}" if failed else ""
+        failed = [result for result in outcome.results if result.failure]
+        first = f"; first: point {failed[0].point.number}: {failed[0].failure}" if failed else ""
         print(shown(f"error: {len(failed)} of {counted(len(sweep.points), 'point')} failed{first}; {resumable(out_dir)}"),
               file=sys.stderr)  # fmt: skip
         return ExitCode.RUNTIME_FAILURE

@@ -27,8 +27,8 @@ from typing import Any
 from pydantic import BaseModel
 
 from ..compute.dask_session import one_dask_cluster
-from ..errors import (FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, command_word, short_repr,
-                      shown_name)  # fmt: skip
+from ..errors import (FrictionlabError, OutputRefused, PresetError, RunError, RunFolderError, command_word, counted,
+                      short_repr, shown_name)  # fmt: skip
 from ..compute.fit import LogFit, json_safe
 from ..plugin.listeners import SweepListener
 from ..options import RunOptions
@@ -269,6 +269,15 @@ class PointResult:
     recorded: dict[str, Any] | None = None  # a row read back (a followed sweep's): stands for ``outcome``
 
     @property
+    def failure(self) -> str:
+        """Why this point makes its sweep failed, "" where it does not: its error (a point failed
+        or in error), or its realizations that failed (a point completed without them)."""
+        if self.status in ("failed", "error"):
+            return self.error or self.status
+        failures = self.outcome.failures if self.outcome is not None else ()
+        return f"{counted(len(failures), 'realization')} failed, the first: {failures[0][1]}" if failures else ""
+
+    @property
     def fit(self) -> LogFit | None:
         """The point's fit of xi = a + b ln f; None where it has none (or only a row read back)."""
         return None if self.outcome is None else self.outcome.fit
@@ -418,7 +427,7 @@ def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, inte
     statuses = {r.status for r in outcome.results}
     if interrupted or statuses & {"interrupted", "cancelled"} or "pending" in statuses:
         outcome.status = "interrupted"
-    elif statuses & {"failed", "error"} or any(r.outcome is not None and r.outcome.failures for r in outcome.results):
+    elif any(result.failure for result in outcome.results):
         outcome.status = "failed"
     else:
         outcome.status = "completed"
