@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 
 from frictionlab import InputFileProblem, open_regular_file
-from frictionlab.errors import out_of_memory_loading
 from frictionlab.plugin import MAX_MAGNITUDE
 
 from .channel_choice import pick_channel
@@ -118,13 +117,23 @@ def _require_extra(path: Path, where: str) -> None:
     try:
         import SurfaceTopography.IO  # noqa: F401
     except ImportError as exc:
-        if out_of_memory_loading(exc) is not None:  # installed, but a library of it found no room: said so
+        if _no_room(exc):  # installed, but under ulimit -v a library of it found no room: said as such
             raise
         raise ValueError(
             f"{where}: {path.suffix or 'a file without suffix'} is read as an instrument file; instrument "
             f"files (X3P, SUR, DATX, OPD, IBW, NetCDF...) are read by the optional extra topography: "
             f"{TOPOGRAPHY_EXTRA}"
         ) from None
+
+
+def _no_room(exc: BaseException | None) -> bool:
+    """Whether an import failed for want of address space (a library's 'failed to map segment',
+    which scipy raises again as 'the install seems to be broken'), not for want of the package."""
+    while exc is not None:
+        if "failed to map segment" in str(exc):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 @contextmanager
