@@ -14,6 +14,7 @@ from frictionlab.cli import main
 from frictionlab.errors import ExitCode
 from frictionlab.exact3d.plan import BROAD_HURSTS, HURSTS, QUICK, TIME_FILE, preset_name
 from frictionlab.exact3d.report import FIGURES, FIGURES_DIR, PAGE
+from frictionlab.runs.rundir import RunDirectory
 
 from ..conftest import PRESETS
 
@@ -135,11 +136,15 @@ def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(qui
     chunks = {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")}
     (runs / "notes.txt").write_text("mine")  # read only: a user's file beside the runs was refused (exit code 4)
     timed = (runs / TIME_FILE).read_bytes(), (runs / TIME_FILE).stat().st_mtime_ns  # and the time file was rewritten
+    files = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file()}
     args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / "page"), "--runs", str(runs),
             "--finished-only", "--quiet"]  # fmt: skip
-    assert main(args) == ExitCode.OK
+    with RunDirectory(runs / "h0.8-n128-bem-halfspace"):  # another process's hold on a finished one: read without its lock
+        assert main(args) == ExitCode.OK
     text = (tmp_path / "page" / PAGE).read_text()
     assert {p: p.stat().st_mtime_ns for p in runs.rglob("chunks/*")} == chunks  # nothing computed
+    assert {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file()} == files  # nothing of the runs written
+    assert "H = 0.8, 128² px, exact" not in text  # the held one is read as finished, not listed as not run
     assert ((runs / TIME_FILE).read_bytes(), (runs / TIME_FILE).stat().st_mtime_ns) == timed  # nothing written
     assert (runs / "notes.txt").read_text() == "mine"
     assert not (runs / "h0.3-n128-bem-halfspace").exists()
@@ -216,9 +221,12 @@ def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, tmp_p
     assert main(args) == ExitCode.OUTPUT_REFUSED
     assert "--force" in capsys.readouterr().err
     assert (quick_study / PAGE).read_text() == before
-    chunks = {p: p.stat().st_mtime_ns for p in (quick_study / "runs").rglob("chunks/*")}
-    assert main([*args, "--force"]) == ExitCode.OK
-    assert {p: p.stat().st_mtime_ns for p in (quick_study / "runs").rglob("chunks/*")} == chunks  # nothing recomputed
+    runs = quick_study / "runs"
+    files = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file() and p.name != TIME_FILE}
+    with RunDirectory(runs / "h0.8-n128-bem-halfspace"):  # another process's hold on a finished one: read without its lock
+        assert main([*args, "--force"]) == ExitCode.OK
+    # nothing of the runs was written, the held one's included: read back, not resumed
+    assert {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file() and p.name != TIME_FILE} == files
     after = (quick_study / PAGE).read_text()
     tables = lambda text: [line for line in text.splitlines() if line.startswith("| ")]
     # the same numbers, compute times included: they are the runs' own, read back with them
@@ -256,28 +264,6 @@ def test_a_presets_folder_without_the_family_is_named_and_refused(tmp_path, caps
     assert "--presets" in err and "exact3d-h03.yaml" in err and str(tmp_path) in err
     assert not (tmp_path / "out").exists()
     assert not (tmp_path / "runs").exists()  # refused before a default runs folder is made
-
-
-def test_finished_ensembles_are_read_without_their_lock_beside_a_process_that_holds_it(quick_study, tmp_path):
-    import shutil
-
-    from frictionlab.runs.rundir import RunDirectory
-
-    runs = tmp_path / "runs"
-    shutil.copytree(quick_study / "runs", runs)
-    files = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file()}
-    busy = runs / "h0.8-n128-bem-halfspace"
-    with RunDirectory(busy):  # another process's hold on it, as a --finished-only page or a study takes
-        for extra in (["--finished-only"], ["--force", "--workers", "1"]):
-            args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / extra[0].strip("-")),
-                    "--runs", str(runs), "--quiet", *extra]  # fmt: skip
-            assert main(args) == ExitCode.OK
-    # nothing of the runs was written: read back, not resumed
-    after = {p: p.stat().st_mtime_ns for p in runs.rglob("*") if p.is_file() and p.name != "exact3d-time.json"}
-    assert after == {p: t for p, t in files.items() if p.name != "exact3d-time.json"}
-    tables = lambda text: [line for line in text.splitlines() if line.startswith("| ")]
-    original = tables((quick_study / PAGE).read_text())
-    assert tables((tmp_path / "force" / PAGE).read_text()) == original  # the same numbers, the held one's included
 
 
 def test_a_broken_preset_of_a_later_h_is_refused_before_any_ensemble_runs(tmp_path, capsys):

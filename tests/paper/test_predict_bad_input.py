@@ -137,13 +137,27 @@ def test_a_fit_field_of_the_wrong_type_or_range(run_copy, capsys, field, value):
 @pytest.mark.parametrize("field", ["a", "b"])
 def test_a_law_edited_beyond_its_own_resamples_is_refused(run_copy, capsys, field):
     """A fit.a (or b) far from what realizations.npz gives, intervals untouched: the
-    prediction would be no run's. Refused naming the field and the span of its resamples."""
+    prediction would be no run's. Refused naming the field, what was stored and the refit."""
     summary = json.loads((run_copy / "summary.json").read_text())
     low, high = summary["fit"][f"{field}_ci"]
     edit_summary(run_copy, lambda s: s["fit"].update({field: high + 100 * (high - low) + 1.0}))
     code, _, err = predict_from(run_copy, capsys)
     assert code == ExitCode.RUN_FOLDER
-    assert f"fit.{field} = " in err and "outside all 200 of its bootstrap resamples" in err, err
+    forged = high + 100 * (high - low) + 1.0
+    assert f"fit.{field} = {forged:.6g} is not the fit of realizations.npz's mean curve ({field} = " in err, err
+
+
+@pytest.mark.parametrize("field", ["a", "b"])
+def test_an_interval_edited_is_refused_as_not_its_resamples(run_copy, capsys, field):
+    """A fit.a_ci (or b_ci) widened, the law untouched: the interval printed beside the
+    prediction would be no run's. Refused naming the field, what was stored and the redrawn one."""
+    summary = json.loads((run_copy / "summary.json").read_text())
+    low, high = summary["fit"][f"{field}_ci"]
+    wider = [low - (high - low), high + (high - low)]
+    edit_summary(run_copy, lambda s: s["fit"].update({f"{field}_ci": wider}))
+    code, out, err = predict_from(run_copy, capsys)
+    assert code == ExitCode.RUN_FOLDER and not out
+    assert f"fit.{field}_ci = [{wider[0]:.6g}, {wider[1]:.6g}] is not the interval of its 200 bootstrap resamples" in err, err
 
 
 @pytest.mark.parametrize("field", ["a", "b"])
@@ -240,7 +254,7 @@ def _one_xi_negative(path):  # an rms slope over another is never below 0: a fil
         np.savez(fh, **arrays)
 
 
-def _one_xi_huge(path):  # finite and >= 0, a and b still among the resamples: the interval of xi went to 1e306
+def _one_xi_huge(path):  # finite and >= 0, a and b still among the resamples: the interval of xi went to 1e306, now refitted
     with np.load(path) as data:
         arrays = dict(data)
     arrays["xi"][0, 0] = 1e308
@@ -314,7 +328,7 @@ def _folder(path):
         (_all_nan, "'xi' must hold finite numbers, or NaN where a line has no xi, with xi defined at two loads or "
                    "more (no line has xi at "),  # said as it is: it once said "(0 of ... are infinite)"
         (_one_xi_negative, "'xi' must hold numbers >= 0, or NaN where a line has no xi (1 of "),
-        (_one_xi_huge, "is not the interval of its 200 bootstrap resamples redrawn from realizations.npz"),
+        (_one_xi_huge, "is not the fit of realizations.npz's mean curve (a = "),
         (_f_not_positive, "'f' must hold finite numbers > 0"),
         (_xi_of_other_shape, "one per load step"),
         (_xi_as_text, "'xi' must be 2-D numbers"),
