@@ -351,3 +351,34 @@ async def test_down_and_up_in_a_field_go_to_the_field_below_and_above(folders, r
     assert below is realizations and realizations.value == "12" and above is seed
     assert past_choice is not choice and isinstance(past_choice, Input) and not opened
     assert isinstance(on_form, PresetForm)
+
+
+@sync
+async def test_going_into_a_field_and_out_restyles_the_form_alone_and_leaves_every_style_as_a_whole_restyle(
+    folders, registry, monkeypatch
+):
+    """Enter into a field and Esc back out restyled the form and every one of its hundreds of
+    widgets (Textual's default on a focus change: 0.1 s a key here). Only the form is, since
+    no rule styles a field by the form's focus; were one added, the styles would differ
+    from a whole restyle's, and this test says so."""
+    from textual.css.stylesheet import Stylesheet
+
+    restyled = []
+    apply = Stylesheet.apply
+    monkeypatch.setattr(Stylesheet, "apply", lambda self, node, *a, **k: restyled.append(node) or apply(self, node, *a, **k))
+
+    def styles(app):
+        return {id(node): (type(node).__name__, node.styles.base.get_rules()) for node in app.screen.walk_children(with_self=True)}
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        in_form = len(list(form.walk_children()))
+        for key in ("enter", "escape", "enter", "escape", "enter"):
+            restyled.clear()
+            await press_settled(pilot, key)
+            assert (app.focused is form) == (key == "escape")
+            assert 0 < len(restyled) < in_form / 2, (key, len(restyled), in_form)
+            kept = styles(app)
+            app.stylesheet.update(app.screen)  # the whole screen restyled, as Textual would have
+            assert styles(app) == kept, key

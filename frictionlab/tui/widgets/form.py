@@ -99,6 +99,12 @@ class PresetForm(VerticalScroll):
         self._marked: dict[str, list[str]] = {}  # widget id -> the messages shown under it
         self._last_field: Widget | None = None  # the field Enter goes back into
 
+    def watch_has_focus(self, _has_focus: bool) -> None:
+        # Textual restyles a widget and every widget in it when its focus changes; no rule
+        # styles a field by the form's focus, so the form alone is restyled, not its hundreds
+        # of fields (a tenth of a second each time Enter goes into a field or Esc comes out)
+        self.app.stylesheet.update_nodes([self], animate=True)
+
     # ------------------------------------------------------------ building
 
     async def load(self, data: dict, base_dir: Path | None = None) -> None:
