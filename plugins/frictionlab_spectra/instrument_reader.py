@@ -26,6 +26,9 @@ BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary va
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
 GSF_MAGIC = b"Gwyddion Simple Field"  # a Gwyddion export no reader of the extra reads
+# the first bytes of formats whose reader states no magic (it answers 'maybe' to any file): a
+# Nanoscope header's first section (binary data: \*; data as text: ?*), under .di, .spm or .000
+HEADER_MAGIC = {"di": (b"\\*File list", b"\\*EC File list", b"?*File list", b"?*EC File list")}
 # numpy, MATLAB and HDF5 files hold bare arrays, without axes: a map there is z[row, column] =
 # z[y, x], as a .npy map and as numpy saves it (SurfaceTopography takes their first index as x)
 BARE_ARRAY_FORMATS = ("npz", "mat", "h5")
@@ -41,7 +44,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     fh.seek(0)
     head = fh.read(MAGIC_BYTES)
     fh.seek(0)
-    matches = [reader for reader in readers if reader.can_read(head) == MagicMatch.YES]
+    matches = [reader for reader in readers
+               if reader.can_read(head) == MagicMatch.YES or head.startswith(HEADER_MAGIC.get(reader.format(), ()))]
     if not matches and (head.startswith(GSF_MAGIC) or path_suffix == "gsf"):  # under any suffix: not text, no reader
         raise ValueError(
             f"{where}: a Gwyddion Simple Field (.gsf) file, a format SurfaceTopography does not read (renaming it would "
