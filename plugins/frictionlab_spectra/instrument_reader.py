@@ -17,7 +17,9 @@ import os
 import re
 import zipfile
 
-from .header_units import NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units
+from .header_units import (
+    NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units, stated_extent,
+)
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
@@ -108,8 +110,13 @@ def parses_text(reader, file) -> bool:
 def _coordinate_rows(fh) -> bool:
     """Whether a text file's first row of numbers (whole within its ``head_text``) holds two or
     three: x, z or x, y, z per point, which SurfaceTopography's matrix reader, chosen by the
-    suffix .txt, took for a map two or three pixels wide."""
-    for line in head_text(fh).splitlines()[:-1]:  # the last line may be cut short
+    suffix .txt, took for a map two or three pixels wide. Not under a header that states the
+    map's width and height (Gwyddion's export of a matrix, however narrow: its XYZ reader refused
+    it, and the file was called damaged)."""
+    text = head_text(fh)
+    if len(stated_extent(text)) == 2:
+        return False
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
     return False
