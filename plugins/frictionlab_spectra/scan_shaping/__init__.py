@@ -16,6 +16,6 @@ from .spikes import despike, line_spike_warning, spike_warning
 
 __all__ = [
     "FLAT", "LEVELS", "Levelling", "cosine_resample", "despike", "edge_lines_warning", "fill_harmonic",
-    "flat_neighbours_warning", "flat_rms", "level", "level_line", "levelling_warning", "line_form_warning", "line_offset_warning", "line_spike_warning",
-    "outlier_warning", "resampled_points", "spike_warning",
+    "flat_neighbours_warning", "flat_rms", "level", "level_line", "levelling_warning", "line_form_warning",
+    "line_offset_warning", "line_spike_warning", "outlier_warning", "resampled_points", "spike_warning",
 ]  # fmt: skip
