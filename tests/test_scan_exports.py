@@ -16,10 +16,11 @@ def rough(ny: int, nx: int, seed: int = 1) -> np.ndarray:
     return np.random.default_rng(np.random.SeedSequence(seed)).normal(size=(ny, nx))
 
 
-def gwyddion_matrix(path, z_um: np.ndarray, pixel_um: tuple[float, float]):
-    """Gwyddion's 'ASCII data matrix' export: the scan's width and height in its header, heights in um."""
+def gwyddion_matrix(path, z_um: np.ndarray, pixel_um: tuple[float, float], words=("Width", "Height")):
+    """Gwyddion's 'ASCII data matrix' export: the scan's width and height in its header (by the
+    ``words`` of its language), heights in um."""
     ny, nx = z_um.shape
-    header = (f"# Channel: Height\n# Width: {nx * pixel_um[0]:.3f} µm\n# Height: {ny * pixel_um[1]:.3f} µm\n"
+    header = (f"# Channel: Height\n# {words[0]}: {nx * pixel_um[0]:.3f} µm\n# {words[1]}: {ny * pixel_um[1]:.3f} µm\n"
               "# Value units: µm\n")  # fmt: skip
     path.write_text(header + "".join("\t".join(f"{v:.6e}" for v in row) + "\n" for row in z_um), encoding="utf-8")
     return path
@@ -41,6 +42,28 @@ def test_a_table_whose_header_states_an_oblong_pixel_is_not_squared_without_a_wo
     square = gwyddion_matrix(tmp_path / "square.txt", rough(16, 32), (0.5, 0.5))
     said = SurfaceFile(path=str(square), format="table", spacing=0.5).input_summary().get("caveats", ())
     assert not any("not square" in caveat for caveat in said)
+
+
+LANGUAGES = [("Width", "Height"), ("Breite", "H\u00f6he"), ("Largeur", "Hauteur")]  # Gwyddion's English, German, French
+
+
+@pytest.mark.parametrize("words", LANGUAGES[1:])  # English: above
+def test_a_gwyddion_export_in_another_language_states_its_pixel(tmp_path, words):
+    path = gwyddion_matrix(tmp_path / "scan.txt", rough(16, 32), (1.0, 0.5), words)
+    summary = SurfaceFile(path=str(path), format="table", spacing=1.0).input_summary()
+    assert summary["file_spacing"] == pytest.approx([1.0, 0.5], rel=1e-9)
+    assert any("its header's pixel of 1 x 0.5 um (x by y), which is not square" in said for said in summary["caveats"])
+
+
+@pytest.mark.parametrize("words", LANGUAGES)
+def test_a_narrow_gwyddion_matrix_is_refused_as_narrow_not_as_a_damaged_file(tmp_path, words):
+    """Three columns of heights under a header stating the map's size: a matrix (its reader's),
+    not x, y, z points, whose reader refused it, and the file was called damaged."""
+    path = gwyddion_matrix(tmp_path / "narrow.txt", rough(20, 3), (1.0, 1.0), words)
+    with pytest.raises(ValueError, match=r"map of 3 x 20 pixels \(x by y\); at least 8 x 8 are needed"):
+        SurfaceFile(path=str(path), format="instrument").input_summary()
+    with pytest.raises(ValueError, match="a 2D map of 3 x 20 pixels .*too narrow for surface-file"):
+        ProfileFile(path=str(path), format="instrument").input_summary()
 
 
 def xz_table(path, x: np.ndarray, z: np.ndarray, header: str = "x [um],z [um]"):

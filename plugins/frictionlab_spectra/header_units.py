@@ -35,7 +35,10 @@ _LABEL = re.compile(  # x [µm], z (nm), z/nm; an inch only in brackets or after
 )
 # a number a header states, its decimal mark a point or a comma (Gwyddion's export in a European locale: 25,6 µm)
 _NUMBER = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
-_SIZE_KEYS = r"width|height|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
+# Gwyddion's words for its text export's width and height, in the languages it writes (as its reader reads them)
+_WIDTH = "width|\u0161\u00ed\u0159ka|breite|anchura|largeur|larghezza|largura|\u0448\u0438\u0440\u0438\u043d\u0430"
+_HEIGHT = "height|v\u00fd\u0161ka|h\u00f6he|altura|hauteur|altezza|\u0432\u044b\u0441\u043e\u0442\u0430"
+_SIZE_KEYS = rf"{_WIDTH}|{_HEIGHT}|x-length|y-length|pixel\s+size|scale\s+[xy]"  # what text exports state sizes by
 _UNIT_KEYS = r"value\s+units|[xyz]-unit|unit\s+(?:x|y|data)"
 # "# Width: 25.6 µm", "# Value units: m": a length a header states by one of those keys (not "# Cutoff: 0.8 mm")
 _STATED = re.compile(rf"\b(?i:{_SIZE_KEYS}|{_UNIT_KEYS})\s*[:=]\s*(?:{_NUMBER})?\s*(?P<unit>{_UNITS})\s*$")  # keys in any case
@@ -104,7 +107,7 @@ def named_units(text: str) -> tuple[list[str], bool]:
     return units, stated_by_key
 
 
-_EXTENT = re.compile(rf"\b(?i:(?P<key>width|height))\s*[:=]\s*(?P<value>{_NUMBER})\s*(?P<unit>{_UNITS})\s*$")
+_EXTENT = re.compile(rf"\b(?i:(?P<width>{_WIDTH})|{_HEIGHT})\s*[:=]\s*(?P<value>{_NUMBER})\s*(?P<unit>{_UNITS})\s*$")
 
 
 def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float] | None:
@@ -115,15 +118,21 @@ def stated_pixel(path, where: str, shape: tuple[int, int]) -> tuple[float, float
     from .instrument_file import open_input  # here: it imports this module
 
     with open_input(path, where) as fh:
-        head = head_text(fh, "utf-8-sig")
-    extent = {}
-    for line in header_lines(head):
-        if (found := _EXTENT.search(line.rstrip())) and length_unit(found["unit"]) in LENGTH_UNITS:
-            value = float(found["value"].replace(",", "."))  # 25,6: a decimal comma (no export groups thousands)
-            extent.setdefault(found["key"].lower(), value * LENGTH_UNITS[length_unit(found["unit"])])
+        extent = stated_extent(head_text(fh, "utf-8-sig"))
     if len(extent) < 2 or not all(side > 0 for side in extent.values()):
         return None
     return extent["width"] / shape[1], extent["height"] / shape[0]
+
+
+def stated_extent(text: str) -> dict[str, float]:
+    """The width and height (in metres, by key) the header of ``text`` states in length units, as
+    Gwyddion's text export of a matrix does; a file of x, y, z points states neither."""
+    extent = {}
+    for line in header_lines(text):
+        if (found := _EXTENT.search(line.rstrip())) and length_unit(found["unit"]) in LENGTH_UNITS:
+            value = float(found["value"].replace(",", "."))  # 25,6: a decimal comma (no export groups thousands)
+            extent.setdefault("width" if found["width"] else "height", value * LENGTH_UNITS[length_unit(found["unit"])])
+    return extent
 
 
 def not_length_label(text: str) -> tuple[str, str] | None:

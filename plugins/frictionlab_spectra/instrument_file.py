@@ -86,12 +86,16 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
     return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # (Nx, Ny): z is (Ny, Nx)
 
 
-def _by_name(fh):
+STREAM_ONLY = ("mitutoyo",)  # readers that judge a name by its suffix (openpyxl: .xlsx), which a descriptor's lacks
+
+
+def _by_name(fh, reader_class):
     """The opened file by a name of its descriptor where the system has one (Linux): the same
     checked file, no race, and readers given a name may map it (given a stream, the NetCDF
-    reader read all of a 128 MiB map's heights to tell its shape: 256 MiB)."""
+    reader read all of a 128 MiB map's heights to tell its shape: 256 MiB). The stream itself
+    to a reader in STREAM_ONLY: given /proc/self/fd/N, openpyxl refused a sound .xlsx."""
     name = f"/proc/self/fd/{fh.fileno()}"
-    return name if os.path.exists(name) else fh
+    return name if os.path.exists(name) and reader_class.format() not in STREAM_ONLY else fh
 
 
 def _open_reader(fh, path: Path, where: str):
@@ -107,7 +111,7 @@ def _open_reader(fh, path: Path, where: str):
         check_declared_values(fh, reader_class, where)
         check_numbers_written(fh, reader_class, where)
     try:
-        return open_topography(_by_name(fh), format=reader_class.format())
+        return open_topography(_by_name(fh, reader_class), format=reader_class.format())
     except Exception as exc:  # a third party's parser of untrusted bytes: named, never quoted
         raise describe_failure(reader_class, exc, where, fh) from None
 

@@ -17,7 +17,9 @@ import os
 import re
 import zipfile
 
-from .header_units import NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units
+from .header_units import (
+    NUMBERS, check_heights_are_lengths, check_units_named, head_text, named_units, stated_extent,
+)
 
 MAGIC_BYTES = 512  # what SurfaceTopography's own detection reads
 XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml) may inflate to
@@ -26,6 +28,9 @@ BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary va
 ZIP_MAGIC = b"PK\x03\x04"
 UTF8_BOM = b"\xef\xbb\xbf"
 GSF_MAGIC = b"Gwyddion Simple Field"  # a Gwyddion export no reader of the extra reads
+# the first bytes of formats whose reader states no magic (it answers 'maybe' to any file): a
+# Nanoscope header's first section (binary data: \*; data as text: ?*), under .di, .spm or .000
+HEADER_MAGIC = {"di": (b"\\*File list", b"\\*EC File list", b"?*File list", b"?*EC File list")}
 # numpy, MATLAB and HDF5 files hold bare arrays, without axes: a map there is z[row, column] =
 # z[y, x], as a .npy map and as numpy saves it (SurfaceTopography takes their first index as x)
 BARE_ARRAY_FORMATS = ("npz", "mat", "h5")
@@ -41,7 +46,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
     fh.seek(0)
     head = fh.read(MAGIC_BYTES)
     fh.seek(0)
-    matches = [reader for reader in readers if reader.can_read(head) == MagicMatch.YES]
+    matches = [reader for reader in readers
+               if reader.can_read(head) == MagicMatch.YES or head.startswith(HEADER_MAGIC.get(reader.format(), ()))]
     if not matches and (head.startswith(GSF_MAGIC) or path_suffix == "gsf"):  # under any suffix: not text, no reader
         raise ValueError(
             f"{where}: a Gwyddion Simple Field (.gsf) file, a format SurfaceTopography does not read (renaming it would "
@@ -104,8 +110,13 @@ def parses_text(reader, file) -> bool:
 def _coordinate_rows(fh) -> bool:
     """Whether a text file's first row of numbers (whole within its ``head_text``) holds two or
     three: x, z or x, y, z per point, which SurfaceTopography's matrix reader, chosen by the
-    suffix .txt, took for a map two or three pixels wide."""
-    for line in head_text(fh).splitlines()[:-1]:  # the last line may be cut short
+    suffix .txt, took for a map two or three pixels wide. Not under a header that states the
+    map's width and height (Gwyddion's export of a matrix, however narrow: its XYZ reader refused
+    it, and the file was called damaged)."""
+    text = head_text(fh)
+    if len(stated_extent(text)) == 2:
+        return False
+    for line in text.splitlines()[:-1]:  # the last line may be cut short
         if NUMBERS.match(line):
             return len(re.split(r"[\s,;]+", line.strip())) in (2, 3)
     return False

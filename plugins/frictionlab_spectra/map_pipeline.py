@@ -23,6 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from frictionlab.plugin import MAX_MAGNITUDE
 
+from .scan_shaping.edge_lines import edge_lines_warning
 from .scan_shaping.height_caveats import flat_neighbours_warning, outlier_warning
 from .scan_shaping.levelling import level, levelling_warning
 from .scan_shaping.line_offsets import line_offset_warning
@@ -160,6 +161,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
     if (warning := flat_neighbours_warning(z, levelled.rms_after, "map")) is not None:
         caveats.append(warning)
     if (warning := line_offset_warning(levelled.heights)) is not None:
+        caveats.append(warning)
+    if (warning := edge_lines_warning(levelled.heights, pixel, done.get("region_pixels"))) is not None:
         caveats.append(warning)
     if (warning := _noise_warning(levelled.heights)) is not None:
         caveats.append(warning)
