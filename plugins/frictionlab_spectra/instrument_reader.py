@@ -74,8 +74,8 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         chosen = next(reader for reader in readers if reader.format() == "xyz")
     if parses_text(chosen, head) and _utf16(head):
         raise ValueError(
-            f"{where}: a text export in UTF-16 (as a Windows program saves 'Unicode text'), which SurfaceTopography's "
-            f"{chosen.name()} reader does not read: save it as UTF-8 (or plain ASCII)"
+            f"{where}: a text export in UTF-16 (as a Windows program saves 'Unicode text'), whose header (units, "
+            "sizes) frictionlab reads only in UTF-8: save it as UTF-8 (or plain ASCII)"
         )
     if parses_text(chosen, head) and not _looks_like_text(head):
         raise ValueError(
