@@ -37,17 +37,6 @@ def pytest_collection_modifyitems(config, items):
             config.hook.pytest_deselected(items=long)
             items[:] = [item for item in items if not item.get_closest_marker("long")]
 
-
-def pytest_collection_finish(session):
-    """What collection imported (frictionlab, numpy, scipy, pydantic, Textual: some 10^6
-    objects that live as long as the session) is taken out of the cycle collector's walks,
-    as ``frictionlab tui`` does with its own: each collection of the oldest generation walked
-    them all, a third of a TUI test's time. Only collection times change, never a result."""
-    import gc
-
-    gc.collect()
-    gc.freeze()
-
 SMALL_PRESET = {
     "name": "small",
     "seed": 7,
