@@ -103,7 +103,11 @@ class PresetForm(VerticalScroll):
         # Textual restyles a widget and every widget in it when its focus changes; no rule
         # styles a field by the form's focus, so the form alone is restyled, not its hundreds
         # of fields (a tenth of a second each time Enter goes into a field or Esc comes out)
-        self.app.stylesheet.update_nodes([self], animate=True)
+        try:
+            app = self.app
+        except RuntimeError:  # no app: a focus change as it closes (Textual's own watcher passes too)
+            return
+        app.stylesheet.update_nodes([self], animate=True)
 
     # ------------------------------------------------------------ building
 
