@@ -91,3 +91,22 @@ async def test_control_characters_pasted_into_a_dialogs_field_are_said_in_the_di
         said = " ".join(str(line.render()).split()) if line.display else ""
     assert field.value.endswith("[1mrough"), field.value
     assert "name: the paste's control characters \\x1b" in said, said
+
+
+@sync
+async def test_a_choice_left_unset_says_so_as_a_text_field_does(folders, registry):
+    """In tmux: a measured profile's unit and detrend, which the preset leaves to their default,
+    showed Textual's prompt "Select" as if that were their value, where a text field left unset
+    says "default: not set"."""
+    import yaml
+
+    from .conftest import TINY, merge, screen_text
+
+    profile = {"name": "profile-file", "params": {"path": "heights.csv"}}
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(merge(TINY, {"spectrum": profile}), sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=(100, 40)) as pilot:
+        await open_first_preset(pilot)
+        await pilot.pause()
+        rows = {line.split()[0]: line.split()[1:] for line in screen_text(app).splitlines() if line.split()}
+    assert rows["unit"][:3] == ["default:", "not", "set"] and rows["detrend"][:3] == ["default:", "not", "set"]

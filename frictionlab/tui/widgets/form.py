@@ -156,11 +156,12 @@ class PresetForm(VerticalScroll):
                 options,
                 value=current if known else Select.NULL,
                 allow_blank=spec.optional or not known,
+                prompt=_unset(spec),  # as a text field says it (Textual's "Select" read as the value)
                 compact=True,
                 id=spec.widget_id,
             )
         elif spec.kind in ("int", "float", "text"):
-            placeholder = "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
+            placeholder = _unset(spec)
             widget = KeyInput(
                 value=display(value),
                 placeholder=placeholder,
@@ -203,6 +204,7 @@ class PresetForm(VerticalScroll):
             [(Content(n), n) for n in names],
             value=known if known else Select.NULL,
             allow_blank=known is None,
+            prompt="choose one",
             compact=True,
             id=f"plugin--{slot}",
         )
@@ -469,6 +471,11 @@ class PresetForm(VerticalScroll):
                 choices=tuple(self.registry.names(slot)),
             )
         self.post_message(self.FieldFocused(spec))
+
+
+def _unset(spec: FieldSpec) -> str:
+    """What a field with no value shows: that it must be given, or what it is left at."""
+    return "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
 
 
 def _on_off(value: bool) -> str:
