@@ -110,3 +110,23 @@ async def test_a_choice_left_unset_says_so_as_a_text_field_does(folders, registr
         await pilot.pause()
         rows = {line.split()[0]: line.split()[1:] for line in screen_text(app).splitlines() if line.split()}
     assert rows["unit"][:3] == ["default:", "not", "set"] and rows["detrend"][:3] == ["default:", "not", "set"]
+
+
+@sync
+async def test_choosing_the_plugin_a_misspelt_name_meant_keeps_its_parameters(folders, registry):
+    """In tmux: a preset whose spectrum said power-lawz (a typo), its hurst and points given,
+    opened with the name unset; choosing power-law from the list dropped every parameter the
+    file gave (hurst and points then 'is required'), unasked."""
+    import yaml
+
+    from .conftest import TINY, choose, merge
+
+    typo = merge(TINY, {"spectrum": {"name": "power-lawz"}})
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(typo, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await choose(pilot, "plugin--spectrum", "power-law")
+        kept, problems = form.data["spectrum"], form.problems
+        shown = app.query_one("#field--spectrum--params--hurst", Input).value
+    assert (kept, problems, shown) == (TINY["spectrum"], [], str(TINY["spectrum"]["params"]["hurst"]))

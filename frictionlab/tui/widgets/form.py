@@ -314,7 +314,10 @@ class PresetForm(VerticalScroll):
         old_params = get_path(self.data, (slot, "params"), {})
         if old_known is not None:
             self._stash[(slot, old_known)] = copy.deepcopy(old_params if isinstance(old_params, dict) else {})
-        self.data[slot] = {"name": new_name, "params": self._stash.get((slot, new_name), {})}
+        params = self._stash.get((slot, new_name))
+        if params is None and old_known is None and isinstance(old_params, dict):
+            params = old_params  # a name no plugin has (a typo): its parameters were meant for the one chosen now
+        self.data[slot] = {"name": new_name, "params": params or {}}
         for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
             del self._specs[spec_id]
             self._marked.pop(spec_id, None)  # its new row starts unmarked
