@@ -55,9 +55,13 @@ class Dialog(ModalScreen):
         """What the status line says of a key that waits for the dialog to close."""
         return WAIT_FOR_DIALOG.format(answers=self.ANSWERS)
 
+    @property
+    def answered_by(self) -> str:
+        """What Enter on a question that Enter does not answer (y or n) says."""
+        return f"This question is answered by its keys: {self.ANSWERS}."
+
     def action_say_answers(self) -> None:
-        """Enter on a question that Enter does not answer (y or n): which keys do."""
-        self.app.say(f"This question is answered by its keys: {self.ANSWERS}.", "warning")
+        self.app.say(self.answered_by, "warning")
 
     def hold(self, key: events.Key) -> bool:
         """Keep ``key`` for the dialog until it is mounted; False once it takes keys itself."""
@@ -86,7 +90,7 @@ class Dialog(ModalScreen):
 
     def on_unmount(self) -> None:
         status = self.app.query("#status")
-        if status and str(status.first().render()) in (self.waiting, f"This question is answered by its keys: {self.ANSWERS}."):
+        if status and str(status.first().render()) in (self.waiting, self.answered_by):
             self.app.say("")  # the dialog is closed: those keys act again
 
     def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
