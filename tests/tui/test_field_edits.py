@@ -130,3 +130,26 @@ async def test_choosing_the_plugin_a_misspelt_name_meant_keeps_its_parameters(fo
         kept, problems = form.data["spectrum"], form.problems
         shown = app.query_one("#field--spectrum--params--hurst", Input).value
     assert (kept, problems, shown) == (TINY["spectrum"], [], str(TINY["spectrum"]["params"]["hurst"]))
+
+
+@sync
+async def test_enter_in_a_text_field_leaves_it_and_f1_lists_what_its_keys_do(folders, registry):
+    """In tmux: a value typed, then Enter, left the cursor in the field and said nothing: F1 listed
+    Enter there as Submit, which did nothing, and Up and Down as a scroll of the one-line field,
+    where they go to the field above and below."""
+    from .conftest import press_settled
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        field = app.query_one("#field--realizations", Input)
+        field.focus()
+        await pilot.pause()
+        listed = {binding.key: binding.description for _, binding, enabled, _ in app.active_bindings.values() if enabled}
+        await press_settled(pilot, "ctrl+u", *"12", "enter")
+        left, kept = app.focused is form, form.data["realizations"]
+        await press_settled(pilot, "enter", "down")  # back in, and on to the field below
+        below = app.focused.id
+    assert (left, kept) == (True, 12)
+    assert (listed["enter"], listed["up"], listed["down"]) == ("Done", "Field above", "Field below")
+    assert below == "plugin--spectrum"

@@ -32,7 +32,7 @@ from ..fields import (
     validation_of,
 )
 from ..hiddenkeys import idle_sideways
-from .keyinput import KeyInput
+from .keyinput import FieldInput
 
 
 def flow_text(value) -> str:
@@ -162,7 +162,7 @@ class PresetForm(VerticalScroll):
             )
         elif spec.kind in ("int", "float", "text"):
             placeholder = _unset(spec)
-            widget = KeyInput(
+            widget = FieldInput(
                 value=display(value),
                 placeholder=placeholder,
                 compact=True,
