@@ -106,7 +106,5 @@ class FieldInput(KeyInput):
         keys["up"] = [Binding("up", "app.focus_previous", "Field above", tooltip="as Shift+Tab", show=False)]
 
     def action_leave_field(self) -> None:
-        from .form import PresetForm
-
-        form = next(node for node in self.ancestors if isinstance(node, PresetForm))
+        form = next(node for node in self.ancestors if hasattr(node, "action_leave_field"))  # the form, unimported
         form.action_leave_field()
