@@ -63,6 +63,7 @@ FOLLOW_SECONDS = 0.25  # how often a run in its own process is read: progress mo
 WATCH_SECONDS = 0.5  # how often the runs and presets folders and the open preset's file are looked at: a run or
 #   preset file made anywhere is listed within this, another program's write to the preset said
 REREAD_SECONDS = 2.0  # the list read again at most this often while only runs' files change
+DRAFT_KEYS = frozenset({"ctrl+s", "ctrl+o", "ctrl+r"})  # save or run the draft
 
 
 class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, PresetSaving, App):
@@ -181,6 +182,8 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
                 return
             if self.esc_closed_keys(event):  # before a list's Esc (Back): the panel says Esc closes it
                 return
+            if event.key in DRAFT_KEYS and self._mounted("EditPane") is not None:
+                await self.form_settled()  # what was typed before the key is in the draft it saves or runs
         await super().on_event(event)
 
     async def on_ready(self) -> None:

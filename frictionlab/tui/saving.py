@@ -59,13 +59,19 @@ class PresetSaving:
         answered, and the app heard of the change only after it had quit without asking."""
         if self.modified or self._saved is None or self._mounted("EditPane") is None:
             return self.modified
+        form = await self.form_settled()
+        return form.data is not None and form.data != self._saved
+
+    async def form_settled(self):
+        """The form, once the keys already handed to its fields are in its draft and its problems:
+        a value typed, then Esc and Ctrl+S together, was saved as it was before the value, unasked."""
         form = self.query_one("#form")
         pumps = [form, *form.query("*")]
         for _ in range(1000):  # each turn lets the fields' and the form's queues move on
             if not any(pump.message_queue_size for pump in pumps):
                 break
             await asyncio.sleep(0)
-        return form.data is not None and form.data != self._saved
+        return form
 
     def _changed_on_disk(self) -> bool:
         """Whether the open preset's file is there and not as it was read or last saved here."""
@@ -118,13 +124,14 @@ class PresetSaving:
     def _save_checked(self, path: Path, data: dict | None = None) -> None:
         """Write the draft (or ``data``, Ctrl+O's renamed copy of it) to ``path``, asking first when it has problems."""
         data = self._draft() if data is None else data
-        if not self.problems:
+        problems = self.query_one("#form").problems  # the form's now: its message to the app may be on its way
+        if not problems:
             self._write(path, data, template=self.draft_source)
             return
-        count = len(self.problems)
+        count = len(problems)
         question = (
             f"This preset has {count} problem{'s' if count != 1 else ''}; frictionlab run will refuse it:\n"
-            + "\n".join(self.problems[:6])
+            + "\n".join(problems[:6])
             + "\n\nSave it anyway?"
         )
         self.push_screen(

@@ -19,11 +19,12 @@ def test_the_docs_list_every_key():
     """F1 shows Textual's key panel, built from the bindings (description, then tooltip);
     the docs' key table has each one."""
     from frictionlab.tui.widgets import PresetForm, PresetsPane, ResultsPane, RunPane
+    from frictionlab.tui.widgets.sweeptable import SweepTable
     from frictionlab.tui.widgets.tables import ListTable
 
     page = (ROOT / "docs" / "how-to" / "tui.md").read_text()
     section = page.split("## Keys", 1)[1]
-    for owner in (FrictionlabApp, ListTable, PresetsPane, PresetForm, RunPane, ResultsPane):
+    for owner in (FrictionlabApp, ListTable, SweepTable, PresetsPane, PresetForm, RunPane, ResultsPane):
         for binding in owner.BINDINGS:
             text = f"{binding.description} {binding.tooltip}".strip()  # as the key panel shows it
             assert text in section, f"docs/how-to/tui.md's key table misses {text!r}"

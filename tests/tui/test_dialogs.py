@@ -88,8 +88,27 @@ async def test_f2_to_f5_wait_while_a_dialog_is_open_and_say_so(folders, registry
         after = app.query_one("#tabs").active
     assert tab == ("presets" if opened_by == "n" else "edit")
     assert tabs == [(tab, True)] * 4
-    assert said.startswith("A dialog is open: Enter answers it, Esc closes it; then") and "F2 to F5 act" in said
+    # a question takes y or n: "Enter answers it" sent the user to a key that did nothing there
+    answers = "y answers yes, n or Esc no" if opened_by == "question" else "Enter answers it, Esc closes it"
+    assert said.startswith(f"A dialog is open: {answers}; then") and "F2 to F5 act" in said
     assert after == "results"
+
+
+@sync
+async def test_enter_on_a_question_says_which_keys_answer_it_and_answers_nothing(folders, registry):
+    """In tmux: Enter on 'The open preset has unsaved changes. Discard them?' did nothing, and
+    nothing said so (the key table listed Enter as a dialog's Confirm)."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        answers = []
+        app.push_screen(ConfirmScreen("The open preset has unsaved changes. Discard them?"), answers.append)
+        await pilot.pause()
+        await press_settled(pilot, "enter")
+        said, still_asked = status_text(app), isinstance(app.screen, ConfirmScreen)
+        await press_settled(pilot, "n")
+        after = status_text(app)
+    assert said == "This question is answered by its keys: y answers yes, n or Esc no." and still_asked
+    assert answers == [False] and after == ""
 
 
 @sync

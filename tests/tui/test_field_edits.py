@@ -91,3 +91,65 @@ async def test_control_characters_pasted_into_a_dialogs_field_are_said_in_the_di
         said = " ".join(str(line.render()).split()) if line.display else ""
     assert field.value.endswith("[1mrough"), field.value
     assert "name: the paste's control characters \\x1b" in said, said
+
+
+@sync
+async def test_a_choice_left_unset_says_so_as_a_text_field_does(folders, registry):
+    """In tmux: a measured profile's unit and detrend, which the preset leaves to their default,
+    showed Textual's prompt "Select" as if that were their value, where a text field left unset
+    says "default: not set"."""
+    import yaml
+
+    from .conftest import TINY, merge, screen_text
+
+    profile = {"name": "profile-file", "params": {"path": "heights.csv"}}
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(merge(TINY, {"spectrum": profile}), sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=(100, 40)) as pilot:
+        await open_first_preset(pilot)
+        await pilot.pause()
+        rows = {line.split()[0]: line.split()[1:] for line in screen_text(app).splitlines() if line.split()}
+    assert rows["unit"][:3] == ["default:", "not", "set"] and rows["detrend"][:3] == ["default:", "not", "set"]
+
+
+@sync
+async def test_choosing_the_plugin_a_misspelt_name_meant_keeps_its_parameters(folders, registry):
+    """In tmux: a preset whose spectrum said power-lawz (a typo), its hurst and points given,
+    opened with the name unset; choosing power-law from the list dropped every parameter the
+    file gave (hurst and points then 'is required'), unasked."""
+    import yaml
+
+    from .conftest import TINY, choose, merge
+
+    typo = merge(TINY, {"spectrum": {"name": "power-lawz"}})
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(typo, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await choose(pilot, "plugin--spectrum", "power-law")
+        kept, problems = form.data["spectrum"], form.problems
+        shown = app.query_one("#field--spectrum--params--hurst", Input).value
+    assert (kept, problems, shown) == (TINY["spectrum"], [], str(TINY["spectrum"]["params"]["hurst"]))
+
+
+@sync
+async def test_enter_in_a_text_field_leaves_it_and_f1_lists_what_its_keys_do(folders, registry):
+    """In tmux: a value typed, then Enter, left the cursor in the field and said nothing: F1 listed
+    Enter there as Submit, which did nothing, and Up and Down as a scroll of the one-line field,
+    where they go to the field above and below."""
+    from .conftest import press_settled
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        field = app.query_one("#field--realizations", Input)
+        field.focus()
+        await pilot.pause()
+        listed = {binding.key: binding.description for _, binding, enabled, _ in app.active_bindings.values() if enabled}
+        await press_settled(pilot, "ctrl+u", *"12", "enter")
+        left, kept = app.focused is form, form.data["realizations"]
+        await press_settled(pilot, "enter", "down")  # back in, and on to the field below
+        below = app.focused.id
+    assert (left, kept) == (True, 12)
+    assert (listed["enter"], listed["up"], listed["down"]) == ("Done", "Field above", "Field below")
+    assert below == "plugin--spectrum"

@@ -10,7 +10,7 @@ from textual.widgets import Input, TabbedContent
 from frictionlab.tui.screens import PathScreen
 from frictionlab.tui.widgets.presets import PresetsPane
 
-from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, press_settled, sync, wait_until
+from .conftest import SIZE, TINY, make_app, open_first_preset, post_keys, press_settled, record_said, sync, wait_until
 
 
 @sync
@@ -233,3 +233,46 @@ async def test_keys_typed_after_q_are_dropped_not_answered_on_a_closing_screen(f
         post_keys(app, ["q", *after])
         await wait_until(pilot, lambda: not app.is_running, timeout=10.0)
     assert app.return_code == 0
+
+
+@pytest.mark.parametrize("value", ["0", "12"], ids=["a-problem", "valid"])
+@sync
+async def test_a_value_typed_then_esc_and_ctrl_s_at_once_is_the_one_saved(folders, registry, value):
+    """In tmux: -3 typed into points, then Esc and Ctrl+S, saved points: -3 without the question a
+    preset with problems asks first: the field's edit was still on its way to the app when Ctrl+S
+    (run at once) read the preset's problems. Typed together, the value saved is the one the field
+    shows, asked about when it is a problem."""
+    from frictionlab.tui.screens import ConfirmScreen
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        app.query_one("#field--realizations", Input).focus()
+        await pilot.pause()
+        said = record_said(app)
+        post_keys(app, ["end", "ctrl+u", *value, "escape", "ctrl+s"])
+        await wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen) or any(s.startswith("Saved") for s in said), timeout=10.0)
+        await pilot.pause()
+        asked, modified = isinstance(app.screen, ConfirmScreen), app.modified
+        saved = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())["realizations"]
+    assert (asked, modified, saved) == ((True, True, TINY["realizations"]) if value == "0" else (False, False, int(value)))
+
+
+@sync
+async def test_a_problem_typed_then_esc_and_ctrl_r_at_once_runs_nothing(folders, registry):
+    """The same for Ctrl+R: the run started from the preset as it was before the value typed, which
+    the field showed refused (realizations 0) while the run went on with the old one."""
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        app.query_one("#field--realizations", Input).focus()
+        await pilot.pause()
+        said = record_said(app)
+        post_keys(app, ["end", "ctrl+u", "0", "escape", "ctrl+r"])
+        await wait_until(pilot, lambda: app.running or app.last_outcome is not None or bool(said), timeout=10.0)
+        started = app.running or app.last_outcome is not None
+        if app.running:
+            app.followed.cancel()
+            await wait_until(pilot, lambda: app.followed is None)
+    assert not started and not (folders / "runs").exists()
+    assert said[0].startswith("realizations: must be >= 1")

@@ -338,3 +338,59 @@ async def test_a_killed_run_opened_says_how_it_ended_not_that_its_curve_file_is_
     assert not compare_offered
     assert "no such" not in info and "interrupted before its results were written" in info, info
     assert "realizations stored; u resumes it" in info and "u resumes it" in said, said
+
+
+@pytest.mark.long  # a TUI session that runs a sweep
+@sync
+async def test_enter_on_a_point_of_the_run_tabs_sweep_opens_its_run_on_the_results_tab(folders, registry):
+    """In tmux: F1 on the Run tab's table of a finished sweep listed Enter as Select, and Enter on a
+    point did nothing (on the Results tab Enter on a point opens its run); Left, Right, Ctrl+PgUp
+    and Ctrl+PgDn were listed too, where the table fits the screen and they do nothing."""
+    from textual.widgets import TabbedContent
+
+    from .conftest import sweep_app
+
+    app = sweep_app(folders, registry)
+    async with started(app) as pilot:
+        await run_to_the_end(pilot)
+        table = app.query_one("#sweep-table")
+        table.focus()
+        await pilot.pause()
+        listed = {binding.action for _, binding, enabled, _ in app.active_bindings.values() if enabled}
+        await press_settled(pilot, "down", "enter")
+        await pilot.pause()
+        tab = app.query_one("#tabs", TabbedContent).active
+        shown = [e.path.resolve() for e in app.query_one(ResultsPane).overlay]
+        on_points = app.query_one("#results-sweep").has_focus
+        point = app.query_one("#results-sweep").cursor_row
+        folder = app.last_out_dir
+    second = json.loads((folder / "sweep.json").read_text())["points"][1]["folder"]
+    assert (tab, shown, on_points, point) == ("results", [(folder / second).resolve()], True, 1)
+    assert not listed & {"cursor_left", "cursor_right", "page_left", "page_right"}
+
+
+@pytest.mark.long  # a TUI session that runs a sweep, cancelled
+@sync
+async def test_enter_on_a_finished_point_while_the_sweep_goes_on_opens_its_run(folders, registry):
+    """The same while the sweep's next point runs: the TUI quit with a traceback (the last run's
+    folder, read there, is set only once a run has ended)."""
+    from textual.widgets import TabbedContent
+
+    from .conftest import SWEEP, merge, sweep_app, wait_until
+
+    app = sweep_app(folders, registry, merge(SWEEP, {"sweep": {"parameters": {"realizations": {"values": [4, 100_000]}}}}))
+    async with started(app) as pilot:
+        await pilot.press("ctrl+r")
+        table = app.query_one("#sweep-table")
+        await wait_until(pilot, lambda: table.row_count == 1)
+        table.focus()
+        await pilot.pause()
+        await press_settled(pilot, "enter")
+        await pilot.pause()
+        tab = app.query_one("#tabs", TabbedContent).active
+        shown = [e.path.resolve() for e in app.query_one(ResultsPane).overlay]
+        folder, running = app.followed.folder, app.is_running
+        app.followed.cancel()
+        await wait_until(pilot, lambda: app.followed is None)
+    first = json.loads((folder / "sweep.json").read_text())["points"][0]["folder"]
+    assert (running, tab, shown) == (True, "results", [(folder / first).resolve()])

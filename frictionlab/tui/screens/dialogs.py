@@ -22,7 +22,7 @@ from ..widgets.footer import KeysFooter
 from ..widgets.keyinput import KeyInput
 
 
-WAIT_FOR_DIALOG = "A dialog is open: Enter answers it, Esc closes it; then Ctrl+S, Ctrl+O, Ctrl+R and F2 to F5 act."
+WAIT_FOR_DIALOG = "A dialog is open: {answers}; then Ctrl+S, Ctrl+O, Ctrl+R and F2 to F5 act."
 WAITING_KEYS = frozenset({"ctrl+s", "ctrl+o", "ctrl+r", "f2", "f3", "f4", "f5"})  # the app's keys that pass a dialog
 
 
@@ -44,9 +44,24 @@ class Dialog(ModalScreen):
         Binding("pageup", "scroll_dialog(-5)", show=False),
     ]
 
+    ANSWERS = "Enter answers it, Esc closes it"  # the keys that answer it, as the status line says them
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._held: list[events.Key] | None = []  # None once the keys held are answered
+
+    @property
+    def waiting(self) -> str:
+        """What the status line says of a key that waits for the dialog to close."""
+        return WAIT_FOR_DIALOG.format(answers=self.ANSWERS)
+
+    @property
+    def answered_by(self) -> str:
+        """What Enter on a question that Enter does not answer (y or n) says."""
+        return f"This question is answered by its keys: {self.ANSWERS}."
+
+    def action_say_answers(self) -> None:
+        self.app.say(self.answered_by, "warning")
 
     def hold(self, key: events.Key) -> bool:
         """Keep ``key`` for the dialog until it is mounted; False once it takes keys itself."""
@@ -69,13 +84,13 @@ class Dialog(ModalScreen):
         preset, or switched the tab behind it, the dialog left up over another tab).
         (Esc closes the keys panel over it first: ``KeysHelp.esc_closed_keys``.)"""
         if key.key in WAITING_KEYS:
-            self.app.say(WAIT_FOR_DIALOG, "warning")
+            self.app.say(self.waiting, "warning")
             return True
         return False
 
     def on_unmount(self) -> None:
         status = self.app.query("#status")
-        if status and str(status.first().render()) == WAIT_FOR_DIALOG:
+        if status and str(status.first().render()) in (self.waiting, self.answered_by):
             self.app.say("")  # the dialog is closed: those keys act again
 
     def on_key_input_left_out(self, event: KeyInput.LeftOut) -> None:
@@ -106,9 +121,11 @@ class SubmitInput(KeyInput):
 
 
 class ConfirmScreen(Dialog, ModalScreen[bool]):
+    ANSWERS = "y answers yes, n or Esc no"
     BINDINGS = [
         Binding("y", "answer(True)", "Yes"),
         Binding("n,escape", "answer(False)", "No"),
+        Binding("enter", "say_answers", show=False),  # it did nothing, unsaid: never a yes (a discard) by habit
     ]
 
     def __init__(self, question: str):
@@ -138,10 +155,12 @@ class QuitRunEndedScreen(ConfirmScreen):
 class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
     """Quit while a run goes on: leave it running ("leave"), cancel it ("cancel"), or stay (None)."""
 
+    ANSWERS = "l leaves the run going and quits, c cancels it and quits, Esc stays"
     BINDINGS = [
         Binding("l", "answer('leave')", "Leave it running"),
         Binding("c", "answer('cancel')", "Cancel it"),
         Binding("escape,n", "answer(None)", "Stay"),
+        Binding("enter", "say_answers", show=False),
     ]
 
     def __init__(self, question: str):

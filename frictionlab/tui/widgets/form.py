@@ -32,7 +32,7 @@ from ..fields import (
     validation_of,
 )
 from ..hiddenkeys import idle_sideways
-from .keyinput import KeyInput
+from .keyinput import FieldInput
 
 
 def flow_text(value) -> str:
@@ -166,12 +166,13 @@ class PresetForm(VerticalScroll):
                 options,
                 value=current if known else Select.NULL,
                 allow_blank=spec.optional or not known,
+                prompt=_unset(spec),  # as a text field says it (Textual's "Select" read as the value)
                 compact=True,
                 id=spec.widget_id,
             )
         elif spec.kind in ("int", "float", "text"):
-            placeholder = "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
-            widget = KeyInput(
+            placeholder = _unset(spec)
+            widget = FieldInput(
                 value=display(value),
                 placeholder=placeholder,
                 compact=True,
@@ -213,6 +214,7 @@ class PresetForm(VerticalScroll):
             [(Content(n), n) for n in names],
             value=known if known else Select.NULL,
             allow_blank=known is None,
+            prompt="choose one",
             compact=True,
             id=f"plugin--{slot}",
         )
@@ -322,7 +324,10 @@ class PresetForm(VerticalScroll):
         old_params = get_path(self.data, (slot, "params"), {})
         if old_known is not None:
             self._stash[(slot, old_known)] = copy.deepcopy(old_params if isinstance(old_params, dict) else {})
-        self.data[slot] = {"name": new_name, "params": self._stash.get((slot, new_name), {})}
+        params = self._stash.get((slot, new_name))
+        if params is None and old_known is None and isinstance(old_params, dict):
+            params = old_params  # a name no plugin has (a typo): its parameters were meant for the one chosen now
+        self.data[slot] = {"name": new_name, "params": params or {}}
         for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
             del self._specs[spec_id]
             self._marked.pop(spec_id, None)  # its new row starts unmarked
@@ -479,6 +484,11 @@ class PresetForm(VerticalScroll):
                 choices=tuple(self.registry.names(slot)),
             )
         self.post_message(self.FieldFocused(spec))
+
+
+def _unset(spec: FieldSpec) -> str:
+    """What a field with no value shows: that it must be given, or what it is left at."""
+    return "required" if spec.required else f"default: {display(spec.default) or 'not set'}"
 
 
 def _on_off(value: bool) -> str:

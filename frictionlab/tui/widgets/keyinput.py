@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 from textual import events
+from textual.binding import Binding
 from textual.message import Message
 from textual.widgets import Input
 
@@ -88,3 +89,22 @@ class KeyInput(Input):
             say_quit = getattr(self.app, "action_help_quit", None)
             if say_quit is not None:
                 say_quit(in_field=True)
+
+
+class FieldInput(KeyInput):
+    """A text field of the preset form. Enter leaves it, back to the form, as Esc does: Input's
+    own Enter (Submit, so F1 listed it) did nothing there. Up and Down go to the field above or
+    below (the form's keys), which F1 listed as a scroll of this one-line field."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._bindings = self._bindings.copy()  # this field's, not every Input's
+        keys = self._bindings.key_to_bindings
+        # F1 lists them; the footer keeps Esc's Leave field, as before
+        keys["enter"] = [Binding("enter", "leave_field", "Done", tooltip="leave the field (back to the form), as Esc", show=False)]
+        keys["down"] = [Binding("down", "app.focus_next", "Field below", tooltip="as Tab", show=False)]
+        keys["up"] = [Binding("up", "app.focus_previous", "Field above", tooltip="as Shift+Tab", show=False)]
+
+    def action_leave_field(self) -> None:
+        form = next(node for node in self.ancestors if hasattr(node, "action_leave_field"))  # the form, unimported
+        form.action_leave_field()

@@ -239,13 +239,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         points = self.query_one("#results-sweep", DataTable)
         if points.has_focus and self.open_sweep is not None:
             row = points.cursor_row
-            if not 0 <= row < len(self.open_sweep.points):
-                return
-            try:
-                entry = read_run(self.open_sweep.point_folder(self.open_sweep.points[row]))
-            except (OSError, FrictionlabError) as exc:
-                self.app.say(f"this point has no finished run to show ({exc})", "warning",
-                             about=self.open_sweep.path / f"point {row}")
+            if not 0 <= row < len(self.open_sweep.points) or (entry := self._point_run(row)) is None:
                 return
         else:
             row = self.query_one("#runs-table", DataTable).cursor_row
@@ -296,6 +290,31 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             self._inform(
                 Content(f"{name} is hidden from the plot: Space on its row shows it again; Enter opens a run.")
             )
+
+    def _point_run(self, row: int) -> RunEntry | None:
+        """The run of the open sweep's point ``row``; None, said why, where it has none to show."""
+        try:
+            return read_run(self.open_sweep.point_folder(self.open_sweep.points[row]))
+        except (OSError, FrictionlabError) as exc:
+            self.app.say(f"this point has no finished run to show ({exc})", "warning",
+                         about=self.open_sweep.path / f"point {row}")  # fmt: skip
+            return None
+
+    def open_point(self, sweep: Path, point: int) -> None:
+        """Enter on a point of the Run tab's sweep: the sweep open here, that point's run shown."""
+        self.app.reload_runs()
+        entry = next((e for e in self.runs if isinstance(e, SweepEntry) and e.path.resolve() == sweep.resolve()), None)
+        numbers = [row.get("point") for row in entry.points] if entry is not None else []
+        if point not in numbers:
+            self.app.say(f"point {point} of {shown(sweep)} has no finished run to show yet", "warning")
+            return
+        self.query_one("#runs-table", DataTable).move_cursor(row=self.runs.index(entry), animate=False)
+        self._show_sweep(entry)
+        row = numbers.index(point)
+        self.query_one("#results-sweep", SweepList).move_cursor(row=row, animate=False)
+        if (run := self._point_run(row)) is not None:
+            self.overlay = [run]
+            self._show_overlay()
 
     def _say_no_results(self, entry: RunEntry, shown_alone: bool) -> None:
         """A run that ended before it wrote its results (its process killed) has no curve: Enter and

@@ -142,6 +142,15 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             return not app.running and app.last_resumable
         return True
 
+    def on_data_table_row_selected(self, event) -> None:
+        """Enter on a finished point of the sweep: its run on the Results tab, the sweep's points beside it."""
+        event.stop()
+        app = self.app
+        folder = app.followed.folder if app.running else app.last_out_dir  # the latter is the last run's once it ends
+        if folder is not None:
+            app.action_show_tab("results")
+            app.query_one("ResultsPane").open_point(folder, int(event.row_key.value))
+
     def action_not_run(self) -> None:
         self.app.say(R_ON_RUN_TAB)
 

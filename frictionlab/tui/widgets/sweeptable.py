@@ -5,8 +5,10 @@ from __future__ import annotations
 
 from rich.cells import cell_len
 from rich.text import Text
+from textual.binding import Binding
 from textual.widgets import DataTable
 
+from ..hiddenkeys import idle_sideways
 from ..sweepview import row_cells, table_columns
 from .tables import ListTable
 
@@ -73,7 +75,14 @@ class SweepRows:
 
 
 class SweepTable(SweepRows, DataTable):
-    """The Run tab's table of a sweep's finished points."""
+    """The Run tab's table of a sweep's finished points: Enter opens a point's run on the Results
+    tab (F1 listed Enter as Select, and it did nothing); Left, Right and Ctrl+PgUp/PgDn are listed
+    only where the table is wider than the screen."""
+
+    BINDINGS = [Binding("enter", "select_cursor", "Open", tooltip="the point's run on the Results tab")]
+
+    def check_action(self, action: str, parameters) -> bool:
+        return not idle_sideways(self, action)
 
 
 class SweepList(SweepRows, ListTable):
