@@ -3,6 +3,8 @@ and its distribution, and none costs a run."""
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 from pydantic import Field
 
@@ -13,7 +15,9 @@ from frictionlab.options import RunOptions
 from frictionlab.plugin.registry import Registry, validate_plugin_class
 from frictionlab.preset import build_scene
 
+from .conftest import SMALL_PRESET
 from .test_registry import fake_dists  # noqa: F401 - the fixture
+from .testing.fakes import GoodSlopes, GoodSolver, GoodSpectrum
 
 RAISING_LOGGER = '''
 import frictionlab
@@ -267,3 +271,112 @@ def test_the_kit_names_a_solvers_float32_field_as_an_attribute_of_what_solve_ret
 
     with pytest.raises(AssertionError, match=r"on a line, solve\(\.\.\., control='force'\)\.force must be float64"):
         check_solver(Single)
+
+
+EXITING = '''
+import sys
+
+import frictionlab
+from frictionlab import ContactSolver, ForceNormalisation, Profile, SpectrumGenerator
+
+
+class ExitingLine(SpectrumGenerator):
+    name = "acme-exiting-line"
+    summary = "a line whose rms_height() ends the process"
+
+    def generate(self, rng):
+        return Profile(heights=rng.standard_normal(64), spacing=1.0)
+
+    def rms_height(self):
+        sys.exit(3)
+
+
+class ExitingSolver(ContactSolver):
+    name = "acme-exiting"
+    summary = "a solver whose solve() ends the process, with success"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
+
+    def stiffness(self):
+        return 1.0
+
+    def solve(self, profile, loads, control, slopes):
+        sys.exit(0)
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(ExitingLine)
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(ExitingSolver)
+'''
+
+
+@pytest.fixture
+def exiting_plugin(fake_dists):  # noqa: F811
+    """The exiting plugin installed, as the ``frictionlab`` command finds it."""
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-exits", "acme-exits", "acme_exits_plugin", EXITING)
+    registry_module.default_registry.cache_clear()
+    yield
+    registry_module.default_registry.cache_clear()
+
+
+def test_a_plugin_calling_sys_exit_in_a_realization_fails_it_and_the_run_says_so(exiting_plugin, small_preset,
+                                                                                 tmp_path, capsys):  # fmt: skip
+    """Taken as it came, the SystemExit ended the command silently with the plugin's code:
+    0 here, a run that never solved told as done (3 would have read as an unreadable preset)."""
+    import yaml
+
+    from frictionlab.cli.main import main
+
+    small_preset.update(realizations=3, solver={"name": "acme-exiting"})
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
+    code = main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet", "--no-plot"])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    assert ("solver 'acme-exiting' (acme_exits_plugin.ExitingSolver from acme-exits) raised SystemExit: 0 in "
+            "solve() at acme_exits_plugin.py:") in err  # fmt: skip
+    assert "no realization finished: 3 failed" in err and "Traceback" not in err
+
+
+def test_a_plugin_calling_sys_exit_before_the_run_is_told_as_its_fault(exiting_plugin, small_preset, tmp_path, capsys):
+    """Taken as it came, validate exited 3 without a word (as for a preset file it cannot read)."""
+    import yaml
+
+    from frictionlab.cli.main import main
+
+    small_preset["spectrum"] = {"name": "acme-exiting-line"}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert ("spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) raised SystemExit: 3 in "
+            "rms_height() at acme_exits_plugin.py:") in err  # fmt: skip
+    assert "Traceback" not in err
+
+
+class ExitingWorker(GoodSolver):
+    name = "acme-exiting-worker"
+
+    def solve(self, profile, loads, control, slopes):
+        sys.exit(5)
+
+
+def test_a_plugin_calling_sys_exit_in_a_worker_process_fails_its_realizations_not_the_worker(register_plugin):
+    """Taken as it came, each worker died three times over and the run ended on "a worker
+    process died", naming neither the plugin nor its line."""
+    registry = register_plugin(ExitingWorker)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    preset = {**SMALL_PRESET, "realizations": 4, "spectrum": {"name": "good-spectrum"},
+              "solver": {"name": "acme-exiting-worker"}, "slope": {"name": "good-slopes"}}  # fmt: skip
+    outcome = engine.run(build_scene(preset, registry=registry), RunOptions(workers=2, executor="processes"),
+                         registry=registry)  # fmt: skip
+    assert outcome.done == 0 and len(outcome.failures) == 4
+    for _, error in outcome.failures:
+        assert "solver 'acme-exiting-worker' (tests.test_plugin_faults.ExitingWorker from " in error
+        assert "raised SystemExit: 5 in solve() at test_plugin_faults.py:" in error

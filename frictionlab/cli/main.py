@@ -232,7 +232,7 @@ def _missing_package(exc: Exception, purpose: str):
     return MissingDependency(name, purpose)
 
 
-def _plugin_at_fault(exc: Exception):
+def _plugin_at_fault(exc: BaseException):
     """The PluginError that names the installed plugin whose code raised ``exc``, or None; a
     ``SolveFailed`` (a failure the plugin explains) as its message, naming it without blame."""
     if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
@@ -393,6 +393,11 @@ def _run_command(args) -> int:
 
             message += f"; {resumable(folder)}"
         return _refused(args, message, ExitCode.RUNTIME_FAILURE)
+    except SystemExit as exc:  # a plugin's sys.exit() before a realization (validate, realization 0's checks)
+        fault = _plugin_at_fault(exc)
+        if fault is None:
+            raise
+        return _refused(args, str(fault), fault.exit_code, f"{error_label()}: ")
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""

@@ -209,11 +209,11 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise
-    except Exception as exc:  # carried, not raised: one bad line must not end the run
+    except (Exception, SystemExit) as exc:  # carried, not raised: one bad line (a plugin's sys.exit()) must not end the run
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
-def _failure(scene: Scene, exc: Exception) -> str:
+def _failure(scene: Scene, exc: BaseException) -> str:
     """A realization's error as recorded, ``Type: message``: a failure the plugin explains
     (``SolveFailed``) as its message; one raised in a third party's plugin as that plugin's
     fault; a broken answer named with its plugin; anything else with the line that raised it."""
