@@ -274,6 +274,7 @@ def test_the_kit_names_a_solvers_float32_field_as_an_attribute_of_what_solve_ret
 
 
 EXITING = '''
+import os
 import sys
 
 import frictionlab
@@ -288,6 +289,8 @@ class ExitingLine(SpectrumGenerator):
         return Profile(heights=rng.standard_normal(64), spacing=1.0)
 
     def rms_height(self):
+        if os.environ.get("ACME_RAISE"):
+            raise KeyboardInterrupt  # by no Ctrl-C
         sys.exit(3)
 
 
@@ -344,39 +347,51 @@ def test_a_plugin_calling_sys_exit_in_a_realization_fails_it_and_the_run_says_so
     assert "no realization finished: 3 failed" in err and "Traceback" not in err
 
 
-def test_a_plugin_calling_sys_exit_before_the_run_is_told_as_its_fault(exiting_plugin, small_preset, tmp_path, capsys):
-    """Taken as it came, validate exited 3 without a word (as for a preset file it cannot read)."""
+@pytest.mark.parametrize("raising, said", [(False, "SystemExit: 3"), (True, "KeyboardInterrupt")])
+def test_a_plugin_ending_the_command_before_the_run_is_told_as_its_fault(exiting_plugin, small_preset, tmp_path, capsys,
+                                                                        monkeypatch, raising, said):  # fmt: skip
+    """Taken as it came, validate exited 3 without a word (as for a preset file it cannot read),
+    or 130, "interrupted", by no Ctrl-C."""
     import yaml
 
     from frictionlab.cli.main import main
 
+    if raising:
+        monkeypatch.setenv("ACME_RAISE", "1")
     small_preset["spectrum"] = {"name": "acme-exiting-line"}
     (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
     assert main(["validate", str(tmp_path / "p.yaml")]) == 2
     err = capsys.readouterr().err
-    assert ("spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) raised SystemExit: 3 in "
+    assert (f"spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) raised {said} in "
             "rms_height() at acme_exits_plugin.py:") in err  # fmt: skip
     assert "Traceback" not in err
 
 
-class ExitingWorker(GoodSolver):
-    name = "acme-exiting-worker"
-
+def _ending(how):
     def solve(self, profile, loads, control, slopes):
-        sys.exit(5)
+        if how == "exit":
+            sys.exit(5)
+        raise KeyboardInterrupt  # no Ctrl-C: none reaches a worker, nor the thread solving in this process
+
+    return type(f"Ending{how.title()}", (GoodSolver,), {"name": "acme-ending", "solve": solve})
 
 
-def test_a_plugin_calling_sys_exit_in_a_worker_process_fails_its_realizations_not_the_worker(register_plugin):
-    """Taken as it came, each worker died three times over and the run ended on "a worker
-    process died", naming neither the plugin nor its line."""
-    registry = register_plugin(ExitingWorker)
+@pytest.mark.parametrize("how, said", [("exit", "SystemExit: 5"), ("raise", "KeyboardInterrupt")])
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_plugin_ending_the_process_in_a_realization_fails_that_realization_alone(register_plugin, how, said, workers):
+    """Taken as it came, a worker process died three times over and the run ended on "a worker
+    process died", naming neither the plugin nor its line; in this process (one worker) the
+    command ended with the plugin's exit code, or as interrupted (exit 130) by no Ctrl-C."""
+    broken = _ending(how)
+    registry = register_plugin(broken)
     for cls in (GoodSpectrum, GoodSlopes):
         register_plugin(cls)
     preset = {**SMALL_PRESET, "realizations": 4, "spectrum": {"name": "good-spectrum"},
-              "solver": {"name": "acme-exiting-worker"}, "slope": {"name": "good-slopes"}}  # fmt: skip
-    outcome = engine.run(build_scene(preset, registry=registry), RunOptions(workers=2, executor="processes"),
+              "solver": {"name": "acme-ending"}, "slope": {"name": "good-slopes"}}  # fmt: skip
+    executor = "processes" if workers > 1 else "serial"
+    outcome = engine.run(build_scene(preset, registry=registry), RunOptions(workers=workers, executor=executor),
                          registry=registry)  # fmt: skip
     assert outcome.done == 0 and len(outcome.failures) == 4
     for _, error in outcome.failures:
-        assert "solver 'acme-exiting-worker' (tests.test_plugin_faults.ExitingWorker from " in error
-        assert "raised SystemExit: 5 in solve() at test_plugin_faults.py:" in error
+        assert f"solver 'acme-ending' (tests.test_plugin_faults.{broken.__name__} from " in error
+        assert f"raised {said} in solve() at test_plugin_faults.py:" in error

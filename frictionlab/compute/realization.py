@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import threading
 import time
 import traceback
@@ -210,6 +211,16 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         raise
     except (Exception, SystemExit) as exc:  # carried, not raised: one bad line (a plugin's sys.exit()) must not end the run
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
+    except KeyboardInterrupt as exc:  # Ctrl-C where a signal can raise it; elsewhere a plugin's own raise
+        if _signals_raise_here():
+            raise
+        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
+
+
+def _signals_raise_here() -> bool:
+    """Whether Ctrl-C (SIGTERM, SIGHUP) can raise KeyboardInterrupt in this thread: only in the main
+    thread of a process that does not ignore SIGINT (a pool's worker does: its parent stops it)."""
+    return threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN
 
 
 def _failure(scene: Scene, exc: BaseException) -> str:
