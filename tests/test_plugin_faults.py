@@ -395,3 +395,53 @@ def test_a_plugin_ending_the_process_in_a_realization_fails_that_realization_alo
     for _, error in outcome.failures:
         assert f"solver 'acme-ending' (tests.test_plugin_faults.{broken.__name__} from " in error
         assert f"raised {said} in solve() at test_plugin_faults.py:" in error
+
+
+VALIDATED = '''
+import frictionlab
+from pydantic import Field, field_validator
+from frictionlab import PluginParams, Profile, SpectrumGenerator
+
+
+class Alpha(SpectrumGenerator):
+    name = "acme-alpha"
+    summary = "a good line, listed first"
+
+    def generate(self, rng):
+        return Profile(heights=rng.standard_normal(64), spacing=1.0)
+
+    def rms_height(self):
+        return 1.0
+
+
+class Checked(Alpha):
+    name = "acme-checked"
+    summary = "a line whose Params validator has a bug"
+
+    class Params(PluginParams):
+        points: int = Field(64, ge=8, le=4096, description="number of points")
+
+        @field_validator("points")
+        @classmethod
+        def even(cls, value):
+            return value // (1 - value % 2)  # a bug: an odd value divides by zero
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Alpha)
+    register(Checked)
+'''
+
+
+def test_a_bug_in_a_params_validator_names_its_own_plugin_not_the_first_of_its_package(fake_dists, small_preset):  # noqa: F811
+    """A validator is a classmethod of Params (no plugin instance on the stack): taken as it came,
+    the fault went to the first plugin the package registered, acme-alpha."""
+    fake_dists("acme-checked", "acme-checked", "acme_checked_plugin", VALIDATED)
+    registry = Registry(env={})
+    small_preset["spectrum"] = {"name": "acme-checked", "params": {"points": 65}}
+    with pytest.raises(ZeroDivisionError) as excinfo:
+        build_scene(small_preset, registry=registry)
+    assert str(registry.at_fault(excinfo.value)).startswith(
+        "spectrum 'acme-checked' (acme_checked_plugin.Checked from acme-checked) raised ZeroDivisionError: "
+        "integer division or modulo by zero in even() at acme_checked_plugin.py:")
