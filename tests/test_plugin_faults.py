@@ -4,6 +4,7 @@ and its distribution, and none costs a run."""
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import pytest
 from pydantic import Field
@@ -276,6 +277,7 @@ def test_the_kit_names_a_solvers_float32_field_as_an_attribute_of_what_solve_ret
 EXITING = '''
 import os
 import sys
+from typing import Any
 
 import frictionlab
 from frictionlab import ContactSolver, ForceNormalisation, Profile, SpectrumGenerator
@@ -445,3 +447,24 @@ def test_a_bug_in_a_params_validator_names_its_own_plugin_not_the_first_of_its_p
     assert str(registry.at_fault(excinfo.value)).startswith(
         "spectrum 'acme-checked' (acme_checked_plugin.Checked from acme-checked) raised ZeroDivisionError: "
         "integer division or modulo by zero in even() at acme_checked_plugin.py:")
+
+
+class AnyExtra(GoodSpectrum):
+    name = "acme-any"
+    summary = "a line with a parameter of any type"
+
+    class Params(GoodSpectrum.Params):
+        extra: Any = Field(None, description="anything the plugin reads")
+
+
+def test_infinity_hidden_in_a_parameter_of_any_type_is_refused_as_in_a_number(register_plugin, small_preset):
+    """Taken as it came, the run went on and stored the value as null: resumed, it ran with None."""
+    from frictionlab.errors import PresetError
+
+    registry = register_plugin(AnyExtra)
+    small_preset["spectrum"] = {"name": "acme-any", "params": {"extra": [1.0, {"a": float("inf")}]}}
+    with pytest.raises(PresetError) as refused:
+        build_scene(small_preset, registry=registry)
+    assert refused.value.problems == ["spectrum.params.extra[1].a: must be a finite number, got inf"]
+    small_preset["spectrum"]["params"]["extra"] = [1.0, {"a": "text", "b": [2, None]}]
+    assert build_scene(small_preset, registry=registry).spectrum.params.extra[1]["b"] == [2, None]
