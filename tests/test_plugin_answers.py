@@ -195,10 +195,11 @@ def _in_place_slopes(self, heights, spacing, periodic=True):
     return GoodSlopes.slopes(self, heights, spacing, periodic)
 
 
-def _solved(method, values):
+def _solved(method, values, source=None):
+    """A good solve() whose ``method`` is ``values`` of its own (or of its ``source``: a declared array it gives)."""
     def solve(self, profile, loads, control, slopes):
         curve = GoodSolver.solve(self, profile, loads, control, slopes)
-        return replace(curve, **{method: values(getattr(curve, method))})
+        return replace(curve, **{method: values(getattr(curve, source or method))})
 
     return solve
 
@@ -233,6 +234,15 @@ RUN_BROKEN = {
                              "solve(..., control='force').indentation must not decrease as the load grows. Got "),
     "reversed-count": (GoodSolver, {"solve": _solved("contact_count", lambda c: c[::-1].copy())},
                        "solve(..., control='force').contact_count must not decrease as the load grows. Got "),
+    "negative-rms": (GoodSolver, {"solve": _solved("slope_rms_contact", lambda r: -r)},
+                     "solve().slope_rms_contact must lie in [0, max |slope| = "),
+    "rms-past-the-steepest": (GoodSolver, {"solve": _solved("slope_rms_contact", lambda r: r * 1e6)},
+                              "solve().slope_rms_contact must lie in [0, max |slope| = "),
+    "negative-gradient": (GoodSolver, {"real_gradient": True, "solve": _solved("real_gradient_rms", lambda r: -r, "slope_rms_contact")},
+                          "solve().real_gradient_rms is an rms slope and must be >= 0. Got array([-"),
+    "area-past-the-count": (GoodSolver, {"corrected_area": True,
+                                         "solve": _solved("real_area_corrected", lambda a: 2 * a, "contact_fraction")},
+                            "solve().real_area_corrected must lie in [0, contact_fraction]"),
 }
 
 

@@ -3,6 +3,9 @@ and its distribution, and none costs a run."""
 
 from __future__ import annotations
 
+import sys
+from typing import Any
+
 import pytest
 from pydantic import Field
 
@@ -13,7 +16,9 @@ from frictionlab.options import RunOptions
 from frictionlab.plugin.registry import Registry, validate_plugin_class
 from frictionlab.preset import build_scene
 
+from .conftest import SMALL_PRESET
 from .test_registry import fake_dists  # noqa: F401 - the fixture
+from .testing.fakes import GoodSlopes, GoodSolver, GoodSpectrum
 
 RAISING_LOGGER = '''
 import frictionlab
@@ -267,3 +272,199 @@ def test_the_kit_names_a_solvers_float32_field_as_an_attribute_of_what_solve_ret
 
     with pytest.raises(AssertionError, match=r"on a line, solve\(\.\.\., control='force'\)\.force must be float64"):
         check_solver(Single)
+
+
+EXITING = '''
+import os
+import sys
+from typing import Any
+
+import frictionlab
+from frictionlab import ContactSolver, ForceNormalisation, Profile, SpectrumGenerator
+
+
+class ExitingLine(SpectrumGenerator):
+    name = "acme-exiting-line"
+    summary = "a line whose rms_height() ends the process"
+
+    def generate(self, rng):
+        return Profile(heights=rng.standard_normal(64), spacing=1.0)
+
+    def rms_height(self):
+        if os.environ.get("ACME_RAISE"):
+            raise KeyboardInterrupt  # by no Ctrl-C
+        sys.exit(3)
+
+
+class ExitingSolver(ContactSolver):
+    name = "acme-exiting"
+    summary = "a solver whose solve() ends the process, with success"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
+
+    def stiffness(self):
+        return 1.0
+
+    def solve(self, profile, loads, control, slopes):
+        sys.exit(0)
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(ExitingLine)
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(ExitingSolver)
+'''
+
+
+@pytest.fixture
+def exiting_plugin(fake_dists):  # noqa: F811
+    """The exiting plugin installed, as the ``frictionlab`` command finds it."""
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-exits", "acme-exits", "acme_exits_plugin", EXITING)
+    registry_module.default_registry.cache_clear()
+    yield
+    registry_module.default_registry.cache_clear()
+
+
+def test_a_plugin_calling_sys_exit_in_a_realization_fails_it_and_the_run_says_so(exiting_plugin, small_preset,
+                                                                                 tmp_path, capsys):  # fmt: skip
+    """Taken as it came, the SystemExit ended the command silently with the plugin's code:
+    0 here, a run that never solved told as done (3 would have read as an unreadable preset)."""
+    import yaml
+
+    from frictionlab.cli.main import main
+
+    small_preset.update(realizations=3, solver={"name": "acme-exiting"})
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
+    code = main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet", "--no-plot"])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    assert ("solver 'acme-exiting' (acme_exits_plugin.ExitingSolver from acme-exits) raised SystemExit: 0 in "
+            "solve() at acme_exits_plugin.py:") in err  # fmt: skip
+    assert "no realization finished: 3 failed" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("raising, said", [(False, "SystemExit: 3"), (True, "KeyboardInterrupt")])
+def test_a_plugin_ending_the_command_before_the_run_is_told_as_its_fault(exiting_plugin, small_preset, tmp_path, capsys,
+                                                                        monkeypatch, raising, said):  # fmt: skip
+    """Taken as it came, validate exited 3 without a word (as for a preset file it cannot read),
+    or 130, "interrupted", by no Ctrl-C."""
+    import yaml
+
+    from frictionlab.cli.main import main
+
+    if raising:
+        monkeypatch.setenv("ACME_RAISE", "1")
+    small_preset["spectrum"] = {"name": "acme-exiting-line"}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert (f"spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) raised {said} in "
+            "rms_height() at acme_exits_plugin.py:") in err  # fmt: skip
+    assert "Traceback" not in err
+
+
+def _ending(how):
+    def solve(self, profile, loads, control, slopes):
+        if how == "exit":
+            sys.exit(5)
+        raise KeyboardInterrupt  # no Ctrl-C: none reaches a worker, nor the thread solving in this process
+
+    return type(f"Ending{how.title()}", (GoodSolver,), {"name": "acme-ending", "solve": solve})
+
+
+@pytest.mark.parametrize("how, said", [("exit", "SystemExit: 5"), ("raise", "KeyboardInterrupt")])
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_plugin_ending_the_process_in_a_realization_fails_that_realization_alone(register_plugin, how, said, workers):
+    """Taken as it came, a worker process died three times over and the run ended on "a worker
+    process died", naming neither the plugin nor its line; in this process (one worker) the
+    command ended with the plugin's exit code, or as interrupted (exit 130) by no Ctrl-C."""
+    broken = _ending(how)
+    registry = register_plugin(broken)
+    for cls in (GoodSpectrum, GoodSlopes):
+        register_plugin(cls)
+    preset = {**SMALL_PRESET, "realizations": 4, "spectrum": {"name": "good-spectrum"},
+              "solver": {"name": "acme-ending"}, "slope": {"name": "good-slopes"}}  # fmt: skip
+    executor = "processes" if workers > 1 else "serial"
+    outcome = engine.run(build_scene(preset, registry=registry), RunOptions(workers=workers, executor=executor),
+                         registry=registry)  # fmt: skip
+    assert outcome.done == 0 and len(outcome.failures) == 4
+    for _, error in outcome.failures:
+        assert f"solver 'acme-ending' (tests.test_plugin_faults.{broken.__name__} from " in error
+        assert f"raised {said} in solve() at test_plugin_faults.py:" in error
+
+
+VALIDATED = '''
+import frictionlab
+from pydantic import Field, field_validator
+from frictionlab import PluginParams, Profile, SpectrumGenerator
+
+
+class Alpha(SpectrumGenerator):
+    name = "acme-alpha"
+    summary = "a good line, listed first"
+
+    def generate(self, rng):
+        return Profile(heights=rng.standard_normal(64), spacing=1.0)
+
+    def rms_height(self):
+        return 1.0
+
+
+class Checked(Alpha):
+    name = "acme-checked"
+    summary = "a line whose Params validator has a bug"
+
+    class Params(PluginParams):
+        points: int = Field(64, ge=8, le=4096, description="number of points")
+
+        @field_validator("points")
+        @classmethod
+        def even(cls, value):
+            return value // (1 - value % 2)  # a bug: an odd value divides by zero
+
+
+@frictionlab.hookimpl
+def register_spectra(register):
+    register(Alpha)
+    register(Checked)
+'''
+
+
+def test_a_bug_in_a_params_validator_names_its_own_plugin_not_the_first_of_its_package(fake_dists, small_preset):  # noqa: F811
+    """A validator is a classmethod of Params (no plugin instance on the stack): taken as it came,
+    the fault went to the first plugin the package registered, acme-alpha."""
+    fake_dists("acme-checked", "acme-checked", "acme_checked_plugin", VALIDATED)
+    registry = Registry(env={})
+    small_preset["spectrum"] = {"name": "acme-checked", "params": {"points": 65}}
+    with pytest.raises(ZeroDivisionError) as excinfo:
+        build_scene(small_preset, registry=registry)
+    assert str(registry.at_fault(excinfo.value)).startswith(
+        "spectrum 'acme-checked' (acme_checked_plugin.Checked from acme-checked) raised ZeroDivisionError: "
+        "integer division or modulo by zero in even() at acme_checked_plugin.py:")
+
+
+class AnyExtra(GoodSpectrum):
+    name = "acme-any"
+    summary = "a line with a parameter of any type"
+
+    class Params(GoodSpectrum.Params):
+        extra: Any = Field(None, description="anything the plugin reads")
+
+
+def test_infinity_hidden_in_a_parameter_of_any_type_is_refused_as_in_a_number(register_plugin, small_preset):
+    """Taken as it came, the run went on and stored the value as null: resumed, it ran with None."""
+    from frictionlab.errors import PresetError
+
+    registry = register_plugin(AnyExtra)
+    small_preset["spectrum"] = {"name": "acme-any", "params": {"extra": [1.0, {"a": float("inf")}]}}
+    with pytest.raises(PresetError) as refused:
+        build_scene(small_preset, registry=registry)
+    assert refused.value.problems == ["spectrum.params.extra[1].a: must be a finite number, got inf"]
+    small_preset["spectrum"]["params"]["extra"] = [1.0, {"a": "text", "b": [2, None]}]
+    assert build_scene(small_preset, registry=registry).spectrum.params.extra[1]["b"] == [2, None]

@@ -35,7 +35,7 @@ from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_une
                       out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, refuse_blas_without_room,
                             spare_address_space_under_a_limit)  # fmt: skip
-from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word
+from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word, received
 from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
 from .console import error_label
 
@@ -232,7 +232,7 @@ def _missing_package(exc: Exception, purpose: str):
     return MissingDependency(name, purpose)
 
 
-def _plugin_at_fault(exc: Exception):
+def _plugin_at_fault(exc: BaseException):
     """The PluginError that names the installed plugin whose code raised ``exc``, or None; a
     ``SolveFailed`` (a failure the plugin explains) as its message, naming it without blame."""
     if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none is at fault
@@ -393,7 +393,13 @@ def _run_command(args) -> int:
 
             message += f"; {resumable(folder)}"
         return _refused(args, message, ExitCode.RUNTIME_FAILURE)
-    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
+    except (SystemExit, KeyboardInterrupt) as exc:  # a plugin's sys.exit() or raise outside a realization (validate)
+        fault = None if received else _plugin_at_fault(exc)  # after a signal: Ctrl-C's, wherever it landed
+        if fault is not None:
+            return _refused(args, str(fault), fault.exit_code, f"{error_label()}: ")
+        if isinstance(exc, SystemExit):
+            raise
+        # Ctrl-C, SIGTERM or SIGHUP (signals.Terminated), or a command of several runs
         code = interrupted_exit_code()  # stopped after one (signals.WorkInterrupted: it says what is kept)
         said = f": {shown(str(exc))}" if str(exc) else ""
         return _refused(args, f"{interrupted_word()}{said}", code, "")

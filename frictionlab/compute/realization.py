@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import threading
 import time
 import traceback
@@ -19,8 +20,8 @@ import numpy as np
 from ..errors import PluginError
 from ..plugin.registry import plugin_fault
 from ..plugin.outputs import (
-    LEAVE_INPUTS, RandomWatch, curve_problem, height_of, order_problem, profile_problem, read_only, refuse,
-    reported_problem, schedule_problem, seed_problem, slopes_problem,
+    LEAVE_INPUTS, RandomWatch, curve_problem, height_of, largest_magnitude, order_problem, profile_problem, read_only,
+    refuse, reported_problem, schedule_problem, seed_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
@@ -121,8 +122,7 @@ def slope_scale(slopes: np.ndarray) -> float:
     """1, or the power of two that brings the largest magnitude among ``slopes`` to about 1
     when their squares would overflow or underflow (heights over spacing past 1e154, say: both
     numbers a preset allows); a power of two scales every slope exactly."""
-    # the extremes, passing NaN by (an undefined slope), rather than a temporary of |slopes|
-    largest = float(np.fmax(np.fmax.reduce(slopes, axis=None), -np.fmin.reduce(slopes, axis=None))) if slopes.size else 0.0
+    largest = largest_magnitude(slopes)  # NaN ones (undefined slopes) passed by
     if not math.isfinite(largest) or largest == 0.0 or 1 / SAFE_SLOPE <= largest <= SAFE_SLOPE:
         return 1.0
     return math.ldexp(1.0, -math.frexp(largest)[1])
@@ -147,7 +147,7 @@ def _solve(scene: Scene, profile, slopes: np.ndarray, watch: _SolveWatch, unit: 
     curve = scene.solver.solve(profile, read_only(loads), control, slopes)
     refuse(scene.solver, randomness.problem("solve()")
            or curve_problem(scene.solver, curve, loads.size)
-           or reported_problem(curve, loads, control, profile.points)
+           or reported_problem(curve, loads, control, profile.points, largest_magnitude(slopes))
            or order_problem(scene.solver, curve, control))  # fmt: skip
     return curve
 
@@ -209,11 +209,21 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise
-    except Exception as exc:  # carried, not raised: one bad line must not end the run
+    except (Exception, SystemExit) as exc:  # carried, not raised: one bad line (a plugin's sys.exit()) must not end the run
+        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
+    except KeyboardInterrupt as exc:  # Ctrl-C where a signal can raise it; elsewhere a plugin's own raise
+        if _signals_raise_here():
+            raise
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
-def _failure(scene: Scene, exc: Exception) -> str:
+def _signals_raise_here() -> bool:
+    """Whether Ctrl-C (SIGTERM, SIGHUP) can raise KeyboardInterrupt in this thread: only in the main
+    thread of a process that does not ignore SIGINT (a pool's worker does: its parent stops it)."""
+    return threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN
+
+
+def _failure(scene: Scene, exc: BaseException) -> str:
     """A realization's error as recorded, ``Type: message``: a failure the plugin explains
     (``SolveFailed``) as its message; one raised in a third party's plugin as that plugin's
     fault; a broken answer named with its plugin; anything else with the line that raised it."""

@@ -22,7 +22,7 @@ import traceback
 import warnings
 from typing import TYPE_CHECKING, Protocol
 
-from .base import Plugin
+from .base import Plugin, PluginParams
 from .hookspecs import hookspec
 
 if TYPE_CHECKING:  # annotations only: the engine imports this module
@@ -77,15 +77,26 @@ LIFECYCLE_HOOKS = (
 
 def fault_site(exc: BaseException, package: str):
     """Where ``exc`` was raised in ``package`` (a plugin's top-level module): its innermost frame
-    there, ``solve() at module.py:12``, and the plugin instance whose method is nearest to it on
-    the stack (a helper function has none of its own); (None, "", None) if no frame is there."""
+    there, ``solve() at module.py:12``, and the class of the plugin (or of its ``Params``) whose
+    method is nearest to it on the stack (a helper function has none of its own; a validator is a
+    classmethod: its ``cls``); (None, "", None) if no frame is there."""
     frames = [(frame, lineno) for frame, lineno in traceback.walk_tb(exc.__traceback__)
               if str(frame.f_globals.get("__name__", "")).partition(".")[0] == package][::-1]  # fmt: skip
     if not frames:
         return None, "", None
     frame, lineno = frames[0]
-    owner = next((f.f_locals["self"] for f, _ in frames if isinstance(f.f_locals.get("self"), Plugin)), None)
+    owner = next((kind for f, _ in frames if (kind := _owner(f.f_locals)) is not None), None)
     return frame, f"{frame.f_code.co_name}() at {os.path.basename(frame.f_code.co_filename)}:{lineno}", owner
+
+
+def _owner(names: dict) -> type | None:
+    """The Plugin or PluginParams class a frame's ``self`` or ``cls`` is (or is an instance of), or None."""
+    for name in ("self", "cls"):
+        value = names.get(name)
+        kind = value if isinstance(value, type) else type(value)
+        if value is not None and issubclass(kind, (Plugin, PluginParams)):
+            return kind
+    return None
 
 
 class GuardedListener:

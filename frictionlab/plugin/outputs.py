@@ -157,10 +157,23 @@ def curve_problem(solver: ContactSolver, curve, loads: int, where: str = "solve(
     return None
 
 
-def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, points: int) -> str | None:
+SLOPE_RTOL = 1e-6  # an rms of slopes past the largest by this much: the rounding of sums over a million points, not a bug
+
+
+def largest_magnitude(values: np.ndarray) -> float:
+    """The largest |value|, NaN ones passed by (0 for none; NaN when all are), without a
+    temporary the size of ``values``."""
+    if not values.size:
+        return 0.0
+    return float(np.fmax(np.fmax.reduce(values, axis=None), -np.fmin.reduce(values, axis=None)))
+
+
+def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, points: int, steepest: float) -> str | None:
     """What is wrong with the numbers of a well-formed ``curve`` solved for ``loads`` under ``control``
-    on a profile of ``points`` points: the loads not reported as asked (within 1%, as the
-    conformance kit asks), a count or fraction out of its range."""
+    on a profile of ``points`` points whose largest |slope| handed to the solver is ``steepest``: the
+    loads not reported as asked (within 1%, as the conformance kit asks), a count or fraction out of
+    its range, an rms slope below 0 or (in contact) past ``steepest``, a corrected area out of
+    [0, contact_fraction]."""
     reported, what = getattr(curve, control), f"solve(..., control={control!r}).{control}"
     if not np.allclose(reported, loads, rtol=1e-2, atol=0):
         return f"{what} must report the loads asked for: {short_repr(loads, 300)}. Got {short_repr(reported, 300)} instead."
@@ -169,6 +182,16 @@ def reported_problem(curve: ContactCurve, loads: np.ndarray, control: str, point
         return f"solve().contact_count must lie in 0 .. {points} (points of the profile). Got {short_repr(count, 300)}."
     if fraction.size and (fraction.min() < 0 or fraction.max() > 1):
         return f"solve().contact_fraction must lie in [0, 1]. Got {short_repr(fraction, 300)}."
+    rms = curve.slope_rms_contact  # NaN (where declared) compares False: passed by
+    if np.any(rms < 0) or np.any(rms > steepest * (1 + SLOPE_RTOL)):
+        return (f"solve().slope_rms_contact must lie in [0, max |slope| = {steepest:.6g}] (an rms of the slopes "
+                f"solve() is given, over the points in contact). Got {short_repr(rms, 300)}.")  # fmt: skip
+    if curve.real_gradient_rms is not None and np.any(curve.real_gradient_rms < 0):
+        return f"solve().real_gradient_rms is an rms slope and must be >= 0. Got {short_repr(curve.real_gradient_rms, 300)}."
+    corrected = curve.real_area_corrected
+    if corrected is not None and (np.any(corrected < 0) or np.any(corrected > fraction * (1 + 1e-12))):
+        return ("solve().real_area_corrected must lie in [0, contact_fraction]: the correction removes part of the "
+                f"pixels counted. Got {short_repr(corrected, 300)}.")  # fmt: skip
     return None
 
 

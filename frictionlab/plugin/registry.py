@@ -412,10 +412,11 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
     for package, cls in packages.items():
         frame, where, owner = fault_site(exc, package)
         if frame is not None:
-            cls = cls if owner is None else type(owner)
+            if owner is not None:  # a Params class: the plugin it is of (another class of the package may be first)
+                cls = owner if issubclass(owner, Plugin) else next((c for c in classes if c.Params is owner), cls)
+            said = f": {short_repr(str(exc), 300)[1:-1]}" if str(exc) else ""  # MemoryError(), sys.exit(): no message
             return PluginError(
-                f"{plugin_label(cls)} raised "
-                f"{type(exc).__name__}: {short_repr(str(exc), 300)[1:-1]} in {where}; the plugin is at fault: "
+                f"{plugin_label(cls)} raised {type(exc).__name__}{said} in {where}; the plugin is at fault: "
                 "tell its authors, or choose another plugin"
             )
     return None

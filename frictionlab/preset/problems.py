@@ -317,11 +317,25 @@ def number_problems(model: type[BaseModel], data, prefix: str = "") -> list[str]
             problem = _number_problem(value, path, allow, "text or a number" if str in kinds else "a number",
                                       positive=_refuses_zero(field), own=Bounds.of(field))  # fmt: skip
             problems += [problem] if problem else []
+        elif kinds & {typing.Any, object} and not allow:  # any value: none may hide an infinity JSON cannot hold
+            problems += _non_finite(value, path)
         elif (sequence := _sequence_kind(kinds)) is not None and isinstance(value, list):
             items = set().union(*(_kinds(a) for a in typing.get_args(sequence) if a is not Ellipsis))
             if items & {int, float} and bool not in items:
                 problems += [p for i, v in enumerate(value) if (p := _number_problem(v, f"{path}[{i}]", allow))]
     return problems
+
+
+def _non_finite(value, path: str) -> list[str]:
+    """Infinity or NaN anywhere in ``value`` (a field of any type): summary.json would write it as
+    null, and a resume would then run with None (every other field refuses them by its type)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return [f"{path}: must be a finite number, got {value!r}"]
+    if isinstance(value, dict):
+        return [p for key, entry in value.items() for p in _non_finite(entry, f"{path}.{key}")]
+    if isinstance(value, list | tuple):
+        return [p for i, entry in enumerate(value) for p in _non_finite(entry, f"{path}[{i}]")]
+    return []
 
 
 def merge_problems(numbers: list[str], pydantic_lines: list[str]) -> list[str]:
