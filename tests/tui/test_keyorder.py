@@ -235,6 +235,18 @@ async def test_keys_typed_after_q_are_dropped_not_answered_on_a_closing_screen(f
     assert app.return_code == 0
 
 
+async def realizations_typed_then(pilot, value: str, key: str) -> list[str]:
+    """The first preset open, ``value`` typed into its realizations, then Esc and ``key`` posted in
+    one burst, as a terminal delivers keys typed fast; the list of what the app says from then."""
+    app = pilot.app
+    await open_first_preset(pilot)
+    app.query_one("#field--realizations", Input).focus()
+    await pilot.pause()
+    said = record_said(app)
+    post_keys(app, ["end", "ctrl+u", *value, "escape", key])
+    return said
+
+
 @pytest.mark.parametrize("value", ["0", "12"], ids=["a-problem", "valid"])
 @sync
 async def test_a_value_typed_then_esc_and_ctrl_s_at_once_is_the_one_saved(folders, registry, value):
@@ -246,11 +258,7 @@ async def test_a_value_typed_then_esc_and_ctrl_s_at_once_is_the_one_saved(folder
 
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await open_first_preset(pilot)
-        app.query_one("#field--realizations", Input).focus()
-        await pilot.pause()
-        said = record_said(app)
-        post_keys(app, ["end", "ctrl+u", *value, "escape", "ctrl+s"])
+        said = await realizations_typed_then(pilot, value, "ctrl+s")
         await wait_until(pilot, lambda: isinstance(app.screen, ConfirmScreen) or any(s.startswith("Saved") for s in said), timeout=10.0)
         await pilot.pause()
         asked, modified = isinstance(app.screen, ConfirmScreen), app.modified
@@ -264,11 +272,7 @@ async def test_a_problem_typed_then_esc_and_ctrl_r_at_once_runs_nothing(folders,
     the field showed refused (realizations 0) while the run went on with the old one."""
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
-        await open_first_preset(pilot)
-        app.query_one("#field--realizations", Input).focus()
-        await pilot.pause()
-        said = record_said(app)
-        post_keys(app, ["end", "ctrl+u", "0", "escape", "ctrl+r"])
+        said = await realizations_typed_then(pilot, "0", "ctrl+r")
         await wait_until(pilot, lambda: app.running or app.last_outcome is not None or bool(said), timeout=10.0)
         started = app.running or app.last_outcome is not None
         if app.running:
