@@ -166,6 +166,8 @@ BROKEN_ANSWERS = {
     "no-spacing": ("spectrum", "generate", lambda p: Profile(p.heights, 0.0), "Profile.spacing must be finite and > 0"),
     "short-slopes": ("slope", "slopes", lambda s: s[:-1], "slopes() must have shape (64,). Got (63,)"),
     "nan-slopes": ("slope", "slopes", lambda s: s * np.nan, "slopes() must be finite"),
+    # was 'the rms slope of the whole line is 0.0 (is the line constant?)', naming no plugin
+    "zero-slopes": ("slope", "slopes", np.zeros_like, "slopes() gave 0 at every point of a line whose heights span "),
     "short-curve": ("solver", "solve", lambda c: replace_curve(c, slope_rms_contact=c.slope_rms_contact[:-1]),
                     "solve().slope_rms_contact must have shape (12,). Got (11,)"),
     "text-counts": ("solver", "solve", lambda c: replace_curve(c, contact_count=c.contact_count.astype(str)),
