@@ -180,6 +180,7 @@ class FinishedSweep:
     total: int
     elapsed: float
     last: FinishedRun | None  # None when no point wrote its results
+    last_point: int | None = None  # its number, from 1
 
 
 def read_finished_sweep(folder: Path) -> FinishedSweep:
@@ -188,14 +189,15 @@ def read_finished_sweep(folder: Path) -> FinishedSweep:
     from ..errors import FrictionlabError
 
     entry, state = read_sweep(folder), sweep_state(folder)
-    last = None
-    for row in reversed(entry.points):
+    last, number = None, None
+    for number, row in reversed(list(enumerate(entry.points, start=1))):
         try:
             last = read_finished(entry.point_folder(row))
             break
         except (FrictionlabError, OSError, ValueError, TypeError, KeyError):
             continue
-    return FinishedSweep(state.status, state.done or 0, state.total or 0, entry.elapsed, last)
+    return FinishedSweep(state.status, state.done or 0, state.total or 0, entry.elapsed, last,
+                         number if last is not None else None)  # fmt: skip
 
 
 def read_finished(folder: Path) -> FinishedRun:

@@ -313,12 +313,13 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
 
     # ------------------------------------------------------------ at the end
 
-    def show_outcome(self, run) -> str:
-        """Show a finished run (``FinishedRun``, read back from its folder); return the line the app notifies."""
+    def show_outcome(self, run, point: str = "") -> str:
+        """Show a finished run (``FinishedRun``, read back from its folder), ``point`` the sweep's point it
+        is ('point 3/3: ', said before its bar's line); return the line the app notifies."""
         result = run.result
         done, requested = result.realizations
         self._show_bar(requested, done)
-        self._set("run-stats", f"{result.status}: {done}/{requested} realizations in "
+        self._set("run-stats", f"{point}{result.status}: {done}/{requested} realizations in "
                                f"{format_duration(result.elapsed)}, {run.workers} worker"
                                f"{'s' if run.workers != 1 else ''}")  # fmt: skip
         f, xi = result.table["f"], result.table["xi"]
@@ -339,7 +340,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     def show_sweep_outcome(self, sweep) -> str:
         """Show a finished sweep (``FinishedSweep``, read back from its folder); return the line the app notifies."""
         if sweep.last is not None:  # the last point as it ended (a short one may have been over before it was read)
-            self.show_outcome(sweep.last)
+            self.show_outcome(sweep.last, f"point {sweep.last_point}/{sweep.total}: ")  # its bar, not the sweep's
         self._set("sweep-point", f"{sweep.status}: {sweep.finished}/{sweep.total} points in "
                                  f"{format_duration(sweep.elapsed)} (sweep.csv, sweep.png)")  # fmt: skip
         return f"Sweep {sweep.status}: {sweep.finished}/{sweep.total} points"
