@@ -347,13 +347,14 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         else:
             self.draft_source, self.disk_stamp = None, None
         self.draft_path = path
-        await self.query_one("#form").load(data, base_dir=path.parent)
-        if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one
-            self.say("")
-        self.modified = modified
-        self._saved = None if modified else copy.deepcopy(self._draft())
-        self._show_edit_state()
-        self.action_show_tab("edit")
+        with self.batch_update():  # the new form and its tab drawn once, not as each part of them is built
+            await self.query_one("#form").load(data, base_dir=path.parent)
+            if self.query_one("#status").has_class("-error") or self.taken_back_on == "open":  # not this one
+                self.say("")
+            self.modified = modified
+            self._saved = None if modified else copy.deepcopy(self._draft())
+            self._show_edit_state()
+            self.action_show_tab("edit")
 
     def duplicate_selected_preset(self) -> None:
         entry = self.query_one(PresetsPane).selected()
