@@ -110,8 +110,11 @@ async def test_the_info_box_under_the_plot_is_read_whole_at_60x20(folders, regis
         missing = [word for word in " ".join(said).split() if not any(word in step for step in seen)]
         assert len(said) >= 2 and not missing, (name, missing)
     assert said[-1].strip().endswith("Esc goes back to the list.")
-    last = read["seed1-with-a-longer-name"][0][-2:]  # b= and its interval, on a line of its own in 20 columns
-    assert "b=0.0150" in " ".join(last) and last[-1].strip().startswith("[")
+    lines = read["seed1-with-a-longer-name"][0]
+    b_line = next(i for i, line in enumerate(lines) if "b=0.0150" in line)
+    assert lines[b_line + 1].strip().startswith("[")  # b's interval, on a line of its own in 20 columns
+    # then what a and b are, and the intervals' level, as the Run tab says them
+    assert " ".join(lines[b_line + 2:]).split() == ["in", "xi", "=", "a", "+", "b", "ln", "f,", "95%", "CI"]
 
 @pytest.mark.long  # a TUI session
 @sync
