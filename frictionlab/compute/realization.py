@@ -212,11 +212,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         )
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise
-    except (Exception, SystemExit) as exc:  # carried, not raised: one bad line (a plugin's sys.exit()) must not end the run
-        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
-    except KeyboardInterrupt as exc:  # Ctrl-C where a signal can raise it; elsewhere a plugin's own raise
-        if _signals_raise_here():
-            raise
+    except (Exception, SystemExit, KeyboardInterrupt) as exc:  # carried, not raised: one bad line (a plugin's
+        if isinstance(exc, KeyboardInterrupt) and _signals_raise_here():  # sys.exit()) must not end the run; Ctrl-C
+            raise  # must, where a signal can raise it (elsewhere it is a plugin's own raise)
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
 
 
