@@ -84,7 +84,7 @@ class LogFit:
         return self.a + self.b * np.log(f)
 
     def __repr__(self) -> str:  # rounded as the CLI prints a fit; the exact numbers are the fields
-        level = f"{100 * self.confidence:g}% CI" + (f", bootstrap {self.bootstrap}" if self.bootstrap else "")
+        level = ci_label(self.confidence) + (f", bootstrap {self.bootstrap}" if self.bootstrap else "")
         fitted = f"; R² = {format_number(self.r2)}, {self.points} points" if self.points else ""  # else a law given by hand
         return f"LogFit(a = {format_estimate(self.a, self.a_ci)}, b = {format_estimate(self.b, self.b_ci)} ({level}){fitted})"
 
@@ -101,6 +101,11 @@ def json_safe(value):
 def format_number(value: float, digits: int = 4) -> str:
     """``value`` with ``digits`` decimals, or in ``g`` form when that would run long (from 1e6)."""
     return f"{value:.{digits}f}" if abs(value) < 1e6 else f"{value:.{digits + 2}g}"
+
+
+def ci_label(confidence: float) -> str:
+    """The intervals' level as every front end says it: ``95% CI``."""
+    return f"{100 * confidence:g}% CI"
 
 
 def format_interval(ci, digits: int = 4, missing: str = "n/a", sep: str = ", ") -> str:

@@ -17,7 +17,7 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown, shown_name
-from ...compute.fit import format_interval
+from ...compute.fit import ci_label, format_interval
 from ...io.values import number_or_nan
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
@@ -398,8 +398,7 @@ def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
         lines += packed([f"a={entry.a:.4f}", interval("a_ci"), f"R^2={entry.r2:.4f}"], width)
         lines += packed([f"b={entry.b:.4f}", interval("b_ci")], width)
         level = number_or_nan(entry.fit.get("confidence"))
-        law = ["in", "xi = a + b ln f"]  # what a and b are, and the intervals' level, as the Run tab says them
-        if entry.interval("a_ci") is not None and 0 < level < 1:
-            law = [*law[:-1], "xi = a + b ln f,", f"{100 * level:g}% CI"]
-        lines += packed(law, width)  # after the numbers: a short box shows them first
+        leveled = entry.interval("a_ci") is not None and 0 < level < 1
+        # what a and b are, and the intervals' level, as the Run tab says them; after the numbers: a short box shows them first
+        lines += packed(["in", "xi = a + b ln f,", ci_label(level)] if leveled else ["in", "xi = a + b ln f"], width)
     return [Content(line) if isinstance(line, str) else line for line in lines]

@@ -14,7 +14,7 @@ from textual.content import Content
 from textual.widgets import ProgressBar, Static
 
 from ...errors import shown
-from ...compute.fit import format_estimate
+from ...compute.fit import ci_label, format_estimate
 from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
@@ -35,7 +35,7 @@ def fit_lines(fit, *, final: bool, f_formula: str = "", short: bool = False) -> 
     head = "xi = a + b ln f" + ("" if final else "  (interim)")
     lines = [head, *what, f"  a = {fit.a:.4f}", f"  b = {fit.b:.4f}"]
     if final:
-        level = f"{100 * fit.confidence:g}% CI"
+        level = ci_label(fit.confidence)
         about = [f"  {level}, bootstrap {fit.bootstrap}"] if fit.bootstrap else [
             "  no CI (bootstrap off,", "  or < 2 realizations)"]  # either; two lines: the panel is as wide as its longest
         if short:
