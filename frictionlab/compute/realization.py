@@ -178,8 +178,8 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         else:  # every slope defined: a NaN makes the rms NaN, refused below
             slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
         if slope_rms_line == 0 and (span := float(np.ptp(profile.heights))) > 0:  # NaN heights: no span said
-            refuse(scene.slope, f"slopes() gave 0 at every point of a line whose heights span {span:.6g}: no slope "
-                                "of that line is 0 everywhere")  # fmt: skip
+            refuse(scene.slope, f"slopes() gave 0 at every point of a line whose heights span {span:.6g} (in the "
+                                "profile's length unit): no slope of that line is 0 everywhere")  # fmt: skip
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
