@@ -65,6 +65,29 @@ def registry():
     return Registry(discover=False)
 
 
+@pytest.fixture(scope="session")
+def built_once(tmp_path_factory, worker_id):
+    """``built_once(name, build)``: the folder ``name`` that ``build(folder)`` fills, built once a
+    session. The pytest-xdist workers share it (built under a file lock) rather than each building
+    its own: a reference run of seconds that several tests compare with. Tests only read it."""
+    from filelock import FileLock
+
+    shared = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        shared = shared.parent  # the base folder all the workers' own are made in
+
+    def get(name: str, build) -> Path:
+        out, done = shared / name, shared / f"{name}.built"
+        with FileLock(shared / f"{name}.lock"):
+            if not done.is_file():
+                assert not out.exists(), f"{out} was left half built by a failed build"
+                build(out)
+                done.touch()
+        return out
+
+    return get
+
+
 @pytest.fixture
 def small_preset():
     return copy.deepcopy(SMALL_PRESET)

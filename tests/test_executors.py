@@ -453,7 +453,7 @@ def test_a_tls_scheduler_is_reached_with_certificate_files(tmp_path, scene_24, s
 @pytest.mark.long
 @needs_dask
 @pytest.mark.parametrize("server", ["http", "silent"])
-def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_connect_timeout(server):
+def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_connect_timeout(server, monkeypatch):
     """An HTTP server (the dashboard's port, say), or one that accepts and never answers,
     is refused with a message within the connect timeout: a Client would wait for minutes."""
     import http.server
@@ -461,8 +461,12 @@ def test_an_address_that_answers_but_not_as_a_scheduler_is_refused_within_the_co
     import threading
     import time
 
-    from frictionlab.compute.dask_security import CONNECT_SECONDS, connect_scheduler
+    from frictionlab.compute import dask_security
+    from frictionlab.compute.dask_security import connect_scheduler
     from frictionlab.errors import RunError
+
+    CONNECT_SECONDS = 2  # the timeout shortened from its 10 s: the test waits it out
+    monkeypatch.setattr(dask_security, "CONNECT_SECONDS", CONNECT_SECONDS)
 
     class Quiet(http.server.SimpleHTTPRequestHandler):
         def log_message(self, *args):

@@ -30,7 +30,7 @@ from frictionlab.preset import build_scene
 from frictionlab.runs.runner import run_to_folder
 
 from .conftest import ROOT, SMALL_PRESET, merge
-from .test_resume import KILL_PRESET, NO_PLOT, CancelAfter, same_files
+from .test_resume import KILL_PRESET, NO_PLOT, CancelAfter, kill_preset_whole, same_files  # noqa: F401 (a fixture)
 
 # ------------------------------------------------------------------ a worker killed mid-send
 
@@ -102,7 +102,7 @@ def _signalled_mid_run(tmp_path, signum, preexec_fn=None) -> tuple[subprocess.Po
 
 @pytest.mark.long
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGHUP, 129)])  # SIGHUP: the terminal closed
-def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(registry, tmp_path, signum, code):
+def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(registry, tmp_path, signum, code, kill_preset_whole):
     process, out, err, run_dir = _signalled_mid_run(tmp_path, signum)
     assert process.returncode == code, err
     assert "status interrupted" in out and "Traceback" not in err
@@ -118,8 +118,7 @@ def test_sigterm_or_a_hangup_mid_run_ends_interrupted_and_resumes_bitwise(regist
     )  # fmt: skip
     assert resumed.returncode == 0, resumed.stderr
     assert 0 < json.loads(resumed.stdout)["resumed_realizations"] < KILL_PRESET["realizations"]
-    run_to_folder(build_scene(KILL_PRESET, registry=registry), tmp_path / "whole", RunOptions(workers=2))
-    same_files(run_dir, tmp_path / "whole")
+    same_files(run_dir, kill_preset_whole)
 
 
 @pytest.mark.long

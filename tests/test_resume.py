@@ -374,9 +374,15 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
+@pytest.fixture
+def kill_preset_whole(built_once, registry):
+    """``KILL_PRESET`` run uninterrupted, once a session: the numbers its killed runs end with."""
+    return built_once("kill-preset-whole", lambda out: run_to_folder(build_scene(KILL_PRESET, registry=registry), out, RunOptions(workers=2)))
+
+
 @pytest.mark.long
 @pytest.mark.parametrize("data", [KILL_PRESET, KILL_SURFACE], ids=["line", "exact-3d-surface"])
-def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path, data):
+def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tmp_path, data, request):
     preset = tmp_path / "kill.yaml"
     preset.write_text(yaml.safe_dump(data))
     run_dir = tmp_path / "run"
@@ -408,8 +414,12 @@ def test_kill_9_mid_run_then_resume_gives_the_uninterrupted_numbers(registry, tm
     assert 0 < summary["resumed_realizations"] < data["realizations"]
     assert kept >= 2
 
-    run_to_folder(build_scene(data, registry=registry), tmp_path / "whole", RunOptions(workers=2))
-    same_files(run_dir, tmp_path / "whole")
+    if data is KILL_PRESET:
+        whole = request.getfixturevalue("kill_preset_whole")
+    else:
+        whole = tmp_path / "whole"
+        run_to_folder(build_scene(data, registry=registry), whole, RunOptions(workers=2))
+    same_files(run_dir, whole)
 
 
 def test_a_chunks_folder_no_file_can_be_written_in_is_refused_before_any_realization(make_scene, tmp_path, monkeypatch, capsys):

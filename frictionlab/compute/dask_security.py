@@ -96,7 +96,7 @@ def connect_scheduler(address: str):
     distributed = import_distributed()
     check_address(address)
     security = distributed.Security()
-    _check_answers_as_scheduler(address, security)
+    _check_answers_as_scheduler(address, security, CONNECT_SECONDS)
     try:
         return distributed.Client(
             address, timeout=f"{CONNECT_SECONDS}s", security=security, direct_to_workers=_on_this_machine(address)

@@ -32,13 +32,17 @@ LONG_SOLVES = merge(SMALL_PRESET, {
 STOP_SECONDS = 1.0  # from the signal to the run's end, all its realizations' solves stopped
 
 
-@pytest.fixture(scope="module")
-def uninterrupted(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("whole")
-    preset = write_preset(folder, LONG_SOLVES)
-    done = run_cli("run", preset, "--out", folder / "out", "--workers", "2")  # the numbers of any worker count
-    assert done.returncode == 0, done.stderr
-    return preset, folder / "out"
+@pytest.fixture
+def uninterrupted(built_once):
+    """``LONG_SOLVES`` run uninterrupted, once a session: its preset, and the numbers it ends with."""
+
+    def build(folder):
+        folder.mkdir()
+        done = run_cli("run", write_preset(folder, LONG_SOLVES), "--out", folder / "out", "--workers", "2")  # any worker count's numbers
+        assert done.returncode == 0, done.stderr
+
+    folder = built_once("long-solves-whole", build)
+    return folder / "preset.yaml", folder / "out"
 
 
 def _mid_solve(line: str) -> bool:

@@ -20,22 +20,16 @@ from ..conftest import PRESETS
 
 
 @pytest.fixture(scope="module")
-def quick_study(tmp_path_factory, worker_id):
-    """The quick study, run once per session: the pytest-xdist workers that get some of
-    this module's tests share one copy (built under a file lock) rather than each building
-    its own. Tests read it; a test that writes works on a copy."""
-    from filelock import FileLock
+def quick_study(built_once):
+    """The quick study, run once a session (``built_once``). Tests read it; a test that writes
+    works on a copy."""
 
-    shared = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        shared = shared.parent  # the base folder all the workers' own are made in
-    out = shared / "exact3d-quick"
-    with FileLock(shared / "exact3d-quick.lock"):
-        if not (out / PAGE).is_file():
-            code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"),
-                         "--quiet", "--workers", "1"])  # fmt: skip
-            assert code == ExitCode.OK
-    return out
+    def build(out):
+        code = main(["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(out), "--runs", str(out / "runs"),
+                     "--quiet", "--workers", "1"])  # fmt: skip
+        assert code == ExitCode.OK
+
+    return built_once("exact3d-quick", build)
 
 
 def test_the_presets_of_the_family_exist_and_differ_only_in_h():

@@ -164,8 +164,10 @@ async def run_to_the_end(pilot):
 
 
 def error_text(app, widget_id):
-    label = app.query_one(f"#{widget_id}--error", Static)
-    return str(label.render()) if label.display else ""
+    """The messages under a field ("" when none: the line under it is made once it has one)."""
+    app.query_one(f"#{widget_id}")  # the field itself is there
+    label = app.query(f"#{widget_id}--error")
+    return str(label.first(Static).render()) if label and label.first().display else ""
 
 
 SWEEP = merge(

@@ -22,8 +22,12 @@ class KeysFooter(Footer):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._fitted_to = 0  # the width the keys were last fitted to
+        self._drawn: tuple | None = None  # what the keys were last composed from (_keys_shown)
+        self._check_queued = False
 
     def compose(self):
+        if self._bindings_ready:
+            self._drawn = self._keys_shown()
         keys = list(super().compose())  # FooterKeys: this app's bindings have no groups
         width = self._fitted_to = self.app.size.width
         self.compact = drawn_width(keys, compact=False) > width  # no padding around a key, one space after it
@@ -35,6 +39,28 @@ class KeysFooter(Footer):
             last = max(i for i, key in enumerate(keys) if key.action != "help")
             keys = keys[:last] + keys[last + 1 :]
         yield from keys
+
+    def _keys_shown(self) -> tuple:
+        """What the footer draws its keys from: the width and each shown binding's key, action,
+        description, state and tooltip (Textual's footer reads nothing else)."""
+        return (self.app.size.width, *(
+            (binding.key, binding.action, binding.description, enabled, tooltip)
+            for _, binding, enabled, tooltip in self.screen.active_bindings.values()
+            if binding.show
+        ))  # fmt: skip
+
+    def bindings_changed(self, screen) -> None:
+        # Textual recomposes the footer (a dozen widgets mounted and styled) whenever the focus
+        # moves, most often to keys it already shows: recompose once a refresh, and only for new keys
+        self._bindings_ready = True
+        if screen.app.app_focus and self.is_attached and screen is self.screen and not self._check_queued:
+            self._check_queued = True
+            self.call_after_refresh(self._recompose_if_new)
+
+    async def _recompose_if_new(self) -> None:
+        self._check_queued = False
+        if self.is_attached and self._keys_shown() != self._drawn:
+            await self.recompose()
 
     def on_resize(self, event: events.Resize) -> None:
         if event.size.width != self._fitted_to:
