@@ -94,6 +94,29 @@ async def test_save_and_run_are_listed_once_a_preset_is_open(folders, registry):
     assert "^s Save" in open_ and "^r Run" in open_
 
 
+@sync
+async def test_the_footer_is_remade_only_when_its_keys_change(folders, registry, monkeypatch):
+    """Textual remade the footer (a dozen widgets mounted and styled) on every focus change, most
+    often for the keys it already showed: Tab from field to field, each key a form's layout slower.
+    Between two text fields it stays; Esc out of the fields (Edit, not Leave field) remakes it."""
+    from frictionlab.tui.widgets.footer import KeysFooter
+
+    made = []
+    compose = KeysFooter.compose
+    monkeypatch.setattr(KeysFooter, "compose", lambda self: (made.append(1), (yield from compose(self)))[1])
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        app.query_one("#field--seed").focus()
+        await pilot.pause()
+        in_a_field, before = footer(app), len(made)
+        await press_settled(pilot, "tab")  # to realizations: a text field too
+        tabbed = len(made) - before
+        await press_settled(pilot, "escape")
+        left, after_esc = footer(app), len(made) - before
+    assert tabbed == 0 and after_esc >= 1
+    assert "Leave field" in in_a_field and "Leave field" not in left and "Edit" in left
+
+
 @pytest.mark.long  # a sweep made first, then a TUI session at 60x20: seconds
 @sync
 async def test_a_60_column_footer_keeps_save_run_and_keys_and_f1_lists_what_it_leaves_out(folders, registry):

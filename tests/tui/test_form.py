@@ -47,11 +47,14 @@ async def test_invalid_value_shows_the_headless_message_then_save_round_trips(fo
     app = make_app(registry)
     async with app.run_test(size=SIZE) as pilot:
         form = await open_first_preset(pilot)
+        assert not [line for line in form.query(".field-error") if line.display]  # a valid preset: no message shown
         await type_into(pilot, "field--spectrum--params--hurst", "2.0")
         expected = headless_problems(merge(TINY, {"spectrum": {"params": {"hurst": 2.0}}}), registry)
         assert expected == ["spectrum.params.hurst: must be <= 1.5, got 2.0"]
         assert form.problems == expected
         assert error_text(app, "field--spectrum--params--hurst") == expected[0]
+        row = app.query_one("#field--spectrum--params--hurst").parent  # the message right under its field's row
+        assert row.parent.children[row.parent.children.index(row) + 1].id == "field--spectrum--params--hurst--error"
         assert app.query_one("#field--spectrum--params--hurst", Input).has_class("-invalid")
         assert expected[0] in str(app.query_one("#problems", Static).render())
 
