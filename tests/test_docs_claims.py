@@ -71,7 +71,8 @@ def test_ci_runs_the_long_tests_the_readmes_command_leaves_out():
     assert "-n auto" in options["addopts"]
     assert any(marker.startswith("long:") for marker in options["markers"])
     ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
-    assert ci.index("pytest -m long") > ci.index('pip install -e ".[test]" && pytest')
+    long = next(i for i, line in enumerate(ci) if line.startswith("pytest -m long"))
+    assert long > ci.index('pip install -e ".[test]" && pytest')
 
 
 def _collected(*args: str) -> str:

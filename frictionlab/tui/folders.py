@@ -316,6 +316,7 @@ class SweepEntry:
     points: list[dict]  # sweep.json's rows: the swept values and the columns of sweep.csv
     mtime: float
     elapsed: float = 0.0  # seconds, as sweep.json says
+    confidence: float | None = 0.95  # the level of the points' intervals; None where the sweep sets it
 
     @cached_property
     def failed_for_good(self) -> str:
@@ -346,7 +347,26 @@ def read_sweep(folder: Path) -> SweepEntry:
         points=summary["points"],
         mtime=os.lstat(folder / "sweep.json").st_mtime,
         elapsed=record.elapsed_seconds,
+        confidence=_recorded_confidence(record.base_preset, list(record.sweep.parameters)),
     )
+
+
+def _recorded_confidence(base_preset: dict, paths: list[str]) -> float | None:
+    """The level of the intervals of a sweep read from its folder: its base preset's
+    ``fit.confidence`` (the default where unsaid), None where the sweep sets it, or the
+    recorded value is not a level (sweep.json is untrusted, as any file of a run folder)."""
+    from pydantic import ValidationError
+
+    from ..preset.schema import FitSettings
+
+    if "fit.confidence" in paths:
+        return None
+    fit = base_preset.get("fit", {})
+    level = {"confidence": fit["confidence"]} if isinstance(fit, dict) and "confidence" in fit else {}
+    try:  # the level alone, checked as a preset's is: another field's forged value says nothing of it
+        return FitSettings.model_validate(level if isinstance(fit, dict) else {"confidence": None}).confidence
+    except ValidationError:
+        return None
 
 
 def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:

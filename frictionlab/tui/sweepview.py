@@ -12,7 +12,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from ..compute.fit import format_interval
+from ..compute.fit import ci_label, format_interval
 from ..plugin.listeners import SweepListener
 from ..runs.sweep import PointResult, Sweep, SweepPoint, yaml_scalar
 from .text import format_count
@@ -61,11 +61,18 @@ STATUS_MARKS = {
 }  # fmt: skip
 
 
-def table_columns(paths: list[str], intervals: bool = True) -> list[str]:
+def table_columns(paths: list[str], intervals: bool = True, confidence: float | None = 0.95) -> list[str]:
     """The sweep table's headers: short, so a one-parameter sweep fits 80 columns (60 without
-    the ``intervals``)."""
-    a, b = ("a [95% CI]", "b [95% CI]") if intervals else ("a", "b")
+    the ``intervals``). ``confidence``: the intervals' level, None where the points differ in it."""
+    level = "CI" if confidence is None else ci_label(confidence)
+    a, b = (f"a [{level}]", f"b [{level}]") if intervals else ("a", "b")
     return ["#", *(short_name(p) for p in paths), "", a, b, "R^2", "contacts"]
+
+
+def sweep_confidence(sweep: Sweep) -> float | None:
+    """The level of a sweep's intervals (its points' ``fit.confidence``), None where they differ."""
+    levels = {point.scene.preset.fit.confidence for point in sweep.points}
+    return levels.pop() if len(levels) == 1 else None
 
 
 def _estimate(row: dict[str, Any], name: str, intervals: bool) -> str:

@@ -11,6 +11,7 @@ from frictionlab.runs.sweep import load_sweep, run_sweep
 from frictionlab.runs.sweepfiles import read_table
 from frictionlab.tui.widgets import ResultsPane
 
+from ..conftest import merge
 from .conftest import (
     SWEEP, fits_width, make_app, make_runs, numbers_in, press_settled, run_to_the_end, runs_app, screen_text, started, sync,
 )
@@ -120,7 +121,8 @@ async def test_the_info_box_under_the_plot_is_read_whole_at_60x20(folders, regis
 @sync
 async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(folders, registry):
     make_runs(folders, registry)
-    (folders / "sweep.yaml").write_text(yaml.safe_dump(SWEEP, sort_keys=False))
+    # intervals at 90%: the table says their level (it said 95% whatever the preset's)
+    (folders / "sweep.yaml").write_text(yaml.safe_dump(merge(SWEEP, {"fit": {"confidence": 0.9}}), sort_keys=False))
     run_sweep(load_sweep(folders / "sweep.yaml", registry=registry), folders / "runs" / "sw", RunOptions(workers=1), plot=False)
     rows = read_table(folders / "runs" / "sw" / "sweep.csv")
     app = make_app(registry)
@@ -134,6 +136,7 @@ async def test_results_lists_a_sweep_shows_its_points_and_opens_a_points_run(fol
         points = app.query_one("#results-sweep")
         assert points.display and points.has_focus
         cells = [[str(c) for c in points.get_row_at(i)] for i in range(points.row_count)]
+        assert [str(c.label) for c in points.columns.values()][3:5] == ["a [90% CI]", "b [90% CI]"]
         assert fits_width(points), "the sweep table is cut at 80 columns"
         await pilot.press("down", "enter")  # the second point's own run
         await pilot.pause()

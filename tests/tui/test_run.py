@@ -296,7 +296,7 @@ async def test_c_pressed_again_while_cancelling_signals_the_run_once(folders, re
 
 @sync
 async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, registry):
-    app = sweep_app(folders, registry)
+    app = sweep_app(folders, registry, merge(SWEEP, {"fit": {"confidence": 0.9}}))  # the columns say the level
     async with app.run_test(size=SIZE) as pilot:
         await run_to_the_end(pilot)
         table = app.query_one("#sweep-table")
@@ -307,7 +307,7 @@ async def test_a_sweep_fills_the_table_with_the_rows_of_sweep_csv(folders, regis
         fits = fits_width(table)
     assert app.last_outcome.status == "completed" and point_text.startswith("completed: 3/3 points")
     assert out_dir.parent.name == "runs" and out_dir.name.startswith("tinysweep-")
-    assert columns == ["#", "hurst", "", "a [95% CI]", "b [95% CI]", "R^2", "contacts"]
+    assert columns == ["#", "hurst", "", "a [90% CI]", "b [90% CI]", "R^2", "contacts"]
     assert fits, "the sweep table is cut at 80 columns"
     rows = read_table(out_dir / "sweep.csv")
     assert len(cells) == len(rows) == 3

@@ -334,7 +334,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
         """The sweep's table of points, formatted as the Run tab formats a live sweep."""
         self.open_sweep = entry
         table = self.query_one("#results-sweep", SweepList)
-        table.show_points(entry.paths, entry.points)
+        table.show_points(entry.paths, entry.points, entry.confidence)
         self.set_class(True, "-sweep")
         self.call_after_refresh(self._keep_list_rows)
         self._inform(

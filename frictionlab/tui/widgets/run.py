@@ -19,7 +19,7 @@ from ...plugin.listeners import format_duration, progress_text
 from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
-from ..sweepview import point_line
+from ..sweepview import point_line, sweep_confidence
 from ..text import failure_message, format_count, shorten_middle
 from .chart import Chart
 from .pathline import PathLine
@@ -237,7 +237,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             self._set("run-title", Content.assemble((self._fitted(sweep.name, what), "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
-            self.query_one("#sweep-table", SweepTable).show_points(sweep.paths)
+            self.query_one("#sweep-table", SweepTable).show_points(sweep.paths, confidence=sweep_confidence(sweep))
         self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
         self._show_bar(preset.realizations, 0)
         self._set("run-error", "")

@@ -23,10 +23,13 @@ class SweepRows:
         self._paths: list[str] = []
         self._points: dict[str, dict] = {}  # sweep.json's points (PointResult.row()), by point number
         self._intervals: bool | None = None  # the form shown; None: no sweep's columns
+        self._confidence: float | None = None  # the intervals' level (None: the points' differ)
 
-    def show_points(self, paths: list[str], rows=()) -> None:
-        """The columns of a sweep over ``paths`` and its ``rows`` (sweep.json's points), keyed by point number."""
+    def show_points(self, paths: list[str], rows=(), confidence: float | None = 0.95) -> None:
+        """The columns of a sweep over ``paths`` and its ``rows`` (sweep.json's points), keyed by point
+        number; ``confidence``, the level of its intervals (None where its points differ in it)."""
         self._paths, self._points, self._intervals = list(paths), {str(row["point"]): row for row in rows}, None
+        self._confidence = confidence
         self._refill()
 
     def clear_points(self) -> None:
@@ -58,7 +61,7 @@ class SweepRows:
     def _fits_intervals(self) -> bool:
         """Whether every column fits with the intervals (beside the vertical scroll bar); not
         laid out yet, they are assumed to (a resize checks again)."""
-        columns = [table_columns(self._paths), *(row_cells(self._paths, row) for row in self._points.values())]
+        columns = [table_columns(self._paths, True, self._confidence), *(row_cells(self._paths, row) for row in self._points.values())]
         needed = sum(max(map(cell_len, cells)) + 2 * self.cell_padding for cells in zip(*columns))
         return not self.size.width or needed <= self.size.width - self.styles.scrollbar_size_vertical
 
@@ -67,7 +70,7 @@ class SweepRows:
         row = self.cursor_row
         self._intervals = self._fits_intervals()
         self.clear(columns=True)
-        self.add_columns(*table_columns(self._paths, self._intervals))
+        self.add_columns(*table_columns(self._paths, self._intervals, self._confidence))
         for key, point in self._points.items():
             self.add_row(*map(Text, row_cells(self._paths, point, self._intervals)), key=key)
         if self.row_count:
