@@ -106,5 +106,6 @@ class FieldInput(KeyInput):
         keys["up"] = [Binding("up", "app.focus_previous", "Field above", tooltip="as Shift+Tab", show=False)]
 
     def action_leave_field(self) -> None:
-        form = next(node for node in self.ancestors if hasattr(node, "action_leave_field"))  # the form, unimported
-        form.action_leave_field()
+        from .form import PresetForm  # here: the form's module imports this one
+
+        next(node for node in self.ancestors if isinstance(node, PresetForm)).action_leave_field()
