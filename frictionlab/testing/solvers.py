@@ -46,7 +46,8 @@ def check_solver(cls, **params) -> None:
     which a periodic elastic half-space reaches full contact): it returns a ``ContactCurve``
     whose arrays all have the shape of ``loads`` and are finite, float64 but for the counts; the controlled
     quantity is reported back (``force`` resp. ``indentation`` equal to the
-    loads within 1 %); force and indentation do not decrease with load; contact
+    loads within 1 %); force and indentation do not decrease with load (an iterative solver's
+    stop may leave a drop of 1e-3 of the largest, as a run allows); contact
     counts are whole numbers, do not decrease with load, and lie in 1 .. N;
     ``contact_fraction == contact_count / N`` (the fraction of points, of the
     real contact or of MDR springs as ``contact_measure`` says); ``real_area_corrected`` is
@@ -55,7 +56,7 @@ def check_solver(cls, **params) -> None:
     ``contact_spots`` is given exactly when ``counts_spots`` is True, whole numbers in 1 .. contact_count;
     ``half_load_points``, where given, holds whole numbers in 1 .. contact_count;
     ``slope_rms_contact`` is >= 0 and
-    no larger than the largest |slope|; every ``extras`` array has one entry per
+    no larger than the largest |slope| (to a relative 1e-6: a sum's rounding); every ``extras`` array has one entry per
     load; the inputs are not modified; the same input gives the same output.
     ``stiffness()`` is finite and > 0. The declarations: the forces come from
     ``frictionlab.force_unit``, the solver's ``normalisation`` of the profile;
@@ -99,7 +100,7 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
     import numpy as np
 
     from frictionlab.plugin import Profile, force_unit
-    from frictionlab.plugin.outputs import LEAVE_INPUTS, curve_problem
+    from frictionlab.plugin.outputs import LEAVE_INPUTS, curve_problem, order_problem, reported_problem
 
     n = heights.size
     shape = "line" if heights.ndim == 1 else "surface"
@@ -138,22 +139,13 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
         if corrected is not None and (np.any(corrected <= 0) or np.any(corrected > arrays["contact_fraction"] * (1 + 1e-12))):
             fail(cls, f"{where}.real_area_corrected must lie in (0, contact_fraction]: the correction "
                       f"removes part of the pixels counted. Got {corrected!r}.")  # fmt: skip
-        gradient = curve.real_gradient_rms
-        if gradient is not None and np.any(gradient < 0):
-            fail(cls, f"{where}.real_gradient_rms is an rms slope and must be >= 0. Got {gradient!r}.")
         _whole_counts(cls, where, curve, "contact_spots", curve.contact_spots)
         _whole_counts(cls, where, curve, "half_load_points", curve.half_load_points)
         for name, value in curve.extras.items():
             if np.shape(value)[:1] != loads.shape:
                 fail(cls, f"{where}.extras[{name!r}] must have one entry per load. Got shape {np.shape(value)}.")
 
-        reported = arrays[control]
-        if not np.allclose(reported, loads, rtol=1e-2, atol=0):
-            fail(cls, f"{where}.{control} must report the loads asked for: {loads!r}. Got {reported!r} instead.")
-        for name in ("force", "indentation", "contact_count"):
-            if np.any(np.diff(arrays[name]) < 0):
-                fail(cls, f"{where}.{name} must not decrease as the load grows. Got {arrays[name]!r}.")
-        count = arrays["contact_count"]
+        count = arrays["contact_count"]  # every load here has a point in contact: stricter than a run's range
         if np.any(count < 1) or np.any(count > n):
             fail(cls, f"{where}.contact_count must lie in 1 .. {n} (points of the {shape}). Got {count!r}.")
         if not np.allclose(arrays["contact_fraction"], count / n, rtol=1e-12, atol=1e-12):
@@ -162,13 +154,9 @@ def _check_solves(cls, solver, heights, spacing, slopes) -> None:
                 f"{where}.contact_fraction must equal contact_count / N = {count / n!r}. "
                 f"Got {arrays['contact_fraction']!r} instead.",
             )
-        rms = arrays["slope_rms_contact"]
-        if np.any(rms < 0) or np.any(rms > np.abs(slopes).max() * (1 + 1e-12)):
-            fail(
-                cls,
-                f"{where}.slope_rms_contact must lie in [0, max |slope| = {np.abs(slopes).max():.6g}]. "
-                f"Got {rms!r}.",
-            )
+        # then the numbers as a run checks them: the loads reported as asked, the ranges, the order
+        if problem := reported_problem(curve, loads, control, n, float(np.abs(slopes).max())) or order_problem(solver, curve, control):
+            fail(cls, f"on a {shape}, {problem}")
 
         again = run()
         for name in names:
