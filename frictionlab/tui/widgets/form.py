@@ -173,6 +173,7 @@ class PresetForm(VerticalScroll):
         elif spec.kind in ("int", "float", "text"):
             placeholder = _unset(spec)
             widget = FieldInput(
+                leave=self.action_leave_field,
                 value=display(value),
                 placeholder=placeholder,
                 compact=True,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 
 from textual import events
 from textual.binding import Binding
@@ -96,8 +97,9 @@ class FieldInput(KeyInput):
     own Enter (Submit, so F1 listed it) did nothing there. Up and Down go to the field above or
     below (the form's keys), which F1 listed as a scroll of this one-line field."""
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args, leave: Callable[[], None], **kwargs):
         super().__init__(*args, **kwargs)
+        self._leave = leave  # the form's Esc: back to the form
         self._bindings = self._bindings.copy()  # this field's, not every Input's
         keys = self._bindings.key_to_bindings
         # F1 lists them; the footer keeps Esc's Leave field, as before
@@ -106,6 +108,4 @@ class FieldInput(KeyInput):
         keys["up"] = [Binding("up", "app.focus_previous", "Field above", tooltip="as Shift+Tab", show=False)]
 
     def action_leave_field(self) -> None:
-        from .form import PresetForm  # here: the form's module imports this one
-
-        next(node for node in self.ancestors if isinstance(node, PresetForm)).action_leave_field()
+        self._leave()
