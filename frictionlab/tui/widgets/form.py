@@ -374,13 +374,11 @@ class PresetForm(VerticalScroll):
             return
         if field_id is None:
             field.set_class(bool(messages), "-invalid")
-        shown = self.query(f"#{widget_id}--error")
-        if shown:
+        if shown := self.query(f"#{widget_id}--error"):
             label = shown.first(Static)
-        elif messages:
+        elif messages:  # under its row, in the form or in a plugin's parameters
             label = Static(id=f"{widget_id}--error", classes="field-error")
-            row = field.parent  # in the form, or in a plugin's parameters
-            row.parent.mount(label, after=row)
+            field.parent.parent.mount(label, after=field.parent)
         else:
             return
         label.update(Content("\n".join(messages)))
