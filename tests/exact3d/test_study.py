@@ -32,6 +32,16 @@ def quick_study(built_once):
     return built_once("exact3d-quick", build)
 
 
+@pytest.fixture
+def figures_not_drawn(monkeypatch):
+    """The page's figures written as a few bytes, not drawn (some 10 s a page): for the tests of
+    what a page says and what a second invocation reads back. The figures themselves: the quick
+    study's, checked by test_quick_page_has_every_h_every_grid_and_mdr."""
+    from frictionlab.exact3d import report
+
+    monkeypatch.setattr(report, "PLOTS", tuple(lambda runs, numbers, fh, dpi: fh.write(b"not drawn") for _ in report.PLOTS))
+
+
 def test_the_presets_of_the_family_exist_and_differ_only_in_h():
     import yaml
 
@@ -120,7 +130,7 @@ def test_exact_and_mdr_ran_at_the_same_f_on_the_same_spectrum(quick_study):
             assert spectra[0] == spectra[1] and spectra[0]["params"]["points"] == n
 
 
-def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(quick_study, tmp_path, capsys):
+def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(quick_study, tmp_path, capsys, figures_not_drawn):
     import shutil
 
     runs = tmp_path / "runs"
@@ -205,7 +215,7 @@ def f_column(folder):
     return np.loadtxt(folder / "curve.csv", delimiter=",", skiprows=1, usecols=1)
 
 
-def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, tmp_path, capsys):
+def test_an_existing_page_is_refused_and_a_second_run_resumes(quick_study, tmp_path, capsys, figures_not_drawn):
     import shutil
 
     quick_study = shutil.copytree(quick_study, tmp_path / "study", symlinks=True)  # the shared one stays as it was
