@@ -115,7 +115,7 @@ def connect_scheduler(address: str):
 CONNECT_SECONDS = 10
 
 
-def _check_answers_as_scheduler(address: str, security, seconds: float = CONNECT_SECONDS) -> None:
+def _check_answers_as_scheduler(address: str, security, seconds: float) -> None:
     """RunError unless ``address`` answers Dask's ``identity`` request as a scheduler
     within ``seconds``: a Client would wait for minutes on a port that accepts and
     answers something else (an HTTP server, such as the dashboard's port)."""

@@ -258,6 +258,11 @@ class RunEntry:
     def r2(self) -> float:
         return number_or_nan((self.fit or {}).get("r2"))
 
+    @property
+    def confidence(self) -> float | None:
+        """The level of the fit's intervals, None where the summary gives none (or not a level)."""
+        return recorded_level((self.fit or {}).get("confidence"))
+
     def interval(self, key: str) -> tuple[float, float] | None:
         """The fit's ``a_ci`` or ``b_ci`` as two numbers, None if it has none (or a damaged one)."""
         pair = (self.fit or {}).get(key)
@@ -314,9 +319,9 @@ class SweepEntry:
     status: str
     paths: list[str]  # the swept dotted paths
     points: list[dict]  # sweep.json's rows: the swept values and the columns of sweep.csv
+    confidence: float | None  # the level of the points' intervals; None where the sweep sets it
     mtime: float
     elapsed: float = 0.0  # seconds, as sweep.json says
-    confidence: float | None = 0.95  # the level of the points' intervals; None where the sweep sets it
 
     @cached_property
     def failed_for_good(self) -> str:
@@ -351,22 +356,23 @@ def read_sweep(folder: Path) -> SweepEntry:
     )
 
 
+def recorded_level(value) -> float | None:
+    """A level of intervals (``fit.confidence``) as a run folder's record gives it: a number in
+    (0, 1), else None (the records are untrusted)."""
+    level = number_or_nan(value)
+    return level if 0 < level < 1 else None
+
+
 def _recorded_confidence(base_preset: dict, paths: list[str]) -> float | None:
     """The level of the intervals of a sweep read from its folder: its base preset's
-    ``fit.confidence`` (the default where unsaid), None where the sweep sets it, or the
-    recorded value is not a level (sweep.json is untrusted, as any file of a run folder)."""
-    from pydantic import ValidationError
-
+    ``fit.confidence`` (the default where unsaid), None where the sweep sets it point by point
+    or the base preset's is not a level."""
     from ..preset.schema import FitSettings
 
-    if "fit.confidence" in paths:
-        return None
     fit = base_preset.get("fit", {})
-    level = {"confidence": fit["confidence"]} if isinstance(fit, dict) and "confidence" in fit else {}
-    try:  # the level alone, checked as a preset's is: another field's forged value says nothing of it
-        return FitSettings.model_validate(level if isinstance(fit, dict) else {"confidence": None}).confidence
-    except ValidationError:
+    if "fit.confidence" in paths or not isinstance(fit, dict):
         return None
+    return recorded_level(fit.get("confidence", FitSettings().confidence))
 
 
 def list_runs(runs_dir: Path) -> list[RunEntry | SweepEntry]:

@@ -61,7 +61,7 @@ STATUS_MARKS = {
 }  # fmt: skip
 
 
-def table_columns(paths: list[str], intervals: bool = True, confidence: float | None = 0.95) -> list[str]:
+def table_columns(paths: list[str], intervals: bool, confidence: float | None) -> list[str]:
     """The sweep table's headers: short, so a one-parameter sweep fits 80 columns (60 without
     the ``intervals``). ``confidence``: the intervals' level, None where the points differ in it."""
     level = "CI" if confidence is None else ci_label(confidence)

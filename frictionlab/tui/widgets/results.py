@@ -18,7 +18,6 @@ from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown, shown_name
 from ...compute.fit import ci_label, format_interval
-from ...io.values import number_or_nan
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
 from ...runs.results import read_curve
@@ -397,8 +396,7 @@ def _entry_lines(entry: RunEntry, style: str, width: int) -> list[Content]:
         interval = lambda key: format_interval(entry.interval(key) or (None, None), missing="")  # noqa: E731
         lines += packed([f"a={entry.a:.4f}", interval("a_ci"), f"R^2={entry.r2:.4f}"], width)
         lines += packed([f"b={entry.b:.4f}", interval("b_ci")], width)
-        level = number_or_nan(entry.fit.get("confidence"))
-        leveled = entry.interval("a_ci") is not None and 0 < level < 1
+        level = entry.confidence if entry.interval("a_ci") is not None else None
         # what a and b are, and the intervals' level, as the Run tab says them; after the numbers: a short box shows them first
-        lines += packed(["in", "xi = a + b ln f,", ci_label(level)] if leveled else ["in", "xi = a + b ln f"], width)
+        lines += packed(["in", "xi = a + b ln f"] if level is None else ["in", "xi = a + b ln f,", ci_label(level)], width)
     return [Content(line) if isinstance(line, str) else line for line in lines]

@@ -237,7 +237,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
             self._set("run-title", Content.assemble((self._fitted(sweep.name, what), "bold"), what))
             self._set("sweep-point", f"{sweep.spec.mode} over {', '.join(sweep.paths)}")
             self._set("run-stats", "")
-            self.query_one("#sweep-table", SweepTable).show_points(sweep.paths, confidence=sweep_confidence(sweep))
+            self.query_one("#sweep-table", SweepTable).show_points(sweep.paths, (), sweep_confidence(sweep))
         self.query_one("#run-folder", PathLine).show("into ", str(out_dir))
         self._show_bar(preset.realizations, 0)
         self._set("run-error", "")

@@ -25,7 +25,7 @@ class SweepRows:
         self._intervals: bool | None = None  # the form shown; None: no sweep's columns
         self._confidence: float | None = None  # the intervals' level (None: the points' differ)
 
-    def show_points(self, paths: list[str], rows=(), confidence: float | None = 0.95) -> None:
+    def show_points(self, paths: list[str], rows, confidence: float | None) -> None:
         """The columns of a sweep over ``paths`` and its ``rows`` (sweep.json's points), keyed by point
         number; ``confidence``, the level of its intervals (None where its points differ in it)."""
         self._paths, self._points, self._intervals = list(paths), {str(row["point"]): row for row in rows}, None
