@@ -1,5 +1,6 @@
 import contextlib
 import copy
+import gc
 import io
 import logging
 import os
@@ -15,6 +16,13 @@ from frictionlab.plugin.registry import Registry
 
 ROOT = Path(__file__).resolve().parents[1]
 PRESETS = ROOT / "presets"
+
+# A test process holds every module the commands and the TUI import, and what each test
+# leaves for the collector (some 3 x 10^5 objects): Python's default thresholds walked them
+# all every ~70,000 new objects, 0.2 s each time, a seventh of a TUI test's CPU. Collected
+# less often, as the commands' processes are (frictionlab.cli.main); the numbers live in
+# numpy arrays, which the collector never walks.
+gc.set_threshold(10_000, 20, 20)
 
 LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study, the example plugin pip-installed
     # and found from a fresh process; test_registry.py checks discovery without one): `pytest -m long` runs them

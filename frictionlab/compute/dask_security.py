@@ -182,8 +182,11 @@ def _refuse_nothing_listening(address: str, seconds: float) -> None:
 # half-space realization took 0.23 s instead of 0.16 s. This user's own cluster keeps glibc's
 # adaptive default (None unsets the variable). Its workers do not sample their own stacks
 # every 10 ms for the dashboard's profile page (4 % of a Fig. 2 task's time), unless the
-# dashboard is asked for.
-WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+# dashboard is asked for. Its workers log only what is critical: on a loaded machine a
+# worker's heartbeat raced the cluster's close at the end of a run that had finished, and
+# printed an ERROR with three tracebacks under its results (a task's failure is said by the run).
+WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                 "distributed.nanny.pre-spawn-environ.DASK_LOGGING__DISTRIBUTED": "critical"}  # fmt: skip
 PROFILE_OFF = {"distributed.worker.profile.enabled": False}
 
 

@@ -11,8 +11,10 @@ of a few pixels of the finest grid: a band of 32 and more, Nayak parameter 10 to
 some H, the comparison family (long cut-off = the side, the family the page used
 before) and the spectral gradient. Every family is pressed at the same loads, so at the
 same f. Every ensemble is an ordinary run into its own folder (``runner.run_to_folder``):
-resumable, its files those of ``frictionlab run``. The jobs run in the plan's order of
-value, so an interrupted study has the most important ensembles.
+resumable, its files those of ``frictionlab run`` but plot.png (the page's figures draw the
+ensembles together; drawing one figure per ensemble took twice the compute of the quick plan).
+The jobs run in the plan's order of value, so an interrupted study has the most important
+ensembles.
 """
 
 from __future__ import annotations
@@ -369,7 +371,7 @@ def run_plan(
             else:
                 resume = (folder / STATE_FILE).is_file()
                 log(f"exact3d: {job.describe()}" + (" (resumed)" if resume else ""))
-                outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume))
+                outcome, _ = run_to_folder(scene, folder, replace(options, resume=resume), plot=False)
             if outcome.status in ("interrupted", "cancelled") or interrupted_since(seen):
                 raise KeyboardInterrupt
             if outcome.status != "completed":
@@ -383,7 +385,7 @@ def run_plan(
                 count_time()
     except KeyboardInterrupt:  # in a run (which ended interrupted, its work kept) or between two
         raise WorkInterrupted(kept) from None
-    except (OSError, RunError) as exc:  # a full disk (at a run's plot.png: a RunError): what finished stays
+    except (OSError, RunError) as exc:  # a full disk: what finished stays
         raise (write_failed(exc, kept) if isinstance(exc, OSError) else RunError(f"{exc}; {kept}")) from None
     finally:  # the time of an invocation that computed counts in the study's, however it ended
         count_time()

@@ -377,7 +377,8 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         f"The presets are {presets}; each runs alone as `frictionlab run presets/exact3d-h08.yaml` (its 1024² grid "
         "and its own loads; the study presses every family at the plan's loads). The exact runs are ordinary runs: "
         "processes or Dask, the memory estimate before the start, resumable (`--runs` of an interrupted study "
-        "resumes every ensemble, and `--finished-only` writes the page from those that finished).",
+        "resumes every ensemble, and `--finished-only` writes the page from those that finished); their folders hold "
+        "the files of `frictionlab run` but plot.png, the figures here drawing the ensembles together.",
         "",
     ]
     return "\n".join(lines)

@@ -84,7 +84,7 @@ def test_a_study_that_fails_midway_still_counts_its_time(tmp_path, monkeypatch):
     runs.mkdir()
     calls = []
 
-    def refused(scene, folder, options):
+    def refused(scene, folder, options, **kwargs):
         calls.append(folder)
         time.sleep(0.05)
         raise FrictionlabError(f"{folder} is in use by another run")
@@ -113,11 +113,11 @@ def test_a_study_counts_its_time_after_every_ensemble(tmp_path, monkeypatch):
     real_run = study.run_to_folder
     seen_before = []
 
-    def killed_at_the_second(scene, folder, options):
+    def killed_at_the_second(scene, folder, options, **kwargs):
         if seen_before:  # the second ensemble: what a SIGKILL here would leave on disk
             raise SystemExit(json.loads((runs / study.TIME_FILE).read_text())["seconds"])
         started = time.perf_counter()
-        outcome = real_run(scene, folder, options)
+        outcome = real_run(scene, folder, options, **kwargs)
         seen_before.append(time.perf_counter() - started)
         return outcome
 

@@ -69,6 +69,10 @@ def test_quick_page_has_every_h_every_grid_and_mdr(quick_study):
     folders = sorted(p.name for p in (quick_study / "runs").iterdir() if p.is_dir())
     assert len(folders) == len(QUICK.jobs()) == (len(HURSTS) * (2 * len(QUICK.resolutions) + 3) + 2 * len(QUICK.extra)
                                                  + len(BROAD_HURSTS))
+    # each an ordinary run's numbers, and no figure of its own: the page's figures draw them together
+    for folder in folders:
+        assert (quick_study / "runs" / folder / "curve.csv").is_file() and (quick_study / "runs" / folder / "summary.json").is_file()
+        assert not (quick_study / "runs" / folder / "plot.png").exists()
     # the literature kappa is the corrected range, never the old bracket
     assert "about 1.6 to about 2" not in text and "2 to 2.3" in text and "2.51" in text and "1.60" in text
 
