@@ -18,13 +18,13 @@ def add_parser(sub) -> None:
         "intervals, show its convergence on paired grids with a Richardson limit, test it against a power law and "
         "a log law with curvature, measure kappa and kappa_r (the rms gradient over the real contact) of the "
         "corrected contact area and the contact spots, and write the page exact-3d-law.md with its figures. The "
-        "full plan takes many hours of 2 cores (run it resumably with --runs); --quick about a minute of one core "
+        "full plan takes many hours of 2 cores (run it resumably with --runs); --quick about half a minute of one core "
         "(not converged).",
         epilog="examples:\n  frictionlab exact3d --quick --out runs/exact3d-quick\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --force\n"
         "  frictionlab exact3d --out docs --runs runs/exact3d-full --finished-only --force",
     )
-    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about a minute of one core, not converged")
+    p.add_argument("--quick", action="store_true", help="smaller grids and ensembles: about half a minute of one core, not converged")
     p.add_argument("--finished-only", action="store_true", help="run nothing: write the page from the ensembles of "
                    "--runs that finished; the page lists the plan's others as not run")
     p.add_argument("--out", metavar="DIR", help="folder of the page and its figures (default: the runs folder)")

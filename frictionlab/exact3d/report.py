@@ -229,7 +229,7 @@ def page_text(runs: StudyRuns, numbers: Numbers, command: str, machine_text: str
         f"{wall_time_text(runs.seconds, compute, os.cpu_count() or 1)} on {machine_text}, a machine shared with "
         f"other jobs, and **{format_duration(compute)}** of compute (the surfaces' "
         "solve times summed, so waiting for a busy CPU counts in it; each ensemble's is in the ensembles' table). "
-        "`--quick` runs the same pipeline on small grids and ensembles in a minute of one core (not converged).",
+        "`--quick` runs the same pipeline on small grids and ensembles in half a minute of one core (not converged).",
         "",
         *definitions(runs, numbers),
         "## What ran",
