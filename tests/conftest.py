@@ -23,6 +23,9 @@ PRESETS = ROOT / "presets"
 # less often, as the commands' processes are (frictionlab.cli.main); the numbers live in
 # numpy arrays, which the collector never walks.
 gc.set_threshold(10_000, 20, 20)
+# Textual's animations (a tab's underline sliding, a smooth scroll) end where they would
+# jump to; a test that waits for the screen to settle waited out each (0.3 s a tab switch)
+os.environ.setdefault("TEXTUAL_ANIMATIONS", "none")
 
 LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D study, the example plugin pip-installed
     # and found from a fresh process; test_registry.py checks discovery without one): `pytest -m long` runs them
