@@ -34,6 +34,15 @@ LONG_MODULES = {  # whole modules of long tests (TUI sessions, the exact 3D stud
 }  # fmt: skip
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto`` (pyproject.toml's addopts): a worker more than pytest-xdist's count of cores,
+    whose tests wait part of their time (on a subprocess, the TUI settling, a signal); a count
+    set in PYTEST_XDIST_AUTO_NUM_WORKERS stands as given."""
+    workers = yield
+    return workers if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS") else workers + 1
+
+
 def pytest_collection_modifyitems(config, items):
     """Mark the tests of ``LONG_MODULES`` ``long``, and leave the long tests out of a bare
     `pytest` (the README's command: a newcomer's run takes minutes). CI runs them with

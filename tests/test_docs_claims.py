@@ -75,6 +75,17 @@ def test_ci_runs_the_long_tests_the_readmes_command_leaves_out():
     assert long > ci.index('pip install -e ".[test]" && pytest')
 
 
+def test_pytest_runs_a_worker_more_than_the_cores_unless_a_count_is_set(pytestconfig, monkeypatch):
+    """The README: `pytest` runs on every core with a worker more (``-n auto``)."""
+    from xdist import plugin
+
+    monkeypatch.delenv("PYTEST_XDIST_AUTO_NUM_WORKERS", raising=False)
+    cores = plugin.pytest_xdist_auto_num_workers(pytestconfig)  # pytest-xdist's own count
+    assert pytestconfig.hook.pytest_xdist_auto_num_workers(config=pytestconfig) == cores + 1
+    monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "5")
+    assert pytestconfig.hook.pytest_xdist_auto_num_workers(config=pytestconfig) == 5
+
+
 def _collected(*args: str) -> str:
     import subprocess
     import sys
