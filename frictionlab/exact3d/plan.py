@@ -12,7 +12,7 @@ some H, the comparison family (long cut-off = the side, the family the page used
 before) and the spectral gradient. Every family is pressed at the same loads, so at the
 same f. Every ensemble is an ordinary run into its own folder (``runner.run_to_folder``):
 resumable, its files those of ``frictionlab run`` but plot.png (the page's figures draw the
-ensembles together; drawing one figure per ensemble took twice the compute of the quick plan).
+ensembles together; one figure per ensemble took two thirds of the quick plan's time).
 The jobs run in the plan's order of value, so an interrupted study has the most important
 ensembles.
 """
