@@ -468,3 +468,65 @@ def test_infinity_hidden_in_a_parameter_of_any_type_is_refused_as_in_a_number(re
     assert refused.value.problems == ["spectrum.params.extra[1].a: must be a finite number, got inf"]
     small_preset["spectrum"]["params"]["extra"] = [1.0, {"a": "text", "b": [2, None]}]
     assert build_scene(small_preset, registry=registry).spectrum.params.extra[1]["b"] == [2, None]
+
+
+ALLOCATING = '''
+import os
+
+import frictionlab
+from frictionlab import ContactSolver, ForceNormalisation
+
+
+class Allocating(ContactSolver):
+    name = "acme-allocating"
+    summary = "a solver that allocates more than the machine has"
+    normalisations = {1: ForceNormalisation(load="force", modulus="k", extent="length")}
+    problem = "Winkler foundation"
+
+    def __init__(self, params=None):
+        super().__init__(params)
+        if os.environ.get("ACME_ALLOCATE_AT_START"):
+            raise MemoryError("Unable to allocate 8.00 TiB for an array with shape (1099511627776,)")
+
+    def stiffness(self):
+        return 1.0
+
+    def solve(self, profile, loads, control, slopes):
+        raise MemoryError("Unable to allocate 16.0 GiB for an array with shape (2147483648,)")
+
+
+@frictionlab.hookimpl
+def register_solvers(register):
+    register(Allocating)
+'''
+
+
+@pytest.mark.parametrize("at_start", [True, False])
+def test_a_plugin_out_of_memory_is_the_machines_limit_said_where_not_its_fault(fake_dists, small_preset, tmp_path,
+                                                                              capsys, monkeypatch, at_start):  # noqa: F811
+    """Taken as it came, a MemoryError in a plugin's __init__ was told as "out of memory" with no
+    word of where, and one in its solve() as the plugin's fault, without the advice that helps."""
+    import yaml
+
+    from frictionlab.cli.main import main
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-allocates", "acme-allocating", "acme_allocating_plugin", ALLOCATING)
+    registry_module.default_registry.cache_clear()
+    if at_start:
+        monkeypatch.setenv("ACME_ALLOCATE_AT_START", "1")
+    small_preset.update(realizations=2, solver={"name": "acme-allocating"})
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(small_preset))
+    try:
+        code = main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "out"), "--workers", "1", "--quiet",
+                     "--no-plot"])  # fmt: skip
+    finally:
+        registry_module.default_registry.cache_clear()
+    err = capsys.readouterr().err
+    assert code == 1, err
+    assert "out of memory" in err and "at fault" not in err and "Traceback" not in err
+    method = "__init__" if at_start else "solve"
+    assert (f"(in solver 'acme-allocating' (acme_allocating_plugin.Allocating from acme-allocates), "
+            f"{method}() at acme_allocating_plugin.py:") in err  # fmt: skip
+    if not at_start:
+        assert "2 realization(s) ran out of memory" in err and "fewer workers" in err

@@ -242,6 +242,15 @@ def _plugin_at_fault(exc: BaseException):
     return solve_failed(exc) or installed_plugin_fault(exc)
 
 
+def _plugin_place(exc: BaseException) -> tuple[str, str] | None:
+    """The installed plugin whose code raised ``exc``, and where (``fault_place``), or None."""
+    if "frictionlab.plugin.registry" not in sys.modules:  # no plugin was loaded: none raised it
+        return None
+    from ..plugin.registry import installed_plugin_place
+
+    return installed_plugin_place(exc)
+
+
 def _plain_warning(message, category, filename, lineno, file=None, line=None):
     return f"warning: {shown(str(message))}\n"  # a resume's warning names a folder
 
@@ -386,6 +395,8 @@ def _run_command(args) -> int:
         if library is not None:  # the program itself does not fit: fewer points would not help
             return _out_of_memory_loading(args, library)
         detail = f": {exc}" if str(exc) else ""
+        if (place := _plugin_place(exc)) is not None:  # met in a plugin's own code: which, and where
+            detail += f" (in {place[0]}, {place[1]})"
         message = f"out of memory{detail}; ask for fewer points, realizations or workers{limit_advice()}"
         folder = getattr(args, "out_dir", None)  # a run's folder, once made: what it holds is not lost
         if folder is not None:

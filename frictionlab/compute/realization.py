@@ -17,8 +17,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import PluginError
-from ..plugin.registry import plugin_fault
+from ..errors import OUT_OF_MEMORY, PluginError
+from ..plugin.registry import fault_place, plugin_fault
 from ..plugin.outputs import (
     LEAVE_INPUTS, RandomWatch, curve_problem, height_of, largest_magnitude, order_problem, profile_problem, read_only,
     refuse, reported_problem, schedule_problem, seed_problem, slopes_problem,
@@ -230,7 +230,10 @@ def _failure(scene: Scene, exc: BaseException) -> str:
     fault; a broken answer named with its plugin; anything else with the line that raised it."""
     if isinstance(exc, SolveFailed):  # deliberate and told for the user: no source line, no blame
         return f"SolveFailed: {exc}"
-    fault = plugin_fault(exc, [type(scene.spectrum), type(scene.solver), type(scene.slope)])
+    classes = [type(scene.spectrum), type(scene.solver), type(scene.slope)]
+    if isinstance(exc, MemoryError) and (place := fault_place(exc, classes)) is not None:
+        return f"{OUT_OF_MEMORY}: {exc} (in {place[0]}, {place[1]})"  # the machine's limit, met in a plugin: no blame
+    fault = plugin_fault(exc, classes)
     if fault is not None:
         return f"PluginError: {fault}" + (f" ({LEAVE_INPUTS})" if "read-only" in str(exc) else "")
     error = f"{type(exc).__name__}: {exc}"

@@ -405,6 +405,18 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
     """``exc`` told as the fault of the plugin among ``classes`` whose code raised it (the innermost
     frame of its traceback in a third party's plugin package), or None: the built-ins are
     frictionlab's own, and a fault anywhere else is not a plugin's."""
+    place = fault_place(exc, classes)
+    if place is None:
+        return None
+    plugin, where = place
+    said = f": {short_repr(str(exc), 300)[1:-1]}" if str(exc) else ""  # MemoryError(), sys.exit(): no message
+    return PluginError(f"{plugin} raised {type(exc).__name__}{said} in {where}; the plugin is at fault: "
+                       "tell its authors, or choose another plugin")  # fmt: skip
+
+
+def fault_place(exc: BaseException, classes) -> tuple[str, str] | None:
+    """The third party's plugin among ``classes`` whose code raised ``exc``, and where, as messages
+    name them: ``("solver 'x' (module.Class from dist)", "solve() at module.py:12")``; None if none."""
     packages: dict[str, type] = {}
     for cls in classes:
         if (top := cls.__module__.partition(".")[0]) not in BUILTIN_MODULES:
@@ -414,11 +426,7 @@ def plugin_fault(exc: BaseException, classes) -> PluginError | None:
         if frame is not None:
             if owner is not None:  # a Params class: the plugin it is of (another class of the package may be first)
                 cls = owner if issubclass(owner, Plugin) else next((c for c in classes if c.Params is owner), cls)
-            said = f": {short_repr(str(exc), 300)[1:-1]}" if str(exc) else ""  # MemoryError(), sys.exit(): no message
-            return PluginError(
-                f"{plugin_label(cls)} raised {type(exc).__name__}{said} in {where}; the plugin is at fault: "
-                "tell its authors, or choose another plugin"
-            )
+            return plugin_label(cls), where
     return None
 
 
@@ -440,6 +448,14 @@ def installed_plugin_fault(exc: BaseException) -> PluginError | None:
     if default_registry.cache_info().currsize == 0:
         return None
     return default_registry().at_fault(exc)
+
+
+def installed_plugin_place(exc: BaseException) -> tuple[str, str] | None:
+    """Where in an installed plugin ``exc`` was raised (``fault_place``), or None (also when no
+    plugin was loaded in this process)."""
+    if default_registry.cache_info().currsize == 0:
+        return None
+    return fault_place(exc, [info.cls for info in default_registry().infos()])
 
 
 @functools.cache
