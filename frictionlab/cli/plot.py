@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import (ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word, refuse_unusable_matplotlib,
-                      resume_hint, shown_name)  # fmt: skip
+from ..errors import (ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word,
+                      refuse_unusable_matplotlib, resume_hint, shown_name)  # fmt: skip
 
 
 def add_parser(sub) -> None:
@@ -20,7 +20,8 @@ def add_parser(sub) -> None:
         "  frictionlab plot runs/h06 --out h06.png --force",
     )
     p.add_argument("folder", metavar="DIR", help="a run folder (summary.json) or a sweep's folder (sweep.json)")
-    p.add_argument("--out", metavar="FILE", help="the PNG file to write (default: plot.png in DIR, a sweep's sweep.png)")
+    p.add_argument("--out", metavar="FILE",
+                   help="the PNG file to write (default: plot.png in DIR, a sweep's sweep.png)")  # fmt: skip
     p.add_argument("--force", action="store_true", help="replace the file if it exists (a link is replaced, never the "
                    "file it points at)")  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="print nothing once the figure is written")
@@ -55,7 +56,8 @@ def run(args) -> ExitCode:
         from ..runs.results import write_curve_figure
 
         figure = CurveFigure.read_back(result)
-        write_curve_figure(out := _output(args, folder / "plot.png"), figure, devices=named)
+        out = _output(args, folder / "plot.png")
+        write_curve_figure(out, figure, devices=named)
     if not args.quiet:
         print(f"wrote {shown_name(out)}")
     return ExitCode.OK
@@ -68,6 +70,11 @@ def _output(args, default: Path) -> Path:
 
     from ..io.files import check_output_file
 
-    if args.out is None and not args.force and os.path.lexists(default) and not os.path.isdir(default):
-        raise OutputRefused(f"{shown_name(default)} exists: give --force to replace it, or --out FILE to write another")
+    if args.out is None and os.path.lexists(default):
+        if os.path.isdir(default):  # never replaced, --force or not
+            raise OutputRefused(f"{shown_name(default)} is a folder: move it aside, or give --out FILE.png to write "
+                                "another file")  # fmt: skip
+        if not args.force:
+            raise OutputRefused(f"{shown_name(default)} exists: give --force to replace it, or --out FILE.png to "
+                                "write another")  # fmt: skip
     return check_output_file(args.out or default, "--out", force=args.force)
