@@ -174,13 +174,9 @@ class SweepResult:
         import matplotlib.pyplot as plt
 
         from .plot import sweep_figure
-        from .preset import SweepSettings
         from .runs.sweep import Sweep
-        from .runs.sweeprecord import read_sweep_record
 
-        summary, _ = read_sweep_record(self.folder)  # its spec and base preset: the axes' scales and names
-        sweep = Sweep(self.name, SweepSettings.model_validate(summary["sweep"]), summary["base_preset"], points=[])
-        return sweep_figure(sweep, self.rows, make=plt.figure)
+        return sweep_figure(Sweep.recorded(self.folder), self.rows, make=plt.figure)  # its spec: the axes' scales and names
 
     def _repr_html_(self) -> str:  # a notebook's view: a row per point with its fit
         from .reprs import sweep_html

@@ -36,10 +36,11 @@ from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_une
 from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, refuse_blas_without_room,
                             spare_address_space_under_a_limit)  # fmt: skip
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word, received
-from . import completion, exact3d, follow, plugins, predict, presets, report, resume, run, runs, schema, study, tui, validate
+from . import (completion, exact3d, follow, plot, plugins, predict, presets, report, resume, run, runs, schema, study, tui,
+               validate)  # fmt: skip
 from .console import error_label
 
-COMMANDS = (run, resume, runs, follow, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
+COMMANDS = (run, resume, runs, follow, plot, validate, schema, plugins, presets, report, predict, tui, study, exact3d, completion)
 """Each a module with ``add_parser(subparsers)`` and a handler ``run(args) -> ExitCode``."""
 
 
@@ -170,8 +171,8 @@ def _stray_option(word: str, options: list[str]) -> bool:
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The parser of every command, or with ``only`` of that one command (what parsing its
-    own words needs: its help, usage and errors are the same; building all fourteen was
-    a tenth of a short run's start)."""
+    own words needs: its help, usage and errors are the same; building all of them,
+    fourteen then, was a tenth of a short run's start)."""
     parser = _Parser(prog="frictionlab", description=DESCRIPTION, epilog=EPILOG)
     parser.add_argument(
         "-V", "--version", action="version", version=f"frictionlab {__version__}", help="print the version and exit"

@@ -68,9 +68,7 @@ class Scene:
     def pressed(self) -> str:
         """What is pressed, in words and by the name the preset gives: 'power-law lines',
         'power-law-2d surfaces', 'MDR-equivalent lines of power-law-2d surfaces'."""
-        if self.equivalent_line is not None:
-            return f"MDR-equivalent lines of {self.spectrum.name} surfaces"
-        return f"{self.spectrum.name} {'surfaces' if self.spectrum.dimension == 2 else 'lines'}"
+        return pressed_words(self.spectrum.name, self.spectrum.dimension, self.equivalent_line is not None)
 
     @property
     def normalisation(self) -> ForceNormalisation:
@@ -150,6 +148,27 @@ class Scene:
             for kind, plugin in self.plugins().items()
             for field in input_fields(type(plugin.params))
         }
+
+
+def pressed_words(spectrum: str, dimension: int, mdr_line: bool) -> str:
+    """``Scene.pressed``: what a ``spectrum`` of ``dimension`` makes is pressed, or (``mdr_line``)
+    its surfaces' MDR-equivalent lines."""
+    if mdr_line:
+        return f"MDR-equivalent lines of {spectrum} surfaces"
+    return f"{spectrum} {'surfaces' if dimension == 2 else 'lines'}"
+
+
+def recorded_pressed(spectrum: str, solver: str, registry: Registry | None = None) -> str | None:
+    """``Scene.pressed`` of a run whose preset named the plugins ``spectrum`` and ``solver``,
+    from what their installed classes declare, no scene built (a run folder read back: its
+    input file may be gone); None where either is not installed. A surface goes to a solver
+    of lines as its MDR-equivalent line, as ``_match_dimensions`` makes it."""
+    registry = registry or default_registry()
+    try:
+        made, presses = registry.get("spectrum", spectrum).dimension, registry.get("solver", solver)
+    except PluginError:
+        return None
+    return pressed_words(spectrum, made, made == 2 and made not in presses.dimensions and presses.mdr_lines)
 
 
 def build_scene(

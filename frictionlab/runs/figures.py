@@ -23,7 +23,7 @@ from importlib import import_module
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..errors import MissingDependency, RunError, shown_name
+from ..errors import MissingDependency, RunError, RunFolderError, shown_name
 
 # Imported only in the functions that use them: a command imports this module to fork
 # before pydantic or matplotlib are imported.
@@ -35,18 +35,21 @@ if TYPE_CHECKING:
     from ..compute.ensemble import RunOutcome
     from ..compute.fit import LogFit
     from ..preset import Scene
+    from ..result import Result
 
 PLOT_MODULE = "frictionlab.plot"  # draws the figures: imported by name, where and when needed (it imports matplotlib)
 
 
-def write_figure(path: Path, draw) -> None:
+def write_figure(path: Path, draw, *, devices: bool = False) -> None:
     """Write a figure file with ``draw(file)``, which imports matplotlib itself. A
     failure is a RunError naming the file: a folder that said no, or matplotlib
-    refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then."""
+    refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then.
+    ``devices``: ``path`` is one the user named, a FIFO or device there written into, not
+    replaced (``io.files.atomic_write``)."""
     from ..io.files import atomic_write
 
     try:
-        atomic_write(path, draw, binary=True)
+        atomic_write(path, draw, binary=True, devices=devices)
     except OSError as exc:
         raise RunError(f"cannot write {shown_name(path)}: {exc.strerror or exc}; the numbers are written") from None
     except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
@@ -73,11 +76,43 @@ class CurveFigure:
     @classmethod
     def of(cls, scene: Scene, outcome: RunOutcome) -> CurveFigure:
         return cls(
-            title=f"{scene.preset.name}: {scene.pressed}, {scene.solver.name}, {scene.slope.name}",
+            title=_title(scene.preset.name, scene.pressed, scene.solver.name, scene.slope.name),
             f_label=scene.normalisation.definition,
             f=outcome.f, xi=outcome.xi, xi_sem=outcome.xi_sem, contact_count=outcome.contact_count,
             fit=outcome.fit, done=outcome.done, caveats=tuple(outcome.caveats),
         )  # fmt: skip
+
+    @classmethod
+    def read_back(cls, result: Result) -> CurveFigure:
+        """What ``of`` made of a run, from its folder read back (``frictionlab.load``): its
+        curve, fit, caveats and f's definition as summary.json and curve.csv hold them; what
+        was pressed worked out from the plugins its preset names (``preset.scene.recorded_pressed``),
+        which summary.json does not say in words: the spectrum's name alone where they are not
+        installed. RunFolderError where the preset recorded names no plugin."""
+        from ..preset.scene import recorded_pressed
+
+        names = {kind: _plugin_name(result, kind) for kind in ("spectrum", "solver", "slope")}
+        pressed = recorded_pressed(names["spectrum"], names["solver"]) or names["spectrum"]
+        table = result.table
+        return cls(
+            title=_title(result.name, pressed, names["solver"], names["slope"]), f_label=result.normalisation,
+            f=table["f"], xi=table["xi"], xi_sem=table["xi_sem"], contact_count=table["contact_count"],
+            fit=result.fit, done=result.realizations[0], caveats=tuple(result.caveats),
+        )  # fmt: skip
+
+
+def _title(name: str, pressed: str, solver: str, slope: str) -> str:
+    return f"{name}: {pressed}, {solver}, {slope}"
+
+
+def _plugin_name(result: Result, kind: str) -> str:
+    """The name of the ``kind`` plugin in the preset ``result``'s folder recorded (untrusted: checked)."""
+    section = result.preset.get(kind)
+    name = section.get("name") if isinstance(section, dict) else None
+    if not isinstance(name, str) or not name.strip():
+        where = shown_name(Path(result.folder or ".") / "summary.json")
+        raise RunFolderError(f"{where} is damaged: field 'preset.{kind}.name' must name the {kind} plugin the run used")
+    return name
 
 
 def plot_wanted(scene: Scene, outcome: RunOutcome) -> bool:

@@ -85,6 +85,14 @@ class Sweep:
     points: list[SweepPoint]
     source: str | None = None
 
+    @classmethod
+    def recorded(cls, out_dir: Path) -> Sweep:
+        """The sweep that the sweep.json in ``out_dir`` records, without its points: its name, spec
+        and base preset, what names and scales sweep.png's axes (read as untrusted input:
+        ``read_sweep_record``, a RunFolderError naming the file and the field)."""
+        summary, record = read_sweep_record(out_dir)
+        return cls(record.name, SweepSettings.model_validate(summary["sweep"]), summary["base_preset"], points=[])
+
     @property
     def paths(self) -> list[str]:
         return list(self.spec.parameters)
@@ -117,7 +125,8 @@ class Sweep:
         if self.points:
             plugin = self.points[0].scene.plugins().get(section)
             return type(plugin.params) if plugin is not None else None
-        name = (self.base.get(section) or {}).get("name")
+        chosen = self.base.get(section)
+        name = chosen.get("name") if isinstance(chosen, dict) else None  # a sweep.json's base preset: untrusted
         try:
             return default_registry().get(section, name).Params if isinstance(name, str) else None
         except FrictionlabError:  # not installed (any more): the figure names the field by its key
@@ -433,13 +442,15 @@ def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, inte
         outcome.status = "completed"
     outcome.files = write_tables(sweep, outcome, out_dir)
     if plot and any(r.fit is not None or (r.recorded or {}).get("a") is not None for r in outcome.results):
-
-        def draw(fh) -> None:  # matplotlib is slow to import: only when drawing (its points import it ahead)
-            imported(PLOT_MODULE).plot_sweep(sweep, outcome.rows, fh)
-
-        write_figure(out_dir / "sweep.png", draw)
+        write_sweep_figure(out_dir / "sweep.png", sweep, outcome.rows)
         outcome.files["plot"] = out_dir / "sweep.png"
         write_tables(sweep, outcome, out_dir)
+
+
+def write_sweep_figure(path: Path, sweep: Sweep, rows: list[dict[str, Any]], *, devices: bool = False) -> None:
+    """sweep.png of ``rows`` (a row per point, as sweep.json holds them), drawn in this process
+    (``devices``: ``write_figure``'s). matplotlib is imported only as it draws (a sweep's points import it ahead)."""
+    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_sweep(sweep, rows, fh), devices=devices)
 
 
 def sweep_of_point(folder: str | Path) -> Path | None:

@@ -13,6 +13,7 @@ DRAWING_COMMANDS = [  # each draws figures that are its output; matplotlib's imp
     ["study", "quickstart", "--axes", "grid", "--grid-factors", "0.5,1", "--quiet", "--out", "out"],
     ["report", "--quiet", "--out", "out"],
     ["exact3d", "--quick", "--quiet", "--runs", "out"],
+    ["plot", "out"],  # said before the folder is looked for
 ]
 
 
