@@ -99,6 +99,7 @@ class ProfileFile(MeasuredFile):
     @cached_on_params
     def _measured(self) -> Measured:
         from .instrument_file import check_spacing, read_scan, scan_summary, uniform_spacing
+        from .scan_shaping.edge_lines import edge_points_warning
         from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
         from .scan_shaping.levelling import level_line, line_form_warning
         from .scan_shaping.spikes import line_spike_warning
@@ -160,7 +161,7 @@ class ProfileFile(MeasuredFile):
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
-                   units_warning(heights, float(dx), summary, "line")]  # as a map's
+                   edge_points_warning(heights, float(dx)), units_warning(heights, float(dx), summary, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)
