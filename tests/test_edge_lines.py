@@ -72,7 +72,7 @@ def test_a_lines_first_and_last_points_that_carry_its_slope_are_said_with_the_po
     caveat = edge_points_warning(line_from_slopes(slopes, 0.5), 0.5)
     found = LINE_EDGE.search(caveat)
     whole = (5 * r**2 + 4 * q**2 + (n - 9) * s**2) / n
-    assert found[1] == "first 5 and last 4 points" and int(found[2]) == round(100 * (1 - s**2 / whole))  # 43 %
+    assert found[1] == "first 5 points and last 4 points" and int(found[2]) == round(100 * (1 - s**2 / whole))  # 43 %
     assert float(found[3]) == pytest.approx(np.sqrt(whole), rel=2e-3) and float(found[5]) == pytest.approx(s, rel=2e-3)
     assert float(found[4]) == pytest.approx(np.sqrt(whole) / s, rel=2e-3)
     assert found.group(6, 7, 8) == ("5", "995", "1000")
@@ -100,7 +100,7 @@ def test_a_profile_files_steep_ends_are_said_in_its_caveats_with_the_runs_rms_sl
     np.savetxt(tmp_path / "trace.csv", z)
     [found] = [m for c in ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25).input_summary()["caveats"]
                if (m := LINE_EDGE.search(c))]  # fmt: skip
-    assert found[1] == "first 6 and last 5 points" and found.group(6, 7, 8) == ("6", "1994", "2000")
+    assert found[1] == "first 6 points and last 5 points" and found.group(6, 7, 8) == ("6", "1994", "2000")
     heights = ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25).generate(None).heights
     slopes = ForwardDifference().slopes(heights, 0.25, periodic=False)
     assert float(found[3]) == float(f"{np.sqrt(np.mean(slopes**2)):.3g}")
@@ -129,6 +129,8 @@ def test_edge_lines_and_points_on_a_level_rest_are_said_without_a_ratio():
     and the ratio to it was a division by zero."""
     z = np.zeros((40, 16))
     z[-1] = 1.0
-    assert "(its rms slope is 0.224, the rest level)" in edge_lines_warning(z - z.mean(), (1.0, 1.0))
+    said = edge_lines_warning(z - z.mean(), (1.0, 1.0))
+    assert "the map's last 2 rows carry 100 %" in said and "(its rms slope is 0.224, the rest level)" in said
+    assert "the map's first row carries 100 %" in edge_lines_warning(z[::-1] - z.mean(), (1.0, 1.0))
     line = np.r_[0.0, np.full(39, 2.0)]
-    assert "the line's first 1 points carry 100 %" in edge_points_warning(line - line.mean(), 1.0)
+    assert "the line's first point carries 100 %" in edge_points_warning(line - line.mean(), 1.0)

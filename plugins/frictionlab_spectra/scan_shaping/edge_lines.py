@@ -100,20 +100,21 @@ def _steep_edges(z: np.ndarray, sums_of: Sums, inner: bool = False) -> tuple[End
     return (ends, whole, rest) if rest < (1.0 - EDGE_SHARE) * whole else None
 
 
-def _share_said(whole: float, rest: float, kind: str, why: str) -> str:
-    """The clause of the edge ``kind``s (line, point): the share of the mean squared slope
-    ``whole`` they carry (``rest`` without them), the rms slopes, and what follows of them (a scan
-    starts or ends with them: ``why``)."""
+def _share_said(whole: float, rest: float, kind: str, why: str, one: bool = False) -> str:
+    """The clause of the edge ``kind``s (line, point; ``one``: a single one): the share of the
+    mean squared slope ``whole`` they carry (``rest`` without them), the rms slopes, and what
+    follows of them (a scan starts or ends with them: ``why``)."""
     than = f"{math.sqrt(whole / rest):.3g} times the {math.sqrt(rest):.3g} of the rest" if rest else "the rest level"
-    return (f"carry {100 * (1 - rest / whole):.0f} % of its mean squared slope, each more than {EDGE_LINE_TIMES:g} "
+    carry, each = ("carries", "") if one else ("carry", "each ")
+    return (f"{carry} {100 * (1 - rest / whole):.0f} % of its mean squared slope, {each}more than {EDGE_LINE_TIMES:g} "
             f"times a typical {kind}'s (its rms slope is {math.sqrt(whole):.3g}, {than}): {kind}s a scan starts or "
             f"ends with ({why}), whose slopes the rms slope xi divides by, and the full-contact estimate p = E* g, "
             "are then theirs")
 
 
-def _ends_said(counts: tuple[int, int]) -> list[str]:
-    """"first 2", "last 4": the edge lines (points) at each end that has some."""
-    return [f"{where} {n}" for n, where in zip(counts, ("first", "last")) if n]
+def _ends_said(counts: tuple[int, int], kind: str) -> list[str]:
+    """"first row", "last 4 rows": the edge ``kind``s (row, column, point) at each end that has some."""
+    return [f"{where} {kind}" if n == 1 else f"{where} {n} {kind}s" for n, where in zip(counts, ("first", "last")) if n]
 
 
 def edge_lines_warning(z: np.ndarray, pixel: tuple[float, float], region=None) -> str | None:
@@ -126,12 +127,11 @@ def edge_lines_warning(z: np.ndarray, pixel: tuple[float, float], region=None) -
     ((top, bottom), (left, right)), whole, rest = steep
     ny, nx = z.shape
     (x0, _), (y0, _) = region if region is not None else ((0, nx), (0, ny))
-    said = [f"{end} rows" for end in _ends_said((top, bottom))]
-    said += [f"{end} columns" for end in _ends_said((left, right))]
+    said = _ends_said((top, bottom), "row") + _ends_said((left, right), "column")
     crop = ", ".join(f"{axis}: [{start}, {stop}]" for axis, start, stop, cut in (
         ("x", x0 + left, x0 + nx - right, left or right), ("y", y0 + top, y0 + ny - bottom, top or bottom)) if cut)  # fmt: skip
     why = "a scanner settling, the tip leaving the surface"
-    return (f"the map's {' and '.join(said)} {_share_said(whole, rest, 'line', why)}; crop them with region "
+    return (f"the map's {' and '.join(said)} {_share_said(whole, rest, 'line', why, top + bottom + left + right == 1)}; crop them with region "
             f"({crop}, pixels of the file), if they are not the surface's own")
 
 
@@ -143,7 +143,7 @@ def edge_points_warning(z: np.ndarray, spacing: float) -> str | None:
     if steep is None:
         return None
     ((first, last),), whole, rest = steep
-    said = " and ".join(_ends_said((first, last))) + " points"
+    said = " and ".join(_ends_said((first, last), "point"))
     why = "a stylus landing or settling, the trace running off the sample"
-    return (f"the line's {said} {_share_said(whole, rest, 'point', why)}; leave them out of the file, keeping its "
+    return (f"the line's {said} {_share_said(whole, rest, 'point', why, first + last == 1)}; leave them out of the file, keeping its "
             f"points {first} to {z.size - last - 1} of {z.size} (counted from 0), if they are not the surface's own")
