@@ -48,11 +48,10 @@ def draw_curve(ax, f, xi, xi_sem, fit: LogFit | None, *, done: int, caveats=(), 
     ax.set_ylabel(XI_LABEL, fontsize=fontsize + 1)
     ax.legend(fontsize=fontsize, loc="upper left")  # a fixed corner: "best" searches every data point
     ax.grid(True, which="both", alpha=0.3)
-    for i, caveat in enumerate(caveats):
-        ax.text(
-            0.99, 0.02 + 0.09 * i, "caveat: " + textwrap.fill(caveat, 70), transform=ax.transAxes, ha="right",
-            va="bottom", fontsize=fontsize - 1, color="C3", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0},
-        )  # fmt: skip
+    if caveats:  # one block: caveats of several lines each, stacked by the text's own layout, never overlapping
+        said = "\n".join("caveat: " + textwrap.fill(caveat, 70) for caveat in caveats)
+        ax.text(0.99, 0.02, said, transform=ax.transAxes, ha="right", va="bottom", fontsize=fontsize - 1, color="C3",
+                bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})  # fmt: skip
 
 
 _SUPERSCRIPTS = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")

@@ -121,3 +121,32 @@ def test_a_long_title_of_plot_png_is_inside_the_figure(make_scene, monkeypatch):
     assert name in title.get_text().replace("\n", " ")
     box = title.get_window_extent(canvas.get_renderer())
     assert box.x0 >= inside.x0 and box.x1 <= inside.x1 and box.y1 <= inside.y1, (box, inside)
+
+
+def test_caveats_of_several_lines_each_are_all_readable_none_over_another():
+    """Each caveat was placed 0.09 of the axes above the last, whatever its lines: two of five lines
+    each (a measured line's edge points) were drawn one over the other, neither readable."""
+    import itertools
+
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from frictionlab.plot import draw_curve
+
+    edge = ("the line's first 8 points and last 6 points carry 81 % of its mean squared slope, each more than 10 times "
+            "a typical point's: points a scan starts or ends with, whose slopes the rms slope xi divides by, are then "
+            "theirs; leave them out of the file, keeping its points 8 to 2993 of 3000 (counted from 0)")  # fmt: skip
+    caveats = [edge, "fewer than 3 points in contact at the first load", edge.replace("81 %", "64 %")]
+    fig = Figure(figsize=(6.4, 5.6))
+    ax = fig.subplots()
+    f = np.geomspace(1e-9, 2e-8, 40)
+    draw_curve(ax, f, 0.3 + 0.02 * np.log(f / f[0]), np.full(40, 0.01), None, done=8, caveats=caveats)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    said = [t for t in ax.texts if "caveat: " in t.get_text()]
+    text = " ".join(" ".join(t.get_text().split()) for t in said)
+    assert all(f"caveat: {caveat}" in text for caveat in caveats), text
+    boxes = [t.get_window_extent(canvas.get_renderer()) for t in said]
+    assert not any(a.overlaps(b) for a, b in itertools.combinations(boxes, 2)), boxes
+    assert all(box.y1 <= ax.bbox.y1 for box in boxes)  # inside the axes, under the legend's row at most
