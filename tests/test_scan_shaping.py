@@ -538,3 +538,16 @@ def test_self_affine_surfaces_draw_no_spike_or_pit_caveat(registry, hurst):
     for index in range(3):
         z = generator.generate(realization_rng(3, index)).heights
         assert spike_warning(z - z.mean(), float(np.std(z))) is None
+
+
+def test_a_spike_on_a_line_level_but_for_rounding_says_the_rest_level_not_a_ratio_of_1e15():
+    """A line flat but for a spike and a step of 1e-14: despiked, its mean squared slope is rounding's
+    residue, and the caveat said the rms slope was 4.24e+15 times what it is without the spike."""
+    from frictionlab_spectra.scan_shaping import line_spike_warning
+
+    z = np.r_[np.zeros(200), np.full(200, 1e-14)]
+    z[100] += 30.0
+    z -= z.mean()
+    said = line_spike_warning(z, float(np.sqrt(np.mean(z**2))), 1.0)
+    assert f"(its rms slope is {np.sqrt(np.mean(np.diff(z) ** 2)):.3g}, the rest level)" in said, said
+    assert "times what it is without them" not in said

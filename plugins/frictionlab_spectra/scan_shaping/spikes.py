@@ -35,6 +35,7 @@ def spike_warning(z: np.ndarray, rms: float, pixel: tuple[float, float] = (1.0, 
 
 
 SPIKE_SLOPE_SHARE = 0.5  # of the mean squared slope: spikes carrying more make the rms slope theirs
+LEVEL_REST = 1e-12  # of the mean squared slope: the rest, despiked, carrying less is level (a ratio past 1e6)
 
 
 def _spike_slope_note(z: np.ndarray, rms: float, pixel: tuple[float, float], what: str) -> tuple[str, int]:
@@ -49,7 +50,8 @@ def _spike_slope_note(z: np.ndarray, rms: float, pixel: tuple[float, float], wha
     spiky, smooth = mean_square_slope(z, pixel), mean_square_slope(cleaned, pixel)
     if not spiky > 0 or smooth >= (1.0 - SPIKE_SLOPE_SHARE) * spiky:
         return "", count
-    times = f", {math.sqrt(spiky / smooth):.3g} times what it is without them" if smooth > 0 else ""
+    level = smooth <= LEVEL_REST * spiky  # rounding's residue, not a slope: no ratio of 1e17 said
+    times = ", the rest level" if level else f", {math.sqrt(spiky / smooth):.3g} times what it is without them"
     return (f"; they carry {100 * (1 - smooth / spiky):.0f} % of the {what}'s mean squared slope (its rms slope is "
             f"{math.sqrt(spiky):.3g}{times}), so the rms slope xi divides by, and the full-contact estimate p = E* g, "
             "are theirs too", count)  # fmt: skip
