@@ -150,3 +150,34 @@ def test_caveats_of_several_lines_each_are_all_readable_none_over_another():
     boxes = [t.get_window_extent(canvas.get_renderer()) for t in said]
     assert not any(a.overlaps(b) for a, b in itertools.combinations(boxes, 2)), boxes
     assert all(box.y1 <= ax.bbox.y1 for box in boxes)  # inside the axes, under the legend's row at most
+
+
+def test_a_folder_with_thousands_of_long_caveats_is_drawn_with_the_first_few_and_how_many_more(tmp_path, monkeypatch):
+    """A run folder is untrusted: its summary.json (up to 64 MB) may hold any number of caveats.
+    2000 of 2000 characters each kept `frictionlab plot` drawing for minutes; a figure shows the
+    first few, each cut, and says how many more the folder holds."""
+    import json
+
+    import yaml
+    from matplotlib.figure import Figure
+
+    from frictionlab import load
+    from frictionlab.cli.main import main
+    from frictionlab.runs.figures import SHOWN_CAVEAT_CHARS, SHOWN_CAVEATS
+
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump({**SMALL_PRESET, "realizations": 2}))
+    assert main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "run"), "--quiet", "--no-plot"]) == 0
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    summary["caveats"] = [f"caveat number {i} " + "x" * 2000 for i in range(2000)]
+    (tmp_path / "run" / "summary.json").write_text(json.dumps(summary))
+    drawn = []
+    save = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
+    assert main(["plot", str(tmp_path / "run"), "--quiet"]) == 0
+    ax = load(tmp_path / "run").plot(Figure().subplots())  # and in a notebook
+    for texts in (drawn[0].axes[0].texts, ax.texts):
+        [block] = [t.get_text() for t in texts if "caveat: " in t.get_text()]
+        said = block.split("caveat: ")[1:]
+        assert len(said) == SHOWN_CAVEATS + 1 and all(f"caveat number {i} " in said[i] for i in range(SHOWN_CAVEATS))
+        assert all(len("".join(part.split())) <= SHOWN_CAVEAT_CHARS + 3 for part in said)
+        assert f"and {2000 - SHOWN_CAVEATS} more, not shown here" in " ".join(said[-1].split())

@@ -38,6 +38,18 @@ if TYPE_CHECKING:
     from ..result import Result
 
 PLOT_MODULE = "frictionlab.plot"  # draws the figures: imported by name, where and when needed (it imports matplotlib)
+SHOWN_CAVEATS = 8  # a run has a handful: a folder read back may hold any number (its summary.json up to 64 MB)
+SHOWN_CAVEAT_CHARS = 1500  # frictionlab's own are shorter, but for a file's name in them
+
+
+def shown_caveats(caveats) -> list[str]:
+    """``caveats`` as a figure or a screen shows them: the first SHOWN_CAVEATS, each cut at
+    SHOWN_CAVEAT_CHARS, then how many more there are. A folder holding thousands of long ones
+    (damaged, or a plugin's) took minutes to draw, the figure under them unreadable anyway."""
+    said = [c if len(c) <= SHOWN_CAVEAT_CHARS else c[:SHOWN_CAVEAT_CHARS] + "..." for c in caveats[:SHOWN_CAVEATS]]
+    if len(caveats) > SHOWN_CAVEATS:
+        said.append(f"and {len(caveats) - SHOWN_CAVEATS} more, not shown here (the run's summary.json lists them all)")
+    return said
 
 
 def write_figure(path: Path, draw, *, devices: bool = False) -> None:
@@ -79,7 +91,7 @@ class CurveFigure:
             title=_title(scene.preset.name, scene.pressed, scene.solver.name, scene.slope.name),
             f_label=scene.normalisation.definition,
             f=outcome.f, xi=outcome.xi, xi_sem=outcome.xi_sem, contact_count=outcome.contact_count,
-            fit=outcome.fit, done=outcome.done, caveats=tuple(outcome.caveats),
+            fit=outcome.fit, done=outcome.done, caveats=tuple(shown_caveats(outcome.caveats)),
         )  # fmt: skip
 
     @classmethod
@@ -97,7 +109,7 @@ class CurveFigure:
         return cls(
             title=_title(result.name, pressed, names["solver"], names["slope"]), f_label=result.normalisation,
             f=table["f"], xi=table["xi"], xi_sem=table["xi_sem"], contact_count=table["contact_count"],
-            fit=result.fit, done=result.realizations[0], caveats=tuple(result.caveats),
+            fit=result.fit, done=result.realizations[0], caveats=tuple(shown_caveats(result.caveats)),
         )  # fmt: skip
 
 

@@ -16,6 +16,7 @@ from textual.widgets import ProgressBar, Static
 from ...errors import shown
 from ...compute.fit import ci_label, format_estimate
 from ...plugin.listeners import format_duration, progress_text
+from ...runs.figures import shown_caveats
 from ..chart import Series
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..live import Snapshot
@@ -329,7 +330,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         self.query_one("#run-chart", Chart).show(series)
         lines, short = (fit_lines(result.fit, final=True, f_formula=run.f_formula, short=s) for s in (False, True))
         self.query_one("#run-fit", FitPanel).show(lines, result.table["contact_count"], short)
-        self._caveats([f"caveat: {caveat}" for caveat in result.caveats])  # as frictionlab run prints them
+        self._caveats([f"caveat: {caveat}" for caveat in shown_caveats(result.caveats)])  # as frictionlab run prints them
         if run.failures:  # a realization's own error, told as the user can act on it (the summary quotes it raw)
             index, reason = run.failures[0]
             self._error(f"{run.failed} realization(s) failed; #{index}: {failure_message(reason)}")
