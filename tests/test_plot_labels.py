@@ -155,7 +155,8 @@ def test_caveats_of_several_lines_each_are_all_readable_none_over_another():
 def test_a_folder_with_thousands_of_long_caveats_is_drawn_with_the_first_few_and_how_many_more(tmp_path, monkeypatch):
     """A run folder is untrusted: its summary.json (up to 64 MB) may hold any number of caveats.
     2000 of 2000 characters each kept `frictionlab plot` drawing for minutes; a figure shows the
-    first few, each cut, and says how many more the folder holds."""
+    first few, each cut, and says how many more the folder holds. A name and f's definition of
+    300000 characters left no room for the axes (matplotlib's 'bottom cannot be >= top')."""
     import json
 
     import yaml
@@ -163,17 +164,21 @@ def test_a_folder_with_thousands_of_long_caveats_is_drawn_with_the_first_few_and
 
     from frictionlab import load
     from frictionlab.cli.main import main
-    from frictionlab.runs.figures import SHOWN_CAVEAT_CHARS, SHOWN_CAVEATS
+    from frictionlab.runs.figures import SHOWN_CAVEAT_CHARS, SHOWN_CAVEATS, SHOWN_LABEL_CHARS
 
     (tmp_path / "p.yaml").write_text(yaml.safe_dump({**SMALL_PRESET, "realizations": 2}))
     assert main(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "run"), "--quiet", "--no-plot"]) == 0
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     summary["caveats"] = [f"caveat number {i} " + "x" * 2000 for i in range(2000)]
+    summary["preset"]["name"], summary["normalisation"]["f"] = "n" * 300_000, "f " * 150_000
     (tmp_path / "run" / "summary.json").write_text(json.dumps(summary))
     drawn = []
     save = Figure.savefig
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: (drawn.append(fig), save(fig, *a, **k))[1])
     assert main(["plot", str(tmp_path / "run"), "--quiet"]) == 0
+    title, label = drawn[0].axes[0].get_title(), drawn[0].axes[1].get_xlabel()
+    assert title.startswith("nnn") and len("".join(title.split())) <= SHOWN_LABEL_CHARS + 3
+    assert label.startswith("f f") and len(label) <= 2 * SHOWN_LABEL_CHARS
     ax = load(tmp_path / "run").plot(Figure().subplots())  # and in a notebook
     for texts in (drawn[0].axes[0].texts, ax.texts):
         [block] = [t.get_text() for t in texts if "caveat: " in t.get_text()]

@@ -40,13 +40,19 @@ if TYPE_CHECKING:
 PLOT_MODULE = "frictionlab.plot"  # draws the figures: imported by name, where and when needed (it imports matplotlib)
 SHOWN_CAVEATS = 8  # a run has a handful: a folder read back may hold any number (its summary.json up to 64 MB)
 SHOWN_CAVEAT_CHARS = 1500  # frictionlab's own are shorter, but for a file's name in them
+SHOWN_LABEL_CHARS = 400  # of a title or an axis's label read back: a run's own are under 300 (a preset's name 100)
+
+
+def cut(text: str, limit: int) -> str:
+    """``text``, or its first ``limit`` characters and "..."."""
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def shown_caveats(caveats) -> list[str]:
     """``caveats`` as a figure or a screen shows them: the first SHOWN_CAVEATS, each cut at
     SHOWN_CAVEAT_CHARS, then how many more there are. A folder holding thousands of long ones
     (damaged, or a plugin's) took minutes to draw, the figure under them unreadable anyway."""
-    said = [c if len(c) <= SHOWN_CAVEAT_CHARS else c[:SHOWN_CAVEAT_CHARS] + "..." for c in caveats[:SHOWN_CAVEATS]]
+    said = [cut(caveat, SHOWN_CAVEAT_CHARS) for caveat in caveats[:SHOWN_CAVEATS]]
     if len(caveats) > SHOWN_CAVEATS:
         said.append(f"and {len(caveats) - SHOWN_CAVEATS} more, not shown here (the run's summary.json lists them all)")
     return said
@@ -100,14 +106,16 @@ class CurveFigure:
         curve, fit, caveats and f's definition as summary.json and curve.csv hold them; what
         was pressed worked out from the plugins its preset names (``preset.scene.recorded_pressed``),
         which summary.json does not say in words: the spectrum's name alone where they are not
-        installed. RunFolderError where the preset recorded names no plugin."""
+        installed. RunFolderError where the preset recorded names no plugin. Its texts are cut at
+        SHOWN_LABEL_CHARS (a damaged folder's title of 300000 characters left no room for the axes)."""
         from ..preset.scene import recorded_pressed
 
         names = {kind: _plugin_name(result, kind) for kind in ("spectrum", "solver", "slope")}
         pressed = recorded_pressed(names["spectrum"], names["solver"]) or names["spectrum"]
         table = result.table
         return cls(
-            title=_title(result.name, pressed, names["solver"], names["slope"]), f_label=result.normalisation,
+            title=cut(_title(result.name, pressed, names["solver"], names["slope"]), SHOWN_LABEL_CHARS),
+            f_label=cut(result.normalisation, SHOWN_LABEL_CHARS),
             f=table["f"], xi=table["xi"], xi_sem=table["xi_sem"], contact_count=table["contact_count"],
             fit=result.fit, done=result.realizations[0], caveats=tuple(shown_caveats(result.caveats)),
         )  # fmt: skip
