@@ -89,9 +89,13 @@ class Sweep:
     def recorded(cls, out_dir: Path) -> Sweep:
         """The sweep that the sweep.json in ``out_dir`` records, without its points: its name, spec
         and base preset, what names and scales sweep.png's axes (read as untrusted input:
-        ``read_sweep_record``, a RunFolderError naming the file and the field)."""
+        ``read_sweep_record``, a RunFolderError naming the file and the field); its name cut as a
+        title is (``figures.SHOWN_LABEL_CHARS``: one of 300000 characters took 40 s to draw)."""
+        from .figures import SHOWN_LABEL_CHARS, cut
+
         summary, record = read_sweep_record(out_dir)
-        return cls(record.name, SweepSettings.model_validate(summary["sweep"]), summary["base_preset"], points=[])
+        spec = SweepSettings.model_validate(summary["sweep"])
+        return cls(cut(record.name, SHOWN_LABEL_CHARS), spec, summary["base_preset"], points=[])
 
     @property
     def paths(self) -> list[str]:

@@ -53,6 +53,16 @@ def test_a_sweeps_figure_is_the_one_the_sweep_draws(tmp_path, cli, registry):
     assert (done.returncode, done.stdout) == (ExitCode.OK, f"wrote {out}\n"), done.stderr
     np.testing.assert_array_equal(pixels(out), pixels(tmp_path / "sweep" / "sweep.png"))
 
+    import json
+
+    from frictionlab.runs.figures import SHOWN_LABEL_CHARS
+    from frictionlab.runs.sweep import Sweep
+
+    record = json.loads((tmp_path / "sweep" / "sweep.json").read_text())
+    record["name"] = "s" * 300_000  # a damaged sweep.json: its title took 40 s to draw, the axes squeezed out
+    (tmp_path / "sweep" / "sweep.json").write_text(json.dumps(record))
+    assert Sweep.recorded(tmp_path / "sweep").name == "s" * SHOWN_LABEL_CHARS + "..."
+
 
 def test_a_folder_that_holds_no_run_or_nothing_to_draw_is_refused_by_name(tmp_path, cli, make_scene):
     empty, linked, nothing = tmp_path / "empty", tmp_path / "linked", tmp_path / "nothing"
