@@ -91,7 +91,7 @@ class Result:
         None, through pyplot, so a notebook shows it); returns the Axes."""
         refuse_unusable_matplotlib()  # a bad MPLBACKEND: named, not matplotlib's ValueError from its import
         from .plot import AXES_NEEDS, draw_curve
-        from .runs.figures import shown_caveats
+        from .runs.figures import SHOWN_LABEL_CHARS, cut, shown_caveats
 
         missing = [name for name in AXES_NEEDS if not callable(getattr(ax, name, None))] if ax is not None else []
         if missing or (ax is not None and not hasattr(ax, "transAxes")):
@@ -106,8 +106,8 @@ class Result:
         t = self.table
         draw_curve(ax, t["f"], t["xi"], t["xi_sem"], self.fit, done=self.realizations[0],
                    caveats=shown_caveats(self.caveats))  # fmt: skip
-        ax.set_xlabel(self.normalisation, fontsize=8)
-        ax.set_title(self.name, fontsize=10)
+        ax.set_xlabel(cut(self.normalisation, SHOWN_LABEL_CHARS), fontsize=8)  # a damaged folder's may be any length
+        ax.set_title(cut(self.name, SHOWN_LABEL_CHARS), fontsize=10)
         return ax
 
     def _repr_html_(self) -> str:  # a notebook's view: the fit's table with its intervals, and the curve

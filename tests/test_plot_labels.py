@@ -180,6 +180,7 @@ def test_a_folder_with_thousands_of_long_caveats_is_drawn_with_the_first_few_and
     assert title.startswith("nnn") and len("".join(title.split())) <= SHOWN_LABEL_CHARS + 3
     assert label.startswith("f f") and len(label) <= 2 * SHOWN_LABEL_CHARS
     ax = load(tmp_path / "run").plot(Figure().subplots())  # and in a notebook
+    assert len(ax.get_title()) == len(ax.get_xlabel()) == SHOWN_LABEL_CHARS + 3
     for texts in (drawn[0].axes[0].texts, ax.texts):
         [block] = [t.get_text() for t in texts if "caveat: " in t.get_text()]
         said = block.split("caveat: ")[1:]
