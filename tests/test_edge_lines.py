@@ -19,8 +19,8 @@ EDGE = re.compile(r"the map's (.*?) carry (\d+) % of its mean squared slope.*its
 
 
 LINE_EDGE = re.compile(r"the line's (.*?) carry (\d+) % of its mean squared slope.*its rms slope is ([0-9.e+-]+), "
-                       r"([0-9.e+-]+) times the ([0-9.e+-]+) of the rest\).*keeping its points (\d+) to (\d+) of (\d+) "
-                       r"\(counted from 0\)")  # fmt: skip
+                       r"([0-9.e+-]+) times the ([0-9.e+-]+) of the rest\).*crop them with region \(x: \[(\d+), (\d+)\], "
+                       r"pixels of the file\)")  # fmt: skip
 
 
 def rough(n: int = 64) -> np.ndarray:
@@ -75,8 +75,10 @@ def test_a_lines_first_and_last_points_that_carry_its_slope_are_said_with_the_po
     assert found[1] == "first 5 points and last 4 points" and int(found[2]) == round(100 * (1 - s**2 / whole))  # 43 %
     assert float(found[3]) == pytest.approx(np.sqrt(whole), rel=2e-3) and float(found[5]) == pytest.approx(s, rel=2e-3)
     assert float(found[4]) == pytest.approx(np.sqrt(whole) / s, rel=2e-3)
-    assert found.group(6, 7, 8) == ("5", "995", "1000")
+    assert found.group(6, 7) == ("5", "996")  # half-open: the points 5 to 995 of 1000
     assert edge_points_warning(line_from_slopes(slopes[5:-3], 0.5), 0.5) is None  # the points kept: no caveat
+    shifted = LINE_EDGE.search(edge_points_warning(line_from_slopes(slopes, 0.5), 0.5, [[40, 1040]]))
+    assert shifted.group(6, 7) == ("45", "1036")  # in the file's points, past a region already given
 
 
 @pytest.mark.parametrize("steep, said", [(36.0, False), (68.0, True)])  # 14.9 % and 25.1 % of the mean squared slope
@@ -90,8 +92,8 @@ def test_edge_points_are_said_when_they_carry_more_than_a_fifth_of_the_mean_squa
 def test_a_profile_files_steep_ends_are_said_in_its_caveats_with_the_runs_rms_slope(tmp_path):
     """A measured-like trace (two sines and noise) whose stylus lands over its first 6 points and
     runs off the sample over its last 4, read from a table: the caveat is among the line's, its
-    rms slope the forward difference's of the heights the run is given; the points it says to keep,
-    saved alone, draw none."""
+    rms slope the forward difference's of the heights the run is given; the region it says to crop
+    them with, given in the preset, draws none."""
     rng = np.random.default_rng(np.random.SeedSequence(8))
     t = np.arange(2000.0)
     z = np.sin(2 * np.pi * t / 700.0) + 0.3 * np.cos(2 * np.pi * t / 130.0) + 0.01 * rng.standard_normal(t.size)
@@ -100,12 +102,12 @@ def test_a_profile_files_steep_ends_are_said_in_its_caveats_with_the_runs_rms_sl
     np.savetxt(tmp_path / "trace.csv", z)
     [found] = [m for c in ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25).input_summary()["caveats"]
                if (m := LINE_EDGE.search(c))]  # fmt: skip
-    assert found[1] == "first 6 points and last 5 points" and found.group(6, 7, 8) == ("6", "1994", "2000")
+    assert found[1] == "first 6 points and last 5 points" and found.group(6, 7) == ("6", "1995")
     heights = ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25).generate(None).heights
     slopes = ForwardDifference().slopes(heights, 0.25, periodic=False)
     assert float(found[3]) == float(f"{np.sqrt(np.mean(slopes**2)):.3g}")
-    np.savetxt(tmp_path / "kept.csv", z[6:1995])
-    said = ProfileFile(path=str(tmp_path / "kept.csv"), spacing=0.25).input_summary().get("caveats", ())
+    region = {"x": [int(found[6]), int(found[7])]}
+    said = ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25, region=region).input_summary().get("caveats", ())
     assert not any(LINE_EDGE.search(c) for c in said), said
 
 

@@ -288,7 +288,7 @@ def test_a_line_with_a_large_filled_share_says_so_beside_its_own_caveats(tmp_pat
     UniformLineScan(z, z.size * PIXEL_UM, unit="um").to_netcdf(str(tmp_path / "line.nc"))
     caveats = ProfileFile(path=str(tmp_path / "line.nc"), unit="um", undefined="harmonic").input_summary()["caveats"]
     assert caveats[0].startswith("7.5 % of the file's points were undefined and filled")
-    assert "cut the line in the file to its measured part" in caveats[0]
+    assert "crop the line to its measured part (region)" in caveats[0]
     assert any("a curvature carries" in caveat for caveat in caveats[1:])  # the line's own caveat kept beside it
 
 @pytest.mark.parametrize("pixel, writer, unit, said", [

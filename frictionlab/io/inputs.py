@@ -255,8 +255,8 @@ def describe_input(summary: dict) -> str:
         notes.append("x decreasing (a scan written right to left): the line read as written, mirrored, which changes "
                      "no statistic and no contact")
     if summary.get("region_pixels"):
-        (x0, x1), (y0, y1) = summary["region_pixels"]
-        notes.append(f"cropped to x {x0}:{x1}, y {y0}:{y1} (pixels of the file)")
+        spans = ", ".join(f"{axis} {start}:{stop}" for axis, (start, stop) in zip("xy", summary["region_pixels"]))
+        notes.append(f"cropped to {spans} ({kind} of the file)")
     if summary.get("pixels"):
         notes.append(f"pixels {summary['pixels']}")
     stated, given = summary.get("file_spacing"), summary.get("downsampled", {}).get("from_pixel", summary["spacing"])

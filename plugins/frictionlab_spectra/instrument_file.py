@@ -296,7 +296,7 @@ def filled_caveat(filled: int, total: int, p, ndim: int, of: str = "the file's")
     share = filled / total if p.undefined == "harmonic" else 0.0
     if share < FILLED_CAVEAT_SHARE:
         return None
-    crop = "crop the map to its measured part (region)" if ndim == 2 else "cut the line in the file to its measured part"
+    crop = f"crop the {'map' if ndim == 2 else 'line'} to its measured part (region)"
     return (f"{100 * share:.3g} % of {of} points were undefined and filled by harmonic interpolation: their "
             "slopes are the interpolation's (smooth), not the surface's, nor is xi where a contact reaches them; "
             f"{crop} where it is large enough")  # fmt: skip

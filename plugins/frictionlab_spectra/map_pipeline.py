@@ -50,11 +50,38 @@ class Region(BaseModel):
 
     @model_validator(mode="after")
     def _ordered(self):
-        for name, span in (("x", self.x), ("y", self.y)):
-            if span is not None and not 0 <= span[0] < span[1] < math.inf:
-                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: needs 0 <= start < stop")
-            if span is not None and self.units == "pixels" and not all(float(v).is_integer() for v in span):
-                raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: pixels are whole numbers")
+        check_span("x", self.x, self.units)
+        check_span("y", self.y, self.units)
+        return self
+
+
+def check_span(name: str, span: tuple[float, float] | None, units: str) -> None:
+    """ValueError unless the span ``region.<name>`` is ordered from 0 up and, in pixels, whole."""
+    if span is not None and not 0 <= span[0] < span[1] < math.inf:
+        raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: needs 0 <= start < stop")
+    if span is not None and units == "pixels" and not all(float(v).is_integer() for v in span):
+        raise ValueError(f"region.{name} = [{span[0]:g}, {span[1]:g}]: pixels are whole numbers")
+
+
+class LineRegion(BaseModel):
+    """A measured line's crop (``profile-file``): ``x`` as [start, stop) along the line, in points
+    of the file or in the run's length unit from its first point (``units``), as a map's ``Region``."""
+
+    model_config = ConfigDict(extra="forbid", defer_build=True)  # built when a preset reads a file
+    x: tuple[_Finite, _Finite] | None = Field(None, description="[start, stop) along the line (its points)")
+    units: Literal["pixels", "length"] = Field("pixels", description="points of the file, or the run's length unit")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_rows(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "y" in data:  # said before pydantic's 'extra inputs are not permitted'
+            raise ValueError(f"region.y = {data['y']!r}: a line has no rows (y), only its points along x; give "
+                             "region.x alone")  # fmt: skip
+        return data
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        check_span("x", self.x, self.units)
         return self
 
 
@@ -90,38 +117,60 @@ def _nearly_square(dx: float, dy: float) -> bool:
     return abs(dx - dy) <= PIXEL_TOLERANCE * max(dx, dy)
 
 
-def crop(z: np.ndarray, pixel: tuple[float, float], region: Region, where: str) -> tuple[np.ndarray, list]:
-    ny, nx = z.shape
+def crop(z: np.ndarray, pixel: tuple[float, float], region: Region | LineRegion, where: str) -> tuple[np.ndarray, list]:
+    """``z`` (a map, or a line: then ``region`` a ``LineRegion``) cut to ``region``, and the spans
+    kept in the file's pixels, [[x0, x1], [y0, y1]] (a line's [[x0, x1]])."""
+    line = z.ndim == 1
+    what, kind = ("line", "point") if line else ("map", "pixel")
+    sides = [(region.x, pixel[0], z.shape[-1], "x")] + ([] if line else [(region.y, pixel[1], z.shape[0], "y")])
     bounds = []
-    for span, side, count, name in ((region.x, pixel[0], nx, "x"), (region.y, pixel[1], ny, "y")):
+    for span, side, count, name in sides:
         if span is None:
             bounds.append((0, count))
             continue
         start, stop = (round(v / side) for v in span) if region.units == "length" else (int(v) for v in span)
+        along = "" if line else f" along {name}"
         if stop <= count and stop - start < 1:  # inside, in the run's length unit, but rounded to no pixel
             raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] (length) is narrower than one "
-                             f"pixel, {side:g} (the run's length unit) along {name}")  # fmt: skip
+                             f"{kind}, {side:g} (the run's length unit){along}")  # fmt: skip
         if stop > count:
-            extent = f"{count} pixels" if region.units == "pixels" else f"{count * side:g} (the run's length unit)"
-            raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] ({region.units}) is not inside the map, "
-                             f"{extent} along {name}")  # fmt: skip
+            extent = f"{count} {kind}s" if region.units == "pixels" else f"{count * side:g} (the run's length unit)"
+            raise ValueError(f"{where}: region.{name} = [{span[0]:g}, {span[1]:g}] ({region.units}) is not inside the "
+                             f"{what}, {extent}{along}")  # fmt: skip
         bounds.append((start, stop))
+    if line:
+        (x0, x1), = bounds
+        return z[x0:x1], [[x0, x1]]
     (x0, x1), (y0, y1) = bounds
     return z[y0:y1, x0:x1], [[x0, x1], [y0, y1]]
 
 
-def check_still_periodic(pixel: tuple[float, float], p, where: str) -> None:
-    """Refuse a periodic map that a step of ``shape_map`` would leave no longer tiling the
-    plane: a crop, or a resampling (onto square pixels, or coarser), whose cosine series
+def undefined_in_region(mask: np.ndarray, undefined: int, pixel: tuple[float, float], p, where: str) -> dict[str, Any]:
+    """What the summary says of a scan's ``undefined`` points (``mask``: a map's or a line's) once
+    cropped: those inside ``region`` (filled, or refused) and those it leaves out."""
+    from .instrument_file import filled_caveat
+
+    region_mask = crop(mask, pixel, p.region, where)[0]  # the scan's shape: its size is the region's
+    inside, size = int(np.count_nonzero(region_mask)), region_mask.size
+    caveat = filled_caveat(inside, size, p, mask.ndim, "the region's")
+    return {"undefined_points": inside, "undefined_outside_region": undefined - inside,
+            "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
+            "caveats": [caveat] if caveat else []}  # fmt: skip
+
+
+def check_still_periodic(pixel: tuple[float, float], p, where: str, what: str = "map") -> None:
+    """Refuse a periodic map (``what``: or line) that a step of ``shape_map`` would leave no longer
+    repeating: a crop, or a resampling (onto square pixels, or coarser), whose cosine series
     ends at the last sample rather than one pixel past it."""
     dx, dy = pixel
     steps = [*(["cropped to region"] if p.region is not None else []),
              *([f"resampled from pixels of {dx:.6g} x {dy:.6g} onto square ones"] if not _nearly_square(dx, dy) else []),
-             *(["downsampled"] if p.downsample is not None else [])]  # fmt: skip
+             *(["downsampled"] if getattr(p, "downsample", None) is not None else [])]  # fmt: skip
+    repeats, edges, kind = ("tiles the plane", "edges", "pixels") if what == "map" else ("repeats", "ends", "points")
     if steps:
-        raise ValueError(f"{where}: a periodic map (periodic: true, or as the file says) no longer tiles the plane once "
-                         f"{' and '.join(steps)}; set periodic: false (its slopes are then not taken across its edges), "
-                         "or leave the map whole on its own pixels")  # fmt: skip
+        raise ValueError(f"{where}: a periodic {what} (periodic: true, or as the file says) no longer {repeats} once "
+                         f"{' and '.join(steps)}; set periodic: false (its slopes are then not taken across its {edges}), "
+                         f"or leave the {what} whole on its own {kind}")  # fmt: skip
 
 
 def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instrument: bool, periodic: bool):

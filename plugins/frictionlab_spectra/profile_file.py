@@ -37,6 +37,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 # The readers (instrument_file, text_table, scan_shaping) are imported where a file is read:
 # a run of a generated surface, and every command, registers this class without them.
 from .file_kinds import ScanHeader, is_instrument_file
+from .map_pipeline import LineRegion
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 
@@ -68,13 +69,19 @@ class ProfileFile(MeasuredFile):
             "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table or a "
             "periodic line (a tilt taken off it would leave a step where it repeats)",
         )
+        region: LineRegion | None = Field(
+            None, description="a crop, {x: [start, stop], units: pixels | length}: a half-open span along the line, in "
+            "the file's points (default) or in the run's length unit from the first point; before the levelling and "
+            "every check, so undefined points left out of it are not refused",
+        )
 
     # ------------------------------------------------------------ contract
 
     def grid_shape(self) -> tuple[int]:
         """The line's points, from the file's header when it has one (a .npy, an instrument
-        file's metadata): the memory estimate refuses a line too long before it is read."""
-        header = self._header()
+        file's metadata) and no crop is asked: the memory estimate refuses a line too long before
+        it is read."""
+        header = self._header() if self.params.region is None else None
         return header.shape if header is not None else self._measured().heights.shape
 
     # ------------------------------------------------------------ reading
@@ -98,7 +105,8 @@ class ProfileFile(MeasuredFile):
 
     @cached_on_params
     def _measured(self) -> Measured:
-        from .instrument_file import check_spacing, read_scan, scan_summary, uniform_spacing
+        from .instrument_file import read_scan, scan_summary
+        from .line_crop import crop_line
         from .scan_shaping.edge_lines import edge_points_warning
         from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
         from .scan_shaping.levelling import level_line, line_form_warning
@@ -108,8 +116,10 @@ class ProfileFile(MeasuredFile):
         path = Path(p.path)
         where = f"profile-file {str(path)!r}"
         instrument = is_instrument_file(path, p.format)
+        scan = None
         if instrument:
-            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=p.undefined, channel=p.channel,
+            undefined = "keep" if p.region is not None else p.undefined  # refused or filled inside the region alone
+            scan = read_scan(path, where, dimension=1, unit=p.unit, undefined=undefined, channel=p.channel,
                              spacing_given=p.spacing is not None)  # fmt: skip
             x, z = None, scan.heights
             summary = scan_summary(scan, p)
@@ -122,27 +132,20 @@ class ProfileFile(MeasuredFile):
                 "periodic_from": "preset" if p.periodic is not None else "default",
                 **({"x_decreasing": True} if x is not None and x[-1] < x[0] else {}),  # read mirrored: uniform_spacing
             }  # fmt: skip
-            summary.update(fill_table(where, z, p))
+            if p.region is None:  # else inside the region alone, once cropped
+                summary.update(fill_table(where, z, p))
             periodic = bool(p.periodic)
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         text = None if instrument or file_suffix(path, where) == ".npy" else path
-        check_finite(where, "heights", z, table_fill_advice(p, instrument), text, None if x is None else 2)
+        dx = _line_spacing(where, x, scan, p, summary, text)
+        start = 0
+        if p.region is not None:
+            z = crop_line(z, dx, p, where, periodic, summary, instrument)
+            start = summary["region_pixels"][0][0]
+        what = "heights" if p.region is None else "the region's heights"
+        check_finite(where, what, z, table_fill_advice(p, instrument), text, None if x is None else 2, start)
         check_heights_not_underflowing(where, z)
-        if x is None:
-            if p.spacing is None and not instrument:
-                raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
-            dx = scan.pixel[0] if p.spacing is None else p.spacing
-        else:
-            check_finite(where, "x", x, table=text, column=1)
-            dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), summary["unit"])
-            if p.spacing is not None:
-                if not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
-                    raise ValueError(
-                        f"{where}: parameter spacing={p.spacing!r} disagrees with the spacing "
-                        f"of the file's x column ({dx!r}); drop the parameter or fix the file"
-                    )
-                dx = p.spacing
         mode = p.detrend if p.detrend is not None else "tilt" if instrument and not periodic else "mean"  # as a map's
         heights = level_line(z, mode)
         rms = float(np.std(heights))
@@ -161,10 +164,30 @@ class ProfileFile(MeasuredFile):
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
-                   edge_points_warning(heights, float(dx)), units_warning(heights, float(dx), summary, "line")]  # as a map's
+                   edge_points_warning(heights, float(dx), summary.get("region_pixels")),
+                   units_warning(heights, float(dx), summary, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)
+
+
+def _line_spacing(where: str, x: np.ndarray | None, scan, p, summary: dict, text: Path | None) -> float:
+    """The line's spacing dx: the preset's, else its x column's (which it must agree with), else an
+    instrument file's; the x column checked whole, as the file holds it."""
+    from .instrument_file import check_spacing, uniform_spacing
+
+    if x is None:
+        if p.spacing is None and scan is None:
+            raise ValueError(f"{where}: the file has only heights, so the parameter spacing is required")
+        return scan.pixel[0] if p.spacing is None else p.spacing
+    check_finite(where, "x", x, table=text, column=1)
+    dx = check_spacing(where, "x spaced by", uniform_spacing(where, x), summary["unit"])
+    if p.spacing is not None and not math.isclose(p.spacing, dx, rel_tol=SPACING_TOLERANCE):
+        raise ValueError(
+            f"{where}: parameter spacing={p.spacing!r} disagrees with the spacing "
+            f"of the file's x column ({dx!r}); drop the parameter or fix the file"
+        )
+    return dx if p.spacing is None else p.spacing
 
 
 def _npy_line_points(shape: tuple[int, ...]) -> int | None:
@@ -394,18 +417,19 @@ def fill_table(where: str, z: np.ndarray, p) -> dict:
 
 
 def check_finite(where: str, what: str, values: np.ndarray, advice: str = "", table: Path | None = None,
-                 column: int | None = None) -> None:
+                 column: int | None = None, start: int = 0) -> None:
     """ValueError counting the NaN/inf in ``values``, or values beyond a preset number's largest
     magnitude (1e100: squares and sums of them must stay finite), locating the first (by its line
-    and column in the text file ``table`` the values are its ``column`` of, if given); ``advice`` after."""
+    and column in the text file ``table`` the values are its ``column`` of, if given; a line's
+    values cropped from its point ``start``: their index in the file); ``advice`` after."""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(values) | (np.abs(values) > MAX_MAGNITUDE)
     if bad.any():
         from .text_table import first_not_finite
 
         first = np.unravel_index(int(np.argmax(bad)), bad.shape)
-        at = f"index {int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
-        if table is not None and (cell := first_not_finite(table, where, column)) is not None:
+        at = f"index {start + int(first[0])}" if bad.ndim == 1 else f"row {int(first[0])}, column {int(first[1])}"
+        if table is not None and (cell := first_not_finite(table, where, column, start)) is not None:
             at = f"line {cell[0]}, column {cell[1]} of the file"
         raise ValueError(
             f"{where}: {int(bad.sum())} value(s) in {what} not finite (NaN or inf) or beyond {MAX_MAGNITUDE:g} "

@@ -54,7 +54,7 @@ from .equivalent_line import EquivalentLine
 # The readers (instrument_file, text_table, header_units) are imported where a file is read:
 # a run of a generated surface, and every command, registers this class without them.
 from .file_kinds import LENGTH_UNITS, MIN_SIDE, ScanHeader, is_instrument_file
-from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape
+from .map_pipeline import Downsample, Level, Region, crop, shape_map, square_shape, undefined_in_region
 from .measured import Measured, MeasuredFile, MeasuredParams, table_unit
 from .params_cache import cached_on_params
 from .power_law import TWO_PI
@@ -290,20 +290,6 @@ def _check_defined(z: np.ndarray, pixel: tuple[float, float], p: SurfaceFile.Par
                  table_fill_advice(p, instrument), path if text and p.region is None else None)
 
 
-def _undefined_in_region(mask: np.ndarray, undefined: int, pixel: tuple[float, float], p: SurfaceFile.Params,
-                         where: str) -> dict[str, Any]:
-    """What the summary says of a map's ``undefined`` points (``mask``) once cropped: those inside
-    ``region`` (filled, or refused by ``_check_defined``) and those it leaves out."""
-    from .instrument_file import filled_caveat
-
-    region_mask = crop(mask, pixel, p.region, where)[0]  # the map's shape: its size is the region's
-    inside, size = int(np.count_nonzero(region_mask)), region_mask.size
-    caveat = filled_caveat(inside, size, p, 2, "the region's")
-    return {"undefined_points": inside, "undefined_outside_region": undefined - inside,
-            "filled_by": p.undefined if inside and p.undefined != "refuse" else None,
-            "caveats": [caveat] if caveat else []}  # fmt: skip
-
-
 def _square_over_oblong(pixel: tuple[float, float] | None, p: SurfaceFile.Params, unit: str | None,
                         whose: str = "the file's", use: str = "leave spacing out") -> str | None:
     """The caveat of ``spacing`` alone replacing a file's ``pixel`` (dx, dy in ``unit``; None where
@@ -363,7 +349,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
         data, pixel = scan.heights, scan.pixel if p.spacing is None else p.preset_pixel()
         summary = scan_summary(scan, p)
         if p.region is not None and scan.undefined:  # its caveat replaces the whole file's
-            summary.update(_undefined_in_region(scan.undefined_mask, scan.undefined, pixel, p, where))
+            summary.update(undefined_in_region(scan.undefined_mask, scan.undefined, pixel, p, where))
         if caveat := _square_over_oblong(scan.pixel if scan.pixel_stated else None, p, summary.get("unit")):
             summary["caveats"] = [*summary.get("caveats", ()), caveat]
         periodic = scan.periodic if p.periodic is None else p.periodic
@@ -389,7 +375,7 @@ def _read_map(path: Path, where: str, p: SurfaceFile.Params) -> tuple[np.ndarray
             holes = np.isnan(data) if p.region is not None and p.undefined == "harmonic" else None
             checked, filled = _table_checks(path, where, data, p, unit), fill_table(where, data, p)
             if filled and holes is not None:  # counted inside the region, as an instrument file's
-                filled = _undefined_in_region(holes, filled["undefined_points"], pixel, p, where)
+                filled = undefined_in_region(holes, filled["undefined_points"], pixel, p, where)
             caveats = [*checked.pop("caveats", ()), *filled.pop("caveats", ())]
             summary.update(checked, **filled, **({"caveats": caveats} if caveats else {}))
         periodic = bool(p.periodic)

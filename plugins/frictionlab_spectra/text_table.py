@@ -54,11 +54,11 @@ def read_text_table(path: Path, where: str, copies: int = TABLE_COPIES) -> np.nd
             text.detach()  # the file is open_input's to close
 
 
-def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple[int, int] | None:
+def first_not_finite(path: Path, where: str, column: int | None = None, skip: int = 0) -> tuple[int, int] | None:
     """The line and column (from 1, as an editor shows them) of the first number of a text table
     (in its ``column``, if given) that is not finite or is beyond MAX_MAGNITUDE (a NaN a
-    profilometer writes for a point it did not measure), read a line at a time; None if there is
-    none (a header's cells are no numbers)."""
+    profilometer writes for a point it did not measure), read a line at a time, past its first
+    ``skip`` numbers (those a crop left out); None if there is none (a header's cells are no numbers)."""
     from frictionlab.plugin import MAX_MAGNITUDE  # here: only a table refused for such a number needs it
 
     with open_input(path, where) as fh:
@@ -68,8 +68,11 @@ def first_not_finite(path: Path, where: str, column: int | None = None) -> tuple
             if not text or not _numbers(text, delimiter):
                 continue
             for at, cell in enumerate(text.split(delimiter), start=1):
-                if column in (None, at) and not abs(float(e_exponents(cell))) <= MAX_MAGNITUDE:  # NaN too
+                if column not in (None, at):
+                    continue
+                if skip <= 0 and not abs(float(e_exponents(cell))) <= MAX_MAGNITUDE:  # NaN too
                     return lineno, at
+                skip -= 1
     return None
 
 

@@ -135,15 +135,17 @@ def edge_lines_warning(z: np.ndarray, pixel: tuple[float, float], region=None) -
             f"({crop}, pixels of the file), if they are not the surface's own")
 
 
-def edge_points_warning(z: np.ndarray, spacing: float) -> str | None:
+def edge_points_warning(z: np.ndarray, spacing: float, region=None) -> str | None:
     """The caveat of a levelled line (points ``spacing`` apart) whose first or last points, each
     counted in from its end as a map's edge lines are, carry more than EDGE_SHARE of its mean
-    squared slope, with the points of the file to keep (``profile-file`` has no crop)."""
+    squared slope, with the ``region`` that leaves them out, in the file's points (``region`` is the
+    crop already made, [[x0, x1]], or None), as ``edge_lines_warning`` gives a map's."""
     steep = _steep_edges(z, lambda heights: _point_squares(heights, spacing), inner=True)
     if steep is None:
         return None
     ((first, last),), whole, rest = steep
+    ((x0, _),) = region if region is not None else ((0, z.size),)
     said = " and ".join(_ends_said((first, last), "point"))
     why = "a stylus landing or settling, the trace running off the sample"
-    return (f"the line's {said} {_share_said(whole, rest, 'point', why, first + last == 1)}; leave them out of the file, keeping its "
-            f"points {first} to {z.size - last - 1} of {z.size} (counted from 0), if they are not the surface's own")
+    return (f"the line's {said} {_share_said(whole, rest, 'point', why, first + last == 1)}; crop them with region "
+            f"(x: [{x0 + first}, {x0 + z.size - last}], pixels of the file), if they are not the surface's own")
