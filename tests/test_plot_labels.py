@@ -136,7 +136,7 @@ def test_caveats_of_several_lines_each_are_all_readable_none_over_another():
 
     edge = ("the line's first 8 points and last 6 points carry 81 % of its mean squared slope, each more than 10 times "
             "a typical point's: points a scan starts or ends with, whose slopes the rms slope xi divides by, are then "
-            "theirs; leave them out of the file, keeping its points 8 to 2993 of 3000 (counted from 0)")  # fmt: skip
+            "theirs; crop them with region (x: [8, 2994], pixels of the file), if they are not the surface's own")  # fmt: skip
     caveats = [edge, "fewer than 3 points in contact at the first load", edge.replace("81 %", "64 %")]
     fig = Figure(figsize=(6.4, 5.6))
     ax = fig.subplots()

@@ -192,8 +192,8 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
     expected = int(np.count_nonzero(levelled - ndimage.median_filter(levelled, size=5, mode="reflect") > 6 * rms))
     assert expected == where.stop - where.start
     caveat, *edge = said["spiky"]["caveats"]
-    at_end = where.start in (0, 511)  # a point off the rest there is also the line's steep end: the points to keep
-    assert [c.startswith("the line's ") and "keeping its points" in c for c in edge] == [True] * at_end
+    at_end = where.start in (0, 511)  # a point off the rest there is also the line's steep end: the region that crops it
+    assert [c.startswith("the line's ") and "crop them with region (x: " in c for c in edge] == [True] * at_end
     assert caveat.startswith(
         f"{expected} of the line's 16 highest points {'stands' if expected == 1 else 'stand'} more than 6 rms heights "
         "above the median of the 5 points around them: spikes (dust, an instrument's artefact) take the first contact "
@@ -204,7 +204,7 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
     )
     assert "caveats" not in said["smooth"]
     low = said["low"].get("caveats", ())  # no spike; at an end, its step the line's steep end
-    assert [c.startswith("the line's ") and "keeping its points" in c for c in low] == [True] * at_end
+    assert [c.startswith("the line's ") and "crop them with region (x: " in c for c in low] == [True] * at_end
 
 
 @pytest.mark.parametrize("hurst", [0.3, 0.7, 1.0])

@@ -138,14 +138,18 @@ class ProfileFile(MeasuredFile):
         if z.size < MIN_POINTS:
             raise ValueError(f"{where}: {z.size} points, at least {MIN_POINTS} are needed")
         text = None if instrument or file_suffix(path, where) == ".npy" else path
-        dx = _line_spacing(where, x, scan, p, summary, text)
+        # the heights are checked before the spacing, but for a crop in the run's length unit, taken in it
+        dx = _line_spacing(where, x, scan, p, summary, text) if p.region is not None and p.region.units == "length" \
+            else None  # fmt: skip
         start = 0
         if p.region is not None:
-            z = crop_line(z, dx, p, where, periodic, summary, instrument)
+            z = crop_line(z, 1.0 if dx is None else dx, p, where, periodic, summary, instrument)  # pixels: no spacing
             start = summary["region_pixels"][0][0]
         what = "heights" if p.region is None else "the region's heights"
         check_finite(where, what, z, table_fill_advice(p, instrument), text, None if x is None else 2, start)
         check_heights_not_underflowing(where, z)
+        if dx is None:
+            dx = _line_spacing(where, x, scan, p, summary, text)
         mode = p.detrend if p.detrend is not None else "tilt" if instrument and not periodic else "mean"  # as a map's
         heights = level_line(z, mode)
         rms = float(np.std(heights))
