@@ -291,6 +291,22 @@ def test_a_line_with_a_large_filled_share_says_so_beside_its_own_caveats(tmp_pat
     assert "crop the line to its measured part (region)" in caveats[0]
     assert any("a curvature carries" in caveat for caveat in caveats[1:])  # the line's own caveat kept beside it
 
+
+def test_a_line_scans_undefined_points_outside_its_region_are_left_out_inside_refused_or_filled(tmp_path):
+    from SurfaceTopography import UniformLineScan
+
+    z = np.cumsum(np.random.default_rng(0).standard_normal(200))
+    z[[3, 150]] = np.nan
+    UniformLineScan(z, z.size * PIXEL_UM, unit="um").to_netcdf(str(tmp_path / "line.nc"))
+    kept = ProfileFile(path=str(tmp_path / "line.nc"), unit="um", detrend="mean", region={"x": [10, 140]})
+    np.testing.assert_allclose(kept.generate(None).heights, z[10:140] - z[10:140].mean(), rtol=0, atol=1e-9)
+    summary = kept.input_summary()
+    assert (summary["undefined_points"], summary["undefined_outside_region"], summary["filled_by"]) == (0, 2, None)
+    with pytest.raises(ValueError, match=r"1 of 190 points of the region are undefined in the file"):
+        ProfileFile(path=str(tmp_path / "line.nc"), unit="um", region={"x": [10, 200]}).generate(None)
+    filled = ProfileFile(path=str(tmp_path / "line.nc"), unit="um", region={"x": [10, 200]}, undefined="harmonic")
+    assert np.isfinite(filled.generate(None).heights).all() and filled.input_summary()["undefined_points"] == 1
+
 @pytest.mark.parametrize("pixel, writer, unit, said", [
     (1e99, "to_gwy", "pm", "pixels of 1e+102 pm"),  # 1e90 m in the file: in range, beyond it once converted
     (np.inf, "to_netcdf", None, "pixels of inf nm"),
