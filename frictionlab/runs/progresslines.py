@@ -17,6 +17,7 @@ import numpy as np
 
 from ..compute.realization import RealizationResult
 from ..io.values import number_or_nan, whole_or
+from .figures import cut
 
 MAX_LINE_BYTES = 1024 * 1024  # an event's line, at most (a realization's curves thinned to fit): within READ_BLOCK
 MAX_TEXT = 4000  # characters of a message, in a line that would pass MAX_LINE_BYTES otherwise
@@ -131,7 +132,7 @@ def _line(event: dict) -> bytes:
 def _cut(value):
     """``value`` with every string in it cut to ``MAX_TEXT`` characters."""
     if isinstance(value, str):
-        return value if len(value) <= MAX_TEXT else value[:MAX_TEXT] + "..."
+        return cut(value, MAX_TEXT)
     if isinstance(value, dict):
         return {key: _cut(item) for key, item in value.items()}
     return [_cut(item) for item in value] if isinstance(value, list) else value

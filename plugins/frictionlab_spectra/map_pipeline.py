@@ -165,7 +165,7 @@ def check_still_periodic(pixel: tuple[float, float], p, where: str, what: str = 
     dx, dy = pixel
     steps = [*(["cropped to region"] if p.region is not None else []),
              *([f"resampled from pixels of {dx:.6g} x {dy:.6g} onto square ones"] if not _nearly_square(dx, dy) else []),
-             *(["downsampled"] if getattr(p, "downsample", None) is not None else [])]  # fmt: skip
+             *(["downsampled"] if what == "map" and p.downsample is not None else [])]  # fmt: skip
     repeats, edges, kind = ("tiles the plane", "edges", "pixels") if what == "map" else ("repeats", "ends", "points")
     if steps:
         raise ValueError(f"{where}: a periodic {what} (periodic: true, or as the file says) no longer {repeats} once "
