@@ -31,6 +31,10 @@ _EXTENT_DEFINITIONS = {
     "area": "A the surface's apparent area",
     "mdr length": "L = 2 sqrt(A / pi), A the surface's apparent area",
 }
+_MODULUS_DEFINITIONS = {
+    "E*": "E* = E / (1 - nu^2) the contact modulus",
+    "k": "k the foundation's modulus",
+}
 _EXTENT_DIMENSIONS = {"one": (1, 2), "length": (1,), "area": (2,), "mdr length": (2,)}
 _EXTENT_POWERS = {"one": 0, "length": 1, "area": 2, "mdr length": 1}  # X ~ length^power
 
@@ -62,6 +66,9 @@ class ForceNormalisation:
     # What X is, in words, where the profile's own words would mislead (an MDR-equivalent
     # line: its length is 2 sqrt(A / pi) of the surface it stands for); "" for the usual ones.
     extent_words: str = ""
+    # What the modulus is, in words, for a symbol other than E* and k (``"G the shear modulus"``);
+    # "" says "<modulus> the solver's modulus".
+    modulus_words: str = ""
     # Where a load may be given as a nominal pressure over the modulus, p / k (``PressureArea``).
     pressure_area: PressureArea = ""
 
@@ -103,11 +110,17 @@ class ForceNormalisation:
 
     @property
     def definition(self) -> str:
-        """``f = F / (E* h L), L = 2 sqrt(A / pi), ...``: the formula with its symbols explained."""
-        where = [f"{self.load_symbol} the {self.load}", "h the rms height"]
+        """``f = F / (E* h L), F the force, E* = E / (1 - nu^2) ...``: the formula with its symbols explained."""
+        where = [f"{self.load_symbol} the {self.load}", self.modulus_definition, "h the rms height"]
         if self.extent != "one":
             where.append(self.extent_words or _EXTENT_DEFINITIONS[self.extent])
         return f"f = {self.formula}, " + ", ".join(where)
+
+    @property
+    def modulus_definition(self) -> str:
+        """``E* = E / (1 - nu^2) the contact modulus``: what the modulus of f is."""
+        known = _MODULUS_DEFINITIONS.get(self.modulus, f"{self.modulus} the solver's modulus")
+        return self.modulus_words or known
 
     def extent_of(self, profile: Profile) -> float:
         """X of f = F / (k h X) for ``profile``."""

@@ -49,10 +49,10 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
     assert len(rows) == 16
     # the load and f say what they are: MDR's load is a force, f = F / (E* h L)
     header = (out / "curve.csv").read_text().splitlines()[0]
-    assert header.startswith("F [force: modulus x length^2],f [F / (E* h L); F the force; h the rms height; L the line's length]")
+    assert header.startswith("F [force: modulus x length^2],f [F / (E* h L); F the force; E* = E / (1 - nu^2) the contact modulus; h the rms height; L the line's length]")
     assert "contact_fraction [fraction of MDR springs in contact; not the real area]" in header
     normalisation = summary["normalisation"]
-    assert normalisation["f"] == "f = F / (E* h L), F the force, h the rms height, L the line's length"
+    assert normalisation["f"] == "f = F / (E* h L), F the force, E* = E / (1 - nu^2) the contact modulus, h the rms height, L the line's length"
     assert normalisation["load"] == "force" and normalisation["extent"] == "length"
     assert normalisation["extent_value"] == 1024.0 and normalisation["rms_height"] == 1.0
     np.testing.assert_allclose(
