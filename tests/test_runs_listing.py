@@ -383,3 +383,17 @@ def test_a_sweep_folder_whose_sweep_json_is_gone_is_said_so_not_a_missing_preset
     assert err.startswith(f"error: {sweep} is a sweep's folder (it holds sweep.csv and points/) but its sweep.json")
     assert f"frictionlab {command} POINT_FOLDER" in err and "Traceback" not in err
     assert sorted(p.name for p in sweep.rglob("*")) == before  # nothing written or deleted
+
+
+def test_a_damaged_folders_huge_name_is_listed_cut_on_one_short_row(tmp_path, registry, capsys):
+    runs = tmp_path / "runs"
+    _run(runs / "long", registry)
+    state_file = runs / "long" / "run.json"
+    manifest = json.loads(state_file.read_text())
+    manifest["preset"]["name"] = "n" * 300_000
+    state_file.write_text(json.dumps(manifest))
+    (state,) = list_run_states(runs)
+    assert state.name == "n" * 100 + "..."
+    assert main(["runs", str(runs)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if "long" in line)
+    assert len(row) < 100 + len(str(runs / "long")) + 40, len(row)

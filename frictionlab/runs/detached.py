@@ -29,10 +29,14 @@ from pathlib import Path
 from . import runfolder
 from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name, warn_user
 from ..options import RunOptions
+from .figures import cut
 from .progressevents import MAX_COUNT
 from .progresslog import ProgressLog, ProgressReader, StartOf, told_by
 from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
+
+LISTED_NAME_CHARS = 100
+"""A listed run's name is cut there: a preset's name is at most that long, a damaged folder's any length."""
 
 SWEEP_FILE = "sweep.json"  # what marks a sweep's folder (it has no run.json)
 RUN_MARKERS = (STATE_FILE, "summary.json", SWEEP_FILE)  # a folder holding one is a run's (or was meant to be)
@@ -288,7 +292,7 @@ def run_state(folder: str | Path) -> RunState:
     if manifest is None:
         raise RunFolderError(f"{shown_name(folder)} holds no run (no {STATE_FILE})")
     preset = manifest.get("preset") if isinstance(manifest.get("preset"), dict) else {}
-    name = str(preset.get("name") or folder.name)
+    name = cut(str(preset.get("name") or folder.name), LISTED_NAME_CHARS)
     status = str(manifest.get("status") or "?")
     total = _count(manifest.get("realizations"))
     if total is None:  # the count the run was started with is its preset's too
@@ -388,7 +392,7 @@ def sweep_state(folder: str | Path) -> RunState:
             _, record = read_sweep_record(folder)
             status = "interrupted" if record.status == "running" else record.status
     done = sum(point.status not in UNFINISHED for point in record.points)
-    return RunState(folder, record.name, status, done, len(record.points), pid, kind="sweep")
+    return RunState(folder, cut(record.name, LISTED_NAME_CHARS), status, done, len(record.points), pid, kind="sweep")
 
 
 def _summary(folder: Path) -> dict | None:
