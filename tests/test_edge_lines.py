@@ -136,3 +136,23 @@ def test_edge_lines_and_points_on_a_level_rest_are_said_without_a_ratio():
     assert "the map's first row carries 100 %" in edge_lines_warning(z[::-1] - z.mean(), (1.0, 1.0))
     line = np.r_[0.0, np.full(39, 2.0)]
     assert "the line's first point carries 100 %" in edge_points_warning(line - line.mean(), 1.0)
+
+
+def test_a_periodic_map_or_line_has_no_edges_to_crop(tmp_path):
+    """The first and last lines of a periodic scan are neighbours, and a region is refused for it:
+    the steep rows or points said of the same heights read as not periodic are not said of it."""
+    z = rough(128)
+    z[-3:] += np.array([[0.6], [-0.4], [0.8]])
+    np.save(tmp_path / "scan.npy", z)
+    assert edge_caveats(SurfaceFile(path=str(tmp_path / "scan.npy"), spacing=0.125))
+    assert edge_caveats(SurfaceFile(path=str(tmp_path / "scan.npy"), spacing=0.125, periodic=True)) == []
+    with pytest.raises(ValueError, match="periodic"):
+        SurfaceFile(path=str(tmp_path / "scan.npy"), spacing=0.125, periodic=True, region={"y": [0, 124]}).generate(None)
+    t = np.arange(2000.0)
+    line = np.sin(2 * np.pi * t / 500.0)
+    line[:6] += np.linspace(3.0, 0.5, 6)
+    np.savetxt(tmp_path / "trace.csv", line)
+    def said(**periodic):
+        caveats = ProfileFile(path=str(tmp_path / "trace.csv"), spacing=0.25, **periodic).input_summary().get("caveats", ())
+        return [c for c in caveats if LINE_EDGE.search(c)]
+    assert said() and said(periodic=True) == []

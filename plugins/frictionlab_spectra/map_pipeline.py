@@ -211,7 +211,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
         caveats.append(warning)
     if (warning := line_offset_warning(levelled.heights)) is not None:
         caveats.append(warning)
-    if (warning := edge_lines_warning(levelled.heights, pixel, done.get("region_pixels"))) is not None:
+    # a periodic map has no edges (its first and last lines are neighbours), and no region crops it
+    if not periodic and (warning := edge_lines_warning(levelled.heights, pixel, done.get("region_pixels"))) is not None:
         caveats.append(warning)
     if (warning := _noise_warning(levelled.heights)) is not None:
         caveats.append(warning)

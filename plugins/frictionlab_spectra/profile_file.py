@@ -168,7 +168,7 @@ class ProfileFile(MeasuredFile):
                    "rms_height": rms}  # fmt: skip
         caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
-                   edge_points_warning(heights, float(dx), summary.get("region_pixels")),
+                   None if periodic else edge_points_warning(heights, float(dx), summary.get("region_pixels")),
                    units_warning(heights, float(dx), summary, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
