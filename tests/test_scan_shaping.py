@@ -199,7 +199,7 @@ def test_a_line_left_with_spikes_says_so_as_a_map_does(tmp_path, where):
         "above the median of the 5 points around them: spikes (dust, an instrument's artefact) take the first contact "
         "alone, and the law at small loads is theirs; they carry "  # and the rms slope: checked below
     ) and caveat.endswith(
-        f"; remove {'it' if expected == 1 else 'them'} from the profile, if {'it is' if expected == 1 else 'they are'} "
+        f"; despike: 6 replaces {'it' if expected == 1 else 'them'}, if {'it is' if expected == 1 else 'they are'} "
         "not the surface's own"
     )
     assert "caveats" not in said["smooth"]
@@ -509,7 +509,7 @@ def test_a_pit_that_makes_the_rms_slope_says_so_and_despike_is_named(tmp_path, d
     """A pixel far below a smooth map (a dropout the instrument wrote as a height, not NaN) is no
     spike up, and nothing was said, though it made the map's rms slope, xi's denominator and the
     full-contact estimate E* g. The caveat counts it, gives the rms slope on the file's pixels with
-    and without it, and names despike; a line's names removing it from the profile."""
+    and without it, and names despike, for a line as for a map."""
     z, _ = band_limited(40, 48, seed=5, top=0.2)
     z[20, 30] += depth * np.std(z)
     np.save(tmp_path / "map.npy", z)
@@ -526,7 +526,9 @@ def test_a_pit_that_makes_the_rms_slope_says_so_and_despike_is_named(tmp_path, d
     said = ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.2).input_summary()["caveats"]
     (caveat,) = [c for c in said if "of the line's points" in c]
     assert caveat.startswith("2 of the line's points stand more than 6 rms heights from the median of the 5 points")
-    assert caveat.endswith("; remove them from the profile, if they are not the surface's own")
+    assert caveat.endswith("; despike: 6 replaces them, if they are not the surface's own")
+    cleaned = ProfileFile(path=str(tmp_path / "line.npy"), spacing=0.2, despike=6.0).input_summary()
+    assert cleaned["despiked"]["points"] == 2 and not any("of the line's points" in c for c in cleaned.get("caveats", ()))
 
 
 @pytest.mark.parametrize("hurst", [0.3, 0.8])

@@ -273,7 +273,8 @@ def describe_input(summary: dict) -> str:
     if summary.get("extent"):
         notes.append(_extent_note(summary["extent"], length))
     if summary.get("despiked"):
-        notes.append(f"despike {summary['despiked']['k']:g} rms: {summary['despiked']['points']} points replaced")
+        replaced = summary["despiked"]["points"]
+        notes.append(f"despike {summary['despiked']['k']:g} rms: {replaced} point{'' if replaced == 1 else 's'} replaced")
     if "detrend" in summary:
         notes.append(f"detrend {summary['detrend']} ({summary.get('detrend_from', 'preset')}) removed "
                      f"{100 * summary['rms_removed_fraction']:.1f} % of the rms height "

@@ -74,6 +74,11 @@ class ProfileFile(MeasuredFile):
             "the file's points (default) or in the run's length unit from the first point; before the levelling and "
             "every check, so undefined points left out of it are not refused",
         )
+        despike: float | None = Field(
+            None, gt=0.0, description="replace points more than this many rms heights from the median of the 5 "
+            "points around them by the straight line between their nearest kept neighbours (off by default; a value "
+            "that would replace more than 5 % of the points is refused)",
+        )
 
     # ------------------------------------------------------------ contract
 
@@ -152,6 +157,8 @@ class ProfileFile(MeasuredFile):
             dx = _line_spacing(where, x, scan, p, summary, text)
         mode = p.detrend if p.detrend is not None else "tilt" if instrument and not periodic else "mean"  # as a map's
         heights = level_line(z, mode)
+        if p.despike is not None:
+            z, heights = _despiked(z, heights, mode, p.despike, where, summary)
         rms = float(np.std(heights))
         scale = float(np.max(np.abs(z)))
         if not rms > FLAT * scale:  # also true for scale == 0
@@ -166,13 +173,31 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), line_spike_warning(heights, rms, float(dx)),
+        caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), None if p.despike is not None else line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
                    None if periodic else edge_points_warning(heights, float(dx), summary.get("region_pixels")),
                    units_warning(heights, float(dx), summary, "line")]  # as a map's
         if any(caveats):
             summary["caveats"] = [caveat for caveat in caveats if caveat is not None]
         return Measured(heights, float(dx), rms, periodic, summary)
+
+
+def _despiked(z: np.ndarray, levelled: np.ndarray, mode: str, k: float, where: str, summary: dict):
+    """The line ``z`` (``levelled`` by ``mode``) with its spikes and pits (``despike``, as a map's)
+    replaced, and it levelled again (as a map is: what levelling removed is then said of the
+    line without them); said in ``summary``."""
+    from .scan_shaping.levelling import level_line
+    from .scan_shaping.spikes import despike
+
+    try:
+        despiked, count = despike(levelled.reshape(1, -1), k, float(np.std(levelled)))
+    except ValueError as exc:  # k too small: said with the file's name
+        raise ValueError(f"{where}: {exc}") from None
+    summary["despiked"] = {"k": k, "points": count}
+    if not count:
+        return z, levelled
+    z = z + (despiked[0] - levelled)
+    return z, level_line(z, mode)
 
 
 def _line_spacing(where: str, x: np.ndarray | None, scan, p, summary: dict, text: Path | None) -> float:

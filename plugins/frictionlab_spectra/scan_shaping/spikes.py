@@ -111,13 +111,12 @@ def line_spike_warning(z: np.ndarray, rms: float, spacing: float = 1.0) -> str |
     line = z.reshape(1, -1)
     spikes = _spikes(line, rms)
     if not spikes:
-        return _pits_warning(line, rms, (spacing, spacing), "line", "remove {them} from the profile")
+        return _pits_warning(line, rms, (spacing, spacing), "line", f"despike: {SPIKE_K:g} replaces {{them}}")
     stand, them, they = _agreeing(spikes)
     return (f"{spikes} of the line's {SPIKE_LOOKED_AT} highest points {stand} more than {SPIKE_K:g} rms heights above "
             f"the median of the {SPIKE_WINDOW} points around them: spikes (dust, an instrument's artefact) take the "
             f"first contact alone, and the law at small loads is theirs{_spike_slope_note(line, rms, (spacing, spacing), 'line')[0]}; "
-            f"remove {them} from the profile, if {they} "
-            "not the surface's own")  # fmt: skip
+            f"despike: {SPIKE_K:g} replaces {them}, if {they} not the surface's own")  # fmt: skip
 
 def _spikes(z: np.ndarray, rms: float) -> int:
     """How many of the SPIKE_LOOKED_AT highest points of ``z`` (above 3 ``rms``) stand more than
@@ -146,7 +145,9 @@ def despike(z: np.ndarray, k: float, rms: float) -> tuple[np.ndarray, int]:
     """``z`` with every point more than ``k`` ``rms`` from the median of the 5 x 5 pixels around
     it (a spike up to a few pixels wide cannot move that median) replaced by the solution of
     Laplace's equation from its neighbours; and how many were replaced. ValueError when more than
-    MAX_SPIKE_FRACTION of the points would be (``k`` too small: the scan itself, not its spikes)."""
+    MAX_SPIKE_FRACTION of the points would be (``k`` too small: the scan itself, not its spikes).
+    A line is one row: the median of the 5 points around, and the straight line between the
+    nearest points kept (Laplace's equation on a line; level from the one kept past an end)."""
     from scipy import ndimage
     from scipy.sparse.linalg import spsolve
 
