@@ -280,6 +280,12 @@ class RunEntry:
         return formula if isinstance(formula, str) else ""
 
     @property
+    def definition(self) -> str:
+        """f with its symbols said (``f = F / (E* h L), F the force, ...``), as summary.json gives it ("" if not)."""
+        definition = _mapping(self.summary.get("normalisation")).get("f")
+        return definition if isinstance(definition, str) else ""
+
+    @property
     def failed_for_good(self) -> str:
         """Why the run failed with every realization finished and none failed (no law: each load
         pressed the same points), "" otherwise: a resume computes nothing and fails the same way

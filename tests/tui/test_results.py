@@ -34,6 +34,9 @@ async def test_results_lists_opens_and_overlays_runs(folders, registry):
     for seed in (1, 2):
         summary = json.loads((folders / "runs" / f"seed{seed}" / "summary.json").read_text())
         assert f"a={summary['fit']['a']:.4f}" in info
+    # under the runs, once for both, what each symbol of f is
+    assert " ".join(info.split()).count(summary["normalisation"]["f"]) == 1
+    assert "E* = E / (1 - nu^2) the contact modulus" in summary["normalisation"]["f"]
 
 
 @pytest.mark.long  # a TUI session
@@ -115,7 +118,10 @@ async def test_the_info_box_under_the_plot_is_read_whole_at_60x20(folders, regis
     b_line = next(i for i, line in enumerate(lines) if "b=0.0150" in line)
     assert lines[b_line + 1].strip().startswith("[")  # b's interval, on a line of its own in 20 columns
     # then what a and b are, and the intervals' level, as the Run tab says them
-    assert " ".join(lines[b_line + 2:]).split() == ["in", "xi", "=", "a", "+", "b", "ln", "f,", "95%", "CI"]
+    definition = next(i for i, line in enumerate(lines) if line.startswith("f = "))
+    assert " ".join(lines[b_line + 2:definition]).split() == ["in", "xi", "=", "a", "+", "b", "ln", "f,", "95%", "CI"]
+    # last, what each symbol of f is, broken between words within the box
+    assert " ".join(lines[definition:]).split()[:4] == ["f", "=", "F", "/"] and "(1 - nu^2)" in " ".join(lines[definition:])
 
 @pytest.mark.long  # a TUI session
 @sync
@@ -292,7 +298,9 @@ async def test_a_failed_run_opened_says_why_it_failed(folders, registry):
     assert "failed" in info and why in " ".join(info.split())
     # why, broken between words and indented as the box's other lines: wrapped, it went on at the box's edge
     lines = info.splitlines()
-    assert all(line.startswith("  ") and len(line) <= width for line in lines[1:]), lines
+    definition = next(i for i, line in enumerate(lines) if line.startswith("f = "))  # what f is, under the runs
+    assert all(line.startswith("  ") and len(line) <= width for line in lines[1:definition]), lines
+    assert all(len(line) <= width for line in lines[definition:]), lines
 
 
 @sync

@@ -20,6 +20,7 @@ from ...errors import FrictionlabError, shown, shown_name
 from ...compute.fit import ci_label, format_interval
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
+from ...runs.figures import SHOWN_LABEL_CHARS, cut
 from ...runs.results import read_curve
 from ..folders import RunEntry, SweepEntry, list_runs, read_run
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
@@ -359,6 +360,10 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
             if math.isfinite(entry.a):
                 series.append(fit_series(f, entry.a, entry.b, f"dim {style}"))
             lines += _entry_lines(entry, style, self._info_width())
+        for definition in dict.fromkeys(entry.definition for entry in self.overlay if entry.definition):
+            # what each symbol of f is, once under the runs (their lines give the formula alone)
+            words = shown(cut(definition, SHOWN_LABEL_CHARS)).split()
+            lines += [Content.styled(line, "dim") for line in packed(words, self._info_width(), indent="")]
         self.query_one("#results-chart", Chart).show(series, empty="run removed" if note else NO_DATA)
         self._inform(Content("\n").join(lines) if lines else HINT)
 
