@@ -297,14 +297,18 @@ def test_a_tables_nan_outside_the_region_is_counted_there_when_filled(tmp_path):
 
 
 def test_a_lines_outlier_caveat_names_what_a_line_has(tmp_path):
-    """A profile's dropout written as -999999 was told to 'remove them (despike, region)': a line has
-    neither; it is removed from the file, or written NaN, which undefined: harmonic fills."""
+    """A profile's dropout written as -999999 was told to 'remove them (despike, region)' when a line
+    had neither. It now has despike, which replaces it, and a region that crops its ends alone; or the
+    value is written NaN in the file, which undefined: harmonic fills."""
     x, z = np.arange(128) * 0.5, rough(1, 128, 19)[0]
     z[40] = -999999.0
-    caveats = ProfileFile(path=str(xz_table(tmp_path / "sentinel.csv", x, z))).input_summary()["caveats"]
+    table = str(xz_table(tmp_path / "sentinel.csv", x, z))
+    caveats = ProfileFile(path=table).input_summary()["caveats"]
     (said,) = [caveat for caveat in caveats if "rms height is" in caveat]
-    assert "despike" not in said and "region" not in said
-    assert "remove them from the file, or write NaN in their place, which undefined: harmonic fills" in said
+    assert "remove them (despike; region at its ends), or write NaN in their place in the file, which undefined: " \
+        "harmonic fills" in said
+    despiked = ProfileFile(path=table, despike=6.0).input_summary()
+    assert despiked["despiked"]["points"] == 1 and not any("rms height is" in c for c in despiked.get("caveats", ()))
     filled = ProfileFile(path=str(xz_table(tmp_path / "nan.csv", x, np.where(z < -1e5, np.nan, z))), undefined="harmonic")
     assert not any("rms height is" in caveat for caveat in filled.input_summary().get("caveats", ()))
 

@@ -42,7 +42,7 @@ def outlier_warning(z: np.ndarray, what: str) -> str | None:
     ratio = f"{rms / robust:.3g} times" if robust > 0 else f"more than {OUTLIER_RATIO:g} times"
     zero = "" if robust > 0 else "; here zero: more than half of them have one height"
     fix = "remove them (despike, region), or mark them undefined in the file (a table's NaN)" if what == "map" else \
-        "remove them from the file, or write NaN in their place"  # a line has no despike; its region crops only its ends
+        "remove them (despike; region at its ends), or write NaN in their place in the file"
     return (f"the {what}'s rms height is {ratio} what most of its points say ({MAD_TO_SIGMA} times their median "
             f"distance from the median, the rms height of Gaussian heights{zero}): a few points far from the rest make the "
             f"rms height h, and with it f's unit E* h L, theirs. A value written for a missing pixel, spikes or "
