@@ -3,10 +3,12 @@
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import sys
 import threading
+import time
 from pathlib import Path
 
 from ..errors import ExitCode, command_word, shown, shown_name
@@ -25,7 +27,8 @@ def add_parser(sub) -> None:
         "follow",
         help="show the progress of a run going on in DIR until it ends",
         description="Follow the run in DIR by reading what it writes there (progress.jsonl): progress on stderr "
-        "until it ends, then its state on stdout. For a sweep's folder: each point as it starts, its "
+        "until it ends, then its state on stdout. A run started without --detach outside the TUI writes no "
+        "progress.jsonl: the count of realizations its chunks hold is shown instead. For a sweep's folder: each point as it starts, its "
         "realizations, and its fit once it ends. Ctrl-C stops following; the run goes on. The exit code is 0 "
         "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it) or its folder was "
         "deleted while it ran, 130 if following was stopped with Ctrl-C (143: SIGTERM, 129: SIGHUP).",
@@ -80,6 +83,7 @@ def run(args) -> ExitCode:
     error, gone, identity, holder = None, False, _identity(folder), state.pid
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
+        counter = None if sweep is not None or args.quiet else _ChunkCount(follower.reader)
         stopped = _StopSignals()  # a signal is noted and acted on between polls, never raised mid-draw
         try:
             try:
@@ -94,12 +98,16 @@ def run(args) -> ExitCode:
                                 gone = True
                                 break
                             state = now
+                            if counter is not None:
+                                counter.tell(state)
                     if stopped.signal is None:
                         follower.poll()  # the last events, written as it ended
                         _say_warnings(follower.warnings.take())
             finally:  # a bar still showing ends on its own line, before anything else is printed
                 for listener in follower.listeners:
                     listener.close()
+                if counter is not None:
+                    counter.close()
             if stopped.signal is not None:
                 raise KeyboardInterrupt
         except KeyboardInterrupt:
@@ -210,6 +218,41 @@ def _rows(folder: Path) -> list[dict]:
 
     _, record = read_sweep_record(folder)
     return [point.model_dump() for point in record.points]
+
+
+class _ChunkCount:
+    """The count of a run that writes no progress file (``frictionlab run`` in a terminal), read
+    from its chunks: why, said once, then the count as it moves, on one line of a terminal (a
+    line at most every LOG_SECONDS elsewhere)."""
+
+    LOG_SECONDS = 30.0
+
+    def __init__(self, reader):
+        from ..runs.progresslog import NoProgressFile
+
+        self.missing = NoProgressFile(reader)
+        self.said = False
+        self.shown: tuple | None = None
+        self.at = -math.inf
+        self.terminal = sys.stderr.isatty()
+
+    def tell(self, state) -> None:
+        if (why := self.missing.reason()) is None:
+            return
+        if not self.said:
+            self.said = True
+            print(f"{why}: its count comes from its chunks", file=sys.stderr)
+        count = (state.done, state.total)
+        now = time.monotonic()
+        if count == self.shown or state.done is None or (not self.terminal and now - self.at < self.LOG_SECONDS):
+            return
+        self.shown, self.at = count, now
+        line = shown(f"{state.name}: {state.done}/{state.total} realizations stored")
+        print(f"\r{line}\x1b[K" if self.terminal else line, end="" if self.terminal else "\n", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.terminal and self.shown is not None:
+            print(file=sys.stderr)  # what follows on a line of its own
 
 
 def _follower(folder: Path, sweep, quiet: bool):

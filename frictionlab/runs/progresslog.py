@@ -23,6 +23,7 @@ import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from ..errors import shown
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
 from ..io.values import number_or_nan, whole_or
@@ -176,6 +177,31 @@ class ProgressLog:
 
 REALIZATIONS = ("realization", "realizations")  # one realization's event (as written before), several's
 HEAD_BYTES = 4096  # of the first line, kept to tell a rewritten file (its ``started`` names a new pid and time)
+
+
+NO_PROGRESS_FILE_WAIT = 2.0  # seconds a run found running may go without a progress file before it is said to write none
+
+
+class NoProgressFile:
+    """Whether a run found running writes no progress file (``frictionlab run`` in a terminal
+    writes none): none there, nothing read from one, for NO_PROGRESS_FILE_WAIT seconds. Its
+    count is then read from its chunks (``detached.run_state``)."""
+
+    def __init__(self, reader: ProgressReader):
+        self.reader = reader
+        self._missing_since: float | None = None
+
+    def reason(self) -> str | None:
+        """Why the run's count comes from its chunks; None while it has (or may yet write) a progress file."""
+        if self.reader.offset > 0 or os.path.lexists(self.reader.path):
+            self._missing_since = None
+            return None
+        now = time.monotonic()
+        self._missing_since = self._missing_since or now
+        if now - self._missing_since < NO_PROGRESS_FILE_WAIT:
+            return None
+        return (f"the run in {shown(self.reader.path.parent)} writes no {PROGRESS_FILE} (frictionlab run in a "
+                "terminal writes none; frictionlab run --detach and the terminal UI do)")
 
 
 class ProgressReader:

@@ -14,7 +14,7 @@ from pathlib import Path
 from ..api import Result, load
 from ..runs.detached import cancel, lock_held, lock_holder, stored_count
 from ..errors import FrictionlabError, RunFolderError, shown
-from ..runs.progresslog import PROGRESS_FILE, Follower
+from ..runs.progresslog import PROGRESS_FILE, Follower, NoProgressFile
 from ..runs.sweeplog import SweepFollower
 from .folders import read_run, read_sweep
 from .live import LiveListener
@@ -37,6 +37,7 @@ class FollowedRun:
         self.cancelling = False
         self.refusal: str | None = None  # why a cancel signalled nothing
         self.said_progress_problem = False  # that its progress file cannot be written (said once)
+        self.no_progress_file = NoProgressFile(self.follower.reader)
 
     @property
     def pid(self) -> int | None:
@@ -65,7 +66,7 @@ class FollowedRun:
     def poll(self) -> bool:
         """Read what the run wrote since the last call (a snapshot even when nothing came:
         the elapsed time moves); True once its process has ended."""
-        if not self.follower.poll() and self.live is not None and self.progress_problem() is None:
+        if not self.follower.poll() and self.live is not None and self.count_from_chunks() is None:
             self.live.tick()  # the elapsed time moves (not over the count read from the chunks instead)
         if self.process is not None:
             over = self.process.poll() is not None  # also reaps it: no zombie reads as alive
@@ -90,6 +91,11 @@ class FollowedRun:
             return None
         what = "a symbolic link" if stat.S_ISLNK(mode) else "not a regular file"
         return f"{PROGRESS_FILE} in {shown(self.folder)} is {what}, never written through"
+
+    def count_from_chunks(self) -> str | None:
+        """Why this run's count is read from its chunks rather than its progress file: the file
+        cannot be read (``progress_problem``), or a run not started here writes none; None if not."""
+        return self.progress_problem() or (None if self.process is not None else self.no_progress_file.reason())
 
     def stored_count(self) -> tuple[int | None, int | None]:
         """(done, total) realizations as the run folder's manifest says (its chunks)."""
@@ -140,6 +146,9 @@ class FollowedSweep(FollowedRun):
 
     def progress_problem(self) -> str | None:
         return None  # a sweep's count is its points', never read from chunks: its live tick goes on
+
+    def count_from_chunks(self) -> str | None:
+        return None  # as above
 
     def _listeners_of(self, point) -> list[object]:
         self.live = LiveListener(self._post)

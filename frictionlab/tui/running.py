@@ -280,7 +280,7 @@ class RunControl:
         from ..runs.detached import lock_held
         from .following import FollowedSweep, read_finished, read_finished_sweep
 
-        if not isinstance(followed, FollowedSweep) and followed.progress_problem():
+        if not isinstance(followed, FollowedSweep) and followed.count_from_chunks():
             self._count_from_chunks(followed)
         ended = followed.ended
         over = followed.poll()
@@ -361,10 +361,10 @@ class RunControl:
                                                     going_on, min(stored or 0, total), total)  # fmt: skip
 
     def _count_from_chunks(self, followed: FollowedRun) -> None:
-        """A run whose progress file cannot be written: said once; its count read from its chunks."""
+        """A run whose progress file cannot be read, or that writes none: said once; its count read from its chunks."""
         if not followed.said_progress_problem:
             followed.said_progress_problem = True
-            self.say(f"{followed.progress_problem()}: the count comes from the run's chunks, without a live plot", "warning")
+            self.say(f"{followed.count_from_chunks()}: the count comes from the run's chunks, without a live plot", "warning")
         done, total = followed.stored_count()
         if total and (pane := self._mounted("RunPane")) is not None:
             pane.show_stored_count(done or 0, total)

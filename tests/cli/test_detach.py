@@ -53,6 +53,34 @@ def test_follow_prints_progress_until_a_cancelled_run_ends_and_exits_1(tmp_path,
     assert "interrupted" in stdout and f"frictionlab resume {out} continues it" in stdout
 
 
+@pytest.mark.long
+def test_follow_counts_a_terminal_runs_chunks_which_writes_no_progress_file(tmp_path, cli):
+    """Found by a newcomer: ``frictionlab run`` in a terminal writes no progress.jsonl, and follow
+    showed nothing at all until the run ended. It says why, and the count its chunks hold."""
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, {"realizations": 100_000}))
+    out = tmp_path / "long"
+    run = subprocess.Popen([sys.executable, "-m", "frictionlab", "run", str(preset), "--quiet", "--no-plot", "--workers",
+                            "1", "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while not ((out / "run.json").exists() and (run_state(out).done or 0) > 0):
+            assert run.poll() is None and time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.05)
+        follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True)  # fmt: skip
+        why, count = follow.stderr.readline(), follow.stderr.readline()
+        run.terminate()
+        stdout, _ = follow.communicate(timeout=60)
+    finally:
+        run.kill()
+        run.wait()
+    assert why.startswith(f"the run in {out} writes no progress.jsonl") and "its count comes from its chunks" in why
+    done, total = (int(n) for n in count.removeprefix("small: ").split(" ")[0].split("/"))
+    assert count.endswith(" realizations stored\n") and 0 < done < total == 100_000
+    assert follow.returncode == 1 and "interrupted" in stdout
+    assert not (out / "progress.jsonl").exists()
+
+
 def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path, cli):
     preset = write_preset(tmp_path, SMALL_PRESET)
     mine = tmp_path / "mine"

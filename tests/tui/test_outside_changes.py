@@ -2,6 +2,9 @@
 editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
 
 import shutil
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -9,12 +12,13 @@ import yaml
 from textual.widgets import Static
 
 from frictionlab.options import RunOptions
+from frictionlab.runs.detached import lock_held, run_state
 from frictionlab.runs.sweep import load_sweep, run_sweep
 from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+    LONG, SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
 )
 
 
@@ -177,6 +181,37 @@ async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chun
                 await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
             process.terminate()
             await wait_until(pilot, lambda: app.followed is None)
+
+
+@pytest.mark.long
+@sync
+async def test_a_run_started_by_frictionlab_run_in_a_terminal_shows_its_count_from_its_chunks(folders, registry):
+    """Found by a newcomer: a run started with ``frictionlab run`` in another terminal (it writes no
+    progress file) stayed at 0 % on the Run tab until it ended. It is said, and its count moves,
+    read from its chunks."""
+    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
+    out = folders / "runs" / "long"
+    command = [sys.executable, "-m", "frictionlab", "run", "presets/long.yaml", "--out", "runs/long", "--quiet",
+               "--no-plot", "--workers", "1"]  # fmt: skip
+    process = subprocess.Popen(command, cwd=folders, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60.0
+        while not (lock_held(out) and (run_state(out).done or 0) > 0):
+            assert process.poll() is None and time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.05)
+        app = make_app(registry)
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: "writes no progress.jsonl" in status_text(app))
+            assert "the count comes from the run's chunks" in status_text(app)
+            counts = []
+            for _ in range(2):  # the count moves on, read from the chunks
+                await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+                counts.append(numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0])
+                await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
+            assert not (out / "progress.jsonl").exists()
+    finally:
+        process.kill()
+        process.wait()
 
 
 @pytest.mark.long
