@@ -323,7 +323,16 @@ class FrictionlabApp(KeysHelp, TabSwitching, SaysWhyUnavailable, RunControl, Pre
         if entry is None:
             self.say(NO_PRESETS, "warning")
             return
-        self.run_worker(self._open_after_confirm(entry.path), exclusive=True, group="open")
+        self.run_worker(self._open_or_show(entry.path), exclusive=True, group="open")
+
+    async def _open_or_show(self, path: Path) -> None:
+        """Enter on a preset: opened; the one already open with unsaved changes is shown as it is
+        (asked whether to discard them, Enter on the row it came from threw them away)."""
+        if path == self.draft_source and await self.unsaved():
+            self.action_show_tab("edit")
+            self.say(f"{shown_name(path.name)} is open, with unsaved changes: Ctrl+S saves them")
+            return
+        await self._open_after_confirm(path)
 
     async def _open_after_confirm(self, path: Path, data: dict | None = None, *, modified: bool = False) -> bool:
         """Open a preset in place of the draft, asking first when the draft has unsaved changes

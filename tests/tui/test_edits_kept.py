@@ -4,7 +4,7 @@ on the form (Enter on the list, New, Duplicate) asks first, and No keeps the edi
 import pytest
 from textual.widgets import Input
 
-from .conftest import make_app, press_settled, screen_text, started, sync, type_into, wait_until
+from .conftest import make_app, press_settled, screen_text, started, status_text, sync, type_into, wait_until
 
 
 async def edit_realizations(pilot, value="7"):
@@ -50,3 +50,35 @@ async def test_duplicate_asks_before_it_opens_the_copy_over_unsaved_edits(folder
     assert kept == ("tiny.yaml", "7", True)
     assert (folders / "presets" / "tiny-copy.yaml").is_file()  # the copy asked for is written either way
 
+
+
+def move_to(app, name: str) -> None:
+    """The Presets list's cursor on the project preset ``name``."""
+    from frictionlab.tui.widgets import PresetsPane
+
+    rows = [entry.path.name for entry in app.query_one(PresetsPane).presets]
+    app.query_one("#preset-table").move_cursor(row=rows.index(name))
+
+
+@pytest.mark.long  # a TUI session
+@sync
+async def test_enter_on_the_open_preset_shows_it_with_its_edits_and_on_another_asks(folders, registry):
+    """Found by a newcomer: Enter on the row of the preset already open asked to discard its
+    unsaved edits (y threw them away) where the user only wanted to go back to it."""
+    (folders / "presets" / "other.yaml").write_text((folders / "presets" / "tiny.yaml").read_text())
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await edit_realizations(pilot)
+        move_to(app, "tiny.yaml")
+        await press_settled(pilot, "enter")
+        await wait_until(pilot, lambda: app.query_one("#tabs").active == "edit")
+        shown = (asks_discard(app), app.draft_path.name, app.query_one("#field--realizations", Input).value, app.modified)
+        said = status_text(app)
+        await press_settled(pilot, "f2")
+        move_to(app, "other.yaml")
+        await press_settled(pilot, "enter")
+        await wait_until(pilot, lambda: asks_discard(app) or app.draft_path.name != "tiny.yaml")
+        asked_for_another = asks_discard(app)
+    assert shown == (False, "tiny.yaml", "7", True)
+    assert said == "tiny.yaml is open, with unsaved changes: Ctrl+S saves them"
+    assert asked_for_another
