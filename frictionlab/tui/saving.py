@@ -10,7 +10,7 @@ import copy
 from pathlib import Path
 
 from ..errors import shown, shown_name
-from ..preset.builtin import user_presets_dir
+from ..preset.builtin import listed_preset_folders, user_presets_dir
 from .folders import (
     copy_name,
     copy_target,
@@ -146,9 +146,12 @@ class PresetSaving:
         except OSError as exc:  # a read-only folder, not the user's, a file in the way
             self._ask_elsewhere(path, exc, lambda there: self._write(there, data, then_open, template))
             return
-        self.say(f"Saved {shown_name(path)}", until_open=not then_open)  # of the open preset: not of the next one opened
         self.reload_presets()
-        self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
+        listed = self.query_one(PresetsPane).highlight(path)  # a listed folder: the preset is there
+        # else said: a bare name typed is saved in the working folder, which the list does not show
+        shows = ", ".join(shown_name(folder) for folder in listed_preset_folders(self.presets_dir))
+        where = "" if listed else f" (not listed: the Presets list shows the presets in {shows})"
+        self.say(f"Saved {shown_name(path)}{where}", until_open=not then_open)  # of the open preset: not of the next one opened
         if then_open:
             self.run_worker(self._open_after_confirm(path), group="open")  # the copy is saved either way
         else:

@@ -82,3 +82,24 @@ async def test_enter_on_the_open_preset_shows_it_with_its_edits_and_on_another_a
     assert shown == (False, "tiny.yaml", "7", True)
     assert said == "tiny.yaml is open, with unsaved changes: Ctrl+S saves them"
     assert asked_for_another
+
+
+@pytest.mark.long  # a TUI session
+@sync
+async def test_a_copy_saved_outside_the_listed_folders_says_it_is_not_listed(folders, registry):
+    """Found by a newcomer: `d`, then a bare name (dup2) typed over presets/tiny-copy.yaml, saved
+    ./dup2.yaml, said "Saved dup2.yaml", and the list never showed it. It says where the list looks."""
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "f2")
+        move_to(app, "tiny.yaml")
+        await press_settled(pilot, "d", "ctrl+u", *"dup2", "enter")
+        await wait_until(pilot, lambda: (folders / "dup2.yaml").is_file() and "Saved" in status_text(app))
+        outside = status_text(app)
+        await press_settled(pilot, "f2")
+        move_to(app, "tiny.yaml")
+        await press_settled(pilot, "d", "enter")  # the default, presets/tiny-copy.yaml: listed
+        await wait_until(pilot, lambda: (folders / "presets" / "tiny-copy.yaml").is_file() and "Saved" in status_text(app))
+        inside = status_text(app)
+    assert outside == "Saved dup2.yaml (not listed: the Presets list shows the presets in presets)"
+    assert inside == "Saved presets/tiny-copy.yaml"

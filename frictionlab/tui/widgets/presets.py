@@ -98,11 +98,12 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
         else:
             self._show_info(self.query_one("#preset-table", DataTable).cursor_row)
 
-    def highlight(self, path: Path) -> None:
-        """Move the list's cursor to the preset in ``path``, if it is listed."""
+    def highlight(self, path: Path) -> bool:
+        """Move the list's cursor to the preset in ``path``, if it is listed; whether it is."""
         rows = [i for i, entry in enumerate(self.presets) if entry.path.resolve() == Path(path).resolve()]
         if rows:
             self.query_one("#preset-table", DataTable).move_cursor(row=rows[0], animate=False)
+        return bool(rows)
 
     def selected(self) -> PresetEntry | None:
         row = self.query_one("#preset-table", DataTable).cursor_row
