@@ -7,6 +7,7 @@ parameters appear in the form with no code of its own. No Textual here.
 
 from __future__ import annotations
 
+import copy
 import types
 import typing
 from dataclasses import dataclass
@@ -17,7 +18,7 @@ from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
 from ..errors import PresetError
-from ..io.inputs import describe_input
+from ..io.inputs import describe_input, input_fields
 from ..plugin import KINDS
 from ..preset import MISSING, Preset, build_scene, resolve_input_paths
 from ..io.safe_yaml import load_yaml
@@ -227,3 +228,16 @@ def preset_from_defaults(name: str, spectrum: str, registry) -> dict:
     data["loading"] = {"control": "force", "start": 1.0, "stop": 20.0, "steps": 40, "spacing": "log"}
     return data
 
+
+def shared_params(registry, slot: str, old: str, new: str, params: dict) -> dict:
+    """Of ``params`` (plugin ``old``'s), those plugin ``new`` of the same ``slot`` has too, by name:
+    kept when the user switches from one to the other (a Hurst exponent from power-law to rolloff;
+    they were left blank, "required"). None between spectra of lines and of surfaces (a line's
+    points are not a surface's), nor to or from a plugin that reads a file: its spacing is the
+    file's, not a generated line's."""
+    before, after = registry.get(slot, old), registry.get(slot, new)
+    if input_fields(before.Params) or input_fields(after.Params):
+        return {}
+    if slot == "spectrum" and before.dimension != after.dimension:
+        return {}
+    return {key: copy.deepcopy(value) for key, value in params.items() if key in after.Params.model_fields}

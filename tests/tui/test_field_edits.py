@@ -153,3 +153,26 @@ async def test_enter_in_a_text_field_leaves_it_and_f1_lists_what_its_keys_do(fol
     assert (left, kept) == (True, 12)
     assert (listed["enter"], listed["up"], listed["down"]) == ("Done", "Field above", "Field below")
     assert below == "plugin--spectrum"
+
+
+@sync
+async def test_switching_between_plugins_keeps_the_parameters_both_have_unless_they_differ_in_kind(folders, registry):
+    """Found by a newcomer: power-law to rolloff left hurst and points blank ('is required'),
+    though both take them. They are kept; not from a line's spectrum to a surface's (a line's
+    points are not a surface's), nor into a file's (its spacing is the file's own)."""
+    from .conftest import TINY, choose
+
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        await choose(pilot, "plugin--spectrum", "rolloff")
+        rolloff = dict(form.data["spectrum"]["params"])
+        await choose(pilot, "plugin--spectrum", "power-law-2d")
+        surface = dict(form.data["spectrum"]["params"])
+        await choose(pilot, "plugin--spectrum", "profile-file")
+        measured = dict(form.data["spectrum"]["params"])
+        await choose(pilot, "plugin--spectrum", "power-law")
+        back = dict(form.data["spectrum"]["params"])
+    assert rolloff == TINY["spectrum"]["params"]  # each of power-law's is rolloff's too
+    assert surface == {} and measured == {}
+    assert back == TINY["spectrum"]["params"]  # its own, kept aside as it was left

@@ -29,6 +29,7 @@ from ..fields import (
     parse,
     problem_path,
     problems_for,
+    shared_params,
     validation_of,
 )
 from ..hiddenkeys import idle_sideways
@@ -322,8 +323,8 @@ class PresetForm(VerticalScroll):
         if old_known is not None:
             self._stash[(slot, old_known)] = copy.deepcopy(old_params if isinstance(old_params, dict) else {})
         params = self._stash.get((slot, new_name))
-        if params is None and old_known is None and isinstance(old_params, dict):
-            params = old_params  # a name no plugin has (a typo): its parameters were meant for the one chosen now
+        if params is None and isinstance(old_params, dict):  # a typo's were meant for the one chosen now; else those it shares
+            params = old_params if old_known is None else shared_params(self.registry, slot, old_known, new_name, old_params)
         self.data[slot] = {"name": new_name, "params": params or {}}
         for spec_id in [i for i, s in self._specs.items() if s.path[0] == slot]:
             del self._specs[spec_id]
