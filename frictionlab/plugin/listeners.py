@@ -151,7 +151,10 @@ class SweepListener:
 
 
 def format_duration(seconds: float) -> str:
-    """``12.3 s`` below a minute, ``4:05`` below an hour, then ``1:02:03``."""
+    """``12.3 s`` below a minute (``0.04 s`` below a tenth: not "0.0 s" for a run that took
+    some), ``4:05`` below an hour, then ``1:02:03``."""
+    if 0 < seconds < 0.095:
+        return f"{seconds:.1g} s"
     if seconds < 60:
         return f"{seconds:.1f} s"
     minutes, seconds = divmod(int(seconds), 60)

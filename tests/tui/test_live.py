@@ -146,3 +146,12 @@ def test_the_time_left_waits_for_a_rate_of_a_few_realizations():
     line = progress_text(done, 4000, 0, 1.0)  # a rate of ESTIMATE_AFTER per second
     assert line.endswith(f"left {(4000 - done) // ESTIMATE_AFTER // 60}:{(4000 - done) // ESTIMATE_AFTER % 60:02d}"), line
     assert progress_text(2, 2, 0, 0.5).endswith("left 0.0 s")  # all done: nothing is left
+
+
+@pytest.mark.parametrize("seconds, said", [(0.0, "0.0 s"), (0.004, "0.004 s"), (0.0123, "0.01 s"), (0.04, "0.04 s"),
+                                           (0.1, "0.1 s"), (12.34, "12.3 s"), (245.0, "4:05"), (3723.0, "1:02:03")])
+def test_a_duration_is_said_with_a_digit_that_is_not_zero_unless_it_is_none(seconds, said):
+    """Found by a newcomer: 'completed: 8/8 realizations in 0.0 s' of a run that took 0.04 s."""
+    from frictionlab.plugin.listeners import format_duration
+
+    assert format_duration(seconds) == said
