@@ -1,6 +1,7 @@
 """The Results tab: runs and sweeps listed, opened and overlaid."""
 
 import json
+import re
 
 import pytest
 import yaml
@@ -66,10 +67,16 @@ async def test_the_results_plot_before_any_run_is_opened_says_none_is_open(folde
     async with started(app) as pilot:
         await press_settled(pilot, "f5")
         first = screen_text(app)
+        hint = " ".join(str(app.query_one("#results-info", Static).render()).split())
         await press_settled(pilot, "enter")
         opened = screen_text(app)
     assert "no data yet" not in first and "no run open" in first and "Enter opens a run" in first
     assert "no run open" not in opened
+    # and what the list's marks are (a newcomer found them explained nowhere): each mark with its status
+    from frictionlab.tui.sweepview import STATUS_MARKS
+
+    for status, mark in STATUS_MARKS.items():
+        assert re.search(rf"{re.escape(mark)} (\w+ or )*{status}\b", hint), (status, hint)
 
 
 async def wheel_read(pilot, region, turns: int = 12) -> list[str]:

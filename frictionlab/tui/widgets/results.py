@@ -32,7 +32,8 @@ from .sweeptable import SweepList
 from .tables import ListTable
 
 OVERLAY_STYLES = ("cyan", "magenta", "green", "yellow")
-HINT = "Enter opens a run; Space adds it to the overlay."
+HINT = "Enter opens a run; Space adds it to the overlay.\n" + ", ".join(  # what the list's marks are
+    f"{mark} {' or '.join(s for s, m in STATUS_MARKS.items() if m == mark)}" for mark in dict.fromkeys(STATUS_MARKS.values()))
 NO_RUN_OPEN = "no run open"
 NO_RUNS = "No runs yet: Ctrl+R runs the open preset (F2 lists the presets)."
 FIXED_COLUMNS = (1, 7, 7)  # the status mark, a, b; the name takes the rest of the list's width
