@@ -83,7 +83,7 @@ def run(args) -> ExitCode:
     error, gone, identity, holder = None, False, _identity(folder), state.pid
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
-        counter = None if sweep is not None or args.quiet else _ChunkCount(follower.reader)
+        counter = None if args.quiet else _ChunkCount(follower.reader, folder, sweep)
         stopped = _StopSignals()  # a signal is noted and acted on between polls, never raised mid-draw
         try:
             try:
@@ -221,16 +221,18 @@ def _rows(folder: Path) -> list[dict]:
 
 
 class _ChunkCount:
-    """The count of a run that writes no progress file (``frictionlab run`` in a terminal), read
-    from its chunks: why, said once, then the count as it moves, on one line of a terminal (a
-    line at most every LOG_SECONDS elsewhere)."""
+    """The count of a run (a sweep) that writes no progress file (``frictionlab run`` in a
+    terminal), read from its chunks (its points done, and the chunks of the one going on): why,
+    said once, then the count as it moves, on one line of a terminal (a line at most every
+    LOG_SECONDS elsewhere)."""
 
     LOG_SECONDS = 30.0
 
-    def __init__(self, reader):
+    def __init__(self, reader, folder: Path, sweep=None):
         from ..runs.progresslog import NoProgressFile
 
         self.missing = NoProgressFile(reader)
+        self.folder, self.sweep = folder, sweep
         self.said = False
         self.shown: tuple | None = None
         self.at = -math.inf
@@ -242,13 +244,35 @@ class _ChunkCount:
         if not self.said:
             self.said = True
             print(f"{why}: its count comes from its chunks", file=sys.stderr)
-        count = (state.done, state.total)
+        count = (state.done, state.total, *self._point_count(state))
         now = time.monotonic()
         if count == self.shown or state.done is None or (not self.terminal and now - self.at < self.LOG_SECONDS):
             return
         self.shown, self.at = count, now
-        line = shown(f"{state.name}: {state.done}/{state.total} realizations stored")
+        if self.sweep is None:
+            line = shown(f"{state.name}: {state.done}/{state.total} realizations stored")
+        else:
+            point = f"; point {count[2]}: {count[3]}/{count[4]} realizations stored" if count[2] else ""
+            line = shown(f"{state.name}: {state.done}/{state.total} points done{point}")
         print(f"\r{line}\x1b[K" if self.terminal else line, end="" if self.terminal else "\n", file=sys.stderr, flush=True)
+
+    def _point_count(self, state) -> tuple:
+        """A sweep's point going on (the first not done): (its number, its stored realizations, its
+        total); () of a run, or of a sweep with none going on."""
+        from ..errors import FrictionlabError
+        from ..runs.detached import stored_count
+        from ..runs.sweep import UNFINISHED, point_folder
+        from ..runs.sweeprecord import read_sweep_record
+
+        if self.sweep is None:
+            return ()
+        try:
+            done = {row.point for row in read_sweep_record(self.folder)[1].points if row.status not in UNFINISHED}
+            point = next((point for point in self.sweep.points if point.number not in done), None)
+            stored, total = (None, None) if point is None else stored_count(point_folder(self.folder, point))
+        except (OSError, FrictionlabError):  # a point not begun: nothing stored
+            return ()
+        return () if point is None else (point.number, stored or 0, total or point.scene.preset.realizations)
 
     def close(self) -> None:
         if self.terminal and self.shown is not None:

@@ -141,6 +141,8 @@ class FollowedSweep(FollowedRun):
         self._post = post
         self.follower = SweepFollower(folder, sweep, [SweepPoster(post_point, self._listeners_of)],
                                       pid=process.pid if process is not None else None)  # fmt: skip
+        self.said_progress_problem = False
+        self.no_progress_file = NoProgressFile(self.follower.reader)
         self.cancelling = False
         self.refusal: str | None = None
 
@@ -148,7 +150,9 @@ class FollowedSweep(FollowedRun):
         return None  # a sweep's count is its points', never read from chunks: its live tick goes on
 
     def count_from_chunks(self) -> str | None:
-        return None  # as above
+        """Why its points' count comes from sweep.json and the chunks of the one going on: it writes
+        no progress file (a sweep started in a terminal); None if not."""
+        return None if self.process is not None else self.no_progress_file.reason()
 
     def _listeners_of(self, point) -> list[object]:
         self.live = LiveListener(self._post)

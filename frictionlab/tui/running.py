@@ -280,7 +280,7 @@ class RunControl:
         from ..runs.detached import lock_held
         from .following import FollowedSweep, read_finished, read_finished_sweep
 
-        if not isinstance(followed, FollowedSweep) and followed.count_from_chunks():
+        if followed.count_from_chunks():
             self._count_from_chunks(followed)
         ended = followed.ended
         over = followed.poll()
@@ -337,7 +337,7 @@ class RunControl:
         if done is not None and total:
             self.query_one("RunPane").show_stored_count(done, total, resuming=resuming)
 
-    def _show_stored_sweep(self, folder: Path, sweep) -> None:
+    def _show_stored_sweep(self, folder: Path, sweep, resuming: bool = True) -> None:
         """A sweep's resume: the points its sweep.json holds as done, and the first point it
         goes on with, with the realizations that point's chunks hold."""
         from ..runs.detached import stored_count
@@ -358,13 +358,18 @@ class RunControl:
             stored, total = None, None
         total = total or going_on.scene.preset.realizations
         self.query_one("RunPane").show_stored_sweep(sweep, [row for row in rows if row["point"] in done],
-                                                    going_on, min(stored or 0, total), total)  # fmt: skip
+                                                    going_on, min(stored or 0, total), total, resuming)  # fmt: skip
 
     def _count_from_chunks(self, followed: FollowedRun) -> None:
         """A run whose progress file cannot be read, or that writes none: said once; its count read from its chunks."""
         if not followed.said_progress_problem:
             followed.said_progress_problem = True
             self.say(f"{followed.count_from_chunks()}: the count comes from the run's chunks, without a live plot", "warning")
+        from .following import FollowedSweep
+
+        if isinstance(followed, FollowedSweep):  # its points done, and the chunks of the one going on
+            self._show_stored_sweep(followed.folder, followed.sweep, resuming=False)
+            return
         done, total = followed.stored_count()
         if total and (pane := self._mounted("RunPane")) is not None:
             pane.show_stored_count(done or 0, total)

@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -79,6 +80,30 @@ def test_follow_counts_a_terminal_runs_chunks_which_writes_no_progress_file(tmp_
     assert count.endswith(" realizations stored\n") and 0 < done < total == 100_000
     assert follow.returncode == 1 and "interrupted" in stdout
     assert not (out / "progress.jsonl").exists()
+
+
+@pytest.mark.long
+def test_follow_counts_a_terminal_sweeps_points_and_the_chunks_of_the_one_going_on(tmp_path, cli):
+    sweep = {"sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}, "realizations": 100_000}
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, sweep), "sweep.yaml")
+    out = tmp_path / "sweep"
+    run = subprocess.Popen([sys.executable, "-m", "frictionlab", "run", str(preset), "--quiet", "--no-plot", "--workers",
+                            "1", "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while not list(out.glob("points/01-*/chunks/*")):
+            assert run.poll() is None and time.monotonic() < deadline, "the sweep did not start"
+            time.sleep(0.05)
+        follow = subprocess.Popen([sys.executable, "-m", "frictionlab", "follow", str(out)], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True)  # fmt: skip
+        why, count = follow.stderr.readline(), follow.stderr.readline()
+        run.terminate()
+        follow.communicate(timeout=60)
+    finally:
+        run.kill()
+        run.wait()
+    assert "writes no progress.jsonl" in why
+    assert re.fullmatch(r"small: 0/2 points done; point 1: [1-9]\d*/100000 realizations stored\n", count), count
 
 
 def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path, cli):

@@ -216,6 +216,32 @@ async def test_a_run_started_by_frictionlab_run_in_a_terminal_shows_its_count_fr
 
 @pytest.mark.long
 @sync
+async def test_a_sweep_started_in_a_terminal_shows_its_point_and_the_count_its_chunks_hold(folders, registry):
+    (folders / "presets" / "longsweep.yaml").write_text(yaml.safe_dump(merge(SWEEP, {"realizations": 100_000})))
+    out = folders / "runs" / "longsweep"
+    command = [sys.executable, "-m", "frictionlab", "run", "presets/longsweep.yaml", "--out", "runs/longsweep",
+               "--quiet", "--no-plot", "--workers", "1"]  # fmt: skip
+    process = subprocess.Popen(command, cwd=folders, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60.0
+        while not list(out.glob("points/01-*/chunks/*")):
+            assert process.poll() is None and time.monotonic() < deadline, "the sweep did not start"
+            time.sleep(0.05)
+        app = make_app(registry)
+        async with started(app) as pilot:
+            await wait_until(pilot, lambda: "writes no progress.jsonl" in status_text(app))
+            await wait_until(pilot, lambda: "stored (read from the run's chunks)" in str(app.query_one("#run-stats").render()))
+            point = str(app.query_one("#sweep-point").render())
+            first = numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0]
+            await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > first)
+    finally:
+        process.kill()
+        process.wait()
+    assert point.startswith("point 1/") and first > 0
+
+
+@pytest.mark.long
+@sync
 async def test_a_read_only_preset_file_is_kept_and_another_file_asked(folders, registry, monkeypatch):
     """Renaming the new text over it replaced a file made read-only (mode 444), made writable."""
     monkeypatch.setenv("FRICTIONLAB_PRESETS_DIR", str(folders / "mine"))

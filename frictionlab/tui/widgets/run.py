@@ -288,14 +288,15 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         what = "resuming" if resuming else "read from the run's chunks"
         self._set("run-stats", f"{done}/{total} realizations stored ({what})")
 
-    def show_stored_sweep(self, sweep, rows: list[dict], point, done: int, total: int) -> None:
-        """A sweep's resume as it begins: the rows of its points that are done (sweep.json's),
-        and ``point``, which it goes on with, at the count its chunks hold."""
+    def show_stored_sweep(self, sweep, rows: list[dict], point, done: int, total: int, resuming: bool = True) -> None:
+        """A sweep's resume as it begins (or a sweep that writes no progress file, as it goes): the
+        rows of its points that are done (sweep.json's), and ``point``, which it goes on with, at the
+        count its chunks hold."""
         table = self.query_one("#sweep-table", SweepTable)
         for row in rows:
             table.put_point(row)
         self._set("sweep-point", point_line(sweep, point))
-        self.show_stored_count(done, total, resuming=True)
+        self.show_stored_count(done, total, resuming=resuming)
 
     def show_cancelling(self) -> None:
         self._set("run-stats", "cancelling: the solves running stop; what finished is kept")
