@@ -144,6 +144,8 @@ async def test_the_run_tab_shows_no_progress_bar_until_a_run_is_shown(folders, r
     async with app.run_test(size=SIZE) as pilot:
         await press_settled(pilot, "f4")
         assert "No run yet" in screen_text(app)
+        # and where the runs made before are (a newcomer, after a restart, read "No run yet" beside one)
+        assert "F5 lists the runs made before" in " ".join(screen_text(app).split())
         assert not app.query_one("#run-bar").display and "--%" not in screen_text(app)
         await run_to_the_end(pilot)
         assert app.query_one("#run-bar").display and "100%" in screen_text(app)

@@ -120,7 +120,8 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
     ]
 
     def compose(self) -> ComposeResult:
-        yield Static("No run yet: open a preset and press Ctrl+R.", id="run-title")
+        yield Static("No run yet: open a preset and press Ctrl+R (F5 lists the runs made before; u resumes one).",
+                     id="run-title")
         yield PathLine(id="run-folder")
         yield Static("", id="sweep-point")
         yield ProgressBar(id="run-bar", show_eta=False)
