@@ -1,6 +1,7 @@
 """What happens around the TUI while it is open: its preset's file written by another program (an
 editor, a second TUI), a presets folder it cannot write in, a run folder removed while shown."""
 
+import contextlib
 import shutil
 import subprocess
 import sys
@@ -18,7 +19,7 @@ from frictionlab.tui.widgets import ResultsPane
 
 from ..conftest import merge
 from .conftest import (
-    LONG, SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
+    LONG, SWEEP, TINY, long_run_going, make_app, numbers_in, press_settled, record_said, runs_app, screen_text, started, status_text, sync, type_into, wait_until,
 )
 
 
@@ -162,6 +163,36 @@ async def test_u_on_the_run_tab_after_the_runs_folder_was_removed_says_so(folder
     assert said == "runs/long was removed from disk: nothing is left to resume; Ctrl+R runs the preset again."
 
 
+async def count_moves_from_chunks(pilot, app) -> None:
+    """Wait until the Run tab's count, read from the run's chunks, has moved on."""
+    def stored() -> int:
+        return numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0]
+
+    await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
+    first = stored()
+    await wait_until(pilot, lambda: stored() > first)
+
+
+@contextlib.contextmanager
+def run_in_a_terminal(folders, preset: str, data: dict, started):
+    """``frictionlab run presets/PRESET --out runs/STEM`` as a user types it in another terminal
+    (it writes no progress file), until ``started(folder)``; killed when the block ends."""
+    (folders / "presets" / preset).write_text(yaml.safe_dump(data))
+    out = folders / "runs" / Path(preset).stem
+    command = [sys.executable, "-m", "frictionlab", "run", f"presets/{preset}", "--out", f"runs/{out.name}",
+               "--quiet", "--no-plot", "--workers", "1"]  # fmt: skip
+    process = subprocess.Popen(command, cwd=folders, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60.0
+        while not started(out):
+            assert process.poll() is None and time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.05)
+        yield out
+    finally:
+        process.kill()
+        process.wait()
+
+
 @pytest.mark.long
 @sync
 async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chunks(folders, registry):
@@ -174,11 +205,7 @@ async def test_a_followed_runs_progress_file_removed_says_so_and_counts_its_chun
             (out / "progress.jsonl").unlink()
             await wait_until(pilot, lambda: "was removed while the run goes on" in status_text(app))
             assert "the count comes from the run's chunks" in status_text(app)
-            counts = []
-            for _ in range(2):  # the count moves on, read from the chunks
-                await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
-                counts.append(numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0])
-                await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
+            await count_moves_from_chunks(pilot, app)
             process.terminate()
             await wait_until(pilot, lambda: app.followed is None)
 
@@ -189,55 +216,33 @@ async def test_a_run_started_by_frictionlab_run_in_a_terminal_shows_its_count_fr
     """Found by a newcomer: a run started with ``frictionlab run`` in another terminal (it writes no
     progress file) stayed at 0 % on the Run tab until it ended. It is said, and its count moves,
     read from its chunks."""
-    (folders / "presets" / "long.yaml").write_text(yaml.safe_dump(LONG))
-    out = folders / "runs" / "long"
-    command = [sys.executable, "-m", "frictionlab", "run", "presets/long.yaml", "--out", "runs/long", "--quiet",
-               "--no-plot", "--workers", "1"]  # fmt: skip
-    process = subprocess.Popen(command, cwd=folders, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + 60.0
-        while not (lock_held(out) and (run_state(out).done or 0) > 0):
-            assert process.poll() is None and time.monotonic() < deadline, "the run did not start"
-            time.sleep(0.05)
+    def begun(out) -> bool:  # the lock is taken before run.json is written
+        return lock_held(out) and (out / "run.json").exists() and (run_state(out).done or 0) > 0
+
+    with run_in_a_terminal(folders, "long.yaml", LONG, begun) as out:
         app = make_app(registry)
+        said = record_said(app)  # every message, in order: another may follow this one at once
         async with started(app) as pilot:
-            await wait_until(pilot, lambda: "writes no progress.jsonl" in status_text(app))
-            assert "the count comes from the run's chunks" in status_text(app)
-            counts = []
-            for _ in range(2):  # the count moves on, read from the chunks
-                await wait_until(pilot, lambda: "stored" in str(app.query_one("#run-stats").render()))
-                counts.append(numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0])
-                await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > counts[0])
+            await wait_until(pilot, lambda: any("writes no progress.jsonl" in text for text in said))
+            (told,) = [text for text in said if "writes no progress.jsonl" in text]
+            assert told.endswith("the count comes from the run's chunks, without a live plot")
+            await count_moves_from_chunks(pilot, app)
             assert not (out / "progress.jsonl").exists()
-    finally:
-        process.kill()
-        process.wait()
 
 
 @pytest.mark.long
 @sync
 async def test_a_sweep_started_in_a_terminal_shows_its_point_and_the_count_its_chunks_hold(folders, registry):
-    (folders / "presets" / "longsweep.yaml").write_text(yaml.safe_dump(merge(SWEEP, {"realizations": 100_000})))
-    out = folders / "runs" / "longsweep"
-    command = [sys.executable, "-m", "frictionlab", "run", "presets/longsweep.yaml", "--out", "runs/longsweep",
-               "--quiet", "--no-plot", "--workers", "1"]  # fmt: skip
-    process = subprocess.Popen(command, cwd=folders, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + 60.0
-        while not list(out.glob("points/01-*/chunks/*")):
-            assert process.poll() is None and time.monotonic() < deadline, "the sweep did not start"
-            time.sleep(0.05)
+    data = merge(SWEEP, {"realizations": 100_000})
+    with run_in_a_terminal(folders, "longsweep.yaml", data, lambda out: list(out.glob("points/01-*/chunks/*"))):
         app = make_app(registry)
+        said = record_said(app)
         async with started(app) as pilot:
-            await wait_until(pilot, lambda: "writes no progress.jsonl" in status_text(app))
+            await wait_until(pilot, lambda: any("writes no progress.jsonl" in text for text in said))
             await wait_until(pilot, lambda: "stored (read from the run's chunks)" in str(app.query_one("#run-stats").render()))
             point = str(app.query_one("#sweep-point").render())
-            first = numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0]
-            await wait_until(pilot, lambda: numbers_in(str(app.query_one("#run-stats").render()).split("/")[0])[0] > first)
-    finally:
-        process.kill()
-        process.wait()
-    assert point.startswith("point 1/") and first > 0
+            await count_moves_from_chunks(pilot, app)
+    assert point.startswith("point 1/")
 
 
 @pytest.mark.long
