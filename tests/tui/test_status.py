@@ -37,7 +37,7 @@ async def test_a_message_about_a_results_row_goes_when_another_row_is_highlighte
         after_moving_back = status_text(app)
     assert "seed2 is damaged" in damaged
     assert after_moving == ""
-    assert "damaged" in info and "damaged" not in info_after_moving  # the box beside the plot too
+    assert "summary.json is damaged" in info and "is damaged" not in info_after_moving  # the box beside the plot too
     assert "seed1 is complete" in complete and after_reload == complete
     assert after_moving_back == ""
 
