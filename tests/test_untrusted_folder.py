@@ -378,6 +378,8 @@ RESUME_REFUSALS = {  # damage -> what the message says
     "preset.yaml a FIFO": (lambda f, u: fifo(f / "preset.yaml"), "preset file is a FIFO"),
     "run.lock a link": (lambda f, u: (f / "run.lock").symlink_to(u / "notes.txt"), "run.lock is not a regular file"),
     "run.lock a FIFO": (lambda f, u: os.mkfifo(f / "run.lock"), "run.lock is not a regular file"),
+    # a hard link is no link to refuse when opened, and who holds the lock was written into the user's file
+    "run.lock a hard link": (lambda f, u: hard_link(f / "run.lock", u / "notes.txt"), "run.lock is a hard link"),
     "future manifest": (lambda f, u: _edit_manifest(f, format=9), "format 9; this one reads up to 2"),
     "status NaN": (lambda f, u: (f / "run.json").write_text('{"status": NaN}'), "status is not a word, but a number"),
     "status the secret": (lambda f, u: _edit_manifest(f, status=[SECRET]), "status is not a word, but an array"),
@@ -385,6 +387,31 @@ RESUME_REFUSALS = {  # damage -> what the message says
                              "status is 'done', not one of running, completed, interrupted, cancelled, failed"),
     "chunks a list": (lambda f, u: _edit_manifest(f, chunks=[SECRET]), "chunks is not a mapping"),
 }
+
+
+def hard_link(name: Path, target: Path) -> None:
+    """``name`` made another name of the user's file ``target``."""
+    name.unlink(missing_ok=True)
+    os.link(target, name)
+
+
+@pytest.mark.parametrize("make", [hard_link, lambda name, target: name.symlink_to(target)], ids=["hard link", "link"])
+def test_a_detached_run_is_refused_a_progress_file_that_is_a_users_file_which_stays_unchanged(run_copy, tmp_path, make):
+    """A hard-linked progress.jsonl was emptied and written through by ``resume --detach``; a
+    symbolic one made the run go on unseen, said to have ended at once."""
+    from frictionlab.runs.detached import start_detached
+    from frictionlab.runs.progresslog import ProgressLog
+
+    user = tmp_path / "notes.txt"
+    user.write_text(SECRET)
+    make(run_copy / "progress.jsonl", user)
+    with pytest.raises(RunFolderError, match=r"progress\.jsonl in .* is a (hard|symbolic) link.*, never written through"):
+        start_detached({}, run_copy)
+    log = ProgressLog(run_copy)  # a run begun in the folder all the same writes no progress, and empties nothing
+    log._open(truncate=True)
+    log.write({"event": "started"})
+    log.close()
+    assert user.read_text() == SECRET
 
 
 def _edit_manifest(folder: Path, **changes) -> None:

@@ -246,3 +246,12 @@ def _deflates(array: np.ndarray) -> bool:
     items = max(1, _SAMPLE_BYTES // max(array.itemsize, 1))
     sample = np.ascontiguousarray(array.reshape(-1)[:items]).tobytes()
     return bool(sample) and len(zlib.compress(sample, 1)) < _WORTH_IT * len(sample)
+
+
+def written_through(status: os.stat_result) -> str | None:
+    """Why a run folder's file opened in place (its lock, its progress file) must not be written:
+    not a regular file, or a file with another name (a hard link: writing it would change a file
+    outside the folder); None if it is the folder's own."""
+    if not stat.S_ISREG(status.st_mode):
+        return "not a regular file"
+    return "a hard link (the file has another name)" if status.st_nlink > 1 else None

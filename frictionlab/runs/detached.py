@@ -31,7 +31,7 @@ from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, s
 from ..options import RunOptions
 from .figures import cut
 from .progressevents import MAX_COUNT
-from .progresslog import ProgressLog, ProgressReader, StartOf, told_by
+from .progresslog import ProgressLog, ProgressReader, StartOf, progress_file_problem, told_by
 from .results import read_summary
 from .rundir import LOCK_FILE, STATE_FILE, RunDirectory
 
@@ -89,6 +89,8 @@ def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = Ru
     preset data with its ``sweep`` section, as ``sweep.plan_sweep`` takes it) into ``out_dir``
     as its own process in a new session, and return at once. The preset and the options
     go through a pipe, read before the run begins: the terminal is none of its files."""
+    if (problem := progress_file_problem(out_dir)) is not None:  # its run would go on unseen, said to end at once
+        raise RunFolderError(f"{problem}; remove it, then run again (a detached run is followed through it)")
     request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot,
                "source": source}  # fmt: skip
     process = subprocess.Popen(

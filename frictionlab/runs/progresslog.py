@@ -26,6 +26,7 @@ from pathlib import Path
 from ..errors import shown
 from ..plugin.hookspecs import hookimpl
 from ..compute.realization import RealizationResult
+from ..io.files import written_through
 from ..io.values import number_or_nan, whole_or
 from .progresslines import MAX_BATCH, Batch, batch_results, fitted_line, result_of
 from .progressevents import checked_event
@@ -56,11 +57,13 @@ class ProgressLog:
 
     def _open(self, truncate: bool) -> None:
         self.close()
-        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0) | (os.O_TRUNC if truncate else 0)
+        flags = os.O_WRONLY | os.O_CREAT | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
         try:
             self._fd = os.open(self.path, flags, 0o644)
-            if not stat.S_ISREG(os.fstat(self._fd).st_mode):
+            if written_through(os.fstat(self._fd)):  # emptied only once known to be the folder's own file
                 self.close()
+            elif truncate:
+                os.ftruncate(self._fd, 0)
         except OSError:
             self._fd = None
 
@@ -177,6 +180,18 @@ class ProgressLog:
 
 REALIZATIONS = ("realization", "realizations")  # one realization's event (as written before), several's
 HEAD_BYTES = 4096  # of the first line, kept to tell a rewritten file (its ``started`` names a new pid and time)
+
+
+def progress_file_problem(folder: str | Path) -> str | None:
+    """Why the progress file in ``folder`` would not be written (``written_through``; a symbolic
+    link, never followed); None if it is fine or not there."""
+    path = Path(folder) / PROGRESS_FILE
+    try:
+        status = os.lstat(path)
+    except FileNotFoundError:
+        return None
+    why = "a symbolic link" if stat.S_ISLNK(status.st_mode) else written_through(status)
+    return None if why is None else f"{PROGRESS_FILE} in {shown(Path(folder))} is {why}, never written through"
 
 
 NO_PROGRESS_FILE_WAIT = 2.0  # seconds a run found running may go without a progress file before it is said to write none

@@ -12,6 +12,9 @@ import os
 from pathlib import Path
 from typing import Callable
 
+from ..errors import RunFolderError, shown_name
+from ..io.files import written_through
+
 try:
     import fcntl
 except ImportError:  # Windows: filelock's LockFileEx
@@ -69,6 +72,11 @@ class RunLock:
             if self._still_the_file(fd):
                 break
             os.close(fd)  # the holder removed the file we opened as it let go: lock the new one
+        if (why := written_through(os.fstat(fd))) is not None:  # who holds it is written into it
+            fcntl.flock(fd, fcntl.LOCK_UN)
+            os.close(fd)
+            raise RunFolderError(f"{shown_name(self.path)} is {why}: a run's lock is never written through; "
+                                 "remove it (no run holds it)")
         self._fd = fd
         _HELD.add(fd)
         try:
