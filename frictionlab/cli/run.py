@@ -7,8 +7,8 @@ import json
 import sys
 from pathlib import Path
 
-from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, RunFolderError, command_word, counted, ran_out_of_memory,
-                      resume_hint, shown, shown_name, too_long_path, write_failed)  # fmt: skip
+from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word, counted,
+                      ran_out_of_memory, resume_hint, shown, shown_name, too_long_path, write_failed)  # fmt: skip
 from .options import (
     add_executor_options,
     add_workers_option,
@@ -99,7 +99,7 @@ def refuse_what_no_resume_helps(run_dir: Path) -> None:
 def _run(args, drawer) -> ExitCode:
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path, same_name_note
-    from ..runs.rundir import new_run_folder
+    from ..runs.rundir import PRESET_FILE, new_run_folder
     from ..runs.runner import memory_check_before_reading
 
     overrides = preset_overrides(args)
@@ -128,6 +128,9 @@ def _run(args, drawer) -> ExitCode:
     if args.resume and not Path(args.out).is_dir():
         raise RunFolderError(f"{shown_name(args.out)} is not a run folder to resume (it does not exist, or is not a folder)")
     out_dir = args.out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)  # named if memory runs out
+    if not getattr(args, "stored", False) and Path(args.preset).resolve() == (out_dir / PRESET_FILE).resolve():
+        raise OutputRefused(f"{shown_name(args.preset)} is the preset being run: the run writes its own {PRESET_FILE} "
+                            "there; give another --out, or rename the preset")  # --force would replace it
     try:
         if args.detach:
             return detach(args, data, scene, out_dir, options)

@@ -143,6 +143,14 @@ def replace_problem(path: Path) -> str | None:
     return f"is a {kind}, not a file" if kind in ("folder", "socket", "block device") else None
 
 
+def named_files(preset: dict) -> set[Path]:
+    """The files a resolved preset's plugins name (absolute paths once resolved), resolved: a
+    run's results must not be written over one of them (--force into the folder of its scan)."""
+    params = [slot.get("params") for slot in preset.values() if isinstance(slot, dict)]
+    values = [value for p in params if isinstance(p, dict) for value in p.values()]
+    return {Path(value).resolve() for value in values if isinstance(value, str) and os.path.isabs(value)}
+
+
 def refuse_unreplaceable(paths, what: str, instead: str) -> None:
     """OutputRefused naming the first of ``paths`` that ``atomic_write`` cannot replace (a
     folder, ...): said before the ``what`` (a study, a report) does its work, --force or not,

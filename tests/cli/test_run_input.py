@@ -2,6 +2,7 @@
 under the progress's first line; nothing under ``--quiet``, nothing for a generated surface."""
 
 import numpy as np
+import pytest
 
 import frictionlab
 from frictionlab.cli import main
@@ -65,3 +66,19 @@ def test_the_python_api_says_it_with_its_progress_and_keeps_it_on_the_result(tmp
     assert result.input["detrend"] == "tilt" and frictionlab.load(tmp_path / "o").input == result.input
     frictionlab.run(data, workers=1, plot=False, progress=False)
     assert not _read_lines(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("scan_name, preset_name", [("curve.csv", "mine.yaml"), ("scan.csv", "preset.yaml")])
+def test_force_into_the_folder_of_its_own_scan_or_preset_replaces_neither(tmp_path, capsys, scan_name, preset_name):
+    """Found by a hostile-input audit: ``run preset.yaml --out . --force`` in the folder of a scan
+    named curve.csv replaced the scan by the results table (and the preset by the run's copy):
+    the run then could not even be resumed. Refused before anything is computed (exit 4)."""
+    data = _measured(tmp_path)
+    (tmp_path / "scan.csv").rename(tmp_path / scan_name)
+    data["spectrum"]["params"]["path"] = scan_name  # beside the preset, as a user keeps them
+    preset = write_preset(tmp_path, data, preset_name)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    assert main(["run", str(preset), "--out", str(tmp_path), "--force", "--quiet", "--no-plot"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert ("is this run's input" in err) if scan_name == "curve.csv" else ("is the preset being run" in err), err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before  # nothing written over
