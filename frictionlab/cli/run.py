@@ -4,11 +4,13 @@ run folder; a short table (or the summary as JSON) on stdout, progress on stderr
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
 from ..errors import (MEMORY_ADVICE, ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word, counted,
-                      ran_out_of_memory, resume_hint, shown, shown_name, too_long_path, write_failed)  # fmt: skip
+                      ran_out_of_memory, refuse_unusable_matplotlib, resume_hint, shown, shown_name, too_long_path,
+                      write_failed)  # fmt: skip
 from .options import (
     add_executor_options,
     add_workers_option,
@@ -121,6 +123,8 @@ def _run(args, drawer) -> ExitCode:
         scene = scene.for_pressing()
     if drawer is not None and (scene.preset.sweep is not None or not scene.preset.output.plot):
         drawer.close()  # no plot.png to draw: its import takes a core no longer
+    if not args.no_plot and scene.preset.output.plot and os.environ.get("MPLBACKEND", "").strip().lower() not in ("", "agg"):
+        refuse_unusable_matplotlib()  # named before the work, not as each plot.png failed after it; agg costs no import
     if args.out is not None and (too_long := too_long_path(args.out)):
         raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:

@@ -14,10 +14,12 @@ DRAWING_COMMANDS = [  # each draws figures that are its output; matplotlib's imp
     ["report", "--quiet", "--out", "out"],
     ["exact3d", "--quick", "--quiet", "--runs", "out"],
     ["plot", "out"],  # said before the folder is looked for
+    ["run", "quickstart", "--quiet", "--out", "out"],  # it computed every point of a sweep, then failed each plot.png
+    ["run", "quickstart", "--quiet", "--out", "out", "--set", "sweep.parameters.seed.values=[1,2]"],
 ]
 
 
-@pytest.mark.parametrize("argv", DRAWING_COMMANDS, ids=lambda argv: argv[0])
+@pytest.mark.parametrize("argv", DRAWING_COMMANDS, ids=lambda argv: " ".join(argv[:1] + argv[5:]))
 def test_a_bad_mplbackend_is_refused_before_a_drawing_command_runs(tmp_path, argv):
     env = {**os.environ, "MPLBACKEND": "no-such-backend"}
     done = subprocess.run([sys.executable, "-m", "frictionlab", *argv], capture_output=True, text=True, cwd=tmp_path,
