@@ -349,15 +349,6 @@ def test_a_figure_that_cannot_be_written_fails_the_command_but_the_run_is_finish
         assert main(["run", str(preset), "--out", str(out), "--quiet", "--no-plot"]) == ExitCode.OK  # not "unfinished"
 
 
-def test_a_broken_matplotlib_setting_is_said_and_the_run_is_finished(tmp_path):
-    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
-    done = subprocess.run([sys.executable, "-m", "frictionlab", "run", str(preset), "--out", str(tmp_path / "run"), "--quiet"],
-                          capture_output=True, text=True, timeout=120, env={**os.environ, "MPLBACKEND": "no-such-backend"})  # fmt: skip
-    assert done.returncode == ExitCode.RUNTIME_FAILURE and "internal error" not in done.stderr
-    assert "cannot draw" in done.stderr and "no-such-backend" in done.stderr
-    assert _status(tmp_path / "run") == "completed"
-
-
 @pytest.mark.parametrize(
     "damage, said",
     [
