@@ -75,6 +75,9 @@ IN_PROCESS = {
     "control char in a file path": (replace("name: power-law", "name: profile-file").replace(
         "hurst: 0.8\n    points: 1024\n    rms_height: 1.0", 'path: "scan\\n.csv"\n    spacing: 1.0'),
         ExitCode.USAGE, "spectrum.params.path: must not contain control characters"),
+    "a number for a section": (replace("loading:\n", "loading: 3\nx:\n"), ExitCode.USAGE,
+                               "loading: must be a mapping of keys to values (keys: control, spacing, start, steps, stop, "
+                               "unit), got 3"),  # it named no key
 }
 
 
@@ -354,6 +357,23 @@ def test_numbers_are_read_as_python_reads_them_not_as_yaml_1_1_bases():
     assert data == {"a": 10, "b": 8, "c": 31, "d": 1000, "e": "1:30", "f": "1:30.5", "g": "1__0", "h": "0b101",
                     "i": -math.inf, "j": 2.5}
     assert [type(data[k]) for k in "abcd"] == [int] * 4
+
+
+def test_a_key_yaml_1_1_reads_as_a_boolean_or_null_is_kept_as_written_and_values_are_not():
+    from frictionlab.io.safe_yaml import YamlProblem, load_yaml
+
+    assert load_yaml("yes: 1\non: 2\nNo: 3\n~: 4\nnull: 5\nx: [yes, off, ~]\n1: 6") == {
+        "yes": 1, "on": 2, "No": 3, "~": 4, "null": 5, "x": [True, False, None], 1: 6}  # fmt: skip
+    with pytest.raises(YamlProblem, match="duplicate key 'yes' at lines 1 and 2"):  # was: the last kept
+        load_yaml('yes: 1\n"yes": 2')
+
+
+def test_a_misplaced_yes_key_is_named_as_written(tmp_path, capsys):
+    preset = tmp_path / "p.yaml"
+    preset.write_text(yaml.safe_dump(SMALL_PRESET, sort_keys=False) + "yes: 3\n")
+    assert main(["validate", str(preset)]) == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert "yes: is not a known field" in err and "1:" not in err  # it was "1: keys should be strings, got True"
 
 
 @pytest.mark.parametrize(("value", "field"), [("1:30", "seed"), ("2:00", "realizations")])

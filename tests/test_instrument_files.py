@@ -19,6 +19,7 @@ import json
 import struct
 import sys
 import warnings
+import zipfile
 
 import numpy as np
 import pytest
@@ -441,6 +442,15 @@ def test_an_sdf_whose_data_holds_more_numbers_than_its_header_declares_is_named_
     err = capsys.readouterr().err
     points = 20 * COLUMNS if key == "NumProfiles" else 31 * ROWS
     assert f"its data holds {ROWS * COLUMNS} numbers, {ROWS * COLUMNS - points} more" in err and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("name", ["empty.npz", "empty.x3p"])
+def test_an_empty_archive_is_said_to_hold_no_file_not_to_be_damaged(tmp_path, name):
+    with zipfile.ZipFile(tmp_path / name, "w"):  # as np.savez() with no array writes it
+        pass
+    with pytest.raises(ValueError, match="an empty ZIP archive: it holds no file") as refused:
+        SurfaceFile(path=str(tmp_path / name)).rms_height()
+    assert "damaged" not in str(refused.value)
 
 
 def test_an_sdf_with_a_byte_order_mark_is_named_as_such_not_as_another_format(tmp_path):

@@ -255,6 +255,25 @@ def test_a_npy_whose_header_declares_itself_longer_than_the_file_is_damage_not_m
     assert peak < 2**26
 
 
+@pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
+def test_a_npy_past_the_memory_left_is_said_with_advice_for_a_line_and_a_map(tmp_path, plugin, monkeypatch):
+    """A .npy numpy cannot allocate (as under ulimit -v) was told 'crop or resample the map', of
+    a line too, whose region is cut from the file read whole."""
+    path = tmp_path / "big.npy"
+    np.save(path, np.zeros((16, 16) if plugin is SurfaceFile else 256))
+
+    def no_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(np, "load", no_memory)
+    with pytest.raises(ValueError) as info:
+        plugin(path=str(path), spacing=1.0).rms_height()
+    said = str(info.value)
+    shape = "(16, 16)" if plugin is SurfaceFile else "(256,)"
+    assert f"its array of shape {shape} (" in said and "does not fit in this process's memory" in said
+    assert "save a part of it (a crop, or every n-th point) to a file of its own" in said and "the map" not in said
+
+
 @pytest.mark.parametrize(("region", "said"), [
     ({"x": [True, 20]}, "spectrum.params.region.x[0]: must be a number, not true or false, got true"),
     ({"y": [0, False]}, "spectrum.params.region.y[1]: must be a number, not true or false, got false"),

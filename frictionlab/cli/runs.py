@@ -46,7 +46,7 @@ def run(args) -> ExitCode:
         emit("runs", {"runs_dir": str(runs_dir), "runs": [s.to_dict() for s in states]})
         return ExitCode.OK
     if not states:
-        print(f"no run folders in {shown(runs_dir)}/{_what_it_is(runs_dir)}")
+        print(f"no run folders in {shown(runs_dir).rstrip('/')}/{_what_it_is(runs_dir)}")  # "/", not "//"
         return ExitCode.OK
     from .console import print_table
 

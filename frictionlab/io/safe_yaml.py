@@ -61,6 +61,13 @@ class _BoundedLoader(yaml.SafeLoader):
                 raise
             raise _Unconvertible(node, exc) from None
 
+    def construct_mapping(self, node, deep=False):
+        """A plain key YAML 1.1 reads as a boolean or null (``yes:``, ``on:``, ``null:``) is kept as
+        the text written: a preset's keys are names, and True would be said as 1 (and ``yes`` and
+        ``on`` would collide without a word)."""
+        node.value = [(_as_text(key), value) for key, value in node.value]
+        return super().construct_mapping(node, deep)
+
     def compose_node(self, parent, index):
         self._depth += 1
         try:
@@ -74,6 +81,15 @@ class _BoundedLoader(yaml.SafeLoader):
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
+
+
+_WORDS = ("tag:yaml.org,2002:bool", "tag:yaml.org,2002:null")
+
+
+def _as_text(key):
+    if isinstance(key, yaml.ScalarNode) and key.tag in _WORDS and key.style is None:
+        return yaml.ScalarNode("tag:yaml.org,2002:str", key.value, key.start_mark, key.end_mark)  # a copy: an alias keeps its own
+    return key
 
 
 # Numbers are read as YAML 1.2 and Python read them, not as YAML 1.1: ``1e-6`` is a float
@@ -131,7 +147,7 @@ def _children(node) -> list:
 
 def _duplicate_key(node: yaml.MappingNode, path: str) -> str | None:
     seen: dict[tuple[str, str], int] = {}
-    for key, _ in node.value:
+    for key in (_as_text(key) for key, _ in node.value):  # as constructed: ``yes:`` and ``"yes":`` are one key
         if not isinstance(key, yaml.ScalarNode) or key.tag == "tag:yaml.org,2002:merge":
             continue
         ident = (key.tag, key.value)

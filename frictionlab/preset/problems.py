@@ -93,9 +93,11 @@ def _describe(error: dict, model: type[BaseModel]) -> str:
     if kind == "string_unicode":  # !!binary bytes that are not UTF-8: 'unable to parse raw data as a unicode string'
         return "must be UTF-8 text"
     if kind in {"dict_type", "model_type", "model_attributes_type"}:
-        if _model_at(model, tuple(error["loc"])) is SweepParameter:  # a bare list is the likely slip
+        target = _model_at(model, tuple(error["loc"]))
+        if target is SweepParameter:  # a bare list is the likely slip
             return "must be a mapping: {values: [...]} for a list, or {start: ..., stop: ..., num: ...} for a range"
-        return "must be a mapping of keys to values"
+        keys = f" (keys: {', '.join(sorted(target.model_fields))})" if target is not None else ""
+        return f"must be a mapping of keys to values{keys}"
     if kind in {"list_type", "tuple_type"}:
         return "must be a list"
     if kind == "string_too_short":

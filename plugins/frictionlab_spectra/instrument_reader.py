@@ -26,6 +26,7 @@ XML_LIMIT = 64 * 2**20  # bytes an XML member of a ZIP container (X3P's main.xml
 TEXT_FORMATS = ("xyz", "asc", "sdf")  # readers that parse text: never given a binary file
 BINARY_VARIANTS = {"sdf": b"bISO-1.0"}  # the magic of a text format's binary variant, which its reader reads too
 ZIP_MAGIC = b"PK\x03\x04"
+EMPTY_ZIP_MAGIC = b"PK\x05\x06"
 UTF8_BOM = b"\xef\xbb\xbf"
 GSF_MAGIC = b"Gwyddion Simple Field"  # a Gwyddion export no reader of the extra reads
 # the first bytes of formats whose reader states no magic (it answers 'maybe' to any file): a
@@ -59,6 +60,9 @@ def choose_reader(fh, path_suffix: str, where: str, *, text: bool | None = None)
         chosen = next((r for r in by_suffix if r.can_read(head) != MagicMatch.NO), None)
     if chosen is None and head.startswith(UTF8_BOM):  # a text format's magic behind a byte-order mark
         chosen = next((r for r in by_suffix if r.can_read(head[len(UTF8_BOM) :]) == MagicMatch.YES), None)
+    if chosen is None and head.startswith(EMPTY_ZIP_MAGIC):  # a ZIP of no member is its directory's end alone
+        raise ValueError(f"{where}: an empty ZIP archive: it holds no file{' (no array)' * (path_suffix == 'npz')}, so "
+                         "no heights; save or export the scan again")  # fmt: skip
     if chosen is None and by_suffix:
         names = " or ".join(dict.fromkeys(reader.name() for reader in by_suffix))
         raise ValueError(f"{where}: its suffix .{path_suffix} names {names}, but its first bytes are not that "

@@ -289,9 +289,10 @@ def load_npy(path: Path, where: str) -> np.ndarray:
         _check_npy_size(fh, where)
         try:
             data = np.load(fh, allow_pickle=False)
-        except MemoryError:  # the header asks for more than this process can allocate
-            raise ValueError(f"{where}: {_claimed_array(fh)} does not fit in this process's memory; "
-                             "crop or resample the map") from None
+        except MemoryError:  # the header asks for more than this process can allocate (a line's too: no "map")
+            raise ValueError(f"{where}: {_claimed_array(fh)} does not fit in this process's memory; save a part "
+                             "of it (a crop, or every n-th point) to a file of its own: region and downsample cut what "
+                             "was read whole") from None  # fmt: skip
         except Exception as exc:  # noqa: BLE001 - a header numpy cannot read: why, in its words cut short
             raise ValueError(f"{where}: {_unreadable_npy(fh, exc)}") from None
     if data.dtype.kind not in "iuf":  # numpy counts a timedelta64 as an integer
@@ -392,13 +393,18 @@ def _check_npy_size(fh, where: str) -> None:
 def _unreadable_npy(fh, exc: Exception) -> str:
     """Why np.load could not read a .npy file: not one at all (no magic string), or a header
     it refuses (a format version it does not know, a key too many), as numpy says."""
+    import tokenize  # numpy parses the header with it: a cut one raises its TokenError
+
     from .reader_failures import reason_said
 
     fh.seek(0)
     if fh.read(6) != b"\x93NUMPY":
         return ("not a .npy file (it does not start as numpy.save writes one); save the heights with numpy.save, "
                 "or as a .csv/.txt table of numbers")  # fmt: skip
-    reason = reason_said(exc) or type(exc).__name__
+    if isinstance(exc, (SyntaxError, tokenize.TokenError)) or isinstance(exc.__context__, SyntaxError):
+        reason = "it is not a whole Python dictionary: cut short or edited"  # the parser's own words name no field
+    else:
+        reason = reason_said(exc) or type(exc).__name__
     return f"a damaged .npy file: numpy cannot read its header ({reason}); save the array again"
 
 

@@ -269,3 +269,5 @@ def test_runs_given_a_run_or_sweep_folder_says_what_it_is(marker, hint, tmp_path
     capsys.readouterr()
     assert main(["runs", str(tmp_path)]) == 0  # a folder of run folders' folders: no hint
     assert capsys.readouterr().out == f"no run folders in {tmp_path}/\n"
+    assert main(["runs", f"{tmp_path}/"]) == 0  # given with its slash: one slash (`runs /` said "//")
+    assert capsys.readouterr().out == f"no run folders in {tmp_path}/\n"
