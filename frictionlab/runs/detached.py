@@ -54,6 +54,7 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
     from .runner import check_memory
 
     _check_not_in_use(out_dir)
+    _check_progress_file(out_dir)
     if not options.resume:
         RunDirectory(out_dir, force=options.force).check_fresh(scene)
     if options.memory_check:
@@ -63,6 +64,12 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
 def _check_not_in_use(out_dir: str | Path) -> None:
     if lock_held(out_dir):
         raise in_use(out_dir)
+
+
+def _check_progress_file(out_dir: str | Path) -> None:
+    """A detached run is followed through its progress file: one it would not write is refused."""
+    if (problem := progress_file_problem(out_dir)) is not None:  # its run would go on unseen, said to end at once
+        raise RunFolderError(f"{problem}; remove it, then run again (a detached run is followed through it)")
 
 
 def in_use(out_dir: str | Path, holder: int | None = None) -> RunFolderError:
@@ -79,6 +86,7 @@ def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> No
     from .sweepfiles import check_sweep_folder
 
     _check_not_in_use(out_dir)
+    _check_progress_file(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)
     check_sweep_memory(sweep, options)
 
@@ -89,8 +97,7 @@ def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = Ru
     preset data with its ``sweep`` section, as ``sweep.plan_sweep`` takes it) into ``out_dir``
     as its own process in a new session, and return at once. The preset and the options
     go through a pipe, read before the run begins: the terminal is none of its files."""
-    if (problem := progress_file_problem(out_dir)) is not None:  # its run would go on unseen, said to end at once
-        raise RunFolderError(f"{problem}; remove it, then run again (a detached run is followed through it)")
+    _check_progress_file(out_dir)  # checked again: a caller may start it unchecked
     request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot,
                "source": source}  # fmt: skip
     process = subprocess.Popen(

@@ -208,6 +208,10 @@ class RunControl:
             self.say(f"cannot start the run: {exc.strerror or exc}", "error", title="Run failed")
             self._unclaim(out_dir, options)
             return
+        except FrictionlabError as exc:  # its folder changed since the check above
+            self.say(str(exc), "error", title="Cannot resume" if options.resume else "Cannot run")
+            self._unclaim(out_dir, options)
+            return
         self.followed = self._follower(out_dir, scene, sweep, process)
         self.refresh_bindings()  # the Run tab's keys: cancel now, not run nor resume
         self.query_one("RunPane").start(scene, sweep, out_dir)
