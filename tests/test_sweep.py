@@ -414,7 +414,7 @@ def test_a_resumed_sweep_writes_again_a_completed_points_damaged_files(tmp_path,
     assert (folder / "realizations.npz").read_bytes() == sound["realizations.npz"]
 
 
-@pytest.mark.parametrize("text, said", [("[]", "is damaged (a JSON list, not an object)"), ("{", "is damaged (not valid JSON"),
+@pytest.mark.parametrize("text, said", [("[]", "is damaged (an array, not a JSON object)"), ("{", "is damaged (not valid JSON"),
                                         ('{"sweep": {}}', "is damaged: field 'sweep.parameters': field required; field 'base_preset': field required")])  # fmt: skip
 def test_resume_of_a_sweep_folder_whose_record_is_damaged_names_it(tmp_path, capsys, text, said):
     (tmp_path / "sweep.json").write_text(text)

@@ -581,3 +581,68 @@ def test_predict_from_a_sweeps_folder_names_it_as_one_and_where_its_points_laws_
     assert f"--from {folder} is a sweep's folder, which holds a law per point" in err
     assert f"frictionlab runs {folder / 'points'} lists them" in err
     assert main([*PREDICT, "--from", str(folder / "points" / "01-seed-1")]) == ExitCode.OK
+
+
+def loop(path: Path) -> None:
+    """A symbolic link that points at itself: any open of it fails with ELOOP."""
+    path.unlink(missing_ok=True)
+    path.symlink_to(path.name)
+
+
+@pytest.mark.parametrize("name", ["run.json", "summary.json", "curve.csv"])
+def test_resume_of_a_folder_holding_a_link_to_itself_is_said_never_an_internal_error(run_copy, name, capsys):
+    """Path.resolve raised RuntimeError('Symlink loop') on such a link: exit 70, 'internal error'."""
+    loop(run_copy / name)
+    code = main(["resume", str(run_copy), "--quiet", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert "internal error" not in err and "Traceback" not in err
+    if name == "run.json":  # the manifest is read: a link is refused, naming it
+        assert code == ExitCode.RUN_FOLDER and "symbolic link" in err
+    else:  # a result file is written anew: the link is replaced by the file, never followed
+        assert code == ExitCode.OK
+        assert not (run_copy / name).is_symlink() and (run_copy / name).is_file()
+
+
+def test_a_run_into_a_folder_holding_a_link_to_itself_is_refused_or_forced_never_an_internal_error(tmp_path, capsys):
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    out = tmp_path / "out"
+    out.mkdir()
+    loop(out / "summary.json")
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    assert "summary.json" in capsys.readouterr().err
+    assert main(["run", str(preset), "--out", str(out), "--quiet", "--force"]) == ExitCode.OK
+    assert (out / "summary.json").is_file() and not (out / "summary.json").is_symlink()
+
+
+def test_an_out_folder_that_is_a_link_to_itself_is_named(tmp_path, capsys):
+    preset = tmp_path / "p.yaml"
+    preset.write_text(json.dumps(QUICK))
+    loop(tmp_path / "out")
+    assert main(["run", str(preset), "--out", str(tmp_path / "out"), "--quiet"]) == ExitCode.OUTPUT_REFUSED
+    err = capsys.readouterr().err
+    assert "out is a symbolic link to nothing" in err and "internal error" not in err
+
+
+@pytest.mark.parametrize("command", [["schema"], ["plot", "RUN"]])
+def test_an_output_file_that_is_a_link_to_itself_is_refused_as_a_link_and_forced_replaced(run_copy, tmp_path, command, capsys):
+    """It was 'error: Too many levels of symbolic links' with exit 1 (a run failed)."""
+    target = tmp_path / "looped.png"
+    loop(target)
+    args = [str(run_copy) if word == "RUN" else word for word in command]
+    assert main([*args, "--out", str(target)]) == ExitCode.OUTPUT_REFUSED
+    assert "is a symbolic link: give another file, or --force" in capsys.readouterr().err
+    assert main([*args, "--out", str(target), "--force"]) == ExitCode.OK
+    assert target.is_file() and not target.is_symlink()
+
+
+@pytest.mark.parametrize("written, said", [
+    ("null", "(null, not a JSON object)"),  # was 'a JSON NoneType'
+    ('{"preset": "quick"}', "field 'preset': input should be a JSON object"),  # was 'instance of _PresetName'
+    ('{"seed": ' + "7" * 5000 + "}", "a number of more digits than are read"),  # was 'not valid JSON'
+], ids=["null", "preset a string", "a 5000-digit number"])  # fmt: skip
+def test_a_damaged_summary_is_said_in_the_file_s_terms_never_python_s(run_copy, written, said):
+    (run_copy / "summary.json").write_text(written)
+    raised = with_timeout(lambda: frictionlab.load(run_copy))
+    assert isinstance(raised, RunFolderError) and said in str(raised), str(raised)
+    assert "NoneType" not in str(raised) and "_PresetName" not in str(raised)

@@ -72,7 +72,9 @@ def run(args) -> ExitCode:
 
     folder = Path(args.run_dir)
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
-        folder = folder.resolve()
+        from ..io.files import real_path
+
+        folder = real_path(folder)
     refuse_a_part_of_a_run(folder, "follow")
     if folder.is_dir():  # else run_state says what it is
         from ..runs.sweepfiles import refuse_a_sweep_without_record

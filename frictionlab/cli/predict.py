@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import argparse
+
 from ..errors import ExitCode, FrictionlabError
 
 
@@ -21,11 +23,11 @@ def add_parser(sub) -> None:
     p.add_argument("--b-ci", type=float, nargs=2, metavar=("LO", "HI"), help="interval of b (LO <= HI)")
     p.add_argument("--confidence", type=float, help="level of the given intervals, in (0, 1) (default 0.95)")
     p.add_argument("--from", dest="from_run", metavar="RUN_DIR", help="take the law from a run folder (summary.json)")
-    p.add_argument("--area", type=float, required=True, metavar="A", help="apparent contact area A")
-    p.add_argument("--modulus", type=float, required=True, metavar="ESTAR", help="effective modulus E*")
-    p.add_argument("--rms-height", type=float, required=True, metavar="H", help="rms height h of the surface")
-    p.add_argument("--force", type=float, required=True, metavar="F", help="normal force F")
-    p.add_argument("--rms-slope", type=float, metavar="S", help="the surface's rms slope: also print S * xi")
+    p.add_argument("--area", type=number, required=True, metavar="A", help="apparent contact area A")
+    p.add_argument("--modulus", type=number, required=True, metavar="ESTAR", help="effective modulus E*")
+    p.add_argument("--rms-height", type=number, required=True, metavar="H", help="rms height h of the surface")
+    p.add_argument("--force", type=number, required=True, metavar="F", help="normal force F")
+    p.add_argument("--rms-slope", type=number, metavar="S", help="the surface's rms slope: also print S * xi")
     p.add_argument("--json", action="store_true", help="as JSON")
     p.set_defaults(handler=run)
 
@@ -77,3 +79,12 @@ def run(args) -> ExitCode:
         print(f"law: xi = {format_number(law.a)} + {format_number(law.b)} ln f")
         print(prediction_text(prediction))
     return ExitCode.OK
+
+
+def number(text: str) -> float:
+    """``float(text)``, refused where it rounds a number that is not zero to 0 (1e-400): the
+    check on the value would say 'Got 0.0', a number the user never typed."""
+    value = float(text)
+    if value == 0 and any(digit in "123456789" for digit in text.lower().split("e")[0]):
+        raise argparse.ArgumentTypeError(f"{text} is below the smallest number above 0 a double holds (about 5e-324)")
+    return value

@@ -132,7 +132,9 @@ def _run(args, drawer) -> ExitCode:
     if args.resume and not Path(args.out).is_dir():
         raise RunFolderError(f"{shown_name(args.out)} is not a run folder to resume (it does not exist, or is not a folder)")
     out_dir = args.out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)  # named if memory runs out
-    if not getattr(args, "stored", False) and Path(args.preset).resolve() == (out_dir / PRESET_FILE).resolve():
+    from ..io.files import real_path
+
+    if not getattr(args, "stored", False) and real_path(args.preset) == real_path(out_dir / PRESET_FILE):
         raise OutputRefused(f"{shown_name(args.preset)} is the preset being run: the run writes its own {PRESET_FILE} "
                             "there; give another --out, or rename the preset")  # --force would replace it
     try:

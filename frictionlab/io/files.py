@@ -148,7 +148,7 @@ def named_files(preset: dict) -> set[Path]:
     run's results must not be written over one of them (--force into the folder of its scan)."""
     params = [slot.get("params") for slot in preset.values() if isinstance(slot, dict)]
     values = [value for p in params if isinstance(p, dict) for value in p.values()]
-    return {Path(value).resolve() for value in values if isinstance(value, str) and os.path.isabs(value)}
+    return {real_path(value) for value in values if isinstance(value, str) and os.path.isabs(value)}
 
 
 def refuse_unreplaceable(paths, what: str, instead: str) -> None:
@@ -161,13 +161,24 @@ def refuse_unreplaceable(paths, what: str, instead: str) -> None:
                                 f"move it aside, or {instead}")
 
 
+def real_path(path: str | Path) -> Path:
+    """``path`` with every link resolved as far as it goes: ``Path.resolve`` raises
+    RuntimeError on a link that points back at itself, and a folder is untrusted."""
+    return Path(os.path.realpath(path))
+
+
 def _kind(path: Path, follow_links: bool = True) -> str | None:
     """What is at ``path`` (links followed unless ``follow_links`` is False: then a
-    link is "symbolic link"): "file", "folder", "FIFO"..., None if nothing."""
+    link is "symbolic link"): "file", "folder", "FIFO"..., None if nothing (or a
+    link that leads to itself)."""
     try:
         mode = os.stat(path, follow_symlinks=follow_links).st_mode
     except (FileNotFoundError, NotADirectoryError):
         return None
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return None
+        raise
     return _KINDS.get(stat.S_IFMT(mode), "special file")
 
 

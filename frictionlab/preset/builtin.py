@@ -77,8 +77,10 @@ def preset_folders(presets_dir: Path | None = None, env=None) -> list[tuple[str,
         return [("presets", Path(presets_dir))]
     folders = [("project", PROJECT_PRESETS_DIR)] if PROJECT_PRESETS_DIR.is_dir() else []
     folders.append(("user", user_presets_dir(env)))
+    from ..io.files import real_path
+
     shipped = builtin_folder()
-    if shipped is not None and not any(folder.resolve() == shipped.resolve() for _, folder in folders):
+    if shipped is not None and not any(real_path(folder) == real_path(shipped) for _, folder in folders):
         folders.append((BUILTIN, shipped))
     return folders
 
@@ -101,11 +103,13 @@ def same_named_presets(argument: str | Path, resolved: Path) -> list[Path]:
         folders, own = listed_preset_folders(), builtin.path.read_bytes()
     except (FrictionlabError, OSError):
         return []
+    from ..io.files import real_path
+
     found = []
     for path in (folder / f"{builtin.name}{suffix}" for folder in folders for suffix in (".yaml", ".yml")):
         try:
             # read only a file the built-in's size: another size differs, however large it is
-            if path.is_file() and path.resolve() != builtin.path.resolve() and (
+            if path.is_file() and real_path(path) != real_path(builtin.path) and (
                     path.stat().st_size != len(own) or path.read_bytes() != own):
                 found.append(path)
         except OSError:

@@ -39,7 +39,7 @@ import yaml
 
 from .. import __version__
 from ..errors import OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
-from ..io.files import atomic_write, named_files, output_path_problem, replace_problem
+from ..io.files import atomic_write, named_files, output_path_problem, real_path, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly
 from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import as_now, with_new_defaults
@@ -274,7 +274,7 @@ class RunDirectory:
         written += ["realizations.npz"] if scene.preset.output.realizations else []
         inputs = named_files(scene.resolved())  # a result written over the run's own scan: --force into its folder
         for name in written:
-            problem = replace_problem(self.path / name) or ("is this run's input" if (self.path / name).resolve() in inputs else None)
+            problem = replace_problem(self.path / name) or ("is this run's input" if real_path(self.path / name) in inputs else None)
             if problem:
                 refused, then = (RunFolderError, "resume") if resume else (OutputRefused, "run again")
                 raise refused(f"{shown(self.path / name)} {problem}: the run writes its {name} there; move it aside, then {then}")

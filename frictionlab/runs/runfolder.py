@@ -206,11 +206,12 @@ def parse_json_object(raw: bytes, path: Path) -> dict:
         raise RunFolderError(f"{shown(path)} is damaged (key {short_repr(exc.args[0])} given twice in one object)") from None
     except ValueError as exc:  # not JSON, not UTF-8, an int of too many digits
         where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
-        raise RunFolderError(f"{shown(path)} is damaged (not valid JSON{where})") from None
+        what = "a number of more digits than are read" if "digits" in str(exc) else "not valid JSON"
+        raise RunFolderError(f"{shown(path)} is damaged ({what}{where})") from None
     except RecursionError:
         raise RunFolderError(f"{shown(path)} is damaged (JSON nested too deeply)") from None
     if not isinstance(data, dict):
-        raise RunFolderError(f"{shown(path)} is damaged (a JSON {type(data).__name__}, not an object)")
+        raise RunFolderError(f"{shown(path)} is damaged ({json_kind(data)}, not a JSON object)")
     return data
 
 
@@ -278,13 +279,20 @@ def checked(model: type[BaseModel], data: dict, path: Path):
         return model.model_validate(data)
     except ValidationError as exc:
         errors = exc.errors(include_input=False, include_url=False, include_context=False)
-        problems = [f"field '{_dotted(e['loc'])}': {_lower(e['msg'])}" for e in errors[:3]]
+        problems = [f"field '{_dotted(e['loc'])}': {_said(e)}" for e in errors[:3]]
         more = f" (and {len(errors) - 3} more)" if len(errors) > 3 else ""
         raise RunFolderError(f"{shown(path)} is damaged: " + "; ".join(problems) + more) from None
 
 
 def _dotted(loc) -> str:
     return ".".join(shown(str(part))[:40] for part in loc) or "(top)"
+
+
+def _said(error: dict) -> str:
+    """Pydantic's message for one field, in the file's terms (a nested record is a JSON object)."""
+    if error["type"] == "model_type":  # "a valid dictionary or instance of _Counts": a class name of ours
+        return "input should be a JSON object"
+    return _lower(error["msg"])
 
 
 def _lower(message: str) -> str:

@@ -21,6 +21,7 @@ from pathlib import Path
 import yaml
 
 from ..errors import FrictionlabError, RunFolderError
+from ..io.files import real_path
 from ..io.inputs import expand_user, read_regular_file
 from ..preset import load_preset_file, resolve_input_paths
 from ..preset.builtin import BUILTIN, PROJECT_PRESETS_DIR, builtin_folder, builtin_presets, user_presets_dir
@@ -40,8 +41,8 @@ def writable_folder(folders: list[tuple[str, Path]]) -> Path:
 def is_builtin(path: Path) -> bool:
     """Whether ``path`` is one of the presets shipped in the installed package (not to be written)."""
     shipped = builtin_folder()
-    return shipped is not None and shipped.resolve() != PROJECT_PRESETS_DIR.resolve() and \
-        Path(path).resolve().parent == shipped.resolve()  # fmt: skip
+    return shipped is not None and real_path(shipped) != real_path(PROJECT_PRESETS_DIR) and \
+        real_path(path).parent == real_path(shipped)  # fmt: skip
 
 
 def save_folder(presets_dir: Path | None = None) -> Path:
@@ -55,7 +56,7 @@ def made_when_saved(folder: Path, save_to: Path) -> bool:
     """Whether ``folder`` is a presets folder made when first saved into: ``save_to`` (where new
     presets go) or the user folder (offered for a preset that cannot be written where it is)."""
     try:
-        return any(Path(expand_user(str(folder))).resolve() == Path(expand_user(str(made))).resolve()
+        return any(real_path(expand_user(str(folder))) == real_path(expand_user(str(made)))
                    for made in (save_to, user_presets_dir()))  # fmt: skip
     except ValueError:  # ~user of no user: no folder of ours
         return False
@@ -131,9 +132,9 @@ def templates(entries: list[PresetEntry]) -> list[tuple[str, Path]]:
     (quickstart first), then the listed ones that can be read."""
     shipped = sorted(builtin_presets(), key=lambda p: p.name != FIRST_TEMPLATE)
     choices = [(f"{p.name} ({BUILTIN})", p.path) for p in shipped]
-    seen = {p.path.resolve() for p in shipped}
+    seen = {real_path(p.path) for p in shipped}
     for entry in entries:
-        if not entry.error and entry.path.resolve() not in seen:
+        if not entry.error and real_path(entry.path) not in seen:
             choices.append((f"{entry.name} ({entry.label})", entry.path))
     return choices
 
@@ -142,7 +143,7 @@ def preset_from_template(template: Path, name: str, new_path: Path, registry=Non
     """A template preset's data renamed ``name``, its relative input files
     made to work from ``new_path``'s folder (raises ``PresetError``)."""
     data = load_preset_file(template)
-    if Path(template).resolve().parent != Path(new_path).resolve().parent:
+    if real_path(template).parent != real_path(new_path).parent:
         data = resolve_input_paths(data, Path(template).parent, registry)
     data["name"] = name
     return data
@@ -176,7 +177,7 @@ def names_taken(entries: list[PresetEntry], replaced: Path | None = None) -> set
 
 def _resolved(path: Path) -> Path:
     try:
-        return Path(path).resolve()
+        return real_path(path)
     except (OSError, RuntimeError):  # a link loop
         return Path(path)
 

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from textual.css.query import NoMatches
 from textual.widgets import TabbedContent
 
+from ..io.files import real_path
 from ..errors import FrictionlabError, PresetError, RunFolderError, command_word, counted, shown, shown_name
 from ..options import RunOptions
 from ..preset import build_scene, resolve_input_paths
@@ -243,7 +244,7 @@ class RunControl:
 
     def show_running(self, folder: Path) -> None:
         """The Run tab, following the run going on in ``folder`` (if it is not the one shown)."""
-        if self.followed is None or self.followed.folder.resolve() != folder.resolve():
+        if self.followed is None or real_path(self.followed.folder) != real_path(folder):
             if self.running:
                 self.say("A run is shown: it goes on when you quit; follow this one after it (or from another TUI).",
                          "warning", about=folder)

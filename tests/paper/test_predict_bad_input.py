@@ -68,7 +68,7 @@ def test_the_undamaged_copy_predicts(run_copy, capsys):
     [
         ("junk", "not valid JSON"),
         ("", "not valid JSON"),
-        ("[1, 2]", "not an object"),
+        ("[1, 2]", "(an array, not a JSON object)"),
         pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", id="deep-list"),
         pytest.param('{"a": ' * 100_000 + "1" + "}" * 100_000, "nested too deeply", id="deep-object"),
         pytest.param("\udcff", "not valid JSON", id="not-utf8"),  # a lone byte 0xff once written
@@ -449,3 +449,15 @@ def test_huge_but_finite_numbers_print_short(capsys):
     assert main(["predict", *contact, "--a", "1", "--b", "1e307", "--a-ci", "0", "2", "--b-ci", "1e306", "1e307"]) == 0
     out = capsys.readouterr().out
     assert "e+307" in out and max(len(line) for line in out.splitlines() if not line.startswith("warning:")) < 120
+
+
+@pytest.mark.parametrize("option", ["--area", "--modulus", "--rms-height", "--force"])
+def test_a_number_too_small_for_a_double_is_named_as_typed_not_as_zero(option, capsys):
+    """1e-400 reads as 0.0: the message said 'Got 0.0 instead', a value nobody typed."""
+    given = {"--area": "1", "--modulus": "1", "--rms-height": "1", "--force": "1", option: "1e-400"}
+    args = ["predict", "--a", "1", "--b", "0.1", *(word for pair in given.items() for word in pair)]
+    with pytest.raises(SystemExit) as ended:
+        main(args)
+    assert ended.value.code == ExitCode.USAGE
+    err = capsys.readouterr().err
+    assert f"argument {option}: 1e-400 is below the smallest number above 0" in err and "0.0" not in err

@@ -13,6 +13,7 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ...errors import shown_name
+from ...io.files import real_path
 from ..folders import PresetEntry, list_presets
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
 from ..text import shorten_middle
@@ -100,7 +101,7 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
 
     def highlight(self, path: Path) -> bool:
         """Move the list's cursor to the preset in ``path``, if it is listed; whether it is."""
-        rows = [i for i, entry in enumerate(self.presets) if entry.path.resolve() == Path(path).resolve()]
+        rows = [i for i, entry in enumerate(self.presets) if real_path(entry.path) == real_path(path)]
         if rows:
             self.query_one("#preset-table", DataTable).move_cursor(row=rows[0], animate=False)
         return bool(rows)

@@ -17,6 +17,7 @@ from textual.content import Content
 from textual.widgets import DataTable, Static
 
 from ...errors import FrictionlabError, shown, shown_name
+from ...io.files import real_path
 from ...compute.fit import ci_label, format_interval
 from ...runs.detached import RESUMABLE
 from ..chart import NO_DATA, Series
@@ -305,7 +306,7 @@ class ResultsPane(SaysWhyUnavailable, Vertical):
     def open_point(self, sweep: Path, point: int) -> None:
         """Enter on a point of the Run tab's sweep: the sweep open here, that point's run shown."""
         self.app.reload_runs()
-        entry = next((e for e in self.runs if isinstance(e, SweepEntry) and e.path.resolve() == sweep.resolve()), None)
+        entry = next((e for e in self.runs if isinstance(e, SweepEntry) and real_path(e.path) == real_path(sweep)), None)
         numbers = [row.get("point") for row in entry.points] if entry is not None else []
         if point not in numbers:
             self.app.say(f"point {point} of {shown(sweep)} has no finished run to show yet", "warning")
