@@ -26,7 +26,7 @@ def add_parser(sub) -> None:
     p.add_argument("--figures", metavar="DIR", help="PNG folder (default: figures/ in --out); a file is refused")
     p.add_argument("--force", action="store_true", help="overwrite an earlier report, its figures and runs (run "
                    "afresh), and a --markdown you name; never files it did not write: an --out that is not a "
-                   "report's is refused")
+                   "report's, or a figure in --figures that no report drew, is refused")
     add_workers_option(p, "all cores")
     p.add_argument("--readings", action="store_true", help="also run the readings of the paper's method (slower)")
     p.add_argument("--replicates", type=int, default=1, metavar="K",

@@ -10,6 +10,7 @@ from ..plot import draw_interval
 from .figures import PAPER_H07, PAPER_POINTS_VS_H, FigureRun
 from .readings import ReadingRow
 
+FIGURE_MARK = {"Software": "frictionlab report"}  # in each figure's PNG: what report --force may replace
 F_UNIT = 1e-9  # the paper's f axis is in units of 1e-9
 
 
@@ -43,7 +44,7 @@ def plot_figure(run: FigureRun, fh, dpi: int = 90) -> None:
     ax_n.set_xlabel(r"$f = F / (E^* h L)$ in units of $10^{-9}$")
     ax_n.grid(True, which="both", alpha=0.3)
     ax_n.legend(fontsize=7, loc="upper left")
-    fig.savefig(fh, format="png", dpi=dpi)
+    fig.savefig(fh, format="png", dpi=dpi, metadata=FIGURE_MARK)
 
 
 def _sweep_series(run: FigureRun) -> dict:
@@ -88,7 +89,7 @@ def plot_fig5(run: FigureRun, fh, dpi: int = 90) -> None:
     _mark_paper_against_h(axes)
     axes[0].legend(fontsize=7)
     fig.suptitle("Fig. 5: xi = a + b ln f against H (each point as Fig. 2, h = 1e4)", fontsize=10)
-    fig.savefig(fh, format="png", dpi=dpi)
+    fig.savefig(fh, format="png", dpi=dpi, metadata=FIGURE_MARK)
 
 
 def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 90) -> None:
@@ -107,4 +108,4 @@ def plot_fig5_calibrated(run: FigureRun, rows: list[ReadingRow], fh, dpi: int = 
     axes[2].grid(True, which="both", alpha=0.3)
     axes[2].legend(fontsize=7)
     fig.suptitle("Fig. 5 with h calibrated at each H (counts 4 at F = 1, 12 at F = 20; 95% CI)", fontsize=10)
-    fig.savefig(fh, format="png", dpi=dpi)
+    fig.savefig(fh, format="png", dpi=dpi, metadata=FIGURE_MARK)

@@ -5,6 +5,7 @@ of the paper's method and Fig. 5 with h calibrated at each H."""
 from __future__ import annotations
 
 import os
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -19,11 +20,14 @@ from ..runs.runfolder import output_subfolder
 from ..compute.signals import WorkInterrupted
 from .figures import FIGURES, find_presets, kept_in, run_figures
 from .markdown import HEADING, markdown
-from .plots import plot_fig5, plot_fig5_calibrated, plot_figure
+from .plots import FIGURE_MARK, plot_fig5, plot_fig5_calibrated, plot_figure
 from .readings import (CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, check_reading_folders, fig5_calibrated_readings,
                        run_readings)
 
 
+MARK_BYTES = 4096  # of a PNG: matplotlib writes its text chunks right after the header
+MARK_CHUNK = b"tEXtSoftware\x00" + FIGURE_MARK["Software"].encode()
+MAX_MARKDOWN_BYTES = 1 << 20  # of a report's markdown, read for its image links (one is about 20 kB)
 FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
 DEFAULT_MARKDOWN, DEFAULT_FIGURES = "REPRODUCTION.md", "figures"  # in --out
 
@@ -136,6 +140,37 @@ def _refuse_overwriting(markdown_path: Path | None, figures_dir: Path | None, fo
     if taken and not force:
         shown = ", ".join(str(p) for p in taken[:3]) + (", ..." if len(taken) > 3 else "")
         raise OutputRefused(f"the report would overwrite {shown}: give other --out/--markdown/--figures, or --force")
+    linked = _linked_figures(markdown_path)
+    for figure in (p for p in figures if p in taken and not p.is_symlink()):  # a link is replaced, never its target
+        shown_as = os.path.relpath(figure, markdown_path.parent) if markdown_path else None
+        if not (_marked(figure) or shown_as in linked):
+            raise OutputRefused(f"{shown_name(figure)} was not drawn by frictionlab report: the report never replaces "
+                                "it, --force or not; move it aside, or give --figures another folder")  # fmt: skip
+
+
+def _marked(figure: Path) -> bool:
+    """Whether ``figure`` is a PNG holding the mark every report's figure carries (FIGURE_MARK)."""
+    try:
+        with open_regular_file(figure, follow_links=False) as fh:
+            head = fh.read(MARK_BYTES)
+    except (InputFileProblem, OSError):
+        return False
+    return head.startswith(b"\x89PNG") and MARK_CHUNK in head
+
+
+def _linked_figures(markdown_path: Path | None) -> set[str]:
+    """The figures a report's markdown at ``markdown_path`` shows (its image links): those of a
+    report drawn before its figures carried FIGURE_MARK are its own too."""
+    if markdown_path is None or not os.path.lexists(markdown_path):
+        return set()
+    try:
+        with open_regular_file(markdown_path, follow_links=False) as fh:
+            text = fh.read(MAX_MARKDOWN_BYTES).decode("utf-8", "replace")
+    except (InputFileProblem, OSError):
+        return set()
+    if not text.startswith(HEADING + "\n"):
+        return set()
+    return set(re.findall(r"^!\[[^\]\n]*\]\(([^)\n]+)\)$", text, flags=re.MULTILINE))
 
 
 def write_report(

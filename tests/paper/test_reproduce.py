@@ -16,12 +16,13 @@ import yaml
 
 from frictionlab.compute import engine
 from frictionlab.cli import main
-from frictionlab.errors import ExitCode
+from frictionlab.errors import ExitCode, OutputRefused
 from frictionlab.options import RunOptions
 from frictionlab.paper.calibration import COUNT_TARGETS, calibrated_rms_height
 from frictionlab.paper.figures import FIGURES, find_presets, run_figures
 from frictionlab.paper.markdown import fig5_calibrated_markdown, readings_markdown
 from frictionlab.paper.plots import plot_fig5_calibrated
+from frictionlab.paper.reproduce import report_paths
 from frictionlab.paper.readings import (
     Reading,
     average_curve,
@@ -367,3 +368,35 @@ def test_a_report_run_again_continues_its_stopped_and_finished_runs(tiny_presets
     assert not [w for w in recwarn if "runs again" in str(w.message)]
     run_figures(tiny_presets, out, RunOptions(workers=1, force=True))  # --force: every run afresh
     assert json.loads((out / "fig2" / "summary.json").read_text())["resumed_realizations"] == 0
+
+
+def test_force_replaces_a_report_s_figures_never_a_figure_of_the_user_s(tiny_report, tmp_path, capsys):
+    """--force wrote its fig2.png over a file of the user's in --figures (its help: never files
+    it did not write). A figure the report drew, or one its own markdown shows, is replaced."""
+    folder, done = tiny_report
+    drawn = folder / Path(json.loads(done.stdout)["report"]).parent / "figures"
+    mine, theirs = tmp_path / "mine", tmp_path / "theirs"
+    shutil.copytree(drawn, theirs)
+    mine.mkdir()
+    (mine / "fig2.png").write_bytes(b"\x89PNG\r\n\x1a\n my own plot, drawn by hand")
+    with pytest.raises(OutputRefused, match=r"fig2.png was not drawn by frictionlab report: .* --force or not"):
+        report_paths(tmp_path / "out", tmp_path / "mine.md", mine, force=True)
+    assert (mine / "fig2.png").read_bytes().endswith(b"drawn by hand")
+    report_paths(tmp_path / "out", tmp_path / "again.md", theirs, force=True)  # each bears the report's mark
+    capsys.readouterr()
+
+
+def test_force_replaces_the_unmarked_figures_an_earlier_report_s_markdown_shows(tiny_report, tmp_path):
+    """A report drawn before its figures carried a mark: its own markdown's image links name them."""
+    folder, done = tiny_report
+    report = Path(json.loads(done.stdout)["report"])
+    figures = tmp_path / "figures"
+    figures.mkdir()
+    for name in ("fig2.png", "fig3.png"):
+        (figures / name).write_bytes(b"\x89PNG\r\n\x1a\n an older report's figure, unmarked")
+    markdown = tmp_path / "REPRODUCTION.md"
+    shutil.copy(folder / report, markdown)  # links figures/fig2.png ... as a report in tmp_path would
+    report_paths(tmp_path / "out", markdown, figures, force=True)
+    markdown.write_text(markdown.read_text().replace("](figures/fig3.png)", "](elsewhere/fig3.png)"))
+    with pytest.raises(OutputRefused, match=r"fig3.png was not drawn by frictionlab report"):
+        report_paths(tmp_path / "out", markdown, figures, force=True)
