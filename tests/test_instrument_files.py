@@ -461,3 +461,27 @@ def test_an_sdf_with_a_byte_order_mark_is_named_as_such_not_as_another_format(tm
     with pytest.raises(ValueError, match="starts with a UTF-8 byte-order mark .* save it without one") as refused:
         SurfaceFile(path=str(tmp_path / "marked.sdf")).rms_height()
     assert "damaged" not in str(refused.value) and "another format" not in str(refused.value)
+
+
+def test_a_damaged_file_whose_reader_logs_its_bytes_is_said_in_one_problem_only(tmp_path, caplog):
+    """igor2 logs 'could not reshape data from (N,) to b'...'' (the file's bytes, 5 kB a line)
+    before it raises; with no logging set up, Python printed that twice on stderr."""
+    import io
+    import logging
+
+    from igor2 import binarywave
+
+    damaged = b"\x05\x00" + np.random.default_rng(3).bytes(2000)  # a version 5 wave's first bytes, then noise
+    with caplog.at_level(logging.ERROR, logger="igor2"), pytest.raises(Exception):
+        binarywave.load(io.BytesIO(damaged))
+    assert any("could not reshape" in record.getMessage() for record in caplog.records)  # the reader does log
+    (tmp_path / "wave.ibw").write_bytes(damaged)
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset(tmp_path / "wave.ibw", "um")))
+    import subprocess  # a process of its own: pytest's log capture would hide logging's last resort
+
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "validate", str(tmp_path / "p.yaml")],
+                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert done.returncode == ExitCode.USAGE
+    err = done.stderr + done.stdout
+    assert "could not reshape" not in err and "\\x" not in err
+    assert "a damaged Igor binary wave file" in err and len(err.splitlines()) <= 3

@@ -13,6 +13,7 @@ chooses ``undefined: harmonic``.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
@@ -65,8 +66,7 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
     """The shape and periodicity ``read_scan`` gives, from the reader's metadata alone: what
     the memory estimate needs before a run reads the file. None when the metadata does not
     say, or says another dimension (``read_scan`` then reads the file and names the problem)."""
-    with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
-        warnings.simplefilter("ignore")
+    with open_input(path, where) as fh, _readers_quiet(), ExitStack() as stack:
         try:
             reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
             check_payload(fh, type(reader), where, checksum=False)  # a shape its heights do not fill is no map's
@@ -84,6 +84,21 @@ def scan_header(path: Path, where: str, *, dimension: int, channel: str | int | 
         along = 0 if shape[1] == 1 else 1
         return ScanHeader((shape[along],), periodic, None if pixel is None else pixel[along : along + 1], unit)
     return ScanHeader(shape[::-1], periodic, pixel, unit) if len(shape) == dimension else None  # (Nx, Ny): z is (Ny, Nx)
+
+
+@contextmanager
+def _readers_quiet():
+    """Readers warn and log about their own internals (mmap, metadata; igor2 logged a damaged
+    file's bytes, 5 kB a line, through logging's last resort): what is wrong with the file is
+    said once, by the ValueError naming it."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        before = logging.root.manager.disable
+        logging.disable(logging.CRITICAL)
+        try:
+            yield
+        finally:
+            logging.disable(before)
 
 
 STREAM_ONLY = ("mitutoyo",)  # readers that judge a name by its suffix (openpyxl: .xlsx), which a descriptor's lacks
@@ -183,8 +198,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
     ``undefined``: ``refuse``, ``harmonic``, or ``keep`` (left NaN, for a crop to check).
     ``spacing_given``: the preset gives the pixel side, so a file that states no physical
     size is read (its pixel a placeholder of 1, ``Scan.pixel_stated`` false) rather than refused."""
-    with open_input(path, where) as fh, warnings.catch_warnings(), ExitStack() as stack:
-        warnings.simplefilter("ignore")  # readers warn about their own internals (mmap, metadata)
+    with open_input(path, where) as fh, _readers_quiet(), ExitStack() as stack:
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
         check_channel_of_heights(reader, chosen, where)
