@@ -5,14 +5,12 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import sys
-import threading
 import time
 from pathlib import Path
 
 from ..errors import ExitCode, command_word, shown, shown_name
-from ..compute.signals import ENDINGS, install
+from ..compute.signals import ENDINGS, SignalsNoted
 
 POLL_SECONDS = 0.2
 EXAMPLES = """examples:
@@ -40,32 +38,6 @@ def add_parser(sub) -> None:
     p.set_defaults(handler=run)
 
 
-class _StopSignals:
-    """Within the block, Ctrl-C, SIGTERM and SIGHUP are noted (``signal``) instead of raised: raised
-    at any line they could stop a progress bar while it holds its lock, and closing the bar
-    then waits for ever on the thread that draws it."""
-
-    def __init__(self):
-        self.signal: int | None = None
-        self._noted = threading.Event()
-        self._previous: dict[int, object] = {}
-
-    def _note(self, signum, frame) -> None:
-        self.signal = signum
-        self._noted.set()
-
-    def wait(self, seconds: float) -> None:
-        self._noted.wait(seconds)
-
-    def __enter__(self):
-        self._previous = install(self._note)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for signum, handler in self._previous.items():
-            signal.signal(signum, handler)
-
-
 def run(args) -> ExitCode:
     from ..runs.detached import logged_error, logged_warnings, process_alive, run_state
     from .resume import refuse_a_part_of_a_run
@@ -86,7 +58,7 @@ def run(args) -> ExitCode:
     if state.status == "running":
         follower = _follower(folder, sweep, args.quiet)
         counter = None if args.quiet else _ChunkCount(follower.reader, folder, sweep)
-        stopped = _StopSignals()  # a signal is noted and acted on between polls, never raised mid-draw
+        stopped = SignalsNoted()  # acted on between polls: raised mid-draw, it left the bar's lock held for ever
         try:
             try:
                 with stopped:

@@ -308,11 +308,15 @@ def run(args) -> ExitCode:
         study.run()
     except KeyboardInterrupt:
         interrupted = True
-    text = recommendation(study)
-    try:
-        files = write_outputs(study, out_dir, text, command_line(args))
-    except OSError as exc:  # a full disk: what was measured is kept elsewhere, never measured again
-        _kept_elsewhere(study, out_dir, text, args, exc)
+    from ..compute.signals import SignalsNoted
+
+    with SignalsNoted() as held:  # a signal among the writes left study.csv without its study.md: the folder was refused
+        text = recommendation(study)
+        try:
+            files = write_outputs(study, out_dir, text, command_line(args))
+        except OSError as exc:  # a full disk: what was measured is kept elsewhere, never measured again
+            _kept_elsewhere(study, out_dir, text, args, exc)
+    interrupted = interrupted or held.signal is not None
     if args.json:
         from ..compute.fit import json_safe
         from ..tradeoff.axes import COLUMNS

@@ -97,6 +97,35 @@ class RunInterrupted(KeyboardInterrupt):
 _in_command = False  # within RaiseOnSignals: a signal received ends the command, not only its run
 
 
+class SignalsNoted:
+    """Within the block, Ctrl-C, SIGTERM and SIGHUP are noted (``signal``, the last one; each
+    in ``received``) instead of raised: the caller acts on them where it chooses (between two
+    polls, once a set of files is all written). Outside the main thread it notes nothing."""
+
+    def __init__(self):
+        self.signal: int | None = None
+        self._noted = threading.Event()
+        self._previous: dict[int, object] = {}
+
+    def _note(self, signum, frame) -> None:
+        received.append(signum)
+        self.signal = signum
+        self._noted.set()
+
+    def wait(self, seconds: float) -> None:
+        """Sleep ``seconds``, or less if a signal comes."""
+        self._noted.wait(seconds)
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._previous = install(self._note)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+
+
 class RaiseOnSignals:
     """While a command runs: SIGTERM raises Terminated and Ctrl-C KeyboardInterrupt (as
     Python's own handler does), each recorded in ``received``; earlier signals are
