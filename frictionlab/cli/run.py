@@ -246,6 +246,7 @@ def resumable(out_dir: Path) -> str:
 def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     from ..compute.signals import interrupted_exit_code
     from ..runs.runner import memory_check_before_reading
+    from ..runs.settled import why_no_resume_helps
     from ..runs.sweep import plan_sweep, run_sweep
     from ..progress import SweepProgress
 
@@ -269,7 +270,10 @@ def run_sweep_into(args, data: dict, out_dir: Path, options) -> ExitCode:
     if outcome.status == "failed":  # said on stderr as a run's failure is, under --quiet and --json too
         failed = [result for result in outcome.results if result.failure]
         first = f"; first: point {failed[0].point.number}: {failed[0].failure}" if failed else ""
-        print(shown(f"error: {len(failed)} of {counted(len(sweep.points), 'point')} failed{first}; {resumable(out_dir)}"),
+        settled = why_no_resume_helps(out_dir)[0] == "sweep"  # each failed its fit with every realization done
+        then = ("a resume would compute nothing new and fail the same way: change the preset as that says (other "
+                "loads, more realizations) and run it into a new folder" if settled else resumable(out_dir))
+        print(shown(f"error: {len(failed)} of {counted(len(sweep.points), 'point')} failed{first}; {then}"),
               file=sys.stderr)  # fmt: skip
         return ExitCode.RUNTIME_FAILURE
     return ExitCode.OK

@@ -66,7 +66,10 @@ def test_resume_of_a_sweep_whose_only_failures_are_no_law_fits_is_refused_naming
     A point that can go on (here one whose row says it was in error) makes the sweep resumable."""
     preset = write_preset(tmp_path, NO_LAW_SWEEP)
     out = tmp_path / "sw"
-    assert cli("run", preset, "--out", out, "--workers", "1", "--quiet", "--no-plot").returncode == ExitCode.RUNTIME_FAILURE
+    ran = cli("run", preset, "--out", out, "--workers", "1", "--quiet", "--no-plot")
+    assert ran.returncode == ExitCode.RUNTIME_FAILURE
+    assert "frictionlab resume" not in ran.stderr  # it advised the resume refused below
+    assert "a resume would compute nothing new and fail the same way" in ran.stderr
     before = files_of(out)
     for args in (["resume", out], ["run", preset, "--out", out, "--resume"]):
         done = cli(*args, "--no-plot")
