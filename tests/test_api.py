@@ -471,3 +471,15 @@ def test_numpy_bools_are_taken_as_flags(tmp_path):
                              out=tmp_path / "run")  # fmt: skip
     assert result.status == "completed"
     assert not (tmp_path / "run" / "plot.png").exists()
+
+
+@pytest.mark.parametrize("swept", [False, True])
+def test_a_resume_into_a_folder_that_is_not_there_is_refused_and_makes_none(tmp_path, swept):
+    """The API made the folder, then refused it as holding no run (left behind empty); a sweep's
+    resume ran afresh. The CLI (run --resume --out NEW) made nothing."""
+    preset = merge(SMALL_PRESET, {"realizations": 2, "output": {"plot": False}})
+    if swept:
+        preset["sweep"] = {"parameters": {"spectrum.params.hurst": {"values": [0.6, 0.8]}}}
+    with pytest.raises(RunFolderError, match="is not a run folder to resume \\(it does not exist"):
+        frictionlab.run(preset, out=tmp_path / "new", resume=True, workers=1, progress=False)
+    assert not (tmp_path / "new").exists()

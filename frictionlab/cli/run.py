@@ -102,6 +102,7 @@ def _run(args, drawer) -> ExitCode:
     from ..preset import build_scene, read_preset
     from ..preset.builtin import preset_source, resolve_preset_path, same_name_note
     from ..runs.rundir import PRESET_FILE, new_run_folder
+    from ..runs.runfolder import refuse_nothing_to_resume
     from ..runs.runner import memory_check_before_reading
 
     overrides = preset_overrides(args)
@@ -129,8 +130,8 @@ def _run(args, drawer) -> ExitCode:
         raise FrictionlabError(f"--out {too_long}")
     if args.resume and not args.out:
         raise FrictionlabError("--resume needs the run directory: give --out DIR (or use `frictionlab resume DIR`).")
-    if args.resume and not Path(args.out).is_dir():
-        raise RunFolderError(f"{shown_name(args.out)} is not a run folder to resume (it does not exist, or is not a folder)")
+    if args.resume:
+        refuse_nothing_to_resume(args.out)
     out_dir = args.out_dir = Path(args.out) if args.out else new_run_folder(scene.preset.name)  # named if memory runs out
     from ..io.files import real_path
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..compute.dask_session import one_dask_cluster
 from ..errors import OutputRefused, first_names, shown_name, write_failed
-from ..io.inputs import InputFileProblem, open_regular_file
+from ..io.inputs import InputFileProblem, open_regular_file, read_regular_file
 from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
 from ..options import RunOptions
 from ..runs.rundir import new_run_folder
@@ -27,7 +27,7 @@ from .readings import (CALIBRATED_FOLDER, READINGS, READINGS_FOLDER, check_readi
 
 MARK_BYTES = 4096  # of a PNG: matplotlib writes its text chunks right after the header
 MARK_CHUNK = b"tEXtSoftware\x00" + FIGURE_MARK["Software"].encode()
-MAX_MARKDOWN_BYTES = 1 << 20  # of a report's markdown, read for its image links (one is about 20 kB)
+MAX_MARKDOWN_BYTES = 16 << 20  # of a report's markdown, read for its image links (one is about 20 kB)
 FIGURE_FILES = ("fig2.png", "fig3.png", "fig4.png", "fig5.png", "fig5-calibrated.png")
 DEFAULT_MARKDOWN, DEFAULT_FIGURES = "REPRODUCTION.md", "figures"  # in --out
 
@@ -164,9 +164,8 @@ def _linked_figures(markdown_path: Path | None) -> set[str]:
     if markdown_path is None or not os.path.lexists(markdown_path):
         return set()
     try:
-        with open_regular_file(markdown_path, follow_links=False) as fh:
-            text = fh.read(MAX_MARKDOWN_BYTES).decode("utf-8", "replace")
-    except (InputFileProblem, OSError):
+        text = read_regular_file(markdown_path, MAX_MARKDOWN_BYTES, follow_links=False).decode("utf-8", "replace")
+    except (InputFileProblem, OSError):  # a link, a FIFO, one too long: no report's
         return set()
     if not text.startswith(HEADING + "\n"):
         return set()

@@ -489,3 +489,10 @@ def _not_to_signal(pid: int) -> str | None:
     except OSError:
         return "gone, or not this user's"
     return None if owner == os.getuid() else "another user's"
+
+
+def refuse_nothing_to_resume(out_dir: str | Path) -> None:
+    """A resume into a folder that is not there: refused before anything is made (the folder
+    was made, then refused as holding no run, and left behind empty)."""
+    if not os.path.isdir(out_dir):
+        raise RunFolderError(f"{shown_name(out_dir)} is not a run folder to resume (it does not exist, or is not a folder)")

@@ -17,7 +17,7 @@ from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
 from ..preset import Scene
 from .import_ahead import PlotImportAhead
-from .runfolder import MAX_WALL_SECONDS
+from .runfolder import MAX_WALL_SECONDS, refuse_nothing_to_resume
 from .results import add_plot, holds_results, plot_path, read_summary, results_on_disk, write_results
 from ..compute.realization import RealizationResult
 from .rundir import RunDirectory
@@ -131,6 +131,8 @@ def run_to_folder(
     ``drawer`` (``figures.DrawingProcess``) where one is given, sent the figure as soon as the
     fit exists. Returns the outcome and the paths of the files written.
     """
+    if options.resume:
+        refuse_nothing_to_resume(out_dir)
     if options.memory_check:
         check_memory(scene, options)
     check_loads(scene)  # a unit the solver cannot take, a load past its arithmetic: before the folder is touched

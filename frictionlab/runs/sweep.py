@@ -40,7 +40,7 @@ from ..plugin.registry import Registry, default_registry
 from .import_ahead import PLOT_MODULE, imported
 from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
-from .runfolder import make_subfolder
+from .runfolder import make_subfolder, refuse_nothing_to_resume
 from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, stored_sweep, write_tables
 from .sweeprecord import read_sweep_record
 from ..compute.memory import estimate
@@ -399,6 +399,8 @@ def run_sweep(
     ``options.force``. It holds the folder's lock (``run.lock``) while it runs, and its sweep.json says
     "running" until the end: a sweep whose process died reads as interrupted (``detached.run_state``)."""
     out_dir = Path(out_dir)
+    if options.resume:
+        refuse_nothing_to_resume(out_dir)
     check_sweep_folder(sweep, out_dir, options.force)
     check_sweep_memory(sweep, options)
     listeners = list(listeners)
