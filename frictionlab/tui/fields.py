@@ -17,7 +17,7 @@ from typing import Any, Literal
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
-from ..errors import PresetError
+from ..errors import PresetError, shown
 from ..io.inputs import describe_input, input_fields
 from ..plugin import KINDS
 from ..preset import MISSING, Preset, build_scene, resolve_input_paths
@@ -133,8 +133,8 @@ def display(value) -> str:
         return ""
     if isinstance(value, float):
         return repr(value)
-    if isinstance(value, str):
-        return " ".join(value.split("\n")).strip()  # an input is one line (YAML folds keep a newline)
+    if isinstance(value, str):  # one line (YAML folds keep a newline); an escape sequence in the file shown escaped
+        return shown(" ".join(value.split("\n")).strip())
     return str(value)
 
 

@@ -42,3 +42,34 @@ async def test_the_presets_and_results_lists_name_a_file_on_one_row(folders, reg
         await pilot.pause()
     odd = [row for row in rows if row.endswith("p\\n\\t\\x1b[31mx.yaml")]
     assert odd and not any("\n" in row or "\x1b" in row for row in rows), rows
+
+
+OSC = "\x1b]0;PWNED\x07"  # sets the terminal's title; its BEL dropped, it swallowed the text after it
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="control characters in file names")
+@sync
+async def test_a_preset_s_own_text_with_escape_codes_is_drawn_as_text_everywhere(folders, registry):
+    """The preset's description under the list, its path line and the Edit form's fields wrote
+    the file's escape codes to the terminal (the pane's title changed, the screen was cleared)."""
+    import yaml
+
+    from frictionlab.tui.widgets.pathline import PathLine
+    from frictionlab.tui.widgets.presets import PresetsPane
+
+    data = yaml.safe_load((folders / "presets" / "tiny.yaml").read_text())
+    data.update(name=f"red\x1b[31m{OSC}", description=f"A {OSC} B\x1b[2J")
+    odd = folders / "presets" / f"f{OSC}.yaml"
+    odd.write_text(yaml.safe_dump(data))
+    app = make_app(registry)
+    async with started(app) as pilot:
+        pane = app.query_one(PresetsPane)
+        pane.highlight(odd)
+        await pilot.pause()
+        drawn = [str(pane.query_one("#preset-info").render()), str(pane.query_one("#preset-path", PathLine).render())]
+        await press_settled(pilot, "enter")  # opens it in the Edit tab's form
+        drawn += [field.value for field in app.query(Input)]
+    assert any("A \\x1b]0;PWNED\\x07 B\\x1b[2J" in text for text in drawn), drawn  # the description
+    assert any("\\x1b]0;PWNED\\x07.yaml" in text for text in drawn), drawn  # the path line
+    assert any(text.startswith("red\\x1b[31m") for text in drawn), drawn  # the name's field
+    assert not any("\x1b" in text or "\x07" in text for text in drawn), drawn

@@ -19,19 +19,11 @@ from textual.message import Message
 from textual.widget import Widget
 from textual.widgets import Input, Label, Select, Static, Switch
 
+from ...errors import shown
 from ...plugin import KINDS
 from ...preset import MISSING, Preset, get_path, set_path
-from ..fields import (
-    FieldSpec,
-    default_plugin_name,
-    display,
-    field_specs,
-    parse,
-    problem_path,
-    problems_for,
-    shared_params,
-    validation_of,
-)
+from ..fields import (FieldSpec, default_plugin_name, display, field_specs, parse, problem_path, problems_for,
+                      shared_params, validation_of)  # fmt: skip
 from ..hiddenkeys import idle_sideways
 from .keyinput import FieldInput
 
@@ -145,7 +137,7 @@ class PresetForm(VerticalScroll):
                 yield Static("", id=_section_id(spec.path), classes="field-error")
         unknown = [key for key in self.data if key not in Preset.model_fields]
         if unknown:
-            yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(map(str, unknown))}"), classes="note")
+            yield Static(Content(f"Kept as in the file (edit the YAML to change): {', '.join(shown(k) for k in unknown)}"), classes="note")
 
     @property
     def swept(self) -> dict[str, object]:
@@ -186,9 +178,9 @@ class PresetForm(VerticalScroll):
             )
             widget.cursor_position = len(widget.value) if spec.kind == "text" else 0  # typing adds to a name
         else:  # mappings, lists, optional sections (a sweep): shown whole, kept, edited in the YAML
-            shown = "(none)" if value in (MISSING, None) else flow_text(value)
+            text = "(none)" if value in (MISSING, None) else shown(flow_text(value))
             # Content, not markup: a shortened value can hold an unclosed "[" (a sweep's list)
-            note = Content.assemble(shown, "  ", ("(edit in the YAML)", "dim"))
+            note = Content.assemble(text, "  ", ("(edit in the YAML)", "dim"))
             widget = Static(note, id=spec.widget_id, classes="other")
         if spec.kind == "bool":
             self._seen[spec.widget_id] = bool(current)
@@ -292,9 +284,9 @@ class PresetForm(VerticalScroll):
             self._store(spec, parse(spec, event.value))
 
     def on_switch_changed(self, event: Switch.Changed) -> None:
-        shown = self.query(f"#{event.switch.id}--state")
-        if shown:
-            shown.first().update(_on_off(event.value))
+        state = self.query(f"#{event.switch.id}--state")
+        if state:
+            state.first().update(_on_off(event.value))
         spec = self._specs.get(event.switch.id or "")
         if spec is not None and self.data is not None and self._is_new(spec.widget_id, event.value):
             event.stop()
@@ -343,19 +335,19 @@ class PresetForm(VerticalScroll):
         self.problems, read = [], ""
         if self.data is not None:
             self.problems, read = validation_of(self.data, self.registry, self.base_dir)
-        shown = set()
+        placed = set()  # problems shown under a field
         for widget_id, spec in self._specs.items():
             messages = problems_for(self.problems, spec.dotted)
-            shown.update(messages)
+            placed.update(messages)
             self._set_error(widget_id, messages)
         for slot in KINDS:
             messages = problems_for(self.problems, f"{slot}.name")
-            shown.update(messages)
+            placed.update(messages)
             self._set_error(f"field--{slot}--name", messages, field_id=f"plugin--{slot}")
         for section in self.query(".field-error"):
             if section.id and section.id.startswith("section--"):
                 dotted = section.id.removeprefix("section--").replace("--", ".")
-                messages = [p for p in self.problems if p not in shown and problem_path(p) == dotted]
+                messages = [p for p in self.problems if p not in placed and problem_path(p) == dotted]
                 if self._marked.get(section.id, []) != messages:
                     self._marked[section.id] = messages
                     section.update(Content("\n".join(messages)))
@@ -375,8 +367,8 @@ class PresetForm(VerticalScroll):
             return
         if field_id is None:
             field.set_class(bool(messages), "-invalid")
-        if shown := self.query(f"#{widget_id}--error"):
-            label = shown.first(Static)
+        if existing := self.query(f"#{widget_id}--error"):
+            label = existing.first(Static)
         elif messages:  # under its row, in the form or in a plugin's parameters
             label = Static(id=f"{widget_id}--error", classes="field-error")
             field.parent.parent.mount(label, after=field.parent)

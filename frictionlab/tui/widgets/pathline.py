@@ -5,6 +5,7 @@ from __future__ import annotations
 from textual.content import Content
 from textual.widget import Widget
 
+from ...errors import shown
 from ..text import shorten_middle
 
 
@@ -24,4 +25,4 @@ class PathLine(Widget):
 
     def render(self) -> Content:
         room = max(self.size.width - len(self.head) - len(self.tail), 12)
-        return Content.assemble((self.head, "bold"), shorten_middle(self.path, room), self.tail)
+        return Content.assemble((self.head, "bold"), shorten_middle(shown(self.path), room), self.tail)  # a name's escape codes as text

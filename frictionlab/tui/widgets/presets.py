@@ -12,7 +12,7 @@ from textual.containers import Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import DataTable, Static
 
-from ...errors import shown_name
+from ...errors import shown, shown_name
 from ...io.files import real_path
 from ..folders import PresetEntry, list_presets
 from ..hiddenkeys import SaysWhyUnavailable, said_when_hidden
@@ -115,7 +115,7 @@ class PresetsPane(SaysWhyUnavailable, Vertical):
             entry = self.presets[row]
             text = entry.error or entry.description or "(no description)"
             self.query_one("#preset-path", PathLine).show("", str(entry.path))
-            self.query_one("#preset-info", Static).update(Content(text))
+            self.query_one("#preset-info", Static).update(Content(shown(text)))  # an escape sequence in the file: text
             self.query_one("#preset-info-box").scroll_home(animate=False)  # a description is read from its start
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
