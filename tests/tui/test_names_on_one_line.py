@@ -73,3 +73,18 @@ async def test_a_preset_s_own_text_with_escape_codes_is_drawn_as_text_everywhere
     assert any("\\x1b]0;PWNED\\x07.yaml" in text for text in drawn), drawn  # the path line
     assert any(text.startswith("red\\x1b[31m") for text in drawn), drawn  # the name's field
     assert not any("\x1b" in text or "\x07" in text for text in drawn), drawn
+
+
+@sync
+async def test_a_question_quoting_an_escape_code_draws_it_as_text(folders, registry):
+    from textual.widgets import Static
+
+    from frictionlab.tui.screens.dialogs import ConfirmScreen
+
+    app = make_app(registry)
+    async with started(app) as pilot:
+        app.push_screen(ConfirmScreen(f"Discard presets/f{OSC}.yaml?"))
+        await pilot.pause()
+        drawn = [str(static.render()) for static in app.screen.query(Static)]
+    assert any("presets/f\\x1b]0;PWNED\\x07.yaml" in text for text in drawn), drawn
+    assert not any("\x1b" in text for text in drawn), drawn

@@ -356,6 +356,18 @@ async def test_the_preview_shows_what_an_instrument_file_gave(folders, registry)
 
 
 @sync
+async def test_the_preview_names_a_file_whose_name_looks_like_markup_as_it_is(folders, registry):
+    """The panel took what was read as markup: '[b]map.npy' was drawn as a bold 'map.npy'."""
+    np.save(folders / "presets" / "[b]map.npy", np.random.default_rng(2).normal(size=(16, 12)))
+    spectrum = {"name": "surface-file", "params": {"path": "[b]map.npy", "unit": "um", "spacing": 0.5}}
+    write_preset(folders, "tiny", {**TINY, "spectrum": spectrum, "solver": {"name": "winkler"}})
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app):
+        panel = str(app.query_one("#problems").render())
+    assert panel.startswith("valid: Ctrl+R runs it") and "read [b]map.npy (.npy)" in panel, panel
+
+
+@sync
 async def test_an_unreadable_profile_file_is_refused_before_a_run_with_its_message(folders, registry):
     """The validator reads a measured profile (as `frictionlab validate` does): Ctrl+R
     refuses the preset with the file's own message instead of running it to fail."""

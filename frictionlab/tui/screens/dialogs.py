@@ -13,7 +13,7 @@ from textual.content import Content
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Select, Static
 
-from ...errors import shown_name
+from ...errors import shown, shown_name
 from ...io.inputs import expand_user
 from ...preset.problems import shown_value
 from ...preset.schema import NAME_PATTERN, NAME_RULE
@@ -133,7 +133,7 @@ class ConfirmScreen(Dialog, ModalScreen[bool]):
         self.question = question
 
     def body(self) -> ComposeResult:
-        yield Static(Content(self.question))  # it quotes problems and paths: text, not markup
+        yield Static(Content(shown(self.question)))  # it quotes problems and paths: text, never markup nor escape codes
         yield Label("y: yes    n / Esc: no", classes="hint")
 
     def action_answer(self, value: bool) -> None:
@@ -168,7 +168,7 @@ class QuitDuringRunScreen(Dialog, ModalScreen[str | None]):
         self.question = question
 
     def body(self) -> ComposeResult:
-        yield Static(Content(self.question))
+        yield Static(Content(shown(self.question)))
         yield Label("l: leave it running and quit    c: cancel it and quit    Esc: stay", classes="hint")
 
     def action_answer(self, value: str | None) -> None:
@@ -225,7 +225,7 @@ class PathScreen(Dialog, ModalScreen[Path | None]):
         self.confirmed: Path | None = None  # an existing file the user pressed Enter on once
 
     def body(self) -> ComposeResult:
-        yield Label(Content(self.title_text), classes="heading")
+        yield Label(Content(shown(self.title_text)), classes="heading")
         yield SubmitInput(str(self.default), "Save", name="path", id="path-input")
         yield Static("", id="path-error", classes="field-error")
         yield Label("Enter: save    Esc: cancel", classes="hint")

@@ -10,6 +10,7 @@ from textual.containers import Vertical, VerticalScroll
 from textual.content import Content
 from textual.widgets import Static
 
+from ...errors import shown
 from .form import PresetForm, flow_text
 from .pathline import PathLine
 
@@ -51,7 +52,8 @@ class EditPane(Vertical):
             panel.update(Content.assemble(head, " (as frictionlab validate says):\n", "\n".join(problems)))
             panel.set_class(True, "-invalid")
         else:
-            panel.update("valid: Ctrl+R runs it, Ctrl+S saves it" + (f"\n{read}" if read else ""))
+            # text, never markup: what was read names the file ('[b]scan.npy' lost its '[b]')
+            panel.update(Content(shown("valid: Ctrl+R runs it, Ctrl+S saves it" + (f"\n{read}" if read else ""))))
             panel.set_class(False, "-invalid")
 
     def on_preset_form_field_focused(self, event: PresetForm.FieldFocused) -> None:
