@@ -553,3 +553,24 @@ def test_a_spike_on_a_line_level_but_for_rounding_says_the_rest_level_not_a_rati
     said = line_spike_warning(z, float(np.sqrt(np.mean(z**2))), 1.0)
     assert f"(its rms slope is {np.sqrt(np.mean(np.diff(z) ** 2)):.3g}, the rest level)" in said, said
     assert "times what it is without them" not in said
+
+
+@pytest.mark.parametrize("line", [False, True])
+def test_a_spike_that_alone_makes_a_scan_steep_is_not_called_a_unit_mismatch(line):
+    """One spike 1000 rms heights high made the rms slope 20 or more: the units caveat then advised
+    converting a file whose heights and pixels agreed. A scan steep without its spike still gets it."""
+    from frictionlab_spectra.scan_shaping.height_caveats import SLOPES, units_warning
+    from frictionlab_spectra.scan_shaping.spikes import mean_square_slope
+
+    rng = np.random.default_rng(np.random.SeedSequence(5))
+    z = rng.standard_normal(4096 if line else (128, 128))  # rms slope about 2: a rough, plausible scan
+    z -= z.mean()
+    spiked = z.copy()
+    spiked[(2000,) if line else (40, 60)] += 1000.0
+    rows = spiked.reshape(1, -1) if line else spiked
+    assert math.sqrt(mean_square_slope(rows, (1.0, 1.0))) > SLOPES[1]  # steep by its spike alone
+    summary = {"unit": "um", "unit_from": "preset", "spacing_from": "preset"}
+    what = "line" if line else "map"
+    assert units_warning(spiked, 1.0, summary, what) is None
+    assert "different units" in units_warning(spiked * 1e6, 1.0, summary, what)  # heights 1e6 times: steep without it
+    assert "different units" in units_warning(spiked * 1e-8, 1.0, summary, what)  # flat: below the range

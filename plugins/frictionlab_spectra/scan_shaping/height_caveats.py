@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .spikes import mean_square_slope
+from .spikes import SPIKE_K, despike, mean_square_slope
 
 FLAT = 1e-12  # an rms height below this share of the largest height is the rounding of the numbers: flat
 OUTLIER_RATIO = 5.0  # rms height over the robust one: Gaussian heights 1, a sine's 0.67, a map with a sentinel 100s
@@ -111,8 +111,9 @@ def units_warning(z: np.ndarray, spacing: float, summary: dict, what: str) -> st
     (heights in m beside pixels in um: slopes 1e-6 times a surface's). xi against f does not
     change with the ratio, but the force unit E* h L and E* g do, so F and p/E* are off by it.
     ``summary`` (the input summary) says which unit each was taken in and from where."""
-    slope = math.sqrt(mean_square_slope(z if z.ndim == 2 else z.reshape(1, -1), (spacing, spacing)))
-    if SLOPES[0] <= slope <= SLOPES[1] or not math.isfinite(slope):
+    rows = z if z.ndim == 2 else z.reshape(1, -1)
+    slope = math.sqrt(mean_square_slope(rows, (spacing, spacing)))
+    if SLOPES[0] <= slope <= SLOPES[1] or not math.isfinite(slope) or (slope > SLOPES[1] and _spikes_steepen(rows, spacing)):
         return None
     unit = summary.get("unit")
     heights = f"heights in {unit}" if unit else "heights in no stated unit"
@@ -129,3 +130,15 @@ def units_warning(z: np.ndarray, spacing: float, summary: dict, what: str) -> st
             "(heights in m beside pixels in um: a millionth of the slope). xi against f does not change, but the force "
             "unit E* h L and the full-contact pressure E* g are off by the ratio of the units, and with them every "
             "F and p/E*: give the heights in the unit of the pixel side (unit, spacing), or convert the file")  # fmt: skip
+
+
+def _spikes_steepen(rows: np.ndarray, spacing: float) -> bool:
+    """Whether the map (or line, one row) is steeper than SLOPES only by what ``despike: 6``
+    replaces: the spike caveat says so, and the units agree (a spike 1000 rms heights high made
+    this caveat advise converting a file whose units were right)."""
+    rms = math.sqrt(float(np.mean(np.square(rows))))
+    try:
+        cleaned, count = despike(rows, SPIKE_K, rms)
+    except ValueError:  # too many points for spikes: not what makes it steep
+        return False
+    return count > 0 and math.sqrt(mean_square_slope(cleaned, (spacing, spacing))) <= SLOPES[1]
