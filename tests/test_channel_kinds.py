@@ -113,3 +113,14 @@ def test_a_signal_in_metres_first_in_the_file_is_passed_over_for_the_height_chan
                           "was taken (channel: 0 takes the other)") in text
     asked = SurfaceFile(path=str(path), unit="nm", detrend="mean", channel=0).input_summary()
     assert asked["channel"] == signal and "channel_note" not in asked
+
+
+def test_the_channels_of_heights_offered_leave_out_a_signal_named_so():
+    """An amplitude in m is in a length unit, yet no heights (the default channel's note says so):
+    the refusal offered it beside the heights. Where only such channels are in lengths, they are offered."""
+    reader = Listing(units=(("Amplitude", "m"), ("Height", "m"), ("Current", "A")))
+    with pytest.raises(ValueError, match=r"choose a channel of heights with channel \(1: 'Height'\), or export"):
+        check_channel_of_heights(reader, reader.channels[2], "scan")
+    only = Listing(units=(("Amplitude", "m"), ("Current", "A")))
+    with pytest.raises(ValueError, match=r"choose a channel of heights with channel \(0: 'Amplitude'\), or export"):
+        check_channel_of_heights(only, only.channels[1], "scan")

@@ -4,7 +4,7 @@ AFM's signal other than heights; refusals list the channels to choose from."""
 
 from __future__ import annotations
 
-from .instrument_reader import quoted
+from .instrument_reader import HEIGHT_WORDS, SIGNAL_WORDS, names_a_signal, quoted, says
 
 
 LEFT_OUT = " (most readers list channels of heights only: one in degrees, volts or no unit may be left out)"
@@ -41,18 +41,11 @@ def pick_channel(reader, wanted: str | int | None, where: str):
     return channel, note
 
 
-SIGNAL_WORDS = ("amplitude", "deflection", "error", "phase", "friction", "lateral", "adhesion", "dissipation")
-HEIGHT_WORDS = ("height", "topograph", "z sensor")
-
-
 def _default_channel(default, channels):
     """The reader's default channel, unless its name is an AFM's signal other than heights (an
     amplitude or a deflection error, in m like heights) and another's names heights: then the
     first of those, and a note saying so."""
-    def says(channel, words):
-        return any(word in str(channel.name).casefold() for word in words)
-
-    if not says(default, SIGNAL_WORDS) or says(default, HEIGHT_WORDS):
+    if not names_a_signal(default):
         return default, None
     heights = [c for c in channels if says(c, HEIGHT_WORDS) and not says(c, SIGNAL_WORDS)]
     if not heights:

@@ -212,10 +212,27 @@ def check_channel_of_heights(reader, channel, where: str) -> None:
     else:
         said = f"values in {quoted(data_unit)}" if data_unit else "values without a unit"
         what = f"{'' if kind in ('height', 'other') else kind + ' '}{said}, not heights"
-    heights = [f"{int(c.index)}: {quoted(c.name)}" for c in reader.channels if _not_heights(reader, c) is None]
+    lengths = [c for c in reader.channels if _not_heights(reader, c) is None]
+    named = [c for c in lengths if not names_a_signal(c)] or lengths  # an amplitude in m is no height either
+    heights = [f"{int(c.index)}: {quoted(c.name)}" for c in named]
     choose = f"choose a channel of heights with channel ({', '.join(heights)})" if heights else "the file holds no channel of heights"
     raise ValueError(f"{where}: channel {channel.index} ({quoted(channel.name)}) holds {what}: {choose}, or export "
                      "the height channel alone")  # fmt: skip
+
+
+SIGNAL_WORDS = ("amplitude", "deflection", "error", "phase", "friction", "lateral", "adhesion", "dissipation")
+HEIGHT_WORDS = ("height", "topograph", "z sensor")
+
+
+def says(channel, words) -> bool:
+    """Whether the channel's name holds one of ``words``."""
+    return any(word in str(channel.name).casefold() for word in words)
+
+
+def names_a_signal(channel) -> bool:
+    """Whether the channel's name is an AFM's signal other than heights (an amplitude or a
+    deflection error, in m like heights), and not also the heights'."""
+    return says(channel, SIGNAL_WORDS) and not says(channel, HEIGHT_WORDS)
 
 
 def _not_heights(reader, channel) -> tuple[str, str | None] | None:
