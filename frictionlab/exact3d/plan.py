@@ -30,7 +30,7 @@ from pathlib import Path
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..errors import (FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, limit_advice, shown_name,
-                      write_failed)
+                      warn_user, write_failed)
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
@@ -364,6 +364,12 @@ def run_plan(
             # a completed ensemble is read, not resumed: no lock taken, nothing written (a
             # --finished-only page may be reading it while a study walks past it)
             done = RunDirectory(folder).completed_results(scene) if finished(folder) else None
+            if done is None and not compute:  # marked completed, its numbers not whole: read, never repaired here
+                warn_user(f"{shown_name(folder)} says it finished, but its results do not check out (a chunk changed "
+                          "or missing, another preset): left out of the page; the same command without "
+                          "--finished-only recomputes what is damaged")  # fmt: skip
+                runs.missing.append(job)
+                continue
             seen = mark()
             if done is not None:
                 log(f"exact3d: {job.describe()} (finished: read back)")

@@ -134,6 +134,24 @@ def test_exact_and_mdr_ran_at_the_same_f_on_the_same_spectrum(quick_study):
             assert spectra[0] == spectra[1] and spectra[0]["params"]["points"] == n
 
 
+def test_finished_only_never_repairs_a_finished_ensemble_whose_chunk_was_damaged(quick_study, tmp_path, capsys, figures_not_drawn):
+    """A finished ensemble whose chunk no longer checks out was recomputed and rewritten by
+    --finished-only (hours on the full plan, in a folder it only reads): left out, said, unwritten."""
+    runs = tmp_path / "runs"
+    shutil.copytree(quick_study / "runs", runs)
+    damaged = runs / "h0.3-n64-bem-halfspace"
+    chunk = next((damaged / "chunks").iterdir())
+    os.truncate(chunk, 500)
+    files = {p: (p.stat().st_mtime_ns, p.stat().st_size) for p in runs.rglob("*") if p.is_file()}
+    args = ["exact3d", "--quick", "--presets", str(PRESETS), "--out", str(tmp_path / "page"), "--runs", str(runs),
+            "--finished-only", "--quiet", "--workers", "1"]  # fmt: skip
+    with pytest.warns(UserWarning, match=r"h0.3-n64-bem-halfspace says it finished, but its results do not check out"):
+        assert main(args) == ExitCode.OK
+    assert {p: (p.stat().st_mtime_ns, p.stat().st_size) for p in runs.rglob("*") if p.is_file()} == files
+    assert "H = 0.3, 64² px, exact" in (tmp_path / "page" / PAGE).read_text()  # listed among those not run
+    capsys.readouterr()
+
+
 def test_finished_only_writes_the_page_from_what_finished_and_names_the_rest(quick_study, tmp_path, capsys, figures_not_drawn):
     import shutil
 
