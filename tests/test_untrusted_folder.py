@@ -6,6 +6,7 @@ and never a line of a file outside the folder; nothing is written through a link
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import os
 import re
@@ -646,3 +647,46 @@ def test_a_damaged_summary_is_said_in_the_file_s_terms_never_python_s(run_copy, 
     raised = with_timeout(lambda: frictionlab.load(run_copy))
     assert isinstance(raised, RunFolderError) and said in str(raised), str(raised)
     assert "NoneType" not in str(raised) and "_PresetName" not in str(raised)
+
+
+def deflated_zeros(path: Path, arrays: dict, rows: int, columns: int) -> None:
+    """An .npz whose array 'xi' is ``rows`` x ``columns`` zeros, deflated (megabytes in a few kB),
+    written a block at a time (the test never holds it unpacked); ``arrays`` beside it as they are."""
+    import zipfile
+
+    import numpy as np
+
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, array in arrays.items():
+            if name != "xi":
+                with archive.open(f"{name}.npy", "w") as member:
+                    np.lib.format.write_array(member, array)
+        with archive.open("xi.npy", "w", force_zip64=True) as member:
+            np.lib.format.write_array_header_1_0(member, {"descr": "<f8", "fortran_order": False, "shape": (rows, columns)})
+            block = bytes(8 * columns * 256)
+            for _ in range(rows // 256):
+                member.write(block)
+
+
+def test_an_archive_that_unpacks_past_what_its_run_writes_is_refused_before_it_is_unpacked(run_copy, capsys):
+    """A realizations.npz (or a chunk) of deflated zeros: 1 MB on disk unpacked to 1 GB in memory
+    before its shape was checked. The sizes its directory declares are checked first."""
+    import numpy as np
+
+    from frictionlab.preset import build_scene
+    from frictionlab.runs.chunks import ChunkDamage, read_chunk
+
+    steps = QUICK["loading"]["steps"]
+    with np.load(run_copy / "realizations.npz") as data:
+        kept = {name: data[name] for name in data.files}
+    deflated_zeros(run_copy / "realizations.npz", kept, rows=4096, columns=steps)  # 4 were done
+    assert (run_copy / "realizations.npz").stat().st_size < 200_000
+    assert main([*PREDICT, "--from", str(run_copy)]) == ExitCode.RUN_FOLDER
+    assert "array 'xi' unpacks to" in capsys.readouterr().err
+    scene = build_scene(QUICK)
+    bomb = run_copy / "chunks" / "00000000-00000003.npz"
+    bomb.parent.mkdir(exist_ok=True)
+    deflated_zeros(bomb, {}, rows=65536, columns=steps)  # 8 MB: past its errors' room too
+    digest = hashlib.sha256(bomb.read_bytes()).hexdigest()
+    with pytest.raises(ChunkDamage, match="array 'xi' unpacks to"):
+        read_chunk(run_copy, bomb.name, digest, scene)

@@ -34,11 +34,13 @@ import numpy as np
 from ..arguments import path_argument
 from ..errors import FrictionlabError, RunFolderError, command_word, short_repr, shown_name
 from ..compute.fit import LogFit, fit_log_law, format_interval, format_number, percentile_interval, resample_pairs
+from ..io.files import npz_unpacked_problem
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
 from ..runs.results import read_curve, read_summary
 from ..runs.runfolder import read_member
 from ..runs.settled import fit_failed
+from ..preset.schema import MAX_REALIZATIONS, MAX_STEPS
 from ..preset.seeds import bootstrap_rng
 
 MDR_OF_A_SURFACE = ForceNormalisation(load="force", modulus="E*", extent="mdr length")
@@ -376,6 +378,17 @@ def _fit_of(summary: dict, path: Path) -> LogFit:
     return law
 
 
+def _most_array_bytes(summary: dict) -> int:
+    """The largest array its run writes in realizations.npz: one float64 per realization done
+    and load step (as summary.json says them, each within what a preset allows)."""
+    counts, loading = summary.get("realizations"), (summary.get("preset") or {}).get("loading")
+    done = counts.get("done") if isinstance(counts, dict) else None
+    steps = loading.get("steps") if isinstance(loading, dict) else None
+    done = done if isinstance(done, int) and 0 < done <= MAX_REALIZATIONS else MAX_REALIZATIONS
+    steps = steps if isinstance(steps, int) and 2 <= steps <= MAX_STEPS else MAX_STEPS
+    return done * steps * 8 + 4096
+
+
 def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarray] | None:
     """(xi per realization, f) of realizations.npz, checked; None when the run kept no such file."""
     if not os.path.lexists(path):
@@ -384,6 +397,8 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         raw = read_member(path.parent, path.name, MAX_REALIZATIONS_BYTES, "realizations.npz")
         if raw[:2] != b"PK":  # every zip, so every .npz, starts so
             raise RunFolderError(f"{shown_name(path)} is damaged (not an .npz archive: it does not start as a zip file does)")
+        if problem := npz_unpacked_problem(io.BytesIO(raw), _most_array_bytes(summary)):
+            raise RunFolderError(f"{shown_name(path)} is damaged ({problem})")
         with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             missing = [name for name in ("xi", "f") if name not in data.files]
             if missing:

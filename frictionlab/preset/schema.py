@@ -32,13 +32,17 @@ class PluginChoice(_Strict):
     )
 
 
+MAX_STEPS = 1_000_000  # load steps of a preset
+MAX_REALIZATIONS = 10_000_000  # realizations of a preset
+
+
 class Loading(_Strict):
     control: Literal["force", "indentation"] = Field(
         "force", description="Whether the loads are total normal forces or indentations (rigid-body approach)."
     )
     start: float = Field(gt=0, description="First load (force, or indentation), > 0.")
     stop: float = Field(gt=0, description="Last load, > start.")
-    steps: int = Field(ge=2, le=1_000_000, description="Number of load steps, start and stop included.")
+    steps: int = Field(ge=2, le=MAX_STEPS, description="Number of load steps, start and stop included.")
     spacing: Literal["linear", "log"] = Field("linear", description="Load steps evenly spaced in value or in log.")
     unit: Literal["force", "f", "pressure", "contact-fraction"] = Field(
         "force",
@@ -223,7 +227,7 @@ class Preset(_Strict):
     )
     description: str = Field("", description="What the scene is and where its numbers come from.")
     seed: int = Field(0, ge=0, description="Root seed: realization i uses SeedSequence(seed, spawn_key=(0, i)).")
-    realizations: int = Field(ge=1, le=10_000_000, description="Number of independent random lines (M).")
+    realizations: int = Field(ge=1, le=MAX_REALIZATIONS, description="Number of independent random lines (M).")
     spectrum: PluginChoice = Field(description="Spectrum generator: how the rough lines are made.")
     solver: PluginChoice = Field(
         default_factory=lambda: PluginChoice(name="mdr"), description="Contact solver."

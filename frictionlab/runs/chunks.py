@@ -18,7 +18,7 @@ import numpy as np
 from ..compute.ensemble import OWN_H_TOLERANCE
 from ..compute.realization import RealizationResult
 from ..errors import OutputRefused, RunFolderError, first_names, shown
-from ..io.files import output_path_problem
+from ..io.files import npz_unpacked_problem, output_path_problem
 from ..io.inputs import InputFileProblem
 from ..preset import Scene
 from .runfolder import MAX_WALL_SECONDS, open_member, read_member
@@ -26,6 +26,7 @@ from .runfolder import MAX_WALL_SECONDS, open_member, read_member
 CHUNK_DIR = "chunks"
 MAX_CHUNK_DIRECTORY_BYTES = 256 * 1024  # a chunk's ~30 arrays list in under 8 kB of its zip's central directory
 MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
+ERROR_BYTES = 1 << 18  # of a failed realization's error, as text (4 bytes a character): a bound on an array's size
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
@@ -118,13 +119,18 @@ def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[Realizatio
         raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
     if hashlib.sha256(raw).hexdigest() != digest:
         raise ChunkDamage("checksum mismatch")
+    first, last = int(match[1]), int(match[2])
+    held = max(1, min(last - first + 1, scene.preset.realizations))  # realizations it can hold
     try:
         _check_archive(io.BytesIO(raw))
+        if problem := npz_unpacked_problem(io.BytesIO(raw), held * (scene.loads.size * 8 + ERROR_BYTES) + 4096):
+            raise ChunkDamage(problem)
         with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
+    except ChunkDamage:
+        raise
     except Exception as exc:  # a damaged zip or array header
         raise ChunkDamage(f"unreadable ({type(exc).__name__})") from None
-    first, last = int(match[1]), int(match[2])
     return chunk_results(arrays, first, last, scene)
 
 
