@@ -281,7 +281,7 @@ def _xi_of_other_shape(path):
 def _xi_as_text(path):
     with np.load(path) as data:
         arrays = dict(data)
-    arrays["xi"] = arrays["xi"].astype(str)
+    arrays["xi"] = arrays["xi"].astype("<U1")  # one character (4 bytes): wider text unpacks past a float64 array's room
     with path.open("wb") as fh:
         np.savez(fh, **arrays)
 
