@@ -261,16 +261,15 @@ def write_npz(fh, arrays: Mapping[str, np.ndarray]) -> None:
                 np.lib.format.write_array(out, array, allow_pickle=False)
 
 
-def npz_unpacked_problem(fh, most: int) -> str | None:
-    """Why the .npz archive ``fh`` is no run's: an array that its central directory says
+def npz_unpacked_problem(archive: zipfile.ZipFile, most: int) -> str | None:
+    """Why the opened .npz ``archive`` is no run's: an array that its central directory says
     unpacks to more than ``most`` bytes (zeros deflated: 1 MB on disk, 1 GB unpacked, all
     of it in memory before its shape could be checked), or None. zipfile unpacks no more
     of a member than that declared size."""
-    with zipfile.ZipFile(fh) as archive:
-        for member in archive.infolist():
-            if member.file_size > most:
-                return (f"array {member.filename.removesuffix('.npy')!r} unpacks to {member.file_size:,} bytes, "
-                        f"more than the {most:,} its run can write")  # fmt: skip
+    for member in archive.infolist():
+        if member.file_size > most:
+            return (f"array {member.filename.removesuffix('.npy')!r} unpacks to {member.file_size:,} bytes, "
+                    f"more than the {most:,} its run can write")  # fmt: skip
     return None
 
 

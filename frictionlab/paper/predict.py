@@ -397,7 +397,9 @@ def _read_realizations(path: Path, summary: dict) -> tuple[np.ndarray, np.ndarra
         raw = read_member(path.parent, path.name, MAX_REALIZATIONS_BYTES, "realizations.npz")
         if raw[:2] != b"PK":  # every zip, so every .npz, starts so
             raise RunFolderError(f"{shown_name(path)} is damaged (not an .npz archive: it does not start as a zip file does)")
-        if problem := npz_unpacked_problem(io.BytesIO(raw), _most_array_bytes(summary)):
+        with zipfile.ZipFile(io.BytesIO(raw)) as archive:
+            problem = npz_unpacked_problem(archive, _most_array_bytes(summary))
+        if problem:
             raise RunFolderError(f"{shown_name(path)} is damaged ({problem})")
         with np.load(io.BytesIO(raw), allow_pickle=False) as data:
             missing = [name for name in ("xi", "f") if name not in data.files]

@@ -122,15 +122,15 @@ def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[Realizatio
     first, last = int(match[1]), int(match[2])
     held = max(1, min(last - first + 1, scene.preset.realizations))  # realizations it can hold
     try:
-        _check_archive(io.BytesIO(raw))
-        if problem := npz_unpacked_problem(io.BytesIO(raw), held * (scene.loads.size * 8 + ERROR_BYTES) + 4096):
-            raise ChunkDamage(problem)
-        with np.load(io.BytesIO(raw), allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
-    except ChunkDamage:
-        raise
+        with _check_archive(io.BytesIO(raw)) as archive:  # its directory parsed once, for the sizes it declares
+            problem = npz_unpacked_problem(archive, held * (scene.loads.size * 8 + ERROR_BYTES) + 4096)
+        if problem is None:
+            with np.load(io.BytesIO(raw), allow_pickle=False) as data:
+                arrays = {key: data[key] for key in data.files}
     except Exception as exc:  # a damaged zip or array header
         raise ChunkDamage(f"unreadable ({type(exc).__name__})") from None
+    if problem is not None:
+        raise ChunkDamage(problem)
     return chunk_results(arrays, first, last, scene)
 
 
