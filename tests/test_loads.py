@@ -329,3 +329,23 @@ def test_a_contact_fraction_reached_at_the_first_touch_is_found_not_an_error():
     assert 0 < forces[0] <= 1e-9  # far below the first guess, 0.01
     count = solver.solve(profile, forces, "force", np.zeros_like(heights)).contact_count
     assert int(np.asarray(count)[0]) == 128
+
+
+def test_fractions_a_plateau_covers_share_its_force_and_the_forces_never_decrease():
+    """Fractions below a clipped map's plateau (half of its points at the top): each search
+    stopped at some force below 1e-9 of its own first guess, and the forces went up and down
+    (the run then refused them: 'the loads handed to the solver must not decrease')."""
+    from frictionlab.preset.loads import forces_for_fractions
+
+    heights = np.zeros((16, 16))
+    heights[:, :8] = 1.0
+    heights[:, 8:] = np.linspace(0.0, 0.5, 128).reshape(16, 8)  # below the plateau: distinct heights
+    profile = Profile(heights=heights, spacing=1.0, periodic=False)
+    solver = BEMHalfSpaceFree(youngs_modulus=1.0, poisson_ratio=0.0)
+    fractions = np.array([0.01, 0.05, 0.1, 0.3, 0.45, 0.6])
+    forces = forces_for_fractions(solver, profile, fractions, np.zeros_like(heights), first_guess=1.0)
+    assert np.all(np.diff(forces) >= 0), forces
+    assert np.unique(forces[:5]).size == 1  # the plateau's 128 points cover 1 % to 45 %: one force, its first touch
+    assert forces[5] > forces[4]  # 60 % needs more than the plateau
+    counts = np.asarray(solver.solve(profile, forces, "force", np.zeros_like(heights)).contact_count)
+    assert np.all(counts >= np.ceil(fractions * heights.size - 1e-9)), counts

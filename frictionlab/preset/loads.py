@@ -176,16 +176,21 @@ def forces_for_fractions(
     points = profile.points
     forces = np.empty(np.size(fractions))
     low = (0.0, 0)  # (force, count) known short of the target
+    reached = (0.0, 0)  # (force, count) of the last load found
     for j, fraction in enumerate(np.asarray(fractions, dtype=float)):
         if on_load is not None:
             on_load(j)
         target = min(points, max(1, math.ceil(fraction * points - 1e-9)))
-        forces[j], low = _search(solver, profile, slopes, target, low, max(first_guess * fraction, low[0] * 2))
+        if j and reached[1] >= target:  # the last load's contact covers this one (a plateau, a jump): its force
+            forces[j] = reached[0]
+            continue
+        reached, low = _search(solver, profile, slopes, target, low, max(first_guess * fraction, low[0] * 2))
+        forces[j] = reached[0]
     return forces
 
 
 def _search(solver, profile, slopes, target: int, low: tuple[float, int], guess: float):
-    """(force, the bracket's low end for the next target) of one target count."""
+    """((force, count) found, the bracket's low end for the next target) of one target count."""
     high = None
     force = guess
     with listening_to_loads(None):  # the search's solves are not the run's loads
@@ -197,9 +202,9 @@ def _search(solver, profile, slopes, target: int, low: tuple[float, int], guess:
             else:
                 low = (force, count)
             if high is not None and (high[1] == target or (low[0] > 0 and high[0] <= low[0] * (1 + SEARCH_PRECISION))):
-                return high[0], low
+                return high, low
             if high is not None and low[0] == 0.0 and high[0] <= guess * FIRST_TOUCH:
-                return high[0], low  # more than the target touch at first contact: points of equal height (a plateau)
+                return high, low  # more than the target touch at first contact: points of equal height (a plateau)
             force = _next_force(low, high, target)
     raise ValueError(
         f"no force found at which {target} of {profile.points} points touch within {SEARCH_STEPS} solves "

@@ -31,8 +31,8 @@ from .channel_choice import pick_channel
 from .file_kinds import LENGTH_UNITS, MIN_SIDE, ScanHeader
 from .instrument_reader import (
     BARE_ARRAY_FORMATS, channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points,
-    check_fill_room, check_header_units, check_payload, check_text_heights, check_text_room, choose_reader, parses_text,
-    quoted, xy_order,
+    check_fill_room, check_header_units, check_payload, check_stated_sides, check_text_heights, check_text_room,
+    choose_reader, parses_text, quoted, xy_order,
 )
 from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
@@ -202,6 +202,8 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         reader = stack.enter_context(_closed_after(_open_reader(fh, path, where)))
         chosen, note = pick_channel(reader, channel, where)
         check_channel_of_heights(reader, chosen, where)
+        if not spacing_given:
+            check_stated_sides(reader, chosen, where)
         check_payload(fh, type(reader), where, checksum=False)
         if chosen.nb_grid_pts is not None:
             check_declared_points(tuple(int(n) for n in chosen.nb_grid_pts), where, fh, type(reader))

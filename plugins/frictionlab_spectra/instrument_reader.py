@@ -261,15 +261,39 @@ def _is_length(unit: str) -> bool:
     return is_length_unit(mangle_length_unit_utf8(unit))
 
 
-def _gwyddion_amperes(reader, channel) -> bool:
-    """Whether ``channel`` of a Gwyddion file holds values in A (``check_channel_of_heights``)."""
+def _gwyddion_field(reader, channel) -> dict:
+    """The raw data field of ``channel`` of a Gwyddion file; {} for another format, or a file
+    this does not follow (its reader's reading then stands)."""
     if reader.format() != "gwy":
-        return False
+        return {}
     try:
         field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
-        return field["si_unit_z"]["GwySIUnit"]["unitstr"] == "A"
-    except (AttributeError, KeyError, TypeError):  # a file this does not follow: its reader's reading stands
+    except (AttributeError, KeyError, TypeError):
+        return {}
+    return field if isinstance(field, dict) else {}
+
+
+def _gwyddion_amperes(reader, channel) -> bool:
+    """Whether ``channel`` of a Gwyddion file holds values in A (``check_channel_of_heights``)."""
+    try:
+        return _gwyddion_field(reader, channel)["si_unit_z"]["GwySIUnit"]["unitstr"] == "A"
+    except (KeyError, TypeError):
         return False
+
+
+def check_stated_sides(reader, channel, where: str) -> None:
+    """Refuse a Gwyddion map whose width (xreal) or height (yreal) is 0 along a side of more than
+    one pixel: Gwyddion, and its reader here, take a size of 0 as 1 m, so a 32 um wide map of 0
+    height was read with pixels 31000 times longer along y, and resampled onto a million rows.
+    Called only where the preset gives no spacing (its pixel is then used instead)."""
+    field = _gwyddion_field(reader, channel)
+    zero = [f"{side} ({key})" for side, key, points in (("width", "xreal", "xres"), ("height", "yreal", "yres"))
+            if field.get(key) == 0 and field.get(points, 2) != 1]  # fmt: skip
+    if zero:
+        raise ValueError(f"{where}: channel {channel.index} ({quoted(channel.name)}) states a {' and a '.join(zero)} "
+                         "of 0, which Gwyddion shows as 1 m: its pixels have no size; give the pixel side with "
+                         "spacing (and spacing_y for pixels that are not square), or set the size in Gwyddion "
+                         "and save the file again")  # fmt: skip
 
 
 def check_payload(fh, reader, where: str, *, checksum: bool = True) -> None:
