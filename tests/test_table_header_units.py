@@ -316,3 +316,25 @@ def test_a_headers_size_with_a_decimal_comma_gives_its_pixel_under_format_table(
     comma.write_text(comma.read_text(encoding="utf-8").replace("1,600 µm", "3,200 µm"), encoding="utf-8")
     caveats = SurfaceFile(path=str(comma), spacing=0.2, unit="um", format="table").input_summary()["caveats"]
     assert any("which is not square" in caveat and "0.1 x 0.2 um" in caveat for caveat in caveats)
+
+
+@pytest.mark.parametrize("header", ["x_um,z_nm", '"X, um","Z, nm"', "x in um,z in nm", "x {um},z {nm}", "x:um,z:nm",
+                                    "# x: um, z: nm\nx,z", "x_um z_nm"])  # fmt: skip
+def test_units_labelled_as_spreadsheets_write_them_are_read(tmp_path, header):
+    """x in um beside heights in nm, labelled without brackets: the labels were read as no unit, the
+    numbers bare, and the force unit, every F and p / E* off by 1000 without a word."""
+    x = np.arange(32) * 0.5
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(x, rough(1, 32, 4)[0]))
+    (tmp_path / "mixed.csv").write_text(header + "\n" + rows, encoding="utf-8")
+    with pytest.raises(ValueError, match=r"its header names the length units um, nm, .* convert the columns"):
+        ProfileFile(path=str(tmp_path / "mixed.csv")).rms_height()
+    (tmp_path / "same.csv").write_text(header.replace("nm", "um") + "\n" + rows, encoding="utf-8")
+    line = ProfileFile(path=str(tmp_path / "same.csv"))
+    assert line.generate(None).spacing == pytest.approx(0.5) and line.input_summary()["unit"] == "um"
+
+
+@pytest.mark.parametrize("header", ["time_ms,z", "# Cutoff: 0.8 mm\nx,z", "# operator: Smith\nx,z"])
+def test_words_that_only_look_like_units_are_no_unit(tmp_path, header):
+    rows = "".join(f"{i * 0.5!r},{float(v)!r}\n" for i, v in enumerate(rough(1, 32)[0]))
+    (tmp_path / "p.csv").write_text(header + "\n" + rows)
+    assert ProfileFile(path=str(tmp_path / "p.csv"), unit="um").generate(None).spacing == pytest.approx(0.5)

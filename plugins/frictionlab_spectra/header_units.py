@@ -1,5 +1,5 @@
 """The length units a text file's header names, before its first row of numbers: in a column's
-label (``x [µm]``, ``z (nm)``, ``z/nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
+label (``x [µm]``, ``z (nm)``, ``z/nm``, ``z_nm``, ``z in nm``, ``z: nm``) or as a stated value (Gwyddion's ``# Width: 25.6 µm``,
 ``# Value units: m``). A table's numbers are read bare, so what its header says of their units
 is checked against the preset, and is their unit where the preset gives none
 (``check_table_header``); a text export read by SurfaceTopography
@@ -33,6 +33,9 @@ _NOT_LENGTH_LABEL = re.compile(rf"[\[(]\s*(?:{NOT_LENGTH})\s*[\])]|/\s*(?:{NOT_L
 _LABEL = re.compile(  # x [µm], z (nm), z/nm; an inch only in brackets or after a slash ("z (in nm)" names nm)
     rf"[\[(/]\s*({_UNITS})\s*(?=[\])\s,;]|$)|[\[(]\s*({IMPERIAL})\s*[\])]|/\s*({IMPERIAL})\s*(?=[,;\t]|$)"
 )
+# x_um, "X, um", x in um, x {um}, x:um ("# x: um, z: nm" above the labels): a unit after an underscore, a comma
+# inside quotes, "in", a brace or a colon, ending its label (not "time_ms", "# Cutoff: 0.8 mm")
+_LOOSE_LABEL = re.compile(rf"(?:(?<=\w)_|\bin\s+|\{{\s*|(?<=\w):\s*|,\s*(?=[^\",]*\"))({_UNITS})(?=[\s,;\"'}})\]]|$)")
 # a number a header states, its decimal mark a point or a comma (Gwyddion's export in a European locale: 25,6 µm)
 _NUMBER = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
 # Gwyddion's words for its text export's width and height, in the languages it writes (as its reader reads them)
@@ -104,6 +107,8 @@ def named_units(text: str) -> tuple[list[str], bool]:
         if stated := _STATED.search(line.rstrip()):
             units.append(length_unit(stated["unit"]))
             stated_by_key = True
+        else:
+            units += [length_unit(unit) for unit in _LOOSE_LABEL.findall(line)]
     return units, stated_by_key
 
 
