@@ -27,3 +27,18 @@ def test_both_sides_of_size_zero_are_named_together(tmp_path, capsys):
     path = write_gwy(tmp_path / "scan.gwy", rough(32, 32) * 1e-6, 1e-6, 0.0, xreal=0.0)
     code, text = validate(tmp_path, capsys, path, unit="um")
     assert code == 2 and "states a width (xreal) and a height (yreal) of 0" in text
+
+
+def test_nan_heights_of_a_gwyddion_file_without_a_mask_are_not_said_to_be_under_one(tmp_path):
+    """A Gwyddion map with NaN heights and no mask was refused as having points 'under its Gwyddion
+    mask', and told to remove a mask it does not have."""
+    from frictionlab_spectra import SurfaceFile
+
+    z = rough(16, 16) * 1e-6
+    z[2, 3:6] = np.nan
+    path = write_gwy(tmp_path / "holes.gwy", z, 1e-6, 1e-6)
+    with pytest.raises(ValueError) as refused:
+        SurfaceFile(path=str(path), unit="um").generate(None)
+    said = str(refused.value)
+    assert "3 of 256 points are undefined in the file (not measured); set undefined: harmonic" in said
+    assert "mask" not in said

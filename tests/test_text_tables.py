@@ -62,3 +62,15 @@ def test_fortran_exponents_are_read_as_the_numbers_they_are(tmp_path):
     (tmp_path / "bad.txt").write_text("\n".join(holed) + "\n")
     with pytest.raises(ValueError, match=r"non-numeric content at line 10 .*: column 1 is not a number"):
         ProfileFile(path=str(tmp_path / "bad.txt"), spacing=1.0).rms_height()
+
+
+@pytest.mark.parametrize("quoted", ['"{v!r}"\n', '"{i}","{v!r}"\n', "{i},'{v!r}'\n"])
+def test_numbers_in_quotes_are_named_as_such(tmp_path, quoted):
+    """A spreadsheet's export that quotes every field: each line was taken for 'a second line of
+    text before the numbers'."""
+    z = np.random.default_rng(np.random.SeedSequence(5)).normal(size=32).tolist()
+    (tmp_path / "q.csv").write_text("".join(quoted.format(i=i, v=v) for i, v in enumerate(z)))
+    with pytest.raises(ValueError, match=r"numbers in quotes at line 2 \(as \"1.5\"\); a table's numbers are bare"):
+        ProfileFile(path=str(tmp_path / "q.csv"), spacing=1.0).generate(None)
+    (tmp_path / "header.csv").write_text('"x","z"\n' + "".join(f"{i},{v!r}\n" for i, v in enumerate(z)))  # a quoted header
+    assert ProfileFile(path=str(tmp_path / "header.csv")).generate(None).heights.size == 32

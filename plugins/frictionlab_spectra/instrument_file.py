@@ -32,7 +32,7 @@ from .file_kinds import LENGTH_UNITS, MIN_SIDE, ScanHeader
 from .instrument_reader import (
     BARE_ARRAY_FORMATS, channel_list, check_channel_of_heights, check_declared_bytes, check_declared_points,
     check_fill_room, check_header_units, check_payload, check_stated_sides, check_text_heights, check_text_room,
-    choose_reader, parses_text, quoted, xy_order,
+    choose_reader, gwyddion_masked, parses_text, quoted, xy_order,
 )
 from .reader_failures import describe_failure
 from .text_exports import check_declared_values, check_numbers_written, check_text_whole
@@ -245,7 +245,7 @@ def read_scan(path: Path, where: str, *, dimension: int, unit: str | None, undef
         mask = None if mask is None else np.ascontiguousarray(mask.T if transpose else mask)
         if missing:
             if undefined == "refuse":
-                raise ValueError(undefined_message(where, missing, heights.size, gwyddion=reader.format() == "gwy"))
+                raise ValueError(undefined_message(where, missing, heights.size, gwyddion=gwyddion_masked(reader, chosen)))
             if undefined == "keep":  # NaN, for a crop to leave out (surface-file's region)
                 heights = np.ma.filled(np.ma.asarray(heights, dtype=np.float64), np.nan)
             else:

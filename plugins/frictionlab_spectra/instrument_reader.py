@@ -273,6 +273,17 @@ def _gwyddion_field(reader, channel) -> dict:
     return field if isinstance(field, dict) else {}
 
 
+def gwyddion_masked(reader, channel) -> bool:
+    """Whether ``channel`` of a Gwyddion file has a mask (its undefined points then include those
+    under it; without one, they are the file's NaN heights)."""
+    if reader.format() != "gwy":
+        return False
+    try:
+        return f"/{channel.tags['index']}/mask" in channel.info["raw_metadata"]
+    except (AttributeError, KeyError, TypeError):  # a file this does not follow: said as points not measured
+        return False
+
+
 def _gwyddion_amperes(reader, channel) -> bool:
     """Whether ``channel`` of a Gwyddion file holds values in A (``check_channel_of_heights``)."""
     try:

@@ -214,6 +214,9 @@ def _first_bad_line(lines, skip: int, delimiter: str | None) -> str:
                 return _trailing_text(lineno, delimiter)
             if _numbers(text.replace(",", "."), ";" if ";" in text else None):  # 1,5;2,25 or 1,5 2,25
                 return decimal_commas(lineno)
+            if ('"' in text or "'" in text) and _numbers(re.sub("[\"']", "", text), delimiter):  # "0.5","1.25"
+                return (f"numbers in quotes at line {lineno} (as \"1.5\"); a table's numbers are bare: export it "
+                        "without quotes around numbers")  # fmt: skip
             words = not is_number(text.split(delimiter)[0]) and not _mostly_numbers(text, delimiter)  # no row of data
             footer = columns is not None and words and _footer(lines, delimiter)
             return (f"non-numeric content at line {lineno} (expected numbers separated by {_separator(delimiter)})"
