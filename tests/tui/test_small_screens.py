@@ -97,6 +97,30 @@ async def test_a_sweeps_table_at_60x20_shows_four_points_with_every_column(folde
 
 
 @sync
+async def test_a_part_of_the_run_tab_that_grows_or_shrinks_refits_the_sweeps_table(folders, registry):
+    """The table was fitted to the tab only when the progress line, an error or the caveats
+    changed: fitted to sizes read before a layout (under load), it kept them, 3 of 8 points in
+    sight at 60x20 where 4 fit. Any part that changes the plot's rows refits it."""
+    sweep = {**SWEEP, "sweep": {"parameters": {"spectrum.params.hurst": {"start": 0.3, "stop": 1.0, "num": 8}}}}
+    app = sweep_app(folders, registry, sweep)
+    async with app.run_test(size=(60, 20)) as pilot:
+        await run_to_the_end(pilot)
+        await pilot.pause()
+        table, title = app.query_one("#sweep-table"), app.query_one("#run-title")
+        fitted = table.styles.max_height.value
+        table.styles.max_height = 2  # as fitted to stale sizes
+        title.styles.height = 2  # a part above the plot grows: the plot's rows change
+        await pilot.pause()
+        await pilot.pause()
+        grown = table.styles.max_height.value
+        title.styles.height = 1
+        await pilot.pause()
+        await pilot.pause()
+        assert table.styles.max_height.value == fitted and grown == fitted - 1, (fitted, grown)
+        assert len(rows_on_screen(table, screen_text(app))) >= 4
+
+
+@sync
 async def test_the_results_box_at_60x20_breaks_its_lines_between_numbers(folders, registry):
     """Its 20 columns wrapped `completed 8/8, contacts 1.38..38.6` within the run's name and numbers."""
     (folders / "presets" / "few.yaml").write_text(yaml.safe_dump(FEW))

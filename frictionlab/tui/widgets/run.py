@@ -100,6 +100,18 @@ class FitPanel(Static):
             self.update(Content(text))
 
 
+class PlotAndFit(Horizontal):
+    """The plot and the fit beside it, 1fr of the tab: a part above or below it that grows or
+    shrinks (the progress line's second row, an error) resizes it, and a sweep's table is fitted
+    again then (``RunPane._fit_table``). Fitted only when the line changed, a table fitted to
+    sizes read before a layout kept them: 3 of 8 points at 60x20 where 4 fit."""
+
+    def on_resize(self) -> None:
+        pane = self.parent
+        if isinstance(pane, RunPane):
+            pane.call_after_refresh(pane._fit_table)
+
+
 R_ON_RUN_TAB = "r reloads the lists on the Presets and Results tabs; Ctrl+R runs the open preset."
 PLOT_ROWS = 10  # a sweep's plot keeps its whole legend (final fit and contacts): #run-body's min-height
 PLOT_FLOOR = 6  # where the tab is short: the fit's short lines and its contacts (FitPanel)
@@ -126,7 +138,7 @@ class RunPane(SaysWhyUnavailable, Vertical, can_focus=True):
         yield Static("", id="sweep-point")
         yield ProgressBar(id="run-bar", show_eta=False)
         yield Static("", id="run-stats")
-        with Horizontal(id="run-body"):
+        with PlotAndFit(id="run-body"):
             yield Chart(id="run-chart")
             yield FitPanel("", id="run-fit")
         with VerticalScroll(id="run-caveats-box", can_focus=False):  # wrapped, whole; scrolls at 60x20
