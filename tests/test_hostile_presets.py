@@ -414,6 +414,22 @@ def test_the_range_a_magnitude_refusal_names_is_the_fields_own(tmp_path, capsys,
     assert said in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("end", ["start", "stop"])
+@pytest.mark.parametrize("path", ["seed", "spectrum.params.hurst"])
+def test_a_range_end_past_a_floats_range_is_refused_not_an_internal_error(tmp_path, capsys, end, path):
+    """An integer range end of 310 digits: pydantic's finite check on an int or a float ran
+    math.isfinite on it, an OverflowError, exit 70."""
+    ends = {"start": 1, "stop": 2, end: -(10**309) if path == "seed" else 10**309}
+    preset = merge(SMALL_PRESET, {"sweep": {"parameters": {path: {**ends, "num": 2}}}})
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(preset))
+    assert main(["validate", str(tmp_path / "p.yaml")]) == ExitCode.USAGE
+    said = capsys.readouterr().err
+    assert f"sweep.parameters.{path}.{end}: must be 0 or between 1e-100 and 1e+100 in magnitude, got " in said, said
+    whole = merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"start": 1, "stop": 10**30, "num": 2}}}})
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(whole))  # a whole number of 31 digits: a seed, kept whole
+    assert main(["validate", str(tmp_path / "p.yaml")]) == 0, capsys.readouterr().err
+
+
 @pytest.mark.parametrize(("assignment", "said"), [
     ("spectrum.params={hurst: 0.5, hurst: 0.6}", "duplicate key 'hurst'"),
     ("sweep.parameters.seed.values=[1, 2", "a [ list opened here is not closed"),

@@ -238,6 +238,19 @@ def test_a_sweep_json_without_a_row_for_every_point_is_damaged(tmp_path):
     assert len(frictionlab.load(folder).points) == 2
 
 
+def test_a_sweep_json_whose_range_ends_past_a_floats_range_is_damaged(tmp_path):
+    """JSON holds integers of any length: a range end of 310 digits reached pydantic's finite
+    check (math.isfinite), an OverflowError, exit 70, wherever the folder was read."""
+    folder = tmp_path / "sweep"
+    preset = merge(QUICK, {"sweep": {"parameters": {"seed": {"start": 1, "stop": 2, "num": 2}}}})
+    frictionlab.run(preset, out=folder, workers=1, progress=False, plot=False)
+    data = json.loads((folder / "sweep.json").read_text())
+    data["sweep"]["parameters"]["seed"]["stop"] = 10**309
+    (folder / "sweep.json").write_text(json.dumps(data))
+    with pytest.raises(RunFolderError, match=r"sweep.json is damaged \(sweep: not a sweep section a preset can hold\)"):
+        frictionlab.load(folder)
+
+
 def test_a_sweep_json_row_without_its_swept_value_is_damaged(tmp_path):
     """A row without the value its point gave the swept parameter, or a mapping there, was shown
     (and compared with its point's run) as that value."""

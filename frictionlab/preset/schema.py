@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
@@ -95,13 +95,18 @@ class OutputSettings(_Strict):
 SweepScalar = str | bool | int | float | None
 
 
+# an int within the magnitudes any number keeps, or a finite float: allow_inf_nan on the union ran
+# math.isfinite on an int past a float's range (10**309), an OverflowError (exit 70), not a refusal
+RangeEnd = Annotated[int, Field(ge=-(10**100), le=10**100)] | Annotated[float, Field(allow_inf_nan=False)]
+
+
 class SweepParameter(_Strict):
     """The values one swept parameter takes: a list, or a range start..stop with num values."""
 
     values: list[SweepScalar] | None = Field(None, description="Explicit values (YAML scalars); or give a range.")
     # int kept as int: a seed of 20 digits is no float's
-    start: int | float | None = Field(None, allow_inf_nan=False, description="First value of a range.")
-    stop: int | float | None = Field(None, allow_inf_nan=False, description="Last value of a range (included).")
+    start: RangeEnd | None = Field(None, description="First value of a range.")
+    stop: RangeEnd | None = Field(None, description="Last value of a range (included).")
     num: int | None = Field(None, ge=1, le=100_000, description="Number of values of a range, >= 1.")
     spacing: Literal["linear", "log"] = Field("linear", description="Range values evenly spaced in value or in log.")
 

@@ -27,8 +27,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name, warn_user
+from ..errors import (
+    ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word, short_repr, shown, shown_name, warn_user,
+)
 from ..options import RunOptions
+from ..io.files import output_path_problem
 from .figures import cut
 from .progressevents import MAX_COUNT
 from .progresslog import ProgressLog, ProgressReader, StartOf, progress_file_problem, told_by
@@ -54,7 +57,7 @@ def check_startable(scene, out_dir: str | Path, options: RunOptions) -> None:
     from .runner import check_memory
 
     _check_not_in_use(out_dir)
-    _check_progress_file(out_dir)
+    _check_followable_folder(out_dir)
     if not options.resume:
         RunDirectory(out_dir, force=options.force).check_fresh(scene)
     if options.memory_check:
@@ -66,8 +69,12 @@ def _check_not_in_use(out_dir: str | Path) -> None:
         raise in_use(out_dir)
 
 
-def _check_progress_file(out_dir: str | Path) -> None:
-    """A detached run is followed through its progress file: one it would not write is refused."""
+def _check_followable_folder(out_dir: str | Path) -> None:
+    """A folder that cannot be one (a file, a path under a file) is refused as the run would
+    refuse it, before its progress file is looked for (that was 'Not a directory: afile/progress.jsonl',
+    exit 1); a detached run is followed through its progress file: one it would not write is refused."""
+    if (problem := output_path_problem(Path(out_dir))) is not None:
+        raise OutputRefused(f"{problem}; give a folder for the output")
     if (problem := progress_file_problem(out_dir)) is not None:  # its run would go on unseen, said to end at once
         raise RunFolderError(f"{problem}; remove it, then run again (a detached run is followed through it)")
 
@@ -86,7 +93,7 @@ def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> No
     from .sweepfiles import check_sweep_folder
 
     _check_not_in_use(out_dir)
-    _check_progress_file(out_dir)
+    _check_followable_folder(out_dir)
     check_sweep_folder(sweep, Path(out_dir), options.force)
     check_sweep_memory(sweep, options)
 
@@ -97,7 +104,7 @@ def start_detached(resolved: dict, out_dir: str | Path, options: RunOptions = Ru
     preset data with its ``sweep`` section, as ``sweep.plan_sweep`` takes it) into ``out_dir``
     as its own process in a new session, and return at once. The preset and the options
     go through a pipe, read before the run begins: the terminal is none of its files."""
-    _check_progress_file(out_dir)  # checked again: a caller may start it unchecked
+    _check_followable_folder(out_dir)  # checked again: a caller may start it unchecked
     request = {"preset": resolved, "out": str(Path(out_dir).absolute()), "options": asdict(options), "plot": plot,
                "source": source}  # fmt: skip
     process = subprocess.Popen(

@@ -117,6 +117,21 @@ def test_detach_refuses_what_the_run_would_refuse_before_starting_it(tmp_path, c
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
 
 
+@pytest.mark.parametrize("out", ["afile", "afile/sub", "/dev/null"])
+@pytest.mark.parametrize("sweep", [False, True])
+def test_detach_refuses_a_file_for_the_folder_as_the_run_does(tmp_path, cli, out, sweep):
+    """A file given as --out was refused with 'Not a directory: afile/progress.jsonl', exit 1 (a
+    run that failed), naming a file the user never gave; the run itself refuses it as output, exit 4."""
+    data = merge(SMALL_PRESET, {"sweep": {"parameters": {"seed": {"values": [1, 2]}}}} if sweep else {})
+    preset = write_preset(tmp_path, data)
+    (tmp_path / "afile").write_text("keep")
+    given = out if out.startswith("/") else tmp_path / out
+    detached, attached = (cli("run", preset, *extra, "--out", given) for extra in (["--detach"], ["--no-plot"]))
+    assert detached.returncode == attached.returncode == 4, detached.stderr
+    assert detached.stderr.splitlines()[-1] == attached.stderr.splitlines()[-1], (detached.stderr, attached.stderr)
+    assert "progress.jsonl" not in detached.stderr and (tmp_path / "afile").read_text() == "keep"
+
+
 @pytest.mark.long
 def test_a_detached_sweep_is_one_entry_of_runs_and_follow_shows_each_point_and_its_fit(tmp_path, cli):
     data = merge(SMALL_PRESET, {"realizations": 20, "sweep": {"parameters": {"spectrum.params.hurst": {"values": [0.5, 0.7]}}}})
