@@ -69,7 +69,12 @@ IN_PROCESS = {
     "NUL name": (replace("name: small", 'name: "a\\0b"'), ExitCode.USAGE, "got 'a\\x00b'"),
     "NUL byte in the file": (BASE + "description: a\x00b\n", ExitCode.USAGE, "character #x0000 is not allowed"),
     "int past the digit limit": (replace("seed: 7", "seed: " + "1" * 5000), ExitCode.USAGE,
-                                 "seed: the value at line 2 cannot be converted (ValueError: Exceeds the limit (4300 digits)"),
+                                 "seed: the whole number at line 2 has 5000 digits: a number must be 0 or between 1e-100 "
+                                 "and 1e+100 in magnitude"),  # not Python's own words ('Exceeds the limit (4300 digits)')
+    "a date for a key": (BASE + "2001-01-01: 2\n", ExitCode.USAGE,  # not 'datetime.date(2001, 1, 1): keys should be strings'
+                         "(preset): the key 2001-01-01 must be text, and YAML reads it as a date: quote it ('2001-01-01')"),
+    "a number for a key of params": (replace("hurst: 0.8", "hurst: 0.8\n    3: 4"), ExitCode.USAGE,
+                                     "spectrum.params: the key 3 must be text, and YAML reads it as a whole number"),
     "impossible date": (replace("name: small", "name: 2020-13-45"), ExitCode.USAGE,
                         "name: the value at line 1 cannot be converted (ValueError: month must be in 1..12)"),
     "control char in a file path": (replace("name: power-law", "name: profile-file").replace(

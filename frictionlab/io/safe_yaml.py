@@ -273,6 +273,9 @@ def load_yaml(text: str) -> Any:
         except _Unconvertible as exc:  # the reason names limits and ranges, never the text
             reason = str(exc.cause).split(";")[0][:100]
             field = f"{paths[id(exc.node)]}: " if paths.get(id(exc.node)) else ""  # a list's item has no key of its own
+            if digits := re.search(r"integer string conversion: value has (\d+) digits", str(exc.cause)):
+                raise YamlProblem(f"{field}the whole number at line {exc.line} has {digits[1]} digits: a number must be "
+                                  "0 or between 1e-100 and 1e+100 in magnitude") from None  # fmt: skip
             raise YamlProblem(f"{field}the value at line {exc.line} cannot be converted ({type(exc.cause).__name__}: "
                               f"{reason})") from None
         except (ValueError, OverflowError) as exc:

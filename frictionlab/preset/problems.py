@@ -143,6 +143,11 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
     for error in _one_per_union(_short_tuples(errors)):
         if error["type"] == "missing" and tuple(error["loc"]) in misspelt:
             continue
+        if error["type"] == "invalid_key" or error["loc"][-1:] == ("[key]",):  # pydantic's loc: the key's repr, or the key and '[key]'
+            parent = error["loc"][:-2] if error["loc"][-1] == "[key]" else error["loc"][:-1]
+            path = ".".join(_shown_key(p) for p in (prefix, *parent) if p != "")
+            lines.append(f"{path or '(preset)'}: {_key_problem(error['input'])}")
+            continue
         path = ".".join(_shown_key(p) for p in (prefix, *error["loc"]) if p != "")
         line = f"{path or '(preset)'}: {_describe(error, model)}"
         checked_together = error["type"] == "value_error" and (not error["loc"] or isinstance(error["input"], dict))
@@ -150,6 +155,19 @@ def format_validation_error(exc: ValidationError, model: type[BaseModel], prefix
             line += f", got {shown_value(error['input'])}"
         lines.append(line)
     return lines
+
+
+YAML_KINDS = {bool: "true or false", int: "a whole number", float: "a number", type(None): "null"}
+
+
+def _key_problem(key) -> str:
+    """A key that is no text (``2001-01-01:``, ``3:``, ``1.5:``), as the preset wrote it."""
+    import datetime
+
+    written = key.isoformat() if isinstance(key, datetime.date) else "null" if key is None else \
+        str(key).lower() if isinstance(key, bool) else _shown_key(key)
+    kind = "a date" if isinstance(key, datetime.date) else YAML_KINDS.get(type(key), "no text")
+    return f"the key {written} must be text, and YAML reads it as {kind}: quote it ('{written}')"
 
 
 def _short_tuples(errors: list[dict]) -> list[dict]:
