@@ -8,6 +8,8 @@ from pathlib import Path
 from ..errors import (ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word,
                       refuse_unusable_matplotlib, resume_hint, shown_name)  # fmt: skip
 
+REDRAWN = "the run folder is as it was"  # what a figure that could not be drawn leaves: nothing is computed here
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser(
@@ -45,7 +47,7 @@ def run(args) -> ExitCode:
         from ..runs.sweep import Sweep, write_sweep_figure
 
         out = _output(args, folder / "sweep.png")
-        write_sweep_figure(out, Sweep.recorded(folder), result.rows, devices=named)
+        write_sweep_figure(out, Sweep.recorded(folder), result.rows, devices=named, kept=REDRAWN)
     else:
         done, requested = result.realizations
         if not done:  # the run itself draws none then (``plot_wanted``)
@@ -57,7 +59,7 @@ def run(args) -> ExitCode:
 
         figure = CurveFigure.read_back(result)
         out = _output(args, folder / "plot.png")
-        write_curve_figure(out, figure, devices=named)
+        write_curve_figure(out, figure, devices=named, kept=REDRAWN)
     if not args.quiet:
         print(f"wrote {shown_name(out)}")
     return ExitCode.OK

@@ -58,23 +58,26 @@ def shown_caveats(caveats) -> list[str]:
     return said
 
 
-def write_figure(path: Path, draw, *, devices: bool = False) -> None:
+WRITTEN = "the numbers are written"  # what a run's failed figure leaves: said after its failure
+
+
+def write_figure(path: Path, draw, *, devices: bool = False, kept: str = WRITTEN) -> None:
     """Write a figure file with ``draw(file)``, which imports matplotlib itself. A
     failure is a RunError naming the file: a folder that said no, or matplotlib
     refusing (a bad MPLBACKEND, a broken font cache); the numbers are written by then.
     ``devices``: ``path`` is one the user named, a FIFO or device there written into, not
-    replaced (``io.files.atomic_write``)."""
+    replaced (``io.files.atomic_write``). ``kept``: what is left as it was, said after a failure."""
     from ..io.files import atomic_write
 
     try:
         atomic_write(path, draw, binary=True, devices=devices)
     except OSError as exc:
-        raise RunError(f"cannot write {shown_name(path)}: {exc.strerror or exc}; the numbers are written") from None
+        raise RunError(f"cannot write {shown_name(path)}: {exc.strerror or exc}; {kept}") from None
     except ModuleNotFoundError as exc:  # a broken install: the message says how to mend it
         raise RunError(f"cannot draw {shown_name(path)}: {MissingDependency(exc.name or 'matplotlib', 'drawing')}; "
-                       "the numbers are written") from None  # fmt: skip
+                       f"{kept}") from None  # fmt: skip
     except Exception as exc:
-        raise RunError(f"cannot draw {shown_name(path)}: {type(exc).__name__}: {exc}; the numbers are written") from None
+        raise RunError(f"cannot draw {shown_name(path)}: {type(exc).__name__}: {exc}; {kept}") from None
 
 
 @dataclass(frozen=True)

@@ -433,9 +433,9 @@ def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict
     return files
 
 
-def write_curve_figure(path: Path, figure: CurveFigure, *, devices: bool = False) -> None:
-    """plot.png of ``figure``, drawn in this process (``devices``: ``write_figure``'s)."""
-    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_curve(figure, fh), devices=devices)
+def write_curve_figure(path: Path, figure: CurveFigure, **written) -> None:
+    """plot.png of ``figure``, drawn in this process (``written``: ``write_figure``'s devices and kept)."""
+    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_curve(figure, fh), **written)
 
 
 def _write_summary(out: Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path]) -> None:

@@ -453,10 +453,11 @@ def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, inte
         write_tables(sweep, outcome, out_dir)
 
 
-def write_sweep_figure(path: Path, sweep: Sweep, rows: list[dict[str, Any]], *, devices: bool = False) -> None:
+def write_sweep_figure(path: Path, sweep: Sweep, rows: list[dict[str, Any]], **written) -> None:
     """sweep.png of ``rows`` (a row per point, as sweep.json holds them), drawn in this process
-    (``devices``: ``write_figure``'s). matplotlib is imported only as it draws (a sweep's points import it ahead)."""
-    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_sweep(sweep, rows, fh), devices=devices)
+    (``written``: ``write_figure``'s devices and kept). matplotlib is imported only as it draws (a
+    sweep's points import it ahead)."""
+    write_figure(path, lambda fh: imported(PLOT_MODULE).plot_sweep(sweep, rows, fh), **written)
 
 
 def sweep_of_point(folder: str | Path) -> Path | None:

@@ -83,3 +83,18 @@ def test_a_folder_that_holds_no_run_or_nothing_to_draw_is_refused_by_name(tmp_pa
     wrong = cli("plot", empty, "--out", tmp_path / "figure.jpg")
     assert wrong.returncode == ExitCode.USAGE and f"--out {tmp_path / 'figure.jpg'}" in wrong.stderr
     assert "ends in .png" in wrong.stderr and not (tmp_path / "figure.jpg").exists()
+
+
+def test_a_figure_that_cannot_be_written_is_said_so_in_the_commands_terms(tmp_path, cli):
+    """plot computes nothing: its failure to write ended '; the numbers are written', as a run's does."""
+    import os
+
+    preset = write_preset(tmp_path, merge(SMALL_PRESET, TINY))
+    bare = tmp_path / "bare"
+    assert cli("run", preset, "--out", bare, "--workers", "1", "--quiet", "--no-plot").returncode == ExitCode.OK
+    before = sorted(p.name for p in bare.iterdir())
+    os.symlink("/dev/full", tmp_path / "full.png")  # a device the user names is written into: no space left on it
+    done = cli("plot", bare, "--out", tmp_path / "full.png")
+    assert done.returncode == ExitCode.RUNTIME_FAILURE and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr.rstrip().endswith("No space left on device; the run folder is as it was"), done.stderr
+    assert sorted(p.name for p in bare.iterdir()) == before
