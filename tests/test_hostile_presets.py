@@ -75,6 +75,10 @@ IN_PROCESS = {
                          "(preset): the key 2001-01-01 must be text, and YAML reads it as a date: quote it ('2001-01-01')"),
     "a number for a key of params": (replace("hurst: 0.8", "hurst: 0.8\n    3: 4"), ExitCode.USAGE,
                                      "spectrum.params: the key 3 must be text, and YAML reads it as a whole number"),
+    "a key past 1024 characters": (BASE + "k" * 1100 + ": 1\n", ExitCode.USAGE,  # was 'neither key: value nor ...'
+                                   "a key of 1100 characters, where YAML takes at most 1024; shorten it"),
+    "a nested key past 1024 characters": (replace("hurst: 0.8", "hurst: 0.8\n    " + "k" * 2000 + ": 1"),
+                                          ExitCode.USAGE, "a key of 2000 characters, where YAML takes at most 1024"),
     "impossible date": (replace("name: small", "name: 2020-13-45"), ExitCode.USAGE,
                         "name: the value at line 1 cannot be converted (ValueError: month must be in 1..12)"),
     "control char in a file path": (replace("name: power-law", "name: profile-file").replace(

@@ -217,6 +217,18 @@ _INDENTED = ("a line indented under a value that is already whole (words after a
              "under 'key: value'); indent it as the keys beside it, or make it part of that value")
 
 
+def _text_line(text: str, index: int) -> str:
+    lines = text.splitlines()
+    return lines[index] if index < len(lines) else ""
+
+
+def _long_key(characters: int) -> str | None:
+    """YAML's plain keys end within 1024 characters: a key longer than that is no key to it."""
+    if characters <= 1024:
+        return None
+    return f"a key of {characters} characters, where YAML takes at most 1024; shorten it (no key of a preset is that long)"
+
+
 def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     """The parser's complaint, at the line where the fault is: a bracket or a quote left
     open is found only at the end of the file, so it is told where it was opened."""
@@ -224,7 +236,8 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     at_end = mark is not None and not text[mark.index:].strip()
     what = (exc.context or "").removeprefix("while parsing ").removeprefix("while scanning ")[:60]
     if exc.problem == "could not find expected ':'" and context is not None:  # found at the next line, or the end
-        return f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_NO_COLON}"
+        key = _text_line(text, context.line).find(":", context.column) - context.column
+        return f"not valid YAML at line {context.line + 1}, column {context.column + 1}: {_long_key(key) or _NO_COLON}"
     if at_end and context is not None and exc.context:  # "while parsing a flow sequence" ...
         return (f"not valid YAML at line {context.line + 1}, column {context.column + 1}: "
                 f"{_OPENED.get(what, what)} opened here is not closed before the end of the file")  # fmt: skip
@@ -238,6 +251,10 @@ def _syntax_problem(exc: yaml.MarkedYAMLError, text: str) -> str:
     where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
     problem = exc.problem or exc.context or "syntax error"
     said = _TAB if "'\\t'" in problem else _STRAY_COLON if problem == "mapping values are not allowed here" else problem[:80]
+    if said is _STRAY_COLON and mark is not None:  # a key past 1024 characters, its ':' then taken for a value's
+        line = _text_line(text, mark.line)
+        key = line[len(line) - len(line.lstrip()) : mark.column]
+        said = (": " not in key and _long_key(len(key))) or said  # not a long value holding ': '
     if problem.startswith("expected <block end>, but found") and exc.context == "while parsing a block mapping":
         said = _INDENTED
     return f"not valid YAML{where}: {said}"
