@@ -902,12 +902,14 @@ def _header_of(text: bytes, version: bytes = b"\x01\x00") -> bytes:
     (b"hello world" * 20, "not a .npy file (it does not start as numpy.save writes one); save the heights with "
                           "numpy.save, or as a .csv/.txt table of numbers"),
     (_header_of(b"{'descr': '<f8', 'fortran_order': 'yes', 'shape': (12, 10)}") + bytes(960),
-     "a damaged .npy file: numpy cannot read its header (fortran_order is not a valid bool: 'yes'); save the array again"),
+     "a damaged .npy file: numpy cannot read its header (fortran_order is not a valid bool); save the array again"),
+    (_header_of(b"{'descr': '<f8', 'fo\xfftran_order': False, 'shape': (12, 10)}") + bytes(960),  # the file's text unquoted
+     "numpy cannot read its header (its keys are not numpy's descr, fortran_order and shape); save the array again"),
     (b"\x93NUMPY\x09\x00" + bytes(200), "numpy cannot read its header (we only support format version (1,0), (2,0), "
                                         "and (3,0), not (9, 0))"),
     (_header_of(b"{'descr': '<f8', 'fortran_order': False, 'shape': (12, 10)") + bytes(960),  # its } cut
      "numpy cannot read its header (it is not a whole Python dictionary: cut short or edited)"),  # was the tokenizer's tuple
-], ids=["no-npy", "header", "version", "cut-header"])  # fmt: skip
+], ids=["no-npy", "header", "keys", "version", "cut-header"])  # fmt: skip
 @pytest.mark.parametrize("plugin", [SurfaceFile, ProfileFile])
 def test_a_npy_numpy_cannot_read_is_told_why(tmp_path, content, said, plugin):
     """A file that is no .npy at all, and one whose header numpy refuses, were both 'not a

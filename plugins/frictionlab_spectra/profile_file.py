@@ -403,8 +403,10 @@ def _unreadable_npy(fh, exc: Exception) -> str:
                 "or as a .csv/.txt table of numbers")  # fmt: skip
     if isinstance(exc, (SyntaxError, tokenize.TokenError)) or isinstance(exc.__context__, SyntaxError):
         reason = "it is not a whole Python dictionary: cut short or edited"  # the parser's own words name no field
-    else:
-        reason = reason_said(exc) or type(exc).__name__
+    else:  # numpy's words name the field, then quote the header's text ("descr is not a valid dtype descriptor: 'zz9'")
+        reason = (reason_said(exc) or type(exc).__name__).split(":", 1)[0]
+        if reason == "Header does not contain the correct keys":
+            reason = "its keys are not numpy's descr, fortran_order and shape"
     return f"a damaged .npy file: numpy cannot read its header ({reason}); save the array again"
 
 
