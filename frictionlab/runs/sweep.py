@@ -455,8 +455,7 @@ def _finish(sweep: Sweep, outcome: SweepOutcome, out_dir: Path, plot: bool, inte
 
 def write_sweep_figure(path: Path, sweep: Sweep, rows: list[dict[str, Any]], **written) -> None:
     """sweep.png of ``rows`` (a row per point, as sweep.json holds them), drawn in this process
-    (``written``: ``write_figure``'s devices and kept). matplotlib is imported only as it draws (a
-    sweep's points import it ahead)."""
+    (``written``: ``write_figure``'s devices and kept); matplotlib imported only as it draws."""
     write_figure(path, lambda fh: imported(PLOT_MODULE).plot_sweep(sweep, rows, fh), **written)
 
 
