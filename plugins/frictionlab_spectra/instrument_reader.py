@@ -261,27 +261,29 @@ def _is_length(unit: str) -> bool:
     return is_length_unit(mangle_length_unit_utf8(unit))
 
 
-def _gwyddion_field(reader, channel) -> dict:
-    """The raw data field of ``channel`` of a Gwyddion file; {} for another format, or a file
-    this does not follow (its reader's reading then stands)."""
+def _gwyddion_entry(reader, channel, part: str) -> dict:
+    """The raw entry ``/<index>/<part>`` (``data``, ``mask``) of ``channel`` of a Gwyddion file; {}
+    where there is none, for another format, or a file this does not follow (its reader's reading
+    then stands)."""
     if reader.format() != "gwy":
         return {}
     try:
-        field = channel.info["raw_metadata"][f"/{channel.tags['index']}/data"]["GwyDataField"]
+        entry = channel.info["raw_metadata"].get(f"/{channel.tags['index']}/{part}")
     except (AttributeError, KeyError, TypeError):
         return {}
+    return entry if isinstance(entry, dict) else {}
+
+
+def _gwyddion_field(reader, channel) -> dict:
+    """The raw data field of ``channel`` of a Gwyddion file ({}: ``_gwyddion_entry``)."""
+    field = _gwyddion_entry(reader, channel, "data").get("GwyDataField")
     return field if isinstance(field, dict) else {}
 
 
 def gwyddion_masked(reader, channel) -> bool:
     """Whether ``channel`` of a Gwyddion file has a mask (its undefined points then include those
     under it; without one, they are the file's NaN heights)."""
-    if reader.format() != "gwy":
-        return False
-    try:
-        return f"/{channel.tags['index']}/mask" in channel.info["raw_metadata"]
-    except (AttributeError, KeyError, TypeError):  # a file this does not follow: said as points not measured
-        return False
+    return bool(_gwyddion_entry(reader, channel, "mask"))
 
 
 def _gwyddion_amperes(reader, channel) -> bool:
