@@ -225,6 +225,12 @@ def output_path_problem(path: Path) -> str | None:
     return None
 
 
+def refuse_unusable_folder(path: str | Path) -> None:
+    """OutputRefused where ``path`` cannot be (or become) a run's folder (``output_path_problem``)."""
+    if (problem := output_path_problem(Path(path))) is not None:
+        raise OutputRefused(f"{problem}; give a folder for the output")
+
+
 def _not_a_folder(path: Path) -> str:
     """What ``path``, which is there and no folder, is: a file, or the node or dangling link it is."""
     if path.is_symlink() and not path.exists():

@@ -27,11 +27,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from . import runfolder
-from ..errors import (
-    ExitCode, FrictionlabError, OutputRefused, RunFolderError, command_word, short_repr, shown, shown_name, warn_user,
-)
+from ..errors import ExitCode, FrictionlabError, RunFolderError, command_word, short_repr, shown, shown_name, warn_user
 from ..options import RunOptions
-from ..io.files import output_path_problem
+from ..io.files import refuse_unusable_folder
 from .figures import cut
 from .progressevents import MAX_COUNT
 from .progresslog import ProgressLog, ProgressReader, StartOf, progress_file_problem, told_by
@@ -73,8 +71,7 @@ def _check_followable_folder(out_dir: str | Path) -> None:
     """A folder that cannot be one (a file, a path under a file) is refused as the run would
     refuse it, before its progress file is looked for (that was 'Not a directory: afile/progress.jsonl',
     exit 1); a detached run is followed through its progress file: one it would not write is refused."""
-    if (problem := output_path_problem(Path(out_dir))) is not None:
-        raise OutputRefused(f"{problem}; give a folder for the output")
+    refuse_unusable_folder(out_dir)
     if (problem := progress_file_problem(out_dir)) is not None:  # its run would go on unseen, said to end at once
         raise RunFolderError(f"{problem}; remove it, then run again (a detached run is followed through it)")
 

@@ -39,7 +39,7 @@ import yaml
 
 from .. import __version__
 from ..errors import OutputRefused, PresetError, RunFolderError, command_word, shown, shown_name, warn_user
-from ..io.files import atomic_write, named_files, output_path_problem, real_path, replace_problem
+from ..io.files import atomic_write, named_files, real_path, refuse_unusable_folder, replace_problem
 from ..io.inputs import InputFileProblem, holds_exactly
 from ..preset import Scene, differences, load_preset_file
 from ..preset.paths import as_now, with_new_defaults
@@ -72,9 +72,7 @@ def new_run_folder(name: str, runs_dir: str | Path = DEFAULT_RUNS_DIR) -> Path:
     the name is taken, also by a run started in the same second by another process: making
     the folder is what claims it): where a run goes when the user names no folder."""
     base = Path(runs_dir) / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
-    problem = output_path_problem(base.parent)
-    if problem:
-        raise OutputRefused(f"{problem}; give a folder for the output")
+    refuse_unusable_folder(base.parent)
     base.parent.mkdir(parents=True, exist_ok=True)
     candidate, n = base, 2
     while True:
@@ -143,9 +141,7 @@ class RunDirectory:
     # ------------------------------------------------------------ lock
 
     def __enter__(self) -> RunDirectory:
-        problem = output_path_problem(self.path)
-        if problem:
-            raise OutputRefused(f"{problem}; give a folder for the output")
+        refuse_unusable_folder(self.path)
         self.path.mkdir(parents=True, exist_ok=True)
         lock = self.path / LOCK_FILE
         if lock.is_symlink() or (os.path.lexists(lock) and not lock.is_file()):  # a link would be truncated through
@@ -293,9 +289,7 @@ class RunDirectory:
     def check_fresh(self, scene: Scene) -> None:
         """Refuse now, writing nothing, what a fresh ``start(scene)`` would refuse here
         (a front end that starts the run in another process says it at once)."""
-        problem = output_path_problem(self.path)
-        if problem:
-            raise OutputRefused(f"{problem}; give a folder for the output")
+        refuse_unusable_folder(self.path)
         if not self.path.is_dir():
             return
         try:

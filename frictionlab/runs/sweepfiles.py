@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from .. import __version__
 from ..errors import OutputRefused, RunFolderError, shown_name
-from ..io.files import atomic_write, output_path_problem, refuse_unreplaceable
+from ..io.files import atomic_write, refuse_unreplaceable, refuse_unusable_folder
 from .runfolder import read_json, refuse_other_kind
 from .sweeprecord import MAX_SWEEP_RECORD_BYTES, SWEEP_SCHEMA_VERSION, as_it_ran, read_sweep_record
 
@@ -33,9 +33,7 @@ SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")  # what a sweep writes in
 def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
     """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
     (its sweep.json names the same sweep and base preset), or ``force``."""
-    problem = output_path_problem(out_dir)
-    if problem:
-        raise OutputRefused(f"{problem}; give a folder for the output")
+    refuse_unusable_folder(out_dir)
     refuse_unreplaceable([out_dir / name for name in SWEEP_FILES], "sweep", "give another output folder")  # --force too
     refuse_other_kind(out_dir, "sweep")  # --force too
     if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
