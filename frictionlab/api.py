@@ -159,14 +159,17 @@ def _plugin_told(entry):
 
     @functools.wraps(entry)
     def called(*args, **keys):
-        try:
-            return entry(*args, **keys)
-        except Exception as exc:
-            from .plugin.registry import installed_plugin_fault, solve_failed
+        from .interrupts import interrupts_marked, raised_by_signal
 
-            if (fault := solve_failed(exc) or installed_plugin_fault(exc)) is None:
-                raise
-            raise fault from None
+        with interrupts_marked():  # Ctrl-C told from a plugin's own KeyboardInterrupt
+            try:
+                return entry(*args, **keys)
+            except (Exception, SystemExit, KeyboardInterrupt) as exc:  # a plugin's sys.exit() or own interrupt: its fault
+                from .plugin.registry import installed_plugin_fault, solve_failed
+
+                if raised_by_signal(exc) or (fault := solve_failed(exc) or installed_plugin_fault(exc)) is None:
+                    raise
+                raise fault from None
 
     return called
 

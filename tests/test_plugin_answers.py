@@ -33,6 +33,10 @@ BROKEN = {
         "Profile.periodic must be what periodic() declares, True. Got False instead."),
     "global-random": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(
         self, np.random.default_rng(np.random.randint(2**31)))}, "generate() used numpy's global random state"),
+    "own-seed": (GoodSpectrum, {"generate": lambda self, rng: GoodSpectrum.generate(self, np.random.default_rng(0))},
+                 "different seeds gave identical heights"),
+    "zero-slopes": (GoodSlopes, {"slopes": lambda self, heights, spacing, periodic=True: np.zeros_like(heights)},
+                    "slopes() gave 0 at every point of a line whose heights span "),
     "no-stiffness": (GoodSolver, {"stiffness": lambda self: 0.0}, "stiffness() must be finite and > 0. Got 0.0"),
     "nan-tolerance": (GoodSolver, {"tolerance": lambda self: float("nan")},
                       "tolerance() must be None or a number finite and > 0. Got nan"),
@@ -65,6 +69,29 @@ def test_a_broken_answer_is_refused_by_the_plugin_s_name(register_plugin, case):
     assert str(excinfo.value) == (f"{SLOTS[base]} 'broken-{SLOTS[base]}' (tests.test_plugin_answers.Broken from "
                                   f"tests.test_plugin_answers) broke the plugin contract: {problem}"
                                   + str(excinfo.value).partition(problem)[2])
+
+
+@pytest.mark.parametrize("case", BROKEN)
+def test_a_run_refuses_before_it_starts_what_validate_refuses(register_plugin, tmp_path, case):
+    """Taken as they came, a run of a generator ignoring its rng completed with a fit over copies of
+    one line (realization 0 alone failed), one whose grid_shape() was not its shape completed, and
+    one whose rms_height() raised failed every realization: validate refused each."""
+    from frictionlab.api import run_scene, scene_record
+    from frictionlab.options import RunOptions
+
+    base, methods, problem = BROKEN[case]
+    broken = type("Broken", (base,), {"name": f"broken-{SLOTS[base]}", **methods})
+    registry = register_plugin(broken)
+    for cls in {GoodSpectrum, GoodSolver, GoodSlopes} - {base}:
+        register_plugin(cls)
+    data = {**GOOD, SLOTS[base]: {"name": broken.name}}
+    with pytest.raises(PluginError) as validated:
+        scene_record(build_scene(data, registry=registry))
+    for out in (None, tmp_path / "run"):
+        with pytest.raises(PluginError) as ran:
+            run_scene(build_scene(data, registry=registry), out, RunOptions(workers=1), plot=False)
+        assert str(ran.value) == str(validated.value) and problem in str(ran.value)
+    assert not (tmp_path / "run").exists()  # refused before the folder was made
 
 
 def test_an_exception_in_a_plugin_s_code_is_told_as_its_fault(register_plugin):

@@ -3,12 +3,14 @@ and its distribution, and none costs a run."""
 
 from __future__ import annotations
 
+import functools
 import sys
 from typing import Any
 
 import pytest
 from pydantic import Field
 
+import frictionlab
 from frictionlab import ContactSolver, ForceNormalisation, PluginParams, Profile, SpectrumGenerator
 from frictionlab.compute import engine
 from frictionlab.errors import PluginError
@@ -49,6 +51,42 @@ def test_a_listener_that_raises_is_told_and_the_run_goes_on(fake_dists, small_pr
     import acme_logger_plugin
 
     assert acme_logger_plugin.heard == []  # heard no more of the run once it failed
+
+
+ENDING_LOGGER = '''
+import sys
+import frictionlab
+
+heard = []
+
+@frictionlab.hookimpl
+def {hook}(run, **rest):
+    heard.append("{hook}")
+    {raising}
+'''
+
+
+@pytest.mark.parametrize("hook", ["run_started", "realization_done", "run_finished"])
+@pytest.mark.parametrize("raising, said", [("sys.exit('log server unreachable')", "SystemExit: log server unreachable"),
+                                           ("raise KeyboardInterrupt", "KeyboardInterrupt in ")])
+def test_a_listener_that_exits_or_interrupts_is_told_and_the_run_goes_on(fake_dists, small_preset, monkeypatch,
+                                                                         hook, raising, said):  # noqa: F811
+    """Taken as they came, a sys.exit() in run_started ended the run (a notebook's script with it),
+    told as the fault of another plugin of the package; a KeyboardInterrupt of its own in
+    realization_done cancelled the run (exit 130), naming no plugin."""
+    from frictionlab.plugin import registry as registry_module
+
+    fake_dists("acme-logs", "acme-ending-logger", "acme_ending_logger", ENDING_LOGGER.format(hook=hook, raising=raising))
+    monkeypatch.setattr(registry_module, "default_registry", functools.cache(lambda: Registry(env={})))
+    with pytest.warns(RuntimeWarning) as warned:
+        result = frictionlab.run({**small_preset, "realizations": 3}, workers=1, progress=False, plot=False)
+    assert (result.status, result.realizations) == ("completed", (3, 3))
+    [message] = [str(w.message) for w in warned if "raised" in str(w.message)]
+    assert f"'acme-ending-logger' from acme-logs raised {said}" in message and f"{hook}() at acme_ending_logger.py:" in message
+    assert "it hears no more of this run, which goes on" in message
+    import acme_ending_logger
+
+    assert acme_ending_logger.heard == [hook]  # heard no more once it failed
 
 
 RAISING_SOLVER = '''
@@ -367,6 +405,24 @@ def test_a_plugin_ending_the_command_before_the_run_is_told_as_its_fault(exiting
     assert (f"spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) raised {said} in "
             "rms_height() at acme_exits_plugin.py:") in err  # fmt: skip
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("raising, said", [(False, "SystemExit: 3"), (True, "KeyboardInterrupt")])
+@pytest.mark.parametrize("entry", ["validate", "run"])
+def test_a_plugin_ending_a_python_call_before_the_run_raises_its_plugin_error(exiting_plugin, small_preset, monkeypatch,
+                                                                            raising, said, entry):  # fmt: skip
+    """Taken as they came, frictionlab.validate and frictionlab.run let the plugin's SystemExit
+    out (a script ended with the plugin's code) or its KeyboardInterrupt, by no Ctrl-C."""
+    from frictionlab.errors import PluginError
+
+    if raising:
+        monkeypatch.setenv("ACME_RAISE", "1")
+    small_preset["spectrum"] = {"name": "acme-exiting-line"}
+    keys = {"progress": False, "plot": False} if entry == "run" else {}
+    with pytest.raises(PluginError) as told:
+        getattr(frictionlab, entry)(small_preset, **keys)
+    assert str(told.value).startswith(f"spectrum 'acme-exiting-line' (acme_exits_plugin.ExitingLine from acme-exits) "
+                                      f"raised {said} in rms_height() at acme_exits_plugin.py:")  # fmt: skip
 
 
 def _ending(how):

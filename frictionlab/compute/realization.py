@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import threading
 import time
 import traceback
@@ -18,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import OUT_OF_MEMORY, PluginError
+from ..interrupts import raised_by_signal
 from ..plugin.registry import fault_place, plugin_fault
 from ..plugin.outputs import (
     LEAVE_INPUTS, RandomWatch, curve_problem, height_of, largest_magnitude, order_problem, profile_problem, read_only,
@@ -160,7 +160,7 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         randomness = RandomWatch()  # looked at between plugin calls: one look per call
         profile = scene.generator.generate(rng)
         refuse(scene.generator, randomness.problem("generate()") or profile_problem(scene.generator, profile))
-        if index == 0:  # once a run (two more profiles made): what a generator ignoring its rng makes of every realization
+        if index == 0 and not scene.probed:  # a generator ignoring its rng: checked once a run, here if not before it
             def again(i: int):  # realization i's profile, from a fresh generator of its seed
                 return scene.generator.generate(realization_rng(scene.preset.seed, i))
 
@@ -177,9 +177,6 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
             slope_rms_line = defined_rms(slopes)  # over the points that have a slope
         else:  # every slope defined: a NaN makes the rms NaN, refused below
             slope_rms_line = float(np.sqrt(np.mean(np.square(slopes))))
-        if slope_rms_line == 0 and (span := float(np.ptp(profile.heights))) > 0:  # NaN heights: no span said
-            refuse(scene.slope, f"slopes() gave 0 at every point of a line whose heights span {span:.6g} (in the "
-                                "profile's length unit): no slope of that line is 0 everywhere")  # fmt: skip
         if not (math.isfinite(slope_rms_line) and slope_rms_line > 0):
             raise ValueError(
                 f"the rms slope of the whole line is {slope_rms_line}: xi is undefined (is the line constant?)"
@@ -213,15 +210,9 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     except SolveCancelled:  # neither a result nor a failure: the realization runs again on resume
         raise
     except (Exception, SystemExit, KeyboardInterrupt) as exc:  # carried, not raised: one bad line (a plugin's
-        if isinstance(exc, KeyboardInterrupt) and _signals_raise_here():  # sys.exit()) must not end the run; Ctrl-C
-            raise  # must, where a signal can raise it (elsewhere it is a plugin's own raise)
+        if raised_by_signal(exc):  # sys.exit(), its own KeyboardInterrupt) must not end the run; Ctrl-C must
+            raise
         return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
-
-
-def _signals_raise_here() -> bool:
-    """Whether Ctrl-C (SIGTERM, SIGHUP) can raise KeyboardInterrupt in this thread: only in the main
-    thread of a process that does not ignore SIGINT (a pool's worker does: its parent stops it)."""
-    return threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is not signal.SIG_IGN
 
 
 def _failure(scene: Scene, exc: BaseException) -> str:

@@ -16,6 +16,7 @@ import signal
 import threading
 
 from ..errors import ExitCode, shown
+from ..interrupts import signal_interrupt
 
 HANDLED = (signal.SIGINT, signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else []))  # no SIGHUP on Windows
 ENDINGS = {signal.SIGINT: (ExitCode.INTERRUPTED, "interrupted"), signal.SIGTERM: (ExitCode.TERMINATED, "terminated")}
@@ -31,7 +32,12 @@ class Terminated(KeyboardInterrupt):
 
 def _raise_for(signum: int):
     received.append(signum)
-    raise KeyboardInterrupt() if signum == signal.SIGINT else Terminated()
+    raise _interrupt(signum)
+
+
+def _interrupt(signum: int) -> KeyboardInterrupt:
+    """What signal ``signum`` raises, marked as a signal's (a plugin's own raise is its fault)."""
+    return signal_interrupt(signum, KeyboardInterrupt if signum == signal.SIGINT else Terminated)
 
 
 def _ending() -> tuple[ExitCode, str]:
@@ -157,7 +163,7 @@ def stop_if_interrupted() -> None:
     dropped, say), raise again instead of starting it. A notebook's own process, outside
     any command, starts every run it asks for."""
     if _in_command and received:
-        raise KeyboardInterrupt() if received[-1] == signal.SIGINT else Terminated()
+        raise _interrupt(received[-1])
 
 
 class CancelOnSignals:

@@ -22,6 +22,7 @@ import traceback
 import warnings
 from typing import TYPE_CHECKING, Protocol
 
+from ..interrupts import raised_by_signal
 from .base import Plugin, PluginParams
 from .hookspecs import hookspec
 
@@ -116,11 +117,14 @@ class GuardedListener:
                 return None
             try:
                 return function(*args, **kwargs)
-            except Exception as exc:  # the plugin's fault: told, not the run's end
+            except (Exception, SystemExit, KeyboardInterrupt) as exc:  # the plugin's fault (its sys.exit() too): told,
+                if raised_by_signal(exc):  # not the run's end; Ctrl-C is
+                    raise
                 self._failed = True
                 _, where, _ = fault_site(exc, function.__module__.partition(".")[0])
+                said = f": {exc}" if str(exc) else ""  # sys.exit(), a bare raise: no message
                 warnings.warn(
-                    f"{self._label} raised {type(exc).__name__}: {exc} in {where or name + '()'}; it hears no more "
+                    f"{self._label} raised {type(exc).__name__}{said} in {where or name + '()'}; it hears no more "
                     f"of this run, which goes on: {self._advice}", RuntimeWarning, stacklevel=2,
                 )  # fmt: skip
                 return None

@@ -132,6 +132,9 @@ def slopes_problem(estimator: SlopeEstimator, slopes, profile: Profile, what: st
         problem += f" A NaN (a point without a slope) needs undefined_points({profile.periodic}) to return True."
     if not problem and slopes.ndim == 2 and slopes.size and (least := float(np.fmin.reduce(slopes, axis=None))) < 0:
         problem = f"{what} on a surface must be gradient magnitudes |grad z| >= 0. Got a minimum of {least:.6g}."
+    if not problem and slopes.size and not slopes.any() and (span := float(np.ptp(profile.heights))) > 0:
+        problem = (f"{what} gave 0 at every point of a {'surface' if slopes.ndim == 2 else 'line'} whose heights span "
+                   f"{span:.6g} (in the profile's length unit): no slope of it is 0 everywhere")  # fmt: skip
     return problem
 
 

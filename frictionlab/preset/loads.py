@@ -20,7 +20,8 @@ import numpy as np
 
 from ..plugin import ContactSolver, Profile, force_unit, listening_to_loads
 from ..plugin.outputs import (
-    RandomWatch, full_contact_problem, height_of, profile_problem, read_only, refuse, shape_problem, slopes_problem,
+    RandomWatch, full_contact_problem, height_of, profile_problem, read_only, refuse, seed_problem, shape_problem,
+    slopes_problem,
 )  # fmt: skip
 
 LOAD_UNITS = {
@@ -80,6 +81,13 @@ def _generated(scene) -> Profile:
     profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
     refuse(scene.generator, watch.problem("generate()") or profile_problem(scene.generator, profile)
            or shape_problem(scene.generator, profile))  # fmt: skip
+
+    def again(index: int) -> Profile:  # realization index's profile, from a fresh generator of its seed
+        return scene.generator.generate(realization_rng(scene.preset.seed, index))
+
+    # a generator ignoring its rng (every realization one line) is refused here, before the run
+    refuse(scene.generator, seed_problem(scene.generator, profile, again, scene.preset.realizations > 1)
+           or watch.problem("generate()"))  # fmt: skip
     return profile
 
 
@@ -127,7 +135,10 @@ def solver_loads(scene) -> np.ndarray | None:
 
 
 def check_loads(scene) -> None:
-    """Refuse, before a run, loads ``scene``'s solver cannot take (``load_problems``): a PresetError."""
+    """Refuse, before a run, loads ``scene``'s solver cannot take (``load_problems``): a PresetError;
+    and a plugin's broken answer on realization 0's profile (``Scene.load_scales`` makes it and
+    checks every answer a run reads: its shape, seeds, slopes, h, full contact): a PluginError."""
+    scene.load_scales  # noqa: B018 - made once (cached): the run and validate check the same answers
     from ..errors import PresetError
 
     problems = load_problems(scene)

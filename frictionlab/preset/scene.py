@@ -105,6 +105,12 @@ class Scene:
         return load_scales(self)
 
     @property
+    def probed(self) -> bool:
+        """Whether realization 0's profile was made and every plugin's answer on it checked
+        (``load_scales``, which the run's front doors and validate ask for before a run)."""
+        return "load_scales" in vars(self)
+
+    @property
     def forces_vary(self) -> bool:
         """Whether each realization has forces of its own (indentation control, contact fractions)."""
         return self.control == "indentation" or self.preset.loading.unit == "contact-fraction"

@@ -30,10 +30,21 @@ def reported(check: Callable) -> Callable:
     @functools.wraps(check)
     def checked(*args, **kwargs):
         __tracebackhide__ = True
-        try:
-            return check(*args, **kwargs)
-        except AssertionError as exc:
-            raise exc.with_traceback(None)
+        from frictionlab.interrupts import interrupts_marked, raised_by_signal
+
+        with interrupts_marked():
+            try:
+                return check(*args, **kwargs)
+            except AssertionError as exc:
+                raise exc.with_traceback(None)
+            except (SystemExit, KeyboardInterrupt) as exc:  # the plugin's sys.exit() or own interrupt, where a
+                if raised_by_signal(exc):  # check calls it outside ``call``: a failure, not the end of the tests
+                    raise
+                plugin = next((arg for arg in args if isinstance(arg, type)), None)
+                said = f": {exc}" if str(exc) else ""
+                error = AssertionError(f"{label(plugin)}: raised {type(exc).__name__}{said}; a plugin raises an "
+                                       "exception where it cannot go on, it never exits nor interrupts")  # fmt: skip
+                raise error.with_traceback(None) from exc
 
     return checked
 
@@ -46,13 +57,20 @@ def fail(cls, message: str, cause: BaseException | None = None):
 
 
 def call(cls, what: str, fn: Callable[..., Any], *args, **kwargs):
-    """Run plugin code; any exception becomes an AssertionError naming the call."""
-    try:
-        return fn(*args, **kwargs)
-    except AssertionError:
-        raise
-    except Exception as exc:
-        fail(cls, f"{what} raised {type(exc).__name__}: {exc}", _from_the_call(exc))
+    """Run plugin code; any exception becomes an AssertionError naming the call (a ``sys.exit()``
+    and a ``KeyboardInterrupt`` the code raised itself included: a Ctrl-C stops the tests)."""
+    from frictionlab.interrupts import interrupts_marked, raised_by_signal
+
+    with interrupts_marked():
+        try:
+            return fn(*args, **kwargs)
+        except AssertionError:
+            raise
+        except (Exception, SystemExit, KeyboardInterrupt) as exc:
+            if raised_by_signal(exc):
+                raise
+            said = f": {exc}" if str(exc) else ""
+            fail(cls, f"{what} raised {type(exc).__name__}{said}", _from_the_call(exc))
 
 
 def _from_the_call(exc: BaseException) -> BaseException:

@@ -69,6 +69,30 @@ def test_solver_check_fails_for_bad_stiffness():
         fltesting.check_solver(cls)
 
 
+def _ends(how):
+    def stiffness(self):
+        if how == "exit":
+            import sys
+
+            sys.exit("bye from stiffness")
+        raise KeyboardInterrupt("by no Ctrl-C")
+
+    return stiffness
+
+
+@pytest.mark.parametrize("how, said", [("exit", "SystemExit: bye from stiffness"),
+                                       ("interrupt", "KeyboardInterrupt: by no Ctrl-C")])
+@pytest.mark.parametrize("check", ["check_solver", "check_plugin"])
+def test_a_solver_that_exits_or_interrupts_fails_the_check_and_the_tests_go_on(how, said, check):
+    """Taken as they came, the kit let a plugin's sys.exit() out, and its KeyboardInterrupt ended
+    the whole pytest session ("no tests ran")."""
+    cls = type("Ending", (GoodSolver,), {"name": "ending", "stiffness": _ends(how)})
+    arguments = (cls,) if check == "check_solver" else ("solver", cls)
+    with pytest.raises(AssertionError) as failed:
+        getattr(fltesting, check)(*arguments)
+    assert said in str(failed.value) and "Ending" in str(failed.value)
+
+
 def test_solver_check_fails_for_a_wrong_normalisation():
     """Springs of stiffness k dx under a force, declared as a force per unit depth over k h:
     the load scales as k h L, not as k h, so f is not dimensionless."""
