@@ -219,7 +219,8 @@ def test_a_periodic_map_is_levelled_by_its_mean_and_refused_where_it_would_stop_
     assert tile.input_summary()["detrend"] == "mean" and tile.input_summary()["detrend_from"] == "default"
     np.testing.assert_allclose(tile.generate(None).heights, z - z.mean(), rtol=0, atol=1e-12 * np.abs(z).max())
     assert SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", periodic=False).input_summary()["detrend"] == "plane"
-    assert SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", detrend="plane").input_summary()["detrend"] == "plane"
+    with pytest.raises(ValueError, match="detrend: 'plane' on a periodic map .* leaves a step where the map repeats"):
+        SurfaceFile(path=str(tmp_path / "tile.nc"), unit="um", detrend="plane").input_summary()
     for changed, said in (({"region": {"x": [0, 16]}}, "once cropped to region"),
                           ({"downsample": {"factor": 2}}, "once downsampled")):  # fmt: skip
         with pytest.raises(ValueError, match=f"a periodic map .* no longer tiles the plane {said}; set periodic: false"):
@@ -242,6 +243,40 @@ def test_a_periodic_line_is_levelled_by_its_mean(tmp_path):
     assert ring.input_summary()["detrend"] == "mean"
     np.testing.assert_allclose(ring.generate(None).heights, z - z.mean(), rtol=0, atol=1e-12 * np.abs(z).max())
     assert ProfileFile(path=str(tmp_path / "ring.nc"), unit="um", periodic=False).input_summary()["detrend"] == "tilt"
+
+@pytest.mark.parametrize("kind", ["map", "line"])
+def test_a_periodic_sine_has_no_tilt_said_and_a_tilt_taken_off_it_is_refused(tmp_path, kind):
+    """A map (line) that repeats has no tilt: the least-squares plane of sin(2 pi x / L) carries
+    half its variance, which was said as 'a tilt carries 56.1 % ... detrend: plane levels it'; the
+    plane taken off, as advised, left a step of 2.6 rms heights where it repeats, and the rms
+    slope over the map went from 0.55 to 1.05 without a word."""
+    n = 64
+    x = np.arange(n) / n
+    z = np.sin(2 * np.pi * x)[None, :] + 0.3 * np.cos(6 * np.pi * x + 1)[:, None] if kind == "map" else np.sin(2 * np.pi * x)
+    np.save(tmp_path / "tile.npy", z)
+    reader = SurfaceFile if kind == "map" else ProfileFile
+    keys = {"path": str(tmp_path / "tile.npy"), "spacing": 1.0}
+    tile = reader(**keys, periodic=True)
+    assert tile.input_summary()["detrend"] == "mean"
+    assert not any("tilt" in caveat or "curvature" in caveat for caveat in tile.input_summary().get("caveats", ()))
+    said = reader(**keys, periodic=False).input_summary()["caveats"]  # not periodic: a form the run should know of
+    assert any(caveat.startswith("a tilt carries") for caveat in said)
+    form = "plane" if kind == "map" else "tilt"
+    for detrend in (form, "quadratic"):
+        with pytest.raises(ValueError, match=rf"detrend: '{detrend}' on a periodic {kind} \(periodic: true, or as the "
+                                             rf"file says\) takes off a {form} .* give detrend: mean or none, or set periodic: false"):
+            reader(**keys, periodic=True, detrend=detrend).generate(None)
+    reader(**keys, periodic=True, detrend="none").generate(None)  # read
+
+
+def test_a_form_kept_in_a_map_is_said_with_the_tilt_s_and_the_curvature_s_own_shares():
+    """'a tilt carries 54.9 %' was the tilt's and the curvature's shares together (the tilt's own: 47.5 %)."""
+    from frictionlab_spectra.scan_shaping.levelling import _form_kept
+
+    said = _form_kept(0.475, 0.074, "map", "mean", "plane")
+    assert said.startswith("a tilt carries 47.5 % and a curvature 7.4 % more of the map's height variance (detrend: mean)")
+    assert _form_kept(0.95, 0.0, "line", "none", "tilt").startswith("a tilt carries 95.0 % of the line's")
+
 
 def test_undefined_points_are_refused_or_filled_and_recorded(tmp_path):
     z = scan_um()

@@ -25,7 +25,7 @@ from frictionlab.plugin import MAX_MAGNITUDE
 
 from .scan_shaping.edge_lines import edge_lines_warning
 from .scan_shaping.height_caveats import flat_neighbours_warning, outlier_warning
-from .scan_shaping.levelling import level, levelling_warning
+from .scan_shaping.levelling import level, levelling_warning, periodic_levelling_problem
 from .scan_shaping.line_offsets import line_offset_warning
 from .scan_shaping.resampling import cosine_resample, resampled_points
 from .scan_shaping.spikes import despike, spike_warning
@@ -175,12 +175,14 @@ def check_still_periodic(pixel: tuple[float, float], p, where: str, what: str = 
 
 def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instrument: bool, periodic: bool):
     """The map to press, its square pixel side, and what was done (the summary's entries).
-    A periodic map is levelled by its mean unless asked otherwise: a plane taken off it
-    would leave a step where it repeats."""
+    A periodic map is levelled by its mean, or not at all: a plane taken off it would leave a
+    step where it repeats (refused)."""
     done: dict[str, Any] = {}
     caveats: list[str] = []
     if periodic:
         check_still_periodic(pixel, p, where)
+        if problem := periodic_levelling_problem(p.detrend, "map"):
+            raise ValueError(f"{where}: {problem}")
     if p.region is not None:
         z, done["region_pixels"] = crop(z, pixel, p.region, where)
         if min(z.shape) < 2:  # a line, which no resampling makes a map: refused before its levelling divides by zero
@@ -201,7 +203,8 @@ def shape_map(z: np.ndarray, pixel: tuple[float, float], p, where: str, *, instr
             del despiked
     done.update(detrend=mode, detrend_from="preset" if p.detrend is not None else "default",
                 rms_before_detrend=levelled.rms_before, rms_removed_fraction=_removed(levelled))  # fmt: skip
-    if (warning := levelling_warning(levelled, mode)) is not None:
+    # a periodic map's least-squares plane is no tilt (a tilted map does not repeat): nothing to say
+    if not periodic and (warning := levelling_warning(levelled, mode)) is not None:
         caveats.append(warning)
     if p.despike is None and (warning := spike_warning(levelled.heights, levelled.rms_after, pixel)) is not None:
         caveats.append(warning)

@@ -66,8 +66,8 @@ class ProfileFile(MeasuredFile):
         )
         detrend: Literal["none", "mean", "tilt", "quadratic"] | None = Field(
             None, description="remove nothing, the mean, the least-squares line (tilt) or parabola (quadratic: a bowed "
-            "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table or a "
-            "periodic line (a tilt taken off it would leave a step where it repeats)",
+            "scan) before use; default: tilt for an instrument file (a scan is rarely level), mean for a table; a "
+            "periodic line takes mean or none only (a tilt taken off it would leave a step where it repeats)",
         )
         region: LineRegion | None = Field(
             None, description="a crop, {x: [start, stop], units: pixels | length}: a half-open span along the line, in "
@@ -114,7 +114,7 @@ class ProfileFile(MeasuredFile):
         from .line_crop import crop_line
         from .scan_shaping.edge_lines import edge_points_warning
         from .scan_shaping.height_caveats import FLAT, flat_neighbours_warning, flat_rms, outlier_warning, units_warning
-        from .scan_shaping.levelling import level_line, line_form_warning
+        from .scan_shaping.levelling import level_line, line_form_warning, periodic_levelling_problem
         from .scan_shaping.spikes import line_spike_warning
 
         p = self.params
@@ -155,6 +155,8 @@ class ProfileFile(MeasuredFile):
         check_heights_not_underflowing(where, z)
         if dx is None:
             dx = _line_spacing(where, x, scan, p, summary, text)
+        if periodic and (problem := periodic_levelling_problem(p.detrend, "line")):
+            raise ValueError(f"{where}: {problem}")
         mode = p.detrend if p.detrend is not None else "tilt" if instrument and not periodic else "mean"  # as a map's
         heights = level_line(z, mode)
         if p.despike is not None:
@@ -173,7 +175,7 @@ class ProfileFile(MeasuredFile):
                    "detrend": mode, "detrend_from": "preset" if p.detrend is not None else "default",
                    "rms_before_detrend": rms_before, "rms_removed_fraction": 1.0 - rms / rms_before if rms_before else 0.0,
                    "rms_height": rms}  # fmt: skip
-        caveats = [*summary.get("caveats", ()), line_form_warning(z, mode), None if p.despike is not None else line_spike_warning(heights, rms, float(dx)),
+        caveats = [*summary.get("caveats", ()), None if periodic else line_form_warning(z, mode), None if p.despike is not None else line_spike_warning(heights, rms, float(dx)),
                    outlier_warning(heights, "line"), flat_neighbours_warning(z, rms, "line"),
                    None if periodic else edge_points_warning(heights, float(dx), summary.get("region_pixels")),
                    units_warning(heights, float(dx), summary, "line")]  # as a map's

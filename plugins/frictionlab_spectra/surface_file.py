@@ -128,8 +128,8 @@ class SurfaceFile(MeasuredFile):
         detrend: Level | None = Field(
             None,
             description="remove nothing, the mean, the least-squares plane or quadratic before use; default: plane "
-            "for an instrument file (a scan is rarely level), mean for a table or a periodic map (a plane taken off "
-            "it would leave a step where it repeats)",
+            "for an instrument file (a scan is rarely level), mean for a table; a periodic map takes mean or none "
+            "only (a plane taken off it would leave a step where it repeats)",
         )
         region: Region | None = Field(
             None, description="a crop, {x: [start, stop], y: [start, stop], units: pixels | length}: half-open spans "

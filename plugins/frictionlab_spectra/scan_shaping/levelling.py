@@ -80,6 +80,18 @@ def level_line(z: np.ndarray, mode: str) -> np.ndarray:
     return out
 
 
+def periodic_levelling_problem(detrend: str | None, what: str) -> str | None:
+    """What is wrong with levelling a periodic map (``what``: or line) by more than its mean: the
+    least-squares plane (tilt) or parabola of heights that repeat is no form of theirs, and taking
+    it off leaves a step where they repeat (the rms slope of a sine map doubled)."""
+    if detrend in (None, "none", "mean"):
+        return None
+    form = "plane" if what == "map" else "tilt"
+    return (f"detrend: {detrend!r} on a periodic {what} (periodic: true, or as the file says) takes off a {form} or "
+            f"parabola that heights which repeat do not have, and leaves a step where the {what} repeats; give "
+            "detrend: mean or none, or set periodic: false")  # fmt: skip
+
+
 def levelling_warning(levelled: Levelling, mode: str) -> str | None:
     """The caveat of a map whose height is mostly a tilt or a curvature left in it."""
     plane, curvature = levelled.plane_share, levelled.curvature_share
@@ -125,7 +137,8 @@ def line_form_warning(z: np.ndarray, mode: str) -> str | None:
 def _form_kept(tilt: float, curvature: float, what: str, mode: str, levels_tilt: str) -> str:
     """The caveat of a form kept (shares of the variance), with the levelling that removes it: the
     tilt's (``levels_tilt``) only if what that leaves is not mostly the curvature, which it keeps."""
-    part = "a tilt" if tilt >= curvature else "a curvature"
+    (part, share), (other, more) = sorted((("a tilt", tilt), ("a curvature", curvature)), key=lambda kv: -kv[1])
+    also = f" and {other} {100 * more:.1f} % more" if more >= 0.0005 else ""  # each its own share, as rounded
     remedy = "quadratic" if curvature > MOST * (1.0 - tilt) else f"{levels_tilt} (or quadratic)"
-    return (f"{part} carries {100 * (tilt + curvature):.1f} % of the {what}'s height variance (detrend: {mode}): the "
+    return (f"{part} carries {100 * share:.1f} %{also} of the {what}'s height variance (detrend: {mode}): the "
             f"contact sits where the tilt or the form puts it, not on the roughness; detrend: {remedy} levels it")  # fmt: skip
