@@ -34,7 +34,8 @@ def result_html(result) -> str:
         rows = "".join(
             f"<tr><td>{name}</td><td>{format_number(value)}</td><td>{_number(se)}</td>"
             f"<td>{html.escape(format_interval(ci))}</td></tr>"
-            for name, value, se, ci in (("a", fit.a, fit.a_se, fit.a_ci), ("b", fit.b, fit.b_se, fit.b_ci))
+            for name, value, se, ci in (("a", fit.a, fit.standard_errors[0], fit.a_ci),
+                                        ("b", fit.b, fit.standard_errors[1], fit.b_ci))
         )
         parts.append(
             "<table><thead><tr><th>xi = a + b ln f</th><th>estimate</th><th>std. err.</th>"

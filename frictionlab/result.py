@@ -28,7 +28,9 @@ class Result:
     """One finished run: what ``frictionlab.run`` returns and ``frictionlab.load`` reads.
 
     ``fit``: the ``LogFit`` of xi = a + b ln f (``a``, ``b``, ``a_ci``, ``b_ci``,
-    ``a_se``, ``b_se``, ``r2``, ``residual_rms``), None if nothing finished.
+    ``a_se``, ``b_se`` (least squares over the forces), ``a_se_bootstrap``, ``b_se_bootstrap``
+    (over the realizations: ``standard_errors`` gives those shown), ``r2``, ``residual_rms``),
+    None if nothing finished.
     ``table``: per load step, arrays named as curve.csv's columns: ``F`` (the
     load, see ``normalisation``), ``f``, ``xi``, ``xi_sem``, ``lines_used`` (the
     realizations whose xi is defined there; absent from a folder written before it), ``contact_count``,

@@ -57,6 +57,29 @@ def test_bootstrap_interval_covers_the_truth_at_about_its_level():
     assert 0.8 <= b_hits / trials <= 0.97
 
 
+def test_the_standard_errors_shown_are_the_spread_between_lines_not_the_fit_s_residuals():
+    """Lines each on an exact log law of their own, a_i + b_i ln f: the mean curve is an exact log
+    law, so the least-squares errors over the force grid are 0, while a and b are known only to
+    std(a_i) / sqrt(M) and std(b_i) / sqrt(M). The table showed the former ('std.err 0.0228'
+    beside an interval 0.23 wide); it shows the bootstrap's, which estimates the latter."""
+    f = np.geomspace(0.1, 10, 25)
+    rng = np.random.default_rng(4)
+    m = 400
+    a_i, b_i = 1.2 + rng.normal(0, 0.3, m), 0.05 + rng.normal(0, 0.04, m)
+    xi = a_i[:, None] + b_i[:, None] * np.log(f)
+    fit = fit_log_law(f, xi, bootstrap=2000, rng=np.random.default_rng(1))
+    assert fit.a_se < 1e-12 and fit.b_se < 1e-12  # the fit's own: the mean curve is exact
+    truth = np.std(a_i, ddof=1) / math.sqrt(m), np.std(b_i, ddof=1) / math.sqrt(m)
+    assert fit.a_se_bootstrap == pytest.approx(truth[0], rel=0.08)  # a bootstrap of 2000: a few per cent
+    assert fit.b_se_bootstrap == pytest.approx(truth[1], rel=0.08)
+    assert fit.standard_errors == (fit.a_se_bootstrap, fit.b_se_bootstrap)
+    # no bootstrap, or one curve resampled (no spread between lines): the least-squares ones are shown
+    noisy = xi + rng.normal(0, 0.01, xi.shape)
+    for without in (fit_log_law(f, noisy, bootstrap=0), fit_log_law(f, np.vstack([noisy[0]] * 5), bootstrap=200,
+                                                                       rng=np.random.default_rng(2))):  # fmt: skip
+        assert math.isnan(without.a_se_bootstrap) and without.standard_errors == (without.a_se, without.b_se) > (0, 0)
+
+
 def test_bootstrap_is_reproducible_and_brackets_the_estimate():
     rng = np.random.default_rng(5)
     f = np.linspace(1, 20, 40)

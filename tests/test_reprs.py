@@ -56,8 +56,8 @@ def test_a_results_html_is_its_fit_rounded_with_intervals_and_its_curve():
     fit = result.fit
     level = f"{100 * fit.confidence:g}% CI (bootstrap {fit.bootstrap})"
     assert cells[:4] == ["xi = a + b ln f", "estimate", "std. err.", level]
-    assert cells[4:8] == ["a", f"{fit.a:.4f}", f"{fit.a_se:.4f}", f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]"]
-    assert cells[8:12] == ["b", f"{fit.b:.4f}", f"{fit.b_se:.4f}", f"[{fit.b_ci[0]:.4f}, {fit.b_ci[1]:.4f}]"]
+    assert cells[4:8] == ["a", f"{fit.a:.4f}", f"{fit.standard_errors[0]:.4f}", f"[{fit.a_ci[0]:.4f}, {fit.a_ci[1]:.4f}]"]
+    assert cells[8:12] == ["b", f"{fit.b:.4f}", f"{fit.standard_errors[1]:.4f}", f"[{fit.b_ci[0]:.4f}, {fit.b_ci[1]:.4f}]"]
     assert f"R² = {fit.r2:.4f}" in html and f"{result.realizations[0]}/{result.realizations[1]} realizations" in html
     (image,) = parsed(html).images
     png = base64.b64decode(image.removeprefix("data:image/png;base64,"))

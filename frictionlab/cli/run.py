@@ -292,10 +292,11 @@ def result_table(scene, outcome, out_dir: Path) -> str:
     fit = outcome.fit
     if fit is not None:
         level = f"{100 * fit.confidence:g}% CI"
+        a_se, b_se = fit.standard_errors
         lines += [
             f"  xi = a + b ln f      estimate    std.err    {level} (bootstrap {fit.bootstrap})",
-            f"  a                  {fit.a:10.4f} {fit.a_se:10.4f}    {format_interval(fit.a_ci)}",
-            f"  b                  {fit.b:10.4f} {fit.b_se:10.4f}    {format_interval(fit.b_ci)}",
+            f"  a                  {fit.a:10.4f} {a_se:10.4f}    {format_interval(fit.a_ci)}",
+            f"  b                  {fit.b:10.4f} {b_se:10.4f}    {format_interval(fit.b_ci)}",
             f"  R^2 = {fit.r2:.4f}, residual rms = {fit.residual_rms:.3g}, {fit.points} load steps",
             f"  {outcome.normalisation.definition}",
         ]

@@ -42,8 +42,10 @@ class LogFit:
 
     a: float
     b: float
-    a_se: float = math.nan
+    a_se: float = math.nan  # least squares over the force grid: neighbouring forces correlate, it understates
     b_se: float = math.nan
+    a_se_bootstrap: float = math.nan  # the bootstrap's standard deviation over realizations: the intervals' spread
+    b_se_bootstrap: float = math.nan
     a_ci: tuple[float, float] = NAN2
     b_ci: tuple[float, float] = NAN2
     confidence: float = 0.95
@@ -70,6 +72,8 @@ class LogFit:
             b=number_or_nan(data["b"]),
             a_se=number_or_nan(data.get("a_se")),
             b_se=number_or_nan(data.get("b_se")),
+            a_se_bootstrap=number_or_nan(data.get("a_se_bootstrap")),
+            b_se_bootstrap=number_or_nan(data.get("b_se_bootstrap")),
             a_ci=interval(data.get("a_ci")),
             b_ci=interval(data.get("b_ci")),
             confidence=number_or_nan(data.get("confidence", 0.95)),
@@ -78,6 +82,14 @@ class LogFit:
             residual_rms=number_or_nan(data.get("residual_rms")),
             points=int(data.get("points") or 0),
         )
+
+    @property
+    def standard_errors(self) -> tuple[float, float]:
+        """The standard errors of a and b a reader is shown: the bootstrap's over realizations,
+        beside its intervals; the least-squares ones over the force grid where none ran."""
+        if math.isnan(self.a_se_bootstrap):
+            return self.a_se, self.b_se
+        return self.a_se_bootstrap, self.b_se_bootstrap
 
     def xi(self, f):
         """a + b ln f."""
@@ -311,7 +323,7 @@ def fit_log_law(
     f, xi_per_realization, average = _over_defined(f, xi_per_realization, average)
     curve = xi_per_realization.mean(axis=0) if average is None else average(None)
     fit = fit_curve(f, curve)
-    intervals = [NAN2] * 2
+    intervals, spread = [NAN2] * 2, NAN2
     if bootstrap > 0 and realizations >= 2:
         if rng is None:
             raise ValueError("bootstrap needs a numpy Generator (rng)")
@@ -319,8 +331,15 @@ def fit_log_law(
         if samples.shape[0]:
             low, high = percentile_interval(samples, confidence, axis=0)
             intervals = [(float(low[0]), float(high[0])), (float(low[1]), float(high[1]))]
+        one_curve = np.array_equal(xi_per_realization, np.broadcast_to(xi_per_realization[0], xi_per_realization.shape),
+                                   equal_nan=True)  # every line alike (a measured one): no spread between lines to say
+        if samples.shape[0] >= 2 and not one_curve:
+            deviations = np.std(samples, axis=0, ddof=1)
+            spread = (float(deviations[0]), float(deviations[1]))
     return replace(
         fit,
+        a_se_bootstrap=spread[0],
+        b_se_bootstrap=spread[1],
         a_ci=intervals[0],
         b_ci=intervals[1],
         confidence=confidence,

@@ -235,6 +235,8 @@ class FitRecord(Record):
     b: Finite
     a_se: Spread | None = None
     b_se: Spread | None = None
+    a_se_bootstrap: Spread | None = None
+    b_se_bootstrap: Spread | None = None
     a_ci: _Interval | None = None
     b_ci: _Interval | None = None
     confidence: Annotated[float, Field(gt=0, lt=1, strict=True)] = 0.95

@@ -67,6 +67,12 @@ def test_run_writes_every_output_file_with_the_documented_contents(tmp_path, cap
     # the table on stdout carries the same fit; stdout has no progress in it
     assert f"{fit['a']:10.4f}" in captured.out
     assert "realizations," not in captured.out
+    # its std.err is the bootstrap's spread over the lines, beside the interval it draws, not the
+    # least-squares error over the forces (several times smaller: neighbouring forces correlate)
+    for name in ("a", "b"):
+        [row] = [line.split() for line in captured.out.splitlines() if line.split()[:1] == [name]]
+        assert float(row[2]) == pytest.approx(fit[f"{name}_se_bootstrap"], abs=5e-5)
+        assert fit[f"{name}_se_bootstrap"] > 2 * fit[f"{name}_se"] > 0
 
 
 def test_resolved_preset_reruns_to_the_same_numbers(tmp_path, capsys):
