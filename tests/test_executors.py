@@ -143,6 +143,36 @@ def test_a_worker_that_always_dies_fails_the_run_after_bounded_retries(scene_24,
     assert outcome.done == 1  # only the realization measured in the main process
 
 
+UNGUARDED = """
+import threading, time
+import frictionlab
+
+threading.Thread(target=time.sleep, args=(60,), daemon=True).start()  # as a notebook's or a GUI's thread
+result = frictionlab.run("quickstart", realizations=6, workers=2, executor="processes", progress=False, plot=False)
+print(result.status, result.error)
+"""
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_script_whose_run_is_not_under_a_main_guard_is_told_to_put_it_there(tmp_path, guarded):
+    """A thread running beside the run has its workers started by forkserver, which imports the
+    script again: unguarded, each ran the run again and died starting a pool, and the run failed
+    on "a worker process died 3 times (exit code 1)", saying nothing of the script."""
+    source = UNGUARDED.replace("result =", 'if __name__ == "__main__":\n    result =').replace(
+        "\nprint", "\n    print") if guarded else UNGUARDED  # fmt: skip
+    (tmp_path / "script.py").write_text(source, encoding="utf-8")
+    done = subprocess.run([sys.executable, str(tmp_path / "script.py")], capture_output=True, text=True, timeout=120,
+                          cwd=tmp_path)  # fmt: skip
+    last = done.stdout.strip().splitlines()[-1]
+    if guarded:
+        assert last == "completed None", done.stderr[-2000:]
+    else:
+        assert last.startswith("failed a worker process died "), done.stderr[-2000:]
+        assert last.endswith(f"the workers start by importing {tmp_path / 'script.py'} again (a thread of its own runs "
+                             "beside the run, so they are not forked) and run what its top level does: put the run "
+                             'under `if __name__ == "__main__":`')  # fmt: skip
+
+
 def test_unknown_executor_and_scheduler_without_dask_are_refused():
     with pytest.raises(FrictionlabError, match="executor must be one of serial, processes, dask. Got 'mpi'"):
         RunOptions(executor="mpi", workers=2)

@@ -35,7 +35,7 @@ from collections.abc import Iterator, Sequence
 
 from .dask_security import DASK_MISSING, connect_scheduler, import_distributed, start_local_cluster
 from .dask_session import current_session
-from ..errors import RunError, warn_user
+from ..errors import RunError, shown_name, warn_user
 from ..options import RunOptions
 from .pool import JobFailed, PoolNotStarted, WorkerLost, WorkerPool, send_progress, stop_event
 from ..preset import Scene
@@ -164,6 +164,23 @@ def pool_context():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
+def _unguarded_script(context, how: str) -> str:
+    """Advice for workers that exit 1 where they start by importing the main script again
+    (forkserver or spawn: chosen while a thread runs beside the run) and the script has no
+    ``if __name__ == "__main__":``: each worker ran its run again, and died starting a pool."""
+    script = getattr(sys.modules.get("__main__"), "__file__", None)
+    if context.get_start_method() == "fork" or not script or "exit code 1" not in how:
+        return ""
+    try:
+        with open(script, encoding="utf-8", errors="replace") as fh:
+            if "__main__" in fh.read(1 << 20):
+                return ""  # guarded: the workers died of something else
+    except OSError:
+        return ""
+    return (f"; the workers start by importing {shown_name(script)} again (a thread of its own runs beside the run, so "
+            "they are not forked) and run what its top level does: put the run under `if __name__ == \"__main__\":`")
+
+
 def pool_refused() -> str | None:
     """Why this system starts no process pool, or None. The pool's stop event is a POSIX
     semaphore, which a system without a usable /dev/shm (some containers and batch nodes) refuses."""
@@ -198,8 +215,9 @@ class ProcessExecutor:
             if listener is not None:
                 listener(*payload[1:])
 
+        context = pool_context()
         pool = WorkerPool(
-            min(self.workers, len(chunks)), pool_context(), _run_chunk, _init_worker, (scene.for_pressing(),),
+            min(self.workers, len(chunks)), context, _run_chunk, _init_worker, (scene.for_pressing(),),
             retries=self.retries,
         )
         ended = set()
@@ -218,7 +236,7 @@ class ProcessExecutor:
         except WorkerLost as lost:
             raise RunError(
                 f"a worker process died {lost.deaths} times while running realizations "
-                f"{chunk_label(jobs[lost.key])} ({lost.how}); giving up"
+                f"{chunk_label(jobs[lost.key])} ({lost.how}); giving up{_unguarded_script(context, lost.how)}"
             ) from None
         except JobFailed as failed:
             raise RunError(
