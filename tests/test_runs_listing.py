@@ -334,6 +334,28 @@ def test_a_run_folder_that_cannot_be_looked_into_is_said_so_not_taken_for_no_run
     assert sorted(p.relative_to(runs) for p in runs.rglob("*")) == held
 
 
+def test_a_run_folder_inside_one_that_cannot_be_searched_is_said_so_by_every_command(tmp_path, registry):
+    """A run folder whose parent the user may not search: follow, runs and predict --from said
+    'error: Permission denied: q/run' with exit code 1 (follow's "the run ended other than
+    completed"), where plot and resume named the folder and the permission, exit code 5."""
+    import subprocess
+    import sys
+
+    _run(tmp_path / "q" / "run", registry)
+    drop = ["setpriv", "--bounding-set=-dac_override,-dac_read_search"] if os.geteuid() == 0 else []
+    predict = ["predict", "--area", "1e-4", "--modulus", "1e9", "--rms-height", "1e-6", "--force", "1e-5", "--from"]
+    (tmp_path / "q").chmod(0o000)
+    try:
+        for args, folder in ((["follow", "--quiet"], "q/run"), (["runs"], "q"), (predict, "q/run"),
+                             (["plot", "--out", str(tmp_path / "x.png")], "q/run")):  # fmt: skip
+            done = subprocess.run([*drop, sys.executable, "-m", "frictionlab", *args, str(tmp_path / folder)],
+                                  capture_output=True, text=True, timeout=120)  # fmt: skip
+            assert done.returncode == 5, (args, done.stderr)
+            assert done.stderr == f"error: {tmp_path / folder} cannot be read (permission denied): its files cannot be looked at\n"
+    finally:
+        (tmp_path / "q").chmod(0o755)
+
+
 def test_follow_of_a_link_the_user_named_follows_the_folder_as_resume_does(tmp_path, registry, capsys):
     """`follow LINK` of a link to a run folder was refused ('not a run folder (not a folder, or a
     link to one)') while resume, predict --from and load take the folder named, link or not."""

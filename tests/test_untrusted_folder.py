@@ -131,6 +131,14 @@ HOSTILE = {
     "fit.b_se negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.b_se", -0.01)),  # a std.err, an rms: never
     "fit.residual_rms negative": lambda f: edit_summary(f, lambda d: set_in(d, "fit.residual_rms", -1)),  # below 0
     "fit a number": lambda f: edit_summary(f, lambda d: set_in(d, "fit", 3)),
+    # values of the right type that no run writes (each was read, plotted and predicted from)
+    "fit.a_ci reversed": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a_ci", [2.0, 0.5])),
+    "fit.a past 1e100": lambda f: edit_summary(f, lambda d: set_in(d, "fit.a", 1e308)),  # plot: 'overflow in multiply'
+    "fit.points past the steps": lambda f: edit_summary(f, lambda d: set_in(d, "fit.points", 10**15)),
+    "workers a string": lambda f: edit_summary(f, lambda d: set_in(d, "workers", "many")),
+    "failures not failures": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.failures", [{"x": 1}] * 3)),
+    "preset.realizations negative": lambda f: edit_summary(f, lambda d: set_in(d, "preset.realizations", -3)),
+    "curve entry run.json": lambda f: edit_summary(f, lambda d: set_in(d, "files.curve", "run.json")),  # blamed run.json
     "done a float": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", 2.5)),
     "done negative": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", -1)),
     "done true": lambda f: edit_summary(f, lambda d: set_in(d, "realizations.done", True)),

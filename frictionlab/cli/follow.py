@@ -29,7 +29,8 @@ def add_parser(sub) -> None:
         "progress.jsonl: the count of realizations its chunks hold is shown instead. For a sweep's folder: each point as it starts, its "
         "realizations, and its fit once it ends. Ctrl-C stops following; the run goes on. The exit code is 0 "
         "if the run completed, 1 if it ended any other way (frictionlab resume DIR continues it) or its folder was "
-        "deleted while it ran, 130 if following was stopped with Ctrl-C (143: SIGTERM, 129: SIGHUP).",
+        "deleted while it ran, 5 if DIR is no run folder or cannot be read (a damaged or unreadable run.json, a link "
+        "in its place), 130 if following was stopped with Ctrl-C (143: SIGTERM, 129: SIGHUP).",
         epilog=EXAMPLES,
     )
     p.add_argument("run_dir", metavar="DIR", help="a run folder, or a sweep's folder")
@@ -40,9 +41,11 @@ def add_parser(sub) -> None:
 
 def run(args) -> ExitCode:
     from ..runs.detached import logged_error, logged_warnings, process_alive, run_state
+    from ..runs.runfolder import check_searchable
     from .resume import refuse_a_part_of_a_run
 
     folder = Path(args.run_dir)
+    check_searchable(folder)  # before the first look at it: a folder whose parent cannot be searched too
     if folder.is_symlink() and folder.is_dir():  # the folder named may be a link, as for resume: it is the user's
         from ..io.files import real_path
 

@@ -33,8 +33,10 @@ def add_parser(sub) -> None:
 def run(args) -> ExitCode:
     from ..runs.detached import list_run_states
     from ..runs.rundir import DEFAULT_RUNS_DIR
+    from ..runs.runfolder import check_searchable
 
     runs_dir = Path(args.runs_dir) if args.runs_dir is not None else DEFAULT_RUNS_DIR
+    check_searchable(runs_dir)  # a folder that cannot be looked into: said so (exit 5), never "Permission denied"
     if args.runs_dir is not None and not runs_dir.is_dir():
         what = "is not a folder" if runs_dir.exists() else "does not exist"
         # a bad argument (exit 2, as exact3d's --runs), not a run folder that cannot be used (5)

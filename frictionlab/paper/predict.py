@@ -38,7 +38,7 @@ from ..io.files import npz_unpacked_problem
 from ..io.inputs import InputFileProblem
 from ..plugin import ForceNormalisation, mdr_length
 from ..runs.results import read_curve, read_summary
-from ..runs.runfolder import read_member
+from ..runs.runfolder import check_searchable, read_member
 from ..runs.settled import fit_failed
 from ..preset.schema import MAX_REALIZATIONS, MAX_STEPS
 from ..preset.seeds import bootstrap_rng
@@ -260,6 +260,7 @@ def read_run_law(
     the file and the field, for a run that did not complete or whose files are damaged;
     ``name`` says how a message names the folder (the command line: ``--from``)."""
     run_dir = path_argument(run_dir, "run_dir", "a run folder")
+    check_searchable(run_dir)  # a folder that cannot be looked into is said so, exit 5
     summary = _read_summary(run_dir, name)
     path = run_dir / "summary.json"
     status = summary.get("status", "completed")

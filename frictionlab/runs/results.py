@@ -26,7 +26,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import Field
+from pydantic import AfterValidator, Field, field_validator
 
 from .. import __version__
 from ..compute.ensemble import RunOutcome
@@ -35,7 +35,8 @@ from ..io.files import atomic_write, write_npz
 from ..io.inputs import InputFileProblem, holds_exactly, open_regular_file
 from ..compute.fit import json_safe
 from ..preset import Scene
-from ..preset.schema import MAX_BOOTSTRAP
+from ..plugin import MAX_MAGNITUDE
+from ..preset.schema import MAX_BOOTSTRAP, MAX_REALIZATIONS, MAX_STEPS
 from .figures import CurveFigure, DrawingProcess, plot_wanted, write_figure
 from .import_ahead import PLOT_MODULE, imported
 from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json, read_number_table
@@ -224,15 +225,26 @@ def _check_counts(curve: dict[str, np.ndarray], path: Path) -> None:
 
 # ------------------------------------------------------------------ summary.json, read back
 
-_Interval = Annotated[list[Finite | None], Field(min_length=2, max_length=2)]
+WRITTEN_FILES = {"curve": "curve.csv", "preset": "preset.yaml", "realizations": "realizations.npz",
+                 "summary": "summary.json", "plot": "plot.png"}  # summary.json's files, by key: the names written
+Coefficient = Annotated[float, Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE, allow_inf_nan=False, strict=True)]
+
+
+def _ordered(interval: list | None) -> list | None:
+    if interval is not None and None not in interval and interval[0] > interval[1]:
+        raise ValueError(f"must be an interval LO <= HI, got {interval[0]!r} > {interval[1]!r}")
+    return interval
+
+
+_Interval = Annotated[list[Coefficient | None], Field(min_length=2, max_length=2), AfterValidator(_ordered)]
 
 
 Spread = Annotated[float, Field(ge=0, allow_inf_nan=False, strict=True)]  # a standard error, an rms: never < 0
 
 
 class FitRecord(Record):
-    a: Finite
-    b: Finite
+    a: Coefficient  # xi is at most a few: 1e308 drew an overflow
+    b: Coefficient
     a_se: Spread | None = None
     b_se: Spread | None = None
     a_se_bootstrap: Spread | None = None
@@ -243,17 +255,24 @@ class FitRecord(Record):
     bootstrap: Annotated[int, Field(ge=0, le=MAX_BOOTSTRAP, strict=True)] = 0  # predict --from redraws them
     r2: Finite | None = None
     residual_rms: Spread | None = None
-    points: Count = 0
+    points: Annotated[int, Field(ge=0, le=MAX_STEPS, strict=True)] = 0  # load steps fitted
+
+
+class _Failure(Record):
+    index: Count
+    error: str
 
 
 class _Counts(Record):
-    requested: Count
+    requested: Annotated[int, Field(ge=0, le=MAX_REALIZATIONS, strict=True)]
     done: Count
     failed: Count = 0
+    failures: list[_Failure] = []
 
 
 class _PresetName(Record):
     name: Annotated[str, Field(min_length=1)]
+    realizations: Annotated[int, Field(ge=1, le=MAX_REALIZATIONS, strict=True)] | None = None
 
 
 class _Normalisation(Record):
@@ -282,9 +301,21 @@ class SummaryRecord(Record):
     elapsed_seconds: Seconds = 0.0
     contact_count_at_first_load: Finite | None = None
     contact_count_at_last_load: Finite | None = None
+    workers: Annotated[int, Field(ge=1, strict=True)] | None = None
+    executor: str | None = None
     files: dict[str, MemberName] = {}
     # what a measured file gave (shape, pixel size, unit, rms height, where each came from)
     input: dict[str, InputValue] | None = None
+
+    @field_validator("files")
+    @classmethod
+    def _files_named_as_written(cls, files: dict[str, str]) -> dict[str, str]:
+        """Each file a run writes under its own name: another (curve: run.json) was read as it, and
+        its faults blamed on a file that has none."""
+        for key, name in files.items():
+            if key in WRITTEN_FILES and name != WRITTEN_FILES[key]:
+                raise ValueError(f"files.{key} must be {WRITTEN_FILES[key]!r}, the name a run writes it under; got {name!r}")
+        return files
 
 
 def read_summary(folder: Path) -> tuple[dict[str, Any], SummaryRecord]:
@@ -398,26 +429,26 @@ def write_results(out_dir: str | Path, scene: Scene, outcome: RunOutcome) -> dic
     out = Path(out_dir)
     files: dict[str, Path] = {}
 
-    files["curve"] = out / "curve.csv"
+    files["curve"] = out / WRITTEN_FILES["curve"]
     atomic_write(files["curve"], lambda fh: _write_curve(scene, outcome, fh))
 
-    files["preset"] = out / "preset.yaml"
+    files["preset"] = out / WRITTEN_FILES["preset"]
     preset = yaml.safe_dump(scene.resolved(), sort_keys=False)
     if not holds_exactly(files["preset"], preset.encode()):  # the run's start wrote it: one fsync less
         atomic_write(files["preset"], lambda fh: fh.write(preset))
 
     if scene.preset.output.realizations:
-        files["realizations"] = out / "realizations.npz"
+        files["realizations"] = out / WRITTEN_FILES["realizations"]
         arrays = _realization_arrays(outcome)
         atomic_write(files["realizations"], lambda fh: write_npz(fh, arrays), binary=True)
 
-    files["summary"] = out / "summary.json"  # last: its presence means the numbers are complete
+    files["summary"] = out / WRITTEN_FILES["summary"]  # last: its presence means the numbers are complete
     _write_summary(out, scene, outcome, files)
     return files
 
 
 def plot_path(out_dir: str | Path) -> Path:
-    return Path(out_dir) / "plot.png"
+    return Path(out_dir) / WRITTEN_FILES["plot"]
 
 
 def add_plot(out_dir: str | Path, scene: Scene, outcome: RunOutcome, files: dict[str, Path],
