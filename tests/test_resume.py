@@ -145,6 +145,8 @@ def test_a_resume_keeps_the_time_an_older_frictionlab_recorded(make_scene, tmp_p
 def test_a_forged_recorded_time_is_no_time_or_kept_within_what_a_summary_holds(make_scene, tmp_path, forged, kept):
     """A manifest's elapsed_seconds is read only as a time a summary.json may hold (at most 1e9 s):
     the sum past it was written, and the folder then refused by load() as damaged."""
+    import warnings
+
     import frictionlab
 
     scene = make_scene({"realizations": 4, **NO_PLOT})
@@ -152,7 +154,12 @@ def test_a_forged_recorded_time_is_no_time_or_kept_within_what_a_summary_holds(m
     manifest = json.loads((tmp_path / "run" / "run.json").read_text())
     manifest["elapsed_seconds"] = forged
     (tmp_path / "run" / "run.json").write_text(json.dumps(manifest))
-    again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, resume=True))
+    told = [str(w.message) for w in said if "elapsed_seconds" in str(w.message)]
+    assert told == ([] if kept else [f"{tmp_path / 'run'}: the run's recorded elapsed_seconds ({forged!r}) is no time from "
+                                     "0 to 1e+09 s: its earlier sessions' time is not counted"])  # was lost without a word
     assert frictionlab.load(tmp_path / "run").elapsed == pytest.approx(min(kept + again.elapsed, 1e9), abs=2e-6)
 
 

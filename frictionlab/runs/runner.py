@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..compute.executors import dask_memory_limits
-from ..errors import RunError, RunFolderError, process_limit
+from ..errors import RunError, RunFolderError, process_limit, short_repr, shown_name, warn_user
 from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
@@ -177,7 +177,12 @@ def recorded_seconds(run_dir: RunDirectory) -> float:
     except RunFolderError:  # start() says what is wrong with the manifest; a damaged summary.json is rewritten
         return 0.0
     number = isinstance(seconds, (int, float)) and not isinstance(seconds, bool)
-    return float(seconds) if number and 0 <= seconds <= MAX_WALL_SECONDS else 0.0
+    if number and 0 <= seconds <= MAX_WALL_SECONDS:
+        return float(seconds)
+    if seconds is not None:  # a forged or damaged record: said, not lost without a word
+        warn_user(f"{shown_name(run_dir.path)}: the run's recorded elapsed_seconds ({short_repr(seconds, 40)}) is no "
+                  f"time from 0 to {MAX_WALL_SECONDS:g} s: its earlier sessions' time is not counted")  # fmt: skip
+    return 0.0
 
 
 def read_back(scene: Scene, folder: Path, listeners: Iterable[object] = (), plot: bool = True) -> RunOutcome | None:
