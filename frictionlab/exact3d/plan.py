@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import time
 from collections.abc import Callable
@@ -29,8 +30,8 @@ from pathlib import Path
 
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
-from ..errors import (FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, limit_advice, shown_name,
-                      warn_user, write_failed)
+from ..errors import (FrictionlabError, OutputRefused, RunError, RunFolderError, command_word, limit_advice,
+                      short_repr, shown_name, warn_user, write_failed)
 from ..io.files import atomic_write, output_path_problem
 from ..options import RunOptions
 from ..preset import Scene, first_unlike, read_preset
@@ -444,12 +445,23 @@ def _add_time(runs_dir: Path, plan: Plan, seconds: float) -> float:
 
 def _time(runs_dir: Path, plan: Plan) -> float:
     """The study's wall time so far in ``runs_dir``'s TIME_FILE (0 if it has none of this plan)."""
+    if not os.path.lexists(runs_dir / TIME_FILE):  # none yet
+        return 0.0
     try:
         earlier = read_json(runs_dir, TIME_FILE, TIME_FILE_BYTES)
-    except RunFolderError:  # none yet, or not one this study wrote: started afresh
-        earlier = {}
+    except RunFolderError as exc:  # not one this study wrote: started afresh, said so
+        return _time_not_counted(str(exc))
+    if earlier.get("plan") != plan.name:  # another plan's (a --quick study before): its time is not this one's
+        return 0.0
     seconds_before = earlier.get("seconds")
     usable = isinstance(seconds_before, int | float) and not isinstance(seconds_before, bool)
     # an edited file's -5 or 1e308 was printed on the page as the study's wall time (1e308: 300 digits)
-    usable = usable and 0 <= seconds_before <= MAX_WALL_SECONDS and earlier.get("plan") == plan.name
-    return float(seconds_before) if usable else 0.0
+    if usable and 0 <= seconds_before <= MAX_WALL_SECONDS:
+        return float(seconds_before)
+    return _time_not_counted(f"{shown_name(runs_dir / TIME_FILE)}: seconds is {short_repr(seconds_before, 40)}, "
+                             f"not a time from 0 to {MAX_WALL_SECONDS:g}")  # fmt: skip
+
+
+def _time_not_counted(why: str) -> float:
+    warn_user(f"{why}: the study's earlier invocations' time is not counted in the wall time its page gives")
+    return 0.0

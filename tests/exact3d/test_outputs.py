@@ -182,13 +182,28 @@ def test_an_ensemble_beyond_the_memory_refuses_the_study_before_any_runs(tmp_pat
     ('{"plan": "quick", "seconds": Infinity}', 0.0),
     ('{"plan": "quick", "seconds": NaN}', 0.0),
     ('{"plan": "quick", "seconds": "12"}', 0.0),
-    ('{"plan": "full", "seconds": 12.5}', 0.0),
+    ('{"plan": "full", "seconds": 12.5}', 0.0),  # another plan's: no warning
+    ("\x00\xff random", 0.0),
+    ("link", 0.0),
 ])  # fmt: skip
 def test_an_edited_time_file_counts_only_a_wall_time_a_study_can_have_taken(tmp_path, text, seconds):
+    """A damaged one is said (it was read as no time without a word, and the page's wall time fell)."""
+    import warnings
+
     from frictionlab.exact3d import plan as study
 
-    (tmp_path / study.TIME_FILE).write_text(text)
-    assert study._time(tmp_path, study.QUICK) == seconds
+    if text == "link":
+        (tmp_path / "elsewhere.json").write_text('{"plan": "quick", "seconds": 12.5}')
+        (tmp_path / study.TIME_FILE).symlink_to(tmp_path / "elsewhere.json")
+    else:
+        (tmp_path / study.TIME_FILE).write_text(text)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        assert study._time(tmp_path, study.QUICK) == seconds
+    told = [str(w.message) for w in said]
+    assert len(told) == (0 if seconds or '"full"' in text else 1), told
+    assert all(study.TIME_FILE in message and message.endswith("the study's earlier invocations' time is not counted "
+                                                               "in the wall time its page gives") for message in told)
 
 
 def test_an_ensembles_folder_its_run_refuses_is_refused_before_any_runs(tmp_path, capsys, monkeypatch):
