@@ -486,3 +486,23 @@ def test_a_resume_into_a_folder_that_is_not_there_is_refused_and_makes_none(tmp_
     with pytest.raises(RunFolderError, match="is not a run folder to resume \\(it does not exist"):
         frictionlab.run(preset, out=tmp_path / "new", resume=True, workers=1, progress=False)
     assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.parametrize("overrides", ["seed=3", {"seed": 3}, 5])
+def test_overrides_that_are_not_a_list_are_refused_as_such(overrides):
+    """load_scene("quickstart", "seed=3") was told letter by letter ("--set 's': must look like
+    dotted.path=value", six times); a mapping as "--set 'seed'"; a number as a TypeError."""
+    from frictionlab.preset import load_scene
+
+    with pytest.raises(PresetError) as refused:
+        load_scene("quickstart", overrides)
+    assert refused.value.problems == [f"overrides must be a list of 'dotted.path=value' strings, e.g. ['seed=3']. Got "
+                                      f"{overrides!r} ({type(overrides).__name__}) instead"]  # fmt: skip
+    assert load_scene("quickstart", ("seed=3",)).preset.seed == 3  # a tuple is a list of them
+
+
+def test_the_contract_of_an_unknown_kind_names_the_kinds():
+    """frictionlab.contract("solvers") raised a bare KeyError: 'solvers'."""
+    with pytest.raises(ValueError, match=r"^kind must be one of 'spectrum', 'solver', 'slope'. Got 'solvers' instead.$"):
+        frictionlab.contract("solvers")
+    assert {"solve", "stiffness"} <= frictionlab.contract("solver")

@@ -282,7 +282,10 @@ class ContactSolver(Plugin):
 
 def contract(kind: str) -> frozenset[str]:
     """Every name the framework may use of a plugin of ``kind``: the public attributes and
-    methods of its base class (and of ``Plugin``), declared above; nothing else."""
+    methods of its base class (and of ``Plugin``), declared above; nothing else. ValueError
+    naming the kinds for another ``kind``."""
+    if kind not in KINDS:  # a bare KeyError('solvers') said neither what is allowed nor what was asked
+        raise ValueError(f"kind must be one of {', '.join(map(repr, KINDS))}. Got {kind!r} instead.")
     base = KINDS[kind]
     annotated = {name for cls in base.__mro__ for name in cls.__dict__.get("__annotations__", {})}
     return frozenset(name for name in {*dir(base), *annotated} if not name.startswith("_"))

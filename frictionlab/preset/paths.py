@@ -101,6 +101,9 @@ def swept_paths(data: dict, paths: Sequence[str]) -> list[str]:
 
 def apply_overrides(data: dict, assignments: Sequence[str]) -> dict:
     """A copy of ``data`` with ``dotted.path=value`` assignments applied (values read as YAML scalars)."""
+    if isinstance(assignments, str | bytes) or not isinstance(assignments, Sequence):  # "seed=3": told letter by letter
+        raise PresetError([f"overrides must be a list of 'dotted.path=value' strings, e.g. ['seed=3']. Got "
+                           f"{short_repr(assignments, 80)} ({type(assignments).__name__}) instead"], source="overrides")  # fmt: skip
     data = copy.deepcopy(data)
     problems = []
     for assignment in map(as_typed, assignments):

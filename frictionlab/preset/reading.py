@@ -92,4 +92,4 @@ def read_preset(path: str | Path, overrides: list[str] = (), registry: Registry 
     folder, then ``--set`` overrides applied (a relative path given there is
     taken from the current folder, as in any command line)."""
     data = resolve_input_paths(load_preset_file(path), Path(path).parent, registry)
-    return apply_overrides(data, list(overrides))
+    return apply_overrides(data, overrides)  # a list or tuple: a string or mapping is refused there

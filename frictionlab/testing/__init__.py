@@ -62,67 +62,17 @@ docstrings say how. ``check_plugin(kind, cls, **params)`` runs both.
 
 from __future__ import annotations
 
-import pytest
-
 from .classes import check_plugin_class
 from .common import reported
 from .slopes import check_slope_estimator
 from .solvers import check_solver
 from .spectra import check_spectrum
 
-__all__ = [
-    "check_plugin",
-    "check_plugin_class",
-    "check_slope_estimator",
-    "check_solver",
-    "check_spectrum",
-    "frictionlab_registry",
-    "register_plugin",
-]
-
-
-@pytest.fixture
-def frictionlab_registry():
-    """A fresh registry: built-ins loaded, entry-point discovery blocked."""
-    from frictionlab.plugin.registry import Registry
-
-    return Registry(discover=False)
-
-
-@pytest.fixture
-def register_plugin(frictionlab_registry):
-    """``register_plugin(obj, name=None) -> registry``: register ``obj`` on
-    ``frictionlab_registry`` for this test only."""
-    registered: list[object] = []
-
-    def register(obj, name: str | None = None):
-        plugin = _as_hook_plugin(obj)
-        if name is None and plugin is not obj:
-            name = f"{obj.__module__}.{obj.__qualname__}"
-        frictionlab_registry.register_plugin(plugin, name=name)
-        registered.append(plugin)
-        return frictionlab_registry
-
-    yield register
-
-    for plugin in reversed(registered):
-        if frictionlab_registry.pm.is_registered(plugin):
-            frictionlab_registry.unregister_plugin(plugin)
-
-
-def _as_hook_plugin(obj):
-    """A plugin class (not a hook holder) becomes a namespace with one hookimpl."""
-    from frictionlab.plugin import Plugin
-
-    if isinstance(obj, type) and issubclass(obj, Plugin) and obj.kind:
-        import types
-
-        from frictionlab.plugin.hookspecs import hookimpl
-        def _register(register):
-            register(obj)
-
-        return types.SimpleNamespace(**{obj.register_hook: hookimpl(_register)})
-    return obj
+try:  # the fixtures need pytest; the checks are plain functions, usable without it
+    from .fixtures import frictionlab_registry, register_plugin
+except ModuleNotFoundError as missing:
+    if missing.name != "pytest":
+        raise
 
 
 @reported
@@ -136,3 +86,14 @@ def check_plugin(kind: str, cls, *, deterministic: bool = False, **params) -> No
         check_solver(cls, **params)
     else:
         check_slope_estimator(cls, **params)
+
+
+__all__ = [name for name in (
+    "check_plugin",
+    "check_plugin_class",
+    "check_slope_estimator",
+    "check_solver",
+    "check_spectrum",
+    "frictionlab_registry",
+    "register_plugin",
+) if name in globals()]  # the fixtures where pytest is

@@ -452,7 +452,9 @@ class BandLimitedSpectrum(SpectrumGenerator):
         return 2.0 * s.psd_knee * band_integral(s.band, order, above, 0.0)
 
     def rms_height_continuum(self) -> float:
-        """sqrt(2 * integral psd dq) over the band: the continuum limit of ``rms_height()``."""
+        """sqrt(2 * integral psd dq) over the band. Not the limit of ``rms_height()`` as the pixels
+        shrink: the discrete modes q_k = 2 pi k / L near the long cut-off carry the rms height, and
+        sum to it otherwise than the integral does (by a ratio set by H) at any pixel size."""
         return math.sqrt(self._moment(0))
 
     def rms_slope(self) -> float:

@@ -263,7 +263,9 @@ class BandLimitedSurface(SpectrumGenerator):
         return TWO_PI * s.psd_knee * band_integral(s.band, order + 1, 2.0 * self.params.hurst + 2.0, 0.0)
 
     def rms_height_continuum(self) -> float:
-        """sqrt(2 pi integral q C2D dq): the continuum limit of ``rms_height()``."""
+        """sqrt(2 pi integral q C2D dq). Not the limit of ``rms_height()`` as the pixels shrink:
+        the discrete modes near the long cut-off carry the rms height and sum to it otherwise than
+        the integral does, at any pixel size."""
         return math.sqrt(self._moment(0))
 
     def rms_slope(self) -> float:

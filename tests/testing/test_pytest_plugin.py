@@ -121,3 +121,20 @@ def test_testing_module_import_is_cheap():
     added = ast.literal_eval(out.stdout.strip())
     assert "frictionlab.testing" in added, out.stdout
     assert all(name.startswith("frictionlab.testing.") for name in added if name != "frictionlab.testing"), out.stdout
+
+
+def test_the_checks_run_where_pytest_is_not_installed():
+    """The checks are plain functions: without pytest, `from frictionlab.testing import
+    check_plugin` failed with "No module named 'pytest'" (pytest is not one of frictionlab's
+    dependencies; only the fixtures need it)."""
+    code = (
+        "import sys; sys.modules['pytest'] = None\n"  # as where it is not installed: importing it fails
+        "from frictionlab.testing import *\n"
+        "from frictionlab_slopes import ForwardDifference\n"
+        "check_plugin('slope', ForwardDifference)\n"
+        "print(sorted(name for name in dir() if name.startswith('check_')), 'register_plugin' in dir())"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == ("['check_plugin', 'check_plugin_class', 'check_slope_estimator', 'check_solver', "
+                                   "'check_spectrum'] False")
