@@ -159,7 +159,7 @@ def _plugin_told(entry):
 
     @functools.wraps(entry)
     def called(*args, **keys):
-        from .interrupts import interrupts_marked, raised_by_signal
+        from .errors.interrupts import interrupts_marked, raised_by_signal
 
         with interrupts_marked():  # Ctrl-C told from a plugin's own KeyboardInterrupt
             try:

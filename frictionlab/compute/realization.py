@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import OUT_OF_MEMORY, PluginError
-from ..interrupts import raised_by_signal
+from ..errors.interrupts import raised_by_signal
 from ..plugin.registry import fault_place, plugin_fault
 from ..plugin.outputs import (
     LEAVE_INPUTS, RandomWatch, curve_problem, height_of, largest_magnitude, order_problem, profile_problem, read_only,

@@ -16,7 +16,7 @@ import signal
 import threading
 
 from ..errors import ExitCode, shown
-from ..interrupts import signal_interrupt
+from ..errors.interrupts import signal_interrupt
 
 HANDLED = (signal.SIGINT, signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else []))  # no SIGHUP on Windows
 ENDINGS = {signal.SIGINT: (ExitCode.INTERRUPTED, "interrupted"), signal.SIGTERM: (ExitCode.TERMINATED, "terminated")}

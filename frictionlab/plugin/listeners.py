@@ -22,7 +22,7 @@ import traceback
 import warnings
 from typing import TYPE_CHECKING, Protocol
 
-from ..interrupts import raised_by_signal
+from ..errors.interrupts import raised_by_signal
 from .base import Plugin, PluginParams
 from .hookspecs import hookspec
 

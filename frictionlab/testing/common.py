@@ -30,7 +30,7 @@ def reported(check: Callable) -> Callable:
     @functools.wraps(check)
     def checked(*args, **kwargs):
         __tracebackhide__ = True
-        from frictionlab.interrupts import interrupts_marked, raised_by_signal
+        from frictionlab.errors.interrupts import interrupts_marked, raised_by_signal
 
         with interrupts_marked():
             try:
@@ -59,7 +59,7 @@ def fail(cls, message: str, cause: BaseException | None = None):
 def call(cls, what: str, fn: Callable[..., Any], *args, **kwargs):
     """Run plugin code; any exception becomes an AssertionError naming the call (a ``sys.exit()``
     and a ``KeyboardInterrupt`` the code raised itself included: a Ctrl-C stops the tests)."""
-    from frictionlab.interrupts import interrupts_marked, raised_by_signal
+    from frictionlab.errors.interrupts import interrupts_marked, raised_by_signal
 
     with interrupts_marked():
         try:

@@ -1,4 +1,4 @@
-"""Error types and process exit codes shared by every front end."""
+"""Error types and exit codes shared by every front end (``interrupts``: a signal's Ctrl-C told apart)."""
 
 from __future__ import annotations
 
@@ -456,7 +456,7 @@ def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
     warning shown once per place is shown again for each place of the user's that causes it."""
     import warnings
 
-    package, frame, level = os.path.dirname(__file__) + os.sep, sys._getframe(1), 1
+    package, frame, level = os.path.dirname(os.path.dirname(__file__)) + os.sep, sys._getframe(1), 1  # frictionlab/
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level + 1 if frame is not None else 2)
