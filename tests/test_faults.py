@@ -176,6 +176,14 @@ def truncated(folder):
     path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
 
 
+def grown(folder):  # past what a chunk of 10 realizations can hold: refused by its size, never read (sparse: no disk)
+    with (folder / "chunks" / _second(folder)).open("r+b") as fh:
+        fh.truncate(GROWN_BYTES)
+
+
+GROWN_BYTES = 64 * 1024**2
+
+
 def emptied(folder):
     (folder / "chunks" / _second(folder)).write_bytes(b"")
 
@@ -298,6 +306,7 @@ def listed_twice(folder):
 DAMAGE = {
     truncated: "'00000001-00000010.npz': checksum mismatch",
     emptied: "checksum mismatch",
+    grown: f"'00000001-00000010.npz': file of {GROWN_BYTES:,} bytes, more than the limit of ",
     deleted: "'00000001-00000010.npz': missing",
     edited_value: "checksum mismatch",
     nan_row: "checksum mismatch",

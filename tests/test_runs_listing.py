@@ -203,8 +203,8 @@ def test_a_chunk_with_a_forged_central_directory_is_not_parsed(tmp_path, registr
     scene = build_scene(TINY, registry=registry)
     try:
         read_chunk(out, forged.name, entries[forged.name], scene)
-    except ChunkDamage as exc:
-        assert "unreadable" in str(exc)
+    except ChunkDamage as exc:  # by its size first: more than a chunk of one realization can be
+        assert "more than the limit of" in str(exc) or "unreadable" in str(exc), str(exc)
     else:
         raise AssertionError("a forged central directory was read as a chunk")
 

@@ -99,6 +99,19 @@ def test_a_resume_ends_where_the_unlimited_run_ends(tmp_path, reference):
     same_files(tmp_path / "run", reference)
 
 
+def test_a_resume_recomputes_a_chunk_grown_past_what_it_can_hold_without_reading_it(tmp_path, reference):
+    """A chunk of a few realizations grown to 3 GiB was read whole: "out of memory", and the
+    resume it said to run failed the same way. It is refused by its size, and recomputed."""
+    cancel = threading.Event()
+    run_to_folder(build_scene(SMALL), tmp_path / "run", RunOptions(workers=1), listeners=[CancelAfter(3, cancel)],
+                  cancel=cancel)  # fmt: skip
+    chunk = tmp_path / "run" / "chunks" / min(json.loads((tmp_path / "run" / "run.json").read_text())["chunks"])
+    os.truncate(chunk, 3 * 1024**3)  # sparse: past LIMIT, no disk
+    done = ok(limited("resume", str(tmp_path / "run"), "--workers", "1", cwd=tmp_path))
+    assert f"'{chunk.name}': file of {3 * 1024**3:,} bytes, more than the limit of " in done.stderr, done.stderr
+    same_files(tmp_path / "run", reference)
+
+
 def test_load_runs_and_follow_read_a_finished_run(tmp_path, reference):
     import frictionlab
 

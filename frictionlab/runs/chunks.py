@@ -34,6 +34,8 @@ CURVE_ARRAYS = ("xi", "contact_count", "indentation")
 OPTIONAL_CURVE_ARRAYS = ("force", "real_area_corrected", "real_gradient_rms", "contact_spots")
 ADDED_OPTIONAL_ARRAYS = frozenset({"real_gradient_rms", "contact_spots"})  # of those, absent from older chunks: NaN
 ADDED_CURVE_ARRAYS = ("half_load_points",)  # kept by every run, absent from the chunks of older versions: NaN
+HEIGHT_ARRAYS = ("measured_rms_height", "own_rms_height", "peak_rms")  # absent from the chunks of older versions: NaN
+ENTRY_BYTES = 1024  # of an array in a chunk besides its values: its zip entry's two headers and its .npy header, ~300 bytes
 
 
 class ChunkDamage(ValueError):
@@ -80,6 +82,19 @@ def chunk_bytes(results: list[RealizationResult]) -> bytes:
     return data
 
 
+def most_chunk_bytes(held: int, steps: int) -> int:
+    """The largest file ``chunk_bytes`` writes for ``held`` realizations of ``steps`` load steps,
+    each finished (8 bytes in each per-realization array, 8 a step in each curve any solver keeps)
+    or failed (8 bytes in its index and its time, its error at most ERROR_BYTES): a larger file is
+    refused before it is read (a chunk of 877 realizations, 1 MB, grown to 3 GB was read whole and
+    a resume ran out of memory, again at each resume)."""
+    curves = CURVE_ARRAYS + OPTIONAL_CURVE_ARRAYS + ADDED_CURVE_ARRAYS
+    finished = 8 * (len(OK_ARRAYS + HEIGHT_ARRAYS) + steps * len(curves))
+    failed = 8 * 2 + ERROR_BYTES
+    arrays = len(OK_ARRAYS + HEIGHT_ARRAYS + FAILED_ARRAYS + curves)
+    return min(MAX_CHUNK_BYTES, held * max(finished, failed) + arrays * ENTRY_BYTES)
+
+
 def damage_report(chunk_dir: Path, listed: set[str], damaged: dict[str, str], kept: set[int], total: int) -> str:
     """What a resume found wrong in ``chunk_dir``: the ``damaged`` chunks (name: why) and the
     files the manifest does not ``list``, with how many of the ``total`` realizations they held
@@ -113,14 +128,14 @@ def read_chunk(folder: Path, name: str, digest, scene: Scene) -> list[Realizatio
     match = CHUNK_NAME.fullmatch(name) if isinstance(name, str) else None
     if match is None or not isinstance(digest, str):
         raise ChunkDamage("not a chunk name")
+    first, last = int(match[1]), int(match[2])
+    held = max(1, min(last - first + 1, scene.preset.realizations))  # realizations it can hold
     try:
-        raw = read_member(folder, f"{CHUNK_DIR}/{name}", MAX_CHUNK_BYTES, what="file")
+        raw = read_member(folder, f"{CHUNK_DIR}/{name}", most_chunk_bytes(held, scene.loads.size), what="file")
     except InputFileProblem as exc:
         raise ChunkDamage("missing" if str(exc).startswith("no such") else str(exc)) from None
     if hashlib.sha256(raw).hexdigest() != digest:
         raise ChunkDamage("checksum mismatch")
-    first, last = int(match[1]), int(match[2])
-    held = max(1, min(last - first + 1, scene.preset.realizations))  # realizations it can hold
     try:
         with _check_archive(io.BytesIO(raw)) as archive:  # its directory parsed once, for the sizes it declares
             problem = npz_unpacked_problem(archive, held * (scene.loads.size * 8 + ERROR_BYTES) + 4096)
@@ -294,7 +309,7 @@ def chunk_results(arrays: dict, first: int, last: int, scene: Scene) -> list[Rea
     if indices.size == 0 or indices.min() < low or indices.max() > high or repeated:
         raise ChunkDamage(f"indices outside {first}..{last} of this run, or repeated")
     heights = {}  # absent from the chunks of older versions: NaN
-    for name in ("measured_rms_height", "own_rms_height", "peak_rms"):
+    for name in HEIGHT_ARRAYS:
         heights[name] = arrays.get(name, np.full(n, math.nan))
         if heights[name].shape != (n,):
             raise ChunkDamage(f"array {name} of shape {heights[name].shape}, expected {(n,)}")
