@@ -15,6 +15,7 @@ import subprocess
 import sys
 import threading
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -216,6 +217,22 @@ def repeated_index(folder):
     _rewrite(folder, _second(folder), lambda a: a["index"].__setitem__(1, a["index"][0]), True)
 
 
+def forged_header(folder):  # xi's header claims 7 TiB over 64 bytes: numpy tried to allocate them ('unreadable')
+    path = folder / "chunks" / _second(folder)
+    with np.load(path) as data:
+        arrays = {key: data[key] for key in data.files if key != "xi"}
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6)})
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    with zipfile.ZipFile(buffer, "a") as archive:
+        archive.writestr("xi.npy", header.getvalue() + bytes(64))
+    path.write_bytes(buffer.getvalue())
+    manifest = _manifest(folder)
+    manifest["chunks"][path.name] = hashlib.sha256(buffer.getvalue()).hexdigest()
+    (folder / "run.json").write_text(json.dumps(manifest))
+
+
 def misshapen_rows(folder):
     _rewrite(folder, _second(folder), lambda a: a.__setitem__("xi", a["xi"][:, :-1]), True)
 
@@ -315,6 +332,7 @@ DAMAGE = {
     negative_index: "indices outside",
     repeated_index: "or repeated",
     misshapen_rows: "array xi of shape",
+    forged_header: "'00000001-00000010.npz': array 'xi': its header claims shape (1000000, 1000000) of float64",
     text_xi: "array xi of type <U32, not real numbers",
     negative_count: "contact_count below 0 or above the profile's points",
     count_above_points: "contact_count below 0 or above the profile's points",

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from frictionlab.io.files import atomic_write, write_npz
+from frictionlab.io.files import atomic_write, npz_unpacked_problem, write_npz
 
 
 def test_atomic_write_gives_the_usual_permissions_not_mkstemps(tmp_path):
@@ -241,3 +241,23 @@ def test_a_socket_given_as_an_input_file_is_named_a_socket(tmp_path, cli):
             open_member(tmp_path / "run", "run.json")
         done = cli("validate", str(tmp_path / "p.yaml"))
     assert done.returncode == 3 and "preset file is a socket, not a regular file" in done.stdout + done.stderr
+
+
+def test_an_npy_header_claiming_more_than_its_deflated_entry_can_unpack_to_is_refused_unread():
+    """The sizes a zip's directory declares are the forger's too: an entry of 2 GiB declared
+    over a few hundred deflated bytes passed a bound of what the run can write, and numpy
+    allocated the 2 GiB its header claimed before reading them (EOF)."""
+    claimed = 2**28  # float64s: 2 GiB
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": (claimed,)})
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("xi.npy", header.getvalue() + bytes(64))
+    data = bytearray(buffer.getvalue())
+    declared = (len(header.getvalue()) + 8 * claimed).to_bytes(4, "little")  # both headers' uncompressed size
+    local, central = data.index(b"PK\x03\x04"), data.index(b"PK\x01\x02")
+    data[local + 22 : local + 26], data[central + 24 : central + 28] = declared, declared
+    with zipfile.ZipFile(io.BytesIO(bytes(data))) as archive:
+        assert archive.getinfo("xi.npy").file_size > 8 * claimed  # as declared: no smaller than the claim
+        problem = npz_unpacked_problem(archive, most=2**40)
+    assert problem is not None and f"array 'xi': its header claims shape ({claimed},) of float64" in problem

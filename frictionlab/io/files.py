@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import io
+import math
 import os
 import re
 import stat
@@ -268,15 +269,49 @@ def write_npz(fh, arrays: Mapping[str, np.ndarray]) -> None:
 
 
 def npz_unpacked_problem(archive: zipfile.ZipFile, most: int) -> str | None:
-    """Why the opened .npz ``archive`` is no run's: an array that its central directory says
-    unpacks to more than ``most`` bytes (zeros deflated: 1 MB on disk, 1 GB unpacked, all
-    of it in memory before its shape could be checked), or None. zipfile unpacks no more
-    of a member than that declared size."""
+    """Why the opened .npz ``archive`` is no run's, or None: an array that its central directory
+    says unpacks to more than ``most`` bytes (zeros deflated: 1 MB on disk, 1 GB unpacked, all of
+    it in memory before its shape could be checked; zipfile unpacks no more of a member than that
+    declared size), or whose .npy header claims more data than its entry holds (numpy allocates
+    what the header claims before reading any: 7 TiB for a 3 kB file). Only headers are read."""
     for member in archive.infolist():
+        name = member.filename.removesuffix(".npy")
         if member.file_size > most:
-            return (f"array {member.filename.removesuffix('.npy')!r} unpacks to {member.file_size:,} bytes, "
+            return (f"array {name!r} unpacks to {member.file_size:,} bytes, "
                     f"more than the {most:,} its run can write")  # fmt: skip
+        with archive.open(member) as fh:
+            try:
+                shape, dtype = npy_header(fh)
+            except ValueError as exc:  # no .npy magic: np.load hands back the entry's bytes, not an array
+                return f"array {name!r} has no readable .npy header ({exc})"
+            held = _entry_bytes(member) - fh.tell()
+        claimed = math.prod(shape) * dtype.itemsize
+        if claimed > held and not dtype.hasobject:  # an object array np.load refuses before it allocates
+            return (f"array {name!r}: its header claims shape {shape} of {dtype} ({claimed:,} bytes), "
+                    f"but its entry holds {max(held, 0):,} bytes of data")  # fmt: skip
     return None
+
+
+DEFLATE_MOST_RATIO = 1032  # deflate writes at least 2 bits for 258 bytes: no entry unpacks to more than this times its size
+
+
+def _entry_bytes(member: zipfile.ZipInfo) -> int:
+    """The most bytes the zip entry ``member`` can unpack to: its declared size, and for a stored or
+    deflated entry no more than its packed bytes allow (zipfile ends the read there: EOFError)."""
+    if member.compress_type == zipfile.ZIP_STORED:
+        return min(member.file_size, member.compress_size)
+    if member.compress_type == zipfile.ZIP_DEFLATED:
+        return min(member.file_size, DEFLATE_MOST_RATIO * member.compress_size)
+    return member.file_size
+
+
+def npy_header(fh) -> tuple[tuple[int, ...], np.dtype]:
+    """The shape and type that the .npy header at ``fh`` declares, read without its data (a
+    forged shape must size no buffer); ValueError for a damaged header."""
+    version = np.lib.format.read_magic(fh)
+    read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+    shape, _, dtype = read_header(fh)
+    return shape, dtype
 
 
 def _deflates(array: np.ndarray) -> bool:

@@ -18,7 +18,7 @@ import numpy as np
 from ..compute.ensemble import OWN_H_TOLERANCE
 from ..compute.realization import RealizationResult
 from ..errors import OutputRefused, RunFolderError, first_names, shown
-from ..io.files import npz_unpacked_problem, output_path_problem
+from ..io.files import npy_header, npz_unpacked_problem, output_path_problem
 from ..io.inputs import InputFileProblem
 from ..preset import Scene
 from .runfolder import MAX_WALL_SECONDS, open_member, read_member
@@ -190,9 +190,7 @@ def _index_array(member, most: int, file_size: int) -> np.ndarray:
     """A 1-D integer .npy array of at most ``most`` values read from ``member`` of a file of
     ``file_size`` bytes, its header checked before anything is allocated (a forged shape
     must not size a buffer)."""
-    version = np.lib.format.read_magic(member)
-    read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
-    shape, _, dtype = read_header(member)
+    shape, dtype = npy_header(member)
     if len(shape) != 1 or dtype.kind not in "iu" or shape[0] > most or shape[0] * dtype.itemsize > file_size:
         raise ValueError("not an index array")
     raw = member.read(min(shape[0] * dtype.itemsize, file_size))

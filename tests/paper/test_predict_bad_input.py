@@ -294,16 +294,23 @@ def _fewer_rows(path):  # realizations of another run: fewer than summary.json s
         np.savez(fh, **arrays)
 
 
-def _array_larger_than_memory(path):  # a header may claim any shape
+def _xi_claimed(path, shape):  # a header may claim any shape, over 64 bytes of data
     header = io.BytesIO()
-    claim = {"descr": "<f8", "fortran_order": False, "shape": (10**14, 16)}  # past any address space
-    np.lib.format.write_array_header_1_0(header, claim)
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False, "shape": shape})
     with np.load(path) as data:
         f = data["f"]
     with zipfile.ZipFile(path, "w") as archive:
         archive.writestr("xi.npy", header.getvalue() + bytes(64))
         with archive.open("f.npy", "w") as member:
             np.save(member, f)
+
+
+def _array_claimed_past_memory(path):  # 7 TiB were asked of the machine for a 3 kB file
+    _xi_claimed(path, (10**6, 10**6))
+
+
+def _array_of_a_gigabyte(path):  # 1 GB was allocated, then 'EOF: reading array data'
+    _xi_claimed(path, (50, 2_500_000))
 
 
 def _one_array(path):
@@ -323,7 +330,9 @@ def _folder(path):
         (_empty, "is damaged"),
         (_truncated, "is damaged"),
         (_pickled, "pickled Python objects, which are never loaded"),
-        (_array_larger_than_memory, "larger than this machine's memory"),
+        (_array_claimed_past_memory, "is damaged (array 'xi': its header claims shape (1000000, 1000000) of float64 "
+                                    f"({10**12 * 8:,} bytes), but its entry holds 64 bytes of data)"),
+        (_array_of_a_gigabyte, f"array 'xi': its header claims shape (50, 2500000) of float64 ({50 * 2_500_000 * 8:,} bytes)"),
         (_without_xi, "no array 'xi'"),
         (_all_nan, "'xi' must hold finite numbers, or NaN where a line has no xi, with xi defined at two loads or "
                    "more (no line has xi at "),  # said as it is: it once said "(0 of ... are infinite)"
