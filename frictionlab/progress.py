@@ -342,11 +342,12 @@ def point_result_line(sweep, point, row: dict) -> str:
 
     values = ", ".join(f"{p.rsplit('.', 1)[-1]}={yaml_scalar(point.values[p])}" for p in sweep.paths)
     fit = row_fit(row)
-    if fit is None:  # why not, where the row says (a point in error: what to do)
-        reason = f": {row['error']}" if isinstance(row.get("error"), str) and row["error"] else ""
-        return shown(f"  {point.number:>3}  {values}: {row['status']}{reason}")
+    reason = row["error"] if isinstance(row.get("error"), str) and row["error"] else ""  # what to do: a point in error, a kept row's
+    if fit is None:
+        return shown(f"  {point.number:>3}  {values}: {row['status']}{reason and ': '}{reason}")
     first, last = row.get("contact_first"), row.get("contact_last")  # an edited sweep.json may hold one
     contacts = "" if first is None or last is None else f", contacts {first:.2f} .. {last:.2f}"
     return shown(f"  {point.number:>3}  {values}: a = {format_estimate(fit.a, fit.a_ci)}, "
             f"b = {format_estimate(fit.b, fit.b_ci)}, R^2 = {fit.r2:.3f}{contacts}"
-            + ("" if row["status"] == "completed" else f" ({row['status']})"))  # fmt: skip
+            + ("" if row["status"] == "completed" else f" ({row['status']})")
+            + (f"; error: {reason}" if reason else ""))  # fmt: skip

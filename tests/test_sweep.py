@@ -467,7 +467,8 @@ def test_the_table_after_a_sweep_says_why_a_point_failed_even_with_quiet(tmp_pat
     point.symlink_to(elsewhere)
     assert main(["resume", str(out), "--workers", "1", "--quiet", "--no-plot"]) == 1
     printed, said = capsys.readouterr()
-    assert f"seed=1: error: {point} is a symbolic link or not a folder" in printed
+    assert "seed=1: a = " in printed  # its finished row kept (the point is not recomputed), and why it failed
+    assert f"; error: {point} is a symbolic link or not a folder" in printed
     assert "seed=2: a = " in printed
     assert "(sweep.csv, points/)" in printed
     # on stderr too, as a run's failure is: under --quiet it said nothing there, exit 1 (a sweep

@@ -91,7 +91,7 @@ def check_sweep_startable(sweep, out_dir: str | Path, options: RunOptions) -> No
 
     _check_not_in_use(out_dir)
     _check_followable_folder(out_dir)
-    check_sweep_folder(sweep, Path(out_dir), options.force)
+    check_sweep_folder(sweep, Path(out_dir), options.force, options.resume)
     check_sweep_memory(sweep, options)
 
 

@@ -343,14 +343,7 @@ class RunDirectory:
             sweep = os.path.lexists(self.path / "sweep.json")  # its points are runs of their own
             raise RunFolderError(f"{shown_name(self.path)} holds no run to resume (no {STATE_FILE})" + (
                 f": it is a sweep's folder, which `frictionlab resume {command_word(self.path)}` continues" if sweep else ""))
-        if not same_preset(state, resolved, scene):
-            stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
-            changed = differences(stored, resolved)
-            if not changed:  # the same preset, and a fingerprint that is not its own
-                raise RunFolderError(
-                    f"cannot resume {shown_name(self.path)}: the fingerprint in its {STATE_FILE} is not that of the preset it "
-                    f"holds (the file damaged or edited); run the preset again into a new folder"
-                )
+        if changed := self.preset_changes(state, resolved, scene):
             given = f" ({scene.source})" if scene.source else ""  # `resume DIR`: DIR/preset.yaml, edited
             raise RunFolderError(f"cannot resume {shown_name(self.path)}: the preset its {STATE_FILE} started with differs from the one "
                                  f"given{given}\n  " + "\n  ".join(changed))
@@ -370,6 +363,17 @@ class RunDirectory:
         self._kept = {r.index: r for r in results}
         self._write_manifest()
         return results
+
+    def preset_changes(self, state: dict, resolved: dict, scene: Scene) -> list[str]:
+        """Where the preset the manifest ``state`` started with differs from ``scene``'s (``resolved``), a
+        line per field; [] where it is the same, RunFolderError where the manifest's fingerprint is not its own."""
+        if same_preset(state, resolved, scene):
+            return []
+        stored = state.get("preset") if isinstance(state.get("preset"), dict) else self.stored_preset()
+        if not (changed := differences(stored, resolved)):  # the same preset, and a fingerprint that is not its own
+            raise RunFolderError(f"cannot resume {shown_name(self.path)}: the fingerprint in its {STATE_FILE} is not that of "
+                                 "the preset it holds (the file damaged or edited); run the preset again into a new folder")
+        return changed
 
     # ------------------------------------------------------------ chunks
 

@@ -41,7 +41,7 @@ from .import_ahead import PLOT_MODULE, imported
 from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder, refuse_nothing_to_resume
-from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, stored_sweep, write_tables
+from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, completed_rows, stored_sweep, write_tables
 from .sweeprecord import read_sweep_record
 from ..compute.memory import estimate
 from .runner import check_memory, read_back, run_to_folder
@@ -122,7 +122,6 @@ class Sweep:
         head = re.split(r"[:;(,]", (field.description or "") if field is not None else "")[0].strip()
         return head if 0 < len(head) <= 40 else keys[-1].replace("_", " ")
 
-
     def _params_model(self, section: str) -> type[BaseModel] | None:
         """The Params of the plugin in ``section``: a point's, else (a sweep read back
         from its folder, without points) the installed plugin the base preset names."""
@@ -146,9 +145,7 @@ def _label(values: dict[str, Any]) -> str:
 
 
 def _model_of(annotation) -> type[BaseModel] | None:
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    for arg in getattr(annotation, "__args__", ()):  # Optional[Model]
+    for arg in (annotation, *getattr(annotation, "__args__", ())):  # Model, or Optional[Model]
         if isinstance(arg, type) and issubclass(arg, BaseModel):
             return arg
     return None
@@ -285,7 +282,7 @@ class PointResult:
     def failure(self) -> str:
         """Why this point makes its sweep failed, "" where it does not: its error (a point failed
         or in error), or its realizations that failed (a point completed without them)."""
-        if self.status in ("failed", "error"):
+        if self.status in ("failed", "error") or (self.recorded is not None and self.error):  # a kept row: its point's error
             return self.error or self.status
         failures = self.outcome.failures if self.outcome is not None else ()
         return f"{counted(len(failures), 'realization')} failed, the first: {failures[0][1]}" if failures else ""
@@ -401,7 +398,7 @@ def run_sweep(
     out_dir = Path(out_dir)
     if options.resume:
         refuse_nothing_to_resume(out_dir)
-    check_sweep_folder(sweep, out_dir, options.force)
+    check_sweep_folder(sweep, out_dir, options.force, options.resume)
     check_sweep_memory(sweep, options)
     listeners = list(listeners)
     cancel = threading.Event() if cancel is None else cancel
@@ -409,6 +406,7 @@ def run_sweep(
     results = {p.number: PointResult(p, "pending", point_folder(out_dir, p)) for p in sweep.points}
     outcome = SweepOutcome(status="running", results=list(results.values()), elapsed=0.0)
     with RunDirectory(out_dir):  # its lock: one sweep at a time here, and a dead one reads as interrupted
+        kept = completed_rows(out_dir) if options.resume else {}  # a finished row stays so where its point is not read back
         try:  # every point's folder is in points/: a file or a link there refuses the sweep, not each point
             make_subfolder(out_dir, "points")
         except RunFolderError as exc:
@@ -421,7 +419,9 @@ def run_sweep(
         try:
             with one_dask_cluster(options):  # on Dask, every point's run uses one client and cluster
                 for result in _run_points(sweep, out_dir, options, listeners, cancel, plot):
-                    results[result.point.number] = result.held()  # the listeners hear it whole
+                    number = result.point.number  # the listeners hear it whole, and its error
+                    results[number] = result.held() if result.status != "error" or number not in kept else replace(
+                        result, status="completed", recorded=kept[number])
                     outcome.results = list(results.values())
                     outcome.elapsed = time.perf_counter() - started
                     write_tables(sweep, outcome, out_dir)

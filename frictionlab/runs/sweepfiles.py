@@ -30,14 +30,20 @@ class OtherSweep(OutputRefused):
 SWEEP_FILES = ("sweep.csv", "sweep.json", "sweep.png")  # what a sweep writes in its folder, beside points/
 
 
-def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None:
+def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False, resume: bool = False) -> None:
     """OutputRefused unless ``out_dir`` is new, empty, or holds this same sweep
-    (its sweep.json names the same sweep and base preset), or ``force``."""
+    (its sweep.json names the same sweep and base preset), or ``force``; with ``resume``,
+    RunFolderError where a point's folder started another preset (``refuse_changed_points``)."""
     refuse_unusable_folder(out_dir)
     refuse_unreplaceable([out_dir / name for name in SWEEP_FILES], "sweep", "give another output folder")  # --force too
     refuse_other_kind(out_dir, "sweep")  # --force too
-    if force or not out_dir.is_dir() or not any(out_dir.iterdir()):
-        return
+    if not force and out_dir.is_dir() and any(out_dir.iterdir()):
+        _refuse_other_sweep(sweep, out_dir)
+    if resume:  # after: a preset given that is not the sweep's is said so, not as sweep.json edited
+        refuse_changed_points(sweep, out_dir)
+
+
+def _refuse_other_sweep(sweep: Sweep, out_dir: Path) -> None:
     hint = "give another output folder, or force it (--force; force=True in Python) to write into it anyway"
     try:
         old = as_it_ran(read_json(out_dir, "sweep.json", MAX_SWEEP_RECORD_BYTES))
@@ -50,6 +56,38 @@ def check_sweep_folder(sweep: Sweep, out_dir: Path, force: bool = False) -> None
     if not isinstance(old, dict) or any(old.get(key) != value for key, value in mine.items()):
         raise OtherSweep(f"{shown_name(out_dir)} holds another sweep: {hint} (its tables are then replaced)"
                          + _changes(old, mine))
+
+
+def refuse_changed_points(sweep: Sweep, out_dir: Path, shown: int = 8) -> None:
+    """RunFolderError, before a resumed sweep runs or writes anything, where every started point's run.json
+    began with another preset than the sweep (its sweep.json, edited) plans for it: each point's own resume
+    refused it, and the sweep then wrote its finished rows as errors, their fits gone. Where only some
+    differ, their folders do (another run moved there): the sweep goes on, and says so of each."""
+    from .rundir import STATE_FILE, RunDirectory, json_copy
+
+    changed: dict[tuple[str, ...], list[int]] = {}  # the differences, and the points that have them
+    started = 0
+    for point in sweep.points:
+        folder = RunDirectory(out_dir / "points" / point.folder_name)
+        if folder.path.is_symlink() or not (folder.path / STATE_FILE).is_file():
+            continue  # not started, or not a folder of the sweep's: the point's own run says so
+        try:
+            state = folder.state()
+            lines = folder.preset_changes(state, json_copy(point.scene.resolved()), point.scene) if state else []
+        except RunFolderError:  # a damaged run.json: the point's own resume says what is wrong
+            continue
+        started += 1
+        if lines:
+            changed.setdefault(tuple(lines), []).append(point.number)
+    if changed and sum(map(len, changed.values())) == started:
+        said = "".join(f"\n  point{'s' if len(n) > 1 else ''} {', '.join(map(str, n))}: " + "; ".join(lines[:shown])
+                       + (f"; ... and {len(lines) - shown} more" if len(lines) > shown else "") for lines, n in changed.items())
+        raise RunFolderError(
+            f"cannot resume {shown_name(out_dir)}: {shown_name(out_dir / 'sweep.json')} (its base_preset and sweep) differs from "
+            f"the preset its points' {STATE_FILE} started with ('in the run directory': a point's {STATE_FILE}; 'given': sweep.json)"
+            f"{said}\nnothing was run or written: put sweep.json back as it was, or run the changed sweep into another "
+            f"folder; a point folder that holds another run: move it aside, then resume the sweep to compute that point afresh"
+        )
 
 
 def _changes(old, mine: dict, shown: int = 8) -> str:
@@ -89,6 +127,15 @@ def stored_sweep(out_dir: Path) -> dict:
     and the sweep), for ``frictionlab resume``; RunFolderError if it holds none, or a damaged one."""
     data, _ = read_sweep_record(out_dir)
     return {**data["base_preset"], "sweep": data["sweep"]}  # as Sweep.preset_data
+
+
+def completed_rows(out_dir: Path) -> dict[int, dict]:
+    """The rows of the sweep.json in ``out_dir`` whose point completed, by number ({} where none is read):
+    a resumed point in error (its folder refused) kept its fit nowhere but in its row."""
+    try:
+        return {n: row for n, row in enumerate(read_sweep_record(out_dir)[0]["points"], 1) if row["status"] == "completed"}
+    except RunFolderError:
+        return {}
 
 
 def write_tables(sweep: Sweep, outcome: SweepOutcome, out_dir: Path) -> dict[str, Path]:
