@@ -80,3 +80,32 @@ def test_a_finished_row_stays_completed_where_its_point_cannot_be_read_back(fini
     record = json.loads((finished / "sweep.json").read_text())
     assert record["status"] == "failed" and record["points"][0]["status"] == "completed"
     assert "fingerprint" in record["points"][0]["error"] and record["points"][0]["a"] == float(rows[0]["a"])
+
+
+@pytest.mark.parametrize("change, field, said", [
+    (lambda r: r["sweep"]["parameters"]["seed"].update(values=[1, 3]), "points.1.seed", "is 2, but point 2 of its sweep.parameters has 3"),
+    (lambda r: r.update(points=[r["points"][0]] * 2), "points.1.point", "is 1, but point 2 of its sweep.parameters has 2"),
+    (lambda r: r.update(points=r["points"][::-1]), "points.0.point", "is 2, but point 1 of its sweep.parameters has 1"),
+    (lambda r: r["points"][1].update(folder="points/01-seed-1"), "points.1.folder",
+     "is 'points/01-seed-1', but point 2 of its sweep.parameters has 'points/02-seed-2'"),
+    (lambda r: r["points"][0].update(seed=True), "points.0.seed", "is True, but point 1 of its sweep.parameters has 1"),
+])  # fmt: skip
+def test_rows_that_are_not_the_plans_points_are_a_damaged_sweep_json_to_every_reader(finished, capsys, change, field, said):
+    """sweep.json's rows were never held to its plan: values [1, 3] showed point 2's fit (seed 2) as seed 3 in
+    follow, plot and runs (completed 2/2), and a resume computed 02-seed-3 beside 02-seed-2; a row repeated
+    showed point 1's fit twice."""
+    import frictionlab
+    from frictionlab.errors import RunFolderError
+
+    _edit(finished, change)
+    before = _files(finished)
+    damaged = f"{finished / 'sweep.json'} is damaged: field '{field}' {said}"
+    for command in (["follow", str(finished)], ["plot", str(finished), "--out", str(finished.parent / "x.png")],
+                    ["resume", str(finished), *RESUME]):  # fmt: skip
+        assert main(command) == 5, command
+        assert damaged in capsys.readouterr().err, command
+    main(["runs", str(finished.parent)])  # a listing: the folder said damaged, not completed 2/2
+    assert damaged.replace(f"{finished / 'sweep.json'}", "sweep.json") in capsys.readouterr().out
+    with pytest.raises(RunFolderError, match="its rows are not those of its sweep"):
+        frictionlab.load(finished)
+    assert _files(finished) == before and not (finished.parent / "x.png").exists()  # nothing computed or rewritten

@@ -14,7 +14,6 @@ Front ends follow a sweep through ``listeners.SweepListener``s; each point's run
 
 from __future__ import annotations
 
-import itertools
 import os
 import re
 import threading
@@ -42,7 +41,7 @@ from .figures import write_figure
 from .rundir import STATE_FILE, RunDirectory
 from .runfolder import make_subfolder, refuse_nothing_to_resume
 from .sweepfiles import RESULT_COLUMNS, check_sweep_folder, completed_rows, stored_sweep, write_tables
-from .sweeprecord import read_sweep_record
+from .sweeprecord import combinations, folder_name, read_sweep_record
 from ..compute.memory import estimate
 from .runner import check_memory, read_back, run_to_folder
 
@@ -136,14 +135,6 @@ class Sweep:
             return None
 
 
-def _label(values: dict[str, Any]) -> str:
-    parts = []
-    for path, value in values.items():
-        text = f"{value:.6g}" if isinstance(value, float) else str(value)
-        parts.append(f"{path.rsplit('.', 1)[-1]}-{text}")
-    return re.sub(r"[^A-Za-z0-9._+=-]+", "-", "_".join(parts))[:80].strip("-") or "point"
-
-
 def _model_of(annotation) -> type[BaseModel] | None:
     for arg in (annotation, *getattr(annotation, "__args__", ())):  # Model, or Optional[Model]
         if isinstance(arg, type) and issubclass(arg, BaseModel):
@@ -194,13 +185,6 @@ def _plugin_param_problem(where, keys, data, spec, registry) -> str | None:
     return None
 
 
-def _combinations(spec: SweepSettings) -> list[dict[str, Any]]:
-    paths = list(spec.parameters)
-    columns = [spec.parameters[p].points() for p in paths]
-    rows = itertools.product(*columns) if spec.mode == "grid" else zip(*columns, strict=True)
-    return [dict(zip(paths, row, strict=True)) for row in rows]
-
-
 def plan_sweep(data: dict, registry: Registry | None = None, source: str | None = None, before_reading=None) -> Sweep:
     """Expand preset data with a ``sweep`` section into validated points, each checked by ``before_reading``.
     Every problem of every point is reported at once (``sweep point N (path=value): ...``); nothing runs unless
@@ -214,8 +198,8 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
     if problems:
         raise PresetError(problems, source=source)
     base = {k: v for k, v in data.items() if k != "sweep"}
-    combos = _combinations(spec)
-    points, problems, width = [], [], max(2, len(str(len(combos))))
+    combos = combinations(spec)
+    points, problems = [], []
     for number, values in enumerate(combos, start=1):
         try:
             assignments = [f"{path}={yaml_scalar(v)}" for path, v in values.items()]
@@ -225,7 +209,7 @@ def plan_sweep(data: dict, registry: Registry | None = None, source: str | None 
             continue
         except RunError as exc:  # the memory check: the point named, before any point runs
             raise RunError(f"{_point_named(number, values)}: {exc}") from None
-        folder = f"{number:0{width}d}-{_label(values)}"
+        folder = folder_name(number, len(combos), values)
         points.append(SweepPoint(number=number, values=values, folder_name=folder, scene=scene if scene.input_files() else scene.for_pressing()))
     problems = fold_point_problems(problems)
     if not problems and (pair := first_repeat([ensemble_settings(p.scene.resolved()) for p in points])) is not None:

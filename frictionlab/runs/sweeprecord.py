@@ -1,15 +1,19 @@
 """A sweep folder's sweep.json read back as untrusted input: every value checked
-(``runfolder``), and a row for every point its sweep section counts."""
+(``runfolder``), and a row for every point its sweep section plans, that point's own
+(``combinations`` and ``folder_name``, which the planner ``sweep.plan_sweep`` uses too)."""
 
 from __future__ import annotations
 
+import itertools
+import json
 import math
+import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from ..errors import RunFolderError, shown, shown_name
+from ..errors import RunFolderError, short_repr, shown, shown_name
 from ..preset.paths import MISSING, as_now, get_path
 from ..preset.schema import SweepSettings
 from .runfolder import Count, Finite, MemberName, Record, Seconds, check_schema_version, checked, read_json
@@ -72,13 +76,43 @@ def read_sweep_record(out_dir: Path) -> tuple[dict[str, Any], SweepRecord]:
     check_schema_version(data, path, SWEEP_SCHEMA_VERSION)
     record = checked(SweepRecord, data, path)
     try:  # a row per point: a list cut short would be read as a smaller sweep
-        points = SweepSettings.model_validate(data["sweep"]).count()
+        spec = SweepSettings.model_validate(data["sweep"])
     except ValidationError:
         raise RunFolderError(f"{shown_name(path)} is damaged (sweep: not a sweep section a preset can hold)") from None
-    if len(record.points) != points:
+    if len(record.points) != (points := spec.count()):
         raise RunFolderError(f"{shown_name(path)} is damaged (points: {len(record.points)} rows for a sweep of {points} points)")
     _check_swept_values(data["points"], list(record.sweep.parameters), path)
+    _check_rows_are_the_plans(data["points"], combinations(spec), path)
     return data, record
+
+
+def combinations(spec: SweepSettings) -> list[dict[str, Any]]:
+    """Each point's swept values, in the points' order: the product of the values (grid), or their pairs (zip)."""
+    paths = list(spec.parameters)
+    columns = [spec.parameters[p].points() for p in paths]
+    rows = itertools.product(*columns) if spec.mode == "grid" else zip(*columns, strict=True)
+    return [dict(zip(paths, row, strict=True)) for row in rows]
+
+
+def folder_name(number: int, count: int, values: dict[str, Any]) -> str:
+    """The name of the folder in points/ of point ``number`` (of ``count``) whose swept values are ``values``."""
+    parts = [f"{path.rsplit('.', 1)[-1]}-{f'{v:.6g}' if isinstance(v, float) else v}" for path, v in values.items()]
+    label = re.sub(r"[^A-Za-z0-9._+=-]+", "-", "_".join(parts))[:80].strip("-") or "point"
+    return f"{number:0{max(2, len(str(count)))}d}-{label}"
+
+
+def _check_rows_are_the_plans(rows: list[dict], planned: list[dict[str, Any]], path: Path) -> None:
+    """Each row is its point's of the plan (sweep.parameters): its number, its swept values, its folder. A row
+    edited, repeated or reordered was shown, drawn and counted as the point's, and a resume left its folder behind."""
+    same = lambda a, b: a == b and isinstance(a, bool) == isinstance(b, bool)  # noqa: E731  (True is 1 to Python)
+    for index, (row, values) in enumerate(zip(rows, planned, strict=True)):
+        number, name = index + 1, folder_name(index + 1, len(planned), values)
+        wanted = {"point": number, **json.loads(json.dumps(values, default=str)), "label": name, "folder": f"points/{name}"}
+        for field, value in wanted.items():
+            if (field in values or row.get(field) is not None) and not same(row.get(field), value):
+                raise RunFolderError(
+                    f"{shown_name(path)} is damaged: field 'points.{index}.{field}' is {short_repr(row.get(field))}, but "
+                    f"point {number} of its sweep.parameters has {short_repr(value)}: its rows are not those of its sweep")
 
 
 def as_it_ran(data):
