@@ -306,3 +306,31 @@ def test_a_failure_a_plugin_explains_is_its_message_alone(make_scene):
     diverging = type("Diverging", (base,), {"name": "diverging", "solve": solve})(scene.solver.params)
     result = compute_realization(Scene(preset=scene.preset, spectrum=scene.spectrum, solver=diverging, slope=scene.slope), 0)
     assert result.error == "SolveFailed: gave up: raise max_iterations"
+
+
+def test_an_error_of_a_megabyte_is_recorded_cut_and_its_chunk_resumed_as_it_is(make_scene, tmp_path):
+    """A solver failing with a SolveFailed of a million characters (its own words, recorded as
+    they are): the error was recorded whole, its chunk grew past what any chunk can hold, and
+    every resume refused it as damaged and computed it again. Recorded cut to
+    MAX_ERROR_CHARACTERS, saying how much was left out."""
+    import warnings
+
+    from frictionlab import SolveFailed
+    from frictionlab.compute.realization import MAX_ERROR_CHARACTERS
+    from frictionlab.runs.runner import run_to_folder
+
+    scene = make_scene({"realizations": 3, "spectrum": {"params": {"points": 64}}, "fit": {"bootstrap": 0}})
+
+    def solve(self, profile, loads, control, slopes):
+        raise SolveFailed("x" * 10**6)
+
+    solver = type("Loud", (type(scene.solver),), {"name": "loud", "solve": solve})(scene.solver.params)
+    scene = Scene(preset=scene.preset, spectrum=scene.spectrum, solver=solver, slope=scene.slope)
+    outcome, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, executor="serial"))
+    [error, *_] = [e for _, e in outcome.failures]
+    kept = MAX_ERROR_CHARACTERS - 40
+    assert error == f"SolveFailed: {'x' * (kept - 13)}... ({10**6 + 13 - kept} more characters)"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a chunk refused as damaged is said with a warning
+        again, _ = run_to_folder(scene, tmp_path / "run", RunOptions(workers=1, executor="serial", resume=True))
+    assert again.extra["retried"] == 3  # read back as failures, not as damage

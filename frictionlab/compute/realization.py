@@ -212,7 +212,19 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
     except (Exception, SystemExit, KeyboardInterrupt) as exc:  # carried, not raised: one bad line (a plugin's
         if raised_by_signal(exc):  # sys.exit(), its own KeyboardInterrupt) must not end the run; Ctrl-C must
             raise
-        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_failure(scene, exc))
+        return RealizationResult(index=index, seconds=time.perf_counter() - start, error=_capped(_failure(scene, exc)))
+
+
+MAX_ERROR_CHARACTERS = 4000  # of a realization's recorded error: a chunk holds it (runs.chunks bounds its size)
+
+
+def _capped(error: str) -> str:
+    """``error`` cut to MAX_ERROR_CHARACTERS, saying how much was left out: a plugin's message of a
+    megabyte made its chunk larger than any chunk can be, refused and computed again on each resume."""
+    if len(error) <= MAX_ERROR_CHARACTERS:
+        return error
+    cut = MAX_ERROR_CHARACTERS - 40
+    return f"{error[:cut]}... ({len(error) - cut} more characters)"
 
 
 def _failure(scene: Scene, exc: BaseException) -> str:

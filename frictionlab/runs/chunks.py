@@ -26,7 +26,9 @@ from .runfolder import MAX_WALL_SECONDS, open_member, read_member
 CHUNK_DIR = "chunks"
 MAX_CHUNK_DIRECTORY_BYTES = 256 * 1024  # a chunk's ~30 arrays list in under 8 kB of its zip's central directory
 MAX_CHUNK_BYTES = 16 * 1024**3  # a chunk holds curves of many realizations; larger is no run's
-ERROR_BYTES = 1 << 18  # of a failed realization's error, as text (4 bytes a character): a bound on an array's size
+# of a failed realization's error, as text (4 bytes a character): a bound on an array's size; an error is
+# recorded cut to compute.realization.MAX_ERROR_CHARACTERS (16,000 bytes), an older chunk's may be longer
+ERROR_BYTES = 1 << 18
 CHUNK_NAME = re.compile(r"(\d{8})-(\d{8})(?:\.(\d+))?\.npz")
 OK_ARRAYS = ("index", "seconds", "slope_rms_line", "points", "force_unit")
 FAILED_ARRAYS = ("failed_index", "failed_seconds", "failed_error")
