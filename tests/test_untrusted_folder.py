@@ -201,6 +201,15 @@ def test_predict_from_a_hostile_folder_exits_5(run_copy, case, capsys):
     assert codes == [ExitCode.RUN_FOLDER] and "summary.json" in err and SECRET not in err, err
 
 
+def test_a_curve_with_a_column_of_another_s_is_refused_by_its_header_not_its_first_cell(run_copy):
+    """An added column of text was told as 'line 2, column 10: not a finite number'."""
+    lines = (run_copy / "curve.csv").read_text().splitlines()
+    (run_copy / "curve.csv").write_text("\n".join([lines[0] + ",note", *(line + ",ok" for line in lines[1:])]) + "\n")
+    with pytest.raises(RunFolderError, match=r"curve.csv is damaged \(its header does not name the \d+ columns frictionlab "
+                                             r"writes: F, f, xi"):  # fmt: skip
+        frictionlab.load(run_copy)
+
+
 def test_a_future_schema_is_refused_naming_its_version(run_copy):
     edit_summary(run_copy, lambda d: set_in(d, "schema_version", 99))
     with pytest.raises(RunFolderError, match=r"newer frictionlab \(schema_version 99; this one reads up to 2\)"):

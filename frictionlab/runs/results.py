@@ -185,17 +185,20 @@ def read_curve(folder: Path, name: str = "curve.csv") -> dict[str, np.ndarray]:
 
 def read_curve_table(folder: Path, name: str = "curve.csv") -> tuple[list[str], dict[str, np.ndarray]]:
     """``read_curve``, with the header row as written."""
-    header, rows = read_number_table(folder, name)
+
+    def check_header(header: list[str]) -> None:
+        stripped = [column_name(h).rstrip("'") for h in header]  # F' on the half-plane
+        expected = [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]
+        optional = [CORRECTED_AREA, *GRADIENT_COLUMNS, SPOTS]  # in this order, for the solvers that give them
+        extra = stripped[len(expected) :]
+        if stripped[: len(expected)] != expected or extra != [c for c in optional if c in extra] or len(set(extra)) != len(extra):
+            raise RunFolderError(
+                f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
+                f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
+            )
+
+    header, rows = read_number_table(folder, name, check_header=check_header)
     names = [column_name(h) for h in header]
-    stripped = [n.rstrip("'") for n in names]  # F' on the half-plane
-    expected = [c for c in CURVE_COLUMNS if c in stripped or c not in ADDED_CURVE_COLUMNS]
-    optional = [CORRECTED_AREA, *GRADIENT_COLUMNS, SPOTS]  # in this order, for the solvers that give them
-    extra = stripped[len(expected) :]
-    if stripped[: len(expected)] != expected or extra != [c for c in optional if c in extra] or len(set(extra)) != len(extra):
-        raise RunFolderError(
-            f"{shown(Path(folder) / name)} is damaged (its header does not name the {len(CURVE_COLUMNS)} columns "
-            f"frictionlab writes: {', '.join(CURVE_COLUMNS)})"
-        )
     table = np.array(rows, dtype=float).reshape(len(rows), len(names))
     curve = {n: table[:, i].copy() for i, n in enumerate(names)}
     _check_counts(curve, Path(folder) / name)

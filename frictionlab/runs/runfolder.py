@@ -25,6 +25,7 @@ import math
 import os
 import re
 import stat
+from collections.abc import Callable
 from pathlib import Path, PurePosixPath
 from typing import Annotated
 
@@ -299,11 +300,10 @@ def _lower(message: str) -> str:
     return message[:1].lower() + message[1:]
 
 
-def read_number_table(folder: Path, name: str, limit: int = MAX_CSV_BYTES) -> tuple[list[str], list[list[float]]]:
-    """A CSV file of the run folder as written by frictionlab: a header, then rows of as
-    many cells, each a finite number or empty (read as NaN). RunFolderError naming the
-    file, the line and the column for binary content, a ragged row or a cell that is not
-    a number."""
+def read_number_table(folder: Path, name: str, limit: int = MAX_CSV_BYTES,
+                      check_header: Callable[[list[str]], None] | None = None) -> tuple[list[str], list[list[float]]]:  # fmt: skip
+    """A CSV of the run folder as frictionlab writes it: a header (``check_header`` raises for others' columns),
+    rows of as many cells, each a finite number or empty (NaN); else RunFolderError naming file, line, column."""
     path = Path(folder) / name
     try:
         raw = read_member(folder, name, limit)
@@ -323,6 +323,8 @@ def read_number_table(folder: Path, name: str, limit: int = MAX_CSV_BYTES) -> tu
     if not rows:
         raise RunFolderError(f"{shown(path)} is damaged (empty: no header)")
     header, table = rows[0], []
+    if check_header is not None:  # another's column said as such, not by its first cell that is no number
+        check_header(header)
     for line, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
             raise RunFolderError(
