@@ -54,16 +54,22 @@ GOOD = {**{k: v for k, v in SMALL_PRESET.items() if k not in SLOTS.values()},
         "spectrum": {"name": "good-spectrum"}, "solver": {"name": "good-solver"}, "slope": {"name": "good-slopes"}}
 
 
-@pytest.mark.parametrize("case", BROKEN)
-def test_a_broken_answer_is_refused_by_the_plugin_s_name(register_plugin, case):
-    """Taken as it came, each was an internal error (grid_shape as text, full contact as text),
-    a message about the preset's magnitudes (a negative h), or a scene built on it."""
-    base, methods, problem = BROKEN[case]
+def _broken_preset(register_plugin, case: str):
+    """(preset data, registry) of BROKEN[case]'s plugin beside good ones of the other kinds."""
+    base, methods, _ = BROKEN[case]
     broken = type("Broken", (base,), {"name": f"broken-{SLOTS[base]}", **methods})
     registry = register_plugin(broken)
     for cls in {GoodSpectrum, GoodSolver, GoodSlopes} - {base}:
         register_plugin(cls)
-    data = {**GOOD, SLOTS[base]: {"name": broken.name}}
+    return {**GOOD, SLOTS[base]: {"name": broken.name}}, registry
+
+
+@pytest.mark.parametrize("case", BROKEN)
+def test_a_broken_answer_is_refused_by_the_plugin_s_name(register_plugin, case):
+    """Taken as it came, each was an internal error (grid_shape as text, full contact as text),
+    a message about the preset's magnitudes (a negative h), or a scene built on it."""
+    base, _, problem = BROKEN[case]
+    data, registry = _broken_preset(register_plugin, case)
     with pytest.raises(PluginError) as excinfo:
         load_scales(build_scene(data, registry=registry))
     assert str(excinfo.value) == (f"{SLOTS[base]} 'broken-{SLOTS[base]}' (tests.test_plugin_answers.Broken from "
@@ -79,12 +85,8 @@ def test_a_run_refuses_before_it_starts_what_validate_refuses(register_plugin, t
     from frictionlab.api import run_scene, scene_record
     from frictionlab.options import RunOptions
 
-    base, methods, problem = BROKEN[case]
-    broken = type("Broken", (base,), {"name": f"broken-{SLOTS[base]}", **methods})
-    registry = register_plugin(broken)
-    for cls in {GoodSpectrum, GoodSolver, GoodSlopes} - {base}:
-        register_plugin(cls)
-    data = {**GOOD, SLOTS[base]: {"name": broken.name}}
+    problem = BROKEN[case][2]
+    data, registry = _broken_preset(register_plugin, case)
     with pytest.raises(PluginError) as validated:
         scene_record(build_scene(data, registry=registry))
     for out in (None, tmp_path / "run"):
