@@ -235,3 +235,20 @@ async def test_a_30_column_footer_shows_whole_keys_and_keeps_f1(folders, registr
     for line in lines:
         assert "f1 Keys" in line, lines
         assert line.endswith(("Keys", "Open", "Compare", "Save", "Run", "Edit", "Resume", "Cancel", "New")), lines
+
+
+@sync
+async def test_the_keys_panel_told_of_a_resize_after_its_lines_went_says_nothing(folders, registry):
+    """F1 and Esc typed together (or a terminal widened as the panel closes): the resize's update
+    of its first line came once Esc had removed its lines, and the app ended in a traceback
+    ("NoMatches: No nodes match '#keys-close'"), unsaved edits lost."""
+    from frictionlab.tui.widgets.keyspanel import KeysPanel
+
+    app = make_app(registry, preset="presets/tiny.yaml")
+    async with started(app) as pilot:
+        await press_settled(pilot, "f1")
+        panel = app.screen.query_one(KeysPanel)
+        await panel.remove_children()  # as Esc leaves it, the update still queued
+        panel.say_close()
+        await pilot.pause()
+        assert app.is_running

@@ -4,6 +4,7 @@ the whole screen, the footer under it, and nothing there said how to get out).""
 from __future__ import annotations
 
 from textual.app import ComposeResult
+from textual.css.query import NoMatches
 from textual.widgets import HelpPanel, KeyPanel, Static
 
 MORE = "Esc closes; F1: next page"
@@ -27,6 +28,11 @@ class KeysPanel(HelpPanel):
         self.call_after_refresh(self.say_close)
 
     def say_close(self) -> None:
-        """The first line as F1 would act now: another page, or close the panel after the last."""
-        keys = self.query_one(KeyPanel)
-        self.query_one("#keys-close", Static).update(MORE if keys.scroll_y < keys.max_scroll_y else LAST)
+        """The first line as F1 would act now: another page, or close the panel after the last.
+        Nothing once the panel is closing: a resize or a scroll heard after Esc removed its lines
+        (F1 and Esc typed together, a terminal widened as it closes) ended the app in a traceback."""
+        try:
+            keys, line = self.query_one(KeyPanel), self.query_one("#keys-close", Static)
+        except NoMatches:
+            return
+        line.update(MORE if keys.scroll_y < keys.max_scroll_y else LAST)
