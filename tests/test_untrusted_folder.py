@@ -720,3 +720,22 @@ def test_an_archive_that_unpacks_past_what_its_run_writes_is_refused_before_it_i
     digest = hashlib.sha256(bomb.read_bytes()).hexdigest()
     with pytest.raises(ChunkDamage, match="array 'xi' unpacks to"):
         read_chunk(run_copy, bomb.name, digest, scene)
+
+
+def test_the_curve_of_the_most_load_steps_a_preset_may_ask_is_read_back(tmp_path):
+    """A preset of 200,000 steps (the limit was 10^6) ran to completion, and its curve.csv of 26 MB
+    was refused by every reader (16 MiB at most): the TUI said the run had failed. The longest rows
+    any solver writes, at the most steps a preset may ask, fit what the readers take."""
+    from frictionlab.preset import build_scene
+    from frictionlab.preset.schema import MAX_STEPS
+    from frictionlab.runs.results import curve_headers
+    from frictionlab.runs.runfolder import MAX_CSV_BYTES
+
+    widest = build_scene(merge(SMALL_PRESET, {"spectrum": {"name": "power-law-2d", "params": {"points": 16}},
+                                              "solver": {"name": "bem-halfspace"}}))  # fmt: skip
+    header = curve_headers(widest)
+    assert len(header) == 14  # every column a solver adds
+    longest = ",".join([repr(-1.2345678901234567e-123)] * len(header)) + "\r\n"  # as csv writes a row
+    assert len((",".join(header) + "\r\n").encode()) + MAX_STEPS * len(longest) <= MAX_CSV_BYTES
+    with pytest.raises(frictionlab.errors.PresetError, match=f"loading.steps: .*{MAX_STEPS}"):
+        frictionlab.validate(merge(SMALL_PRESET, {"loading": {"steps": MAX_STEPS + 1}}))

@@ -32,7 +32,7 @@ class PluginChoice(_Strict):
     )
 
 
-MAX_STEPS = 1_000_000  # load steps of a preset
+MAX_STEPS = 40_000  # load steps of a preset: its curve.csv, 14 numbers a step at most, is read back (16 MiB at most)
 MAX_REALIZATIONS = 10_000_000  # realizations of a preset
 
 
