@@ -19,7 +19,7 @@ an ESC inside a paste made the rest of it keys: ``paste_keeps_escapes``.
 from __future__ import annotations
 
 from textual import events
-from textual.widgets import DataTable, Input
+from textual.widgets import DataTable, Input, Select, Switch
 
 # the actions that only move the focus, or open a dialog (which holds the keys after it until its field
 # has the focus): run at once, they change nothing else than Textual's own order would
@@ -47,7 +47,7 @@ async def answer_focus_key(app, key: events.Key) -> bool:
     """Run ``key``'s binding now if the binding it would reach (the first from the focused
     widget up) moves the focus, opens a dialog or moves a list's cursor; True if it did. A printable key is the
     focused text field's (n and d open dialogs from the Presets list)."""
-    if key.is_forwarded or (key.is_printable and isinstance(app.focused, Input)):
+    if key.is_forwarded or (key.is_printable and _in_a_field(app.focused)):
         return False
     for namespace, bindings in app.screen._modal_binding_chain:
         for binding in bindings.key_to_bindings.get(key.key, ()):
@@ -60,6 +60,15 @@ async def answer_focus_key(app, key: events.Key) -> bool:
                 return False  # another binding comes first: Textual's order
             return await app.run_action(binding.action, namespace)
     return False
+
+
+def _in_a_field(widget) -> bool:
+    """Whether ``widget`` is a field, whose printable keys are never the app's: a text field, or a
+    choice or switch of the preset form (q there quit at once, the footer saying "Leave field")."""
+    from .widgets.form import PresetForm
+
+    return isinstance(widget, Input) or (isinstance(widget, Select | Switch)
+                                         and any(isinstance(a, PresetForm) for a in widget.ancestors))  # fmt: skip
 
 
 def _xterm_parser():

@@ -176,3 +176,25 @@ async def test_switching_between_plugins_keeps_the_parameters_both_have_unless_t
     assert rolloff == TINY["spectrum"]["params"]  # each of power-law's is rolloff's too
     assert surface == {} and measured == {}
     assert back == TINY["spectrum"]["params"]  # its own, kept aside as it was left
+
+
+@sync
+async def test_a_letter_typed_in_a_choice_field_is_not_one_of_the_app_s_keys(folders, registry):
+    """Found by a newcomer: with a choice field focused (the footer saying "esc Leave field"), q quit
+    the app at once and the rest of what was typed went to the shell; 2 went to the Presets tab."""
+    from textual.widgets import Select
+
+    from .conftest import press_settled, status_text
+
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_first_preset(pilot)
+        field = app.query_one("#plugin--spectrum", Select)
+        field.focus()
+        await pilot.pause()
+        before = field.value
+        await press_settled(pilot, "q", "2")
+        assert app.is_running and app.focused is field and field.value == before
+        assert "'2' types nothing in this field: Enter or Space changes it, Esc leaves it" in status_text(app)
+        await press_settled(pilot, "space")  # its own key still opens its list
+        assert field.expanded

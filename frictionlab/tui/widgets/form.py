@@ -460,9 +460,16 @@ class PresetForm(VerticalScroll):
     def on_focus(self, event) -> None:
         self.post_message(self.FieldFocused(None))
 
+    def on_key(self, event) -> None:
+        """A letter typed in a choice or a switch (which take none) is not the app's: q quit, 2 went to Presets."""
+        focused = self.screen.focused
+        if event.is_printable and focused is not self and event.key not in focused._bindings.key_to_bindings:
+            event.stop()
+            self.app.say(f"{event.character!r} types nothing in this field: Enter or Space changes it, Esc leaves it "
+                         "(then q, ? and the app's keys act)", "warning")  # fmt: skip
+
     def on_resize(self, event) -> None:
-        """The help and problems under the form grow as a field is focused or typed into: the
-        form, shorter, keeps that field in sight (it hid the last row, the one just focused)."""
+        """The help under the form grows as a field is focused: the form keeps that field in sight."""
         focused = self.screen.focused
         if focused is not None and focused is not self and self in focused.ancestors:
             focused.scroll_visible(animate=False)
