@@ -81,7 +81,7 @@ def test_a_surface_too_large_for_its_line_to_be_made_is_refused_before_it_is_mad
     assert provisional.equivalent_line is None and provisional.spectrum.params.points == 2048
     fits = memory.estimate(provisional, workers=1, executor="serial", points=side**2).total
     too_many = memory.estimate(provisional, workers=1, executor="serial", points=(side + 1) ** 2).total
-    assert fits <= 256 * MiB < too_many
+    assert fits <= 0.98 * 256 * MiB < too_many  # 2 % to spare
     monkeypatch.setattr(memory, "available_memory", lambda: (fits, "a test limit"))
     scene = build_scene(mdr_surface(side), registry=registry, before_reading=check)  # the side offered is made
     assert scene.equivalent_line.grid_shape() == (memory.line_points(side**2),)

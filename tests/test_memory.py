@@ -52,10 +52,12 @@ FULL_CONTACT = {"loading": {"start": 1.0, "stop": 1e10, "steps": 16, "spacing": 
     [
         (300_000, FULL_CONTACT),
         (2_000_000, {**FULL_CONTACT, "output": {"plot": False}}),
+        # a length whose prime factor passes its root: numpy's FFT takes 128 B a point more (Bluestein)
+        (2 * 1_000_003, {**FULL_CONTACT, "output": {"plot": False}}),
         # the large grid of the docs' memory example (1e7 points, about 1 GiB at full contact)
         pytest.param(10_000_000, {**FULL_CONTACT, "output": {"plot": False}}, marks=pytest.mark.slow),
     ],
-    ids=["3e5-with-plot", "2e6", "1e7"],
+    ids=["3e5-with-plot", "2e6", "2e6-prime-factor", "1e7"],
 )
 @pytest.mark.long  # a process of its own, seconds end to end: pytest -m long
 def test_the_estimate_bounds_the_measured_peak_of_a_real_run(registry, tmp_path, points, changes):
@@ -121,11 +123,12 @@ def test_a_solver_declaring_more_bytes_per_point_raises_the_estimate(registry):
 
 
 def assert_offer_is_the_most_that_fits(scene, message: str, points=lambda offered: offered) -> None:
-    """The points a refusal offers fit in the 1 GiB limit on one worker, and one more would not."""
+    """The points a refusal offers fit in the 1 GiB limit on one worker with 2 % to spare (an offer
+    at the very edge was refused when run), and one more would not."""
     offered = offered_points(message)
     fits = memory.estimate(scene, workers=1, executor="processes", points=points(offered)).total
     too_many = memory.estimate(scene, workers=1, executor="processes", points=points(offered + 1)).total
-    assert fits <= GiB < too_many
+    assert fits <= 0.98 * GiB < too_many
 
 
 def test_a_surface_too_large_for_the_half_space_is_refused_with_the_side_that_fits(registry, monkeypatch):
@@ -234,9 +237,11 @@ def test_worker_check_takes_the_smallest_limit_and_skips_workers_without_one(reg
     assert "Dask worker tcp://small:2 has a memory limit of 0.20 GiB (the smallest of 2 workers with a limit;" in message
     assert message.startswith(f"one realization of 1,000,000 points would need about {need / GiB:.2f} GiB in a Dask worker")
     offered = offered_points(message)
-    room = int(200 * MiB * 0.95)
-    assert memory.DASK_WORKER_PROCESS + offered * memory.BYTES_PER_POINT < room
-    assert memory.DASK_WORKER_PROCESS + (offered + 1) * memory.BYTES_PER_POINT + 16 * memory.BYTES_PER_STEP > room
+    room = 0.98 * int(200 * MiB * 0.95)  # 2 % to spare
+    larger = min(m for m in range(offered + 1, 2 * offered) if memory.smooth_at_most(m) == m)  # the next FFT length
+    assert memory.smooth_at_most(offered) == offered  # a line's length its FFT takes without more memory
+    assert memory.DASK_WORKER_PROCESS + offered * memory.BYTES_PER_POINT + 16 * memory.BYTES_PER_STEP <= room
+    assert memory.DASK_WORKER_PROCESS + larger * memory.BYTES_PER_POINT + 16 * memory.BYTES_PER_STEP > room
     # when even the worker process alone does not fit, only a larger limit helps
     with pytest.raises(RunError, match=r"It would fit with workers with a memory limit of at least 0\.\d\d GiB\."):
         memory.check_worker_limits(scene, {"tcp://tiny:1": 100 * MiB}, usable=0.95)
@@ -514,3 +519,20 @@ def test_a_refusal_in_python_names_the_keyword_that_skips_it():
         frictionlab.run(SMALL_PRESET, spectrum__params__points=2**40, workers=1, progress=False)
     assert "(memory_check=False skips this estimate, an upper bound.)" in str(caught.value)
     assert frictionlab.run(SMALL_PRESET, workers=1, progress=False, memory_check=False).status == "completed"
+
+
+def test_the_largest_7_smooth_length_is_found_as_brute_force_finds_it():
+    """The advice offers a length numpy's FFT takes without Bluestein's extra memory: 2,814,498
+    (2 x 3^2 x 156,361) was offered under 600 MB and every realization ran out of memory."""
+    def smooth(n):
+        for p in (2, 3, 5, 7):
+            while n % p == 0:
+                n //= p
+        return n == 1
+
+    for n in [*range(1, 3000), 2_814_498, 15_614_498, 2**31 - 1]:
+        best = memory.smooth_at_most(n)
+        assert smooth(best) and best <= n, n
+        assert n > 5000 or not any(smooth(m) for m in range(best + 1, n + 1)), n  # the largest (brute force)
+    for n, extra in ((2_814_498, True), (2 * 1_000_003, True), (2**21, False), (2_799_360, False), (1_654_784, False)):
+        assert (memory.fft_extra_bytes(n) > 0) is extra, n  # 1,654,784 = 2^14 x 101: numpy's own passes

@@ -55,6 +55,9 @@ KEPT_COPIES = 3  # per-realization rows: the results, the stacked arrays, the fi
 # spectra's worst, a non-periodic map read, reflected across its edges and transformed
 # (72 B measured), plus a third.
 EQUIVALENT_LINE_BYTES_PER_POINT = 96
+# numpy's FFT of a line whose length has a prime factor above its square root (Bluestein's algorithm,
+# on a padded length of about twice it): 128 B a point more, measured (2,814,498 = 2 x 3^2 x 156,361)
+BLUESTEIN_BYTES_PER_POINT = 160
 
 
 @dataclass(frozen=True)
@@ -172,6 +175,8 @@ def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = 
     steps = int(scene.loads.size)
     kept = scene.preset.realizations * (steps * 8 * kept_arrays(scene) * KEPT_COPIES + 512)
     per_realization = points * bytes_per_point(scene) + steps * BYTES_PER_STEP
+    if points == grid and scene.spectrum.dimension == 1:  # a line made by one FFT of its length
+        per_realization += fft_extra_bytes(points)
     main = PROCESS_BASE + kept + making  # what the surface keeps of its making stays in this process
     if executor == "serial":
         per_worker, total, workers = 0, main + per_realization, 1
@@ -180,6 +185,32 @@ def estimate(scene: Scene, *, workers: int, executor: str, points: int | None = 
         # the main process measures one realization before the workers start
         total = main + max(per_realization, workers * per_worker)
     return MemoryEstimate(points, workers, executor, per_realization, per_worker, main, total, grid, making)
+
+
+def fft_extra_bytes(points: int) -> int:
+    """What numpy's FFT of ``points`` takes beyond the line pipeline's figure: BLUESTEIN_BYTES_PER_POINT
+    a point where a prime factor exceeds the square root (it may choose Bluestein's algorithm), else 0."""
+    rest, factor = points, 2
+    while factor * factor <= rest:  # the prime factors below the root divided out
+        while rest % factor == 0:
+            rest //= factor
+        factor += 1 if factor == 2 else 2
+    return BLUESTEIN_BYTES_PER_POINT * points if rest > 1 and rest * rest > points else 0
+
+
+def smooth_at_most(n: int) -> int:
+    """The largest 2^a 3^b 5^c 7^d <= ``n`` (>= 1): a length numpy's FFT takes in place, fast."""
+    best, power7 = 1, 1
+    while power7 <= n:
+        power5 = power7
+        while power5 <= n:
+            power3 = power5
+            while power3 <= n:
+                best = max(best, power3 << (n // power3).bit_length() - 1)  # the largest 2^a after it
+                power3 *= 3
+            power5 *= 5
+        power7 *= 7
+    return best
 
 
 def available_memory() -> tuple[int, str]:
@@ -339,16 +370,23 @@ def _in_dask_worker(guess: MemoryEstimate) -> int:
 
 def _most_points(scene: Scene, executor: str, available: int, need=_total) -> int:
     """The largest points per side (``SpectrumGenerator.points_param``) whose one-worker
-    estimate fits: ``need(estimate) <= available`` (by default the run's whole peak)."""
-    dimension = scene.spectrum.dimension
+    estimate fits: ``need(estimate) <= available`` (by default the run's whole peak), 2 % to
+    spare, as ``_higher_limit`` leaves (a count offered at the edge was refused when run, the
+    process holding a MiB more at its check). A line's is a length its FFT takes without more
+    memory (``smooth_at_most``: 2,814,498, with a prime factor of 156,361, was offered and ran out)."""
+    available, dimension = int(0.98 * available), scene.spectrum.dimension
+    side = smooth_at_most if dimension == 1 else (lambda n: n)  # monotone: the search below holds
+
+    def fits(n: int) -> bool:
+        return need(estimate(scene, workers=1, executor=executor, points=side(n) ** dimension)) <= available
+
     low, high = 1, 2
-    while need(estimate(scene, workers=1, executor=executor, points=high**dimension)) <= available:
+    while fits(high):
         low, high = high, 2 * high
     while high - low > 1:
         middle = (low + high) // 2
-        fits = need(estimate(scene, workers=1, executor=executor, points=middle**dimension)) <= available
-        low, high = (middle, high) if fits else (low, middle)
-    return low
+        low, high = (middle, high) if fits(middle) else (low, middle)
+    return side(low)
 
 
 def check_fits(scene: Scene, *, workers: int, executor: str, remote_workers: bool = False) -> MemoryEstimate:
