@@ -132,6 +132,7 @@ class PresetSaving:
         question = (
             f"This preset has {count} problem{'s' if count != 1 else ''}; frictionlab run will refuse it:\n"
             + "\n".join(problems[:6])
+            + (f"\n(and {count - 6} more, listed under the form)" if count > 6 else "")  # 7 said as 6, nothing more
             + "\n\nSave it anyway?"
         )
         self.push_screen(

@@ -386,3 +386,22 @@ async def test_going_into_a_field_and_out_restyles_the_form_alone_and_leaves_eve
             kept = styles(app)
             app.stylesheet.update(app.screen)  # the whole screen restyled, as Textual would have
             assert styles(app) == kept, key
+
+
+@sync
+async def test_save_with_more_problems_than_it_lists_says_how_many_more(folders, registry):
+    """'This preset has 7 problems' was followed by 6 of them and nothing more."""
+    from frictionlab.tui.screens import ConfirmScreen
+
+    data = merge(TINY, {"realizations": 0, "seed": -1, **{f"extra{i}": i for i in range(6)}})
+    (folders / "presets" / "tiny.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    app = make_app(registry)
+    async with app.run_test(size=SIZE) as pilot:
+        form = await open_first_preset(pilot)
+        count = len(form.problems)
+        await type_into(pilot, "field--description", "x")
+        await press_settled(pilot, "ctrl+s")
+        assert isinstance(app.screen, ConfirmScreen)
+        said = " ".join(app.screen.question.split())
+    assert count > 6 and f"This preset has {count} problems" in said
+    assert f"(and {count - 6} more, listed under the form)" in said
