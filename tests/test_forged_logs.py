@@ -184,14 +184,16 @@ def test_a_reporter_fed_numbers_out_of_bounds_returns(tmp_path):
 # ------------------------------------------------------------------ the size of a line
 
 
-def test_a_realization_of_200000_load_steps_is_written_in_a_line_a_follower_reads(tmp_path):
+def test_a_realization_of_the_most_load_steps_is_written_in_a_line_a_follower_reads(tmp_path):
     from frictionlab.compute.engine import RunInfo
+    from frictionlab.preset.schema import MAX_STEPS
 
-    scene = build_scene(merge(SMALL_PRESET, {"loading": {"steps": 200_000}}))
+    scene = build_scene(merge(SMALL_PRESET, {"loading": {"steps": MAX_STEPS, "control": "indentation", "start": 0.01,
+                                                         "stop": 0.1}}))  # its forces vary: three curves a line
     steps = scene.loads.size
     rng = np.random.default_rng(3)
     result = RealizationResult(index=0, seconds=1.0, xi=rng.random(steps), contact_count=rng.integers(0, 900, steps) * 1.0,
-                               points=1024, force_unit=2.0, slope_rms_line=0.5)  # fmt: skip
+                               force=rng.random(steps), points=1024, force_unit=2.0, slope_rms_line=0.5)  # fmt: skip
     log = ProgressLog(tmp_path)
     log.run_started(RunInfo(scene=scene, total=1, workers=1))
     log.realization_done(result, 1, 1)
