@@ -487,3 +487,19 @@ def test_resume_refuses_a_file_now_read_otherwise_and_resumes_an_older_folder(tm
     (out / "run.json").write_text(json.dumps(manifest))
     assert main(["resume", str(out), "--quiet"]) == ExitCode.OK
     assert json.loads((out / "run.json").read_text())["read"] == read  # recorded from now on
+
+
+def test_a_run_that_draws_no_figure_says_the_one_in_its_folder_is_an_earlier_run_s(tmp_path, capsys):
+    """`run B --out DIR_of_A --force --no-plot` left A's plot.png beside B's numbers without a word."""
+    preset = write(tmp_path / "p.yaml", merge(SMALL_PRESET, {"output": {"plot": True}}))
+    other = write(tmp_path / "q.yaml", merge(SMALL_PRESET, {"output": {"plot": True}, "seed": 8}))
+    out = tmp_path / "run"
+    assert main(["run", str(preset), "--out", str(out), "--quiet"]) == ExitCode.OK
+    drawn = (out / "plot.png").read_bytes()
+    capsys.readouterr()
+    with pytest.warns(UserWarning, match=r"plot.png is an earlier run's figure, not this one's \(none was drawn\): "
+                                         r"`frictionlab plot .* --force` draws this run's"):  # fmt: skip
+        assert main(["run", str(other), "--out", str(out), "--quiet", "--force", "--no-plot"]) == ExitCode.OK
+    assert (out / "plot.png").read_bytes() == drawn  # the user's folder: nothing deleted
+    assert main(["run", str(other), "--out", str(out), "--quiet", "--force"]) == ExitCode.OK  # drawn: nothing said
+    assert "earlier run" not in capsys.readouterr().err

@@ -4,6 +4,7 @@ same files, hold the same lock and can all be resumed."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -11,7 +12,7 @@ from typing import TYPE_CHECKING
 from ..compute import engine
 from ..compute.ensemble import RunOutcome
 from ..compute.executors import dask_memory_limits
-from ..errors import RunError, RunFolderError, process_limit, short_repr, shown_name, warn_user
+from ..errors import RunError, RunFolderError, command_word, process_limit, short_repr, shown_name, warn_user
 from ..preset.loads import check_loads
 from ..compute.memory import check_fits, check_worker_limits
 from ..options import RunOptions
@@ -159,6 +160,9 @@ def run_to_folder(
                 on_results(outcome, files)
             if plot:
                 files = add_plot(out_dir, scene, outcome, files, drawing)
+            if "plot" not in files and os.path.lexists(plot_path(out_dir)):  # an earlier run's, read as this one's
+                warn_user(f"{shown_name(plot_path(out_dir))} is an earlier run's figure, not this one's (none was drawn): "
+                          f"`frictionlab plot {command_word(out_dir)} --force` draws this run's")  # fmt: skip
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
             run_dir.finish(scene, outcome.status, seconds=recorded)
     return outcome, files
