@@ -4,7 +4,6 @@ same files, hold the same lock and can all be resumed."""
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -160,8 +159,9 @@ def run_to_folder(
                 on_results(outcome, files)
             if plot:
                 files = add_plot(out_dir, scene, outcome, files, drawing)
-            if "plot" not in files and os.path.lexists(plot_path(out_dir)):  # an earlier run's, read as this one's
-                warn_user(f"{shown_name(plot_path(out_dir))} is an earlier run's figure, not this one's (none was drawn): "
+            drawn_before = plot_path(out_dir)
+            if "plot" not in files and drawn_before.is_file() and not drawn_before.is_symlink():  # an earlier run's
+                warn_user(f"{shown_name(drawn_before)} is an earlier run's figure, not this one's (none was drawn): "
                           f"`frictionlab plot {command_word(out_dir)} --force` draws this run's")  # fmt: skip
         finally:  # the numbers are written: the folder records how the run ended, even if the figure failed
             run_dir.finish(scene, outcome.status, seconds=recorded)
