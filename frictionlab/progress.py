@@ -208,7 +208,7 @@ class ProgressReporter:
         )  # fmt: skip
         self._write(
             f"{preset.name}: {run.total} realization{'s' if run.total != 1 else ''} of {run.scene.pressed}{restored}, "
-            f"{preset.loading.steps} {preset.loading.control} steps, {run.workers} worker(s){crowded}"
+            f"{preset.loading.steps} {preset.loading.control} steps, {'up to ' * run.sized}{run.workers} worker(s){crowded}"
         )
         self._say_input(run.scene.spectrum.input_summary())
 

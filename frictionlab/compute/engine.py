@@ -40,6 +40,9 @@ class RunInfo:
     resumed: int = 0  # realizations restored from the run directory, not recomputed
     cores: int = 0  # the cores this process may use where the run started; 0: not known (a run replayed from its log)
     retried: int = 0  # realizations that had failed before the resume and run again
+    # the default pool, which the first realization's time may still replace by this process
+    # (``executors.sized_executor``): its workers are the most the run takes
+    sized: bool = False
     # the restored results themselves (by index): a listener's running sums start from them
     restored: tuple[RealizationResult, ...] = field(default=(), repr=False)
 
@@ -99,7 +102,7 @@ def run(
     todo = [i for i in range(total) if i not in accumulator.results]
     info = RunInfo(
         scene=scene, total=total, workers=pool.workers, executor=pool.name, resumed=resumed, retried=retried,
-        cores=default_workers(),
+        cores=default_workers(), sized=options.executor is None and pool.name == "processes",
         restored=tuple(accumulator.results[i] for i in sorted(accumulator.results)),
     )  # fmt: skip
     from ..plugin.registry import default_registry

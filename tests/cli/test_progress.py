@@ -115,6 +115,19 @@ def test_more_workers_than_cores_are_said_to_take_turns(make_scene, monkeypatch)
     assert stream.getvalue().splitlines()[0].endswith(", 1 worker(s)")
 
 
+def test_a_pool_the_run_may_still_go_without_is_said_as_the_most_workers_it_takes(make_scene):
+    """`run --workers 8` began "8 worker(s) on 2 core(s)" and ended "(1 worker)": the default pool
+    gives way to this process where the work would not repay its start (the first realization
+    tells). The first line says "up to"; an executor asked for by name runs as asked."""
+    outcomes = []
+    for executor, said in ((None, ", up to 2 worker(s)"), ("processes", ", 2 worker(s)")):
+        stream = FakeTerminal()
+        outcomes.append(engine.run(make_scene({"realizations": 4}), RunOptions(workers=2, executor=executor),
+                                   listeners=[ProgressReporter(stream, after=0)]))  # fmt: skip
+        assert stream.getvalue().splitlines()[0].split(" on ")[0].endswith(said), stream.getvalue()
+    assert outcomes[0].workers == 1  # four small realizations: not worth a pool
+
+
 def test_a_run_replayed_from_its_log_does_not_guess_the_cores_it_ran_on(make_scene):
     """A run followed from its progress log (``frictionlab follow``, maybe copied from another
     machine) says its workers, never this machine's cores beside them."""
