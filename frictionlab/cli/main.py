@@ -32,7 +32,7 @@ import warnings
 
 from .. import __version__
 from ..errors import (ExitCode, FrictionlabError, FrontEnd, advising, escape_unencodable_output, limit_advice,
-                      out_of_memory_loading, output_failed, short_repr, shown, shown_name, too_long_path)  # fmt: skip
+                      out_of_memory_loading, output_failed, shell_word, short_repr, shown, shown_name, too_long_path)  # fmt: skip
 from ..compute.heap import (keep_freed_memory, one_blas_thread_unless_chosen, refuse_blas_without_room,
                             spare_address_space_under_a_limit)  # fmt: skip
 from ..compute.signals import RaiseOnSignals, interrupted_exit_code, interrupted_word, received
@@ -95,7 +95,10 @@ class _Parser(argparse.ArgumentParser):
             from ..errors import did_you_mean
 
             choices = [c.strip("'") for c in choice.group(2).split(", ")]  # quoted before Python 3.12.8, bare after
-            message += did_you_mean(choice.group(1), choices, 0.7)
+            close = did_you_mean(choice.group(1), choices, 0.7)
+            if not close and choices == ["copy"] and self.prog.endswith(" presets"):  # `presets quickstart f.yaml`
+                close = f"; to copy a preset out: {self.prog} copy {shell_word(choice.group(1))} [DEST]"
+            message += close
         if message.startswith("the following arguments are required"):
             # argparse says so before it looks at words it does not know: `run --hlep` is a
             # misspelt option more often than a forgotten preset

@@ -103,3 +103,13 @@ def test_a_word_the_parser_refuses_is_quoted_escaped_never_as_terminal_control(c
     assert "unrecognized arguments: " in captured.err
     assert "\x1b" not in captured.err + captured.out and "\x07" not in captured.err + captured.out
     assert "\\x1b" in captured.err
+
+
+def test_presets_without_its_action_says_how_to_copy_the_preset_named(capsys):
+    """`frictionlab presets quickstart f.yaml` said "invalid choice: 'quickstart' (choose from
+    'copy')", no word on what was meant."""
+    err = usage_error(capsys, ["presets", "quickstart", "f.yaml"])
+    assert err.rstrip().endswith("invalid choice: 'quickstart' (choose from 'copy'); to copy a preset out: "
+                                 "frictionlab presets copy quickstart [DEST]")  # fmt: skip
+    err = usage_error(capsys, ["presets", "cpy", "quickstart"])
+    assert err.rstrip().endswith("did you mean 'copy'?")  # a misspelt action: that alone
