@@ -117,7 +117,7 @@ def test_validate_prints_what_an_input_file_says_escaped(tmp_path, capsys, monke
 def test_progress_lines_print_a_realization_error_and_a_point_error_escaped():
     class Run:
         scene = build_scene(SMALL_PRESET)
-        total, resumed, retried, workers, executor, cores = 2, 0, 0, 1, "serial", 0
+        total, resumed, retried, workers, executor, cores, sized = 2, 0, 0, 1, "serial", 0, False
 
     stream = io.StringIO()
     reporter = ProgressReporter(stream=stream, interactive=False, after=0.0)

@@ -170,7 +170,7 @@ def test_follow_of_a_log_with_numbers_out_of_bounds_ends_and_spins_no_loop(tmp_p
 def test_a_reporter_fed_numbers_out_of_bounds_returns(tmp_path):
     class Run:
         scene = build_scene(SMALL_PRESET)
-        total, resumed, retried, workers, executor, cores = -12, 0, 0, 1, "serial", 0
+        total, resumed, retried, workers, executor, cores, sized = -12, 0, 0, 1, "serial", 0, False
 
     reporter = ProgressReporter(stream=open(os.devnull, "w"), interactive=False, after=0.0)
     reporter.run_started(Run())
