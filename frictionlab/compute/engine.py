@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import pluggy
 
 from .ensemble import Accumulator, RunOutcome
+from .heap import hand_back_freed_memory
 from ..errors import RunError
 from .executors import make_executor, plan_chunks, sized_executor
 from ..plugin.hookspecs import PROJECT_NAME
@@ -88,6 +89,7 @@ def run(
     says ``cancelled`` or ``interrupted`` (``outcome.extra["signal"]``: which).
     """
     stop_if_interrupted()  # a command of several runs whose Ctrl-C was dropped (in a finalizer) starts no more
+    hand_back_freed_memory()  # what the checks before the run freed: not kept beside its first realization
     total = scene.preset.realizations
     workers = options.workers_for(total)
     pool = make_executor(options, workers)
