@@ -21,10 +21,11 @@ from ..errors.interrupts import raised_by_signal
 from ..plugin.registry import fault_place, plugin_fault
 from ..plugin.outputs import (
     LEAVE_INPUTS, RandomWatch, curve_problem, height_of, largest_magnitude, order_problem, profile_problem, read_only,
-    refuse, reported_problem, schedule_problem, seed_problem, slopes_problem,
+    refuse, reported_problem, schedule_problem, slopes_problem,
 )  # fmt: skip
 from ..plugin import SolveCancelled, SolveFailed, defined_rms, force_unit, listening_to_iterations, listening_to_loads
 from ..preset import Scene
+from ..preset.loads import rng_problem
 from ..preset.seeds import realization_rng
 
 
@@ -161,11 +162,7 @@ def _compute(scene: Scene, index: int, watch: _SolveWatch) -> RealizationResult:
         profile = scene.generator.generate(rng)
         refuse(scene.generator, randomness.problem("generate()") or profile_problem(scene.generator, profile))
         if index == 0 and not scene.probed:  # a generator ignoring its rng: checked once a run, here if not before it
-            def again(i: int):  # realization i's profile, from a fresh generator of its seed
-                return scene.generator.generate(realization_rng(scene.preset.seed, i))
-
-            others = scene.preset.realizations > 1
-            refuse(scene.generator, seed_problem(scene.generator, profile, again, others) or randomness.problem("generate()"))
+            refuse(scene.generator, rng_problem(scene, profile) or randomness.problem("generate()"))
         profile = replace(profile, heights=read_only(profile.heights))  # what the estimator and solver are lent
         check_cancel()  # a large surface takes a second to generate
         slopes = scene.slope.slopes(profile.heights, profile.spacing, profile.periodic)

@@ -81,14 +81,20 @@ def _generated(scene) -> Profile:
     profile = scene.generator.generate(realization_rng(scene.preset.seed, 0))
     refuse(scene.generator, watch.problem("generate()") or profile_problem(scene.generator, profile)
            or shape_problem(scene.generator, profile))  # fmt: skip
+    # a generator ignoring its rng (every realization one line) is refused here, before the run
+    refuse(scene.generator, rng_problem(scene, profile) or watch.problem("generate()"))
+    return profile
+
+
+def rng_problem(scene, profile: Profile) -> str | None:
+    """``seed_problem`` of ``scene``'s generator, whose realization 0 is ``profile``: made again
+    from fresh generators of realization 0's seed and (where the run has more) realization 1's."""
+    from .seeds import realization_rng
 
     def again(index: int) -> Profile:  # realization index's profile, from a fresh generator of its seed
         return scene.generator.generate(realization_rng(scene.preset.seed, index))
 
-    # a generator ignoring its rng (every realization one line) is refused here, before the run
-    refuse(scene.generator, seed_problem(scene.generator, profile, again, scene.preset.realizations > 1)
-           or watch.problem("generate()"))  # fmt: skip
-    return profile
+    return seed_problem(scene.generator, profile, again, scene.preset.realizations > 1)
 
 
 def load_scales(scene, profile: Profile | None = None) -> LoadScales:
